@@ -1,0 +1,40 @@
+"""granplate: ordered granular media (Hertz, friction, rotations) against a
+finite-element plate, driven by a shock.
+
+Data flow: Scenario -> Model (arrays) -> compiled time loop -> xarray Dataset -> figures.
+
+    >>> import granplate as gp
+    >>> s = gp.preset("ptfe-r05")
+    >>> s = gp.with_changes(s, {"load.q0": 2e4})
+    >>> ds = gp.simulate(s, t_end=2e-4)
+    >>> gp.summary(ds)["ep_max_fraction"]
+"""
+from __future__ import annotations
+
+__version__ = "0.1.0"
+
+from .errors import GranplateError, ScenarioError, SimulationError  # noqa: E402
+from .materials import LIBRARY, Material  # noqa: E402
+from .scenario import (  # noqa: E402
+    Contact, Granule, Layout, Load, PairCoefficients, Plate, Scenario, Solver, TimeSettings, Wall,
+)
+
+
+def __getattr__(name: str):
+    # heavy modules (numba, scikit-fem, xarray) load on first use
+    if name in ("simulate",):
+        from .simulate import simulate
+        return simulate
+    if name in ("build_model",):
+        from .model import build_model
+        return build_model
+    if name in ("preset", "preset_names"):
+        from . import presets
+        return getattr(presets, name)
+    if name in ("load_scenario", "loads", "dumps", "load", "dump", "with_changes"):
+        from . import scenario_io
+        return getattr(scenario_io, name)
+    if name in ("write", "read", "summary"):
+        from . import results
+        return getattr(results, name)
+    raise AttributeError(f"module 'granplate' has no attribute {name!r}")

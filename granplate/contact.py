@@ -1,0 +1,110 @@
+"""Contact laws of the paper, eqs. (2)-(6), one small pure function each.
+
+Every function is compiled by numba and used as-is by the time loop (kernels.py); tests
+call the very same functions. Units: metres, newtons, seconds, pascals.
+
+Normal force (eq. 2): |N| = A delta^(3/2) + gamma d(delta)/dt with A = 4/3 E* sqrt(R*)
+(eq. 3) and gamma = alpha_n sqrt(m* A) delta^(1/4). A contact never pulls: when the
+damping term would make the force tensile (a fast separation), the magnitude is clipped
+at zero (MODEL.md section 3); `clip=False` gives the paper's raw eq. (2) instead.
+
+Friction (eq. 5): |f| = mu |N| tanh(k_s v_t), opposed to the slip rate v_t (eq. 6); on a
+sphere it also gives a torque -|f| R (both spheres spin against the slip).
+"""
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+
+@njit(cache=True)
+def hertz_coefficient(e_star: float, r_star: float) -> float:
+    """A = 4/3 E* sqrt(R*) [N/m^(3/2)], paper eq. (3)."""
+    return 4.0 / 3.0 * e_star * math.sqrt(r_star)
+
+
+@njit(cache=True)
+def damping_coefficient(alpha_n: float, m_star: float, a: float) -> float:
+    """c such that gamma = c delta^(1/4): c = alpha_n sqrt(m* A), paper eq. (3).
+
+    m* = 0 (rigid layer, MODEL.md) gives c = 0: no viscous damping.
+    """
+    return alpha_n * math.sqrt(m_star * a)
+
+
+@njit(cache=True)
+def pair_overlap(xi: float, yi: float, ri: float, xj: float, yj: float, rj: float):
+    """Overlap of spheres i, j and the unit normal from i to j.
+
+    Returns (delta, nx, ny, distance): delta = R_i + R_j - |s_j - s_i| (negative = gap).
+    """
+    dx = xj - xi
+    dy = yj - yi
+    dist = math.sqrt(dx * dx + dy * dy)
+    return ri + rj - dist, dx / dist, dy / dist, dist
+
+
+@njit(cache=True)
+def hertz_elastic(delta: float, a: float) -> float:
+    """Elastic part of the normal force A delta^(3/2) [N]; zero when not in contact."""
+    if delta <= 0.0:
+        return 0.0
+    return a * delta * math.sqrt(delta)
+
+
+@njit(cache=True)
+def normal_force(delta: float, delta_dot: float, a: float, c: float, clip: bool):
+    """Magnitude of the normal force |N| of eq. (2) and its elastic part [N].
+
+    |N| = A delta^(3/2) + c delta^(1/4) d(delta)/dt for delta > 0, else 0. With clip,
+    |N| >= 0 (no tensile force). Returns (N, elastic).
+    """
+    if delta <= 0.0:
+        return 0.0, 0.0
+    sq = math.sqrt(delta)
+    elastic = a * delta * sq
+    n = elastic + c * math.sqrt(sq) * delta_dot
+    if clip and n < 0.0:
+        n = 0.0
+    return n, elastic
+
+
+@njit(cache=True)
+def friction_magnitude(n_abs: float, v_t: float, mu: float, k_s: float) -> float:
+    """Signed friction mu |N| tanh(k_s v_t) [N], eq. (5); the force on i is minus this along t."""
+    return mu * n_abs * math.tanh(k_s * v_t)
+
+
+@njit(cache=True)
+def contact_energy(delta: float, a: float) -> float:
+    """Elastic energy stored in a Hertz contact, 2/5 A delta^(5/2) [J] (eq. 9)."""
+    if delta <= 0.0:
+        return 0.0
+    return 0.4 * a * delta * delta * math.sqrt(delta)
+
+
+@njit(cache=True)
+def viscous_power(n: float, elastic: float, delta_dot: float) -> float:
+    """Power dissipated by the damping part of the applied normal force [W].
+
+    (|N| - A delta^(3/2)) d(delta)/dt: gamma (d delta/dt)^2 when not clipped, and exact
+    (still >= 0) when the force is clipped at zero during a fast separation.
+    """
+    return (n - elastic) * delta_dot
+
+
+@njit(cache=True)
+def friction_power(f: float, v_t: float) -> float:
+    """Power dissipated by friction, f v_t = mu |N| tanh(k_s v_t) v_t >= 0 [W]."""
+    return f * v_t
+
+
+@njit(cache=True)
+def local_map_modulus(mu: float, k_s: float, n_abs: float, dt: float, c_t: float, v_t: float) -> float:
+    """|lambda| of the frictional local map at a plate contact, paper eq. (8).
+
+    c_t: the tangential driving DOF's diagonal entry of (M + dt^2 K / 4)^-1 [1/kg].
+    """
+    ch = math.cosh(k_s * v_t)
+    return 0.5 * mu * k_s * n_abs * dt * c_t / (ch * ch)

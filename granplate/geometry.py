@@ -1,0 +1,122 @@
+"""The paper's three-column packing and scenario resolution (MODEL.md section 1).
+
+`paper_layout` turns a `Layout` into the 14 granules (1..5, intruders 6..9, A..E), the
+left, bottom and top walls and the x position of the plate's left edge. `resolve` turns
+any scenario into an explicit one: the layout expanded, the plate placed, every granule
+and wall labelled.
+
+Geometry (origin at the bottom-left corner of the granular domain, x to the right):
+
+    d  = sqrt((R1 + R2)^2 - R1^2)       horizontal offset between neighbouring columns
+    column 1 (1..5):   x = R1,          y = 9R1, 7R1, 5R1, 3R1, R1
+    column 2 (6..9):   x = R1 + d,      y = 8R1, 6R1, 4R1, 2R1       (radius R2)
+    column 3 (A..E):   x = R1 + 2d,     y = 9R1, 7R1, 5R1, 3R1, R1
+    plate left edge:   xp = R1 + 2d + R1
+    walls:             x = 0 (left), y = 0 (bottom), y = 10 R1 (top)
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+
+from .errors import ScenarioError
+from .scenario import Granule, Layout, Scenario, Wall
+
+#: Labels of the paper's granules, in the order `paper_layout` returns them.
+PAPER_LABELS: tuple[str, ...] = ("1", "2", "3", "4", "5", "6", "7", "8", "9",
+                                 "A", "B", "C", "D", "E")
+#: Labels of the three walls `paper_layout` returns, in order.
+PAPER_WALLS: tuple[str, ...] = ("left", "bottom", "top")
+
+
+def column_offset(R1: float, R2: float) -> float:
+    """d = sqrt((R1 + R2)^2 - R1^2) [m]: the x distance between neighbouring columns.
+
+    With it, an intruder at (R1 + d, 2k R1) touches the heavy granules at (R1, (2k +- 1) R1)
+    and at (R1 + 2d, (2k +- 1) R1) exactly. R2 = R1 gives sqrt(3) R1 (hexagonal packing),
+    R2 = 0.5 R1 gives 1.1180 R1.
+    """
+    return math.sqrt((R1 + R2) ** 2 - R1**2)
+
+
+def plate_edge_x(layout: Layout) -> float:
+    """xp = R1 + 2d + R1 [m]: the plate's left edge, touching column 3 (A..E)."""
+    R1 = layout.R1
+    d = column_offset(R1, layout.R2_ratio * R1)
+    return (R1 + 2.0 * d) + R1
+
+
+def paper_layout(layout: Layout) -> tuple[tuple[Granule, ...], tuple[Wall, ...], float]:
+    """The paper's packing: (granules 1..9, A..E), (left, bottom, top walls), plate x0.
+
+    Heavy granules (1..5, A..E) take `layout.heavy_material` and radius R1, intruders
+    (6..9) `layout.intruder_material` and radius R2 = R2_ratio R1; the walls take
+    `layout.wall_material`. No range checks here: `validate` refuses a bad layout first.
+    """
+    R1 = layout.R1
+    R2 = layout.R2_ratio * R1
+    d = column_offset(R1, R2)
+    heavy_y = (9.0 * R1, 7.0 * R1, 5.0 * R1, 3.0 * R1, R1)
+    intruder_y = (8.0 * R1, 6.0 * R1, 4.0 * R1, 2.0 * R1)
+    x1, x2, x3 = R1, R1 + d, R1 + 2.0 * d
+    hm, im = layout.heavy_material, layout.intruder_material
+
+    granules: list[Granule] = []
+    granules += [Granule(x1, y, R1, hm, label=lab) for lab, y in zip("12345", heavy_y)]
+    granules += [Granule(x2, y, R2, im, label=lab) for lab, y in zip("6789", intruder_y)]
+    granules += [Granule(x3, y, R1, hm, label=lab) for lab, y in zip("ABCDE", heavy_y)]
+
+    wm = layout.wall_material
+    walls = (
+        Wall((-1.0, 0.0), 0.0, label="left", material=wm),
+        Wall((0.0, -1.0), 0.0, label="bottom", material=wm),
+        Wall((0.0, 1.0), 10.0 * R1, label="top", material=wm),
+    )
+    xp = (x3 + R1)
+    return tuple(granules), walls, xp
+
+
+def default_granule_label(index: int) -> str:
+    """The label `resolve` gives an unlabelled granule at 0-based position `index`."""
+    return f"g{index}"
+
+
+def default_wall_label(index: int) -> str:
+    """The label `resolve` gives an unlabelled wall at 0-based position `index`."""
+    return f"w{index}"
+
+
+def resolve(scenario: Scenario) -> Scenario:
+    """An equivalent, explicit scenario: layout expanded, plate placed, labels filled.
+
+    - With a `layout`: granules and walls come from `paper_layout`, `layout` becomes None,
+      and a plate with `x0 = None` is placed at the layout's xp. A layout together with
+      explicit granules or walls is a ScenarioError (give one or the other).
+    - Without a layout, a plate needs an explicit `x0` (ScenarioError otherwise).
+    - Unlabelled granules get the label "g<i>", unlabelled walls "w<i>" (i: 0-based index).
+
+    Idempotent: resolving a resolved scenario returns an equal scenario. Range checks are
+    `validate`'s job; this function only builds.
+    """
+    granules, walls, plate = scenario.granules, scenario.walls, scenario.plate
+    if scenario.layout is not None:
+        if granules:
+            raise ScenarioError("granules", f"{len(granules)} granules",
+                                "give either [layout] or [[granules]], not both")
+        if walls:
+            raise ScenarioError("walls", f"{len(walls)} walls",
+                                "give either [layout] or [[walls]], not both "
+                                "(the layout generates the left, bottom and top walls)")
+        granules, walls, xp = paper_layout(scenario.layout)
+        if plate is not None and plate.x0 is None:
+            plate = dataclasses.replace(plate, x0=xp)
+    if plate is not None and plate.x0 is None:
+        raise ScenarioError("plate.x0", None,
+                            "must be given when the scenario has no [layout] "
+                            "(the plate's lower-left corner x [m])")
+    granules = tuple(g if g.label else dataclasses.replace(g, label=default_granule_label(i))
+                     for i, g in enumerate(granules))
+    walls = tuple(w if w.label else dataclasses.replace(w, label=default_wall_label(i))
+                  for i, w in enumerate(walls))
+    return dataclasses.replace(scenario, layout=None, granules=granules, walls=walls,
+                               plate=plate)

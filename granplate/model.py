@@ -1,0 +1,206 @@
+"""Scenario -> model arrays: contact topology, coefficients (eqs. 3-4), load resultants
+and the plate's modal model, built once per run (the plate part is cached on disk).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import kernels
+from .contact import damping_coefficient, hertz_coefficient
+from .errors import ScenarioError
+from .geometry import resolve
+from .load import shock_resultants
+from .materials import effective_modulus, sphere_inertia, sphere_mass
+from .scenario import Scenario
+from .validate import validate
+
+
+@dataclass(frozen=True)
+class Model:
+    """Everything the time loop needs, plus the names that label its arrays.
+
+    scenario: the resolved scenario (layout expanded); labels: granule labels;
+    pairs: (np, 2) granule index pairs; wall_contacts: (nw, 2) [granule, wall];
+    plate_contacts: (nk,) granule index per plate contact; plate: the PlateModel or None.
+    """
+
+    scenario: Scenario
+    labels: tuple[str, ...]
+    granular: kernels.Granular
+    plate_arrays: kernels.PlateArrays
+    config: kernels.Config
+    plate: object | None
+    initial_state: np.ndarray
+    pairs: np.ndarray
+    wall_contacts: np.ndarray
+    plate_contacts: np.ndarray
+
+    @property
+    def n_granules(self) -> int:
+        return len(self.labels)
+
+    @property
+    def contact_labels(self) -> tuple[str, ...]:
+        """Labels of the plate contacts (the granule touching the plate)."""
+        return tuple(self.labels[i] for i in self.plate_contacts)
+
+
+def _granule_arrays(s: Scenario):
+    x = np.array([g.x for g in s.granules], float)
+    y = np.array([g.y for g in s.granules], float)
+    r = np.array([g.radius for g in s.granules], float)
+    rho = np.array([s.material(g.material).rho for g in s.granules], float)
+    return x, y, r, rho
+
+
+def find_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: float) -> np.ndarray:
+    """Potential granule-granule contacts: pairs whose initial surface gap is at most
+    gap_ratio * min(R_i, R_j) (the topology is fixed, MODEL.md section 1)."""
+    out = []
+    n = len(x)
+    for i in range(n):
+        for j in range(i + 1, n):
+            gap = math.hypot(x[j] - x[i], y[j] - y[i]) - r[i] - r[j]
+            if gap <= gap_ratio * min(r[i], r[j]):
+                out.append((i, j))
+    return np.array(out, np.int64).reshape(-1, 2)
+
+
+def find_wall_contacts(s: Scenario, x, y, r) -> np.ndarray:
+    """(granule, wall) pairs whose initial gap is at most neighbour_gap * R."""
+    out = []
+    for w, wall in enumerate(s.walls):
+        nx, ny = wall.normal
+        for i in range(len(x)):
+            gap = wall.offset - (x[i] * nx + y[i] * ny) - r[i]
+            if gap <= s.contact.neighbour_gap * r[i]:
+                out.append((i, w))
+    return np.array(out, np.int64).reshape(-1, 2)
+
+
+def find_plate_contacts(s: Scenario, x, y, r) -> np.ndarray:
+    """Granules facing the plate's left edge (within neighbour_gap * R of it)."""
+    if s.plate is None or len(x) == 0:
+        return np.zeros(0, np.int64)
+    p = s.plate
+    out = []
+    for i in range(len(x)):
+        gap = p.x0 - (x[i] + r[i])
+        if gap <= s.contact.neighbour_gap * r[i] and p.y0 < y[i] < p.y0 + p.height:
+            out.append(i)
+    return np.array(out, np.int64)
+
+
+def loaded_granules(s: Scenario, x, r) -> np.ndarray:
+    """Mask of the granules the line load pushes: load.granules, or column 1 (the
+    granules whose left surface is leftmost)."""
+    n = len(x)
+    if s.load.kind == "none" or s.load.target != "granules" or n == 0:
+        return np.zeros(n, bool)
+    if s.load.granules:
+        labels = [g.label for g in s.granules]
+        return np.array([lab in s.load.granules for lab in labels])
+    left = x - r
+    return np.abs(left - left.min()) <= 1e-9 * r.max()
+
+
+def build_model(scenario: Scenario) -> Model:
+    """Validate, resolve and turn a scenario into the loop's arrays."""
+    validate(scenario)
+    s = resolve(scenario)
+    x, y, r, rho = _granule_arrays(s)
+    mats = [s.material(g.material) for g in s.granules]
+    mass = np.array([sphere_mass(ri, rhoi) for ri, rhoi in zip(r, rho)])
+    inertia = np.array([sphere_inertia(ri, rhoi) for ri, rhoi in zip(r, rho)])
+    ng = len(x)
+
+    pairs = find_pairs(x, y, r, s.contact.neighbour_gap)
+    pair_coef = np.zeros((len(pairs), 4))
+    for p, (i, j) in enumerate(pairs):
+        e_star = effective_modulus(mats[i], mats[j])
+        r_star = r[i] * r[j] / (r[i] + r[j])
+        m_star = mass[i] * mass[j] / (mass[i] + mass[j])
+        alpha, mu, ks = s.contact.for_pair(mats[i].name, mats[j].name)
+        a = hertz_coefficient(e_star, r_star)
+        pair_coef[p] = (a, damping_coefficient(alpha, m_star, a), mu, ks)
+
+    wc = find_wall_contacts(s, x, y, r)
+    wall_geo = np.zeros((len(wc), 3))
+    wall_coef = np.zeros((len(wc), 4))
+    for k, (i, w) in enumerate(wc):
+        wall = s.walls[w]
+        nrm = np.asarray(wall.normal, float)
+        nrm = nrm / np.linalg.norm(nrm)
+        wall_geo[k] = (nrm[0], nrm[1], wall.offset)
+        alpha, mu, ks = s.contact.for_pair(mats[i].name, wall.material)
+        a = hertz_coefficient(effective_modulus(mats[i], None), r[i])
+        wall_coef[k] = (a, damping_coefficient(alpha, mass[i], a), mu, ks)
+
+    pc = find_plate_contacts(s, x, y, r)
+    pc_coef = np.zeros((len(pc), 4))
+    pc_x = np.zeros(len(pc))
+    for k, i in enumerate(pc):
+        alpha, mu, ks = s.contact.for_pair(mats[i].name, s.plate.material)
+        a = hertz_coefficient(effective_modulus(mats[i], None), r[i])
+        # rigid layer: E_k, R_k -> infinity and m_k -> 0, so m* = 0 (no viscous damping)
+        pc_coef[k] = (a, damping_coefficient(alpha, 0.0, a), mu, ks)
+        pc_x[k] = s.plate.x0
+
+    loaded = loaded_granules(s, x, r)
+    fres, tres = shock_resultants(y, r, loaded, s.load.y0, s.load.length)
+
+    plate_model = None
+    nk = len(pc)
+    if s.plate is not None:
+        from .plate import build_plate
+
+        edge = None
+        if s.load.kind == "line" and s.load.target == "plate":
+            edge = (s.load.y0, s.load.length)
+        plate_model = build_plate(
+            s.plate, s.plate.x0, [float(y[i]) for i in pc], edge_load=edge,
+            material=s.material(s.plate.material),
+        )
+        omega2 = np.asarray(plate_model.omega, float) ** 2
+        phi_d = np.ascontiguousarray(plate_model.phi_drive, float)
+        load_modal = np.ascontiguousarray(plate_model.edge_load_modal, float)
+    else:
+        omega2 = np.zeros(0)
+        phi_d = np.zeros((0, 0))
+        load_modal = np.zeros(0)
+    if phi_d.shape != (2 * nk, len(omega2)):
+        phi_d = phi_d.reshape(2 * nk, len(omega2))
+
+    granular = kernels.Granular(
+        mass=mass, inertia=inertia, radius=r, pair_ij=pairs, pair_coef=pair_coef,
+        wall_i=np.ascontiguousarray(wc[:, 0]), wall_geo=wall_geo, wall_coef=wall_coef,
+        pc_i=pc, pc_x=pc_x, pc_coef=pc_coef, shock_force=fres, shock_torque=tres,
+    )
+    plate_arrays = kernels.PlateArrays(omega2=omega2, phi_d=phi_d, load_modal=load_modal)
+    t = s.time
+    sol = s.solver
+    q0 = s.load.q0 if s.load.kind == "line" else 0.0
+    config = kernels.Config(
+        q0=float(q0), duration=float(s.load.duration), clip=bool(s.contact.clip_tensile),
+        lambda_target=float(sol.lambda_target), rtol=float(sol.iteration_rtol),
+        atol=float(sol.iteration_atol), max_iter=int(sol.max_iterations),
+        energy_tol=float(sol.energy_tol), dt_max=float(t.dt_max), dt_min=float(t.dt_min),
+        out_dt=float(t.output_interval), t_end=float(t.t_end),
+        load_on_plate=bool(s.load.kind == "line" and s.load.target == "plate"),
+    )
+    y0 = np.zeros((ng, 6))
+    y0[:, 0] = x
+    y0[:, 1] = y
+    y0[:, 3] = [g.vx for g in s.granules]
+    y0[:, 4] = [g.vy for g in s.granules]
+    y0[:, 5] = [g.omega for g in s.granules]
+    if nk and s.plate is None:  # pragma: no cover - guarded by validation
+        raise ScenarioError("plate", None, "plate contacts need a plate")
+    return Model(
+        scenario=s, labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
+        granular=granular, plate_arrays=plate_arrays, config=config, plate=plate_model,
+        initial_state=y0, pairs=pairs, wall_contacts=wc, plate_contacts=pc,
+    )

@@ -1,0 +1,69 @@
+"""The paper's six cases as ready scenarios (MODEL.md section 8).
+
+    preset("steel-r1")  ->  Scenario
+    preset_names()      ->  ["bare-plate", "steel-r1", "steel-r05", "ptfe-r05",
+                             "ptfe-r05-moderate", "ptfe-r05-weak"]
+
+All use the default plate (4 x 40 Q8 elements, top and bottom clamped), contact
+coefficients (mu 0.099, k_s 1000 s/m, alpha_n 6.313e-3, steel-PTFE 6.313e-2), time
+settings (2 ms) and solver. `granplate preset NAME` prints a preset as TOML.
+"""
+from __future__ import annotations
+
+from typing import Callable
+
+from .errors import ScenarioError
+from .scenario import Layout, Load, Plate, Scenario
+
+#: One line per preset, naming the paper figures it reproduces.
+DESCRIPTIONS: dict[str, str] = {
+    "bare-plate": "Bare plate, no granules, q0 = 50 kN/m on its left edge (paper Fig. 2a, 3)",
+    "steel-r1": "Steel packing, R2 = R1, q0 = 50 kN/m on column 1 (paper Fig. 2b, 3, 4a, A.1)",
+    "steel-r05": "Steel packing, R2 = 0.5 R1, q0 = 50 kN/m (paper Fig. 4b, 6a, 7a)",
+    "ptfe-r05": "PTFE intruders, R2 = 0.5 R1, q0 = 50 kN/m (paper Fig. 5, 6b, 7b, 8c)",
+    "ptfe-r05-moderate": "PTFE intruders, R2 = 0.5 R1, moderate shock q0 = 10 kN/m "
+                         "(paper Fig. 8b)",
+    "ptfe-r05-weak": "PTFE intruders, R2 = 0.5 R1, weak shock q0 = 2 kN/m (paper Fig. 8a)",
+}
+
+
+def _bare_plate() -> Scenario:
+    return Scenario(name="bare-plate", description=DESCRIPTIONS["bare-plate"],
+                    plate=Plate(x0=0.0), load=Load(target="plate", q0=50_000.0))
+
+
+def _packing(name: str, ratio: float, intruder: str, q0: float) -> Callable[[], Scenario]:
+    def make() -> Scenario:
+        return Scenario(name=name, description=DESCRIPTIONS[name],
+                        layout=Layout(R2_ratio=ratio, intruder_material=intruder),
+                        plate=Plate(), load=Load(target="granules", q0=q0))
+    make.__doc__ = DESCRIPTIONS[name]
+    return make
+
+
+_bare_plate.__doc__ = DESCRIPTIONS["bare-plate"]
+
+#: name -> function building that preset's Scenario.
+PRESETS: dict[str, Callable[[], Scenario]] = {
+    "bare-plate": _bare_plate,
+    "steel-r1": _packing("steel-r1", 1.0, "steel", 50_000.0),
+    "steel-r05": _packing("steel-r05", 0.5, "steel", 50_000.0),
+    "ptfe-r05": _packing("ptfe-r05", 0.5, "ptfe", 50_000.0),
+    "ptfe-r05-moderate": _packing("ptfe-r05-moderate", 0.5, "ptfe", 10_000.0),
+    "ptfe-r05-weak": _packing("ptfe-r05-weak", 0.5, "ptfe", 2_000.0),
+}
+
+
+def preset_names() -> list[str]:
+    """The preset names, in the order of MODEL.md section 8."""
+    return list(PRESETS)
+
+
+def preset(name: str) -> Scenario:
+    """The preset called `name` (ScenarioError listing the names if there is none)."""
+    try:
+        make = PRESETS[name]
+    except (KeyError, TypeError):
+        raise ScenarioError("preset", name, "unknown preset; presets are: "
+                            + ", ".join(PRESETS)) from None
+    return make()

@@ -1,0 +1,196 @@
+"""Output buffers -> an xarray Dataset with units and descriptions; netCDF I/O.
+
+Every name is documented in docs/output.md. The scenario (as TOML), the package version
+and the solver's figures travel in the attributes, so any figure can be traced back.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from . import __version__
+from . import kernels as K
+
+#: name -> (units, description) of every data variable
+VARIABLES: dict[str, tuple[str, str]] = {
+    "x": ("m", "granule centre, horizontal"),
+    "y": ("m", "granule centre, vertical"),
+    "theta": ("rad", "granule rotation (anticlockwise)"),
+    "vx": ("m/s", "granule velocity, horizontal"),
+    "vy": ("m/s", "granule velocity, vertical"),
+    "omega": ("rad/s", "granule angular velocity (anticlockwise)"),
+    "E_shock": ("J", "work of the applied shock, int sum(F_i vx_i + tau_i omega_i) dt or int F.dx/dt (bare plate)"),
+    "E_granular": ("J", "granular energy E_g: kinetic (translation, rotation) + 2/5 A delta^5/2 of every granule, wall and plate contact (eq. 9)"),
+    "E_plate": ("J", "plate energy E_p = 1/2 v^T M v + 1/2 x^T K x (eq. 9)"),
+    "D_viscous": ("J", "energy dissipated by the damping part of the normal forces (eq. 10)"),
+    "D_friction": ("J", "energy dissipated by friction (eq. 10)"),
+    "E_contact": ("J", "elastic energy stored in all contacts (part of E_granular)"),
+    "KE_horizontal": ("J", "granular kinetic energy, horizontal translation"),
+    "KE_vertical": ("J", "granular kinetic energy, vertical translation"),
+    "KE_rotational": ("J", "granular kinetic energy, rotation"),
+    "energy_residual": ("1", "(E_p + E_g + D - E_shock - E_initial) / max over past times of (E_shock + E_initial), eq. 11"),
+    "energy_residual_max": ("1", "largest |energy_residual| over the steps since the previous output"),
+    "max_von_mises": ("Pa", "maximum over the plate's quadrature points of the plane-stress von Mises stress (eq. 12)"),
+    "max_eps_yy": ("1", "maximum over the plate's quadrature points of |eps_yy|"),
+    "plate_vx_symmetry": ("m/s", "plate horizontal velocity along the symmetry line y = y0 + height/2"),
+    "plate_ux": ("m", "plate nodal displacement, horizontal (at field_time)"),
+    "plate_uy": ("m", "plate nodal displacement, vertical (at field_time)"),
+    "plate_von_mises": ("Pa", "largest von Mises stress in each element (at field_time)"),
+    "contact_normal_force": ("N", "normal force on the plate at each rigid-layer contact (+x)"),
+    "contact_tangential_force": ("N", "friction force on the plate at each contact (+y)"),
+    "contact_slip_rate": ("m/s", "tangential slip rate v_t at each plate contact (eq. 6)"),
+    "local_map_modulus": ("1", "largest |lambda| of the frictional local map (eq. 8) since the previous output"),
+    "iterations": ("1", "largest number of interface iterations a contact's force needed since the previous output"),
+    "dt_min": ("s", "smallest time step since the previous output"),
+    "dt_max": ("s", "largest time step since the previous output"),
+    "n_steps": ("1", "time steps taken so far"),
+    "n_iterations": ("1", "interface iterations taken so far"),
+}
+
+
+def _var(name: str, dims, data) -> xr.DataArray:
+    units, desc = VARIABLES[name]
+    return xr.DataArray(data, dims=dims, attrs={"units": units, "long_name": desc})
+
+
+def _chunked(fn, q: np.ndarray, size: int = 256) -> np.ndarray:
+    """Apply fn to q in chunks along the first axis (bounded memory)."""
+    if len(q) == 0:
+        return fn(q)
+    return np.concatenate([fn(q[i:i + size]) for i in range(0, len(q), size)])
+
+
+def plate_fields(model, q: np.ndarray, qd: np.ndarray, times: np.ndarray) -> dict[str, xr.DataArray]:
+    """Plate outputs computed from the modal coordinates after the run."""
+    plate = model.plate
+    s = model.scenario
+    out: dict[str, xr.DataArray] = {}
+
+    def max_vm(qc):
+        return plate.von_mises(qc).reshape(len(qc), -1).max(axis=1)
+
+    def max_eyy(qc):
+        return np.abs(plate.strains(qc)[1]).reshape(len(qc), -1).max(axis=1)
+
+    out["max_von_mises"] = _var("max_von_mises", ("time",), _chunked(max_vm, q))
+    out["max_eps_yy"] = _var("max_eps_yy", ("time",), _chunked(max_eyy, q))
+    sym = np.asarray(plate.symmetry_nodes)
+    vx = _chunked(lambda qc: plate.full_displacement(qc)[:, sym, 0], qd)
+    out["plate_vx_symmetry"] = _var("plate_vx_symmetry", ("time", "x_symmetry"), vx)
+    stride = max(1, int(round(s.time.field_interval / s.time.output_interval)))
+    idx = np.arange(0, len(times), stride)
+    if len(times) and idx[-1] != len(times) - 1 and np.isclose(times[-1], s.time.t_end):
+        idx = np.append(idx, len(times) - 1)
+    u = plate.full_displacement(q[idx])
+    out["plate_ux"] = _var("plate_ux", ("field_time", "node"), u[..., 0])
+    out["plate_uy"] = _var("plate_uy", ("field_time", "node"), u[..., 1])
+    vm = plate.von_mises(q[idx]).max(axis=-1)
+    out["plate_von_mises"] = _var("plate_von_mises", ("field_time", "element"), vm)
+    out["_field_time"] = times[idx]
+    return out
+
+
+def to_dataset(model, out: K.Output, n: int, info: dict) -> xr.Dataset:
+    """Build the result Dataset from the first n output rows."""
+    from .scenario_io import dumps
+
+    s = model.scenario
+    t = out.t[:n].copy()
+    y = out.y[:n]
+    e = out.energy[:n]
+    data: dict[str, xr.DataArray] = {}
+    for c, name in enumerate(("x", "y", "theta", "vx", "vy", "omega")):
+        data[name] = _var(name, ("time", "granule"), y[:, :, c].copy())
+    for col, name in (
+        (K.E_SHOCK, "E_shock"), (K.E_GRAN, "E_granular"), (K.E_PLATE, "E_plate"),
+        (K.D_VISC, "D_viscous"), (K.D_FRIC, "D_friction"), (K.E_POTG, "E_contact"),
+        (K.KE_X, "KE_horizontal"), (K.KE_Y, "KE_vertical"), (K.KE_ROT, "KE_rotational"),
+        (K.RESID, "energy_residual"), (K.RESID_MAX, "energy_residual_max"),
+    ):
+        data[name] = _var(name, ("time",), e[:, col].copy())
+    nk = len(model.plate_contacts)
+    data["contact_normal_force"] = _var("contact_normal_force", ("time", "contact"), out.force[:n, :, 0].copy())
+    data["contact_tangential_force"] = _var("contact_tangential_force", ("time", "contact"), out.force[:n, :, 1].copy())
+    data["contact_slip_rate"] = _var("contact_slip_rate", ("time", "contact"), out.slip[:n].copy())
+    data["local_map_modulus"] = _var("local_map_modulus", ("time", "contact"), out.lam[:n].copy())
+    data["iterations"] = _var("iterations", ("time", "contact"), out.iters[:n].copy())
+    data["dt_min"] = _var("dt_min", ("time",), out.stats[:n, K.S_DT_MIN].copy())
+    data["dt_max"] = _var("dt_max", ("time",), out.stats[:n, K.S_DT_MAX].copy())
+    data["n_steps"] = _var("n_steps", ("time",), out.stats[:n, K.S_STEPS].astype(np.int64))
+    data["n_iterations"] = _var("n_iterations", ("time",), out.stats[:n, K.S_ITERS].astype(np.int64))
+    coords = {
+        "time": ("time", t, {"units": "s", "long_name": "time"}),
+        "granule": ("granule", np.array(model.labels, dtype=str), {"long_name": "granule label (paper numbering)"}),
+        "contact": ("contact", np.array(model.contact_labels, dtype=str), {"long_name": "granule at each plate contact"}),
+        "radius": ("granule", model.granular.radius.copy(), {"units": "m", "long_name": "granule radius"}),
+        "mass": ("granule", model.granular.mass.copy(), {"units": "kg", "long_name": "granule mass"}),
+        "material": ("granule", np.array([g.material for g in s.granules], dtype=str), {"long_name": "granule material"}),
+    }
+    if model.plate is not None:
+        pf = plate_fields(model, out.q[:n], out.qd[:n], t)
+        ft = pf.pop("_field_time")
+        data.update(pf)
+        plate = model.plate
+        coords["field_time"] = ("field_time", ft, {"units": "s", "long_name": "time of the plate field snapshots"})
+        coords["node_x"] = ("node", plate.node_xy[:, 0].copy(), {"units": "m", "long_name": "plate node x"})
+        coords["node_y"] = ("node", plate.node_xy[:, 1].copy(), {"units": "m", "long_name": "plate node y"})
+        coords["x_symmetry"] = ("x_symmetry", plate.node_xy[np.asarray(plate.symmetry_nodes), 0].copy(), {"units": "m", "long_name": "x along the plate's symmetry line"})
+        data["element_nodes"] = xr.DataArray(np.asarray(plate.elements, np.int64), dims=("element", "element_node"), attrs={"long_name": "plate element connectivity (VTK quadratic quad order)"})
+        data["contact_y"] = xr.DataArray(np.asarray(plate.contact_y, float), dims=("contact",), attrs={"units": "m", "long_name": "y of each plate contact"})
+    ds = xr.Dataset(data, coords=coords)
+    if nk == 0:
+        ds = ds.drop_dims("contact", errors="ignore")
+    ds.attrs.update({
+        "title": f"granplate result: {s.name}",
+        "scenario_name": s.name,
+        "scenario_toml": dumps(s),
+        "granplate_version": __version__,
+        "scheme": s.solver.scheme,
+        "conventions": "SI units; see docs/output.md",
+        "run_info": json.dumps(info),
+        "E_initial": float(out.energy[0, K.E_GRAN] + out.energy[0, K.E_PLATE]) if n else 0.0,
+    })
+    for k, v in info.items():
+        ds.attrs[k] = v
+    return ds
+
+
+def write(ds: xr.Dataset, path: str | Path) -> Path:
+    """Write a result to netCDF (compressed) and return the path."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    enc = {v: {"zlib": True, "complevel": 4} for v in ds.data_vars if ds[v].dtype.kind == "f"}
+    ds.to_netcdf(path, encoding=enc)
+    return path
+
+
+def read(path: str | Path) -> xr.Dataset:
+    """Open a result written by `write` (loaded into memory)."""
+    with xr.open_dataset(path) as ds:
+        return ds.load()
+
+
+def summary(ds: xr.Dataset) -> dict:
+    """The headline figures of a run (the CLI's table and --summary JSON)."""
+    e0 = float(ds.attrs.get("E_initial", 0.0))
+    e_in = float(ds.E_shock[-1]) if ds.sizes["time"] else 0.0
+    ref = e_in + e0 if e_in + e0 > 0 else 1.0
+    has_plate = "E_plate" in ds and "max_von_mises" in ds
+    info = json.loads(ds.attrs.get("run_info", "{}"))
+    return {
+        "scenario": ds.attrs.get("scenario_name", ""),
+        "t_end": float(ds.time[-1]),
+        "e_shock": e_in,
+        "ep_max_fraction": float(ds.E_plate.max()) / ref,
+        "ep_final_fraction": float(ds.E_plate[-1]) / ref,
+        "eg_final_fraction": float(ds.E_granular[-1]) / ref,
+        "dissipated_fraction": float(ds.D_viscous[-1] + ds.D_friction[-1]) / ref,
+        "max_von_mises": float(ds.max_von_mises.max()) if has_plate else 0.0,
+        "max_eps_yy": float(ds.max_eps_yy.max()) if has_plate else 0.0,
+        "energy_residual_max": float(np.max(np.abs(ds.energy_residual_max))),
+        "n_steps": int(info.get("n_steps", 0)),
+        "wall_time_s": float(info.get("wall_time_s", 0.0)),
+    }

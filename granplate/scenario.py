@@ -1,0 +1,215 @@
+"""Scenario: everything that defines a run, as frozen dataclasses (SI units throughout).
+
+A scenario is written as a TOML file (see docs/scenario.md) or built in Python. The
+paper's three-column packing is generated from a `Layout`; any other planar assembly is
+given granule by granule. Validation (`validate`) refuses bad input before anything runs,
+with a `ScenarioError` naming the field, the value and what is allowed.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from .materials import LIBRARY, Material
+
+
+@dataclass(frozen=True)
+class Granule:
+    """One sphere: centre (x, y) [m], radius [m], material name, initial velocities.
+
+    vx, vy [m/s]; omega [rad/s] (positive anticlockwise); label is the paper's name
+    ("1".."9", "A".."E") or any unique string.
+    """
+
+    x: float
+    y: float
+    radius: float
+    material: str
+    label: str = ""
+    vx: float = 0.0
+    vy: float = 0.0
+    omega: float = 0.0
+
+
+@dataclass(frozen=True)
+class Wall:
+    """A rigid, clamped straight wall: the line {p : p . normal = offset}.
+
+    normal: unit vector from the granules into the wall (outward for the granular
+    domain); offset [m]. The left wall x = 0 is normal (-1, 0), offset 0; the top wall
+    y = 0.1 is normal (0, 1), offset 0.1.
+    """
+
+    normal: tuple[float, float]
+    offset: float
+    label: str = ""
+    material: str = "steel"
+
+
+@dataclass(frozen=True)
+class Layout:
+    """The paper's packing (MODEL.md section 1): columns 1..5, intruders 6..9, A..E.
+
+    R1: heavy-granule radius [m]; R2_ratio = R2 / R1 in [sqrt(2) - 1, 1].
+    Generates the 14 granules, the left, bottom and top walls and the plate's x position.
+    """
+
+    R1: float = 0.01
+    R2_ratio: float = 1.0
+    heavy_material: str = "steel"
+    intruder_material: str = "steel"
+    wall_material: str = "steel"
+
+
+@dataclass(frozen=True)
+class Plate:
+    """The elastic plate (plane stress, Q8 elements), MODEL.md section 4.
+
+    x0, y0: lower-left corner [m] (x0 = None: placed against the layout's column 3);
+    width (along x) and height (along y) [m]; thickness [m]; nx, ny: elements along x, y;
+    rigid_layer_width: w [m] (None = one element edge along y); clamped_edges: subset of
+    {"top", "bottom", "left", "right"}; n_modes: number of modes kept (0 = all, which is
+    exactly Newmark on the full system).
+    """
+
+    width: float = 0.01
+    height: float = 0.1
+    thickness: float = 0.001
+    material: str = "steel"
+    x0: float | None = None
+    y0: float = 0.0
+    nx: int = 4
+    ny: int = 40
+    rigid_layer_width: float | None = None
+    clamped_edges: tuple[str, ...] = ("top", "bottom")
+    n_modes: int = 0
+
+    @property
+    def element_height(self) -> float:
+        """Element edge along y [m]."""
+        return self.height / self.ny
+
+    @property
+    def layer_width(self) -> float:
+        """The rigid-layer width actually used [m]."""
+        return self.element_height if self.rigid_layer_width is None else self.rigid_layer_width
+
+
+@dataclass(frozen=True)
+class Load:
+    """The half-sine shock of MODEL.md section 5.
+
+    q(y, t) = q0 sin(pi t / T) sin(pi (y - y0) / L) on 0 <= t <= T, y0 <= y <= y0 + L.
+    kind: "line" or "none"; target: "granules" (push +x on the left surface of the
+    loaded granules) or "plate" (consistent nodal forces on the plate's left edge);
+    q0 [N/m], duration T [s], length L [m], y0 [m]; granules: labels of the loaded
+    granules (empty = every granule touching the leftmost wall, i.e. column 1).
+    """
+
+    kind: str = "line"
+    target: str = "granules"
+    q0: float = 50_000.0
+    duration: float = 1e-5
+    length: float = 0.05
+    y0: float = 0.025
+    granules: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class PairCoefficients:
+    """Contact coefficients for one material pair (order-free), overriding the defaults."""
+
+    materials: tuple[str, str]
+    alpha_n: float | None = None
+    mu: float | None = None
+    k_s: float | None = None
+
+
+@dataclass(frozen=True)
+class Contact:
+    """Contact-law coefficients (MODEL.md sections 2-3).
+
+    mu: Coulomb coefficient [-]; k_s: tanh smoothing [s/m]; alpha_n: damping coefficient
+    [-] of eq. (3) for pairs not listed in `pairs`; clip_tensile: the normal force never
+    pulls (True, MODEL.md) or the paper's raw eq. (2) (False); neighbour_gap: pairs whose
+    initial surface gap is at most this fraction of the smaller radius are potential
+    contacts (the topology is fixed).
+    """
+
+    mu: float = 0.099
+    k_s: float = 1000.0
+    alpha_n: float = 6.313e-3
+    pairs: tuple[PairCoefficients, ...] = (
+        PairCoefficients(("steel", "ptfe"), alpha_n=6.313e-2),
+    )
+    clip_tensile: bool = True
+    neighbour_gap: float = 0.05
+
+    def for_pair(self, a: str, b: str) -> tuple[float, float, float]:
+        """(alpha_n, mu, k_s) for materials a and b."""
+        alpha, mu, ks = self.alpha_n, self.mu, self.k_s
+        for p in self.pairs:
+            if {a, b} == set(p.materials) and (a != b or p.materials[0] == p.materials[1]):
+                alpha = alpha if p.alpha_n is None else p.alpha_n
+                mu = mu if p.mu is None else p.mu
+                ks = ks if p.k_s is None else p.k_s
+        return alpha, mu, ks
+
+
+@dataclass(frozen=True)
+class TimeSettings:
+    """Time settings [s]: end time, initial/max/min step, output intervals.
+
+    output_interval: scalar outputs and granule states; field_interval: plate
+    displacement snapshots (a multiple of output_interval).
+    """
+
+    t_end: float = 2e-3
+    dt_initial: float = 4e-8
+    dt_max: float = 4e-8
+    dt_min: float = 1e-13
+    output_interval: float = 1e-6
+    field_interval: float = 2e-5
+
+
+@dataclass(frozen=True)
+class Solver:
+    """Coupling solver settings (MODEL.md section 6).
+
+    scheme: "paper" (fixed-point interpolation-iteration, criterion (8) step control);
+    lambda_target: the local-map modulus the step control aims for (< 1);
+    iteration_rtol, iteration_atol [N]: convergence of the interface forces;
+    max_iterations: per step before the step is retried at half size;
+    energy_tol: the largest relative energy residual a run accepts.
+    """
+
+    scheme: str = "paper"
+    lambda_target: float = 0.5
+    iteration_rtol: float = 1e-9
+    iteration_atol: float = 1e-10
+    max_iterations: int = 60
+    energy_tol: float = 1e-4
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A complete run definition. Either `layout` or explicit `granules`/`walls`."""
+
+    name: str = "custom"
+    description: str = ""
+    materials: dict[str, Material] = field(default_factory=lambda: dict(LIBRARY))
+    layout: Layout | None = None
+    granules: tuple[Granule, ...] = ()
+    walls: tuple[Wall, ...] = ()
+    plate: Plate | None = None
+    load: Load = Load()
+    contact: Contact = Contact()
+    time: TimeSettings = TimeSettings()
+    solver: Solver = Solver()
+
+    def material(self, name: str) -> Material:
+        """The material called `name` (file-defined ones override the library)."""
+        return self.materials[name]
+
+
+SQRT2_MINUS_1 = math.sqrt(2.0) - 1.0

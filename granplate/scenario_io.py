@@ -1,0 +1,388 @@
+"""Scenarios to and from TOML text and plain dicts (docs/scenario.md describes the format).
+
+- `from_dict(d)` / `to_dict(s)`: plain dicts (TOML-shaped: tables are dicts, arrays are
+  lists) <-> `Scenario`; `from_dict(to_dict(s)) == s`.
+- `loads(text)` / `load(path)` / `dumps(s)` / `dump(s, path)`: TOML. Reading checks the
+  *shape* (unknown keys, missing required fields, wrong types), not the physics.
+- `load_scenario(name_or_path)`: a preset or a TOML file, validated (`validate`).
+- `with_changes(s, {"load.q0": 1e4, "layout.R2_ratio": 0.5})`: tweak by dotted paths.
+
+Every error is a `ScenarioError` naming the field by its dotted path (`plate.nx`,
+`granules[2].radius`, `materials.ptfe.nu`; array indices 0-based, in file order).
+"""
+from __future__ import annotations
+
+import dataclasses
+import numbers
+import os
+import re
+import tomllib
+import types
+import typing
+from typing import Any
+
+import tomli_w
+
+from .errors import ScenarioError
+from .materials import LIBRARY, Material
+from .scenario import (Contact, Granule, Layout, Load, PairCoefficients, Plate, Scenario,
+                       Solver, TimeSettings, Wall)
+
+#: Fields that a table must give (everything else takes the dataclass default).
+REQUIRED: dict[type, tuple[str, ...]] = {
+    Granule: ("x", "y", "radius", "material"),
+    Wall: ("normal", "offset"),
+    PairCoefficients: ("materials",),
+}
+#: Keys of a [materials.NAME] table (all required).
+MATERIAL_KEYS: tuple[str, ...] = ("E", "nu", "rho")
+
+
+class _Missing:
+    """Stands for the value of a required field that is absent."""
+
+    def __repr__(self) -> str:
+        return "<missing>"
+
+
+MISSING = _Missing()
+
+
+# --------------------------------------------------------------------------- dict -> Scenario
+
+def _type_name(tp: Any) -> str:
+    if tp is float:
+        return "a number"
+    if tp is int:
+        return "an integer"
+    if tp is str:
+        return "a string"
+    if tp is bool:
+        return "true or false"
+    origin = typing.get_origin(tp)
+    if origin is tuple:
+        args = typing.get_args(tp)
+        if len(args) == 2 and args[1] is Ellipsis:
+            return f"an array of {_plural(args[0])}"
+        return f"an array of {len(args)} {_plural(args[0])}"
+    if origin in (typing.Union, types.UnionType):
+        return " or ".join(_type_name(a) for a in typing.get_args(tp) if a is not type(None))
+    if dataclasses.is_dataclass(tp):
+        return "a table"
+    return str(tp)
+
+
+def _plural(tp: Any) -> str:
+    return {float: "numbers", int: "integers", str: "strings", bool: "booleans"}.get(
+        tp, "tables")
+
+
+def _convert(path: str, value: Any, tp: Any) -> Any:
+    """Convert one TOML/dict value to the annotated type `tp`, or raise ScenarioError."""
+    origin = typing.get_origin(tp)
+    if origin in (typing.Union, types.UnionType):
+        args = typing.get_args(tp)
+        if value is None and type(None) in args:
+            return None
+        inner = [a for a in args if a is not type(None)]
+        if len(inner) == 1:
+            return _convert(path, value, inner[0])
+        raise TypeError(f"unsupported annotation {tp!r}")  # pragma: no cover
+    if tp is float:
+        if isinstance(value, numbers.Real) and not isinstance(value, bool):
+            return float(value)
+        raise ScenarioError(path, value, f"wrong type: expected {_type_name(tp)}")
+    if tp is int:
+        if isinstance(value, numbers.Integral) and not isinstance(value, bool):
+            return int(value)
+        raise ScenarioError(path, value, f"wrong type: expected {_type_name(tp)}")
+    if tp is str:
+        if isinstance(value, str):
+            return value
+        raise ScenarioError(path, value, f"wrong type: expected {_type_name(tp)}")
+    if tp is bool:
+        if isinstance(value, bool):
+            return value
+        raise ScenarioError(path, value, f"wrong type: expected {_type_name(tp)}")
+    if origin is tuple:
+        args = typing.get_args(tp)
+        if not isinstance(value, (list, tuple)):
+            raise ScenarioError(path, value, f"wrong type: expected {_type_name(tp)}")
+        if len(args) == 2 and args[1] is Ellipsis:
+            return tuple(_convert(f"{path}[{i}]", v, args[0]) for i, v in enumerate(value))
+        if len(value) != len(args):
+            raise ScenarioError(path, value, f"wrong length: expected {_type_name(tp)}")
+        return tuple(_convert(f"{path}[{i}]", v, a) for i, (v, a) in
+                     enumerate(zip(value, args)))
+    if dataclasses.is_dataclass(tp):
+        return _table(path, value, tp)
+    raise TypeError(f"unsupported annotation {tp!r}")  # pragma: no cover
+
+
+def _check_keys(path: str, d: Any, allowed: list[str]) -> None:
+    if not isinstance(d, dict):
+        raise ScenarioError(path or "scenario", d, "wrong type: expected a table")
+    for k in d:
+        if k not in allowed:
+            full = f"{path}.{k}" if path else str(k)
+            raise ScenarioError(full, d[k], f"unknown field '{full}'; allowed: "
+                                + ", ".join(allowed))
+
+
+def _table(path: str, d: Any, cls: type) -> Any:
+    """Build dataclass `cls` from table `d` (unknown keys refused, required ones checked)."""
+    hints = typing.get_type_hints(cls)
+    names = [f.name for f in dataclasses.fields(cls)]
+    _check_keys(path, d, names)
+    kwargs = {}
+    for name in names:
+        fpath = f"{path}.{name}"
+        if d.get(name) is None:  # absent (or None in a Python dict): the default
+            if name in REQUIRED.get(cls, ()):
+                raise ScenarioError(fpath, MISSING, f"missing required field '{fpath}'")
+            continue
+        kwargs[name] = _convert(fpath, d[name], hints[name])
+    return cls(**kwargs)
+
+
+def _materials(d: Any) -> dict[str, Material]:
+    """The library updated by the [materials.NAME] tables of `d`."""
+    if not isinstance(d, dict):
+        raise ScenarioError("materials", d, "wrong type: expected a table of "
+                            "[materials.NAME] tables")
+    out = dict(LIBRARY)
+    for name, t in d.items():
+        p = f"materials.{name}"
+        if not isinstance(t, dict):
+            raise ScenarioError(p, t, "wrong type: expected a table with E, nu, rho")
+        _check_keys(p, t, list(MATERIAL_KEYS))
+        vals = {}
+        for k in MATERIAL_KEYS:
+            if t.get(k) is None:
+                raise ScenarioError(f"{p}.{k}", MISSING, f"missing required field '{p}.{k}'")
+            vals[k] = _convert(f"{p}.{k}", t[k], float)
+        out[str(name)] = Material(str(name), **vals)
+    return out
+
+
+_TOP_TABLES: dict[str, type] = {
+    "layout": Layout, "plate": Plate, "load": Load, "contact": Contact,
+    "time": TimeSettings, "solver": Solver,
+}
+
+
+def from_dict(d: dict) -> Scenario:
+    """A Scenario from a TOML-shaped dict; shape errors raise ScenarioError (no physics).
+
+    Top-level keys: name, description, materials, layout, granules, walls, plate, load,
+    contact, time, solver. Missing tables take the defaults (no layout, no plate).
+    """
+    names = [f.name for f in dataclasses.fields(Scenario)]
+    _check_keys("", d, names)
+    kw: dict[str, Any] = {}
+    for key in ("name", "description"):
+        if d.get(key) is not None:
+            kw[key] = _convert(key, d[key], str)
+    if d.get("materials") is not None:
+        kw["materials"] = _materials(d["materials"])
+    for key, cls in _TOP_TABLES.items():
+        if d.get(key) is not None:
+            kw[key] = _table(key, d[key], cls)
+    for key, cls in (("granules", Granule), ("walls", Wall)):
+        if d.get(key) is not None:
+            kw[key] = _convert(key, d[key], tuple[cls, ...])
+    return Scenario(**kw)
+
+
+# --------------------------------------------------------------------------- Scenario -> dict
+
+def _plain(value: Any) -> Any:
+    """Dataclasses -> dicts without None entries; tuples -> lists."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {f.name: _plain(getattr(value, f.name)) for f in dataclasses.fields(value)
+                if getattr(value, f.name) is not None}
+    if isinstance(value, (tuple, list)):
+        return [_plain(v) for v in value]
+    if isinstance(value, bool) or isinstance(value, str):
+        return value
+    if isinstance(value, numbers.Integral):
+        return int(value)
+    if isinstance(value, numbers.Real):
+        return float(value)
+    return value
+
+
+def _used_materials(s: Scenario) -> set[str]:
+    used = {g.material for g in s.granules} | {w.material for w in s.walls}
+    if s.layout is not None:
+        used |= {s.layout.heavy_material, s.layout.intruder_material, s.layout.wall_material}
+    if s.plate is not None:
+        used.add(s.plate.material)
+    for p in s.contact.pairs:
+        used |= set(p.materials)
+    return used
+
+
+def _material_dict(m: Material) -> dict[str, float]:
+    return {"E": float(m.E), "nu": float(m.nu), "rho": float(m.rho)}
+
+
+def to_dict(s: Scenario, all_materials: bool = False) -> dict:
+    """A TOML-shaped dict of `s` (None values omitted, tuples as lists).
+
+    Materials written: every one the scenario uses, plus every one that is absent from or
+    differs from `materials.LIBRARY` (all of them with `all_materials=True`), so that
+    `from_dict(to_dict(s)) == s` whenever `s.materials` holds the library's names.
+    Empty top-level granules/walls are left out (their default).
+    """
+    d: dict[str, Any] = {"name": s.name, "description": s.description}
+    used = _used_materials(s)
+    mats = {name: _material_dict(m) for name, m in sorted(s.materials.items())
+            if all_materials or name in used or LIBRARY.get(name) != m}
+    if mats:
+        d["materials"] = mats
+    if s.layout is not None:
+        d["layout"] = _plain(s.layout)
+    if s.granules:
+        d["granules"] = _plain(s.granules)
+    if s.walls:
+        d["walls"] = _plain(s.walls)
+    if s.plate is not None:
+        d["plate"] = _plain(s.plate)
+    for key in ("load", "contact", "time", "solver"):
+        d[key] = _plain(getattr(s, key))
+    return d
+
+
+# --------------------------------------------------------------------------- TOML
+
+def loads(text: str) -> Scenario:
+    """A Scenario from TOML text (shape checked, physics not: see `validate`)."""
+    try:
+        d = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise ScenarioError("toml", _excerpt(text, e), f"TOML syntax error: {e}") from None
+    return from_dict(d)
+
+
+def _excerpt(text: str, e: tomllib.TOMLDecodeError) -> str:
+    """The offending line, when tomllib's message gives one."""
+    m = re.search(r"line (\d+)", str(e))
+    if not m:
+        return "<toml>"
+    lines = text.splitlines()
+    n = int(m.group(1))
+    return lines[n - 1] if 1 <= n <= len(lines) else "<end of file>"
+
+
+def load(path: str | os.PathLike) -> Scenario:
+    """A Scenario from a TOML file (shape checked, physics not: see `validate`)."""
+    try:
+        with open(path, "rb") as f:
+            raw = f.read()
+    except FileNotFoundError:
+        raise ScenarioError("file", str(path), "no such file") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise ScenarioError("file", str(path), f"not UTF-8 text: {e}") from None
+    try:
+        d = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise ScenarioError("file", str(path), f"TOML syntax error: {e}") from None
+    return from_dict(d)
+
+
+def dumps(s: Scenario, all_materials: bool = False) -> str:
+    """`s` as TOML text (see `to_dict` for which materials are written)."""
+    return tomli_w.dumps(to_dict(s, all_materials=all_materials))
+
+
+def dump(s: Scenario, path: str | os.PathLike, all_materials: bool = False) -> None:
+    """Write `s` as TOML to `path`."""
+    with open(path, "wb") as f:
+        f.write(dumps(s, all_materials=all_materials).encode("utf-8"))
+
+
+def load_scenario(path_or_preset: str | os.PathLike) -> Scenario:
+    """A validated scenario: the preset of that name, or else the TOML file at that path.
+
+    The scenario is returned as written (not resolved; `geometry.resolve` expands it).
+    """
+    from . import presets  # local import: presets imports nothing of this module's users
+    from .validate import validate
+
+    key = os.fspath(path_or_preset)
+    if isinstance(key, str) and key in presets.PRESETS:
+        s = presets.preset(key)
+    else:
+        if not os.path.isfile(key):
+            raise ScenarioError("file", key, "no such file or preset; presets are: "
+                                + ", ".join(presets.preset_names()))
+        s = load(key)
+    validate(s)
+    return s
+
+
+# --------------------------------------------------------------------------- tweaks
+
+_STEP = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)((?:\[\d+\])*)$")
+
+
+def _split(path: str) -> list[str | int]:
+    steps: list[str | int] = []
+    for part in path.split("."):
+        m = _STEP.match(part)
+        if not m:
+            raise ScenarioError(path, part, "not a dotted field path such as 'load.q0' or "
+                                "'granules[2].vx'")
+        steps.append(m.group(1))
+        steps += [int(i) for i in re.findall(r"\[(\d+)\]", m.group(2))]
+    return steps
+
+
+def with_changes(s: Scenario, changes: dict[str, object]) -> Scenario:
+    """A copy of `s` with fields set by dotted path, e.g. {"load.q0": 1e4, "plate.ny": 80}.
+
+    Paths are as in TOML: "layout.R2_ratio", "granules[2].vx", "materials.ptfe.E".
+    A missing table on the way is created ({"plate.ny": 80} on a scenario without a plate
+    adds a default plate with ny = 80); a value of None removes the key (back to its
+    default; {"plate": None} removes the plate). The result is shape-checked by
+    `from_dict`, not validated.
+    """
+    d = to_dict(s, all_materials=True)
+    for path, value in changes.items():
+        steps = _split(path)
+        node: Any = d
+        for k, step in enumerate(steps[:-1]):
+            nxt = steps[k + 1]
+            if isinstance(step, int):
+                if not isinstance(node, list) or not 0 <= step < len(node):
+                    raise ScenarioError(path, value, f"index [{step}] out of range "
+                                        f"({len(node) if isinstance(node, list) else 0} items)")
+                node = node[step]
+                continue
+            if not isinstance(node, dict):
+                raise ScenarioError(path, value, f"'{step}' is inside something that "
+                                    "is not a table")
+            if node.get(step) is None:
+                if isinstance(nxt, int):
+                    raise ScenarioError(path, value, f"there is no array '{step}' to index")
+                node[step] = {}
+            node = node[step]
+        last = steps[-1]
+        if isinstance(last, int):
+            if not isinstance(node, list) or not 0 <= last < len(node):
+                raise ScenarioError(path, value, f"index [{last}] out of range")
+            node[last] = _plain(value)
+        elif not isinstance(node, dict):
+            raise ScenarioError(path, value, "the parent is not a table")
+        elif value is None:
+            node.pop(last, None)
+        else:
+            node[last] = _plain(value)
+    return from_dict(d)
+
+
+__all__ = ["from_dict", "to_dict", "loads", "load", "dumps", "dump", "load_scenario",
+           "with_changes", "REQUIRED", "MATERIAL_KEYS", "MISSING"]

@@ -1,0 +1,320 @@
+"""Refuse a bad scenario before anything runs.
+
+`validate(scenario)` raises `ScenarioError(field, value, allowed)` for the first problem
+found. `field` is the dotted path as written in TOML (`granules[3].radius`,
+`materials.ptfe.nu`, `layout.R2_ratio`, `time.t_end`...; indices are 0-based, in file
+order), `allowed` says in words what would be accepted. The layout is checked as
+`layout.*` before it is expanded; everything else is checked on the resolved scenario
+(`geometry.resolve`), so generated granules are named `granules[i]` with their label.
+
+Mesh-node checks at plate contacts (a contact point on a node) belong to the plate module.
+"""
+from __future__ import annotations
+
+import math
+import numbers
+from typing import Any
+
+from .errors import ScenarioError
+from .geometry import resolve
+from .scenario import SQRT2_MINUS_1, Scenario
+
+#: Coupling schemes the solver knows (Solver.scheme).
+SCHEMES: tuple[str, ...] = ("paper",)
+#: Load kinds (Load.kind) and targets (Load.target).
+LOAD_KINDS: tuple[str, ...] = ("line", "none")
+LOAD_TARGETS: tuple[str, ...] = ("granules", "plate")
+#: Plate edges that may be clamped (Plate.clamped_edges).
+PLATE_EDGES: tuple[str, ...] = ("top", "bottom", "left", "right")
+
+#: Relative tolerance on overlaps/penetrations at t = 0 (times the smaller radius).
+OVERLAP_RTOL = 1e-9
+#: Tolerance on |normal| - 1 for walls.
+NORMAL_TOL = 1e-9
+#: Tolerance on the R2/R1 bounds.
+RATIO_TOL = 1e-12
+#: Relative tolerance for field_interval being a multiple of output_interval.
+INTERVAL_RTOL = 1e-9
+
+
+# --------------------------------------------------------------------------- helpers
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, numbers.Real) and not isinstance(v, bool)
+
+
+def _finite(path: str, v: Any, what: str = "must be a finite number") -> float:
+    if not _is_number(v) or not math.isfinite(float(v)):
+        raise ScenarioError(path, v, what)
+    return float(v)
+
+
+def _positive(path: str, v: Any) -> None:
+    x = _finite(path, v, "must be > 0 (a finite number)")
+    if not x > 0.0:
+        raise ScenarioError(path, v, "must be > 0")
+
+
+def _nonneg(path: str, v: Any) -> None:
+    x = _finite(path, v, "must be >= 0 (a finite number)")
+    if not x >= 0.0:
+        raise ScenarioError(path, v, "must be >= 0")
+
+
+def _int_at_least(path: str, v: Any, lo: int) -> None:
+    if not isinstance(v, numbers.Integral) or isinstance(v, bool) or v < lo:
+        raise ScenarioError(path, v, f"must be an integer >= {lo}")
+
+
+def _string_in(path: str, v: Any, allowed: tuple[str, ...]) -> None:
+    if not isinstance(v, str) or v not in allowed:
+        raise ScenarioError(path, v, "must be one of " + ", ".join(repr(a) for a in allowed))
+
+
+def _material_exists(path: str, name: Any, s: Scenario) -> None:
+    if not isinstance(name, str) or name not in s.materials:
+        raise ScenarioError(path, name, "unknown material; defined materials are: "
+                            + ", ".join(sorted(s.materials)))
+
+
+# --------------------------------------------------------------------------- sections
+
+def _check_materials(s: Scenario) -> None:
+    if not isinstance(s.materials, dict) or not s.materials:
+        raise ScenarioError("materials", s.materials, "must be a non-empty table of materials")
+    for name, m in s.materials.items():
+        p = f"materials.{name}"
+        _positive(f"{p}.E", m.E)
+        _finite(f"{p}.nu", m.nu, "must be in (-1, 0.5) (a finite number)")
+        if not -1.0 < m.nu < 0.5:
+            raise ScenarioError(f"{p}.nu", m.nu, "must be in (-1, 0.5)")
+        _positive(f"{p}.rho", m.rho)
+
+
+def _check_layout(s: Scenario) -> None:
+    lay = s.layout
+    if lay is None:
+        return
+    _positive("layout.R1", lay.R1)
+    r = _finite("layout.R2_ratio", lay.R2_ratio,
+                f"must be in [{SQRT2_MINUS_1:.8f}, 1] (sqrt(2)-1 <= R2/R1 <= 1)")
+    if not (SQRT2_MINUS_1 - RATIO_TOL <= r <= 1.0 + RATIO_TOL):
+        raise ScenarioError("layout.R2_ratio", lay.R2_ratio,
+                            f"must be in [{SQRT2_MINUS_1:.8f}, 1] (sqrt(2)-1 <= R2/R1 <= 1)")
+    for f in ("heavy_material", "intruder_material", "wall_material"):
+        _material_exists(f"layout.{f}", getattr(lay, f), s)
+
+
+def _check_granules(s: Scenario) -> None:
+    seen: dict[str, int] = {}
+    for i, g in enumerate(s.granules):
+        p = f"granules[{i}]"
+        _finite(f"{p}.x", g.x)
+        _finite(f"{p}.y", g.y)
+        _positive(f"{p}.radius", g.radius)
+        for f in ("vx", "vy", "omega"):
+            _finite(f"{p}.{f}", getattr(g, f))
+        _material_exists(f"{p}.material", g.material, s)
+        if not isinstance(g.label, str):
+            raise ScenarioError(f"{p}.label", g.label, "must be a string")
+        if g.label in seen:
+            raise ScenarioError(f"{p}.label", g.label,
+                                f"labels must be unique; granules[{seen[g.label]}] has it too")
+        seen[g.label] = i
+    gs = s.granules
+    for i in range(len(gs)):
+        gi = gs[i]
+        for j in range(i + 1, len(gs)):
+            gj = gs[j]
+            dist = math.hypot(gj.x - gi.x, gj.y - gi.y)
+            overlap = gi.radius + gj.radius - dist
+            if overlap > OVERLAP_RTOL * min(gi.radius, gj.radius):
+                raise ScenarioError(
+                    f"granules[{i}]", gi.label,
+                    f"overlaps granule '{gj.label}' (granules[{j}]) by {overlap:.6g} m at t = 0; "
+                    f"granules may touch but not overlap (tolerance "
+                    f"{OVERLAP_RTOL:g} x the smaller radius)")
+
+
+def _check_walls(s: Scenario) -> None:
+    seen: dict[str, int] = {}
+    for k, w in enumerate(s.walls):
+        p = f"walls[{k}]"
+        n = w.normal
+        if (not isinstance(n, tuple) or len(n) != 2
+                or not all(_is_number(c) and math.isfinite(c) for c in n)):
+            raise ScenarioError(f"{p}.normal", n, "must be two finite numbers [nx, ny]")
+        norm = math.hypot(n[0], n[1])
+        if abs(norm - 1.0) > NORMAL_TOL:
+            raise ScenarioError(f"{p}.normal", n,
+                                f"must be a unit vector (|normal| = {norm:.12g}; "
+                                f"allowed 1 within {NORMAL_TOL:g})")
+        _finite(f"{p}.offset", w.offset)
+        _material_exists(f"{p}.material", w.material, s)
+        if not isinstance(w.label, str):
+            raise ScenarioError(f"{p}.label", w.label, "must be a string")
+        if w.label in seen:
+            raise ScenarioError(f"{p}.label", w.label,
+                                f"labels must be unique; walls[{seen[w.label]}] has it too")
+        seen[w.label] = k
+        for i, g in enumerate(s.granules):
+            pen = g.x * n[0] + g.y * n[1] + g.radius - w.offset
+            if pen > OVERLAP_RTOL * g.radius:
+                raise ScenarioError(
+                    f"granules[{i}]", g.label,
+                    f"penetrates wall '{w.label}' (walls[{k}]) by {pen:.6g} m at t = 0; "
+                    f"a granule may touch a wall but not cross it")
+
+
+def _check_plate(s: Scenario) -> None:
+    pl = s.plate
+    if pl is None:
+        return
+    for f in ("width", "height", "thickness"):
+        _positive(f"plate.{f}", getattr(pl, f))
+    _material_exists("plate.material", pl.material, s)
+    x0 = _finite("plate.x0", pl.x0)
+    _finite("plate.y0", pl.y0)
+    _int_at_least("plate.nx", pl.nx, 1)
+    _int_at_least("plate.ny", pl.ny, 1)
+    if pl.rigid_layer_width is not None:
+        _positive("plate.rigid_layer_width", pl.rigid_layer_width)
+    edges = pl.clamped_edges
+    if not isinstance(edges, tuple) or not all(isinstance(e, str) and e in PLATE_EDGES
+                                               for e in edges):
+        raise ScenarioError("plate.clamped_edges", edges,
+                            "must be a subset of " + ", ".join(repr(e) for e in PLATE_EDGES))
+    _int_at_least("plate.n_modes", pl.n_modes, 0)
+    for i, g in enumerate(s.granules):
+        if pl.y0 <= g.y <= pl.y0 + pl.height:
+            pen = g.x + g.radius - x0
+            if pen > OVERLAP_RTOL * g.radius:
+                raise ScenarioError(
+                    f"granules[{i}]", g.label,
+                    f"penetrates the plate (left edge x0 = {x0:.6g} m) by {pen:.6g} m at "
+                    f"t = 0; granules must lie left of the plate (x + radius <= plate.x0)")
+
+
+def _check_load(s: Scenario) -> None:
+    ld = s.load
+    _string_in("load.kind", ld.kind, LOAD_KINDS)
+    _string_in("load.target", ld.target, LOAD_TARGETS)
+    q0 = _finite("load.q0", ld.q0, "must be >= 0 (a finite number) [N/m]")
+    if not q0 >= 0.0:
+        raise ScenarioError("load.q0", ld.q0, "must be >= 0 [N/m]")
+    _positive("load.duration", ld.duration)
+    _positive("load.length", ld.length)
+    _finite("load.y0", ld.y0)
+    if not isinstance(ld.granules, tuple) or not all(isinstance(x, str) for x in ld.granules):
+        raise ScenarioError("load.granules", ld.granules, "must be a list of granule labels")
+    labels = {g.label for g in s.granules}
+    for i, lab in enumerate(ld.granules):
+        if lab not in labels:
+            raise ScenarioError(f"load.granules[{i}]", lab,
+                                "no granule has this label; labels are: "
+                                + ", ".join(g.label for g in s.granules))
+    if ld.kind == "line":
+        if ld.target == "plate" and s.plate is None:
+            raise ScenarioError("load.target", ld.target,
+                                "a load on the plate needs a [plate]; use target = "
+                                "\"granules\" or kind = \"none\"")
+        if ld.target == "granules" and not s.granules:
+            raise ScenarioError("load.target", ld.target,
+                                "a load on the granules needs granules (or a [layout]); "
+                                "use target = \"plate\" or kind = \"none\"")
+
+
+def _check_contact(s: Scenario) -> None:
+    c = s.contact
+    _nonneg("contact.mu", c.mu)
+    _positive("contact.k_s", c.k_s)
+    _nonneg("contact.alpha_n", c.alpha_n)
+    _nonneg("contact.neighbour_gap", c.neighbour_gap)
+    if not isinstance(c.clip_tensile, bool):
+        raise ScenarioError("contact.clip_tensile", c.clip_tensile, "must be true or false")
+    for i, pc in enumerate(c.pairs):
+        p = f"contact.pairs[{i}]"
+        mats = pc.materials
+        if not isinstance(mats, tuple) or len(mats) != 2:
+            raise ScenarioError(f"{p}.materials", mats, "must be two material names")
+        for k, m in enumerate(mats):
+            _material_exists(f"{p}.materials[{k}]", m, s)
+        if pc.alpha_n is not None:
+            _nonneg(f"{p}.alpha_n", pc.alpha_n)
+        if pc.mu is not None:
+            _nonneg(f"{p}.mu", pc.mu)
+        if pc.k_s is not None:
+            _positive(f"{p}.k_s", pc.k_s)
+
+
+def _check_time(s: Scenario) -> None:
+    t = s.time
+    for f in ("t_end", "dt_initial", "dt_max", "dt_min", "output_interval", "field_interval"):
+        _positive(f"time.{f}", getattr(t, f))
+    if t.dt_min > t.dt_initial:
+        raise ScenarioError("time.dt_min", t.dt_min,
+                            f"must be <= time.dt_initial = {t.dt_initial!r} "
+                            "(dt_min <= dt_initial <= dt_max)")
+    if t.dt_initial > t.dt_max:
+        raise ScenarioError("time.dt_initial", t.dt_initial,
+                            f"must be <= time.dt_max = {t.dt_max!r} "
+                            "(dt_min <= dt_initial <= dt_max)")
+    if t.output_interval > t.t_end:
+        raise ScenarioError("time.output_interval", t.output_interval,
+                            f"must be <= time.t_end = {t.t_end!r}")
+    r = t.field_interval / t.output_interval
+    n = round(r)
+    if n < 1 or abs(r - n) > INTERVAL_RTOL * r:
+        raise ScenarioError("time.field_interval", t.field_interval,
+                            f"must be a whole multiple (>= 1) of time.output_interval = "
+                            f"{t.output_interval!r}")
+
+
+def _check_solver(s: Scenario) -> None:
+    sv = s.solver
+    _string_in("solver.scheme", sv.scheme, SCHEMES)
+    lam = _finite("solver.lambda_target", sv.lambda_target, "must be in (0, 1)")
+    if not 0.0 < lam < 1.0:
+        raise ScenarioError("solver.lambda_target", sv.lambda_target, "must be in (0, 1)")
+    _positive("solver.iteration_rtol", sv.iteration_rtol)
+    _positive("solver.iteration_atol", sv.iteration_atol)
+    _int_at_least("solver.max_iterations", sv.max_iterations, 1)
+    _positive("solver.energy_tol", sv.energy_tol)
+
+
+# --------------------------------------------------------------------------- entry point
+
+def validate(scenario: Scenario) -> None:
+    """Raise ScenarioError(field, value, allowed) for the first problem in `scenario`.
+
+    Order: materials, layout (as `layout.*`, before it is expanded), then on the resolved
+    scenario: granules (values, unique labels, overlaps), walls (unit normals,
+    penetration), plate, load, contact, time, solver. A scenario with neither granules
+    (nor a layout) nor a plate is refused.
+    """
+    s = scenario
+    if not isinstance(s.name, str):
+        raise ScenarioError("name", s.name, "must be a string")
+    if not isinstance(s.description, str):
+        raise ScenarioError("description", s.description, "must be a string")
+    _check_materials(s)
+    _check_layout(s)
+    if s.layout is None and not s.granules and s.plate is None:
+        raise ScenarioError("granules", (), "a scenario needs granules (or a [layout]) "
+                            "or a [plate], or both; it has neither")
+    if s.plate is not None and s.plate.x0 is not None:
+        _finite("plate.x0", s.plate.x0)
+    r = resolve(s)
+    _check_granules(r)
+    _check_walls(r)
+    _check_plate(r)
+    _check_load(r)
+    _check_contact(r)
+    _check_time(r)
+    _check_solver(r)
+
+
+def validated(scenario: Scenario) -> Scenario:
+    """`validate(scenario)`, then return `scenario` unchanged (for chaining)."""
+    validate(scenario)
+    return scenario

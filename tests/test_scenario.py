@@ -1,0 +1,255 @@
+"""Scenario input: TOML/dict reading, validation messages, round trips (docs/scenario.md)."""
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+from pathlib import Path
+
+import pytest
+
+from granplate import scenario_io
+from granplate.errors import ScenarioError
+from granplate.materials import LIBRARY, Material
+from granplate.presets import preset
+from granplate.scenario import (Granule, Layout, Load, PairCoefficients, Plate, Scenario,
+                                Solver, TimeSettings, Wall)
+from granplate.validate import SCHEMES, validate
+
+DOC = Path(__file__).resolve().parents[1] / "docs" / "scenario.md"
+
+
+def _two_spheres(**changes) -> Scenario:
+    """Two steel spheres flying at each other, no plate, no load."""
+    s = Scenario(name="two-spheres",
+                 granules=(Granule(0.0, 0.0, 0.01, "steel", "a", vx=1.0),
+                           Granule(0.03, 0.0, 0.01, "steel", "b", vx=-1.0)),
+                 load=Load(kind="none"))
+    return dataclasses.replace(s, **changes)
+
+
+def _with(changes):
+    return lambda: validate(scenario_io.with_changes(preset("steel-r1"), changes))
+
+
+def _granules(*gs, walls=()):
+    return lambda: validate(_two_spheres(granules=gs, walls=walls))
+
+
+def _toml(text):
+    return lambda: scenario_io.loads(text)
+
+
+STEEL = "steel"
+BAD = [
+    # (id, action, field path in the message, allowed range in the message)
+    ("zero radius", _granules(Granule(0, 0, 0.0, STEEL, "a"), Granule(1, 0, 0.01, STEEL, "b")),
+     "granules[0].radius", "must be > 0"),
+    ("negative modulus", _with({"materials.ptfe.E": -5e9}), "materials.ptfe.E", "must be > 0"),
+    ("nu = 0.5", _with({"materials.steel.nu": 0.5}), "materials.steel.nu",
+     "must be in (-1, 0.5)"),
+    ("nu = -1", _with({"materials.ptfe.nu": -1.0}), "materials.ptfe.nu",
+     "must be in (-1, 0.5)"),
+    ("R2_ratio 0.3", _with({"layout.R2_ratio": 0.3}), "layout.R2_ratio",
+     "must be in [0.41421356, 1] (sqrt(2)-1 <= R2/R1 <= 1)"),
+    ("R2_ratio 1.2", _with({"layout.R2_ratio": 1.2}), "layout.R2_ratio",
+     "must be in [0.41421356, 1] (sqrt(2)-1 <= R2/R1 <= 1)"),
+    ("overlapping granules",
+     _granules(Granule(0, 0, 0.01, STEEL, "a"), Granule(0.015, 0, 0.01, STEEL, "b")),
+     "granules[0]", "overlaps granule 'b'"),
+    ("granule through a wall",
+     _granules(Granule(0.005, 0.05, 0.01, STEEL, "a"), walls=(Wall((-1.0, 0.0), 0.0, "left"),)),
+     "granules[0]", "penetrates wall 'left'"),
+    ("granule through the plate", _with({"plate.x0": 0.05}), "granules[9]",
+     "penetrates the plate"),
+    ("unknown field", _toml("[plate]\nnxx = 4\n"), "plate.nxx",
+     "unknown field 'plate.nxx'; allowed: width, height"),
+    ("missing field", _toml('[[granules]]\nx = 0\ny = 0\nradius = 0.01\nmaterial = "steel"\n'
+                            '[[granules]]\nx = 0\ny = 0.1\nmaterial = "steel"\n'),
+     "granules[1].radius", "missing required field 'granules[1].radius'"),
+    ("missing material key", _toml("[materials.wood]\nE = 1e10\nnu = 0.3\n"),
+     "materials.wood.rho", "missing required field"),
+    ("wrong type string", _toml('[load]\nq0 = "strong"\n'), "load.q0",
+     "wrong type: expected a number"),
+    ("wrong type bool", _toml("[time]\nt_end = true\n"), "time.t_end",
+     "wrong type: expected a number"),
+    ("float for an integer", _toml("[plate]\nny = 40.5\n"), "plate.ny",
+     "expected an integer"),
+    ("negative t_end", _with({"time.t_end": -1e-3}), "time.t_end", "must be > 0"),
+    ("infinite t_end", _with({"time.t_end": math.inf}), "time.t_end", "must be > 0"),
+    ("unknown material", _with({"layout.intruder_material": "wood"}),
+     "layout.intruder_material", "unknown material; defined materials are: ptfe, steel"),
+    ("unknown granule material",
+     _granules(Granule(0, 0, 0.01, "wood", "a"), Granule(1, 0, 0.01, STEEL, "b")),
+     "granules[0].material", "unknown material"),
+    ("unknown pair material", _with({"contact.pairs": [{"materials": ["steel", "oak"]}]}),
+     "contact.pairs[0].materials[1]", "unknown material"),
+    ("unknown preset or file", lambda: scenario_io.load_scenario("steel-r3"), "file",
+     "no such file or preset; presets are: bare-plate, steel-r1"),
+    ("duplicate labels",
+     _granules(Granule(0, 0, 0.01, STEEL, "a"), Granule(1, 0, 0.01, STEEL, "a")),
+     "granules[1].label", "unique"),
+    ("q0 negative", _with({"load.q0": -1.0}), "load.q0", "must be >= 0"),
+    ("load kind", _with({"load.kind": "point"}), "load.kind", "'line', 'none'"),
+    ("load target", _with({"load.target": "wall"}), "load.target", "'granules', 'plate'"),
+    ("load on a missing plate", lambda: validate(_two_spheres(load=Load(target="plate"))),
+     "load.target", "needs a [plate]"),
+    ("load on missing granules",
+     lambda: validate(Scenario(plate=Plate(x0=0.0), load=Load(target="granules"))),
+     "load.target", "needs granules"),
+    ("loaded label unknown", _with({"load.granules": ["2", "Z"]}), "load.granules[1]",
+     "no granule has this label"),
+    ("load duration", _with({"load.duration": 0.0}), "load.duration", "must be > 0"),
+    ("load length", _with({"load.length": -0.05}), "load.length", "must be > 0"),
+    ("non-unit wall normal",
+     _granules(Granule(0.02, 0, 0.01, STEEL, "a"), Granule(0.05, 0, 0.01, STEEL, "b"),
+               walls=(Wall((-1.0, 0.1), 0.0, "left"),)),
+     "walls[0].normal", "must be a unit vector"),
+    ("plate thickness", _with({"plate.thickness": 0.0}), "plate.thickness", "must be > 0"),
+    ("plate width", _with({"plate.width": -0.01}), "plate.width", "must be > 0"),
+    ("plate nx", _with({"plate.nx": 0}), "plate.nx", "must be an integer >= 1"),
+    ("clamped edge", _with({"plate.clamped_edges": ["top", "front"]}), "plate.clamped_edges",
+     "must be a subset of 'top', 'bottom', 'left', 'right'"),
+    ("n_modes", _with({"plate.n_modes": -1}), "plate.n_modes", "must be an integer >= 0"),
+    ("rigid layer", _with({"plate.rigid_layer_width": 0.0}), "plate.rigid_layer_width",
+     "must be > 0"),
+    ("plate without position", lambda: validate(Scenario(plate=Plate(), load=Load("none"))),
+     "plate.x0", "must be given"),
+    ("dt order", _with({"time.dt_initial": 1e-7}), "time.dt_initial", "must be <= time.dt_max"),
+    ("dt_min", _with({"time.dt_min": 1e-7, "time.dt_max": 1e-6}), "time.dt_min",
+     "must be <= time.dt_initial"),
+    ("output interval", _with({"time.t_end": 1e-7}), "time.output_interval",
+     "must be <= time.t_end"),
+    ("field interval", _with({"time.field_interval": 2.5e-6}), "time.field_interval",
+     "whole multiple"),
+    ("scheme", _with({"solver.scheme": "monolithic"}), "solver.scheme", "'paper'"),
+    ("lambda_target", _with({"solver.lambda_target": 1.0}), "solver.lambda_target",
+     "must be in (0, 1)"),
+    ("iteration tolerance", _with({"solver.iteration_rtol": 0.0}), "solver.iteration_rtol",
+     "must be > 0"),
+    ("max iterations", _with({"solver.max_iterations": 0}), "solver.max_iterations",
+     "must be an integer >= 1"),
+    ("energy tol", _with({"solver.energy_tol": -1e-4}), "solver.energy_tol", "must be > 0"),
+    ("mu", _with({"contact.mu": -0.1}), "contact.mu", "must be >= 0"),
+    ("k_s", _with({"contact.k_s": 0.0}), "contact.k_s", "must be > 0"),
+    ("alpha_n", _with({"contact.alpha_n": -1.0}), "contact.alpha_n", "must be >= 0"),
+    ("neighbour gap", _with({"contact.neighbour_gap": -0.1}), "contact.neighbour_gap",
+     "must be >= 0"),
+    ("layout R1", _with({"layout.R1": 0.0}), "layout.R1", "must be > 0"),
+    ("nothing to simulate", lambda: validate(Scenario(load=Load(kind="none"))), "granules",
+     "needs granules (or a [layout]) or a [plate]"),
+    ("layout and granules", lambda: validate(dataclasses.replace(
+        preset("steel-r1"), granules=(Granule(0.5, 0.5, 0.01, STEEL),))),
+     "granules", "either [layout] or [[granules]]"),
+    ("toml syntax", _toml("[plate\nnx = 4\n"), "toml", "TOML syntax error"),
+]
+
+
+@pytest.mark.parametrize("action, field, allowed", [b[1:] for b in BAD],
+                         ids=[b[0] for b in BAD])
+def test_bad_input_is_refused_with_field_and_allowed_range(action, field, allowed):
+    """Each bad input raises a ScenarioError whose message names the field path and what is allowed."""
+    with pytest.raises(ScenarioError) as info:
+        action()
+    msg = str(info.value)
+    assert f"'{field}'" in msg, msg
+    assert allowed in msg, msg
+    assert info.value.field == field
+
+
+def test_valid_scenarios_pass():
+    """The two-sphere impact, a layout at sqrt(2)-1 and at the 1e-12 tolerance, and exact touches all validate."""
+    validate(_two_spheres())
+    validate(scenario_io.with_changes(preset("steel-r1"),
+                                      {"layout.R2_ratio": math.sqrt(2.0) - 1.0}))
+    validate(scenario_io.with_changes(preset("steel-r1"), {"layout.R2_ratio": 1.0 + 5e-13}))
+    validate(scenario_io.with_changes(preset("ptfe-r05"), {"plate.ny": 80, "plate.nx": 8}))
+    touching = _two_spheres(granules=(Granule(0.0, 0.0, 0.01, STEEL, "a"),
+                                      Granule(0.02 - 5e-12, 0.0, 0.01, STEEL, "b")))
+    validate(touching)
+
+
+def test_toml_syntax_error_names_the_line(tmp_path):
+    """A TOML syntax error in a file becomes a ScenarioError carrying tomllib's line number."""
+    p = tmp_path / "bad.toml"
+    p.write_text('name = "x"\n[plate\n')
+    with pytest.raises(ScenarioError, match=r"line 2"):
+        scenario_io.load(p)
+    with pytest.raises(ScenarioError, match=r"line 2"):
+        scenario_io.load_scenario(str(p))
+
+
+def test_load_scenario_validates_files(tmp_path):
+    """load_scenario refuses a file that parses but is physically invalid."""
+    p = tmp_path / "s.toml"
+    scenario_io.dump(scenario_io.with_changes(preset("steel-r1"), {"plate.thickness": -1.0}), p)
+    scenario_io.load(p)  # shape is fine
+    with pytest.raises(ScenarioError, match="plate.thickness"):
+        scenario_io.load_scenario(str(p))
+
+
+def test_dict_round_trip_of_a_custom_scenario():
+    """from_dict(to_dict(s)) == s for a scenario using every table, optional values and a user material."""
+    mats = dict(LIBRARY)
+    mats["rubber"] = Material("rubber", E=1e7, nu=0.49, rho=1100.0)
+    s = Scenario(
+        name="everything", description="all tables",
+        materials=mats,
+        granules=(Granule(0.01, 0.01, 0.01, "rubber", "a", vx=2.0, vy=-1.0, omega=3.0),
+                  Granule(0.03, 0.01, 0.01, "steel", "b")),
+        walls=(Wall((-1.0, 0.0), 0.0, "left"), Wall((0.0, -1.0), 0.0, "floor", "rubber")),
+        plate=Plate(x0=0.04, nx=2, ny=20, rigid_layer_width=0.004,
+                    clamped_edges=("top", "bottom", "right"), n_modes=30),
+        load=Load(target="granules", q0=1234.5, granules=("a",)),
+        contact=dataclasses.replace(preset("steel-r1").contact, pairs=(
+            PairCoefficients(("steel", "rubber"), alpha_n=0.1, mu=0.3, k_s=50.0),
+            PairCoefficients(("steel", "steel"), mu=0.2)), clip_tensile=False),
+        time=TimeSettings(t_end=1e-4, output_interval=1e-6, field_interval=1e-5),
+        solver=Solver(lambda_target=0.3, max_iterations=10),
+    )
+    validate(s)
+    d = scenario_io.to_dict(s)
+    assert scenario_io.from_dict(d) == s
+    assert scenario_io.loads(scenario_io.dumps(s)) == s
+    assert "x0" not in scenario_io.to_dict(preset("steel-r1"))["plate"]  # None omitted
+    assert d["walls"][0]["normal"] == [-1.0, 0.0]  # tuples as arrays
+
+
+def test_ints_accepted_for_floats_and_defaults_filled():
+    """Integers are accepted where floats go, and absent fields take the dataclass defaults."""
+    s = scenario_io.loads('[[granules]]\nx = 0\ny = 1\nradius = 1\nmaterial = "steel"\n'
+                          '[load]\nq0 = 50000\n')
+    g = s.granules[0]
+    assert (g.x, g.y, g.radius) == (0.0, 1.0, 1.0) and isinstance(g.x, float)
+    assert s.load == Load(q0=50_000.0) and isinstance(s.load.q0, float)
+    assert s.plate is None and s.layout is None and s.time == TimeSettings()
+    assert s.materials == LIBRARY
+
+
+def test_user_material_overrides_library():
+    """A [materials.steel] table overrides the library's steel; new names are added."""
+    s = scenario_io.loads("[materials.steel]\nE = 2.1e11\nnu = 0.29\nrho = 7800\n"
+                          "[materials.glass]\nE = 6.3e10\nnu = 0.23\nrho = 2500\n")
+    assert s.material("steel") == Material("steel", 2.1e11, 0.29, 7800.0)
+    assert s.material("glass").rho == 2500.0 and s.material("ptfe") == LIBRARY["ptfe"]
+
+
+def test_schemes_constant():
+    """The solver schemes accepted are listed in SCHEMES, which holds the paper's scheme."""
+    assert SCHEMES == ("paper",)
+
+
+def _doc_block(title: str) -> str:
+    text = DOC.read_text()
+    m = re.search(re.escape(title) + r".*?```toml\n(.*?)```", text, re.S)
+    assert m, title
+    return m.group(1)
+
+
+def test_docs_examples_load_and_validate():
+    """docs/scenario.md's steel-r1 example is dumps(preset) verbatim, and its custom example validates."""
+    assert _doc_block("<!-- example: steel-r1 -->") == scenario_io.dumps(preset("steel-r1"))
+    s = scenario_io.loads(_doc_block("<!-- example: two-spheres -->"))
+    validate(s)
+    assert s.plate is None and s.load.kind == "none" and len(s.granules) == 2
+    assert s.granules[0].vx > 0 > s.granules[1].vx
