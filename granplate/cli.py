@@ -7,11 +7,20 @@ keeps what it computed (written to -o) and exits with status 3.
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import sys
 from pathlib import Path
 
 from .errors import ScenarioError, SimulationError
+
+#: modules that add subcommands: each defines register(subparsers), adding parsers whose
+#: `func(args) -> int` runs the command (ScenarioError is reported as a user error).
+COMMAND_MODULES = (
+    "granplate.reproduce",      # reproduce, plot, animate, export
+    "granplate.verification",   # verify
+    "granplate.bench",          # bench
+)
 
 SUMMARY_ROWS = (
     ("e_shock", "E_shock", "J", "{:.4e}"),
@@ -101,6 +110,14 @@ def build_parser() -> argparse.ArgumentParser:
     pr.add_argument("name")
     pr.add_argument("-o", "--output", help="write to this file instead of stdout")
     pr.set_defaults(func=_cmd_preset)
+    for module in COMMAND_MODULES:
+        try:
+            mod = importlib.import_module(module)
+        except ModuleNotFoundError as err:  # an optional command module not present
+            if err.name != module:
+                raise
+            continue
+        mod.register(sub)
     return p
 
 
