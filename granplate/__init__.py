@@ -23,7 +23,7 @@ from .scenario import (  # noqa: E402
 def __getattr__(name: str):
     # heavy modules (numba, scikit-fem, xarray) load on first use
     if name in ("simulate",):
-        from .simulate import simulate
+        from .integrate import simulate
         return simulate
     if name in ("build_model",):
         from .model import build_model

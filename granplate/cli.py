@@ -50,7 +50,7 @@ def format_summary(summary: dict) -> str:
 def _cmd_run(args) -> int:
     from .results import summary, write
     from .scenario_io import load_scenario
-    from .simulate import simulate
+    from .integrate import simulate
 
     scenario = load_scenario(args.scenario)
     out = Path(args.output) if args.output else Path(f"{scenario.name}.nc")

@@ -37,7 +37,7 @@ from .contact import (
     normal_force,
     viscous_power,
 )
-from .load import time_profile
+from .shock import time_profile
 
 # --- layout of the small bookkeeping arrays -------------------------------------------
 # clock (float64)

@@ -12,7 +12,7 @@ from . import kernels
 from .contact import damping_coefficient, hertz_coefficient
 from .errors import ScenarioError
 from .geometry import resolve
-from .load import shock_resultants
+from .shock import shock_resultants
 from .materials import effective_modulus, sphere_inertia, sphere_mass
 from .scenario import Scenario
 from .validate import validate
