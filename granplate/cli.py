@@ -26,6 +26,7 @@ SUMMARY_ROWS = (
     ("e_shock", "E_shock", "J", "{:.4e}"),
     ("ep_max_fraction", "plate energy, peak / E_shock", "-", "{:.4f}"),
     ("ep_final_fraction", "plate energy, final / E_shock", "-", "{:.4f}"),
+    ("eg_max_fraction", "granular energy, peak / E_shock", "-", "{:.4f}"),
     ("eg_final_fraction", "granular energy, final / E_shock", "-", "{:.4f}"),
     ("dissipated_fraction", "dissipated, final / E_shock", "-", "{:.4f}"),
     ("max_von_mises", "max von Mises stress", "MPa", "{:.2f}"),

@@ -186,6 +186,7 @@ def summary(ds: xr.Dataset) -> dict:
         "e_shock": e_in,
         "ep_max_fraction": float(ds.E_plate.max()) / ref,
         "ep_final_fraction": float(ds.E_plate[-1]) / ref,
+        "eg_max_fraction": float(ds.E_granular.max()) / ref,
         "eg_final_fraction": float(ds.E_granular[-1]) / ref,
         "dissipated_fraction": float(ds.D_viscous[-1] + ds.D_friction[-1]) / ref,
         "max_von_mises": float(ds.max_von_mises.max()) if has_plate else 0.0,
