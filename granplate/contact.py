@@ -108,3 +108,16 @@ def local_map_modulus(mu: float, k_s: float, n_abs: float, dt: float, c_t: float
     """
     ch = math.cosh(k_s * v_t)
     return 0.5 * mu * k_s * n_abs * dt * c_t / (ch * ch)
+
+
+@njit(cache=True)
+def contact_response(delta: float, delta_dot: float, v_t: float, a: float, c: float,
+                     mu: float, k_s: float, clip: bool):
+    """The whole law of one contact in touch (delta > 0), eqs. (2)-(5) and (9)-(10).
+
+    Returns (|N|, signed friction f, viscous power, friction power, stored energy);
+    the force on the first body is -|N| n - f t and its torque -f R.
+    """
+    n, el = normal_force(delta, delta_dot, a, c, clip)
+    f = friction_magnitude(n, v_t, mu, k_s)
+    return n, f, viscous_power(n, el, delta_dot), friction_power(f, v_t), contact_energy(delta, a)

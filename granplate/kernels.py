@@ -29,14 +29,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .contact import (
-    contact_energy,
-    friction_magnitude,
-    friction_power,
-    local_map_modulus,
-    normal_force,
-    viscous_power,
-)
+from .contact import contact_response, local_map_modulus
 from .shock import time_profile
 
 # --- layout of the small bookkeeping arrays -------------------------------------------
@@ -243,9 +236,9 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip):
         nx = dx / dist
         nz = dz / dist
         ddot = -((y[j, 3] - y[i, 3]) * nx + (y[j, 4] - y[i, 4]) * nz)
-        n, el = normal_force(delta, ddot, g.pair_coef[p, 0], g.pair_coef[p, 1], cfg.clip)
         vt = -(y[i, 3] - y[j, 3]) * nz + (y[i, 4] - y[j, 4]) * nx + ri * y[i, 5] + rj * y[j, 5]
-        f = friction_magnitude(n, vt, g.pair_coef[p, 2], g.pair_coef[p, 3])
+        c = g.pair_coef[p]
+        n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[0], c[1], c[2], c[3], cfg.clip)
         # on i: -n nvec - f tvec, tvec = (-nz, nx); on j the opposite
         fx = -n * nx + f * nz
         fz = -n * nz - f * nx
@@ -255,9 +248,9 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip):
         dy[j, 4] -= fz
         dy[i, 5] -= f * ri
         dy[j, 5] -= f * rj
-        p_visc += viscous_power(n, el, ddot)
-        p_fric += friction_power(f, vt)
-        e_pot += contact_energy(delta, g.pair_coef[p, 0])
+        p_visc += pv
+        p_fric += pf
+        e_pot += ep
     # rigid walls
     for w in range(g.wall_i.shape[0]):
         i = g.wall_i[w]
@@ -268,15 +261,15 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip):
         if delta <= 0.0:
             continue
         ddot = y[i, 3] * nx + y[i, 4] * nz
-        n, el = normal_force(delta, ddot, g.wall_coef[w, 0], g.wall_coef[w, 1], cfg.clip)
         vt = -y[i, 3] * nz + y[i, 4] * nx + ri * y[i, 5]
-        f = friction_magnitude(n, vt, g.wall_coef[w, 2], g.wall_coef[w, 3])
+        c = g.wall_coef[w]
+        n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[0], c[1], c[2], c[3], cfg.clip)
         dy[i, 3] += -n * nx + f * nz
         dy[i, 4] += -n * nz - f * nx
         dy[i, 5] -= f * ri
-        p_visc += viscous_power(n, el, ddot)
-        p_fric += friction_power(f, vt)
-        e_pot += contact_energy(delta, g.wall_coef[w, 0])
+        p_visc += pv
+        p_fric += pf
+        e_pot += ep
     # plate contacts through the rigid layers (n = (1, 0), t = (0, 1))
     for k in range(g.pc_i.shape[0]):
         i = g.pc_i[k]
@@ -287,14 +280,14 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip):
         n = 0.0
         f = 0.0
         if delta > 0.0:
-            n, el = normal_force(delta, ddot, g.pc_coef[k, 0], g.pc_coef[k, 1], cfg.clip)
-            f = friction_magnitude(n, vt, g.pc_coef[k, 2], g.pc_coef[k, 3])
+            c = g.pc_coef[k]
+            n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[0], c[1], c[2], c[3], cfg.clip)
             dy[i, 3] -= n
             dy[i, 4] -= f
             dy[i, 5] -= f * ri
-            p_visc += viscous_power(n, el, ddot)
-            p_fric += friction_power(f, vt)
-            e_pot += contact_energy(delta, g.pc_coef[k, 0])
+            p_visc += pv
+            p_fric += pf
+            e_pot += ep
         fplate[2 * k] = n
         fplate[2 * k + 1] = f
         normal[k] = n
