@@ -1,0 +1,74 @@
+"""The benchmark harness on one tiny case: the JSON report has every documented key."""
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+pytestmark = pytest.mark.skipif(not (ROOT / "benchmarks" / "harness.py").is_file(),
+                                reason="needs the source checkout's benchmarks/")
+
+
+def documented_keys() -> dict[str, set[str]]:
+    """Keys of the README's JSON tables, per section ('top', 'compile', 'results')."""
+    text = (ROOT / "benchmarks" / "README.md").read_text()
+    keys: dict[str, set[str]] = {}
+    section = None
+    for line in text.splitlines():
+        m = re.match(r"^###\s+JSON:\s+(\w+)", line)
+        if m:
+            section = m.group(1)
+            keys[section] = set()
+            continue
+        if line.startswith("## "):
+            section = None
+        m = re.match(r"^\|\s*`([A-Za-z_0-9]+)`", line)
+        if section and m:
+            keys[section].add(m.group(1))
+    return keys
+
+
+def main(argv: list[str]) -> int:
+    """`granplate bench ARGV` through granplate.bench's own parser (independent of cli.py)."""
+    import argparse
+
+    from granplate import bench
+
+    parser = argparse.ArgumentParser(prog="granplate")
+    bench.register(parser.add_subparsers(dest="command", required=True))
+    args = parser.parse_args(argv)
+    return int(args.func(args))
+
+
+def test_bench_json_has_documented_keys(tmp_path, monkeypatch):
+    from granplate import bench
+
+    h = bench._load_harness()
+    assert h is not None
+
+    monkeypatch.setattr(h, "REFERENCE_DIR", tmp_path / "ref")
+    out = tmp_path / "bench.json"
+    rc = main(["bench", "--cases", "bare-plate", "--t-end", "1e-5", "--repeats", "1", "--json", str(out)])
+    assert rc == 0
+    report = json.loads(out.read_text())
+    keys = documented_keys()
+    assert set(keys) == {"top", "compile", "results"}
+    assert keys["top"] <= set(report), keys["top"] - set(report)
+    assert set(report["compile"]) == set(report["schemes"])
+    for c in report["compile"].values():
+        assert keys["compile"] <= set(c), keys["compile"] - set(c)
+    assert len(report["results"]) == len(report["schemes"])
+    for r in report["results"]:
+        assert keys["results"] <= set(r), keys["results"] - set(r)
+        assert set(r["rel_error"]) == set(h.METRICS)
+        assert r["n_steps"] > 0 and r["dt_min_s"] > 0
+    # the reference was cached on disk, keyed by the scenario
+    assert list((tmp_path / "ref").glob("bare-plate-*.json"))
+
+
+def test_bench_unknown_case_is_a_user_error(capsys):
+    assert main(["bench", "--cases", "no-such-preset"]) == 2
+    assert "unknown case" in capsys.readouterr().err
