@@ -57,6 +57,9 @@ N_ERR = 8
 OK, ERR_NAN, ERR_ENERGY, ERR_NOCONV, ERR_BUFFER = 0, 1, 2, 3, 4
 
 LEVEL_RATIO = 2.0 ** -0.25
+#: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps
+#: h * (friction relaxation rate of every granule contact) below this bound.
+RK4_FRICTION_LIMIT = 1.0
 N_LEVELS = 200
 
 
@@ -114,6 +117,7 @@ class Config(NamedTuple):
     out_dt: float
     t_end: float
     load_on_plate: bool
+    arm_shrink: float  # 0: friction arm R (MODEL.md); 1: arm to the contact point
 
 
 class State(NamedTuple):
@@ -197,7 +201,10 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip):
 
     y: (ng, 6) state; up, vp: driving-DOF displacement and velocity at t; writes dy,
     fplate (nd,) = force ON the plate [N, N], normal and slip at each plate contact.
-    Returns (shock power, viscous power, friction power, contact potential energy) [W, J].
+    Returns (shock power, viscous power, friction power, contact potential energy,
+    largest friction relaxation rate of a granule contact) [W, J, 1/s]. That rate,
+    mu k_s |N| cosh^-2(k_s v_t) (1/m_i + 1/m_j + a_i^2/I_i + a_j^2/I_j), is how fast the
+    slip of a sticking contact relaxes; RK4 needs h times it below ~2.8.
     """
     ng = y.shape[0]
     for i in range(ng):
@@ -211,6 +218,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip):
     p_visc = 0.0
     p_fric = 0.0
     e_pot = 0.0
+    rate = 0.0
     # shock on the loaded granules
     if not cfg.load_on_plate:
         amp = cfg.q0 * time_profile(t, cfg.duration)
@@ -236,9 +244,13 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip):
         nx = dx / dist
         nz = dz / dist
         ddot = -((y[j, 3] - y[i, 3]) * nx + (y[j, 4] - y[i, 4]) * nz)
-        vt = -(y[i, 3] - y[j, 3]) * nz + (y[i, 4] - y[j, 4]) * nx + ri * y[i, 5] + rj * y[j, 5]
+        ai = ri - 0.5 * cfg.arm_shrink * delta
+        aj = rj - 0.5 * cfg.arm_shrink * delta
+        vt = -(y[i, 3] - y[j, 3]) * nz + (y[i, 4] - y[j, 4]) * nx + ai * y[i, 5] + aj * y[j, 5]
         c = g.pair_coef[p]
         n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[0], c[1], c[2], c[3], cfg.clip)
+        rate = max(rate, slip_relaxation_rate(n, vt, c[2], c[3], 1.0 / g.mass[i] + 1.0 / g.mass[j]
+                                              + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]))
         # on i: -n nvec - f tvec, tvec = (-nz, nx); on j the opposite
         fx = -n * nx + f * nz
         fz = -n * nz - f * nx
@@ -246,8 +258,8 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip):
         dy[i, 4] += fz
         dy[j, 3] -= fx
         dy[j, 4] -= fz
-        dy[i, 5] -= f * ri
-        dy[j, 5] -= f * rj
+        dy[i, 5] -= f * ai
+        dy[j, 5] -= f * aj
         p_visc += pv
         p_fric += pf
         e_pot += ep
@@ -261,12 +273,14 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip):
         if delta <= 0.0:
             continue
         ddot = y[i, 3] * nx + y[i, 4] * nz
-        vt = -y[i, 3] * nz + y[i, 4] * nx + ri * y[i, 5]
+        ai = ri - cfg.arm_shrink * delta
+        vt = -y[i, 3] * nz + y[i, 4] * nx + ai * y[i, 5]
         c = g.wall_coef[w]
         n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[0], c[1], c[2], c[3], cfg.clip)
+        rate = max(rate, slip_relaxation_rate(n, vt, c[2], c[3], 1.0 / g.mass[i] + ai * ai / g.inertia[i]))
         dy[i, 3] += -n * nx + f * nz
         dy[i, 4] += -n * nz - f * nx
-        dy[i, 5] -= f * ri
+        dy[i, 5] -= f * ai
         p_visc += pv
         p_fric += pf
         e_pot += ep
@@ -276,15 +290,18 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip):
         ri = g.radius[i]
         delta = y[i, 0] + ri - (g.pc_x[k] + up[2 * k])
         ddot = y[i, 3] - vp[2 * k]
-        vt = y[i, 4] - vp[2 * k + 1] + ri * y[i, 5]
+        ai = ri - cfg.arm_shrink * max(delta, 0.0)
+        vt = y[i, 4] - vp[2 * k + 1] + ai * y[i, 5]
         n = 0.0
         f = 0.0
         if delta > 0.0:
             c = g.pc_coef[k]
             n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[0], c[1], c[2], c[3], cfg.clip)
+            # the granule side only: the plate side of this map is criterion (8)
+            rate = max(rate, slip_relaxation_rate(n, vt, c[2], c[3], 1.0 / g.mass[i] + ai * ai / g.inertia[i]))
             dy[i, 3] -= n
             dy[i, 4] -= f
-            dy[i, 5] -= f * ri
+            dy[i, 5] -= f * ai
             p_visc += pv
             p_fric += pf
             e_pot += ep
@@ -296,7 +313,16 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip):
         dy[i, 3] /= g.mass[i]
         dy[i, 4] /= g.mass[i]
         dy[i, 5] /= g.inertia[i]
-    return p_shock, p_visc, p_fric, e_pot
+    return p_shock, p_visc, p_fric, e_pot, rate
+
+
+@njit(cache=True)
+def slip_relaxation_rate(n, vt, mu, k_s, inv_mass_t):
+    """d(friction)/d(slip) times the contact's tangential inverse mass [1/s]."""
+    if n <= 0.0:
+        return 0.0
+    ch = math.cosh(k_s * vt)
+    return mu * k_s * n / (ch * ch) * inv_mass_t
 
 
 @njit(cache=True)
@@ -347,7 +373,7 @@ def rk4_granular_step(t, h, st, g, cfg, w):
     w.pend[0] = pe[0]
     w.pend[1] = pe[1]
     w.pend[2] = pe[2]
-    return pe[3]
+    return pe[3], pe[4]
 
 
 # --- plate --------------------------------------------------------------------------------
@@ -609,6 +635,7 @@ def advance(t_stop, g, p, cfg, st, w, out):
             w.conv_iter[k] = 0
         converged = False
         e_pot = 0.0
+        rate = 0.0
         it = 0
         worst = -1
         while it < cfg.max_iter:
@@ -619,7 +646,7 @@ def advance(t_stop, g, p, cfg, st, w, out):
                     s += gm[d, e] * w.fguess[e]
                 w.anext[d] = s
                 w.aavg[d] = 0.5 * (st.a[d] + s)
-            e_pot = rk4_granular_step(t, h, st, g, cfg, w)
+            e_pot, rate = rk4_granular_step(t, h, st, g, cfg, w)
             converged = True
             worst = -1
             worst_err = 0.0
@@ -700,6 +727,8 @@ def advance(t_stop, g, p, cfg, st, w, out):
             h_new = min(h * cfg.lambda_target / lam_max, 2.0 * h_lvl, cfg.dt_max)
         else:
             h_new = min(2.0 * h_lvl, cfg.dt_max)
+        if rate * h_new > RK4_FRICTION_LIMIT:
+            h_new = RK4_FRICTION_LIMIT / rate
         new_level = level_for(h_new, cfg)
         if level_step(new_level, cfg) < cfg.dt_min:
             st.err[ERR_T] = st.clock[T_NOW]

@@ -190,6 +190,7 @@ def build_model(scenario: Scenario) -> Model:
         energy_tol=float(sol.energy_tol), dt_max=float(t.dt_max), dt_min=float(t.dt_min),
         out_dt=float(t.output_interval), t_end=float(t.t_end),
         load_on_plate=bool(s.load.kind == "line" and s.load.target == "plate"),
+        arm_shrink=1.0 if s.contact.torque_arm == "contact_point" else 0.0,
     )
     y0 = np.zeros((ng, 6))
     y0[:, 0] = x

@@ -133,7 +133,11 @@ class Contact:
     [-] of eq. (3) for pairs not listed in `pairs`; clip_tensile: the normal force never
     pulls (True, MODEL.md) or the paper's raw eq. (2) (False); neighbour_gap: pairs whose
     initial surface gap is at most this fraction of the smaller radius are potential
-    contacts (the topology is fixed).
+    contacts (the topology is fixed); torque_arm: lever arm of the friction torque,
+    "radius" (R_i, MODEL.md and paper eq. 1) or "contact_point" (R_i - delta/2 for a
+    pair, R_i - delta at a wall or plate: the true contact point, which conserves the
+    angular momentum of a free assembly; with "radius" each sliding pair adds a couple
+    -f delta). The slip rate uses the same arms, so the friction power stays f v_t.
     """
 
     mu: float = 0.099
@@ -144,6 +148,7 @@ class Contact:
     )
     clip_tensile: bool = True
     neighbour_gap: float = 0.05
+    torque_arm: str = "radius"
 
     def for_pair(self, a: str, b: str) -> tuple[float, float, float]:
         """(alpha_n, mu, k_s) for materials a and b."""

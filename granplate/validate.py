@@ -19,6 +19,8 @@ from .errors import ScenarioError
 from .geometry import resolve
 from .scenario import SQRT2_MINUS_1, Scenario
 
+#: Lever arms of the friction torque (Contact.torque_arm).
+TORQUE_ARMS: tuple[str, ...] = ("radius", "contact_point")
 #: Coupling schemes the solver knows (Solver.scheme).
 SCHEMES: tuple[str, ...] = ("paper",)
 #: Load kinds (Load.kind) and targets (Load.target).
@@ -230,6 +232,7 @@ def _check_contact(s: Scenario) -> None:
     _positive("contact.k_s", c.k_s)
     _nonneg("contact.alpha_n", c.alpha_n)
     _nonneg("contact.neighbour_gap", c.neighbour_gap)
+    _string_in("contact.torque_arm", c.torque_arm, TORQUE_ARMS)
     if not isinstance(c.clip_tensile, bool):
         raise ScenarioError("contact.clip_tensile", c.clip_tensile, "must be true or false")
     for i, pc in enumerate(c.pairs):
