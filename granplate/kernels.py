@@ -117,7 +117,7 @@ class Config(NamedTuple):
     out_dt: float
     t_end: float
     load_on_plate: bool
-    arm_shrink: float  # 0: friction arm R (MODEL.md); 1: arm to the contact point
+    arm_shrink: float = 0.0  # 0: friction arm R (MODEL.md); 1: arm to the contact point
 
 
 class State(NamedTuple):

@@ -1,0 +1,619 @@
+"""Reproduce the paper: run the six presets (and the sensitivity checks) in parallel,
+reuse results that are still current, then draw every figure, both animations and the
+report. Also the CLI commands `reproduce`, `plot`, `animate` and `export`.
+
+    granplate reproduce --out results            # everything (about a minute on 2 cores)
+    granplate reproduce --out quick --t-end 1e-4 # shortened runs (a smoke test)
+    granplate plot results/steel-r1.nc --figure A.1
+    granplate plot results --figure 3            # a directory holding the presets' results
+    granplate animate results/ptfe-r05.nc -o ptfe.mp4
+    granplate export results/steel-r1.nc --vtk vtk/
+
+A result DIR/NAME.nc is reused when its attributes `scenario_toml` and
+`granplate_version` equal those a new run would write; anything else is run again.
+Runs, figures and animations are spread over `--jobs` worker processes; each figure or
+animation starts as soon as the results it needs are there.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from contextlib import contextmanager
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from dataclasses import dataclass, field
+from multiprocessing import get_context
+from pathlib import Path
+
+from .errors import ScenarioError
+
+#: Default output directory of `granplate reproduce`.
+DEFAULT_OUT = "granplate-results"
+
+#: The two runs animated (paper Appendix B: steel and PTFE intruders, R2 = 0.5 R1).
+ANIMATED = ("steel-r05", "ptfe-r05")
+
+#: Default number of animation frames.
+DEFAULT_FRAMES = 120
+
+CHECK_MODES = ("fast", "all", "none")
+
+
+# --------------------------------------------------------------------------------------
+# What to run
+# --------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Job:
+    """One simulation: `scenario` written to `path`; kind "preset" or "check"."""
+
+    name: str
+    scenario: object
+    path: Path
+    kind: str = "preset"
+
+
+@dataclass
+class RunRecord:
+    """What happened to a job: status "reused", "ran" or "failed", wall time [s]."""
+
+    name: str
+    path: Path
+    status: str
+    seconds: float = 0.0
+    message: str = ""
+    kind: str = "preset"
+
+
+@dataclass
+class Outcome:
+    """Everything `reproduce` made: run records, figure and animation files, report."""
+
+    out_dir: Path
+    runs: list[RunRecord] = field(default_factory=list)
+    figures: dict[str, list[Path]] = field(default_factory=dict)
+    animations: list[Path] = field(default_factory=list)
+    report: list[Path] = field(default_factory=list)
+    problems: list[str] = field(default_factory=list)
+    seconds: float = 0.0
+
+    @property
+    def ok(self) -> bool:
+        return not self.problems
+
+
+def shortened(scenario, t_end: float | None):
+    """The scenario ending at t_end [s] (None: unchanged); output intervals shrink to fit."""
+    from .scenario_io import with_changes
+
+    if t_end is None:
+        return scenario
+    changes: dict[str, object] = {"time.t_end": float(t_end)}
+    if scenario.time.output_interval > t_end:
+        changes["time.output_interval"] = float(t_end)
+        changes["time.field_interval"] = float(t_end)
+    elif scenario.time.field_interval > t_end:
+        changes["time.field_interval"] = scenario.time.output_interval
+    return with_changes(scenario, changes)
+
+
+def preset_scenario(name: str, t_end: float | None = None):
+    """Preset `name`, shortened to t_end [s] when given."""
+    from .presets import preset
+
+    return shortened(preset(name), t_end)
+
+
+def expected_identity(scenario) -> tuple[str, str]:
+    """(scenario_toml, granplate_version) a run of `scenario` would write."""
+    from . import __version__
+    from .geometry import resolve
+    from .scenario_io import dumps
+
+    return dumps(resolve(scenario)), __version__
+
+
+def stored_identity(path: Path) -> tuple[str, str] | None:
+    """(scenario_toml, granplate_version) stored in a result file; None if unreadable."""
+    import xarray as xr
+
+    try:
+        with xr.open_dataset(path) as ds:
+            return str(ds.attrs.get("scenario_toml", "")), str(ds.attrs.get("granplate_version", ""))
+    except Exception:  # noqa: BLE001 - missing, partial or foreign file: not current
+        return None
+
+
+def is_current(path: str | Path, scenario) -> bool:
+    """Whether the result at path was made from `scenario` by this granplate version."""
+    path = Path(path)
+    return path.is_file() and stored_identity(path) == expected_identity(scenario)
+
+
+def plan(out_dir: Path, t_end: float | None = None, checks: str = "fast") -> list[Job]:
+    """The presets (DIR/NAME.nc) and the sensitivity checks (DIR/checks/NAME.nc) to run."""
+    from .checks import CHECKS, check_scenario
+    from .presets import preset_names
+
+    if checks not in CHECK_MODES:
+        raise ScenarioError("--checks", checks, f"allowed: {', '.join(CHECK_MODES)}")
+    jobs = [Job(n, preset_scenario(n, t_end), out_dir / f"{n}.nc") for n in preset_names()]
+    if checks != "none":
+        for c in CHECKS:
+            if c.slow and checks != "all":
+                continue
+            jobs.append(Job(c.name, check_scenario(c, t_end), out_dir / "checks" / f"{c.name}.nc", "check"))
+    return jobs
+
+
+# --------------------------------------------------------------------------------------
+# Work done in the worker processes (top-level functions, so they pickle)
+# --------------------------------------------------------------------------------------
+def run_job(job: Job) -> RunRecord:
+    """Simulate one job and write its result atomically; a failed run keeps its partial
+    result as NAME.partial.nc (never reused) and reports why."""
+    import granplate
+    from .errors import SimulationError
+    from .results import write
+
+    t0 = time.perf_counter()
+    job.path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = job.path.with_name(job.path.stem + ".tmp.nc")
+    try:
+        ds = granplate.simulate(job.scenario, progress=False)
+    except SimulationError as err:
+        if err.result is not None:
+            write(err.result, job.path.with_name(job.path.stem + ".partial.nc"))
+        return RunRecord(job.name, job.path, "failed", time.perf_counter() - t0, str(err), job.kind)
+    write(ds, tmp)
+    os.replace(tmp, job.path)
+    return RunRecord(job.name, job.path, "ran", time.perf_counter() - t0, "", job.kind)
+
+
+def make_figure(key: str, paths: list[Path], out_dir: Path) -> list[Path]:
+    """Draw figure `key` from the result files (in the figure's preset order); PNG + PDF."""
+    from . import plots
+    from .results import read
+
+    spec = plots.FIGURES[key]
+    fig = spec.function(*[read(p) for p in paths])
+    return plots.save_figure(fig, out_dir, plots.figure_stem(key))
+
+
+def make_animation(path: Path, target: Path, frames: int | None) -> Path:
+    """Animate the result at path into target (.mp4, or .gif as a fallback)."""
+    from .animate import animate
+    from .results import read
+
+    return animate(read(path), target, frames=frames)
+
+
+# --------------------------------------------------------------------------------------
+# The driver
+# --------------------------------------------------------------------------------------
+#: Thread-count variables of the BLAS / OpenMP libraries the workers use.
+THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS")
+
+
+@contextmanager
+def _worker_threads(n_workers: int):
+    """Share the cores among the workers: each worker's BLAS gets cores // workers threads
+    (the workers inherit the environment; variables the user set are left alone)."""
+    per = str(max(1, (os.cpu_count() or 1) // max(1, n_workers)))
+    saved = {k: os.environ.get(k) for k in THREAD_VARIABLES}
+    try:
+        for k in THREAD_VARIABLES:
+            os.environ.setdefault(k, per)
+        yield
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+@contextmanager
+def _executor(n_jobs: int):
+    """A pool of n_jobs spawned workers (clean: no forked numba / thread state); on the way
+    out, queued tasks are cancelled (an interrupt does not wait for them)."""
+    pool = ProcessPoolExecutor(max_workers=max(1, n_jobs), mp_context=get_context("spawn"))
+    try:
+        yield pool
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+class _Progress:
+    """Progress on stderr: one line per finished task, and a bar on a terminal."""
+
+    def __init__(self, total: int, quiet: bool = False):
+        self.quiet = quiet
+        self.done = 0
+        self.total = total
+        self.bar = None
+        if not quiet and sys.stderr.isatty():
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=total, desc="reproduce", unit="task", leave=False)
+
+    def add(self, n: int) -> None:
+        self.total += n
+        if self.bar is not None:
+            self.bar.total = self.total
+            self.bar.refresh()
+
+    def step(self, line: str) -> None:
+        self.done += 1
+        text = f"[{self.done}/{self.total}] {line}"
+        if self.bar is not None:
+            self.bar.update(1)
+            self.bar.write(text, file=sys.stderr)
+        elif not self.quiet:
+            print(text, file=sys.stderr, flush=True)
+
+    def note(self, line: str) -> None:
+        if self.bar is not None:
+            self.bar.write(line, file=sys.stderr)
+        elif not self.quiet:
+            print(line, file=sys.stderr, flush=True)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+@dataclass(frozen=True)
+class _Product:
+    """A figure (key: the figure's name) or an animation (key: the run animated) waiting
+    for the runs it needs."""
+
+    kind: str
+    key: str
+    needs: tuple[str, ...]
+
+    @property
+    def label(self) -> str:
+        return f"{self.kind} {self.key}"
+
+
+class _Driver:
+    """Runs the jobs on a pool and starts each figure / animation once its runs are in."""
+
+    def __init__(self, pool: ProcessPoolExecutor, outcome: Outcome, products: list[_Product],
+                 available: dict[str, Path], progress: _Progress, frames: int | None):
+        self.pool, self.outcome, self.products = pool, outcome, products
+        self.available, self.failed = available, set()
+        self.progress, self.frames = progress, frames
+        self.running: dict[Future, tuple[str, object]] = {}
+
+    def submit_runs(self, jobs: list[Job]) -> None:
+        """Queue the simulations, longest first (finer meshes, steel packings)."""
+        for job in sorted(jobs, key=_expected_cost, reverse=True):
+            self.running[self.pool.submit(run_job, job)] = ("run", job)
+
+    def launch_ready(self) -> None:
+        """Start every product whose runs are all in; drop those whose runs failed."""
+        out = self.outcome.out_dir
+        for prod in list(self.products):
+            lost = [n for n in prod.needs if n in self.failed]
+            if lost:
+                self.products.remove(prod)
+                self.outcome.problems.append(f"{prod.label} not made: run {', '.join(lost)} failed")
+                self.progress.step(f"skipped {prod.label}")
+            elif all(n in self.available for n in prod.needs):
+                self.products.remove(prod)
+                paths = [self.available[n] for n in prod.needs]
+                if prod.kind == "figure":
+                    fut = self.pool.submit(make_figure, prod.key, paths, out / "figures")
+                else:
+                    fut = self.pool.submit(make_animation, paths[0], out / "animations" / f"{prod.key}.mp4",
+                                           self.frames)
+                self.running[fut] = (prod.kind, prod)
+
+    def finish(self, fut: Future) -> None:
+        """Record one finished task (a run, a figure or an animation)."""
+        kind, what = self.running.pop(fut)
+        if kind == "run":
+            try:
+                rec = fut.result()
+            except Exception as exc:  # noqa: BLE001 - a crashed worker: report, go on
+                rec = RunRecord(what.name, what.path, "failed", 0.0, repr(exc), what.kind)
+            self.outcome.runs.append(rec)
+            if rec.status == "ran":
+                self.available[rec.name] = rec.path
+                self.progress.step(f"ran {rec.name} in {rec.seconds:.1f} s -> {rec.path}")
+            else:
+                self.failed.add(rec.name)
+                self.outcome.problems.append(f"run {rec.name} failed: {rec.message}")
+                self.progress.step(f"FAILED {rec.name}: {rec.message}")
+            self.launch_ready()
+            return
+        try:
+            res = fut.result()
+        except Exception as exc:  # noqa: BLE001 - report, go on with the rest
+            self.outcome.problems.append(f"{what.label} failed: {exc!r}")
+            self.progress.step(f"FAILED {what.label}: {exc!r}")
+            return
+        if kind == "figure":
+            self.outcome.figures[what.key] = res
+            self.progress.step(f"drew {what.label} -> {res[0]}")
+        else:
+            self.outcome.animations.append(res)
+            self.progress.step(f"made {what.label} -> {res}")
+
+    def run(self, jobs: list[Job]) -> None:
+        """Everything, to the end (products whose runs never come are left out)."""
+        self.submit_runs(jobs)
+        self.launch_ready()
+        while self.running:
+            done, _ = wait(list(self.running), return_when=FIRST_COMPLETED)
+            for fut in done:
+                self.finish(fut)
+
+
+def _products(figures: bool, animations: bool) -> list[_Product]:
+    """The figures (each with the presets it takes) and the Appendix B animations."""
+    from . import plots
+
+    out = [_Product("figure", k, spec.presets) for k, spec in plots.FIGURES.items()] if figures else []
+    return out + ([_Product("animation", n, (n,)) for n in ANIMATED] if animations else [])
+
+
+def reproduce(
+    out_dir: str | Path = DEFAULT_OUT,
+    *,
+    t_end: float | None = None,
+    jobs: int | None = None,
+    force: bool = False,
+    checks: str = "fast",
+    figures: bool = True,
+    animations: bool = True,
+    frames: int | None = DEFAULT_FRAMES,
+    quiet: bool = False,
+) -> Outcome:
+    """Run (or reuse) every preset and check, then write figures, animations and report.
+
+    out_dir: results, figures, animations and report go here; t_end: shorten every run
+    to this time [s]; jobs: worker processes (default: os.cpu_count()); force: run
+    everything again; checks: "fast", "all" or "none" sensitivity runs; figures: draw
+    the figures; animations / frames: the Appendix B animations and their frame count;
+    quiet: no progress.
+    """
+    from .report import write_report
+
+    t_start = time.perf_counter()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    n_jobs = int(jobs or os.cpu_count() or 1)
+    if n_jobs < 1:
+        raise ScenarioError("--jobs", jobs, "allowed: an integer >= 1")
+    outcome = Outcome(out)
+    available: dict[str, Path] = {}
+    to_run: list[Job] = []
+    for job in plan(out, t_end, checks):
+        if not force and is_current(job.path, job.scenario):
+            outcome.runs.append(RunRecord(job.name, job.path, "reused", 0.0, "", job.kind))
+            available[job.name] = job.path
+        else:
+            to_run.append(job)
+    products = _products(figures, animations)
+    progress = _Progress(len(to_run) + len(products), quiet)
+    for rec in outcome.runs:
+        progress.note(f"reused {rec.name} ({rec.path})")
+    n_workers = min(n_jobs, max(1, len(to_run) + len(products)))
+    try:
+        with _worker_threads(n_workers), _executor(n_workers) as pool:
+            _Driver(pool, outcome, products, available, progress, frames).run(to_run)
+    finally:
+        progress.close()
+    if not figures:
+        outcome.figures.update(_earlier_figures(out / "figures", available))
+    if not animations:
+        outcome.animations += _earlier_animations(out / "animations", available)
+    outcome.seconds = time.perf_counter() - t_start
+    outcome.report = write_report(out, outcome)
+    outcome.seconds = time.perf_counter() - t_start
+    return outcome
+
+
+def _up_to_date(target: Path, inputs: list[Path]) -> bool:
+    """Whether target exists and is newer than every input file."""
+    return target.is_file() and all(target.stat().st_mtime >= p.stat().st_mtime for p in inputs)
+
+
+def _earlier_figures(fig_dir: Path, available: dict[str, Path]) -> dict[str, list[Path]]:
+    """Figures drawn by an earlier reproduce from the same result files (for the report)."""
+    from . import plots
+
+    found = {}
+    for key, spec in plots.FIGURES.items():
+        files = [fig_dir / f"{plots.figure_stem(key)}{ext}" for ext in (".png", ".pdf")]
+        if all(n in available for n in spec.presets) and all(
+                _up_to_date(f, [available[n] for n in spec.presets]) for f in files):
+            found[key] = files
+    return found
+
+
+def _earlier_animations(anim_dir: Path, available: dict[str, Path]) -> list[Path]:
+    """Animations made by an earlier reproduce from the same result files."""
+    found = []
+    for name in ANIMATED:
+        for ext in (".mp4", ".gif"):
+            f = anim_dir / f"{name}{ext}"
+            if name in available and _up_to_date(f, [available[name]]):
+                found.append(f)
+                break
+    return found
+
+
+def _expected_cost(job: Job) -> float:
+    """A rough cost of a job for ordering: elements x simulated time, steel > PTFE."""
+    s = job.scenario
+    plate = getattr(s, "plate", None)
+    elements = (plate.nx * plate.ny) if plate is not None else 1
+    stiff = 2.0 if (getattr(s, "layout", None) is not None and s.layout.intruder_material == "steel") else 1.0
+    return elements * s.time.t_end * stiff
+
+
+# --------------------------------------------------------------------------------------
+# CLI
+# --------------------------------------------------------------------------------------
+def _existing(path: str, what: str = "file") -> Path:
+    p = Path(path)
+    if not p.exists():
+        raise ScenarioError(what, path, "no such file or directory")
+    return p
+
+
+def _read(path: Path):
+    from .results import read
+
+    try:
+        return read(path)
+    except Exception as exc:  # noqa: BLE001 - not a result file: a user's mistake
+        raise ScenarioError("file", str(path), f"not a granplate result ({exc.__class__.__name__}: {exc})") from None
+
+
+def figure_inputs(key: str, inputs: list[str]) -> list[Path]:
+    """The result files figure `key` takes, in its preset order, from files or a directory.
+
+    A directory is searched for PRESET.nc; files are matched to the figure's presets by
+    their scenario name, or else taken in the order given (when the count is right).
+    """
+    from . import plots
+
+    need = plots.FIGURES[key].presets
+    files: list[Path] = []
+    for item in inputs:
+        p = _existing(item)
+        if p.is_dir():
+            for name in need:
+                f = p / f"{name}.nc"
+                if f.is_file():
+                    files.append(f)
+        else:
+            files.append(p)
+    by_name: dict[str, Path] = {}
+    for f in files:
+        ident = stored_identity(f)
+        if ident is None:
+            raise ScenarioError("file", str(f), "not a readable granplate result (netCDF)")
+        import xarray as xr
+
+        with xr.open_dataset(f) as ds:
+            by_name.setdefault(str(ds.attrs.get("scenario_name", "")), f)
+    if all(n in by_name for n in need):
+        return [by_name[n] for n in need]
+    if len(files) == len(need):
+        return files
+    raise ScenarioError(
+        "--figure", key,
+        f"figure {key} takes {len(need)} result(s): {', '.join(need)} (files named by their scenario, "
+        f"in this order, or a directory holding NAME.nc); got {len(files)}",
+    )
+
+
+def _cmd_reproduce(args) -> int:
+    outcome = reproduce(
+        args.out, t_end=args.t_end, jobs=args.jobs, force=args.force, checks=args.checks,
+        figures=not args.no_figures, animations=not args.no_animations, frames=args.frames, quiet=args.quiet,
+    )
+    reused = sum(r.status == "reused" for r in outcome.runs)
+    ran = sum(r.status == "ran" for r in outcome.runs)
+    print(f"runs: {ran} ran, {reused} reused; figures: {len(outcome.figures)}; "
+          f"animations: {len(outcome.animations)}; {outcome.seconds:.1f} s")
+    for p in outcome.report:
+        print(f"report: {p}")
+    for line in outcome.problems:
+        print(f"granplate: {line}", file=sys.stderr)
+    return 0 if outcome.ok else 3
+
+
+def _cmd_plot(args) -> int:
+    from . import plots
+
+    names = list(plots.FIGURES) if args.figure.lower() == "all" else [args.figure]
+    for name in names:
+        try:
+            key = plots.figure_key(name)
+        except KeyError:
+            raise ScenarioError("--figure", name, "allowed: " + ", ".join(plots.FIGURES) + " (or 'all'; "
+                                "'fig3', 'A.1' also work)") from None
+        paths = figure_inputs(key, args.results)
+        for p in paths:
+            _read(p)  # a clear error for a file that is not a result
+        for written in make_figure(key, paths, Path(args.out)):
+            print(f"written {written}")
+    return 0
+
+
+def _cmd_animate(args) -> int:
+    from .animate import animate
+
+    ds = _read(_existing(args.result))
+    target = Path(args.output) if args.output else Path(f"{ds.attrs.get('scenario_name', 'result')}.mp4")
+    if target.suffix.lower() not in (".mp4", ".gif"):
+        raise ScenarioError("-o", str(target), "allowed: a .mp4 or .gif file name")
+    if ds.sizes.get("field_time", 0) == 0:
+        raise ScenarioError("result", args.result, "has no plate-field snapshots to animate")
+    written = animate(ds, target, frames=args.frames, fps=args.fps, magnify=args.magnify)
+    print(f"written {written}")
+    return 0
+
+
+def _cmd_export(args) -> int:
+    from .analysis import has_plate
+    from .export import export_vtk
+
+    ds = _read(_existing(args.result))
+    if not has_plate(ds):
+        raise ScenarioError("result", args.result, "has no plate to export")
+    pvd = export_vtk(ds, args.vtk)
+    print(f"written {ds.sizes.get('field_time', 0)} snapshots; open {pvd} in ParaView")
+    return 0
+
+
+def _positive_int(text: str) -> int:
+    v = int(text)
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: must be an integer >= 1")
+    return v
+
+
+def register(subparsers) -> None:
+    """Add the `reproduce`, `plot`, `animate` and `export` commands."""
+    r = subparsers.add_parser("reproduce", help="run the paper's six cases, draw every figure, "
+                              "both animations and the report (reusing unchanged results)")
+    r.add_argument("--out", default=DEFAULT_OUT, help=f"output directory (default {DEFAULT_OUT})")
+    r.add_argument("--t-end", type=float, default=None, help="shorten every run to this time [s]")
+    r.add_argument("--jobs", type=_positive_int, default=os.cpu_count() or 1,
+                   help="worker processes (default: the number of cores)")
+    r.add_argument("--force", action="store_true", help="run everything again, even unchanged results")
+    r.add_argument("--checks", choices=CHECK_MODES, default="fast",
+                   help="sensitivity runs for the report's discussion: fast (default, ~1 min on "
+                        "2 cores), all (adds finer meshes, ~3 min), none")
+    r.add_argument("--frames", type=_positive_int, default=DEFAULT_FRAMES, help="animation frames (at most)")
+    r.add_argument("--no-figures", action="store_true", help="skip the figures (runs and report only)")
+    r.add_argument("--no-animations", action="store_true", help="skip the animations")
+    r.add_argument("-q", "--quiet", action="store_true", help="no progress output")
+    r.set_defaults(func=_cmd_reproduce)
+
+    p = subparsers.add_parser("plot", help="draw one paper figure from result file(s)")
+    p.add_argument("results", nargs="+", help="result .nc file(s), or a directory holding PRESET.nc files")
+    p.add_argument("--figure", required=True, help="3, 4, 5, 6, 7, 8, A1 (or 'all')")
+    p.add_argument("--out", default=".", help="directory for the PNG and PDF (default .)")
+    p.set_defaults(func=_cmd_plot)
+
+    a = subparsers.add_parser("animate", help="animate a result (granules, deformed plate, x125)")
+    a.add_argument("result", help="a result .nc file")
+    a.add_argument("-o", "--output", help="output .mp4 (or .gif) (default SCENARIO.mp4)")
+    a.add_argument("--frames", type=_positive_int, default=DEFAULT_FRAMES, help="at most this many frames")
+    a.add_argument("--fps", type=_positive_int, default=15, help="frames per second")
+    a.add_argument("--magnify", type=float, default=125.0, help="displacement magnification")
+    a.set_defaults(func=_cmd_animate)
+
+    e = subparsers.add_parser("export", help="write a ParaView time series (VTK, .pvd) of a result")
+    e.add_argument("result", help="a result .nc file")
+    e.add_argument("--vtk", required=True, help="output directory for the .vtu and .pvd files")
+    e.set_defaults(func=_cmd_export)

@@ -1,0 +1,138 @@
+"""Verification suite: `granplate verify [--out DIR] [--full] [--case NAME ...]`.
+
+Every part of the simulator is checked against independent truth (docs/validation.md is
+the page this writes, regenerated with --full):
+
+- granular.py: Chung & Ooi (2011) tests 1-4, sliding to rolling, Nesterenko's solitary
+  wave on a striker-hit chain;
+- plate_cases.py: patch test, clamped strip against Timoshenko beam theory (statics and
+  frequencies), Q8 convergence rates, Newmark's period elongation;
+- conservation.py: energy residual of every preset, momenta of a free assembly, forces
+  equal minus the gradient of the contact energies;
+- coupled.py (slow, --full): convergence of the PTFE and steel presets under halving of
+  the time step, iteration tolerance and element size, and the rigid-layer width;
+- page.py: DIR/validation.md, DIR/validation.html, DIR/validation.json and the figures
+  in DIR/validation-figures/.
+
+    >>> from granplate.verification import run_suite
+    >>> results = run_suite("out", full=False)      # list of CaseResult, pages written
+
+Simulated cases are scenario files in `granplate/verification/scenarios/`.
+"""
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+
+
+def __getattr__(name: str):
+    # the CLI imports this package to register `verify`: keep that import light
+    if name in ("Case", "CaseResult", "Check", "Context", "run_case"):
+        from . import base
+        return getattr(base, name)
+    raise AttributeError(f"module 'granplate.verification' has no attribute {name!r}")
+
+
+def all_cases() -> tuple:
+    """Every registered case, in page order."""
+    from . import conservation, coupled, granular, plate_cases
+
+    return granular.CASES + plate_cases.CASES + conservation.CASES + coupled.CASES
+
+
+def case_names(full: bool = True) -> list[str]:
+    """Names of the cases the fast (full=False) or full suite runs."""
+    return [c.name for c in all_cases() if full or not c.slow]
+
+
+def get_case(name: str):
+    """The case called `name` (KeyError listing the names otherwise)."""
+    for c in all_cases():
+        if c.name == name:
+            return c
+    raise KeyError(f"no verification case {name!r}; cases are: {', '.join(case_names())}")
+
+
+def run_suite(out: str | Path, full: bool = False, names: list[str] | None = None,
+              log=None) -> list:
+    """Run the suite (or the cases `names`), write the pages into `out`, return the results.
+
+    full: include the slow cases (and the full-length preset runs); log: a callable taking
+    one line of progress (None: silent).
+    """
+    from .base import Context, run_case
+    from .coupled import load_run_cache, save_run_cache
+    from .page import write_pages
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    cache_path = out / "validation-runs.json"
+    ctx = Context(out=out, full=full, run_cache=load_run_cache(cache_path) if full else None)
+    cases = [get_case(n) for n in names] if names else [c for c in all_cases() if full or not c.slow]
+    t0 = time.perf_counter()
+    results = []
+    for case in cases:
+        if log:
+            log(f"verify: {case.name} ...")
+        r = run_case(case, ctx)
+        results.append(r)
+        if log:
+            bad = [c.quantity for c in r.checks if not c.passed]
+            state = "crashed" if r.crashed else ("pass" if r.passed else f"FAIL ({'; '.join(bad)})")
+            log(f"verify: {case.name}: {state} [{r.seconds:.1f} s]")
+    if full and ctx.run_cache is not None:
+        save_run_cache(cache_path, ctx.run_cache)
+    write_pages(out, results, full or any(c.slow for c in cases), time.perf_counter() - t0)
+    return results
+
+
+def _cmd_verify(args) -> int:
+    def log(line: str) -> None:
+        print(line, file=sys.stderr, flush=True)
+
+    if args.list:
+        for case in all_cases():
+            print(f"{case.name:22s} {'(--full) ' if case.slow else ''}{case.title}")
+        return 0
+    try:
+        names = args.case or None
+        if names:
+            for n in names:
+                get_case(n)
+    except KeyError as err:
+        print(f"granplate: error: {err.args[0]}", file=sys.stderr)
+        return 2
+    results = run_suite(args.out, full=args.full, names=names, log=None if args.quiet else log)
+    n_bad = sum(1 for r in results if not r.passed)
+    n_checks = sum(len(r.checks) for r in results)
+    bad_checks = sum(1 for r in results for c in r.checks if not c.passed)
+    out = Path(args.out)
+    print(f"{len(results)} cases, {n_checks} checks: "
+          + ("all pass" if n_bad == 0 else f"{bad_checks} checks fail in {n_bad} cases"))
+    print(f"page: {out / 'validation.md'} (and validation.html)")
+    return 0 if n_bad == 0 else 1
+
+
+def register(subparsers) -> None:
+    """Add `granplate verify` to the CLI's subparsers."""
+    p = subparsers.add_parser(
+        "verify", help="run the verification suite and write the validation page",
+        description="Run the verification suite (each part of the simulator against "
+                    "independent truth) and write DIR/validation.md and DIR/validation.html. "
+                    "Exits with status 1 when a case fails.")
+    p.add_argument("--out", default="out/verification", metavar="DIR",
+                   help="output folder for the page, its figures and data (default: out/verification)")
+    p.add_argument("--full", action="store_true",
+                   help="also run the slow convergence studies of the coupled runs (minutes; "
+                        "their runs are cached in DIR/validation-runs.json)")
+    p.add_argument("--case", action="append", metavar="NAME",
+                   help="run only this case (repeatable; see --list)")
+    p.add_argument("--list", action="store_true", help="list the cases and exit")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
+    p.set_defaults(func=_cmd_verify)
+
+
+__all__ = ["run_suite", "all_cases", "case_names", "get_case", "register", "Case", "CaseResult",
+           "Check", "Context"]

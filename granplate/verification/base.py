@@ -1,0 +1,265 @@
+"""The pieces every verification case is made of: checks, case results, the registry.
+
+A *check* compares one number the simulator produced ("ours") with an independent
+reference (a closed form, a published value, an independent high-accuracy solution),
+under a tolerance that is justified in words on the page. A *case* runs one physical
+situation (usually a scenario file under `verification/scenarios/`), returns its checks
+and draws one figure.
+
+Check kinds (how `error` and `passed` are computed):
+
+- "rel": error = |ours - reference| / |reference|, passes when error <= tolerance;
+- "abs": error = |ours - reference|, passes when error <= tolerance;
+- "max": an upper bound: error = ours, passes when ours <= tolerance (reference is the
+  ideal value, usually 0);
+- "min": a lower bound: error = ours, passes when ours >= tolerance.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+import traceback
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+#: Folder (inside the output directory) that holds the figures.
+FIGURE_DIR = "validation-figures"
+
+#: Machine epsilon of float64.
+EPS = float(np.finfo(float).eps)
+
+
+@dataclass(frozen=True)
+class Check:
+    """One number against its reference.
+
+    quantity: what is compared (with the setting, e.g. "t_c, glass"); unit: its unit
+    ("-" for none); reference: the true value; source: where the reference comes from;
+    ours: the simulator's value; tolerance: see the module docstring for `kind`;
+    why: one sentence justifying the tolerance (time-step order, mesh order, offsets).
+    """
+
+    quantity: str
+    unit: str
+    reference: float
+    source: str
+    ours: float
+    tolerance: float
+    why: str
+    kind: str = "rel"
+
+    def __post_init__(self) -> None:
+        if self.kind not in ("rel", "abs", "max", "min"):
+            raise ValueError(f"unknown check kind {self.kind!r}")
+
+    @property
+    def error(self) -> float:
+        """The compared error measure (see the module docstring)."""
+        ours, ref = float(self.ours), float(self.reference)
+        if self.kind == "rel":
+            return abs(ours - ref) / abs(ref) if ref != 0.0 else math.inf
+        if self.kind == "abs":
+            return abs(ours - ref)
+        return ours
+
+    @property
+    def passed(self) -> bool:
+        """Whether the check holds (a NaN never passes)."""
+        err = self.error
+        if not math.isfinite(float(self.ours)) or math.isnan(err):
+            return False
+        if self.kind == "min":
+            return err >= self.tolerance
+        return err <= self.tolerance
+
+    def as_dict(self) -> dict:
+        """Plain dict (for JSON), with error and passed."""
+        d = dataclasses.asdict(self)
+        d["error"] = float(self.error)
+        d["passed"] = bool(self.passed)
+        return d
+
+
+@dataclass
+class CaseResult:
+    """What one case returns: its checks, its figure, a description and notes.
+
+    description: what is run and against which truth (Markdown, a paragraph);
+    figure: file name inside FIGURE_DIR (None when the case crashed before plotting);
+    notes: extra sentences for the page (known limitations, what is out of scope);
+    tables: extra Markdown tables (the convergence studies); crashed: the traceback
+    when the case raised (the case then fails).
+    """
+
+    name: str
+    family: str
+    title: str
+    description: str = ""
+    checks: list[Check] = field(default_factory=list)
+    figure: str | None = None
+    notes: list[str] = field(default_factory=list)
+    tables: list[str] = field(default_factory=list)
+    seconds: float = 0.0
+    crashed: str | None = None
+
+    @property
+    def passed(self) -> bool:
+        """True when the case ran and every check passed."""
+        return self.crashed is None and bool(self.checks) and all(c.passed for c in self.checks)
+
+    def as_dict(self) -> dict:
+        """Plain dict (for JSON)."""
+        return {
+            "name": self.name, "family": self.family, "title": self.title,
+            "passed": self.passed, "seconds": self.seconds, "crashed": self.crashed,
+            "figure": self.figure, "checks": [c.as_dict() for c in self.checks],
+        }
+
+
+@dataclass(frozen=True)
+class Case:
+    """A registered case: `run(ctx)` returns its CaseResult (family, title filled in).
+
+    slow: only with `granplate verify --full`.
+    """
+
+    name: str
+    family: str
+    title: str
+    run: Callable[["Context"], CaseResult]
+    slow: bool = False
+
+
+@dataclass
+class Context:
+    """What a case may use: the output directory and a run cache (for slow studies)."""
+
+    out: Path
+    full: bool = False
+    run_cache: dict | None = None
+
+    @property
+    def figure_dir(self) -> Path:
+        path = self.out / FIGURE_DIR
+        path.mkdir(parents=True, exist_ok=True)
+        return path
+
+    def figure_path(self, name: str) -> Path:
+        """Where the figure of case `name` goes."""
+        return self.figure_dir / f"{name}.png"
+
+
+def run_case(case: Case, ctx: Context) -> CaseResult:
+    """Run one case; an exception becomes a failing result carrying the traceback."""
+    t0 = time.perf_counter()
+    try:
+        result = case.run(ctx)
+    except Exception:  # noqa: BLE001 - a crashing case is reported, not fatal
+        result = CaseResult(case.name, case.family, case.title, crashed=traceback.format_exc())
+    result.name, result.family, result.title = case.name, case.family, case.title
+    result.seconds = time.perf_counter() - t0
+    return result
+
+
+# --------------------------------------------------------------------------- scenarios
+
+def scenario_text(name: str) -> str:
+    """The TOML text of verification scenario `name` (package data)."""
+    return (resources.files("granplate.verification") / "scenarios" / f"{name}.toml").read_text(
+        encoding="utf-8")
+
+
+def scenario_names() -> list[str]:
+    """Every verification scenario file, without the .toml suffix."""
+    folder = resources.files("granplate.verification") / "scenarios"
+    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def load_case_scenario(name: str, changes: dict | None = None):
+    """The verification scenario `name`, with dotted-path `changes`, validated."""
+    from ..scenario_io import loads, with_changes
+    from ..validate import validate
+
+    s = loads(scenario_text(name))
+    if changes:
+        s = with_changes(s, changes)
+    validate(s)
+    return s
+
+
+def step_changes(dt: float, t_end: float, out: float | None = None) -> dict:
+    """Dotted-path changes setting a fixed step dt, the end time and the output interval."""
+    out = dt if out is None else out
+    return {"time.dt_max": dt, "time.dt_initial": dt, "time.dt_min": min(1e-13, dt),
+            "time.t_end": t_end, "time.output_interval": out, "time.field_interval": out}
+
+
+def simulate(scenario):
+    """Run a scenario quietly and return its Dataset."""
+    from .. import simulate as run
+
+    return run(scenario, progress=False)
+
+
+# --------------------------------------------------------------------------- numerics
+
+def parabolic_peak(t: np.ndarray, y: np.ndarray) -> tuple[float, float]:
+    """Time and value of the maximum of samples y(t), refined by a parabola through the
+    largest sample and its two neighbours (uniform spacing). Returns (t_peak, y_peak)."""
+    k = int(np.argmax(y))
+    if k == 0 or k == len(y) - 1:
+        return float(t[k]), float(y[k])
+    y0, y1, y2 = float(y[k - 1]), float(y[k]), float(y[k + 1])
+    den = y0 - 2.0 * y1 + y2
+    if den == 0.0:
+        return float(t[k]), y1
+    p = 0.5 * (y0 - y2) / den
+    return float(t[k] + p * (t[k + 1] - t[k])), y1 - 0.25 * (y0 - y2) * p
+
+
+def last_zero_crossing(t: np.ndarray, y: np.ndarray) -> float:
+    """Time where y goes from > 0 to <= 0 for the last time (linear interpolation)."""
+    pos = np.flatnonzero(y > 0.0)
+    if pos.size == 0 or pos[-1] == len(y) - 1:
+        return math.nan
+    j = int(pos[-1])
+    return float(t[j] + (t[j + 1] - t[j]) * y[j] / (y[j] - y[j + 1]))
+
+
+def observed_order(e_coarse: float, e_fine: float, ratio: float = 2.0) -> float:
+    """log(e_coarse / e_fine) / log(ratio): the order seen when h shrinks by `ratio`."""
+    if e_fine == 0.0 or e_coarse == 0.0:
+        return math.nan
+    return math.log(abs(e_coarse) / abs(e_fine)) / math.log(ratio)
+
+
+def loglog_slope(x: np.ndarray, y: np.ndarray) -> float:
+    """Least-squares slope of log|y| against log x."""
+    return float(np.polyfit(np.log(np.asarray(x, float)), np.log(np.abs(np.asarray(y, float))), 1)[0])
+
+
+def new_figure(ncols: int = 1, nrows: int = 1, width: float = 6.4, height: float = 4.0):
+    """A matplotlib figure (Agg backend) and its axes."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=True)
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(nrows, ncols, figsize=(width * ncols if ncols > 1 else width, height * nrows),
+                             squeeze=False)
+    return fig, axes
+
+
+def save_figure(fig, ctx: Context, name: str) -> str:
+    """Save and close a figure as FIGURE_DIR/name.png; returns the file name."""
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    fig.savefig(ctx.figure_path(name), dpi=110)
+    plt.close(fig)
+    return f"{name}.png"
