@@ -785,3 +785,21 @@ def build_plate(
         E=float(material.E),
         nu=float(material.nu),
     )
+
+
+def transverse_mode_frequencies(model: PlateModel, n: int = 3) -> np.ndarray:
+    """Frequencies [Hz] of the n lowest modes whose kinetic energy is mostly along x.
+
+    For a strip clamped at its ends along y these are its in-plane bending modes; the
+    others are extensional (along y). Phi is mass-normalised, so v^T M v = 1 per mode.
+    """
+    M = model.mass_matrix()
+    out: list[float] = []
+    for j in range(model.n_modes):
+        vx = model.T @ model.Phi[:, j]
+        vx[1::2] = 0.0
+        if vx @ (M @ vx) > 0.5:
+            out.append(float(model.omega[j]) / (2.0 * np.pi))
+            if len(out) == n:
+                break
+    return np.array(out)

@@ -69,19 +69,7 @@ def timoshenko_clamped_frequencies(E, G, rho, k, length, depth, n=3):
     return np.array(roots[:n]) / (2 * np.pi)
 
 
-def bending_frequencies(model: gp.PlateModel, n: int = 3) -> np.ndarray:
-    """Frequencies [Hz] of the n lowest modes whose kinetic energy is mostly in x."""
-    M = model.mass_matrix()
-    out = []
-    for j in range(model.n_modes):
-        v = model.T @ model.Phi[:, j]
-        vx = v.copy()
-        vx[1::2] = 0.0
-        if vx @ (M @ vx) > 0.5:  # Phi is mass-normalised: v^T M v = 1
-            out.append(model.omega[j] / (2 * np.pi))
-        if len(out) == n:
-            break
-    return np.array(out)
+bending_frequencies = gp.transverse_mode_frequencies
 
 
 def test_clamped_strip_matches_timoshenko_beam():
