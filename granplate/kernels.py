@@ -34,8 +34,9 @@ from .shock import time_profile
 
 # --- layout of the small bookkeeping arrays -------------------------------------------
 # clock (float64)
-T_NOW, H_LAST, E_IN_MAX, E_ZERO, E_POT, CUSTOM_H = 0, 1, 2, 3, 4, 5
-N_CLOCK = 8
+T_NOW, H_LAST, E_IN_MAX, E_ZERO, E_POT, CUSTOM_H, F_SCALE = 0, 1, 2, 3, 4, 5, 6
+A_SCALE = 7  # 3 slots: 7, 8, 9
+N_CLOCK = 10
 # count (int64)
 C_STEPS, C_LEVEL, C_OUT, C_ITERS, C_RETRIES = 0, 1, 2, 3, 4
 N_COUNT = 8
@@ -56,6 +57,7 @@ N_ERR = 8
 # status codes returned by `advance`
 OK, ERR_NAN, ERR_ENERGY, ERR_NOCONV, ERR_BUFFER = 0, 1, 2, 3, 4
 
+SCHEME_PAPER, SCHEME_IMPLICIT = 0, 1
 LEVEL_RATIO = 2.0 ** -0.25
 #: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps
 #: h * (friction relaxation rate of every granule contact) below this bound.
@@ -118,6 +120,8 @@ class Config(NamedTuple):
     t_end: float
     load_on_plate: bool
     arm_shrink: float = 0.0  # 0: friction arm R (MODEL.md); 1: arm to the contact point
+    scheme: int = 0  # SCHEME_PAPER or SCHEME_IMPLICIT
+    error_tol: float = 1e-3  # implicit scheme: local error target of the step control
 
 
 class State(NamedTuple):
@@ -134,6 +138,8 @@ class State(NamedTuple):
     force: np.ndarray  # (nd,) interface force on the plate
     force_prev: np.ndarray
     k1: np.ndarray  # (ng, 6) time derivative at t_n
+    k0: np.ndarray  # (ng, 6) time derivative at t_n-1
+    pforce: np.ndarray  # (nd,) the plate's end-force history P_n (Newmark bookkeeping)
     p1: np.ndarray  # (3,) shock, viscous, friction power at t_n
     normal: np.ndarray  # (nk,) |N| at plate contacts
     slip: np.ndarray  # (nk,) tangential slip rate at plate contacts
@@ -157,6 +163,10 @@ class Work(NamedTuple):
     anext: np.ndarray
     aavg: np.ndarray
     fguess: np.ndarray
+    pvec: np.ndarray  # (nd,) plate end forces of the step being solved
+    fbar: np.ndarray  # (nk,) implicit scheme: plate-contact friction held over the step
+    k1i: np.ndarray  # (ng, 6) implicit scheme: stage-1 derivative with fbar
+    p1i: np.ndarray  # (3,)
     fnew: np.ndarray
     fscratch: np.ndarray
     pend: np.ndarray
@@ -196,11 +206,13 @@ class Output(NamedTuple):
 
 
 @njit(cache=True)
-def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip):
+def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
     """Time derivative of the granular state and the plate-contact forces.
 
     y: (ng, 6) state; up, vp: driving-DOF displacement and velocity at t; writes dy,
     fplate (nd,) = force ON the plate [N, N], normal and slip at each plate contact.
+    hold: the plate-contact friction is fbar[k] (held over the step, implicit scheme)
+    instead of mu |N| tanh(k_s v_t).
     Returns (shock power, viscous power, friction power, contact potential energy,
     largest friction relaxation rate of a granule contact) [W, J, 1/s]. That rate,
     mu k_s |N| cosh^-2(k_s v_t) (1/m_i + 1/m_j + a_i^2/I_i + a_j^2/I_j), is how fast the
@@ -294,17 +306,23 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip):
         vt = y[i, 4] - vp[2 * k + 1] + ai * y[i, 5]
         n = 0.0
         f = 0.0
+        pf = 0.0
         if delta > 0.0:
             c = g.pc_coef[k]
             n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[0], c[1], c[2], c[3], cfg.clip)
-            # the granule side only: the plate side of this map is criterion (8)
-            rate = max(rate, slip_relaxation_rate(n, vt, c[2], c[3], 1.0 / g.mass[i] + ai * ai / g.inertia[i]))
+            if not hold:
+                # the granule side only: the plate side of this map is criterion (8)
+                rate = max(rate, slip_relaxation_rate(n, vt, c[2], c[3], 1.0 / g.mass[i] + ai * ai / g.inertia[i]))
             dy[i, 3] -= n
+            p_visc += pv
+            e_pot += ep
+        if hold:
+            f = fbar[k]
+            pf = f * vt
+        if f != 0.0:
             dy[i, 4] -= f
             dy[i, 5] -= f * ai
-            p_visc += pv
             p_fric += pf
-            e_pot += ep
         fplate[2 * k] = n
         fplate[2 * k + 1] = f
         normal[k] = n
@@ -345,31 +363,43 @@ def rk4_granular_step(t, h, st, g, cfg, w):
     t + h), w.pend, w.dacc (integrated shock, viscous, friction work over the step).
     """
     y0 = st.y
-    k1 = st.k1
     ng = y0.shape[0]
+    hold = cfg.scheme == SCHEME_IMPLICIT
+    k1 = st.k1
+    p1 = st.p1
+    if hold:  # stage 1 depends on the held friction: no FSAL
+        for d in range(st.u.shape[0]):
+            w.up[d] = st.u[d]
+            w.vp[d] = st.v[d]
+        pr = granular_rhs(t, y0, w.up, w.vp, g, cfg, w.k1i, w.fscratch, w.nscratch, w.sscratch, True, w.fbar)
+        w.p1i[0] = pr[0]
+        w.p1i[1] = pr[1]
+        w.p1i[2] = pr[2]
+        k1 = w.k1i
+        p1 = w.p1i
     hh = 0.5 * h
     contact_point_motion(hh, st.u, st.v, w.aavg, w.up, w.vp)
     for i in range(ng):
         for c in range(6):
             w.ytmp[i, c] = y0[i, c] + hh * k1[i, c]
-    p2 = granular_rhs(t + hh, w.ytmp, w.up, w.vp, g, cfg, w.k2, w.fscratch, w.nscratch, w.sscratch)
+    p2 = granular_rhs(t + hh, w.ytmp, w.up, w.vp, g, cfg, w.k2, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar)
     for i in range(ng):
         for c in range(6):
             w.ytmp[i, c] = y0[i, c] + hh * w.k2[i, c]
-    p3 = granular_rhs(t + hh, w.ytmp, w.up, w.vp, g, cfg, w.k3, w.fscratch, w.nscratch, w.sscratch)
+    p3 = granular_rhs(t + hh, w.ytmp, w.up, w.vp, g, cfg, w.k3, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar)
     contact_point_motion(h, st.u, st.v, w.aavg, w.up, w.vp)
     for i in range(ng):
         for c in range(6):
             w.ytmp[i, c] = y0[i, c] + h * w.k3[i, c]
-    p4 = granular_rhs(t + h, w.ytmp, w.up, w.vp, g, cfg, w.k4, w.fscratch, w.nscratch, w.sscratch)
+    p4 = granular_rhs(t + h, w.ytmp, w.up, w.vp, g, cfg, w.k4, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar)
     h6 = h / 6.0
     for i in range(ng):
         for c in range(6):
             w.ynew[i, c] = y0[i, c] + h6 * (k1[i, c] + 2.0 * w.k2[i, c] + 2.0 * w.k3[i, c] + w.k4[i, c])
-    w.dacc[0] = h6 * (st.p1[0] + 2.0 * p2[0] + 2.0 * p3[0] + p4[0])
-    w.dacc[1] = h6 * (st.p1[1] + 2.0 * p2[1] + 2.0 * p3[1] + p4[1])
-    w.dacc[2] = h6 * (st.p1[2] + 2.0 * p2[2] + 2.0 * p3[2] + p4[2])
-    pe = granular_rhs(t + h, w.ynew, w.up, w.vp, g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new)
+    w.dacc[0] = h6 * (p1[0] + 2.0 * p2[0] + 2.0 * p3[0] + p4[0])
+    w.dacc[1] = h6 * (p1[1] + 2.0 * p2[1] + 2.0 * p3[1] + p4[1])
+    w.dacc[2] = h6 * (p1[2] + 2.0 * p2[2] + 2.0 * p3[2] + p4[2])
+    pe = granular_rhs(t + h, w.ynew, w.up, w.vp, g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar)
     w.pend[0] = pe[0]
     w.pend[1] = pe[1]
     w.pend[2] = pe[2]
@@ -474,7 +504,7 @@ def initialise(st, g, p, cfg, w):
     for d in range(nd):
         w.up[d] = st.u[d]
         w.vp[d] = st.v[d]
-    pr = granular_rhs(st.clock[T_NOW], st.y, w.up, w.vp, g, cfg, st.k1, st.force, st.normal, st.slip)
+    pr = granular_rhs(st.clock[T_NOW], st.y, w.up, w.vp, g, cfg, st.k1, st.force, st.normal, st.slip, False, w.fbar)
     st.p1[0] = pr[0]
     st.p1[1] = pr[1]
     st.p1[2] = pr[2]
@@ -587,6 +617,74 @@ def level_for(h, cfg):
 
 
 @njit(cache=True)
+def plate_end_forces(implicit, st, w):
+    """The plate's end force P_n+1 from the unknowns w.fguess.
+
+    paper: P = F_n+1 (Newmark's trapezoid averages F_n and F_n+1). implicit: normal
+    forces the same; the friction fbar is held over the whole step for the plate and the
+    granule alike (backward Euler for the stiff friction, L-stable: no stick chatter),
+    which in Newmark's trapezoid is the end force P = 2 fbar - P_n.
+    """
+    nd = w.fguess.shape[0]
+    for d in range(nd):
+        if implicit and d % 2 == 1:
+            w.fbar[d // 2] = w.fguess[d]
+            w.pvec[d] = 2.0 * w.fguess[d] - st.pforce[d]
+        else:
+            w.pvec[d] = w.fguess[d]
+
+
+@njit(cache=True)
+def newton_update(h, gm, g, w):
+    """One diagonal Newton step on r = U - F(U) at every plate contact (implicit scheme).
+
+    Normal: dF/dU = -3/2 A delta^1/2 (h^2/4) G_xx (the plate yields under the force);
+    friction: dF/dU = -mu |N| k_s cosh^-2(k_s v_t) h (G_yy + 1/m + a^2/I) (the held force
+    changes the plate's and the granule's tangential velocity).
+    """
+    for k in range(g.pc_i.shape[0]):
+        i = g.pc_i[k]
+        dx = 2 * k
+        dt_ = 2 * k + 1
+        delta = w.ynew[i, 0] + g.radius[i] - (g.pc_x[k] + w.up[dx])
+        jac = 1.0
+        if delta > 0.0:
+            jac += 1.5 * g.pc_coef[k, 0] * math.sqrt(delta) * 0.25 * h * h * gm[dx, dx]
+        w.fguess[dx] -= (w.fguess[dx] - w.fnew[dx]) / jac
+        n = w.normal_new[k]
+        ch = math.cosh(g.pc_coef[k, 3] * w.slip_new[k])
+        jt = 1.0 + g.pc_coef[k, 2] * n * g.pc_coef[k, 3] / (ch * ch) * h * (
+            gm[dt_, dt_] + 1.0 / g.mass[i] + g.radius[i] ** 2 / g.inertia[i])
+        w.fguess[dt_] -= (w.fguess[dt_] - w.fnew[dt_]) / jt
+
+
+@njit(cache=True)
+def step_error(ratio, st, w, nd):
+    """Local error estimate of the implicit scheme (relative, ~ h^2 f''/2).
+
+    The distance of the new interface forces and granule accelerations from their linear
+    extrapolation over the last two steps, relative to the largest values met so far.
+    """
+    err = 0.0
+    for d in range(nd):
+        u = w.fguess[d]
+        st.clock[F_SCALE] = max(st.clock[F_SCALE], abs(u))
+        pred = st.force[d] + ratio * (st.force[d] - st.force_prev[d])
+        err = max(err, abs(u - pred))
+    err = err / max(st.clock[F_SCALE], 1e-300)
+    for c in range(3):
+        sc = st.clock[A_SCALE + c]
+        for i in range(st.y.shape[0]):
+            sc = max(sc, abs(w.kend[i, 3 + c]))
+        st.clock[A_SCALE + c] = sc
+        if sc > 0.0:
+            for i in range(st.y.shape[0]):
+                pred = st.k1[i, 3 + c] + ratio * (st.k1[i, 3 + c] - st.k0[i, 3 + c])
+                err = max(err, abs(w.kend[i, 3 + c] - pred) / sc)
+    return err
+
+
+@njit(cache=True)
 def advance(t_stop, g, p, cfg, st, w, out):
     """Advance from st.clock[T_NOW] to t_stop (an output time). Returns a status code.
 
@@ -638,12 +736,14 @@ def advance(t_stop, g, p, cfg, st, w, out):
         rate = 0.0
         it = 0
         worst = -1
+        implicit = cfg.scheme == SCHEME_IMPLICIT
         while it < cfg.max_iter:
             it += 1
+            plate_end_forces(implicit, st, w)
             for d in range(nd):
                 s = w.astar[d]
                 for e in range(nd):
-                    s += gm[d, e] * w.fguess[e]
+                    s += gm[d, e] * w.pvec[e]
                 w.anext[d] = s
                 w.aavg[d] = 0.5 * (st.a[d] + s)
             e_pot, rate = rk4_granular_step(t, h, st, g, cfg, w)
@@ -662,8 +762,11 @@ def advance(t_stop, g, p, cfg, st, w, out):
                             worst = k
             if converged:
                 break
-            for d in range(nd):
-                w.fguess[d] = w.fnew[d]
+            if implicit:
+                newton_update(h, gm, g, w)
+            else:
+                for d in range(nd):
+                    w.fguess[d] = w.fnew[d]
         st.count[C_ITERS] += it
         if not converged:
             st.count[C_RETRIES] += 1
@@ -683,22 +786,27 @@ def advance(t_stop, g, p, cfg, st, w, out):
                 return ERR_NOCONV
             st.count[C_LEVEL] = new_level
             continue
-        # accept: the plate moves with the forces the granules saw (w.fguess)
-        work = newmark_correct(t, h, st, p, cfg, dm, w.qdd_star, w.fguess)
+        # accept: the plate moves with the forces the granules saw (w.pvec)
+        work = newmark_correct(t, h, st, p, cfg, dm, w.qdd_star, w.pvec)
+        err = 0.0
+        if implicit:
+            err = step_error(ratio, st, w, nd)
         for d in range(nd):
             s = w.astar[d]
             for e in range(nd):
-                s += gm[d, e] * w.fguess[e]
+                s += gm[d, e] * w.pvec[e]
             a1 = s
             v1 = st.v[d] + 0.5 * h * (st.a[d] + a1)
             st.u[d] = st.u[d] + h * st.v[d] + 0.25 * h * h * (st.a[d] + a1)
             st.v[d] = v1
             st.a[d] = a1
+            st.pforce[d] = w.pvec[d]
             st.force_prev[d] = st.force[d]
-            st.force[d] = w.fnew[d]
+            st.force[d] = w.fguess[d] if implicit else w.fnew[d]
         for i in range(ng):
             for c in range(6):
                 st.y[i, c] = w.ynew[i, c]
+                st.k0[i, c] = st.k1[i, c]
                 st.k1[i, c] = w.kend[i, c]
         st.p1[0] = w.pend[0]
         st.p1[1] = w.pend[1]
@@ -723,7 +831,10 @@ def advance(t_stop, g, p, cfg, st, w, out):
             w.lam_int[k] = max(w.lam_int[k], lam)
             w.it_int[k] = max(w.it_int[k], w.conv_iter[k] if w.conv_iter[k] > 0 else 1)
             lam_max = max(lam_max, lam)
-        if lam_max > 0.0:
+        if implicit:
+            grow = 2.0 if err <= 0.0 else min(2.0, max(0.3, 0.9 * math.sqrt(cfg.error_tol / err)))
+            h_new = min(max(h, h_lvl if slot == N_LEVELS else h) * grow, cfg.dt_max)
+        elif lam_max > 0.0:
             h_new = min(h * cfg.lambda_target / lam_max, 2.0 * h_lvl, cfg.dt_max)
         else:
             h_new = min(2.0 * h_lvl, cfg.dt_max)
@@ -776,7 +887,8 @@ def new_state(ng: int, nm: int, nk: int) -> State:
     z = np.zeros
     return State(
         y=z((ng, 6)), acc=z(N_ACC), q=z(nm), qd=z(nm), qdd=z(nm), u=z(nd), v=z(nd),
-        a=z(nd), force=z(nd), force_prev=z(nd), k1=z((ng, 6)), p1=z(3), normal=z(nk),
+        a=z(nd), force=z(nd), force_prev=z(nd), k1=z((ng, 6)), k0=z((ng, 6)), pforce=z(nd),
+        p1=z(3), normal=z(nk),
         slip=z(nk), clock=z(N_CLOCK), count=np.zeros(N_COUNT, np.int64), err=z(N_ERR),
     )
 
@@ -788,7 +900,7 @@ def new_work(ng: int, nm: int, nk: int) -> Work:
     return Work(
         ytmp=z((ng, 6)), ynew=z((ng, 6)), k2=z((ng, 6)), k3=z((ng, 6)), k4=z((ng, 6)),
         kend=z((ng, 6)), up=z(nd), vp=z(nd), astar=z(nd), anext=z(nd), aavg=z(nd),
-        fguess=z(nd), fnew=z(nd), fscratch=z(nd), pend=z(3), dacc=z(3), qdd_star=z(nm),
+        fguess=z(nd), pvec=z(nd), fbar=z(nk), k1i=z((ng, 6)), p1i=z(3), fnew=z(nd), fscratch=z(nd), pend=z(3), dacc=z(3), qdd_star=z(nm),
         normal_new=z(nk), slip_new=z(nk), nscratch=z(nk), sscratch=z(nk),
         conv_iter=np.zeros(nk, np.int64), dmode=z((N_LEVELS + 1, nm)),
         gmat=z((N_LEVELS + 1, nd, nd)), g_ok=np.zeros(N_LEVELS + 1, np.int64),

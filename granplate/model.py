@@ -187,10 +187,13 @@ def build_model(scenario: Scenario) -> Model:
         q0=float(q0), duration=float(s.load.duration), clip=bool(s.contact.clip_tensile),
         lambda_target=float(sol.lambda_target), rtol=float(sol.iteration_rtol),
         atol=float(sol.iteration_atol), max_iter=int(sol.max_iterations),
-        energy_tol=float(sol.energy_tol), dt_max=float(t.dt_max), dt_min=float(t.dt_min),
+        energy_tol=float(sol.energy_tol),
+        dt_max=float(sol.implicit_dt_max if sol.scheme == "implicit" else t.dt_max), dt_min=float(t.dt_min),
         out_dt=float(t.output_interval), t_end=float(t.t_end),
         load_on_plate=bool(s.load.kind == "line" and s.load.target == "plate"),
         arm_shrink=1.0 if s.contact.torque_arm == "contact_point" else 0.0,
+        scheme=kernels.SCHEME_IMPLICIT if sol.scheme == "implicit" else kernels.SCHEME_PAPER,
+        error_tol=float(sol.error_tol),
     )
     y0 = np.zeros((ng, 6))
     y0[:, 0] = x

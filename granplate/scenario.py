@@ -185,7 +185,11 @@ class Solver:
     lambda_target: the local-map modulus the step control aims for (< 1);
     iteration_rtol, iteration_atol [N]: convergence of the interface forces;
     max_iterations: per step before the step is retried at half size;
-    energy_tol: the largest relative energy residual a run accepts.
+    energy_tol: the largest relative energy residual a run accepts;
+    error_tol: "implicit" scheme, the local error (relative distance of the interface
+    forces and granule accelerations from their extrapolation) the step control aims at;
+    implicit_dt_max: "implicit" scheme, the largest step [s] (time.dt_max bounds the
+    "paper" scheme).
     """
 
     scheme: str = "paper"
@@ -194,6 +198,8 @@ class Solver:
     iteration_atol: float = 1e-10
     max_iterations: int = 60
     energy_tol: float = 1e-4
+    error_tol: float = 1e-3
+    implicit_dt_max: float = 2e-7
 
 
 @dataclass(frozen=True)

@@ -22,7 +22,7 @@ from .scenario import SQRT2_MINUS_1, Scenario
 #: Lever arms of the friction torque (Contact.torque_arm).
 TORQUE_ARMS: tuple[str, ...] = ("radius", "contact_point")
 #: Coupling schemes the solver knows (Solver.scheme).
-SCHEMES: tuple[str, ...] = ("paper",)
+SCHEMES: tuple[str, ...] = ("paper", "implicit")
 #: Load kinds (Load.kind) and targets (Load.target).
 LOAD_KINDS: tuple[str, ...] = ("line", "none")
 LOAD_TARGETS: tuple[str, ...] = ("granules", "plate")
@@ -283,6 +283,8 @@ def _check_solver(s: Scenario) -> None:
     _positive("solver.iteration_atol", sv.iteration_atol)
     _int_at_least("solver.max_iterations", sv.max_iterations, 1)
     _positive("solver.energy_tol", sv.energy_tol)
+    _positive("solver.error_tol", sv.error_tol)
+    _positive("solver.implicit_dt_max", sv.implicit_dt_max)
 
 
 # --------------------------------------------------------------------------- entry point

@@ -235,8 +235,10 @@ def test_user_material_overrides_library():
 
 
 def test_schemes_constant():
-    """The solver schemes accepted are listed in SCHEMES, which holds the paper's scheme."""
-    assert SCHEMES == ("paper",)
+    """The solver schemes accepted are listed in SCHEMES: the paper's one (the default) and
+    the implicit one; anything else is refused naming solver.scheme."""
+    assert SCHEMES == ("paper", "implicit")
+    assert Solver().scheme == "paper"
 
 
 def _doc_block(title: str) -> str:

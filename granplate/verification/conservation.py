@@ -138,7 +138,7 @@ def friction_couple(model, y: np.ndarray) -> tuple[float, float, float]:
     ng = y.shape[0]
     dy = np.zeros((ng, 6))
     z = np.zeros(0)
-    K.granular_rhs(0.0, y, z, z, g, cfg, dy, z, z, z)
+    K.granular_rhs(0.0, y, z, z, g, cfg, dy, z, z, z, False, z)
     m, inertia = g.mass, g.inertia
     terms = np.concatenate([m * y[:, 0] * dy[:, 4], -m * y[:, 1] * dy[:, 3], inertia * dy[:, 5]])
     dL = float(terms.sum())
@@ -259,7 +259,7 @@ def _energy_and_forces(model, y: np.ndarray, up: np.ndarray):
     dy = np.zeros((ng, 6))
     fplate = np.zeros(nd)
     nk = nd // 2
-    out = K.granular_rhs(0.0, y, up, np.zeros(nd), g, cfg, dy, fplate, np.zeros(nk), np.zeros(nk))
+    out = K.granular_rhs(0.0, y, up, np.zeros(nd), g, cfg, dy, fplate, np.zeros(nk), np.zeros(nk), False, np.zeros(nk))
     forces = dy[:, 3:5] * g.mass[:, None]
     return float(out[3]), forces, dy[:, 5] * g.inertia, fplate
 
