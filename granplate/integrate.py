@@ -80,7 +80,7 @@ def simulate(
     ng, nm, nk = model.n_granules, len(p.omega2), len(model.plate_contacts)
     times = output_times(cfg.t_end, cfg.out_dt)
     st = K.new_state(ng, nm, nk)
-    w = K.new_work(ng, nm, nk)
+    w = K.new_work(ng, nm, nk, exact=cfg.scheme == K.SCHEME_IMPLICIT)
     out = K.new_output(times, ng, nm, nk)
     st.y[:] = model.initial_state
     st.count[K.C_LEVEL] = K.level_for(model.scenario.time.dt_initial, cfg)

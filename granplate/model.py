@@ -14,6 +14,17 @@ from .errors import ScenarioError
 from .geometry import resolve
 from .shock import shock_resultants
 from .materials import effective_modulus, sphere_inertia, sphere_mass
+
+#: implicit scheme: the error estimate's smallest force scale, as a fraction of the
+#: shock's peak resultant force on the granules (q0 times the load resultants).
+FORCE_FLOOR_FRACTION = 1e-2
+
+
+def implicit_step_max(dt_max: float, out_dt: float) -> float:
+    """The implicit scheme's largest step: out_dt / 2^k, the largest not above dt_max [s]
+    (its steps are dyadic fractions of the output interval, which they tile exactly)."""
+    k = max(0, math.ceil(math.log2(out_dt / dt_max) - 1e-12))
+    return out_dt / 2.0**k
 from .scenario import Scenario
 from .validate import validate
 
@@ -188,12 +199,15 @@ def build_model(scenario: Scenario) -> Model:
         lambda_target=float(sol.lambda_target), rtol=float(sol.iteration_rtol),
         atol=float(sol.iteration_atol), max_iter=int(sol.max_iterations),
         energy_tol=float(sol.energy_tol),
-        dt_max=float(sol.implicit_dt_max if sol.scheme == "implicit" else t.dt_max), dt_min=float(t.dt_min),
+        dt_max=float(implicit_step_max(sol.implicit_dt_max, t.output_interval) if sol.scheme == "implicit"
+                     else t.dt_max), dt_min=float(t.dt_min),
         out_dt=float(t.output_interval), t_end=float(t.t_end),
         load_on_plate=bool(s.load.kind == "line" and s.load.target == "plate"),
         arm_shrink=1.0 if s.contact.torque_arm == "contact_point" else 0.0,
         scheme=kernels.SCHEME_IMPLICIT if sol.scheme == "implicit" else kernels.SCHEME_PAPER,
         error_tol=float(sol.error_tol),
+        force_floor=FORCE_FLOOR_FRACTION * float(q0) * float(
+            np.abs(fres).sum() + np.abs(tres / np.maximum(r, 1e-300)).sum() if ng else 0.0),
     )
     y0 = np.zeros((ng, 6))
     y0[:, 0] = x

@@ -181,25 +181,29 @@ class TimeSettings:
 class Solver:
     """Coupling solver settings (MODEL.md section 6).
 
-    scheme: "paper" (fixed-point interpolation-iteration, criterion (8) step control);
+    scheme: "implicit" (default: Newton on the interface forces with the plate-contact
+    friction held over the step, plate modes integrated exactly, step from an error
+    estimate) or "paper" (the paper's fixed-point interpolation-iteration with the
+    criterion (8) step control);
     lambda_target: the local-map modulus the step control aims for (< 1);
     iteration_rtol, iteration_atol [N]: convergence of the interface forces;
     max_iterations: per step before the step is retried at half size;
     energy_tol: the largest relative energy residual a run accepts;
     error_tol: "implicit" scheme, the local error (relative distance of the interface
-    forces and granule accelerations from their extrapolation) the step control aims at;
-    implicit_dt_max: "implicit" scheme, the largest step [s] (time.dt_max bounds the
-    "paper" scheme).
+    forces and the granules' net forces from their extrapolation) the step control aims
+    at; the step is also held to an energy-residual growth of energy_tol / 2 over the run;
+    implicit_dt_max: "implicit" scheme, the largest step [s] (rounded down to
+    time.output_interval / 2^k; time.dt_max bounds the "paper" scheme).
     """
 
-    scheme: str = "paper"
+    scheme: str = "implicit"
     lambda_target: float = 0.5
     iteration_rtol: float = 1e-9
     iteration_atol: float = 1e-10
     max_iterations: int = 60
     energy_tol: float = 1e-4
     error_tol: float = 1e-3
-    implicit_dt_max: float = 2e-7
+    implicit_dt_max: float = 1e-6
 
 
 @dataclass(frozen=True)
