@@ -191,9 +191,6 @@ class Work(NamedTuple):
     mmat: np.ndarray  # (N_LEVELS + 1, 4, nd, nd) implicit scheme: response to the unknowns
     qn: np.ndarray  # (nm,) implicit scheme: modal state at the end of the step being tried
     qdn: np.ndarray
-    f0m: np.ndarray  # (nm,) implicit scheme: modal forces at the start / end of the step
-    f1m: np.ndarray
-    mval: np.ndarray  # (4, nm) implicit scheme: modal u, v at t + h/2, t + h (known part)
     fbar: np.ndarray  # (nk,) implicit scheme: plate-contact friction held over the step
     k1i: np.ndarray  # (ng, 6) implicit scheme: stage-1 derivative with fbar
     p1i: np.ndarray  # (3,)
@@ -697,11 +694,10 @@ def exact_matrices(phi_d, coef, mmat):
 
 
 @njit(cache=True)
-def modal_forces(st, p, cfg, t, h, force, held, w):
-    """Modal forces at the start and the end of the step into w.f0m, w.f1m: the edge load
-    (linear over the step) plus Phi_d^T of the interface forces; at the start the normal
-    forces are N_n (st.pforce), the friction forces are `force` if `held`, else left out.
-    Loops run along the modes (contiguous in Phi_d)."""
+def exact_predict(t, h, st, p, cfg, coef, w):
+    """Known part of the driving-DOF motion at t + h/2 and t + h (w.ustar): the free
+    vibration, the edge load (linear over the step) and the normal forces' start values
+    N_n (st.pforce, even DOFs); the unknowns' share is added by stage_motion_exact."""
     nm = p.omega2.shape[0]
     nd = p.phi_d.shape[0]
     amp0 = 0.0
@@ -709,56 +705,46 @@ def modal_forces(st, p, cfg, t, h, force, held, w):
     if cfg.load_on_plate:
         amp0 = cfg.q0 * time_profile(t, cfg.duration)
         amp1 = cfg.q0 * time_profile(t + h, cfg.duration)
-    for m in range(nm):
-        w.f0m[m] = amp0 * p.load_modal[m]
-        w.f1m[m] = amp1 * p.load_modal[m]
-    for d in range(nd):
-        p0 = st.pforce[d] if d % 2 == 0 else (force[d] if held else 0.0)
-        p1 = force[d]
-        row = p.phi_d[d]
-        for m in range(nm):
-            w.f0m[m] += row[m] * p0
-            w.f1m[m] += row[m] * p1
-    return amp0, amp1
-
-
-@njit(cache=True)
-def exact_predict(t, h, st, p, cfg, coef, w):
-    """Known part of the driving-DOF motion at t + h/2 and t + h (w.ustar): the free
-    vibration, the edge load (linear over the step) and the normal forces' start values
-    N_n (st.pforce, even DOFs); the unknowns' share is added by stage_motion_exact."""
-    nm = p.omega2.shape[0]
-    nd = p.phi_d.shape[0]
-    for d in range(nd):
-        w.rhs[d] = 0.0
-    modal_forces(st, p, cfg, t, h, w.rhs, False, w)
     for r in range(4):
-        base = (r // 2) * MC_STRIDE + (0 if r % 2 == 0 else MC_VQ)
-        for m in range(nm):
-            w.mval[r, m] = (coef[m, base] * st.q[m] + coef[m, base + 1] * st.qd[m]
-                            + coef[m, base + 2] * w.f0m[m] + coef[m, base + 3] * w.f1m[m])
         for d in range(nd):
-            row = p.phi_d[d]
-            acc = 0.0
-            for m in range(nm):
-                acc += row[m] * w.mval[r, m]
-            w.ustar[r, d] = acc
+            w.ustar[r, d] = 0.0
+    for m in range(nm):
+        f0 = amp0 * p.load_modal[m]
+        for d in range(0, nd, 2):
+            f0 += p.phi_d[d, m] * st.pforce[d]
+        f1 = amp1 * p.load_modal[m]
+        q0 = st.q[m]
+        v0 = st.qd[m]
+        for r in range(4):
+            base = (r // 2) * MC_STRIDE + (0 if r % 2 == 0 else MC_VQ)
+            val = coef[m, base] * q0 + coef[m, base + 1] * v0 + coef[m, base + 2] * f0 + coef[m, base + 3] * f1
+            for d in range(nd):
+                w.ustar[r, d] += p.phi_d[d, m] * val
 
 
 @njit(cache=True)
-def exact_correct(t, h, st, p, cfg, coef, force, qn, qdn, w):
+def exact_correct(t, h, st, p, cfg, coef, force, qn, qdn):
     """Every mode at the end of the step (into qn, qdn) with the interface forces `force`
     (normal: linear from st.pforce to force; friction: held at force). Returns the work
     of the edge load over the step (exact for its linear interpolation) [J] and the plate
     energy at the end [J]."""
     nm = p.omega2.shape[0]
-    amp0, amp1 = modal_forces(st, p, cfg, t, h, force, True, w)
+    nd = p.phi_d.shape[0]
+    amp0 = 0.0
+    amp1 = 0.0
+    if cfg.load_on_plate:
+        amp0 = cfg.q0 * time_profile(t, cfg.duration)
+        amp1 = cfg.q0 * time_profile(t + h, cfg.duration)
     work = 0.0
     energy = 0.0
     b = MC_STRIDE
     for m in range(nm):
-        f0 = w.f0m[m]
-        f1 = w.f1m[m]
+        f0 = amp0 * p.load_modal[m]
+        f1 = amp1 * p.load_modal[m]
+        for d in range(nd):
+            phi = p.phi_d[d, m]
+            f1 += phi * force[d]
+            f0 += phi * (force[d] if d % 2 == 1 else st.pforce[d])
         q0 = st.q[m]
         v0 = st.qd[m]
         q1 = coef[m, b + MC_QQ] * q0 + coef[m, b + MC_QV] * v0 + coef[m, b + MC_QF0] * f0 + coef[m, b + MC_QF1] * f1
@@ -1215,7 +1201,7 @@ def advance(t_stop, g, p, cfg, st, w, out):
         if implicit:
             # the end state, not yet committed: the step may still be refused
             fric_work = held_friction_work(st, g, cfg, w)
-            work, ep_new = exact_correct(t, h, st, p, cfg, w.mcoef[slot], w.fguess, w.qn, w.qdn, w)
+            work, ep_new = exact_correct(t, h, st, p, cfg, w.mcoef[slot], w.fguess, w.qn, w.qdn)
             kx, ky, kr = kinetic_energies(w.ynew, g)
             e_in = st.clock[E_ZERO] + st.acc[A_SHOCK_G] + w.dacc[0] + st.acc[A_SHOCK_P] + work
             total = (kx + ky + kr + e_pot + ep_new + st.acc[A_VISC] + w.dacc[1]
@@ -1368,7 +1354,7 @@ def new_work(ng: int, nm: int, nk: int, exact: bool = False) -> Work:
     return Work(
         ytmp=z((ng, 6)), ynew=z((ng, 6)), k2=z((ng, 6)), k3=z((ng, 6)), k4=z((ng, 6)),
         kend=z((ng, 6)), up=z(nd), vp=z(nd), astar=z(nd), anext=z(nd), aavg=z(nd),
-        fguess=z(nd), stage=z((4, nd)), ustar=z((4, nd)), qn=z(nm), qdn=z(nm), f0m=z(nm), f1m=z(nm), mval=z((4, nm)), jac=z((nd, nd)), rhs=z(nd), vguess=z(nk),
+        fguess=z(nd), stage=z((4, nd)), ustar=z((4, nd)), qn=z(nm), qdn=z(nm), jac=z((nd, nd)), rhs=z(nd), vguess=z(nk),
         mcoef=z((N_LEVELS + 1 if exact else 1, nm if exact else 1, N_MCOEF)),
         mmat=z((N_LEVELS + 1 if exact else 1, 4, nd, nd)), fbar=z(nk), k1i=z((ng, 6)), p1i=z(3), fnew=z(nd), fscratch=z(nd), pend=z(3), dacc=z(3), qdd_star=z(nm),
         normal_new=z(nk), slip_new=z(nk), nscratch=z(nk), sscratch=z(nk),
