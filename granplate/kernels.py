@@ -73,7 +73,7 @@ SCHEME_PAPER, SCHEME_IMPLICIT = 0, 1
 LEVEL_RATIO = 2.0 ** -0.25
 #: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps
 #: h * (friction relaxation rate of every granule contact) below this bound.
-RK4_FRICTION_LIMIT = 2.5
+RK4_FRICTION_LIMIT = 1.0
 N_LEVELS = 200
 #: implicit scheme: a step whose error estimate exceeds REJECT_FACTOR * error_tol is redone smaller.
 REJECT_FACTOR = 2.0

@@ -12,6 +12,8 @@ import math
 
 import numpy as np
 
+from ..kernels import ENERGY_STEP_FRACTION
+from ..scenario import Solver
 from .base import (EPS, Case, CaseResult, Check, Context, load_case_scenario, new_figure,
                    observed_order, save_figure, simulate)
 
@@ -26,9 +28,10 @@ RESIDUAL_WHY = ("one part per million, a hundred times below the simulator's own
 
 #: The implicit scheme's step control lets the residual grow by solver.energy_tol times
 #: kernels.ENERGY_STEP_FRACTION over a run.
-IMPLICIT_RESIDUAL_TOL = 5e-5
+IMPLICIT_RESIDUAL_TOL = Solver().energy_tol * ENERGY_STEP_FRACTION
 IMPLICIT_RESIDUAL_WHY = ("the implicit scheme picks its step so that the residual grows by at most "
-                         "solver.energy_tol x ENERGY_STEP_FRACTION = 1e-4 x 0.5 over a run (its "
+                         f"solver.energy_tol x ENERGY_STEP_FRACTION = {Solver().energy_tol:g} x "
+                         f"{ENERGY_STEP_FRACTION:g} over a run (its "
                          "accuracy, not a stability limit, sets the step, so the residual is larger "
                          "than the paper scheme's at its tiny steps, and its order is not a step "
                          "property).")
