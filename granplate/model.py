@@ -12,9 +12,10 @@ from . import kernels
 from .contact import damping_coefficient, hertz_coefficient
 from .errors import ScenarioError
 from .geometry import resolve
-from .scenario import Scenario
 from .shock import shock_resultants
 from .materials import effective_modulus, sphere_inertia, sphere_mass
+from .scenario import Scenario
+from .validate import validate
 
 #: implicit scheme: the error estimate's smallest force scale, as a fraction of the
 #: shock's peak resultant force on the granules (q0 times the load resultants).
@@ -39,8 +40,6 @@ def implicit_step_max(dt_max: float, out_dt: float) -> float:
     (its steps are dyadic fractions of the output interval, which they tile exactly)."""
     k = max(0, math.ceil(math.log2(out_dt / dt_max) - 1e-12))
     return out_dt / 2.0**k
-from .scenario import Scenario
-from .validate import validate
 
 
 @dataclass(frozen=True)
