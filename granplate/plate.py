@@ -45,7 +45,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from .scenario import Plate
 
 #: Bump when anything that changes the cached arrays changes (formulas, ordering, dtypes).
-CACHE_VERSION = 1
+CACHE_VERSION = 2
 
 #: Gauss order for K, M and stress recovery: 3 x 3 = 9 points per element.
 INTORDER = 4
@@ -503,17 +503,34 @@ def modal_basis(K_r: sp.spmatrix, M_r: sp.spmatrix, n_modes: int = 0) -> tuple[n
     """Lowest n_modes (0 = all) of K_r phi = omega^2 M_r phi, dense scipy.linalg.eigh.
 
     Returns (Phi, omega): Phi (n_red, n_modes) mass-normalised (Phi^T M_r Phi = I),
-    each column signed so that its largest-magnitude entry is positive; omega [rad/s]
-    ascending (tiny negative eigenvalues of rigid motions are clipped to 0).
+    each column signed by `fix_mode_signs`; omega [rad/s] ascending (tiny negative
+    eigenvalues of rigid motions are clipped to 0).
     """
     n = K_r.shape[0]
     Kd = K_r.toarray() if sp.issparse(K_r) else np.asarray(K_r)
     Md = M_r.toarray() if sp.issparse(M_r) else np.asarray(M_r)
     subset = None if n_modes in (0, n) else [0, n_modes - 1]
     lam, Phi = scipy.linalg.eigh(Kd, Md, subset_by_index=subset)
-    big = np.argmax(np.abs(Phi), axis=0)
-    Phi = Phi * np.sign(Phi[big, np.arange(Phi.shape[1])])
-    return np.ascontiguousarray(Phi), np.sqrt(np.maximum(lam, 0.0))
+    return np.ascontiguousarray(fix_mode_signs(Phi)), np.sqrt(np.maximum(lam, 0.0))
+
+
+def sign_reference(n: int) -> np.ndarray:
+    """A fixed, generic weight vector of length n (no symmetry of the mesh maps it to +-itself).
+
+    w_i = 1 + frac(i * golden ratio): positive, aperiodic, the same on every machine.
+    """
+    return 1.0 + np.modf(np.arange(n) * 0.6180339887498949)[0]
+
+
+def fix_mode_signs(Phi: np.ndarray) -> np.ndarray:
+    """Sign each column of Phi so that sign_reference . phi > 0.
+
+    A deterministic rule that also holds for symmetric and antisymmetric modes, whose
+    largest entries come in pairs of opposite sign (a rule based on the largest entry then
+    depends on round-off, and two eigensolvers can disagree).
+    """
+    s = sign_reference(Phi.shape[0]) @ Phi
+    return Phi * np.where(s < 0.0, -1.0, 1.0)
 
 
 # --------------------------------------------------------------------------------------
