@@ -11,11 +11,11 @@ Data flow: Scenario -> Model (arrays) -> compiled time loop -> xarray Dataset ->
 """
 from __future__ import annotations
 
-__version__ = "0.1.0"
+from granplate.version import __version__  # noqa: E402,F401
 
-from .errors import GranplateError, ScenarioError, SimulationError  # noqa: E402
-from .materials import LIBRARY, Material  # noqa: E402
-from .scenario import (  # noqa: E402
+from granplate.errors import GranplateError, ScenarioError, SimulationError  # noqa: E402
+from granplate.setup.materials import LIBRARY, Material  # noqa: E402
+from granplate.setup.scenario import (  # noqa: E402
     Contact, Granule, Layout, Load, PairCoefficients, Plate, Scenario, Solver, TimeSettings, Wall,
 )
 
@@ -23,18 +23,18 @@ from .scenario import (  # noqa: E402
 def __getattr__(name: str):
     # heavy modules (numba, scikit-fem, xarray) load on first use
     if name in ("simulate",):
-        from .integrate import simulate
+        from granplate.solver.driver import simulate
         return simulate
     if name in ("build_model",):
-        from .model import build_model
+        from granplate.model.arrays import build_model
         return build_model
     if name in ("preset", "preset_names"):
-        from . import presets
+        from granplate.setup import presets
         return getattr(presets, name)
     if name in ("load_scenario", "loads", "dumps", "load", "dump", "with_changes"):
-        from . import scenario_io
+        from granplate.setup import io as scenario_io
         return getattr(scenario_io, name)
     if name in ("write", "read", "summary"):
-        from . import results
-        return getattr(results, name)
+        from granplate.results import dataset
+        return getattr(dataset, name)
     raise AttributeError(f"module 'granplate' has no attribute {name!r}")

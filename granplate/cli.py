@@ -12,14 +12,14 @@ import json
 import sys
 from pathlib import Path
 
-from .errors import ScenarioError, SimulationError
+from granplate.errors import ScenarioError, SimulationError
 
 #: modules that add subcommands: each defines register(subparsers), adding parsers whose
 #: `func(args) -> int` runs the command (ScenarioError is reported as a user error).
 COMMAND_MODULES = (
-    "granplate.reproduce",      # reproduce, plot, animate, export
+    "granplate.paper.reproduce",     # reproduce, plot, animate, export
     "granplate.verification",   # verify
-    "granplate.bench",          # bench
+    "granplate.bench.cli",      # bench
 )
 
 SUMMARY_ROWS = (
@@ -49,9 +49,9 @@ def format_summary(summary: dict) -> str:
 
 
 def _cmd_run(args) -> int:
-    from .results import summary, write
-    from .scenario_io import load_scenario
-    from .integrate import simulate
+    from granplate.results.dataset import summary, write
+    from granplate.setup.io import load_scenario
+    from granplate.solver.driver import simulate
 
     scenario = load_scenario(args.scenario)
     out = Path(args.output) if args.output else Path(f"{scenario.name}.nc")
@@ -75,7 +75,7 @@ def _cmd_run(args) -> int:
 
 
 def _cmd_presets(args) -> int:
-    from .presets import preset, preset_names
+    from granplate.setup.presets import preset, preset_names
 
     for name in preset_names():
         print(f"{name:20s} {preset(name).description}")
@@ -83,8 +83,8 @@ def _cmd_presets(args) -> int:
 
 
 def _cmd_preset(args) -> int:
-    from .presets import preset
-    from .scenario_io import dumps
+    from granplate.setup.presets import preset
+    from granplate.setup.io import dumps
 
     text = dumps(preset(args.name))
     if args.output:

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import pytest
 
-from granplate.scenario import Contact, Granule, Load, Scenario, TimeSettings, Wall
+from granplate.setup.scenario import Contact, Granule, Load, Scenario, TimeSettings, Wall
 
 
 @pytest.fixture(autouse=True, scope="session")

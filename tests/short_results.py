@@ -14,6 +14,6 @@ T_END = 1e-4
 def short_results(t_end: float = T_END) -> dict[str, xr.Dataset]:
     """preset name -> result Dataset of a run shortened to t_end [s] (do not modify: copy)."""
     import granplate as gp
-    from granplate.presets import preset, preset_names
+    from granplate.setup.presets import preset, preset_names
 
     return {name: gp.simulate(preset(name), t_end=t_end, progress=False) for name in preset_names()}

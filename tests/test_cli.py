@@ -7,7 +7,7 @@ import json
 import pytest
 
 from granplate.cli import main
-from granplate.scenario_io import load
+from granplate.setup.io import load
 
 SUMMARY_KEYS = {
     "e_shock", "ep_max_fraction", "ep_final_fraction", "eg_final_fraction", "dissipated_fraction",

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from scipy.special import gamma as G
 
-from granplate import contact as C
-from granplate.materials import LIBRARY, effective_modulus, sphere_mass
-from granplate.integrate import simulate
+from granplate.physics import contact as C
+from granplate.setup.materials import LIBRARY, effective_modulus, sphere_mass
+from granplate.solver.driver import simulate
 
 from conftest import two_spheres
 

@@ -9,7 +9,7 @@ import meshio
 import numpy as np
 import pytest
 
-from granplate.export import export_vtk
+from granplate.results.export import export_vtk
 
 from short_results import short_results
 

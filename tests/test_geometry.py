@@ -7,8 +7,8 @@ import math
 import pytest
 
 from granplate.errors import ScenarioError
-from granplate.geometry import column_offset, paper_layout, resolve
-from granplate.scenario import Granule, Layout, Plate, Scenario, Wall
+from granplate.setup.geometry import column_offset, paper_layout, resolve
+from granplate.setup.scenario import Granule, Layout, Plate, Scenario, Wall
 
 RATIOS = [math.sqrt(2.0) - 1.0, 0.5, 0.75, 1.0]
 R1 = 0.01

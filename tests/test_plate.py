@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import sys
 
 import numpy as np
 import pytest
@@ -12,8 +13,8 @@ from skfem import MeshQuad
 
 from granplate import plate as gp
 from granplate.errors import ScenarioError
-from granplate.materials import LIBRARY
-from granplate.scenario import Plate
+from granplate.setup.materials import LIBRARY
+from granplate.setup.scenario import Plate
 
 STEEL = LIBRARY["steel"]
 X0 = 0.01 + 2 * math.sqrt(0.02**2 - 0.01**2) + 0.01  # the paper's plate position, R2 = R1
@@ -387,7 +388,7 @@ def test_cache_roundtrip_and_corrupt_file(tmp_path, monkeypatch):
     def must_not_solve(*a, **k):
         raise AssertionError("modal_basis called although the cache holds the result")
 
-    monkeypatch.setattr(gp, "modal_basis", must_not_solve)
+    monkeypatch.setattr(sys.modules[gp.build_plate.__module__], "modal_basis", must_not_solve)
     cached = gp.build_plate(*args)
     a, b = _arrays(fresh), _arrays(cached)
     for name in a:
@@ -406,7 +407,7 @@ def test_cache_roundtrip_and_corrupt_file(tmp_path, monkeypatch):
         calls.append(1)
         return real_modal_basis(*a, **k)
 
-    monkeypatch.setattr(gp, "modal_basis", counting)
+    monkeypatch.setattr(sys.modules[gp.build_plate.__module__], "modal_basis", counting)
     repaired = gp.build_plate(*args)
     assert calls == [1]
     c = _arrays(repaired)

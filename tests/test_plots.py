@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from granplate import plots
+from granplate.paper import plots
 
 from short_results import short_results
 

@@ -3,12 +3,12 @@ from __future__ import annotations
 
 import pytest
 
-from granplate import scenario_io
+from granplate.setup import io as scenario_io
 from granplate.errors import ScenarioError
-from granplate.geometry import resolve
-from granplate.presets import DESCRIPTIONS, preset, preset_names
-from granplate.scenario import Contact, Plate, Solver, TimeSettings
-from granplate.validate import validate
+from granplate.setup.geometry import resolve
+from granplate.setup.presets import DESCRIPTIONS, preset, preset_names
+from granplate.setup.scenario import Contact, Plate, Solver, TimeSettings
+from granplate.setup.validate import validate
 
 NAMES = ["bare-plate", "steel-r1", "steel-r05", "ptfe-r05", "ptfe-r05-moderate",
          "ptfe-r05-weak"]

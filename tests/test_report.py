@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from granplate import analysis as an
-from granplate import report
+from granplate.results import analysis as an
+from granplate.paper import report
 
 from short_results import short_results
 
@@ -115,8 +115,8 @@ class _Outcome:
 
 def test_write_report_md_and_html(runs, tmp_path):
     """report.md links the figures; report.html embeds them (base64) and opens alone."""
-    from granplate import plots
-    from granplate.results import write
+    from granplate.paper import plots
+    from granplate.results.dataset import write
 
     recs = []
     for name, ds in runs.items():

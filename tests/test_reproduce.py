@@ -5,11 +5,12 @@ from __future__ import annotations
 
 import pytest
 
-from granplate import __version__, reproduce as rp
+from granplate.version import __version__
+from granplate.paper import reproduce as rp
 from granplate.cli import main
-from granplate.plots import FIGURES
-from granplate.presets import preset, preset_names
-from granplate.results import read, write
+from granplate.paper.plots import FIGURES
+from granplate.setup.presets import preset, preset_names
+from granplate.results.dataset import read, write
 
 from short_results import short_results
 
@@ -131,7 +132,7 @@ def test_cli_user_mistakes_exit_2(first, argv, capsys):
 def test_failed_run_keeps_partial_result(tmp_path):
     """A run that breaks (here: an impossible energy tolerance) is reported as failed, its
     partial result kept as NAME.partial.nc, and nothing is written under NAME.nc."""
-    from granplate.scenario_io import with_changes
+    from granplate.setup.io import with_changes
 
     s = with_changes(preset("steel-r1"), {"solver.energy_tol": 1e-16, "time.t_end": 2e-5})
     rec = rp.run_job(rp.Job("bad", s, tmp_path / "bad.nc"))

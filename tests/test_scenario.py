@@ -8,13 +8,13 @@ from pathlib import Path
 
 import pytest
 
-from granplate import scenario_io
+from granplate.setup import io as scenario_io
 from granplate.errors import ScenarioError
-from granplate.materials import LIBRARY, Material
-from granplate.presets import preset
-from granplate.scenario import (Granule, Layout, Load, PairCoefficients, Plate, Scenario,
+from granplate.setup.materials import LIBRARY, Material
+from granplate.setup.presets import preset
+from granplate.setup.scenario import (Granule, Layout, Load, PairCoefficients, Plate, Scenario,
                                 Solver, TimeSettings, Wall)
-from granplate.validate import SCHEMES, validate
+from granplate.setup.validate import SCHEMES, validate
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "scenario.md"
 

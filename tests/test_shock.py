@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from granplate.shock import granule_resultants, time_profile, total_impulse
+from granplate.physics.shock import granule_resultants, time_profile, total_impulse
 
 
 @pytest.mark.parametrize("yc", [0.03, 0.05, 0.07, 0.09, 0.01])

@@ -7,8 +7,8 @@ import pytest
 
 import granplate as gp
 from granplate.errors import SimulationError
-from granplate.presets import preset, preset_names
-from granplate.scenario_io import with_changes
+from granplate.setup.presets import preset, preset_names
+from granplate.setup.io import with_changes
 
 from conftest import sphere_on_wall
 

@@ -61,7 +61,7 @@ def test_check_kinds():
 
 def test_scenario_files_are_package_data_and_valid():
     """Every verification scenario ships with the package and passes validation."""
-    from granplate.model import build_model
+    from granplate.model.arrays import build_model
 
     names = base.scenario_names()
     assert {"chung-ooi-1-glass", "striker-chain", "free-assembly"} <= set(names)

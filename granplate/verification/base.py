@@ -182,8 +182,8 @@ def scenario_names() -> list[str]:
 
 def load_case_scenario(name: str, changes: dict | None = None):
     """The verification scenario `name`, with dotted-path `changes`, validated."""
-    from ..scenario_io import loads, with_changes
-    from ..validate import validate
+    from granplate.setup.io import loads, with_changes
+    from granplate.setup.validate import validate
 
     s = loads(scenario_text(name))
     if changes:
@@ -202,7 +202,7 @@ def step_changes(dt: float, t_end: float, out: float | None = None) -> dict:
 
 def simulate(scenario):
     """Run a scenario quietly and return its Dataset."""
-    from .. import simulate as run
+    from granplate.solver.driver import simulate as run
 
     return run(scenario, progress=False)
 

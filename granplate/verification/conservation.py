@@ -12,8 +12,8 @@ import math
 
 import numpy as np
 
-from ..kernels import ENERGY_STEP_FRACTION
-from ..scenario import Solver
+from granplate.solver.kernels import ENERGY_STEP_FRACTION
+from granplate.setup.scenario import Solver
 from .base import (EPS, Case, CaseResult, Check, Context, load_case_scenario, new_figure,
                    observed_order, save_figure, simulate)
 
@@ -39,7 +39,7 @@ IMPLICIT_RESIDUAL_WHY = ("the implicit scheme picks its step so that the residua
 
 def _halved(s):
     """The scenario with every step halved: dt_max, dt_initial and the eq. (8) target."""
-    from ..scenario_io import with_changes
+    from granplate.setup.io import with_changes
 
     return with_changes(s, {"time.dt_max": s.time.dt_max / 2, "time.dt_initial": s.time.dt_initial / 2,
                             "solver.lambda_target": s.solver.lambda_target / 2})
@@ -52,12 +52,12 @@ def _residual(ds) -> float:
 def energy_residual(ctx: Context) -> CaseResult:
     """Energy residual of every preset: its size with both schemes, and its decrease under
     step halving with the paper scheme."""
-    from ..presets import preset, preset_names
+    from granplate.setup.presets import preset, preset_names
 
     checks = []
     series = {}
     full_rows = []
-    from ..scenario_io import with_changes
+    from granplate.setup.io import with_changes
 
     for name in preset_names():
         # the default (implicit) scheme: its step control holds the residual's growth
@@ -126,7 +126,7 @@ def energy_residual(ctx: Context) -> CaseResult:
 
 def simulate_short(s):
     """The scenario run for SHORT_T_END seconds."""
-    from .. import simulate as run
+    from granplate.solver.driver import simulate as run
 
     return run(s, t_end=SHORT_T_END, progress=False)
 
@@ -154,8 +154,8 @@ def friction_couple(model, y: np.ndarray) -> tuple[float, float, float]:
     MODEL.md torques (arm R on each granule) a frictional pair leaves the couple
     f (d - R_i - R_j) = -f delta, so dL/dt = -sum_pairs f delta.
     """
-    from .. import kernels as K
-    from ..contact import friction_magnitude, normal_force
+    from granplate.solver import kernels as K
+    from granplate.physics.contact import friction_magnitude, normal_force
 
     g, cfg = model.granular, model.config
     ng = y.shape[0]
@@ -182,7 +182,7 @@ def friction_couple(model, y: np.ndarray) -> tuple[float, float, float]:
 
 def free_assembly(ctx: Context) -> CaseResult:
     """Linear and angular momentum of a free assembly (no walls, no plate, no load)."""
-    from ..model import build_model
+    from granplate.model.arrays import build_model
 
     s_fric = load_case_scenario("free-assembly")
     s_free = load_case_scenario("free-assembly", {"contact.mu": 0.0})
@@ -274,7 +274,7 @@ PLATE_U = np.array([-2e-5, 1e-6])
 
 def _energy_and_forces(model, y: np.ndarray, up: np.ndarray):
     """(contact energy, forces on the granules (ng, 2), torques (ng,), force on the plate)."""
-    from .. import kernels as K
+    from granplate.solver import kernels as K
 
     g, cfg = model.granular, model.config
     ng = y.shape[0]
@@ -301,7 +301,7 @@ def _gradient(fun, x0: np.ndarray, eta: float) -> np.ndarray:
 
 def force_gradient(ctx: Context) -> CaseResult:
     """Forces (granular_rhs) = minus the gradient of the contact energies (finite differences)."""
-    from ..model import build_model
+    from granplate.model.arrays import build_model
 
     model = build_model(load_case_scenario("force-gradient"))
     y = model.initial_state.copy()

@@ -83,8 +83,8 @@ STUDIES: tuple[Study, ...] = (
 
 def cache_key(scenario, t_end: float | None = None) -> str:
     """sha256 of the scenario's TOML, the end time and the package version."""
-    from .. import __version__
-    from ..scenario_io import dumps
+    from granplate.version import __version__
+    from granplate.setup.io import dumps
 
     text = dumps(scenario) + f"\nt_end={t_end!r}\nversion={__version__}\n"
     return hashlib.sha256(text.encode()).hexdigest()
@@ -114,8 +114,8 @@ def _vm_location(ds) -> list[float]:
 
 def study_run(ctx: Context, scenario) -> dict:
     """Summary of a full run of `scenario`, from the cache when there."""
-    from .. import simulate as run
-    from ..results import summary
+    from granplate.solver.driver import simulate as run
+    from granplate.results.dataset import summary
 
     key = cache_key(scenario)
     cache = ctx.run_cache if ctx.run_cache is not None else {}
@@ -186,8 +186,8 @@ def study_tables(results: dict, preset: str) -> str:
 
 def coupled_convergence(ctx: Context) -> CaseResult:
     """The studies above for both presets, with checks on the default settings."""
-    from ..presets import preset
-    from ..scenario_io import with_changes
+    from granplate.setup.presets import preset
+    from granplate.setup.io import with_changes
 
     results: dict = {}
     for name in PRESETS:

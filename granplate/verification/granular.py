@@ -122,7 +122,7 @@ def _impact_series(ds, wall: bool) -> tuple[np.ndarray, np.ndarray]:
 
 def _impact_measure(name: str, changes: dict | None = None) -> dict:
     """Run scenario `name` (two spheres or sphere on wall) and measure the impact."""
-    from ..model import build_model
+    from granplate.model.arrays import build_model
 
     s = load_case_scenario(name, changes)
     wall = bool(s.walls)

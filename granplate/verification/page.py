@@ -76,7 +76,7 @@ def summary_counts(results: list[CaseResult]) -> tuple[int, int, int, int]:
 
 
 def header_lines(results: list[CaseResult], full: bool, seconds: float) -> list[str]:
-    from .. import __version__
+    from granplate.version import __version__
 
     n_cases, bad_cases, n_checks, bad_checks = summary_counts(results)
     when = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")

@@ -26,7 +26,7 @@ STRIP_THICKNESS = 0.001
 
 
 def _steel():
-    from ..materials import LIBRARY
+    from granplate.setup.materials import LIBRARY
 
     return LIBRARY["steel"]
 
@@ -52,7 +52,7 @@ def distorted_mesh(nx: int = 4, ny: int = 5, seed: int = 3):
 
 def patch_test(ctx: Context) -> CaseResult:
     """Linear displacement data on a distorted mesh: FE solution and strains exact."""
-    from .. import plate as gp
+    from granplate import plate as gp
 
     st = _steel()
     mesh = distorted_mesh()
@@ -118,8 +118,8 @@ def patch_test(ctx: Context) -> CaseResult:
 
 def _strip(nx: int, ny: int):
     """Basis, K, M, node coordinates and free dofs of the clamped strip (top/bottom clamped)."""
-    from .. import plate as gp
-    from ..scenario import Plate
+    from granplate import plate as gp
+    from granplate.setup.scenario import Plate
 
     st = _steel()
     p = Plate(width=STRIP_DEPTH, height=STRIP_LENGTH, thickness=STRIP_THICKNESS, nx=nx, ny=ny)
@@ -248,8 +248,8 @@ def timoshenko_clamped_frequencies(n: int = 3) -> np.ndarray:
 
 def strip_bending_frequencies(nx: int, ny: int, n: int = 3) -> np.ndarray:
     """The n lowest frequencies [Hz] of the clamped strip whose modes move mostly along x."""
-    from .. import plate as gp
-    from ..scenario import Plate
+    from granplate import plate as gp
+    from granplate.setup.scenario import Plate
 
     strip = Plate(width=STRIP_DEPTH, height=STRIP_LENGTH, thickness=STRIP_THICKNESS, nx=nx, ny=ny,
                   n_modes=4 * n + 4)
@@ -323,7 +323,7 @@ def manufactured_errors(n: int, E: float = 1.0, nu: float = 0.3) -> tuple[float,
     """L2 and energy-norm errors of the Q8 solution on an n x n mesh of the unit square."""
     from skfem import Functional, LinearForm, MeshQuad, asm
 
-    from .. import plate as gp
+    from granplate import plate as gp
 
     exact, grad, body = _manufactured(E, nu)
     D = gp.plane_stress_matrix(E, nu)
@@ -405,7 +405,7 @@ def q8_convergence(ctx: Context) -> CaseResult:
 def newmark_oscillator(omega_h: float, n_periods: float = 20.0) -> tuple[np.ndarray, np.ndarray]:
     """Free vibration of one mode (omega = 2 pi 1 kHz, q(0) = 1) stepped by the simulator's
     compiled `kernels.newmark_predict` / `newmark_correct`. Returns (q_n, energy_n)."""
-    from .. import kernels as K
+    from granplate.solver import kernels as K
 
     w = 2.0 * math.pi * 1000.0
     h = omega_h / w

@@ -21,7 +21,7 @@ SCHEMES = ("paper", "implicit")
 
 def fingerprint(ds) -> dict:
     """Summary metrics and a few time-series samples of one result."""
-    from granplate.results import summary
+    from granplate.results.dataset import summary
 
     out = {k: v for k, v in summary(ds).items() if k not in ("wall_time_s", "scenario")}
     idx = np.linspace(0, ds.sizes["time"] - 1, 10).round().astype(int)

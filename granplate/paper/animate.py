@@ -2,7 +2,7 @@
 displacements magnified (125 times by default), granules coloured by speed and plate
 elements by von Mises stress, with a time label.
 
-    >>> from granplate.animate import animate
+    >>> from granplate.paper.animate import animate
     >>> animate(gp.read("ptfe-r05.nc"), "ptfe-r05.mp4")   # -> Path (.gif if no ffmpeg)
 
 Frames are the result's plate-field snapshots (`field_time`, every 20 us by default),
@@ -23,7 +23,7 @@ from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
-from . import analysis as an
+from granplate.results import analysis as an
 
 #: The paper's magnification of displacements in its animations.
 MAGNIFY = 125.0
@@ -57,7 +57,7 @@ def plate_polygons(ds: xr.Dataset, k: int, factor: float) -> np.ndarray:
 
 
 def _walls(ds: xr.Dataset):
-    from .scenario_io import loads
+    from granplate.setup.io import loads
 
     return loads(ds.attrs["scenario_toml"]).walls
 

@@ -1,15 +1,15 @@
-"""Benchmark harness for granplate (issue 5): speed and accuracy of every coupling scheme.
+"""Benchmark harness for granplate: speed and accuracy of every coupling scheme.
 
 For each case (a paper preset, possibly shortened) and each scheme in
 ``granplate.validate.SCHEMES`` it runs the simulation in a fresh worker subprocess
 (one warm-up call so the numba cache is loaded, then ``repeats`` timed calls), and
 compares the key metrics with a converged reference run of the same case, cached on
-disk under ``benchmarks/.reference/`` keyed by the reference scenario's TOML. It also
+disk in the granplate cache (``bench-reference/``) keyed by the reference scenario's TOML. It also
 measures the compile / cache-load time once per scheme in a fresh subprocess.
 
 Run it as ``granplate bench [--quick] [--json FILE] [--cases A,B] [--repeats N]`` or
-``python -m benchmarks.harness ...``. The JSON keys are documented in
-``benchmarks/README.md``.
+``python -m granplate.bench.harness ...``. The JSON keys are documented in
+``docs/benchmarks.md``.
 """
 from __future__ import annotations
 
@@ -24,8 +24,13 @@ import sys
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-REFERENCE_DIR = Path(__file__).resolve().parent / ".reference"
+
+def reference_dir() -> Path:
+    """Where converged reference runs are kept: the granplate cache's bench-reference/."""
+    from granplate.plate.fe import cache_directory
+
+    return cache_directory() / "bench-reference"
+
 
 #: Key metrics compared with the converged reference (keys of granplate.summary).
 METRICS = ("e_shock", "ep_max_fraction", "ep_final_fraction", "max_von_mises", "max_eps_yy")
@@ -75,7 +80,7 @@ def reference_scenario(case: str, t_end: float | None):
 
 
 def _scenario_key(s) -> str:
-    from granplate.scenario_io import dumps
+    from granplate.setup.io import dumps
 
     return hashlib.sha256(dumps(s, all_materials=True).encode()).hexdigest()[:16]
 
@@ -85,14 +90,14 @@ def reference_summary(case: str, t_end: float | None, log=print) -> dict:
     import granplate as gp
 
     s = reference_scenario(case, t_end)
-    path = REFERENCE_DIR / f"{case}-{_scenario_key(s)}.json"
+    path = reference_dir() / f"{case}-{_scenario_key(s)}.json"
     if path.exists():
         return json.loads(path.read_text())
     log(f"  reference run for {case} (t_end {s.time.t_end:g} s), cached in {path} ...")
     ds = gp.simulate(s, progress=False)
     summ = gp.summary(ds)
     summ["n_iterations"] = int(ds.attrs.get("n_iterations", 0)) if "n_iterations" in ds.attrs else None
-    REFERENCE_DIR.mkdir(parents=True, exist_ok=True)
+    reference_dir().mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(".tmp")
     tmp.write_text(json.dumps(summ, indent=2) + "\n")
     tmp.replace(path)
@@ -164,11 +169,11 @@ def _worker(spec: dict) -> dict:
 
 
 def _spawn(spec: dict) -> dict:
-    code = (f"import sys, json; sys.path.insert(0, {str(ROOT)!r}); "
-            "from benchmarks.harness import _worker; "
+    code = ("import sys, json; "
+            "from granplate.bench.harness import _worker; "
             "print('@@RESULT ' + json.dumps(_worker(json.loads(sys.stdin.read()))))")
     p = subprocess.run([sys.executable, "-c", code], input=json.dumps(spec), capture_output=True,
-                       text=True, cwd=str(ROOT))
+                       text=True)
     for line in p.stdout.splitlines():
         if line.startswith("@@RESULT "):
             return json.loads(line[len("@@RESULT "):])
@@ -220,7 +225,7 @@ def bench_case(case: str, scheme: str, t_end: float | None, repeats: int, ref: d
 
 
 def schemes() -> tuple[str, ...]:
-    from granplate.validate import SCHEMES
+    from granplate.setup.validate import SCHEMES
 
     return tuple(SCHEMES)
 
@@ -328,6 +333,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(prog="python -m benchmarks.harness")
+    ap = argparse.ArgumentParser(prog="python -m granplate.bench.harness")
     add_arguments(ap)
     sys.exit(main(ap.parse_args()))

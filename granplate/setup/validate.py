@@ -15,9 +15,9 @@ import math
 import numbers
 from typing import Any
 
-from .errors import ScenarioError
-from .geometry import resolve
-from .scenario import SQRT2_MINUS_1, Scenario
+from granplate.errors import ScenarioError
+from granplate.setup.geometry import resolve
+from granplate.setup.scenario import SQRT2_MINUS_1, Scenario
 
 #: Lever arms of the friction torque (Contact.torque_arm).
 TORQUE_ARMS: tuple[str, ...] = ("radius", "contact_point")

@@ -21,9 +21,9 @@ from typing import Callable
 import numpy as np
 import xarray as xr
 
-from . import analysis as an
-from . import checks as ck
-from .document import Block, to_html, to_markdown
+from granplate.results import analysis as an
+from granplate.paper import checks as ck
+from granplate.results.document import Block, to_html, to_markdown
 
 Results = dict[str, xr.Dataset]
 
@@ -267,7 +267,7 @@ def _vertical(r1, r05):
 @_statement("Frictional local maps stay contractive at contacts A, B, C", "App. A, Fig. A.1",
             "abs(lambda) < 1", "max over the run < 1", "steel-r1")
 def _lambda(steel):
-    from .scenario_io import loads
+    from granplate.setup.io import loads
 
     labels = [str(c) for c in steel["contact"].values]
     idx = [labels.index(c) for c in ("A", "B", "C") if c in labels]
@@ -311,7 +311,7 @@ def statements(results: Results) -> list[Row]:
 
 
 def _energy_tol(ds: xr.Dataset) -> float:
-    from .scenario_io import loads
+    from granplate.setup.io import loads
 
     return float(loads(ds.attrs["scenario_toml"]).solver.energy_tol)
 
@@ -474,13 +474,13 @@ def _window(ds: xr.Dataset, t_end: float) -> xr.Dataset:
 
 
 def _element_height(ds: xr.Dataset) -> float:
-    from .scenario_io import loads
+    from granplate.setup.io import loads
 
     return float(loads(ds.attrs["scenario_toml"]).plate.element_height)
 
 
 def _layer_width(ds: xr.Dataset) -> float:
-    from .scenario_io import loads
+    from granplate.setup.io import loads
 
     return float(loads(ds.attrs["scenario_toml"]).plate.layer_width)
 
@@ -608,8 +608,8 @@ def build_report(
     seconds: float | None = None,
 ) -> list[Block]:
     """The report as blocks: summary, comparison table, runs, discussion, figures."""
-    from . import __version__
-    from .plots import FIGURES, figure_stem
+    from granplate.version import __version__
+    from granplate.paper.plots import FIGURES, figure_stem
 
     rows = statements(results)
     judged = [r for r in rows if r.holds is not None]
@@ -665,7 +665,7 @@ def build_report(
 
 def load_results(paths: dict[str, Path]) -> Results:
     """Read result files (name -> path) into Datasets, skipping unreadable ones."""
-    from .results import read
+    from granplate.results.dataset import read
 
     out: Results = {}
     for name, p in paths.items():
@@ -682,7 +682,7 @@ def write_report(out_dir: str | Path, outcome) -> list[Path]:
     outcome: anything with .runs (RunRecord: name, path, status, kind), .figures
     (key -> paths), .animations (paths) and .seconds.
     """
-    from .presets import preset_names
+    from granplate.setup.presets import preset_names
 
     out = Path(out_dir)
     done = [r for r in outcome.runs if r.status in ("ran", "reused")]

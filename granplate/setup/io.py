@@ -23,9 +23,9 @@ from typing import Any
 
 import tomli_w
 
-from .errors import ScenarioError
-from .materials import LIBRARY, Material
-from .scenario import (Contact, Granule, Layout, Load, PairCoefficients, Plate, Scenario,
+from granplate.errors import ScenarioError
+from granplate.setup.materials import LIBRARY, Material
+from granplate.setup.scenario import (Contact, Granule, Layout, Load, PairCoefficients, Plate, Scenario,
                        Solver, TimeSettings, Wall)
 
 #: Fields that a table must give (everything else takes the dataclass default).
@@ -309,8 +309,8 @@ def load_scenario(path_or_preset: str | os.PathLike) -> Scenario:
 
     The scenario is returned as written (not resolved; `geometry.resolve` expands it).
     """
-    from . import presets  # local import: presets imports nothing of this module's users
-    from .validate import validate
+    from granplate.setup import presets  # local import: presets imports nothing of this module's users
+    from granplate.setup.validate import validate
 
     key = os.fspath(path_or_preset)
     if isinstance(key, str) and key in presets.PRESETS:

@@ -38,11 +38,11 @@ import scipy.sparse as sp
 import skfem
 from skfem import Basis, BilinearForm, ElementQuadS2, ElementVector, FacetBasis, LinearForm, MeshQuad, asm
 
-from .errors import ScenarioError
-from .materials import LIBRARY, Material
+from granplate.errors import ScenarioError
+from granplate.setup.materials import LIBRARY, Material
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .scenario import Plate
+    from granplate.setup.scenario import Plate
 
 #: Bump when anything that changes the cached arrays changes (formulas, ordering, dtypes).
 CACHE_VERSION = 2

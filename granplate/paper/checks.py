@@ -104,8 +104,8 @@ def get_check(name: str) -> Check:
 def check_scenario(check: Check, t_end: float | None = None):
     """The Scenario a check runs: its preset with its changes, ending at the earlier of
     the check's t_end and `t_end` [s] (None: no cap)."""
-    from .presets import preset
-    from .scenario_io import with_changes
+    from granplate.setup.presets import preset
+    from granplate.setup.io import with_changes
 
     ends = [v for v in (check.t_end, t_end) if v is not None]
     changes = dict(check.changes)
@@ -172,7 +172,7 @@ def von_mises_at(
 
 def plate_material(ds: xr.Dataset) -> tuple[float, float]:
     """(E [Pa], nu) of the plate, read from the result's scenario."""
-    from .scenario_io import loads
+    from granplate.setup.io import loads
 
     s = loads(ds.attrs["scenario_toml"])
     m = s.material(s.plate.material)

@@ -1,6 +1,6 @@
 """VTK time series of a run for ParaView, through meshio.
 
-    >>> from granplate.export import export_vtk
+    >>> from granplate.results.export import export_vtk
     >>> export_vtk(gp.read("steel-r1.nc"), "vtk/")      # -> vtk/steel-r1.pvd
 
 One file per plate-field snapshot (`field_time`) and per part:
@@ -27,7 +27,7 @@ import meshio
 import numpy as np
 import xarray as xr
 
-from . import analysis as an
+from granplate.results import analysis as an
 
 
 def _points3(x: np.ndarray, y: np.ndarray) -> np.ndarray:

@@ -19,8 +19,8 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from .errors import ScenarioError
-from .scenario import Granule, Layout, Scenario, Wall
+from granplate.errors import ScenarioError
+from granplate.setup.scenario import Granule, Layout, Scenario, Wall
 
 #: Labels of the paper's granules, in the order `paper_layout` returns them.
 PAPER_LABELS: tuple[str, ...] = ("1", "2", "3", "4", "5", "6", "7", "8", "9",

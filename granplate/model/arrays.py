@@ -8,14 +8,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import kernels
-from .contact import damping_coefficient, hertz_coefficient
-from .errors import ScenarioError
-from .geometry import resolve
-from .shock import shock_resultants
-from .materials import effective_modulus, sphere_inertia, sphere_mass
-from .scenario import Scenario
-from .validate import validate
+from granplate.solver import kernels
+from granplate.physics.contact import damping_coefficient, hertz_coefficient
+from granplate.errors import ScenarioError
+from granplate.setup.geometry import resolve
+from granplate.physics.shock import shock_resultants
+from granplate.setup.materials import effective_modulus, sphere_inertia, sphere_mass
+from granplate.setup.scenario import Scenario
+from granplate.setup.validate import validate
 
 #: implicit scheme: the error estimate's smallest force scale, as a fraction of the
 #: shock's peak resultant force on the granules (q0 times the load resultants).
@@ -179,7 +179,7 @@ def build_model(scenario: Scenario) -> Model:
     plate_model = None
     nk = len(pc)
     if s.plate is not None:
-        from .plate import build_plate
+        from granplate.plate.fe import build_plate
 
         edge = None
         if s.load.kind == "line" and s.load.target == "plate":

@@ -5,7 +5,7 @@ the numbers in the datasets it is given (through `granplate.analysis`), with uni
 every axis and a caption line naming the runs. `FIGURES` says which presets each figure
 takes; `save_figure` writes a PNG and a PDF.
 
-    >>> from granplate import plots
+    >>> from granplate.paper import plots
     >>> fig = plots.fig_3(gp.read("bare-plate.nc"), gp.read("steel-r1.nc"))
     >>> plots.save_figure(fig, "out", "fig3")
 
@@ -27,7 +27,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 
-from . import analysis as an
+from granplate.results import analysis as an
 
 #: The granules whose velocities the paper plots (Figs. 4e-f, 5c).
 VELOCITY_GRANULES = ("3", "8", "C")
@@ -300,7 +300,7 @@ def fig_8(weak: xr.Dataset, moderate: xr.Dataset, strong: xr.Dataset) -> Figure:
 
 
 def _scenario(ds: xr.Dataset):
-    from .scenario_io import loads
+    from granplate.setup.io import loads
 
     return loads(ds.attrs["scenario_toml"])
 

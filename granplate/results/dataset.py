@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from . import __version__
-from . import kernels as K
+from granplate.version import __version__
+from granplate.solver import kernels as K
 
 #: name -> (units, description) of every data variable
 VARIABLES: dict[str, tuple[str, str]] = {
@@ -95,7 +95,7 @@ def plate_fields(model, q: np.ndarray, qd: np.ndarray, times: np.ndarray) -> dic
 
 def to_dataset(model, out: K.Output, n: int, info: dict) -> xr.Dataset:
     """Build the result Dataset from the first n output rows."""
-    from .scenario_io import dumps
+    from granplate.setup.io import dumps
 
     s = model.scenario
     t = out.t[:n].copy()

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 from typing import Callable
 
-from .errors import ScenarioError
-from .scenario import Layout, Load, Plate, Scenario
+from granplate.errors import ScenarioError
+from granplate.setup.scenario import Layout, Load, Plate, Scenario
 
 #: One line per preset, naming the paper figures it reproduces.
 DESCRIPTIONS: dict[str, str] = {

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from .materials import LIBRARY, Material
+from granplate.setup.materials import LIBRARY, Material
 
 
 @dataclass(frozen=True)

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 from multiprocessing import get_context
 from pathlib import Path
 
-from .errors import ScenarioError
+from granplate.errors import ScenarioError
 
 #: Default output directory of `granplate reproduce`.
 DEFAULT_OUT = "granplate-results"
@@ -84,7 +84,7 @@ class Outcome:
 
 def shortened(scenario, t_end: float | None):
     """The scenario ending at t_end [s] (None: unchanged); output intervals shrink to fit."""
-    from .scenario_io import with_changes
+    from granplate.setup.io import with_changes
 
     if t_end is None:
         return scenario
@@ -99,16 +99,16 @@ def shortened(scenario, t_end: float | None):
 
 def preset_scenario(name: str, t_end: float | None = None):
     """Preset `name`, shortened to t_end [s] when given."""
-    from .presets import preset
+    from granplate.setup.presets import preset
 
     return shortened(preset(name), t_end)
 
 
 def expected_identity(scenario) -> tuple[str, str]:
     """(scenario_toml, granplate_version) a run of `scenario` would write."""
-    from . import __version__
-    from .geometry import resolve
-    from .scenario_io import dumps
+    from granplate.version import __version__
+    from granplate.setup.geometry import resolve
+    from granplate.setup.io import dumps
 
     return dumps(resolve(scenario)), __version__
 
@@ -132,8 +132,8 @@ def is_current(path: str | Path, scenario) -> bool:
 
 def plan(out_dir: Path, t_end: float | None = None, checks: str = "fast") -> list[Job]:
     """The presets (DIR/NAME.nc) and the sensitivity checks (DIR/checks/NAME.nc) to run."""
-    from .checks import CHECKS, check_scenario
-    from .presets import preset_names
+    from granplate.paper.checks import CHECKS, check_scenario
+    from granplate.setup.presets import preset_names
 
     if checks not in CHECK_MODES:
         raise ScenarioError("--checks", checks, f"allowed: {', '.join(CHECK_MODES)}")
@@ -153,8 +153,8 @@ def run_job(job: Job) -> RunRecord:
     """Simulate one job and write its result atomically; a failed run keeps its partial
     result as NAME.partial.nc (never reused) and reports why."""
     import granplate
-    from .errors import SimulationError
-    from .results import write
+    from granplate.errors import SimulationError
+    from granplate.results.dataset import write
 
     t0 = time.perf_counter()
     job.path.parent.mkdir(parents=True, exist_ok=True)
@@ -172,8 +172,8 @@ def run_job(job: Job) -> RunRecord:
 
 def make_figure(key: str, paths: list[Path], out_dir: Path) -> list[Path]:
     """Draw figure `key` from the result files (in the figure's preset order); PNG + PDF."""
-    from . import plots
-    from .results import read
+    from granplate.paper import plots
+    from granplate.results.dataset import read
 
     spec = plots.FIGURES[key]
     fig = spec.function(*[read(p) for p in paths])
@@ -182,8 +182,8 @@ def make_figure(key: str, paths: list[Path], out_dir: Path) -> list[Path]:
 
 def make_animation(path: Path, target: Path, frames: int | None) -> Path:
     """Animate the result at path into target (.mp4, or .gif as a fallback)."""
-    from .animate import animate
-    from .results import read
+    from granplate.paper.animate import animate
+    from granplate.results.dataset import read
 
     return animate(read(path), target, frames=frames)
 
@@ -354,7 +354,7 @@ class _Driver:
 
 def _products(figures: bool, animations: bool) -> list[_Product]:
     """The figures (each with the presets it takes) and the Appendix B animations."""
-    from . import plots
+    from granplate.paper import plots
 
     out = [_Product("figure", k, spec.presets) for k, spec in plots.FIGURES.items()] if figures else []
     return out + ([_Product("animation", n, (n,)) for n in ANIMATED] if animations else [])
@@ -380,7 +380,7 @@ def reproduce(
     the figures; animations / frames: the Appendix B animations and their frame count;
     quiet: no progress.
     """
-    from .report import write_report
+    from granplate.paper.report import write_report
 
     t_start = time.perf_counter()
     out = Path(out_dir)
@@ -424,7 +424,7 @@ def _up_to_date(target: Path, inputs: list[Path]) -> bool:
 
 def _earlier_figures(fig_dir: Path, available: dict[str, Path]) -> dict[str, list[Path]]:
     """Figures drawn by an earlier reproduce from the same result files (for the report)."""
-    from . import plots
+    from granplate.paper import plots
 
     found = {}
     for key, spec in plots.FIGURES.items():
@@ -467,7 +467,7 @@ def _existing(path: str, what: str = "file") -> Path:
 
 
 def _read(path: Path):
-    from .results import read
+    from granplate.results.dataset import read
 
     try:
         return read(path)
@@ -481,7 +481,7 @@ def figure_inputs(key: str, inputs: list[str]) -> list[Path]:
     A directory is searched for PRESET.nc; files are matched to the figure's presets by
     their scenario name, or else taken in the order given (when the count is right).
     """
-    from . import plots
+    from granplate.paper import plots
 
     need = plots.FIGURES[key].presets
     files: list[Path] = []
@@ -531,7 +531,7 @@ def _cmd_reproduce(args) -> int:
 
 
 def _cmd_plot(args) -> int:
-    from . import plots
+    from granplate.paper import plots
 
     names = list(plots.FIGURES) if args.figure.lower() == "all" else [args.figure]
     for name in names:
@@ -549,7 +549,7 @@ def _cmd_plot(args) -> int:
 
 
 def _cmd_animate(args) -> int:
-    from .animate import animate
+    from granplate.paper.animate import animate
 
     ds = _read(_existing(args.result))
     target = Path(args.output) if args.output else Path(f"{ds.attrs.get('scenario_name', 'result')}.mp4")
@@ -563,8 +563,8 @@ def _cmd_animate(args) -> int:
 
 
 def _cmd_export(args) -> int:
-    from .analysis import has_plate
-    from .export import export_vtk
+    from granplate.results.analysis import has_plate
+    from granplate.results.export import export_vtk
 
     ds = _read(_existing(args.result))
     if not has_plate(ds):

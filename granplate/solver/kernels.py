@@ -42,8 +42,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .contact import contact_response, friction_magnitude, local_map_modulus
-from .shock import time_profile
+from granplate.physics.contact import contact_response, friction_magnitude, local_map_modulus
+from granplate.physics.shock import time_profile
 
 # --- layout of the small bookkeeping arrays -------------------------------------------
 # clock (float64)

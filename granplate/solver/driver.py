@@ -13,10 +13,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from . import kernels as K
-from .errors import SimulationError
-from .model import Model, build_model
-from .scenario import Scenario
+from granplate.solver import kernels as K
+from granplate.errors import SimulationError
+from granplate.model.arrays import Model, build_model
+from granplate.setup.scenario import Scenario
 
 
 def _status_message(status: int, model: Model, st: K.State) -> str:
@@ -66,7 +66,7 @@ def simulate(
     is a terminal). Raises SimulationError (with the partial Dataset in `.result`) when
     the run goes numerically wrong.
     """
-    from .results import to_dataset
+    from granplate.results.dataset import to_dataset
 
     if t_end is not None:
         scenario = replace(scenario, time=replace(scenario.time, t_end=float(t_end)))

@@ -5,7 +5,7 @@ Pure functions of an xarray Dataset written by `granplate.simulate`; no plotting
 The figures (`granplate.plots`) and the report (`granplate.report`) both draw their
 numbers from here, so a figure and the table that quotes it can never disagree.
 
-    >>> from granplate import analysis
+    >>> from granplate.results import analysis
     >>> e = analysis.normalised_energies(ds)   # dict of arrays, fractions of E_shock
     >>> analysis.plate_share(ds)["peak"]       # the plate's peak share of E_shock
 """

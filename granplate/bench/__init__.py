@@ -1,0 +1,1 @@
+"""`granplate bench`: speed and accuracy of the schemes on the presets."""

@@ -1,0 +1,21 @@
+"""`granplate bench`: the command line of the benchmark harness (granplate.bench.harness)."""
+from __future__ import annotations
+
+
+def _cmd_bench(args) -> int:
+    from granplate.bench import harness
+
+    return int(harness.main(args))
+
+
+def register(subparsers) -> None:
+    b = subparsers.add_parser("bench", help="benchmark speed and accuracy of every scheme")
+    b.add_argument("--quick", action="store_true",
+                   help="a subset of presets, shortened, 1 repeat (under a minute)")
+    b.add_argument("--json", metavar="FILE", help="write the report as JSON to FILE")
+    b.add_argument("--cases", help="comma-separated preset names (default: all six; quick: a subset)")
+    b.add_argument("--repeats", type=int, default=None,
+                   help="timed repeats per case; the median is reported (default 3, quick 1)")
+    b.add_argument("--t-end", dest="t_end", type=float, default=None,
+                   help="simulated time [s] for every case (overrides the mode's)")
+    b.set_defaults(func=_cmd_bench)

@@ -1,0 +1,1 @@
+"""The paper study: its statements and checks, figures, animations, report, `reproduce`."""

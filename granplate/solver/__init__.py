@@ -1,0 +1,1 @@
+"""Solver layer: the compiled time loop, its schemes and the driver (`simulate`)."""
