@@ -179,7 +179,7 @@ def build_model(scenario: Scenario) -> Model:
     plate_model = None
     nk = len(pc)
     if s.plate is not None:
-        from granplate.plate.fe import build_plate
+        from granplate.plate import build_plate
 
         edge = None
         if s.load.kind == "line" and s.load.target == "plate":

@@ -1,22 +1,33 @@
-"""Plate layer: Q8 finite elements (scikit-fem), rigid layers, modes, stresses, the plate cache."""
+"""Plate layer: Q8 finite elements (scikit-fem), rigid layers, modes, edge load, stresses.
 
-from granplate.plate.fe import (  # noqa: F401
-    CACHE_VERSION,
+One module per concept: `fe` (mesh, Q8 basis, K and M, nodes, VTK element order),
+`constraints` (edges, clamps, symmetry line, rigid layers, the reduction T), `modes`
+(the eigenproblem and the mode sign rule), `load` (the half-sine edge load), `stress`
+(plane-stress D, strain operator, stress recovery) and `build` (PlateModel, build_plate
+and its cache).
+"""
+
+from granplate.plate.stress import (  # noqa: F401
     INTORDER,
-    EDGE_LOAD_POINTS,
-    GEOMETRY_RTOL,
-    EDGES,
-    PlateModel,
     plane_stress_matrix,
     von_mises_plane_stress,
+    voigt_strain,
+    strain_operator,
+    quadrature_points,
+    gauss_point_strains,
+    plane_stresses,
+)
+from granplate.plate.fe import (  # noqa: F401
     plate_mesh,
     q8_basis,
     assemble_stiffness,
     assemble_mass,
-    strain_operator,
-    quadrature_points,
     node_coordinates,
     vtk_elements,
+)
+from granplate.plate.constraints import (  # noqa: F401
+    GEOMETRY_RTOL,
+    EDGES,
     nodes_on_line,
     edge_nodes,
     clamped_dofs,
@@ -25,13 +36,18 @@ from granplate.plate.fe import (  # noqa: F401
     check_layers_off_clamps,
     rigid_layer_map,
     reduce_matrix,
+)
+from granplate.plate.modes import (  # noqa: F401
     modal_basis,
     sign_reference,
     fix_mode_signs,
-    half_sine_line_load,
-    edge_load_vector,
+    transverse_mode_frequencies,
+)
+from granplate.plate.load import EDGE_LOAD_POINTS, half_sine_line_load, edge_load_vector  # noqa: F401
+from granplate.plate.build import (  # noqa: F401
+    CACHE_VERSION,
+    PlateModel,
     cache_directory,
     cache_key,
     build_plate,
-    transverse_mode_frequencies,
 )

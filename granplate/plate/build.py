@@ -1,0 +1,406 @@
+"""Build the plate model: mesh, reduction, modes and output operators, cached on disk.
+
+Data flows one way::
+
+    Plate, Material -> mesh, basis -> K, M (full)            assemble_stiffness, assemble_mass
+                    -> T (clamps + rigid layers)             clamped_dofs, rigid_layer_map
+                    -> K_r = T^T K T, M_r = T^T M T -> Phi, omega   modal_basis
+                    -> strain_op, edge_load_full                    strain_operator, edge_load_vector
+
+A full displacement vector is x_full = T @ x_red with x_red = Phi @ q, q the modal
+coordinates. The expensive part of `build_plate` (assembly and the dense generalized
+eigenproblem) is cached in an ``.npz`` file under ``$GRANPLATE_CACHE`` (default
+``~/.cache/granplate``), keyed by a sha256 of every input.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import os
+import tempfile
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Sequence
+
+import numpy as np
+import scipy.sparse as sp
+import skfem
+from skfem import Basis, MeshQuad
+
+from granplate.errors import ScenarioError
+from granplate.plate.constraints import (
+    GEOMETRY_RTOL,
+    check_layers_off_clamps,
+    clamped_dofs,
+    reduce_matrix,
+    rigid_layer_map,
+    rigid_layer_nodes,
+    symmetry_line_nodes,
+)
+from granplate.plate.fe import assemble_mass, assemble_stiffness, node_coordinates, plate_mesh, q8_basis, vtk_elements
+from granplate.plate.load import EDGE_LOAD_POINTS, edge_load_vector
+from granplate.plate.modes import modal_basis
+from granplate.plate.stress import (
+    INTORDER,
+    gauss_point_strains,
+    plane_stress_matrix,
+    plane_stresses,
+    quadrature_points,
+    strain_operator,
+    von_mises_plane_stress,
+)
+from granplate.setup.materials import LIBRARY, Material
+
+if TYPE_CHECKING:  # pragma: no cover
+    from granplate.setup.scenario import Plate
+
+#: Bump when anything that changes the cached arrays changes (formulas, ordering, dtypes).
+CACHE_VERSION = 2
+
+_CACHED_ARRAYS = (
+    "Phi",
+    "omega",
+    "strain_op_data",
+    "strain_op_indices",
+    "strain_op_indptr",
+    "strain_op_shape",
+    "edge_load_full",
+    "edge_load_modal",
+)
+
+
+@dataclass(frozen=True)
+class PlateModel:
+    """A built plate: mesh, reduction, modes and output operators.
+
+    Shapes: n_nodes Q8 nodes, n_full = 2 n_nodes dofs, n_red reduced dofs (clamped dofs
+    removed, rigid-layer nodes slaved), n_modes kept modes, n_elem elements, n_qp = 9
+    Gauss points per element, n_contacts rigid layers.
+
+    Attributes
+    ----------
+    mesh, basis: the scikit-fem mesh and full (unconstrained) vector Q8 basis.
+    node_xy: (n_nodes, 2) node coordinates [m]; node n has dofs 2n (x), 2n + 1 (y).
+    elements: (n_elem, 8) node indices in VTK_QUADRATIC_QUAD order (4 corners
+        anticlockwise, then the midsides of edges 0-1, 1-2, 2-3, 3-0).
+    T: (n_full, n_red) sparse 0/1 map x_full = T @ x_red.
+    Phi: (n_red, n_modes) mass-normalised modes, Phi^T M_r Phi = I [kg^-1/2].
+    omega: (n_modes,) angular frequencies [rad/s], ascending.
+    drive_dofs: (n_contacts, 2) reduced indices of each contact's driving x and y dofs.
+    phi_drive: (2 n_contacts, n_modes) = Phi[drive_dofs.ravel()].
+    edge_load_modal: (n_modes,) Phi^T T^T edge_load_full [N / kg^1/2 per N/m of q0].
+    edge_load_full: (n_full,) consistent nodal forces [N] of the left-edge line load
+        q(y) = sin(pi (y - y0_load) / L) for q0 = 1 N/m (zeros when none was asked).
+    strain_op: (3 n_elem n_qp, n_full) sparse; rows [component][element][qp] give
+        eps_xx, eps_yy, gamma_xy (engineering shear) [-] from x_full [m].
+    qp_xy: (n_elem, n_qp, 2) Gauss point coordinates [m].
+    D: (3, 3) plane-stress constitutive matrix [Pa].
+    symmetry_nodes: node indices on y = y0 + height / 2, sorted by x.
+    contact_y: (n_contacts,) contact heights as given [m].
+    thickness [m], rho [kg/m^3], E [Pa], nu [-].
+    """
+
+    mesh: MeshQuad
+    basis: Basis
+    node_xy: np.ndarray
+    elements: np.ndarray
+    T: sp.csr_matrix
+    Phi: np.ndarray
+    omega: np.ndarray
+    drive_dofs: np.ndarray
+    phi_drive: np.ndarray
+    edge_load_modal: np.ndarray
+    edge_load_full: np.ndarray
+    strain_op: sp.csr_matrix
+    qp_xy: np.ndarray
+    D: np.ndarray
+    symmetry_nodes: np.ndarray
+    contact_y: np.ndarray
+    thickness: float
+    rho: float
+    E: float
+    nu: float
+
+    # ---- sizes -------------------------------------------------------------------
+    @property
+    def n_full(self) -> int:
+        """Number of unconstrained dofs (2 per node)."""
+        return self.T.shape[0]
+
+    @property
+    def n_red(self) -> int:
+        """Number of reduced dofs."""
+        return self.T.shape[1]
+
+    @property
+    def n_modes(self) -> int:
+        """Number of kept modes."""
+        return self.omega.shape[0]
+
+    @property
+    def n_qp(self) -> int:
+        """Gauss points per element."""
+        return self.qp_xy.shape[1]
+
+    # ---- matrices on demand (not cached: cheap to assemble) -------------------------
+    def stiffness_matrix(self) -> sp.csr_matrix:
+        """Full (unconstrained) stiffness K [N/m], (n_full, n_full)."""
+        return assemble_stiffness(self.basis, self.D, self.thickness)
+
+    def mass_matrix(self) -> sp.csr_matrix:
+        """Full (unconstrained) consistent mass M [kg], (n_full, n_full)."""
+        return assemble_mass(self.basis, self.rho, self.thickness)
+
+    # ---- fields from modal coordinates --------------------------------------------
+    def full_dofs(self, q: np.ndarray) -> np.ndarray:
+        """x_full = T Phi q [m]: (..., n_modes) -> (..., n_full)."""
+        q = np.asarray(q, dtype=float)
+        flat = q.reshape(-1, self.n_modes)
+        x_full = (self.T @ (self.Phi @ flat.T)).T
+        return x_full.reshape(q.shape[:-1] + (self.n_full,))
+
+    def full_displacement(self, q: np.ndarray) -> np.ndarray:
+        """Nodal displacements [m]: q (..., n_modes) -> (..., n_nodes, 2)."""
+        x_full = self.full_dofs(q)
+        return x_full.reshape(x_full.shape[:-1] + (-1, 2))
+
+    def strains(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """eps_xx, eps_yy, gamma_xy [-] at the Gauss points, each (..., n_elem, n_qp)."""
+        return gauss_point_strains(self.strain_op, self.full_dofs(q), self.qp_xy.shape[0], self.n_qp)
+
+    def stresses(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """sigma_xx, sigma_yy, tau_xy [Pa] at the Gauss points, each (..., n_elem, n_qp)."""
+        return plane_stresses(self.D, *self.strains(q))
+
+    def von_mises(self, q: np.ndarray) -> np.ndarray:
+        """Plane-stress von Mises stress [Pa] (MODEL.md eq. 12) at the Gauss points.
+
+        sqrt(sxx^2 - sxx syy + syy^2 + 3 sxy^2), shape (..., n_elem, n_qp).
+        """
+        sxx, syy, sxy = self.stresses(q)
+        return von_mises_plane_stress(sxx, syy, sxy)
+
+    def energy(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """Plate energy [J]: 1/2 qdot.qdot + 1/2 sum omega^2 q^2 (= 1/2 v^T M v + 1/2 x^T K x)."""
+        q = np.asarray(q, dtype=float)
+        qdot = np.asarray(qdot, dtype=float)
+        return 0.5 * np.sum(qdot**2, axis=-1) + 0.5 * np.sum(self.omega**2 * q**2, axis=-1)
+
+    def compliance(self, dt: float) -> np.ndarray:
+        """Driving-dof block of (M_r + dt^2 K_r / 4)^-1 [1/kg] (paper eq. 8), (2 nc, 2 nc).
+
+        = phi_drive diag(1 / (1 + dt^2 omega^2 / 4)) phi_drive^T; rows/columns ordered
+        [k0x, k0y, k1x, k1y, ...]. With all modes kept this is exact; with fewer it is
+        the truncated modal approximation.
+        """
+        weights = 1.0 / (1.0 + 0.25 * dt**2 * self.omega**2)
+        return (self.phi_drive * weights) @ self.phi_drive.T
+
+
+def cache_directory() -> Path:
+    """$GRANPLATE_CACHE, else ~/.cache/granplate."""
+    env = os.environ.get("GRANPLATE_CACHE")
+    return Path(env) if env else Path.home() / ".cache" / "granplate"
+
+
+def cache_key(
+    plate: "Plate",
+    material: Material,
+    x0: float,
+    contact_y: Sequence[float],
+    edge_load: tuple[float, float] | None,
+    symmetry_line: bool,
+) -> str:
+    """sha256 of every input of build_plate (floats written exactly via repr)."""
+    payload = {
+        "cache_version": CACHE_VERSION,
+        "skfem": getattr(skfem, "__version__", "?"),
+        "plate": dataclasses.asdict(plate),
+        "material": [material.name, repr(float(material.E)), repr(float(material.nu)), repr(float(material.rho))],
+        "x0": repr(float(x0)),
+        "contact_y": [repr(float(y)) for y in contact_y],
+        "edge_load": None if edge_load is None else [repr(float(v)) for v in edge_load],
+        "symmetry_line": symmetry_line,
+        "intorder": INTORDER,
+        "edge_load_points": EDGE_LOAD_POINTS,
+    }
+    text = json.dumps(payload, sort_keys=True, default=repr)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _load_cached(path: Path, key: str) -> dict[str, np.ndarray] | None:
+    """The arrays stored at path, or None when missing, unreadable or from another key."""
+    if not path.is_file():
+        return None
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            if str(data["key"]) != key:
+                return None
+            return {name: np.array(data[name]) for name in _CACHED_ARRAYS}
+    except Exception:  # noqa: BLE001 - any unreadable file just means "recompute"
+        return None
+
+
+def _save_cached(path: Path, key: str, arrays: dict[str, np.ndarray]) -> None:
+    """Write arrays atomically (temporary file + rename); failures only warn."""
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.stem, suffix=".tmp")
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                np.savez(fh, key=np.array(key), **arrays)
+            os.replace(tmp, path)
+        finally:
+            if os.path.exists(tmp):
+                os.remove(tmp)
+    except OSError as exc:
+        warnings.warn(f"granplate: could not write the plate cache {path}: {exc}", stacklevel=3)
+
+
+def _check_plate(plate: "Plate", x0: float, n_modes_max: int | None = None) -> None:
+    """Refuse sizes that cannot make a mesh."""
+    for name in ("width", "height", "thickness"):
+        value = getattr(plate, name)
+        if not (np.isfinite(value) and value > 0):
+            raise ScenarioError(f"plate.{name}", value, "allowed: a positive length in metres")
+    for name in ("nx", "ny"):
+        value = getattr(plate, name)
+        if not (isinstance(value, (int, np.integer)) and value >= 1):
+            raise ScenarioError(f"plate.{name}", value, "allowed: an integer >= 1")
+    if plate.layer_width < 0 or not np.isfinite(plate.layer_width):
+        raise ScenarioError("plate.rigid_layer_width", plate.rigid_layer_width, "allowed: None or a length >= 0 m")
+    if not np.isfinite(x0):
+        raise ScenarioError("plate.x0", x0, "allowed: a finite x position in metres")
+    if n_modes_max is not None and not (0 <= plate.n_modes <= n_modes_max):
+        raise ScenarioError("plate.n_modes", plate.n_modes, f"allowed: 0 (all) or 1..{n_modes_max}")
+
+
+def _compute_arrays(
+    basis: Basis,
+    mesh: MeshQuad,
+    D: np.ndarray,
+    material: Material,
+    plate: "Plate",
+    x0: float,
+    T: sp.csr_matrix,
+    edge_load: tuple[float, float] | None,
+) -> dict[str, np.ndarray]:
+    """The expensive arrays: modes, strain operator, edge load (what the cache holds)."""
+    K = assemble_stiffness(basis, D, plate.thickness)
+    M = assemble_mass(basis, material.rho, plate.thickness)
+    Phi, omega = modal_basis(reduce_matrix(K, T), reduce_matrix(M, T), plate.n_modes)
+    op = strain_operator(basis)
+    if edge_load is None:
+        f = np.zeros(basis.N)
+    else:
+        f = edge_load_vector(mesh, x0, float(edge_load[0]), float(edge_load[1]), GEOMETRY_RTOL * plate.width)
+    return {
+        "Phi": Phi,
+        "omega": omega,
+        "strain_op_data": op.data,
+        "strain_op_indices": op.indices,
+        "strain_op_indptr": op.indptr,
+        "strain_op_shape": np.array(op.shape),
+        "edge_load_full": f,
+        "edge_load_modal": Phi.T @ (T.T @ f),
+    }
+
+
+def _arrays_fit(arrays: dict[str, np.ndarray], n_full: int, n_red: int, n_modes: int, n_rows: int) -> bool:
+    """Whether cached arrays have the shapes this build needs."""
+    return (
+        arrays["Phi"].shape == (n_red, n_modes)
+        and arrays["omega"].shape == (n_modes,)
+        and tuple(arrays["strain_op_shape"]) == (n_rows, n_full)
+        and arrays["edge_load_full"].shape == (n_full,)
+        and arrays["edge_load_modal"].shape == (n_modes,)
+    )
+
+
+def build_plate(
+    plate: "Plate",
+    x0: float,
+    contact_y: Sequence[float],
+    edge_load: tuple[float, float] | None = None,
+    cache: bool = True,
+    material: Material | None = None,
+    symmetry_line: bool = True,
+) -> PlateModel:
+    """Build the plate model (mesh, reduction, modes, output operators).
+
+    plate: the scenario's Plate (plate.x0 is ignored: x0 is given resolved) [m];
+    x0: the plate's left edge x [m]; contact_y: the y [m] of each granule contact on the
+    left edge (each must be a node; one rigid layer per contact); edge_load = (y0_load, L)
+    [m] for the half-sine line load on the left edge, or None; cache: read/write the
+    expensive arrays in cache_directory(); material: the plate's Material (None: the
+    library's plate.material); symmetry_line: require (even ny) and return the nodes on
+    y = y0 + height / 2 (False: symmetry_nodes is empty and ny may be odd).
+
+    Raises ScenarioError for contacts that are not on a free left-edge node, rigid
+    layers that overlap or touch a clamp, odd ny when symmetry_line, bad n_modes.
+    """
+    if material is None:
+        if plate.material not in LIBRARY:
+            raise ScenarioError("plate.material", plate.material, f"allowed: one of {sorted(LIBRARY)}")
+        material = LIBRARY[plate.material]
+    x0 = float(x0)
+    contact_y = [float(y) for y in contact_y]
+    _check_plate(plate, x0)
+
+    mesh = plate_mesh(x0, plate.y0, plate.width, plate.height, plate.nx, plate.ny)
+    basis = q8_basis(mesh)
+    node_xy = node_coordinates(basis)
+    n_full = basis.N
+    symmetry_nodes = symmetry_line_nodes(node_xy, plate) if symmetry_line else np.empty(0, dtype=np.int64)
+    fixed = clamped_dofs(node_xy, plate, x0)
+    driving, layers = rigid_layer_nodes(node_xy, plate, x0, contact_y)
+    check_layers_off_clamps(fixed, driving, layers, plate, contact_y)
+    T, drive_dofs = rigid_layer_map(n_full, fixed, driving, layers)
+    n_red = T.shape[1]
+    _check_plate(plate, x0, n_modes_max=n_red)
+    n_modes = plate.n_modes or n_red
+    n_elem, n_qp = basis.dx.shape
+    D = plane_stress_matrix(material.E, material.nu)
+
+    arrays = None
+    path = None
+    if cache:
+        key = cache_key(plate, material, x0, contact_y, edge_load, symmetry_line)
+        path = cache_directory() / f"plate-{key[:40]}.npz"
+        arrays = _load_cached(path, key)
+        if arrays is not None and not _arrays_fit(arrays, n_full, n_red, n_modes, 3 * n_elem * n_qp):
+            arrays = None
+    if arrays is None:
+        arrays = _compute_arrays(basis, mesh, D, material, plate, x0, T, edge_load)
+        if cache and path is not None:
+            _save_cached(path, key, arrays)
+
+    strain_op = sp.csr_matrix(
+        (arrays["strain_op_data"], arrays["strain_op_indices"], arrays["strain_op_indptr"]),
+        shape=tuple(int(s) for s in arrays["strain_op_shape"]),
+    )
+    Phi = arrays["Phi"]
+    return PlateModel(
+        mesh=mesh,
+        basis=basis,
+        node_xy=node_xy,
+        elements=vtk_elements(mesh),
+        T=T,
+        Phi=Phi,
+        omega=arrays["omega"],
+        drive_dofs=drive_dofs,
+        phi_drive=np.ascontiguousarray(Phi[drive_dofs.ravel()]),
+        edge_load_modal=arrays["edge_load_modal"],
+        edge_load_full=arrays["edge_load_full"],
+        strain_op=strain_op,
+        qp_xy=quadrature_points(basis),
+        D=D,
+        symmetry_nodes=symmetry_nodes,
+        contact_y=np.array(contact_y, dtype=float),
+        thickness=float(plate.thickness),
+        rho=float(material.rho),
+        E=float(material.E),
+        nu=float(material.nu),
+    )

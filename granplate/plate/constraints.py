@@ -1,0 +1,172 @@
+"""Constraints of the plate: edges, clamps, symmetry line, rigid layers, the reduction T.
+
+A full displacement vector is x_full = T @ x_red: clamped dofs are removed and every
+node of a contact's rigid layer copies its driving node's dofs (a multi-point
+constraint); a matrix A reduces to T^T A T.
+"""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Sequence
+
+import numpy as np
+import scipy.sparse as sp
+
+from granplate.errors import ScenarioError
+
+if TYPE_CHECKING:  # pragma: no cover
+    from granplate.setup.scenario import Plate
+
+#: Relative tolerance (times the plate height / width) for "a node lies at this coordinate".
+GEOMETRY_RTOL = 1e-9
+
+EDGES = ("top", "bottom", "left", "right")
+
+
+def nodes_on_line(node_xy: np.ndarray, axis: int, value: float, tol: float) -> np.ndarray:
+    """Indices of the nodes whose coordinate `axis` (0: x, 1: y) is value +- tol."""
+    return np.flatnonzero(np.abs(node_xy[:, axis] - value) <= tol)
+
+
+def edge_nodes(node_xy: np.ndarray, plate: "Plate", x0: float) -> dict[str, np.ndarray]:
+    """Node indices on each of the four plate edges ("top", "bottom", "left", "right")."""
+    tx, ty = GEOMETRY_RTOL * plate.width, GEOMETRY_RTOL * plate.height
+    return {
+        "left": nodes_on_line(node_xy, 0, x0, tx),
+        "right": nodes_on_line(node_xy, 0, x0 + plate.width, tx),
+        "bottom": nodes_on_line(node_xy, 1, plate.y0, ty),
+        "top": nodes_on_line(node_xy, 1, plate.y0 + plate.height, ty),
+    }
+
+
+def clamped_dofs(node_xy: np.ndarray, plate: "Plate", x0: float) -> np.ndarray:
+    """Sorted full-dof indices fixed by plate.clamped_edges (both dofs of every edge node)."""
+    unknown = [e for e in plate.clamped_edges if e not in EDGES]
+    if unknown:
+        raise ScenarioError(
+            "plate.clamped_edges", plate.clamped_edges, f"allowed: a subset of {EDGES}; unknown {unknown}"
+        )
+    edges = edge_nodes(node_xy, plate, x0)
+    nodes = np.unique(np.concatenate([edges[e] for e in plate.clamped_edges] + [np.empty(0, np.int64)]))
+    return np.sort(np.concatenate([2 * nodes, 2 * nodes + 1])).astype(np.int64)
+
+
+def symmetry_line_nodes(node_xy: np.ndarray, plate: "Plate") -> np.ndarray:
+    """Nodes on y = y0 + height / 2, sorted by x; requires an even plate.ny."""
+    if plate.ny % 2:
+        raise ScenarioError(
+            "plate.ny",
+            plate.ny,
+            f"must be even so that the symmetry line y = y0 + height/2 = {plate.y0 + plate.height / 2:g} m "
+            "is a row of element edges (with Q8 nodes along it)",
+        )
+    nodes = nodes_on_line(node_xy, 1, plate.y0 + 0.5 * plate.height, GEOMETRY_RTOL * plate.height)
+    return nodes[np.argsort(node_xy[nodes, 0], kind="stable")]
+
+
+def rigid_layer_nodes(
+    node_xy: np.ndarray, plate: "Plate", x0: float, contact_y: Sequence[float]
+) -> tuple[np.ndarray, list[np.ndarray]]:
+    """Driving node and layer nodes of each contact on the left edge x = x0.
+
+    Returns (driving, layers): driving[k] is the left-edge node at y_k; layers[k] the
+    other left-edge nodes with |y - y_k| <= w/2 (w = plate.layer_width), which move
+    with it. Raises ScenarioError for a contact off the plate, between nodes, or
+    layers that overlap.
+    """
+    tol = GEOMETRY_RTOL * plate.height
+    left = edge_nodes(node_xy, plate, x0)["left"]
+    left_y = node_xy[left, 1]
+    half = 0.5 * plate.layer_width
+    spacing = plate.height / (2 * plate.ny)
+    driving = np.empty(len(contact_y), dtype=np.int64)
+    layers: list[np.ndarray] = []
+    owner: dict[int, int] = {}
+    for k, yk in enumerate(contact_y):
+        if not (plate.y0 - tol <= yk <= plate.y0 + plate.height + tol):
+            raise ScenarioError(
+                "plate.y0",
+                plate.y0,
+                f"contact {k} at y={yk:g} m lies outside the plate's left edge "
+                f"[{plate.y0:g}, {plate.y0 + plate.height:g}] m",
+            )
+        at = left[np.abs(left_y - yk) <= tol]
+        if at.size != 1:
+            raise ScenarioError(
+                "plate.ny",
+                plate.ny,
+                f"contact {k} at y={yk:g} m is not on a mesh node; the left-edge node spacing "
+                f"is height/(2 ny) = {spacing:g} m; allowed: ny such that (y_contact - y0) is a "
+                f"multiple of height/(2 ny) for every contact",
+            )
+        driving[k] = at[0]
+        members = left[np.abs(left_y - yk) <= half + tol]
+        for n in members:
+            if int(n) in owner:
+                j = owner[int(n)]
+                raise ScenarioError(
+                    "plate.rigid_layer_width",
+                    plate.rigid_layer_width,
+                    f"the rigid layers of contacts {j} (y={contact_y[j]:g} m) and {k} (y={yk:g} m) "
+                    f"share the node at y={node_xy[n, 1]:g} m with w = {plate.layer_width:g} m; "
+                    "allowed: w smaller than the distance between neighbouring contacts",
+                )
+            owner[int(n)] = k
+        layers.append(members[members != at[0]])
+    return driving, layers
+
+
+def check_layers_off_clamps(
+    fixed: np.ndarray, driving: np.ndarray, layers: Sequence[np.ndarray], plate: "Plate", contact_y: Sequence[float]
+) -> None:
+    """Refuse a contact on a clamped node, or a rigid layer that reaches one."""
+    fixed_nodes = set(int(d) // 2 for d in fixed)
+    for k, (d, members) in enumerate(zip(driving, layers)):
+        if int(d) in fixed_nodes:
+            raise ScenarioError(
+                "plate.clamped_edges",
+                plate.clamped_edges,
+                f"contact {k} at y={contact_y[k]:g} m sits on a clamped node; allowed: contacts on "
+                "free parts of the left edge only",
+            )
+        if any(int(n) in fixed_nodes for n in members):
+            raise ScenarioError(
+                "plate.rigid_layer_width",
+                plate.rigid_layer_width,
+                f"the rigid layer of contact {k} at y={contact_y[k]:g} m (w = {plate.layer_width:g} m) "
+                "reaches a clamped node; allowed: a width that keeps every layer off the clamped edges",
+            )
+
+
+def rigid_layer_map(
+    n_full: int, fixed: np.ndarray, driving: np.ndarray, layers: Sequence[np.ndarray]
+) -> tuple[sp.csr_matrix, np.ndarray]:
+    """The reduction x_full = T x_red and the reduced indices of the driving dofs.
+
+    Reduced dofs are the full dofs that are neither fixed nor slaved, in increasing
+    order. A slaved node's x (y) dof copies its driving node's x (y) dof. Driving and
+    slaved nodes must be free (see check_layers_off_clamps). Returns T (n_full, n_red)
+    and drive_dofs (n_contacts, 2).
+    """
+    master = np.arange(n_full)
+    free = np.ones(n_full, dtype=bool)
+    free[fixed] = False
+    for d, members in zip(driving, layers):
+        if not free[2 * d] or any(not free[2 * n] for n in members):
+            raise ValueError("rigid-layer nodes must be free and belong to one layer only")
+        for n in members:
+            for c in (0, 1):
+                master[2 * n + c] = 2 * d + c
+                free[2 * n + c] = False
+    reduced_of_full = np.full(n_full, -1, dtype=np.int64)
+    reduced_of_full[free] = np.arange(int(free.sum()))
+    rows = np.flatnonzero(free | (master != np.arange(n_full)))
+    cols = reduced_of_full[master[rows]]
+    T = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(n_full, int(free.sum())))
+    drive_dofs = np.stack([reduced_of_full[2 * driving], reduced_of_full[2 * driving + 1]], axis=1)
+    return T, drive_dofs.reshape(-1, 2).astype(np.int64)
+
+
+def reduce_matrix(A: sp.spmatrix, T: sp.spmatrix) -> sp.csr_matrix:
+    """T^T A T, symmetrised exactly."""
+    Ar = (T.T @ A @ T).tocsr()
+    return ((Ar + Ar.T) * 0.5).tocsr()

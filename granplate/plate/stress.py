@@ -1,0 +1,90 @@
+"""Stress recovery of the plate: plane-stress D, strains and stresses at the Gauss points.
+
+Strains are (eps_xx, eps_yy, gamma_xy) with gamma_xy the engineering shear strain [-];
+stresses (sigma_xx, sigma_yy, tau_xy) [Pa]; von Mises of plane stress is MODEL.md eq. 12.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from skfem import Basis
+
+#: Gauss order for K, M and stress recovery: 3 x 3 = 9 points per element.
+INTORDER = 4
+
+
+def plane_stress_matrix(E: float, nu: float) -> np.ndarray:
+    """D = E / (1 - nu^2) [[1, nu, 0], [nu, 1, 0], [0, 0, (1 - nu) / 2]] [Pa].
+
+    Acts on (eps_xx, eps_yy, gamma_xy) with gamma_xy the engineering shear strain.
+    """
+    return E / (1.0 - nu**2) * np.array(
+        [[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, 0.5 * (1.0 - nu)]]
+    )
+
+
+def von_mises_plane_stress(sxx: np.ndarray, syy: np.ndarray, sxy: np.ndarray) -> np.ndarray:
+    """sqrt(sxx^2 - sxx syy + syy^2 + 3 sxy^2) [Pa] (plane stress, szz = 0)."""
+    return np.sqrt(np.maximum(sxx**2 - sxx * syy + syy**2 + 3.0 * sxy**2, 0.0))
+
+
+def voigt_strain(grad: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(eps_xx, eps_yy, gamma_xy) from a displacement gradient grad[i, j] = du_i/dx_j."""
+    return grad[0, 0], grad[1, 1], grad[0, 1] + grad[1, 0]
+
+
+def strain_operator(basis: Basis) -> sp.csr_matrix:
+    """Sparse map from the full dof vector to (eps_xx, eps_yy, gamma_xy) at the Gauss points.
+
+    Shape (3 n_elem n_qp, n_full); row = component * n_elem * n_qp + element * n_qp + qp.
+    """
+    n_elem, n_qp = basis.dx.shape
+    n_local = basis.element_dofs.shape[0]
+    data = np.empty((3, n_local, n_elem, n_qp))
+    cols = np.empty((n_local, n_elem, n_qp), dtype=np.int64)
+    for i in range(n_local):
+        exx, eyy, gxy = voigt_strain(basis.basis[i][0].grad)
+        data[0, i], data[1, i], data[2, i] = exx, eyy, gxy
+        cols[i] = basis.element_dofs[i][:, None]
+    rows = (
+        np.arange(3)[:, None, None, None] * (n_elem * n_qp)
+        + np.arange(n_elem)[None, None, :, None] * n_qp
+        + np.arange(n_qp)[None, None, None, :]
+    )
+    rows = np.broadcast_to(rows, data.shape)
+    cols3 = np.broadcast_to(cols, data.shape)
+    keep = data != 0.0
+    op = sp.coo_matrix(
+        (data[keep], (rows[keep], cols3[keep])), shape=(3 * n_elem * n_qp, basis.N)
+    ).tocsr()
+    op.sum_duplicates()
+    op.sort_indices()
+    return op
+
+
+def quadrature_points(basis: Basis) -> np.ndarray:
+    """Gauss point coordinates [m], (n_elem, n_qp, 2)."""
+    return np.moveaxis(np.asarray(basis.mapping.F(basis.X)), 0, -1)
+
+
+def gauss_point_strains(
+    strain_op: sp.csr_matrix, x_full: np.ndarray, n_elem: int, n_qp: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """eps_xx, eps_yy, gamma_xy [-] at the Gauss points from x_full (..., n_full) [m].
+
+    Each is (..., n_elem, n_qp); strain_op is `strain_operator`'s [component][element][qp] map.
+    """
+    flat = x_full.reshape(-1, strain_op.shape[1])
+    eps = (strain_op @ flat.T).T  # (batch, 3 n_elem n_qp)
+    eps = eps.reshape(x_full.shape[:-1] + (3, n_elem, n_qp))
+    return eps[..., 0, :, :], eps[..., 1, :, :], eps[..., 2, :, :]
+
+
+def plane_stresses(
+    D: np.ndarray, exx: np.ndarray, eyy: np.ndarray, gxy: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """sigma_xx, sigma_yy, tau_xy = D (eps_xx, eps_yy, gamma_xy) [Pa], componentwise."""
+    sxx = D[0, 0] * exx + D[0, 1] * eyy + D[0, 2] * gxy
+    syy = D[1, 0] * exx + D[1, 1] * eyy + D[1, 2] * gxy
+    sxy = D[2, 0] * exx + D[2, 1] * eyy + D[2, 2] * gxy
+    return sxx, syy, sxy
