@@ -13,8 +13,11 @@ from skfem import MeshQuad
 
 from granplate import plate as gp
 from granplate.errors import ScenarioError
+from granplate.plate import EDGES
+from granplate.setup import validate as validation
 from granplate.setup.materials import LIBRARY
-from granplate.setup.scenario import Plate
+from granplate.setup.scenario import Granule, Load, Plate, Scenario
+from granplate.setup.validate import validate
 
 STEEL = LIBRARY["steel"]
 X0 = 0.01 + 2 * math.sqrt(0.02**2 - 0.01**2) + 0.01  # the paper's plate position, R2 = R1
@@ -314,29 +317,89 @@ def test_no_edge_load_is_zero():
 
 
 # --------------------------------------------------------------------------------------
-# 7. Bad inputs
+# 7. Bad inputs: scenarios refused by validation, direct callers by the plate layer
 # --------------------------------------------------------------------------------------
-def test_contact_between_nodes_is_refused():
-    """A contact at a y with no mesh node raises ScenarioError naming plate.ny."""
+def plate_scenario(contacts, radius: float = 0.002, **plate) -> Scenario:
+    """A plate at X0 with one steel granule touching its left edge at each height in contacts."""
+    granules = tuple(
+        Granule(x=X0 - radius, y=y, radius=radius, material="steel", label=f"g{k}") for k, y in enumerate(contacts)
+    )
+    return Scenario(granules=granules, plate=Plate(x0=X0, **plate), load=Load(kind="none"))
+
+
+def refusal(scenario: Scenario) -> ScenarioError:
+    """The ScenarioError validate raises for scenario (fails the test when there is none)."""
     with pytest.raises(ScenarioError) as err:
-        gp.build_plate(Plate(), X0, [0.09, 0.0712], cache=False)
-    assert err.value.field == "plate.ny" and err.value.value == 40
-    assert "not on a mesh node" in str(err.value) and "0.0712" in str(err.value)
+        validate(scenario)
+    return err.value
 
 
-def test_odd_ny_refused_when_symmetry_line_needed():
-    """Odd ny raises ScenarioError (no node row on y = height/2) unless no symmetry line is asked."""
-    odd = Plate(ny=41, n_modes=2)
-    with pytest.raises(ScenarioError) as err:
-        gp.build_plate(odd, X0, [], cache=False)
-    assert err.value.field == "plate.ny"
-    m = gp.build_plate(odd, X0, [], cache=False, symmetry_line=False)
-    assert m.symmetry_nodes.size == 0
+def test_validation_refuses_contact_between_nodes():
+    """A plate contact at a y with no left-edge node: ScenarioError naming plate.ny, the contact and the spacing."""
+    err = refusal(plate_scenario((0.09, 0.0712)))
+    assert err.field == "plate.ny" and err.value == 40
+    assert "not on a mesh node" in str(err) and "0.0712" in str(err) and "0.00125" in str(err)
+    validate(plate_scenario((0.09, 0.07125)))  # on a midside node: accepted
 
 
-def test_overlapping_layers_clamped_contacts_and_bad_sizes_refused():
-    """Overlapping rigid layers, a contact on a clamp or off the plate, bad n_modes: ScenarioError."""
+def test_validation_refuses_odd_ny():
+    """Odd plate.ny (no node row on the symmetry line y = height/2): ScenarioError naming plate.ny."""
+    err = refusal(plate_scenario((), ny=41))
+    assert err.field == "plate.ny" and err.value == 41 and "must be even" in str(err)
+    validate(plate_scenario((), ny=42))
+
+
+def test_validation_refuses_overlapping_rigid_layers():
+    """Rigid layers of neighbouring contacts that share a node: ScenarioError naming plate.rigid_layer_width."""
+    err = refusal(plate_scenario(CONTACTS, rigid_layer_width=0.02))
+    assert err.field == "plate.rigid_layer_width" and err.value == 0.02
+    assert "contacts 0 (y=0.09 m) and 1 (y=0.07 m)" in str(err)
+    validate(plate_scenario(CONTACTS, rigid_layer_width=0.0175))  # 7 nodes each, none shared
+
+
+def test_validation_refuses_contacts_and_layers_on_clamps():
+    """A contact on a clamped node or a layer reaching one: ScenarioError naming the clamp or the width."""
+    err = refusal(plate_scenario((0.05,), clamped_edges=("left",)))
+    assert err.field == "plate.clamped_edges" and "sits on a clamped node" in str(err)
+    err = refusal(plate_scenario((0.0025,), rigid_layer_width=0.005))
+    assert err.field == "plate.rigid_layer_width" and "reaches a clamped node" in str(err)
+    validate(plate_scenario((0.0025,), rigid_layer_width=0.0025))  # reaches y = 0.00125, not y = 0
+    validate(plate_scenario((0.0025,), rigid_layer_width=0.005, clamped_edges=("top",)))
+
+
+@pytest.mark.parametrize("clamped", [("top", "bottom"), (), ("left",), ("top", "right"), EDGES])
+def test_reduced_dof_count_matches_the_built_plate(clamped):
+    """validate's count of reduced dofs = the built plate's n_red, for several clamps and layers."""
+    contacts = () if "left" in clamped else (0.05, 0.025)
+    for plate in (Plate(nx=2, ny=10, clamped_edges=clamped), Plate(nx=3, ny=12, clamped_edges=clamped, rigid_layer_width=0.02)):
+        s = plate_scenario(contacts, **{k: getattr(plate, k) for k in ("nx", "ny", "clamped_edges", "rigid_layer_width")})
+        n_slaved = sum(len(m) for _, m in validation._rigid_layers(s.plate, list(contacts)))
+        m = gp.build_plate(s.plate, X0, contacts, cache=False, symmetry_line=False)
+        assert validation.reduced_dof_count(s.plate, n_slaved) == m.n_red
+
+
+def test_validation_refuses_too_many_modes():
+    """plate.n_modes above the reduced dofs: ScenarioError with the allowed range 0..n_red; n_red itself passes."""
+    n_red = 2 * (569 - 18 - 10)  # paper plate: 569 nodes, 18 clamped, 2 slaved per layer of 5
+    validate(plate_scenario(CONTACTS, n_modes=n_red))
+    err = refusal(plate_scenario(CONTACTS, n_modes=n_red + 1))
+    assert err.field == "plate.n_modes" and f"1..{n_red}" in str(err)
+
+
+def test_plate_contacts_are_the_granules_facing_the_left_edge():
+    """A granule farther than neighbour_gap * R from the plate, or beyond its height, is not a plate contact."""
+    s = plate_scenario((0.05,))
+    far = Granule(x=X0 - 0.01, y=0.0712, radius=0.002, material="steel", label="far")  # gap 4 R
+    above = Granule(x=X0 - 0.002, y=0.11, radius=0.002, material="steel", label="above")
+    s = dataclasses.replace(s, granules=s.granules + (far, above))
+    assert validation.plate_contact_heights(s) == [0.05]
+    validate(s)  # 0.0712 is between nodes, but that granule does not touch the plate
+
+
+def test_build_plate_refuses_inconsistent_inputs():
+    """A direct caller's bad contacts, layers, clamps or sizes: PlateError (not ScenarioError) naming the input."""
     cases = [
+        (Plate(), (0.09, 0.0712), "plate.ny"),
         (Plate(rigid_layer_width=0.02), CONTACTS, "plate.rigid_layer_width"),
         (Plate(), (0.0,), "plate.clamped_edges"),
         (Plate(clamped_edges=("left",)), (0.05,), "plate.clamped_edges"),
@@ -344,11 +407,17 @@ def test_overlapping_layers_clamped_contacts_and_bad_sizes_refused():
         (Plate(), (0.15,), "plate.y0"),
         (Plate(n_modes=10**6), CONTACTS, "plate.n_modes"),
         (Plate(clamped_edges=("front",)), CONTACTS, "plate.clamped_edges"),
+        (Plate(thickness=0.0), CONTACTS, "plate.thickness"),
+        (Plate(material="unobtainium"), CONTACTS, "plate.material"),
     ]
-    for plate, contacts, field in cases:
-        with pytest.raises(ScenarioError) as err:
+    for plate, contacts, name in cases:
+        with pytest.raises(gp.PlateError) as err:
             gp.build_plate(plate, X0, contacts, cache=False)
-        assert err.value.field == field, (plate, contacts, err.value)
+        assert err.value.name == name and not isinstance(err.value, ScenarioError), (plate, contacts, err.value)
+    odd = Plate(ny=41, n_modes=2)
+    with pytest.raises(gp.PlateError, match="must be even"):
+        gp.build_plate(odd, X0, [], cache=False)
+    assert gp.build_plate(odd, X0, [], cache=False, symmetry_line=False).symmetry_nodes.size == 0
 
 
 # --------------------------------------------------------------------------------------

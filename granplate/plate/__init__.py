@@ -7,6 +7,7 @@ One module per concept: `fe` (mesh, Q8 basis, K and M, nodes, VTK element order)
 and its cache).
 """
 
+from granplate.plate.errors import PlateError  # noqa: F401
 from granplate.plate.stress import (  # noqa: F401
     INTORDER,
     plane_stress_matrix,

@@ -29,7 +29,7 @@ import scipy.sparse as sp
 import skfem
 from skfem import Basis, MeshQuad
 
-from granplate.errors import ScenarioError
+from granplate.plate.errors import PlateError
 from granplate.plate.constraints import (
     GEOMETRY_RTOL,
     check_layers_off_clamps,
@@ -264,17 +264,17 @@ def _check_plate(plate: "Plate", x0: float, n_modes_max: int | None = None) -> N
     for name in ("width", "height", "thickness"):
         value = getattr(plate, name)
         if not (np.isfinite(value) and value > 0):
-            raise ScenarioError(f"plate.{name}", value, "allowed: a positive length in metres")
+            raise PlateError(f"plate.{name}", value, "allowed: a positive length in metres")
     for name in ("nx", "ny"):
         value = getattr(plate, name)
         if not (isinstance(value, (int, np.integer)) and value >= 1):
-            raise ScenarioError(f"plate.{name}", value, "allowed: an integer >= 1")
+            raise PlateError(f"plate.{name}", value, "allowed: an integer >= 1")
     if plate.layer_width < 0 or not np.isfinite(plate.layer_width):
-        raise ScenarioError("plate.rigid_layer_width", plate.rigid_layer_width, "allowed: None or a length >= 0 m")
+        raise PlateError("plate.rigid_layer_width", plate.rigid_layer_width, "allowed: None or a length >= 0 m")
     if not np.isfinite(x0):
-        raise ScenarioError("plate.x0", x0, "allowed: a finite x position in metres")
+        raise PlateError("plate.x0", x0, "allowed: a finite x position in metres")
     if n_modes_max is not None and not (0 <= plate.n_modes <= n_modes_max):
-        raise ScenarioError("plate.n_modes", plate.n_modes, f"allowed: 0 (all) or 1..{n_modes_max}")
+        raise PlateError("plate.n_modes", plate.n_modes, f"allowed: 0 (all) or 1..{n_modes_max}")
 
 
 def _compute_arrays(
@@ -338,12 +338,13 @@ def build_plate(
     library's plate.material); symmetry_line: require (even ny) and return the nodes on
     y = y0 + height / 2 (False: symmetry_nodes is empty and ny may be odd).
 
-    Raises ScenarioError for contacts that are not on a free left-edge node, rigid
-    layers that overlap or touch a clamp, odd ny when symmetry_line, bad n_modes.
+    Raises PlateError for contacts that are not on a free left-edge node, rigid
+    layers that overlap or touch a clamp, odd ny when symmetry_line, bad sizes or
+    n_modes (a scenario is refused earlier, by granplate.setup.validate).
     """
     if material is None:
         if plate.material not in LIBRARY:
-            raise ScenarioError("plate.material", plate.material, f"allowed: one of {sorted(LIBRARY)}")
+            raise PlateError("plate.material", plate.material, f"allowed: one of {sorted(LIBRARY)}")
         material = LIBRARY[plate.material]
     x0 = float(x0)
     contact_y = [float(y) for y in contact_y]

@@ -11,13 +11,15 @@ from typing import TYPE_CHECKING, Sequence
 import numpy as np
 import scipy.sparse as sp
 
-from granplate.errors import ScenarioError
+from granplate.plate.errors import PlateError
+from granplate.setup.validate import NODE_RTOL
 
 if TYPE_CHECKING:  # pragma: no cover
     from granplate.setup.scenario import Plate
 
-#: Relative tolerance (times the plate height / width) for "a node lies at this coordinate".
-GEOMETRY_RTOL = 1e-9
+#: Relative tolerance (times the plate height / width) for "a node lies at this coordinate"
+#: (the one validation uses to put contacts on nodes).
+GEOMETRY_RTOL = NODE_RTOL
 
 EDGES = ("top", "bottom", "left", "right")
 
@@ -42,7 +44,7 @@ def clamped_dofs(node_xy: np.ndarray, plate: "Plate", x0: float) -> np.ndarray:
     """Sorted full-dof indices fixed by plate.clamped_edges (both dofs of every edge node)."""
     unknown = [e for e in plate.clamped_edges if e not in EDGES]
     if unknown:
-        raise ScenarioError(
+        raise PlateError(
             "plate.clamped_edges", plate.clamped_edges, f"allowed: a subset of {EDGES}; unknown {unknown}"
         )
     edges = edge_nodes(node_xy, plate, x0)
@@ -53,7 +55,7 @@ def clamped_dofs(node_xy: np.ndarray, plate: "Plate", x0: float) -> np.ndarray:
 def symmetry_line_nodes(node_xy: np.ndarray, plate: "Plate") -> np.ndarray:
     """Nodes on y = y0 + height / 2, sorted by x; requires an even plate.ny."""
     if plate.ny % 2:
-        raise ScenarioError(
+        raise PlateError(
             "plate.ny",
             plate.ny,
             f"must be even so that the symmetry line y = y0 + height/2 = {plate.y0 + plate.height / 2:g} m "
@@ -70,7 +72,7 @@ def rigid_layer_nodes(
 
     Returns (driving, layers): driving[k] is the left-edge node at y_k; layers[k] the
     other left-edge nodes with |y - y_k| <= w/2 (w = plate.layer_width), which move
-    with it. Raises ScenarioError for a contact off the plate, between nodes, or
+    with it. Raises PlateError for a contact off the plate, between nodes, or
     layers that overlap.
     """
     tol = GEOMETRY_RTOL * plate.height
@@ -83,7 +85,7 @@ def rigid_layer_nodes(
     owner: dict[int, int] = {}
     for k, yk in enumerate(contact_y):
         if not (plate.y0 - tol <= yk <= plate.y0 + plate.height + tol):
-            raise ScenarioError(
+            raise PlateError(
                 "plate.y0",
                 plate.y0,
                 f"contact {k} at y={yk:g} m lies outside the plate's left edge "
@@ -91,7 +93,7 @@ def rigid_layer_nodes(
             )
         at = left[np.abs(left_y - yk) <= tol]
         if at.size != 1:
-            raise ScenarioError(
+            raise PlateError(
                 "plate.ny",
                 plate.ny,
                 f"contact {k} at y={yk:g} m is not on a mesh node; the left-edge node spacing "
@@ -103,7 +105,7 @@ def rigid_layer_nodes(
         for n in members:
             if int(n) in owner:
                 j = owner[int(n)]
-                raise ScenarioError(
+                raise PlateError(
                     "plate.rigid_layer_width",
                     plate.rigid_layer_width,
                     f"the rigid layers of contacts {j} (y={contact_y[j]:g} m) and {k} (y={yk:g} m) "
@@ -122,14 +124,14 @@ def check_layers_off_clamps(
     fixed_nodes = set(int(d) // 2 for d in fixed)
     for k, (d, members) in enumerate(zip(driving, layers)):
         if int(d) in fixed_nodes:
-            raise ScenarioError(
+            raise PlateError(
                 "plate.clamped_edges",
                 plate.clamped_edges,
                 f"contact {k} at y={contact_y[k]:g} m sits on a clamped node; allowed: contacts on "
                 "free parts of the left edge only",
             )
         if any(int(n) in fixed_nodes for n in members):
-            raise ScenarioError(
+            raise PlateError(
                 "plate.rigid_layer_width",
                 plate.rigid_layer_width,
                 f"the rigid layer of contact {k} at y={contact_y[k]:g} m (w = {plate.layer_width:g} m) "

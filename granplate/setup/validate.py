@@ -7,7 +7,10 @@ order), `allowed` says in words what would be accepted. The layout is checked as
 `layout.*` before it is expanded; everything else is checked on the resolved scenario
 (`geometry.resolve`), so generated granules are named `granules[i]` with their label.
 
-Mesh-node checks at plate contacts (a contact point on a node) belong to the plate module.
+The plate's mesh is checked here too, before anything is built: an even `plate.ny` (a row
+of nodes on the symmetry line), every plate contact on a left-edge node, rigid layers
+that neither overlap nor reach a clamped node, and `plate.n_modes` at most the number of
+reduced dofs. The plate layer itself only checks the internal consistency of its inputs.
 """
 from __future__ import annotations
 
@@ -15,9 +18,11 @@ import math
 import numbers
 from typing import Any
 
+import numpy as np
+
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import resolve
-from granplate.setup.scenario import SQRT2_MINUS_1, Scenario
+from granplate.setup.scenario import SQRT2_MINUS_1, Plate, Scenario
 
 #: Lever arms of the friction torque (Contact.torque_arm).
 TORQUE_ARMS: tuple[str, ...] = ("radius", "contact_point")
@@ -37,6 +42,8 @@ NORMAL_TOL = 1e-9
 RATIO_TOL = 1e-12
 #: Relative tolerance for field_interval being a multiple of output_interval.
 INTERVAL_RTOL = 1e-9
+#: Relative tolerance (times the plate height / width) for "a point lies on a mesh node".
+NODE_RTOL = 1e-9
 
 
 # --------------------------------------------------------------------------- helpers
@@ -197,6 +204,126 @@ def _check_plate(s: Scenario) -> None:
                     f"t = 0; granules must lie left of the plate (x + radius <= plate.x0)")
 
 
+# --------------------------------------------------------------------------- plate mesh
+
+def plate_contact_heights(s: Scenario) -> list[float]:
+    """y [m] of the granules facing the plate's left edge, in granule order.
+
+    A granule faces the plate when its gap x0 - (x + R) is at most contact.neighbour_gap * R
+    and y0 < y < y0 + height (s resolved, with a plate).
+    """
+    p = s.plate
+    gap_ratio = s.contact.neighbour_gap
+    return [float(g.y) for g in s.granules
+            if p.x0 - (g.x + g.radius) <= gap_ratio * g.radius and p.y0 < g.y < p.y0 + p.height]
+
+
+def left_edge_node_heights(p: Plate) -> np.ndarray:
+    """y [m] of the 2 ny + 1 Q8 nodes on the plate's left edge, bottom to top."""
+    corners = np.linspace(p.y0, p.y0 + p.height, p.ny + 1)
+    y = np.empty(2 * p.ny + 1)
+    y[0::2] = corners
+    y[1::2] = 0.5 * (corners[:-1] + corners[1:])
+    return y
+
+
+def clamped_left_nodes(p: Plate) -> set[int]:
+    """Indices (into left_edge_node_heights) of the left-edge nodes on a clamped edge."""
+    n = 2 * p.ny + 1
+    if "left" in p.clamped_edges:
+        return set(range(n))
+    return ({0} if "bottom" in p.clamped_edges else set()) | ({n - 1} if "top" in p.clamped_edges else set())
+
+
+def clamped_node_count(p: Plate) -> int:
+    """Number of Q8 nodes on the clamped edges (corners shared by two edges counted once)."""
+    ni, nj = 2 * p.nx, 2 * p.ny  # node lattice (i, j), 0 <= i <= ni, 0 <= j <= nj
+    lines = {
+        "left": {(0, j) for j in range(nj + 1)},
+        "right": {(ni, j) for j in range(nj + 1)},
+        "bottom": {(i, 0) for i in range(ni + 1)},
+        "top": {(i, nj) for i in range(ni + 1)},
+    }
+    return len(set().union(*(lines[e] for e in p.clamped_edges)))
+
+
+def reduced_dof_count(p: Plate, n_slaved: int) -> int:
+    """Dofs left after clamping and slaving n_slaved rigid-layer nodes: 2 per free node."""
+    n_nodes = (p.nx + 1) * (p.ny + 1) + p.nx * (p.ny + 1) + p.ny * (p.nx + 1)
+    return 2 * (n_nodes - clamped_node_count(p) - n_slaved)
+
+
+def _check_symmetry_row(p: Plate) -> None:
+    if p.ny % 2:
+        raise ScenarioError(
+            "plate.ny", p.ny,
+            f"must be even so that the symmetry line y = y0 + height/2 = {p.y0 + p.height / 2:g} m "
+            "is a row of element edges (with Q8 nodes along it)")
+
+
+def _contact_node(p: Plate, k: int, yk: float, left_y: np.ndarray) -> int:
+    """Index of the left-edge node at contact k's height yk [m]; ScenarioError when none."""
+    at = np.flatnonzero(np.abs(left_y - yk) <= NODE_RTOL * p.height)
+    if at.size != 1:
+        raise ScenarioError(
+            "plate.ny", p.ny,
+            f"contact {k} at y={yk:g} m is not on a mesh node; the left-edge node spacing "
+            f"is height/(2 ny) = {p.height / (2 * p.ny):g} m; allowed: ny such that (y_contact - y0) "
+            "is a multiple of height/(2 ny) for every contact")
+    return int(at[0])
+
+
+def _rigid_layers(p: Plate, contact_y: list[float]) -> list[tuple[int, list[int]]]:
+    """(driving node, other layer nodes) of each contact; refuses overlapping layers."""
+    left_y = left_edge_node_heights(p)
+    half, tol = 0.5 * p.layer_width, NODE_RTOL * p.height
+    owner: dict[int, int] = {}
+    layers = []
+    for k, yk in enumerate(contact_y):
+        at = _contact_node(p, k, yk, left_y)
+        members = [int(n) for n in np.flatnonzero(np.abs(left_y - yk) <= half + tol)]
+        for n in members:
+            if n in owner:
+                j = owner[n]
+                raise ScenarioError(
+                    "plate.rigid_layer_width", p.rigid_layer_width,
+                    f"the rigid layers of contacts {j} (y={contact_y[j]:g} m) and {k} (y={yk:g} m) "
+                    f"share the node at y={left_y[n]:g} m with w = {p.layer_width:g} m; "
+                    "allowed: w smaller than the distance between neighbouring contacts")
+            owner[n] = k
+        layers.append((at, [n for n in members if n != at]))
+    return layers
+
+
+def _check_layers_off_clamps(p: Plate, contact_y: list[float], layers: list[tuple[int, list[int]]]) -> None:
+    clamped = clamped_left_nodes(p)
+    for k, (at, members) in enumerate(layers):
+        if at in clamped:
+            raise ScenarioError(
+                "plate.clamped_edges", p.clamped_edges,
+                f"contact {k} at y={contact_y[k]:g} m sits on a clamped node; allowed: contacts on "
+                "free parts of the left edge only")
+        if any(n in clamped for n in members):
+            raise ScenarioError(
+                "plate.rigid_layer_width", p.rigid_layer_width,
+                f"the rigid layer of contact {k} at y={contact_y[k]:g} m (w = {p.layer_width:g} m) "
+                "reaches a clamped node; allowed: a width that keeps every layer off the clamped edges")
+
+
+def _check_plate_mesh(s: Scenario) -> None:
+    """The mesh the plate layer will build can hold the scenario (see the module docstring)."""
+    p = s.plate
+    if p is None:
+        return
+    _check_symmetry_row(p)
+    contact_y = plate_contact_heights(s)
+    layers = _rigid_layers(p, contact_y)
+    _check_layers_off_clamps(p, contact_y, layers)
+    n_red = reduced_dof_count(p, sum(len(m) for _, m in layers))
+    if p.n_modes > n_red:
+        raise ScenarioError("plate.n_modes", p.n_modes, f"allowed: 0 (all) or 1..{n_red}")
+
+
 def _check_load(s: Scenario) -> None:
     ld = s.load
     _string_in("load.kind", ld.kind, LOAD_KINDS)
@@ -294,7 +421,8 @@ def validate(scenario: Scenario) -> None:
 
     Order: materials, layout (as `layout.*`, before it is expanded), then on the resolved
     scenario: granules (values, unique labels, overlaps), walls (unit normals,
-    penetration), plate, load, contact, time, solver. A scenario with neither granules
+    penetration), plate, plate mesh (contacts on nodes, rigid layers, n_modes), load,
+    contact, time, solver. A scenario with neither granules
     (nor a layout) nor a plate is refused.
     """
     s = scenario
@@ -313,6 +441,7 @@ def validate(scenario: Scenario) -> None:
     _check_granules(r)
     _check_walls(r)
     _check_plate(r)
+    _check_plate_mesh(r)
     _check_load(r)
     _check_contact(r)
     _check_time(r)

@@ -1,0 +1,21 @@
+"""The plate layer's own error: an input `build_plate` cannot use.
+
+Scenarios are refused before anything is built (`granplate.setup.validate`, with a
+ScenarioError naming the scenario field); a PlateError reaches only a direct caller of
+the plate layer that passed inconsistent inputs.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+from granplate.errors import GranplateError
+
+
+class PlateError(GranplateError, ValueError):
+    """Inconsistent plate inputs: names the input, the value found and what is allowed."""
+
+    def __init__(self, name: str, value: Any, allowed: str):
+        self.name = name
+        self.value = value
+        self.allowed = allowed
+        super().__init__(f"plate input '{name}' = {value!r}: {allowed}")
