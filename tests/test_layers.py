@@ -13,7 +13,7 @@ PACKAGE = Path(granplate.__file__).parent
 
 #: bottom to top; a module may import its own layer and the layers below it.
 LAYERS = (
-    ("version", "errors"),
+    ("version", "errors", "store"),
     ("setup",),
     ("physics",),
     ("plate",),
