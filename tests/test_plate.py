@@ -449,7 +449,7 @@ def test_cache_roundtrip_and_corrupt_file(tmp_path, monkeypatch):
     plate = Plate(nx=2, ny=20)
     args = (plate, X0, CONTACTS[1:4], (0.025, 0.05))
     fresh = gp.build_plate(*args)
-    files = list(cache_dir.glob("*.npz"))
+    files = list((cache_dir / "plate").glob("*.npz"))
     assert len(files) == 1
 
     real_modal_basis = gp.modal_basis
@@ -487,10 +487,10 @@ def test_cache_roundtrip_and_corrupt_file(tmp_path, monkeypatch):
     assert np.array_equal(again.Phi, fresh.Phi)
 
     # cache=False neither reads nor writes
-    for f in cache_dir.glob("*.npz"):
+    for f in (cache_dir / "plate").glob("*.npz"):
         f.unlink()
     gp.build_plate(*args, cache=False)
-    assert calls == [1, 1] and not list(cache_dir.glob("*.npz"))
+    assert calls == [1, 1] and not list(cache_dir.rglob("*.npz"))
 
 
 def test_mode_sign_rule_is_deterministic_for_symmetric_modes():

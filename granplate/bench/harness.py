@@ -3,8 +3,8 @@
 For each case (a paper preset, possibly shortened) and each scheme in
 ``granplate.validate.SCHEMES`` it runs the simulation in a fresh worker subprocess
 (one warm-up call so the numba cache is loaded, then ``repeats`` timed calls), and
-compares the key metrics with a converged reference run of the same case, cached on
-disk in the granplate cache (``bench-reference/``) keyed by the reference scenario's TOML. It also
+compares the key metrics with a converged reference run of the same case, kept in the
+run store (`granplate.store`, kind ``bench-reference``) keyed by the reference scenario's TOML. It also
 measures the compile / cache-load time once per scheme in a fresh subprocess.
 
 Run it as ``granplate bench [--quick] [--json FILE] [--cases A,B] [--repeats N]`` or
@@ -14,7 +14,6 @@ Run it as ``granplate bench [--quick] [--json FILE] [--cases A,B] [--repeats N]`
 from __future__ import annotations
 
 import argparse
-import hashlib
 import json
 import os
 import platform
@@ -25,11 +24,9 @@ import time
 from pathlib import Path
 
 
-def reference_dir() -> Path:
-    """Where converged reference runs are kept: the granplate cache's bench-reference/."""
-    from granplate.plate.fe import cache_directory
-
-    return cache_directory() / "bench-reference"
+#: The run store's kind of the converged reference summaries, and their format version.
+REFERENCE_KIND = "bench-reference"
+REFERENCE_FORMAT = 1
 
 
 #: Key metrics compared with the converged reference (keys of granplate.summary).
@@ -79,28 +76,29 @@ def reference_scenario(case: str, t_end: float | None):
     })
 
 
-def _scenario_key(s) -> str:
+def reference_payload(s) -> dict:
+    """The reference run's identity in the run store: its scenario's TOML (every material)."""
     from granplate.setup.io import dumps
 
-    return hashlib.sha256(dumps(s, all_materials=True).encode()).hexdigest()[:16]
+    return {"scenario_toml": dumps(s, all_materials=True)}
 
 
 def reference_summary(case: str, t_end: float | None, log=print) -> dict:
-    """Summary of the reference run, from the on-disk cache or computed (and cached)."""
+    """Summary of the reference run, from the run store or computed (and stored)."""
     import granplate as gp
+    from granplate import store
 
     s = reference_scenario(case, t_end)
-    path = reference_dir() / f"{case}-{_scenario_key(s)}.json"
-    if path.exists():
-        return json.loads(path.read_text())
-    log(f"  reference run for {case} (t_end {s.time.t_end:g} s), cached in {path} ...")
+    payload = reference_payload(s)
+    summ = store.load_json(REFERENCE_KIND, payload, REFERENCE_FORMAT, label=case)
+    if summ is not None:
+        return summ
+    log(f"  reference run for {case} (t_end {s.time.t_end:g} s), kept in the run store "
+        f"({store.cache_directory() / REFERENCE_KIND}) ...")
     ds = gp.simulate(s, progress=False)
     summ = gp.summary(ds)
     summ["n_iterations"] = int(ds.attrs.get("n_iterations", 0)) if "n_iterations" in ds.attrs else None
-    reference_dir().mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(json.dumps(summ, indent=2) + "\n")
-    tmp.replace(path)
+    store.save_json(REFERENCE_KIND, payload, REFERENCE_FORMAT, summ, label=case)
     return summ
 
 

@@ -104,6 +104,12 @@ def preset_scenario(name: str, t_end: float | None = None):
     return shortened(preset(name), t_end)
 
 
+#: The run store's kind of reproduce's results and their format version: the store's key
+#: is the identity rule; the results themselves are the files DIR/NAME.nc.
+RESULT_KIND = "reproduce"
+RESULT_FORMAT = 1
+
+
 def expected_identity(scenario) -> tuple[str, str]:
     """(scenario_toml, granplate_version) a run of `scenario` would write."""
     from granplate.version import __version__
@@ -124,10 +130,18 @@ def stored_identity(path: Path) -> tuple[str, str] | None:
         return None
 
 
+def result_key(scenario_toml: str, version: str) -> str:
+    """The run store's key of a result made from scenario_toml by granplate `version`."""
+    from granplate import store
+
+    return store.key(RESULT_KIND, {"scenario_toml": scenario_toml}, RESULT_FORMAT, version)
+
+
 def is_current(path: str | Path, scenario) -> bool:
     """Whether the result at path was made from `scenario` by this granplate version."""
     path = Path(path)
-    return path.is_file() and stored_identity(path) == expected_identity(scenario)
+    stored = stored_identity(path) if path.is_file() else None
+    return stored is not None and result_key(*stored) == result_key(*expected_identity(scenario))
 
 
 def plan(out_dir: Path, t_end: float | None = None, checks: str = "fast") -> list[Job]:
@@ -153,20 +167,19 @@ def run_job(job: Job) -> RunRecord:
     """Simulate one job and write its result atomically; a failed run keeps its partial
     result as NAME.partial.nc (never reused) and reports why."""
     import granplate
+    from granplate import store
     from granplate.errors import SimulationError
     from granplate.results.dataset import write
 
     t0 = time.perf_counter()
     job.path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = job.path.with_name(job.path.stem + ".tmp.nc")
     try:
         ds = granplate.simulate(job.scenario, progress=False)
     except SimulationError as err:
         if err.result is not None:
             write(err.result, job.path.with_name(job.path.stem + ".partial.nc"))
         return RunRecord(job.name, job.path, "failed", time.perf_counter() - t0, str(err), job.kind)
-    write(ds, tmp)
-    os.replace(tmp, job.path)
+    store.atomic_write(job.path, lambda tmp: write(ds, tmp))
     return RunRecord(job.name, job.path, "ran", time.perf_counter() - t0, "", job.kind)
 
 

@@ -4,7 +4,7 @@ One module per concept: `fe` (mesh, Q8 basis, K and M, nodes, VTK element order)
 `constraints` (edges, clamps, symmetry line, rigid layers, the reduction T), `modes`
 (the eigenproblem and the mode sign rule), `load` (the half-sine edge load), `stress`
 (plane-stress D, strain operator, stress recovery) and `build` (PlateModel, build_plate
-and its cache).
+and its entry in the run store).
 """
 
 from granplate.plate.errors import PlateError  # noqa: F401
@@ -46,9 +46,9 @@ from granplate.plate.modes import (  # noqa: F401
 )
 from granplate.plate.load import EDGE_LOAD_POINTS, half_sine_line_load, edge_load_vector  # noqa: F401
 from granplate.plate.build import (  # noqa: F401
-    CACHE_VERSION,
+    PLATE_FORMAT,
+    STORE_KIND,
     PlateModel,
-    cache_directory,
-    cache_key,
+    cache_payload,
     build_plate,
 )

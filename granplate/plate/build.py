@@ -9,19 +9,13 @@ Data flows one way::
 
 A full displacement vector is x_full = T @ x_red with x_red = Phi @ q, q the modal
 coordinates. The expensive part of `build_plate` (assembly and the dense generalized
-eigenproblem) is cached in an ``.npz`` file under ``$GRANPLATE_CACHE`` (default
-``~/.cache/granplate``), keyed by a sha256 of every input.
+eigenproblem) is kept in the run store (`granplate.store`, kind "plate"), keyed by every
+input (`cache_payload`).
 """
 from __future__ import annotations
 
 import dataclasses
-import hashlib
-import json
-import os
-import tempfile
-import warnings
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Sequence
 
 import numpy as np
@@ -30,6 +24,7 @@ import skfem
 from skfem import Basis, MeshQuad
 
 from granplate.plate.errors import PlateError
+from granplate import store
 from granplate.plate.constraints import (
     GEOMETRY_RTOL,
     check_layers_off_clamps,
@@ -56,8 +51,10 @@ from granplate.setup.materials import LIBRARY, Material
 if TYPE_CHECKING:  # pragma: no cover
     from granplate.setup.scenario import Plate
 
+#: The run store's kind of the plate's cached arrays.
+STORE_KIND = "plate"
 #: Bump when anything that changes the cached arrays changes (formulas, ordering, dtypes).
-CACHE_VERSION = 2
+PLATE_FORMAT = 3
 
 _CACHED_ARRAYS = (
     "Phi",
@@ -199,23 +196,16 @@ class PlateModel:
         return (self.phi_drive * weights) @ self.phi_drive.T
 
 
-def cache_directory() -> Path:
-    """$GRANPLATE_CACHE, else ~/.cache/granplate."""
-    env = os.environ.get("GRANPLATE_CACHE")
-    return Path(env) if env else Path.home() / ".cache" / "granplate"
-
-
-def cache_key(
+def cache_payload(
     plate: "Plate",
     material: Material,
     x0: float,
     contact_y: Sequence[float],
     edge_load: tuple[float, float] | None,
     symmetry_line: bool,
-) -> str:
-    """sha256 of every input of build_plate (floats written exactly via repr)."""
-    payload = {
-        "cache_version": CACHE_VERSION,
+) -> dict:
+    """Every input of build_plate, for the run store's key (floats written exactly via repr)."""
+    return {
         "skfem": getattr(skfem, "__version__", "?"),
         "plate": dataclasses.asdict(plate),
         "material": [material.name, repr(float(material.E)), repr(float(material.nu)), repr(float(material.rho))],
@@ -226,37 +216,6 @@ def cache_key(
         "intorder": INTORDER,
         "edge_load_points": EDGE_LOAD_POINTS,
     }
-    text = json.dumps(payload, sort_keys=True, default=repr)
-    return hashlib.sha256(text.encode()).hexdigest()
-
-
-def _load_cached(path: Path, key: str) -> dict[str, np.ndarray] | None:
-    """The arrays stored at path, or None when missing, unreadable or from another key."""
-    if not path.is_file():
-        return None
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            if str(data["key"]) != key:
-                return None
-            return {name: np.array(data[name]) for name in _CACHED_ARRAYS}
-    except Exception:  # noqa: BLE001 - any unreadable file just means "recompute"
-        return None
-
-
-def _save_cached(path: Path, key: str, arrays: dict[str, np.ndarray]) -> None:
-    """Write arrays atomically (temporary file + rename); failures only warn."""
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.stem, suffix=".tmp")
-        try:
-            with os.fdopen(fd, "wb") as fh:
-                np.savez(fh, key=np.array(key), **arrays)
-            os.replace(tmp, path)
-        finally:
-            if os.path.exists(tmp):
-                os.remove(tmp)
-    except OSError as exc:
-        warnings.warn(f"granplate: could not write the plate cache {path}: {exc}", stacklevel=3)
 
 
 def _check_plate(plate: "Plate", x0: float, n_modes_max: int | None = None) -> None:
@@ -309,9 +268,10 @@ def _compute_arrays(
 
 
 def _arrays_fit(arrays: dict[str, np.ndarray], n_full: int, n_red: int, n_modes: int, n_rows: int) -> bool:
-    """Whether cached arrays have the shapes this build needs."""
+    """Whether cached arrays are all there, with the shapes this build needs."""
     return (
-        arrays["Phi"].shape == (n_red, n_modes)
+        all(name in arrays for name in _CACHED_ARRAYS)
+        and         arrays["Phi"].shape == (n_red, n_modes)
         and arrays["omega"].shape == (n_modes,)
         and tuple(arrays["strain_op_shape"]) == (n_rows, n_full)
         and arrays["edge_load_full"].shape == (n_full,)
@@ -334,7 +294,7 @@ def build_plate(
     x0: the plate's left edge x [m]; contact_y: the y [m] of each granule contact on the
     left edge (each must be a node; one rigid layer per contact); edge_load = (y0_load, L)
     [m] for the half-sine line load on the left edge, or None; cache: read/write the
-    expensive arrays in cache_directory(); material: the plate's Material (None: the
+    expensive arrays in the run store; material: the plate's Material (None: the
     library's plate.material); symmetry_line: require (even ny) and return the nodes on
     y = y0 + height / 2 (False: symmetry_nodes is empty and ny may be odd).
 
@@ -366,17 +326,15 @@ def build_plate(
     D = plane_stress_matrix(material.E, material.nu)
 
     arrays = None
-    path = None
     if cache:
-        key = cache_key(plate, material, x0, contact_y, edge_load, symmetry_line)
-        path = cache_directory() / f"plate-{key[:40]}.npz"
-        arrays = _load_cached(path, key)
+        payload = cache_payload(plate, material, x0, contact_y, edge_load, symmetry_line)
+        arrays = store.load_arrays(STORE_KIND, payload, PLATE_FORMAT)
         if arrays is not None and not _arrays_fit(arrays, n_full, n_red, n_modes, 3 * n_elem * n_qp):
             arrays = None
     if arrays is None:
         arrays = _compute_arrays(basis, mesh, D, material, plate, x0, T, edge_load)
-        if cache and path is not None:
-            _save_cached(path, key, arrays)
+        if cache:
+            store.save_arrays(STORE_KIND, payload, PLATE_FORMAT, arrays)
 
     strain_op = sp.csr_matrix(
         (arrays["strain_op_data"], arrays["strain_op_indices"], arrays["strain_op_indptr"]),

@@ -8,14 +8,13 @@ come from three levels, p = log2 |Q1 - Q2| / |Q2 - Q3|; the error bar of the def
 setting is its difference to the next finer level (and a Richardson estimate where the
 order is meaningful).
 
-Runs are expensive (5-150 s each), so their summaries are kept in
-DIR/validation-runs.json, keyed by a hash of the scenario, the end time and the package
-version: a second `--full` run only computes what changed (like pystencils' parameter
-studies).
+Runs are expensive (5-150 s each), so their summaries are kept in the run store
+(`granplate.store`, kind "verification") and in DIR/validation-runs.json, both keyed by
+the store's key of the scenario, the end time and the package version: a second `--full`
+run only computes what changed (like pystencils' parameter studies).
 """
 from __future__ import annotations
 
-import hashlib
 import json
 import math
 from dataclasses import dataclass
@@ -81,26 +80,40 @@ STUDIES: tuple[Study, ...] = (
 )
 
 
-def cache_key(scenario, t_end: float | None = None) -> str:
-    """sha256 of the scenario's TOML, the end time and the package version."""
-    from granplate.version import __version__
+#: The run store's kind of the study runs' summaries, and their format version.
+RUN_KIND = "verification"
+RUN_FORMAT = 1
+
+
+def run_payload(scenario, t_end: float | None = None) -> dict:
+    """A study run's identity: the scenario's TOML and the end time [s] (None: the scenario's)."""
     from granplate.setup.io import dumps
 
-    text = dumps(scenario) + f"\nt_end={t_end!r}\nversion={__version__}\n"
-    return hashlib.sha256(text.encode()).hexdigest()
+    return {"scenario_toml": dumps(scenario), "t_end": None if t_end is None else repr(float(t_end))}
+
+
+def cache_key(scenario, t_end: float | None = None) -> str:
+    """The run store's key of a study run (scenario, end time, package version)."""
+    from granplate import store
+
+    return store.key(RUN_KIND, run_payload(scenario, t_end), RUN_FORMAT)
 
 
 def load_run_cache(path: Path) -> dict:
     """The run cache stored at path ({} when absent or unreadable)."""
     try:
-        return json.loads(path.read_text())
+        cache = json.loads(path.read_text())
     except (OSError, ValueError):
         return {}
+    return cache if isinstance(cache, dict) else {}
 
 
 def save_run_cache(path: Path, cache: dict) -> None:
-    """Write the run cache (sorted, indented: it is committed next to the page)."""
-    path.write_text(json.dumps(cache, indent=1, sort_keys=True) + "\n")
+    """Write the run cache atomically (sorted, indented: it is committed next to the page)."""
+    from granplate import store
+
+    text = json.dumps(cache, indent=1, sort_keys=True) + "\n"
+    store.atomic_write(path, lambda tmp: tmp.write_text(text))
 
 
 def _vm_location(ds) -> list[float]:
@@ -113,17 +126,22 @@ def _vm_location(ds) -> list[float]:
 
 
 def study_run(ctx: Context, scenario) -> dict:
-    """Summary of a full run of `scenario`, from the cache when there."""
+    """Summary of a full run of `scenario`: from the page's run cache, else the run store,
+    else computed (and kept in both)."""
+    from granplate import store
     from granplate.solver.driver import simulate as run
     from granplate.results.dataset import summary
 
     key = cache_key(scenario)
     cache = ctx.run_cache if ctx.run_cache is not None else {}
     if key not in cache:
-        ds = run(scenario, progress=False)
-        summ = summary(ds)
-        summ["energy_residual_max"] = float(np.max(np.abs(ds.energy_residual_max.values)))
-        summ["vm_location"] = _vm_location(ds)
+        summ = store.load_json(RUN_KIND, run_payload(scenario), RUN_FORMAT)
+        if summ is None:
+            ds = run(scenario, progress=False)
+            summ = summary(ds)
+            summ["energy_residual_max"] = float(np.max(np.abs(ds.energy_residual_max.values)))
+            summ["vm_location"] = _vm_location(ds)
+            store.save_json(RUN_KIND, run_payload(scenario), RUN_FORMAT, summ)
         cache[key] = summ
         if ctx.run_cache is not None and ctx.out is not None:
             save_run_cache(ctx.out / "validation-runs.json", ctx.run_cache)
