@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Sequence
+from typing import TYPE_CHECKING, Callable, Sequence
 
 import numpy as np
 import scipy.sparse as sp
@@ -279,6 +279,30 @@ def _arrays_fit(arrays: dict[str, np.ndarray], n_full: int, n_red: int, n_modes:
     )
 
 
+def _reduction(
+    node_xy: np.ndarray, plate: "Plate", x0: float, contact_y: Sequence[float], n_full: int
+) -> tuple[sp.csr_matrix, np.ndarray]:
+    """T and drive_dofs of the clamps and rigid layers (PlateError when they clash)."""
+    fixed = clamped_dofs(node_xy, plate, x0)
+    driving, layers = rigid_layer_nodes(node_xy, plate, x0, contact_y)
+    check_layers_off_clamps(fixed, driving, layers, plate, contact_y)
+    return rigid_layer_map(n_full, fixed, driving, layers)
+
+
+def _stored_or_computed(
+    payload: dict | None, fits: Callable[[dict], bool], compute: Callable[[], dict]
+) -> dict[str, np.ndarray]:
+    """The arrays the run store holds for payload when they fit, else compute() (then
+    stored); payload None: neither read nor write the store."""
+    arrays = None if payload is None else store.load_arrays(STORE_KIND, payload, PLATE_FORMAT)
+    if arrays is not None and fits(arrays):
+        return arrays
+    arrays = compute()
+    if payload is not None:
+        store.save_arrays(STORE_KIND, payload, PLATE_FORMAT, arrays)
+    return arrays
+
+
 def build_plate(
     plate: "Plate",
     x0: float,
@@ -315,26 +339,18 @@ def build_plate(
     node_xy = node_coordinates(basis)
     n_full = basis.N
     symmetry_nodes = symmetry_line_nodes(node_xy, plate) if symmetry_line else np.empty(0, dtype=np.int64)
-    fixed = clamped_dofs(node_xy, plate, x0)
-    driving, layers = rigid_layer_nodes(node_xy, plate, x0, contact_y)
-    check_layers_off_clamps(fixed, driving, layers, plate, contact_y)
-    T, drive_dofs = rigid_layer_map(n_full, fixed, driving, layers)
+    T, drive_dofs = _reduction(node_xy, plate, x0, contact_y, n_full)
     n_red = T.shape[1]
     _check_plate(plate, x0, n_modes_max=n_red)
     n_modes = plate.n_modes or n_red
     n_elem, n_qp = basis.dx.shape
     D = plane_stress_matrix(material.E, material.nu)
 
-    arrays = None
-    if cache:
-        payload = cache_payload(plate, material, x0, contact_y, edge_load, symmetry_line)
-        arrays = store.load_arrays(STORE_KIND, payload, PLATE_FORMAT)
-        if arrays is not None and not _arrays_fit(arrays, n_full, n_red, n_modes, 3 * n_elem * n_qp):
-            arrays = None
-    if arrays is None:
-        arrays = _compute_arrays(basis, mesh, D, material, plate, x0, T, edge_load)
-        if cache:
-            store.save_arrays(STORE_KIND, payload, PLATE_FORMAT, arrays)
+    arrays = _stored_or_computed(
+        cache_payload(plate, material, x0, contact_y, edge_load, symmetry_line) if cache else None,
+        lambda a: _arrays_fit(a, n_full, n_red, n_modes, 3 * n_elem * n_qp),
+        lambda: _compute_arrays(basis, mesh, D, material, plate, x0, T, edge_load),
+    )
 
     strain_op = sp.csr_matrix(
         (arrays["strain_op_data"], arrays["strain_op_indices"], arrays["strain_op_indptr"]),
