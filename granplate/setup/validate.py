@@ -421,8 +421,8 @@ def validate(scenario: Scenario) -> None:
 
     Order: materials, layout (as `layout.*`, before it is expanded), then on the resolved
     scenario: granules (values, unique labels, overlaps), walls (unit normals,
-    penetration), plate, plate mesh (contacts on nodes, rigid layers, n_modes), load,
-    contact, time, solver. A scenario with neither granules
+    penetration), plate, load, contact, plate mesh (contacts on nodes, rigid layers,
+    n_modes), time, solver. A scenario with neither granules
     (nor a layout) nor a plate is refused.
     """
     s = scenario
@@ -441,9 +441,9 @@ def validate(scenario: Scenario) -> None:
     _check_granules(r)
     _check_walls(r)
     _check_plate(r)
-    _check_plate_mesh(r)
     _check_load(r)
     _check_contact(r)
+    _check_plate_mesh(r)
     _check_time(r)
     _check_solver(r)
 
