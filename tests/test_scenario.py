@@ -255,3 +255,49 @@ def test_docs_examples_load_and_validate():
     validate(s)
     assert s.plate is None and s.load.kind == "none" and len(s.granules) == 2
     assert s.granules[0].vx > 0 > s.granules[1].vx
+
+
+def test_with_changes_states_the_changes_in_the_description():
+    """A changed scenario never keeps a description that contradicts it: the preset's line
+    is followed by every changed field with its value; the name stays."""
+    s = preset("steel-r1")
+    t = scenario_io.with_changes(s, {"load.q0": 1e12, "solver.scheme": "paper"})
+    assert t.name == s.name
+    assert t.description == s.description + '; changed: load.q0 = 1e+12, solver.scheme = "paper"'
+    # a second round merges: a field changed again shows its latest value, in its first place
+    u = scenario_io.with_changes(t, {"load.q0": 2e4, "plate": None,
+                                     "plate.clamped_edges": None, "name": "mine"})
+    assert u.name == "mine"
+    assert u.description == (s.description + '; changed: load.q0 = 20000, solver.scheme = "paper", '
+                              "plate = removed, plate.clamped_edges = removed")
+    # the TOML text carries it, and reading it back changes nothing
+    assert scenario_io.loads(scenario_io.dumps(u)) == u
+
+
+def test_with_changes_description_edge_cases():
+    """No change keeps the description; an explicit description wins; an empty one gets the list alone."""
+    s = preset("ptfe-r05")
+    assert scenario_io.with_changes(s, {}).description == s.description
+    assert scenario_io.with_changes(s, {"name": "x"}).description == s.description
+    assert scenario_io.with_changes(s, {"load.q0": 1.0, "description": "mine"}).description == "mine"
+    e = _two_spheres(description="")
+    once = scenario_io.with_changes(e, {"granules[0].vx": 2.5, "contact.clip_tensile": False})
+    assert once.description == "changed: granules[0].vx = 2.5, contact.clip_tensile = false"
+    twice = scenario_io.with_changes(once, {"granules[0].vx": 3.0})
+    assert twice.description == "changed: granules[0].vx = 3, contact.clip_tensile = false"
+    lists = scenario_io.with_changes(preset("steel-r1"), {"plate.clamped_edges": ["top", "right"],
+                                                          "plate.ny": 80})
+    assert lists.description.endswith('changed: plate.clamped_edges = ["top", "right"], plate.ny = 80')
+    again = scenario_io.with_changes(lists, {"plate.ny": 40})
+    assert again.description.endswith('changed: plate.clamped_edges = ["top", "right"], plate.ny = 40')
+
+
+def test_docs_python_example_runs(tmp_path, monkeypatch, capsys):
+    """docs/scenario.md's Python block runs as written (in an empty directory)."""
+    m = re.search(r"```python\n(.*?)```", DOC.read_text(), re.S)
+    assert m
+    monkeypatch.chdir(tmp_path)
+    exec(compile(m.group(1), "docs/scenario.md", "exec"), {"__name__": "docs_example"})
+    out = capsys.readouterr().out
+    assert "changed: load.q0 = 10000, layout.R2_ratio = 0.5, plate.ny = 80" in out
+    assert (tmp_path / "my_case.toml").exists()

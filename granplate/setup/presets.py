@@ -1,4 +1,4 @@
-"""The paper's six cases as ready scenarios (MODEL.md section 8).
+"""The paper's six cases as ready scenarios (docs/model.md section 8).
 
     preset("steel-r1")  ->  Scenario
     preset_names()      ->  ["bare-plate", "steel-r1", "steel-r05", "ptfe-r05",
@@ -55,7 +55,7 @@ PRESETS: dict[str, Callable[[], Scenario]] = {
 
 
 def preset_names() -> list[str]:
-    """The preset names, in the order of MODEL.md section 8."""
+    """The preset names, in the order of docs/model.md section 8."""
     return list(PRESETS)
 
 
