@@ -362,13 +362,21 @@ def _change_text(value: object) -> str:
     return str(value)
 
 
+#: Top-level keys whose changes a description does not list: the name and description
+#: themselves, and the numerical settings (time, solver), which a description never states
+#: (the result's scenario_toml carries them), so that a shortened run of a preset keeps
+#: the preset's description.
+UNLISTED = ("name", "description", "time", "solver")
+
+
 def describe_changes(description: str, changes: dict[str, object]) -> str:
     """`description` followed by "; changed: PATH = VALUE, ...", merged with earlier changes.
 
-    A description that already ends in a list of changes keeps it; a path changed again
-    shows its latest value in its first place. "name" and "description" are not listed.
+    Listed: changes to the case itself (materials, layout, granules, walls, plate, load,
+    contact), not those of `UNLISTED`. A description that already ends in a list of
+    changes keeps it; a path changed again shows its latest value in its first place.
     """
-    listed = {k: v for k, v in changes.items() if k not in ("name", "description")}
+    listed = {k: v for k, v in changes.items() if _split(k)[0] not in UNLISTED}
     if not listed:
         return description
     head = CHANGED.lstrip("; ")
@@ -395,9 +403,9 @@ def with_changes(s: Scenario, changes: dict[str, object]) -> Scenario:
     default; {"plate": None} removes the plate). The result is shape-checked by
     `from_dict`, not validated.
 
-    The description says what changed ("...; changed: load.q0 = 1e+12", see
-    `describe_changes`) unless `changes` sets "description" itself; the name stays
-    unless `changes` sets "name".
+    The description says what changed in the case ("...; changed: load.q0 = 1e+12", see
+    `describe_changes`; time and solver settings are not listed) unless `changes` sets
+    "description" itself; the name stays unless `changes` sets "name".
     """
     d = to_dict(s, all_materials=True)
     if "description" not in changes:
@@ -436,4 +444,4 @@ def with_changes(s: Scenario, changes: dict[str, object]) -> Scenario:
 
 
 __all__ = ["from_dict", "to_dict", "loads", "load", "dumps", "dump", "load_scenario",
-           "with_changes", "describe_changes", "CHANGED", "REQUIRED", "MATERIAL_KEYS", "MISSING"]
+           "with_changes", "describe_changes", "CHANGED", "UNLISTED", "REQUIRED", "MATERIAL_KEYS", "MISSING"]
