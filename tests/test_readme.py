@@ -63,3 +63,20 @@ def test_sample_error_is_the_real_message():
     with pytest.raises(gp.ScenarioError) as err:
         validate(gp.with_changes(gp.preset("ptfe-r05"), {"layout.R2_ratio": 0.2}))
     assert str(err.value) == m.group(1)
+
+
+def test_model_citations_point_to_existing_sections():
+    """Every "docs/model.md section N" (or "sections N-M", "section N.M") cited in the package,
+    the docs, the README or the tests names a heading that docs/model.md has."""
+    root = README.parent
+    headings = set(re.findall(r"^#{2,3} (\d+(?:\.\d+)?)[. ]", (root / "docs" / "model.md").read_text(), re.M))
+    assert {"1", "2", "3", "4", "5", "6", "7", "8"} <= headings
+    files = [README, *(root / "docs").glob("*.md"), *(root / "granplate").rglob("*.py"),
+             *(root / "tests").glob("*.py")]
+    cited = []
+    for f in files:
+        for m in re.finditer(r"docs/model\.md,? sections? (\d+(?:\.\d+)?)(?:-(\d+))?", f.read_text()):
+            cited += [(f.name, n) for n in m.groups() if n]
+    assert cited
+    missing = [(name, n) for name, n in cited if n not in headings]
+    assert not missing, missing
