@@ -22,29 +22,62 @@ COMMAND_MODULES = (
     "granplate.bench.cli",      # bench
 )
 
+#: (summary key, label, unit shown, format, scale to the unit shown). "{ref}" in a label
+#: is the energy the fractions are of (`reference_name`); "-": a pure number.
 SUMMARY_ROWS = (
-    ("e_shock", "E_shock", "J", "{:.4e}"),
-    ("ep_max_fraction", "plate energy, peak / E_shock", "-", "{:.4f}"),
-    ("ep_final_fraction", "plate energy, final / E_shock", "-", "{:.4f}"),
-    ("eg_max_fraction", "granular energy, peak / E_shock", "-", "{:.4f}"),
-    ("eg_final_fraction", "granular energy, final / E_shock", "-", "{:.4f}"),
-    ("dissipated_fraction", "dissipated, final / E_shock", "-", "{:.4f}"),
-    ("max_von_mises", "max von Mises stress", "MPa", "{:.2f}"),
-    ("max_eps_yy", "max |eps_yy|", "-", "{:.3e}"),
-    ("energy_residual_max", "max |energy residual|", "-", "{:.2e}"),
-    ("n_steps", "time steps", "-", "{:d}"),
-    ("wall_time_s", "wall time", "s", "{:.2f}"),
+    ("e_shock", "E_shock, work of the load", "J", "{:.4e}", 1.0),
+    ("e_initial", "E_initial, energy at t = 0", "J", "{:.4e}", 1.0),
+    ("e_in", "E_in = E_shock + E_initial", "J", "{:.4e}", 1.0),
+    ("ep_max_fraction", "plate energy, peak / {ref}", "-", "{:.4f}", 1.0),
+    ("ep_final_fraction", "plate energy, final / {ref}", "-", "{:.4f}", 1.0),
+    ("eg_max_fraction", "granular energy, peak / {ref}", "-", "{:.4f}", 1.0),
+    ("eg_final_fraction", "granular energy, final / {ref}", "-", "{:.4f}", 1.0),
+    ("dissipated_fraction", "dissipated, final / {ref}", "-", "{:.4f}", 1.0),
+    ("max_von_mises", "max von Mises stress", "MPa", "{:.2f}", 1e-6),
+    ("max_eps_yy", "max |eps_yy|", "-", "{:.3e}", 1.0),
+    ("energy_residual_max", "max |energy residual|", "-", "{:.2e}", 1.0),
+    ("n_steps", "time steps", "-", "{:d}", 1),
+    ("wall_time_s", "wall time", "s", "{:.2f}", 1.0),
 )
 
 
+#: An energy below this fraction of e_in is round-off (a run from rest has E_initial ~1e-33 J).
+NEGLIGIBLE = 1e-9
+
+
+def _negligible(summary: dict, key: str) -> bool:
+    return abs(summary.get(key) or 0.0) <= NEGLIGIBLE * abs(summary.get("e_in") or 0.0)
+
+
+def reference_name(summary: dict) -> str:
+    """The energy the summary's fractions are of, by name: e_in = e_shock + e_initial is
+    "E_shock" when the run starts at rest (the paper's cases), "E_initial" without a load,
+    else "E_in"."""
+    if _negligible(summary, "e_initial"):
+        return "E_shock"
+    if _negligible(summary, "e_shock"):
+        return "E_initial"
+    return "E_in"
+
+
 def format_summary(summary: dict) -> str:
-    """The summary as an aligned text table (stresses in MPa)."""
-    lines = [f"{'quantity':34s} {'value':>14s}  unit", "-" * 56]
-    for key, label, unit, fmt in SUMMARY_ROWS:
+    """The summary as an aligned text table; "-" where a value does not apply (None).
+
+    The E_initial row shows only when the run does not start at rest, the E_in row only
+    when both E_shock and E_initial count.
+    """
+    ref = reference_name(summary)
+    hidden = {"e_initial"} if ref == "E_shock" else set()
+    if ref != "E_in":
+        hidden.add("e_in")
+    width = 36
+    lines = [f"{'quantity':{width}s} {'value':>14s}  unit", "-" * (width + 22)]
+    for key, label, unit, fmt, scale in SUMMARY_ROWS:
+        if key not in summary or key in hidden:
+            continue
         v = summary[key]
-        if key == "max_von_mises":
-            v = v / 1e6
-        lines.append(f"{label:34s} {fmt.format(v):>14s}  {unit}")
+        text = "-" if v is None else fmt.format(v * scale)
+        lines.append(f"{label.format(ref=ref):{width}s} {text:>14s}  {unit}")
     return "\n".join(lines)
 
 

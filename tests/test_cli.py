@@ -3,6 +3,7 @@ prints presets, and refuses bad input with one clear line (no traceback)."""
 from __future__ import annotations
 
 import json
+import math
 
 import pytest
 
@@ -10,9 +11,32 @@ from granplate.cli import main
 from granplate.setup.io import load
 
 SUMMARY_KEYS = {
-    "e_shock", "ep_max_fraction", "ep_final_fraction", "eg_final_fraction", "dissipated_fraction",
-    "max_von_mises", "max_eps_yy", "energy_residual_max", "n_steps", "wall_time_s",
+    "e_shock", "e_initial", "e_in", "ep_max_fraction", "ep_final_fraction", "eg_max_fraction",
+    "eg_final_fraction", "dissipated_fraction", "max_von_mises", "max_eps_yy",
+    "energy_residual_max", "n_steps", "wall_time_s", "t_end",
 }
+
+#: Two steel spheres (R = 1 cm) 0.4 mm apart closing at 2 m/s: no plate, no load.
+TWO_SPHERES = """name = "two-spheres"
+[[granules]]
+x = 0.0
+y = 0.0
+radius = 0.01
+material = "steel"
+vx = 1.0
+[[granules]]
+x = 0.0204
+y = 0.0
+radius = 0.01
+material = "steel"
+vx = -1.0
+[load]
+kind = "none"
+[time]
+t_end = 4e-4
+output_interval = 1e-7
+field_interval = 1e-6
+"""
 
 
 def test_run_preset_writes_result_and_summary(tmp_path, capsys):
@@ -21,10 +45,66 @@ def test_run_preset_writes_result_and_summary(tmp_path, capsys):
     assert main(["run", "steel-r1", "--t-end", "2e-5", "-o", str(out), "--summary", str(js), "-q"]) == 0
     text = capsys.readouterr().out
     assert "E_shock" in text and "max von Mises" in text and "MPa" in text
+    # a run from rest: the fractions are of E_shock, and the table says so
+    assert "plate energy, peak / E_shock" in text and "E_initial" not in text
     s = json.loads(js.read_text())
     assert SUMMARY_KEYS <= set(s)
+    assert set(s["units"]) == SUMMARY_KEYS  # every number has its unit
+    assert (s["units"]["e_shock"], s["units"]["max_von_mises"], s["units"]["t_end"]) == ("J", "Pa", "s")
     assert s["e_shock"] == pytest.approx(7.48e-4, rel=0.01)
+    assert s["e_in"] == s["e_shock"] + s["e_initial"] and s["e_initial"] < 1e-20
     assert out.exists()
+
+
+def test_summary_fractions_are_of_e_in(tmp_path):
+    """Each *_fraction is the stated energy divided by e_in = E_shock(t_end) + E_initial."""
+    from granplate.results.dataset import read, summary
+
+    out = tmp_path / "r.nc"
+    assert main(["run", "steel-r1", "--t-end", "2e-5", "-o", str(out), "-q"]) == 0
+    ds = read(out)
+    s = summary(ds)
+    e_in = float(ds.E_shock[-1]) + float(ds.attrs["E_initial"])
+    assert s["e_in"] == e_in
+    assert s["ep_max_fraction"] == float(ds.E_plate.max()) / e_in
+    assert s["eg_final_fraction"] == float(ds.E_granular[-1]) / e_in
+    assert s["dissipated_fraction"] == float(ds.D_viscous[-1] + ds.D_friction[-1]) / e_in
+
+
+def test_run_without_plate_or_load(tmp_path, capsys):
+    """No load: the fractions are of the initial kinetic energy m v^2 (two spheres of mass m
+    at 1 m/s) and say so; no plate: plate metrics are null in the JSON and "-" in the table;
+    granular energy + dissipated = E_initial (eq. 11)."""
+    f, js = tmp_path / "two.toml", tmp_path / "s.json"
+    f.write_text(TWO_SPHERES)
+    assert main(["run", str(f), "-o", str(tmp_path / "r.nc"), "--summary", str(js), "-q"]) == 0
+    text = capsys.readouterr().out
+    s = json.loads(js.read_text())
+    mass = 4.0 / 3.0 * math.pi * 0.01 ** 3 * 7850.0
+    assert s["e_shock"] == 0.0
+    assert s["e_initial"] == pytest.approx(mass * 1.0 ** 2, rel=1e-12)
+    assert s["e_in"] == s["e_initial"]
+    for k in ("ep_max_fraction", "ep_final_fraction", "max_von_mises", "max_eps_yy"):
+        assert s[k] is None, k
+    assert s["eg_final_fraction"] + s["dissipated_fraction"] == pytest.approx(1.0, abs=1e-6)
+    assert s["dissipated_fraction"] > 0.001  # the spheres did collide (damped contact)
+    rows = {line[:36].strip(): line[36:].split() for line in text.splitlines()}
+    assert rows["max von Mises stress"] == ["-", "MPa"]
+    assert rows["plate energy, peak / E_initial"] == ["-", "-"]
+    assert rows["granular energy, peak / E_initial"][0] == "1.0000"
+    assert "E_shock" not in "".join(k for k in rows if "/" in k)
+
+
+def test_format_summary_names_the_reference_energy():
+    """With both a load and initial motion the fractions are of E_in, shown as a row."""
+    from granplate.cli import format_summary
+
+    s = {"e_shock": 1e-3, "e_initial": 3e-3, "e_in": 4e-3, "ep_max_fraction": 0.25,
+         "max_von_mises": 2.5e7}
+    text = format_summary(s)
+    assert "E_in = E_shock + E_initial" in text and "4.0000e-03" in text
+    assert "plate energy, peak / E_in" in text and "0.2500" in text
+    assert "25.00" in text  # Pa shown in MPa
 
 
 def test_preset_as_toml_runs_like_the_preset(tmp_path, capsys):

@@ -1,4 +1,4 @@
-"""The paper's six cases as presets (MODEL.md section 8)."""
+"""The paper's six cases as presets (docs/model.md section 8)."""
 from __future__ import annotations
 
 import pytest
@@ -15,7 +15,7 @@ NAMES = ["bare-plate", "steel-r1", "steel-r05", "ptfe-r05", "ptfe-r05-moderate",
 
 
 def test_exactly_the_six_paper_cases():
-    """preset_names() lists exactly the six cases of MODEL.md section 8, each described with a paper figure."""
+    """preset_names() lists exactly the six cases of docs/model.md section 8, each described with a paper figure."""
     assert preset_names() == NAMES
     for n in NAMES:
         s = preset(n)

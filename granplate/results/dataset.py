@@ -173,24 +173,50 @@ def read(path: str | Path) -> xr.Dataset:
         return ds.load()
 
 
+#: Unit of every number in `summary` ("1": a pure number; the *_fraction values are
+#: fractions of e_in = e_shock + e_initial).
+SUMMARY_UNITS: dict[str, str] = {
+    "t_end": "s", "e_shock": "J", "e_initial": "J", "e_in": "J",
+    "ep_max_fraction": "1", "ep_final_fraction": "1", "eg_max_fraction": "1",
+    "eg_final_fraction": "1", "dissipated_fraction": "1",
+    "max_von_mises": "Pa", "max_eps_yy": "1", "energy_residual_max": "1",
+    "n_steps": "1", "wall_time_s": "s",
+}
+
+
 def summary(ds: xr.Dataset) -> dict:
-    """The headline figures of a run (the CLI's table and --summary JSON)."""
+    """The headline figures of a run (the CLI's table and --summary JSON), units in "units".
+
+    Energies are fractions of e_in = e_shock + e_initial [J], the work of the load plus
+    the energy present at t = 0 (docs/output.md); they are None when e_in = 0. Plate
+    metrics are None for a run without a plate (not applicable, not zero).
+    """
     e0 = float(ds.attrs.get("E_initial", 0.0))
-    e_in = float(ds.E_shock[-1]) if ds.sizes["time"] else 0.0
-    ref = e_in + e0 if e_in + e0 > 0 else 1.0
-    has_plate = "E_plate" in ds and "max_von_mises" in ds
+    e_shock = float(ds.E_shock[-1]) if ds.sizes["time"] else 0.0
+    e_in = e_shock + e0
+    ref = e_in if e_in > 0 else None
+    has_plate = "max_von_mises" in ds
     info = json.loads(ds.attrs.get("run_info", "{}"))
+
+    def fraction(energy, plate: bool = False) -> float | None:
+        if ref is None or (plate and not has_plate):
+            return None
+        return float(energy) / ref
+
     return {
         "scenario": ds.attrs.get("scenario_name", ""),
+        "units": dict(SUMMARY_UNITS),
         "t_end": float(ds.time[-1]),
-        "e_shock": e_in,
-        "ep_max_fraction": float(ds.E_plate.max()) / ref,
-        "ep_final_fraction": float(ds.E_plate[-1]) / ref,
-        "eg_max_fraction": float(ds.E_granular.max()) / ref,
-        "eg_final_fraction": float(ds.E_granular[-1]) / ref,
-        "dissipated_fraction": float(ds.D_viscous[-1] + ds.D_friction[-1]) / ref,
-        "max_von_mises": float(ds.max_von_mises.max()) if has_plate else 0.0,
-        "max_eps_yy": float(ds.max_eps_yy.max()) if has_plate else 0.0,
+        "e_shock": e_shock,
+        "e_initial": e0,
+        "e_in": e_in,
+        "ep_max_fraction": fraction(ds.E_plate.max(), plate=True),
+        "ep_final_fraction": fraction(ds.E_plate[-1], plate=True),
+        "eg_max_fraction": fraction(ds.E_granular.max()),
+        "eg_final_fraction": fraction(ds.E_granular[-1]),
+        "dissipated_fraction": fraction(ds.D_viscous[-1] + ds.D_friction[-1]),
+        "max_von_mises": float(ds.max_von_mises.max()) if has_plate else None,
+        "max_eps_yy": float(ds.max_eps_yy.max()) if has_plate else None,
         "energy_residual_max": float(np.max(np.abs(ds.energy_residual_max))),
         "n_steps": int(info.get("n_steps", 0)),
         "wall_time_s": float(info.get("wall_time_s", 0.0)),

@@ -5,7 +5,8 @@
 - `loads(text)` / `load(path)` / `dumps(s)` / `dump(s, path)`: TOML. Reading checks the
   *shape* (unknown keys, missing required fields, wrong types), not the physics.
 - `load_scenario(name_or_path)`: a preset or a TOML file, validated (`validate`).
-- `with_changes(s, {"load.q0": 1e4, "layout.R2_ratio": 0.5})`: tweak by dotted paths.
+- `with_changes(s, {"load.q0": 1e4, "layout.R2_ratio": 0.5})`: tweak by dotted paths; the
+  description then lists the changes.
 
 Every error is a `ScenarioError` naming the field by its dotted path (`plate.nx`,
 `granules[2].radius`, `materials.ptfe.nu`; array indices 0-based, in file order).
@@ -341,6 +342,58 @@ def _split(path: str) -> list[str | int]:
     return steps
 
 
+#: What `with_changes` writes between a description and the list of changed fields.
+CHANGED = "; changed: "
+_CHANGE_ITEM = re.compile(r", (?=[A-Za-z_][A-Za-z0-9_.\[\]]* = )")
+
+
+def _change_text(value: object) -> str:
+    """A changed value as the description shows it: 1e+12, 0.6, "paper", [1, 2], removed."""
+    if value is None:
+        return "removed"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, numbers.Real):
+        return f"{value:.6g}"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_change_text(v) for v in value) + "]"
+    return str(value)
+
+
+#: Top-level keys whose changes a description does not list: the name and description
+#: themselves, and the numerical settings (time, solver), which a description never states
+#: (the result's scenario_toml carries them), so that a shortened run of a preset keeps
+#: the preset's description.
+UNLISTED = ("name", "description", "time", "solver")
+
+
+def describe_changes(description: str, changes: dict[str, object]) -> str:
+    """`description` followed by "; changed: PATH = VALUE, ...", merged with earlier changes.
+
+    Listed: changes to the case itself (materials, layout, granules, walls, plate, load,
+    contact), not those of `UNLISTED`. A description that already ends in a list of
+    changes keeps it; a path changed again shows its latest value in its first place.
+    """
+    listed = {k: v for k, v in changes.items() if _split(k)[0] not in UNLISTED}
+    if not listed:
+        return description
+    head = CHANGED.lstrip("; ")
+    if description.startswith(head):  # an empty description with changes listed
+        base, sep, tail = "", head, description[len(head):]
+    else:
+        base, sep, tail = description.partition(CHANGED)
+    items: dict[str, str] = {}
+    if sep:
+        for item in _CHANGE_ITEM.split(tail):
+            path, _, text = item.partition(" = ")
+            items[path] = text
+    for path, value in listed.items():
+        items[path] = _change_text(value)
+    return (base + CHANGED if base else head) + ", ".join(f"{k} = {v}" for k, v in items.items())
+
+
 def with_changes(s: Scenario, changes: dict[str, object]) -> Scenario:
     """A copy of `s` with fields set by dotted path, e.g. {"load.q0": 1e4, "plate.ny": 80}.
 
@@ -349,8 +402,14 @@ def with_changes(s: Scenario, changes: dict[str, object]) -> Scenario:
     adds a default plate with ny = 80); a value of None removes the key (back to its
     default; {"plate": None} removes the plate). The result is shape-checked by
     `from_dict`, not validated.
+
+    The description says what changed in the case ("...; changed: load.q0 = 1e+12", see
+    `describe_changes`; time and solver settings are not listed) unless `changes` sets
+    "description" itself; the name stays unless `changes` sets "name".
     """
     d = to_dict(s, all_materials=True)
+    if "description" not in changes:
+        d["description"] = describe_changes(s.description, changes)
     for path, value in changes.items():
         steps = _split(path)
         node: Any = d
@@ -385,4 +444,4 @@ def with_changes(s: Scenario, changes: dict[str, object]) -> Scenario:
 
 
 __all__ = ["from_dict", "to_dict", "loads", "load", "dumps", "dump", "load_scenario",
-           "with_changes", "REQUIRED", "MATERIAL_KEYS", "MISSING"]
+           "with_changes", "describe_changes", "CHANGED", "UNLISTED", "REQUIRED", "MATERIAL_KEYS", "MISSING"]

@@ -1,4 +1,4 @@
-"""The paper's six cases as ready scenarios (MODEL.md section 8).
+"""The paper's six cases as ready scenarios (docs/model.md section 8).
 
     preset("steel-r1")  ->  Scenario
     preset_names()      ->  ["bare-plate", "steel-r1", "steel-r05", "ptfe-r05",
@@ -6,7 +6,9 @@
 
 All use the default plate (4 x 40 Q8 elements, top and bottom clamped), contact
 coefficients (mu 0.099, k_s 1000 s/m, alpha_n 6.313e-3, steel-PTFE 6.313e-2), time
-settings (2 ms) and solver. `granplate preset NAME` prints a preset as TOML.
+settings (2 ms) and solver. `granplate preset NAME` prints a preset as TOML. Each
+description names the paper figures the preset reproduces; a preset changed by
+`with_changes` keeps its name, and its description gains "; changed: PATH = VALUE, ...".
 """
 from __future__ import annotations
 
@@ -55,7 +57,7 @@ PRESETS: dict[str, Callable[[], Scenario]] = {
 
 
 def preset_names() -> list[str]:
-    """The preset names, in the order of MODEL.md section 8."""
+    """The preset names, in the order of docs/model.md section 8."""
     return list(PRESETS)
 
 
