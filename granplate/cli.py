@@ -128,6 +128,24 @@ def _cmd_preset(args) -> int:
     return 0
 
 
+def _cmd_cache(args) -> int:
+    from granplate import store
+
+    if args.action == "clear":
+        n = store.clear(args.kind)
+        print(f"removed {n} entries from {store.cache_directory()}")
+        return 0
+    table = store.info()
+    print(f"cache directory: {store.cache_directory()} (cap {store.max_bytes() / 2**20:.0f} MiB, "
+          f"${store.MAX_BYTES_ENV})")
+    print(f"{'kind':20s} {'entries':>8s} {'MiB':>10s}")
+    for kind, row in sorted(table.items()):
+        print(f"{kind:20s} {row['entries']:8d} {row['bytes'] / 2**20:10.2f}")
+    total = sum(row["bytes"] for row in table.values())
+    print(f"{'total':20s} {sum(row['entries'] for row in table.values()):8d} {total / 2**20:10.2f}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="granplate", description="Granular media against an elastic plate: shock-mitigation simulator.")
     sub = p.add_subparsers(dest="command", required=True)
@@ -144,6 +162,10 @@ def build_parser() -> argparse.ArgumentParser:
     pr.add_argument("name")
     pr.add_argument("-o", "--output", help="write to this file instead of stdout")
     pr.set_defaults(func=_cmd_preset)
+    ca = sub.add_parser("cache", help="show or clear the on-disk cache (plate models, reused runs)")
+    ca.add_argument("action", choices=("info", "clear"), help="info: entries and size per kind; clear: remove")
+    ca.add_argument("--kind", default=None, help="with clear: only this kind (e.g. plate, reproduce)")
+    ca.set_defaults(func=_cmd_cache)
     for module in COMMAND_MODULES:
         try:
             mod = importlib.import_module(module)

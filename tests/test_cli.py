@@ -159,3 +159,18 @@ def test_unknown_preset_and_bad_t_end(capsys):
     assert "presets are" in capsys.readouterr().err
     assert main(["run", "steel-r1", "--t-end", "-1"]) == 2
     assert "must be > 0" in capsys.readouterr().err
+
+
+def test_cache_info_and_clear(tmp_path, monkeypatch, capsys):
+    """`granplate cache info` lists the entries a plate build stored; `clear` removes them."""
+    import granplate as gp
+
+    monkeypatch.setenv("GRANPLATE_CACHE", str(tmp_path))
+    gp.build_model(gp.preset("bare-plate"))
+    assert main(["cache", "info"]) == 0
+    lines = {line.split()[0]: line.split()[1:] for line in capsys.readouterr().out.splitlines()[2:]}
+    assert int(lines["plate"][0]) == 1 and float(lines["plate"][1]) > 0
+    assert main(["cache", "clear", "--kind", "plate"]) == 0
+    assert "removed 1 entries" in capsys.readouterr().out
+    assert main(["cache", "info"]) == 0
+    assert "plate" not in capsys.readouterr().out.split("total")[0].split("MiB")[-1]
