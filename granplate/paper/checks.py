@@ -7,8 +7,9 @@ unchanged results like the presets) and `granplate.report` compares each with it
 baseline over the same time window.
 
 Also here: von Mises stress evaluated at the Q8 element nodes (rather than at the Gauss
-points the simulator uses), from the nodal displacements a result stores, to show how
-much the "maximum stress in the plate" depends on where it is sampled.
+points the simulator uses), from the nodal displacements a result stores, by the plate's
+own strain operator and plane-stress law (`granplate.plate`), to show how much the
+"maximum stress in the plate" depends on where it is sampled.
 """
 from __future__ import annotations
 
@@ -16,16 +17,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import xarray as xr
-
-#: Reference coordinates of the Q8 nodes in VTK_QUADRATIC_QUAD order on [-1, 1]^2:
-#: 4 corners anticlockwise, then the midsides of edges 0-1, 1-2, 2-3, 3-0.
-Q8_NODES = np.array(
-    [[-1, -1], [1, -1], [1, 1], [-1, 1], [0, -1], [1, 0], [0, 1], [-1, 0]], dtype=float
-)
-
-#: 3 x 3 Gauss-Legendre points on [-1, 1]^2 (the simulator's stress points).
-GAUSS_3X3 = np.array([[a, b] for a in (-np.sqrt(0.6), 0.0, np.sqrt(0.6)) for b in (-np.sqrt(0.6), 0.0, np.sqrt(0.6))])
-
 
 @dataclass(frozen=True)
 class Check:
@@ -115,82 +106,59 @@ def check_scenario(check: Check, t_end: float | None = None):
 
 
 # --------------------------------------------------------------------------------------
-# Q8 stresses at arbitrary reference points
+# Stresses at the element nodes, by the plate's own recovery
 # --------------------------------------------------------------------------------------
-def q8_shape_derivatives(points: np.ndarray) -> np.ndarray:
-    """dN_a/d(xi, eta) of the 8 serendipity shape functions at reference points.
+#: Where stress_series samples the stress: the 8 Q8 nodes of each element (corners and
+#: midsides of skfem's reference square [0, 1]^2) or the simulator's 3 x 3 Gauss points.
+SAMPLING = ("nodes", "gauss")
 
-    points: (n_p, 2) in [-1, 1]^2; returns (n_p, 8, 2), node order as Q8_NODES.
+#: The Q8 nodes on skfem's reference square [0, 1]^2: (2, 8).
+_Q8_REFERENCE_NODES = np.array([[0, 1, 1, 0, 0.5, 1, 0.5, 0], [0, 0, 1, 1, 0, 0.5, 1, 0.5]], dtype=float)
+
+
+def stress_operator(ds: xr.Dataset, where: str = "nodes"):
+    """(strain operator, plane-stress D [Pa]) of the result's plate, sampled `where`.
+
+    The strain operator (granplate.plate.strain_operator) maps the full nodal displacement
+    vector [m] to (eps_xx, eps_yy, gamma_xy) at the sampling points of every element; the
+    mesh is rebuilt from the result's scenario and checked against its node coordinates.
     """
-    xi, eta = points[:, 0:1], points[:, 1:2]
-    a, b = Q8_NODES[:, 0][None, :], Q8_NODES[:, 1][None, :]
-    corner = (np.abs(a) == 1) & (np.abs(b) == 1)
-    mid_x = a == 0  # midside on an edge eta = +-1
-    d_xi = np.where(
-        corner, 0.25 * a * (1 + eta * b) * (2 * xi * a + eta * b),
-        np.where(mid_x, -xi * (1 + eta * b), 0.5 * a * (1 - eta**2)),
-    )
-    d_eta = np.where(
-        corner, 0.25 * b * (1 + xi * a) * (xi * a + 2 * eta * b),
-        np.where(mid_x, 0.5 * b * (1 - xi**2), -eta * (1 + xi * a)),
-    )
-    return np.stack([d_xi, d_eta], axis=-1)
+    from skfem import Basis
 
+    from granplate.plate import (node_coordinates, plane_stress_matrix, plate_mesh, q8_basis,
+                                 strain_operator)
+    from granplate.results.dataset import scenario_of
 
-def q8_gradients(element_xy: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """dN_a/d(x, y) [1/m] at reference points of each element.
-
-    element_xy: (n_el, 8, 2) node coordinates [m]; points (n_p, 2); returns (n_el, n_p, 8, 2).
-    """
-    dref = q8_shape_derivatives(points)  # (p, a, r)
-    jac = np.einsum("eai,par->epir", element_xy, dref)  # J[i, r] = dx_i / dxi_r
-    inv = np.linalg.inv(jac)  # dxi_r/dx_i: inv[r, i]
-    return np.einsum("par,epri->epai", dref, inv)
-
-
-def von_mises_at(
-    ux: np.ndarray, uy: np.ndarray, node_xy: np.ndarray, elements: np.ndarray,
-    points: np.ndarray, E: float, nu: float,
-) -> np.ndarray:
-    """Plane-stress von Mises stress [Pa] at reference points of every element.
-
-    ux, uy: (n_t, n_nodes) nodal displacements [m]; node_xy (n_nodes, 2) [m]; elements
-    (n_el, 8) VTK-ordered node indices; points (n_p, 2) reference coordinates; E [Pa], nu.
-    Returns (n_t, n_el, n_p). Stresses are not averaged between elements.
-    """
-    grad = q8_gradients(node_xy[elements], points)  # (e, p, a, j)
-    uxe, uye = ux[:, elements], uy[:, elements]  # (t, e, a)
-    exx = np.einsum("tea,epa->tep", uxe, grad[..., 0])
-    eyy = np.einsum("tea,epa->tep", uye, grad[..., 1])
-    gxy = np.einsum("tea,epa->tep", uxe, grad[..., 1]) + np.einsum("tea,epa->tep", uye, grad[..., 0])
-    c = E / (1 - nu**2)
-    sxx = c * (exx + nu * eyy)
-    syy = c * (nu * exx + eyy)
-    sxy = c * 0.5 * (1 - nu) * gxy
-    return np.sqrt(np.maximum(sxx**2 - sxx * syy + syy**2 + 3 * sxy**2, 0.0))
-
-
-def plate_material(ds: xr.Dataset) -> tuple[float, float]:
-    """(E [Pa], nu) of the plate, read from the result's scenario."""
-    from granplate.setup.io import loads
-
-    s = loads(ds.attrs["scenario_toml"])
-    m = s.material(s.plate.material)
-    return float(m.E), float(m.nu)
+    if where not in SAMPLING:
+        raise ValueError(f"where = {where!r}: allowed {SAMPLING}")
+    s = scenario_of(ds)
+    p = s.plate
+    mesh = plate_mesh(p.x0, p.y0, p.width, p.height, p.nx, p.ny)
+    basis = q8_basis(mesh)
+    if where == "nodes":
+        weights = np.full(_Q8_REFERENCE_NODES.shape[1], 1.0 / _Q8_REFERENCE_NODES.shape[1])
+        basis = Basis(mesh, basis.elem, quadrature=(_Q8_REFERENCE_NODES, weights))
+    xy = node_coordinates(basis)
+    if not (np.allclose(xy[:, 0], ds["node_x"].values) and np.allclose(xy[:, 1], ds["node_y"].values)):
+        raise ValueError("the result's plate nodes do not match the mesh of its scenario")
+    m = s.material(p.material)
+    return strain_operator(basis), plane_stress_matrix(float(m.E), float(m.nu))
 
 
 def stress_series(ds: xr.Dataset, where: str = "nodes", chunk: int = 200) -> np.ndarray:
     """Max von Mises stress over the plate at each field_time [Pa], sampled at the element
-    nodes (where="nodes") or the 3 x 3 Gauss points (where="gauss")."""
-    points = Q8_NODES if where == "nodes" else GAUSS_3X3
-    E, nu = plate_material(ds)
-    xy = np.stack([ds["node_x"].values, ds["node_y"].values], axis=1)
-    elements = np.asarray(ds["element_nodes"].values, dtype=np.int64)
+    nodes (where="nodes", not averaged between elements) or the 3 x 3 Gauss points
+    (where="gauss", the simulator's own points), from the stored nodal displacements."""
+    from granplate.plate import von_mises_plane_stress
+
+    op, D = stress_operator(ds, where)
     ux, uy = np.asarray(ds["plate_ux"].values), np.asarray(ds["plate_uy"].values)
     out = []
     for i in range(0, len(ux), chunk):
-        vm = von_mises_at(ux[i:i + chunk], uy[i:i + chunk], xy, elements, points, E, nu)
-        out.append(vm.reshape(len(vm), -1).max(axis=1))
+        x_full = np.stack([ux[i:i + chunk], uy[i:i + chunk]], axis=-1).reshape(len(ux[i:i + chunk]), -1)
+        exx, eyy, gxy = (op @ x_full.T).reshape(3, -1, x_full.shape[0])
+        sxx, syy, sxy = (D[a, 0] * exx + D[a, 1] * eyy + D[a, 2] * gxy for a in range(3))
+        out.append(von_mises_plane_stress(sxx, syy, sxy).max(axis=0))
     return np.concatenate(out) if out else np.zeros(0)
 
 

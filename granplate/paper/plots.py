@@ -300,9 +300,9 @@ def fig_8(weak: xr.Dataset, moderate: xr.Dataset, strong: xr.Dataset) -> Figure:
 
 
 def _scenario(ds: xr.Dataset):
-    from granplate.setup.io import loads
+    from granplate.results.dataset import scenario_of
 
-    return loads(ds.attrs["scenario_toml"])
+    return scenario_of(ds)
 
 
 def _q0(ds: xr.Dataset) -> float:

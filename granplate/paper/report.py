@@ -23,6 +23,7 @@ import xarray as xr
 
 from granplate.results import analysis as an
 from granplate.paper import checks as ck
+from granplate.results.dataset import scenario_of
 from granplate.results.document import Block, to_html, to_markdown
 
 Results = dict[str, xr.Dataset]
@@ -267,12 +268,10 @@ def _vertical(r1, r05):
 @_statement("Frictional local maps stay contractive at contacts A, B, C", "App. A, Fig. A.1",
             "abs(lambda) < 1", "max over the run < 1", "steel-r1")
 def _lambda(steel):
-    from granplate.setup.io import loads
-
     labels = [str(c) for c in steel["contact"].values]
     idx = [labels.index(c) for c in ("A", "B", "C") if c in labels]
     v = float(steel["local_map_modulus"].values[:, idx].max())
-    if loads(steel.attrs["scenario_toml"]).solver.scheme != "paper":
+    if scenario_of(steel).solver.scheme != "paper":
         # criterion (8) is the stability limit of the paper's fixed-point iteration only
         return (f"max abs(lambda) = {v:.1f} with the implicit scheme (Newton: stable for any "
                 "abs(lambda), not judged; solver.scheme = \"paper\" keeps it < 1)"), None, None
@@ -311,9 +310,7 @@ def statements(results: Results) -> list[Row]:
 
 
 def _energy_tol(ds: xr.Dataset) -> float:
-    from granplate.setup.io import loads
-
-    return float(loads(ds.attrs["scenario_toml"]).solver.energy_tol)
+    return float(scenario_of(ds).solver.energy_tol)
 
 
 def run_rows(results: Results, records: dict[str, object] | None = None) -> list[list[str]]:
@@ -474,15 +471,11 @@ def _window(ds: xr.Dataset, t_end: float) -> xr.Dataset:
 
 
 def _element_height(ds: xr.Dataset) -> float:
-    from granplate.setup.io import loads
-
-    return float(loads(ds.attrs["scenario_toml"]).plate.element_height)
+    return float(scenario_of(ds).plate.element_height)
 
 
 def _layer_width(ds: xr.Dataset) -> float:
-    from granplate.setup.io import loads
-
-    return float(loads(ds.attrs["scenario_toml"]).plate.layer_width)
+    return float(scenario_of(ds).plate.layer_width)
 
 
 def ptfe_discussion(results: Results, checks: Results) -> list[str]:
