@@ -1,11 +1,11 @@
 """Criteria that judge a number of ours, and the one `Check` type they judge.
 
 A *criterion* decides whether a value holds (`holds(value, reference)`) and writes its
-own text (`text(quantity, reference)`), so a report never types a threshold twice:
+own text (`text(reference)`), naming what it judges, so a report never types a threshold twice:
 
     >>> Within(0.02).holds(1.52e-2, 1.53e-2), Within(0.02).text()
     (True, 'within 2% of the paper's value')
-    >>> Between(0.45, 0.60, percent=True).text("plate peak share")
+    >>> Between(0.45, 0.60, percent=True, name="plate peak share").text()
     'plate peak share in [45%, 60%]'
 
 A *check* is one number of ours against a reference under a criterion: a verification
@@ -42,7 +42,7 @@ class Criterion:
     def holds(self, value: Any, reference: float | None = None) -> bool | None:
         raise NotImplementedError
 
-    def text(self, quantity: str = "", reference: float | None = None) -> str:
+    def text(self, reference: float | None = None) -> str:
         raise NotImplementedError
 
     @property
@@ -65,8 +65,8 @@ class Criterion:
         return self.text()
 
 
-def _q(quantity: str) -> str:
-    return f"{quantity} " if quantity else ""
+def _q(name: str) -> str:
+    return f"{name} " if name else ""
 
 
 @dataclass(frozen=True)
@@ -79,6 +79,7 @@ class Within(Criterion):
     tol: float
     of: float | None = None
     absolute: bool = False
+    name: str = ""
 
     def _ref(self, reference: float | None) -> float:
         return float(self.of if self.of is not None else reference)
@@ -93,10 +94,10 @@ class Within(Criterion):
         err = self.error(value, reference)
         return _finite(value) and not math.isnan(err) and err <= self.tol
 
-    def text(self, quantity: str = "", reference: float | None = None) -> str:
+    def text(self, reference: float | None = None) -> str:
         of = "the paper's value" if self.of is None else f"{self.of:g}"
         size = f"{self.tol:g}" if self.absolute else number_text(self.tol, percent=True)
-        return f"{_q(quantity)}within {size} of {of}"
+        return f"{_q(self.name)}within {size} of {of}"
 
     @property
     def kind(self) -> str:
@@ -117,6 +118,7 @@ class Bound(Criterion):
     bound: float
     op: str = "<"
     percent: bool = False
+    name: str = ""
 
     def __post_init__(self) -> None:
         if self.op not in ("<", "<=", ">", ">="):
@@ -128,8 +130,8 @@ class Bound(Criterion):
         v, b = float(value), float(self.bound)
         return {"<": v < b, "<=": v <= b, ">": v > b, ">=": v >= b}[self.op]
 
-    def text(self, quantity: str = "", reference: float | None = None) -> str:
-        return f"{_q(quantity)}{self.op} {number_text(self.bound, self.percent)}"
+    def text(self, reference: float | None = None) -> str:
+        return f"{_q(self.name)}{self.op} {number_text(self.bound, self.percent)}"
 
     @property
     def kind(self) -> str:
@@ -147,24 +149,24 @@ class Bound(Criterion):
         return f"ours {self.op} {self.bound:g}"
 
 
-def Below(bound: float, percent: bool = False) -> Bound:  # noqa: N802 - reads as a criterion
+def Below(bound: float, name: str = "", percent: bool = False) -> Bound:  # noqa: N802 - reads as a criterion
     """value < bound."""
-    return Bound(bound, "<", percent)
+    return Bound(bound, "<", percent, name)
 
 
-def Above(bound: float, percent: bool = False) -> Bound:  # noqa: N802
+def Above(bound: float, name: str = "", percent: bool = False) -> Bound:  # noqa: N802
     """value > bound."""
-    return Bound(bound, ">", percent)
+    return Bound(bound, ">", percent, name)
 
 
-def AtMost(bound: float, percent: bool = False) -> Bound:  # noqa: N802
+def AtMost(bound: float, name: str = "", percent: bool = False) -> Bound:  # noqa: N802
     """value <= bound."""
-    return Bound(bound, "<=", percent)
+    return Bound(bound, "<=", percent, name)
 
 
-def AtLeast(bound: float, percent: bool = False) -> Bound:  # noqa: N802
+def AtLeast(bound: float, name: str = "", percent: bool = False) -> Bound:  # noqa: N802
     """value >= bound."""
-    return Bound(bound, ">=", percent)
+    return Bound(bound, ">=", percent, name)
 
 
 @dataclass(frozen=True)
@@ -175,6 +177,7 @@ class Between(Criterion):
     hi: float
     upper_open: bool = False
     percent: bool = False
+    name: str = ""
 
     def holds(self, value: Any, reference: float | None = None) -> bool:
         if not _finite(value):
@@ -182,9 +185,9 @@ class Between(Criterion):
         v = float(value)
         return self.lo <= v and (v < self.hi if self.upper_open else v <= self.hi)
 
-    def text(self, quantity: str = "", reference: float | None = None) -> str:
+    def text(self, reference: float | None = None) -> str:
         lo, hi = number_text(self.lo, self.percent), number_text(self.hi, self.percent)
-        return f"{_q(quantity)}in [{lo}, {hi}{')' if self.upper_open else ']'}"
+        return f"{_q(self.name)}in [{lo}, {hi}{')' if self.upper_open else ']'}"
 
 
 @dataclass(frozen=True)
@@ -193,6 +196,7 @@ class Increasing(Criterion):
     as later than any number, but the first value must be a number."""
 
     nan_is_never: bool = False
+    name: str = ""
 
     def holds(self, value: Any, reference: float | None = None) -> bool:
         seq = [float(v) for v in value]
@@ -202,9 +206,9 @@ class Increasing(Criterion):
             seq = [math.inf if math.isnan(v) else v for v in seq]
         return all(a < b for a, b in zip(seq, seq[1:]))
 
-    def text(self, quantity: str = "", reference: float | None = None) -> str:
+    def text(self, reference: float | None = None) -> str:
         never = " ('never' counts as the latest)" if self.nan_is_never else ""
-        return f"{quantity + ': ' if quantity else ''}strictly increasing{never}"
+        return f"{self.name + ': ' if self.name else ''}strictly increasing{never}"
 
     def error(self, value: Any, reference: float | None = None) -> float:
         return math.nan
@@ -212,17 +216,16 @@ class Increasing(Criterion):
 
 @dataclass(frozen=True)
 class Item(Criterion):
-    """A criterion applied to one entry of a sequence value, named `name`."""
+    """A criterion applied to one entry of a sequence value."""
 
     index: int
     criterion: Criterion
-    name: str
 
     def holds(self, value: Any, reference: float | None = None) -> bool | None:
         return self.criterion.holds(value[self.index], reference)
 
-    def text(self, quantity: str = "", reference: float | None = None) -> str:
-        return self.criterion.text(self.name, reference)
+    def text(self, reference: float | None = None) -> str:
+        return self.criterion.text(reference)
 
 
 @dataclass(frozen=True)
@@ -235,8 +238,23 @@ class AllOf(Criterion):
         verdicts = [p.holds(value, reference) for p in self.parts]
         return None if any(v is None for v in verdicts) else all(verdicts)
 
-    def text(self, quantity: str = "", reference: float | None = None) -> str:
-        return " and ".join(p.text(quantity, reference) for p in self.parts)
+    def text(self, reference: float | None = None) -> str:
+        return " and ".join(p.text(reference) for p in self.parts)
+
+
+@dataclass(frozen=True)
+class AtMostSetting(Criterion):
+    """value <= the reference the check carries, a setting of the runs called `setting`."""
+
+    setting: str
+    name: str = ""
+
+    def holds(self, value: Any, reference: float | None = None) -> bool:
+        return _finite(value) and reference is not None and float(value) <= float(reference)
+
+    def text(self, reference: float | None = None) -> str:
+        value = "" if reference is None else f" = {reference:g}"
+        return f"{_q(self.name)}<= {self.setting}{value}"
 
 
 @dataclass(frozen=True)
@@ -246,7 +264,7 @@ class ReportedOnly(Criterion):
     def holds(self, value: Any, reference: float | None = None) -> None:
         return None
 
-    def text(self, quantity: str = "", reference: float | None = None) -> str:
+    def text(self, reference: float | None = None) -> str:
         return "reported, not judged"
 
 
@@ -304,7 +322,7 @@ class Check:
     @property
     def rule(self) -> str:
         """The criterion's text, with the reason in parentheses when there is one."""
-        text = self.criterion.text(self.quantity, self.reference)
+        text = self.criterion.text(self.reference)
         return f"{text} ({self.why})" if self.why else text
 
     def as_dict(self) -> dict:
