@@ -541,8 +541,7 @@ def _cmd_plot(args) -> int:
             raise ScenarioError("--figure", name, "allowed: " + ", ".join(plots.FIGURES) + " (or 'all'; "
                                 "'fig3', 'A.1' also work)") from None
         paths = figure_inputs(key, args.results)
-        for p in paths:
-            _read(p)  # a clear error for a file that is not a result
+        plots.check_inputs(key, [_read(p) for p in paths])  # clear errors for unfit files
         for written in make_figure(key, paths, Path(args.out)):
             print(f"written {written}")
     return 0
