@@ -15,7 +15,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-import xarray as xr
 
 from granplate.paper import checks as ck
 from granplate.paper.discussion import (
