@@ -1,6 +1,6 @@
 """Sensitivity checks behind the report's discussion of where we differ from the paper.
 
-Each `Check` is a preset with a few changed fields (finer mesh, another rigid-layer
+Each `SensitivityRun` is a preset with a few changed fields (finer mesh, another rigid-layer
 width, a smaller time step, plate fields at every output, a contact-law variant) run
 for a possibly shorter time; `granplate reproduce` runs them beside the presets (reusing
 unchanged results like the presets) and `granplate.report` compares each with its
@@ -19,7 +19,7 @@ import numpy as np
 import xarray as xr
 
 @dataclass(frozen=True)
-class Check:
+class SensitivityRun:
     """One sensitivity run: `preset` with `changes` (dotted paths), up to t_end [s].
 
     baseline: the result it is compared with (a preset name, or another check's name);
@@ -39,41 +39,41 @@ class Check:
 STRESS_WINDOW = 5e-4
 
 #: Every check the report knows how to discuss.
-CHECKS: tuple[Check, ...] = (
-    Check("steel-r1-fields", "steel-r1", {"time.field_interval": 1e-6}, STRESS_WINDOW,
+CHECKS: tuple[SensitivityRun, ...] = (
+    SensitivityRun("steel-r1-fields", "steel-r1", {"time.field_interval": 1e-6}, STRESS_WINDOW,
           "plate displacements at every output, to evaluate von Mises at the element nodes",
           baseline="steel-r1"),
-    Check("bare-plate-fields", "bare-plate", {"time.field_interval": 1e-6}, STRESS_WINDOW,
+    SensitivityRun("bare-plate-fields", "bare-plate", {"time.field_interval": 1e-6}, STRESS_WINDOW,
           "plate displacements at every output, to evaluate von Mises at the element nodes",
           baseline="bare-plate"),
-    Check("steel-r1-ny80", "steel-r1",
+    SensitivityRun("steel-r1-ny80", "steel-r1",
           {"plate.ny": 80, "plate.rigid_layer_width": 0.0025, "time.field_interval": 1e-6},
           STRESS_WINDOW, "mesh 2x finer along y (1.25 mm elements), same 2.5 mm rigid layer",
           baseline="steel-r1"),
-    Check("steel-r1-ny80-w1.25", "steel-r1", {"plate.ny": 80}, STRESS_WINDOW,
+    SensitivityRun("steel-r1-ny80-w1.25", "steel-r1", {"plate.ny": 80}, STRESS_WINDOW,
           "mesh 2x finer along y, rigid layer one (fine) element edge = 1.25 mm",
           baseline="steel-r1"),
-    Check("steel-r1-w5", "steel-r1", {"plate.rigid_layer_width": 0.005}, STRESS_WINDOW,
+    SensitivityRun("steel-r1-w5", "steel-r1", {"plate.rigid_layer_width": 0.005}, STRESS_WINDOW,
           "rigid layer 5 mm wide (two element edges) on the default mesh",
           baseline="steel-r1"),
-    Check("steel-r1-dt2", "steel-r1", {"time.dt_max": 2e-8, "time.dt_initial": 2e-8},
+    SensitivityRun("steel-r1-dt2", "steel-r1", {"time.dt_max": 2e-8, "time.dt_initial": 2e-8},
           STRESS_WINDOW, "time step halved (dt_max = 2e-8 s)", baseline="steel-r1"),
-    Check("bare-plate-ny80", "bare-plate", {"plate.ny": 80}, None,
+    SensitivityRun("bare-plate-ny80", "bare-plate", {"plate.ny": 80}, None,
           "bare plate, mesh 2x finer along y", baseline="bare-plate"),
-    Check("ptfe-r05-dt2", "ptfe-r05", {"time.dt_max": 2e-8, "time.dt_initial": 2e-8}, None,
+    SensitivityRun("ptfe-r05-dt2", "ptfe-r05", {"time.dt_max": 2e-8, "time.dt_initial": 2e-8}, None,
           "time step halved (dt_max = 2e-8 s)", baseline="ptfe-r05"),
-    Check("ptfe-r05-raw-eq2", "ptfe-r05", {"contact.clip_tensile": False}, None,
+    SensitivityRun("ptfe-r05-raw-eq2", "ptfe-r05", {"contact.clip_tensile": False}, None,
           "the paper's raw eq. (2): the damped normal force may pull", baseline="ptfe-r05"),
-    Check("ptfe-r05-alpha-steel", "ptfe-r05", {"contact.pairs[0].alpha_n": 6.313e-3}, None,
+    SensitivityRun("ptfe-r05-alpha-steel", "ptfe-r05", {"contact.pairs[0].alpha_n": 6.313e-3}, None,
           "steel-PTFE damping alpha_n = 6.313e-3 (the steel value) instead of 6.313e-2",
           baseline="ptfe-r05"),
-    Check("ptfe-r05-ny80", "ptfe-r05", {"plate.ny": 80, "plate.rigid_layer_width": 0.0025}, None,
+    SensitivityRun("ptfe-r05-ny80", "ptfe-r05", {"plate.ny": 80, "plate.rigid_layer_width": 0.0025}, None,
           "mesh 2x finer along y, same 2.5 mm rigid layer", baseline="ptfe-r05"),
-    Check("steel-r1-ny160", "steel-r1",
+    SensitivityRun("steel-r1-ny160", "steel-r1",
           {"plate.ny": 160, "plate.rigid_layer_width": 0.0025, "time.field_interval": 1e-6},
           STRESS_WINDOW, "mesh 4x finer along y (0.625 mm elements), same 2.5 mm rigid layer",
           baseline="steel-r1", slow=True),
-    Check("ptfe-r05-ny80-w1.25", "ptfe-r05", {"plate.ny": 80}, None,
+    SensitivityRun("ptfe-r05-ny80-w1.25", "ptfe-r05", {"plate.ny": 80}, None,
           "mesh 2x finer along y, rigid layer one (fine) element edge = 1.25 mm",
           baseline="ptfe-r05", slow=True),
 )
@@ -84,7 +84,7 @@ def check_names(include_slow: bool = False) -> list[str]:
     return [c.name for c in CHECKS if include_slow or not c.slow]
 
 
-def get_check(name: str) -> Check:
+def get_check(name: str) -> SensitivityRun:
     """The check called `name` (KeyError listing the names if there is none)."""
     for c in CHECKS:
         if c.name == name:
@@ -92,7 +92,7 @@ def get_check(name: str) -> Check:
     raise KeyError(f"no check {name!r}; checks are {[c.name for c in CHECKS]}")
 
 
-def check_scenario(check: Check, t_end: float | None = None):
+def check_scenario(check: SensitivityRun, t_end: float | None = None):
     """The Scenario a check runs: its preset with its changes, ending at the earlier of
     the check's t_end and `t_end` [s] (None: no cap)."""
     from granplate.setup.presets import preset
