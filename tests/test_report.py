@@ -158,3 +158,16 @@ def test_every_criterion_text_is_in_the_report(runs, tmp_path):
         assert _row(rows, s.text).rule == rule
     tol = float(scenario_of(runs["steel-r1"]).solver.energy_tol)
     assert ENERGY_BALANCE.criterion.text(tol) in text and f"= {tol:g}" in ENERGY_BALANCE.criterion.text(tol)
+
+
+def test_every_sensitivity_run_is_discussed():
+    """The discussion picks its checks by baseline and role from the records: each check
+    run is in exactly one of its groups (none is typed in by name, none is forgotten)."""
+    from granplate.paper import checks as ck
+    from granplate.paper import discussion as dn
+
+    groups = (list(dn.STRESS_CHECKS) + ck.runs_of(dn.STEEL, "sampling") + list(dn.PTFE_NUMERIC)
+              + list(dn.PTFE_PLATE) + ck.runs_of(dn.BARE, "sampling", "mesh"))
+    assert sorted(groups) == sorted(c.name for c in ck.CHECKS)
+    with pytest.raises(ValueError, match="role"):
+        ck.SensitivityRun("x", "steel-r1", role="colour")

@@ -23,7 +23,8 @@ class SensitivityRun:
     """One sensitivity run: `preset` with `changes` (dotted paths), up to t_end [s].
 
     baseline: the result it is compared with (a preset name, or another check's name);
-    t_end None keeps the preset's 2 ms; slow: left out unless all checks are asked for.
+    t_end None keeps the preset's 2 ms; slow: left out unless all checks are asked for;
+    role: what it varies, one of ROLES (the report's discussion groups runs by it).
     """
 
     name: str
@@ -33,6 +34,17 @@ class SensitivityRun:
     purpose: str = ""
     baseline: str = ""
     slow: bool = False
+    role: str = "numerics"
+
+    def __post_init__(self) -> None:
+        if self.role not in ROLES:
+            raise ValueError(f"role = {self.role!r}: allowed {ROLES}")
+
+
+#: What a sensitivity run varies: where the stress is sampled (plate fields kept at every
+#: output), the mesh (same rigid layer), the rigid-layer width, a numerical setting (time
+#: step), a modelling choice (contact law).
+ROLES = ("sampling", "mesh", "layer", "numerics", "model")
 
 
 #: The time window of the stress checks [s]: the steel cases' stress peak (~0.3 ms) is in it.
@@ -42,46 +54,51 @@ STRESS_WINDOW = 5e-4
 CHECKS: tuple[SensitivityRun, ...] = (
     SensitivityRun("steel-r1-fields", "steel-r1", {"time.field_interval": 1e-6}, STRESS_WINDOW,
           "plate displacements at every output, to evaluate von Mises at the element nodes",
-          baseline="steel-r1"),
+          baseline="steel-r1", role="sampling"),
     SensitivityRun("bare-plate-fields", "bare-plate", {"time.field_interval": 1e-6}, STRESS_WINDOW,
           "plate displacements at every output, to evaluate von Mises at the element nodes",
-          baseline="bare-plate"),
+          baseline="bare-plate", role="sampling"),
     SensitivityRun("steel-r1-ny80", "steel-r1",
           {"plate.ny": 80, "plate.rigid_layer_width": 0.0025, "time.field_interval": 1e-6},
           STRESS_WINDOW, "mesh 2x finer along y (1.25 mm elements), same 2.5 mm rigid layer",
-          baseline="steel-r1"),
+          baseline="steel-r1", role="mesh"),
     SensitivityRun("steel-r1-ny80-w1.25", "steel-r1", {"plate.ny": 80}, STRESS_WINDOW,
           "mesh 2x finer along y, rigid layer one (fine) element edge = 1.25 mm",
-          baseline="steel-r1"),
+          baseline="steel-r1", role="layer"),
     SensitivityRun("steel-r1-w5", "steel-r1", {"plate.rigid_layer_width": 0.005}, STRESS_WINDOW,
           "rigid layer 5 mm wide (two element edges) on the default mesh",
-          baseline="steel-r1"),
+          baseline="steel-r1", role="layer"),
     SensitivityRun("steel-r1-dt2", "steel-r1", {"time.dt_max": 2e-8, "time.dt_initial": 2e-8},
-          STRESS_WINDOW, "time step halved (dt_max = 2e-8 s)", baseline="steel-r1"),
+          STRESS_WINDOW, "time step halved (dt_max = 2e-8 s)", baseline="steel-r1", role="numerics"),
     SensitivityRun("bare-plate-ny80", "bare-plate", {"plate.ny": 80}, None,
-          "bare plate, mesh 2x finer along y", baseline="bare-plate"),
+          "bare plate, mesh 2x finer along y", baseline="bare-plate", role="mesh"),
     SensitivityRun("ptfe-r05-dt2", "ptfe-r05", {"time.dt_max": 2e-8, "time.dt_initial": 2e-8}, None,
-          "time step halved (dt_max = 2e-8 s)", baseline="ptfe-r05"),
+          "time step halved (dt_max = 2e-8 s)", baseline="ptfe-r05", role="numerics"),
     SensitivityRun("ptfe-r05-raw-eq2", "ptfe-r05", {"contact.clip_tensile": False}, None,
-          "the paper's raw eq. (2): the damped normal force may pull", baseline="ptfe-r05"),
+          "the paper's raw eq. (2): the damped normal force may pull", baseline="ptfe-r05", role="model"),
     SensitivityRun("ptfe-r05-alpha-steel", "ptfe-r05", {"contact.pairs[0].alpha_n": 6.313e-3}, None,
           "steel-PTFE damping alpha_n = 6.313e-3 (the steel value) instead of 6.313e-2",
-          baseline="ptfe-r05"),
+          baseline="ptfe-r05", role="model"),
     SensitivityRun("ptfe-r05-ny80", "ptfe-r05", {"plate.ny": 80, "plate.rigid_layer_width": 0.0025}, None,
-          "mesh 2x finer along y, same 2.5 mm rigid layer", baseline="ptfe-r05"),
+          "mesh 2x finer along y, same 2.5 mm rigid layer", baseline="ptfe-r05", role="mesh"),
     SensitivityRun("steel-r1-ny160", "steel-r1",
           {"plate.ny": 160, "plate.rigid_layer_width": 0.0025, "time.field_interval": 1e-6},
           STRESS_WINDOW, "mesh 4x finer along y (0.625 mm elements), same 2.5 mm rigid layer",
-          baseline="steel-r1", slow=True),
+          baseline="steel-r1", role="mesh", slow=True),
     SensitivityRun("ptfe-r05-ny80-w1.25", "ptfe-r05", {"plate.ny": 80}, None,
           "mesh 2x finer along y, rigid layer one (fine) element edge = 1.25 mm",
-          baseline="ptfe-r05", slow=True),
+          baseline="ptfe-r05", role="layer", slow=True),
 )
 
 
 def check_names(include_slow: bool = False) -> list[str]:
     """Names of the checks to run (the slow ones only when asked)."""
     return [c.name for c in CHECKS if include_slow or not c.slow]
+
+
+def runs_of(baseline: str, *roles: str) -> list[str]:
+    """Names of the checks compared with `baseline` that vary one of `roles`, in CHECKS order."""
+    return [c.name for c in CHECKS if c.baseline == baseline and c.role in roles]
 
 
 def get_check(name: str) -> SensitivityRun:

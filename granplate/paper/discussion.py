@@ -29,10 +29,16 @@ ENERGY_BARELY = 0.03
 #: A check moves the PTFE share "toward the paper's" when it adds more than this [-].
 TOWARD_PAPER = 0.05
 
-#: The stress checks on steel R2 = R1 compared with the default run, and the PTFE checks.
-STRESS_CHECKS = ("steel-r1-ny80", "steel-r1-ny160", "steel-r1-ny80-w1.25", "steel-r1-w5", "steel-r1-dt2")
-PTFE_NUMERIC = ("ptfe-r05-dt2", "ptfe-r05-raw-eq2", "ptfe-r05-alpha-steel")
-PTFE_PLATE = ("ptfe-r05-ny80", "ptfe-r05-ny80-w1.25")
+#: The checks of each discussion, by baseline and role (granplate.paper.checks).
+STEEL, BARE, PTFE = "steel-r1", "bare-plate", "ptfe-r05"
+STRESS_CHECKS = tuple(ck.runs_of(STEEL, "mesh", "layer", "numerics"))
+PTFE_NUMERIC = tuple(ck.runs_of(PTFE, "numerics", "model"))
+PTFE_PLATE = tuple(ck.runs_of(PTFE, "mesh", "layer"))
+
+
+def _first(baseline: str, role: str, checks: Results) -> str | None:
+    """The first check run of `role` against `baseline` that is among `checks`."""
+    return next((n for n in ck.runs_of(baseline, role) if n in checks), None)
 
 
 def paper_says(key: str) -> str:
@@ -59,9 +65,9 @@ def _change(new: float, old: float) -> str:
 
 def stress_discussion(results: Results, checks: Results) -> list[str]:
     """Paragraphs on the max von Mises stress with granules, from the stress checks."""
-    if "steel-r1" not in results:
+    if STEEL not in results:
         return []
-    base = results["steel-r1"]
+    base = results[STEEL]
     out = []
     v = _max_vm(base)
     t, x, y = an.peak_stress_location(base)
@@ -81,8 +87,8 @@ def stress_discussion(results: Results, checks: Results) -> list[str]:
         f"where the stress is sampled, none of which the paper states. The checks:")
     items = []
     samples: list[float] = []  # every peak stress the checks found (for the range)
-    if "steel-r1-fields" in checks:
-        f = checks["steel-r1-fields"]
+    if _first(STEEL, "sampling", checks):
+        f = checks[_first(STEEL, "sampling", checks)]
         nodal, gauss = ck.stress_series(f, "nodes").max(), ck.stress_series(f, "gauss").max()
         samples += [nodal, gauss]
         items.append(f"stress at the element nodes instead of the 3 x 3 Gauss points (same run, plate "
@@ -96,22 +102,22 @@ def stress_discussion(results: Results, checks: Results) -> list[str]:
             val = _max_vm(c)
             samples.append(val)
             extra = ""
-            if name in ("steel-r1-ny80", "steel-r1-ny160") and c.sizes.get("field_time", 0) > 2:
+            if ck.get_check(name).role == "mesh" and c.sizes.get("field_time", 0) > 2:
                 nodal = ck.stress_series(c, "nodes").max()
                 samples.append(nodal)
                 extra = f"; at its element nodes {_mpa(nodal)}"
             share = f"; plate peak share {_pct(an.plate_share(c)['peak'])} vs {_pct(an.plate_share(_window(base, w))['peak'])}"
             items.append(f"{what}: {_mpa(val)} vs {_mpa(ref)} on the default run over the same "
                          f"{w * 1e3:.2g} ms ({_change(val, ref)}){extra}{share}")
-    for name in ("bare-plate-fields", "bare-plate-ny80"):
-        if name in checks and "bare-plate" in results:
+    for name in ck.runs_of(BARE, "sampling", "mesh"):
+        if name in checks and BARE in results:
             c = checks[name]
-            if name == "bare-plate-fields":
+            if ck.get_check(name).role == "sampling":
                 nodal, gauss = ck.stress_series(c, "nodes").max(), ck.stress_series(c, "gauss").max()
                 items.append(f"bare plate, nodal vs Gauss-point stress (same run, first {float(c['time'].values[-1]) * 1e3:.2g} ms): "
                              f"{_mpa(nodal)} vs {_mpa(gauss)} ({_change(nodal, gauss)})")
             else:
-                ref = _max_vm(results["bare-plate"])
+                ref = _max_vm(results[BARE])
                 items.append(f"{_what(name)}: {_mpa(_max_vm(c))} vs {_mpa(ref)} ({_change(_max_vm(c), ref)})")
     if not items:
         out.append("(No check runs found: run `granplate reproduce --checks fast` to add them.)")
@@ -123,10 +129,10 @@ def stress_discussion(results: Results, checks: Results) -> list[str]:
 
 def _stress_verdict(results: Results, checks: Results, samples: list[float]) -> list[str]:
     """Sentences drawing the conclusion of the stress checks from their numbers."""
-    base = results["steel-r1"]
+    base = results[STEEL]
     v = _max_vm(base)
     verdict = []
-    mesh = [_max_vm(checks[n]) for n in ("steel-r1-ny80", "steel-r1-ny160") if n in checks]
+    mesh = [_max_vm(checks[n]) for n in ck.runs_of(STEEL, "mesh") if n in checks]
     if mesh:
         grows = all(b > a * (1 + MESH_RAISES) for a, b in zip([v] + mesh, mesh))
         verdict.append(f"Refining the mesh {'raises' if grows else 'changes'} the peak from {_mpa(v)} to "
@@ -135,8 +141,8 @@ def _stress_verdict(results: Results, checks: Results, samples: list[float]) -> 
     inside = lo <= PAPER_VM_STEEL <= hi
     verdict.append(f"Over the checks (mesh, layer width, Gauss or nodal sampling) the peak spans {_mpa(lo)} to "
                    f"{_mpa(hi)}: the paper's {paper_says('steel_vm')} is {'inside' if inside else 'outside'} that range.")
-    if "steel-r1-dt2" in checks:
-        c = checks["steel-r1-dt2"]
+    if _first(STEEL, "numerics", checks):
+        c = checks[_first(STEEL, "numerics", checks)]
         d = abs(_max_vm(c) / ck.max_in_window(base, "max_von_mises", float(c["time"].values[-1])) - 1)
         if d < STEP_UNCHANGED:
             verdict.append(f"The time step is not the cause (halving it changes the peak by less than "
@@ -144,17 +150,18 @@ def _stress_verdict(results: Results, checks: Results, samples: list[float]) -> 
         else:
             verdict.append(f"Halving the time step changes the peak by {100 * d:.1f}%.")
     shares = [an.plate_share(checks[n])["peak"] / an.plate_share(_window(base, float(checks[n]["time"].values[-1])))["peak"] - 1
-              for n in ("steel-r1-ny80", "steel-r1-ny80-w1.25", "steel-r1-w5", "steel-r1-ny160") if n in checks]
+              for n in ck.runs_of(STEEL, "mesh", "layer") if n in checks]
     reason = ("Most likely reason: the paper's plate mesh, rigid-layer width or stress sampling differ from "
               "MODEL.md's defaults (none is stated in the paper).")
     if shares and max(abs(s) for s in shares) < ENERGY_BARELY:
         reason += (f" The energies, on which the paper's conclusions rest, barely move with these choices (plate "
                    f"peak share within {100 * max(abs(s) for s in shares):.1f}%).")
     verdict.append(reason)
-    if "bare-plate" in results and "bare-plate-ny80" in checks:
-        bare = results["bare-plate"]
+    fine = _first(BARE, "mesh", checks)
+    if BARE in results and fine:
+        bare = results[BARE]
         _, bx, by = an.peak_stress_location(bare)
-        d = _max_vm(checks["bare-plate-ny80"]) / _max_vm(bare) - 1
+        d = _max_vm(checks[fine]) / _max_vm(bare) - 1
         edge = "a clamped corner" if min(by, float(bare["node_y"].max()) - by) < 0.005 else f"y = {by * 1e3:.1f} mm"
         verdict.append(f"The bare plate's peak sits at {edge} (element centre {bx * 1e3:.2f} mm from the left edge, "
                        f"y = {by * 1e3:.2f} mm) and moves {100 * d:+.0f}% with the finer mesh, which is why it agrees "
@@ -177,9 +184,9 @@ def _layer_width(ds: xr.Dataset) -> float:
 
 def ptfe_discussion(results: Results, checks: Results) -> list[str]:
     """Paragraphs on the PTFE plate share (the paper's 'about 10%'), from the PTFE checks."""
-    if "ptfe-r05" not in results:
+    if PTFE not in results:
         return []
-    base = results["ptfe-r05"]
+    base = results[PTFE]
     v = an.plate_share(base)["peak"]
     out = [f"**Plate share with PTFE intruders: ours peaks at {_pct(v)} of E_shock, the paper says {PAPER_SHARES['ptfe-r05']} "
            f"(ratio {v / PAPER_SHARE_PTFE:.2f}).** The qualitative claim holds (far below steel's share, see the table); "
@@ -193,7 +200,7 @@ def ptfe_discussion(results: Results, checks: Results) -> list[str]:
         out.append("(No check runs found: run `granplate reproduce --checks fast` to add them.)")
         return out
     out.append("\n".join(f"- {s}" for s in items))
-    moved = {n: an.plate_share(checks[n])["peak"] / v - 1 for n in checks if n.startswith("ptfe-r05-")}
+    moved = {n: an.plate_share(checks[n])["peak"] / v - 1 for n in PTFE_NUMERIC + PTFE_PLATE if n in checks}
     numeric = [n for n in PTFE_NUMERIC if n in moved]
     plate = [n for n in PTFE_PLATE if n in moved]
     text = []
