@@ -166,3 +166,40 @@ def test_figure_names(name, key):
 def test_unknown_figure_name():
     with pytest.raises(KeyError):
         plots.figure_key("9")
+
+
+def test_paper_figure_of_a_custom_scenario_is_a_clean_error(tmp_path, capsys):
+    """`granplate plot FILE --figure 5` on a two-sphere result: exit 2, one line naming the
+    figure and what it needs (granules 3, 8, C and a plate), no traceback."""
+    import granplate as gp
+    from granplate.cli import main
+    from granplate.results.dataset import write
+
+    from conftest import two_spheres
+
+    path = write(gp.simulate(two_spheres(0.1, t_end=2e-6, out=1e-6), progress=False), tmp_path / "two.nc")
+    for figure, needs, n in (("5", "granules 3, 8 and C", 1), ("A1", "contacts A, B and C", 1), ("7", "a plate", 2)):
+        assert main(["plot", *[str(path)] * n, "--figure", figure, "--out", str(tmp_path)]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("granplate: error:") and "Traceback" not in err and err.count("\n") == 1
+        assert f"figure {figure}" in err and needs in err and "two-spheres" in err
+
+
+def test_coinciding_vertical_velocities_stay_visible(runs):
+    """Granules 3 and C have vy = 0 (symmetry; round-off apart): C is drawn dashed with
+    markers over 3 and its legend says so; the panel letters are distinct; units stay."""
+    fig = plots.fig_5(runs["ptfe-r05"])
+    (line3,), (lineC,) = _lines(fig, "vy:3"), _lines(fig, "vy:C")
+    ax = lineC.axes
+    top = max(float(np.max(np.abs(ln.get_ydata()))) for ln in lineC.axes.get_lines())
+    assert np.max(np.abs(line3.get_ydata() - lineC.get_ydata())) <= plots.COINCIDE * top
+    assert lineC.get_linestyle() != line3.get_linestyle() and lineC.get_marker() not in ("", "None", None)
+    assert "= granule 3" in lineC.get_label()
+    assert "[m/s]" in ax.get_ylabel() and "[ms]" in ax.get_xlabel()
+    titles = [a.get_title(loc="left")[:3] for a in fig.axes if a.get_title(loc="left")]
+    assert len(titles) == len(set(titles)) == 4
+    fig4 = plots.fig_4(runs["steel-r1"], runs["steel-r05"])
+    letters = [a.get_title(loc="left")[:3] for a in fig4.axes if a.get_title(loc="left")]
+    assert sorted(letters) == [f"({c})" for c in "abcdefgh"]
+    _check_axes_and_caption(fig)
+    _check_axes_and_caption(fig4)

@@ -4,7 +4,7 @@ the figures embedded."""
 from __future__ import annotations
 
 import base64
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +22,7 @@ def runs():
 
 
 def _row(rows, start):
-    found = [r for r in rows if r.statement.startswith(start)]
+    found = [r for r in rows if r.quantity.startswith(start)]
     assert len(found) == 1, f"{len(found)} rows start with {start!r}"
     return found[0]
 
@@ -32,14 +32,14 @@ def test_rows_show_the_runs_numbers(runs):
     rows = report.statements(runs)
     e_bare = float(runs["bare-plate"].E_shock[-1])
     r = _row(rows, "Shock energy put into the bare plate")
-    assert r.ours == f"{e_bare:.3e} J"
+    assert r.ours_text == f"{e_bare:.3e} J"
     assert r.ratio == pytest.approx(e_bare / 1.53e-2)
     vm = float(runs["steel-r1"].max_von_mises.max())
     r = _row(rows, "Max von Mises stress with granules")
-    assert r.ours == f"{vm / 1e6:.1f} MPa" and r.ratio == pytest.approx(vm / 80e6)
+    assert r.ours_text == f"{vm / 1e6:.1f} MPa" and r.ratio == pytest.approx(vm / 80e6)
     peak = float(runs["steel-r1"].E_plate.max()) / float(runs["steel-r1"].E_shock[-1])
     r = _row(rows, "Plate energy peak, steel R2 = R1")
-    assert r.ours == f"{100 * peak:.1f}%"
+    assert r.ours_text == f"{100 * peak:.1f}%"
     assert r.holds == (0.45 <= peak <= 0.60)
 
 
@@ -56,7 +56,7 @@ def test_table_changes_with_the_data(runs):
     after = _row(rows, "Plate energy peak, steel R2 = R1")
     assert after.ratio == pytest.approx(2.0 * before.ratio)
     vm = _row(rows, "Max von Mises stress with granules")
-    assert vm.ours == "80.0 MPa" and vm.holds is True and vm.ratio == pytest.approx(1.0)
+    assert vm.ours_text == "80.0 MPa" and vm.holds is True and vm.ratio == pytest.approx(1.0)
     assert _row(rows, "Shock energy put into the bare plate") == _row(base, "Shock energy put into the bare plate")
 
 
@@ -69,14 +69,14 @@ def test_ordering_statement_follows_the_data(runs):
         ds["E_plate"] = ds["E_plate"] + 0.5 * float(ds.E_shock[-1])  # the "weak" run now gives most to the plate
     r = _row(report.statements(swapped), "The plate's share grows with the shock intensity (peak share)")
     assert r.holds is False
-    assert _row(rows, "The plate's share grows with the shock intensity (peak share)").ours != r.ours
+    assert _row(rows, "The plate's share grows with the shock intensity (peak share)").ours_text != r.ours_text
 
 
 def test_missing_runs_are_marked(runs):
     """A statement whose run is absent says so and is not judged."""
     rows = report.statements({"bare-plate": runs["bare-plate"]})
     r = _row(rows, "Max von Mises stress with granules")
-    assert r.ours.startswith("not run") and r.holds is None
+    assert r.ours_text.startswith("not run") and r.holds is None
     assert _row(rows, "Shock energy put into the bare plate").holds is not None
 
 
@@ -84,7 +84,7 @@ def test_energy_balance_row_uses_every_run(runs):
     """The energy-balance row reports the worst residual over all runs."""
     worst = max(float(np.abs(d.energy_residual_max).max()) for d in runs.values())
     r = _row(report.statements(runs), "Energy balance")
-    assert r.ours == f"max |residual| = {worst:.1e}"
+    assert r.ours_text == f"max |residual| = {worst:.1e}"
 
 
 def test_run_table_has_residual_and_wall_time(runs):
@@ -137,6 +137,37 @@ def test_conclusions_follow_the_rows(runs):
     rows = report.statements(runs)
     lines = report.conclusions(rows)
     assert len(lines) == len(report.CONCLUSIONS)
-    flipped = [report.Row(**{**r.__dict__, "holds": False}) if r.key == "vm_reduction" else r for r in rows]
+    flipped = [replace(r, ours=10.0) if r.key == "vm_reduction" else r for r in rows]  # 10 > 0.5: fails
     assert "does not hold" in report.conclusions(flipped)[0]
     assert report.conclusions(report.statements({}))[0].split(": ")[1].startswith("not run")
+
+
+def test_every_criterion_text_is_in_the_report(runs, tmp_path):
+    """Each statement's criterion writes the text of the table's criterion column: the
+    report shows it, with the reason, for every statement (thresholds typed once)."""
+    from granplate.paper.statements import ENERGY_BALANCE, STATEMENTS
+    from granplate.results.dataset import scenario_of
+
+    blocks = report.build_report(runs, {})
+    text = "\n".join(b.text for b in blocks) + "\n".join(" ".join(r) for b in blocks for r in b.rows)
+    rows = report.statements(runs)
+    assert all(n in runs for s in STATEMENTS for n in s.needs)
+    for s in STATEMENTS:
+        rule = s.criterion.text() + (f" ({s.why})" if s.why else "")
+        assert rule in text, s.key
+        assert _row(rows, s.text).rule == rule
+    tol = float(scenario_of(runs["steel-r1"]).solver.energy_tol)
+    assert ENERGY_BALANCE.criterion.text(tol) in text and f"= {tol:g}" in ENERGY_BALANCE.criterion.text(tol)
+
+
+def test_every_sensitivity_run_is_discussed():
+    """The discussion picks its checks by baseline and role from the records: each check
+    run is in exactly one of its groups (none is typed in by name, none is forgotten)."""
+    from granplate.paper import checks as ck
+    from granplate.paper import discussion as dn
+
+    groups = (list(dn.STRESS_CHECKS) + ck.runs_of(dn.STEEL, "sampling") + list(dn.PTFE_NUMERIC)
+              + list(dn.PTFE_PLATE) + ck.runs_of(dn.BARE, "sampling", "mesh"))
+    assert sorted(groups) == sorted(c.name for c in ck.CHECKS)
+    with pytest.raises(ValueError, match="role"):
+        ck.SensitivityRun("x", "steel-r1", role="colour")

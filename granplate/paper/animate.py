@@ -57,9 +57,9 @@ def plate_polygons(ds: xr.Dataset, k: int, factor: float) -> np.ndarray:
 
 
 def _walls(ds: xr.Dataset):
-    from granplate.setup.io import loads
+    from granplate.results.dataset import scenario_of
 
-    return loads(ds.attrs["scenario_toml"]).walls
+    return scenario_of(ds).walls
 
 
 def _ffmpeg_path() -> str | None:

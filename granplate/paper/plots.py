@@ -42,17 +42,25 @@ COLOURS = {
     "3": "tab:blue", "8": "tab:orange", "C": "tab:green",
 }
 STYLES = {"total": "--", "sum": "-."}
+#: Two curves of a panel coincide when they differ by less than this fraction of its
+#: largest value: far below a pixel (the vy of granules 3 and C, zero by symmetry, is
+#: 1e-9 of granule 8's in the runs: the solver's round-off and tolerances).
+COINCIDE = 1e-6
+#: Markers of a curve drawn over an identical one (so that both stay visible).
+MARKERS = ("o", "s", "^", "v", "D")
 
 PNG_DPI = 150
 
 
 @dataclass(frozen=True)
 class FigureSpec:
-    """A paper figure: its drawing function and the presets it takes, in order."""
+    """A paper figure: its drawing function, the presets it takes (in order), its title
+    and what it needs of every result it is given (keys of REQUIREMENTS)."""
 
     function: Callable[..., Figure]
     presets: tuple[str, ...]
     title: str
+    needs: tuple[str, ...] = ("plate",)
 
 
 # --------------------------------------------------------------------------------------
@@ -123,11 +131,28 @@ def kinetic_panel(ax, ds: xr.Dataset, legend: bool = True) -> None:
 
 
 def velocity_panel(ax, ds: xr.Dataset, component: str, labels=VELOCITY_GRANULES, legend: bool = True) -> None:
-    """Velocity component ("vx" or "vy") of the given granules [m/s] vs time."""
+    """Velocity component ("vx" or "vy") of the given granules [m/s] vs time.
+
+    A curve equal to one drawn before it, within COINCIDE of the panel's largest value
+    (granules 3 and C move only horizontally, their vy is 0 by symmetry), is drawn
+    dashed with markers on top of it, and its legend entry says which curve it equals.
+    """
     t = an.times_ms(ds)
-    for lab in labels:
-        i = an.granule_index(ds, lab)
-        ax.plot(t, ds[component].values[:, i], color=COLOURS.get(lab), lw=0.9, label=f"granule {lab}", gid=f"{component}:{lab}")
+    curves = {lab: np.asarray(ds[component].values[:, an.granule_index(ds, lab)]) for lab in labels}
+    tiny = COINCIDE * max((float(np.max(np.abs(y))) for y in curves.values()), default=0.0)
+    drawn: dict[str, np.ndarray] = {}
+    lines: dict[str, object] = {}
+    for k, (lab, y) in enumerate(curves.items()):
+        same = next((other for other, prev in drawn.items() if np.max(np.abs(prev - y)) <= tiny), None)
+        label, style = f"granule {lab}", {"ls": "-"}
+        if same is not None:
+            label += f" (= granule {same}{', both ~0' if np.max(np.abs(y)) <= tiny else ''})"
+            style = {"ls": (0, (4, 3)), "marker": MARKERS[k % len(MARKERS)], "ms": 3.5,
+                     "markevery": max(1, len(t) // 15), "zorder": 3}
+        (line,) = ax.plot(t, y, color=COLOURS.get(lab), lw=0.9, label=label, gid=f"{component}:{lab}", **style)
+        if same is not None:
+            lines[same].set_linewidth(2.4)  # the curve underneath shows around the dashes
+        drawn[lab], lines[lab] = y, line
     word = "horizontal" if component == "vx" else "vertical"
     ax.set_ylabel(f"{word} velocity [m/s]")
     _time_axis(ax, ds)
@@ -164,9 +189,8 @@ def fig_3(bare: xr.Dataset, granular: xr.Dataset) -> Figure:
 def fig_4(same_size: xr.Dataset, small: xr.Dataset) -> Figure:
     """Fig. 4: R2 = R1 (left) vs R2 = 0.5 R1 (right): energies, kinetic split, velocities."""
     fig = _new_figure(11.0, 12.0)
-    ax = fig.subplot_mosaic([["a", "b"], ["c", "d"], ["e", "f"], ["e2", "f2"]])
-    for col, ds, letters in (("left", same_size, "ace"), ("right", small, "bdf")):
-        a, c, e = letters
+    ax = fig.subplot_mosaic([["a", "b"], ["c", "d"], ["e", "f"], ["g", "h"]])
+    for ds, (a, c, e, g) in ((same_size, "aceg"), (small, "bdfh")):
         tag = _name(ds)
         energy_panel(ax[a], ds)
         _label(ax[a], f"({a}) normalised energies, {tag}")
@@ -174,14 +198,15 @@ def fig_4(same_size: xr.Dataset, small: xr.Dataset) -> Figure:
         _label(ax[c], f"({c}) granular kinetic energy, {tag}")
         velocity_panel(ax[e], ds, "vx")
         _label(ax[e], f"({e}) horizontal velocities, {tag}")
-        velocity_panel(ax[e + "2"], ds, "vy")
-        _label(ax[e + "2"], f"({e}) vertical velocities, {tag}")
-    for row in (("c", "d"), ("e", "f"), ("e2", "f2")):
+        velocity_panel(ax[g], ds, "vy")
+        _label(ax[g], f"({g}) vertical velocities, {tag}")
+    for row in (("c", "d"), ("e", "f"), ("g", "h")):
         _share_y(ax[row[0]], ax[row[1]])
     _caption(fig, "Fig. 4. Two intruder sizes, R2 = R1 (left) and R2 = 0.5 R1 (right): (a, b) energies "
              "over E_shock; (c, d) kinetic energy of the granular medium, horizontal / vertical / "
-             "rotational; (e, f) horizontal and vertical velocities of granules 3, 8 and C.",
-             same_size, small)
+             "rotational; (e, f) horizontal and (g, h) vertical velocities of granules 3, 8 and C (the "
+             "paper's panels e-f). A curve equal to another (3 and C: no vertical motion, by symmetry) "
+             "is dashed with markers.", same_size, small)
     return fig
 
 
@@ -195,7 +220,7 @@ def _share_y(a, b) -> None:
 def fig_5(ptfe: xr.Dataset) -> Figure:
     """Fig. 5: PTFE intruders: energies, kinetic split, velocities of granules 3, 8, C."""
     fig = _new_figure(11.0, 7.5)
-    ax = fig.subplot_mosaic([["a", "b"], ["c", "c2"]])
+    ax = fig.subplot_mosaic([["a", "b"], ["c", "d"]])
     tag = _name(ptfe)
     energy_panel(ax["a"], ptfe)
     _label(ax["a"], f"(a) normalised energies, {tag}")
@@ -203,11 +228,12 @@ def fig_5(ptfe: xr.Dataset) -> Figure:
     _label(ax["b"], f"(b) granular kinetic energy, {tag}")
     velocity_panel(ax["c"], ptfe, "vx")
     _label(ax["c"], "(c) horizontal velocities")
-    velocity_panel(ax["c2"], ptfe, "vy")
-    _label(ax["c2"], "(c) vertical velocities")
+    velocity_panel(ax["d"], ptfe, "vy")
+    _label(ax["d"], "(d) vertical velocities")
     _caption(fig, "Fig. 5. PTFE intruders, R2 = 0.5 R1: (a) energies over E_shock; (b) kinetic energy "
-             "of the granular medium, horizontal / vertical / rotational; (c) horizontal and vertical "
-             "velocities of granules 3, 8 and C.", ptfe)
+             "of the granular medium, horizontal / vertical / rotational; (c) horizontal and (d) vertical "
+             "velocities of granules 3, 8 and C (the paper's panel c). A curve equal to another (3 and C: no "
+             "vertical motion, by symmetry) is dashed with markers.", ptfe)
     return fig
 
 
@@ -300,9 +326,9 @@ def fig_8(weak: xr.Dataset, moderate: xr.Dataset, strong: xr.Dataset) -> Figure:
 
 
 def _scenario(ds: xr.Dataset):
-    from granplate.setup.io import loads
+    from granplate.results.dataset import scenario_of
 
-    return loads(ds.attrs["scenario_toml"])
+    return scenario_of(ds)
 
 
 def _q0(ds: xr.Dataset) -> float:
@@ -350,16 +376,47 @@ def fig_A1(steel: xr.Dataset) -> Figure:
     return fig
 
 
+#: What a figure may need of a result: a test of the Dataset and its words.
+REQUIREMENTS: dict[str, tuple[Callable[[xr.Dataset], bool], str]] = {
+    "plate": (an.has_plate, "a plate"),
+    "velocity granules": (lambda ds: an.has_granules(ds) and all(
+        lab in {str(g) for g in ds["granule"].values} for lab in VELOCITY_GRANULES),
+        "granules " + ", ".join(VELOCITY_GRANULES[:-1]) + " and " + VELOCITY_GRANULES[-1]),
+    "columns and symmetry line": (lambda ds: an.has_granules(ds) and ds.sizes.get("x_symmetry", 0) > 0,
+                                  "granules and the plate's symmetry line"),
+    "lambda contacts": (lambda ds: "contact" in ds.dims and all(
+        lab in {str(c) for c in ds["contact"].values} for lab in LAMBDA_CONTACTS),
+        "plate contacts " + ", ".join(LAMBDA_CONTACTS[:-1]) + " and " + LAMBDA_CONTACTS[-1]),
+}
+
+_GRANULAR = ("plate", "velocity granules")
+
 #: Figure name -> function and the presets it takes (MODEL.md section 8).
 FIGURES: dict[str, FigureSpec] = {
     "3": FigureSpec(fig_3, ("bare-plate", "steel-r1"), "von Mises stress and energies, bare plate vs granules"),
-    "4": FigureSpec(fig_4, ("steel-r1", "steel-r05"), "two intruder sizes"),
-    "5": FigureSpec(fig_5, ("ptfe-r05",), "PTFE intruders"),
-    "6": FigureSpec(fig_6, ("steel-r05", "ptfe-r05"), "space-time maps of horizontal velocity"),
+    "4": FigureSpec(fig_4, ("steel-r1", "steel-r05"), "two intruder sizes", _GRANULAR),
+    "5": FigureSpec(fig_5, ("ptfe-r05",), "PTFE intruders", _GRANULAR),
+    "6": FigureSpec(fig_6, ("steel-r05", "ptfe-r05"), "space-time maps of horizontal velocity",
+                    ("plate", "columns and symmetry line")),
     "7": FigureSpec(fig_7, ("steel-r05", "ptfe-r05"), "maximum eps_yy in the plate"),
     "8": FigureSpec(fig_8, ("ptfe-r05-weak", "ptfe-r05-moderate", "ptfe-r05"), "three shock intensities"),
-    "A1": FigureSpec(fig_A1, ("steel-r1",), "local-map eigenvalue modulus at contacts A, B, C"),
+    "A1": FigureSpec(fig_A1, ("steel-r1",), "local-map eigenvalue modulus at contacts A, B, C",
+                     ("plate", "lambda contacts")),
 }
+
+
+def check_inputs(key: str, datasets: list[xr.Dataset]) -> None:
+    """Raise ScenarioError (one line: the figure, what it needs, what the result lacks)
+    when a result cannot make figure `key` (e.g. a custom scenario without granule 3)."""
+    from granplate.errors import ScenarioError
+
+    spec = FIGURES[key]
+    for ds in datasets:
+        lacking = [REQUIREMENTS[n][1] for n in spec.needs if not REQUIREMENTS[n][0](ds)]
+        if lacking:
+            raise ScenarioError("--figure", key, f"figure {key} ({spec.title}) needs results with "
+                                f"{' and '.join(lacking)}, as the paper's {', '.join(spec.presets)} have; "
+                                f"result '{_name(ds)}' has not")
 
 
 def figure_key(name: str) -> str:

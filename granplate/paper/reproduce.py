@@ -20,10 +20,7 @@ import argparse
 import os
 import sys
 import time
-from contextlib import contextmanager
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
-from multiprocessing import get_context
 from pathlib import Path
 
 from granplate.errors import ScenarioError
@@ -201,176 +198,13 @@ def make_animation(path: Path, target: Path, frames: int | None) -> Path:
     return animate(read(path), target, frames=frames)
 
 
-# --------------------------------------------------------------------------------------
-# The driver
-# --------------------------------------------------------------------------------------
-#: Thread-count variables of the BLAS / OpenMP libraries the workers use.
-THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS")
-
-
-@contextmanager
-def _worker_threads(n_workers: int):
-    """Share the cores among the workers: each worker's BLAS gets cores // workers threads
-    (the workers inherit the environment; variables the user set are left alone)."""
-    per = str(max(1, (os.cpu_count() or 1) // max(1, n_workers)))
-    saved = {k: os.environ.get(k) for k in THREAD_VARIABLES}
-    try:
-        for k in THREAD_VARIABLES:
-            os.environ.setdefault(k, per)
-        yield
-    finally:
-        for k, v in saved.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
-
-
-@contextmanager
-def _executor(n_jobs: int):
-    """A pool of n_jobs spawned workers (clean: no forked numba / thread state); on the way
-    out, queued tasks are cancelled (an interrupt does not wait for them)."""
-    pool = ProcessPoolExecutor(max_workers=max(1, n_jobs), mp_context=get_context("spawn"))
-    try:
-        yield pool
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
-
-
-class _Progress:
-    """Progress on stderr: one line per finished task, and a bar on a terminal."""
-
-    def __init__(self, total: int, quiet: bool = False):
-        self.quiet = quiet
-        self.done = 0
-        self.total = total
-        self.bar = None
-        if not quiet and sys.stderr.isatty():
-            from tqdm import tqdm
-
-            self.bar = tqdm(total=total, desc="reproduce", unit="task", leave=False)
-
-    def add(self, n: int) -> None:
-        self.total += n
-        if self.bar is not None:
-            self.bar.total = self.total
-            self.bar.refresh()
-
-    def step(self, line: str) -> None:
-        self.done += 1
-        text = f"[{self.done}/{self.total}] {line}"
-        if self.bar is not None:
-            self.bar.update(1)
-            self.bar.write(text, file=sys.stderr)
-        elif not self.quiet:
-            print(text, file=sys.stderr, flush=True)
-
-    def note(self, line: str) -> None:
-        if self.bar is not None:
-            self.bar.write(line, file=sys.stderr)
-        elif not self.quiet:
-            print(line, file=sys.stderr, flush=True)
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
-
-
-@dataclass(frozen=True)
-class _Product:
-    """A figure (key: the figure's name) or an animation (key: the run animated) waiting
-    for the runs it needs."""
-
-    kind: str
-    key: str
-    needs: tuple[str, ...]
-
-    @property
-    def label(self) -> str:
-        return f"{self.kind} {self.key}"
-
-
-class _Driver:
-    """Runs the jobs on a pool and starts each figure / animation once its runs are in."""
-
-    def __init__(self, pool: ProcessPoolExecutor, outcome: Outcome, products: list[_Product],
-                 available: dict[str, Path], progress: _Progress, frames: int | None):
-        self.pool, self.outcome, self.products = pool, outcome, products
-        self.available, self.failed = available, set()
-        self.progress, self.frames = progress, frames
-        self.running: dict[Future, tuple[str, object]] = {}
-
-    def submit_runs(self, jobs: list[Job]) -> None:
-        """Queue the simulations, longest first (finer meshes, steel packings)."""
-        for job in sorted(jobs, key=_expected_cost, reverse=True):
-            self.running[self.pool.submit(run_job, job)] = ("run", job)
-
-    def launch_ready(self) -> None:
-        """Start every product whose runs are all in; drop those whose runs failed."""
-        out = self.outcome.out_dir
-        for prod in list(self.products):
-            lost = [n for n in prod.needs if n in self.failed]
-            if lost:
-                self.products.remove(prod)
-                self.outcome.problems.append(f"{prod.label} not made: run {', '.join(lost)} failed")
-                self.progress.step(f"skipped {prod.label}")
-            elif all(n in self.available for n in prod.needs):
-                self.products.remove(prod)
-                paths = [self.available[n] for n in prod.needs]
-                if prod.kind == "figure":
-                    fut = self.pool.submit(make_figure, prod.key, paths, out / "figures")
-                else:
-                    fut = self.pool.submit(make_animation, paths[0], out / "animations" / f"{prod.key}.mp4",
-                                           self.frames)
-                self.running[fut] = (prod.kind, prod)
-
-    def finish(self, fut: Future) -> None:
-        """Record one finished task (a run, a figure or an animation)."""
-        kind, what = self.running.pop(fut)
-        if kind == "run":
-            try:
-                rec = fut.result()
-            except Exception as exc:  # noqa: BLE001 - a crashed worker: report, go on
-                rec = RunRecord(what.name, what.path, "failed", 0.0, repr(exc), what.kind)
-            self.outcome.runs.append(rec)
-            if rec.status == "ran":
-                self.available[rec.name] = rec.path
-                self.progress.step(f"ran {rec.name} in {rec.seconds:.1f} s -> {rec.path}")
-            else:
-                self.failed.add(rec.name)
-                self.outcome.problems.append(f"run {rec.name} failed: {rec.message}")
-                self.progress.step(f"FAILED {rec.name}: {rec.message}")
-            self.launch_ready()
-            return
-        try:
-            res = fut.result()
-        except Exception as exc:  # noqa: BLE001 - report, go on with the rest
-            self.outcome.problems.append(f"{what.label} failed: {exc!r}")
-            self.progress.step(f"FAILED {what.label}: {exc!r}")
-            return
-        if kind == "figure":
-            self.outcome.figures[what.key] = res
-            self.progress.step(f"drew {what.label} -> {res[0]}")
-        else:
-            self.outcome.animations.append(res)
-            self.progress.step(f"made {what.label} -> {res}")
-
-    def run(self, jobs: list[Job]) -> None:
-        """Everything, to the end (products whose runs never come are left out)."""
-        self.submit_runs(jobs)
-        self.launch_ready()
-        while self.running:
-            done, _ = wait(list(self.running), return_when=FIRST_COMPLETED)
-            for fut in done:
-                self.finish(fut)
-
-
-def _products(figures: bool, animations: bool) -> list[_Product]:
+def _products(figures: bool, animations: bool) -> list:
     """The figures (each with the presets it takes) and the Appendix B animations."""
     from granplate.paper import plots
+    from granplate.paper.pool import Product
 
-    out = [_Product("figure", k, spec.presets) for k, spec in plots.FIGURES.items()] if figures else []
-    return out + ([_Product("animation", n, (n,)) for n in ANIMATED] if animations else [])
+    out = [Product("figure", k, spec.presets) for k, spec in plots.FIGURES.items()] if figures else []
+    return out + ([Product("animation", n, (n,)) for n in ANIMATED] if animations else [])
 
 
 def reproduce(
@@ -393,6 +227,7 @@ def reproduce(
     the figures; animations / frames: the Appendix B animations and their frame count;
     quiet: no progress.
     """
+    from granplate.paper.pool import Driver, Progress, executor, worker_threads
     from granplate.paper.report import write_report
 
     t_start = time.perf_counter()
@@ -411,13 +246,13 @@ def reproduce(
         else:
             to_run.append(job)
     products = _products(figures, animations)
-    progress = _Progress(len(to_run) + len(products), quiet)
+    progress = Progress(len(to_run) + len(products), quiet)
     for rec in outcome.runs:
         progress.note(f"reused {rec.name} ({rec.path})")
     n_workers = min(n_jobs, max(1, len(to_run) + len(products)))
     try:
-        with _worker_threads(n_workers), _executor(n_workers) as pool:
-            _Driver(pool, outcome, products, available, progress, frames).run(to_run)
+        with worker_threads(n_workers), executor(n_workers) as pool:
+            Driver(pool, outcome, products, available, progress, frames).run(to_run)
     finally:
         progress.close()
     if not figures:
@@ -460,7 +295,7 @@ def _earlier_animations(anim_dir: Path, available: dict[str, Path]) -> list[Path
     return found
 
 
-def _expected_cost(job: Job) -> float:
+def expected_cost(job: Job) -> float:
     """A rough cost of a job for ordering: elements x simulated time, steel > PTFE."""
     s = job.scenario
     plate = getattr(s, "plate", None)
@@ -554,8 +389,7 @@ def _cmd_plot(args) -> int:
             raise ScenarioError("--figure", name, "allowed: " + ", ".join(plots.FIGURES) + " (or 'all'; "
                                 "'fig3', 'A.1' also work)") from None
         paths = figure_inputs(key, args.results)
-        for p in paths:
-            _read(p)  # a clear error for a file that is not a result
+        plots.check_inputs(key, [_read(p) for p in paths])  # clear errors for unfit files
         for written in make_figure(key, paths, Path(args.out)):
             print(f"written {written}")
     return 0

@@ -160,6 +160,17 @@ def vertical_kinetic_share(ds: xr.Dataset) -> float:
     return float(k["vertical"].sum() / total) if total > 0 else 0.0
 
 
+def peak_stress_location(ds: xr.Dataset) -> tuple[float, float, float]:
+    """(time [s], x from the plate's left edge [m], y [m]) of the element with the largest
+    von Mises stress among the field snapshots (x, y: the mean of its 4 corner nodes)."""
+    vm = ds["plate_von_mises"].values
+    k, e = np.unravel_index(int(np.argmax(vm)), vm.shape)
+    nodes = ds["element_nodes"].values[e, :4]
+    x = float(ds["node_x"].values[nodes].mean() - ds["node_x"].values.min())
+    y = float(ds["node_y"].values[nodes].mean())
+    return float(ds["field_time"].values[k]), x, y
+
+
 def run_info(ds: xr.Dataset) -> dict:
     """The solver's run record (wall time, steps, status) stored in the attributes."""
     import json

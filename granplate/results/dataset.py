@@ -221,3 +221,18 @@ def summary(ds: xr.Dataset) -> dict:
         "n_steps": int(info.get("n_steps", 0)),
         "wall_time_s": float(info.get("wall_time_s", 0.0)),
     }
+
+
+def scenario_of(ds: xr.Dataset):
+    """The Scenario a result was made from, read back from its `scenario_toml` attribute.
+
+    Raises ScenarioError naming the attribute when the result carries none.
+    """
+    from granplate.errors import ScenarioError
+    from granplate.setup.io import loads
+
+    text = ds.attrs.get("scenario_toml")
+    if not text:
+        raise ScenarioError("result attribute scenario_toml", None,
+                            "missing: not a result written by granplate.simulate")
+    return loads(str(text))

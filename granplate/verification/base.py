@@ -16,7 +16,6 @@ Check kinds (how `error` and `passed` are computed):
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 import traceback
@@ -27,6 +26,8 @@ from typing import Callable
 
 import numpy as np
 
+from granplate.results import criteria
+
 #: Folder (inside the output directory) that holds the figures.
 FIGURE_DIR = "validation-figures"
 
@@ -34,55 +35,17 @@ FIGURE_DIR = "validation-figures"
 EPS = float(np.finfo(float).eps)
 
 
-@dataclass(frozen=True)
-class Check:
-    """One number against its reference.
+def Check(quantity: str, unit: str, reference: float, source: str, ours: float, tolerance: float,  # noqa: N802
+          why: str, kind: str = "rel") -> criteria.Check:
+    """One number against its reference: a granplate.results.criteria.Check whose
+    criterion is given by `kind` and `tolerance` (see the module docstring).
 
     quantity: what is compared (with the setting, e.g. "t_c, glass"); unit: its unit
     ("-" for none); reference: the true value; source: where the reference comes from;
-    ours: the simulator's value; tolerance: see the module docstring for `kind`;
-    why: one sentence justifying the tolerance (time-step order, mesh order, offsets).
+    ours: the simulator's value; why: one sentence justifying the tolerance (time-step
+    order, mesh order, offsets). ValueError for an unknown kind.
     """
-
-    quantity: str
-    unit: str
-    reference: float
-    source: str
-    ours: float
-    tolerance: float
-    why: str
-    kind: str = "rel"
-
-    def __post_init__(self) -> None:
-        if self.kind not in ("rel", "abs", "max", "min"):
-            raise ValueError(f"unknown check kind {self.kind!r}")
-
-    @property
-    def error(self) -> float:
-        """The compared error measure (see the module docstring)."""
-        ours, ref = float(self.ours), float(self.reference)
-        if self.kind == "rel":
-            return abs(ours - ref) / abs(ref) if ref != 0.0 else math.inf
-        if self.kind == "abs":
-            return abs(ours - ref)
-        return ours
-
-    @property
-    def passed(self) -> bool:
-        """Whether the check holds (a NaN never passes)."""
-        err = self.error
-        if not math.isfinite(float(self.ours)) or math.isnan(err):
-            return False
-        if self.kind == "min":
-            return err >= self.tolerance
-        return err <= self.tolerance
-
-    def as_dict(self) -> dict:
-        """Plain dict (for JSON), with error and passed."""
-        d = dataclasses.asdict(self)
-        d["error"] = float(self.error)
-        d["passed"] = bool(self.passed)
-        return d
+    return criteria.Check(quantity, unit, reference, source, ours, criteria.criterion_of_kind(kind, tolerance), why)
 
 
 @dataclass
@@ -100,7 +63,7 @@ class CaseResult:
     family: str
     title: str
     description: str = ""
-    checks: list[Check] = field(default_factory=list)
+    checks: list[criteria.Check] = field(default_factory=list)
     figure: str | None = None
     notes: list[str] = field(default_factory=list)
     tables: list[str] = field(default_factory=list)

@@ -118,11 +118,9 @@ def save_run_cache(path: Path, cache: dict) -> None:
 
 def _vm_location(ds) -> list[float]:
     """(x - x0, y) [m] of the element with the largest von Mises stress in the snapshots."""
-    vm = ds.plate_von_mises.values
-    k = np.unravel_index(int(np.argmax(vm)), vm.shape)
-    nodes = ds.element_nodes.values[k[1]][:4]
-    x = ds.node_x.values
-    return [float(x[nodes].mean() - x.min()), float(ds.node_y.values[nodes].mean())]
+    from granplate.results.analysis import peak_stress_location
+
+    return list(peak_stress_location(ds)[1:])
 
 
 def study_run(ctx: Context, scenario) -> dict:

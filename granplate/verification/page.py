@@ -1,19 +1,21 @@
 """The validation page: DIR/validation.md, DIR/validation.html and DIR/validation.json.
 
-Both pages are written from the same case results: a summary table (case, quantity,
-reference and its source, ours, error, tolerance, result), then one section per case
-with what was run, its figure, every tolerance with its justification, notes and tables.
+Both pages are rendered by granplate.results.document from the same blocks: a summary
+table (case, quantity, reference and its source, ours, error, tolerance, result), then
+one section per case with what was run, its figure, every tolerance with its
+justification, notes and tables.
 """
 from __future__ import annotations
 
 import datetime as _dt
-import html
 import json
 import platform
-import re
 from pathlib import Path
 
-from .base import FIGURE_DIR, CaseResult, Check
+from granplate.results.criteria import Check
+from granplate.results.document import Block, to_html, to_markdown
+
+from .base import FIGURE_DIR, CaseResult
 
 FAMILY_TITLES = {
     "granular": "Granular contact laws and wave propagation",
@@ -50,22 +52,12 @@ def error_text(c: Check) -> str:
 
 
 def tolerance_text(c: Check) -> str:
-    """The tolerance column: rel./abs. tolerance or the bound."""
-    if c.kind == "rel":
-        return f"{c.tolerance:.1e}"
-    if c.kind == "abs":
-        return f"{c.tolerance:.1e} (abs.)"
-    if c.kind == "max":
-        return f"ours <= {c.tolerance:.1e}"
-    return f"ours >= {c.tolerance:g}"
+    """The tolerance column: rel./abs. tolerance or the bound (the criterion's own)."""
+    return c.criterion.tolerance_text()
 
 
 def verdict(passed: bool) -> str:
     return "pass" if passed else "**FAIL**"
-
-
-def _md_cell(text: str) -> str:
-    return str(text).replace("|", "\\|").replace("\n", " ")
 
 
 def summary_counts(results: list[CaseResult]) -> tuple[int, int, int, int]:
@@ -76,6 +68,7 @@ def summary_counts(results: list[CaseResult]) -> tuple[int, int, int, int]:
 
 
 def header_lines(results: list[CaseResult], full: bool, seconds: float) -> list[str]:
+    """The page's opening paragraphs (separated by empty strings)."""
     from granplate.version import __version__
 
     n_cases, bad_cases, n_checks, bad_checks = summary_counts(results)
@@ -97,146 +90,69 @@ def header_lines(results: list[CaseResult], full: bool, seconds: float) -> list[
     ]
 
 
-def markdown(results: list[CaseResult], full: bool, seconds: float) -> str:
-    """The page as Markdown."""
-    lines = ["# granplate: verification and validation", ""]
-    lines += header_lines(results, full, seconds)
-    lines += ["", "## Results", "",
-              "| case | quantity | reference | source | ours | error | tolerance | result |",
-              "|---|---|---|---|---|---|---|---|"]
+RESULT_HEADER = ("case", "quantity", "reference", "source", "ours", "error", "tolerance", "result")
+
+
+def result_rows(results: list[CaseResult]) -> tuple[tuple[str, ...], ...]:
+    """The summary table: one row per check (and one per crashed case)."""
+    rows = []
     for r in results:
+        link = f"[{r.name}](#{r.name})"
         if r.crashed:
-            lines.append(f"| [{r.name}](#{r.name}) | (case crashed) | | | | | | **FAIL** |")
+            rows.append((link, "(case crashed)", "", "", "", "", "", "**FAIL**"))
         for c in r.checks:
-            lines.append("| " + " | ".join(_md_cell(x) for x in (
-                f"[{r.name}](#{r.name})", c.quantity, _num(c.reference, c.unit), c.source,
-                _num(c.ours, c.unit), error_text(c), tolerance_text(c))) + f" | {verdict(c.passed)} |")
+            rows.append((link, c.quantity, _num(c.reference, c.unit), c.source, _num(c.ours, c.unit),
+                         error_text(c), tolerance_text(c), verdict(c.passed)))
+    return tuple(rows)
+
+
+def case_blocks(r: CaseResult) -> list[Block]:
+    """One case's section: status, description, figure, tolerances, notes, tables."""
+    out = [Block("h3", r.title, anchor=r.name), Block("p", f"`{r.name}`: {verdict(r.passed)}, {r.seconds:.1f} s")]
+    if r.description:
+        out.append(Block("p", r.description))
+    if r.figure:
+        out.append(Block("image", r.title, path=Path(f"{FIGURE_DIR}/{r.figure}")))
+    if r.checks:
+        seen: dict[str, list[str]] = {}
+        for c in r.checks:
+            seen.setdefault(c.why, []).append(c.quantity)
+        out += [Block("p", "Tolerances:"), Block("p", "\n".join(f"- {'; '.join(qs)}: {why}" for why, qs in seen.items()))]
+    failing = [c for c in r.checks if not c.passed]
+    if failing:
+        out.append(Block("p", "Failing: " + "; ".join(f"{c.quantity} (ours {_num(c.ours, c.unit)}, "
+                                                      f"reference {_num(c.reference, c.unit)})" for c in failing)))
+    out += [Block("quote", note) for note in r.notes]
+    out += [Block("markdown", table) for table in r.tables]
+    if r.crashed:
+        out += [Block("p", "The case crashed:"), Block("code", r.crashed)]
+    return out
+
+
+def page_blocks(results: list[CaseResult], full: bool, seconds: float) -> list[Block]:
+    """The whole page as document blocks."""
+    blocks = [Block("h1", "granplate: verification and validation")]
+    blocks += [Block("p", p) for p in "\n".join(header_lines(results, full, seconds)).split("\n\n")]
+    blocks += [Block("h2", "Results"), Block("table", header=RESULT_HEADER, rows=result_rows(results))]
     family = None
     for r in results:
+        if family is not None:
+            blocks.append(Block("p", ""))  # the page's wider gap after each case
         if r.family != family:
             family = r.family
-            lines += ["", f"## {FAMILY_TITLES.get(family, family)}"]
-        lines += ["", f'<a id="{r.name}"></a>', "", f"### {r.title}",
-                  "", f"`{r.name}`: {verdict(r.passed)}, {r.seconds:.1f} s", ""]
-        if r.description:
-            lines += [r.description, ""]
-        if r.figure:
-            lines += [f"![{r.title}]({FIGURE_DIR}/{r.figure})", ""]
-        if r.checks:
-            lines += ["Tolerances:", ""]
-            seen: dict[str, list[str]] = {}
-            for c in r.checks:
-                seen.setdefault(c.why, []).append(c.quantity)
-            for why, qs in seen.items():
-                lines.append(f"- {'; '.join(qs)}: {why}")
-            lines.append("")
-        failing = [c for c in r.checks if not c.passed]
-        if failing:
-            lines += ["Failing: " + "; ".join(f"{c.quantity} (ours {_num(c.ours, c.unit)}, "
-                                             f"reference {_num(c.reference, c.unit)})" for c in failing), ""]
-        for note in r.notes:
-            lines += [f"> {note}", ""]
-        for table in r.tables:
-            lines += [table, ""]
-        if r.crashed:
-            lines += ["The case crashed:", "", "```", r.crashed.rstrip(), "```", ""]
-    return "\n".join(lines).rstrip() + "\n"
+            blocks.append(Block("h2", FAMILY_TITLES.get(family, family)))
+        blocks += case_blocks(r)
+    return blocks
 
 
-_CODE = re.compile(r"`([^`]+)`")
-_BOLD = re.compile(r"\*\*([^*]+)\*\*")
-_LINK = re.compile(r"\[([^\]]+)\]\(([^)]+)\)")
-
-
-def _inline(text: str) -> str:
-    """Markdown inline markup (code, bold, links) to HTML, everything else escaped."""
-    out = html.escape(text, quote=False)
-    out = _CODE.sub(lambda m: f"<code>{m.group(1)}</code>", out)
-    out = _BOLD.sub(lambda m: f"<strong>{m.group(1)}</strong>", out)
-    return _LINK.sub(lambda m: f'<a href="{m.group(2)}">{m.group(1)}</a>', out)
-
-
-def _md_table_to_html(table: str) -> str:
-    rows = [ln.strip() for ln in table.strip().splitlines()]
-    out = []
-    for ln in rows:
-        if ln.startswith("#"):
-            out.append(f"<h4>{_inline(ln.lstrip('#').strip())}</h4>")
-        elif ln.startswith("|---"):
-            continue
-        elif ln.startswith("|"):
-            cells = [c.strip() for c in ln.strip("|").split("|")]
-            out.append("<tr>" + "".join(f"<td>{_inline(c)}</td>" for c in cells) + "</tr>")
-        elif ln:
-            out.append(f"<p>{_inline(ln)}</p>")
-    html_rows, buf = [], []
-    for item in out:
-        if item.startswith("<tr>"):
-            buf.append(item)
-        else:
-            if buf:
-                html_rows.append("<table>" + "".join(buf) + "</table>")
-                buf = []
-            html_rows.append(item)
-    if buf:
-        html_rows.append("<table>" + "".join(buf) + "</table>")
-    return "\n".join(html_rows)
-
-
-CSS = """body{font-family:sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;color:#222}
-table{border-collapse:collapse;margin:0.5em 0;font-size:0.85em}td,th{border:1px solid #ccc;
-padding:2px 6px;vertical-align:top}th{background:#f0f0f0}.fail{color:#b00;font-weight:bold}
-.pass{color:#070}blockquote{border-left:3px solid #ccc;margin:0.5em 0;padding-left:0.8em;
-color:#444}img{max-width:100%}code{background:#f4f4f4}"""
+def markdown(results: list[CaseResult], full: bool, seconds: float) -> str:
+    """The page as Markdown."""
+    return to_markdown(page_blocks(results, full, seconds), Path("."))
 
 
 def html_page(results: list[CaseResult], full: bool, seconds: float) -> str:
-    """The page as a self-contained HTML file (figures linked from FIGURE_DIR)."""
-    h = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
-         "<title>granplate: verification and validation</title>", f"<style>{CSS}</style></head><body>",
-         "<h1>granplate: verification and validation</h1>"]
-    h += [f"<p>{_inline(p)}</p>" for p in "\n".join(header_lines(results, full, seconds)).split("\n\n")]
-    h += ["<h2>Results</h2>", "<table><tr><th>case</th><th>quantity</th><th>reference</th>"
-          "<th>source</th><th>ours</th><th>error</th><th>tolerance</th><th>result</th></tr>"]
-    for r in results:
-        if r.crashed:
-            h.append(f'<tr><td><a href="#{r.name}">{r.name}</a></td><td>(case crashed)</td>'
-                     '<td></td><td></td><td></td><td></td><td></td><td class="fail">FAIL</td></tr>')
-        for c in r.checks:
-            cls = "pass" if c.passed else "fail"
-            cells = [f'<a href="#{r.name}">{r.name}</a>'] + [html.escape(x) for x in (
-                c.quantity, _num(c.reference, c.unit), c.source, _num(c.ours, c.unit),
-                error_text(c), tolerance_text(c))]
-            h.append("<tr>" + "".join(f"<td>{x}</td>" for x in cells)
-                     + f'<td class="{cls}">{"pass" if c.passed else "FAIL"}</td></tr>')
-    h.append("</table>")
-    family = None
-    for r in results:
-        if r.family != family:
-            family = r.family
-            h.append(f"<h2>{html.escape(FAMILY_TITLES.get(family, family))}</h2>")
-        cls = "pass" if r.passed else "fail"
-        h.append(f'<h3 id="{r.name}">{html.escape(r.title)}</h3>')
-        h.append(f'<p><code>{r.name}</code>: <span class="{cls}">{"pass" if r.passed else "FAIL"}'
-                 f"</span>, {r.seconds:.1f} s</p>")
-        if r.description:
-            h.append(f"<p>{_inline(r.description)}</p>")
-        if r.figure:
-            h.append(f'<p><img src="{FIGURE_DIR}/{r.figure}" alt="{html.escape(r.title)}"></p>')
-        if r.checks:
-            seen: dict[str, list[str]] = {}
-            for c in r.checks:
-                seen.setdefault(c.why, []).append(c.quantity)
-            h.append("<p>Tolerances:</p><ul>" + "".join(
-                f"<li>{html.escape('; '.join(qs))}: {_inline(why)}</li>" for why, qs in seen.items()) + "</ul>")
-        for note in r.notes:
-            h.append(f"<blockquote>{_inline(note)}</blockquote>")
-        for table in r.tables:
-            h.append(_md_table_to_html(table))
-        if r.crashed:
-            h.append(f"<pre>{html.escape(r.crashed)}</pre>")
-    h.append("</body></html>")
-    return "\n".join(h) + "\n"
+    """The page as an HTML file (figures linked from FIGURE_DIR)."""
+    return to_html(page_blocks(results, full, seconds), Path("."), embed=False)
 
 
 def write_pages(out: Path, results: list[CaseResult], full: bool, seconds: float) -> list[Path]:
