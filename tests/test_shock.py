@@ -1,4 +1,4 @@
-"""The half-sine shock (MODEL.md section 5): resultants on granules and their sum."""
+"""The half-sine shock (docs/model.md section 5): resultants on granules and their sum."""
 from __future__ import annotations
 
 import numpy as np

@@ -152,7 +152,7 @@ def _stress_verdict(results: Results, checks: Results, samples: list[float]) -> 
     shares = [an.plate_share(checks[n])["peak"] / an.plate_share(_window(base, float(checks[n]["time"].values[-1])))["peak"] - 1
               for n in ck.runs_of(STEEL, "mesh", "layer") if n in checks]
     reason = ("Most likely reason: the paper's plate mesh, rigid-layer width or stress sampling differ from "
-              "MODEL.md's defaults (none is stated in the paper).")
+              "granplate's defaults (docs/model.md section 9) (none is stated in the paper).")
     if shares and max(abs(s) for s in shares) < ENERGY_BARELY:
         reason += (f" The energies, on which the paper's conclusions rest, barely move with these choices (plate "
                    f"peak share within {100 * max(abs(s) for s in shares):.1f}%).")

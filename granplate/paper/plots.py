@@ -391,7 +391,7 @@ REQUIREMENTS: dict[str, tuple[Callable[[xr.Dataset], bool], str]] = {
 
 _GRANULAR = ("plate", "velocity granules")
 
-#: Figure name -> function and the presets it takes (MODEL.md section 8).
+#: Figure name -> function and the presets it takes (docs/model.md section 8).
 FIGURES: dict[str, FigureSpec] = {
     "3": FigureSpec(fig_3, ("bare-plate", "steel-r1"), "von Mises stress and energies, bare plate vs granules"),
     "4": FigureSpec(fig_4, ("steel-r1", "steel-r05"), "two intruder sizes", _GRANULAR),

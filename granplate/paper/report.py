@@ -1,4 +1,4 @@
-"""The reproduction report: our numbers beside the paper's (MODEL.md section 8).
+"""The reproduction report: our numbers beside the paper's (docs/model.md section 8).
 
 The comparison table is `granplate.paper.statements` judged on the result Datasets
 (one Check per statement: the paper's value, ours, their ratio, the verdict and the
@@ -62,7 +62,7 @@ RUN_HEADER = ["run", "t_end [ms]", "E_shock [J]", "plate peak", "plate at t_end"
 # --------------------------------------------------------------------------------------
 # Rendering
 # --------------------------------------------------------------------------------------
-#: The paper's qualitative conclusions (issue 3, "done means") and the rows that show them.
+#: The paper's qualitative conclusions and the rows that show them.
 CONCLUSIONS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("With granules, the max von Mises stress and the energy put in are far below the bare plate's",
      ("vm_reduction", "energy_reduction")),
@@ -119,7 +119,7 @@ def build_report(
              + (f" (this reproduce took {seconds:.0f} s; each run's own wall time is in the run table)"
                 if seconds is not None else "") + ". "
              f"{n_ok} of {len(judged)} judged statements hold. Every 'ours' value below is computed from the "
-             f"result files by `granplate.report`; the paper's values are from its text (MODEL.md section 8).")
+             f"result files by `granplate.report`; the paper's values are from its text (docs/model.md section 8).")
     if t_ends and max(t_ends) < 2e-3 * 0.999:
         intro += (f" **The runs were shortened (t_end = {max(t_ends) * 1e3:.3g} ms instead of 2 ms): the "
                   f"comparison with the paper is not meaningful.**")

@@ -1,5 +1,5 @@
 """The paper's statements as data: what it says, where, its value, how ours is measured
-and the criterion that judges it (MODEL.md section 8).
+and the criterion that judges it (docs/model.md section 8).
 
 Each `Statement` is one record; `judge(statement, results)` turns it into a
 granplate.results.criteria.Check with our value, computed from the result Datasets
@@ -289,7 +289,7 @@ def judge(s: Statement, results: Results) -> Check:
 
 
 def statements(results: Results) -> list[Check]:
-    """The comparison table (MODEL.md section 8) computed from the result datasets.
+    """The comparison table (docs/model.md section 8) computed from the result datasets.
 
     results: preset name -> Dataset. A statement whose runs are missing shows
     "not run" with no verdict; the plate-share rows appear for the runs given that have

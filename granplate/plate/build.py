@@ -172,7 +172,7 @@ class PlateModel:
         return plane_stresses(self.D, *self.strains(q))
 
     def von_mises(self, q: np.ndarray) -> np.ndarray:
-        """Plane-stress von Mises stress [Pa] (MODEL.md eq. 12) at the Gauss points.
+        """Plane-stress von Mises stress [Pa] (docs/model.md section 4.4, eq. 12) at the Gauss points.
 
         sqrt(sxx^2 - sxx syy + syy^2 + 3 sxy^2), shape (..., n_elem, n_qp).
         """

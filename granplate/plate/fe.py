@@ -1,4 +1,4 @@
-"""Plane-stress Q8 finite elements of the plate: mesh, basis, K and M, nodes (MODEL.md section 4).
+"""Plane-stress Q8 finite elements of the plate: mesh, basis, K and M, nodes (docs/model.md section 4).
 
 The plate occupies x in [x0, x0 + width], y in [y0, y0 + height] and is meshed with
 8-node serendipity quadrilaterals (scikit-fem `ElementVector(ElementQuadS2())` on

@@ -1,7 +1,7 @@
 """Stress recovery of the plate: plane-stress D, strains and stresses at the Gauss points.
 
 Strains are (eps_xx, eps_yy, gamma_xy) with gamma_xy the engineering shear strain [-];
-stresses (sigma_xx, sigma_yy, tau_xy) [Pa]; von Mises of plane stress is MODEL.md eq. 12.
+stresses (sigma_xx, sigma_yy, tau_xy) [Pa]; von Mises of plane stress is docs/model.md section 4.4, eq. 12.
 """
 from __future__ import annotations
 

@@ -23,7 +23,7 @@ class Material:
         return self.E / (1.0 - self.nu**2)
 
 
-#: Built-in material library (MODEL.md section 2).
+#: Built-in material library (docs/model.md section 2).
 LIBRARY: dict[str, Material] = {
     "steel": Material("steel", E=200e9, nu=0.30, rho=7850.0),
     "ptfe": Material("ptfe", E=0.54e9, nu=0.42, rho=2150.0),

@@ -2,7 +2,7 @@
 assembly, and forces equal to minus the gradient of the contact energies.
 
 The energy residual (E_p + E_g + D - E_shock - E_0) / max(E_in) is an output of every run
-(MODEL.md section 7). It is a discretisation error, so besides its size we check that it
+(docs/model.md section 7). It is a discretisation error, so besides its size we check that it
 shrinks when the step is halved: a term missing from the bookkeeping would leave a
 residual that does not.
 """
@@ -63,7 +63,7 @@ def energy_residual(ctx: Context) -> CaseResult:
         # the default (implicit) scheme: its step control holds the residual's growth
         r_imp = _residual(simulate_short(preset(name)))
         checks.append(Check(f"max |energy residual|, {name}, 50 µs, implicit scheme", "-", 0.0,
-                            "exact balance E_p + E_g + D = E_shock (MODEL.md sec. 7)", r_imp,
+                            "exact balance E_p + E_g + D = E_shock (docs/model.md section 7)", r_imp,
                             IMPLICIT_RESIDUAL_TOL, IMPLICIT_RESIDUAL_WHY, kind="max"))
         # the paper scheme: size and order under step halving
         s = with_changes(preset(name), {"solver.scheme": "paper"})
@@ -81,7 +81,7 @@ def energy_residual(ctx: Context) -> CaseResult:
                                 "round-off accumulates (10 eps per step).", kind="max"))
             continue
         checks.append(Check(f"max |energy residual|, {name}, 50 µs", "-", 0.0,
-                            "exact balance E_p + E_g + D = E_shock (MODEL.md sec. 7)", r1,
+                            "exact balance E_p + E_g + D = E_shock (docs/model.md section 7)", r1,
                             RESIDUAL_TOL, RESIDUAL_WHY, kind="max"))
         checks.append(Check(f"observed order of the residual, {name}, h -> h/2", "-", 1.0,
                             "consistency: the residual vanishes as h -> 0", observed_order(r1, r2),
@@ -95,7 +95,7 @@ def energy_residual(ctx: Context) -> CaseResult:
             summ = study_run(ctx, with_changes(preset(name), {"solver.scheme": "paper"}))
             full_rows.append((name, summ))
             checks.append(Check(f"max |energy residual|, {name}, full 2 ms run", "-", 0.0,
-                                "exact balance E_p + E_g + D = E_shock (MODEL.md sec. 7)",
+                                "exact balance E_p + E_g + D = E_shock (docs/model.md section 7)",
                                 summ["energy_residual_max"], RESIDUAL_TOL, RESIDUAL_WHY, kind="max"))
     fig, axes = new_figure()
     ax = axes[0, 0]
@@ -151,7 +151,7 @@ def friction_couple(model, y: np.ndarray) -> tuple[float, float, float]:
     """At state y: (dL/dt from granular_rhs, -sum f delta over the pairs, torque scale).
 
     dL/dt = sum m (x a_y - y a_x) + I alpha about the origin (velocity terms cancel). With the
-    MODEL.md torques (arm R on each granule) a frictional pair leaves the couple
+    default torques of docs/model.md section 3.2 (arm R on each granule) a frictional pair leaves the couple
     f (d - R_i - R_j) = -f delta, so dL/dt = -sum_pairs f delta.
     """
     from granplate.solver import kernels as K
@@ -208,7 +208,7 @@ def free_assembly(ctx: Context) -> CaseResult:
     L_drift = float(np.abs(L - L[0]).max() / Ls)
     checks.append(Check("angular momentum drift / scale, with friction (mu = 0.3), "
                         "contact.torque_arm = contact_point", "-", 0.0,
-                        "issue 4: conserved to round-off", L_drift, tol, roundoff_why, kind="max"))
+                        "conserved to round-off", L_drift, tol, roundoff_why, kind="max"))
     model = build_model(s_fric)
     ds = runs["friction"]
     state = np.stack([ds[k].values for k in ("x", "y", "theta", "vx", "vy", "omega")], axis=-1)
@@ -220,7 +220,7 @@ def free_assembly(ctx: Context) -> CaseResult:
         if scale > 0:
             worst = max(worst, abs(dL - couple) / scale)
     checks.append(Check("dL/dt + sum f delta, every output, / sum of torque terms", "-", 0.0,
-                        "MODEL.md eq. (1): torque arm R leaves the couple -f delta per pair", worst,
+                        "eq. (1), docs/model.md section 3.1: torque arm R leaves the couple -f delta per pair", worst,
                         100 * EPS, "both sides evaluated at the same state: round-off of a sum of "
                         "~20 terms (100 eps).", kind="max"))
     L_fric = mom["friction"][2]
@@ -245,7 +245,7 @@ def free_assembly(ctx: Context) -> CaseResult:
             "momentum sum m v and angular momentum about the origin sum m (x v_y - y v_x) + I "
             "omega are evaluated at every output (1 µs).")
     notes = [
-        "With the torques of the paper's eq. (1) (MODEL.md section 3, the default "
+        "With the torques of the paper's eq. (1) (docs/model.md section 3, the default "
         "contact.torque_arm = radius) angular momentum is not conserved when friction acts: "
         "friction acts on each sphere with arm R_i, "
         "but the two arms add up to R_i + R_j = d + delta, not to the centre distance d, so every "

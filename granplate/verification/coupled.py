@@ -24,7 +24,7 @@ import numpy as np
 
 from .base import Case, CaseResult, Check, Context, new_figure, save_figure
 
-#: Presets studied (issue 4: the PTFE and the steel R2 = R1 cases).
+#: Presets studied (the PTFE and the steel R2 = R1 cases).
 PRESETS: tuple[str, ...] = ("ptfe-r05", "steel-r1")
 #: (summary key, label, unit, scale to the unit).
 QUANTITIES: tuple[tuple[str, str, str, float], ...] = (
@@ -272,7 +272,7 @@ def coupled_convergence(ctx: Context) -> CaseResult:
         "the default 4 x 40 mesh is 10-20% below the refined value: that is its error bar. The "
         "final share at 2 ms (after many reflections in the plate) is not mesh-converged for "
         "either preset.",
-        "The rigid-layer width is a model parameter (MODEL.md section 4), not a discretisation: "
+        "The rigid-layer width is a model parameter (docs/model.md section 4), not a discretisation: "
         "it changes the PTFE peak share from -42% to +61% around the default, the steel one by "
         "only 1%.",
     ]

@@ -238,7 +238,7 @@ def chung_ooi_2(ctx: Context) -> CaseResult:
             "(E = 70 GPa, nu = 0.33, rho = 2699 kg/m^3) and magnesium alloy (E = 45 GPa, "
             "nu = 0.35, rho = 1800 kg/m^3), Chung & Ooi (2011) test 2. Scenario files "
             "`chung-ooi-2-aluminium.toml`, `chung-ooi-2-magnesium.toml`; h = 0.4 µs (about "
-            "t_c/1800). Against a rigid wall E* = E/(1 - nu^2), R* = R, m* = m (MODEL.md "
+            "t_c/1800). Against a rigid wall E* = E/(1 - nu^2), R* = R, m* = m (docs/model.md "
             "section 3).")
     return CaseResult("", "", "", desc, checks, fig)
 
@@ -579,7 +579,7 @@ def striker_chain(ctx: Context) -> CaseResult:
         Check("solitary-wave speed V_s, striker 1 m/s", "m/s", v_lw,
               "Nesterenko (2001), long-wave: V_s = (16/25)^(1/5) c0^(4/5) v_m^(1/5), v_m ours",
               r1["V"], 0.02,
-              "2%, as asked by issue 4: the discrete wave is known to run about 1% slower than the "
+              "2%, the discrete wave is known to run about 1% slower than the "
               "long-wave (continuum) compacton of the same amplitude; the independent discrete "
               "solution below gives that offset exactly."),
         Check("solitary-wave speed V_s, striker 1 m/s", "m/s", r1["V_ref"],
