@@ -403,3 +403,13 @@ def test_short_run_of_a_small_hexagonal_protector_balances_energy():
     ds = simulate(s, t_end=2e-5, progress=False)
     assert float(ds.E_shock[-1]) > 0
     assert float(np.abs(ds.energy_residual_max).max()) < 1e-4
+
+
+def test_every_layout_field_is_documented():
+    """docs/scenario.md has a table row for every field of every layout kind and of the imperfections."""
+    from granplate.setup.scenario import LAYOUT_KINDS
+
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "scenario.md").read_text()
+    for cls in {*LAYOUT_KINDS.values(), Imperfections}:
+        for f in dataclasses.fields(cls):
+            assert f"| `{f.name}` |" in doc, (cls.__name__, f.name)
