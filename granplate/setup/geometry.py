@@ -22,7 +22,7 @@ import math
 
 from granplate.errors import ScenarioError
 from granplate.setup import layouts
-from granplate.setup.scenario import Granule, Layout, Scenario, Wall
+from granplate.setup.scenario import ChainLayout, Granule, LatticeLayout, Layout, Scenario, Wall
 
 #: Labels of the paper's granules, in the order `paper_layout` returns them.
 PAPER_LABELS: tuple[str, ...] = ("1", "2", "3", "4", "5", "6", "7", "8", "9",
@@ -78,7 +78,7 @@ def paper_layout(layout: Layout) -> tuple[tuple[Granule, ...], tuple[Wall, ...],
     return tuple(granules), walls, xp
 
 
-def layout_packing(layout) -> layouts.Packing:
+def layout_packing(layout: Layout | LatticeLayout | ChainLayout) -> layouts.Packing:
     """The packing of any layout kind (paper, hexagonal, square, chain), imperfections applied."""
     if layout.kind == "paper":
         granules, walls, xp = paper_layout(layout)

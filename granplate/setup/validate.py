@@ -25,8 +25,8 @@ from scipy.spatial import cKDTree
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import layout_packing, resolve
 from granplate.setup.layouts import column_radii, half_pitch, hexagonal_offsets, lattice_sites
-from granplate.setup.scenario import (LAYOUT_KINDS, SQRT2_MINUS_1, ChainLayout, Imperfections,
-                                      LatticeLayout, Layout, Plate, Scenario)
+from granplate.setup.scenario import (LAYOUT_KINDS, SQRT2_MINUS_1, ChainLayout, Granule,
+                                      Imperfections, LatticeLayout, Layout, Plate, Scenario)
 
 #: Lever arms of the friction torque (Contact.torque_arm).
 TORQUE_ARMS: tuple[str, ...] = ("radius", "contact_point")
@@ -213,7 +213,7 @@ def _check_chain_layout(s: Scenario, lay: ChainLayout) -> None:
         _finite("layout.y", lay.y)
 
 
-def _check_imperfections(imp: Imperfections, sites) -> None:
+def _check_imperfections(imp: Imperfections, sites: tuple[Granule, ...]) -> None:
     p = "layout.imperfections"
     _int_at_least(f"{p}.seed", imp.seed, 0)
     for f in ("radius_spread", "jitter", "vacancy_fraction"):
@@ -262,7 +262,7 @@ def _check_granules(s: Scenario) -> None:
                 f"{OVERLAP_RTOL:g} x the smaller radius)")
 
 
-def _close_pairs(gs) -> list[tuple[int, int]]:
+def _close_pairs(gs: tuple[Granule, ...]) -> list[tuple[int, int]]:
     """Sorted pairs (i < j) of granules whose centres are at most 2 R_max apart (k-d tree):
     every pair that can overlap, found in O(N log N)."""
     if len(gs) < 2:
