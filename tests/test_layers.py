@@ -23,7 +23,7 @@ LAYERS = (
     ("paper",),
     ("verification",),
     ("bench",),
-    ("cli",),
+    ("cli", "commands"),
 )
 RANK = {name: rank for rank, names in enumerate(LAYERS) for name in names}
 

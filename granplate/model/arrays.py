@@ -83,14 +83,9 @@ def _granule_arrays(s: Scenario):
 def find_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: float) -> np.ndarray:
     """Potential granule-granule contacts: pairs whose initial surface gap is at most
     gap_ratio * min(R_i, R_j) (the topology is fixed, MODEL.md section 1)."""
-    out = []
-    n = len(x)
-    for i in range(n):
-        for j in range(i + 1, n):
-            gap = math.hypot(x[j] - x[i], y[j] - y[i]) - r[i] - r[j]
-            if gap <= gap_ratio * min(r[i], r[j]):
-                out.append((i, j))
-    return np.array(out, np.int64).reshape(-1, 2)
+    from granplate.model.neighbours import contact_pairs
+
+    return contact_pairs(x, y, r, gap_ratio)
 
 
 def find_wall_contacts(s: Scenario, x, y, r) -> np.ndarray:

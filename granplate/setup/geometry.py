@@ -1,7 +1,8 @@
-"""The paper's three-column packing and scenario resolution (MODEL.md section 1).
+"""The paper's three-column packing and scenario resolution (docs/model.md section 1).
 
 `paper_layout` turns a `Layout` into the 14 granules (1..5, intruders 6..9, A..E), the
-left, bottom and top walls and the x position of the plate's left edge. `resolve` turns
+left, bottom and top walls and the x position of the plate's left edge; the other layout
+kinds are built in `layouts` and `layout_packing` picks the kind. `resolve` turns
 any scenario into an explicit one: the layout expanded, the plate placed, every granule
 and wall labelled.
 
@@ -20,7 +21,8 @@ import dataclasses
 import math
 
 from granplate.errors import ScenarioError
-from granplate.setup.scenario import Granule, Layout, Scenario, Wall
+from granplate.setup import layouts
+from granplate.setup.scenario import ChainLayout, Granule, LatticeLayout, Layout, Scenario, Wall
 
 #: Labels of the paper's granules, in the order `paper_layout` returns them.
 PAPER_LABELS: tuple[str, ...] = ("1", "2", "3", "4", "5", "6", "7", "8", "9",
@@ -76,6 +78,20 @@ def paper_layout(layout: Layout) -> tuple[tuple[Granule, ...], tuple[Wall, ...],
     return tuple(granules), walls, xp
 
 
+def layout_packing(layout: Layout | LatticeLayout | ChainLayout) -> layouts.Packing:
+    """The packing of any layout kind (paper, hexagonal, square, chain), imperfections applied."""
+    if layout.kind == "paper":
+        granules, walls, xp = paper_layout(layout)
+        packing = layouts.Packing(granules, walls, xp, PAPER_LABELS[:5])
+    elif layout.kind == "chain":
+        packing = layouts.chain_packing(layout)
+    else:
+        packing = layouts.lattice_packing(layout)
+    if layout.imperfections is not None:
+        packing = layouts.imperfect(packing, layout.imperfections)
+    return packing
+
+
 def default_granule_label(index: int) -> str:
     """The label `resolve` gives an unlabelled granule at 0-based position `index`."""
     return f"g{index}"
@@ -89,8 +105,10 @@ def default_wall_label(index: int) -> str:
 def resolve(scenario: Scenario) -> Scenario:
     """An equivalent, explicit scenario: layout expanded, plate placed, labels filled.
 
-    - With a `layout`: granules and walls come from `paper_layout`, `layout` becomes None,
-      and a plate with `x0 = None` is placed at the layout's xp. A layout together with
+    - With a `layout`: granules and walls come from `layout_packing` (any kind),
+      `layout` becomes None, and a plate with `x0 = None` is placed at the layout's xp.
+      With imperfections and an empty `load.granules`, the load is given column 1's labels
+      (the leftmost-surface rule would pick one granule of a polydisperse column). A layout together with
       explicit granules or walls is a ScenarioError (give one or the other).
     - Without a layout, a plate needs an explicit `x0` (ScenarioError otherwise).
     - Unlabelled granules get the label "g<i>", unlabelled walls "w<i>" (i: 0-based index).
@@ -98,7 +116,7 @@ def resolve(scenario: Scenario) -> Scenario:
     Idempotent: resolving a resolved scenario returns an equal scenario. Range checks are
     `validate`'s job; this function only builds.
     """
-    granules, walls, plate = scenario.granules, scenario.walls, scenario.plate
+    granules, walls, plate, load = scenario.granules, scenario.walls, scenario.plate, scenario.load
     if scenario.layout is not None:
         if granules:
             raise ScenarioError("granules", f"{len(granules)} granules",
@@ -107,9 +125,11 @@ def resolve(scenario: Scenario) -> Scenario:
             raise ScenarioError("walls", f"{len(walls)} walls",
                                 "give either [layout] or [[walls]], not both "
                                 "(the layout generates the left, bottom and top walls)")
-        granules, walls, xp = paper_layout(scenario.layout)
+        granules, walls, xp, column1 = layout_packing(scenario.layout)
         if plate is not None and plate.x0 is None:
             plate = dataclasses.replace(plate, x0=xp)
+        if scenario.layout.imperfections is not None and not load.granules:
+            load = dataclasses.replace(load, granules=column1)
     if plate is not None and plate.x0 is None:
         raise ScenarioError("plate.x0", None,
                             "must be given when the scenario has no [layout] "
@@ -119,4 +139,4 @@ def resolve(scenario: Scenario) -> Scenario:
     walls = tuple(w if w.label else dataclasses.replace(w, label=default_wall_label(i))
                   for i, w in enumerate(walls))
     return dataclasses.replace(scenario, layout=None, granules=granules, walls=walls,
-                               plate=plate)
+                               plate=plate, load=load)

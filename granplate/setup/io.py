@@ -26,8 +26,8 @@ import tomli_w
 
 from granplate.errors import ScenarioError
 from granplate.setup.materials import LIBRARY, Material
-from granplate.setup.scenario import (Contact, Granule, Layout, Load, PairCoefficients, Plate, Scenario,
-                       Solver, TimeSettings, Wall)
+from granplate.setup.scenario import (LAYOUT_KINDS, Contact, Granule, Layout, Load, PairCoefficients,
+                                      Plate, Scenario, Solver, TimeSettings, Wall)
 
 #: Fields that a table must give (everything else takes the dataclass default).
 REQUIRED: dict[type, tuple[str, ...]] = {
@@ -167,9 +167,20 @@ def _materials(d: Any) -> dict[str, Material]:
 
 
 _TOP_TABLES: dict[str, type] = {
-    "layout": Layout, "plate": Plate, "load": Load, "contact": Contact,
+    "plate": Plate, "load": Load, "contact": Contact,
     "time": TimeSettings, "solver": Solver,
 }
+
+
+def _layout(d: Any) -> Any:
+    """The [layout] table as the dataclass of its `kind` (absent kind: "paper")."""
+    if not isinstance(d, dict):
+        raise ScenarioError("layout", d, "wrong type: expected a table")
+    kind = d.get("kind", "paper")
+    if kind not in LAYOUT_KINDS:
+        raise ScenarioError("layout.kind", kind, "must be one of "
+                            + ", ".join(repr(k) for k in LAYOUT_KINDS))
+    return _table("layout", d, LAYOUT_KINDS[kind])
 
 
 def from_dict(d: dict) -> Scenario:
@@ -186,6 +197,8 @@ def from_dict(d: dict) -> Scenario:
             kw[key] = _convert(key, d[key], str)
     if d.get("materials") is not None:
         kw["materials"] = _materials(d["materials"])
+    if d.get("layout") is not None:
+        kw["layout"] = _layout(d["layout"])
     for key, cls in _TOP_TABLES.items():
         if d.get(key) is not None:
             kw[key] = _table(key, d[key], cls)
@@ -216,12 +229,32 @@ def _plain(value: Any) -> Any:
 def _used_materials(s: Scenario) -> set[str]:
     used = {g.material for g in s.granules} | {w.material for w in s.walls}
     if s.layout is not None:
-        used |= {s.layout.heavy_material, s.layout.intruder_material, s.layout.wall_material}
+        used |= _layout_materials(s.layout)
     if s.plate is not None:
         used.add(s.plate.material)
     for p in s.contact.pairs:
         used |= set(p.materials)
     return used
+
+
+def _layout_materials(layout: Any) -> set[str]:
+    """Every material name a layout's fields give (fields named *material or *materials)."""
+    used: set[str] = set()
+    for f in dataclasses.fields(layout):
+        v = getattr(layout, f.name)
+        if f.name.endswith("material") and isinstance(v, str):
+            used.add(v)
+        elif f.name.endswith("materials") and isinstance(v, tuple):
+            used |= {m for m in v if isinstance(m, str)}
+    return used
+
+
+def _layout_dict(layout: Any) -> dict:
+    """[layout] as a dict; `kind` left out for the paper's packing (its default)."""
+    d = _plain(layout)
+    if d.get("kind") == "paper":
+        del d["kind"]
+    return d
 
 
 def _material_dict(m: Material) -> dict[str, float]:
@@ -243,7 +276,7 @@ def to_dict(s: Scenario, all_materials: bool = False) -> dict:
     if mats:
         d["materials"] = mats
     if s.layout is not None:
-        d["layout"] = _plain(s.layout)
+        d["layout"] = _layout_dict(s.layout)
     if s.granules:
         d["granules"] = _plain(s.granules)
     if s.walls:

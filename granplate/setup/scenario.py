@@ -1,8 +1,9 @@
 """Scenario: everything that defines a run, as frozen dataclasses (SI units throughout).
 
 A scenario is written as a TOML file (see docs/scenario.md) or built in Python. The
-paper's three-column packing is generated from a `Layout`; any other planar assembly is
-given granule by granule. Validation (`validate`) refuses bad input before anything runs,
+paper's three-column packing is generated from a `Layout`, hexagonal and square packings
+from a `LatticeLayout`, chains from a `ChainLayout`; any other planar assembly is given
+granule by granule. Validation (`validate`) refuses bad input before anything runs,
 with a `ScenarioError` naming the field, the value and what is allowed.
 """
 from __future__ import annotations
@@ -47,11 +48,35 @@ class Wall:
 
 
 @dataclass(frozen=True)
+class Imperfections:
+    """Seeded imperfections of a generated packing (any layout kind), `[layout.imperfections]`.
+
+    Every granule stays inside the disc of its perfect site (radius R at the perfect centre),
+    so nothing overlaps and nothing crosses a wall or the plate; the packing becomes loose.
+    seed: numpy.random.default_rng(seed), integer >= 0; radius_spread [-]: radii uniform in
+    [R (1 - jitter - radius_spread), R (1 - jitter)]; jitter [-]: each granule shrunk by
+    jitter R and its centre moved uniformly within a disc of radius jitter R;
+    radius_spread + jitter < 1. vacancy_fraction [-]: round(fraction x sites) sites
+    removed at random, in [0, 1); vacancies: labels of sites removed as well.
+    Contacts are only the pairs whose gap at t = 0 is within contact.neighbour_gap x the
+    smaller radius: wider gaps never interact (raise neighbour_gap to keep them).
+    """
+
+    seed: int = 0
+    radius_spread: float = 0.0
+    jitter: float = 0.0
+    vacancy_fraction: float = 0.0
+    vacancies: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
 class Layout:
-    """The paper's packing (MODEL.md section 1): columns 1..5, intruders 6..9, A..E.
+    """The paper's packing (docs/model.md section 1): columns 1..5, intruders 6..9, A..E.
 
     R1: heavy-granule radius [m]; R2_ratio = R2 / R1 in [sqrt(2) - 1, 1].
     Generates the 14 granules, the left, bottom and top walls and the plate's x position.
+    kind: "paper" (the default, not written to TOML); imperfections: None (perfect) or
+    seeded imperfections.
     """
 
     R1: float = 0.01
@@ -59,13 +84,81 @@ class Layout:
     heavy_material: str = "steel"
     intruder_material: str = "steel"
     wall_material: str = "steel"
+    kind: str = "paper"
+    imperfections: Imperfections | None = None
+
+
+@dataclass(frozen=True)
+class LatticeLayout:
+    """A hexagonal or square packing of vertical columns, `kind = "hexagonal"` or `"square"`.
+
+    Columns are numbered 1..columns from the loaded side (x increasing), rows 1..rows from
+    the top; odd columns of a hexagonal packing hold `rows` granules, even ones rows - 1
+    (shifted by half a pitch), a square packing `rows` in every column. Neighbours touch:
+    the vertical pitch is 2 a with a = the largest column radius, and the column offsets
+    are sqrt((R_c + R_c+1)^2 - a^2) (hexagonal) or R_c + R_c+1 (square). Walls left,
+    bottom, top enclose the packing; the plate is placed against the rightmost surface.
+
+    radius [m], material: every column's, unless column_radii / column_materials (one per
+    column) are given. intruder_columns: whole columns whose radius is intruder_ratio x the
+    column's radius (the offsets follow, as the paper's column 2); intruder_sites (labels
+    "c{column}r{row}") and intruder_every = n (every n-th site in granule order, 0 = none):
+    single sites whose granule is intruder_ratio (<= 1) x the site's radius, at its centre
+    (loose when < 1). Intruders take intruder_material (None = material).
+    """
+
+    kind: str = "hexagonal"
+    columns: int = 3
+    rows: int = 5
+    radius: float = 0.01
+    material: str = "steel"
+    column_radii: tuple[float, ...] = ()
+    column_materials: tuple[str, ...] = ()
+    intruder_ratio: float = 1.0
+    intruder_material: str | None = None
+    intruder_columns: tuple[int, ...] = ()
+    intruder_sites: tuple[str, ...] = ()
+    intruder_every: int = 0
+    wall_material: str = "steel"
+    imperfections: Imperfections | None = None
+
+
+@dataclass(frozen=True)
+class ChainLayout:
+    """A horizontal chain of touching spheres along y = y (default: the largest radius).
+
+    Granule k = 1..count ("c{k}", from the loaded side) has radius radius x taper^(k-1),
+    times dimer_ratio and with dimer_material (None = material) when k is even (a dimer
+    chain); decorated_ratio > 0 puts a small granule "d{k}" of radius decorated_ratio x
+    R_k (decorated_material, None = material) between granules k and k + 1.
+    One wall, `left`, touches granule 1; the plate is placed against the last granule.
+    """
+
+    kind: str = "chain"
+    count: int = 10
+    radius: float = 0.01
+    material: str = "steel"
+    taper: float = 1.0
+    dimer_ratio: float = 1.0
+    dimer_material: str | None = None
+    decorated_ratio: float = 0.0
+    decorated_material: str | None = None
+    y: float | None = None
+    wall_material: str = "steel"
+    imperfections: Imperfections | None = None
+
+
+#: `[layout] kind` -> the dataclass that holds that kind's fields.
+LAYOUT_KINDS: dict[str, type] = {
+    "paper": Layout, "hexagonal": LatticeLayout, "square": LatticeLayout, "chain": ChainLayout,
+}
 
 
 @dataclass(frozen=True)
 class Plate:
-    """The elastic plate (plane stress, Q8 elements), MODEL.md section 4.
+    """The elastic plate (plane stress, Q8 elements), docs/model.md section 4.
 
-    x0, y0: lower-left corner [m] (x0 = None: placed against the layout's column 3);
+    x0, y0: lower-left corner [m] (x0 = None: placed against the layout's last column);
     width (along x) and height (along y) [m]; thickness [m]; nx, ny: elements along x, y;
     rigid_layer_width: w [m] (None = one element edge along y); clamped_edges: subset of
     {"top", "bottom", "left", "right"}; n_modes: number of modes kept (0 = all, which is
@@ -97,7 +190,7 @@ class Plate:
 
 @dataclass(frozen=True)
 class Load:
-    """The half-sine shock of MODEL.md section 5.
+    """The half-sine shock of docs/model.md section 5.
 
     q(y, t) = q0 sin(pi t / T) sin(pi (y - y0) / L) on 0 <= t <= T, y0 <= y <= y0 + L.
     kind: "line" or "none"; target: "granules" (push +x on the left surface of the
@@ -127,14 +220,14 @@ class PairCoefficients:
 
 @dataclass(frozen=True)
 class Contact:
-    """Contact-law coefficients (MODEL.md sections 2-3).
+    """Contact-law coefficients (docs/model.md sections 2-3).
 
     mu: Coulomb coefficient [-]; k_s: tanh smoothing [s/m]; alpha_n: damping coefficient
     [-] of eq. (3) for pairs not listed in `pairs`; clip_tensile: the normal force never
-    pulls (True, MODEL.md) or the paper's raw eq. (2) (False); neighbour_gap: pairs whose
+    pulls (True, docs/model.md section 3.2) or the paper's raw eq. (2) (False); neighbour_gap: pairs whose
     initial surface gap is at most this fraction of the smaller radius are potential
     contacts (the topology is fixed); torque_arm: lever arm of the friction torque,
-    "radius" (R_i, MODEL.md and paper eq. 1) or "contact_point" (R_i - delta/2 for a
+    "radius" (R_i, paper eq. 1, docs/model.md section 3.2) or "contact_point" (R_i - delta/2 for a
     pair, R_i - delta at a wall or plate: the true contact point, which conserves the
     angular momentum of a free assembly; with "radius" each sliding pair adds a couple
     -f delta). The slip rate uses the same arms, so the friction power stays f v_t.
@@ -179,7 +272,7 @@ class TimeSettings:
 
 @dataclass(frozen=True)
 class Solver:
-    """Coupling solver settings (MODEL.md section 6).
+    """Coupling solver settings (docs/model.md section 6).
 
     scheme: "implicit" (default: Newton on the interface forces with the plate-contact
     friction held over the step, plate modes integrated exactly, step from an error
@@ -213,7 +306,7 @@ class Scenario:
     name: str = "custom"
     description: str = ""
     materials: dict[str, Material] = field(default_factory=lambda: dict(LIBRARY))
-    layout: Layout | None = None
+    layout: Layout | LatticeLayout | ChainLayout | None = None
     granules: tuple[Granule, ...] = ()
     walls: tuple[Wall, ...] = ()
     plate: Plate | None = None

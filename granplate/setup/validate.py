@@ -14,15 +14,19 @@ reduced dofs. The plate layer itself only checks the internal consistency of its
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import numbers
 from typing import Any
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from granplate.errors import ScenarioError
-from granplate.setup.geometry import resolve
-from granplate.setup.scenario import SQRT2_MINUS_1, Plate, Scenario
+from granplate.setup.geometry import layout_packing, resolve
+from granplate.setup.layouts import column_radii, half_pitch, hexagonal_offsets, lattice_sites
+from granplate.setup.scenario import (LAYOUT_KINDS, SQRT2_MINUS_1, ChainLayout, Granule,
+                                      Imperfections, LatticeLayout, Layout, Plate, Scenario)
 
 #: Lever arms of the friction torque (Contact.torque_arm).
 TORQUE_ARMS: tuple[str, ...] = ("radius", "contact_point")
@@ -104,6 +108,23 @@ def _check_layout(s: Scenario) -> None:
     lay = s.layout
     if lay is None:
         return
+    _string_in("layout.kind", lay.kind, tuple(LAYOUT_KINDS))
+    if not isinstance(lay, LAYOUT_KINDS[lay.kind]):
+        raise ScenarioError("layout.kind", lay.kind,
+                            f"a {type(lay).__name__} must have kind one of " + ", ".join(
+                                repr(k) for k, c in LAYOUT_KINDS.items() if isinstance(lay, c)))
+    if lay.kind == "paper":
+        _check_paper_layout(s, lay)
+    elif lay.kind == "chain":
+        _check_chain_layout(s, lay)
+    else:
+        _check_lattice_layout(s, lay)
+    if lay.imperfections is not None:
+        _check_imperfections(lay.imperfections, layout_packing(
+            dataclasses.replace(lay, imperfections=None)).granules)
+
+
+def _check_paper_layout(s: Scenario, lay: Layout) -> None:
     _positive("layout.R1", lay.R1)
     r = _finite("layout.R2_ratio", lay.R2_ratio,
                 f"must be in [{SQRT2_MINUS_1:.8f}, 1] (sqrt(2)-1 <= R2/R1 <= 1)")
@@ -112,6 +133,104 @@ def _check_layout(s: Scenario) -> None:
                             f"must be in [{SQRT2_MINUS_1:.8f}, 1] (sqrt(2)-1 <= R2/R1 <= 1)")
     for f in ("heavy_material", "intruder_material", "wall_material"):
         _material_exists(f"layout.{f}", getattr(lay, f), s)
+
+
+def _list_of_columns(path: str, values: Any, columns: int) -> None:
+    if not isinstance(values, tuple) or (values and len(values) != columns):
+        raise ScenarioError(path, values, f"must be empty or a list of {columns} values "
+                            "(one per column, layout.columns)")
+
+
+def _check_lattice_layout(s: Scenario, lay: LatticeLayout) -> None:
+    _int_at_least("layout.columns", lay.columns, 1)
+    _int_at_least("layout.rows", lay.rows, 2 if lay.kind == "hexagonal" and lay.columns > 1 else 1)
+    _positive("layout.radius", lay.radius)
+    for f in ("material", "wall_material"):
+        _material_exists(f"layout.{f}", getattr(lay, f), s)
+    if lay.intruder_material is not None:
+        _material_exists("layout.intruder_material", lay.intruder_material, s)
+    _list_of_columns("layout.column_radii", lay.column_radii, lay.columns)
+    for c, r in enumerate(lay.column_radii):
+        _positive(f"layout.column_radii[{c}]", r)
+    _list_of_columns("layout.column_materials", lay.column_materials, lay.columns)
+    for c, m in enumerate(lay.column_materials):
+        _material_exists(f"layout.column_materials[{c}]", m, s)
+    _positive("layout.intruder_ratio", lay.intruder_ratio)
+    for k, c in enumerate(lay.intruder_columns):
+        if not isinstance(c, numbers.Integral) or isinstance(c, bool) or not 1 <= c <= lay.columns:
+            raise ScenarioError(f"layout.intruder_columns[{k}]", c,
+                                f"must be a column number in 1..{lay.columns} (layout.columns)")
+    _int_at_least("layout.intruder_every", lay.intruder_every, 0)
+    sites = [g.label for g in lattice_sites(dataclasses.replace(lay, intruder_columns=()))]
+    known = set(sites)
+    for k, lab in enumerate(lay.intruder_sites):
+        if lab not in known:
+            raise ScenarioError(f"layout.intruder_sites[{k}]", lab,
+                                f"no such site; sites are c1r1..c{lay.columns}r{lay.rows} "
+                                "(column, row from the top; even hexagonal columns have rows - 1)")
+    if (lay.intruder_sites or lay.intruder_every) and lay.intruder_ratio > 1.0:
+        raise ScenarioError("layout.intruder_ratio", lay.intruder_ratio,
+                            "must be in (0, 1] with intruder_sites or intruder_every "
+                            "(a single-site intruder larger than its site overlaps its neighbours)")
+    _check_column_offsets(lay)
+
+
+def _check_column_offsets(lay: LatticeLayout) -> None:
+    """Neighbouring columns reach each other, and columns c and c+2 do not overlap."""
+    radii = column_radii(lay)
+    what = "layout.column_radii" if lay.column_radii else "layout.intruder_ratio"
+    value = lay.column_radii if lay.column_radii else lay.intruder_ratio
+    if lay.kind != "hexagonal" or len(radii) < 2:
+        return
+    a = half_pitch(radii)
+    d = hexagonal_offsets(radii, a)
+    for c in range(len(radii) - 1):
+        if not radii[c] + radii[c + 1] >= a:
+            raise ScenarioError(what, value,
+                                f"columns {c + 1} and {c + 2} cannot touch: R_{c + 1} + R_{c + 2} = "
+                                f"{radii[c] + radii[c + 1]:.6g} m < the largest radius {a:.6g} m; "
+                                "allowed: R_c + R_c+1 >= max R (hexagonal packing)")
+    for c in range(len(radii) - 2):
+        gap = d[c] + d[c + 1] - radii[c] - radii[c + 2]
+        if gap < -OVERLAP_RTOL * min(radii[c], radii[c + 2]):
+            raise ScenarioError(what, value,
+                                f"columns {c + 1} and {c + 3} overlap by {-gap:.6g} m (column "
+                                f"{c + 2} too small to hold them apart); allowed: "
+                                "d_c + d_c+1 >= R_c + R_c+2 with d_c = sqrt((R_c + R_c+1)^2 - a^2), "
+                                "e.g. R_c+1 >= (sqrt(2) - 1) R_c for equal outer columns")
+
+
+def _check_chain_layout(s: Scenario, lay: ChainLayout) -> None:
+    _int_at_least("layout.count", lay.count, 1)
+    _positive("layout.radius", lay.radius)
+    _positive("layout.taper", lay.taper)
+    _positive("layout.dimer_ratio", lay.dimer_ratio)
+    _nonneg("layout.decorated_ratio", lay.decorated_ratio)
+    for f in ("material", "wall_material", "dimer_material", "decorated_material"):
+        if getattr(lay, f) is not None:
+            _material_exists(f"layout.{f}", getattr(lay, f), s)
+    if lay.y is not None:
+        _finite("layout.y", lay.y)
+
+
+def _check_imperfections(imp: Imperfections, sites: tuple[Granule, ...]) -> None:
+    p = "layout.imperfections"
+    _int_at_least(f"{p}.seed", imp.seed, 0)
+    for f in ("radius_spread", "jitter", "vacancy_fraction"):
+        v = _finite(f"{p}.{f}", getattr(imp, f), "must be in [0, 1) (a finite number)")
+        if not 0.0 <= v < 1.0:
+            raise ScenarioError(f"{p}.{f}", v, "must be in [0, 1)")
+    if not imp.radius_spread + imp.jitter < 1.0:
+        raise ScenarioError(f"{p}.jitter", imp.jitter,
+                            f"radius_spread + jitter must be < 1 (radius_spread = "
+                            f"{imp.radius_spread!r}: the smallest radius R (1 - jitter - "
+                            "radius_spread) must stay > 0)")
+    labels = {g.label for g in sites}
+    for k, lab in enumerate(imp.vacancies):
+        if lab not in labels:
+            raise ScenarioError(f"{p}.vacancies[{k}]", lab,
+                                "no such site in the perfect packing (labels such as "
+                                + ", ".join(list(g.label for g in sites)[:3]) + ", ...)")
 
 
 def _check_granules(s: Scenario) -> None:
@@ -131,18 +250,27 @@ def _check_granules(s: Scenario) -> None:
                                 f"labels must be unique; granules[{seen[g.label]}] has it too")
         seen[g.label] = i
     gs = s.granules
-    for i in range(len(gs)):
-        gi = gs[i]
-        for j in range(i + 1, len(gs)):
-            gj = gs[j]
-            dist = math.hypot(gj.x - gi.x, gj.y - gi.y)
-            overlap = gi.radius + gj.radius - dist
-            if overlap > OVERLAP_RTOL * min(gi.radius, gj.radius):
-                raise ScenarioError(
-                    f"granules[{i}]", gi.label,
-                    f"overlaps granule '{gj.label}' (granules[{j}]) by {overlap:.6g} m at t = 0; "
-                    f"granules may touch but not overlap (tolerance "
-                    f"{OVERLAP_RTOL:g} x the smaller radius)")
+    for i, j in _close_pairs(gs):
+        gi, gj = gs[i], gs[j]
+        dist = math.hypot(gj.x - gi.x, gj.y - gi.y)
+        overlap = gi.radius + gj.radius - dist
+        if overlap > OVERLAP_RTOL * min(gi.radius, gj.radius):
+            raise ScenarioError(
+                f"granules[{i}]", gi.label,
+                f"overlaps granule '{gj.label}' (granules[{j}]) by {overlap:.6g} m at t = 0; "
+                f"granules may touch but not overlap (tolerance "
+                f"{OVERLAP_RTOL:g} x the smaller radius)")
+
+
+def _close_pairs(gs: tuple[Granule, ...]) -> list[tuple[int, int]]:
+    """Sorted pairs (i < j) of granules whose centres are at most 2 R_max apart (k-d tree):
+    every pair that can overlap, found in O(N log N)."""
+    if len(gs) < 2:
+        return []
+    xy = np.array([(g.x, g.y) for g in gs], float)
+    r_max = max(g.radius for g in gs)
+    pairs = cKDTree(xy).query_pairs(2.0 * r_max * (1.0 + 1e-9), output_type="ndarray")
+    return sorted(map(tuple, pairs.tolist()))
 
 
 def _check_walls(s: Scenario) -> None:

@@ -1,0 +1,66 @@
+"""Neighbour search at t = 0: the potential granule-granule contacts in O(N).
+
+A pair (i, j) is a potential contact when its initial surface gap is at most
+gap_ratio * min(R_i, R_j) (docs/model.md section 1, the topology is fixed):
+
+    |c_j - c_i| - R_i - R_j <= gap_ratio * min(R_i, R_j)
+
+`contact_pairs` finds them with a k-d tree (scipy.spatial.cKDTree.query_pairs): every
+such pair has centres at most 2 R_max + gap_ratio R_max apart, so the tree returns a
+superset of candidates in O(N log N) for packings of bounded size ratio, and the exact
+test above (the same floating-point expression as the O(N^2) double loop,
+`brute_force_pairs`) picks the pairs. The result is sorted (i, j), i < j: identical to
+the double loop's.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+#: Relative margin on the k-d tree's search distance, so that rounding never drops a pair
+#: that the exact test would keep.
+SEARCH_MARGIN = 1e-9
+
+
+def is_contact(dx: float, dy: float, ri: float, rj: float, gap_ratio: float) -> bool:
+    """True when the surface gap |(dx, dy)| - R_i - R_j [m] is at most gap_ratio min(R_i, R_j)."""
+    return math.hypot(dx, dy) - ri - rj <= gap_ratio * min(ri, rj)
+
+
+def brute_force_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: float) -> np.ndarray:
+    """(n_pairs, 2) potential contacts by the O(N^2) double loop (the reference)."""
+    n = len(x)
+    out = [(i, j) for i in range(n) for j in range(i + 1, n)
+           if is_contact(x[j] - x[i], y[j] - y[i], r[i], r[j], gap_ratio)]
+    return np.array(out, np.int64).reshape(-1, 2)
+
+
+def search_distance(r: np.ndarray, gap_ratio: float) -> float:
+    """Largest centre distance [m] of a potential contact: (2 + gap_ratio) R_max, plus margin."""
+    return (2.0 + gap_ratio) * float(r.max()) * (1.0 + SEARCH_MARGIN)
+
+
+def candidate_pairs(x: np.ndarray, y: np.ndarray, distance: float) -> np.ndarray:
+    """(n, 2) sorted pairs (i < j) of centres at most `distance` [m] apart (k-d tree)."""
+    if len(x) < 2:
+        return np.zeros((0, 2), np.int64)
+    tree = cKDTree(np.column_stack([x, y]))
+    pairs = tree.query_pairs(distance, output_type="ndarray").astype(np.int64)
+    order = np.lexsort((pairs[:, 1], pairs[:, 0]))
+    return pairs[order].reshape(-1, 2)
+
+
+def contact_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: float) -> np.ndarray:
+    """(n_pairs, 2) potential contacts, sorted (i, j) with i < j, in O(N log N).
+
+    Same pairs in the same order as `brute_force_pairs`: the k-d tree gives candidates and
+    `is_contact` decides each one exactly as the double loop does.
+    """
+    x, y, r = (np.asarray(a, float) for a in (x, y, r))
+    if len(x) < 2:
+        return np.zeros((0, 2), np.int64)
+    cand = candidate_pairs(x, y, search_distance(r, gap_ratio))
+    keep = [is_contact(x[j] - x[i], y[j] - y[i], r[i], r[j], gap_ratio) for i, j in cand.tolist()]
+    return cand[np.array(keep, bool)].reshape(-1, 2)
