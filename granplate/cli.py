@@ -51,7 +51,7 @@ def format_summary(summary: dict) -> str:
 def _cmd_run(args) -> int:
     from granplate.results.dataset import summary, write
     from granplate.setup.io import load_scenario
-    from granplate.solver.driver import simulate
+    from granplate.results.run import simulate
 
     scenario = load_scenario(args.scenario)
     out = Path(args.output) if args.output else Path(f"{scenario.name}.nc")

@@ -8,8 +8,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from granplate.solver import kernels
-from granplate.physics.contact import damping_coefficient, hertz_coefficient
+from granplate.model.inputs import Config, Granular, PlateArrays, scheme_number
+from granplate.physics.contact import (
+    COEF_A, COEF_C, COEF_KS, COEF_MU, N_COEF, damping_coefficient, hertz_coefficient,
+)
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import resolve
 from granplate.physics.shock import shock_resultants
@@ -53,9 +55,9 @@ class Model:
 
     scenario: Scenario
     labels: tuple[str, ...]
-    granular: kernels.Granular
-    plate_arrays: kernels.PlateArrays
-    config: kernels.Config
+    granular: Granular
+    plate_arrays: PlateArrays
+    config: Config
     plate: object | None
     initial_state: np.ndarray
     pairs: np.ndarray
@@ -70,6 +72,14 @@ class Model:
     def contact_labels(self) -> tuple[str, ...]:
         """Labels of the plate contacts (the granule touching the plate)."""
         return tuple(self.labels[i] for i in self.plate_contacts)
+
+
+def coefficient_row(a: float, c: float, mu: float, k_s: float) -> np.ndarray:
+    """One row of pair_coef / wall_coef / pc_coef in the columns of physics.contact:
+    Hertz A [N/m^1.5], damping c, mu [-], k_s [s/m] (eqs. 3, 5)."""
+    row = np.zeros(N_COEF)
+    row[COEF_A], row[COEF_C], row[COEF_MU], row[COEF_KS] = a, c, mu, k_s
+    return row
 
 
 def _granule_arrays(s: Scenario):
@@ -142,18 +152,18 @@ def build_model(scenario: Scenario) -> Model:
     ng = len(x)
 
     pairs = find_pairs(x, y, r, s.contact.neighbour_gap)
-    pair_coef = np.zeros((len(pairs), 4))
+    pair_coef = np.zeros((len(pairs), N_COEF))
     for p, (i, j) in enumerate(pairs):
         e_star = effective_modulus(mats[i], mats[j])
         r_star = r[i] * r[j] / (r[i] + r[j])
         m_star = mass[i] * mass[j] / (mass[i] + mass[j])
         alpha, mu, ks = s.contact.for_pair(mats[i].name, mats[j].name)
         a = hertz_coefficient(e_star, r_star)
-        pair_coef[p] = (a, damping_coefficient(alpha, m_star, a), mu, ks)
+        pair_coef[p] = coefficient_row(a, damping_coefficient(alpha, m_star, a), mu, ks)
 
     wc = find_wall_contacts(s, x, y, r)
     wall_geo = np.zeros((len(wc), 3))
-    wall_coef = np.zeros((len(wc), 4))
+    wall_coef = np.zeros((len(wc), N_COEF))
     for k, (i, w) in enumerate(wc):
         wall = s.walls[w]
         nrm = np.asarray(wall.normal, float)
@@ -161,16 +171,16 @@ def build_model(scenario: Scenario) -> Model:
         wall_geo[k] = (nrm[0], nrm[1], wall.offset)
         alpha, mu, ks = s.contact.for_pair(mats[i].name, wall.material)
         a = hertz_coefficient(effective_modulus(mats[i], None), r[i])
-        wall_coef[k] = (a, damping_coefficient(alpha, mass[i], a), mu, ks)
+        wall_coef[k] = coefficient_row(a, damping_coefficient(alpha, mass[i], a), mu, ks)
 
     pc = find_plate_contacts(s, x, y, r)
-    pc_coef = np.zeros((len(pc), 4))
+    pc_coef = np.zeros((len(pc), N_COEF))
     pc_x = np.zeros(len(pc))
     for k, i in enumerate(pc):
         alpha, mu, ks = s.contact.for_pair(mats[i].name, s.plate.material)
         a = hertz_coefficient(effective_modulus(mats[i], None), r[i])
         # rigid layer: E_k, R_k -> infinity and m_k -> 0, so m* = 0 (no viscous damping)
-        pc_coef[k] = (a, damping_coefficient(alpha, 0.0, a), mu, ks)
+        pc_coef[k] = coefficient_row(a, damping_coefficient(alpha, 0.0, a), mu, ks)
         pc_x[k] = s.plate.x0
 
     loaded = loaded_granules(s, x, r)
@@ -198,16 +208,16 @@ def build_model(scenario: Scenario) -> Model:
     if phi_d.shape != (2 * nk, len(omega2)):
         phi_d = phi_d.reshape(2 * nk, len(omega2))
 
-    granular = kernels.Granular(
+    granular = Granular(
         mass=mass, inertia=inertia, radius=r, pair_ij=pairs, pair_coef=pair_coef,
         wall_i=np.ascontiguousarray(wc[:, 0]), wall_geo=wall_geo, wall_coef=wall_coef,
         pc_i=pc, pc_x=pc_x, pc_coef=pc_coef, shock_force=fres, shock_torque=tres,
     )
-    plate_arrays = kernels.PlateArrays(omega2=omega2, phi_d=phi_d, load_modal=load_modal)
+    plate_arrays = PlateArrays(omega2=omega2, phi_d=phi_d, load_modal=load_modal)
     t = s.time
     sol = s.solver
     q0 = s.load.q0 if s.load.kind == "line" else 0.0
-    config = kernels.Config(
+    config = Config(
         q0=float(q0), duration=float(s.load.duration), clip=bool(s.contact.clip_tensile),
         lambda_target=float(sol.lambda_target), rtol=float(sol.iteration_rtol),
         atol=float(sol.iteration_atol), max_iter=int(sol.max_iterations),
@@ -217,7 +227,7 @@ def build_model(scenario: Scenario) -> Model:
         out_dt=float(t.output_interval), t_end=float(t.t_end),
         load_on_plate=bool(s.load.kind == "line" and s.load.target == "plate"),
         arm_shrink=1.0 if s.contact.torque_arm == "contact_point" else 0.0,
-        scheme=kernels.SCHEME_IMPLICIT if sol.scheme == "implicit" else kernels.SCHEME_PAPER,
+        scheme=scheme_number(sol.scheme),
         error_tol=float(sol.error_tol),
         force_floor=force_floor(q0, fres, tres, r, mass, s, t.output_interval),
     )

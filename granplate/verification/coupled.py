@@ -114,7 +114,7 @@ def _vm_location(ds) -> list[float]:
 
 def study_run(ctx: Context, scenario) -> dict:
     """Summary of a full run of `scenario`, from the cache when there."""
-    from granplate.solver.driver import simulate as run
+    from granplate.results.run import simulate as run
     from granplate.results.dataset import summary
 
     key = cache_key(scenario)

@@ -1,0 +1,62 @@
+"""The granule-plate interface inside a step, shared by every scheme: the first guess
+of the interface forces, their convergence test, and criterion (8) at the contacts.
+"""
+from __future__ import annotations
+
+from numba import njit
+
+from granplate.physics.contact import COEF_KS, COEF_MU, local_map_modulus
+
+
+@njit(cache=True)
+def first_guess(ratio, st, w):
+    """Interface forces extrapolated linearly from the last two steps into w.fguess
+    (ratio = h / h_last); every contact's convergence mark is cleared."""
+    for d in range(w.fguess.shape[0]):
+        w.fguess[d] = st.force[d] + ratio * (st.force[d] - st.force_prev[d])
+    for k in range(w.conv_iter.shape[0]):
+        w.conv_iter[k] = 0
+
+
+@njit(cache=True)
+def forces_converged(it, cfg, w):
+    """Whether the forces at the end of the trial step (w.fnew) agree with the ones
+    the plate moved with (w.fguess) to rtol |F| + atol. Marks in w.conv_iter each
+    contact still moving at iteration `it`; returns (converged, worst contact or -1)."""
+    converged = True
+    worst = -1
+    worst_err = 0.0
+    for k in range(w.conv_iter.shape[0]):
+        for c in range(2):
+            d = 2 * k + c
+            diff = abs(w.fnew[d] - w.fguess[d])
+            if diff > cfg.rtol * abs(w.fnew[d]) + cfg.atol:
+                converged = False
+                w.conv_iter[k] = it + 1
+                if diff > worst_err:
+                    worst_err = diff
+                    worst = k
+    return converged, worst
+
+
+@njit(cache=True)
+def contact_modulus(k, h, gm, g, normal, slip):
+    """|lambda| of eq. (8) at plate contact k for step h (gm: G(h))."""
+    return local_map_modulus(g.pc_coef[k, COEF_MU], g.pc_coef[k, COEF_KS], normal[k], h,
+                             gm[2 * k + 1, 2 * k + 1], slip[k])
+
+
+@njit(cache=True)
+def accept_contacts(h, gm, st, g, w):
+    """Take the end-of-step |N| and slip rates into the state and keep the largest
+    |lambda| (eq. 8) and iteration count per contact since the last output; returns
+    the largest |lambda| of this step."""
+    lam_max = 0.0
+    for k in range(g.pc_i.shape[0]):
+        st.normal[k] = w.normal_new[k]
+        st.slip[k] = w.slip_new[k]
+        lam = contact_modulus(k, h, gm, g, st.normal, st.slip)
+        w.lam_int[k] = max(w.lam_int[k], lam)
+        w.it_int[k] = max(w.it_int[k], w.conv_iter[k] if w.conv_iter[k] > 0 else 1)
+        lam_max = max(lam_max, lam)
+    return lam_max
