@@ -5,7 +5,6 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
-
 import granplate
 
 PACKAGE = Path(granplate.__file__).parent

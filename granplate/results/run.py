@@ -13,8 +13,13 @@ from granplate.errors import SimulationError
 from granplate.model.arrays import Model, build_model
 from granplate.results.dataset import to_dataset
 from granplate.setup.scenario import Scenario
-from granplate.solver.driver import run as run_loop
+from granplate.solver.driver import INTERRUPTED_STATUS, run as run_loop
 from granplate.solver.state import OK
+
+
+def interrupted(ds) -> bool:
+    """Whether the result `ds` is that of a run stopped by the user (SIGINT/SIGTERM)."""
+    return str(ds.attrs.get("status", "")).startswith(INTERRUPTED_STATUS)
 
 
 def with_t_end(scenario: Scenario, t_end: float) -> Scenario:

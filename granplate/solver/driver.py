@@ -24,6 +24,7 @@ CHUNK_SECONDS = 0.15
 FIRST_BUDGET = 64
 #: status of a run stopped by a signal (SIGINT, SIGTERM) or a stop request.
 INTERRUPTED = -1
+INTERRUPTED_STATUS = "interrupted by the user"
 
 
 class RunRecord(NamedTuple):
@@ -52,7 +53,7 @@ def status_message(status: int, model: Model, st: S.State) -> str:
     cfg = model.config
     t = e[S.ERR_T]
     if status == INTERRUPTED:
-        return f"interrupted by the user at t = {st.clock[S.T_NOW]:.6e} s."
+        return f"{INTERRUPTED_STATUS} at t = {st.clock[S.T_NOW]:.6e} s."
     if status == S.ERR_NOCONV:
         k = int(e[S.ERR_CONTACT])
         where = f"plate contact '{model.contact_labels[k]}'" if 0 <= k < len(model.contact_labels) else "the interface"
