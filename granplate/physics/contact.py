@@ -163,21 +163,19 @@ def normal_force_slopes(delta: float, a: float, c: float):
 @njit(cache=True)
 def friction_slope(n_abs: float, v_t: float, mu: float, k_s: float) -> float:
     """d f / d v_t = mu k_s |N| / cosh^2(k_s v_t) [N s/m], the slope of eq. (5) that
-    criterion (8) multiplies by the step and the compliance; zero out of touch."""
-    if n_abs <= 0.0:
-        return 0.0
+    criterion (8) multiplies by the step and the compliance."""
     ch = math.cosh(k_s * v_t)
     return mu * k_s * n_abs / (ch * ch)
 
 
 @njit(cache=True)
 def local_map_modulus(mu: float, k_s: float, n_abs: float, dt: float, c_t: float, v_t: float) -> float:
-    """|lambda| of the frictional local map at a plate contact, paper eq. (8).
+    """|lambda| of the frictional local map at a plate contact, paper eq. (8):
+    1/2 (d f / d v_t) dt c_t.
 
     c_t: the tangential driving DOF's diagonal entry of (M + dt^2 K / 4)^-1 [1/kg].
     """
-    ch = math.cosh(k_s * v_t)
-    return 0.5 * mu * k_s * n_abs * dt * c_t / (ch * ch)
+    return 0.5 * friction_slope(n_abs, v_t, mu, k_s) * dt * c_t
 
 
 @njit(cache=True)

@@ -16,7 +16,9 @@ from granplate.physics.shock import time_profile
 @njit(cache=True)
 def slip_relaxation_rate(n, vt, mu, k_s, inv_mass_t):
     """How fast the slip of a sticking contact relaxes [1/s]: the friction slope
-    (eq. 8's d f/d v_t) times the contact's tangential inverse mass."""
+    (eq. 8's d f/d v_t) times the contact's tangential inverse mass; zero out of touch."""
+    if n <= 0.0:
+        return 0.0
     return friction_slope(n, vt, mu, k_s) * inv_mass_t
 
 

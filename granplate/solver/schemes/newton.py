@@ -75,6 +75,8 @@ def chain_to_variables(normal, fguess, vguess, g, jac):
         k_s = g.pc_coef[j, COEF_KS]
         ch = math.cosh(k_s * vguess[j])
         nbar = 0.5 * (normal[j] + max(fguess[2 * j], 0.0))
+        # = friction_slope(nbar, v, mu, k_s) in another rounding order; kept, since the
+        # shared function moves the implicit results by round-off (golden not bitwise)
         phi_v = mu * nbar * k_s / (ch * ch)
         phi_n = 0.5 * mu * math.tanh(k_s * vguess[j])
         for a in range(nd):
