@@ -23,28 +23,41 @@ def slip_relaxation_rate(n, vt, mu, k_s, inv_mass_t):
 
 
 @njit(cache=True)
-def shock_on_granules(t, y, g, cfg, dy):
-    """Add the shock's force and torque (load resultants times q0 f(t)) to dy; returns
-    its power [W]."""
+def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
+    """Time derivative of the granular state and the plate-contact forces.
+
+    y: (ng, 6) state; up, vp: driving-DOF displacement and velocity at t; writes dy,
+    fplate (nd,) = force ON the plate [N, N] per contact, normal and slip at each plate
+    contact. hold: the plate-contact friction is fbar[k] (held over the step, its work
+    booked by the scheme) instead of eq. (5). Returns (shock power, viscous power,
+    friction power, contact potential energy, largest slip relaxation rate of a granule
+    contact) [W, W, W, J, 1/s]; RK4 needs h times that rate below ~2.8. One function
+    (not one per contact kind): calls that pass the model tuples cost more per step
+    than the loops themselves when the medium is small.
+    """
+    ng = y.shape[0]
+    for i in range(ng):
+        dy[i, 0] = y[i, 3]
+        dy[i, 1] = y[i, 4]
+        dy[i, 2] = y[i, 5]
+        dy[i, 3] = 0.0
+        dy[i, 4] = 0.0
+        dy[i, 5] = 0.0
     p_shock = 0.0
-    if not cfg.load_on_plate:
+    p_visc = 0.0
+    p_fric = 0.0
+    e_pot = 0.0
+    rate = 0.0
+    if not cfg.load_on_plate:  # the shock on the loaded granules
         amp = cfg.q0 * time_profile(t, cfg.duration)
         if amp != 0.0:
-            for i in range(y.shape[0]):
+            for i in range(ng):
                 fx = amp * g.shock_force[i]
                 tq = amp * g.shock_torque[i]
                 dy[i, 3] += fx
                 dy[i, 5] += tq
                 p_shock += fx * y[i, 3] + tq * y[i, 5]
-    return p_shock
-
-
-@njit(cache=True)
-def pair_forces(y, g, cfg, dy, p_visc, p_fric, e_pot, rate):
-    """Add the granule-granule contact forces to dy and their viscous power, friction
-    power, stored energy and largest slip relaxation rate to the running totals given
-    (summed in contact order); returns the new totals."""
-    for p in range(g.pair_ij.shape[0]):
+    for p in range(g.pair_ij.shape[0]):  # granule-granule contacts
         i = g.pair_ij[p, 0]
         j = g.pair_ij[p, 1]
         ri = g.radius[i]
@@ -59,8 +72,7 @@ def pair_forces(y, g, cfg, dy, p_visc, p_fric, e_pot, rate):
         n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
         rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + 1.0 / g.mass[j]
                                               + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]))
-        # on i: -n nvec - f tvec, tvec = (-nz, nx); on j the opposite
-        fx = -n * nx + f * nz
+        fx = -n * nx + f * nz  # on i: -n nvec - f tvec, tvec = (-nz, nx); on j the opposite
         fz = -n * nz - f * nx
         dy[i, 3] += fx
         dy[i, 4] += fz
@@ -71,13 +83,7 @@ def pair_forces(y, g, cfg, dy, p_visc, p_fric, e_pot, rate):
         p_visc += pv
         p_fric += pf
         e_pot += ep
-    return p_visc, p_fric, e_pot, rate
-
-
-@njit(cache=True)
-def wall_forces(y, g, cfg, dy, p_visc, p_fric, e_pot, rate):
-    """Add the rigid walls' contact forces to dy (running totals as in pair_forces)."""
-    for w in range(g.wall_i.shape[0]):
+    for w in range(g.wall_i.shape[0]):  # rigid walls
         i = g.wall_i[w]
         ri = g.radius[i]
         nx = g.wall_geo[w, 0]
@@ -96,17 +102,7 @@ def wall_forces(y, g, cfg, dy, p_visc, p_fric, e_pot, rate):
         p_visc += pv
         p_fric += pf
         e_pot += ep
-    return p_visc, p_fric, e_pot, rate
-
-
-@njit(cache=True)
-def plate_contact_forces(y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar,
-                         p_visc, p_fric, e_pot, rate):
-    """Add the plate contacts' forces (through the rigid layers) to dy and write the
-    force ON the plate (fplate, [N, N] per contact), |N| and the slip rate. hold: the
-    friction is fbar[k] (held over the step) instead of eq. (5), its work booked by the
-    scheme. Running totals as in pair_forces."""
-    for k in range(g.pc_i.shape[0]):
+    for k in range(g.pc_i.shape[0]):  # plate contacts through the rigid layers, n = (1, 0)
         i = g.pc_i[k]
         ri = g.radius[i]
         delta = plate_overlap(y[i, 0], ri, g.pc_x[k] + up[2 * k])
@@ -118,8 +114,7 @@ def plate_contact_forces(y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar
         if delta > 0.0:
             c = g.pc_coef[k]
             n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
-            if not hold:
-                # the granule side only: the plate side of this map is criterion (8)
+            if not hold:  # the granule side only: the plate side of this map is criterion (8)
                 rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i]))
             dy[i, 3] -= n
             p_visc += pv
@@ -135,32 +130,6 @@ def plate_contact_forces(y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar
         fplate[2 * k + 1] = f
         normal[k] = n
         slip[k] = vt
-    return p_visc, p_fric, e_pot, rate
-
-
-@njit(cache=True)
-def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
-    """Time derivative of the granular state and the plate-contact forces.
-
-    y: (ng, 6) state; up, vp: driving-DOF displacement and velocity at t; writes dy,
-    fplate (nd,) = force ON the plate, normal and slip at each plate contact (see
-    plate_contact_forces for hold, fbar). Returns (shock power, viscous power, friction
-    power, contact potential energy, largest slip relaxation rate of a granule contact)
-    [W, W, W, J, 1/s]; RK4 needs h times that rate below ~2.8.
-    """
-    ng = y.shape[0]
-    for i in range(ng):
-        dy[i, 0] = y[i, 3]
-        dy[i, 1] = y[i, 4]
-        dy[i, 2] = y[i, 5]
-        dy[i, 3] = 0.0
-        dy[i, 4] = 0.0
-        dy[i, 5] = 0.0
-    p_shock = shock_on_granules(t, y, g, cfg, dy)
-    tot = pair_forces(y, g, cfg, dy, 0.0, 0.0, 0.0, 0.0)
-    tot = wall_forces(y, g, cfg, dy, tot[0], tot[1], tot[2], tot[3])
-    p_visc, p_fric, e_pot, rate = plate_contact_forces(y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar,
-                                                       tot[0], tot[1], tot[2], tot[3])
     for i in range(ng):
         dy[i, 3] /= g.mass[i]
         dy[i, 4] /= g.mass[i]
