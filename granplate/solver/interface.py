@@ -47,16 +47,18 @@ def contact_modulus(k, h, gm, g, normal, slip):
 
 
 @njit(cache=True)
-def accept_contacts(h, gm, st, g, w):
-    """Take the end-of-step |N| and slip rates into the state and keep the largest
-    |lambda| (eq. 8) and iteration count per contact since the last output; returns
-    the largest |lambda| of this step."""
+def accept_contacts(h, gm, pc_coef, normal_new, slip_new, conv_iter, normal, slip, lam_int, it_int):
+    """Take the end-of-step |N| and slip rates into the state (normal, slip) and keep
+    the largest |lambda| (eq. 8) and iteration count per contact since the last output
+    (lam_int, it_int); returns the largest |lambda| of this step. (Arrays, not the state
+    tuples: this runs every step.)"""
     lam_max = 0.0
-    for k in range(g.pc_i.shape[0]):
-        st.normal[k] = w.normal_new[k]
-        st.slip[k] = w.slip_new[k]
-        lam = contact_modulus(k, h, gm, g, st.normal, st.slip)
-        w.lam_int[k] = max(w.lam_int[k], lam)
-        w.it_int[k] = max(w.it_int[k], w.conv_iter[k] if w.conv_iter[k] > 0 else 1)
+    for k in range(normal.shape[0]):
+        normal[k] = normal_new[k]
+        slip[k] = slip_new[k]
+        lam = local_map_modulus(pc_coef[k, COEF_MU], pc_coef[k, COEF_KS], normal[k], h,
+                                gm[2 * k + 1, 2 * k + 1], slip[k])
+        lam_int[k] = max(lam_int[k], lam)
+        it_int[k] = max(it_int[k], conv_iter[k] if conv_iter[k] > 0 else 1)
         lam_max = max(lam_max, lam)
     return lam_max

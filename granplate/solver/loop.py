@@ -157,17 +157,22 @@ def check_energy(h, st, g, p, cfg, w):
 @njit(cache=True)
 def prepare_slot(sw, h, slot, st, p, w):
     """G(h) and the scheme's matrices for `slot`: once per ladder level, and for an
-    odd step (slot N_LEVELS) whenever it changes."""
+    odd step (slot N_LEVELS) whenever it changes (see `needs_matrices`)."""
     if slot == N_LEVELS:
-        if st.clock[CUSTOM_H] == h:
-            return
         st.clock[CUSTOM_H] = h
-    elif w.g_ok[slot]:
-        return
     else:
         w.g_ok[slot] = 1
     step_matrices(h, p, w.dmode[slot], w.gmat[slot])
     S.prepare_level(sw, h, p, slot)
+
+
+@njit(cache=True)
+def needs_matrices(h, slot, clock, g_ok):
+    """Whether `slot` lacks its matrices for step h (checked every step, so it takes
+    arrays, not the state tuples)."""
+    if slot == N_LEVELS:
+        return clock[CUSTOM_H] != h
+    return g_ok[slot] == 0
 
 
 @njit(cache=True)
@@ -206,8 +211,9 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
         o = st.count[C_OUT]
         if o >= out.t.shape[0]:
             return ERR_BUFFER
-        level, h, slot, land = S.plan(sw, st, cfg, t - out.target[o - 1], out.target[o] - t)
-        prepare_slot(sw, h, slot, st, p, w)
+        level, h, slot, land = S.plan(sw, st.count, cfg, t - out.target[o - 1], out.target[o] - t)
+        if needs_matrices(h, slot, st.clock, w.g_ok):
+            prepare_slot(sw, h, slot, st, p, w)
         ratio = h / st.clock[H_LAST] if st.clock[H_LAST] > 0.0 else 0.0
         first_guess(ratio, st, w)
         converged, it, worst, e_pot, rate = S.attempt(sw, t, h, slot, st, g, p, cfg, w)
@@ -226,8 +232,9 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
             continue
         plate_work = S.commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w)
         accept_granular(t, h, land, out.target[o], plate_work, e_pot, st, w)
-        lam_max = accept_contacts(h, w.gmat[slot], st, g, w)
-        new_level, h_new = S.next_level(sw, h, slot, level, err, lam_max, rate, st, cfg)
+        lam_max = accept_contacts(h, w.gmat[slot], g.pc_coef, w.normal_new, w.slip_new, w.conv_iter,
+                                  st.normal, st.slip, w.lam_int, w.it_int)
+        new_level, h_new = S.next_level(sw, h, slot, level, err, lam_max, rate, st.clock[T_NOW], cfg)
         if level_step(new_level, cfg) < cfg.dt_min:
             return step_too_small(st.clock[T_NOW], h_new, it, worst_contact(w), lam_max, st.normal, st.slip, st)
         st.count[C_LEVEL] = new_level

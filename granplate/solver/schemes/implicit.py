@@ -32,7 +32,7 @@ from granplate.solver.plate_modal import (
 from granplate.solver.schemes.newton import held_friction, newton_update
 from granplate.solver.state import (
     A_FRIC, A_SHOCK_G, A_SHOCK_P, A_VISC, C_LEVEL, E_IN_MAX, E_ZERO, F_SCALE, H_LAST, N_LEVELS,
-    RES_LAST, T_NOW,
+    RES_LAST,
 )
 
 NAME = "implicit"
@@ -67,12 +67,12 @@ def new_scratch(ng: int, nm: int, nk: int) -> Scratch:
 
 
 @njit(cache=True)
-def plan(sw, st, cfg, pos, rem):
+def plan(sw, count, cfg, pos, rem):
     """A dyadic level that tiles the output interval from `pos` [s] on, and its step
     (on the ladder when it lands on the output `rem` [s] away). Returns (level, h,
     slot, land)."""
-    level = dyadic_level(st.count[C_LEVEL], pos, cfg)
-    st.count[C_LEVEL] = level
+    level = dyadic_level(count[C_LEVEL], pos, cfg)
+    count[C_LEVEL] = level
     h, slot, land = step_to_output(level, rem, True, cfg)
     return level, h, slot, land
 
@@ -224,7 +224,7 @@ def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
 
 
 @njit(cache=True)
-def next_level(sw, h, slot, level, err, lam_max, rate, st, cfg):
+def next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg):
     """The next step from the error estimate (grow at most 2x), RK4 stable on the
     friction, the shock pulse resolved; below dt_min it goes on at dt_min (accuracy,
     not stability). Returns (level, step [s])."""
@@ -232,7 +232,7 @@ def next_level(sw, h, slot, level, err, lam_max, rate, st, cfg):
     grow = 2.0 if err <= 0.0 else min(2.0, max(0.3, 0.9 / math.sqrt(err)))
     h_new = min(max(h, h_lvl if slot == N_LEVELS else h) * grow, cfg.dt_max)
     h_new = rk4_limit(h_new, rate)
-    if cfg.q0 != 0.0 and st.clock[T_NOW] < cfg.duration:
+    if cfg.q0 != 0.0 and t_now < cfg.duration:
         h_new = min(h_new, cfg.duration / SHOCK_STEPS)
     new_level = level_for(h_new, cfg)
     if level_step(new_level, cfg) < cfg.dt_min:

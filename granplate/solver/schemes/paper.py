@@ -43,10 +43,11 @@ def new_scratch(ng: int, nm: int, nk: int) -> Scratch:
 
 
 @njit(cache=True)
-def plan(sw, st, cfg, pos, rem):
-    """Level and step: the current level, cut to land on the next output time `rem`
-    [s] away (pos: time since the last output, unused). Returns (level, h, slot, land)."""
-    level = st.count[C_LEVEL]
+def plan(sw, count, cfg, pos, rem):
+    """Level and step: the current level (count[C_LEVEL]), cut to land on the next
+    output time `rem` [s] away (pos: time since the last output, unused). Returns
+    (level, h, slot, land)."""
+    level = count[C_LEVEL]
     h, slot, land = step_to_output(level, rem, False, cfg)
     return level, h, slot, land
 
@@ -132,7 +133,7 @@ def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
 
 
 @njit(cache=True)
-def next_level(sw, h, slot, level, err, lam_max, rate, st, cfg):
+def next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg):
     """The next step keeps |lambda| near lambda_target (at most doubling) and RK4
     stable on the friction. Returns (level, step [s])."""
     h_lvl = level_step(level, cfg)
