@@ -19,20 +19,21 @@ def first_guess(ratio, st, w):
 
 
 @njit(cache=True)
-def forces_converged(it, cfg, w):
-    """Whether the forces at the end of the trial step (w.fnew) agree with the ones
-    the plate moved with (w.fguess) to rtol |F| + atol. Marks in w.conv_iter each
-    contact still moving at iteration `it`; returns (converged, worst contact or -1)."""
+def forces_converged(it, rtol, atol, fnew, fguess, conv_iter):
+    """Whether the forces at the end of the trial step (fnew) agree with the ones the
+    plate moved with (fguess) to rtol |F| + atol. Marks in conv_iter each contact still
+    moving at iteration `it`; returns (converged, worst contact or -1). (Arrays, not
+    the tuples: this runs every iteration.)"""
     converged = True
     worst = -1
     worst_err = 0.0
-    for k in range(w.conv_iter.shape[0]):
+    for k in range(conv_iter.shape[0]):
         for c in range(2):
             d = 2 * k + c
-            diff = abs(w.fnew[d] - w.fguess[d])
-            if diff > cfg.rtol * abs(w.fnew[d]) + cfg.atol:
+            diff = abs(fnew[d] - fguess[d])
+            if diff > rtol * abs(fnew[d]) + atol:
                 converged = False
-                w.conv_iter[k] = it + 1
+                conv_iter[k] = it + 1
                 if diff > worst_err:
                     worst_err = diff
                     worst = k

@@ -127,7 +127,7 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
         stage_motion(sw.mmat[slot], sw.ustar, w.fguess, w.stage)
         e_pot, rate = rk4_granular_step(t, h, w.stage, True, st, g, cfg, w)
         held_friction_target(st.normal, w.normal_new, w.slip_new, g, w.fnew)
-        converged, worst = forces_converged(it, cfg, w)
+        converged, worst = forces_converged(it, cfg.rtol, cfg.atol, w.fnew, w.fguess, w.conv_iter)
         if converged:
             break
         newton_update(h, sw.mmat[slot], w.stage[2], g, st, w, sw.jac, sw.rhs, sw.vguess)

@@ -100,7 +100,7 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
             sw.aavg[d] = 0.5 * (st.a[d] + sw.anext[d])
         stage_motion(h, st.u, st.v, sw.aavg, w.stage)
         e_pot, rate = rk4_granular_step(t, h, w.stage, False, st, g, cfg, w)
-        converged, worst = forces_converged(it, cfg, w)
+        converged, worst = forces_converged(it, cfg.rtol, cfg.atol, w.fnew, w.fguess, w.conv_iter)
         if converged:
             break
         for d in range(w.fguess.shape[0]):
