@@ -23,7 +23,7 @@ from granplate.setup.scenario import (  # noqa: E402
 def __getattr__(name: str):
     # heavy modules (numba, scikit-fem, xarray) load on first use
     if name in ("simulate",):
-        from granplate.solver.driver import simulate
+        from granplate.results.run import simulate
         return simulate
     if name in ("build_model",):
         from granplate.model.arrays import build_model

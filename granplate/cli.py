@@ -85,7 +85,7 @@ def format_summary(summary: dict) -> str:
 def _cmd_run(args) -> int:
     from granplate.results.dataset import summary, write
     from granplate.setup.io import load_scenario
-    from granplate.solver.driver import simulate
+    from granplate.results.run import interrupted, simulate
 
     scenario = load_scenario(args.scenario)
     out = Path(args.output) if args.output else Path(f"{scenario.name}.nc")
@@ -93,10 +93,12 @@ def _cmd_run(args) -> int:
         ds = simulate(scenario, t_end=args.t_end, progress=not args.quiet)
     except SimulationError as err:
         print(f"granplate: run stopped: {err}", file=sys.stderr)
-        if err.result is not None:
-            write(err.result, out)
-            print(f"granplate: partial result written to {out}", file=sys.stderr)
-        return 3
+        if err.result is None:
+            return 3
+        write(err.result, out)
+        print(f"granplate: the result so far is written to {out} (its 'status' attribute says why "
+              f"the run stopped)", file=sys.stderr)
+        return 130 if interrupted(err.result) else 3
     write(ds, out)
     s = summary(ds)
     print(f"{scenario.name}: {scenario.description}".rstrip(": "))

@@ -10,7 +10,7 @@ from scipy.special import gamma as G
 
 from granplate.physics import contact as C
 from granplate.setup.materials import LIBRARY, effective_modulus, sphere_mass
-from granplate.solver.driver import simulate
+from granplate.results.run import simulate
 
 from conftest import two_spheres
 

@@ -1,4 +1,4 @@
-"""The paper's packing (MODEL.md section 1) and scenario resolution."""
+"""The paper's packing (docs/model.md section 1) and scenario resolution."""
 from __future__ import annotations
 
 import dataclasses

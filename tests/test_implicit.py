@@ -67,7 +67,7 @@ def test_exact_modal_step_matches_an_ode_solve(omega):
     q, q' at h/2 and h and the integral of q as an independent tight ODE solve does."""
     from scipy.integrate import solve_ivp
 
-    from granplate.solver import kernels as K
+    from granplate.solver import plate_modal as K
 
     h, q0, v0, f0, f1 = 1e-6, 2e-7, -0.03, 5.0, -3.0
     row = np.zeros(K.N_MCOEF)
@@ -87,7 +87,7 @@ def test_exact_modal_step_matches_an_ode_solve(omega):
 def test_newmark_mode_coefficients_are_newmark():
     """Above omega h = 1 a mode is advanced by Newmark's average acceleration: the
     coefficients reproduce one textbook Newmark step (beta 1/4, gamma 1/2)."""
-    from granplate.solver import kernels as K
+    from granplate.solver import plate_modal as K
 
     h, w2, q0, v0, f0, f1 = 1e-6, (5e6) ** 2, 1e-9, 0.02, 4.0, 1.0
     row = np.zeros(K.N_MCOEF)

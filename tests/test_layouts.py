@@ -394,7 +394,7 @@ def test_resolve_a_preset():
 def test_short_run_of_a_small_hexagonal_protector_balances_energy():
     """A 4 x 3 hexagonal protector (steel and PTFE columns) against the plate, shocked for 2e-5 s:
     E_p + E_g + D = E_shock (energy residual below 1e-4)."""
-    from granplate.solver.driver import simulate
+    from granplate.results.run import simulate
 
     s = Scenario(layout=LatticeLayout(columns=4, rows=3, radius=0.01,
                                       column_materials=("steel", "ptfe", "steel", "ptfe")),

@@ -8,8 +8,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from granplate.solver import kernels
-from granplate.physics.contact import damping_coefficient, hertz_coefficient
+from granplate.model.inputs import Config, Granular, PlateArrays, scheme_number
+from granplate.physics.contact import (
+    COEF_A, COEF_C, COEF_KS, COEF_MU, N_COEF, damping_coefficient, hertz_coefficient,
+)
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import resolve
 from granplate.physics.shock import shock_resultants
@@ -53,9 +55,9 @@ class Model:
 
     scenario: Scenario
     labels: tuple[str, ...]
-    granular: kernels.Granular
-    plate_arrays: kernels.PlateArrays
-    config: kernels.Config
+    granular: Granular
+    plate_arrays: PlateArrays
+    config: Config
     plate: object | None
     initial_state: np.ndarray
     pairs: np.ndarray
@@ -72,6 +74,14 @@ class Model:
         return tuple(self.labels[i] for i in self.plate_contacts)
 
 
+def coefficient_row(a: float, c: float, mu: float, k_s: float) -> np.ndarray:
+    """One row of pair_coef / wall_coef / pc_coef in the columns of physics.contact:
+    Hertz A [N/m^1.5], damping c, mu [-], k_s [s/m] (eqs. 3, 5)."""
+    row = np.zeros(N_COEF)
+    row[COEF_A], row[COEF_C], row[COEF_MU], row[COEF_KS] = a, c, mu, k_s
+    return row
+
+
 def _granule_arrays(s: Scenario):
     x = np.array([g.x for g in s.granules], float)
     y = np.array([g.y for g in s.granules], float)
@@ -82,7 +92,7 @@ def _granule_arrays(s: Scenario):
 
 def find_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: float) -> np.ndarray:
     """Potential granule-granule contacts: pairs whose initial surface gap is at most
-    gap_ratio * min(R_i, R_j) (the topology is fixed, MODEL.md section 1)."""
+    gap_ratio * min(R_i, R_j) (the topology is fixed, docs/model.md section 1)."""
     from granplate.model.neighbours import contact_pairs
 
     return contact_pairs(x, y, r, gap_ratio)
@@ -126,29 +136,24 @@ def loaded_granules(s: Scenario, x, r) -> np.ndarray:
     return np.abs(left - left.min()) <= 1e-9 * r.max()
 
 
-def build_model(scenario: Scenario) -> Model:
-    """Validate, resolve and turn a scenario into the loop's arrays."""
-    validate(scenario)
-    s = resolve(scenario)
-    x, y, r, rho = _granule_arrays(s)
-    mats = [s.material(g.material) for g in s.granules]
-    mass = np.array([sphere_mass(ri, rhoi) for ri, rhoi in zip(r, rho)])
-    inertia = np.array([sphere_inertia(ri, rhoi) for ri, rhoi in zip(r, rho)])
-    ng = len(x)
-
-    pairs = find_pairs(x, y, r, s.contact.neighbour_gap)
-    pair_coef = np.zeros((len(pairs), 4))
+def pair_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """(np, N_COEF) coefficients of the granule pairs: E*, R*, m* of the two (eqs. 3-4)."""
+    pair_coef = np.zeros((len(pairs), N_COEF))
     for p, (i, j) in enumerate(pairs):
         e_star = effective_modulus(mats[i], mats[j])
         r_star = r[i] * r[j] / (r[i] + r[j])
         m_star = mass[i] * mass[j] / (mass[i] + mass[j])
         alpha, mu, ks = s.contact.for_pair(mats[i].name, mats[j].name)
         a = hertz_coefficient(e_star, r_star)
-        pair_coef[p] = (a, damping_coefficient(alpha, m_star, a), mu, ks)
+        pair_coef[p] = coefficient_row(a, damping_coefficient(alpha, m_star, a), mu, ks)
+    return pair_coef
 
-    wc = find_wall_contacts(s, x, y, r)
+
+def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarray):
+    """(nw, 3) [nx, ny, offset] with the unit outward normal, and (nw, N_COEF)
+    coefficients against a rigid body (R* = R, m* = m)."""
     wall_geo = np.zeros((len(wc), 3))
-    wall_coef = np.zeros((len(wc), 4))
+    wall_coef = np.zeros((len(wc), N_COEF))
     for k, (i, w) in enumerate(wc):
         wall = s.walls[w]
         nrm = np.asarray(wall.normal, float)
@@ -156,21 +161,24 @@ def build_model(scenario: Scenario) -> Model:
         wall_geo[k] = (nrm[0], nrm[1], wall.offset)
         alpha, mu, ks = s.contact.for_pair(mats[i].name, wall.material)
         a = hertz_coefficient(effective_modulus(mats[i], None), r[i])
-        wall_coef[k] = (a, damping_coefficient(alpha, mass[i], a), mu, ks)
+        wall_coef[k] = coefficient_row(a, damping_coefficient(alpha, mass[i], a), mu, ks)
+    return wall_geo, wall_coef
 
-    pc = find_plate_contacts(s, x, y, r)
-    pc_coef = np.zeros((len(pc), 4))
-    pc_x = np.zeros(len(pc))
+
+def plate_contact_coefficients(s: Scenario, mats, r: np.ndarray, pc: np.ndarray) -> np.ndarray:
+    """(nk, N_COEF) coefficients against the plate's rigid layers: E_k, R_k -> infinity
+    and m_k -> 0, so m* = 0 (no viscous damping)."""
+    pc_coef = np.zeros((len(pc), N_COEF))
     for k, i in enumerate(pc):
         alpha, mu, ks = s.contact.for_pair(mats[i].name, s.plate.material)
         a = hertz_coefficient(effective_modulus(mats[i], None), r[i])
-        # rigid layer: E_k, R_k -> infinity and m_k -> 0, so m* = 0 (no viscous damping)
-        pc_coef[k] = (a, damping_coefficient(alpha, 0.0, a), mu, ks)
-        pc_x[k] = s.plate.x0
+        pc_coef[k] = coefficient_row(a, damping_coefficient(alpha, 0.0, a), mu, ks)
+    return pc_coef
 
-    loaded = loaded_granules(s, x, r)
-    fres, tres = shock_resultants(y, r, loaded, s.load.y0, s.load.length)
 
+def plate_modal_arrays(s: Scenario, y: np.ndarray, pc: np.ndarray):
+    """The plate's model (or None) and its PlateArrays (modes, shapes at the driving
+    DOFs of the contacts pc, modal edge load)."""
     plate_model = None
     nk = len(pc)
     if s.plate is not None:
@@ -192,17 +200,15 @@ def build_model(scenario: Scenario) -> Model:
         load_modal = np.zeros(0)
     if phi_d.shape != (2 * nk, len(omega2)):
         phi_d = phi_d.reshape(2 * nk, len(omega2))
+    return plate_model, PlateArrays(omega2=omega2, phi_d=phi_d, load_modal=load_modal)
 
-    granular = kernels.Granular(
-        mass=mass, inertia=inertia, radius=r, pair_ij=pairs, pair_coef=pair_coef,
-        wall_i=np.ascontiguousarray(wc[:, 0]), wall_geo=wall_geo, wall_coef=wall_coef,
-        pc_i=pc, pc_x=pc_x, pc_coef=pc_coef, shock_force=fres, shock_torque=tres,
-    )
-    plate_arrays = kernels.PlateArrays(omega2=omega2, phi_d=phi_d, load_modal=load_modal)
+
+def loop_config(s: Scenario, fres: np.ndarray, tres: np.ndarray, r: np.ndarray, mass: np.ndarray) -> Config:
+    """The loop's scalar settings from the scenario's load, contact, time and solver."""
     t = s.time
     sol = s.solver
     q0 = s.load.q0 if s.load.kind == "line" else 0.0
-    config = kernels.Config(
+    return Config(
         q0=float(q0), duration=float(s.load.duration), clip=bool(s.contact.clip_tensile),
         lambda_target=float(sol.lambda_target), rtol=float(sol.iteration_rtol),
         atol=float(sol.iteration_atol), max_iter=int(sol.max_iterations),
@@ -212,20 +218,49 @@ def build_model(scenario: Scenario) -> Model:
         out_dt=float(t.output_interval), t_end=float(t.t_end),
         load_on_plate=bool(s.load.kind == "line" and s.load.target == "plate"),
         arm_shrink=1.0 if s.contact.torque_arm == "contact_point" else 0.0,
-        scheme=kernels.SCHEME_IMPLICIT if sol.scheme == "implicit" else kernels.SCHEME_PAPER,
+        scheme=scheme_number(sol.scheme),
         error_tol=float(sol.error_tol),
         force_floor=force_floor(q0, fres, tres, r, mass, s, t.output_interval),
     )
-    y0 = np.zeros((ng, 6))
+
+
+def initial_state(s: Scenario, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """(ng, 6) x, y, theta = 0, vx, vy, omega of every granule at t = 0."""
+    y0 = np.zeros((len(x), 6))
     y0[:, 0] = x
     y0[:, 1] = y
     y0[:, 3] = [g.vx for g in s.granules]
     y0[:, 4] = [g.vy for g in s.granules]
     y0[:, 5] = [g.omega for g in s.granules]
-    if nk and s.plate is None:  # pragma: no cover - guarded by validation
+    return y0
+
+
+def build_model(scenario: Scenario) -> Model:
+    """Validate, resolve and turn a scenario into the loop's arrays."""
+    validate(scenario)
+    s = resolve(scenario)
+    x, y, r, rho = _granule_arrays(s)
+    mats = [s.material(g.material) for g in s.granules]
+    mass = np.array([sphere_mass(ri, rhoi) for ri, rhoi in zip(r, rho)])
+    inertia = np.array([sphere_inertia(ri, rhoi) for ri, rhoi in zip(r, rho)])
+    pairs = find_pairs(x, y, r, s.contact.neighbour_gap)
+    wc = find_wall_contacts(s, x, y, r)
+    wall_geo, wall_coef = wall_arrays(s, mats, r, mass, wc)
+    pc = find_plate_contacts(s, x, y, r)
+    if len(pc) and s.plate is None:  # pragma: no cover - guarded by validation
         raise ScenarioError("plate", None, "plate contacts need a plate")
+    fres, tres = shock_resultants(y, r, loaded_granules(s, x, r), s.load.y0, s.load.length)
+    plate_model, plate_arrays = plate_modal_arrays(s, y, pc)
+    granular = Granular(
+        mass=mass, inertia=inertia, radius=r, pair_ij=pairs,
+        pair_coef=pair_coefficients(s, mats, r, mass, pairs),
+        wall_i=np.ascontiguousarray(wc[:, 0]), wall_geo=wall_geo, wall_coef=wall_coef,
+        pc_i=pc, pc_x=np.full(len(pc), float(s.plate.x0) if s.plate is not None else 0.0),
+        pc_coef=plate_contact_coefficients(s, mats, r, pc), shock_force=fres, shock_torque=tres,
+    )
     return Model(
         scenario=s, labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
-        granular=granular, plate_arrays=plate_arrays, config=config, plate=plate_model,
-        initial_state=y0, pairs=pairs, wall_contacts=wc, plate_contacts=pc,
+        granular=granular, plate_arrays=plate_arrays, config=loop_config(s, fres, tres, r, mass),
+        plate=plate_model, initial_state=initial_state(s, x, y), pairs=pairs, wall_contacts=wc,
+        plate_contacts=pc,
     )

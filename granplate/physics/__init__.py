@@ -1,3 +1,3 @@
-"""Physics layer: contact laws (one function per equation), the shock load, energies.
+"""Physics layer: contact laws (one function per equation), the energy balance, the shock.
 
-Compiled (numba) scalar laws that the solver kernels call; imports only set-up."""
+Compiled (numba) scalar laws that the solver calls; imports only set-up."""

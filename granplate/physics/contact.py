@@ -1,12 +1,15 @@
-"""Contact laws of the paper, eqs. (2)-(6), one small pure function each.
+"""Contact laws of the paper, eqs. (2)-(10), one small pure function each.
 
-Every function is compiled by numba and used as-is by the time loop (kernels.py); tests
-call the very same functions. Units: metres, newtons, seconds, pascals.
+Every function is compiled by numba and used as-is by the time loop (granplate.solver);
+tests call the very same functions. Units: metres, newtons, seconds, pascals.
+
+Kinematics: the overlap delta and its rate, and the slip rate v_t of eq. (6), for the
+three contact kinds (granule-granule, granule-wall, granule-plate through a rigid layer).
 
 Normal force (eq. 2): |N| = A delta^(3/2) + gamma d(delta)/dt with A = 4/3 E* sqrt(R*)
 (eq. 3) and gamma = alpha_n sqrt(m* A) delta^(1/4). A contact never pulls: when the
 damping term would make the force tensile (a fast separation), the magnitude is clipped
-at zero (MODEL.md section 3); `clip=False` gives the paper's raw eq. (2) instead.
+at zero (docs/model.md section 3.2); `clip=False` gives the paper's raw eq. (2) instead.
 
 Friction (eq. 5): |f| = mu |N| tanh(k_s v_t), opposed to the slip rate v_t (eq. 6); on a
 sphere it also gives a torque -|f| R (both spheres spin against the slip).
@@ -28,21 +31,70 @@ def hertz_coefficient(e_star: float, r_star: float) -> float:
 def damping_coefficient(alpha_n: float, m_star: float, a: float) -> float:
     """c such that gamma = c delta^(1/4): c = alpha_n sqrt(m* A), paper eq. (3).
 
-    m* = 0 (rigid layer, MODEL.md) gives c = 0: no viscous damping.
+    m* = 0 (rigid layer, docs/model.md section 3.4) gives c = 0: no viscous damping.
     """
     return alpha_n * math.sqrt(m_star * a)
 
 
+#: columns of the coefficient arrays pair_coef, wall_coef, pc_coef (model arrays):
+#: Hertz coefficient A [N/m^1.5] (eq. 3), damping coefficient c with gamma = c delta^(1/4)
+#: (eq. 3), friction coefficient mu [-] and regularisation k_s [s/m] (eq. 5).
+COEF_A, COEF_C, COEF_MU, COEF_KS = 0, 1, 2, 3
+N_COEF = 4
+
+
+@njit(cache=True)
+def contact_arm(radius: float, delta: float, shrink: float) -> float:
+    """Lever arm of the friction force on a sphere [m]: R - shrink delta (shrink = 0: the
+    radius, docs/model.md section 3.2; 1/2 between spheres or 1 against a rigid body: the contact point)."""
+    return radius - shrink * delta
+
+
 @njit(cache=True)
 def pair_overlap(xi: float, yi: float, ri: float, xj: float, yj: float, rj: float):
-    """Overlap of spheres i, j and the unit normal from i to j.
-
-    Returns (delta, nx, ny, distance): delta = R_i + R_j - |s_j - s_i| (negative = gap).
-    """
+    """Overlap of spheres i, j, delta = R_i + R_j - |s_j - s_i| [m] (negative: a gap),
+    and the unit normal (nx, nz) from i to j. Returns (delta, nx, nz)."""
     dx = xj - xi
-    dy = yj - yi
-    dist = math.sqrt(dx * dx + dy * dy)
-    return ri + rj - dist, dx / dist, dy / dist, dist
+    dz = yj - yi
+    dist = math.sqrt(dx * dx + dz * dz)
+    return ri + rj - dist, dx / dist, dz / dist
+
+
+@njit(cache=True)
+def pair_rates(vxi: float, vyi: float, wi: float, vxj: float, vyj: float, wj: float,
+               nx: float, nz: float, ai: float, aj: float):
+    """Overlap rate d(delta)/dt and slip rate v_t (eq. 6) of spheres i, j [m/s].
+
+    t = (-nz, nx); v_t = (v_i - v_j).t + a_i omega_i + a_j omega_j with the arms a_i, a_j.
+    """
+    ddot = -((vxj - vxi) * nx + (vyj - vyi) * nz)
+    vt = -(vxi - vxj) * nz + (vyi - vyj) * nx + ai * wi + aj * wj
+    return ddot, vt
+
+
+@njit(cache=True)
+def wall_overlap(x: float, y: float, r: float, nx: float, nz: float, offset: float) -> float:
+    """Overlap of a sphere with the rigid wall {s.n = offset} (n: its outward normal) [m]."""
+    return x * nx + y * nz + r - offset
+
+
+@njit(cache=True)
+def wall_rates(vx: float, vy: float, w: float, nx: float, nz: float, a: float):
+    """Overlap rate and slip rate v_t (eq. 6) of a sphere on a fixed wall [m/s]."""
+    return vx * nx + vy * nz, -vx * nz + vy * nx + a * w
+
+
+@njit(cache=True)
+def plate_overlap(x: float, r: float, edge_x: float) -> float:
+    """Overlap of a sphere with the plate's rigid layer at x = edge_x (n = (1, 0)) [m]."""
+    return x + r - edge_x
+
+
+@njit(cache=True)
+def plate_rates(vx: float, vy: float, w: float, a: float, edge_vx: float, edge_vy: float):
+    """Overlap rate and slip rate v_t (eq. 6) against the moving plate edge [m/s]
+    (t = (0, 1): v_t = v_y - v_edge,y + a omega)."""
+    return vx - edge_vx, vy - edge_vy + a * w
 
 
 @njit(cache=True)
@@ -101,13 +153,29 @@ def friction_power(f: float, v_t: float) -> float:
 
 
 @njit(cache=True)
+def normal_force_slopes(delta: float, a: float, c: float):
+    """dN/d(delta) = 3/2 A delta^(1/2) [N/m] and dN/d(delta rate) = c delta^(1/4) [N s/m]
+    of eq. (2) in touch (delta > 0)."""
+    sq = math.sqrt(delta)
+    return 1.5 * a * sq, c * math.sqrt(sq)
+
+
+@njit(cache=True)
+def friction_slope(n_abs: float, v_t: float, mu: float, k_s: float) -> float:
+    """d f / d v_t = mu k_s |N| / cosh^2(k_s v_t) [N s/m], the slope of eq. (5) that
+    criterion (8) multiplies by the step and the compliance."""
+    ch = math.cosh(k_s * v_t)
+    return mu * k_s * n_abs / (ch * ch)
+
+
+@njit(cache=True)
 def local_map_modulus(mu: float, k_s: float, n_abs: float, dt: float, c_t: float, v_t: float) -> float:
-    """|lambda| of the frictional local map at a plate contact, paper eq. (8).
+    """|lambda| of the frictional local map at a plate contact, paper eq. (8):
+    1/2 (d f / d v_t) dt c_t.
 
     c_t: the tangential driving DOF's diagonal entry of (M + dt^2 K / 4)^-1 [1/kg].
     """
-    ch = math.cosh(k_s * v_t)
-    return 0.5 * mu * k_s * n_abs * dt * c_t / (ch * ch)
+    return 0.5 * friction_slope(n_abs, v_t, mu, k_s) * dt * c_t
 
 
 @njit(cache=True)

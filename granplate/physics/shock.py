@@ -1,4 +1,4 @@
-"""The half-sine shock of MODEL.md section 5 (paper Fig. 2c, d).
+"""The half-sine shock of docs/model.md section 5 (paper Fig. 2c, d).
 
 q(y, t) = q0 sin(pi t / T) sin(pi (y - y0) / L) on 0 <= t <= T and y0 <= y <= y0 + L.
 On granules the line load pushes +x on the left surface of each loaded granule over

@@ -12,7 +12,7 @@ import numpy as np
 import xarray as xr
 
 from granplate.version import __version__
-from granplate.solver import kernels as K
+from granplate.solver import state as K
 
 #: name -> (units, description) of every data variable
 VARIABLES: dict[str, tuple[str, str]] = {

@@ -1,48 +1,42 @@
-"""Run a scenario: build the model once, call the compiled loop in chunks (progress is
-shown between chunks, never per step), and return the result Dataset.
-
-    >>> import granplate
-    >>> ds = granplate.simulate(granplate.preset("steel-r1"), t_end=1e-4)
+"""Run the compiled loop on a model: allocate the state once, call `loop.advance` in
+chunks (each bounded by output times and by a step budget calibrated to a wall-time
+target, so progress shows and a stop request is honoured within about a second, even
+when the steps have collapsed), and return a plain record of the output buffers.
 """
 from __future__ import annotations
 
 import math
-import sys
+import signal
+import threading
 import time
-from dataclasses import replace
+from contextlib import contextmanager
+from typing import Callable, NamedTuple
 
 import numpy as np
 
-from granplate.solver import kernels as K
-from granplate.errors import SimulationError
-from granplate.model.arrays import Model, build_model
-from granplate.setup.scenario import Scenario
+from granplate.model.arrays import Model
+from granplate.solver import loop, state as S
+from granplate.solver.ladder import level_for
+from granplate.solver.schemes import scheme
+
+#: wall-time target of one compiled chunk [s], and the step budget of the first one.
+CHUNK_SECONDS = 0.15
+FIRST_BUDGET = 64
+#: status of a run stopped by a signal (SIGINT, SIGTERM) or a stop request.
+INTERRUPTED = -1
+INTERRUPTED_STATUS = "interrupted by the user"
 
 
-def _status_message(status: int, model: Model, st: K.State) -> str:
-    e = st.err
-    cfg = model.config
-    t = e[K.ERR_T]
-    if status == K.ERR_NOCONV:
-        k = int(e[K.ERR_CONTACT])
-        where = f"plate contact '{model.contact_labels[k]}'" if 0 <= k < len(model.contact_labels) else "the interface"
-        return (
-            f"the interface-force iteration cannot go on at t = {t:.6e} s: {where} has "
-            f"|N| = {e[K.ERR_N]:.4g} N, slip rate {e[K.ERR_VT]:.4g} m/s, local-map modulus "
-            f"|lambda| = {e[K.ERR_LAM]:.3g} (eq. 8) with step {e[K.ERR_H]:.3e} s after "
-            f"{int(e[K.ERR_ITER])} iterations, and the step may not go below time.dt_min = "
-            f"{cfg.dt_min:.3e} s. Lower solver.lambda_target, raise solver.max_iterations or "
-            f"lower time.dt_min."
-        )
-    if status == K.ERR_ENERGY:
-        return (
-            f"energy balance broken at t = {t:.6e} s: residual (E_p + E_g + D - E_in)/E_in = "
-            f"{e[K.ERR_RESID]:.3e} exceeds solver.energy_tol = {cfg.energy_tol:.1e} "
-            f"(step {e[K.ERR_H]:.3e} s). Lower time.dt_max or solver.lambda_target."
-        )
-    if status == K.ERR_NAN:
-        return f"the state became non-finite (NaN/inf) at t = {t:.6e} s (step {e[K.ERR_H]:.3e} s)."
-    return f"output buffer exhausted at t = {t:.6e} s (internal error, status {status})."
+class RunRecord(NamedTuple):
+    """What the loop leaves: the output buffers, how many rows are valid, the status
+    code (state.OK, an error code, or INTERRUPTED), its message ("ok" or why the run
+    stopped) and the timings and counters (info)."""
+
+    out: S.Output
+    n_valid: int
+    status: int
+    message: str
+    info: dict
 
 
 def output_times(t_end: float, dt_out: float) -> np.ndarray:
@@ -53,82 +47,133 @@ def output_times(t_end: float, dt_out: float) -> np.ndarray:
     return t
 
 
-def simulate(
-    scenario: Scenario,
-    *,
-    t_end: float | None = None,
-    progress: bool | None = None,
-    model: Model | None = None,
-):
-    """Simulate `scenario` and return an xarray Dataset (see docs/output.md).
+def status_message(status: int, model: Model, st: S.State) -> str:
+    """Why the run stopped, naming the quantities, the limits and what to change."""
+    e = st.err
+    cfg = model.config
+    t = e[S.ERR_T]
+    if status == INTERRUPTED:
+        return f"{INTERRUPTED_STATUS} at t = {st.clock[S.T_NOW]:.6e} s."
+    if status == S.ERR_NOCONV:
+        k = int(e[S.ERR_CONTACT])
+        where = f"plate contact '{model.contact_labels[k]}'" if 0 <= k < len(model.contact_labels) else "the interface"
+        return (
+            f"the interface-force iteration cannot go on at t = {t:.6e} s: {where} has "
+            f"|N| = {e[S.ERR_N]:.4g} N, slip rate {e[S.ERR_VT]:.4g} m/s, local-map modulus "
+            f"|lambda| = {e[S.ERR_LAM]:.3g} (eq. 8) with step {e[S.ERR_H]:.3e} s after "
+            f"{int(e[S.ERR_ITER])} iterations, and the step may not go below time.dt_min = "
+            f"{cfg.dt_min:.3e} s. Lower solver.lambda_target, raise solver.max_iterations or "
+            f"lower time.dt_min."
+        )
+    if status == S.ERR_ENERGY:
+        return (
+            f"energy balance broken at t = {t:.6e} s: residual (E_p + E_g + D - E_in)/E_in = "
+            f"{e[S.ERR_RESID]:.3e} exceeds solver.energy_tol = {cfg.energy_tol:.1e} "
+            f"(step {e[S.ERR_H]:.3e} s). Lower time.dt_max or solver.lambda_target."
+        )
+    if status == S.ERR_NAN:
+        return f"the state became non-finite (NaN/inf) at t = {t:.6e} s (step {e[S.ERR_H]:.3e} s)."
+    return f"output buffer exhausted at t = {t:.6e} s (internal error, status {status})."
 
-    t_end overrides scenario.time.t_end [s]; progress shows a bar (default: when stderr
-    is a terminal). Raises SimulationError (with the partial Dataset in `.result`) when
-    the run goes numerically wrong.
+
+@contextmanager
+def stop_on_signals():
+    """Yield a function telling whether SIGINT or SIGTERM arrived meanwhile; the
+    previous handlers are restored afterwards. Outside the main thread no handler is
+    installed (signals cannot be caught there) and the function always says no."""
+    flag = {"stop": False}
+    if threading.current_thread() is not threading.main_thread():
+        yield lambda: False
+        return
+
+    def handler(signum, frame):
+        flag["stop"] = True
+
+    old = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield lambda: flag["stop"]
+    finally:
+        for sig, h in old.items():
+            signal.signal(sig, h)
+
+
+def next_budget(budget: int, attempts: int, seconds: float) -> int:
+    """Step budget of the next chunk so that it lasts about CHUNK_SECONDS."""
+    if seconds <= 0.0 or attempts <= 0:
+        return min(budget * 2, 1 << 24)
+    per = seconds / attempts
+    return int(min(max(CHUNK_SECONDS / per, 1), 1 << 24))
+
+
+def _loop_chunks(times, model, st, w, sw, out, should_stop, on_progress) -> int:
+    """Call the compiled loop chunk by chunk until the end, an error or a stop request."""
+    g, p, cfg = model.granular, model.plate_arrays, model.config
+    n_chunks = min(200, len(times) - 1)
+    stops = np.unique(np.linspace(1, len(times) - 1, n_chunks).round().astype(int)) if n_chunks else []
+    budget = FIRST_BUDGET
+    for o_stop in stops:
+        status = S.PAUSED
+        while status == S.PAUSED:
+            if should_stop():
+                return INTERRUPTED
+            before = st.count[S.C_OUT]
+            n0 = st.count[S.C_STEPS] + st.count[S.C_RETRIES]
+            t0 = time.perf_counter()
+            status = loop.advance(float(times[o_stop]), budget, g, p, cfg, st, w, sw, out)
+            budget = next_budget(budget, int(st.count[S.C_STEPS] + st.count[S.C_RETRIES] - n0),
+                                 time.perf_counter() - t0)
+            on_progress(int(st.count[S.C_OUT] - before))
+        if status != S.OK:
+            return status
+    return S.OK
+
+
+def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool] | None = None,
+        interruptible: bool = True) -> RunRecord:
+    """Run the time loop of `model` to its t_end.
+
+    progress: a bar on stderr; should_stop: polled between chunks (a stop request);
+    interruptible: SIGINT/SIGTERM stop the run between chunks (main thread only).
     """
-    from granplate.results.dataset import to_dataset
-
-    if t_end is not None:
-        scenario = replace(scenario, time=replace(scenario.time, t_end=float(t_end)))
-        if scenario.time.output_interval > scenario.time.t_end:
-            scenario = replace(scenario, time=replace(scenario.time, output_interval=scenario.time.t_end))
-    t0 = time.perf_counter()
-    if model is None:
-        model = build_model(scenario)
-    t_setup = time.perf_counter() - t0
     g, p, cfg = model.granular, model.plate_arrays, model.config
     ng, nm, nk = model.n_granules, len(p.omega2), len(model.plate_contacts)
     times = output_times(cfg.t_end, cfg.out_dt)
-    st = K.new_state(ng, nm, nk)
-    w = K.new_work(ng, nm, nk, exact=cfg.scheme == K.SCHEME_IMPLICIT)
-    out = K.new_output(times, ng, nm, nk)
+    st = S.new_state(ng, nm, nk)
+    w = S.new_work(ng, nm, nk)
+    sw = scheme(cfg.scheme).new_scratch(ng, nm, nk)
+    out = S.new_output(times, ng, nm, nk)
     st.y[:] = model.initial_state
-    st.count[K.C_LEVEL] = K.level_for(model.scenario.time.dt_initial, cfg)
+    st.count[S.C_LEVEL] = level_for(model.scenario.time.dt_initial, cfg)
     t1 = time.perf_counter()
-    K.initialise(st, g, p, cfg, w)
-    K.record(0, st, g, p, w, out)
-    st.count[K.C_OUT] = 1
-    t_first = time.perf_counter() - t1  # includes compiling / loading the kernels
-
-    if progress is None:
-        progress = sys.stderr.isatty()
+    loop.initialise(st, g, p, cfg, w)
+    loop.record(0, st, g, p, w, out)
+    st.count[S.C_OUT] = 1
+    t_first = time.perf_counter() - t1  # includes compiling / loading the loop
     bar = None
     if progress:
         from tqdm import tqdm
 
         bar = tqdm(total=len(times) - 1, desc=model.scenario.name, unit="out", leave=False)
-    n_chunks = min(200, len(times) - 1)
-    stops = np.unique(np.linspace(1, len(times) - 1, n_chunks).round().astype(int)) if n_chunks else []
-    status = K.OK
+    polls = [should_stop] if should_stop is not None else []
     t2 = time.perf_counter()
     try:
-        for o_stop in stops:
-            before = st.count[K.C_OUT]
-            status = K.advance(float(times[o_stop]), g, p, cfg, st, w, out)
-            if bar is not None:
-                bar.update(int(st.count[K.C_OUT] - before))
-            if status != K.OK:
-                break
+        with (stop_on_signals() if interruptible else _never()) as signalled:
+            status = _loop_chunks(times, model, st, w, sw, out, lambda: signalled() or any(f() for f in polls),
+                                  bar.update if bar is not None else (lambda n: None))
     finally:
         if bar is not None:
             bar.close()
-    t_loop = time.perf_counter() - t2
-    n_valid = int(st.count[K.C_OUT])
     info = {
-        "wall_time_s": time.perf_counter() - t0,
-        "setup_time_s": t_setup,
         "first_call_time_s": t_first,
-        "loop_time_s": t_loop,
-        "n_steps": int(st.count[K.C_STEPS]),
-        "n_iterations": int(st.count[K.C_ITERS]),
-        "n_retries": int(st.count[K.C_RETRIES]),
-        "status": "ok" if status == K.OK else _status_message(status, model, st),
+        "loop_time_s": time.perf_counter() - t2,
+        "n_steps": int(st.count[S.C_STEPS]),
+        "n_iterations": int(st.count[S.C_ITERS]),
+        "n_retries": int(st.count[S.C_RETRIES]),
     }
-    ds = to_dataset(model, out, n_valid, info)
-    if status != K.OK:
-        raise SimulationError(
-            f"{model.scenario.name}: {info['status']} The {n_valid} output times computed "
-            f"so far (up to t = {times[n_valid - 1]:.6e} s) are kept in the error's .result.",
-            result=ds,
-        )
-    return ds
+    message = "ok" if status == S.OK else status_message(status, model, st)
+    return RunRecord(out=out, n_valid=int(st.count[S.C_OUT]), status=status, message=message, info=info)
+
+
+@contextmanager
+def _never():
+    yield lambda: False

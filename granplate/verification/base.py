@@ -165,7 +165,7 @@ def step_changes(dt: float, t_end: float, out: float | None = None) -> dict:
 
 def simulate(scenario):
     """Run a scenario quietly and return its Dataset."""
-    from granplate.solver.driver import simulate as run
+    from granplate.results.run import simulate as run
 
     return run(scenario, progress=False)
 

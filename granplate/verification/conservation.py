@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from granplate.solver.kernels import ENERGY_STEP_FRACTION
+from granplate.solver.schemes.implicit import ENERGY_STEP_FRACTION
 from granplate.setup.scenario import Solver
 from .base import (EPS, Case, CaseResult, Check, Context, load_case_scenario, new_figure,
                    observed_order, save_figure, simulate)
@@ -27,7 +27,7 @@ RESIDUAL_WHY = ("one part per million, a hundred times below the simulator's own
 
 
 #: The implicit scheme's step control lets the residual grow by solver.energy_tol times
-#: kernels.ENERGY_STEP_FRACTION over a run.
+#: schemes.implicit.ENERGY_STEP_FRACTION over a run.
 IMPLICIT_RESIDUAL_TOL = Solver().energy_tol * ENERGY_STEP_FRACTION
 IMPLICIT_RESIDUAL_WHY = ("the implicit scheme picks its step so that the residual grows by at most "
                          f"solver.energy_tol x ENERGY_STEP_FRACTION = {Solver().energy_tol:g} x "
@@ -126,7 +126,7 @@ def energy_residual(ctx: Context) -> CaseResult:
 
 def simulate_short(s):
     """The scenario run for SHORT_T_END seconds."""
-    from granplate.solver.driver import simulate as run
+    from granplate.results.run import simulate as run
 
     return run(s, t_end=SHORT_T_END, progress=False)
 
@@ -154,8 +154,8 @@ def friction_couple(model, y: np.ndarray) -> tuple[float, float, float]:
     default torques of docs/model.md section 3.2 (arm R on each granule) a frictional pair leaves the couple
     f (d - R_i - R_j) = -f delta, so dL/dt = -sum_pairs f delta.
     """
-    from granplate.solver import kernels as K
-    from granplate.physics.contact import friction_magnitude, normal_force
+    from granplate.physics.contact import friction_magnitude, normal_force, pair_overlap, pair_rates
+    from granplate.solver import granular as K
 
     g, cfg = model.granular, model.config
     ng = y.shape[0]
@@ -167,15 +167,11 @@ def friction_couple(model, y: np.ndarray) -> tuple[float, float, float]:
     dL = float(terms.sum())
     couple = 0.0
     for p, (i, j) in enumerate(g.pair_ij):
-        dx, dz = y[j, 0] - y[i, 0], y[j, 1] - y[i, 1]
-        dist = math.hypot(dx, dz)
-        delta = g.radius[i] + g.radius[j] - dist
+        delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], g.radius[i], y[j, 0], y[j, 1], g.radius[j])
         if delta <= 0.0:
             continue
-        nx, nz = dx / dist, dz / dist
-        ddot = -((y[j, 3] - y[i, 3]) * nx + (y[j, 4] - y[i, 4]) * nz)
+        ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, g.radius[i], g.radius[j])
         n, _ = normal_force(delta, ddot, g.pair_coef[p, 0], g.pair_coef[p, 1], cfg.clip)
-        vt = -(y[i, 3] - y[j, 3]) * nz + (y[i, 4] - y[j, 4]) * nx + g.radius[i] * y[i, 5] + g.radius[j] * y[j, 5]
         couple -= friction_magnitude(n, vt, g.pair_coef[p, 2], g.pair_coef[p, 3]) * delta
     return dL, couple, float(np.abs(terms).sum())
 
@@ -274,7 +270,7 @@ PLATE_U = np.array([-2e-5, 1e-6])
 
 def _energy_and_forces(model, y: np.ndarray, up: np.ndarray):
     """(contact energy, forces on the granules (ng, 2), torques (ng,), force on the plate)."""
-    from granplate.solver import kernels as K
+    from granplate.solver import granular as K
 
     g, cfg = model.granular, model.config
     ng = y.shape[0]
@@ -358,7 +354,7 @@ def force_gradient(ctx: Context) -> CaseResult:
             "each other, a left and a bottom wall, and a 2 x 20 plate through a rigid layer) is "
             "pressed into overlap by displacing the granules and the plate contact by a few "
             f"µm (smallest overlap {d_min:.2e} m), at rest. The forces returned by the compiled "
-            "`kernels.granular_rhs` are compared with minus the finite-difference gradient of "
+            "`solver.granular.granular_rhs` are compared with minus the finite-difference gradient of "
             "the contact energy it returns (sum 2/5 A delta^(5/2) over every pair, wall and "
             "plate contact), with respect to every granule coordinate and the plate's "
             "driving displacement.")

@@ -127,7 +127,7 @@ def study_run(ctx: Context, scenario) -> dict:
     """Summary of a full run of `scenario`: from the page's run cache, else the run store,
     else computed (and kept in both)."""
     from granplate import store
-    from granplate.solver.driver import simulate as run
+    from granplate.results.run import simulate as run
     from granplate.results.dataset import summary
 
     key = cache_key(scenario)

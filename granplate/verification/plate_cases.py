@@ -3,7 +3,7 @@ Timoshenko beam theory, Q8 convergence rates, and Newmark's period elongation.
 
 Every case assembles with the functions of `granplate.plate` (mesh, Q8 basis, plane-stress
 matrix, stiffness, mass, clamps, strain operator) and the Newmark case steps the compiled
-`kernels.newmark_predict` / `kernels.newmark_correct` themselves, so what is verified is
+`solver.plate_modal.newmark_predict` / `newmark_correct` themselves, so what is verified is
 the code the simulator runs. tests/test_plate.py checks the same assembly in other ways
 (rigid-body modes, rigid layers, cache); nothing here repeats those tests.
 
@@ -404,16 +404,18 @@ def q8_convergence(ctx: Context) -> CaseResult:
 
 def newmark_oscillator(omega_h: float, n_periods: float = 20.0) -> tuple[np.ndarray, np.ndarray]:
     """Free vibration of one mode (omega = 2 pi 1 kHz, q(0) = 1) stepped by the simulator's
-    compiled `kernels.newmark_predict` / `newmark_correct`. Returns (q_n, energy_n)."""
-    from granplate.solver import kernels as K
+    compiled `plate_modal.newmark_predict` / `newmark_correct`. Returns (q_n, energy_n)."""
+    from granplate.model.inputs import Config, PlateArrays
+    from granplate.solver import plate_modal as K
+    from granplate.solver.state import new_state
 
     w = 2.0 * math.pi * 1000.0
     h = omega_h / w
-    p = K.PlateArrays(omega2=np.array([w * w]), phi_d=np.zeros((0, 1)), load_modal=np.zeros(1))
-    cfg = K.Config(q0=0.0, duration=1.0, clip=True, lambda_target=0.5, rtol=1e-9, atol=1e-10,
+    p = PlateArrays(omega2=np.array([w * w]), phi_d=np.zeros((0, 1)), load_modal=np.zeros(1))
+    cfg = Config(q0=0.0, duration=1.0, clip=True, lambda_target=0.5, rtol=1e-9, atol=1e-10,
                    max_iter=1, energy_tol=1.0, dt_max=h, dt_min=h, out_dt=h, t_end=1.0,
                    load_on_plate=False)
-    st = K.new_state(0, 1, 0)
+    st = new_state(0, 1, 0)
     st.q[0], st.qd[0], st.qdd[0] = 1.0, 0.0, -w * w
     dmode = np.zeros(1)
     K.step_matrices(h, p, dmode, np.zeros((0, 0)))
@@ -476,7 +478,7 @@ def newmark_elongation(ctx: Context) -> CaseResult:
     ax.legend(fontsize=8)
     name = save_figure(fig, ctx, "newmark-elongation")
     desc = ("One undamped mode (f = 1 kHz, q(0) = 1) advanced for 20 periods by the compiled "
-            "`kernels.newmark_predict` and `kernels.newmark_correct` that advance every plate mode "
+            "`newmark_predict` and `newmark_correct` (solver/plate_modal.py) that advance every plate mode "
             "in a run (beta = 1/4, gamma = 1/2, no interface force), at omega h = 0.05 ... 0.4. "
             "The numerical frequency is read exactly from the three-term recurrence of the "
             "sequence. At the simulator's step (40 ns) the plate's first bending mode has "

@@ -1,0 +1,83 @@
+"""The time loop's inputs: flat arrays of the granular medium, the plate's modal model
+and the scalar settings, as numba-friendly named tuples built once by `build_model`.
+
+Coefficient columns of pair_coef, wall_coef and pc_coef are named in
+granplate.physics.contact (COEF_A, COEF_C, COEF_MU, COEF_KS).
+"""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+#: the coupling schemes, numbered in this order (Config.scheme); each has a module in
+#: granplate.solver.schemes registered under the same name.
+SCHEME_NAMES = ("paper", "implicit")
+SCHEME_PAPER, SCHEME_IMPLICIT = 0, 1
+
+
+def scheme_number(name: str) -> int:
+    """Config.scheme of the scheme called `name` (one of SCHEME_NAMES)."""
+    if name not in SCHEME_NAMES:
+        raise ValueError(f"solver.scheme = {name!r}: allowed {', '.join(SCHEME_NAMES)}")
+    return SCHEME_NAMES.index(name)
+
+
+class Granular(NamedTuple):
+    """Flat arrays of the granular medium and its contacts (SI units).
+
+    mass, inertia, radius: (ng,); pair_ij: (np, 2) granule indices; pair_coef: (np, 4)
+    [A, c, mu, k_s] with gamma = c delta^(1/4); wall_i: (nw,); wall_geo: (nw, 3)
+    [nx, ny, offset]; wall_coef: (nw, 4); pc_i: (nk,) granule of each plate contact;
+    pc_x: (nk,) undeformed x of the plate edge; pc_coef: (nk, 4); shock_force,
+    shock_torque: (ng,) load resultants per unit q0 [m, m^2].
+    """
+
+    mass: np.ndarray
+    inertia: np.ndarray
+    radius: np.ndarray
+    pair_ij: np.ndarray
+    pair_coef: np.ndarray
+    wall_i: np.ndarray
+    wall_geo: np.ndarray
+    wall_coef: np.ndarray
+    pc_i: np.ndarray
+    pc_x: np.ndarray
+    pc_coef: np.ndarray
+    shock_force: np.ndarray
+    shock_torque: np.ndarray
+
+
+class PlateArrays(NamedTuple):
+    """The plate in mass-normalised modal coordinates.
+
+    omega2: (nm,) squared circular frequencies [rad^2/s^2]; phi_d: (nd, nm) mode shapes
+    at the driving DOFs (x, y of each contact); load_modal: (nm,) modal edge load per
+    unit q0 (zeros when the shock is on the granules).
+    """
+
+    omega2: np.ndarray
+    phi_d: np.ndarray
+    load_modal: np.ndarray
+
+
+class Config(NamedTuple):
+    """Scalar settings of the loop (SI units)."""
+
+    q0: float
+    duration: float
+    clip: bool
+    lambda_target: float
+    rtol: float
+    atol: float
+    max_iter: int
+    energy_tol: float
+    dt_max: float
+    dt_min: float
+    out_dt: float
+    t_end: float
+    load_on_plate: bool
+    arm_shrink: float = 0.0  # 0: friction arm R (docs/model.md section 3.2); 1: arm to the contact point
+    scheme: int = 0  # index into SCHEME_NAMES
+    error_tol: float = 1e-3  # implicit scheme: local error target of the step control
+    force_floor: float = 0.0  # implicit scheme: smallest force scale of the error estimate [N]

@@ -1,0 +1,72 @@
+"""Simulate a scenario and return the result Dataset.
+
+    >>> import granplate
+    >>> ds = granplate.simulate(granplate.preset("steel-r1"), t_end=1e-4)
+"""
+from __future__ import annotations
+
+import sys
+import time
+from dataclasses import replace
+
+from granplate.errors import SimulationError
+from granplate.model.arrays import Model, build_model
+from granplate.results.dataset import to_dataset
+from granplate.setup.scenario import Scenario
+from granplate.solver.driver import INTERRUPTED_STATUS, run as run_loop
+from granplate.solver.state import OK
+
+
+def interrupted(ds) -> bool:
+    """Whether the result `ds` is that of a run stopped by the user (SIGINT/SIGTERM)."""
+    return str(ds.attrs.get("status", "")).startswith(INTERRUPTED_STATUS)
+
+
+def with_t_end(scenario: Scenario, t_end: float) -> Scenario:
+    """The scenario with time.t_end = t_end [s] (the output interval cut to fit)."""
+    scenario = replace(scenario, time=replace(scenario.time, t_end=float(t_end)))
+    if scenario.time.output_interval > scenario.time.t_end:
+        scenario = replace(scenario, time=replace(scenario.time, output_interval=scenario.time.t_end))
+    return scenario
+
+
+def simulate(
+    scenario: Scenario,
+    *,
+    t_end: float | None = None,
+    progress: bool | None = None,
+    model: Model | None = None,
+):
+    """Simulate `scenario` and return an xarray Dataset (see docs/output.md).
+
+    t_end overrides scenario.time.t_end [s]; progress shows a bar (default: when stderr
+    is a terminal). Raises SimulationError (with the partial Dataset in `.result`, its
+    `status` attribute saying why) when the run goes numerically wrong or is stopped by
+    SIGINT/SIGTERM (Ctrl-C).
+    """
+    if t_end is not None:
+        scenario = with_t_end(scenario, t_end)
+    t0 = time.perf_counter()
+    if model is None:
+        model = build_model(scenario)
+    t_setup = time.perf_counter() - t0
+    if progress is None:
+        progress = sys.stderr.isatty()
+    rec = run_loop(model, progress=progress)
+    info = {
+        "wall_time_s": time.perf_counter() - t0,
+        "setup_time_s": t_setup,
+        **rec.info,
+        "status": rec.message,
+    }
+    info = {k: info[k] for k in ("wall_time_s", "setup_time_s", "first_call_time_s", "loop_time_s",
+                                 "n_steps", "n_iterations", "n_retries", "status")}
+    ds = to_dataset(model, rec.out, rec.n_valid, info)
+    if rec.status != OK:
+        t_last = rec.out.t[rec.n_valid - 1]
+        raise SimulationError(
+            f"{model.scenario.name}: {rec.message} The {rec.n_valid} output times computed "
+            f"so far (up to t = {t_last:.6e} s) are kept in the error's .result.",
+            result=ds,
+        )
+    return ds

@@ -1,0 +1,211 @@
+"""The granular medium in the loop: the time derivative of every granule's state with
+the contact forces of eqs. (2)-(6), and one RK4 step of it with the plate's contact
+points moving as a scheme prescribes (docs/model.md section 6).
+"""
+from __future__ import annotations
+
+from numba import njit
+
+from granplate.physics.contact import (
+    COEF_A, COEF_C, COEF_KS, COEF_MU, contact_arm, contact_response, friction_slope, pair_overlap,
+    pair_rates, plate_overlap, plate_rates, wall_overlap, wall_rates,
+)
+from granplate.physics.shock import time_profile
+
+
+@njit(cache=True)
+def slip_relaxation_rate(n, vt, mu, k_s, inv_mass_t):
+    """How fast the slip of a sticking contact relaxes [1/s]: the friction slope
+    (eq. 8's d f/d v_t) times the contact's tangential inverse mass; zero out of touch."""
+    if n <= 0.0:
+        return 0.0
+    return friction_slope(n, vt, mu, k_s) * inv_mass_t
+
+
+@njit(cache=True)
+def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
+    """Time derivative of the granular state and the plate-contact forces.
+
+    y: (ng, 6) state; up, vp: driving-DOF displacement and velocity at t; writes dy,
+    fplate (nd,) = force ON the plate [N, N] per contact, normal and slip at each plate
+    contact. hold: the plate-contact friction is fbar[k] (held over the step, its work
+    booked by the scheme) instead of eq. (5). Returns (shock power, viscous power,
+    friction power, contact potential energy, largest slip relaxation rate of a granule
+    contact) [W, W, W, J, 1/s]; RK4 needs h times that rate below ~2.8. One function
+    (not one per contact kind): calls that pass the model tuples cost more per step
+    than the loops themselves when the medium is small.
+    """
+    ng = y.shape[0]
+    for i in range(ng):
+        dy[i, 0] = y[i, 3]
+        dy[i, 1] = y[i, 4]
+        dy[i, 2] = y[i, 5]
+        dy[i, 3] = 0.0
+        dy[i, 4] = 0.0
+        dy[i, 5] = 0.0
+    p_shock = 0.0
+    p_visc = 0.0
+    p_fric = 0.0
+    e_pot = 0.0
+    rate = 0.0
+    if not cfg.load_on_plate:  # the shock on the loaded granules
+        amp = cfg.q0 * time_profile(t, cfg.duration)
+        if amp != 0.0:
+            for i in range(ng):
+                fx = amp * g.shock_force[i]
+                tq = amp * g.shock_torque[i]
+                dy[i, 3] += fx
+                dy[i, 5] += tq
+                p_shock += fx * y[i, 3] + tq * y[i, 5]
+    for p in range(g.pair_ij.shape[0]):  # granule-granule contacts
+        i = g.pair_ij[p, 0]
+        j = g.pair_ij[p, 1]
+        ri = g.radius[i]
+        rj = g.radius[j]
+        delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
+        if delta <= 0.0:
+            continue
+        ai = contact_arm(ri, delta, 0.5 * cfg.arm_shrink)
+        aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
+        ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
+        c = g.pair_coef[p]
+        n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
+        rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + 1.0 / g.mass[j]
+                                              + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]))
+        fx = -n * nx + f * nz  # on i: -n nvec - f tvec, tvec = (-nz, nx); on j the opposite
+        fz = -n * nz - f * nx
+        dy[i, 3] += fx
+        dy[i, 4] += fz
+        dy[j, 3] -= fx
+        dy[j, 4] -= fz
+        dy[i, 5] -= f * ai
+        dy[j, 5] -= f * aj
+        p_visc += pv
+        p_fric += pf
+        e_pot += ep
+    for w in range(g.wall_i.shape[0]):  # rigid walls
+        i = g.wall_i[w]
+        ri = g.radius[i]
+        nx = g.wall_geo[w, 0]
+        nz = g.wall_geo[w, 1]
+        delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, g.wall_geo[w, 2])
+        if delta <= 0.0:
+            continue
+        ai = contact_arm(ri, delta, cfg.arm_shrink)
+        ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
+        c = g.wall_coef[w]
+        n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
+        rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i]))
+        dy[i, 3] += -n * nx + f * nz
+        dy[i, 4] += -n * nz - f * nx
+        dy[i, 5] -= f * ai
+        p_visc += pv
+        p_fric += pf
+        e_pot += ep
+    for k in range(g.pc_i.shape[0]):  # plate contacts through the rigid layers, n = (1, 0)
+        i = g.pc_i[k]
+        ri = g.radius[i]
+        delta = plate_overlap(y[i, 0], ri, g.pc_x[k] + up[2 * k])
+        ai = contact_arm(ri, max(delta, 0.0), cfg.arm_shrink)
+        ddot, vt = plate_rates(y[i, 3], y[i, 4], y[i, 5], ai, vp[2 * k], vp[2 * k + 1])
+        n = 0.0
+        f = 0.0
+        pf = 0.0
+        if delta > 0.0:
+            c = g.pc_coef[k]
+            n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
+            if not hold:  # the granule side only: the plate side of this map is criterion (8)
+                rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i]))
+            dy[i, 3] -= n
+            p_visc += pv
+            e_pot += ep
+        if hold:
+            f = fbar[k]
+            pf = 0.0
+        if f != 0.0:
+            dy[i, 4] -= f
+            dy[i, 5] -= f * ai
+            p_fric += pf
+        fplate[2 * k] = n
+        fplate[2 * k + 1] = f
+        normal[k] = n
+        slip[k] = vt
+    for i in range(ng):
+        dy[i, 3] /= g.mass[i]
+        dy[i, 4] /= g.mass[i]
+        dy[i, 5] /= g.inertia[i]
+    return p_shock, p_visc, p_fric, e_pot, rate
+
+
+@njit(cache=True)
+def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
+    """One RK4 step of the granules from st.y with the plate's contact points at
+    stage[0], stage[1] (u, v at t + h/2) and stage[2], stage[3] (u, v at t + h).
+
+    Stage 1 reuses st.k1/st.p1 (first same as last), unless hold (the plate-contact
+    friction held at w.fbar over the step), which changes it. Writes w.ynew, w.kend,
+    w.fnew (forces on the plate at t + h), w.normal_new, w.slip_new, w.pend (powers at
+    t + h) and w.dacc (shock, viscous, friction work over the step). Returns (stored
+    contact energy at t + h [J], largest slip relaxation rate [1/s]).
+    """
+    y0 = st.y
+    ng = y0.shape[0]
+    k1 = st.k1
+    p1 = st.p1
+    if hold:
+        pr = granular_rhs(t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, True, w.fbar)
+        w.p1h[0] = pr[0]
+        w.p1h[1] = pr[1]
+        w.p1h[2] = pr[2]
+        k1 = w.k1h
+        p1 = w.p1h
+    hh = 0.5 * h
+    for i in range(ng):
+        for c in range(6):
+            w.ytmp[i, c] = y0[i, c] + hh * k1[i, c]
+    p2 = granular_rhs(t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k2, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar)
+    for i in range(ng):
+        for c in range(6):
+            w.ytmp[i, c] = y0[i, c] + hh * w.k2[i, c]
+    p3 = granular_rhs(t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k3, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar)
+    for i in range(ng):
+        for c in range(6):
+            w.ytmp[i, c] = y0[i, c] + h * w.k3[i, c]
+    p4 = granular_rhs(t + h, w.ytmp, stage[2], stage[3], g, cfg, w.k4, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar)
+    h6 = h / 6.0
+    for i in range(ng):
+        for c in range(6):
+            w.ynew[i, c] = y0[i, c] + h6 * (k1[i, c] + 2.0 * w.k2[i, c] + 2.0 * w.k3[i, c] + w.k4[i, c])
+    for c in range(3):
+        w.dacc[c] = h6 * (p1[c] + 2.0 * p2[c] + 2.0 * p3[c] + p4[c])
+    pe = granular_rhs(t + h, w.ynew, stage[2], stage[3], g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar)
+    w.pend[0] = pe[0]
+    w.pend[1] = pe[1]
+    w.pend[2] = pe[2]
+    return pe[3], pe[4]
+
+
+@njit(cache=True)
+def kinetic_energies(y, g):
+    """Horizontal, vertical and rotational kinetic energy of the granules [J] (eq. 10)."""
+    kx = 0.0
+    ky = 0.0
+    kr = 0.0
+    for i in range(y.shape[0]):
+        kx += 0.5 * g.mass[i] * y[i, 3] * y[i, 3]
+        ky += 0.5 * g.mass[i] * y[i, 4] * y[i, 4]
+        kr += 0.5 * g.inertia[i] * y[i, 5] * y[i, 5]
+    return kx, ky, kr
+
+
+#: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps
+#: h * (friction relaxation rate of every granule contact) below this bound.
+RK4_FRICTION_LIMIT = 1.0
+
+
+@njit(cache=True)
+def rk4_limit(h, rate):
+    """The step h [s], cut so that h * rate stays within RK4_FRICTION_LIMIT."""
+    if rate * h > RK4_FRICTION_LIMIT:
+        return RK4_FRICTION_LIMIT / rate
+    return h

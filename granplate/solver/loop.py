@@ -1,0 +1,257 @@
+"""The compiled time loop: choose the step, let the scheme try it, commit or retry,
+check the energy balance (eq. 11) and record the output. Scheme-independent; the
+scheme's hooks are picked at compile time from its scratch type (solver/schemes).
+
+Everything here is numba-compiled (cached on disk), takes only arrays and named tuples
+of arrays, allocates nothing per step and runs no Python per step.
+"""
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from granplate.physics.energy import energy_residual, energy_total
+from granplate.solver import schemes as S
+from granplate.solver.granular import granular_rhs, kinetic_energies
+from granplate.solver.interface import accept_contacts, contact_modulus, first_guess
+from granplate.solver.ladder import level_step
+from granplate.solver.plate_modal import driving_dofs, modal_acceleration, plate_energy, step_matrices
+from granplate.solver.state import (
+    A_FRIC, A_SHOCK_G, A_SHOCK_P, A_VISC, C_ITERS, C_LEVEL, C_OUT, C_RETRIES, C_STEPS, CUSTOM_H,
+    D_FRIC, D_VISC, E_GRAN, E_IN_MAX, E_PLATE, E_POT, E_POTG, E_SHOCK, E_ZERO, ERR_BUFFER,
+    ERR_CONTACT, ERR_ENERGY, ERR_H, ERR_ITER, ERR_LAM, ERR_N, ERR_NAN, ERR_NOCONV, ERR_RESID,
+    ERR_T, ERR_VT, H_LAST, KE_ROT, KE_X, KE_Y, N_LEVELS, OK, PAUSED, RES_LAST, RESID, RESID_MAX,
+    S_DT_MAX, S_DT_MIN, S_ITERS, S_LAM_MAX, S_RETRIES, S_STEPS, T_NOW,
+)
+
+
+@njit(cache=True)
+def initialise(st, g, p, cfg, w):
+    """Forces, accelerations and energies at t = 0 (state y, q, qd already set)."""
+    pr = granular_rhs(st.clock[T_NOW], st.y, st.u, st.v, g, cfg, st.k1, st.force, st.normal, st.slip, False, w.fbar)
+    st.p1[0] = pr[0]
+    st.p1[1] = pr[1]
+    st.p1[2] = pr[2]
+    st.clock[E_POT] = pr[3]
+    modal_acceleration(st.clock[T_NOW], st, p, cfg, st.force)
+    driving_dofs(st, p)
+    for d in range(st.force.shape[0]):
+        st.force_prev[d] = st.force[d]
+        st.pforce[d] = st.force[d]
+    kx, ky, kr = kinetic_energies(st.y, g)
+    e0 = kx + ky + kr + pr[3] + plate_energy(st, p)
+    st.clock[E_ZERO] = e0
+    st.clock[E_IN_MAX] = e0
+    reset_interval(w)
+
+
+@njit(cache=True)
+def reset_interval(w):
+    """Restart the per-output-interval maxima."""
+    for k in range(w.lam_int.shape[0]):
+        w.lam_int[k] = 0.0
+        w.it_int[k] = 0
+    w.dt_int[0] = 1e300
+    w.dt_int[1] = 0.0
+    w.res_int[0] = 0.0
+
+
+@njit(cache=True)
+def energy_terms(st, g, p):
+    """The terms of eq. (11) at t_n: (E_shock, E_g, E_p, KE_x, KE_y, KE_rot) [J]."""
+    kx, ky, kr = kinetic_energies(st.y, g)
+    eg = kx + ky + kr + st.clock[E_POT]
+    ep = plate_energy(st, p)
+    eshock = st.acc[A_SHOCK_G] + st.acc[A_SHOCK_P]
+    return eshock, eg, ep, kx, ky, kr
+
+
+@njit(cache=True)
+def record(o, st, g, p, w, out):
+    """Write the state at t_n into output row o and restart the interval maxima."""
+    eshock, eg, ep, kx, ky, kr = energy_terms(st, g, p)
+    e_in = st.clock[E_ZERO] + eshock
+    denom = max(st.clock[E_IN_MAX], 1e-300)
+    out.t[o] = st.clock[T_NOW]
+    for i in range(st.y.shape[0]):
+        for c in range(6):
+            out.y[o, i, c] = st.y[i, c]
+    e = out.energy[o]
+    e[E_SHOCK] = eshock
+    e[E_GRAN] = eg
+    e[E_PLATE] = ep
+    e[D_VISC] = st.acc[A_VISC]
+    e[D_FRIC] = st.acc[A_FRIC]
+    e[KE_X] = kx
+    e[KE_Y] = ky
+    e[KE_ROT] = kr
+    e[RESID] = energy_residual(energy_total(eg, ep, st.acc[A_VISC], st.acc[A_FRIC]), e_in, denom)
+    e[RESID_MAX] = w.res_int[0]
+    e[E_POTG] = st.clock[E_POT]
+    for m in range(st.q.shape[0]):
+        out.q[o, m] = st.q[m]
+        out.qd[o, m] = st.qd[m]
+    lam_max = 0.0
+    for k in range(st.normal.shape[0]):
+        out.force[o, k, 0] = st.force[2 * k]
+        out.force[o, k, 1] = st.force[2 * k + 1]
+        out.slip[o, k] = st.slip[k]
+        out.lam[o, k] = w.lam_int[k]
+        out.iters[o, k] = w.it_int[k]
+        lam_max = max(lam_max, w.lam_int[k])
+    s = out.stats[o]
+    s[S_STEPS] = st.count[C_STEPS]
+    s[S_DT_MIN] = w.dt_int[0] if w.dt_int[1] > 0.0 else 0.0
+    s[S_DT_MAX] = w.dt_int[1]
+    s[S_ITERS] = st.count[C_ITERS]
+    s[S_RETRIES] = st.count[C_RETRIES]
+    s[S_LAM_MAX] = lam_max
+    reset_interval(w)
+
+
+@njit(cache=True)
+def fail(status, st, t, h, contact, n, vt, lam, resid, it):
+    """Fill the failure record st.err (time, contact, |N|, slip, |lambda|, step,
+    residual, iterations) and return `status`."""
+    st.err[ERR_T] = t
+    st.err[ERR_CONTACT] = contact
+    st.err[ERR_N] = n
+    st.err[ERR_VT] = vt
+    st.err[ERR_LAM] = lam
+    st.err[ERR_H] = h
+    st.err[ERR_RESID] = resid
+    st.err[ERR_ITER] = it
+    return status
+
+
+@njit(cache=True)
+def step_too_small(t, h, it, worst, lam, normal, slip, st):
+    """ERR_NOCONV: the step would go below dt_min, at `worst` (or -1)."""
+    if worst < 0:
+        return fail(ERR_NOCONV, st, t, h, -1.0, 0.0, 0.0, lam, 0.0, it)
+    return fail(ERR_NOCONV, st, t, h, worst, normal[worst], slip[worst], lam, 0.0, it)
+
+
+@njit(cache=True)
+def check_energy(h, st, g, p, cfg, w):
+    """Eq. (11) after an accepted step: keep the residual's running values; returns OK,
+    ERR_NAN or ERR_ENERGY (above energy_tol)."""
+    eshock, eg, ep, kx, ky, kr = energy_terms(st, g, p)
+    e_in = st.clock[E_ZERO] + eshock
+    if e_in > st.clock[E_IN_MAX]:
+        st.clock[E_IN_MAX] = e_in
+    total = energy_total(eg, ep, st.acc[A_VISC], st.acc[A_FRIC])
+    if not (math.isfinite(total) and math.isfinite(e_in)):
+        return fail(ERR_NAN, st, st.clock[T_NOW], h, -1.0, 0.0, 0.0, 0.0, 0.0, 0)
+    denom = st.clock[E_IN_MAX]
+    if denom > 0.0:
+        res = energy_residual(total, e_in, denom)
+        st.clock[RES_LAST] = res
+        w.res_int[0] = max(w.res_int[0], abs(res))
+        if abs(res) > cfg.energy_tol:
+            return fail(ERR_ENERGY, st, st.clock[T_NOW], h, -1.0, 0.0, 0.0, 0.0, res, 0)
+    return OK
+
+
+@njit(cache=True)
+def prepare_slot(sw, h, slot, st, p, w):
+    """G(h) and the scheme's matrices for `slot`: once per ladder level, and for an
+    odd step (slot N_LEVELS) whenever it changes (see `needs_matrices`)."""
+    if slot == N_LEVELS:
+        st.clock[CUSTOM_H] = h
+    else:
+        w.g_ok[slot] = 1
+    step_matrices(h, p, w.dmode[slot], w.gmat[slot])
+    S.prepare_level(sw, h, p, slot)
+
+
+@njit(cache=True)
+def needs_matrices(h, slot, clock, g_ok):
+    """Whether `slot` lacks its matrices for step h (checked every step, so it takes
+    arrays, not the state tuples)."""
+    if slot == N_LEVELS:
+        return clock[CUSTOM_H] != h
+    return g_ok[slot] == 0
+
+
+@njit(cache=True)
+def accept_granular(t, h, land, t_out, plate_work, e_pot, st, w):
+    """Take the trial step's granule state, derivatives and work into the state and
+    move the clock (onto the output time when the step lands on it)."""
+    for i in range(st.y.shape[0]):
+        for c in range(6):
+            st.y[i, c] = w.ynew[i, c]
+            st.k0[i, c] = st.k1[i, c]
+            st.k1[i, c] = w.kend[i, c]
+    for c in range(3):
+        st.p1[c] = w.pend[c]
+    st.acc[A_SHOCK_G] += w.dacc[0]
+    st.acc[A_VISC] += w.dacc[1]
+    st.acc[A_FRIC] += w.dacc[2]
+    st.acc[A_SHOCK_P] += plate_work
+    st.clock[E_POT] = e_pot
+    st.clock[T_NOW] = t_out if land else t + h
+    st.clock[H_LAST] = h
+    st.count[C_STEPS] += 1
+    w.dt_int[0] = min(w.dt_int[0], h)
+    w.dt_int[1] = max(w.dt_int[1], h)
+
+
+@njit(cache=True)
+def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
+    """Advance from st.clock[T_NOW] to t_stop (an output time) with the scheme whose
+    scratch is sw, trying at most max_attempts steps. Returns a status: OK, PAUSED
+    (budget spent; call again) or an error, with st.err filled and the state the last
+    accepted one."""
+    for _ in range(max_attempts):
+        t = st.clock[T_NOW]
+        if t >= t_stop - 1e-9 * cfg.dt_min:
+            return OK
+        o = st.count[C_OUT]
+        if o >= out.t.shape[0]:
+            return ERR_BUFFER
+        level, h, slot, land = S.plan(sw, st.count, cfg, t - out.target[o - 1], out.target[o] - t)
+        if needs_matrices(h, slot, st.clock, w.g_ok):
+            prepare_slot(sw, h, slot, st, p, w)
+        ratio = h / st.clock[H_LAST] if st.clock[H_LAST] > 0.0 else 0.0
+        first_guess(ratio, st, w)
+        converged, it, worst, e_pot, rate = S.attempt(sw, t, h, slot, st, g, p, cfg, w)
+        st.count[C_ITERS] += it
+        if not converged:
+            st.count[C_RETRIES] += 1
+            if level_step(level + 4, cfg) < cfg.dt_min or level + 4 >= N_LEVELS:
+                lam = contact_modulus(worst, h, w.gmat[slot], g, w.normal_new, w.slip_new) if worst >= 0 else 0.0
+                return step_too_small(t, h, it, worst, lam, w.normal_new, w.slip_new, st)
+            st.count[C_LEVEL] = level + 4
+            continue
+        err, retry, plate_work, fric_work = S.judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w)
+        if retry >= 0:
+            st.count[C_RETRIES] += 1
+            st.count[C_LEVEL] = retry
+            continue
+        plate_work = S.commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w)
+        accept_granular(t, h, land, out.target[o], plate_work, e_pot, st, w)
+        lam_max = accept_contacts(h, w.gmat[slot], g.pc_coef, w.normal_new, w.slip_new, w.conv_iter,
+                                  st.normal, st.slip, w.lam_int, w.it_int)
+        new_level, h_new = S.next_level(sw, h, slot, level, err, lam_max, rate, st.clock[T_NOW], cfg)
+        if level_step(new_level, cfg) < cfg.dt_min:
+            return step_too_small(st.clock[T_NOW], h_new, it, worst_contact(w), lam_max, st.normal, st.slip, st)
+        st.count[C_LEVEL] = new_level
+        status = check_energy(h, st, g, p, cfg, w)
+        if status != OK:
+            return status
+        if land:
+            record(o, st, g, p, w, out)
+            st.count[C_OUT] = o + 1
+    return OK if st.clock[T_NOW] >= t_stop - 1e-9 * cfg.dt_min else PAUSED
+
+
+@njit(cache=True)
+def worst_contact(w):
+    """The plate contact with the largest |lambda| since the last output (-1: none)."""
+    kw = -1
+    for k in range(w.lam_int.shape[0]):
+        if kw < 0 or w.lam_int[k] >= w.lam_int[kw]:
+            kw = k
+    return kw

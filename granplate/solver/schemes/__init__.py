@@ -1,0 +1,124 @@
+"""The coupling schemes, one module each, behind one interface, and their registry.
+
+A scheme module defines NAME, a `Scratch` named tuple (its own scratch arrays),
+`new_scratch(ng, nm, nk)`, and six compiled hooks, each taking its Scratch first:
+
+    plan(sw, count, cfg, pos, rem) -> (level, h, slot, land)
+    prepare_level(sw, h, p, slot)
+    attempt(sw, t, h, slot, st, g, p, cfg, w) -> (converged, iterations, worst, e_pot, rate)
+    judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w) -> (err, retry, work, fric_work)
+    commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w) -> plate work [J]
+    next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg) -> (level, h_new)
+
+The time loop (solver/loop.py) calls the hooks below; numba picks the scheme's function
+from the type of the scratch at compile time (one compiled loop per scheme, each cached
+on disk; no Python and no function pointer per step). Hooks called every step take
+only the arrays they need: a call that passes the big state tuples costs ~0.4 us. Adding a scheme: write its module
+and add it to SCHEMES (and its name to model.inputs.SCHEME_NAMES).
+"""
+from __future__ import annotations
+
+from types import ModuleType
+
+from numba.extending import overload
+
+from granplate.model.inputs import SCHEME_NAMES
+from granplate.solver.schemes import implicit, paper
+
+#: the registered schemes by name, in the order of model.inputs.SCHEME_NAMES.
+SCHEMES: dict[str, ModuleType] = {m.NAME: m for m in (paper, implicit)}
+_BY_SCRATCH = {m.Scratch: m for m in SCHEMES.values()}
+assert tuple(SCHEMES) == SCHEME_NAMES, "model.inputs.SCHEME_NAMES and SCHEMES disagree"
+
+
+def scheme(name_or_number: str | int) -> ModuleType:
+    """The scheme module called `name_or_number` (a name or Config.scheme)."""
+    name = name_or_number
+    if isinstance(name_or_number, int):
+        if not 0 <= name_or_number < len(SCHEME_NAMES):
+            raise ValueError(f"scheme number {name_or_number}: allowed 0 to {len(SCHEME_NAMES) - 1}")
+        name = SCHEME_NAMES[name_or_number]
+    if name not in SCHEMES:
+        raise ValueError(f"solver.scheme = {name!r}: allowed {', '.join(SCHEMES)}")
+    return SCHEMES[name]
+
+
+def _hook_of(sw, name: str):
+    """The compiled hook `name` of the scheme whose Scratch type is `sw` (numba type)."""
+    module = _BY_SCRATCH.get(getattr(sw, "instance_class", None))
+    return None if module is None else getattr(module, name)
+
+
+def plan(sw, count, cfg, pos, rem):
+    """The scheme's level and step (see the module docstring)."""
+    raise NotImplementedError("compiled use only")
+
+
+def prepare_level(sw, h, p, slot):
+    """The scheme's per-level matrices."""
+    raise NotImplementedError("compiled use only")
+
+
+def attempt(sw, t, h, slot, st, g, p, cfg, w):
+    """The scheme's trial step."""
+    raise NotImplementedError("compiled use only")
+
+
+def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
+    """The scheme's acceptance test of a converged trial step."""
+    raise NotImplementedError("compiled use only")
+
+
+def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
+    """The scheme's plate update of an accepted step."""
+    raise NotImplementedError("compiled use only")
+
+
+def next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg):
+    """The scheme's next step."""
+    raise NotImplementedError("compiled use only")
+
+
+@overload(plan)
+def _plan(sw, count, cfg, pos, rem):
+    fn = _hook_of(sw, "plan")
+    if fn is not None:
+        return lambda sw, count, cfg, pos, rem: fn(sw, count, cfg, pos, rem)
+
+
+@overload(prepare_level)
+def _prepare_level(sw, h, p, slot):
+    fn = _hook_of(sw, "prepare_level")
+    if fn is not None:
+        return lambda sw, h, p, slot: fn(sw, h, p, slot)
+
+
+@overload(attempt)
+def _attempt(sw, t, h, slot, st, g, p, cfg, w):
+    fn = _hook_of(sw, "attempt")
+    if fn is not None:
+        return lambda sw, t, h, slot, st, g, p, cfg, w: fn(sw, t, h, slot, st, g, p, cfg, w)
+
+
+@overload(judge)
+def _judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
+    fn = _hook_of(sw, "judge")
+    if fn is not None:
+        return lambda sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w: fn(
+            sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w)
+
+
+@overload(commit)
+def _commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
+    fn = _hook_of(sw, "commit")
+    if fn is not None:
+        return lambda sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w: fn(
+            sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w)
+
+
+@overload(next_level)
+def _next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg):
+    fn = _hook_of(sw, "next_level")
+    if fn is not None:
+        return lambda sw, h, slot, level, err, lam_max, rate, t_now, cfg: fn(
+            sw, h, slot, level, err, lam_max, rate, t_now, cfg)

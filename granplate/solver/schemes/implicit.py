@@ -1,0 +1,240 @@
+"""The implicit coupling scheme (the default).
+
+One step t -> t + h:
+1. the plate modes are advanced exactly for interface forces linear over the step
+   (Newmark above omega h = EXACT_OMEGA_H, where the exact response would alias), so the
+   driving DOFs' motion at t + h/2 and t + h is affine in the unknowns U (exact_predict,
+   exact_matrices); the normal forces are linear from N_n to U, the plate-contact
+   friction is held at U over the step for the plate and the granule alike (backward
+   Euler for the stiff friction: L-stable, no stick chatter), its work booked exactly;
+2. U is found by Newton in (normal force, end slip rate) with the full Jacobian, the
+   contacts coupled through the plate (schemes/newton.py);
+3. the step is accepted, or redone smaller, on a local error estimate (the distance of
+   the interface and granule forces from their extrapolation) and the growth of the
+   energy residual (eq. 11); steps are output_interval / 2^k and tile every interval.
+"""
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm, friction_magnitude, plate_overlap
+from granplate.physics.energy import energy_residual
+from granplate.solver.granular import kinetic_energies, rk4_granular_step, rk4_limit
+from granplate.solver.interface import forces_converged
+from granplate.solver.ladder import dyadic_level, level_for, level_step, step_to_output
+from granplate.solver.plate_modal import (
+    N_MCOEF, exact_correct, exact_matrices, exact_predict, modal_coefficients,
+)
+from granplate.solver.schemes.newton import held_friction, newton_update
+from granplate.solver.state import (
+    A_FRIC, A_SHOCK_G, A_SHOCK_P, A_VISC, C_LEVEL, E_IN_MAX, E_ZERO, F_SCALE, H_LAST, N_LEVELS,
+    RES_LAST,
+)
+
+NAME = "implicit"
+#: a step whose error estimate exceeds REJECT_FACTOR * error_tol is redone smaller.
+REJECT_FACTOR = 2.0
+#: the step is at most the shock's duration / SHOCK_STEPS while it acts.
+SHOCK_STEPS = 100
+#: share of solver.energy_tol the step control lets the residual drift over a run.
+ENERGY_STEP_FRACTION = 0.5
+
+
+class Scratch(NamedTuple):
+    """The implicit scheme's own scratch."""
+
+    ustar: np.ndarray  # (4, nd) known part of the driving-DOF motion (stage rows)
+    jac: np.ndarray  # (nd, nd) Newton matrix
+    rhs: np.ndarray  # (nd,)
+    vguess: np.ndarray  # (nk,) Newton iterate of the end slip rates
+    mcoef: np.ndarray  # (N_LEVELS + 1, nm, N_MCOEF) modal coefficients per level
+    mmat: np.ndarray  # (N_LEVELS + 1, 4, nd, nd) driving-DOF response to the unknowns
+    qn: np.ndarray  # (nm,) modes at the end of the step being tried
+    qdn: np.ndarray
+
+
+def new_scratch(ng: int, nm: int, nk: int) -> Scratch:
+    """Scratch for ng granules, nm modes, nk plate contacts."""
+    nd = 2 * nk
+    z = np.zeros
+    return Scratch(ustar=z((4, nd)), jac=z((nd, nd)), rhs=z(nd), vguess=z(nk),
+                   mcoef=z((N_LEVELS + 1, nm, N_MCOEF)), mmat=z((N_LEVELS + 1, 4, nd, nd)),
+                   qn=z(nm), qdn=z(nm))
+
+
+@njit(cache=True)
+def plan(sw, count, cfg, pos, rem):
+    """A dyadic level that tiles the output interval from `pos` [s] on, and its step
+    (on the ladder when it lands on the output `rem` [s] away). Returns (level, h,
+    slot, land)."""
+    level = dyadic_level(count[C_LEVEL], pos, cfg)
+    count[C_LEVEL] = level
+    h, slot, land = step_to_output(level, rem, True, cfg)
+    return level, h, slot, land
+
+
+@njit(cache=True)
+def prepare_level(sw, h, p, slot):
+    """Modal coefficients and driving-DOF response matrices for a step h."""
+    modal_coefficients(h, p.omega2, sw.mcoef[slot])
+    exact_matrices(p.phi_d, sw.mcoef[slot], sw.mmat[slot])
+
+
+@njit(cache=True)
+def stage_motion(mmat, ustar, force, stage):
+    """Driving-DOF motion at t + h/2 and t + h: the known part ustar plus the response
+    mmat to the unknown interface forces. Writes stage rows u(h/2), v(h/2), u(h), v(h)."""
+    nd = force.shape[0]
+    for r in range(4):
+        for d in range(nd):
+            acc = ustar[r, d]
+            for e in range(nd):
+                acc += mmat[r, d, e] * force[e]
+            stage[r, d] = acc
+
+
+@njit(cache=True)
+def held_friction_target(normal, normal_new, slip_new, g, fnew):
+    """The value the held plate-contact friction must take, into fnew's odd entries:
+    mu Nbar tanh(k_s v_t,n+1) (eq. 5) with Nbar = (|N_n| + |N_n+1|)/2: the end slip
+    rate (backward Euler) but the normal force averaged over the step, so that in gross
+    slip the friction impulse is second-order accurate like the normal one."""
+    for k in range(g.pc_i.shape[0]):
+        nbar = 0.5 * (normal[k] + normal_new[k])
+        fnew[2 * k + 1] = friction_magnitude(nbar, slip_new[k], g.pc_coef[k, COEF_MU], g.pc_coef[k, COEF_KS])
+
+
+@njit(cache=True)
+def attempt(sw, t, h, slot, st, g, p, cfg, w):
+    """Known plate motion, then Newton on the interface unknowns from the guess in
+    w.fguess. Returns (converged, iterations, worst contact, stored energy at t + h,
+    largest slip relaxation rate)."""
+    exact_predict(t, h, st, p, cfg, sw.mcoef[slot], sw.ustar)
+    for k in range(sw.vguess.shape[0]):
+        sw.vguess[k] = st.slip[k]
+    held_friction(st.normal, w.fguess, sw.vguess, g, w.fbar)
+    converged = False
+    worst = -1
+    e_pot = 0.0
+    rate = 0.0
+    it = 0
+    while it < cfg.max_iter:
+        it += 1
+        stage_motion(sw.mmat[slot], sw.ustar, w.fguess, w.stage)
+        e_pot, rate = rk4_granular_step(t, h, w.stage, True, st, g, cfg, w)
+        held_friction_target(st.normal, w.normal_new, w.slip_new, g, w.fnew)
+        converged, worst = forces_converged(it, cfg.rtol, cfg.atol, w.fnew, w.fguess, w.conv_iter)
+        if converged:
+            break
+        newton_update(h, sw.mmat[slot], w.stage[2], g, st, w, sw.jac, sw.rhs, sw.vguess)
+    return converged, it, worst, e_pot, rate
+
+
+@njit(cache=True)
+def held_friction_work(st, g, cfg, w):
+    """Energy dissipated over the step by the held plate-contact friction [J], exactly:
+    fbar times the slip displacement (dy_granule + a dtheta - du_plate,y), not a
+    quadrature of fbar v_t (the plate's velocity may vibrate faster than the step)."""
+    work = 0.0
+    for k in range(g.pc_i.shape[0]):
+        i = g.pc_i[k]
+        dy = 2 * k + 1
+        delta = plate_overlap(w.ynew[i, 0], g.radius[i], g.pc_x[k] + w.stage[2, 2 * k])
+        arm = contact_arm(g.radius[i], max(delta, 0.0), cfg.arm_shrink)
+        slide = (w.ynew[i, 1] - st.y[i, 1]) + arm * (w.ynew[i, 2] - st.y[i, 2]) - (w.stage[2, dy] - st.u[dy])
+        work += w.fbar[k] * slide
+    return work
+
+
+@njit(cache=True)
+def step_error(ratio, st, g, cfg, w):
+    """Local error estimate (relative, ~ h^2 F''/2): the distance of the new interface
+    forces and of the granules' net forces (m a, and I alpha / R) from their linear
+    extrapolation over the last two steps, relative to the largest of these forces met
+    so far and at least cfg.force_floor (so a contact's first touch is judged against
+    the forces of the problem, not against itself)."""
+    sc = max(st.clock[F_SCALE], cfg.force_floor)
+    err = 0.0
+    for d in range(w.fguess.shape[0]):
+        u = w.fguess[d]
+        sc = max(sc, abs(u))
+        pred = st.force[d] + ratio * (st.force[d] - st.force_prev[d])
+        err = max(err, abs(u - pred))
+    for i in range(st.y.shape[0]):
+        for c in range(3):
+            m = g.mass[i] if c < 2 else g.inertia[i] / g.radius[i]
+            sc = max(sc, m * abs(w.kend[i, 3 + c]))
+            pred = st.k1[i, 3 + c] + ratio * (st.k1[i, 3 + c] - st.k0[i, 3 + c])
+            err = max(err, m * abs(w.kend[i, 3 + c] - pred))
+    st.clock[F_SCALE] = sc
+    if sc <= 0.0:
+        return 0.0
+    return err / sc
+
+
+@njit(cache=True)
+def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
+    """Error of the converged trial step (nothing committed yet): the local error
+    estimate and the energy residual's growth (eq. 11) over its share. Returns (error
+    relative to error_tol, level to retry at or -1, edge-load work [J], held-friction
+    work [J])."""
+    fric_work = held_friction_work(st, g, cfg, w)
+    work, ep_new = exact_correct(t, h, st, p, cfg, sw.mcoef[slot], w.fguess, sw.qn, sw.qdn)
+    kx, ky, kr = kinetic_energies(w.ynew, g)
+    e_in = st.clock[E_ZERO] + st.acc[A_SHOCK_G] + w.dacc[0] + st.acc[A_SHOCK_P] + work
+    total = (kx + ky + kr + e_pot + ep_new + st.acc[A_VISC] + w.dacc[1]
+             + st.acc[A_FRIC] + w.dacc[2] + fric_work)
+    denom = max(st.clock[E_IN_MAX], e_in)
+    d_res = 0.0
+    if denom > 0.0 and math.isfinite(total):
+        d_res = energy_residual(total, e_in, denom) - st.clock[RES_LAST]
+    err = step_error(ratio, st, g, cfg, w) / cfg.error_tol
+    if not (cfg.q0 != 0.0 and t < cfg.duration):  # (E_in ~ 0 while the shock starts)
+        # each step may add its share of energy_tol * ENERGY_STEP_FRACTION, the run
+        # counted in steps of dt_max
+        err = max(err, abs(d_res) * cfg.t_end / (cfg.energy_tol * ENERGY_STEP_FRACTION * cfg.dt_max))
+    retry = -1
+    if err > REJECT_FACTOR and st.clock[H_LAST] > 0.0:
+        new_level = max(level_for(h * max(0.2, 0.9 / math.sqrt(err)), cfg), level + 1)
+        if level_step(new_level, cfg) >= cfg.dt_min and new_level < N_LEVELS:
+            retry = new_level
+    return err, retry, work, fric_work
+
+
+@njit(cache=True)
+def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
+    """Take the trial step's modes and driving-DOF motion; book the held friction's
+    work. Returns the edge load's work over the step [J]."""
+    w.dacc[2] += fric_work
+    for m in range(st.q.shape[0]):
+        st.q[m] = sw.qn[m]
+        st.qd[m] = sw.qdn[m]
+    for d in range(st.u.shape[0]):
+        st.u[d] = w.stage[2, d]
+        st.v[d] = w.stage[3, d]
+        st.a[d] = 0.0  # not used by the modal integration of this scheme
+        st.pforce[d] = w.fguess[d]
+        st.force_prev[d] = st.force[d]
+        st.force[d] = w.fguess[d]
+    return plate_work
+
+
+@njit(cache=True)
+def next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg):
+    """The next step from the error estimate (grow at most 2x), RK4 stable on the
+    friction, the shock pulse resolved; below dt_min it goes on at dt_min (accuracy,
+    not stability). Returns (level, step [s])."""
+    h_lvl = level_step(level, cfg)
+    grow = 2.0 if err <= 0.0 else min(2.0, max(0.3, 0.9 / math.sqrt(err)))
+    h_new = min(max(h, h_lvl if slot == N_LEVELS else h) * grow, cfg.dt_max)
+    h_new = rk4_limit(h_new, rate)
+    if cfg.q0 != 0.0 and t_now < cfg.duration:
+        h_new = min(h_new, cfg.duration / SHOCK_STEPS)
+    new_level = level_for(h_new, cfg)
+    if level_step(new_level, cfg) < cfg.dt_min:
+        new_level = level_for(cfg.dt_min, cfg) - 1
+    return new_level, h_new

@@ -1,0 +1,150 @@
+"""The loop's state, shared scratch and output buffers, and the layouts of their small
+bookkeeping arrays (named columns). Allocated once per run, updated in place.
+"""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+# clock (float64)
+T_NOW, H_LAST, E_IN_MAX, E_ZERO, E_POT, CUSTOM_H, F_SCALE, RES_LAST = 0, 1, 2, 3, 4, 5, 6, 7
+N_CLOCK = 10
+# count (int64)
+C_STEPS, C_LEVEL, C_OUT, C_ITERS, C_RETRIES = 0, 1, 2, 3, 4
+N_COUNT = 8
+# acc (float64): integrated powers
+A_SHOCK_G, A_VISC, A_FRIC, A_SHOCK_P = 0, 1, 2, 3
+N_ACC = 4
+# energy output columns
+(
+    E_SHOCK, E_GRAN, E_PLATE, D_VISC, D_FRIC, KE_X, KE_Y, KE_ROT, RESID, RESID_MAX, E_POTG,
+) = range(11)
+N_ENERGY = 11
+# step-statistics output columns
+S_STEPS, S_DT_MIN, S_DT_MAX, S_ITERS, S_RETRIES, S_LAM_MAX = range(6)
+N_STEPSTAT = 6
+# failure record (float64)
+ERR_T, ERR_CONTACT, ERR_N, ERR_VT, ERR_LAM, ERR_H, ERR_RESID, ERR_ITER = range(8)
+N_ERR = 8
+# status codes of `advance`; PAUSED: the chunk's step budget is spent (not an error)
+OK, ERR_NAN, ERR_ENERGY, ERR_NOCONV, ERR_BUFFER, PAUSED = 0, 1, 2, 3, 4, 5
+
+#: time steps live on a ladder h_l = dt_max 2^(-l/4), l < N_LEVELS; slot N_LEVELS of the
+#: per-level arrays holds an odd step (one that lands on an output time).
+LEVEL_RATIO = 2.0 ** -0.25
+N_LEVELS = 200
+
+
+class State(NamedTuple):
+    """Everything at t_n (updated in place by `advance`)."""
+
+    y: np.ndarray  # (ng, 6): x, y, theta, vx, vy, omega
+    acc: np.ndarray  # (N_ACC,)
+    q: np.ndarray  # (nm,) modal displacement, velocity, acceleration
+    qd: np.ndarray
+    qdd: np.ndarray
+    u: np.ndarray  # (nd,) driving-DOF displacement, velocity, acceleration
+    v: np.ndarray
+    a: np.ndarray
+    force: np.ndarray  # (nd,) interface force on the plate
+    force_prev: np.ndarray
+    k1: np.ndarray  # (ng, 6) time derivative at t_n
+    k0: np.ndarray  # (ng, 6) time derivative at t_n-1
+    pforce: np.ndarray  # (nd,) the force the plate moved with over the last step
+    p1: np.ndarray  # (3,) shock, viscous, friction power at t_n
+    normal: np.ndarray  # (nk,) |N| at plate contacts
+    slip: np.ndarray  # (nk,) tangential slip rate at plate contacts
+    clock: np.ndarray
+    count: np.ndarray
+    err: np.ndarray
+
+
+class Work(NamedTuple):
+    """Scratch every scheme uses: the RK4 stages, the trial step's end values, the
+    per-level G(h) and the per-output-interval maxima (allocated once)."""
+
+    ytmp: np.ndarray  # (ng, 6) RK4 stage state
+    ynew: np.ndarray  # (ng, 6) granules at the end of the trial step
+    k1h: np.ndarray  # (ng, 6) stage-1 derivative when the plate friction is held
+    k2: np.ndarray
+    k3: np.ndarray
+    k4: np.ndarray
+    kend: np.ndarray  # (ng, 6) derivative at the end of the trial step
+    up: np.ndarray  # (nd,) driving-DOF displacement, velocity of the current RK4 stage
+    vp: np.ndarray
+    fguess: np.ndarray  # (nd,) the interface forces the plate moves with (the unknowns)
+    fbar: np.ndarray  # (nk,) plate-contact friction held over the step
+    stage: np.ndarray  # (4, nd) driving-DOF u, v at t + h/2 and u, v at t + h
+    fnew: np.ndarray  # (nd,) interface forces at the end of the trial step
+    fscratch: np.ndarray
+    pend: np.ndarray  # (3,) shock, viscous, friction power at the end
+    dacc: np.ndarray  # (3,) their integrals over the step
+    p1h: np.ndarray  # (3,) stage-1 powers when the plate friction is held
+    normal_new: np.ndarray  # (nk,) |N| and slip rate at the end of the trial step
+    slip_new: np.ndarray
+    nscratch: np.ndarray
+    sscratch: np.ndarray
+    conv_iter: np.ndarray  # (nk,) int: iteration at which each contact converged
+    dmode: np.ndarray  # (N_LEVELS + 1, nm) 1/(1 + h^2 omega^2/4) per level
+    gmat: np.ndarray  # (N_LEVELS + 1, nd, nd) G(h) per level
+    g_ok: np.ndarray  # (N_LEVELS + 1,) int: level computed
+    lam_int: np.ndarray  # (nk,) max |lambda| since last output
+    it_int: np.ndarray  # (nk,) max iterations since last output
+    dt_int: np.ndarray  # (2,) min, max step since last output
+    res_int: np.ndarray  # (1,) max |residual| since last output
+
+
+class Output(NamedTuple):
+    """Preallocated output buffers at the output times o * out_dt."""
+
+    target: np.ndarray  # (no,) the output times, set by the caller
+    t: np.ndarray  # (no,) the times reached (equal to target)
+    y: np.ndarray  # (no, ng, 6)
+    energy: np.ndarray  # (no, N_ENERGY)
+    q: np.ndarray  # (no, nm)
+    qd: np.ndarray  # (no, nm)
+    force: np.ndarray  # (no, nk, 2) normal, tangential force on the plate
+    slip: np.ndarray  # (no, nk)
+    lam: np.ndarray  # (no, nk) max |lambda| over the interval ending here
+    iters: np.ndarray  # (no, nk) max iterations to converge over the interval
+    stats: np.ndarray  # (no, N_STEPSTAT)
+
+
+def new_state(ng: int, nm: int, nk: int) -> State:
+    """A zeroed State for ng granules, nm modes and nk plate contacts."""
+    nd = 2 * nk
+    z = np.zeros
+    return State(
+        y=z((ng, 6)), acc=z(N_ACC), q=z(nm), qd=z(nm), qdd=z(nm), u=z(nd), v=z(nd),
+        a=z(nd), force=z(nd), force_prev=z(nd), k1=z((ng, 6)), k0=z((ng, 6)), pforce=z(nd),
+        p1=z(3), normal=z(nk), slip=z(nk), clock=z(N_CLOCK),
+        count=np.zeros(N_COUNT, np.int64), err=z(N_ERR),
+    )
+
+
+def new_work(ng: int, nm: int, nk: int) -> Work:
+    """Shared scratch for ng granules, nm modes and nk plate contacts."""
+    nd = 2 * nk
+    z = np.zeros
+    return Work(
+        ytmp=z((ng, 6)), ynew=z((ng, 6)), k1h=z((ng, 6)), k2=z((ng, 6)), k3=z((ng, 6)),
+        k4=z((ng, 6)), kend=z((ng, 6)), up=z(nd), vp=z(nd), fguess=z(nd), fbar=z(nk),
+        stage=z((4, nd)), fnew=z(nd), fscratch=z(nd), pend=z(3), dacc=z(3), p1h=z(3),
+        normal_new=z(nk), slip_new=z(nk), nscratch=z(nk), sscratch=z(nk),
+        conv_iter=np.zeros(nk, np.int64), dmode=z((N_LEVELS + 1, nm)),
+        gmat=z((N_LEVELS + 1, nd, nd)), g_ok=np.zeros(N_LEVELS + 1, np.int64),
+        lam_int=z(nk), it_int=np.zeros(nk, np.int64), dt_int=z(2), res_int=z(1),
+    )
+
+
+def new_output(times: np.ndarray, ng: int, nm: int, nk: int) -> Output:
+    """Output buffers for the given output times."""
+    z = np.zeros
+    n_out = len(times)
+    return Output(
+        target=np.asarray(times, float).copy(), t=z(n_out), y=z((n_out, ng, 6)),
+        energy=z((n_out, N_ENERGY)), q=z((n_out, nm)), qd=z((n_out, nm)),
+        force=z((n_out, nk, 2)), slip=z((n_out, nk)), lam=z((n_out, nk)),
+        iters=np.zeros((n_out, nk), np.int64), stats=z((n_out, N_STEPSTAT)),
+    )
