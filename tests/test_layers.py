@@ -20,6 +20,7 @@ LAYERS = (
     ("model",),
     ("solver",),
     ("results",),
+    ("figures",),
     ("paper",),
     ("verification",),
     ("bench",),
