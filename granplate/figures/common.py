@@ -56,3 +56,32 @@ def time_axis(ax, t_end_ms: float) -> None:
     ax.set_xlabel("time [ms]")
     ax.set_xlim(0.0, t_end_ms)
     ax.grid(True, lw=0.3, alpha=0.5)
+
+
+#: Two curves of a panel coincide when they differ by less than this fraction of the
+#: panel's largest value (e.g. granules placed symmetrically about the load's centre).
+COINCIDE = 1e-6
+#: Markers of a curve drawn over an identical one, so that both stay visible.
+MARKERS = ("o", "s", "^", "v", "D", "P", "X")
+
+
+def plot_curves(ax, t, curves: list[tuple[str, object, str]], **style) -> list:
+    """Plot (label, values, gid) curves over t; a curve equal to an earlier one (within
+    COINCIDE of the panel's largest value) is drawn dashed with sparse markers, its label
+    saying which it equals, so that no curve hides under another. Returns the lines."""
+    import numpy as np
+
+    arrays = [np.asarray(v, float) for _, v, _ in curves]
+    top = max((float(np.max(np.abs(a))) for a in arrays if a.size), default=0.0)
+    lines, drawn, k_marker = [], [], 0
+    for (label, _, gid), y in zip(curves, arrays):
+        twin = next((lab for lab, yy in drawn if top > 0 and np.max(np.abs(y - yy)) <= COINCIDE * top), None)
+        if twin is None:
+            lines += ax.plot(t, y, label=label, gid=gid, **style)
+        else:
+            marker = MARKERS[k_marker % len(MARKERS)]
+            k_marker += 1
+            lines += ax.plot(t, y, label=f"{label} (= {twin})", gid=gid, ls="--", marker=marker,
+                             markevery=max(len(y) // 12, 1), markersize=4, **style)
+        drawn.append((label, y))
+    return lines

@@ -20,7 +20,7 @@ import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
 
-from granplate.figures.common import new_figure, scenario_name, time_axis
+from granplate.figures.common import new_figure, plot_curves, scenario_name, time_axis
 from granplate.results import analysis as an
 
 #: Beyond this many granules the speeds are drawn as an envelope.
@@ -70,13 +70,17 @@ def energy_curves(ds: xr.Dataset) -> dict[str, tuple[str, np.ndarray]]:
         out["plate"] = ("$E_{plate}$", ds["E_plate"].values)
     dissipated = ds["D_viscous"].values + ds["D_friction"].values
     out["dissipated"] = ("$D_{viscous} + D_{friction}$", dissipated)
-    plate = ds["E_plate"].values if an.has_plate(ds) else 0.0
-    out["total"] = ("$E_{granular} + E_{plate} + D$", ds["E_granular"].values + plate + dissipated)
+    if an.has_plate(ds):
+        out["total"] = ("$E_{granular} + E_{plate} + D$", ds["E_granular"].values + ds["E_plate"].values + dissipated)
+    else:
+        out["total"] = ("$E_{granular} + D$", ds["E_granular"].values + dissipated)
     return out
 
 
-ENERGY_STYLE = {"shock": ("black", ":"), "granular": ("tab:blue", "-"), "plate": ("tab:red", "-"),
-                "dissipated": ("tab:green", "-"), "total": ("tab:purple", "--")}
+#: (colour, line style, width) per curve: E_shock wide and light, so that the sum drawn
+#: over it (equal up to the residual, panel c) leaves both visible.
+ENERGY_STYLE = {"shock": ("0.7", "-", 4.0), "granular": ("tab:blue", "-", 1.3), "plate": ("tab:red", "-", 1.3),
+                "dissipated": ("tab:green", "-", 1.3), "total": ("tab:purple", "--", 1.3)}
 
 
 def fig_energies(ds: xr.Dataset) -> Figure:
@@ -86,9 +90,9 @@ def fig_energies(ds: xr.Dataset) -> Figure:
     t = _t_ms(ds)
     ref = an.reference_energy(ds)
     for key, (label, e) in energy_curves(ds).items():
-        colour, ls = ENERGY_STYLE[key]
-        a.plot(t, e, color=colour, ls=ls, lw=1.3, label=label, gid=f"energy:{key}")
-        b.plot(t, e / ref, color=colour, ls=ls, lw=1.3, label=label, gid=f"fraction:{key}")
+        colour, ls, lw = ENERGY_STYLE[key]
+        a.plot(t, e, color=colour, ls=ls, lw=lw, label=label, gid=f"energy:{key}")
+        b.plot(t, e / ref, color=colour, ls=ls, lw=lw, label=label, gid=f"fraction:{key}")
     a.set_ylabel("energy [J]")
     a.ticklabel_format(axis="y", style="sci", scilimits=(-3, 3))
     a.legend(fontsize=8, loc="best")
@@ -114,14 +118,16 @@ def fig_contact_forces(ds: xr.Dataset) -> Figure:
     a, b = fig.subplots(2, 1, sharex=True)
     t = _t_ms(ds)
     labels = [str(c) for c in ds["contact"].values]
-    for k, lab in enumerate(labels):
-        a.plot(t, ds["contact_normal_force"].values[:, k], lw=1.2, label=f"contact {lab}", gid=f"normal:{lab}")
-        b.plot(t, ds["contact_tangential_force"].values[:, k], lw=1.2, label=f"contact {lab}", gid=f"tangential:{lab}")
+    fn, ft = ds["contact_normal_force"].values, ds["contact_tangential_force"].values
+    plot_curves(a, t, [(f"contact {lab}", fn[:, k], f"normal:{lab}") for k, lab in enumerate(labels)], lw=1.2)
+    plot_curves(b, t, [(f"contact {lab}", ft[:, k], f"tangential:{lab}") for k, lab in enumerate(labels)], lw=1.2)
+    b.legend(fontsize=8, ncol=min(len(labels), 3), loc="best")
     a.set_ylabel("normal force [N]")
     a.set_title("(a) normal force on the plate (+x)", loc="left", fontsize=10)
     b.set_ylabel("tangential force [N]")
     b.set_title("(b) friction force on the plate (+y)", loc="left", fontsize=10)
-    a.legend(fontsize=8, ncol=min(len(labels), 5), loc="best", title="granule at the contact", title_fontsize=8)
+    a.legend(fontsize=8, ncol=min(len(labels), 3), loc="best", title="contact: the granule touching the plate",
+             title_fontsize=8)
     for ax in (a, b):
         time_axis(ax, _end_ms(ds))
     a.set_xlabel("")
@@ -161,15 +167,14 @@ def fig_granule_speeds(ds: xr.Dataset) -> Figure:
     v = granule_speeds(ds)
     labels = [str(g) for g in ds["granule"].values]
     if len(labels) <= MAX_LABELLED:
-        for k, lab in enumerate(labels):
-            ax.plot(t, v[:, k], lw=1.2, label=f"granule {lab}", gid=f"speed:{lab}")
+        plot_curves(ax, t, [(f"granule {lab}", v[:, k], f"speed:{lab}") for k, lab in enumerate(labels)], lw=1.2)
         ax.set_title("speed of each granule", loc="left", fontsize=10)
     else:
         ax.fill_between(t, v.min(axis=1), v.max(axis=1), color="0.8", label=f"all {len(labels)} granules: min to max",
                         gid="speed:envelope")
         ax.plot(t, np.median(v, axis=1), color="0.3", lw=1.0, ls="--", label="median", gid="speed:median")
-        for k in np.argsort(v.max(axis=0))[::-1][:FASTEST]:
-            ax.plot(t, v[:, k], lw=1.2, label=f"granule {labels[k]}", gid=f"speed:{labels[k]}")
+        fastest = np.argsort(-v.max(axis=0), kind="stable")[:FASTEST]
+        plot_curves(ax, t, [(f"granule {labels[k]}", v[:, k], f"speed:{labels[k]}") for k in fastest], lw=1.2)
         ax.set_title(f"granule speeds: envelope and the {FASTEST} fastest granules", loc="left", fontsize=10)
     ax.set_ylabel("speed |v| [m/s]")
     ax.legend(fontsize=8, loc="best")

@@ -209,7 +209,7 @@ def _title(a: Assembly) -> str:
     if a.plate is not None:
         if a.plate.deformed:
             lines.append(f"plate displacements magnified x{a.plate.magnify:g} (largest "
-                         f"{a.plate.largest_displacement * 1e6:.3g} µm)"
+                         f"{a.plate.largest_displacement:.3g} m)"
                          + ("; granules at true positions" if len(a.x) else ""))
         else:
             lines.append("plate undeformed: no plate-field snapshot at this time")
