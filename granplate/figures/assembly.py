@@ -279,8 +279,8 @@ def choose_time(ds: xr.Dataset, time: float | None) -> tuple[int, str]:
             best = int(snaps[np.argmax(ep[snaps])])
             if best == peak:
                 return best, "time of the largest plate energy"
-            return best, (f"the plate snapshot of largest plate energy (the peak, between snapshots, "
-                           f"is at {t[peak] * 1e3:.4g} ms)")
+            return best, (f"the plate snapshot of largest plate energy; the peak, between snapshots, "
+                           f"is at {t[peak] * 1e3:.4g} ms")
         return peak, "time of the largest plate energy"
     return len(t) - 1, "last output time (no plate)"
 

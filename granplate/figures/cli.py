@@ -52,7 +52,7 @@ def _cmd_show(args) -> int:
     if out.suffix.lower() not in (".png", ".pdf", ".svg"):
         raise ScenarioError("-o", str(out), "allowed: a .png, .pdf or .svg file name")
     out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=PNG_DPI, bbox_inches="tight")
+    fig.savefig(out, dpi=args.dpi, bbox_inches="tight")
     print(f"written {out}")
     return 0
 
@@ -101,6 +101,18 @@ def _time(text: str) -> float:
         raise argparse.ArgumentTypeError(f"{text!r}: must be a time in seconds, e.g. 8e-5") from None
 
 
+def _dpi(text: str) -> int:
+    import argparse
+
+    try:
+        v = int(text)
+    except ValueError:
+        v = 0
+    if not 20 <= v <= 1200:
+        raise argparse.ArgumentTypeError(f"{text!r}: must be an integer from 20 to 1200 (dots per inch)")
+    return v
+
+
 def register(subparsers) -> None:
     """Add the `show` command."""
     s = subparsers.add_parser("show", help="draw an assembly: a scenario, a preset or a result at one time")
@@ -110,4 +122,6 @@ def register(subparsers) -> None:
     s.add_argument("--time", type=_time, default=None,
                    help="result only: the time shown [s] (default: the largest plate energy, or the last "
                         "output without a plate)")
+    s.add_argument("--dpi", type=_dpi, default=PNG_DPI, help=f"resolution of a .png [dots per inch] "
+                   f"(default {PNG_DPI})")
     s.set_defaults(func=_cmd_show)

@@ -85,7 +85,7 @@ ENERGY_STYLE = {"shock": ("0.7", "-", 4.0), "granular": ("tab:blue", "-", 1.3), 
 
 def fig_energies(ds: xr.Dataset) -> Figure:
     """Energies in J (a), as fractions of the energy put in (b), balance residual (c)."""
-    fig = new_figure(7.5, 8.0)
+    fig = new_figure(9.0, 8.0)
     a, b, c = fig.subplots(3, 1, sharex=True, height_ratios=(1.0, 1.0, 0.6))
     t = _t_ms(ds)
     ref = an.reference_energy(ds)
@@ -95,7 +95,7 @@ def fig_energies(ds: xr.Dataset) -> Figure:
         b.plot(t, e / ref, color=colour, ls=ls, lw=lw, label=label, gid=f"fraction:{key}")
     a.set_ylabel("energy [J]")
     a.ticklabel_format(axis="y", style="sci", scilimits=(-3, 3))
-    a.legend(fontsize=8, loc="best")
+    a.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     a.set_title("(a) energies", loc="left", fontsize=10)
     b.set_ylabel(f"energy / {reference_label(ds)} [-]")
     b.set_title(f"(b) fractions of {reference_label(ds)} = {ref:.4g} J", loc="left", fontsize=10)
@@ -114,20 +114,19 @@ def fig_energies(ds: xr.Dataset) -> Figure:
 
 def fig_contact_forces(ds: xr.Dataset) -> Figure:
     """Normal (a) and tangential (b) force at each plate contact [N]."""
-    fig = new_figure(7.5, 6.0)
+    fig = new_figure(9.0, 6.0)
     a, b = fig.subplots(2, 1, sharex=True)
     t = _t_ms(ds)
     labels = [str(c) for c in ds["contact"].values]
     fn, ft = ds["contact_normal_force"].values, ds["contact_tangential_force"].values
     plot_curves(a, t, [(f"contact {lab}", fn[:, k], f"normal:{lab}") for k, lab in enumerate(labels)], lw=1.2)
     plot_curves(b, t, [(f"contact {lab}", ft[:, k], f"tangential:{lab}") for k, lab in enumerate(labels)], lw=1.2)
-    b.legend(fontsize=8, ncol=min(len(labels), 3), loc="best")
     a.set_ylabel("normal force [N]")
     a.set_title("(a) normal force on the plate (+x)", loc="left", fontsize=10)
     b.set_ylabel("tangential force [N]")
     b.set_title("(b) friction force on the plate (+y)", loc="left", fontsize=10)
-    a.legend(fontsize=8, ncol=min(len(labels), 3), loc="best", title="contact: the granule touching the plate",
-             title_fontsize=8)
+    a.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False,
+             title="contact: the granule\ntouching the plate", title_fontsize=8)
     for ax in (a, b):
         time_axis(ax, _end_ms(ds))
     a.set_xlabel("")
@@ -161,7 +160,7 @@ def granule_speeds(ds: xr.Dataset) -> np.ndarray:
 
 def fig_granule_speeds(ds: xr.Dataset) -> Figure:
     """Speed of each granule [m/s]; many granules: envelope, median and the fastest."""
-    fig = new_figure(7.5, 4.5)
+    fig = new_figure(9.0, 4.5)
     ax = fig.add_subplot()
     t = _t_ms(ds)
     v = granule_speeds(ds)
@@ -177,7 +176,7 @@ def fig_granule_speeds(ds: xr.Dataset) -> Figure:
         plot_curves(ax, t, [(f"granule {labels[k]}", v[:, k], f"speed:{labels[k]}") for k in fastest], lw=1.2)
         ax.set_title(f"granule speeds: envelope and the {FASTEST} fastest granules", loc="left", fontsize=10)
     ax.set_ylabel("speed |v| [m/s]")
-    ax.legend(fontsize=8, loc="best")
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     time_axis(ax, _end_ms(ds))
     _caption(fig, ds, "granule speeds")
     return fig

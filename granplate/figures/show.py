@@ -205,7 +205,7 @@ def _title(a: Assembly) -> str:
     head = f"{a.name}"
     if a.time is None:
         return f"{head}: assembly before the run"
-    lines = [f"{head} at t = {a.time * 1e3:.4g} ms", f"({a.time_note})"]
+    lines = [f"{head} at t = {a.time * 1e3:.4g} ms", a.time_note]
     if a.plate is not None:
         if a.plate.deformed:
             lines.append(f"plate displacements magnified x{a.plate.magnify:g} (largest "
