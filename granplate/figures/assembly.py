@@ -51,7 +51,7 @@ class PlateDrawing:
     """The plate as drawn [m]: its undeformed rectangle (x0, y0, width, height), the
     element outlines (n_elem, k, 2), each rigid layer as a polyline (n_pts, 2); deformed:
     whether a displacement snapshot was drawn, magnified `magnify` times, and its largest
-    nodal displacement [m]."""
+    nodal displacement [m]; clamped_edges: plate.clamped_edges ("top", "bottom", ...)."""
 
     rectangle: tuple[float, float, float, float]
     elements: np.ndarray
@@ -59,6 +59,7 @@ class PlateDrawing:
     magnify: float = 1.0
     deformed: bool = False
     largest_displacement: float = 0.0
+    clamped_edges: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -213,7 +214,7 @@ def scenario_plate(s: Scenario, plate_contacts, y) -> PlateDrawing | None:
     elements = grid_elements(p.x0, p.y0, p.width, p.height, p.nx, p.ny)
     layers = tuple(np.array([[p.x0, lo], [p.x0, hi]]) for lo, hi in layer_spans([y[i] for i in plate_contacts],
                                                                              p.layer_width))
-    return PlateDrawing((p.x0, p.y0, p.width, p.height), elements, layers)
+    return PlateDrawing((p.x0, p.y0, p.width, p.height), elements, layers, clamped_edges=tuple(p.clamped_edges))
 
 
 def result_plate(s: Scenario, ds: xr.Dataset, t: float) -> PlateDrawing | None:
@@ -239,7 +240,8 @@ def result_plate(s: Scenario, ds: xr.Dataset, t: float) -> PlateDrawing | None:
     for lo, hi in layer_spans(ys, p.layer_width):
         band = np.flatnonzero(left & (y_nodes >= lo - 1e-9 * p.height) & (y_nodes <= hi + 1e-9 * p.height))
         layers.append(xy[band[np.argsort(y_nodes[band])]])
-    return PlateDrawing((p.x0, p.y0, p.width, p.height), elements, tuple(layers), magnify, deformed, umax)
+    return PlateDrawing((p.x0, p.y0, p.width, p.height), elements, tuple(layers), magnify, deformed, umax,
+                        tuple(p.clamped_edges))
 
 
 # --------------------------------------------------------------------------------------

@@ -5,7 +5,7 @@ the normal force for a result). Axes in mm, equal aspect.
 
     >>> from granplate.figures import assembly, show
     >>> fig = show.draw(assembly.of_scenario(gp.preset("steel-r1")))
-    >>> fig.savefig("steel-r1.png", dpi=150)
+    >>> fig.savefig("steel-r1.png", dpi=150, bbox_inches="tight")   # the legend is beside the axes
 """
 from __future__ import annotations
 
@@ -31,7 +31,7 @@ MAX_LINE_WIDTH = 6.0
 #: Contacts below this fraction of the largest force are drawn thin and dotted.
 OPEN_FRACTION = 0.01
 #: Labels are drawn only at this font size [points] or above.
-MIN_FONT = 4.0
+MIN_FONT = 5.0
 MAX_FONT = 14.0
 #: Force colours: the upper part of YlOrRd (orange to dark red), readable on any granule.
 FORCE_CMAP = ListedColormap(colormaps["YlOrRd"](np.linspace(0.35, 1.0, 256)), name="force")
@@ -56,9 +56,9 @@ def clip_line(point: np.ndarray, direction: np.ndarray, box: tuple[float, float,
 
 def label_font_size(radius_pt: float, label: str) -> float:
     """Font size [points] of a label inside a circle of radius_pt points: the text's
-    height within 1.1 r and its width (about 0.6 of the size per character) within 1.5 r;
+    height within 1.1 r and its width (about 0.65 of the size per character) within 1.2 r;
     0 when below MIN_FONT (too small to read: not drawn)."""
-    size = min(1.1 * radius_pt, 1.5 * radius_pt / (0.6 * max(len(label), 1)), MAX_FONT)
+    size = min(1.1 * radius_pt, 1.2 * radius_pt / (0.65 * max(len(label), 1)), MAX_FONT)
     return size if size >= MIN_FONT else 0.0
 
 
@@ -106,6 +106,15 @@ def _draw_plate(ax, a: Assembly) -> None:
         x0, y0, w, h = (v * MM for v in p.rectangle)
         ax.add_patch(Polygon([(x0, y0), (x0 + w, y0), (x0 + w, y0 + h), (x0, y0 + h)], closed=True, fill=False,
                              ls="--", lw=0.7, ec="0.3", zorder=2, gid="plate:undeformed"))
+    x0, y0, w, h = (v * MM for v in p.rectangle)
+    t = 0.08 * w  # the clamp's drawn thickness [mm]
+    strips = {"top": [(x0, y0 + h), (x0 + w, y0 + h), (x0 + w, y0 + h + t), (x0, y0 + h + t)],
+              "bottom": [(x0, y0), (x0 + w, y0), (x0 + w, y0 - t), (x0, y0 - t)],
+              "left": [(x0, y0), (x0, y0 + h), (x0 - t, y0 + h), (x0 - t, y0)],
+              "right": [(x0 + w, y0), (x0 + w, y0 + h), (x0 + w + t, y0 + h), (x0 + w + t, y0)]}
+    for edge in p.clamped_edges:
+        ax.add_patch(Polygon(strips[edge], closed=True, fc="0.35", ec="0.35", hatch="xxxx", lw=0.5, zorder=2,
+                             gid=f"plate:clamped:{edge}"))
     for k, layer in enumerate(p.rigid_layers):
         ax.plot(layer[:, 0] * MM, layer[:, 1] * MM, color="darkred", lw=4, solid_capstyle="butt", zorder=3,
                 gid=f"plate:rigid-layer:{k}")
@@ -128,7 +137,7 @@ def _draw_labels(fig: Figure, ax, a: Assembly) -> int:
             skipped += 1
             continue
         ax.text(x * MM, y * MM, lab, ha="center", va="center", fontsize=size, zorder=6, gid=f"label:{lab}",
-                color="black", bbox={"boxstyle": "round,pad=0.1", "fc": "white", "ec": "none", "alpha": 0.6})
+                color="black", bbox={"boxstyle": "round,pad=0.05", "fc": "white", "ec": "none", "alpha": 0.6})
     return skipped
 
 
@@ -238,6 +247,9 @@ def draw(a: Assembly, width: float = 8.0) -> Figure:
         handles.append(Patch(fc="white", ec="0.3", hatch="///", label="rigid wall (hatched: solid side)"))
     if a.plate is not None:
         handles.append(Patch(fc="#e3e9f0", ec="0.45", label="plate, element edges"))
+        if a.plate.clamped_edges:
+            handles.append(Patch(fc="0.35", ec="0.35", hatch="xxxx",
+                                 label="plate clamped: " + ", ".join(a.plate.clamped_edges)))
         if a.plate.rigid_layers:
             handles.append(Line2D([], [], color="darkred", lw=4, label=f"rigid layers ({len(a.plate.rigid_layers)})"))
     handles += _draw_contacts(fig, ax, a)
