@@ -111,6 +111,16 @@ def test_two_spheres_without_plate_skip_plate_figures(spheres):
         _units_everywhere(fig)
 
 
+def test_bare_plate_has_no_granule_figures():
+    """The bare plate: energies (E_plate, no E_granular curve) and stress-strain only."""
+    bare = short_results()["bare-plate"]
+    figs = run.figures(bare)
+    assert list(figs) == ["energies", "stress-strain"]
+    gids = {ln.get_gid() for ax in figs["energies"].axes for ln in ax.get_lines()}
+    assert "energy:plate" in gids and "energy:granular" not in gids
+    assert run.missing("granule-speeds", bare) == "the run has no granules"
+
+
 def test_coinciding_curves_stay_visible():
     """A curve equal to an earlier one is drawn dashed with markers and says which it equals."""
     fig = new_figure(3, 2)

@@ -60,20 +60,23 @@ def reference_label(ds: xr.Dataset) -> str:
 
 
 def energy_curves(ds: xr.Dataset) -> dict[str, tuple[str, np.ndarray]]:
-    """key -> (legend label, energy [J] over time) of the energy figure; E_plate only
-    with a plate, E_shock only when the load does work."""
+    """key -> (legend label, energy [J] over time) of the energy figure: E_shock when the
+    load does work, E_granular with granules, E_plate with a plate, the dissipation
+    D = D_viscous + D_friction, and the sum of those stored and dissipated."""
     out = {}
     if float(np.abs(ds["E_shock"].values).max()) > 0:
         out["shock"] = ("$E_{shock}$, work of the load", ds["E_shock"].values)
-    out["granular"] = ("$E_{granular}$", ds["E_granular"].values)
+    parts = []
+    if an.has_granules(ds):
+        out["granular"] = ("$E_{granular}$", ds["E_granular"].values)
+        parts.append(("E_{granular}", ds["E_granular"].values))
     if an.has_plate(ds):
         out["plate"] = ("$E_{plate}$", ds["E_plate"].values)
+        parts.append(("E_{plate}", ds["E_plate"].values))
     dissipated = ds["D_viscous"].values + ds["D_friction"].values
-    out["dissipated"] = ("$D_{viscous} + D_{friction}$", dissipated)
-    if an.has_plate(ds):
-        out["total"] = ("$E_{granular} + E_{plate} + D$", ds["E_granular"].values + ds["E_plate"].values + dissipated)
-    else:
-        out["total"] = ("$E_{granular} + D$", ds["E_granular"].values + dissipated)
+    out["dissipated"] = ("$D = D_{viscous} + D_{friction}$", dissipated)
+    parts.append(("D", dissipated))
+    out["total"] = ("$" + " + ".join(name for name, _ in parts) + "$", sum(v for _, v in parts))
     return out
 
 
