@@ -18,6 +18,7 @@ from granplate.errors import ScenarioError, SimulationError
 #: `func(args) -> int` runs the command (ScenarioError is reported as a user error).
 COMMAND_MODULES = (
     "granplate.paper.reproduce",     # reproduce, plot, animate, export
+    "granplate.figures.cli",    # show
     "granplate.verification",   # verify
     "granplate.bench.cli",      # bench
     "granplate.commands.resolve",  # resolve

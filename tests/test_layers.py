@@ -18,6 +18,7 @@ LAYERS = (
     ("model",),
     ("solver",),
     ("results",),
+    ("figures",),
     ("paper",),
     ("verification",),
     ("bench",),

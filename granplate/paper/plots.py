@@ -18,15 +18,15 @@ from __future__ import annotations
 
 import textwrap
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Callable
 
 import numpy as np
 import xarray as xr
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 
+from granplate.figures.common import PNG_DPI, save_figure  # noqa: F401 - part of this module's interface
+from granplate.figures.common import new_figure as _new_figure
 from granplate.results import analysis as an
 
 #: The granules whose velocities the paper plots (Figs. 4e-f, 5c).
@@ -49,8 +49,6 @@ COINCIDE = 1e-6
 #: Markers of a curve drawn over an identical one (so that both stay visible).
 MARKERS = ("o", "s", "^", "v", "D")
 
-PNG_DPI = 150
-
 
 @dataclass(frozen=True)
 class FigureSpec:
@@ -66,13 +64,6 @@ class FigureSpec:
 # --------------------------------------------------------------------------------------
 # Helpers
 # --------------------------------------------------------------------------------------
-def _new_figure(width: float, height: float) -> Figure:
-    """A Figure on the Agg canvas with constrained layout."""
-    fig = Figure(figsize=(width, height), layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
-
-
 def _name(ds: xr.Dataset) -> str:
     return str(ds.attrs.get("scenario_name", "result"))
 
@@ -434,13 +425,3 @@ def figure_key(name: str) -> str:
 def figure_stem(key: str) -> str:
     """File stem of a figure: fig3, figA1."""
     return f"fig{key}"
-
-
-def save_figure(fig: Figure, out_dir: str | Path, stem: str) -> list[Path]:
-    """Write fig as STEM.png (PNG_DPI) and STEM.pdf in out_dir; returns the two paths."""
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    paths = [out / f"{stem}.png", out / f"{stem}.pdf"]
-    fig.savefig(paths[0], dpi=PNG_DPI)
-    fig.savefig(paths[1])
-    return paths

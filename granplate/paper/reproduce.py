@@ -381,6 +381,10 @@ def _cmd_reproduce(args) -> int:
 def _cmd_plot(args) -> int:
     from granplate.paper import plots
 
+    if args.figure is None:  # the generic figures of any run
+        from granplate.figures.cli import plot_results
+
+        return plot_results(args.results, args.out)
     names = list(plots.FIGURES) if args.figure.lower() == "all" else [args.figure]
     for name in names:
         try:
@@ -446,9 +450,10 @@ def register(subparsers) -> None:
     r.add_argument("-q", "--quiet", action="store_true", help="no progress output")
     r.set_defaults(func=_cmd_reproduce)
 
-    p = subparsers.add_parser("plot", help="draw one paper figure from result file(s)")
+    p = subparsers.add_parser("plot", help="draw the figures of any run, or one paper figure (--figure)")
     p.add_argument("results", nargs="+", help="result .nc file(s), or a directory holding PRESET.nc files")
-    p.add_argument("--figure", required=True, help="3, 4, 5, 6, 7, 8, A1 (or 'all')")
+    p.add_argument("--figure", default=None, help="a paper figure: 3, 4, 5, 6, 7, 8, A1 (or 'all'); without "
+                   "it: energies, contact forces, stress and strain, granule speeds of each result")
     p.add_argument("--out", default=".", help="directory for the PNG and PDF (default .)")
     p.set_defaults(func=_cmd_plot)
 

@@ -1,0 +1,211 @@
+"""The generic figures of any result (`granplate plot RESULT`): one Figure per topic.
+
+- energies: E_shock, E_granular, E_plate, dissipation D_viscous + D_friction and their
+  sum in J; the same as fractions of the energy put in; the energy-balance residual;
+- contact-forces: normal and tangential force at each plate contact [N];
+- stress-strain: the plate's largest von Mises stress [MPa] and largest |eps_yy| [-];
+- granule-speeds: |v| of each granule [m/s] (beyond MAX_LABELLED granules: the
+  min-max envelope, the median and the fastest few, labelled).
+
+`missing(name, ds)` says why a run cannot have a figure (no plate, no contacts, no
+granules), None when it can; `figures(ds)` builds those it can. Time in ms throughout.
+
+    >>> from granplate.figures import run
+    >>> for name, fig in run.figures(ds).items():
+    ...     save_figure(fig, "out", f"{ds.attrs['scenario_name']}-{name}")
+"""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+from matplotlib.figure import Figure
+
+from granplate.figures.common import new_figure, plot_curves, scenario_name, time_axis
+from granplate.results import analysis as an
+
+#: Beyond this many granules the speeds are drawn as an envelope.
+MAX_LABELLED = 8
+#: Granules named on the envelope: the fastest few (largest peak speed).
+FASTEST = 3
+#: An energy below this fraction of the energy put in counts as zero (round-off).
+NEGLIGIBLE = 1e-9
+
+
+def _t_ms(ds: xr.Dataset) -> np.ndarray:
+    return an.times_ms(ds)
+
+
+def _end_ms(ds: xr.Dataset) -> float:
+    t = _t_ms(ds)
+    return float(t[-1]) if len(t) and t[-1] > 0 else 1.0
+
+
+def _caption(fig: Figure, ds: xr.Dataset, what: str) -> None:
+    fig.suptitle(f"{scenario_name(ds)}: {what}", fontsize=11, x=0.01, ha="left")
+    fig.supxlabel(f"run {scenario_name(ds)}, t_end = {_end_ms(ds):.4g} ms, scheme {ds.attrs.get('scheme', '?')}, "
+                  f"granplate {ds.attrs.get('granplate_version', '?')}", fontsize=7, color="0.35")
+
+
+def reference_label(ds: xr.Dataset) -> str:
+    """The name of the energy the fractions are of: E_shock for a run from rest, E_initial
+    for a run without a load, else E_shock + E_initial (see `analysis.reference_energy`)."""
+    e0 = float(ds.attrs.get("E_initial", 0.0))
+    es = float(ds["E_shock"].values[-1]) if ds.sizes.get("time", 0) else 0.0
+    total = abs(e0) + abs(es)
+    if abs(e0) <= NEGLIGIBLE * total:
+        return "E_shock"
+    if abs(es) <= NEGLIGIBLE * total:
+        return "E_initial"
+    return "E_shock + E_initial"
+
+
+def energy_curves(ds: xr.Dataset) -> dict[str, tuple[str, np.ndarray]]:
+    """key -> (legend label, energy [J] over time) of the energy figure: E_shock when the
+    load does work, E_granular with granules, E_plate with a plate, the dissipation
+    D = D_viscous + D_friction, and the sum of those stored and dissipated."""
+    out = {}
+    if float(np.abs(ds["E_shock"].values).max()) > 0:
+        out["shock"] = ("$E_{shock}$, work of the load", ds["E_shock"].values)
+    parts = []
+    if an.has_granules(ds):
+        out["granular"] = ("$E_{granular}$", ds["E_granular"].values)
+        parts.append(("E_{granular}", ds["E_granular"].values))
+    if an.has_plate(ds):
+        out["plate"] = ("$E_{plate}$", ds["E_plate"].values)
+        parts.append(("E_{plate}", ds["E_plate"].values))
+    dissipated = ds["D_viscous"].values + ds["D_friction"].values
+    out["dissipated"] = ("$D = D_{viscous} + D_{friction}$", dissipated)
+    parts.append(("D", dissipated))
+    out["total"] = ("$" + " + ".join(name for name, _ in parts) + "$", sum(v for _, v in parts))
+    return out
+
+
+#: (colour, line style, width) per curve: E_shock wide and light, so that the sum drawn
+#: over it (equal up to the residual, panel c) leaves both visible.
+ENERGY_STYLE = {"shock": ("0.7", "-", 4.0), "granular": ("tab:blue", "-", 1.3), "plate": ("tab:red", "-", 1.3),
+                "dissipated": ("tab:green", "-", 1.3), "total": ("tab:purple", "--", 1.3)}
+
+
+def fig_energies(ds: xr.Dataset) -> Figure:
+    """Energies in J (a), as fractions of the energy put in (b), balance residual (c)."""
+    fig = new_figure(9.0, 8.0)
+    a, b, c = fig.subplots(3, 1, sharex=True, height_ratios=(1.0, 1.0, 0.6))
+    t = _t_ms(ds)
+    ref = an.reference_energy(ds)
+    for key, (label, e) in energy_curves(ds).items():
+        colour, ls, lw = ENERGY_STYLE[key]
+        a.plot(t, e, color=colour, ls=ls, lw=lw, label=label, gid=f"energy:{key}")
+        b.plot(t, e / ref, color=colour, ls=ls, lw=lw, label=label, gid=f"fraction:{key}")
+    a.set_ylabel("energy [J]")
+    a.ticklabel_format(axis="y", style="sci", scilimits=(-3, 3))
+    a.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    a.set_title("(a) energies", loc="left", fontsize=10)
+    b.set_ylabel(f"energy / {reference_label(ds)} [-]")
+    b.set_title(f"(b) fractions of {reference_label(ds)} = {ref:.4g} J", loc="left", fontsize=10)
+    c.plot(t, ds["energy_residual"].values, color="0.2", lw=1.0, gid="energy:residual")
+    c.set_ylabel("residual [-]")
+    c.set_title("(c) energy-balance residual (eq. 11): (E_p + E_g + D - E_shock - E_initial) / E_in",
+                loc="left", fontsize=9)
+    c.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
+    for ax in (a, b, c):
+        time_axis(ax, _end_ms(ds))
+    a.set_xlabel("")
+    b.set_xlabel("")
+    _caption(fig, ds, "energies")
+    return fig
+
+
+def fig_contact_forces(ds: xr.Dataset) -> Figure:
+    """Normal (a) and tangential (b) force at each plate contact [N]."""
+    fig = new_figure(9.0, 6.0)
+    a, b = fig.subplots(2, 1, sharex=True)
+    t = _t_ms(ds)
+    labels = [str(c) for c in ds["contact"].values]
+    fn, ft = ds["contact_normal_force"].values, ds["contact_tangential_force"].values
+    plot_curves(a, t, [(f"contact {lab}", fn[:, k], f"normal:{lab}") for k, lab in enumerate(labels)], lw=1.2)
+    plot_curves(b, t, [(f"contact {lab}", ft[:, k], f"tangential:{lab}") for k, lab in enumerate(labels)], lw=1.2)
+    a.set_ylabel("normal force [N]")
+    a.set_title("(a) normal force on the plate (+x)", loc="left", fontsize=10)
+    b.set_ylabel("tangential force [N]")
+    b.set_title("(b) friction force on the plate (+y)", loc="left", fontsize=10)
+    a.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False,
+             title="contact: the granule\ntouching the plate", title_fontsize=8)
+    for ax in (a, b):
+        time_axis(ax, _end_ms(ds))
+    a.set_xlabel("")
+    _caption(fig, ds, "plate contact forces")
+    return fig
+
+
+def fig_stress_strain(ds: xr.Dataset) -> Figure:
+    """The plate's largest von Mises stress [MPa] (a) and largest |eps_yy| [-] (b)."""
+    fig = new_figure(7.5, 6.0)
+    a, b = fig.subplots(2, 1, sharex=True)
+    t = _t_ms(ds)
+    a.plot(t, ds["max_von_mises"].values / 1e6, color="tab:red", lw=1.3, gid="max_von_mises")
+    a.set_ylabel("max von Mises [MPa]")
+    a.set_title("(a) largest von Mises stress over the plate (eq. 12)", loc="left", fontsize=10)
+    b.plot(t, ds["max_eps_yy"].values, color="tab:blue", lw=1.3, gid="max_eps_yy")
+    b.set_ylabel("max |eps_yy| [-]")
+    b.ticklabel_format(axis="y", style="sci", scilimits=(-3, 3))
+    b.set_title("(b) largest |eps_yy| over the plate", loc="left", fontsize=10)
+    for ax in (a, b):
+        time_axis(ax, _end_ms(ds))
+    a.set_xlabel("")
+    _caption(fig, ds, "plate stress and strain")
+    return fig
+
+
+def granule_speeds(ds: xr.Dataset) -> np.ndarray:
+    """|v| = sqrt(vx^2 + vy^2) [m/s], shape (time, granule)."""
+    return np.hypot(ds["vx"].values, ds["vy"].values)
+
+
+def fig_granule_speeds(ds: xr.Dataset) -> Figure:
+    """Speed of each granule [m/s]; many granules: envelope, median and the fastest."""
+    fig = new_figure(9.0, 4.5)
+    ax = fig.add_subplot()
+    t = _t_ms(ds)
+    v = granule_speeds(ds)
+    labels = [str(g) for g in ds["granule"].values]
+    if len(labels) <= MAX_LABELLED:
+        plot_curves(ax, t, [(f"granule {lab}", v[:, k], f"speed:{lab}") for k, lab in enumerate(labels)], lw=1.2)
+        ax.set_title("speed of each granule", loc="left", fontsize=10)
+    else:
+        ax.fill_between(t, v.min(axis=1), v.max(axis=1), color="0.8", label=f"all {len(labels)} granules: min to max",
+                        gid="speed:envelope")
+        ax.plot(t, np.median(v, axis=1), color="0.3", lw=1.0, ls="--", label="median", gid="speed:median")
+        fastest = np.argsort(-v.max(axis=0), kind="stable")[:FASTEST]
+        plot_curves(ax, t, [(f"granule {labels[k]}", v[:, k], f"speed:{labels[k]}") for k in fastest], lw=1.2)
+        ax.set_title(f"granule speeds: envelope and the {FASTEST} fastest granules", loc="left", fontsize=10)
+    ax.set_ylabel("speed |v| [m/s]")
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    time_axis(ax, _end_ms(ds))
+    _caption(fig, ds, "granule speeds")
+    return fig
+
+
+FIGURES = {
+    "energies": fig_energies,
+    "contact-forces": fig_contact_forces,
+    "stress-strain": fig_stress_strain,
+    "granule-speeds": fig_granule_speeds,
+}
+
+
+def missing(name: str, ds: xr.Dataset) -> str | None:
+    """Why the result cannot have figure `name` ("no plate", ...), None when it can."""
+    if ds.sizes.get("time", 0) == 0:
+        return "the run has no output times"
+    if name == "contact-forces" and (ds.sizes.get("contact", 0) == 0 or "contact_normal_force" not in ds):
+        return "the run has no plate contacts"
+    if name == "stress-strain" and not ("max_von_mises" in ds and an.has_plate(ds)):
+        return "the run has no plate"
+    if name == "granule-speeds" and not an.has_granules(ds):
+        return "the run has no granules"
+    return None
+
+
+def figures(ds: xr.Dataset) -> dict[str, Figure]:
+    """The generic figures the result can have, by name (FIGURES order)."""
+    return {name: fn(ds) for name, fn in FIGURES.items() if missing(name, ds) is None}
