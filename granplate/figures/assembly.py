@@ -26,6 +26,8 @@ import numpy as np
 import xarray as xr
 
 from granplate.errors import ScenarioError
+from granplate.model.arrays import loaded_granules
+from granplate.physics.contact import hertz_coefficient
 from granplate.results import analysis as an
 from granplate.results.dataset import scenario_of
 from granplate.setup.geometry import resolve
@@ -96,9 +98,9 @@ class Assembly:
 # Contacts
 # --------------------------------------------------------------------------------------
 def hertz_elastic_force(e_star: float, r_star: float, delta: float) -> float:
-    """Elastic part of the Hertz normal force [N]: A delta^(3/2), A = 4/3 E* sqrt(R*)
-    (paper eqs. 2-3); E* [Pa], R* [m], delta [m] (a negative overlap gives 0)."""
-    return 4.0 / 3.0 * e_star * math.sqrt(r_star) * max(delta, 0.0) ** 1.5
+    """Elastic part of the Hertz normal force [N]: A delta^(3/2) with A of paper eq. (3)
+    (a negative overlap gives 0)."""
+    return hertz_coefficient(e_star, r_star) * max(delta, 0.0) ** 1.5
 
 
 def contact_lists(scenario: Scenario) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -161,18 +163,6 @@ def contact_forces(s: Scenario, ds: xr.Dataset, ti: int, pairs, wall_contacts, p
 # --------------------------------------------------------------------------------------
 # Load
 # --------------------------------------------------------------------------------------
-def loaded_granules(s: Scenario, x: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """Mask of the granules a granule load pushes: load.granules, else those whose left
-    surface is leftmost (column 1), as docs/scenario.md says; all False otherwise."""
-    n = len(x)
-    if s.load.kind == "none" or s.load.target != "granules" or n == 0:
-        return np.zeros(n, bool)
-    if s.load.granules:
-        return np.array([g.label in s.load.granules for g in s.granules])
-    left = x - r
-    return np.abs(left - left.min()) <= 1e-9 * r.max()
-
-
 def load_profile(load: Load, y: np.ndarray) -> np.ndarray:
     """sin(pi (y - y0) / L) on the load's y-range, 0 outside: the shape of q(y) [-]."""
     u = (np.asarray(y, float) - load.y0) / load.length

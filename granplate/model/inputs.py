@@ -10,9 +10,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-#: the coupling schemes, numbered in this order (Config.scheme); each has a module in
-#: granplate.solver.schemes registered under the same name.
-SCHEME_NAMES = ("paper", "implicit")
+from granplate.setup.validate import SCHEMES
+
+#: the coupling schemes (setup.validate.SCHEMES), numbered in this order (Config.scheme);
+#: each has a module in granplate.solver.schemes registered under the same name.
+SCHEME_NAMES = SCHEMES
 SCHEME_PAPER, SCHEME_IMPLICIT = 0, 1
 
 
