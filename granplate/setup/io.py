@@ -26,7 +26,7 @@ import tomli_w
 
 from granplate.errors import ScenarioError
 from granplate.setup.materials import LIBRARY, Material
-from granplate.setup.scenario import (LAYOUT_KINDS, Contact, Granule, Layout, Load, PairCoefficients,
+from granplate.setup.scenario import (LAYOUT_KINDS, Contact, Granule, Load, PairCoefficients,
                                       Plate, Scenario, Solver, TimeSettings, Wall)
 
 #: Fields that a table must give (everything else takes the dataclass default).

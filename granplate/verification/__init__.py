@@ -3,7 +3,7 @@
 Every part of the simulator is checked against independent truth (docs/validation.md is
 the page this writes, regenerated with --full):
 
-- granular.py: Chung & Ooi (2011) tests 1-4, sliding to rolling, Nesterenko's solitary
+- granular.py: Chung & Ooi (2011) tests 1-4, sliding to rolling; chain.py: Nesterenko's solitary
   wave on a striker-hit chain;
 - plate_cases.py: patch test, clamped strip against Timoshenko beam theory (statics and
   frequencies), Q8 convergence rates, Newmark's period elongation;
@@ -37,9 +37,9 @@ def __getattr__(name: str):
 
 def all_cases() -> tuple:
     """Every registered case, in page order."""
-    from . import conservation, coupled, granular, plate_cases
+    from . import chain, conservation, coupled, granular, plate_cases
 
-    return granular.CASES + plate_cases.CASES + conservation.CASES + coupled.CASES
+    return granular.CASES + chain.CASES + plate_cases.CASES + conservation.CASES + coupled.CASES
 
 
 def case_names(full: bool = True) -> list[str]:
