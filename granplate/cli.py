@@ -123,12 +123,9 @@ def _cmd_preset(args) -> int:
     from granplate.setup.presets import preset
     from granplate.setup.io import dumps
 
-    text = dumps(preset(args.name))
-    if args.output:
-        Path(args.output).write_text(text)
-        print(f"written {args.output}")
-    else:
-        sys.stdout.write(text)
+    from granplate.commands import emit_text
+
+    emit_text(dumps(preset(args.name)), args.output)
     return 0
 
 

@@ -6,8 +6,7 @@ file builds the same model as the layout.
 """
 from __future__ import annotations
 
-import sys
-from pathlib import Path
+from granplate.commands import emit_text
 
 
 def resolved_toml(name_or_path: str) -> str:
@@ -19,12 +18,7 @@ def resolved_toml(name_or_path: str) -> str:
 
 
 def _cmd_resolve(args) -> int:
-    text = resolved_toml(args.scenario)
-    if args.output:
-        Path(args.output).write_text(text)
-        print(f"written {args.output}")
-    else:
-        sys.stdout.write(text)
+    emit_text(resolved_toml(args.scenario), args.output)
     return 0
 
 
