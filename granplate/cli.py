@@ -20,6 +20,7 @@ COMMAND_MODULES = (
     "granplate.paper.reproduce",     # reproduce, plot, animate, export
     "granplate.verification",   # verify
     "granplate.bench.cli",      # bench
+    "granplate.study.cli",      # sweep
 )
 
 #: (summary key, label, unit shown, format, scale to the unit shown). "{ref}" in a label

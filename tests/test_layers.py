@@ -22,6 +22,7 @@ LAYERS = (
     ("results",),
     ("paper",),
     ("verification",),
+    ("study",),
     ("bench",),
     ("cli",),
 )
