@@ -26,6 +26,27 @@ DESIGNS = "designs"
 WARM_T_END = 1e-6
 
 
+#: Metrics a study adds to gp.summary: name -> (unit, meaning).
+EXTRA_METRICS: dict[str, tuple[str, str]] = {
+    "granular_mass": ("kg", "total mass of the granules (the protector)"),
+}
+
+
+def metrics(ds) -> dict[str, Any]:
+    """gp.summary of a result, with the study's extra metrics (and their units) added."""
+    summary = gp.summary(ds)
+    summary["granular_mass"] = float(ds["mass"].sum()) if "mass" in ds else None
+    summary["units"] = {**summary.get("units", {}), **{k: u for k, (u, _) in EXTRA_METRICS.items()}}
+    return summary
+
+
+def metric_units() -> dict[str, str]:
+    """Every metric a design has (gp.summary's and the extra ones) and its unit."""
+    from granplate.results.dataset import SUMMARY_UNITS
+
+    return {**SUMMARY_UNITS, **{k: u for k, (u, _) in EXTRA_METRICS.items()}}
+
+
 def design_key(scenario_toml: str) -> str:
     """The design's identity: SHA-256 of its scenario's TOML and the granplate version."""
     return store.key(RECORD_KIND, scenario_toml, RECORD_FORMAT)
@@ -41,13 +62,13 @@ def run_design(scenario_toml: str, full: bool = False) -> dict[str, Any]:
 
     status is "ok" or the failure message (a scenario the physics refuses, a run that goes
     numerically wrong, or any other error: a failing design never stops a sweep); summary
-    is gp.summary of the run (None on failure); result the Dataset when full, else None.
+    is `metrics` of the run: gp.summary and EXTRA_METRICS (None on failure); result the Dataset when full, else None.
     """
     t0 = time.perf_counter()
     ds = summary = None
     try:
         ds = gp.simulate(gp.loads(scenario_toml), progress=False)
-        summary = gp.summary(ds)
+        summary = metrics(ds)
         status = "ok"
     except GranplateError as err:
         status = failure_message(err)

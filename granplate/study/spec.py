@@ -252,30 +252,40 @@ def base_scenario(base: Any, folder: Path):
         raise ScenarioError(f"base ({base}): {err.field}", err.value, err.allowed) from None
 
 
-def parse_study(doc: dict, folder: str | os.PathLike = ".") -> Study:
-    """A Study from a study file's table (relative base files are found in folder)."""
+def check_document(doc: Any, allowed: tuple[str, ...] = STUDY_KEYS) -> dict:
+    """The study file's table, its top-level keys checked."""
     if not isinstance(doc, dict):
         raise ScenarioError("study", doc, "expected a table")
     for k in doc:
-        if k not in STUDY_KEYS:
-            raise ScenarioError(k, doc[k], "unknown key; allowed: " + ", ".join(STUDY_KEYS))
+        if k not in allowed:
+            raise ScenarioError(k, doc[k], "unknown key; allowed: " + ", ".join(allowed))
     if "base" not in doc:
         raise ScenarioError("base", None, "missing: name a preset or a scenario file")
+    return doc
+
+
+def base_and_fixed(doc: dict, folder: str | os.PathLike) -> tuple[Any, dict[str, Value]]:
+    """(the validated base scenario, the [set] changes, checked against it)."""
     raw = base_scenario(doc["base"], Path(folder))
     fixed = doc.get("set", {})
     if not isinstance(fixed, dict):
         raise ScenarioError("set", fixed, "expected a table of dotted path = value")
-    parameters = doc.get("parameters", {})
-    zipped = doc.get("zip", {})
-    fields, points = axes(parameters, zipped)
+    _check_changes("set", raw, fixed)
+    return raw, dict(fixed)
+
+
+def parse_study(doc: dict, folder: str | os.PathLike = ".") -> Study:
+    """A Study from a study file's table (relative base files are found in folder)."""
+    check_document(doc)
+    raw, fixed = base_and_fixed(doc, folder)
+    fields, points = axes(doc.get("parameters", {}), doc.get("zip", {}))
     names, designs = grid(fields, points)
     for f in names:
         if f in fixed:
-            raise ScenarioError(f, f"set and varied", "a field is either fixed in [set] or varied")
+            raise ScenarioError(f, "set and varied", "a field is either fixed in [set] or varied")
         if names.count(f) > 1:
             raise ScenarioError(f, "varied twice", "a field is varied once (in [parameters] or [zip])")
-    _check_changes("set", raw, fixed)
-    study = Study(str(doc["base"]), raw, dict(fixed), names, tuple(designs),
+    study = Study(str(doc["base"]), raw, fixed, names, tuple(designs),
                   {k: v for k, v in doc.items() if k not in ("base", "set", "parameters", "zip")})
     for i in range(len(designs)):
         try:
@@ -293,13 +303,17 @@ def _check_changes(table: str, base, changes: dict) -> None:
         raise ScenarioError(f"{table}: {err.field}", err.value, err.allowed) from None
 
 
-def load_study(path: str | os.PathLike) -> Study:
-    """The Study of a TOML file (its base file, when relative, is beside it)."""
+def read_document(path: str | os.PathLike) -> dict:
+    """The table of a study's TOML file."""
     path = Path(path)
     if not path.is_file():
         raise ScenarioError("study file", str(path), "no such file")
     try:
-        doc = tomllib.loads(path.read_text())
+        return tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as err:
         raise ScenarioError("study file", str(path), f"not valid TOML: {err}") from None
-    return parse_study(doc, path.parent)
+
+
+def load_study(path: str | os.PathLike) -> Study:
+    """The Study of a TOML file (its base file, when relative, is beside it)."""
+    return parse_study(read_document(path), Path(path).parent)

@@ -24,7 +24,7 @@ import signal
 import sys
 import threading
 import time
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterator
@@ -148,7 +148,7 @@ def sweep(study: Study, out: str | Path, *, client=None, workers: int | None = N
     report = SweepReport(len(keys), n_before, out=out)
     try:
         if todo:
-            with (_same(client) if client is not None else dask_client(workers, scheduler)) as c:
+            with (nullcontext(client) if client is not None else dask_client(workers, scheduler)) as c:
                 report.warm_up_s = warm_workers(c, texts[todo[0][1]])
                 _run(c, study, out, todo, texts, keys, full, progress, report)
     finally:
@@ -156,11 +156,6 @@ def sweep(study: Study, out: str | Path, *, client=None, workers: int | None = N
         report.n_failed = sum(1 for k in set(keys) if (r := D.read_record(out, k)) and r["status"] != "ok")
         report.elapsed_s = time.perf_counter() - t0
     return report
-
-
-@contextmanager
-def _same(client):
-    yield client
 
 
 def _run(client, study: Study, out: Path, todo: list[tuple[str, int]], texts: list[str],
