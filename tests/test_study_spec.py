@@ -120,3 +120,42 @@ def test_study_file_errors(tmp_path):
     with pytest.raises(ScenarioError, match="not valid TOML"):
         load_study(tmp_path / "bad.toml")
     assert tomllib  # the study file is TOML read by the standard library
+
+
+# ------------------------------------------------------------------------- optimize
+
+def test_optimize_search_space():
+    from optuna.distributions import CategoricalDistribution, FloatDistribution, IntDistribution
+
+    from granplate.study.optimize import parse_optimization
+
+    opt = parse_optimization({**BASE, "parameters": {
+        "load.q0": {"range": [1e3, 5e4], "log": True}, "plate.ny": {"range": [20, 40]},
+        "contact.mu": [0.05, 0.2]}, "objectives": {"ep_max_fraction": "minimize",
+                                                   "granular_mass": "minimize"}})
+    assert opt.space["load.q0"] == FloatDistribution(1e3, 5e4, log=True)
+    assert opt.space["plate.ny"] == IntDistribution(20, 40)
+    assert opt.space["contact.mu"] == CategoricalDistribution([0.05, 0.2])
+    assert opt.scenario({"load.q0": 2e3}).load.q0 == 2e3 and opt.scenario({}).time.t_end == 2e-5
+
+
+@pytest.mark.parametrize("doc, field, words", [
+    ({"parameters": {"load.q0": [1.0]}}, "objectives", "at least one"),
+    ({"parameters": {"load.q0": [1.0]}, "objectives": {"nope": "minimize"}}, "objectives.nope",
+     "unknown metric"),
+    ({"parameters": {"load.q0": [1.0]}, "objectives": {"ep_max_fraction": "least"}},
+     "objectives.ep_max_fraction", "minimize, maximize"),
+    ({"parameters": {"load.q0": {"range": [1.0, 2.0], "num": 3}}, "objectives": {"e_in": "maximize"}},
+     "parameters.load.q0.num", "searched continuously"),
+    ({"parameters": {"load.q0": {"sample": "uniform"}}, "objectives": {"e_in": "maximize"}},
+     "parameters.load.q0", "categorical"),
+    ({"parameters": {"load.qq": [1.0]}, "objectives": {"e_in": "maximize"}}, "load.qq", "unknown field"),
+    ({"zip": {"load.q0": [1.0]}, "objectives": {"e_in": "maximize"}}, "zip", "allowed: base, set"),
+])
+def test_optimize_validation_names_the_field(doc, field, words):
+    from granplate.study.optimize import parse_optimization
+
+    with pytest.raises(ScenarioError) as err:
+        parse_optimization({"base": "ptfe-r05", **doc})
+    assert err.value.field == field, str(err.value)
+    assert words in str(err.value)

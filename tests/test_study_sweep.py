@@ -135,3 +135,51 @@ def test_cli_refuses_a_bad_study_before_running(tmp_path, capsys):
     assert main(["sweep", str(tmp_path / "s.toml"), "--out", str(tmp_path / "o")]) == 2
     assert "parameters.load.q0" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+# ------------------------------------------------------------------------- optimize
+
+OPTIMIZE = {"base": "ptfe-r05", "set": {"time.t_end": 1e-5},
+            "parameters": {"load.q0": {"range": [1e3, 5e4], "log": True}, "contact.mu": [0.05, 0.2]},
+            "objectives": {"eg_max_fraction": "minimize", "dissipated_fraction": "maximize"}}
+
+
+def dominated(a: list[float], b: list[float]) -> bool:
+    """Whether (minimize, maximize) values a are dominated by b."""
+    no_worse = b[0] <= a[0] and b[1] >= a[1]
+    return no_worse and (b[0] < a[0] or b[1] > a[1])
+
+
+def test_optimize_resumes_from_its_database(client, tmp_path):
+    import csv
+
+    import optuna
+
+    from granplate.study.optimize import open_study, optimize, parse_optimization
+
+    opt = parse_optimization(OPTIMIZE)
+    # a trial left running by a killed run: failed on the next run, its parameters run again
+    stale = open_study(opt, tmp_path, seed=0).ask(opt.space)
+    first = optimize(opt, tmp_path, 4, client=client, progress=False)
+    assert (first.n_before, first.n_computed + first.n_reused, first.n_failed) == (0, 4, 0)
+    second = optimize(opt, tmp_path, 6, client=client, progress=False)
+    assert (second.n_before, second.n_computed + second.n_reused) == (4, 2)
+    assert optimize(opt, tmp_path, 6, client=client, progress=False).n_computed == 0
+    study = optuna.load_study(study_name="granplate", storage=f"sqlite:///{tmp_path / 'optuna.db'}")
+    states = [t.state.name for t in study.trials]
+    assert states.count("COMPLETE") == 6 and states.count("FAIL") == 1
+    assert study.trials[stale.number].state.name == "FAIL"
+    assert any(t.params == stale.params and t.state.name == "COMPLETE" for t in study.trials)
+    # every design is recorded, and a trial's values are its record's metrics
+    for t in study.trials:
+        if t.state.name == "COMPLETE":
+            rec = read_record(tmp_path, t.user_attrs["key"])
+            assert t.values == [rec["summary"]["eg_max_fraction"], rec["summary"]["dissipated_fraction"]]
+    # the Pareto front: no trial dominates a front member; every undominated trial is on it
+    rows = list(csv.DictReader(open(tmp_path / "trials.csv")))
+    front = {int(r["trial"]) for r in csv.DictReader(open(tmp_path / "pareto.csv"))}
+    points = {int(r["trial"]): [float(r["eg_max_fraction"]), float(r["dissipated_fraction"])]
+              for r in rows if r["state"] == "COMPLETE"}
+    undominated = {n for n, p in points.items() if not any(dominated(p, q) for q in points.values())}
+    assert front == undominated and front
+    assert (tmp_path / "pareto.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

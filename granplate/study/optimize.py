@@ -186,9 +186,12 @@ def requeue_interrupted(study) -> int:
 
 
 def finished(study) -> int:
+    """Trials that count towards --trials: completed or failed with their design's status
+    (not those an interruption cut short, whose parameters run again)."""
     from optuna.trial import TrialState
 
-    return len(study.get_trials(deepcopy=False, states=(TrialState.COMPLETE, TrialState.FAIL)))
+    return sum(1 for t in study.get_trials(deepcopy=False, states=(TrialState.COMPLETE, TrialState.FAIL))
+               if "status" in t.user_attrs)
 
 
 def tell(study, opt: Optimization, trial, record: dict) -> bool:
@@ -276,6 +279,7 @@ def _search(client, study, opt: Optimization, out: Path, trials: int, progress: 
             except Exception as err:  # noqa: BLE001 - a lost task: the trial fails, no record
                 from optuna.trial import TrialState
 
+                trial.set_user_attr("status", f"lost: {D.failure_message(err)}")
                 study.tell(trial, state=TrialState.FAIL)
                 report.n_failed += 1
                 done += 1
