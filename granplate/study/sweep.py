@@ -99,11 +99,12 @@ def warm_workers(client, scenario_toml: str) -> float:
     client.wait_for_workers(1)
     workers = sorted(client.scheduler_info(n_workers=-1)["workers"])
     first, rest = workers[:1], workers[1:]
-    client.submit(D.warm_up, scenario_toml, workers=first, allow_other_workers=False,
-                  pure=False).result()
-    futures = [client.submit(D.warm_up, scenario_toml, workers=[w], allow_other_workers=False,
-                             pure=False) for w in rest]
-    client.gather(futures)
+    for group in (first, rest):
+        futures = [client.submit(D.warm_up, scenario_toml, workers=[w], allow_other_workers=False,
+                                 pure=False) for w in group]
+        client.gather(futures)
+        for f in futures:  # pinned to its worker: never to be recomputed if that worker dies
+            f.release()
     return time.perf_counter() - t0
 
 
