@@ -32,6 +32,22 @@ def test_smallest_study_as_written_is_the_full_grid():
     assert (DOCS / "studies" / "smallest.toml").read_text().strip() in (DOCS / "studies.md").read_text()
 
 
+@pytest.mark.parametrize("name", ["forms.toml", "optimize.toml"])
+def test_documented_study_files_are_the_ones_shown_and_valid(name):
+    # the page shows each example file as written (after its first comment line)
+    body = (DOCS / "studies" / name).read_text().split("\n", 1)[1].strip()
+    assert body in (DOCS / "studies.md").read_text()
+    if name == "forms.toml":  # 3 loads x 2 plates (zip) x 4 sampled points
+        s = load_study(DOCS / "studies" / name)
+        assert len(s.designs) == 24
+        assert s.names == ("load.q0", "plate.thickness", "plate.ny", "contact.mu", "materials.ptfe.E")
+    else:
+        from granplate.study.optimize import load_optimization
+
+        assert list(load_optimization(DOCS / "studies" / name).objectives) == ["ep_max_fraction",
+                                                                              "granular_mass"]
+
+
 def test_range_linear_and_log():
     s = study(parameters={"load.q0": {"range": [1e3, 5e3], "num": 5}})
     assert [d[0] for d in s.designs] == [1e3, 2e3, 3e3, 4e3, 5e3]
