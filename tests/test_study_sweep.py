@@ -8,6 +8,7 @@ import json
 import os
 import subprocess
 import sys
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -183,3 +184,32 @@ def test_optimize_resumes_from_its_database(client, tmp_path):
     undominated = {n for n, p in points.items() if not any(dominated(p, q) for q in points.values())}
     assert front == undominated and front
     assert (tmp_path / "pareto.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_ctrl_c_keeps_finished_designs_and_a_rerun_computes_only_the_rest(client, tmp_path):
+    # Ctrl-C in a terminal signals the whole process group: driver and local workers
+    import signal
+    import time
+
+    study = tmp_path / "s.toml"
+    study.write_text('base = "ptfe-r05"\n[set]\n"time.t_end" = 2e-4\n[parameters]\n'
+                     '"load.q0" = {range = [5e3, 5e4], num = 10}\n"contact.mu" = [0.05, 0.1, 0.2]\n')
+    out = tmp_path / "out"
+    p = subprocess.Popen([sys.executable, "-m", "granplate.cli", "sweep", str(study), "--out", str(out),
+                          "--workers", "2", "-q"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         text=True, start_new_session=True,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    deadline = time.monotonic() + 120
+    while len(list((out / "designs").glob("*.json"))) < 3 and time.monotonic() < deadline:
+        time.sleep(0.05)
+    os.killpg(p.pid, signal.SIGINT)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 130, err
+    assert "rerun the same command" in err and "Traceback" not in err
+    kept = len(list((out / "designs").glob("*.json")))
+    assert 3 <= kept < 30
+    ds = table(out / "results.nc")
+    assert list(ds.status.values).count("not run") == 30 - kept
+    rerun = sweep(parse_study(tomllib.loads(study.read_text())), out, client=client, progress=False)
+    assert (rerun.n_done_before, rerun.n_computed) == (kept, 30 - kept)
+    assert list(table(out / "results.nc").status.values) == ["ok"] * 30

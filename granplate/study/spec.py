@@ -162,7 +162,12 @@ def sample_points(method: str, n: int, d: int, seed: int):
         return np.random.default_rng(seed).random((n, d))
     from scipy.stats import qmc
 
-    return qmc.LatinHypercube(d=d, rng=np.random.default_rng(seed)).random(n)
+    rng = np.random.default_rng(seed)
+    try:
+        sampler = qmc.LatinHypercube(d=d, rng=rng)
+    except TypeError:  # SciPy < 1.15 names it seed
+        sampler = qmc.LatinHypercube(d=d, seed=rng)
+    return sampler.random(n)
 
 
 def sample_values(forms: dict[str, dict]) -> list[tuple[float, ...]]:
