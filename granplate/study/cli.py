@@ -5,6 +5,9 @@ from __future__ import annotations
 
 import sys
 
+#: Lost designs listed one by one (a lost scheduler loses every design not done).
+MAX_LOST_LINES = 5
+
 
 def _cmd_sweep(args) -> int:
     from granplate.study.spec import load_study
@@ -27,8 +30,10 @@ def _cmd_sweep(args) -> int:
     print(f"designs: {report.n_designs}, already done: {report.n_done_before}, computed: "
           f"{report.n_computed}, failed: {report.n_failed}, lost: {len(report.lost)}; "
           f"{report.elapsed_s:.1f} s")
-    for line in report.lost:
+    for line in report.lost[:MAX_LOST_LINES]:
         print(f"lost (a rerun retries it): {line}", file=sys.stderr)
+    if len(report.lost) > MAX_LOST_LINES:
+        print(f"... and {len(report.lost) - MAX_LOST_LINES} more lost designs", file=sys.stderr)
     print(f"table: {report.out / RESULTS_NC}, {report.out / RESULTS_CSV}")
     return 0 if not report.lost else 1
 
