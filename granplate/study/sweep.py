@@ -17,7 +17,6 @@ and also when the sweep is interrupted.
 """
 from __future__ import annotations
 
-import json
 import logging
 import os
 import signal
@@ -55,6 +54,14 @@ class SweepReport:
     out: Path = Path(".")
 
 
+def available_cores() -> int:
+    """The cores this process may run on (its CPU affinity where the system tells it)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
 @contextmanager
 def sigint_ignored() -> Iterator[None]:
     """Ignore SIGINT (Ctrl-C) while processes are started (they keep ignoring it), then
@@ -82,7 +89,7 @@ def dask_client(workers: int | None = None, scheduler: str | None = None) -> Ite
         finally:
             client.close()
         return
-    n = workers or os.cpu_count() or 1
+    n = workers or available_cores()
     with sigint_ignored():  # the workers inherit it: Ctrl-C reaches this process alone
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                dashboard_address=None, silence_logs=logging.ERROR)
@@ -116,7 +123,7 @@ def progress_bar(total: int, initial: int, enabled: bool):
                 disable=not enabled, dynamic_ncols=True)
 
 
-def write_table(study: Study, out: Path, texts: list[str], keys: list[str]) -> Path:
+def write_table(study: Study, out: Path, keys: list[str]) -> Path:
     """Read every design's record and write results.nc and results.csv; the .nc path."""
     records = [D.read_record(out, k) for k in keys]
     attrs = {"base": study.base_name, "fixed": T.attrs_json(study.fixed),
@@ -153,7 +160,7 @@ def sweep(study: Study, out: str | Path, *, client=None, workers: int | None = N
                 report.warm_up_s = warm_workers(c, texts[todo[0][1]])
                 _run(c, study, out, todo, texts, keys, full, progress, report)
     finally:
-        write_table(study, out, texts, keys)
+        write_table(study, out, keys)
         report.n_failed = sum(1 for k in set(keys) if (r := D.read_record(out, k)) and r["status"] != "ok")
         report.elapsed_s = time.perf_counter() - t0
     return report
