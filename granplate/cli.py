@@ -17,9 +17,10 @@ from granplate.errors import ScenarioError, SimulationError
 #: modules that add subcommands: each defines register(subparsers), adding parsers whose
 #: `func(args) -> int` runs the command (ScenarioError is reported as a user error).
 COMMAND_MODULES = (
-    "granplate.paper.reproduce",     # reproduce, plot, animate, export
+    "granplate.paper.reproduce",  # reproduce, plot, animate, export
     "granplate.figures.cli",    # show
     "granplate.verification",   # verify
+    "granplate.study.cli",      # sweep, optimize
     "granplate.bench.cli",      # bench
     "granplate.commands.resolve",  # resolve
 )

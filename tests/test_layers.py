@@ -21,6 +21,7 @@ LAYERS = (
     ("figures",),
     ("paper",),
     ("verification",),
+    ("study",),
     ("bench",),
     ("cli", "commands"),
 )

@@ -1,0 +1,90 @@
+"""`granplate sweep STUDY.toml --out DIR`: run a study's designs on Dask;
+`granplate optimize STUDY.toml --out DIR --trials N`: search its parameters with Optuna
+(docs/studies.md)."""
+from __future__ import annotations
+
+import sys
+
+#: Lost designs listed one by one (a lost scheduler loses every design not done).
+MAX_LOST_LINES = 5
+
+
+def _cmd_sweep(args) -> int:
+    from granplate.study.spec import load_study
+    from granplate.study.sweep import RESULTS_CSV, RESULTS_NC, sweep
+
+    study = load_study(args.study)
+    if args.workers is not None and args.workers < 1:
+        print(f"granplate: error: --workers = {args.workers}: must be >= 1", file=sys.stderr)
+        return 2
+    print(f"{len(study.designs)} designs of {study.base_name} "
+          f"({', '.join(study.names) or 'no parameters'}) -> {args.out}", file=sys.stderr)
+    try:
+        report = sweep(study, args.out, workers=args.workers, scheduler=args.scheduler,
+                       full=args.full, limit=args.limit, progress=not args.quiet)
+    except KeyboardInterrupt:
+        print(f"granplate: sweep interrupted; the finished designs are kept in {args.out}/designs "
+              "and the table lists the others as \"not run\": rerun the same command to compute "
+              "only those", file=sys.stderr)
+        raise
+    print(f"designs: {report.n_designs}, already done: {report.n_done_before}, computed: "
+          f"{report.n_computed}, failed: {report.n_failed}, lost: {len(report.lost)}; "
+          f"{report.elapsed_s:.1f} s")
+    for line in report.lost[:MAX_LOST_LINES]:
+        print(f"lost (a rerun retries it): {line}", file=sys.stderr)
+    if len(report.lost) > MAX_LOST_LINES:
+        print(f"... and {len(report.lost) - MAX_LOST_LINES} more lost designs", file=sys.stderr)
+    print(f"table: {report.out / RESULTS_NC}, {report.out / RESULTS_CSV}")
+    return 0 if not report.lost else 1
+
+
+def _cmd_optimize(args) -> int:
+    from granplate.study.optimize import DATABASE, PARETO_CSV, PARETO_PNG, TRIALS_CSV, load_optimization, optimize
+
+    opt = load_optimization(args.study)
+    for name, value in (("--trials", args.trials), ("--workers", args.workers)):
+        if value is not None and value < 1:
+            print(f"granplate: error: {name} = {value}: must be >= 1", file=sys.stderr)
+            return 2
+    print(f"optimize {', '.join(f'{k} ({v})' for k, v in opt.objectives.items())} over "
+          f"{', '.join(opt.space)} of {opt.base_name} -> {args.out}", file=sys.stderr)
+    try:
+        report = optimize(opt, args.out, args.trials, workers=args.workers, scheduler=args.scheduler,
+                          seed=args.seed, progress=not args.quiet)
+    except KeyboardInterrupt:
+        print(f"granplate: optimize interrupted; rerun the same command to continue the study in "
+              f"{args.out}/{DATABASE}", file=sys.stderr)
+        raise
+    print(f"trials: {args.trials}, finished before: {report.n_before}, computed: {report.n_computed}, "
+          f"from existing designs: {report.n_reused}, failed: {report.n_failed}; {report.elapsed_s:.1f} s")
+    out = report.out
+    print(f"study: {out / DATABASE}; trials: {out / TRIALS_CSV}; Pareto front: {out / PARETO_CSV}, {out / PARETO_PNG}")
+    return 0
+
+
+def _cluster_options(p) -> None:
+    p.add_argument("--workers", type=int, default=None,
+                   help="worker processes of the local cluster (default: the machine's cores)")
+    p.add_argument("--scheduler", default=None,
+                   help="address of an existing Dask scheduler (e.g. tcp://host:8786) instead of a local cluster")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+
+
+def register(sub) -> None:
+    """Add the `sweep` and `optimize` subcommands."""
+    p = sub.add_parser("sweep", help="run a design study (a grid or sample of scenario changes) on Dask")
+    p.add_argument("study", help="the study TOML file (docs/studies.md)")
+    p.add_argument("--out", required=True, help="output folder: results.nc, results.csv, designs/")
+    _cluster_options(p)
+    p.add_argument("--full", action="store_true", help="keep each design's full result (designs/KEY.nc)")
+    p.add_argument("--limit", type=int, default=None,
+                   help="compute at most this many of the missing designs (a rerun continues)")
+    p.set_defaults(func=_cmd_sweep)
+    o = sub.add_parser("optimize", help="search a study's parameters for its [objectives] with Optuna, on Dask")
+    o.add_argument("study", help="the study TOML file, with an [objectives] table (docs/studies.md)")
+    o.add_argument("--out", required=True, help="output folder: optuna.db, trials.csv, pareto.csv, pareto.png, designs/")
+    o.add_argument("--trials", type=int, required=True,
+                   help="finished trials to reach (those of earlier runs into --out count)")
+    o.add_argument("--seed", type=int, default=0, help="seed of the sampler (TPE)")
+    _cluster_options(o)
+    o.set_defaults(func=_cmd_optimize)

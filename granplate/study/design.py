@@ -1,0 +1,127 @@
+"""One design of a study: its identity, its run (a pure function of the scenario's TOML
+text, run on a Dask worker) and its record on disk, DIR/designs/KEY.json.
+
+A design's KEY is `granplate.store.key` of the changed scenario's TOML (gp.dumps) and the
+granplate version: the same design in a rerun (or in another study) has the same record,
+and another granplate version computes it again. Records are written atomically, one
+per design as soon as it is in, so a killed sweep keeps every finished design.
+"""
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+from typing import Any
+
+import granplate as gp
+from granplate import store
+from granplate.errors import GranplateError
+
+#: The run store kind (and format version) of a design's identity.
+RECORD_KIND = "study-design"
+RECORD_FORMAT = 1
+#: Folder of the records inside a study's output folder.
+DESIGNS = "designs"
+#: Simulated time of a worker's warm-up run [s] (compiles or loads the kernels, builds the plate).
+WARM_T_END = 1e-6
+
+
+#: Metrics a study adds to gp.summary: name -> (unit, meaning).
+EXTRA_METRICS: dict[str, tuple[str, str]] = {
+    "granular_mass": ("kg", "total mass of the granules (the protector)"),
+}
+
+
+def metrics(ds) -> dict[str, Any]:
+    """gp.summary of a result, with the study's extra metrics (and their units) added."""
+    summary = gp.summary(ds)
+    summary["granular_mass"] = float(ds["mass"].sum()) if "mass" in ds else None
+    summary["units"] = {**summary.get("units", {}), **{k: u for k, (u, _) in EXTRA_METRICS.items()}}
+    return summary
+
+
+def metric_units() -> dict[str, str]:
+    """Every metric a design has (gp.summary's and the extra ones) and its unit."""
+    from granplate.results.dataset import SUMMARY_UNITS
+
+    return {**SUMMARY_UNITS, **{k: u for k, (u, _) in EXTRA_METRICS.items()}}
+
+
+def design_key(scenario_toml: str) -> str:
+    """The design's identity: SHA-256 of its scenario's TOML and the granplate version."""
+    return store.key(RECORD_KIND, scenario_toml, RECORD_FORMAT)
+
+
+def failure_message(err: BaseException) -> str:
+    """A failure as one line: the exception's class and message."""
+    return f"{type(err).__name__}: {err}".replace("\n", " ")
+
+
+def run_design(scenario_toml: str, full: bool = False) -> dict[str, Any]:
+    """Simulate one design (runs on a worker): {"status", "summary", "elapsed_s", "result"}.
+
+    status is "ok" or the failure message (a scenario the physics refuses, a run that goes
+    numerically wrong, or any other error: a failing design never stops a sweep); summary
+    is `metrics` of the run: gp.summary and EXTRA_METRICS (None on failure); result the Dataset when full, else None.
+    """
+    t0 = time.perf_counter()
+    ds = summary = None
+    try:
+        ds = gp.simulate(gp.loads(scenario_toml), progress=False)
+        summary = metrics(ds)
+        status = "ok"
+    except GranplateError as err:
+        status = failure_message(err)
+    except Exception as err:  # noqa: BLE001 - recorded as the design's failure
+        status = failure_message(err)
+    return {"status": status, "summary": summary, "elapsed_s": time.perf_counter() - t0,
+            "result": ds if full and summary is not None else None}
+
+
+def warm_up(scenario_toml: str) -> float:
+    """A short run of a design (on each worker before the sweep): the compiled kernels are
+    loaded from numba's on-disk cache (or compiled and written there) and the design's plate
+    model is built into, or read from, the run store. The seconds it took."""
+    t0 = time.perf_counter()
+    s = gp.loads(scenario_toml)
+    try:
+        gp.simulate(s, t_end=min(s.time.t_end, WARM_T_END), progress=False)
+    except Exception:  # noqa: BLE001 - the design itself reports its failure later
+        pass
+    return time.perf_counter() - t0
+
+
+# ------------------------------------------------------------------------- records
+
+def record_path(out: str | Path, key: str, suffix: str = ".json") -> Path:
+    return Path(out) / DESIGNS / f"{key}{suffix}"
+
+
+def make_record(key: str, changes: dict, scenario_toml: str, outcome: dict) -> dict:
+    """The JSON record of a finished design."""
+    return {"key": key, "granplate_version": gp.__version__, "status": outcome["status"],
+            "changes": changes, "summary": outcome["summary"],
+            "elapsed_s": outcome["elapsed_s"], "scenario_toml": scenario_toml}
+
+
+def write_record(out: str | Path, record: dict, result=None) -> Path:
+    """Write designs/KEY.json atomically (and KEY.nc first, with the full result)."""
+    if result is not None:
+        store.atomic_write(record_path(out, record["key"], ".nc"), lambda tmp: gp.write(result, tmp))
+    text = json.dumps(record, indent=1) + "\n"
+    return store.atomic_write(record_path(out, record["key"]), lambda tmp: tmp.write_text(text))
+
+
+def read_record(out: str | Path, key: str, full: bool = False) -> dict | None:
+    """The record of design KEY, or None when missing, unreadable or of another key (and,
+    with full, when a successful design's KEY.nc is missing)."""
+    path = record_path(out, key)
+    try:
+        record = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(record, dict) or record.get("key") != key or "status" not in record:
+        return None
+    if full and record["status"] == "ok" and not record_path(out, key, ".nc").is_file():
+        return None
+    return record

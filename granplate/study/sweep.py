@@ -1,0 +1,196 @@
+"""Run a study's designs on Dask distributed and write its table (docs/studies.md).
+
+The designs are tasks of a Dask cluster: by default a LocalCluster of worker processes
+with one thread each; or an existing cluster given by its scheduler's address (more
+machines: start workers there, nothing else changes). Before the designs, every worker
+runs a short warm-up (`design.warm_up`), one worker first and the others after it, so the
+compiled kernels are written to numba's on-disk cache once and then only read (numba
+writes its cache files atomically, so concurrent writers are safe but each would compile
+again), and the first design's plate model is built once into the run store, where every
+worker finds it (the store is keyed by the plate's inputs: designs with the same plate
+share one model).
+
+Results are gathered with `as_completed`: each design's record is written as soon as it
+is in, so an interrupted sweep loses only the designs in flight, and a rerun computes only
+the designs without a record. The table (results.nc, results.csv) is written at the end,
+and also when the sweep is interrupted.
+"""
+from __future__ import annotations
+
+import logging
+import os
+import signal
+import sys
+import threading
+import time
+from contextlib import contextmanager, nullcontext
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterator
+
+import granplate as gp
+from granplate.study import design as D
+from granplate.study import table as T
+from granplate.study.spec import Study
+
+#: Table files inside a study's output folder.
+RESULTS_NC = "results.nc"
+RESULTS_CSV = "results.csv"
+
+
+@dataclass
+class SweepReport:
+    """What a sweep did: designs in the study, found already done, computed now, failed
+    (among all recorded), lost (a task that did not come back: no record, a rerun retries)."""
+
+    n_designs: int
+    n_done_before: int
+    n_computed: int = 0
+    n_failed: int = 0
+    lost: list[str] = field(default_factory=list)
+    elapsed_s: float = 0.0
+    compute_s: float = 0.0
+    warm_up_s: float = 0.0
+    out: Path = Path(".")
+
+
+def available_cores() -> int:
+    """The cores this process may run on (its CPU affinity where the system tells it)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+@contextmanager
+def sigint_ignored() -> Iterator[None]:
+    """Ignore SIGINT (Ctrl-C) while processes are started (they keep ignoring it), then
+    restore the handler; a no-op outside the main thread."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+@contextmanager
+def dask_client(workers: int | None = None, scheduler: str | None = None) -> Iterator:
+    """A Dask Client: of the cluster at scheduler's address, else of a new LocalCluster of
+    `workers` processes (default: the machine's cores), one thread each; closed on exit."""
+    from distributed import Client, LocalCluster
+
+    if scheduler:
+        client = Client(scheduler)
+        try:
+            yield client
+        finally:
+            client.close()
+        return
+    n = workers or available_cores()
+    with sigint_ignored():  # the workers inherit it: Ctrl-C reaches this process alone
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                               dashboard_address=None, silence_logs=logging.ERROR)
+    try:
+        with Client(cluster) as client:
+            yield client
+    finally:
+        cluster.close()
+
+
+def warm_workers(client, scenario_toml: str) -> float:
+    """Run design.warm_up on one worker, then on all the others at once; the seconds."""
+    t0 = time.perf_counter()
+    client.wait_for_workers(1)
+    workers = sorted(client.scheduler_info(n_workers=-1)["workers"])
+    first, rest = workers[:1], workers[1:]
+    for group in (first, rest):
+        futures = [client.submit(D.warm_up, scenario_toml, workers=[w], allow_other_workers=False,
+                                 pure=False) for w in group]
+        client.gather(futures)
+        for f in futures:  # pinned to its worker: never to be recomputed if that worker dies
+            f.release()
+    return time.perf_counter() - t0
+
+
+def progress_bar(total: int, initial: int, enabled: bool):
+    """A tqdm bar with ETA on stderr."""
+    from tqdm import tqdm
+
+    return tqdm(total=total, initial=initial, desc="sweep", unit="design", file=sys.stderr,
+                disable=not enabled, dynamic_ncols=True)
+
+
+def write_table(study: Study, out: Path, keys: list[str]) -> Path:
+    """Read every design's record and write results.nc and results.csv; the .nc path."""
+    records = [D.read_record(out, k) for k in keys]
+    attrs = {"base": study.base_name, "fixed": T.attrs_json(study.fixed),
+             "parameters": T.attrs_json(list(study.names)), "granplate_version": gp.__version__,
+             "n_designs": len(keys), "n_ok": sum(1 for r in records if r and r["status"] == "ok")}
+    ds = T.to_dataset(study.names, study.designs, keys, records, attrs)
+    T.write_netcdf(ds, out / RESULTS_NC)
+    T.write_csv(ds, out / RESULTS_CSV)
+    return out / RESULTS_NC
+
+
+def sweep(study: Study, out: str | Path, *, client=None, workers: int | None = None,
+          scheduler: str | None = None, full: bool = False, limit: int | None = None,
+          progress: bool = True) -> SweepReport:
+    """Compute the designs of `study` that have no record in out/designs, then write the
+    table. client: an open Dask Client to use (else one is made from workers/scheduler,
+    see `dask_client`); full: keep each design's whole result (designs/KEY.nc); limit:
+    compute at most this many of the missing designs (None: all)."""
+    t0 = time.perf_counter()
+    out = Path(out)
+    (out / D.DESIGNS).mkdir(parents=True, exist_ok=True)
+    texts = [gp.dumps(study.scenario(i)) for i in range(len(study.designs))]
+    keys = [D.design_key(t) for t in texts]
+    missing: dict[str, int] = {}  # key -> first design with it (equal designs run once)
+    for i, k in enumerate(keys):
+        if k not in missing and D.read_record(out, k, full=full) is None:
+            missing[k] = i
+    n_before = sum(1 for k in keys if k not in missing)
+    todo = list(missing.items())[: limit if limit is not None else None]
+    report = SweepReport(len(keys), n_before, out=out)
+    try:
+        if todo:
+            with (nullcontext(client) if client is not None else dask_client(workers, scheduler)) as c:
+                report.warm_up_s = warm_workers(c, texts[todo[0][1]])
+                _run(c, study, out, todo, texts, keys, full, progress, report)
+    finally:
+        write_table(study, out, keys)
+        report.n_failed = sum(1 for k in set(keys) if (r := D.read_record(out, k)) and r["status"] != "ok")
+        report.elapsed_s = time.perf_counter() - t0
+    return report
+
+
+def _run(client, study: Study, out: Path, todo: list[tuple[str, int]], texts: list[str],
+         keys: list[str], full: bool, progress: bool, report: SweepReport) -> None:
+    """Submit the designs, write each record as it comes in (cancel the rest on interrupt)."""
+    from distributed import as_completed
+
+    futures = {client.submit(D.run_design, texts[i], full, key=f"design-{k}", pure=False): (k, i)
+               for k, i in todo}
+    bar = progress_bar(len(set(keys)), len(set(keys)) - len(todo), progress)
+    try:
+        for fut in as_completed(futures):
+            k, i = futures.pop(fut)
+            try:
+                outcome = fut.result()
+            except Exception as err:  # noqa: BLE001 - a lost task: no record, a rerun retries
+                report.lost.append(f"design {i}: {D.failure_message(err)}")
+                bar.update(1)
+                continue
+            D.write_record(out, D.make_record(k, study.changes(i), texts[i], outcome),
+                           outcome.get("result"))
+            report.n_computed += 1
+            report.compute_s += outcome["elapsed_s"]
+            bar.update(1)
+            if outcome["status"] != "ok":
+                bar.write(f"design {i} failed: {outcome['status']}", file=sys.stderr)
+    finally:
+        bar.close()
+        if futures:
+            client.cancel(list(futures))
