@@ -105,10 +105,10 @@ def hertz_elastic_force(e_star: float, r_star: float, delta: float) -> float:
 
 def contact_lists(scenario: Scenario) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The model's contact network: (pairs (np, 2), wall contacts (nw, 2) [granule,
-    wall], plate contacts (nk,) granule indices), from granplate.build_model."""
-    import granplate as gp
+    wall], plate contacts (nk,) granule indices), from the model's contact lists."""
+    from granplate.model.arrays import build_model
 
-    model = gp.build_model(scenario)
+    model = build_model(scenario)
     return (np.asarray(model.pairs, int).reshape(-1, 2), np.asarray(model.wall_contacts, int).reshape(-1, 2),
             np.asarray(model.plate_contacts, int).reshape(-1))
 

@@ -163,15 +163,15 @@ def plan(out_dir: Path, t_end: float | None = None, checks: str = "fast") -> lis
 def run_job(job: Job) -> RunRecord:
     """Simulate one job and write its result atomically; a failed run keeps its partial
     result as NAME.partial.nc (never reused) and reports why."""
-    import granplate
     from granplate import store
     from granplate.errors import SimulationError
     from granplate.results.dataset import write
+    from granplate.results.run import simulate
 
     t0 = time.perf_counter()
     job.path.parent.mkdir(parents=True, exist_ok=True)
     try:
-        ds = granplate.simulate(job.scenario, progress=False)
+        ds = simulate(job.scenario, progress=False)
     except SimulationError as err:
         if err.result is not None:
             write(err.result, job.path.with_name(job.path.stem + ".partial.nc"))
