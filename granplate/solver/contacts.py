@@ -1,14 +1,15 @@
 """The contact watch after every accepted step (docs/model.md section 1.3): how far each
 granule has moved since the contact list was built (past cfg.rebuild_move the chunk ends
 and the driver rebuilds the list), the largest overlap of every contact against the
-smaller radius (past cfg.overlap_stop the run stops), and granules without a plate
+smaller radius (the step's largest one, found by granular_rhs; past cfg.overlap_stop
+the run stops), and granules without a plate
 contact reaching the plate's face (the run stops).
 """
 from __future__ import annotations
 
 from numba import njit
 
-from granplate.physics.contact import pair_overlap, plate_overlap, wall_overlap
+from granplate.physics.contact import plate_overlap
 from granplate.solver.state import (
     ERR_CONTACT, ERR_ITER, ERR_JUMP, ERR_N, ERR_OVERLAP, ERR_PLATE_REACH, ERR_RESID, ERR_T, ERR_VT,
     OK, PARTNER_PLATE, REBUILD,
@@ -51,35 +52,18 @@ def plate_face(u):
 def watch_contacts(t, y, u, g, cfg, w, err):
     """Check the state after an accepted step; returns OK, REBUILD (the list must be
     rebuilt: a granule moved cfg.rebuild_move since it was built), ERR_OVERLAP,
-    ERR_PLATE_REACH or ERR_JUMP with err filled."""
-    for p in range(g.pair_ij.shape[0]):
-        i = g.pair_ij[p, 0]
-        j = g.pair_ij[p, 1]
-        ri = g.radius[i]
-        rj = g.radius[j]
-        delta, _, _ = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
-        if delta > 0.0:
-            rel = delta / min(ri, rj)
-            note_overlap(i, j, rel, w.ovl, w.ovl_with)
-            note_overlap(j, i, rel, w.ovl, w.ovl_with)
-            if rel > cfg.overlap_stop:
-                return stop(ERR_OVERLAP, t, err, i, j, delta, rel)
-    for k in range(g.wall_i.shape[0]):
-        i = g.wall_i[k]
-        delta = wall_overlap(y[i, 0], y[i, 1], g.radius[i], g.wall_geo[k, 0], g.wall_geo[k, 1], g.wall_geo[k, 2])
-        if delta > 0.0:
-            rel = delta / g.radius[i]
-            note_overlap(i, -1 - g.wall_w[k], rel, w.ovl, w.ovl_with)
-            if rel > cfg.overlap_stop:
-                return stop(ERR_OVERLAP, t, err, i, -1 - g.wall_w[k], delta, rel)
-    for k in range(g.pc_i.shape[0]):
-        i = g.pc_i[k]
-        delta = plate_overlap(y[i, 0], g.radius[i], g.pc_x[k] + u[2 * k])
-        if delta > 0.0:
-            rel = delta / g.radius[i]
-            note_overlap(i, PARTNER_PLATE, rel, w.ovl, w.ovl_with)
-            if rel > cfg.overlap_stop:
-                return stop(ERR_OVERLAP, t, err, i, PARTNER_PLATE, delta, rel)
+    ERR_PLATE_REACH or ERR_JUMP with err filled. The step's largest overlap comes from
+    the last evaluation of the forces (w.ovl_new, w.ovl_who: granular.granular_rhs)."""
+    i = w.ovl_who[0]
+    if i >= 0:
+        partner = w.ovl_who[1]
+        rel = w.ovl_new[0]
+        note_overlap(i, partner, rel, w.ovl, w.ovl_with)
+        if partner >= 0:
+            note_overlap(partner, i, rel, w.ovl, w.ovl_with)
+        if rel > cfg.overlap_stop:
+            r = g.radius[i] if partner < 0 else min(g.radius[i], g.radius[partner])
+            return stop(ERR_OVERLAP, t, err, i, partner, rel * r, rel)
     face = cfg.plate_x0 + plate_face(u)
     status = OK
     move2 = cfg.rebuild_move * cfg.rebuild_move

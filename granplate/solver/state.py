@@ -105,6 +105,8 @@ class Work(NamedTuple):
     ovl: np.ndarray  # (ng,) largest overlap / smaller radius seen at each granule's contacts
     ovl_with: np.ndarray  # (ng,) int: its partner (granule j, wall -1 - w, PARTNER_PLATE)
     plate_free: np.ndarray  # (ng,) int: 1 for a granule without a plate contact
+    ovl_new: np.ndarray  # (1,) largest overlap / smaller radius at the end of the trial step
+    ovl_who: np.ndarray  # (2,) int: its granule and partner (-1, -1: no overlap)
 
 
 class Output(NamedTuple):
@@ -148,6 +150,7 @@ def new_work(ng: int, nm: int, nk: int) -> Work:
         gmat=z((N_LEVELS + 1, nd, nd)), g_ok=np.zeros(N_LEVELS + 1, np.int64),
         lam_int=z(nk), it_int=np.zeros(nk, np.int64), dt_int=z(2), res_int=z(1),
         yref=z((ng, 2)), ovl=z(ng), ovl_with=np.zeros(ng, np.int64), plate_free=np.zeros(ng, np.int64),
+        ovl_new=z(1), ovl_who=np.full(2, -1, np.int64),
     )
 
 
