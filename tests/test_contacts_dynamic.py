@@ -248,3 +248,37 @@ def test_contact_lists_modes():
     assert p.tolist() == [[0, 1]] and w.tolist() == [[0, 0]]
     p, w = contact_lists(Contact(detection="fixed"), walls, x, y, r)
     assert p.shape == (0, 2) and w.shape == (0, 2)
+
+
+def test_paper_preset_is_bitwise_the_same_under_both_detections():
+    """steel-r1's contacts are those at t = 0: the Verlet list adds only pairs that never
+    touch, summed in the same order, so every output is bitwise that of the fixed topology."""
+    runs = [simulate(replace(preset("steel-r1"), contact=replace(preset("steel-r1").contact, detection=d)),
+                     t_end=5e-5, progress=False) for d in ("fixed", "dynamic")]
+    for name in ("x", "y", "vx", "vy", "omega", "E_granular", "E_plate", "D_viscous", "D_friction"):
+        np.testing.assert_array_equal(runs[0][name].values, runs[1][name].values, err_msg=name)
+
+
+@pytest.mark.parametrize("field, value, words", [
+    ("detection", "sometimes", "must be one of 'dynamic', 'fixed'"),
+    ("skin", 0.0, "must be > 0"),
+    ("skin", 1.5, "at most 1"),
+    ("overlap_warn", -0.1, "must be > 0"),
+    ("overlap_stop", 0.01, "must lie in [contact.overlap_warn = 0.05, 1)"),
+    ("overlap_stop", 1.0, "must lie in"),
+])
+def test_contact_detection_fields_are_checked(field, value, words):
+    """Each new contact field is range-checked, the message naming it."""
+    from granplate.errors import ScenarioError
+    from granplate.setup.validate import validate
+
+    s = head_on(1e-3, 1.0, 0.0, 1e-4, **{field: value})
+    with pytest.raises(ScenarioError, match=re_escape(f"contact.{field}")) as err:
+        validate(s)
+    assert words in str(err.value)
+
+
+def re_escape(text: str) -> str:
+    import re
+
+    return re.escape(text)
