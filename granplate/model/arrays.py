@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from granplate.model.contacts import contact_lists, fixed_wall_contacts
 from granplate.model.inputs import Config, Granular, PlateArrays, scheme_number
 from granplate.physics.contact import (
     COEF_A, COEF_C, COEF_KS, COEF_MU, N_COEF, damping_coefficient, hertz_coefficient,
@@ -49,8 +50,11 @@ class Model:
     """Everything the time loop needs, plus the names that label its arrays.
 
     scenario: the resolved scenario (layout expanded); labels: granule labels;
-    pairs: (np, 2) granule index pairs; wall_contacts: (nw, 2) [granule, wall];
-    plate_contacts: (nk,) granule index per plate contact; plate: the PlateModel or None.
+    pairs: (np, 2) granule pairs in contact at t = 0 (gap within contact.neighbour_gap);
+    wall_contacts: (nw, 2) [granule, wall] likewise; plate_contacts: (nk,) granule index
+    per plate contact; plate: the PlateModel or None. The loop's lists are in `granular`
+    (pair_ij, wall_i: with contact.detection = "dynamic" the Verlet lists at t = 0,
+    rebuilt during the run by `granular_with_contacts`). materials: each granule's Material.
     """
 
     scenario: Scenario
@@ -63,6 +67,7 @@ class Model:
     pairs: np.ndarray
     wall_contacts: np.ndarray
     plate_contacts: np.ndarray
+    materials: tuple = ()
 
     @property
     def n_granules(self) -> int:
@@ -100,14 +105,7 @@ def find_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: float) ->
 
 def find_wall_contacts(s: Scenario, x, y, r) -> np.ndarray:
     """(granule, wall) pairs whose initial gap is at most neighbour_gap * R."""
-    out = []
-    for w, wall in enumerate(s.walls):
-        nx, ny = wall.normal
-        for i in range(len(x)):
-            gap = wall.offset - (x[i] * nx + y[i] * ny) - r[i]
-            if gap <= s.contact.neighbour_gap * r[i]:
-                out.append((i, w))
-    return np.array(out, np.int64).reshape(-1, 2)
+    return fixed_wall_contacts(s.walls, x, y, r, s.contact.neighbour_gap)
 
 
 def find_plate_contacts(s: Scenario, x, y, r) -> np.ndarray:
@@ -152,6 +150,7 @@ def pair_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, pairs:
 def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarray):
     """(nw, 3) [nx, ny, offset] with the unit outward normal, and (nw, N_COEF)
     coefficients against a rigid body (R* = R, m* = m)."""
+    wc = np.asarray(wc, np.int64).reshape(-1, 2)
     wall_geo = np.zeros((len(wc), 3))
     wall_coef = np.zeros((len(wc), N_COEF))
     for k, (i, w) in enumerate(wc):
@@ -221,7 +220,18 @@ def loop_config(s: Scenario, fres: np.ndarray, tres: np.ndarray, r: np.ndarray, 
         scheme=scheme_number(sol.scheme),
         error_tol=float(sol.error_tol),
         force_floor=force_floor(q0, fres, tres, r, mass, s, t.output_interval),
+        rebuild_move=rebuild_move(s.contact.skin, r),
+        overlap_stop=float(s.contact.overlap_stop),
+        plate_x0=float(s.plate.x0) if s.plate is not None else math.inf,
+        plate_ylo=float(s.plate.y0) if s.plate is not None else 0.0,
+        plate_yhi=float(s.plate.y0 + s.plate.height) if s.plate is not None else 0.0,
     )
+
+
+def rebuild_move(skin: float, r: np.ndarray) -> float:
+    """How far a granule may move [m] before the contact list is rebuilt (dynamic) or
+    searched for unlisted overlaps (fixed): skin * R_min / 2 (docs/model.md section 1.3)."""
+    return 0.5 * skin * float(r.min()) if len(r) else 0.0
 
 
 def initial_state(s: Scenario, x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -245,16 +255,18 @@ def build_model(scenario: Scenario) -> Model:
     inertia = np.array([sphere_inertia(ri, rhoi) for ri, rhoi in zip(r, rho)])
     pairs = find_pairs(x, y, r, s.contact.neighbour_gap)
     wc = find_wall_contacts(s, x, y, r)
-    wall_geo, wall_coef = wall_arrays(s, mats, r, mass, wc)
+    loop_pairs, loop_wc = contact_lists(s.contact, s.walls, x, y, r)
+    wall_geo, wall_coef = wall_arrays(s, mats, r, mass, loop_wc)
     pc = find_plate_contacts(s, x, y, r)
     if len(pc) and s.plate is None:  # pragma: no cover - guarded by validation
         raise ScenarioError("plate", None, "plate contacts need a plate")
     fres, tres = shock_resultants(y, r, loaded_granules(s, x, r), s.load.y0, s.load.length)
     plate_model, plate_arrays = plate_modal_arrays(s, y, pc)
     granular = Granular(
-        mass=mass, inertia=inertia, radius=r, pair_ij=pairs,
-        pair_coef=pair_coefficients(s, mats, r, mass, pairs),
-        wall_i=np.ascontiguousarray(wc[:, 0]), wall_geo=wall_geo, wall_coef=wall_coef,
+        mass=mass, inertia=inertia, radius=r, pair_ij=loop_pairs,
+        pair_coef=pair_coefficients(s, mats, r, mass, loop_pairs),
+        wall_i=np.ascontiguousarray(loop_wc[:, 0]), wall_geo=wall_geo, wall_coef=wall_coef,
+        wall_w=np.ascontiguousarray(loop_wc[:, 1]),
         pc_i=pc, pc_x=np.full(len(pc), float(s.plate.x0) if s.plate is not None else 0.0),
         pc_coef=plate_contact_coefficients(s, mats, r, pc), shock_force=fres, shock_torque=tres,
     )
@@ -262,5 +274,25 @@ def build_model(scenario: Scenario) -> Model:
         scenario=s, labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
         granular=granular, plate_arrays=plate_arrays, config=loop_config(s, fres, tres, r, mass),
         plate=plate_model, initial_state=initial_state(s, x, y), pairs=pairs, wall_contacts=wc,
-        plate_contacts=pc,
+        plate_contacts=pc, materials=tuple(mats),
     )
+
+
+def granular_with_contacts(model: Model, g: Granular, pairs: np.ndarray, wc: np.ndarray,
+                           known: dict | None = None) -> Granular:
+    """`g` with the contact lists pairs (np, 2) and wc (nw, 2) [granule, wall] and their
+    coefficients; known: pair coefficient rows by (i, j), reused and extended (rows are
+    the same numbers `pair_coefficients` gives)."""
+    s, mats = model.scenario, list(model.materials)
+    known = {} if known is None else known
+    keys = [(int(i), int(j)) for i, j in pairs]
+    new = [k for k in keys if k not in known]
+    if new:
+        rows = pair_coefficients(s, mats, g.radius, g.mass, np.array(new, np.int64).reshape(-1, 2))
+        known.update(zip(new, rows))
+    pair_coef = np.array([known[k] for k in keys], float).reshape(-1, N_COEF)
+    wall_geo, wall_coef = wall_arrays(s, mats, g.radius, g.mass, wc)
+    wc = np.asarray(wc, np.int64).reshape(-1, 2)
+    return g._replace(pair_ij=np.ascontiguousarray(pairs, np.int64).reshape(-1, 2), pair_coef=pair_coef,
+                      wall_i=np.ascontiguousarray(wc[:, 0]), wall_geo=wall_geo, wall_coef=wall_coef,
+                      wall_w=np.ascontiguousarray(wc[:, 1]))

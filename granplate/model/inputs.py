@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+import math
+
 import numpy as np
 
 from granplate.setup.validate import SCHEMES
@@ -28,9 +30,10 @@ def scheme_number(name: str) -> int:
 class Granular(NamedTuple):
     """Flat arrays of the granular medium and its contacts (SI units).
 
-    mass, inertia, radius: (ng,); pair_ij: (np, 2) granule indices; pair_coef: (np, 4)
-    [A, c, mu, k_s] with gamma = c delta^(1/4); wall_i: (nw,); wall_geo: (nw, 3)
-    [nx, ny, offset]; wall_coef: (nw, 4); pc_i: (nk,) granule of each plate contact;
+    mass, inertia, radius: (ng,); pair_ij: (np, 2) granule indices (the pairs that may
+    touch, sorted); pair_coef: (np, 4) [A, c, mu, k_s] with gamma = c delta^(1/4); wall_i:
+    (nw,); wall_geo: (nw, 3) [nx, ny, offset]; wall_coef: (nw, 4); wall_w: (nw,) index of
+    the wall in the scenario; pc_i: (nk,) granule of each plate contact;
     pc_x: (nk,) undeformed x of the plate edge; pc_coef: (nk, 4); shock_force,
     shock_torque: (ng,) load resultants per unit q0 [m, m^2].
     """
@@ -43,6 +46,7 @@ class Granular(NamedTuple):
     wall_i: np.ndarray
     wall_geo: np.ndarray
     wall_coef: np.ndarray
+    wall_w: np.ndarray
     pc_i: np.ndarray
     pc_x: np.ndarray
     pc_coef: np.ndarray
@@ -83,3 +87,8 @@ class Config(NamedTuple):
     scheme: int = 0  # index into SCHEME_NAMES
     error_tol: float = 1e-3  # implicit scheme: local error target of the step control
     force_floor: float = 0.0  # implicit scheme: smallest force scale of the error estimate [N]
+    rebuild_move: float = 0.0  # a granule moving this far [m] since the list was built ends the chunk (0: never)
+    overlap_stop: float = math.inf  # an overlap beyond this fraction of the smaller radius stops the run
+    plate_x0: float = math.inf  # the plate's undeformed face x [m] (inf: no plate)
+    plate_ylo: float = 0.0  # its extent in y [m]
+    plate_yhi: float = 0.0

@@ -1,4 +1,6 @@
-"""Neighbour search at t = 0: the potential granule-granule contacts in O(N).
+"""Neighbour search: the potential granule-granule contacts in O(N log N), at t = 0 by
+the initial gap (contact.detection = "fixed") or as a Verlet list (`verlet_pairs`,
+`verlet_walls`; docs/model.md section 1.3).
 
 A pair (i, j) is a potential contact when its initial surface gap is at most
 gap_ratio * min(R_i, R_j) (docs/model.md section 1, the topology is fixed):
@@ -64,3 +66,28 @@ def contact_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: float)
     cand = candidate_pairs(x, y, search_distance(r, gap_ratio))
     keep = [is_contact(x[j] - x[i], y[j] - y[i], r[i], r[j], gap_ratio) for i, j in cand.tolist()]
     return cand[np.array(keep, bool)].reshape(-1, 2)
+
+
+def verlet_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, skin: float) -> np.ndarray:
+    """(n_pairs, 2) pairs whose centres are at most (R_i + R_j)(1 + skin) apart, sorted
+    (i, j) with i < j, in O(N log N) (the Verlet list of docs/model.md section 1.3)."""
+    x, y, r = (np.asarray(a, float) for a in (x, y, r))
+    if len(x) < 2:
+        return np.zeros((0, 2), np.int64)
+    cand = candidate_pairs(x, y, 2.0 * float(r.max()) * (1.0 + skin) * (1.0 + SEARCH_MARGIN))
+    i, j = cand[:, 0], cand[:, 1]
+    keep = np.hypot(x[j] - x[i], y[j] - y[i]) <= (r[i] + r[j]) * (1.0 + skin)
+    return np.ascontiguousarray(cand[keep]).reshape(-1, 2)
+
+
+def verlet_walls(x: np.ndarray, y: np.ndarray, r: np.ndarray, normals: np.ndarray, offsets: np.ndarray,
+                 skin: float) -> np.ndarray:
+    """(n, 2) [granule, wall] whose gap offset - s.n - R is at most skin R (granules
+    beyond the wall included), sorted (wall, granule); normals: (nw, 2) unit outward."""
+    x, y, r = (np.asarray(a, float) for a in (x, y, r))
+    out = []
+    for w in range(len(offsets)):
+        gap = offsets[w] - (x * normals[w, 0] + y * normals[w, 1]) - r
+        for i in np.flatnonzero(gap <= skin * r):
+            out.append((int(i), w))
+    return np.array(out, np.int64).reshape(-1, 2)

@@ -58,8 +58,8 @@ class Imperfections:
     jitter R and its centre moved uniformly within a disc of radius jitter R;
     radius_spread + jitter < 1. vacancy_fraction [-]: round(fraction x sites) sites
     removed at random, in [0, 1); vacancies: labels of sites removed as well.
-    Contacts are only the pairs whose gap at t = 0 is within contact.neighbour_gap x the
-    smaller radius: wider gaps never interact (raise neighbour_gap to keep them).
+    Gaps close during a run (contact.detection = "dynamic"); with detection = "fixed" only
+    the pairs whose gap at t = 0 is within contact.neighbour_gap x the smaller radius interact.
     """
 
     seed: int = 0
@@ -224,9 +224,17 @@ class Contact:
 
     mu: Coulomb coefficient [-]; k_s: tanh smoothing [s/m]; alpha_n: damping coefficient
     [-] of eq. (3) for pairs not listed in `pairs`; clip_tensile: the normal force never
-    pulls (True, docs/model.md section 3.2) or the paper's raw eq. (2) (False); neighbour_gap: pairs whose
-    initial surface gap is at most this fraction of the smaller radius are potential
-    contacts (the topology is fixed); torque_arm: lever arm of the friction torque,
+    pulls (True, docs/model.md section 3.2) or the paper's raw eq. (2) (False); detection:
+    which pairs can touch (docs/model.md section 1.3): "dynamic" finds granule-granule and
+    granule-wall contacts as they form and drops them as they open (a Verlet list of pairs
+    within (R_i + R_j)(1 + skin), rebuilt when a granule has moved skin * R_min / 2),
+    "fixed" keeps the pairs whose initial surface gap is at most neighbour_gap x the
+    smaller radius (the paper's fixed topology; an overlap of any other pair stops the
+    run); skin [-]: the Verlet list's margin, a fraction of R_i + R_j; neighbour_gap [-]:
+    the initial gap, as a fraction of the smaller radius, of the fixed pairs and of the
+    plate contacts (fixed in both modes); overlap_warn, overlap_stop [-]: an overlap beyond
+    this fraction of the smaller radius warns (Hertz assumes small overlaps) or stops the
+    run; torque_arm: lever arm of the friction torque,
     "radius" (R_i, paper eq. 1, docs/model.md section 3.2) or "contact_point" (R_i - delta/2 for a
     pair, R_i - delta at a wall or plate: the true contact point, which conserves the
     angular momentum of a free assembly; with "radius" each sliding pair adds a couple
@@ -242,6 +250,10 @@ class Contact:
     clip_tensile: bool = True
     neighbour_gap: float = 0.05
     torque_arm: str = "radius"
+    detection: str = "dynamic"
+    skin: float = 0.1
+    overlap_warn: float = 0.05
+    overlap_stop: float = 0.2
 
     def for_pair(self, a: str, b: str) -> tuple[float, float, float]:
         """(alpha_n, mu, k_s) for materials a and b."""

@@ -30,6 +30,7 @@ from granplate.setup.scenario import (LAYOUT_KINDS, SQRT2_MINUS_1, ChainLayout, 
 
 #: Lever arms of the friction torque (Contact.torque_arm).
 TORQUE_ARMS: tuple[str, ...] = ("radius", "contact_point")
+DETECTIONS: tuple[str, ...] = ("dynamic", "fixed")
 #: Coupling schemes the solver knows (Solver.scheme).
 SCHEMES: tuple[str, ...] = ("paper", "implicit")
 #: Load kinds (Load.kind) and targets (Load.target).
@@ -488,6 +489,15 @@ def _check_contact(s: Scenario) -> None:
     _nonneg("contact.alpha_n", c.alpha_n)
     _nonneg("contact.neighbour_gap", c.neighbour_gap)
     _string_in("contact.torque_arm", c.torque_arm, TORQUE_ARMS)
+    _string_in("contact.detection", c.detection, DETECTIONS)
+    _positive("contact.skin", c.skin)
+    if c.skin > 1.0:
+        raise ScenarioError("contact.skin", c.skin, "must be at most 1 (a fraction of R_i + R_j)")
+    _positive("contact.overlap_warn", c.overlap_warn)
+    _positive("contact.overlap_stop", c.overlap_stop)
+    if not c.overlap_warn <= c.overlap_stop < 1.0:
+        raise ScenarioError("contact.overlap_stop", c.overlap_stop,
+                            f"must lie in [contact.overlap_warn = {c.overlap_warn:g}, 1)")
     if not isinstance(c.clip_tensile, bool):
         raise ScenarioError("contact.clip_tensile", c.clip_tensile, "must be true or false")
     for i, pc in enumerate(c.pairs):

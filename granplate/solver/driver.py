@@ -9,12 +9,15 @@ import math
 import signal
 import threading
 import time
+import warnings
 from contextlib import contextmanager
 from typing import Callable, NamedTuple
 
 import numpy as np
 
-from granplate.model.arrays import Model
+from granplate.model.arrays import Model, granular_with_contacts
+from granplate.model.contacts import Missed, contact_lists, missed_contacts, wall_planes
+from granplate.model.neighbours import verlet_pairs, verlet_walls
 from granplate.solver import loop, state as S
 from granplate.solver.ladder import level_for
 from granplate.solver.schemes import scheme
@@ -71,9 +74,97 @@ def status_message(status: int, model: Model, st: S.State) -> str:
             f"{e[S.ERR_RESID]:.3e} exceeds solver.energy_tol = {cfg.energy_tol:.1e} "
             f"(step {e[S.ERR_H]:.3e} s). Lower time.dt_max or solver.lambda_target."
         )
+    if status in (S.ERR_OVERLAP, S.ERR_MISSED, S.ERR_PLATE_REACH, S.ERR_JUMP):
+        return contact_message(status, model, st)
     if status == S.ERR_NAN:
         return f"the state became non-finite (NaN/inf) at t = {t:.6e} s (step {e[S.ERR_H]:.3e} s)."
     return f"output buffer exhausted at t = {t:.6e} s (internal error, status {status})."
+
+
+def partner_name(model: Model, partner: int) -> str:
+    """'granule X', 'wall w (x, y)' or 'the plate' from a partner code (state.PARTNER_PLATE)."""
+    if partner == S.PARTNER_PLATE:
+        return "the plate"
+    if partner < 0:
+        w = -1 - partner
+        return f"wall {w} (normal {tuple(model.scenario.walls[w].normal)}, offset {model.scenario.walls[w].offset:g} m)"
+    return f"granule '{model.labels[partner]}'"
+
+
+def contact_message(status: int, model: Model, st: S.State) -> str:
+    """Why the contact watch stopped the run (solver/contacts.py, model/contacts.py)."""
+    e = st.err
+    c = model.scenario.contact
+    t = e[S.ERR_T]
+    i = int(e[S.ERR_CONTACT])
+    who = f"granule '{model.labels[i]}'"
+    other = partner_name(model, int(e[S.ERR_ITER]))
+    where = f"(at x = {st.y[i, 0]:.6g} m, y = {st.y[i, 1]:.6g} m)"
+    if status == S.ERR_OVERLAP:
+        return (f"{who} {where} and {other} overlap by {e[S.ERR_N]:.4g} m at t = {t:.6e} s, "
+                f"{e[S.ERR_RESID]:.3g} of the smaller radius, beyond contact.overlap_stop = "
+                f"{c.overlap_stop:g}: Hertz's law assumes small overlaps. Lower the load or "
+                f"time.dt_max, or stiffen the contact.")
+    if status == S.ERR_MISSED:
+        how = ("it is not one of the fixed contacts (contact.detection = \"fixed\"); use "
+               "detection = \"dynamic\"" if c.detection == "fixed" else
+               "the contact formed unseen within one step: lower time.dt_max or raise contact.skin")
+        return (f"{who} {where} and {other} interpenetrate by {e[S.ERR_N]:.4g} m at t = {t:.6e} s "
+                f"and no contact accounts for it: {how}.")
+    if status == S.ERR_PLATE_REACH:
+        return (f"{who} {where} reached the plate's face at t = {t:.6e} s (overlap "
+                f"{e[S.ERR_N]:.4g} m) but has no plate contact: plate contacts are those at t = 0 "
+                f"(within contact.neighbour_gap = {c.neighbour_gap:g} R of the plate).")
+    return (f"{who} {where} moved {e[S.ERR_N]:.4g} m ({e[S.ERR_RESID]:.3g} radii) in one step at "
+            f"t = {t:.6e} s: contacts may have been passed through. Lower time.dt_max.")
+
+
+def overlap_warnings(model: Model, w: S.Work) -> list[str]:
+    """One line per granule whose largest contact overlap exceeded contact.overlap_warn
+    (of the smaller radius), with that contact's partner: Hertz's law assumes small overlaps."""
+    lim = model.scenario.contact.overlap_warn
+    out = []
+    seen = set()
+    for i in np.flatnonzero(w.ovl > lim):
+        j = int(w.ovl_with[i])
+        key = (min(i, j), max(i, j)) if j >= 0 else (int(i), j)
+        if key in seen:
+            continue
+        seen.add(key)
+        out.append(f"granule '{model.labels[i]}' and {partner_name(model, j)}: overlap "
+                   f"{w.ovl[i]:.3g} of the smaller radius (contact.overlap_warn = {lim:g})")
+    return out
+
+
+class ContactLists:
+    """The loop's contact lists during a run: rebuilt (detection = "dynamic") or checked
+    (fixed) from the granules' positions, between compiled chunks (model/contacts.py)."""
+
+    def __init__(self, model: Model):
+        self.model = model
+        self.g = model.granular
+        self.known: dict = {}
+        self.planes = wall_planes(model.scenario.walls)
+        self.n_rebuilds = 0
+
+    def refresh(self, y: np.ndarray) -> Missed | None:
+        """Rebuild (dynamic) or check (fixed) the lists at positions y[:, :2]; returns the
+        worst overlap no contact of the current list accounts for, or None."""
+        m, g = self.model, self.g
+        x, yy, r = y[:, 0], y[:, 1], g.radius
+        c = m.scenario.contact
+        fixed = c.detection == "fixed"
+        normals, offsets = self.planes
+        self.n_rebuilds += 1
+        if fixed:
+            cand_p, cand_w = verlet_pairs(x, yy, r, 0.0), verlet_walls(x, yy, r, normals, offsets, 0.0)
+        else:
+            cand_p, cand_w = contact_lists(c, m.scenario.walls, x, yy, r)
+        cur_w = np.column_stack([g.wall_i, g.wall_w]).astype(np.int64)
+        missed = missed_contacts(g.pair_ij, cur_w, cand_p, cand_w, normals, offsets, x, yy, r)
+        if not fixed:
+            self.g = granular_with_contacts(m, g, cand_p, cand_w, self.known)
+        return missed[0] if missed else None
 
 
 @contextmanager
@@ -105,9 +196,25 @@ def next_budget(budget: int, attempts: int, seconds: float) -> int:
     return int(min(max(CHUNK_SECONDS / per, 1), 1 << 24))
 
 
-def _loop_chunks(times, model, st, w, sw, out, should_stop, on_progress) -> int:
-    """Call the compiled loop chunk by chunk until the end, an error or a stop request."""
-    g, p, cfg = model.granular, model.plate_arrays, model.config
+def _refresh(lists: ContactLists, st: S.State, w: S.Work) -> int:
+    """Rebuild or check the contact lists at the current state: OK or ERR_MISSED (st.err filled)."""
+    miss = lists.refresh(st.y)
+    w.yref[:] = st.y[:, :2]
+    if miss is None:
+        return S.OK
+    st.err[S.ERR_T] = st.clock[S.T_NOW]
+    st.err[S.ERR_CONTACT] = miss.i
+    st.err[S.ERR_ITER] = miss.partner
+    st.err[S.ERR_N] = miss.overlap
+    return S.ERR_MISSED
+
+
+def _loop_chunks(times, model, st, w, sw, out, should_stop, on_progress, lists) -> int:
+    """Call the compiled loop chunk by chunk until the end, an error or a stop request;
+    between chunks the contact lists are rebuilt when the loop asks (REBUILD) and, with
+    fixed contacts, checked after every chunk."""
+    p, cfg = model.plate_arrays, model.config
+    fixed = model.scenario.contact.detection == "fixed"
     n_chunks = min(200, len(times) - 1)
     stops = np.unique(np.linspace(1, len(times) - 1, n_chunks).round().astype(int)) if n_chunks else []
     budget = FIRST_BUDGET
@@ -119,13 +226,19 @@ def _loop_chunks(times, model, st, w, sw, out, should_stop, on_progress) -> int:
             before = st.count[S.C_OUT]
             n0 = st.count[S.C_STEPS] + st.count[S.C_RETRIES]
             t0 = time.perf_counter()
-            status = loop.advance(float(times[o_stop]), budget, g, p, cfg, st, w, sw, out)
+            status = loop.advance(float(times[o_stop]), budget, lists.g, p, cfg, st, w, sw, out)
             budget = next_budget(budget, int(st.count[S.C_STEPS] + st.count[S.C_RETRIES] - n0),
                                  time.perf_counter() - t0)
             on_progress(int(st.count[S.C_OUT] - before))
+            if status == S.REBUILD or (fixed and status in (S.OK, S.PAUSED)):
+                checked = _refresh(lists, st, w)
+                if checked != S.OK:
+                    return checked
+                if status == S.REBUILD:
+                    status = S.PAUSED
         if status != S.OK:
             return status
-    return S.OK
+    return _refresh(lists, st, w)
 
 
 def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool] | None = None,
@@ -143,6 +256,10 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
     sw = scheme(cfg.scheme).new_scratch(ng, nm, nk)
     out = S.new_output(times, ng, nm, nk)
     st.y[:] = model.initial_state
+    w.yref[:] = st.y[:, :2]
+    w.plate_free[:] = 1
+    w.plate_free[model.plate_contacts] = 0
+    lists = ContactLists(model)
     st.count[S.C_LEVEL] = level_for(model.scenario.time.dt_initial, cfg)
     t1 = time.perf_counter()
     loop.initialise(st, g, p, cfg, w)
@@ -159,7 +276,7 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
     try:
         with (stop_on_signals() if interruptible else _never()) as signalled:
             status = _loop_chunks(times, model, st, w, sw, out, lambda: signalled() or any(f() for f in polls),
-                                  bar.update if bar is not None else (lambda n: None))
+                                  bar.update if bar is not None else (lambda n: None), lists)
     finally:
         if bar is not None:
             bar.close()
@@ -169,8 +286,13 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
         "n_steps": int(st.count[S.C_STEPS]),
         "n_iterations": int(st.count[S.C_ITERS]),
         "n_retries": int(st.count[S.C_RETRIES]),
+        "n_rebuilds": lists.n_rebuilds,
+        "overlap_warnings": overlap_warnings(model, w),
     }
     message = "ok" if status == S.OK else status_message(status, model, st)
+    for line in info["overlap_warnings"]:
+        warnings.warn(f"{model.scenario.name}: {line}: Hertz's law assumes overlaps small against the radii.",
+                      RuntimeWarning, stacklevel=2)
     return RunRecord(out=out, n_valid=int(st.count[S.C_OUT]), status=status, message=message, info=info)
 
 

@@ -11,6 +11,7 @@ from granplate.physics.contact import (
     pair_rates, plate_overlap, plate_rates, wall_overlap, wall_rates,
 )
 from granplate.physics.shock import time_profile
+from granplate.solver.state import PARTNER_PLATE
 
 
 @njit(cache=True)
@@ -31,7 +32,9 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
     contact. hold: the plate-contact friction is fbar[k] (held over the step, its work
     booked by the scheme) instead of eq. (5). Returns (shock power, viscous power,
     friction power, contact potential energy, largest slip relaxation rate of a granule
-    contact) [W, W, W, J, 1/s]; RK4 needs h times that rate below ~2.8. One function
+    contact, largest overlap over the smaller radius, its granule, its partner (granule j,
+    wall -1 - w or PARTNER_PLATE; -1, -1 with no overlap; as floats)) [W, W, W, J, 1/s, -, -, -]; RK4
+    needs h times that rate below ~2.8. One function
     (not one per contact kind): calls that pass the model tuples cost more per step
     than the loops themselves when the medium is small.
     """
@@ -48,6 +51,9 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
     p_fric = 0.0
     e_pot = 0.0
     rate = 0.0
+    ovl = 0.0  # the largest overlap / smaller radius, at granule ovl_i with ovl_j
+    ovl_i = -1
+    ovl_j = -1
     if not cfg.load_on_plate:  # the shock on the loaded granules
         amp = cfg.q0 * time_profile(t, cfg.duration)
         if amp != 0.0:
@@ -65,6 +71,10 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
         delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
         if delta <= 0.0:
             continue
+        if delta > ovl * min(ri, rj):
+            ovl = delta / min(ri, rj)
+            ovl_i = i
+            ovl_j = j
         ai = contact_arm(ri, delta, 0.5 * cfg.arm_shrink)
         aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
         ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
@@ -91,6 +101,10 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
         delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, g.wall_geo[w, 2])
         if delta <= 0.0:
             continue
+        if delta > ovl * ri:
+            ovl = delta / ri
+            ovl_i = i
+            ovl_j = -1 - g.wall_w[w]
         ai = contact_arm(ri, delta, cfg.arm_shrink)
         ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
         c = g.wall_coef[w]
@@ -112,6 +126,10 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
         f = 0.0
         pf = 0.0
         if delta > 0.0:
+            if delta > ovl * ri:
+                ovl = delta / ri
+                ovl_i = i
+                ovl_j = PARTNER_PLATE
             c = g.pc_coef[k]
             n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
             if not hold:  # the granule side only: the plate side of this map is criterion (8)
@@ -134,7 +152,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
         dy[i, 3] /= g.mass[i]
         dy[i, 4] /= g.mass[i]
         dy[i, 5] /= g.inertia[i]
-    return p_shock, p_visc, p_fric, e_pot, rate
+    return p_shock, p_visc, p_fric, e_pot, rate, ovl, float(ovl_i), float(ovl_j)  # one float tuple: indexable
 
 
 @njit(cache=True)
@@ -145,7 +163,8 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     Stage 1 reuses st.k1/st.p1 (first same as last), unless hold (the plate-contact
     friction held at w.fbar over the step), which changes it. Writes w.ynew, w.kend,
     w.fnew (forces on the plate at t + h), w.normal_new, w.slip_new, w.pend (powers at
-    t + h) and w.dacc (shock, viscous, friction work over the step). Returns (stored
+    t + h) and w.dacc (shock, viscous, friction work over the step), w.ovl_new and
+    w.ovl_who (the largest relative overlap at t + h and its contact). Returns (stored
     contact energy at t + h [J], largest slip relaxation rate [1/s]).
     """
     y0 = st.y
@@ -182,6 +201,9 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     w.pend[0] = pe[0]
     w.pend[1] = pe[1]
     w.pend[2] = pe[2]
+    w.ovl_new[0] = pe[5]
+    w.ovl_who[0] = int(pe[6])
+    w.ovl_who[1] = int(pe[7])
     return pe[3], pe[4]
 
 

@@ -13,6 +13,7 @@ from numba import njit
 
 from granplate.physics.energy import energy_residual, energy_total
 from granplate.solver import schemes as S
+from granplate.solver.contacts import watch_contacts
 from granplate.solver.granular import granular_rhs, kinetic_energies
 from granplate.solver.interface import accept_contacts, contact_modulus, first_guess
 from granplate.solver.ladder import level_step
@@ -203,7 +204,8 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
     """Advance from st.clock[T_NOW] to t_stop (an output time) with the scheme whose
     scratch is sw, trying at most max_attempts steps. Returns a status: OK, PAUSED
     (budget spent; call again) or an error, with st.err filled and the state the last
-    accepted one."""
+    accepted one. After every accepted step the contact watch runs (solver/contacts.py):
+    REBUILD asks the driver to rebuild the contact list and call again."""
     for _ in range(max_attempts):
         t = st.clock[T_NOW]
         if t >= t_stop - 1e-9 * cfg.dt_min:
@@ -244,6 +246,9 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
         if land:
             record(o, st, g, p, w, out)
             st.count[C_OUT] = o + 1
+        status = watch_contacts(st.clock[T_NOW], st.y, st.u, g, cfg, w, st.err)
+        if status != OK:
+            return status
     return OK if st.clock[T_NOW] >= t_stop - 1e-9 * cfg.dt_min else PAUSED
 
 

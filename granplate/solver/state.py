@@ -27,8 +27,16 @@ N_STEPSTAT = 6
 # failure record (float64)
 ERR_T, ERR_CONTACT, ERR_N, ERR_VT, ERR_LAM, ERR_H, ERR_RESID, ERR_ITER = range(8)
 N_ERR = 8
-# status codes of `advance`; PAUSED: the chunk's step budget is spent (not an error)
+# status codes of `advance`; PAUSED: the chunk's step budget is spent (not an error);
+# REBUILD: a granule moved farther than the contact list allows (rebuild it, go on);
+# ERR_OVERLAP: an overlap beyond contact.overlap_stop; ERR_PLATE_REACH: a granule without
+# a plate contact reached the plate's face; ERR_JUMP: a granule moved more than the
+# smallest radius in one step; ERR_MISSED: two bodies overlap that no contact accounts
+# for (found by the driver's search when the list is rebuilt or checked)
 OK, ERR_NAN, ERR_ENERGY, ERR_NOCONV, ERR_BUFFER, PAUSED = 0, 1, 2, 3, 4, 5
+REBUILD, ERR_OVERLAP, ERR_PLATE_REACH, ERR_JUMP, ERR_MISSED = 6, 7, 8, 9, 10
+#: partner code of a plate contact in Work.ovl_with (a granule j >= 0, wall w: -1 - w)
+PARTNER_PLATE = -(1 << 40)
 
 #: time steps live on a ladder h_l = dt_max 2^(-l/4), l < N_LEVELS; slot N_LEVELS of the
 #: per-level arrays holds an odd step (one that lands on an output time).
@@ -93,6 +101,12 @@ class Work(NamedTuple):
     it_int: np.ndarray  # (nk,) max iterations since last output
     dt_int: np.ndarray  # (2,) min, max step since last output
     res_int: np.ndarray  # (1,) max |residual| since last output
+    yref: np.ndarray  # (ng, 2) granule centres when the contact list was last built
+    ovl: np.ndarray  # (ng,) largest overlap / smaller radius seen at each granule's contacts
+    ovl_with: np.ndarray  # (ng,) int: its partner (granule j, wall -1 - w, PARTNER_PLATE)
+    plate_free: np.ndarray  # (ng,) int: 1 for a granule without a plate contact
+    ovl_new: np.ndarray  # (1,) largest overlap / smaller radius at the end of the trial step
+    ovl_who: np.ndarray  # (2,) int: its granule and partner (-1, -1: no overlap)
 
 
 class Output(NamedTuple):
@@ -135,6 +149,8 @@ def new_work(ng: int, nm: int, nk: int) -> Work:
         conv_iter=np.zeros(nk, np.int64), dmode=z((N_LEVELS + 1, nm)),
         gmat=z((N_LEVELS + 1, nd, nd)), g_ok=np.zeros(N_LEVELS + 1, np.int64),
         lam_int=z(nk), it_int=np.zeros(nk, np.int64), dt_int=z(2), res_int=z(1),
+        yref=z((ng, 2)), ovl=z(ng), ovl_with=np.zeros(ng, np.int64), plate_free=np.zeros(ng, np.int64),
+        ovl_new=z(1), ovl_who=np.full(2, -1, np.int64),
     )
 
 

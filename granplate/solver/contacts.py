@@ -1,0 +1,84 @@
+"""The contact watch after every accepted step (docs/model.md section 1.3): how far each
+granule has moved since the contact list was built (past cfg.rebuild_move the chunk ends
+and the driver rebuilds the list), the largest overlap of every contact against the
+smaller radius (the step's largest one, found by granular_rhs; past cfg.overlap_stop
+the run stops), and granules without a plate
+contact reaching the plate's face (the run stops).
+"""
+from __future__ import annotations
+
+from numba import njit
+
+from granplate.physics.contact import plate_overlap
+from granplate.solver.state import (
+    ERR_CONTACT, ERR_ITER, ERR_JUMP, ERR_N, ERR_OVERLAP, ERR_PLATE_REACH, ERR_RESID, ERR_T, ERR_VT,
+    OK, PARTNER_PLATE, REBUILD,
+)
+
+
+@njit(cache=True)
+def note_overlap(i, partner, rel, ovl, ovl_with):
+    """Keep the largest relative overlap `rel` of granule i and its partner."""
+    if rel > ovl[i]:
+        ovl[i] = rel
+        ovl_with[i] = partner
+
+
+@njit(cache=True)
+def stop(status, t, err, i, partner, value, rel):
+    """Fill the failure record: granule i, its partner, the overlap or distance [m] and
+    its ratio to the smaller radius; return `status`."""
+    err[ERR_T] = t
+    err[ERR_CONTACT] = i
+    err[ERR_ITER] = partner
+    err[ERR_N] = value
+    err[ERR_RESID] = rel
+    err[ERR_VT] = 0.0
+    return status
+
+
+@njit(cache=True)
+def plate_face(u):
+    """The x of the plate's face for the reach test [m], relative to its undeformed x0:
+    the largest displacement of a contact point, never below 0 (no false alarms when the
+    plate moves away)."""
+    dmax = 0.0
+    for k in range(u.shape[0] // 2):
+        dmax = max(dmax, u[2 * k])
+    return dmax
+
+
+@njit(cache=True)
+def watch_contacts(t, y, u, g, cfg, w, err):
+    """Check the state after an accepted step; returns OK, REBUILD (the list must be
+    rebuilt: a granule moved cfg.rebuild_move since it was built), ERR_OVERLAP,
+    ERR_PLATE_REACH or ERR_JUMP with err filled. The step's largest overlap comes from
+    the last evaluation of the forces (w.ovl_new, w.ovl_who: granular.granular_rhs)."""
+    i = w.ovl_who[0]
+    if i >= 0:
+        partner = w.ovl_who[1]
+        rel = w.ovl_new[0]
+        note_overlap(i, partner, rel, w.ovl, w.ovl_with)
+        if partner >= 0:
+            note_overlap(partner, i, rel, w.ovl, w.ovl_with)
+        if rel > cfg.overlap_stop:
+            r = g.radius[i] if partner < 0 else min(g.radius[i], g.radius[partner])
+            return stop(ERR_OVERLAP, t, err, i, partner, rel * r, rel)
+    face = cfg.plate_x0 + plate_face(u)
+    status = OK
+    move2 = cfg.rebuild_move * cfg.rebuild_move
+    for i in range(y.shape[0]):
+        if w.plate_free[i] != 0 and cfg.plate_ylo < y[i, 1] < cfg.plate_yhi:
+            reach = plate_overlap(y[i, 0], g.radius[i], face)
+            if reach > 0.0:
+                return stop(ERR_PLATE_REACH, t, err, i, PARTNER_PLATE, reach, reach / g.radius[i])
+        if cfg.rebuild_move > 0.0:
+            dx = y[i, 0] - w.yref[i, 0]
+            dy = y[i, 1] - w.yref[i, 1]
+            d2 = dx * dx + dy * dy
+            if d2 > move2:
+                status = REBUILD
+                jump = cfg.rebuild_move + g.radius[i]
+                if d2 > jump * jump:
+                    return stop(ERR_JUMP, t, err, i, -1, d2 ** 0.5, d2 ** 0.5 / g.radius[i])
+    return status
