@@ -256,3 +256,23 @@ def test_cli_time_outside_or_on_a_scenario_exits_2(files, capsys):
     assert "--time" in err and "0.0001 s" in err and err.count("\n") == 1
     assert main(["show", "steel-r1", "--time", "1e-5"]) == 2
     assert "only with a result" in capsys.readouterr().err
+
+
+def test_show_result_draws_contacts_formed_during_the_run():
+    """Two spheres 1 mm apart: no contact line at t = 0, one at the time of closest approach."""
+    from granplate.setup.scenario import Granule, Load, Scenario, TimeSettings
+
+    s = Scenario(
+        name="head-on",
+        granules=(Granule(x=0.01, y=0.05, radius=0.01, material="steel", label="a", vx=1.0),
+                  Granule(x=0.031, y=0.05, radius=0.01, material="steel", label="b", vx=-1.0)),
+        load=Load(kind="none"),
+        time=TimeSettings(t_end=6e-4, output_interval=2e-6, field_interval=2e-6),
+    )
+    ds = gp.simulate(s, progress=False)
+    gap = (ds.x.values[:, 1] - ds.x.values[:, 0]) - 0.02
+    start = assembly.of_result(ds, float(ds.time[0]))
+    closest = assembly.of_result(ds, float(ds.time[int(np.argmin(gap))]))
+    assert gap.min() < 0 < gap[0]
+    assert list(start.kinds).count("granule") == 0
+    assert list(closest.kinds).count("granule") == 1

@@ -103,14 +103,27 @@ def hertz_elastic_force(e_star: float, r_star: float, delta: float) -> float:
     return hertz_coefficient(e_star, r_star) * max(delta, 0.0) ** 1.5
 
 
-def contact_lists(scenario: Scenario) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The model's contact network: (pairs (np, 2), wall contacts (nw, 2) [granule,
-    wall], plate contacts (nk,) granule indices), from the model's contact lists."""
+def contact_lists(scenario: Scenario, x: np.ndarray | None = None, y: np.ndarray | None = None,
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The contact network: (pairs (np, 2), wall contacts (nw, 2) [granule, wall], plate
+    contacts (nk,) granule indices). Without positions: the model's lists at t = 0; with
+    positions x, y [m] (a result at some time): the pairs and wall contacts touching there
+    (gap at most contact.neighbour_gap R, the model's rule), since contacts form and open
+    during a run; plate contacts are the model's."""
     from granplate.model.arrays import build_model
+    from granplate.model.contacts import fixed_wall_contacts
+    from granplate.model.neighbours import contact_pairs
 
     model = build_model(scenario)
-    return (np.asarray(model.pairs, int).reshape(-1, 2), np.asarray(model.wall_contacts, int).reshape(-1, 2),
-            np.asarray(model.plate_contacts, int).reshape(-1))
+    plate = np.asarray(model.plate_contacts, int).reshape(-1)
+    if x is None:
+        return (np.asarray(model.pairs, int).reshape(-1, 2),
+                np.asarray(model.wall_contacts, int).reshape(-1, 2), plate)
+    s = model.scenario
+    r = np.asarray(model.granular.radius, float)
+    gap = s.contact.neighbour_gap
+    return (np.asarray(contact_pairs(x, y, r, gap), int).reshape(-1, 2),
+            np.asarray(fixed_wall_contacts(s.walls, x, y, r, gap), int).reshape(-1, 2), plate)
 
 
 def wall_foot(x: float, y: float, wall: Wall) -> tuple[float, float]:
@@ -308,8 +321,8 @@ def of_result(ds: xr.Dataset, time: float | None = None) -> Assembly:
     s = resolve(scenario)
     ti, note = choose_time(ds, time)
     t = float(ds["time"].values[ti])
-    pairs, walls, plate = contact_lists(scenario)
     x, y = np.asarray(ds["x"].values[ti], float), np.asarray(ds["y"].values[ti], float)
+    pairs, walls, plate = contact_lists(scenario, x, y)
     r = np.asarray(ds["radius"].values, float)
     segs, kinds = contact_segments(x, y, r, s.walls, pairs, walls, plate)
     return Assembly(
