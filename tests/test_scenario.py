@@ -258,7 +258,8 @@ def test_docs_examples_load_and_validate():
 
 
 def test_docs_two_sphere_example_bounces_as_stated():
-    """docs/scenario.md's two-sphere example does collide: momentum stays zero (equal masses,
+    """docs/scenario.md's two-sphere example, 1 mm apart at t = 0, does collide: momentum
+    stays zero (equal masses,
     opposite velocities), the spheres come apart at the speed the page states (0.991 m/s),
     and the energy kept is that speed squared (98.2%)."""
     import granplate as gp
@@ -266,6 +267,8 @@ def test_docs_two_sphere_example_bounces_as_stated():
     s = scenario_io.loads(_doc_block("<!-- example: two-spheres -->"))
     ds = gp.simulate(s, progress=False)
     vx = ds.vx.values
+    gap = ds.x.values[:, 1] - ds.x.values[:, 0] - 0.02
+    assert gap[0] == pytest.approx(1e-3) and gap.min() < 0 < gap[-1]
     assert abs(vx[-1].sum()) < 1e-12
     assert vx[-1, 0] == pytest.approx(-0.991, abs=5e-4) and vx[-1, 1] == pytest.approx(0.991, abs=5e-4)
     kept = float(ds.E_granular[-1] / ds.E_granular[0])
