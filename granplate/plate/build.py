@@ -36,7 +36,7 @@ from granplate.plate.constraints import (
 )
 from granplate.plate.fe import assemble_mass, assemble_stiffness, node_coordinates, plate_mesh, q8_basis, vtk_elements
 from granplate.plate.load import EDGE_LOAD_POINTS, edge_load_vector
-from granplate.plate.modes import modal_basis, residual_compliance, truncated_modal_basis
+from granplate.plate.modes import modal_basis, residual_compliance, truncated_modal_basis, weyl_mode_count
 from granplate.plate.stress import (
     INTORDER,
     gauss_point_strains,
@@ -301,7 +301,8 @@ def _compute_arrays(
     del K, M
     if kind == "truncated":
         max_omega = 2.0 * np.pi * float(plate.max_frequency or DEFAULT_MAX_FREQUENCY)
-        Phi, omega, psi = truncated_modal_basis(K_r, M_r, drive, max_omega, plate.n_modes)
+        expected = weyl_mode_count(plate.width * plate.height, material.E, material.nu, material.rho, max_omega)
+        Phi, omega, psi = truncated_modal_basis(K_r, M_r, drive, max_omega, plate.n_modes, expected)
     else:
         Phi, omega = modal_basis(K_r, M_r, plate.n_modes)
         psi = np.zeros((T.shape[1], 0))

@@ -27,14 +27,29 @@ def modal_basis(K_r: sp.spmatrix, M_r: sp.spmatrix, n_modes: int = 0) -> tuple[n
     return np.ascontiguousarray(fix_mode_signs(Phi)), np.sqrt(np.maximum(lam, 0.0))
 
 
-#: First number of modes the sparse eigensolver asks for (doubled until the cut-off is passed).
-FIRST_MODE_COUNT = 64
+#: Fewest modes the sparse eigensolver asks for.
+FIRST_MODE_COUNT = 32
+#: Modes asked for per mode Weyl's law predicts below the cut-off (a margin: the
+#: finite-element spectrum lies above the continuum's).
+WEYL_MARGIN = 1.15
+#: Growth of the number of modes asked when the cut-off was not reached.
+MODE_COUNT_GROWTH = 1.5
 #: Relative tolerance of the sparse eigensolver (ARPACK's tol).
 EIGSH_TOL = 1e-12
 
 
+def weyl_mode_count(area: float, E: float, nu: float, rho: float, omega: float) -> float:
+    """Number of in-plane modes of a plane-stress plate of `area` [m^2] below omega
+    [rad/s] by Weyl's law: N ~ area omega^2 / (4 pi) (1/c_L^2 + 1/c_T^2), with
+    c_L^2 = E / (rho (1 - nu^2)) and c_T^2 = E / (2 rho (1 + nu)) [m^2/s^2]."""
+    c_l2 = E / (rho * (1.0 - nu * nu))
+    c_t2 = E / (2.0 * rho * (1.0 + nu))
+    return area * omega * omega / (4.0 * np.pi) * (1.0 / c_l2 + 1.0 / c_t2)
+
+
 def truncated_modal_basis(
-    K_r: sp.spmatrix, M_r: sp.spmatrix, drive: np.ndarray, max_omega: float, n_modes: int = 0
+    K_r: sp.spmatrix, M_r: sp.spmatrix, drive: np.ndarray, max_omega: float, n_modes: int = 0,
+    expected: float = 0.0,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The modes up to max_omega [rad/s] (or the n_modes lowest when n_modes > 0) and the
     static residual shapes at the driving dofs (docs/model.md section 4.5).
@@ -42,7 +57,9 @@ def truncated_modal_basis(
     One sparse LU factorisation of K_r (positive definite: the plate is clamped) serves
     scipy.sparse.linalg.eigsh in shift-invert mode about sigma = 0 (its start vector fixed,
     so the basis is the same on every run) and the static solves. The number of modes
-    asked starts at FIRST_MODE_COUNT and doubles until the largest found exceeds max_omega.
+    asked starts at WEYL_MARGIN times `expected` (weyl_mode_count), at least
+    FIRST_MODE_COUNT, and grows by MODE_COUNT_GROWTH until the largest found exceeds
+    max_omega.
 
     Returns (Phi, omega, Psi): Phi (n_red, nm) mass-normalised and signed by
     `fix_mode_signs`, omega (nm,) ascending, and Psi (n_red, nd) = K_r^-1 E_d -
@@ -57,15 +74,18 @@ def truncated_modal_basis(
     lu = spla.splu(K)
     opinv = spla.LinearOperator((n, n), matvec=lu.solve, dtype=float)
     v0 = sign_reference(n)
-    k = min(n_modes if n_modes > 0 else FIRST_MODE_COUNT, n - 1)
+    k = n_modes if n_modes > 0 else max(FIRST_MODE_COUNT, int(WEYL_MARGIN * expected))
+    k = min(k, n - 1)
     while True:
-        lam, Phi = spla.eigsh(K, k=k, M=M, sigma=0.0, which="LM", OPinv=opinv, v0=v0, tol=EIGSH_TOL)
+        ncv = min(n, k + max(k // 2, 20))
+        lam, Phi = spla.eigsh(K, k=k, M=M, sigma=0.0, which="LM", OPinv=opinv, v0=v0, tol=EIGSH_TOL,
+                              ncv=ncv)
         order = np.argsort(lam)
         lam, Phi = lam[order], Phi[:, order]
         omega = np.sqrt(np.maximum(lam, 0.0))
         if n_modes > 0 or omega[-1] > max_omega or k == n - 1:
             break
-        k = min(2 * k, n - 1)
+        k = min(int(MODE_COUNT_GROWTH * k), n - 1)
     if n_modes == 0:
         keep = omega <= max_omega
         lam, Phi, omega = lam[keep], Phi[:, keep], omega[keep]

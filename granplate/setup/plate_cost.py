@@ -22,7 +22,7 @@ MODE_CHOICES: tuple[str, ...] = ("auto", "all", "truncated")
 #: "auto" uses the dense basis up to this many reduced dofs.
 DENSE_DOF_LIMIT = 2000
 #: The truncated basis' default cut-off [Hz] (Plate.max_frequency = None).
-DEFAULT_MAX_FREQUENCY = 3.0e5
+DEFAULT_MAX_FREQUENCY = 1.0e6
 #: Peak memory of the dense eigendecomposition per n^2 [bytes] (dense K, M, the
 #: eigenvectors and LAPACK's work space; measured 1.0 GB at n = 4,194).
 DENSE_BYTES_PER_DOF2 = 60.0
@@ -32,7 +32,7 @@ DENSE_SECONDS_PER_DOF3 = 8.0e-10
 #: factorisation, the Lanczos vectors; an upper bound of the measured values).
 TRUNCATED_BYTES_PER_DOF = 40_000.0
 #: Time of the truncated basis per reduced dof [s] (an upper bound of the measured values).
-TRUNCATED_SECONDS_PER_DOF = 1.0e-3
+TRUNCATED_SECONDS_PER_DOF = 3.0e-3
 #: Share of the machine's physical memory a plate may take.
 MEMORY_SHARE = 0.7
 
