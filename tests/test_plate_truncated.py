@@ -43,6 +43,9 @@ def test_auto_keeps_the_paper_mesh_dense(full):
     assert full.n_modes == full.n_red and not full.truncated and full.resid.shape == (0, 0)
     assert plate_cost.basis_kind("auto", full.n_red) == "all"
     assert plate_cost.basis_kind("auto", plate_cost.DENSE_DOF_LIMIT + 1) == "truncated"
+    # a plate the static correction does not cover keeps every mode
+    assert not plate_cost.truncation_supported((), False) and not plate_cost.truncation_supported(("top",), True)
+    assert plate_cost.basis_kind("auto", plate_cost.DENSE_DOF_LIMIT + 1, supported=False) == "all"
 
 
 def test_truncated_modes_are_the_lowest_full_modes(full, truncated):

@@ -47,7 +47,7 @@ from granplate.plate.stress import (
     von_mises_plane_stress,
 )
 from granplate.setup.materials import LIBRARY, Material
-from granplate.setup.plate_cost import DEFAULT_MAX_FREQUENCY, basis_kind, check_fits
+from granplate.setup.plate_cost import DEFAULT_MAX_FREQUENCY, basis_kind, check_fits, truncation_supported
 
 if TYPE_CHECKING:  # pragma: no cover
     from granplate.setup.scenario import Plate
@@ -404,7 +404,8 @@ def build_plate(
     T, drive_dofs = _reduction(node_xy, plate, x0, contact_y, n_full)
     n_red = T.shape[1]
     _check_plate(plate, x0, n_modes_max=n_red)
-    kind = basis_kind(getattr(plate, "modes", "all"), n_red)
+    kind = basis_kind(getattr(plate, "modes", "all"), n_red,
+                      truncation_supported(plate.clamped_edges, edge_load is not None))
     n_modes = None if kind == "truncated" and not plate.n_modes else (plate.n_modes or n_red)
     n_elem, n_qp = basis.dx.shape
     D = plane_stress_matrix(material.E, material.nu)

@@ -8,8 +8,9 @@ Two bases (Plate.modes):
 - "truncated": the modes up to Plate.max_frequency from a sparse shift-invert
   eigensolver plus the static residual compliance at the contacts: memory and time
   about linear in n (one sparse factorisation of K_r, a few hundred vectors).
-"auto" is "all" up to DENSE_DOF_LIMIT reduced dofs (the paper's 4 x 40 mesh has 1,138),
-"truncated" above.
+"auto" is "all" up to DENSE_DOF_LIMIT reduced dofs (the paper's 4 x 40 mesh has 1,082,
+4 x 80 has about 2,200), "truncated" above where the plate supports it (at least one
+clamped edge, no load on its edge), else "all".
 """
 from __future__ import annotations
 
@@ -20,7 +21,7 @@ from granplate.errors import ScenarioError
 #: Plate.modes values.
 MODE_CHOICES: tuple[str, ...] = ("auto", "all", "truncated")
 #: "auto" uses the dense basis up to this many reduced dofs.
-DENSE_DOF_LIMIT = 2000
+DENSE_DOF_LIMIT = 3000
 #: The truncated basis' default cut-off [Hz] (Plate.max_frequency = None).
 DEFAULT_MAX_FREQUENCY = 1.0e6
 #: Peak memory of the dense eigendecomposition per n^2 [bytes] (dense K, M, the
@@ -45,11 +46,19 @@ def physical_memory() -> float:
         return 0.0
 
 
-def basis_kind(modes: str, n_red: int) -> str:
-    """The basis a plate of n_red reduced dofs gets: "all" or "truncated"."""
+def basis_kind(modes: str, n_red: int, supported: bool = True) -> str:
+    """The basis a plate of n_red reduced dofs gets: "all" or "truncated" (supported:
+    whether the plate allows the truncated one, see the module docstring)."""
     if modes == "auto":
-        return "all" if n_red <= DENSE_DOF_LIMIT else "truncated"
+        return "truncated" if n_red > DENSE_DOF_LIMIT and supported else "all"
     return modes
+
+
+def truncation_supported(clamped_edges, edge_load: bool) -> bool:
+    """Whether a plate with these clamped edges and (edge_load) a load on its edge can
+    take the truncated basis: its static correction needs a clamped plate and covers the
+    contact forces only."""
+    return bool(clamped_edges) and not edge_load
 
 
 def build_estimate(kind: str, n_red: int) -> tuple[float, float]:

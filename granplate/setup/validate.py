@@ -25,7 +25,7 @@ from scipy.spatial import cKDTree
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import layout_packing, resolve
 from granplate.setup.layouts import column_radii, half_pitch, hexagonal_offsets, lattice_sites
-from granplate.setup.plate_cost import MODE_CHOICES, basis_kind, check_fits
+from granplate.setup.plate_cost import MODE_CHOICES, basis_kind, check_fits, truncation_supported
 from granplate.setup.scenario import (LAYOUT_KINDS, SQRT2_MINUS_1, ChainLayout, Granule,
                                       Imperfections, LatticeLayout, Layout, Plate, Scenario)
 
@@ -454,7 +454,8 @@ def _check_plate_mesh(s: Scenario) -> None:
     n_red = reduced_dof_count(p, sum(len(m) for _, m in layers))
     if p.n_modes > n_red:
         raise ScenarioError("plate.n_modes", p.n_modes, f"allowed: 0 (all) or 1..{n_red}")
-    kind = basis_kind(p.modes, n_red)
+    edge_load = s.load.kind == "line" and s.load.target == "plate"
+    kind = basis_kind(p.modes, n_red, truncation_supported(p.clamped_edges, edge_load))
     if kind == "truncated":
         _check_truncated_plate(s)
     check_fits(kind, n_red, p.modes)
