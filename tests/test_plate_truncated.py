@@ -177,3 +177,16 @@ def test_bench_plates_command(tmp_path, capsys):
     assert row["truncated"] and 0 < row["n_modes"] < row["n_red"] == 290
     assert row["setup_s"] > 0 and row["run_s"] > 0 and row["rss_peak_mib"] >= row["rss_setup_mib"] > 0
     assert "| 2 x 20 | truncated | 290 |" in capsys.readouterr().out
+
+
+def test_plate_basis_fields_round_trip_through_toml():
+    """plate.modes and plate.max_frequency are written and read back by the scenario I/O."""
+    from granplate.setup import io as scenario_io
+
+    s = preset("steel-r1")
+    s = dataclasses.replace(s, plate=dataclasses.replace(s.plate, nx=8, ny=80, modes="truncated",
+                                                         max_frequency=5e5))
+    text = scenario_io.dumps(s)
+    assert 'modes = "truncated"' in text and "max_frequency = 500000.0" in text
+    assert scenario_io.loads(text) == s
+    validate(s)
