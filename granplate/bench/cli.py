@@ -3,6 +3,10 @@ from __future__ import annotations
 
 
 def _cmd_bench(args) -> int:
+    if getattr(args, "plates", False):
+        from granplate.bench import plates
+
+        return int(plates.main(args))
     from granplate.bench import harness
 
     return int(harness.main(args))
@@ -18,4 +22,10 @@ def register(subparsers) -> None:
                    help="timed repeats per case; the median is reported (default 3, quick 1)")
     b.add_argument("--t-end", dest="t_end", type=float, default=None,
                    help="simulated time [s] for every case (overrides the mode's)")
+    b.add_argument("--plates", action="store_true",
+                   help="instead: the plate-scaling table (set-up time, peak memory, steel-r1 run "
+                        "time per plate mesh, each in a fresh process with a cold plate cache)")
+    b.add_argument("--meshes", help="with --plates: comma-separated NXxNY (default 4x40,8x80,16x160,32x320)")
+    b.add_argument("--modes", dest="plate_modes", choices=("auto", "all", "truncated"), default=None,
+                   help="with --plates: plate.modes of every mesh (default auto)")
     b.set_defaults(func=_cmd_bench)

@@ -193,13 +193,15 @@ def plate_modal_arrays(s: Scenario, y: np.ndarray, pc: np.ndarray):
         omega2 = np.asarray(plate_model.omega, float) ** 2
         phi_d = np.ascontiguousarray(plate_model.phi_drive, float)
         load_modal = np.ascontiguousarray(plate_model.edge_load_modal, float)
+        resid = np.ascontiguousarray(plate_model.resid, float)
     else:
         omega2 = np.zeros(0)
         phi_d = np.zeros((0, 0))
         load_modal = np.zeros(0)
+        resid = np.zeros((0, 0))
     if phi_d.shape != (2 * nk, len(omega2)):
         phi_d = phi_d.reshape(2 * nk, len(omega2))
-    return plate_model, PlateArrays(omega2=omega2, phi_d=phi_d, load_modal=load_modal)
+    return plate_model, PlateArrays(omega2=omega2, phi_d=phi_d, load_modal=load_modal, resid=resid)
 
 
 def loop_config(s: Scenario, fres: np.ndarray, tres: np.ndarray, r: np.ndarray, mass: np.ndarray) -> Config:

@@ -59,12 +59,15 @@ class PlateArrays(NamedTuple):
 
     omega2: (nm,) squared circular frequencies [rad^2/s^2]; phi_d: (nd, nm) mode shapes
     at the driving DOFs (x, y of each contact); load_modal: (nm,) modal edge load per
-    unit q0 (zeros when the shock is on the granules).
+    unit q0 (zeros when the shock is on the granules); resid: (nd, nd) residual static
+    compliance R [m/N] of a truncated basis (docs/model.md section 4.5), (0, 0) when
+    every mode is kept.
     """
 
     omega2: np.ndarray
     phi_d: np.ndarray
     load_modal: np.ndarray
+    resid: np.ndarray = np.zeros((0, 0))
 
 
 class Config(NamedTuple):

@@ -36,7 +36,7 @@ from granplate.plate.constraints import (
 )
 from granplate.plate.fe import assemble_mass, assemble_stiffness, node_coordinates, plate_mesh, q8_basis, vtk_elements
 from granplate.plate.load import EDGE_LOAD_POINTS, edge_load_vector
-from granplate.plate.modes import modal_basis
+from granplate.plate.modes import modal_basis, residual_compliance, truncated_modal_basis, weyl_mode_count
 from granplate.plate.stress import (
     INTORDER,
     gauss_point_strains,
@@ -47,6 +47,7 @@ from granplate.plate.stress import (
     von_mises_plane_stress,
 )
 from granplate.setup.materials import LIBRARY, Material
+from granplate.setup.plate_cost import DEFAULT_MAX_FREQUENCY, basis_kind, check_fits, truncation_supported
 
 if TYPE_CHECKING:  # pragma: no cover
     from granplate.setup.scenario import Plate
@@ -87,6 +88,11 @@ class PlateModel:
     omega: (n_modes,) angular frequencies [rad/s], ascending.
     drive_dofs: (n_contacts, 2) reduced indices of each contact's driving x and y dofs.
     phi_drive: (2 n_contacts, n_modes) = Phi[drive_dofs.ravel()].
+    psi: (n_red, 2 n_contacts) static residual shapes of the truncated basis (docs/model.md
+        section 4.5): the displacement per unit contact force the kept modes miss
+        [m/N]; (n_red, 0) for the full basis.
+    resid: (2 n_contacts, 2 n_contacts) = psi at the driving dofs, the residual
+        compliance R [m/N]; (0, 0) for the full basis.
     edge_load_modal: (n_modes,) Phi^T T^T edge_load_full [N / kg^1/2 per N/m of q0].
     edge_load_full: (n_full,) consistent nodal forces [N] of the left-edge line load
         q(y) = sin(pi (y - y0_load) / L) for q0 = 1 N/m (zeros when none was asked).
@@ -108,6 +114,8 @@ class PlateModel:
     omega: np.ndarray
     drive_dofs: np.ndarray
     phi_drive: np.ndarray
+    psi: np.ndarray
+    resid: np.ndarray
     edge_load_modal: np.ndarray
     edge_load_full: np.ndarray
     strain_op: sp.csr_matrix
@@ -137,6 +145,11 @@ class PlateModel:
         return self.omega.shape[0]
 
     @property
+    def truncated(self) -> bool:
+        """Whether the basis is truncated (with the static residual at the contacts)."""
+        return self.psi.shape[1] > 0
+
+    @property
     def n_qp(self) -> int:
         """Gauss points per element."""
         return self.qp_xy.shape[1]
@@ -151,49 +164,71 @@ class PlateModel:
         return assemble_mass(self.basis, self.rho, self.thickness)
 
     # ---- fields from modal coordinates --------------------------------------------
-    def full_dofs(self, q: np.ndarray) -> np.ndarray:
-        """x_full = T Phi q [m]: (..., n_modes) -> (..., n_full)."""
+    def full_dofs(self, q: np.ndarray, force: np.ndarray | None = None) -> np.ndarray:
+        """x_full = T (Phi q + Psi F) [m]: q (..., n_modes) -> (..., n_full).
+
+        force: the contact forces on the plate F (..., 2 n_contacts) [N], ordered [k0x,
+        k0y, k1x, ...]; only the truncated basis uses them (its static part Psi F)."""
         q = np.asarray(q, dtype=float)
         flat = q.reshape(-1, self.n_modes)
-        x_full = (self.T @ (self.Phi @ flat.T)).T
+        x_red = self.Phi @ flat.T
+        if self.truncated and force is not None:
+            x_red = x_red + self.psi @ np.asarray(force, dtype=float).reshape(-1, self.psi.shape[1]).T
+        x_full = (self.T @ x_red).T
         return x_full.reshape(q.shape[:-1] + (self.n_full,))
 
-    def full_displacement(self, q: np.ndarray) -> np.ndarray:
-        """Nodal displacements [m]: q (..., n_modes) -> (..., n_nodes, 2)."""
-        x_full = self.full_dofs(q)
+    def full_displacement(self, q: np.ndarray, force: np.ndarray | None = None) -> np.ndarray:
+        """Nodal displacements [m]: q (..., n_modes) -> (..., n_nodes, 2) (force: see full_dofs)."""
+        x_full = self.full_dofs(q, force)
         return x_full.reshape(x_full.shape[:-1] + (-1, 2))
 
-    def strains(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def strains(self, q: np.ndarray, force: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """eps_xx, eps_yy, gamma_xy [-] at the Gauss points, each (..., n_elem, n_qp)."""
-        return gauss_point_strains(self.strain_op, self.full_dofs(q), self.qp_xy.shape[0], self.n_qp)
+        return gauss_point_strains(self.strain_op, self.full_dofs(q, force), self.qp_xy.shape[0], self.n_qp)
 
-    def stresses(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def stresses(self, q: np.ndarray, force: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """sigma_xx, sigma_yy, tau_xy [Pa] at the Gauss points, each (..., n_elem, n_qp)."""
-        return plane_stresses(self.D, *self.strains(q))
+        return plane_stresses(self.D, *self.strains(q, force))
 
-    def von_mises(self, q: np.ndarray) -> np.ndarray:
+    def von_mises(self, q: np.ndarray, force: np.ndarray | None = None) -> np.ndarray:
         """Plane-stress von Mises stress [Pa] (docs/model.md section 4.4, eq. 12) at the Gauss points.
 
         sqrt(sxx^2 - sxx syy + syy^2 + 3 sxy^2), shape (..., n_elem, n_qp).
         """
-        sxx, syy, sxy = self.stresses(q)
+        sxx, syy, sxy = self.stresses(q, force)
         return von_mises_plane_stress(sxx, syy, sxy)
 
-    def energy(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
-        """Plate energy [J]: 1/2 qdot.qdot + 1/2 sum omega^2 q^2 (= 1/2 v^T M v + 1/2 x^T K x)."""
+    def energy(self, q: np.ndarray, qdot: np.ndarray, force: np.ndarray | None = None) -> np.ndarray:
+        """Plate energy [J]: 1/2 qdot.qdot + 1/2 sum omega^2 q^2 (= 1/2 v^T M v + 1/2 x^T K x),
+        plus the truncated basis' static part 1/2 F^T R F (docs/model.md section 4.5)."""
         q = np.asarray(q, dtype=float)
         qdot = np.asarray(qdot, dtype=float)
-        return 0.5 * np.sum(qdot**2, axis=-1) + 0.5 * np.sum(self.omega**2 * q**2, axis=-1)
+        e = 0.5 * np.sum(qdot**2, axis=-1) + 0.5 * np.sum(self.omega**2 * q**2, axis=-1)
+        if self.truncated and force is not None:
+            f = np.asarray(force, dtype=float)
+            e = e + 0.5 * np.einsum("...i,ij,...j->...", f, self.resid, f)
+        return e
 
     def compliance(self, dt: float) -> np.ndarray:
         """Driving-dof block of (M_r + dt^2 K_r / 4)^-1 [1/kg] (paper eq. 8), (2 nc, 2 nc).
 
         = phi_drive diag(1 / (1 + dt^2 omega^2 / 4)) phi_drive^T; rows/columns ordered
-        [k0x, k0y, k1x, k1y, ...]. With all modes kept this is exact; with fewer it is
-        the truncated modal approximation.
+        [k0x, k0y, k1x, k1y, ...]. With all modes kept this is exact; the truncated basis
+        adds its missing modes quasi-statically, 4 R / dt^2 (docs/model.md section 4.5).
         """
         weights = 1.0 / (1.0 + 0.25 * dt**2 * self.omega**2)
-        return (self.phi_drive * weights) @ self.phi_drive.T
+        g = (self.phi_drive * weights) @ self.phi_drive.T
+        if self.truncated:
+            g = g + 4.0 * self.resid / dt**2
+        return g
+
+    def static_compliance(self) -> np.ndarray:
+        """Driving-dof block of K_r^-1 [m/N] as the basis represents it:
+        phi_drive diag(1/omega^2) phi_drive^T (+ R for the truncated basis)."""
+        g = (self.phi_drive / self.omega**2) @ self.phi_drive.T
+        if self.truncated:
+            g = g + self.resid
+        return g
 
 
 def cache_payload(
@@ -203,11 +238,20 @@ def cache_payload(
     contact_y: Sequence[float],
     edge_load: tuple[float, float] | None,
     symmetry_line: bool,
+    kind: str = "all",
 ) -> dict:
-    """Every input of build_plate, for the run store's key (floats written exactly via repr)."""
+    """Every input of build_plate, for the run store's key (floats written exactly via repr).
+
+    kind: the basis ("all" or "truncated"); the fields choosing it (modes, max_frequency)
+    enter the key only for the truncated basis, so the full one keeps its key."""
+    fields = dataclasses.asdict(plate)
+    fields.pop("modes", None)
+    max_frequency = fields.pop("max_frequency", None)
+    if kind == "truncated":
+        fields["basis"] = ["truncated", repr(float(max_frequency or DEFAULT_MAX_FREQUENCY))]
     return {
         "skfem": getattr(skfem, "__version__", "?"),
-        "plate": dataclasses.asdict(plate),
+        "plate": fields,
         "material": [material.name, repr(float(material.E)), repr(float(material.nu)), repr(float(material.rho))],
         "x0": repr(float(x0)),
         "contact_y": [repr(float(y)) for y in contact_y],
@@ -245,11 +289,23 @@ def _compute_arrays(
     x0: float,
     T: sp.csr_matrix,
     edge_load: tuple[float, float] | None,
+    kind: str,
+    drive: np.ndarray,
 ) -> dict[str, np.ndarray]:
-    """The expensive arrays: modes, strain operator, edge load (what the cache holds)."""
+    """The expensive arrays: modes (kind "all": dense, every mode; "truncated": sparse, up
+    to the cut-off, with the static residual shapes psi), strain operator, edge load
+    (what the cache holds)."""
     K = assemble_stiffness(basis, D, plate.thickness)
     M = assemble_mass(basis, material.rho, plate.thickness)
-    Phi, omega = modal_basis(reduce_matrix(K, T), reduce_matrix(M, T), plate.n_modes)
+    K_r, M_r = reduce_matrix(K, T), reduce_matrix(M, T)
+    del K, M
+    if kind == "truncated":
+        max_omega = 2.0 * np.pi * float(plate.max_frequency or DEFAULT_MAX_FREQUENCY)
+        expected = weyl_mode_count(plate.width * plate.height, material.E, material.nu, material.rho, max_omega)
+        Phi, omega, psi = truncated_modal_basis(K_r, M_r, drive, max_omega, plate.n_modes, expected)
+    else:
+        Phi, omega = modal_basis(K_r, M_r, plate.n_modes)
+        psi = np.zeros((T.shape[1], 0))
     op = strain_operator(basis)
     if edge_load is None:
         f = np.zeros(basis.N)
@@ -264,14 +320,20 @@ def _compute_arrays(
         "strain_op_shape": np.array(op.shape),
         "edge_load_full": f,
         "edge_load_modal": Phi.T @ (T.T @ f),
+        "psi": psi,
     }
 
 
-def _arrays_fit(arrays: dict[str, np.ndarray], n_full: int, n_red: int, n_modes: int, n_rows: int) -> bool:
-    """Whether cached arrays are all there, with the shapes this build needs."""
+def _arrays_fit(arrays: dict[str, np.ndarray], n_full: int, n_red: int, n_modes: int | None, n_rows: int) -> bool:
+    """Whether cached arrays are all there, with the shapes this build needs (n_modes
+    None: any number, the truncated basis')."""
+    if not all(name in arrays for name in _CACHED_ARRAYS):
+        return False
+    if n_modes is None and not ("psi" in arrays and arrays["psi"].shape[0] == n_red):
+        return False
+    n_modes = arrays["omega"].shape[0] if n_modes is None else n_modes
     return (
-        all(name in arrays for name in _CACHED_ARRAYS)
-        and         arrays["Phi"].shape == (n_red, n_modes)
+        arrays["Phi"].shape == (n_red, n_modes)
         and arrays["omega"].shape == (n_modes,)
         and tuple(arrays["strain_op_shape"]) == (n_rows, n_full)
         and arrays["edge_load_full"].shape == (n_full,)
@@ -342,14 +404,20 @@ def build_plate(
     T, drive_dofs = _reduction(node_xy, plate, x0, contact_y, n_full)
     n_red = T.shape[1]
     _check_plate(plate, x0, n_modes_max=n_red)
-    n_modes = plate.n_modes or n_red
+    kind = basis_kind(getattr(plate, "modes", "all"), n_red,
+                      truncation_supported(plate.clamped_edges, edge_load is not None))
+    n_modes = None if kind == "truncated" and not plate.n_modes else (plate.n_modes or n_red)
     n_elem, n_qp = basis.dx.shape
     D = plane_stress_matrix(material.E, material.nu)
 
+    def compute() -> dict[str, np.ndarray]:
+        check_fits(kind, n_red, getattr(plate, "modes", "all"))
+        return _compute_arrays(basis, mesh, D, material, plate, x0, T, edge_load, kind, drive_dofs)
+
     arrays = _stored_or_computed(
-        cache_payload(plate, material, x0, contact_y, edge_load, symmetry_line) if cache else None,
+        cache_payload(plate, material, x0, contact_y, edge_load, symmetry_line, kind) if cache else None,
         lambda a: _arrays_fit(a, n_full, n_red, n_modes, 3 * n_elem * n_qp),
-        lambda: _compute_arrays(basis, mesh, D, material, plate, x0, T, edge_load),
+        compute,
     )
 
     strain_op = sp.csr_matrix(
@@ -357,6 +425,7 @@ def build_plate(
         shape=tuple(int(s) for s in arrays["strain_op_shape"]),
     )
     Phi = arrays["Phi"]
+    psi = arrays["psi"] if "psi" in arrays else np.zeros((n_red, 0))
     return PlateModel(
         mesh=mesh,
         basis=basis,
@@ -367,6 +436,8 @@ def build_plate(
         omega=arrays["omega"],
         drive_dofs=drive_dofs,
         phi_drive=np.ascontiguousarray(Phi[drive_dofs.ravel()]),
+        psi=psi,
+        resid=residual_compliance(psi, drive_dofs) if psi.shape[1] else np.zeros((0, 0)),
         edge_load_modal=arrays["edge_load_modal"],
         edge_load_full=arrays["edge_load_full"],
         strain_op=strain_op,

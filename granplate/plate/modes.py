@@ -6,6 +6,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 if TYPE_CHECKING:  # pragma: no cover
     from granplate.plate.build import PlateModel
@@ -24,6 +25,85 @@ def modal_basis(K_r: sp.spmatrix, M_r: sp.spmatrix, n_modes: int = 0) -> tuple[n
     subset = None if n_modes in (0, n) else [0, n_modes - 1]
     lam, Phi = scipy.linalg.eigh(Kd, Md, subset_by_index=subset)
     return np.ascontiguousarray(fix_mode_signs(Phi)), np.sqrt(np.maximum(lam, 0.0))
+
+
+#: Fewest modes the sparse eigensolver asks for.
+FIRST_MODE_COUNT = 32
+#: Modes asked for per mode Weyl's law predicts below the cut-off (a margin: the
+#: finite-element spectrum lies above the continuum's).
+WEYL_MARGIN = 1.15
+#: Growth of the number of modes asked when the cut-off was not reached.
+MODE_COUNT_GROWTH = 1.5
+#: Relative tolerance of the sparse eigensolver (ARPACK's tol).
+EIGSH_TOL = 1e-12
+
+
+def weyl_mode_count(area: float, E: float, nu: float, rho: float, omega: float) -> float:
+    """Number of in-plane modes of a plane-stress plate of `area` [m^2] below omega
+    [rad/s] by Weyl's law: N ~ area omega^2 / (4 pi) (1/c_L^2 + 1/c_T^2), with
+    c_L^2 = E / (rho (1 - nu^2)) and c_T^2 = E / (2 rho (1 + nu)) [m^2/s^2]."""
+    c_l2 = E / (rho * (1.0 - nu * nu))
+    c_t2 = E / (2.0 * rho * (1.0 + nu))
+    return area * omega * omega / (4.0 * np.pi) * (1.0 / c_l2 + 1.0 / c_t2)
+
+
+def truncated_modal_basis(
+    K_r: sp.spmatrix, M_r: sp.spmatrix, drive: np.ndarray, max_omega: float, n_modes: int = 0,
+    expected: float = 0.0,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The modes up to max_omega [rad/s] (or the n_modes lowest when n_modes > 0) and the
+    static residual shapes at the driving dofs (docs/model.md section 4.5).
+
+    One sparse LU factorisation of K_r (positive definite: the plate is clamped) serves
+    scipy.sparse.linalg.eigsh in shift-invert mode about sigma = 0 (its start vector fixed,
+    so the basis is the same on every run) and the static solves. The number of modes
+    asked starts at WEYL_MARGIN times `expected` (weyl_mode_count), at least
+    FIRST_MODE_COUNT, and grows by MODE_COUNT_GROWTH until the largest found exceeds
+    max_omega.
+
+    Returns (Phi, omega, Psi): Phi (n_red, nm) mass-normalised and signed by
+    `fix_mode_signs`, omega (nm,) ascending, and Psi (n_red, nd) = K_r^-1 E_d -
+    Phi diag(1/omega^2) Phi_d^T, the displacement per unit force at each driving dof
+    that the kept modes miss (E_d: the unit vectors of the dofs `drive`), so that the
+    static response at the driving dofs, Phi_d diag(1/omega^2) Phi_d^T + Psi[drive], is
+    exactly K_r^-1 restricted to them.
+    """
+    n = K_r.shape[0]
+    K = sp.csc_matrix(K_r)
+    M = sp.csc_matrix(M_r)
+    lu = spla.splu(K)
+    opinv = spla.LinearOperator((n, n), matvec=lu.solve, dtype=float)
+    v0 = sign_reference(n)
+    k = n_modes if n_modes > 0 else max(FIRST_MODE_COUNT, int(WEYL_MARGIN * expected))
+    k = min(k, n - 1)
+    while True:
+        ncv = min(n, k + max(k // 2, 20))
+        lam, Phi = spla.eigsh(K, k=k, M=M, sigma=0.0, which="LM", OPinv=opinv, v0=v0, tol=EIGSH_TOL,
+                              ncv=ncv)
+        order = np.argsort(lam)
+        lam, Phi = lam[order], Phi[:, order]
+        omega = np.sqrt(np.maximum(lam, 0.0))
+        if n_modes > 0 or omega[-1] > max_omega or k == n - 1:
+            break
+        k = min(int(MODE_COUNT_GROWTH * k), n - 1)
+    if n_modes == 0:
+        keep = omega <= max_omega
+        lam, Phi, omega = lam[keep], Phi[:, keep], omega[keep]
+    # M-orthonormalise once more (ARPACK's vectors are orthonormal to its tolerance)
+    Phi = Phi / np.sqrt(np.einsum("ij,ij->j", Phi, M @ Phi))
+    Phi = np.ascontiguousarray(fix_mode_signs(Phi))
+    drive = np.asarray(drive, dtype=np.int64).ravel()
+    unit = np.zeros((n, drive.size))
+    unit[drive, np.arange(drive.size)] = 1.0
+    Psi = lu.solve(unit) - Phi @ (Phi[drive].T / lam[:, None])
+    return Phi, omega, Psi
+
+
+def residual_compliance(Psi: np.ndarray, drive: np.ndarray) -> np.ndarray:
+    """R = Psi[drive], symmetrised [m/N] (nd, nd): the static compliance of the driving
+    dofs that the kept modes miss (docs/model.md section 4.5)."""
+    R = Psi[np.asarray(drive, dtype=np.int64).ravel()]
+    return np.ascontiguousarray(0.5 * (R + R.T))
 
 
 def sign_reference(n: int) -> np.ndarray:

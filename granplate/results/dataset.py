@@ -63,20 +63,30 @@ def _chunked(fn, q: np.ndarray, size: int = 256) -> np.ndarray:
     return np.concatenate([fn(q[i:i + size]) for i in range(0, len(q), size)])
 
 
-def plate_fields(model, q: np.ndarray, qd: np.ndarray, times: np.ndarray) -> dict[str, xr.DataArray]:
-    """Plate outputs computed from the modal coordinates after the run."""
+def plate_fields(model, q: np.ndarray, qd: np.ndarray, times: np.ndarray,
+                 force: np.ndarray | None = None) -> dict[str, xr.DataArray]:
+    """Plate outputs computed from the modal coordinates after the run; force (time,
+    2 n_contacts) [N]: the contact forces on the plate, whose static part a truncated
+    basis adds to the displacements and stresses (docs/model.md section 4.5)."""
     plate = model.plate
     s = model.scenario
     out: dict[str, xr.DataArray] = {}
+    if force is None or not plate.truncated:
+        qf = q
+    else:  # modal coordinates and forces side by side, so that chunks keep them together
+        qf = np.concatenate([q, np.asarray(force, dtype=float).reshape(len(q), -1)], axis=1)
 
-    def max_vm(qc):
-        return plate.von_mises(qc).reshape(len(qc), -1).max(axis=1)
+    def split(c):
+        return c[:, :plate.n_modes], (c[:, plate.n_modes:] if c.shape[1] > plate.n_modes else None)
 
-    def max_eyy(qc):
-        return np.abs(plate.strains(qc)[1]).reshape(len(qc), -1).max(axis=1)
+    def max_vm(c):
+        return plate.von_mises(*split(c)).reshape(len(c), -1).max(axis=1)
 
-    out["max_von_mises"] = _var("max_von_mises", ("time",), _chunked(max_vm, q))
-    out["max_eps_yy"] = _var("max_eps_yy", ("time",), _chunked(max_eyy, q))
+    def max_eyy(c):
+        return np.abs(plate.strains(*split(c))[1]).reshape(len(c), -1).max(axis=1)
+
+    out["max_von_mises"] = _var("max_von_mises", ("time",), _chunked(max_vm, qf))
+    out["max_eps_yy"] = _var("max_eps_yy", ("time",), _chunked(max_eyy, qf))
     sym = np.asarray(plate.symmetry_nodes)
     vx = _chunked(lambda qc: plate.full_displacement(qc)[:, sym, 0], qd)
     out["plate_vx_symmetry"] = _var("plate_vx_symmetry", ("time", "x_symmetry"), vx)
@@ -84,10 +94,10 @@ def plate_fields(model, q: np.ndarray, qd: np.ndarray, times: np.ndarray) -> dic
     idx = np.arange(0, len(times), stride)
     if len(times) and idx[-1] != len(times) - 1 and np.isclose(times[-1], s.time.t_end):
         idx = np.append(idx, len(times) - 1)
-    u = plate.full_displacement(q[idx])
+    u = plate.full_displacement(*split(qf[idx]))
     out["plate_ux"] = _var("plate_ux", ("field_time", "node"), u[..., 0])
     out["plate_uy"] = _var("plate_uy", ("field_time", "node"), u[..., 1])
-    vm = plate.von_mises(q[idx]).max(axis=-1)
+    vm = plate.von_mises(*split(qf[idx])).max(axis=-1)
     out["plate_von_mises"] = _var("plate_von_mises", ("field_time", "element"), vm)
     out["_field_time"] = times[idx]
     return out
@@ -130,7 +140,7 @@ def to_dataset(model, out: K.Output, n: int, info: dict) -> xr.Dataset:
         "material": ("granule", np.array([g.material for g in s.granules], dtype=str), {"long_name": "granule material"}),
     }
     if model.plate is not None:
-        pf = plate_fields(model, out.q[:n], out.qd[:n], t)
+        pf = plate_fields(model, out.q[:n], out.qd[:n], t, out.force[:n].reshape(n, -1))
         ft = pf.pop("_field_time")
         data.update(pf)
         plate = model.plate

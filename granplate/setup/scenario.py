@@ -162,7 +162,12 @@ class Plate:
     width (along x) and height (along y) [m]; thickness [m]; nx, ny: elements along x, y;
     rigid_layer_width: w [m] (None = one element edge along y); clamped_edges: subset of
     {"top", "bottom", "left", "right"}; n_modes: number of modes kept (0 = all, which is
-    exactly Newmark on the full system).
+    exactly Newmark on the full system); modes: the modal basis, "all" (dense
+    eigendecomposition of the whole model), "truncated" (the modes up to max_frequency
+    from a sparse eigensolver plus the static residual compliance at the contacts,
+    docs/model.md section 4.5) or "auto" ("all" up to DENSE_DOF_LIMIT reduced dofs,
+    "truncated" above); max_frequency: the truncated basis' cut-off [Hz] (None:
+    DEFAULT_MAX_FREQUENCY).
     """
 
     width: float = 0.01
@@ -176,6 +181,8 @@ class Plate:
     rigid_layer_width: float | None = None
     clamped_edges: tuple[str, ...] = ("top", "bottom")
     n_modes: int = 0
+    modes: str = "auto"
+    max_frequency: float | None = None
 
     @property
     def element_height(self) -> float:

@@ -25,6 +25,7 @@ from scipy.spatial import cKDTree
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import layout_packing, resolve
 from granplate.setup.layouts import column_radii, half_pitch, hexagonal_offsets, lattice_sites
+from granplate.setup.plate_cost import MODE_CHOICES, basis_kind, check_fits, truncation_supported
 from granplate.setup.scenario import (LAYOUT_KINDS, SQRT2_MINUS_1, ChainLayout, Granule,
                                       Imperfections, LatticeLayout, Layout, Plate, Scenario)
 
@@ -323,6 +324,9 @@ def _check_plate(s: Scenario) -> None:
         raise ScenarioError("plate.clamped_edges", edges,
                             "must be a subset of " + ", ".join(repr(e) for e in PLATE_EDGES))
     _int_at_least("plate.n_modes", pl.n_modes, 0)
+    _string_in("plate.modes", pl.modes, MODE_CHOICES)
+    if pl.max_frequency is not None:
+        _positive("plate.max_frequency", pl.max_frequency)
     for i, g in enumerate(s.granules):
         if pl.y0 <= g.y <= pl.y0 + pl.height:
             pen = g.x + g.radius - x0
@@ -451,6 +455,32 @@ def _check_plate_mesh(s: Scenario) -> None:
     n_red = reduced_dof_count(p, sum(len(m) for _, m in layers))
     if p.n_modes > n_red:
         raise ScenarioError("plate.n_modes", p.n_modes, f"allowed: 0 (all) or 1..{n_red}")
+    edge_load = s.load.kind == "line" and s.load.target == "plate"
+    kind = basis_kind(p.modes, n_red, truncation_supported(p.clamped_edges, edge_load))
+    if kind == "truncated":
+        _check_truncated_plate(s)
+    check_fits(kind, n_red, p.modes)
+
+
+def _check_truncated_plate(s: Scenario) -> None:
+    """What the truncated modal basis (docs/model.md section 4.5) supports."""
+    p = s.plate
+    if s.solver.scheme != "implicit":
+        raise ScenarioError(
+            "solver.scheme", s.solver.scheme,
+            f"the truncated plate basis (plate.modes = {p.modes!r}, here with more than the "
+            "dense limit of reduced dofs) is supported by the 'implicit' scheme only; allowed: "
+            "solver.scheme = 'implicit', or plate.modes = 'all' with a smaller mesh")
+    if s.load.kind == "line" and s.load.target == "plate":
+        raise ScenarioError(
+            "load.target", s.load.target,
+            "the truncated plate basis has a static correction at the contacts only, not for a "
+            "load on the plate's edge; allowed: load.target = 'granules', or plate.modes = 'all'")
+    if not p.clamped_edges:
+        raise ScenarioError(
+            "plate.clamped_edges", p.clamped_edges,
+            "the truncated plate basis needs a plate held by at least one clamped edge (its static "
+            "compliance); allowed: a non-empty subset of top, bottom, left, right, or plate.modes = 'all'")
 
 
 def _check_load(s: Scenario) -> None:

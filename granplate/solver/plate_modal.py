@@ -1,6 +1,11 @@
 """The plate in the loop: mass-normalised modes q'' + omega^2 q = Phi_d^T F + L(t),
 stepped by Newmark's average acceleration (beta = 1/4, gamma = 1/2) or exactly for
 forces linear over the step, and the driving-DOF compliance G(h) of criterion (8).
+
+A truncated basis (p.resid not empty, docs/model.md section 4.5) adds the static
+response of the modes it drops at the driving DOFs: u_d = Phi_d q + R F, with energy
+1/2 F^T R F; G(h) gains 4 R / h^2. The functions marked "static part" add it; with every
+mode kept p.resid is (0, 0) and they add nothing.
 """
 from __future__ import annotations
 
@@ -25,6 +30,10 @@ def step_matrices(h, p, dmode, gmat):
                 s += p.phi_d[a, m] * dmode[m] * p.phi_d[b, m]
             gmat[a, b] = s
             gmat[b, a] = s
+    # static part: the dropped modes respond quasi-statically, h^2/4 G = R
+    for a in range(p.resid.shape[0]):
+        for b in range(nd):
+            gmat[a, b] += 4.0 * p.resid[a, b] / (h * h)
 
 
 @njit(cache=True)
@@ -254,6 +263,42 @@ def exact_predict(t, h, st, p, cfg, coef, ustar):
             val = coef[m, base] * q0 + coef[m, base + 1] * v0 + coef[m, base + 2] * f0 + coef[m, base + 3] * f1
             for d in range(nd):
                 ustar[r, d] += p.phi_d[d, m] * val
+    # static part R F(s) of the normal forces' start values: F(h/2) holds N_n / 2, F(h)
+    # none, and dF/ds = (U - N_n)/h
+    for d in range(p.resid.shape[0]):
+        s0 = 0.0
+        for e in range(0, nd, 2):
+            s0 += p.resid[d, e] * st.pforce[e]
+        ustar[0, d] += 0.5 * s0
+        ustar[1, d] -= s0 / h
+        ustar[3, d] -= s0 / h
+
+
+@njit(cache=True)
+def static_matrices(h, resid, mmat):
+    """Static part of the driving-DOF response to the unknowns U (see exact_matrices),
+    added to mmat: u(h/2) gains R U/2 (normal, linear from N_n) or R U (held friction),
+    u(h) gains R U, v(h/2) and v(h) gain R U/h (normal) or nothing (held)."""
+    nd = resid.shape[0]
+    for d in range(nd):
+        for e in range(nd):
+            held = e % 2 == 1
+            r = resid[d, e]
+            mmat[0, d, e] += r if held else 0.5 * r
+            mmat[2, d, e] += r
+            if not held:
+                mmat[1, d, e] += r / h
+                mmat[3, d, e] += r / h
+
+
+@njit(cache=True)
+def static_energy(resid, force):
+    """1/2 F^T R F [J]: the energy of the truncated basis' static part (0 with every mode)."""
+    e = 0.0
+    for a in range(resid.shape[0]):
+        for b in range(resid.shape[0]):
+            e += 0.5 * force[a] * resid[a, b] * force[b]
+    return e
 
 
 @njit(cache=True)
@@ -289,15 +334,20 @@ def exact_correct(t, h, st, p, cfg, coef, force, qn, qdn):
         qn[m] = q1
         qdn[m] = v1
         energy += 0.5 * (v1 * v1 + p.omega2[m] * q1 * q1)
+    if p.resid.shape[0] > 0:
+        energy += static_energy(p.resid, force)
     return work, energy
 
 
 @njit(cache=True)
 def plate_energy(st, p):
-    """E_p = 1/2 q'.q' + 1/2 sum omega^2 q^2 = 1/2 v^T M v + 1/2 x^T K x [J] (eq. 9)."""
+    """E_p = 1/2 q'.q' + 1/2 sum omega^2 q^2 = 1/2 v^T M v + 1/2 x^T K x [J] (eq. 9),
+    plus the static part 1/2 F^T R F of a truncated basis."""
     e = 0.0
     for m in range(p.omega2.shape[0]):
         e += 0.5 * (st.qd[m] * st.qd[m] + p.omega2[m] * st.q[m] * st.q[m])
+    if p.resid.shape[0] > 0:
+        e += static_energy(p.resid, st.force)
     return e
 
 
@@ -326,6 +376,8 @@ def driving_dofs(st, p):
             su += p.phi_d[d, m] * st.q[m]
             sv += p.phi_d[d, m] * st.qd[m]
             sa += p.phi_d[d, m] * st.qdd[m]
+        for e in range(p.resid.shape[0]):
+            su += p.resid[d, e] * st.force[e]  # static part
         st.u[d] = su
         st.v[d] = sv
         st.a[d] = sa

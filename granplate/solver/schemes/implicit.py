@@ -27,7 +27,7 @@ from granplate.solver.granular import kinetic_energies, rk4_granular_step, rk4_l
 from granplate.solver.interface import forces_converged
 from granplate.solver.ladder import dyadic_level, level_for, level_step, step_to_output
 from granplate.solver.plate_modal import (
-    N_MCOEF, exact_correct, exact_matrices, exact_predict, modal_coefficients,
+    N_MCOEF, exact_correct, exact_matrices, exact_predict, modal_coefficients, static_matrices,
 )
 from granplate.solver.schemes.newton import held_friction, newton_update
 from granplate.solver.state import (
@@ -82,6 +82,7 @@ def prepare_level(sw, h, p, slot):
     """Modal coefficients and driving-DOF response matrices for a step h."""
     modal_coefficients(h, p.omega2, sw.mcoef[slot])
     exact_matrices(p.phi_d, sw.mcoef[slot], sw.mmat[slot])
+    static_matrices(h, p.resid, sw.mmat[slot])
 
 
 @njit(cache=True)
