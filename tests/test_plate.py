@@ -14,7 +14,7 @@ from skfem import MeshQuad
 from granplate import plate as gp
 from granplate.errors import ScenarioError
 from granplate.plate import EDGES
-from granplate.setup import validate as validation
+from granplate.setup import plate_checks
 from granplate.setup.materials import LIBRARY
 from granplate.setup.scenario import Granule, Load, Plate, Scenario
 from granplate.setup.validate import validate
@@ -373,9 +373,9 @@ def test_reduced_dof_count_matches_the_built_plate(clamped):
     contacts = () if "left" in clamped else (0.05, 0.025)
     for plate in (Plate(nx=2, ny=10, clamped_edges=clamped), Plate(nx=3, ny=12, clamped_edges=clamped, rigid_layer_width=0.02)):
         s = plate_scenario(contacts, **{k: getattr(plate, k) for k in ("nx", "ny", "clamped_edges", "rigid_layer_width")})
-        n_slaved = sum(len(m) for _, m in validation._rigid_layers(s.plate, list(contacts)))
+        n_slaved = sum(len(m) for _, m in plate_checks.rigid_layers(s.plate, list(contacts)))
         m = gp.build_plate(s.plate, X0, contacts, cache=False, symmetry_line=False)
-        assert validation.reduced_dof_count(s.plate, n_slaved) == m.n_red
+        assert plate_checks.reduced_dof_count(s.plate, n_slaved) == m.n_red
 
 
 def test_validation_refuses_too_many_modes():
@@ -392,7 +392,7 @@ def test_plate_contacts_are_the_granules_facing_the_left_edge():
     far = Granule(x=X0 - 0.01, y=0.0712, radius=0.002, material="steel", label="far")  # gap 4 R
     above = Granule(x=X0 - 0.002, y=0.11, radius=0.002, material="steel", label="above")
     s = dataclasses.replace(s, granules=s.granules + (far, above))
-    assert validation.plate_contact_heights(s) == [0.05]
+    assert plate_checks.plate_contact_heights(s) == [0.05]
     validate(s)  # 0.0712 is between nodes, but that granule does not touch the plate
 
 

@@ -18,6 +18,7 @@ from granplate.setup.geometry import resolve
 from granplate.physics.shock import shock_resultants
 from granplate.setup.materials import effective_modulus, sphere_inertia, sphere_mass
 from granplate.setup.scenario import Scenario
+from granplate.setup.plate_checks import faces_plate
 from granplate.setup.validate import validate
 
 #: implicit scheme: the error estimate's smallest force scale, as a fraction of the
@@ -109,16 +110,11 @@ def find_wall_contacts(s: Scenario, x, y, r) -> np.ndarray:
 
 
 def find_plate_contacts(s: Scenario, x, y, r) -> np.ndarray:
-    """Granules facing the plate's left edge (within neighbour_gap * R of it)."""
+    """Granules facing the plate's left edge (setup.plate_checks.faces_plate)."""
     if s.plate is None or len(x) == 0:
         return np.zeros(0, np.int64)
-    p = s.plate
-    out = []
-    for i in range(len(x)):
-        gap = p.x0 - (x[i] + r[i])
-        if gap <= s.contact.neighbour_gap * r[i] and p.y0 < y[i] < p.y0 + p.height:
-            out.append(i)
-    return np.array(out, np.int64)
+    gap = s.contact.neighbour_gap
+    return np.array([i for i in range(len(x)) if faces_plate(s.plate, gap, x[i], y[i], r[i])], np.int64)
 
 
 def loaded_granules(s: Scenario, x, r) -> np.ndarray:

@@ -12,7 +12,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from granplate.plate.errors import PlateError
-from granplate.setup.validate import NODE_RTOL
+from granplate.setup.plate_checks import NODE_RTOL
 
 if TYPE_CHECKING:  # pragma: no cover
     from granplate.setup.scenario import Plate

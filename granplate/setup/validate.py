@@ -7,10 +7,9 @@ order), `allowed` says in words what would be accepted. The layout is checked as
 `layout.*` before it is expanded; everything else is checked on the resolved scenario
 (`geometry.resolve`), so generated granules are named `granules[i]` with their label.
 
-The plate's mesh is checked here too, before anything is built: an even `plate.ny` (a row
-of nodes on the symmetry line), every plate contact on a left-edge node, rigid layers
-that neither overlap nor reach a clamped node, and `plate.n_modes` at most the number of
-reduced dofs. The plate layer itself only checks the internal consistency of its inputs.
+The plate's mesh is checked too, before anything is built (setup.plate_checks); single
+fields are checked by setup.fields. The plate layer itself only checks the internal
+consistency of its inputs.
 """
 from __future__ import annotations
 
@@ -25,9 +24,11 @@ from scipy.spatial import cKDTree
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import layout_packing, resolve
 from granplate.setup.layouts import column_radii, half_pitch, hexagonal_offsets, lattice_sites
-from granplate.setup.plate_cost import MODE_CHOICES, basis_kind, check_fits, truncation_supported
+from granplate.setup.fields import finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
+from granplate.setup.plate_checks import check_plate_mesh
+from granplate.setup.plate_cost import MODE_CHOICES
 from granplate.setup.scenario import (LAYOUT_KINDS, SQRT2_MINUS_1, ChainLayout, Granule,
-                                      Imperfections, LatticeLayout, Layout, Plate, Scenario)
+                                      Imperfections, LatticeLayout, Layout, Scenario)
 
 #: Lever arms of the friction torque (Contact.torque_arm).
 TORQUE_ARMS: tuple[str, ...] = ("radius", "contact_point")
@@ -48,48 +49,6 @@ NORMAL_TOL = 1e-9
 RATIO_TOL = 1e-12
 #: Relative tolerance for field_interval being a multiple of output_interval.
 INTERVAL_RTOL = 1e-9
-#: Relative tolerance (times the plate height / width) for "a point lies on a mesh node".
-NODE_RTOL = 1e-9
-
-
-# --------------------------------------------------------------------------- helpers
-
-def _is_number(v: Any) -> bool:
-    return isinstance(v, numbers.Real) and not isinstance(v, bool)
-
-
-def _finite(path: str, v: Any, what: str = "must be a finite number") -> float:
-    if not _is_number(v) or not math.isfinite(float(v)):
-        raise ScenarioError(path, v, what)
-    return float(v)
-
-
-def _positive(path: str, v: Any) -> None:
-    x = _finite(path, v, "must be > 0 (a finite number)")
-    if not x > 0.0:
-        raise ScenarioError(path, v, "must be > 0")
-
-
-def _nonneg(path: str, v: Any) -> None:
-    x = _finite(path, v, "must be >= 0 (a finite number)")
-    if not x >= 0.0:
-        raise ScenarioError(path, v, "must be >= 0")
-
-
-def _int_at_least(path: str, v: Any, lo: int) -> None:
-    if not isinstance(v, numbers.Integral) or isinstance(v, bool) or v < lo:
-        raise ScenarioError(path, v, f"must be an integer >= {lo}")
-
-
-def _string_in(path: str, v: Any, allowed: tuple[str, ...]) -> None:
-    if not isinstance(v, str) or v not in allowed:
-        raise ScenarioError(path, v, "must be one of " + ", ".join(repr(a) for a in allowed))
-
-
-def _material_exists(path: str, name: Any, s: Scenario) -> None:
-    if not isinstance(name, str) or name not in s.materials:
-        raise ScenarioError(path, name, "unknown material; defined materials are: "
-                            + ", ".join(sorted(s.materials)))
 
 
 # --------------------------------------------------------------------------- sections
@@ -99,18 +58,18 @@ def _check_materials(s: Scenario) -> None:
         raise ScenarioError("materials", s.materials, "must be a non-empty table of materials")
     for name, m in s.materials.items():
         p = f"materials.{name}"
-        _positive(f"{p}.E", m.E)
-        _finite(f"{p}.nu", m.nu, "must be in (-1, 0.5) (a finite number)")
+        positive(f"{p}.E", m.E)
+        finite(f"{p}.nu", m.nu, "must be in (-1, 0.5) (a finite number)")
         if not -1.0 < m.nu < 0.5:
             raise ScenarioError(f"{p}.nu", m.nu, "must be in (-1, 0.5)")
-        _positive(f"{p}.rho", m.rho)
+        positive(f"{p}.rho", m.rho)
 
 
 def _check_layout(s: Scenario) -> None:
     lay = s.layout
     if lay is None:
         return
-    _string_in("layout.kind", lay.kind, tuple(LAYOUT_KINDS))
+    string_in("layout.kind", lay.kind, tuple(LAYOUT_KINDS))
     if not isinstance(lay, LAYOUT_KINDS[lay.kind]):
         raise ScenarioError("layout.kind", lay.kind,
                             f"a {type(lay).__name__} must have kind one of " + ", ".join(
@@ -127,14 +86,14 @@ def _check_layout(s: Scenario) -> None:
 
 
 def _check_paper_layout(s: Scenario, lay: Layout) -> None:
-    _positive("layout.R1", lay.R1)
-    r = _finite("layout.R2_ratio", lay.R2_ratio,
+    positive("layout.R1", lay.R1)
+    r = finite("layout.R2_ratio", lay.R2_ratio,
                 f"must be in [{SQRT2_MINUS_1:.8f}, 1] (sqrt(2)-1 <= R2/R1 <= 1)")
     if not (SQRT2_MINUS_1 - RATIO_TOL <= r <= 1.0 + RATIO_TOL):
         raise ScenarioError("layout.R2_ratio", lay.R2_ratio,
                             f"must be in [{SQRT2_MINUS_1:.8f}, 1] (sqrt(2)-1 <= R2/R1 <= 1)")
     for f in ("heavy_material", "intruder_material", "wall_material"):
-        _material_exists(f"layout.{f}", getattr(lay, f), s)
+        material_exists(f"layout.{f}", getattr(lay, f), s)
 
 
 def _list_of_columns(path: str, values: Any, columns: int) -> None:
@@ -144,25 +103,25 @@ def _list_of_columns(path: str, values: Any, columns: int) -> None:
 
 
 def _check_lattice_layout(s: Scenario, lay: LatticeLayout) -> None:
-    _int_at_least("layout.columns", lay.columns, 1)
-    _int_at_least("layout.rows", lay.rows, 2 if lay.kind == "hexagonal" and lay.columns > 1 else 1)
-    _positive("layout.radius", lay.radius)
+    int_at_least("layout.columns", lay.columns, 1)
+    int_at_least("layout.rows", lay.rows, 2 if lay.kind == "hexagonal" and lay.columns > 1 else 1)
+    positive("layout.radius", lay.radius)
     for f in ("material", "wall_material"):
-        _material_exists(f"layout.{f}", getattr(lay, f), s)
+        material_exists(f"layout.{f}", getattr(lay, f), s)
     if lay.intruder_material is not None:
-        _material_exists("layout.intruder_material", lay.intruder_material, s)
+        material_exists("layout.intruder_material", lay.intruder_material, s)
     _list_of_columns("layout.column_radii", lay.column_radii, lay.columns)
     for c, r in enumerate(lay.column_radii):
-        _positive(f"layout.column_radii[{c}]", r)
+        positive(f"layout.column_radii[{c}]", r)
     _list_of_columns("layout.column_materials", lay.column_materials, lay.columns)
     for c, m in enumerate(lay.column_materials):
-        _material_exists(f"layout.column_materials[{c}]", m, s)
-    _positive("layout.intruder_ratio", lay.intruder_ratio)
+        material_exists(f"layout.column_materials[{c}]", m, s)
+    positive("layout.intruder_ratio", lay.intruder_ratio)
     for k, c in enumerate(lay.intruder_columns):
         if not isinstance(c, numbers.Integral) or isinstance(c, bool) or not 1 <= c <= lay.columns:
             raise ScenarioError(f"layout.intruder_columns[{k}]", c,
                                 f"must be a column number in 1..{lay.columns} (layout.columns)")
-    _int_at_least("layout.intruder_every", lay.intruder_every, 0)
+    int_at_least("layout.intruder_every", lay.intruder_every, 0)
     sites = [g.label for g in lattice_sites(dataclasses.replace(lay, intruder_columns=()))]
     known = set(sites)
     for k, lab in enumerate(lay.intruder_sites):
@@ -203,23 +162,23 @@ def _check_column_offsets(lay: LatticeLayout) -> None:
 
 
 def _check_chain_layout(s: Scenario, lay: ChainLayout) -> None:
-    _int_at_least("layout.count", lay.count, 1)
-    _positive("layout.radius", lay.radius)
-    _positive("layout.taper", lay.taper)
-    _positive("layout.dimer_ratio", lay.dimer_ratio)
-    _nonneg("layout.decorated_ratio", lay.decorated_ratio)
+    int_at_least("layout.count", lay.count, 1)
+    positive("layout.radius", lay.radius)
+    positive("layout.taper", lay.taper)
+    positive("layout.dimer_ratio", lay.dimer_ratio)
+    nonneg("layout.decorated_ratio", lay.decorated_ratio)
     for f in ("material", "wall_material", "dimer_material", "decorated_material"):
         if getattr(lay, f) is not None:
-            _material_exists(f"layout.{f}", getattr(lay, f), s)
+            material_exists(f"layout.{f}", getattr(lay, f), s)
     if lay.y is not None:
-        _finite("layout.y", lay.y)
+        finite("layout.y", lay.y)
 
 
 def _check_imperfections(imp: Imperfections, sites: tuple[Granule, ...]) -> None:
     p = "layout.imperfections"
-    _int_at_least(f"{p}.seed", imp.seed, 0)
+    int_at_least(f"{p}.seed", imp.seed, 0)
     for f in ("radius_spread", "jitter", "vacancy_fraction"):
-        v = _finite(f"{p}.{f}", getattr(imp, f), "must be in [0, 1) (a finite number)")
+        v = finite(f"{p}.{f}", getattr(imp, f), "must be in [0, 1) (a finite number)")
         if not 0.0 <= v < 1.0:
             raise ScenarioError(f"{p}.{f}", v, "must be in [0, 1)")
     if not imp.radius_spread + imp.jitter < 1.0:
@@ -239,12 +198,12 @@ def _check_granules(s: Scenario) -> None:
     seen: dict[str, int] = {}
     for i, g in enumerate(s.granules):
         p = f"granules[{i}]"
-        _finite(f"{p}.x", g.x)
-        _finite(f"{p}.y", g.y)
-        _positive(f"{p}.radius", g.radius)
+        finite(f"{p}.x", g.x)
+        finite(f"{p}.y", g.y)
+        positive(f"{p}.radius", g.radius)
         for f in ("vx", "vy", "omega"):
-            _finite(f"{p}.{f}", getattr(g, f))
-        _material_exists(f"{p}.material", g.material, s)
+            finite(f"{p}.{f}", getattr(g, f))
+        material_exists(f"{p}.material", g.material, s)
         if not isinstance(g.label, str):
             raise ScenarioError(f"{p}.label", g.label, "must be a string")
         if g.label in seen:
@@ -281,15 +240,15 @@ def _check_walls(s: Scenario) -> None:
         p = f"walls[{k}]"
         n = w.normal
         if (not isinstance(n, tuple) or len(n) != 2
-                or not all(_is_number(c) and math.isfinite(c) for c in n)):
+                or not all(is_number(c) and math.isfinite(c) for c in n)):
             raise ScenarioError(f"{p}.normal", n, "must be two finite numbers [nx, ny]")
         norm = math.hypot(n[0], n[1])
         if abs(norm - 1.0) > NORMAL_TOL:
             raise ScenarioError(f"{p}.normal", n,
                                 f"must be a unit vector (|normal| = {norm:.12g}; "
                                 f"allowed 1 within {NORMAL_TOL:g})")
-        _finite(f"{p}.offset", w.offset)
-        _material_exists(f"{p}.material", w.material, s)
+        finite(f"{p}.offset", w.offset)
+        material_exists(f"{p}.material", w.material, s)
         if not isinstance(w.label, str):
             raise ScenarioError(f"{p}.label", w.label, "must be a string")
         if w.label in seen:
@@ -310,23 +269,23 @@ def _check_plate(s: Scenario) -> None:
     if pl is None:
         return
     for f in ("width", "height", "thickness"):
-        _positive(f"plate.{f}", getattr(pl, f))
-    _material_exists("plate.material", pl.material, s)
-    x0 = _finite("plate.x0", pl.x0)
-    _finite("plate.y0", pl.y0)
-    _int_at_least("plate.nx", pl.nx, 1)
-    _int_at_least("plate.ny", pl.ny, 1)
+        positive(f"plate.{f}", getattr(pl, f))
+    material_exists("plate.material", pl.material, s)
+    x0 = finite("plate.x0", pl.x0)
+    finite("plate.y0", pl.y0)
+    int_at_least("plate.nx", pl.nx, 1)
+    int_at_least("plate.ny", pl.ny, 1)
     if pl.rigid_layer_width is not None:
-        _positive("plate.rigid_layer_width", pl.rigid_layer_width)
+        positive("plate.rigid_layer_width", pl.rigid_layer_width)
     edges = pl.clamped_edges
     if not isinstance(edges, tuple) or not all(isinstance(e, str) and e in PLATE_EDGES
                                                for e in edges):
         raise ScenarioError("plate.clamped_edges", edges,
                             "must be a subset of " + ", ".join(repr(e) for e in PLATE_EDGES))
-    _int_at_least("plate.n_modes", pl.n_modes, 0)
-    _string_in("plate.modes", pl.modes, MODE_CHOICES)
+    int_at_least("plate.n_modes", pl.n_modes, 0)
+    string_in("plate.modes", pl.modes, MODE_CHOICES)
     if pl.max_frequency is not None:
-        _positive("plate.max_frequency", pl.max_frequency)
+        positive("plate.max_frequency", pl.max_frequency)
     for i, g in enumerate(s.granules):
         if pl.y0 <= g.y <= pl.y0 + pl.height:
             pen = g.x + g.radius - x0
@@ -337,162 +296,16 @@ def _check_plate(s: Scenario) -> None:
                     f"t = 0; granules must lie left of the plate (x + radius <= plate.x0)")
 
 
-# --------------------------------------------------------------------------- plate mesh
-
-def plate_contact_heights(s: Scenario) -> list[float]:
-    """y [m] of the granules facing the plate's left edge, in granule order.
-
-    A granule faces the plate when its gap x0 - (x + R) is at most contact.neighbour_gap * R
-    and y0 < y < y0 + height (s resolved, with a plate).
-    """
-    p = s.plate
-    gap_ratio = s.contact.neighbour_gap
-    return [float(g.y) for g in s.granules
-            if p.x0 - (g.x + g.radius) <= gap_ratio * g.radius and p.y0 < g.y < p.y0 + p.height]
-
-
-def left_edge_node_heights(p: Plate) -> np.ndarray:
-    """y [m] of the 2 ny + 1 Q8 nodes on the plate's left edge, bottom to top."""
-    corners = np.linspace(p.y0, p.y0 + p.height, p.ny + 1)
-    y = np.empty(2 * p.ny + 1)
-    y[0::2] = corners
-    y[1::2] = 0.5 * (corners[:-1] + corners[1:])
-    return y
-
-
-def clamped_left_nodes(p: Plate) -> set[int]:
-    """Indices (into left_edge_node_heights) of the left-edge nodes on a clamped edge."""
-    n = 2 * p.ny + 1
-    if "left" in p.clamped_edges:
-        return set(range(n))
-    return ({0} if "bottom" in p.clamped_edges else set()) | ({n - 1} if "top" in p.clamped_edges else set())
-
-
-def clamped_node_count(p: Plate) -> int:
-    """Number of Q8 nodes on the clamped edges (corners shared by two edges counted once)."""
-    ni, nj = 2 * p.nx, 2 * p.ny  # node lattice (i, j), 0 <= i <= ni, 0 <= j <= nj
-    lines = {
-        "left": {(0, j) for j in range(nj + 1)},
-        "right": {(ni, j) for j in range(nj + 1)},
-        "bottom": {(i, 0) for i in range(ni + 1)},
-        "top": {(i, nj) for i in range(ni + 1)},
-    }
-    return len(set().union(*(lines[e] for e in p.clamped_edges)))
-
-
-def reduced_dof_count(p: Plate, n_slaved: int) -> int:
-    """Dofs left after clamping and slaving n_slaved rigid-layer nodes: 2 per free node."""
-    n_nodes = (p.nx + 1) * (p.ny + 1) + p.nx * (p.ny + 1) + p.ny * (p.nx + 1)
-    return 2 * (n_nodes - clamped_node_count(p) - n_slaved)
-
-
-def _check_symmetry_row(p: Plate) -> None:
-    if p.ny % 2:
-        raise ScenarioError(
-            "plate.ny", p.ny,
-            f"must be even so that the symmetry line y = y0 + height/2 = {p.y0 + p.height / 2:g} m "
-            "is a row of element edges (with Q8 nodes along it)")
-
-
-def _contact_node(p: Plate, k: int, yk: float, left_y: np.ndarray) -> int:
-    """Index of the left-edge node at contact k's height yk [m]; ScenarioError when none."""
-    at = np.flatnonzero(np.abs(left_y - yk) <= NODE_RTOL * p.height)
-    if at.size != 1:
-        raise ScenarioError(
-            "plate.ny", p.ny,
-            f"contact {k} at y={yk:g} m is not on a mesh node; the left-edge node spacing "
-            f"is height/(2 ny) = {p.height / (2 * p.ny):g} m; allowed: ny such that (y_contact - y0) "
-            "is a multiple of height/(2 ny) for every contact")
-    return int(at[0])
-
-
-def _rigid_layers(p: Plate, contact_y: list[float]) -> list[tuple[int, list[int]]]:
-    """(driving node, other layer nodes) of each contact; refuses overlapping layers."""
-    left_y = left_edge_node_heights(p)
-    half, tol = 0.5 * p.layer_width, NODE_RTOL * p.height
-    owner: dict[int, int] = {}
-    layers = []
-    for k, yk in enumerate(contact_y):
-        at = _contact_node(p, k, yk, left_y)
-        members = [int(n) for n in np.flatnonzero(np.abs(left_y - yk) <= half + tol)]
-        for n in members:
-            if n in owner:
-                j = owner[n]
-                raise ScenarioError(
-                    "plate.rigid_layer_width", p.rigid_layer_width,
-                    f"the rigid layers of contacts {j} (y={contact_y[j]:g} m) and {k} (y={yk:g} m) "
-                    f"share the node at y={left_y[n]:g} m with w = {p.layer_width:g} m; "
-                    "allowed: w smaller than the distance between neighbouring contacts")
-            owner[n] = k
-        layers.append((at, [n for n in members if n != at]))
-    return layers
-
-
-def _check_layers_off_clamps(p: Plate, contact_y: list[float], layers: list[tuple[int, list[int]]]) -> None:
-    clamped = clamped_left_nodes(p)
-    for k, (at, members) in enumerate(layers):
-        if at in clamped:
-            raise ScenarioError(
-                "plate.clamped_edges", p.clamped_edges,
-                f"contact {k} at y={contact_y[k]:g} m sits on a clamped node; allowed: contacts on "
-                "free parts of the left edge only")
-        if any(n in clamped for n in members):
-            raise ScenarioError(
-                "plate.rigid_layer_width", p.rigid_layer_width,
-                f"the rigid layer of contact {k} at y={contact_y[k]:g} m (w = {p.layer_width:g} m) "
-                "reaches a clamped node; allowed: a width that keeps every layer off the clamped edges")
-
-
-def _check_plate_mesh(s: Scenario) -> None:
-    """The mesh the plate layer will build can hold the scenario (see the module docstring)."""
-    p = s.plate
-    if p is None:
-        return
-    _check_symmetry_row(p)
-    contact_y = plate_contact_heights(s)
-    layers = _rigid_layers(p, contact_y)
-    _check_layers_off_clamps(p, contact_y, layers)
-    n_red = reduced_dof_count(p, sum(len(m) for _, m in layers))
-    if p.n_modes > n_red:
-        raise ScenarioError("plate.n_modes", p.n_modes, f"allowed: 0 (all) or 1..{n_red}")
-    edge_load = s.load.kind == "line" and s.load.target == "plate"
-    kind = basis_kind(p.modes, n_red, truncation_supported(p.clamped_edges, edge_load))
-    if kind == "truncated":
-        _check_truncated_plate(s)
-    check_fits(kind, n_red, p.modes)
-
-
-def _check_truncated_plate(s: Scenario) -> None:
-    """What the truncated modal basis (docs/model.md section 4.5) supports."""
-    p = s.plate
-    if s.solver.scheme != "implicit":
-        raise ScenarioError(
-            "solver.scheme", s.solver.scheme,
-            f"the truncated plate basis (plate.modes = {p.modes!r}, here with more than the "
-            "dense limit of reduced dofs) is supported by the 'implicit' scheme only; allowed: "
-            "solver.scheme = 'implicit', or plate.modes = 'all' with a smaller mesh")
-    if s.load.kind == "line" and s.load.target == "plate":
-        raise ScenarioError(
-            "load.target", s.load.target,
-            "the truncated plate basis has a static correction at the contacts only, not for a "
-            "load on the plate's edge; allowed: load.target = 'granules', or plate.modes = 'all'")
-    if not p.clamped_edges:
-        raise ScenarioError(
-            "plate.clamped_edges", p.clamped_edges,
-            "the truncated plate basis needs a plate held by at least one clamped edge (its static "
-            "compliance); allowed: a non-empty subset of top, bottom, left, right, or plate.modes = 'all'")
-
-
 def _check_load(s: Scenario) -> None:
     ld = s.load
-    _string_in("load.kind", ld.kind, LOAD_KINDS)
-    _string_in("load.target", ld.target, LOAD_TARGETS)
-    q0 = _finite("load.q0", ld.q0, "must be >= 0 (a finite number) [N/m]")
+    string_in("load.kind", ld.kind, LOAD_KINDS)
+    string_in("load.target", ld.target, LOAD_TARGETS)
+    q0 = finite("load.q0", ld.q0, "must be >= 0 (a finite number) [N/m]")
     if not q0 >= 0.0:
         raise ScenarioError("load.q0", ld.q0, "must be >= 0 [N/m]")
-    _positive("load.duration", ld.duration)
-    _positive("load.length", ld.length)
-    _finite("load.y0", ld.y0)
+    positive("load.duration", ld.duration)
+    positive("load.length", ld.length)
+    finite("load.y0", ld.y0)
     if not isinstance(ld.granules, tuple) or not all(isinstance(x, str) for x in ld.granules):
         raise ScenarioError("load.granules", ld.granules, "must be a list of granule labels")
     labels = {g.label for g in s.granules}
@@ -514,17 +327,17 @@ def _check_load(s: Scenario) -> None:
 
 def _check_contact(s: Scenario) -> None:
     c = s.contact
-    _nonneg("contact.mu", c.mu)
-    _positive("contact.k_s", c.k_s)
-    _nonneg("contact.alpha_n", c.alpha_n)
-    _nonneg("contact.neighbour_gap", c.neighbour_gap)
-    _string_in("contact.torque_arm", c.torque_arm, TORQUE_ARMS)
-    _string_in("contact.detection", c.detection, DETECTIONS)
-    _positive("contact.skin", c.skin)
+    nonneg("contact.mu", c.mu)
+    positive("contact.k_s", c.k_s)
+    nonneg("contact.alpha_n", c.alpha_n)
+    nonneg("contact.neighbour_gap", c.neighbour_gap)
+    string_in("contact.torque_arm", c.torque_arm, TORQUE_ARMS)
+    string_in("contact.detection", c.detection, DETECTIONS)
+    positive("contact.skin", c.skin)
     if c.skin > 1.0:
         raise ScenarioError("contact.skin", c.skin, "must be at most 1 (a fraction of R_i + R_j)")
-    _positive("contact.overlap_warn", c.overlap_warn)
-    _positive("contact.overlap_stop", c.overlap_stop)
+    positive("contact.overlap_warn", c.overlap_warn)
+    positive("contact.overlap_stop", c.overlap_stop)
     if not c.overlap_warn <= c.overlap_stop < 1.0:
         raise ScenarioError("contact.overlap_stop", c.overlap_stop,
                             f"must lie in [contact.overlap_warn = {c.overlap_warn:g}, 1)")
@@ -536,19 +349,19 @@ def _check_contact(s: Scenario) -> None:
         if not isinstance(mats, tuple) or len(mats) != 2:
             raise ScenarioError(f"{p}.materials", mats, "must be two material names")
         for k, m in enumerate(mats):
-            _material_exists(f"{p}.materials[{k}]", m, s)
+            material_exists(f"{p}.materials[{k}]", m, s)
         if pc.alpha_n is not None:
-            _nonneg(f"{p}.alpha_n", pc.alpha_n)
+            nonneg(f"{p}.alpha_n", pc.alpha_n)
         if pc.mu is not None:
-            _nonneg(f"{p}.mu", pc.mu)
+            nonneg(f"{p}.mu", pc.mu)
         if pc.k_s is not None:
-            _positive(f"{p}.k_s", pc.k_s)
+            positive(f"{p}.k_s", pc.k_s)
 
 
 def _check_time(s: Scenario) -> None:
     t = s.time
     for f in ("t_end", "dt_initial", "dt_max", "dt_min", "output_interval", "field_interval"):
-        _positive(f"time.{f}", getattr(t, f))
+        positive(f"time.{f}", getattr(t, f))
     if t.dt_min > t.dt_initial:
         raise ScenarioError("time.dt_min", t.dt_min,
                             f"must be <= time.dt_initial = {t.dt_initial!r} "
@@ -570,16 +383,16 @@ def _check_time(s: Scenario) -> None:
 
 def _check_solver(s: Scenario) -> None:
     sv = s.solver
-    _string_in("solver.scheme", sv.scheme, SCHEMES)
-    lam = _finite("solver.lambda_target", sv.lambda_target, "must be in (0, 1)")
+    string_in("solver.scheme", sv.scheme, SCHEMES)
+    lam = finite("solver.lambda_target", sv.lambda_target, "must be in (0, 1)")
     if not 0.0 < lam < 1.0:
         raise ScenarioError("solver.lambda_target", sv.lambda_target, "must be in (0, 1)")
-    _positive("solver.iteration_rtol", sv.iteration_rtol)
-    _positive("solver.iteration_atol", sv.iteration_atol)
-    _int_at_least("solver.max_iterations", sv.max_iterations, 1)
-    _positive("solver.energy_tol", sv.energy_tol)
-    _positive("solver.error_tol", sv.error_tol)
-    _positive("solver.implicit_dt_max", sv.implicit_dt_max)
+    positive("solver.iteration_rtol", sv.iteration_rtol)
+    positive("solver.iteration_atol", sv.iteration_atol)
+    int_at_least("solver.max_iterations", sv.max_iterations, 1)
+    positive("solver.energy_tol", sv.energy_tol)
+    positive("solver.error_tol", sv.error_tol)
+    positive("solver.implicit_dt_max", sv.implicit_dt_max)
 
 
 # --------------------------------------------------------------------------- entry point
@@ -604,14 +417,14 @@ def validate(scenario: Scenario) -> None:
         raise ScenarioError("granules", (), "a scenario needs granules (or a [layout]) "
                             "or a [plate], or both; it has neither")
     if s.plate is not None and s.plate.x0 is not None:
-        _finite("plate.x0", s.plate.x0)
+        finite("plate.x0", s.plate.x0)
     r = resolve(s)
     _check_granules(r)
     _check_walls(r)
     _check_plate(r)
     _check_load(r)
     _check_contact(r)
-    _check_plate_mesh(r)
+    check_plate_mesh(r)
     _check_time(r)
     _check_solver(r)
 

@@ -1,0 +1,47 @@
+"""Checks of single scenario fields: each raises ScenarioError(field, value, allowed)."""
+from __future__ import annotations
+
+import math
+import numbers
+from typing import Any
+
+from granplate.errors import ScenarioError
+from granplate.setup.scenario import Scenario
+
+
+def is_number(v: Any) -> bool:
+    return isinstance(v, numbers.Real) and not isinstance(v, bool)
+
+
+def finite(path: str, v: Any, what: str = "must be a finite number") -> float:
+    if not is_number(v) or not math.isfinite(float(v)):
+        raise ScenarioError(path, v, what)
+    return float(v)
+
+
+def positive(path: str, v: Any) -> None:
+    x = finite(path, v, "must be > 0 (a finite number)")
+    if not x > 0.0:
+        raise ScenarioError(path, v, "must be > 0")
+
+
+def nonneg(path: str, v: Any) -> None:
+    x = finite(path, v, "must be >= 0 (a finite number)")
+    if not x >= 0.0:
+        raise ScenarioError(path, v, "must be >= 0")
+
+
+def int_at_least(path: str, v: Any, lo: int) -> None:
+    if not isinstance(v, numbers.Integral) or isinstance(v, bool) or v < lo:
+        raise ScenarioError(path, v, f"must be an integer >= {lo}")
+
+
+def string_in(path: str, v: Any, allowed: tuple[str, ...]) -> None:
+    if not isinstance(v, str) or v not in allowed:
+        raise ScenarioError(path, v, "must be one of " + ", ".join(repr(a) for a in allowed))
+
+
+def material_exists(path: str, name: Any, s: Scenario) -> None:
+    if not isinstance(name, str) or name not in s.materials:
+        raise ScenarioError(path, name, "unknown material; defined materials are: "
+                            + ", ".join(sorted(s.materials)))

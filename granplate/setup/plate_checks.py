@@ -1,0 +1,161 @@
+"""The plate's mesh checked before anything is built: an even `plate.ny` (a row of nodes
+on the symmetry line), every plate contact on a left-edge node, rigid layers that neither
+overlap nor reach a clamped node, `plate.n_modes` at most the number of reduced dofs, and
+a basis that fits the machine (setup.plate_cost). Counts come from the mesh's structure
+alone (docs/model.md section 4), so no matrix is assembled.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from granplate.errors import ScenarioError
+from granplate.setup.plate_cost import basis_kind, check_fits, truncation_supported
+from granplate.setup.scenario import Plate, Scenario
+
+#: Relative tolerance (times the plate height / width) for "a point lies on a mesh node".
+NODE_RTOL = 1e-9
+
+
+def faces_plate(p: Plate, gap_ratio: float, x: float, y: float, radius: float) -> bool:
+    """A granule at (x, y) [m] faces the plate's left edge, so that it has a plate contact:
+    its gap x0 - (x + R) is at most gap_ratio * R and y0 < y < y0 + height."""
+    return p.x0 - (x + radius) <= gap_ratio * radius and p.y0 < y < p.y0 + p.height
+
+
+def plate_contact_heights(s: Scenario) -> list[float]:
+    """y [m] of the granules facing the plate's left edge (`faces_plate`), in granule
+    order (s resolved, with a plate)."""
+    return [float(g.y) for g in s.granules
+            if faces_plate(s.plate, s.contact.neighbour_gap, g.x, g.y, g.radius)]
+
+
+def left_edge_node_heights(p: Plate) -> np.ndarray:
+    """y [m] of the 2 ny + 1 Q8 nodes on the plate's left edge, bottom to top."""
+    corners = np.linspace(p.y0, p.y0 + p.height, p.ny + 1)
+    y = np.empty(2 * p.ny + 1)
+    y[0::2] = corners
+    y[1::2] = 0.5 * (corners[:-1] + corners[1:])
+    return y
+
+
+def clamped_left_nodes(p: Plate) -> set[int]:
+    """Indices (into left_edge_node_heights) of the left-edge nodes on a clamped edge."""
+    n = 2 * p.ny + 1
+    if "left" in p.clamped_edges:
+        return set(range(n))
+    return ({0} if "bottom" in p.clamped_edges else set()) | ({n - 1} if "top" in p.clamped_edges else set())
+
+
+def clamped_node_count(p: Plate) -> int:
+    """Number of Q8 nodes on the clamped edges (corners shared by two edges counted once)."""
+    ni, nj = 2 * p.nx, 2 * p.ny  # node lattice (i, j), 0 <= i <= ni, 0 <= j <= nj
+    lines = {
+        "left": {(0, j) for j in range(nj + 1)},
+        "right": {(ni, j) for j in range(nj + 1)},
+        "bottom": {(i, 0) for i in range(ni + 1)},
+        "top": {(i, nj) for i in range(ni + 1)},
+    }
+    return len(set().union(*(lines[e] for e in p.clamped_edges)))
+
+
+def reduced_dof_count(p: Plate, n_slaved: int) -> int:
+    """Dofs left after clamping and slaving n_slaved rigid-layer nodes: 2 per free node."""
+    n_nodes = (p.nx + 1) * (p.ny + 1) + p.nx * (p.ny + 1) + p.ny * (p.nx + 1)
+    return 2 * (n_nodes - clamped_node_count(p) - n_slaved)
+
+
+def _check_symmetry_row(p: Plate) -> None:
+    if p.ny % 2:
+        raise ScenarioError(
+            "plate.ny", p.ny,
+            f"must be even so that the symmetry line y = y0 + height/2 = {p.y0 + p.height / 2:g} m "
+            "is a row of element edges (with Q8 nodes along it)")
+
+
+def _contact_node(p: Plate, k: int, yk: float, left_y: np.ndarray) -> int:
+    """Index of the left-edge node at contact k's height yk [m]; ScenarioError when none."""
+    at = np.flatnonzero(np.abs(left_y - yk) <= NODE_RTOL * p.height)
+    if at.size != 1:
+        raise ScenarioError(
+            "plate.ny", p.ny,
+            f"contact {k} at y={yk:g} m is not on a mesh node; the left-edge node spacing "
+            f"is height/(2 ny) = {p.height / (2 * p.ny):g} m; allowed: ny such that (y_contact - y0) "
+            "is a multiple of height/(2 ny) for every contact")
+    return int(at[0])
+
+
+def rigid_layers(p: Plate, contact_y: list[float]) -> list[tuple[int, list[int]]]:
+    """(driving node, other layer nodes) of each contact; refuses overlapping layers."""
+    left_y = left_edge_node_heights(p)
+    half, tol = 0.5 * p.layer_width, NODE_RTOL * p.height
+    owner: dict[int, int] = {}
+    layers = []
+    for k, yk in enumerate(contact_y):
+        at = _contact_node(p, k, yk, left_y)
+        members = [int(n) for n in np.flatnonzero(np.abs(left_y - yk) <= half + tol)]
+        for n in members:
+            if n in owner:
+                j = owner[n]
+                raise ScenarioError(
+                    "plate.rigid_layer_width", p.rigid_layer_width,
+                    f"the rigid layers of contacts {j} (y={contact_y[j]:g} m) and {k} (y={yk:g} m) "
+                    f"share the node at y={left_y[n]:g} m with w = {p.layer_width:g} m; "
+                    "allowed: w smaller than the distance between neighbouring contacts")
+            owner[n] = k
+        layers.append((at, [n for n in members if n != at]))
+    return layers
+
+
+def _check_layers_off_clamps(p: Plate, contact_y: list[float], layers: list[tuple[int, list[int]]]) -> None:
+    clamped = clamped_left_nodes(p)
+    for k, (at, members) in enumerate(layers):
+        if at in clamped:
+            raise ScenarioError(
+                "plate.clamped_edges", p.clamped_edges,
+                f"contact {k} at y={contact_y[k]:g} m sits on a clamped node; allowed: contacts on "
+                "free parts of the left edge only")
+        if any(n in clamped for n in members):
+            raise ScenarioError(
+                "plate.rigid_layer_width", p.rigid_layer_width,
+                f"the rigid layer of contact {k} at y={contact_y[k]:g} m (w = {p.layer_width:g} m) "
+                "reaches a clamped node; allowed: a width that keeps every layer off the clamped edges")
+
+
+def check_plate_mesh(s: Scenario) -> None:
+    """The mesh the plate layer will build can hold the scenario (see the module docstring)."""
+    p = s.plate
+    if p is None:
+        return
+    _check_symmetry_row(p)
+    contact_y = plate_contact_heights(s)
+    layers = rigid_layers(p, contact_y)
+    _check_layers_off_clamps(p, contact_y, layers)
+    n_red = reduced_dof_count(p, sum(len(m) for _, m in layers))
+    if p.n_modes > n_red:
+        raise ScenarioError("plate.n_modes", p.n_modes, f"allowed: 0 (all) or 1..{n_red}")
+    edge_load = s.load.kind == "line" and s.load.target == "plate"
+    kind = basis_kind(p.modes, n_red, truncation_supported(p.clamped_edges, edge_load))
+    if kind == "truncated":
+        check_truncated_plate(s)
+    check_fits(kind, n_red, p.modes)
+
+
+def check_truncated_plate(s: Scenario) -> None:
+    """What the truncated modal basis (docs/model.md section 4.5) supports."""
+    p = s.plate
+    if s.solver.scheme != "implicit":
+        raise ScenarioError(
+            "solver.scheme", s.solver.scheme,
+            f"the truncated plate basis (plate.modes = {p.modes!r}, here with more than the "
+            "dense limit of reduced dofs) is supported by the 'implicit' scheme only; allowed: "
+            "solver.scheme = 'implicit', or plate.modes = 'all' with a smaller mesh")
+    if s.load.kind == "line" and s.load.target == "plate":
+        raise ScenarioError(
+            "load.target", s.load.target,
+            "the truncated plate basis has a static correction at the contacts only, not for a "
+            "load on the plate's edge; allowed: load.target = 'granules', or plate.modes = 'all'")
+    if not p.clamped_edges:
+        raise ScenarioError(
+            "plate.clamped_edges", p.clamped_edges,
+            "the truncated plate basis needs a plate held by at least one clamped edge (its static "
+            "compliance); allowed: a non-empty subset of top, bottom, left, right, or plate.modes = 'all'")
