@@ -17,6 +17,15 @@ from granplate.physics.shock import time_profile
 
 
 @njit(cache=True)
+def edge_load_amplitudes(t, h, cfg):
+    """The edge load's amplitude q0 f(t) at the start and end of a step [N/m] (0, 0 when
+    the shock acts on the granules)."""
+    if not cfg.load_on_plate:
+        return 0.0, 0.0
+    return cfg.q0 * time_profile(t, cfg.duration), cfg.q0 * time_profile(t + h, cfg.duration)
+
+
+@njit(cache=True)
 def step_matrices(h, p, dmode, gmat):
     """For step h: dmode[m] = 1/(1 + h^2 omega_m^2/4) and G(h) = Phi_d diag(dmode) Phi_d^T."""
     nm = p.omega2.shape[0]
@@ -62,11 +71,7 @@ def newmark_correct(t, h, st, p, cfg, dmode, qdd_star, force):
     is exact for this scheme's energy balance) [J]."""
     nm = p.omega2.shape[0]
     nd = p.phi_d.shape[0]
-    amp0 = 0.0
-    amp1 = 0.0
-    if cfg.load_on_plate:
-        amp0 = cfg.q0 * time_profile(t, cfg.duration)
-        amp1 = cfg.q0 * time_profile(t + h, cfg.duration)
+    amp0, amp1 = edge_load_amplitudes(t, h, cfg)
     work = 0.0
     for m in range(nm):
         proj = 0.0
@@ -243,11 +248,7 @@ def exact_predict(t, h, st, p, cfg, coef, ustar):
     stage_motion_exact."""
     nm = p.omega2.shape[0]
     nd = p.phi_d.shape[0]
-    amp0 = 0.0
-    amp1 = 0.0
-    if cfg.load_on_plate:
-        amp0 = cfg.q0 * time_profile(t, cfg.duration)
-        amp1 = cfg.q0 * time_profile(t + h, cfg.duration)
+    amp0, amp1 = edge_load_amplitudes(t, h, cfg)
     for r in range(4):
         for d in range(nd):
             ustar[r, d] = 0.0
@@ -309,11 +310,7 @@ def exact_correct(t, h, st, p, cfg, coef, force, qn, qdn):
     energy at the end [J]."""
     nm = p.omega2.shape[0]
     nd = p.phi_d.shape[0]
-    amp0 = 0.0
-    amp1 = 0.0
-    if cfg.load_on_plate:
-        amp0 = cfg.q0 * time_profile(t, cfg.duration)
-        amp1 = cfg.q0 * time_profile(t + h, cfg.duration)
+    amp0, amp1 = edge_load_amplitudes(t, h, cfg)
     work = 0.0
     energy = 0.0
     b = MC_STRIDE
