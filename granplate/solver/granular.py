@@ -208,15 +208,16 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
 
 
 @njit(cache=True)
-def kinetic_energies(y, g):
-    """Horizontal, vertical and rotational kinetic energy of the granules [J] (eq. 10)."""
+def kinetic_energies(y, mass, inertia):
+    """Horizontal, vertical and rotational kinetic energy of the granules [J] (eq. 10).
+    (Arrays, not the model tuple: this runs every step.)"""
     kx = 0.0
     ky = 0.0
     kr = 0.0
     for i in range(y.shape[0]):
-        kx += 0.5 * g.mass[i] * y[i, 3] * y[i, 3]
-        ky += 0.5 * g.mass[i] * y[i, 4] * y[i, 4]
-        kr += 0.5 * g.inertia[i] * y[i, 5] * y[i, 5]
+        kx += 0.5 * mass[i] * y[i, 3] * y[i, 3]
+        ky += 0.5 * mass[i] * y[i, 4] * y[i, 4]
+        kr += 0.5 * inertia[i] * y[i, 5] * y[i, 5]
     return kx, ky, kr
 
 
