@@ -156,6 +156,20 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
 
 
 @njit(cache=True)
+def no_granules_step(h, p1, dacc, pend, ovl_new, ovl_who):
+    """rk4_granular_step without granules (a bare plate): no forces, no powers (the
+    work is summed as RK4 would, from zeros), no overlap; returns (0, 0)."""
+    h6 = h / 6.0
+    for c in range(3):
+        dacc[c] = h6 * (p1[c] + 2.0 * 0.0 + 2.0 * 0.0 + 0.0)
+        pend[c] = 0.0
+    ovl_new[0] = 0.0
+    ovl_who[0] = -1
+    ovl_who[1] = -1
+    return 0.0, 0.0
+
+
+@njit(cache=True)
 def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     """One RK4 step of the granules from st.y with the plate's contact points at
     stage[0], stage[1] (u, v at t + h/2) and stage[2], stage[3] (u, v at t + h).
@@ -169,6 +183,8 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     """
     y0 = st.y
     ng = y0.shape[0]
+    if ng == 0:
+        return no_granules_step(h, st.p1, w.dacc, w.pend, w.ovl_new, w.ovl_who)
     k1 = st.k1
     p1 = st.p1
     if hold:
@@ -208,15 +224,16 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
 
 
 @njit(cache=True)
-def kinetic_energies(y, g):
-    """Horizontal, vertical and rotational kinetic energy of the granules [J] (eq. 10)."""
+def kinetic_energies(y, mass, inertia):
+    """Horizontal, vertical and rotational kinetic energy of the granules [J] (eq. 10).
+    (Arrays, not the model tuple: this runs every step.)"""
     kx = 0.0
     ky = 0.0
     kr = 0.0
     for i in range(y.shape[0]):
-        kx += 0.5 * g.mass[i] * y[i, 3] * y[i, 3]
-        ky += 0.5 * g.mass[i] * y[i, 4] * y[i, 4]
-        kr += 0.5 * g.inertia[i] * y[i, 5] * y[i, 5]
+        kx += 0.5 * mass[i] * y[i, 3] * y[i, 3]
+        ky += 0.5 * mass[i] * y[i, 4] * y[i, 4]
+        kr += 0.5 * inertia[i] * y[i, 5] * y[i, 5]
     return kx, ky, kr
 
 

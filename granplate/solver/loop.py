@@ -40,8 +40,8 @@ def initialise(st, g, p, cfg, w):
     for d in range(st.force.shape[0]):
         st.force_prev[d] = st.force[d]
         st.pforce[d] = st.force[d]
-    kx, ky, kr = kinetic_energies(st.y, g)
-    e0 = kx + ky + kr + pr[3] + plate_energy(st, p)
+    kx, ky, kr = kinetic_energies(st.y, g.mass, g.inertia)
+    e0 = kx + ky + kr + pr[3] + plate_energy(st.q, st.qd, st.force, p.omega2, p.resid)
     st.clock[E_ZERO] = e0
     st.clock[E_IN_MAX] = e0
     reset_interval(w)
@@ -59,19 +59,21 @@ def reset_interval(w):
 
 
 @njit(cache=True)
-def energy_terms(st, g, p):
-    """The terms of eq. (11) at t_n: (E_shock, E_g, E_p, KE_x, KE_y, KE_rot) [J]."""
-    kx, ky, kr = kinetic_energies(st.y, g)
-    eg = kx + ky + kr + st.clock[E_POT]
-    ep = plate_energy(st, p)
-    eshock = st.acc[A_SHOCK_G] + st.acc[A_SHOCK_P]
+def energy_terms(y, q, qd, force, clock, acc, mass, inertia, omega2, resid):
+    """The terms of eq. (11) at t_n: (E_shock, E_g, E_p, KE_x, KE_y, KE_rot) [J]. (Arrays,
+    not the state tuples: this runs every step.)"""
+    kx, ky, kr = kinetic_energies(y, mass, inertia)
+    eg = kx + ky + kr + clock[E_POT]
+    ep = plate_energy(q, qd, force, omega2, resid)
+    eshock = acc[A_SHOCK_G] + acc[A_SHOCK_P]
     return eshock, eg, ep, kx, ky, kr
 
 
 @njit(cache=True)
 def record(o, st, g, p, w, out):
     """Write the state at t_n into output row o and restart the interval maxima."""
-    eshock, eg, ep, kx, ky, kr = energy_terms(st, g, p)
+    eshock, eg, ep, kx, ky, kr = energy_terms(st.y, st.q, st.qd, st.force, st.clock, st.acc, g.mass, g.inertia,
+                                              p.omega2, p.resid)
     e_in = st.clock[E_ZERO] + eshock
     denom = max(st.clock[E_IN_MAX], 1e-300)
     out.t[o] = st.clock[T_NOW]
@@ -112,17 +114,17 @@ def record(o, st, g, p, w, out):
 
 
 @njit(cache=True)
-def fail(status, st, t, h, contact, n, vt, lam, resid, it):
-    """Fill the failure record st.err (time, contact, |N|, slip, |lambda|, step,
+def fail(status, err, t, h, contact, n, vt, lam, resid, it):
+    """Fill the failure record err (st.err: time, contact, |N|, slip, |lambda|, step,
     residual, iterations) and return `status`."""
-    st.err[ERR_T] = t
-    st.err[ERR_CONTACT] = contact
-    st.err[ERR_N] = n
-    st.err[ERR_VT] = vt
-    st.err[ERR_LAM] = lam
-    st.err[ERR_H] = h
-    st.err[ERR_RESID] = resid
-    st.err[ERR_ITER] = it
+    err[ERR_T] = t
+    err[ERR_CONTACT] = contact
+    err[ERR_N] = n
+    err[ERR_VT] = vt
+    err[ERR_LAM] = lam
+    err[ERR_H] = h
+    err[ERR_RESID] = resid
+    err[ERR_ITER] = it
     return status
 
 
@@ -130,28 +132,29 @@ def fail(status, st, t, h, contact, n, vt, lam, resid, it):
 def step_too_small(t, h, it, worst, lam, normal, slip, st):
     """ERR_NOCONV: the step would go below dt_min, at `worst` (or -1)."""
     if worst < 0:
-        return fail(ERR_NOCONV, st, t, h, -1.0, 0.0, 0.0, lam, 0.0, it)
-    return fail(ERR_NOCONV, st, t, h, worst, normal[worst], slip[worst], lam, 0.0, it)
+        return fail(ERR_NOCONV, st.err, t, h, -1.0, 0.0, 0.0, lam, 0.0, it)
+    return fail(ERR_NOCONV, st.err, t, h, worst, normal[worst], slip[worst], lam, 0.0, it)
 
 
 @njit(cache=True)
-def check_energy(h, st, g, p, cfg, w):
-    """Eq. (11) after an accepted step: keep the residual's running values; returns OK,
-    ERR_NAN or ERR_ENERGY (above energy_tol)."""
-    eshock, eg, ep, kx, ky, kr = energy_terms(st, g, p)
-    e_in = st.clock[E_ZERO] + eshock
-    if e_in > st.clock[E_IN_MAX]:
-        st.clock[E_IN_MAX] = e_in
-    total = energy_total(eg, ep, st.acc[A_VISC], st.acc[A_FRIC])
+def check_energy(h, y, q, qd, force, clock, acc, mass, inertia, omega2, resid, energy_tol, res_int, err):
+    """Eq. (11) after an accepted step: keep the residual's running values (clock,
+    res_int); returns OK, ERR_NAN or ERR_ENERGY (above energy_tol) with err filled.
+    (Arrays, not the state tuples: this runs every step.)"""
+    eshock, eg, ep, kx, ky, kr = energy_terms(y, q, qd, force, clock, acc, mass, inertia, omega2, resid)
+    e_in = clock[E_ZERO] + eshock
+    if e_in > clock[E_IN_MAX]:
+        clock[E_IN_MAX] = e_in
+    total = energy_total(eg, ep, acc[A_VISC], acc[A_FRIC])
     if not (math.isfinite(total) and math.isfinite(e_in)):
-        return fail(ERR_NAN, st, st.clock[T_NOW], h, -1.0, 0.0, 0.0, 0.0, 0.0, 0)
-    denom = st.clock[E_IN_MAX]
+        return fail(ERR_NAN, err, clock[T_NOW], h, -1.0, 0.0, 0.0, 0.0, 0.0, 0)
+    denom = clock[E_IN_MAX]
     if denom > 0.0:
         res = energy_residual(total, e_in, denom)
-        st.clock[RES_LAST] = res
-        w.res_int[0] = max(w.res_int[0], abs(res))
-        if abs(res) > cfg.energy_tol:
-            return fail(ERR_ENERGY, st, st.clock[T_NOW], h, -1.0, 0.0, 0.0, 0.0, res, 0)
+        clock[RES_LAST] = res
+        res_int[0] = max(res_int[0], abs(res))
+        if abs(res) > energy_tol:
+            return fail(ERR_ENERGY, err, clock[T_NOW], h, -1.0, 0.0, 0.0, 0.0, res, 0)
     return OK
 
 
@@ -240,7 +243,8 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
         if level_step(new_level, cfg) < cfg.dt_min:
             return step_too_small(st.clock[T_NOW], h_new, it, worst_contact(w), lam_max, st.normal, st.slip, st)
         st.count[C_LEVEL] = new_level
-        status = check_energy(h, st, g, p, cfg, w)
+        status = check_energy(h, st.y, st.q, st.qd, st.force, st.clock, st.acc, g.mass, g.inertia, p.omega2,
+                              p.resid, cfg.energy_tol, w.res_int, st.err)
         if status != OK:
             return status
         if land:

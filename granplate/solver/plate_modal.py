@@ -337,14 +337,15 @@ def exact_correct(t, h, st, p, cfg, coef, force, qn, qdn):
 
 
 @njit(cache=True)
-def plate_energy(st, p):
+def plate_energy(q, qd, force, omega2, resid):
     """E_p = 1/2 q'.q' + 1/2 sum omega^2 q^2 = 1/2 v^T M v + 1/2 x^T K x [J] (eq. 9),
-    plus the static part 1/2 F^T R F of a truncated basis."""
+    plus the static part 1/2 F^T R F of a truncated basis. (Arrays, not the state
+    tuples: this runs every step.)"""
     e = 0.0
-    for m in range(p.omega2.shape[0]):
-        e += 0.5 * (st.qd[m] * st.qd[m] + p.omega2[m] * st.q[m] * st.q[m])
-    if p.resid.shape[0] > 0:
-        e += static_energy(p.resid, st.force)
+    for m in range(omega2.shape[0]):
+        e += 0.5 * (qd[m] * qd[m] + omega2[m] * q[m] * q[m])
+    if resid.shape[0] > 0:
+        e += static_energy(resid, force)
     return e
 
 

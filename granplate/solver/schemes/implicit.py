@@ -185,7 +185,7 @@ def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
     work [J])."""
     fric_work = held_friction_work(st, g, cfg, w)
     work, ep_new = exact_correct(t, h, st, p, cfg, sw.mcoef[slot], w.fguess, sw.qn, sw.qdn)
-    kx, ky, kr = kinetic_energies(w.ynew, g)
+    kx, ky, kr = kinetic_energies(w.ynew, g.mass, g.inertia)
     e_in = st.clock[E_ZERO] + st.acc[A_SHOCK_G] + w.dacc[0] + st.acc[A_SHOCK_P] + work
     total = (kx + ky + kr + e_pot + ep_new + st.acc[A_VISC] + w.dacc[1]
              + st.acc[A_FRIC] + w.dacc[2] + fric_work)
