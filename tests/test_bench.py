@@ -67,3 +67,40 @@ def test_bench_json_has_documented_keys(tmp_path, monkeypatch):
 def test_bench_unknown_case_is_a_user_error(capsys):
     assert main(["bench", "--cases", "no-such-preset"]) == 2
     assert "unknown case" in capsys.readouterr().err
+
+
+def test_scaling_rows_are_measured_and_documented(tmp_path):
+    """`bench --scaling` on a 2 x 3 packing (5 granules, 7 touching pairs): one row per
+    friction, every documented key, a small error against the RK4 reference, and LAMMPS
+    reaching the same accuracy where it is installed."""
+    from granplate.bench import scaling
+    from granplate.verification import lammps as L
+
+    out = tmp_path / "scaling.json"
+    assert main(["bench", "--scaling", "--sizes", "2x3", "--t-end", "4e-6", "--json", str(out)]) == 0
+    rows = json.loads(out.read_text())
+    assert [r["mu"] for r in rows] == list(scaling.FRICTIONS)
+    text = (ROOT / "docs" / "benchmarks.md").read_text().split("### Scaling JSON")[1]
+    documented = {k for line in text.splitlines() if line.startswith("| `")
+                  for k in re.findall(r"`([a-z_0-9]+)`", line.split("|")[1])}
+    for r in rows:
+        assert {"granules", "contacts", "setup_s", "loop_s", "n_steps", "rss_peak_mib"} <= documented
+        assert set(r) - {"lammps"} <= documented | {"error"}, set(r) - documented
+        assert r["granules"] == 5 and r["contacts"] == 7 and r["n_steps"] > 0
+        assert r["us_per_contact_step"] == pytest.approx(1e6 * r["loop_s"] / (r["n_steps"] * 7))
+        assert r["energy_residual"] < 1e-6
+    assert 0.0 < rows[0]["error"] < 1e-5
+    lm = rows[0]["lammps"]
+    if L.unavailable():
+        assert "skipped" in lm
+    else:
+        assert lm["reached"] and lm["error"] <= rows[0]["error"]
+
+
+def test_scaling_sizes_are_checked(capsys):
+    """A malformed --sizes item is a user error naming it and the allowed form."""
+    from granplate.bench import scaling
+
+    assert scaling.granule_count(100, 100) == 9950 and scaling.granule_count(4, 3) == 10
+    assert main(["bench", "--scaling", "--sizes", "4x3,ten"]) == 2
+    assert "--sizes item 'ten'" in capsys.readouterr().err

@@ -3,6 +3,10 @@ from __future__ import annotations
 
 
 def _cmd_bench(args) -> int:
+    if getattr(args, "scaling", False):
+        from granplate.bench import scaling
+
+        return int(scaling.main(args))
     if getattr(args, "plates", False):
         from granplate.bench import plates
 
@@ -28,4 +32,13 @@ def register(subparsers) -> None:
     b.add_argument("--meshes", help="with --plates: comma-separated NXxNY (default 4x40,8x80,16x160,32x320)")
     b.add_argument("--modes", dest="plate_modes", choices=("auto", "all", "truncated"), default=None,
                    help="with --plates: plate.modes of every mesh (default auto)")
+    b.add_argument("--scaling", action="store_true",
+                   help="instead: the granule-scaling table (10 to 10,000 granules of a launched hexagonal "
+                        "packing, with and without friction: set-up, steps, loop time, us per contact and "
+                        "step, peak memory; LAMMPS's time to the same accuracy where it is installed)")
+    b.add_argument("--sizes", help="with --scaling: comma-separated COLUMNSxROWS (default 4x3,8x13,32x32,56x54,100x100)")
+    b.add_argument("--scheme", choices=("implicit", "paper"), default=None,
+                   help="with --scaling: solver.scheme of granplate's runs (default implicit)")
+    b.add_argument("--no-lammps", dest="no_lammps", action="store_true",
+                   help="with --scaling: leave LAMMPS out even where it is installed")
     b.set_defaults(func=_cmd_bench)
