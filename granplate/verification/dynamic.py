@@ -384,8 +384,9 @@ def wall_bounce(ctx: Context) -> CaseResult:
 
 # --------------------------------------------------------------------------- loose packing
 
-#: Loose packing: granules, box size [m], seed.
+#: Loose packing: granules (quick, --full), box side for LOOSE_COUNT [m], seed.
 LOOSE_COUNT = 16
+LOOSE_COUNT_FULL = 30
 LOOSE_BOX = 0.07
 LOOSE_SEED = 7
 
@@ -393,12 +394,13 @@ LOOSE_SEED = 7
 def loose_packing(count: int = LOOSE_COUNT, seed: int = LOOSE_SEED, t_end: float = 4e-3, dt: float = 2e-8,
                   alpha_n: float = 0.0):
     """`count` steel spheres of radii 4-8 mm at seeded random sites in a closed box of
-    side LOOSE_BOX [m], none touching anything at t = 0 (gaps >= 0.3 mm), random velocities
-    up to 3 m/s, frictionless, damping alpha_n; dynamic detection, fixed step dt [s]."""
+    side LOOSE_BOX sqrt(count / LOOSE_COUNT) [m] (the same area per granule), none touching
+    anything at t = 0 (gaps >= 0.3 mm), random velocities up to 3 m/s, frictionless,
+    damping alpha_n; dynamic detection, fixed step dt [s]."""
     from granplate.setup.scenario import Contact, Granule, Load, Scenario, TimeSettings, Wall
 
     rng = np.random.default_rng(seed)
-    side = LOOSE_BOX
+    side = LOOSE_BOX * math.sqrt(count / LOOSE_COUNT)
     gs: list = []
     while len(gs) < count:
         r = float(rng.uniform(0.004, 0.008))
@@ -423,11 +425,12 @@ def _paper_solver():
 
 def loose_packing_case(ctx: Context) -> CaseResult:
     """A loose box of spheres against the independent integrator over every pair and wall."""
-    s = loose_packing(t_end=2e-2 if ctx.full else 4e-3)
+    s = loose_packing(count=LOOSE_COUNT_FULL if ctx.full else LOOSE_COUNT)
     ds = simulate(s)
     t = ds.time.values
     ref = reference_motion(s, t)
     n = len(s.granules)
+    side = LOOSE_BOX * math.sqrt(n / LOOSE_COUNT)
     r = np.array([g.radius for g in s.granules])
     dist = np.hypot(ds.x.values[:, :, None] - ds.x.values[:, None, :], ds.y.values[:, :, None] - ds.y.values[:, None, :])
     touch = dist < (r[:, None] + r[None, :])
@@ -438,12 +441,12 @@ def loose_packing_case(ctx: Context) -> CaseResult:
     vel_err = float(np.abs(np.stack([ds.vx.values, ds.vy.values], 1) - ref[:, 3:5]).max() / v_scale)
     why = ("RK4 at h = 20 ns (about t_c/1000 of the fastest impact) with every contact starting "
            "inside a step: O((h/t_c)^(5/2)) ~ 3e-8 of the impact per impact, carried and amplified "
-           "by the collisions that follow (measured at this step: 6e-10 m and 1.6e-6 of 3 m/s; "
-           "the bounds leave a factor of 10 or more); mid-contact samples turn a position error into a force error times the "
+           "by the collisions that follow (measured: 6e-10 m and 1.6e-6 of 3 m/s with 16 granules, "
+           "5e-10 m and 1.0e-5 with 30); mid-contact samples turn a position error into a force error times the "
            "contact stiffness, hence the looser bound on velocities.")
     checks = [
         Check(f"positions, max over {n} granules and the run", "m", 0.0, IVP_SOURCE, pos_err, 2e-8, why, kind="max"),
-        Check("velocities, max |v - v_ref| / 3 m/s", "-", 0.0, IVP_SOURCE, vel_err, 2e-5, why, kind="max"),
+        Check("velocities, max |v - v_ref| / 3 m/s", "-", 0.0, IVP_SOURCE, vel_err, 5e-5, why, kind="max"),
         Check("pairs that touched during the run (none at t = 0)", "-", 5.0, "contacts must form",
               float(pairs_met), 5.0, "a packing test needs several collisions", kind="min"),
         Check("energy residual", "-", 0.0, "eq. (11)", float(np.abs(ds.energy_residual.values).max()), 1e-7,
@@ -457,8 +460,8 @@ def loose_packing_case(ctx: Context) -> CaseResult:
         ax.add_patch(__import__("matplotlib.patches", fromlist=["Circle"]).Circle(
             (s.granules[k].x * 1e3, s.granules[k].y * 1e3), r[k] * 1e3, fill=False, lw=0.5, color="0.5"))
     ax.set_aspect("equal")
-    ax.set_xlim(0, LOOSE_BOX * 1e3)
-    ax.set_ylim(0, LOOSE_BOX * 1e3)
+    ax.set_xlim(0, side * 1e3)
+    ax.set_ylim(0, side * 1e3)
     ax.set_xlabel("x [mm]")
     ax.set_ylabel("y [mm] (dots: reference)")
     ax = axes[0, 1]
@@ -468,16 +471,21 @@ def loose_packing_case(ctx: Context) -> CaseResult:
     ax.set_ylabel("max |v - v_ref| [m/s]")
     name = save_figure(fig, ctx, "loose-packing")
     desc = (f"{n} steel spheres (R = 4-8 mm, seed {LOOSE_SEED}) at random sites in a closed "
-            f"{LOOSE_BOX * 1e3:.0f} mm box, none touching anything at t = 0, with random "
+            f"{side * 1e3:.0f} mm box, none touching anything at t = 0, with random "
             "velocities up to 3 m/s, frictionless and undamped (damping is checked by the "
             "cases above), dynamic detection, "
-            f"h = 20 ns, {t[-1] * 1e3:g} ms ({'--full' if ctx.full else 'quick; 20 ms with --full'}). "
+            f"h = 20 ns, {t[-1] * 1e3:g} ms ({'--full' if ctx.full else f'quick; {LOOSE_COUNT_FULL} granules with --full'}). "
             "Every position and velocity is compared, at 100 output times, with an independent "
             "solve_ivp (DOP853, rtol 1e-11, steps <= 1 µs) of the Hertz law over all pairs and all walls, "
             "written in this module from the equations (no neighbour list: every pair is tested "
             "at every evaluation).")
     return CaseResult("", "", "", desc, checks, name,
-                      notes=[f"{pairs_met} pairs touched; largest velocity error {vel_err * v_scale:.2e} m/s, position error {pos_err:.2e} m."])
+                      notes=[f"{pairs_met} pairs touched; largest velocity error {vel_err * v_scale:.2e} m/s, position error {pos_err:.2e} m.",
+                             "The comparison stops at 4 ms: a box of colliding spheres is a chaotic billiard, "
+                             "which amplifies any difference exponentially with the number of successive "
+                             "collisions (measured: the 16-granule box at 20 ms differs by 0.5 m/s, granplate "
+                             "keeping its energy balance to 1e-8), so a longer run compares the amplification, not the "
+                             "integrators."])
 
 
 CASES: tuple[Case, ...] = (
@@ -487,6 +495,6 @@ CASES: tuple[Case, ...] = (
          oblique_gap),
     Case("wall-bounce", "contacts", "A sphere bouncing between two walls: period, energy, speed decay",
          wall_bounce),
-    Case("loose-packing", "contacts", "A loose box of 16 spheres vs an independent integrator over all pairs",
+    Case("loose-packing", "contacts", "A loose box of spheres vs an independent integrator over all pairs",
          loose_packing_case),
 )
