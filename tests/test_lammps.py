@@ -47,10 +47,11 @@ def test_adapter_refuses_what_it_cannot_map():
     """Walls, friction, damping or two materials are refused naming the field, before
     LAMMPS is started."""
     s = L.launched_hexagon(2, 2)
-    for bad, field in ((dataclasses.replace(s, walls=(Wall(normal=(-1.0, 0.0), offset=0.0),)), "walls"),
-                       (dataclasses.replace(s, contact=dataclasses.replace(s.contact, mu=0.1)), "contact.mu"),
-                       (dataclasses.replace(s, contact=dataclasses.replace(s.contact, alpha_n=0.01)), "contact.mu, contact.alpha_n"),
-                       (dataclasses.replace(s, granules=(dataclasses.replace(s.granules[0], material="ptfe"),) + s.granules[1:]),
+    swap = dataclasses.replace
+    for bad, field in ((swap(s, walls=(Wall(normal=(-1.0, 0.0), offset=0.0),)), "walls"),
+                       (swap(s, contact=swap(s.contact, mu=0.1)), "contact.mu"),
+                       (swap(s, contact=swap(s.contact, alpha_n=0.01)), "contact.mu, contact.alpha_n"),
+                       (swap(s, granules=(swap(s.granules[0], material="ptfe"),) + s.granules[1:]),
                         "granules[].material")):
         with pytest.raises(ValueError, match=field.replace(".", r"\.").replace("[]", r"\[\]")):
             L.packing_arrays(bad)

@@ -25,7 +25,7 @@ import subprocess
 import sys
 import time
 
-#: Packings (columns, rows) of the table: 10, 100, 1008, 3024 and 9950 granules.
+#: Packings (columns, rows) of the table: 10, 100, 1,008, 2,996 and 9,950 granules.
 SIZES: tuple[tuple[int, int], ...] = ((4, 3), (8, 13), (32, 32), (56, 54), (100, 100))
 #: Friction coefficients of the rows: frictionless (compared with LAMMPS) and the default.
 FRICTIONS: tuple[float, ...] = (0.0, 0.099)
@@ -51,8 +51,8 @@ def _warm_up() -> None:
     from granplate.verification.lammps import launched_hexagon
 
     for scheme in ("implicit", "paper"):
-        simulate(launched_hexagon(2, 2, radius=RADIUS, t_end=1e-6, scheme=scheme, dt=4e-8 if scheme == "paper" else None),
-                 progress=False)
+        dt = 4e-8 if scheme == "paper" else None
+        simulate(launched_hexagon(2, 2, radius=RADIUS, t_end=1e-6, scheme=scheme, dt=dt), progress=False)
 
 
 def _max_error(vx, vy, ref: dict) -> float:
@@ -170,7 +170,7 @@ def format_scaling_table(rows: list[dict]) -> str:
     lines = ["| granules | contacts | mu | set-up [s] | steps | loop [s] | us/step | us/(contact step) "
              "| peak [MiB] | error | LAMMPS dt [s] | LAMMPS steps | LAMMPS loop [s] | LAMMPS us/(contact step) "
              "| LAMMPS error |",
-             "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
+             "|" + " ---: |" * 15]
     for r in rows:
         if "failed" in r:
             lines.append(f"| {granule_count(r['columns'], r['rows']):,} | | {r['mu']:g} | {r['failed']} |"

