@@ -98,9 +98,12 @@ def test_scaling_rows_are_measured_and_documented(tmp_path):
 
 
 def test_scaling_sizes_are_checked(capsys):
-    """A malformed --sizes item is a user error naming it and the allowed form."""
+    """A malformed --sizes item or a non-positive --t-end is a user error naming it and
+    the allowed values, before anything runs."""
     from granplate.bench import scaling
 
     assert scaling.granule_count(100, 100) == 9950 and scaling.granule_count(4, 3) == 10
     assert main(["bench", "--scaling", "--sizes", "4x3,ten"]) == 2
     assert "--sizes item 'ten'" in capsys.readouterr().err
+    assert main(["bench", "--scaling", "--sizes", "4x3", "--t-end", "0"]) == 2
+    assert "--t-end 0.0: must be > 0" in capsys.readouterr().err

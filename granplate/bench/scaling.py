@@ -208,8 +208,8 @@ def main(args) -> int:
     except ValueError as err:
         print(f"granplate: error: {err}", file=sys.stderr)
         return 2
-    t_end = getattr(args, "t_end", None) or T_END
-    if not (t_end > 0.0):
+    t_end = T_END if getattr(args, "t_end", None) is None else float(args.t_end)
+    if not t_end > 0.0:
         print(f"granplate: error: --t-end {t_end}: must be > 0 [s]", file=sys.stderr)
         return 2
     rows = run_scaling(sizes, t_end=t_end, scheme=getattr(args, "scheme", None) or "implicit",
