@@ -131,6 +131,14 @@ def test_heat_maps_of_three_parameters_are_one_panel_per_value_of_the_third(tmp_
     fig = P.fig_heatmap(out, "max_von_mises")
     panels = [ax for ax in fig.axes if ax.images]
     assert [ax.get_title() for ax in panels] == ["contact.mu = 0.1", "contact.mu = 0.2"]
+    # a parameter zipped with another is no axis of its own: named with it
+    for r in out.rows:
+        r.params["contact.alpha_n"] = r.params["contact.mu"] / 10
+    out.names = out.names + ("contact.alpha_n",)
+    assert P.varied(out) == ["load.q0", "layout.R2_ratio", "contact.mu"] and P.is_grid(out)
+    fig = P.fig_heatmap(out, "max_von_mises")
+    assert [ax.get_title() for ax in fig.axes if ax.images] == ["contact.mu = 0.1", "contact.mu = 0.2"]
+    assert P.label(out, "contact.mu") == "contact.mu [-]\nwith contact.alpha_n [-]"
 
 
 def test_failures_table_lists_each_failed_design_with_its_message(synthetic_report):
@@ -211,6 +219,9 @@ def test_targets_judge_each_combination_of_the_choices():
     assert (p40.design, p40.holds) == (1, True)
     assert (s80.metric, s80.holds) == ("max_von_mises", False)  # the closer of the two
     assert p80.holds is False
+    # a parameter zipped with the one a target names is no choice: the same two groups
+    zipped = [{**d, "ratio": 1.0 if d["case"] == "steel" else 0.5} for d in designs]
+    assert [p for p, _ in judge(targets, ("mesh", "case", "ratio"), zipped, values)] == [{"mesh": 40}, {"mesh": 80}]
 
 
 @pytest.mark.parametrize("table, field", [

@@ -17,9 +17,11 @@ worker, runs each as a design on the cluster and tells its metrics back. The Opt
 lives in DIR/optuna.db (SQLite), so a rerun continues it up to --trials; each design also
 gets its record in DIR/designs (a trial whose design was already computed, here or by a
 sweep into the same folder, is not computed again). Trials cut short by an interruption
-are marked failed on the next run and their parameters queued again. Constraints go to
-the sampler's constraints_func (granplate.study.constraints): an infeasible trial is
-complete but marked infeasible, and the Pareto front is that of the feasible trials.
+are marked failed on the next run and their parameters queued again. Constraints
+(granplate.study.constraints) are told to Optuna with the trial: `Trial.set_constraint`
+from Optuna 5 on, the sampler's `constraints_func` before (deprecated in 5); an
+infeasible trial is complete but marked infeasible, and the Pareto front is that of the
+feasible trials.
 """
 from __future__ import annotations
 
@@ -173,6 +175,14 @@ def stored_constraints(trial) -> list[float]:
     return list(trial.user_attrs.get("constraints", []))
 
 
+def trial_constraints() -> bool:
+    """Whether Optuna takes constraints from the trial (Trial.set_constraint, Optuna >= 5)
+    rather than from the sampler's constraints_func."""
+    from optuna.trial import Trial
+
+    return hasattr(Trial, "set_constraint")
+
+
 def constraint_texts(opt: Optimization) -> list[str]:
     """The constraints as text with units ('granular_mass <= 0.02 kg')."""
     units = D.metric_units()
@@ -184,8 +194,8 @@ def open_study(opt: Optimization, out: Path, seed: int):
     import optuna
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
-    sampler = optuna.samplers.TPESampler(
-        seed=seed, constraints_func=stored_constraints if opt.constraints else None)
+    by_sampler = bool(opt.constraints) and not trial_constraints()
+    sampler = optuna.samplers.TPESampler(seed=seed, constraints_func=stored_constraints if by_sampler else None)
     study = optuna.create_study(storage=f"sqlite:///{out / DATABASE}", study_name=STUDY_NAME,
                                 directions=list(opt.objectives.values()), load_if_exists=True,
                                 sampler=sampler)
@@ -228,8 +238,12 @@ def tell(study, opt: Optimization, trial, record: dict) -> bool:
     values = objective_values(opt, record)
     if values is not None and opt.constraints:
         summary = record["summary"]
-        trial.set_user_attr("constraints", violations(opt.constraints, summary))
+        values_c = violations(opt.constraints, summary)
+        trial.set_user_attr("constraints", values_c)
         trial.set_user_attr("constrained", {b.metric: summary.get(b.metric) for b in opt.constraints})
+        if trial_constraints():
+            for k, v in enumerate(values_c):
+                trial.set_constraint(f"c{k}", v)
     if values is None:
         study.tell(trial, state=TrialState.FAIL)
         return False

@@ -37,8 +37,12 @@ def shown(unit: str) -> tuple[float, str]:
 
 
 def label(out: StudyOutcome, name: str) -> str:
-    """'max_von_mises [MPa]', 'ep_max_fraction [-]': the axis label of a quantity."""
-    return f"{name} [{shown(out.unit(name))[1]}]"
+    """'max_von_mises [MPa]', 'ep_max_fraction [-]': the axis label of a quantity (a
+    parameter's companions, those that vary with it, are named after it)."""
+    text = f"{name} [{shown(out.unit(name))[1]}]"
+    if name in out.names:
+        text += "".join(f"\nwith {n} [{shown(out.unit(n))[1]}]" for n in companions(out, name))
+    return text
 
 
 def is_numeric(values: list[Any]) -> bool:
@@ -52,17 +56,35 @@ def distinct(values: list[Any]) -> list[Any]:
 
 
 def is_grid(out: StudyOutcome, names: tuple[str, ...] | None = None) -> bool:
-    """Whether the rows are the full grid of the distinct values of `names` (each
-    combination once)."""
-    names = out.names if names is None else names
+    """Whether the rows are the full grid of the distinct values of `names` (default: the
+    varied parameters, one of each group that varies together), each combination once."""
+    names = tuple(varied(out)) if names is None else names
     combos = {tuple(str(r.params.get(n)) for n in names) for r in out.rows}
     size = math.prod(len(distinct(out.values(n))) for n in names)
     return len(combos) == len(out.rows) == size
 
 
+def tied(out: StudyOutcome, a: str, b: str) -> bool:
+    """Whether parameters a and b vary together, one value of b for each value of a and
+    the reverse (a [zip] table)."""
+    pairs = {(str(x), str(y)) for x, y in zip(out.values(a), out.values(b))}
+    return len(pairs) == len({p[0] for p in pairs}) == len({p[1] for p in pairs})
+
+
 def varied(out: StudyOutcome) -> list[str]:
-    """The parameters that take more than one value."""
-    return [n for n in out.names if len(distinct(out.values(n))) > 1]
+    """The parameters that take more than one value, one of each group that varies
+    together (the first: the others follow it, `companions`)."""
+    names: list[str] = []
+    for n in out.names:
+        if len(distinct(out.values(n))) > 1 and not any(tied(out, m, n) for m in names):
+            names.append(n)
+    return names
+
+
+def companions(out: StudyOutcome, name: str) -> list[str]:
+    """The parameters that vary together with `name` (after it in the study)."""
+    later = out.names[out.names.index(name) + 1:]
+    return [n for n in later if len(distinct(out.values(n))) > 1 and tied(out, name, n)]
 
 
 def _positions(values: list[Any], levels: list[Any]) -> np.ndarray:
@@ -172,7 +194,7 @@ def fig_heatmap(out: StudyOutcome, metric: str) -> Figure | None:
     values = np.array(out.metric(metric)) * factor
     finite = values[np.isfinite(values)]
     lo, hi = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
-    ncol = min(3, len(combos))
+    ncol = len(combos) if len(combos) <= 3 else math.ceil(math.sqrt(len(combos)))
     nrow = math.ceil(len(combos) / ncol)
     fig = new_figure(PANEL[0] * ncol + 0.8, PANEL[1] * nrow + 0.5)
     grid = fig.subplots(nrow, ncol, squeeze=False)
@@ -194,8 +216,7 @@ def fig_heatmap(out: StudyOutcome, metric: str) -> Figure | None:
         ax.set_xlabel(label(out, xn), fontsize=8)
         ax.set_ylabel(label(out, yn), fontsize=8)
         if others:
-            ax.set_title(", ".join(f"{n} = {v:g}" if isinstance(v, float) else f"{n} = {v}"
-                                   for n, v in zip(others, combo)), fontsize=7)
+            ax.set_title("\n".join(f"{n} = {_short(v)}" for n, v in zip(others, combo)), fontsize=7)
     for k in range(len(combos), nrow * ncol):
         grid[k // ncol][k % ncol].set_visible(False)
     if image is not None:
@@ -233,8 +254,11 @@ def fig_pareto(out: StudyOutcome, front: list[int], chosen: dict[str, int]) -> F
     if front:
         pts = sorted(xy(i) for i in front)
         ax.plot(*zip(*pts), "o-" if two else "o", color="C3", ms=5, label="Pareto front", gid="front")
+    by_row: dict[int, list[str]] = {}
     for metric, i in chosen.items():
-        ax.annotate(f"best {metric}", xy(i), fontsize=7, xytext=(6, 6), textcoords="offset points")
+        by_row.setdefault(i, []).append(metric)
+    for i, metrics in by_row.items():
+        ax.annotate(f"best {', '.join(metrics)}", xy(i), fontsize=7, xytext=(6, 6), textcoords="offset points")
     if two:
         ax.set_xlabel(f"{label(out, names[0])} ({out.objectives[names[0]]})", fontsize=8)
         ax.set_ylabel(f"{label(out, names[1])} ({out.objectives[names[1]]})", fontsize=8)

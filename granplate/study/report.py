@@ -35,6 +35,13 @@ FIGURES = "report"
 HEADLINE: tuple[str, ...] = ("ep_max_fraction", "max_von_mises")
 #: Metrics that say how the run went rather than what the design does (figures last).
 RUN_METRICS: tuple[str, ...] = ("t_end", "energy_residual_max", "n_steps", "wall_time_s")
+#: Metrics of the designs table besides the objectives, constraints and targets (the CSV
+#: table has them all).
+TABLE_METRICS: tuple[str, ...] = ("ep_max_fraction", "ep_final_fraction", "dissipated_fraction",
+                                  "max_von_mises", "max_von_mises_nodes", "max_eps_yy", "granular_mass")
+#: Values this small [SI units] are round-off of a quantity that is zero (e_initial of a
+#: run from rest): a metric with no larger value is not drawn.
+NEGLIGIBLE = 1e-30
 #: Most rows of the designs table on the page (results.csv has them all).
 MAX_ROWS = 120
 #: Figures of a chosen design (granplate.figures.run names) besides its assembly.
@@ -63,8 +70,10 @@ def shown_metrics(out: StudyOutcome) -> tuple[list[str], list[str]]:
     for m in out.metrics:
         v = np.array(out.metric(m))
         finite = v[np.isfinite(v)]
-        (drawn if finite.size and np.ptp(finite) > 0 else left).append(m)
-    drawn.sort(key=lambda m: m in RUN_METRICS)
+        varies = finite.size and np.ptp(finite) > 0 and np.max(np.abs(finite)) > NEGLIGIBLE
+        (drawn if varies else left).append(m)
+    first = list(out.objectives) + list(HEADLINE)
+    drawn.sort(key=lambda m: (m in RUN_METRICS, m not in first, first.index(m) if m in first else 0))
     return drawn, left
 
 
@@ -184,15 +193,31 @@ def _definition(out: StudyOutcome) -> list[Block]:
     return blocks
 
 
+def same_design(out: StudyOutcome) -> dict[int, int]:
+    """row -> the first row of the same design (an optimiser may ask for a design again:
+    the same record, the same numbers)."""
+    first: dict[str, int] = {}
+    return {i: first.setdefault(r.key, i) if r.key else i for i, r in enumerate(out.rows)}
+
+
 def _designs_table(out: StudyOutcome, metrics: list[str], chosen: dict[str, int], front: list[int]) -> Block:
-    cols = [m for m in metrics if m not in RUN_METRICS]
+    wanted = (set(out.objectives) | {b.metric for b in out.constraints} | set(TABLE_METRICS)
+              | {m for t in out.report.targets for m in t.metrics})
+    cols = [m for m in metrics if m in wanted]
     header = ("design",) + tuple(_head(out, n) for n in out.names) + tuple(_head(out, m) for m in cols)
     header += (("feasible",) if out.constraints else ()) + ("status",)
-    marks = {i: [f"best {m}" for m, j in chosen.items() if j == i] + (["front"] if i in front else [])
-             for i in range(len(out.rows))}
+    first = same_design(out)
+    marks = {i: [f"best {m}" for m, j in chosen.items() if first[j] == i]
+             + (["front"] if any(first[j] == i for j in front) else []) for i in range(len(out.rows))}
+    repeats = {i: sum(1 for j in first.values() if j == i) for i in set(first.values())}
     rows = []
-    for i, r in enumerate(out.rows[:MAX_ROWS]):
-        name = str(r.number) + (f" ({', '.join(marks[i])})" if marks[i] else "")
+    for i, r in enumerate(out.rows):
+        if first[i] != i:
+            continue  # a trial of a design listed above
+        if len(rows) == MAX_ROWS:
+            break
+        name = str(r.number) + (f" (x{repeats[i]} trials)" if repeats[i] > 1 else "") \
+            + (f" ({', '.join(marks[i])})" if marks[i] else "")
         rows.append((name,) + tuple(fmt(r.params.get(n), out.unit(n)) for n in out.names)
                     + tuple(fmt(r.metrics.get(m), out.unit(m)) for m in cols)
                     + (({True: "yes", False: "no", None: "-"}[r.feasible],) if out.constraints else ())
@@ -277,8 +302,10 @@ def build_report(out: StudyOutcome, progress: bool = False) -> list[Block]:
     front = pareto_front(out)
     blocks += _targets(out)
     blocks.append(Block("h2", "Designs"))
-    if len(out.rows) > MAX_ROWS:
-        blocks.append(Block("p", f"The first {MAX_ROWS} of {len(out.rows)} (all in the CSV table)."))
+    blocks.append(Block("p", "The main metrics of each design (every metric is in the CSV table)"
+                        + (f"; the first {MAX_ROWS} designs" if len(out.rows) > MAX_ROWS else "")
+                        + (". A design the optimiser asked for more than once is listed once, with "
+                           "its first trial" if out.kind == "optimization" else "") + "."))
     blocks.append(_designs_table(out, drawn, chosen, front))
     if out.objectives:
         blocks.append(Block("h2", "Pareto front"))
@@ -288,8 +315,12 @@ def build_report(out: StudyOutcome, progress: bool = False) -> list[Block]:
                                           + (" (crosses: infeasible)" if out.constraints else "")
                                           + "; axes in the objectives' units",
                                 path=_save(fig, fig_dir / "pareto-front.png")))
-        blocks.append(Block("p", "On the front: " + (", ".join(f"design {out.rows[i].number}" for i in front)
-                                                     or "no feasible design") + "."))
+        first = same_design(out)
+        on_front = list(dict.fromkeys(first[i] for i in front))
+        blocks.append(Block("p", "On the front: " + (", ".join(
+            f"{'trial' if out.kind == 'optimization' else 'design'} {out.rows[i].number}"
+            + (f" (and {n - 1} more trials of the same design)" if (n := sum(first[j] == i for j in front)) > 1 else "")
+            for i in on_front) or "no feasible design") + "."))
     blocks.append(Block("h2", "Metrics against the parameters"))
     if left:
         blocks.append(Block("p", "Not drawn (the same for every design, or no design has it): "
@@ -302,7 +333,8 @@ def build_report(out: StudyOutcome, progress: bool = False) -> list[Block]:
         blocks.append(Block("h2", "Heat maps"))
         blocks.append(Block("p", f"Over {heat[0]} and {heat[1]}"
                                  + (f", one panel per value of {', '.join(heat[2])}" if heat[2] else "") + "."))
-        for m in dict.fromkeys(list(out.objectives) + list(HEADLINE)):
+        targets = [m for t in out.report.targets for m in t.metrics]
+        for m in dict.fromkeys(list(out.objectives) + list(HEADLINE) + targets):
             if m in drawn:
                 fig = P.fig_heatmap(out, m)
                 if fig is not None:

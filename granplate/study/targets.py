@@ -11,7 +11,7 @@ designs are judged against (docs/studies.md).
     where = {"layout.intruder_material" = "steel"}      # the designs it applies to
 
 The designs are grouped by the *choices*: the parameters that no target's `where`
-names. Within a group, a target takes the design that matches its `where` and holds when
+names (nor zipped with one it names). Within a group, a target takes the design that matches its `where` and holds when
 |v / value - 1| <= within for its metric (for one of the alternatives, when several are
 given: e.g. two ways to sample the same quantity). A group meets the targets when every
 target holds: `judge` returns one row per group.
@@ -144,10 +144,22 @@ def _verdict(target: Target, rows: list[tuple[int, dict[str, Any], dict[str, Any
     return Verdict(None, target.metrics[0], None, None)
 
 
-def choices(targets: tuple[Target, ...], names: tuple[str, ...]) -> tuple[str, ...]:
-    """The parameters no target's `where` names: what a group of designs shares."""
-    named = {k for t in targets for k, _ in t.where}
-    return tuple(n for n in names if n not in named)
+def choices(targets: tuple[Target, ...], names: tuple[str, ...],
+            designs: list[dict[str, Any]] = ()) -> tuple[str, ...]:
+    """The parameters no target's `where` names, nor follow from those it names (a
+    parameter zipped with them): what a group of designs shares."""
+    named = [k for t in targets for k, _ in t.where]
+    named = list(dict.fromkeys(named))
+
+    def tied(n: str) -> bool:
+        seen: dict[tuple, str] = {}
+        for p in designs:
+            k = tuple(str(p.get(m)) for m in named)
+            if seen.setdefault(k, str(p.get(n))) != str(p.get(n)):
+                return False
+        return bool(named) and bool(designs)
+
+    return tuple(n for n in names if n not in named and not tied(n))
 
 
 def judge(targets: tuple[Target, ...], names: tuple[str, ...], designs: list[dict[str, Any]],
@@ -155,7 +167,7 @@ def judge(targets: tuple[Target, ...], names: tuple[str, ...], designs: list[dic
     """One row per group of designs sharing the choice parameters (in design order):
     (the choices' values, one Verdict per target). designs[i]: design i's parameter
     values; values[i]: its metrics (None where it has none)."""
-    keep = choices(targets, names)
+    keep = choices(targets, names, designs)
     groups: dict[tuple, list[tuple[int, dict, dict]]] = {}
     for i, (p, v) in enumerate(zip(designs, values)):
         groups.setdefault(tuple(str(p.get(n)) for n in keep), []).append((i, p, v))
