@@ -18,7 +18,7 @@ from granplate.errors import ScenarioError
 from granplate.study import design as D
 from granplate.study import plots as P
 from granplate.study.outcome import read_outcome
-from granplate.study.report import FIGURES, PAGE, best_designs, pareto_front, write_report
+from granplate.study.report import FIGURES, PAGE, best_designs, pareto_front, target_designs, write_report
 from granplate.study.spec import parse_study
 from granplate.study.sweep import write_table
 from granplate.study.targets import judge, parse_report_table
@@ -155,7 +155,7 @@ def test_page_is_self_contained_and_holds_the_definition_and_chosen_designs(synt
     out = read_outcome(folder)
     # best ep_max_fraction: the smallest q0 x R2 (design 0); best stress: q0 / R2 least (design 1)
     assert best_designs(out) == {"ep_max_fraction": 0, "max_von_mises": 1}
-    assert "Best ep_max_fraction (minimize): design 0" in page
+    assert "Design 0: best ep_max_fraction (minimize)" in page and "Design 1: best max_von_mises (minimize)" in page
     for i in (0, 1):
         stem = f"design-{out.rows[i].key[:12]}"
         assert (folder / FIGURES / f"{stem}-assembly.png").is_file()
@@ -235,3 +235,16 @@ def test_report_table_mistakes_name_the_field(table, field):
     with pytest.raises(ScenarioError) as err:
         parse_report_table(table, ("load.q0",))
     assert err.value.field == field
+
+
+def test_page_judges_the_targets_and_draws_the_designs_that_meet_them(tmp_path):
+    synthetic(tmp_path)
+    # ep_max_fraction = q0 / 1e4 x R2 is 0.1 only for (q0 2000, R2 0.5): design 2
+    (tmp_path / "study.toml").write_text(STUDY_TOML + '[report]\nconclusion = "Only one."\n'
+                                         '[[report.targets]]\nmetric = "ep_max_fraction"\nvalue = 0.1\n'
+                                         'within = 0.01\nwhere = {"layout.R2_ratio" = 0.5}\n')
+    out = read_outcome(tmp_path)
+    assert target_designs(out) == [2]
+    page = write_report(tmp_path).read_text()
+    assert "1 of 3 combinations meet every target" in page and "<p>Only one.</p>" in page
+    assert "Design 2: meets the targets" in page

@@ -92,8 +92,11 @@ def candidates(out: StudyOutcome) -> list[int]:
 
 
 def best_designs(out: StudyOutcome) -> dict[str, int]:
-    """metric -> the row of the best feasible design for it (`directions`)."""
-    best = {}
+    """metric -> the row of the best feasible design for it (`directions`); none for a
+    study judged by targets without objectives (its designs are those of the targets)."""
+    best: dict[str, int] = {}
+    if out.report.targets and not out.objectives:
+        return best
     for m, way in directions(out).items():
         rows = [(v, i) for i in candidates(out) if math.isfinite(v := float(out.metric(m)[i]))]
         if rows:
@@ -200,6 +203,37 @@ def same_design(out: StudyOutcome) -> dict[int, int]:
     return {i: first.setdefault(r.key, i) if r.key else i for i, r in enumerate(out.rows)}
 
 
+def _with_unit(v: Any, unit: str) -> str:
+    """'4000 N/m', '15.3 MPa', 'ptfe' (no unit for a dimensionless or text value)."""
+    shown_unit = P.shown(unit)[1]
+    text = fmt(v, unit)
+    return text if shown_unit == "-" or not isinstance(v, (int, float)) or isinstance(v, bool) else f"{text} {shown_unit}"
+
+
+def target_designs(out: StudyOutcome) -> list[int]:
+    """The rows the targets took in the first combination of choices that meets every
+    target ([] without targets, or when none does)."""
+    if not out.report.targets:
+        return []
+    values = [r.metrics if r.ok else {} for r in out.rows]
+    for _, verdicts in judge(out.report.targets, out.names, [r.params for r in out.rows], values):
+        if all(v.holds for v in verdicts):
+            return list(dict.fromkeys(v.design for v in verdicts))
+    return []
+
+
+def chosen_designs(out: StudyOutcome, best: dict[str, int]) -> dict[int, str]:
+    """row -> why it is drawn: best for which objectives (directions), or meeting every
+    target; each design once."""
+    picks: dict[int, list[str]] = {}
+    for m, i in best.items():
+        picks.setdefault(i, []).append(m)
+    out_ = {i: "best " + ", ".join(f"{m} ({directions(out)[m]})" for m in ms) for i, ms in picks.items()}
+    for i in target_designs(out):
+        out_[i] = (out_[i] + "; " if i in out_ else "") + "meets the targets with the other designs of its combination"
+    return out_
+
+
 def _designs_table(out: StudyOutcome, metrics: list[str], chosen: dict[str, int], front: list[int]) -> Block:
     wanted = (set(out.objectives) | {b.metric for b in out.constraints} | set(TABLE_METRICS)
               | {m for t in out.report.targets for m in t.metrics})
@@ -229,7 +263,7 @@ def _targets(out: StudyOutcome) -> list[Block]:
     t = out.report
     if not t.targets and not t.conclusion:
         return []
-    blocks = [Block("h2", "Targets and conclusion")]
+    blocks = [Block("h2", "Targets and conclusion" if t.targets else "Conclusion")]
     if t.targets:
         designs = [r.params for r in out.rows]
         values = [r.metrics if r.ok else {} for r in out.rows]
@@ -242,7 +276,8 @@ def _targets(out: StudyOutcome) -> list[Block]:
         blocks.append(Block("p", "Each row is one combination of the choices (the parameters no target "
                                  "restricts); a target takes the design of the row that matches it, and "
                                  "holds when its metric (the closest of its alternatives) is within the "
-                                 "tolerance:\n" + "\n".join(lines)))
+                                 "tolerance:"))
+        blocks.append(Block("p", "\n".join(lines)))
         header = tuple(_head(out, n) for n in keep)
         for k in range(len(t.targets)):
             header += (f"target {k + 1}: metric", f"target {k + 1}: value", f"target {k + 1}: holds")
@@ -258,8 +293,9 @@ def _targets(out: StudyOutcome) -> list[Block]:
             body.append(cells + ("pass" if every else "FAIL",))
         blocks.append(Block("table", header=header, rows=tuple(body)))
         blocks.append(Block("p", f"**{n_all} of {len(rows_)} combinations meet every target.**"))
-    if t.conclusion:
+    if t.conclusion and t.targets:
         blocks.append(Block("h3", "Conclusion"))
+    if t.conclusion:
         for para in t.conclusion.split("\n\n"):
             blocks.append(Block("p", para.strip()))
     return blocks
@@ -293,9 +329,9 @@ def build_report(out: StudyOutcome, progress: bool = False) -> list[Block]:
                              + (f"; {n_bad} infeasible (constraints)" if out.constraints else "")
                              + f". Made by granplate {gp.__version__} from the records of granplate "
                              f"{out.version or '?'}; the figures are PNG files in `{FIGURES}/` beside this "
-                             "page; the whole table is `results.csv` (a sweep) or `trials.csv` (an "
-                             "optimisation). Metrics are those of the run summary (docs/output.md), with "
-                             "their units; Pa are shown in MPa, dimensionless quantities as [-]."))
+                             f"page; the whole table is `{'trials.csv' if out.kind == 'optimization' else 'results.csv'}`."
+                             " Metrics are those of the run summary (docs/output.md), with their units; Pa "
+                             "are shown in MPa, dimensionless quantities as [-]."))
     blocks += _definition(out)
     drawn, left = shown_metrics(out)
     chosen = best_designs(out)
@@ -340,20 +376,31 @@ def build_report(out: StudyOutcome, progress: bool = False) -> list[Block]:
                 if fig is not None:
                     blocks.append(Block("figure", f"{m} [{P.shown(out.unit(m))[1]}] over {heat[0]} and {heat[1]}",
                                         path=_save(fig, fig_dir / f"heatmap-{m}.png")))
-    if chosen:
+    picks = chosen_designs(out, chosen)
+    if picks:
         blocks.append(Block("h2", "Chosen designs"))
-        blocks.append(Block("p", "The best feasible design for each "
-                                 + ("objective" if out.objectives else "headline metric")
-                                 + "; its figures are drawn from its full result (re-run when the study "
-                                 "did not keep it, `--full`)."))
-        for m, i in chosen.items():
+        blocks.append(Block("p", ("the best feasible design for each "
+                                  + ("objective" if out.objectives else "headline metric") if chosen else "")
+                                 + (("; " if chosen else "") + "the designs of the first combination that "
+                                    "meets every target" if any("meets" in w for w in picks.values()) else "")
+                                 + "; their figures are drawn from their full results (re-run when the "
+                                 "study did not keep them, `--full`)."))
+        intro = blocks[-1].text
+        blocks[-1] = Block("p", intro[:1].upper() + intro[1:])
+        for i, why in picks.items():
             r = out.rows[i]
-            blocks.append(Block("h3", f"Best {m} ({directions(out)[m]}): design {r.number}"))
-            blocks.append(Block("p", ", ".join(f"{n} = {fmt(r.params.get(n), out.unit(n))} "
-                                               f"{P.shown(out.unit(n))[1]}" for n in out.names)
-                                + f"; {m} = {fmt(r.metrics.get(m), out.unit(m))} {P.shown(out.unit(m))[1]}."))
+            blocks.append(Block("h3", f"Design {r.number}: {why}"))
+            metrics = [m for m in dict.fromkeys(list(directions(out)) + [m for t in out.report.targets
+                                                                      for m in t.metrics]) if m in r.metrics]
+            blocks.append(Block("p", ", ".join(f"{n} = {_with_unit(r.params.get(n), out.unit(n))}" for n in out.names)
+                                + "; " + ", ".join(f"{m} = {_with_unit(r.metrics.get(m), out.unit(m))}"
+                                                   for m in metrics) + "."))
             for name, path in design_figures(out.folder, r.key, progress):
                 blocks.append(Block("figure", f"design {r.number}: {name}", path=path))
+    drawn_keys = {out.rows[i].key[:12] for i in picks}
+    for old in fig_dir.glob("design-*.png"):  # designs no longer chosen
+        if old.name.split("-")[1] not in drawn_keys:
+            old.unlink()
     blocks += _failures(out)
     return blocks
 
