@@ -96,6 +96,12 @@ def test_infeasible_trial_is_left_off_the_front_and_reported(records, tmp_path):
         f'[constraints]\n"granular_mass" = {{min = {(steel + ptfe) / 2!r}}}\n')
     out = read_outcome(tmp_path)
     assert out.kind == "optimization" and [r.feasible for r in out.rows] == [True, False]
+    # ... and its page: the front is the feasible trial, the other one marked infeasible
+    from granplate.study.report import FIGURES, write_report
+
+    page = write_report(tmp_path).read_text()
+    assert "1 infeasible (constraints)" in page and "On the front: trial 0." in page
+    assert (tmp_path / FIGURES / "pareto-front.png").is_file()
 
 
 @pytest.mark.parametrize("table, field, words", [

@@ -160,14 +160,17 @@ def _read_trials(folder: Path, doc: dict) -> StudyOutcome:
     names = tuple(header[2:end])
     col = {h: j for j, h in enumerate(header)}
     keys = [r[col["key"]] if "key" in col else "" for r in body]
-    summaries = [_summary(folder, k) for k in keys]
+    summaries = []
+    for r, k in zip(body, keys):
+        s = _summary(folder, k)
+        if r[col["state"]] == "COMPLETE" and not s:  # told, but its record is not here
+            s = {m: _value(r[col[m]]) for m in header[end:] if m in known and r[col[m]] != ""}
+        summaries.append(s)
     metrics, units = _metrics_of(summaries)
     rows = []
     for r, k, s in zip(body, keys, summaries):
         state = r[col["state"]]
         status = r[col["status"]] or ("not run" if state != "COMPLETE" else "ok")
-        if state == "COMPLETE" and status == "ok" and not s:  # told, but its record is gone
-            s = {m: _value(r[col[m]]) for m in header[end:] if m in known and r[col[m]] != ""}
         feasible = {"yes": True, "no": False}.get(r[col["feasible"]]) if "feasible" in col else None
         rows.append(Row(int(r[0]), {n: _value(r[col[n]]) for n in names if r[col[n]] != ""},
                         {m: s.get(m) for m in metrics} if s else {}, status, k, feasible))
