@@ -111,7 +111,7 @@ def _short(v: Any) -> str:
 def fig_metric(out: StudyOutcome, metric: str) -> Figure:
     """The metric against each varied parameter, one panel each. On a grid, the designs
     that share the other parameters are joined by a line, coloured by the value of the
-    other parameter with the fewest values (the legend); otherwise each design is a
+    other parameter with the fewest values (text before numbers; the legend); otherwise each design is a
     point. Infeasible designs are crosses."""
     names = varied(out) or list(out.names[:1])
     factor, _ = shown(out.unit(metric))
@@ -126,7 +126,9 @@ def fig_metric(out: StudyOutcome, metric: str) -> Figure:
         others = [n for n in names if n != name]
         if grid and others:
             # one line per combination of the others, coloured by the one with fewest values
-            hue = min(others, key=lambda n: (len(distinct(out.values(n))), others.index(n)))
+            # (a named choice, such as a material, before a number)
+            hue = min(others, key=lambda n: (len(distinct(out.values(n))), is_numeric(out.values(n)),
+                                             others.index(n)))
             colours = {str(v): f"C{k % 10}" for k, v in enumerate(distinct(out.values(hue)))}
             groups: dict[tuple, list[int]] = {}
             for i, r in enumerate(out.rows):
