@@ -1,12 +1,35 @@
 """`granplate sweep STUDY.toml --out DIR`: run a study's designs on Dask;
-`granplate optimize STUDY.toml --out DIR --trials N`: search its parameters with Optuna
-(docs/studies.md)."""
+`granplate optimize STUDY.toml --out DIR --trials N`: search its parameters with Optuna;
+`granplate study report DIR`: the study's report page (docs/studies.md). Sweep and
+optimize keep the study file as DIR/study.toml and end by writing the report."""
 from __future__ import annotations
 
+import shutil
 import sys
+from pathlib import Path
 
 #: Lost designs listed one by one (a lost scheduler loses every design not done).
 MAX_LOST_LINES = 5
+
+
+def keep_study_file(study_file: str, out: str) -> None:
+    """Copy the study file into the output folder (DIR/study.toml) for the report."""
+    from granplate.study.outcome import STUDY_FILE
+
+    Path(out).mkdir(parents=True, exist_ok=True)
+    target = Path(out) / STUDY_FILE
+    if Path(study_file).resolve() != target.resolve():
+        shutil.copyfile(study_file, target)
+
+
+def _report(out: str, enabled: bool, progress: bool) -> None:
+    """Write the study report (unless --no-report) and say where it is."""
+    if not enabled:
+        return
+    from granplate.study.report import write_report
+
+    page = write_report(out, progress=progress)
+    print(f"report: {page}")
 
 
 def _cmd_sweep(args) -> int:
@@ -14,6 +37,7 @@ def _cmd_sweep(args) -> int:
     from granplate.study.sweep import RESULTS_CSV, RESULTS_NC, sweep
 
     study = load_study(args.study)
+    keep_study_file(args.study, args.out)
     if args.workers is not None and args.workers < 1:
         print(f"granplate: error: --workers = {args.workers}: must be >= 1", file=sys.stderr)
         return 2
@@ -35,6 +59,7 @@ def _cmd_sweep(args) -> int:
     if len(report.lost) > MAX_LOST_LINES:
         print(f"... and {len(report.lost) - MAX_LOST_LINES} more lost designs", file=sys.stderr)
     print(f"table: {report.out / RESULTS_NC}, {report.out / RESULTS_CSV}")
+    _report(args.out, args.report, not args.quiet)
     return 0 if not report.lost else 1
 
 
@@ -46,6 +71,7 @@ def _cmd_optimize(args) -> int:
         if value is not None and value < 1:
             print(f"granplate: error: {name} = {value}: must be >= 1", file=sys.stderr)
             return 2
+    keep_study_file(args.study, args.out)
     print(f"optimize {', '.join(f'{k} ({v})' for k, v in opt.objectives.items())} over "
           f"{', '.join(opt.space)} of {opt.base_name} -> {args.out}", file=sys.stderr)
     try:
@@ -59,6 +85,12 @@ def _cmd_optimize(args) -> int:
           f"from existing designs: {report.n_reused}, failed: {report.n_failed}; {report.elapsed_s:.1f} s")
     out = report.out
     print(f"study: {out / DATABASE}; trials: {out / TRIALS_CSV}; Pareto front: {out / PARETO_CSV}, {out / PARETO_PNG}")
+    _report(args.out, args.report, not args.quiet)
+    return 0
+
+
+def _cmd_report(args) -> int:
+    _report(args.dir, True, not args.quiet)
     return 0
 
 
@@ -68,6 +100,8 @@ def _cluster_options(p) -> None:
     p.add_argument("--scheduler", default=None,
                    help="address of an existing Dask scheduler (e.g. tcp://host:8786) instead of a local cluster")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--no-report", dest="report", action="store_false",
+                   help="do not write the report page at the end (granplate study report DIR does)")
 
 
 def register(sub) -> None:
@@ -88,3 +122,10 @@ def register(sub) -> None:
     o.add_argument("--seed", type=int, default=0, help="seed of the sampler (TPE)")
     _cluster_options(o)
     o.set_defaults(func=_cmd_optimize)
+    st = sub.add_parser("study", help="about a study's output folder: its report page")
+    sst = st.add_subparsers(dest="study_command", required=True)
+    r = sst.add_parser("report", help="write DIR/report.html (and its PNG figures in DIR/report/) "
+                                      "from a sweep's or an optimisation's folder")
+    r.add_argument("dir", help="the study's output folder (--out of granplate sweep / optimize)")
+    r.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
+    r.set_defaults(func=_cmd_report)

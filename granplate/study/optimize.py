@@ -9,13 +9,19 @@ The study file is a sweep's (base, [set], [parameters]) with an [objectives] tab
     [objectives]                                    #   categorical
     "ep_max_fraction" = "minimize"
     "granular_mass" = "minimize"
+    [constraints]                                   # optional: bounds on metrics
+    "granular_mass" = {max = 0.02}
 
 Optuna's ask/tell interface drives the search: the driver asks for trials, one per free
 worker, runs each as a design on the cluster and tells its metrics back. The Optuna study
 lives in DIR/optuna.db (SQLite), so a rerun continues it up to --trials; each design also
 gets its record in DIR/designs (a trial whose design was already computed, here or by a
 sweep into the same folder, is not computed again). Trials cut short by an interruption
-are marked failed on the next run and their parameters queued again.
+are marked failed on the next run and their parameters queued again. Constraints
+(granplate.study.constraints) are told to Optuna with the trial: `Trial.set_constraint`
+from Optuna 5 on, the sampler's `constraints_func` before (deprecated in 5); an
+infeasible trial is complete but marked infeasible, and the Pareto front is that of the
+feasible trials.
 """
 from __future__ import annotations
 
@@ -26,17 +32,18 @@ import os
 import sys
 import time
 from contextlib import nullcontext
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import granplate as gp
 from granplate.errors import ScenarioError
 from granplate.study import design as D
+from granplate.study.constraints import Bound, is_feasible, parse_constraints, violations
 from granplate.study.spec import Value, base_and_fixed, check_document, range_values
 
 #: Top-level keys of an optimisation's study file ([zip] and sampled parameters are a sweep's).
-OPTIMIZE_KEYS: tuple[str, ...] = ("base", "set", "parameters", "objectives")
+OPTIMIZE_KEYS: tuple[str, ...] = ("base", "set", "parameters", "objectives", "constraints", "report")
 #: Directions of an objective.
 DIRECTIONS: tuple[str, ...] = ("minimize", "maximize")
 #: Files in the output folder.
@@ -51,13 +58,15 @@ STUDY_NAME = "granplate"
 @dataclass(frozen=True)
 class Optimization:
     """What to search: the base, fixed changes, the search space {dotted path: Optuna
-    distribution} and the objectives {metric: "minimize" | "maximize"}, in file order."""
+    distribution}, the objectives {metric: "minimize" | "maximize"}, in file order, and
+    the constraints (bounds on metrics; none: every completed trial is feasible)."""
 
     base_name: str
     raw_base: Any
     fixed: dict[str, Value]
     space: dict[str, Any]
     objectives: dict[str, str]
+    constraints: tuple[Bound, ...] = field(default=())
 
     def scenario(self, params: dict[str, Value]):
         """The scenario of a trial's parameters (shape-checked, not validated)."""
@@ -128,7 +137,11 @@ def parse_optimization(doc: dict, folder: str | os.PathLike = ".") -> Optimizati
             raise ScenarioError(f"objectives.{name}", direction, "unknown metric; allowed: " + ", ".join(units))
         if direction not in DIRECTIONS:
             raise ScenarioError(f"objectives.{name}", direction, "allowed: " + ", ".join(DIRECTIONS))
-    opt = Optimization(str(doc["base"]), raw, fixed, space, dict(objectives))
+    constraints = parse_constraints(doc.get("constraints"), units)
+    from granplate.study.targets import parse_report_table
+
+    parse_report_table(doc.get("report"), tuple(space))
+    opt = Optimization(str(doc["base"]), raw, fixed, space, dict(objectives), constraints)
     for f, dist in space.items():  # an unknown path or a value of the wrong type, now
         values = dist.choices if hasattr(dist, "choices") else (dist.low, dist.high)
         for v in values:
@@ -157,20 +170,42 @@ def objective_values(opt: Optimization, record: dict) -> list[float] | None:
     return [float(v) for v in values]
 
 
+def stored_constraints(trial) -> list[float]:
+    """The sampler's constraints_func: the constraint values `tell` stored on the trial."""
+    return list(trial.user_attrs.get("constraints", []))
+
+
+def trial_constraints() -> bool:
+    """Whether Optuna takes constraints from the trial (Trial.set_constraint, Optuna >= 5)
+    rather than from the sampler's constraints_func."""
+    from optuna.trial import Trial
+
+    return hasattr(Trial, "set_constraint")
+
+
+def constraint_texts(opt: Optimization) -> list[str]:
+    """The constraints as text with units ('granular_mass <= 0.02 kg')."""
+    units = D.metric_units()
+    return [b.text(units.get(b.metric, "")) for b in opt.constraints]
+
+
 def open_study(opt: Optimization, out: Path, seed: int):
     """The Optuna study in out/optuna.db (created, or loaded to continue it)."""
     import optuna
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
+    by_sampler = bool(opt.constraints) and not trial_constraints()
+    sampler = optuna.samplers.TPESampler(seed=seed, constraints_func=stored_constraints if by_sampler else None)
     study = optuna.create_study(storage=f"sqlite:///{out / DATABASE}", study_name=STUDY_NAME,
                                 directions=list(opt.objectives.values()), load_if_exists=True,
-                                sampler=optuna.samplers.TPESampler(seed=seed))
-    stored = study.user_attrs.get("objectives")
-    if stored is None:
-        study.set_user_attr("objectives", list(opt.objectives))
-    elif stored != list(opt.objectives):
-        raise ScenarioError("objectives", list(opt.objectives), f"{out / DATABASE} optimizes "
-                            f"{stored}: use another --out folder for other objectives")
+                                sampler=sampler)
+    for name, value in (("objectives", list(opt.objectives)), ("constraints", constraint_texts(opt))):
+        stored = study.user_attrs.get(name)
+        if stored is None:
+            study.set_user_attr(name, value)
+        elif stored != value:
+            raise ScenarioError(name, value, f"{out / DATABASE} was made with {name} {stored}: use "
+                                f"another --out folder for other {name}")
     return study
 
 
@@ -201,6 +236,14 @@ def tell(study, opt: Optimization, trial, record: dict) -> bool:
     trial.set_user_attr("key", record["key"])
     trial.set_user_attr("status", record["status"])
     values = objective_values(opt, record)
+    if values is not None and opt.constraints:
+        summary = record["summary"]
+        values_c = violations(opt.constraints, summary)
+        trial.set_user_attr("constraints", values_c)
+        trial.set_user_attr("constrained", {b.metric: summary.get(b.metric) for b in opt.constraints})
+        if trial_constraints():
+            for k, v in enumerate(values_c):
+                trial.set_constraint(f"c{k}", v)
     if values is None:
         study.tell(trial, state=TrialState.FAIL)
         return False
@@ -298,12 +341,28 @@ def _search(client, study, opt: Optimization, out: Path, trials: int, progress: 
 
 # ------------------------------------------------------------------------- outputs
 
+def constrained_only(opt: Optimization) -> list[str]:
+    """The constrained metrics that are not objectives (their own columns in the CSVs)."""
+    return list(dict.fromkeys(b.metric for b in opt.constraints if b.metric not in opt.objectives))
+
+
+def feasible_text(trial) -> str:
+    """"yes" / "no" for a completed trial of a constrained study, "" otherwise."""
+    ok = is_feasible(trial.user_attrs.get("constraints")) if trial.values is not None else None
+    return "" if ok is None else ("yes" if ok else "no")
+
+
 def _rows(study, opt: Optimization, trials) -> tuple[list[str], list[list[Any]]]:
-    header = ["trial", "state"] + list(opt.space) + list(opt.objectives) + ["status", "key"]
+    extra = constrained_only(opt)
+    header = (["trial", "state"] + list(opt.space) + list(opt.objectives) + extra
+              + (["feasible"] if opt.constraints else []) + ["status", "key"])
     rows = []
     for t in trials:
         values = list(t.values) if t.values is not None else [None] * len(opt.objectives)
+        constrained = t.user_attrs.get("constrained", {})
         rows.append([t.number, t.state.name] + [t.params.get(f) for f in opt.space] + values
+                    + [constrained.get(m) for m in extra]
+                    + ([feasible_text(t)] if opt.constraints else [])
                     + [t.user_attrs.get("status", ""), t.user_attrs.get("key", "")])
     return header, rows
 
@@ -323,8 +382,17 @@ def _write_csv(path: Path, header: list[str], rows: list[list[Any]]) -> None:
 
 def pareto_trials(study) -> list:
     """The completed trials no other completed trial dominates (the best one for a single
-    objective), by trial number."""
+    objective), by trial number; with constraints, among the feasible trials only."""
     return sorted(study.best_trials, key=lambda t: t.number)
+
+
+def excluded_trials(study, complete: list) -> list:
+    """The infeasible trials that no other completed trial dominates, feasible or not: the
+    better compromises the constraints rule out (none without constraints), by number."""
+    from optuna.study._multi_objective import _get_pareto_front_trials_by_trials
+
+    front = _get_pareto_front_trials_by_trials(complete, study.directions, consider_constraint=False)
+    return sorted((t for t in front if feasible_text(t) == "no"), key=lambda t: t.number)
 
 
 def write_outputs(study, opt: Optimization, out: Path) -> None:
@@ -335,7 +403,8 @@ def write_outputs(study, opt: Optimization, out: Path) -> None:
     _write_csv(out / TRIALS_CSV, *_rows(study, opt, all_trials))
     complete = [t for t in all_trials if t.state == TrialState.COMPLETE]
     front = pareto_trials(study) if complete else []
-    _write_csv(out / PARETO_CSV, *_rows(study, opt, front))
+    excluded = excluded_trials(study, complete) if complete and opt.constraints else []
+    _write_csv(out / PARETO_CSV, *_rows(study, opt, front + excluded))
     if complete:
         plot_front(opt, complete, front, out / PARETO_PNG)
 
@@ -357,9 +426,14 @@ def plot_front(opt: Optimization, complete: list, front: list, path: Path) -> No
 
     names = list(opt.objectives)
     fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    bad = [t for t in complete if feasible_text(t) == "no"]
+    complete = [t for t in complete if feasible_text(t) != "no"]
     if len(names) >= 2:
         ax.scatter([t.values[0] for t in complete], [t.values[1] for t in complete], s=14,
                    color="0.7", label="trials")
+        if bad:
+            ax.scatter([t.values[0] for t in bad], [t.values[1] for t in bad], s=18, marker="x",
+                       color="0.45", label="infeasible (constraints)")
         pts = sorted((t.values[0], t.values[1]) for t in front)
         ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", color="C3", ms=5, label="Pareto front")
         ax.set_xlabel(f"{axis_label(names[0])} ({opt.objectives[names[0]]})")
@@ -367,10 +441,13 @@ def plot_front(opt: Optimization, complete: list, front: list, path: Path) -> No
     else:
         ax.plot([t.number for t in complete], [t.values[0] for t in complete], "o", color="0.6",
                 ms=4, label="trials")
+        if bad:
+            ax.plot([t.number for t in bad], [t.values[0] for t in bad], "x", color="0.45",
+                    label="infeasible (constraints)")
         ax.plot([t.number for t in front], [t.values[0] for t in front], "o", color="C3", label="best")
         ax.set_xlabel("trial")
         ax.set_ylabel(f"{axis_label(names[0])} ({opt.objectives[names[0]]})")
-    ax.set_title(f"{opt.base_name}: {len(complete)} trials", fontsize=10)
+    ax.set_title(f"{opt.base_name}: {len(complete) + len(bad)} trials", fontsize=10)
     ax.legend(fontsize=8)
     fig.tight_layout()
     atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=120, format="png"))

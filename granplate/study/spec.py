@@ -33,7 +33,8 @@ import granplate as gp
 from granplate.errors import ScenarioError
 
 #: Top-level keys of a study file.
-STUDY_KEYS: tuple[str, ...] = ("base", "set", "parameters", "zip", "objectives")
+STUDY_KEYS: tuple[str, ...] = ("base", "set", "parameters", "zip", "objectives", "constraints",
+                               "report")
 #: Keys of a range form {range = [a, b], num = n, log = false}.
 RANGE_KEYS: tuple[str, ...] = ("range", "num", "log")
 #: Keys of a sample form {sample = METHOD, low, high, n, seed, log = false}.
@@ -51,7 +52,7 @@ class Study:
     base_name: the preset name or the file as written in the study; raw_base: that
     scenario (validated); fixed: the [set] changes; names: the varied dotted paths, in study
     order; designs: one tuple of values per design (in the order of names); extra: the
-    other top-level tables (objectives).
+    other top-level tables (objectives, constraints, report: used by the study report).
     """
 
     base_name: str
@@ -290,6 +291,12 @@ def parse_study(doc: dict, folder: str | os.PathLike = ".") -> Study:
             raise ScenarioError(f, "set and varied", "a field is either fixed in [set] or varied")
         if names.count(f) > 1:
             raise ScenarioError(f, "varied twice", "a field is varied once (in [parameters] or [zip])")
+    from granplate.study.constraints import parse_constraints
+    from granplate.study.design import metric_units
+    from granplate.study.targets import parse_report_table
+
+    parse_constraints(doc.get("constraints"), metric_units())  # used by the report
+    parse_report_table(doc.get("report"), names)
     study = Study(str(doc["base"]), raw, fixed, names, tuple(designs),
                   {k: v for k, v in doc.items() if k not in ("base", "set", "parameters", "zip")})
     for i in range(len(designs)):

@@ -18,7 +18,7 @@ FIELD_UNITS: dict[str, str] = {
     "dt_max": "s", "output_interval": "s", "field_interval": "s", "R1": "m", "R2_ratio": "1",
     "E": "Pa", "nu": "1", "rho": "kg/m^3", "radius": "m", "x": "m", "y": "m", "vx": "m/s",
     "vy": "m/s", "width": "m", "height": "m", "thickness": "m", "mu": "1", "nx": "1", "ny": "1",
-    "n_modes": "1",
+    "n_modes": "1", "rigid_layer_width": "m", "column_radii": "m", "alpha_n": "1",
 }
 
 

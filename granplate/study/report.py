@@ -1,0 +1,417 @@
+"""The report of a study: one self-contained HTML page, DIR/report.html, with its figures
+as PNG files beside it in DIR/report/ (docs/studies.md).
+
+The page holds the study's definition (the study file as run), a table of the designs,
+the [report] targets and conclusion when the study has them, the Pareto front (an
+optimisation, or a sweep with [objectives]), one figure per metric against the
+parameters, heat maps over two grid parameters, the chosen designs (the best for each
+objective, with their assembly, energies and stress, re-run in full when their result
+was not kept) and the failures with their messages. It is rendered by
+granplate.results.document, like the reproduction and verification pages.
+
+    >>> from granplate.study.report import write_report
+    >>> write_report("q0-r2")          # -> q0-r2/report.html, q0-r2/report/*.png
+"""
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import granplate as gp
+from granplate.results.document import Block, to_html
+from granplate.study import design as D
+from granplate.study import plots as P
+from granplate.study.outcome import StudyOutcome, read_outcome
+from granplate.study.targets import judge
+
+#: The page and its figure folder inside the study's folder.
+PAGE = "report.html"
+FIGURES = "report"
+#: Metrics of the heat maps and, without [objectives], those whose best design is drawn.
+HEADLINE: tuple[str, ...] = ("ep_max_fraction", "max_von_mises")
+#: Metrics that say how the run went rather than what the design does (figures last).
+RUN_METRICS: tuple[str, ...] = ("t_end", "energy_residual_max", "n_steps", "wall_time_s")
+#: Metrics of the designs table besides the objectives, constraints and targets (the CSV
+#: table has them all).
+TABLE_METRICS: tuple[str, ...] = ("ep_max_fraction", "ep_final_fraction", "dissipated_fraction",
+                                  "max_von_mises", "max_von_mises_nodes", "max_eps_yy", "granular_mass")
+#: Values this small [SI units] are round-off of a quantity that is zero (e_initial of a
+#: run from rest): a metric with no larger value is not drawn.
+NEGLIGIBLE = 1e-30
+#: Most rows of the designs table on the page (results.csv has them all).
+MAX_ROWS = 120
+#: Figures of a chosen design (granplate.figures.run names) besides its assembly.
+DESIGN_FIGURES: tuple[str, ...] = ("energies", "stress-strain")
+
+
+def fmt(v: Any, unit: str = "") -> str:
+    """A value for a table cell: 4 significant digits, Pa shown in MPa."""
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "-"
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return str(v)
+    factor, _ = P.shown(unit)
+    return f"{v * factor:.4g}"
+
+
+def _head(out: StudyOutcome, name: str) -> str:
+    unit = P.shown(out.unit(name))[1]
+    return f"{name} [{unit}]"
+
+
+def shown_metrics(out: StudyOutcome) -> tuple[list[str], list[str]]:
+    """(metrics drawn: some design has a value and they are not all equal, run metrics
+    last; metrics left out as constant or absent)."""
+    drawn, left = [], []
+    for m in out.metrics:
+        v = np.array(out.metric(m))
+        finite = v[np.isfinite(v)]
+        varies = finite.size and np.ptp(finite) > 0 and np.max(np.abs(finite)) > NEGLIGIBLE
+        (drawn if varies else left).append(m)
+    first = list(out.objectives) + list(HEADLINE)
+    drawn.sort(key=lambda m: (m in RUN_METRICS, m not in first, first.index(m) if m in first else 0))
+    return drawn, left
+
+
+# ------------------------------------------------------------------------- choices
+
+def directions(out: StudyOutcome) -> dict[str, str]:
+    """The objectives, else the headline metrics to minimise (those the study has)."""
+    if out.objectives:
+        return dict(out.objectives)
+    return {m: "minimize" for m in HEADLINE if m in out.metrics}
+
+
+def candidates(out: StudyOutcome) -> list[int]:
+    """Rows that completed with metrics and are feasible (or unconstrained)."""
+    return [i for i, r in enumerate(out.rows) if r.ok and r.metrics and r.feasible is not False]
+
+
+def best_designs(out: StudyOutcome) -> dict[str, int]:
+    """metric -> the row of the best feasible design for it (`directions`); none for a
+    study judged by targets without objectives (its designs are those of the targets)."""
+    best: dict[str, int] = {}
+    if out.report.targets and not out.objectives:
+        return best
+    for m, way in directions(out).items():
+        rows = [(v, i) for i in candidates(out) if math.isfinite(v := float(out.metric(m)[i]))]
+        if rows:
+            best[m] = (min(rows) if way == "minimize" else max(rows))[1]
+    return best
+
+
+def pareto_front(out: StudyOutcome) -> list[int]:
+    """Rows of the feasible designs no other feasible design dominates in the objectives
+    (the best one for a single objective); [] without objectives."""
+    names = list(out.objectives)
+    if not names:
+        return []
+    sign = np.array([1.0 if out.objectives[n] == "minimize" else -1.0 for n in names])
+    rows = [i for i in candidates(out) if all(math.isfinite(out.metric(n)[i]) for n in names)]
+    pts = {i: sign * np.array([out.metric(n)[i] for n in names]) for i in rows}
+    return [i for i in rows if not any(np.all(pts[j] <= pts[i]) and np.any(pts[j] < pts[i])
+                                       for j in rows if j != i)]
+
+
+# ------------------------------------------------------------------------- figures
+
+#: Colours of a report PNG (an adaptive palette: a few times smaller than full colour).
+PALETTE = 96
+
+
+def _png(fig, tmp: Path) -> None:
+    """fig as a palette PNG."""
+    import io
+
+    from PIL import Image
+
+    buf = io.BytesIO()
+    fig.savefig(buf, dpi=P.DPI, format="png")
+    image = Image.open(buf).convert("RGB").quantize(PALETTE, method=Image.Quantize.MEDIANCUT)
+    image.save(tmp, format="png", optimize=True)
+
+
+def _save(fig, path: Path) -> Path:
+    from granplate.store import atomic_write
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write(path, lambda tmp: _png(fig, tmp))
+    return path
+
+
+def design_result(folder: Path, key: str, progress: bool = False):
+    """The full result of a design: its kept designs/KEY.nc, else a new run of its
+    scenario (the record's scenario_toml); None when it has no record."""
+    record = D.read_record(folder, key)
+    if record is None:
+        return None
+    nc = D.record_path(folder, key, ".nc")
+    if nc.is_file():
+        return gp.read(nc)
+    if progress:
+        print(f"report: re-running design {key[:12]} for its figures", file=sys.stderr)
+    return gp.simulate(gp.loads(record["scenario_toml"]), progress=False)
+
+
+def design_figures(folder: Path, key: str, progress: bool = False) -> list[tuple[str, Path]]:
+    """(caption, PNG) of a chosen design: its assembly, energies and plate stress, drawn
+    once (kept in DIR/report/ and reused by the next report)."""
+    from granplate.figures import assembly, run, show
+
+    fig_dir = folder / FIGURES
+    stem = f"design-{key[:12]}"
+    names = ("assembly",) + DESIGN_FIGURES
+    existing = [(n, fig_dir / f"{stem}-{n}.png") for n in names if (fig_dir / f"{stem}-{n}.png").is_file()]
+    if (fig_dir / f"{stem}-assembly.png").is_file() and (fig_dir / f"{stem}-energies.png").is_file():
+        return existing
+    ds = design_result(folder, key, progress)
+    if ds is None:
+        return []
+    made = [("assembly", _save(show.draw(assembly.of_scenario(gp.loads(ds.attrs["scenario_toml"])), width=5.0),
+                               fig_dir / f"{stem}-assembly.png"))]
+    for name, fig in run.figures(ds).items():
+        if name in DESIGN_FIGURES:
+            made.append((name, _save(fig, fig_dir / f"{stem}-{name}.png")))
+    return made
+
+
+# ------------------------------------------------------------------------- the page
+
+def _definition(out: StudyOutcome) -> list[Block]:
+    blocks = [Block("h2", "The study")]
+    rows = [("base", out.base or "-", "")]
+    rows += [(f"[set] {k}", str(v), out.unit(k)) for k, v in out.fixed.items()]
+    rows += [(f"parameter {n}", ", ".join(fmt(v, out.unit(n)) for v in P.distinct(out.values(n))),
+              P.shown(out.unit(n))[1]) for n in out.names]
+    rows += [(f"objective {m}", way, P.shown(out.unit(m))[1]) for m, way in out.objectives.items()]
+    rows += [("constraint", b.text(out.unit(b.metric)), "") for b in out.constraints]
+    blocks.append(Block("table", header=("", "value(s)", "unit"), rows=tuple(rows)))
+    if out.study_text:
+        blocks.append(Block("p", "The study file as run (`study.toml` in the study's folder):"))
+        blocks.append(Block("code", out.study_text))
+    return blocks
+
+
+def same_design(out: StudyOutcome) -> dict[int, int]:
+    """row -> the first row of the same design (an optimiser may ask for a design again:
+    the same record, the same numbers)."""
+    first: dict[str, int] = {}
+    return {i: first.setdefault(r.key, i) if r.key else i for i, r in enumerate(out.rows)}
+
+
+def _with_unit(v: Any, unit: str) -> str:
+    """'4000 N/m', '15.3 MPa', 'ptfe' (no unit for a dimensionless or text value)."""
+    shown_unit = P.shown(unit)[1]
+    text = fmt(v, unit)
+    return text if shown_unit == "-" or not isinstance(v, (int, float)) or isinstance(v, bool) else f"{text} {shown_unit}"
+
+
+def target_designs(out: StudyOutcome) -> list[int]:
+    """The rows the targets took in the first combination of choices that meets every
+    target ([] without targets, or when none does)."""
+    if not out.report.targets:
+        return []
+    values = [r.metrics if r.ok else {} for r in out.rows]
+    for _, verdicts in judge(out.report.targets, out.names, [r.params for r in out.rows], values):
+        if all(v.holds for v in verdicts):
+            return list(dict.fromkeys(v.design for v in verdicts))
+    return []
+
+
+def chosen_designs(out: StudyOutcome, best: dict[str, int]) -> dict[int, str]:
+    """row -> why it is drawn: best for which objectives (directions), or meeting every
+    target; each design once."""
+    picks: dict[int, list[str]] = {}
+    for m, i in best.items():
+        picks.setdefault(i, []).append(m)
+    out_ = {i: "best " + ", ".join(f"{m} ({directions(out)[m]})" for m in ms) for i, ms in picks.items()}
+    for i in target_designs(out):
+        out_[i] = (out_[i] + "; " if i in out_ else "") + "meets the targets with the other designs of its combination"
+    return out_
+
+
+def _designs_table(out: StudyOutcome, metrics: list[str], chosen: dict[str, int], front: list[int]) -> Block:
+    wanted = (set(out.objectives) | {b.metric for b in out.constraints} | set(TABLE_METRICS)
+              | {m for t in out.report.targets for m in t.metrics})
+    cols = [m for m in metrics if m in wanted]
+    header = ("design",) + tuple(_head(out, n) for n in out.names) + tuple(_head(out, m) for m in cols)
+    header += (("feasible",) if out.constraints else ()) + ("status",)
+    first = same_design(out)
+    marks = {i: [f"best {m}" for m, j in chosen.items() if first[j] == i]
+             + (["front"] if any(first[j] == i for j in front) else []) for i in range(len(out.rows))}
+    repeats = {i: sum(1 for j in first.values() if j == i) for i in set(first.values())}
+    rows = []
+    for i, r in enumerate(out.rows):
+        if first[i] != i:
+            continue  # a trial of a design listed above
+        if len(rows) == MAX_ROWS:
+            break
+        name = str(r.number) + (f" (x{repeats[i]} trials)" if repeats[i] > 1 else "") \
+            + (f" ({', '.join(marks[i])})" if marks[i] else "")
+        rows.append((name,) + tuple(fmt(r.params.get(n), out.unit(n)) for n in out.names)
+                    + tuple(fmt(r.metrics.get(m), out.unit(m)) for m in cols)
+                    + (({True: "yes", False: "no", None: "-"}[r.feasible],) if out.constraints else ())
+                    + ("ok" if r.ok else "failed" if r.status != "not run" else "not run",))
+    return Block("table", header=header, rows=tuple(rows))
+
+
+def _targets(out: StudyOutcome) -> list[Block]:
+    t = out.report
+    if not t.targets and not t.conclusion:
+        return []
+    blocks = [Block("h2", "Targets and conclusion" if t.targets else "Conclusion")]
+    if t.targets:
+        designs = [r.params for r in out.rows]
+        values = [r.metrics if r.ok else {} for r in out.rows]
+        rows_ = judge(t.targets, out.names, designs, values)
+        keep = list(rows_[0][0]) if rows_ else []
+        lines = [f"- **{x.label}**: {' or '.join(x.metrics)} within {100 * x.within:.0f}% of "
+                 f"{fmt(x.value, out.unit(x.metrics[0]))} {P.shown(out.unit(x.metrics[0]))[1]}"
+                 + (f", for {', '.join(f'{k} = {v}' for k, v in x.where)}" if x.where else "")
+                 for x in t.targets]
+        blocks.append(Block("p", "Each row is one combination of the choices (the parameters no target "
+                                 "restricts); a target takes the design of the row that matches it, and "
+                                 "holds when its metric (the closest of its alternatives) is within the "
+                                 "tolerance:"))
+        blocks.append(Block("p", "\n".join(lines)))
+        header = tuple(_head(out, n) for n in keep)
+        for k in range(len(t.targets)):
+            header += (f"target {k + 1}: metric", f"target {k + 1}: value", f"target {k + 1}: holds")
+        header += ("result",)
+        body, n_all = [], 0
+        for params, verdicts in rows_:
+            every = all(v.holds for v in verdicts)
+            n_all += every
+            cells = tuple(fmt(params[n], out.unit(n)) for n in keep)
+            for x, v in zip(t.targets, verdicts):
+                cells += (v.metric, f"{fmt(v.value, out.unit(v.metric))} {P.shown(out.unit(v.metric))[1]}",
+                          {True: "yes", False: "no", None: "-"}[v.holds])
+            body.append(cells + ("pass" if every else "FAIL",))
+        blocks.append(Block("table", header=header, rows=tuple(body)))
+        blocks.append(Block("p", f"**{n_all} of {len(rows_)} combinations meet every target.**"))
+    if t.conclusion and t.targets:
+        blocks.append(Block("h3", "Conclusion"))
+    if t.conclusion:
+        for para in t.conclusion.split("\n\n"):
+            blocks.append(Block("p", para.strip()))
+    return blocks
+
+
+def _failures(out: StudyOutcome) -> list[Block]:
+    bad = [r for r in out.rows if not r.ok]
+    blocks = [Block("h2", "Failures")]
+    if not bad:
+        return blocks + [Block("p", "None: every design ran to its end.")]
+    blocks.append(Block("p", f"{len(bad)} of {len(out.rows)} designs have no result: the message is the "
+                             "failure's (or \"not run\": not computed yet, rerun the same command)."))
+    blocks.append(Block("table", header=("design",) + out.names + ("message",),
+                        rows=tuple((str(r.number),) + tuple(fmt(r.params.get(n)) for n in out.names)
+                                   + (r.status,) for r in bad)))
+    return blocks
+
+
+def build_report(out: StudyOutcome, progress: bool = False) -> list[Block]:
+    """The report's blocks; its figures are written to DIR/report/ on the way."""
+    fig_dir = out.folder / FIGURES
+    for stale in (*fig_dir.glob("metric-*.png"), *fig_dir.glob("heatmap-*.png"), fig_dir / "pareto-front.png"):
+        stale.unlink(missing_ok=True)  # drawn again below, or no longer part of the study
+    n_ok = sum(r.ok for r in out.rows)
+    n_failed = sum(not r.ok and r.status != "not run" for r in out.rows)
+    n_bad = sum(r.feasible is False for r in out.rows)
+    what = "optimisation" if out.kind == "optimization" else "sweep"
+    blocks = [Block("h1", f"Study report: {out.folder.name} ({what} of {out.base or 'a scenario'})")]
+    blocks.append(Block("p", f"{len(out.rows)} {'trials' if out.kind == 'optimization' else 'designs'}: "
+                             f"{n_ok} ran, {n_failed} failed, {len(out.rows) - n_ok - n_failed} not run"
+                             + (f"; {n_bad} infeasible (constraints)" if out.constraints else "")
+                             + f". Made by granplate {gp.__version__} from the records of granplate "
+                             f"{out.version or '?'}; the figures are PNG files in `{FIGURES}/` beside this "
+                             f"page; the whole table is `{'trials.csv' if out.kind == 'optimization' else 'results.csv'}`."
+                             " Metrics are those of the run summary (docs/output.md), with their units; Pa "
+                             "are shown in MPa, dimensionless quantities as [-]."))
+    blocks += _definition(out)
+    drawn, left = shown_metrics(out)
+    chosen = best_designs(out)
+    front = pareto_front(out)
+    blocks += _targets(out)
+    blocks.append(Block("h2", "Designs"))
+    blocks.append(Block("p", "The main metrics of each design (every metric is in the CSV table)"
+                        + (f"; the first {MAX_ROWS} designs" if len(out.rows) > MAX_ROWS else "")
+                        + (". A design the optimiser asked for more than once is listed once, with "
+                           "its first trial" if out.kind == "optimization" else "") + "."))
+    blocks.append(_designs_table(out, drawn, chosen, front))
+    if out.objectives:
+        blocks.append(Block("h2", "Pareto front"))
+        fig = P.fig_pareto(out, front, chosen)
+        if fig is not None:
+            blocks.append(Block("figure", "The trials and the Pareto front of the feasible ones"
+                                          + (" (crosses: infeasible)" if out.constraints else "")
+                                          + "; axes in the objectives' units",
+                                path=_save(fig, fig_dir / "pareto-front.png")))
+        first = same_design(out)
+        on_front = list(dict.fromkeys(first[i] for i in front))
+        blocks.append(Block("p", "On the front: " + (", ".join(
+            f"{'trial' if out.kind == 'optimization' else 'design'} {out.rows[i].number}"
+            + (f" (and {n - 1} more trials of the same design)" if (n := sum(first[j] == i for j in front)) > 1 else "")
+            for i in on_front) or "no feasible design") + "."))
+    blocks.append(Block("h2", "Metrics against the parameters"))
+    if left:
+        blocks.append(Block("p", "Not drawn (the same for every design, or no design has it): "
+                                 + ", ".join(f"`{m}`" for m in left) + "."))
+    for m in drawn:
+        blocks.append(Block("figure", f"{m} [{P.shown(out.unit(m))[1]}] against each parameter",
+                            path=_save(P.fig_metric(out, m), fig_dir / f"metric-{m}.png")))
+    heat = P.heat_axes(out)
+    if heat is not None:
+        blocks.append(Block("h2", "Heat maps"))
+        blocks.append(Block("p", f"Over {heat[0]} and {heat[1]}"
+                                 + (f", one panel per value of {', '.join(heat[2])}" if heat[2] else "") + "."))
+        targets = [m for t in out.report.targets for m in t.metrics]
+        for m in dict.fromkeys(list(out.objectives) + list(HEADLINE) + targets):
+            if m in drawn:
+                fig = P.fig_heatmap(out, m)
+                if fig is not None:
+                    blocks.append(Block("figure", f"{m} [{P.shown(out.unit(m))[1]}] over {heat[0]} and {heat[1]}",
+                                        path=_save(fig, fig_dir / f"heatmap-{m}.png")))
+    picks = chosen_designs(out, chosen)
+    if picks:
+        blocks.append(Block("h2", "Chosen designs"))
+        blocks.append(Block("p", ("the best feasible design for each "
+                                  + ("objective" if out.objectives else "headline metric") if chosen else "")
+                                 + (("; " if chosen else "") + "the designs of the first combination that "
+                                    "meets every target" if any("meets" in w for w in picks.values()) else "")
+                                 + "; their figures are drawn from their full results (re-run when the "
+                                 "study did not keep them, `--full`)."))
+        intro = blocks[-1].text
+        blocks[-1] = Block("p", intro[:1].upper() + intro[1:])
+        for i, why in picks.items():
+            r = out.rows[i]
+            blocks.append(Block("h3", f"Design {r.number}: {why}"))
+            metrics = [m for m in dict.fromkeys(list(directions(out)) + [m for t in out.report.targets
+                                                                      for m in t.metrics]) if m in r.metrics]
+            blocks.append(Block("p", ", ".join(f"{n} = {_with_unit(r.params.get(n), out.unit(n))}" for n in out.names)
+                                + "; " + ", ".join(f"{m} = {_with_unit(r.metrics.get(m), out.unit(m))}"
+                                                   for m in metrics) + "."))
+            for name, path in design_figures(out.folder, r.key, progress):
+                blocks.append(Block("figure", f"design {r.number}: {name}", path=path))
+    drawn_keys = {out.rows[i].key[:12] for i in picks}
+    for old in fig_dir.glob("design-*.png"):  # designs no longer chosen
+        if old.name.split("-")[1] not in drawn_keys:
+            old.unlink()
+    blocks += _failures(out)
+    return blocks
+
+
+def write_report(folder: str | Path, progress: bool = False) -> Path:
+    """Write DIR/report.html (figures embedded) and its PNGs in DIR/report/; the page."""
+    from granplate.store import atomic_write
+
+    out = read_outcome(folder)
+    blocks = build_report(out, progress)
+    page = out.folder / PAGE
+    text = to_html(blocks, out.folder)
+    atomic_write(page, lambda tmp: tmp.write_text(text))
+    return page

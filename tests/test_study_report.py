@@ -1,0 +1,250 @@
+"""The study report: built from a synthetic study folder whose metrics are known functions
+of the parameters, its figures show exactly those values (one figure per varying metric,
+units on every axis; the heat map of a 2-parameter grid cell by cell; the failures with
+their messages); built at the end of a tiny real sweep by the CLI; the [report] targets
+judge each combination of the choices by its own designs."""
+from __future__ import annotations
+
+import html
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import granplate as gp
+from granplate.cli import main
+from granplate.errors import ScenarioError
+from granplate.study import design as D
+from granplate.study import plots as P
+from granplate.study.outcome import read_outcome
+from granplate.study.report import FIGURES, PAGE, best_designs, pareto_front, target_designs, write_report
+from granplate.study.spec import parse_study
+from granplate.study.sweep import write_table
+from granplate.study.targets import judge, parse_report_table
+
+STUDY_TOML = '''base = "ptfe-r05"
+[set]
+"time.t_end" = 1e-6
+[parameters]
+"load.q0" = [1000.0, 2000.0, 4000.0]
+"layout.R2_ratio" = [0.5, 1.0]
+[objectives]
+"ep_max_fraction" = "minimize"
+"max_von_mises" = "minimize"
+'''
+#: The synthetic design that fails, and its message.
+FAILED = 4
+MESSAGE = "SimulationError: synthetic failure of design 4 at t = 1e-07 s"
+
+
+def known_metrics(q0: float, r2: float) -> dict:
+    """The synthetic metrics of a design: simple functions of its parameters."""
+    return {"ep_max_fraction": q0 / 1e4 * r2, "max_von_mises": 1e3 * q0 / r2,
+            "granular_mass": 0.1 + r2, "t_end": 1e-6, "n_steps": int(q0 / 100)}
+
+
+def synthetic(folder: Path):
+    """A sweep's folder written by hand: records with known metrics, one failure."""
+    import tomllib
+
+    study = parse_study(tomllib.loads(STUDY_TOML))
+    keys = []
+    for i, (q0, r2) in enumerate(study.designs):
+        text = gp.dumps(study.scenario(i))
+        key = D.design_key(text)
+        keys.append(key)
+        summary = {**known_metrics(q0, r2), "units": D.metric_units()}
+        outcome = {"status": MESSAGE if i == FAILED else "ok",
+                   "summary": None if i == FAILED else summary, "elapsed_s": 0.0}
+        D.write_record(folder, D.make_record(key, study.changes(i), text, outcome))
+    write_table(study, folder, keys)
+    (folder / "study.toml").write_text(STUDY_TOML)
+    return study
+
+
+@pytest.fixture(scope="module")
+def synthetic_report(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("synthetic")
+    study = synthetic(folder)
+    page = write_report(folder)
+    return folder, study, page.read_text()
+
+
+def test_outcome_reads_back_the_parameters_metrics_and_failures(synthetic_report):
+    folder, study, _ = synthetic_report
+    out = read_outcome(folder)
+    assert out.kind == "sweep" and out.names == ("load.q0", "layout.R2_ratio")
+    assert [r.ok for r in out.rows] == [i != FAILED for i in range(6)]
+    for r, (q0, r2) in zip(out.rows, study.designs):
+        assert r.params == {"load.q0": q0, "layout.R2_ratio": r2}
+        if r.ok:
+            assert r.metrics["ep_max_fraction"] == q0 / 1e4 * r2
+    assert out.rows[FAILED].status == MESSAGE
+    assert out.unit("max_von_mises") == "Pa" and out.unit("load.q0") == "N/m"
+
+
+def test_one_figure_per_varying_metric_with_its_unit(synthetic_report):
+    folder, _, page = synthetic_report
+    out = read_outcome(folder)
+    shown = {"ep_max_fraction": "-", "max_von_mises": "MPa", "granular_mass": "kg", "n_steps": "-"}
+    for metric, unit in shown.items():
+        assert (folder / FIGURES / f"metric-{metric}.png").read_bytes()[:4] == b"\x89PNG"
+        fig = P.fig_metric(out, metric)
+        assert [ax.get_ylabel() for ax in fig.axes] == [f"{metric} [{unit}]"] * 2
+        assert [ax.get_xlabel() for ax in fig.axes] == ["load.q0 [N/m]", "layout.R2_ratio [-]"]
+        # the points drawn are the metric's values (Pa in MPa), failed design left out
+        drawn = np.concatenate([ln.get_ydata() for ln in fig.axes[0].get_lines()])
+        expected = [known_metrics(q0, r2)[metric] * (1e-6 if unit == "MPa" else 1)
+                    for i, (q0, r2) in enumerate(zip(out.values("load.q0"), out.values("layout.R2_ratio")))
+                    if i != FAILED]
+        np.testing.assert_allclose(np.sort(drawn[np.isfinite(drawn)]), np.sort(expected), rtol=1e-12)
+    # constant metrics are named, not drawn
+    assert not (folder / FIGURES / "metric-t_end.png").exists()
+    assert "<code>t_end</code>" in page.split("Not drawn", 1)[1].split("</p>", 1)[0]
+
+
+def test_heat_map_of_a_two_parameter_grid_shows_each_design_in_its_cell(synthetic_report):
+    folder, _, page = synthetic_report
+    out = read_outcome(folder)
+    assert P.heat_axes(out) == ("load.q0", "layout.R2_ratio", [])
+    fig = P.fig_heatmap(out, "ep_max_fraction")
+    z = np.ma.filled(fig.axes[0].images[0].get_array().astype(float), np.nan)
+    expected = np.array([[q0 / 1e4 * r2 for q0 in (1e3, 2e3, 4e3)] for r2 in (0.5, 1.0)])
+    expected[0, 2] = np.nan  # design 4 = (q0 4000, R2 0.5) failed
+    np.testing.assert_array_equal(z, expected)
+    assert fig.axes[-1].get_ylabel() == "ep_max_fraction [-]"  # the colour bar
+    for m in ("ep_max_fraction", "max_von_mises"):
+        assert (folder / FIGURES / f"heatmap-{m}.png").is_file()
+    assert "Heat maps" in page
+
+
+def test_heat_maps_of_three_parameters_are_one_panel_per_value_of_the_third(tmp_path):
+    synthetic(tmp_path)
+    out = read_outcome(tmp_path)
+    for r in out.rows:  # a third parameter, crossing the grid: two copies of each design
+        r.params["contact.mu"] = 0.1
+    rows = list(out.rows)
+    out.rows = rows + [type(r)(r.number + 6, {**r.params, "contact.mu": 0.2}, r.metrics, r.status, r.key)
+                       for r in rows]
+    out.names = out.names + ("contact.mu",)
+    fig = P.fig_heatmap(out, "max_von_mises")
+    panels = [ax for ax in fig.axes if ax.images]
+    assert [ax.get_title() for ax in panels] == ["contact.mu = 0.1", "contact.mu = 0.2"]
+    # a parameter zipped with another is no axis of its own: named with it
+    for r in out.rows:
+        r.params["contact.alpha_n"] = r.params["contact.mu"] / 10
+    out.names = out.names + ("contact.alpha_n",)
+    assert P.varied(out) == ["load.q0", "layout.R2_ratio", "contact.mu"] and P.is_grid(out)
+    fig = P.fig_heatmap(out, "max_von_mises")
+    assert [ax.get_title() for ax in fig.axes if ax.images] == ["contact.mu = 0.1", "contact.mu = 0.2"]
+    assert P.label(out, "contact.mu") == "contact.mu [-]\nwith contact.alpha_n [-]"
+
+
+def test_failures_table_lists_each_failed_design_with_its_message(synthetic_report):
+    _, _, page = synthetic_report
+    failures = page.split("<h2>Failures</h2>", 1)[1]
+    rows = re.findall(r"<tr>(<td>.*?)</tr>", failures)
+    assert rows == [f"<td>4</td><td>4000</td><td>0.5</td><td>{MESSAGE}</td>"]
+
+
+def test_page_is_self_contained_and_holds_the_definition_and_chosen_designs(synthetic_report):
+    folder, _, page = synthetic_report
+    assert page.count("data:image/png;base64,") == len(list((folder / FIGURES).glob("*.png")))
+    assert "<pre>" in page and html.escape('"load.q0" = [1000.0, 2000.0, 4000.0]') in page
+    out = read_outcome(folder)
+    # best ep_max_fraction: the smallest q0 x R2 (design 0); best stress: q0 / R2 least (design 1)
+    assert best_designs(out) == {"ep_max_fraction": 0, "max_von_mises": 1}
+    assert "Design 0: best ep_max_fraction (minimize)" in page and "Design 1: best max_von_mises (minimize)" in page
+    for i in (0, 1):
+        stem = f"design-{out.rows[i].key[:12]}"
+        assert (folder / FIGURES / f"{stem}-assembly.png").is_file()
+        assert (folder / FIGURES / f"{stem}-energies.png").is_file()
+
+
+def test_pareto_front_is_the_undominated_designs(synthetic_report):
+    folder, _, _ = synthetic_report
+    out = read_outcome(folder)
+    # minimise (q0 R2 / 1e4, 1e3 q0 / R2): at fixed q0 the two trade off, so the front
+    # is every design not beaten in both by another: checked by brute force
+    pts = {i: (r.metrics["ep_max_fraction"], r.metrics["max_von_mises"]) for i, r in enumerate(out.rows) if r.ok}
+    brute = [i for i, p in pts.items()
+             if not any(q[0] <= p[0] and q[1] <= p[1] and q != p for q in pts.values())]
+    assert pareto_front(out) == brute and brute
+
+
+def test_cli_writes_the_report_at_the_end_of_a_tiny_real_sweep(tmp_path, capsys):
+    (tmp_path / "s.toml").write_text('base = "ptfe-r05"\n[set]\n"time.t_end" = 2e-5\n'
+                                     '[parameters]\n"load.q0" = [-1.0, 2e4]\n"layout.R2_ratio" = [0.5, 1.0]\n')
+    out = tmp_path / "out"
+    assert main(["sweep", str(tmp_path / "s.toml"), "--out", str(out), "--workers", "1", "-q"]) == 0
+    assert f"report: {out / PAGE}" in capsys.readouterr().out
+    page = (out / PAGE).read_text()
+    assert (out / "study.toml").read_text() == (tmp_path / "s.toml").read_text()
+    # the two designs of the negative load fail with the scenario's own message
+    failures = page.split("<h2>Failures</h2>", 1)[1]
+    assert failures.count("load.q0") >= 2 and "must be &gt;= 0" in failures
+    assert (out / FIGURES / "heatmap-ep_max_fraction.png").is_file()
+    # the report again, from the folder alone
+    assert main(["study", "report", str(out), "-q"]) == 0
+    assert (out / PAGE).read_text().count("<figure>") == page.count("<figure>")
+
+
+def test_report_of_a_folder_without_a_study_is_a_clear_error(tmp_path, capsys):
+    assert main(["study", "report", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "study folder" in err and "results.nc" in err
+
+
+# ------------------------------------------------------------------------- targets
+
+def test_targets_judge_each_combination_of_the_choices():
+    table = parse_report_table({"conclusion": " In words. ", "targets": [
+        {"label": "stress", "metric": ["max_von_mises", "max_von_mises_nodes"], "value": 10.0,
+         "within": 0.1, "where": {"case": "steel"}},
+        {"label": "share", "metric": "ep_max_fraction", "value": 1.0, "within": 0.5,
+         "where": {"case": "ptfe"}}]}, ("mesh", "case"))
+    targets = table.targets
+    assert table.conclusion == "In words."
+    assert targets[0].metrics == ("max_von_mises", "max_von_mises_nodes") and targets[1].within == 0.5
+    designs = [{"mesh": m, "case": c} for m in (40, 80) for c in ("steel", "ptfe")]
+    values = [{"max_von_mises": 8.0, "max_von_mises_nodes": 10.5},   # mesh 40 steel: nodes hold
+              {"ep_max_fraction": 1.4},                              # mesh 40 ptfe: holds
+              {"max_von_mises": 8.5, "max_von_mises_nodes": 7.0},    # mesh 80 steel: neither
+              {"ep_max_fraction": 1.6}]                              # mesh 80 ptfe: no
+    rows = judge(targets, ("mesh", "case"), designs, values)
+    assert [params for params, _ in rows] == [{"mesh": 40}, {"mesh": 80}]
+    (_, (s40, p40)), (_, (s80, p80)) = rows
+    assert (s40.design, s40.metric, s40.value, s40.holds) == (0, "max_von_mises_nodes", 10.5, True)
+    assert (p40.design, p40.holds) == (1, True)
+    assert (s80.metric, s80.holds) == ("max_von_mises", False)  # the closer of the two
+    assert p80.holds is False
+    # a parameter zipped with the one a target names is no choice: the same two groups
+    zipped = [{**d, "ratio": 1.0 if d["case"] == "steel" else 0.5} for d in designs]
+    assert [p for p, _ in judge(targets, ("mesh", "case", "ratio"), zipped, values)] == [{"mesh": 40}, {"mesh": 80}]
+
+
+@pytest.mark.parametrize("table, field", [
+    ({"targets": [{"metric": "nope", "value": 1.0}]}, "report.targets[0].metric"),
+    ({"targets": [{"metric": "ep_max_fraction", "value": 0.0}]}, "report.targets[0].value"),
+    ({"targets": [{"metric": "ep_max_fraction", "value": 0.1, "where": {"x.y": 1}}]},
+     "report.targets[0].where.x.y"),
+    ({"conclusions": "typo"}, "report.conclusions"),
+])
+def test_report_table_mistakes_name_the_field(table, field):
+    with pytest.raises(ScenarioError) as err:
+        parse_report_table(table, ("load.q0",))
+    assert err.value.field == field
+
+
+def test_page_judges_the_targets_and_draws_the_designs_that_meet_them(tmp_path):
+    synthetic(tmp_path)
+    # ep_max_fraction = q0 / 1e4 x R2 is 0.1 only for (q0 2000, R2 0.5): design 2
+    (tmp_path / "study.toml").write_text(STUDY_TOML + '[report]\nconclusion = "Only one."\n'
+                                         '[[report.targets]]\nmetric = "ep_max_fraction"\nvalue = 0.1\n'
+                                         'within = 0.01\nwhere = {"layout.R2_ratio" = 0.5}\n')
+    out = read_outcome(tmp_path)
+    assert target_designs(out) == [2]
+    page = write_report(tmp_path).read_text()
+    assert "1 of 3 combinations meet every target" in page and "<p>Only one.</p>" in page
+    assert "Design 2: meets the targets" in page
