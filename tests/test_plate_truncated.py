@@ -121,12 +121,15 @@ def test_short_run_agrees_with_the_full_basis():
 
 
 def test_truncated_plate_is_refused_where_unsupported():
-    """The paper scheme and a load on the plate's edge are refused, naming the field."""
+    """The paper scheme and a load on the plate's edge are refused, naming the field and why."""
     s = preset("steel-r1")
     bad = dataclasses.replace(s, plate=dataclasses.replace(s.plate, modes="truncated"),
                               solver=dataclasses.replace(s.solver, scheme="paper"))
-    with pytest.raises(ScenarioError, match="solver.scheme"):
+    with pytest.raises(ScenarioError, match="solver.scheme") as refused:
         validate(bad)
+    # the refusal says why (the massless static part defeats criterion (8)) and what to use
+    assert "R_tt / h" in str(refused.value) and "'implicit'" in str(refused.value)
+    assert "plate.modes = 'all'" in str(refused.value)
     b = preset("bare-plate")
     with pytest.raises(ScenarioError, match="load.target"):
         validate(dataclasses.replace(b, plate=dataclasses.replace(b.plate, modes="truncated")))

@@ -171,3 +171,23 @@ def test_every_sensitivity_run_is_discussed():
     assert sorted(groups) == sorted(c.name for c in ck.CHECKS)
     with pytest.raises(ValueError, match="role"):
         ck.SensitivityRun("x", "steel-r1", role="colour")
+
+
+@pytest.mark.parametrize("growth, settled", [(1.01, True), (1.3, False)])
+def test_stress_discussion_quotes_the_disc_averaged_stress(runs, growth, settled):
+    """The stress discussion gives the disc-averaged stress of the run and of each mesh
+    check, and says it has settled only when every refinement moves it by < 5%."""
+    from granplate.paper import discussion as dn
+
+    steel = runs["steel-r1"]
+    disc = float(steel["max_von_mises_disc"].max())
+    checks = {}
+    for k, name in enumerate(n for n in dn.STRESS_CHECKS if n.endswith(("ny80", "ny160"))):
+        c = steel.copy(deep=True)
+        c["max_von_mises_disc"] = c["max_von_mises_disc"] * growth ** (k + 1)
+        checks[name] = c
+    text = "\n".join(dn.stress_discussion(runs, checks))
+    assert f"the largest stress is {disc / 1e6:.1f} MPa" in text
+    assert f"disc mean {disc * growth / 1e6:.1f} MPa vs {disc / 1e6:.1f} MPa" in text
+    assert ("barely moves with the mesh" in text) == settled
+    assert ("refinements of +30.0%, +30.0%" in text) == (not settled)
