@@ -159,10 +159,11 @@ def test_bench_plate_table_helpers():
         parse_meshes("4x")
     table = format_plate_table([
         {"mesh": "4 x 40", "modes": "auto", "setup_s": 2.5, "rss_setup_mib": 180.0, "n_red": 1082,
-         "n_modes": 1082, "truncated": False, "run_s": 16.0, "rss_peak_mib": 220.0},
+         "n_modes": 1082, "truncated": False, "run_s": 16.0, "rss_peak_mib": 220.0,
+         "summary": {"max_von_mises": 43.6e6, "max_von_mises_disc": 30.3e6}},
         {"mesh": "64 x 640", "modes": "all", "refused": "scenario field 'plate.modes'"},
     ])
-    assert "| 4 x 40 | all | 1,082 | 1082 | 2.5 | 180 | 16.0 | 220 |" in table
+    assert "| 4 x 40 | all | 1,082 | 1082 | 2.5 | 180 | 16.0 | 220 | 43.6 | 30.3 |" in table
     assert "plate.modes" in table.splitlines()[-1]
 
 
