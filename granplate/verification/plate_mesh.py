@@ -141,14 +141,16 @@ def _order_text(values: list[float]) -> str:
 
 def convergence_table(label: str, rows: list[tuple[str, str, list[float], float]], meshes) -> str:
     """Markdown: one column per mesh, then the observed orders and the Richardson limit
-    of the finest three (rows: (quantity, unit, values, scale))."""
+    of the finest three where they converge monotonically with 0.5 < p < 8 (rows:
+    (quantity, unit, values, scale))."""
     head = f"| {label} | " + " | ".join(f"{nx} x {ny}" for nx, ny in meshes) + " | observed order | Richardson limit |"
     out = [head, "|---" * (len(meshes) + 3) + "|"]
     for name, unit, values, scale in rows:
         p = observed_orders(values)[-1] if len(values) >= 3 else math.nan
-        lim = richardson(values, p) if len(values) >= 3 else math.nan
-        cells = " | ".join(f"{v * scale:.5g}" for v in values)
-        limit = f"{lim * scale:.5g}" if math.isfinite(lim) else "-"
+        monotone = len(values) >= 3 and (values[-3] - values[-2]) * (values[-2] - values[-1]) > 0
+        lim = richardson(values, p) if monotone and 0.5 < p < 8 else math.nan
+        cells = " | ".join(f"{v * scale:.8g}" for v in values)
+        limit = f"{lim * scale:.8g}" if math.isfinite(lim) else "-"
         out.append(f"| {name} [{unit}] | {cells} | {_order_text(values)} | {limit} |")
     return "\n".join(out)
 
