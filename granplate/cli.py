@@ -37,6 +37,7 @@ SUMMARY_ROWS = (
     ("eg_final_fraction", "granular energy, final / {ref}", "-", "{:.4f}", 1.0),
     ("dissipated_fraction", "dissipated, final / {ref}", "-", "{:.4f}", 1.0),
     ("max_von_mises", "max von Mises stress", "MPa", "{:.2f}", 1e-6),
+    ("max_von_mises_disc", "max von Mises, disc average", "MPa", "{:.2f}", 1e-6),
     ("max_eps_yy", "max |eps_yy|", "-", "{:.3e}", 1.0),
     ("energy_residual_max", "max |energy residual|", "-", "{:.2e}", 1.0),
     ("n_steps", "time steps", "-", "{:d}", 1),

@@ -12,7 +12,7 @@ from granplate.setup.io import load
 
 SUMMARY_KEYS = {
     "e_shock", "e_initial", "e_in", "ep_max_fraction", "ep_final_fraction", "eg_max_fraction",
-    "eg_final_fraction", "dissipated_fraction", "max_von_mises", "max_eps_yy",
+    "eg_final_fraction", "dissipated_fraction", "max_von_mises", "max_von_mises_disc", "max_eps_yy",
     "energy_residual_max", "n_steps", "wall_time_s", "t_end",
 }
 
@@ -84,7 +84,7 @@ def test_run_without_plate_or_load(tmp_path, capsys):
     assert s["e_shock"] == 0.0
     assert s["e_initial"] == pytest.approx(mass * 1.0 ** 2, rel=1e-12)
     assert s["e_in"] == s["e_initial"]
-    for k in ("ep_max_fraction", "ep_final_fraction", "max_von_mises", "max_eps_yy"):
+    for k in ("ep_max_fraction", "ep_final_fraction", "max_von_mises", "max_von_mises_disc", "max_eps_yy"):
         assert s[k] is None, k
     assert s["eg_final_fraction"] + s["dissipated_fraction"] == pytest.approx(1.0, abs=1e-6)
     assert s["dissipated_fraction"] > 0.001  # the spheres did collide (damped contact)

@@ -121,12 +121,15 @@ def test_short_run_agrees_with_the_full_basis():
 
 
 def test_truncated_plate_is_refused_where_unsupported():
-    """The paper scheme and a load on the plate's edge are refused, naming the field."""
+    """The paper scheme and a load on the plate's edge are refused, naming the field and why."""
     s = preset("steel-r1")
     bad = dataclasses.replace(s, plate=dataclasses.replace(s.plate, modes="truncated"),
                               solver=dataclasses.replace(s.solver, scheme="paper"))
-    with pytest.raises(ScenarioError, match="solver.scheme"):
+    with pytest.raises(ScenarioError, match="solver.scheme") as refused:
         validate(bad)
+    # the refusal says why (the massless static part defeats criterion (8)) and what to use
+    assert "R_tt / h" in str(refused.value) and "'implicit'" in str(refused.value)
+    assert "plate.modes = 'all'" in str(refused.value)
     b = preset("bare-plate")
     with pytest.raises(ScenarioError, match="load.target"):
         validate(dataclasses.replace(b, plate=dataclasses.replace(b.plate, modes="truncated")))
@@ -156,10 +159,11 @@ def test_bench_plate_table_helpers():
         parse_meshes("4x")
     table = format_plate_table([
         {"mesh": "4 x 40", "modes": "auto", "setup_s": 2.5, "rss_setup_mib": 180.0, "n_red": 1082,
-         "n_modes": 1082, "truncated": False, "run_s": 16.0, "rss_peak_mib": 220.0},
+         "n_modes": 1082, "truncated": False, "run_s": 16.0, "rss_peak_mib": 220.0,
+         "summary": {"max_von_mises": 43.6e6, "max_von_mises_disc": 30.3e6}},
         {"mesh": "64 x 640", "modes": "all", "refused": "scenario field 'plate.modes'"},
     ])
-    assert "| 4 x 40 | all | 1,082 | 1082 | 2.5 | 180 | 16.0 | 220 |" in table
+    assert "| 4 x 40 | all | 1,082 | 1082 | 2.5 | 180 | 16.0 | 220 | 43.6 | 30.3 |" in table
     assert "plate.modes" in table.splitlines()[-1]
 
 

@@ -88,13 +88,20 @@ def test_energy_balance_row_uses_every_run(runs):
 
 
 def test_run_table_has_residual_and_wall_time(runs):
+    """The run table shows each run's own residual, wall time and disc-averaged stress."""
     rows = report.run_rows(runs)
     assert [r[0] for r in rows] == list(runs)
     i_res = report.RUN_HEADER.index("max abs(energy residual)")
     i_wall = report.RUN_HEADER.index("wall time [s]")
+    i_disc = report.RUN_HEADER.index("disc-averaged von Mises [MPa]")
     for r, ds in zip(rows, runs.values()):
+        assert len(r) == len(report.RUN_HEADER)
         assert r[i_res] == f"{an.max_energy_residual(ds):.1e}"
         assert r[i_wall] == f"{an.run_info(ds)['wall_time_s']:.1f}"
+        assert r[i_disc] == f"{float(ds.max_von_mises_disc.max()) / 1e6:.1f}"
+    # a result written before the disc average existed shows "-", it does not crash
+    old = {"steel-r1": runs["steel-r1"].drop_vars("max_von_mises_disc")}
+    assert report.run_rows(old)[0][i_disc] == "-"
 
 
 @dataclass
@@ -171,3 +178,23 @@ def test_every_sensitivity_run_is_discussed():
     assert sorted(groups) == sorted(c.name for c in ck.CHECKS)
     with pytest.raises(ValueError, match="role"):
         ck.SensitivityRun("x", "steel-r1", role="colour")
+
+
+@pytest.mark.parametrize("growth, settled", [(1.01, True), (1.3, False)])
+def test_stress_discussion_quotes_the_disc_averaged_stress(runs, growth, settled):
+    """The stress discussion gives the disc-averaged stress of the run and of each mesh
+    check, and says it has settled only when every refinement moves it by < 5%."""
+    from granplate.paper import discussion as dn
+
+    steel = runs["steel-r1"]
+    disc = float(steel["max_von_mises_disc"].max())
+    checks = {}
+    for k, name in enumerate(n for n in dn.STRESS_CHECKS if n.endswith(("ny80", "ny160"))):
+        c = steel.copy(deep=True)
+        c["max_von_mises_disc"] = c["max_von_mises_disc"] * growth ** (k + 1)
+        checks[name] = c
+    text = "\n".join(dn.stress_discussion(runs, checks))
+    assert f"the largest stress is {disc / 1e6:.1f} MPa" in text
+    assert f"disc mean {disc * growth / 1e6:.1f} MPa vs {disc / 1e6:.1f} MPa" in text
+    assert ("barely moves with the mesh" in text) == settled
+    assert ("refinements of +30.0%, +30.0%" in text) == (not settled)

@@ -111,3 +111,18 @@ def test_cli_exit_status(tmp_path, monkeypatch):
     md = (tmp_path / "validation.md").read_text()
     assert "boom" in md and "FAIL" in md
     assert cli.main(["verify", "--out", str(tmp_path), "--case", "nonexistent"]) == 2
+
+
+def test_observed_orders_and_richardson_recover_a_known_rate():
+    """Q_h = Q + C h^p sampled at h, h/2, h/4, h/8 gives back p and Q (the plate mesh study's
+    arithmetic, granplate.verification.plate_mesh)."""
+    from granplate.verification.plate_mesh import convergence_table, observed_orders, richardson
+
+    q = [1.5 + 0.3 * (0.5**k) ** 2.0 for k in range(4)]
+    orders = observed_orders(q)
+    assert orders == pytest.approx([2.0, 2.0], rel=1e-9)
+    assert richardson(q, orders[-1]) == pytest.approx(1.5, rel=1e-12)
+    table = convergence_table("q", [("q", "-", q, 1.0), ("wobbly", "-", [1.0, 0.9, 0.95, 0.94], 1.0)],
+                              ((1, 1), (2, 2), (4, 4), (8, 8)))
+    assert "| q [-] | 1.8 | 1.575 | 1.51875 | 1.5046875 | p = 2.00, 2.00 | 1.5 |" in table
+    assert "(not monotone) | - |" in table

@@ -3,7 +3,7 @@
 One module per concept: `fe` (mesh, Q8 basis, K and M, nodes, VTK element order),
 `constraints` (edges, clamps, symmetry line, rigid layers, the reduction T), `modes`
 (the eigenproblem and the mode sign rule), `load` (the half-sine edge load), `stress`
-(plane-stress D, strain operator, stress recovery) and `build` (PlateModel, build_plate
+(plane-stress D, strain operator, stress recovery, the disc-averaged stress) and `build` (PlateModel, build_plate
 and its entry in the run store).
 """
 
@@ -17,6 +17,9 @@ from granplate.plate.stress import (  # noqa: F401
     quadrature_points,
     gauss_point_strains,
     plane_stresses,
+    disc_centres,
+    disc_average_operator,
+    max_disc_average,
 )
 from granplate.plate.fe import (  # noqa: F401
     plate_mesh,

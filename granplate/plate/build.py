@@ -38,8 +38,12 @@ from granplate.plate.fe import assemble_mass, assemble_stiffness, node_coordinat
 from granplate.plate.load import EDGE_LOAD_POINTS, edge_load_vector
 from granplate.plate.modes import modal_basis, residual_compliance, truncated_modal_basis, weyl_mode_count
 from granplate.plate.stress import (
+    DISC_CENTRE_SPACING,
     INTORDER,
+    disc_average_operator,
+    disc_centres,
     gauss_point_strains,
+    max_disc_average,
     plane_stress_matrix,
     plane_stresses,
     quadrature_points,
@@ -103,6 +107,10 @@ class PlateModel:
     symmetry_nodes: node indices on y = y0 + height / 2, sorted by x.
     contact_y: (n_contacts,) contact heights as given [m].
     thickness [m], rho [kg/m^3], E [Pa], nu [-].
+    disc_radius: radius of the stress-averaging discs [m] (Plate.disc_radius);
+    disc_centres: (n_discs, 2) their centres [m], a lattice DISC_CENTRE_SPACING x
+        disc_radius apart over the plate; disc_op: (n_discs, n_elem n_qp) sparse mean over
+        each disc of a Gauss-point field (docs/model.md section 4.4).
     """
 
     mesh: MeshQuad
@@ -127,6 +135,9 @@ class PlateModel:
     rho: float
     E: float
     nu: float
+    disc_radius: float
+    disc_centres: np.ndarray
+    disc_op: sp.csr_matrix
 
     # ---- sizes -------------------------------------------------------------------
     @property
@@ -198,6 +209,12 @@ class PlateModel:
         sxx, syy, sxy = self.stresses(q, force)
         return von_mises_plane_stress(sxx, syy, sxy)
 
+    def max_disc_von_mises(self, von_mises: np.ndarray) -> np.ndarray:
+        """Largest von Mises stress averaged over a disc of radius disc_radius [Pa]
+        (docs/model.md section 4.4), from Gauss-point values (..., n_elem, n_qp) -> (...)."""
+        vm = np.asarray(von_mises)
+        return max_disc_average(self.disc_op, vm.reshape(vm.shape[:-2] + (-1,)))
+
     def energy(self, q: np.ndarray, qdot: np.ndarray, force: np.ndarray | None = None) -> np.ndarray:
         """Plate energy [J]: 1/2 qdot.qdot + 1/2 sum omega^2 q^2 (= 1/2 v^T M v + 1/2 x^T K x),
         plus the truncated basis' static part 1/2 F^T R F (docs/model.md section 4.5)."""
@@ -246,6 +263,7 @@ def cache_payload(
     enter the key only for the truncated basis, so the full one keeps its key."""
     fields = dataclasses.asdict(plate)
     fields.pop("modes", None)
+    fields.pop("stress_radius", None)  # an output setting: the cached arrays do not depend on it
     max_frequency = fields.pop("max_frequency", None)
     if kind == "truncated":
         fields["basis"] = ["truncated", repr(float(max_frequency or DEFAULT_MAX_FREQUENCY))]
@@ -276,6 +294,10 @@ def _check_plate(plate: "Plate", x0: float, n_modes_max: int | None = None) -> N
         raise PlateError("plate.rigid_layer_width", plate.rigid_layer_width, "allowed: None or a length >= 0 m")
     if not np.isfinite(x0):
         raise PlateError("plate.x0", x0, "allowed: a finite x position in metres")
+    radius = plate.disc_radius
+    if not (np.isfinite(radius) and 0 < radius <= max(plate.width, plate.height)):
+        raise PlateError("plate.stress_radius", plate.stress_radius,
+                         "allowed: None or 0 < r <= max(plate.width, plate.height) in metres")
     if n_modes_max is not None and not (0 <= plate.n_modes <= n_modes_max):
         raise PlateError("plate.n_modes", plate.n_modes, f"allowed: 0 (all) or 1..{n_modes_max}")
 
@@ -426,6 +448,10 @@ def build_plate(
     )
     Phi = arrays["Phi"]
     psi = arrays["psi"] if "psi" in arrays else np.zeros((n_red, 0))
+    qp_xy = quadrature_points(basis)
+    radius = float(plate.disc_radius)
+    centres = disc_centres(x0, plate.y0, plate.width, plate.height, DISC_CENTRE_SPACING * radius)
+    disc_op = disc_average_operator(qp_xy.reshape(-1, 2), np.asarray(basis.dx).ravel(), centres, radius)
     return PlateModel(
         mesh=mesh,
         basis=basis,
@@ -441,7 +467,7 @@ def build_plate(
         edge_load_modal=arrays["edge_load_modal"],
         edge_load_full=arrays["edge_load_full"],
         strain_op=strain_op,
-        qp_xy=quadrature_points(basis),
+        qp_xy=qp_xy,
         D=D,
         symmetry_nodes=symmetry_nodes,
         contact_y=np.array(contact_y, dtype=float),
@@ -449,4 +475,7 @@ def build_plate(
         rho=float(material.rho),
         E=float(material.E),
         nu=float(material.nu),
+        disc_radius=radius,
+        disc_centres=centres,
+        disc_op=disc_op,
     )

@@ -286,6 +286,13 @@ def _check_plate(s: Scenario) -> None:
     string_in("plate.modes", pl.modes, MODE_CHOICES)
     if pl.max_frequency is not None:
         positive("plate.max_frequency", pl.max_frequency)
+    if pl.stress_radius is not None:
+        positive("plate.stress_radius", pl.stress_radius)
+        if pl.stress_radius > max(pl.width, pl.height):
+            raise ScenarioError("plate.stress_radius", pl.stress_radius,
+                                f"allowed: 0 < r <= max(plate.width, plate.height) = "
+                                f"{max(pl.width, pl.height):g} m (a disc larger than the plate "
+                                "averages over all of it)")
     for i, g in enumerate(s.granules):
         if pl.y0 <= g.y <= pl.y0 + pl.height:
             pen = g.x + g.radius - x0

