@@ -1,17 +1,30 @@
 """The granular medium in the loop: the time derivative of every granule's state with
 the contact forces of eqs. (2)-(6), and one RK4 step of it with the plate's contact
 points moving as a scheme prescribes (docs/model.md section 6).
+
+Friction at granule-granule and granule-wall contacts relaxes the slip at a rate that
+grows with |N| (`slip_relaxation_rate`); RK4 is stable only while the step times that
+rate stays small. A step that would exceed RK4_FRICTION_LIMIT there is split (Strang):
+half a step of friction alone, solved exactly contact by contact (`friction_flow`),
+RK4 of every other force, the other half of friction in the reverse contact order. Steps
+within the limit are the plain RK4 of all forces.
 """
 from __future__ import annotations
 
 from numba import njit
 
 from granplate.physics.contact import (
-    COEF_A, COEF_C, COEF_KS, COEF_MU, contact_arm, contact_response, friction_slope, pair_overlap,
-    pair_rates, plate_overlap, plate_rates, wall_overlap, wall_rates,
+    COEF_A, COEF_C, COEF_KS, COEF_MU, contact_arm, contact_response, friction_slope, normal_force,
+    pair_overlap, pair_rates, plate_overlap, plate_rates, slip_after_friction, wall_overlap, wall_rates,
 )
 from granplate.physics.shock import time_profile
-from granplate.solver.state import PARTNER_PLATE
+from granplate.solver.state import PARTNER_PLATE, R_FRIC
+
+
+#: RK4 stays stable for h * rate < 2.785 on a decaying mode: a step h beyond this bound
+#: times the friction relaxation rate of a granule-granule or granule-wall contact is
+#: split (`friction_split`); at a plate contact the step control keeps it below.
+RK4_FRICTION_LIMIT = 1.0
 
 
 @njit(cache=True)
@@ -24,17 +37,19 @@ def slip_relaxation_rate(n, vt, mu, k_s, inv_mass_t):
 
 
 @njit(cache=True)
-def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
+def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, split=False):
     """Time derivative of the granular state and the plate-contact forces.
 
     y: (ng, 6) state; up, vp: driving-DOF displacement and velocity at t; writes dy,
     fplate (nd,) = force ON the plate [N, N] per contact, normal and slip at each plate
     contact. hold: the plate-contact friction is fbar[k] (held over the step, its work
-    booked by the scheme) instead of eq. (5). Returns (shock power, viscous power,
-    friction power, contact potential energy, largest slip relaxation rate of a granule
-    contact, largest overlap over the smaller radius, its granule, its partner (granule j,
-    wall -1 - w or PARTNER_PLATE; -1, -1 with no overlap; as floats)) [W, W, W, J, 1/s, -, -, -]; RK4
-    needs h times that rate below ~2.8. One function
+    booked by the scheme) instead of eq. (5); split: no friction at granule-granule and
+    granule-wall contacts (`friction_flow` applies it). Returns (shock power, viscous power,
+    friction power, contact potential energy, largest slip relaxation rate of a
+    granule-granule or granule-wall contact, largest overlap over the smaller radius, its
+    granule, its partner (granule j, wall -1 - w or PARTNER_PLATE; -1, -1 with no overlap;
+    as floats), largest slip relaxation rate of a plate contact (0 with hold))
+    [W, W, W, J, 1/s, -, -, -, 1/s]; RK4 needs h times a rate below ~2.8. One function
     (not one per contact kind): calls that pass the model tuples cost more per step
     than the loops themselves when the medium is small.
     """
@@ -51,6 +66,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
     p_fric = 0.0
     e_pot = 0.0
     rate = 0.0
+    rate_plate = 0.0
     ovl = 0.0  # the largest overlap / smaller radius, at granule ovl_i with ovl_j
     ovl_i = -1
     ovl_j = -1
@@ -82,6 +98,9 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
         n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
         rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + 1.0 / g.mass[j]
                                               + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]))
+        if split:
+            f = 0.0
+            pf = 0.0
         fx = -n * nx + f * nz  # on i: -n nvec - f tvec, tvec = (-nz, nx); on j the opposite
         fz = -n * nz - f * nx
         dy[i, 3] += fx
@@ -110,6 +129,9 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
         c = g.wall_coef[w]
         n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
         rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i]))
+        if split:
+            f = 0.0
+            pf = 0.0
         dy[i, 3] += -n * nx + f * nz
         dy[i, 4] += -n * nz - f * nx
         dy[i, 5] -= f * ai
@@ -133,7 +155,8 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
             c = g.pc_coef[k]
             n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
             if not hold:  # the granule side only: the plate side of this map is criterion (8)
-                rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i]))
+                rate_plate = max(rate_plate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS],
+                                                                  1.0 / g.mass[i] + ai * ai / g.inertia[i]))
             dy[i, 3] -= n
             p_visc += pv
             e_pot += ep
@@ -152,7 +175,85 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
         dy[i, 3] /= g.mass[i]
         dy[i, 4] /= g.mass[i]
         dy[i, 5] /= g.inertia[i]
-    return p_shock, p_visc, p_fric, e_pot, rate, ovl, float(ovl_i), float(ovl_j)  # one float tuple: indexable
+    # one float tuple: indexable
+    return p_shock, p_visc, p_fric, e_pot, rate, ovl, float(ovl_i), float(ovl_j), rate_plate
+
+
+@njit(cache=True)
+def pair_friction_flow(p, y, dt, g, cfg):
+    """Friction alone at granule pair p over dt [s] (eq. 5, |N| held at its value in y):
+    the slip relaxes exactly (`slip_after_friction`) and the impulse P = m_t (v_t - v_t')
+    changes both granules' velocities and spins in y. Returns the energy it dissipates,
+    the kinetic energy lost, 1/2 P (v_t + v_t') >= 0 [J]."""
+    i = g.pair_ij[p, 0]
+    j = g.pair_ij[p, 1]
+    ri = g.radius[i]
+    rj = g.radius[j]
+    delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
+    c = g.pair_coef[p]
+    if delta <= 0.0 or c[COEF_MU] == 0.0:
+        return 0.0
+    ai = contact_arm(ri, delta, 0.5 * cfg.arm_shrink)
+    aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
+    ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
+    n, _ = normal_force(delta, ddot, c[COEF_A], c[COEF_C], cfg.clip)
+    inv_t = 1.0 / g.mass[i] + 1.0 / g.mass[j] + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]
+    v1 = slip_after_friction(vt, n, c[COEF_MU], c[COEF_KS], inv_t, dt)
+    imp = (vt - v1) / inv_t  # the impulse of f: -imp t on i, +imp t on j, t = (-nz, nx)
+    y[i, 3] += imp * nz / g.mass[i]
+    y[i, 4] -= imp * nx / g.mass[i]
+    y[i, 5] -= imp * ai / g.inertia[i]
+    y[j, 3] -= imp * nz / g.mass[j]
+    y[j, 4] += imp * nx / g.mass[j]
+    y[j, 5] -= imp * aj / g.inertia[j]
+    return 0.5 * imp * (vt + v1)
+
+
+@njit(cache=True)
+def wall_friction_flow(w, y, dt, g, cfg):
+    """Friction alone at wall contact w over dt [s], as `pair_friction_flow` with the wall
+    at rest. Returns the energy it dissipates [J]."""
+    i = g.wall_i[w]
+    ri = g.radius[i]
+    nx = g.wall_geo[w, 0]
+    nz = g.wall_geo[w, 1]
+    delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, g.wall_geo[w, 2])
+    c = g.wall_coef[w]
+    if delta <= 0.0 or c[COEF_MU] == 0.0:
+        return 0.0
+    ai = contact_arm(ri, delta, cfg.arm_shrink)
+    ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
+    n, _ = normal_force(delta, ddot, c[COEF_A], c[COEF_C], cfg.clip)
+    inv_t = 1.0 / g.mass[i] + ai * ai / g.inertia[i]
+    v1 = slip_after_friction(vt, n, c[COEF_MU], c[COEF_KS], inv_t, dt)
+    imp = (vt - v1) / inv_t
+    y[i, 3] += imp * nz / g.mass[i]
+    y[i, 4] -= imp * nx / g.mass[i]
+    y[i, 5] -= imp * ai / g.inertia[i]
+    return 0.5 * imp * (vt + v1)
+
+
+@njit(cache=True)
+def friction_flow(y, dt, g, cfg, forward):
+    """Friction alone at every granule-granule and granule-wall contact over dt [s], one
+    contact after the other (pairs then walls; forward False: the reverse order, so that
+    two half steps in opposite orders make a symmetric, second-order split). Changes the
+    velocities and spins in y, never the positions. Returns the energy dissipated [J]
+    (>= 0, booked exactly as the kinetic energy each contact removes)."""
+    n_p = g.pair_ij.shape[0]
+    n_w = g.wall_i.shape[0]
+    work = 0.0
+    if forward:
+        for p in range(n_p):
+            work += pair_friction_flow(p, y, dt, g, cfg)
+        for w in range(n_w):
+            work += wall_friction_flow(w, y, dt, g, cfg)
+    else:
+        for w in range(n_w - 1, -1, -1):
+            work += wall_friction_flow(w, y, dt, g, cfg)
+        for p in range(n_p - 1, -1, -1):
+            work += pair_friction_flow(p, y, dt, g, cfg)
+    return work
 
 
 @njit(cache=True)
@@ -170,25 +271,49 @@ def no_granules_step(h, p1, dacc, pend, ovl_new, ovl_who):
 
 
 @njit(cache=True)
+def friction_split(h, rate, cfg):
+    """Whether a step h [s] splits off the granule-granule and granule-wall friction:
+    with cfg.split_friction, when h times their largest slip relaxation rate at its
+    start, rate [1/s], is beyond RK4_FRICTION_LIMIT (plain RK4 otherwise)."""
+    return cfg.split_friction and h * rate > RK4_FRICTION_LIMIT
+
+
+@njit(cache=True)
 def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
-    """One RK4 step of the granules from st.y with the plate's contact points at
-    stage[0], stage[1] (u, v at t + h/2) and stage[2], stage[3] (u, v at t + h).
+    """One step of the granules from st.y with the plate's contact points at stage[0],
+    stage[1] (u, v at t + h/2) and stage[2], stage[3] (u, v at t + h): RK4 of every force,
+    or, when the granule-granule and granule-wall friction is too stiff for RK4
+    (`friction_split` with the rate at t, st.clock[R_FRIC]), half a step of that friction
+    alone (`friction_flow`), RK4 of the other forces, and the other half in reverse order.
 
     Stage 1 reuses st.k1/st.p1 (first same as last), unless hold (the plate-contact
-    friction held at w.fbar over the step), which changes it. Writes w.ynew, w.kend,
+    friction held at w.fbar over the step) or the split changes it. Writes w.ynew, w.kend,
     w.fnew (forces on the plate at t + h), w.normal_new, w.slip_new, w.pend (powers at
     t + h) and w.dacc (shock, viscous, friction work over the step), w.ovl_new and
-    w.ovl_who (the largest relative overlap at t + h and its contact). Returns (stored
-    contact energy at t + h [J], largest slip relaxation rate [1/s]).
+    w.ovl_who (the largest relative overlap at t + h and its contact), w.rate_new (the
+    largest granule-granule or granule-wall slip relaxation rate at t + h). Returns
+    (stored contact energy at t + h [J], the largest slip relaxation rate at t + h that
+    bounds the next step [1/s]: of a plate contact, and of every contact without
+    cfg.split_friction).
     """
     y0 = st.y
     ng = y0.shape[0]
     if ng == 0:
+        w.rate_new[0] = 0.0
         return no_granules_step(h, st.p1, w.dacc, w.pend, w.ovl_new, w.ovl_who)
     k1 = st.k1
     p1 = st.p1
-    if hold:
-        pr = granular_rhs(t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, True, w.fbar)
+    split = friction_split(h, st.clock[R_FRIC], cfg)
+    fric_split = 0.0
+    if split:  # friction over [t, t + h/2]; RK4 then starts from w.ynew, updated in place
+        for i in range(ng):
+            for c in range(6):
+                w.ynew[i, c] = y0[i, c]
+        fric_split = friction_flow(w.ynew, 0.5 * h, g, cfg, True)
+        y0 = w.ynew
+    if hold or split:
+        pr = granular_rhs(t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar,
+                          split)
         w.p1h[0] = pr[0]
         w.p1h[1] = pr[1]
         w.p1h[2] = pr[2]
@@ -198,21 +323,27 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     for i in range(ng):
         for c in range(6):
             w.ytmp[i, c] = y0[i, c] + hh * k1[i, c]
-    p2 = granular_rhs(t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k2, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar)
+    p2 = granular_rhs(t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k2, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar,
+                      split)
     for i in range(ng):
         for c in range(6):
             w.ytmp[i, c] = y0[i, c] + hh * w.k2[i, c]
-    p3 = granular_rhs(t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k3, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar)
+    p3 = granular_rhs(t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k3, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar,
+                      split)
     for i in range(ng):
         for c in range(6):
             w.ytmp[i, c] = y0[i, c] + h * w.k3[i, c]
-    p4 = granular_rhs(t + h, w.ytmp, stage[2], stage[3], g, cfg, w.k4, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar)
+    p4 = granular_rhs(t + h, w.ytmp, stage[2], stage[3], g, cfg, w.k4, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar,
+                      split)
     h6 = h / 6.0
     for i in range(ng):
-        for c in range(6):
+        for c in range(6):  # (y0 may be w.ynew itself: each entry is read before it is written)
             w.ynew[i, c] = y0[i, c] + h6 * (k1[i, c] + 2.0 * w.k2[i, c] + 2.0 * w.k3[i, c] + w.k4[i, c])
     for c in range(3):
         w.dacc[c] = h6 * (p1[c] + 2.0 * p2[c] + 2.0 * p3[c] + p4[c])
+    if split:  # friction over [t + h/2, t + h]
+        fric_split += friction_flow(w.ynew, 0.5 * h, g, cfg, False)
+        w.dacc[2] += fric_split
     pe = granular_rhs(t + h, w.ynew, stage[2], stage[3], g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar)
     w.pend[0] = pe[0]
     w.pend[1] = pe[1]
@@ -220,7 +351,10 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     w.ovl_new[0] = pe[5]
     w.ovl_who[0] = int(pe[6])
     w.ovl_who[1] = int(pe[7])
-    return pe[3], pe[4]
+    w.rate_new[0] = pe[4]
+    if cfg.split_friction:
+        return pe[3], pe[8]
+    return pe[3], max(pe[4], pe[8])
 
 
 @njit(cache=True)
@@ -236,10 +370,6 @@ def kinetic_energies(y, mass, inertia):
         kr += 0.5 * inertia[i] * y[i, 5] * y[i, 5]
     return kx, ky, kr
 
-
-#: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps
-#: h * (friction relaxation rate of every granule contact) below this bound.
-RK4_FRICTION_LIMIT = 1.0
 
 
 @njit(cache=True)
