@@ -4,10 +4,11 @@ points moving as a scheme prescribes (docs/model.md section 6).
 
 Friction at granule-granule and granule-wall contacts relaxes the slip at a rate that
 grows with |N| (`slip_relaxation_rate`); RK4 is stable only while the step times that
-rate stays small. A step that would exceed RK4_FRICTION_LIMIT there is split (Strang):
-half a step of friction alone, solved exactly contact by contact (`friction_flow`),
-RK4 of every other force, the other half of friction in the reverse contact order. Steps
-within the limit are the plain RK4 of all forces.
+rate stays below ~2.8. With cfg.split_friction (solver.granular_friction = "split") that
+friction is split off every step (Strang): half a step of friction alone, solved exactly
+contact by contact (`friction_flow`), RK4 of every other force, the other half of
+friction in the reverse contact order; stable for any step. Without it, RK4 integrates
+every force and the step control keeps h times that rate within RK4_FRICTION_LIMIT.
 """
 from __future__ import annotations
 
@@ -18,12 +19,11 @@ from granplate.physics.contact import (
     pair_overlap, pair_rates, plate_overlap, plate_rates, slip_after_friction, wall_overlap, wall_rates,
 )
 from granplate.physics.shock import time_profile
-from granplate.solver.state import PARTNER_PLATE, R_FRIC
+from granplate.solver.state import PARTNER_PLATE
 
 
-#: RK4 stays stable for h * rate < 2.785 on a decaying mode: a step h beyond this bound
-#: times the friction relaxation rate of a granule-granule or granule-wall contact is
-#: split (`friction_split`); at a plate contact the step control keeps it below.
+#: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps h
+#: times the friction relaxation rate of every contact that RK4 integrates below this bound.
 RK4_FRICTION_LIMIT = 1.0
 
 
@@ -271,39 +271,28 @@ def no_granules_step(h, p1, dacc, pend, ovl_new, ovl_who):
 
 
 @njit(cache=True)
-def friction_split(h, rate, cfg):
-    """Whether a step h [s] splits off the granule-granule and granule-wall friction:
-    with cfg.split_friction, when h times their largest slip relaxation rate at its
-    start, rate [1/s], is beyond RK4_FRICTION_LIMIT (plain RK4 otherwise)."""
-    return cfg.split_friction and h * rate > RK4_FRICTION_LIMIT
-
-
-@njit(cache=True)
 def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     """One step of the granules from st.y with the plate's contact points at stage[0],
     stage[1] (u, v at t + h/2) and stage[2], stage[3] (u, v at t + h): RK4 of every force,
-    or, when the granule-granule and granule-wall friction is too stiff for RK4
-    (`friction_split` with the rate at t, st.clock[R_FRIC]), half a step of that friction
-    alone (`friction_flow`), RK4 of the other forces, and the other half in reverse order.
+    or with cfg.split_friction, half a step of the granule-granule and granule-wall
+    friction alone (`friction_flow`), RK4 of the other forces, and the other half of that
+    friction in reverse order (Strang).
 
     Stage 1 reuses st.k1/st.p1 (first same as last), unless hold (the plate-contact
-    friction held at w.fbar over the step) or the split changes it. Writes w.ynew, w.kend,
-    w.fnew (forces on the plate at t + h), w.normal_new, w.slip_new, w.pend (powers at
-    t + h) and w.dacc (shock, viscous, friction work over the step), w.ovl_new and
-    w.ovl_who (the largest relative overlap at t + h and its contact), w.rate_new (the
-    largest granule-granule or granule-wall slip relaxation rate at t + h). Returns
-    (stored contact energy at t + h [J], the largest slip relaxation rate at t + h that
-    bounds the next step [1/s]: of a plate contact, and of every contact without
-    cfg.split_friction).
+    friction held at w.fbar over the step) or the split (the friction half step moves
+    the velocities) changes it. Writes w.ynew, w.kend (without the split friction), w.fnew
+    (forces on the plate at t + h), w.normal_new, w.slip_new, w.pend (powers at t + h) and
+    w.dacc (shock, viscous, friction work over the step), w.ovl_new and w.ovl_who (the
+    largest relative overlap at t + h and its contact). Returns (stored contact energy at
+    t + h [J], largest slip relaxation rate of a contact RK4 integrates, at t + h [1/s]).
     """
     y0 = st.y
     ng = y0.shape[0]
     if ng == 0:
-        w.rate_new[0] = 0.0
         return no_granules_step(h, st.p1, w.dacc, w.pend, w.ovl_new, w.ovl_who)
     k1 = st.k1
     p1 = st.p1
-    split = friction_split(h, st.clock[R_FRIC], cfg)
+    split = cfg.split_friction
     fric_split = 0.0
     if split:  # friction over [t, t + h/2]; RK4 then starts from w.ynew, updated in place
         for i in range(ng):
@@ -342,16 +331,16 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     for c in range(3):
         w.dacc[c] = h6 * (p1[c] + 2.0 * p2[c] + 2.0 * p3[c] + p4[c])
     if split:  # friction over [t + h/2, t + h]
-        fric_split += friction_flow(w.ynew, 0.5 * h, g, cfg, False)
+        fric_split += friction_flow(w.ynew, hh, g, cfg, False)
         w.dacc[2] += fric_split
-    pe = granular_rhs(t + h, w.ynew, stage[2], stage[3], g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar)
+    pe = granular_rhs(t + h, w.ynew, stage[2], stage[3], g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar,
+                      split)
     w.pend[0] = pe[0]
     w.pend[1] = pe[1]
     w.pend[2] = pe[2]
     w.ovl_new[0] = pe[5]
     w.ovl_who[0] = int(pe[6])
     w.ovl_who[1] = int(pe[7])
-    w.rate_new[0] = pe[4]
     if cfg.split_friction:
         return pe[3], pe[8]
     return pe[3], max(pe[4], pe[8])

@@ -22,7 +22,7 @@ from granplate.solver.state import (
     A_FRIC, A_SHOCK_G, A_SHOCK_P, A_VISC, C_ITERS, C_LEVEL, C_OUT, C_RETRIES, C_STEPS, CUSTOM_H,
     D_FRIC, D_VISC, E_GRAN, E_IN_MAX, E_PLATE, E_POT, E_POTG, E_SHOCK, E_ZERO, ERR_BUFFER,
     ERR_CONTACT, ERR_ENERGY, ERR_H, ERR_ITER, ERR_LAM, ERR_N, ERR_NAN, ERR_NOCONV, ERR_RESID,
-    ERR_T, ERR_VT, H_LAST, R_FRIC, KE_ROT, KE_X, KE_Y, N_LEVELS, OK, PAUSED, RES_LAST, RESID, RESID_MAX,
+    ERR_T, ERR_VT, H_LAST, KE_ROT, KE_X, KE_Y, N_LEVELS, OK, PAUSED, RES_LAST, RESID, RESID_MAX,
     S_DT_MAX, S_DT_MIN, S_ITERS, S_LAM_MAX, S_RETRIES, S_STEPS, T_NOW,
 )
 
@@ -35,7 +35,6 @@ def initialise(st, g, p, cfg, w):
     st.p1[1] = pr[1]
     st.p1[2] = pr[2]
     st.clock[E_POT] = pr[3]
-    st.clock[R_FRIC] = pr[4]
     modal_acceleration(st.clock[T_NOW], st, p, cfg, st.force)
     driving_dofs(st, p)
     for d in range(st.force.shape[0]):
@@ -182,8 +181,8 @@ def needs_matrices(h, slot, clock, g_ok):
 
 @njit(cache=True)
 def accept_granular(t, h, land, t_out, plate_work, e_pot, st, w):
-    """Take the trial step's granule state, derivatives, work and friction relaxation
-    rate into the state and move the clock (onto the output time when the step lands on it)."""
+    """Take the trial step's granule state, derivatives and work into the state and
+    move the clock (onto the output time when the step lands on it)."""
     for i in range(st.y.shape[0]):
         for c in range(6):
             st.y[i, c] = w.ynew[i, c]
@@ -196,7 +195,6 @@ def accept_granular(t, h, land, t_out, plate_work, e_pot, st, w):
     st.acc[A_FRIC] += w.dacc[2]
     st.acc[A_SHOCK_P] += plate_work
     st.clock[E_POT] = e_pot
-    st.clock[R_FRIC] = w.rate_new[0]
     st.clock[T_NOW] = t_out if land else t + h
     st.clock[H_LAST] = h
     st.count[C_STEPS] += 1

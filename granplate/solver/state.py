@@ -8,9 +8,7 @@ from typing import NamedTuple
 import numpy as np
 
 # clock (float64)
-# R_FRIC: largest slip relaxation rate of a granule-granule or granule-wall contact at
-# t_n [1/s] (solver.granular.friction_split)
-T_NOW, H_LAST, E_IN_MAX, E_ZERO, E_POT, CUSTOM_H, F_SCALE, RES_LAST, R_FRIC = 0, 1, 2, 3, 4, 5, 6, 7, 8
+T_NOW, H_LAST, E_IN_MAX, E_ZERO, E_POT, CUSTOM_H, F_SCALE, RES_LAST = 0, 1, 2, 3, 4, 5, 6, 7
 N_CLOCK = 10
 # count (int64)
 C_STEPS, C_LEVEL, C_OUT, C_ITERS, C_RETRIES = 0, 1, 2, 3, 4
@@ -109,7 +107,6 @@ class Work(NamedTuple):
     plate_free: np.ndarray  # (ng,) int: 1 for a granule without a plate contact
     ovl_new: np.ndarray  # (1,) largest overlap / smaller radius at the end of the trial step
     ovl_who: np.ndarray  # (2,) int: its granule and partner (-1, -1: no overlap)
-    rate_new: np.ndarray  # (1,) largest granule-granule or granule-wall slip relaxation rate at the end [1/s]
 
 
 class Output(NamedTuple):
@@ -153,7 +150,7 @@ def new_work(ng: int, nm: int, nk: int) -> Work:
         gmat=z((N_LEVELS + 1, nd, nd)), g_ok=np.zeros(N_LEVELS + 1, np.int64),
         lam_int=z(nk), it_int=np.zeros(nk, np.int64), dt_int=z(2), res_int=z(1),
         yref=z((ng, 2)), ovl=z(ng), ovl_with=np.zeros(ng, np.int64), plate_free=np.zeros(ng, np.int64),
-        ovl_new=z(1), ovl_who=np.full(2, -1, np.int64), rate_new=z(1),
+        ovl_new=z(1), ovl_who=np.full(2, -1, np.int64),
     )
 
 
