@@ -133,7 +133,7 @@ def test_friction_no_longer_sets_the_step_in_a_packing():
     assert steps["rk4"] > 2.0 * steps["frictionless"]
     assert steps["fine"] > 8 * steps["split"]
     ds, ref = runs["split"], runs["fine"]
-    for v in ("vx", "vy"):
-        np.testing.assert_allclose(ds[v].values[-1], ref[v].values[-1], atol=2e-3)
-    np.testing.assert_allclose(ds.omega.values[-1] * 1e-3, ref.omega.values[-1] * 1e-3, atol=2e-3)
-    assert ds.D_friction.values[-1] == pytest.approx(ref.D_friction.values[-1], rel=1e-2)
+    for v in ("vx", "vy"):  # [m/s], the struck column at 1 m/s (measured: 2e-4)
+        np.testing.assert_allclose(ds[v].values[-1], ref[v].values[-1], atol=5e-4)
+    np.testing.assert_allclose(ds.omega.values[-1] * 1e-3, ref.omega.values[-1] * 1e-3, atol=2e-3)  # R omega (8e-4)
+    assert ds.D_friction.values[-1] == pytest.approx(ref.D_friction.values[-1], rel=1e-4)  # (3e-5)

@@ -180,79 +180,70 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
 
 
 @njit(cache=True)
-def pair_friction_flow(p, y, dt, g, cfg):
-    """Friction alone at granule pair p over dt [s] (eq. 5, |N| held at its value in y):
-    the slip relaxes exactly (`slip_after_friction`) and the impulse P = m_t (v_t - v_t')
-    changes both granules' velocities and spins in y. Returns the energy it dissipates,
-    the kinetic energy lost, 1/2 P (v_t + v_t') >= 0 [J]."""
-    i = g.pair_ij[p, 0]
-    j = g.pair_ij[p, 1]
-    ri = g.radius[i]
-    rj = g.radius[j]
-    delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
-    c = g.pair_coef[p]
-    if delta <= 0.0 or c[COEF_MU] == 0.0:
-        return 0.0
-    ai = contact_arm(ri, delta, 0.5 * cfg.arm_shrink)
-    aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
-    ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
-    n, _ = normal_force(delta, ddot, c[COEF_A], c[COEF_C], cfg.clip)
-    inv_t = 1.0 / g.mass[i] + 1.0 / g.mass[j] + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]
-    v1 = slip_after_friction(vt, n, c[COEF_MU], c[COEF_KS], inv_t, dt)
-    imp = (vt - v1) / inv_t  # the impulse of f: -imp t on i, +imp t on j, t = (-nz, nx)
-    y[i, 3] += imp * nz / g.mass[i]
-    y[i, 4] -= imp * nx / g.mass[i]
-    y[i, 5] -= imp * ai / g.inertia[i]
-    y[j, 3] -= imp * nz / g.mass[j]
-    y[j, 4] += imp * nx / g.mass[j]
-    y[j, 5] -= imp * aj / g.inertia[j]
-    return 0.5 * imp * (vt + v1)
-
-
-@njit(cache=True)
-def wall_friction_flow(w, y, dt, g, cfg):
-    """Friction alone at wall contact w over dt [s], as `pair_friction_flow` with the wall
-    at rest. Returns the energy it dissipates [J]."""
-    i = g.wall_i[w]
-    ri = g.radius[i]
-    nx = g.wall_geo[w, 0]
-    nz = g.wall_geo[w, 1]
-    delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, g.wall_geo[w, 2])
-    c = g.wall_coef[w]
-    if delta <= 0.0 or c[COEF_MU] == 0.0:
-        return 0.0
-    ai = contact_arm(ri, delta, cfg.arm_shrink)
-    ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
-    n, _ = normal_force(delta, ddot, c[COEF_A], c[COEF_C], cfg.clip)
-    inv_t = 1.0 / g.mass[i] + ai * ai / g.inertia[i]
-    v1 = slip_after_friction(vt, n, c[COEF_MU], c[COEF_KS], inv_t, dt)
-    imp = (vt - v1) / inv_t
-    y[i, 3] += imp * nz / g.mass[i]
-    y[i, 4] -= imp * nx / g.mass[i]
-    y[i, 5] -= imp * ai / g.inertia[i]
-    return 0.5 * imp * (vt + v1)
+def friction_impulse(vt, n, mu, k_s, inv_mass_t, dt):
+    """Friction alone at one contact over dt [s] (eq. 5, |N| = n held): the slip rate vt
+    [m/s] relaxes exactly (`slip_after_friction`) to v1. Returns (the impulse
+    P = (vt - v1) / m_t^-1 [N s], along -t on the first body, and the energy it dissipates,
+    the kinetic energy it removes, P (vt + v1) / 2 >= 0 [J])."""
+    v1 = slip_after_friction(vt, n, mu, k_s, inv_mass_t, dt)
+    imp = (vt - v1) / inv_mass_t
+    return imp, 0.5 * imp * (vt + v1)
 
 
 @njit(cache=True)
 def friction_flow(y, dt, g, cfg, forward):
     """Friction alone at every granule-granule and granule-wall contact over dt [s], one
-    contact after the other (pairs then walls; forward False: the reverse order, so that
-    two half steps in opposite orders make a symmetric, second-order split). Changes the
-    velocities and spins in y, never the positions. Returns the energy dissipated [J]
-    (>= 0, booked exactly as the kinetic energy each contact removes)."""
+    contact after the other (`friction_impulse`, |N| at the current state; pairs then
+    walls, or with forward False the reverse order, so that two half steps in opposite
+    orders make a symmetric split). Changes the velocities and spins in y, never the
+    positions. Returns the energy dissipated [J] (>= 0, booked exactly as the kinetic
+    energy each contact removes). One function, not one call per contact (a call that
+    passes the model tuples costs more than a contact)."""
     n_p = g.pair_ij.shape[0]
     n_w = g.wall_i.shape[0]
     work = 0.0
-    if forward:
-        for p in range(n_p):
-            work += pair_friction_flow(p, y, dt, g, cfg)
-        for w in range(n_w):
-            work += wall_friction_flow(w, y, dt, g, cfg)
-    else:
-        for w in range(n_w - 1, -1, -1):
-            work += wall_friction_flow(w, y, dt, g, cfg)
-        for p in range(n_p - 1, -1, -1):
-            work += pair_friction_flow(p, y, dt, g, cfg)
+    for k in range(n_p + n_w):
+        q = k if forward else n_p + n_w - 1 - k
+        if q < n_p:  # pair q: -P t on i, +P t on j, t = (-nz, nx); torques -P a
+            i = g.pair_ij[q, 0]
+            j = g.pair_ij[q, 1]
+            ri = g.radius[i]
+            rj = g.radius[j]
+            delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
+            c = g.pair_coef[q]
+            if delta <= 0.0 or c[COEF_MU] == 0.0:
+                continue
+            ai = contact_arm(ri, delta, 0.5 * cfg.arm_shrink)
+            aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
+            ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
+            n, _ = normal_force(delta, ddot, c[COEF_A], c[COEF_C], cfg.clip)
+            inv_t = 1.0 / g.mass[i] + 1.0 / g.mass[j] + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]
+            imp, dw = friction_impulse(vt, n, c[COEF_MU], c[COEF_KS], inv_t, dt)
+            y[i, 3] += imp * nz / g.mass[i]
+            y[i, 4] -= imp * nx / g.mass[i]
+            y[i, 5] -= imp * ai / g.inertia[i]
+            y[j, 3] -= imp * nz / g.mass[j]
+            y[j, 4] += imp * nx / g.mass[j]
+            y[j, 5] -= imp * aj / g.inertia[j]
+            work += dw
+        else:  # wall contact w, the wall at rest
+            w = q - n_p
+            i = g.wall_i[w]
+            ri = g.radius[i]
+            nx = g.wall_geo[w, 0]
+            nz = g.wall_geo[w, 1]
+            delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, g.wall_geo[w, 2])
+            c = g.wall_coef[w]
+            if delta <= 0.0 or c[COEF_MU] == 0.0:
+                continue
+            ai = contact_arm(ri, delta, cfg.arm_shrink)
+            ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
+            n, _ = normal_force(delta, ddot, c[COEF_A], c[COEF_C], cfg.clip)
+            imp, dw = friction_impulse(vt, n, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i], dt)
+            y[i, 3] += imp * nz / g.mass[i]
+            y[i, 4] -= imp * nx / g.mass[i]
+            y[i, 5] -= imp * ai / g.inertia[i]
+            work += dw
     return work
 
 
