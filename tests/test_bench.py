@@ -67,3 +67,14 @@ def test_bench_json_has_documented_keys(tmp_path, monkeypatch):
 def test_bench_unknown_case_is_a_user_error(capsys):
     assert main(["bench", "--cases", "no-such-preset"]) == 2
     assert "unknown case" in capsys.readouterr().err
+
+
+def test_bench_friction_table_runs_every_case(capsys, monkeypatch):
+    """`granplate bench --friction --t-end 2e-7` (on a 4 x 6 packing) prints a row per case."""
+    from granplate.bench import friction
+
+    monkeypatch.setitem(friction.PACKING, "columns", 4)
+    monkeypatch.setitem(friction.PACKING, "rows", 6)
+    assert main(["bench", "--friction", "--t-end", "2e-7"]) == 0
+    out = capsys.readouterr().out
+    assert out.count("packing 22, mu") == 3 and out.count("ptfe-r05, q0 1e7") == 2

@@ -275,7 +275,9 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     (forces on the plate at t + h), w.normal_new, w.slip_new, w.pend (powers at t + h) and
     w.dacc (shock, viscous, friction work over the step), w.ovl_new and w.ovl_who (the
     largest relative overlap at t + h and its contact). Returns (stored contact energy at
-    t + h [J], largest slip relaxation rate of a contact RK4 integrates, at t + h [1/s]).
+    t + h [J], largest slip relaxation rate at t + h of a contact whose friction RK4
+    integrates [1/s]: with cfg.split_friction the plate contacts unless hold, 0 with hold;
+    without it every contact, as the presets' results were computed).
     """
     y0 = st.y
     ng = y0.shape[0]
@@ -332,9 +334,9 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     w.ovl_new[0] = pe[5]
     w.ovl_who[0] = int(pe[6])
     w.ovl_who[1] = int(pe[7])
-    if cfg.split_friction:
-        return pe[3], pe[8]
-    return pe[3], max(pe[4], pe[8])
+    if not cfg.split_friction:
+        return pe[3], max(pe[4], pe[8])
+    return pe[3], 0.0 if hold else pe[8]  # a held plate-contact friction is not RK4's
 
 
 @njit(cache=True)
