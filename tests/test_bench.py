@@ -107,3 +107,14 @@ def test_scaling_sizes_are_checked(capsys):
     assert "--sizes item 'ten'" in capsys.readouterr().err
     assert main(["bench", "--scaling", "--sizes", "4x3", "--t-end", "0"]) == 2
     assert "--t-end 0.0: must be > 0" in capsys.readouterr().err
+
+
+def test_bench_friction_table_runs_every_case(capsys, monkeypatch):
+    """`granplate bench --friction --t-end 2e-7` (on a 4 x 6 packing) prints a row per case."""
+    from granplate.bench import friction
+
+    monkeypatch.setitem(friction.PACKING, "columns", 4)
+    monkeypatch.setitem(friction.PACKING, "rows", 6)
+    assert main(["bench", "--friction", "--t-end", "2e-7"]) == 0
+    out = capsys.readouterr().out
+    assert out.count("packing 22, mu") == 3 and out.count("ptfe-r05, q0 1e7") == 2

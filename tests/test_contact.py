@@ -135,3 +135,20 @@ def test_local_map_modulus_eq8():
     lam = C.local_map_modulus(0.099, 1000.0, 50.0, 4e-9, 1e5, 0.0)
     assert lam == pytest.approx(0.5 * 0.099 * 1000 * 50 * 4e-9 * 1e5)
     assert C.local_map_modulus(0.099, 1000.0, 50.0, 4e-9, 1e5, 1e-2) < lam
+
+
+@pytest.mark.parametrize("v0, decay", [(2e-4, 0.3), (2e-3, 5.0), (-0.05, 40.0), (0.5, 1e3), (36.0, 2e4), (-36.0, 4e4)])
+def test_slip_after_friction_solves_the_friction_ode(v0, decay):
+    """slip_after_friction equals a tight numerical solution of dv/dt = -m_t^-1 mu N tanh(k_s v)
+    (eq. 5), never changes sign and only decays, also where sinh(k_s v) overflows."""
+    from scipy.integrate import solve_ivp
+
+    mu, k_s, n, inv_m = 0.1, 1000.0, 50.0, 100.0
+    dt = decay / (mu * k_s * n * inv_m)  # decay = stick relaxation rate x dt
+    got = C.slip_after_friction(v0, n, mu, k_s, inv_m, dt)
+    sol = solve_ivp(lambda t, v: -inv_m * mu * n * np.tanh(k_s * v), (0.0, dt), [v0], method="Radau",
+                    rtol=1e-12, atol=1e-15)
+    assert got == pytest.approx(sol.y[0, -1], rel=1e-7, abs=1e-12)
+    assert 0.0 <= got / v0 <= 1.0
+    if abs(k_s * v0) > 30.0 and inv_m * mu * n * dt < abs(v0) / 2:  # gross slip: Coulomb deceleration
+        assert got == pytest.approx(v0 - math.copysign(inv_m * mu * n * dt, v0), rel=1e-12)

@@ -123,6 +123,8 @@ BAD = [
     ("field interval", _with({"time.field_interval": 2.5e-6}), "time.field_interval",
      "whole multiple"),
     ("scheme", _with({"solver.scheme": "monolithic"}), "solver.scheme", "'paper'"),
+    ("granular friction", _with({"solver.granular_friction": "explicit"}), "solver.granular_friction",
+     "'split', 'rk4'"),
     ("lambda_target", _with({"solver.lambda_target": 1.0}), "solver.lambda_target",
      "must be in (0, 1)"),
     ("iteration tolerance", _with({"solver.iteration_rtol": 0.0}), "solver.iteration_rtol",

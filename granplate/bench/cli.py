@@ -7,6 +7,10 @@ def _cmd_bench(args) -> int:
         from granplate.bench import scaling
 
         return int(scaling.main(args))
+    if getattr(args, "friction", False):
+        from granplate.bench import friction
+
+        return int(friction.main(args))
     if getattr(args, "plates", False):
         from granplate.bench import plates
 
@@ -41,4 +45,7 @@ def register(subparsers) -> None:
                    help="with --scaling: solver.scheme of granplate's runs (default implicit)")
     b.add_argument("--no-lammps", dest="no_lammps", action="store_true",
                    help="with --scaling: leave LAMMPS out even where it is installed")
+    b.add_argument("--friction", action="store_true",
+                   help="instead: steps and time with the granules' friction split off or inside RK4 "
+                        "(a 990-granule packing, ptfe-r05 under q0 = 1e7 N/m)")
     b.set_defaults(func=_cmd_bench)

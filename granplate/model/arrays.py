@@ -223,6 +223,7 @@ def loop_config(s: Scenario, fres: np.ndarray, tres: np.ndarray, r: np.ndarray, 
         plate_x0=float(s.plate.x0) if s.plate is not None else math.inf,
         plate_ylo=float(s.plate.y0) if s.plate is not None else 0.0,
         plate_yhi=float(s.plate.y0 + s.plate.height) if s.plate is not None else 0.0,
+        split_friction=sol.granular_friction == "split",
     )
 
 

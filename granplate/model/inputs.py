@@ -95,3 +95,4 @@ class Config(NamedTuple):
     plate_x0: float = math.inf  # the plate's undeformed face x [m] (inf: no plate)
     plate_ylo: float = 0.0  # its extent in y [m]
     plate_yhi: float = 0.0
+    split_friction: bool = True  # solver.granular_friction = "split" (solver.granular.rk4_granular_step)

@@ -168,6 +168,33 @@ def friction_slope(n_abs: float, v_t: float, mu: float, k_s: float) -> float:
     return mu * k_s * n_abs / (ch * ch)
 
 
+#: beyond this |k_s v_t| sinh(k_s v_t) is handled through its logarithm (no overflow).
+_SINH_LOG = 20.0
+
+
+@njit(cache=True)
+def slip_after_friction(v_t: float, n_abs: float, mu: float, k_s: float, inv_mass_t: float, dt: float) -> float:
+    """Slip rate [m/s] after friction alone has acted for dt [s] at one contact: the exact
+    solution of d v_t/dt = -m_t^-1 mu |N| tanh(k_s v_t) (eq. 5 on the tangential inverse
+    mass m_t^-1 [1/kg], |N| held), sinh(k_s v_t) = sinh(k_s v_t,0) exp(-mu k_s |N| m_t^-1 dt).
+
+    Decays monotonically towards 0 without changing sign, for any dt (stable however stiff
+    the friction is); in gross slip (|k_s v_t| >> 1) v_t falls by mu |N| m_t^-1 dt, in
+    stick it relaxes exponentially at the rate of `friction_slope` times m_t^-1.
+    """
+    x = k_s * v_t
+    decay = mu * k_s * n_abs * inv_mass_t * dt
+    if x == 0.0 or decay <= 0.0:
+        return v_t
+    ax = abs(x)
+    if ax < _SINH_LOG:
+        return math.copysign(math.asinh(math.sinh(ax) * math.exp(-decay)), x) / k_s
+    z = ax - decay  # log(2 sinh(ax) e^-decay) up to e^(-2 ax)
+    if z > _SINH_LOG:
+        return math.copysign(z, x) / k_s  # asinh(e^z / 2) = z up to e^(-2 z)
+    return math.copysign(math.asinh(0.5 * math.exp(z)), x) / k_s
+
+
 @njit(cache=True)
 def local_map_modulus(mu: float, k_s: float, n_abs: float, dt: float, c_t: float, v_t: float) -> float:
     """|lambda| of the frictional local map at a plate contact, paper eq. (8):

@@ -318,7 +318,10 @@ class Solver:
     forces and the granules' net forces from their extrapolation) the step control aims
     at; the step is also held to an energy-residual growth of energy_tol / 2 over the run;
     implicit_dt_max: "implicit" scheme, the largest step [s] (rounded down to
-    time.output_interval / 2^k; time.dt_max bounds the "paper" scheme).
+    time.output_interval / 2^k; time.dt_max bounds the "paper" scheme);
+    granular_friction: friction at granule-granule and granule-wall contacts, "split"
+    (a step too large for RK4 on it takes it apart: exact friction half steps around RK4
+    of the other forces) or "rk4" (always in RK4, the step cut to keep RK4 stable on it).
     """
 
     scheme: str = "implicit"
@@ -329,6 +332,7 @@ class Solver:
     energy_tol: float = 1e-4
     error_tol: float = 1e-3
     implicit_dt_max: float = 1e-6
+    granular_friction: str = "split"
 
 
 @dataclass(frozen=True)

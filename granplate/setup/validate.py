@@ -35,6 +35,8 @@ TORQUE_ARMS: tuple[str, ...] = ("radius", "contact_point")
 DETECTIONS: tuple[str, ...] = ("dynamic", "fixed")
 #: Coupling schemes the solver knows (Solver.scheme).
 SCHEMES: tuple[str, ...] = ("paper", "implicit")
+#: Treatments of the granule-granule and granule-wall friction (Solver.granular_friction).
+GRANULAR_FRICTIONS: tuple[str, ...] = ("split", "rk4")
 #: Load kinds (Load.kind) and targets (Load.target).
 LOAD_KINDS: tuple[str, ...] = ("line", "none")
 LOAD_TARGETS: tuple[str, ...] = ("granules", "plate")
@@ -391,6 +393,7 @@ def _check_time(s: Scenario) -> None:
 def _check_solver(s: Scenario) -> None:
     sv = s.solver
     string_in("solver.scheme", sv.scheme, SCHEMES)
+    string_in("solver.granular_friction", sv.granular_friction, GRANULAR_FRICTIONS)
     lam = finite("solver.lambda_target", sv.lambda_target, "must be in (0, 1)")
     if not 0.0 < lam < 1.0:
         raise ScenarioError("solver.lambda_target", sv.lambda_target, "must be in (0, 1)")

@@ -1,17 +1,30 @@
 """The granular medium in the loop: the time derivative of every granule's state with
 the contact forces of eqs. (2)-(6), and one RK4 step of it with the plate's contact
 points moving as a scheme prescribes (docs/model.md section 6).
+
+Friction at granule-granule and granule-wall contacts relaxes the slip at a rate that
+grows with |N| (`slip_relaxation_rate`); RK4 is stable only while the step times that
+rate stays below ~2.8. With cfg.split_friction (solver.granular_friction = "split") that
+friction is split off every step (Strang): half a step of friction alone, solved exactly
+contact by contact (`friction_flow`), RK4 of every other force, the other half of
+friction in the reverse contact order; stable for any step. Without it, RK4 integrates
+every force and the step control keeps h times that rate within RK4_FRICTION_LIMIT.
 """
 from __future__ import annotations
 
 from numba import njit
 
 from granplate.physics.contact import (
-    COEF_A, COEF_C, COEF_KS, COEF_MU, contact_arm, contact_response, friction_slope, pair_overlap,
-    pair_rates, plate_overlap, plate_rates, wall_overlap, wall_rates,
+    COEF_A, COEF_C, COEF_KS, COEF_MU, contact_arm, contact_response, friction_slope, normal_force,
+    pair_overlap, pair_rates, plate_overlap, plate_rates, slip_after_friction, wall_overlap, wall_rates,
 )
 from granplate.physics.shock import time_profile
 from granplate.solver.state import PARTNER_PLATE
+
+
+#: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps h
+#: times the friction relaxation rate of every contact that RK4 integrates below this bound.
+RK4_FRICTION_LIMIT = 1.0
 
 
 @njit(cache=True)
@@ -24,17 +37,19 @@ def slip_relaxation_rate(n, vt, mu, k_s, inv_mass_t):
 
 
 @njit(cache=True)
-def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
+def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, split=False):
     """Time derivative of the granular state and the plate-contact forces.
 
     y: (ng, 6) state; up, vp: driving-DOF displacement and velocity at t; writes dy,
     fplate (nd,) = force ON the plate [N, N] per contact, normal and slip at each plate
     contact. hold: the plate-contact friction is fbar[k] (held over the step, its work
-    booked by the scheme) instead of eq. (5). Returns (shock power, viscous power,
-    friction power, contact potential energy, largest slip relaxation rate of a granule
-    contact, largest overlap over the smaller radius, its granule, its partner (granule j,
-    wall -1 - w or PARTNER_PLATE; -1, -1 with no overlap; as floats)) [W, W, W, J, 1/s, -, -, -]; RK4
-    needs h times that rate below ~2.8. One function
+    booked by the scheme) instead of eq. (5); split: no friction at granule-granule and
+    granule-wall contacts (`friction_flow` applies it). Returns (shock power, viscous power,
+    friction power, contact potential energy, largest slip relaxation rate of a
+    granule-granule or granule-wall contact, largest overlap over the smaller radius, its
+    granule, its partner (granule j, wall -1 - w or PARTNER_PLATE; -1, -1 with no overlap;
+    as floats), largest slip relaxation rate of a plate contact (0 with hold))
+    [W, W, W, J, 1/s, -, -, -, 1/s]; RK4 needs h times a rate below ~2.8. One function
     (not one per contact kind): calls that pass the model tuples cost more per step
     than the loops themselves when the medium is small.
     """
@@ -51,6 +66,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
     p_fric = 0.0
     e_pot = 0.0
     rate = 0.0
+    rate_plate = 0.0
     ovl = 0.0  # the largest overlap / smaller radius, at granule ovl_i with ovl_j
     ovl_i = -1
     ovl_j = -1
@@ -82,6 +98,9 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
         n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
         rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + 1.0 / g.mass[j]
                                               + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]))
+        if split:
+            f = 0.0
+            pf = 0.0
         fx = -n * nx + f * nz  # on i: -n nvec - f tvec, tvec = (-nz, nx); on j the opposite
         fz = -n * nz - f * nx
         dy[i, 3] += fx
@@ -110,6 +129,9 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
         c = g.wall_coef[w]
         n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
         rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i]))
+        if split:
+            f = 0.0
+            pf = 0.0
         dy[i, 3] += -n * nx + f * nz
         dy[i, 4] += -n * nz - f * nx
         dy[i, 5] -= f * ai
@@ -133,7 +155,8 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
             c = g.pc_coef[k]
             n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
             if not hold:  # the granule side only: the plate side of this map is criterion (8)
-                rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i]))
+                rate_plate = max(rate_plate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS],
+                                                                  1.0 / g.mass[i] + ai * ai / g.inertia[i]))
             dy[i, 3] -= n
             p_visc += pv
             e_pot += ep
@@ -152,7 +175,76 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar):
         dy[i, 3] /= g.mass[i]
         dy[i, 4] /= g.mass[i]
         dy[i, 5] /= g.inertia[i]
-    return p_shock, p_visc, p_fric, e_pot, rate, ovl, float(ovl_i), float(ovl_j)  # one float tuple: indexable
+    # one float tuple: indexable
+    return p_shock, p_visc, p_fric, e_pot, rate, ovl, float(ovl_i), float(ovl_j), rate_plate
+
+
+@njit(cache=True)
+def friction_impulse(vt, n, mu, k_s, inv_mass_t, dt):
+    """Friction alone at one contact over dt [s] (eq. 5, |N| = n held): the slip rate vt
+    [m/s] relaxes exactly (`slip_after_friction`) to v1. Returns (the impulse
+    P = (vt - v1) / m_t^-1 [N s], along -t on the first body, and the energy it dissipates,
+    the kinetic energy it removes, P (vt + v1) / 2 >= 0 [J])."""
+    v1 = slip_after_friction(vt, n, mu, k_s, inv_mass_t, dt)
+    imp = (vt - v1) / inv_mass_t
+    return imp, 0.5 * imp * (vt + v1)
+
+
+@njit(cache=True)
+def friction_flow(y, dt, g, cfg, forward):
+    """Friction alone at every granule-granule and granule-wall contact over dt [s], one
+    contact after the other (`friction_impulse`, |N| at the current state; pairs then
+    walls, or with forward False the reverse order, so that two half steps in opposite
+    orders make a symmetric split). Changes the velocities and spins in y, never the
+    positions. Returns the energy dissipated [J] (>= 0, booked exactly as the kinetic
+    energy each contact removes). One function, not one call per contact (a call that
+    passes the model tuples costs more than a contact)."""
+    n_p = g.pair_ij.shape[0]
+    n_w = g.wall_i.shape[0]
+    work = 0.0
+    for k in range(n_p + n_w):
+        q = k if forward else n_p + n_w - 1 - k
+        if q < n_p:  # pair q: -P t on i, +P t on j, t = (-nz, nx); torques -P a
+            i = g.pair_ij[q, 0]
+            j = g.pair_ij[q, 1]
+            ri = g.radius[i]
+            rj = g.radius[j]
+            delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
+            c = g.pair_coef[q]
+            if delta <= 0.0 or c[COEF_MU] == 0.0:
+                continue
+            ai = contact_arm(ri, delta, 0.5 * cfg.arm_shrink)
+            aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
+            ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
+            n, _ = normal_force(delta, ddot, c[COEF_A], c[COEF_C], cfg.clip)
+            inv_t = 1.0 / g.mass[i] + 1.0 / g.mass[j] + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]
+            imp, dw = friction_impulse(vt, n, c[COEF_MU], c[COEF_KS], inv_t, dt)
+            y[i, 3] += imp * nz / g.mass[i]
+            y[i, 4] -= imp * nx / g.mass[i]
+            y[i, 5] -= imp * ai / g.inertia[i]
+            y[j, 3] -= imp * nz / g.mass[j]
+            y[j, 4] += imp * nx / g.mass[j]
+            y[j, 5] -= imp * aj / g.inertia[j]
+            work += dw
+        else:  # wall contact w, the wall at rest
+            w = q - n_p
+            i = g.wall_i[w]
+            ri = g.radius[i]
+            nx = g.wall_geo[w, 0]
+            nz = g.wall_geo[w, 1]
+            delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, g.wall_geo[w, 2])
+            c = g.wall_coef[w]
+            if delta <= 0.0 or c[COEF_MU] == 0.0:
+                continue
+            ai = contact_arm(ri, delta, cfg.arm_shrink)
+            ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
+            n, _ = normal_force(delta, ddot, c[COEF_A], c[COEF_C], cfg.clip)
+            imp, dw = friction_impulse(vt, n, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i], dt)
+            y[i, 3] += imp * nz / g.mass[i]
+            y[i, 4] -= imp * nx / g.mass[i]
+            y[i, 5] -= imp * ai / g.inertia[i]
+            work += dw
+    return work
 
 
 @njit(cache=True)
@@ -171,15 +263,21 @@ def no_granules_step(h, p1, dacc, pend, ovl_new, ovl_who):
 
 @njit(cache=True)
 def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
-    """One RK4 step of the granules from st.y with the plate's contact points at
-    stage[0], stage[1] (u, v at t + h/2) and stage[2], stage[3] (u, v at t + h).
+    """One step of the granules from st.y with the plate's contact points at stage[0],
+    stage[1] (u, v at t + h/2) and stage[2], stage[3] (u, v at t + h): RK4 of every force,
+    or with cfg.split_friction, half a step of the granule-granule and granule-wall
+    friction alone (`friction_flow`), RK4 of the other forces, and the other half of that
+    friction in reverse order (Strang).
 
     Stage 1 reuses st.k1/st.p1 (first same as last), unless hold (the plate-contact
-    friction held at w.fbar over the step), which changes it. Writes w.ynew, w.kend,
-    w.fnew (forces on the plate at t + h), w.normal_new, w.slip_new, w.pend (powers at
-    t + h) and w.dacc (shock, viscous, friction work over the step), w.ovl_new and
-    w.ovl_who (the largest relative overlap at t + h and its contact). Returns (stored
-    contact energy at t + h [J], largest slip relaxation rate [1/s]).
+    friction held at w.fbar over the step) or the split (the friction half step moves
+    the velocities) changes it. Writes w.ynew, w.kend (without the split friction), w.fnew
+    (forces on the plate at t + h), w.normal_new, w.slip_new, w.pend (powers at t + h) and
+    w.dacc (shock, viscous, friction work over the step), w.ovl_new and w.ovl_who (the
+    largest relative overlap at t + h and its contact). Returns (stored contact energy at
+    t + h [J], largest slip relaxation rate at t + h of a contact whose friction RK4
+    integrates [1/s]: with cfg.split_friction the plate contacts unless hold, 0 with hold;
+    without it every contact, as the presets' results were computed).
     """
     y0 = st.y
     ng = y0.shape[0]
@@ -187,8 +285,17 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
         return no_granules_step(h, st.p1, w.dacc, w.pend, w.ovl_new, w.ovl_who)
     k1 = st.k1
     p1 = st.p1
-    if hold:
-        pr = granular_rhs(t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, True, w.fbar)
+    split = cfg.split_friction
+    fric_split = 0.0
+    if split:  # friction over [t, t + h/2]; RK4 then starts from w.ynew, updated in place
+        for i in range(ng):
+            for c in range(6):
+                w.ynew[i, c] = y0[i, c]
+        fric_split = friction_flow(w.ynew, 0.5 * h, g, cfg, True)
+        y0 = w.ynew
+    if hold or split:
+        pr = granular_rhs(t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar,
+                          split)
         w.p1h[0] = pr[0]
         w.p1h[1] = pr[1]
         w.p1h[2] = pr[2]
@@ -198,29 +305,38 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     for i in range(ng):
         for c in range(6):
             w.ytmp[i, c] = y0[i, c] + hh * k1[i, c]
-    p2 = granular_rhs(t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k2, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar)
+    p2 = granular_rhs(t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k2, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar,
+                      split)
     for i in range(ng):
         for c in range(6):
             w.ytmp[i, c] = y0[i, c] + hh * w.k2[i, c]
-    p3 = granular_rhs(t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k3, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar)
+    p3 = granular_rhs(t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k3, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar,
+                      split)
     for i in range(ng):
         for c in range(6):
             w.ytmp[i, c] = y0[i, c] + h * w.k3[i, c]
-    p4 = granular_rhs(t + h, w.ytmp, stage[2], stage[3], g, cfg, w.k4, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar)
+    p4 = granular_rhs(t + h, w.ytmp, stage[2], stage[3], g, cfg, w.k4, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar,
+                      split)
     h6 = h / 6.0
     for i in range(ng):
-        for c in range(6):
+        for c in range(6):  # (y0 may be w.ynew itself: each entry is read before it is written)
             w.ynew[i, c] = y0[i, c] + h6 * (k1[i, c] + 2.0 * w.k2[i, c] + 2.0 * w.k3[i, c] + w.k4[i, c])
     for c in range(3):
         w.dacc[c] = h6 * (p1[c] + 2.0 * p2[c] + 2.0 * p3[c] + p4[c])
-    pe = granular_rhs(t + h, w.ynew, stage[2], stage[3], g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar)
+    if split:  # friction over [t + h/2, t + h]
+        fric_split += friction_flow(w.ynew, hh, g, cfg, False)
+        w.dacc[2] += fric_split
+    pe = granular_rhs(t + h, w.ynew, stage[2], stage[3], g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar,
+                      split)
     w.pend[0] = pe[0]
     w.pend[1] = pe[1]
     w.pend[2] = pe[2]
     w.ovl_new[0] = pe[5]
     w.ovl_who[0] = int(pe[6])
     w.ovl_who[1] = int(pe[7])
-    return pe[3], pe[4]
+    if not cfg.split_friction:
+        return pe[3], max(pe[4], pe[8])
+    return pe[3], 0.0 if hold else pe[8]  # a held plate-contact friction is not RK4's
 
 
 @njit(cache=True)
@@ -236,10 +352,6 @@ def kinetic_energies(y, mass, inertia):
         kr += 0.5 * inertia[i] * y[i, 5] * y[i, 5]
     return kx, ky, kr
 
-
-#: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps
-#: h * (friction relaxation rate of every granule contact) below this bound.
-RK4_FRICTION_LIMIT = 1.0
 
 
 @njit(cache=True)

@@ -29,8 +29,10 @@ from granplate.solver.state import (
 
 @njit(cache=True)
 def initialise(st, g, p, cfg, w):
-    """Forces, accelerations and energies at t = 0 (state y, q, qd already set)."""
-    pr = granular_rhs(st.clock[T_NOW], st.y, st.u, st.v, g, cfg, st.k1, st.force, st.normal, st.slip, False, w.fbar)
+    """Forces, accelerations and energies at t = 0 (state y, q, qd already set); the
+    granules' derivative as every step's end one (without the split-off friction)."""
+    pr = granular_rhs(st.clock[T_NOW], st.y, st.u, st.v, g, cfg, st.k1, st.force, st.normal, st.slip, False, w.fbar,
+                      cfg.split_friction)
     st.p1[0] = pr[0]
     st.p1[1] = pr[1]
     st.p1[2] = pr[2]

@@ -253,9 +253,10 @@ def free_assembly(ctx: Context) -> CaseResult:
         "conservation row shows.",
         "The free assembly needs h = 10 ns: while a frictional contact sticks, the tanh law "
         "relaxes the slip at rate mu k_s |N| (1/m_i + 1/m_j + R_i^2/I_i + R_j^2/I_j), about 2e8 "
-        "1/s at the peak force here, and RK4 is stable only below h times that rate = 2.8. The "
-        "step control now bounds h times that rate by 1 at every granule contact (besides "
-        "criterion (8) at the plate contacts); the scenario fixes dt_max = 10 ns anyway.",
+        "1/s at the peak force here, and RK4 is stable only below h times that rate = 2.8. With "
+        "solver.granular_friction = rk4 the step control bounds h times that rate by 1 at every "
+        "granule contact; the default (split) solves that friction exactly per contact at any "
+        "step; the scenario fixes dt_max = 10 ns anyway.",
     ]
     return CaseResult("", "", "", desc, checks, name, notes=notes)
 

@@ -495,7 +495,8 @@ def sliding_rolling(ctx: Context) -> CaseResult:
     return CaseResult("", "", "", desc, checks, name, notes=[
         "The step is 4 ns because while the contact sticks the tanh law is stiff: the slip "
         "relaxes at rate (7/2) mu k_s |N| / m ~ 2e7 1/s here, and RK4 is stable only for "
-        "h times that rate below 2.8; the step control of eq. (8) watches plate contacts only."])
+        "h times that rate below 2.8 (with solver.granular_friction = rk4; the default, split, "
+        "solves this friction exactly per contact at any step)."])
 
 
 CASES: tuple[Case, ...] = (

@@ -113,7 +113,7 @@ def held_friction_target(normal, normal_new, slip_new, g, fnew):
 def attempt(sw, t, h, slot, st, g, p, cfg, w):
     """Known plate motion, then Newton on the interface unknowns from the guess in
     w.fguess. Returns (converged, iterations, worst contact, stored energy at t + h,
-    largest slip relaxation rate)."""
+    largest slip relaxation rate of a contact whose friction RK4 integrates)."""
     exact_predict(t, h, st, p, cfg, sw.mcoef[slot], sw.ustar)
     for k in range(sw.vguess.shape[0]):
         sw.vguess[k] = st.slip[k]
@@ -227,7 +227,8 @@ def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
 @njit(cache=True)
 def next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg):
     """The next step from the error estimate (grow at most 2x), RK4 stable on the
-    friction, the shock pulse resolved; below dt_min it goes on at dt_min (accuracy,
+    friction it integrates (rate [1/s]: none with solver.granular_friction = "split"), the
+    shock pulse resolved; below dt_min it goes on at dt_min (accuracy,
     not stability). Returns (level, step [s])."""
     h_lvl = level_step(level, cfg)
     grow = 2.0 if err <= 0.0 else min(2.0, max(0.3, 0.9 / math.sqrt(err)))

@@ -85,7 +85,7 @@ def stage_motion(h, u, v, aavg, stage):
 def attempt(sw, t, h, slot, st, g, p, cfg, w):
     """Predictor, then the interpolation-iteration from the guess in w.fguess.
     Returns (converged, iterations, worst contact, stored energy at t + h, largest
-    slip relaxation rate)."""
+    slip relaxation rate of a contact whose friction RK4 integrates)."""
     newmark_predict(t, h, st, p, cfg, w.dmode[slot], sw.qdd_star, sw.astar)
     gm = w.gmat[slot]
     converged = False
@@ -135,7 +135,8 @@ def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
 @njit(cache=True)
 def next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg):
     """The next step keeps |lambda| near lambda_target (at most doubling) and RK4
-    stable on the friction. Returns (level, step [s])."""
+    stable on the friction it integrates (rate [1/s]: the plate contacts', and the granule
+    contacts' with solver.granular_friction = "rk4"). Returns (level, step [s])."""
     h_lvl = level_step(level, cfg)
     if lam_max > 0.0:
         h_new = min(h * cfg.lambda_target / lam_max, 2.0 * h_lvl, cfg.dt_max)
