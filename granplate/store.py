@@ -11,7 +11,9 @@ tag, such as a preset name), carry their key inside (an npz array, a JSON field,
 attribute) and are compared with it when read. Writes are atomic (a temporary file in the
 same folder, then os.replace); a read returns None, never raises, for a missing,
 truncated, corrupt or mismatched entry, and a failed save only warns (the caller just
-computes again next time). Reading an entry marks it used; beyond
+computes again next time). `exclusive` makes processes that would compute the same entry
+at the same time (the workers of a sweep) take turns, so it is computed once. Reading an
+entry marks it used; beyond
 ``$GRANPLATE_CACHE_MAX_BYTES`` (default 2 GiB) the least recently used entries are
 removed after each save.
 """
@@ -22,8 +24,9 @@ import json
 import os
 import tempfile
 import warnings
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 #: Environment variable naming the cache directory.
 CACHE_ENV = "GRANPLATE_CACHE"
@@ -35,6 +38,8 @@ DEFAULT_MAX_BYTES = 2 * 1024**3
 KEY_FIELD = "granplate_store_key"
 #: Suffix of the temporary files of an atomic write (never an entry).
 TMP_SUFFIX = ".tmp"
+#: Suffix of the lock files of `exclusive` (never an entry).
+LOCK_SUFFIX = ".lock"
 
 
 # --------------------------------------------------------------------------------------
@@ -88,6 +93,32 @@ def atomic_write(path: str | Path, write: Callable[[Path], Any]) -> Path:
         if tmp.exists():
             tmp.unlink()
     return path
+
+
+@contextmanager
+def exclusive(kind: str, payload: Any, fmt: int) -> Iterator[None]:
+    """Hold the entry key(kind, payload, fmt) for this process: another process asking for
+    the same entry waits until this one leaves (so that it finds the entry stored instead
+    of computing it again). A lock on DIR/KIND/.KEY.lock, released by the system when the
+    process dies; where locking is not available (no fcntl, an unwritable folder) it
+    does not wait."""
+    path = cache_directory() / kind / f".{key(kind, payload, fmt)}{LOCK_SUFFIX}"
+    try:
+        import fcntl
+
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fh = open(path, "a")
+    except (ImportError, OSError):
+        yield
+        return
+    try:
+        try:
+            fcntl.flock(fh.fileno(), fcntl.LOCK_EX)
+        except OSError:
+            pass
+        yield
+    finally:
+        fh.close()  # releases the lock
 
 
 def _save(kind: str, entry_key: str, suffix: str, label: str, write: Callable[[Path], Any]) -> Path | None:
@@ -200,7 +231,7 @@ def _entries(kind: str | None = None) -> list[tuple[str, Path]]:
     for folder in kinds:
         if folder.is_dir():
             out += [(folder.name, p) for p in sorted(folder.iterdir())
-                    if p.is_file() and not p.name.endswith(TMP_SUFFIX)]
+                    if p.is_file() and not p.name.endswith((TMP_SUFFIX, LOCK_SUFFIX))]
     return out
 
 

@@ -22,9 +22,6 @@ RECORD_KIND = "study-design"
 RECORD_FORMAT = 1
 #: Folder of the records inside a study's output folder.
 DESIGNS = "designs"
-#: Simulated time of a worker's warm-up run [s] (compiles or loads the kernels, builds the plate).
-WARM_T_END = 1e-6
-
 
 #: Metrics a study adds to gp.summary: name -> (unit, meaning).
 EXTRA_METRICS: dict[str, tuple[str, str]] = {
@@ -62,12 +59,13 @@ def run_design(scenario_toml: str, full: bool = False) -> dict[str, Any]:
 
     status is "ok" or the failure message (a scenario the physics refuses, a run that goes
     numerically wrong, or any other error: a failing design never stops a sweep); summary
-    is `metrics` of the run: gp.summary and EXTRA_METRICS (None on failure); result the Dataset when full, else None.
+    is `metrics` of the run: gp.summary and EXTRA_METRICS (None on failure); result the
+    Dataset when full, else None (and then only what the summary reads is computed).
     """
     t0 = time.perf_counter()
     ds = summary = None
     try:
-        ds = gp.simulate(gp.loads(scenario_toml), progress=False)
+        ds = gp.simulate(gp.loads(scenario_toml), progress=False, summary_only=not full)
         summary = metrics(ds)
         status = "ok"
     except GranplateError as err:
@@ -76,19 +74,6 @@ def run_design(scenario_toml: str, full: bool = False) -> dict[str, Any]:
         status = failure_message(err)
     return {"status": status, "summary": summary, "elapsed_s": time.perf_counter() - t0,
             "result": ds if full and summary is not None else None}
-
-
-def warm_up(scenario_toml: str) -> float:
-    """A short run of a design (on each worker before the sweep): the compiled kernels are
-    loaded from numba's on-disk cache (or compiled and written there) and the design's plate
-    model is built into, or read from, the run store. The seconds it took."""
-    t0 = time.perf_counter()
-    s = gp.loads(scenario_toml)
-    try:
-        gp.simulate(s, t_end=min(s.time.t_end, WARM_T_END), progress=False)
-    except Exception:  # noqa: BLE001 - the design itself reports its failure later
-        pass
-    return time.perf_counter() - t0
 
 
 # ------------------------------------------------------------------------- records
