@@ -154,12 +154,31 @@ def save_arrays(kind: str, payload: Any, fmt: int, arrays: dict[str, Any], label
     return _save(kind, k, ".npz", label, write)
 
 
+#: The entry `load_arrays` read last in this process: path -> (file signature, arrays).
+_LAST_ARRAYS: dict[Path, tuple[tuple, dict]] = {}
+
+
+def _signature(path: Path) -> tuple | None:
+    """What identifies a file's content here: device, inode, size, modification time."""
+    try:
+        st = path.stat()
+    except OSError:
+        return None
+    return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+
+
 def load_arrays(kind: str, payload: Any, fmt: int, label: str = "") -> dict[str, Any] | None:
-    """The arrays stored under key(kind, payload, fmt), or None (missing, unreadable, other key)."""
+    """The arrays stored under key(kind, payload, fmt), or None (missing, unreadable, other key).
+
+    The entry read last is kept in memory while its file is unchanged (the designs of a
+    study that share a plate read it once per process): callers must not modify the arrays."""
     import numpy as np
 
     k = key(kind, payload, fmt)
     path = entry_path(kind, k, ".npz", label)
+    last = _LAST_ARRAYS.get(path)
+    if last is not None and last[0] == _signature(path):
+        return dict(last[1])
     try:
         with np.load(path, allow_pickle=False) as data:
             if str(data[KEY_FIELD]) != k:
@@ -168,7 +187,11 @@ def load_arrays(kind: str, payload: Any, fmt: int, label: str = "") -> dict[str,
     except Exception:  # noqa: BLE001 - any unreadable entry just means "compute again"
         return None
     _touch(path)
-    return arrays
+    sig = _signature(path)
+    _LAST_ARRAYS.clear()
+    if sig is not None:
+        _LAST_ARRAYS[path] = (sig, arrays)
+    return dict(arrays)
 
 
 def save_json(kind: str, payload: Any, fmt: int, doc: Any, label: str = "") -> Path | None:

@@ -55,12 +55,15 @@ def failure_message(err: BaseException) -> str:
 
 
 def run_design(scenario_toml: str, full: bool = False) -> dict[str, Any]:
-    """Simulate one design (runs on a worker): {"status", "summary", "elapsed_s", "result"}.
+    """Simulate one design (runs on a worker): {"status", "summary", "elapsed_s",
+    "timings", "result"}.
 
     status is "ok" or the failure message (a scenario the physics refuses, a run that goes
     numerically wrong, or any other error: a failing design never stops a sweep); summary
-    is `metrics` of the run: gp.summary and EXTRA_METRICS (None on failure); result the
-    Dataset when full, else None (and then only what the summary reads is computed).
+    is `metrics` of the run: gp.summary and EXTRA_METRICS (None on failure); elapsed_s the
+    task's seconds on its worker, all included; timings the run's set-up and loop seconds
+    (`timings`, {} on failure); result the Dataset when full, else None (and then only
+    what the summary reads is computed).
     """
     t0 = time.perf_counter()
     ds = summary = None
@@ -73,7 +76,13 @@ def run_design(scenario_toml: str, full: bool = False) -> dict[str, Any]:
     except Exception as err:  # noqa: BLE001 - recorded as the design's failure
         status = failure_message(err)
     return {"status": status, "summary": summary, "elapsed_s": time.perf_counter() - t0,
+            "timings": timings(ds) if summary is not None else {},
             "result": ds if full and summary is not None else None}
+
+
+def timings(ds) -> dict[str, float]:
+    """Where a design's run spent its time [s]: set-up (model), loop (first call included)."""
+    return {"setup_s": float(ds.attrs.get("setup_time_s", 0.0)), "loop_s": float(ds.attrs.get("loop_time_s", 0.0))}
 
 
 # ------------------------------------------------------------------------- records
@@ -86,7 +95,8 @@ def make_record(key: str, changes: dict, scenario_toml: str, outcome: dict) -> d
     """The JSON record of a finished design."""
     return {"key": key, "granplate_version": gp.__version__, "status": outcome["status"],
             "changes": changes, "summary": outcome["summary"],
-            "elapsed_s": outcome["elapsed_s"], "scenario_toml": scenario_toml}
+            "elapsed_s": outcome["elapsed_s"], "timings": outcome.get("timings", {}),
+            "scenario_toml": scenario_toml}
 
 
 def write_record(out: str | Path, record: dict, result=None) -> Path:
