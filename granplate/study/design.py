@@ -62,10 +62,10 @@ def run_design(scenario_toml: str, full: bool = False) -> dict[str, Any]:
     numerically wrong, or any other error: a failing design never stops a sweep); summary
     is `metrics` of the run: gp.summary and EXTRA_METRICS (None on failure); elapsed_s the
     task's seconds on its worker, all included; timings the run's set-up and loop seconds
-    (`timings`, {} on failure); result the Dataset when full, else None (and then only
+    (`timings`) and the task's CPU seconds (cpu_s; {} on failure); result the Dataset when full, else None (and then only
     what the summary reads is computed).
     """
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.thread_time()
     ds = summary = None
     try:
         ds = gp.simulate(gp.loads(scenario_toml), progress=False, summary_only=not full)
@@ -76,7 +76,7 @@ def run_design(scenario_toml: str, full: bool = False) -> dict[str, Any]:
     except Exception as err:  # noqa: BLE001 - recorded as the design's failure
         status = failure_message(err)
     return {"status": status, "summary": summary, "elapsed_s": time.perf_counter() - t0,
-            "timings": timings(ds) if summary is not None else {},
+            "timings": {**timings(ds), "cpu_s": time.thread_time() - c0} if summary is not None else {},
             "result": ds if full and summary is not None else None}
 
 
