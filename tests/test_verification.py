@@ -111,6 +111,7 @@ def test_cli_exit_status(tmp_path, monkeypatch):
     md = (tmp_path / "validation.md").read_text()
     assert "boom" in md and "FAIL" in md
     assert cli.main(["verify", "--out", str(tmp_path), "--case", "nonexistent"]) == 2
+    assert cli.main(["verify", "--out", str(tmp_path), "--full", "--workers", "0"]) == 2
 
 
 def test_long_runs_are_every_slow_run_once():

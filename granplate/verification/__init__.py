@@ -99,6 +99,9 @@ def _cmd_verify(args) -> int:
     def log(line: str) -> None:
         print(line, file=sys.stderr, flush=True)
 
+    if args.workers is not None and args.workers < 1:
+        print(f"granplate: error: --workers = {args.workers}: must be >= 1", file=sys.stderr)
+        return 2
     if args.list:
         for case in all_cases():
             print(f"{case.name:22s} {'(--full) ' if case.slow else ''}{case.title}")
