@@ -21,7 +21,7 @@ from pathlib import Path
 
 import granplate as gp
 from granplate.results import engine
-from granplate.results.engine import available_cores, dask_client  # noqa: F401 - the study's engine
+from granplate.results.engine import dask_client
 from granplate.study import design as D
 from granplate.study import table as T
 from granplate.study.spec import Study
