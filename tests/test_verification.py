@@ -136,6 +136,7 @@ def test_long_runs_on_dask_are_kept_and_then_only_read(tmp_path, monkeypatch):
 
     runs = [with_changes(preset(n), {"solver.scheme": "paper", "time.t_end": 2e-5}) for n in ("ptfe-r05", "bare-plate")]
     monkeypatch.setattr(long_runs, "long_runs", lambda: runs)
+    monkeypatch.setenv("GRANPLATE_CACHE", str(tmp_path / "store"))  # an empty run store (the workers inherit it)
     ctx = Context(out=tmp_path, full=True, run_cache={})
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
             Client(cluster) as client:
