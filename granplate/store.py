@@ -11,7 +11,9 @@ tag, such as a preset name), carry their key inside (an npz array, a JSON field,
 attribute) and are compared with it when read. Writes are atomic (a temporary file in the
 same folder, then os.replace); a read returns None, never raises, for a missing,
 truncated, corrupt or mismatched entry, and a failed save only warns (the caller just
-computes again next time). Reading an entry marks it used; beyond
+computes again next time). `exclusive` makes processes that would compute the same entry
+at the same time (the workers of a sweep) take turns, so it is computed once. Reading an
+entry marks it used; beyond
 ``$GRANPLATE_CACHE_MAX_BYTES`` (default 2 GiB) the least recently used entries are
 removed after each save.
 """
@@ -22,8 +24,9 @@ import json
 import os
 import tempfile
 import warnings
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 #: Environment variable naming the cache directory.
 CACHE_ENV = "GRANPLATE_CACHE"
@@ -35,6 +38,8 @@ DEFAULT_MAX_BYTES = 2 * 1024**3
 KEY_FIELD = "granplate_store_key"
 #: Suffix of the temporary files of an atomic write (never an entry).
 TMP_SUFFIX = ".tmp"
+#: Suffix of the lock files of `exclusive` (never an entry).
+LOCK_SUFFIX = ".lock"
 
 
 # --------------------------------------------------------------------------------------
@@ -90,6 +95,32 @@ def atomic_write(path: str | Path, write: Callable[[Path], Any]) -> Path:
     return path
 
 
+@contextmanager
+def exclusive(kind: str, payload: Any, fmt: int) -> Iterator[None]:
+    """Hold the entry key(kind, payload, fmt) for this process: another process asking for
+    the same entry waits until this one leaves (so that it finds the entry stored instead
+    of computing it again). A lock on DIR/KIND/.KEY.lock, released by the system when the
+    process dies; where locking is not available (no fcntl, an unwritable folder) it
+    does not wait."""
+    path = cache_directory() / kind / f".{key(kind, payload, fmt)}{LOCK_SUFFIX}"
+    try:
+        import fcntl
+
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fh = open(path, "a")
+    except (ImportError, OSError):
+        yield
+        return
+    try:
+        try:
+            fcntl.flock(fh.fileno(), fcntl.LOCK_EX)
+        except OSError:
+            pass
+        yield
+    finally:
+        fh.close()  # releases the lock
+
+
 def _save(kind: str, entry_key: str, suffix: str, label: str, write: Callable[[Path], Any]) -> Path | None:
     """Atomically write an entry, then enforce the size cap; an OSError only warns."""
     path = entry_path(kind, entry_key, suffix, label)
@@ -123,12 +154,31 @@ def save_arrays(kind: str, payload: Any, fmt: int, arrays: dict[str, Any], label
     return _save(kind, k, ".npz", label, write)
 
 
+#: The entry `load_arrays` read last in this process: path -> (file signature, arrays).
+_LAST_ARRAYS: dict[Path, tuple[tuple, dict]] = {}
+
+
+def _signature(path: Path) -> tuple | None:
+    """What identifies a file's content here: device, inode, size, modification time."""
+    try:
+        st = path.stat()
+    except OSError:
+        return None
+    return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+
+
 def load_arrays(kind: str, payload: Any, fmt: int, label: str = "") -> dict[str, Any] | None:
-    """The arrays stored under key(kind, payload, fmt), or None (missing, unreadable, other key)."""
+    """The arrays stored under key(kind, payload, fmt), or None (missing, unreadable, other key).
+
+    The entry read last is kept in memory while its file is unchanged (the designs of a
+    study that share a plate read it once per process): callers must not modify the arrays."""
     import numpy as np
 
     k = key(kind, payload, fmt)
     path = entry_path(kind, k, ".npz", label)
+    last = _LAST_ARRAYS.get(path)
+    if last is not None and last[0] == _signature(path):
+        return dict(last[1])
     try:
         with np.load(path, allow_pickle=False) as data:
             if str(data[KEY_FIELD]) != k:
@@ -137,7 +187,11 @@ def load_arrays(kind: str, payload: Any, fmt: int, label: str = "") -> dict[str,
     except Exception:  # noqa: BLE001 - any unreadable entry just means "compute again"
         return None
     _touch(path)
-    return arrays
+    sig = _signature(path)
+    _LAST_ARRAYS.clear()
+    if sig is not None:
+        _LAST_ARRAYS[path] = (sig, arrays)
+    return dict(arrays)
 
 
 def save_json(kind: str, payload: Any, fmt: int, doc: Any, label: str = "") -> Path | None:
@@ -200,7 +254,7 @@ def _entries(kind: str | None = None) -> list[tuple[str, Path]]:
     for folder in kinds:
         if folder.is_dir():
             out += [(folder.name, p) for p in sorted(folder.iterdir())
-                    if p.is_file() and not p.name.endswith(TMP_SUFFIX)]
+                    if p.is_file() and not p.name.endswith((TMP_SUFFIX, LOCK_SUFFIX))]
     return out
 
 

@@ -50,7 +50,7 @@ def test_bench_json_has_documented_keys(tmp_path, monkeypatch):
     assert rc == 0
     report = json.loads(out.read_text())
     keys = documented_keys()
-    assert set(keys) == {"top", "compile", "results"}
+    assert set(keys) == {"top", "compile", "results", "study"}
     assert keys["top"] <= set(report), keys["top"] - set(report)
     assert set(report["compile"]) == set(report["schemes"])
     for c in report["compile"].values():
@@ -118,3 +118,17 @@ def test_bench_friction_table_runs_every_case(capsys, monkeypatch):
     assert main(["bench", "--friction", "--t-end", "2e-7"]) == 0
     out = capsys.readouterr().out
     assert out.count("packing 22, mu") == 3 and out.count("ptfe-r05, q0 1e7") == 2
+
+
+def test_bench_study_json_has_documented_keys(tmp_path):
+    """`granplate bench --study` on a tiny study: every design computed, the JSON has every
+    documented key, and the shares are consistent (loop + overhead = the whole)."""
+    out = tmp_path / "study.json"
+    assert main(["bench", "--study", "--designs", "4", "--workers", "2", "--t-end", "1e-5",
+                 "--json", str(out)]) == 0
+    report = json.loads(out.read_text())
+    keys = documented_keys()["study"]
+    assert keys == set(report), keys ^ set(report)
+    assert report["designs"] == report["designs_ok"] == 4 and report["workers"] == 2
+    assert report["loop_share"] * (1.0 + report["overhead_vs_loop"]) == pytest.approx(1.0)
+    assert 0.0 < report["loop_vs_task_median"] <= 1.0 and report["task_cpu_s_median"] > 0

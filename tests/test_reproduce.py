@@ -20,7 +20,7 @@ T_END = 4e-5  # shock over (1e-5 s), wave inside the packing: every code path, s
 @pytest.fixture(scope="module")
 def first(tmp_path_factory):
     out = tmp_path_factory.mktemp("repro")
-    outcome = rp.reproduce(out, t_end=T_END, jobs=2, frames=3, quiet=True)
+    outcome = rp.reproduce(out, t_end=T_END, workers=2, frames=3, quiet=True)
     return out, outcome
 
 
@@ -46,7 +46,7 @@ def test_second_run_reuses_everything(first):
     """Nothing changed: every result is reused, no file is rewritten."""
     out, outcome = first
     stamps = {r.name: r.path.stat().st_mtime_ns for r in outcome.runs}
-    again = rp.reproduce(out, t_end=T_END, jobs=2, figures=False, animations=False, quiet=True)
+    again = rp.reproduce(out, t_end=T_END, workers=2, figures=False, animations=False, quiet=True)
     assert again.ok and {r.status for r in again.runs} == {"reused"}
     assert {r.name: r.path.stat().st_mtime_ns for r in again.runs} == stamps
 
@@ -61,7 +61,7 @@ def test_changed_scenario_or_version_runs_again(first):
     ds2 = read(out / "ptfe-r05-weak.nc")
     ds2.attrs["granplate_version"] = "0.0.0-old"
     write(ds2, out / "ptfe-r05-weak.nc")
-    again = rp.reproduce(out, t_end=T_END, jobs=2, checks="none", figures=False, animations=False, quiet=True)
+    again = rp.reproduce(out, t_end=T_END, workers=2, checks="none", figures=False, animations=False, quiet=True)
     status = {r.name: r.status for r in again.runs}
     assert status.pop("steel-r1") == "ran" and status.pop("ptfe-r05-weak") == "ran"
     assert set(status.values()) == {"reused"}

@@ -219,3 +219,37 @@ def test_json_entry_is_readable_json():
     path = store.save_json("k", PAYLOAD, 1, {"a": 1})
     entry = json.loads(path.read_text())
     assert entry == {store.KEY_FIELD: store.key("k", PAYLOAD, 1), "doc": {"a": 1}}
+
+
+def test_last_arrays_read_are_kept_while_the_file_is_unchanged(monkeypatch):
+    """A second read of the same entry does not open the file; a rewritten entry is read
+    again, with its new numbers."""
+    store.save_arrays("plate", PAYLOAD, 1, {"a": np.arange(3.0)})
+    assert np.array_equal(store.load_arrays("plate", PAYLOAD, 1)["a"], np.arange(3.0))
+    real_load = np.load
+    monkeypatch.setattr(np, "load", lambda *a, **k: pytest.fail("the entry was read again"))
+    assert np.array_equal(store.load_arrays("plate", PAYLOAD, 1)["a"], np.arange(3.0))
+    monkeypatch.setattr(np, "load", real_load)
+    store.save_arrays("plate", PAYLOAD, 1, {"a": np.arange(4.0)})
+    assert np.array_equal(store.load_arrays("plate", PAYLOAD, 1)["a"], np.arange(4.0))
+
+
+def test_exclusive_makes_a_second_process_wait(tmp_path):
+    """While one process holds an entry, another asking for it waits until it is released."""
+    import subprocess
+    import sys
+    import time
+
+    code = ("import sys, time; from granplate import store\n"
+            "print('ready', flush=True)\n"
+            "t0 = time.perf_counter()\n"
+            "with store.exclusive('plate', {'n': 1}, 1):\n"
+            "    print(time.perf_counter() - t0, flush=True)\n")
+    with store.exclusive("plate", {"n": 1}, 1):
+        other = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True,
+                                 env={**os.environ})
+        assert other.stdout.readline().strip() == "ready"
+        time.sleep(1.0)
+        assert other.poll() is None  # still waiting
+    waited = float(other.communicate(timeout=60)[0])
+    assert waited >= 0.9

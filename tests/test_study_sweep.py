@@ -213,3 +213,43 @@ def test_ctrl_c_keeps_finished_designs_and_a_rerun_computes_only_the_rest(client
     rerun = sweep(parse_study(tomllib.loads(study.read_text())), out, client=client, progress=False)
     assert (rerun.n_done_before, rerun.n_computed) == (kept, 30 - kept)
     assert list(table(out / "results.nc").status.values) == ["ok"] * 30
+
+
+def test_a_killed_worker_loses_no_design(tmp_path):
+    """SIGKILL of a worker process in the middle of a sweep: Dask runs its design again
+    elsewhere (the nanny restarts the worker), nothing is lost, and the table equals that
+    of an undisturbed sweep."""
+    import signal
+    import threading
+    import time
+
+    from distributed import Client, LocalCluster
+
+    from granplate.results.engine import worker_pids
+
+    study = parse_study({"base": "ptfe-r05", "set": {"time.t_end": 1e-4},
+                         "parameters": {"load.q0": {"range": [1e4, 5e4], "num": 12}}})
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
+    killed: list[int] = []
+    with Client(cluster) as c:
+        c.wait_for_workers(2)
+
+        def kill_one_when_a_design_is_in() -> None:
+            deadline = time.monotonic() + 120
+            while not list((tmp_path / "a" / "designs").glob("*.json")) and time.monotonic() < deadline:
+                time.sleep(0.01)
+            pid = sorted(worker_pids(c).values())[0]
+            os.kill(pid, signal.SIGKILL)
+            killed.append(len(list((tmp_path / "a" / "designs").glob("*.json"))))
+
+        killer = threading.Thread(target=kill_one_when_a_design_is_in)
+        killer.start()
+        report = sweep(study, tmp_path / "a", client=c, progress=False)
+        killer.join()
+        undisturbed = sweep(study, tmp_path / "b", client=c, progress=False)
+    cluster.close()
+    assert killed and 1 <= killed[0] < 12, "the worker was not killed during the sweep"
+    assert (report.n_computed, report.n_failed, report.lost) == (12, 0, [])
+    xr.testing.assert_identical(comparable(table(tmp_path / "a" / "results.nc")),
+                                comparable(table(tmp_path / "b" / "results.nc")))
+    assert undisturbed.n_computed == 12

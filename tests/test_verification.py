@@ -111,6 +111,47 @@ def test_cli_exit_status(tmp_path, monkeypatch):
     md = (tmp_path / "validation.md").read_text()
     assert "boom" in md and "FAIL" in md
     assert cli.main(["verify", "--out", str(tmp_path), "--case", "nonexistent"]) == 2
+    assert cli.main(["verify", "--out", str(tmp_path), "--full", "--workers", "0"]) == 2
+
+
+def test_long_runs_are_every_slow_run_once():
+    """The runs computed ahead on Dask are exactly the distinct runs the slow cases read."""
+    from granplate.verification import conservation, coupled, long_runs
+
+    keys = [coupled.cache_key(s) for s in long_runs.long_runs()]
+    wanted = {coupled.cache_key(s) for _, _, s in coupled.study_scenarios()}
+    wanted |= {coupled.cache_key(s) for _, s in conservation.full_runs()}
+    assert len(keys) == len(set(keys)) and set(keys) == wanted
+
+
+def test_long_runs_on_dask_are_kept_and_then_only_read(tmp_path, monkeypatch):
+    """Runs computed on a 2-worker cluster land in the page's run cache and the run store
+    with the summary an in-process run gives (to round-off of the stress: the workers use
+    one BLAS thread); a second pass computes nothing and the cases' study_run reads them."""
+    from distributed import Client, LocalCluster
+
+    from granplate.setup.io import with_changes
+    from granplate.setup.presets import preset
+    from granplate.verification import coupled, long_runs
+
+    runs = [with_changes(preset(n), {"solver.scheme": "paper", "time.t_end": 2e-5}) for n in ("ptfe-r05", "bare-plate")]
+    monkeypatch.setattr(long_runs, "long_runs", lambda: runs)
+    monkeypatch.setenv("GRANPLATE_CACHE", str(tmp_path / "store"))  # an empty run store (the workers inherit it)
+    ctx = Context(out=tmp_path, full=True, run_cache={})
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            Client(cluster) as client:
+        assert long_runs.compute_missing(ctx, client=client) == 2
+        assert long_runs.compute_missing(ctx, client=client) == 0
+    stored = json.loads((tmp_path / "validation-runs.json").read_text())
+    assert set(stored) == {coupled.cache_key(s) for s in runs}
+    here = [coupled.run_summary(s) for s in runs]
+    monkeypatch.setattr(coupled, "run_summary", lambda s: pytest.fail("computed again"))
+    for s, ref in zip(runs, here):
+        got = coupled.study_run(Context(out=None, full=True, run_cache=None), s)  # from the run store
+        assert got == stored[coupled.cache_key(s)]
+        assert got["n_steps"] == ref["n_steps"] > 0 and got["e_shock"] == ref["e_shock"]
+        for k in ("ep_max_fraction", "max_von_mises", "energy_residual_max"):
+            assert got[k] == pytest.approx(ref[k], rel=1e-9, abs=1e-300), k
 
 
 def test_observed_orders_and_richardson_recover_a_known_rate():

@@ -2,7 +2,7 @@
 reuse results that are still current, then draw every figure, both animations and the
 report. Also the CLI commands `reproduce`, `plot`, `animate` and `export`.
 
-    granplate reproduce --out results            # everything (about a minute on 2 cores)
+    granplate reproduce --out results            # everything (a few minutes on 2 cores)
     granplate reproduce --out quick --t-end 1e-4 # shortened runs (a smoke test)
     granplate plot results/steel-r1.nc --figure A.1
     granplate plot results --figure 3            # a directory holding the presets' results
@@ -11,13 +11,13 @@ report. Also the CLI commands `reproduce`, `plot`, `animate` and `export`.
 
 A result DIR/NAME.nc is reused when its attributes `scenario_toml` and
 `granplate_version` equal those a new run would write; anything else is run again.
-Runs, figures and animations are spread over `--jobs` worker processes; each figure or
-animation starts as soon as the results it needs are there.
+Runs, figures and animations are tasks of the distributed engine (`granplate.results.engine`:
+a local cluster of `--workers` processes, or an existing one by `--scheduler ADDRESS`);
+each figure or animation starts as soon as the results it needs are there.
 """
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from dataclasses import dataclass, field
@@ -201,7 +201,7 @@ def make_animation(path: Path, target: Path, frames: int | None) -> Path:
 def _products(figures: bool, animations: bool) -> list:
     """The figures (each with the presets it takes) and the Appendix B animations."""
     from granplate.paper import plots
-    from granplate.paper.pool import Product
+    from granplate.paper.runner import Product
 
     out = [Product("figure", k, spec.presets) for k, spec in plots.FIGURES.items()] if figures else []
     return out + ([Product("animation", n, (n,)) for n in ANIMATED] if animations else [])
@@ -211,7 +211,9 @@ def reproduce(
     out_dir: str | Path = DEFAULT_OUT,
     *,
     t_end: float | None = None,
-    jobs: int | None = None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    client=None,
     force: bool = False,
     checks: str = "fast",
     figures: bool = True,
@@ -222,20 +224,24 @@ def reproduce(
     """Run (or reuse) every preset and check, then write figures, animations and report.
 
     out_dir: results, figures, animations and report go here; t_end: shorten every run
-    to this time [s]; jobs: worker processes (default: os.cpu_count()); force: run
-    everything again; checks: "fast", "all" or "none" sensitivity runs; figures: draw
-    the figures; animations / frames: the Appendix B animations and their frame count;
-    quiet: no progress.
+    to this time [s]; workers: worker processes of the local cluster (default: the
+    cores; at most one per task); scheduler: the address of an existing Dask cluster
+    instead (its workers must see out_dir); client: an open Dask Client instead of
+    either; force: run everything again; checks: "fast", "all" or "none" sensitivity
+    runs; figures: draw the figures; animations / frames: the Appendix B animations and
+    their frame count; quiet: no progress.
     """
-    from granplate.paper.pool import Driver, Progress, executor, worker_threads
+    from contextlib import nullcontext
+
     from granplate.paper.report import write_report
+    from granplate.paper.runner import Driver, Progress
+    from granplate.results import engine
 
     t_start = time.perf_counter()
+    if workers is not None and (not isinstance(workers, int) or workers < 1):
+        raise ScenarioError("--workers", workers, "allowed: an integer >= 1")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    n_jobs = int(jobs or os.cpu_count() or 1)
-    if n_jobs < 1:
-        raise ScenarioError("--jobs", jobs, "allowed: an integer >= 1")
     outcome = Outcome(out)
     available: dict[str, Path] = {}
     to_run: list[Job] = []
@@ -249,10 +255,14 @@ def reproduce(
     progress = Progress(len(to_run) + len(products), quiet)
     for rec in outcome.runs:
         progress.note(f"reused {rec.name} ({rec.path})")
-    n_workers = min(n_jobs, max(1, len(to_run) + len(products)))
+    n_workers = min(workers or engine.available_cores(), max(1, len(to_run) + len(products)))
     try:
-        with worker_threads(n_workers), executor(n_workers) as pool:
-            Driver(pool, outcome, products, available, progress, frames).run(to_run)
+        if to_run or products:
+            own = client is None
+            with (engine.dask_client(n_workers, scheduler) if own else nullcontext(client)) as c:
+                if to_run:
+                    engine.warm_workers(c, warm_up_scenarios(to_run))
+                Driver(c, outcome, products, available, progress, frames).run(to_run)
     finally:
         progress.close()
     if not figures:
@@ -302,6 +312,17 @@ def expected_cost(job: Job) -> float:
     elements = (plate.nx * plate.ny) if plate is not None else 1
     stiff = 2.0 if (getattr(s, "layout", None) is not None and s.layout.intruder_material == "steel") else 1.0
     return elements * s.time.t_end * stiff
+
+
+def warm_up_scenarios(jobs: list[Job]) -> list[str]:
+    """TOML texts to warm the workers up on: the cheapest job of each coupling scheme
+    (each scheme has its own compiled kernels)."""
+    from granplate.setup.io import dumps
+
+    first: dict[str, Job] = {}
+    for job in sorted(jobs, key=expected_cost):
+        first.setdefault(job.scenario.solver.scheme, job)
+    return [dumps(j.scenario) for j in first.values()]
 
 
 # --------------------------------------------------------------------------------------
@@ -364,7 +385,8 @@ def figure_inputs(key: str, inputs: list[str]) -> list[Path]:
 
 def _cmd_reproduce(args) -> int:
     outcome = reproduce(
-        args.out, t_end=args.t_end, jobs=args.jobs, force=args.force, checks=args.checks,
+        args.out, t_end=args.t_end, workers=args.workers, scheduler=args.scheduler, force=args.force,
+        checks=args.checks,
         figures=not args.no_figures, animations=not args.no_animations, frames=args.frames, quiet=args.quiet,
     )
     reused = sum(r.status == "reused" for r in outcome.runs)
@@ -438,8 +460,11 @@ def register(subparsers) -> None:
                               "both animations and the report (reusing unchanged results)")
     r.add_argument("--out", default=DEFAULT_OUT, help=f"output directory (default {DEFAULT_OUT})")
     r.add_argument("--t-end", type=float, default=None, help="shorten every run to this time [s]")
-    r.add_argument("--jobs", type=_positive_int, default=os.cpu_count() or 1,
-                   help="worker processes (default: the number of cores)")
+    r.add_argument("--workers", "--jobs", dest="workers", type=_positive_int, default=None,
+                   help="worker processes of the local Dask cluster (default: the number of cores)")
+    r.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                   help="run on an existing Dask cluster (e.g. tcp://host:8786) instead; its "
+                        "workers must see the output directory")
     r.add_argument("--force", action="store_true", help="run everything again, even unchanged results")
     r.add_argument("--checks", choices=CHECK_MODES, default="fast",
                    help="sensitivity runs for the report's discussion: fast (default, ~1 min on "

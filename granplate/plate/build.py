@@ -377,12 +377,18 @@ def _stored_or_computed(
     payload: dict | None, fits: Callable[[dict], bool], compute: Callable[[], dict]
 ) -> dict[str, np.ndarray]:
     """The arrays the run store holds for payload when they fit, else compute() (then
-    stored); payload None: neither read nor write the store."""
-    arrays = None if payload is None else store.load_arrays(STORE_KIND, payload, PLATE_FORMAT)
+    stored; a process building the same plate at the same time is waited for, and its
+    arrays read); payload None: neither read nor write the store."""
+    if payload is None:
+        return compute()
+    arrays = store.load_arrays(STORE_KIND, payload, PLATE_FORMAT)
     if arrays is not None and fits(arrays):
         return arrays
-    arrays = compute()
-    if payload is not None:
+    with store.exclusive(STORE_KIND, payload, PLATE_FORMAT):  # one process builds, the others wait and read
+        arrays = store.load_arrays(STORE_KIND, payload, PLATE_FORMAT)
+        if arrays is not None and fits(arrays):
+            return arrays
+        arrays = compute()
         store.save_arrays(STORE_KIND, payload, PLATE_FORMAT, arrays)
     return arrays
 

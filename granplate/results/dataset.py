@@ -12,6 +12,7 @@ import numpy as np
 import xarray as xr
 
 from granplate.version import __version__
+from granplate.plate.stress import plane_stresses, von_mises_plane_stress
 from granplate.solver import state as K
 
 #: name -> (units, description) of every data variable
@@ -64,6 +65,22 @@ def _chunked(fn, q: np.ndarray, size: int = 256) -> np.ndarray:
     return np.concatenate([fn(q[i:i + size]) for i in range(0, len(q), size)])
 
 
+def plate_maxima(plate, qf: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Largest von Mises stress [Pa] (eq. 12), largest disc-averaged von Mises stress [Pa]
+    (docs/model.md section 4.4) and largest |eps_yy| [-] over the plate's Gauss points at
+    each output time, from qf (time, n_modes [+ 2 n_contacts forces of a truncated
+    basis]); the strains are computed once for all three."""
+    def maxima(c):
+        q, force = c[:, :plate.n_modes], (c[:, plate.n_modes:] if c.shape[1] > plate.n_modes else None)
+        exx, eyy, gxy = plate.strains(q, force)
+        vm = von_mises_plane_stress(*plane_stresses(plate.D, exx, eyy, gxy))
+        return np.stack([vm.reshape(len(c), -1).max(axis=1), plate.max_disc_von_mises(vm),
+                         np.abs(eyy).reshape(len(c), -1).max(axis=1)], axis=1)
+
+    every = _chunked(maxima, qf) if len(qf) else np.zeros((0, 3))
+    return every[:, 0].copy(), every[:, 1].copy(), every[:, 2].copy()
+
+
 def plate_fields(model, q: np.ndarray, qd: np.ndarray, times: np.ndarray,
                  force: np.ndarray | None = None) -> dict[str, xr.DataArray]:
     """Plate outputs computed from the modal coordinates after the run; force (time,
@@ -80,17 +97,10 @@ def plate_fields(model, q: np.ndarray, qd: np.ndarray, times: np.ndarray,
     def split(c):
         return c[:, :plate.n_modes], (c[:, plate.n_modes:] if c.shape[1] > plate.n_modes else None)
 
-    def max_vm(c):  # (chunk, 2): the Gauss-point peak and the largest disc average
-        vm = plate.von_mises(*split(c))
-        return np.stack([vm.reshape(len(c), -1).max(axis=1), plate.max_disc_von_mises(vm)], axis=1)
-
-    def max_eyy(c):
-        return np.abs(plate.strains(*split(c))[1]).reshape(len(c), -1).max(axis=1)
-
-    peaks = _chunked(max_vm, qf).reshape(-1, 2)
-    out["max_von_mises"] = _var("max_von_mises", ("time",), peaks[:, 0].copy())
-    out["max_von_mises_disc"] = _var("max_von_mises_disc", ("time",), peaks[:, 1].copy())
-    out["max_eps_yy"] = _var("max_eps_yy", ("time",), _chunked(max_eyy, qf))
+    max_vm, max_disc, max_eyy = plate_maxima(plate, qf)
+    out["max_von_mises"] = _var("max_von_mises", ("time",), max_vm)
+    out["max_von_mises_disc"] = _var("max_von_mises_disc", ("time",), max_disc)
+    out["max_eps_yy"] = _var("max_eps_yy", ("time",), max_eyy)
     sym = np.asarray(plate.symmetry_nodes)
     vx = _chunked(lambda qc: plate.full_displacement(qc)[:, sym, 0], qd)
     out["plate_vx_symmetry"] = _var("plate_vx_symmetry", ("time", "x_symmetry"), vx)
@@ -107,8 +117,18 @@ def plate_fields(model, q: np.ndarray, qd: np.ndarray, times: np.ndarray,
     return out
 
 
-def to_dataset(model, out: K.Output, n: int, info: dict) -> xr.Dataset:
-    """Build the result Dataset from the first n output rows."""
+#: What a summary-only Dataset holds (`to_dataset(..., summary_only=True)`): what
+#: `summary` and the studies' metrics read.
+SUMMARY_VARIABLES = ("E_shock", "E_granular", "E_plate", "D_viscous", "D_friction",
+                     "energy_residual_max", "max_von_mises", "max_von_mises_disc", "max_eps_yy")
+
+
+def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = False) -> xr.Dataset:
+    """Build the result Dataset from the first n output rows.
+
+    summary_only: only the variables `summary` reads (SUMMARY_VARIABLES, the time and
+    granule coordinates and the attributes), the same numbers at a fraction of the cost
+    (no plate fields, snapshots or per-contact records)."""
     from granplate.setup.io import dumps
 
     s = model.scenario
@@ -116,16 +136,39 @@ def to_dataset(model, out: K.Output, n: int, info: dict) -> xr.Dataset:
     y = out.y[:n]
     e = out.energy[:n]
     data: dict[str, xr.DataArray] = {}
-    for c, name in enumerate(("x", "y", "theta", "vx", "vy", "omega")):
-        data[name] = _var(name, ("time", "granule"), y[:, :, c].copy())
+    if not summary_only:
+        for c, name in enumerate(("x", "y", "theta", "vx", "vy", "omega")):
+            data[name] = _var(name, ("time", "granule"), y[:, :, c].copy())
     for col, name in (
         (K.E_SHOCK, "E_shock"), (K.E_GRAN, "E_granular"), (K.E_PLATE, "E_plate"),
         (K.D_VISC, "D_viscous"), (K.D_FRIC, "D_friction"), (K.E_POTG, "E_contact"),
         (K.KE_X, "KE_horizontal"), (K.KE_Y, "KE_vertical"), (K.KE_ROT, "KE_rotational"),
         (K.RESID, "energy_residual"), (K.RESID_MAX, "energy_residual_max"),
     ):
-        data[name] = _var(name, ("time",), e[:, col].copy())
+        if not summary_only or name in SUMMARY_VARIABLES:
+            data[name] = _var(name, ("time",), e[:, col].copy())
     nk = len(model.plate_contacts)
+    coords = {
+        "time": ("time", t, {"units": "s", "long_name": "time"}),
+        "granule": ("granule", np.array(model.labels, dtype=str), {"long_name": "granule label (paper numbering)"}),
+        **({} if summary_only else {"contact": ("contact", np.array(model.contact_labels, dtype=str),
+                                                {"long_name": "granule at each plate contact"})}),
+        "radius": ("granule", model.granular.radius.copy(), {"units": "m", "long_name": "granule radius"}),
+        "mass": ("granule", model.granular.mass.copy(), {"units": "kg", "long_name": "granule mass"}),
+        "material": ("granule", np.array([g.material for g in s.granules], dtype=str), {"long_name": "granule material"}),
+    }
+    if summary_only:
+        if model.plate is not None:
+            qf = out.q[:n]
+            if model.plate.truncated:
+                qf = np.concatenate([qf, out.force[:n].reshape(n, -1)], axis=1)
+            max_vm, max_disc, max_eyy = plate_maxima(model.plate, qf)
+            data["max_von_mises"] = _var("max_von_mises", ("time",), max_vm)
+            data["max_von_mises_disc"] = _var("max_von_mises_disc", ("time",), max_disc)
+            data["max_eps_yy"] = _var("max_eps_yy", ("time",), max_eyy)
+        ds = xr.Dataset(data, coords=coords)
+        ds.attrs.update(_attrs(model, out, n, info, dumps(s)))
+        return ds
     data["contact_normal_force"] = _var("contact_normal_force", ("time", "contact"), out.force[:n, :, 0].copy())
     data["contact_tangential_force"] = _var("contact_tangential_force", ("time", "contact"), out.force[:n, :, 1].copy())
     data["contact_slip_rate"] = _var("contact_slip_rate", ("time", "contact"), out.slip[:n].copy())
@@ -135,14 +178,6 @@ def to_dataset(model, out: K.Output, n: int, info: dict) -> xr.Dataset:
     data["dt_max"] = _var("dt_max", ("time",), out.stats[:n, K.S_DT_MAX].copy())
     data["n_steps"] = _var("n_steps", ("time",), out.stats[:n, K.S_STEPS].astype(np.int64))
     data["n_iterations"] = _var("n_iterations", ("time",), out.stats[:n, K.S_ITERS].astype(np.int64))
-    coords = {
-        "time": ("time", t, {"units": "s", "long_name": "time"}),
-        "granule": ("granule", np.array(model.labels, dtype=str), {"long_name": "granule label (paper numbering)"}),
-        "contact": ("contact", np.array(model.contact_labels, dtype=str), {"long_name": "granule at each plate contact"}),
-        "radius": ("granule", model.granular.radius.copy(), {"units": "m", "long_name": "granule radius"}),
-        "mass": ("granule", model.granular.mass.copy(), {"units": "kg", "long_name": "granule mass"}),
-        "material": ("granule", np.array([g.material for g in s.granules], dtype=str), {"long_name": "granule material"}),
-    }
     if model.plate is not None:
         pf = plate_fields(model, out.q[:n], out.qd[:n], t, out.force[:n].reshape(n, -1))
         ft = pf.pop("_field_time")
@@ -157,19 +192,25 @@ def to_dataset(model, out: K.Output, n: int, info: dict) -> xr.Dataset:
     ds = xr.Dataset(data, coords=coords)
     if nk == 0:
         ds = ds.drop_dims("contact", errors="ignore")
-    ds.attrs.update({
+    ds.attrs.update(_attrs(model, out, n, info, dumps(s)))
+    return ds
+
+
+def _attrs(model, out: K.Output, n: int, info: dict, scenario_toml: str) -> dict:
+    """The result's attributes: scenario, version, scheme, E_initial and the run's figures."""
+    s = model.scenario
+    attrs = {
         "title": f"granplate result: {s.name}",
         "scenario_name": s.name,
-        "scenario_toml": dumps(s),
+        "scenario_toml": scenario_toml,
         "granplate_version": __version__,
         "scheme": s.solver.scheme,
         "conventions": "SI units; see docs/output.md",
         "run_info": json.dumps(info),
         "E_initial": float(out.energy[0, K.E_GRAN] + out.energy[0, K.E_PLATE]) if n else 0.0,
-    })
-    for k, v in info.items():
-        ds.attrs[k] = v
-    return ds
+    }
+    attrs.update(info)
+    return attrs
 
 
 def write(ds: xr.Dataset, path: str | Path) -> Path:

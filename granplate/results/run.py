@@ -36,13 +36,16 @@ def simulate(
     t_end: float | None = None,
     progress: bool | None = None,
     model: Model | None = None,
+    summary_only: bool = False,
 ):
     """Simulate `scenario` and return an xarray Dataset (see docs/output.md).
 
     t_end overrides scenario.time.t_end [s]; progress shows a bar (default: when stderr
-    is a terminal). Raises SimulationError (with the partial Dataset in `.result`, its
-    `status` attribute saying why) when the run goes numerically wrong or is stopped by
-    SIGINT/SIGTERM (Ctrl-C).
+    is a terminal); model: the scenario's model when already built; summary_only: return
+    only what `summary` reads (energies, plate maxima, residual, granule masses; the same
+    numbers without the plate fields, for studies that keep only the summary). Raises
+    SimulationError (with the partial, whole Dataset in `.result`, its `status` attribute
+    saying why) when the run goes numerically wrong or is stopped by SIGINT/SIGTERM (Ctrl-C).
     """
     if t_end is not None:
         scenario = with_t_end(scenario, t_end)
@@ -61,6 +64,8 @@ def simulate(
     }
     info = {k: info[k] for k in ("wall_time_s", "setup_time_s", "first_call_time_s", "loop_time_s",
                                  "n_steps", "n_iterations", "n_retries", "status")}
+    if rec.status == OK and summary_only:
+        return to_dataset(model, rec.out, rec.n_valid, info, summary_only=True)
     ds = to_dataset(model, rec.out, rec.n_valid, info)
     if rec.status != OK:
         t_last = rec.out.t[rec.n_valid - 1]

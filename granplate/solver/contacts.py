@@ -49,36 +49,39 @@ def plate_face(u):
 
 
 @njit(cache=True)
-def watch_contacts(t, y, u, g, cfg, w, err):
+def watch_contacts(t, y, u, radius, plate_free, yref, ovl, ovl_with, ovl_new, ovl_who, overlap_stop,
+                   plate_x0, plate_ylo, plate_yhi, rebuild_move, err):
     """Check the state after an accepted step; returns OK, REBUILD (the list must be
-    rebuilt: a granule moved cfg.rebuild_move since it was built), ERR_OVERLAP,
+    rebuilt: a granule moved rebuild_move since it was built, at yref), ERR_OVERLAP,
     ERR_PLATE_REACH or ERR_JUMP with err filled. The step's largest overlap comes from
-    the last evaluation of the forces (w.ovl_new, w.ovl_who: granular.granular_rhs)."""
-    i = w.ovl_who[0]
+    the last evaluation of the forces (ovl_new, ovl_who: granular.granular_rhs); ovl,
+    ovl_with keep each granule's largest. (Arrays and the Config's scalars, not the
+    tuples: this runs every step.)"""
+    i = ovl_who[0]
     if i >= 0:
-        partner = w.ovl_who[1]
-        rel = w.ovl_new[0]
-        note_overlap(i, partner, rel, w.ovl, w.ovl_with)
+        partner = ovl_who[1]
+        rel = ovl_new[0]
+        note_overlap(i, partner, rel, ovl, ovl_with)
         if partner >= 0:
-            note_overlap(partner, i, rel, w.ovl, w.ovl_with)
-        if rel > cfg.overlap_stop:
-            r = g.radius[i] if partner < 0 else min(g.radius[i], g.radius[partner])
+            note_overlap(partner, i, rel, ovl, ovl_with)
+        if rel > overlap_stop:
+            r = radius[i] if partner < 0 else min(radius[i], radius[partner])
             return stop(ERR_OVERLAP, t, err, i, partner, rel * r, rel)
-    face = cfg.plate_x0 + plate_face(u)
+    face = plate_x0 + plate_face(u)
     status = OK
-    move2 = cfg.rebuild_move * cfg.rebuild_move
+    move2 = rebuild_move * rebuild_move
     for i in range(y.shape[0]):
-        if w.plate_free[i] != 0 and cfg.plate_ylo < y[i, 1] < cfg.plate_yhi:
-            reach = plate_overlap(y[i, 0], g.radius[i], face)
+        if plate_free[i] != 0 and plate_ylo < y[i, 1] < plate_yhi:
+            reach = plate_overlap(y[i, 0], radius[i], face)
             if reach > 0.0:
-                return stop(ERR_PLATE_REACH, t, err, i, PARTNER_PLATE, reach, reach / g.radius[i])
-        if cfg.rebuild_move > 0.0:
-            dx = y[i, 0] - w.yref[i, 0]
-            dy = y[i, 1] - w.yref[i, 1]
+                return stop(ERR_PLATE_REACH, t, err, i, PARTNER_PLATE, reach, reach / radius[i])
+        if rebuild_move > 0.0:
+            dx = y[i, 0] - yref[i, 0]
+            dy = y[i, 1] - yref[i, 1]
             d2 = dx * dx + dy * dy
             if d2 > move2:
                 status = REBUILD
-                jump = cfg.rebuild_move + g.radius[i]
+                jump = rebuild_move + radius[i]
                 if d2 > jump * jump:
-                    return stop(ERR_JUMP, t, err, i, -1, d2 ** 0.5, d2 ** 0.5 / g.radius[i])
+                    return stop(ERR_JUMP, t, err, i, -1, d2 ** 0.5, d2 ** 0.5 / radius[i])
     return status

@@ -252,7 +252,9 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
         if land:
             record(o, st, g, p, w, out)
             st.count[C_OUT] = o + 1
-        status = watch_contacts(st.clock[T_NOW], st.y, st.u, g, cfg, w, st.err)
+        status = watch_contacts(st.clock[T_NOW], st.y, st.u, g.radius, w.plate_free, w.yref, w.ovl, w.ovl_with,
+                                w.ovl_new, w.ovl_who, cfg.overlap_stop, cfg.plate_x0, cfg.plate_ylo, cfg.plate_yhi,
+                                cfg.rebuild_move, st.err)
         if status != OK:
             return status
     return OK if st.clock[T_NOW] >= t_stop - 1e-9 * cfg.dt_min else PAUSED

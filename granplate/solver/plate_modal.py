@@ -72,6 +72,7 @@ def newmark_correct(t, h, st, p, cfg, dmode, qdd_star, force):
     nm = p.omega2.shape[0]
     nd = p.phi_d.shape[0]
     amp0, amp1 = edge_load_amplitudes(t, h, cfg)
+    loaded = amp0 != 0.0 or amp1 != 0.0  # unloaded, every term of the work is 0: skip the sum
     work = 0.0
     for m in range(nm):
         proj = 0.0
@@ -80,7 +81,8 @@ def newmark_correct(t, h, st, p, cfg, dmode, qdd_star, force):
         qdd1 = qdd_star[m] + dmode[m] * proj
         qt = st.q[m] + h * st.qd[m] + 0.25 * h * h * st.qdd[m]
         q1 = qt + 0.25 * h * h * qdd1
-        work += 0.5 * (amp0 + amp1) * p.load_modal[m] * (q1 - st.q[m])
+        if loaded:
+            work += 0.5 * (amp0 + amp1) * p.load_modal[m] * (q1 - st.q[m])
         st.qd[m] += 0.5 * h * (st.qdd[m] + qdd1)
         st.q[m] = q1
         st.qdd[m] = qdd1

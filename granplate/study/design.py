@@ -22,9 +22,6 @@ RECORD_KIND = "study-design"
 RECORD_FORMAT = 1
 #: Folder of the records inside a study's output folder.
 DESIGNS = "designs"
-#: Simulated time of a worker's warm-up run [s] (compiles or loads the kernels, builds the plate).
-WARM_T_END = 1e-6
-
 
 #: Metrics a study adds to gp.summary: name -> (unit, meaning).
 EXTRA_METRICS: dict[str, tuple[str, str]] = {
@@ -77,16 +74,20 @@ def failure_message(err: BaseException) -> str:
 
 
 def run_design(scenario_toml: str, full: bool = False) -> dict[str, Any]:
-    """Simulate one design (runs on a worker): {"status", "summary", "elapsed_s", "result"}.
+    """Simulate one design (runs on a worker): {"status", "summary", "elapsed_s",
+    "timings", "result"}.
 
     status is "ok" or the failure message (a scenario the physics refuses, a run that goes
     numerically wrong, or any other error: a failing design never stops a sweep); summary
-    is `metrics` of the run: gp.summary and EXTRA_METRICS (None on failure); result the Dataset when full, else None.
+    is `metrics` of the run: gp.summary and EXTRA_METRICS (None on failure); elapsed_s the
+    task's seconds on its worker, all included; timings the run's set-up and loop seconds
+    (`timings`) and the task's CPU seconds (cpu_s; {} on failure); result the Dataset when full, else None (and then only
+    what the summary reads is computed).
     """
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.thread_time()
     ds = summary = None
     try:
-        ds = gp.simulate(gp.loads(scenario_toml), progress=False)
+        ds = gp.simulate(gp.loads(scenario_toml), progress=False, summary_only=not full)
         summary = metrics(ds)
         status = "ok"
     except GranplateError as err:
@@ -94,20 +95,13 @@ def run_design(scenario_toml: str, full: bool = False) -> dict[str, Any]:
     except Exception as err:  # noqa: BLE001 - recorded as the design's failure
         status = failure_message(err)
     return {"status": status, "summary": summary, "elapsed_s": time.perf_counter() - t0,
+            "timings": {**timings(ds), "cpu_s": time.thread_time() - c0} if summary is not None else {},
             "result": ds if full and summary is not None else None}
 
 
-def warm_up(scenario_toml: str) -> float:
-    """A short run of a design (on each worker before the sweep): the compiled kernels are
-    loaded from numba's on-disk cache (or compiled and written there) and the design's plate
-    model is built into, or read from, the run store. The seconds it took."""
-    t0 = time.perf_counter()
-    s = gp.loads(scenario_toml)
-    try:
-        gp.simulate(s, t_end=min(s.time.t_end, WARM_T_END), progress=False)
-    except Exception:  # noqa: BLE001 - the design itself reports its failure later
-        pass
-    return time.perf_counter() - t0
+def timings(ds) -> dict[str, float]:
+    """Where a design's run spent its time [s]: set-up (model), loop (first call included)."""
+    return {"setup_s": float(ds.attrs.get("setup_time_s", 0.0)), "loop_s": float(ds.attrs.get("loop_time_s", 0.0))}
 
 
 # ------------------------------------------------------------------------- records
@@ -120,7 +114,8 @@ def make_record(key: str, changes: dict, scenario_toml: str, outcome: dict) -> d
     """The JSON record of a finished design."""
     return {"key": key, "granplate_version": gp.__version__, "status": outcome["status"],
             "changes": changes, "summary": outcome["summary"],
-            "elapsed_s": outcome["elapsed_s"], "scenario_toml": scenario_toml}
+            "elapsed_s": outcome["elapsed_s"], "timings": outcome.get("timings", {}),
+            "scenario_toml": scenario_toml}
 
 
 def write_record(out: str | Path, record: dict, result=None) -> Path:

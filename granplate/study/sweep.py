@@ -1,34 +1,27 @@
 """Run a study's designs on Dask distributed and write its table (docs/studies.md).
 
-The designs are tasks of a Dask cluster: by default a LocalCluster of worker processes
-with one thread each; or an existing cluster given by its scheduler's address (more
-machines: start workers there, nothing else changes). Before the designs, every worker
-runs a short warm-up (`design.warm_up`), one worker first and the others after it, so the
-compiled kernels are written to numba's on-disk cache once and then only read (numba
-writes its cache files atomically, so concurrent writers are safe but each would compile
-again), and the first design's plate model is built once into the run store, where every
-worker finds it (the store is keyed by the plate's inputs: designs with the same plate
-share one model).
+The designs are tasks of the distributed engine (`granplate.results.engine`): by default
+a LocalCluster of worker processes with one thread each, or an existing cluster given by
+its scheduler's address. Before the designs, every worker is warmed up (the compiled
+kernels loaded, the first design's plate model built once into the run store, where every
+worker finds it: designs with the same plate share one model).
 
 Results are gathered with `as_completed`: each design's record is written as soon as it
-is in, so an interrupted sweep loses only the designs in flight, and a rerun computes only
-the designs without a record. The table (results.nc, results.csv) is written at the end,
-and also when the sweep is interrupted.
+is in, so an interrupted sweep, a killed worker or a lost scheduler loses only the designs
+in flight, and a rerun computes only the designs without a record. The table (results.nc,
+results.csv) is written at the end, and also when the sweep is interrupted.
 """
 from __future__ import annotations
 
-import logging
-import os
-import signal
 import sys
-import threading
 import time
-from contextlib import contextmanager, nullcontext
+from contextlib import nullcontext
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterator
 
 import granplate as gp
+from granplate.results import engine
+from granplate.results.engine import dask_client
 from granplate.study import design as D
 from granplate.study import table as T
 from granplate.study.spec import Study
@@ -54,65 +47,9 @@ class SweepReport:
     out: Path = Path(".")
 
 
-def available_cores() -> int:
-    """The cores this process may run on (its CPU affinity where the system tells it)."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # not on Linux
-        return os.cpu_count() or 1
-
-
-@contextmanager
-def sigint_ignored() -> Iterator[None]:
-    """Ignore SIGINT (Ctrl-C) while processes are started (they keep ignoring it), then
-    restore the handler; a no-op outside the main thread."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
-
-
-@contextmanager
-def dask_client(workers: int | None = None, scheduler: str | None = None) -> Iterator:
-    """A Dask Client: of the cluster at scheduler's address, else of a new LocalCluster of
-    `workers` processes (default: the machine's cores), one thread each; closed on exit."""
-    from distributed import Client, LocalCluster
-
-    if scheduler:
-        client = Client(scheduler)
-        try:
-            yield client
-        finally:
-            client.close()
-        return
-    n = workers or available_cores()
-    with sigint_ignored():  # the workers inherit it: Ctrl-C reaches this process alone
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.ERROR)
-    try:
-        with Client(cluster) as client:
-            yield client
-    finally:
-        cluster.close()
-
-
 def warm_workers(client, scenario_toml: str) -> float:
-    """Run design.warm_up on one worker, then on all the others at once; the seconds."""
-    t0 = time.perf_counter()
-    client.wait_for_workers(1)
-    workers = sorted(client.scheduler_info(n_workers=-1)["workers"])
-    first, rest = workers[:1], workers[1:]
-    for group in (first, rest):
-        futures = [client.submit(D.warm_up, scenario_toml, workers=[w], allow_other_workers=False,
-                                 pure=False) for w in group]
-        client.gather(futures)
-        for f in futures:  # pinned to its worker: never to be recomputed if that worker dies
-            f.release()
-    return time.perf_counter() - t0
+    """Warm every worker up on one design (`engine.warm_workers`); the seconds."""
+    return engine.warm_workers(client, [scenario_toml])
 
 
 def progress_bar(total: int, initial: int, enabled: bool):
@@ -192,5 +129,4 @@ def _run(client, study: Study, out: Path, todo: list[tuple[str, int]], texts: li
                 bar.write(f"design {i} failed: {outcome['status']}", file=sys.stderr)
     finally:
         bar.close()
-        if futures:
-            client.cancel(list(futures))
+        engine.cancel(client, futures)

@@ -17,6 +17,7 @@ the page this writes, regenerated with --full):
   equal minus the gradient of the contact energies;
 - coupled.py (slow, --full): convergence of the PTFE and steel presets under halving of
   the time step, iteration tolerance and element size, and the rigid-layer width;
+- long_runs.py: the slow cases' full-length runs, computed side by side on Dask first;
 - page.py: DIR/validation.md, DIR/validation.html, DIR/validation.json and the figures
   in DIR/validation-figures/.
 
@@ -63,11 +64,13 @@ def get_case(name: str):
 
 
 def run_suite(out: str | Path, full: bool = False, names: list[str] | None = None,
-              log=None) -> list:
+              log=None, *, workers: int | None = None, scheduler: str | None = None,
+              client=None) -> list:
     """Run the suite (or the cases `names`), write the pages into `out`, return the results.
 
-    full: include the slow cases (and the full-length preset runs); log: a callable taking
-    one line of progress (None: silent).
+    full: include the slow cases (and the full-length preset runs, computed first on Dask:
+    a local cluster of `workers` processes, the cluster at `scheduler`, or `client`); log:
+    a callable taking one line of progress (None: silent).
     """
     from .base import Context, run_case
     from .coupled import load_run_cache, save_run_cache
@@ -79,6 +82,10 @@ def run_suite(out: str | Path, full: bool = False, names: list[str] | None = Non
     ctx = Context(out=out, full=full, run_cache=load_run_cache(cache_path) if full else None)
     cases = [get_case(n) for n in names] if names else [c for c in all_cases() if full or not c.slow]
     t0 = time.perf_counter()
+    if full and any(c.slow for c in cases):
+        from .long_runs import compute_missing
+
+        compute_missing(ctx, client=client, workers=workers, scheduler=scheduler, log=log)
     results = []
     for case in cases:
         if log:
@@ -99,6 +106,9 @@ def _cmd_verify(args) -> int:
     def log(line: str) -> None:
         print(line, file=sys.stderr, flush=True)
 
+    if args.workers is not None and args.workers < 1:
+        print(f"granplate: error: --workers = {args.workers}: must be >= 1", file=sys.stderr)
+        return 2
     if args.list:
         for case in all_cases():
             print(f"{case.name:22s} {'(--full) ' if case.slow else ''}{case.title}")
@@ -111,7 +121,8 @@ def _cmd_verify(args) -> int:
     except KeyError as err:
         print(f"granplate: error: {err.args[0]}", file=sys.stderr)
         return 2
-    results = run_suite(args.out, full=args.full, names=names, log=None if args.quiet else log)
+    results = run_suite(args.out, full=args.full, names=names, log=None if args.quiet else log,
+                        workers=args.workers, scheduler=args.scheduler)
     n_bad = sum(1 for r in results if not r.passed)
     n_checks = sum(len(r.checks) for r in results)
     bad_checks = sum(1 for r in results for c in r.checks if not c.passed)
@@ -134,6 +145,11 @@ def register(subparsers) -> None:
     p.add_argument("--full", action="store_true",
                    help="also run the slow convergence studies of the coupled runs (minutes; "
                         "their runs are cached in DIR/validation-runs.json)")
+    p.add_argument("--workers", type=int, default=None, metavar="N",
+                   help="with --full: worker processes of the local Dask cluster that computes "
+                        "the full-length runs (default: the number of cores)")
+    p.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                   help="with --full: compute the full-length runs on an existing Dask cluster")
     p.add_argument("--case", action="append", metavar="NAME",
                    help="run only this case (repeatable; see --list)")
     p.add_argument("--list", action="store_true", help="list the cases and exit")

@@ -91,8 +91,8 @@ def energy_residual(ctx: Context) -> CaseResult:
     if ctx.full:
         from .coupled import study_run
 
-        for name in preset_names():
-            summ = study_run(ctx, with_changes(preset(name), {"solver.scheme": "paper"}))
+        for name, s_full in full_runs():
+            summ = study_run(ctx, s_full)
             full_rows.append((name, summ))
             checks.append(Check(f"max |energy residual|, {name}, full 2 ms run", "-", 0.0,
                                 "exact balance E_p + E_g + D = E_shock (docs/model.md section 7)",
@@ -122,6 +122,15 @@ def energy_residual(ctx: Context) -> CaseResult:
                          f"{summ['n_steps']} |")
         res.tables.append("\n".join(lines))
     return res
+
+
+def full_runs() -> list:
+    """(preset, scenario) of the full-length runs checked with --full: every preset with
+    the paper scheme."""
+    from granplate.setup.io import with_changes
+    from granplate.setup.presets import preset, preset_names
+
+    return [(name, with_changes(preset(name), {"solver.scheme": "paper"})) for name in preset_names()]
 
 
 def simulate_short(s):

@@ -125,27 +125,67 @@ def _vm_location(ds) -> list[float]:
     return list(peak_stress_location(ds)[1:])
 
 
-def study_run(ctx: Context, scenario) -> dict:
-    """Summary of a full run of `scenario`: from the page's run cache, else the run store,
-    else computed (and kept in both)."""
-    from granplate import store
+def run_summary(scenario) -> dict:
+    """Summary of a full run of `scenario` (a Scenario or its TOML text): gp.summary, the
+    largest |energy residual| and the location of the largest von Mises stress."""
     from granplate.results.run import simulate as run
     from granplate.results.dataset import summary
+    from granplate.setup.io import loads
 
-    key = cache_key(scenario)
-    cache = ctx.run_cache if ctx.run_cache is not None else {}
-    if key not in cache:
-        summ = store.load_json(RUN_KIND, run_payload(scenario), RUN_FORMAT)
-        if summ is None:
-            ds = run(scenario, progress=False)
-            summ = summary(ds)
-            summ["energy_residual_max"] = float(np.max(np.abs(ds.energy_residual_max.values)))
-            summ["vm_location"] = _vm_location(ds)
-            store.save_json(RUN_KIND, run_payload(scenario), RUN_FORMAT, summ)
-        cache[key] = summ
-        if ctx.run_cache is not None and ctx.out is not None:
+    ds = run(loads(scenario) if isinstance(scenario, str) else scenario, progress=False)
+    summ = summary(ds)
+    summ["energy_residual_max"] = float(np.max(np.abs(ds.energy_residual_max.values)))
+    summ["vm_location"] = _vm_location(ds)
+    return summ
+
+
+def keep_run(ctx: Context, scenario, summ: dict, in_store: bool = False) -> None:
+    """Keep a study run's summary in the run store (unless in_store: read from there) and
+    in the page's run cache."""
+    from granplate import store
+
+    if not in_store:
+        store.save_json(RUN_KIND, run_payload(scenario), RUN_FORMAT, summ)
+    if ctx.run_cache is not None:
+        ctx.run_cache[cache_key(scenario)] = summ
+        if ctx.out is not None:
             save_run_cache(ctx.out / "validation-runs.json", ctx.run_cache)
-    return cache[key]
+
+
+def stored_run(ctx: Context, scenario) -> dict | None:
+    """A study run's summary from the page's run cache, else the run store (kept in the
+    run cache then); None: not run yet."""
+    from granplate import store
+
+    if ctx.run_cache is not None and (key := cache_key(scenario)) in ctx.run_cache:
+        return ctx.run_cache[key]
+    summ = store.load_json(RUN_KIND, run_payload(scenario), RUN_FORMAT)
+    if summ is not None:
+        keep_run(ctx, scenario, summ, in_store=True)
+    return summ
+
+
+def study_run(ctx: Context, scenario) -> dict:
+    """Summary of a full run of `scenario`: from the page's run cache, else the run store,
+    else computed here (and kept in both)."""
+    summ = stored_run(ctx, scenario)
+    if summ is None:
+        summ = run_summary(scenario)
+        keep_run(ctx, scenario, summ)
+    return summ
+
+
+def study_scenarios() -> list:
+    """Every run of the studies: (preset, study, scenario), level by level."""
+    from granplate.setup.presets import preset
+    from granplate.setup.io import with_changes
+
+    out = []
+    for name in PRESETS:
+        base = with_changes(preset(name), {"solver.scheme": "paper"})  # the studies vary its step
+        for study in STUDIES:
+            out += [(name, study, with_changes(base, ch) if ch else base) for _, ch in study.levels]
+    return out
 
 
 def _order(q: list[float]) -> float:
@@ -204,15 +244,9 @@ def study_tables(results: dict, preset: str) -> str:
 
 def coupled_convergence(ctx: Context) -> CaseResult:
     """The studies above for both presets, with checks on the default settings."""
-    from granplate.setup.presets import preset
-    from granplate.setup.io import with_changes
-
     results: dict = {}
-    for name in PRESETS:
-        base = with_changes(preset(name), {"solver.scheme": "paper"})  # the studies vary its step
-        for study in STUDIES:
-            results[(name, study.name)] = [study_run(ctx, with_changes(base, ch) if ch else base)
-                                           for _, ch in study.levels]
+    for name, study, scenario in study_scenarios():
+        results.setdefault((name, study.name), []).append(study_run(ctx, scenario))
     checks = []
     for name in PRESETS:
         for study in STUDIES:

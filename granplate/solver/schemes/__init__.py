@@ -79,28 +79,28 @@ def next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg):
     raise NotImplementedError("compiled use only")
 
 
-@overload(plan)
+@overload(plan, inline="always")
 def _plan(sw, count, cfg, pos, rem):
     fn = _hook_of(sw, "plan")
     if fn is not None:
         return lambda sw, count, cfg, pos, rem: fn(sw, count, cfg, pos, rem)
 
 
-@overload(prepare_level)
+@overload(prepare_level, inline="always")
 def _prepare_level(sw, h, p, slot):
     fn = _hook_of(sw, "prepare_level")
     if fn is not None:
         return lambda sw, h, p, slot: fn(sw, h, p, slot)
 
 
-@overload(attempt)
+@overload(attempt, inline="always")
 def _attempt(sw, t, h, slot, st, g, p, cfg, w):
     fn = _hook_of(sw, "attempt")
     if fn is not None:
         return lambda sw, t, h, slot, st, g, p, cfg, w: fn(sw, t, h, slot, st, g, p, cfg, w)
 
 
-@overload(judge)
+@overload(judge, inline="always")
 def _judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
     fn = _hook_of(sw, "judge")
     if fn is not None:
@@ -108,7 +108,7 @@ def _judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
             sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w)
 
 
-@overload(commit)
+@overload(commit, inline="always")
 def _commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
     fn = _hook_of(sw, "commit")
     if fn is not None:
@@ -116,7 +116,7 @@ def _commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
             sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w)
 
 
-@overload(next_level)
+@overload(next_level, inline="always")
 def _next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg):
     fn = _hook_of(sw, "next_level")
     if fn is not None:

@@ -1,52 +1,20 @@
-"""The process pool behind `granplate reproduce`: worker threads per process, the
-spawned pool, progress on stderr, and the driver that starts each figure or animation as
-soon as the runs it needs are in.
+"""The runs, figures and animations of `granplate reproduce` as tasks of the distributed
+engine (`granplate.results.engine`): progress on stderr, and the driver that submits the
+runs longest first and each figure or animation as soon as the runs it needs are in.
+
+The tasks read and write the output folder, so the workers of a cluster given by
+`--scheduler` must see it (the same machine, or a shared file system).
 """
 from __future__ import annotations
 
-import os
 import sys
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
-from contextlib import contextmanager
 from dataclasses import dataclass
-from multiprocessing import get_context
 from pathlib import Path
 
+from granplate.results import engine
 from granplate.paper.reproduce import (
     Job, Outcome, RunRecord, expected_cost, make_animation, make_figure, run_job,
 )
-
-#: Thread-count variables of the BLAS / OpenMP libraries the workers use.
-THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS")
-
-
-@contextmanager
-def worker_threads(n_workers: int):
-    """Share the cores among the workers: each worker's BLAS gets cores // workers threads
-    (the workers inherit the environment; variables the user set are left alone)."""
-    per = str(max(1, (os.cpu_count() or 1) // max(1, n_workers)))
-    saved = {k: os.environ.get(k) for k in THREAD_VARIABLES}
-    try:
-        for k in THREAD_VARIABLES:
-            os.environ.setdefault(k, per)
-        yield
-    finally:
-        for k, v in saved.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
-
-
-@contextmanager
-def executor(n_jobs: int):
-    """A pool of n_jobs spawned workers (clean: no forked numba / thread state); on the way
-    out, queued tasks are cancelled (an interrupt does not wait for them)."""
-    pool = ProcessPoolExecutor(max_workers=max(1, n_jobs), mp_context=get_context("spawn"))
-    try:
-        yield pool
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
 
 
 class Progress:
@@ -103,19 +71,29 @@ class Product:
 
 
 class Driver:
-    """Runs the jobs on a pool and starts each figure / animation once its runs are in."""
+    """Runs the jobs on a Dask client and starts each figure / animation once its runs are in."""
 
-    def __init__(self, pool: ProcessPoolExecutor, outcome: Outcome, products: list[Product],
+    def __init__(self, client, outcome: Outcome, products: list[Product],
                  available: dict[str, Path], progress: Progress, frames: int | None):
-        self.pool, self.outcome, self.products = pool, outcome, products
+        from distributed import as_completed
+
+        self.client, self.outcome, self.products = client, outcome, products
         self.available, self.failed = available, set()
         self.progress, self.frames = progress, frames
-        self.running: dict[Future, tuple[str, object]] = {}
+        self.running: dict = {}
+        self.pending = as_completed()
+
+    def submit(self, kind: str, what, function, *args, priority: int = 0) -> None:
+        """One task (a run, a figure or an animation) on the cluster."""
+        fut = self.client.submit(function, *args, pure=False, priority=priority)
+        self.running[fut] = (kind, what)
+        self.pending.add(fut)
 
     def submit_runs(self, jobs: list[Job]) -> None:
         """Queue the simulations, longest first (finer meshes, steel packings)."""
-        for job in sorted(jobs, key=expected_cost, reverse=True):
-            self.running[self.pool.submit(run_job, job)] = ("run", job)
+        ordered = sorted(jobs, key=expected_cost, reverse=True)
+        for rank, job in enumerate(ordered):
+            self.submit("run", job, run_job, job, priority=len(ordered) - rank)
 
     def launch_ready(self) -> None:
         """Start every product whose runs are all in; drop those whose runs failed."""
@@ -130,19 +108,18 @@ class Driver:
                 self.products.remove(prod)
                 paths = [self.available[n] for n in prod.needs]
                 if prod.kind == "figure":
-                    fut = self.pool.submit(make_figure, prod.key, paths, out / "figures")
+                    self.submit(prod.kind, prod, make_figure, prod.key, paths, out / "figures")
                 else:
-                    fut = self.pool.submit(make_animation, paths[0], out / "animations" / f"{prod.key}.mp4",
-                                           self.frames)
-                self.running[fut] = (prod.kind, prod)
+                    self.submit(prod.kind, prod, make_animation, paths[0],
+                                out / "animations" / f"{prod.key}.mp4", self.frames)
 
-    def finish(self, fut: Future) -> None:
+    def finish(self, fut) -> None:
         """Record one finished task (a run, a figure or an animation)."""
         kind, what = self.running.pop(fut)
         if kind == "run":
             try:
                 rec = fut.result()
-            except Exception as exc:  # noqa: BLE001 - a crashed worker: report, go on
+            except Exception as exc:  # noqa: BLE001 - a lost worker: report, go on
                 rec = RunRecord(what.name, what.path, "failed", 0.0, repr(exc), what.kind)
             self.outcome.runs.append(rec)
             if rec.status == "ran":
@@ -168,10 +145,12 @@ class Driver:
             self.progress.step(f"made {what.label} -> {res}")
 
     def run(self, jobs: list[Job]) -> None:
-        """Everything, to the end (products whose runs never come are left out)."""
+        """Everything, to the end (products whose runs never come are left out); on an
+        interruption the tasks not finished are cancelled."""
         self.submit_runs(jobs)
         self.launch_ready()
-        while self.running:
-            done, _ = wait(list(self.running), return_when=FIRST_COMPLETED)
-            for fut in done:
+        try:
+            for fut in self.pending:
                 self.finish(fut)
+        finally:
+            engine.cancel(self.client, self.running)
