@@ -2,8 +2,9 @@
 granule has moved since the contact list was built (past cfg.rebuild_move the chunk ends
 and the driver rebuilds the list), the largest overlap of every contact against the
 smaller radius (the step's largest one, found by granular_rhs; past cfg.overlap_stop
-the run stops), and granules without a plate
-contact reaching the plate's face (the run stops).
+the run stops), and granules without a plate contact near the plate's face: within
+cfg.face_skin R of it the chunk ends and the driver gives them a patch contact
+(docs/model.md section 3.5); one that reaches the face without a contact stops the run.
 """
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from numba import njit
 from granplate.physics.contact import plate_overlap
 from granplate.solver.state import (
     ERR_CONTACT, ERR_ITER, ERR_JUMP, ERR_N, ERR_OVERLAP, ERR_PLATE_REACH, ERR_RESID, ERR_T, ERR_VT,
-    OK, PARTNER_PLATE, REBUILD,
+    NEW_PLATE, OK, PARTNER_PLATE, REBUILD,
 )
 
 
@@ -51,8 +52,10 @@ def plate_face(u):
 @njit(cache=True)
 def watch_contacts(t, y, u, g, cfg, w, err):
     """Check the state after an accepted step; returns OK, REBUILD (the list must be
-    rebuilt: a granule moved cfg.rebuild_move since it was built), ERR_OVERLAP,
-    ERR_PLATE_REACH or ERR_JUMP with err filled. The step's largest overlap comes from
+    rebuilt: a granule moved cfg.rebuild_move since it was built), NEW_PLATE (a granule
+    without a plate contact is within cfg.face_skin R of the undeformed face: it needs a
+    patch contact; err[ERR_CONTACT] names it), ERR_OVERLAP, ERR_PLATE_REACH or ERR_JUMP
+    with err filled. The step's largest overlap comes from
     the last evaluation of the forces (w.ovl_new, w.ovl_who: granular.granular_rhs)."""
     i = w.ovl_who[0]
     if i >= 0:
@@ -72,6 +75,9 @@ def watch_contacts(t, y, u, g, cfg, w, err):
             reach = plate_overlap(y[i, 0], g.radius[i], face)
             if reach > 0.0:
                 return stop(ERR_PLATE_REACH, t, err, i, PARTNER_PLATE, reach, reach / g.radius[i])
+            if cfg.face_skin > 0.0 and plate_overlap(y[i, 0], g.radius[i] * (1.0 + cfg.face_skin), cfg.plate_x0) > 0.0:
+                status = NEW_PLATE
+                err[ERR_CONTACT] = i
         if cfg.rebuild_move > 0.0:
             dx = y[i, 0] - w.yref[i, 0]
             dy = y[i, 1] - w.yref[i, 1]
