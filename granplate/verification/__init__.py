@@ -37,9 +37,10 @@ def __getattr__(name: str):
 
 def all_cases() -> tuple:
     """Every registered case, in page order."""
-    from . import chain, conservation, coupled, granular, plate_cases
+    from . import chain, conservation, coupled, face_contacts, granular, plate_cases
 
-    return granular.CASES + chain.CASES + plate_cases.CASES + conservation.CASES + coupled.CASES
+    return (granular.CASES + chain.CASES + plate_cases.CASES + conservation.CASES + face_contacts.CASES
+            + coupled.CASES)
 
 
 def case_names(full: bool = True) -> list[str]:
