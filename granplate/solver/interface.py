@@ -106,7 +106,8 @@ def place_patch(k, y_c, st, p, cfg, w):
 @njit(cache=True)
 def move_patches(st, g, p, cfg, w):
     """After an accepted step, move every patch contact whose granule has slid along the
-    face (PATCH_MOVE): new weights at the granule's height, frozen over the next step.
+    face (PATCH_MOVE) and is within cfg.face_skin R of it (a patch far from its granule
+    waits): new weights at the granule's height, frozen over the next step.
 
     The overlap stays continuous across a move: the face x the contact measures from
     (g.pc_x) takes up the change of u_c, so the stored energy of eq. (9) does not jump
@@ -121,7 +122,8 @@ def move_patches(st, g, p, cfg, w):
             continue
         i = g.pc_i[k]
         y_c = st.y[i, 1]
-        if abs(y_c - w.patch_y[k]) > PATCH_MOVE * cfg.patch_width:
+        near = plate_overlap(st.y[i, 0], g.radius[i] * (1.0 + cfg.face_skin), g.pc_x[k] + st.u[2 * k]) > 0.0
+        if near and abs(y_c - w.patch_y[k]) > PATCH_MOVE * cfg.patch_width:
             u_old = st.u[2 * k]
             place_patch(k, y_c, st, p, cfg, w)
             g.pc_x[k] += u_old - st.u[2 * k]
