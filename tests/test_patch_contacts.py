@@ -54,7 +54,7 @@ def test_sliding_granule_carries_its_patch_and_obeys_coulomb():
     touch; the tangential impulse stays within mu times the normal one, friction
     dissipates, and eq. (11) balances."""
     mu = 0.3
-    ds = simulate(drop_scenario(0.05, vx=1.0, vy=4.0, mu=mu, t_end=1e-3), progress=False)
+    ds = simulate(drop_scenario(0.05, vx=1.0, vy=4.0, mu=mu, t_end=1e-3, out=5e-7), progress=False)
     b = bounce(ds)
     assert b["travel"] > node_spacing(40)
     assert 0.1 * mu * b["j_n"] < abs(b["j_t"]) <= mu * b["j_n"] * 1.001

@@ -154,7 +154,7 @@ def _table(soft: dict, meshes) -> str:
 def face_slide(ctx: Context) -> CaseResult:
     """An oblique impact with friction: the granule slides along the face, its patch follows."""
     mu = 0.3
-    ds = simulate(drop_scenario(0.05, vx=1.0, vy=4.0, mu=mu, t_end=1e-3))
+    ds = simulate(drop_scenario(0.05, vx=1.0, vy=4.0, mu=mu, t_end=1e-3, out=5e-7))
     b = bounce(ds)
     d_fric = float(ds.D_friction.values[-1])
     e0 = float(ds.E_granular.values[0])
