@@ -124,11 +124,15 @@ def test_fixed_detection_still_stops_at_the_plate():
 
 
 def test_patch_needs_the_full_basis():
-    """The truncated basis keeps the plate contacts to those at t = 0: no face shapes in
-    the loop's arrays, no patch contacts (a granule reaching the face stops the run)."""
+    """A truncated basis (here without any initial contact) keeps the plate contacts to
+    those at t = 0: no face shapes in the loop's arrays, no patch contacts (a granule
+    reaching the face stops the run, naming plate.modes)."""
     s = drop_scenario(0.05, ny=8)
     s = s.__class__(**{**s.__dict__, "plate": s.plate.__class__(**{**s.plate.__dict__, "modes": "truncated",
                                                                    "max_frequency": 2e5})})
     model = build_model(s)
-    assert model.plate.truncated and model.config.face_skin == 0.0 and len(model.plate_arrays.face_y) == 0
+    assert model.plate.n_modes < model.plate.n_red
+    assert model.config.face_skin == 0.0 and len(model.plate_arrays.face_y) == 0
+    with pytest.raises(SimulationError, match=r"granule 'g' .* reached the plate's face .*plate.modes = \"all\""):
+        simulate(s, model=model, progress=False)
     assert build_model(drop_scenario(0.05, ny=8)).config.face_skin > 0.0

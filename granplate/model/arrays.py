@@ -176,7 +176,7 @@ def face_contacts_possible(s: Scenario, plate_model) -> bool:
     dynamic detection, granules, and a plate integrated in all its modes (a truncated
     basis would need the static correction at every face dof)."""
     return (s.contact.detection == "dynamic" and plate_model is not None and len(s.granules) > 0
-            and not plate_model.truncated)
+            and plate_model.n_modes == plate_model.n_red)
 
 
 def plate_modal_arrays(s: Scenario, y: np.ndarray, pc: np.ndarray):

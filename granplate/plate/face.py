@@ -1,5 +1,5 @@
 """The plate's face (its left edge, facing the granules) and the patch contacts on it
-(docs/model.md section 4.6).
+(docs/model.md section 3.5).
 
 A patch contact spreads its force as a uniform traction over [y_c - w/2, y_c + w/2]
 (w the rigid-layer width, cut to the face), integrated with the face's quadratic Q8 edge

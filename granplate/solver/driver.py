@@ -126,7 +126,8 @@ def contact_message(status: int, model: Model, st: S.State) -> str:
                    f"contact.neighbour_gap = {c.neighbour_gap:g} R of the plate); use detection = \"dynamic\"")
         else:
             why = ("contacts forming on the plate's face need the plate in all its modes; use "
-                   "plate.modes = \"all\" (the truncated basis keeps plate contacts to those at t = 0)")
+                   "plate.modes = \"all\" and plate.n_modes = 0 (a truncated basis keeps plate contacts "
+                   "to those at t = 0)")
         return (f"{who} {where} reached the plate's face at t = {t:.6e} s (overlap "
                 f"{e[S.ERR_N]:.4g} m) but has no plate contact: {why}.")
     return (f"{who} {where} moved {e[S.ERR_N]:.4g} m ({e[S.ERR_RESID]:.3g} radii) in one step at "
