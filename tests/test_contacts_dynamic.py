@@ -228,11 +228,12 @@ def test_overlap_beyond_the_warning_fraction_warns_once_per_contact():
 
 
 def test_granule_reaching_the_plate_without_a_plate_contact_stops_the_run():
-    """Plate contacts are those at t = 0: a granule 1 mm from the plate (beyond
-    neighbour_gap R) that flies into it stops the run, naming it, the time and the place."""
+    """With the fixed topology plate contacts are those at t = 0: a granule 1 mm from the
+    plate (beyond neighbour_gap R) that flies into it stops the run, naming it, the time
+    and the place (with dynamic detection it gets a patch contact: test_patch_contacts.py)."""
     plate = Plate(x0=0.03, y0=0.0, height=0.1, ny=40)
     s = scenario([Granule(x=0.03 - R - 1e-3, y=0.05, radius=R, material="steel", label="g", vx=2.0)],
-                 t_end=1e-3, dt=1e-7, out=1e-6, plate=plate)
+                 t_end=1e-3, dt=1e-7, out=1e-6, plate=plate, detection="fixed")
     with pytest.raises(SimulationError, match=r"granule 'g' \(at x = .* y = 0.05 m\) reached the plate's face "
                                               r"at t = 5.0\d*e-04 s") as err:
         simulate(s, progress=False)

@@ -171,11 +171,21 @@ def plate_contact_coefficients(s: Scenario, mats, r: np.ndarray, pc: np.ndarray)
     return pc_coef
 
 
+def face_contacts_possible(s: Scenario, plate_model) -> bool:
+    """Whether granules may get patch contacts during the run (docs/model.md section 3.5):
+    dynamic detection, granules, and a plate integrated in all its modes (a truncated
+    basis would need the static correction at every face dof)."""
+    return (s.contact.detection == "dynamic" and plate_model is not None and len(s.granules) > 0
+            and plate_model.n_modes == plate_model.n_red)
+
+
 def plate_modal_arrays(s: Scenario, y: np.ndarray, pc: np.ndarray):
     """The plate's model (or None) and its PlateArrays (modes, shapes at the driving
-    DOFs of the contacts pc, modal edge load)."""
+    DOFs of the contacts pc, modal edge load, and the face's shapes when patch contacts
+    may form)."""
     plate_model = None
     nk = len(pc)
+    face_y, phi_face = np.zeros(0), np.zeros((0, 0))
     if s.plate is not None:
         from granplate.plate import build_plate
 
@@ -190,6 +200,9 @@ def plate_modal_arrays(s: Scenario, y: np.ndarray, pc: np.ndarray):
         phi_d = np.ascontiguousarray(plate_model.phi_drive, float)
         load_modal = np.ascontiguousarray(plate_model.edge_load_modal, float)
         resid = np.ascontiguousarray(plate_model.resid, float)
+        if face_contacts_possible(s, plate_model):
+            face_y = np.ascontiguousarray(plate_model.face_y, float)
+            phi_face = np.ascontiguousarray(plate_model.phi_face, float)
     else:
         omega2 = np.zeros(0)
         phi_d = np.zeros((0, 0))
@@ -197,11 +210,14 @@ def plate_modal_arrays(s: Scenario, y: np.ndarray, pc: np.ndarray):
         resid = np.zeros((0, 0))
     if phi_d.shape != (2 * nk, len(omega2)):
         phi_d = phi_d.reshape(2 * nk, len(omega2))
-    return plate_model, PlateArrays(omega2=omega2, phi_d=phi_d, load_modal=load_modal, resid=resid)
+    return plate_model, PlateArrays(omega2=omega2, phi_d=phi_d, load_modal=load_modal, resid=resid,
+                                    face_y=face_y, phi_face=phi_face)
 
 
-def loop_config(s: Scenario, fres: np.ndarray, tres: np.ndarray, r: np.ndarray, mass: np.ndarray) -> Config:
-    """The loop's scalar settings from the scenario's load, contact, time and solver."""
+def loop_config(s: Scenario, fres: np.ndarray, tres: np.ndarray, r: np.ndarray, mass: np.ndarray,
+                face: bool = False) -> Config:
+    """The loop's scalar settings from the scenario's load, contact, time and solver;
+    face: whether granules may get patch contacts during the run."""
     t = s.time
     sol = s.solver
     q0 = s.load.q0 if s.load.kind == "line" else 0.0
@@ -224,6 +240,8 @@ def loop_config(s: Scenario, fres: np.ndarray, tres: np.ndarray, r: np.ndarray, 
         plate_ylo=float(s.plate.y0) if s.plate is not None else 0.0,
         plate_yhi=float(s.plate.y0 + s.plate.height) if s.plate is not None else 0.0,
         split_friction=sol.granular_friction == "split",
+        face_skin=float(s.contact.skin) if face else 0.0,
+        patch_width=float(s.plate.layer_width) if s.plate is not None else 0.0,
     )
 
 
@@ -271,7 +289,8 @@ def build_model(scenario: Scenario) -> Model:
     )
     return Model(
         scenario=s, labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
-        granular=granular, plate_arrays=plate_arrays, config=loop_config(s, fres, tres, r, mass),
+        granular=granular, plate_arrays=plate_arrays,
+        config=loop_config(s, fres, tres, r, mass, face=len(plate_arrays.face_y) > 0),
         plate=plate_model, initial_state=initial_state(s, x, y), pairs=pairs, wall_contacts=wc,
         plate_contacts=pc, materials=tuple(mats),
     )
@@ -295,3 +314,19 @@ def granular_with_contacts(model: Model, g: Granular, pairs: np.ndarray, wc: np.
     return g._replace(pair_ij=np.ascontiguousarray(pairs, np.int64).reshape(-1, 2), pair_coef=pair_coef,
                       wall_i=np.ascontiguousarray(wc[:, 0]), wall_geo=wall_geo, wall_coef=wall_coef,
                       wall_w=np.ascontiguousarray(wc[:, 1]))
+
+
+def granular_with_patch_contacts(model: Model, g: Granular, new: np.ndarray) -> Granular:
+    """`g` with a patch contact appended for each granule of `new` (docs/model.md section
+    3.5): the coefficients of a rigid layer (m* = 0), the overlap measured from the
+    undeformed face, pc_patch = 1."""
+    new = np.asarray(new, np.int64).ravel()
+    s, mats = model.scenario, list(model.materials)
+    patch = g.pc_patch if len(g.pc_patch) == len(g.pc_i) else np.zeros(len(g.pc_i), np.int64)
+    return g._replace(
+        pc_i=np.concatenate([g.pc_i, new]).astype(np.int64),
+        pc_x=np.concatenate([g.pc_x, np.full(len(new), float(s.plate.x0))]),
+        pc_coef=np.ascontiguousarray(np.vstack([g.pc_coef.reshape(-1, N_COEF),
+                                                plate_contact_coefficients(s, mats, g.radius, new)])),
+        pc_patch=np.concatenate([patch, np.ones(len(new), np.int64)]),
+    )

@@ -34,8 +34,12 @@ class Granular(NamedTuple):
     touch, sorted); pair_coef: (np, 4) [A, c, mu, k_s] with gamma = c delta^(1/4); wall_i:
     (nw,); wall_geo: (nw, 3) [nx, ny, offset]; wall_coef: (nw, 4); wall_w: (nw,) index of
     the wall in the scenario; pc_i: (nk,) granule of each plate contact;
-    pc_x: (nk,) undeformed x of the plate edge; pc_coef: (nk, 4); shock_force,
-    shock_torque: (ng,) load resultants per unit q0 [m, m^2].
+    pc_x: (nk,) x of the plate edge the contact's overlap is measured from (the
+    undeformed face; a patch contact's is shifted as its patch moves, docs/model.md
+    section 3.5); pc_coef: (nk, 4); shock_force, shock_torque: (ng,) load resultants per
+    unit q0 [m, m^2]; pc_patch: (nk,) int, 1 for a patch contact (its plate rows move
+    with the granule, docs/model.md section 3.5), 0 for a rigid layer; empty while
+    there is no patch contact (the loop then skips them at no cost).
     """
 
     mass: np.ndarray
@@ -52,6 +56,7 @@ class Granular(NamedTuple):
     pc_coef: np.ndarray
     shock_force: np.ndarray
     shock_torque: np.ndarray
+    pc_patch: np.ndarray = np.zeros(0, np.int64)
 
 
 class PlateArrays(NamedTuple):
@@ -61,13 +66,17 @@ class PlateArrays(NamedTuple):
     at the driving DOFs (x, y of each contact); load_modal: (nm,) modal edge load per
     unit q0 (zeros when the shock is on the granules); resid: (nd, nd) residual static
     compliance R [m/N] of a truncated basis (docs/model.md section 4.5), (0, 0) when
-    every mode is kept.
+    every mode is kept; face_y: (n_face,) heights of the face nodes [m] and phi_face:
+    (2 n_face, nm) the mode shapes at their dofs, which patch contacts average
+    (docs/model.md section 3.5; empty without patch contacts).
     """
 
     omega2: np.ndarray
     phi_d: np.ndarray
     load_modal: np.ndarray
     resid: np.ndarray = np.zeros((0, 0))
+    face_y: np.ndarray = np.zeros(0)
+    phi_face: np.ndarray = np.zeros((0, 0))
 
 
 class Config(NamedTuple):
@@ -96,3 +105,5 @@ class Config(NamedTuple):
     plate_ylo: float = 0.0  # its extent in y [m]
     plate_yhi: float = 0.0
     split_friction: bool = True  # solver.granular_friction = "split" (solver.granular.rk4_granular_step)
+    face_skin: float = 0.0  # > 0: a granule within face_skin R of the face gets a patch contact (0: never)
+    patch_width: float = 0.0  # width of a patch contact [m] (plate.rigid_layer_width)

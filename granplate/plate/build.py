@@ -34,6 +34,7 @@ from granplate.plate.constraints import (
     rigid_layer_nodes,
     symmetry_line_nodes,
 )
+from granplate.plate.face import face_modes, face_nodes
 from granplate.plate.fe import assemble_mass, assemble_stiffness, node_coordinates, plate_mesh, q8_basis, vtk_elements
 from granplate.plate.load import EDGE_LOAD_POINTS, edge_load_vector
 from granplate.plate.modes import modal_basis, residual_compliance, truncated_modal_basis, weyl_mode_count
@@ -106,6 +107,10 @@ class PlateModel:
     D: (3, 3) plane-stress constitutive matrix [Pa].
     symmetry_nodes: node indices on y = y0 + height / 2, sorted by x.
     contact_y: (n_contacts,) contact heights as given [m].
+    face_nodes: (n_face,) the nodes of the face x = x0 (the left edge), bottom to top.
+    face_y: (n_face,) their heights [m].
+    phi_face: (2 n_face, n_modes) mode shapes at the face nodes' dofs, rows [n0 x, n0 y,
+        n1 x, ...] [kg^-1/2]: what a patch contact (plate/face.py) averages.
     thickness [m], rho [kg/m^3], E [Pa], nu [-].
     disc_radius: radius of the stress-averaging discs [m] (Plate.disc_radius);
     disc_centres: (n_discs, 2) their centres [m], a lattice DISC_CENTRE_SPACING x
@@ -131,6 +136,9 @@ class PlateModel:
     D: np.ndarray
     symmetry_nodes: np.ndarray
     contact_y: np.ndarray
+    face_nodes: np.ndarray
+    face_y: np.ndarray
+    phi_face: np.ndarray
     thickness: float
     rho: float
     E: float
@@ -454,6 +462,7 @@ def build_plate(
     )
     Phi = arrays["Phi"]
     psi = arrays["psi"] if "psi" in arrays else np.zeros((n_red, 0))
+    face = face_nodes(node_xy, x0, GEOMETRY_RTOL * plate.width)
     qp_xy = quadrature_points(basis)
     radius = float(plate.disc_radius)
     centres = disc_centres(x0, plate.y0, plate.width, plate.height, DISC_CENTRE_SPACING * radius)
@@ -477,6 +486,9 @@ def build_plate(
         D=D,
         symmetry_nodes=symmetry_nodes,
         contact_y=np.array(contact_y, dtype=float),
+        face_nodes=face,
+        face_y=np.ascontiguousarray(node_xy[face, 1]),
+        phi_face=face_modes(T, Phi, face),
         thickness=float(plate.thickness),
         rho=float(material.rho),
         E=float(material.E),

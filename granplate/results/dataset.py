@@ -41,7 +41,7 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "plate_ux": ("m", "plate nodal displacement, horizontal (at field_time)"),
     "plate_uy": ("m", "plate nodal displacement, vertical (at field_time)"),
     "plate_von_mises": ("Pa", "largest von Mises stress in each element (at field_time)"),
-    "contact_normal_force": ("N", "normal force on the plate at each rigid-layer contact (+x)"),
+    "contact_normal_force": ("N", "normal force on the plate at each plate contact (+x)"),
     "contact_tangential_force": ("N", "friction force on the plate at each contact (+y)"),
     "contact_slip_rate": ("m/s", "tangential slip rate v_t at each plate contact (eq. 6)"),
     "local_map_modulus": ("1", "largest |lambda| of the frictional local map (eq. 8) since the previous output"),

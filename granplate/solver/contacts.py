@@ -2,8 +2,9 @@
 granule has moved since the contact list was built (past cfg.rebuild_move the chunk ends
 and the driver rebuilds the list), the largest overlap of every contact against the
 smaller radius (the step's largest one, found by granular_rhs; past cfg.overlap_stop
-the run stops), and granules without a plate
-contact reaching the plate's face (the run stops).
+the run stops), and granules without a plate contact near the plate's face: within
+cfg.face_skin R of it the chunk ends and the driver gives them a patch contact
+(docs/model.md section 3.5); one that reaches the face without a contact stops the run.
 """
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from numba import njit
 from granplate.physics.contact import plate_overlap
 from granplate.solver.state import (
     ERR_CONTACT, ERR_ITER, ERR_JUMP, ERR_N, ERR_OVERLAP, ERR_PLATE_REACH, ERR_RESID, ERR_T, ERR_VT,
-    OK, PARTNER_PLATE, REBUILD,
+    NEW_PLATE, OK, PARTNER_PLATE, REBUILD,
 )
 
 
@@ -50,13 +51,14 @@ def plate_face(u):
 
 @njit(cache=True)
 def watch_contacts(t, y, u, radius, plate_free, yref, ovl, ovl_with, ovl_new, ovl_who, overlap_stop,
-                   plate_x0, plate_ylo, plate_yhi, rebuild_move, err):
+                   plate_x0, plate_ylo, plate_yhi, rebuild_move, face_skin, err):
     """Check the state after an accepted step; returns OK, REBUILD (the list must be
-    rebuilt: a granule moved rebuild_move since it was built, at yref), ERR_OVERLAP,
-    ERR_PLATE_REACH or ERR_JUMP with err filled. The step's largest overlap comes from
-    the last evaluation of the forces (ovl_new, ovl_who: granular.granular_rhs); ovl,
-    ovl_with keep each granule's largest. (Arrays and the Config's scalars, not the
-    tuples: this runs every step.)"""
+    rebuilt: a granule moved rebuild_move since it was built, at yref), NEW_PLATE (a
+    granule without a plate contact is within face_skin R of the undeformed face: it needs
+    a patch contact; err[ERR_CONTACT] names it), ERR_OVERLAP, ERR_PLATE_REACH or ERR_JUMP
+    with err filled. The step's largest overlap comes from the last evaluation of the
+    forces (ovl_new, ovl_who: granular.granular_rhs); ovl, ovl_with keep each granule's
+    largest. (Arrays and the Config's scalars, not the tuples: this runs every step.)"""
     i = ovl_who[0]
     if i >= 0:
         partner = ovl_who[1]
@@ -75,6 +77,9 @@ def watch_contacts(t, y, u, radius, plate_free, yref, ovl, ovl_with, ovl_new, ov
             reach = plate_overlap(y[i, 0], radius[i], face)
             if reach > 0.0:
                 return stop(ERR_PLATE_REACH, t, err, i, PARTNER_PLATE, reach, reach / radius[i])
+            if face_skin > 0.0 and plate_overlap(y[i, 0], radius[i] * (1.0 + face_skin), plate_x0) > 0.0:
+                status = NEW_PLATE
+                err[ERR_CONTACT] = i
         if rebuild_move > 0.0:
             dx = y[i, 0] - yref[i, 0]
             dy = y[i, 1] - yref[i, 1]

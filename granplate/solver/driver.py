@@ -15,10 +15,12 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
-from granplate.model.arrays import Model, granular_with_contacts
+from granplate.model.arrays import Model, granular_with_contacts, granular_with_patch_contacts
 from granplate.model.contacts import Missed, contact_lists, missed_contacts, wall_planes
 from granplate.model.neighbours import verlet_pairs, verlet_walls
+from granplate.physics.contact import plate_overlap
 from granplate.solver import loop, state as S
+from granplate.solver.interface import place_patch
 from granplate.solver.ladder import level_for
 from granplate.solver.schemes import scheme
 
@@ -33,13 +35,16 @@ INTERRUPTED_STATUS = "interrupted by the user"
 class RunRecord(NamedTuple):
     """What the loop leaves: the output buffers, how many rows are valid, the status
     code (state.OK, an error code, or INTERRUPTED), its message ("ok" or why the run
-    stopped) and the timings and counters (info)."""
+    stopped), the timings and counters (info), and the granule of every plate contact
+    (the model's, then the patch contacts formed during the run, in the order of the
+    output's contact axis)."""
 
     out: S.Output
     n_valid: int
     status: int
     message: str
     info: dict
+    plate_contacts: np.ndarray | None = None
 
 
 def output_times(t_end: float, dt_out: float) -> np.ndarray:
@@ -95,6 +100,7 @@ def contact_message(status: int, model: Model, st: S.State) -> str:
     """Why the contact watch stopped the run (solver/contacts.py, model/contacts.py)."""
     e = st.err
     c = model.scenario.contact
+    cfg = model.config
     t = e[S.ERR_T]
     i = int(e[S.ERR_CONTACT])
     who = f"granule '{model.labels[i]}'"
@@ -112,9 +118,18 @@ def contact_message(status: int, model: Model, st: S.State) -> str:
         return (f"{who} {where} and {other} interpenetrate by {e[S.ERR_N]:.4g} m at t = {t:.6e} s "
                 f"and no contact accounts for it: {how}.")
     if status == S.ERR_PLATE_REACH:
+        if cfg.face_skin > 0.0:
+            why = ("it came from farther than contact.skin R within one step, so its patch contact "
+                   "formed unseen: lower time.dt_max or raise contact.skin")
+        elif c.detection == "fixed":
+            why = (f"with contact.detection = \"fixed\" plate contacts are those at t = 0 (within "
+                   f"contact.neighbour_gap = {c.neighbour_gap:g} R of the plate); use detection = \"dynamic\"")
+        else:
+            why = ("contacts forming on the plate's face need the plate in all its modes; use "
+                   "plate.modes = \"all\" and plate.n_modes = 0 (a truncated basis keeps plate contacts "
+                   "to those at t = 0)")
         return (f"{who} {where} reached the plate's face at t = {t:.6e} s (overlap "
-                f"{e[S.ERR_N]:.4g} m) but has no plate contact: plate contacts are those at t = 0 "
-                f"(within contact.neighbour_gap = {c.neighbour_gap:g} R of the plate).")
+                f"{e[S.ERR_N]:.4g} m) but has no plate contact: {why}.")
     return (f"{who} {where} moved {e[S.ERR_N]:.4g} m ({e[S.ERR_RESID]:.3g} radii) in one step at "
             f"t = {t:.6e} s: contacts may have been passed through. Lower time.dt_max.")
 
@@ -167,6 +182,74 @@ class ContactLists:
         return missed[0] if missed else None
 
 
+class LoopArrays:
+    """The arrays one run advances, replaced as a whole when a patch contact is added
+    (their contact dimension grows): the plate's modal arrays (p: its contact rows are
+    this run's own), the state, the shared and the scheme's scratch and the outputs."""
+
+    def __init__(self, model: Model, times: np.ndarray, nk: int):
+        g, p, cfg = model.granular, model.plate_arrays, model.config
+        ng, nm = model.n_granules, len(p.omega2)
+        self.p = p._replace(phi_d=p.phi_d.copy()) if cfg.face_skin > 0.0 else p
+        self.st = S.new_state(ng, nm, nk)
+        self.w = S.new_work(ng, nm, nk, len(p.face_y))
+        self.sw = scheme(cfg.scheme).new_scratch(ng, nm, nk)
+        self.out = S.new_output(times, ng, nm, nk)
+        self.scheme = cfg.scheme
+        self.patch_y0: list[float] = []  # the height [m] at which each patch contact formed
+
+    def grow(self, nk_new: int) -> None:
+        """Room for nk_new plate contacts: every array reallocated with the old values
+        kept (contacts keep their indices; the new ones start at zero) and the per-level
+        matrices marked stale."""
+        st, w = self.st, self.w
+        ng, nm = st.y.shape[0], st.q.shape[0]
+        self.st = _copied(st, S.new_state(ng, nm, nk_new))
+        self.w = _copied(w, S.new_work(ng, nm, nk_new, len(w.wface)))
+        self.sw = _copied(self.sw, scheme(self.scheme).new_scratch(ng, nm, nk_new))
+        self.out = _copied(self.out, S.new_output(self.out.target, ng, nm, nk_new))
+        phi_d = np.zeros((2 * nk_new, nm))
+        phi_d[: self.p.phi_d.shape[0]] = self.p.phi_d
+        self.p = self.p._replace(phi_d=phi_d)
+        self.w.g_ok[:] = 0
+        self.st.clock[S.CUSTOM_H] = -1.0
+
+
+def _copied(old: tuple, new: tuple) -> tuple:
+    """`new` (a named tuple of arrays) with each array's leading block taken from `old`'s."""
+    for a, b in zip(old, new):
+        b[tuple(slice(0, min(m, n)) for m, n in zip(a.shape, b.shape))] = \
+            a[tuple(slice(0, min(m, n)) for m, n in zip(a.shape, b.shape))]
+    return new
+
+
+def near_face(model: Model, y: np.ndarray, free: np.ndarray) -> np.ndarray:
+    """Granules without a plate contact (free != 0) whose centre lies within the plate's
+    height and whose surface is within contact.skin R of its undeformed face (docs/model.md
+    section 3.5), ascending."""
+    cfg, r = model.config, model.granular.radius
+    inside = (cfg.plate_ylo < y[:, 1]) & (y[:, 1] < cfg.plate_yhi) & (free != 0)
+    near = plate_overlap(y[:, 0], r * (1.0 + cfg.face_skin), cfg.plate_x0) > 0.0
+    return np.flatnonzero(inside & near).astype(np.int64)
+
+
+def add_patch_contacts(model: Model, lists: "ContactLists", arr: LoopArrays) -> int:
+    """Give every granule near the face without a plate contact a patch contact
+    centred at its height (docs/model.md section 3.5); returns how many were added."""
+    new = near_face(model, arr.st.y, arr.w.plate_free)
+    if len(new) == 0:
+        return 0
+    nk = len(lists.g.pc_i)
+    lists.g = granular_with_patch_contacts(model, lists.g, new)
+    arr.grow(nk + len(new))
+    for k, i in enumerate(new, start=nk):
+        place_patch(k, float(arr.st.y[i, 1]), arr.st, arr.p, model.config, arr.w)
+        arr.patch_y0.append(float(arr.st.y[i, 1]))
+        arr.st.slip[k] = arr.st.y[i, 4] + model.granular.radius[i] * arr.st.y[i, 5] - arr.st.v[2 * k + 1]
+    arr.w.plate_free[new] = 0
+    return len(new)
+
+
 @contextmanager
 def stop_on_signals():
     """Yield a function telling whether SIGINT or SIGTERM arrived meanwhile; the
@@ -209,11 +292,12 @@ def _refresh(lists: ContactLists, st: S.State, w: S.Work) -> int:
     return S.ERR_MISSED
 
 
-def _loop_chunks(times, model, st, w, sw, out, should_stop, on_progress, lists) -> int:
+def _loop_chunks(times, model, arr: LoopArrays, should_stop, on_progress, lists) -> int:
     """Call the compiled loop chunk by chunk until the end, an error or a stop request;
-    between chunks the contact lists are rebuilt when the loop asks (REBUILD) and, with
-    fixed contacts, checked after every chunk."""
-    p, cfg = model.plate_arrays, model.config
+    between chunks the contact lists are rebuilt when the loop asks (REBUILD), patch
+    contacts added (NEW_PLATE) and, with fixed contacts, the lists checked after every
+    chunk."""
+    cfg = model.config
     fixed = model.scenario.contact.detection == "fixed"
     n_chunks = min(200, len(times) - 1)
     stops = np.unique(np.linspace(1, len(times) - 1, n_chunks).round().astype(int)) if n_chunks else []
@@ -223,22 +307,25 @@ def _loop_chunks(times, model, st, w, sw, out, should_stop, on_progress, lists) 
         while status == S.PAUSED:
             if should_stop():
                 return INTERRUPTED
+            st = arr.st
             before = st.count[S.C_OUT]
             n0 = st.count[S.C_STEPS] + st.count[S.C_RETRIES]
             t0 = time.perf_counter()
-            status = loop.advance(float(times[o_stop]), budget, lists.g, p, cfg, st, w, sw, out)
+            status = loop.advance(float(times[o_stop]), budget, lists.g, arr.p, cfg, st, arr.w, arr.sw, arr.out)
             budget = next_budget(budget, int(st.count[S.C_STEPS] + st.count[S.C_RETRIES] - n0),
                                  time.perf_counter() - t0)
             on_progress(int(st.count[S.C_OUT] - before))
+            if status in (S.REBUILD, S.NEW_PLATE) and cfg.face_skin > 0.0:
+                add_patch_contacts(model, lists, arr)
             if status == S.REBUILD or (fixed and status in (S.OK, S.PAUSED)):
-                checked = _refresh(lists, st, w)
+                checked = _refresh(lists, arr.st, arr.w)
                 if checked != S.OK:
                     return checked
-                if status == S.REBUILD:
-                    status = S.PAUSED
+            if status in (S.REBUILD, S.NEW_PLATE):
+                status = S.PAUSED
         if status != S.OK:
             return status
-    return _refresh(lists, st, w)
+    return _refresh(lists, arr.st, arr.w)
 
 
 def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool] | None = None,
@@ -248,22 +335,21 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
     progress: a bar on stderr; should_stop: polled between chunks (a stop request);
     interruptible: SIGINT/SIGTERM stop the run between chunks (main thread only).
     """
-    g, p, cfg = model.granular, model.plate_arrays, model.config
-    ng, nm, nk = model.n_granules, len(p.omega2), len(model.plate_contacts)
+    g, cfg = model.granular, model.config
     times = output_times(cfg.t_end, cfg.out_dt)
-    st = S.new_state(ng, nm, nk)
-    w = S.new_work(ng, nm, nk)
-    sw = scheme(cfg.scheme).new_scratch(ng, nm, nk)
-    out = S.new_output(times, ng, nm, nk)
+    arr = LoopArrays(model, times, len(model.plate_contacts))
+    st, w = arr.st, arr.w
     st.y[:] = model.initial_state
     w.yref[:] = st.y[:, :2]
     w.plate_free[:] = 1
     w.plate_free[model.plate_contacts] = 0
     lists = ContactLists(model)
+    if cfg.face_skin > 0.0:  # this run's own (patch contacts move their face)
+        lists.g = lists.g._replace(pc_x=g.pc_x.copy())
     st.count[S.C_LEVEL] = level_for(model.scenario.time.dt_initial, cfg)
     t1 = time.perf_counter()
-    loop.initialise(st, g, p, cfg, w)
-    loop.record(0, st, g, p, w, out)
+    loop.initialise(st, lists.g, arr.p, cfg, w)
+    loop.record(0, st, lists.g, arr.p, w, arr.out)
     st.count[S.C_OUT] = 1
     t_first = time.perf_counter() - t1  # includes compiling / loading the loop
     bar = None
@@ -275,11 +361,12 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
     t2 = time.perf_counter()
     try:
         with (stop_on_signals() if interruptible else _never()) as signalled:
-            status = _loop_chunks(times, model, st, w, sw, out, lambda: signalled() or any(f() for f in polls),
+            status = _loop_chunks(times, model, arr, lambda: signalled() or any(f() for f in polls),
                                   bar.update if bar is not None else (lambda n: None), lists)
     finally:
         if bar is not None:
             bar.close()
+    st, w = arr.st, arr.w
     info = {
         "first_call_time_s": t_first,
         "loop_time_s": time.perf_counter() - t2,
@@ -288,12 +375,14 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
         "n_retries": int(st.count[S.C_RETRIES]),
         "n_rebuilds": lists.n_rebuilds,
         "overlap_warnings": overlap_warnings(model, w),
+        "patch_y0": list(arr.patch_y0),
     }
     message = "ok" if status == S.OK else status_message(status, model, st)
     for line in info["overlap_warnings"]:
         warnings.warn(f"{model.scenario.name}: {line}: Hertz's law assumes overlaps small against the radii.",
                       RuntimeWarning, stacklevel=2)
-    return RunRecord(out=out, n_valid=int(st.count[S.C_OUT]), status=status, message=message, info=info)
+    return RunRecord(out=arr.out, n_valid=int(st.count[S.C_OUT]), status=status, message=message, info=info,
+                     plate_contacts=np.asarray(lists.g.pc_i, np.int64).copy())
 
 
 @contextmanager

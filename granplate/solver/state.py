@@ -32,9 +32,11 @@ N_ERR = 8
 # ERR_OVERLAP: an overlap beyond contact.overlap_stop; ERR_PLATE_REACH: a granule without
 # a plate contact reached the plate's face; ERR_JUMP: a granule moved more than the
 # smallest radius in one step; ERR_MISSED: two bodies overlap that no contact accounts
-# for (found by the driver's search when the list is rebuilt or checked)
+# for (found by the driver's search when the list is rebuilt or checked); NEW_PLATE: a
+# granule without a plate contact came within contact.skin R of the plate's face (the
+# driver gives it a patch contact, docs/model.md section 3.5, and goes on)
 OK, ERR_NAN, ERR_ENERGY, ERR_NOCONV, ERR_BUFFER, PAUSED = 0, 1, 2, 3, 4, 5
-REBUILD, ERR_OVERLAP, ERR_PLATE_REACH, ERR_JUMP, ERR_MISSED = 6, 7, 8, 9, 10
+REBUILD, ERR_OVERLAP, ERR_PLATE_REACH, ERR_JUMP, ERR_MISSED, NEW_PLATE = 6, 7, 8, 9, 10, 11
 #: partner code of a plate contact in Work.ovl_with (a granule j >= 0, wall w: -1 - w)
 PARTNER_PLATE = -(1 << 40)
 
@@ -107,6 +109,8 @@ class Work(NamedTuple):
     plate_free: np.ndarray  # (ng,) int: 1 for a granule without a plate contact
     ovl_new: np.ndarray  # (1,) largest overlap / smaller radius at the end of the trial step
     ovl_who: np.ndarray  # (2,) int: its granule and partner (-1, -1: no overlap)
+    wface: np.ndarray  # (n_face,) scratch: a patch's nodal weights
+    patch_y: np.ndarray  # (nk,) the height [m] each patch contact's weights were computed at
 
 
 class Output(NamedTuple):
@@ -137,8 +141,8 @@ def new_state(ng: int, nm: int, nk: int) -> State:
     )
 
 
-def new_work(ng: int, nm: int, nk: int) -> Work:
-    """Shared scratch for ng granules, nm modes and nk plate contacts."""
+def new_work(ng: int, nm: int, nk: int, n_face: int = 0) -> Work:
+    """Shared scratch for ng granules, nm modes, nk plate contacts and n_face face nodes."""
     nd = 2 * nk
     z = np.zeros
     return Work(
@@ -150,7 +154,7 @@ def new_work(ng: int, nm: int, nk: int) -> Work:
         gmat=z((N_LEVELS + 1, nd, nd)), g_ok=np.zeros(N_LEVELS + 1, np.int64),
         lam_int=z(nk), it_int=np.zeros(nk, np.int64), dt_int=z(2), res_int=z(1),
         yref=z((ng, 2)), ovl=z(ng), ovl_with=np.zeros(ng, np.int64), plate_free=np.zeros(ng, np.int64),
-        ovl_new=z(1), ovl_who=np.full(2, -1, np.int64),
+        ovl_new=z(1), ovl_who=np.full(2, -1, np.int64), wface=z(n_face), patch_y=z(nk),
     )
 
 

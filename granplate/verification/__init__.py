@@ -44,10 +44,10 @@ def __getattr__(name: str):
 
 def all_cases() -> tuple:
     """Every registered case, in page order."""
-    from . import chain, conservation, coupled, dynamic, granular, lammps, plate_cases, plate_mesh
+    from . import chain, conservation, coupled, dynamic, face_contacts, granular, lammps, plate_cases, plate_mesh
 
     return (granular.CASES + chain.CASES + dynamic.CASES + lammps.cases() + plate_cases.CASES
-            + plate_mesh.CASES + conservation.CASES + coupled.CASES)
+            + plate_mesh.CASES + conservation.CASES + face_contacts.CASES + coupled.CASES)
 
 
 def case_names(full: bool = True) -> list[str]:

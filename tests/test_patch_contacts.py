@@ -1,0 +1,138 @@
+"""Plate contacts that form during the run on the plate's face (docs/model.md section
+3.5): against Hertz's rigid-wall impact on a stiff plate, against themselves at a node
+and between nodes, Coulomb's bound when sliding, the energy balance of eq. (11) (exactly
+across a patch move), and the fixed detection's error kept."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from granplate.errors import SimulationError
+from granplate.model.arrays import build_model
+from granplate.physics.contact import COEF_A, contact_energy
+from granplate.results.run import simulate
+from granplate.setup.materials import LIBRARY, effective_modulus, sphere_mass
+from granplate.setup.scenario import Wall
+from granplate.solver import driver, loop, state as S
+from granplate.solver.interface import move_patches
+from granplate.solver.plate_modal import plate_energy
+from granplate.verification.face_contacts import (
+    R, STIFF_THICKNESS, X0, bounce, drop_scenario, node_spacing,
+)
+from granplate.verification.granular import hertz_reference
+
+STEEL = LIBRARY["steel"]
+BETWEEN = 0.05 + 0.37 * node_spacing(40)
+
+
+def test_stiff_plate_impact_is_hertz_on_a_rigid_wall():
+    """A granule thrown from a gap at a very stiff, heavy plate, between two nodes,
+    gets a patch contact, stays in touch for Hertz's t_c and rebounds elastically."""
+    ds = simulate(drop_scenario(BETWEEN, thickness=STIFF_THICKNESS, t_end=6.4e-4, out=2.5e-7), progress=False)
+    b = bounce(ds)
+    ref = hertz_reference(sphere_mass(R, STEEL.rho), effective_modulus(STEEL, None), R, 1.0)
+    assert list(ds.contact.values) == ["g"] and ds.contact_y.values[0] == pytest.approx(BETWEEN)
+    assert b["t_c"] == pytest.approx(ref["t_c"], rel=0.02)
+    assert b["f_max"] == pytest.approx(ref["force_max"], rel=0.02)
+    assert 0.99 < b["e"] <= 1.0
+    assert b["residual"] < 1e-5
+
+
+def test_impact_between_nodes_rebounds_as_at_a_node():
+    """On the paper's plate the rebound (the energy the plate keeps) hardly depends on
+    where the nodes are: the patch spreads the force over 2.5 mm either way."""
+    at_node = bounce(simulate(drop_scenario(0.05, t_end=1e-3), progress=False))
+    between = bounce(simulate(drop_scenario(BETWEEN, t_end=1e-3), progress=False))
+    assert 0.8 < at_node["e"] < 0.99  # the plate keeps a share
+    assert between["e"] == pytest.approx(at_node["e"], rel=0.02)
+    assert between["t_c"] == pytest.approx(at_node["t_c"], rel=0.03)
+    assert max(at_node["residual"], between["residual"]) < 1e-5
+
+
+def test_sliding_granule_carries_its_patch_and_obeys_coulomb():
+    """An oblique impact with friction: the granule slides past a face node while in
+    touch; the tangential impulse stays within mu times the normal one, friction
+    dissipates, and eq. (11) balances."""
+    mu = 0.3
+    ds = simulate(drop_scenario(0.05, vx=1.0, vy=4.0, mu=mu, t_end=1e-3, out=5e-7), progress=False)
+    b = bounce(ds)
+    assert b["travel"] > node_spacing(40)
+    assert 0.1 * mu * b["j_n"] < abs(b["j_t"]) <= mu * b["j_n"] * 1.001
+    assert ds.D_friction.values[-1] > 1e-3 * ds.E_granular.values[0]
+    assert b["residual"] < 1e-5
+
+
+def test_granule_leaves_and_comes_back_on_the_same_contact():
+    """A granule between a wall and the plate hits the plate, flies back to the wall and
+    hits the plate again: one patch contact, two separate touches, energy balanced."""
+    s = drop_scenario(0.05, vx=2.0, t_end=2.8e-3)
+    s = s.__class__(**{**s.__dict__, "walls": (Wall(normal=(-1.0, 0.0), offset=-(X0 - 2 * R - 1.6e-3)),)})
+    ds = simulate(s, progress=False)
+    fn = ds.contact_normal_force.values[:, 0]
+    touching = fn > 0
+    starts = np.flatnonzero(touching[1:] & ~touching[:-1])
+    assert list(ds.contact.values) == ["g"]
+    assert len(starts) >= 2  # two impacts on the plate
+    assert abs(ds.energy_residual.values).max() < 1e-5
+
+
+def test_moving_a_patch_changes_no_energy_term():
+    """Move a loaded patch contact along a deformed face: its rows change, the stored
+    contact energy and the plate's energy stay the same to round-off (the overlap is
+    kept continuous), so eq. (11) is unaffected by the move."""
+    model = build_model(drop_scenario(0.05, gap=6e-4))
+    arr = driver.LoopArrays(model, np.array([0.0, 1e-6]), 0)
+    lists = driver.ContactLists(model)
+    lists.g = lists.g._replace(pc_x=lists.g.pc_x.copy())
+    st, g, p, cfg = arr.st, lists.g, arr.p, model.config
+    st.y[:] = model.initial_state
+    arr.w.plate_free[:] = 1
+    rng = np.random.default_rng(11)
+    st.q[:] = rng.normal(size=st.q.shape) * 1e-9 / np.sqrt(p.omega2 / p.omega2[0])  # a deformed plate
+    st.qd[:] = rng.normal(size=st.q.shape) * 1e-6
+    assert driver.add_patch_contacts(model, lists, arr) == 1
+    st, g, p, w = arr.st, lists.g, arr.p, arr.w
+    st.y[0, 0] = X0 + st.u[0] - R + 2e-6  # 2 um into the face
+    a = g.pc_coef[0, COEF_A]
+
+    def energies():
+        delta = st.y[0, 0] + R - (g.pc_x[0] + st.u[0])
+        return contact_energy(delta, a), plate_energy(st.q, st.qd, st.force, p.omega2, p.resid)
+
+    e_contact, e_plate = energies()
+    rows = p.phi_d.copy()
+    st.y[0, 1] += 0.37 * node_spacing(40)  # the granule slid
+    assert move_patches(st, g, p, cfg, w)
+    assert not np.array_equal(rows, p.phi_d) and g.pc_x[0] != X0
+    e2_contact, e2_plate = energies()
+    assert e_contact > 0 and e2_contact == pytest.approx(e_contact, rel=1e-9)
+    assert e2_plate == e_plate
+    assert not w.g_ok.any()  # the per-level matrices are stale
+    st.y[0, 0] -= 1e-4  # the contact opens: the shift is released
+    move_patches(st, g, p, cfg, w)
+    assert g.pc_x[0] == X0
+
+
+def test_fixed_detection_still_stops_at_the_plate():
+    """contact.detection = "fixed": plate contacts are those at t = 0, and a granule that
+    flies into the plate stops the run, naming it and what to change."""
+    s = drop_scenario(0.05, gap=1e-3, t_end=1.5e-3)
+    s = s.__class__(**{**s.__dict__, "contact": s.contact.__class__(pairs=(), detection="fixed")})
+    with pytest.raises(SimulationError, match=r"granule 'g' \(at x = .* y = 0.05 m\) reached the plate's face "
+                                              r"at t = 1.0\d*e-03 s.*detection = \"dynamic\""):
+        simulate(s, progress=False)
+
+
+def test_patch_needs_the_full_basis():
+    """A truncated basis (here without any initial contact) keeps the plate contacts to
+    those at t = 0: no face shapes in the loop's arrays, no patch contacts (a granule
+    reaching the face stops the run, naming plate.modes)."""
+    s = drop_scenario(0.05, ny=8)
+    s = s.__class__(**{**s.__dict__, "plate": s.plate.__class__(**{**s.plate.__dict__, "modes": "truncated",
+                                                                   "max_frequency": 2e5})})
+    model = build_model(s)
+    assert model.plate.n_modes < model.plate.n_red
+    assert model.config.face_skin == 0.0 and len(model.plate_arrays.face_y) == 0
+    with pytest.raises(SimulationError, match=r"granule 'g' .* reached the plate's face .*plate.modes = \"all\""):
+        simulate(s, model=model, progress=False)
+    assert build_model(drop_scenario(0.05, ny=8)).config.face_skin > 0.0
