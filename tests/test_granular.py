@@ -6,6 +6,7 @@ friction no longer sets the step."""
 from __future__ import annotations
 
 import dataclasses
+import warnings
 
 import numpy as np
 import pytest
@@ -158,3 +159,21 @@ def test_strong_shock_takes_the_steps_of_the_frictionless_run():
     assert ds.attrs["n_steps"] <= 1.5 * free.attrs["n_steps"]
     assert np.all(np.diff(ds.D_friction.values) >= 0.0) and ds.D_friction.values[-1] > 0.0
     assert float(np.max(np.abs(ds.energy_residual.values))) < 1e-4
+
+
+def test_a_run_set_by_rk4_friction_is_told_to_split_it(monkeypatch):
+    """With solver.granular_friction = "rk4" a packing whose steps RK4's stability on the
+    friction cuts (> 2x the frictionless steps, above) counts the steps taken at that bound
+    (about a third here) and warns, naming the setting that lifts it; split off, no step is
+    at a friction bound."""
+    from granplate.solver import driver
+
+    monkeypatch.setattr(driver, "FRICTION_BOUND_MIN_STEPS", 10)
+    monkeypatch.setattr(driver, "FRICTION_BOUND_SHARE", 0.25)
+    with pytest.warns(RuntimeWarning, match='solver.granular_friction = "split"'):
+        ds = simulate(packing(0.099, "rk4"), progress=False)
+    assert ds.attrs["n_friction_bound"] > driver.FRICTION_BOUND_SHARE * ds.attrs["n_steps"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        split = simulate(packing(0.099, "split"), progress=False)
+    assert split.attrs["n_friction_bound"] == 0

@@ -292,6 +292,24 @@ def _refresh(lists: ContactLists, st: S.State, w: S.Work) -> int:
     return S.ERR_MISSED
 
 
+#: A run whose step RK4's stability on the granule friction cuts (solver.granular_friction
+#: = "rk4") on more than FRICTION_BOUND_SHARE of FRICTION_BOUND_MIN_STEPS or more steps
+#: is told how to lift that bound.
+FRICTION_BOUND_SHARE = 0.5
+FRICTION_BOUND_MIN_STEPS = 5000
+FRICTION_BOUND_HINT = (
+    "{name}: friction at granule contacts, integrated inside RK4 (solver.granular_friction = "
+    "\"rk4\", the presets' setting), sets the step on most steps so far (t = {t:.4g} s): the run "
+    "is slow for stability, not accuracy. solver.granular_friction = \"split\" integrates that "
+    "friction exactly, at any step (docs/model.md section 6.4).")
+
+
+def friction_bound(count: np.ndarray) -> bool:
+    """Whether granule friction inside RK4 has set most steps of a long enough run."""
+    steps = int(count[S.C_STEPS])
+    return steps >= FRICTION_BOUND_MIN_STEPS and count[S.C_FRICTION_BOUND] > FRICTION_BOUND_SHARE * steps
+
+
 def _loop_chunks(times, model, arr: LoopArrays, should_stop, on_progress, lists) -> int:
     """Call the compiled loop chunk by chunk until the end, an error or a stop request;
     between chunks the contact lists are rebuilt when the loop asks (REBUILD), patch
@@ -302,6 +320,7 @@ def _loop_chunks(times, model, arr: LoopArrays, should_stop, on_progress, lists)
     n_chunks = min(200, len(times) - 1)
     stops = np.unique(np.linspace(1, len(times) - 1, n_chunks).round().astype(int)) if n_chunks else []
     budget = FIRST_BUDGET
+    warned = False
     for o_stop in stops:
         status = S.PAUSED
         while status == S.PAUSED:
@@ -315,6 +334,10 @@ def _loop_chunks(times, model, arr: LoopArrays, should_stop, on_progress, lists)
             budget = next_budget(budget, int(st.count[S.C_STEPS] + st.count[S.C_RETRIES] - n0),
                                  time.perf_counter() - t0)
             on_progress(int(st.count[S.C_OUT] - before))
+            if not warned and friction_bound(st.count):
+                warned = True
+                warnings.warn(FRICTION_BOUND_HINT.format(name=model.scenario.name, t=st.clock[S.T_NOW]),
+                              RuntimeWarning, stacklevel=4)
             if status in (S.REBUILD, S.NEW_PLATE) and cfg.face_skin > 0.0:
                 add_patch_contacts(model, lists, arr)
             if status == S.REBUILD or (fixed and status in (S.OK, S.PAUSED)):
@@ -374,6 +397,7 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
         "n_iterations": int(st.count[S.C_ITERS]),
         "n_retries": int(st.count[S.C_RETRIES]),
         "n_rebuilds": lists.n_rebuilds,
+        "n_friction_bound": int(st.count[S.C_FRICTION_BOUND]),
         "overlap_warnings": overlap_warnings(model, w),
         "patch_y0": list(arr.patch_y0),
     }

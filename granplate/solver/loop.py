@@ -14,12 +14,12 @@ from numba import njit
 from granplate.physics.energy import energy_residual, energy_total
 from granplate.solver import schemes as S
 from granplate.solver.contacts import watch_contacts
-from granplate.solver.granular import granular_rhs, kinetic_energies
+from granplate.solver.granular import RK4_FRICTION_LIMIT, granular_rhs, kinetic_energies
 from granplate.solver.interface import accept_contacts, contact_modulus, first_guess, move_patches
 from granplate.solver.ladder import level_step
 from granplate.solver.plate_modal import driving_dofs, modal_acceleration, plate_energy, step_matrices
 from granplate.solver.state import (
-    A_FRIC, A_SHOCK_G, A_SHOCK_P, A_VISC, C_ITERS, C_LEVEL, C_OUT, C_RETRIES, C_STEPS, CUSTOM_H,
+    A_FRIC, A_SHOCK_G, A_SHOCK_P, A_VISC, C_FRICTION_BOUND, C_ITERS, C_LEVEL, C_OUT, C_RETRIES, C_STEPS, CUSTOM_H,
     D_FRIC, D_VISC, E_GRAN, E_IN_MAX, E_PLATE, E_POT, E_POTG, E_SHOCK, E_ZERO, ERR_BUFFER,
     ERR_CONTACT, ERR_ENERGY, ERR_H, ERR_ITER, ERR_LAM, ERR_N, ERR_NAN, ERR_NOCONV, ERR_RESID,
     ERR_T, ERR_VT, H_LAST, KE_ROT, KE_X, KE_Y, N_LEVELS, OK, PAUSED, RES_LAST, RESID, RESID_MAX,
@@ -244,6 +244,8 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
         lam_max = accept_contacts(h, w.gmat[slot], g.pc_coef, w.normal_new, w.slip_new, w.conv_iter,
                                   st.normal, st.slip, w.lam_int, w.it_int)
         new_level, h_new = S.next_level(sw, h, slot, level, err, lam_max, rate, st.clock[T_NOW], cfg)
+        if not cfg.split_friction and rate * h > 0.5 * RK4_FRICTION_LIMIT:  # the step was at RK4's friction bound
+            st.count[C_FRICTION_BOUND] += 1
         if level_step(new_level, cfg) < cfg.dt_min:
             return step_too_small(st.clock[T_NOW], h_new, it, worst_contact(w), lam_max, st.normal, st.slip, st)
         st.count[C_LEVEL] = new_level

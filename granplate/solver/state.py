@@ -12,6 +12,9 @@ T_NOW, H_LAST, E_IN_MAX, E_ZERO, E_POT, CUSTOM_H, F_SCALE, RES_LAST = 0, 1, 2, 3
 N_CLOCK = 10
 # count (int64)
 C_STEPS, C_LEVEL, C_OUT, C_ITERS, C_RETRIES = 0, 1, 2, 3, 4
+# steps taken within 2x of RK4's stability bound on the friction it integrates
+# (solver.granular_friction = "rk4" only; the driver then suggests "split")
+C_FRICTION_BOUND = 5
 N_COUNT = 8
 # acc (float64): integrated powers
 A_SHOCK_G, A_VISC, A_FRIC, A_SHOCK_P = 0, 1, 2, 3
