@@ -26,7 +26,7 @@ from granplate.physics.energy import energy_residual
 from granplate.solver.granular import kinetic_energies, rk4_granular_step, rk4_limit
 from granplate.solver.interface import forces_converged
 from granplate.solver.ladder import (
-    dyadic_level, dyadic_round, level_for, level_step, realign_step, step_to_output,
+    dyadic_level, dyadic_round, level_for, level_step, position_tolerance, realign_step, step_to_output,
 )
 from granplate.solver.plate_modal import (
     N_MCOEF, exact_correct, exact_matrices, exact_predict, modal_coefficients, static_matrices,
@@ -77,7 +77,7 @@ def plan(sw, count, cfg, pos, rem):
     level = dyadic_level(count[C_LEVEL], pos, cfg)
     count[C_LEVEL] = level
     h_align = realign_step(level, pos, cfg)
-    if h_align > 0.0 and h_align < rem:  # back onto the dyadic grid (an odd step)
+    if h_align > 0.0 and h_align < rem - position_tolerance(cfg):  # back onto the grid (an odd step)
         return level, h_align, N_LEVELS, False
     h, slot, land = step_to_output(level, rem, True, cfg)
     return level, h, slot, land
