@@ -29,13 +29,15 @@ def level_for(h, cfg):
 #: run's end time (it is the difference of two times near t_end and the steps' sum):
 #: a step "fits" it when it is a whole number of steps to within this or 1e-6 steps.
 FIT_ULPS = 64.0
+#: the rounding unit of float64 relative to 1 (machine epsilon).
+EPS = 2.0**-52
 
 
 @njit(cache=True)
 def position_tolerance(cfg):
     """How well the time since the last output is known [s]: FIT_ULPS rounding units
     of the end time."""
-    return FIT_ULPS * 2.220446049250313e-16 * max(cfg.t_end, cfg.out_dt)
+    return FIT_ULPS * EPS * max(cfg.t_end, cfg.out_dt)
 
 
 @njit(cache=True)
@@ -47,8 +49,9 @@ def fits(pos, h, tol):
 
 @njit(cache=True)
 def dyadic_round(level, cfg):
-    """The dyadic level (every fourth) at or below level `level`'s step, but the
-    deepest whose step is not below dt_min when that is shallower."""
+    """The dyadic level (every fourth) whose step is the largest not above level
+    `level`'s, or the deepest dyadic level whose step is not below dt_min when that
+    one's is larger."""
     lv = level + (-level) % 4
     while lv >= 4 and level_step(lv, cfg) < cfg.dt_min:
         lv -= 4
