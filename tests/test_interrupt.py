@@ -100,3 +100,21 @@ def test_cli_ctrl_c_writes_partial_file(tmp_path):
     assert "interrupted by the user" in text and str(out) in text
     ds = gp.read(out)
     assert interrupted(ds) and ds.sizes["time"] >= 2
+
+
+def test_run_whose_clock_stops_ends_with_a_message(monkeypatch):
+    """A loop that keeps pausing without moving the clock is stopped by the driver after
+    STALL_ATTEMPTS attempts with the step-control message, the rows so far kept."""
+    model = gp.build_model(gp.with_changes(gp.preset("steel-r1"), {"time.t_end": 1e-5}))
+    calls = []
+
+    def frozen(t_stop, budget, g, p, cfg, st, w, sw, out):
+        calls.append(budget)
+        st.count[driver.S.C_RETRIES] += 1
+        return driver.S.PAUSED
+
+    monkeypatch.setattr(driver.loop, "advance", frozen)
+    rec = driver.run(model, interruptible=False)
+    assert rec.status == driver.S.ERR_NOCONV
+    assert "cannot move the clock on at t = 0.000000e+00 s" in rec.message
+    assert len(calls) == driver.STALL_ATTEMPTS + 1 and rec.n_valid == 1

@@ -27,6 +27,9 @@ from granplate.solver.schemes import scheme
 #: wall-time target of one compiled chunk [s], and the step budget of the first one.
 CHUNK_SECONDS = 0.15
 FIRST_BUDGET = 64
+#: step attempts without the clock moving after which a run is stopped (every retry
+#: goes one ladder level deeper, so a run that still advances never needs more)
+STALL_ATTEMPTS = 2 * S.N_LEVELS
 #: status of a run stopped by a signal (SIGINT, SIGTERM) or a stop request.
 INTERRUPTED = -1
 INTERRUPTED_STATUS = "interrupted by the user"
@@ -62,6 +65,12 @@ def status_message(status: int, model: Model, st: S.State) -> str:
     t = e[S.ERR_T]
     if status == INTERRUPTED:
         return f"{INTERRUPTED_STATUS} at t = {st.clock[S.T_NOW]:.6e} s."
+    if status == S.ERR_NOCONV and int(e[S.ERR_ITER]) == 0:
+        return (
+            f"the time step cannot move the clock on at t = {t:.6e} s (step {e[S.ERR_H]:.3e} s, "
+            f"time.dt_min = {cfg.dt_min:.3e} s): the step control has collapsed. Raise time.dt_min "
+            f"or solver.error_tol."
+        )
     if status == S.ERR_NOCONV:
         k = int(e[S.ERR_CONTACT])
         where = f"plate contact '{model.contact_labels[k]}'" if 0 <= k < len(model.contact_labels) else "the interface"
@@ -310,6 +319,15 @@ def friction_bound(count: np.ndarray) -> bool:
     return steps >= FRICTION_BOUND_MIN_STEPS and count[S.C_FRICTION_BOUND] > FRICTION_BOUND_SHARE * steps
 
 
+def stalled(st: S.State) -> int:
+    """ERR_NOCONV for a run whose clock no longer moves (st.err filled: time, last step)."""
+    st.err[:] = 0.0
+    st.err[S.ERR_T] = st.clock[S.T_NOW]
+    st.err[S.ERR_H] = st.clock[S.H_LAST]
+    st.err[S.ERR_CONTACT] = -1.0
+    return S.ERR_NOCONV
+
+
 def _loop_chunks(times, model, arr: LoopArrays, should_stop, on_progress, lists) -> int:
     """Call the compiled loop chunk by chunk until the end, an error or a stop request;
     between chunks the contact lists are rebuilt when the loop asks (REBUILD), patch
@@ -321,6 +339,7 @@ def _loop_chunks(times, model, arr: LoopArrays, should_stop, on_progress, lists)
     stops = np.unique(np.linspace(1, len(times) - 1, n_chunks).round().astype(int)) if n_chunks else []
     budget = FIRST_BUDGET
     warned = False
+    idle = 0  # step attempts since the clock last moved
     for o_stop in stops:
         status = S.PAUSED
         while status == S.PAUSED:
@@ -329,10 +348,14 @@ def _loop_chunks(times, model, arr: LoopArrays, should_stop, on_progress, lists)
             st = arr.st
             before = st.count[S.C_OUT]
             n0 = st.count[S.C_STEPS] + st.count[S.C_RETRIES]
+            t_before = st.clock[S.T_NOW]
             t0 = time.perf_counter()
             status = loop.advance(float(times[o_stop]), budget, lists.g, arr.p, cfg, st, arr.w, arr.sw, arr.out)
-            budget = next_budget(budget, int(st.count[S.C_STEPS] + st.count[S.C_RETRIES] - n0),
-                                 time.perf_counter() - t0)
+            attempts = int(st.count[S.C_STEPS] + st.count[S.C_RETRIES] - n0)
+            budget = next_budget(budget, attempts, time.perf_counter() - t0)
+            idle = idle + max(attempts, 1) if st.clock[S.T_NOW] <= t_before else 0
+            if status == S.PAUSED and idle > STALL_ATTEMPTS:
+                return stalled(st)
             on_progress(int(st.count[S.C_OUT] - before))
             if not warned and friction_bound(st.count):
                 warned = True

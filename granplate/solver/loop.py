@@ -221,6 +221,8 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
         if o >= out.t.shape[0]:
             return ERR_BUFFER
         level, h, slot, land = S.plan(sw, st.count, cfg, t - out.target[o - 1], out.target[o] - t)
+        if not land and t + h <= t:  # a step too small to move the clock: it would spin
+            return step_too_small(t, h, 0, -1, 0.0, st.normal, st.slip, st)
         if needs_matrices(h, slot, st.clock, w.g_ok):
             prepare_slot(sw, h, slot, st, p, w)
         ratio = h / st.clock[H_LAST] if st.clock[H_LAST] > 0.0 else 0.0

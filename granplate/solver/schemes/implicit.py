@@ -25,7 +25,9 @@ from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm, friction_ma
 from granplate.physics.energy import energy_residual
 from granplate.solver.granular import kinetic_energies, rk4_granular_step, rk4_limit
 from granplate.solver.interface import forces_converged
-from granplate.solver.ladder import dyadic_level, level_for, level_step, step_to_output
+from granplate.solver.ladder import (
+    dyadic_level, dyadic_round, level_for, level_step, position_tolerance, realign_step, step_to_output,
+)
 from granplate.solver.plate_modal import (
     N_MCOEF, exact_correct, exact_matrices, exact_predict, modal_coefficients, static_matrices,
 )
@@ -69,10 +71,14 @@ def new_scratch(ng: int, nm: int, nk: int) -> Scratch:
 @njit(cache=True)
 def plan(sw, count, cfg, pos, rem):
     """A dyadic level that tiles the output interval from `pos` [s] on, and its step
-    (on the ladder when it lands on the output `rem` [s] away). Returns (level, h,
-    slot, land)."""
+    (on the ladder when it lands on the output `rem` [s] away); where pos is off every
+    dyadic grid down to dt_min (rounding of t after many small steps), the odd step
+    back onto the level's grid. Returns (level, h, slot, land)."""
     level = dyadic_level(count[C_LEVEL], pos, cfg)
     count[C_LEVEL] = level
+    h_align = realign_step(level, pos, cfg)
+    if h_align > 0.0 and h_align < rem - position_tolerance(cfg):  # back onto the grid (an odd step)
+        return level, h_align, N_LEVELS, False
     h, slot, land = step_to_output(level, rem, True, cfg)
     return level, h, slot, land
 
@@ -201,7 +207,7 @@ def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
     retry = -1
     if err > REJECT_FACTOR and st.clock[H_LAST] > 0.0:
         new_level = max(level_for(h * max(0.2, 0.9 / math.sqrt(err)), cfg), level + 1)
-        if level_step(new_level, cfg) >= cfg.dt_min and new_level < N_LEVELS:
+        if new_level < N_LEVELS and level_step(dyadic_round(new_level, cfg), cfg) < level_step(level, cfg):
             retry = new_level
     return err, retry, work, fric_work
 
@@ -236,7 +242,5 @@ def next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg):
     h_new = rk4_limit(h_new, rate)
     if cfg.q0 != 0.0 and t_now < cfg.duration:
         h_new = min(h_new, cfg.duration / SHOCK_STEPS)
-    new_level = level_for(h_new, cfg)
-    if level_step(new_level, cfg) < cfg.dt_min:
-        new_level = level_for(cfg.dt_min, cfg) - 1
+    new_level = dyadic_round(level_for(h_new, cfg), cfg)
     return new_level, h_new
