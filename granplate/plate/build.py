@@ -213,19 +213,22 @@ class PlateModel:
         return x_full.reshape(q.shape[:-1] + (self.n_full,))
 
     @functools.cached_property
-    def _stiffness_solve(self) -> Callable[[np.ndarray], np.ndarray]:
-        """x -> K_r^-1 x (a sparse LU of the reduced stiffness, factorised once)."""
-        return spla.splu(sp.csc_matrix(reduce_matrix(self.stiffness_matrix(), self.T))).solve
+    def patch_psi(self) -> np.ndarray:
+        """(n_red, 2 n_patch) static residual shapes of the patch contacts at
+        contact_y[n_layers:] [m/N], columns [p0 x, p0 y, p1 x, ...]: (K_r^-1 - Phi
+        diag(1/omega^2) Phi^T) E^T w per unit force, E = face_rows (docs/model.md section
+        4.5); one sparse factorisation of K_r, computed once per model."""
+        heights = self.contact_y[self.psi.shape[1] // 2:]
+        units = np.eye(2 * len(heights))
+        f_red = np.asarray(face_rows(self.T, self.face_nodes).T
+                           @ face_forces(self.face_y, heights, self.patch_width, units).T)
+        K_r = sp.csc_matrix(reduce_matrix(self.stiffness_matrix(), self.T))
+        return spla.splu(K_r).solve(f_red) - self.Phi @ ((self.Phi.T @ f_red) / self.omega[:, None] ** 2)
 
     def patch_static(self, force: np.ndarray) -> np.ndarray:
-        """(n_red, n_times) static displacement the truncated basis' kept modes miss
-        [m] under patch contacts at contact_y[n_layers:] with forces (n_times, 2 n_patch)
-        [N]: (K_r^-1 - Phi diag(1/omega^2) Phi^T) E^T (w F), E = face_rows (docs/model.md
-        section 4.5)."""
-        heights = self.contact_y[self.psi.shape[1] // 2:]
-        f_red = (face_rows(self.T, self.face_nodes).T
-                 @ face_forces(self.face_y, heights, self.patch_width, force).T)
-        return self._stiffness_solve(np.asarray(f_red)) - self.Phi @ ((self.Phi.T @ f_red) / self.omega[:, None] ** 2)
+        """(n_red, n_times) static displacement the truncated basis' kept modes miss [m]
+        under the patch contacts' forces (n_times, 2 n_patch) [N]: patch_psi F."""
+        return self.patch_psi @ np.asarray(force, dtype=float).T
 
     def full_displacement(self, q: np.ndarray, force: np.ndarray | None = None) -> np.ndarray:
         """Nodal displacements [m]: q (..., n_modes) -> (..., n_nodes, 2) (force: see full_dofs)."""
