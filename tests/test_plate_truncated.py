@@ -7,11 +7,14 @@ import math
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from granplate import plate as gp
 from granplate.bench.plates import format_plate_table, parse_meshes
 from granplate.errors import ScenarioError
+from granplate.plate.constraints import reduce_matrix
+from granplate.plate.face import face_forces, face_rows
 from granplate.setup import plate_cost
 from granplate.setup.presets import preset
 from granplate.setup.scenario import Plate
@@ -194,3 +197,54 @@ def test_plate_basis_fields_round_trip_through_toml():
     assert 'modes = "truncated"' in text and "max_frequency = 500000.0" in text
     assert scenario_io.loads(text) == s
     validate(s)
+
+
+def _exact_face_compliance(model: gp.PlateModel) -> np.ndarray:
+    """E K_r^-1 E^T over the face's dofs [m/N] by a direct sparse solve (E = face_rows)."""
+    E = face_rows(model.T, model.face_nodes)
+    K_r = reduce_matrix(model.stiffness_matrix(), model.T)
+    return E @ spla.splu(sp.csc_matrix(K_r)).solve(E.T.toarray())
+
+
+def test_face_residual_compliance_completes_the_static_response(full, truncated):
+    """Over every face dof, phi_face diag(1/omega^2) phi_face^T + R_face is K_r^-1
+    restricted to the face (a direct solve) and the full basis' static compliance; R_face
+    holds the rigid layers' R at their nodes and is positive semi-definite."""
+    exact = _exact_face_compliance(truncated)
+    scale = np.abs(exact).max()
+    ours = (truncated.phi_face / truncated.omega**2) @ truncated.phi_face.T + truncated.resid_face
+    np.testing.assert_allclose(ours, exact, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(ours, (full.phi_face / full.omega**2) @ full.phi_face.T, rtol=0, atol=1e-9 * scale)
+    at = [int(np.flatnonzero(np.isclose(truncated.face_y, y))[0]) for y in CONTACTS]
+    dofs = np.ravel([[2 * n, 2 * n + 1] for n in at])
+    np.testing.assert_allclose(truncated.resid_face[np.ix_(dofs, dofs)], truncated.resid, rtol=0, atol=1e-12 * scale)
+    assert np.linalg.eigvalsh(truncated.resid_face).min() > -1e-12 * scale
+    assert full.resid_face.shape == (0, 0)
+
+
+def test_patch_force_static_displacement_is_exact(full, truncated):
+    """A static force on a patch between nodes (beyond the rigid layers' contacts): the
+    truncated basis' modes plus its static part (full_dofs with the patch force) give the
+    full basis' static displacement everywhere."""
+    y_p = 0.0604375
+    t_model = dataclasses.replace(truncated, contact_y=np.append(truncated.contact_y, y_p))
+    f_model = dataclasses.replace(full, contact_y=np.append(full.contact_y, y_p))
+    F = np.zeros(2 * len(CONTACTS) + 2)
+    F[-2:] = (-3.0, 1.0)  # [N] x, y on the patch
+    F[0] = -2.0  # and a rigid layer's
+    f_face = face_forces(full.face_y, [y_p], full.patch_width, F[-2:])
+    f_red = face_rows(full.T, full.face_nodes).T @ f_face + np.eye(full.n_red)[:, full.drive_dofs.ravel()] @ F[:-2]
+    q_full = (full.Phi.T @ f_red) / full.omega**2
+    q_trunc = (truncated.Phi.T @ f_red) / truncated.omega**2
+    u_f, u_t = f_model.full_dofs(q_full), t_model.full_dofs(q_trunc, F)
+    np.testing.assert_allclose(u_t, u_f, rtol=0, atol=1e-8 * np.abs(u_f).max())
+    assert np.abs(truncated.full_dofs(q_trunc) - u_f).max() > 0.01 * np.abs(u_f).max()  # the static part matters
+
+
+def test_face_compliance_enters_the_memory_estimate():
+    """The truncated basis' estimate holds the (2 n_face)^2 doubles of R_face: 3.3 MB for
+    the 321 face nodes of a 32 x 320 plate."""
+    base, _ = plate_cost.build_estimate("truncated", 100_000)
+    with_face, _ = plate_cost.build_estimate("truncated", 100_000, n_face=321)
+    assert with_face - base == pytest.approx(642**2 * 8.0)
+    assert plate_cost.build_estimate("all", 4194, n_face=161) == plate_cost.build_estimate("all", 4194)

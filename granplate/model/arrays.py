@@ -173,10 +173,11 @@ def plate_contact_coefficients(s: Scenario, mats, r: np.ndarray, pc: np.ndarray)
 
 def face_contacts_possible(s: Scenario, plate_model) -> bool:
     """Whether granules may get patch contacts during the run (docs/model.md section 3.5):
-    dynamic detection, granules, and a plate integrated in all its modes (a truncated
-    basis would need the static correction at every face dof)."""
+    dynamic detection, granules, and a plate integrated in all its modes or in the
+    truncated basis, whose static correction covers every face dof (section 4.5; a dense
+    basis cut to plate.n_modes has none)."""
     return (s.contact.detection == "dynamic" and plate_model is not None and len(s.granules) > 0
-            and plate_model.n_modes == plate_model.n_red)
+            and (plate_model.n_modes == plate_model.n_red or plate_model.truncated))
 
 
 def plate_modal_arrays(s: Scenario, y: np.ndarray, pc: np.ndarray):
@@ -185,7 +186,7 @@ def plate_modal_arrays(s: Scenario, y: np.ndarray, pc: np.ndarray):
     may form)."""
     plate_model = None
     nk = len(pc)
-    face_y, phi_face = np.zeros(0), np.zeros((0, 0))
+    face_y, phi_face, resid_face = np.zeros(0), np.zeros((0, 0)), np.zeros((0, 0))
     if s.plate is not None:
         from granplate.plate import build_plate
 
@@ -203,6 +204,7 @@ def plate_modal_arrays(s: Scenario, y: np.ndarray, pc: np.ndarray):
         if face_contacts_possible(s, plate_model):
             face_y = np.ascontiguousarray(plate_model.face_y, float)
             phi_face = np.ascontiguousarray(plate_model.phi_face, float)
+            resid_face = np.ascontiguousarray(plate_model.resid_face, float)
     else:
         omega2 = np.zeros(0)
         phi_d = np.zeros((0, 0))
@@ -211,7 +213,7 @@ def plate_modal_arrays(s: Scenario, y: np.ndarray, pc: np.ndarray):
     if phi_d.shape != (2 * nk, len(omega2)):
         phi_d = phi_d.reshape(2 * nk, len(omega2))
     return plate_model, PlateArrays(omega2=omega2, phi_d=phi_d, load_modal=load_modal, resid=resid,
-                                    face_y=face_y, phi_face=phi_face)
+                                    face_y=face_y, phi_face=phi_face, resid_face=resid_face)
 
 
 def loop_config(s: Scenario, fres: np.ndarray, tres: np.ndarray, r: np.ndarray, mass: np.ndarray,

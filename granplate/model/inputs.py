@@ -68,7 +68,10 @@ class PlateArrays(NamedTuple):
     compliance R [m/N] of a truncated basis (docs/model.md section 4.5), (0, 0) when
     every mode is kept; face_y: (n_face,) heights of the face nodes [m] and phi_face:
     (2 n_face, nm) the mode shapes at their dofs, which patch contacts average
-    (docs/model.md section 3.5; empty without patch contacts).
+    (docs/model.md section 3.5; empty without patch contacts); resid_face: (2 n_face,
+    2 n_face) the truncated basis' residual compliance between the face's dofs [m/N],
+    whose weighted averages w^T R_face w are the patch contacts' rows of resid (docs/model.md
+    section 4.5; (0, 0) with every mode kept or without patch contacts).
     """
 
     omega2: np.ndarray
@@ -77,6 +80,7 @@ class PlateArrays(NamedTuple):
     resid: np.ndarray = np.zeros((0, 0))
     face_y: np.ndarray = np.zeros(0)
     phi_face: np.ndarray = np.zeros((0, 0))
+    resid_face: np.ndarray = np.zeros((0, 0))
 
 
 class Config(NamedTuple):

@@ -15,11 +15,13 @@ input (`cache_payload`).
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable, Sequence
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 import skfem
 from skfem import Basis, MeshQuad
 
@@ -34,7 +36,7 @@ from granplate.plate.constraints import (
     rigid_layer_nodes,
     symmetry_line_nodes,
 )
-from granplate.plate.face import face_modes, face_nodes
+from granplate.plate.face import face_forces, face_modes, face_nodes, face_rows
 from granplate.plate.fe import assemble_mass, assemble_stiffness, node_coordinates, plate_mesh, q8_basis, vtk_elements
 from granplate.plate.load import EDGE_LOAD_POINTS, edge_load_vector
 from granplate.plate.modes import modal_basis, residual_compliance, truncated_modal_basis, weyl_mode_count
@@ -111,11 +113,15 @@ class PlateModel:
     face_y: (n_face,) their heights [m].
     phi_face: (2 n_face, n_modes) mode shapes at the face nodes' dofs, rows [n0 x, n0 y,
         n1 x, ...] [kg^-1/2]: what a patch contact (plate/face.py) averages.
+    resid_face: (2 n_face, 2 n_face) residual compliance of the truncated basis between
+        the face nodes' dofs (same order) [m/N]: a patch contact's static correction is
+        w^T resid_face w (docs/model.md section 4.5); (0, 0) for the full basis.
     thickness [m], rho [kg/m^3], E [Pa], nu [-].
     disc_radius: radius of the stress-averaging discs [m] (Plate.disc_radius);
     disc_centres: (n_discs, 2) their centres [m], a lattice DISC_CENTRE_SPACING x
         disc_radius apart over the plate; disc_op: (n_discs, n_elem n_qp) sparse mean over
         each disc of a Gauss-point field (docs/model.md section 4.4).
+    patch_width: width of a patch contact [m] (Plate.layer_width, plate/face.py).
     """
 
     mesh: MeshQuad
@@ -139,6 +145,7 @@ class PlateModel:
     face_nodes: np.ndarray
     face_y: np.ndarray
     phi_face: np.ndarray
+    resid_face: np.ndarray
     thickness: float
     rho: float
     E: float
@@ -146,6 +153,7 @@ class PlateModel:
     disc_radius: float
     disc_centres: np.ndarray
     disc_op: sp.csr_matrix
+    patch_width: float = 0.0
 
     # ---- sizes -------------------------------------------------------------------
     @property
@@ -165,8 +173,9 @@ class PlateModel:
 
     @property
     def truncated(self) -> bool:
-        """Whether the basis is truncated (with the static residual at the contacts)."""
-        return self.psi.shape[1] > 0
+        """Whether the basis is truncated (with the static residual at the contacts and
+        over the face)."""
+        return self.psi.shape[1] > 0 or self.resid_face.shape[0] > 0
 
     @property
     def n_qp(self) -> int:
@@ -187,14 +196,39 @@ class PlateModel:
         """x_full = T (Phi q + Psi F) [m]: q (..., n_modes) -> (..., n_full).
 
         force: the contact forces on the plate F (..., 2 n_contacts) [N], ordered [k0x,
-        k0y, k1x, ...]; only the truncated basis uses them (its static part Psi F)."""
+        k0y, k1x, ...]; only the truncated basis uses them (its static part Psi F). Columns
+        beyond the rigid layers' are patch contacts (docs/model.md section 3.5) at the
+        heights contact_y[n_layers:], each spread by its weights w over the face: their
+        static part is the residual response to those nodal forces (`patch_static`)."""
         q = np.asarray(q, dtype=float)
         flat = q.reshape(-1, self.n_modes)
         x_red = self.Phi @ flat.T
         if self.truncated and force is not None:
-            x_red = x_red + self.psi @ np.asarray(force, dtype=float).reshape(-1, self.psi.shape[1]).T
+            n_layer = self.psi.shape[1]
+            f = np.asarray(force, dtype=float).reshape(flat.shape[0], -1)
+            x_red = x_red + self.psi @ f[:, :n_layer].T
+            if f.shape[1] > n_layer:
+                x_red = x_red + self.patch_static(f[:, n_layer:])
         x_full = (self.T @ x_red).T
         return x_full.reshape(q.shape[:-1] + (self.n_full,))
+
+    @functools.cached_property
+    def patch_psi(self) -> np.ndarray:
+        """(n_red, 2 n_patch) static residual shapes of the patch contacts at
+        contact_y[n_layers:] [m/N], columns [p0 x, p0 y, p1 x, ...]: (K_r^-1 - Phi
+        diag(1/omega^2) Phi^T) E^T w per unit force, E = face_rows (docs/model.md section
+        4.5); one sparse factorisation of K_r, computed once per model."""
+        heights = self.contact_y[self.psi.shape[1] // 2:]
+        units = np.eye(2 * len(heights))
+        f_red = np.asarray(face_rows(self.T, self.face_nodes).T
+                           @ face_forces(self.face_y, heights, self.patch_width, units).T)
+        K_r = sp.csc_matrix(reduce_matrix(self.stiffness_matrix(), self.T))
+        return spla.splu(K_r).solve(f_red) - self.Phi @ ((self.Phi.T @ f_red) / self.omega[:, None] ** 2)
+
+    def patch_static(self, force: np.ndarray) -> np.ndarray:
+        """(n_red, n_times) static displacement the truncated basis' kept modes miss [m]
+        under the patch contacts' forces (n_times, 2 n_patch) [N]: patch_psi F."""
+        return self.patch_psi @ np.asarray(force, dtype=float).T
 
     def full_displacement(self, q: np.ndarray, force: np.ndarray | None = None) -> np.ndarray:
         """Nodal displacements [m]: q (..., n_modes) -> (..., n_nodes, 2) (force: see full_dofs)."""
@@ -321,10 +355,12 @@ def _compute_arrays(
     edge_load: tuple[float, float] | None,
     kind: str,
     drive: np.ndarray,
+    face: np.ndarray,
 ) -> dict[str, np.ndarray]:
     """The expensive arrays: modes (kind "all": dense, every mode; "truncated": sparse, up
-    to the cut-off, with the static residual shapes psi), strain operator, edge load
-    (what the cache holds)."""
+    to the cut-off, with the static residual shapes psi at the drive dofs and the residual
+    compliance resid_face over the face nodes' dofs), strain operator, edge load (what the
+    cache holds)."""
     K = assemble_stiffness(basis, D, plate.thickness)
     M = assemble_mass(basis, material.rho, plate.thickness)
     K_r, M_r = reduce_matrix(K, T), reduce_matrix(M, T)
@@ -332,10 +368,12 @@ def _compute_arrays(
     if kind == "truncated":
         max_omega = 2.0 * np.pi * float(plate.max_frequency or DEFAULT_MAX_FREQUENCY)
         expected = weyl_mode_count(plate.width * plate.height, material.E, material.nu, material.rho, max_omega)
-        Phi, omega, psi = truncated_modal_basis(K_r, M_r, drive, max_omega, plate.n_modes, expected)
+        Phi, omega, psi, resid_face = truncated_modal_basis(K_r, M_r, drive, max_omega, plate.n_modes, expected,
+                                                            face=face_rows(T, face))
     else:
         Phi, omega = modal_basis(K_r, M_r, plate.n_modes)
         psi = np.zeros((T.shape[1], 0))
+        resid_face = np.zeros((0, 0))
     op = strain_operator(basis)
     if edge_load is None:
         f = np.zeros(basis.N)
@@ -351,15 +389,20 @@ def _compute_arrays(
         "edge_load_full": f,
         "edge_load_modal": Phi.T @ (T.T @ f),
         "psi": psi,
+        "resid_face": resid_face,
     }
 
 
-def _arrays_fit(arrays: dict[str, np.ndarray], n_full: int, n_red: int, n_modes: int | None, n_rows: int) -> bool:
+def _arrays_fit(arrays: dict[str, np.ndarray], n_full: int, n_red: int, n_modes: int | None, n_rows: int,
+                n_face: int = 0) -> bool:
     """Whether cached arrays are all there, with the shapes this build needs (n_modes
-    None: any number, the truncated basis')."""
+    None: any number, the truncated basis', which also needs psi and the (2 n_face,
+    2 n_face) resid_face)."""
     if not all(name in arrays for name in _CACHED_ARRAYS):
         return False
-    if n_modes is None and not ("psi" in arrays and arrays["psi"].shape[0] == n_red):
+    if n_modes is None and not ("psi" in arrays and arrays["psi"].shape[0] == n_red
+                                and "resid_face" in arrays
+                                and arrays["resid_face"].shape == (2 * n_face, 2 * n_face)):
         return False
     n_modes = arrays["omega"].shape[0] if n_modes is None else n_modes
     return (
@@ -445,14 +488,15 @@ def build_plate(
     n_modes = None if kind == "truncated" and not plate.n_modes else (plate.n_modes or n_red)
     n_elem, n_qp = basis.dx.shape
     D = plane_stress_matrix(material.E, material.nu)
+    face = face_nodes(node_xy, x0, GEOMETRY_RTOL * plate.width)
 
     def compute() -> dict[str, np.ndarray]:
-        check_fits(kind, n_red, getattr(plate, "modes", "all"))
-        return _compute_arrays(basis, mesh, D, material, plate, x0, T, edge_load, kind, drive_dofs)
+        check_fits(kind, n_red, getattr(plate, "modes", "all"), n_face=len(face))
+        return _compute_arrays(basis, mesh, D, material, plate, x0, T, edge_load, kind, drive_dofs, face)
 
     arrays = _stored_or_computed(
         cache_payload(plate, material, x0, contact_y, edge_load, symmetry_line, kind) if cache else None,
-        lambda a: _arrays_fit(a, n_full, n_red, n_modes, 3 * n_elem * n_qp),
+        lambda a: _arrays_fit(a, n_full, n_red, n_modes, 3 * n_elem * n_qp, len(face)),
         compute,
     )
 
@@ -462,7 +506,7 @@ def build_plate(
     )
     Phi = arrays["Phi"]
     psi = arrays["psi"] if "psi" in arrays else np.zeros((n_red, 0))
-    face = face_nodes(node_xy, x0, GEOMETRY_RTOL * plate.width)
+    resid_face = arrays["resid_face"] if kind == "truncated" else np.zeros((0, 0))
     qp_xy = quadrature_points(basis)
     radius = float(plate.disc_radius)
     centres = disc_centres(x0, plate.y0, plate.width, plate.height, DISC_CENTRE_SPACING * radius)
@@ -489,6 +533,7 @@ def build_plate(
         face_nodes=face,
         face_y=np.ascontiguousarray(node_xy[face, 1]),
         phi_face=face_modes(T, Phi, face),
+        resid_face=np.ascontiguousarray(resid_face, dtype=float),
         thickness=float(plate.thickness),
         rho=float(material.rho),
         E=float(material.E),
@@ -496,4 +541,5 @@ def build_plate(
         disc_radius=radius,
         disc_centres=centres,
         disc_op=disc_op,
+        patch_width=float(plate.layer_width),
     )

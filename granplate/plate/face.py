@@ -26,12 +26,30 @@ def face_nodes(node_xy: np.ndarray, x0: float, tol: float) -> np.ndarray:
     return nodes[np.argsort(node_xy[nodes, 1], kind="stable")]
 
 
-def face_modes(T: sp.spmatrix, Phi: np.ndarray, nodes: np.ndarray) -> np.ndarray:
-    """(2 n_face, n_modes) mode shapes at the face nodes, rows [n0 x, n0 y, n1 x, ...]
-    [kg^-1/2]: (T Phi) at their dofs (zero rows at clamped nodes; a rigid layer's nodes
-    copy its driving node)."""
+def face_rows(T: sp.spmatrix, nodes: np.ndarray) -> sp.csr_matrix:
+    """(2 n_face, n_red) sparse 0/1: the rows of T at the face nodes' dofs, ordered [n0 x,
+    n0 y, n1 x, ...] (empty at clamped nodes; a rigid layer's nodes copy its driving
+    node). Face displacements are face_rows @ x_red; face forces f reach the reduced dofs
+    as face_rows^T f."""
     dofs = np.stack([2 * nodes, 2 * nodes + 1], axis=1).ravel()
-    return np.ascontiguousarray(sp.csr_matrix(T)[dofs] @ Phi)
+    return sp.csr_matrix(T)[dofs]
+
+
+def face_modes(T: sp.spmatrix, Phi: np.ndarray, nodes: np.ndarray) -> np.ndarray:
+    """(2 n_face, n_modes) mode shapes at the face nodes [kg^-1/2]: face_rows(T) @ Phi."""
+    return np.ascontiguousarray(face_rows(T, nodes) @ Phi)
+
+
+def face_forces(face_y: np.ndarray, patch_y: np.ndarray, width: float, force: np.ndarray) -> np.ndarray:
+    """Nodal forces on the face's dofs [N] (..., 2 n_face), rows [n0 x, n0 y, ...], of
+    patch contacts at heights patch_y (n_patch,) [m] of `width` [m] carrying `force`
+    (..., 2 n_patch) [N] ordered [p0 x, p0 y, p1 x, ...]: each spread as w F."""
+    patch_y = np.asarray(patch_y, dtype=float)
+    W = np.stack([patch_weight_vector(face_y, y, width) for y in patch_y]) if len(patch_y) else \
+        np.zeros((0, len(face_y)))
+    f = np.asarray(force, dtype=float).reshape(np.shape(force)[:-1] + (len(patch_y), 2))
+    nodal = np.einsum("kn,...kc->...nc", W, f)
+    return nodal.reshape(nodal.shape[:-2] + (2 * len(face_y),))
 
 
 @njit(cache=True)

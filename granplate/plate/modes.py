@@ -49,8 +49,8 @@ def weyl_mode_count(area: float, E: float, nu: float, rho: float, omega: float) 
 
 def truncated_modal_basis(
     K_r: sp.spmatrix, M_r: sp.spmatrix, drive: np.ndarray, max_omega: float, n_modes: int = 0,
-    expected: float = 0.0,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    expected: float = 0.0, face: sp.spmatrix | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The modes up to max_omega [rad/s] (or the n_modes lowest when n_modes > 0) and the
     static residual shapes at the driving dofs (docs/model.md section 4.5).
 
@@ -61,12 +61,13 @@ def truncated_modal_basis(
     FIRST_MODE_COUNT, and grows by MODE_COUNT_GROWTH until the largest found exceeds
     max_omega.
 
-    Returns (Phi, omega, Psi): Phi (n_red, nm) mass-normalised and signed by
+    Returns (Phi, omega, Psi, R_face): Phi (n_red, nm) mass-normalised and signed by
     `fix_mode_signs`, omega (nm,) ascending, and Psi (n_red, nd) = K_r^-1 E_d -
     Phi diag(1/omega^2) Phi_d^T, the displacement per unit force at each driving dof
     that the kept modes miss (E_d: the unit vectors of the dofs `drive`), so that the
     static response at the driving dofs, Phi_d diag(1/omega^2) Phi_d^T + Psi[drive], is
-    exactly K_r^-1 restricted to them.
+    exactly K_r^-1 restricted to them; R_face = `face_residual_compliance` of the face
+    map `face` ((0, 0) when face is None).
     """
     n = K_r.shape[0]
     K = sp.csc_matrix(K_r)
@@ -96,7 +97,35 @@ def truncated_modal_basis(
     unit = np.zeros((n, drive.size))
     unit[drive, np.arange(drive.size)] = 1.0
     Psi = lu.solve(unit) - Phi @ (Phi[drive].T / lam[:, None])
-    return Phi, omega, Psi
+    R_face = np.zeros((0, 0)) if face is None else face_residual_compliance(lu.solve, Phi, lam, face)
+    return Phi, omega, Psi, R_face
+
+
+#: Static solves per block when computing the face's residual compliance (bounded memory).
+FACE_SOLVE_BLOCK = 64
+
+
+def face_residual_compliance(solve, Phi: np.ndarray, lam: np.ndarray, face: sp.spmatrix) -> np.ndarray:
+    """R_face = E (K_r^-1 - Phi diag(1/lam) Phi^T) E^T [m/N], (nf, nf), symmetrised: the
+    static compliance the kept modes miss between every pair of face dofs (docs/model.md
+    section 4.5), which patch contacts average as w^T R_face w.
+
+    solve: x -> K_r^-1 x (the factorisation the eigensolver used); Phi (n_red, nm), lam
+    (nm,) = omega^2 [rad^2/s^2]; face: (nf, n_red) sparse 0/1 map from the reduced dofs
+    to the face's full dofs (T's face rows: a clamped dof's row is empty, the nodes of a
+    rigid layer share their driving dof's column). Solved FACE_SOLVE_BLOCK columns at a
+    time, only the face rows kept.
+    """
+    E = sp.csr_matrix(face)
+    nf = E.shape[0]
+    Et = sp.csc_matrix(E.T)
+    R = np.empty((nf, nf))
+    for j0 in range(0, nf, FACE_SOLVE_BLOCK):
+        j1 = min(nf, j0 + FACE_SOLVE_BLOCK)
+        R[:, j0:j1] = E @ solve(Et[:, j0:j1].toarray())
+    phi_face = E @ Phi
+    R -= (phi_face / lam) @ phi_face.T
+    return np.ascontiguousarray(0.5 * (R + R.T))
 
 
 def residual_compliance(Psi: np.ndarray, drive: np.ndarray) -> np.ndarray:

@@ -137,7 +137,7 @@ def check_plate_mesh(s: Scenario) -> None:
     kind = basis_kind(p.modes, n_red, truncation_supported(p.clamped_edges, edge_load))
     if kind == "truncated":
         check_truncated_plate(s)
-    check_fits(kind, n_red, p.modes)
+    check_fits(kind, n_red, p.modes, n_face=2 * p.ny + 1)
 
 
 def check_truncated_plate(s: Scenario) -> None:

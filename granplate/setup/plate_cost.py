@@ -6,8 +6,10 @@ Two bases (Plate.modes):
 - "all": every mode, from a dense generalized eigendecomposition (scipy.linalg.eigh):
   memory ~ DENSE_BYTES_PER_DOF2 n^2, time ~ DENSE_SECONDS_PER_DOF3 n^3 (n reduced dofs);
 - "truncated": the modes up to Plate.max_frequency from a sparse shift-invert
-  eigensolver plus the static residual compliance at the contacts: memory and time
-  about linear in n (one sparse factorisation of K_r, a few hundred vectors).
+  eigensolver plus the static residual compliance at the contacts and over the face's
+  dofs (for patch contacts): memory and time about linear in n (one sparse
+  factorisation of K_r, a few hundred vectors), plus the dense face compliance,
+  FACE_BYTES_PER_DOF2 (2 n_face)^2 (32 x 320: 321 face nodes, 3.3 MB).
 "auto" is "all" up to DENSE_DOF_LIMIT reduced dofs (the paper's 4 x 40 mesh has 1,082,
 4 x 80 has about 2,200), "truncated" above where the plate supports it (at least one
 clamped edge, no load on its edge), else "all".
@@ -34,6 +36,9 @@ DENSE_SECONDS_PER_DOF3 = 8.0e-10
 TRUNCATED_BYTES_PER_DOF = 40_000.0
 #: Time of the truncated basis per reduced dof [s] (an upper bound of the measured values).
 TRUNCATED_SECONDS_PER_DOF = 3.0e-3
+#: Memory of the truncated basis' face residual compliance per (face dof)^2 [bytes]
+#: (one float64 matrix over the 2 n_face face dofs).
+FACE_BYTES_PER_DOF2 = 8.0
 #: Share of the machine's physical memory a plate may take.
 MEMORY_SHARE = 0.7
 
@@ -61,19 +66,22 @@ def truncation_supported(clamped_edges, edge_load: bool) -> bool:
     return bool(clamped_edges) and not edge_load
 
 
-def build_estimate(kind: str, n_red: int) -> tuple[float, float]:
-    """(peak memory [bytes], time [s]) of building a basis of `kind` for n_red dofs."""
+def build_estimate(kind: str, n_red: int, n_face: int = 0) -> tuple[float, float]:
+    """(peak memory [bytes], time [s]) of building a basis of `kind` for n_red dofs
+    (n_face: the face's nodes, whose residual compliance the truncated basis keeps)."""
     if kind == "all":
         return DENSE_BYTES_PER_DOF2 * n_red**2, DENSE_SECONDS_PER_DOF3 * n_red**3
-    return TRUNCATED_BYTES_PER_DOF * n_red, TRUNCATED_SECONDS_PER_DOF * n_red
+    return (TRUNCATED_BYTES_PER_DOF * n_red + FACE_BYTES_PER_DOF2 * (2 * n_face) ** 2,
+            TRUNCATED_SECONDS_PER_DOF * n_red)
 
 
-def check_fits(kind: str, n_red: int, modes: str, memory: float | None = None) -> None:
+def check_fits(kind: str, n_red: int, modes: str, memory: float | None = None, n_face: int = 0) -> None:
     """ScenarioError (field plate.modes) when building the basis would not fit in memory
-    (memory [bytes], None: MEMORY_SHARE of the machine's physical memory)."""
+    (memory [bytes], None: MEMORY_SHARE of the machine's physical memory; n_face: see
+    build_estimate)."""
     if memory is None:
         memory = MEMORY_SHARE * physical_memory()
-    need, seconds = build_estimate(kind, n_red)
+    need, seconds = build_estimate(kind, n_red, n_face)
     if memory <= 0.0 or need <= memory:
         return
     hint = ("use plate.modes = \"truncated\" (or \"auto\"), or fewer elements (plate.nx, plate.ny)"

@@ -20,7 +20,8 @@ from granplate.model.contacts import Missed, contact_lists, missed_contacts, wal
 from granplate.model.neighbours import verlet_pairs, verlet_walls
 from granplate.physics.contact import plate_overlap
 from granplate.solver import loop, state as S
-from granplate.solver.interface import place_patch
+from granplate.plate.face import patch_weights
+from granplate.solver.interface import place_patch, set_face_weights
 from granplate.solver.ladder import level_for
 from granplate.solver.schemes import scheme
 
@@ -134,9 +135,10 @@ def contact_message(status: int, model: Model, st: S.State) -> str:
             why = (f"with contact.detection = \"fixed\" plate contacts are those at t = 0 (within "
                    f"contact.neighbour_gap = {c.neighbour_gap:g} R of the plate); use detection = \"dynamic\"")
         else:
-            why = ("contacts forming on the plate's face need the plate in all its modes; use "
-                   "plate.modes = \"all\" and plate.n_modes = 0 (a truncated basis keeps plate contacts "
-                   "to those at t = 0)")
+            why = ("contacts forming on the plate's face need every mode or the truncated basis' "
+                   "static correction; use plate.n_modes = 0 (with plate.modes = \"all\"), or "
+                   "plate.modes = \"truncated\" (a dense basis cut to plate.n_modes keeps plate "
+                   "contacts to those at t = 0)")
         return (f"{who} {where} reached the plate's face at t = {t:.6e} s (overlap "
                 f"{e[S.ERR_N]:.4g} m) but has no plate contact: {why}.")
     return (f"{who} {where} moved {e[S.ERR_N]:.4g} m ({e[S.ERR_RESID]:.3g} radii) in one step at "
@@ -199,9 +201,13 @@ class LoopArrays:
     def __init__(self, model: Model, times: np.ndarray, nk: int):
         g, p, cfg = model.granular, model.plate_arrays, model.config
         ng, nm = model.n_granules, len(p.omega2)
-        self.p = p._replace(phi_d=p.phi_d.copy()) if cfg.face_skin > 0.0 else p
+        self.p = p._replace(phi_d=p.phi_d.copy(), resid=p.resid.copy()) if cfg.face_skin > 0.0 else p
         self.st = S.new_state(ng, nm, nk)
         self.w = S.new_work(ng, nm, nk, len(p.face_y))
+        if cfg.face_skin > 0.0 and p.resid_face.shape[0] > 0:  # the rigid layers' face weights: their node
+            for k, y_k in enumerate(model.plate.contact_y[:nk]):
+                first, last = patch_weights(p.face_y, float(y_k), 0.0, self.w.wface)
+                set_face_weights(k, first, last, self.w)
         self.sw = scheme(cfg.scheme).new_scratch(ng, nm, nk)
         self.out = S.new_output(times, ng, nm, nk)
         self.scheme = cfg.scheme
@@ -220,6 +226,11 @@ class LoopArrays:
         phi_d = np.zeros((2 * nk_new, nm))
         phi_d[: self.p.phi_d.shape[0]] = self.p.phi_d
         self.p = self.p._replace(phi_d=phi_d)
+        if self.p.resid_face.shape[0] > 0:  # a truncated basis: the new contacts' static rows start at zero
+            resid = np.zeros((2 * nk_new, 2 * nk_new))
+            n = self.p.resid.shape[0]
+            resid[:n, :n] = self.p.resid
+            self.p = self.p._replace(resid=resid)
         self.w.g_ok[:] = 0
         self.st.clock[S.CUSTOM_H] = -1.0
 

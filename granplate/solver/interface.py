@@ -10,8 +10,8 @@ from granplate.model.inputs import SCHEME_PAPER
 from granplate.physics.contact import COEF_KS, COEF_MU, local_map_modulus, plate_overlap
 from granplate.plate.face import patch_weights
 from granplate.solver.granular import granular_rhs
-from granplate.solver.plate_modal import modal_acceleration
-from granplate.solver.state import CUSTOM_H, T_NOW
+from granplate.solver.plate_modal import modal_acceleration, static_energy
+from granplate.solver.state import CUSTOM_H, E_ZERO, T_NOW
 
 
 @njit(cache=True)
@@ -78,11 +78,60 @@ PATCH_MOVE = 1e-3
 
 
 @njit(cache=True)
+def face_compliance(k, j, c, cj, p, w):
+    """w_k^T R_face w_j for dof c of contact k and cj of contact j [m/N] (docs/model.md
+    section 4.5): the truncated basis' static correction between two contacts, from
+    their face weights (w.pweight, w.prange)."""
+    s = 0.0
+    for n in range(w.prange[k, 0], w.prange[k, 1] + 1):
+        wk = w.pweight[k, n]
+        if wk == 0.0:
+            continue
+        for m in range(w.prange[j, 0], w.prange[j, 1] + 1):
+            s += wk * w.pweight[j, m] * p.resid_face[2 * n + c, 2 * m + cj]
+    return s
+
+
+@njit(cache=True)
+def set_face_weights(k, first, last, w):
+    """Keep w.wface[first:last + 1] as contact k's face weights (w.pweight, w.prange)."""
+    for n in range(w.pweight.shape[1]):
+        w.pweight[k, n] = 0.0
+    for n in range(first, last + 1):
+        w.pweight[k, n] = w.wface[n]
+    w.prange[k, 0] = first
+    w.prange[k, 1] = last
+
+
+@njit(cache=True)
+def place_static(k, st, p, w):
+    """Contact k's rows and columns of the truncated basis' residual compliance p.resid,
+    w_k^T R_face w_j against every contact j (docs/model.md section 4.5). The static
+    part R F of the other contacts' displacements st.u follows the change of their
+    cross terms (F held)."""
+    nk = p.resid.shape[0] // 2
+    for j in range(nk):
+        for c in range(2):
+            for cj in range(2):
+                val = face_compliance(k, j, c, cj, p, w)
+                if j != k:
+                    st.u[2 * j + cj] += (val - p.resid[2 * k + c, 2 * j + cj]) * st.force[2 * k + c]
+                p.resid[2 * k + c, 2 * j + cj] = val
+                p.resid[2 * j + cj, 2 * k + c] = val
+
+
+@njit(cache=True)
 def place_patch(k, y_c, st, p, cfg, w):
     """Centre patch contact k at height y_c [m]: its rows of p.phi_d, w^T Phi_face (x and
     y), and its displacement, velocity and acceleration from the modes (st.u, st.v; st.a
-    for the paper scheme, whose Newmark interpolation uses it)."""
+    for the paper scheme, whose Newmark interpolation uses it). With a truncated basis
+    (p.resid not empty) also its static correction (place_static) and the static part
+    R F of its displacement."""
     first, last = patch_weights(p.face_y, y_c, cfg.patch_width, w.wface)
+    truncated = p.resid_face.shape[0] > 0
+    if truncated:
+        set_face_weights(k, first, last, w)
+        place_static(k, st, p, w)
     paper = cfg.scheme == SCHEME_PAPER
     for c in range(2):
         row = 2 * k + c
@@ -97,6 +146,9 @@ def place_patch(k, y_c, st, p, cfg, w):
             su += s * st.q[m]
             sv += s * st.qd[m]
             sa += s * st.qdd[m]
+        if truncated:
+            for e in range(p.resid.shape[0]):
+                su += p.resid[row, e] * st.force[e]  # static part
         st.u[row] = su
         st.v[row] = sv
         st.a[row] = sa if paper else 0.0
@@ -112,11 +164,16 @@ def move_patches(st, g, p, cfg, w):
     The overlap stays continuous across a move: the face x the contact measures from
     (g.pc_x) takes up the change of u_c, so the stored energy of eq. (9) does not jump
     and eq. (11) stays balanced. While the contact is open that shift is released
-    (back to the undeformed face, as far as it creates no overlap). A move invalidates
+    (back to the undeformed face, as far as it creates no overlap). With a truncated
+    basis the move also changes the static compliance R (forces held): every contact's
+    face x takes up the change of its static part R F, and the change of the plate's
+    static energy 1/2 F^T R F is booked as energy put in (st.clock[E_ZERO]), so that
+    eq. (11) stays exact (docs/model.md section 4.5). A move invalidates
     the per-level matrices (they hold the contact rows) and refreshes what the next step
     starts from: the granules' derivative at t_n and, for the paper scheme, the modal
     acceleration with the forces at t_n on the new rows. Returns whether a patch moved."""
     moved = False
+    truncated = p.resid_face.shape[0] > 0
     for k in range(g.pc_patch.shape[0]):
         if g.pc_patch[k] == 0:
             continue
@@ -124,9 +181,18 @@ def move_patches(st, g, p, cfg, w):
         y_c = st.y[i, 1]
         near = plate_overlap(st.y[i, 0], g.radius[i] * (1.0 + cfg.face_skin), g.pc_x[k] + st.u[2 * k]) > 0.0
         if near and abs(y_c - w.patch_y[k]) > PATCH_MOVE * cfg.patch_width:
-            u_old = st.u[2 * k]
-            place_patch(k, y_c, st, p, cfg, w)
-            g.pc_x[k] += u_old - st.u[2 * k]
+            if truncated:
+                e_old = static_energy(p.resid, st.force)
+                for j in range(g.pc_i.shape[0]):
+                    w.nscratch[j] = st.u[2 * j]
+                place_patch(k, y_c, st, p, cfg, w)
+                for j in range(g.pc_i.shape[0]):
+                    g.pc_x[j] += w.nscratch[j] - st.u[2 * j]
+                st.clock[E_ZERO] += static_energy(p.resid, st.force) - e_old
+            else:
+                u_old = st.u[2 * k]
+                place_patch(k, y_c, st, p, cfg, w)
+                g.pc_x[k] += u_old - st.u[2 * k]
             moved = True
         if plate_overlap(st.y[i, 0], g.radius[i], g.pc_x[k] + st.u[2 * k]) <= 0.0:
             g.pc_x[k] = cfg.plate_x0 + max(0.0, plate_overlap(st.y[i, 0], g.radius[i], cfg.plate_x0 + st.u[2 * k]))

@@ -114,6 +114,8 @@ class Work(NamedTuple):
     ovl_who: np.ndarray  # (2,) int: its granule and partner (-1, -1: no overlap)
     wface: np.ndarray  # (n_face,) scratch: a patch's nodal weights
     patch_y: np.ndarray  # (nk,) the height [m] each patch contact's weights were computed at
+    pweight: np.ndarray  # (nk, n_face) each plate contact's nodal weights on the face (truncated basis)
+    prange: np.ndarray  # (nk, 2) int: the first and last face node of each row of pweight
 
 
 class Output(NamedTuple):
@@ -158,6 +160,7 @@ def new_work(ng: int, nm: int, nk: int, n_face: int = 0) -> Work:
         lam_int=z(nk), it_int=np.zeros(nk, np.int64), dt_int=z(2), res_int=z(1),
         yref=z((ng, 2)), ovl=z(ng), ovl_with=np.zeros(ng, np.int64), plate_free=np.zeros(ng, np.int64),
         ovl_new=z(1), ovl_who=np.full(2, -1, np.int64), wface=z(n_face), patch_y=z(nk),
+        pweight=z((nk, n_face)), prange=np.zeros((nk, 2), np.int64),
     )
 
 
