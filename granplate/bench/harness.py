@@ -334,3 +334,17 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser(prog="python -m granplate.bench.harness")
     add_arguments(ap)
     sys.exit(main(ap.parse_args()))
+
+
+def parse_pairs(text: str, flag: str, form: str, example: str, min_second: int = 1) -> list[tuple[int, int]]:
+    """'4x40,8x80' -> [(4, 40), (8, 80)]: a bench option's comma-separated AxB items, each
+    A >= 1 and B >= min_second (ValueError naming the option, the bad item and the form)."""
+    out = []
+    for item in text.split(","):
+        parts = item.strip().lower().split("x")
+        if (len(parts) != 2 or not all(p.strip().isdigit() and int(p) >= 1 for p in parts)
+                or int(parts[1]) < min_second):
+            rows = f" ({form.split('x')[1]} >= {min_second})" if min_second > 1 else ""
+            raise ValueError(f"{flag} item {item!r}: allowed {form} with integers >= 1{rows}, e.g. {example}")
+        out.append((int(parts[0]), int(parts[1])))
+    return out

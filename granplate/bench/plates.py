@@ -17,6 +17,8 @@ import sys
 import tempfile
 import time
 
+from granplate.bench.harness import parse_pairs
+
 #: Meshes (nx, ny) of the table, the paper's first.
 PLATE_MESHES: tuple[tuple[int, int], ...] = ((4, 40), (8, 80), (16, 160), (32, 320))
 #: The preset whose plate is refined.
@@ -110,13 +112,7 @@ def run_plates(meshes=PLATE_MESHES, modes: str = "auto", t_end: float | None = N
 
 def parse_meshes(text: str) -> list[tuple[int, int]]:
     """'4x40,8x80' -> [(4, 40), (8, 80)] (ValueError naming the bad item)."""
-    out = []
-    for item in text.split(","):
-        parts = item.strip().lower().split("x")
-        if len(parts) != 2 or not all(p.strip().isdigit() and int(p) >= 1 for p in parts):
-            raise ValueError(f"--meshes item {item!r}: allowed NXxNY with integers >= 1, e.g. 8x80")
-        out.append((int(parts[0]), int(parts[1])))
-    return out
+    return parse_pairs(text, "--meshes", "NXxNY", "8x80")
 
 
 def main(args) -> int:

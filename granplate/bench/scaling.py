@@ -25,6 +25,8 @@ import subprocess
 import sys
 import time
 
+from granplate.bench.harness import parse_pairs
+
 #: Packings (columns, rows) of the table: 10, 100, 1,008, 2,996 and 9,950 granules.
 SIZES: tuple[tuple[int, int], ...] = ((4, 3), (8, 13), (32, 32), (56, 54), (100, 100))
 #: Friction coefficients of the rows: frictionless (compared with LAMMPS) and the default.
@@ -192,13 +194,7 @@ def format_scaling_table(rows: list[dict]) -> str:
 
 def parse_sizes(text: str) -> list[tuple[int, int]]:
     """'4x3,32x32' -> [(4, 3), (32, 32)] (columns x rows; ValueError naming the bad item)."""
-    out = []
-    for item in text.split(","):
-        parts = item.strip().lower().split("x")
-        if len(parts) != 2 or not all(p.strip().isdigit() and int(p) >= 1 for p in parts) or int(parts[1]) < 2:
-            raise ValueError(f"--sizes item {item!r}: allowed COLUMNSxROWS with integers >= 1 (rows >= 2), e.g. 32x32")
-        out.append((int(parts[0]), int(parts[1])))
-    return out
+    return parse_pairs(text, "--sizes", "COLUMNSxROWS", "32x32", min_second=2)
 
 
 def main(args) -> int:
