@@ -115,7 +115,8 @@ def test_registry_names_and_refusals():
     for i, name in enumerate(SCHEME_NAMES):
         mod = schemes.scheme(name)
         assert schemes.scheme(i) is mod and mod.NAME == name
-        for hook in ("plan", "prepare_level", "attempt", "judge", "commit", "next_level", "new_scratch"):
+        for hook in ("plan", "prepare_level", "attempt", "judge", "commit", "next_level", "contact_placed",
+                     "contacts_moved", "new_scratch"):
             assert callable(getattr(mod, hook))
     with pytest.raises(ValueError, match="allowed paper, implicit"):
         schemes.scheme("leapfrog")

@@ -1,8 +1,8 @@
 """Plate contacts that form during the run on the plate's face (docs/model.md section
 3.5): against Hertz's rigid-wall impact on a stiff plate, against themselves at a node
 and between nodes, Coulomb's bound when sliding, the energy balance of eq. (11) (exactly
-across a patch move), the truncated basis against the full one, and the fixed
-detection's error kept."""
+across a patch move), the truncated basis against the full one, the fixed detection's
+error kept, and the record of when and where each contact formed."""
 from __future__ import annotations
 
 import dataclasses
@@ -208,3 +208,45 @@ def test_patch_contacts_need_every_mode_or_the_static_correction():
     with pytest.raises(SimulationError, match=r"granule 'g' .* reached the plate's face .*plate.n_modes = 0"
                                               r".*plate.modes = \"truncated\""):
         simulate(s, model=model, progress=False)
+
+
+def test_contacts_formed_and_rebuilds_are_recorded_when_and_where_they_happen():
+    """A granule in free flight towards the face: its patch contact forms within one step
+    after its surface comes within skin R of the face (t = (gap - skin R) / vx), at its
+    height y0 + vy t then; the lists are rebuilt every skin R / 2 of travel (3 times)."""
+    gap, vx, vy, t_end = 2e-3, 1.0, 0.5, 1.6e-3
+    s = drop_scenario(0.05, vx=vx, vy=vy, gap=gap, t_end=t_end, out=1e-5)
+    skin = s.contact.skin
+    ds = simulate(s, progress=False)
+    t_cross = (gap - skin * R) / vx
+    assert list(ds.contact.values) == ["g"]
+    t_formed = float(ds.contact_time_formed.values[0])
+    assert 0.0 <= t_formed - t_cross <= float(ds.dt_max.max())
+    assert ds.contact_y.values[0] == pytest.approx(0.05 + vy * t_formed, rel=1e-12)
+    travel = np.hypot(vx, vy) * t_end
+    assert ds.attrs["n_rebuilds"] == int(travel // (0.5 * skin * R)) == 3
+    assert ds.contact_normal_force.values.max() == 0.0  # formed, not yet touched
+
+
+@pytest.mark.parametrize("scheme", ["paper", "implicit"])
+def test_a_patch_contact_added_starts_from_the_modes(scheme):
+    """A patch contact added on a moving plate: its displacement and velocity are
+    Phi_d q and Phi_d q' on its new rows; the paper scheme's Newmark interpolation starts
+    from a_n = Phi_d q'' there, the implicit scheme keeps no acceleration."""
+    model = build_model(drop_scenario(0.05, gap=6e-4, scheme=scheme))
+    arr = driver.LoopArrays(model, np.array([0.0, 1e-6]), 0)
+    lists = driver.ContactLists(model)
+    lists.g = lists.g._replace(pc_x=lists.g.pc_x.copy())
+    st = arr.st
+    st.y[:] = model.initial_state
+    arr.w.plate_free[:] = 1
+    rng = np.random.default_rng(5)
+    scale = 1.0 / np.sqrt(model.plate_arrays.omega2 / model.plate_arrays.omega2[0])
+    st.q[:], st.qd[:], st.qdd[:] = (rng.normal(size=st.q.shape) * scale * f for f in (1e-9, 1e-6, 1e-3))
+    assert driver.add_patch_contacts(model, lists, arr) == 1
+    st, p = arr.st, arr.p
+    assert np.allclose(st.u, p.phi_d @ st.q, rtol=1e-12, atol=0) and np.allclose(st.v, p.phi_d @ st.qd, rtol=1e-12, atol=0)
+    expected = p.phi_d @ st.qdd if scheme == "paper" else np.zeros(2)
+    assert np.abs(expected).max() > 0 or scheme == "implicit"
+    assert np.allclose(st.a, expected, rtol=1e-12, atol=0)
+    assert lists.changes().granule.tolist() == [0] and lists.changes().y.tolist() == [0.05]

@@ -6,7 +6,9 @@ and the solver's figures travel in the attributes, so any figure can be traced b
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 import xarray as xr
@@ -50,6 +52,7 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "dt_max": ("s", "largest time step since the previous output"),
     "n_steps": ("1", "time steps taken so far"),
     "n_iterations": ("1", "interface iterations taken so far"),
+    "contact_time_formed": ("s", "time each plate contact formed: 0 for those at t = 0, a patch contact's when its granule came within contact.skin R of the face"),
 }
 
 
@@ -82,11 +85,12 @@ def plate_maxima(plate, qf: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndar
 
 
 def plate_fields(model, q: np.ndarray, qd: np.ndarray, times: np.ndarray,
-                 force: np.ndarray | None = None) -> dict[str, xr.DataArray]:
+                 force: np.ndarray | None = None, plate=None) -> dict[str, xr.DataArray]:
     """Plate outputs computed from the modal coordinates after the run; force (time,
     2 n_contacts) [N]: the contact forces on the plate, whose static part a truncated
-    basis adds to the displacements and stresses (docs/model.md section 4.5)."""
-    plate = model.plate
+    basis adds to the displacements and stresses (docs/model.md section 4.5); plate: the
+    plate with the run's contacts (`run_contacts`; default model.plate)."""
+    plate = model.plate if plate is None else plate
     s = model.scenario
     out: dict[str, xr.DataArray] = {}
     if force is None or not plate.truncated:
@@ -123,15 +127,44 @@ SUMMARY_VARIABLES = ("E_shock", "E_granular", "E_plate", "D_viscous", "D_frictio
                      "energy_residual_max", "max_von_mises", "max_von_mises_disc", "max_eps_yy")
 
 
-def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = False) -> xr.Dataset:
+class RunContacts(NamedTuple):
+    """The output's contact axis: the model's plate contacts (at t = 0), then the patch
+    contacts the run formed."""
+
+    granule: np.ndarray  # (nk,) int64: the granule of each plate contact
+    y: np.ndarray  # (nk,) [m]: its height on the face (a patch contact's where it formed)
+    time_formed: np.ndarray  # (nk,) [s]: when it formed (0 for the model's)
+    plate: object  # the plate with every contact's height (its truncated basis' static part reads them), or None
+
+
+def run_contacts(model, contacts=None) -> RunContacts:
+    """The contact axis of a run of `model` whose contacts changed as `contacts` says
+    (solver.driver.ContactChanges; None: as the model's)."""
+    plate = model.plate
+    granule = np.asarray(model.plate_contacts, np.int64)
+    y = np.asarray(plate.contact_y, float) if plate is not None else np.zeros(len(granule))
+    t = np.zeros(len(granule))
+    if contacts is not None and len(contacts.granule):
+        granule = np.concatenate([granule, contacts.granule])
+        y = np.concatenate([y, contacts.y])
+        t = np.concatenate([t, contacts.time])
+        plate = replace(plate, contact_y=y)
+    return RunContacts(granule=granule, y=y, time_formed=t, plate=plate)
+
+
+def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = False,
+               contacts=None) -> xr.Dataset:
     """Build the result Dataset from the first n output rows.
 
     summary_only: only the variables `summary` reads (SUMMARY_VARIABLES, the time and
     granule coordinates and the attributes), the same numbers at a fraction of the cost
-    (no plate fields, snapshots or per-contact records)."""
+    (no plate fields, snapshots or per-contact records); contacts: how the run's contacts
+    changed (solver.driver.ContactChanges: the patch contacts formed extend the contact
+    axis; None: none formed)."""
     from granplate.setup.io import dumps
 
     s = model.scenario
+    axis = run_contacts(model, contacts)
     t = out.t[:n].copy()
     y = out.y[:n]
     e = out.energy[:n]
@@ -147,11 +180,11 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
     ):
         if not summary_only or name in SUMMARY_VARIABLES:
             data[name] = _var(name, ("time",), e[:, col].copy())
-    nk = len(model.plate_contacts)
+    nk = len(axis.granule)
     coords = {
         "time": ("time", t, {"units": "s", "long_name": "time"}),
         "granule": ("granule", np.array(model.labels, dtype=str), {"long_name": "granule label (paper numbering)"}),
-        **({} if summary_only else {"contact": ("contact", np.array(model.contact_labels, dtype=str),
+        **({} if summary_only else {"contact": ("contact", np.array([model.labels[i] for i in axis.granule], dtype=str),
                                                 {"long_name": "granule at each plate contact"})}),
         "radius": ("granule", model.granular.radius.copy(), {"units": "m", "long_name": "granule radius"}),
         "mass": ("granule", model.granular.mass.copy(), {"units": "kg", "long_name": "granule mass"}),
@@ -162,7 +195,7 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
             qf = out.q[:n]
             if model.plate.truncated:
                 qf = np.concatenate([qf, out.force[:n].reshape(n, -1)], axis=1)
-            max_vm, max_disc, max_eyy = plate_maxima(model.plate, qf)
+            max_vm, max_disc, max_eyy = plate_maxima(axis.plate, qf)
             data["max_von_mises"] = _var("max_von_mises", ("time",), max_vm)
             data["max_von_mises_disc"] = _var("max_von_mises_disc", ("time",), max_disc)
             data["max_eps_yy"] = _var("max_eps_yy", ("time",), max_eyy)
@@ -178,11 +211,12 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
     data["dt_max"] = _var("dt_max", ("time",), out.stats[:n, K.S_DT_MAX].copy())
     data["n_steps"] = _var("n_steps", ("time",), out.stats[:n, K.S_STEPS].astype(np.int64))
     data["n_iterations"] = _var("n_iterations", ("time",), out.stats[:n, K.S_ITERS].astype(np.int64))
+    data["contact_time_formed"] = _var("contact_time_formed", ("contact",), axis.time_formed)
     if model.plate is not None:
-        pf = plate_fields(model, out.q[:n], out.qd[:n], t, out.force[:n].reshape(n, -1))
+        pf = plate_fields(model, out.q[:n], out.qd[:n], t, out.force[:n].reshape(n, -1), plate=axis.plate)
         ft = pf.pop("_field_time")
         data.update(pf)
-        plate = model.plate
+        plate = axis.plate
         coords["field_time"] = ("field_time", ft, {"units": "s", "long_name": "time of the plate field snapshots"})
         coords["node_x"] = ("node", plate.node_xy[:, 0].copy(), {"units": "m", "long_name": "plate node x"})
         coords["node_y"] = ("node", plate.node_xy[:, 1].copy(), {"units": "m", "long_name": "plate node y"})

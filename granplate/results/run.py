@@ -9,8 +9,6 @@ import sys
 import time
 from dataclasses import replace
 
-import numpy as np
-
 from granplate.errors import SimulationError
 from granplate.model.arrays import Model, build_model
 from granplate.results.dataset import to_dataset
@@ -66,13 +64,10 @@ def simulate(
     }
     info = {k: info[k] for k in ("wall_time_s", "setup_time_s", "first_call_time_s", "loop_time_s",
                                  "n_steps", "n_iterations", "n_retries", "n_friction_bound", "status")}
-    if rec.plate_contacts is not None and len(rec.plate_contacts) != len(model.plate_contacts):
-        # with the patch contacts formed during the run, at the height where each formed
-        plate = replace(model.plate, contact_y=np.concatenate([model.plate.contact_y, rec.info["patch_y0"]]))
-        model = replace(model, plate_contacts=rec.plate_contacts, plate=plate)
+    info["n_rebuilds"] = rec.contacts.n_rebuilds
     if rec.status == OK and summary_only:
-        return to_dataset(model, rec.out, rec.n_valid, info, summary_only=True)
-    ds = to_dataset(model, rec.out, rec.n_valid, info)
+        return to_dataset(model, rec.out, rec.n_valid, info, summary_only=True, contacts=rec.contacts)
+    ds = to_dataset(model, rec.out, rec.n_valid, info, contacts=rec.contacts)
     if rec.status != OK:
         t_last = rec.out.t[rec.n_valid - 1]
         raise SimulationError(

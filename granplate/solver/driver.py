@@ -21,7 +21,7 @@ from granplate.model.neighbours import verlet_pairs, verlet_walls
 from granplate.physics.contact import plate_overlap
 from granplate.solver import loop, state as S
 from granplate.plate.face import patch_weights
-from granplate.solver.interface import place_patch, set_face_weights
+from granplate.solver.interface import set_face_weights
 from granplate.solver.ladder import level_for
 from granplate.solver.schemes import scheme
 
@@ -36,19 +36,30 @@ INTERRUPTED = -1
 INTERRUPTED_STATUS = "interrupted by the user"
 
 
+class ContactChanges(NamedTuple):
+    """How a run's contacts changed: the patch contacts formed on the plate's face
+    (docs/model.md section 3.5), in the order they follow the model's plate contacts on
+    the output's contact axis, and the contact lists' rebuilds."""
+
+    granule: np.ndarray  # (n_formed,) int64: the granule of each patch contact formed
+    time: np.ndarray  # (n_formed,) [s]: when it formed (its granule within contact.skin R of the face)
+    y: np.ndarray  # (n_formed,) [m]: the height on the face where it formed (its granule's y then)
+    n_rebuilds: int  # contact-list rebuilds (detection = "dynamic": a granule moved skin R_min / 2)
+
+
 class RunRecord(NamedTuple):
     """What the loop leaves: the output buffers, how many rows are valid, the status
     code (state.OK, an error code, or INTERRUPTED), its message ("ok" or why the run
-    stopped), the timings and counters (info), and the granule of every plate contact
-    (the model's, then the patch contacts formed during the run, in the order of the
-    output's contact axis)."""
+    stopped), the timings and counters (info), and how the contacts changed (contacts:
+    the patch contacts formed, which extend the output's contact axis, and the list
+    rebuilds)."""
 
     out: S.Output
     n_valid: int
     status: int
     message: str
     info: dict
-    plate_contacts: np.ndarray | None = None
+    contacts: ContactChanges
 
 
 def output_times(t_end: float, dt_out: float) -> np.ndarray:
@@ -164,14 +175,22 @@ def overlap_warnings(model: Model, w: S.Work) -> list[str]:
 
 class ContactLists:
     """The loop's contact lists during a run: rebuilt (detection = "dynamic") or checked
-    (fixed) from the granules' positions, between compiled chunks (model/contacts.py)."""
+    (fixed) from the granules' positions, between compiled chunks (model/contacts.py),
+    and how they changed (`changes`)."""
 
     def __init__(self, model: Model):
         self.model = model
         self.g = model.granular
         self.known: dict = {}
         self.planes = wall_planes(model.scenario.walls)
-        self.n_rebuilds = 0
+        self.n_rebuilds = 0  # rebuilds the loop asked for (REBUILD, dynamic detection)
+        self.formed: list[tuple[int, float, float]] = []  # patch contacts: (granule, t [s], y [m])
+
+    def changes(self) -> ContactChanges:
+        """The patch contacts formed so far and the rebuilds, as a ContactChanges."""
+        i, t, y = zip(*self.formed) if self.formed else ((), (), ())
+        return ContactChanges(granule=np.array(i, np.int64), time=np.array(t, float), y=np.array(y, float),
+                              n_rebuilds=self.n_rebuilds)
 
     def refresh(self, y: np.ndarray) -> Missed | None:
         """Rebuild (dynamic) or check (fixed) the lists at positions y[:, :2]; returns the
@@ -181,7 +200,6 @@ class ContactLists:
         c = m.scenario.contact
         fixed = c.detection == "fixed"
         normals, offsets = self.planes
-        self.n_rebuilds += 1
         if fixed:
             cand_p, cand_w = verlet_pairs(x, yy, r, 0.0), verlet_walls(x, yy, r, normals, offsets, 0.0)
         else:
@@ -211,7 +229,6 @@ class LoopArrays:
         self.sw = scheme(cfg.scheme).new_scratch(ng, nm, nk)
         self.out = S.new_output(times, ng, nm, nk)
         self.scheme = cfg.scheme
-        self.patch_y0: list[float] = []  # the height [m] at which each patch contact formed
 
     def grow(self, nk_new: int) -> None:
         """Room for nk_new plate contacts: every array reallocated with the old values
@@ -263,8 +280,8 @@ def add_patch_contacts(model: Model, lists: "ContactLists", arr: LoopArrays) -> 
     lists.g = granular_with_patch_contacts(model, lists.g, new)
     arr.grow(nk + len(new))
     for k, i in enumerate(new, start=nk):
-        place_patch(k, float(arr.st.y[i, 1]), arr.st, arr.p, model.config, arr.w)
-        arr.patch_y0.append(float(arr.st.y[i, 1]))
+        loop.place_contact(arr.sw, k, float(arr.st.y[i, 1]), arr.st, arr.p, model.config, arr.w)
+        lists.formed.append((int(i), float(arr.st.clock[S.T_NOW]), float(arr.st.y[i, 1])))
         arr.st.slip[k] = arr.st.y[i, 4] + model.granular.radius[i] * arr.st.y[i, 5] - arr.st.v[2 * k + 1]
     arr.w.plate_free[new] = 0
     return len(new)
@@ -374,6 +391,8 @@ def _loop_chunks(times, model, arr: LoopArrays, should_stop, on_progress, lists)
                               RuntimeWarning, stacklevel=4)
             if status in (S.REBUILD, S.NEW_PLATE) and cfg.face_skin > 0.0:
                 add_patch_contacts(model, lists, arr)
+            if status == S.REBUILD and not fixed:
+                lists.n_rebuilds += 1
             if status == S.REBUILD or (fixed and status in (S.OK, S.PAUSED)):
                 checked = _refresh(lists, arr.st, arr.w)
                 if checked != S.OK:
@@ -430,17 +449,15 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
         "n_steps": int(st.count[S.C_STEPS]),
         "n_iterations": int(st.count[S.C_ITERS]),
         "n_retries": int(st.count[S.C_RETRIES]),
-        "n_rebuilds": lists.n_rebuilds,
         "n_friction_bound": int(st.count[S.C_FRICTION_BOUND]),
         "overlap_warnings": overlap_warnings(model, w),
-        "patch_y0": list(arr.patch_y0),
     }
     message = "ok" if status == S.OK else status_message(status, model, st)
     for line in info["overlap_warnings"]:
         warnings.warn(f"{model.scenario.name}: {line}: Hertz's law assumes overlaps small against the radii.",
                       RuntimeWarning, stacklevel=2)
     return RunRecord(out=arr.out, n_valid=int(st.count[S.C_OUT]), status=status, message=message, info=info,
-                     plate_contacts=np.asarray(lists.g.pc_i, np.int64).copy())
+                     contacts=lists.changes())
 
 
 @contextmanager

@@ -1,16 +1,19 @@
 """The granule-plate interface inside a step, shared by every scheme: the first guess
 of the interface forces, their convergence test, criterion (8) at the contacts, and the
 patch contacts that follow their granules along the face between steps.
+
+Nothing here depends on the scheme: what a scheme derives from the contacts' rows of
+Phi_d is its own (its hooks `contact_placed` and `contacts_moved`, solver/schemes),
+called by the loop and the driver after these functions change the rows.
 """
 from __future__ import annotations
 
 from numba import njit
 
-from granplate.model.inputs import SCHEME_PAPER
 from granplate.physics.contact import COEF_KS, COEF_MU, local_map_modulus, plate_overlap
 from granplate.plate.face import patch_weights
 from granplate.solver.granular import granular_rhs
-from granplate.solver.plate_modal import modal_acceleration, static_energy
+from granplate.solver.plate_modal import static_energy
 from granplate.solver.state import CUSTOM_H, E_ZERO, T_NOW
 
 
@@ -123,21 +126,19 @@ def place_static(k, st, p, w):
 @njit(cache=True)
 def place_patch(k, y_c, st, p, cfg, w):
     """Centre patch contact k at height y_c [m]: its rows of p.phi_d, w^T Phi_face (x and
-    y), and its displacement, velocity and acceleration from the modes (st.u, st.v; st.a
-    for the paper scheme, whose Newmark interpolation uses it). With a truncated basis
-    (p.resid not empty) also its static correction (place_static) and the static part
-    R F of its displacement."""
+    y), and its displacement and velocity from the modes (st.u, st.v). With a truncated
+    basis (p.resid not empty) also its static correction (place_static) and the static
+    part R F of its displacement. What the scheme keeps at the rows (the paper scheme's
+    acceleration st.a) is its hook `contact_placed` (loop.place_contact)."""
     first, last = patch_weights(p.face_y, y_c, cfg.patch_width, w.wface)
     truncated = p.resid_face.shape[0] > 0
     if truncated:
         set_face_weights(k, first, last, w)
         place_static(k, st, p, w)
-    paper = cfg.scheme == SCHEME_PAPER
     for c in range(2):
         row = 2 * k + c
         su = 0.0
         sv = 0.0
-        sa = 0.0
         for m in range(p.omega2.shape[0]):
             s = 0.0
             for n in range(first, last + 1):
@@ -145,13 +146,11 @@ def place_patch(k, y_c, st, p, cfg, w):
             p.phi_d[row, m] = s
             su += s * st.q[m]
             sv += s * st.qd[m]
-            sa += s * st.qdd[m]
         if truncated:
             for e in range(p.resid.shape[0]):
                 su += p.resid[row, e] * st.force[e]  # static part
         st.u[row] = su
         st.v[row] = sv
-        st.a[row] = sa if paper else 0.0
     w.patch_y[k] = y_c
 
 
@@ -169,9 +168,11 @@ def move_patches(st, g, p, cfg, w):
     face x takes up the change of its static part R F, and the change of the plate's
     static energy 1/2 F^T R F is booked as energy put in (st.clock[E_ZERO]), so that
     eq. (11) stays exact (docs/model.md section 4.5). A move invalidates
-    the per-level matrices (they hold the contact rows) and refreshes what the next step
-    starts from: the granules' derivative at t_n and, for the paper scheme, the modal
-    acceleration with the forces at t_n on the new rows. Returns whether a patch moved."""
+    the per-level matrices (they hold the contact rows) and refreshes the granules'
+    derivative at t_n, which the next step starts from; what the scheme derives from the
+    new rows with the forces at t_n (the paper scheme's modal acceleration) is its hook
+    `contacts_moved`, which the loop calls when this returns True. Returns whether a
+    patch moved."""
     moved = False
     truncated = p.resid_face.shape[0] > 0
     for k in range(g.pc_patch.shape[0]):
@@ -205,11 +206,4 @@ def move_patches(st, g, p, cfg, w):
         st.p1[0] = pr[0]
         st.p1[1] = pr[1]
         st.p1[2] = pr[2]
-        if cfg.scheme == SCHEME_PAPER:
-            modal_acceleration(st.clock[T_NOW], st, p, cfg, st.force)
-            for d in range(p.phi_d.shape[0]):
-                sa = 0.0
-                for m in range(p.omega2.shape[0]):
-                    sa += p.phi_d[d, m] * st.qdd[m]
-                st.a[d] = sa
     return moved

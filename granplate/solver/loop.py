@@ -15,7 +15,7 @@ from granplate.physics.energy import energy_residual, energy_total
 from granplate.solver import schemes as S
 from granplate.solver.contacts import watch_contacts
 from granplate.solver.granular import RK4_FRICTION_LIMIT, granular_rhs, kinetic_energies
-from granplate.solver.interface import accept_contacts, contact_modulus, first_guess, move_patches
+from granplate.solver.interface import accept_contacts, contact_modulus, first_guess, move_patches, place_patch
 from granplate.solver.ladder import level_step
 from granplate.solver.plate_modal import driving_dofs, modal_acceleration, plate_energy, step_matrices
 from granplate.solver.state import (
@@ -210,9 +210,9 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
     scratch is sw, trying at most max_attempts steps. Returns a status: OK, PAUSED
     (budget spent; call again) or an error, with st.err filled and the state the last
     accepted one. After every accepted step the patch contacts follow their granules
-    (interface.move_patches) and the contact watch runs (solver/contacts.py): REBUILD
-    asks the driver to rebuild the contact list, NEW_PLATE to add a patch contact, and
-    to call again."""
+    (interface.move_patches, then the scheme's hook contacts_moved) and the contact
+    watch runs (solver/contacts.py): REBUILD asks the driver to rebuild the contact
+    list, NEW_PLATE to add a patch contact, and to call again."""
     for _ in range(max_attempts):
         t = st.clock[T_NOW]
         if t >= t_stop - 1e-9 * cfg.dt_min:
@@ -258,14 +258,23 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
         if land:
             record(o, st, g, p, w, out)
             st.count[C_OUT] = o + 1
-        if g.pc_patch.shape[0] > 0:  # patch contacts follow their granules (between steps)
-            move_patches(st, g, p, cfg, w)
+        if g.pc_patch.shape[0] > 0 and move_patches(st, g, p, cfg, w):  # patch contacts follow their granules
+            S.contacts_moved(sw, st.clock[T_NOW], st, p, cfg)
         status = watch_contacts(st.clock[T_NOW], st.y, st.u, g.radius, w.plate_free, w.yref, w.ovl, w.ovl_with,
                                 w.ovl_new, w.ovl_who, cfg.overlap_stop, cfg.plate_x0, cfg.plate_ylo, cfg.plate_yhi,
                                 cfg.rebuild_move, cfg.face_skin, st.err)
         if status != OK:
             return status
     return OK if st.clock[T_NOW] >= t_stop - 1e-9 * cfg.dt_min else PAUSED
+
+
+@njit(cache=True)
+def place_contact(sw, k, y_c, st, p, cfg, w):
+    """Centre patch contact k at height y_c [m] on the face (interface.place_patch) and
+    give the scheme whose scratch is sw its state at the contact's rows (its hook
+    contact_placed); the driver calls this for every patch contact it adds."""
+    place_patch(k, y_c, st, p, cfg, w)
+    S.contact_placed(sw, k, st, p)
 
 
 @njit(cache=True)

@@ -1,7 +1,7 @@
 """The coupling schemes, one module each, behind one interface, and their registry.
 
 A scheme module defines NAME, a `Scratch` named tuple (its own scratch arrays),
-`new_scratch(ng, nm, nk)`, and six compiled hooks, each taking its Scratch first:
+`new_scratch(ng, nm, nk)`, and eight compiled hooks, each taking its Scratch first:
 
     plan(sw, count, cfg, pos, rem) -> (level, h, slot, land)
     prepare_level(sw, h, p, slot)
@@ -9,6 +9,14 @@ A scheme module defines NAME, a `Scratch` named tuple (its own scratch arrays),
     judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w) -> (err, retry, work, fric_work)
     commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w) -> plate work [J]
     next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg) -> (level, h_new)
+    contact_placed(sw, k, st, p)
+    contacts_moved(sw, t, st, p, cfg)
+
+The last two keep the scheme's own driving-DOF state true when the plate contacts' rows
+of Phi_d change between steps (solver/interface.py, docs/model.md section 3.5):
+`contact_placed` after plate contact k's rows were set with the modes held (a patch
+contact added), `contacts_moved` after loaded patch contacts moved (what depends on
+Phi_d^T F at t_n).
 
 The time loop (solver/loop.py) calls the hooks below; numba picks the scheme's function
 from the type of the scratch at compile time (one compiled loop per scheme, each cached
@@ -79,6 +87,16 @@ def next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg):
     raise NotImplementedError("compiled use only")
 
 
+def contact_placed(sw, k, st, p):
+    """The scheme's state at plate contact k's rows of Phi_d, just set."""
+    raise NotImplementedError("compiled use only")
+
+
+def contacts_moved(sw, t, st, p, cfg):
+    """The scheme's state after loaded patch contacts moved at t [s]."""
+    raise NotImplementedError("compiled use only")
+
+
 @overload(plan, inline="always")
 def _plan(sw, count, cfg, pos, rem):
     fn = _hook_of(sw, "plan")
@@ -122,3 +140,17 @@ def _next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg):
     if fn is not None:
         return lambda sw, h, slot, level, err, lam_max, rate, t_now, cfg: fn(
             sw, h, slot, level, err, lam_max, rate, t_now, cfg)
+
+
+@overload(contact_placed, inline="always")
+def _contact_placed(sw, k, st, p):
+    fn = _hook_of(sw, "contact_placed")
+    if fn is not None:
+        return lambda sw, k, st, p: fn(sw, k, st, p)
+
+
+@overload(contacts_moved, inline="always")
+def _contacts_moved(sw, t, st, p, cfg):
+    fn = _hook_of(sw, "contacts_moved")
+    if fn is not None:
+        return lambda sw, t, st, p, cfg: fn(sw, t, st, p, cfg)

@@ -244,3 +244,18 @@ def next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg):
         h_new = min(h_new, cfg.duration / SHOCK_STEPS)
     new_level = dyadic_round(level_for(h_new, cfg), cfg)
     return new_level, h_new
+
+
+@njit(cache=True)
+def contact_placed(sw, k, st, p):
+    """Nothing to derive from the modes: this scheme keeps no driving-DOF acceleration
+    (st.a, zero: not used by its modal integration)."""
+    st.a[2 * k] = 0.0
+    st.a[2 * k + 1] = 0.0
+
+
+@njit(cache=True)
+def contacts_moved(sw, t, st, p, cfg):
+    """Nothing: each step advances the modes from q, q' and the forces at t_n as they
+    stand, with the contacts' rows of Phi_d of that step."""
+    return

@@ -21,7 +21,7 @@ from numba import njit
 from granplate.solver.granular import rk4_granular_step, rk4_limit
 from granplate.solver.interface import forces_converged
 from granplate.solver.ladder import level_for, level_step, step_to_output
-from granplate.solver.plate_modal import newmark_correct, newmark_predict
+from granplate.solver.plate_modal import modal_acceleration, newmark_correct, newmark_predict
 from granplate.solver.state import C_LEVEL
 
 NAME = "paper"
@@ -144,3 +144,27 @@ def next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg):
         h_new = min(2.0 * h_lvl, cfg.dt_max)
     h_new = rk4_limit(h_new, rate)
     return level_for(h_new, cfg), h_new
+
+
+@njit(cache=True)
+def contact_placed(sw, k, st, p):
+    """Plate contact k's driving-DOF acceleration a_n = Phi_d q'' (x and y) on its rows
+    of Phi_d just set, the modes held: the interpolation of the next step starts from it."""
+    for c in range(2):
+        row = 2 * k + c
+        sa = 0.0
+        for m in range(p.omega2.shape[0]):
+            sa += p.phi_d[row, m] * st.qdd[m]
+        st.a[row] = sa
+
+
+@njit(cache=True)
+def contacts_moved(sw, t, st, p, cfg):
+    """After loaded patch contacts moved at t [s]: the modal acceleration q'' with the
+    forces at t on the new rows of Phi_d, and a_n = Phi_d q'' at every driving DOF."""
+    modal_acceleration(t, st, p, cfg, st.force)
+    for d in range(p.phi_d.shape[0]):
+        sa = 0.0
+        for m in range(p.omega2.shape[0]):
+            sa += p.phi_d[d, m] * st.qdd[m]
+        st.a[d] = sa
