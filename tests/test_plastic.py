@@ -58,6 +58,23 @@ def test_unloading_curve_is_thorntons(ratio):
     assert P.plastic_force(A, D_Y, d, m) == pytest.approx(want, rel=1e-9)
 
 
+def test_contact_yield_overlap_of_materials():
+    """delta_y of a contact from the softer body's Y: Thornton's delta_y for a known Y
+    (steel on PTFE: PTFE's), inf (Hertz) for an unknown one."""
+    from granplate.setup.materials import LIBRARY, Material, effective_modulus, softer_yield_strength
+
+    steel, ptfe = LIBRARY["steel"], LIBRARY["ptfe"]
+    e_star = effective_modulus(steel, ptfe)
+    y = softer_yield_strength(steel, ptfe)
+    assert y == ptfe.Y and softer_yield_strength(steel, None) == steel.Y
+    want = (math.pi * 1.6 * ptfe.Y / (2.0 * e_star)) ** 2 * R_STAR
+    assert P.contact_yield_overlap(e_star, R_STAR, y) == pytest.approx(want, rel=1e-14)
+    glass = Material("glass", 63e9, 0.23, 2500.0)
+    assert softer_yield_strength(steel, glass) is None
+    assert P.contact_yield_overlap(e_star, R_STAR, None) == math.inf
+    assert P.contact_yield_overlap(e_star, R_STAR, math.inf) == math.inf
+
+
 def test_infinite_yield_strength_is_hertz():
     """Y -> infinity (delta_y above every overlap, or inf) gives Hertz's A delta^(3/2) and
     2/5 A delta^(5/2) to round-off (bitwise for delta_y = inf), with no plastic work."""
@@ -127,6 +144,9 @@ def test_slope_matches_finite_differences(ratio):
             num = fd(lambda x: P.plastic_force(A, D_Y, x, m), d, h)
         got = P.plastic_force_slope(A, D_Y, d, m)
         assert got == pytest.approx(num, rel=1e-6, abs=1e-9 * P.plastic_stiffness(A, D_Y))
+        force, slope = P.plastic_response(A, D_Y, d, m)  # the one-call form: the same values
+        assert force == pytest.approx(P.plastic_force(A, D_Y, d, m), rel=1e-14, abs=0.0)
+        assert slope == pytest.approx(got, rel=1e-14, abs=0.0)
 
 
 @pytest.mark.parametrize("ratio", [1.01, 2.0, 25.0, 1000.0])

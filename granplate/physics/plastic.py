@@ -61,6 +61,15 @@ def yield_overlap(e_star: float, r_star: float, p_y: float) -> float:
     return q * q * r_star
 
 
+def contact_yield_overlap(e_star: float, r_star: float, y_strength: float | None) -> float:
+    """delta_y [m] (P3 with P1) of a contact whose softer body has yield strength Y [Pa]
+    (`setup.materials.softer_yield_strength`); inf when Y is unknown (None) or infinite:
+    the law is then Hertz's. Plain Python: for building a contact's coefficients."""
+    if y_strength is None or math.isinf(y_strength):
+        return math.inf
+    return yield_overlap(e_star, r_star, limiting_pressure(y_strength))
+
+
 @njit(cache=True)
 def yield_force(a: float, delta_y: float) -> float:
     """F_y = A delta_y^(3/2) = pi^3 p_y^3 R*^2 / (6 E*^2) [N] (P4)."""
@@ -159,6 +168,27 @@ def plastic_force_slope(a: float, delta_y: float, delta: float, delta_max: float
     if d <= 0.0:
         return 0.0
     return 1.5 * loading_force(a, delta_y, m) * math.sqrt(d) / (w * math.sqrt(w))
+
+
+@njit(cache=True)
+def plastic_response(a: float, delta_y: float, delta: float, delta_max: float):
+    """(F [N], dF/d delta [N/m]) of `plastic_force` and `plastic_force_slope` in one call,
+    the unloading curve computed once (what a contact loop needs per evaluation)."""
+    m = updated_max_overlap(delta, delta_max)
+    if m <= delta_y:
+        if delta <= 0.0:
+            return 0.0, 0.0
+        sq = math.sqrt(delta)
+        return a * delta * sq, 1.5 * a * sq
+    if delta >= m:
+        return loading_force(a, delta_y, delta), plastic_stiffness(a, delta_y)
+    w = unloading_span(delta_y, m)
+    d = delta - (m - w)
+    if d <= 0.0:
+        return 0.0, 0.0
+    scale = loading_force(a, delta_y, m) / (w * math.sqrt(w))
+    sq = math.sqrt(d)
+    return scale * d * sq, 1.5 * scale * sq
 
 
 @njit(cache=True)
