@@ -19,6 +19,11 @@ residual overlap delta_p (P7), continuous with the loading curve at delta_max (P
 stored elastic energy (P9) plus the plastic work W_p(delta_max) (P10) equal the work done
 on the contact along any path. Nothing here knows the dimension: the same functions serve
 a contact in the plane or in space.
+
+A contact loop calls `plastic_response` (force and slope in one call) with the history of
+the contact, then `updated_max_overlap` once the state is accepted; the energy bookkeeping
+uses `plastic_elastic_energy` (stored, part of E_granular) and `plastic_work`
+(dissipated). `contact_yield_overlap` gives delta_y from E*, R* and the softer body's Y.
 """
 from __future__ import annotations
 
