@@ -36,7 +36,9 @@ def _granules(*gs, walls=()):
     return lambda: validate(_two_spheres(granules=gs, walls=walls))
 
 
-def _toml(text):
+def _toml(text, validated=False):
+    if validated:
+        return lambda: validate(scenario_io.loads(text))
     return lambda: scenario_io.loads(text)
 
 
@@ -67,6 +69,17 @@ BAD = [
     ("missing field", _toml('[[granules]]\nx = 0\ny = 0\nradius = 0.01\nmaterial = "steel"\n'
                             '[[granules]]\nx = 0\ny = 0.1\nmaterial = "steel"\n'),
      "granules[1].radius", "missing required field 'granules[1].radius'"),
+    ("zero yield strength", _with({"materials.ptfe.Y": 0.0}), "materials.ptfe.Y", "must be > 0"),
+    ("negative yield strength", _with({"materials.steel.Y": -355e6}), "materials.steel.Y",
+     "must be > 0"),
+    ("NaN yield strength", _toml("[materials.wood]\nE = 1e10\nnu = 0.3\nrho = 600\nY = nan\n"
+                                 "[[granules]]\nx = 0\ny = 0\nradius = 0.01\nmaterial = \"wood\"\n"
+                                 "[load]\nkind = \"none\"\n", validated=True),
+     "materials.wood.Y", "must be > 0 (a finite number)"),
+    ("infinite yield strength", _with({"materials.steel.Y": math.inf}), "materials.steel.Y",
+     "must be > 0 (a finite number)"),
+    ("text yield strength", _toml('[materials.steel]\nE = 2e11\nnu = 0.3\nrho = 7850\nY = "hard"\n'),
+     "materials.steel.Y", "wrong type: expected a number"),
     ("missing material key", _toml("[materials.wood]\nE = 1e10\nnu = 0.3\n"),
      "materials.wood.rho", "missing required field"),
     ("wrong type string", _toml('[load]\nq0 = "strong"\n'), "load.q0",
@@ -78,7 +91,7 @@ BAD = [
     ("negative t_end", _with({"time.t_end": -1e-3}), "time.t_end", "must be > 0"),
     ("infinite t_end", _with({"time.t_end": math.inf}), "time.t_end", "must be > 0"),
     ("unknown material", _with({"layout.intruder_material": "wood"}),
-     "layout.intruder_material", "unknown material; defined materials are: ptfe, steel"),
+     "layout.intruder_material", "unknown material; defined materials are: bearing_steel, ptfe, steel"),
     ("unknown granule material",
      _granules(Granule(0, 0, 0.01, "wood", "a"), Granule(1, 0, 0.01, STEEL, "b")),
      "granules[0].material", "unknown material"),
@@ -234,6 +247,20 @@ def test_user_material_overrides_library():
                           "[materials.glass]\nE = 6.3e10\nnu = 0.23\nrho = 2500\n")
     assert s.material("steel") == Material("steel", 2.1e11, 0.29, 7800.0)
     assert s.material("glass").rho == 2500.0 and s.material("ptfe") == LIBRARY["ptfe"]
+
+
+def test_yield_strength_is_optional_and_round_trips():
+    """Y is read, written back by dumps (a preset's TOML round-trips it), absent means
+    unknown (None), and the library's materials carry their documented Y."""
+    s = scenario_io.loads("[materials.glass]\nE = 6.3e10\nnu = 0.23\nrho = 2500\n"
+                          "[materials.wood]\nE = 1e10\nnu = 0.3\nrho = 600\nY = 4e7\n")
+    assert s.material("glass").Y is None and s.material("wood").Y == 4e7
+    assert scenario_io.loads(scenario_io.dumps(s, all_materials=True)) == s
+    text = scenario_io.dumps(preset("ptfe-r05"))
+    assert "Y = 11000000.0" in text and "Y = 355000000.0" in text
+    assert scenario_io.loads(text) == preset("ptfe-r05")
+    assert (LIBRARY["steel"].Y, LIBRARY["bearing_steel"].Y, LIBRARY["ptfe"].Y) == (355e6, 2.0e9, 11e6)
+    assert dataclasses.replace(LIBRARY["bearing_steel"], name="steel", Y=355e6) == LIBRARY["steel"]
 
 
 def test_schemes_constant():

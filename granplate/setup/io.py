@@ -35,8 +35,9 @@ REQUIRED: dict[type, tuple[str, ...]] = {
     Wall: ("normal", "offset"),
     PairCoefficients: ("materials",),
 }
-#: Keys of a [materials.NAME] table (all required).
-MATERIAL_KEYS: tuple[str, ...] = ("E", "nu", "rho")
+#: Keys of a [materials.NAME] table: E, nu, rho required; Y optional (absent: unknown).
+MATERIAL_KEYS: tuple[str, ...] = ("E", "nu", "rho", "Y")
+MATERIAL_REQUIRED: tuple[str, ...] = ("E", "nu", "rho")
 
 
 class _Missing:
@@ -155,12 +156,14 @@ def _materials(d: Any) -> dict[str, Material]:
     for name, t in d.items():
         p = f"materials.{name}"
         if not isinstance(t, dict):
-            raise ScenarioError(p, t, "wrong type: expected a table with E, nu, rho")
+            raise ScenarioError(p, t, "wrong type: expected a table with E, nu, rho (and optionally Y)")
         _check_keys(p, t, list(MATERIAL_KEYS))
         vals = {}
         for k in MATERIAL_KEYS:
             if t.get(k) is None:
-                raise ScenarioError(f"{p}.{k}", MISSING, f"missing required field '{p}.{k}'")
+                if k in MATERIAL_REQUIRED:
+                    raise ScenarioError(f"{p}.{k}", MISSING, f"missing required field '{p}.{k}'")
+                continue
             vals[k] = _convert(f"{p}.{k}", t[k], float)
         out[str(name)] = Material(str(name), **vals)
     return out
@@ -258,7 +261,10 @@ def _layout_dict(layout: Any) -> dict:
 
 
 def _material_dict(m: Material) -> dict[str, float]:
-    return {"E": float(m.E), "nu": float(m.nu), "rho": float(m.rho)}
+    d = {"E": float(m.E), "nu": float(m.nu), "rho": float(m.rho)}
+    if m.Y is not None:
+        d["Y"] = float(m.Y)
+    return d
 
 
 def to_dict(s: Scenario, all_materials: bool = False) -> dict:
@@ -477,4 +483,4 @@ def with_changes(s: Scenario, changes: dict[str, object]) -> Scenario:
 
 
 __all__ = ["from_dict", "to_dict", "loads", "load", "dumps", "dump", "load_scenario",
-           "with_changes", "describe_changes", "CHANGED", "UNLISTED", "REQUIRED", "MATERIAL_KEYS", "MISSING"]
+           "with_changes", "describe_changes", "CHANGED", "UNLISTED", "REQUIRED", "MATERIAL_KEYS", "MATERIAL_REQUIRED", "MISSING"]

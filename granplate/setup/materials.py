@@ -9,13 +9,16 @@ from dataclasses import dataclass
 class Material:
     """An isotropic linear-elastic material.
 
-    E: Young's modulus [Pa]; nu: Poisson ratio [-]; rho: density [kg/m^3].
+    E: Young's modulus [Pa]; nu: Poisson ratio [-]; rho: density [kg/m^3];
+    Y: yield strength [Pa] (None: unknown). Y enters no elastic law: it says where Hertz
+    stops holding (the onset of yield, docs/model.md section 3.6).
     """
 
     name: str
     E: float
     nu: float
     rho: float
+    Y: float | None = None
 
     @property
     def plane_modulus(self) -> float:
@@ -23,10 +26,20 @@ class Material:
         return self.E / (1.0 - self.nu**2)
 
 
-#: Built-in material library (docs/model.md section 2).
+#: Built-in material library (docs/model.md section 2). The paper gives E, nu and rho but
+#: no grade; the yield strengths are those of the grades stated here:
+#: - steel: a structural steel, EN 10025-2 S355 (minimum yield strength 355 MPa,
+#:   thickness up to 16 mm);
+#: - bearing_steel: a through-hardened bearing steel, AISI 52100 / 100Cr6 at about
+#:   60 HRC (yield strength about 2.0 GPa, ASM Handbook vol. 1), with the elastic
+#:   constants and density of `steel` (within the grade's handbook range) so that the
+#:   two differ in Y alone;
+#: - ptfe: unfilled PTFE, compressive yield stress at room temperature and quasi-static
+#:   rate about 11 MPa (Rae & Dattelbaum 2004, Polymer 45, 7615).
 LIBRARY: dict[str, Material] = {
-    "steel": Material("steel", E=200e9, nu=0.30, rho=7850.0),
-    "ptfe": Material("ptfe", E=0.54e9, nu=0.42, rho=2150.0),
+    "steel": Material("steel", E=200e9, nu=0.30, rho=7850.0, Y=355e6),
+    "bearing_steel": Material("bearing_steel", E=200e9, nu=0.30, rho=7850.0, Y=2.0e9),
+    "ptfe": Material("ptfe", E=0.54e9, nu=0.42, rho=2150.0, Y=11e6),
 }
 
 
@@ -36,6 +49,17 @@ def effective_modulus(a: Material, b: Material | None) -> float:
     if b is not None:
         inv += (1.0 - b.nu**2) / b.E
     return 1.0 / inv
+
+
+def softer_yield_strength(a: Material, b: Material | None) -> float | None:
+    """Y of the body that yields first at a contact of a and b [Pa]: min(Y_a, Y_b);
+    b = None is a rigid body (wall, rigid layer), which never yields: Y_a. None when a
+    Y that matters is unknown."""
+    if b is None:
+        return a.Y
+    if a.Y is None or b.Y is None:
+        return None
+    return min(a.Y, b.Y)
 
 
 def sphere_mass(radius: float, rho: float) -> float:

@@ -65,6 +65,8 @@ def _check_materials(s: Scenario) -> None:
         if not -1.0 < m.nu < 0.5:
             raise ScenarioError(f"{p}.nu", m.nu, "must be in (-1, 0.5)")
         positive(f"{p}.rho", m.rho)
+        if m.Y is not None:  # the yield strength is optional (None: unknown)
+            positive(f"{p}.Y", m.Y)
 
 
 def _check_layout(s: Scenario) -> None:
