@@ -11,13 +11,5 @@
 """
 from __future__ import annotations
 
-
-def __getattr__(name: str):
-    # the CLI imports this package to register `sweep`: Dask and xarray load on first use
-    if name in ("Study", "load_study", "parse_study"):
-        from granplate.study import spec
-        return getattr(spec, name)
-    if name in ("SweepReport", "sweep"):
-        from granplate.study import sweep as sweep_module
-        return getattr(sweep_module, name)
-    raise AttributeError(f"module 'granplate.study' has no attribute {name!r}")
+from granplate.study.spec import Study, load_study, parse_study  # noqa: F401
+from granplate.study.sweep import SweepReport, sweep  # noqa: F401

@@ -52,11 +52,11 @@ def warm_workers(client, scenario_toml: str) -> float:
     return engine.warm_workers(client, [scenario_toml])
 
 
-def progress_bar(total: int, initial: int, enabled: bool):
-    """A tqdm bar with ETA on stderr."""
+def progress_bar(total: int, initial: int, enabled: bool, desc: str = "sweep", unit: str = "design"):
+    """A tqdm bar with ETA on stderr, labelled `desc`, counting `unit`s."""
     from tqdm import tqdm
 
-    return tqdm(total=total, initial=initial, desc="sweep", unit="design", file=sys.stderr,
+    return tqdm(total=total, initial=initial, desc=desc, unit=unit, file=sys.stderr,
                 disable=not enabled, dynamic_ncols=True)
 
 
