@@ -188,8 +188,6 @@ def design_result(folder: Path, key: str, progress: bool = False):
 def design_figures(folder: Path, key: str, progress: bool = False) -> list[tuple[str, Path]]:
     """(caption, PNG) of a chosen design: its assembly, energies and plate stress, drawn
     once (kept in DIR/report/ and reused by the next report)."""
-    from granplate.figures import assembly, run, show
-
     fig_dir = folder / FIGURES
     stem = f"design-{key[:12]}"
     names = ("assembly",) + DESIGN_FIGURES
@@ -199,6 +197,8 @@ def design_figures(folder: Path, key: str, progress: bool = False) -> list[tuple
     ds = design_result(folder, key, progress)
     if ds is None:
         return []
+    from granplate.figures import assembly, run, show
+
     made = [("assembly", _save(show.draw(assembly.of_scenario(gp.loads(ds.attrs["scenario_toml"])), width=5.0),
                                fig_dir / f"{stem}-assembly.png"))]
     for name, fig in run.figures(ds).items():
