@@ -30,9 +30,10 @@ from granplate.solver.schemes import scheme
 CHUNK_SECONDS = 0.15
 FIRST_BUDGET = 64
 #: About how long [s] compiling the time loop of each scheme takes when numba's cache
-#: does not hold it (the first run after installing; measured on 2 cores, see
-#: docs/benchmarks.md): the first scheme compiles the shared callees too.
-COMPILE_SECONDS = {"implicit": 75, "paper": 40}
+#: does not hold it (the first run after installing; docs/benchmarks.md, "Compiling the
+#: kernels"): implicit 73 s on 2 idle cores (97 s of CPU time on a loaded machine); paper
+#: 26 s of CPU time once the callees it shares with implicit are cached.
+COMPILE_SECONDS = {"implicit": 75, "paper": 25}
 
 log = logging.getLogger(__name__)
 #: step attempts without the clock moving after which a run is stopped (every retry
