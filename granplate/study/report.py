@@ -447,6 +447,6 @@ def write_report(folder: str | Path, progress: bool = False) -> Path:
     text = to_html(blocks, out.folder)
     if not (fresh and page.read_text() == text):
         atomic_write(page, lambda tmp: tmp.write_text(text))
-    (out.folder / FIGURES).mkdir(parents=True, exist_ok=True)
-    atomic_write(out.folder / FIGURES / INPUTS_FILE, lambda tmp: tmp.write_text(digest + "\n"))
+    if not fresh:
+        atomic_write(out.folder / FIGURES / INPUTS_FILE, lambda tmp: tmp.write_text(digest + "\n"))
     return page
