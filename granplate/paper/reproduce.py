@@ -260,7 +260,8 @@ def reproduce(
         if to_run or products:
             own = client is None
             if own:
-                progress.note(f"starting {'the cluster at ' + scheduler if scheduler else f'{n_workers} local Dask workers'}")
+                progress.note(f"connecting to the cluster at {scheduler}" if scheduler
+                              else f"starting {n_workers} local Dask workers")
             with (engine.dask_client(n_workers, scheduler) if own else nullcontext(client)) as c:
                 if to_run:
                     progress.note("warming the workers up (compiling the kernels where they are not cached "
