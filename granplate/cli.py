@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import logging
 import sys
 from pathlib import Path
 
@@ -180,8 +181,25 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+class _StderrLines(logging.Handler):
+    """The library's log lines on stderr (the stream of the moment), `granplate: ...`."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        print(f"granplate: {record.getMessage()}", file=sys.stderr, flush=True)
+
+
+def show_notes(quiet: bool) -> None:
+    """Print what the library announces (compiling the time loop, building a plate: INFO
+    lines of the "granplate" logger) on stderr; with quiet, only its warnings."""
+    logger = logging.getLogger("granplate")
+    if not any(isinstance(h, _StderrLines) for h in logger.handlers):
+        logger.addHandler(_StderrLines())
+    logger.setLevel(logging.WARNING if quiet else logging.INFO)
+
+
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    show_notes(bool(getattr(args, "quiet", False)))
     if getattr(args, "t_end", None) is not None and not args.t_end > 0:
         print(f"granplate: error: --t-end = {args.t_end!r}: must be > 0 (seconds)", file=sys.stderr)
         return 2

@@ -174,3 +174,28 @@ def test_cache_info_and_clear(tmp_path, monkeypatch, capsys):
     assert "removed 1 entries" in capsys.readouterr().out
     assert main(["cache", "info"]) == 0
     assert "plate" not in capsys.readouterr().out.split("total")[0].split("MiB")[-1]
+
+
+#: Modules only some subcommands need: none may load to parse the command line.
+HEAVY_MODULES = ("matplotlib", "dask", "distributed", "optuna")
+
+
+@pytest.mark.parametrize("code", [
+    "import granplate",
+    "import granplate.cli",
+    "import granplate.cli, contextlib, io\n"
+    "with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):\n"
+    "    granplate.cli.main(['--help'])",
+])
+def test_start_up_imports_no_heavy_module(code):
+    """Truth: a fresh interpreter's sys.modules after `import granplate`, `import
+    granplate.cli` and `granplate --help` holds none of matplotlib, dask, distributed, optuna."""
+    import subprocess
+    import sys
+
+    probe = code + "\nimport sys\nprint(' '.join(m for m in sys.modules if m.split('.')[0] in %r))" % (
+        HEAVY_MODULES,)
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    loaded = done.stdout.strip().splitlines()[-1] if done.stdout.strip() else ""
+    assert loaded == "", f"loaded at start-up: {loaded}"

@@ -18,7 +18,7 @@ from granplate.errors import ScenarioError
 from granplate.study import design as D
 from granplate.study import plots as P
 from granplate.study.outcome import read_outcome
-from granplate.study.report import FIGURES, PAGE, best_designs, pareto_front, target_designs, write_report
+from granplate.study.report import FIGURES, INPUTS_FILE, PAGE, best_designs, pareto_front, target_designs, write_report
 from granplate.study.spec import parse_study
 from granplate.study.sweep import write_table
 from granplate.study.targets import judge, parse_report_table
@@ -177,7 +177,7 @@ def test_cli_writes_the_report_at_the_end_of_a_tiny_real_sweep(tmp_path, capsys)
     (tmp_path / "s.toml").write_text('base = "ptfe-r05"\n[set]\n"time.t_end" = 2e-5\n'
                                      '[parameters]\n"load.q0" = [-1.0, 2e4]\n"layout.R2_ratio" = [0.5, 1.0]\n')
     out = tmp_path / "out"
-    assert main(["sweep", str(tmp_path / "s.toml"), "--out", str(out), "--workers", "1", "-q"]) == 0
+    assert main(["sweep", str(tmp_path / "s.toml"), "--out", str(out), "--workers", "1", "-q"]) == 1
     assert f"report: {out / PAGE}" in capsys.readouterr().out
     page = (out / PAGE).read_text()
     assert (out / "study.toml").read_text() == (tmp_path / "s.toml").read_text()
@@ -188,6 +188,32 @@ def test_cli_writes_the_report_at_the_end_of_a_tiny_real_sweep(tmp_path, capsys)
     # the report again, from the folder alone
     assert main(["study", "report", str(out), "-q"]) == 0
     assert (out / PAGE).read_text().count("<figure>") == page.count("<figure>")
+    # the sweep again: nothing to compute, no cluster, nothing redrawn
+    drawn = {p: p.stat().st_mtime_ns for p in [out / PAGE, *(out / FIGURES).glob("*.png")]}
+    assert main(["sweep", str(tmp_path / "s.toml"), "--out", str(out), "--workers", "1", "-q"]) == 1
+    assert "computed: 0," in capsys.readouterr().out
+    assert {p: p.stat().st_mtime_ns for p in drawn} == drawn
+
+
+def test_report_redraws_only_when_its_inputs_change(tmp_path):
+    """Truth: the figures' files are kept (same mtimes) by a second report of the same
+    folder, and drawn again once a design's metrics change (the hash beside them too)."""
+    synthetic(tmp_path)
+    write_report(tmp_path)
+    figures = sorted((tmp_path / FIGURES).glob("*.png"))
+    assert figures
+    before = {p: p.stat().st_mtime_ns for p in figures}
+    digest = (tmp_path / FIGURES / INPUTS_FILE).read_text()
+    write_report(tmp_path)
+    assert {p: p.stat().st_mtime_ns for p in figures} == before
+    # design 0's metrics change: its record is written again with another value
+    record = D.read_record(tmp_path, read_outcome(tmp_path).rows[0].key)
+    record["summary"]["ep_max_fraction"] *= 2.0
+    D.write_record(tmp_path, record)
+    write_report(tmp_path)
+    assert (tmp_path / FIGURES / INPUTS_FILE).read_text() != digest
+    metric = tmp_path / FIGURES / "metric-ep_max_fraction.png"
+    assert metric.stat().st_mtime_ns != before[metric]
 
 
 def test_report_of_a_folder_without_a_study_is_a_clear_error(tmp_path, capsys):

@@ -253,3 +253,29 @@ def test_a_killed_worker_loses_no_design(tmp_path):
     xr.testing.assert_identical(comparable(table(tmp_path / "a" / "results.nc")),
                                 comparable(table(tmp_path / "b" / "results.nc")))
     assert undisturbed.n_computed == 12
+
+
+def test_cli_sweep_with_a_failing_design_exits_1_and_says_how_many(client, tmp_path, capsys):
+    """Truth: of two designs one has a negative load (refused when it runs): the sweep
+    exits 1 and its last line says 1 of 2 designs failed."""
+    (tmp_path / "s.toml").write_text('base = "ptfe-r05"\n[set]\n"time.t_end" = 1e-5\n'
+                                     '[parameters]\n"load.q0" = [1e4, -1.0]\n')
+    rc = main(["sweep", str(tmp_path / "s.toml"), "--out", str(tmp_path / "o"),
+               "--scheduler", client.scheduler.address, "-q", "--no-report"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 1
+    assert err[-1] == "granplate: 1 of 2 designs failed"
+
+
+def test_cli_optimize_with_failing_trials_exits_1_and_labels_its_bar(client, tmp_path, capsys):
+    """Truth: every trial's design has a negative load, so both trials fail: optimize exits
+    1, its last line says 2 of 2 trials failed, and its progress bar reads "optimize"."""
+    (tmp_path / "o.toml").write_text('base = "ptfe-r05"\n[set]\n"time.t_end" = 1e-5\n'
+                                     '[parameters]\n"load.q0" = [-1.0, -2.0]\n'
+                                     '[objectives]\n"ep_max_fraction" = "minimize"\n')
+    rc = main(["optimize", str(tmp_path / "o.toml"), "--out", str(tmp_path / "o"), "--trials", "2",
+               "--scheduler", client.scheduler.address, "--no-report"])
+    err = capsys.readouterr().err
+    assert rc == 1
+    assert err.strip().splitlines()[-1] == "granplate: 2 of 2 trials of this run failed"
+    assert "optimize:" in err and "sweep:" not in err

@@ -2,10 +2,11 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import xarray as xr
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
+if TYPE_CHECKING:  # matplotlib and xarray load when a figure is drawn, not when the CLI starts
+    import xarray as xr
+    from matplotlib.figure import Figure
 
 #: Resolution of the PNG files [dots per inch].
 PNG_DPI = 150
@@ -17,6 +18,9 @@ OTHER_COLOURS = ("#7fc97f", "#beaed4", "#fdc086", "#f0027f", "#bf5b17", "#66a61e
 
 def new_figure(width: float, height: float) -> Figure:
     """A Figure [inches] on the Agg canvas with constrained layout."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
     fig = Figure(figsize=(width, height), layout="constrained")
     FigureCanvasAgg(fig)
     return fig

@@ -259,9 +259,15 @@ def reproduce(
     try:
         if to_run or products:
             own = client is None
+            if own:
+                progress.note(f"connecting to the cluster at {scheduler}" if scheduler
+                              else f"starting {n_workers} local Dask workers")
             with (engine.dask_client(n_workers, scheduler) if own else nullcontext(client)) as c:
                 if to_run:
-                    engine.warm_workers(c, warm_up_scenarios(to_run))
+                    progress.note("warming the workers up (compiling the kernels where they are not cached "
+                                  "yet, building the plates)")
+                    seconds = engine.warm_workers(c, warm_up_scenarios(to_run))
+                    progress.note(f"workers warm after {seconds:.1f} s; running {len(to_run)} runs")
                 Driver(c, outcome, products, available, progress, frames).run(to_run)
     finally:
         progress.close()

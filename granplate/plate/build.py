@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import logging
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable, Sequence
 
@@ -54,10 +55,28 @@ from granplate.plate.stress import (
     von_mises_plane_stress,
 )
 from granplate.setup.materials import LIBRARY, Material
-from granplate.setup.plate_cost import DEFAULT_MAX_FREQUENCY, basis_kind, check_fits, truncation_supported
+from granplate.setup.plate_cost import (DEFAULT_MAX_FREQUENCY, basis_kind, build_estimate, check_fits,
+                                        truncation_supported)
 
 if TYPE_CHECKING:  # pragma: no cover
     from granplate.setup.scenario import Plate
+
+log = logging.getLogger(__name__)
+#: A plate build estimated to take at least this long [s] is announced (log, INFO).
+NOTE_BUILD_SECONDS = 2.0
+
+
+def build_note(plate: "Plate", kind: str, n_red: int, n_face: int) -> str | None:
+    """The line announcing a plate build estimated (setup.plate_cost) to take at least
+    NOTE_BUILD_SECONDS; None for a quicker one."""
+    seconds = build_estimate(kind, n_red, n_face)[1]
+    if seconds < NOTE_BUILD_SECONDS:
+        return None
+    what = (f"all {n_red} modes (dense)" if kind == "all" else
+            f"modes below {plate.max_frequency or DEFAULT_MAX_FREQUENCY:.3g} Hz and the static correction "
+            f"({n_red} dofs)")
+    return f"building the {plate.nx} x {plate.ny} plate: {what} (about {seconds:.0f} s; cached afterwards) ..."
+
 
 #: The run store's kind of the plate's cached arrays.
 STORE_KIND = "plate"
@@ -492,6 +511,9 @@ def build_plate(
 
     def compute() -> dict[str, np.ndarray]:
         check_fits(kind, n_red, getattr(plate, "modes", "all"), n_face=len(face))
+        note = build_note(plate, kind, n_red, len(face))
+        if note is not None:
+            log.info(note)
         return _compute_arrays(basis, mesh, D, material, plate, x0, T, edge_load, kind, drive_dofs, face)
 
     arrays = _stored_or_computed(

@@ -14,7 +14,6 @@ import numpy as np
 import xarray as xr
 
 from granplate.version import __version__
-from granplate.plate.stress import plane_stresses, von_mises_plane_stress
 from granplate.solver import state as K
 
 #: name -> (units, description) of every data variable
@@ -73,6 +72,8 @@ def plate_maxima(plate, qf: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndar
     (docs/model.md section 4.4) and largest |eps_yy| [-] over the plate's Gauss points at
     each output time, from qf (time, n_modes [+ 2 n_contacts forces of a truncated
     basis]); the strains are computed once for all three."""
+    from granplate.plate.stress import plane_stresses, von_mises_plane_stress  # numba: on first use
+
     def maxima(c):
         q, force = c[:, :plate.n_modes], (c[:, plate.n_modes:] if c.shape[1] > plate.n_modes else None)
         exx, eyy, gxy = plate.strains(q, force)

@@ -5,6 +5,7 @@ when the steps have collapsed), and return a plain record of the output buffers.
 """
 from __future__ import annotations
 
+import logging
 import math
 import signal
 import threading
@@ -28,6 +29,13 @@ from granplate.solver.schemes import scheme
 #: wall-time target of one compiled chunk [s], and the step budget of the first one.
 CHUNK_SECONDS = 0.15
 FIRST_BUDGET = 64
+#: About how long [s] compiling the time loop of each scheme takes when numba's cache
+#: does not hold it (the first run after installing; docs/benchmarks.md, "Compiling the
+#: kernels"): implicit 73 s on 2 idle cores (97 s of CPU time on a loaded machine); paper
+#: 26 s of CPU time once the callees it shares with implicit are cached.
+COMPILE_SECONDS = {"implicit": 75, "paper": 25}
+
+log = logging.getLogger(__name__)
 #: step attempts without the clock moving after which a run is stopped (every retry
 #: goes one ladder level deeper, so a run that still advances never needs more)
 STALL_ATTEMPTS = 2 * S.N_LEVELS
@@ -404,6 +412,31 @@ def _loop_chunks(times, model, arr: LoopArrays, should_stop, on_progress, lists)
     return _refresh(lists, arr.st, arr.w)
 
 
+def is_compiled(dispatcher, args: tuple) -> bool:
+    """Whether numba holds `dispatcher` compiled for these arguments' types, in memory or
+    in its on-disk cache (an entry for this source and signature in the cache's index);
+    True when numba's cache cannot be asked (then nothing is said about compiling)."""
+    try:
+        sig = tuple(dispatcher.typeof_pyval(a) for a in args)
+        if sig in dispatcher.overloads:
+            return True
+        cache = dispatcher._cache
+        return cache._index_key(sig, dispatcher.targetctx.codegen()) in cache._cache_file._load_index()
+    except Exception:  # noqa: BLE001 - numba's cache internals: an unknown layout says nothing
+        return True
+
+
+def note_compile(model: Model, calls: list[tuple]) -> bool:
+    """Log (INFO) that the time loop is about to be compiled when any of `calls`
+    ((dispatcher, args)) is not compiled yet; True when it is not."""
+    if all(is_compiled(f, args) for f, args in calls):
+        return False
+    name = model.scenario.solver.scheme
+    log.info(f"compiling the time loop for the {name} scheme (first run after install; about "
+             f"{COMPILE_SECONDS.get(name, 60)} s on 2 idle cores; cached afterwards) ...")
+    return True
+
+
 def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool] | None = None,
         interruptible: bool = True) -> RunRecord:
     """Run the time loop of `model` to its t_end.
@@ -423,6 +456,10 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
     if cfg.face_skin > 0.0:  # this run's own (patch contacts move their face)
         lists.g = lists.g._replace(pc_x=g.pc_x.copy())
     st.count[S.C_LEVEL] = level_for(model.scenario.time.dt_initial, cfg)
+    note_compile(model, [(loop.initialise, (st, lists.g, arr.p, cfg, w)),
+                         (loop.record, (0, st, lists.g, arr.p, w, arr.out)),
+                         (loop.advance, (float(times[-1]), FIRST_BUDGET, lists.g, arr.p, cfg, st, arr.w,
+                                         arr.sw, arr.out))])
     t1 = time.perf_counter()
     loop.initialise(st, lists.g, arr.p, cfg, w)
     loop.record(0, st, lists.g, arr.p, w, arr.out)

@@ -32,6 +32,16 @@ def _report(out: str, enabled: bool, progress: bool) -> None:
     print(f"report: {page}")
 
 
+def _verdict(n_failed: int, n_lost: int, n_total: int, what: str) -> int:
+    """The exit status of a study command, 1 when any design failed or was lost, 0 else;
+    that case is said on the last line (stderr)."""
+    if not n_failed and not n_lost:
+        return 0
+    lost = f" and {n_lost} lost (a rerun retries them)" if n_lost else ""
+    print(f"granplate: {n_failed} of {n_total} {what} failed{lost}", file=sys.stderr)
+    return 1
+
+
 def _cmd_sweep(args) -> int:
     from granplate.study.spec import load_study
     from granplate.study.sweep import RESULTS_CSV, RESULTS_NC, sweep
@@ -60,7 +70,7 @@ def _cmd_sweep(args) -> int:
         print(f"... and {len(report.lost) - MAX_LOST_LINES} more lost designs", file=sys.stderr)
     print(f"table: {report.out / RESULTS_NC}, {report.out / RESULTS_CSV}")
     _report(args.out, args.report, not args.quiet)
-    return 0 if not report.lost else 1
+    return _verdict(report.n_failed, len(report.lost), report.n_designs, "designs")
 
 
 def _cmd_optimize(args) -> int:
@@ -86,7 +96,7 @@ def _cmd_optimize(args) -> int:
     out = report.out
     print(f"study: {out / DATABASE}; trials: {out / TRIALS_CSV}; Pareto front: {out / PARETO_CSV}, {out / PARETO_PNG}")
     _report(args.out, args.report, not args.quiet)
-    return 0
+    return _verdict(report.n_failed, 0, args.trials - report.n_before, "trials of this run")
 
 
 def _cmd_report(args) -> int:

@@ -287,7 +287,7 @@ def _search(client, study, opt: Optimization, out: Path, trials: int, progress: 
     pending = as_completed()
     running: dict[Any, tuple[Any, str, str, dict]] = {}
     done = report.n_before
-    bar = progress_bar(trials, done, progress)
+    bar = progress_bar(trials, done, progress, desc="optimize", unit="trial")
 
     def finish(trial, record) -> None:
         nonlocal done

@@ -11,11 +11,15 @@ import itertools
 import math
 from typing import Any
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-from matplotlib.figure import Figure
 
 from granplate.figures.common import new_figure
 from granplate.study.outcome import StudyOutcome
+
+if TYPE_CHECKING:  # matplotlib loads when a figure is drawn
+    from matplotlib.figure import Figure
 
 #: Units shown scaled: unit -> (factor, shown unit).
 SHOWN_UNITS: dict[str, tuple[float, str]] = {"Pa": (1e-6, "MPa")}

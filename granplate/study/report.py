@@ -14,6 +14,8 @@ granplate.results.document, like the reproduction and verification pages.
 """
 from __future__ import annotations
 
+import dataclasses
+import hashlib
 import math
 import sys
 from pathlib import Path
@@ -31,6 +33,9 @@ from granplate.study.targets import judge
 #: The page and its figure folder inside the study's folder.
 PAGE = "report.html"
 FIGURES = "report"
+#: Beside the figures: the SHA-256 of the inputs they were drawn from (`inputs_hash`); a
+#: report of the same inputs keeps them and draws nothing.
+INPUTS_FILE = "inputs.sha256"
 #: Metrics of the heat maps and, without [objectives], those whose best design is drawn.
 HEADLINE: tuple[str, ...] = ("ep_max_fraction", "max_von_mises")
 #: Metrics that say how the run went rather than what the design does (figures last).
@@ -135,6 +140,29 @@ def _png(fig, tmp: Path) -> None:
     image.save(tmp, format="png", optimize=True)
 
 
+def inputs_hash(out: StudyOutcome) -> str:
+    """SHA-256 of everything the report's figures are drawn from: the granplate version
+    and the study as read back (every row's parameters, metrics and status, the study
+    file, the folder's name), so equal inputs give equal figures."""
+    text = repr((gp.__version__, dataclasses.replace(out, folder=Path(out.folder.name))))
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def stored_hash(fig_dir: Path) -> str:
+    """The inputs hash the figures in fig_dir were drawn from ("" when none is stored)."""
+    path = fig_dir / INPUTS_FILE
+    return path.read_text().strip() if path.is_file() else ""
+
+
+def _figure(path: Path, make, fresh: bool) -> Path | None:
+    """The figure at path: kept as it is when `fresh` (drawn from the same inputs) and
+    there, else drawn by make() (None: no such figure) and saved."""
+    if fresh and path.is_file():
+        return path
+    fig = make()
+    return None if fig is None else _save(fig, path)
+
+
 def _save(fig, path: Path) -> Path:
     from granplate.store import atomic_write
 
@@ -160,8 +188,6 @@ def design_result(folder: Path, key: str, progress: bool = False):
 def design_figures(folder: Path, key: str, progress: bool = False) -> list[tuple[str, Path]]:
     """(caption, PNG) of a chosen design: its assembly, energies and plate stress, drawn
     once (kept in DIR/report/ and reused by the next report)."""
-    from granplate.figures import assembly, run, show
-
     fig_dir = folder / FIGURES
     stem = f"design-{key[:12]}"
     names = ("assembly",) + DESIGN_FIGURES
@@ -171,6 +197,8 @@ def design_figures(folder: Path, key: str, progress: bool = False) -> list[tuple
     ds = design_result(folder, key, progress)
     if ds is None:
         return []
+    from granplate.figures import assembly, run, show
+
     made = [("assembly", _save(show.draw(assembly.of_scenario(gp.loads(ds.attrs["scenario_toml"])), width=5.0),
                                fig_dir / f"{stem}-assembly.png"))]
     for name, fig in run.figures(ds).items():
@@ -314,11 +342,14 @@ def _failures(out: StudyOutcome) -> list[Block]:
     return blocks
 
 
-def build_report(out: StudyOutcome, progress: bool = False) -> list[Block]:
-    """The report's blocks; its figures are written to DIR/report/ on the way."""
+def build_report(out: StudyOutcome, progress: bool = False, fresh: bool = False) -> list[Block]:
+    """The report's blocks; its figures are written to DIR/report/ on the way (fresh: the
+    figures there were drawn from these same inputs and are kept)."""
     fig_dir = out.folder / FIGURES
-    for stale in (*fig_dir.glob("metric-*.png"), *fig_dir.glob("heatmap-*.png"), fig_dir / "pareto-front.png"):
-        stale.unlink(missing_ok=True)  # drawn again below, or no longer part of the study
+    if not fresh:
+        (fig_dir / INPUTS_FILE).unlink(missing_ok=True)
+        for stale in (*fig_dir.glob("metric-*.png"), *fig_dir.glob("heatmap-*.png"), fig_dir / "pareto-front.png"):
+            stale.unlink(missing_ok=True)  # drawn again below, or no longer part of the study
     n_ok = sum(r.ok for r in out.rows)
     n_failed = sum(not r.ok and r.status != "not run" for r in out.rows)
     n_bad = sum(r.feasible is False for r in out.rows)
@@ -345,12 +376,11 @@ def build_report(out: StudyOutcome, progress: bool = False) -> list[Block]:
     blocks.append(_designs_table(out, drawn, chosen, front))
     if out.objectives:
         blocks.append(Block("h2", "Pareto front"))
-        fig = P.fig_pareto(out, front, chosen)
-        if fig is not None:
+        path = _figure(fig_dir / "pareto-front.png", lambda: P.fig_pareto(out, front, chosen), fresh)
+        if path is not None:
             blocks.append(Block("figure", "The trials and the Pareto front of the feasible ones"
                                           + (" (crosses: infeasible)" if out.constraints else "")
-                                          + "; axes in the objectives' units",
-                                path=_save(fig, fig_dir / "pareto-front.png")))
+                                          + "; axes in the objectives' units", path=path))
         first = same_design(out)
         on_front = list(dict.fromkeys(first[i] for i in front))
         blocks.append(Block("p", "On the front: " + (", ".join(
@@ -363,7 +393,7 @@ def build_report(out: StudyOutcome, progress: bool = False) -> list[Block]:
                                  + ", ".join(f"`{m}`" for m in left) + "."))
     for m in drawn:
         blocks.append(Block("figure", f"{m} [{P.shown(out.unit(m))[1]}] against each parameter",
-                            path=_save(P.fig_metric(out, m), fig_dir / f"metric-{m}.png")))
+                            path=_figure(fig_dir / f"metric-{m}.png", lambda: P.fig_metric(out, m), fresh)))
     heat = P.heat_axes(out)
     if heat is not None:
         blocks.append(Block("h2", "Heat maps"))
@@ -372,10 +402,10 @@ def build_report(out: StudyOutcome, progress: bool = False) -> list[Block]:
         targets = [m for t in out.report.targets for m in t.metrics]
         for m in dict.fromkeys(list(out.objectives) + list(HEADLINE) + targets):
             if m in drawn:
-                fig = P.fig_heatmap(out, m)
-                if fig is not None:
+                path = _figure(fig_dir / f"heatmap-{m}.png", lambda: P.fig_heatmap(out, m), fresh)
+                if path is not None:
                     blocks.append(Block("figure", f"{m} [{P.shown(out.unit(m))[1]}] over {heat[0]} and {heat[1]}",
-                                        path=_save(fig, fig_dir / f"heatmap-{m}.png")))
+                                        path=path))
     picks = chosen_designs(out, chosen)
     if picks:
         blocks.append(Block("h2", "Chosen designs"))
@@ -410,8 +440,13 @@ def write_report(folder: str | Path, progress: bool = False) -> Path:
     from granplate.store import atomic_write
 
     out = read_outcome(folder)
-    blocks = build_report(out, progress)
+    digest = inputs_hash(out)
     page = out.folder / PAGE
+    fresh = page.is_file() and stored_hash(out.folder / FIGURES) == digest
+    blocks = build_report(out, progress, fresh)
     text = to_html(blocks, out.folder)
-    atomic_write(page, lambda tmp: tmp.write_text(text))
+    if not (fresh and page.read_text() == text):
+        atomic_write(page, lambda tmp: tmp.write_text(text))
+    if not fresh:
+        atomic_write(out.folder / FIGURES / INPUTS_FILE, lambda tmp: tmp.write_text(digest + "\n"))
     return page

@@ -13,6 +13,8 @@ results.csv) is written at the end, and also when the sweep is interrupted.
 """
 from __future__ import annotations
 
+import hashlib
+import json
 import sys
 import time
 from contextlib import nullcontext
@@ -29,6 +31,8 @@ from granplate.study.spec import Study
 #: Table files inside a study's output folder.
 RESULTS_NC = "results.nc"
 RESULTS_CSV = "results.csv"
+#: Beside the table: the SHA-256 of what it was written from (`table_inputs_hash`).
+RESULTS_HASH = "results.sha256"
 
 
 @dataclass
@@ -52,23 +56,40 @@ def warm_workers(client, scenario_toml: str) -> float:
     return engine.warm_workers(client, [scenario_toml])
 
 
-def progress_bar(total: int, initial: int, enabled: bool):
-    """A tqdm bar with ETA on stderr."""
+def progress_bar(total: int, initial: int, enabled: bool, desc: str = "sweep", unit: str = "design"):
+    """A tqdm bar with ETA on stderr, labelled `desc`, counting `unit`s."""
     from tqdm import tqdm
 
-    return tqdm(total=total, initial=initial, desc="sweep", unit="design", file=sys.stderr,
+    return tqdm(total=total, initial=initial, desc=desc, unit=unit, file=sys.stderr,
                 disable=not enabled, dynamic_ncols=True)
 
 
+def table_inputs_hash(study: Study, keys: list[str], records: list, attrs: dict) -> str:
+    """SHA-256 of everything the table is written from: its attributes (the granplate
+    version among them), the parameters, the designs, their keys and records."""
+    text = json.dumps([attrs, list(study.names), study.designs, keys, records], sort_keys=True, default=repr)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
 def write_table(study: Study, out: Path, keys: list[str]) -> Path:
-    """Read every design's record and write results.nc and results.csv; the .nc path."""
+    """Read every design's record and write results.nc and results.csv (kept as they are
+    when written from the same inputs: `RESULTS_HASH`); the .nc path."""
+    from granplate.store import atomic_write
+
     records = [D.read_record(out, k) for k in keys]
     attrs = {"base": study.base_name, "fixed": T.attrs_json(study.fixed),
              "parameters": T.attrs_json(list(study.names)), "granplate_version": gp.__version__,
              "n_designs": len(keys), "n_ok": sum(1 for r in records if r and r["status"] == "ok")}
+    digest = table_inputs_hash(study, keys, records, attrs)
+    stored = out / RESULTS_HASH
+    if ((out / RESULTS_NC).is_file() and (out / RESULTS_CSV).is_file() and stored.is_file()
+            and stored.read_text().strip() == digest):
+        return out / RESULTS_NC
+    stored.unlink(missing_ok=True)
     ds = T.to_dataset(study.names, study.designs, keys, records, attrs)
     T.write_netcdf(ds, out / RESULTS_NC)
     T.write_csv(ds, out / RESULTS_CSV)
+    atomic_write(stored, lambda tmp: tmp.write_text(digest + "\n"))
     return out / RESULTS_NC
 
 
