@@ -241,7 +241,7 @@ def plate_mesh_convergence(ctx: Context) -> CaseResult:
             f"{WINDOW * 1e3:g} ms (the plate's energy and stress peak inside it) with the default basis "
             "(dense on 4 x 40, truncated above). Observed orders from three consecutive meshes, the last "
             "one giving the Richardson limit.")
-    notes = [f"Dropped modes' share of the bare-plate E_shock, upper bound: "
+    notes = ["Dropped modes' share of the bare-plate E_shock, upper bound: "
              + ", ".join(f"{nx} x {ny}: {b['tail_bound'] / b['e_shock']:.1e}" for (nx, ny), b in zip(MESHES, bare))
              + " (relative).",
              _stress_note([r["max_von_mises"] for r in steel], [r["max_von_mises_disc"] for r in steel])]
