@@ -387,7 +387,10 @@ def draw_force_gradient(p: dict):
 
 
 CASES: tuple[Case, ...] = (
-    Case("energy-residual", "conservation", "Energy residual of every preset", energy_residual, draw=draw_energy_residual),
-    Case("free-assembly", "conservation", "Momenta of a free assembly", free_assembly, draw=draw_free_assembly),
-    Case("force-gradient", "conservation", "Forces = minus the gradient of the contact energies", force_gradient, draw=draw_force_gradient),
+    Case("energy-residual", "conservation", "Energy residual of every preset", energy_residual,
+         draw=draw_energy_residual),
+    Case("free-assembly", "conservation", "Momenta of a free assembly", free_assembly,
+         draw=draw_free_assembly),
+    Case("force-gradient", "conservation", "Forces = minus the gradient of the contact energies", force_gradient,
+         draw=draw_force_gradient),
 )

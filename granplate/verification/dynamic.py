@@ -214,7 +214,7 @@ def gap_head_on(ctx: Context) -> CaseResult:
             "e = 1 without damping; with alpha_n = 0.05 the restitution and the contact time "
             "(until the overlap closes) come from the normalised damped-impact ODE.")
     return CaseResult.of(desc, checks, plot={"el": el, "dm": dm, "alpha": alpha, "tc_ref": tc_ref},
-                      notes=[f"Contact time: Hertz {tc_ref:.6e} s; damped (alpha_n = {alpha:g}) {tc_damped:.6e} s."])
+                         notes=[f"Contact time: Hertz {tc_ref:.6e} s; damped (alpha_n = {alpha:g}) {tc_damped:.6e} s."])
 
 
 def draw_gap_head_on(p: dict):
@@ -377,13 +377,17 @@ def wall_bounce(ctx: Context) -> CaseResult:
             "free flight must stay constant over all bounces; with alpha_n = 0.02 each impact "
             "multiplies the speed by the same e (the normalised ODE: e does not depend on the "
             "speed).")
-    return CaseResult.of(desc, checks, plot={"t": t, "ds": ds, "centre": centre, "dd": dd, "xd": xd, "alpha": alpha, "free": free, "k_imp": k_imp, "ratio": ratio, "e_ref": e_ref},
-                      notes=[f"Elastic: {len(ups)} passes, period {periods.mean():.9e} s vs {period_ref:.9e} s."])
+    plot = {"t": t, "ds": ds, "centre": centre, "dd": dd, "xd": xd,
+            "alpha": alpha, "free": free, "k_imp": k_imp, "ratio": ratio, "e_ref": e_ref}
+    return CaseResult.of(desc, checks, plot=plot,
+                         notes=[f"Elastic: {len(ups)} passes, period {periods.mean():.9e} s vs {period_ref:.9e} s."])
 
 
 def draw_wall_bounce(p: dict):
     """The figure of wall_bounce, from its numbers."""
-    t, ds, centre, dd, xd, alpha, free, k_imp, ratio, e_ref = p["t"], p["ds"], p["centre"], p["dd"], p["xd"], p["alpha"], p["free"], p["k_imp"], p["ratio"], p["e_ref"]
+    t, ds, centre, dd = p["t"], p["ds"], p["centre"], p["dd"]
+    xd, alpha, free, k_imp = p["xd"], p["alpha"], p["free"], p["k_imp"]
+    ratio, e_ref = p["ratio"], p["e_ref"]
     fig, axes = new_figure(ncols=2)
     ax = axes[0, 0]
     ax.plot(t * 1e3, (ds.x.values[:, 0] - centre) * 1e3, lw=0.8, label="elastic")
@@ -483,14 +487,15 @@ def loose_packing_case(ctx: Context) -> CaseResult:
             "solve_ivp (DOP853, rtol 1e-11, steps <= 1 µs) of the Hertz law over all pairs and all walls, "
             "written in this module from the equations (no neighbour list: every pair is tested "
             "at every evaluation).")
-    return CaseResult.of(desc, checks, plot={"n": n, "ds": ds, "ref": ref, "s": s, "r": r, "side": side, "t": t},
-                      notes=[f"{pairs_met} pairs touched; largest velocity error {vel_err * v_scale:.2e} m/s, "
-                             f"position error {pos_err:.2e} m.",
-                             "The comparison stops at 4 ms: a box of colliding spheres is a chaotic billiard, "
-                             "which amplifies any difference exponentially with the number of successive "
-                             "collisions (measured: the 16-granule box at 20 ms differs by 0.5 m/s, granplate "
-                             "keeping its energy balance to 1e-8), so a longer run compares the amplification, not the "
-                             "integrators."])
+    plot = {"n": n, "ds": ds, "ref": ref, "s": s, "r": r, "side": side, "t": t}
+    return CaseResult.of(desc, checks, plot=plot,
+                         notes=[f"{pairs_met} pairs touched; largest velocity error {vel_err * v_scale:.2e} m/s, "
+                                f"position error {pos_err:.2e} m.",
+                                "The comparison stops at 4 ms: a box of colliding spheres is a chaotic billiard, "
+                                "which amplifies any difference exponentially with the number of successive "
+                                "collisions (measured: the 16-granule box at 20 ms differs by 0.5 m/s, granplate "
+                                "keeping its energy balance to 1e-8), so a longer run compares the amplification, not the "
+                                "integrators."])
 
 
 def draw_loose_packing_case(p: dict):

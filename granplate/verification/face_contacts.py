@@ -122,7 +122,7 @@ def face_drop(ctx: Context) -> CaseResult:
             "plate) must not depend on where the nodes are, more so as the mesh is refined "
             f"(ny = {', '.join(map(str, meshes))}).")
     return CaseResult.of(desc, checks, plot={"stiff": stiff, "ref": ref, "meshes": meshes, "soft": soft},
-                      tables=[_table(soft, meshes)])
+                         tables=[_table(soft, meshes)])
 
 
 def draw_face_drop(p: dict):
@@ -201,5 +201,6 @@ def draw_face_slide(p: dict):
 CASES: tuple[Case, ...] = (
     Case("plate-face-drop", "coupled", "Patch contact: impact at a node and between nodes, stiff-plate Hertz limit",
          face_drop, draw=draw_face_drop),
-    Case("plate-face-slide", "coupled", "Patch contact: a granule sliding along the face under friction", face_slide, draw=draw_face_slide),
+    Case("plate-face-slide", "coupled", "Patch contact: a granule sliding along the face under friction", face_slide,
+         draw=draw_face_slide),
 )

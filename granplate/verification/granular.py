@@ -206,7 +206,8 @@ def chung_ooi_1(ctx: Context) -> CaseResult:
                         "order from two step sizes; the smooth part of the motion contributes "
                         "4th-order terms that shift the observed value by less than 0.2.", kind="abs"))
     checks.append(_elastic_restitution_check(glass, lime))
-    plot = {"runs": [("glass", glass), ("limestone", lime)], "title": "Chung & Ooi test 1: two spheres, 10 m/s each"}
+    plot = {"runs": [("glass", glass), ("limestone", lime)],
+            "title": "Chung & Ooi test 1: two spheres, 10 m/s each"}
     desc = ("Two identical spheres (R = 10 mm) meet head-on at 10 m/s each, no damping "
             "(`alpha_n = 0`): glass (E = 48 GPa, nu = 0.20, rho = 2800 kg/m^3) and limestone "
             "(E = 20 GPa, nu = 0.25, rho = 2500 kg/m^3), the materials of Chung & Ooi (2011, "
@@ -233,7 +234,8 @@ def chung_ooi_2(ctx: Context) -> CaseResult:
     mg = _impact_measure("chung-ooi-2-magnesium")
     checks = _impact_checks(al, "Al alloy") + _impact_checks(mg, "Mg alloy")
     checks.append(_elastic_restitution_check(al, mg))
-    plot = {"runs": [("Al alloy", al), ("Mg alloy", mg)], "title": "Chung & Ooi test 2: sphere on a rigid wall, 0.2 m/s"}
+    plot = {"runs": [("Al alloy", al), ("Mg alloy", mg)],
+            "title": "Chung & Ooi test 2: sphere on a rigid wall, 0.2 m/s"}
     desc = ("A sphere (R = 0.1 m) hits a rigid wall at 0.2 m/s, no damping: aluminium alloy "
             "(E = 70 GPa, nu = 0.33, rho = 2699 kg/m^3) and magnesium alloy (E = 45 GPa, "
             "nu = 0.35, rho = 1800 kg/m^3), Chung & Ooi (2011) test 2. Scenario files "
@@ -334,7 +336,8 @@ def chung_ooi_3(ctx: Context) -> CaseResult:
             "int gamma delta'^2 dt over the elastic collision = (2 pi alpha_n/sqrt 5) of the "
             "kinetic energy), and check that e does not change over two decades of impact "
             "speed (0.39-39 m/s).")
-    return CaseResult.of(desc, checks, plot={"alphas": alphas, "runs": runs, "speeds": speeds, "iron": iron}, notes=[
+    plot = {"alphas": alphas, "runs": runs, "speeds": speeds, "iron": iron}
+    return CaseResult.of(desc, checks, plot=plot, notes=[
         f"Second-order coefficient of the closed form (from the ODE): e - sqrt(1 - 2 pi alpha/sqrt 5) "
         f"= {c2:.3f} alpha^2 + O(alpha^3).",
         "With clipping (the default) the sphere leaves when the force reaches zero, before the "
@@ -436,12 +439,14 @@ def chung_ooi_4(ctx: Context) -> CaseResult:
         "the contact point), which this model does not have. The figure shows our points there "
         "for information only.",
     ]
-    return CaseResult.of(desc, checks, plot={"threshold": threshold, "mu": mu, "e_n": e_n, "radius": radius, "angles": angles, "runs": runs}, notes=notes)
+    plot = {"threshold": threshold, "mu": mu, "e_n": e_n, "radius": radius, "angles": angles, "runs": runs}
+    return CaseResult.of(desc, checks, plot=plot, notes=notes)
 
 
 def draw_chung_ooi_4(p: dict):
     """The figure of chung_ooi_4, from its numbers."""
-    threshold, mu, e_n, radius, angles, runs = p["threshold"], p["mu"], p["e_n"], p["radius"], p["angles"], p["runs"]
+    threshold, mu, e_n, radius = p["threshold"], p["mu"], p["e_n"], p["radius"]
+    angles, runs = p["angles"], p["runs"]
     fig, axes = new_figure(ncols=2)
     th = np.linspace(1.0, 89.0, 200)
     slide = th > threshold
@@ -491,7 +496,8 @@ def sliding_rolling(ctx: Context) -> CaseResult:
             "total normal impulse, during compression, "
             "after which the tanh law keeps the slip at zero. Friction acts at the contact point, "
             "so m R v_t - I omega is conserved and the sphere leaves rolling at v = 5/7 v0.")
-    return CaseResult.of(desc, checks, plot={"ds": ds, "vy": vy, "g": g, "w": w, "slip": slip, "vt0": vt0}, notes=[
+    plot = {"ds": ds, "vy": vy, "g": g, "w": w, "slip": slip, "vt0": vt0}
+    return CaseResult.of(desc, checks, plot=plot, notes=[
         "The step is 4 ns because while the contact sticks the tanh law is stiff: the slip "
         "relaxes at rate (7/2) mu k_s |N| / m ~ 2e7 1/s here, and RK4 is stable only for "
         "h times that rate below 2.8 (with solver.granular_friction = rk4; the default, split, "
@@ -515,9 +521,14 @@ def draw_sliding_rolling(p: dict):
 
 
 CASES: tuple[Case, ...] = (
-    Case("chung-ooi-1", "granular", "Chung & Ooi test 1: two spheres, Hertz closed forms", chung_ooi_1, draw=draw_impacts),
-    Case("chung-ooi-2", "granular", "Chung & Ooi test 2: sphere on a rigid wall", chung_ooi_2, draw=draw_impacts),
-    Case("chung-ooi-3", "granular", "Chung & Ooi test 3: restitution of the damped impact", chung_ooi_3, draw=draw_chung_ooi_3),
-    Case("chung-ooi-4", "granular", "Chung & Ooi test 4: oblique impact, gross sliding", chung_ooi_4, draw=draw_chung_ooi_4),
-    Case("sliding-rolling", "granular", "Sliding to rolling: v = 5/7 v0", sliding_rolling, draw=draw_sliding_rolling),
+    Case("chung-ooi-1", "granular", "Chung & Ooi test 1: two spheres, Hertz closed forms", chung_ooi_1,
+         draw=draw_impacts),
+    Case("chung-ooi-2", "granular", "Chung & Ooi test 2: sphere on a rigid wall", chung_ooi_2,
+         draw=draw_impacts),
+    Case("chung-ooi-3", "granular", "Chung & Ooi test 3: restitution of the damped impact", chung_ooi_3,
+         draw=draw_chung_ooi_3),
+    Case("chung-ooi-4", "granular", "Chung & Ooi test 4: oblique impact, gross sliding", chung_ooi_4,
+         draw=draw_chung_ooi_4),
+    Case("sliding-rolling", "granular", "Sliding to rolling: v = 5/7 v0", sliding_rolling,
+         draw=draw_sliding_rolling),
 )

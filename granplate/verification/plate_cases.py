@@ -513,8 +513,12 @@ def draw_newmark_elongation(p: dict):
 
 CASES: tuple[Case, ...] = (
     Case("patch-test", "plate", "Patch test on a distorted Q8 mesh", patch_test, draw=draw_patch_test),
-    Case("strip-deflection", "plate", "Clamped strip: static mid-span deflection vs Timoshenko", strip_deflection, draw=draw_strip_deflection),
-    Case("strip-frequencies", "plate", "Clamped strip: first three bending frequencies vs Timoshenko", strip_frequencies, draw=draw_strip_frequencies),
-    Case("q8-convergence", "plate", "Q8 convergence rates (manufactured solution)", q8_convergence, draw=draw_q8_convergence),
-    Case("newmark-elongation", "plate", "Newmark period elongation vs (omega h)^2/12", newmark_elongation, draw=draw_newmark_elongation),
+    Case("strip-deflection", "plate", "Clamped strip: static mid-span deflection vs Timoshenko", strip_deflection,
+         draw=draw_strip_deflection),
+    Case("strip-frequencies", "plate", "Clamped strip: first three bending frequencies vs Timoshenko", strip_frequencies,
+         draw=draw_strip_frequencies),
+    Case("q8-convergence", "plate", "Q8 convergence rates (manufactured solution)", q8_convergence,
+         draw=draw_q8_convergence),
+    Case("newmark-elongation", "plate", "Newmark period elongation vs (omega h)^2/12", newmark_elongation,
+         draw=draw_newmark_elongation),
 )
