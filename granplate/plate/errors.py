@@ -2,7 +2,8 @@
 
 Scenarios are refused before anything is built (`granplate.setup.validate`, with a
 ScenarioError naming the scenario field); a PlateError reaches only a direct caller of
-the plate layer that passed inconsistent inputs.
+the plate layer that passed inconsistent inputs. Both come from the same checks
+(`granplate.setup.plate_checks`): `plate_inputs` reports theirs as a PlateError.
 """
 from __future__ import annotations
 

@@ -7,9 +7,9 @@ order), `allowed` says in words what would be accepted. The layout is checked as
 `layout.*` before it is expanded; everything else is checked on the resolved scenario
 (`geometry.resolve`), so generated granules are named `granules[i]` with their label.
 
-The plate's mesh is checked too, before anything is built (setup.plate_checks); single
-fields are checked by setup.fields. The plate layer itself only checks the internal
-consistency of its inputs.
+The plate's fields and mesh are checked too, before anything is built (setup.plate_checks,
+the one owner of those rules: the plate layer runs the same checks on a direct caller's
+inputs); single fields are checked by setup.fields.
 """
 from __future__ import annotations
 
