@@ -131,6 +131,41 @@ def test_coinciding_curves_stay_visible():
     assert c.get_linestyle() == "--" and c.get_marker() not in ("", "None", None) and c.get_label() == "E (= A)"
 
 
+def test_curves_within_a_tolerance_coincide():
+    """A curve 0.06% of the peak off an earlier one is drawn as coinciding under rtol = 1%
+    (and says so), not under the default round-off tolerance; 2% off stays its own."""
+    fig = new_figure(3, 2)
+    ax = fig.add_subplot()
+    t = np.linspace(0, 1, 50)
+    y = np.sin(3 * t)
+    curves = [("A", y, "a"), ("B", y + 6e-4 * y.max(), "b"), ("C", y + 2e-2 * y.max(), "c")]
+    a, b, c = plot_curves(ax, t, curves, rtol=0.01)
+    assert b.get_linestyle() == "--" and b.get_label() == "B (~ A within 1% of the peak)"
+    assert c.get_linestyle() == "-" and c.get_label() == "C"
+    assert all(ln.get_linestyle() == "-" for ln in plot_curves(fig.add_subplot(), t, curves))
+
+
+def test_symmetric_plate_contacts_are_drawn_as_coinciding(steel):
+    """steel-r1's plate contacts symmetric about the load's centre (A and E, B and D) carry
+    equal forces; with D's made 0.06% larger (as a longer run leaves them), D is still
+    drawn dashed with markers over B and its legend says "within 1% of the peak", E's
+    says "= contact A"; the antisymmetric friction forces stay separate curves."""
+    ds = steel.copy(deep=True)
+    labels = [str(c) for c in ds.contact.values]
+    assert labels == list("ABCDE")
+    ds["contact_normal_force"].values[:, 3] *= 1.0006
+    fig = run.fig_contact_forces(ds)
+    (d,), (e,) = _lines(fig, "normal:D"), _lines(fig, "normal:E")
+    for line in (d, e):
+        assert line.get_linestyle() == "--" and line.get_marker() not in ("", "None", None)
+    assert d.get_label() == "contact D (~ contact B within 1% of the peak)"
+    assert e.get_label() == "contact E (= contact A)"
+    assert all(_lines(fig, f"normal:{lab}")[0].get_linestyle() == "-" for lab in "ABC")
+    assert _lines(fig, "tangential:D")[0].get_linestyle() == "-"  # -B's, not B's
+    legend = [txt.get_text() for txt in fig.axes[0].get_legend().get_texts()]
+    assert "contact D (~ contact B within 1% of the peak)" in legend
+
+
 # --------------------------------------------------------------------------------------
 # show: the assembly
 # --------------------------------------------------------------------------------------

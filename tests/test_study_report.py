@@ -274,3 +274,76 @@ def test_page_judges_the_targets_and_draws_the_designs_that_meet_them(tmp_path):
     page = write_report(tmp_path).read_text()
     assert "1 of 3 combinations meet every target" in page and "<p>Only one.</p>" in page
     assert "Design 2: meets the targets" in page
+
+
+LOG_TOML = '''base = "ptfe-r05"
+[set]
+"time.t_end" = 1e-6
+[parameters]
+"materials.ptfe.E" = {range = [1e9, 1e10], num = 3, log = true}
+"load.q0" = [1000.0, 2000.0, 4000.0]
+'''
+
+
+@pytest.fixture(scope="module")
+def log_study(tmp_path_factory):
+    """A sweep over a modulus in Pa spaced with log = true, and q0 in a plain list; the
+    metrics are known functions of the two."""
+    import tomllib
+
+    folder = tmp_path_factory.mktemp("log-study")
+    study = parse_study(tomllib.loads(LOG_TOML))
+    keys = []
+    for i, (E, q0) in enumerate(study.designs):
+        text = gp.dumps(study.scenario(i))
+        keys.append(D.design_key(text))
+        summary = {"ep_max_fraction": q0 / 1e5 * (E / 1e9) ** 0.3, "max_von_mises": 1e4 * q0,
+                   "units": D.metric_units()}
+        D.write_record(folder, D.make_record(keys[-1], study.changes(i), text,
+                                             {"status": "ok", "summary": summary, "elapsed_s": 0.0}))
+    write_table(study, folder, keys)
+    (folder / "study.toml").write_text(LOG_TOML)
+    return read_outcome(folder)
+
+
+def test_axis_labels_name_the_unit_of_the_values_drawn(log_study):
+    """An axis labelled [MPa] carries values in MPa: the modulus 1e9..1e10 Pa is drawn at
+    1e3..1e4 on the metric figure's x axis and in the heat map's tick labels."""
+    out = log_study
+    E_mpa = [1e3, 1e3 * 10 ** 0.5, 1e4]
+    fig = P.fig_metric(out, "ep_max_fraction")
+    ax = next(a for a in fig.axes if a.get_xlabel().startswith("materials.ptfe.E"))
+    assert ax.get_xlabel() == "materials.ptfe.E [MPa]"
+    drawn = np.unique(np.concatenate([ln.get_xdata() for ln in ax.get_lines()]))
+    np.testing.assert_allclose(drawn, E_mpa, rtol=1e-12)
+    lo, hi = ax.get_xlim()
+    assert lo < E_mpa[0] and E_mpa[-1] < hi < 1e5
+    heat = P.fig_heatmap(out, "max_von_mises")
+    panel = heat.axes[0]
+    axis, ticks = ((panel.get_xlabel(), panel.get_xticklabels()) if panel.get_xlabel().startswith("materials")
+                   else (panel.get_ylabel(), panel.get_yticklabels()))
+    assert axis == "materials.ptfe.E [MPa]"
+    np.testing.assert_allclose([float(t.get_text()) for t in ticks], E_mpa, rtol=1e-3)
+    cells = sorted(float(t.get_text()) for t in panel.texts if t.get_gid() == "cell-max_von_mises")
+    np.testing.assert_allclose(cells, sorted([10.0, 20.0, 40.0] * 3), rtol=1e-12)  # 1e4 q0 Pa in MPa
+
+
+def test_log_parameters_are_drawn_on_log_axes(log_study):
+    """A parameter spaced with log = true gets a log x axis (even over one decade); a plain
+    list over a factor of 4 stays linear."""
+    out = log_study
+    assert out.log_parameters == frozenset({"materials.ptfe.E"})
+    fig = P.fig_metric(out, "ep_max_fraction")
+    scales = {ax.get_xlabel().split(" [")[0]: ax.get_xscale() for ax in fig.axes if ax.get_xlabel()}
+    assert scales == {"materials.ptfe.E": "log", "load.q0": "linear"}
+
+
+def test_heat_map_cells_are_legible(log_study):
+    """The heat map is sized to its grid and its cell values and ticks are at least 8 pt
+    (11 px at the saved DPI)."""
+    heat = P.fig_heatmap(log_study, "max_von_mises")
+    panel = heat.axes[0]
+    sizes = [t.get_fontsize() for t in panel.texts] + [t.get_fontsize() for t in panel.get_xticklabels()]
+    assert min(sizes) >= 8 and min(sizes) * P.DPI / 72 >= 11
+    width, height = heat.get_size_inches()
+    assert width >= P.HEAT_CELL[0] * 3 and height >= P.HEAT_CELL[1] * 3

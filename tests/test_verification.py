@@ -38,6 +38,42 @@ def test_fast_case(name, ctx):
                                  for c in result.checks if not c.passed]
 
 
+#: Quick cases whose checks are run without drawing (plate, contacts, conservation).
+CHECKS_ONLY = ("patch-test", "newmark-elongation", "force-gradient")
+
+
+def test_checks_run_without_matplotlib(tmp_path):
+    """A case computes and checks in its run and draws in its draw: with figures off, the
+    checks of a few quick cases run and pass in a fresh process that never imports
+    matplotlib, and no figure is written."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, json\n"
+        "from pathlib import Path\n"
+        "from granplate import verification as V\n"
+        "from granplate.verification.base import Context, run_case\n"
+        f"ctx = Context(out=Path({str(tmp_path)!r}), figures=False)\n"
+        f"results = [run_case(V.get_case(n), ctx) for n in {CHECKS_ONLY!r}]\n"
+        "print(json.dumps({'matplotlib': sorted(m for m in sys.modules if m.split('.')[0] == 'matplotlib'),"
+        " 'results': [[r.name, r.crashed, len(r.checks), r.passed, r.figure] for r in results]}))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=900)
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout.strip().splitlines()[-1])
+    assert report["matplotlib"] == []
+    for name, crashed, n_checks, passed, figure in report["results"]:
+        assert crashed is None and n_checks > 0 and passed and figure is None, (name, crashed)
+    assert not (tmp_path / base.FIGURE_DIR).exists()
+
+
+def test_every_case_draws_from_its_own_numbers():
+    """Every registered case has a draw function: its figure is drawn apart from its checks."""
+    cases = V.all_cases()
+    assert cases and all(c.draw is not None for c in cases), [c.name for c in cases if c.draw is None]
+
+
 def test_slow_cases_are_only_in_the_full_suite():
     """--full adds the coupled convergence study; the fast suite leaves it out."""
     assert "coupled-convergence" in V.case_names(full=True)
@@ -97,10 +133,10 @@ def test_cli_exit_status(tmp_path, monkeypatch):
     """`granplate verify` exits 0 when every check passes, 1 when one fails or a case crashes."""
 
     def good(ctx):
-        return CaseResult("", "", "", "d", [Check("x", "-", 1.0, "s", 1.0, 1e-9, "w")], None)
+        return CaseResult.of("d", [Check("x", "-", 1.0, "s", 1.0, 1e-9, "w")])
 
     def bad(ctx):
-        return CaseResult("", "", "", "d", [Check("x", "-", 1.0, "s", 2.0, 1e-9, "w")], None)
+        return CaseResult.of("d", [Check("x", "-", 1.0, "s", 2.0, 1e-9, "w")])
 
     def crash(ctx):
         raise RuntimeError("boom")

@@ -69,23 +69,26 @@ COINCIDE = 1e-6
 MARKERS = ("o", "s", "^", "v", "D", "P", "X")
 
 
-def plot_curves(ax, t, curves: list[tuple[str, object, str]], **style) -> list:
+def plot_curves(ax, t, curves: list[tuple[str, object, str]], rtol: float = COINCIDE, **style) -> list:
     """Plot (label, values, gid) curves over t; a curve equal to an earlier one (within
-    COINCIDE of the panel's largest value) is drawn dashed with sparse markers, its label
-    saying which it equals, so that no curve hides under another. Returns the lines."""
+    rtol of the panel's largest |value|; default COINCIDE, round-off) is drawn dashed with
+    sparse markers, its label saying which it equals ("= A" within COINCIDE, "~ A" with
+    the tolerance otherwise), so that no curve hides under another. Returns the lines."""
     import numpy as np
 
     arrays = [np.asarray(v, float) for _, v, _ in curves]
     top = max((float(np.max(np.abs(a))) for a in arrays if a.size), default=0.0)
     lines, drawn, k_marker = [], [], 0
     for (label, _, gid), y in zip(curves, arrays):
-        twin = next((lab for lab, yy in drawn if top > 0 and np.max(np.abs(y - yy)) <= COINCIDE * top), None)
+        gaps = [(lab, float(np.max(np.abs(y - yy)))) for lab, yy in drawn if top > 0 and y.size]
+        twin = next(((lab, gap) for lab, gap in gaps if gap <= rtol * top), None)
         if twin is None:
             lines += ax.plot(t, y, label=label, gid=gid, **style)
         else:
             marker = MARKERS[k_marker % len(MARKERS)]
             k_marker += 1
-            lines += ax.plot(t, y, label=f"{label} (= {twin})", gid=gid, ls="--", marker=marker,
+            same = f"= {twin[0]}" if twin[1] <= COINCIDE * top else f"~ {twin[0]} within {rtol:.0%} of the peak"
+            lines += ax.plot(t, y, label=f"{label} ({same})", gid=gid, ls="--", marker=marker,
                              markevery=max(len(y) // 12, 1), markersize=4, **style)
         drawn.append((label, y))
     return lines

@@ -27,6 +27,9 @@ from granplate.results import analysis as an
 MAX_LABELLED = 8
 #: Granules named on the envelope: the fastest few (largest peak speed).
 FASTEST = 3
+#: Plate contact forces that differ by less than this fraction of the panel's peak are
+#: drawn as coinciding (symmetric contacts agree to round-off of the time loop, ~0.1%).
+FORCE_COINCIDE = 0.01
 #: An energy below this fraction of the energy put in counts as zero (round-off).
 NEGLIGIBLE = 1e-9
 
@@ -116,14 +119,18 @@ def fig_energies(ds: xr.Dataset) -> Figure:
 
 
 def fig_contact_forces(ds: xr.Dataset) -> Figure:
-    """Normal (a) and tangential (b) force at each plate contact [N]."""
+    """Normal (a) and tangential (b) force at each plate contact [N]; a contact whose force
+    stays within FORCE_COINCIDE of the panel's peak of an earlier one's is drawn dashed
+    with markers over it, its legend entry naming that contact."""
     fig = new_figure(9.0, 6.0)
     a, b = fig.subplots(2, 1, sharex=True)
     t = _t_ms(ds)
     labels = [str(c) for c in ds["contact"].values]
     fn, ft = ds["contact_normal_force"].values, ds["contact_tangential_force"].values
-    plot_curves(a, t, [(f"contact {lab}", fn[:, k], f"normal:{lab}") for k, lab in enumerate(labels)], lw=1.2)
-    plot_curves(b, t, [(f"contact {lab}", ft[:, k], f"tangential:{lab}") for k, lab in enumerate(labels)], lw=1.2)
+    plot_curves(a, t, [(f"contact {lab}", fn[:, k], f"normal:{lab}") for k, lab in enumerate(labels)],
+                rtol=FORCE_COINCIDE, lw=1.2)
+    plot_curves(b, t, [(f"contact {lab}", ft[:, k], f"tangential:{lab}") for k, lab in enumerate(labels)],
+                rtol=FORCE_COINCIDE, lw=1.2)
     a.set_ylabel("normal force [N]")
     a.set_title("(a) normal force on the plate (+x)", loc="left", fontsize=10)
     b.set_ylabel("tangential force [N]")

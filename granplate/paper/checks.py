@@ -91,11 +91,6 @@ CHECKS: tuple[SensitivityRun, ...] = (
 )
 
 
-def check_names(include_slow: bool = False) -> list[str]:
-    """Names of the checks to run (the slow ones only when asked)."""
-    return [c.name for c in CHECKS if include_slow or not c.slow]
-
-
 def runs_of(baseline: str, *roles: str) -> list[str]:
     """Names of the checks compared with `baseline` that vary one of `roles`, in CHECKS order."""
     return [c.name for c in CHECKS if c.baseline == baseline and c.role in roles]

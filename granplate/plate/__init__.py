@@ -37,7 +37,6 @@ from granplate.plate.constraints import (  # noqa: F401
     clamped_dofs,
     symmetry_line_nodes,
     rigid_layer_nodes,
-    check_layers_off_clamps,
     rigid_layer_map,
     reduce_matrix,
 )

@@ -26,11 +26,10 @@ import scipy.sparse.linalg as spla
 import skfem
 from skfem import Basis, MeshQuad
 
-from granplate.plate.errors import PlateError
+from granplate.plate.errors import PlateError, plate_inputs
 from granplate import store
 from granplate.plate.constraints import (
     GEOMETRY_RTOL,
-    check_layers_off_clamps,
     clamped_dofs,
     reduce_matrix,
     rigid_layer_map,
@@ -55,6 +54,7 @@ from granplate.plate.stress import (
     von_mises_plane_stress,
 )
 from granplate.setup.materials import LIBRARY, Material
+from granplate.setup.plate_checks import check_layers_off_clamps, check_mode_count, check_plate_fields
 from granplate.setup.plate_cost import (DEFAULT_MAX_FREQUENCY, basis_kind, build_estimate, check_fits,
                                         truncation_supported)
 
@@ -342,25 +342,12 @@ def cache_payload(
 
 
 def _check_plate(plate: "Plate", x0: float, n_modes_max: int | None = None) -> None:
-    """Refuse sizes that cannot make a mesh."""
-    for name in ("width", "height", "thickness"):
-        value = getattr(plate, name)
-        if not (np.isfinite(value) and value > 0):
-            raise PlateError(f"plate.{name}", value, "allowed: a positive length in metres")
-    for name in ("nx", "ny"):
-        value = getattr(plate, name)
-        if not (isinstance(value, (int, np.integer)) and value >= 1):
-            raise PlateError(f"plate.{name}", value, "allowed: an integer >= 1")
-    if plate.layer_width < 0 or not np.isfinite(plate.layer_width):
-        raise PlateError("plate.rigid_layer_width", plate.rigid_layer_width, "allowed: None or a length >= 0 m")
-    if not np.isfinite(x0):
-        raise PlateError("plate.x0", x0, "allowed: a finite x position in metres")
-    radius = plate.disc_radius
-    if not (np.isfinite(radius) and 0 < radius <= max(plate.width, plate.height)):
-        raise PlateError("plate.stress_radius", plate.stress_radius,
-                         "allowed: None or 0 < r <= max(plate.width, plate.height) in metres")
-    if n_modes_max is not None and not (0 <= plate.n_modes <= n_modes_max):
-        raise PlateError("plate.n_modes", plate.n_modes, f"allowed: 0 (all) or 1..{n_modes_max}")
+    """Refuse sizes that cannot make a mesh (setup.plate_checks' ranges; n_modes_max: the
+    reduced dofs, once known)."""
+    with plate_inputs():
+        check_plate_fields(plate, x0)
+        if n_modes_max is not None:
+            check_mode_count(plate, n_modes_max)
 
 
 def _compute_arrays(
@@ -439,7 +426,8 @@ def _reduction(
     """T and drive_dofs of the clamps and rigid layers (PlateError when they clash)."""
     fixed = clamped_dofs(node_xy, plate, x0)
     driving, layers = rigid_layer_nodes(node_xy, plate, x0, contact_y)
-    check_layers_off_clamps(fixed, driving, layers, plate, contact_y)
+    with plate_inputs():
+        check_layers_off_clamps(plate, contact_y, list(zip(driving, layers)), {int(d) // 2 for d in fixed})
     return rigid_layer_map(n_full, fixed, driving, layers)
 
 

@@ -11,8 +11,8 @@ from typing import TYPE_CHECKING, Sequence
 import numpy as np
 import scipy.sparse as sp
 
-from granplate.plate.errors import PlateError
-from granplate.setup.plate_checks import NODE_RTOL
+from granplate.plate.errors import plate_inputs
+from granplate.setup.plate_checks import NODE_RTOL, PLATE_EDGES, check_clamped_edges, check_symmetry_row, rigid_layers
 
 if TYPE_CHECKING:  # pragma: no cover
     from granplate.setup.scenario import Plate
@@ -21,7 +21,7 @@ if TYPE_CHECKING:  # pragma: no cover
 #: (the one validation uses to put contacts on nodes).
 GEOMETRY_RTOL = NODE_RTOL
 
-EDGES = ("top", "bottom", "left", "right")
+EDGES = PLATE_EDGES
 
 
 def nodes_on_line(node_xy: np.ndarray, axis: int, value: float, tol: float) -> np.ndarray:
@@ -42,11 +42,8 @@ def edge_nodes(node_xy: np.ndarray, plate: "Plate", x0: float) -> dict[str, np.n
 
 def clamped_dofs(node_xy: np.ndarray, plate: "Plate", x0: float) -> np.ndarray:
     """Sorted full-dof indices fixed by plate.clamped_edges (both dofs of every edge node)."""
-    unknown = [e for e in plate.clamped_edges if e not in EDGES]
-    if unknown:
-        raise PlateError(
-            "plate.clamped_edges", plate.clamped_edges, f"allowed: a subset of {EDGES}; unknown {unknown}"
-        )
+    with plate_inputs():
+        check_clamped_edges(plate)
     edges = edge_nodes(node_xy, plate, x0)
     nodes = np.unique(np.concatenate([edges[e] for e in plate.clamped_edges] + [np.empty(0, np.int64)]))
     return np.sort(np.concatenate([2 * nodes, 2 * nodes + 1])).astype(np.int64)
@@ -54,13 +51,8 @@ def clamped_dofs(node_xy: np.ndarray, plate: "Plate", x0: float) -> np.ndarray:
 
 def symmetry_line_nodes(node_xy: np.ndarray, plate: "Plate") -> np.ndarray:
     """Nodes on y = y0 + height / 2, sorted by x; requires an even plate.ny."""
-    if plate.ny % 2:
-        raise PlateError(
-            "plate.ny",
-            plate.ny,
-            f"must be even so that the symmetry line y = y0 + height/2 = {plate.y0 + plate.height / 2:g} m "
-            "is a row of element edges (with Q8 nodes along it)",
-        )
+    with plate_inputs():
+        check_symmetry_row(plate)
     nodes = nodes_on_line(node_xy, 1, plate.y0 + 0.5 * plate.height, GEOMETRY_RTOL * plate.height)
     return nodes[np.argsort(node_xy[nodes, 0], kind="stable")]
 
@@ -75,68 +67,12 @@ def rigid_layer_nodes(
     with it. Raises PlateError for a contact off the plate, between nodes, or
     layers that overlap.
     """
-    tol = GEOMETRY_RTOL * plate.height
     left = edge_nodes(node_xy, plate, x0)["left"]
-    left_y = node_xy[left, 1]
-    half = 0.5 * plate.layer_width
-    spacing = plate.height / (2 * plate.ny)
-    driving = np.empty(len(contact_y), dtype=np.int64)
-    layers: list[np.ndarray] = []
-    owner: dict[int, int] = {}
-    for k, yk in enumerate(contact_y):
-        if not (plate.y0 - tol <= yk <= plate.y0 + plate.height + tol):
-            raise PlateError(
-                "plate.y0",
-                plate.y0,
-                f"contact {k} at y={yk:g} m lies outside the plate's left edge "
-                f"[{plate.y0:g}, {plate.y0 + plate.height:g}] m",
-            )
-        at = left[np.abs(left_y - yk) <= tol]
-        if at.size != 1:
-            raise PlateError(
-                "plate.ny",
-                plate.ny,
-                f"contact {k} at y={yk:g} m is not on a mesh node; the left-edge node spacing "
-                f"is height/(2 ny) = {spacing:g} m; allowed: ny such that (y_contact - y0) is a "
-                f"multiple of height/(2 ny) for every contact",
-            )
-        driving[k] = at[0]
-        members = left[np.abs(left_y - yk) <= half + tol]
-        for n in members:
-            if int(n) in owner:
-                j = owner[int(n)]
-                raise PlateError(
-                    "plate.rigid_layer_width",
-                    plate.rigid_layer_width,
-                    f"the rigid layers of contacts {j} (y={contact_y[j]:g} m) and {k} (y={yk:g} m) "
-                    f"share the node at y={node_xy[n, 1]:g} m with w = {plate.layer_width:g} m; "
-                    "allowed: w smaller than the distance between neighbouring contacts",
-                )
-            owner[int(n)] = k
-        layers.append(members[members != at[0]])
+    with plate_inputs():
+        found = rigid_layers(plate, contact_y, node_xy[left, 1])
+    driving = np.array([left[at] for at, _ in found], dtype=np.int64)
+    layers = [left[np.asarray(members, dtype=np.int64)] for _, members in found]
     return driving, layers
-
-
-def check_layers_off_clamps(
-    fixed: np.ndarray, driving: np.ndarray, layers: Sequence[np.ndarray], plate: "Plate", contact_y: Sequence[float]
-) -> None:
-    """Refuse a contact on a clamped node, or a rigid layer that reaches one."""
-    fixed_nodes = set(int(d) // 2 for d in fixed)
-    for k, (d, members) in enumerate(zip(driving, layers)):
-        if int(d) in fixed_nodes:
-            raise PlateError(
-                "plate.clamped_edges",
-                plate.clamped_edges,
-                f"contact {k} at y={contact_y[k]:g} m sits on a clamped node; allowed: contacts on "
-                "free parts of the left edge only",
-            )
-        if any(int(n) in fixed_nodes for n in members):
-            raise PlateError(
-                "plate.rigid_layer_width",
-                plate.rigid_layer_width,
-                f"the rigid layer of contact {k} at y={contact_y[k]:g} m (w = {plate.layer_width:g} m) "
-                "reaches a clamped node; allowed: a width that keeps every layer off the clamped edges",
-            )
 
 
 def rigid_layer_map(
@@ -146,7 +82,7 @@ def rigid_layer_map(
 
     Reduced dofs are the full dofs that are neither fixed nor slaved, in increasing
     order. A slaved node's x (y) dof copies its driving node's x (y) dof. Driving and
-    slaved nodes must be free (see check_layers_off_clamps). Returns T (n_full, n_red)
+    slaved nodes must be free (see setup.plate_checks.check_layers_off_clamps). Returns T (n_full, n_red)
     and drive_dofs (n_contacts, 2).
     """
     master = np.arange(n_full)

@@ -2,13 +2,15 @@
 
 Scenarios are refused before anything is built (`granplate.setup.validate`, with a
 ScenarioError naming the scenario field); a PlateError reaches only a direct caller of
-the plate layer that passed inconsistent inputs.
+the plate layer that passed inconsistent inputs. Both come from the same checks
+(`granplate.setup.plate_checks`): `plate_inputs` reports theirs as a PlateError.
 """
 from __future__ import annotations
 
-from typing import Any
+import contextlib
+from typing import Any, Iterator
 
-from granplate.errors import GranplateError
+from granplate.errors import GranplateError, ScenarioError
 
 
 class PlateError(GranplateError, ValueError):
@@ -19,3 +21,13 @@ class PlateError(GranplateError, ValueError):
         self.value = value
         self.allowed = allowed
         super().__init__(f"plate input '{name}' = {value!r}: {allowed}")
+
+
+@contextlib.contextmanager
+def plate_inputs() -> Iterator[None]:
+    """Report the setup layer's plate checks (`setup.plate_checks`, the one owner of the
+    plate's ranges and topology rules) on a direct caller's inputs as a PlateError."""
+    try:
+        yield
+    except ScenarioError as err:
+        raise PlateError(err.field, err.value, err.allowed) from None

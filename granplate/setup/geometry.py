@@ -41,13 +41,6 @@ def column_offset(R1: float, R2: float) -> float:
     return math.sqrt((R1 + R2) ** 2 - R1**2)
 
 
-def plate_edge_x(layout: Layout) -> float:
-    """xp = R1 + 2d + R1 [m]: the plate's left edge, touching column 3 (A..E)."""
-    R1 = layout.R1
-    d = column_offset(R1, layout.R2_ratio * R1)
-    return (R1 + 2.0 * d) + R1
-
-
 def paper_layout(layout: Layout) -> tuple[tuple[Granule, ...], tuple[Wall, ...], float]:
     """The paper's packing: (granules 1..9, A..E), (left, bottom, top walls), plate x0.
 

@@ -1,19 +1,67 @@
-"""The plate's mesh checked before anything is built: an even `plate.ny` (a row of nodes
-on the symmetry line), every plate contact on a left-edge node, rigid layers that neither
-overlap nor reach a clamped node, `plate.n_modes` at most the number of reduced dofs, and
-a basis that fits the machine (setup.plate_cost). Counts come from the mesh's structure
-alone (docs/model.md section 4), so no matrix is assembled.
+"""The plate's fields and mesh checked before anything is built: each field in its range,
+an even `plate.ny` (a row of nodes on the symmetry line), every plate contact on a
+left-edge node, rigid layers that neither overlap nor reach a clamped node,
+`plate.n_modes` at most the number of reduced dofs, and a basis that fits the machine
+(setup.plate_cost). Counts come from the mesh's structure alone (docs/model.md section 4),
+so no matrix is assembled.
+
+These checks are the only ones: the plate layer (`plate.constraints`, `plate.build`) calls
+them on its own inputs and reports their ScenarioError as a PlateError.
 """
 from __future__ import annotations
+
+from typing import Sequence
 
 import numpy as np
 
 from granplate.errors import ScenarioError
-from granplate.setup.plate_cost import basis_kind, check_fits, truncation_supported
+from granplate.setup.fields import finite, int_at_least, positive, string_in
+from granplate.setup.plate_cost import MODE_CHOICES, basis_kind, check_fits, truncation_supported
 from granplate.setup.scenario import Plate, Scenario
 
 #: Relative tolerance (times the plate height / width) for "a point lies on a mesh node".
 NODE_RTOL = 1e-9
+
+#: The plate's edges, any subset of which `plate.clamped_edges` may clamp.
+PLATE_EDGES: tuple[str, ...] = ("top", "bottom", "left", "right")
+
+
+def check_plate_fields(p: Plate, x0: float) -> None:
+    """Each of the plate's own fields in its range; x0 [m] is the resolved left edge."""
+    for f in ("width", "height", "thickness"):
+        positive(f"plate.{f}", getattr(p, f))
+    finite("plate.x0", x0)
+    finite("plate.y0", p.y0)
+    int_at_least("plate.nx", p.nx, 1)
+    int_at_least("plate.ny", p.ny, 1)
+    if p.rigid_layer_width is not None:
+        positive("plate.rigid_layer_width", p.rigid_layer_width)
+    check_clamped_edges(p)
+    int_at_least("plate.n_modes", p.n_modes, 0)
+    string_in("plate.modes", p.modes, MODE_CHOICES)
+    if p.max_frequency is not None:
+        positive("plate.max_frequency", p.max_frequency)
+    if p.stress_radius is not None:
+        positive("plate.stress_radius", p.stress_radius)
+        if p.stress_radius > max(p.width, p.height):
+            raise ScenarioError("plate.stress_radius", p.stress_radius,
+                                f"allowed: 0 < r <= max(plate.width, plate.height) = "
+                                f"{max(p.width, p.height):g} m (a disc larger than the plate "
+                                "averages over all of it)")
+
+
+def check_clamped_edges(p: Plate) -> None:
+    """`plate.clamped_edges` is a tuple of names from PLATE_EDGES."""
+    edges = p.clamped_edges
+    if not isinstance(edges, tuple) or not all(isinstance(e, str) and e in PLATE_EDGES for e in edges):
+        raise ScenarioError("plate.clamped_edges", edges,
+                            "must be a subset of " + ", ".join(repr(e) for e in PLATE_EDGES))
+
+
+def check_mode_count(p: Plate, n_red: int) -> None:
+    """`plate.n_modes` is 0 (all) or at most the n_red reduced dofs."""
+    if p.n_modes > n_red:
+        raise ScenarioError("plate.n_modes", p.n_modes, f"allowed: 0 (all) or 1..{n_red}")
 
 
 def faces_plate(p: Plate, gap_ratio: float, x: float, y: float, radius: float) -> bool:
@@ -64,7 +112,8 @@ def reduced_dof_count(p: Plate, n_slaved: int) -> int:
     return 2 * (n_nodes - clamped_node_count(p) - n_slaved)
 
 
-def _check_symmetry_row(p: Plate) -> None:
+def check_symmetry_row(p: Plate) -> None:
+    """An even `plate.ny`, so that the symmetry line is a row of element edges."""
     if p.ny % 2:
         raise ScenarioError(
             "plate.ny", p.ny,
@@ -84,13 +133,21 @@ def _contact_node(p: Plate, k: int, yk: float, left_y: np.ndarray) -> int:
     return int(at[0])
 
 
-def rigid_layers(p: Plate, contact_y: list[float]) -> list[tuple[int, list[int]]]:
-    """(driving node, other layer nodes) of each contact; refuses overlapping layers."""
-    left_y = left_edge_node_heights(p)
+def rigid_layers(p: Plate, contact_y: Sequence[float],
+                 left_y: np.ndarray | None = None) -> list[tuple[int, list[int]]]:
+    """(driving node, other layer nodes) of each contact, as indices into left_y [m] (the
+    heights of the left-edge nodes, in any order; None: `left_edge_node_heights`);
+    refuses a contact off the left edge or between nodes, and overlapping layers."""
+    left_y = left_edge_node_heights(p) if left_y is None else np.asarray(left_y)
     half, tol = 0.5 * p.layer_width, NODE_RTOL * p.height
     owner: dict[int, int] = {}
     layers = []
     for k, yk in enumerate(contact_y):
+        if not (p.y0 - tol <= yk <= p.y0 + p.height + tol):
+            raise ScenarioError(
+                "plate.y0", p.y0,
+                f"contact {k} at y={yk:g} m lies outside the plate's left edge "
+                f"[{p.y0:g}, {p.y0 + p.height:g}] m")
         at = _contact_node(p, k, yk, left_y)
         members = [int(n) for n in np.flatnonzero(np.abs(left_y - yk) <= half + tol)]
         for n in members:
@@ -106,15 +163,19 @@ def rigid_layers(p: Plate, contact_y: list[float]) -> list[tuple[int, list[int]]
     return layers
 
 
-def _check_layers_off_clamps(p: Plate, contact_y: list[float], layers: list[tuple[int, list[int]]]) -> None:
-    clamped = clamped_left_nodes(p)
+def check_layers_off_clamps(p: Plate, contact_y: Sequence[float],
+                            layers: Sequence[tuple[int, Sequence[int]]], clamped: set[int]) -> None:
+    """Refuse a contact on a clamped node, or a rigid layer that reaches one: layers as
+    `rigid_layers` gives them and clamped, in the same node numbering (the plate layer's
+    mesh nodes, or the indices of `clamped_left_nodes`)."""
     for k, (at, members) in enumerate(layers):
+        at = int(at)
         if at in clamped:
             raise ScenarioError(
                 "plate.clamped_edges", p.clamped_edges,
                 f"contact {k} at y={contact_y[k]:g} m sits on a clamped node; allowed: contacts on "
                 "free parts of the left edge only")
-        if any(n in clamped for n in members):
+        if any(int(n) in clamped for n in members):
             raise ScenarioError(
                 "plate.rigid_layer_width", p.rigid_layer_width,
                 f"the rigid layer of contact {k} at y={contact_y[k]:g} m (w = {p.layer_width:g} m) "
@@ -126,13 +187,12 @@ def check_plate_mesh(s: Scenario) -> None:
     p = s.plate
     if p is None:
         return
-    _check_symmetry_row(p)
+    check_symmetry_row(p)
     contact_y = plate_contact_heights(s)
     layers = rigid_layers(p, contact_y)
-    _check_layers_off_clamps(p, contact_y, layers)
+    check_layers_off_clamps(p, contact_y, layers, clamped_left_nodes(p))
     n_red = reduced_dof_count(p, sum(len(m) for _, m in layers))
-    if p.n_modes > n_red:
-        raise ScenarioError("plate.n_modes", p.n_modes, f"allowed: 0 (all) or 1..{n_red}")
+    check_mode_count(p, n_red)
     edge_load = s.load.kind == "line" and s.load.target == "plate"
     kind = basis_kind(p.modes, n_red, truncation_supported(p.clamped_edges, edge_load))
     if kind == "truncated":

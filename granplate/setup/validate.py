@@ -7,9 +7,9 @@ order), `allowed` says in words what would be accepted. The layout is checked as
 `layout.*` before it is expanded; everything else is checked on the resolved scenario
 (`geometry.resolve`), so generated granules are named `granules[i]` with their label.
 
-The plate's mesh is checked too, before anything is built (setup.plate_checks); single
-fields are checked by setup.fields. The plate layer itself only checks the internal
-consistency of its inputs.
+The plate's fields and mesh are checked too, before anything is built (setup.plate_checks,
+the one owner of those rules: the plate layer runs the same checks on a direct caller's
+inputs); single fields are checked by setup.fields.
 """
 from __future__ import annotations
 
@@ -25,8 +25,7 @@ from granplate.errors import ScenarioError
 from granplate.setup.geometry import layout_packing, resolve
 from granplate.setup.layouts import column_radii, half_pitch, hexagonal_offsets, lattice_sites
 from granplate.setup.fields import finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
-from granplate.setup.plate_checks import check_plate_mesh
-from granplate.setup.plate_cost import MODE_CHOICES
+from granplate.setup.plate_checks import check_plate_fields, check_plate_mesh
 from granplate.setup.scenario import (LAYOUT_KINDS, SQRT2_MINUS_1, ChainLayout, Granule,
                                       Imperfections, LatticeLayout, Layout, Scenario)
 
@@ -41,7 +40,6 @@ GRANULAR_FRICTIONS: tuple[str, ...] = ("split", "rk4")
 LOAD_KINDS: tuple[str, ...] = ("line", "none")
 LOAD_TARGETS: tuple[str, ...] = ("granules", "plate")
 #: Plate edges that may be clamped (Plate.clamped_edges).
-PLATE_EDGES: tuple[str, ...] = ("top", "bottom", "left", "right")
 
 #: Relative tolerance on overlaps/penetrations at t = 0 (times the smaller radius).
 OVERLAP_RTOL = 1e-9
@@ -272,31 +270,9 @@ def _check_plate(s: Scenario) -> None:
     pl = s.plate
     if pl is None:
         return
-    for f in ("width", "height", "thickness"):
-        positive(f"plate.{f}", getattr(pl, f))
+    check_plate_fields(pl, pl.x0)
     material_exists("plate.material", pl.material, s)
-    x0 = finite("plate.x0", pl.x0)
-    finite("plate.y0", pl.y0)
-    int_at_least("plate.nx", pl.nx, 1)
-    int_at_least("plate.ny", pl.ny, 1)
-    if pl.rigid_layer_width is not None:
-        positive("plate.rigid_layer_width", pl.rigid_layer_width)
-    edges = pl.clamped_edges
-    if not isinstance(edges, tuple) or not all(isinstance(e, str) and e in PLATE_EDGES
-                                               for e in edges):
-        raise ScenarioError("plate.clamped_edges", edges,
-                            "must be a subset of " + ", ".join(repr(e) for e in PLATE_EDGES))
-    int_at_least("plate.n_modes", pl.n_modes, 0)
-    string_in("plate.modes", pl.modes, MODE_CHOICES)
-    if pl.max_frequency is not None:
-        positive("plate.max_frequency", pl.max_frequency)
-    if pl.stress_radius is not None:
-        positive("plate.stress_radius", pl.stress_radius)
-        if pl.stress_radius > max(pl.width, pl.height):
-            raise ScenarioError("plate.stress_radius", pl.stress_radius,
-                                f"allowed: 0 < r <= max(plate.width, plate.height) = "
-                                f"{max(pl.width, pl.height):g} m (a disc larger than the plate "
-                                "averages over all of it)")
+    x0 = float(pl.x0)
     for i, g in enumerate(s.granules):
         if pl.y0 <= g.y <= pl.y0 + pl.height:
             pen = g.x + g.radius - x0

@@ -19,6 +19,7 @@ from typing import Any
 
 from granplate.errors import ScenarioError
 from granplate.study import design as D
+from granplate.study.spec import log_parameters
 from granplate.study.constraints import Bound, is_feasible, parse_constraints, violations
 from granplate.study.table import NOT_METRICS, field_unit
 from granplate.study.targets import ReportTable, parse_report_table
@@ -52,7 +53,8 @@ class Row:
 class StudyOutcome:
     """A study folder read back: kind ("sweep" or "optimization"), base, fixed changes,
     parameter names, rows, metric names and units, objectives, constraints, the [report]
-    table and the study file's text ("" when the folder has none)."""
+    table, the study file's text ("" when the folder has none) and the parameters it
+    spaces on a log scale (`log = true`)."""
 
     folder: Path
     kind: str
@@ -67,6 +69,7 @@ class StudyOutcome:
     report: ReportTable = field(default_factory=ReportTable)
     study_text: str = ""
     version: str = ""
+    log_parameters: frozenset[str] = frozenset()
 
     def unit(self, name: str) -> str:
         """The unit of a metric or parameter ("" when unknown, "1" when dimensionless)."""
@@ -196,6 +199,7 @@ def read_outcome(folder: str | Path) -> StudyOutcome:
     out.constraints = parse_constraints(doc.get("constraints"), units)
     out.report = parse_report_table(doc.get("report"), out.names)
     out.study_text = text
+    out.log_parameters = log_parameters(doc.get("parameters"))
     if out.constraints:  # a sweep's designs are judged here; a trial's verdict is Optuna's
         out.rows = [r if r.feasible is not None or not r.metrics else
                     Row(r.number, r.params, r.metrics, r.status, r.key,

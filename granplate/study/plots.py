@@ -1,6 +1,8 @@
 """Figures of a study (its report page): each metric against each parameter, heat maps of
 a metric over two grid parameters (one panel per value of the others), and the Pareto
-front of an optimisation. Every axis and colour bar names its quantity and unit.
+front of an optimisation. Every axis and colour bar names its quantity and unit, and the
+values drawn on it are in that unit (`scaled`: Pa shown in MPa, parameters as metrics); a
+parameter spaced with `log = true` is drawn on a log axis.
 
 Figures are `matplotlib.figure.Figure` objects on the Agg canvas (granplate.figures.common);
 the drawn quantities carry a `gid` naming them, for the tests.
@@ -30,7 +32,13 @@ MAX_LEGEND = 8
 MAX_PANELS = 9
 #: Size of one panel [inches] and the PNG resolution [dots per inch] of a study figure.
 PANEL = (3.4, 2.8)
-DPI = 90
+DPI = 100
+#: Font size [pt] of a heat map's cell values and tick labels (8 pt: 11 px at DPI).
+HEAT_FONT = 8
+#: Room [inches] a heat-map cell takes at least (width for "1.23e+04" at HEAT_FONT,
+#: height for one line), and the margin of a panel around its cells (labels, ticks).
+HEAT_CELL = (0.62, 0.34)
+HEAT_MARGIN = (1.5, 1.2)
 
 
 def shown(unit: str) -> tuple[float, str]:
@@ -40,12 +48,32 @@ def shown(unit: str) -> tuple[float, str]:
     return 1.0, ("-" if unit in ("1", "") else unit)
 
 
+def scaled(out: StudyOutcome, name: str) -> tuple[float, str]:
+    """(factor, unit) a metric's or parameter's values are drawn in: the one source of the
+    number on an axis and the unit in its label."""
+    return shown(out.unit(name))
+
+
+def scaled_values(out: StudyOutcome, name: str, values: list[Any]) -> list[Any]:
+    """Values of `name` in the unit drawn (`scaled`); text and missing values as they are."""
+    factor = scaled(out, name)[0]
+    return [v * factor if isinstance(v, (int, float)) and not isinstance(v, bool) else v for v in values]
+
+
+def is_log(out: StudyOutcome, name: str, levels: list[Any]) -> bool:
+    """Whether parameter `name` is drawn on a log axis: the study spaces it with `log =
+    true`, or its positive values span a factor of 50 or more (three or more of them)."""
+    if not is_numeric(levels) or not levels or min(levels) <= 0:
+        return False
+    return name in out.log_parameters or (len(levels) > 2 and max(levels) / min(levels) >= 50)
+
+
 def label(out: StudyOutcome, name: str) -> str:
     """'max_von_mises [MPa]', 'ep_max_fraction [-]': the axis label of a quantity (a
     parameter's companions, those that vary with it, are named after it)."""
-    text = f"{name} [{shown(out.unit(name))[1]}]"
+    text = f"{name} [{scaled(out, name)[1]}]"
     if name in out.names:
-        text += "".join(f"\nwith {n} [{shown(out.unit(n))[1]}]" for n in companions(out, name))
+        text += "".join(f"\nwith {n} [{scaled(out, n)[1]}]" for n in companions(out, name))
     return text
 
 
@@ -104,12 +132,20 @@ def _x_axis(ax, out: StudyOutcome, name: str, levels: list[Any]) -> None:
     if not is_numeric(levels):
         ax.set_xticks(range(len(levels)), [str(v) for v in levels], fontsize=8)
         ax.set_xlim(-0.5, len(levels) - 0.5)
-    elif len(levels) > 2 and min(levels) > 0 and max(levels) / min(levels) >= 50:
+    elif is_log(out, name, levels):
         ax.set_xscale("log")
 
 
 def _short(v: Any) -> str:
     return f"{v:.4g}" if isinstance(v, float) else str(v)
+
+
+def _with_unit(out: StudyOutcome, name: str, v: Any) -> str:
+    """A parameter's value in the unit drawn, with the unit unless dimensionless or text."""
+    shown_v = scaled_values(out, name, [v])[0]
+    unit = scaled(out, name)[1]
+    numeric = isinstance(v, (int, float)) and not isinstance(v, bool)
+    return _short(shown_v) + (f" {unit}" if numeric and unit not in ("-", "") else "")
 
 
 def fig_metric(out: StudyOutcome, metric: str) -> Figure:
@@ -118,15 +154,15 @@ def fig_metric(out: StudyOutcome, metric: str) -> Figure:
     other parameter with the fewest values (text before numbers; the legend); otherwise each design is a
     point. Infeasible designs are crosses."""
     names = varied(out) or list(out.names[:1])
-    factor, _ = shown(out.unit(metric))
+    factor, _ = scaled(out, metric)
     y = np.array(out.metric(metric)) * factor
     grid = is_grid(out)
     fig = new_figure(PANEL[0] * max(1, len(names)), PANEL[1] + 0.4)
     axes = fig.subplots(1, max(1, len(names)), squeeze=False)[0]
     infeasible = np.array([r.feasible is False for r in out.rows])
     for ax, name in zip(axes, names):
-        levels = distinct(out.values(name))
-        x = _positions(out.values(name), levels)
+        levels = distinct(scaled_values(out, name, out.values(name)))
+        x = _positions(scaled_values(out, name, out.values(name)), levels)
         others = [n for n in names if n != name]
         if grid and others:
             # one line per combination of the others, coloured by the one with fewest values
@@ -141,7 +177,8 @@ def fig_metric(out: StudyOutcome, metric: str) -> Figure:
             for g, idx in groups.items():
                 idx = sorted(idx, key=lambda i: x[i])
                 value = str(g[others.index(hue)])
-                text = f"{hue.rsplit('.', 1)[-1]} = {_short(g[others.index(hue)])}" if value not in named else None
+                text = (f"{hue.rsplit('.', 1)[-1]} = {_with_unit(out, hue, g[others.index(hue)])}"
+                        if value not in named else None)
                 named.add(value)
                 ax.plot(x[idx], y[idx], "o-", ms=3, lw=1, color=colours[value], alpha=0.8, label=text,
                         gid=f"{metric}-vs-{name}")
@@ -174,6 +211,16 @@ def heat_axes(out: StudyOutcome) -> tuple[str, str, list[str]] | None:
     return x, y, [n for n in names if n not in (x, y)]
 
 
+def heat_panel_size(nx: int, ny: int) -> tuple[float, float]:
+    """(width, height) [inches] of a heat-map panel of nx x ny cells: at least PANEL, and
+    enough for each cell's value at HEAT_FONT (HEAT_CELL) plus the labels (HEAT_MARGIN)."""
+    return (max(PANEL[0], HEAT_MARGIN[0] + HEAT_CELL[0] * nx), max(PANEL[1], HEAT_MARGIN[1] + HEAT_CELL[1] * ny))
+
+
+def _tick(v: Any) -> str:
+    return f"{v:.3g}" if isinstance(v, float) else str(v)
+
+
 def _cell_text(v: float) -> str:
     return "" if not np.isfinite(v) else f"{v:.3g}"
 
@@ -194,15 +241,16 @@ def fig_heatmap(out: StudyOutcome, metric: str) -> Figure | None:
         while keep and math.prod(len(distinct(out.values(n))) for n in keep) > MAX_PANELS:
             keep.pop(0)
         fixed = {n: distinct(out.values(n))[0] for n in others if n not in keep}
-        sliced = "; " + ", ".join(f"{n} = {v}" for n, v in fixed.items())
+        sliced = "; " + ", ".join(f"{n} = {_with_unit(out, n, v)}" for n, v in fixed.items())
         combos = [c for c in combos if all(str(c[others.index(n)]) == str(v) for n, v in fixed.items())]
-    factor, unit = shown(out.unit(metric))
+    factor, unit = scaled(out, metric)
     values = np.array(out.metric(metric)) * factor
     finite = values[np.isfinite(values)]
     lo, hi = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
     ncol = len(combos) if len(combos) <= 3 else math.ceil(math.sqrt(len(combos)))
     nrow = math.ceil(len(combos) / ncol)
-    fig = new_figure(PANEL[0] * ncol + 0.8, PANEL[1] * nrow + 0.5)
+    width, height = heat_panel_size(len(xl), len(yl))
+    fig = new_figure(width * ncol + 1.2, height * nrow + 0.6)
     grid = fig.subplots(nrow, ncol, squeeze=False)
     image = None
     for k, combo in enumerate(combos):
@@ -215,18 +263,22 @@ def fig_heatmap(out: StudyOutcome, metric: str) -> Figure | None:
         image = ax.imshow(z, origin="lower", aspect="auto", cmap="viridis", vmin=lo, vmax=hi,
                           gid=f"heatmap-{metric}")
         for (a, b), v in np.ndenumerate(z):
-            ax.text(b, a, _cell_text(v), ha="center", va="center", fontsize=6,
-                    color="w" if np.isfinite(v) and v < (lo + hi) / 2 else "k")
-        ax.set_xticks(range(len(xl)), [f"{v:.3g}" if isinstance(v, float) else str(v) for v in xl], fontsize=7)
-        ax.set_yticks(range(len(yl)), [f"{v:.3g}" if isinstance(v, float) else str(v) for v in yl], fontsize=7)
-        ax.set_xlabel(label(out, xn), fontsize=8)
-        ax.set_ylabel(label(out, yn), fontsize=8)
+            ax.text(b, a, _cell_text(v), ha="center", va="center", fontsize=HEAT_FONT,
+                    color="w" if np.isfinite(v) and v < (lo + hi) / 2 else "k", gid=f"cell-{metric}")
+        ax.set_xticks(range(len(xl)), [_tick(v) for v in scaled_values(out, xn, xl)], fontsize=HEAT_FONT,
+                      rotation=30 if len(xl) > 6 else 0)
+        ax.set_yticks(range(len(yl)), [_tick(v) for v in scaled_values(out, yn, yl)], fontsize=HEAT_FONT)
+        ax.set_xlabel(label(out, xn), fontsize=HEAT_FONT)
+        ax.set_ylabel(label(out, yn), fontsize=HEAT_FONT)
         if others:
-            ax.set_title("\n".join(f"{n} = {_short(v)}" for n, v in zip(others, combo)), fontsize=7)
+            ax.set_title("\n".join(f"{n} = {_with_unit(out, n, v)}" for n, v in zip(others, combo)),
+                         fontsize=HEAT_FONT)
     for k in range(len(combos), nrow * ncol):
         grid[k // ncol][k % ncol].set_visible(False)
     if image is not None:
-        fig.colorbar(image, ax=grid.ravel().tolist(), label=f"{metric} [{unit}]", shrink=0.9)
+        bar = fig.colorbar(image, ax=grid.ravel().tolist(), shrink=0.9)
+        bar.set_label(f"{metric} [{unit}]", fontsize=HEAT_FONT)
+        bar.ax.tick_params(labelsize=HEAT_FONT)
     fig.suptitle(f"{metric} [{unit}]{sliced}", fontsize=9)
     return fig
 
@@ -240,8 +292,8 @@ def fig_pareto(out: StudyOutcome, front: list[int], chosen: dict[str, int]) -> F
         return None
     done = [i for i, r in enumerate(out.rows) if r.ok and r.metrics]
     two = len(names) >= 2
-    fx = shown(out.unit(names[0]))[0]
-    fy = shown(out.unit(names[1]))[0] if two else 1.0
+    fx = scaled(out, names[0])[0]
+    fy = scaled(out, names[1])[0] if two else 1.0
 
     def xy(i: int) -> tuple[float, float]:
         m = out.rows[i].metrics

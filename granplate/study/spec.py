@@ -195,6 +195,13 @@ def sample_values(forms: dict[str, dict]) -> list[tuple[float, ...]]:
 
 # ------------------------------------------------------------------------- the grid
 
+def log_parameters(parameters: Any) -> frozenset[str]:
+    """The parameters given in a range or sample form with `log = true` (drawn on log axes)."""
+    if not isinstance(parameters, dict):
+        return frozenset()
+    return frozenset(f for f, spec in parameters.items() if isinstance(spec, dict) and spec.get("log") is True)
+
+
 def axes(parameters: dict, zipped: dict) -> tuple[list[tuple[str, ...]], list[list[tuple]]]:
     """The study's axes: (fields of each axis, points of each axis), first axis slowest.
 

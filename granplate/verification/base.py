@@ -3,8 +3,10 @@
 A *check* compares one number the simulator produced ("ours") with an independent
 reference (a closed form, a published value, an independent high-accuracy solution),
 under a tolerance that is justified in words on the page. A *case* runs one physical
-situation (usually a scenario file under `verification/scenarios/`), returns its checks
-and draws one figure.
+situation (usually a scenario file under `verification/scenarios/`): its `run` computes
+and returns the checks (and the numbers its figure shows, `CaseResult.plot`), its `draw`
+turns those numbers into one figure. The checks thus run without matplotlib
+(`Context(figures=False)`).
 
 Check kinds (how `error` and `passed` are computed):
 
@@ -22,7 +24,7 @@ import traceback
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
@@ -56,7 +58,9 @@ class CaseResult:
     figure: file name inside FIGURE_DIR (None when the case crashed before plotting);
     notes: extra sentences for the page (known limitations, what is out of scope);
     tables: extra Markdown tables (the convergence studies); crashed: the traceback
-    when the case raised (the case then fails).
+    when the case raised (the case then fails); plot: the numbers the case's `draw` makes
+    its figure from (not written to the page). A case returns `CaseResult.of(...)`; the
+    registry fills in name, family, title, figure and seconds (`run_case`).
     """
 
     name: str
@@ -69,6 +73,15 @@ class CaseResult:
     tables: list[str] = field(default_factory=list)
     seconds: float = 0.0
     crashed: str | None = None
+    plot: dict[str, Any] = field(default_factory=dict, repr=False)
+
+    @classmethod
+    def of(cls, description: str, checks: Sequence[criteria.Check], *, notes: Sequence[str] = (),
+           tables: Sequence[str] = (), plot: dict[str, Any] | None = None) -> "CaseResult":
+        """What a case's run returns: its description, checks, notes, tables and the
+        numbers of its figure (name, family, title and figure filled in by `run_case`)."""
+        return cls("", "", "", description, list(checks), None, list(notes), list(tables),
+                   plot=dict(plot or {}))
 
     @property
     def passed(self) -> bool:
@@ -86,7 +99,9 @@ class CaseResult:
 
 @dataclass(frozen=True)
 class Case:
-    """A registered case: `run(ctx)` returns its CaseResult (family, title filled in).
+    """A registered case: `run(ctx)` computes its checks and returns its CaseResult
+    (family, title filled in); `draw(result.plot)` returns its figure (a matplotlib
+    Figure), saved as FIGURE_DIR/NAME.png.
 
     slow: only with `granplate verify --full`.
     """
@@ -96,15 +111,18 @@ class Case:
     title: str
     run: Callable[["Context"], CaseResult]
     slow: bool = False
+    draw: Callable[[dict], Any] | None = None
 
 
 @dataclass
 class Context:
-    """What a case may use: the output directory and a run cache (for slow studies)."""
+    """What a case may use: the output directory and a run cache (for slow studies);
+    figures: draw and save each case's figure (False: the checks only, no matplotlib)."""
 
     out: Path
     full: bool = False
     run_cache: dict | None = None
+    figures: bool = True
 
     @property
     def figure_dir(self) -> Path:
@@ -118,10 +136,13 @@ class Context:
 
 
 def run_case(case: Case, ctx: Context) -> CaseResult:
-    """Run one case; an exception becomes a failing result carrying the traceback."""
+    """Run one case and draw its figure (with ctx.figures); an exception becomes a failing
+    result carrying the traceback."""
     t0 = time.perf_counter()
     try:
         result = case.run(ctx)
+        if ctx.figures and case.draw is not None:
+            result.figure = save_figure(case.draw(result.plot), ctx, case.name)
     except Exception:  # noqa: BLE001 - a crashing case is reported, not fatal
         result = CaseResult(case.name, case.family, case.title, crashed=traceback.format_exc())
     result.name, result.family, result.title = case.name, case.family, case.title

@@ -15,7 +15,7 @@ import numpy as np
 from granplate.solver.schemes.implicit import ENERGY_STEP_FRACTION
 from granplate.setup.scenario import Solver
 from .base import (EPS, Case, CaseResult, Check, Context, load_case_scenario, new_figure,
-                   observed_order, save_figure, simulate)
+                   observed_order, simulate)
 
 #: Shortened run of the fast suite [s]: the 10 µs shock and the first arrivals at the plate.
 SHORT_T_END = 5e-5
@@ -97,6 +97,26 @@ def energy_residual(ctx: Context) -> CaseResult:
             checks.append(Check(f"max |energy residual|, {name}, full 2 ms run", "-", 0.0,
                                 "exact balance E_p + E_g + D = E_shock (docs/model.md section 7)",
                                 summ["energy_residual_max"], RESIDUAL_TOL, RESIDUAL_WHY, kind="max"))
+    desc = ("Every preset (`granplate presets`) is run for 50 µs (the shock and the first "
+            "arrivals at the plate) with the default (implicit) scheme, and with the paper "
+            "scheme at its default settings and again with every step halved "
+            "(time.dt_max, time.dt_initial and solver.lambda_target halved); the largest "
+            "per-step residual |E_p + E_g + D - E_shock - E_0| / max(E_in) is reported. "
+            + ("With --full the full 2 ms runs are checked too." if ctx.full else
+               "The full 2 ms runs are checked by `granplate verify --full`."))
+    res = CaseResult.of(desc, checks, plot={"series": series})
+    if full_rows:
+        lines = ["| preset | E_shock [J] | max abs residual, 2 ms | steps |", "|---|---|---|---|"]
+        for name, summ in full_rows:
+            lines.append(f"| {name} | {summ['e_shock']:.4e} | {summ['energy_residual_max']:.2e} | "
+                         f"{summ['n_steps']} |")
+        res.tables.append("\n".join(lines))
+    return res
+
+
+def draw_energy_residual(p: dict):
+    """The figure of energy_residual, from its numbers."""
+    series = p["series"]
     fig, axes = new_figure()
     ax = axes[0, 0]
     for name, ds in series.items():
@@ -106,22 +126,7 @@ def energy_residual(ctx: Context) -> CaseResult:
     ax.set_ylabel("|energy residual| per output interval [-]")
     ax.set_title("paper scheme, default step (40 ns), first 50 µs")
     ax.legend(fontsize=7)
-    fig_name = save_figure(fig, ctx, "energy-residual")
-    desc = ("Every preset (`granplate presets`) is run for 50 µs (the shock and the first "
-            "arrivals at the plate) with the default (implicit) scheme, and with the paper "
-            "scheme at its default settings and again with every step halved "
-            "(time.dt_max, time.dt_initial and solver.lambda_target halved); the largest "
-            "per-step residual |E_p + E_g + D - E_shock - E_0| / max(E_in) is reported. "
-            + ("With --full the full 2 ms runs are checked too." if ctx.full else
-               "The full 2 ms runs are checked by `granplate verify --full`."))
-    res = CaseResult("", "", "", desc, checks, fig_name)
-    if full_rows:
-        lines = ["| preset | E_shock [J] | max abs residual, 2 ms | steps |", "|---|---|---|---|"]
-        for name, summ in full_rows:
-            lines.append(f"| {name} | {summ['e_shock']:.4e} | {summ['energy_residual_max']:.2e} | "
-                         f"{summ['n_steps']} |")
-        res.tables.append("\n".join(lines))
-    return res
+    return fig
 
 
 def full_runs() -> list:
@@ -232,18 +237,6 @@ def free_assembly(ctx: Context) -> CaseResult:
     L_change = float(L_fric[-1] - L_fric[0])
     impulse = float(np.trapezoid(defect, ds.time.values)) if hasattr(np, "trapezoid") else float(
         np.trapz(defect, ds.time.values))
-    fig, axes = new_figure()
-    ax = axes[0, 0]
-    t = ds.time.values * 1e3
-    for k, style in (("friction", "-"), ("frictionless", "--"), ("friction, contact-point arm", ":")):
-        px, py, L, ps, Ls = mom[k]
-        ax.semilogy(t, np.abs(px - px[0]) / ps + 1e-18, style, lw=1, label=f"|d p_x| / scale, {k}")
-        ax.semilogy(t, np.abs(L - L[0]) / Ls + 1e-18, style, lw=1.5, label=f"|d L| / scale, {k}")
-    ax.set_xlabel("time [ms]")
-    ax.set_ylabel("relative drift [-]")
-    ax.set_ylim(1e-18, 1e-2)
-    ax.legend(fontsize=7)
-    name = save_figure(fig, ctx, "free-assembly")
     desc = ("Four steel spheres (R = 8-10 mm) with spins collide obliquely in free space, no "
             "walls, plate or load (`free-assembly.toml`: mu = 0.3, alpha_n = 0.05, h = 10 ns, 1 ms, "
             "several collisions with sliding and damping), and the same with mu = 0. Linear "
@@ -267,7 +260,24 @@ def free_assembly(ctx: Context) -> CaseResult:
         "granule contact; the default (split) solves that friction exactly per contact at any "
         "step; the scenario fixes dt_max = 10 ns anyway.",
     ]
-    return CaseResult("", "", "", desc, checks, name, notes=notes)
+    return CaseResult.of(desc, checks, plot={"ds": ds, "mom": mom}, notes=notes)
+
+
+def draw_free_assembly(p: dict):
+    """The figure of free_assembly, from its numbers."""
+    ds, mom = p["ds"], p["mom"]
+    fig, axes = new_figure()
+    ax = axes[0, 0]
+    t = ds.time.values * 1e3
+    for k, style in (("friction", "-"), ("frictionless", "--"), ("friction, contact-point arm", ":")):
+        px, py, L, ps, Ls = mom[k]
+        ax.semilogy(t, np.abs(px - px[0]) / ps + 1e-18, style, lw=1, label=f"|d p_x| / scale, {k}")
+        ax.semilogy(t, np.abs(L - L[0]) / Ls + 1e-18, style, lw=1.5, label=f"|d L| / scale, {k}")
+    ax.set_xlabel("time [ms]")
+    ax.set_ylabel("relative drift [-]")
+    ax.set_ylim(1e-18, 1e-2)
+    ax.legend(fontsize=7)
+    return fig
 
 
 # --------------------------------------------------------------------------- force gradient
@@ -351,15 +361,6 @@ def force_gradient(ctx: Context) -> CaseResult:
     ]
     etas = 2.0 ** np.round(np.log2(np.geomspace(1e-7, 0.3, 20) * d_min))
     errs = [float(np.abs(forces + _gradient(e_pos, y[:, 0:2].copy(), e)).max() / scale) for e in etas]
-    fig, axes = new_figure()
-    ax = axes[0, 0]
-    ax.loglog(etas / d_min, errs, "o-")
-    ax.axvline(eta / d_min, color="k", ls=":", lw=0.8, label="step used")
-    ax.set_xlabel("finite-difference step eta / delta_min [-]")
-    ax.set_ylabel("max |F + dE/dx| / max |F| [-]")
-    ax.set_title("truncation (eta^4) vs round-off (1/eta)")
-    ax.legend(fontsize=8)
-    name = save_figure(fig, ctx, "force-gradient")
     desc = ("A static assembly (`force-gradient.toml`: three spheres, steel and PTFE, touching "
             "each other, a left and a bottom wall, and a 2 x 20 plate through a rigid layer) is "
             "pressed into overlap by displacing the granules and the plate contact by a few "
@@ -368,11 +369,28 @@ def force_gradient(ctx: Context) -> CaseResult:
             "the contact energy it returns (sum 2/5 A delta^(5/2) over every pair, wall and "
             "plate contact), with respect to every granule coordinate and the plate's "
             "driving displacement.")
-    return CaseResult("", "", "", desc, checks, name)
+    return CaseResult.of(desc, checks, plot={"etas": etas, "d_min": d_min, "errs": errs, "eta": eta})
+
+
+def draw_force_gradient(p: dict):
+    """The figure of force_gradient, from its numbers."""
+    etas, d_min, errs, eta = p["etas"], p["d_min"], p["errs"], p["eta"]
+    fig, axes = new_figure()
+    ax = axes[0, 0]
+    ax.loglog(etas / d_min, errs, "o-")
+    ax.axvline(eta / d_min, color="k", ls=":", lw=0.8, label="step used")
+    ax.set_xlabel("finite-difference step eta / delta_min [-]")
+    ax.set_ylabel("max |F + dE/dx| / max |F| [-]")
+    ax.set_title("truncation (eta^4) vs round-off (1/eta)")
+    ax.legend(fontsize=8)
+    return fig
 
 
 CASES: tuple[Case, ...] = (
-    Case("energy-residual", "conservation", "Energy residual of every preset", energy_residual),
-    Case("free-assembly", "conservation", "Momenta of a free assembly", free_assembly),
-    Case("force-gradient", "conservation", "Forces = minus the gradient of the contact energies", force_gradient),
+    Case("energy-residual", "conservation", "Energy residual of every preset", energy_residual,
+         draw=draw_energy_residual),
+    Case("free-assembly", "conservation", "Momenta of a free assembly", free_assembly,
+         draw=draw_free_assembly),
+    Case("force-gradient", "conservation", "Forces = minus the gradient of the contact energies", force_gradient,
+         draw=draw_force_gradient),
 )

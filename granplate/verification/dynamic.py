@@ -16,7 +16,7 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .base import (Case, CaseResult, Check, Context, load_case_scenario, new_figure, save_figure,
+from .base import (Case, CaseResult, Check, Context, load_case_scenario, new_figure,
                    simulate)
 from .granular import HERTZ_SOURCE, HERTZ_TC, ODE_SOURCE, hertz_reference, impact_ode, plane_modulus, sphere_mass
 
@@ -206,6 +206,20 @@ def gap_head_on(ctx: Context) -> CaseResult:
               "RK4's energy error over one impact at h = t_c/5300 is ~1e-10; 1e-8 is a factor "
               "100 above it and 1e4 below energy_tol.", kind="max"),
     ]
+    desc = ("Two steel spheres (R = 10 mm) start 1.23 mm apart and fly at each other at 1 m/s each "
+            "(`gap-head-on.toml`, `contact.detection = \"dynamic\"`, h = 10 ns, about t_c/5300): the "
+            "pair is in the Verlet list but not touching at t = 0. The first touch must come at "
+            "gap / v, the contact must last Hertz's t_c = 2.868 (m*^2 / (R* E*^2 v))^(1/5) (E*, "
+            "R*, m* computed here from the material constants), and the spheres must leave at "
+            "e = 1 without damping; with alpha_n = 0.05 the restitution and the contact time "
+            "(until the overlap closes) come from the normalised damped-impact ODE.")
+    return CaseResult.of(desc, checks, plot={"el": el, "dm": dm, "alpha": alpha, "tc_ref": tc_ref},
+                         notes=[f"Contact time: Hertz {tc_ref:.6e} s; damped (alpha_n = {alpha:g}) {tc_damped:.6e} s."])
+
+
+def draw_gap_head_on(p: dict):
+    """The figure of gap_head_on, from its numbers."""
+    el, dm, alpha, tc_ref = p["el"], p["dm"], p["alpha"], p["tc_ref"]
     fig, axes = new_figure()
     ax = axes[0, 0]
     for run, label in ((el, "alpha_n = 0"), (dm, f"alpha_n = {alpha:g}")):
@@ -217,16 +231,7 @@ def gap_head_on(ctx: Context) -> CaseResult:
     ax.set_xlabel("time [µs]")
     ax.set_ylabel("overlap R_1 + R_2 - |s_2 - s_1| [µm]")
     ax.legend(fontsize=8)
-    name = save_figure(fig, ctx, "gap-head-on")
-    desc = ("Two steel spheres (R = 10 mm) start 1.23 mm apart and fly at each other at 1 m/s each "
-            "(`gap-head-on.toml`, `contact.detection = \"dynamic\"`, h = 10 ns, about t_c/5300): the "
-            "pair is in the Verlet list but not touching at t = 0. The first touch must come at "
-            "gap / v, the contact must last Hertz's t_c = 2.868 (m*^2 / (R* E*^2 v))^(1/5) (E*, "
-            "R*, m* computed here from the material constants), and the spheres must leave at "
-            "e = 1 without damping; with alpha_n = 0.05 the restitution and the contact time "
-            "(until the overlap closes) come from the normalised damped-impact ODE.")
-    return CaseResult("", "", "", desc, checks, name,
-                      notes=[f"Contact time: Hertz {tc_ref:.6e} s; damped (alpha_n = {alpha:g}) {tc_damped:.6e} s."])
+    return fig
 
 
 # --------------------------------------------------------------------------- oblique impact
@@ -273,6 +278,22 @@ def oblique_gap(ctx: Context) -> CaseResult:
               "the case is built to slide throughout, where tanh(k_s v_t) = sign(v_t) and the reference is not stiff",
               kind="abs"),
     ]
+    desc = ("A steel sphere (R = 10 mm) spinning at 30 rad/s flies at 2 m/s into a resting one, "
+            "off-centre (impact parameter 12 mm), from a gap (`oblique-gap.toml`, dynamic "
+            "detection, mu = 0.08, k_s = 1000 s/m, alpha_n = 0.05, h = 5 ns). Every velocity "
+            "and spin over the run is compared with an independent solve_ivp (DOP853, rtol 1e-11) "
+            "of the same contact equations (Hertz + damping along the line of centres, "
+            "tanh-Coulomb friction on the slip rate with torque arms R, docs/model.md 3.2), "
+            "written in this module from the equations.")
+    return CaseResult.of(desc, checks, plot={"t": t, "ds": ds, "s": s, "ref": ref}, notes=[
+        f"After impact: ours v_a = ({ours[-1, 3, 0]:.8f}, {ours[-1, 4, 0]:.8f}) m/s, "
+        f"omega_a = {ours[-1, 5, 0]:.6f} rad/s; "
+        f"reference ({ref[-1, 3, 0]:.8f}, {ref[-1, 4, 0]:.8f}) m/s, {ref[-1, 5, 0]:.6f} rad/s."])
+
+
+def draw_oblique_gap(p: dict):
+    """The figure of oblique_gap, from its numbers."""
+    t, ds, s, ref = p["t"], p["ds"], p["s"], p["ref"]
     fig, axes = new_figure(ncols=2)
     ax = axes[0, 0]
     for g, c in ((0, "C0"), (1, "C1")):
@@ -290,18 +311,7 @@ def oblique_gap(ctx: Context) -> CaseResult:
     ax.set_xlabel("time [µs]")
     ax.set_ylabel("angular velocity [rad/s]")
     ax.legend(fontsize=7)
-    name = save_figure(fig, ctx, "oblique-gap")
-    desc = ("A steel sphere (R = 10 mm) spinning at 30 rad/s flies at 2 m/s into a resting one, "
-            "off-centre (impact parameter 12 mm), from a gap (`oblique-gap.toml`, dynamic "
-            "detection, mu = 0.08, k_s = 1000 s/m, alpha_n = 0.05, h = 5 ns). Every velocity "
-            "and spin over the run is compared with an independent solve_ivp (DOP853, rtol 1e-11) "
-            "of the same contact equations (Hertz + damping along the line of centres, "
-            "tanh-Coulomb friction on the slip rate with torque arms R, docs/model.md 3.2), "
-            "written in this module from the equations.")
-    return CaseResult("", "", "", desc, checks, name, notes=[
-        f"After impact: ours v_a = ({ours[-1, 3, 0]:.8f}, {ours[-1, 4, 0]:.8f}) m/s, "
-        f"omega_a = {ours[-1, 5, 0]:.6f} rad/s; "
-        f"reference ({ref[-1, 3, 0]:.8f}, {ref[-1, 4, 0]:.8f}) m/s, {ref[-1, 5, 0]:.6f} rad/s."])
+    return fig
 
 
 # --------------------------------------------------------------------------- between two walls
@@ -360,6 +370,24 @@ def wall_bounce(ctx: Context) -> CaseResult:
               "each impact errs by O(alpha (h/t_c)^(5/4)) (chung-ooi-3); the errors add over up to "
               "20 impacts.", kind="max"),
     ]
+    desc = ("A steel sphere (R = 10 mm) at 10 m/s between two walls whose distance exceeds its "
+            "diameter by 0.5 mm (`wall-bounce.toml`, dynamic detection, h = 20 ns): every wall "
+            "contact forms during the run. Without damping the period must be the free flight "
+            "2 gap / v plus two Hertz sphere-on-wall contact times, and the kinetic energy in "
+            "free flight must stay constant over all bounces; with alpha_n = 0.02 each impact "
+            "multiplies the speed by the same e (the normalised ODE: e does not depend on the "
+            "speed).")
+    plot = {"t": t, "ds": ds, "centre": centre, "dd": dd, "xd": xd,
+            "alpha": alpha, "free": free, "k_imp": k_imp, "ratio": ratio, "e_ref": e_ref}
+    return CaseResult.of(desc, checks, plot=plot,
+                         notes=[f"Elastic: {len(ups)} passes, period {periods.mean():.9e} s vs {period_ref:.9e} s."])
+
+
+def draw_wall_bounce(p: dict):
+    """The figure of wall_bounce, from its numbers."""
+    t, ds, centre, dd = p["t"], p["ds"], p["centre"], p["dd"]
+    xd, alpha, free, k_imp = p["xd"], p["alpha"], p["free"], p["k_imp"]
+    ratio, e_ref = p["ratio"], p["e_ref"]
     fig, axes = new_figure(ncols=2)
     ax = axes[0, 0]
     ax.plot(t * 1e3, (ds.x.values[:, 0] - centre) * 1e3, lw=0.8, label="elastic")
@@ -375,16 +403,7 @@ def wall_bounce(ctx: Context) -> CaseResult:
     ax.set_xlabel("wall impacts k")
     ax.set_ylabel("speed / initial speed")
     ax.legend(fontsize=8)
-    name = save_figure(fig, ctx, "wall-bounce")
-    desc = ("A steel sphere (R = 10 mm) at 10 m/s between two walls whose distance exceeds its "
-            "diameter by 0.5 mm (`wall-bounce.toml`, dynamic detection, h = 20 ns): every wall "
-            "contact forms during the run. Without damping the period must be the free flight "
-            "2 gap / v plus two Hertz sphere-on-wall contact times, and the kinetic energy in "
-            "free flight must stay constant over all bounces; with alpha_n = 0.02 each impact "
-            "multiplies the speed by the same e (the normalised ODE: e does not depend on the "
-            "speed).")
-    return CaseResult("", "", "", desc, checks, name,
-                      notes=[f"Elastic: {len(ups)} passes, period {periods.mean():.9e} s vs {period_ref:.9e} s."])
+    return fig
 
 
 # --------------------------------------------------------------------------- loose packing
@@ -458,6 +477,30 @@ def loose_packing_case(ctx: Context) -> CaseResult:
         Check("energy residual", "-", 0.0, "eq. (11)", float(np.abs(ds.energy_residual.values).max()), 1e-7,
               "RK4's energy error over a few tens of impacts at h = 20 ns.", kind="max"),
     ]
+    desc = (f"{n} steel spheres (R = 4-8 mm, seed {LOOSE_SEED}) at random sites in a closed "
+            f"{side * 1e3:.0f} mm box, none touching anything at t = 0, with random "
+            "velocities up to 3 m/s, frictionless and undamped (damping is checked by the "
+            "cases above), dynamic detection, "
+            f"h = 20 ns, {t[-1] * 1e3:g} ms "
+            f"({'--full' if ctx.full else f'quick; {LOOSE_COUNT_FULL} granules with --full'}). "
+            "Every position and velocity is compared, at 100 output times, with an independent "
+            "solve_ivp (DOP853, rtol 1e-11, steps <= 1 µs) of the Hertz law over all pairs and all walls, "
+            "written in this module from the equations (no neighbour list: every pair is tested "
+            "at every evaluation).")
+    plot = {"n": n, "ds": ds, "ref": ref, "s": s, "r": r, "side": side, "t": t}
+    return CaseResult.of(desc, checks, plot=plot,
+                         notes=[f"{pairs_met} pairs touched; largest velocity error {vel_err * v_scale:.2e} m/s, "
+                                f"position error {pos_err:.2e} m.",
+                                "The comparison stops at 4 ms: a box of colliding spheres is a chaotic billiard, "
+                                "which amplifies any difference exponentially with the number of successive "
+                                "collisions (measured: the 16-granule box at 20 ms differs by 0.5 m/s, granplate "
+                                "keeping its energy balance to 1e-8), so a longer run compares the amplification, not the "
+                                "integrators."])
+
+
+def draw_loose_packing_case(p: dict):
+    """The figure of loose_packing_case, from its numbers."""
+    n, ds, ref, s, r, side, t = p["n"], p["ds"], p["ref"], p["s"], p["r"], p["side"], p["t"]
     fig, axes = new_figure(ncols=2)
     from matplotlib.patches import Circle
 
@@ -477,34 +520,16 @@ def loose_packing_case(ctx: Context) -> CaseResult:
     ax.semilogy(t * 1e3, np.maximum(err_t, 1e-16))
     ax.set_xlabel("time [ms]")
     ax.set_ylabel("max |v - v_ref| [m/s]")
-    name = save_figure(fig, ctx, "loose-packing")
-    desc = (f"{n} steel spheres (R = 4-8 mm, seed {LOOSE_SEED}) at random sites in a closed "
-            f"{side * 1e3:.0f} mm box, none touching anything at t = 0, with random "
-            "velocities up to 3 m/s, frictionless and undamped (damping is checked by the "
-            "cases above), dynamic detection, "
-            f"h = 20 ns, {t[-1] * 1e3:g} ms "
-            f"({'--full' if ctx.full else f'quick; {LOOSE_COUNT_FULL} granules with --full'}). "
-            "Every position and velocity is compared, at 100 output times, with an independent "
-            "solve_ivp (DOP853, rtol 1e-11, steps <= 1 µs) of the Hertz law over all pairs and all walls, "
-            "written in this module from the equations (no neighbour list: every pair is tested "
-            "at every evaluation).")
-    return CaseResult("", "", "", desc, checks, name,
-                      notes=[f"{pairs_met} pairs touched; largest velocity error {vel_err * v_scale:.2e} m/s, "
-                             f"position error {pos_err:.2e} m.",
-                             "The comparison stops at 4 ms: a box of colliding spheres is a chaotic billiard, "
-                             "which amplifies any difference exponentially with the number of successive "
-                             "collisions (measured: the 16-granule box at 20 ms differs by 0.5 m/s, granplate "
-                             "keeping its energy balance to 1e-8), so a longer run compares the amplification, not the "
-                             "integrators."])
+    return fig
 
 
 CASES: tuple[Case, ...] = (
     Case("gap-head-on", "contacts", "Two spheres from a gap: meeting time, Hertz contact time, restitution",
-         gap_head_on),
+         gap_head_on, draw=draw_gap_head_on),
     Case("oblique-gap", "contacts", "Oblique impact from a gap with friction and spin vs an independent integrator",
-         oblique_gap),
+         oblique_gap, draw=draw_oblique_gap),
     Case("wall-bounce", "contacts", "A sphere bouncing between two walls: period, energy, speed decay",
-         wall_bounce),
+         wall_bounce, draw=draw_wall_bounce),
     Case("loose-packing", "contacts", "A loose box of spheres vs an independent integrator over all pairs",
-         loose_packing_case),
+         loose_packing_case, draw=draw_loose_packing_case),
 )

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from .base import Case, CaseResult, Check, Context, new_figure, save_figure, simulate
+from .base import Case, CaseResult, Check, Context, new_figure, simulate
 from .granular import hertz_reference
 
 #: the granule: steel, radius R [m]; the plate's face at x = X0 [m], 0.1 m tall.
@@ -114,6 +114,20 @@ def face_drop(ctx: Context) -> CaseResult:
                         "the implicit scheme's own residual with a rigid-layer contact is 2e-6 on this "
                         "impact; the patch contact (weights frozen over a step, overlap continuous when "
                         "it moves) adds no term.", kind="max"))
+    desc = ("A steel sphere (R = 1 cm) 0.55 mm from the plate's face flies at it at 1 m/s, centred "
+            "on a face node or 0.37 node spacings above one; it has no plate contact at t = 0 and "
+            "gets a patch contact (2.5 mm wide) when it comes within contact.skin R of the face. "
+            f"On a plate {STIFF_THICKNESS:g} m thick (1e4 times stiffer and heavier) the impact is "
+            "Hertz's on a rigid wall; on the paper's plate the restitution (the energy left in the "
+            "plate) must not depend on where the nodes are, more so as the mesh is refined "
+            f"(ny = {', '.join(map(str, meshes))}).")
+    return CaseResult.of(desc, checks, plot={"stiff": stiff, "ref": ref, "meshes": meshes, "soft": soft},
+                         tables=[_table(soft, meshes)])
+
+
+def draw_face_drop(p: dict):
+    """The figure of face_drop, from its numbers."""
+    stiff, ref, meshes, soft = p["stiff"], p["ref"], p["meshes"], p["soft"]
     fig, axes = new_figure(ncols=2, width=4.6)
     ax = axes[0, 0]
     for where, b in stiff.items():
@@ -129,16 +143,7 @@ def face_drop(ctx: Context) -> CaseResult:
     ax.set_ylabel("restitution [-]")
     ax.set_title("paper's plate, patch 2.5 mm", fontsize=9)
     ax.legend(fontsize=8)
-    name = save_figure(fig, ctx, "plate-face-drop")
-    desc = ("A steel sphere (R = 1 cm) 0.55 mm from the plate's face flies at it at 1 m/s, centred "
-            "on a face node or 0.37 node spacings above one; it has no plate contact at t = 0 and "
-            "gets a patch contact (2.5 mm wide) when it comes within contact.skin R of the face. "
-            f"On a plate {STIFF_THICKNESS:g} m thick (1e4 times stiffer and heavier) the impact is "
-            "Hertz's on a rigid wall; on the paper's plate the restitution (the energy left in the "
-            "plate) must not depend on where the nodes are, more so as the mesh is refined "
-            f"(ny = {', '.join(map(str, meshes))}).")
-    return CaseResult("", "", "", desc, checks, name,
-                      tables=[_table(soft, meshes)])
+    return fig
 
 
 def _table(soft: dict, meshes) -> str:
@@ -171,6 +176,16 @@ def face_slide(ctx: Context) -> CaseResult:
         Check("largest |energy residual| of eq. (11)", "-", 0.0, "every joule accounted: E_p + E_g + D = E_initial",
               b["residual"], 1e-5, "as the normal impact: the moving patch adds no term.", kind="max"),
     ]
+    desc = ("The sphere of the drop case hits the face at 1 m/s while moving up at 4 m/s, with "
+            f"mu = {mu}: it slides along the face while in touch, so its patch contact moves (new "
+            "weights between steps, the overlap kept continuous). Checks: the patch moved, "
+            "Coulomb's bound, the friction dissipated, and the energy balance of eq. (11).")
+    return CaseResult.of(desc, checks, plot={"ds": ds, "e0": e0})
+
+
+def draw_face_slide(p: dict):
+    """The figure of face_slide, from its numbers."""
+    ds, e0 = p["ds"], p["e0"]
     fig, axes = new_figure()
     ax = axes[0, 0]
     t = ds.time.values * 1e3
@@ -180,16 +195,12 @@ def face_slide(ctx: Context) -> CaseResult:
     ax.set_xlabel("t [ms]")
     ax.set_ylabel("energy / initial energy [-]")
     ax.legend(fontsize=8)
-    name = save_figure(fig, ctx, "plate-face-slide")
-    desc = ("The sphere of the drop case hits the face at 1 m/s while moving up at 4 m/s, with "
-            f"mu = {mu}: it slides along the face while in touch, so its patch contact moves (new "
-            "weights between steps, the overlap kept continuous). Checks: the patch moved, "
-            "Coulomb's bound, the friction dissipated, and the energy balance of eq. (11).")
-    return CaseResult("", "", "", desc, checks, name)
+    return fig
 
 
 CASES: tuple[Case, ...] = (
     Case("plate-face-drop", "coupled", "Patch contact: impact at a node and between nodes, stiff-plate Hertz limit",
-         face_drop),
-    Case("plate-face-slide", "coupled", "Patch contact: a granule sliding along the face under friction", face_slide),
+         face_drop, draw=draw_face_drop),
+    Case("plate-face-slide", "coupled", "Patch contact: a granule sliding along the face under friction", face_slide,
+         draw=draw_face_slide),
 )

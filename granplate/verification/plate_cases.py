@@ -18,7 +18,7 @@ import numpy as np
 import scipy.sparse.linalg as spla
 from scipy.optimize import brentq
 
-from .base import EPS, Case, CaseResult, Check, Context, loglog_slope, new_figure, save_figure
+from .base import EPS, Case, CaseResult, Check, Context, loglog_slope, new_figure
 
 STRIP_LENGTH = 0.1
 STRIP_DEPTH = 0.01
@@ -91,6 +91,19 @@ def patch_test(ctx: Context) -> CaseResult:
               "assembly of a constant stress cancels at interior nodes up to round-off of the "
               "quadrature sums (~1e3 eps).", kind="max"),
     ]
+    desc = ("A 1 x 1.2 patch of 4 x 5 Q8 elements whose interior vertices are moved at random by "
+            "up to 25% of a cell (straight edges, mid-side nodes at edge midpoints), assembled "
+            "with `plate.q8_basis`, `plate.assemble_stiffness` (plane stress, steel) and "
+            "`plate.strain_operator`. The boundary nodes take the linear field u = a + B x; the "
+            "interior is solved for. A conforming element passes when the interior nodes "
+            "reproduce the linear field and every Gauss point the constant strain, up to "
+            "round-off (Irons' patch test).")
+    return CaseResult.of(desc, checks, plot={"mesh": mesh, "u": u, "exact": exact, "xy": xy})
+
+
+def draw_patch_test(p: dict):
+    """The figure of patch_test, from its numbers."""
+    mesh, u, exact, xy = p["mesh"], p["u"], p["exact"], p["xy"]
     fig, axes = new_figure(width=5.0, height=5.0)
     ax = axes[0, 0]
     for e in mesh.t.T:
@@ -103,15 +116,7 @@ def patch_test(ctx: Context) -> CaseResult:
     ax.set_ylabel("y [m]")
     ax.set_aspect("equal")
     ax.set_title("displacement patch test, distorted Q8 mesh")
-    name = save_figure(fig, ctx, "patch-test")
-    desc = ("A 1 x 1.2 patch of 4 x 5 Q8 elements whose interior vertices are moved at random by "
-            "up to 25% of a cell (straight edges, mid-side nodes at edge midpoints), assembled "
-            "with `plate.q8_basis`, `plate.assemble_stiffness` (plane stress, steel) and "
-            "`plate.strain_operator`. The boundary nodes take the linear field u = a + B x; the "
-            "interior is solved for. A conforming element passes when the interior nodes "
-            "reproduce the linear field and every Gauss point the constant strain, up to "
-            "round-off (Irons' patch test).")
-    return CaseResult("", "", "", desc, checks, name)
+    return fig
 
 
 # --------------------------------------------------------------------------- clamped strip
@@ -183,16 +188,6 @@ def strip_deflection(ctx: Context) -> CaseResult:
     checks = [Check("mid-span deflection, 4 x 40 mesh", "m", w_ref,
                     "Timoshenko beam, clamped-clamped, uniform load, Cowper k", w_mid,
                     (STRIP_DEPTH / STRIP_LENGTH) ** 2, MODEL_FORM_WHY)]
-    fig, axes = new_figure()
-    ax = axes[0, 0]
-    yy = np.linspace(0, STRIP_LENGTH, 200)
-    ax.plot(yy * 1e3, timoshenko_uniform_load_deflection(q, yy) * 1e9, "-", label="Timoshenko beam")
-    ax.plot(yy * 1e3, q * yy**2 * (STRIP_LENGTH - yy) ** 2 / (24 * EI) * 1e9, ":", label="Euler-Bernoulli beam")
-    ax.plot(y * 1e3, w * 1e9, "o", ms=3, label="granplate Q8, 4 x 40 (neutral axis)")
-    ax.set_xlabel("position along the strip y [mm]")
-    ax.set_ylabel("deflection u_x [nm]")
-    ax.legend(fontsize=8)
-    name = save_figure(fig, ctx, "strip-deflection")
     desc = ("The paper's plate as a clamped-clamped strip (0.1 m x 0.01 m, 1 mm thick, steel, "
             "plane stress, top and bottom edges clamped) under a uniform body force along x "
             f"(q = {q:g} N/m per unit length), assembled with the plate module's functions on "
@@ -205,7 +200,22 @@ def strip_deflection(ctx: Context) -> CaseResult:
              "mesh error falls only as h^1.5: the stress is singular at the four corners where "
              "a clamped edge meets a free one, which caps the rate below the smooth-solution "
              "rates of the convergence case."]
-    return CaseResult("", "", "", desc, checks, name, notes=notes)
+    return CaseResult.of(desc, checks, plot={"q": q, "EI": EI, "y": y, "w": w}, notes=notes)
+
+
+def draw_strip_deflection(p: dict):
+    """The figure of strip_deflection, from its numbers."""
+    q, EI, y, w = p["q"], p["EI"], p["y"], p["w"]
+    fig, axes = new_figure()
+    ax = axes[0, 0]
+    yy = np.linspace(0, STRIP_LENGTH, 200)
+    ax.plot(yy * 1e3, timoshenko_uniform_load_deflection(q, yy) * 1e9, "-", label="Timoshenko beam")
+    ax.plot(yy * 1e3, q * yy**2 * (STRIP_LENGTH - yy) ** 2 / (24 * EI) * 1e9, ":", label="Euler-Bernoulli beam")
+    ax.plot(y * 1e3, w * 1e9, "o", ms=3, label="granplate Q8, 4 x 40 (neutral axis)")
+    ax.set_xlabel("position along the strip y [mm]")
+    ax.set_ylabel("deflection u_x [nm]")
+    ax.legend(fontsize=8)
+    return fig
 
 
 def timoshenko_clamped_frequencies(n: int = 3) -> np.ndarray:
@@ -267,17 +277,6 @@ def strip_frequencies(ctx: Context) -> CaseResult:
     checks = [Check(f"bending frequency {i + 1}, 4 x 40 mesh", "Hz", float(timo[i]),
                     "Timoshenko beam, clamped-clamped, Cowper k (determinant roots)", float(fe[i]),
                     (STRIP_DEPTH / STRIP_LENGTH) ** 2, MODEL_FORM_WHY) for i in range(3)]
-    fig, axes = new_figure()
-    ax = axes[0, 0]
-    modes = np.arange(1, 4)
-    ax.plot(modes, timo / 1e3, "s-", label="Timoshenko beam")
-    ax.plot(modes, euler / 1e3, "^:", label="Euler-Bernoulli beam")
-    ax.plot(modes, fe / 1e3, "o", label="granplate Q8, 4 x 40")
-    ax.set_xticks(modes)
-    ax.set_xlabel("bending mode")
-    ax.set_ylabel("frequency [kHz]")
-    ax.legend(fontsize=8)
-    name = save_figure(fig, ctx, "strip-frequencies")
     desc = ("Modes of the clamped strip built by `plate.build_plate` (the simulator's own "
             "reduction and generalised eigen-solve; 4 x 40 default mesh), keeping the lowest "
             "modes whose kinetic energy is mostly along x (bending). Reference: the "
@@ -289,7 +288,23 @@ def strip_frequencies(ctx: Context) -> CaseResult:
              f"Timoshenko {np.array2string(timo, precision=1)}, "
              f"Euler-Bernoulli {np.array2string(euler, precision=1)} "
              f"({np.array2string((fe / euler - 1) * 100, precision=1)}% off)."]
-    return CaseResult("", "", "", desc, checks, name, notes=notes)
+    return CaseResult.of(desc, checks, plot={"timo": timo, "euler": euler, "fe": fe}, notes=notes)
+
+
+def draw_strip_frequencies(p: dict):
+    """The figure of strip_frequencies, from its numbers."""
+    timo, euler, fe = p["timo"], p["euler"], p["fe"]
+    fig, axes = new_figure()
+    ax = axes[0, 0]
+    modes = np.arange(1, 4)
+    ax.plot(modes, timo / 1e3, "s-", label="Timoshenko beam")
+    ax.plot(modes, euler / 1e3, "^:", label="Euler-Bernoulli beam")
+    ax.plot(modes, fe / 1e3, "o", label="granplate Q8, 4 x 40")
+    ax.set_xticks(modes)
+    ax.set_xlabel("bending mode")
+    ax.set_ylabel("frequency [kHz]")
+    ax.legend(fontsize=8)
+    return fig
 
 
 # --------------------------------------------------------------------------- convergence
@@ -375,16 +390,6 @@ def q8_convergence(ctx: Context) -> CaseResult:
         Check("log-log slope of the energy-norm error, h = 1/4 ... 1/32", "-", 2.0, "FE theory: O(h^p), p = 2",
               p_en, 0.05, why, kind="abs"),
     ]
-    fig, axes = new_figure()
-    ax = axes[0, 0]
-    ax.loglog(h, errs[:, 0], "o-", label=f"L2 error (slope {p_l2:.3f})")
-    ax.loglog(h, errs[:, 1], "s-", label=f"energy-norm error (slope {p_en:.3f})")
-    ax.loglog(h, errs[0, 0] * (h / h[0]) ** 3, "k:", lw=0.8, label="h^3, h^2")
-    ax.loglog(h, errs[0, 1] * (h / h[0]) ** 2, "k:", lw=0.8)
-    ax.set_xlabel("element size h [-] (unit square)")
-    ax.set_ylabel("error [-]")
-    ax.legend(fontsize=8)
-    name = save_figure(fig, ctx, "q8-convergence")
     desc = ("Method of manufactured solutions: u = (sin pi x sin pi y, sin pi x sin 2 pi y) on "
             "the unit square (zero on the boundary), plane stress (E = 1, nu = 0.3), body force "
             "f = -div sigma(u) derived by hand (and checked by finite differences while writing "
@@ -397,7 +402,22 @@ def q8_convergence(ctx: Context) -> CaseResult:
         "a free one, so its mid-span deflection converges more slowly (about h^1.5, see the "
         "strip case); serendipity elements also lose one order on non-affine (distorted) "
         "meshes, which the plate never uses (its mesh is rectangular)."]
-    return CaseResult("", "", "", desc, checks, name, notes=notes)
+    return CaseResult.of(desc, checks, plot={"h": h, "errs": errs, "p_l2": p_l2, "p_en": p_en}, notes=notes)
+
+
+def draw_q8_convergence(p: dict):
+    """The figure of q8_convergence, from its numbers."""
+    h, errs, p_l2, p_en = p["h"], p["errs"], p["p_l2"], p["p_en"]
+    fig, axes = new_figure()
+    ax = axes[0, 0]
+    ax.loglog(h, errs[:, 0], "o-", label=f"L2 error (slope {p_l2:.3f})")
+    ax.loglog(h, errs[:, 1], "s-", label=f"energy-norm error (slope {p_en:.3f})")
+    ax.loglog(h, errs[0, 0] * (h / h[0]) ** 3, "k:", lw=0.8, label="h^3, h^2")
+    ax.loglog(h, errs[0, 1] * (h / h[0]) ** 2, "k:", lw=0.8)
+    ax.set_xlabel("element size h [-] (unit square)")
+    ax.set_ylabel("error [-]")
+    ax.legend(fontsize=8)
+    return fig
 
 
 # --------------------------------------------------------------------------- Newmark
@@ -467,6 +487,18 @@ def newmark_elongation(ctx: Context) -> CaseResult:
     checks.append(Check("energy drift max |E_n/E_0 - 1| (undamped mode)", "-", 0.0,
                         "average acceleration conserves energy exactly", drift, nsteps * EPS,
                         f"only round-off may accumulate: {nsteps} steps x eps.", kind="max"))
+    desc = ("One undamped mode (f = 1 kHz, q(0) = 1) advanced for 20 periods by the compiled "
+            "`newmark_predict` and `newmark_correct` (solver/plate_modal.py) that advance every plate mode "
+            "in a run (beta = 1/4, gamma = 1/2, no interface force), at omega h = 0.05 ... 0.4. "
+            "The numerical frequency is read exactly from the three-term recurrence of the "
+            "sequence. At the simulator's step (40 ns) the plate's first bending mode has "
+            "omega h ~ 1e-3: elongation 1e-7.")
+    return CaseResult.of(desc, checks, plot={"whs": whs, "elong": elong})
+
+
+def draw_newmark_elongation(p: dict):
+    """The figure of newmark_elongation, from its numbers."""
+    whs, elong = p["whs"], p["elong"]
     fig, axes = new_figure()
     ax = axes[0, 0]
     xx = np.geomspace(0.02, 1.0, 50)
@@ -476,20 +508,17 @@ def newmark_elongation(ctx: Context) -> CaseResult:
     ax.set_xlabel("omega h [-]")
     ax.set_ylabel("relative period elongation [-]")
     ax.legend(fontsize=8)
-    name = save_figure(fig, ctx, "newmark-elongation")
-    desc = ("One undamped mode (f = 1 kHz, q(0) = 1) advanced for 20 periods by the compiled "
-            "`newmark_predict` and `newmark_correct` (solver/plate_modal.py) that advance every plate mode "
-            "in a run (beta = 1/4, gamma = 1/2, no interface force), at omega h = 0.05 ... 0.4. "
-            "The numerical frequency is read exactly from the three-term recurrence of the "
-            "sequence. At the simulator's step (40 ns) the plate's first bending mode has "
-            "omega h ~ 1e-3: elongation 1e-7.")
-    return CaseResult("", "", "", desc, checks, name)
+    return fig
 
 
 CASES: tuple[Case, ...] = (
-    Case("patch-test", "plate", "Patch test on a distorted Q8 mesh", patch_test),
-    Case("strip-deflection", "plate", "Clamped strip: static mid-span deflection vs Timoshenko", strip_deflection),
-    Case("strip-frequencies", "plate", "Clamped strip: first three bending frequencies vs Timoshenko", strip_frequencies),
-    Case("q8-convergence", "plate", "Q8 convergence rates (manufactured solution)", q8_convergence),
-    Case("newmark-elongation", "plate", "Newmark period elongation vs (omega h)^2/12", newmark_elongation),
+    Case("patch-test", "plate", "Patch test on a distorted Q8 mesh", patch_test, draw=draw_patch_test),
+    Case("strip-deflection", "plate", "Clamped strip: static mid-span deflection vs Timoshenko", strip_deflection,
+         draw=draw_strip_deflection),
+    Case("strip-frequencies", "plate", "Clamped strip: first three bending frequencies vs Timoshenko", strip_frequencies,
+         draw=draw_strip_frequencies),
+    Case("q8-convergence", "plate", "Q8 convergence rates (manufactured solution)", q8_convergence,
+         draw=draw_q8_convergence),
+    Case("newmark-elongation", "plate", "Newmark period elongation vs (omega h)^2/12", newmark_elongation,
+         draw=draw_newmark_elongation),
 )

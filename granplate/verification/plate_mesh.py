@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from .base import Case, CaseResult, Check, Context, new_figure, save_figure
+from .base import Case, CaseResult, Check, Context, new_figure
 from .coupled import study_run
 
 #: Meshes of the convergence study (each halves the element), coarse to fine.
@@ -217,6 +217,24 @@ def plate_mesh_convergence(ctx: Context) -> CaseResult:
     table = convergence_table("quantity", rows, MESHES)
     dofs = "| reduced dofs | " + " | ".join(f"{b['n_red']:,}" for b in bare) + " | | |"
     table += "\n" + dofs
+    desc = ("The plate refined from 4 x 40 to 32 x 320 elements (2.5 to 0.31 mm) at a fixed rigid-layer "
+            f"width w = {LAYER_WIDTH * 1e3:g} mm. Bare plate: E_shock from the modes alone (each mode's energy "
+            "after the 10 us half-sine pulse, 1/2 q0^2 L_m^2 |P(omega_m)|^2; the dense basis on 4 x 40, the "
+            "truncated one below 1 MHz above, with a bound on the dropped modes' share), checked against "
+            "the solver's run on 4 x 40; after the pulse the plate's energy is E_shock. steel-r1: runs to "
+            f"{WINDOW * 1e3:g} ms (the plate's energy and stress peak inside it) with the default basis "
+            "(dense on 4 x 40, truncated above). Observed orders from three consecutive meshes, the last "
+            "one giving the Richardson limit.")
+    notes = ["Dropped modes' share of the bare-plate E_shock, upper bound: "
+             + ", ".join(f"{nx} x {ny}: {b['tail_bound'] / b['e_shock']:.1e}" for (nx, ny), b in zip(MESHES, bare))
+             + " (relative).",
+             _stress_note([r["max_von_mises"] for r in steel], [r["max_von_mises_disc"] for r in steel])]
+    return CaseResult.of(desc, checks, plot={"rows": rows, "steel": steel}, notes=notes, tables=[table])
+
+
+def draw_plate_mesh_convergence(p: dict):
+    """The figure of plate_mesh_convergence, from its numbers."""
+    rows, steel = p["rows"], p["steel"]
     fig, axes = new_figure(ncols=2, width=4.4, height=3.6)
     h = np.array([2.5 / (nx / 4) for nx, _ in MESHES])
     ax = axes[0, 0]
@@ -232,20 +250,7 @@ def plate_mesh_convergence(ctx: Context) -> CaseResult:
     element_size_axis(ax, h)
     ax.set_ylabel("steel-r1 stress [MPa]")
     ax.legend(fontsize=6)
-    fig_name = save_figure(fig, ctx, "plate-mesh-convergence")
-    desc = ("The plate refined from 4 x 40 to 32 x 320 elements (2.5 to 0.31 mm) at a fixed rigid-layer "
-            f"width w = {LAYER_WIDTH * 1e3:g} mm. Bare plate: E_shock from the modes alone (each mode's energy "
-            "after the 10 us half-sine pulse, 1/2 q0^2 L_m^2 |P(omega_m)|^2; the dense basis on 4 x 40, the "
-            "truncated one below 1 MHz above, with a bound on the dropped modes' share), checked against "
-            "the solver's run on 4 x 40; after the pulse the plate's energy is E_shock. steel-r1: runs to "
-            f"{WINDOW * 1e3:g} ms (the plate's energy and stress peak inside it) with the default basis "
-            "(dense on 4 x 40, truncated above). Observed orders from three consecutive meshes, the last "
-            "one giving the Richardson limit.")
-    notes = [f"Dropped modes' share of the bare-plate E_shock, upper bound: "
-             + ", ".join(f"{nx} x {ny}: {b['tail_bound'] / b['e_shock']:.1e}" for (nx, ny), b in zip(MESHES, bare))
-             + " (relative).",
-             _stress_note([r["max_von_mises"] for r in steel], [r["max_von_mises_disc"] for r in steel])]
-    return CaseResult("", "", "", desc, checks, fig_name, notes=notes, tables=[table])
+    return fig
 
 
 def _stress_note(peak: list[float], disc: list[float]) -> str:
@@ -264,7 +269,7 @@ def _stress_note(peak: list[float], disc: list[float]) -> str:
 
 # --------------------------------------------------------------------------- truncated basis
 
-def truncated_agreement(ctx: Context, meshes, t_end: float, name: str) -> CaseResult:
+def truncated_agreement(ctx: Context, meshes, t_end: float) -> CaseResult:
     """Every summary metric of steel-r1 with the truncated basis against the full one."""
     checks, table, diffs = [], [], {}
     for nx, ny in meshes:
@@ -278,6 +283,21 @@ def truncated_agreement(ctx: Context, meshes, t_end: float, name: str) -> CaseRe
         table.append(f"| {nx} x {ny} | " + " | ".join(f"{100 * d:+.3f}%" for d in diffs[(nx, ny)]) + " |")
     head = "| mesh | " + " | ".join(SUMMARY_METRICS) + " |"
     tables = ["\n".join([head, "|---" * (len(SUMMARY_METRICS) + 1) + "|"] + table)]
+    desc = ("steel-r1 (its rigid layer one element edge wide) run twice on each mesh, implicit scheme: with every "
+            "mode (plate.modes = \"all\", the exact full system) and with the modes below 1 MHz plus the "
+            "static residual compliance at the contacts (plate.modes = \"truncated\", docs/model.md "
+            "section 4.5). Every summary metric must agree within 0.5%.")
+    notes = ["The most sensitive metric is ep_final_fraction, the plate's free vibration left at the "
+             "end, a few per cent of E_shock. With the layer fixed at 2.5 mm on 8 x 80 (two element "
+             "edges) instead of one edge, the truncated basis put it 1.04% low over 2 ms (0.019270 against "
+             "0.019472, 2e-4 of E_shock), the other metrics within 0.12% (measured): raise "
+             "plate.max_frequency where that share matters."]
+    return CaseResult.of(desc, checks, plot={"meshes": meshes, "diffs": diffs}, notes=notes, tables=tables)
+
+
+def draw_truncated_agreement(p: dict):
+    """The figure of truncated_agreement, from its numbers."""
+    meshes, diffs = p["meshes"], p["diffs"]
     fig, axes = new_figure(width=7.0)
     ax = axes[0, 0]
     x = np.arange(len(SUMMARY_METRICS))
@@ -289,33 +309,24 @@ def truncated_agreement(ctx: Context, meshes, t_end: float, name: str) -> CaseRe
     ax.set_xticks(x, SUMMARY_METRICS, rotation=45, ha="right", fontsize=7)
     ax.set_ylabel("truncated / full - 1 [%]")
     ax.legend(fontsize=7)
-    fig_name = save_figure(fig, ctx, name)
-    desc = ("steel-r1 (its rigid layer one element edge wide) run twice on each mesh, implicit scheme: with every "
-            "mode (plate.modes = \"all\", the exact full system) and with the modes below 1 MHz plus the "
-            "static residual compliance at the contacts (plate.modes = \"truncated\", docs/model.md "
-            "section 4.5). Every summary metric must agree within 0.5%.")
-    notes = ["The most sensitive metric is ep_final_fraction, the plate's free vibration left at the "
-             "end, a few per cent of E_shock. With the layer fixed at 2.5 mm on 8 x 80 (two element "
-             "edges) instead of one edge, the truncated basis put it 1.04% low over 2 ms (0.019270 against "
-             "0.019472, 2e-4 of E_shock), the other metrics within 0.12% (measured): raise "
-             "plate.max_frequency where that share matters."]
-    return CaseResult("", "", "", desc, checks, fig_name, notes=notes, tables=tables)
+    return fig
 
 
 def truncated_basis(ctx: Context) -> CaseResult:
     """The fast check: 4 x 40, to 0.5 ms."""
-    return truncated_agreement(ctx, MESHES[:1], WINDOW, "truncated-basis")
+    return truncated_agreement(ctx, MESHES[:1], WINDOW)
 
 
 def truncated_basis_fine(ctx: Context) -> CaseResult:
     """The full check: 4 x 40 and 8 x 80, the whole 2 ms."""
-    return truncated_agreement(ctx, MESHES[:2], 2e-3, "truncated-basis-8x80")
+    return truncated_agreement(ctx, MESHES[:2], 2e-3)
 
 
 CASES: tuple[Case, ...] = (
-    Case("truncated-basis", "plate", "Truncated modal basis vs the full one, 4 x 40 (0.5 ms)", truncated_basis),
+    Case("truncated-basis", "plate", "Truncated modal basis vs the full one, 4 x 40 (0.5 ms)", truncated_basis,
+         draw=draw_truncated_agreement),
     Case("truncated-basis-8x80", "plate", "Truncated modal basis vs the full one, 4 x 40 and 8 x 80 (2 ms)",
-         truncated_basis_fine, slow=True),
+         truncated_basis_fine, slow=True, draw=draw_truncated_agreement),
     Case("plate-mesh-convergence", "plate", "Plate mesh convergence to 32 x 320: energies and stresses",
-         plate_mesh_convergence, slow=True),
+         plate_mesh_convergence, slow=True, draw=draw_plate_mesh_convergence),
 )
