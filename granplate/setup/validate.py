@@ -26,7 +26,8 @@ from granplate.setup.geometry import layout_packing, resolve
 from granplate.setup.layouts import column_radii, half_pitch, hexagonal_offsets, lattice_sites
 from granplate.setup.fields import finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
 from granplate.setup.plate_checks import check_plate_mesh
-from granplate.setup.plate_cost import MODE_CHOICES
+from granplate.setup.plate_cost import MEMORY_SHARE, MODE_CHOICES, physical_memory
+from granplate.setup.materials import Material
 from granplate.setup.scenario import (LAYOUT_KINDS, SQRT2_MINUS_1, ChainLayout, Granule,
                                       Imperfections, LatticeLayout, Layout, Scenario)
 
@@ -51,6 +52,11 @@ NORMAL_TOL = 1e-9
 RATIO_TOL = 1e-12
 #: Relative tolerance for field_interval being a multiple of output_interval.
 INTERVAL_RTOL = 1e-9
+#: Every coordinate and size lies within LENGTH_RANGE x the scenario's smallest length h
+#: (`length_scale`): there the spacing of doubles, 2.2e-16 |x|, stays below 2.2e-10 h,
+#: under the OVERLAP_RTOL x h tolerance at t = 0, so overlaps and gaps are resolved (and
+#: the k-d tree's squared distances cannot overflow).
+LENGTH_RANGE = 1e6
 
 
 # --------------------------------------------------------------------------- sections
@@ -206,12 +212,66 @@ def _check_granules(s: Scenario) -> None:
         for f in ("vx", "vy", "omega"):
             finite(f"{p}.{f}", getattr(g, f))
         material_exists(f"{p}.material", g.material, s)
+        _check_speeds(p, g, s.material(g.material))
         if not isinstance(g.label, str):
             raise ScenarioError(f"{p}.label", g.label, "must be a string")
         if g.label in seen:
             raise ScenarioError(f"{p}.label", g.label,
                                 f"labels must be unique; granules[{seen[g.label]}] has it too")
         seen[g.label] = i
+
+
+def bar_wave_speed(m: Material) -> float:
+    """c = sqrt(E / rho) [m/s]: the speed of elastic waves along a bar of material m."""
+    return math.sqrt(m.E / m.rho)
+
+
+def _check_speeds(p: str, g: Granule, m: Material) -> None:
+    """|vx|, |vy| and the surface speed |omega| R below the wave speed of the granule's
+    material: Hertz's law is quasi-static and holds for impact speeds far below it."""
+    c = bar_wave_speed(m)
+    for f, speed in (("vx", abs(g.vx)), ("vy", abs(g.vy)), ("omega", abs(g.omega) * g.radius)):
+        if not speed < c:
+            unit = "|omega| x radius" if f == "omega" else f"|{f}|"
+            raise ScenarioError(f"{p}.{f}", getattr(g, f),
+                                f"allowed: {unit} < sqrt(E / rho) = {c:.6g} m/s, the elastic "
+                                f"wave speed of material '{m.name}' (Hertz's contact law is "
+                                "quasi-static: it holds for speeds far below it)")
+
+
+def length_scale(s: Scenario) -> tuple[float, str]:
+    """(h [m], what it is): the smallest length of a resolved scenario whose granule radii
+    and plate sizes are valid numbers: a granule radius or a plate element edge."""
+    found = [(g.radius, f"granules[{i}].radius") for i, g in enumerate(s.granules)]
+    if s.plate is not None:
+        found += [(s.plate.width / s.plate.nx, "plate.width / plate.nx"),
+                  (s.plate.height / s.plate.ny, "plate.height / plate.ny")]
+    return min(found)
+
+
+def _check_lengths(s: Scenario) -> None:
+    """Coordinates and sizes within LENGTH_RANGE x the smallest length (see LENGTH_RANGE)."""
+    h, what = length_scale(s)
+    limit = LENGTH_RANGE * h
+    why = (f"{LENGTH_RANGE:g} x the smallest length of the scenario, h = {h:.6g} m ({what}): "
+           f"farther out, round-off of a coordinate (2.2e-16 |x|) exceeds the {OVERLAP_RTOL:g} h "
+           "overlap tolerance at t = 0")
+    values = [(f"granules[{i}].{f}", getattr(g, f)) for i, g in enumerate(s.granules)
+              for f in ("x", "y", "radius")]
+    values += [(f"walls[{k}].offset", w.offset) for k, w in enumerate(s.walls)]
+    if s.plate is not None:
+        pl = s.plate
+        values += [(f"plate.{f}", getattr(pl, f)) for f in ("x0", "y0", "width", "height", "thickness",
+                                                            "rigid_layer_width")
+                   if getattr(pl, f) is not None]
+    for path, v in values:
+        if not abs(v) <= limit:
+            raise ScenarioError(path, v, f"allowed: |value| <= {limit:.6g} m, {why}")
+
+
+def _check_overlaps(s: Scenario) -> None:
+    """Granules may touch but not overlap at t = 0 (k-d tree over the centres; the
+    coordinates are within `length_range`, so its squared distances cannot overflow)."""
     gs = s.granules
     for i, j in _close_pairs(gs):
         gi, gj = gs[i], gs[j]
@@ -257,6 +317,12 @@ def _check_walls(s: Scenario) -> None:
             raise ScenarioError(f"{p}.label", w.label,
                                 f"labels must be unique; walls[{seen[w.label]}] has it too")
         seen[w.label] = k
+
+
+def _check_wall_penetration(s: Scenario) -> None:
+    """No granule crosses a wall at t = 0."""
+    for k, w in enumerate(s.walls):
+        n = w.normal
         for i, g in enumerate(s.granules):
             pen = g.x * n[0] + g.y * n[1] + g.radius - w.offset
             if pen > OVERLAP_RTOL * g.radius:
@@ -273,7 +339,7 @@ def _check_plate(s: Scenario) -> None:
     for f in ("width", "height", "thickness"):
         positive(f"plate.{f}", getattr(pl, f))
     material_exists("plate.material", pl.material, s)
-    x0 = finite("plate.x0", pl.x0)
+    finite("plate.x0", pl.x0)
     finite("plate.y0", pl.y0)
     int_at_least("plate.nx", pl.nx, 1)
     int_at_least("plate.ny", pl.ny, 1)
@@ -295,6 +361,14 @@ def _check_plate(s: Scenario) -> None:
                                 f"allowed: 0 < r <= max(plate.width, plate.height) = "
                                 f"{max(pl.width, pl.height):g} m (a disc larger than the plate "
                                 "averages over all of it)")
+
+
+def _check_plate_penetration(s: Scenario) -> None:
+    """No granule crosses the plate's left edge at t = 0."""
+    pl = s.plate
+    if pl is None:
+        return
+    x0 = pl.x0
     for i, g in enumerate(s.granules):
         if pl.y0 <= g.y <= pl.y0 + pl.height:
             pen = g.x + g.radius - x0
@@ -312,6 +386,14 @@ def _check_load(s: Scenario) -> None:
     q0 = finite("load.q0", ld.q0, "must be >= 0 (a finite number) [N/m]")
     if not q0 >= 0.0:
         raise ScenarioError("load.q0", ld.q0, "must be >= 0 [N/m]")
+    e_max, h = _stiffest_modulus(s), length_scale(s)[0]
+    if not q0 <= e_max * h:
+        raise ScenarioError("load.q0", ld.q0,
+                            f"allowed: 0 <= q0 <= E h = {e_max * h:.6g} N/m, E = {e_max:.6g} Pa the "
+                            f"largest Young's modulus of the granules and plate, h = {h:.6g} m the "
+                            "smallest length (a granule radius or plate element edge): a larger "
+                            "line load presses on h harder than E, far beyond Hertz's small "
+                            "overlaps and linear elasticity")
     positive("load.duration", ld.duration)
     positive("load.length", ld.length)
     finite("load.y0", ld.y0)
@@ -334,12 +416,21 @@ def _check_load(s: Scenario) -> None:
                                 "use target = \"plate\" or kind = \"none\"")
 
 
+def _stiffest_modulus(s: Scenario) -> float:
+    """The largest Young's modulus [Pa] of the granules' and the plate's materials."""
+    names = {g.material for g in s.granules} | ({s.plate.material} if s.plate is not None else set())
+    return max(s.material(n).E for n in names)
+
+
 def _check_contact(s: Scenario) -> None:
     c = s.contact
     nonneg("contact.mu", c.mu)
     positive("contact.k_s", c.k_s)
     nonneg("contact.alpha_n", c.alpha_n)
     nonneg("contact.neighbour_gap", c.neighbour_gap)
+    if c.neighbour_gap > 1.0:
+        raise ScenarioError("contact.neighbour_gap", c.neighbour_gap,
+                            "must be at most 1 (a gap of at most the smaller radius, as contact.skin)")
     string_in("contact.torque_arm", c.torque_arm, TORQUE_ARMS)
     string_in("contact.detection", c.detection, DETECTIONS)
     positive("contact.skin", c.skin)
@@ -390,6 +481,43 @@ def _check_time(s: Scenario) -> None:
                             f"{t.output_interval!r}")
 
 
+#: Bytes kept per output time, per granule (its state in the buffers, the Dataset and
+#: the file written: 3 copies of 6 numbers and a few per contact) and per plate dof (the
+#: modal coordinates and their rates, 3 copies), and per plate snapshot and plate dof
+#: (displacements, strains and stresses at the nodes, 3 copies).
+OUTPUT_BYTES_PER_GRANULE = 3 * 8 * 12
+OUTPUT_BYTES_PER_DOF = 3 * 8 * 2
+FIELD_BYTES_PER_DOF = 3 * 8 * 4
+
+
+def output_bytes_per_second(s: Scenario) -> float:
+    """About the memory [bytes] a run's outputs take per second of simulated time: a row
+    of the granules' states and the plate's modal coordinates per output_interval, a plate
+    snapshot per field_interval (s resolved)."""
+    t = s.time
+    n_dof = 0
+    if s.plate is not None:
+        p = s.plate
+        n_dof = 2 * ((p.nx + 1) * (p.ny + 1) + p.nx * (p.ny + 1) + p.ny * (p.nx + 1))
+    row = OUTPUT_BYTES_PER_GRANULE * len(s.granules) + OUTPUT_BYTES_PER_DOF * n_dof + 400.0
+    return row / t.output_interval + FIELD_BYTES_PER_DOF * n_dof / t.field_interval
+
+
+def _check_output_size(s: Scenario) -> None:
+    """The outputs of t_end fit in MEMORY_SHARE of the machine's memory."""
+    memory = MEMORY_SHARE * physical_memory()
+    t_max = memory / output_bytes_per_second(s)
+    t = s.time
+    if memory > 0.0 and not t.t_end <= t_max:
+        raise ScenarioError(
+            "time.t_end", t.t_end,
+            f"allowed: t_end <= {t_max:.3g} s with these output intervals: the outputs would need "
+            f"about {t.t_end / t_max * (memory / 1e9):.3g} GB ({t.t_end / t.output_interval:.3g} "
+            f"output times, time.output_interval = {t.output_interval!r} s; "
+            f"{t.t_end / t.field_interval:.3g} plate snapshots, time.field_interval = "
+            f"{t.field_interval!r} s), this machine allows {memory / 1e9:.3g} GB")
+
+
 def _check_solver(s: Scenario) -> None:
     sv = s.solver
     string_in("solver.scheme", sv.scheme, SCHEMES)
@@ -432,10 +560,15 @@ def validate(scenario: Scenario) -> None:
     _check_granules(r)
     _check_walls(r)
     _check_plate(r)
+    _check_lengths(r)
+    _check_overlaps(r)
+    _check_wall_penetration(r)
+    _check_plate_penetration(r)
     _check_load(r)
     _check_contact(r)
     check_plate_mesh(r)
     _check_time(r)
+    _check_output_size(r)
     _check_solver(r)
 
 
