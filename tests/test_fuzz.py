@@ -81,14 +81,14 @@ def cases(n: int, seed: int) -> list[tuple[str, object]]:
     """n (field, bad value) pairs drawn without replacement by a seeded RNG."""
     product = list(itertools.product(numeric_fields(BASE), BAD_VALUES))
     rng = np.random.default_rng(seed)
-    return [product[k] for k in sorted(rng.choice(len(product), size=n, replace=False))]
+    return [product[k] for k in rng.choice(len(product), size=n, replace=False)]
 
 
 def names_field(message: str, path: str) -> bool:
     """The message names the field; a conflict between bodies (an overlap, a crossed wall)
     may name the body instead (granules[1] for granules[1].y), a vector its whole
     (walls[0].normal for walls[0].normal[1])."""
-    if f"'{path}'" in message:
+    if re.search(re.escape(path) + r"(?![\w\[.])", message):
         return True
     body = re.match(r"^((?:granules|walls)\[\d+\])\.(?:x|y|radius|offset)$", path)
     if body and body.group(1) in message:

@@ -325,3 +325,35 @@ def test_docs_python_example_runs(tmp_path, monkeypatch, capsys):
     out = capsys.readouterr().out
     assert "changed: load.q0 = 10000, layout.R2_ratio = 0.5, plate.ny = 80" in out
     assert (tmp_path / "my_case.toml").exists()
+
+
+@pytest.mark.parametrize("text, field, near", [
+    ('nmae = "x"', "nmae", "name"),
+    ('[layout]\nR2_ratoi = 0.5', "layout.R2_ratoi", "layout.R2_ratio"),
+    ('[layout]\nkind = "chain"\ncuont = 3', "layout.cuont", "layout.count"),
+    ('[layout.imperfections]\njiter = 0.1', "layout.imperfections.jiter", "layout.imperfections.jitter"),
+    ('[plate]\nnxx = 4', "plate.nxx", "plate.nx"),
+    ('[contact]\nskn = 0.1', "contact.skn", "contact.skin"),
+    ('[[contact.pairs]]\nmaterials = ["steel", "ptfe"]\nmuu = 0.2', "contact.pairs[0].muu", "contact.pairs[0].mu"),
+    ('[materials.foam]\nE = 1e6\nnu = 0.2\nrh = 30.0', "materials.foam.rh", "materials.foam.rho"),
+    ('[[granules]]\nx = 0\ny = 0\nmaterial = "steel"\nradius = 0.01\nraduis = 0.01', "granules[0].raduis", "granules[0].radius"),
+    ('[[walls]]\nnormal = [1.0, 0.0]\noffset = 0.0\nofset = 1.0', "walls[0].ofset", "walls[0].offset"),
+    ('[load]\nduraton = 1e-5', "load.duraton", "load.duration"),
+    ('[time]\nt_edn = 1e-4', "time.t_edn", "time.t_end"),
+    ('[solver]\nshceme = "paper"', "solver.shceme", "solver.scheme"),
+])
+def test_unknown_field_suggests_the_closest_name(text, field, near):
+    """A misspelled key in any table: the error names it, suggests the closest allowed
+    name (difflib) with its dotted path, and still lists the allowed ones."""
+    with pytest.raises(ScenarioError) as err:
+        scenario_io.loads(text)
+    msg = str(err.value)
+    assert err.value.field == field
+    assert f"did you mean '{near}'?" in msg and "; allowed: " in msg
+
+
+def test_unknown_field_far_from_every_name_suggests_nothing():
+    """A key like no allowed one gets the list of allowed names without a guess."""
+    with pytest.raises(ScenarioError, match="allowed: ") as err:
+        scenario_io.loads("[plate]\nzzzzzz = 1")
+    assert "did you mean" not in str(err.value)

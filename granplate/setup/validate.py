@@ -46,6 +46,10 @@ PLATE_EDGES: tuple[str, ...] = ("top", "bottom", "left", "right")
 
 #: Relative tolerance on overlaps/penetrations at t = 0 (times the smaller radius).
 OVERLAP_RTOL = 1e-9
+#: Largest Young's modulus [Pa] and density [kg/m^3] of a material: about ten times and
+#: four times those of the stiffest and the densest solids (diamond, osmium).
+E_MAX = 1e13
+RHO_MAX = 1e5
 #: Tolerance on |normal| - 1 for walls.
 NORMAL_TOL = 1e-9
 #: Tolerance on the R2/R1 bounds.
@@ -67,10 +71,16 @@ def _check_materials(s: Scenario) -> None:
     for name, m in s.materials.items():
         p = f"materials.{name}"
         positive(f"{p}.E", m.E)
+        if m.E > E_MAX:
+            raise ScenarioError(f"{p}.E", m.E, f"must be in (0, {E_MAX:g}] Pa (diamond, the "
+                                "stiffest solid, has 1.2e12)")
         finite(f"{p}.nu", m.nu, "must be in (-1, 0.5) (a finite number)")
         if not -1.0 < m.nu < 0.5:
             raise ScenarioError(f"{p}.nu", m.nu, "must be in (-1, 0.5)")
         positive(f"{p}.rho", m.rho)
+        if m.rho > RHO_MAX:
+            raise ScenarioError(f"{p}.rho", m.rho, f"must be in (0, {RHO_MAX:g}] kg/m^3 (osmium, "
+                                "the densest solid, has 22,590)")
 
 
 def _check_layout(s: Scenario) -> None:
@@ -375,7 +385,7 @@ def _check_plate_penetration(s: Scenario) -> None:
             if pen > OVERLAP_RTOL * g.radius:
                 raise ScenarioError(
                     f"granules[{i}]", g.label,
-                    f"penetrates the plate (left edge x0 = {x0:.6g} m) by {pen:.6g} m at "
+                    f"penetrates the plate (left edge plate.x0 = {x0:.6g} m) by {pen:.6g} m at "
                     f"t = 0; granules must lie left of the plate (x + radius <= plate.x0)")
 
 
@@ -422,11 +432,47 @@ def _stiffest_modulus(s: Scenario) -> float:
     return max(s.material(n).E for n in names)
 
 
+#: Largest Coulomb coefficient (real dry pairs stay below about 2, rubber on glass).
+MU_MAX = 10.0
+#: Largest tanh smoothing k_s [s/m]: a smoothing slip rate 1/k_s of at least 1 um/s (the
+#: paper's is 1 mm/s); a sharper law is a step in the slip rate that no time step resolves.
+KS_MAX = 1e6
+
+
+#: Largest damping coefficient alpha_n of eq. (3): near 2 a contact is already critically
+#: damped (restitution about 0); more only stiffens the time integration.
+ALPHA_N_MAX = 10.0
+
+
+def _damping(path: str, alpha_n: Any) -> None:
+    """alpha_n in [0, ALPHA_N_MAX] (None: not given)."""
+    if alpha_n is None:
+        return
+    nonneg(path, alpha_n)
+    if alpha_n > ALPHA_N_MAX:
+        raise ScenarioError(path, alpha_n, f"must be in [0, {ALPHA_N_MAX:g}] (eq. 3's damping "
+                            "coefficient; near 2 a contact is already critically damped)")
+
+
+def _friction(path: str, mu: Any, k_s: Any) -> None:
+    """mu in [0, MU_MAX] and k_s in (0, KS_MAX] (either None: not given)."""
+    if mu is not None:
+        nonneg(f"{path}.mu", mu)
+        if mu > MU_MAX:
+            raise ScenarioError(f"{path}.mu", mu, f"must be in [0, {MU_MAX:g}] (a Coulomb "
+                                "coefficient; real dry pairs stay below about 2)")
+    if k_s is not None:
+        positive(f"{path}.k_s", k_s)
+        if k_s > KS_MAX:
+            raise ScenarioError(f"{path}.k_s", k_s, f"must be in (0, {KS_MAX:g}] s/m (a smoothing "
+                                "slip rate 1/k_s of at least 1 um/s; sharper, friction is a step no "
+                                "time step resolves)")
+
+
 def _check_contact(s: Scenario) -> None:
     c = s.contact
-    nonneg("contact.mu", c.mu)
-    positive("contact.k_s", c.k_s)
-    nonneg("contact.alpha_n", c.alpha_n)
+    _friction("contact", c.mu, c.k_s)
+    _damping("contact.alpha_n", c.alpha_n)
     nonneg("contact.neighbour_gap", c.neighbour_gap)
     if c.neighbour_gap > 1.0:
         raise ScenarioError("contact.neighbour_gap", c.neighbour_gap,
@@ -437,6 +483,9 @@ def _check_contact(s: Scenario) -> None:
     if c.skin > 1.0:
         raise ScenarioError("contact.skin", c.skin, "must be at most 1 (a fraction of R_i + R_j)")
     positive("contact.overlap_warn", c.overlap_warn)
+    if not c.overlap_warn < 1.0:
+        raise ScenarioError("contact.overlap_warn", c.overlap_warn,
+                            "must be in (0, 1) (a fraction of the smaller radius)")
     positive("contact.overlap_stop", c.overlap_stop)
     if not c.overlap_warn <= c.overlap_stop < 1.0:
         raise ScenarioError("contact.overlap_stop", c.overlap_stop,
@@ -450,12 +499,8 @@ def _check_contact(s: Scenario) -> None:
             raise ScenarioError(f"{p}.materials", mats, "must be two material names")
         for k, m in enumerate(mats):
             material_exists(f"{p}.materials[{k}]", m, s)
-        if pc.alpha_n is not None:
-            nonneg(f"{p}.alpha_n", pc.alpha_n)
-        if pc.mu is not None:
-            nonneg(f"{p}.mu", pc.mu)
-        if pc.k_s is not None:
-            positive(f"{p}.k_s", pc.k_s)
+        _damping(f"{p}.alpha_n", pc.alpha_n)
+        _friction(p, pc.mu, pc.k_s)
 
 
 def _check_time(s: Scenario) -> None:
@@ -475,10 +520,10 @@ def _check_time(s: Scenario) -> None:
                             f"must be <= time.t_end = {t.t_end!r}")
     r = t.field_interval / t.output_interval
     n = round(r)
-    if n < 1 or abs(r - n) > INTERVAL_RTOL * r:
+    if n < 1 or abs(r - n) > INTERVAL_RTOL * r or n > 2**53:
         raise ScenarioError("time.field_interval", t.field_interval,
-                            f"must be a whole multiple (>= 1) of time.output_interval = "
-                            f"{t.output_interval!r}")
+                            f"must be a whole multiple n of time.output_interval = "
+                            f"{t.output_interval!r}, 1 <= n <= 2^53 (beyond, every double is whole)")
 
 
 #: Bytes kept per output time, per granule (its state in the buffers, the Dataset and
