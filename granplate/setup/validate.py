@@ -250,8 +250,9 @@ def _check_speeds(p: str, g: Granule, m: Material) -> None:
 
 
 def length_scale(s: Scenario) -> tuple[float, str]:
-    """(h [m], what it is): the smallest length of a resolved scenario whose granule radii
-    and plate sizes are valid numbers: a granule radius or a plate element edge."""
+    """(h [m], the field it comes from): the smallest length of a resolved scenario, a
+    granule radius or a plate element edge (width / nx, height / ny); its radii and plate
+    sizes already checked to be positive numbers."""
     found = [(g.radius, f"granules[{i}].radius") for i, g in enumerate(s.granules)]
     if s.plate is not None:
         found += [(s.plate.width / s.plate.nx, "plate.width / plate.nx"),
@@ -281,7 +282,7 @@ def _check_lengths(s: Scenario) -> None:
 
 def _check_overlaps(s: Scenario) -> None:
     """Granules may touch but not overlap at t = 0 (k-d tree over the centres; the
-    coordinates are within `length_range`, so its squared distances cannot overflow)."""
+    coordinates are within LENGTH_RANGE x h, so its squared distances cannot overflow)."""
     gs = s.granules
     for i, j in _close_pairs(gs):
         gi, gj = gs[i], gs[j]
@@ -584,10 +585,11 @@ def validate(scenario: Scenario) -> None:
     """Raise ScenarioError(field, value, allowed) for the first problem in `scenario`.
 
     Order: materials, layout (as `layout.*`, before it is expanded), then on the resolved
-    scenario: granules (values, unique labels, overlaps), walls (unit normals,
-    penetration), plate, load, contact, plate mesh (contacts on nodes, rigid layers,
-    n_modes), time, solver. A scenario with neither granules
-    (nor a layout) nor a plate is refused.
+    scenario: granules (values, speeds, unique labels), walls (unit normals), plate, the
+    range of every coordinate and size (`LENGTH_RANGE`), overlaps and penetrations at
+    t = 0, load, contact, plate mesh (contacts on nodes, rigid layers, n_modes), time, the
+    outputs' memory, solver. A scenario with neither granules (nor a layout) nor a plate
+    is refused.
     """
     s = scenario
     if not isinstance(s.name, str):
