@@ -380,3 +380,4 @@ def test_far_coordinates_and_fast_granules_are_refused_with_the_range():
     with pytest.raises(ScenarioError, match=r"'load\.q0'.*q0 <= E h = 2e\+09 N/m"):
         validate(_two_spheres(load=shock))
     validate(_two_spheres(load=dataclasses.replace(shock, q0=1.99e9)))
+    validate(_two_spheres(load=dataclasses.replace(shock, kind="none")))  # no load: q0 unused
