@@ -56,7 +56,7 @@ N_CASES = 45
 #: cannot fit, a snapshot stride no integer holds, a damping that overflows the forces.
 ALWAYS: tuple = (("granules[1].y", 1e300), ("time.t_end", 1e300), ("time.field_interval", 1e300),
                  ("contact.pairs[0].alpha_n", 1e300))
-N_CLI_CASES = 4
+N_CLI_CASES = 3
 #: A run of 2 us of this scenario takes well under a second once the kernels are compiled;
 #: the limit also covers their first compilation (1-3 min on a loaded machine).
 RUN_TIMEOUT_S = 600.0
