@@ -14,6 +14,7 @@ import sys
 from pathlib import Path
 
 from granplate.errors import ScenarioError, SimulationError
+from granplate.setup.fields import positive
 
 #: modules that add subcommands: each defines register(subparsers), adding parsers whose
 #: `func(args) -> int` runs the command (ScenarioError is reported as a user error).
@@ -46,7 +47,7 @@ SUMMARY_ROWS = (
 )
 
 
-#: An energy below this fraction of e_in is round-off (a run from rest has E_initial ~1e-33 J).
+#: An energy below this fraction of e_in is negligible (a run from rest has E_initial = 0).
 NEGLIGIBLE = 1e-9
 
 
@@ -197,13 +198,54 @@ def show_notes(quiet: bool) -> None:
     logger.setLevel(logging.WARNING if quiet else logging.INFO)
 
 
-def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
-    show_notes(bool(getattr(args, "quiet", False)))
-    if getattr(args, "t_end", None) is not None and not args.t_end > 0:
-        print(f"granplate: error: --t-end = {args.t_end!r}: must be > 0 (seconds)", file=sys.stderr)
-        return 2
+def _value_options(parser: argparse.ArgumentParser) -> set[str]:
+    """The option strings of `parser` and its subcommands that take a value (--t-end, -o...)."""
+    found: set[str] = set()
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for sub in action.choices.values():
+                found |= _value_options(sub)
+        elif action.option_strings and action.nargs != 0:
+            found.update(action.option_strings)
+    return found
+
+
+def _is_negative_number(text: str) -> bool:
+    """'-1e-4', '-inf', '-5': a value argparse would take for an option (its own test
+    knows plain decimals only)."""
+    if not text.startswith("-"):
+        return False
     try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def join_negative_values(parser: argparse.ArgumentParser, argv: list[str]) -> list[str]:
+    """argv with "OPTION -1e-4" written "OPTION=-1e-4" for every option that takes a value,
+    so that a negative number reaches the checks that name the field (argparse would
+    read it as an option and answer "expected one argument")."""
+    options = _value_options(parser)
+    out: list[str] = []
+    i = 0
+    while i < len(argv):
+        if argv[i] in options and i + 1 < len(argv) and _is_negative_number(argv[i + 1]):
+            out.append(f"{argv[i]}={argv[i + 1]}")
+            i += 2
+            continue
+        out.append(argv[i])
+        i += 1
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(join_negative_values(parser, sys.argv[1:] if argv is None else list(argv)))
+    show_notes(bool(getattr(args, "quiet", False)))
+    try:
+        if getattr(args, "t_end", None) is not None:
+            positive("time.t_end", args.t_end)  # the field's own check, before any command runs
         return int(args.func(args))
     except ScenarioError as err:
         print(f"granplate: error: {err}", file=sys.stderr)

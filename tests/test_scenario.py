@@ -65,7 +65,7 @@ BAD = [
     ("granule through the plate", _with({"plate.x0": 0.05}), "granules[9]",
      "penetrates the plate"),
     ("unknown field", _toml("[plate]\nnxx = 4\n"), "plate.nxx",
-     "unknown field 'plate.nxx'; allowed: width, height"),
+     "unknown field 'plate.nxx'; did you mean 'plate.nx'? allowed: width, height"),
     ("missing field", _toml('[[granules]]\nx = 0\ny = 0\nradius = 0.01\nmaterial = "steel"\n'
                             '[[granules]]\nx = 0\ny = 0.1\nmaterial = "steel"\n'),
      "granules[1].radius", "missing required field 'granules[1].radius'"),
@@ -352,3 +352,59 @@ def test_docs_python_example_runs(tmp_path, monkeypatch, capsys):
     out = capsys.readouterr().out
     assert "changed: load.q0 = 10000, layout.R2_ratio = 0.5, plate.ny = 80" in out
     assert (tmp_path / "my_case.toml").exists()
+
+
+@pytest.mark.parametrize("text, field, near", [
+    ('nmae = "x"', "nmae", "name"),
+    ('[layout]\nR2_ratoi = 0.5', "layout.R2_ratoi", "layout.R2_ratio"),
+    ('[layout]\nkind = "chain"\ncuont = 3', "layout.cuont", "layout.count"),
+    ('[layout.imperfections]\njiter = 0.1', "layout.imperfections.jiter", "layout.imperfections.jitter"),
+    ('[plate]\nnxx = 4', "plate.nxx", "plate.nx"),
+    ('[contact]\nskn = 0.1', "contact.skn", "contact.skin"),
+    ('[[contact.pairs]]\nmaterials = ["steel", "ptfe"]\nmuu = 0.2', "contact.pairs[0].muu", "contact.pairs[0].mu"),
+    ('[materials.foam]\nE = 1e6\nnu = 0.2\nrh = 30.0', "materials.foam.rh", "materials.foam.rho"),
+    ('[[granules]]\nx = 0\ny = 0\nmaterial = "steel"\nradius = 0.01\nraduis = 0.01', "granules[0].raduis", "granules[0].radius"),
+    ('[[walls]]\nnormal = [1.0, 0.0]\noffset = 0.0\nofset = 1.0', "walls[0].ofset", "walls[0].offset"),
+    ('[load]\nduraton = 1e-5', "load.duraton", "load.duration"),
+    ('[time]\nt_edn = 1e-4', "time.t_edn", "time.t_end"),
+    ('[solver]\nshceme = "paper"', "solver.shceme", "solver.scheme"),
+])
+def test_unknown_field_suggests_the_closest_name(text, field, near):
+    """A misspelled key in any table: the error names it, suggests the closest allowed
+    name (difflib) with its dotted path, and still lists the allowed ones."""
+    with pytest.raises(ScenarioError) as err:
+        scenario_io.loads(text)
+    msg = str(err.value)
+    assert err.value.field == field
+    assert f"did you mean '{near}'? allowed: " in msg
+
+
+def test_unknown_field_far_from_every_name_suggests_nothing():
+    """A key like no allowed one gets the list of allowed names without a guess."""
+    with pytest.raises(ScenarioError, match="allowed: ") as err:
+        scenario_io.loads("[plate]\nzzzzzz = 1")
+    assert "did you mean" not in str(err.value)
+
+
+def test_far_coordinates_and_fast_granules_are_refused_with_the_range():
+    """A granule at x = 1e300 (which overflows the neighbour search's squared distances),
+    a wall 1e7 radii out, a speed above sqrt(E/rho) and a shock pressing harder than E on
+    the smallest length: each named, with the bound derived from the scenario."""
+    g = (Granule(0.0, 0.0, 0.01, "steel", "a"), Granule(0.03, 0.0, 0.01, "steel", "b"))
+    far = dataclasses.replace(g[1], x=1e300)
+    with pytest.raises(ScenarioError, match=r"'granules\[1\]\.x'.*\|value\| <= 10000 m, 1e\+06 x the "
+                       r"smallest length of the scenario, h = 0\.01 m \(granules\[0\]\.radius\)"):
+        validate(_two_spheres(granules=(g[0], far)))
+    wall = Wall((1.0, 0.0), 1.0e5, "far")
+    with pytest.raises(ScenarioError, match=r"'walls\[0\]\.offset'"):
+        validate(_two_spheres(walls=(wall,)))
+    c = math.sqrt(LIBRARY["steel"].E / LIBRARY["steel"].rho)
+    for f, v in (("vx", 1.01 * c), ("vy", -1.01 * c), ("omega", 1.01 * c / 0.01)):
+        with pytest.raises(ScenarioError, match=rf"'granules\[0\]\.{f}'.*sqrt\(E / rho\) = {c:.6g} m/s"):
+            validate(_two_spheres(granules=(dataclasses.replace(g[0], **{f: v}), g[1])))
+    validate(_two_spheres(granules=(dataclasses.replace(g[0], vx=0.99 * c), g[1])))
+    shock = Load(q0=2.01e9, length=0.05, y0=-0.025)  # E_steel x h = 2e11 x 0.01 = 2e9 N/m
+    with pytest.raises(ScenarioError, match=r"'load\.q0'.*q0 <= E h = 2e\+09 N/m"):
+        validate(_two_spheres(load=shock))
+    validate(_two_spheres(load=dataclasses.replace(shock, q0=1.99e9)))
+    validate(_two_spheres(load=dataclasses.replace(shock, kind="none")))  # no load: q0 unused

@@ -122,3 +122,16 @@ def test_summary_only_run_gives_the_full_runs_summary(short_runs, name, changes)
     assert a == b and a["max_von_mises"] > 0
     assert np.array_equal(full["mass"].values, light["mass"].values)
     assert "plate_ux" not in light and "plate_ux" in full
+
+
+@pytest.mark.parametrize("v", [0.0, 0.5])
+def test_initial_energy_is_the_kinetic_energy_of_the_initial_velocities(v):
+    """E_initial = sum 1/2 m v^2 exactly (0 from rest), although two spheres touching at
+    x = R and 3R overlap by round-off (2R - (0.03 - 0.01) = 3.5e-18 m) and store ~1e-35 J."""
+    from conftest import two_spheres
+
+    ds = gp.simulate(two_spheres(v, t_end=2e-7, out=1e-7), progress=False)
+    assert float(ds.E_contact[0]) > 0.0  # the round-off energy is there ...
+    m = 7850.0 * 4.0 / 3.0 * np.pi * 0.01**3
+    assert ds.attrs["E_initial"] == pytest.approx(2 * 0.5 * m * v**2, rel=1e-14, abs=0.0)  # ... but not counted
+    assert gp.summary(ds)["e_initial"] == ds.attrs["E_initial"]

@@ -14,6 +14,7 @@ Every error is a `ScenarioError` naming the field by its dotted path (`plate.nx`
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import numbers
 import os
 import re
@@ -121,13 +122,22 @@ def _convert(path: str, value: Any, tp: Any) -> Any:
     raise TypeError(f"unsupported annotation {tp!r}")  # pragma: no cover
 
 
+def closest_name(name: str, allowed: list[str]) -> str | None:
+    """The allowed name closest to a misspelled `name` (difflib's ratio >= 0.6), or None."""
+    close = difflib.get_close_matches(str(name), allowed, n=1)
+    return close[0] if close else None
+
+
 def _check_keys(path: str, d: Any, allowed: list[str]) -> None:
+    """Refuse a key of table `d` (at `path`) that is not in `allowed`, suggesting the closest."""
     if not isinstance(d, dict):
         raise ScenarioError(path or "scenario", d, "wrong type: expected a table")
     for k in d:
         if k not in allowed:
             full = f"{path}.{k}" if path else str(k)
-            raise ScenarioError(full, d[k], f"unknown field '{full}'; allowed: "
+            near = closest_name(k, allowed)
+            hint = "" if near is None else f"did you mean '{f'{path}.{near}' if path else near}'? "
+            raise ScenarioError(full, d[k], f"unknown field '{full}'; {hint}allowed: "
                                 + ", ".join(allowed))
 
 

@@ -26,6 +26,8 @@ from granplate.setup.geometry import layout_packing, resolve
 from granplate.setup.layouts import column_radii, half_pitch, hexagonal_offsets, lattice_sites
 from granplate.setup.fields import finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
 from granplate.setup.plate_checks import check_plate_fields, check_plate_mesh
+from granplate.setup.plate_cost import MEMORY_SHARE, physical_memory
+from granplate.setup.materials import Material
 from granplate.setup.scenario import (LAYOUT_KINDS, SQRT2_MINUS_1, ChainLayout, Granule,
                                       Imperfections, LatticeLayout, Layout, Scenario)
 
@@ -43,12 +45,21 @@ LOAD_TARGETS: tuple[str, ...] = ("granules", "plate")
 
 #: Relative tolerance on overlaps/penetrations at t = 0 (times the smaller radius).
 OVERLAP_RTOL = 1e-9
+#: Largest Young's modulus [Pa] and density [kg/m^3] of a material: about ten times and
+#: four times those of the stiffest and the densest solids (diamond, osmium).
+E_MAX = 1e13
+RHO_MAX = 1e5
 #: Tolerance on |normal| - 1 for walls.
 NORMAL_TOL = 1e-9
 #: Tolerance on the R2/R1 bounds.
 RATIO_TOL = 1e-12
 #: Relative tolerance for field_interval being a multiple of output_interval.
 INTERVAL_RTOL = 1e-9
+#: Every coordinate and size lies within LENGTH_RANGE x the scenario's smallest length h
+#: (`length_scale`): there the spacing of doubles, 2.2e-16 |x|, stays below 2.2e-10 h,
+#: under the OVERLAP_RTOL x h tolerance at t = 0, so overlaps and gaps are resolved (and
+#: the k-d tree's squared distances cannot overflow).
+LENGTH_RANGE = 1e6
 
 
 # --------------------------------------------------------------------------- sections
@@ -59,12 +70,18 @@ def _check_materials(s: Scenario) -> None:
     for name, m in s.materials.items():
         p = f"materials.{name}"
         positive(f"{p}.E", m.E)
+        if m.E > E_MAX:
+            raise ScenarioError(f"{p}.E", m.E, f"must be in (0, {E_MAX:g}] Pa (diamond, the "
+                                "stiffest solid, has 1.2e12)")
         finite(f"{p}.nu", m.nu, "must be in (-1, 0.5) (a finite number)")
         if not -1.0 < m.nu < 0.5:
             raise ScenarioError(f"{p}.nu", m.nu, "must be in (-1, 0.5)")
         positive(f"{p}.rho", m.rho)
         if m.Y is not None:  # the yield strength is optional (None: unknown)
             positive(f"{p}.Y", m.Y)
+        if m.rho > RHO_MAX:
+            raise ScenarioError(f"{p}.rho", m.rho, f"must be in (0, {RHO_MAX:g}] kg/m^3 (osmium, "
+                                "the densest solid, has 22,590)")
 
 
 def _check_layout(s: Scenario) -> None:
@@ -206,12 +223,67 @@ def _check_granules(s: Scenario) -> None:
         for f in ("vx", "vy", "omega"):
             finite(f"{p}.{f}", getattr(g, f))
         material_exists(f"{p}.material", g.material, s)
+        _check_speeds(p, g, s.material(g.material))
         if not isinstance(g.label, str):
             raise ScenarioError(f"{p}.label", g.label, "must be a string")
         if g.label in seen:
             raise ScenarioError(f"{p}.label", g.label,
                                 f"labels must be unique; granules[{seen[g.label]}] has it too")
         seen[g.label] = i
+
+
+def bar_wave_speed(m: Material) -> float:
+    """c = sqrt(E / rho) [m/s]: the speed of elastic waves along a bar of material m."""
+    return math.sqrt(m.E / m.rho)
+
+
+def _check_speeds(p: str, g: Granule, m: Material) -> None:
+    """|vx|, |vy| and the surface speed |omega| R below the wave speed of the granule's
+    material: Hertz's law is quasi-static and holds for impact speeds far below it."""
+    c = bar_wave_speed(m)
+    for f, speed in (("vx", abs(g.vx)), ("vy", abs(g.vy)), ("omega", abs(g.omega) * g.radius)):
+        if not speed < c:
+            unit = "|omega| x radius" if f == "omega" else f"|{f}|"
+            raise ScenarioError(f"{p}.{f}", getattr(g, f),
+                                f"allowed: {unit} < sqrt(E / rho) = {c:.6g} m/s, the elastic "
+                                f"wave speed of material '{m.name}' (Hertz's contact law is "
+                                "quasi-static: it holds for speeds far below it)")
+
+
+def length_scale(s: Scenario) -> tuple[float, str]:
+    """(h [m], the field it comes from): the smallest length of a resolved scenario, a
+    granule radius or a plate element edge (width / nx, height / ny); its radii and plate
+    sizes already checked to be positive numbers."""
+    found = [(g.radius, f"granules[{i}].radius") for i, g in enumerate(s.granules)]
+    if s.plate is not None:
+        found += [(s.plate.width / s.plate.nx, "plate.width / plate.nx"),
+                  (s.plate.height / s.plate.ny, "plate.height / plate.ny")]
+    return min(found)
+
+
+def _check_lengths(s: Scenario) -> None:
+    """Coordinates and sizes within LENGTH_RANGE x the smallest length (see LENGTH_RANGE)."""
+    h, what = length_scale(s)
+    limit = LENGTH_RANGE * h
+    why = (f"{LENGTH_RANGE:g} x the smallest length of the scenario, h = {h:.6g} m ({what}): "
+           f"farther out, round-off of a coordinate (2.2e-16 |x|) exceeds the {OVERLAP_RTOL:g} h "
+           "overlap tolerance at t = 0")
+    values = [(f"granules[{i}].{f}", getattr(g, f)) for i, g in enumerate(s.granules)
+              for f in ("x", "y", "radius")]
+    values += [(f"walls[{k}].offset", w.offset) for k, w in enumerate(s.walls)]
+    if s.plate is not None:
+        pl = s.plate
+        values += [(f"plate.{f}", getattr(pl, f)) for f in ("x0", "y0", "width", "height", "thickness",
+                                                            "rigid_layer_width")
+                   if getattr(pl, f) is not None]
+    for path, v in values:
+        if not abs(v) <= limit:
+            raise ScenarioError(path, v, f"allowed: |value| <= {limit:.6g} m, {why}")
+
+
+def _check_overlaps(s: Scenario) -> None:
+    """Granules may touch but not overlap at t = 0 (k-d tree over the centres; the
+    coordinates are within LENGTH_RANGE x h, so its squared distances cannot overflow)."""
     gs = s.granules
     for i, j in _close_pairs(gs):
         gi, gj = gs[i], gs[j]
@@ -257,6 +329,12 @@ def _check_walls(s: Scenario) -> None:
             raise ScenarioError(f"{p}.label", w.label,
                                 f"labels must be unique; walls[{seen[w.label]}] has it too")
         seen[w.label] = k
+
+
+def _check_wall_penetration(s: Scenario) -> None:
+    """No granule crosses a wall at t = 0."""
+    for k, w in enumerate(s.walls):
+        n = w.normal
         for i, g in enumerate(s.granules):
             pen = g.x * n[0] + g.y * n[1] + g.radius - w.offset
             if pen > OVERLAP_RTOL * g.radius:
@@ -272,14 +350,19 @@ def _check_plate(s: Scenario) -> None:
         return
     check_plate_fields(pl, pl.x0)
     material_exists("plate.material", pl.material, s)
-    x0 = float(pl.x0)
+def _check_plate_penetration(s: Scenario) -> None:
+    """No granule crosses the plate's left edge at t = 0."""
+    pl = s.plate
+    if pl is None:
+        return
+    x0 = pl.x0
     for i, g in enumerate(s.granules):
         if pl.y0 <= g.y <= pl.y0 + pl.height:
             pen = g.x + g.radius - x0
             if pen > OVERLAP_RTOL * g.radius:
                 raise ScenarioError(
                     f"granules[{i}]", g.label,
-                    f"penetrates the plate (left edge x0 = {x0:.6g} m) by {pen:.6g} m at "
+                    f"penetrates the plate (left edge plate.x0 = {x0:.6g} m) by {pen:.6g} m at "
                     f"t = 0; granules must lie left of the plate (x + radius <= plate.x0)")
 
 
@@ -290,6 +373,14 @@ def _check_load(s: Scenario) -> None:
     q0 = finite("load.q0", ld.q0, "must be >= 0 (a finite number) [N/m]")
     if not q0 >= 0.0:
         raise ScenarioError("load.q0", ld.q0, "must be >= 0 [N/m]")
+    e_max, h = _stiffest_modulus(s), length_scale(s)[0]
+    if ld.kind == "line" and not q0 <= e_max * h:
+        raise ScenarioError("load.q0", ld.q0,
+                            f"allowed: 0 <= q0 <= E h = {e_max * h:.6g} N/m, E = {e_max:.6g} Pa the "
+                            f"largest Young's modulus of the granules and plate, h = {h:.6g} m the "
+                            "smallest length (a granule radius or plate element edge): a larger "
+                            "line load presses on h harder than E, far beyond Hertz's small "
+                            "overlaps and linear elasticity")
     positive("load.duration", ld.duration)
     positive("load.length", ld.length)
     finite("load.y0", ld.y0)
@@ -312,18 +403,66 @@ def _check_load(s: Scenario) -> None:
                                 "use target = \"plate\" or kind = \"none\"")
 
 
+def _stiffest_modulus(s: Scenario) -> float:
+    """The largest Young's modulus [Pa] of the granules' and the plate's materials."""
+    names = {g.material for g in s.granules} | ({s.plate.material} if s.plate is not None else set())
+    return max(s.material(n).E for n in names)
+
+
+#: Largest Coulomb coefficient (real dry pairs stay below about 2, rubber on glass).
+MU_MAX = 10.0
+#: Largest tanh smoothing k_s [s/m]: a smoothing slip rate 1/k_s of at least 1 um/s (the
+#: paper's is 1 mm/s); a sharper law is a step in the slip rate that no time step resolves.
+KS_MAX = 1e6
+
+
+#: Largest damping coefficient alpha_n of eq. (3): near 2 a contact is already critically
+#: damped (restitution about 0); more only stiffens the time integration.
+ALPHA_N_MAX = 10.0
+
+
+def _damping(path: str, alpha_n: Any) -> None:
+    """alpha_n in [0, ALPHA_N_MAX] (None: not given)."""
+    if alpha_n is None:
+        return
+    nonneg(path, alpha_n)
+    if alpha_n > ALPHA_N_MAX:
+        raise ScenarioError(path, alpha_n, f"must be in [0, {ALPHA_N_MAX:g}] (eq. 3's damping "
+                            "coefficient; near 2 a contact is already critically damped)")
+
+
+def _friction(path: str, mu: Any, k_s: Any) -> None:
+    """mu in [0, MU_MAX] and k_s in (0, KS_MAX] (either None: not given)."""
+    if mu is not None:
+        nonneg(f"{path}.mu", mu)
+        if mu > MU_MAX:
+            raise ScenarioError(f"{path}.mu", mu, f"must be in [0, {MU_MAX:g}] (a Coulomb "
+                                "coefficient; real dry pairs stay below about 2)")
+    if k_s is not None:
+        positive(f"{path}.k_s", k_s)
+        if k_s > KS_MAX:
+            raise ScenarioError(f"{path}.k_s", k_s, f"must be in (0, {KS_MAX:g}] s/m (a smoothing "
+                                "slip rate 1/k_s of at least 1 um/s; sharper, friction is a step no "
+                                "time step resolves)")
+
+
 def _check_contact(s: Scenario) -> None:
     c = s.contact
-    nonneg("contact.mu", c.mu)
-    positive("contact.k_s", c.k_s)
-    nonneg("contact.alpha_n", c.alpha_n)
+    _friction("contact", c.mu, c.k_s)
+    _damping("contact.alpha_n", c.alpha_n)
     nonneg("contact.neighbour_gap", c.neighbour_gap)
+    if c.neighbour_gap > 1.0:
+        raise ScenarioError("contact.neighbour_gap", c.neighbour_gap,
+                            "must be at most 1 (a gap of at most the smaller radius, as contact.skin)")
     string_in("contact.torque_arm", c.torque_arm, TORQUE_ARMS)
     string_in("contact.detection", c.detection, DETECTIONS)
     positive("contact.skin", c.skin)
     if c.skin > 1.0:
         raise ScenarioError("contact.skin", c.skin, "must be at most 1 (a fraction of R_i + R_j)")
     positive("contact.overlap_warn", c.overlap_warn)
+    if not c.overlap_warn < 1.0:
+        raise ScenarioError("contact.overlap_warn", c.overlap_warn,
+                            "must be in (0, 1) (a fraction of the smaller radius)")
     positive("contact.overlap_stop", c.overlap_stop)
     if not c.overlap_warn <= c.overlap_stop < 1.0:
         raise ScenarioError("contact.overlap_stop", c.overlap_stop,
@@ -337,12 +476,8 @@ def _check_contact(s: Scenario) -> None:
             raise ScenarioError(f"{p}.materials", mats, "must be two material names")
         for k, m in enumerate(mats):
             material_exists(f"{p}.materials[{k}]", m, s)
-        if pc.alpha_n is not None:
-            nonneg(f"{p}.alpha_n", pc.alpha_n)
-        if pc.mu is not None:
-            nonneg(f"{p}.mu", pc.mu)
-        if pc.k_s is not None:
-            positive(f"{p}.k_s", pc.k_s)
+        _damping(f"{p}.alpha_n", pc.alpha_n)
+        _friction(p, pc.mu, pc.k_s)
 
 
 def _check_time(s: Scenario) -> None:
@@ -362,10 +497,47 @@ def _check_time(s: Scenario) -> None:
                             f"must be <= time.t_end = {t.t_end!r}")
     r = t.field_interval / t.output_interval
     n = round(r)
-    if n < 1 or abs(r - n) > INTERVAL_RTOL * r:
+    if n < 1 or abs(r - n) > INTERVAL_RTOL * r or n > 2**53:
         raise ScenarioError("time.field_interval", t.field_interval,
-                            f"must be a whole multiple (>= 1) of time.output_interval = "
-                            f"{t.output_interval!r}")
+                            f"must be a whole multiple n of time.output_interval = "
+                            f"{t.output_interval!r}, 1 <= n <= 2^53 (beyond, every double is whole)")
+
+
+#: Bytes kept per output time, per granule (its state in the buffers, the Dataset and
+#: the file written: 3 copies of 6 numbers and a few per contact) and per plate dof (the
+#: modal coordinates and their rates, 3 copies), and per plate snapshot and plate dof
+#: (displacements, strains and stresses at the nodes, 3 copies).
+OUTPUT_BYTES_PER_GRANULE = 3 * 8 * 12
+OUTPUT_BYTES_PER_DOF = 3 * 8 * 2
+FIELD_BYTES_PER_DOF = 3 * 8 * 4
+
+
+def output_bytes_per_second(s: Scenario) -> float:
+    """About the memory [bytes] a run's outputs take per second of simulated time: a row
+    of the granules' states and the plate's modal coordinates per output_interval, a plate
+    snapshot per field_interval (s resolved)."""
+    t = s.time
+    n_dof = 0
+    if s.plate is not None:
+        p = s.plate
+        n_dof = 2 * ((p.nx + 1) * (p.ny + 1) + p.nx * (p.ny + 1) + p.ny * (p.nx + 1))
+    row = OUTPUT_BYTES_PER_GRANULE * len(s.granules) + OUTPUT_BYTES_PER_DOF * n_dof + 400.0
+    return row / t.output_interval + FIELD_BYTES_PER_DOF * n_dof / t.field_interval
+
+
+def _check_output_size(s: Scenario) -> None:
+    """The outputs of t_end fit in MEMORY_SHARE of the machine's memory."""
+    memory = MEMORY_SHARE * physical_memory()
+    t_max = memory / output_bytes_per_second(s)
+    t = s.time
+    if memory > 0.0 and not t.t_end <= t_max:
+        raise ScenarioError(
+            "time.t_end", t.t_end,
+            f"allowed: t_end <= {t_max:.3g} s with these output intervals: the outputs would need "
+            f"about {t.t_end / t_max * (memory / 1e9):.3g} GB ({t.t_end / t.output_interval:.3g} "
+            f"output times, time.output_interval = {t.output_interval!r} s; "
+            f"{t.t_end / t.field_interval:.3g} plate snapshots, time.field_interval = "
+            f"{t.field_interval!r} s), this machine allows {memory / 1e9:.3g} GB")
 
 
 def _check_solver(s: Scenario) -> None:
@@ -389,10 +561,11 @@ def validate(scenario: Scenario) -> None:
     """Raise ScenarioError(field, value, allowed) for the first problem in `scenario`.
 
     Order: materials, layout (as `layout.*`, before it is expanded), then on the resolved
-    scenario: granules (values, unique labels, overlaps), walls (unit normals,
-    penetration), plate, load, contact, plate mesh (contacts on nodes, rigid layers,
-    n_modes), time, solver. A scenario with neither granules
-    (nor a layout) nor a plate is refused.
+    scenario: granules (values, speeds, unique labels), walls (unit normals), plate, the
+    range of every coordinate and size (`LENGTH_RANGE`), overlaps and penetrations at
+    t = 0, load, contact, plate mesh (contacts on nodes, rigid layers, n_modes), time, the
+    outputs' memory, solver. A scenario with neither granules (nor a layout) nor a plate
+    is refused.
     """
     s = scenario
     if not isinstance(s.name, str):
@@ -410,10 +583,15 @@ def validate(scenario: Scenario) -> None:
     _check_granules(r)
     _check_walls(r)
     _check_plate(r)
+    _check_lengths(r)
+    _check_overlaps(r)
+    _check_wall_penetration(r)
+    _check_plate_penetration(r)
     _check_load(r)
     _check_contact(r)
     check_plate_mesh(r)
     _check_time(r)
+    _check_output_size(r)
     _check_solver(r)
 
 

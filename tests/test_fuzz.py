@@ -1,0 +1,173 @@
+"""Bad numbers anywhere in a scenario: a clean run or one line naming the field, never a
+traceback or a hang (docs/scenario.md, "Reading and checking")."""
+from __future__ import annotations
+
+import copy
+import itertools
+import math
+import os
+import re
+import signal
+import subprocess
+import sys
+import threading
+
+import numpy as np
+import pytest
+import tomli_w
+
+import granplate as gp
+from granplate.errors import ScenarioError, SimulationError
+from granplate.setup.io import from_dict
+from granplate.setup.validate import validate
+
+#: Three granules in a row between a left wall and the plate (the middle one of a user
+#: material, moving), a bottom wall, a pair override and a 2 x 8 plate; 2 us of a shock.
+BASE: dict = {
+    "name": "fuzz",
+    "description": "three granules against a small plate",
+    "materials": {"soft": {"E": 1e9, "nu": 0.3, "rho": 1200.0}},
+    "granules": [
+        {"label": "a", "x": 0.005, "y": 0.02, "radius": 0.005, "material": "steel"},
+        {"label": "b", "x": 0.015, "y": 0.02, "radius": 0.005, "material": "soft", "vx": 0.1},
+        {"label": "c", "x": 0.025, "y": 0.02, "radius": 0.005, "material": "steel"},
+    ],
+    "walls": [
+        {"label": "left", "normal": [-1.0, 0.0], "offset": 0.0},
+        {"label": "bottom", "normal": [0.0, -1.0], "offset": 0.0, "material": "soft"},
+    ],
+    "plate": {"width": 0.005, "height": 0.04, "thickness": 0.001, "x0": 0.03, "y0": 0.0,
+              "nx": 2, "ny": 8, "rigid_layer_width": 0.004, "n_modes": 0,
+              "max_frequency": 1e6, "stress_radius": 0.002},
+    "load": {"q0": 5e4, "duration": 1e-5, "length": 0.04, "y0": 0.0},
+    "contact": {"mu": 0.1, "k_s": 1000.0, "alpha_n": 6e-3, "neighbour_gap": 0.05, "skin": 0.1,
+                "overlap_warn": 0.05, "overlap_stop": 0.2,
+                "pairs": [{"materials": ["steel", "soft"], "alpha_n": 0.01, "mu": 0.2, "k_s": 500.0}]},
+    "time": {"t_end": 2e-6, "dt_initial": 4e-8, "dt_max": 4e-8, "dt_min": 1e-13,
+             "output_interval": 1e-6, "field_interval": 2e-6},
+    "solver": {"lambda_target": 0.5, "iteration_rtol": 1e-9, "iteration_atol": 1e-10,
+               "max_iterations": 60, "energy_tol": 1e-4, "error_tol": 1e-3, "implicit_dt_max": 1e-6},
+}
+#: The bad values every numeric field is tried with.
+BAD_VALUES: tuple = (-1, 0, math.nan, math.inf, 1e300, "x")
+SEED = 20240601
+N_CASES = 45
+#: Cases always tried: a granule far out (the neighbour search's overflow), outputs that
+#: cannot fit, a snapshot stride no integer holds, a damping that overflows the forces.
+ALWAYS: tuple = (("granules[1].y", 1e300), ("time.t_end", 1e300), ("time.field_interval", 1e300),
+                 ("contact.pairs[0].alpha_n", 1e300))
+N_CLI_CASES = 3
+#: A run of 2 us of this scenario takes well under a second once the kernels are compiled;
+#: the limit also covers their first compilation (1-3 min on a loaded machine).
+RUN_TIMEOUT_S = 600.0
+
+
+def numeric_fields(d, prefix: str = "") -> list[str]:
+    """Dotted paths of every number in a TOML-shaped dict (indices as in TOML: [i])."""
+    if isinstance(d, dict):
+        return [p for k, v in d.items() for p in numeric_fields(v, f"{prefix}.{k}" if prefix else k)]
+    if isinstance(d, list):
+        return [p for i, v in enumerate(d) for p in numeric_fields(v, f"{prefix}[{i}]")]
+    return [prefix] if isinstance(d, (int, float)) and not isinstance(d, bool) else []
+
+
+def mutated(path: str, value) -> dict:
+    """BASE with the field at dotted `path` set to `value`."""
+    d = copy.deepcopy(BASE)
+    steps = [int(s) if s.isdigit() else s for s in re.findall(r"[^.\[\]]+", path)]
+    node = d
+    for step in steps[:-1]:
+        node = node[step]
+    node[steps[-1]] = value
+    return d
+
+
+def cases(n: int, seed: int) -> list[tuple[str, object]]:
+    """n (field, bad value) pairs drawn without replacement by a seeded RNG."""
+    product = list(itertools.product(numeric_fields(BASE), BAD_VALUES))
+    rng = np.random.default_rng(seed)
+    return [product[k] for k in rng.choice(len(product), size=n, replace=False)]
+
+
+def names_field(message: str, path: str) -> bool:
+    """The message names the field; a conflict between bodies (an overlap, a crossed wall)
+    may name the body instead (granules[1] for granules[1].y), a vector its whole
+    (walls[0].normal for walls[0].normal[1])."""
+    if re.search(re.escape(path) + r"(?![\w\[.])", message):
+        return True
+    body = re.match(r"^((?:granules|walls)\[\d+\])\.(?:x|y|radius|offset)$", path)
+    if body and body.group(1) in message:
+        return True
+    vector = re.match(r"^(.*\])\.normal\[\d\]$", path)
+    return bool(vector) and f"'{vector.group(1)}.normal'" in message
+
+
+def run_with_timeout(scenario, seconds: float):
+    """simulate(scenario), stopped as a Ctrl-C does (SIGINT, the driver's stop request)
+    when it runs longer than `seconds`."""
+    timer = threading.Timer(seconds, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        return gp.simulate(scenario, progress=False)
+    finally:
+        timer.cancel()
+
+
+def test_base_scenario_runs():
+    """The unmutated scenario is valid and runs 2 us with finite energies and a plate
+    contact (the fuzz starts from a case that works)."""
+    ds = run_with_timeout(from_dict(BASE), RUN_TIMEOUT_S)
+    assert float(ds.time[-1]) == pytest.approx(2e-6)
+    assert float(ds.E_shock[-1]) > 0.0
+    assert len(numeric_fields(BASE)) * len(BAD_VALUES) >= 200
+
+
+@pytest.mark.parametrize("path,value", [*ALWAYS, *(c for c in cases(N_CASES, SEED) if c not in ALWAYS)],
+                         ids=lambda v: repr(v))
+def test_bad_number_is_refused_by_name_or_runs(path, value):
+    """Any field set to -1, 0, NaN, inf, 1e300 or a string: a one-line ScenarioError naming
+    the field before anything runs, or a 2 us run that ends with finite energies."""
+    d = mutated(path, value)
+    try:
+        validate(from_dict(d))
+    except ScenarioError as err:
+        assert names_field(str(err), path), str(err)
+        assert "\n" not in str(err)
+        return
+    try:
+        ds = run_with_timeout(from_dict(d), RUN_TIMEOUT_S)
+    except SimulationError as err:  # pragma: no cover - what the test exists to catch
+        pytest.fail(f"{path} = {value!r} passed validation but the run failed: {err}")
+    for var in ("E_shock", "E_granular", "E_plate", "D_viscous", "D_friction", "energy_residual"):
+        assert np.isfinite(ds[var].values).all(), var
+    assert float(ds.time[-1]) == pytest.approx(d["time"]["t_end"])
+
+
+def _refused_cases() -> list[tuple[str, object]]:
+    """A few of the seeded cases that validation refuses (for the command line)."""
+    found = []
+    for path, value in cases(3 * N_CASES, SEED + 1):
+        try:
+            validate(from_dict(mutated(path, value)))
+        except ScenarioError:
+            found.append((path, value))
+        if len(found) == N_CLI_CASES:
+            break
+    return found
+
+
+def test_command_line_reports_bad_numbers_in_one_line(tmp_path):
+    """`granplate run FILE` with a bad number: exit status 2 and one line
+    'granplate: error: ...' naming the field on stderr, no traceback, no result file."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    for k, (path, value) in enumerate(_refused_cases()):
+        f = tmp_path / f"case{k}.toml"
+        f.write_text(tomli_w.dumps(mutated(path, value)))
+        out = tmp_path / f"case{k}.nc"
+        p = subprocess.run([sys.executable, "-m", "granplate.cli", "run", str(f), "-q", "-o", str(out)],
+                           capture_output=True, text=True, timeout=120, env=env)
+        lines = p.stderr.strip().splitlines()
+        assert p.returncode == 2, (path, value, p.stderr)
+        assert len(lines) == 1 and lines[0].startswith("granplate: error: "), p.stderr
+        assert "Traceback" not in p.stderr and names_field(lines[0], path), lines[0]
+        assert not out.exists()
