@@ -16,7 +16,7 @@ from numba import njit
 
 from granplate.physics.contact import (
     COEF_A, COEF_C, COEF_KS, COEF_MU, contact_arm, contact_response, friction_slope, normal_force,
-    pair_overlap, pair_rates, plate_overlap, plate_rates, slip_after_friction, wall_overlap, wall_rates,
+    normal_response, pair_apart, pair_normal_rate, pair_overlap, pair_rates, plate_overlap, plate_rates, slip_after_friction, wall_overlap, wall_rates,
 )
 from granplate.physics.shock import time_profile
 from granplate.solver.state import PARTNER_PLATE
@@ -84,6 +84,8 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         j = g.pair_ij[p, 1]
         ri = g.radius[i]
         rj = g.radius[j]
+        if pair_apart(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj):
+            continue
         delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
         if delta <= 0.0:
             continue
@@ -91,16 +93,25 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             ovl = delta / min(ri, rj)
             ovl_i = i
             ovl_j = j
+        c = g.pair_coef[p]
+        if split:  # the normal force alone: friction_flow applies the friction
+            n, pv, ep = normal_response(delta, pair_normal_rate(y[i, 3], y[i, 4], y[j, 3], y[j, 4], nx, nz),
+                                        c[COEF_A], c[COEF_C], cfg.clip)
+            fx = -n * nx
+            fz = -n * nz
+            dy[i, 3] += fx
+            dy[i, 4] += fz
+            dy[j, 3] -= fx
+            dy[j, 4] -= fz
+            p_visc += pv
+            e_pot += ep
+            continue
         ai = contact_arm(ri, delta, 0.5 * cfg.arm_shrink)
         aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
         ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
-        c = g.pair_coef[p]
         n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
         rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + 1.0 / g.mass[j]
                                               + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]))
-        if split:
-            f = 0.0
-            pf = 0.0
         fx = -n * nx + f * nz  # on i: -n nvec - f tvec, tvec = (-nz, nx); on j the opposite
         fz = -n * nz - f * nx
         dy[i, 3] += fx
@@ -124,14 +135,18 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             ovl = delta / ri
             ovl_i = i
             ovl_j = -1 - g.wall_w[w]
+        c = g.wall_coef[w]
+        if split:  # the normal force alone: friction_flow applies the friction
+            n, pv, ep = normal_response(delta, y[i, 3] * nx + y[i, 4] * nz, c[COEF_A], c[COEF_C], cfg.clip)
+            dy[i, 3] += -n * nx
+            dy[i, 4] += -n * nz
+            p_visc += pv
+            e_pot += ep
+            continue
         ai = contact_arm(ri, delta, cfg.arm_shrink)
         ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
-        c = g.wall_coef[w]
         n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
         rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i]))
-        if split:
-            f = 0.0
-            pf = 0.0
         dy[i, 3] += -n * nx + f * nz
         dy[i, 4] += -n * nz - f * nx
         dy[i, 5] -= f * ai
@@ -209,6 +224,8 @@ def friction_flow(y, dt, g, cfg, forward):
             j = g.pair_ij[q, 1]
             ri = g.radius[i]
             rj = g.radius[j]
+            if pair_apart(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj):
+                continue
             delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
             c = g.pair_coef[q]
             if delta <= 0.0 or c[COEF_MU] == 0.0:
