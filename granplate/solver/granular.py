@@ -12,6 +12,8 @@ every force and the step control keeps h times that rate within RK4_FRICTION_LIM
 """
 from __future__ import annotations
 
+from typing import NamedTuple
+
 from numba import njit
 
 from granplate.physics.contact import (
@@ -25,6 +27,22 @@ from granplate.solver.state import PARTNER_PLATE
 #: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps h
 #: times the friction relaxation rate of every contact that RK4 integrates below this bound.
 RK4_FRICTION_LIMIT = 1.0
+
+
+class ForceSums(NamedTuple):
+    """What one evaluation of the granular forces (`granular_rhs`) gives besides the
+    derivative: sums over the contacts and the largest values the step control and the
+    contact watch read (numba compiles it as a named tuple; read it by name)."""
+
+    p_shock: float  # power of the shock on the granules [W]
+    p_visc: float  # viscous power of the normal damping [W]
+    p_fric: float  # friction power [W] (without the split-off friction)
+    e_pot: float  # elastic energy stored in the contacts [J] (eq. 9)
+    rate: float  # largest slip relaxation rate of a granule-granule or granule-wall contact [1/s]
+    ovl: float  # largest overlap over the smaller radius [-]
+    ovl_i: int  # its granule (-1 with no overlap)
+    ovl_j: int  # its partner: granule j, wall -1 - w or PARTNER_PLATE (-1 with no overlap)
+    rate_plate: float  # largest slip relaxation rate of a plate contact [1/s] (0 with hold)
 
 
 @njit(cache=True)
@@ -44,12 +62,10 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
     fplate (nd,) = force ON the plate [N, N] per contact, normal and slip at each plate
     contact. hold: the plate-contact friction is fbar[k] (held over the step, its work
     booked by the scheme) instead of eq. (5); split: no friction at granule-granule and
-    granule-wall contacts (`friction_flow` applies it). Returns (shock power, viscous power,
-    friction power, contact potential energy, largest slip relaxation rate of a
-    granule-granule or granule-wall contact, largest overlap over the smaller radius, its
-    granule, its partner (granule j, wall -1 - w or PARTNER_PLATE; -1, -1 with no overlap;
-    as floats), largest slip relaxation rate of a plate contact (0 with hold))
-    [W, W, W, J, 1/s, -, -, -, 1/s]; RK4 needs h times a rate below ~2.8. One function
+    granule-wall contacts (`friction_flow` applies it; their slip relaxation rate is then
+    not computed, and ForceSums.rate is 0). Returns the ForceSums (powers, stored energy,
+    the largest overlap and its contact, the largest slip relaxation rates); RK4 needs h
+    times a rate below ~2.8. One function
     (not one per contact kind): calls that pass the model tuples cost more per step
     than the loops themselves when the medium is small.
     """
@@ -190,8 +206,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         dy[i, 3] /= g.mass[i]
         dy[i, 4] /= g.mass[i]
         dy[i, 5] /= g.inertia[i]
-    # one float tuple: indexable
-    return p_shock, p_visc, p_fric, e_pot, rate, ovl, float(ovl_i), float(ovl_j), rate_plate
+    return ForceSums(p_shock, p_visc, p_fric, e_pot, rate, ovl, ovl_i, ovl_j, rate_plate)
 
 
 @njit(cache=True)
@@ -313,9 +328,9 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     if hold or split:
         pr = granular_rhs(t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar,
                           split)
-        w.p1h[0] = pr[0]
-        w.p1h[1] = pr[1]
-        w.p1h[2] = pr[2]
+        w.p1h[0] = pr.p_shock
+        w.p1h[1] = pr.p_visc
+        w.p1h[2] = pr.p_fric
         k1 = w.k1h
         p1 = w.p1h
     hh = 0.5 * h
@@ -338,22 +353,23 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     for i in range(ng):
         for c in range(6):  # (y0 may be w.ynew itself: each entry is read before it is written)
             w.ynew[i, c] = y0[i, c] + h6 * (k1[i, c] + 2.0 * w.k2[i, c] + 2.0 * w.k3[i, c] + w.k4[i, c])
-    for c in range(3):
-        w.dacc[c] = h6 * (p1[c] + 2.0 * p2[c] + 2.0 * p3[c] + p4[c])
+    w.dacc[0] = h6 * (p1[0] + 2.0 * p2.p_shock + 2.0 * p3.p_shock + p4.p_shock)
+    w.dacc[1] = h6 * (p1[1] + 2.0 * p2.p_visc + 2.0 * p3.p_visc + p4.p_visc)
+    w.dacc[2] = h6 * (p1[2] + 2.0 * p2.p_fric + 2.0 * p3.p_fric + p4.p_fric)
     if split:  # friction over [t + h/2, t + h]
         fric_split += friction_flow(w.ynew, hh, g, cfg, False)
         w.dacc[2] += fric_split
     pe = granular_rhs(t + h, w.ynew, stage[2], stage[3], g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar,
                       split)
-    w.pend[0] = pe[0]
-    w.pend[1] = pe[1]
-    w.pend[2] = pe[2]
-    w.ovl_new[0] = pe[5]
-    w.ovl_who[0] = int(pe[6])
-    w.ovl_who[1] = int(pe[7])
+    w.pend[0] = pe.p_shock
+    w.pend[1] = pe.p_visc
+    w.pend[2] = pe.p_fric
+    w.ovl_new[0] = pe.ovl
+    w.ovl_who[0] = pe.ovl_i
+    w.ovl_who[1] = pe.ovl_j
     if not cfg.split_friction:
-        return pe[3], max(pe[4], pe[8])
-    return pe[3], 0.0 if hold else pe[8]  # a held plate-contact friction is not RK4's
+        return pe.e_pot, max(pe.rate, pe.rate_plate)
+    return pe.e_pot, 0.0 if hold else pe.rate_plate  # a held plate-contact friction is not RK4's
 
 
 @njit(cache=True)
