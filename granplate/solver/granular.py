@@ -249,14 +249,17 @@ def friction_flow(y, dt, g, cfg, forward):
             aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
             ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
             n, _ = normal_force(delta, ddot, c[COEF_A], c[COEF_C], cfg.clip)
-            inv_t = 1.0 / g.mass[i] + 1.0 / g.mass[j] + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]
-            imp, dw = friction_impulse(vt, n, c[COEF_MU], c[COEF_KS], inv_t, dt)
-            y[i, 3] += imp * nz / g.mass[i]
-            y[i, 4] -= imp * nx / g.mass[i]
-            y[i, 5] -= imp * ai / g.inertia[i]
-            y[j, 3] -= imp * nz / g.mass[j]
-            y[j, 4] += imp * nx / g.mass[j]
-            y[j, 5] -= imp * aj / g.inertia[j]
+            inv_mi = 1.0 / g.mass[i]
+            inv_mj = 1.0 / g.mass[j]
+            inv_ii = ai / g.inertia[i]  # the spin change per unit impulse
+            inv_ij = aj / g.inertia[j]
+            imp, dw = friction_impulse(vt, n, c[COEF_MU], c[COEF_KS], inv_mi + inv_mj + ai * inv_ii + aj * inv_ij, dt)
+            y[i, 3] += imp * nz * inv_mi
+            y[i, 4] -= imp * nx * inv_mi
+            y[i, 5] -= imp * inv_ii
+            y[j, 3] -= imp * nz * inv_mj
+            y[j, 4] += imp * nx * inv_mj
+            y[j, 5] -= imp * inv_ij
             work += dw
         else:  # wall contact w, the wall at rest
             w = q - n_p
@@ -271,10 +274,12 @@ def friction_flow(y, dt, g, cfg, forward):
             ai = contact_arm(ri, delta, cfg.arm_shrink)
             ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
             n, _ = normal_force(delta, ddot, c[COEF_A], c[COEF_C], cfg.clip)
-            imp, dw = friction_impulse(vt, n, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i], dt)
-            y[i, 3] += imp * nz / g.mass[i]
-            y[i, 4] -= imp * nx / g.mass[i]
-            y[i, 5] -= imp * ai / g.inertia[i]
+            inv_m = 1.0 / g.mass[i]
+            inv_i = ai / g.inertia[i]
+            imp, dw = friction_impulse(vt, n, c[COEF_MU], c[COEF_KS], inv_m + ai * inv_i, dt)
+            y[i, 3] += imp * nz * inv_m
+            y[i, 4] -= imp * nx * inv_m
+            y[i, 5] -= imp * inv_i
             work += dw
     return work
 
