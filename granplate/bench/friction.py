@@ -12,7 +12,7 @@ Then, where LAMMPS is installed (granplate.verification.lammps.run_granular), th
 with mu = 0.099 side by side with LAMMPS (pair_style granular: the same Hertz law and
 damping, Mindlin's tangential law with the same mu; velocity Verlet at LAMMPS_DT):
 granplate's "split" run and LAMMPS's, alternately REPEATS times each, their median loop
-times, steps, cost per contact and step (the listed contacts at t = 0, the same count for
+times (wall, and CPU time of this process: on a shared machine what each code used), steps, cost per contact and step (the listed contacts at t = 0, the same count for
 both), and each one's error against its own converged run (granplate: the "rk4" row, whose
 own error is ~3e-5 m/s; LAMMPS: its step / LAMMPS_REF_DIVISOR): the largest |v - v_ref|
 over the granules' velocity components at t_end [m/s].
@@ -146,24 +146,29 @@ def lammps_comparison(t_end: float | None, reference: dict, log=print) -> dict:
     contacts = listed_contacts(s)
     log(f"LAMMPS reference, dt {LAMMPS_DT / LAMMPS_REF_DIVISOR:g} s ...")
     lref = L.run_granular(s, LAMMPS_DT / LAMMPS_REF_DIVISOR, t)
-    ours_s, theirs_s = [], []
+    ours_s, theirs_s, ours_c, theirs_c = [], [], [], []
     for k in range(REPEATS):
         log(f"granplate and LAMMPS, side by side ({k + 1} of {REPEATS}) ...")
         ds, _ = timed_run(s)
         ours_s.append(float(ds.attrs["loop_time_s"]))
+        ours_c.append(float(ds.attrs["loop_cpu_s"]))
         lm = L.run_granular(s, LAMMPS_DT, t)
         theirs_s.append(lm["loop_time_s"])
+        theirs_c.append(lm["loop_cpu_s"])
     n_ours, n_theirs = int(ds.attrs["n_steps"]), int(lm["n_steps"])
     ours = {"code": "granplate", "law": "tanh (eq. 5), split", "dt_s": t / n_ours, "n_steps": n_ours,
             "loop_s": statistics.median(ours_s), "loop_s_all": ours_s,
+            "loop_cpu_s": statistics.median(ours_c), "loop_cpu_s_all": ours_c,
             "error_m_s": velocity_error(final_velocities(ds), reference)}
     theirs = {"code": "LAMMPS", "law": "Mindlin", "dt_s": LAMMPS_DT, "n_steps": n_theirs,
               "loop_s": statistics.median(theirs_s), "loop_s_all": theirs_s,
+            "loop_cpu_s": statistics.median(theirs_c), "loop_cpu_s_all": theirs_c,
               "error_m_s": velocity_error(lm, lref)}
     for r in (ours, theirs):
         r["us_per_contact_step"] = per_contact_step_us(r["loop_s"], r["n_steps"], contacts)
+        r["cpu_us_per_contact_step"] = per_contact_step_us(r["loop_cpu_s"], r["n_steps"], contacts)
     return {"contacts": contacts, "t_end_s": t, "granplate": ours, "lammps": theirs,
-            "loop_ratio": ours["loop_s"] / theirs["loop_s"]}
+            "loop_ratio": ours["loop_s"] / theirs["loop_s"], "cpu_ratio": ours["loop_cpu_s"] / theirs["loop_cpu_s"]}
 
 
 def format_friction_table(rows: list[dict]) -> str:
@@ -181,13 +186,14 @@ def format_lammps_table(cmp: dict) -> str:
     if "skipped" in cmp:
         return f"LAMMPS comparison skipped: {cmp['skipped']}"
     head = (f"{'code':<10} {'friction law':<20} {'dt [s]':>9} {'steps':>7} {'loop [s]':>9} "
-            f"{'us/(contact step)':>17} {'error [m/s]':>11}")
+            f"{'us/(contact step)':>17} {'CPU [s]':>8} {'CPU us/(c. step)':>16} {'error [m/s]':>11}")
     lines = [f"packing with mu 0.099 side by side ({cmp['contacts']} listed contacts, t_end {cmp['t_end_s']:g} s, "
              f"median of {len(cmp['granplate']['loop_s_all'])} alternate runs each)", head, "-" * len(head)]
     for r in (cmp["granplate"], cmp["lammps"]):
         lines.append(f"{r['code']:<10} {r['law']:<20} {r['dt_s']:>9.3g} {r['n_steps']:>7d} {r['loop_s']:>9.3f} "
-                     f"{r['us_per_contact_step']:>17.3f} {r['error_m_s']:>11.2e}")
-    lines.append(f"loop time granplate / LAMMPS: {cmp['loop_ratio']:.2f}")
+                     f"{r['us_per_contact_step']:>17.3f} {r['loop_cpu_s']:>8.3f} {r['cpu_us_per_contact_step']:>16.3f} "
+                     f"{r['error_m_s']:>11.2e}")
+    lines.append(f"loop time granplate / LAMMPS: {cmp['loop_ratio']:.2f} (wall), {cmp['cpu_ratio']:.2f} (CPU)")
     return "\n".join(lines)
 
 

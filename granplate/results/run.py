@@ -64,7 +64,7 @@ def simulate(
         **rec.info,
         "status": rec.message,
     }
-    info = {k: info[k] for k in ("wall_time_s", "setup_time_s", "first_call_time_s", "loop_time_s",
+    info = {k: info[k] for k in ("wall_time_s", "setup_time_s", "first_call_time_s", "loop_time_s", "loop_cpu_s",
                                  "n_steps", "n_iterations", "n_retries", "n_friction_bound", "status")}
     if rec.plate_contacts is not None and len(rec.plate_contacts) != len(model.plate_contacts):
         # with the patch contacts formed during the run, at the height where each formed
