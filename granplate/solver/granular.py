@@ -18,7 +18,8 @@ from numba import njit
 
 from granplate.physics.contact import (
     COEF_A, COEF_C, COEF_KS, COEF_MU, contact_arm, contact_response, friction_slope, normal_force,
-    normal_response, pair_apart, pair_normal_rate, pair_overlap, pair_rates, plate_overlap, plate_rates, slip_after_friction, wall_overlap, wall_rates,
+    normal_response, pair_apart, pair_normal_rate, pair_overlap, pair_rates, plate_overlap, plate_rates,
+    slip_after_friction, wall_overlap, wall_rates,
 )
 from granplate.physics.shock import time_profile
 from granplate.solver.state import PARTNER_PLATE
