@@ -109,15 +109,39 @@ def test_scaling_sizes_are_checked(capsys):
     assert "--t-end 0.0: must be > 0" in capsys.readouterr().err
 
 
-def test_bench_friction_table_runs_every_case(capsys, monkeypatch):
-    """`granplate bench --friction --t-end 2e-7` (on a 4 x 6 packing) prints a row per case."""
+def test_bench_friction_table_runs_every_case(capsys, monkeypatch, tmp_path):
+    """`granplate bench --friction --t-end 2e-7` (on a 4 x 6 packing) prints a row per case
+    and, where LAMMPS is installed, both codes' loop time, steps, cost per contact and step
+    (loop / (steps x listed contacts)) and error, and their ratio; the JSON has the
+    documented keys."""
     from granplate.bench import friction
+    from granplate.verification import lammps as L
 
     monkeypatch.setitem(friction.PACKING, "columns", 4)
     monkeypatch.setitem(friction.PACKING, "rows", 6)
-    assert main(["bench", "--friction", "--t-end", "2e-7"]) == 0
+    monkeypatch.setattr(friction, "REPEATS", 1)
+    out_json = tmp_path / "friction.json"
+    assert main(["bench", "--friction", "--t-end", "2e-7", "--json", str(out_json)]) == 0
     out = capsys.readouterr().out
     assert out.count("packing 22, mu") == 3 and out.count("ptfe-r05, q0 1e7") == 2
+    report = json.loads(out_json.read_text())
+    assert len(report["rows"]) == 5 and "final" not in report["rows"][0]
+    cmp = report["lammps"]
+    if L.unavailable():
+        assert "skipped" in cmp and "LAMMPS comparison skipped" in out
+        return
+    assert "loop time granplate / LAMMPS" in out
+    text = (ROOT / "docs" / "benchmarks.md").read_text().split("### Friction JSON")[1]
+    documented = {k for line in text.splitlines() if line.startswith("| `")
+                  for k in re.findall(r"`([a-z_0-9]+)`", line.split("|")[1])}
+    assert set(cmp) <= documented and set(cmp["granplate"]) <= documented, set(cmp["granplate"]) - documented
+    assert set(cmp["lammps"]) <= documented
+    assert cmp["loop_ratio"] == pytest.approx(cmp["granplate"]["loop_s"] / cmp["lammps"]["loop_s"])
+    assert cmp["cpu_ratio"] == pytest.approx(cmp["granplate"]["loop_cpu_s"] / cmp["lammps"]["loop_cpu_s"])
+    for r in (cmp["granplate"], cmp["lammps"]):
+        assert r["n_steps"] > 0 and r["error_m_s"] >= 0.0
+        assert r["us_per_contact_step"] == pytest.approx(1e6 * r["loop_s"] / (r["n_steps"] * cmp["contacts"]))
+        assert r["cpu_us_per_contact_step"] == pytest.approx(1e6 * r["loop_cpu_s"] / (r["n_steps"] * cmp["contacts"]))
 
 
 def test_bench_study_json_has_documented_keys(tmp_path):

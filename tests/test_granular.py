@@ -177,3 +177,36 @@ def test_a_run_set_by_rk4_friction_is_told_to_split_it(monkeypatch):
         warnings.simplefilter("error", RuntimeWarning)
         split = simulate(packing(0.099, "split"), progress=False)
     assert split.attrs["n_friction_bound"] == 0
+
+
+@pytest.mark.parametrize("split", [False, True])
+def test_force_sums_name_the_stored_energy_and_the_largest_overlap(split):
+    """granular_rhs's ForceSums on a sphere pressed into a wall and into a second sphere:
+    e_pot is eq. (9)'s 2/5 A delta^(5/2) summed over both contacts, ovl the larger overlap
+    over the radius with its granule and partner (granule 1, then wall 0: -1), and with the
+    friction split off no friction power, no torque and no slip relaxation rate."""
+    from granplate.solver.granular import granular_rhs
+
+    a = Granule(x=R + 1e-5, y=0.0, radius=R, material="steel", label="a")
+    b = Granule(x=3 * R + 2e-5, y=0.0, radius=R, material="steel", label="b")
+    s = dataclasses.replace(single(a, [Wall(normal=(-1.0, 0.0), offset=0.0, label="left")], 1e-5, "split"),
+                            granules=(a, b))
+    model = build_model(s)
+    g, cfg = model.granular, model.config
+    assert g.pair_ij.shape[0] == 1 and g.wall_i.tolist() == [0]
+    z = np.zeros(0)
+    for wall_d, pair_d, who in ((2e-6, 5e-6, (0, 1)), (8e-6, 5e-6, (0, -1))):
+        y = model.initial_state.copy()
+        y[0, 0] = R - wall_d
+        y[1, 0] = y[0, 0] + 2 * R - pair_d
+        y[:, 4] = (0.2, -0.1)  # sliding: friction at both contacts
+        dy = np.zeros_like(y)
+        sums = granular_rhs(0.0, y, z, z, g, cfg, dy, z, z, z, False, z, split)
+        stored = 0.4 * (g.pair_coef[0, COEF_A] * pair_d**2.5 + g.wall_coef[0, COEF_A] * wall_d**2.5)
+        assert sums.e_pot == pytest.approx(stored, rel=1e-9)
+        assert sums.ovl == pytest.approx(max(wall_d, pair_d) / R, rel=1e-9)
+        assert (sums.ovl_i, sums.ovl_j) == who and isinstance(sums.ovl_i, int)
+        if split:
+            assert sums.p_fric == 0.0 and sums.rate == 0.0 and np.all(dy[:, 5] == 0.0)
+        else:
+            assert sums.p_fric > 0.0 and sums.rate > 0.0 and np.all(dy[:, 5] != 0.0)

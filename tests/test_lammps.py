@@ -71,3 +71,21 @@ def test_missing_lammps_is_reported_not_raised(monkeypatch):
             L.run_hertz(L.launched_hexagon(2, 2), 1e-9, 1e-8)
     finally:
         L._load.cache_clear()
+
+
+def test_granular_adapter_maps_walls_and_damping():
+    """run_granular's mapping, before LAMMPS starts: the packing's axis-aligned walls become
+    the planes {s.n = offset} (left x = 0 and bottom y = 0 bound the granules from below, top
+    y = 0.1 from above), LAMMPS's tsuji alpha of the chosen restitution is our alpha_n, and
+    a tilted wall is refused naming it."""
+    from granplate.bench.friction import packing_scenario
+
+    s = packing_scenario(0.099, "split")
+    p = L.granular_arrays(s)
+    assert p["walls"] == [("xplane", "0.0", "NULL"), ("yplane", "0.0", "NULL"), ("yplane", "NULL", "0.1")]
+    assert p["mu"] == 0.099 and len(p["radius"]) == len(s.granules)
+    e = L.tsuji_restitution(s.contact.alpha_n)
+    assert 0.9 < e < 1.0 and L.tsuji_alpha(e) == pytest.approx(s.contact.alpha_n, rel=1e-9)
+    tilted = dataclasses.replace(s, walls=(Wall(normal=(0.6, 0.8), offset=0.0),))
+    with pytest.raises(ValueError, match=r"walls\[0\]\.normal"):
+        L.granular_arrays(tilted)

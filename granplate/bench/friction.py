@@ -7,6 +7,15 @@ friction: a 990-granule hexagonal packing of 1 mm steel spheres (20 columns of 5
 (granules reach ~36 m/s, overlaps up to ~0.4 R: contact.overlap_stop 0.5), 2 ms with
 "split" and 0.2 ms with "rk4", which needs ~1e-9 s steps there. Each run is timed after a
 1 us warm-up run of the same scenario (the compiled loop loaded), in this process.
+
+Then, where LAMMPS is installed (granplate.verification.lammps.run_granular), the packing
+with mu = 0.099 side by side with LAMMPS (pair_style granular: the same Hertz law and
+damping, Mindlin's tangential law with the same mu; velocity Verlet at LAMMPS_DT):
+granplate's "split" run and LAMMPS's, alternately REPEATS times each, their median loop
+times (wall, and CPU time of this process: on a shared machine what each code used), steps, cost per contact and step (the listed contacts at t = 0, the same count for
+both), and each one's error against its own converged run (granplate: the "rk4" row, whose
+own error is ~3e-5 m/s; LAMMPS: its step / LAMMPS_REF_DIVISOR): the largest |v - v_ref|
+over the granules' velocity components at t_end [m/s].
 """
 from __future__ import annotations
 
@@ -19,6 +28,11 @@ import time
 PACKING = {"columns": 20, "rows": 50, "radius": 1e-3, "v0": 1.0, "t_end": 1e-4}
 #: ptfe-r05 under a strong shock: q0 [N/m], overlap_stop, t_end [s] per treatment.
 STRONG = {"q0": 1e7, "overlap_stop": 0.5, "t_end": {"split": 2e-3, "rk4": 2e-4}}
+#: LAMMPS's step on the packing [s], its converged reference's step divisor, and how many
+#: times each code's run is timed (alternately; medians).
+LAMMPS_DT = 1e-7
+LAMMPS_REF_DIVISOR = 16
+REPEATS = 3
 
 
 def packing_scenario(mu: float, friction: str, t_end: float | None = None):
@@ -63,8 +77,9 @@ def cases(t_end: float | None = None) -> list[tuple[str, str, object]]:
             ("ptfe-r05, q0 1e7", "rk4", strong_scenario("rk4", t_end))]
 
 
-def bench_run(case: str, friction: str, s) -> dict:
-    """Steps, wall time and friction work of one run (after a 1 us warm-up)."""
+def timed_run(s):
+    """(dataset, wall time [s]) of one run of `s` after a 1 us warm-up run (the compiled
+    loop loaded); overlap warnings silenced."""
     import warnings
 
     import granplate as gp
@@ -75,12 +90,85 @@ def bench_run(case: str, friction: str, s) -> dict:
                                         "time.field_interval": 1e-6}), progress=False)
         t0 = time.perf_counter()
         ds = gp.simulate(s, progress=False)
-        wall = time.perf_counter() - t0
+        return ds, time.perf_counter() - t0
+
+
+def final_velocities(ds) -> dict:
+    """vx, vy [m/s] of every granule at the run's last output."""
+    return {"vx": ds.vx.values[-1].copy(), "vy": ds.vy.values[-1].copy()}
+
+
+def velocity_error(v: dict, ref: dict) -> float:
+    """The largest |v - v_ref| over the granules' velocity components [m/s]."""
+    import numpy as np
+
+    return float(max(np.abs(np.asarray(v["vx"]) - ref["vx"]).max(), np.abs(np.asarray(v["vy"]) - ref["vy"]).max()))
+
+
+def bench_run(case: str, friction: str, s) -> dict:
+    """Steps, wall time and friction work of one run (after a 1 us warm-up); the final
+    velocities under the key "final" (not part of the table or the JSON)."""
+    ds, wall = timed_run(s)
     return {"case": case, "friction": friction, "t_end_s": float(s.time.t_end),
             "n_steps": int(ds.attrs["n_steps"]), "wall_s": wall,
             "steps_per_ms": int(ds.attrs["n_steps"]) / (1e3 * float(s.time.t_end)),
             "d_friction_J": float(ds.D_friction.values[-1]),
-            "energy_residual_max": float(abs(ds.energy_residual.values).max())}
+            "energy_residual_max": float(abs(ds.energy_residual.values).max()),
+            "final": final_velocities(ds)}
+
+
+def listed_contacts(s) -> int:
+    """Granule-granule and granule-wall contacts listed at t = 0 (the count both codes'
+    cost per contact and step divides by)."""
+    from granplate.model.arrays import build_model
+
+    g = build_model(s).granular
+    return int(g.pair_ij.shape[0] + g.wall_i.shape[0])
+
+
+def per_contact_step_us(loop_s: float, n_steps: int, contacts: int) -> float:
+    """1e6 loop_s / (n_steps contacts) [us]."""
+    return 1e6 * loop_s / (n_steps * contacts)
+
+
+def lammps_comparison(t_end: float | None, reference: dict, log=print) -> dict:
+    """The packing with mu = 0.099: granplate ("split") and LAMMPS side by side (see the
+    module's docstring); `reference`: granplate's converged final velocities (the "rk4"
+    row). Returns {"skipped": why} where LAMMPS is not installed."""
+    import statistics
+
+    from granplate.verification import lammps as L
+
+    if L.unavailable():
+        return {"skipped": L.unavailable()}
+    s = packing_scenario(0.099, "split", t_end)
+    t = float(s.time.t_end)
+    contacts = listed_contacts(s)
+    log(f"LAMMPS reference, dt {LAMMPS_DT / LAMMPS_REF_DIVISOR:g} s ...")
+    lref = L.run_granular(s, LAMMPS_DT / LAMMPS_REF_DIVISOR, t)
+    ours_s, theirs_s, ours_c, theirs_c = [], [], [], []
+    for k in range(REPEATS):
+        log(f"granplate and LAMMPS, side by side ({k + 1} of {REPEATS}) ...")
+        ds, _ = timed_run(s)
+        ours_s.append(float(ds.attrs["loop_time_s"]))
+        ours_c.append(float(ds.attrs["loop_cpu_s"]))
+        lm = L.run_granular(s, LAMMPS_DT, t)
+        theirs_s.append(lm["loop_time_s"])
+        theirs_c.append(lm["loop_cpu_s"])
+    n_ours, n_theirs = int(ds.attrs["n_steps"]), int(lm["n_steps"])
+    ours = {"code": "granplate", "law": "tanh (eq. 5), split", "dt_s": t / n_ours, "n_steps": n_ours,
+            "loop_s": statistics.median(ours_s), "loop_s_all": ours_s,
+            "loop_cpu_s": statistics.median(ours_c), "loop_cpu_s_all": ours_c,
+            "error_m_s": velocity_error(final_velocities(ds), reference)}
+    theirs = {"code": "LAMMPS", "law": "Mindlin", "dt_s": LAMMPS_DT, "n_steps": n_theirs,
+              "loop_s": statistics.median(theirs_s), "loop_s_all": theirs_s,
+            "loop_cpu_s": statistics.median(theirs_c), "loop_cpu_s_all": theirs_c,
+              "error_m_s": velocity_error(lm, lref)}
+    for r in (ours, theirs):
+        r["us_per_contact_step"] = per_contact_step_us(r["loop_s"], r["n_steps"], contacts)
+        r["cpu_us_per_contact_step"] = per_contact_step_us(r["loop_cpu_s"], r["n_steps"], contacts)
+    return {"contacts": contacts, "t_end_s": t, "granplate": ours, "lammps": theirs,
+            "loop_ratio": ours["loop_s"] / theirs["loop_s"], "cpu_ratio": ours["loop_cpu_s"] / theirs["loop_cpu_s"]}
 
 
 def format_friction_table(rows: list[dict]) -> str:
@@ -93,15 +181,41 @@ def format_friction_table(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
+def format_lammps_table(cmp: dict) -> str:
+    """The side-by-side comparison as a plain-text table (or why it was left out)."""
+    if "skipped" in cmp:
+        return f"LAMMPS comparison skipped: {cmp['skipped']}"
+    head = (f"{'code':<10} {'friction law':<20} {'dt [s]':>9} {'steps':>7} {'loop [s]':>9} "
+            f"{'us/(contact step)':>17} {'CPU [s]':>8} {'CPU us/(c. step)':>16} {'error [m/s]':>11}")
+    lines = [f"packing with mu 0.099 side by side ({cmp['contacts']} listed contacts, t_end {cmp['t_end_s']:g} s, "
+             f"median of {len(cmp['granplate']['loop_s_all'])} alternate runs each)", head, "-" * len(head)]
+    for r in (cmp["granplate"], cmp["lammps"]):
+        lines.append(f"{r['code']:<10} {r['law']:<20} {r['dt_s']:>9.3g} {r['n_steps']:>7d} {r['loop_s']:>9.3f} "
+                     f"{r['us_per_contact_step']:>17.3f} {r['loop_cpu_s']:>8.3f} {r['cpu_us_per_contact_step']:>16.3f} "
+                     f"{r['error_m_s']:>11.2e}")
+    lines.append(f"loop time granplate / LAMMPS: {cmp['loop_ratio']:.2f} (wall), {cmp['cpu_ratio']:.2f} (CPU)")
+    return "\n".join(lines)
+
+
 def main(args) -> int:
-    """`granplate bench --friction [--t-end T] [--json FILE]`."""
+    """`granplate bench --friction [--t-end T] [--no-lammps] [--json FILE]`."""
     rows = []
-    for case, friction, s in cases(getattr(args, "t_end", None)):
+    t_end = getattr(args, "t_end", None)
+    for case, friction, s in cases(t_end):
         print(f"{case} ({friction}) ...", file=sys.stderr, flush=True)
         rows.append(bench_run(case, friction, s))
     print(format_friction_table(rows))
+    if getattr(args, "no_lammps", False):
+        cmp = {"skipped": "--no-lammps"}
+    else:
+        reference = next(r["final"] for r in rows if r["case"].endswith("mu 0.099") and r["friction"] == "rk4")
+        cmp = lammps_comparison(t_end, reference, log=lambda m: print(m, file=sys.stderr, flush=True))
+    print()
+    print(format_lammps_table(cmp))
+    for r in rows:
+        r.pop("final")
     if getattr(args, "json", None):
         with open(args.json, "w") as fh:
-            fh.write(json.dumps(rows, indent=2) + "\n")
+            fh.write(json.dumps({"rows": rows, "lammps": cmp}, indent=2) + "\n")
         print(f"json: {args.json}")
     return 0

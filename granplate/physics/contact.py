@@ -60,6 +60,28 @@ def pair_overlap(xi: float, yi: float, ri: float, xj: float, yj: float, rj: floa
     return ri + rj - dist, dx / dist, dz / dist
 
 
+#: a squared centre distance beyond (R_i + R_j)^2 (1 + APART_MARGIN) is a gap whatever the
+#: rounding of its square root (`pair_apart`).
+APART_MARGIN = 1e-9
+
+
+@njit(cache=True)
+def pair_apart(xi: float, yi: float, ri: float, xj: float, yj: float, rj: float) -> bool:
+    """Whether spheres i, j are certainly apart (delta < 0 in `pair_overlap`), told from the
+    squared distance without its square root: the cheap test that skips the listed pairs
+    out of touch. Near touch (within round-off) it says False and pair_overlap decides."""
+    dx = xj - xi
+    dz = yj - yi
+    reach = ri + rj
+    return dx * dx + dz * dz > reach * reach * (1.0 + APART_MARGIN)
+
+
+@njit(cache=True)
+def pair_normal_rate(vxi: float, vyi: float, vxj: float, vyj: float, nx: float, nz: float) -> float:
+    """Overlap rate d(delta)/dt of spheres i, j [m/s] (the normal part of `pair_rates`)."""
+    return -((vxj - vxi) * nx + (vyj - vyi) * nz)
+
+
 @njit(cache=True)
 def pair_rates(vxi: float, vyi: float, wi: float, vxj: float, vyj: float, wj: float,
                nx: float, nz: float, ai: float, aj: float):
@@ -67,7 +89,7 @@ def pair_rates(vxi: float, vyi: float, wi: float, vxj: float, vyj: float, wj: fl
 
     t = (-nz, nx); v_t = (v_i - v_j).t + a_i omega_i + a_j omega_j with the arms a_i, a_j.
     """
-    ddot = -((vxj - vxi) * nx + (vyj - vyi) * nz)
+    ddot = pair_normal_rate(vxi, vyi, vxj, vyj, nx, nz)
     vt = -(vxi - vxj) * nz + (vyi - vyj) * nx + ai * wi + aj * wj
     return ddot, vt
 
@@ -203,6 +225,14 @@ def local_map_modulus(mu: float, k_s: float, n_abs: float, dt: float, c_t: float
     c_t: the tangential driving DOF's diagonal entry of (M + dt^2 K / 4)^-1 [1/kg].
     """
     return 0.5 * friction_slope(n_abs, v_t, mu, k_s) * dt * c_t
+
+
+@njit(cache=True)
+def normal_response(delta: float, delta_dot: float, a: float, c: float, clip: bool):
+    """The normal law of one contact in touch (delta > 0), eqs. (2)-(3) and (9)-(10), without
+    friction: (|N| [N], viscous power [W], stored energy [J]), as `contact_response` gives them."""
+    n, el = normal_force(delta, delta_dot, a, c, clip)
+    return n, viscous_power(n, el, delta_dot), contact_energy(delta, a)
 
 
 @njit(cache=True)

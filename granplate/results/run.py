@@ -62,7 +62,7 @@ def simulate(
         **rec.info,
         "status": rec.message,
     }
-    info = {k: info[k] for k in ("wall_time_s", "setup_time_s", "first_call_time_s", "loop_time_s",
+    info = {k: info[k] for k in ("wall_time_s", "setup_time_s", "first_call_time_s", "loop_time_s", "loop_cpu_s",
                                  "n_steps", "n_iterations", "n_retries", "n_friction_bound", "status")}
     info["n_rebuilds"] = rec.contacts.n_rebuilds
     if rec.status == OK and summary_only:

@@ -472,6 +472,7 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
         bar = tqdm(total=len(times) - 1, desc=model.scenario.name, unit="out", leave=False)
     polls = [should_stop] if should_stop is not None else []
     t2 = time.perf_counter()
+    c2 = time.process_time()
     try:
         with (stop_on_signals() if interruptible else _never()) as signalled:
             status = _loop_chunks(times, model, arr, lambda: signalled() or any(f() for f in polls),
@@ -483,6 +484,7 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
     info = {
         "first_call_time_s": t_first,
         "loop_time_s": time.perf_counter() - t2,
+        "loop_cpu_s": time.process_time() - c2,
         "n_steps": int(st.count[S.C_STEPS]),
         "n_iterations": int(st.count[S.C_ITERS]),
         "n_retries": int(st.count[S.C_RETRIES]),

@@ -12,11 +12,14 @@ every force and the step control keeps h times that rate within RK4_FRICTION_LIM
 """
 from __future__ import annotations
 
+from typing import NamedTuple
+
 from numba import njit
 
 from granplate.physics.contact import (
     COEF_A, COEF_C, COEF_KS, COEF_MU, contact_arm, contact_response, friction_slope, normal_force,
-    pair_overlap, pair_rates, plate_overlap, plate_rates, slip_after_friction, wall_overlap, wall_rates,
+    normal_response, pair_apart, pair_normal_rate, pair_overlap, pair_rates, plate_overlap, plate_rates,
+    slip_after_friction, wall_overlap, wall_rates,
 )
 from granplate.physics.shock import time_profile
 from granplate.solver.state import PARTNER_PLATE
@@ -25,6 +28,22 @@ from granplate.solver.state import PARTNER_PLATE
 #: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps h
 #: times the friction relaxation rate of every contact that RK4 integrates below this bound.
 RK4_FRICTION_LIMIT = 1.0
+
+
+class ForceSums(NamedTuple):
+    """What one evaluation of the granular forces (`granular_rhs`) gives besides the
+    derivative: sums over the contacts and the largest values the step control and the
+    contact watch read (numba compiles it as a named tuple; read it by name)."""
+
+    p_shock: float  # power of the shock on the granules [W]
+    p_visc: float  # viscous power of the normal damping [W]
+    p_fric: float  # friction power [W] (without the split-off friction)
+    e_pot: float  # elastic energy stored in the contacts [J] (eq. 9)
+    rate: float  # largest slip relaxation rate of a granule-granule or granule-wall contact [1/s]
+    ovl: float  # largest overlap over the smaller radius [-]
+    ovl_i: int  # its granule (-1 with no overlap)
+    ovl_j: int  # its partner: granule j, wall -1 - w or PARTNER_PLATE (-1 with no overlap)
+    rate_plate: float  # largest slip relaxation rate of a plate contact [1/s] (0 with hold)
 
 
 @njit(cache=True)
@@ -44,12 +63,10 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
     fplate (nd,) = force ON the plate [N, N] per contact, normal and slip at each plate
     contact. hold: the plate-contact friction is fbar[k] (held over the step, its work
     booked by the scheme) instead of eq. (5); split: no friction at granule-granule and
-    granule-wall contacts (`friction_flow` applies it). Returns (shock power, viscous power,
-    friction power, contact potential energy, largest slip relaxation rate of a
-    granule-granule or granule-wall contact, largest overlap over the smaller radius, its
-    granule, its partner (granule j, wall -1 - w or PARTNER_PLATE; -1, -1 with no overlap;
-    as floats), largest slip relaxation rate of a plate contact (0 with hold))
-    [W, W, W, J, 1/s, -, -, -, 1/s]; RK4 needs h times a rate below ~2.8. One function
+    granule-wall contacts (`friction_flow` applies it; their slip relaxation rate is then
+    not computed, and ForceSums.rate is 0). Returns the ForceSums (powers, stored energy,
+    the largest overlap and its contact, the largest slip relaxation rates); RK4 needs h
+    times a rate below ~2.8. One function
     (not one per contact kind): calls that pass the model tuples cost more per step
     than the loops themselves when the medium is small.
     """
@@ -84,6 +101,8 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         j = g.pair_ij[p, 1]
         ri = g.radius[i]
         rj = g.radius[j]
+        if pair_apart(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj):
+            continue
         delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
         if delta <= 0.0:
             continue
@@ -91,16 +110,25 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             ovl = delta / min(ri, rj)
             ovl_i = i
             ovl_j = j
+        c = g.pair_coef[p]
+        if split:  # the normal force alone: friction_flow applies the friction
+            n, pv, ep = normal_response(delta, pair_normal_rate(y[i, 3], y[i, 4], y[j, 3], y[j, 4], nx, nz),
+                                        c[COEF_A], c[COEF_C], cfg.clip)
+            fx = -n * nx
+            fz = -n * nz
+            dy[i, 3] += fx
+            dy[i, 4] += fz
+            dy[j, 3] -= fx
+            dy[j, 4] -= fz
+            p_visc += pv
+            e_pot += ep
+            continue
         ai = contact_arm(ri, delta, 0.5 * cfg.arm_shrink)
         aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
         ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
-        c = g.pair_coef[p]
         n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
         rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + 1.0 / g.mass[j]
                                               + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]))
-        if split:
-            f = 0.0
-            pf = 0.0
         fx = -n * nx + f * nz  # on i: -n nvec - f tvec, tvec = (-nz, nx); on j the opposite
         fz = -n * nz - f * nx
         dy[i, 3] += fx
@@ -124,14 +152,18 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             ovl = delta / ri
             ovl_i = i
             ovl_j = -1 - g.wall_w[w]
+        c = g.wall_coef[w]
+        if split:  # the normal force alone: friction_flow applies the friction
+            n, pv, ep = normal_response(delta, y[i, 3] * nx + y[i, 4] * nz, c[COEF_A], c[COEF_C], cfg.clip)
+            dy[i, 3] += -n * nx
+            dy[i, 4] += -n * nz
+            p_visc += pv
+            e_pot += ep
+            continue
         ai = contact_arm(ri, delta, cfg.arm_shrink)
         ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
-        c = g.wall_coef[w]
         n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
         rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i]))
-        if split:
-            f = 0.0
-            pf = 0.0
         dy[i, 3] += -n * nx + f * nz
         dy[i, 4] += -n * nz - f * nx
         dy[i, 5] -= f * ai
@@ -175,8 +207,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         dy[i, 3] /= g.mass[i]
         dy[i, 4] /= g.mass[i]
         dy[i, 5] /= g.inertia[i]
-    # one float tuple: indexable
-    return p_shock, p_visc, p_fric, e_pot, rate, ovl, float(ovl_i), float(ovl_j), rate_plate
+    return ForceSums(p_shock, p_visc, p_fric, e_pot, rate, ovl, ovl_i, ovl_j, rate_plate)
 
 
 @njit(cache=True)
@@ -209,6 +240,8 @@ def friction_flow(y, dt, g, cfg, forward):
             j = g.pair_ij[q, 1]
             ri = g.radius[i]
             rj = g.radius[j]
+            if pair_apart(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj):
+                continue
             delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
             c = g.pair_coef[q]
             if delta <= 0.0 or c[COEF_MU] == 0.0:
@@ -217,14 +250,17 @@ def friction_flow(y, dt, g, cfg, forward):
             aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
             ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
             n, _ = normal_force(delta, ddot, c[COEF_A], c[COEF_C], cfg.clip)
-            inv_t = 1.0 / g.mass[i] + 1.0 / g.mass[j] + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]
-            imp, dw = friction_impulse(vt, n, c[COEF_MU], c[COEF_KS], inv_t, dt)
-            y[i, 3] += imp * nz / g.mass[i]
-            y[i, 4] -= imp * nx / g.mass[i]
-            y[i, 5] -= imp * ai / g.inertia[i]
-            y[j, 3] -= imp * nz / g.mass[j]
-            y[j, 4] += imp * nx / g.mass[j]
-            y[j, 5] -= imp * aj / g.inertia[j]
+            inv_mi = 1.0 / g.mass[i]
+            inv_mj = 1.0 / g.mass[j]
+            inv_ii = ai / g.inertia[i]  # the spin change per unit impulse
+            inv_ij = aj / g.inertia[j]
+            imp, dw = friction_impulse(vt, n, c[COEF_MU], c[COEF_KS], inv_mi + inv_mj + ai * inv_ii + aj * inv_ij, dt)
+            y[i, 3] += imp * nz * inv_mi
+            y[i, 4] -= imp * nx * inv_mi
+            y[i, 5] -= imp * inv_ii
+            y[j, 3] -= imp * nz * inv_mj
+            y[j, 4] += imp * nx * inv_mj
+            y[j, 5] -= imp * inv_ij
             work += dw
         else:  # wall contact w, the wall at rest
             w = q - n_p
@@ -239,10 +275,12 @@ def friction_flow(y, dt, g, cfg, forward):
             ai = contact_arm(ri, delta, cfg.arm_shrink)
             ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
             n, _ = normal_force(delta, ddot, c[COEF_A], c[COEF_C], cfg.clip)
-            imp, dw = friction_impulse(vt, n, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i], dt)
-            y[i, 3] += imp * nz / g.mass[i]
-            y[i, 4] -= imp * nx / g.mass[i]
-            y[i, 5] -= imp * ai / g.inertia[i]
+            inv_m = 1.0 / g.mass[i]
+            inv_i = ai / g.inertia[i]
+            imp, dw = friction_impulse(vt, n, c[COEF_MU], c[COEF_KS], inv_m + ai * inv_i, dt)
+            y[i, 3] += imp * nz * inv_m
+            y[i, 4] -= imp * nx * inv_m
+            y[i, 5] -= imp * inv_i
             work += dw
     return work
 
@@ -296,9 +334,9 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     if hold or split:
         pr = granular_rhs(t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar,
                           split)
-        w.p1h[0] = pr[0]
-        w.p1h[1] = pr[1]
-        w.p1h[2] = pr[2]
+        w.p1h[0] = pr.p_shock
+        w.p1h[1] = pr.p_visc
+        w.p1h[2] = pr.p_fric
         k1 = w.k1h
         p1 = w.p1h
     hh = 0.5 * h
@@ -321,22 +359,23 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     for i in range(ng):
         for c in range(6):  # (y0 may be w.ynew itself: each entry is read before it is written)
             w.ynew[i, c] = y0[i, c] + h6 * (k1[i, c] + 2.0 * w.k2[i, c] + 2.0 * w.k3[i, c] + w.k4[i, c])
-    for c in range(3):
-        w.dacc[c] = h6 * (p1[c] + 2.0 * p2[c] + 2.0 * p3[c] + p4[c])
+    w.dacc[0] = h6 * (p1[0] + 2.0 * p2.p_shock + 2.0 * p3.p_shock + p4.p_shock)
+    w.dacc[1] = h6 * (p1[1] + 2.0 * p2.p_visc + 2.0 * p3.p_visc + p4.p_visc)
+    w.dacc[2] = h6 * (p1[2] + 2.0 * p2.p_fric + 2.0 * p3.p_fric + p4.p_fric)
     if split:  # friction over [t + h/2, t + h]
         fric_split += friction_flow(w.ynew, hh, g, cfg, False)
         w.dacc[2] += fric_split
     pe = granular_rhs(t + h, w.ynew, stage[2], stage[3], g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar,
                       split)
-    w.pend[0] = pe[0]
-    w.pend[1] = pe[1]
-    w.pend[2] = pe[2]
-    w.ovl_new[0] = pe[5]
-    w.ovl_who[0] = int(pe[6])
-    w.ovl_who[1] = int(pe[7])
+    w.pend[0] = pe.p_shock
+    w.pend[1] = pe.p_visc
+    w.pend[2] = pe.p_fric
+    w.ovl_new[0] = pe.ovl
+    w.ovl_who[0] = pe.ovl_i
+    w.ovl_who[1] = pe.ovl_j
     if not cfg.split_friction:
-        return pe[3], max(pe[4], pe[8])
-    return pe[3], 0.0 if hold else pe[8]  # a held plate-contact friction is not RK4's
+        return pe.e_pot, max(pe.rate, pe.rate_plate)
+    return pe.e_pot, 0.0 if hold else pe.rate_plate  # a held plate-contact friction is not RK4's
 
 
 @njit(cache=True)

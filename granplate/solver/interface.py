@@ -203,7 +203,7 @@ def move_patches(st, g, p, cfg, w):
         st.clock[CUSTOM_H] = -1.0
         pr = granular_rhs(st.clock[T_NOW], st.y, st.u, st.v, g, cfg, st.k1, w.fscratch, w.nscratch, w.sscratch,
                           False, w.fbar)
-        st.p1[0] = pr[0]
-        st.p1[1] = pr[1]
-        st.p1[2] = pr[2]
+        st.p1[0] = pr.p_shock
+        st.p1[1] = pr.p_visc
+        st.p1[2] = pr.p_fric
     return moved

@@ -33,17 +33,17 @@ def initialise(st, g, p, cfg, w):
     granules' derivative as every step's end one (without the split-off friction)."""
     pr = granular_rhs(st.clock[T_NOW], st.y, st.u, st.v, g, cfg, st.k1, st.force, st.normal, st.slip, False, w.fbar,
                       cfg.split_friction)
-    st.p1[0] = pr[0]
-    st.p1[1] = pr[1]
-    st.p1[2] = pr[2]
-    st.clock[E_POT] = pr[3]
+    st.p1[0] = pr.p_shock
+    st.p1[1] = pr.p_visc
+    st.p1[2] = pr.p_fric
+    st.clock[E_POT] = pr.e_pot
     modal_acceleration(st.clock[T_NOW], st, p, cfg, st.force)
     driving_dofs(st, p)
     for d in range(st.force.shape[0]):
         st.force_prev[d] = st.force[d]
         st.pforce[d] = st.force[d]
     kx, ky, kr = kinetic_energies(st.y, g.mass, g.inertia)
-    e0 = kx + ky + kr + pr[3] + plate_energy(st.q, st.qd, st.force, p.omega2, p.resid)
+    e0 = kx + ky + kr + pr.e_pot + plate_energy(st.q, st.qd, st.force, p.omega2, p.resid)
     st.clock[E_ZERO] = e0
     st.clock[E_IN_MAX] = e0
     reset_interval(w)

