@@ -171,3 +171,49 @@ def test_command_line_reports_bad_numbers_in_one_line(tmp_path):
         assert len(lines) == 1 and lines[0].startswith("granplate: error: "), p.stderr
         assert "Traceback" not in p.stderr and names_field(lines[0], path), lines[0]
         assert not out.exists()
+
+
+#: Every layout kind, from its worked example (docs/examples) and the paper's preset.
+LAYOUT_SOURCES: tuple[str, ...] = ("paper", "hexagonal", "square", "chain", "imperfect",
+                                   "intruder-lattice")
+LAYOUT_BAD_VALUES: tuple = (-1.0, 0.0, math.nan, math.inf, 1e300, 1e-300, "x")
+
+
+def _layout_scenario(name: str):
+    from pathlib import Path
+
+    from granplate.setup.io import load_scenario
+    if name == "paper":
+        return gp.preset("steel-r1")
+    return load_scenario(Path(__file__).resolve().parents[1] / "docs" / "examples" / f"{name}.toml")
+
+
+@pytest.mark.parametrize("name", LAYOUT_SOURCES)
+def test_layout_fields_refused_by_name(name):
+    """Each numeric field of a layout (and of its imperfections) set to a bad value is either
+    accepted by validation or refused naming that field: never an overflow in the layout's
+    expansion, never a derived granule field blamed instead."""
+    import dataclasses
+    s = _layout_scenario(name)
+    lay = s.layout
+    tables = [("layout", lay, lambda v: dataclasses.replace(lay, **v))]
+    if lay.imperfections is not None:
+        imp = lay.imperfections
+        tables.append(("layout.imperfections", imp,
+                       lambda v: dataclasses.replace(lay, imperfections=dataclasses.replace(imp, **v))))
+    tried = 0
+    for prefix, table, rebuild in tables:
+        for f in dataclasses.fields(table):
+            v0 = getattr(table, f.name)
+            if not isinstance(v0, (int, float)) or isinstance(v0, bool) or f.name == "y" and v0 is None:
+                continue
+            for bad in LAYOUT_BAD_VALUES:
+                changed = dataclasses.replace(s, layout=rebuild({f.name: bad}))
+                tried += 1
+                try:
+                    validate(changed)
+                except ScenarioError as err:
+                    if f"{prefix}.{f.name}" in str(err) or "plate.clamped_edges" in str(err):
+                        continue  # named; a granule placed on a clamp names the clamp
+                    pytest.fail(f"{prefix}.{f.name} = {bad!r}: the error names another field: {err}")
+    assert tried > 0

@@ -60,6 +60,11 @@ INTERVAL_RTOL = 1e-9
 #: under the OVERLAP_RTOL x h tolerance at t = 0, so overlaps and gaps are resolved (and
 #: the k-d tree's squared distances cannot overflow).
 LENGTH_RANGE = 1e6
+#: A layout's radii [m]: from a nanometre (below it a continuum contact law means nothing) to
+#: a kilometre; its size ratios (taper, dimer, decorated, intruder) within 1 / LENGTH_RANGE
+#: .. LENGTH_RANGE of the radius they scale, so that the granules it makes stay in the range
+#: every coordinate is checked against (LENGTH_RANGE).
+LAYOUT_RADIUS_RANGE: tuple[float, float] = (1e-9, 1e3)
 
 
 # --------------------------------------------------------------------------- sections
@@ -104,8 +109,27 @@ def _check_layout(s: Scenario) -> None:
             dataclasses.replace(lay, imperfections=None)).granules)
 
 
+def layout_radius(path: str, value: Any) -> None:
+    """A layout's radius [m], within LAYOUT_RADIUS_RANGE."""
+    lo, hi = LAYOUT_RADIUS_RANGE
+    positive(path, value)
+    if not lo <= float(value) <= hi:
+        raise ScenarioError(path, value, f"allowed: {lo:g} m <= radius <= {hi:g} m")
+
+
+def layout_ratio(path: str, value: Any, power: int = 1) -> None:
+    """A layout's size ratio whose power-th power scales a radius (a chain's taper: count - 1)
+    within 1 / LENGTH_RANGE .. LENGTH_RANGE, so that the radii it makes stay within the length
+    range every coordinate is checked against."""
+    positive(path, value)
+    if not power * abs(math.log(float(value))) <= math.log(LENGTH_RANGE):
+        what = "value" if power == 1 else f"value^{power} (the last radius over the first)"
+        raise ScenarioError(path, value, f"allowed: {what} within {1.0 / LENGTH_RANGE:g} .. "
+                            f"{LENGTH_RANGE:g} (a ratio of radii)")
+
+
 def _check_paper_layout(s: Scenario, lay: Layout) -> None:
-    positive("layout.R1", lay.R1)
+    layout_radius("layout.R1", lay.R1)
     r = finite("layout.R2_ratio", lay.R2_ratio,
                 f"must be in [{SQRT2_MINUS_1:.8f}, 1] (sqrt(2)-1 <= R2/R1 <= 1)")
     if not (SQRT2_MINUS_1 - RATIO_TOL <= r <= 1.0 + RATIO_TOL):
@@ -124,18 +148,18 @@ def _list_of_columns(path: str, values: Any, columns: int) -> None:
 def _check_lattice_layout(s: Scenario, lay: LatticeLayout) -> None:
     int_at_least("layout.columns", lay.columns, 1)
     int_at_least("layout.rows", lay.rows, 2 if lay.kind == "hexagonal" and lay.columns > 1 else 1)
-    positive("layout.radius", lay.radius)
+    layout_radius("layout.radius", lay.radius)
     for f in ("material", "wall_material"):
         material_exists(f"layout.{f}", getattr(lay, f), s)
     if lay.intruder_material is not None:
         material_exists("layout.intruder_material", lay.intruder_material, s)
     _list_of_columns("layout.column_radii", lay.column_radii, lay.columns)
     for c, r in enumerate(lay.column_radii):
-        positive(f"layout.column_radii[{c}]", r)
+        layout_radius(f"layout.column_radii[{c}]", r)
     _list_of_columns("layout.column_materials", lay.column_materials, lay.columns)
     for c, m in enumerate(lay.column_materials):
         material_exists(f"layout.column_materials[{c}]", m, s)
-    positive("layout.intruder_ratio", lay.intruder_ratio)
+    layout_ratio("layout.intruder_ratio", lay.intruder_ratio)
     for k, c in enumerate(lay.intruder_columns):
         if not isinstance(c, numbers.Integral) or isinstance(c, bool) or not 1 <= c <= lay.columns:
             raise ScenarioError(f"layout.intruder_columns[{k}]", c,
@@ -182,15 +206,20 @@ def _check_column_offsets(lay: LatticeLayout) -> None:
 
 def _check_chain_layout(s: Scenario, lay: ChainLayout) -> None:
     int_at_least("layout.count", lay.count, 1)
-    positive("layout.radius", lay.radius)
-    positive("layout.taper", lay.taper)
-    positive("layout.dimer_ratio", lay.dimer_ratio)
+    layout_radius("layout.radius", lay.radius)
+    layout_ratio("layout.taper", lay.taper, power=max(int(lay.count) - 1, 1))
+    layout_ratio("layout.dimer_ratio", lay.dimer_ratio)
     nonneg("layout.decorated_ratio", lay.decorated_ratio)
+    if lay.decorated_ratio > 0.0:
+        layout_ratio("layout.decorated_ratio", lay.decorated_ratio)
     for f in ("material", "wall_material", "dimer_material", "decorated_material"):
         if getattr(lay, f) is not None:
             material_exists(f"layout.{f}", getattr(lay, f), s)
     if lay.y is not None:
         finite("layout.y", lay.y)
+        if not abs(float(lay.y)) <= LENGTH_RANGE * lay.radius:
+            raise ScenarioError("layout.y", lay.y, f"allowed: |y| <= {LENGTH_RANGE:g} x layout.radius "
+                                f"= {LENGTH_RANGE * lay.radius:.6g} m")
 
 
 def _check_imperfections(imp: Imperfections, sites: tuple[Granule, ...]) -> None:
