@@ -22,7 +22,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from granplate.errors import ScenarioError
-from granplate.setup.geometry import layout_packing, resolve
+from granplate.setup.geometry import granule_named, layout_packing, resolve
 from granplate.setup.layouts import column_radii, half_pitch, hexagonal_offsets, lattice_sites
 from granplate.setup.fields import finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
 from granplate.setup.plate_checks import check_plate_mesh
@@ -196,7 +196,7 @@ def _check_imperfections(imp: Imperfections, sites: tuple[Granule, ...]) -> None
                                 + ", ".join(list(g.label for g in sites)[:3]) + ", ...)")
 
 
-def _check_granules(s: Scenario) -> None:
+def _check_granules(s: Scenario, named: dict[int, str]) -> None:
     seen: dict[str, int] = {}
     for i, g in enumerate(s.granules):
         p = f"granules[{i}]"
@@ -220,7 +220,7 @@ def _check_granules(s: Scenario) -> None:
         if overlap > OVERLAP_RTOL * min(gi.radius, gj.radius):
             raise ScenarioError(
                 f"granules[{i}]", gi.label,
-                f"overlaps granule '{gj.label}' (granules[{j}]) by {overlap:.6g} m at t = 0; "
+                f"{named[i]} overlaps {named[j]} (granules[{j}]) by {overlap:.6g} m at t = 0; "
                 f"granules may touch but not overlap (tolerance "
                 f"{OVERLAP_RTOL:g} x the smaller radius)")
 
@@ -236,7 +236,7 @@ def _close_pairs(gs: tuple[Granule, ...]) -> list[tuple[int, int]]:
     return sorted(map(tuple, pairs.tolist()))
 
 
-def _check_walls(s: Scenario) -> None:
+def _check_walls(s: Scenario, named: dict[int, str]) -> None:
     seen: dict[str, int] = {}
     for k, w in enumerate(s.walls):
         p = f"walls[{k}]"
@@ -262,11 +262,11 @@ def _check_walls(s: Scenario) -> None:
             if pen > OVERLAP_RTOL * g.radius:
                 raise ScenarioError(
                     f"granules[{i}]", g.label,
-                    f"penetrates wall '{w.label}' (walls[{k}]) by {pen:.6g} m at t = 0; "
+                    f"{named[i]} penetrates wall '{w.label}' (walls[{k}]) by {pen:.6g} m at t = 0; "
                     f"a granule may touch a wall but not cross it")
 
 
-def _check_plate(s: Scenario) -> None:
+def _check_plate(s: Scenario, named: dict[int, str]) -> None:
     pl = s.plate
     if pl is None:
         return
@@ -301,7 +301,7 @@ def _check_plate(s: Scenario) -> None:
             if pen > OVERLAP_RTOL * g.radius:
                 raise ScenarioError(
                     f"granules[{i}]", g.label,
-                    f"penetrates the plate (left edge x0 = {x0:.6g} m) by {pen:.6g} m at "
+                    f"{named[i]} penetrates the plate (left edge x0 = {x0:.6g} m) by {pen:.6g} m at "
                     f"t = 0; granules must lie left of the plate (x + radius <= plate.x0)")
 
 
@@ -407,12 +407,27 @@ def _check_solver(s: Scenario) -> None:
 
 # --------------------------------------------------------------------------- entry point
 
+class _GranuleNames(dict):
+    """Granule i of the resolved scenario as messages name it (`geometry.granule_named`:
+    its label and the fields that place it), made when a message asks."""
+
+    def __init__(self, scenario: Scenario, resolved: Scenario):
+        super().__init__()
+        self.scenario, self.resolved = scenario, resolved
+
+    def __missing__(self, i: int) -> str:
+        return granule_named(self.scenario, self.resolved, i)
+
+    def get(self, i, default=None):
+        return self[i] if 0 <= i < len(self.resolved.granules) else default
+
+
 def validate(scenario: Scenario) -> None:
     """Raise ScenarioError(field, value, allowed) for the first problem in `scenario`.
 
     Order: materials, layout (as `layout.*`, before it is expanded), then on the resolved
     scenario: granules (values, unique labels, overlaps), walls (unit normals,
-    penetration), plate, load, contact, plate mesh (contacts on nodes, rigid layers,
+    penetration), plate, load, contact, plate mesh (rigid layers of the contacts on nodes, patch contacts between nodes,
     n_modes), time, solver. A scenario with neither granules
     (nor a layout) nor a plate is refused.
     """
@@ -429,12 +444,13 @@ def validate(scenario: Scenario) -> None:
     if s.plate is not None and s.plate.x0 is not None:
         finite("plate.x0", s.plate.x0)
     r = resolve(s)
-    _check_granules(r)
-    _check_walls(r)
-    _check_plate(r)
+    named = _GranuleNames(s, r)
+    _check_granules(r, named)
+    _check_walls(r, named)
+    _check_plate(r, named)
     _check_load(r)
     _check_contact(r)
-    check_plate_mesh(r)
+    check_plate_mesh(r, named)
     _check_time(r)
     _check_solver(r)
 
