@@ -184,7 +184,7 @@ def check_plate_mesh(s: Scenario, names: dict[int, str] | None = None) -> None:
         return
     _check_symmetry_row(p)
     on, between = split_initial_contacts(s)
-    names = {i: (names if names is not None else {}).get(i, f"granule '{s.granules[i].label}'") for i in on + between}
+    names = {i: names[i] if names is not None else f"granule '{s.granules[i].label}'" for i in on + between}
     contact_y = [float(s.granules[i].y) for i in on]
     layers = rigid_layers(p, contact_y, [names[i] for i in on])
     _check_layers_off_clamps(p, contact_y, layers, [names[i] for i in on])

@@ -418,17 +418,14 @@ class _GranuleNames(dict):
     def __missing__(self, i: int) -> str:
         return granule_named(self.scenario, self.resolved, i)
 
-    def get(self, i, default=None):
-        return self[i] if 0 <= i < len(self.resolved.granules) else default
-
 
 def validate(scenario: Scenario) -> None:
     """Raise ScenarioError(field, value, allowed) for the first problem in `scenario`.
 
     Order: materials, layout (as `layout.*`, before it is expanded), then on the resolved
     scenario: granules (values, unique labels, overlaps), walls (unit normals,
-    penetration), plate, load, contact, plate mesh (rigid layers of the contacts on nodes, patch contacts between nodes,
-    n_modes), time, solver. A scenario with neither granules
+    penetration), plate, load, contact, plate mesh (rigid layers of the contacts on
+    nodes, patch contacts between nodes, n_modes), time, solver. A scenario with neither granules
     (nor a layout) nor a plate is refused.
     """
     s = scenario
