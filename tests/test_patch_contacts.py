@@ -2,7 +2,9 @@
 3.5): against Hertz's rigid-wall impact on a stiff plate, against themselves at a node
 and between nodes, Coulomb's bound when sliding, the energy balance of eq. (11) (exactly
 across a patch move), the truncated basis against the full one, the fixed detection's
-error kept, and the record of when and where each contact formed."""
+error kept, and the record of when and where each contact formed; granules touching the
+face between nodes at t = 0 (patch contacts from the start) against the same granule
+reaching the face during the run."""
 from __future__ import annotations
 
 import dataclasses
@@ -250,3 +252,87 @@ def test_a_patch_contact_added_starts_from_the_modes(scheme):
     assert np.abs(expected).max() > 0 or scheme == "implicit"
     assert np.allclose(st.a, expected, rtol=1e-12, atol=0)
     assert lists.changes().granule.tolist() == [0] and lists.changes().y.tolist() == [0.05]
+
+
+def test_granule_touching_between_nodes_at_t0_bounces_as_one_reaching_the_face():
+    """A granule touching the face between nodes at t = 0 gets its patch contact before the
+    first step and bounces as the same granule reaching that spot from a gap (the patch
+    formed during the run): restitution, force peak and the plate's energy, eq. (11) held."""
+    touch_s = drop_scenario(BETWEEN, gap=0.0, t_end=5e-4)
+    model = build_model(touch_s)
+    assert len(model.plate_contacts) == 0 and list(model.initial_patches) == [0]
+    touch = simulate(touch_s, model=model, progress=False)
+    gap = simulate(drop_scenario(BETWEEN, t_end=1e-3), progress=False)
+    b_t, b_g = bounce(touch), bounce(gap)
+    assert list(touch.contact.values) == ["g"] and touch.contact_y.values[0] == pytest.approx(BETWEEN)
+    assert touch.contact_normal_force.values[1, 0] > 0.0  # in touch from the first step
+    assert b_t["e"] == pytest.approx(b_g["e"], rel=1e-4)
+    assert b_t["f_max"] == pytest.approx(b_g["f_max"], rel=1e-3)
+    assert b_t["t_c"] == pytest.approx(b_g["t_c"], abs=1e-6)
+    assert touch.E_plate.values[-1] == pytest.approx(gap.E_plate.values[-1], rel=1e-3)
+    assert b_t["residual"] < 1e-5
+
+
+def test_granule_touching_between_nodes_at_t0_on_a_truncated_basis():
+    """The same granule on the truncated basis (its patch's static rows w^T R_face w set
+    at t = 0): restitution and the plate's energy within 0.5% of the full basis, eq. (11) held."""
+    fast = dict(gap=0.0, t_end=5e-4)
+    full = simulate(drop_scenario(BETWEEN, **fast), progress=False)
+    trunc_s = _truncated(drop_scenario(BETWEEN, **fast))
+    model = build_model(trunc_s)
+    assert model.plate.truncated and list(model.initial_patches) == [0]
+    trunc = simulate(trunc_s, model=model, progress=False)
+    b_f, b_t = bounce(full), bounce(trunc)
+    assert b_t["e"] == pytest.approx(b_f["e"], rel=5e-3)
+    assert trunc.E_plate.values[-1] == pytest.approx(full.E_plate.values[-1], rel=5e-3)
+    assert b_t["residual"] < 1e-5
+
+
+def test_initial_contacts_on_nodes_keep_their_rigid_layers():
+    """Contacts at t = 0 on a face node keep the rigid layer (the paper's model), those between
+    nodes become patch contacts, listed after the layers on the output's contact axis."""
+    from granplate.setup.scenario import Granule
+
+    s = drop_scenario(BETWEEN, gap=0.0, t_end=2e-5)
+    on_node = Granule(x=X0 - 0.004, y=0.08, radius=0.004, material="steel", label="n", vx=1.0)
+    s = dataclasses.replace(s, granules=(on_node, *s.granules))
+    model = build_model(s)
+    assert list(model.plate_contacts) == [0] and list(model.initial_patches) == [1]
+    ds = simulate(s, model=model, progress=False)
+    assert list(ds.contact.values) == ["n", "g"]
+    assert list(ds.contact_y.values) == pytest.approx([0.08, BETWEEN])
+
+
+def test_patches_at_t0_refused_only_where_patches_are_impossible():
+    """Between nodes at t = 0: the paper scheme on a truncated basis keeps its refusal
+    (solver.scheme); fixed detection is refused naming the granule and contact.detection."""
+    from granplate.errors import ScenarioError
+
+    s = _truncated(drop_scenario(BETWEEN, gap=0.0, scheme="paper"))
+    with pytest.raises(ScenarioError, match=r"'solver.scheme' = 'paper': the truncated plate basis"):
+        build_model(s)
+    s = drop_scenario(BETWEEN, gap=0.0)
+    s = dataclasses.replace(s, contact=dataclasses.replace(s.contact, detection="fixed"))
+    with pytest.raises(ScenarioError, match=r"'contact.detection' = 'fixed': granule 'g' \(placed by "
+                                            r"granules\[0\].x, granules\[0\].y, granules\[0\].radius"):
+        build_model(s)
+
+
+def test_continuous_layout_radius_builds_and_a_remaining_refusal_names_the_granule_and_the_layout():
+    """A lattice with a radius off the node spacing builds (patch contacts at t = 0); a refusal
+    that remains names the granule's label and the layout fields that placed it, no contact index."""
+    from granplate.errors import ScenarioError
+    from granplate.setup.scenario import LatticeLayout, Plate, Scenario
+
+    s = Scenario(layout=LatticeLayout(columns=2, radius=0.0093, column_radii=(0.0093, 0.0071)),
+                 plate=Plate(height=0.1))
+    model = build_model(s)
+    assert len(model.initial_patches) == 4 and len(model.plate_contacts) == 0
+    bad = dataclasses.replace(s, plate=Plate(height=0.1, clamped_edges=("left",)))
+    assert len(build_model(bad).initial_patches) == 4  # patches may sit by clamped nodes
+    bad = dataclasses.replace(s, plate=Plate(height=0.1, n_modes=30))
+    with pytest.raises(ScenarioError) as err:
+        build_model(bad)
+    msg = str(err.value)
+    assert "granule 'c2r1' (placed by layout.columns, layout.radius, layout.column_radii;" in msg
+    assert "contact 0" not in msg and err.value.field == "plate.n_modes"

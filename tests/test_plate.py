@@ -334,12 +334,20 @@ def refusal(scenario: Scenario) -> ScenarioError:
     return err.value
 
 
-def test_validation_refuses_contact_between_nodes():
-    """A plate contact at a y with no left-edge node: ScenarioError naming plate.ny, the contact and the spacing."""
-    err = refusal(plate_scenario((0.09, 0.0712)))
-    assert err.field == "plate.ny" and err.value == 40
-    assert "not on a mesh node" in str(err) and "0.0712" in str(err) and "0.00125" in str(err)
-    validate(plate_scenario((0.09, 0.07125)))  # on a midside node: accepted
+def test_contact_between_nodes_is_a_patch_where_patches_are_possible():
+    """A contact at t = 0 between face nodes: accepted (a patch contact) with dynamic detection on
+    all modes; refused with fixed detection or a cut dense basis, naming the field, the granule and
+    the spacing."""
+    s = plate_scenario((0.09, 0.0712))
+    validate(s)
+    assert plate_checks.split_initial_contacts(s) == ([0], [1])
+    err = refusal(dataclasses.replace(s, contact=dataclasses.replace(s.contact, detection="fixed")))
+    assert err.field == "contact.detection" and err.value == "fixed"
+    assert "granule 'g1'" in str(err) and "between face nodes" in str(err) and "0.0712" in str(err)
+    assert "0.00125" in str(err) and "contact 1" not in str(err)
+    err = refusal(plate_scenario((0.09, 0.0712), n_modes=20))
+    assert err.field == "plate.n_modes" and "granule 'g1'" in str(err)
+    validate(plate_scenario((0.09, 0.07125), n_modes=20))  # on a midside node: a rigid layer
 
 
 def test_validation_refuses_odd_ny():
@@ -353,14 +361,16 @@ def test_validation_refuses_overlapping_rigid_layers():
     """Rigid layers of neighbouring contacts that share a node: ScenarioError naming plate.rigid_layer_width."""
     err = refusal(plate_scenario(CONTACTS, rigid_layer_width=0.02))
     assert err.field == "plate.rigid_layer_width" and err.value == 0.02
-    assert "contacts 0 (y=0.09 m) and 1 (y=0.07 m)" in str(err)
+    assert "granule 'g0' (placed by granules[0].x, granules[0].y, granules[0].radius;" in str(err)
+    assert "at y=0.09 m and granule 'g1'" in str(err) and "at y=0.07 m share" in str(err)
     validate(plate_scenario(CONTACTS, rigid_layer_width=0.0175))  # 7 nodes each, none shared
 
 
 def test_validation_refuses_contacts_and_layers_on_clamps():
     """A contact on a clamped node or a layer reaching one: ScenarioError naming the clamp or the width."""
     err = refusal(plate_scenario((0.05,), clamped_edges=("left",)))
-    assert err.field == "plate.clamped_edges" and "sits on a clamped node" in str(err)
+    assert err.field == "plate.clamped_edges" and "granule 'g0' (placed by" in str(err)
+    assert "touches the plate at y=0.05 m, on a clamped node" in str(err)
     err = refusal(plate_scenario((0.0025,), rigid_layer_width=0.005))
     assert err.field == "plate.rigid_layer_width" and "reaches a clamped node" in str(err)
     validate(plate_scenario((0.0025,), rigid_layer_width=0.0025))  # reaches y = 0.00125, not y = 0

@@ -34,3 +34,20 @@ def test_mass_is_the_sum_of_the_granules_masses(runs):
     _, sparse = runs
     r1, rho = 0.01, 7850.0
     assert D.metrics(sparse)["granular_mass"] == pytest.approx(14 * 4 / 3 * np.pi * r1 ** 3 * rho, rel=1e-12)
+
+
+def test_a_continuous_radius_is_valid_and_a_geometric_failure_names_the_granule_and_the_field():
+    """A trial with radii off the mesh's node spacing validates (patch contacts at t = 0); a
+    geometric refusal that remains reaches the trial's status naming the granule's label and
+    the layout field the study varies, not a contact index or plate.ny."""
+    from pathlib import Path
+
+    from granplate.setup.validate import validate
+
+    base = gp.load_scenario(str(Path(__file__).parents[1] / "docs" / "studies" / "two-layer-base.toml"))
+    trial = gp.with_changes(base, {"layout.column_radii": (0.0093, 0.0071)})
+    validate(trial)
+    refused = gp.with_changes(trial, {"plate.n_modes": 30})
+    status = D.run_design(gp.dumps(refused))["status"]
+    assert status.startswith("ScenarioError: scenario field 'plate.n_modes' = 30: granule 'c2r")
+    assert "layout.column_radii" in status and "contact 0" not in status and "plate.ny" not in status

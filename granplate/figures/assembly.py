@@ -115,7 +115,8 @@ def contact_lists(scenario: Scenario, x: np.ndarray | None = None, y: np.ndarray
     from granplate.model.neighbours import contact_pairs
 
     model = build_model(scenario)
-    plate = np.asarray(model.plate_contacts, int).reshape(-1)
+    plate = np.concatenate([np.asarray(model.plate_contacts, int).reshape(-1),
+                            np.asarray(model.initial_patches, int).reshape(-1)])
     if x is None:
         return (np.asarray(model.pairs, int).reshape(-1, 2),
                 np.asarray(model.wall_contacts, int).reshape(-1, 2), plate)

@@ -4,7 +4,7 @@ and the plate's modal model, built once per run (the plate part is cached on dis
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -18,7 +18,7 @@ from granplate.setup.geometry import resolve
 from granplate.physics.shock import shock_resultants
 from granplate.setup.materials import effective_modulus, sphere_inertia, sphere_mass
 from granplate.setup.scenario import Scenario
-from granplate.setup.plate_checks import faces_plate
+from granplate.setup.plate_checks import split_initial_contacts
 from granplate.setup.validate import validate
 
 #: implicit scheme: the error estimate's smallest force scale, as a fraction of the
@@ -53,7 +53,9 @@ class Model:
     scenario: the resolved scenario (layout expanded); labels: granule labels;
     pairs: (np, 2) granule pairs in contact at t = 0 (gap within contact.neighbour_gap);
     wall_contacts: (nw, 2) [granule, wall] likewise; plate_contacts: (nk,) granule index
-    per plate contact; plate: the PlateModel or None. The loop's lists are in `granular`
+    per rigid-layer contact (those on a face node at t = 0); initial_patches: the granules
+    touching the face between nodes at t = 0, which the driver gives patch contacts before
+    the first step (docs/model.md section 3.5); plate: the PlateModel or None. The loop's lists are in `granular`
     (pair_ij, wall_i: with contact.detection = "dynamic" the Verlet lists at t = 0,
     rebuilt during the run by `granular_with_contacts`). materials: each granule's Material.
     """
@@ -69,6 +71,7 @@ class Model:
     wall_contacts: np.ndarray
     plate_contacts: np.ndarray
     materials: tuple = ()
+    initial_patches: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
 
     @property
     def n_granules(self) -> int:
@@ -109,12 +112,14 @@ def find_wall_contacts(s: Scenario, x, y, r) -> np.ndarray:
     return fixed_wall_contacts(s.walls, x, y, r, s.contact.neighbour_gap)
 
 
-def find_plate_contacts(s: Scenario, x, y, r) -> np.ndarray:
-    """Granules facing the plate's left edge (setup.plate_checks.faces_plate)."""
-    if s.plate is None or len(x) == 0:
-        return np.zeros(0, np.int64)
-    gap = s.contact.neighbour_gap
-    return np.array([i for i in range(len(x)) if faces_plate(s.plate, gap, x[i], y[i], r[i])], np.int64)
+def find_plate_contacts(s: Scenario) -> tuple[np.ndarray, np.ndarray]:
+    """Granules facing the plate's left edge at t = 0 (setup.plate_checks.faces_plate), as
+    (on a face node: rigid layers, between nodes: patch contacts from the start; docs/model.md
+    section 1.3)."""
+    if s.plate is None or not s.granules:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    on, between = split_initial_contacts(s)
+    return np.array(on, np.int64), np.array(between, np.int64)
 
 
 def loaded_granules(s: Scenario, x, r) -> np.ndarray:
@@ -276,11 +281,12 @@ def build_model(scenario: Scenario) -> Model:
     wc = find_wall_contacts(s, x, y, r)
     loop_pairs, loop_wc = contact_lists(s.contact, s.walls, x, y, r)
     wall_geo, wall_coef = wall_arrays(s, mats, r, mass, loop_wc)
-    pc = find_plate_contacts(s, x, y, r)
-    if len(pc) and s.plate is None:  # pragma: no cover - guarded by validation
-        raise ScenarioError("plate", None, "plate contacts need a plate")
+    pc, patches = find_plate_contacts(s)
     fres, tres = shock_resultants(y, r, loaded_granules(s, x, r), s.load.y0, s.load.length)
     plate_model, plate_arrays = plate_modal_arrays(s, y, pc)
+    if len(patches) and len(plate_arrays.face_y) == 0:  # pragma: no cover - guarded by validation
+        raise ScenarioError("contact.detection", s.contact.detection,
+                            "granules touching the face between nodes at t = 0 need patch contacts")
     granular = Granular(
         mass=mass, inertia=inertia, radius=r, pair_ij=loop_pairs,
         pair_coef=pair_coefficients(s, mats, r, mass, loop_pairs),
@@ -294,7 +300,7 @@ def build_model(scenario: Scenario) -> Model:
         granular=granular, plate_arrays=plate_arrays,
         config=loop_config(s, fres, tres, r, mass, face=len(plate_arrays.face_y) > 0),
         plate=plate_model, initial_state=initial_state(s, x, y), pairs=pairs, wall_contacts=wc,
-        plate_contacts=pc, materials=tuple(mats),
+        plate_contacts=pc, materials=tuple(mats), initial_patches=patches,
     )
 
 

@@ -133,3 +133,35 @@ def resolve(scenario: Scenario) -> Scenario:
                   for i, w in enumerate(walls))
     return dataclasses.replace(scenario, layout=None, granules=granules, walls=walls,
                                plate=plate, load=load)
+
+
+#: The fields of each layout kind that place its granules (materials do not), in the
+#: order a message lists them; the kind's radius is always listed.
+PLACING_FIELDS: dict[type, tuple[str, ...]] = {
+    Layout: ("R1", "R2_ratio", "imperfections"),
+    LatticeLayout: ("kind", "columns", "rows", "radius", "column_radii", "intruder_ratio", "intruder_columns",
+                    "intruder_sites", "intruder_every", "imperfections"),
+    ChainLayout: ("count", "radius", "taper", "dimer_ratio", "decorated_ratio", "y", "imperfections"),
+}
+
+
+def placing_fields(scenario: Scenario, index: int) -> tuple[str, ...]:
+    """The scenario fields (dotted, as in TOML) that place granule `index` of the resolved
+    scenario: its own x, y, radius in [[granules]], or the layout's fields that set the
+    packing's geometry (those that differ from their defaults, and the kind's radius), so
+    that a message about the granule names what to change. `scenario`: as written, before
+    `resolve`."""
+    lay = scenario.layout
+    if lay is None:
+        return tuple(f"granules[{index}].{f}" for f in ("x", "y", "radius"))
+    primary = "R1" if isinstance(lay, Layout) else "radius"
+    default = type(lay)()
+    return tuple(f"layout.{f}" for f in PLACING_FIELDS[type(lay)]
+                 if f == primary or getattr(lay, f) != getattr(default, f))
+
+
+def granule_named(scenario: Scenario, resolved: Scenario, index: int) -> str:
+    """"granule 'LABEL' (placed by FIELDS; centre (x, y), radius R [m])" for messages."""
+    g = resolved.granules[index]
+    return (f"granule '{g.label}' (placed by {', '.join(placing_fields(scenario, index))}; centre "
+            f"({g.x:.6g}, {g.y:.6g}) m, radius {g.radius:.6g} m)")

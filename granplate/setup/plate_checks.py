@@ -1,6 +1,7 @@
 """The plate's fields and mesh checked before anything is built: each field in its range,
-an even `plate.ny` (a row of nodes on the symmetry line), every plate contact on a
-left-edge node, rigid layers that neither overlap nor reach a clamped node,
+an even `plate.ny` (a row of nodes on the symmetry line), the plate contacts at t = 0 (on
+a left-edge node: a rigid layer; between nodes: a patch contact, where patch contacts are
+possible), rigid layers that neither overlap nor reach a clamped node,
 `plate.n_modes` at most the number of reduced dofs, and a basis that fits the machine
 (setup.plate_cost). Counts come from the mesh's structure alone (docs/model.md section 4),
 so no matrix is assembled.
@@ -73,8 +74,29 @@ def faces_plate(p: Plate, gap_ratio: float, x: float, y: float, radius: float) -
 def plate_contact_heights(s: Scenario) -> list[float]:
     """y [m] of the granules facing the plate's left edge (`faces_plate`), in granule
     order (s resolved, with a plate)."""
-    return [float(g.y) for g in s.granules
+    return [float(s.granules[i].y) for i in facing_granules(s)]
+
+
+def facing_granules(s: Scenario) -> list[int]:
+    """Indices of the granules facing the plate's left edge at t = 0 (`faces_plate`), in
+    granule order (s resolved, with a plate): its plate contacts at t = 0."""
+    return [i for i, g in enumerate(s.granules)
             if faces_plate(s.plate, s.contact.neighbour_gap, g.x, g.y, g.radius)]
+
+
+def on_face_node(p: Plate, y: float) -> bool:
+    """Whether height y [m] is that of a left-edge node (within NODE_RTOL x height)."""
+    return bool(np.any(np.abs(left_edge_node_heights(p) - y) <= NODE_RTOL * p.height))
+
+
+def split_initial_contacts(s: Scenario) -> tuple[list[int], list[int]]:
+    """The plate contacts at t = 0 as (on a node, between nodes): granule indices, in
+    granule order (s resolved, with a plate). A contact on a face node gets a rigid layer
+    (docs/model.md section 3.4: the paper's model), one between nodes a patch contact
+    (section 3.5), the same as a contact that forms during the run."""
+    facing = facing_granules(s)
+    on = [i for i in facing if on_face_node(s.plate, s.granules[i].y)]
+    return on, [i for i in facing if i not in set(on)]
 
 
 def left_edge_node_heights(p: Plate) -> np.ndarray:
@@ -121,23 +143,31 @@ def check_symmetry_row(p: Plate) -> None:
             "is a row of element edges (with Q8 nodes along it)")
 
 
-def _contact_node(p: Plate, k: int, yk: float, left_y: np.ndarray) -> int:
-    """Index of the left-edge node at contact k's height yk [m]; ScenarioError when none."""
+def _contact_node(p: Plate, name: str, yk: float, left_y: np.ndarray) -> int:
+    """Index of the left-edge node at the height yk [m] of the contact of `name` (a
+    granule, for the message); ScenarioError when none."""
     at = np.flatnonzero(np.abs(left_y - yk) <= NODE_RTOL * p.height)
     if at.size != 1:
         raise ScenarioError(
             "plate.ny", p.ny,
-            f"contact {k} at y={yk:g} m is not on a mesh node; the left-edge node spacing "
-            f"is height/(2 ny) = {p.height / (2 * p.ny):g} m; allowed: ny such that (y_contact - y0) "
-            "is a multiple of height/(2 ny) for every contact")
+            f"the rigid layer of {name} at y={yk:g} m is not on a mesh node; the left-edge node "
+            f"spacing is height/(2 ny) = {p.height / (2 * p.ny):g} m; allowed: a layer at a multiple "
+            "of height/(2 ny) above plate.y0")
     return int(at[0])
 
 
-def rigid_layers(p: Plate, contact_y: Sequence[float],
-                 left_y: np.ndarray | None = None) -> list[tuple[int, list[int]]]:
-    """(driving node, other layer nodes) of each contact, as indices into left_y [m] (the
-    heights of the left-edge nodes, in any order; None: `left_edge_node_heights`);
-    refuses a contact off the left edge or between nodes, and overlapping layers."""
+def _names(n: int, names: Sequence[str] | None) -> list[str]:
+    return list(names) if names is not None else [f"contact {k}" for k in range(n)]
+
+
+def rigid_layers(p: Plate, contact_y: Sequence[float], left_y: np.ndarray | None = None,
+                 names: Sequence[str] | None = None) -> list[tuple[int, list[int]]]:
+    """(driving node, other layer nodes) of each rigid-layer contact at the heights
+    contact_y [m], as indices into left_y [m] (the heights of the left-edge nodes, in any
+    order; None: `left_edge_node_heights`); refuses a contact off the left edge or between
+    nodes, and overlapping layers. names: the granule of each contact, as the messages
+    name it (default: "contact k")."""
+    names = _names(len(contact_y), names)
     left_y = left_edge_node_heights(p) if left_y is None else np.asarray(left_y)
     half, tol = 0.5 * p.layer_width, NODE_RTOL * p.height
     owner: dict[int, int] = {}
@@ -146,16 +176,16 @@ def rigid_layers(p: Plate, contact_y: Sequence[float],
         if not (p.y0 - tol <= yk <= p.y0 + p.height + tol):
             raise ScenarioError(
                 "plate.y0", p.y0,
-                f"contact {k} at y={yk:g} m lies outside the plate's left edge "
+                f"{names[k]} at y={yk:g} m lies outside the plate's left edge "
                 f"[{p.y0:g}, {p.y0 + p.height:g}] m")
-        at = _contact_node(p, k, yk, left_y)
+        at = _contact_node(p, names[k], yk, left_y)
         members = [int(n) for n in np.flatnonzero(np.abs(left_y - yk) <= half + tol)]
         for n in members:
             if n in owner:
                 j = owner[n]
                 raise ScenarioError(
                     "plate.rigid_layer_width", p.rigid_layer_width,
-                    f"the rigid layers of contacts {j} (y={contact_y[j]:g} m) and {k} (y={yk:g} m) "
+                    f"the rigid layers of {names[j]} at y={contact_y[j]:g} m and {names[k]} at y={yk:g} m "
                     f"share the node at y={left_y[n]:g} m with w = {p.layer_width:g} m; "
                     "allowed: w smaller than the distance between neighbouring contacts")
             owner[n] = k
@@ -164,39 +194,70 @@ def rigid_layers(p: Plate, contact_y: Sequence[float],
 
 
 def check_layers_off_clamps(p: Plate, contact_y: Sequence[float],
-                            layers: Sequence[tuple[int, Sequence[int]]], clamped: set[int]) -> None:
+                            layers: Sequence[tuple[int, Sequence[int]]], clamped: set[int],
+                            names: Sequence[str] | None = None) -> None:
     """Refuse a contact on a clamped node, or a rigid layer that reaches one: layers as
     `rigid_layers` gives them and clamped, in the same node numbering (the plate layer's
-    mesh nodes, or the indices of `clamped_left_nodes`)."""
+    mesh nodes, or the indices of `clamped_left_nodes`); names as in `rigid_layers`."""
+    names = _names(len(contact_y), names)
     for k, (at, members) in enumerate(layers):
         at = int(at)
         if at in clamped:
             raise ScenarioError(
                 "plate.clamped_edges", p.clamped_edges,
-                f"contact {k} at y={contact_y[k]:g} m sits on a clamped node; allowed: contacts on "
-                "free parts of the left edge only")
+                f"{names[k]} touches the plate at y={contact_y[k]:g} m, on a clamped node; allowed: "
+                "contacts on free parts of the left edge only")
         if any(int(n) in clamped for n in members):
             raise ScenarioError(
                 "plate.rigid_layer_width", p.rigid_layer_width,
-                f"the rigid layer of contact {k} at y={contact_y[k]:g} m (w = {p.layer_width:g} m) "
+                f"the rigid layer of {names[k]} at y={contact_y[k]:g} m (w = {p.layer_width:g} m) "
                 "reaches a clamped node; allowed: a width that keeps every layer off the clamped edges")
 
 
-def check_plate_mesh(s: Scenario) -> None:
-    """The mesh the plate layer will build can hold the scenario (see the module docstring)."""
+def patches_possible(s: Scenario, n_red: int, kind: str) -> bool:
+    """Whether plate contacts may be patch contacts (docs/model.md section 3.5): dynamic
+    detection and a plate in all its modes or in the truncated basis (a dense basis cut
+    to plate.n_modes has no static correction over the face); `kind` as `basis_kind`."""
+    return s.contact.detection == "dynamic" and (kind == "truncated" or s.plate.n_modes in (0, n_red))
+
+
+def _check_patches_at_start(s: Scenario, between: list[int], n_red: int, kind: str, names: dict[int, str]) -> None:
+    """Granules touching the face between nodes at t = 0 need patch contacts."""
+    if not between or patches_possible(s, n_red, kind):
+        return
+    p, i = s.plate, between[0]
+    fixed = s.contact.detection == "fixed"
+    field, value = ("contact.detection", "fixed") if fixed else ("plate.n_modes", p.n_modes)
+    why = ("contacts with fixed detection are those of t = 0 on rigid layers, which sit on nodes" if fixed else
+           "a dense basis cut to plate.n_modes has no static correction over the face")
+    raise ScenarioError(
+        field, value,
+        f"{names[i]} touches the plate's face at y={s.granules[i].y:g} m between face nodes (spacing "
+        f"height/(2 ny) = {p.height / (2 * p.ny):g} m), which takes a patch contact (docs/model.md "
+        f"section 3.5), and {why}; allowed: contact.detection = 'dynamic' with plate.n_modes = 0 "
+        "(all modes, or plate.modes = 'truncated'), or the granule's contact on a node")
+
+
+def check_plate_mesh(s: Scenario, names: dict[int, str] | None = None) -> None:
+    """The mesh the plate layer will build can hold the scenario (see the module docstring).
+    names: how messages name granule i (default: "granule 'LABEL'")."""
     p = s.plate
     if p is None:
         return
     check_symmetry_row(p)
-    contact_y = plate_contact_heights(s)
-    layers = rigid_layers(p, contact_y)
-    check_layers_off_clamps(p, contact_y, layers, clamped_left_nodes(p))
+    on, between = split_initial_contacts(s)
+    names = {i: names[i] if names is not None else f"granule '{s.granules[i].label}'" for i in on + between}
+    contact_y = [float(s.granules[i].y) for i in on]
+    on_names = [names[i] for i in on]
+    layers = rigid_layers(p, contact_y, names=on_names)
+    check_layers_off_clamps(p, contact_y, layers, clamped_left_nodes(p), on_names)
     n_red = reduced_dof_count(p, sum(len(m) for _, m in layers))
     check_mode_count(p, n_red)
     edge_load = s.load.kind == "line" and s.load.target == "plate"
     kind = basis_kind(p.modes, n_red, truncation_supported(p.clamped_edges, edge_load))
     if kind == "truncated":
         check_truncated_plate(s)
+    _check_patches_at_start(s, between, n_red, kind, names)
     check_fits(kind, n_red, p.modes, n_face=2 * p.ny + 1)
 
 

@@ -22,7 +22,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from granplate.errors import ScenarioError
-from granplate.setup.geometry import layout_packing, resolve
+from granplate.setup.geometry import granule_named, layout_packing, resolve
 from granplate.setup.layouts import column_radii, half_pitch, hexagonal_offsets, lattice_sites
 from granplate.setup.fields import finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
 from granplate.setup.plate_checks import check_plate_fields, check_plate_mesh
@@ -310,7 +310,7 @@ def _check_lengths(s: Scenario) -> None:
             raise ScenarioError(path, v, f"allowed: |value| <= {limit:.6g} m, {why}")
 
 
-def _check_overlaps(s: Scenario) -> None:
+def _check_overlaps(s: Scenario, named: dict[int, str]) -> None:
     """Granules may touch but not overlap at t = 0 (k-d tree over the centres; the
     coordinates are within LENGTH_RANGE x h, so its squared distances cannot overflow)."""
     gs = s.granules
@@ -321,7 +321,7 @@ def _check_overlaps(s: Scenario) -> None:
         if overlap > OVERLAP_RTOL * min(gi.radius, gj.radius):
             raise ScenarioError(
                 f"granules[{i}]", gi.label,
-                f"overlaps granule '{gj.label}' (granules[{j}]) by {overlap:.6g} m at t = 0; "
+                f"{named[i]} overlaps {named[j]} (granules[{j}]) by {overlap:.6g} m at t = 0; "
                 f"granules may touch but not overlap (tolerance "
                 f"{OVERLAP_RTOL:g} x the smaller radius)")
 
@@ -360,7 +360,7 @@ def _check_walls(s: Scenario) -> None:
         seen[w.label] = k
 
 
-def _check_wall_penetration(s: Scenario) -> None:
+def _check_wall_penetration(s: Scenario, named: dict[int, str]) -> None:
     """No granule crosses a wall at t = 0."""
     for k, w in enumerate(s.walls):
         n = w.normal
@@ -369,7 +369,7 @@ def _check_wall_penetration(s: Scenario) -> None:
             if pen > OVERLAP_RTOL * g.radius:
                 raise ScenarioError(
                     f"granules[{i}]", g.label,
-                    f"penetrates wall '{w.label}' (walls[{k}]) by {pen:.6g} m at t = 0; "
+                    f"{named[i]} penetrates wall '{w.label}' (walls[{k}]) by {pen:.6g} m at t = 0; "
                     f"a granule may touch a wall but not cross it")
 
 
@@ -379,7 +379,7 @@ def _check_plate(s: Scenario) -> None:
         return
     check_plate_fields(pl, pl.x0)
     material_exists("plate.material", pl.material, s)
-def _check_plate_penetration(s: Scenario) -> None:
+def _check_plate_penetration(s: Scenario, named: dict[int, str]) -> None:
     """No granule crosses the plate's left edge at t = 0."""
     pl = s.plate
     if pl is None:
@@ -391,7 +391,7 @@ def _check_plate_penetration(s: Scenario) -> None:
             if pen > OVERLAP_RTOL * g.radius:
                 raise ScenarioError(
                     f"granules[{i}]", g.label,
-                    f"penetrates the plate (left edge plate.x0 = {x0:.6g} m) by {pen:.6g} m at "
+                    f"{named[i]} penetrates the plate (left edge plate.x0 = {x0:.6g} m) by {pen:.6g} m at "
                     f"t = 0; granules must lie left of the plate (x + radius <= plate.x0)")
 
 
@@ -586,13 +586,26 @@ def _check_solver(s: Scenario) -> None:
 
 # --------------------------------------------------------------------------- entry point
 
+class _GranuleNames(dict):
+    """Granule i of the resolved scenario as messages name it (`geometry.granule_named`:
+    its label and the fields that place it), made when a message asks."""
+
+    def __init__(self, scenario: Scenario, resolved: Scenario):
+        super().__init__()
+        self.scenario, self.resolved = scenario, resolved
+
+    def __missing__(self, i: int) -> str:
+        return granule_named(self.scenario, self.resolved, i)
+
+
 def validate(scenario: Scenario) -> None:
     """Raise ScenarioError(field, value, allowed) for the first problem in `scenario`.
 
     Order: materials, layout (as `layout.*`, before it is expanded), then on the resolved
     scenario: granules (values, speeds, unique labels), walls (unit normals), plate, the
     range of every coordinate and size (`LENGTH_RANGE`), overlaps and penetrations at
-    t = 0, load, contact, plate mesh (contacts on nodes, rigid layers, n_modes), time, the
+    t = 0, load, contact, plate mesh (rigid layers of the contacts on nodes, patch contacts
+    between nodes, n_modes), time, the
     outputs' memory, solver. A scenario with neither granules (nor a layout) nor a plate
     is refused.
     """
@@ -613,12 +626,13 @@ def validate(scenario: Scenario) -> None:
     _check_walls(r)
     _check_plate(r)
     _check_lengths(r)
-    _check_overlaps(r)
-    _check_wall_penetration(r)
-    _check_plate_penetration(r)
+    named = _GranuleNames(s, r)
+    _check_overlaps(r, named)
+    _check_wall_penetration(r, named)
+    _check_plate_penetration(r, named)
     _check_load(r)
     _check_contact(r)
-    check_plate_mesh(r)
+    check_plate_mesh(r, named)
     _check_time(r)
     _check_output_size(r)
     _check_solver(r)

@@ -45,8 +45,9 @@ INTERRUPTED_STATUS = "interrupted by the user"
 
 
 class ContactChanges(NamedTuple):
-    """How a run's contacts changed: the patch contacts formed on the plate's face
-    (docs/model.md section 3.5), in the order they follow the model's plate contacts on
+    """How a run's contacts changed: the patch contacts on the plate's face (docs/model.md
+    section 3.5), those of the granules touching the face between nodes at t = 0 (time 0)
+    then those formed during the run, in the order they follow the model's rigid layers on
     the output's contact axis, and the contact lists' rebuilds."""
 
     granule: np.ndarray  # (n_formed,) int64: the granule of each patch contact formed
@@ -281,7 +282,15 @@ def near_face(model: Model, y: np.ndarray, free: np.ndarray) -> np.ndarray:
 def add_patch_contacts(model: Model, lists: "ContactLists", arr: LoopArrays) -> int:
     """Give every granule near the face without a plate contact a patch contact
     centred at its height (docs/model.md section 3.5); returns how many were added."""
-    new = near_face(model, arr.st.y, arr.w.plate_free)
+    return attach_patches(model, lists, arr, near_face(model, arr.st.y, arr.w.plate_free))
+
+
+def attach_patches(model: Model, lists: "ContactLists", arr: LoopArrays, new: np.ndarray) -> int:
+    """Give each granule of `new` (ascending) a patch contact centred at its height: the
+    one path of every patch contact, those formed during the run (NEW_PLATE) and those of
+    the granules touching the face between nodes at t = 0 (before the first step); returns
+    how many were added."""
+    new = np.asarray(new, np.int64)
     if len(new) == 0:
         return 0
     nk = len(lists.g.pc_i)
@@ -455,6 +464,8 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
     lists = ContactLists(model)
     if cfg.face_skin > 0.0:  # this run's own (patch contacts move their face)
         lists.g = lists.g._replace(pc_x=g.pc_x.copy())
+        attach_patches(model, lists, arr, model.initial_patches)  # touching between nodes at t = 0
+        st, w = arr.st, arr.w  # grown
     st.count[S.C_LEVEL] = level_for(model.scenario.time.dt_initial, cfg)
     note_compile(model, [(loop.initialise, (st, lists.g, arr.p, cfg, w)),
                          (loop.record, (0, st, lists.g, arr.p, w, arr.out)),
