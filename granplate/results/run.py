@@ -15,7 +15,7 @@ from granplate.errors import SimulationError
 from granplate.model.arrays import Model, build_model
 from granplate.results.dataset import to_dataset
 from granplate.setup.scenario import Scenario
-from granplate.solver.driver import INTERRUPTED_STATUS, run as run_loop
+from granplate.solver.driver import INTERRUPTED_STATUS, run as run_loop, stop_on_signals
 from granplate.solver.state import OK
 
 
@@ -57,26 +57,28 @@ def simulate(
     t_setup = time.perf_counter() - t0
     if progress is None:
         progress = sys.stderr.isatty()
-    rec = run_loop(model, progress=progress)
-    info = {
-        "wall_time_s": time.perf_counter() - t0,
-        "setup_time_s": t_setup,
-        **rec.info,
-        "status": rec.message,
-    }
-    info = {k: info[k] for k in ("wall_time_s", "setup_time_s", "first_call_time_s", "loop_time_s",
-                                 "n_steps", "n_iterations", "n_retries", "n_friction_bound", "status")}
-    if rec.plate_contacts is not None and len(rec.plate_contacts) != len(model.plate_contacts):
-        # with the patch contacts formed during the run, at the height where each formed
-        plate = replace(model.plate, contact_y=np.concatenate([model.plate.contact_y, rec.info["patch_y0"]]))
-        model = replace(model, plate_contacts=rec.plate_contacts, plate=plate)
-    if rec.status == OK and summary_only:
-        return to_dataset(model, rec.out, rec.n_valid, info, summary_only=True)
-    ds = to_dataset(model, rec.out, rec.n_valid, info)
-    if rec.status != OK:
-        t_last = rec.out.t[rec.n_valid - 1]
+    with stop_on_signals() as stop_requested:  # a signal after the loop stops building the result
+        rec = run_loop(model, progress=progress)
+        info = {
+            "wall_time_s": time.perf_counter() - t0,
+            "setup_time_s": t_setup,
+            **rec.info,
+            "status": rec.message,
+        }
+        info = {k: info[k] for k in ("wall_time_s", "setup_time_s", "first_call_time_s", "loop_time_s",
+                                     "n_steps", "n_iterations", "n_retries", "n_friction_bound", "status")}
+        if rec.plate_contacts is not None and len(rec.plate_contacts) != len(model.plate_contacts):
+            # with the patch contacts formed during the run, at the height where each formed
+            plate = replace(model.plate, contact_y=np.concatenate([model.plate.contact_y, rec.info["patch_y0"]]))
+            model = replace(model, plate_contacts=rec.plate_contacts, plate=plate)
+        if rec.status == OK and summary_only:
+            return to_dataset(model, rec.out, rec.n_valid, info, summary_only=True)
+        ds = to_dataset(model, rec.out, rec.n_valid, info, should_stop=stop_requested, progress=progress)
+    if rec.status != OK or interrupted(ds):
+        n = ds.sizes["time"]
+        t_last = float(ds.time[-1]) if n else 0.0
         raise SimulationError(
-            f"{model.scenario.name}: {rec.message} The {rec.n_valid} output times computed "
+            f"{model.scenario.name}: {ds.attrs['status']} The {n} output times computed "
             f"so far (up to t = {t_last:.6e} s) are kept in the error's .result.",
             result=ds,
         )
