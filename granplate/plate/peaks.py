@@ -83,14 +83,17 @@ def time_maxima(plate, c: np.ndarray, should_stop: Callable[[], bool] | None = N
     return out
 
 
-#: The unit peaks last computed: (key, the arrays the key names, peaks) (a study's
-#: designs share one plate: computed once per process).
+#: The unit peaks last computed: (plate key, peaks) (a study's designs share one plate:
+#: computed once per process).
 _LAST_UNIT_PEAKS: list = []
 
 
-def _unit_key(plate) -> tuple:
-    return (id(plate.Phi), id(plate.psi), id(plate.strain_op.data), plate.disc_radius,
-            plate.disc_op.shape, plate.disc_op.nnz, plate.T.shape)
+def _unit_key(plate) -> tuple | None:
+    """What identifies a plate's unit peaks: its stored arrays and the averaging discs
+    (None for a plate built without the store: not kept)."""
+    if not plate.arrays_key:
+        return None
+    return (plate.arrays_key, plate.disc_radius, plate.disc_op.shape, plate.disc_op.nnz)
 
 
 def unit_peaks(plate, n_cols: int) -> np.ndarray:
@@ -100,12 +103,13 @@ def unit_peaks(plate, n_cols: int) -> np.ndarray:
     patch-contact columns (which depend on the run) are computed each time."""
     n_base = min(n_cols, plate.n_modes + plate.psi.shape[1])
     key = _unit_key(plate)
-    if _LAST_UNIT_PEAKS and _LAST_UNIT_PEAKS[0][0] == key and len(_LAST_UNIT_PEAKS[0][2]) >= n_base:
-        base = _LAST_UNIT_PEAKS[0][2][:n_base]
+    if key is not None and _LAST_UNIT_PEAKS and _LAST_UNIT_PEAKS[0][0] == key:
+        base = _LAST_UNIT_PEAKS[0][1][:n_base]
     else:
         n_all = plate.n_modes + plate.psi.shape[1]
         base = _unit_rows(plate, 0, n_all, n_cols=max(n_cols, n_all))
-        _LAST_UNIT_PEAKS[:] = [(key, (plate.Phi, plate.psi, plate.strain_op.data), base)]
+        if key is not None:
+            _LAST_UNIT_PEAKS[:] = [(key, base)]
         base = base[:n_base]
     if n_cols == n_base:
         return base
@@ -163,12 +167,22 @@ def peak_maxima(plate, c: np.ndarray, block: int = BLOCK, stride: int = REFERENC
     scale = np.maximum(upper.max(axis=0), np.finfo(float).tiny)
     best = np.full(3, -np.inf)
     done = np.zeros(len(starts), dtype=bool)
+    known = np.zeros(n, dtype=bool)
+    known[ref] = True
+    values = np.zeros((n, 3))
+    values[ref] = ref_values
     while True:
         open_ = ~done & np.any(upper > best, axis=1)
         if not open_.any():
             return out
         k = int(np.argmax(np.where(open_, (upper / scale).max(axis=1), -np.inf)))
         rows = slice(starts[k], min(starts[k] + block, n))
-        out[rows] = block_maxima(plate, c[rows])
+        out[rows] = values[rows] = block_maxima(plate, c[rows])
+        known[rows] = True
         best = np.maximum(best, out[rows].max(axis=0))
         done[k] = True
+        anchors = np.flatnonzero(known)
+        for j in (k - 1, k + 1):  # the evaluated rows bound their neighbours more tightly
+            if 0 <= j < len(starts) and not done[j] and np.any(upper[j] > best):
+                nb = np.arange(starts[j], min(starts[j] + block, n))
+                upper[j] = np.minimum(upper[j], reference_bounds(c, m, nb, anchors, values[anchors], rest).max(axis=0))
