@@ -92,7 +92,7 @@ def run(n_designs: int = DEFAULT_DESIGNS, workers: int | None = None, scheduler:
         "task_s_median": statistics.median(elapsed),
         "task_cpu_s_median": statistics.median(r["timings"]["cpu_s"] for r in ok),
         "loop_vs_task_median": statistics.median(lp / e for lp, e in zip(loop, elapsed)),
-        "after_loop_s_median": statistics.median(e - s - lp for e, s, lp in zip(elapsed, setup, loop)),
+        "after_loop_s_median": statistics.median(after),
         "loop_share": mean_loop / per_design,
         "overhead_vs_loop": (per_design - mean_loop) / mean_loop,
         "overhead_vs_loop_steady": (steady - mean_loop) / mean_loop,

@@ -33,7 +33,7 @@ import numpy as np
 from granplate.plate.stress import plane_stresses, von_mises_plane_stress
 
 #: Output times per exact block (the same blocks on every route).
-BLOCK = 16
+BLOCK = 32
 #: Every REFERENCE_STRIDE-th output time is evaluated to bound the times between.
 REFERENCE_STRIDE = 32
 #: Relative margin of the bounds [-]: covers the round-off of the products (about
