@@ -87,8 +87,19 @@ def format_summary(summary: dict) -> str:
     return "\n".join(lines)
 
 
+def _write_result(ds, out: Path) -> bool:
+    """Write the result to out, finishing even when SIGINT/SIGTERM arrives meanwhile;
+    whether one did (the caller then exits with 130)."""
+    from granplate.results.dataset import write
+    from granplate.solver.driver import stop_on_signals
+
+    with stop_on_signals() as stop_requested:
+        write(ds, out)
+    return stop_requested()
+
+
 def _cmd_run(args) -> int:
-    from granplate.results.dataset import summary, write
+    from granplate.results.dataset import summary
     from granplate.setup.io import load_scenario
     from granplate.results.run import interrupted, simulate
 
@@ -100,11 +111,14 @@ def _cmd_run(args) -> int:
         print(f"granplate: run stopped: {err}", file=sys.stderr)
         if err.result is None:
             return 3
-        write(err.result, out)
+        stopped = _write_result(err.result, out)
         print(f"granplate: the result so far is written to {out} (its 'status' attribute says why "
               f"the run stopped)", file=sys.stderr)
-        return 130 if interrupted(err.result) else 3
-    write(ds, out)
+        return 130 if stopped or interrupted(err.result) else 3
+    if _write_result(ds, out):
+        print(f"granplate: interrupted while writing the result; it is written in full to {out}",
+              file=sys.stderr)
+        return 130
     s = summary(ds)
     print(f"{scenario.name}: {scenario.description}".rstrip(": "))
     print(format_summary(s))

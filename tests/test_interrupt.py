@@ -118,3 +118,51 @@ def test_run_whose_clock_stops_ends_with_a_message(monkeypatch):
     assert rec.status == driver.S.ERR_NOCONV
     assert "cannot move the clock on at t = 0.000000e+00 s" in rec.message
     assert len(calls) == driver.STALL_ATTEMPTS + 1 and rec.n_valid == 1
+
+
+def test_signal_while_building_the_result_keeps_the_times_built(monkeypatch, tmp_path):
+    """SIGINT while the plate's stresses are computed after the loop: SimulationError whose
+    .result holds the output times built so far (one block), says 'interrupted by the user
+    at t = ... while building the result', and writes to netCDF with its plate fields."""
+    from granplate.plate import peaks
+
+    real = peaks.block_maxima
+    calls = []
+
+    def signal_then_build(plate, c):
+        if not calls:
+            os.kill(os.getpid(), signal.SIGINT)
+        calls.append(len(c))
+        return real(plate, c)
+
+    monkeypatch.setattr(peaks, "block_maxima", signal_then_build)
+    with pytest.raises(SimulationError) as err:
+        simulate(gp.preset("steel-r1"), t_end=1e-4, progress=False)
+    ds = err.value.result
+    assert interrupted(ds) and "while building the result" in ds.attrs["status"]
+    assert ds.sizes["time"] == peaks.BLOCK == calls[0] and len(calls) == 1
+    assert f"at t = {float(ds.time[-1]):.6e} s" in str(err.value)
+    back = gp.read(gp.write(ds, tmp_path / "partial.nc"))
+    assert back.sizes["time"] == peaks.BLOCK and "plate_ux" in back and back.sizes["field_time"] >= 1
+
+
+def test_signal_while_writing_finishes_the_file(monkeypatch, tmp_path):
+    """`granplate run` with SIGINT arriving while the result is written: the whole file is
+    written (every output time) and the command exits with 130."""
+    import xarray as xr
+
+    from granplate import cli
+
+    real = xr.Dataset.to_netcdf
+
+    def signal_then_write(self, *args, **kwargs):
+        os.kill(os.getpid(), signal.SIGINT)
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", signal_then_write)
+    scenario, out = tmp_path / "short.toml", tmp_path / "short.nc"
+    gp.dump(gp.with_changes(gp.preset("steel-r1"), {"time.t_end": 1e-4}), scenario)
+    assert cli.main(["run", str(scenario), "-o", str(out), "--quiet"]) == 130
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", real)
+    ds = gp.read(out)
+    assert ds.sizes["time"] == 101 and not interrupted(ds)

@@ -21,6 +21,8 @@ DEFAULT_DESIGNS = 200
 #: The design count the report extrapolates to, and on how many cores.
 EXTRAPOLATE_DESIGNS = 10_000
 EXTRAPOLATE_CORES = 2
+#: The target for those designs on those cores [h].
+TARGET_HOURS = 1.0
 #: Friction coefficients of the benchmarked study (the load has DEFAULT_DESIGNS / 10 values).
 MU_VALUES = (0.05, 0.08, 0.099, 0.12, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4)
 
@@ -65,7 +67,12 @@ def run(n_designs: int = DEFAULT_DESIGNS, workers: int | None = None, scheduler:
     elapsed = [r["elapsed_s"] for r in ok]
     loop = [r["timings"]["loop_s"] for r in ok]
     setup = [r["timings"]["setup_s"] for r in ok]
+    first = [r["timings"].get("first_call_s", 0.0) for r in ok]
+    after = [r["timings"].get("summary_s", e - s_ - lp) for r, e, s_, lp in zip(ok, elapsed, setup, loop)]
     n = len(records)
+    store_s = report.store_s / max(report.n_computed, 1)
+    parts = {"setup": statistics.median(s_ + f for s_, f in zip(setup, first)),
+             "loop": statistics.median(loop), "summary": statistics.median(after), "store": store_s}
     per_design = wall * n_workers / n  # core-seconds, all included
     steady = (report.elapsed_s - report.warm_up_s) * n_workers / n
     mean_loop = statistics.fmean(loop)
@@ -85,7 +92,7 @@ def run(n_designs: int = DEFAULT_DESIGNS, workers: int | None = None, scheduler:
         "task_s_median": statistics.median(elapsed),
         "task_cpu_s_median": statistics.median(r["timings"]["cpu_s"] for r in ok),
         "loop_vs_task_median": statistics.median(lp / e for lp, e in zip(loop, elapsed)),
-        "after_loop_s_median": statistics.median(e - s - lp for e, s, lp in zip(elapsed, setup, loop)),
+        "after_loop_s_median": statistics.median(after),
         "loop_share": mean_loop / per_design,
         "overhead_vs_loop": (per_design - mean_loop) / mean_loop,
         "overhead_vs_loop_steady": (steady - mean_loop) / mean_loop,
@@ -93,11 +100,16 @@ def run(n_designs: int = DEFAULT_DESIGNS, workers: int | None = None, scheduler:
         "extrapolated_designs": EXTRAPOLATE_DESIGNS,
         "extrapolated_cores": EXTRAPOLATE_CORES,
         "n_steps_median": statistics.median(r["summary"]["n_steps"] for r in ok),
+        "breakdown_s_median": parts,
+        "outside_loop_vs_loop_median": statistics.median(
+            (s_ + f + a + store_s) / lp for s_, f, a, lp in zip(setup, first, after, loop) if lp > 0),
+        "core_s_per_design_target": TARGET_HOURS * 3600.0 * EXTRAPOLATE_CORES / EXTRAPOLATE_DESIGNS,
     }
 
 
 def format_report(r: dict) -> str:
     """The study benchmark as text."""
+    b = r["breakdown_s_median"]
     return "\n".join([
         f"study: {r['designs']} designs ({r['designs_ok']} ok) of ptfe-r05, t_end {r['t_end_s']:g} s, "
         f"{r['workers']} workers, {r['wall_time_s']:.1f} s wall (cluster start {r['cluster_start_s']:.1f} s, "
@@ -110,6 +122,10 @@ def format_report(r: dict) -> str:
         f"on a busy machine); loop / task {100 * r['loop_vs_task_median']:.0f}% (median)",
         f"loop share {100 * r['loop_share']:.0f}%, overhead {100 * r['overhead_vs_loop']:.0f}% of the loop "
         f"(steady state {100 * r['overhead_vs_loop_steady']:.0f}%)",
+        f"per design on its worker (medians): set-up {b['setup']:.4f} s, loop {b['loop']:.4f} s, "
+        f"summary {b['summary']:.4f} s, store {b['store']:.4f} s (mean): outside the loop "
+        f"{100 * r['outside_loop_vs_loop_median']:.0f}% of the loop (median over the designs)",
         f"{r['extrapolated_designs']} designs on {r['extrapolated_cores']} cores: "
-        f"{r['extrapolated_hours']:.2f} h",
+        f"{r['extrapolated_hours']:.2f} h (target {TARGET_HOURS:g} h: "
+        f"{r['core_s_per_design_target']:.2f} core-s per design)",
     ])

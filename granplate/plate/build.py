@@ -141,6 +141,8 @@ class PlateModel:
         disc_radius apart over the plate; disc_op: (n_discs, n_elem n_qp) sparse mean over
         each disc of a Gauss-point field (docs/model.md section 4.4).
     patch_width: width of a patch contact [m] (Plate.layer_width, plate/face.py).
+    arrays_key: the run store's key of the stored arrays (mesh, modes, operators) the
+        model was built from; "" when built without the store.
     """
 
     mesh: MeshQuad
@@ -173,6 +175,7 @@ class PlateModel:
     disc_centres: np.ndarray
     disc_op: sp.csr_matrix
     patch_width: float = 0.0
+    arrays_key: str = ""
 
     # ---- sizes -------------------------------------------------------------------
     @property
@@ -504,8 +507,9 @@ def build_plate(
             log.info(note)
         return _compute_arrays(basis, mesh, D, material, plate, x0, T, edge_load, kind, drive_dofs, face)
 
+    payload = cache_payload(plate, material, x0, contact_y, edge_load, symmetry_line, kind) if cache else None
     arrays = _stored_or_computed(
-        cache_payload(plate, material, x0, contact_y, edge_load, symmetry_line, kind) if cache else None,
+        payload,
         lambda a: _arrays_fit(a, n_full, n_red, n_modes, 3 * n_elem * n_qp, len(face)),
         compute,
     )
@@ -552,4 +556,5 @@ def build_plate(
         disc_centres=centres,
         disc_op=disc_op,
         patch_width=float(plate.layer_width),
+        arrays_key=store.key(STORE_KIND, payload, PLATE_FORMAT) if payload is not None else "",
     )

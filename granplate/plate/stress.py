@@ -24,8 +24,22 @@ def plane_stress_matrix(E: float, nu: float) -> np.ndarray:
 
 
 def von_mises_plane_stress(sxx: np.ndarray, syy: np.ndarray, sxy: np.ndarray) -> np.ndarray:
-    """sqrt(sxx^2 - sxx syy + syy^2 + 3 sxy^2) [Pa] (plane stress, szz = 0)."""
-    return np.sqrt(np.maximum(sxx**2 - sxx * syy + syy**2 + 3.0 * sxy**2, 0.0))
+    """sqrt(sxx^2 - sxx syy + syy^2 + 3 sxy^2) [Pa] (plane stress, szz = 0).
+
+    Evaluated left to right in place (two temporaries, the same bits as the expression)."""
+    sxx, syy, sxy = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (sxx, syy, sxy)))
+    if sxx.ndim == 0:
+        return np.sqrt(np.maximum(sxx**2 - sxx * syy + syy**2 + 3.0 * sxy**2, 0.0))
+    total = sxx * sxx
+    term = sxx * syy
+    total -= term
+    np.multiply(syy, syy, out=term)
+    total += term
+    np.multiply(sxy, sxy, out=term)
+    term *= 3.0
+    total += term
+    np.maximum(total, 0.0, out=total)
+    return np.sqrt(total, out=total)
 
 
 def voigt_strain(grad: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -83,11 +97,20 @@ def gauss_point_strains(
 def plane_stresses(
     D: np.ndarray, exx: np.ndarray, eyy: np.ndarray, gxy: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """sigma_xx, sigma_yy, tau_xy = D (eps_xx, eps_yy, gamma_xy) [Pa], componentwise."""
-    sxx = D[0, 0] * exx + D[0, 1] * eyy + D[0, 2] * gxy
-    syy = D[1, 0] * exx + D[1, 1] * eyy + D[1, 2] * gxy
-    sxy = D[2, 0] * exx + D[2, 1] * eyy + D[2, 2] * gxy
-    return sxx, syy, sxy
+    """sigma_xx, sigma_yy, tau_xy = D (eps_xx, eps_yy, gamma_xy) [Pa], componentwise.
+
+    Terms whose coefficient is zero (the shear coupling of an isotropic D) are left out:
+    adding them changes no value (x + 0 = x)."""
+    def row(i: int) -> np.ndarray:
+        out = None
+        for j, eps in enumerate((exx, eyy, gxy)):
+            if D[i, j] == 0.0 and not (out is None and j == 2):
+                continue
+            term = D[i, j] * eps
+            out = term if out is None else out + term
+        return out
+
+    return row(0), row(1), row(2)
 
 
 # --------------------------------------------------------------------------------------

@@ -6,15 +6,17 @@ and the solver's figures travel in the attributes, so any figure can be traced b
 from __future__ import annotations
 
 import json
-from dataclasses import replace
 from pathlib import Path
-from typing import NamedTuple
+from dataclasses import replace
+from typing import Callable, NamedTuple
 
 import numpy as np
 import xarray as xr
 
 from granplate.version import __version__
+from granplate.plate.peaks import BLOCK, block_starts, peak_maxima, split_coordinates, time_maxima
 from granplate.solver import state as K
+from granplate.solver.driver import INTERRUPTED_STATUS
 
 #: name -> (units, description) of every data variable
 VARIABLES: dict[str, tuple[str, str]] = {
@@ -60,66 +62,117 @@ def _var(name: str, dims, data) -> xr.DataArray:
     return xr.DataArray(data, dims=dims, attrs={"units": units, "long_name": desc})
 
 
-def _chunked(fn, q: np.ndarray, size: int = 256) -> np.ndarray:
-    """Apply fn to q in chunks along the first axis (bounded memory)."""
-    if len(q) == 0:
-        return fn(q)
-    return np.concatenate([fn(q[i:i + size]) for i in range(0, len(q), size)])
-
-
 def plate_maxima(plate, qf: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Largest von Mises stress [Pa] (eq. 12), largest disc-averaged von Mises stress [Pa]
     (docs/model.md section 4.4) and largest |eps_yy| [-] over the plate's Gauss points at
     each output time, from qf (time, n_modes [+ 2 n_contacts forces of a truncated
-    basis]); the strains are computed once for all three."""
-    from granplate.plate.stress import plane_stresses, von_mises_plane_stress  # numba: on first use
-
-    def maxima(c):
-        q, force = c[:, :plate.n_modes], (c[:, plate.n_modes:] if c.shape[1] > plate.n_modes else None)
-        exx, eyy, gxy = plate.strains(q, force)
-        vm = von_mises_plane_stress(*plane_stresses(plate.D, exx, eyy, gxy))
-        return np.stack([vm.reshape(len(c), -1).max(axis=1), plate.max_disc_von_mises(vm),
-                         np.abs(eyy).reshape(len(c), -1).max(axis=1)], axis=1)
-
-    every = _chunked(maxima, qf) if len(qf) else np.zeros((0, 3))
+    basis]); the strains are computed once for all three (granplate.plate.peaks)."""
+    every = time_maxima(plate, qf)
     return every[:, 0].copy(), every[:, 1].copy(), every[:, 2].copy()
 
 
+def plate_coordinates(plate, q: np.ndarray, force: np.ndarray | None) -> np.ndarray:
+    """(time, n_modes [+ 2 n_contacts]): the modal coordinates, and beside them the contact
+    forces [N] that a truncated basis' static part needs (docs/model.md section 4.5)."""
+    if force is None or not plate.truncated:
+        return q
+    return np.concatenate([q, np.asarray(force, dtype=float).reshape(len(q), -1)], axis=1)
+
+
+def symmetry_velocity(plate, qd: np.ndarray) -> np.ndarray:
+    """(time, n_symmetry) horizontal velocity [m/s] of the symmetry line's nodes from the
+    modal velocities qd (time, n_modes): only their rows of T Phi are formed."""
+    rows = 2 * np.asarray(plate.symmetry_nodes, dtype=np.int64)
+    if len(rows) == 0:
+        return np.zeros((len(qd), 0))
+    shapes = np.asarray(plate.T[rows] @ plate.Phi)  # (n_symmetry, n_modes) [kg^-1/2]
+    return qd @ shapes.T
+
+
+#: Output times per block of the fields (the symmetry line's velocity and the snapshots
+#: in those times): larger than the stresses' blocks, the products being cheaper per time.
+FIELD_BLOCK = 8 * BLOCK
+
+
+class _Bar:
+    """A progress bar of one phase of building the result (tqdm on stderr), or nothing."""
+
+    def __init__(self, enabled: bool, total: int, what: str):
+        self.bar = None
+        if enabled and total:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=total, desc=f"result: {what}", unit="out", leave=False)
+
+    def update(self, n: int) -> None:
+        if self.bar is not None:
+            self.bar.update(n)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
 def plate_fields(model, q: np.ndarray, qd: np.ndarray, times: np.ndarray,
-                 force: np.ndarray | None = None, plate=None) -> dict[str, xr.DataArray]:
-    """Plate outputs computed from the modal coordinates after the run; force (time,
-    2 n_contacts) [N]: the contact forces on the plate, whose static part a truncated
-    basis adds to the displacements and stresses (docs/model.md section 4.5); plate: the
-    plate with the run's contacts (`run_contacts`; default model.plate)."""
+                 force: np.ndarray | None = None, should_stop: Callable[[], bool] | None = None,
+                 progress: bool = False, plate=None) -> tuple[dict[str, xr.DataArray], int]:
+    """Plate outputs computed from the modal coordinates after the run, and the number of
+    output times they cover; force (time, 2 n_contacts) [N]: the contact forces on the
+    plate, whose static part a truncated basis adds to the displacements and stresses
+    (docs/model.md section 4.5).
+
+    Computed block by block, first the stresses (the three maxima at every output time),
+    then the fields (the symmetry line's velocity, the snapshots); progress: a bar per
+    phase; should_stop: polled after each block: when it says yes, the outputs cover the
+    output times computed so far (fewer than len(times)); plate: the plate with the run's
+    contacts (`run_contacts`; default model.plate)."""
     plate = model.plate if plate is None else plate
     s = model.scenario
     out: dict[str, xr.DataArray] = {}
-    if force is None or not plate.truncated:
-        qf = q
-    else:  # modal coordinates and forces side by side, so that chunks keep them together
-        qf = np.concatenate([q, np.asarray(force, dtype=float).reshape(len(q), -1)], axis=1)
-
-    def split(c):
-        return c[:, :plate.n_modes], (c[:, plate.n_modes:] if c.shape[1] > plate.n_modes else None)
-
-    max_vm, max_disc, max_eyy = plate_maxima(plate, qf)
-    out["max_von_mises"] = _var("max_von_mises", ("time",), max_vm)
-    out["max_von_mises_disc"] = _var("max_von_mises_disc", ("time",), max_disc)
-    out["max_eps_yy"] = _var("max_eps_yy", ("time",), max_eyy)
-    sym = np.asarray(plate.symmetry_nodes)
-    vx = _chunked(lambda qc: plate.full_displacement(qc)[:, sym, 0], qd)
-    out["plate_vx_symmetry"] = _var("plate_vx_symmetry", ("time", "x_symmetry"), vx)
+    qf = plate_coordinates(plate, q, force)
+    n = len(times)
+    bar = _Bar(progress, n, "stresses")
+    try:
+        every = time_maxima(plate, qf, should_stop, bar.update)
+    finally:
+        bar.close()
+    n = len(every)
     stride = max(1, int(round(s.time.field_interval / s.time.output_interval)))
-    idx = np.arange(0, len(times), stride)
-    if len(times) and idx[-1] != len(times) - 1 and np.isclose(times[-1], s.time.t_end):
-        idx = np.append(idx, len(times) - 1)
-    u = plate.full_displacement(*split(qf[idx]))
-    out["plate_ux"] = _var("plate_ux", ("field_time", "node"), u[..., 0])
-    out["plate_uy"] = _var("plate_uy", ("field_time", "node"), u[..., 1])
-    vm = plate.von_mises(*split(qf[idx])).max(axis=-1)
+    idx = np.arange(0, n, stride)
+    if n == len(times) and n and idx[-1] != n - 1 and np.isclose(times[-1], s.time.t_end):
+        idx = np.append(idx, n - 1)
+    sym = np.asarray(plate.symmetry_nodes)
+    vx = np.zeros((n, len(sym)))
+    u = np.zeros((len(idx), plate.node_xy.shape[0], 2))
+    vm = np.zeros((len(idx), plate.elements.shape[0]))
+    bar = _Bar(progress, n, "fields")
+    try:
+        done, kept = 0, 0
+        for i in block_starts(n, FIELD_BLOCK):
+            rows = slice(i, min(i + FIELD_BLOCK, n))
+            vx[rows] = symmetry_velocity(plate, qd[rows])
+            snaps = np.flatnonzero((idx >= rows.start) & (idx < rows.stop))
+            if len(snaps):
+                c = split_coordinates(plate, qf[idx[snaps]])
+                u[snaps] = plate.full_displacement(*c)
+                vm[snaps] = plate.von_mises(*c).max(axis=-1)
+            done, kept = rows.stop, (snaps[-1] + 1 if len(snaps) else kept)
+            bar.update(rows.stop - rows.start)
+            if should_stop is not None and done < n and should_stop():
+                break
+    finally:
+        bar.close()
+    if done < n:
+        n, every, vx, idx, u, vm = done, every[:done], vx[:done], idx[:kept], u[:kept], vm[:kept]
+    out["max_von_mises"] = _var("max_von_mises", ("time",), every[:, 0].copy())
+    out["max_von_mises_disc"] = _var("max_von_mises_disc", ("time",), every[:, 1].copy())
+    out["max_eps_yy"] = _var("max_eps_yy", ("time",), every[:, 2].copy())
+    out["plate_vx_symmetry"] = _var("plate_vx_symmetry", ("time", "x_symmetry"), vx)
+    out["plate_ux"] = _var("plate_ux", ("field_time", "node"), u[..., 0].copy())
+    out["plate_uy"] = _var("plate_uy", ("field_time", "node"), u[..., 1].copy())
     out["plate_von_mises"] = _var("plate_von_mises", ("field_time", "element"), vm)
     out["_field_time"] = times[idx]
-    return out
+    return out, n
 
 
 #: What a summary-only Dataset holds (`to_dataset(..., summary_only=True)`): what
@@ -154,18 +207,37 @@ def run_contacts(model, contacts=None) -> RunContacts:
 
 
 def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = False,
-               contacts=None) -> xr.Dataset:
+               contacts=None, should_stop: Callable[[], bool] | None = None,
+               progress: bool = False) -> xr.Dataset:
     """Build the result Dataset from the first n output rows.
 
     summary_only: only the variables `summary` reads (SUMMARY_VARIABLES, the time and
     granule coordinates and the attributes), the same numbers at a fraction of the cost
-    (no plate fields, snapshots or per-contact records); contacts: how the run's contacts
-    changed (solver.driver.ContactChanges: the patch contacts formed extend the contact
-    axis; None: none formed)."""
+    (no plate fields, snapshots or per-contact records; the plate maxima only at the
+    output times that can hold the run's largest value, NaN at the others:
+    granplate.plate.peaks); contacts: how the run's contacts changed
+    (solver.driver.ContactChanges: the patch contacts extend the contact axis; None: none
+    formed). progress: a bar per phase of the plate outputs; should_stop: polled while
+    they are computed: when it says yes, the Dataset holds the output times computed so
+    far and its status says "interrupted by the user at t = ..."."""
     from granplate.setup.io import dumps
 
     s = model.scenario
     axis = run_contacts(model, contacts)
+    plate_data: dict[str, xr.DataArray] = {}
+    if model.plate is not None:
+        force = out.force[:n].reshape(n, out.force.shape[1] * out.force.shape[2])
+        if summary_only:
+            every = peak_maxima(axis.plate, plate_coordinates(axis.plate, out.q[:n], force))
+            for col, name in enumerate(("max_von_mises", "max_von_mises_disc", "max_eps_yy")):
+                plate_data[name] = _var(name, ("time",), every[:, col].copy())
+        else:
+            plate_data, n_done = plate_fields(model, out.q[:n], out.qd[:n], out.t[:n], force,
+                                              should_stop=should_stop, progress=progress, plate=axis.plate)
+            if n_done < n:
+                n = n_done
+                info = {**info, "status": f"{INTERRUPTED_STATUS} at t = {out.t[n - 1]:.6e} s, "
+                                          "while building the result."}
     t = out.t[:n].copy()
     y = out.y[:n]
     e = out.energy[:n]
@@ -192,14 +264,7 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
         "material": ("granule", np.array([g.material for g in s.granules], dtype=str), {"long_name": "granule material"}),
     }
     if summary_only:
-        if model.plate is not None:
-            qf = out.q[:n]
-            if model.plate.truncated:
-                qf = np.concatenate([qf, out.force[:n].reshape(n, -1)], axis=1)
-            max_vm, max_disc, max_eyy = plate_maxima(axis.plate, qf)
-            data["max_von_mises"] = _var("max_von_mises", ("time",), max_vm)
-            data["max_von_mises_disc"] = _var("max_von_mises_disc", ("time",), max_disc)
-            data["max_eps_yy"] = _var("max_eps_yy", ("time",), max_eyy)
+        data.update(plate_data)
         ds = xr.Dataset(data, coords=coords)
         ds.attrs.update(_attrs(model, out, n, info, dumps(s)))
         return ds
@@ -214,9 +279,8 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
     data["n_iterations"] = _var("n_iterations", ("time",), out.stats[:n, K.S_ITERS].astype(np.int64))
     data["contact_time_formed"] = _var("contact_time_formed", ("contact",), axis.time_formed)
     if model.plate is not None:
-        pf = plate_fields(model, out.q[:n], out.qd[:n], t, out.force[:n].reshape(n, -1), plate=axis.plate)
-        ft = pf.pop("_field_time")
-        data.update(pf)
+        ft = plate_data.pop("_field_time")
+        data.update(plate_data)
         plate = axis.plate
         coords["field_time"] = ("field_time", ft, {"units": "s", "long_name": "time of the plate field snapshots"})
         coords["node_x"] = ("node", plate.node_xy[:, 0].copy(), {"units": "m", "long_name": "plate node x"})

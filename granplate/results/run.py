@@ -13,7 +13,7 @@ from granplate.errors import SimulationError
 from granplate.model.arrays import Model, build_model
 from granplate.results.dataset import to_dataset
 from granplate.setup.scenario import Scenario
-from granplate.solver.driver import INTERRUPTED_STATUS, run as run_loop
+from granplate.solver.driver import INTERRUPTED_STATUS, run as run_loop, stop_on_signals
 from granplate.solver.state import OK
 
 
@@ -55,23 +55,27 @@ def simulate(
     t_setup = time.perf_counter() - t0
     if progress is None:
         progress = sys.stderr.isatty()
-    rec = run_loop(model, progress=progress)
-    info = {
-        "wall_time_s": time.perf_counter() - t0,
-        "setup_time_s": t_setup,
-        **rec.info,
-        "status": rec.message,
-    }
-    info = {k: info[k] for k in ("wall_time_s", "setup_time_s", "first_call_time_s", "loop_time_s", "loop_cpu_s",
-                                 "n_steps", "n_iterations", "n_retries", "n_friction_bound", "status")}
-    info["n_rebuilds"] = rec.contacts.n_rebuilds
-    if rec.status == OK and summary_only:
-        return to_dataset(model, rec.out, rec.n_valid, info, summary_only=True, contacts=rec.contacts)
-    ds = to_dataset(model, rec.out, rec.n_valid, info, contacts=rec.contacts)
-    if rec.status != OK:
-        t_last = rec.out.t[rec.n_valid - 1]
+    with stop_on_signals() as stop_requested:  # a signal after the loop stops building the result
+        rec = run_loop(model, progress=progress)
+        info = {
+            "wall_time_s": time.perf_counter() - t0,
+            "setup_time_s": t_setup,
+            **rec.info,
+            "status": rec.message,
+        }
+        info = {k: info[k] for k in ("wall_time_s", "setup_time_s", "first_call_time_s", "loop_time_s",
+                                     "loop_cpu_s", "n_steps", "n_iterations", "n_retries", "n_friction_bound",
+                                     "status")}
+        info["n_rebuilds"] = rec.contacts.n_rebuilds
+        if rec.status == OK and summary_only:
+            return to_dataset(model, rec.out, rec.n_valid, info, summary_only=True, contacts=rec.contacts)
+        ds = to_dataset(model, rec.out, rec.n_valid, info, contacts=rec.contacts, should_stop=stop_requested,
+                        progress=progress)
+    if rec.status != OK or interrupted(ds):
+        n = ds.sizes["time"]
+        t_last = float(ds.time[-1]) if n else 0.0
         raise SimulationError(
-            f"{model.scenario.name}: {rec.message} The {rec.n_valid} output times computed "
+            f"{model.scenario.name}: {ds.attrs['status']} The {n} output times computed "
             f"so far (up to t = {t_last:.6e} s) are kept in the error's .result.",
             result=ds,
         )

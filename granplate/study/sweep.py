@@ -38,7 +38,9 @@ RESULTS_HASH = "results.sha256"
 @dataclass
 class SweepReport:
     """What a sweep did: designs in the study, found already done, computed now, failed
-    (among all recorded), lost (a task that did not come back: no record, a rerun retries)."""
+    (among all recorded), lost (a task that did not come back: no record, a rerun retries);
+    the seconds of the whole sweep, of the designs' tasks (compute_s), of writing their
+    records (store_s) and of the workers' warm-up."""
 
     n_designs: int
     n_done_before: int
@@ -47,6 +49,7 @@ class SweepReport:
     lost: list[str] = field(default_factory=list)
     elapsed_s: float = 0.0
     compute_s: float = 0.0
+    store_s: float = 0.0
     warm_up_s: float = 0.0
     out: Path = Path(".")
 
@@ -141,8 +144,10 @@ def _run(client, study: Study, out: Path, todo: list[tuple[str, int]], texts: li
                 report.lost.append(f"design {i}: {D.failure_message(err)}")
                 bar.update(1)
                 continue
+            t_store = time.perf_counter()
             D.write_record(out, D.make_record(k, study.changes(i), texts[i], outcome),
                            outcome.get("result"))
+            report.store_s += time.perf_counter() - t_store
             report.n_computed += 1
             report.compute_s += outcome["elapsed_s"]
             bar.update(1)
