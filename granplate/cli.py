@@ -98,6 +98,17 @@ def _write_result(ds, out: Path) -> bool:
     return stop_requested()
 
 
+def keep_dask_out() -> None:
+    """Mark Dask absent in this process (`import dask` then raises ImportError): a single
+    run needs none of it, but xarray imports dask.array when it is installed (and netCDF
+    writes import distributed), which costs a fresh `granplate run` process about as much
+    as its other imports together (docs/benchmarks.md, "Start-up"). Only for commands that
+    never use Dask, and only where no Dask module is loaded yet."""
+    if not any(m == "dask" or m.startswith(("dask.", "distributed")) for m in sys.modules):
+        for name in ("dask", "distributed"):
+            sys.modules.setdefault(name, None)
+
+
 def _cmd_run(args) -> int:
     from granplate.results.dataset import summary
     from granplate.setup.io import load_scenario
@@ -257,6 +268,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(join_negative_values(parser, sys.argv[1:] if argv is None else list(argv)))
     show_notes(bool(getattr(args, "quiet", False)))
+    if argv is None and getattr(args, "func", None) is _cmd_run:  # this process is the run's own
+        keep_dask_out()
     try:
         if getattr(args, "t_end", None) is not None:
             positive("time.t_end", args.t_end)  # the field's own check, before any command runs

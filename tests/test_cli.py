@@ -221,3 +221,22 @@ def test_start_up_imports_no_heavy_module(code):
     assert done.returncode == 0, done.stderr
     loaded = done.stdout.strip().splitlines()[-1] if done.stdout.strip() else ""
     assert loaded == "", f"loaded at start-up: {loaded}"
+
+
+def test_a_run_process_writes_its_result_without_loading_dask(tmp_path):
+    """Truth: with Dask marked absent (`keep_dask_out`, as `granplate run` does in its own
+    process), xarray builds and writes a netCDF result that reads back equal, and neither
+    dask nor distributed is loaded."""
+    import subprocess
+    import sys
+
+    path = tmp_path / "r.nc"
+    probe = ("import sys\nfrom granplate.cli import keep_dask_out\nkeep_dask_out()\n"
+             "import numpy as np, xarray as xr\n"
+             f"xr.Dataset({{'a': ('t', np.arange(3.0))}}).to_netcdf({str(path)!r})\n"
+             f"back = xr.load_dataset({str(path)!r})\nassert back.a.values.tolist() == [0.0, 1.0, 2.0]\n"
+             "print(' '.join(m for m, v in sys.modules.items() if v is not None and m.split('.')[0] in "
+             "('dask', 'distributed')))")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "", f"loaded: {done.stdout.strip()}"
