@@ -30,6 +30,16 @@ def test_nodal_stress_only_with_fields_at_every_output(runs):
                                rtol=1e-9)
 
 
+def test_a_design_with_fields_at_every_output_gets_its_nodal_stress(runs):
+    """Truth: run_design of a design keeping its plate fields at every output (and not
+    asked for its whole result) reports the nodal stress of the full result's displacements."""
+    every, _ = runs
+    s = gp.with_changes(gp.load_scenario("steel-r1"), {"time.field_interval": 1e-6, "time.t_end": 2e-5})
+    rec = D.run_design(gp.dumps(s))
+    assert rec["status"] == "ok" and rec["result"] is None
+    assert rec["summary"]["max_von_mises_nodes"] == D.metrics(every)["max_von_mises_nodes"]
+
+
 def test_mass_is_the_sum_of_the_granules_masses(runs):
     _, sparse = runs
     r1, rho = 0.01, 7850.0
