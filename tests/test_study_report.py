@@ -216,6 +216,22 @@ def test_report_redraws_only_when_its_inputs_change(tmp_path):
     assert metric.stat().st_mtime_ns != before[metric]
 
 
+def test_the_inputs_hash_follows_the_code_that_draws(tmp_path, monkeypatch):
+    """Truth: the same study read back hashes alike, and differently once the source of the
+    figures' module changes (a changed figure is redrawn within one version)."""
+    from granplate.study import plots
+    from granplate.study.report import inputs_hash
+
+    synthetic(tmp_path)
+    out = read_outcome(tmp_path)
+    digest = inputs_hash(out)
+    assert inputs_hash(read_outcome(tmp_path)) == digest
+    edited = tmp_path / "plots.py"
+    edited.write_bytes(Path(plots.__file__).read_bytes() + b"\n# a changed figure\n")
+    monkeypatch.setattr(plots, "__file__", str(edited))
+    assert inputs_hash(out) != digest
+
+
 def test_report_of_a_folder_without_a_study_is_a_clear_error(tmp_path, capsys):
     assert main(["study", "report", str(tmp_path)]) == 2
     err = capsys.readouterr().err

@@ -142,11 +142,14 @@ def _png(fig, tmp: Path) -> None:
 
 
 def inputs_hash(out: StudyOutcome) -> str:
-    """SHA-256 of everything the report's figures are drawn from: the granplate version
-    and the study as read back (every row's parameters, metrics and status, the study
-    file, the folder's name), so equal inputs give equal figures."""
-    text = repr((gp.__version__, dataclasses.replace(out, folder=Path(out.folder.name))))
-    return hashlib.sha256(text.encode()).hexdigest()
+    """SHA-256 of everything the report's figures are drawn from: the granplate version,
+    the source of the modules that draw them (so that a changed figure is redrawn within a
+    version too) and the study as read back (every row's parameters, metrics and status,
+    the study file, the folder's name), so equal inputs give equal figures."""
+    h = hashlib.sha256(repr((gp.__version__, dataclasses.replace(out, folder=Path(out.folder.name)))).encode())
+    for module in (P, sys.modules[__name__]):
+        h.update(Path(module.__file__).read_bytes())
+    return h.hexdigest()
 
 
 def stored_hash(fig_dir: Path) -> str:
