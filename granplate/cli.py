@@ -38,6 +38,9 @@ SUMMARY_ROWS = (
     ("eg_max_fraction", "granular energy, peak / {ref}", "-", "{:.4f}", 1.0),
     ("eg_final_fraction", "granular energy, final / {ref}", "-", "{:.4f}", 1.0),
     ("dissipated_fraction", "dissipated, final / {ref}", "-", "{:.4f}", 1.0),
+    ("plastic_fraction", "of which plastic, final / {ref}", "-", "{:.4f}", 1.0),
+    ("max_contact_pressure", "max Hertz contact pressure p0", "MPa", "{:.4g}", 1e-6),
+    ("yield_onset_ratio", "max p0 / (1.6 Y), yield onset", "-", "{:.3f}", 1.0),
     ("max_von_mises", "max von Mises stress", "MPa", "{:.2f}", 1e-6),
     ("max_von_mises_disc", "max von Mises, disc average", "MPa", "{:.2f}", 1e-6),
     ("max_eps_yy", "max |eps_yy|", "-", "{:.3e}", 1.0),
@@ -84,6 +87,13 @@ def format_summary(summary: dict) -> str:
         v = summary[key]
         text = "-" if v is None else fmt.format(v * scale)
         lines.append(f"{label.format(ref=ref):{width}s} {text:>14s}  {unit}")
+    pairs = summary.get("contact_pairs") or []
+    if pairs:
+        lines += ["", f"{'material pair (normal law)':{width}s} {'max p0 [MPa]':>14s}  p0 / (1.6 Y)   contact, time"]
+        for p in pairs:
+            ratio = "unknown Y" if p["yield_onset_ratio"] is None else f"{p['yield_onset_ratio']:.3f}"
+            lines.append(f"{p['pair'] + ' (' + p['normal_law'] + ')':{width}s} {p['max_contact_pressure'] * 1e-6:>14.4g}"
+                         f"  {ratio:>12s}   {p['contact']}, {p['time']:.4g} s")
     return "\n".join(lines)
 
 

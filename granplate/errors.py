@@ -33,3 +33,9 @@ class SimulationError(GranplateError, RuntimeError):
     def __init__(self, message: str, result: Any = None):
         super().__init__(message)
         self.result = result
+
+
+class YieldWarning(UserWarning):
+    """A run's elastic (Hertz) contacts passed the onset of yield of their softer body
+    (docs/model.md section 3.6): the law no longer holds there. Its own category, so that
+    studies and scripts can filter it (`warnings.simplefilter("ignore", YieldWarning)`)."""

@@ -13,7 +13,8 @@ from granplate.setup.io import load
 SUMMARY_KEYS = {
     "e_shock", "e_initial", "e_in", "ep_max_fraction", "ep_final_fraction", "eg_max_fraction",
     "eg_final_fraction", "dissipated_fraction", "max_von_mises", "max_von_mises_disc", "max_eps_yy",
-    "energy_residual_max", "n_steps", "wall_time_s", "t_end",
+    "energy_residual_max", "n_steps", "wall_time_s", "t_end", "plastic_fraction", "max_contact_pressure",
+    "yield_onset_ratio", "contact_pairs",
 }
 
 #: Two steel spheres (R = 1 cm) 0.4 mm apart closing at 2 m/s: no plate, no load.
@@ -51,6 +52,9 @@ def test_run_preset_writes_result_and_summary(tmp_path, capsys):
     assert SUMMARY_KEYS <= set(s)
     assert set(s["units"]) == SUMMARY_KEYS  # every number has its unit
     assert (s["units"]["e_shock"], s["units"]["max_von_mises"], s["units"]["t_end"]) == ("J", "Pa", "s")
+    assert s["units"]["contact_pairs"]["max_contact_pressure"] == "Pa"
+    assert {p["pair"] for p in s["contact_pairs"]} == {"steel-plate", "steel-steel", "steel-wall"}
+    assert s["max_contact_pressure"] == max(p["max_contact_pressure"] for p in s["contact_pairs"])
     assert s["e_shock"] == pytest.approx(7.48e-4, rel=0.01)
     assert s["e_in"] == s["e_shock"] + s["e_initial"] and s["e_initial"] == 0.0  # from rest: exactly
     assert out.exists()

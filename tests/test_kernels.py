@@ -9,6 +9,7 @@ import pytest
 import scipy.linalg
 
 from granplate.model.inputs import SCHEME_NAMES, Config, Granular, PlateArrays, scheme_number
+from granplate.physics.contact import N_COEF
 from granplate.solver import loop, schemes, state as S
 from granplate.solver.plate_modal import step_matrices
 from granplate.solver.schemes.newton import solve_dense
@@ -54,8 +55,8 @@ def one_mode_run(scheme: str, omega_h: float, n_steps: int = 1, budget: int = 10
     h = omega_h / w
     ei, ef = np.zeros(0, np.int64), np.zeros(0)
     g = Granular(mass=ef, inertia=ef, radius=ef, pair_ij=np.zeros((0, 2), np.int64),
-                 pair_coef=np.zeros((0, 4)), wall_i=ei, wall_geo=np.zeros((0, 3)),
-                 wall_coef=np.zeros((0, 4)), wall_w=ei, pc_i=ei, pc_x=ef, pc_coef=np.zeros((0, 4)),
+                 pair_coef=np.zeros((0, N_COEF)), wall_i=ei, wall_geo=np.zeros((0, 3)),
+                 wall_coef=np.zeros((0, N_COEF)), wall_w=ei, pc_i=ei, pc_x=ef, pc_coef=np.zeros((0, N_COEF)),
                  shock_force=ef, shock_torque=ef)
     p = PlateArrays(omega2=np.array([w * w]), phi_d=np.zeros((0, 1)), load_modal=np.zeros(1))
     cfg = Config(q0=0.0, duration=1.0, clip=True, lambda_target=0.5, rtol=1e-9, atol=1e-10,

@@ -93,13 +93,14 @@ def test_wall_and_plate_kinematics_eq_6():
 
 
 def test_energy_residual_eq_11():
-    """(E_g + E_p + D_visc + D_fric - E_in) / scale, eq. (11)."""
-    tot = energy_total(1.0, 2.0, 0.25, 0.5)
+    """(E_g + E_p + D_visc + D_fric + D_plastic - E_in) / scale, eq. (11)."""
+    tot = energy_total(1.0, 2.0, 0.25, 0.5, 0.0)
     assert tot == 3.75
+    assert energy_total(1.0, 2.0, 0.25, 0.5, 0.125) == 3.875
     assert energy_residual(tot, 3.5, 4.0) == pytest.approx(0.0625)
 
 
 def test_coefficient_columns():
-    """The named columns index A, c, mu, k_s in that order (the model arrays' layout)."""
-    assert (C.COEF_A, C.COEF_C, C.COEF_MU, C.COEF_KS, C.N_COEF) == (0, 1, 2, 3, 4)
+    """The named columns index A, c, mu, k_s, delta_y in that order (the model arrays' layout)."""
+    assert (C.COEF_A, C.COEF_C, C.COEF_MU, C.COEF_KS, C.COEF_DY, C.N_COEF) == (0, 1, 2, 3, 4, 5)
     assert C.hertz_coefficient(1e11, 0.004) == pytest.approx(4 / 3 * 1e11 * math.sqrt(0.004))

@@ -9,14 +9,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from granplate.model.contacts import contact_lists, fixed_wall_contacts
-from granplate.model.inputs import Config, Granular, PlateArrays, scheme_number
+from granplate.model.inputs import HIST_MAX, Config, Granular, PlateArrays, no_history, scheme_number
 from granplate.physics.contact import (
-    COEF_A, COEF_C, COEF_KS, COEF_MU, N_COEF, damping_coefficient, hertz_coefficient,
+    COEF_A, COEF_C, COEF_DY, COEF_KS, COEF_MU, N_COEF, damping_coefficient, hertz_coefficient,
 )
+from granplate.physics.plastic import contact_yield_overlap
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import resolve
 from granplate.physics.shock import shock_resultants
-from granplate.setup.materials import effective_modulus, sphere_inertia, sphere_mass
+from granplate.setup.materials import effective_modulus, softer_yield_strength, sphere_inertia, sphere_mass
 from granplate.setup.scenario import Scenario
 from granplate.setup.plate_checks import split_initial_contacts
 from granplate.setup.validate import validate
@@ -83,12 +84,30 @@ class Model:
         return tuple(self.labels[i] for i in self.plate_contacts)
 
 
-def coefficient_row(a: float, c: float, mu: float, k_s: float) -> np.ndarray:
+def coefficient_row(a: float, c: float, mu: float, k_s: float, delta_y: float = math.inf) -> np.ndarray:
     """One row of pair_coef / wall_coef / pc_coef in the columns of physics.contact:
-    Hertz A [N/m^1.5], damping c, mu [-], k_s [s/m] (eqs. 3, 5)."""
+    Hertz A [N/m^1.5], damping c, mu [-], k_s [s/m] (eqs. 3, 5) and the yield overlap
+    delta_y [m] (docs/model.md eq. P3; inf: Hertz's law)."""
     row = np.zeros(N_COEF)
-    row[COEF_A], row[COEF_C], row[COEF_MU], row[COEF_KS] = a, c, mu, k_s
+    row[COEF_A], row[COEF_C], row[COEF_MU], row[COEF_KS], row[COEF_DY] = a, c, mu, k_s, delta_y
     return row
+
+
+def normal_law_of(s: Scenario, a: str, b: str) -> str:
+    """The normal law (contact.normal_law, or its [[contact.pairs]] override) between
+    materials a and b."""
+    return s.contact.law_for_pair(a, b) if hasattr(s.contact, "law_for_pair") else "hertz"
+
+
+def law_yield_overlap(s: Scenario, a, b, b_name: str, e_star: float, r_star: float) -> float:
+    """COEF_DY of a contact of material a (a granule's Material) with b (a granule's
+    Material, or None for a rigid wall or the plate's face, whose material is b_name):
+    the yield overlap delta_y [m] (docs/model.md eqs. P1, P3) of the softer body under the
+    elastic-plastic law "thornton", inf under Hertz's law. (Validation refuses "thornton"
+    where the Y it needs is unknown.)"""
+    if normal_law_of(s, a.name, b_name) != "thornton":
+        return math.inf
+    return contact_yield_overlap(e_star, r_star, softer_yield_strength(a, b))
 
 
 def _granule_arrays(s: Scenario):
@@ -144,7 +163,8 @@ def pair_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, pairs:
         m_star = mass[i] * mass[j] / (mass[i] + mass[j])
         alpha, mu, ks = s.contact.for_pair(mats[i].name, mats[j].name)
         a = hertz_coefficient(e_star, r_star)
-        pair_coef[p] = coefficient_row(a, damping_coefficient(alpha, m_star, a), mu, ks)
+        pair_coef[p] = coefficient_row(a, damping_coefficient(alpha, m_star, a), mu, ks,
+                                       law_yield_overlap(s, mats[i], mats[j], mats[j].name, e_star, r_star))
     return pair_coef
 
 
@@ -160,8 +180,10 @@ def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarr
         nrm = nrm / np.linalg.norm(nrm)
         wall_geo[k] = (nrm[0], nrm[1], wall.offset)
         alpha, mu, ks = s.contact.for_pair(mats[i].name, wall.material)
-        a = hertz_coefficient(effective_modulus(mats[i], None), r[i])
-        wall_coef[k] = coefficient_row(a, damping_coefficient(alpha, mass[i], a), mu, ks)
+        e_star = effective_modulus(mats[i], None)
+        a = hertz_coefficient(e_star, r[i])
+        wall_coef[k] = coefficient_row(a, damping_coefficient(alpha, mass[i], a), mu, ks,
+                                       law_yield_overlap(s, mats[i], None, wall.material, e_star, r[i]))
     return wall_geo, wall_coef
 
 
@@ -171,8 +193,10 @@ def plate_contact_coefficients(s: Scenario, mats, r: np.ndarray, pc: np.ndarray)
     pc_coef = np.zeros((len(pc), N_COEF))
     for k, i in enumerate(pc):
         alpha, mu, ks = s.contact.for_pair(mats[i].name, s.plate.material)
-        a = hertz_coefficient(effective_modulus(mats[i], None), r[i])
-        pc_coef[k] = coefficient_row(a, damping_coefficient(alpha, 0.0, a), mu, ks)
+        e_star = effective_modulus(mats[i], None)
+        a = hertz_coefficient(e_star, r[i])
+        pc_coef[k] = coefficient_row(a, damping_coefficient(alpha, 0.0, a), mu, ks,
+                                     law_yield_overlap(s, mats[i], None, s.plate.material, e_star, r[i]))
     return pc_coef
 
 
@@ -294,6 +318,7 @@ def build_model(scenario: Scenario) -> Model:
         wall_w=np.ascontiguousarray(loop_wc[:, 1]),
         pc_i=pc, pc_x=np.full(len(pc), float(s.plate.x0) if s.plate is not None else 0.0),
         pc_coef=plate_contact_coefficients(s, mats, r, pc), shock_force=fres, shock_torque=tres,
+        pair_hist=no_history(len(loop_pairs)), wall_hist=no_history(len(loop_wc)), pc_hist=no_history(len(pc)),
     )
     return Model(
         scenario=s, labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
@@ -304,13 +329,36 @@ def build_model(scenario: Scenario) -> Model:
     )
 
 
+def carried_history(old_keys: list, old_hist: np.ndarray, new_keys: list, store: dict) -> np.ndarray:
+    """The histories (columns HIST_*) of the contacts new_keys of a rebuilt list: each one's
+    row from the old list (old_keys, old_hist) or from `store`, which holds the contacts
+    that left the list with a history and takes those leaving now. A contact keeps its
+    largest overlap (and so its plastic flattening, docs/model.md section 3.6) for the
+    whole run, whether or not the list holds it."""
+    kept = dict(store)
+    kept.update({old_keys[n]: old_hist[n].copy() for n in np.flatnonzero(old_hist[:, HIST_MAX] > 0.0)})
+    where = {k: n for n, k in enumerate(new_keys)}
+    out = no_history(len(new_keys))
+    store.clear()
+    for k, row in kept.items():
+        n = where.get(k)
+        if n is None:
+            store[k] = row
+        else:
+            out[n] = row
+    return out
+
+
 def granular_with_contacts(model: Model, g: Granular, pairs: np.ndarray, wc: np.ndarray,
-                           known: dict | None = None) -> Granular:
-    """`g` with the contact lists pairs (np, 2) and wc (nw, 2) [granule, wall] and their
-    coefficients; known: pair coefficient rows by (i, j), reused and extended (rows are
-    the same numbers `pair_coefficients` gives)."""
+                           known: dict | None = None, stores: tuple[dict, dict] | None = None) -> Granular:
+    """`g` with the contact lists pairs (np, 2) and wc (nw, 2) [granule, wall], their
+    coefficients and their histories carried over (`carried_history`; stores: the pairs'
+    and the walls' histories off the list, keyed (i, j) and (i, wall), updated); known:
+    pair coefficient rows by (i, j), reused and extended (rows are the same numbers
+    `pair_coefficients` gives)."""
     s, mats = model.scenario, list(model.materials)
     known = {} if known is None else known
+    stores = ({}, {}) if stores is None else stores
     keys = [(int(i), int(j)) for i, j in pairs]
     new = [k for k in keys if k not in known]
     if new:
@@ -319,15 +367,20 @@ def granular_with_contacts(model: Model, g: Granular, pairs: np.ndarray, wc: np.
     pair_coef = np.array([known[k] for k in keys], float).reshape(-1, N_COEF)
     wall_geo, wall_coef = wall_arrays(s, mats, g.radius, g.mass, wc)
     wc = np.asarray(wc, np.int64).reshape(-1, 2)
+    old_pairs = [(int(i), int(j)) for i, j in g.pair_ij]
+    old_walls = [(int(i), int(w)) for i, w in zip(g.wall_i, g.wall_w)]
+    new_walls = [(int(i), int(w)) for i, w in wc]
     return g._replace(pair_ij=np.ascontiguousarray(pairs, np.int64).reshape(-1, 2), pair_coef=pair_coef,
                       wall_i=np.ascontiguousarray(wc[:, 0]), wall_geo=wall_geo, wall_coef=wall_coef,
-                      wall_w=np.ascontiguousarray(wc[:, 1]))
+                      wall_w=np.ascontiguousarray(wc[:, 1]),
+                      pair_hist=carried_history(old_pairs, g.pair_hist, keys, stores[0]),
+                      wall_hist=carried_history(old_walls, g.wall_hist, new_walls, stores[1]))
 
 
 def granular_with_patch_contacts(model: Model, g: Granular, new: np.ndarray) -> Granular:
     """`g` with a patch contact appended for each granule of `new` (docs/model.md section
     3.5): the coefficients of a rigid layer (m* = 0), the overlap measured from the
-    undeformed face, pc_patch = 1."""
+    undeformed face, pc_patch = 1, and a fresh history."""
     new = np.asarray(new, np.int64).ravel()
     s, mats = model.scenario, list(model.materials)
     patch = g.pc_patch if len(g.pc_patch) == len(g.pc_i) else np.zeros(len(g.pc_i), np.int64)
@@ -337,4 +390,5 @@ def granular_with_patch_contacts(model: Model, g: Granular, new: np.ndarray) -> 
         pc_coef=np.ascontiguousarray(np.vstack([g.pc_coef.reshape(-1, N_COEF),
                                                 plate_contact_coefficients(s, mats, g.radius, new)])),
         pc_patch=np.concatenate([patch, np.ones(len(new), np.int64)]),
+        pc_hist=np.vstack([g.pc_hist.reshape(-1, g.pc_hist.shape[1]), no_history(len(new))]),
     )

@@ -2,7 +2,7 @@
 and the scalar settings, as numba-friendly named tuples built once by `build_model`.
 
 Coefficient columns of pair_coef, wall_coef and pc_coef are named in
-granplate.physics.contact (COEF_A, COEF_C, COEF_MU, COEF_KS).
+granplate.physics.contact (COEF_A, COEF_C, COEF_MU, COEF_KS, COEF_DY).
 """
 from __future__ import annotations
 
@@ -27,6 +27,20 @@ def scheme_number(name: str) -> int:
     return SCHEME_NAMES.index(name)
 
 
+#: columns of the contact histories pair_hist, wall_hist, pc_hist (Granular): the largest
+#: overlap so far delta_max [m] (the elastic-plastic law's history, docs/model.md section
+#: 3.6; for every law, its largest Hertz peak pressure), the time it was reached [s], and
+#: the overlap at the end of the last trial step [m] (taken into delta_max when the step is
+#: accepted).
+HIST_MAX, HIST_TIME, HIST_END = 0, 1, 2
+N_HIST = 3
+
+
+def no_history(n: int) -> np.ndarray:
+    """A zero history for n contacts ((n, N_HIST), columns HIST_*)."""
+    return np.zeros((n, N_HIST))
+
+
 class Granular(NamedTuple):
     """Flat arrays of the granular medium and its contacts (SI units).
 
@@ -39,7 +53,9 @@ class Granular(NamedTuple):
     section 3.5); pc_coef: (nk, 4); shock_force, shock_torque: (ng,) load resultants per
     unit q0 [m, m^2]; pc_patch: (nk,) int, 1 for a patch contact (its plate rows move
     with the granule, docs/model.md section 3.5), 0 for a rigid layer; empty while
-    there is no patch contact (the loop then skips them at no cost).
+    there is no patch contact (the loop then skips them at no cost); pair_hist,
+    wall_hist, pc_hist: (np, N_HIST), (nw, N_HIST), (nk, N_HIST) each contact's history
+    (columns HIST_*), this run's own (the loop updates them in place).
     """
 
     mass: np.ndarray
@@ -57,6 +73,9 @@ class Granular(NamedTuple):
     shock_force: np.ndarray
     shock_torque: np.ndarray
     pc_patch: np.ndarray = np.zeros(0, np.int64)
+    pair_hist: np.ndarray = no_history(0)
+    wall_hist: np.ndarray = no_history(0)
+    pc_hist: np.ndarray = no_history(0)
 
 
 class PlateArrays(NamedTuple):

@@ -38,9 +38,11 @@ def damping_coefficient(alpha_n: float, m_star: float, a: float) -> float:
 
 #: columns of the coefficient arrays pair_coef, wall_coef, pc_coef (model arrays):
 #: Hertz coefficient A [N/m^1.5] (eq. 3), damping coefficient c with gamma = c delta^(1/4)
-#: (eq. 3), friction coefficient mu [-] and regularisation k_s [s/m] (eq. 5).
-COEF_A, COEF_C, COEF_MU, COEF_KS = 0, 1, 2, 3
-N_COEF = 4
+#: (eq. 3), friction coefficient mu [-], regularisation k_s [s/m] (eq. 5), and the yield
+#: overlap delta_y [m] of the elastic-plastic law (docs/model.md section 3.6, eq. P3;
+#: inf: the contact follows Hertz's law, eq. 2).
+COEF_A, COEF_C, COEF_MU, COEF_KS, COEF_DY = 0, 1, 2, 3, 4
+N_COEF = 5
 
 
 @njit(cache=True)

@@ -224,3 +224,39 @@ def plastic_work(a: float, delta_y: float, delta_max: float) -> float:
     x = m - delta_y
     loading_work = 0.4 * f_y * delta_y + f_y * x + 0.5 * plastic_stiffness(a, delta_y) * x * x
     return loading_work - 0.4 * loading_force(a, delta_y, m) * unloading_span(delta_y, m)
+
+
+@njit(cache=True)
+def yielding_normal_response(delta: float, delta_dot: float, a: float, c: float, delta_y: float,
+                             delta_max: float, clip: bool):
+    """The elastic-plastic law of one contact in touch (delta > 0) with the paper's
+    damping (P13): |N| = F(delta, delta_max) (P8) + c (delta - delta_p)^(1/4) d(delta)/dt
+    while delta > delta_p, 0 at or below the residual overlap delta_p; with clip, |N| >= 0.
+    For an elastic history (delta_p = 0) this is eq. (2).
+
+    Returns (|N| [N], viscous power [W] (as `contact.viscous_power`), stored elastic energy
+    [J] (P9), plastic work [J] done past delta_max, W_p(max(delta, delta_max)) - W_p(delta_max)
+    (P10), which is zero unless the contact loads past its largest overlap).
+    """
+    m = updated_max_overlap(delta, delta_max)
+    w_p = 0.0
+    if m > delta_max and m > delta_y:
+        w_p = plastic_work(a, delta_y, m) - plastic_work(a, delta_y, delta_max)
+    d_el = delta - residual_overlap(delta_y, m)
+    if d_el <= 0.0:
+        return 0.0, 0.0, 0.0, w_p
+    f = plastic_force(a, delta_y, delta, delta_max)
+    n = f + c * math.sqrt(math.sqrt(d_el)) * delta_dot
+    if clip and n < 0.0:
+        n = 0.0
+    return n, (n - f) * delta_dot, plastic_elastic_energy(a, delta_y, delta, delta_max), w_p
+
+
+@njit(cache=True)
+def yielding_normal_slopes(delta: float, a: float, c: float, delta_y: float, delta_max: float):
+    """dN/d(delta) [N/m] (`plastic_force_slope`) and dN/d(delta rate) = c (delta - delta_p)^(1/4)
+    [N s/m] of `yielding_normal_response` in touch (the implicit scheme's Newton)."""
+    d_el = delta - residual_overlap(delta_y, updated_max_overlap(delta, delta_max))
+    if d_el <= 0.0:
+        return 0.0, 0.0
+    return plastic_force_slope(a, delta_y, delta, delta_max), c * math.sqrt(math.sqrt(d_el))

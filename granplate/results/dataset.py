@@ -6,6 +6,7 @@ and the solver's figures travel in the attributes, so any figure can be traced b
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from dataclasses import replace
 from typing import Callable, NamedTuple
@@ -16,6 +17,7 @@ import xarray as xr
 from granplate.version import __version__
 from granplate.plate.peaks import BLOCK, block_starts, peak_maxima, split_coordinates, time_maxima
 from granplate.solver import state as K
+from granplate.results.yielding import largest, pair_yield
 from granplate.solver.driver import INTERRUPTED_STATUS
 
 #: name -> (units, description) of every data variable
@@ -31,6 +33,13 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "E_plate": ("J", "plate energy E_p = 1/2 v^T M v + 1/2 x^T K x (eq. 9)"),
     "D_viscous": ("J", "energy dissipated by the damping part of the normal forces (eq. 10)"),
     "D_friction": ("J", "energy dissipated by friction (eq. 10)"),
+    "D_plastic": ("J", "plastic work of the contacts that yield (docs/model.md eq. P10; 0 under Hertz's law)"),
+    "pair_max_contact_pressure": ("Pa", "largest Hertz peak pressure p0 = (2/pi) E* sqrt(delta/R*) over the pair's contacts and the run (docs/model.md eq. P2)"),
+    "pair_yield_onset_ratio": ("1", "that p0 over the yield onset 1.6 Y of the softer body (eq. P1); NaN where Y is unknown"),
+    "pair_yield_strength": ("Pa", "Y of the softer body of the pair (a wall or the plate's face: the granule's); NaN where unknown"),
+    "pair_max_pressure_time": ("s", "when the contact of that largest p0 reached its largest overlap"),
+    "pair_max_pressure_contact": ("1", "that contact: granule labels, or a granule and 'wall w' / 'plate'"),
+    "pair_normal_law": ("1", "the pair's normal law (contact.normal_law: hertz or thornton)"),
     "E_contact": ("J", "elastic energy stored in all contacts (part of E_granular)"),
     "KE_horizontal": ("J", "granular kinetic energy, horizontal translation"),
     "KE_vertical": ("J", "granular kinetic energy, vertical translation"),
@@ -177,7 +186,7 @@ def plate_fields(model, q: np.ndarray, qd: np.ndarray, times: np.ndarray,
 
 #: What a summary-only Dataset holds (`to_dataset(..., summary_only=True)`): what
 #: `summary` and the studies' metrics read.
-SUMMARY_VARIABLES = ("E_shock", "E_granular", "E_plate", "D_viscous", "D_friction",
+SUMMARY_VARIABLES = ("E_shock", "E_granular", "E_plate", "D_viscous", "D_friction", "D_plastic",
                      "energy_residual_max", "max_von_mises", "max_von_mises_disc", "max_eps_yy")
 
 
@@ -247,7 +256,7 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
             data[name] = _var(name, ("time", "granule"), y[:, :, c].copy())
     for col, name in (
         (K.E_SHOCK, "E_shock"), (K.E_GRAN, "E_granular"), (K.E_PLATE, "E_plate"),
-        (K.D_VISC, "D_viscous"), (K.D_FRIC, "D_friction"), (K.E_POTG, "E_contact"),
+        (K.D_VISC, "D_viscous"), (K.D_FRIC, "D_friction"), (K.D_PLASTIC, "D_plastic"), (K.E_POTG, "E_contact"),
         (K.KE_X, "KE_horizontal"), (K.KE_Y, "KE_vertical"), (K.KE_ROT, "KE_rotational"),
         (K.RESID, "energy_residual"), (K.RESID_MAX, "energy_residual_max"),
     ):
@@ -263,6 +272,17 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
         "mass": ("granule", model.granular.mass.copy(), {"units": "kg", "long_name": "granule mass"}),
         "material": ("granule", np.array([g.material for g in s.granules], dtype=str), {"long_name": "granule material"}),
     }
+    py = pair_yield(model, contacts.peaks) if contacts is not None and contacts.peaks is not None else None
+    if py is not None:
+        coords["material_pair"] = ("material_pair", np.array(py.pair, dtype=str),
+                                   {"long_name": "material pair of contacts (docs/model.md section 3.6)"})
+        for name, values in (("pair_max_contact_pressure", py.pressure), ("pair_yield_onset_ratio", py.ratio),
+                             ("pair_yield_strength", py.yield_strength), ("pair_max_pressure_time", py.time),
+                             ("pair_max_pressure_contact", np.array(py.contact, dtype=str)),
+                             ("pair_normal_law", np.array(py.law, dtype=str))):
+            data[name] = _var(name, ("material_pair",), values)
+        p_max, ratio = largest(py)
+        info = {**info, "max_contact_pressure": p_max, "yield_onset_ratio": ratio}
     if summary_only:
         data.update(plate_data)
         ds = xr.Dataset(data, coords=coords)
@@ -338,10 +358,12 @@ def read(path: str | Path) -> xr.Dataset:
 
 #: Unit of every number in `summary` ("1": a pure number; the *_fraction values are
 #: fractions of e_in = e_shock + e_initial).
-SUMMARY_UNITS: dict[str, str] = {
+SUMMARY_UNITS: dict[str, object] = {
     "t_end": "s", "e_shock": "J", "e_initial": "J", "e_in": "J",
     "ep_max_fraction": "1", "ep_final_fraction": "1", "eg_max_fraction": "1",
     "eg_final_fraction": "1", "dissipated_fraction": "1",
+    "plastic_fraction": "1", "max_contact_pressure": "Pa", "yield_onset_ratio": "1",
+    "contact_pairs": {"max_contact_pressure": "Pa", "yield_onset_ratio": "1", "yield_strength": "Pa", "time": "s"},
     "max_von_mises": "Pa", "max_von_mises_disc": "Pa", "max_eps_yy": "1", "energy_residual_max": "1",
     "n_steps": "1", "wall_time_s": "s",
 }
@@ -360,6 +382,7 @@ def summary(ds: xr.Dataset) -> dict:
     ref = e_in if e_in > 0 else None
     has_plate = "max_von_mises" in ds
     info = json.loads(ds.attrs.get("run_info", "{}"))
+    plastic = float(ds.D_plastic[-1]) if "D_plastic" in ds and ds.sizes["time"] else 0.0
 
     def fraction(energy, plate: bool = False) -> float | None:
         if ref is None or (plate and not has_plate):
@@ -377,7 +400,11 @@ def summary(ds: xr.Dataset) -> dict:
         "ep_final_fraction": fraction(ds.E_plate[-1], plate=True),
         "eg_max_fraction": fraction(ds.E_granular.max()),
         "eg_final_fraction": fraction(ds.E_granular[-1]),
-        "dissipated_fraction": fraction(ds.D_viscous[-1] + ds.D_friction[-1]),
+        "dissipated_fraction": fraction(ds.D_viscous[-1] + ds.D_friction[-1] + plastic),
+        "plastic_fraction": fraction(plastic),
+        "max_contact_pressure": _finite(ds.attrs.get("max_contact_pressure")),
+        "yield_onset_ratio": _finite(ds.attrs.get("yield_onset_ratio")),
+        "contact_pairs": pair_table(ds),
         "max_von_mises": float(ds.max_von_mises.max()) if has_plate else None,
         "max_von_mises_disc": (float(ds.max_von_mises_disc.max())
                                if has_plate and "max_von_mises_disc" in ds else None),
@@ -386,6 +413,29 @@ def summary(ds: xr.Dataset) -> dict:
         "n_steps": int(info.get("n_steps", 0)),
         "wall_time_s": float(info.get("wall_time_s", 0.0)),
     }
+
+
+def _finite(value) -> float | None:
+    """A float, or None for a value that is absent or NaN (unknown)."""
+    if value is None:
+        return None
+    value = float(value)
+    return value if math.isfinite(value) else None
+
+
+def pair_table(ds: xr.Dataset) -> list[dict]:
+    """The per-material-pair contact pressures of a result (one dict per pair: pair,
+    max_contact_pressure [Pa], yield_onset_ratio [-] or None, yield_strength [Pa] or None,
+    time [s], contact, normal_law); empty for a result without them."""
+    if "material_pair" not in ds.coords:
+        return []
+    return [{"pair": str(ds.material_pair.values[k]),
+             "max_contact_pressure": float(ds.pair_max_contact_pressure.values[k]),
+             "yield_onset_ratio": _finite(ds.pair_yield_onset_ratio.values[k]),
+             "yield_strength": _finite(ds.pair_yield_strength.values[k]),
+             "time": float(ds.pair_max_pressure_time.values[k]),
+             "contact": str(ds.pair_max_pressure_contact.values[k]),
+             "normal_law": str(ds.pair_normal_law.values[k])} for k in range(ds.sizes["material_pair"])]
 
 
 def scenario_of(ds: xr.Dataset):

@@ -7,14 +7,32 @@ from __future__ import annotations
 
 import sys
 import time
+import warnings
 from dataclasses import replace
 
-from granplate.errors import SimulationError
+from granplate.errors import SimulationError, YieldWarning
 from granplate.model.arrays import Model, build_model
 from granplate.results.dataset import to_dataset
 from granplate.setup.scenario import Scenario
 from granplate.solver.driver import INTERRUPTED_STATUS, run as run_loop, stop_on_signals
 from granplate.solver.state import OK
+
+
+def yield_note(ds) -> None:
+    """Warn once (errors.YieldWarning) when elastic contacts of the result passed the onset of
+    yield (results.yielding.yield_warning)."""
+    from granplate.results.yielding import PairYield, yield_warning
+
+    if "material_pair" not in ds.coords or ds.sizes["material_pair"] == 0:
+        return
+    py = PairYield(pair=tuple(str(v) for v in ds.material_pair.values),
+                   pressure=ds.pair_max_contact_pressure.values, ratio=ds.pair_yield_onset_ratio.values,
+                   yield_strength=ds.pair_yield_strength.values, time=ds.pair_max_pressure_time.values,
+                   contact=tuple(str(v) for v in ds.pair_max_pressure_contact.values),
+                   law=tuple(str(v) for v in ds.pair_normal_law.values))
+    line = yield_warning(ds.attrs.get("scenario_name", ""), py)
+    if line is not None:
+        warnings.warn(line, YieldWarning, stacklevel=3)
 
 
 def interrupted(ds) -> bool:
@@ -71,6 +89,7 @@ def simulate(
             return to_dataset(model, rec.out, rec.n_valid, info, summary_only=True, contacts=rec.contacts)
         ds = to_dataset(model, rec.out, rec.n_valid, info, contacts=rec.contacts, should_stop=stop_requested,
                         progress=progress)
+    yield_note(ds)
     if rec.status != OK or interrupted(ds):
         n = ds.sizes["time"]
         t_last = float(ds.time[-1]) if n else 0.0

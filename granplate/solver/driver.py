@@ -17,6 +17,7 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from granplate.model.arrays import Model, granular_with_contacts, granular_with_patch_contacts
+from granplate.model.inputs import HIST_MAX, HIST_TIME, no_history
 from granplate.model.contacts import Missed, contact_lists, missed_contacts, wall_planes
 from granplate.model.neighbours import verlet_pairs, verlet_walls
 from granplate.physics.contact import plate_overlap
@@ -44,6 +45,32 @@ INTERRUPTED = -1
 INTERRUPTED_STATUS = "interrupted by the user"
 
 
+class ContactPeaks(NamedTuple):
+    """Every contact that touched during a run, with its largest overlap (the elastic-
+    plastic law's history, docs/model.md section 3.6; the largest Hertz peak pressure
+    follows from it): those in the loop's lists at the end and those that left them."""
+
+    granule: np.ndarray  # (n,) int64: the contact's granule
+    partner: np.ndarray  # (n,) int64: granule j, wall -1 - w, or state.PARTNER_PLATE
+    delta_max: np.ndarray  # (n,) [m]: the largest overlap
+    time: np.ndarray  # (n,) [s]: when it was reached
+
+
+def contact_peaks(g, stores: tuple[dict, dict]) -> ContactPeaks:
+    """The ContactPeaks of the lists of g (pairs, walls, plate contacts) and of the
+    histories off the lists (stores: pairs by (i, j), walls by (i, wall))."""
+    rows = [(int(i), int(j), h) for (i, j), h in zip(g.pair_ij, g.pair_hist)]
+    rows += [(int(i), -1 - int(w), h) for i, w, h in zip(g.wall_i, g.wall_w, g.wall_hist)]
+    rows += [(int(i), S.PARTNER_PLATE, h) for i, h in zip(g.pc_i, g.pc_hist)]
+    rows += [(i, j, h) for (i, j), h in stores[0].items()]
+    rows += [(i, -1 - w, h) for (i, w), h in stores[1].items()]
+    rows = [r for r in rows if r[2][HIST_MAX] > 0.0]
+    return ContactPeaks(granule=np.array([r[0] for r in rows], np.int64),
+                        partner=np.array([r[1] for r in rows], np.int64),
+                        delta_max=np.array([r[2][HIST_MAX] for r in rows], float),
+                        time=np.array([r[2][HIST_TIME] for r in rows], float))
+
+
 class ContactChanges(NamedTuple):
     """How a run's contacts changed: the patch contacts on the plate's face (docs/model.md
     section 3.5), those of the granules touching the face between nodes at t = 0 (time 0)
@@ -54,6 +81,7 @@ class ContactChanges(NamedTuple):
     time: np.ndarray  # (n_formed,) [s]: when it formed (its granule within contact.skin R of the face)
     y: np.ndarray  # (n_formed,) [m]: the height on the face where it formed (its granule's y then)
     n_rebuilds: int  # contact-list rebuilds (detection = "dynamic": a granule moved skin R_min / 2)
+    peaks: ContactPeaks | None = None  # every contact's largest overlap
 
 
 class RunRecord(NamedTuple):
@@ -189,8 +217,12 @@ class ContactLists:
 
     def __init__(self, model: Model):
         self.model = model
-        self.g = model.granular
+        g = model.granular
+        # this run's own histories (the loop updates them in place)
+        self.g = g._replace(pair_hist=no_history(len(g.pair_ij)), wall_hist=no_history(len(g.wall_i)),
+                            pc_hist=no_history(len(g.pc_i)))
         self.known: dict = {}
+        self.stores: tuple[dict, dict] = ({}, {})  # histories of the pairs and wall contacts off the lists
         self.planes = wall_planes(model.scenario.walls)
         self.n_rebuilds = 0  # rebuilds the loop asked for (REBUILD, dynamic detection)
         self.formed: list[tuple[int, float, float]] = []  # patch contacts: (granule, t [s], y [m])
@@ -199,7 +231,7 @@ class ContactLists:
         """The patch contacts formed so far and the rebuilds, as a ContactChanges."""
         i, t, y = zip(*self.formed) if self.formed else ((), (), ())
         return ContactChanges(granule=np.array(i, np.int64), time=np.array(t, float), y=np.array(y, float),
-                              n_rebuilds=self.n_rebuilds)
+                              n_rebuilds=self.n_rebuilds, peaks=contact_peaks(self.g, self.stores))
 
     def refresh(self, y: np.ndarray) -> Missed | None:
         """Rebuild (dynamic) or check (fixed) the lists at positions y[:, :2]; returns the
@@ -216,7 +248,7 @@ class ContactLists:
         cur_w = np.column_stack([g.wall_i, g.wall_w]).astype(np.int64)
         missed = missed_contacts(g.pair_ij, cur_w, cand_p, cand_w, normals, offsets, x, yy, r)
         if not fixed:
-            self.g = granular_with_contacts(m, g, cand_p, cand_w, self.known)
+            self.g = granular_with_contacts(m, g, cand_p, cand_w, self.known, self.stores)
         return missed[0] if missed else None
 
 

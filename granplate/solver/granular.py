@@ -16,11 +16,13 @@ from typing import NamedTuple
 
 from numba import njit
 
+from granplate.model.inputs import HIST_END, HIST_MAX, HIST_TIME
 from granplate.physics.contact import (
-    COEF_A, COEF_C, COEF_KS, COEF_MU, contact_arm, contact_response, friction_slope, normal_force,
-    normal_response, pair_apart, pair_normal_rate, pair_overlap, pair_rates, plate_overlap, plate_rates,
-    slip_after_friction, wall_overlap, wall_rates,
+    COEF_KS, COEF_MU, contact_arm, friction_magnitude, friction_power, friction_slope, pair_apart,
+    pair_normal_rate, pair_overlap, pair_rates, plate_overlap, plate_rates, slip_after_friction, wall_overlap,
+    wall_rates,
 )
+from granplate.physics.laws import normal_law_force, normal_law_response
 from granplate.physics.shock import time_profile
 from granplate.solver.state import PARTNER_PLATE
 
@@ -44,6 +46,7 @@ class ForceSums(NamedTuple):
     ovl_i: int  # its granule (-1 with no overlap)
     ovl_j: int  # its partner: granule j, wall -1 - w or PARTNER_PLATE (-1 with no overlap)
     rate_plate: float  # largest slip relaxation rate of a plate contact [1/s] (0 with hold)
+    w_plastic: float  # plastic work done past the contacts' largest overlaps so far [J] (docs/model.md eq. P10)
 
 
 @njit(cache=True)
@@ -56,7 +59,7 @@ def slip_relaxation_rate(n, vt, mu, k_s, inv_mass_t):
 
 
 @njit(cache=True)
-def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, split=False):
+def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, split=False, record=False):
     """Time derivative of the granular state and the plate-contact forces.
 
     y: (ng, 6) state; up, vp: driving-DOF displacement and velocity at t; writes dy,
@@ -64,7 +67,10 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
     contact. hold: the plate-contact friction is fbar[k] (held over the step, its work
     booked by the scheme) instead of eq. (5); split: no friction at granule-granule and
     granule-wall contacts (`friction_flow` applies it; their slip relaxation rate is then
-    not computed, and ForceSums.rate is 0). Returns the ForceSums (powers, stored energy,
+    not computed, and ForceSums.rate is 0); record: each contact's overlap (0 out of
+    touch) goes into the HIST_END column of its history (g.pair_hist, wall_hist, pc_hist),
+    for `commit_history` once the step is accepted. Each contact's normal law is chosen by
+    its coefficient row (physics.laws) with its largest overlap so far. Returns the ForceSums (powers, stored energy,
     the largest overlap and its contact, the largest slip relaxation rates); RK4 needs h
     times a rate below ~2.8. One function
     (not one per contact kind): calls that pass the model tuples cost more per step
@@ -87,6 +93,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
     ovl = 0.0  # the largest overlap / smaller radius, at granule ovl_i with ovl_j
     ovl_i = -1
     ovl_j = -1
+    w_plastic = 0.0
     if not cfg.load_on_plate:  # the shock on the loaded granules
         amp = cfg.q0 * time_profile(t, cfg.duration)
         if amp != 0.0:
@@ -101,19 +108,24 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         j = g.pair_ij[p, 1]
         ri = g.radius[i]
         rj = g.radius[j]
+        if record:
+            g.pair_hist[p, HIST_END] = 0.0
         if pair_apart(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj):
             continue
         delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
         if delta <= 0.0:
             continue
+        if record:
+            g.pair_hist[p, HIST_END] = delta
         if delta > ovl * min(ri, rj):
             ovl = delta / min(ri, rj)
             ovl_i = i
             ovl_j = j
         c = g.pair_coef[p]
         if split:  # the normal force alone: friction_flow applies the friction
-            n, pv, ep = normal_response(delta, pair_normal_rate(y[i, 3], y[i, 4], y[j, 3], y[j, 4], nx, nz),
-                                        c[COEF_A], c[COEF_C], cfg.clip)
+            n, pv, ep, wp = normal_law_response(delta, pair_normal_rate(y[i, 3], y[i, 4], y[j, 3], y[j, 4], nx, nz),
+                                                c, g.pair_hist[p, HIST_MAX], cfg.clip)
+            w_plastic += wp
             fx = -n * nx
             fz = -n * nz
             dy[i, 3] += fx
@@ -126,7 +138,10 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         ai = contact_arm(ri, delta, 0.5 * cfg.arm_shrink)
         aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
         ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
-        n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
+        n, pv, ep, wp = normal_law_response(delta, ddot, c, g.pair_hist[p, HIST_MAX], cfg.clip)
+        f = friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS])
+        pf = friction_power(f, vt)
+        w_plastic += wp
         rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + 1.0 / g.mass[j]
                                               + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]))
         fx = -n * nx + f * nz  # on i: -n nvec - f tvec, tvec = (-nz, nx); on j the opposite
@@ -146,6 +161,8 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         nx = g.wall_geo[w, 0]
         nz = g.wall_geo[w, 1]
         delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, g.wall_geo[w, 2])
+        if record:
+            g.wall_hist[w, HIST_END] = max(delta, 0.0)
         if delta <= 0.0:
             continue
         if delta > ovl * ri:
@@ -154,7 +171,9 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             ovl_j = -1 - g.wall_w[w]
         c = g.wall_coef[w]
         if split:  # the normal force alone: friction_flow applies the friction
-            n, pv, ep = normal_response(delta, y[i, 3] * nx + y[i, 4] * nz, c[COEF_A], c[COEF_C], cfg.clip)
+            n, pv, ep, wp = normal_law_response(delta, y[i, 3] * nx + y[i, 4] * nz, c, g.wall_hist[w, HIST_MAX],
+                                                cfg.clip)
+            w_plastic += wp
             dy[i, 3] += -n * nx
             dy[i, 4] += -n * nz
             p_visc += pv
@@ -162,7 +181,10 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             continue
         ai = contact_arm(ri, delta, cfg.arm_shrink)
         ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
-        n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
+        n, pv, ep, wp = normal_law_response(delta, ddot, c, g.wall_hist[w, HIST_MAX], cfg.clip)
+        f = friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS])
+        pf = friction_power(f, vt)
+        w_plastic += wp
         rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i]))
         dy[i, 3] += -n * nx + f * nz
         dy[i, 4] += -n * nz - f * nx
@@ -176,6 +198,8 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         delta = plate_overlap(y[i, 0], ri, g.pc_x[k] + up[2 * k])
         ai = contact_arm(ri, max(delta, 0.0), cfg.arm_shrink)
         ddot, vt = plate_rates(y[i, 3], y[i, 4], y[i, 5], ai, vp[2 * k], vp[2 * k + 1])
+        if record:
+            g.pc_hist[k, HIST_END] = max(delta, 0.0)
         n = 0.0
         f = 0.0
         pf = 0.0
@@ -185,7 +209,10 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
                 ovl_i = i
                 ovl_j = PARTNER_PLATE
             c = g.pc_coef[k]
-            n, f, pv, pf, ep = contact_response(delta, ddot, vt, c[COEF_A], c[COEF_C], c[COEF_MU], c[COEF_KS], cfg.clip)
+            n, pv, ep, wp = normal_law_response(delta, ddot, c, g.pc_hist[k, HIST_MAX], cfg.clip)
+            f = friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS])
+            pf = friction_power(f, vt)
+            w_plastic += wp
             if not hold:  # the granule side only: the plate side of this map is criterion (8)
                 rate_plate = max(rate_plate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS],
                                                                   1.0 / g.mass[i] + ai * ai / g.inertia[i]))
@@ -207,7 +234,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         dy[i, 3] /= g.mass[i]
         dy[i, 4] /= g.mass[i]
         dy[i, 5] /= g.inertia[i]
-    return ForceSums(p_shock, p_visc, p_fric, e_pot, rate, ovl, ovl_i, ovl_j, rate_plate)
+    return ForceSums(p_shock, p_visc, p_fric, e_pot, rate, ovl, ovl_i, ovl_j, rate_plate, w_plastic)
 
 
 @njit(cache=True)
@@ -249,7 +276,7 @@ def friction_flow(y, dt, g, cfg, forward):
             ai = contact_arm(ri, delta, 0.5 * cfg.arm_shrink)
             aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
             ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
-            n, _ = normal_force(delta, ddot, c[COEF_A], c[COEF_C], cfg.clip)
+            n = normal_law_force(delta, ddot, c, g.pair_hist[q, HIST_MAX], cfg.clip)
             inv_mi = 1.0 / g.mass[i]
             inv_mj = 1.0 / g.mass[j]
             inv_ii = ai / g.inertia[i]  # the spin change per unit impulse
@@ -274,7 +301,7 @@ def friction_flow(y, dt, g, cfg, forward):
                 continue
             ai = contact_arm(ri, delta, cfg.arm_shrink)
             ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
-            n, _ = normal_force(delta, ddot, c[COEF_A], c[COEF_C], cfg.clip)
+            n = normal_law_force(delta, ddot, c, g.wall_hist[w, HIST_MAX], cfg.clip)
             inv_m = 1.0 / g.mass[i]
             inv_i = ai / g.inertia[i]
             imp, dw = friction_impulse(vt, n, c[COEF_MU], c[COEF_KS], inv_m + ai * inv_i, dt)
@@ -293,6 +320,7 @@ def no_granules_step(h, p1, dacc, pend, ovl_new, ovl_who):
     for c in range(3):
         dacc[c] = h6 * (p1[c] + 2.0 * 0.0 + 2.0 * 0.0 + 0.0)
         pend[c] = 0.0
+    dacc[3] = 0.0
     ovl_new[0] = 0.0
     ovl_who[0] = -1
     ovl_who[1] = -1
@@ -311,7 +339,8 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     friction held at w.fbar over the step) or the split (the friction half step moves
     the velocities) changes it. Writes w.ynew, w.kend (without the split friction), w.fnew
     (forces on the plate at t + h), w.normal_new, w.slip_new, w.pend (powers at t + h) and
-    w.dacc (shock, viscous, friction work over the step), w.ovl_new and w.ovl_who (the
+    w.dacc (shock, viscous, friction work over the step, and the plastic work past the
+    contacts' largest overlaps, whose end overlaps go into their histories' HIST_END), w.ovl_new and w.ovl_who (the
     largest relative overlap at t + h and its contact). Returns (stored contact energy at
     t + h [J], largest slip relaxation rate at t + h of a contact whose friction RK4
     integrates [1/s]: with cfg.split_friction the plate contacts unless hold, 0 with hold;
@@ -366,7 +395,8 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
         fric_split += friction_flow(w.ynew, hh, g, cfg, False)
         w.dacc[2] += fric_split
     pe = granular_rhs(t + h, w.ynew, stage[2], stage[3], g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar,
-                      split)
+                      split, True)
+    w.dacc[3] = pe.w_plastic
     w.pend[0] = pe.p_shock
     w.pend[1] = pe.p_visc
     w.pend[2] = pe.p_fric
@@ -376,6 +406,25 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     if not cfg.split_friction:
         return pe.e_pot, max(pe.rate, pe.rate_plate)
     return pe.e_pot, 0.0 if hold else pe.rate_plate  # a held plate-contact friction is not RK4's
+
+
+@njit(cache=True)
+def commit_history(t, hist):
+    """Take the accepted step's end overlaps (column HIST_END) into the contacts' largest
+    overlaps (HIST_MAX, reached at time t [s]: HIST_TIME) of one history array."""
+    for k in range(hist.shape[0]):
+        d = hist[k, HIST_END]
+        if d > hist[k, HIST_MAX]:
+            hist[k, HIST_MAX] = d
+            hist[k, HIST_TIME] = t
+
+
+@njit(cache=True)
+def commit_histories(t, g):
+    """`commit_history` of every contact kind of g (pairs, walls, plate contacts)."""
+    commit_history(t, g.pair_hist)
+    commit_history(t, g.wall_hist)
+    commit_history(t, g.pc_hist)
 
 
 @njit(cache=True)

@@ -14,13 +14,13 @@ from numba import njit
 from granplate.physics.energy import energy_residual, energy_total
 from granplate.solver import schemes as S
 from granplate.solver.contacts import watch_contacts
-from granplate.solver.granular import RK4_FRICTION_LIMIT, granular_rhs, kinetic_energies
+from granplate.solver.granular import RK4_FRICTION_LIMIT, commit_histories, granular_rhs, kinetic_energies
 from granplate.solver.interface import accept_contacts, contact_modulus, first_guess, move_patches, place_patch
 from granplate.solver.ladder import level_step
 from granplate.solver.plate_modal import driving_dofs, modal_acceleration, plate_energy, step_matrices
 from granplate.solver.state import (
-    A_FRIC, A_SHOCK_G, A_SHOCK_P, A_VISC, C_FRICTION_BOUND, C_ITERS, C_LEVEL, C_OUT, C_RETRIES, C_STEPS, CUSTOM_H,
-    D_FRIC, D_VISC, E_GRAN, E_IN_MAX, E_PLATE, E_POT, E_POTG, E_SHOCK, E_ZERO, ERR_BUFFER,
+    A_FRIC, A_PLASTIC, A_SHOCK_G, A_SHOCK_P, A_VISC, C_FRICTION_BOUND, C_ITERS, C_LEVEL, C_OUT, C_RETRIES, C_STEPS, CUSTOM_H,
+    D_FRIC, D_PLASTIC, D_VISC, E_GRAN, E_IN_MAX, E_PLATE, E_POT, E_POTG, E_SHOCK, E_ZERO, ERR_BUFFER,
     ERR_CONTACT, ERR_ENERGY, ERR_H, ERR_ITER, ERR_LAM, ERR_N, ERR_NAN, ERR_NOCONV, ERR_RESID,
     ERR_T, ERR_VT, H_LAST, KE_ROT, KE_X, KE_Y, N_LEVELS, OK, PAUSED, RES_LAST, RESID, RESID_MAX,
     S_DT_MAX, S_DT_MIN, S_ITERS, S_LAM_MAX, S_RETRIES, S_STEPS, T_NOW,
@@ -30,9 +30,12 @@ from granplate.solver.state import (
 @njit(cache=True)
 def initialise(st, g, p, cfg, w):
     """Forces, accelerations and energies at t = 0 (state y, q, qd already set); the
-    granules' derivative as every step's end one (without the split-off friction)."""
+    granules' derivative as every step's end one (without the split-off friction); the
+    contacts' histories start at their overlaps at t = 0 (a contact that starts beyond
+    its yield overlap starts loaded there: no plastic work is booked for it)."""
     pr = granular_rhs(st.clock[T_NOW], st.y, st.u, st.v, g, cfg, st.k1, st.force, st.normal, st.slip, False, w.fbar,
-                      cfg.split_friction)
+                      cfg.split_friction, True)
+    commit_histories(st.clock[T_NOW], g)
     st.p1[0] = pr.p_shock
     st.p1[1] = pr.p_visc
     st.p1[2] = pr.p_fric
@@ -88,10 +91,11 @@ def record(o, st, g, p, w, out):
     e[E_PLATE] = ep
     e[D_VISC] = st.acc[A_VISC]
     e[D_FRIC] = st.acc[A_FRIC]
+    e[D_PLASTIC] = st.acc[A_PLASTIC]
     e[KE_X] = kx
     e[KE_Y] = ky
     e[KE_ROT] = kr
-    e[RESID] = energy_residual(energy_total(eg, ep, st.acc[A_VISC], st.acc[A_FRIC]), e_in, denom)
+    e[RESID] = energy_residual(energy_total(eg, ep, st.acc[A_VISC], st.acc[A_FRIC], st.acc[A_PLASTIC]), e_in, denom)
     e[RESID_MAX] = w.res_int[0]
     e[E_POTG] = st.clock[E_POT]
     for m in range(st.q.shape[0]):
@@ -147,7 +151,7 @@ def check_energy(h, y, q, qd, force, clock, acc, mass, inertia, omega2, resid, e
     e_in = clock[E_ZERO] + eshock
     if e_in > clock[E_IN_MAX]:
         clock[E_IN_MAX] = e_in
-    total = energy_total(eg, ep, acc[A_VISC], acc[A_FRIC])
+    total = energy_total(eg, ep, acc[A_VISC], acc[A_FRIC], acc[A_PLASTIC])
     if not (math.isfinite(total) and math.isfinite(e_in)):
         return fail(ERR_NAN, err, clock[T_NOW], h, -1.0, 0.0, 0.0, 0.0, 0.0, 0)
     denom = clock[E_IN_MAX]
@@ -183,8 +187,9 @@ def needs_matrices(h, slot, clock, g_ok):
 
 @njit(cache=True)
 def accept_granular(t, h, land, t_out, plate_work, e_pot, st, w):
-    """Take the trial step's granule state, derivatives and work into the state and
-    move the clock (onto the output time when the step lands on it)."""
+    """Take the trial step's granule state, derivatives and work (with the plastic work of
+    the contacts loaded past their largest overlaps) into the state and move the clock
+    (onto the output time when the step lands on it)."""
     for i in range(st.y.shape[0]):
         for c in range(6):
             st.y[i, c] = w.ynew[i, c]
@@ -195,6 +200,7 @@ def accept_granular(t, h, land, t_out, plate_work, e_pot, st, w):
     st.acc[A_SHOCK_G] += w.dacc[0]
     st.acc[A_VISC] += w.dacc[1]
     st.acc[A_FRIC] += w.dacc[2]
+    st.acc[A_PLASTIC] += w.dacc[3]
     st.acc[A_SHOCK_P] += plate_work
     st.clock[E_POT] = e_pot
     st.clock[T_NOW] = t_out if land else t + h
@@ -243,6 +249,7 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
             continue
         plate_work = S.commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w)
         accept_granular(t, h, land, out.target[o], plate_work, e_pot, st, w)
+        commit_histories(st.clock[T_NOW], g)
         lam_max = accept_contacts(h, w.gmat[slot], g.pc_coef, w.normal_new, w.slip_new, w.conv_iter,
                                   st.normal, st.slip, w.lam_int, w.it_int)
         new_level, h_new = S.next_level(sw, h, slot, level, err, lam_max, rate, st.clock[T_NOW], cfg)

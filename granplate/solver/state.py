@@ -16,14 +16,15 @@ C_STEPS, C_LEVEL, C_OUT, C_ITERS, C_RETRIES = 0, 1, 2, 3, 4
 # (solver.granular_friction = "rk4" only; the driver then suggests "split")
 C_FRICTION_BOUND = 5
 N_COUNT = 8
-# acc (float64): integrated powers
-A_SHOCK_G, A_VISC, A_FRIC, A_SHOCK_P = 0, 1, 2, 3
-N_ACC = 4
+# acc (float64): integrated powers, and the plastic work (docs/model.md eq. P10) booked
+# as each contact loaded past its largest overlap
+A_SHOCK_G, A_VISC, A_FRIC, A_SHOCK_P, A_PLASTIC = 0, 1, 2, 3, 4
+N_ACC = 5
 # energy output columns
 (
-    E_SHOCK, E_GRAN, E_PLATE, D_VISC, D_FRIC, KE_X, KE_Y, KE_ROT, RESID, RESID_MAX, E_POTG,
-) = range(11)
-N_ENERGY = 11
+    E_SHOCK, E_GRAN, E_PLATE, D_VISC, D_FRIC, KE_X, KE_Y, KE_ROT, RESID, RESID_MAX, E_POTG, D_PLASTIC,
+) = range(12)
+N_ENERGY = 12
 # step-statistics output columns
 S_STEPS, S_DT_MIN, S_DT_MAX, S_ITERS, S_RETRIES, S_LAM_MAX = range(6)
 N_STEPSTAT = 6
@@ -92,7 +93,7 @@ class Work(NamedTuple):
     fnew: np.ndarray  # (nd,) interface forces at the end of the trial step
     fscratch: np.ndarray
     pend: np.ndarray  # (3,) shock, viscous, friction power at the end
-    dacc: np.ndarray  # (3,) their integrals over the step
+    dacc: np.ndarray  # (4,) their integrals over the step, and the plastic work past the largest overlaps
     p1h: np.ndarray  # (3,) stage-1 powers when the plate friction is held
     normal_new: np.ndarray  # (nk,) |N| and slip rate at the end of the trial step
     slip_new: np.ndarray
@@ -153,7 +154,7 @@ def new_work(ng: int, nm: int, nk: int, n_face: int = 0) -> Work:
     return Work(
         ytmp=z((ng, 6)), ynew=z((ng, 6)), k1h=z((ng, 6)), k2=z((ng, 6)), k3=z((ng, 6)),
         k4=z((ng, 6)), kend=z((ng, 6)), up=z(nd), vp=z(nd), fguess=z(nd), fbar=z(nk),
-        stage=z((4, nd)), fnew=z(nd), fscratch=z(nd), pend=z(3), dacc=z(3), p1h=z(3),
+        stage=z((4, nd)), fnew=z(nd), fscratch=z(nd), pend=z(3), dacc=z(4), p1h=z(3),
         normal_new=z(nk), slip_new=z(nk), nscratch=z(nk), sscratch=z(nk),
         conv_iter=np.zeros(nk, np.int64), dmode=z((N_LEVELS + 1, nm)),
         gmat=z((N_LEVELS + 1, nd, nd)), g_ok=np.zeros(N_LEVELS + 1, np.int64),

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 #: Summary entries that are not metrics of the design.
-NOT_METRICS: tuple[str, ...] = ("scenario", "units")
+NOT_METRICS: tuple[str, ...] = ("scenario", "units", "contact_pairs")
 #: Status of a design without a record (not computed yet, or lost with its worker).
 NOT_RUN = "not run"
 #: Units of scenario fields by their last dotted-path step (the others have none in attrs).

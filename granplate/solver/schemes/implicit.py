@@ -33,7 +33,7 @@ from granplate.solver.plate_modal import (
 )
 from granplate.solver.schemes.newton import held_friction, newton_update
 from granplate.solver.state import (
-    A_FRIC, A_SHOCK_G, A_SHOCK_P, A_VISC, C_LEVEL, E_IN_MAX, E_ZERO, F_SCALE, H_LAST, N_LEVELS,
+    A_FRIC, A_PLASTIC, A_SHOCK_G, A_SHOCK_P, A_VISC, C_LEVEL, E_IN_MAX, E_ZERO, F_SCALE, H_LAST, N_LEVELS,
     RES_LAST,
 )
 
@@ -194,7 +194,7 @@ def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
     kx, ky, kr = kinetic_energies(w.ynew, g.mass, g.inertia)
     e_in = st.clock[E_ZERO] + st.acc[A_SHOCK_G] + w.dacc[0] + st.acc[A_SHOCK_P] + work
     total = (kx + ky + kr + e_pot + ep_new + st.acc[A_VISC] + w.dacc[1]
-             + st.acc[A_FRIC] + w.dacc[2] + fric_work)
+             + st.acc[A_FRIC] + w.dacc[2] + fric_work + st.acc[A_PLASTIC] + w.dacc[3])
     denom = max(st.clock[E_IN_MAX], e_in)
     d_res = 0.0
     if denom > 0.0 and math.isfinite(total):

@@ -16,9 +16,9 @@ import math
 
 from numba import njit
 
-from granplate.physics.contact import (
-    COEF_A, COEF_C, COEF_KS, COEF_MU, friction_magnitude, normal_force_slopes, plate_overlap,
-)
+from granplate.model.inputs import HIST_MAX
+from granplate.physics.contact import COEF_KS, COEF_MU, friction_magnitude, plate_overlap
+from granplate.physics.laws import normal_law_slopes
 
 
 @njit(cache=True)
@@ -35,7 +35,8 @@ def held_friction(normal, fguess, vguess, g, fbar):
 def law_jacobian(h, mmat, u_end, g, w, jac, rhs, vguess):
     """Residuals (rhs) and their derivatives with respect to the interface forces U
     (jac), row by row from the contact laws: dN_k/dU_e = dN/d(delta) d(delta)/dU_e +
-    dN/d(rate) d(rate)/dU_e (eq. 2) and dv_k/dU_e (eq. 6). u_end: driving-DOF
+    dN/d(rate) d(rate)/dU_e (eq. 2, or the elastic-plastic law's slope, physics.laws) and
+    dv_k/dU_e (eq. 6). u_end: driving-DOF
     displacement at t + h; w: the trial step's end values (ynew, fnew, slip_new)."""
     nd = jac.shape[0]
     for k in range(g.pc_i.shape[0]):
@@ -49,7 +50,7 @@ def law_jacobian(h, mmat, u_end, g, w, jac, rhs, vguess):
         n_d = 0.0  # dN/d(delta)
         n_v = 0.0  # dN/d(delta rate)
         if delta > 0.0 and w.normal_new[k] > 0.0:
-            n_d, n_v = normal_force_slopes(delta, c[COEF_A], c[COEF_C])
+            n_d, n_v = normal_law_slopes(delta, c, g.pc_hist[k, HIST_MAX])
         inv_m = 1.0 / g.mass[i]
         inv_t = inv_m + g.radius[i] * g.radius[i] / g.inertia[i]
         for e in range(nd):

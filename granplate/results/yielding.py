@@ -1,0 +1,96 @@
+"""How close a run's contacts came to yield (docs/model.md section 3.6): the largest
+Hertz peak pressure p0 (eq. P2) of every contact, from its largest overlap, and its ratio
+to the yield onset 1.6 Y of the softer body (eq. P1), gathered by material pair.
+
+A pair is labelled by its two materials, sorted ("ptfe-steel"), or by the granule's
+material and "wall" / "plate" for the rigid bodies, which enter the contact law with the
+granule's modulus and radius alone (E_k, R_k -> infinity, eq. 3) and so never yield: the
+granule does. The ratio is NaN where a Y it needs is unknown (summary: null).
+"""
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from granplate.physics.plastic import hertz_peak_pressure, limiting_pressure
+from granplate.setup.materials import effective_modulus, softer_yield_strength
+from granplate.solver.state import PARTNER_PLATE
+
+
+class PairYield(NamedTuple):
+    """The largest Hertz peak pressure of each material pair and where it was reached."""
+
+    pair: tuple[str, ...]  # material-pair labels, sorted
+    pressure: np.ndarray  # [Pa] the largest Hertz peak pressure p0 (eq. P2) at a contact of the pair
+    ratio: np.ndarray  # [-] p0 / (1.6 Y) of the softer body (eq. P1); NaN where Y is unknown
+    yield_strength: np.ndarray  # [Pa] Y of the softer body; NaN where unknown
+    time: np.ndarray  # [s] when that contact reached its largest overlap
+    contact: tuple[str, ...]  # the contact: "c1r1-c2r1", "c1r1-wall 0", "c3r1-plate"
+    law: tuple[str, ...]  # the pair's normal law ("hertz", "thornton")
+
+
+def _law(s, a: str, b: str) -> str:
+    return s.contact.law_for_pair(a, b) if hasattr(s.contact, "law_for_pair") else "hertz"
+
+
+def contact_yield(model, peaks) -> list[tuple[str, float, float, float, float, str, str]]:
+    """One (pair label, p0 [Pa], ratio [-], Y [Pa], time [s], contact label, law) per contact
+    of `peaks` (solver.driver.ContactPeaks)."""
+    s, mats, r, labels = model.scenario, model.materials, model.granular.radius, model.labels
+    rows = []
+    for i, j, d, t in zip(peaks.granule, peaks.partner, peaks.delta_max, peaks.time):
+        a = mats[i]
+        if j >= 0:
+            b = mats[j]
+            e_star, r_star = effective_modulus(a, b), r[i] * r[j] / (r[i] + r[j])
+            pair, who, law = "-".join(sorted((a.name, b.name))), f"{labels[i]}-{labels[j]}", _law(s, a.name, b.name)
+        else:
+            e_star, r_star = effective_modulus(a, None), r[i]
+            if j == PARTNER_PLATE:
+                pair, who, law = f"{a.name}-plate", f"{labels[i]}-plate", _law(s, a.name, s.plate.material)
+            else:
+                w = -1 - j
+                pair, who, law = f"{a.name}-wall", f"{labels[i]}-wall {w}", _law(s, a.name, s.walls[w].material)
+        y = softer_yield_strength(a, b if j >= 0 else None)
+        p0 = hertz_peak_pressure(e_star, r_star, float(d))
+        ratio = p0 / limiting_pressure(y) if y is not None else math.nan
+        rows.append((pair, p0, ratio, math.nan if y is None else float(y), float(t), who, law))
+    return rows
+
+
+def pair_yield(model, peaks) -> PairYield:
+    """The largest p0 of each material pair of the run (`contact_yield`), sorted by pair."""
+    best: dict[str, tuple] = {}
+    for row in contact_yield(model, peaks):
+        if row[0] not in best or row[1] > best[row[0]][1]:
+            best[row[0]] = row
+    rows = [best[k] for k in sorted(best)]
+    col = list(zip(*rows)) if rows else [()] * 7
+    return PairYield(pair=tuple(col[0]), pressure=np.array(col[1], float), ratio=np.array(col[2], float),
+                     yield_strength=np.array(col[3], float), time=np.array(col[4], float),
+                     contact=tuple(col[5]), law=tuple(col[6]))
+
+
+def largest(py: PairYield) -> tuple[float, float]:
+    """(max_contact_pressure [Pa], yield_onset_ratio [-]) over the pairs: the largest p0
+    (0 without contacts) and the largest ratio over the pairs whose Y is known (NaN: none)."""
+    p = float(py.pressure.max()) if len(py.pressure) else 0.0
+    known = py.ratio[np.isfinite(py.ratio)]
+    return p, float(known.max()) if len(known) else math.nan
+
+
+def yield_warning(name: str, py: PairYield) -> str | None:
+    """One line for the elastic (Hertz) pair whose contacts went furthest past the onset of
+    yield (ratio > 1), naming the pair, the contact, the time, the ratio and the plastic law;
+    None when no elastic contact passed it."""
+    over = [k for k in range(len(py.pair)) if py.law[k] == "hertz" and py.ratio[k] > 1.0]
+    if not over:
+        return None
+    k = max(over, key=lambda q: py.ratio[q])
+    more = f" ({len(over) - 1} other pair(s) too)" if len(over) > 1 else ""
+    return (f"{name}: Hertz contacts passed the onset of yield: pair {py.pair[k]}, contact {py.contact[k]} at "
+            f"t = {py.time[k]:.4g} s, p0 = {py.pressure[k] / 1e6:.4g} MPa = {py.ratio[k]:.3g} x 1.6 Y "
+            f"(Y = {py.yield_strength[k] / 1e6:.4g} MPa){more}. The elastic law no longer holds there; "
+            f"contact.normal_law = \"thornton\" follows contacts that yield (docs/model.md section 3.6).")
