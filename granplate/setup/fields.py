@@ -1,6 +1,7 @@
 """Checks of single scenario fields: each raises ScenarioError(field, value, allowed)."""
 from __future__ import annotations
 
+import difflib
 import math
 import numbers
 from typing import Any
@@ -36,9 +37,18 @@ def int_at_least(path: str, v: Any, lo: int) -> None:
         raise ScenarioError(path, v, f"must be an integer >= {lo}")
 
 
+def closest_name(name: str, allowed: list[str]) -> str | None:
+    """The allowed name closest to a misspelled `name` (difflib's ratio >= 0.6), or None."""
+    close = difflib.get_close_matches(str(name), allowed, n=1)
+    return close[0] if close else None
+
+
 def string_in(path: str, v: Any, allowed: tuple[str, ...]) -> None:
+    """v is one of `allowed`; a misspelled string is refused with the closest one suggested."""
     if not isinstance(v, str) or v not in allowed:
-        raise ScenarioError(path, v, "must be one of " + ", ".join(repr(a) for a in allowed))
+        near = closest_name(v, list(allowed)) if isinstance(v, str) else None
+        hint = "" if near is None else f" (did you mean {near!r}?)"
+        raise ScenarioError(path, v, "must be one of " + ", ".join(repr(a) for a in allowed) + hint)
 
 
 def material_exists(path: str, name: Any, s: Scenario) -> None:

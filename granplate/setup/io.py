@@ -14,7 +14,6 @@ Every error is a `ScenarioError` naming the field by its dotted path (`plate.nx`
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import numbers
 import os
 import re
@@ -26,9 +25,10 @@ from typing import Any
 import tomli_w
 
 from granplate.errors import ScenarioError
+from granplate.setup.fields import closest_name, string_in
 from granplate.setup.materials import LIBRARY, Material
-from granplate.setup.scenario import (LAYOUT_KINDS, Contact, Granule, Load, PairCoefficients,
-                                      Plate, Scenario, Solver, TimeSettings, Wall)
+from granplate.setup.scenario import (LAYOUT_KINDS, NORMAL_LAWS, Contact, Granule, Load,
+                                      PairCoefficients, Plate, Scenario, Solver, TimeSettings, Wall)
 
 #: Fields that a table must give (everything else takes the dataclass default).
 REQUIRED: dict[type, tuple[str, ...]] = {
@@ -39,6 +39,15 @@ REQUIRED: dict[type, tuple[str, ...]] = {
 #: Keys of a [materials.NAME] table: E, nu, rho required; Y optional (absent: unknown).
 MATERIAL_KEYS: tuple[str, ...] = ("E", "nu", "rho", "Y")
 MATERIAL_REQUIRED: tuple[str, ...] = ("E", "nu", "rho")
+#: String fields whose value a file must take from a fixed list, checked on reading (a
+#: misspelled one is refused with the closest allowed value suggested).
+CHOICES: dict[tuple[type, str], tuple[str, ...]] = {
+    (Contact, "normal_law"): NORMAL_LAWS,
+    (PairCoefficients, "normal_law"): NORMAL_LAWS,
+}
+#: Fields left out of a written table when they hold this default (written, they would
+#: change the text, and so the stored results' keys, of every scenario written before).
+UNWRITTEN_DEFAULTS: dict[str, dict[str, Any]] = {"contact": {"normal_law": "hertz"}}
 
 
 class _Missing:
@@ -122,12 +131,6 @@ def _convert(path: str, value: Any, tp: Any) -> Any:
     raise TypeError(f"unsupported annotation {tp!r}")  # pragma: no cover
 
 
-def closest_name(name: str, allowed: list[str]) -> str | None:
-    """The allowed name closest to a misspelled `name` (difflib's ratio >= 0.6), or None."""
-    close = difflib.get_close_matches(str(name), allowed, n=1)
-    return close[0] if close else None
-
-
 def _check_keys(path: str, d: Any, allowed: list[str]) -> None:
     """Refuse a key of table `d` (at `path`) that is not in `allowed`, suggesting the closest."""
     if not isinstance(d, dict):
@@ -154,6 +157,8 @@ def _table(path: str, d: Any, cls: type) -> Any:
                 raise ScenarioError(fpath, MISSING, f"missing required field '{fpath}'")
             continue
         kwargs[name] = _convert(fpath, d[name], hints[name])
+        if (cls, name) in CHOICES:
+            string_in(fpath, kwargs[name], CHOICES[cls, name])
     return cls(**kwargs)
 
 
@@ -283,7 +288,8 @@ def to_dict(s: Scenario, all_materials: bool = False) -> dict:
     Materials written: every one the scenario uses, plus every one that is absent from or
     differs from `materials.LIBRARY` (all of them with `all_materials=True`), so that
     `from_dict(to_dict(s)) == s` whenever `s.materials` holds the library's names.
-    Empty top-level granules/walls are left out (their default).
+    Empty top-level granules/walls are left out (their default), and so are the fields of
+    `UNWRITTEN_DEFAULTS` that hold their default (`contact.normal_law = "hertz"`).
     """
     d: dict[str, Any] = {"name": s.name, "description": s.description}
     used = _used_materials(s)
@@ -301,6 +307,9 @@ def to_dict(s: Scenario, all_materials: bool = False) -> dict:
         d["plate"] = _plain(s.plate)
     for key in ("load", "contact", "time", "solver"):
         d[key] = _plain(getattr(s, key))
+        for name, default in UNWRITTEN_DEFAULTS.get(key, {}).items():
+            if d[key].get(name) == default:
+                del d[key][name]
     return d
 
 
@@ -493,4 +502,4 @@ def with_changes(s: Scenario, changes: dict[str, object]) -> Scenario:
 
 
 __all__ = ["from_dict", "to_dict", "loads", "load", "dumps", "dump", "load_scenario",
-           "with_changes", "describe_changes", "CHANGED", "UNLISTED", "REQUIRED", "MATERIAL_KEYS", "MATERIAL_REQUIRED", "MISSING"]
+           "with_changes", "describe_changes", "CHANGED", "UNLISTED", "REQUIRED", "CHOICES", "MATERIAL_KEYS", "MATERIAL_REQUIRED", "MISSING"]

@@ -228,14 +228,31 @@ class Load:
     granules: tuple[str, ...] = ()
 
 
+#: Normal contact laws (`Contact.normal_law`, `PairCoefficients.normal_law`): "hertz",
+#: eq. (2)'s elastic law with eq. (3)'s damping; "thornton", Thornton's (1997)
+#: elastic-perfectly plastic law (docs/model.md section 3.6), which needs the yield
+#: strength Y of every body that can yield at the contact.
+NORMAL_LAWS: tuple[str, ...] = ("hertz", "thornton")
+
+
 @dataclass(frozen=True)
 class PairCoefficients:
-    """Contact coefficients for one material pair (order-free), overriding the defaults."""
+    """Contact coefficients for one material pair (order-free), overriding the defaults.
+
+    alpha_n [-], mu [-], k_s [s/m], normal_law (one of NORMAL_LAWS): None keeps the
+    `Contact` value.
+    """
 
     materials: tuple[str, str]
     alpha_n: float | None = None
     mu: float | None = None
     k_s: float | None = None
+    normal_law: str | None = None
+
+    def matches(self, a: str, b: str) -> bool:
+        """Whether this entry is the pair of materials a and b (in either order); a pair
+        of one material matches only an entry that names it twice."""
+        return {a, b} == set(self.materials) and (a != b or self.materials[0] == self.materials[1])
 
 
 @dataclass(frozen=True)
@@ -254,7 +271,11 @@ class Contact:
     the initial gap, as a fraction of the smaller radius, of the fixed pairs and of the
     plate contacts (fixed in both modes); overlap_warn, overlap_stop [-]: an overlap beyond
     this fraction of the smaller radius warns (Hertz assumes small overlaps) or stops the
-    run; torque_arm: lever arm of the friction torque,
+    run; normal_law: the normal force law of pairs not listed in `pairs` (one of
+    NORMAL_LAWS: "hertz", eq. 2, or "thornton", elastic-perfectly plastic, docs/model.md
+    section 3.6; walls and the plate are rigid bodies to it, so a granule-wall or
+    granule-plate contact takes the law of the granule's material with the wall's or the
+    plate's, `law_for_pair`); torque_arm: lever arm of the friction torque,
     "radius" (R_i, paper eq. 1, docs/model.md section 3.2) or "contact_point" (R_i - delta/2 for a
     pair, R_i - delta at a wall or plate: the true contact point, which conserves the
     angular momentum of a free assembly; with "radius" each sliding pair adds a couple
@@ -274,16 +295,34 @@ class Contact:
     skin: float = 0.1
     overlap_warn: float = 0.05
     overlap_stop: float = 0.2
+    normal_law: str = "hertz"
 
     def for_pair(self, a: str, b: str) -> tuple[float, float, float]:
         """(alpha_n, mu, k_s) for materials a and b."""
         alpha, mu, ks = self.alpha_n, self.mu, self.k_s
         for p in self.pairs:
-            if {a, b} == set(p.materials) and (a != b or p.materials[0] == p.materials[1]):
+            if p.matches(a, b):
                 alpha = alpha if p.alpha_n is None else p.alpha_n
                 mu = mu if p.mu is None else p.mu
                 ks = ks if p.k_s is None else p.k_s
         return alpha, mu, ks
+
+    def law_index(self, a: str, b: str) -> int | None:
+        """Index in `pairs` of the entry that sets the normal law of materials a and b (the
+        last matching one with a normal_law, as `for_pair` lets later entries win), or
+        None when the contact default `normal_law` applies."""
+        found = None
+        for k, p in enumerate(self.pairs):
+            if p.normal_law is not None and p.matches(a, b):
+                found = k
+        return found
+
+    def law_for_pair(self, a: str, b: str) -> str:
+        """The normal law (one of NORMAL_LAWS) for materials a and b: the pair's override,
+        else `normal_law`. At a granule-wall or granule-plate contact, b is the wall's or
+        the plate's material (a rigid body to the law: only the granule's Y matters)."""
+        k = self.law_index(a, b)
+        return self.normal_law if k is None else self.pairs[k].normal_law
 
 
 @dataclass(frozen=True)

@@ -16,6 +16,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
+from collections import Counter
 from typing import Any
 
 import numpy as np
@@ -28,12 +29,15 @@ from granplate.setup.fields import finite, int_at_least, is_number, material_exi
 from granplate.setup.plate_checks import check_plate_fields, check_plate_mesh
 from granplate.setup.plate_cost import MEMORY_SHARE, physical_memory
 from granplate.setup.materials import Material
-from granplate.setup.scenario import (LAYOUT_KINDS, SQRT2_MINUS_1, ChainLayout, Granule,
-                                      Imperfections, LatticeLayout, Layout, Scenario)
+from granplate.setup.scenario import (LAYOUT_KINDS, NORMAL_LAWS, SQRT2_MINUS_1, ChainLayout,
+                                      Granule, Imperfections, LatticeLayout, Layout, Scenario)
 
 #: Lever arms of the friction torque (Contact.torque_arm).
 TORQUE_ARMS: tuple[str, ...] = ("radius", "contact_point")
 DETECTIONS: tuple[str, ...] = ("dynamic", "fixed")
+#: Normal laws (of NORMAL_LAWS) that need the yield strength Y of every body that can
+#: yield at a contact (both granules; the granule alone against a wall or the plate).
+YIELDING_LAWS: tuple[str, ...] = ("thornton",)
 #: Coupling schemes the solver knows (Solver.scheme).
 SCHEMES: tuple[str, ...] = ("paper", "implicit")
 #: Treatments of the granule-granule and granule-wall friction (Solver.granular_friction).
@@ -485,6 +489,7 @@ def _check_contact(s: Scenario) -> None:
                             "must be at most 1 (a gap of at most the smaller radius, as contact.skin)")
     string_in("contact.torque_arm", c.torque_arm, TORQUE_ARMS)
     string_in("contact.detection", c.detection, DETECTIONS)
+    string_in("contact.normal_law", c.normal_law, NORMAL_LAWS)
     positive("contact.skin", c.skin)
     if c.skin > 1.0:
         raise ScenarioError("contact.skin", c.skin, "must be at most 1 (a fraction of R_i + R_j)")
@@ -507,6 +512,45 @@ def _check_contact(s: Scenario) -> None:
             material_exists(f"{p}.materials[{k}]", m, s)
         _damping(f"{p}.alpha_n", pc.alpha_n)
         _friction(p, pc.mu, pc.k_s)
+        if pc.normal_law is not None:
+            string_in(f"{p}.normal_law", pc.normal_law, NORMAL_LAWS)
+    _check_yield_strengths(s)
+
+
+def possible_contacts(s: Scenario) -> list[tuple[str, str, str]]:
+    """(kind, a, b) for every pair of materials that can touch in the resolved scenario `s`:
+    "granule-granule" for two materials of its granules (a with itself when two granules
+    share it), "granule-wall" for a granule's material a and a wall's material b,
+    "granule-plate" for a and the plate's material b; materials in the order the granules
+    and walls first name them."""
+    count = Counter(g.material for g in s.granules)
+    mats = list(count)
+    found = []
+    for i, a in enumerate(mats):
+        if count[a] > 1:
+            found.append(("granule-granule", a, a))
+        found += [("granule-granule", a, b) for b in mats[i + 1:]]
+    found += [("granule-wall", a, b) for a in mats for b in dict.fromkeys(w.material for w in s.walls)]
+    if s.plate is not None:
+        found += [("granule-plate", a, s.plate.material) for a in mats]
+    return found
+
+
+def _check_yield_strengths(s: Scenario) -> None:
+    """A yielding normal law (YIELDING_LAWS) at a contact that can occur has the yield
+    strength of each body there that can yield: both granules' materials, or the granule's
+    alone against a wall or the plate (rigid bodies to the law, which never yield)."""
+    c = s.contact
+    for kind, a, b in possible_contacts(s):
+        law = c.law_for_pair(a, b)
+        if law not in YIELDING_LAWS:
+            continue
+        for m in dict.fromkeys((a, b) if kind == "granule-granule" else (a,)):
+            if s.material(m).Y is None:
+                k = c.law_index(a, b)
+                path = "contact.normal_law" if k is None else f"contact.pairs[{k}].normal_law"
+                raise ScenarioError(path, law, f"needs the yield strength of material '{m}' "
+                                    f"({kind} contacts {a}-{b}): set materials.{m}.Y [Pa]")
 
 
 def _check_time(s: Scenario) -> None:
@@ -604,8 +648,8 @@ def validate(scenario: Scenario) -> None:
     Order: materials, layout (as `layout.*`, before it is expanded), then on the resolved
     scenario: granules (values, speeds, unique labels), walls (unit normals), plate, the
     range of every coordinate and size (`LENGTH_RANGE`), overlaps and penetrations at
-    t = 0, load, contact, plate mesh (rigid layers of the contacts on nodes, patch contacts
-    between nodes, n_modes), time, the
+    t = 0, load, contact (and the yield strengths its normal laws need), plate mesh (rigid
+    layers of the contacts on nodes, patch contacts between nodes, n_modes), time, the
     outputs' memory, solver. A scenario with neither granules (nor a layout) nor a plate
     is refused.
     """
