@@ -96,7 +96,7 @@ def coefficient_row(a: float, c: float, mu: float, k_s: float, delta_y: float = 
 def normal_law_of(s: Scenario, a: str, b: str) -> str:
     """The normal law (contact.normal_law, or its [[contact.pairs]] override) between
     materials a and b."""
-    return s.contact.law_for_pair(a, b) if hasattr(s.contact, "law_for_pair") else "hertz"
+    return s.contact.law_for_pair(a, b)
 
 
 def law_yield_overlap(s: Scenario, a, b, b_name: str, e_star: float, r_star: float) -> float:

@@ -14,6 +14,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from granplate.model.arrays import normal_law_of
 from granplate.physics.plastic import hertz_peak_pressure, limiting_pressure
 from granplate.setup.materials import effective_modulus, softer_yield_strength
 from granplate.solver.state import PARTNER_PLATE
@@ -31,10 +32,6 @@ class PairYield(NamedTuple):
     law: tuple[str, ...]  # the pair's normal law ("hertz", "thornton")
 
 
-def _law(s, a: str, b: str) -> str:
-    return s.contact.law_for_pair(a, b) if hasattr(s.contact, "law_for_pair") else "hertz"
-
-
 def contact_yield(model, peaks) -> list[tuple[str, float, float, float, float, str, str]]:
     """One (pair label, p0 [Pa], ratio [-], Y [Pa], time [s], contact label, law) per contact
     of `peaks` (solver.driver.ContactPeaks)."""
@@ -45,14 +42,14 @@ def contact_yield(model, peaks) -> list[tuple[str, float, float, float, float, s
         if j >= 0:
             b = mats[j]
             e_star, r_star = effective_modulus(a, b), r[i] * r[j] / (r[i] + r[j])
-            pair, who, law = "-".join(sorted((a.name, b.name))), f"{labels[i]}-{labels[j]}", _law(s, a.name, b.name)
+            pair, who, law = "-".join(sorted((a.name, b.name))), f"{labels[i]}-{labels[j]}", normal_law_of(s, a.name, b.name)
         else:
             e_star, r_star = effective_modulus(a, None), r[i]
             if j == PARTNER_PLATE:
-                pair, who, law = f"{a.name}-plate", f"{labels[i]}-plate", _law(s, a.name, s.plate.material)
+                pair, who, law = f"{a.name}-plate", f"{labels[i]}-plate", normal_law_of(s, a.name, s.plate.material)
             else:
                 w = -1 - j
-                pair, who, law = f"{a.name}-wall", f"{labels[i]}-wall {w}", _law(s, a.name, s.walls[w].material)
+                pair, who, law = f"{a.name}-wall", f"{labels[i]}-wall {w}", normal_law_of(s, a.name, s.walls[w].material)
         y = softer_yield_strength(a, b if j >= 0 else None)
         p0 = hertz_peak_pressure(e_star, r_star, float(d))
         ratio = p0 / limiting_pressure(y) if y is not None else math.nan
