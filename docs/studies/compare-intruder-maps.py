@@ -90,6 +90,7 @@ def facts(t: pd.DataFrame) -> list[str]:
     same = all((below[f"{m}_e"] == below[f"{m}_p"]).all()
                for m in ("ep_max_fraction", "max_von_mises", "dissipated_fraction", "n_steps"))
     below_names = sorted(below["layout.R2_ratio"].unique())
+    kept_peak = (passed["ep_max_fraction_p"] / passed["ep_max_fraction_e"] - 1.0).abs() < 1e-3
     out.append(f"**Yield in the elastic map.** {len(passed)} of its {len(t)} designs press some "
                f"contact past the yield onset p0 = 1.6 Y (`yield_onset_ratio` "
                f"{span(t['yield_onset_ratio_e'], ratio)}); the {len(below)} that do not "
@@ -97,7 +98,8 @@ def facts(t: pd.DataFrame) -> list[str]:
                f"{', '.join(f'{r:.2f}' for r in below_names)} at "
                f"{', '.join(f'{q * 1e-3:g}' for q in sorted(below['load.q0'].unique()))} kN/m) are "
                f"{'the same, to the last digit,' if same else 'not the same'} in the twin: Thornton's "
-               f"law is Hertz's below p_y.")
+               f"law is Hertz's below p_y. Of the {len(passed)} that yield, {int(kept_peak.sum())} keep their "
+               f"plate's peak share within 0.1%: they yield after that peak.")
     top = t[t["load.q0"] == loads[-1]]
     per_load = ", ".join(f"{span(t.loc[t['load.q0'] == q, 'plastic_fraction_p'])} at {q * 1e-3:g} kN/m"
                          for q in loads)
