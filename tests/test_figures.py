@@ -311,3 +311,21 @@ def test_show_result_draws_contacts_formed_during_the_run():
     assert gap.min() < 0 < gap[0]
     assert list(start.kinds).count("granule") == 0
     assert list(closest.kinds).count("granule") == 1
+
+
+def test_energies_of_a_yielding_impact_count_the_plastic_work():
+    """Two steel spheres meeting at 1 m/s under Thornton's law (well past their yield
+    velocity): the drawn dissipation is D_viscous + D_friction + D_plastic and the drawn
+    sum E_granular + D keeps the energy put in (eq. 11), to the run's residual."""
+    ds = gp.simulate(two_spheres(1.0, t_end=6e-5, out=2e-7, normal_law="thornton"), progress=False)
+    plastic = ds.D_plastic.values
+    assert run.has_plastic_work(ds) and plastic[-1] > 0.1 * float(ds.attrs["E_initial"])
+    e = run.fig_energies(ds)
+    np.testing.assert_array_equal(_lines(e, "energy:dissipated")[0].get_ydata(),
+                                  ds.D_viscous.values + ds.D_friction.values + plastic)
+    total = _lines(e, "energy:total")[0].get_ydata()
+    e_in = float(ds.attrs["E_initial"])
+    assert np.max(np.abs(total - e_in)) / e_in <= np.max(np.abs(ds.energy_residual.values)) + 1e-12
+    assert "D_{plastic}" in _lines(e, "energy:dissipated")[0].get_label()
+    # an elastic run keeps the label and curve without the plastic term
+    assert not run.has_plastic_work(gp.simulate(two_spheres(0.01, t_end=2e-6, out=2e-7), progress=False))

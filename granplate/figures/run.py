@@ -1,7 +1,8 @@
 """The generic figures of any result (`granplate plot RESULT`): one Figure per topic.
 
-- energies: E_shock, E_granular, E_plate, dissipation D_viscous + D_friction and their
-  sum in J; the same as fractions of the energy put in; the energy-balance residual;
+- energies: E_shock, E_granular, E_plate, dissipation D_viscous + D_friction (+ D_plastic
+  where contacts yielded) and their sum in J; the same as fractions of the energy put in;
+  the energy-balance residual;
 - contact-forces: normal and tangential force at each plate contact [N];
 - stress-strain: the plate's largest von Mises stress [MPa] and largest |eps_yy| [-];
 - granule-speeds: |v| of each granule [m/s] (beyond MAX_LABELLED granules: the
@@ -62,10 +63,17 @@ def reference_label(ds: xr.Dataset) -> str:
     return "E_shock + E_initial"
 
 
+def has_plastic_work(ds: xr.Dataset) -> bool:
+    """Whether contacts yielded in the run: D_plastic [J] (docs/output.md) present and not
+    zero throughout (a run under Hertz's law has none)."""
+    return "D_plastic" in ds and bool(np.any(ds["D_plastic"].values != 0.0))
+
+
 def energy_curves(ds: xr.Dataset) -> dict[str, tuple[str, np.ndarray]]:
     """key -> (legend label, energy [J] over time) of the energy figure: E_shock when the
     load does work, E_granular with granules, E_plate with a plate, the dissipation
-    D = D_viscous + D_friction, and the sum of those stored and dissipated."""
+    D = D_viscous + D_friction (+ D_plastic where contacts yielded: eq. 11's D), and the
+    sum of those stored and dissipated."""
     out = {}
     if float(np.abs(ds["E_shock"].values).max()) > 0:
         out["shock"] = ("$E_{shock}$, work of the load", ds["E_shock"].values)
@@ -77,7 +85,11 @@ def energy_curves(ds: xr.Dataset) -> dict[str, tuple[str, np.ndarray]]:
         out["plate"] = ("$E_{plate}$", ds["E_plate"].values)
         parts.append(("E_{plate}", ds["E_plate"].values))
     dissipated = ds["D_viscous"].values + ds["D_friction"].values
-    out["dissipated"] = ("$D = D_{viscous} + D_{friction}$", dissipated)
+    label = "$D = D_{viscous} + D_{friction}$"
+    if has_plastic_work(ds):
+        dissipated = dissipated + ds["D_plastic"].values
+        label = "$D = D_{viscous} + D_{friction} + D_{plastic}$"
+    out["dissipated"] = (label, dissipated)
     parts.append(("D", dissipated))
     out["total"] = ("$" + " + ".join(name for name, _ in parts) + "$", sum(v for _, v in parts))
     return out
