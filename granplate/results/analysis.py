@@ -68,13 +68,16 @@ def has_plate(ds: xr.Dataset) -> bool:
 def normalised_energies(ds: xr.Dataset) -> dict[str, np.ndarray]:
     """E_g, E_p, E_g + E_p and E_g + E_p + D over time, each / reference_energy [-].
 
-    D = D_viscous + D_friction (paper eqs. 9-11); "total" is 1 once the shock is over
-    when the energy balance holds.
+    D = D_viscous + D_friction (paper eqs. 9-11), + D_plastic where contacts yielded
+    (docs/model.md section 3.6); "total" is 1 once the shock is over when the energy
+    balance holds.
     """
     ref = reference_energy(ds)
     eg = np.asarray(ds["E_granular"].values, float)
     ep = np.asarray(ds["E_plate"].values, float)
     d = np.asarray(ds["D_viscous"].values, float) + np.asarray(ds["D_friction"].values, float)
+    if "D_plastic" in ds:
+        d = d + np.asarray(ds["D_plastic"].values, float)
     return {"granular": eg / ref, "plate": ep / ref, "sum": (eg + ep) / ref, "total": (eg + ep + d) / ref}
 
 
