@@ -44,9 +44,10 @@ def __getattr__(name: str):
 
 def all_cases() -> tuple:
     """Every registered case, in page order."""
-    from . import chain, conservation, coupled, dynamic, face_contacts, granular, lammps, plate_cases, plate_mesh
+    from . import (chain, conservation, coupled, dynamic, face_contacts, granular, lammps, plastic_cases, plate_cases,
+                   plate_mesh)
 
-    return (granular.CASES + chain.CASES + dynamic.CASES + lammps.cases() + plate_cases.CASES
+    return (granular.CASES + chain.CASES + dynamic.CASES + lammps.cases() + plastic_cases.CASES + plate_cases.CASES
             + plate_mesh.CASES + conservation.CASES + face_contacts.CASES + coupled.CASES)
 
 
