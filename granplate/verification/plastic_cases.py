@@ -253,7 +253,8 @@ def loop_checks(runs: dict, consts: dict) -> list[Check]:
         Check(f"loop closes: |delta at separation - delta_p| / half an interval's travel, worst of {n} runs",
               "-", 0.0, "P7: delta_p from the measured delta_max", max(closure), 1.0,
               "the sphere leaves during the last output interval whose velocity changed: P7's delta_p must "
-              "lie within that interval's overlaps (1 = its edge).", kind="max"),
+              "lie within that interval's overlaps (1 = its edge; the interval spans 2e-4 to 1e-2 of delta_p "
+              "from 100 down to 1.5 v_y).", kind="max"),
         Check(f"unloading continuous at delta_max: force jump across the turn / F_max, worst of {n} runs", "-", 0.0,
               "P8 starts from the loading force F(delta_max)", max(jump), 1e-6,
               "near the turn the overlap moves by ~(F/m*) h^2 per interval, so the mean forces of the two "
@@ -350,11 +351,13 @@ def plastic_impact(ctx: Context) -> CaseResult:
     data = impact_runs()
     runs, consts = data["runs"], data["consts"]
     cw = consts["wall"]
-    v_johnson = johnson_yield_velocity(cw["E"], cw["rho"], cw["p_y"] / ONSET)
+    y_strength = cw["p_y"] / ONSET
+    v_johnson = johnson_yield_velocity(cw["E"], cw["rho"], y_strength)
+    thornton_constant = cw["rho"] * cw["v_y"] ** 2 / y_strength / (y_strength / cw["E"]) ** 4
     notes = [f"Johnson's yield velocity of a sphere on a rigid flat, rho v_y^2 / Y = {JOHNSON_YIELD:g} (Y/E*)^4, "
              f"is {v_johnson * 1e3:.4f} mm/s against Thornton's P11, {cw['v_y'] * 1e3:.4f} mm/s "
-             f"(ratio {v_johnson / cw['v_y']:.4f}: P11 is 25.5 (Y/E*)^4, which Johnson rounds to 26); "
-             "the runs' speeds are multiples of P11.",
+             f"(ratio {v_johnson / cw['v_y']:.4f}: P11 with p_y = 1.6 Y is rho v_y^2 / Y = "
+             f"{thornton_constant:.2f} (Y/E*)^4, which Johnson rounds to 26); the runs' speeds are multiples of P11.",
              "Y -> infinity: the positions and velocities of the Thornton run are "
              + ("bitwise those of the Hertz run." if data["hertz"]["bitwise"] else "not bitwise the Hertz run's.")]
     desc = ("A structural-steel sphere (R = 1 cm, E = 200 GPa, Y = 355 MPa) touching a rigid wall or an "
