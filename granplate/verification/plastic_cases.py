@@ -49,9 +49,9 @@ LAW_SOURCE = "Thornton's law P3-P8 written out here from E*, R*, 1.6 Y"
 
 def contact_constants(s, kind: str) -> dict:
     """The impact's constants from scenario `s`'s material: the sphere's radius [m] and
-    density [kg/m^3], E* [Pa], R* [m], m* [kg], the
-    yield pressure p_y = 1.6 Y [Pa], delta_y [m] (P3), F_y [N] (P4), the loading line's
-    slope k_p = pi p_y R* [N/m] and the yield velocity v_y [m/s] (P11)."""
+    density [kg/m^3], E* [Pa], R* [m], m* [kg], the yield pressure p_y = 1.6 Y [Pa],
+    delta_y [m] (P3), F_y [N] (P4), the loading line's slope k_p = pi p_y R* [N/m] and
+    the yield velocity v_y [m/s] (P11)."""
     steel = s.materials[s.granules[0].material]
     r = s.granules[0].radius
     e_star, r_star, m1, m2 = effective(steel, steel, r, None if kind == "wall" else s.granules[1].radius)
