@@ -210,3 +210,26 @@ def test_unknown_yield_strength_gives_no_ratio():
         summ = gp.summary(gp.simulate(s, progress=False))
     assert summ["yield_onset_ratio"] is None and summ["max_contact_pressure"] > 0
     assert summ["contact_pairs"][0]["yield_onset_ratio"] is None
+
+
+@pytest.mark.parametrize("scheme", ["paper", "implicit"])
+def test_patch_contact_keeps_its_history_as_it_slides(scheme):
+    """An oblique impact with friction on the paper's plate under the plastic law: the
+    granule's patch contact slides past a face node while the contact yields; its history
+    moves with it, so eq. (11) with D_plastic balances and D_plastic is Thornton's W_p (P10)
+    at the contact's largest overlap (from the Dataset's Hertz peak pressure, P2)."""
+    from granplate.verification.face_contacts import R as R_DROP, bounce, drop_scenario, node_spacing
+
+    s = drop_scenario(0.05, vx=1.0, vy=4.0, mu=0.3, t_end=1e-3, out=5e-7)
+    s = gp.with_changes(s, {"contact.normal_law": "thornton", "solver.scheme": scheme})
+    ds = quiet_simulate(s)
+    b = bounce(ds)
+    assert b["travel"] > node_spacing(40)
+    assert b["residual"] < 1e-5
+    g = s.material(s.granules[0].material)
+    e_star = effective_modulus(g, None)
+    p0 = float(ds.pair_max_contact_pressure.sel(material_pair=f"{g.name}-plate"))
+    delta_max = (math.pi * p0 / (2 * e_star)) ** 2 * R_DROP
+    w_p = plastic_work(hertz_coefficient(e_star, R_DROP), yield_overlap(e_star, R_DROP, 1.6 * g.Y), delta_max)
+    assert float(ds.D_plastic[-1]) == pytest.approx(w_p, rel=1e-9)
+    assert float(ds.D_plastic[-1]) > 1e-3 * float(ds.E_granular[0])  # ~14% of the normal kinetic energy

@@ -33,6 +33,10 @@ def _cmd_bench(args) -> int:
         return int(friction.main(args))
     if getattr(args, "study", False):
         return _cmd_study(args)
+    if getattr(args, "plastic", False):
+        from granplate.bench import plastic
+
+        return int(plastic.main(args))
     if getattr(args, "plates", False):
         from granplate.bench import plates
 
@@ -71,6 +75,9 @@ def register(subparsers) -> None:
                    help="instead: steps and time with the granules' friction split off or inside RK4 "
                         "(a 990-granule packing, ptfe-r05 under q0 = 1e7 N/m), and the packing side by "
                         "side with LAMMPS where it is installed (loop time, us per contact and step, error)")
+    b.add_argument("--plastic", action="store_true",
+                   help="instead: the loop time per step of the elastic-plastic normal law against Hertz's "
+                        "(a 990-granule packing, ptfe-r05 and steel-r1 under both schemes)")
     b.add_argument("--study", action="store_true",
                    help="instead: the throughput of a design study on Dask (a ptfe-r05 sweep, 2 ms "
                         "each): core-seconds per design all included, overhead vs the loop")

@@ -14,8 +14,8 @@ import math
 
 from numba import njit
 
-from granplate.physics.contact import COEF_A, COEF_C, COEF_DY, normal_force_slopes, normal_response
-from granplate.physics.plastic import yielding_normal_response, yielding_normal_slopes
+from granplate.physics.contact import COEF_A, COEF_C, COEF_DY, normal_force, normal_force_slopes, normal_response
+from granplate.physics.plastic import yielding_normal_force, yielding_normal_response, yielding_normal_slopes
 
 
 @njit(cache=True)
@@ -33,7 +33,10 @@ def normal_law_response(delta: float, delta_dot: float, coef, delta_max: float, 
 @njit(cache=True)
 def normal_law_force(delta: float, delta_dot: float, coef, delta_max: float, clip: bool) -> float:
     """|N| [N] of `normal_law_response` alone."""
-    return normal_law_response(delta, delta_dot, coef, delta_max, clip)[0]
+    delta_y = coef[COEF_DY]
+    if delta_y == math.inf:
+        return normal_force(delta, delta_dot, coef[COEF_A], coef[COEF_C], clip)[0]
+    return yielding_normal_force(delta, delta_dot, coef[COEF_A], coef[COEF_C], delta_y, delta_max, clip)
 
 
 @njit(cache=True)

@@ -31,7 +31,7 @@ import math
 
 from numba import njit
 
-from granplate.physics.contact import contact_energy, hertz_elastic
+from granplate.physics.contact import contact_energy, hertz_elastic, normal_force, normal_response
 
 #: p_y / Y: the Hertz peak pressure at which yield starts under a sphere, p0 = 1.6 Y
 #: (von Mises, nu = 0.3; Johnson, Contact Mechanics, 1985, section 6.2), taken by Thornton
@@ -232,24 +232,48 @@ def yielding_normal_response(delta: float, delta_dot: float, a: float, c: float,
     """The elastic-plastic law of one contact in touch (delta > 0) with the paper's
     damping (P13): |N| = F(delta, delta_max) (P8) + c (delta - delta_p)^(1/4) d(delta)/dt
     while delta > delta_p, 0 at or below the residual overlap delta_p; with clip, |N| >= 0.
-    For an elastic history (delta_p = 0) this is eq. (2).
+    For an elastic history (delta_p = 0) this is eq. (2), in the same operations.
 
     Returns (|N| [N], viscous power [W] (as `contact.viscous_power`), stored elastic energy
     [J] (P9), plastic work [J] done past delta_max, W_p(max(delta, delta_max)) - W_p(delta_max)
-    (P10), which is zero unless the contact loads past its largest overlap).
+    (P10), which is zero unless the contact loads past its largest overlap). One pass: the
+    unloading curve of max(delta, delta_max) (P7, P8) is computed once.
     """
     m = updated_max_overlap(delta, delta_max)
+    if m <= delta_y:  # an elastic history: Hertz, eqs. (2) and (9)
+        n, pv, ep = normal_response(delta, delta_dot, a, c, clip)
+        return n, pv, ep, 0.0
     w_p = 0.0
-    if m > delta_max and m > delta_y:
+    if m > delta_max:
         w_p = plastic_work(a, delta_y, m) - plastic_work(a, delta_y, delta_max)
-    d_el = delta - residual_overlap(delta_y, m)
+    w = unloading_span(delta_y, m)
+    d_el = delta - (m - w)
     if d_el <= 0.0:
         return 0.0, 0.0, 0.0, w_p
-    f = plastic_force(a, delta_y, delta, delta_max)
-    n = f + c * math.sqrt(math.sqrt(d_el)) * delta_dot
+    sq = math.sqrt(d_el)
+    scale = loading_force(a, delta_y, m) / (w * math.sqrt(w))
+    f = scale * d_el * sq
+    n = f + c * math.sqrt(sq) * delta_dot
     if clip and n < 0.0:
         n = 0.0
-    return n, (n - f) * delta_dot, plastic_elastic_energy(a, delta_y, delta, delta_max), w_p
+    return n, (n - f) * delta_dot, 0.4 * f * d_el, w_p
+
+
+@njit(cache=True)
+def yielding_normal_force(delta: float, delta_dot: float, a: float, c: float, delta_y: float,
+                          delta_max: float, clip: bool) -> float:
+    """|N| [N] of `yielding_normal_response` alone (no energies: what friction needs)."""
+    m = updated_max_overlap(delta, delta_max)
+    if m <= delta_y:
+        return normal_force(delta, delta_dot, a, c, clip)[0]
+    w = unloading_span(delta_y, m)
+    d_el = delta - (m - w)
+    if d_el <= 0.0:
+        return 0.0
+    sq = math.sqrt(d_el)
+    f = loading_force(a, delta_y, m) / (w * math.sqrt(w)) * d_el * sq
+    n = f + c * math.sqrt(sq) * delta_dot
+    return 0.0 if clip and n < 0.0 else n
 
 
 @njit(cache=True)

@@ -72,8 +72,8 @@ def pair_yield(model, peaks) -> PairYield:
 
 def largest(py: PairYield) -> tuple[float, float]:
     """(max_contact_pressure [Pa], yield_onset_ratio [-]) over the pairs: the largest p0
-    (0 without contacts) and the largest ratio over the pairs whose Y is known (NaN: none)."""
-    p = float(py.pressure.max()) if len(py.pressure) else 0.0
+    (NaN: no contact touched) and the largest ratio over the pairs whose Y is known (NaN: none)."""
+    p = float(py.pressure.max()) if len(py.pressure) else math.nan
     known = py.ratio[np.isfinite(py.ratio)]
     return p, float(known.max()) if len(known) else math.nan
 
