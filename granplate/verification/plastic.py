@@ -16,8 +16,8 @@ Thornton's closed form makes no approximation beyond those of the law itself (th
 truncated-Hertz pressure over the disc a^2 = R* delta while loading, and Hertzian
 unloading of radius R_p): e^2 is U(delta_max) / (1/2 m* v^2), so the integration and
 P12 agree to the integrator's tolerance. These are functions with tests
-(tests/test_plastic_verification.py); the time loop does not use the plastic law yet,
-so there is no `granplate verify` case of a simulated impact.
+(tests/test_plastic_verification.py); the case `plastic-impact` (plastic_cases.py) holds
+the time loop's yielding impacts against them.
 """
 from __future__ import annotations
 
