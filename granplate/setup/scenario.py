@@ -389,6 +389,7 @@ class Scenario:
     contact: Contact = Contact()
     time: TimeSettings = TimeSettings()
     solver: Solver = Solver()
+    dimension: int = 2
 
     def material(self, name: str) -> Material:
         """The material called `name` (file-defined ones override the library)."""
