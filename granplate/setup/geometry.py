@@ -97,7 +97,7 @@ def default_wall_label(index: int) -> str:
 
 def unit(v: tuple[float, ...]) -> tuple[float, ...]:
     """v / |v| [-] (v nonzero and finite: `validate` refuses the others first)."""
-    norm = math.sqrt(math.fsum(c * c for c in v))
+    norm = math.hypot(*v)
     return tuple(c / norm for c in v)
 
 
@@ -112,7 +112,7 @@ def box_walls(box: Box) -> tuple[Wall, ...]:
     walls = []
     for axis in range(3):
         e = tuple(1.0 if k == axis else 0.0 for k in range(3))
-        walls.append(Wall(tuple(-c for c in e), -float(box.lower[axis]),
+        walls.append(Wall(tuple(-1.0 if k == axis else 0.0 for k in range(3)), 0.0 - float(box.lower[axis]),
                           label=BOX_WALLS[2 * axis], material=box.material))
         walls.append(Wall(e, float(box.upper[axis]), label=BOX_WALLS[2 * axis + 1],
                           material=box.material))

@@ -56,6 +56,8 @@ UNWRITTEN_DEFAULTS_2D: dict[str, dict[str, Any]] = {
     "load": {"force": 0.0, "direction": [1.0, 0.0, 0.0]},
     "granules": {"z": 0.0, "vz": 0.0},
 }
+#: The order of a 3D granule's keys as written (its centre, then its velocities).
+GRANULE_KEYS_3D: tuple[str, ...] = ("x", "y", "z", "radius", "material", "label", "vx", "vy", "vz", "omega")
 
 
 class _Missing:
@@ -338,7 +340,7 @@ def to_dict(s: Scenario, all_materials: bool = False) -> dict:
     d: dict[str, Any] = {"name": s.name, "description": s.description}
     if s.dimension != 2:
         d["dimension"] = s.dimension
-    flat = UNWRITTEN_DEFAULTS_2D if s.dimension == 2 else {}
+    flat = UNWRITTEN_DEFAULTS_2D if s.dimension == 2 else {"granules": {"omega": 0.0}}
     used = _used_materials(s)
     mats = {name: _material_dict(m) for name, m in sorted(s.materials.items())
             if all_materials or name in used or LIBRARY.get(name) != m}
@@ -348,6 +350,8 @@ def to_dict(s: Scenario, all_materials: bool = False) -> dict:
         d["layout"] = _layout_dict(s.layout)
     if s.granules:
         d["granules"] = [_without_defaults(g, flat.get("granules", {})) for g in _plain(s.granules)]
+        if s.dimension == 3:
+            d["granules"] = [{k: g[k] for k in sorted(g, key=_granule_key_rank)} for g in d["granules"]]
     if s.walls:
         d["walls"] = _plain(s.walls)
     if s.box is not None:
@@ -358,6 +362,10 @@ def to_dict(s: Scenario, all_materials: bool = False) -> dict:
         d[key] = _without_defaults(_plain(getattr(s, key)),
                                    {**UNWRITTEN_DEFAULTS.get(key, {}), **flat.get(key, {})})
     return d
+
+
+def _granule_key_rank(key: str) -> int:
+    return GRANULE_KEYS_3D.index(key) if key in GRANULE_KEYS_3D else len(GRANULE_KEYS_3D)
 
 
 def _without_defaults(table: dict, defaults: dict[str, Any]) -> dict:
