@@ -29,7 +29,7 @@ from granplate.setup.fields import finite, int_at_least, is_number, material_exi
 from granplate.setup.plate_checks import check_plate_fields, check_plate_mesh
 from granplate.setup.plate_cost import MEMORY_SHARE, physical_memory
 from granplate.setup.materials import Material
-from granplate.setup.scenario import (LAYOUT_KINDS, NORMAL_LAWS, SQRT2_MINUS_1, ChainLayout,
+from granplate.setup.scenario import (BOX_WALLS, LAYOUT_KINDS, NORMAL_LAWS, SQRT2_MINUS_1, ChainLayout,
                                       Granule, Imperfections, LatticeLayout, Layout, Scenario)
 
 #: Lever arms of the friction torque (Contact.torque_arm).
@@ -44,6 +44,7 @@ SCHEMES: tuple[str, ...] = ("paper", "implicit")
 GRANULAR_FRICTIONS: tuple[str, ...] = ("split", "rk4")
 #: Load kinds (Load.kind: "line" is 2D, "force" 3D) and targets (Load.target).
 LOAD_KINDS: tuple[str, ...] = ("line", "force", "none")
+LOAD_KINDS_BY_DIMENSION: dict[int, tuple[str, ...]] = {2: ("line", "none"), 3: ("force", "none")}
 LOAD_TARGETS: tuple[str, ...] = ("granules", "plate")
 #: Plate edges that may be clamped (Plate.clamped_edges).
 
@@ -426,8 +427,19 @@ def length_scale(s: Scenario) -> tuple[float, str]:
     return min(found)
 
 
-def _check_lengths(s: Scenario) -> None:
-    """Coordinates and sizes within LENGTH_RANGE x the smallest length (see LENGTH_RANGE)."""
+def _wall_paths(s: Scenario, boxed: bool) -> list[str]:
+    """The field that places each wall of the resolved `s`: walls[k].offset, or, for the six
+    walls a box expanded into (the last six when `boxed`), box.lower[axis] / box.upper[axis]."""
+    n = len(s.walls) - (len(BOX_WALLS) if boxed else 0)
+    paths = [f"walls[{k}].offset" for k in range(n)]
+    if boxed:
+        paths += [f"box.{'upper' if j % 2 else 'lower'}[{j // 2}]" for j in range(len(BOX_WALLS))]
+    return paths
+
+
+def _check_lengths(s: Scenario, boxed: bool = False) -> None:
+    """Coordinates and sizes within LENGTH_RANGE x the smallest length (see LENGTH_RANGE);
+    boxed: the last six walls are the expanded box (named as its corners' fields)."""
     h, what = length_scale(s)
     limit = LENGTH_RANGE * h
     why = (f"{LENGTH_RANGE:g} x the smallest length of the scenario, h = {h:.6g} m ({what}): "
@@ -436,7 +448,8 @@ def _check_lengths(s: Scenario) -> None:
     coords = ("x", "y", "z", "radius") if s.dimension == 3 else ("x", "y", "radius")
     values = [(f"granules[{i}].{f}", getattr(g, f)) for i, g in enumerate(s.granules)
               for f in coords]
-    values += [(f"walls[{k}].offset", w.offset) for k, w in enumerate(s.walls)]
+    values += [(path, -w.offset if ".lower[" in path else w.offset)  # box.lower: offset -x0
+               for path, w in zip(_wall_paths(s, boxed), s.walls)]
     values += [(f"walls[{k}].point[{c}]", x) for k, w in enumerate(s.walls) if w.point is not None
                for c, x in enumerate(w.point)]
     if s.plate is not None:
@@ -546,7 +559,7 @@ def _check_plate_penetration(s: Scenario, named: dict[int, str]) -> None:
 
 def _check_load(s: Scenario) -> None:
     ld = s.load
-    string_in("load.kind", ld.kind, LOAD_KINDS)
+    string_in("load.kind", ld.kind, LOAD_KINDS_BY_DIMENSION[s.dimension])
     string_in("load.target", ld.target, LOAD_TARGETS)
     q0 = finite("load.q0", ld.q0, "must be >= 0 (a finite number) [N/m]")
     if not q0 >= 0.0:
@@ -838,7 +851,7 @@ def validate(scenario: Scenario) -> None:
     _check_granules(r)
     _check_walls(r)
     _check_plate(r)
-    _check_lengths(r)
+    _check_lengths(r, boxed=s.dimension == 3 and s.box is not None)
     named = _GranuleNames(s, r)
     _check_overlaps(r, named)
     _check_wall_penetration(r, named)
