@@ -333,11 +333,11 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
 
 def initial_energy(energy0: np.ndarray) -> float:
     """E_initial [J]: the kinetic energy of the initial velocities, 1/2 m v^2 + 1/2 I omega^2
-    summed over the granules (the first output row's KE_x + KE_y + KE_rot), exactly 0 for a
+    summed over the granules (the first output row's KE_x + KE_y + KE_rot, + KE_z in space), exactly 0 for a
     run from rest. The plate starts undeformed and at rest; contacts that touch at t = 0
     (overlaps within validation's 1e-9 R) hold only the round-off energy of their overlaps
     (~1e-33 J), which is not energy put in (it stays in the loop's eq. (11) reference)."""
-    return float(energy0[K.KE_X] + energy0[K.KE_Y] + energy0[K.KE_ROT])
+    return float(energy0[K.KE_X] + energy0[K.KE_Y] + energy0[K.KE_ROT] + energy0[K.KE_Z])
 
 
 def _attrs(model, out: K.Output, n: int, info: dict, scenario_toml: str) -> dict:
