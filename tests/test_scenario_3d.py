@@ -18,7 +18,7 @@ from granplate.errors import ScenarioError
 from granplate.setup import io as scenario_io
 from granplate.setup.geometry import box_walls, force_loaded_granules, resolve
 from granplate.setup.presets import preset, preset_names
-from granplate.setup.scenario import (BOX_WALLS, Box, Granule, Load, Plate, Scenario, Wall)
+from granplate.setup.scenario import BOX_WALLS, Box, Granule, Load, Scenario, Wall
 from granplate.setup.validate import validate
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -96,14 +96,14 @@ def test_round_trip_of_every_new_field():
     assert "[box]" in scenario_io.dumps(s) and "point = [" in scenario_io.dumps(s)
 
 
-def test_resolve_cli_writes_the_3d_scenario(tmp_path):
+def test_resolve_cli_writes_the_3d_scenario(tmp_path, capsys):
     """`granplate resolve` of a 3D file prints z, vz, omega vectors and the box as six walls."""
+    from granplate.cli import main
+
     f = tmp_path / "box.toml"
     f.write_text(scenario_io.dumps(scenario_io.from_dict(BASE)))
-    out = subprocess.run([sys.executable, "-m", "granplate", "resolve", str(f)], capture_output=True,
-                         text=True, timeout=600, cwd=ROOT)
-    assert out.returncode == 0, out.stderr
-    r = scenario_io.loads(out.stdout)
+    assert main(["resolve", str(f)]) == 0
+    r = scenario_io.loads(capsys.readouterr().out)
     assert r == resolve(scenario_io.from_dict(BASE))
     assert r.box is None and [w.label for w in r.walls][1:] == list(BOX_WALLS)
 
