@@ -33,7 +33,7 @@ from granplate.setup.scenario import (LAYOUT_KINDS, NORMAL_LAWS, Box, Contact, G
 #: Fields that a table must give (everything else takes the dataclass default).
 REQUIRED: dict[type, tuple[str, ...]] = {
     Granule: ("x", "y", "radius", "material"),
-    Wall: ("normal",),  # and offset, or (3D) point: `_wall`
+    Wall: ("normal",),  # and offset, or (3D) point: `_walls`
     Box: ("lower", "upper"),
     PairCoefficients: ("materials",),
 }
