@@ -126,9 +126,17 @@ def find_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: float) ->
     return contact_pairs(x, y, r, gap_ratio)
 
 
-def find_wall_contacts(s: Scenario, x, y, r) -> np.ndarray:
+def find_wall_contacts(s: Scenario, x, y, r, z=None) -> np.ndarray:
     """(granule, wall) pairs whose initial gap is at most neighbour_gap * R."""
-    return fixed_wall_contacts(s.walls, x, y, r, s.contact.neighbour_gap)
+    return fixed_wall_contacts(s.walls, x, y, r, s.contact.neighbour_gap, z)
+
+
+def find_pairs_and_walls(s: Scenario, x, y, r, z=None) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs and (granule, wall) contacts touching at t = 0 (within contact.neighbour_gap;
+    z: the centres' third coordinate in space, None in the plane)."""
+    from granplate.model.neighbours import contact_pairs
+
+    return contact_pairs(x, y, r, s.contact.neighbour_gap, z), find_wall_contacts(s, x, y, r, z)
 
 
 def find_plate_contacts(s: Scenario) -> tuple[np.ndarray, np.ndarray]:
@@ -169,16 +177,16 @@ def pair_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, pairs:
 
 
 def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarray):
-    """(nw, 3) [nx, ny, offset] with the unit outward normal, and (nw, N_COEF)
-    coefficients against a rigid body (R* = R, m* = m)."""
+    """(nw, d + 1) [nx, ny, (nz,) offset] with the unit outward normal (d = the scenario's
+    dimension), and (nw, N_COEF) coefficients against a rigid body (R* = R, m* = m)."""
     wc = np.asarray(wc, np.int64).reshape(-1, 2)
-    wall_geo = np.zeros((len(wc), 3))
+    wall_geo = np.zeros((len(wc), s.dimension + 1))
     wall_coef = np.zeros((len(wc), N_COEF))
     for k, (i, w) in enumerate(wc):
         wall = s.walls[w]
         nrm = np.asarray(wall.normal, float)
         nrm = nrm / np.linalg.norm(nrm)
-        wall_geo[k] = (nrm[0], nrm[1], wall.offset)
+        wall_geo[k] = (*nrm, wall.offset)
         alpha, mu, ks = s.contact.for_pair(mats[i].name, wall.material)
         e_star = effective_modulus(mats[i], None)
         a = hertz_coefficient(e_star, r[i])
@@ -246,9 +254,10 @@ def plate_modal_arrays(s: Scenario, y: np.ndarray, pc: np.ndarray):
 
 
 def loop_config(s: Scenario, fres: np.ndarray, tres: np.ndarray, r: np.ndarray, mass: np.ndarray,
-                face: bool = False) -> Config:
+                face: bool = False, floor: float | None = None) -> Config:
     """The loop's scalar settings from the scenario's load, contact, time and solver;
-    face: whether granules may get patch contacts during the run."""
+    face: whether granules may get patch contacts during the run; floor: the implicit
+    scheme's force floor [N] when given (else `force_floor` of the plane's load)."""
     t = s.time
     sol = s.solver
     q0 = s.load.q0 if s.load.kind == "line" else 0.0
@@ -264,7 +273,7 @@ def loop_config(s: Scenario, fres: np.ndarray, tres: np.ndarray, r: np.ndarray, 
         arm_shrink=1.0 if s.contact.torque_arm == "contact_point" else 0.0,
         scheme=scheme_number(sol.scheme),
         error_tol=float(sol.error_tol),
-        force_floor=force_floor(q0, fres, tres, r, mass, s, t.output_interval),
+        force_floor=force_floor(q0, fres, tres, r, mass, s, t.output_interval) if floor is None else float(floor),
         rebuild_move=rebuild_move(s.contact.skin, r),
         overlap_stop=float(s.contact.overlap_stop),
         plate_x0=float(s.plate.x0) if s.plate is not None else math.inf,
@@ -294,9 +303,14 @@ def initial_state(s: Scenario, x: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 
 def build_model(scenario: Scenario) -> Model:
-    """Validate, resolve and turn a scenario into the loop's arrays."""
+    """Validate, resolve and turn a scenario into the loop's arrays (in space, dimension =
+    3: `model.space.build_space_model`)."""
     validate(scenario)
     s = resolve(scenario)
+    if s.dimension == 3:
+        from granplate.model.space import build_space_model
+
+        return build_space_model(s)
     x, y, r, rho = _granule_arrays(s)
     mats = [s.material(g.material) for g in s.granules]
     mass = np.array([sphere_mass(ri, rhoi) for ri, rhoi in zip(r, rho)])

@@ -23,7 +23,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from granplate.model.neighbours import contact_pairs, verlet_pairs, verlet_walls
+from granplate.model.neighbours import centre_distances, contact_pairs, normal_coordinates, verlet_pairs, verlet_walls
 
 
 class Missed(NamedTuple):
@@ -35,36 +35,41 @@ class Missed(NamedTuple):
     overlap: float
 
 
-def wall_planes(walls) -> tuple[np.ndarray, np.ndarray]:
-    """(nw, 2) unit outward normals and (nw,) offsets [m] of the scenario's walls."""
-    normals = np.array([w.normal for w in walls], float).reshape(-1, 2)
+def centre_coordinates(state: np.ndarray, dimension: int):
+    """(x, y, z) columns of the granules' state [m] (its first `dimension` columns; z None
+    in the plane), as the neighbour searches take them."""
+    return state[:, 0], state[:, 1], (state[:, 2] if dimension == 3 else None)
+
+
+def wall_planes(walls, dimension: int = 2) -> tuple[np.ndarray, np.ndarray]:
+    """(nw, dimension) unit outward normals and (nw,) offsets [m] of the scenario's walls."""
+    normals = np.array([w.normal for w in walls], float).reshape(-1, dimension)
     if len(normals):
         normals = normals / np.linalg.norm(normals, axis=1)[:, None]
     offsets = np.array([w.offset for w in walls], float)
     return normals, offsets
 
 
-def fixed_wall_contacts(walls, x, y, r, gap_ratio: float) -> np.ndarray:
+def fixed_wall_contacts(walls, x, y, r, gap_ratio: float, z=None) -> np.ndarray:
     """(granule, wall) pairs whose initial gap is at most gap_ratio * R, sorted (wall, granule)."""
     out = []
     for w, wall in enumerate(walls):
-        nx, ny = wall.normal
         for i in range(len(x)):
-            gap = wall.offset - (x[i] * nx + y[i] * ny) - r[i]
+            gap = wall.offset - normal_coordinates(x[i], y[i], None if z is None else z[i], wall.normal) - r[i]
             if gap <= gap_ratio * r[i]:
                 out.append((i, w))
     return np.array(out, np.int64).reshape(-1, 2)
 
 
-def contact_lists(contact, walls, x, y, r) -> tuple[np.ndarray, np.ndarray]:
+def contact_lists(contact, walls, x, y, r, z=None) -> tuple[np.ndarray, np.ndarray]:
     """The loop's (np, 2) granule pairs and (nw, 2) [granule, wall] contacts for the
-    positions x, y [m] under the scenario's `contact` settings: the Verlet lists
-    (detection = "dynamic") or the pairs within neighbour_gap (detection = "fixed")."""
+    positions x, y (and z in space) [m] under the scenario's `contact` settings: the
+    Verlet lists (detection = "dynamic") or the pairs within neighbour_gap (detection = "fixed")."""
     if contact.detection == "fixed":
-        return (contact_pairs(x, y, r, contact.neighbour_gap),
-                fixed_wall_contacts(walls, x, y, r, contact.neighbour_gap))
-    normals, offsets = wall_planes(walls)
-    return verlet_pairs(x, y, r, contact.skin), verlet_walls(x, y, r, normals, offsets, contact.skin)
+        return (contact_pairs(x, y, r, contact.neighbour_gap, z),
+                fixed_wall_contacts(walls, x, y, r, contact.neighbour_gap, z))
+    normals, offsets = wall_planes(walls, 2 if z is None else 3)
+    return verlet_pairs(x, y, r, contact.skin, z), verlet_walls(x, y, r, normals, offsets, contact.skin, z)
 
 
 def pair_keys(pairs: np.ndarray, n: int) -> np.ndarray:
@@ -73,20 +78,20 @@ def pair_keys(pairs: np.ndarray, n: int) -> np.ndarray:
 
 
 def missed_contacts(pairs, wall_contacts, cand_pairs, cand_walls, normals, offsets,
-                    x, y, r) -> list[Missed]:
+                    x, y, r, z=None) -> list[Missed]:
     """Overlapping pairs of the candidate lists that are not in the loop's lists, largest
     overlap first."""
     n = len(x)
     out = []
     if len(cand_pairs):
         i, j = cand_pairs[:, 0], cand_pairs[:, 1]
-        delta = r[i] + r[j] - np.hypot(x[j] - x[i], y[j] - y[i])
+        delta = r[i] + r[j] - centre_distances(x, y, z, i, j)
         new = ~np.isin(pair_keys(cand_pairs, n), pair_keys(pairs, n))
         out += [Missed(int(a), int(b), float(d)) for a, b, d in zip(i[new & (delta > 0)], j[new & (delta > 0)],
                                                                      delta[new & (delta > 0)])]
     if len(cand_walls):
         i, w = cand_walls[:, 0], cand_walls[:, 1]
-        delta = x[i] * normals[w, 0] + y[i] * normals[w, 1] + r[i] - offsets[w]
+        delta = normal_coordinates(x[i], y[i], None if z is None else z[i], normals[w].T) + r[i] - offsets[w]
         new = ~np.isin(i * len(offsets) + w, wall_contacts[:, 0] * len(offsets) + wall_contacts[:, 1])
         out += [Missed(int(a), -1 - int(b), float(d)) for a, b, d in zip(i[new & (delta > 0)], w[new & (delta > 0)],
                                                                           delta[new & (delta > 0)])]

@@ -27,6 +27,10 @@ def scheme_number(name: str) -> int:
     return SCHEME_NAMES.index(name)
 
 
+#: state columns per granule by dimension: the plane's (x, y, theta, vx, vy, omega) and
+#: space's (x, y, z, vx, vy, vz, wx, wy, wz)
+STATE_COLUMNS = {2: 6, 3: 9}
+
 #: columns of the contact histories pair_hist, wall_hist, pc_hist (Granular): the largest
 #: overlap so far delta_max [m] (the elastic-plastic law's history, docs/model.md section
 #: 3.6; for every law, its largest Hertz peak pressure), the time it was reached [s], and
@@ -56,6 +60,35 @@ class Granular(NamedTuple):
     there is no patch contact (the loop then skips them at no cost); pair_hist,
     wall_hist, pc_hist: (np, N_HIST), (nw, N_HIST), (nk, N_HIST) each contact's history
     (columns HIST_*), this run's own (the loop updates them in place).
+    """
+
+    mass: np.ndarray
+    inertia: np.ndarray
+    radius: np.ndarray
+    pair_ij: np.ndarray
+    pair_coef: np.ndarray
+    wall_i: np.ndarray
+    wall_geo: np.ndarray
+    wall_coef: np.ndarray
+    wall_w: np.ndarray
+    pc_i: np.ndarray
+    pc_x: np.ndarray
+    pc_coef: np.ndarray
+    shock_force: np.ndarray
+    shock_torque: np.ndarray
+    pc_patch: np.ndarray = np.zeros(0, np.int64)
+    pair_hist: np.ndarray = no_history(0)
+    wall_hist: np.ndarray = no_history(0)
+    pc_hist: np.ndarray = no_history(0)
+
+
+class Granular3(NamedTuple):
+    """Flat arrays of a granular medium in space (docs/model.md section 3.7), with the
+    fields of `Granular` (so the loop reads both alike; solver.dimension tells them apart
+    by type): wall_geo (nw, 4) [nx, ny, nz, offset] with the unit outward normal;
+    shock_force (ng, 3) [-]: each granule's share of the load's direction, per unit of the
+    total force (load.kind = "force"); shock_torque (ng, 3) zeros; no plate contacts
+    (pc_* empty).
     """
 
     mass: np.ndarray
@@ -127,6 +160,7 @@ class Config(NamedTuple):
     plate_x0: float = math.inf  # the plate's undeformed face x [m] (inf: no plate)
     plate_ylo: float = 0.0  # its extent in y [m]
     plate_yhi: float = 0.0
-    split_friction: bool = True  # solver.granular_friction = "split" (solver.granular.rk4_granular_step)
+    split_friction: bool = True  # solver.granular_friction = "split" (solver.rk4.rk4_granular_step)
     face_skin: float = 0.0  # > 0: a granule within face_skin R of the face gets a patch contact (0: never)
     patch_width: float = 0.0  # width of a patch contact [m] (plate.rigid_layer_width)
+    dimension: int = 2  # 2: the plane (state x, y, theta, vx, vy, omega); 3: space (x, y, z, vx, vy, vz, wx, wy, wz)

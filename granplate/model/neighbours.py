@@ -12,7 +12,8 @@ such pair has centres at most 2 R_max + gap_ratio R_max apart, so the tree retur
 superset of candidates in O(N log N) for packings of bounded size ratio, and the exact
 test above (the same floating-point expression as the O(N^2) double loop,
 `brute_force_pairs`) picks the pairs. The result is sorted (i, j), i < j: identical to
-the double loop's.
+the double loop's. Every function takes the centres as x, y and, in space, z (None in the
+plane: the plane's expressions are kept as they are).
 """
 from __future__ import annotations
 
@@ -26,9 +27,26 @@ from scipy.spatial import cKDTree
 SEARCH_MARGIN = 1e-9
 
 
-def is_contact(dx: float, dy: float, ri: float, rj: float, gap_ratio: float) -> bool:
-    """True when the surface gap |(dx, dy)| - R_i - R_j [m] is at most gap_ratio min(R_i, R_j)."""
-    return math.hypot(dx, dy) - ri - rj <= gap_ratio * min(ri, rj)
+def is_contact(dx: float, dy: float, ri: float, rj: float, gap_ratio: float, dz: float | None = None) -> bool:
+    """True when the surface gap |(dx, dy[, dz])| - R_i - R_j [m] is at most gap_ratio min(R_i, R_j)."""
+    dist = math.hypot(dx, dy) if dz is None else math.hypot(dx, dy, dz)
+    return dist - ri - rj <= gap_ratio * min(ri, rj)
+
+
+def centre_distances(x, y, z, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+    """|s_j - s_i| [m] of the pairs (i, j) (z None: in the plane)."""
+    d = np.hypot(x[j] - x[i], y[j] - y[i])
+    return d if z is None else np.hypot(d, z[j] - z[i])
+
+
+def normal_coordinates(x, y, z, normal) -> np.ndarray:
+    """s . n [m] of every centre along a unit normal n (2 or 3 components)."""
+    s = x * normal[0] + y * normal[1]
+    return s if z is None else s + z * normal[2]
+
+
+def _centres(x, y, z) -> np.ndarray:
+    return np.column_stack([x, y] if z is None else [x, y, z])
 
 
 def brute_force_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: float) -> np.ndarray:
@@ -44,17 +62,18 @@ def search_distance(r: np.ndarray, gap_ratio: float) -> float:
     return (2.0 + gap_ratio) * float(r.max()) * (1.0 + SEARCH_MARGIN)
 
 
-def candidate_pairs(x: np.ndarray, y: np.ndarray, distance: float) -> np.ndarray:
+def candidate_pairs(x: np.ndarray, y: np.ndarray, distance: float, z: np.ndarray | None = None) -> np.ndarray:
     """(n, 2) sorted pairs (i < j) of centres at most `distance` [m] apart (k-d tree)."""
     if len(x) < 2:
         return np.zeros((0, 2), np.int64)
-    tree = cKDTree(np.column_stack([x, y]))
+    tree = cKDTree(_centres(x, y, z))
     pairs = tree.query_pairs(distance, output_type="ndarray").astype(np.int64)
     order = np.lexsort((pairs[:, 1], pairs[:, 0]))
     return pairs[order].reshape(-1, 2)
 
 
-def contact_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: float) -> np.ndarray:
+def contact_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: float,
+                  z: np.ndarray | None = None) -> np.ndarray:
     """(n_pairs, 2) potential contacts, sorted (i, j) with i < j, in O(N log N).
 
     Same pairs in the same order as `brute_force_pairs`: the k-d tree gives candidates and
@@ -63,31 +82,32 @@ def contact_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: float)
     x, y, r = (np.asarray(a, float) for a in (x, y, r))
     if len(x) < 2:
         return np.zeros((0, 2), np.int64)
-    cand = candidate_pairs(x, y, search_distance(r, gap_ratio))
-    keep = [is_contact(x[j] - x[i], y[j] - y[i], r[i], r[j], gap_ratio) for i, j in cand.tolist()]
+    cand = candidate_pairs(x, y, search_distance(r, gap_ratio), z)
+    keep = [is_contact(x[j] - x[i], y[j] - y[i], r[i], r[j], gap_ratio, None if z is None else z[j] - z[i])
+            for i, j in cand.tolist()]
     return cand[np.array(keep, bool)].reshape(-1, 2)
 
 
-def verlet_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, skin: float) -> np.ndarray:
+def verlet_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, skin: float, z: np.ndarray | None = None) -> np.ndarray:
     """(n_pairs, 2) pairs whose centres are at most (R_i + R_j)(1 + skin) apart, sorted
     (i, j) with i < j, in O(N log N) (the Verlet list of docs/model.md section 1.3)."""
     x, y, r = (np.asarray(a, float) for a in (x, y, r))
     if len(x) < 2:
         return np.zeros((0, 2), np.int64)
-    cand = candidate_pairs(x, y, 2.0 * float(r.max()) * (1.0 + skin) * (1.0 + SEARCH_MARGIN))
+    cand = candidate_pairs(x, y, 2.0 * float(r.max()) * (1.0 + skin) * (1.0 + SEARCH_MARGIN), z)
     i, j = cand[:, 0], cand[:, 1]
-    keep = np.hypot(x[j] - x[i], y[j] - y[i]) <= (r[i] + r[j]) * (1.0 + skin)
+    keep = centre_distances(x, y, z, i, j) <= (r[i] + r[j]) * (1.0 + skin)
     return np.ascontiguousarray(cand[keep]).reshape(-1, 2)
 
 
 def verlet_walls(x: np.ndarray, y: np.ndarray, r: np.ndarray, normals: np.ndarray, offsets: np.ndarray,
-                 skin: float) -> np.ndarray:
+                 skin: float, z: np.ndarray | None = None) -> np.ndarray:
     """(n, 2) [granule, wall] whose gap offset - s.n - R is at most skin R (granules
-    beyond the wall included), sorted (wall, granule); normals: (nw, 2) unit outward."""
+    beyond the wall included), sorted (wall, granule); normals: (nw, 2 or 3) unit outward."""
     x, y, r = (np.asarray(a, float) for a in (x, y, r))
     out = []
     for w in range(len(offsets)):
-        gap = offsets[w] - (x * normals[w, 0] + y * normals[w, 1]) - r
+        gap = offsets[w] - normal_coordinates(x, y, z, normals[w]) - r
         for i in np.flatnonzero(gap <= skin * r):
             out.append((int(i), w))
     return np.array(out, np.int64).reshape(-1, 2)

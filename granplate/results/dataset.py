@@ -28,6 +28,11 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "vx": ("m/s", "granule velocity, horizontal"),
     "vy": ("m/s", "granule velocity, vertical"),
     "omega": ("rad/s", "granule angular velocity (anticlockwise)"),
+    "z": ("m", "granule centre, depth (dimension = 3)"),
+    "vz": ("m/s", "granule velocity, depth (dimension = 3)"),
+    "omega_x": ("rad/s", "granule spin vector, x component (dimension = 3)"),
+    "omega_y": ("rad/s", "granule spin vector, y component (dimension = 3)"),
+    "omega_z": ("rad/s", "granule spin vector, z component (dimension = 3)"),
     "E_shock": ("J", "work of the applied shock, int sum(F_i vx_i + tau_i omega_i) dt or int F.dx/dt (bare plate)"),
     "E_granular": ("J", "granular energy E_g: kinetic (translation, rotation) + 2/5 A delta^5/2 of every granule, wall and plate contact (eq. 9)"),
     "E_plate": ("J", "plate energy E_p = 1/2 v^T M v + 1/2 x^T K x (eq. 9)"),
@@ -44,6 +49,7 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "KE_horizontal": ("J", "granular kinetic energy, horizontal translation"),
     "KE_vertical": ("J", "granular kinetic energy, vertical translation"),
     "KE_rotational": ("J", "granular kinetic energy, rotation"),
+    "KE_depth": ("J", "granular kinetic energy, translation along z (dimension = 3)"),
     "energy_residual": ("1", "(E_p + E_g + D - E_shock - E_initial) / max over past times of (E_shock + E_initial), eq. 11"),
     "energy_residual_max": ("1", "largest |energy_residual| over the steps since the previous output"),
     "max_von_mises": ("Pa", "maximum over the plate's quadrature points of the plane-stress von Mises stress (eq. 12)"),
@@ -63,6 +69,14 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "n_steps": ("1", "time steps taken so far"),
     "n_iterations": ("1", "interface iterations taken so far"),
     "contact_time_formed": ("s", "time each plate contact formed: 0 for those at t = 0, a patch contact's when its granule came within contact.skin R of the face"),
+}
+
+
+#: the Dataset's names of the granules' state columns, by the number of columns (the
+#: plane's 6, space's 9; solver.state.STATE_COLUMNS)
+STATE_VARIABLES: dict[int, tuple[str, ...]] = {
+    6: ("x", "y", "theta", "vx", "vy", "omega"),
+    9: ("x", "y", "z", "vx", "vy", "vz", "omega_x", "omega_y", "omega_z"),
 }
 
 
@@ -252,14 +266,16 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
     e = out.energy[:n]
     data: dict[str, xr.DataArray] = {}
     if not summary_only:
-        for c, name in enumerate(("x", "y", "theta", "vx", "vy", "omega")):
+        for c, name in enumerate(STATE_VARIABLES[y.shape[2]]):
             data[name] = _var(name, ("time", "granule"), y[:, :, c].copy())
     for col, name in (
         (K.E_SHOCK, "E_shock"), (K.E_GRAN, "E_granular"), (K.E_PLATE, "E_plate"),
         (K.D_VISC, "D_viscous"), (K.D_FRIC, "D_friction"), (K.D_PLASTIC, "D_plastic"), (K.E_POTG, "E_contact"),
         (K.KE_X, "KE_horizontal"), (K.KE_Y, "KE_vertical"), (K.KE_ROT, "KE_rotational"),
-        (K.RESID, "energy_residual"), (K.RESID_MAX, "energy_residual_max"),
+        (K.RESID, "energy_residual"), (K.RESID_MAX, "energy_residual_max"), (K.KE_Z, "KE_depth"),
     ):
+        if name == "KE_depth" and y.shape[2] != 9:  # (in space only)
+            continue
         if not summary_only or name in SUMMARY_VARIABLES:
             data[name] = _var(name, ("time",), e[:, col].copy())
     nk = len(axis.granule)
@@ -317,11 +333,11 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
 
 def initial_energy(energy0: np.ndarray) -> float:
     """E_initial [J]: the kinetic energy of the initial velocities, 1/2 m v^2 + 1/2 I omega^2
-    summed over the granules (the first output row's KE_x + KE_y + KE_rot), exactly 0 for a
+    summed over the granules (the first output row's KE_x + KE_y + KE_rot, + KE_z in space), exactly 0 for a
     run from rest. The plate starts undeformed and at rest; contacts that touch at t = 0
     (overlaps within validation's 1e-9 R) hold only the round-off energy of their overlaps
     (~1e-33 J), which is not energy put in (it stays in the loop's eq. (11) reference)."""
-    return float(energy0[K.KE_X] + energy0[K.KE_Y] + energy0[K.KE_ROT])
+    return float(energy0[K.KE_X] + energy0[K.KE_Y] + energy0[K.KE_ROT] + energy0[K.KE_Z])
 
 
 def _attrs(model, out: K.Output, n: int, info: dict, scenario_toml: str) -> dict:

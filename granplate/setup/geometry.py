@@ -22,7 +22,7 @@ import math
 
 from granplate.errors import ScenarioError
 from granplate.setup import layouts
-from granplate.setup.scenario import ChainLayout, Granule, LatticeLayout, Layout, Scenario, Wall
+from granplate.setup.scenario import BOX_WALLS, Box, ChainLayout, Granule, LatticeLayout, Layout, Scenario, Wall
 
 #: Labels of the paper's granules, in the order `paper_layout` returns them.
 PAPER_LABELS: tuple[str, ...] = ("1", "2", "3", "4", "5", "6", "7", "8", "9",
@@ -95,6 +95,49 @@ def default_wall_label(index: int) -> str:
     return f"w{index}"
 
 
+def unit(v: tuple[float, ...]) -> tuple[float, ...]:
+    """v / |v| [-] (v nonzero and finite: `validate` refuses the others first)."""
+    norm = math.hypot(*v)
+    return tuple(c / norm for c in v)
+
+
+def plane_offset(normal: tuple[float, ...], point: tuple[float, ...]) -> float:
+    """offset = point . n [m], n = normal / |normal|: the plane through `point` [m]."""
+    return math.fsum(p * n for p, n in zip(point, unit(normal)))
+
+
+def box_walls(box: Box) -> tuple[Wall, ...]:
+    """The six walls of a box, labelled BOX_WALLS: "xmin" is normal -e_x, offset -x0,
+    "xmax" +e_x, offset x1, and so on along y and z (unit normals, offsets [m])."""
+    walls = []
+    for axis in range(3):
+        e = tuple(1.0 if k == axis else 0.0 for k in range(3))
+        walls.append(Wall(tuple(-1.0 if k == axis else 0.0 for k in range(3)), 0.0 - float(box.lower[axis]),
+                          label=BOX_WALLS[2 * axis], material=box.material))
+        walls.append(Wall(e, float(box.upper[axis]), label=BOX_WALLS[2 * axis + 1],
+                          material=box.material))
+    return tuple(walls)
+
+
+#: Tolerance, times the largest radius, of "furthest against the direction" (`force_loaded_granules`).
+FORCE_TIE_RTOL = 1e-9
+
+
+def force_loaded_granules(scenario: Scenario) -> tuple[str, ...]:
+    """Labels of the granules a 3D `kind = "force"` load acts on: `load.granules` when
+    given, else those whose surface is furthest against the load's direction d (the
+    smallest s . d - R [m] over the granules, within FORCE_TIE_RTOL x the largest radius).
+    `scenario`: resolved (labels filled)."""
+    gs = scenario.granules
+    if scenario.load.granules or not gs:
+        return tuple(scenario.load.granules)
+    d = unit(scenario.load.direction)
+    lead = [g.x * d[0] + g.y * d[1] + g.z * d[2] - g.radius for g in gs]
+    tol = FORCE_TIE_RTOL * max(g.radius for g in gs)
+    first = min(lead)
+    return tuple(g.label for g, s in zip(gs, lead) if s <= first + tol)
+
+
 def resolve(scenario: Scenario) -> Scenario:
     """An equivalent, explicit scenario: layout expanded, plate placed, labels filled.
 
@@ -105,6 +148,9 @@ def resolve(scenario: Scenario) -> Scenario:
       explicit granules or walls is a ScenarioError (give one or the other).
     - Without a layout, a plate needs an explicit `x0` (ScenarioError otherwise).
     - Unlabelled granules get the label "g<i>", unlabelled walls "w<i>" (i: 0-based index).
+    - In 3D (`dimension = 3`): a `box` becomes its six walls (`box_walls`), after the
+      explicit walls, and `box` None; a wall given by a `point` gets offset = point . n
+      (`plane_offset`); a granule's default scalar omega 0 becomes (0, 0, 0).
 
     Idempotent: resolving a resolved scenario returns an equal scenario. Range checks are
     `validate`'s job; this function only builds.
@@ -127,12 +173,20 @@ def resolve(scenario: Scenario) -> Scenario:
         raise ScenarioError("plate.x0", None,
                             "must be given when the scenario has no [layout] "
                             "(the plate's lower-left corner x [m])")
+    box = scenario.box
+    if scenario.dimension == 3:
+        granules = tuple(dataclasses.replace(g, omega=(0.0, 0.0, 0.0))
+                         if not isinstance(g.omega, tuple) and g.omega == 0.0 else g for g in granules)
+        walls = tuple(dataclasses.replace(w, offset=plane_offset(w.normal, w.point))
+                      if w.offset is None and w.point is not None else w for w in walls)
+        if box is not None:
+            walls, box = walls + box_walls(box), None
     granules = tuple(g if g.label else dataclasses.replace(g, label=default_granule_label(i))
                      for i, g in enumerate(granules))
     walls = tuple(w if w.label else dataclasses.replace(w, label=default_wall_label(i))
                   for i, w in enumerate(walls))
     return dataclasses.replace(scenario, layout=None, granules=granules, walls=walls,
-                               plate=plate, load=load)
+                               plate=plate, load=load, box=box)
 
 
 #: The fields of each layout kind that place its granules (materials do not), in the
@@ -153,7 +207,8 @@ def placing_fields(scenario: Scenario, index: int) -> tuple[str, ...]:
     `resolve`."""
     lay = scenario.layout
     if lay is None:
-        return tuple(f"granules[{index}].{f}" for f in ("x", "y", "radius"))
+        coords = ("x", "y", "z", "radius") if scenario.dimension == 3 else ("x", "y", "radius")
+        return tuple(f"granules[{index}].{f}" for f in coords)
     primary = "R1" if isinstance(lay, Layout) else "radius"
     default = type(lay)()
     return tuple(f"layout.{f}" for f in PLACING_FIELDS[type(lay)]
@@ -161,7 +216,9 @@ def placing_fields(scenario: Scenario, index: int) -> tuple[str, ...]:
 
 
 def granule_named(scenario: Scenario, resolved: Scenario, index: int) -> str:
-    """"granule 'LABEL' (placed by FIELDS; centre (x, y), radius R [m])" for messages."""
+    """"granule 'LABEL' (placed by FIELDS; centre (x, y), radius R [m])" for messages
+    ((x, y, z) in 3D)."""
     g = resolved.granules[index]
+    centre = f"{g.x:.6g}, {g.y:.6g}" + (f", {g.z:.6g}" if scenario.dimension == 3 else "")
     return (f"granule '{g.label}' (placed by {', '.join(placing_fields(scenario, index))}; centre "
-            f"({g.x:.6g}, {g.y:.6g}) m, radius {g.radius:.6g} m)")
+            f"({centre}) m, radius {g.radius:.6g} m)")

@@ -27,13 +27,14 @@ import tomli_w
 from granplate.errors import ScenarioError
 from granplate.setup.fields import closest_name, string_in
 from granplate.setup.materials import LIBRARY, Material
-from granplate.setup.scenario import (LAYOUT_KINDS, NORMAL_LAWS, Contact, Granule, Load,
+from granplate.setup.scenario import (LAYOUT_KINDS, NORMAL_LAWS, Box, Contact, Granule, Load,
                                       PairCoefficients, Plate, Scenario, Solver, TimeSettings, Wall)
 
 #: Fields that a table must give (everything else takes the dataclass default).
 REQUIRED: dict[type, tuple[str, ...]] = {
     Granule: ("x", "y", "radius", "material"),
-    Wall: ("normal", "offset"),
+    Wall: ("normal",),  # and offset, or (3D) point: `_walls`
+    Box: ("lower", "upper"),
     PairCoefficients: ("materials",),
 }
 #: Keys of a [materials.NAME] table: E, nu, rho required; Y optional (absent: unknown).
@@ -48,6 +49,15 @@ CHOICES: dict[tuple[type, str], tuple[str, ...]] = {
 #: Fields left out of a written table when they hold this default (written, they would
 #: change the text, and so the stored results' keys, of every scenario written before).
 UNWRITTEN_DEFAULTS: dict[str, dict[str, Any]] = {"contact": {"normal_law": "hertz"}}
+#: Fields of the three-dimensional mode left out of a two-dimensional scenario's tables
+#: when they hold their default, so that every 2D scenario is written as before
+#: (`dimension = 2` itself is not written either).
+UNWRITTEN_DEFAULTS_2D: dict[str, dict[str, Any]] = {
+    "load": {"force": 0.0, "direction": [1.0, 0.0, 0.0]},
+    "granules": {"z": 0.0, "vz": 0.0},
+}
+#: The order of a 3D granule's keys as written (its centre, then its velocities).
+GRANULE_KEYS_3D: tuple[str, ...] = ("x", "y", "z", "radius", "material", "label", "vx", "vy", "vz", "omega")
 
 
 class _Missing:
@@ -99,7 +109,14 @@ def _convert(path: str, value: Any, tp: Any) -> Any:
         inner = [a for a in args if a is not type(None)]
         if len(inner) == 1:
             return _convert(path, value, inner[0])
-        raise TypeError(f"unsupported annotation {tp!r}")  # pragma: no cover
+        # a number or an array (Granule.omega: a float in 2D, a 3-vector in 3D): by shape
+        arrays = [a for a in inner if typing.get_origin(a) is tuple]
+        scalars = [a for a in inner if typing.get_origin(a) is not tuple]
+        if isinstance(value, (list, tuple)) and len(arrays) == 1:
+            return _convert(path, value, arrays[0])
+        if (isinstance(value, numbers.Real) and not isinstance(value, bool)) and scalars == [float]:
+            return float(value)
+        raise ScenarioError(path, value, f"wrong type: expected {_type_name(tp)}")
     if tp is float:
         if isinstance(value, numbers.Real) and not isinstance(value, bool):
             return float(value)
@@ -186,8 +203,27 @@ def _materials(d: Any) -> dict[str, Material]:
 
 _TOP_TABLES: dict[str, type] = {
     "plate": Plate, "load": Load, "contact": Contact,
-    "time": TimeSettings, "solver": Solver,
+    "time": TimeSettings, "solver": Solver, "box": Box,
 }
+
+
+def _walls(value: Any, dimension: Any) -> tuple[Wall, ...]:
+    """The [[walls]] tables; each gives `offset` or (3D) `point` (or both)."""
+    walls = _convert("walls", value, tuple[Wall, ...])
+    for i, w in enumerate(walls):
+        if w.offset is None and w.point is None:
+            alt = f" (or 'walls[{i}].point' in 3D)" if dimension == 3 else ""
+            raise ScenarioError(f"walls[{i}].offset", MISSING,
+                                f"missing required field 'walls[{i}].offset'{alt}")
+    return walls
+
+
+def _no_scalar_omega(granules: Any) -> None:
+    """A 3D file's granules give omega as a vector [wx, wy, wz] (or not at all)."""
+    for i, g in enumerate(granules if isinstance(granules, list) else ()):
+        if isinstance(g, dict) and isinstance(g.get("omega"), numbers.Real):
+            raise ScenarioError(f"granules[{i}].omega", g["omega"],
+                                "omega is a vector [wx, wy, wz] in 3D (rad/s)")
 
 
 def _layout(d: Any) -> Any:
@@ -204,8 +240,9 @@ def _layout(d: Any) -> Any:
 def from_dict(d: dict) -> Scenario:
     """A Scenario from a TOML-shaped dict; shape errors raise ScenarioError (no physics).
 
-    Top-level keys: name, description, materials, layout, granules, walls, plate, load,
-    contact, time, solver. Missing tables take the defaults (no layout, no plate).
+    Top-level keys: name, description, dimension, materials, layout, granules, walls, box,
+    plate, load, contact, time, solver. Missing tables take the defaults (no layout, no
+    plate, no box; dimension 2).
     """
     names = [f.name for f in dataclasses.fields(Scenario)]
     _check_keys("", d, names)
@@ -213,6 +250,10 @@ def from_dict(d: dict) -> Scenario:
     for key in ("name", "description"):
         if d.get(key) is not None:
             kw[key] = _convert(key, d[key], str)
+    if d.get("dimension") is not None:
+        kw["dimension"] = _convert("dimension", d["dimension"], int)
+    if kw.get("dimension") == 3 and d.get("granules") is not None:
+        _no_scalar_omega(d["granules"])
     if d.get("materials") is not None:
         kw["materials"] = _materials(d["materials"])
     if d.get("layout") is not None:
@@ -220,9 +261,10 @@ def from_dict(d: dict) -> Scenario:
     for key, cls in _TOP_TABLES.items():
         if d.get(key) is not None:
             kw[key] = _table(key, d[key], cls)
-    for key, cls in (("granules", Granule), ("walls", Wall)):
-        if d.get(key) is not None:
-            kw[key] = _convert(key, d[key], tuple[cls, ...])
+    if d.get("granules") is not None:
+        kw["granules"] = _convert("granules", d["granules"], tuple[Granule, ...])
+    if d.get("walls") is not None:
+        kw["walls"] = _walls(d["walls"], kw.get("dimension", 2))
     return Scenario(**kw)
 
 
@@ -246,6 +288,8 @@ def _plain(value: Any) -> Any:
 
 def _used_materials(s: Scenario) -> set[str]:
     used = {g.material for g in s.granules} | {w.material for w in s.walls}
+    if s.box is not None:
+        used.add(s.box.material)
     if s.layout is not None:
         used |= _layout_materials(s.layout)
     if s.plate is not None:
@@ -289,9 +333,14 @@ def to_dict(s: Scenario, all_materials: bool = False) -> dict:
     differs from `materials.LIBRARY` (all of them with `all_materials=True`), so that
     `from_dict(to_dict(s)) == s` whenever `s.materials` holds the library's names.
     Empty top-level granules/walls are left out (their default), and so are the fields of
-    `UNWRITTEN_DEFAULTS` that hold their default (`contact.normal_law = "hertz"`).
+    `UNWRITTEN_DEFAULTS` that hold their default (`contact.normal_law = "hertz"`). A 2D
+    scenario is written as before the 3D mode: no `dimension`, and the 3D fields of
+    `UNWRITTEN_DEFAULTS_2D` left out where they hold their default.
     """
     d: dict[str, Any] = {"name": s.name, "description": s.description}
+    if s.dimension != 2:
+        d["dimension"] = s.dimension
+    flat = UNWRITTEN_DEFAULTS_2D if s.dimension == 2 else {"granules": {"omega": 0.0}}
     used = _used_materials(s)
     mats = {name: _material_dict(m) for name, m in sorted(s.materials.items())
             if all_materials or name in used or LIBRARY.get(name) != m}
@@ -300,17 +349,28 @@ def to_dict(s: Scenario, all_materials: bool = False) -> dict:
     if s.layout is not None:
         d["layout"] = _layout_dict(s.layout)
     if s.granules:
-        d["granules"] = _plain(s.granules)
+        d["granules"] = [_without_defaults(g, flat.get("granules", {})) for g in _plain(s.granules)]
+        if s.dimension == 3:
+            d["granules"] = [{k: g[k] for k in sorted(g, key=_granule_key_rank)} for g in d["granules"]]
     if s.walls:
         d["walls"] = _plain(s.walls)
+    if s.box is not None:
+        d["box"] = _plain(s.box)
     if s.plate is not None:
         d["plate"] = _plain(s.plate)
     for key in ("load", "contact", "time", "solver"):
-        d[key] = _plain(getattr(s, key))
-        for name, default in UNWRITTEN_DEFAULTS.get(key, {}).items():
-            if d[key].get(name) == default:
-                del d[key][name]
+        d[key] = _without_defaults(_plain(getattr(s, key)),
+                                   {**UNWRITTEN_DEFAULTS.get(key, {}), **flat.get(key, {})})
     return d
+
+
+def _granule_key_rank(key: str) -> int:
+    return GRANULE_KEYS_3D.index(key) if key in GRANULE_KEYS_3D else len(GRANULE_KEYS_3D)
+
+
+def _without_defaults(table: dict, defaults: dict[str, Any]) -> dict:
+    """`table` without the entries that hold their value in `defaults`."""
+    return {k: v for k, v in table.items() if not (k in defaults and v == defaults[k])}
 
 
 # --------------------------------------------------------------------------- TOML

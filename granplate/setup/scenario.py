@@ -16,10 +16,11 @@ from granplate.setup.materials import LIBRARY, Material
 
 @dataclass(frozen=True)
 class Granule:
-    """One sphere: centre (x, y) [m], radius [m], material name, initial velocities.
+    """One sphere: centre (x, y, z) [m], radius [m], material name, initial velocities.
 
-    vx, vy [m/s]; omega [rad/s] (positive anticlockwise); label is the paper's name
-    ("1".."9", "A".."E") or any unique string.
+    vx, vy, vz [m/s]; omega [rad/s]: in 2D (`Scenario.dimension = 2`) a float, the spin
+    about z (positive anticlockwise), and z = vz = 0; in 3D the vector (wx, wy, wz).
+    label is the paper's name ("1".."9", "A".."E") or any unique string.
     """
 
     x: float
@@ -29,21 +30,50 @@ class Granule:
     label: str = ""
     vx: float = 0.0
     vy: float = 0.0
-    omega: float = 0.0
+    omega: float | tuple[float, float, float] = 0.0
+    z: float = 0.0
+    vz: float = 0.0
+
+    def spin(self) -> tuple[float, float, float]:
+        """The angular velocity vector (wx, wy, wz) [rad/s]: (0, 0, omega) in 2D."""
+        if isinstance(self.omega, tuple):
+            return self.omega
+        return (0.0, 0.0, self.omega)
 
 
 @dataclass(frozen=True)
 class Wall:
-    """A rigid, clamped straight wall: the line {p : p . normal = offset}.
+    """A rigid, clamped wall: the line (2D) or plane (3D) {p : p . n = offset}, n the unit normal.
 
-    normal: unit vector from the granules into the wall (outward for the granular
-    domain); offset [m]. The left wall x = 0 is normal (-1, 0), offset 0; the top wall
-    y = 0.1 is normal (0, 1), offset 0.1.
+    normal: from the granules into the wall (outward for the granular domain), [nx, ny]
+    of unit length in 2D, [nx, ny, nz] of any length > 0 in 3D (n = normal / |normal|);
+    offset [m]. The left wall x = 0 is normal (-1, 0), offset 0; the top wall y = 0.1 is
+    normal (0, 1), offset 0.1. point [m]: 3D only, a point on the plane instead of (or
+    agreeing with) offset: `geometry.resolve` sets offset = point . n.
     """
 
-    normal: tuple[float, float]
-    offset: float
+    normal: tuple[float, ...]
+    offset: float | None = None
     label: str = ""
+    material: str = "steel"
+    point: tuple[float, float, float] | None = None
+
+
+#: Labels of the six walls a `Box` expands into, in order (`geometry.box_walls`).
+BOX_WALLS: tuple[str, ...] = ("xmin", "xmax", "ymin", "ymax", "zmin", "zmax")
+
+
+@dataclass(frozen=True)
+class Box:
+    """A 3D box of six walls, `[box]`: lower = (x0, y0, z0), upper = (x1, y1, z1) [m].
+
+    Expanded by `geometry.resolve` into the walls "xmin" (normal -e_x, offset -x0),
+    "xmax" (+e_x, x1), "ymin", "ymax", "zmin", "zmax", of `material`, after the explicit
+    walls; the granules live inside, lower < s < upper.
+    """
+
+    lower: tuple[float, float, float]
+    upper: tuple[float, float, float]
     material: str = "steel"
 
 
@@ -213,10 +243,14 @@ class Load:
     """The half-sine shock of docs/model.md section 5.
 
     q(y, t) = q0 sin(pi t / T) sin(pi (y - y0) / L) on 0 <= t <= T, y0 <= y <= y0 + L.
-    kind: "line" or "none"; target: "granules" (push +x on the left surface of the
-    loaded granules) or "plate" (consistent nodal forces on the plate's left edge);
-    q0 [N/m], duration T [s], length L [m], y0 [m]; granules: labels of the loaded
-    granules (empty = every granule touching the leftmost wall, i.e. column 1).
+    kind: "line" (2D), "force" (3D) or "none"; target: "granules" (push +x on the left
+    surface of the loaded granules) or "plate" (consistent nodal forces on the plate's
+    left edge); q0 [N/m], duration T [s], length L [m], y0 [m]; granules: labels of the
+    loaded granules (empty = every granule touching the leftmost wall, i.e. column 1).
+    kind = "force" (3D): a total force F(t) = force sin(pi t / T) [N] along direction
+    (any length > 0, normalised by the solver), shared equally by the loaded granules
+    (empty `granules`: those whose surface is furthest against the direction,
+    `geometry.force_loaded_granules`).
     """
 
     kind: str = "line"
@@ -226,6 +260,8 @@ class Load:
     length: float = 0.05
     y0: float = 0.025
     granules: tuple[str, ...] = ()
+    force: float = 0.0
+    direction: tuple[float, float, float] = (1.0, 0.0, 0.0)
 
 
 #: Normal contact laws (`Contact.normal_law`, `PairCoefficients.normal_law`): "hertz",
@@ -376,7 +412,11 @@ class Solver:
 
 @dataclass(frozen=True)
 class Scenario:
-    """A complete run definition. Either `layout` or explicit `granules`/`walls`."""
+    """A complete run definition. Either `layout` or explicit `granules`/`walls`.
+
+    dimension: 2 (discs in the plane, the paper's model; the default) or 3 (spheres in
+    space: granules, walls and an optional `box`, no plate or layout yet).
+    """
 
     name: str = "custom"
     description: str = ""
@@ -389,6 +429,8 @@ class Scenario:
     contact: Contact = Contact()
     time: TimeSettings = TimeSettings()
     solver: Solver = Solver()
+    dimension: int = 2
+    box: Box | None = None
 
     def material(self, name: str) -> Material:
         """The material called `name` (file-defined ones override the library)."""

@@ -23,13 +23,13 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from granplate.errors import ScenarioError
-from granplate.setup.geometry import granule_named, layout_packing, resolve
+from granplate.setup.geometry import granule_named, layout_packing, plane_offset, resolve, unit
 from granplate.setup.layouts import column_radii, half_pitch, hexagonal_offsets, lattice_sites
 from granplate.setup.fields import finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
 from granplate.setup.plate_checks import check_plate_fields, check_plate_mesh
 from granplate.setup.plate_cost import MEMORY_SHARE, physical_memory
 from granplate.setup.materials import Material
-from granplate.setup.scenario import (LAYOUT_KINDS, NORMAL_LAWS, SQRT2_MINUS_1, ChainLayout,
+from granplate.setup.scenario import (BOX_WALLS, LAYOUT_KINDS, NORMAL_LAWS, SQRT2_MINUS_1, ChainLayout,
                                       Granule, Imperfections, LatticeLayout, Layout, Scenario)
 
 #: Lever arms of the friction torque (Contact.torque_arm).
@@ -42,8 +42,9 @@ YIELDING_LAWS: tuple[str, ...] = ("thornton",)
 SCHEMES: tuple[str, ...] = ("paper", "implicit")
 #: Treatments of the granule-granule and granule-wall friction (Solver.granular_friction).
 GRANULAR_FRICTIONS: tuple[str, ...] = ("split", "rk4")
-#: Load kinds (Load.kind) and targets (Load.target).
-LOAD_KINDS: tuple[str, ...] = ("line", "none")
+#: Load kinds (Load.kind: "line" is 2D, "force" 3D) and targets (Load.target).
+LOAD_KINDS: tuple[str, ...] = ("line", "force", "none")
+LOAD_KINDS_BY_DIMENSION: dict[int, tuple[str, ...]] = {2: ("line", "none"), 3: ("force", "none")}
 LOAD_TARGETS: tuple[str, ...] = ("granules", "plate")
 #: Plate edges that may be clamped (Plate.clamped_edges).
 
@@ -53,8 +54,12 @@ OVERLAP_RTOL = 1e-9
 #: four times those of the stiffest and the densest solids (diamond, osmium).
 E_MAX = 1e13
 RHO_MAX = 1e5
-#: Tolerance on |normal| - 1 for walls.
+#: Tolerance on |normal| - 1 for walls (2D; a 3D wall's normal may have any length > 0).
 NORMAL_TOL = 1e-9
+#: Scenario dimensions (Scenario.dimension): discs in the plane, spheres in space.
+DIMENSIONS: tuple[int, ...] = (2, 3)
+#: Relative tolerance of a 3D wall's offset against point . n when both are given.
+PLANE_RTOL = 1e-12
 #: Tolerance on the R2/R1 bounds.
 RATIO_TOL = 1e-12
 #: Relative tolerance for field_interval being a multiple of output_interval.
@@ -72,6 +77,122 @@ LAYOUT_RADIUS_RANGE: tuple[float, float] = (1e-9, 1e3)
 
 
 # --------------------------------------------------------------------------- sections
+
+def _check_dimension(s: Scenario) -> None:
+    d = s.dimension
+    if not isinstance(d, numbers.Integral) or isinstance(d, bool) or d not in DIMENSIONS:
+        raise ScenarioError("dimension", d, "must be 2 (discs in the plane, the default) or 3 "
+                            "(spheres in space)")
+
+
+#: The end of every message refusing a 3D field in a 2D scenario.
+SET_3D = "or set dimension = 3 (spheres in space)"
+
+
+def _check_planar(s: Scenario) -> None:
+    """A 2D scenario (as written) uses none of the 3D fields."""
+    if s.box is not None:
+        raise ScenarioError("box", "[box]", f"a box of six walls is 3D: give [[walls]] in 2D, {SET_3D}")
+    for i, g in enumerate(s.granules):
+        p = f"granules[{i}]"
+        for f in ("z", "vz"):
+            v = getattr(g, f)
+            if not (is_number(v) and v == 0.0):
+                raise ScenarioError(f"{p}.{f}", v, f"must be 0 in 2D (discs in the plane), {SET_3D}")
+        if isinstance(g.omega, tuple):
+            raise ScenarioError(f"{p}.omega", list(g.omega), "must be a number in 2D (the spin "
+                                f"about z [rad/s]); a vector [wx, wy, wz] is 3D: {SET_3D}")
+    for k, w in enumerate(s.walls):
+        p = f"walls[{k}]"
+        if isinstance(w.normal, tuple) and len(w.normal) == 3:
+            raise ScenarioError(f"{p}.normal", list(w.normal), "has 3 components, a plane of 3D: "
+                                f"give [nx, ny] in 2D, {SET_3D}")
+        if w.point is not None:
+            raise ScenarioError(f"{p}.point", w.point, f"a point on a plane is 3D: give offset in 2D, {SET_3D}")
+    if s.load.kind == "force":
+        raise ScenarioError("load.kind", s.load.kind, "a total force [N] along a direction is 3D; "
+                            f"in 2D use kind = \"line\" (q0 [N/m]) or \"none\", {SET_3D}")
+
+
+def _check_spatial(s: Scenario) -> None:
+    """A 3D scenario (as written): granules, walls and a box; no plate or layout yet; vector
+    spins; walls as planes."""
+    if s.plate is not None:
+        raise ScenarioError("plate", "[plate]", "three-dimensional elastic bodies are not available "
+                            "yet (a 3D scenario takes granules, walls and a box)")
+    if s.layout is not None:
+        raise ScenarioError("layout", s.layout.kind, "3D layouts: list [[granules]] (generated "
+                            "packings are 2D for now)")
+    if s.load.kind == "line":
+        raise ScenarioError("load.kind", s.load.kind, "a line load q0 [N/m] is 2D; in 3D use "
+                            "kind = \"force\" (or \"none\")")
+    for i, g in enumerate(s.granules):
+        p = f"granules[{i}]"
+        om = g.omega
+        if not isinstance(om, tuple):
+            if is_number(om) and om == 0.0:
+                continue  # the default: resolve makes it (0, 0, 0)
+            raise ScenarioError(f"{p}.omega", om, "omega is a vector [wx, wy, wz] in 3D (rad/s)")
+        if len(om) != 3:
+            raise ScenarioError(f"{p}.omega", list(om), "omega is a vector [wx, wy, wz] in 3D (rad/s): "
+                                "three numbers")
+    for k, w in enumerate(s.walls):
+        _check_plane(f"walls[{k}]", w)
+    if s.box is not None:
+        _check_box(s)
+
+
+def _vector3(path: str, v: Any, what: str) -> tuple[float, float, float]:
+    """Three finite numbers, or a ScenarioError naming `path` (`what`: the vector, in words)."""
+    if not isinstance(v, tuple) or len(v) != 3 or not all(is_number(c) and math.isfinite(c) for c in v):
+        raise ScenarioError(path, list(v) if isinstance(v, tuple) else v,
+                            f"must be three finite numbers {what}")
+    return v
+
+
+def _direction(path: str, v: Any, what: str) -> tuple[float, float, float]:
+    """A 3D direction: three finite numbers, not all zero (any length: normalised)."""
+    _vector3(path, v, what)
+    if not math.hypot(*v) > 0.0:
+        raise ScenarioError(path, list(v), f"must be nonzero {what} (any length > 0: normalised)")
+    return v
+
+
+def _check_plane(p: str, w: Any) -> None:
+    """A 3D wall: a nonzero normal [nx, ny, nz] and offset, or point, or both agreeing."""
+    n = w.normal
+    if isinstance(n, tuple) and len(n) == 2:
+        raise ScenarioError(f"{p}.normal", list(n), "has 2 components, a line of 2D: in 3D give "
+                            "[nx, ny, nz] (a plane's normal)")
+    _direction(f"{p}.normal", n, "[nx, ny, nz]")
+    if w.offset is None and w.point is None:
+        raise ScenarioError(f"{p}.offset", None, f"give the plane's offset [m] or a point on it, "
+                            f"{p}.point = [x, y, z] [m]")
+    if w.offset is not None:
+        finite(f"{p}.offset", w.offset)
+    if w.point is None:
+        return
+    _vector3(f"{p}.point", w.point, "[x, y, z] [m] (a point on the plane)")
+    if w.offset is not None:
+        through = plane_offset(n, w.point)
+        scale = max(abs(w.offset), math.hypot(*w.point))
+        if not abs(w.offset - through) <= PLANE_RTOL * scale:
+            raise ScenarioError(f"{p}.point", list(w.point),
+                                f"lies on the plane of offset {through:.15g} m (point . n, n the unit "
+                                f"normal), not {p}.offset = {w.offset!r} m; give one of the two, or "
+                                f"both agreeing within {PLANE_RTOL:g} relative")
+
+
+def _check_box(s: Scenario) -> None:
+    b = s.box
+    lo = _vector3("box.lower", b.lower, "[x0, y0, z0] [m]")
+    hi = _vector3("box.upper", b.upper, "[x1, y1, z1] [m]")
+    for k, axis in enumerate("xyz"):
+        if not lo[k] < hi[k]:
+            raise ScenarioError("box.upper", list(hi), f"must exceed box.lower = {list(lo)} along "
+                                f"every axis ({axis}: {hi[k]!r} <= {lo[k]!r}); allowed: lower < upper")
+    material_exists("box.material", b.material, s)
+
 
 def _check_materials(s: Scenario) -> None:
     if not isinstance(s.materials, dict) or not s.materials:
@@ -252,9 +373,14 @@ def _check_granules(s: Scenario) -> None:
         p = f"granules[{i}]"
         finite(f"{p}.x", g.x)
         finite(f"{p}.y", g.y)
+        if s.dimension == 3:
+            finite(f"{p}.z", g.z)
         positive(f"{p}.radius", g.radius)
-        for f in ("vx", "vy", "omega"):
+        for f in ("vx", "vy") + (("vz",) if s.dimension == 3 else ("omega",)):
             finite(f"{p}.{f}", getattr(g, f))
+        if s.dimension == 3:
+            for k, w in enumerate(g.omega):
+                finite(f"{p}.omega[{k}]", w)
         material_exists(f"{p}.material", g.material, s)
         _check_speeds(p, g, s.material(g.material))
         if not isinstance(g.label, str):
@@ -271,13 +397,20 @@ def bar_wave_speed(m: Material) -> float:
 
 
 def _check_speeds(p: str, g: Granule, m: Material) -> None:
-    """|vx|, |vy| and the surface speed |omega| R below the wave speed of the granule's
-    material: Hertz's law is quasi-static and holds for impact speeds far below it."""
+    """|vx|, |vy| (|vz|) and the surface speed |omega| R (each component in 3D) below the
+    wave speed of the granule's material: Hertz's law is quasi-static and holds for impact
+    speeds far below it."""
     c = bar_wave_speed(m)
-    for f, speed in (("vx", abs(g.vx)), ("vy", abs(g.vy)), ("omega", abs(g.omega) * g.radius)):
+    if isinstance(g.omega, tuple):
+        spins = [(f"omega[{k}]", w) for k, w in enumerate(g.omega)]
+        speeds = [("vx", g.vx), ("vy", g.vy), ("vz", g.vz)]
+    else:
+        spins, speeds = [("omega", g.omega)], [("vx", g.vx), ("vy", g.vy)]
+    checks = [(f, abs(v), v) for f, v in speeds] + [(f, abs(w) * g.radius, w) for f, w in spins]
+    for f, speed, value in checks:
         if not speed < c:
-            unit = "|omega| x radius" if f == "omega" else f"|{f}|"
-            raise ScenarioError(f"{p}.{f}", getattr(g, f),
+            unit = f"|{f}| x radius" if f.startswith("omega") else f"|{f}|"
+            raise ScenarioError(f"{p}.{f}", value,
                                 f"allowed: {unit} < sqrt(E / rho) = {c:.6g} m/s, the elastic "
                                 f"wave speed of material '{m.name}' (Hertz's contact law is "
                                 "quasi-static: it holds for speeds far below it)")
@@ -294,16 +427,31 @@ def length_scale(s: Scenario) -> tuple[float, str]:
     return min(found)
 
 
-def _check_lengths(s: Scenario) -> None:
-    """Coordinates and sizes within LENGTH_RANGE x the smallest length (see LENGTH_RANGE)."""
+def _wall_paths(s: Scenario, boxed: bool) -> list[str]:
+    """The field that places each wall of the resolved `s`: walls[k].offset, or, for the six
+    walls a box expanded into (the last six when `boxed`), box.lower[axis] / box.upper[axis]."""
+    n = len(s.walls) - (len(BOX_WALLS) if boxed else 0)
+    paths = [f"walls[{k}].offset" for k in range(n)]
+    if boxed:
+        paths += [f"box.{'upper' if j % 2 else 'lower'}[{j // 2}]" for j in range(len(BOX_WALLS))]
+    return paths
+
+
+def _check_lengths(s: Scenario, boxed: bool = False) -> None:
+    """Coordinates and sizes within LENGTH_RANGE x the smallest length (see LENGTH_RANGE);
+    boxed: the last six walls are the expanded box (named as its corners' fields)."""
     h, what = length_scale(s)
     limit = LENGTH_RANGE * h
     why = (f"{LENGTH_RANGE:g} x the smallest length of the scenario, h = {h:.6g} m ({what}): "
            f"farther out, round-off of a coordinate (2.2e-16 |x|) exceeds the {OVERLAP_RTOL:g} h "
            "overlap tolerance at t = 0")
+    coords = ("x", "y", "z", "radius") if s.dimension == 3 else ("x", "y", "radius")
     values = [(f"granules[{i}].{f}", getattr(g, f)) for i, g in enumerate(s.granules)
-              for f in ("x", "y", "radius")]
-    values += [(f"walls[{k}].offset", w.offset) for k, w in enumerate(s.walls)]
+              for f in coords]
+    values += [(path, -w.offset if ".lower[" in path else w.offset)  # box.lower: offset -x0
+               for path, w in zip(_wall_paths(s, boxed), s.walls)]
+    values += [(f"walls[{k}].point[{c}]", x) for k, w in enumerate(s.walls) if w.point is not None
+               for c, x in enumerate(w.point)]
     if s.plate is not None:
         pl = s.plate
         values += [(f"plate.{f}", getattr(pl, f)) for f in ("x0", "y0", "width", "height", "thickness",
@@ -318,9 +466,9 @@ def _check_overlaps(s: Scenario, named: dict[int, str]) -> None:
     """Granules may touch but not overlap at t = 0 (k-d tree over the centres; the
     coordinates are within LENGTH_RANGE x h, so its squared distances cannot overflow)."""
     gs = s.granules
-    for i, j in _close_pairs(gs):
+    for i, j in _close_pairs(gs, s.dimension):
         gi, gj = gs[i], gs[j]
-        dist = math.hypot(gj.x - gi.x, gj.y - gi.y)
+        dist = math.dist(_centre(gi, s.dimension), _centre(gj, s.dimension))
         overlap = gi.radius + gj.radius - dist
         if overlap > OVERLAP_RTOL * min(gi.radius, gj.radius):
             raise ScenarioError(
@@ -330,12 +478,17 @@ def _check_overlaps(s: Scenario, named: dict[int, str]) -> None:
                 f"{OVERLAP_RTOL:g} x the smaller radius)")
 
 
-def _close_pairs(gs: tuple[Granule, ...]) -> list[tuple[int, int]]:
-    """Sorted pairs (i < j) of granules whose centres are at most 2 R_max apart (k-d tree):
-    every pair that can overlap, found in O(N log N)."""
+def _centre(g: Granule, dimension: int) -> tuple[float, ...]:
+    """The centre [m]: (x, y) in 2D, (x, y, z) in 3D."""
+    return (g.x, g.y, g.z) if dimension == 3 else (g.x, g.y)
+
+
+def _close_pairs(gs: tuple[Granule, ...], dimension: int = 2) -> list[tuple[int, int]]:
+    """Sorted pairs (i < j) of granules whose centres are at most 2 R_max apart (k-d tree
+    in the plane, or in space in 3D): every pair that can overlap, found in O(N log N)."""
     if len(gs) < 2:
         return []
-    xy = np.array([(g.x, g.y) for g in gs], float)
+    xy = np.array([_centre(g, dimension) for g in gs], float)
     r_max = max(g.radius for g in gs)
     pairs = cKDTree(xy).query_pairs(2.0 * r_max * (1.0 + 1e-9), output_type="ndarray")
     return sorted(map(tuple, pairs.tolist()))
@@ -346,11 +499,13 @@ def _check_walls(s: Scenario) -> None:
     for k, w in enumerate(s.walls):
         p = f"walls[{k}]"
         n = w.normal
-        if (not isinstance(n, tuple) or len(n) != 2
+        if s.dimension == 3:
+            _check_plane(p, w)
+        elif (not isinstance(n, tuple) or len(n) != 2
                 or not all(is_number(c) and math.isfinite(c) for c in n)):
             raise ScenarioError(f"{p}.normal", n, "must be two finite numbers [nx, ny]")
-        norm = math.hypot(n[0], n[1])
-        if abs(norm - 1.0) > NORMAL_TOL:
+        elif abs(math.hypot(n[0], n[1]) - 1.0) > NORMAL_TOL:
+            norm = math.hypot(n[0], n[1])
             raise ScenarioError(f"{p}.normal", n,
                                 f"must be a unit vector (|normal| = {norm:.12g}; "
                                 f"allowed 1 within {NORMAL_TOL:g})")
@@ -365,11 +520,14 @@ def _check_walls(s: Scenario) -> None:
 
 
 def _check_wall_penetration(s: Scenario, named: dict[int, str]) -> None:
-    """No granule crosses a wall at t = 0."""
+    """No granule crosses a wall at t = 0 (3D: the plane of unit normal n = normal / |normal|)."""
     for k, w in enumerate(s.walls):
         n = w.normal
+        if s.dimension == 3:
+            n = unit(n)
         for i, g in enumerate(s.granules):
-            pen = g.x * n[0] + g.y * n[1] + g.radius - w.offset
+            depth = g.x * n[0] + g.y * n[1] + (g.z * n[2] if s.dimension == 3 else 0.0)
+            pen = depth + g.radius - w.offset
             if pen > OVERLAP_RTOL * g.radius:
                 raise ScenarioError(
                     f"granules[{i}]", g.label,
@@ -401,7 +559,7 @@ def _check_plate_penetration(s: Scenario, named: dict[int, str]) -> None:
 
 def _check_load(s: Scenario) -> None:
     ld = s.load
-    string_in("load.kind", ld.kind, LOAD_KINDS)
+    string_in("load.kind", ld.kind, LOAD_KINDS_BY_DIMENSION[s.dimension])
     string_in("load.target", ld.target, LOAD_TARGETS)
     q0 = finite("load.q0", ld.q0, "must be >= 0 (a finite number) [N/m]")
     if not q0 >= 0.0:
@@ -417,6 +575,20 @@ def _check_load(s: Scenario) -> None:
     positive("load.duration", ld.duration)
     positive("load.length", ld.length)
     finite("load.y0", ld.y0)
+    force = finite("load.force", ld.force, "must be >= 0 (a finite number) [N]")
+    if not force >= 0.0:
+        raise ScenarioError("load.force", ld.force, "must be >= 0 [N]")
+    if ld.kind == "force":
+        if not force <= e_max * h * h:
+            raise ScenarioError("load.force", ld.force,
+                                f"allowed: 0 <= force <= E h^2 = {e_max * h * h:.6g} N, E = {e_max:.6g} Pa "
+                                f"the largest Young's modulus of the granules, h = {h:.6g} m the "
+                                "smallest radius: a larger force presses on h^2 harder than E, far "
+                                "beyond Hertz's small overlaps")
+        _direction("load.direction", ld.direction, "[dx, dy, dz]")
+        if ld.target != "granules":
+            raise ScenarioError("load.target", ld.target, "a force load acts on granules: "
+                                "use target = \"granules\"")
     if not isinstance(ld.granules, tuple) or not all(isinstance(x, str) for x in ld.granules):
         raise ScenarioError("load.granules", ld.granules, "must be a list of granule labels")
     labels = {g.label for g in s.granules}
@@ -425,6 +597,8 @@ def _check_load(s: Scenario) -> None:
             raise ScenarioError(f"load.granules[{i}]", lab,
                                 "no granule has this label; labels are: "
                                 + ", ".join(g.label for g in s.granules))
+    if ld.kind == "force" and not s.granules:
+        raise ScenarioError("load.kind", ld.kind, "a force load needs [[granules]]; use kind = \"none\"")
     if ld.kind == "line":
         if ld.target == "plate" and s.plate is None:
             raise ScenarioError("load.target", ld.target,
@@ -645,7 +819,10 @@ class _GranuleNames(dict):
 def validate(scenario: Scenario) -> None:
     """Raise ScenarioError(field, value, allowed) for the first problem in `scenario`.
 
-    Order: materials, layout (as `layout.*`, before it is expanded), then on the resolved
+    Order: dimension, materials, the fields of the other dimension (2D: no z, vz, vector
+    omega, 3-component normal, point, box or force load; 3D: no plate, layout or line load,
+    vector omegas, walls as planes, the box), layout (as `layout.*`, before it is
+    expanded), then on the resolved
     scenario: granules (values, speeds, unique labels), walls (unit normals), plate, the
     range of every coordinate and size (`LENGTH_RANGE`), overlaps and penetrations at
     t = 0, load, contact (and the yield strengths its normal laws need), plate mesh (rigid
@@ -658,7 +835,12 @@ def validate(scenario: Scenario) -> None:
         raise ScenarioError("name", s.name, "must be a string")
     if not isinstance(s.description, str):
         raise ScenarioError("description", s.description, "must be a string")
+    _check_dimension(s)
     _check_materials(s)
+    if s.dimension == 2:
+        _check_planar(s)
+    else:
+        _check_spatial(s)
     _check_layout(s)
     if s.layout is None and not s.granules and s.plate is None:
         raise ScenarioError("granules", (), "a scenario needs granules (or a [layout]) "
@@ -669,7 +851,7 @@ def validate(scenario: Scenario) -> None:
     _check_granules(r)
     _check_walls(r)
     _check_plate(r)
-    _check_lengths(r)
+    _check_lengths(r, boxed=s.dimension == 3 and s.box is not None)
     named = _GranuleNames(s, r)
     _check_overlaps(r, named)
     _check_wall_penetration(r, named)

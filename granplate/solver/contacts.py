@@ -51,14 +51,15 @@ def plate_face(u):
 
 @njit(cache=True)
 def watch_contacts(t, y, u, radius, plate_free, yref, ovl, ovl_with, ovl_new, ovl_who, overlap_stop,
-                   plate_x0, plate_ylo, plate_yhi, rebuild_move, face_skin, err):
+                   plate_x0, plate_ylo, plate_yhi, rebuild_move, face_skin, ndim, err):
     """Check the state after an accepted step; returns OK, REBUILD (the list must be
     rebuilt: a granule moved rebuild_move since it was built, at yref), NEW_PLATE (a
     granule without a plate contact is within face_skin R of the undeformed face: it needs
     a patch contact; err[ERR_CONTACT] names it), ERR_OVERLAP, ERR_PLATE_REACH or ERR_JUMP
     with err filled. The step's largest overlap comes from the last evaluation of the
     forces (ovl_new, ovl_who: granular.granular_rhs); ovl, ovl_with keep each granule's
-    largest. (Arrays and the Config's scalars, not the tuples: this runs every step.)"""
+    largest; ndim: the positions' dimension (2 or 3: the first ndim state columns). (Arrays
+    and the Config's scalars, not the tuples: this runs every step.)"""
     i = ovl_who[0]
     if i >= 0:
         partner = ovl_who[1]
@@ -81,9 +82,10 @@ def watch_contacts(t, y, u, radius, plate_free, yref, ovl, ovl_with, ovl_new, ov
                 status = NEW_PLATE
                 err[ERR_CONTACT] = i
         if rebuild_move > 0.0:
-            dx = y[i, 0] - yref[i, 0]
-            dy = y[i, 1] - yref[i, 1]
-            d2 = dx * dx + dy * dy
+            d2 = 0.0
+            for c in range(ndim):
+                dc = y[i, c] - yref[i, c]
+                d2 += dc * dc
             if d2 > move2:
                 status = REBUILD
                 jump = rebuild_move + radius[i]

@@ -18,7 +18,7 @@ import numpy as np
 
 from granplate.model.arrays import Model, granular_with_contacts, granular_with_patch_contacts
 from granplate.model.inputs import HIST_MAX, HIST_TIME, no_history
-from granplate.model.contacts import Missed, contact_lists, missed_contacts, wall_planes
+from granplate.model.contacts import Missed, centre_coordinates, contact_lists, missed_contacts, wall_planes
 from granplate.model.neighbours import verlet_pairs, verlet_walls
 from granplate.physics.contact import plate_overlap
 from granplate.solver import loop, state as S
@@ -163,7 +163,7 @@ def contact_message(status: int, model: Model, st: S.State) -> str:
     i = int(e[S.ERR_CONTACT])
     who = f"granule '{model.labels[i]}'"
     other = partner_name(model, int(e[S.ERR_ITER]))
-    where = f"(at x = {st.y[i, 0]:.6g} m, y = {st.y[i, 1]:.6g} m)"
+    where = "(at " + ", ".join(f"{name} = {v:.6g} m" for name, v in zip("xyz", st.y[i, :cfg.dimension])) + ")"
     if status == S.ERR_OVERLAP:
         return (f"{who} {where} and {other} overlap by {e[S.ERR_N]:.4g} m at t = {t:.6e} s, "
                 f"{e[S.ERR_RESID]:.3g} of the smaller radius, beyond contact.overlap_stop = "
@@ -223,7 +223,7 @@ class ContactLists:
                             pc_hist=no_history(len(g.pc_i)))
         self.known: dict = {}
         self.stores: tuple[dict, dict] = ({}, {})  # histories of the pairs and wall contacts off the lists
-        self.planes = wall_planes(model.scenario.walls)
+        self.planes = wall_planes(model.scenario.walls, model.config.dimension)
         self.n_rebuilds = 0  # rebuilds the loop asked for (REBUILD, dynamic detection)
         self.formed: list[tuple[int, float, float]] = []  # patch contacts: (granule, t [s], y [m])
 
@@ -237,16 +237,17 @@ class ContactLists:
         """Rebuild (dynamic) or check (fixed) the lists at positions y[:, :2]; returns the
         worst overlap no contact of the current list accounts for, or None."""
         m, g = self.model, self.g
-        x, yy, r = y[:, 0], y[:, 1], g.radius
+        x, yy, z = centre_coordinates(y, m.config.dimension)
+        r = g.radius
         c = m.scenario.contact
         fixed = c.detection == "fixed"
         normals, offsets = self.planes
         if fixed:
-            cand_p, cand_w = verlet_pairs(x, yy, r, 0.0), verlet_walls(x, yy, r, normals, offsets, 0.0)
+            cand_p, cand_w = verlet_pairs(x, yy, r, 0.0, z), verlet_walls(x, yy, r, normals, offsets, 0.0, z)
         else:
-            cand_p, cand_w = contact_lists(c, m.scenario.walls, x, yy, r)
+            cand_p, cand_w = contact_lists(c, m.scenario.walls, x, yy, r, z)
         cur_w = np.column_stack([g.wall_i, g.wall_w]).astype(np.int64)
-        missed = missed_contacts(g.pair_ij, cur_w, cand_p, cand_w, normals, offsets, x, yy, r)
+        missed = missed_contacts(g.pair_ij, cur_w, cand_p, cand_w, normals, offsets, x, yy, r, z)
         if not fixed:
             self.g = granular_with_contacts(m, g, cand_p, cand_w, self.known, self.stores)
         return missed[0] if missed else None
@@ -260,15 +261,16 @@ class LoopArrays:
     def __init__(self, model: Model, times: np.ndarray, nk: int):
         g, p, cfg = model.granular, model.plate_arrays, model.config
         ng, nm = model.n_granules, len(p.omega2)
+        nc = S.STATE_COLUMNS[cfg.dimension]
         self.p = p._replace(phi_d=p.phi_d.copy(), resid=p.resid.copy()) if cfg.face_skin > 0.0 else p
-        self.st = S.new_state(ng, nm, nk)
-        self.w = S.new_work(ng, nm, nk, len(p.face_y))
+        self.st = S.new_state(ng, nm, nk, nc)
+        self.w = S.new_work(ng, nm, nk, len(p.face_y), nc)
         if cfg.face_skin > 0.0 and p.resid_face.shape[0] > 0:  # the rigid layers' face weights: their node
             for k, y_k in enumerate(model.plate.contact_y[:nk]):
                 first, last = patch_weights(p.face_y, float(y_k), 0.0, self.w.wface)
                 set_face_weights(k, first, last, self.w)
         self.sw = scheme(cfg.scheme).new_scratch(ng, nm, nk)
-        self.out = S.new_output(times, ng, nm, nk)
+        self.out = S.new_output(times, ng, nm, nk, nc)
         self.scheme = cfg.scheme
 
     def grow(self, nk_new: int) -> None:
@@ -277,10 +279,11 @@ class LoopArrays:
         matrices marked stale."""
         st, w = self.st, self.w
         ng, nm = st.y.shape[0], st.q.shape[0]
-        self.st = _copied(st, S.new_state(ng, nm, nk_new))
-        self.w = _copied(w, S.new_work(ng, nm, nk_new, len(w.wface)))
+        nc = st.y.shape[1]
+        self.st = _copied(st, S.new_state(ng, nm, nk_new, nc))
+        self.w = _copied(w, S.new_work(ng, nm, nk_new, len(w.wface), nc))
         self.sw = _copied(self.sw, scheme(self.scheme).new_scratch(ng, nm, nk_new))
-        self.out = _copied(self.out, S.new_output(self.out.target, ng, nm, nk_new))
+        self.out = _copied(self.out, S.new_output(self.out.target, ng, nm, nk_new, nc))
         phi_d = np.zeros((2 * nk_new, nm))
         phi_d[: self.p.phi_d.shape[0]] = self.p.phi_d
         self.p = self.p._replace(phi_d=phi_d)
@@ -365,10 +368,16 @@ def next_budget(budget: int, attempts: int, seconds: float) -> int:
     return int(min(max(CHUNK_SECONDS / per, 1), 1 << 24))
 
 
+def set_reference(w: S.Work, st: S.State, dimension: int) -> None:
+    """Keep the granules' centres (their first `dimension` state columns) as the contact
+    list's reference (the contact watch measures how far each has moved since)."""
+    w.yref[:, :dimension] = st.y[:, :dimension]
+
+
 def _refresh(lists: ContactLists, st: S.State, w: S.Work) -> int:
     """Rebuild or check the contact lists at the current state: OK or ERR_MISSED (st.err filled)."""
     miss = lists.refresh(st.y)
-    w.yref[:] = st.y[:, :2]
+    set_reference(w, st, lists.model.config.dimension)
     if miss is None:
         return S.OK
     st.err[S.ERR_T] = st.clock[S.T_NOW]
@@ -490,7 +499,7 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
     arr = LoopArrays(model, times, len(model.plate_contacts))
     st, w = arr.st, arr.w
     st.y[:] = model.initial_state
-    w.yref[:] = st.y[:, :2]
+    set_reference(w, st, cfg.dimension)
     w.plate_free[:] = 1
     w.plate_free[model.plate_contacts] = 0
     lists = ContactLists(model)

@@ -12,7 +12,7 @@ from numba import njit
 
 from granplate.physics.contact import COEF_KS, COEF_MU, local_map_modulus, plate_overlap
 from granplate.plate.face import patch_weights
-from granplate.solver.granular import granular_rhs
+from granplate.solver.dimension import granular_rhs
 from granplate.solver.plate_modal import static_energy
 from granplate.solver.state import CUSTOM_H, E_ZERO, T_NOW
 
@@ -202,7 +202,7 @@ def move_patches(st, g, p, cfg, w):
             w.g_ok[s] = 0
         st.clock[CUSTOM_H] = -1.0
         pr = granular_rhs(st.clock[T_NOW], st.y, st.u, st.v, g, cfg, st.k1, w.fscratch, w.nscratch, w.sscratch,
-                          False, w.fbar)
+                          False, w.fbar, False, False)
         st.p1[0] = pr.p_shock
         st.p1[1] = pr.p_visc
         st.p1[2] = pr.p_fric

@@ -14,13 +14,15 @@ from numba import njit
 from granplate.physics.energy import energy_residual, energy_total
 from granplate.solver import schemes as S
 from granplate.solver.contacts import watch_contacts
-from granplate.solver.granular import RK4_FRICTION_LIMIT, commit_histories, granular_rhs, kinetic_energies
+from granplate.solver.dimension import granular_rhs, kinetic_energies
+from granplate.solver.granular import commit_histories
+from granplate.solver.rk4 import RK4_FRICTION_LIMIT
 from granplate.solver.interface import accept_contacts, contact_modulus, first_guess, move_patches, place_patch
 from granplate.solver.ladder import level_step
 from granplate.solver.plate_modal import driving_dofs, modal_acceleration, plate_energy, step_matrices
 from granplate.solver.state import (
     A_FRIC, A_PLASTIC, A_SHOCK_G, A_SHOCK_P, A_VISC, C_FRICTION_BOUND, C_ITERS, C_LEVEL, C_OUT, C_RETRIES, C_STEPS, CUSTOM_H,
-    D_FRIC, D_PLASTIC, D_VISC, E_GRAN, E_IN_MAX, E_PLATE, E_POT, E_POTG, E_SHOCK, E_ZERO, ERR_BUFFER,
+    D_FRIC, D_PLASTIC, D_VISC, E_GRAN, KE_Z, E_IN_MAX, E_PLATE, E_POT, E_POTG, E_SHOCK, E_ZERO, ERR_BUFFER,
     ERR_CONTACT, ERR_ENERGY, ERR_H, ERR_ITER, ERR_LAM, ERR_N, ERR_NAN, ERR_NOCONV, ERR_RESID,
     ERR_T, ERR_VT, H_LAST, KE_ROT, KE_X, KE_Y, N_LEVELS, OK, PAUSED, RES_LAST, RESID, RESID_MAX,
     S_DT_MAX, S_DT_MIN, S_ITERS, S_LAM_MAX, S_RETRIES, S_STEPS, T_NOW,
@@ -45,8 +47,8 @@ def initialise(st, g, p, cfg, w):
     for d in range(st.force.shape[0]):
         st.force_prev[d] = st.force[d]
         st.pforce[d] = st.force[d]
-    kx, ky, kr = kinetic_energies(st.y, g.mass, g.inertia)
-    e0 = kx + ky + kr + pr.e_pot + plate_energy(st.q, st.qd, st.force, p.omega2, p.resid)
+    kx, ky, kz, kr = kinetic_energies(st.y, g)
+    e0 = kx + ky + kz + kr + pr.e_pot + plate_energy(st.q, st.qd, st.force, p.omega2, p.resid)
     st.clock[E_ZERO] = e0
     st.clock[E_IN_MAX] = e0
     reset_interval(w)
@@ -64,26 +66,27 @@ def reset_interval(w):
 
 
 @njit(cache=True)
-def energy_terms(y, q, qd, force, clock, acc, mass, inertia, omega2, resid):
-    """The terms of eq. (11) at t_n: (E_shock, E_g, E_p, KE_x, KE_y, KE_rot) [J]. (Arrays,
-    not the state tuples: this runs every step.)"""
-    kx, ky, kr = kinetic_energies(y, mass, inertia)
-    eg = kx + ky + kr + clock[E_POT]
+def energy_terms(y, q, qd, force, clock, acc, g, omega2, resid):
+    """The terms of eq. (11) at t_n: (E_shock, E_g, E_p, KE_x, KE_y, KE_z, KE_rot) [J]
+    (KE_z = 0 in the plane). (Arrays, not the state tuples, but for the granular arrays g
+    that tell the dimension: this runs every step.)"""
+    kx, ky, kz, kr = kinetic_energies(y, g)
+    eg = kx + ky + kz + kr + clock[E_POT]
     ep = plate_energy(q, qd, force, omega2, resid)
     eshock = acc[A_SHOCK_G] + acc[A_SHOCK_P]
-    return eshock, eg, ep, kx, ky, kr
+    return eshock, eg, ep, kx, ky, kz, kr
 
 
 @njit(cache=True)
 def record(o, st, g, p, w, out):
     """Write the state at t_n into output row o and restart the interval maxima."""
-    eshock, eg, ep, kx, ky, kr = energy_terms(st.y, st.q, st.qd, st.force, st.clock, st.acc, g.mass, g.inertia,
-                                              p.omega2, p.resid)
+    eshock, eg, ep, kx, ky, kz, kr = energy_terms(st.y, st.q, st.qd, st.force, st.clock, st.acc, g, p.omega2,
+                                                  p.resid)
     e_in = st.clock[E_ZERO] + eshock
     denom = max(st.clock[E_IN_MAX], 1e-300)
     out.t[o] = st.clock[T_NOW]
     for i in range(st.y.shape[0]):
-        for c in range(6):
+        for c in range(st.y.shape[1]):
             out.y[o, i, c] = st.y[i, c]
     e = out.energy[o]
     e[E_SHOCK] = eshock
@@ -95,6 +98,7 @@ def record(o, st, g, p, w, out):
     e[KE_X] = kx
     e[KE_Y] = ky
     e[KE_ROT] = kr
+    e[KE_Z] = kz
     e[RESID] = energy_residual(energy_total(eg, ep, st.acc[A_VISC], st.acc[A_FRIC], st.acc[A_PLASTIC]), e_in, denom)
     e[RESID_MAX] = w.res_int[0]
     e[E_POTG] = st.clock[E_POT]
@@ -143,11 +147,11 @@ def step_too_small(t, h, it, worst, lam, normal, slip, st):
 
 
 @njit(cache=True)
-def check_energy(h, y, q, qd, force, clock, acc, mass, inertia, omega2, resid, energy_tol, res_int, err):
+def check_energy(h, y, q, qd, force, clock, acc, g, omega2, resid, energy_tol, res_int, err):
     """Eq. (11) after an accepted step: keep the residual's running values (clock,
     res_int); returns OK, ERR_NAN or ERR_ENERGY (above energy_tol) with err filled.
     (Arrays, not the state tuples: this runs every step.)"""
-    eshock, eg, ep, kx, ky, kr = energy_terms(y, q, qd, force, clock, acc, mass, inertia, omega2, resid)
+    eshock, eg, ep, kx, ky, kz, kr = energy_terms(y, q, qd, force, clock, acc, g, omega2, resid)
     e_in = clock[E_ZERO] + eshock
     if e_in > clock[E_IN_MAX]:
         clock[E_IN_MAX] = e_in
@@ -191,7 +195,7 @@ def accept_granular(t, h, land, t_out, plate_work, e_pot, st, w):
     the contacts loaded past their largest overlaps) into the state and move the clock
     (onto the output time when the step lands on it)."""
     for i in range(st.y.shape[0]):
-        for c in range(6):
+        for c in range(st.y.shape[1]):
             st.y[i, c] = w.ynew[i, c]
             st.k0[i, c] = st.k1[i, c]
             st.k1[i, c] = w.kend[i, c]
@@ -258,7 +262,7 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
         if level_step(new_level, cfg) < cfg.dt_min:
             return step_too_small(st.clock[T_NOW], h_new, it, worst_contact(w), lam_max, st.normal, st.slip, st)
         st.count[C_LEVEL] = new_level
-        status = check_energy(h, st.y, st.q, st.qd, st.force, st.clock, st.acc, g.mass, g.inertia, p.omega2,
+        status = check_energy(h, st.y, st.q, st.qd, st.force, st.clock, st.acc, g, p.omega2,
                               p.resid, cfg.energy_tol, w.res_int, st.err)
         if status != OK:
             return status
@@ -269,7 +273,7 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
             S.contacts_moved(sw, st.clock[T_NOW], st, p, cfg)
         status = watch_contacts(st.clock[T_NOW], st.y, st.u, g.radius, w.plate_free, w.yref, w.ovl, w.ovl_with,
                                 w.ovl_new, w.ovl_who, cfg.overlap_stop, cfg.plate_x0, cfg.plate_ylo, cfg.plate_yhi,
-                                cfg.rebuild_move, cfg.face_skin, st.err)
+                                cfg.rebuild_move, cfg.face_skin, cfg.dimension, st.err)
         if status != OK:
             return status
     return OK if st.clock[T_NOW] >= t_stop - 1e-9 * cfg.dt_min else PAUSED

@@ -7,6 +7,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from granplate.model.inputs import STATE_COLUMNS  # noqa: F401 - the state's columns per dimension
+
 # clock (float64)
 T_NOW, H_LAST, E_IN_MAX, E_ZERO, E_POT, CUSTOM_H, F_SCALE, RES_LAST = 0, 1, 2, 3, 4, 5, 6, 7
 N_CLOCK = 10
@@ -22,9 +24,9 @@ A_SHOCK_G, A_VISC, A_FRIC, A_SHOCK_P, A_PLASTIC = 0, 1, 2, 3, 4
 N_ACC = 5
 # energy output columns
 (
-    E_SHOCK, E_GRAN, E_PLATE, D_VISC, D_FRIC, KE_X, KE_Y, KE_ROT, RESID, RESID_MAX, E_POTG, D_PLASTIC,
-) = range(12)
-N_ENERGY = 12
+    E_SHOCK, E_GRAN, E_PLATE, D_VISC, D_FRIC, KE_X, KE_Y, KE_ROT, RESID, RESID_MAX, E_POTG, D_PLASTIC, KE_Z,
+) = range(13)
+N_ENERGY = 13
 # step-statistics output columns
 S_STEPS, S_DT_MIN, S_DT_MAX, S_ITERS, S_RETRIES, S_LAM_MAX = range(6)
 N_STEPSTAT = 6
@@ -107,7 +109,7 @@ class Work(NamedTuple):
     it_int: np.ndarray  # (nk,) max iterations since last output
     dt_int: np.ndarray  # (2,) min, max step since last output
     res_int: np.ndarray  # (1,) max |residual| since last output
-    yref: np.ndarray  # (ng, 2) granule centres when the contact list was last built
+    yref: np.ndarray  # (ng, 3) granule centres when the contact list was last built (z unused in the plane)
     ovl: np.ndarray  # (ng,) largest overlap / smaller radius seen at each granule's contacts
     ovl_with: np.ndarray  # (ng,) int: its partner (granule j, wall -1 - w, PARTNER_PLATE)
     plate_free: np.ndarray  # (ng,) int: 1 for a granule without a plate contact
@@ -135,42 +137,43 @@ class Output(NamedTuple):
     stats: np.ndarray  # (no, N_STEPSTAT)
 
 
-def new_state(ng: int, nm: int, nk: int) -> State:
-    """A zeroed State for ng granules, nm modes and nk plate contacts."""
+def new_state(ng: int, nm: int, nk: int, nc: int = 6) -> State:
+    """A zeroed State for ng granules of nc state columns, nm modes and nk plate contacts."""
     nd = 2 * nk
     z = np.zeros
     return State(
-        y=z((ng, 6)), acc=z(N_ACC), q=z(nm), qd=z(nm), qdd=z(nm), u=z(nd), v=z(nd),
-        a=z(nd), force=z(nd), force_prev=z(nd), k1=z((ng, 6)), k0=z((ng, 6)), pforce=z(nd),
+        y=z((ng, nc)), acc=z(N_ACC), q=z(nm), qd=z(nm), qdd=z(nm), u=z(nd), v=z(nd),
+        a=z(nd), force=z(nd), force_prev=z(nd), k1=z((ng, nc)), k0=z((ng, nc)), pforce=z(nd),
         p1=z(3), normal=z(nk), slip=z(nk), clock=z(N_CLOCK),
         count=np.zeros(N_COUNT, np.int64), err=z(N_ERR),
     )
 
 
-def new_work(ng: int, nm: int, nk: int, n_face: int = 0) -> Work:
-    """Shared scratch for ng granules, nm modes, nk plate contacts and n_face face nodes."""
+def new_work(ng: int, nm: int, nk: int, n_face: int = 0, nc: int = 6) -> Work:
+    """Shared scratch for ng granules of nc state columns, nm modes, nk plate contacts and
+    n_face face nodes."""
     nd = 2 * nk
     z = np.zeros
     return Work(
-        ytmp=z((ng, 6)), ynew=z((ng, 6)), k1h=z((ng, 6)), k2=z((ng, 6)), k3=z((ng, 6)),
-        k4=z((ng, 6)), kend=z((ng, 6)), up=z(nd), vp=z(nd), fguess=z(nd), fbar=z(nk),
+        ytmp=z((ng, nc)), ynew=z((ng, nc)), k1h=z((ng, nc)), k2=z((ng, nc)), k3=z((ng, nc)),
+        k4=z((ng, nc)), kend=z((ng, nc)), up=z(nd), vp=z(nd), fguess=z(nd), fbar=z(nk),
         stage=z((4, nd)), fnew=z(nd), fscratch=z(nd), pend=z(3), dacc=z(4), p1h=z(3),
         normal_new=z(nk), slip_new=z(nk), nscratch=z(nk), sscratch=z(nk),
         conv_iter=np.zeros(nk, np.int64), dmode=z((N_LEVELS + 1, nm)),
         gmat=z((N_LEVELS + 1, nd, nd)), g_ok=np.zeros(N_LEVELS + 1, np.int64),
         lam_int=z(nk), it_int=np.zeros(nk, np.int64), dt_int=z(2), res_int=z(1),
-        yref=z((ng, 2)), ovl=z(ng), ovl_with=np.zeros(ng, np.int64), plate_free=np.zeros(ng, np.int64),
+        yref=z((ng, 3)), ovl=z(ng), ovl_with=np.zeros(ng, np.int64), plate_free=np.zeros(ng, np.int64),
         ovl_new=z(1), ovl_who=np.full(2, -1, np.int64), wface=z(n_face), patch_y=z(nk),
         pweight=z((nk, n_face)), prange=np.zeros((nk, 2), np.int64),
     )
 
 
-def new_output(times: np.ndarray, ng: int, nm: int, nk: int) -> Output:
-    """Output buffers for the given output times."""
+def new_output(times: np.ndarray, ng: int, nm: int, nk: int, nc: int = 6) -> Output:
+    """Output buffers for the given output times (nc state columns per granule)."""
     z = np.zeros
     n_out = len(times)
     return Output(
-        target=np.asarray(times, float).copy(), t=z(n_out), y=z((n_out, ng, 6)),
+        target=np.asarray(times, float).copy(), t=z(n_out), y=z((n_out, ng, nc)),
         energy=z((n_out, N_ENERGY)), q=z((n_out, nm)), qd=z((n_out, nm)),
         force=z((n_out, nk, 2)), slip=z((n_out, nk)), lam=z((n_out, nk)),
         iters=np.zeros((n_out, nk), np.int64), stats=z((n_out, N_STEPSTAT)),

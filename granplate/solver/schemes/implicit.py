@@ -23,7 +23,8 @@ from numba import njit
 
 from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm, friction_magnitude, plate_overlap
 from granplate.physics.energy import energy_residual
-from granplate.solver.granular import kinetic_energies, rk4_granular_step, rk4_limit
+from granplate.solver.dimension import force_error, kinetic_energies
+from granplate.solver.rk4 import rk4_granular_step, rk4_limit
 from granplate.solver.interface import forces_converged
 from granplate.solver.ladder import (
     dyadic_level, dyadic_round, level_for, level_step, position_tolerance, realign_step, step_to_output,
@@ -171,12 +172,7 @@ def step_error(ratio, st, g, cfg, w):
         sc = max(sc, abs(u))
         pred = st.force[d] + ratio * (st.force[d] - st.force_prev[d])
         err = max(err, abs(u - pred))
-    for i in range(st.y.shape[0]):
-        for c in range(3):
-            m = g.mass[i] if c < 2 else g.inertia[i] / g.radius[i]
-            sc = max(sc, m * abs(w.kend[i, 3 + c]))
-            pred = st.k1[i, 3 + c] + ratio * (st.k1[i, 3 + c] - st.k0[i, 3 + c])
-            err = max(err, m * abs(w.kend[i, 3 + c] - pred))
+    sc, err = force_error(st.k1, st.k0, w.kend, ratio, g, sc, err)
     st.clock[F_SCALE] = sc
     if sc <= 0.0:
         return 0.0
@@ -191,9 +187,9 @@ def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
     work [J])."""
     fric_work = held_friction_work(st, g, cfg, w)
     work, ep_new = exact_correct(t, h, st, p, cfg, sw.mcoef[slot], w.fguess, sw.qn, sw.qdn)
-    kx, ky, kr = kinetic_energies(w.ynew, g.mass, g.inertia)
+    kx, ky, kz, kr = kinetic_energies(w.ynew, g)
     e_in = st.clock[E_ZERO] + st.acc[A_SHOCK_G] + w.dacc[0] + st.acc[A_SHOCK_P] + work
-    total = (kx + ky + kr + e_pot + ep_new + st.acc[A_VISC] + w.dacc[1]
+    total = (kx + ky + kz + kr + e_pot + ep_new + st.acc[A_VISC] + w.dacc[1]
              + st.acc[A_FRIC] + w.dacc[2] + fric_work + st.acc[A_PLASTIC] + w.dacc[3])
     denom = max(st.clock[E_IN_MAX], e_in)
     d_res = 0.0

@@ -18,7 +18,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from granplate.solver.granular import rk4_granular_step, rk4_limit
+from granplate.solver.rk4 import rk4_granular_step, rk4_limit
 from granplate.solver.interface import forces_converged
 from granplate.solver.ladder import level_for, level_step, step_to_output
 from granplate.solver.plate_modal import modal_acceleration, newmark_correct, newmark_predict

@@ -1,0 +1,119 @@
+"""Scenario -> model arrays in space (`dimension = 3`, docs/model.md section 3.7): the
+granules' centres, velocities and spin vectors, their pair and wall contact lists and
+coefficients (the same laws and coefficients as the plane, `model.arrays`), the 3D shock
+(load.kind = "force": a half-sine total force shared by the loaded granules along a
+direction, docs/model.md section 5.4) and the loop's settings. No plate in space yet.
+`model.arrays.build_model` calls `build_space_model` for a scenario of dimension 3: the
+one place the model's dimension is decided.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from granplate.model.contacts import contact_lists, fixed_wall_contacts
+from granplate.model.inputs import STATE_COLUMNS, Granular3, PlateArrays, no_history
+from granplate.physics.contact import N_COEF
+from granplate.setup.materials import sphere_inertia, sphere_mass
+from granplate.setup.scenario import Scenario
+
+
+def centres(s: Scenario) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """x, y, z [m] and radii [m] of the granules."""
+    g = s.granules
+    return (np.array([q.x for q in g], float), np.array([q.y for q in g], float),
+            np.array([q.z for q in g], float), np.array([q.radius for q in g], float))
+
+
+def spin_vector(omega) -> tuple[float, float, float]:
+    """A granule's spin (wx, wy, wz) [rad/s] from its `omega` field (a 3-vector in space)."""
+    w = tuple(float(v) for v in omega)
+    return (w[0], w[1], w[2])
+
+
+def load_direction(s: Scenario) -> np.ndarray:
+    """The unit direction of the 3D shock (load.direction, normalised)."""
+    d = np.asarray(s.load.direction, float)
+    return d / np.linalg.norm(d)
+
+
+def loaded_granules_3d(s: Scenario, x, y, z, r) -> np.ndarray:
+    """Mask of the granules the 3D shock pushes: load.granules, or the granules whose
+    surface lies furthest against the load's direction (min of s.d - R within 1e-9 R_max)."""
+    n = len(x)
+    if s.load.kind != "force" or n == 0:
+        return np.zeros(n, bool)
+    if s.load.granules:
+        return np.array([g.label in s.load.granules for g in s.granules])
+    d = load_direction(s)
+    back = x * d[0] + y * d[1] + z * d[2] - r
+    return np.abs(back - back.min()) <= 1e-9 * r.max()
+
+
+def shock_shares(s: Scenario, loaded: np.ndarray) -> np.ndarray:
+    """(ng, 3) each granule's share of the total force along the load's direction [-]:
+    direction / n_loaded on the loaded granules, zero elsewhere (the force amplitude,
+    load.force [N], is the loop's q0)."""
+    out = np.zeros((len(loaded), 3))
+    if loaded.any():
+        out[loaded] = load_direction(s) / int(loaded.sum())
+    return out
+
+
+def initial_state_3d(s: Scenario) -> np.ndarray:
+    """(ng, 9) x, y, z, vx, vy, vz, wx, wy, wz of every granule at t = 0."""
+    y0 = np.zeros((len(s.granules), STATE_COLUMNS[3]))
+    for i, g in enumerate(s.granules):
+        y0[i, :6] = (g.x, g.y, g.z, g.vx, g.vy, g.vz)
+        y0[i, 6:] = spin_vector(g.omega)
+    return y0
+
+
+def force_floor_3d(s: Scenario, mass: np.ndarray, r: np.ndarray, shares: np.ndarray, out_dt: float) -> float:
+    """The implicit scheme's smallest force scale [N] (as model.arrays.force_floor): a
+    fraction of the shock's peak force plus the initial momentum per output interval."""
+    from granplate.model.arrays import FORCE_FLOOR_FRACTION
+
+    if len(r) == 0:
+        return 0.0
+    shock = abs(s.load.force) * float(np.abs(shares).sum()) if s.load.kind == "force" else 0.0
+    momentum = sum(m * (math.sqrt(g.vx**2 + g.vy**2 + g.vz**2) + rr * math.sqrt(sum(w * w for w in spin_vector(g.omega))))
+                   for m, rr, g in zip(mass, r, s.granules))
+    return FORCE_FLOOR_FRACTION * (shock + float(momentum) / out_dt)
+
+
+def build_space_model(s: Scenario):
+    """The Model of a validated, resolved scenario of dimension 3."""
+    from granplate.model.arrays import (
+        Model, find_pairs_and_walls, loop_config, pair_coefficients, wall_arrays,
+    )
+
+    x, y, z, r = centres(s)
+    mats = [s.material(g.material) for g in s.granules]
+    rho = np.array([m.rho for m in mats], float)
+    mass = np.array([sphere_mass(ri, rhoi) for ri, rhoi in zip(r, rho)])
+    inertia = np.array([sphere_inertia(ri, rhoi) for ri, rhoi in zip(r, rho)])
+    pairs, wc = find_pairs_and_walls(s, x, y, r, z)
+    loop_pairs, loop_wc = contact_lists(s.contact, s.walls, x, y, r, z)
+    wall_geo, wall_coef = wall_arrays(s, mats, r, mass, loop_wc)
+    shares = shock_shares(s, loaded_granules_3d(s, x, y, z, r))
+    granular = Granular3(
+        mass=mass, inertia=inertia, radius=r, pair_ij=loop_pairs,
+        pair_coef=pair_coefficients(s, mats, r, mass, loop_pairs),
+        wall_i=np.ascontiguousarray(loop_wc[:, 0]), wall_geo=wall_geo, wall_coef=wall_coef,
+        wall_w=np.ascontiguousarray(loop_wc[:, 1]),
+        pc_i=np.zeros(0, np.int64), pc_x=np.zeros(0), pc_coef=np.zeros((0, N_COEF)),
+        shock_force=shares, shock_torque=np.zeros_like(shares),
+        pair_hist=no_history(len(loop_pairs)), wall_hist=no_history(len(loop_wc)), pc_hist=no_history(0),
+    )
+    cfg = loop_config(s, np.zeros(len(r)), np.zeros(len(r)), r, mass,
+                      floor=force_floor_3d(s, mass, r, shares, s.time.output_interval))._replace(
+        q0=float(s.load.force) if s.load.kind == "force" else 0.0, dimension=3)
+    plate_arrays = PlateArrays(omega2=np.zeros(0), phi_d=np.zeros((0, 0)), load_modal=np.zeros(0))
+    return Model(
+        scenario=s, labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
+        granular=granular, plate_arrays=plate_arrays, config=cfg, plate=None,
+        initial_state=initial_state_3d(s), pairs=pairs, wall_contacts=wc,
+        plate_contacts=np.zeros(0, np.int64), materials=tuple(mats),
+    )

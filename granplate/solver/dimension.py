@@ -1,0 +1,83 @@
+"""Where the dimension lives in the time loop: the granular medium's derivative, its
+split-off friction, its kinetic energies and its error terms, taken from solver.granular
+(the plane: model.inputs.Granular, state x, y, theta, vx, vy, omega) or solver.granular3d
+(space: model.inputs.Granular3, state x, y, z, vx, vy, vz, wx, wy, wz), chosen at compile
+time from the type of the granular arrays `g` (as solver.schemes picks a scheme from its
+scratch). The RK4 step (solver.rk4), the schemes and the loop call only these, so the
+same compiled code serves both dimensions and nothing else asks which one it is.
+
+Adding a dimension-specific granular function: write it in both modules with the same
+signature and add a stub and its overload here.
+"""
+from __future__ import annotations
+
+from numba.extending import overload
+
+from granplate.model.inputs import Granular, Granular3
+from granplate.solver import granular as plane, granular3d as space
+
+_MODULES = {Granular: plane, Granular3: space}
+
+
+def _module_of(g):
+    """solver.granular or solver.granular3d for the numba type of the granular arrays g."""
+    return _MODULES.get(getattr(g, "instance_class", None))
+
+
+def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, split, record):
+    """The granular derivative and ForceSums (solver.granular.granular_rhs)."""
+    raise NotImplementedError("compiled use only")
+
+
+def friction_flow(y, dt, g, cfg, forward):
+    """Friction alone over dt at every pair and wall contact (solver.granular.friction_flow)."""
+    raise NotImplementedError("compiled use only")
+
+
+def kinetic_energies(y, g):
+    """(KE_x, KE_y, KE_z, KE_rot) [J] of the granules (KE_z = 0 in the plane)."""
+    raise NotImplementedError("compiled use only")
+
+
+def force_error(k1, k0, kend, ratio, g, sc, err):
+    """The implicit scheme's granule error terms: (scale, error) [N]."""
+    raise NotImplementedError("compiled use only")
+
+
+@overload(granular_rhs, inline="always")
+def _granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, split, record):
+    m = _module_of(g)
+    if m is not None:
+        fn = m.granular_rhs
+        return lambda t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, split, record: fn(
+            t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, split, record)
+
+
+@overload(friction_flow, inline="always")
+def _friction_flow(y, dt, g, cfg, forward):
+    m = _module_of(g)
+    if m is not None:
+        fn = m.friction_flow
+        return lambda y, dt, g, cfg, forward: fn(y, dt, g, cfg, forward)
+
+
+@overload(kinetic_energies, inline="always")
+def _kinetic_energies(y, g):
+    if _module_of(g) is plane:
+        fn = plane.kinetic_energies
+
+        def plane_energies(y, g):
+            kx, ky, kr = fn(y, g.mass, g.inertia)
+            return kx, ky, 0.0, kr
+        return plane_energies
+    if _module_of(g) is space:
+        fn3 = space.kinetic_energies
+        return lambda y, g: fn3(y, g.mass, g.inertia)
+
+
+@overload(force_error, inline="always")
+def _force_error(k1, k0, kend, ratio, g, sc, err):
+    m = _module_of(g)
+    if m is not None:
+        fn = m.force_error
+        return lambda k1, k0, kend, ratio, g, sc, err: fn(k1, k0, kend, ratio, g.mass, g.inertia, g.radius, sc, err)

@@ -1,0 +1,278 @@
+"""The granular medium in space (docs/model.md section 3.7): the time derivative of every
+granule's state (x, y, z, vx, vy, vz, wx, wy, wz) with the contact forces of eqs. (2)-(5)
+on the 3D kinematics of physics.space, the friction split off exactly per contact, and the
+kinetic energies. The same signatures as solver.granular (the plane), so that the RK4
+step and the time loop are the same code (solver.dimension picks the module from the
+granular arrays' type). No plate contacts in space yet: the plate arguments are unused.
+"""
+from __future__ import annotations
+
+from numba import njit
+
+from granplate.model.inputs import HIST_END, HIST_MAX
+from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm, friction_magnitude
+from granplate.physics.laws import normal_law_force, normal_law_response
+from granplate.physics.shock import time_profile
+from granplate.physics.space import (
+    arm_torque_3d, friction_vector_3d, normal_rate_3d, pair_apart_3d, pair_overlap_3d, slip_velocity_3d,
+    wall_overlap_3d,
+)
+from granplate.solver.granular import ForceSums, friction_impulse, slip_relaxation_rate
+
+#: state columns of a granule in space
+X, Y, Z, VX, VY, VZ, WX, WY, WZ = range(9)
+N_STATE = 9
+
+
+@njit(cache=True)
+def _speed(vx, vy, vz):
+    return (vx * vx + vy * vy + vz * vz) ** 0.5
+
+
+@njit(cache=True)
+def pair_slip(y, i, j, nx, ny, nz, ai, aj):
+    """Overlap rate and slip velocity vector of the pair i, j (n from i to j) [m/s]."""
+    rvx = y[i, VX] - y[j, VX]
+    rvy = y[i, VY] - y[j, VY]
+    rvz = y[i, VZ] - y[j, VZ]
+    ddot = normal_rate_3d(rvx, rvy, rvz, nx, ny, nz)
+    vs = slip_velocity_3d(rvx, rvy, rvz, ai * y[i, WX] + aj * y[j, WX], ai * y[i, WY] + aj * y[j, WY],
+                          ai * y[i, WZ] + aj * y[j, WZ], nx, ny, nz)
+    return ddot, vs[0], vs[1], vs[2]
+
+
+@njit(cache=True)
+def wall_slip(y, i, nx, ny, nz, a):
+    """Overlap rate and slip velocity vector of granule i on a wall at rest [m/s]."""
+    ddot = normal_rate_3d(y[i, VX], y[i, VY], y[i, VZ], nx, ny, nz)
+    vs = slip_velocity_3d(y[i, VX], y[i, VY], y[i, VZ], a * y[i, WX], a * y[i, WY], a * y[i, WZ], nx, ny, nz)
+    return ddot, vs[0], vs[1], vs[2]
+
+
+@njit(cache=True)
+def add_friction(dy, i, a, nx, ny, nz, fx, fy, fz, sign):
+    """Add sign * f and the torque a n x f (sign 1: on i, the first body; -1 keeps the
+    torque's sign, the force's reversed: on j, whose torque is a_j n x f_i)."""
+    dy[i, VX] += sign * fx
+    dy[i, VY] += sign * fy
+    dy[i, VZ] += sign * fz
+    tx, ty, tz = arm_torque_3d(a, nx, ny, nz, fx, fy, fz)
+    dy[i, WX] += tx
+    dy[i, WY] += ty
+    dy[i, WZ] += tz
+
+
+@njit(cache=True)
+def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, split=False, record=False):
+    """Time derivative dy of the state y (ng, 9) in space: shock, normal forces of every
+    listed pair and wall contact (physics.laws, with each contact's history) and, unless
+    split, their friction on the slip vector (physics.space). As solver.granular.granular_rhs
+    (record: the contacts' end overlaps into HIST_END); returns its ForceSums."""
+    ng = y.shape[0]
+    for i in range(ng):
+        for c in range(3):
+            dy[i, c] = y[i, 3 + c]
+        for c in range(3, 9):
+            dy[i, c] = 0.0
+    p_shock = 0.0
+    p_visc = 0.0
+    p_fric = 0.0
+    e_pot = 0.0
+    rate = 0.0
+    ovl = 0.0
+    ovl_i = -1
+    ovl_j = -1
+    w_plastic = 0.0
+    if not cfg.load_on_plate:
+        amp = cfg.q0 * time_profile(t, cfg.duration)
+        if amp != 0.0:
+            for i in range(ng):
+                for c in range(3):
+                    f = amp * g.shock_force[i, c]
+                    dy[i, VX + c] += f
+                    p_shock += f * y[i, VX + c]
+    for p in range(g.pair_ij.shape[0]):
+        i = g.pair_ij[p, 0]
+        j = g.pair_ij[p, 1]
+        ri = g.radius[i]
+        rj = g.radius[j]
+        if record:
+            g.pair_hist[p, HIST_END] = 0.0
+        if pair_apart_3d(y[i, X], y[i, Y], y[i, Z], ri, y[j, X], y[j, Y], y[j, Z], rj):
+            continue
+        delta, nx, ny, nz = pair_overlap_3d(y[i, X], y[i, Y], y[i, Z], ri, y[j, X], y[j, Y], y[j, Z], rj)
+        if delta <= 0.0:
+            continue
+        if record:
+            g.pair_hist[p, HIST_END] = delta
+        if delta > ovl * min(ri, rj):
+            ovl = delta / min(ri, rj)
+            ovl_i = i
+            ovl_j = j
+        c = g.pair_coef[p]
+        ai = contact_arm(ri, delta, 0.5 * cfg.arm_shrink)
+        aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
+        ddot, vsx, vsy, vsz = pair_slip(y, i, j, nx, ny, nz, ai, aj)
+        n, pv, ep, wp = normal_law_response(delta, ddot, c, g.pair_hist[p, HIST_MAX], cfg.clip)
+        dy[i, VX] -= n * nx
+        dy[i, VY] -= n * ny
+        dy[i, VZ] -= n * nz
+        dy[j, VX] += n * nx
+        dy[j, VY] += n * ny
+        dy[j, VZ] += n * nz
+        p_visc += pv
+        e_pot += ep
+        w_plastic += wp
+        if split or c[COEF_MU] == 0.0:
+            continue
+        speed = _speed(vsx, vsy, vsz)
+        f_mag = friction_magnitude(n, speed, c[COEF_MU], c[COEF_KS])
+        fx, fy, fz = friction_vector_3d(f_mag, vsx, vsy, vsz)
+        add_friction(dy, i, ai, nx, ny, nz, fx, fy, fz, 1.0)
+        add_friction(dy, j, aj, nx, ny, nz, fx, fy, fz, -1.0)
+        p_fric += f_mag * speed
+        rate = max(rate, slip_relaxation_rate(n, speed, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + 1.0 / g.mass[j]
+                                              + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]))
+    for w in range(g.wall_i.shape[0]):
+        i = g.wall_i[w]
+        ri = g.radius[i]
+        nx = g.wall_geo[w, 0]
+        ny = g.wall_geo[w, 1]
+        nz = g.wall_geo[w, 2]
+        delta = wall_overlap_3d(y[i, X], y[i, Y], y[i, Z], ri, nx, ny, nz, g.wall_geo[w, 3])
+        if record:
+            g.wall_hist[w, HIST_END] = max(delta, 0.0)
+        if delta <= 0.0:
+            continue
+        if delta > ovl * ri:
+            ovl = delta / ri
+            ovl_i = i
+            ovl_j = -1 - g.wall_w[w]
+        c = g.wall_coef[w]
+        a = contact_arm(ri, delta, cfg.arm_shrink)
+        ddot, vsx, vsy, vsz = wall_slip(y, i, nx, ny, nz, a)
+        n, pv, ep, wp = normal_law_response(delta, ddot, c, g.wall_hist[w, HIST_MAX], cfg.clip)
+        dy[i, VX] -= n * nx
+        dy[i, VY] -= n * ny
+        dy[i, VZ] -= n * nz
+        p_visc += pv
+        e_pot += ep
+        w_plastic += wp
+        if split or c[COEF_MU] == 0.0:
+            continue
+        speed = _speed(vsx, vsy, vsz)
+        f_mag = friction_magnitude(n, speed, c[COEF_MU], c[COEF_KS])
+        fx, fy, fz = friction_vector_3d(f_mag, vsx, vsy, vsz)
+        add_friction(dy, i, a, nx, ny, nz, fx, fy, fz, 1.0)
+        p_fric += f_mag * speed
+        rate = max(rate, slip_relaxation_rate(n, speed, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + a * a / g.inertia[i]))
+    for i in range(ng):
+        for c in range(3):
+            dy[i, VX + c] /= g.mass[i]
+            dy[i, WX + c] /= g.inertia[i]
+    return ForceSums(p_shock, p_visc, p_fric, e_pot, rate, ovl, ovl_i, ovl_j, 0.0, w_plastic)
+
+
+@njit(cache=True)
+def apply_friction_impulse(y, i, a, inv_m, inv_i, nx, ny, nz, px, py, pz, sign):
+    """The impulse sign * P (px, py, pz the friction impulse on the first body [N s]) on
+    granule i: its velocity by sign P / m, its spin by a n x P / I."""
+    y[i, VX] += sign * px * inv_m
+    y[i, VY] += sign * py * inv_m
+    y[i, VZ] += sign * pz * inv_m
+    tx, ty, tz = arm_torque_3d(a, nx, ny, nz, px, py, pz)
+    y[i, WX] += tx * inv_i
+    y[i, WY] += ty * inv_i
+    y[i, WZ] += tz * inv_i
+
+
+@njit(cache=True)
+def friction_flow(y, dt, g, cfg, forward):
+    """Friction alone at every pair and wall contact over dt [s], one contact after the
+    other (as solver.granular.friction_flow): the slip speed |v_s| relaxes exactly along
+    its own direction (a sphere's tangential mobility is isotropic, so an impulse along
+    -v_s changes v_s along v_s only, at the rate m_t^-1 = 1/m_i + 1/m_j + a_i^2/I_i +
+    a_j^2/I_j). Returns the energy dissipated [J]."""
+    n_p = g.pair_ij.shape[0]
+    n_w = g.wall_i.shape[0]
+    work = 0.0
+    for k in range(n_p + n_w):
+        q = k if forward else n_p + n_w - 1 - k
+        if q < n_p:
+            i = g.pair_ij[q, 0]
+            j = g.pair_ij[q, 1]
+            ri = g.radius[i]
+            rj = g.radius[j]
+            if pair_apart_3d(y[i, X], y[i, Y], y[i, Z], ri, y[j, X], y[j, Y], y[j, Z], rj):
+                continue
+            delta, nx, ny, nz = pair_overlap_3d(y[i, X], y[i, Y], y[i, Z], ri, y[j, X], y[j, Y], y[j, Z], rj)
+            c = g.pair_coef[q]
+            if delta <= 0.0 or c[COEF_MU] == 0.0:
+                continue
+            ai = contact_arm(ri, delta, 0.5 * cfg.arm_shrink)
+            aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
+            ddot, vsx, vsy, vsz = pair_slip(y, i, j, nx, ny, nz, ai, aj)
+            speed = _speed(vsx, vsy, vsz)
+            if speed == 0.0:
+                continue
+            n = normal_law_force(delta, ddot, c, g.pair_hist[q, HIST_MAX], cfg.clip)
+            inv_mi = 1.0 / g.mass[i]
+            inv_mj = 1.0 / g.mass[j]
+            imp, dw = friction_impulse(speed, n, c[COEF_MU], c[COEF_KS],
+                                       inv_mi + inv_mj + ai * ai / g.inertia[i] + aj * aj / g.inertia[j], dt)
+            px, py, pz = friction_vector_3d(imp, vsx, vsy, vsz)
+            apply_friction_impulse(y, i, ai, inv_mi, 1.0 / g.inertia[i], nx, ny, nz, px, py, pz, 1.0)
+            apply_friction_impulse(y, j, aj, inv_mj, 1.0 / g.inertia[j], nx, ny, nz, px, py, pz, -1.0)
+            work += dw
+        else:
+            w = q - n_p
+            i = g.wall_i[w]
+            ri = g.radius[i]
+            nx = g.wall_geo[w, 0]
+            ny = g.wall_geo[w, 1]
+            nz = g.wall_geo[w, 2]
+            delta = wall_overlap_3d(y[i, X], y[i, Y], y[i, Z], ri, nx, ny, nz, g.wall_geo[w, 3])
+            c = g.wall_coef[w]
+            if delta <= 0.0 or c[COEF_MU] == 0.0:
+                continue
+            a = contact_arm(ri, delta, cfg.arm_shrink)
+            ddot, vsx, vsy, vsz = wall_slip(y, i, nx, ny, nz, a)
+            speed = _speed(vsx, vsy, vsz)
+            if speed == 0.0:
+                continue
+            n = normal_law_force(delta, ddot, c, g.wall_hist[w, HIST_MAX], cfg.clip)
+            inv_m = 1.0 / g.mass[i]
+            imp, dw = friction_impulse(speed, n, c[COEF_MU], c[COEF_KS], inv_m + a * a / g.inertia[i], dt)
+            px, py, pz = friction_vector_3d(imp, vsx, vsy, vsz)
+            apply_friction_impulse(y, i, a, inv_m, 1.0 / g.inertia[i], nx, ny, nz, px, py, pz, 1.0)
+            work += dw
+    return work
+
+
+@njit(cache=True)
+def kinetic_energies(y, mass, inertia):
+    """Kinetic energy of the granules along x, y, z and of their spins [J]: (KE_x, KE_y,
+    KE_z, KE_rot)."""
+    kx = 0.0
+    ky = 0.0
+    kz = 0.0
+    kr = 0.0
+    for i in range(y.shape[0]):
+        kx += 0.5 * mass[i] * y[i, VX] * y[i, VX]
+        ky += 0.5 * mass[i] * y[i, VY] * y[i, VY]
+        kz += 0.5 * mass[i] * y[i, VZ] * y[i, VZ]
+        kr += 0.5 * inertia[i] * (y[i, WX] * y[i, WX] + y[i, WY] * y[i, WY] + y[i, WZ] * y[i, WZ])
+    return kx, ky, kz, kr
+
+
+@njit(cache=True)
+def force_error(k1, k0, kend, ratio, mass, inertia, radius, sc, err):
+    """The implicit scheme's error terms of the granules (as solver.granular.force_error):
+    m a and I alpha / R against their linear extrapolation; returns (scale, error) [N]."""
+    for i in range(kend.shape[0]):
+        for c in range(6):
+            m = mass[i] if c < 3 else inertia[i] / radius[i]
+            sc = max(sc, m * abs(kend[i, 3 + c]))
+            pred = k1[i, 3 + c] + ratio * (k1[i, 3 + c] - k0[i, 3 + c])
+            err = max(err, m * abs(kend[i, 3 + c] - pred))
+    return sc, err
