@@ -260,7 +260,7 @@ def verdict_text(pairs: list[tuple[Check, Check]]) -> str:
     """A paragraph: how many judged statements still hold, and which ones move."""
     moves: dict[str, list[str]] = {}
     for i, (e, y) in enumerate(pairs):
-        moves.setdefault(movement(e.holds, y.holds), []).append(f"#{i + 1} ({e.quantity})")
+        moves.setdefault(movement(e.holds, y.holds), []).append(f"#{i + 1} {e.quantity}")
     judged = sum(len(v) for k, v in moves.items() if k != "-")
     count = {k: len(moves.get(k, [])) for k in ("still holds", "still does not hold", "no longer holds", "now holds")}
     return (f"Of the {judged} statements judged both ways: still hold {count['still holds']}, still do not hold "

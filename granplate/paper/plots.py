@@ -387,7 +387,8 @@ def fig_yielding(elastic: xr.Dataset, plastic: xr.Dataset) -> Figure:
         ax[key].legend(fontsize=7, loc="best", framealpha=0.8)
         _label(ax[key], f"{text}, {_name(elastic)}")
     _caption(fig, "The plate's energy (a) and the granular energy with the plastic work (b), elastic "
-             "(Hertz, solid) and yielding (Thornton, contact.normal_law = \"thornton\", dashed) contacts.",
+             "(Hertz, solid) and yielding (Thornton, contact.normal_law = \"thornton\", dashed) contacts; the "
+             "second run is the first's twin with yielding contacts.",
              elastic, plastic)
     return fig
 

@@ -155,8 +155,9 @@ def build_report(
                                  "(2/pi) E* sqrt(delta/R*) over the pair's contacts and the run, and its ratio to "
                                  "the yield onset 1.6 Y of the body that yields (docs/model.md eqs. P1-P2; walls and "
                                  "the plate's face are rigid: the granule's Y). Past 1, the elastic law is outside "
-                                 "its validity: the section 'Contacts that yield' reruns the cases with yielding "
-                                 "contacts."))
+                                 "its validity" + (": the section 'Contacts that yield' reruns the cases with yielding "
+                                 "contacts." if twins else " (`granplate reproduce` without `--no-plastic` reruns "
+                                 "the cases with yielding contacts).")))
         blocks.append(Block("table", header=plastic.PAIR_HEADER, rows=tuple(pairs)))
     if checks:
         blocks.append(Block("p", "Check runs (sensitivity, see the discussion):"))
