@@ -41,11 +41,6 @@ FIGURE_CASE = "ptfe-r05"
 #: Key of the section's figure among the products of `granplate reproduce`.
 FIGURE_KEY = "yielding"
 
-#: Yield onset: the Hertz peak pressure p0 at which the softer body starts to yield,
-#: p0 = 1.6 Y (docs/model.md eq. P1); the report's ratios are p0 / (ONSET_FACTOR Y).
-ONSET_FACTOR = 1.6
-
-
 def twin_name(preset: str) -> str:
     """The run name of a preset's twin: "plastic/NAME"."""
     return f"{TWIN_DIR}/{preset}"
@@ -95,7 +90,7 @@ def case_rows(results: Results, twins: Results) -> list[dict]:
     of `results`: name, own_twin (bool), and the elastic and yielding `summary` of each."""
     out = []
     for name, ds in results.items():
-        own = not _has_pairs(ds) and name not in twins
+        own = not _has_granules(ds) and name not in twins
         twin = ds if own else twins.get(name)
         if twin is None:
             continue
@@ -103,7 +98,7 @@ def case_rows(results: Results, twins: Results) -> list[dict]:
     return out
 
 
-def _has_pairs(ds: xr.Dataset) -> bool:
+def _has_granules(ds: xr.Dataset) -> bool:
     """Whether a result has granules (a bare plate's has none)."""
     return ds.sizes.get("granule", 0) > 0
 
@@ -115,7 +110,7 @@ def twin_results(results: Results, twins: Results) -> Results:
     for name, ds in results.items():
         if name in twins:
             out[name] = twins[name]
-        elif not _has_pairs(ds):
+        elif not _has_granules(ds):
             out[name] = ds
     return out
 
