@@ -1,16 +1,18 @@
 """`granplate reproduce` end to end on shortened runs (all figures, both animations, the
-report), reuse of unchanged results (a second run simulates nothing; a changed scenario
-or version is run again), and the plot / animate / export commands."""
+report with the cases rerun with yielding contacts), reuse of unchanged results (a second
+run simulates nothing; a changed scenario or version is run again), `--no-plastic`, and
+the plot / animate / export commands."""
 from __future__ import annotations
 
 import pytest
 
 from granplate.version import __version__
+from granplate.paper import plastic as pl
 from granplate.paper import reproduce as rp
 from granplate.cli import main
-from granplate.paper.plots import FIGURES
+from granplate.paper.plots import EXTRA_FIGURES, FIGURES, figure_stem
 from granplate.setup.presets import preset, preset_names
-from granplate.results.dataset import read, write
+from granplate.results.dataset import read, summary, write
 
 from short_results import short_results
 
@@ -25,21 +27,40 @@ def first(tmp_path_factory):
 
 
 def test_reproduce_makes_everything(first):
-    """Six presets and the fast checks run; 7 figures (PNG + PDF), 2 animations, report."""
+    """Six presets, the fast checks and five yielding twins run; 8 figures (PNG + PDF),
+    2 animations, report."""
     out, outcome = first
     assert outcome.ok, outcome.problems
     assert {r.name for r in outcome.runs if r.kind == "preset"} == set(preset_names())
+    assert {r.name for r in outcome.runs if r.kind == "plastic"} == {pl.twin_name(n) for n in pl.twin_presets()}
     assert all(r.status == "ran" for r in outcome.runs)
     for name in preset_names():
         assert read(out / f"{name}.nc").time.values[-1] == pytest.approx(T_END)
-    for key in FIGURES:
-        assert (out / "figures" / f"fig{key}.png").stat().st_size > 0
-        assert (out / "figures" / f"fig{key}.pdf").stat().st_size > 0
+    for name in pl.twin_presets():
+        twin = read(out / "plastic" / f"{name}.nc")
+        assert twin.time.values[-1] == pytest.approx(T_END) and set(twin.pair_normal_law.values) == {"thornton"}
+    for key in [*FIGURES, *EXTRA_FIGURES]:
+        assert (out / "figures" / f"{figure_stem(key)}.png").stat().st_size > 0
+        assert (out / "figures" / f"{figure_stem(key)}.pdf").stat().st_size > 0
     assert sorted(p.stem for p in outcome.animations) == ["ptfe-r05", "steel-r05"]
     assert all(p.stat().st_size > 0 for p in outcome.animations)
     md = (out / "report.md").read_text()
     assert "The paper's statements and ours" in md and "Where we differ from the paper" in md
-    assert (out / "report.html").read_text().count("data:image/png;base64,") == len(FIGURES)
+    assert "## Contacts that yield" in md
+    assert (out / "report.html").read_text().count("data:image/png;base64,") == len(FIGURES) + len(EXTRA_FIGURES)
+
+
+def test_yielding_section_shows_the_twins_summaries(first):
+    """The section's row of each case carries gp.summary of its stored twin: plate peak
+    share and D_plastic / E_shock."""
+    out, _ = first
+    md = (out / "report.md").read_text().split("## Contacts that yield")[1]
+    for name in pl.twin_presets():
+        e, y = summary(read(out / f"{name}.nc")), summary(read(out / "plastic" / f"{name}.nc"))
+        row = next(line for line in md.splitlines() if line.startswith(f"| {name} |"))
+        assert f"| {100 * e['ep_max_fraction']:.1f}% / {100 * y['ep_max_fraction']:.1f}% |" in row
+        assert f"| {100 * y['plastic_fraction']:.1f}% |" in row
+    assert "bare-plate (its own twin)" in md
 
 
 def test_second_run_reuses_everything(first):
@@ -91,11 +112,24 @@ def test_shortened_keeps_intervals_valid():
 
 
 def test_plan_checks_modes(tmp_path):
-    names = lambda mode: {j.name for j in rp.plan(tmp_path, 1e-5, mode)}  # noqa: E731
+    """--checks picks the sensitivity runs; the twins come with every mode, or not at all."""
+    names = lambda mode, plastic=False: {j.name for j in rp.plan(tmp_path, 1e-5, mode, plastic)}  # noqa: E731
     assert names("none") == set(preset_names())
+    assert names("none", True) == set(preset_names()) | {pl.twin_name(n) for n in pl.twin_presets()}
     assert names("fast") < names("all")
     with pytest.raises(Exception):
         rp.plan(tmp_path, None, "sometimes")
+
+
+def test_no_plastic_leaves_the_twins_out(first, capsys):
+    """`--no-plastic`: no twin runs, no yielding figure, and the report has no section."""
+    out, _ = first
+    assert main(["reproduce", "--out", str(out), "--t-end", str(T_END), "--checks", "none", "--no-plastic",
+                 "--no-figures", "--no-animations", "-q"]) == 0
+    assert "runs: 0 ran, 6 reused" in capsys.readouterr().out
+    md = (out / "report.md").read_text()
+    assert "## Contacts that yield" not in md and "fig-yielding" not in md
+    assert "The paper's statements and ours" in md
 
 
 def test_cli_plot_animate_export(first, tmp_path, capsys):

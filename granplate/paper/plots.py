@@ -27,6 +27,7 @@ from matplotlib.figure import Figure
 
 from granplate.figures.common import PNG_DPI, save_figure  # noqa: F401 - part of this module's interface
 from granplate.figures.common import new_figure as _new_figure
+from granplate.paper import plastic as _plastic
 from granplate.results import analysis as an
 
 #: The granules whose velocities the paper plots (Figs. 4e-f, 5c).
@@ -367,6 +368,31 @@ def fig_A1(steel: xr.Dataset) -> Figure:
     return fig
 
 
+def fig_yielding(elastic: xr.Dataset, plastic: xr.Dataset) -> Figure:
+    """The plate's energy E_p [mJ] over time with elastic (Hertz) and yielding (Thornton)
+    contacts (a), and where the shock energy goes in each: E_g and D_plastic [mJ] (b)."""
+    fig = _new_figure(10.0, 4.2)
+    ax = fig.subplot_mosaic("ab")
+    runs = (("elastic", elastic, "-"), ("yielding", plastic, "--"))
+    for tag, ds, ls in runs:
+        ax["a"].plot(an.times_ms(ds), np.asarray(ds["E_plate"].values) * 1e3, color=COLOURS["plate"], ls=ls,
+                     lw=1.2, label=f"$E_p$, {tag} contacts", gid=f"plate:{tag}")
+        ax["b"].plot(an.times_ms(ds), np.asarray(ds["E_granular"].values) * 1e3, color=COLOURS["granular"],
+                     ls=ls, lw=1.2, label=f"$E_g$, {tag} contacts", gid=f"granular:{tag}")
+    ax["b"].plot(an.times_ms(plastic), np.asarray(plastic["D_plastic"].values) * 1e3, color="tab:brown",
+                 ls="--", lw=1.2, label="$D_{plastic}$, yielding contacts", gid="plastic:yielding")
+    for key, text in (("a", "(a) plate energy"), ("b", "(b) granular energy and plastic work")):
+        _time_axis(ax[key], elastic)
+        ax[key].set_ylabel("energy [mJ]")
+        ax[key].legend(fontsize=7, loc="best", framealpha=0.8)
+        _label(ax[key], f"{text}, {_name(elastic)}")
+    _caption(fig, "The plate's energy (a) and the granular energy with the plastic work (b), elastic "
+             "(Hertz, solid) and yielding (Thornton, contact.normal_law = \"thornton\", dashed) contacts; the "
+             "second run is the first's twin with yielding contacts.",
+             elastic, plastic)
+    return fig
+
+
 #: What a figure may need of a result: a test of the Dataset and its words.
 REQUIREMENTS: dict[str, tuple[Callable[[xr.Dataset], bool], str]] = {
     "plate": (an.has_plate, "a plate"),
@@ -396,6 +422,19 @@ FIGURES: dict[str, FigureSpec] = {
 }
 
 
+#: Figures of the report that are not the paper's: key -> spec ("yielding": the PTFE
+#: headline case with elastic and yielding contacts, granplate.paper.plastic).
+EXTRA_FIGURES: dict[str, FigureSpec] = {
+    _plastic.FIGURE_KEY: FigureSpec(fig_yielding, (_plastic.FIGURE_CASE, _plastic.twin_name(_plastic.FIGURE_CASE)),
+                                    "plate energy with elastic and yielding contacts (PTFE intruders)"),
+}
+
+
+def figure_spec(key: str) -> FigureSpec:
+    """The spec of a paper figure (FIGURES) or of another figure of the report (EXTRA_FIGURES)."""
+    return FIGURES[key] if key in FIGURES else EXTRA_FIGURES[key]
+
+
 def check_inputs(key: str, datasets: list[xr.Dataset]) -> None:
     """Raise ScenarioError (one line: the figure, what it needs, what the result lacks)
     when a result cannot make figure `key` (e.g. a custom scenario without granule 3)."""
@@ -423,5 +462,5 @@ def figure_key(name: str) -> str:
 
 
 def figure_stem(key: str) -> str:
-    """File stem of a figure: fig3, figA1."""
-    return f"fig{key}"
+    """File stem of a figure: fig3, figA1; fig-yielding for the report's own figures."""
+    return f"fig{key}" if key in FIGURES else f"fig-{key}"

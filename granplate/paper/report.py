@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from granplate.paper import checks as ck
+from granplate.paper import plastic
 from granplate.paper.discussion import (
     intensity_discussion, ptfe_discussion, stress_discussion, vertical_discussion,
 )
@@ -34,7 +35,9 @@ def _pct(x: float) -> str:
 
 def run_rows(results: Results, records: dict[str, object] | None = None) -> list[list[str]]:
     """One row per run: E_shock, plate shares, max stress (Gauss-point peak and disc average,
-    "-" for a result written before the latter existed), residual, steps, wall time."""
+    "-" for a result written before the latter existed), the largest Hertz peak pressure
+    p0 and its ratio to the yield onset 1.6 Y (of the material pair with the largest
+    ratio, named; "-" without contacts), residual, steps, wall time."""
     rows = []
     for name, ds in results.items():
         info = an.run_info(ds)
@@ -48,6 +51,7 @@ def run_rows(results: Results, records: dict[str, object] | None = None) -> list
             f"{_max_vm(ds) / 1e6:.1f}",
             f"{float(ds['max_von_mises_disc'].max()) / 1e6:.1f}" if "max_von_mises_disc" in ds else "-",
             f"{float(ds['max_eps_yy'].max()):.2e}",
+            *plastic.pressure_cells(ds),
             f"{an.max_energy_residual(ds):.1e}",
             f"{int(info.get('n_steps', 0)):,}",
             f"{float(info.get('wall_time_s', float('nan'))):.1f}",
@@ -57,7 +61,8 @@ def run_rows(results: Results, records: dict[str, object] | None = None) -> list
 
 
 RUN_HEADER = ["run", "t_end [ms]", "E_shock [J]", "plate peak", "plate at t_end", "max von Mises [MPa]",
-              "disc-averaged von Mises [MPa]", "max abs(eps_yy)", "max abs(energy residual)", "time steps", "wall time [s]", "this time"]
+              "disc-averaged von Mises [MPa]", "max abs(eps_yy)", "largest p0 [MPa] (pair)", "p0 / (1.6 Y)",
+              "max abs(energy residual)", "time steps", "wall time [s]", "this time"]
 
 
 
@@ -106,8 +111,10 @@ def build_report(
     figures: dict[str, list[Path]] | None = None,
     animations: list[Path] | None = None,
     seconds: float | None = None,
+    twins: Results | None = None,
 ) -> list[Block]:
-    """The report as blocks: summary, comparison table, runs, discussion, figures."""
+    """The report as blocks: summary, comparison table, runs, discussion, the cases with
+    yielding contacts (twins: preset name -> the twin's Dataset; none: no section), figures."""
     from granplate.version import __version__
     from granplate.paper.plots import FIGURES, figure_stem
 
@@ -118,6 +125,7 @@ def build_report(
     t_ends = sorted({float(d["time"].values[-1]) for d in results.values()})
     intro = (f"Made by granplate {__version__} from {len(results)} runs"
              + (f" and {len(checks)} check runs" if checks else "")
+             + (f", {len(twins)} of them rerun with yielding contacts" if twins else "")
              + (f" (this reproduce took {seconds:.0f} s; each run's own wall time is in the run table)"
                 if seconds is not None else "") + ". "
              f"{n_ok} of {len(judged)} judged statements hold. Every 'ours' value below is computed from the "
@@ -141,6 +149,16 @@ def build_report(
                              "Wall time: the simulation itself, as recorded in the result; 'this time': whether "
                              "this reproduce ran it or reused the stored result."))
     blocks.append(Block("table", header=tuple(RUN_HEADER), rows=tuple(tuple(r) for r in run_rows(results, records))))
+    pairs = plastic.pair_rows(results)
+    if pairs:
+        blocks.append(Block("p", "Contact pressures per material pair: the largest Hertz peak pressure p0 = "
+                                 "(2/pi) E* sqrt(delta/R*) over the pair's contacts and the run, and its ratio to "
+                                 "the yield onset 1.6 Y of the body that yields (docs/model.md eqs. P1-P2; walls and "
+                                 "the plate's face are rigid: the granule's Y). Past 1, the elastic law is outside "
+                                 "its validity" + (": the section 'Contacts that yield' reruns the cases with yielding "
+                                 "contacts." if twins else " (`granplate reproduce` without `--no-plastic` reruns "
+                                 "the cases with yielding contacts).")))
+        blocks.append(Block("table", header=plastic.PAIR_HEADER, rows=tuple(pairs)))
     if checks:
         blocks.append(Block("p", "Check runs (sensitivity, see the discussion):"))
         blocks.append(Block("table", header=tuple(RUN_HEADER), rows=tuple(tuple(r) for r in run_rows(checks, records))))
@@ -148,6 +166,8 @@ def build_report(
     for para in (stress_discussion(results, checks) + ptfe_discussion(results, checks)
                  + intensity_discussion(results) + vertical_discussion(results)):
         blocks.append(Block("p", para))
+    blocks += plastic.section(results, twins or {}, records=records,
+                              figure=(figures or {}).get(plastic.FIGURE_KEY))
     if figures:
         blocks.append(Block("h2", "Figures"))
         for key in FIGURES:
@@ -179,7 +199,8 @@ def load_results(paths: dict[str, Path]) -> Results:
 def write_report(out_dir: str | Path, outcome) -> list[Path]:
     """Write out_dir/report.md and out_dir/report.html for a reproduce outcome.
 
-    outcome: anything with .runs (RunRecord: name, path, status, kind), .figures
+    outcome: anything with .runs (RunRecord: name, path, status, kind; kind "plastic": a
+    preset's twin with yielding contacts), .figures
     (key -> paths), .animations (paths) and .seconds.
     """
     from granplate.setup.presets import preset_names
@@ -190,10 +211,12 @@ def write_report(out_dir: str | Path, outcome) -> list[Path]:
     presets = {r.name: r.path for r in sorted((r for r in done if r.kind == "preset"), key=lambda r: order.get(r.name, 99))}
     check_paths = {r.name: r.path for r in done if r.kind == "check"}
     check_paths = {c.name: check_paths[c.name] for c in ck.CHECKS if c.name in check_paths}
-    results, checks = load_results(presets), load_results(check_paths)
+    twin_paths = {plastic.twin_preset(r.name): r.path for r in done if r.kind == "plastic"}
+    twin_paths = {n: twin_paths[n] for n in preset_names() if n in twin_paths}
+    results, checks, twins = load_results(presets), load_results(check_paths), load_results(twin_paths)
     records = {r.name: r for r in outcome.runs}
     blocks = build_report(results, checks, records=records, figures=outcome.figures,
-                          animations=outcome.animations, seconds=getattr(outcome, "seconds", None))
+                          animations=outcome.animations, seconds=getattr(outcome, "seconds", None), twins=twins)
     md, page = out / "report.md", out / "report.html"
     md.write_text(to_markdown(blocks, out))
     page.write_text(to_html(blocks, out))

@@ -1,8 +1,10 @@
-"""Reproduce the paper: run the six presets (and the sensitivity checks) in parallel,
-reuse results that are still current, then draw every figure, both animations and the
-report. Also the CLI commands `reproduce`, `plot`, `animate` and `export`.
+"""Reproduce the paper: run the six presets (the sensitivity checks, and the cases with
+yielding contacts, `granplate.paper.plastic`) in parallel, reuse results that are still
+current, then draw every figure, both animations and the report. Also the CLI commands
+`reproduce`, `plot`, `animate` and `export`.
 
     granplate reproduce --out results            # everything (a few minutes on 2 cores)
+    granplate reproduce --out results --no-plastic  # without the yielding-contact twins
     granplate reproduce --out quick --t-end 1e-4 # shortened runs (a smoke test)
     granplate plot results/steel-r1.nc --figure A.1
     granplate plot results --figure 3            # a directory holding the presets' results
@@ -20,6 +22,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -42,7 +45,8 @@ CHECK_MODES = ("fast", "all", "none")
 # --------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Job:
-    """One simulation: `scenario` written to `path`; kind "preset" or "check"."""
+    """One simulation: `scenario` written to `path`; kind "preset", "check" or "plastic"
+    (a preset's twin with yielding contacts, named "plastic/PRESET")."""
 
     name: str
     scenario: object
@@ -141,8 +145,10 @@ def is_current(path: str | Path, scenario) -> bool:
     return stored is not None and result_key(*stored) == result_key(*expected_identity(scenario))
 
 
-def plan(out_dir: Path, t_end: float | None = None, checks: str = "fast") -> list[Job]:
-    """The presets (DIR/NAME.nc) and the sensitivity checks (DIR/checks/NAME.nc) to run."""
+def plan(out_dir: Path, t_end: float | None = None, checks: str = "fast", plastic: bool = True) -> list[Job]:
+    """The presets (DIR/NAME.nc), the sensitivity checks (DIR/checks/NAME.nc) and, with
+    `plastic`, the presets' twins with yielding contacts (DIR/plastic/NAME.nc) to run."""
+    from granplate.paper import plastic as pl
     from granplate.paper.checks import CHECKS, check_scenario
     from granplate.setup.presets import preset_names
 
@@ -154,6 +160,9 @@ def plan(out_dir: Path, t_end: float | None = None, checks: str = "fast") -> lis
             if c.slow and checks != "all":
                 continue
             jobs.append(Job(c.name, check_scenario(c, t_end), out_dir / "checks" / f"{c.name}.nc", "check"))
+    if plastic:
+        for n in pl.twin_presets():
+            jobs.append(Job(pl.twin_name(n), pl.twin_scenario(n, t_end), out_dir / pl.TWIN_DIR / f"{n}.nc", "plastic"))
     return jobs
 
 
@@ -164,14 +173,18 @@ def run_job(job: Job) -> RunRecord:
     """Simulate one job and write its result atomically; a failed run keeps its partial
     result as NAME.partial.nc (never reused) and reports why."""
     from granplate import store
-    from granplate.errors import SimulationError
+    from granplate.errors import SimulationError, YieldWarning
     from granplate.results.dataset import write
     from granplate.results.run import simulate
 
     t0 = time.perf_counter()
     job.path.parent.mkdir(parents=True, exist_ok=True)
     try:
-        ds = simulate(job.scenario, progress=False)
+        with warnings.catch_warnings():
+            # the report says it for every run (the run table's p0 / 1.6 Y, the section
+            # "Contacts that yield"), so the workers' logs need not
+            warnings.simplefilter("ignore", YieldWarning)
+            ds = simulate(job.scenario, progress=False)
     except SimulationError as err:
         if err.result is not None:
             write(err.result, job.path.with_name(job.path.stem + ".partial.nc"))
@@ -181,11 +194,12 @@ def run_job(job: Job) -> RunRecord:
 
 
 def make_figure(key: str, paths: list[Path], out_dir: Path) -> list[Path]:
-    """Draw figure `key` from the result files (in the figure's preset order); PNG + PDF."""
+    """Draw figure `key` (a paper figure, or one of the report's own: plots.EXTRA_FIGURES)
+    from the result files (in the figure's preset order); PNG + PDF."""
     from granplate.paper import plots
     from granplate.results.dataset import read
 
-    spec = plots.FIGURES[key]
+    spec = plots.figure_spec(key)
     fig = spec.function(*[read(p) for p in paths])
     return plots.save_figure(fig, out_dir, plots.figure_stem(key))
 
@@ -198,12 +212,14 @@ def make_animation(path: Path, target: Path, frames: int | None) -> Path:
     return animate(read(path), target, frames=frames)
 
 
-def _products(figures: bool, animations: bool) -> list:
-    """The figures (each with the presets it takes) and the Appendix B animations."""
+def _products(figures: bool, animations: bool, plastic: bool = True) -> list:
+    """The figures (each with the runs it takes; with `plastic`, the yielding-contact
+    figure too) and the Appendix B animations."""
     from granplate.paper import plots
     from granplate.paper.runner import Product
 
-    out = [Product("figure", k, spec.presets) for k, spec in plots.FIGURES.items()] if figures else []
+    specs = {**plots.FIGURES, **(plots.EXTRA_FIGURES if plastic else {})}
+    out = [Product("figure", k, spec.presets) for k, spec in specs.items()] if figures else []
     return out + ([Product("animation", n, (n,)) for n in ANIMATED] if animations else [])
 
 
@@ -216,6 +232,7 @@ def reproduce(
     client=None,
     force: bool = False,
     checks: str = "fast",
+    plastic: bool = True,
     figures: bool = True,
     animations: bool = True,
     frames: int | None = DEFAULT_FRAMES,
@@ -228,7 +245,8 @@ def reproduce(
     cores; at most one per task); scheduler: the address of an existing Dask cluster
     instead (its workers must see out_dir); client: an open Dask Client instead of
     either; force: run everything again; checks: "fast", "all" or "none" sensitivity
-    runs; figures: draw the figures; animations / frames: the Appendix B animations and
+    runs; plastic: also run the presets with yielding contacts (the report's section
+    "Contacts that yield", granplate.paper.plastic); figures: draw the figures; animations / frames: the Appendix B animations and
     their frame count; quiet: no progress.
     """
     from contextlib import nullcontext
@@ -245,13 +263,13 @@ def reproduce(
     outcome = Outcome(out)
     available: dict[str, Path] = {}
     to_run: list[Job] = []
-    for job in plan(out, t_end, checks):
+    for job in plan(out, t_end, checks, plastic):
         if not force and is_current(job.path, job.scenario):
             outcome.runs.append(RunRecord(job.name, job.path, "reused", 0.0, "", job.kind))
             available[job.name] = job.path
         else:
             to_run.append(job)
-    products = _products(figures, animations)
+    products = _products(figures, animations, plastic)
     progress = Progress(len(to_run) + len(products), quiet)
     for rec in outcome.runs:
         progress.note(f"reused {rec.name} ({rec.path})")
@@ -272,7 +290,7 @@ def reproduce(
     finally:
         progress.close()
     if not figures:
-        outcome.figures.update(_earlier_figures(out / "figures", available))
+        outcome.figures.update(_earlier_figures(out / "figures", available, plastic))
     if not animations:
         outcome.animations += _earlier_animations(out / "animations", available)
     outcome.seconds = time.perf_counter() - t_start
@@ -286,12 +304,13 @@ def _up_to_date(target: Path, inputs: list[Path]) -> bool:
     return target.is_file() and all(target.stat().st_mtime >= p.stat().st_mtime for p in inputs)
 
 
-def _earlier_figures(fig_dir: Path, available: dict[str, Path]) -> dict[str, list[Path]]:
+def _earlier_figures(fig_dir: Path, available: dict[str, Path], plastic: bool = True) -> dict[str, list[Path]]:
     """Figures drawn by an earlier reproduce from the same result files (for the report)."""
     from granplate.paper import plots
 
     found = {}
-    for key, spec in plots.FIGURES.items():
+    specs = {**plots.FIGURES, **(plots.EXTRA_FIGURES if plastic else {})}
+    for key, spec in specs.items():
         files = [fig_dir / f"{plots.figure_stem(key)}{ext}" for ext in (".png", ".pdf")]
         if all(n in available for n in spec.presets) and all(
                 _up_to_date(f, [available[n] for n in spec.presets]) for f in files):
@@ -392,7 +411,7 @@ def figure_inputs(key: str, inputs: list[str]) -> list[Path]:
 def _cmd_reproduce(args) -> int:
     outcome = reproduce(
         args.out, t_end=args.t_end, workers=args.workers, scheduler=args.scheduler, force=args.force,
-        checks=args.checks,
+        checks=args.checks, plastic=not args.no_plastic,
         figures=not args.no_figures, animations=not args.no_animations, frames=args.frames, quiet=args.quiet,
     )
     reused = sum(r.status == "reused" for r in outcome.runs)
@@ -462,8 +481,9 @@ def _positive_int(text: str) -> int:
 
 def register(subparsers) -> None:
     """Add the `reproduce`, `plot`, `animate` and `export` commands."""
-    r = subparsers.add_parser("reproduce", help="run the paper's six cases, draw every figure, "
-                              "both animations and the report (reusing unchanged results)")
+    r = subparsers.add_parser("reproduce", help="run the paper's six cases (and again with yielding "
+                              "contacts), draw every figure, both animations and the report (reusing "
+                              "unchanged results)")
     r.add_argument("--out", default=DEFAULT_OUT, help=f"output directory (default {DEFAULT_OUT})")
     r.add_argument("--t-end", type=float, default=None, help="shorten every run to this time [s]")
     r.add_argument("--workers", "--jobs", dest="workers", type=_positive_int, default=None,
@@ -475,6 +495,9 @@ def register(subparsers) -> None:
     r.add_argument("--checks", choices=CHECK_MODES, default="fast",
                    help="sensitivity runs for the report's discussion: fast (default, ~1 min on "
                         "2 cores), all (adds finer meshes, ~3 min), none")
+    r.add_argument("--no-plastic", action="store_true",
+                   help="leave out the cases rerun with yielding contacts (the report's section "
+                        "'Contacts that yield'; 5 more runs, about 10 s on 2 cores)")
     r.add_argument("--frames", type=_positive_int, default=DEFAULT_FRAMES, help="animation frames (at most)")
     r.add_argument("--no-figures", action="store_true", help="skip the figures (runs and report only)")
     r.add_argument("--no-animations", action="store_true", help="skip the animations")
