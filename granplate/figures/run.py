@@ -1,11 +1,12 @@
 """The generic figures of any result (`granplate plot RESULT`): one Figure per topic.
 
 - energies: E_shock, E_granular (in space with its part KE_depth), E_plate, dissipation
-  D_viscous + D_friction (+ D_plastic where contacts yielded) and their sum in J; the same as fractions of the energy put in; the energy-balance residual;
+  D_viscous + D_friction (+ D_plastic where contacts yielded) and their sum in J; the
+  same as fractions of the energy put in; the energy-balance residual;
 - contact-forces: normal and tangential force at each plate contact [N];
 - stress-strain: the plate's largest von Mises stress [MPa] and largest |eps_yy| [-];
-- granule-speeds: |v| of each granule [m/s] (three components in space) (beyond MAX_LABELLED granules: the
-  min-max envelope, the median and the fastest few, labelled).
+- granule-speeds: |v| of each granule [m/s], three components in space (beyond
+  MAX_LABELLED granules: the min-max envelope, the median and the fastest few, labelled).
 
 `missing(name, ds)` says why a run cannot have a figure (no plate, no contacts, no
 granules), None when it can; `figures(ds)` builds those it can. Time in ms throughout.
