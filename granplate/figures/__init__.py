@@ -4,6 +4,9 @@
   and its mesh, the load, the contact network (and its forces at one time of a result);
 - `show`: draws an `Assembly` (granules to scale, coloured by material, walls, plate,
   load arrows, contact lines);
+- `space`: the same for an assembly in space (dimension = 3): three orthogonal
+  projections, spheres depth-sorted and depth-shaded, walls as their traces, contact
+  lines with width by force;
 - `run`: the generic figures of any result (energies, plate contact forces, plate
   stress and strain, granule speeds), each skipped when the run lacks its quantities;
 - `common`: the Figure factory, saving as PNG + PDF, time axes;

@@ -33,16 +33,23 @@ def _read_result(path: str):
 def show_figure(target: str, time: float | None = None):
     """The figure of a scenario (TOML file or preset name) or of a result file at `time`
     [s]; (figure, default output name)."""
-    from granplate.figures import assembly, show
+    from granplate.figures import assembly, show, space
     from granplate.setup.io import load_scenario
 
     if Path(target).suffix.lower() in RESULT_SUFFIXES:
         ds = _read_result(target)
+        if space.is_space(ds):
+            a = space.of_result(ds, time)
+            return space.draw(a), f"{a.name}.png"
         a = assembly.of_result(ds, time)
     else:
         if time is not None:
             raise ScenarioError("--time", time, "allowed only with a result file (.nc), not a scenario")
-        a = assembly.of_scenario(load_scenario(target))
+        scenario = load_scenario(target)
+        if scenario.dimension == 3:
+            a = space.of_scenario(scenario)
+            return space.draw(a), f"{a.name}.png"
+        a = assembly.of_scenario(scenario)
     return show.draw(a), f"{a.name}.png"
 
 

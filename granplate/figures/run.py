@@ -1,12 +1,12 @@
 """The generic figures of any result (`granplate plot RESULT`): one Figure per topic.
 
-- energies: E_shock, E_granular, E_plate, dissipation D_viscous + D_friction (+ D_plastic
-  where contacts yielded) and their sum in J; the same as fractions of the energy put in;
-  the energy-balance residual;
+- energies: E_shock, E_granular (in space with its part KE_depth), E_plate, dissipation
+  D_viscous + D_friction (+ D_plastic where contacts yielded) and their sum in J; the
+  same as fractions of the energy put in; the energy-balance residual;
 - contact-forces: normal and tangential force at each plate contact [N];
 - stress-strain: the plate's largest von Mises stress [MPa] and largest |eps_yy| [-];
-- granule-speeds: |v| of each granule [m/s] (beyond MAX_LABELLED granules: the
-  min-max envelope, the median and the fastest few, labelled).
+- granule-speeds: |v| of each granule [m/s], three components in space (beyond
+  MAX_LABELLED granules: the min-max envelope, the median and the fastest few, labelled).
 
 `missing(name, ds)` says why a run cannot have a figure (no plate, no contacts, no
 granules), None when it can; `figures(ds)` builds those it can. Time in ms throughout.
@@ -64,16 +64,24 @@ def reference_label(ds: xr.Dataset) -> str:
 
 
 def has_plastic_work(ds: xr.Dataset) -> bool:
-    """Whether contacts yielded in the run: D_plastic [J] (docs/output.md) present and not
-    zero throughout (a run under Hertz's law has none)."""
-    return "D_plastic" in ds and bool(np.any(ds["D_plastic"].values != 0.0))
+    """Whether contacts yielded in the run (`plastic_work` is not None)."""
+    return plastic_work(ds) is not None
+
+
+def plastic_work(ds: xr.Dataset) -> np.ndarray | None:
+    """D_plastic [J] over time when some contact yielded in the run (None under Hertz's
+    law, where it is zero throughout)."""
+    if "D_plastic" not in ds or not np.any(ds["D_plastic"].values != 0.0):
+        return None
+    return ds["D_plastic"].values
 
 
 def energy_curves(ds: xr.Dataset) -> dict[str, tuple[str, np.ndarray]]:
     """key -> (legend label, energy [J] over time) of the energy figure: E_shock when the
-    load does work, E_granular with granules, E_plate with a plate, the dissipation
-    D = D_viscous + D_friction (+ D_plastic where contacts yielded: eq. 11's D), and the
-    sum of those stored and dissipated."""
+    load does work, E_granular with granules (in space also its part KE_depth, the
+    translation along z), E_plate with a plate, the dissipation D = D_viscous + D_friction
+    (+ D_plastic, also drawn alone, when contacts yielded), and the sum of those stored
+    and dissipated."""
     out = {}
     if float(np.abs(ds["E_shock"].values).max()) > 0:
         out["shock"] = ("$E_{shock}$, work of the load", ds["E_shock"].values)
@@ -84,12 +92,15 @@ def energy_curves(ds: xr.Dataset) -> dict[str, tuple[str, np.ndarray]]:
     if an.has_plate(ds):
         out["plate"] = ("$E_{plate}$", ds["E_plate"].values)
         parts.append(("E_{plate}", ds["E_plate"].values))
+    if "KE_depth" in ds:  # in space: the kinetic energy along z, a part of E_granular
+        out["depth"] = ("$KE_{depth}$, translation along z (part of $E_{granular}$)", ds["KE_depth"].values)
     dissipated = ds["D_viscous"].values + ds["D_friction"].values
-    label = "$D = D_{viscous} + D_{friction}$"
-    if has_plastic_work(ds):
+    if plastic_work(ds) is not None:
         dissipated = dissipated + ds["D_plastic"].values
-        label = "$D = D_{viscous} + D_{friction} + D_{plastic}$"
-    out["dissipated"] = (label, dissipated)
+        out["plastic"] = ("$D_{plastic}$, plastic work of the contacts (part of D)", ds["D_plastic"].values)
+        out["dissipated"] = ("$D = D_{viscous} + D_{friction} + D_{plastic}$", dissipated)
+    else:
+        out["dissipated"] = ("$D = D_{viscous} + D_{friction}$", dissipated)
     parts.append(("D", dissipated))
     out["total"] = ("$" + " + ".join(name for name, _ in parts) + "$", sum(v for _, v in parts))
     return out
@@ -98,7 +109,8 @@ def energy_curves(ds: xr.Dataset) -> dict[str, tuple[str, np.ndarray]]:
 #: (colour, line style, width) per curve: E_shock wide and light, so that the sum drawn
 #: over it (equal up to the residual, panel c) leaves both visible.
 ENERGY_STYLE = {"shock": ("0.7", "-", 4.0), "granular": ("tab:blue", "-", 1.3), "plate": ("tab:red", "-", 1.3),
-                "dissipated": ("tab:green", "-", 1.3), "total": ("tab:purple", "--", 1.3)}
+                "dissipated": ("tab:green", "-", 1.3), "total": ("tab:purple", "--", 1.3),
+                "depth": ("tab:cyan", ":", 1.3), "plastic": ("tab:olive", ":", 1.3)}
 
 
 def fig_energies(ds: xr.Dataset) -> Figure:
@@ -176,8 +188,9 @@ def fig_stress_strain(ds: xr.Dataset) -> Figure:
 
 
 def granule_speeds(ds: xr.Dataset) -> np.ndarray:
-    """|v| = sqrt(vx^2 + vy^2) [m/s], shape (time, granule)."""
-    return np.hypot(ds["vx"].values, ds["vy"].values)
+    """|v| = sqrt(vx^2 + vy^2 (+ vz^2 in space)) [m/s], shape (time, granule)."""
+    v = np.hypot(ds["vx"].values, ds["vy"].values)
+    return np.hypot(v, ds["vz"].values) if "vz" in ds else v
 
 
 def fig_granule_speeds(ds: xr.Dataset) -> Figure:

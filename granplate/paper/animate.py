@@ -8,6 +8,11 @@ elements by von Mises stress, with a time label.
 Frames are the result's plate-field snapshots (`field_time`, every 20 us by default),
 thinned evenly to at most `frames`. MP4 goes through the ffmpeg binary of the pip
 package imageio-ffmpeg; without it (or when ffmpeg fails) a GIF is written with Pillow.
+
+A run in space (dimension = 3, no plate; `animate_space`, which `animate` calls for it)
+is drawn as the three orthogonal projections of `figures.space` per frame, spheres at
+their true positions (no magnification) coloured by speed and drawn far to near, walls as
+their traces; frames are the output times, thinned the same way.
 """
 from __future__ import annotations
 
@@ -159,9 +164,11 @@ def animate(
     """Write an animation of run `ds` to `path` (.mp4, or .gif) and return the path written.
 
     frames: at most this many frames (None: every field snapshot); fps: frames per
-    second; magnify: displacement magnification [-]; dpi: resolution. An .mp4 path
-    falls back to .gif (Pillow) when ffmpeg is not available or fails.
+    second; magnify: displacement magnification [-] (unused in space); dpi: resolution.
+    An .mp4 path falls back to .gif (Pillow) when ffmpeg is not available or fails.
     """
+    if "z" in ds.variables:
+        return animate_space(ds, path, frames=frames, fps=fps, dpi=dpi)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     snaps = frame_indices(ds.sizes.get("field_time", 0), frames)
@@ -203,3 +210,64 @@ def animate(
     fig.canvas.draw()  # lay out once, then freeze the layout (re-solving it every frame is slow)
     fig.set_layout_engine("none")
     return _save(fig, draw, len(snaps), path, fps, dpi)
+
+
+def animate_space(ds: xr.Dataset, path: str | Path, *, frames: int | None = 120, fps: int = 15,
+                  dpi: int = 90) -> Path:
+    """Write an animation of 3D run `ds` (three projections per frame, spheres coloured by
+    speed [m/s]) to `path` (.mp4, or .gif) and return the path written."""
+    from granplate.figures import space
+    from granplate.figures.run import granule_speeds
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    ti = frame_indices(ds.sizes.get("time", 0), frames)
+    if ti.size == 0:
+        raise ValueError("the result has no output times to animate")
+    a = space.of_result(ds, float(ds["time"].values[-1]))
+    pos = space.positions(ds)[ti]  # (frame, granule, 3) [m]
+    r = np.asarray(ds["radius"].values, float)
+    path_lo = (pos - r[None, :, None]).min(axis=(0, 1))
+    path_hi = (pos + r[None, :, None]).max(axis=(0, 1))
+    lo, hi = space.bounds(a)
+    lo, hi = np.minimum(lo, path_lo), np.maximum(hi, path_hi)
+    speed = granule_speeds(ds)[ti]
+    colours = ScalarMappable(Normalize(0.0, max(float(speed.max()), 1e-12)), "viridis")
+    span = (hi - lo) * 1e3
+    fig = Figure(figsize=(12.0, max(4.0 * span[1:].max() / max(span[:2].max(), 1e-12) + 1.6, 3.5)),
+                 layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(1, 3, width_ratios=[span[0], span[0], span[1]])
+    inner = space.bounds(a, margin=0.0)
+    circles = []
+    for ax, view in zip(axes, space.PROJECTIONS):
+        u, v, _, _ = view
+        ax.set_aspect("equal")
+        ax.set_xlim(lo[u] * 1e3, hi[u] * 1e3)
+        ax.set_ylim(lo[v] * 1e3, hi[v] * 1e3)
+        ax.set_xlabel(f"{space.AXIS_NAMES[u]} [mm]")
+        ax.set_ylabel(f"{space.AXIS_NAMES[v]} [mm]")
+        for wall in a.walls:
+            ends = space.wall_trace(wall, view, *inner)
+            if ends is not None:
+                ax.plot([ends[0][0] * 1e3, ends[1][0] * 1e3], [ends[0][1] * 1e3, ends[1][1] * 1e3], color="0.3", lw=2)
+        circles.append([ax.add_patch(Circle((0.0, 0.0), c * 1e3, ec="k", lw=0.5)) for c in r])
+    fig.colorbar(colours, ax=list(axes), label="sphere speed [m/s]", orientation="horizontal", shrink=0.5, aspect=50)
+    head = f"{ds.attrs.get('scenario_name', '')}: spheres in space (drawn far to near)"
+    label = fig.suptitle(head, fontsize=10, x=0.01, ha="left")
+    times = ds["time"].values[ti]
+
+    def draw(f: int) -> None:
+        rgba = colours.to_rgba(speed[f])
+        for row, (u, v, d, sign) in zip(circles, space.PROJECTIONS):
+            order = np.argsort(sign * pos[f, :, d], kind="stable")
+            for rank, i in enumerate(order):
+                row[i].set_center((pos[f, i, u] * 1e3, pos[f, i, v] * 1e3))
+                row[i].set_facecolor(rgba[i])
+                row[i].set_zorder(2 + rank)
+        label.set_text(f"{head},  t = {times[f] * 1e3:.4f} ms")
+
+    draw(0)
+    fig.canvas.draw()  # lay out once, then freeze the layout
+    fig.set_layout_engine("none")
+    return _save(fig, draw, len(ti), path, fps, dpi)

@@ -453,7 +453,7 @@ def _cmd_animate(args) -> int:
     target = Path(args.output) if args.output else Path(f"{ds.attrs.get('scenario_name', 'result')}.mp4")
     if target.suffix.lower() not in (".mp4", ".gif"):
         raise ScenarioError("-o", str(target), "allowed: a .mp4 or .gif file name")
-    if ds.sizes.get("field_time", 0) == 0:
+    if "z" not in ds.variables and ds.sizes.get("field_time", 0) == 0:  # (in space: every output time)
         raise ScenarioError("result", args.result, "has no plate-field snapshots to animate")
     written = animate(ds, target, frames=args.frames, fps=args.fps, magnify=args.magnify)
     print(f"written {written}")
@@ -462,9 +462,14 @@ def _cmd_animate(args) -> int:
 
 def _cmd_export(args) -> int:
     from granplate.results.analysis import has_plate
-    from granplate.results.export import export_vtk
+    from granplate.results.export import export_vtk, is_space
 
     ds = _read(_existing(args.result))
+    if is_space(ds):
+        pvd = export_vtk(ds, args.vtk)
+        print(f"written {ds.sizes.get('time', 0)} output times of {ds.sizes.get('granule', 0)} spheres; open {pvd} "
+              f"in ParaView (Glyph: sphere, scale array radius, factor 2)")
+        return 0
     if not has_plate(ds):
         raise ScenarioError("result", args.result, "has no plate to export")
     pvd = export_vtk(ds, args.vtk)

@@ -17,6 +17,15 @@ One file per plate-field snapshot (`field_time`) and per part:
 
 and ``NAME.pvd`` (both parts, part 0 = plate, part 1 = granules), ``NAME-plate.pvd`` and
 ``NAME-granules.pvd`` collection files holding the times [s].
+
+A run in space (dimension = 3, no plate) is written per output time (`time`) as
+``spheres_NNNN.vtu``: one vertex per sphere at its centre [m] with point data
+``radius`` [m], ``velocity`` [m/s] and ``angular_velocity`` [rad/s] (3 components
+each), ``speed`` [m/s], ``material_id`` (position of the sphere's material in the
+result's sorted material names, listed in the .pvd's comment) and ``granule_index``; and
+``NAME.pvd`` holding the times [s]. In ParaView: open NAME.pvd, Apply, then Filters >
+Glyph with Glyph Type "Sphere", Scale Array "radius", Scale Factor 2 (the sphere glyph's
+radius is 0.5) and Glyph Mode "All Points"; colour by speed or material_id.
 """
 from __future__ import annotations
 
@@ -65,6 +74,54 @@ def granule_cloud(ds: xr.Dataset, i: int) -> meshio.Mesh:
     )
 
 
+def is_space(ds: xr.Dataset) -> bool:
+    """Whether a result is of a run in space (it stores z)."""
+    return "z" in ds.variables
+
+
+def material_names(ds: xr.Dataset) -> list[str]:
+    """The result's material names, sorted: material_id i is the i-th."""
+    return sorted({str(m) for m in ds["material"].values})
+
+
+def sphere_cloud(ds: xr.Dataset, i: int) -> meshio.Mesh:
+    """The spheres of a 3D result at output index i as a meshio Mesh (one vertex each)."""
+    n = ds.sizes["granule"]
+    pos = np.column_stack([ds[k].values[i] for k in ("x", "y", "z")]).astype(float)
+    vel = np.column_stack([ds[k].values[i] for k in ("vx", "vy", "vz")]).astype(float)
+    spin = np.column_stack([ds[k].values[i] for k in ("omega_x", "omega_y", "omega_z")]).astype(float)
+    names = material_names(ds)
+    return meshio.Mesh(
+        pos,
+        [("vertex", np.arange(n, dtype=np.int64)[:, None])],
+        point_data={
+            "radius": np.asarray(ds["radius"].values, dtype=float),
+            "velocity": vel,
+            "speed": np.linalg.norm(vel, axis=1),
+            "angular_velocity": spin,
+            "material_id": np.array([names.index(str(m)) for m in ds["material"].values], dtype=np.int64),
+            "granule_index": np.arange(n, dtype=np.int64),
+        },
+    )
+
+
+def export_spheres(ds: xr.Dataset, out_dir: str | Path, name: str | None = None) -> Path:
+    """Write the spheres of 3D run `ds` into out_dir, one .vtu per output time, and the
+    collection NAME.pvd (default: the scenario name); returns the .pvd path."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    name = name or str(ds.attrs.get("scenario_name", "result"))
+    entries = []
+    for i, t in enumerate(np.asarray(ds["time"].values, dtype=float)):
+        f = f"spheres_{i:04d}.vtu"
+        meshio.write(out / f, sphere_cloud(ds, i))
+        entries.append((float(t), 0, f))
+    ids = ", ".join(f"{k} = {m}" for k, m in enumerate(material_names(ds))).replace("--", "- -")
+    pvd = out / f"{name}.pvd"
+    pvd.write_text(pvd_text(entries).replace("<Collection>", f"<!-- material_id: {ids} -->\n  <Collection>", 1))
+    return pvd
+
+
 def pvd_text(entries: list[tuple[float, int, str]]) -> str:
     """A ParaView collection file listing (time [s], part, file name) entries."""
     rows = "\n".join(
@@ -85,10 +142,13 @@ def export_vtk(ds: xr.Dataset, out_dir: str | Path, name: str | None = None) -> 
     """Write the VTK time series of run `ds` into out_dir; returns the combined .pvd path.
 
     name: stem of the .pvd files (default: the scenario name). Snapshots are the
-    result's field_time; granule states are taken at the output nearest to each.
+    result's field_time; granule states are taken at the output nearest to each. A run in
+    space is written by `export_spheres` (every output time).
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    if is_space(ds):
+        return export_spheres(ds, out, name)
     name = name or str(ds.attrs.get("scenario_name", "result"))
     if not an.has_plate(ds):
         raise ValueError("the result has no plate to export")

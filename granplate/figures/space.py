@@ -1,0 +1,381 @@
+"""`granplate show` in space (dimension = 3): an assembly of spheres drawn as three
+orthogonal projections side by side (x-y seen from +z, x-z seen from -y, y-z seen from
++x), each sphere a circle of its true radius coloured by material, drawn far to near and
+darkened with its distance from the viewer; the walls as their traces (a wall whose
+plane contains the viewing direction is a line: the six walls of a box draw its
+outline; an oblique plane is listed, not drawn); the contact network as lines between
+touching centres (and from a centre to its wall), width and colour by the normal force
+for a result. Axes in mm.
+
+    >>> from granplate.figures import space
+    >>> fig = space.draw(space.of_scenario(scenario))        # before the run
+    >>> fig = space.draw(space.of_result(ds, time=2e-5))       # a result at t = 0.02 ms
+
+Contact forces of a result at one output time come from the stored centres and the run's
+own contact coefficients (`model.arrays.pair_coefficients`, `wall_arrays`: the run's
+materials and [[contact.pairs]]), through the run's normal law (`physics.laws`: Hertz, or
+the elastic-plastic law with the largest overlap over the stored outputs up to that
+time as its history), at zero overlap rate: the elastic part of the force, as the
+plane's drawing (`figures.assembly`). Overlaps: R_i + R_j - |s_j - s_i| for a pair,
+s_i . n + R_i - offset for a wall (docs/model.md, the laws in space).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import xarray as xr
+from matplotlib.cm import ScalarMappable
+from matplotlib.collections import LineCollection
+from matplotlib.colors import Normalize, to_rgb
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Circle, Patch
+
+from granplate.figures.common import material_colours, new_figure
+from granplate.setup.scenario import Load, Scenario, Wall
+
+MM = 1e3  # m -> mm
+
+#: The three views: (horizontal axis, vertical axis, depth axis, sign): depth * sign grows
+#: towards the viewer (x-y seen from +z, x-z from -y, y-z from +x: right-handed views).
+PROJECTIONS = ((0, 1, 2, 1.0), (0, 2, 1, -1.0), (1, 2, 0, 1.0))
+AXIS_NAMES = ("x", "y", "z")
+#: The farthest sphere of a view is darkened by this fraction (the nearest not at all).
+DEPTH_DARKEN = 0.4
+#: A wall is drawn in a view when its normal is within this of perpendicular to the view.
+EDGE_ON = 1e-9
+#: The widest contact line [points] (the largest force of a result).
+MAX_LINE_WIDTH = 5.0
+#: Contacts below this fraction of the largest force are drawn thin and dotted.
+OPEN_FRACTION = 0.01
+#: Contact line colours by kind (a scenario: no forces).
+KIND_COLOURS = {"granule": "0.1", "wall": "tab:purple"}
+KIND_NAMES = {"granule": "granule-granule", "wall": "granule-wall"}
+LOAD_COLOUR = "crimson"
+
+
+@dataclass(frozen=True)
+class Assembly3D:
+    """An assembly in space as drawn [m, N].
+
+    pos (n, 3) centres and radius (n,); labels, materials per granule; walls: the
+    resolved planes (box walls included); load and loaded: the scenario's load and the
+    mask of the granules it pushes; segments (nc, 2, 3) contact lines (centre to centre,
+    centre to the wall's nearest point), kinds per segment ("granule", "wall"); forces:
+    normal force per segment [N] or None (a scenario); time [s] and time_note: the
+    result time shown (None for a scenario).
+    """
+
+    name: str
+    pos: np.ndarray
+    radius: np.ndarray
+    labels: tuple[str, ...]
+    materials: tuple[str, ...]
+    walls: tuple[Wall, ...]
+    load: Load
+    loaded: np.ndarray
+    segments: np.ndarray
+    kinds: tuple[str, ...]
+    forces: np.ndarray | None = None
+    time: float | None = None
+    time_note: str = ""
+
+
+# --------------------------------------------------------------------------------------
+# Contacts
+# --------------------------------------------------------------------------------------
+def unit_normal(wall: Wall) -> np.ndarray:
+    """The wall's unit normal (n, 3) [-]."""
+    n = np.asarray(wall.normal, float)
+    return n / np.linalg.norm(n)
+
+
+def touching(s: Scenario, pos: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(pairs (np, 2), wall contacts (nw, 2) [granule, wall]) of the spheres at pos [m]
+    within contact.neighbour_gap R (the model's rule for contacts at t = 0)."""
+    from granplate.model.arrays import find_pairs_and_walls
+
+    pairs, wc = find_pairs_and_walls(s, pos[:, 0], pos[:, 1], r, pos[:, 2])
+    return np.asarray(pairs, int).reshape(-1, 2), np.asarray(wc, int).reshape(-1, 2)
+
+
+def wall_foot(p: np.ndarray, wall: Wall) -> np.ndarray:
+    """The point of the wall's plane nearest to p [m]."""
+    n = unit_normal(wall)
+    return p + (float(wall.offset) - float(p @ n)) * n
+
+
+def contact_segments(pos, walls, pairs, wall_contacts) -> tuple[np.ndarray, tuple[str, ...]]:
+    """Contact lines [m] (nc, 2, 3): centre to centre, centre to the wall's nearest point."""
+    segs = [(pos[i], pos[j]) for i, j in pairs]
+    segs += [(pos[i], wall_foot(pos[i], walls[w])) for i, w in wall_contacts]
+    kinds = ("granule",) * len(pairs) + ("wall",) * len(wall_contacts)
+    return np.asarray(segs, float).reshape(-1, 2, 3), kinds
+
+
+def pair_overlaps(pos: np.ndarray, r: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """R_i + R_j - |s_j - s_i| [m] of each pair, for pos of shape (..., n, 3)."""
+    i, j = pairs[:, 0], pairs[:, 1]
+    return r[i] + r[j] - np.linalg.norm(pos[..., j, :] - pos[..., i, :], axis=-1)
+
+
+def wall_overlaps(pos: np.ndarray, r: np.ndarray, walls, wall_contacts: np.ndarray) -> np.ndarray:
+    """s_i . n + R_i - offset [m] of each (granule, wall) contact, for pos (..., n, 3)."""
+    i, w = wall_contacts[:, 0], wall_contacts[:, 1]
+    n = np.array([unit_normal(walls[k]) for k in w]).reshape(-1, 3)
+    off = np.array([float(walls[k].offset) for k in w])
+    return np.sum(pos[..., i, :] * n, axis=-1) + r[i] - off
+
+
+def elastic_forces(coef: np.ndarray, delta: np.ndarray, delta_max: np.ndarray) -> np.ndarray:
+    """|N| [N] of each contact at overlap delta [m] (0 where apart) under the run's normal
+    law (`physics.laws.normal_law_force`, coefficient rows coef, largest overlap so far
+    delta_max), at zero overlap rate: the elastic part of the force."""
+    from granplate.physics.laws import normal_law_force
+
+    return np.array([normal_law_force(float(d), 0.0, c, float(max(m, d)), False) if d > 0.0 else 0.0
+                     for d, c, m in zip(delta, coef, delta_max)], float)
+
+
+def contact_forces(s: Scenario, positions: np.ndarray, r: np.ndarray, pairs, wall_contacts) -> np.ndarray:
+    """Normal force [N] of every contact (pairs, then walls) at the last of positions
+    (times, n, 3) [m], the earlier rows giving the plastic law's largest overlap."""
+    from granplate.model.arrays import pair_coefficients, wall_arrays
+    from granplate.setup.materials import sphere_mass
+
+    mats = [s.material(g.material) for g in s.granules]
+    mass = np.array([sphere_mass(ri, m.rho) for ri, m in zip(r, mats)])
+    out = []
+    if len(pairs):
+        d = pair_overlaps(positions, r, pairs)
+        out.append(elastic_forces(pair_coefficients(s, mats, r, mass, pairs), d[-1], d.max(axis=0)))
+    if len(wall_contacts):
+        d = wall_overlaps(positions, r, s.walls, wall_contacts)
+        out.append(elastic_forces(wall_arrays(s, mats, r, mass, wall_contacts)[1], d[-1], d.max(axis=0)))
+    return np.concatenate(out) if out else np.zeros(0)
+
+
+# --------------------------------------------------------------------------------------
+# Builders
+# --------------------------------------------------------------------------------------
+def is_space(ds: xr.Dataset) -> bool:
+    """Whether a result is of a 3D run (it stores z)."""
+    return "z" in ds.variables
+
+
+def positions(ds: xr.Dataset, upto: int | None = None) -> np.ndarray:
+    """Centres (time, granule, 3) [m] of a 3D result (up to output index `upto`, inclusive)."""
+    sl = slice(None) if upto is None else slice(0, upto + 1)
+    return np.stack([ds[k].values[sl] for k in ("x", "y", "z")], axis=-1).astype(float)
+
+
+def of_scenario(scenario: Scenario) -> Assembly3D:
+    """The 3D assembly of a scenario before its run: initial centres, the contacts
+    touching at t = 0 (no forces)."""
+    from granplate.model.space import loaded_granules_3d
+    from granplate.setup.geometry import resolve
+
+    s = resolve(scenario)
+    pos = np.array([(g.x, g.y, g.z) for g in s.granules], float).reshape(-1, 3)
+    r = np.array([g.radius for g in s.granules], float)
+    pairs, wc = touching(s, pos, r)
+    segs, kinds = contact_segments(pos, s.walls, pairs, wc)
+    return Assembly3D(
+        name=s.name, pos=pos, radius=r, labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
+        materials=tuple(g.material for g in s.granules), walls=s.walls, load=s.load,
+        loaded=loaded_granules_3d(s, pos[:, 0], pos[:, 1], pos[:, 2], r), segments=segs, kinds=kinds,
+    )
+
+
+def of_result(ds: xr.Dataset, time: float | None = None) -> Assembly3D:
+    """The 3D assembly of a result at `time` [s] (None: the last output): centres and
+    contact forces at the nearest output (module docstring)."""
+    from granplate.figures.assembly import choose_time
+    from granplate.model.space import loaded_granules_3d
+    from granplate.results.dataset import scenario_of
+    from granplate.setup.geometry import resolve
+
+    s = resolve(scenario_of(ds))
+    ti, note = choose_time(ds, time)
+    path = positions(ds, ti)
+    pos = path[-1]
+    r = np.asarray(ds["radius"].values, float)
+    pairs, wc = touching(s, pos, r)
+    segs, kinds = contact_segments(pos, s.walls, pairs, wc)
+    p0 = path[0]
+    return Assembly3D(
+        name=s.name, pos=pos, radius=r, labels=tuple(str(v) for v in ds["granule"].values),
+        materials=tuple(str(v) for v in ds["material"].values), walls=s.walls, load=s.load,
+        loaded=loaded_granules_3d(s, p0[:, 0], p0[:, 1], p0[:, 2], r), segments=segs, kinds=kinds,
+        forces=contact_forces(s, path, r, pairs, wc), time=float(ds["time"].values[ti]), time_note=note,
+    )
+
+
+# --------------------------------------------------------------------------------------
+# Drawing
+# --------------------------------------------------------------------------------------
+def depth_fraction(depth: np.ndarray) -> np.ndarray:
+    """0 for the nearest sphere, 1 for the farthest (depth grows towards the viewer)."""
+    d = np.asarray(depth, float)
+    span = float(d.max() - d.min()) if d.size else 0.0
+    return (d.max() - d) / span if span > 0 else np.zeros_like(d)
+
+
+def shaded(colour: str, fraction: float) -> tuple[float, float, float]:
+    """colour darkened by DEPTH_DARKEN * fraction (fraction 0: unchanged)."""
+    return tuple(c * (1.0 - DEPTH_DARKEN * float(fraction)) for c in to_rgb(colour))
+
+
+def bounds(a: Assembly3D, margin: float = 0.05) -> tuple[np.ndarray, np.ndarray]:
+    """(lower, upper) corners [m] of the drawn region: the spheres and the axis-aligned
+    walls (a box), widened by margin times the largest side."""
+    lo = (a.pos - a.radius[:, None]).min(axis=0) if len(a.radius) else np.zeros(3)
+    hi = (a.pos + a.radius[:, None]).max(axis=0) if len(a.radius) else np.zeros(3)
+    for w in a.walls:  # an axis-aligned wall bounds its axis
+        n = unit_normal(w)
+        k = int(np.argmax(np.abs(n)))
+        if abs(abs(n[k]) - 1.0) < EDGE_ON:
+            c = float(w.offset) * n[k]
+            lo[k], hi[k] = min(lo[k], c), max(hi[k], c)
+    m = margin * float((hi - lo).max()) if np.any(hi > lo) else 0.01
+    return lo - m, hi + m
+
+
+def wall_trace(wall: Wall, view: tuple, lo: np.ndarray, hi: np.ndarray):
+    """The wall's line in a view (two end points [m], clipped to the drawn region), or
+    None when its plane is not seen edge-on in that view."""
+    from granplate.figures.show import clip_line
+
+    u, v, d, _ = view
+    n = unit_normal(wall)
+    if abs(n[d]) > EDGE_ON:
+        return None
+    n2 = np.array([n[u], n[v]])
+    n2 = n2 / np.linalg.norm(n2)
+    return clip_line(n2 * float(wall.offset), np.array([-n2[1], n2[0]]), (lo[u], hi[u], lo[v], hi[v]))
+
+
+def _force_style(forces: np.ndarray):
+    """(widths, colours, styles, colour map) of the contact lines by normal force."""
+    from granplate.figures.show import FORCE_CMAP
+
+    f_max = float(forces.max()) if len(forces) else 0.0
+    cmap = ScalarMappable(Normalize(0.0, f_max if f_max > 0 else 1.0), FORCE_CMAP)
+    open_ = forces <= OPEN_FRACTION * f_max
+    widths = np.where(open_, 0.6, MAX_LINE_WIDTH * forces / (f_max if f_max > 0 else 1.0))
+    colours = [(0.45, 0.45, 0.45, 1.0) if o else cmap.to_rgba(v) for o, v in zip(open_, forces)]
+    return widths, colours, [":" if o else "-" for o in open_], cmap, open_, f_max
+
+
+def _draw_view(ax, a: Assembly3D, view: tuple, colours: dict, lo, hi) -> int:
+    """One projection of the region lo..hi [m]; returns the number of walls drawn as lines
+    (each clipped to the region without its margin: a box's walls meet at its corners)."""
+    u, v, d, sign = view
+    ax.set_aspect("equal")
+    ax.set_xlim(lo[u] * MM, hi[u] * MM)
+    ax.set_ylim(lo[v] * MM, hi[v] * MM)
+    ax.set_xlabel(f"{AXIS_NAMES[u]} [mm]")
+    ax.set_ylabel(f"{AXIS_NAMES[v]} [mm]")
+    toward = ("+" if sign > 0 else "-") + AXIS_NAMES[d]
+    ax.set_title(f"{AXIS_NAMES[u]}-{AXIS_NAMES[v]}, seen from {toward}", fontsize=9, loc="left")
+    drawn = 0
+    inner = bounds(a, margin=0.0)
+    for w in a.walls:
+        ends = wall_trace(w, view, *inner)
+        if ends is not None:
+            p, q = ends
+            ax.plot([p[0] * MM, q[0] * MM], [p[1] * MM, q[1] * MM], color="0.2", lw=2.0, zorder=1,
+                    gid=f"wall:{w.label}:{AXIS_NAMES[u]}{AXIS_NAMES[v]}")
+            drawn += 1
+    depth = sign * a.pos[:, d] if len(a.radius) else np.zeros(0)
+    frac = depth_fraction(depth)
+    order = np.argsort(depth, kind="stable")  # far first, near last (on top)
+    for rank, i in enumerate(order):
+        ax.add_patch(Circle((a.pos[i, u] * MM, a.pos[i, v] * MM), a.radius[i] * MM,
+                            fc=shaded(colours[a.materials[i]], frac[i]), ec="0.1", lw=0.6, zorder=2 + rank,
+                            gid=f"granule:{a.labels[i]}:{AXIS_NAMES[u]}{AXIS_NAMES[v]}"))
+    if len(a.segments):
+        segs = a.segments[:, :, [u, v]] * MM
+        z_top = 3 + len(a.radius)
+        if a.forces is None:
+            lines = LineCollection(segs, colors=[KIND_COLOURS[k] for k in a.kinds], linewidths=1.2, zorder=z_top,
+                                   gid=f"contacts:{AXIS_NAMES[u]}{AXIS_NAMES[v]}")
+        else:
+            widths, cols, styles, *_ = _force_style(np.asarray(a.forces, float))
+            lines = LineCollection(segs, colors=cols, linewidths=widths, linestyles=styles, zorder=z_top,
+                                   capstyle="round", gid=f"contacts:{AXIS_NAMES[u]}{AXIS_NAMES[v]}")
+        ax.add_collection(lines)
+    ax.grid(True, lw=0.3, alpha=0.4)
+    return drawn
+
+
+def _title(a: Assembly3D) -> str:
+    if a.time is None:
+        return f"{a.name}: assembly before the run (in space; spheres darker with distance from the viewer)"
+    return (f"{a.name} at t = {a.time * 1e3:.4g} ms, {a.time_note} "
+            f"(in space; spheres darker with distance from the viewer)")
+
+
+def _load_text(a: Assembly3D) -> str | None:
+    ld = a.load
+    if ld.kind != "force" or not a.loaded.any():
+        return None
+    d = np.asarray(ld.direction, float)
+    d = d / np.linalg.norm(d)
+    text = (f"load: {ld.force:.4g} N half-sine, T = {ld.duration * 1e6:.3g} µs, along "
+            f"({d[0]:.3g}, {d[1]:.3g}, {d[2]:.3g}), on {int(a.loaded.sum())} granule(s) (red outline)")
+    if a.time is not None and a.time > ld.duration:
+        text += ", over at this time"
+    return text
+
+
+def _mark_loaded(axes, a: Assembly3D) -> None:
+    for ax, (u, v, _, _) in zip(axes, PROJECTIONS):
+        for i in np.flatnonzero(a.loaded):
+            ax.add_patch(Circle((a.pos[i, u] * MM, a.pos[i, v] * MM), a.radius[i] * MM, fill=False,
+                                ec=LOAD_COLOUR, lw=1.6, zorder=4 + 2 * len(a.radius), gid=f"load:{a.labels[i]}"))
+
+
+def legend_handles(a: Assembly3D, colours: dict, oblique: list[str]) -> list:
+    """Legend entries: materials, walls, contacts, load."""
+    handles = [Patch(fc=c, ec="0.1", label=f"{m} ({a.materials.count(m)} spheres)") for m, c in colours.items()]
+    if len(a.walls) > len(oblique):
+        handles.append(Line2D([], [], color="0.2", lw=2.0, label="rigid walls seen edge-on"))
+    if oblique:
+        handles.append(Line2D([], [], color="none", label="oblique walls, not drawn: " + ", ".join(oblique)))
+    if len(a.segments) and a.forces is None:
+        handles += [Line2D([], [], color=KIND_COLOURS[k], lw=1.2, label=f"contact {KIND_NAMES[k]} "
+                           f"({a.kinds.count(k)})") for k in KIND_COLOURS if k in a.kinds]
+    elif len(a.segments):
+        _, _, _, cmap, open_, f_max = _force_style(np.asarray(a.forces, float))
+        handles += [Line2D([], [], color=cmap.to_rgba(f_max), lw=MAX_LINE_WIDTH,
+                           label=f"contact force, width ∝ force (widest: {f_max:.3g} N)"),
+                    Line2D([], [], color="0.45", lw=0.6, ls=":",
+                           label=f"contact below {OPEN_FRACTION:.0%} of the largest ({int(open_.sum())})")]
+    text = _load_text(a)
+    if text:
+        handles.append(Patch(fc="none", ec=LOAD_COLOUR, lw=1.6, label=text))
+    return handles
+
+
+def draw(a: Assembly3D, width: float = 13.0) -> Figure:
+    """The three orthogonal projections of a 3D assembly (module docstring)."""
+    lo, hi = bounds(a)
+    span = (hi - lo) * MM
+    fig = new_figure(width, min(max(width / 3.0 * span[1:].max() / max(span[:2].max(), 1e-12) + 2.2, 4.0), 9.0))
+    axes = fig.subplots(1, 3, width_ratios=[span[0], span[0], span[1]])
+    colours = material_colours(a.materials)
+    for ax, view in zip(axes, PROJECTIONS):
+        _draw_view(ax, a, view, colours, lo, hi)
+    _mark_loaded(axes, a)
+    oblique = [w.label or f"wall {k}" for k, w in enumerate(a.walls)
+               if all(wall_trace(w, view, lo, hi) is None for view in PROJECTIONS)]
+    if a.forces is not None and len(a.segments):
+        cmap = _force_style(np.asarray(a.forces, float))[3]
+        fig.colorbar(cmap, ax=list(axes), label="contact normal force [N]", orientation="horizontal",
+                     shrink=0.5, aspect=50, location="bottom")
+    fig.legend(handles=legend_handles(a, colours, oblique), loc="outside lower center", ncols=2, fontsize=8,
+               frameon=False)
+    fig.suptitle(_title(a), fontsize=10, x=0.01, ha="left")
+    return fig
