@@ -163,7 +163,7 @@ def test_force_loaded_granules_are_those_furthest_against_the_direction():
     ({"dimension": 4}, "dimension", "must be 2"),
     ({"dimension": 1}, "dimension", "or 3"),
     ({"plate": {"x0": 0.1}}, "plate", "three-dimensional elastic bodies are not available yet"),
-    ({"layout": {"kind": "hexagonal"}, "granules": None}, "layout", "3D layouts: list [[granules]]"),
+    ({"layout": {"kind": "hexagonal"}, "granules": None}, "layout.kind", "a packing of discs in the plane is 2D"),
     ({"load": {"kind": "line"}}, "load.kind", 'a line load q0 [N/m] is 2D; in 3D use kind = "force"'),
     ({"load": {"kind": "force", "direction": [0.0, 0.0, 0.0]}}, "load.direction", "nonzero"),
     ({"load": {"kind": "force", "direction": [1.0, math.nan, 0.0]}}, "load.direction", "finite"),
@@ -281,7 +281,8 @@ def test_unknown_3d_fields_suggest_the_closest_name():
 def test_2d_files_are_written_as_before():
     """dumps of every preset, as written and resolved, and of the docs' example files equals the
     committed main branch's output (the 3D fields add nothing to a 2D file)."""
-    files = sorted(str(p.relative_to(ROOT)) for p in (ROOT / "docs" / "examples").glob("*.toml"))
+    files = sorted(str(p.relative_to(ROOT)) for p in (ROOT / "docs" / "examples").glob("*.toml")
+                   if not p.name.startswith("3d-"))
     script = ("import json, sys\nfrom granplate.setup import io, presets\nfrom granplate.setup.geometry import resolve\n"
               "out = {n: [io.dumps(presets.preset(n)), io.dumps(resolve(presets.preset(n)))] "
               "for n in presets.preset_names()}\n"

@@ -427,7 +427,7 @@ def _check_space_planes(lay: SpaceLattice) -> None:
         rho = plane_gap_distance(lay.kind, plane_type(lay.kind, p), plane_type(lay.kind, p + 1), r_max)
         if not radii[p] + radii[p + 1] >= rho:
             k = _layer_of_plane(lay, p if radii[p] < radii[p + 1] else p + 1)
-            raise ScenarioError(f"layout.layers[{k}].radius", lay.layers[k].radius,
+            raise ScenarioError(f"layout.layers[{k}].radius", min(radii[p], radii[p + 1]),
                                 f"planes {p + 1} and {p + 2} cannot touch: R_p + R_p+1 = "
                                 f"{radii[p] + radii[p + 1]:.6g} m < {rho:.6g} m, the in-plane distance to "
                                 f"the next plane's sites on the {lay.kind} net of the largest radius "
@@ -437,7 +437,7 @@ def _check_space_planes(lay: SpaceLattice) -> None:
         p, q, overlap = clash
         thin = min(range(p + 1, q), key=lambda m: radii[m])
         k = _layer_of_plane(lay, thin)
-        raise ScenarioError(f"layout.layers[{k}].radius", lay.layers[k].radius,
+        raise ScenarioError(f"layout.layers[{k}].radius", radii[thin],
                             f"planes {p + 1} and {q + 1} overlap by {overlap:.6g} m: plane {thin + 1} "
                             f"between them (radius {radii[thin]:.6g} m) is too small to hold them apart; "
                             "allowed: a radius that keeps every pair of planes apart")
