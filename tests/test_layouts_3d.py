@@ -347,6 +347,8 @@ BAD = [
      "must be > 0"),
     ("layer material", _lay3(cells=(2, 2, 2), layers=(Layer(1), Layer(1, material="wood"))),
      "layout.layers[1].material", "unknown material"),
+    ("layer radius ratio", _lay3(kind="sc", cells=(2, 2, 2), layers=(Layer(1, radius=1e-9), Layer(1, radius=1.0))),
+     "layout.layers[0].radius", "of the largest layer radius"),
     ("layer counts", _lay3(cells=(3, 2, 2), layers=(Layer(1), Layer(1))), "layout.layers",
      "add up to layout.cells[0] = 3"),
     ("planes cannot touch", _lay3(kind="fcc", cells=(3, 2, 2),

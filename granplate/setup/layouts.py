@@ -385,7 +385,7 @@ def enclosing_box(granules: list[Granule] | tuple[Granule, ...], labels: tuple[s
         axis, upper = divmod(k, 2)
         coord = [[g.x, g.y, g.z][axis] for g in granules]
         sign = 1.0 if upper else -1.0
-        offset = max(sign * (c) + g.radius for c, g in zip(coord, granules))
+        offset = max(sign * c + g.radius for c, g in zip(coord, granules))
         normal = tuple(sign if a == axis else 0.0 for a in range(3))
         walls.append(Wall(normal, offset, label=name, material=material))
     return tuple(walls)

@@ -2,8 +2,8 @@
 
 A scenario is written as a TOML file (see docs/scenario.md) or built in Python. The
 paper's three-column packing is generated from a `Layout`, hexagonal and square packings
-from a `LatticeLayout`, chains from a `ChainLayout`; any other planar assembly is given
-granule by granule. Validation (`validate`) refuses bad input before anything runs,
+from a `LatticeLayout`, chains from a `ChainLayout`, sc, bcc, fcc and hcp lattices of
+spheres in space from a `SpaceLattice`; any other assembly is given granule by granule. Validation (`validate`) refuses bad input before anything runs,
 with a `ScenarioError` naming the field, the value and what is allowed.
 """
 from __future__ import annotations

@@ -399,6 +399,11 @@ def _check_layers(s: Scenario, lay: SpaceLattice) -> None:
             layout_radius(f"{p}.radius", ly.radius)
         if ly.material is not None:
             material_exists(f"{p}.material", ly.material, s)
+    radii = [lay.radius if ly.radius is None else ly.radius for ly in lay.layers]
+    for k, r in enumerate(radii):
+        if not max(radii) <= LENGTH_RANGE * r:
+            raise ScenarioError(f"layout.layers[{k}].radius", r, f"allowed: at least 1 / {LENGTH_RANGE:g} "
+                                f"of the largest layer radius {max(radii):.6g} m (a ratio of radii)")
     total = sum(ly.count for ly in lay.layers)
     if lay.layers and total != lay.cells[0]:
         raise ScenarioError("layout.layers", [ly.count for ly in lay.layers],
