@@ -175,7 +175,7 @@ def test_command_line_reports_bad_numbers_in_one_line(tmp_path):
 
 #: Every layout kind, from its worked example (docs/examples) and the paper's preset.
 LAYOUT_SOURCES: tuple[str, ...] = ("paper", "hexagonal", "square", "chain", "imperfect",
-                                   "intruder-lattice")
+                                   "intruder-lattice", "3d-sc", "3d-bcc", "3d-fcc", "3d-hcp", "3d-chain")
 LAYOUT_BAD_VALUES: tuple = (-1.0, 0.0, math.nan, math.inf, 1e300, 1e-300, "x")
 
 

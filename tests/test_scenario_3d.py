@@ -163,7 +163,7 @@ def test_force_loaded_granules_are_those_furthest_against_the_direction():
     ({"dimension": 4}, "dimension", "must be 2"),
     ({"dimension": 1}, "dimension", "or 3"),
     ({"plate": {"x0": 0.1}}, "plate", "three-dimensional elastic bodies are not available yet"),
-    ({"layout": {"kind": "hexagonal"}, "granules": None}, "layout", "3D layouts: list [[granules]]"),
+    ({"layout": {"kind": "hexagonal"}, "granules": None}, "layout.kind", "a packing of discs in the plane is 2D"),
     ({"load": {"kind": "line"}}, "load.kind", 'a line load q0 [N/m] is 2D; in 3D use kind = "force"'),
     ({"load": {"kind": "force", "direction": [0.0, 0.0, 0.0]}}, "load.direction", "nonzero"),
     ({"load": {"kind": "force", "direction": [1.0, math.nan, 0.0]}}, "load.direction", "finite"),

@@ -22,7 +22,8 @@ import math
 
 from granplate.errors import ScenarioError
 from granplate.setup import layouts
-from granplate.setup.scenario import BOX_WALLS, Box, ChainLayout, Granule, LatticeLayout, Layout, Scenario, Wall
+from granplate.setup.scenario import (BOX_WALLS, Box, ChainLayout, Granule, LatticeLayout, Layout, Scenario,
+                                      SpaceLattice, Wall)
 
 #: Labels of the paper's granules, in the order `paper_layout` returns them.
 PAPER_LABELS: tuple[str, ...] = ("1", "2", "3", "4", "5", "6", "7", "8", "9",
@@ -71,17 +72,23 @@ def paper_layout(layout: Layout) -> tuple[tuple[Granule, ...], tuple[Wall, ...],
     return tuple(granules), walls, xp
 
 
-def layout_packing(layout: Layout | LatticeLayout | ChainLayout) -> layouts.Packing:
-    """The packing of any layout kind (paper, hexagonal, square, chain), imperfections applied."""
-    if layout.kind == "paper":
+def layout_packing(layout: Layout | LatticeLayout | ChainLayout | SpaceLattice,
+                   dimension: int = 2) -> layouts.Packing:
+    """The packing of any layout kind (paper, hexagonal, square, chain; sc, bcc, fcc, hcp in
+    space), imperfections applied. `dimension`: the scenario's, which places a chain in the
+    plane or in space (a space lattice is always 3D)."""
+    if isinstance(layout, SpaceLattice):
+        dimension = 3
+        packing = layouts.space_packing(layout)
+    elif layout.kind == "paper":
         granules, walls, xp = paper_layout(layout)
         packing = layouts.Packing(granules, walls, xp, PAPER_LABELS[:5])
     elif layout.kind == "chain":
-        packing = layouts.chain_packing(layout)
+        packing = layouts.chain_packing(layout, dimension)
     else:
         packing = layouts.lattice_packing(layout)
     if layout.imperfections is not None:
-        packing = layouts.imperfect(packing, layout.imperfections)
+        packing = layouts.imperfect(packing, layout.imperfections, dimension)
     return packing
 
 
@@ -99,6 +106,13 @@ def unit(v: tuple[float, ...]) -> tuple[float, ...]:
     """v / |v| [-] (v nonzero and finite: `validate` refuses the others first)."""
     norm = math.hypot(*v)
     return tuple(c / norm for c in v)
+
+
+def along_plus_x(direction: object) -> bool:
+    """Whether a load direction is +x (the layers' stacking direction): (d, 0, 0), d > 0."""
+    return (isinstance(direction, tuple) and len(direction) == 3 and direction[1:] == (0.0, 0.0)
+            and isinstance(direction[0], (int, float)) and not isinstance(direction[0], bool)
+            and direction[0] > 0.0)
 
 
 def plane_offset(normal: tuple[float, ...], point: tuple[float, ...]) -> float:
@@ -144,7 +158,9 @@ def resolve(scenario: Scenario) -> Scenario:
     - With a `layout`: granules and walls come from `layout_packing` (any kind),
       `layout` becomes None, and a plate with `x0 = None` is placed at the layout's xp.
       With imperfections and an empty `load.granules`, the load is given column 1's labels
-      (the leftmost-surface rule would pick one granule of a polydisperse column). A layout together with
+      (the leftmost-surface rule would pick one granule of a polydisperse column; in 3D
+      plane 1's, when the load's direction is +x). A 3D layout with a `box` is a
+      ScenarioError (the layout makes its walls). A layout together with
       explicit granules or walls is a ScenarioError (give one or the other).
     - Without a layout, a plate needs an explicit `x0` (ScenarioError otherwise).
     - Unlabelled granules get the label "g<i>", unlabelled walls "w<i>" (i: 0-based index).
@@ -164,10 +180,14 @@ def resolve(scenario: Scenario) -> Scenario:
             raise ScenarioError("walls", f"{len(walls)} walls",
                                 "give either [layout] or [[walls]], not both "
                                 "(the layout generates the left, bottom and top walls)")
-        granules, walls, xp, column1 = layout_packing(scenario.layout)
+        if scenario.box is not None:
+            raise ScenarioError("box", "[box]", "give either [layout] or [box], not both (a 3D "
+                                "layout generates the walls around it: layout.walls)")
+        granules, walls, xp, column1 = layout_packing(scenario.layout, scenario.dimension)
         if plate is not None and plate.x0 is None:
             plate = dataclasses.replace(plate, x0=xp)
-        if scenario.layout.imperfections is not None and not load.granules:
+        along_x = scenario.dimension == 2 or along_plus_x(load.direction)
+        if scenario.layout.imperfections is not None and not load.granules and along_x:
             load = dataclasses.replace(load, granules=column1)
     if plate is not None and plate.x0 is None:
         raise ScenarioError("plate.x0", None,
@@ -195,7 +215,9 @@ PLACING_FIELDS: dict[type, tuple[str, ...]] = {
     Layout: ("R1", "R2_ratio", "imperfections"),
     LatticeLayout: ("kind", "columns", "rows", "radius", "column_radii", "intruder_ratio", "intruder_columns",
                     "intruder_sites", "intruder_every", "imperfections"),
-    ChainLayout: ("count", "radius", "taper", "dimer_ratio", "decorated_ratio", "y", "imperfections"),
+    ChainLayout: ("count", "radius", "taper", "dimer_ratio", "decorated_ratio", "y", "z", "imperfections"),
+    SpaceLattice: ("kind", "cells", "radius", "layers", "intruder_ratio", "intruder_sites",
+                   "intruder_every", "imperfections"),
 }
 
 

@@ -300,7 +300,8 @@ def _used_materials(s: Scenario) -> set[str]:
 
 
 def _layout_materials(layout: Any) -> set[str]:
-    """Every material name a layout's fields give (fields named *material or *materials)."""
+    """Every material name a layout's fields give (fields named *material or *materials, and
+    those of its tables, such as a space lattice's layers)."""
     used: set[str] = set()
     for f in dataclasses.fields(layout):
         v = getattr(layout, f.name)
@@ -308,6 +309,10 @@ def _layout_materials(layout: Any) -> set[str]:
             used.add(v)
         elif f.name.endswith("materials") and isinstance(v, tuple):
             used |= {m for m in v if isinstance(m, str)}
+        elif isinstance(v, tuple):
+            for item in v:
+                if dataclasses.is_dataclass(item) and not isinstance(item, type):
+                    used |= _layout_materials(item)
     return used
 
 

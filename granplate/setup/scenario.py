@@ -2,8 +2,8 @@
 
 A scenario is written as a TOML file (see docs/scenario.md) or built in Python. The
 paper's three-column packing is generated from a `Layout`, hexagonal and square packings
-from a `LatticeLayout`, chains from a `ChainLayout`; any other planar assembly is given
-granule by granule. Validation (`validate`) refuses bad input before anything runs,
+from a `LatticeLayout`, chains from a `ChainLayout`, sc, bcc, fcc and hcp lattices of
+spheres in space from a `SpaceLattice`; any other assembly is given granule by granule. Validation (`validate`) refuses bad input before anything runs,
 with a `ScenarioError` naming the field, the value and what is allowed.
 """
 from __future__ import annotations
@@ -162,6 +162,9 @@ class ChainLayout:
     chain); decorated_ratio > 0 puts a small granule "d{k}" of radius decorated_ratio x
     R_k (decorated_material, None = material) between granules k and k + 1.
     One wall, `left`, touches granule 1; the plate is placed against the last granule.
+    In 3D (`dimension = 3`) the chain runs along x at height y and depth z [m] (default:
+    the largest radius) between the walls "xmin" (x = 0) and "xmax" (the last surface);
+    z is 3D only (None in 2D).
     """
 
     kind: str = "chain"
@@ -174,6 +177,55 @@ class ChainLayout:
     decorated_ratio: float = 0.0
     decorated_material: str | None = None
     y: float | None = None
+    z: float | None = None
+    wall_material: str = "steel"
+    imperfections: Imperfections | None = None
+
+
+#: Kinds of `SpaceLattice` (3D lattices): simple cubic, body-centred cubic, face-centred
+#: cubic, hexagonal close-packed.
+SPACE_LATTICE_KINDS: tuple[str, ...] = ("sc", "bcc", "fcc", "hcp")
+
+
+@dataclass(frozen=True)
+class Layer:
+    """One layer of a `SpaceLattice`, `layout.layers[k]`: `count` cells along x (the load
+    direction) whose spheres have `radius` [m] (None = the layout's radius) and `material`
+    (None = the layout's material)."""
+
+    count: int = 1
+    radius: float | None = None
+    material: str | None = None
+
+
+@dataclass(frozen=True)
+class SpaceLattice:
+    """A lattice of spheres in space (`dimension = 3`), `kind` one of SPACE_LATTICE_KINDS.
+
+    cells = (nx, ny, nz): conventional cells along x (the load direction), y, z. A cell holds
+    1 (sc), 2 (bcc), 4 (fcc) or 4 (hcp, the orthohexagonal cell) sites; each cell along x is
+    1 (sc) or 2 lattice planes normal to x, numbered 1.. from the loaded side (x smallest).
+    Spheres of the largest radius R touch as the lattice says: sc along the axes (edge 2R),
+    bcc along the body diagonals (edge 4R / sqrt(3)), fcc (edge 2 sqrt(2) R) and hcp (a = 2R,
+    c = 4 sqrt(2/3) R) at 2R, 12 neighbours. layers: cells along x of their own radius and
+    material (the counts add up to nx; empty = one layer of radius, material); the planes'
+    spacing follows their radii so that neighbours in adjacent planes touch. Site labels
+    "x{plane}y{row}z{site}" (1-based: plane along x, row along y in the plane, site along z
+    in the row). intruder_sites, intruder_every, intruder_ratio (<= 1), intruder_material: single
+    sites shrunk at their centres, as in `LatticeLayout`. walls: which of the six walls
+    (BOX_WALLS) enclose the packing, each touching its outermost surfaces, of wall_material.
+    """
+
+    kind: str = "fcc"
+    cells: tuple[int, int, int] = (2, 2, 2)
+    radius: float = 0.01
+    material: str = "steel"
+    layers: tuple[Layer, ...] = ()
+    intruder_ratio: float = 1.0
+    intruder_material: str | None = None
+    intruder_sites: tuple[str, ...] = ()
+    intruder_every: int = 0
+    walls: tuple[str, ...] = BOX_WALLS
     wall_material: str = "steel"
     imperfections: Imperfections | None = None
 
@@ -181,6 +233,11 @@ class ChainLayout:
 #: `[layout] kind` -> the dataclass that holds that kind's fields.
 LAYOUT_KINDS: dict[str, type] = {
     "paper": Layout, "hexagonal": LatticeLayout, "square": LatticeLayout, "chain": ChainLayout,
+    **{k: SpaceLattice for k in SPACE_LATTICE_KINDS},
+}
+#: The layout kinds of each dimension (`Scenario.dimension`); a chain is either.
+LAYOUT_KINDS_BY_DIMENSION: dict[int, tuple[str, ...]] = {
+    2: ("paper", "hexagonal", "square", "chain"), 3: SPACE_LATTICE_KINDS + ("chain",),
 }
 
 
@@ -415,13 +472,13 @@ class Scenario:
     """A complete run definition. Either `layout` or explicit `granules`/`walls`.
 
     dimension: 2 (discs in the plane, the paper's model; the default) or 3 (spheres in
-    space: granules, walls and an optional `box`, no plate or layout yet).
+    space: granules, walls and an optional `box`, or a 3D `layout`; no plate yet).
     """
 
     name: str = "custom"
     description: str = ""
     materials: dict[str, Material] = field(default_factory=lambda: dict(LIBRARY))
-    layout: Layout | LatticeLayout | ChainLayout | None = None
+    layout: Layout | LatticeLayout | ChainLayout | SpaceLattice | None = None
     granules: tuple[Granule, ...] = ()
     walls: tuple[Wall, ...] = ()
     plate: Plate | None = None

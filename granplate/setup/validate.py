@@ -24,13 +24,16 @@ from scipy.spatial import cKDTree
 
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import granule_named, layout_packing, plane_offset, resolve, unit
-from granplate.setup.layouts import column_radii, half_pitch, hexagonal_offsets, lattice_sites
+from granplate.setup.layouts import (column_radii, half_pitch, hexagonal_offsets, lattice_sites, plane_clash,
+                                     plane_gap_distance, plane_layers, plane_type, planes_per_cell,
+                                     sites_per_cell, space_sites)
 from granplate.setup.fields import finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
 from granplate.setup.plate_checks import check_plate_fields, check_plate_mesh
 from granplate.setup.plate_cost import MEMORY_SHARE, physical_memory
 from granplate.setup.materials import Material
-from granplate.setup.scenario import (BOX_WALLS, LAYOUT_KINDS, NORMAL_LAWS, SQRT2_MINUS_1, ChainLayout,
-                                      Granule, Imperfections, LatticeLayout, Layout, Scenario)
+from granplate.setup.scenario import (BOX_WALLS, LAYOUT_KINDS, LAYOUT_KINDS_BY_DIMENSION, NORMAL_LAWS,
+                                      SPACE_LATTICE_KINDS, SQRT2_MINUS_1, ChainLayout, Granule,
+                                      Imperfections, LatticeLayout, Layout, Scenario, SpaceLattice)
 
 #: Lever arms of the friction torque (Contact.torque_arm).
 TORQUE_ARMS: tuple[str, ...] = ("radius", "contact_point")
@@ -74,6 +77,9 @@ LENGTH_RANGE = 1e6
 #: .. LENGTH_RANGE of the radius they scale, so that the granules it makes stay in the range
 #: every coordinate is checked against (LENGTH_RANGE).
 LAYOUT_RADIUS_RANGE: tuple[float, float] = (1e-9, 1e3)
+#: The most sites a space lattice may have: `resolve` builds each sphere in Python (about a
+#: second per 10^5), and the solver's scaling is measured up to 10^4 granules.
+MAX_LAYOUT_SITES = 1_000_000
 
 
 # --------------------------------------------------------------------------- sections
@@ -112,17 +118,27 @@ def _check_planar(s: Scenario) -> None:
     if s.load.kind == "force":
         raise ScenarioError("load.kind", s.load.kind, "a total force [N] along a direction is 3D; "
                             f"in 2D use kind = \"line\" (q0 [N/m]) or \"none\", {SET_3D}")
+    lay = s.layout
+    if lay is not None and isinstance(lay.kind, str) and lay.kind in SPACE_LATTICE_KINDS:
+        raise ScenarioError("layout.kind", lay.kind, "a lattice of spheres in space is 3D: in 2D use "
+                            "one of " + ", ".join(repr(k) for k in LAYOUT_KINDS_BY_DIMENSION[2])
+                            + f", {SET_3D}")
+    if isinstance(lay, ChainLayout) and lay.z is not None:
+        raise ScenarioError("layout.z", lay.z, f"a chain's depth z is 3D: leave it out in 2D, {SET_3D}")
 
 
 def _check_spatial(s: Scenario) -> None:
-    """A 3D scenario (as written): granules, walls and a box; no plate or layout yet; vector
-    spins; walls as planes."""
+    """A 3D scenario (as written): granules, walls and a box, or a 3D layout; no plate yet;
+    vector spins; walls as planes."""
     if s.plate is not None:
         raise ScenarioError("plate", "[plate]", "three-dimensional elastic bodies are not available "
                             "yet (a 3D scenario takes granules, walls and a box)")
-    if s.layout is not None:
-        raise ScenarioError("layout", s.layout.kind, "3D layouts: list [[granules]] (generated "
-                            "packings are 2D for now)")
+    lay = s.layout
+    if lay is not None and isinstance(lay.kind, str) and lay.kind in LAYOUT_KINDS \
+            and lay.kind not in LAYOUT_KINDS_BY_DIMENSION[3]:
+        raise ScenarioError("layout.kind", lay.kind, "a packing of discs in the plane is 2D: in 3D use "
+                            "one of " + ", ".join(repr(k) for k in LAYOUT_KINDS_BY_DIMENSION[3])
+                            + " (or list [[granules]])")
     if s.load.kind == "line":
         raise ScenarioError("load.kind", s.load.kind, "a line load q0 [N/m] is 2D; in 3D use "
                             "kind = \"force\" (or \"none\")")
@@ -227,11 +243,13 @@ def _check_layout(s: Scenario) -> None:
         _check_paper_layout(s, lay)
     elif lay.kind == "chain":
         _check_chain_layout(s, lay)
+    elif isinstance(lay, SpaceLattice):
+        _check_space_lattice(s, lay)
     else:
         _check_lattice_layout(s, lay)
     if lay.imperfections is not None:
         _check_imperfections(lay.imperfections, layout_packing(
-            dataclasses.replace(lay, imperfections=None)).granules)
+            dataclasses.replace(lay, imperfections=None), s.dimension).granules)
 
 
 def layout_radius(path: str, value: Any) -> None:
@@ -329,6 +347,107 @@ def _check_column_offsets(lay: LatticeLayout) -> None:
                                 "e.g. R_c+1 >= (sqrt(2) - 1) R_c for equal outer columns")
 
 
+def _check_space_lattice(s: Scenario, lay: SpaceLattice) -> None:
+    """A space lattice's fields, then its planes: neighbours reach each other, nothing else overlaps."""
+    cells = lay.cells
+    if not isinstance(cells, tuple) or len(cells) != 3:
+        raise ScenarioError("layout.cells", cells, "must be three integers [nx, ny, nz] >= 1 (cells "
+                            "along x, the load direction, y and z)")
+    for k, n in enumerate(cells):
+        int_at_least(f"layout.cells[{k}]", n, 1)
+    n_sites = sites_per_cell(lay.kind) * cells[0] * cells[1] * cells[2]
+    if n_sites > MAX_LAYOUT_SITES:
+        raise ScenarioError("layout.cells", list(cells), f"makes {n_sites} sites ({sites_per_cell(lay.kind)} "
+                            f"per {lay.kind} cell); allowed: at most {MAX_LAYOUT_SITES} sites")
+    layout_radius("layout.radius", lay.radius)
+    for f in ("material", "wall_material"):
+        material_exists(f"layout.{f}", getattr(lay, f), s)
+    if lay.intruder_material is not None:
+        material_exists("layout.intruder_material", lay.intruder_material, s)
+    _check_layers(s, lay)
+    if not isinstance(lay.walls, tuple):
+        raise ScenarioError("layout.walls", lay.walls, "must be a list of wall names, a subset of "
+                            + ", ".join(repr(w) for w in BOX_WALLS))
+    for k, w in enumerate(lay.walls):
+        string_in(f"layout.walls[{k}]", w, BOX_WALLS)
+        if w in lay.walls[:k]:
+            raise ScenarioError(f"layout.walls[{k}]", w, "each wall at most once")
+    layout_ratio("layout.intruder_ratio", lay.intruder_ratio)
+    int_at_least("layout.intruder_every", lay.intruder_every, 0)
+    _check_space_planes(lay)
+    sites = [g.label for g in space_sites(lay)]
+    known = set(sites)
+    for k, lab in enumerate(lay.intruder_sites):
+        if lab not in known:
+            raise ScenarioError(f"layout.intruder_sites[{k}]", lab,
+                                f"no such site; sites are {sites[0]}..{sites[-1]} (x{{plane}}y{{row}}"
+                                "z{site}: plane along x, row along y, site along z, from 1)")
+    if (lay.intruder_sites or lay.intruder_every) and lay.intruder_ratio > 1.0:
+        raise ScenarioError("layout.intruder_ratio", lay.intruder_ratio,
+                            "must be in (0, 1] with intruder_sites or intruder_every "
+                            "(a single-site intruder larger than its site overlaps its neighbours)")
+
+
+def _check_layers(s: Scenario, lay: SpaceLattice) -> None:
+    """Each layer: count >= 1, radius (or None), material (or None); counts add up to cells[0]."""
+    if not isinstance(lay.layers, tuple):
+        raise ScenarioError("layout.layers", lay.layers, "must be a list of tables {count, radius, material}")
+    for k, ly in enumerate(lay.layers):
+        p = f"layout.layers[{k}]"
+        int_at_least(f"{p}.count", ly.count, 1)
+        if ly.radius is not None:
+            layout_radius(f"{p}.radius", ly.radius)
+        if ly.material is not None:
+            material_exists(f"{p}.material", ly.material, s)
+    radii = [lay.radius if ly.radius is None else ly.radius for ly in lay.layers]
+    for k, r in enumerate(radii):
+        if not max(radii) <= LENGTH_RANGE * r:
+            raise ScenarioError(f"layout.layers[{k}].radius", r, f"allowed: at least 1 / {LENGTH_RANGE:g} "
+                                f"of the largest layer radius {max(radii):.6g} m (a ratio of radii)")
+    total = sum(ly.count for ly in lay.layers)
+    if lay.layers and total != lay.cells[0]:
+        raise ScenarioError("layout.layers", [ly.count for ly in lay.layers],
+                            f"the layers' counts add up to {total} cells; allowed: they add up to "
+                            f"layout.cells[0] = {lay.cells[0]} (the cells along x)")
+
+
+def _layer_of_plane(lay: SpaceLattice, plane: int) -> int:
+    """The index in layout.layers of the layer holding plane `plane` (0-based)."""
+    cell, acc = plane // planes_per_cell(lay.kind), 0
+    for k, ly in enumerate(lay.layers):
+        acc += ly.count
+        if cell < acc:
+            return k
+    return len(lay.layers) - 1  # pragma: no cover (the counts add up to cells[0])
+
+
+def _check_space_planes(lay: SpaceLattice) -> None:
+    """Neighbouring planes reach each other (R_p + R_p+1 >= rho) and planes two or more apart
+    do not overlap (the layers' radii; one radius always passes)."""
+    radii = [r for r, _ in plane_layers(lay)]
+    if not lay.layers or len(radii) < 2:
+        return
+    r_max = max(radii)
+    for p in range(len(radii) - 1):
+        rho = plane_gap_distance(lay.kind, plane_type(lay.kind, p), plane_type(lay.kind, p + 1), r_max)
+        if not radii[p] + radii[p + 1] >= rho:
+            k = _layer_of_plane(lay, p if radii[p] < radii[p + 1] else p + 1)
+            raise ScenarioError(f"layout.layers[{k}].radius", min(radii[p], radii[p + 1]),
+                                f"planes {p + 1} and {p + 2} cannot touch: R_p + R_p+1 = "
+                                f"{radii[p] + radii[p + 1]:.6g} m < {rho:.6g} m, the in-plane distance to "
+                                f"the next plane's sites on the {lay.kind} net of the largest radius "
+                                f"{r_max:.6g} m; allowed: R_p + R_p+1 >= that distance")
+    clash = plane_clash(lay.kind, radii)
+    if clash is not None:
+        p, q, overlap = clash
+        thin = min(range(p + 1, q), key=lambda m: radii[m])
+        k = _layer_of_plane(lay, thin)
+        raise ScenarioError(f"layout.layers[{k}].radius", radii[thin],
+                            f"planes {p + 1} and {q + 1} overlap by {overlap:.6g} m: plane {thin + 1} "
+                            f"between them (radius {radii[thin]:.6g} m) is too small to hold them apart; "
+                            "allowed: a radius that keeps every pair of planes apart")
+
+
 def _check_chain_layout(s: Scenario, lay: ChainLayout) -> None:
     int_at_least("layout.count", lay.count, 1)
     layout_radius("layout.radius", lay.radius)
@@ -340,11 +459,13 @@ def _check_chain_layout(s: Scenario, lay: ChainLayout) -> None:
     for f in ("material", "wall_material", "dimer_material", "decorated_material"):
         if getattr(lay, f) is not None:
             material_exists(f"layout.{f}", getattr(lay, f), s)
-    if lay.y is not None:
-        finite("layout.y", lay.y)
-        if not abs(float(lay.y)) <= LENGTH_RANGE * lay.radius:
-            raise ScenarioError("layout.y", lay.y, f"allowed: |y| <= {LENGTH_RANGE:g} x layout.radius "
-                                f"= {LENGTH_RANGE * lay.radius:.6g} m")
+    for f in ("y", "z"):
+        v = getattr(lay, f)
+        if v is not None:
+            finite(f"layout.{f}", v)
+            if not abs(float(v)) <= LENGTH_RANGE * lay.radius:
+                raise ScenarioError(f"layout.{f}", v, f"allowed: |{f}| <= {LENGTH_RANGE:g} x layout.radius "
+                                    f"= {LENGTH_RANGE * lay.radius:.6g} m")
 
 
 def _check_imperfections(imp: Imperfections, sites: tuple[Granule, ...]) -> None:
@@ -820,7 +941,7 @@ def validate(scenario: Scenario) -> None:
     """Raise ScenarioError(field, value, allowed) for the first problem in `scenario`.
 
     Order: dimension, materials, the fields of the other dimension (2D: no z, vz, vector
-    omega, 3-component normal, point, box or force load; 3D: no plate, layout or line load,
+    omega, 3-component normal, point, box or force load; 3D: no plate or line load, a 3D layout kind,
     vector omegas, walls as planes, the box), layout (as `layout.*`, before it is
     expanded), then on the resolved
     scenario: granules (values, speeds, unique labels), walls (unit normals), plate, the
