@@ -63,6 +63,19 @@ def in_space(s, direction: np.ndarray | None = None):
     return dataclasses.replace(s, dimension=3, granules=tuple(gs))
 
 
+def simulate_quietly(s):
+    """simulate(s) without the YieldWarning of contacts beyond the yield onset: these cases
+    compare the laws as written (Hertz past its onset, or Thornton's law yielding by
+    design), whatever the pressure they reach."""
+    import warnings
+
+    from granplate.errors import YieldWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", YieldWarning)
+        return simulate(s)
+
+
 def masses(s) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(m [kg], I = 2/5 m R^2 [kg m^2], R [m]) of scenario `s`'s granules."""
     r = np.array([g.radius for g in s.granules])
@@ -97,7 +110,7 @@ CHAIN_OUT = 1e-6
 def _chain_runs() -> dict:
     plane = load_case_scenario("striker-chain", step_changes(1e-8, CHAIN_T_END, out=CHAIN_OUT))
     flat, tilted = in_space(plane), in_space(plane, DIAGONAL)
-    d2, d3, dr = simulate(plane), simulate(flat), simulate(tilted)
+    d2, d3, dr = simulate_quietly(plane), simulate_quietly(flat), simulate_quietly(tilted)
     _, vel_r, spin_r = state_3d(dr)
     pos_r = state_3d(dr)[0]
     e = DIAGONAL
@@ -119,15 +132,18 @@ def chain_in_space(ctx: Context) -> CaseResult:
     tilt_v = float(np.abs(r["vel_along_r"] - d2.vx.values).max())
     tilt_x = float(np.abs(r["along_r"] - d2.x.values).max())
     across = float(r["vel_across_r"].max())
-    e_flat = max(float(np.abs(d3[k].values - d2[k].values).max()) for k in ("E_g", "E_p"))
+    e_flat = max(float(np.abs(d3[k].values - d2[k].values).max()) for k in ("E_granular", "E_contact"))
+    m, _, _ = masses(r["plane"])
+    e_in = 0.5 * float(m[0]) * r["plane"].granules[0].vx ** 2
     moved = float(np.abs(d2.vx.values[-1, 1:]).max())
     why_flat = ("in the plane z = 0 the 3D laws reduce to the plane's term by term (z, vz and "
-                "the in-plane spins stay exactly 0, docs/model.md 3.7): only the order of a few "
-                "floating-point sums may differ, a few ulps per step.")
+                "the in-plane spins stay exactly 0, docs/model.md 3.7): at most the order of a few "
+                "floating-point sums could differ, a few ulps per step (measured: bitwise equal).")
     why_tilt = ("along (2, 3, 6)/7 every coordinate of a centre carries a rounding of eps |s| "
                 "= 2e-16 x 0.5 m, which the overlap R_i + R_j - |s_j - s_i| (about 1e-5 m) "
                 "amplifies by |s| / delta ~ 1e3 into the force, so the two runs differ by ~1e-12 "
-                "relative per contact; 1e-9 bounds it over the ~3e4 steps of the wave.")
+                "relative per contact; 1e-9 bounds it over the ~3e4 steps of the wave (measured "
+                "7.6e-11 for velocities, 6e-12 for positions).")
     checks = [
         Check("the wave has run (largest bead speed at the end / v0)", "-", 0.3, "the wave must cross beads",
               moved / v0, 0.3, "a chain at rest would compare nothing", kind="min"),
@@ -135,8 +151,8 @@ def chain_in_space(ctx: Context) -> CaseResult:
               flat_v / v0, 1e3 * EPS, why_flat, kind="max"),
         Check("plane z = 0: max |s_3D - s_2D| / R", "-", 0.0, "the 2D chain", flat_x / radius, 1e3 * EPS,
               why_flat, kind="max"),
-        Check("plane z = 0: max |E_3D - E_2D| (E_g, E_p)", "J", 0.0, "the 2D chain", e_flat,
-              1e3 * EPS * 0.5 * float(d2.E_initial) if "E_initial" in d2 else 1e-15, why_flat, kind="max"),
+        Check("plane z = 0: max |E_3D - E_2D| / E_in (E_granular, E_contact)", "-", 0.0, "the 2D chain",
+              e_flat / e_in, 1e3 * EPS, why_flat, kind="max"),
         Check("along (2,3,6)/7: max |v.e - v_2D| / v0", "-", 0.0, "the 2D chain, rotated", tilt_v / v0, 1e-9,
               why_tilt, kind="max"),
         Check("along (2,3,6)/7: max |s.e - x_2D| / R", "-", 0.0, "the 2D chain, rotated", tilt_x / radius, 1e-9,
@@ -369,10 +385,13 @@ def rolling_in_space(ctx: Context) -> CaseResult:
         ,
         Check(f"slip while sliding ({int(sliding.sum())} outputs), max |slip - slip_ref| / v0", "-", 0.0,
               "slip_ref = v0 - (7/2) mu J_N / m, J_N = J_load + m v_z (Newton along the normal)",
-              slip_err, 1e-9,
+              slip_err, 3e-9,
               "while sliding (slip > 0.02 v0), tanh(k_s v_s) = 1 to 1e-17 and the slip falls at (7/2) mu |N| / m "
               "whatever the normal force's oscillation on the Hertz spring; J_N is exact from the "
-              "load's closed-form impulse and our v_z, so only RK4's error of a smooth run remains.",
+              "load's closed-form impulse and our v_z, so what remains is the split friction's "
+              "(solver.granular_friction = split, docs/model.md 6.4) O(h^2) splitting error against "
+              "the normal force that changes within a step: measured 6.1e-10 at h = 10 ns, 1.5e-10 "
+              "at 5 ns (order 2), 5e-13 with granular_friction = rk4; 3e-9 leaves a factor of 5.",
               kind="max"),
         Check("motion off the sliding plane: max(|v_y|, R |w_x|, R |w_z|) / v0", "-", 0.0,
               "a slip along x makes a friction force along x and a torque along y only",
@@ -485,15 +504,10 @@ def draw_free_assembly_in_space(p: dict):
 
 def plastic_in_space(ctx: Context) -> CaseResult:
     """Thornton's law in space: restitution on a tilted wall and between two spheres."""
-    from granplate.errors import YieldWarning
-    import warnings
-
     from .plastic import thornton_restitution, thornton_yield_velocity
 
     s = load_case_scenario("3d-plastic")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", YieldWarning)
-        ds = simulate(s)
+    ds = simulate_quietly(s)  # the law yields by design: no warning
     _, vel, _ = state_3d(ds)
     m, _, _ = masses(s)
     w, a, b = s.granules
