@@ -27,6 +27,10 @@ def scheme_number(name: str) -> int:
     return SCHEME_NAMES.index(name)
 
 
+#: state columns per granule by dimension: the plane's (x, y, theta, vx, vy, omega) and
+#: space's (x, y, z, vx, vy, vz, wx, wy, wz)
+STATE_COLUMNS = {2: 6, 3: 9}
+
 #: columns of the contact histories pair_hist, wall_hist, pc_hist (Granular): the largest
 #: overlap so far delta_max [m] (the elastic-plastic law's history, docs/model.md section
 #: 3.6; for every law, its largest Hertz peak pressure), the time it was reached [s], and

@@ -13,11 +13,10 @@ import math
 import numpy as np
 
 from granplate.model.contacts import contact_lists, fixed_wall_contacts
-from granplate.model.inputs import Granular3, PlateArrays, no_history
+from granplate.model.inputs import STATE_COLUMNS, Granular3, PlateArrays, no_history
 from granplate.physics.contact import N_COEF
 from granplate.setup.materials import sphere_inertia, sphere_mass
 from granplate.setup.scenario import Scenario
-from granplate.solver.state import STATE_COLUMNS
 
 
 def centres(s: Scenario) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

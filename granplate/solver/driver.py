@@ -163,7 +163,7 @@ def contact_message(status: int, model: Model, st: S.State) -> str:
     i = int(e[S.ERR_CONTACT])
     who = f"granule '{model.labels[i]}'"
     other = partner_name(model, int(e[S.ERR_ITER]))
-    where = f"(at x = {st.y[i, 0]:.6g} m, y = {st.y[i, 1]:.6g} m)"
+    where = "(at " + ", ".join(f"{name} = {v:.6g} m" for name, v in zip("xyz", st.y[i, :cfg.dimension])) + ")"
     if status == S.ERR_OVERLAP:
         return (f"{who} {where} and {other} overlap by {e[S.ERR_N]:.4g} m at t = {t:.6e} s, "
                 f"{e[S.ERR_RESID]:.3g} of the smaller radius, beyond contact.overlap_stop = "

@@ -7,6 +7,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from granplate.model.inputs import STATE_COLUMNS  # noqa: F401 - the state's columns per dimension
+
 # clock (float64)
 T_NOW, H_LAST, E_IN_MAX, E_ZERO, E_POT, CUSTOM_H, F_SCALE, RES_LAST = 0, 1, 2, 3, 4, 5, 6, 7
 N_CLOCK = 10
@@ -133,11 +135,6 @@ class Output(NamedTuple):
     lam: np.ndarray  # (no, nk) max |lambda| over the interval ending here
     iters: np.ndarray  # (no, nk) max iterations to converge over the interval
     stats: np.ndarray  # (no, N_STEPSTAT)
-
-
-#: state columns per granule: the plane's (x, y, theta, vx, vy, omega) and space's
-#: (x, y, z, vx, vy, vz, wx, wy, wz), by dimension
-STATE_COLUMNS = {2: 6, 3: 9}
 
 
 def new_state(ng: int, nm: int, nk: int, nc: int = 6) -> State:
