@@ -30,7 +30,7 @@ def test_in_space_is_a_rotation_of_the_plane():
 
 def test_in_space_refuses_walls():
     """Only free granules are mapped: a plane scenario with walls is refused naming them."""
-    with pytest.raises(ValueError, match="free granules only"):
+    with pytest.raises(ValueError, match="walls, plate, layout: in_space maps free granules only"):
         S.in_space(load_case_scenario("wall-bounce"))
 
 

@@ -273,7 +273,8 @@ def run_granular(s, dt: float, t_end: float) -> dict:
     """Run scenario `s` (granular_arrays: friction, damping, walls) in LAMMPS to t_end [s]
     with step dt [s] (velocity Verlet, fix nve/sphere: spheres of inertia 2/5 m R^2).
     Returns x, y, vx, vy, omega (n_granules,) at t_end ordered as s.granules, setup_time_s,
-    loop_time_s and loop_cpu_s (the `run` command's wall and CPU time [s]), n_steps. RuntimeError when LAMMPS is not available."""
+    loop_time_s and loop_cpu_s (the `run` command's wall and CPU time [s]), n_steps.
+    RuntimeError when LAMMPS is not available."""
     cls, why = _load()
     if cls is None:
         raise RuntimeError(why)
@@ -493,7 +494,8 @@ def gas_in_box(per_side: tuple[int, int, int] = (4, 4, 3), radius: float = 1e-3,
     component uniform in [-speed, speed] [m/s] (seeded), six walls gap / 2 beyond the outer
     spheres; none touches anything at t = 0. Undamped, frictionless, dynamic detection, the
     paper scheme at the fixed step dt [s]."""
-    from granplate.setup.scenario import Contact, Granule, Load, Scenario, Solver, TimeSettings, Wall
+    from granplate.setup.geometry import box_walls
+    from granplate.setup.scenario import Box, Contact, Granule, Load, Scenario, Solver, TimeSettings
 
     rng = np.random.default_rng(seed)
     a = 2.0 * radius + gap
@@ -507,10 +509,7 @@ def gas_in_box(per_side: tuple[int, int, int] = (4, 4, 3), radius: float = 1e-3,
                                   label=f"g{len(gs)}", vx=float(v[0]), vy=float(v[1]), vz=float(v[2]),
                                   omega=(0.0, 0.0, 0.0)))
     lo = -radius - 0.75 * gap
-    hi = [(n - 1) * a + radius + 0.75 * gap for n in per_side]
-    walls = (Wall(normal=(-1.0, 0.0, 0.0), offset=-lo, label="xmin"), Wall(normal=(1.0, 0.0, 0.0), offset=hi[0], label="xmax"),
-             Wall(normal=(0.0, -1.0, 0.0), offset=-lo, label="ymin"), Wall(normal=(0.0, 1.0, 0.0), offset=hi[1], label="ymax"),
-             Wall(normal=(0.0, 0.0, -1.0), offset=-lo, label="zmin"), Wall(normal=(0.0, 0.0, 1.0), offset=hi[2], label="zmax"))
+    walls = box_walls(Box(lower=(lo, lo, lo), upper=tuple((n - 1) * a + radius + 0.75 * gap for n in per_side)))
     out = t_end / 20.0
     return Scenario(name="gas-in-box", dimension=3, granules=tuple(gs), walls=walls, plate=None, load=Load(kind="none"),
                     contact=Contact(mu=0.0, alpha_n=0.0, pairs=(), detection="dynamic"),

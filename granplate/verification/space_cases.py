@@ -42,7 +42,7 @@ def in_space(s, direction: np.ndarray | None = None):
     granule at x e + y f (e = direction, f: a unit vector normal to it; None: the plane
     z = 0 itself, e = x, f = y), velocities alike, the spin omega about e x f."""
     if s.walls or s.plate is not None or s.layout is not None:
-        raise ValueError("in_space: free granules only (no walls, plate or layout)")
+        raise ValueError("walls, plate, layout: in_space maps free granules only (none of these)")
     if direction is None:
         e, f = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
     else:
@@ -111,8 +111,7 @@ def _chain_runs() -> dict:
     plane = load_case_scenario("striker-chain", step_changes(1e-8, CHAIN_T_END, out=CHAIN_OUT))
     flat, tilted = in_space(plane), in_space(plane, DIAGONAL)
     d2, d3, dr = simulate_quietly(plane), simulate_quietly(flat), simulate_quietly(tilted)
-    _, vel_r, spin_r = state_3d(dr)
-    pos_r = state_3d(dr)[0]
+    pos_r, vel_r, spin_r = state_3d(dr)
     e = DIAGONAL
     return {"plane": plane, "d2": d2, "d3": d3, "dr": dr,
             "along_r": pos_r @ e, "vel_along_r": vel_r @ e,
