@@ -82,33 +82,14 @@ class Granular(NamedTuple):
     pc_hist: np.ndarray = no_history(0)
 
 
-class Granular3(NamedTuple):
-    """Flat arrays of a granular medium in space (docs/model.md section 3.7), with the
-    fields of `Granular` (so the loop reads both alike; solver.dimension tells them apart
-    by type): wall_geo (nw, 4) [nx, ny, nz, offset] with the unit outward normal;
-    shock_force (ng, 3) [-]: each granule's share of the load's direction, per unit of the
-    total force (load.kind = "force"); shock_torque (ng, 3) zeros; no plate contacts
-    (pc_* empty).
-    """
-
-    mass: np.ndarray
-    inertia: np.ndarray
-    radius: np.ndarray
-    pair_ij: np.ndarray
-    pair_coef: np.ndarray
-    wall_i: np.ndarray
-    wall_geo: np.ndarray
-    wall_coef: np.ndarray
-    wall_w: np.ndarray
-    pc_i: np.ndarray
-    pc_x: np.ndarray
-    pc_coef: np.ndarray
-    shock_force: np.ndarray
-    shock_torque: np.ndarray
-    pc_patch: np.ndarray = np.zeros(0, np.int64)
-    pair_hist: np.ndarray = no_history(0)
-    wall_hist: np.ndarray = no_history(0)
-    pc_hist: np.ndarray = no_history(0)
+#: Flat arrays of a granular medium in space (docs/model.md section 3.7), with the fields of
+#: `Granular` (so the loop reads both alike; solver.dimension tells them apart by type):
+#: wall_geo (nw, 4) [nx, ny, nz, offset] with the unit outward normal; shock_force (ng, 3)
+#: [-]: each granule's share of the load's direction, per unit of the total force
+#: (load.kind = "force"); shock_torque (ng, 3) zeros; no plate contacts (pc_* empty).
+Granular3 = NamedTuple("Granular3", list(Granular.__annotations__.items()))
+Granular3.__new__.__defaults__ = Granular.__new__.__defaults__
+Granular3.__doc__ = "Flat arrays of a granular medium in space, with the fields of Granular (model.inputs)."
 
 
 class PlateArrays(NamedTuple):

@@ -309,17 +309,22 @@ def _check_lattice_layout(s: Scenario, lay: LatticeLayout) -> None:
                                 f"must be a column number in 1..{lay.columns} (layout.columns)")
     int_at_least("layout.intruder_every", lay.intruder_every, 0)
     sites = [g.label for g in lattice_sites(dataclasses.replace(lay, intruder_columns=()))]
+    check_intruder_sites(lay, sites, f"c1r1..c{lay.columns}r{lay.rows} "
+                                     "(column, row from the top; even hexagonal columns have rows - 1)")
+    _check_column_offsets(lay)
+
+
+def check_intruder_sites(lay, sites: list[str], names: str) -> None:
+    """A lattice's intruder_sites are among its `sites` (labels; `names` describes them),
+    and a single-site intruder is no larger than its site."""
     known = set(sites)
     for k, lab in enumerate(lay.intruder_sites):
         if lab not in known:
-            raise ScenarioError(f"layout.intruder_sites[{k}]", lab,
-                                f"no such site; sites are c1r1..c{lay.columns}r{lay.rows} "
-                                "(column, row from the top; even hexagonal columns have rows - 1)")
+            raise ScenarioError(f"layout.intruder_sites[{k}]", lab, f"no such site; sites are {names}")
     if (lay.intruder_sites or lay.intruder_every) and lay.intruder_ratio > 1.0:
         raise ScenarioError("layout.intruder_ratio", lay.intruder_ratio,
                             "must be in (0, 1] with intruder_sites or intruder_every "
                             "(a single-site intruder larger than its site overlaps its neighbours)")
-    _check_column_offsets(lay)
 
 
 def _check_column_offsets(lay: LatticeLayout) -> None:
@@ -376,16 +381,8 @@ def _check_space_lattice(s: Scenario, lay: SpaceLattice) -> None:
     int_at_least("layout.intruder_every", lay.intruder_every, 0)
     _check_space_planes(lay)
     sites = [g.label for g in space_sites(lay)]
-    known = set(sites)
-    for k, lab in enumerate(lay.intruder_sites):
-        if lab not in known:
-            raise ScenarioError(f"layout.intruder_sites[{k}]", lab,
-                                f"no such site; sites are {sites[0]}..{sites[-1]} (x{{plane}}y{{row}}"
-                                "z{site}: plane along x, row along y, site along z, from 1)")
-    if (lay.intruder_sites or lay.intruder_every) and lay.intruder_ratio > 1.0:
-        raise ScenarioError("layout.intruder_ratio", lay.intruder_ratio,
-                            "must be in (0, 1] with intruder_sites or intruder_every "
-                            "(a single-site intruder larger than its site overlaps its neighbours)")
+    check_intruder_sites(lay, sites, f"{sites[0]}..{sites[-1]} (x{{plane}}y{{row}}"
+                                     "z{site}: plane along x, row along y, site along z, from 1)")
 
 
 def _check_layers(s: Scenario, lay: SpaceLattice) -> None:

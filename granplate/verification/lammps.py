@@ -714,21 +714,9 @@ def lammps_gas(ctx):
 
 
 def draw_lammps_space(p: dict):
-    """The figure of the LAMMPS cross-checks in space: a few granules' vx, both codes."""
-    from .base import new_figure
-
-    fine, s = p["fine"], p["s"]
-    fig, axes = new_figure()
-    ax = axes[0, 0]
-    t = fine["t"] * 1e6
-    for k in (0, len(s.granules) // 2, len(s.granules) - 1):
-        line, = ax.plot(t, fine["ours"]["vx"][:, k], "-", label=f"granplate, {s.granules[k].label}")
-        ax.plot(fine["lammps"]["t"] * 1e6, fine["lammps"]["vx"][:, k], "o", ms=4, mfc="none", color=line.get_color(),
-                label=f"LAMMPS, {s.granules[k].label}")
-    ax.set_xlabel("time [µs]")
-    ax.set_ylabel("vx [m/s]")
-    ax.legend(fontsize=7)
-    return fig
+    """The figure of the LAMMPS cross-checks in space: a few granules' vx, both codes (as
+    `draw_lammps_hertz` draws the plane's)."""
+    return draw_lammps_hertz(p)
 
 
 def cases() -> tuple:
