@@ -67,9 +67,13 @@ def dask_client(workers: int | None = None, scheduler: str | None = None) -> Ite
             client.close()
         return
     n = workers or available_cores()
+    # silence_logs: Dask's own log lines stay out of the terminal, up to its errors: a
+    # worker whose scheduler closed first (Ctrl-C, the end of a sweep) logs its failed
+    # heartbeat as an error with a traceback; a design's own failure is its record's status,
+    # and a task that does not come back is reported as lost by the sweep.
     with sigint_ignored():
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.ERROR)
+                               dashboard_address=None, silence_logs=logging.CRITICAL)
     try:
         with Client(cluster) as client:
             yield client
