@@ -371,3 +371,15 @@ def test_bad_number_in_3d_is_refused_by_name_or_valid(path, value):
     except ScenarioError as err:
         msg = str(err)
         assert "\n" not in msg and names_field(msg, path), msg
+
+
+def test_a_3d_file_without_a_load_table_has_no_load():
+    """A 3D file without [load] reads as load.kind = "none" (the plane's line load has no
+    meaning in space), validates, and writes back to the same scenario."""
+    from granplate.setup.validate import validate
+
+    s = scenario_io.loads('dimension = 3\n[[granules]]\nx = 0.0\ny = 0.0\nz = 0.0\nradius = 0.01\n'
+                          'material = "steel"\nvx = 1.0\n')
+    assert s.load.kind == "none"
+    validate(s)
+    assert scenario_io.loads(scenario_io.dumps(s)) == s

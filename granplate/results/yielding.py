@@ -28,7 +28,7 @@ class PairYield(NamedTuple):
     ratio: np.ndarray  # [-] p0 / (1.6 Y) of the softer body (eq. P1); NaN where Y is unknown
     yield_strength: np.ndarray  # [Pa] Y of the softer body; NaN where unknown
     time: np.ndarray  # [s] when that contact reached its largest overlap
-    contact: tuple[str, ...]  # the contact: "c1r1-c2r1", "c1r1-wall 0", "c3r1-plate"
+    contact: tuple[str, ...]  # the contact: "c1r1-c2r1", "c1r1-wall left" (its label, else its index), "c3r1-plate"
     law: tuple[str, ...]  # the pair's normal law ("hertz", "thornton")
 
 
@@ -49,7 +49,8 @@ def contact_yield(model, peaks) -> list[tuple[str, float, float, float, float, s
                 pair, who, law = f"{a.name}-plate", f"{labels[i]}-plate", normal_law_of(s, a.name, s.plate.material)
             else:
                 w = -1 - j
-                pair, who, law = f"{a.name}-wall", f"{labels[i]}-wall {w}", normal_law_of(s, a.name, s.walls[w].material)
+                wall = s.walls[w]
+                pair, who, law = f"{a.name}-wall", f"{labels[i]}-wall {wall.label or w}", normal_law_of(s, a.name, wall.material)
         y = softer_yield_strength(a, b if j >= 0 else None)
         p0 = hertz_peak_pressure(e_star, r_star, float(d))
         ratio = p0 / limiting_pressure(y) if y is not None else math.nan

@@ -242,7 +242,7 @@ def from_dict(d: dict) -> Scenario:
 
     Top-level keys: name, description, dimension, materials, layout, granules, walls, box,
     plate, load, contact, time, solver. Missing tables take the defaults (no layout, no
-    plate, no box; dimension 2).
+    plate, no box; dimension 2; in 3D no load, `load.kind = "none"`).
     """
     names = [f.name for f in dataclasses.fields(Scenario)]
     _check_keys("", d, names)
@@ -265,6 +265,8 @@ def from_dict(d: dict) -> Scenario:
         kw["granules"] = _convert("granules", d["granules"], tuple[Granule, ...])
     if d.get("walls") is not None:
         kw["walls"] = _walls(d["walls"], kw.get("dimension", 2))
+    if kw.get("dimension") == 3 and d.get("load") is None:
+        kw["load"] = Load(kind="none")  # the plane's default line load has no meaning in space
     return Scenario(**kw)
 
 
