@@ -2,7 +2,6 @@
 traceback or a hang (docs/scenario.md, "Reading and checking")."""
 from __future__ import annotations
 
-import copy
 import itertools
 import math
 import os
@@ -20,6 +19,7 @@ import granplate as gp
 from granplate.errors import ScenarioError, SimulationError
 from granplate.setup.io import from_dict
 from granplate.setup.validate import validate
+from field_paths import mutated, numeric_fields
 
 #: Three granules in a row between a left wall and the plate (the middle one of a user
 #: material, moving), a bottom wall, a pair override and a 2 x 8 plate; 2 us of a shock.
@@ -60,26 +60,6 @@ N_CLI_CASES = 3
 #: A run of 2 us of this scenario takes well under a second once the kernels are compiled;
 #: the limit also covers their first compilation (1-3 min on a loaded machine).
 RUN_TIMEOUT_S = 600.0
-
-
-def numeric_fields(d, prefix: str = "") -> list[str]:
-    """Dotted paths of every number in a TOML-shaped dict (indices as in TOML: [i])."""
-    if isinstance(d, dict):
-        return [p for k, v in d.items() for p in numeric_fields(v, f"{prefix}.{k}" if prefix else k)]
-    if isinstance(d, list):
-        return [p for i, v in enumerate(d) for p in numeric_fields(v, f"{prefix}[{i}]")]
-    return [prefix] if isinstance(d, (int, float)) and not isinstance(d, bool) else []
-
-
-def mutated(path: str, value) -> dict:
-    """BASE with the field at dotted `path` set to `value`."""
-    d = copy.deepcopy(BASE)
-    steps = [int(s) if s.isdigit() else s for s in re.findall(r"[^.\[\]]+", path)]
-    node = d
-    for step in steps[:-1]:
-        node = node[step]
-    node[steps[-1]] = value
-    return d
 
 
 def cases(n: int, seed: int) -> list[tuple[str, object]]:
@@ -127,7 +107,7 @@ def test_base_scenario_runs():
 def test_bad_number_is_refused_by_name_or_runs(path, value):
     """Any field set to -1, 0, NaN, inf, 1e300 or a string: a one-line ScenarioError naming
     the field before anything runs, or a 2 us run that ends with finite energies."""
-    d = mutated(path, value)
+    d = mutated(BASE, path, value)
     try:
         validate(from_dict(d))
     except ScenarioError as err:
@@ -148,7 +128,7 @@ def _refused_cases() -> list[tuple[str, object]]:
     found = []
     for path, value in cases(3 * N_CASES, SEED + 1):
         try:
-            validate(from_dict(mutated(path, value)))
+            validate(from_dict(mutated(BASE, path, value)))
         except ScenarioError:
             found.append((path, value))
         if len(found) == N_CLI_CASES:
@@ -162,7 +142,7 @@ def test_command_line_reports_bad_numbers_in_one_line(tmp_path):
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
     for k, (path, value) in enumerate(_refused_cases()):
         f = tmp_path / f"case{k}.toml"
-        f.write_text(tomli_w.dumps(mutated(path, value)))
+        f.write_text(tomli_w.dumps(mutated(BASE, path, value)))
         out = tmp_path / f"case{k}.nc"
         p = subprocess.run([sys.executable, "-m", "granplate.cli", "run", str(f), "-q", "-o", str(out)],
                            capture_output=True, text=True, timeout=120, env=env)

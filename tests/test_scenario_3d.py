@@ -20,6 +20,7 @@ from granplate.setup.geometry import box_walls, force_loaded_granules, resolve
 from granplate.setup.presets import preset, preset_names
 from granplate.setup.scenario import BOX_WALLS, Box, Granule, Load, Scenario, Wall
 from granplate.setup.validate import validate
+from field_paths import mutated, numeric_fields
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "scenario.md"
@@ -327,25 +328,6 @@ def test_docs_3d_example_validates():
 BAD_VALUES: tuple = (-1, 0, math.nan, math.inf, 1e300, "x")
 
 
-def numeric_fields(d, prefix: str = "") -> list[str]:
-    """Dotted paths of every number in a TOML-shaped dict."""
-    if isinstance(d, dict):
-        return [p for k, v in d.items() for p in numeric_fields(v, f"{prefix}.{k}" if prefix else k)]
-    if isinstance(d, list):
-        return [p for i, v in enumerate(d) for p in numeric_fields(v, f"{prefix}[{i}]")]
-    return [prefix] if isinstance(d, (int, float)) and not isinstance(d, bool) else []
-
-
-def mutated(path: str, value) -> dict:
-    d = copy.deepcopy(BASE)
-    steps = [int(s) if s.isdigit() else s for s in re.findall(r"[^.\[\]]+", path)]
-    node = d
-    for step in steps[:-1]:
-        node = node[step]
-    node[steps[-1]] = value
-    return d
-
-
 def names_field(message: str, path: str) -> bool:
     """The message names the field, its vector (walls[0].normal for walls[0].normal[1]), or,
     for a conflict between bodies, the body (granules[1] for granules[1].z)."""
@@ -367,7 +349,7 @@ def test_bad_number_in_3d_is_refused_by_name_or_valid(path, value):
     """Every numeric field of a 3D scenario (z, vz, omega components, normals, points, the box,
     the force) set to -1, 0, NaN, inf, 1e300 or a string: valid, or one line naming the field."""
     try:
-        validate(scenario_io.from_dict(mutated(path, value)))
+        validate(scenario_io.from_dict(mutated(BASE, path, value)))
     except ScenarioError as err:
         msg = str(err)
         assert "\n" not in msg and names_field(msg, path), msg

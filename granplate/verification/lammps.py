@@ -153,6 +153,23 @@ def _gather(lmp, name: str, count: int) -> np.ndarray:
     return np.ctypeslib.as_array(lmp.gather_atoms(name, 1, count)).reshape(-1, count).copy()
 
 
+def run_recorded(lmp, n_steps: int, chunk: int, dt: float, out: dict, record) -> float:
+    """Record the state (`record()`), then run n_steps of dt [s] in chunks of `chunk` steps,
+    appending each chunk's end time to out["t"] and recording after it; returns the seconds
+    spent in LAMMPS's `run` commands."""
+    record()
+    done, loop = 0, 0.0
+    while done < n_steps:
+        k = min(chunk, n_steps - done)
+        t1 = time.perf_counter()
+        lmp.command(f"run {k} pre no post no")
+        loop += time.perf_counter() - t1
+        done += k
+        out["t"].append(done * dt)
+        record()
+    return loop
+
+
 def run_hertz(s, dt: float, t_end: float, every: int | None = None) -> dict:
     """Run scenario `s` (see packing_arrays) in LAMMPS to t_end [s] with step dt [s].
 
@@ -186,16 +203,7 @@ def run_hertz(s, dt: float, t_end: float, every: int | None = None) -> dict:
             out["vx"].append(vv[:, 0])
             out["vy"].append(vv[:, 1])
 
-        record()
-        done, loop = 0, 0.0
-        while done < n_steps:
-            k = min(chunk, n_steps - done)
-            t1 = time.perf_counter()
-            lmp.command(f"run {k} pre no post no")
-            loop += time.perf_counter() - t1
-            done += k
-            out["t"].append(done * dt)
-            record()
+        loop = run_recorded(lmp, n_steps, chunk, dt, out, record)
     finally:
         lmp.close()
     res = {key: np.array(v) for key, v in out.items()}
@@ -418,17 +426,8 @@ def run_hertz_3d(s, dt: float, t_end: float, every: int | None = None) -> dict:
                 out[keys[c]].append(xx[:, c])
                 out[keys[3 + c]].append(vv[:, c])
 
-        record()
         chunk = n_steps if every is None else every
-        done, loop = 0, 0.0
-        while done < n_steps:
-            k = min(chunk, n_steps - done)
-            t1 = time.perf_counter()
-            lmp.command(f"run {k} pre no post no")
-            loop += time.perf_counter() - t1
-            done += k
-            out["t"].append(done * dt)
-            record()
+        loop = run_recorded(lmp, n_steps, chunk, dt, out, record)
     finally:
         lmp.close()
     res = {key: np.array(v) for key, v in out.items()}
