@@ -27,7 +27,7 @@ the page this writes, regenerated with --full):
   the time step, iteration tolerance and element size, and the rigid-layer width;
 - long_runs.py: the slow cases' full-length runs, computed side by side on Dask first;
 - page.py: DIR/validation.md, DIR/validation.html, DIR/validation.json and the figures
-  in DIR/validation-figures/.
+  in DIR/validation-figures/ (`--render-only` rebuilds the pages from the JSON).
 
     >>> from granplate.verification import run_suite
     >>> results = run_suite("out", full=False)      # list of CaseResult, pages written
@@ -122,6 +122,8 @@ def _cmd_verify(args) -> int:
     if args.workers is not None and args.workers < 1:
         print(f"granplate: error: --workers = {args.workers}: must be >= 1", file=sys.stderr)
         return 2
+    if args.render_only:
+        return _render_only(Path(args.out))
     if args.list:
         for case in all_cases():
             print(f"{case.name:22s} {'(--full) ' if case.slow else ''}{case.title}")
@@ -146,6 +148,24 @@ def _cmd_verify(args) -> int:
     return 0 if n_bad == 0 else 1
 
 
+def _render_only(out: Path) -> int:
+    """`granplate verify --render-only`: the pages rebuilt from DIR/validation.json."""
+    from .page import render_pages
+
+    source = out / "validation.json"
+    if not source.is_file():
+        print(f"granplate: error: --render-only: {source} not found (run `granplate verify --out {out}` first)",
+              file=sys.stderr)
+        return 2
+    try:
+        paths = render_pages(out)
+    except (ValueError, KeyError, TypeError) as err:
+        print(f"granplate: error: --render-only: {source} is not a validation.json ({err})", file=sys.stderr)
+        return 2
+    print(f"page: {paths[0]} (and {paths[1].name}), rendered from {source.name}")
+    return 0
+
+
 def register(subparsers) -> None:
     """Add `granplate verify` to the CLI's subparsers."""
     p = subparsers.add_parser(
@@ -166,6 +186,8 @@ def register(subparsers) -> None:
     p.add_argument("--case", action="append", metavar="NAME",
                    help="run only this case (repeatable; see --list)")
     p.add_argument("--list", action="store_true", help="list the cases and exit")
+    p.add_argument("--render-only", action="store_true",
+                   help="run no case: rebuild DIR/validation.md and DIR/validation.html from DIR/validation.json")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
     p.set_defaults(func=_cmd_verify)
 

@@ -89,12 +89,23 @@ class CaseResult:
         return self.crashed is None and bool(self.checks) and all(c.passed for c in self.checks)
 
     def as_dict(self) -> dict:
-        """Plain dict (for JSON)."""
+        """Plain dict (for JSON): everything the page shows (`from_dict` reads it back)."""
         return {
             "name": self.name, "family": self.family, "title": self.title,
             "passed": self.passed, "seconds": self.seconds, "crashed": self.crashed,
             "figure": self.figure, "checks": [c.as_dict() for c in self.checks],
+            "description": self.description, "notes": list(self.notes), "tables": list(self.tables),
         }
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "CaseResult":
+        """The result `as_dict` wrote (checks judged again from their numbers; a file
+        written before description, notes and tables were stored has none)."""
+        checks = [Check(c["quantity"], c["unit"], c["reference"], c["source"], c["ours"], c["tolerance"],
+                        c["why"], c["kind"]) for c in d.get("checks", [])]
+        return cls(d["name"], d.get("family", ""), d.get("title", d["name"]), d.get("description", ""),
+                   checks, d.get("figure"), list(d.get("notes", [])), list(d.get("tables", [])),
+                   float(d.get("seconds", 0.0)), d.get("crashed"))
 
 
 @dataclass(frozen=True)
