@@ -198,3 +198,21 @@ def test_stress_discussion_quotes_the_disc_averaged_stress(runs, growth, settled
     assert f"disc mean {disc * growth / 1e6:.1f} MPa vs {disc / 1e6:.1f} MPa" in text
     assert ("barely moves with the mesh" in text) == settled
     assert ("refinements of +30.0%, +30.0%" in text) == (not settled)
+
+
+def test_report_opens_on_the_verdict_counts(runs):
+    """The block after the title is the summary: statements that hold, do not, are only
+    reported, and the conclusions that hold, counted from the rows themselves."""
+    rows = report.statements(runs)
+    blocks = report.build_report(runs, {})
+    first = blocks[1]
+    assert first.kind == "summary" and first == report.verdict_summary(rows, runs, {})
+    cards = {label: value for value, label, _ in first.rows}
+    n_ok, n_bad = sum(r.holds is True for r in rows), sum(r.holds is False for r in rows)
+    assert cards["statements hold"] == str(n_ok) and cards["do not hold"] == str(n_bad)
+    assert cards["reported without a verdict"] == str(sum(r.holds is None for r in rows))
+    n_concl = sum(h is True for _, h, _ in report.conclusion_verdicts(rows))
+    assert cards["conclusions hold"] == f"{n_concl} / {len(report.CONCLUSIONS)}" and cards["runs"] == str(len(runs))
+    assert first.text.startswith(f"{n_ok} of {n_ok + n_bad} judged statements hold")
+    flipped = [replace(r, ours=10.0) if r.key == "vm_reduction" else r for r in rows]
+    assert report.verdict_summary(flipped, runs, {}).rows[3][0] == f"{n_concl - 1} / {len(report.CONCLUSIONS)}"

@@ -203,3 +203,53 @@ def test_observed_orders_and_richardson_recover_a_known_rate():
                               ((1, 1), (2, 2), (4, 4), (8, 8)))
     assert "| q [-] | 1.8 | 1.575 | 1.51875 | 1.5046875 | p = 2.00, 2.00 | 1.5 |" in table
     assert "(not monotone) | - |" in table
+
+
+def _results() -> list[CaseResult]:
+    """A passing case with long tolerance reasons and a failing one with a note and a table."""
+    why = "a reason long enough to be collapsed on the page " * 20
+    good = CaseResult("good", "plate", "A good case", "Runs well.",
+                      [Check(f"x{i}", "m", 1.0, "closed form", 1.0, 1e-9, why) for i in range(3)],
+                      notes=["a short note"], seconds=1.5)
+    bad = CaseResult("bad", "granular", "A bad case", "Runs badly.",
+                     [Check("y", "-", 1.0, "theory", 2.0, 1e-3, "short"), Check("z", "-", 1.0, "theory", 1.0, 1e-3, "short")],
+                     tables=["| h | v |\n|---|---|\n| 1 | 2 |"], seconds=20.0)
+    return [good, bad]
+
+
+def test_page_opens_on_the_counts_then_the_failures_then_the_cases():
+    """First screen: the summary with the counts, then the failing checks alone, the case
+    table, every check; long tolerance reasons collapsed, short ones shown."""
+    from granplate.verification import page
+
+    blocks = page.page_blocks(_results(), full=False, seconds=21.5, generated="Made for a test.")
+    assert blocks[1].kind == "summary" and blocks[1].text == "2 cases, 5 checks: 1 of 5 checks fail, in 1 of 2 cases."
+    assert blocks[1].rows[:3] == (("1 / 2", "cases pass", "no"), ("4 / 5", "checks pass", "no"), ("1", "check fails", "no"))
+    h2 = [b.text for b in blocks if b.kind == "h2"]
+    assert h2[:3] == ["Failures", "Cases", "Results"]
+    tables = [b for b in blocks if b.kind == "table"]
+    assert [r[1] for r in tables[0].rows] == ["y"] and len(tables[2].rows) == 5
+    assert tables[1].rows == (("[good](#good)", "A good case", "3", "0", "1.5", "pass"),
+                              ("[bad](#bad)", "A bad case", "2", "1", "20.0", "**FAIL**"))
+    collapsed = [b for b in blocks if b.kind == "details"]
+    assert [b.text for b in collapsed] == ["Tolerances: the reason for each (3 checks)"]
+    assert any(b.text == "Tolerances:" for b in blocks) and any(b.kind == "quote" for b in blocks)
+
+
+def test_render_only_rebuilds_the_pages_from_the_json(tmp_path, capsys):
+    """`granplate verify --render-only` writes the same pages from validation.json, running
+    no case; without the JSON it says so in one line (exit 2)."""
+    from granplate.verification import page
+
+    page.write_pages(tmp_path, _results(), full=True, seconds=21.5)
+    md, html = (tmp_path / "validation.md").read_text(), (tmp_path / "validation.html").read_text()
+    (tmp_path / "validation.md").unlink()
+    (tmp_path / "validation.html").unlink()
+    assert cli.main(["verify", "--out", str(tmp_path), "--render-only"]) == 0
+    assert (tmp_path / "validation.md").read_text() == md and (tmp_path / "validation.html").read_text() == html
+    results, full, seconds, generated = page.read_results(tmp_path / "validation.json")
+    assert [r.as_dict() for r in results] == [r.as_dict() for r in _results()] and full and seconds == 21.5
+    capsys.readouterr()
+    assert cli.main(["verify", "--out", str(tmp_path / "none"), "--render-only"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--render-only" in err and "validation.json not found" in err

@@ -1,6 +1,8 @@
 """The reproduction report: our numbers beside the paper's (docs/model.md section 8).
 
-The comparison table is `granplate.paper.statements` judged on the result Datasets
+The report opens on its verdicts (`verdict_summary`: statements that hold, that do
+not, reported without a verdict; the paper's conclusions). The comparison table is
+`granplate.paper.statements` judged on the result Datasets
 (one Check per statement: the paper's value, ours, their ratio, the verdict and the
 criterion's own text); `granplate.paper.discussion` explains the disagreements with the
 sensitivity runs of `granplate.paper.checks`. `write_report` renders the table, the run
@@ -24,9 +26,10 @@ from granplate.paper.discussion import (
 from granplate.paper.statements import Results, e_shock as _e_shock, max_von_mises as _max_vm, statements
 from granplate.results import analysis as an
 from granplate.results.criteria import Check
-from granplate.results.document import Block, to_html, to_markdown
+from granplate.results.document import Block, details, summary, to_html, to_markdown
 
-__all__ = ["statements", "run_rows", "conclusions", "build_report", "load_results", "write_report"]
+__all__ = ["statements", "run_rows", "conclusions", "verdict_summary", "build_report", "load_results",
+           "write_report"]
 
 
 def _pct(x: float) -> str:
@@ -79,19 +82,25 @@ CONCLUSIONS: tuple[tuple[str, tuple[str, ...]], ...] = (
 )
 
 
-def conclusions(rows: list[Check]) -> list[str]:
-    """One line per conclusion of the paper: holds / does not hold / not run, from the rows."""
+def conclusion_verdicts(rows: list[Check]) -> list[tuple[str, bool | None, list[int]]]:
+    """Per conclusion of the paper: its text, whether it holds (None: not run) and the
+    numbers (from 1) of the rows that show it."""
     by_key = {r.key: (i, r) for i, r in enumerate(rows) if r.key}
-    lines = []
+    out = []
     for text, keys in CONCLUSIONS:
         found = [by_key[k] for k in keys if k in by_key]
         verdicts = [r.holds for _, r in found]
-        if not found or any(v is None for v in verdicts):
-            word = "not run"
-        else:
-            word = "**holds**" if all(verdicts) else "**does not hold**"
-        refs = ", ".join(f"#{i + 1}" for i, _ in found)
-        lines.append(f"{text}: {word} (rows {refs}).")
+        holds = None if not found or any(v is None for v in verdicts) else all(verdicts)
+        out.append((text, holds, [i + 1 for i, _ in found]))
+    return out
+
+
+def conclusions(rows: list[Check]) -> list[str]:
+    """One line per conclusion of the paper: holds / does not hold / not run, from the rows."""
+    lines = []
+    for text, holds, numbers in conclusion_verdicts(rows):
+        word = "not run" if holds is None else "**holds**" if holds else "**does not hold**"
+        lines.append(f"{text}: {word} (rows {', '.join(f'#{i}' for i in numbers)}).")
     return lines
 
 
@@ -101,6 +110,27 @@ def _holds(h: bool | None) -> str:
 
 def _ratio(r: float | None) -> str:
     return "-" if r is None or not np.isfinite(r) else f"{r:.2f}"
+
+
+def verdict_summary(rows: list[Check], results: Results, checks: Results, twins: Results | None = None) -> Block:
+    """The first screen: statements that hold, that do not, reported without a verdict;
+    the conclusions that hold; the runs behind them."""
+    n_ok = sum(r.holds is True for r in rows)
+    n_bad = sum(r.holds is False for r in rows)
+    n_reported = len(rows) - n_ok - n_bad
+    verdicts = [holds for _, holds, _ in conclusion_verdicts(rows)]
+    n_concl = sum(h is True for h in verdicts)
+    headline = (f"{n_ok} of {n_ok + n_bad} judged statements hold"
+                + (f", {n_bad} do not" if n_bad else "")
+                + f"; {n_concl} of {len(verdicts)} of the paper's conclusions hold.")
+    n_runs = len(results) + len(checks or {}) + len(twins or {})
+    return summary(headline, [
+        (str(n_ok), "statements hold", "yes" if n_ok else ""),
+        (str(n_bad), "do not hold", "no" if n_bad else "yes"),
+        (str(n_reported), "reported without a verdict", ""),
+        (f"{n_concl} / {len(verdicts)}", "conclusions hold", "yes" if n_concl == len(verdicts) else "no"),
+        (str(n_runs), "runs", ""),
+    ])
 
 
 def build_report(
@@ -121,7 +151,8 @@ def build_report(
     rows = statements(results)
     judged = [r for r in rows if r.holds is not None]
     n_ok = sum(r.holds for r in judged)
-    blocks = [Block("h1", "granplate: reproduction of the paper's section 3 and appendices")]
+    blocks = [Block("h1", "granplate: reproduction of the paper's section 3 and appendices"),
+              verdict_summary(rows, results, checks, twins)]
     t_ends = sorted({float(d["time"].values[-1]) for d in results.values()})
     intro = (f"Made by granplate {__version__} from {len(results)} runs"
              + (f" and {len(checks)} check runs" if checks else "")
@@ -160,8 +191,9 @@ def build_report(
                                  "the cases with yielding contacts).")))
         blocks.append(Block("table", header=plastic.PAIR_HEADER, rows=tuple(pairs)))
     if checks:
-        blocks.append(Block("p", "Check runs (sensitivity, see the discussion):"))
-        blocks.append(Block("table", header=tuple(RUN_HEADER), rows=tuple(tuple(r) for r in run_rows(checks, records))))
+        blocks.append(details(f"Check runs (sensitivity, see the discussion): {len(checks)} runs",
+                              [Block("table", header=tuple(RUN_HEADER),
+                                     rows=tuple(tuple(r) for r in run_rows(checks, records)))]))
     blocks.append(Block("h2", "Where we differ from the paper, and why"))
     for para in (stress_discussion(results, checks) + ptfe_discussion(results, checks)
                  + intensity_discussion(results) + vertical_discussion(results)):
