@@ -213,13 +213,14 @@ def _results() -> list[CaseResult]:
                       notes=["a short note"], seconds=1.5)
     bad = CaseResult("bad", "granular", "A bad case", "Runs badly.",
                      [Check("y", "-", 1.0, "theory", 2.0, 1e-3, "short"), Check("z", "-", 1.0, "theory", 1.0, 1e-3, "short")],
-                     tables=["| h | v |\n|---|---|\n| 1 | 2 |"], seconds=20.0)
+                     notes=["why it fails " * 100], tables=["| h | v |\n|---|---|\n| 1 | 2 |"], seconds=20.0)
     return [good, bad]
 
 
 def test_page_opens_on_the_counts_then_the_failures_then_the_cases():
     """First screen: the summary with the counts, then the failing checks alone, the case
-    table, every check; long tolerance reasons collapsed, short ones shown."""
+    table, every check; long tolerance reasons collapsed, short ones shown, a failing
+    case's notes shown however long."""
     from granplate.verification import page
 
     blocks = page.page_blocks(_results(), full=False, seconds=21.5, generated="Made for a test.")
@@ -234,6 +235,7 @@ def test_page_opens_on_the_counts_then_the_failures_then_the_cases():
     collapsed = [b for b in blocks if b.kind == "details"]
     assert [b.text for b in collapsed] == ["Tolerances: the reason for each (3 checks)"]
     assert any(b.text == "Tolerances:" for b in blocks) and any(b.kind == "quote" for b in blocks)
+    assert any(b.kind == "quote" and b.text.startswith("why it fails") for b in blocks), "a failing case's notes stay open"
 
 
 def test_render_only_rebuilds_the_pages_from_the_json(tmp_path, capsys):

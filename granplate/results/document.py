@@ -127,9 +127,10 @@ _CSS = r"""
 body { font-family: system-ui, sans-serif; max-width: 1200px; margin: 2em auto; padding: 0 1em; color: #222; }
 h1, h2, h3, h4, p, li, figcaption, summary { overflow-wrap: anywhere; }
 .table-box { max-width: 100%; max-height: 75vh; overflow: auto; margin: 1em 0; border: 1px solid #ddd; }
-table { border-collapse: collapse; font-size: 0.9em; }
-th, td { border: 1px solid #ccc; padding: 0.3em 0.5em; text-align: left; vertical-align: top;
-         overflow-wrap: break-word; max-width: 32em; }
+table { border-collapse: separate; border-spacing: 0; font-size: 0.9em; }
+th, td { border: 1px solid #ccc; border-width: 0 1px 1px 0; padding: 0.3em 0.5em; text-align: left;
+         vertical-align: top; overflow-wrap: break-word; max-width: 32em; }
+tr > :first-child { border-left-width: 1px; } thead th, table > tbody:first-child td { border-top-width: 1px; }
 td.num { white-space: nowrap; }
 th { background: #f2f2f2; position: sticky; top: 0; z-index: 1; }
 th button.sort { all: unset; cursor: pointer; display: block; width: 100%; font-weight: bold; }

@@ -112,8 +112,11 @@ def summary_block(results: list[CaseResult], seconds: float) -> Block:
 RESULT_HEADER = ("case", "quantity", "reference", "source", "ours", "error", "tolerance", "result")
 CASE_HEADER = ("case", "title", "checks", "failing", "time [s]", "result")
 
-#: A case's tolerances, notes or tables longer than this (characters) are collapsed.
+#: A case's tolerance reasons or notes longer than this (characters) are collapsed (a
+#: failing case's notes never: they say why it fails).
 LONG = 600
+#: A case's tables longer than this in all (characters) are collapsed.
+LONG_TABLES = 2000
 
 
 def result_rows(results: list[CaseResult], failing_only: bool = False) -> tuple[tuple[str, ...], ...]:
@@ -138,15 +141,15 @@ def case_rows(results: list[CaseResult]) -> tuple[tuple[str, ...], ...]:
                   f"{r.seconds:.1f}", verdict(r.passed)) for r in results)
 
 
-def _collapsed(line: str, content: list[Block]) -> list[Block]:
-    """`content` as it is, or in a details block under `line` when its text is long."""
+def _collapsed(line: str, content: list[Block], limit: int = LONG) -> list[Block]:
+    """`content` as it is, or in a details block under `line` when its text is longer than `limit`."""
     size = sum(len(b.text) for b in content)
-    return [details(line, content)] if size > LONG else content
+    return [details(line, content)] if size > limit else content
 
 
 def case_blocks(r: CaseResult) -> list[Block]:
     """One case's section: status, description, figure, failing checks, then the
-    tolerances, notes and tables (each collapsed where long)."""
+    tolerances, notes and tables (each collapsed where long, see LONG and LONG_TABLES)."""
     out = [Block("h3", r.title, anchor=r.name), Block("p", f"`{r.name}`: {verdict(r.passed)}, {r.seconds:.1f} s")]
     if r.description:
         out.append(Block("p", r.description))
@@ -165,9 +168,10 @@ def case_blocks(r: CaseResult) -> list[Block]:
             out.append(details(f"Tolerances: the reason for each ({len(r.checks)} checks)", [listing]))
         else:
             out += [Block("p", "Tolerances:"), listing]
-    out += _collapsed(f"Notes ({len(r.notes)})", [Block("quote", note) for note in r.notes])
+    notes = [Block("quote", note) for note in r.notes]
+    out += _collapsed(f"Notes ({len(r.notes)})", notes) if r.passed else notes
     out += _collapsed(f"Measured values ({len(r.tables)} table{'s' if len(r.tables) != 1 else ''})",
-                      [Block("markdown", table) for table in r.tables])
+                      [Block("markdown", table) for table in r.tables], LONG_TABLES)
     if r.crashed:
         out += [Block("p", "The case crashed:"), details("Traceback", [Block("code", r.crashed)])]
     return out
