@@ -255,3 +255,5 @@ def test_render_only_rebuilds_the_pages_from_the_json(tmp_path, capsys):
     assert cli.main(["verify", "--out", str(tmp_path / "none"), "--render-only"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--render-only" in err and "validation.json not found" in err
+    assert cli.main(["verify", "--out", str(tmp_path), "--render-only", "--case", "patch-test"]) == 2
+    assert capsys.readouterr().err == "granplate: error: --render-only runs no case: --case cannot go with it\n"

@@ -123,6 +123,10 @@ def _cmd_verify(args) -> int:
         print(f"granplate: error: --workers = {args.workers}: must be >= 1", file=sys.stderr)
         return 2
     if args.render_only:
+        clash = [flag for flag, on in (("--case", args.case), ("--full", args.full), ("--list", args.list)) if on]
+        if clash:
+            print(f"granplate: error: --render-only runs no case: {', '.join(clash)} cannot go with it", file=sys.stderr)
+            return 2
         return _render_only(Path(args.out))
     if args.list:
         for case in all_cases():
