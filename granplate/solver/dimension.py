@@ -4,7 +4,8 @@ terms, taken from solver.granular (the plane: model.inputs.Granular, state x, y,
 vx, vy, omega) or solver.granular3d (space: model.inputs.Granular3, state x, y, z, vx,
 vy, vz, wx, wy, wz), chosen at compile time from the type of the granular arrays `g`
 (as solver.schemes picks a scheme from its scratch). The RK4 step (solver.rk4), the
-schemes and the loop call only these, so the same compiled code serves both dimensions and nothing else asks which one it is.
+schemes and the loop call only these, so the same compiled code serves both dimensions
+and nothing else asks which one it is.
 
 Adding a dimension-specific granular function: write it in both modules with the same
 signature and add a stub and its overload here.
