@@ -172,7 +172,8 @@ def test_guards_hold_under_verlet():
     assert int(ds.attrs["n_rebuilds"]) > 0
     s = oblique_pair()
     s = dataclasses.replace(s, contact=dataclasses.replace(s.contact, overlap_warn=1e-3, overlap_stop=1e-3))
-    with pytest.raises(SimulationError, match="overlap"):
+    with pytest.raises(SimulationError, match="overlap"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # the overlap warning before the stop
         quiet_run(with_step(s, "verlet", 2e-8))
 
 
