@@ -111,9 +111,9 @@ def test_scaling_sizes_are_checked(capsys):
 
 def test_bench_friction_table_runs_every_case(capsys, monkeypatch, tmp_path):
     """`granplate bench --friction --t-end 2e-7` (on a 4 x 6 packing) prints a row per case
-    and, where LAMMPS is installed, both codes' loop time, steps, cost per contact and step
-    (loop / (steps x listed contacts)) and error, and their ratio; the JSON has the
-    documented keys."""
+    and, where LAMMPS is installed, the loop time, steps, cost per contact and step (loop /
+    (steps x listed contacts)) and error of granplate ("split" and "verlet") and LAMMPS,
+    and their ratios; the JSON has the documented keys."""
     from granplate.bench import friction
     from granplate.verification import lammps as L
 
@@ -135,10 +135,12 @@ def test_bench_friction_table_runs_every_case(capsys, monkeypatch, tmp_path):
     documented = {k for line in text.splitlines() if line.startswith("| `")
                   for k in re.findall(r"`([a-z_0-9]+)`", line.split("|")[1])}
     assert set(cmp) <= documented and set(cmp["granplate"]) <= documented, set(cmp["granplate"]) - documented
-    assert set(cmp["lammps"]) <= documented
+    assert set(cmp["lammps"]) <= documented and set(cmp["verlet"]) <= documented
     assert cmp["loop_ratio"] == pytest.approx(cmp["granplate"]["loop_s"] / cmp["lammps"]["loop_s"])
     assert cmp["cpu_ratio"] == pytest.approx(cmp["granplate"]["loop_cpu_s"] / cmp["lammps"]["loop_cpu_s"])
-    for r in (cmp["granplate"], cmp["lammps"]):
+    assert cmp["verlet_cpu_ratio"] == pytest.approx(cmp["verlet"]["loop_cpu_s"] / cmp["lammps"]["loop_cpu_s"])
+    assert "verlet / LAMMPS" in out
+    for r in (cmp["granplate"], cmp["verlet"], cmp["lammps"]):
         assert r["n_steps"] > 0 and r["error_m_s"] >= 0.0
         assert r["us_per_contact_step"] == pytest.approx(1e6 * r["loop_s"] / (r["n_steps"] * cmp["contacts"]))
         assert r["cpu_us_per_contact_step"] == pytest.approx(1e6 * r["loop_cpu_s"] / (r["n_steps"] * cmp["contacts"]))

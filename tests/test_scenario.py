@@ -264,9 +264,10 @@ def test_yield_strength_is_optional_and_round_trips():
 
 
 def test_schemes_constant():
-    """The solver schemes accepted are listed in SCHEMES: the paper's one (the default) and
-    the implicit one; anything else is refused naming solver.scheme."""
-    assert SCHEMES == ("paper", "implicit")
+    """The solver schemes accepted are listed in SCHEMES: the paper's one, the implicit one
+    (the default) and velocity Verlet of the granules alone; anything else is refused
+    naming solver.scheme."""
+    assert SCHEMES == ("paper", "implicit", "verlet")
     assert Solver().scheme == "implicit"
 
 

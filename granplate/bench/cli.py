@@ -67,7 +67,7 @@ def register(subparsers) -> None:
                         "packing, with and without friction: set-up, steps, loop time, us per contact and "
                         "step, peak memory; LAMMPS's time to the same accuracy where it is installed)")
     b.add_argument("--sizes", help="with --scaling: comma-separated COLUMNSxROWS (default 4x3,8x13,32x32,56x54,100x100)")
-    b.add_argument("--scheme", choices=("implicit", "paper"), default=None,
+    b.add_argument("--scheme", choices=("implicit", "paper", "verlet"), default=None,
                    help="with --scaling: solver.scheme of granplate's runs (default implicit)")
     b.add_argument("--no-lammps", dest="no_lammps", action="store_true",
                    help="with --scaling or --friction: leave LAMMPS out even where it is installed")

@@ -11,7 +11,9 @@ friction: a 990-granule hexagonal packing of 1 mm steel spheres (20 columns of 5
 Then, where LAMMPS is installed (granplate.verification.lammps.run_granular), the packing
 with mu = 0.099 side by side with LAMMPS (pair_style granular: the same Hertz law and
 damping, Mindlin's tangential law with the same mu; velocity Verlet at LAMMPS_DT):
-granplate's "split" run and LAMMPS's, alternately REPEATS times each, their median loop
+granplate's "split" run, granplate's "verlet" run (solver.scheme = "verlet", velocity
+Verlet at VERLET_DT: the step whose error is about LAMMPS's) and LAMMPS's, alternately
+REPEATS times each, their median loop
 times (wall, and CPU time of this process: on a shared machine what each code used), steps, cost per contact and step (the listed contacts at t = 0, the same count for
 both), and each one's error against its own converged run (granplate: the "rk4" row, whose
 own error is ~3e-5 m/s; LAMMPS: its step / LAMMPS_REF_DIVISOR): the largest |v - v_ref|
@@ -32,6 +34,9 @@ STRONG = {"q0": 1e7, "overlap_stop": 0.5, "t_end": {"split": 2e-3, "rk4": 2e-4}}
 #: times each code's run is timed (alternately; medians).
 LAMMPS_DT = 1e-7
 LAMMPS_REF_DIVISOR = 16
+#: granplate's "verlet" step on the packing [s]: its error against the converged run is
+#: about LAMMPS's at LAMMPS_DT (1.6e-3 against 1.86e-3 m/s; docs/benchmarks.md).
+VERLET_DT = LAMMPS_DT / 6
 REPEATS = 3
 
 
@@ -64,6 +69,13 @@ def strong_scenario(friction: str, t_end: float | None = None):
         "load.q0": STRONG["q0"], "contact.overlap_stop": STRONG["overlap_stop"],
         "solver.granular_friction": friction, "time.t_end": t_end,
         "time.output_interval": min(1e-6, t_end), "time.field_interval": min(2e-5, t_end)})
+
+
+def verlet_scenario(t_end: float | None = None):
+    """The packing with mu = 0.099 under solver.scheme = "verlet" at the fixed step VERLET_DT."""
+    s = packing_scenario(0.099, "split", t_end)
+    return dataclasses.replace(s, solver=dataclasses.replace(s.solver, scheme="verlet"),
+                               time=dataclasses.replace(s.time, dt_initial=VERLET_DT, dt_max=VERLET_DT))
 
 
 def cases(t_end: float | None = None) -> list[tuple[str, str, object]]:
@@ -131,44 +143,53 @@ def per_contact_step_us(loop_s: float, n_steps: int, contacts: int) -> float:
     return 1e6 * loop_s / (n_steps * contacts)
 
 
-def lammps_comparison(t_end: float | None, reference: dict, log=print) -> dict:
-    """The packing with mu = 0.099: granplate ("split") and LAMMPS side by side (see the
-    module's docstring); `reference`: granplate's converged final velocities (the "rk4"
-    row). Returns {"skipped": why} where LAMMPS is not installed."""
+def code_row(code: str, law: str, runs: list[tuple[float, float]], n_steps: int, t_end: float, error: float,
+             contacts: int) -> dict:
+    """One code's row of the side-by-side table from its (loop wall, loop CPU) times [s]."""
     import statistics
 
+    walls, cpus = [r[0] for r in runs], [r[1] for r in runs]
+    row = {"code": code, "law": law, "dt_s": t_end / n_steps, "n_steps": n_steps,
+           "loop_s": statistics.median(walls), "loop_s_all": walls,
+           "loop_cpu_s": statistics.median(cpus), "loop_cpu_s_all": cpus, "error_m_s": error}
+    row["us_per_contact_step"] = per_contact_step_us(row["loop_s"], n_steps, contacts)
+    row["cpu_us_per_contact_step"] = per_contact_step_us(row["loop_cpu_s"], n_steps, contacts)
+    return row
+
+
+def lammps_comparison(t_end: float | None, reference: dict, log=print) -> dict:
+    """The packing with mu = 0.099: granplate ("split" and "verlet") and LAMMPS side by side
+    (see the module's docstring); `reference`: granplate's converged final velocities (the
+    "rk4" row). Returns {"skipped": why} where LAMMPS is not installed."""
     from granplate.verification import lammps as L
 
     if L.unavailable():
         return {"skipped": L.unavailable()}
     s = packing_scenario(0.099, "split", t_end)
+    sv = verlet_scenario(t_end)
     t = float(s.time.t_end)
     contacts = listed_contacts(s)
     log(f"LAMMPS reference, dt {LAMMPS_DT / LAMMPS_REF_DIVISOR:g} s ...")
     lref = L.run_granular(s, LAMMPS_DT / LAMMPS_REF_DIVISOR, t)
-    ours_s, theirs_s, ours_c, theirs_c = [], [], [], []
+    ours, verlet, theirs = [], [], []
     for k in range(REPEATS):
-        log(f"granplate and LAMMPS, side by side ({k + 1} of {REPEATS}) ...")
+        log(f"granplate (split, verlet) and LAMMPS, side by side ({k + 1} of {REPEATS}) ...")
         ds, _ = timed_run(s)
-        ours_s.append(float(ds.attrs["loop_time_s"]))
-        ours_c.append(float(ds.attrs["loop_cpu_s"]))
+        ours.append((float(ds.attrs["loop_time_s"]), float(ds.attrs["loop_cpu_s"])))
+        dv, _ = timed_run(sv)
+        verlet.append((float(dv.attrs["loop_time_s"]), float(dv.attrs["loop_cpu_s"])))
         lm = L.run_granular(s, LAMMPS_DT, t)
-        theirs_s.append(lm["loop_time_s"])
-        theirs_c.append(lm["loop_cpu_s"])
-    n_ours, n_theirs = int(ds.attrs["n_steps"]), int(lm["n_steps"])
-    ours = {"code": "granplate", "law": "tanh (eq. 5), split", "dt_s": t / n_ours, "n_steps": n_ours,
-            "loop_s": statistics.median(ours_s), "loop_s_all": ours_s,
-            "loop_cpu_s": statistics.median(ours_c), "loop_cpu_s_all": ours_c,
-            "error_m_s": velocity_error(final_velocities(ds), reference)}
-    theirs = {"code": "LAMMPS", "law": "Mindlin", "dt_s": LAMMPS_DT, "n_steps": n_theirs,
-              "loop_s": statistics.median(theirs_s), "loop_s_all": theirs_s,
-            "loop_cpu_s": statistics.median(theirs_c), "loop_cpu_s_all": theirs_c,
-              "error_m_s": velocity_error(lm, lref)}
-    for r in (ours, theirs):
-        r["us_per_contact_step"] = per_contact_step_us(r["loop_s"], r["n_steps"], contacts)
-        r["cpu_us_per_contact_step"] = per_contact_step_us(r["loop_cpu_s"], r["n_steps"], contacts)
-    return {"contacts": contacts, "t_end_s": t, "granplate": ours, "lammps": theirs,
-            "loop_ratio": ours["loop_s"] / theirs["loop_s"], "cpu_ratio": ours["loop_cpu_s"] / theirs["loop_cpu_s"]}
+        theirs.append((lm["loop_time_s"], lm["loop_cpu_s"]))
+    rows = {
+        "granplate": code_row("granplate", "tanh (eq. 5), split", ours, int(ds.attrs["n_steps"]), t,
+                              velocity_error(final_velocities(ds), reference), contacts),
+        "verlet": code_row("granplate", "tanh (eq. 5), verlet", verlet, int(dv.attrs["n_steps"]), t,
+                           velocity_error(final_velocities(dv), reference), contacts),
+        "lammps": code_row("LAMMPS", "Mindlin", theirs, int(lm["n_steps"]), t, velocity_error(lm, lref), contacts)}
+    ratio = {f"{key}{name}": rows[r][field] / rows["lammps"][field]
+             for r, key in (("granplate", ""), ("verlet", "verlet_"))
+             for name, field in (("loop_ratio", "loop_s"), ("cpu_ratio", "loop_cpu_s"))}
+    return {"contacts": contacts, "t_end_s": t, **rows, **ratio}
 
 
 def format_friction_table(rows: list[dict]) -> str:
@@ -189,11 +210,12 @@ def format_lammps_table(cmp: dict) -> str:
             f"{'us/(contact step)':>17} {'CPU [s]':>8} {'CPU us/(c. step)':>16} {'error [m/s]':>11}")
     lines = [f"packing with mu 0.099 side by side ({cmp['contacts']} listed contacts, t_end {cmp['t_end_s']:g} s, "
              f"median of {len(cmp['granplate']['loop_s_all'])} alternate runs each)", head, "-" * len(head)]
-    for r in (cmp["granplate"], cmp["lammps"]):
+    for r in (cmp["granplate"], cmp["verlet"], cmp["lammps"]):
         lines.append(f"{r['code']:<10} {r['law']:<20} {r['dt_s']:>9.3g} {r['n_steps']:>7d} {r['loop_s']:>9.3f} "
                      f"{r['us_per_contact_step']:>17.3f} {r['loop_cpu_s']:>8.3f} {r['cpu_us_per_contact_step']:>16.3f} "
                      f"{r['error_m_s']:>11.2e}")
-    lines.append(f"loop time granplate / LAMMPS: {cmp['loop_ratio']:.2f} (wall), {cmp['cpu_ratio']:.2f} (CPU)")
+    lines.append(f"loop time granplate / LAMMPS: {cmp['loop_ratio']:.2f} (wall), {cmp['cpu_ratio']:.2f} (CPU); "
+                 f"verlet / LAMMPS: {cmp['verlet_loop_ratio']:.2f} (wall), {cmp['verlet_cpu_ratio']:.2f} (CPU)")
     return "\n".join(lines)
 
 

@@ -223,9 +223,11 @@ def bench_case(case: str, scheme: str, t_end: float | None, repeats: int, ref: d
 
 
 def schemes() -> tuple[str, ...]:
-    from granplate.setup.validate import SCHEMES
+    """The schemes the presets (each with a plate) run under: every one but those of the
+    granules alone (setup.validate.GRANULAR_SCHEMES)."""
+    from granplate.setup.validate import GRANULAR_SCHEMES, SCHEMES
 
-    return tuple(SCHEMES)
+    return tuple(s for s in SCHEMES if s not in GRANULAR_SCHEMES)
 
 
 def run(quick: bool = False, cases=None, repeats: int | None = None, t_end: float | None = None,

@@ -17,7 +17,7 @@ from granplate.setup.validate import SCHEMES
 #: the coupling schemes (setup.validate.SCHEMES), numbered in this order (Config.scheme);
 #: each has a module in granplate.solver.schemes registered under the same name.
 SCHEME_NAMES = SCHEMES
-SCHEME_PAPER, SCHEME_IMPLICIT = 0, 1
+SCHEME_PAPER, SCHEME_IMPLICIT, SCHEME_VERLET = 0, 1, 2
 
 
 def scheme_number(name: str) -> int:

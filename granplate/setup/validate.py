@@ -42,7 +42,9 @@ DETECTIONS: tuple[str, ...] = ("dynamic", "fixed")
 #: yield at a contact (both granules; the granule alone against a wall or the plate).
 YIELDING_LAWS: tuple[str, ...] = ("thornton",)
 #: Coupling schemes the solver knows (Solver.scheme).
-SCHEMES: tuple[str, ...] = ("paper", "implicit")
+SCHEMES: tuple[str, ...] = ("paper", "implicit", "verlet")
+#: Schemes of the granules alone: a scenario with a [plate] is refused with them.
+GRANULAR_SCHEMES: tuple[str, ...] = ("verlet",)
 #: Treatments of the granule-granule and granule-wall friction (Solver.granular_friction).
 GRANULAR_FRICTIONS: tuple[str, ...] = ("split", "rk4")
 #: Load kinds (Load.kind: "line" is 2D, "force" 3D) and targets (Load.target).
@@ -909,6 +911,8 @@ def _check_solver(s: Scenario) -> None:
     sv = s.solver
     string_in("solver.scheme", sv.scheme, SCHEMES)
     string_in("solver.granular_friction", sv.granular_friction, GRANULAR_FRICTIONS)
+    if sv.scheme in GRANULAR_SCHEMES:
+        _check_granular_scheme(s)
     lam = finite("solver.lambda_target", sv.lambda_target, "must be in (0, 1)")
     if not 0.0 < lam < 1.0:
         raise ScenarioError("solver.lambda_target", sv.lambda_target, "must be in (0, 1)")
@@ -918,6 +922,17 @@ def _check_solver(s: Scenario) -> None:
     positive("solver.energy_tol", sv.energy_tol)
     positive("solver.error_tol", sv.error_tol)
     positive("solver.implicit_dt_max", sv.implicit_dt_max)
+
+
+def _check_granular_scheme(s: Scenario) -> None:
+    """A scheme of the granules alone (GRANULAR_SCHEMES): no plate, friction split off."""
+    sv = s.solver
+    if s.plate is not None:
+        raise ScenarioError("solver.scheme", sv.scheme, "integrates the granules alone (velocity Verlet): a scenario "
+                            "with a [plate] needs \"implicit\" or \"paper\"")
+    if sv.granular_friction != "split":
+        raise ScenarioError("solver.granular_friction", sv.granular_friction, "must be \"split\" with solver.scheme "
+                            f"= {sv.scheme!r} (its friction is split off exactly, never inside the step)")
 
 
 # --------------------------------------------------------------------------- entry point

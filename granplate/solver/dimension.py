@@ -1,10 +1,11 @@
 """Where the dimension lives in the time loop: the granular medium's derivative, its
-split-off friction, its kinetic energies and its error terms, taken from solver.granular
-(the plane: model.inputs.Granular, state x, y, theta, vx, vy, omega) or solver.granular3d
-(space: model.inputs.Granular3, state x, y, z, vx, vy, vz, wx, wy, wz), chosen at compile
-time from the type of the granular arrays `g` (as solver.schemes picks a scheme from its
-scratch). The RK4 step (solver.rk4), the schemes and the loop call only these, so the
-same compiled code serves both dimensions and nothing else asks which one it is.
+split-off friction, the velocity-Verlet force pass, its kinetic energies and its error
+terms, taken from solver.granular (the plane: model.inputs.Granular, state x, y, theta,
+vx, vy, omega) or solver.granular3d (space: model.inputs.Granular3, state x, y, z, vx,
+vy, vz, wx, wy, wz), chosen at compile time from the type of the granular arrays `g`
+(as solver.schemes picks a scheme from its scratch). The RK4 step (solver.rk4), the
+schemes and the loop call only these, so the same compiled code serves both dimensions
+and nothing else asks which one it is.
 
 Adding a dimension-specific granular function: write it in both modules with the same
 signature and add a stub and its overload here.
@@ -34,6 +35,12 @@ def friction_flow(y, dt, g, cfg, forward):
     raise NotImplementedError("compiled use only")
 
 
+def normal_forces(t, y, g, cfg, acc, fdamp, fload):
+    """The velocity-Verlet force pass: shock and normal forces alone, the damping force and
+    load of each granule apart (solver.granular.normal_forces)."""
+    raise NotImplementedError("compiled use only")
+
+
 def kinetic_energies(y, g):
     """(KE_x, KE_y, KE_z, KE_rot) [J] of the granules (KE_z = 0 in the plane)."""
     raise NotImplementedError("compiled use only")
@@ -59,6 +66,14 @@ def _friction_flow(y, dt, g, cfg, forward):
     if m is not None:
         fn = m.friction_flow
         return lambda y, dt, g, cfg, forward: fn(y, dt, g, cfg, forward)
+
+
+@overload(normal_forces, inline="always")
+def _normal_forces(t, y, g, cfg, acc, fdamp, fload):
+    m = _module_of(g)
+    if m is not None:
+        fn = m.normal_forces
+        return lambda t, y, g, cfg, acc, fdamp, fload: fn(t, y, g, cfg, acc, fdamp, fload)
 
 
 @overload(kinetic_energies, inline="always")

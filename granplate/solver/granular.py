@@ -354,3 +354,103 @@ def kinetic_energies(y, mass, inertia):
         ky += 0.5 * mass[i] * y[i, 4] * y[i, 4]
         kr += 0.5 * inertia[i] * y[i, 5] * y[i, 5]
     return kx, ky, kr
+
+
+@njit(cache=True)
+def normal_forces(t, y, g, cfg, acc, fdamp, fload):
+    """The velocity-Verlet force pass (solver.schemes.verlet) in the plane: the shock on
+    the loaded granules and the normal force (eqs. 2-4, physics.laws with each contact's
+    history) of every listed pair and wall contact at state y, whose velocities are the
+    ones the damping reads; no friction (the scheme applies it by `friction_flow`). Writes
+    the accelerations into acc[:, 3:6] and, apart, each granule's damping force and shock
+    load (fdamp, fload [:, 3:6]: N, N, N m), from which the scheme books the work of each
+    kick; each contact's overlap into its history's HIST_END (0 out of touch). No plate
+    contacts (the scheme runs without a plate). Returns the ForceSums: shock and viscous
+    power at y [W], stored energy [J], the largest overlap, the plastic work past the
+    largest overlaps [J]; no friction rates."""
+    ng = y.shape[0]
+    for i in range(ng):
+        for c in range(3, 6):
+            acc[i, c] = 0.0
+            fdamp[i, c] = 0.0
+            fload[i, c] = 0.0
+    p_shock = 0.0
+    p_visc = 0.0
+    e_pot = 0.0
+    ovl = 0.0
+    ovl_i = -1
+    ovl_j = -1
+    w_plastic = 0.0
+    if not cfg.load_on_plate:
+        amp = cfg.q0 * time_profile(t, cfg.duration)
+        if amp != 0.0:
+            for i in range(ng):
+                fx = amp * g.shock_force[i]
+                tq = amp * g.shock_torque[i]
+                fload[i, 3] = fx
+                fload[i, 5] = tq
+                acc[i, 3] += fx
+                acc[i, 5] += tq
+                p_shock += fx * y[i, 3] + tq * y[i, 5]
+    for p in range(g.pair_ij.shape[0]):
+        i = g.pair_ij[p, 0]
+        j = g.pair_ij[p, 1]
+        ri = g.radius[i]
+        rj = g.radius[j]
+        g.pair_hist[p, HIST_END] = 0.0
+        if pair_apart(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj):
+            continue
+        delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
+        if delta <= 0.0:
+            continue
+        g.pair_hist[p, HIST_END] = delta
+        if delta > ovl * min(ri, rj):
+            ovl = delta / min(ri, rj)
+            ovl_i = i
+            ovl_j = j
+        ddot = pair_normal_rate(y[i, 3], y[i, 4], y[j, 3], y[j, 4], nx, nz)
+        n, pv, ep, wp = normal_law_response(delta, ddot, g.pair_coef[p], g.pair_hist[p, HIST_MAX], cfg.clip)
+        w_plastic += wp
+        p_visc += pv
+        e_pot += ep
+        fx = -n * nx
+        fz = -n * nz
+        acc[i, 3] += fx
+        acc[i, 4] += fz
+        acc[j, 3] -= fx
+        acc[j, 4] -= fz
+        if pv != 0.0:  # the damping part of |N|, pv / ddot (eq. 3; with clip, what is left of it)
+            d = pv / ddot
+            fdamp[i, 3] -= d * nx
+            fdamp[i, 4] -= d * nz
+            fdamp[j, 3] += d * nx
+            fdamp[j, 4] += d * nz
+    for w in range(g.wall_i.shape[0]):
+        i = g.wall_i[w]
+        ri = g.radius[i]
+        nx = g.wall_geo[w, 0]
+        nz = g.wall_geo[w, 1]
+        delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, g.wall_geo[w, 2])
+        g.wall_hist[w, HIST_END] = max(delta, 0.0)
+        if delta <= 0.0:
+            continue
+        if delta > ovl * ri:
+            ovl = delta / ri
+            ovl_i = i
+            ovl_j = -1 - g.wall_w[w]
+        ddot = y[i, 3] * nx + y[i, 4] * nz
+        n, pv, ep, wp = normal_law_response(delta, ddot, g.wall_coef[w], g.wall_hist[w, HIST_MAX], cfg.clip)
+        w_plastic += wp
+        p_visc += pv
+        e_pot += ep
+        acc[i, 3] -= n * nx
+        acc[i, 4] -= n * nz
+        if pv != 0.0:
+            d = pv / ddot
+            fdamp[i, 3] -= d * nx
+            fdamp[i, 4] -= d * nz
+    for i in range(ng):
+        acc[i, 3] /= g.mass[i]
+        acc[i, 4] /= g.mass[i]
+        acc[i, 5] /= g.inertia[i]
+    return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic)

@@ -276,3 +276,101 @@ def force_error(k1, k0, kend, ratio, mass, inertia, radius, sc, err):
             pred = k1[i, 3 + c] + ratio * (k1[i, 3 + c] - k0[i, 3 + c])
             err = max(err, m * abs(kend[i, 3 + c] - pred))
     return sc, err
+
+
+@njit(cache=True)
+def normal_forces(t, y, g, cfg, acc, fdamp, fload):
+    """The velocity-Verlet force pass in space (as solver.granular.normal_forces): shock
+    and normal forces of every listed pair and wall contact at state y (no friction), the
+    accelerations into acc[:, 3:9], each granule's damping force and shock load apart
+    (fdamp, fload [:, 3:6] [N]; no torques: normal forces and loads act through the
+    centres), the contacts' overlaps into HIST_END. Returns the ForceSums."""
+    ng = y.shape[0]
+    for i in range(ng):
+        for c in range(3, 9):
+            acc[i, c] = 0.0
+            fdamp[i, c] = 0.0
+            fload[i, c] = 0.0
+    p_shock = 0.0
+    p_visc = 0.0
+    e_pot = 0.0
+    ovl = 0.0
+    ovl_i = -1
+    ovl_j = -1
+    w_plastic = 0.0
+    if not cfg.load_on_plate:
+        amp = cfg.q0 * time_profile(t, cfg.duration)
+        if amp != 0.0:
+            for i in range(ng):
+                for c in range(3):
+                    f = amp * g.shock_force[i, c]
+                    fload[i, VX + c] = f
+                    acc[i, VX + c] += f
+                    p_shock += f * y[i, VX + c]
+    for p in range(g.pair_ij.shape[0]):
+        i = g.pair_ij[p, 0]
+        j = g.pair_ij[p, 1]
+        ri = g.radius[i]
+        rj = g.radius[j]
+        g.pair_hist[p, HIST_END] = 0.0
+        if pair_apart_3d(y[i, X], y[i, Y], y[i, Z], ri, y[j, X], y[j, Y], y[j, Z], rj):
+            continue
+        delta, nx, ny, nz = pair_overlap_3d(y[i, X], y[i, Y], y[i, Z], ri, y[j, X], y[j, Y], y[j, Z], rj)
+        if delta <= 0.0:
+            continue
+        g.pair_hist[p, HIST_END] = delta
+        if delta > ovl * min(ri, rj):
+            ovl = delta / min(ri, rj)
+            ovl_i = i
+            ovl_j = j
+        ddot = normal_rate_3d(y[i, VX] - y[j, VX], y[i, VY] - y[j, VY], y[i, VZ] - y[j, VZ], nx, ny, nz)
+        n, pv, ep, wp = normal_law_response(delta, ddot, g.pair_coef[p], g.pair_hist[p, HIST_MAX], cfg.clip)
+        w_plastic += wp
+        p_visc += pv
+        e_pot += ep
+        acc[i, VX] -= n * nx
+        acc[i, VY] -= n * ny
+        acc[i, VZ] -= n * nz
+        acc[j, VX] += n * nx
+        acc[j, VY] += n * ny
+        acc[j, VZ] += n * nz
+        if pv != 0.0:  # the damping part of |N|, pv / ddot
+            d = pv / ddot
+            fdamp[i, VX] -= d * nx
+            fdamp[i, VY] -= d * ny
+            fdamp[i, VZ] -= d * nz
+            fdamp[j, VX] += d * nx
+            fdamp[j, VY] += d * ny
+            fdamp[j, VZ] += d * nz
+    for w in range(g.wall_i.shape[0]):
+        i = g.wall_i[w]
+        ri = g.radius[i]
+        nx = g.wall_geo[w, 0]
+        ny = g.wall_geo[w, 1]
+        nz = g.wall_geo[w, 2]
+        delta = wall_overlap_3d(y[i, X], y[i, Y], y[i, Z], ri, nx, ny, nz, g.wall_geo[w, 3])
+        g.wall_hist[w, HIST_END] = max(delta, 0.0)
+        if delta <= 0.0:
+            continue
+        if delta > ovl * ri:
+            ovl = delta / ri
+            ovl_i = i
+            ovl_j = -1 - g.wall_w[w]
+        ddot = normal_rate_3d(y[i, VX], y[i, VY], y[i, VZ], nx, ny, nz)
+        n, pv, ep, wp = normal_law_response(delta, ddot, g.wall_coef[w], g.wall_hist[w, HIST_MAX], cfg.clip)
+        w_plastic += wp
+        p_visc += pv
+        e_pot += ep
+        acc[i, VX] -= n * nx
+        acc[i, VY] -= n * ny
+        acc[i, VZ] -= n * nz
+        if pv != 0.0:
+            d = pv / ddot
+            fdamp[i, VX] -= d * nx
+            fdamp[i, VY] -= d * ny
+            fdamp[i, VZ] -= d * nz
+    for i in range(ng):
+        for c in range(3):
+            acc[i, VX + c] /= g.mass[i]
+            acc[i, WX + c] /= g.inertia[i]
+    return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic)

@@ -31,10 +31,10 @@ from types import ModuleType
 from numba.extending import overload
 
 from granplate.model.inputs import SCHEME_NAMES
-from granplate.solver.schemes import implicit, paper
+from granplate.solver.schemes import implicit, paper, verlet
 
 #: the registered schemes by name, in the order of model.inputs.SCHEME_NAMES.
-SCHEMES: dict[str, ModuleType] = {m.NAME: m for m in (paper, implicit)}
+SCHEMES: dict[str, ModuleType] = {m.NAME: m for m in (paper, implicit, verlet)}
 _BY_SCRATCH = {m.Scratch: m for m in SCHEMES.values()}
 assert tuple(SCHEMES) == SCHEME_NAMES, "model.inputs.SCHEME_NAMES and SCHEMES disagree"
 
