@@ -18,9 +18,9 @@ from test_study_explorer import LARGE, synthetic_outcome
 
 STUDIES = Path(__file__).resolve().parent.parent / "docs" / "studies"
 WORKED = ("intruder-map", "intruder-map-plastic", "calibration", "two-layer")
-#: The most seconds a 10,000-design page may take to load and draw (a few on a quiet
-#: machine; docs/benchmarks.md has the measured time).
-LARGE_LOAD_S = 30.0
+#: The most seconds a 10,000-design page may take to load and draw its first screen (a
+#: few; docs/benchmarks.md has the measured time).
+LARGE_LOAD_S = 15.0
 N_SMALL = 200
 
 
@@ -162,7 +162,8 @@ def test_worked_study_pages_render_their_plots_offline(browser, name):
 
 
 def test_a_large_study_opens_in_a_few_seconds(browser, tmp_path):
-    """A 10,000-design page (WebGL) loads and draws its views within LARGE_LOAD_S."""
+    """A 10,000-design page (WebGL) loads and draws its first screen within LARGE_LOAD_S;
+    the parallel coordinates below it are drawn once scrolled to."""
     page = X.write_explorer(synthetic_outcome(LARGE, tmp_path), {}, [])
     console_errors(browser)
     t0 = time.monotonic()
@@ -170,6 +171,11 @@ def test_a_large_study_opens_in_a_few_seconds(browser, tmp_path):
     wait_for(browser, "return document.querySelectorAll('#fig-main canvas').length > 0 && "
                       "document.querySelectorAll('#designs tbody tr').length > 0", LARGE_LOAD_S)
     seconds = time.monotonic() - t0
-    print(f"10,000-design page: {page.stat().st_size / 1e6:.1f} MB, loaded and drawn in {seconds:.1f} s")
+    t1 = time.monotonic()
+    browser.execute_script("document.getElementById('fig-parcoords').scrollIntoView()")
+    wait_for(browser, "return document.querySelectorAll('#fig-parcoords canvas').length > 0", 4 * LARGE_LOAD_S)
+    later = time.monotonic() - t1
+    print(f"10,000-design page: {page.stat().st_size / 1e6:.1f} MB, first screen in {seconds:.1f} s, "
+          f"parallel coordinates in {later:.1f} s more")
     assert seconds < LARGE_LOAD_S
     assert console_errors(browser) == []

@@ -5,6 +5,7 @@
    filters the others and the table; the table sorts by any column. */
 (function () {
   "use strict";
+  var tScript = performance.now();
   var D = JSON.parse(document.getElementById("study-data").textContent);
   var F = JSON.parse(document.getElementById("study-figures").textContent);
   var designs = D.designs;
@@ -75,12 +76,14 @@
     });
     return s;
   }
+  var everFiltered = false;
   function apply() {
     var s = visibleSet();
+    everFiltered = everFiltered || s !== null;
     var n = s === null ? designs.length : s.size;
     document.getElementById("shown").textContent = n + " of " + designs.length + " " + what + "s shown";
     plots.forEach(function (p) {
-      if (filters[p.name]) { return; }  /* the view a selection was made in shows it itself */
+      if (filters[p.name] || !everFiltered) { return; }  /* the view a selection was made in shows it itself */
       var idx = [], sel = [];
       p.div.data.forEach(function (t, k) {
         if (!t.customdata || t.type === "heatmap") { return; }
@@ -250,7 +253,9 @@
   /* ------------------------------------------------------------------ the best designs */
   function bestCards() {
     var box = document.getElementById("best");
-    var chosen = designs.filter(function (d) { return d.why; });
+    var order = Object.keys(D.directions || {});
+    var rank = function (d) { return d.best.length ? order.indexOf(d.best[0]) : order.length; };
+    var chosen = designs.filter(function (d) { return d.why; }).sort(function (a, b) { return rank(a) - rank(b) || a.i - b.i; });
     if (!chosen.length) { box.innerHTML = "<p class='hint'>No design completed yet.</p>"; return; }
     box.innerHTML = chosen.map(function (d) {
       var nums = Object.keys(D.directions || {}).filter(function (m) { return d.metrics[m] !== undefined; }).map(function (m) {
@@ -319,18 +324,38 @@
     fillSlices();
   }
 
+  /* draw a view below the first screen: now for a small study, when it comes near the
+     window for a large one (the first screen is drawn first) */
+  function later(div, drawIt) {
+    if (!div) { return; }
+    if (!D.gl || !("IntersectionObserver" in window)) { drawIt(); return; }
+    var seen = new IntersectionObserver(function (entries) {
+      if (entries.some(function (e) { return e.isIntersecting; })) { seen.disconnect(); drawIt(); }
+    }, { rootMargin: "0px" });
+    seen.observe(div);
+  }
+  var times = {};
+  function mark(name) { times[name] = Math.round(performance.now()); }
+  times.script = Math.round(tScript);
   function init() {
     var main = F.main;
+    mark("parsed");
     var mainDiv = draw("fig-main", main ? F[main] : null, main === "heat" ? null : "main");
     if (main === "heat") { heatChoice(mainDiv); }
     if (main === "metric") { metricChoice(mainDiv); }
+    mark("main");
     var pc = document.getElementById("fig-parcoords");
     if (pc && F.parcoords) {
-      Plotly.newPlot(pc, F.parcoords.data, F.parcoords.layout, CONFIG);
-      pc.on("plotly_restyle", function () { parcoordsFilter(pc); });
+      later(pc, function () {
+        Plotly.newPlot(pc, F.parcoords.data, F.parcoords.layout, CONFIG);
+        pc.on("plotly_restyle", function () { parcoordsFilter(pc); });
+        mark("parcoords");
+      });
     }
-    if (main !== "metric") { metricChoice(draw("fig-metric", F.metric, "metric")); }
-    if (main !== "heat") { heatChoice(draw("fig-heat", F.heat, null)); }
+    if (main !== "metric") { later(document.getElementById("fig-metric"), function () {
+      metricChoice(draw("fig-metric", F.metric, "metric")); mark("metric"); }); }
+    if (main !== "heat") { later(document.getElementById("fig-heat"), function () {
+      heatChoice(draw("fig-heat", F.heat, null)); mark("heat"); }); }
     var feasible = document.getElementById("only-feasible");
     feasible.disabled = !D.constraints.length;
     feasible.addEventListener("change", function () {
@@ -346,7 +371,7 @@
       feasible.checked = false; front.checked = false;
       Object.keys(filters).forEach(function (k) { filters[k] = null; });
       plots.forEach(function (p) { Plotly.restyle(p.div, { selectedpoints: [null] }); });
-      if (pc && F.parcoords) {
+      if (pc && pc.data) {
         Plotly.restyle(pc, F.parcoords.data[0].dimensions.reduce(function (u, d, k) {
           u["dimensions[" + k + "].constraintrange"] = null; return u; }, {}));
       }
@@ -356,7 +381,9 @@
     linkTable();
     sortableStatic();
     apply();
-    window.granplateExplorer = { showDesign: showDesign, setFilter: setFilter, visibleSet: visibleSet, data: D };
+    mark("ready");
+    window.granplateExplorer = { showDesign: showDesign, setFilter: setFilter, visibleSet: visibleSet, data: D,
+                                 times: times };
   }
   init();
 })();
