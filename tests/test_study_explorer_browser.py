@@ -73,10 +73,10 @@ def test_front_view_has_as_many_points_as_feasible_designs(loaded):
     assert n == feasible > 0
 
 
-def test_clicking_a_design_shows_its_numbers(loaded):
-    """A click on the star of the best design (the point itself, with the mouse) opens the
-    panel of that design with its metrics in the units shown; a click on a table row opens
-    that row's design."""
+def test_hovering_and_clicking_a_design_shows_its_numbers(loaded):
+    """Hovering the star of the best design (with the mouse) names it with its parameters
+    and metrics in the units shown (the modulus in MPa); a click opens the panel of that
+    design with its metrics; a click on a table row opens that row's design."""
     from selenium.webdriver.common.action_chains import ActionChains
 
     driver, out = loaded
@@ -85,6 +85,13 @@ def test_clicking_a_design_shows_its_numbers(loaded):
     i = best_designs(out)["ep_max_fraction"]
     traces = driver.find_elements("css selector", "#fig-main .scatterlayer .trace")
     star = traces[-2].find_elements("css selector", "path.point")[0]  # best ep_max_fraction
+    ActionChains(driver).move_to_element(star).perform()
+    wait_for(driver, "return document.querySelectorAll('#fig-main .hoverlayer .hovertext').length > 0")
+    hover = driver.find_element("css selector", "#fig-main .hoverlayer .hovertext").text
+    r = out.rows[i]
+    assert f"trial {r.number}" in hover
+    assert f"materials.steel.E = {r.params['materials.steel.E'] * 1e-6:.4g} MPa" in hover
+    assert f"max_von_mises = {r.metrics['max_von_mises'] * 1e-6:.4g} MPa" in hover
     ActionChains(driver).move_to_element(star).click().perform()
     wait_for(driver, "return !document.getElementById('panel').hidden")
     title = driver.find_element("id", "panel-title")
