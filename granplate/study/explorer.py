@@ -351,8 +351,8 @@ def parcoords_figure(out: StudyOutcome) -> dict[str, Any] | None:
         label = axis_title(out, m, out.objectives.get(m, ""))
         if m in bounds:
             b = bounds[m]
-            label += " in " + (f"{P._short(b.low * factor) if b.low is not None else '-inf'} .. "
-                               f"{P._short(b.high * factor) if b.high is not None else 'inf'}")
+            label += " in " + (f"{level_label(b.low * factor) if b.low is not None else '-inf'} .. "
+                               f"{level_label(b.high * factor) if b.high is not None else 'inf'}")
         dims.append({"values": _values(out, m, rows), "label": label, "name": m})
     feasible = [0 if out.rows[i].feasible is False else 1 for i in rows]
     line = {"color": feasible, "cmin": 0, "cmax": 1, "showscale": False,
@@ -360,6 +360,14 @@ def parcoords_figure(out: StudyOutcome) -> dict[str, Any] | None:
     return {"data": [{"type": "parcoords", "dimensions": dims, "line": line,
                       "labelangle": -12, "labelside": "top"}],
             "layout": {"margin": {"t": 90, "l": 70, "r": 70, "b": 30}, "height": 460}, "rows": rows}
+
+
+def level_label(v: Any) -> str:
+    """A parameter's value as a category label: whole numbers in full (50000, not 5e+04),
+    others to 4 significant digits, text as it is."""
+    if isinstance(v, float) and v.is_integer() and abs(v) < 1e7:
+        return str(int(v))
+    return f"{v:.4g}" if isinstance(v, float) else str(v)
 
 
 def heat_metrics(out: StudyOutcome) -> list[str]:
@@ -391,7 +399,7 @@ def heat_figure(out: StudyOutcome) -> dict[str, Any] | None:
     combos = [c for c in combos if all(str(c[others.index(n)]) == str(v) for n, v in fixed.items())]
 
     def tick(name: str, levels: list) -> list[str]:
-        return [P._tick(v) for v in P.scaled_values(out, name, levels)]
+        return [level_label(v) for v in P.scaled_values(out, name, levels)]
 
     traces, index = [], []
     for m in metrics:

@@ -168,7 +168,7 @@
       return d.number + (d.best.length ? "<span class='mark'>best " + esc(d.best.join(", ")) + "</span>" : "")
         + (d.front ? "<span class='mark'>front</span>" : ""); } }];
     D.parameters.forEach(function (q) {
-      cols.push({ head: q.name + " [" + q.unit + "]", value: function (d) { return d.params[q.name]; },
+      cols.push({ head: q.name + (q.numeric ? " [" + q.unit + "]" : ""), value: function (d) { return d.params[q.name]; },
                   text: function (d) { var v = d.params[q.name]; return esc(typeof v === "number" ? num(v * q.factor) : v); } });
     });
     D.table.forEach(function (m) {
