@@ -108,14 +108,19 @@ def test_hovering_and_clicking_a_design_shows_its_numbers(loaded):
 
 
 def test_filters_change_the_visible_count(loaded):
-    """'feasible only' shows the feasible designs' count (and the table as many rows); a
-    range brushed on a parallel-coordinates axis narrows it; 'show all' restores it."""
+    """'feasible only' shows the feasible designs' count (the table as many rows, the
+    parallel coordinates the others faint); a range brushed on a parallel-coordinates axis
+    narrows it; 'show all' restores it."""
     driver, out = loaded
     assert shown_count(driver) == N_SMALL
     driver.find_element("id", "only-feasible").click()
     feasible = sum(1 for r in out.rows if r.ok and r.feasible)
     assert shown_count(driver) == feasible < N_SMALL
     assert len(driver.find_elements("css selector", "#designs tbody tr")) == feasible
+    # the parallel coordinates show it: the lines filtered out are faint (colour 0.5)
+    faint = driver.execute_script("return document.getElementById('fig-parcoords').data[0].line.color"
+                                  ".filter(function (c) { return c === 0.5; }).length")
+    assert faint == sum(1 for r in out.rows if r.ok) - feasible
     # brush the radius axis (layout.R1, in m) to its lower half
     driver.execute_script("var pc = document.getElementById('fig-parcoords');"
                           "var k = pc.data[0].dimensions.findIndex(function (d) { return d.name === 'layout.R1'; });"

@@ -355,8 +355,9 @@ def parcoords_figure(out: StudyOutcome) -> dict[str, Any] | None:
                                f"{level_label(b.high * factor) if b.high is not None else 'inf'}")
         dims.append({"values": _values(out, m, rows), "label": label, "name": m})
     feasible = [0 if out.rows[i].feasible is False else 1 for i in rows]
-    line = {"color": feasible, "cmin": 0, "cmax": 1, "showscale": False,
-            "colorscale": [[0, COLOURS["infeasible"]], [1, COLOURS["design"]]]}
+    line = {"color": feasible, "cmin": 0, "cmax": 1, "showscale": False,  # 0.5: filtered out elsewhere
+            "colorscale": [[0, COLOURS["infeasible"]], [0.45, COLOURS["infeasible"]], [0.5, "#ececec"],
+                           [0.55, COLOURS["design"]], [1, COLOURS["design"]]]}
     return {"data": [{"type": "parcoords", "dimensions": dims, "line": line,
                       "labelangle": -12, "labelside": "top"}],
             "layout": {"margin": {"t": 90, "l": 70, "r": 70, "b": 30}, "height": 460}, "rows": rows}

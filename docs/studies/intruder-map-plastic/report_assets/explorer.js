@@ -92,7 +92,27 @@
       });
       if (idx.length) { Plotly.restyle(p.div, { selectedpoints: sel }, idx); }
     });
+    recolourParcoords();
     renderTable();
+  }
+  /* the parallel coordinates show the other views' filters: lines filtered out there faint */
+  var parcoordsKey = "";
+  function recolourParcoords() {
+    var pc = document.getElementById("fig-parcoords");
+    if (!pc || !pc.data || !F.parcoords) { return; }
+    var s = null;
+    Object.keys(filters).forEach(function (k) {
+      var f = filters[k];
+      if (!f || k === "parcoords") { return; }
+      s = s === null ? new Set(f) : new Set(Array.from(s).filter(function (i) { return f.has(i); }));
+    });
+    var key = s === null ? "" : Array.from(s).sort(function (a, b) { return a - b; }).join(",");
+    if (key === parcoordsKey) { return; }
+    parcoordsKey = key;
+    var colour = F.parcoords.rows.map(function (i, j) {
+      return s !== null && !s.has(i) ? 0.5 : F.parcoords.data[0].line.color[j];
+    });
+    Plotly.restyle(pc, { "line.color": [colour] });
   }
   function setFilter(name, set) { filters[name] = set; apply(); }
   function linkSelection(div, name) {
