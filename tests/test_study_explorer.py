@@ -267,3 +267,18 @@ def test_cli_watch_of_a_finished_study_writes_the_report_and_says_the_counts(tmp
     assert "watch: 5 done, 1 failed, 0 left of 6" in captured and f"report: {tmp_path / PAGE}" in captured
     assert main(["study", "report", str(tmp_path), "--watch", "--every", "0"]) == 2
     assert "--every = 0.0: must be > 0" in capsys.readouterr().err
+
+
+def test_watch_waits_for_an_optimisation_s_first_table_and_refuses_a_folder_without_a_study(tmp_path):
+    """An optimisation's folder before its first trials.csv: `watch` says it waits (once)
+    and writes nothing; a folder without a study file is the report's one-line error."""
+    from granplate.errors import ScenarioError
+    from granplate.study.watch import WAITING
+
+    (tmp_path / "study.toml").write_text('base = "ptfe-r05"\n[parameters]\n"load.q0" = {range = [1e3, 4e3]}\n'
+                                         '[objectives]\n"ep_max_fraction" = "minimize"\n')
+    lines: list[str] = []
+    assert watch(tmp_path, every=0.0, echo=lines.append, rounds=3)["total"] == 0
+    assert lines == [WAITING] and not (tmp_path / PAGE).exists()
+    with pytest.raises(ScenarioError, match="study folder"):
+        watch(tmp_path / "nothing", every=0.0, rounds=1)

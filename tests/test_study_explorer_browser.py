@@ -76,7 +76,8 @@ def test_front_view_has_as_many_points_as_feasible_designs(loaded):
 def test_hovering_and_clicking_a_design_shows_its_numbers(loaded):
     """Hovering the star of the best design (with the mouse) names it with its parameters
     and metrics in the units shown (the modulus in MPa); a click opens the panel of that
-    design with its metrics; a click on a table row opens that row's design."""
+    design with its metrics; a click on a column sorts the table by it, a click on a row
+    opens that row's design."""
     from selenium.webdriver.common.action_chains import ActionChains
 
     driver, out = loaded
@@ -100,6 +101,20 @@ def test_hovering_and_clicking_a_design_shows_its_numbers(loaded):
               for e in driver.find_elements("css selector", "#panel .metric-value")}
     assert values["ep_max_fraction"] == f"{out.rows[i].metrics['ep_max_fraction']:.4g}"
     assert values["max_von_mises"] == f"{out.rows[i].metrics['max_von_mises'] * 1e-6:.4g} MPa"
+    driver.find_element("css selector", "#panel .close").click()
+    assert not driver.find_element("id", "panel").is_displayed()
+    # the table sorts by a metric's column: the least max_von_mises first, then the most
+    header = next(th for th in driver.find_elements("css selector", "#designs thead th")
+                  if th.text.startswith("max_von_mises"))
+    column = int(header.get_attribute("data-col"))
+    driver.execute_script("arguments[0].scrollIntoView({block: 'center'})", header)
+    header.click()
+    least = min(r.metrics["max_von_mises"] for r in out.rows if r.ok)
+    first = driver.find_elements("css selector", "#designs tbody tr")[0].find_elements("css selector", "td")
+    assert first[column].text == f"{least * 1e-6:.4g}"
+    driver.find_element("css selector", f"#designs thead th[data-col='{column}']").click()
+    first = driver.find_elements("css selector", "#designs tbody tr")[0].find_elements("css selector", "td")
+    assert first[column].text == f"{max(r.metrics['max_von_mises'] for r in out.rows if r.ok) * 1e-6:.4g}"
     row = driver.find_elements("css selector", "#designs tbody tr")[3]
     number = row.find_elements("css selector", "td")[0].text.split()[0]
     driver.execute_script("arguments[0].scrollIntoView({block: 'center'})", row)

@@ -16,6 +16,9 @@ from granplate.study import design as D
 
 #: Seconds between two looks at the study folder.
 EVERY_S = 5.0
+#: Said while a study has its study file but nothing to read yet (an optimisation writes
+#: trials.csv after its first trials).
+WAITING = "watch: waiting for the study's first table (trials.csv)"
 
 
 def folder_state(folder: Path) -> tuple:
@@ -40,6 +43,8 @@ def watch(folder: str | Path, every: float = EVERY_S, echo: Callable[[str], None
     counts; once no design is left (or after `rounds` looks), write the final page (the
     full report when `final`, else the page without its reload) and return the counts.
     A KeyboardInterrupt writes the page without its reload first, then propagates."""
+    from granplate.errors import ScenarioError
+    from granplate.study.outcome import STUDY_FILE
     from granplate.study.report import write_live_page, write_report
 
     folder = Path(folder)
@@ -48,16 +53,25 @@ def watch(folder: str | Path, every: float = EVERY_S, echo: Callable[[str], None
         while True:
             state = folder_state(folder)
             if state != last:
-                _, c = write_live_page(folder)
-                echo(counts_line(c))
+                try:
+                    _, c = write_live_page(folder)
+                    echo(counts_line(c))
+                except ScenarioError:
+                    if not (folder / STUDY_FILE).is_file():
+                        raise  # no study here at all
+                    if last is None:  # an optimisation before its first table
+                        echo(WAITING)
                 last = state
             n += 1
-            if c["left"] == 0 or (rounds is not None and n >= rounds):
+            if (c is not None and c["left"] == 0) or (rounds is not None and n >= rounds):
                 break
             time.sleep(every)
     except KeyboardInterrupt:
-        write_live_page(folder, live=False)
+        if c is not None:
+            write_live_page(folder, live=False)
         raise
+    if c is None:
+        return {"total": 0, "done": 0, "failed": 0, "left": 0, "infeasible": 0}
     if final and c["left"] == 0:
         write_report(folder, live=True)
     else:
