@@ -33,14 +33,25 @@ def small(tmp_path_factory):
     return X.write_explorer(out, {}, []), out
 
 
-@pytest.fixture()
-def loaded(browser, small):
-    """The small page, freshly loaded, its logs cleared before."""
+@pytest.fixture(scope="module")
+def opened(browser, small):
+    """The small page, loaded once for the module, its logs cleared before."""
     console_errors(browser)
     external_requests(browser)
     open_page(browser, small[0])
     wait_for(browser, "return document.querySelectorAll('#fig-main .scatterlayer .trace').length > 0")
     return browser, small[1]
+
+
+@pytest.fixture()
+def loaded(opened):
+    """The small page as loaded: every filter off ('show all'), no panel, at its top."""
+    driver, out = opened
+    driver.execute_script("document.getElementById('panel').hidden = true; window.scrollTo(0, 0);"
+                          "document.getElementById('reset').click();")
+    all_shown = "return document.getElementById('shown').textContent.indexOf('%d of') === 0" % N_SMALL
+    wait_for(driver, all_shown)
+    return driver, out
 
 
 def wait_for(driver, script: str, timeout: float = 20.0) -> None:
