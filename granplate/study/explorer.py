@@ -525,9 +525,9 @@ def counts_text(c: dict[str, int], kind: str) -> str:
 
 def explorer_html(out: StudyOutcome, data: dict[str, Any], figures: dict[str, Any], paper_figures: list[Path],
                   live: bool = False) -> str:
-    """The page: the answer first (counts, conclusion, best designs, the main figure),
-    then the views to explore, the table, targets, failures, the study file (collapsed)
-    and the figures for papers; `live`: it reloads itself every REFRESH_S seconds while
+    """The page: the answer first (counts, conclusion, best designs, the main figure, the
+    targets' verdicts), then the views to explore, the table, failures, the study file
+    (collapsed) and the figures for papers; `live`: it reloads itself every REFRESH_S seconds while
     designs are left."""
     from granplate.study import report as R
 
@@ -569,6 +569,7 @@ def explorer_html(out: StudyOutcome, data: dict[str, Any], figures: dict[str, An
          "<label id='heat-slice-label'>slice <select id='heat-slice'></select></label></div>" if main == "heat" else ""),
         "<div id='fig-main' class='plot main-plot'></div></div>",
         "</section>",
+        (f"<section id='targets'><h2>Targets</h2>{_blocks_html(targets)}</section>" if targets else ""),
         "<section id='explore'><h2>Explore</h2>",
         "<div class='filterbar'><span id='shown'></span> <label><input type='checkbox' id='only-feasible'> "
         "feasible only</label> <label><input type='checkbox' id='only-front'> on the front only</label> "
@@ -583,7 +584,6 @@ def explorer_html(out: StudyOutcome, data: dict[str, Any], figures: dict[str, An
         "<h3>Designs</h3><p class='hint'>Click a column to sort, a row for the design's panel.</p>",
         "<div class='table-wrap' id='table-wrap'><table id='designs'></table></div>",
         "</section>",
-        (f"<section id='targets'><h2>Targets</h2>{_blocks_html(targets)}</section>" if targets else ""),
         f"<section id='failures'>{_blocks_html(failures)}</section>",
         f"<details id='study'><summary>The study: its definition and the study file as run</summary>"
         f"{_blocks_html(definition)}</details>",
