@@ -98,6 +98,8 @@ def requested_urls(driver) -> list[str]:
 
 
 def external_requests(driver) -> list[str]:
-    """The requested URLs that would leave the machine (not file:, data:, blob: or localhost)."""
-    local = ("file:", "data:", "blob:", "about:", "chrome:", "devtools:", "http://localhost", "http://127.0.0.1")
+    """The requested URLs that would leave the machine (not file:, data:, blob:, the
+    browser's own chrome: pages or localhost)."""
+    local = ("file:", "data:", "blob:", "about:", "chrome:", "chrome-untrusted:", "devtools:", "http://localhost",
+             "http://127.0.0.1")
     return [u for u in requested_urls(driver) if not u.startswith(local)]

@@ -100,8 +100,34 @@ def test_infeasible_trial_is_left_off_the_front_and_reported(records, tmp_path):
     from granplate.study.report import FIGURES, write_report
 
     page = write_report(tmp_path).read_text()
-    assert "1 infeasible (constraints)" in page and "On the front: trial 0." in page
+    markdown = (tmp_path / "report.md").read_text()
+    assert "1 infeasible (constraints)" in markdown and "On the front: trial 0." in markdown
+    assert "2 trials: 2 done, 0 failed, 0 left (1 infeasible)" in page
     assert (tmp_path / FIGURES / "pareto-front.png").is_file()
+
+
+def test_trials_table_while_the_search_runs_counts_the_trials_left(records, tmp_path):
+    """Truth: trials.csv written during the search (`write_progress`) lists the trials so
+    far and one waiting row per trial to come, which the report's page counts as left."""
+    from granplate.study.optimize import write_progress
+    from granplate.study.explorer import counts
+    from granplate.study.outcome import read_outcome
+
+    doc = {"base": "ptfe-r05", "set": {"time.t_end": 2e-6},
+           "parameters": {"layout.intruder_material": ["steel", "ptfe"]},
+           "objectives": {"granular_mass": "minimize"}}
+    opt = parse_optimization(doc)
+    study = open_study(opt, tmp_path, seed=0)
+    for material in ("steel", "ptfe"):
+        study.enqueue_trial({"layout.intruder_material": material})
+        assert tell(study, opt, study.ask(opt.space), records[material])
+    study.ask(opt.space)  # a third trial, running
+    write_progress(study, opt, tmp_path, trials=5)
+    rows = list(csv.DictReader(open(tmp_path / TRIALS_CSV)))
+    assert [r["state"] for r in rows] == ["COMPLETE", "COMPLETE", "RUNNING", "WAITING", "WAITING"]
+    (tmp_path / "study.toml").write_text('base = "ptfe-r05"\n[objectives]\n"granular_mass" = "minimize"\n')
+    c = counts(read_outcome(tmp_path, live=True))
+    assert (c["total"], c["done"], c["failed"], c["left"]) == (5, 2, 0, 3)
 
 
 @pytest.mark.parametrize("table, field, words", [

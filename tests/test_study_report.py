@@ -101,7 +101,8 @@ def test_one_figure_per_varying_metric_with_its_unit(synthetic_report):
         np.testing.assert_allclose(np.sort(drawn[np.isfinite(drawn)]), np.sort(expected), rtol=1e-12)
     # constant metrics are named, not drawn
     assert not (folder / FIGURES / "metric-t_end.png").exists()
-    assert "<code>t_end</code>" in page.split("Not drawn", 1)[1].split("</p>", 1)[0]
+    markdown = (folder / "report.md").read_text()
+    assert "`t_end`" in markdown.split("Not drawn", 1)[1].split("\n", 1)[0]
 
 
 def test_heat_map_of_a_two_parameter_grid_shows_each_design_in_its_cell(synthetic_report):
@@ -143,19 +144,27 @@ def test_heat_maps_of_three_parameters_are_one_panel_per_value_of_the_third(tmp_
 
 def test_failures_table_lists_each_failed_design_with_its_message(synthetic_report):
     _, _, page = synthetic_report
-    failures = page.split("<h2>Failures</h2>", 1)[1]
+    failures = page.split("<h2>Failures</h2>", 1)[1].split("</section>", 1)[0]
     rows = re.findall(r"<tr>(<td>.*?)</tr>", failures)
     assert rows == [f"<td>4</td><td>4000</td><td>0.5</td><td>{MESSAGE}</td>"]
 
 
-def test_page_is_self_contained_and_holds_the_definition_and_chosen_designs(synthetic_report):
+def test_pages_link_their_figures_and_hold_the_definition_and_chosen_designs(synthetic_report):
+    """Truth: every figure in DIR/report/ is linked from the page (PNG and PDF) and the
+    Markdown page links its PNGs; the study file is on the page; the chosen designs are
+    the best of each objective, with their figures."""
     folder, _, page = synthetic_report
-    assert page.count("data:image/png;base64,") == len(list((folder / FIGURES).glob("*.png")))
+    markdown = (folder / "report.md").read_text()
+    for p in (folder / FIGURES).glob("*.p[nd][gf]"):
+        assert f"{FIGURES}/{p.name}" in page
+    assert all(f"({FIGURES}/{p.name})" in markdown for p in (folder / FIGURES).glob("metric-*.png"))
     assert "<pre>" in page and html.escape('"load.q0" = [1000.0, 2000.0, 4000.0]') in page
     out = read_outcome(folder)
     # best ep_max_fraction: the smallest q0 x R2 (design 0); best stress: q0 / R2 least (design 1)
     assert best_designs(out) == {"ep_max_fraction": 0, "max_von_mises": 1}
-    assert "Design 0: best ep_max_fraction (minimize)" in page and "Design 1: best max_von_mises (minimize)" in page
+    assert "Design 0: best ep_max_fraction (minimize)" in markdown
+    assert "Design 1: best max_von_mises (minimize)" in markdown
+    assert '"why":"best ep_max_fraction (minimize)"' in page
     for i in (0, 1):
         stem = f"design-{out.rows[i].key[:12]}"
         assert (folder / FIGURES / f"{stem}-assembly.png").is_file()
@@ -182,14 +191,15 @@ def test_cli_writes_the_report_at_the_end_of_a_tiny_real_sweep(tmp_path, capsys)
     page = (out / PAGE).read_text()
     assert (out / "study.toml").read_text() == (tmp_path / "s.toml").read_text()
     # the two designs of the negative load fail with the scenario's own message
-    failures = page.split("<h2>Failures</h2>", 1)[1]
+    failures = page.split("<h2>Failures</h2>", 1)[1].split("</section>", 1)[0]
     assert failures.count("load.q0") >= 2 and "must be &gt;= 0" in failures
     assert (out / FIGURES / "heatmap-ep_max_fraction.png").is_file()
     # the report again, from the folder alone
     assert main(["study", "report", str(out), "-q"]) == 0
-    assert (out / PAGE).read_text().count("<figure>") == page.count("<figure>")
+    assert (out / PAGE).read_text() == page
     # the sweep again: nothing to compute, no cluster, nothing redrawn
-    drawn = {p: p.stat().st_mtime_ns for p in [out / PAGE, *(out / FIGURES).glob("*.png")]}
+    drawn = {p: p.stat().st_mtime_ns for p in [out / PAGE, out / "report.md", *(out / FIGURES).glob("*.p[nd][gf]"),
+                                               *(out / "report_assets").iterdir()]}
     assert main(["sweep", str(tmp_path / "s.toml"), "--out", str(out), "--workers", "1", "-q"]) == 1
     assert "computed: 0," in capsys.readouterr().out
     assert {p: p.stat().st_mtime_ns for p in drawn} == drawn
@@ -289,7 +299,8 @@ def test_page_judges_the_targets_and_draws_the_designs_that_meet_them(tmp_path):
     assert target_designs(out) == [2]
     page = write_report(tmp_path).read_text()
     assert "1 of 3 combinations meet every target" in page and "<p>Only one.</p>" in page
-    assert "Design 2: meets the targets" in page
+    assert "Design 2: meets the targets" in (tmp_path / "report.md").read_text()
+    assert '"why":"meets the targets' in page
 
 
 LOG_TOML = '''base = "ptfe-r05"

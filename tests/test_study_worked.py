@@ -135,3 +135,22 @@ def test_comparison_refuses_tables_of_other_designs(tmp_path):
     (tmp_path / "failed.csv").write_text("\n".join(failed) + "\n")
     with pytest.raises(ValueError, match="did not complete"):
         m.read_tables(tmp_path / "failed.csv", STUDIES / PLASTIC / "results.csv")
+
+
+@pytest.mark.parametrize("name", [ELASTIC, PLASTIC, "calibration", "two-layer"])
+def test_committed_page_is_that_of_its_committed_table(name):
+    """Each worked study's committed report.html is the interactive page the code writes
+    from the committed table and figures, and its report_assets/ are the package's own
+    (plotly.js and the page's script and style): nothing stale is committed."""
+    from granplate.study import explorer as X
+    from granplate.study.outcome import read_outcome
+    from granplate.study.report import kept_figures, paper_figures
+
+    folder = STUDIES / name
+    out = read_outcome(folder)
+    page = X.explorer_html(out, X.explorer_data(out, kept_figures(out)), X.explorer_figures(out), paper_figures(out))
+    assert (folder / "report.html").read_text() == page
+    assets = folder / X.ASSETS
+    assert (assets / X.PLOTLY_JS).read_bytes() == X.plotly_source().read_bytes()
+    for asset in X.OWN_ASSETS:
+        assert (assets / asset).read_bytes() == (Path(X.__file__).parent / "assets" / asset).read_bytes()

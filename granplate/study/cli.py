@@ -1,6 +1,7 @@
 """`granplate sweep STUDY.toml --out DIR`: run a study's designs on Dask;
 `granplate optimize STUDY.toml --out DIR --trials N`: search its parameters with Optuna;
-`granplate study report DIR`: the study's report page (docs/studies.md). Sweep and
+`granplate study report DIR [--watch]`: the study's report page, or followed while the
+study runs (docs/studies.md). Sweep and
 optimize keep the study file as DIR/study.toml and end by writing the report."""
 from __future__ import annotations
 
@@ -100,7 +101,20 @@ def _cmd_optimize(args) -> int:
 
 
 def _cmd_report(args) -> int:
-    _report(args.dir, True, not args.quiet)
+    if not args.watch:
+        _report(args.dir, True, not args.quiet)
+        return 0
+    from granplate.study.watch import watch
+
+    if not args.every > 0:
+        print(f"granplate: error: --every = {args.every}: must be > 0 (seconds)", file=sys.stderr)
+        return 2
+    try:
+        c = watch(args.dir, every=args.every)
+    except KeyboardInterrupt:
+        print(f"watch stopped; the page is {Path(args.dir) / 'report.html'}", file=sys.stderr)
+        return 0
+    print(f"report: {Path(args.dir) / 'report.html'} ({c['done']} done, {c['failed']} failed)")
     return 0
 
 
@@ -138,4 +152,8 @@ def register(sub) -> None:
                                       "from a sweep's or an optimisation's folder")
     r.add_argument("dir", help="the study's output folder (--out of granplate sweep / optimize)")
     r.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
+    r.add_argument("--watch", action="store_true",
+                   help="follow a running study: rewrite the page as designs arrive (it says how many are "
+                        "done, failed and left, and reloads itself), the full report once none is left; Ctrl-C stops")
+    r.add_argument("--every", type=float, default=5.0, help="seconds between two looks with --watch (default 5)")
     r.set_defaults(func=_cmd_report)

@@ -53,6 +53,9 @@ PARETO_CSV = "pareto.csv"
 PARETO_PNG = "pareto.png"
 #: Name of the Optuna study inside the database.
 STUDY_NAME = "granplate"
+#: Least seconds between two writes of trials.csv while the search runs (for
+#: `granplate study report --watch`).
+PROGRESS_EVERY_S = 10.0
 
 
 @dataclass(frozen=True)
@@ -289,13 +292,18 @@ def _search(client, study, opt: Optimization, out: Path, trials: int, progress: 
     done = report.n_before
     bar = progress_bar(trials, done, progress, desc="optimize", unit="trial")
 
+    written = time.monotonic()
+
     def finish(trial, record) -> None:
-        nonlocal done
+        nonlocal done, written
         if not tell(study, opt, trial, record):
             report.n_failed += 1
             bar.write(f"trial {trial.number} failed: {record['status']}", file=sys.stderr)
         done += 1
         bar.update(1)
+        if time.monotonic() - written >= PROGRESS_EVERY_S:
+            write_progress(study, opt, out, trials)
+            written = time.monotonic()
 
     try:
         while done < trials:
@@ -393,6 +401,20 @@ def excluded_trials(study, complete: list) -> list:
 
     front = _get_pareto_front_trials_by_trials(complete, study.directions, consider_constraint=False)
     return sorted((t for t in front if feasible_text(t) == "no"), key=lambda t: t.number)
+
+
+def write_progress(study, opt: Optimization, out: Path, trials: int) -> None:
+    """trials.csv while the search runs: the trials so far, then one row per trial still
+    to come (state WAITING, no parameters: "not run" on the report's page)."""
+    from optuna.trial import TrialState
+
+    all_trials = study.get_trials(deepcopy=False)
+    header, rows = _rows(study, opt, all_trials)
+    n = len(rows)
+    running = sum(1 for t in all_trials if t.state == TrialState.RUNNING)
+    left = max(0, trials - finished(study) - running)
+    rows += [[n + k, "WAITING"] + [None] * (len(header) - 2) for k in range(left)]
+    _write_csv(out / TRIALS_CSV, header, rows)
 
 
 def write_outputs(study, opt: Optimization, out: Path) -> None:

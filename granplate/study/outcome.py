@@ -28,6 +28,7 @@ from granplate.study.targets import ReportTable, parse_report_table
 STUDY_FILE = "study.toml"
 #: A sweep's and an optimisation's table inside the folder.
 SWEEP_TABLE = "results.nc"
+SWEEP_CSV = "results.csv"
 TRIALS_TABLE = "trials.csv"
 
 
@@ -130,26 +131,79 @@ def _metrics_of(summaries: list[dict]) -> tuple[list[str], dict[str, str]]:
     return names, units
 
 
+def _sweep_outcome(folder: Path, doc: dict, names: tuple[str, ...], numbers: list[int],
+                   params: list[dict[str, Any]], table: list[dict[str, Any]], statuses: list[str],
+                   keys: list[str], units: dict[str, str], base: str, fixed: dict, version: str) -> StudyOutcome:
+    """A sweep's outcome from its table's columns: each design's metrics from its record in
+    DIR/designs, else (a folder kept without its records) the table's own values."""
+    summaries = []
+    for k, status, values in zip(keys, statuses, table):
+        s = _summary(folder, k)
+        if not s and status == "ok":  # its record is not here: the table's values
+            s = {m: v for m, v in values.items() if v is not None}
+        summaries.append(s)
+    metrics, metric_units = _metrics_of(summaries)
+    rows = [Row(numbers[i], params[i], {m: summaries[i].get(m) for m in metrics}, statuses[i], keys[i])
+            for i in range(len(keys))]
+    return StudyOutcome(folder, "sweep", base, fixed, names, rows, metrics, {**metric_units, **units},
+                        version=version)
+
+
 def _read_sweep(folder: Path, doc: dict) -> StudyOutcome:
+    import numpy as np
     import xarray as xr
 
     with xr.open_dataset(folder / SWEEP_TABLE) as ds:
         ds = ds.load()
     names = tuple(json.loads(ds.attrs.get("parameters", "[]")))
     keys = [str(k) for k in ds["key"].values]
-    summaries = [_summary(folder, k) for k in keys]
-    metrics, units = _metrics_of(summaries)
-    for n in names:
-        if "units" in ds[n].attrs:
-            units[n] = ds[n].attrs["units"]
-    rows = []
-    for i in range(ds.sizes["design"]):
-        params = {n: ds[n].values[i].item() for n in names}
-        rows.append(Row(int(ds["design"].values[i]), params,
-                        {m: summaries[i].get(m) for m in metrics}, str(ds["status"].values[i]), keys[i]))
-    return StudyOutcome(folder, "sweep", str(ds.attrs.get("base", doc.get("base", ""))),
-                        json.loads(ds.attrs.get("fixed", "{}")), names, rows, metrics, units,
-                        version=str(ds.attrs.get("granplate_version", "")))
+    columns = [v for v in ds.data_vars if v not in names and v not in ("status", "key")]
+    n = ds.sizes["design"]
+    table = [{m: (None if isinstance(v := ds[m].values[i].item(), float) and np.isnan(v) else v)
+              for m in columns} for i in range(n)]
+    units = {n_: ds[n_].attrs["units"] for n_ in names if "units" in ds[n_].attrs}
+    return _sweep_outcome(folder, doc, names, [int(d) for d in ds["design"].values],
+                          [{n_: ds[n_].values[i].item() for n_ in names} for i in range(n)], table,
+                          [str(s) for s in ds["status"].values], keys, units,
+                          str(ds.attrs.get("base", doc.get("base", ""))), json.loads(ds.attrs.get("fixed", "{}")),
+                          str(ds.attrs.get("granplate_version", "")))
+
+
+def _read_sweep_csv(folder: Path, doc: dict) -> StudyOutcome:
+    """A sweep kept as its CSV table alone (results.csv: a worked study in the docs, whose
+    records and results.nc are not kept)."""
+    with open(folder / SWEEP_CSV, newline="") as fh:
+        table = list(csv.reader(fh))
+    if not table:
+        raise ScenarioError(str(folder / SWEEP_CSV), "empty", "no header: rerun granplate sweep")
+    header, body = table[0], table[1:]
+    known = D.metric_units()
+    end = next((j for j, h in enumerate(header) if h in known or h in ("status", "key")), len(header))
+    names = tuple(header[1:end])
+    col = {h: j for j, h in enumerate(header)}
+    metrics = [h for h in header[end:] if h not in ("status", "key")]
+    units = {n: u for n in names if (u := field_unit(n))}
+    return _sweep_outcome(folder, doc, names, [int(r[0]) for r in body],
+                          [{n: _value(r[col[n]]) for n in names} for r in body],
+                          [{m: (_value(r[col[m]]) if r[col[m]] != "" else None) for m in metrics} for r in body],
+                          [r[col["status"]] for r in body], [r[col["key"]] for r in body], units,
+                          str(doc.get("base", "")), dict(doc.get("set", {})), "")
+
+
+def _read_live_sweep(folder: Path, doc: dict) -> StudyOutcome:
+    """A sweep while it runs: its designs from the study file, each design's status from its
+    record in DIR/designs as it arrives ("not run" until then); no table is needed."""
+    from granplate.study.spec import parse_study
+    from granplate.study.table import status_of
+    import granplate as gp
+
+    study = parse_study(doc, folder)
+    keys = [D.design_key(gp.dumps(study.scenario(i))) for i in range(len(study.designs))]
+    records = [D.read_record(folder, k) for k in keys]
+    units = {n: u for n in study.names if (u := field_unit(n))}
+    return _sweep_outcome(folder, doc, tuple(study.names), list(range(len(keys))),
+                          [dict(zip(study.names, d)) for d in study.designs], [{} for _ in keys],
+                          [status_of(r) for r in records], keys, units, study.base_name, dict(study.fixed), "")
 
 
 def _read_trials(folder: Path, doc: dict) -> StudyOutcome:
@@ -182,17 +236,31 @@ def _read_trials(folder: Path, doc: dict) -> StudyOutcome:
                         metrics, units)
 
 
-def read_outcome(folder: str | Path) -> StudyOutcome:
-    """The study in `folder` (an optimisation when it has trials.csv, else a sweep)."""
+def _read_table(folder: Path, doc: dict) -> StudyOutcome:
+    """The study from its table: trials.csv, results.nc or results.csv."""
+    if (folder / TRIALS_TABLE).is_file():
+        return _read_trials(folder, doc)
+    if (folder / SWEEP_TABLE).is_file():
+        return _read_sweep(folder, doc)
+    if (folder / SWEEP_CSV).is_file():
+        return _read_sweep_csv(folder, doc)
+    raise ScenarioError("study folder", str(folder), f"no {SWEEP_TABLE} (granplate sweep) nor "
+                        f"{TRIALS_TABLE} (granplate optimize): run a study into it first")
+
+
+def read_outcome(folder: str | Path, live: bool = False) -> StudyOutcome:
+    """The study in `folder` (an optimisation when it has trials.csv, else a sweep: its
+    results.nc, else its results.csv). live: a sweep read from its study file and the
+    records that have arrived (while it runs: `granplate study report --watch`)."""
     folder = Path(folder)
     doc, text = read_study_file(folder)
-    if (folder / TRIALS_TABLE).is_file():
-        out = _read_trials(folder, doc)
-    elif (folder / SWEEP_TABLE).is_file():
-        out = _read_sweep(folder, doc)
-    else:
-        raise ScenarioError("study folder", str(folder), f"no {SWEEP_TABLE} (granplate sweep) nor "
-                            f"{TRIALS_TABLE} (granplate optimize): run a study into it first")
+    out = None
+    if live and doc and not (folder / TRIALS_TABLE).is_file():
+        try:
+            out = _read_live_sweep(folder, doc)
+        except ScenarioError:  # not a sweep's file (an optimisation's), or its base is elsewhere
+            out = None
+    out = out or _read_table(folder, doc)
     units = D.metric_units()
     out.units = {**units, **out.units}
     out.objectives = {k: str(v) for k, v in (doc.get("objectives") or {}).items()}

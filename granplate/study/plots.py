@@ -98,8 +98,10 @@ def is_grid(out: StudyOutcome, names: tuple[str, ...] | None = None) -> bool:
 
 def tied(out: StudyOutcome, a: str, b: str) -> bool:
     """Whether parameters a and b vary together, one value of b for each value of a and
-    the reverse (a [zip] table)."""
+    the reverse (a [zip] table); never in a sample where each design has values of its own."""
     pairs = {(str(x), str(y)) for x, y in zip(out.values(a), out.values(b))}
+    if len(pairs) == len({str(r.params) for r in out.rows}) > 2:
+        return False  # every design has its own values (a sample): nothing ties them
     return len(pairs) == len({p[0] for p in pairs}) == len({p[1] for p in pairs})
 
 

@@ -1,16 +1,17 @@
-"""The report of a study: one self-contained HTML page, DIR/report.html, with its figures
-as PNG files beside it in DIR/report/ (docs/studies.md).
+"""The report of a study: DIR/report.html, the interactive page (granplate.study.explorer:
+the answer first, views linked, plotly.js in DIR/report_assets/), and for papers
+DIR/report.md with its figures as PNG and PDF files in DIR/report/ (docs/studies.md).
 
-The page holds the study's definition (the study file as run), a table of the designs,
-the [report] targets and conclusion when the study has them, the Pareto front (an
-optimisation, or a sweep with [objectives]), one figure per metric against the
-parameters, heat maps over two grid parameters, the chosen designs (the best for each
-objective, with their assembly, energies and stress, re-run in full when their result
-was not kept) and the failures with their messages. It is rendered by
-granplate.results.document, like the reproduction and verification pages.
+The figures and the Markdown page hold the study's definition (the study file as run), a
+table of the designs, the [report] targets and conclusion when the study has them, the
+Pareto front (an optimisation, or a sweep with [objectives]), one figure per metric
+against the parameters, heat maps over two grid parameters, the chosen designs (the best
+for each objective, with their assembly, energies and stress, re-run in full when their
+result was not kept) and the failures with their messages. The Markdown page is rendered
+by granplate.results.document, like the reproduction and verification pages.
 
     >>> from granplate.study.report import write_report
-    >>> write_report("q0-r2")          # -> q0-r2/report.html, q0-r2/report/*.png
+    >>> write_report("q0-r2")          # -> q0-r2/report.html, report.md, report/*.png|pdf
 """
 from __future__ import annotations
 
@@ -24,7 +25,7 @@ from typing import Any
 import numpy as np
 
 import granplate as gp
-from granplate.results.document import Block, to_html
+from granplate.results.document import Block, to_markdown
 from granplate.study import design as D
 from granplate.study import plots as P
 from granplate.study.outcome import StudyOutcome, read_outcome
@@ -32,6 +33,7 @@ from granplate.study.targets import judge
 
 #: The page and its figure folder inside the study's folder.
 PAGE = "report.html"
+MARKDOWN = "report.md"
 FIGURES = "report"
 #: Beside the figures: the SHA-256 of the inputs they were drawn from (`inputs_hash`); a
 #: report of the same inputs keeps them and draws nothing.
@@ -103,8 +105,10 @@ def best_designs(out: StudyOutcome) -> dict[str, int]:
     best: dict[str, int] = {}
     if out.report.targets and not out.objectives:
         return best
+    rows_ = candidates(out)
     for m, way in directions(out).items():
-        rows = [(v, i) for i in candidates(out) if math.isfinite(v := float(out.metric(m)[i]))]
+        values = out.metric(m)
+        rows = [(v, i) for i in rows_ if math.isfinite(v := float(values[i]))]
         if rows:
             best[m] = (min(rows) if way == "minimize" else max(rows))[1]
     return best
@@ -117,10 +121,30 @@ def pareto_front(out: StudyOutcome) -> list[int]:
     if not names:
         return []
     sign = np.array([1.0 if out.objectives[n] == "minimize" else -1.0 for n in names])
-    rows = [i for i in candidates(out) if all(math.isfinite(out.metric(n)[i]) for n in names)]
-    pts = {i: sign * np.array([out.metric(n)[i] for n in names]) for i in rows}
-    return [i for i in rows if not any(np.all(pts[j] <= pts[i]) and np.any(pts[j] < pts[i])
-                                       for j in rows if j != i)]
+    values = np.array([out.metric(n) for n in names]).T * sign  # (rows, objectives), all minimised
+    rows = [i for i in candidates(out) if np.all(np.isfinite(values[i]))]
+    pts = values[rows]
+    if len(names) == 2:
+        return [rows[k] for k in sorted(_front_2d(pts))]
+    return [i for i, p in zip(rows, pts)
+            if not np.any(np.all(pts <= p, axis=1) & np.any(pts < p, axis=1))]
+
+
+def _front_2d(pts: np.ndarray) -> list[int]:
+    """Indices of the points (n, 2), both minimised, that no other point dominates: one
+    sweep in the order of the first (O(n log n)); equal points are all kept."""
+    order = np.lexsort((pts[:, 1], pts[:, 0]))
+    keep, best_before, k = [], math.inf, 0
+    while k < len(order):
+        group = [order[k]]
+        while k + len(group) < len(order) and pts[order[k + len(group)], 0] == pts[order[k], 0]:
+            group.append(order[k + len(group)])
+        least = pts[group[0], 1]  # the group is sorted by the second objective
+        if least < best_before:
+            keep += [j for j in group if pts[j, 1] == least]
+        best_before = min(best_before, least)
+        k += len(group)
+    return keep
 
 
 # ------------------------------------------------------------------------- figures
@@ -159,12 +183,25 @@ def stored_hash(fig_dir: Path) -> str:
 
 
 def _figure(path: Path, make, fresh: bool) -> Path | None:
-    """The figure at path: kept as it is when `fresh` (drawn from the same inputs) and
-    there, else drawn by make() (None: no such figure) and saved."""
-    if fresh and path.is_file():
+    """The figure at path (PNG, and PDF beside it for papers): kept as it is when `fresh`
+    (drawn from the same inputs) and there, else drawn by make() (None: no such figure)
+    and saved."""
+    if fresh and path.is_file() and path.with_suffix(".pdf").is_file():
         return path
     fig = make()
-    return None if fig is None else _save(fig, path)
+    if fig is None:
+        return None
+    _save_pdf(fig, path.with_suffix(".pdf"))
+    return _save(fig, path)
+
+
+def _save_pdf(fig, path: Path) -> Path:
+    """fig as a PDF (no creation date: the same figure gives the same file)."""
+    from granplate.store import atomic_write
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write(path, lambda tmp: fig.savefig(tmp, format="pdf", metadata={"CreationDate": None}))
+    return path
 
 
 def _save(fig, path: Path) -> Path:
@@ -347,12 +384,13 @@ def _failures(out: StudyOutcome) -> list[Block]:
 
 
 def build_report(out: StudyOutcome, progress: bool = False, fresh: bool = False) -> list[Block]:
-    """The report's blocks; its figures are written to DIR/report/ on the way (fresh: the
-    figures there were drawn from these same inputs and are kept)."""
+    """The report's blocks (the Markdown page); its figures are written to DIR/report/ on
+    the way (fresh: the figures there were drawn from these same inputs and are kept)."""
     fig_dir = out.folder / FIGURES
     if not fresh:
         (fig_dir / INPUTS_FILE).unlink(missing_ok=True)
-        for stale in (*fig_dir.glob("metric-*.png"), *fig_dir.glob("heatmap-*.png"), fig_dir / "pareto-front.png"):
+        for stale in (*fig_dir.glob("metric-*.p[nd][gf]"), *fig_dir.glob("heatmap-*.p[nd][gf]"),
+                      fig_dir / "pareto-front.png", fig_dir / "pareto-front.pdf"):
             stale.unlink(missing_ok=True)  # drawn again below, or no longer part of the study
     n_ok = sum(r.ok for r in out.rows)
     n_failed = sum(not r.ok and r.status != "not run" for r in out.rows)
@@ -363,8 +401,8 @@ def build_report(out: StudyOutcome, progress: bool = False, fresh: bool = False)
                              f"{n_ok} ran, {n_failed} failed, {len(out.rows) - n_ok - n_failed} not run"
                              + (f"; {n_bad} infeasible (constraints)" if out.constraints else "")
                              + f". Made by granplate {gp.__version__} from the records of granplate "
-                             f"{out.version or '?'}; the figures are PNG files in `{FIGURES}/` beside this "
-                             f"page; the whole table is `{'trials.csv' if out.kind == 'optimization' else 'results.csv'}`."
+                             f"{out.version or '?'}; the figures are PNG and PDF files in `{FIGURES}/` beside "
+                             f"this page, the interactive page is `{PAGE}`; the whole table is `{'trials.csv' if out.kind == 'optimization' else 'results.csv'}`."
                              " Metrics are those of the run summary (docs/output.md), with their units; Pa "
                              "are shown in MPa, dimensionless quantities as [-]."))
     blocks += _definition(out)
@@ -439,18 +477,52 @@ def build_report(out: StudyOutcome, progress: bool = False, fresh: bool = False)
     return blocks
 
 
-def write_report(folder: str | Path, progress: bool = False) -> Path:
-    """Write DIR/report.html (figures embedded) and its PNGs in DIR/report/; the page."""
-    from granplate.store import atomic_write
+def chosen_figures(out: StudyOutcome, progress: bool = False) -> dict[int, list[tuple[str, Path]]]:
+    """row -> (caption, PNG) of each chosen design (`chosen_designs`): its figures in
+    DIR/report/, drawn when missing (`design_figures`)."""
+    picks = chosen_designs(out, best_designs(out))
+    return {i: design_figures(out.folder, out.rows[i].key, progress) for i in picks if out.rows[i].key}
 
-    out = read_outcome(folder)
+
+def paper_figures(out: StudyOutcome) -> list[Path]:
+    """The figures for papers in DIR/report/: PNG and PDF, by name."""
+    fig_dir = out.folder / FIGURES
+    return sorted(p for p in fig_dir.glob("*.p[nd][gf]") if p.suffix in (".png", ".pdf")) if fig_dir.is_dir() else []
+
+
+def write_report(folder: str | Path, progress: bool = False, live: bool = False) -> Path:
+    """Write DIR/report.html (the interactive page and DIR/report_assets/), DIR/report.md
+    and the figures in DIR/report/ (PNG, PDF); the page. live: a sweep read from its
+    records (`read_outcome`), for a study that has no table yet."""
+    from granplate.store import atomic_write
+    from granplate.study.explorer import write_explorer
+
+    out = read_outcome(folder, live=live)
     digest = inputs_hash(out)
-    page = out.folder / PAGE
-    fresh = page.is_file() and stored_hash(out.folder / FIGURES) == digest
+    markdown = out.folder / MARKDOWN
+    fresh = markdown.is_file() and stored_hash(out.folder / FIGURES) == digest
     blocks = build_report(out, progress, fresh)
-    text = to_html(blocks, out.folder)
-    if not (fresh and page.read_text() == text):
-        atomic_write(page, lambda tmp: tmp.write_text(text))
+    text = to_markdown(blocks, out.folder)
+    if not (fresh and markdown.read_text() == text):
+        atomic_write(markdown, lambda tmp: tmp.write_text(text))
     if not fresh:
         atomic_write(out.folder / FIGURES / INPUTS_FILE, lambda tmp: tmp.write_text(digest + "\n"))
-    return page
+    return write_explorer(out, chosen_figures(out, progress), paper_figures(out))
+
+
+def kept_figures(out: StudyOutcome) -> dict[int, list[tuple[str, Path]]]:
+    """row -> (caption, PNG) of each chosen design whose figures are already in
+    DIR/report/ (nothing drawn, nothing re-run)."""
+    return {i: [(n, p) for n in ("assembly",) + DESIGN_FIGURES
+                if (p := out.folder / FIGURES / f"design-{out.rows[i].key[:12]}-{n}.png").is_file()]
+            for i in chosen_designs(out, best_designs(out)) if out.rows[i].key}
+
+
+def write_live_page(folder: str | Path, live: bool = True) -> tuple[Path, dict[str, int]]:
+    """The interactive page of a study while it runs: its designs as their records
+    arrive, no figure drawn, reloading itself while designs are left (live; not: the page
+    as it stands, without the reload); (page, counts)."""
+    from granplate.study.explorer import counts, write_explorer
+
+    out = read_outcome(folder, live=True)
+    return write_explorer(out, kept_figures(out), paper_figures(out), live=live), counts(out)
