@@ -217,3 +217,34 @@ def test_a_large_study_opens_in_a_few_seconds(browser, tmp_path):
           f"parallel coordinates in {later:.1f} s more")
     assert seconds < LARGE_LOAD_S
     assert console_errors(browser) == []
+
+
+def test_a_filter_blanks_the_heat_map_cells_of_the_designs_it_hides(browser):
+    """On a sweep's page (the intruder map, whose heat maps follow its front), a range brushed on a
+    parallel-coordinates axis hides designs, and exactly their cells of the heat map go
+    blank; 'show all' brings every cell back."""
+    console_errors(browser)
+    open_page(browser, STUDIES / "intruder-map" / "report.html")
+    wait_for(browser, "var d = document.getElementById('fig-heat'); return d.data && d.data.some("
+                      "function (t) { return t.type === 'heatmap'; }) && document.getElementById('fig-parcoords').data")
+    total = shown_count(browser)
+    blank = ("var d = document.getElementById('fig-heat'); var n = 0; d.data.forEach(function (t) {"
+             " if (t.type !== 'heatmap') { return; } t.z.forEach(function (row, r) { row.forEach(function (v, c) {"
+             " if (v === null && t.customdata[r][c] >= 0) { n += 1; } }); }); }); return n;")
+    hidden_cells = ("var s = new Set(Array.from(document.querySelectorAll('#designs tbody tr')).map(function (tr) {"
+                    " return tr.getAttribute('data-i'); })); var d = document.getElementById('fig-heat'); var n = 0;"
+                    " d.data.forEach(function (t) { if (t.type !== 'heatmap') { return; } t.customdata.forEach("
+                    " function (row) { row.forEach(function (i) { if (i >= 0 && !s.has(String(i))) { n += 1; } }); }); });"
+                    " return n;")
+    assert browser.execute_script(blank) == 0
+    browser.execute_script("var pc = document.getElementById('fig-parcoords'); var v = pc.data[0].dimensions[0].values;"
+                           "var lo = Math.min.apply(null, v), hi = Math.max.apply(null, v);"
+                           "Plotly.restyle(pc, {'dimensions[0].constraintrange': [[lo, lo + 0.5 * (hi - lo)]]});")
+    wait_for(browser, f"return document.getElementById('shown').textContent.indexOf('{total} of') !== 0")
+    n_blank = browser.execute_script(blank)
+    assert n_blank > 0
+    assert n_blank == browser.execute_script(hidden_cells)
+    browser.find_element("id", "reset").click()
+    wait_for(browser, f"return document.getElementById('shown').textContent.indexOf('{total} of') === 0")
+    assert browser.execute_script(blank) == 0
+    assert console_errors(browser) == []

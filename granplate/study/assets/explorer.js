@@ -92,8 +92,30 @@
       });
       if (idx.length) { Plotly.restyle(p.div, { selectedpoints: sel }, idx); }
     });
+    blankHeatCells(s);
     recolourParcoords();
     renderTable();
+  }
+  /* the heat maps show the other views' filters: cells of designs filtered out are left blank */
+  var heatKey = "";
+  function blankHeatCells(s) {
+    var key = s === null ? "" : Array.from(s).sort(function (a, b) { return a - b; }).join(",");
+    if (key === heatKey) { return; }
+    heatKey = key;
+    ["fig-main", "fig-heat"].forEach(function (id) {
+      var div = document.getElementById(id);
+      if (!div || !div.data) { return; }
+      var idx = [], zs = [];
+      div.data.forEach(function (t, k) {
+        if (t.type !== "heatmap" || !t.customdata) { return; }
+        if (!t.zFull) { t.zFull = t.z.map(function (row) { return row.slice(); }); }
+        idx.push(k);
+        zs.push(t.zFull.map(function (row, r) {
+          return row.map(function (v, c) { var i = t.customdata[r][c]; return s !== null && i >= 0 && !s.has(i) ? null : v; });
+        }));
+      });
+      if (idx.length) { Plotly.restyle(div, { z: zs }, idx); }
+    });
   }
   /* the parallel coordinates show the other views' filters: lines filtered out there faint */
   var parcoordsKey = "";
