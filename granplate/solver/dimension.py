@@ -3,8 +3,10 @@ split-off friction, its kinetic energies and its error terms, taken from solver.
 (the plane: model.inputs.Granular, state x, y, theta, vx, vy, omega) or solver.granular3d
 (space: model.inputs.Granular3, state x, y, z, vx, vy, vz, wx, wy, wz), chosen at compile
 time from the type of the granular arrays `g` (as solver.schemes picks a scheme from its
-scratch). The RK4 step (solver.rk4), the schemes and the loop call only these, so the
-same compiled code serves both dimensions and nothing else asks which one it is.
+scratch). The RK4 step (solver.rk4), the schemes and the loop call only these (and
+`plate_friction_held`: whether a held plate-contact friction changes a step's first
+stage), so the same compiled code serves both dimensions and nothing else asks which one
+it is.
 
 Adding a dimension-specific granular function: write it in both modules with the same
 signature and add a stub and its overload here.
@@ -34,6 +36,13 @@ def friction_flow(y, dt, g, cfg, forward):
     raise NotImplementedError("compiled use only")
 
 
+def plate_friction_held(hold, g):
+    """Whether a step holds plate-contact friction that changes its first stage: `hold` in
+    the plane; never in space (no plate contacts there yet), so that the step reuses the
+    derivative at t_n (solver.rk4)."""
+    raise NotImplementedError("compiled use only")
+
+
 def kinetic_energies(y, g):
     """(KE_x, KE_y, KE_z, KE_rot) [J] of the granules (KE_z = 0 in the plane)."""
     raise NotImplementedError("compiled use only")
@@ -59,6 +68,14 @@ def _friction_flow(y, dt, g, cfg, forward):
     if m is not None:
         fn = m.friction_flow
         return lambda y, dt, g, cfg, forward: fn(y, dt, g, cfg, forward)
+
+
+@overload(plate_friction_held, inline="always")
+def _plate_friction_held(hold, g):
+    if _module_of(g) is plane:
+        return lambda hold, g: hold
+    if _module_of(g) is space:
+        return lambda hold, g: False
 
 
 @overload(kinetic_energies, inline="always")
