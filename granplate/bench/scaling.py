@@ -187,11 +187,13 @@ def format_scaling_table(rows: list[dict]) -> str:
         elif "failed" in lm:
             lcols = [lm["failed"]] + ["-"] * 4
         else:
-            lcols = [format_or_dash(lm["dt_s"], ".2e") + ("" if lm["reached"] else " (not reached)"), f"{lm['n_steps']:,}",
-                     format_or_dash(lm["loop_s"], ".3g"), format_or_dash(lm["us_per_contact_step"], ".3f"), format_or_dash(lm["error"], ".1e")]
+            lcols = [format_or_dash(lm["dt_s"], ".2e") + ("" if lm["reached"] else " (not reached)"),
+                     f"{lm['n_steps']:,}", format_or_dash(lm["loop_s"], ".3g"),
+                     format_or_dash(lm["us_per_contact_step"], ".3f"), format_or_dash(lm["error"], ".1e")]
         lines.append(f"| {r['granules']:,} | {r['contacts']:,} | {r['mu']:g} | {r['setup_s']:.3f} | {r['n_steps']:,} "
                      f"| {r['loop_s']:.3g} | {r['us_per_step']:.1f} | {r['us_per_contact_step']:.3f} "
-                     f"| {r['rss_peak_mib']:.0f} | {format_or_dash(r.get('error'), '.1e')} | " + " | ".join(lcols) + " |")
+                     f"| {r['rss_peak_mib']:.0f} | {format_or_dash(r.get('error'), '.1e')} | "
+                     + " | ".join(lcols) + " |")
     return "\n".join(lines)
 
 

@@ -23,8 +23,8 @@ import dataclasses
 import sys
 
 from granplate.bench.scaling import (
-    LAMMPS_DT_START, LAMMPS_HALVINGS, RADIUS, REFERENCE_DT, SPEED, T_END, FRICTIONS, format_or_dash, per_contact_step_us,
-    run_in_subprocess,
+    FRICTIONS, LAMMPS_DT_START, LAMMPS_HALVINGS, RADIUS, REFERENCE_DT, SPEED, T_END, format_or_dash,
+    per_contact_step_us, run_in_subprocess,
 )
 
 #: FCC packings (cells along x, y, z) of the table: 12, 108, 1,008, 2,916 and 10,192 spheres.
@@ -95,11 +95,10 @@ def _ours_worker(spec: dict) -> dict:
     t0 = time.perf_counter()
     model = build_model(s)
     setup = time.perf_counter() - t0
-    c0 = time.process_time()
     ds = simulate(s, model=model, progress=False)
-    cpu = time.process_time() - c0
     out = {"granules": len(s.granules), "contacts": int(len(model.pairs)), "setup_s": setup,
-           "n_steps": int(ds.attrs["n_steps"]), "loop_s": float(ds.attrs["loop_time_s"]), "run_cpu_s": cpu,
+           "n_steps": int(ds.attrs["n_steps"]), "loop_s": float(ds.attrs["loop_time_s"]),
+           "loop_cpu_s": float(ds.attrs["loop_cpu_s"]),
            "rss_peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
            "energy_residual": float(np.abs(ds.energy_residual.values).max())}
     if spec["mu"] == 0.0:
@@ -113,6 +112,7 @@ def _lammps_worker(spec: dict) -> dict:
     """Runs in a fresh subprocess: LAMMPS (run_hertz_3d) on the frictionless packing, steps
     halved from LAMMPS_DT_START until its error is at most spec["error"]."""
     import resource
+    import time
 
     from granplate.verification import lammps as L
 
@@ -123,10 +123,12 @@ def _lammps_worker(spec: dict) -> dict:
     tried = []
     dt = LAMMPS_DT_START
     for _ in range(LAMMPS_HALVINGS + 1):
+        c0 = time.process_time()
         res = L.run_hertz_3d(s, dt, spec["t_end"])
+        cpu = time.process_time() - c0
         err = max_error_3d(tuple(res[k][-1] for k in ("vx", "vy", "vz")), spec["reference"])
         tried.append({"dt_s": dt, "n_steps": res["n_steps"], "setup_s": res["setup_time_s"],
-                      "loop_s": res["loop_time_s"], "error": err})
+                      "loop_s": res["loop_time_s"], "cpu_s": cpu, "error": err})
         if err <= spec["error"]:
             break
         dt /= 2.0
@@ -147,12 +149,15 @@ def run_scaling_space(sizes=SIZES, frictions=FRICTIONS, t_end: float = T_END, sc
             if "failed" not in row:
                 row["us_per_step"] = 1e6 * row["loop_s"] / row["n_steps"]
                 row["us_per_contact_step"] = per_contact_step_us(row["loop_s"], row["n_steps"], row["contacts"])
+                row["cpu_us_per_contact_step"] = per_contact_step_us(row["loop_cpu_s"], row["n_steps"],
+                                                                     row["contacts"])
             if lammps and mu == 0.0 and "error" in row:
                 log(f"scaling in space: {row['granules']} spheres, LAMMPS ...")
                 lm = run_in_subprocess("scaling_space", "_lammps_worker",
                                        {**spec, "error": row["error"], "reference": row["reference"]})
                 if "loop_s" in lm:
                     lm["us_per_contact_step"] = per_contact_step_us(lm["loop_s"], lm["n_steps"], row["contacts"])
+                    lm["cpu_us_per_contact_step"] = per_contact_step_us(lm["cpu_s"], lm["n_steps"], row["contacts"])
                 row["lammps"] = lm
             row.pop("reference", None)
             rows.append(row)
@@ -162,25 +167,28 @@ def run_scaling_space(sizes=SIZES, frictions=FRICTIONS, t_end: float = T_END, sc
 def format_space_table(rows: list[dict]) -> str:
     """The 3D scaling table as Markdown (LAMMPS columns on the frictionless rows)."""
     lines = ["| spheres | cells | contacts | mu | set-up [s] | steps | loop [s] | us/step | us/(contact step) "
-             "| peak [MiB] | error | LAMMPS dt [s] | LAMMPS steps | LAMMPS loop [s] "
-             "| LAMMPS us/(contact step) | LAMMPS error |",
-             "|" + " ---: |" * 16]
+             "| CPU us/(contact step) | peak [MiB] | error | LAMMPS dt [s] | LAMMPS steps | LAMMPS loop [s] "
+             "| LAMMPS us/(contact step) | LAMMPS CPU us/(contact step) | LAMMPS error |",
+             "|" + " ---: |" * 18]
     for r in rows:
         cells = "x".join(str(c) for c in r["cells"])
         if "failed" in r:
-            lines.append(f"| {sphere_count(r['cells']):,} | {cells} | | {r['mu']:g} | {r['failed']} |" + " |" * 11)
+            lines.append(f"| {sphere_count(r['cells']):,} | {cells} | | {r['mu']:g} | {r['failed']} |" + " |" * 13)
             continue
         lm = r.get("lammps") or {}
         if "skipped" in lm or not lm:
-            lcols = ["-"] * 5
+            lcols = ["-"] * 6
         elif "failed" in lm:
-            lcols = [lm["failed"]] + ["-"] * 4
+            lcols = [lm["failed"]] + ["-"] * 5
         else:
-            lcols = [format_or_dash(lm["dt_s"], ".2e") + ("" if lm["reached"] else " (not reached)"), f"{lm['n_steps']:,}",
-                     format_or_dash(lm["loop_s"], ".3g"), format_or_dash(lm["us_per_contact_step"], ".3f"), format_or_dash(lm["error"], ".1e")]
+            lcols = [format_or_dash(lm["dt_s"], ".2e") + ("" if lm["reached"] else " (not reached)"),
+                     f"{lm['n_steps']:,}", format_or_dash(lm["loop_s"], ".3g"),
+                     format_or_dash(lm["us_per_contact_step"], ".3f"),
+                     format_or_dash(lm["cpu_us_per_contact_step"], ".3f"), format_or_dash(lm["error"], ".1e")]
         lines.append(f"| {r['granules']:,} | {cells} | {r['contacts']:,} | {r['mu']:g} | {r['setup_s']:.3f} "
                      f"| {r['n_steps']:,} | {r['loop_s']:.3g} | {r['us_per_step']:.1f} "
-                     f"| {r['us_per_contact_step']:.3f} | {r['rss_peak_mib']:.0f} | {format_or_dash(r.get('error'), '.1e')} | "
+                     f"| {r['us_per_contact_step']:.3f} | {r['cpu_us_per_contact_step']:.3f} "
+                     f"| {r['rss_peak_mib']:.0f} | {format_or_dash(r.get('error'), '.1e')} | "
                      + " | ".join(lcols) + " |")
     return "\n".join(lines)
 
