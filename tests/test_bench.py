@@ -109,6 +109,74 @@ def test_scaling_sizes_are_checked(capsys):
     assert "--t-end 0.0: must be > 0" in capsys.readouterr().err
 
 
+def test_scaling_in_space_rows_are_measured_and_documented(tmp_path):
+    """`bench --scaling --dimension 3` on one FCC cell (4 mutually touching spheres, 6 pairs):
+    one row per friction with `dimension` 3 and every documented key, a small error against
+    the RK4 reference, and LAMMPS's 3D run reaching the same accuracy where it is installed."""
+    from granplate.bench import scaling
+    from granplate.verification import lammps as L
+
+    out = tmp_path / "scaling3.json"
+    assert main(["bench", "--scaling", "--dimension", "3", "--sizes", "1x1x1", "--t-end", "4e-6",
+                 "--json", str(out)]) == 0
+    rows = json.loads(out.read_text())
+    assert [r["mu"] for r in rows] == list(scaling.FRICTIONS)
+    text = (ROOT / "docs" / "benchmarks.md").read_text().split("### Scaling in space JSON")[1].split("\n## ")[0]
+    documented = {k for line in text.splitlines() if line.startswith("| `")
+                  for k in re.findall(r"`([a-z_0-9]+)`", line.split("|")[1])}
+    lammps_keys = set(re.findall(r"`([a-z_0-9]+)`", next(line for line in text.splitlines()
+                                                        if line.startswith("| `lammps`"))))
+    for r in rows:
+        assert set(r) - {"lammps"} <= documented, set(r) - documented
+        assert r["dimension"] == 3 and r["cells"] == [1, 1, 1]
+        assert r["granules"] == 4 and r["contacts"] == 6 and r["n_steps"] > 0
+        assert r["us_per_contact_step"] == pytest.approx(1e6 * r["loop_s"] / (r["n_steps"] * 6))
+        assert r["cpu_us_per_contact_step"] == pytest.approx(1e6 * r["loop_cpu_s"] / (r["n_steps"] * 6))
+        assert r["energy_residual"] < 1e-6
+    assert 0.0 < rows[0]["error"] < 1e-5
+    lm = rows[0]["lammps"]
+    if L.unavailable():
+        assert "skipped" in lm
+    else:
+        assert set(lm) <= lammps_keys, set(lm) - lammps_keys
+        assert lm["reached"] and lm["error"] <= rows[0]["error"]
+        assert lm["cpu_us_per_contact_step"] == pytest.approx(1e6 * lm["cpu_s"] / (lm["n_steps"] * 6))
+
+
+def test_scaling_in_space_options_are_checked(capsys):
+    """In space --sizes takes FCC cells NXxNYxNZ; --dimension is 2 or 3; --scheme is any
+    registered scheme (model.inputs.SCHEME_NAMES), another a user error naming them all."""
+    from granplate.bench import scaling, scaling_space
+    from granplate.model.inputs import SCHEME_NAMES
+
+    assert scaling_space.sphere_count((14, 14, 13)) == 10192
+    assert [scaling_space.sphere_count(c) for c in scaling_space.SIZES] == [12, 108, 1008, 2916, 10192]
+    assert main(["bench", "--scaling", "--dimension", "3", "--sizes", "4x3"]) == 2
+    assert "--sizes item '4x3': allowed NXxNYxNZ" in capsys.readouterr().err
+    assert main(["bench", "--scaling", "--dimension", "4"]) == 2
+    assert "--dimension 4: allowed 2" in capsys.readouterr().err
+    assert all(scaling.check_scheme(name) is None for name in SCHEME_NAMES)
+    assert main(["bench", "--scaling", "--dimension", "3", "--scheme", "no-such"]) == 2
+    assert f"--scheme 'no-such': allowed {', '.join(SCHEME_NAMES)}" in capsys.readouterr().err
+
+
+def test_launched_fcc_is_a_touching_fcc_packing():
+    """The 3D table's packing: 4 spheres per cell, 12 touching neighbours inside, no walls,
+    the first lattice plane (x smallest) moving at 1 m/s and the rest at rest."""
+    import numpy as np
+
+    from granplate.bench.scaling_space import launched_fcc
+    from granplate.model.arrays import build_model
+
+    s = launched_fcc((3, 3, 3), mu=0.099)
+    assert len(s.granules) == 108 and s.walls == () and s.dimension == 3 and s.contact.mu == 0.099
+    x = np.array([g.x for g in s.granules])
+    moving = np.array([g.vx for g in s.granules]) == 1.0
+    assert moving.sum() == 18 and np.allclose(x[moving], x.min())
+    m = build_model(s)
+    assert np.bincount(m.pairs.ravel(), minlength=108).max() == 12
+
+
 def test_bench_friction_table_runs_every_case(capsys, monkeypatch, tmp_path):
     """`granplate bench --friction --t-end 2e-7` (on a 4 x 6 packing) prints a row per case
     and, where LAMMPS is installed, the loop time, steps, cost per contact and step (loop /

@@ -12,7 +12,9 @@ import pytest
 import granplate as gp
 from granplate.model.arrays import build_model
 from granplate.model.inputs import Granular3, no_history
-from granplate.physics.space import arm_torque_3d, friction_vector_3d, slip_velocity_3d
+from granplate.physics.space import (
+    arm_torque_3d, friction_along_slip, friction_vector_3d, pair_contact_3d, pair_overlap_3d, slip_velocity_3d,
+)
 from granplate.solver import granular as plane, granular3d as space
 
 
@@ -108,3 +110,41 @@ def test_kinetic_energies_in_space():
     y = np.array([[0, 0, 0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0]])
     kx, ky, kz, kr = space.kinetic_energies(y, np.array([2.0]), np.array([0.5]))
     assert (kx, ky, kz, kr) == (1.0, 4.0, 9.0, 0.25 * (16 + 25 + 36))
+
+
+def test_pair_contact_is_the_overlap_and_normal_where_spheres_touch():
+    """pair_contact_3d: pair_overlap_3d's overlap exactly and its normal to an ulp where
+    the spheres touch; delta <= 0 and a zero normal where they do not (-inf when the
+    squared distance already says so); friction_along_slip is friction_vector_3d."""
+    rng = np.random.default_rng(11)
+    for _ in range(200):
+        si, sj = rng.normal(size=3) * 1e-3, rng.normal(size=3) * 1e-3
+        ri, rj = rng.uniform(0.5e-3, 1.5e-3, 2)
+        got = pair_contact_3d(*si, ri, *sj, rj)
+        want = pair_overlap_3d(*si, ri, *sj, rj)
+        if want[0] > 0.0:
+            assert got[0] == want[0]
+            np.testing.assert_allclose(got[1:], want[1:], rtol=0, atol=2 * np.finfo(float).eps)
+        else:
+            assert got[0] <= 0.0 and got[1:] == (0.0, 0.0, 0.0)
+    assert pair_contact_3d(0.0, 0.0, 0.0, 1.0, 3.0, 0.0, 0.0, 1.0)[0] == -math.inf
+    assert pair_contact_3d(0.0, 0.0, 0.0, 1.0, 2.0, 0.0, 0.0, 1.0) == (0.0, 0.0, 0.0, 0.0)
+    vs = (0.3, -0.4, 1.2)
+    assert friction_along_slip(2.0, float(np.linalg.norm(vs)), *vs) == pytest.approx(friction_vector_3d(2.0, *vs))
+    assert friction_along_slip(2.0, 0.0, 0.0, 0.0, 0.0) == (0.0, 0.0, 0.0)
+
+
+def test_friction_is_split_off_in_space_only_where_a_contact_has_friction():
+    """model.space: a 3D scenario without friction at any contact runs RK4 unsplit (the
+    friction half steps would change nothing); with contact.mu or a pair override it splits."""
+    import dataclasses
+
+    from granplate.bench.scaling_space import launched_fcc
+    from granplate.setup.scenario import PairCoefficients
+
+    s = launched_fcc((1, 1, 1))
+    assert not build_model(s).config.split_friction
+    assert build_model(launched_fcc((1, 1, 1), mu=0.099)).config.split_friction
+    s = dataclasses.replace(s, contact=dataclasses.replace(
+        s.contact, pairs=(PairCoefficients(materials=("steel", "steel"), mu=0.2),)))
+    assert build_model(s).config.split_friction

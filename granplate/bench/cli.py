@@ -66,9 +66,13 @@ def register(subparsers) -> None:
                    help="instead: the granule-scaling table (10 to 10,000 granules of a launched hexagonal "
                         "packing, with and without friction: set-up, steps, loop time, us per contact and "
                         "step, peak memory; LAMMPS's time to the same accuracy where it is installed)")
-    b.add_argument("--sizes", help="with --scaling: comma-separated COLUMNSxROWS (default 4x3,8x13,32x32,56x54,100x100)")
-    b.add_argument("--scheme", choices=("implicit", "paper", "verlet"), default=None,
-                   help="with --scaling: solver.scheme of granplate's runs (default implicit)")
+    b.add_argument("--dimension", type=int, default=None,
+                   help="with --scaling: 2 (default: the plane, a hexagonal packing) or 3 (space: a launched "
+                        "FCC packing of 12 to 10,192 spheres, LAMMPS's 3D run side by side)")
+    b.add_argument("--sizes", help="with --scaling: comma-separated COLUMNSxROWS (default 4x3,8x13,32x32,56x54,100x100); "
+                                   "with --dimension 3 FCC cells NXxNYxNZ (default 3x1x1,3x3x3,6x6x7,9x9x9,14x14x13)")
+    b.add_argument("--scheme", default=None,
+                   help="with --scaling: solver.scheme of granplate's runs, any registered scheme (default implicit)")
     b.add_argument("--no-lammps", dest="no_lammps", action="store_true",
                    help="with --scaling or --friction: leave LAMMPS out even where it is installed")
     b.add_argument("--friction", action="store_true",

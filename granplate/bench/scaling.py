@@ -122,10 +122,11 @@ def _lammps_worker(spec: dict) -> dict:
             "rss_peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0}
 
 
-def _subprocess(worker: str, spec: dict) -> dict:
-    """Run `worker` (a function of this module) on `spec` in a fresh Python process."""
-    code = ("import sys, json; from granplate.bench import scaling; "
-            f"print('@@RESULT ' + json.dumps(scaling.{worker}(json.loads(sys.stdin.read()))))")
+def run_in_subprocess(module: str, worker: str, spec: dict) -> dict:
+    """Run `worker` (a function of granplate.bench.`module`) on `spec` in a fresh Python
+    process; its result, or {"failed": the last line of its error}."""
+    code = (f"import sys, json; from granplate.bench import {module}; "
+            f"print('@@RESULT ' + json.dumps({module}.{worker}(json.loads(sys.stdin.read()))))")
     p = subprocess.run([sys.executable, "-c", code], input=json.dumps(spec), capture_output=True, text=True,
                        env=dict(os.environ))
     for line in p.stdout.splitlines():
@@ -147,14 +148,15 @@ def run_scaling(sizes=SIZES, frictions=FRICTIONS, t_end: float = T_END, scheme: 
         for mu in frictions:
             log(f"scaling: {granule_count(columns, rows_)} granules, mu = {mu:g} ...")
             spec = {"columns": columns, "rows": rows_, "mu": mu, "t_end": t_end, "scheme": scheme}
-            row = {"columns": columns, "rows": rows_, "mu": mu, "scheme": scheme, "t_end_s": t_end,
-                   **_subprocess("_ours_worker", spec)}
+            row = {"dimension": 2, "columns": columns, "rows": rows_, "mu": mu, "scheme": scheme, "t_end_s": t_end,
+                   **run_in_subprocess("scaling", "_ours_worker", spec)}
             if "failed" not in row:
                 row["us_per_step"] = 1e6 * row["loop_s"] / row["n_steps"]
                 row["us_per_contact_step"] = per_contact_step_us(row["loop_s"], row["n_steps"], row["contacts"])
             if lammps and mu == 0.0 and "error" in row:
                 log(f"scaling: {row['granules']} granules, LAMMPS ...")
-                lm = _subprocess("_lammps_worker", {**spec, "error": row["error"], "reference": row["reference"]})
+                lm = run_in_subprocess("scaling", "_lammps_worker",
+                                       {**spec, "error": row["error"], "reference": row["reference"]})
                 if "loop_s" in lm:
                     lm["us_per_contact_step"] = per_contact_step_us(lm["loop_s"], lm["n_steps"], row["contacts"])
                 row["lammps"] = lm
@@ -163,7 +165,8 @@ def run_scaling(sizes=SIZES, frictions=FRICTIONS, t_end: float = T_END, scheme: 
     return rows
 
 
-def _g(v, fmt: str) -> str:
+def format_or_dash(v, fmt: str) -> str:
+    """format(v, fmt), or '-' for None and NaN."""
     return "-" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, fmt)
 
 
@@ -184,11 +187,13 @@ def format_scaling_table(rows: list[dict]) -> str:
         elif "failed" in lm:
             lcols = [lm["failed"]] + ["-"] * 4
         else:
-            lcols = [_g(lm["dt_s"], ".2e") + ("" if lm["reached"] else " (not reached)"), f"{lm['n_steps']:,}",
-                     _g(lm["loop_s"], ".3g"), _g(lm["us_per_contact_step"], ".3f"), _g(lm["error"], ".1e")]
+            lcols = [format_or_dash(lm["dt_s"], ".2e") + ("" if lm["reached"] else " (not reached)"),
+                     f"{lm['n_steps']:,}", format_or_dash(lm["loop_s"], ".3g"),
+                     format_or_dash(lm["us_per_contact_step"], ".3f"), format_or_dash(lm["error"], ".1e")]
         lines.append(f"| {r['granules']:,} | {r['contacts']:,} | {r['mu']:g} | {r['setup_s']:.3f} | {r['n_steps']:,} "
                      f"| {r['loop_s']:.3g} | {r['us_per_step']:.1f} | {r['us_per_contact_step']:.3f} "
-                     f"| {r['rss_peak_mib']:.0f} | {_g(r.get('error'), '.1e')} | " + " | ".join(lcols) + " |")
+                     f"| {r['rss_peak_mib']:.0f} | {format_or_dash(r.get('error'), '.1e')} | "
+                     + " | ".join(lcols) + " |")
     return "\n".join(lines)
 
 
@@ -197,19 +202,40 @@ def parse_sizes(text: str) -> list[tuple[int, int]]:
     return parse_pairs(text, "--sizes", "COLUMNSxROWS", "32x32", min_second=2)
 
 
+def check_scheme(name: str) -> str | None:
+    """The error line for a --scheme that is not a registered scheme, or None."""
+    from granplate.model.inputs import SCHEME_NAMES
+
+    if name not in SCHEME_NAMES:
+        return f"--scheme {name!r}: allowed {', '.join(SCHEME_NAMES)}"
+    return None
+
+
 def main(args) -> int:
-    """`granplate bench --scaling [--sizes 4x3,32x32] [--t-end T] [--scheme S] [--no-lammps] [--json FILE]`."""
+    """`granplate bench --scaling [--dimension 2|3] [--sizes 4x3,32x32] [--t-end T] [--scheme S]
+    [--no-lammps] [--json FILE]` (--dimension 3: bench.scaling_space, sizes NXxNYxNZ)."""
+    t_end = T_END if getattr(args, "t_end", None) is None else float(args.t_end)
+    if not t_end > 0.0:
+        print(f"granplate: error: --t-end {t_end}: must be > 0 [s]", file=sys.stderr)
+        return 2
+    scheme = getattr(args, "scheme", None) or "implicit"
+    if check_scheme(scheme):
+        print(f"granplate: error: {check_scheme(scheme)}", file=sys.stderr)
+        return 2
+    dimension = getattr(args, "dimension", None) or 2
+    if dimension not in (2, 3):
+        print(f"granplate: error: --dimension {dimension}: allowed 2 (the plane) or 3 (space)", file=sys.stderr)
+        return 2
+    if dimension == 3:
+        from granplate.bench import scaling_space
+
+        return scaling_space.main(args, t_end, scheme)
     try:
         sizes = parse_sizes(args.sizes) if getattr(args, "sizes", None) else SIZES
     except ValueError as err:
         print(f"granplate: error: {err}", file=sys.stderr)
         return 2
-    t_end = T_END if getattr(args, "t_end", None) is None else float(args.t_end)
-    if not t_end > 0.0:
-        print(f"granplate: error: --t-end {t_end}: must be > 0 [s]", file=sys.stderr)
-        return 2
-    rows = run_scaling(sizes, t_end=t_end, scheme=getattr(args, "scheme", None) or "implicit",
-                       lammps=not getattr(args, "no_lammps", False))
+    rows = run_scaling(sizes, t_end=t_end, scheme=scheme, lammps=not getattr(args, "no_lammps", False))
     print()
     print(format_scaling_table(rows))
     if getattr(args, "json", None):

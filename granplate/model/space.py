@@ -83,6 +83,16 @@ def force_floor_3d(s: Scenario, mass: np.ndarray, r: np.ndarray, shares: np.ndar
     return FORCE_FLOOR_FRACTION * (shock + float(momentum) / out_dt)
 
 
+def frictionless(s: Scenario) -> bool:
+    """Whether no granule-granule or granule-wall contact of the scenario can have friction
+    (contact.mu and every [[contact.pairs]] override between its materials zero): its
+    friction need not be split off the RK4 step (solver.rk4: the step then reuses the
+    derivative at t_n as its first stage, one force evaluation fewer)."""
+    names = {g.material for g in s.granules}
+    partners = names | {w.material for w in s.walls}
+    return all(s.contact.for_pair(a, b)[1] == 0.0 for a in names for b in partners)
+
+
 def build_space_model(s: Scenario):
     """The Model of a validated, resolved scenario of dimension 3."""
     from granplate.model.arrays import (
@@ -109,7 +119,8 @@ def build_space_model(s: Scenario):
     )
     cfg = loop_config(s, np.zeros(len(r)), np.zeros(len(r)), r, mass,
                       floor=force_floor_3d(s, mass, r, shares, s.time.output_interval))._replace(
-        q0=float(s.load.force) if s.load.kind == "force" else 0.0, dimension=3)
+        q0=float(s.load.force) if s.load.kind == "force" else 0.0, dimension=3,
+        split_friction=s.solver.granular_friction == "split" and not frictionless(s))
     plate_arrays = PlateArrays(omega2=np.zeros(0), phi_d=np.zeros((0, 0)), load_modal=np.zeros(0))
     return Model(
         scenario=s, labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),

@@ -46,6 +46,27 @@ def pair_apart_3d(xi, yi, zi, ri, xj, yj, zj, rj) -> bool:
 
 
 @njit(cache=True)
+def pair_contact_3d(xi, yi, zi, ri, xj, yj, zj, rj):
+    """(delta, nx, ny, nz): `pair_overlap_3d` of spheres i, j where they touch (delta > 0),
+    the normal scaled by one reciprocal of the distance; where they do not, delta <= 0 and
+    a zero normal, without the square root where the squared distance says they are
+    certainly apart (`pair_apart_3d`: delta = -inf). The pair loops' one test per listed pair."""
+    dx = xj - xi
+    dy = yj - yi
+    dz = zj - zi
+    d2 = dx * dx + dy * dy + dz * dz
+    reach = ri + rj
+    if d2 > reach * reach * (1.0 + APART_MARGIN):
+        return -math.inf, 0.0, 0.0, 0.0
+    dist = math.sqrt(d2)
+    delta = reach - dist
+    if delta <= 0.0:
+        return delta, 0.0, 0.0, 0.0
+    inv = 1.0 / dist
+    return delta, dx * inv, dy * inv, dz * inv
+
+
+@njit(cache=True)
 def wall_overlap_3d(x, y, z, r, nx, ny, nz, offset) -> float:
     """Overlap of a sphere with the plane wall {s.n = offset} (n: its outward unit normal) [m]."""
     return x * nx + y * ny + z * nz + r - offset
@@ -73,7 +94,13 @@ def slip_velocity_3d(vx, vy, vz, sx, sy, sz, nx, ny, nz):
 def friction_vector_3d(f_mag, vsx, vsy, vsz):
     """The friction force on granule i [N]: magnitude f_mag = mu |N| tanh(k_s |v_s|)
     (contact.friction_magnitude with |v_s|) along -v_s / |v_s|; zero without slip."""
-    speed = math.sqrt(vsx * vsx + vsy * vsy + vsz * vsz)
+    return friction_along_slip(f_mag, math.sqrt(vsx * vsx + vsy * vsy + vsz * vsz), vsx, vsy, vsz)
+
+
+@njit(cache=True)
+def friction_along_slip(f_mag, speed, vsx, vsy, vsz):
+    """`friction_vector_3d` with the slip speed |v_s| [m/s] already known (no second square
+    root): f_mag along -v_s / speed [N]; zero without slip."""
     if speed == 0.0:
         return 0.0, 0.0, 0.0
     k = -f_mag / speed

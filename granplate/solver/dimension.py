@@ -4,8 +4,9 @@ terms, taken from solver.granular (the plane: model.inputs.Granular, state x, y,
 vx, vy, omega) or solver.granular3d (space: model.inputs.Granular3, state x, y, z, vx,
 vy, vz, wx, wy, wz), chosen at compile time from the type of the granular arrays `g`
 (as solver.schemes picks a scheme from its scratch). The RK4 step (solver.rk4), the
-schemes and the loop call only these, so the same compiled code serves both dimensions
-and nothing else asks which one it is.
+schemes and the loop call only these (and `plate_friction_held`: whether a held
+plate-contact friction changes a step's first stage), so the same compiled code serves
+both dimensions and nothing else asks which one it is.
 
 Adding a dimension-specific granular function: write it in both modules with the same
 signature and add a stub and its overload here.
@@ -38,6 +39,13 @@ def friction_flow(y, dt, g, cfg, forward):
 def normal_forces(t, y, g, cfg, acc, fdamp, fload):
     """The velocity-Verlet force pass: shock and normal forces alone, the damping force and
     load of each granule apart (solver.granular.normal_forces)."""
+    raise NotImplementedError("compiled use only")
+
+
+def plate_friction_held(hold, g):
+    """Whether a step holds plate-contact friction that changes its first stage: `hold` in
+    the plane; never in space (no plate contacts there yet), so that the step reuses the
+    derivative at t_n (solver.rk4)."""
     raise NotImplementedError("compiled use only")
 
 
@@ -74,6 +82,14 @@ def _normal_forces(t, y, g, cfg, acc, fdamp, fload):
     if m is not None:
         fn = m.normal_forces
         return lambda t, y, g, cfg, acc, fdamp, fload: fn(t, y, g, cfg, acc, fdamp, fload)
+
+
+@overload(plate_friction_held, inline="always")
+def _plate_friction_held(hold, g):
+    if _module_of(g) is plane:
+        return lambda hold, g: hold
+    if _module_of(g) is space:
+        return lambda hold, g: False
 
 
 @overload(kinetic_energies, inline="always")

@@ -14,8 +14,7 @@ from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm, friction_ma
 from granplate.physics.laws import normal_law_force, normal_law_response
 from granplate.physics.shock import time_profile
 from granplate.physics.space import (
-    arm_torque_3d, friction_vector_3d, normal_rate_3d, pair_apart_3d, pair_overlap_3d, slip_velocity_3d,
-    wall_overlap_3d,
+    arm_torque_3d, friction_along_slip, normal_rate_3d, pair_contact_3d, slip_velocity_3d, wall_overlap_3d,
 )
 from granplate.solver.granular import ForceSums, friction_impulse, slip_relaxation_rate
 
@@ -91,43 +90,49 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
                     f = amp * g.shock_force[i, c]
                     dy[i, VX + c] += f
                     p_shock += f * y[i, VX + c]
+    half_shrink = 0.5 * cfg.arm_shrink
     for p in range(g.pair_ij.shape[0]):
         i = g.pair_ij[p, 0]
         j = g.pair_ij[p, 1]
         ri = g.radius[i]
         rj = g.radius[j]
+        delta, nx, ny, nz = pair_contact_3d(y[i, X], y[i, Y], y[i, Z], ri, y[j, X], y[j, Y], y[j, Z], rj)
         if record:
-            g.pair_hist[p, HIST_END] = 0.0
-        if pair_apart_3d(y[i, X], y[i, Y], y[i, Z], ri, y[j, X], y[j, Y], y[j, Z], rj):
-            continue
-        delta, nx, ny, nz = pair_overlap_3d(y[i, X], y[i, Y], y[i, Z], ri, y[j, X], y[j, Y], y[j, Z], rj)
+            g.pair_hist[p, HIST_END] = max(delta, 0.0)
         if delta <= 0.0:
             continue
-        if record:
-            g.pair_hist[p, HIST_END] = delta
-        if delta > ovl * min(ri, rj):
-            ovl = delta / min(ri, rj)
+        r_min = min(ri, rj)
+        if delta > ovl * r_min:
+            ovl = delta / r_min
             ovl_i = i
             ovl_j = j
         c = g.pair_coef[p]
-        ai = contact_arm(ri, delta, 0.5 * cfg.arm_shrink)
-        aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
-        ddot, vsx, vsy, vsz = pair_slip(y, i, j, nx, ny, nz, ai, aj)
-        n, pv, ep, wp = normal_law_response(delta, ddot, c, g.pair_hist[p, HIST_MAX], cfg.clip)
-        dy[i, VX] -= n * nx
-        dy[i, VY] -= n * ny
-        dy[i, VZ] -= n * nz
-        dy[j, VX] += n * nx
-        dy[j, VY] += n * ny
-        dy[j, VZ] += n * nz
+        rvx = y[i, VX] - y[j, VX]
+        rvy = y[i, VY] - y[j, VY]
+        rvz = y[i, VZ] - y[j, VZ]
+        n, pv, ep, wp = normal_law_response(delta, normal_rate_3d(rvx, rvy, rvz, nx, ny, nz), c,
+                                            g.pair_hist[p, HIST_MAX], cfg.clip)
+        fnx = n * nx
+        fny = n * ny
+        fnz = n * nz
+        dy[i, VX] -= fnx
+        dy[i, VY] -= fny
+        dy[i, VZ] -= fnz
+        dy[j, VX] += fnx
+        dy[j, VY] += fny
+        dy[j, VZ] += fnz
         p_visc += pv
         e_pot += ep
         w_plastic += wp
         if split or c[COEF_MU] == 0.0:
             continue
+        ai = contact_arm(ri, delta, half_shrink)
+        aj = contact_arm(rj, delta, half_shrink)
+        vsx, vsy, vsz = slip_velocity_3d(rvx, rvy, rvz, ai * y[i, WX] + aj * y[j, WX], ai * y[i, WY] + aj * y[j, WY],
+                                         ai * y[i, WZ] + aj * y[j, WZ], nx, ny, nz)
         speed = _speed(vsx, vsy, vsz)
         f_mag = friction_magnitude(n, speed, c[COEF_MU], c[COEF_KS])
-        fx, fy, fz = friction_vector_3d(f_mag, vsx, vsy, vsz)
+        fx, fy, fz = friction_along_slip(f_mag, speed, vsx, vsy, vsz)
         add_friction(dy, i, ai, nx, ny, nz, fx, fy, fz, 1.0)
         add_friction(dy, j, aj, nx, ny, nz, fx, fy, fz, -1.0)
         p_fric += f_mag * speed
@@ -149,8 +154,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             ovl_i = i
             ovl_j = -1 - g.wall_w[w]
         c = g.wall_coef[w]
-        a = contact_arm(ri, delta, cfg.arm_shrink)
-        ddot, vsx, vsy, vsz = wall_slip(y, i, nx, ny, nz, a)
+        ddot = normal_rate_3d(y[i, VX], y[i, VY], y[i, VZ], nx, ny, nz)
         n, pv, ep, wp = normal_law_response(delta, ddot, c, g.wall_hist[w, HIST_MAX], cfg.clip)
         dy[i, VX] -= n * nx
         dy[i, VY] -= n * ny
@@ -160,16 +164,20 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         w_plastic += wp
         if split or c[COEF_MU] == 0.0:
             continue
+        a = contact_arm(ri, delta, cfg.arm_shrink)
+        _, vsx, vsy, vsz = wall_slip(y, i, nx, ny, nz, a)
         speed = _speed(vsx, vsy, vsz)
         f_mag = friction_magnitude(n, speed, c[COEF_MU], c[COEF_KS])
-        fx, fy, fz = friction_vector_3d(f_mag, vsx, vsy, vsz)
+        fx, fy, fz = friction_along_slip(f_mag, speed, vsx, vsy, vsz)
         add_friction(dy, i, a, nx, ny, nz, fx, fy, fz, 1.0)
         p_fric += f_mag * speed
         rate = max(rate, slip_relaxation_rate(n, speed, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + a * a / g.inertia[i]))
     for i in range(ng):
+        inv_m = 1.0 / g.mass[i]
+        inv_i = 1.0 / g.inertia[i]
         for c in range(3):
-            dy[i, VX + c] /= g.mass[i]
-            dy[i, WX + c] /= g.inertia[i]
+            dy[i, VX + c] *= inv_m
+            dy[i, WX + c] *= inv_i
     return ForceSums(p_shock, p_visc, p_fric, e_pot, rate, ovl, ovl_i, ovl_j, 0.0, w_plastic)
 
 
@@ -195,22 +203,23 @@ def friction_flow(y, dt, g, cfg, forward):
     a_j^2/I_j). Returns the energy dissipated [J]."""
     n_p = g.pair_ij.shape[0]
     n_w = g.wall_i.shape[0]
+    half_shrink = 0.5 * cfg.arm_shrink
     work = 0.0
     for k in range(n_p + n_w):
         q = k if forward else n_p + n_w - 1 - k
         if q < n_p:
+            c = g.pair_coef[q]
+            if c[COEF_MU] == 0.0:
+                continue
             i = g.pair_ij[q, 0]
             j = g.pair_ij[q, 1]
             ri = g.radius[i]
             rj = g.radius[j]
-            if pair_apart_3d(y[i, X], y[i, Y], y[i, Z], ri, y[j, X], y[j, Y], y[j, Z], rj):
+            delta, nx, ny, nz = pair_contact_3d(y[i, X], y[i, Y], y[i, Z], ri, y[j, X], y[j, Y], y[j, Z], rj)
+            if delta <= 0.0:
                 continue
-            delta, nx, ny, nz = pair_overlap_3d(y[i, X], y[i, Y], y[i, Z], ri, y[j, X], y[j, Y], y[j, Z], rj)
-            c = g.pair_coef[q]
-            if delta <= 0.0 or c[COEF_MU] == 0.0:
-                continue
-            ai = contact_arm(ri, delta, 0.5 * cfg.arm_shrink)
-            aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
+            ai = contact_arm(ri, delta, half_shrink)
+            aj = contact_arm(rj, delta, half_shrink)
             ddot, vsx, vsy, vsz = pair_slip(y, i, j, nx, ny, nz, ai, aj)
             speed = _speed(vsx, vsy, vsz)
             if speed == 0.0:
@@ -218,11 +227,13 @@ def friction_flow(y, dt, g, cfg, forward):
             n = normal_law_force(delta, ddot, c, g.pair_hist[q, HIST_MAX], cfg.clip)
             inv_mi = 1.0 / g.mass[i]
             inv_mj = 1.0 / g.mass[j]
+            inv_ii = 1.0 / g.inertia[i]
+            inv_ij = 1.0 / g.inertia[j]
             imp, dw = friction_impulse(speed, n, c[COEF_MU], c[COEF_KS],
-                                       inv_mi + inv_mj + ai * ai / g.inertia[i] + aj * aj / g.inertia[j], dt)
-            px, py, pz = friction_vector_3d(imp, vsx, vsy, vsz)
-            apply_friction_impulse(y, i, ai, inv_mi, 1.0 / g.inertia[i], nx, ny, nz, px, py, pz, 1.0)
-            apply_friction_impulse(y, j, aj, inv_mj, 1.0 / g.inertia[j], nx, ny, nz, px, py, pz, -1.0)
+                                       inv_mi + inv_mj + ai * ai * inv_ii + aj * aj * inv_ij, dt)
+            px, py, pz = friction_along_slip(imp, speed, vsx, vsy, vsz)
+            apply_friction_impulse(y, i, ai, inv_mi, inv_ii, nx, ny, nz, px, py, pz, 1.0)
+            apply_friction_impulse(y, j, aj, inv_mj, inv_ij, nx, ny, nz, px, py, pz, -1.0)
             work += dw
         else:
             w = q - n_p
@@ -242,9 +253,10 @@ def friction_flow(y, dt, g, cfg, forward):
                 continue
             n = normal_law_force(delta, ddot, c, g.wall_hist[w, HIST_MAX], cfg.clip)
             inv_m = 1.0 / g.mass[i]
-            imp, dw = friction_impulse(speed, n, c[COEF_MU], c[COEF_KS], inv_m + a * a / g.inertia[i], dt)
-            px, py, pz = friction_vector_3d(imp, vsx, vsy, vsz)
-            apply_friction_impulse(y, i, a, inv_m, 1.0 / g.inertia[i], nx, ny, nz, px, py, pz, 1.0)
+            inv_i = 1.0 / g.inertia[i]
+            imp, dw = friction_impulse(speed, n, c[COEF_MU], c[COEF_KS], inv_m + a * a * inv_i, dt)
+            px, py, pz = friction_along_slip(imp, speed, vsx, vsy, vsz)
+            apply_friction_impulse(y, i, a, inv_m, inv_i, nx, ny, nz, px, py, pz, 1.0)
             work += dw
     return work
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from granplate.solver.dimension import friction_flow, granular_rhs
+from granplate.solver.dimension import friction_flow, granular_rhs, plate_friction_held
 
 #: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps h
 #: times the friction relaxation rate of every contact that RK4 integrates below this bound.
@@ -38,8 +38,9 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     friction in reverse order (Strang).
 
     Stage 1 reuses st.k1/st.p1 (first same as last), unless hold (the plate-contact
-    friction held at w.fbar over the step) or the split (the friction half step moves
-    the velocities) changes it. Writes w.ynew, w.kend (without the split friction), w.fnew
+    friction held at w.fbar over the step; in the plane only, solver.dimension) or the
+    split (the friction half step moves the velocities) changes it. Writes w.ynew,
+    w.kend (without the split friction), w.fnew
     (forces on the plate at t + h), w.normal_new, w.slip_new, w.pend (powers at t + h) and
     w.dacc (shock, viscous, friction work over the step, and the plastic work past the
     contacts' largest overlaps, whose end overlaps go into their histories' HIST_END), w.ovl_new and w.ovl_who (the
@@ -63,7 +64,7 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
                 w.ynew[i, c] = y0[i, c]
         fric_split = friction_flow(w.ynew, 0.5 * h, g, cfg, True)
         y0 = w.ynew
-    if hold or split:
+    if plate_friction_held(hold, g) or split:
         pr = granular_rhs(t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar,
                           split, False)
         w.p1h[0] = pr.p_shock

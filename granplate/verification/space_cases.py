@@ -137,7 +137,8 @@ def chain_in_space(ctx: Context) -> CaseResult:
     moved = float(np.abs(d2.vx.values[-1, 1:]).max())
     why_flat = ("in the plane z = 0 the 3D laws reduce to the plane's term by term (z, vz and "
                 "the in-plane spins stay exactly 0, docs/model.md 3.7): at most the order of a few "
-                "floating-point sums could differ, a few ulps per step (measured: bitwise equal).")
+                "floating-point sums could differ, a few ulps per step (measured: an ulp, 2e-16 of v0: "
+                "space scales the normal and the accelerations by reciprocals where the plane divides).")
     why_tilt = ("along (2, 3, 6)/7 every coordinate of a centre carries a rounding of eps |s| "
                 "= 2e-16 x 0.5 m, which the overlap R_i + R_j - |s_j - s_i| (about 1e-5 m) "
                 "amplifies by |s| / delta ~ 1e3 into the force, so the two runs differ by ~1e-12 "

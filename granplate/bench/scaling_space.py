@@ -1,0 +1,227 @@
+"""`granplate bench --scaling --dimension 3`: the granule-scaling table in space, how the 3D
+granular loop's cost grows with the number of spheres, with and without friction, and
+(where LAMMPS is installed) LAMMPS's time to the same accuracy on the same frictionless
+packing (granplate.verification.lammps.run_hertz_3d).
+
+The packing (`launched_fcc`): a free face-centred cubic packing (setup.layouts, kind
+"fcc", NX x NY x NZ conventional cells of 4 sites, 2 NX lattice planes normal to x) of
+steel spheres, R = 1 mm, nearest neighbours touching, no walls, no plate, no load, whose
+first lattice plane is launched at 1 m/s in +x into the rest; undamped, dynamic
+detection, the default (implicit) scheme unless asked (any name of
+model.inputs.SCHEME_NAMES), run to a short t_end (default 20 us).
+
+Each (size, mu) runs in a fresh subprocess as the plane's rows do (bench.scaling): a tiny
+warm-up run, `build_model` (set-up), `simulate` (loop, steps), the peak resident memory,
+then (frictionless rows) the reference, RK4 (the paper scheme) at REFERENCE_DT, and the
+error max |v - v_ref| / SPEED over the spheres' three velocity components at t_end. LAMMPS
+(another fresh subprocess) runs the same packing at steps from LAMMPS_DT_START, halved until
+its error against the same v_ref is at most ours.
+"""
+from __future__ import annotations
+
+import dataclasses
+import sys
+
+from granplate.bench.scaling import (
+    FRICTIONS, LAMMPS_DT_START, LAMMPS_HALVINGS, RADIUS, REFERENCE_DT, SPEED, T_END, format_or_dash,
+    per_contact_step_us, run_in_subprocess,
+)
+
+#: FCC packings (cells along x, y, z) of the table: 12, 108, 1,008, 2,916 and 10,192 spheres.
+SIZES: tuple[tuple[int, int, int], ...] = ((3, 1, 1), (3, 3, 3), (6, 6, 7), (9, 9, 9), (14, 14, 13))
+#: Sites per conventional FCC cell.
+FCC_SITES = 4
+
+
+def sphere_count(cells: tuple[int, int, int]) -> int:
+    """Spheres of an FCC packing of `cells` conventional cells: 4 nx ny nz."""
+    return FCC_SITES * cells[0] * cells[1] * cells[2]
+
+
+def launched_fcc(cells: tuple[int, int, int], radius: float = RADIUS, speed: float = SPEED, mu: float = 0.0,
+                 t_end: float = T_END, scheme: str = "implicit", dt: float | None = None):
+    """A free FCC packing of touching steel spheres (radius [m], `cells` conventional cells,
+    no walls, no plate, no load) whose first lattice plane (x smallest) moves at `speed`
+    [m/s] in +x. Undamped, friction mu, dynamic detection; `scheme` with its own step, or
+    with dt [s] the fixed step dt (dt_initial = dt_max = dt)."""
+    from granplate.setup.geometry import layout_packing
+    from granplate.setup.scenario import Contact, Load, Scenario, Solver, SpaceLattice, TimeSettings
+
+    packing = layout_packing(SpaceLattice(kind="fcc", cells=tuple(cells), radius=radius, walls=()))
+    first = set(packing.column1)
+    granules = tuple(dataclasses.replace(g, vx=speed) if g.label in first else g for g in packing.granules)
+    out = t_end / 20.0
+    time_settings = TimeSettings(t_end=t_end, output_interval=out, field_interval=out)
+    if dt is not None:
+        time_settings = dataclasses.replace(time_settings, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt))
+    name = "fcc-" + "x".join(str(c) for c in cells)
+    return Scenario(name=name, dimension=3, granules=granules, plate=None, load=Load(kind="none"),
+                    contact=Contact(mu=mu, alpha_n=0.0, pairs=(), detection="dynamic"), time=time_settings,
+                    solver=Solver(scheme=scheme))
+
+
+def _warm_up(scheme: str) -> None:
+    """Load the compiled 3D kernels of `scheme` and of the reference's paper scheme (1 us runs)."""
+    from granplate.results.run import simulate
+
+    for name, dt in ((scheme, None), ("paper", 4e-8)):
+        simulate(launched_fcc((1, 1, 1), t_end=1e-6, scheme=name, dt=dt), progress=False)
+
+
+def max_error_3d(v: tuple, ref: dict) -> float:
+    """max |v - v_ref| / SPEED over the spheres' vx, vy, vz at t_end (v: the three arrays)."""
+    import numpy as np
+
+    return float(max(np.abs(np.asarray(vc) - np.asarray(ref[k])).max() for vc, k in zip(v, ("vx", "vy", "vz")))
+                 / SPEED)
+
+
+def _ours_worker(spec: dict) -> dict:
+    """Runs in a fresh subprocess: one (size, mu) of granplate; the reference when mu = 0."""
+    import resource
+    import time
+    import warnings
+
+    import numpy as np
+
+    from granplate.errors import YieldWarning
+    from granplate.model.arrays import build_model
+    from granplate.results.run import simulate
+
+    warnings.simplefilter("ignore", YieldWarning)  # Hertz's law is timed, elastic whatever the pressure
+    _warm_up(spec["scheme"])
+    cells = tuple(spec["cells"])
+    s = launched_fcc(cells, mu=spec["mu"], t_end=spec["t_end"], scheme=spec["scheme"])
+    t0 = time.perf_counter()
+    model = build_model(s)
+    setup = time.perf_counter() - t0
+    ds = simulate(s, model=model, progress=False)
+    out = {"granules": len(s.granules), "contacts": int(len(model.pairs)), "setup_s": setup,
+           "n_steps": int(ds.attrs["n_steps"]), "loop_s": float(ds.attrs["loop_time_s"]),
+           "loop_cpu_s": float(ds.attrs["loop_cpu_s"]),
+           "rss_peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+           "energy_residual": float(np.abs(ds.energy_residual.values).max())}
+    if spec["mu"] == 0.0:
+        ref = simulate(launched_fcc(cells, t_end=spec["t_end"], scheme="paper", dt=REFERENCE_DT), progress=False)
+        out["reference"] = {k: ref[k].values[-1].tolist() for k in ("vx", "vy", "vz")}
+        out["error"] = max_error_3d(tuple(ds[k].values[-1] for k in ("vx", "vy", "vz")), out["reference"])
+    return out
+
+
+def _lammps_worker(spec: dict) -> dict:
+    """Runs in a fresh subprocess: LAMMPS (run_hertz_3d) on the frictionless packing, steps
+    halved from LAMMPS_DT_START until its error is at most spec["error"]."""
+    import resource
+    import time
+
+    from granplate.verification import lammps as L
+
+    if L.unavailable():
+        return {"skipped": L.unavailable()}
+    s = launched_fcc(tuple(spec["cells"]), t_end=spec["t_end"])
+    L.run_hertz_3d(launched_fcc((1, 1, 1), t_end=1e-7), 1e-8, 1e-7)  # load the library once
+    tried = []
+    dt = LAMMPS_DT_START
+    for _ in range(LAMMPS_HALVINGS + 1):
+        c0 = time.process_time()
+        res = L.run_hertz_3d(s, dt, spec["t_end"])
+        cpu = time.process_time() - c0
+        err = max_error_3d(tuple(res[k][-1] for k in ("vx", "vy", "vz")), spec["reference"])
+        tried.append({"dt_s": dt, "n_steps": res["n_steps"], "setup_s": res["setup_time_s"],
+                      "loop_s": res["loop_time_s"], "cpu_s": cpu, "error": err})
+        if err <= spec["error"]:
+            break
+        dt /= 2.0
+    return {**tried[-1], "reached": tried[-1]["error"] <= spec["error"], "tried": tried,
+            "rss_peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0}
+
+
+def run_scaling_space(sizes=SIZES, frictions=FRICTIONS, t_end: float = T_END, scheme: str = "implicit",
+                      lammps: bool = True, log=print) -> list[dict]:
+    """The 3D table's rows: one per (size, mu), each measured in fresh subprocesses."""
+    rows = []
+    for cells in sizes:
+        for mu in frictions:
+            log(f"scaling in space: {sphere_count(cells)} spheres, mu = {mu:g} ...")
+            spec = {"cells": list(cells), "mu": mu, "t_end": t_end, "scheme": scheme}
+            row = {"dimension": 3, "cells": list(cells), "mu": mu, "scheme": scheme, "t_end_s": t_end,
+                   **run_in_subprocess("scaling_space", "_ours_worker", spec)}
+            if "failed" not in row:
+                row["us_per_step"] = 1e6 * row["loop_s"] / row["n_steps"]
+                row["us_per_contact_step"] = per_contact_step_us(row["loop_s"], row["n_steps"], row["contacts"])
+                row["cpu_us_per_contact_step"] = per_contact_step_us(row["loop_cpu_s"], row["n_steps"],
+                                                                     row["contacts"])
+            if lammps and mu == 0.0 and "error" in row:
+                log(f"scaling in space: {row['granules']} spheres, LAMMPS ...")
+                lm = run_in_subprocess("scaling_space", "_lammps_worker",
+                                       {**spec, "error": row["error"], "reference": row["reference"]})
+                if "loop_s" in lm:
+                    lm["us_per_contact_step"] = per_contact_step_us(lm["loop_s"], lm["n_steps"], row["contacts"])
+                    lm["cpu_us_per_contact_step"] = per_contact_step_us(lm["cpu_s"], lm["n_steps"], row["contacts"])
+                row["lammps"] = lm
+            row.pop("reference", None)
+            rows.append(row)
+    return rows
+
+
+def format_space_table(rows: list[dict]) -> str:
+    """The 3D scaling table as Markdown (LAMMPS columns on the frictionless rows)."""
+    lines = ["| spheres | cells | contacts | mu | set-up [s] | steps | loop [s] | us/step | us/(contact step) "
+             "| CPU us/(contact step) | peak [MiB] | error | LAMMPS dt [s] | LAMMPS steps | LAMMPS loop [s] "
+             "| LAMMPS us/(contact step) | LAMMPS CPU us/(contact step) | LAMMPS error |",
+             "|" + " ---: |" * 18]
+    for r in rows:
+        cells = "x".join(str(c) for c in r["cells"])
+        if "failed" in r:
+            lines.append(f"| {sphere_count(r['cells']):,} | {cells} | | {r['mu']:g} | {r['failed']} |" + " |" * 13)
+            continue
+        lm = r.get("lammps") or {}
+        if "skipped" in lm or not lm:
+            lcols = ["-"] * 6
+        elif "failed" in lm:
+            lcols = [lm["failed"]] + ["-"] * 5
+        else:
+            lcols = [format_or_dash(lm["dt_s"], ".2e") + ("" if lm["reached"] else " (not reached)"),
+                     f"{lm['n_steps']:,}", format_or_dash(lm["loop_s"], ".3g"),
+                     format_or_dash(lm["us_per_contact_step"], ".3f"),
+                     format_or_dash(lm["cpu_us_per_contact_step"], ".3f"), format_or_dash(lm["error"], ".1e")]
+        lines.append(f"| {r['granules']:,} | {cells} | {r['contacts']:,} | {r['mu']:g} | {r['setup_s']:.3f} "
+                     f"| {r['n_steps']:,} | {r['loop_s']:.3g} | {r['us_per_step']:.1f} "
+                     f"| {r['us_per_contact_step']:.3f} | {r['cpu_us_per_contact_step']:.3f} "
+                     f"| {r['rss_peak_mib']:.0f} | {format_or_dash(r.get('error'), '.1e')} | "
+                     + " | ".join(lcols) + " |")
+    return "\n".join(lines)
+
+
+def parse_cells(text: str) -> list[tuple[int, int, int]]:
+    """'3x3x3,6x6x7' -> [(3, 3, 3), (6, 6, 7)] (FCC cells along x, y, z; ValueError naming
+    the bad item and the allowed form)."""
+    out = []
+    for item in text.split(","):
+        parts = item.strip().lower().split("x")
+        if len(parts) != 3 or not all(p.strip().isdigit() and int(p) >= 1 for p in parts):
+            raise ValueError(f"--sizes item {item!r}: allowed NXxNYxNZ (FCC cells along x, y, z) with "
+                             "integers >= 1, e.g. 6x6x7")
+        out.append((int(parts[0]), int(parts[1]), int(parts[2])))
+    return out
+
+
+def main(args, t_end: float, scheme: str) -> int:
+    """`granplate bench --scaling --dimension 3 [--sizes 3x3x3,6x6x7] ...` (t_end and scheme
+    checked by bench.scaling.main)."""
+    import json
+
+    try:
+        sizes = parse_cells(args.sizes) if getattr(args, "sizes", None) else SIZES
+    except ValueError as err:
+        print(f"granplate: error: {err}", file=sys.stderr)
+        return 2
+    rows = run_scaling_space(sizes, t_end=t_end, scheme=scheme, lammps=not getattr(args, "no_lammps", False))
+    print()
+    print(format_space_table(rows))
+    if getattr(args, "json", None):
+        with open(args.json, "w") as fh:
+            fh.write(json.dumps(rows, indent=2) + "\n")
+        print(f"json: {args.json}")
+    return 1 if any("failed" in r or "failed" in (r.get("lammps") or {}) for r in rows) else 0
+
