@@ -325,9 +325,7 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
         ri = g.radius[i]
         rj = g.radius[j]
         g.pair_hist[p, HIST_END] = 0.0
-        if pair_apart_3d(y[i, X], y[i, Y], y[i, Z], ri, y[j, X], y[j, Y], y[j, Z], rj):
-            continue
-        delta, nx, ny, nz = pair_overlap_3d(y[i, X], y[i, Y], y[i, Z], ri, y[j, X], y[j, Y], y[j, Z], rj)
+        delta, nx, ny, nz = pair_contact_3d(y[i, X], y[i, Y], y[i, Z], ri, y[j, X], y[j, Y], y[j, Z], rj)
         if delta <= 0.0:
             continue
         g.pair_hist[p, HIST_END] = delta
