@@ -226,3 +226,14 @@ def test_bench_study_json_has_documented_keys(tmp_path):
     assert report["designs"] == report["designs_ok"] == 4 and report["workers"] == 2
     assert report["loop_share"] * (1.0 + report["overhead_vs_loop"]) == pytest.approx(1.0)
     assert 0.0 < report["loop_vs_task_median"] <= 1.0 and report["task_cpu_s_median"] > 0
+
+
+def test_lammps_accuracy_counts_round_off_as_equal():
+    """The same Verlet at the same step reaches our error to round-off: no halving for that,
+    but an error larger by a part in a million is not as accurate."""
+    from granplate.bench.scaling import as_accurate
+
+    ours = 3.071253142543362e-05
+    assert as_accurate(3.071253142600261e-05, ours)  # measured: 2e-14 relative above ours
+    assert as_accurate(0.5 * ours, ours)
+    assert not as_accurate(ours * (1 + 1e-6), ours)

@@ -409,3 +409,22 @@ def test_far_coordinates_and_fast_granules_are_refused_with_the_range():
         validate(_two_spheres(load=shock))
     validate(_two_spheres(load=dataclasses.replace(shock, q0=1.99e9)))
     validate(_two_spheres(load=dataclasses.replace(shock, kind="none")))  # no load: q0 unused
+
+
+def test_smaller_dt_max_alone_sets_the_initial_step():
+    """A [time] table that gives only dt_max below the default first step starts at dt_max
+    (rather than being refused), and a given dt_initial is still checked against it."""
+    import pytest
+
+    from granplate.errors import ScenarioError
+    from granplate.setup.io import loads
+    from granplate.setup.validate import validate
+
+    base = 'dimension = 3\n[[granules]]\nx = 0.0\ny = 0.0\nz = 0.0\nradius = 0.001\nmaterial = "steel"\n'
+    s = loads(base + "[time]\nt_end = 1e-6\ndt_max = 1e-8\n")
+    assert s.time.dt_initial == 1e-8
+    validate(s)
+    with pytest.raises(ScenarioError, match="dt_initial"):
+        validate(loads(base + "[time]\nt_end = 1e-6\ndt_max = 1e-8\ndt_initial = 4e-8\n"))
+    with pytest.raises(ScenarioError, match="dt_max"):
+        validate(loads(base + "[time]\nt_end = 1e-6\ndt_max = -1e-8\n"))

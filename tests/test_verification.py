@@ -2,6 +2,7 @@
 independent reference, the page is written, `granplate verify` exits non-zero on failure."""
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from importlib import resources
@@ -257,3 +258,23 @@ def test_render_only_rebuilds_the_pages_from_the_json(tmp_path, capsys):
     assert err.count("\n") == 1 and "--render-only" in err and "validation.json not found" in err
     assert cli.main(["verify", "--out", str(tmp_path), "--render-only", "--case", "patch-test"]) == 2
     assert capsys.readouterr().err == "granplate: error: --render-only runs no case: --case cannot go with it\n"
+
+
+def test_update_puts_refreshed_cases_in_place_and_keeps_the_rest(tmp_path, capsys):
+    """`verify --case X --update` replaces X's result in validation.json, keeps every other
+    case and their order, and says in the provenance line which cases were refreshed."""
+    from granplate.verification import page
+
+    old = _results()
+    page.write_pages(tmp_path, old, full=True, seconds=21.5, generated="Made for a test.")
+    assert cli.main(["verify", "--out", str(tmp_path), "--case", "patch-test", "--update", "-q"]) == 0
+    results, full, seconds, generated = page.read_results(tmp_path / "validation.json")
+    assert [r.name for r in results] == [r.name for r in old] + ["patch-test"]
+    assert [r.as_dict() for r in results[:2]] == [r.as_dict() for r in old] and full and seconds == 21.5
+    assert generated.startswith("Made for a test. Refreshed by") and "`patch-test`" in generated
+    assert "patch-test" in (tmp_path / "validation.md").read_text()
+    renamed = page.merge_results(results, [dataclasses.replace(results[0], title="again")])
+    assert [r.title for r in renamed][0] == "again" and len(renamed) == len(results)
+    capsys.readouterr()
+    assert cli.main(["verify", "--out", str(tmp_path), "--update"]) == 2
+    assert "--update" in capsys.readouterr().err

@@ -23,7 +23,7 @@ import dataclasses
 import sys
 
 from granplate.bench.scaling import (
-    FRICTIONS, LAMMPS_DT_START, LAMMPS_HALVINGS, RADIUS, REFERENCE_DT, SPEED, T_END, format_or_dash,
+    FRICTIONS, LAMMPS_DT_START, LAMMPS_HALVINGS, RADIUS, REFERENCE_DT, SPEED, T_END, as_accurate, format_or_dash,
     per_contact_step_us, run_in_subprocess,
 )
 
@@ -129,10 +129,10 @@ def _lammps_worker(spec: dict) -> dict:
         err = max_error_3d(tuple(res[k][-1] for k in ("vx", "vy", "vz")), spec["reference"])
         tried.append({"dt_s": dt, "n_steps": res["n_steps"], "setup_s": res["setup_time_s"],
                       "loop_s": res["loop_time_s"], "cpu_s": cpu, "error": err})
-        if err <= spec["error"]:
+        if as_accurate(err, spec["error"]):
             break
         dt /= 2.0
-    return {**tried[-1], "reached": tried[-1]["error"] <= spec["error"], "tried": tried,
+    return {**tried[-1], "reached": as_accurate(tried[-1]["error"], spec["error"]), "tried": tried,
             "rss_peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0}
 
 

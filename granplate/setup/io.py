@@ -237,6 +237,14 @@ def _layout(d: Any) -> Any:
     return _table("layout", d, LAYOUT_KINDS[kind])
 
 
+def _initial_step_within_max(t: TimeSettings, given: dict) -> TimeSettings:
+    """A [time] table that lowers dt_max below the default dt_initial without giving
+    dt_initial starts at dt_max (a first step above the largest would be refused)."""
+    if "dt_initial" not in given and "dt_max" in given and 0.0 < t.dt_max < t.dt_initial:
+        return dataclasses.replace(t, dt_initial=t.dt_max)
+    return t
+
+
 def from_dict(d: dict) -> Scenario:
     """A Scenario from a TOML-shaped dict; shape errors raise ScenarioError (no physics).
 
@@ -261,6 +269,8 @@ def from_dict(d: dict) -> Scenario:
     for key, cls in _TOP_TABLES.items():
         if d.get(key) is not None:
             kw[key] = _table(key, d[key], cls)
+    if "time" in kw:
+        kw["time"] = _initial_step_within_max(kw["time"], d["time"])
     if d.get("granules") is not None:
         kw["granules"] = _convert("granules", d["granules"], tuple[Granule, ...])
     if d.get("walls") is not None:

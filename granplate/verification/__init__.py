@@ -78,16 +78,17 @@ def get_case(name: str):
 
 def run_suite(out: str | Path, full: bool = False, names: list[str] | None = None,
               log=None, *, workers: int | None = None, scheduler: str | None = None,
-              client=None) -> list:
+              client=None, update: bool = False) -> list:
     """Run the suite (or the cases `names`), write the pages into `out`, return the results.
 
     full: include the slow cases (and the full-length preset runs, computed first on Dask:
     a local cluster of `workers` processes, the cluster at `scheduler`, or `client`); log:
-    a callable taking one line of progress (None: silent).
+    a callable taking one line of progress (None: silent); update: with `names`, merge
+    these cases into the existing DIR/validation.json instead of writing a page of them alone.
     """
     from .base import Context, run_case
     from .coupled import load_run_cache, save_run_cache
-    from .page import write_pages
+    from .page import update_pages, write_pages
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -111,7 +112,10 @@ def run_suite(out: str | Path, full: bool = False, names: list[str] | None = Non
             log(f"verify: {case.name}: {state} [{r.seconds:.1f} s]")
     if full and ctx.run_cache is not None:
         save_run_cache(cache_path, ctx.run_cache)
-    write_pages(out, results, full or any(c.slow for c in cases), time.perf_counter() - t0)
+    if update and (out / "validation.json").is_file():
+        update_pages(out, results, time.perf_counter() - t0)
+    else:
+        write_pages(out, results, full or any(c.slow for c in cases), time.perf_counter() - t0)
     return results
 
 
@@ -123,11 +127,16 @@ def _cmd_verify(args) -> int:
         print(f"granplate: error: --workers = {args.workers}: must be >= 1", file=sys.stderr)
         return 2
     if args.render_only:
-        clash = [flag for flag, on in (("--case", args.case), ("--full", args.full), ("--list", args.list)) if on]
+        clash = [flag for flag, on in (("--case", args.case), ("--full", args.full), ("--list", args.list),
+                                       ("--update", args.update)) if on]
         if clash:
             print(f"granplate: error: --render-only runs no case: {', '.join(clash)} cannot go with it", file=sys.stderr)
             return 2
         return _render_only(Path(args.out))
+    if args.update and not args.case:
+        print("granplate: error: --update merges the cases given by --case into DIR/validation.json: "
+              "give at least one --case", file=sys.stderr)
+        return 2
     if args.list:
         for case in all_cases():
             print(f"{case.name:22s} {'(--full) ' if case.slow else ''}{case.title}")
@@ -141,7 +150,7 @@ def _cmd_verify(args) -> int:
         print(f"granplate: error: {err.args[0]}", file=sys.stderr)
         return 2
     results = run_suite(args.out, full=args.full, names=names, log=None if args.quiet else log,
-                        workers=args.workers, scheduler=args.scheduler)
+                        workers=args.workers, scheduler=args.scheduler, update=args.update)
     n_bad = sum(1 for r in results if not r.passed)
     n_checks = sum(len(r.checks) for r in results)
     bad_checks = sum(1 for r in results for c in r.checks if not c.passed)
@@ -189,6 +198,9 @@ def register(subparsers) -> None:
                    help="with --full: compute the full-length runs on an existing Dask cluster")
     p.add_argument("--case", action="append", metavar="NAME",
                    help="run only this case (repeatable; see --list)")
+    p.add_argument("--update", action="store_true",
+                   help="with --case: put the cases run into DIR/validation.json in place of their "
+                        "earlier results, keep the other cases, and rebuild the pages")
     p.add_argument("--list", action="store_true", help="list the cases and exit")
     p.add_argument("--render-only", action="store_true",
                    help="run no case: rebuild DIR/validation.md and DIR/validation.html from DIR/validation.json")

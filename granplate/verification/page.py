@@ -227,6 +227,25 @@ def write_pages(out: Path, results: list[CaseResult], full: bool, seconds: float
     return [md, ht, js]
 
 
+def merge_results(old: list[CaseResult], new: list[CaseResult]) -> list[CaseResult]:
+    """`old` with each case of `new` in its place (by name); new cases appended."""
+    fresh = {r.name: r for r in new}
+    kept = [fresh.pop(r.name, r) for r in old]
+    return kept + [r for r in new if r.name in fresh]
+
+
+def update_pages(out: Path, new: list[CaseResult], seconds: float) -> list[Path]:
+    """`granplate verify --case ... --update`: the cases of `new` replace theirs in
+    DIR/validation.json (the others kept as they were), and the pages are rebuilt; the
+    provenance line says which cases were refreshed, when, how long."""
+    results, full, total, generated = read_results(Path(out) / "validation.json")
+    when = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    names = ", ".join(f"`{r.name}`" for r in new)
+    note = f"Refreshed by `granplate verify --case ... --update` on {when} ({seconds:.0f} s): {names}."
+    return write_pages(Path(out), merge_results(results, new), full, total,
+                       f"{generated or generated_line(full, total)} {note}")
+
+
 def read_results(path: Path) -> tuple[list[CaseResult], bool, float, str | None]:
     """(results, full, seconds, provenance line) from a validation.json."""
     data = json.loads(Path(path).read_text(encoding="utf-8"))
