@@ -1,4 +1,4 @@
-"""Reference solutions for sphere impacts (docs/model.md, "References for elastic bodies").
+"""Reference solutions for sphere impacts (docs/model.md section 4.6).
 
 - Hertz's impact of a sphere on a rigid flat or an elastic half-space (Johnson, Contact
   Mechanics, 1985, section 11.4): the largest overlap, the contact time, the peak force,

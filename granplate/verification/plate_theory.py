@@ -1,4 +1,4 @@
-"""Reference solutions for elastic plates (docs/model.md, "References for elastic bodies").
+"""Reference solutions for elastic plates (docs/model.md section 4.6).
 
 Closed forms and published tables, each from its source, in SI units or as the
 non-dimensional parameters their sources tabulate:
