@@ -113,7 +113,8 @@ def zener_inelasticity_sphere(radius: float, rho_sphere: float, e_star: float, s
     """lambda of a solid sphere on a plate, written out from `zener_inelasticity`:
     lambda = pi^(3/5) / sqrt(3) (R / H)^2 (v0 / c)^(1/5) (rho_s / rho_p)^(3/5)
     (E* / E_p)^(2/5) sqrt(1 - nu_p^2), H the plate's thickness, c = sqrt(E_p / rho_p).
-    Zener (1941) writes the plate's thickness as 2h, so (R / H)^2 is his (R / 2h)^2."""
+    In Zener's notation (1941) the plate is 2h thick, so (R / H)^2 reads (R / 2h)^2; the
+    material factors are derived here from the model's equations, not copied."""
     c = math.sqrt(young_plate / rho_plate)
     return (math.pi**0.6 / math.sqrt(3.0) * (radius / thickness) ** 2 * (speed / c) ** 0.2
             * (rho_sphere / rho_plate) ** 0.6 * (e_star / young_plate) ** 0.4

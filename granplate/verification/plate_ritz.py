@@ -87,8 +87,9 @@ def kirchhoff_centre_deflection(edges: str, load: str, aspect: float = 1.0, nu: 
                                 n_terms: int = 12) -> float:
     """The centre deflection of a Kirchhoff plate under a uniform load ("uniform": as
     w D / (q a^4)) or a central point load ("point": as w D / (P a^2)); edges "C" or "S"."""
+    _check_edges(edges)
     if edges == "F":
-        raise ValueError("a free plate has no static solution under a load")
+        raise ValueError("edges 'F': a free plate has no static solution under a load")
     k, _ = kirchhoff_matrices(edges, aspect, nu, n_terms)
     phi = edge_basis(n_terms, KIRCHHOFF_POWER[edges])
     at_centre = np.array([p(0.0) for p in phi])
@@ -112,6 +113,8 @@ def mindlin_matrices(edges: str, h_over_a: float, nu: float = 0.3, kappa: float 
     supported ("hard") w = 0 and the rotation along the edge = 0; free none.
     kappa G h / D = 6 kappa (1 - nu) / h^2."""
     _check_edges(edges)
+    if not h_over_a > 0.0:
+        raise ValueError(f"h_over_a must be > 0, not {h_over_a!r}")
     n = n_terms
     if edges == "C":
         powers = {"w": (1, 1), "x": (1, 1), "y": (1, 1)}

@@ -79,6 +79,8 @@ def mindlin_ss_matrices(m: int, n: int, h_over_a: float, aspect: float = 1.0, nu
          [S alpha, alpha^2 + (1 - nu)/2 beta^2 + S, (1 + nu)/2 alpha beta],
          [S beta, (1 + nu)/2 alpha beta, beta^2 + (1 - nu)/2 alpha^2 + S]],
     M = diag(1, h^2/12, h^2/12). det(K - omega^2 M) = 0 is Mindlin's cubic in omega^2."""
+    if not h_over_a > 0.0:
+        raise ValueError(f"h_over_a must be > 0, not {h_over_a!r}")
     alpha, beta = m * math.pi, n * math.pi / aspect
     s = 6.0 * kappa * (1.0 - nu) / h_over_a**2
     k = np.array([[s * (alpha**2 + beta**2), s * alpha, s * beta],
