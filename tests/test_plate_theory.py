@@ -77,6 +77,25 @@ def test_mindlin_ss_tends_to_kirchhoff():
         assert gaps[2] / gaps[1] == pytest.approx(4.0, rel=1e-2)
 
 
+def test_mindlin_ss_eigenproblem_equals_closed_roots():
+    """The 3 x 3 eigenproblem of Navier's mode and Mindlin's closed roots (the flexural and
+    thickness-shear quadratic, the thickness-twist root) agree, for square and rectangular
+    plates, thin to thick."""
+    for m, n, t, aspect in ((1, 1, 0.01, 1.0), (2, 3, 0.1, 1.0), (1, 2, 0.2, 1.5), (3, 1, 0.05, 0.7)):
+        k, mass = T.mindlin_ss_matrices(m, n, t, aspect)
+        scale = 1 / np.sqrt(np.diag(mass))
+        eigen = np.sqrt(np.linalg.eigvalsh(k * np.outer(scale, scale)))
+        np.testing.assert_allclose(eigen, sorted(T.mindlin_ss_roots(m, n, t, aspect)), rtol=1e-9)
+
+
+def test_mindlin_ss_tends_to_rayleigh_plate():
+    """With S = kappa G h / D -> infinity (kappa -> infinity) Mindlin's flexural root is the
+    plate with rotary inertia alone, omega^2 = k^4 / (1 + (h/a)^2 k^2 / 12)."""
+    k2, t = 5 * math.pi**2, 0.1
+    rigid_shear = T.mindlin_ss_frequency_parameter(1, 2, t, kappa=1e9)
+    assert rigid_shear == pytest.approx(math.sqrt(k2**2 / (1 + t**2 * k2 / 12)), rel=1e-9)
+
+
 def test_mindlin_ss_closed_form_equals_ritz():
     """The closed form (Navier's modes in Mindlin's equations) and the independent Ritz
     solution of Mindlin's energy agree for the simply supported square, h/a = 0.05 to 0.2."""

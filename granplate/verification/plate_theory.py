@@ -94,11 +94,33 @@ def mindlin_ss_frequency_parameter(m: int, n: int, h_over_a: float, aspect: floa
                                    kappa: float = 5.0 / 6.0) -> float:
     """lambda^2 = omega a^2 sqrt(rho h / D) of the flexural (lowest) root of Mindlin's
     cubic for mode (m, n) of a simply supported rectangle (hard supports: w = 0, the
-    rotation along the edge = 0); tends to pi^2 (m^2 + n^2 (a/b)^2) as h / a -> 0."""
-    k, mass = mindlin_ss_matrices(m, n, h_over_a, aspect, nu, kappa)
-    scale = 1.0 / np.sqrt(np.diag(mass))
-    roots = np.linalg.eigvalsh(k * np.outer(scale, scale))
-    return float(math.sqrt(roots[0]))
+    rotation along the edge = 0); tends to pi^2 (m^2 + n^2 (a/b)^2) as h / a -> 0. From
+    the closed roots (`mindlin_ss_roots`), exact to rounding however thin the plate; the
+    eigenproblem of `mindlin_ss_matrices` is the check on them."""
+    return mindlin_ss_roots(m, n, h_over_a, aspect, nu, kappa)[0]
+
+
+def mindlin_ss_roots(m: int, n: int, h_over_a: float, aspect: float = 1.0, nu: float = 0.3,
+                     kappa: float = 5.0 / 6.0) -> tuple[float, float, float]:
+    """The three lambda^2 of mode (m, n) in closed form (units a = D = rho h = 1,
+    k^2 = alpha^2 + beta^2, S = 6 kappa (1 - nu) / (h/a)^2, r = (h/a)^2 / 12): the rotations
+    split into a gradient and a curl. The curl (thickness-twist) root is
+    omega^2 = ((1 - nu)/2 k^2 + S) / r; the gradient and w give Mindlin's quadratic
+    r omega^4 - (r S k^2 + k^2 + S) omega^2 + S k^4 = 0, whose smaller root is the
+    flexural mode and the larger the thickness-shear mode (Mindlin, Schacknow &
+    Deresiewicz, J. Appl. Mech. 23, 430, 1956, the simply supported plate).
+    Returns (flexural, thickness-shear, thickness-twist) as lambda^2 = omega."""
+    if not h_over_a > 0.0:
+        raise ValueError(f"h_over_a must be > 0, not {h_over_a!r}")
+    k2 = (m * math.pi) ** 2 + (n * math.pi / aspect) ** 2
+    s = 6.0 * kappa * (1.0 - nu) / h_over_a**2
+    r = h_over_a**2 / 12.0
+    b, c = r * s * k2 + k2 + s, s * k2 * k2
+    root = math.sqrt(b * b - 4.0 * r * c)
+    flexural = 2.0 * c / (b + root)  # the smaller root, without cancellation
+    shear = (b + root) / (2.0 * r)
+    twist = ((1.0 - nu) / 2.0 * k2 + s) / r
+    return math.sqrt(flexural), math.sqrt(shear), math.sqrt(twist)
 
 
 def mindlin_ss_frequency_parameters(count: int, h_over_a: float, aspect: float = 1.0, nu: float = 0.3,
