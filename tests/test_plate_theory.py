@@ -19,7 +19,7 @@ STEEL = {"young": 210e9, "poisson": 0.3, "rho": 7800.0}
 
 def test_ritz_simply_supported_equals_navier():
     """Ritz on a simply supported square and on a 1 x 1.5 rectangle gives Navier's
-    pi^2 (m^2 + n^2 (a/b)^2) (Leissa 1969, eq. 4.20)."""
+    pi^2 (m^2 + n^2 (a/b)^2) (Leissa 1969, ch. 4)."""
     for aspect in (1.0, 1.5):
         ritz = R.kirchhoff_frequency_parameters("S", count=6, aspect=aspect, n_terms=12)
         np.testing.assert_allclose(ritz, T.ss_frequency_parameters(6, aspect), rtol=1e-6)
@@ -31,7 +31,7 @@ def test_ss_square_closed_form_values():
 
 
 def test_clamped_square_matches_leissa():
-    """Leissa 1969 (NASA SP-160, section 4.3), CCCC square, the six lowest lambda^2 = 35.99,
+    """Leissa 1969 (NASA SP-160, ch. 4), CCCC square, the six lowest lambda^2 = 35.99,
     73.41, 73.41, 108.27, 131.64, 132.24: Ritz (Legendre polynomials, converged) within
     0.05 % and below them (Leissa's are beam-function Ritz upper bounds)."""
     ritz = R.kirchhoff_frequency_parameters("C", count=6, n_terms=12)
@@ -184,7 +184,7 @@ def test_ritz_point_load_converges_from_below():
 # --------------------------------------------------------------------------- Hertz
 
 def test_hertz_time_constant_is_johnsons():
-    """Johnson 1985 eq. 11.24: t_c = 2.94 delta_max / v0; the exact constant (4/5) B(2/5, 1/2)
+    """Johnson 1985 section 11.4: t_c = 2.94 delta_max / v0; the exact constant (4/5) B(2/5, 1/2)
     rounds to it, and equals 2 int_0^1 dx / sqrt(1 - x^(5/2)) by quadrature."""
     from scipy.integrate import quad
     assert round(I.HERTZ_TIME_CONSTANT, 2) == 2.94

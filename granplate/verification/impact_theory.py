@@ -27,7 +27,7 @@ from scipy.integrate import solve_ivp
 from scipy.special import beta as beta_function
 
 #: t_c = HERTZ_TIME_CONSTANT delta_max / v0: 2 int_0^1 dx / sqrt(1 - x^(5/2)) = (4/5) B(2/5, 1/2)
-#: = 2.9432 (Johnson 1985, eq. 11.24 rounds it to 2.94).
+#: = 2.9432 (Johnson 1985, section 11.4, rounds it to 2.94).
 HERTZ_TIME_CONSTANT = 0.8 * float(beta_function(0.4, 0.5))
 
 
@@ -35,25 +35,25 @@ HERTZ_TIME_CONSTANT = 0.8 * float(beta_function(0.4, 0.5))
 
 def effective_modulus(young_1: float, poisson_1: float, young_2: float = math.inf,
                       poisson_2: float = 0.0) -> float:
-    """E* [Pa]: 1 / E* = (1 - nu1^2) / E1 + (1 - nu2^2) / E2 (Johnson 1985, eq. 4.22);
+    """E* [Pa]: 1 / E* = (1 - nu1^2) / E1 + (1 - nu2^2) / E2 (Johnson 1985, section 4.2);
     E2 = inf: a rigid flat."""
     second = 0.0 if math.isinf(young_2) else (1.0 - poisson_2**2) / young_2
     return 1.0 / ((1.0 - poisson_1**2) / young_1 + second)
 
 
 def hertz_stiffness(e_star: float, radius: float) -> float:
-    """k = (4/3) E* sqrt(R) [N m^-3/2]: F = k delta^(3/2) (Johnson 1985, eq. 4.23)."""
+    """k = (4/3) E* sqrt(R) [N m^-3/2]: F = k delta^(3/2) (Johnson 1985, section 4.2)."""
     return 4.0 / 3.0 * e_star * math.sqrt(radius)
 
 
 def hertz_max_overlap(mass: float, speed: float, e_star: float, radius: float) -> float:
-    """delta_max = (15 m v0^2 / (16 E* sqrt(R)))^(2/5) [m] (Johnson 1985, eq. 11.23), m the
+    """delta_max = (15 m v0^2 / (16 E* sqrt(R)))^(2/5) [m] (Johnson 1985, section 11.4), m the
     reduced mass of the pair, v0 the relative approach speed."""
     return (15.0 * mass * speed**2 / (16.0 * e_star * math.sqrt(radius))) ** 0.4
 
 
 def hertz_contact_time(mass: float, speed: float, e_star: float, radius: float) -> float:
-    """t_c = 2.9432 delta_max / v0 [s] (Johnson 1985, eq. 11.24: 2.94 delta_max / v0)."""
+    """t_c = 2.9432 delta_max / v0 [s] (Johnson 1985, section 11.4: 2.94 delta_max / v0)."""
     return HERTZ_TIME_CONSTANT * hertz_max_overlap(mass, speed, e_star, radius) / speed
 
 

@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-#: Leissa, Vibration of Plates, NASA SP-160 (1969), section 4.3, the clamped (CCCC) square
+#: Leissa, Vibration of Plates, NASA SP-160 (1969), ch. 4, the plate clamped on all sides (CCCC), the square
 #: plate: the six lowest lambda^2 = omega a^2 sqrt(rho h / D) (values as Leissa tabulates
 #: them; Ritz upper bounds from beam functions, independent of nu for clamped edges).
 LEISSA_CCCC_SQUARE = (35.99, 73.41, 73.41, 108.27, 131.64, 132.24)
@@ -50,13 +50,13 @@ def flexural_rigidity(young: float, thickness: float, poisson: float) -> float:
 
 def kirchhoff_frequency(parameter: float, side: float, rigidity: float, rho: float, thickness: float) -> float:
     """omega = lambda^2 / a^2 sqrt(D / (rho h)) [rad/s] of the frequency parameter
-    lambda^2 (Leissa 1969, eq. 4.2) on a plate of side a [m]."""
+    lambda^2 (Leissa 1969, ch. 4) on a plate of side a [m]."""
     return parameter / side**2 * math.sqrt(rigidity / (rho * thickness))
 
 
 def ss_frequency_parameter(m: int, n: int, aspect: float = 1.0) -> float:
     """lambda^2 = pi^2 (m^2 + n^2 (a / b)^2) of mode (m, n) of a simply supported
-    rectangle a x b, b = aspect a (Navier; Leissa 1969, eq. 4.20)."""
+    rectangle a x b, b = aspect a (Navier; Leissa 1969, ch. 4)."""
     return math.pi**2 * (m**2 + (n / aspect) ** 2)
 
 
