@@ -24,9 +24,10 @@ import math
 
 import numpy as np
 
-#: Leissa, Vibration of Plates, NASA SP-160 (1969), ch. 4, the plate clamped on all sides (CCCC), the square
-#: plate: the six lowest lambda^2 = omega a^2 sqrt(rho h / D) (values as Leissa tabulates
-#: them; Ritz upper bounds from beam functions, independent of nu for clamped edges).
+#: Leissa, Vibration of Plates, NASA SP-160 (1969), ch. 4, the plate clamped on all sides
+#: (CCCC), the square: the six lowest lambda^2 = omega a^2 sqrt(rho h / D), as tabulated
+#: (independent of nu for clamped edges; each lies just above the converged Ritz value of
+#: `plate_ritz`, as a Ritz upper bound does).
 LEISSA_CCCC_SQUARE = (35.99, 73.41, 73.41, 108.27, 131.64, 132.24)
 
 #: Timoshenko & Woinowsky-Krieger (1959), the centre deflection of a square plate as
