@@ -16,6 +16,10 @@ the page this writes, regenerated with --full):
   sphere against Thornton's restitution, the yield velocity and overlap, the force-overlap
   loop measured from the trajectory, and Y -> infinity as Hertz (plastic.py: the closed
   forms and an independent integration);
+- plate_theory.py, plate_ritz.py, impact_theory.py: reference solutions for elastic bodies
+  (Kirchhoff and Mindlin plate frequencies, Navier's and Timoshenko's deflections, an
+  independent Ritz solver, Hertz's and Zener's impacts, flexural wave return times),
+  functions with tests (docs/model.md section 4.6);
 - plate_cases.py: patch test, clamped strip against Timoshenko beam theory (statics and
   frequencies), Q8 convergence rates, Newmark's period elongation;
 - plate_mesh.py: the truncated modal basis against the full one (4 x 40; 8 x 80 with --full)
