@@ -332,8 +332,8 @@ def _kind_of(element) -> int:
     name = type(element).__name__
     kinds = {"ElementHexS2": QUAD8, "ElementHex2": QUAD9, "ElementTetP2": TRI6}
     if name not in kinds:
-        raise ScenarioError(f"solid element: {name} has no quadratic surface here; "
-                            f"allowed: ElementHexS2 (hex20), ElementHex2 (hex27), ElementTetP2 (tet10)")
+        raise ScenarioError("solid.element", name,
+                            "one of ElementHexS2 (hex20), ElementHex2 (hex27), ElementTetP2 (tet10)")
     return kinds[name]
 
 
@@ -395,7 +395,8 @@ def boundary_surface(basis, groups: tuple[str, ...] | None = None) -> Surface:
     mesh = basis.mesh
     element = getattr(basis.elem, "elem", None)
     if element is None or getattr(basis.elem, "dim", None) != 3:
-        raise ScenarioError("solid basis: a 3-component ElementVector is required")
+        raise ScenarioError("solid.element", type(basis.elem).__name__,
+                            "a 3-component ElementVector of a quadratic solid element")
     kind = _kind_of(element)
     if groups is None:
         facets = mesh.boundary_facets()
@@ -403,12 +404,13 @@ def boundary_surface(basis, groups: tuple[str, ...] | None = None) -> Surface:
         named = mesh.boundaries or {}
         unknown = [g for g in groups if g not in named]
         if unknown:
-            raise ScenarioError(f"solid surface groups: {unknown} are not facet groups of the mesh; "
-                                f"allowed: {sorted(named)}")
+            raise ScenarioError("solid.surface_groups", unknown,
+                                f"facet groups of the mesh: {sorted(named)}")
         facets = np.unique(np.concatenate([np.asarray(named[g]) for g in groups]))
         inner = facets[mesh.f2t[1, facets] >= 0]
         if len(inner):
-            raise ScenarioError(f"solid surface groups: facets {inner[:5].tolist()} are inside the body")
+            raise ScenarioError("solid.surface_groups", list(groups),
+                                f"groups of boundary facets (facets {inner[:5].tolist()} are inside the body)")
     facets = np.asarray(facets, dtype=np.int64)
     elements = mesh.f2t[0, facets].astype(np.int64)
     ref_faces = _reference_faces(kind, np.asarray(element.doflocs, float))

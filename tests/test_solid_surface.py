@@ -1,0 +1,128 @@
+"""The solid's boundary surface (granplate.solid.surface) against geometry: feet of
+perpendiculars, distances to edges and corners, exact interpolation by the face weights,
+and the sliding projection against the brute-force closest point."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from skfem import Basis, ElementHex2, ElementHexS2, ElementTetP2, ElementVector, MeshHex, MeshTet
+
+from granplate.errors import ScenarioError
+from granplate.solid.surface import (QUAD8, QUAD9, TRI6, boundary_surface, closest_point, face_closest,
+                                     face_neighbours, patch_weights, slide_closest)
+
+#: The unit cube [0, 1]^3 meshed in 2 x 2 x 2 hexes or 48 tets, with each quadratic element.
+ELEMENTS = {"hex20": (MeshHex, ElementHexS2, QUAD8), "hex27": (MeshHex, ElementHex2, QUAD9),
+            "tet10": (MeshTet, ElementTetP2, TRI6)}
+
+
+def cube_basis(name: str, refine: int = 1) -> Basis:
+    mesh_type, element, _ = ELEMENTS[name]
+    return Basis(mesh_type().refined(refine), ElementVector(element()))
+
+
+@pytest.fixture(scope="module", params=list(ELEMENTS))
+def cube(request):
+    basis = cube_basis(request.param)
+    return request.param, basis, boundary_surface(basis)
+
+
+def brute_force(surface, p):
+    """The closest point over all faces, one at a time: (squared distance, point)."""
+    out = np.empty(9)
+    best, point = np.inf, None
+    for f in range(surface.n_faces):
+        d2 = face_closest(surface.nodes[f], surface.kind, p, out)
+        if d2 < best:
+            best, point = d2, out[2:5].copy()
+    return best, point
+
+
+def test_faces_cover_the_cube_outward(cube):
+    """The faces are the cube's 6 sides, their areas sum to 6 and every normal points out."""
+    name, basis, s = cube
+    assert s.kind == ELEMENTS[name][2]
+    assert s.n_faces == (24 if name != "tet10" else 48)
+    centroid = s.nodes.mean(axis=1)
+    for f in range(s.n_faces):
+        cp = closest_point(s, centroid[f] + 0.1 * (centroid[f] - 0.5) / np.abs(centroid[f] - 0.5).max())
+        assert np.isclose(cp.distance, 0.1, atol=1e-12)
+        axis = np.argmax(np.abs(centroid[f] - 0.5))
+        assert np.isclose(cp.normal[axis], np.sign(centroid[f][axis] - 0.5))
+    # the dofs are the basis' own: their locations are the nodes, component c at dofs[..., c]
+    assert np.allclose(basis.doflocs[:, s.dofs[..., 1]], np.moveaxis(s.nodes, -1, 0))
+
+
+def test_foot_of_a_point_above_a_face(cube):
+    """A point above the top side projects to its foot, at its height, normal +z."""
+    _, _, s = cube
+    cp = closest_point(s, [0.3, 0.4, 1.7])
+    assert np.allclose(cp.point, [0.3, 0.4, 1.0], atol=1e-13)
+    assert np.isclose(cp.distance, 0.7) and np.allclose(cp.normal, [0, 0, 1], atol=1e-13)
+    inside = closest_point(s, [0.3, 0.4, 0.9])
+    assert np.isclose(inside.distance, -0.1) and np.allclose(inside.normal, [0, 0, 1], atol=1e-13)
+
+
+def test_edge_and_corner(cube):
+    """Outside an edge the closest point is on the edge, at the distance in the normal plane;
+    outside a corner it is the corner, at the distance to it; the normal points to the centre."""
+    _, _, s = cube
+    edge = closest_point(s, [1.3, 0.45, 1.4])
+    assert np.allclose(edge.point, [1.0, 0.45, 1.0], atol=1e-12)
+    assert np.isclose(edge.distance, 0.5)
+    assert np.allclose(edge.normal, [0.6, 0.0, 0.8], atol=1e-12)
+    corner = closest_point(s, [-0.2, 1.1, -0.2])
+    assert np.allclose(corner.point, [0.0, 1.0, 0.0], atol=1e-12)
+    assert np.isclose(corner.distance, 0.3)
+
+
+def test_weights_interpolate_quadratic_fields(cube):
+    """The weights are the face's shape functions: they sum to 1 and reproduce a linear and a
+    quadratic field (in the element space) exactly at the point, so sum_k w_k F . u_k = F . u."""
+    _, _, s = cube
+    rng = np.random.default_rng(1)
+    fields = (lambda x: 1.0 + 2.0 * x[..., 0] - 3.0 * x[..., 1] + 0.5 * x[..., 2],
+              lambda x: x[..., 0] ** 2 - 2.0 * x[..., 1] * x[..., 2] + x[..., 0] * x[..., 1] + x[..., 2])
+    for _ in range(10):
+        p = rng.uniform(-0.3, 1.3, 3)
+        cp = closest_point(s, p)
+        dofs, w = patch_weights(s, cp.face, cp.xi)
+        assert dofs.shape == (len(w), 3)
+        assert np.isclose(w.sum(), 1.0, atol=1e-14)
+        for u in fields:
+            assert np.isclose(w @ u(s.nodes[cp.face]), u(cp.point), atol=1e-13)
+
+
+def test_sliding_projection_equals_brute_force():
+    """A seeded random walk around the cube (outside and just inside): the compiled sliding
+    projection from the previous face gives the brute-force closest point over all faces."""
+    rng = np.random.default_rng(7)
+    for name in ("hex20", "tet10"):
+        s = boundary_surface(cube_basis(name))
+        nb = face_neighbours(s)
+        p = np.array([0.5, 0.5, 1.1])
+        face = closest_point(s, p).face
+        out = np.empty(9)
+        checked = 0
+        for _ in range(400):
+            trial = p + rng.normal(0.0, 0.05, 3)
+            depth = np.max(np.abs(trial - 0.5)) - 0.5  # > 0 outside the cube
+            if not -0.1 < depth < 0.25:
+                continue
+            p = trial
+            face = slide_closest(s.nodes, s.kind, nb, face, p, out)
+            d2, point = brute_force(s, p)
+            assert np.isclose(out[8] ** 2, d2, rtol=1e-10, atol=1e-14)
+            assert np.allclose(out[2:5], point, atol=1e-9) or abs(np.sqrt(d2) - abs(depth)) < 1e-9
+            checked += 1
+        assert checked > 200
+
+
+def test_named_groups_and_bad_input():
+    """A named facet group gives just its faces; an unknown group is a ScenarioError naming it."""
+    basis = cube_basis("hex20")
+    mesh = basis.mesh.with_boundaries({"top": lambda x: np.isclose(x[2], 1.0)})
+    top = boundary_surface(Basis(mesh, basis.elem), groups=("top",))
+    assert top.n_faces == 4 and np.allclose(top.nodes[..., 2], 1.0)
+    with pytest.raises(ScenarioError, match="bottom"):
+        boundary_surface(Basis(mesh, basis.elem), groups=("bottom",))
