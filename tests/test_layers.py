@@ -15,6 +15,7 @@ LAYERS = (
     ("setup",),
     ("physics",),
     ("plate",),
+    ("solid",),
     ("model",),
     ("solver",),
     ("results",),
