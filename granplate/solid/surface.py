@@ -180,10 +180,12 @@ def face_closest(X, kind, p, out):
     returns the squared distance [m^2].
     """
     n = X.shape[0]
-    N = np.empty(n)
-    dN = np.empty((n, 2))
-    x = np.empty(3)
-    J = np.empty((3, 2))
+    return _face_closest(X, kind, p, out, np.empty(n), np.empty((n, 2)), np.empty(3), np.empty((3, 2)))
+
+
+@njit(cache=True)
+def _face_closest(X, kind, p, out, N, dN, x, J):
+    """`face_closest` with its scratch passed in (N (n,), dN (n, 2), x (3,), J (3, 2))."""
     best = np.inf
     # the interior minimum
     xi = 1.0 / 3.0 if kind == TRI6 else 0.0
@@ -299,19 +301,24 @@ def slide_closest(nodes, kind, neighbours, face, p, out):
     its neighbours (`face_neighbours`), move to the nearest, repeat until the face stays.
 
     nodes: (n_faces, n_nodes, 3) [m]; out (9,): (xi, eta), the point [m], the outward unit
-    normal, the signed distance [m] (`contact_frame`). Returns the face. Allocation-light
-    (small scratch per call); no Python per call. Exact while the centre moves less than
+    normal, the signed distance [m] (`contact_frame`). Returns the face. A small
+    scratch per call, no Python. Exact while the centre moves less than
     about a face per call over a convex surface."""
     trial = np.empty(5)
     best_out = np.empty(5)
-    best = face_closest(nodes[face], kind, p, best_out)
+    n = nodes.shape[1]
+    N = np.empty(n)
+    dN = np.empty((n, 2))
+    x = np.empty(3)
+    J = np.empty((3, 2))
+    best = _face_closest(nodes[face], kind, p, best_out, N, dN, x, J)
     for _ in range(nodes.shape[0]):
         moved = -1
         for j in range(neighbours.shape[1]):
             g = neighbours[face, j]
             if g < 0:
                 break
-            d2 = face_closest(nodes[g], kind, p, trial)
+            d2 = _face_closest(nodes[g], kind, p, trial, N, dN, x, J)
             if d2 < best * (1.0 - 1e-12) - 1e-300:
                 best = d2
                 best_out[:] = trial
