@@ -27,15 +27,17 @@ def cube(request):
     return request.param, basis, boundary_surface(basis)
 
 
-def brute_force(surface, p):
-    """The closest point over all faces, one at a time: (squared distance, point)."""
+def brute_force(surface, p, tie=1e-9):
+    """The closest point over all faces, one at a time: (squared distance, the points of
+    every face within `tie` [m] of the smallest distance: the ties at an edge or a medial
+    plane)."""
     out = np.empty(9)
-    best, point = np.inf, None
+    found = []
     for f in range(surface.n_faces):
         d2 = face_closest(surface.nodes[f], surface.kind, p, out)
-        if d2 < best:
-            best, point = d2, out[2:5].copy()
-    return best, point
+        found.append((d2, out[2:5].copy()))
+    best = min(d2 for d2, _ in found)
+    return best, [x for d2, x in found if np.sqrt(d2) - np.sqrt(best) < tie]
 
 
 def test_faces_cover_the_cube_outward(cube):
@@ -93,29 +95,67 @@ def test_weights_interpolate_quadratic_fields(cube):
             assert np.isclose(w @ u(s.nodes[cp.face]), u(cp.point), atol=1e-13)
 
 
-def test_sliding_projection_equals_brute_force():
-    """A seeded random walk around the cube (outside and just inside): the compiled sliding
+def box_basis(name: str) -> Basis:
+    """The box [0, 2] x [0, 1] x [0, 0.5] in 4 x 2 x 2 hexes (or those cut into tets)."""
+    mesh_type, element, _ = ELEMENTS[name]
+    mesh = mesh_type.init_tensor(np.linspace(0, 2, 5), np.linspace(0, 1, 3), np.linspace(0, 0.5, 3))
+    return Basis(mesh, ElementVector(element()))
+
+
+@pytest.mark.parametrize("name", ["hex20", "tet10"])
+def test_sliding_projection_equals_brute_force(name):
+    """A seeded random walk around a box (outside and just inside): the compiled sliding
     projection from the previous face gives the brute-force closest point over all faces."""
     rng = np.random.default_rng(7)
-    for name in ("hex20", "tet10"):
-        s = boundary_surface(cube_basis(name))
-        nb = face_neighbours(s)
-        p = np.array([0.5, 0.5, 1.1])
-        face = closest_point(s, p).face
-        out = np.empty(9)
-        checked = 0
-        for _ in range(400):
-            trial = p + rng.normal(0.0, 0.05, 3)
-            depth = np.max(np.abs(trial - 0.5)) - 0.5  # > 0 outside the cube
-            if not -0.1 < depth < 0.25:
-                continue
-            p = trial
-            face = slide_closest(s.nodes, s.kind, nb, face, p, out)
-            d2, point = brute_force(s, p)
-            assert np.isclose(out[8] ** 2, d2, rtol=1e-10, atol=1e-14)
-            assert np.allclose(out[2:5], point, atol=1e-9) or abs(np.sqrt(d2) - abs(depth)) < 1e-9
-            checked += 1
-        assert checked > 200
+    s = boundary_surface(box_basis(name))
+    nb = face_neighbours(s)
+    lo, hi = np.zeros(3), np.array([2.0, 1.0, 0.5])
+    p = np.array([1.0, 0.5, 0.6])
+    face = closest_point(s, p).face
+    out = np.empty(9)
+    checked = corners = 0
+    for _ in range(600):
+        trial = p + rng.normal(0.0, 0.06, 3)
+        outside = np.linalg.norm(np.maximum(np.maximum(lo - trial, trial - hi), 0.0))
+        inside = np.min(np.minimum(trial - lo, hi - trial))
+        if not (0.0 < outside < 0.3 or 0.0 < inside < 0.1):
+            continue
+        p = trial
+        face = slide_closest(s.nodes, s.kind, nb, face, p, out)
+        d2, points = brute_force(s, p)
+        assert np.isclose(out[8], outside if outside > 0 else -inside, rtol=1e-10, atol=1e-13)
+        assert np.isclose(out[8] ** 2, d2, rtol=1e-10, atol=1e-14)
+        assert any(np.allclose(out[2:5], x, atol=1e-9) for x in points)
+        checked += 1
+        corners += int(np.sum((p < lo) | (p > hi)) >= 2)
+    assert checked > 300 and corners > 20
+
+
+def test_curved_face_projection():
+    """On a curved quad9 face (nodes on a cylinder of radius 1) the projection is the
+    minimum over a dense grid of the face's reference points, and p - x is normal to it."""
+    ref = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [0, -1], [1, 0], [0, 1], [-1, 0], [0, 0]], float)
+    angle, height = 0.4 * ref[:, 0], 0.5 * ref[:, 1]
+    X = np.stack([np.cos(angle), np.sin(angle), height], axis=1)
+    from granplate.solid.surface import face_normal, face_shape_functions
+    g = np.linspace(-1, 1, 801)
+    N, dN = np.empty(9), np.empty((9, 2))
+    grid = []
+    for a in g[::4]:
+        for b in g[::4]:
+            face_shape_functions(QUAD9, a, b, N, dN)
+            grid.append(N @ X)
+    grid = np.array(grid)
+    out, n = np.empty(9), np.empty(3)
+    for p in ([1.5, 0.1, 0.2], [0.4, -0.1, -0.1], [1.2, 0.8, 0.1], [1.3, -0.6, 0.9]):
+        p = np.array(p)
+        d2 = face_closest(X, QUAD9, p, out)
+        assert np.sqrt(d2) <= np.min(np.linalg.norm(grid - p, axis=1)) + 1e-12
+        assert np.sqrt(d2) >= np.min(np.linalg.norm(grid - p, axis=1)) - 5e-3
+        if np.all(np.abs(out[:2]) < 1 - 1e-9):  # an interior foot: p - x along the normal
+            face_normal(X, QUAD9, out[0], out[1], n)
+            r = p - out[2:5]
+            assert np.allclose(np.cross(r, n), 0.0, atol=1e-10)
 
 
 def test_named_groups_and_bad_input():
@@ -126,3 +166,30 @@ def test_named_groups_and_bad_input():
     assert top.n_faces == 4 and np.allclose(top.nodes[..., 2], 1.0)
     with pytest.raises(ScenarioError, match="bottom"):
         boundary_surface(Basis(mesh, basis.elem), groups=("bottom",))
+
+
+@pytest.mark.parametrize("kind", [QUAD8, QUAD9, TRI6])
+def test_shape_functions_are_nodal_and_their_derivatives_match_differences(kind):
+    """N_k(node j) = delta_kj, and dN, d2N equal central differences of N and dN."""
+    from granplate.solid.surface import NODES_PER_FACE, _QUAD_NODES, _TRI_NODES, face_shape_functions, \
+        face_shape_hessians
+    n = NODES_PER_FACE[kind]
+    ref = (_TRI_NODES if kind == TRI6 else _QUAD_NODES)[:n]
+    N, dN, d2N = np.empty(n), np.empty((n, 2)), np.empty((n, 3))
+    for j, (a, b) in enumerate(ref):
+        face_shape_functions(kind, a, b, N, dN)
+        assert np.allclose(N, np.eye(n)[j], atol=1e-14)
+    a, b, h = 0.23, 0.31, 1e-5
+
+    def at(x, y):
+        Nx, dNx = np.empty(n), np.empty((n, 2))
+        face_shape_functions(kind, x, y, Nx, dNx)
+        return Nx, dNx
+
+    face_shape_functions(kind, a, b, N, dN)
+    face_shape_hessians(kind, a, b, d2N)
+    assert np.allclose(dN[:, 0], (at(a + h, b)[0] - at(a - h, b)[0]) / (2 * h), atol=1e-8)
+    assert np.allclose(dN[:, 1], (at(a, b + h)[0] - at(a, b - h)[0]) / (2 * h), atol=1e-8)
+    assert np.allclose(d2N[:, 0], (at(a + h, b)[1][:, 0] - at(a - h, b)[1][:, 0]) / (2 * h), atol=1e-7)
+    assert np.allclose(d2N[:, 1], (at(a, b + h)[1][:, 0] - at(a, b - h)[1][:, 0]) / (2 * h), atol=1e-7)
+    assert np.allclose(d2N[:, 2], (at(a, b + h)[1][:, 1] - at(a, b - h)[1][:, 1]) / (2 * h), atol=1e-7)

@@ -132,6 +132,65 @@ def face_shape_functions(kind, xi, eta, N, dN):
 
 
 @njit(cache=True)
+def face_shape_hessians(kind, xi, eta, d2N):
+    """The shape functions' second derivatives d2N (n_nodes, 3): (xi xi, xi eta, eta eta)."""
+    if kind == TRI6:
+        d2N[:, :] = 0.0
+        d2N[0, 0] = d2N[0, 1] = d2N[0, 2] = 4.0
+        d2N[1, 0] = 4.0
+        d2N[2, 2] = 4.0
+        d2N[3, 0] = -8.0
+        d2N[3, 1] = -4.0
+        d2N[4, 1] = 4.0
+        d2N[5, 1] = -4.0
+        d2N[5, 2] = -8.0
+        return
+    if kind == QUAD9:
+        ax = (0.5 * xi * (xi - 1.0), 1.0 - xi * xi, 0.5 * xi * (xi + 1.0))
+        dax = (xi - 0.5, -2.0 * xi, xi + 0.5)
+        ay = (0.5 * eta * (eta - 1.0), 1.0 - eta * eta, 0.5 * eta * (eta + 1.0))
+        day = (eta - 0.5, -2.0 * eta, eta + 0.5)
+        dd = (1.0, -2.0, 1.0)
+        for k in range(9):
+            i = int(_QUAD_NODES[k, 0]) + 1
+            j = int(_QUAD_NODES[k, 1]) + 1
+            d2N[k, 0] = dd[i] * ay[j]
+            d2N[k, 1] = dax[i] * day[j]
+            d2N[k, 2] = ax[i] * dd[j]
+        return
+    for k in range(4):
+        a = _QUAD_NODES[k, 0]
+        b = _QUAD_NODES[k, 1]
+        s = 1.0 + a * xi
+        t = 1.0 + b * eta
+        d2N[k, 0] = 0.5 * t
+        d2N[k, 1] = 0.25 * a * b * (a * xi + b * eta - 1.0 + s + t)
+        d2N[k, 2] = 0.5 * s
+    for k in range(4, 8):
+        a = _QUAD_NODES[k, 0]
+        b = _QUAD_NODES[k, 1]
+        if a == 0.0:
+            d2N[k, 0] = -(1.0 + b * eta)
+            d2N[k, 1] = -xi * b
+            d2N[k, 2] = 0.0
+        else:
+            d2N[k, 0] = 0.0
+            d2N[k, 1] = -eta * a
+            d2N[k, 2] = -(1.0 + a * xi)
+
+
+@njit(cache=True)
+def _face_curvature(X, kind, xi, eta, d2N, K):
+    """K (3, 3): x_xixi, x_xieta, x_etaeta (columns) of the face at (xi, eta)."""
+    face_shape_hessians(kind, xi, eta, d2N)
+    for c in range(3):
+        for m in range(3):
+            K[c, m] = 0.0
+            for k in range(X.shape[0]):
+                K[c, m] += d2N[k, m] * X[k, c]
+
+
+@njit(cache=True)
 def _face_point(X, kind, xi, eta, N, dN, x, J):
     """x (3,) and its tangents J (3, 2) at (xi, eta) of the face with nodes X (n, 3) [m]."""
     face_shape_functions(kind, xi, eta, N, dN)
@@ -180,19 +239,23 @@ def face_closest(X, kind, p, out):
     returns the squared distance [m^2].
     """
     n = X.shape[0]
-    return _face_closest(X, kind, p, out, np.empty(n), np.empty((n, 2)), np.empty(3), np.empty((3, 2)))
+    return _face_closest(X, kind, p, out, np.empty(n), np.empty((n, 2)), np.empty((n, 3)), np.empty(3),
+                         np.empty((3, 2)), np.empty((3, 3)))
 
 
 @njit(cache=True)
-def _face_closest(X, kind, p, out, N, dN, x, J):
-    """`face_closest` with its scratch passed in (N (n,), dN (n, 2), x (3,), J (3, 2))."""
+def _face_closest(X, kind, p, out, N, dN, d2N, x, J, K):
+    """`face_closest` with its scratch passed in (N (n,), dN (n, 2), d2N (n, 3), x (3,),
+    J (3, 2), K (3, 3)). Newton's Hessian includes the face's curvature (r . x_ab) where
+    that keeps it positive definite, else the Gauss-Newton J^T J."""
     best = np.inf
     # the interior minimum
     xi = 1.0 / 3.0 if kind == TRI6 else 0.0
     eta = xi
     for _ in range(_NEWTON_ITERATIONS):
         _face_point(X, kind, xi, eta, N, dN, x, J)
-        g0 = g1 = h00 = h01 = h11 = 0.0
+        _face_curvature(X, kind, xi, eta, d2N, K)
+        g0 = g1 = h00 = h01 = h11 = k00 = k01 = k11 = 0.0
         for c in range(3):
             r = x[c] - p[c]
             g0 += J[c, 0] * r
@@ -200,6 +263,13 @@ def _face_closest(X, kind, p, out, N, dN, x, J):
             h00 += J[c, 0] * J[c, 0]
             h01 += J[c, 0] * J[c, 1]
             h11 += J[c, 1] * J[c, 1]
+            k00 += r * K[c, 0]
+            k01 += r * K[c, 1]
+            k11 += r * K[c, 2]
+        if h00 + k00 > 0.0 and (h00 + k00) * (h11 + k11) - (h01 + k01) ** 2 > 0.0:
+            h00 += k00
+            h01 += k01
+            h11 += k11
         det = h00 * h11 - h01 * h01
         d0 = (h11 * g0 - h01 * g1) / det
         d1 = (h00 * g1 - h01 * g0) / det
@@ -232,12 +302,14 @@ def _face_closest(X, kind, p, out, N, dN, x, J):
         u = 0.5
         for _ in range(_NEWTON_ITERATIONS):
             _face_point(X, kind, ax + u * tx, ay + u * ty, N, dN, x, J)
-            g = h = 0.0
+            _face_curvature(X, kind, ax + u * tx, ay + u * ty, d2N, K)
+            g = h = k = 0.0
             for c in range(3):
                 tc = J[c, 0] * tx + J[c, 1] * ty
                 g += tc * (x[c] - p[c])
                 h += tc * tc
-            step = g / h
+                k += (x[c] - p[c]) * (tx * tx * K[c, 0] + 2.0 * tx * ty * K[c, 1] + ty * ty * K[c, 2])
+            step = g / (h + k) if h + k > 0.0 else g / h
             un = min(max(u - step, 0.0), 1.0)
             done = abs(un - u) < _NEWTON_TOL
             u = un
@@ -309,16 +381,18 @@ def slide_closest(nodes, kind, neighbours, face, p, out):
     n = nodes.shape[1]
     N = np.empty(n)
     dN = np.empty((n, 2))
+    d2N = np.empty((n, 3))
     x = np.empty(3)
     J = np.empty((3, 2))
-    best = _face_closest(nodes[face], kind, p, best_out, N, dN, x, J)
+    K = np.empty((3, 3))
+    best = _face_closest(nodes[face], kind, p, best_out, N, dN, d2N, x, J, K)
     for _ in range(nodes.shape[0]):
         moved = -1
         for j in range(neighbours.shape[1]):
             g = neighbours[face, j]
             if g < 0:
                 break
-            d2 = _face_closest(nodes[g], kind, p, trial, N, dN, x, J)
+            d2 = _face_closest(nodes[g], kind, p, trial, N, dN, d2N, x, J, K)
             if d2 < best * (1.0 - 1e-12) - 1e-300:
                 best = d2
                 best_out[:] = trial
