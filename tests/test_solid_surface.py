@@ -166,6 +166,8 @@ def test_named_groups_and_bad_input():
     assert top.n_faces == 4 and np.allclose(top.nodes[..., 2], 1.0)
     with pytest.raises(ScenarioError, match="bottom"):
         boundary_surface(Basis(mesh, basis.elem), groups=("bottom",))
+    with pytest.raises(ScenarioError, match="point"):
+        closest_point(top, [0.0, np.nan, 1.0])
 
 
 @pytest.mark.parametrize("kind", [QUAD8, QUAD9, TRI6])

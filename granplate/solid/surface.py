@@ -27,6 +27,7 @@ faces, edges and corners without Python per step.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numba import njit
@@ -45,6 +46,9 @@ _TRI_NODES = np.array([[0, 0], [1, 0], [0, 1], [0.5, 0], [0.5, 0.5], [0, 0.5]], 
 #: Newton iterations of a projection, and its step tolerance in reference coordinates.
 _NEWTON_ITERATIONS = 30
 _NEWTON_TOL = 1e-14
+#: A face lies within this factor times its largest node distance of its nodes' centroid
+#: (room for the bulge of a curved quadratic face).
+_BULGE = 1.25
 
 
 @dataclass(frozen=True)
@@ -67,6 +71,18 @@ class Surface:
     @property
     def n_faces(self) -> int:
         return len(self.facets)
+
+    @cached_property
+    def centroid_tree(self):
+        """A k-d tree over the faces' node centroids (built on first use)."""
+        from scipy.spatial import cKDTree
+
+        return cKDTree(self.nodes.mean(axis=1))
+
+    @cached_property
+    def largest_radius(self) -> float:
+        """The largest `face_radius` [m]."""
+        return float(face_radius(self).max())
 
 
 # --------------------------------------------------------------------------------------
@@ -368,6 +384,26 @@ def contact_frame(X, kind, p, out):
 
 
 @njit(cache=True)
+def _lower_bound2(X, p):
+    """A lower bound [m^2] of the squared distance from p to the face with nodes X: the
+    distance to the nodes' centroid less the face's radius (`face_radius`), squared, or 0."""
+    c0 = c1 = c2 = 0.0
+    n = X.shape[0]
+    for k in range(n):
+        c0 += X[k, 0]
+        c1 += X[k, 1]
+        c2 += X[k, 2]
+    c0 /= n
+    c1 /= n
+    c2 /= n
+    r2 = 0.0
+    for k in range(n):
+        r2 = max(r2, (X[k, 0] - c0) ** 2 + (X[k, 1] - c1) ** 2 + (X[k, 2] - c2) ** 2)
+    gap = np.sqrt((p[0] - c0) ** 2 + (p[1] - c1) ** 2 + (p[2] - c2) ** 2) - _BULGE * np.sqrt(r2)
+    return gap * gap if gap > 0.0 else 0.0
+
+
+@njit(cache=True)
 def slide_closest(nodes, kind, neighbours, face, p, out):
     """The closest point to p (3,) [m] on the surface near `face`: project onto the face and
     its neighbours (`face_neighbours`), move to the nearest, repeat until the face stays.
@@ -392,6 +428,8 @@ def slide_closest(nodes, kind, neighbours, face, p, out):
             g = neighbours[face, j]
             if g < 0:
                 break
+            if _lower_bound2(nodes[g], p) >= best:
+                continue
             d2 = _face_closest(nodes[g], kind, p, trial, N, dN, d2N, x, J, K)
             if d2 < best * (1.0 - 1e-12) - 1e-300:
                 best = d2
@@ -541,7 +579,7 @@ def face_radius(surface: Surface) -> np.ndarray:
     """(n_faces,) a bound on each face's distance from its nodes' centroid [m]: the largest
     node distance, enlarged by a quarter for the bulge of a curved quadratic face."""
     centroid = surface.nodes.mean(axis=1)
-    return 1.25 * np.linalg.norm(surface.nodes - centroid[:, None, :], axis=2).max(axis=1)
+    return _BULGE * np.linalg.norm(surface.nodes - centroid[:, None, :], axis=2).max(axis=1)
 
 
 @dataclass(frozen=True)
@@ -560,15 +598,14 @@ def closest_point(surface: Surface, point) -> ClosestPoint:
     """The closest point of the whole surface to `point` (3,) [m]: candidate faces from a
     k-d tree over the face centroids (every face whose centroid lies within the first
     face's distance plus the largest face radius), projected each by `face_closest`."""
-    from scipy.spatial import cKDTree
-
-    p = np.asarray(point, dtype=float).reshape(3)
-    centroid = surface.nodes.mean(axis=1)
-    tree = cKDTree(centroid)
+    p = np.asarray(point, dtype=float).ravel()
+    if p.shape != (3,) or not np.all(np.isfinite(p)):
+        raise ScenarioError("point", point, "three finite coordinates [m]")
+    tree = surface.centroid_tree
     _, first = tree.query(p)
     scratch = np.empty(9)
     bound = np.sqrt(face_closest(surface.nodes[first], surface.kind, p, scratch))
-    candidates = tree.query_ball_point(p, bound + face_radius(surface).max())
+    candidates = tree.query_ball_point(p, bound + surface.largest_radius)
     best, best_face, best_out = np.inf, -1, np.empty(9)
     for f in sorted(candidates):
         d2 = face_closest(surface.nodes[f], surface.kind, p, scratch)
