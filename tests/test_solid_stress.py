@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 from skfem import Basis, ElementHex2, ElementHexS2, ElementTetP2, ElementVector, MeshHex, MeshTet
 
-from granplate.solid.stress import (ball_average_operator, ball_mean, ball_von_mises, elasticity_matrix,
+from granplate.errors import ScenarioError
+from granplate.solid.stress import (ball_average_operator, ball_operator, max_ball_von_mises, ball_mean, ball_von_mises, elasticity_matrix,
                                     max_von_mises, modal_unit_stresses, point_spacing, quadrature_points,
                                     quadrature_weights, strain_operator, strains, stresses,
                                     surface_centres, von_mises, von_mises_of_ball_mean)
@@ -133,3 +134,17 @@ def test_surface_centres_lie_on_the_boundary():
     x = surface_centres(basis_of("tet10"))
     assert np.all(np.isclose(x, 0).any(axis=1) | np.isclose(x, 1).any(axis=1))
     assert len(x) == 6 * 5 * 5 - 12 * 5 + 8  # the nodes of a 5 x 5 node grid on each side
+
+
+def test_surface_maximum_of_a_uniform_field():
+    """A uniform uniaxial stress: every ball mean about the surface nodes, cut or not, is E eps,
+    so the surface maximum is E eps; a radius <= 0 is a ScenarioError naming it."""
+    basis = basis_of("hex27")
+    sigma = stresses(elasticity_matrix(E, NU), strains(strain_operator(basis), interpolate(
+        basis, lambda x: 1e-3 * np.stack([x[0], -NU * x[1], -NU * x[2]]))))
+    for partial in (True, False):
+        ball = ball_operator(basis, surface_centres(basis), 0.2, partial_cells=partial)
+        assert np.allclose(ball_von_mises(ball, sigma), E * 1e-3, rtol=1e-12)
+        assert np.isclose(max_ball_von_mises(ball, sigma), E * 1e-3, rtol=1e-12)
+    with pytest.raises(ScenarioError, match="stress_radius"):
+        ball_operator(basis, surface_centres(basis), 0.0)

@@ -20,6 +20,8 @@ import numpy as np
 import scipy.sparse as sp
 from skfem import Basis
 
+from granplate.errors import ScenarioError
+
 #: Voigt components: normal then shear, engineering shear strains.
 COMPONENTS = ("xx", "yy", "zz", "yz", "xz", "xy")
 _SHEAR_PAIRS = ((1, 2), (0, 2), (0, 1))
@@ -186,3 +188,13 @@ def surface_centres(basis: Basis) -> np.ndarray:
     (corners, edge and face mid-points of the boundary facets), each once."""
     dofs = np.asarray(basis.get_dofs().flatten())
     return np.unique(np.round(basis.doflocs[:, dofs].T, 12), axis=0)
+
+
+def ball_operator(basis: Basis, centres: np.ndarray, radius: float, partial_cells: bool = True) -> sp.csr_matrix:
+    """`ball_average_operator` over the basis' quadrature points, about `centres` (n, 3) [m]
+    (`surface_centres` for the body's surface), with the partial cells of `point_spacing`
+    (or, partial_cells=False, the points inside only)."""
+    if not radius > 0.0:
+        raise ScenarioError("stress_radius", radius, "a positive radius [m]")
+    spacing = point_spacing(basis) if partial_cells else 0.0
+    return ball_average_operator(quadrature_points(basis), quadrature_weights(basis), centres, radius, spacing)
