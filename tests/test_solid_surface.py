@@ -195,3 +195,17 @@ def test_shape_functions_are_nodal_and_their_derivatives_match_differences(kind)
     assert np.allclose(d2N[:, 0], (at(a + h, b)[1][:, 0] - at(a - h, b)[1][:, 0]) / (2 * h), atol=1e-7)
     assert np.allclose(d2N[:, 1], (at(a, b + h)[1][:, 0] - at(a, b - h)[1][:, 0]) / (2 * h), atol=1e-7)
     assert np.allclose(d2N[:, 2], (at(a, b + h)[1][:, 1] - at(a, b - h)[1][:, 1]) / (2 * h), atol=1e-7)
+
+
+def test_weights_are_the_element_space_at_the_point(cube):
+    """For a random displacement of the element space (any dof vector), sum_k w_k u_k equals
+    the field scikit-fem evaluates at the point (basis.probes): the work F . u is exact."""
+    _, basis, s = cube
+    rng = np.random.default_rng(11)
+    x = rng.normal(size=basis.N)
+    for _ in range(6):
+        cp = closest_point(s, rng.uniform(-0.3, 1.3, 3))
+        dofs, w = patch_weights(s, cp.face, cp.xi)
+        inward = cp.point - 1e-12 * (cp.point - 0.5)  # inside the element for the point search
+        probe = basis.probes(inward[:, None])  # (3, N): the components at the point
+        assert np.allclose(w @ x[dofs], probe @ x, atol=1e-9)
