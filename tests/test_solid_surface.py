@@ -53,6 +53,8 @@ def test_faces_cover_the_cube_outward(cube):
         assert np.isclose(cp.normal[axis], np.sign(centroid[f][axis] - 0.5))
     # the dofs are the basis' own: their locations are the nodes, component c at dofs[..., c]
     assert np.allclose(basis.doflocs[:, s.dofs[..., 1]], np.moveaxis(s.nodes, -1, 0))
+    # and the same dofs as scikit-fem's own facet dofs of the boundary
+    assert set(s.dofs.ravel()) == set(np.asarray(basis.get_dofs(s.facets).flatten()))
 
 
 def test_foot_of_a_point_above_a_face(cube):
