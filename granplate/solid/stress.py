@@ -1,5 +1,5 @@
 """Strain and stress recovery of the 3D solid, and the ball-averaged von Mises stress
-(docs/model.md section 4.6).
+(docs/model.md section 3.8).
 
 Voigt order (xx, yy, zz, yz, xz, xy): strains with engineering shears gamma_ij =
 du_i/dx_j + du_j/dx_i [-], stresses sigma = D eps [Pa]. Values at the quadrature points are

@@ -1,5 +1,5 @@
 """The boundary surface of a 3D solid as quadratic faces, and patch contacts on it
-(docs/model.md section 4.6).
+(docs/model.md section 3.8).
 
 Each boundary facet of a scikit-fem mesh becomes a face with its quadratic nodes: quad8
 (the trace of the 20-node serendipity hex, `ElementHexS2`), quad9 (the 27-node hex,
