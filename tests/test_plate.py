@@ -510,3 +510,42 @@ def test_mode_sign_rule_is_deterministic_for_symmetric_modes():
     np.testing.assert_array_equal(gp.fix_mode_signs(-phi), fixed)
     np.testing.assert_array_equal(np.abs(fixed), np.abs(phi))
     assert np.all(gp.sign_reference(4) @ fixed > 0)
+
+
+def test_a_plate_asked_again_is_kept_and_equals_a_fresh_build():
+    """The process keeps a built plate (the same object for the same inputs) and it equals,
+    array for array, a plate built afresh (without the store) from the same inputs; other
+    inputs build another plate."""
+    from granplate.plate.build import forget_built_plates
+
+    plate = Plate(nx=2, ny=10, n_modes=8)
+    first = gp.build_plate(plate, X0, [0.05], edge_load=(0.025, 0.05))
+    assert gp.build_plate(plate, X0, [0.05], edge_load=(0.025, 0.05)) is first
+    assert gp.build_plate(plate, X0, [0.03], edge_load=(0.025, 0.05)) is not first
+    fresh = gp.build_plate(plate, X0, [0.05], edge_load=(0.025, 0.05), cache=False)
+    forget_built_plates()
+    again = gp.build_plate(plate, X0, [0.05], edge_load=(0.025, 0.05))
+    assert again is not first
+    for f in dataclasses.fields(first):
+        a, b = getattr(first, f.name), getattr(fresh, f.name)
+        if isinstance(a, np.ndarray):
+            np.testing.assert_array_equal(a, b, err_msg=f.name)
+        elif hasattr(a, "toarray"):
+            np.testing.assert_array_equal(a.toarray(), b.toarray(), err_msg=f.name)
+        elif isinstance(a, (int, float, str)) and f.name != "arrays_key":
+            assert a == b, f.name
+    assert first.arrays_key == again.arrays_key != ""
+
+
+def test_a_run_leaves_the_kept_plate_unchanged():
+    """The loop writes into its own copies: after a run the kept plate's arrays are those
+    it was built with."""
+    import granplate
+
+    s = granplate.with_changes(granplate.preset("steel-r1"), {"time.t_end": 2e-6})
+    plate = granplate.build_model(s).plate
+    before = {n: np.array(getattr(plate, n)) for n in ("Phi", "omega", "phi_drive", "phi_face", "edge_load_modal")}
+    granplate.simulate(s, progress=False)
+    assert granplate.build_model(s).plate is plate
+    for n, v in before.items():
+        np.testing.assert_array_equal(getattr(plate, n), v, err_msg=n)

@@ -464,12 +464,14 @@ BUILT_KEPT = 4
 def memo_key(plate: "Plate", material: Material, x0: float, contact_y: Sequence[float],
              edge_load: tuple[float, float] | None, symmetry_line: bool) -> str:
     """What identifies a built plate in this process: every input of build_plate, the
-    output settings and the basis choice included (floats written exactly via repr)."""
+    output settings and the basis choice included (floats written exactly via repr), and
+    the run store's directory (another store builds, and fills, its own)."""
     fields = {k: repr(v) for k, v in sorted(dataclasses.asdict(plate).items())}
     return repr((fields, material.name, repr(float(material.E)), repr(float(material.nu)),
                  repr(float(material.rho)), repr(float(x0)), [repr(float(y)) for y in contact_y],
                  None if edge_load is None else [repr(float(v)) for v in edge_load], bool(symmetry_line),
-                 getattr(skfem, "__version__", "?"), INTORDER, EDGE_LOAD_POINTS, PLATE_FORMAT))
+                 getattr(skfem, "__version__", "?"), INTORDER, EDGE_LOAD_POINTS, PLATE_FORMAT,
+                 str(store.cache_directory())))
 
 
 def forget_built_plates() -> None:
