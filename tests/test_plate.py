@@ -454,6 +454,8 @@ def _arrays(m: gp.PlateModel) -> dict[str, np.ndarray]:
 
 def test_cache_roundtrip_and_corrupt_file(tmp_path, monkeypatch):
     """A cached build loads (no eigen-solve) identical arrays; a corrupt cache file is recomputed."""
+    from granplate.plate.build import forget_built_plates
+
     cache_dir = tmp_path / "here"
     monkeypatch.setenv("GRANPLATE_CACHE", str(cache_dir))
     plate = Plate(nx=2, ny=20)
@@ -468,6 +470,7 @@ def test_cache_roundtrip_and_corrupt_file(tmp_path, monkeypatch):
         raise AssertionError("modal_basis called although the cache holds the result")
 
     monkeypatch.setattr(sys.modules[gp.build_plate.__module__], "modal_basis", must_not_solve)
+    forget_built_plates()  # the store's copy, not the one this process keeps
     cached = gp.build_plate(*args)
     a, b = _arrays(fresh), _arrays(cached)
     for name in a:
@@ -487,11 +490,13 @@ def test_cache_roundtrip_and_corrupt_file(tmp_path, monkeypatch):
         return real_modal_basis(*a, **k)
 
     monkeypatch.setattr(sys.modules[gp.build_plate.__module__], "modal_basis", counting)
+    forget_built_plates()
     repaired = gp.build_plate(*args)
     assert calls == [1]
     c = _arrays(repaired)
     for name in a:
         assert np.array_equal(a[name], c[name]), name
+    forget_built_plates()
     again = gp.build_plate(*args)
     assert calls == [1]
     assert np.array_equal(again.Phi, fresh.Phi)
