@@ -81,3 +81,12 @@ def test_any_reference_refinement_keeps_the_maxima_bit_for_bit(plate, strides):
     every = P.time_maxima(plate, c)
     some = P.peak_maxima(plate, c, strides=strides)
     assert np.array_equal(np.nanmax(some, axis=0), every.max(axis=0))
+
+
+@pytest.mark.parametrize("n", [1, 5, 64, 300])
+def test_a_plate_at_rest_and_short_runs(plate, n):
+    """A plate at rest (every bound zero: no block stays open after the first references)
+    and runs shorter than a block give the maxima of every output time bit for bit."""
+    for c in (np.zeros((n, plate.n_modes)), synthetic_run(plate, n, None)):
+        some = P.peak_maxima(plate, c)
+        assert np.array_equal(np.nanmax(some, axis=0), P.time_maxima(plate, c).max(axis=0))

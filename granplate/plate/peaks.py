@@ -204,6 +204,8 @@ def peak_maxima(plate, c: np.ndarray, block: int = BLOCK, strides: tuple[int, ..
             new = np.arange(0, n, stride)
             if new[-1] != n - 1:
                 new = np.append(new, n - 1)
+        elif not len(open_blocks):
+            break
         else:
             new = np.concatenate([np.arange(starts[k], stops[k], stride) for k in open_blocks])
             new = new[~known[new]]
@@ -223,6 +225,9 @@ def peak_maxima(plate, c: np.ndarray, block: int = BLOCK, strides: tuple[int, ..
     best = floor.copy()  # a block bounded by the floor holds no value up to the maximum
     done = np.ones(len(starts), dtype=bool)
     done[open_blocks] = False
+    if not len(open_blocks):  # every bound at the floor (a plate at rest): one block still gives the maxima
+        done[int(np.argmax((upper / scale).max(axis=1)))] = False
+        best = np.full(3, -np.inf)
     while True:
         open_ = ~done & np.any(upper > best, axis=1)
         if not open_.any():
