@@ -554,3 +554,15 @@ def test_a_run_leaves_the_kept_plate_unchanged():
     assert granplate.build_model(s).plate is plate
     for n, v in before.items():
         np.testing.assert_array_equal(getattr(plate, n), v, err_msg=n)
+
+
+def test_the_plate_package_loads_its_members_on_first_use():
+    """Truth: a fresh interpreter's sys.modules: the plate maxima (what reading a result
+    needs) load without scikit-fem; asking the package for build_plate loads it."""
+    import subprocess
+
+    probe = ("import sys\nimport granplate.plate.peaks\nprint('skfem' in sys.modules)\n"
+             "from granplate.plate import build_plate\nprint('skfem' in sys.modules)")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["False", "True"]
