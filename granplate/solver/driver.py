@@ -462,15 +462,15 @@ def _loop_chunks(times, model, arr: LoopArrays, should_stop, on_progress, lists)
     return _refresh(lists, arr.st, arr.w)
 
 
-def type_fingerprint(a) -> tuple | str:
+def type_fingerprint(a) -> tuple | type:
     """What numba's type of the argument `a` depends on, cheaply: a tuple's class and its
     members', an array's dtype, dimensions, layout and flags, else the Python type."""
     if isinstance(a, np.ndarray):
         f = a.flags
-        return ("a", a.dtype.str, a.ndim, f.c_contiguous, f.f_contiguous, f.writeable, f.aligned)
+        return (np.ndarray, a.dtype.str, a.ndim, f.c_contiguous, f.f_contiguous, f.writeable, f.aligned)
     if isinstance(a, tuple):
-        return (type(a).__qualname__, *(type_fingerprint(v) for v in a))
-    return type(a).__qualname__
+        return (type(a), *(type_fingerprint(v) for v in a))
+    return type(a)
 
 
 #: (dispatcher id, argument fingerprints) already found compiled in this process.
