@@ -133,10 +133,20 @@ def _save(kind: str, entry_key: str, suffix: str, label: str, write: Callable[[P
     return path
 
 
+#: An entry read again within this many seconds of its last mark is not marked again [s].
+TOUCH_INTERVAL_S = 600.0
+
+
 def _touch(path: Path) -> None:
-    """Mark an entry as used now (its modification time orders the size cap's removals)."""
+    """Mark an entry as used now (its modification time orders the size cap's removals),
+    unless it was marked in the last TOUCH_INTERVAL_S: then the file is left as it is, so
+    that the copies other processes keep in memory (`load_arrays`, which a changed file
+    voids) stay valid while they read the same entry."""
+    import time
+
     try:
-        os.utime(path)
+        if time.time() - path.stat().st_mtime > TOUCH_INTERVAL_S:
+            os.utime(path)
     except OSError:
         pass
 

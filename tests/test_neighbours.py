@@ -62,3 +62,20 @@ def test_ten_thousand_granules_pair_count():
     vertical = 50 * 99 + 50 * 98
     assert m.n_granules == 9950
     assert len(m.pairs) == across + vertical
+
+
+@pytest.mark.parametrize("n", [2, 14, 64, 65, 300])
+@pytest.mark.parametrize("dim", [2, 3])
+def test_close_pairs_equal_the_k_d_trees(n, dim):
+    """setup.pairs: the all-pairs search of a few points and the k-d tree return the same
+    pairs in the same order (sorted i < j) on seeded random points, in the plane and in space."""
+    from granplate.setup.pairs import all_pairs, close_pairs, tree_pairs
+
+    rng = np.random.default_rng(100 * n + dim)
+    points = rng.uniform(0.0, 1.0, size=(n, dim))
+    distance = 0.5 if n < 20 else 2.0 / n ** (1.0 / dim)
+    want = tree_pairs(points, distance)
+    assert n < 20 or len(want) > n // 4
+    np.testing.assert_array_equal(all_pairs(points, distance), want)
+    np.testing.assert_array_equal(close_pairs(points, distance), want)
+    assert close_pairs(points, distance).dtype == np.int64

@@ -454,6 +454,8 @@ def _arrays(m: gp.PlateModel) -> dict[str, np.ndarray]:
 
 def test_cache_roundtrip_and_corrupt_file(tmp_path, monkeypatch):
     """A cached build loads (no eigen-solve) identical arrays; a corrupt cache file is recomputed."""
+    from granplate.plate.build import forget_built_plates
+
     cache_dir = tmp_path / "here"
     monkeypatch.setenv("GRANPLATE_CACHE", str(cache_dir))
     plate = Plate(nx=2, ny=20)
@@ -468,6 +470,7 @@ def test_cache_roundtrip_and_corrupt_file(tmp_path, monkeypatch):
         raise AssertionError("modal_basis called although the cache holds the result")
 
     monkeypatch.setattr(sys.modules[gp.build_plate.__module__], "modal_basis", must_not_solve)
+    forget_built_plates()  # the store's copy, not the one this process keeps
     cached = gp.build_plate(*args)
     a, b = _arrays(fresh), _arrays(cached)
     for name in a:
@@ -487,11 +490,13 @@ def test_cache_roundtrip_and_corrupt_file(tmp_path, monkeypatch):
         return real_modal_basis(*a, **k)
 
     monkeypatch.setattr(sys.modules[gp.build_plate.__module__], "modal_basis", counting)
+    forget_built_plates()
     repaired = gp.build_plate(*args)
     assert calls == [1]
     c = _arrays(repaired)
     for name in a:
         assert np.array_equal(a[name], c[name]), name
+    forget_built_plates()
     again = gp.build_plate(*args)
     assert calls == [1]
     assert np.array_equal(again.Phi, fresh.Phi)
@@ -510,3 +515,54 @@ def test_mode_sign_rule_is_deterministic_for_symmetric_modes():
     np.testing.assert_array_equal(gp.fix_mode_signs(-phi), fixed)
     np.testing.assert_array_equal(np.abs(fixed), np.abs(phi))
     assert np.all(gp.sign_reference(4) @ fixed > 0)
+
+
+def test_a_plate_asked_again_is_kept_and_equals_a_fresh_build():
+    """The process keeps a built plate (the same object for the same inputs) and it equals,
+    array for array, a plate built afresh (without the store) from the same inputs; other
+    inputs build another plate."""
+    from granplate.plate.build import forget_built_plates
+
+    plate = Plate(nx=2, ny=10, n_modes=8)
+    first = gp.build_plate(plate, X0, [0.05], edge_load=(0.025, 0.05))
+    assert gp.build_plate(plate, X0, [0.05], edge_load=(0.025, 0.05)) is first
+    assert gp.build_plate(plate, X0, [0.03], edge_load=(0.025, 0.05)) is not first
+    fresh = gp.build_plate(plate, X0, [0.05], edge_load=(0.025, 0.05), cache=False)
+    forget_built_plates()
+    again = gp.build_plate(plate, X0, [0.05], edge_load=(0.025, 0.05))
+    assert again is not first
+    for f in dataclasses.fields(first):
+        a, b = getattr(first, f.name), getattr(fresh, f.name)
+        if isinstance(a, np.ndarray):
+            np.testing.assert_array_equal(a, b, err_msg=f.name)
+        elif hasattr(a, "toarray"):
+            np.testing.assert_array_equal(a.toarray(), b.toarray(), err_msg=f.name)
+        elif isinstance(a, (int, float, str)) and f.name != "arrays_key":
+            assert a == b, f.name
+    assert first.arrays_key == again.arrays_key != ""
+
+
+def test_a_run_leaves_the_kept_plate_unchanged():
+    """The loop writes into its own copies: after a run the kept plate's arrays are those
+    it was built with."""
+    import granplate
+
+    s = granplate.with_changes(granplate.preset("steel-r1"), {"time.t_end": 2e-6})
+    plate = granplate.build_model(s).plate
+    before = {n: np.array(getattr(plate, n)) for n in ("Phi", "omega", "phi_drive", "phi_face", "edge_load_modal")}
+    granplate.simulate(s, progress=False)
+    assert granplate.build_model(s).plate is plate
+    for n, v in before.items():
+        np.testing.assert_array_equal(getattr(plate, n), v, err_msg=n)
+
+
+def test_the_plate_package_loads_its_members_on_first_use():
+    """Truth: a fresh interpreter's sys.modules: the plate maxima (what reading a result
+    needs) load without scikit-fem; asking the package for build_plate loads it."""
+    import subprocess
+
+    probe = ("import sys\nimport granplate.plate.peaks\nprint('skfem' in sys.modules)\n"
+             "from granplate.plate import build_plate\nprint('skfem' in sys.modules)")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["False", "True"]

@@ -61,3 +61,32 @@ def test_time_maxima_stop_after_a_block(plate):
     part = P.time_maxima(plate, c, should_stop=lambda: True)
     assert len(part) == P.BLOCK
     assert np.array_equal(part, P.time_maxima(plate, c)[:P.BLOCK])
+
+
+def test_distance_peaks_is_the_weighted_distance(plate):
+    """The compiled bound term equals its definition, |c[a] - c[b]| m (and |c[a]| m from
+    rest), to round-off."""
+    m = P.unit_peaks(plate, plate.n_modes)
+    c = synthetic_run(plate, 50, None)
+    rows, refs = np.array([3, 10, 49, 0]), np.array([0, 12, -1, 7])
+    want = np.stack([np.abs(c[a] - (c[b] if b >= 0 else 0.0)) @ m for a, b in zip(rows, refs)])
+    np.testing.assert_allclose(P.distance_peaks(c, m, rows, refs), want, rtol=1e-12)
+
+
+@pytest.mark.parametrize("strides", [(32,), (32, 8), (64, 16, 4), (8, 2)])
+def test_any_reference_refinement_keeps_the_maxima_bit_for_bit(plate, strides):
+    """Whatever the references' spacing, the largest values equal those of every output
+    time bit for bit (the bounds are rigorous at every level)."""
+    c = synthetic_run(plate, 400, 137)
+    every = P.time_maxima(plate, c)
+    some = P.peak_maxima(plate, c, strides=strides)
+    assert np.array_equal(np.nanmax(some, axis=0), every.max(axis=0))
+
+
+@pytest.mark.parametrize("n", [1, 5, 64, 300])
+def test_a_plate_at_rest_and_short_runs(plate, n):
+    """A plate at rest (every bound zero: no block stays open after the first references)
+    and runs shorter than a block give the maxima of every output time bit for bit."""
+    for c in (np.zeros((n, plate.n_modes)), synthetic_run(plate, n, None)):
+        some = P.peak_maxima(plate, c)
+        assert np.array_equal(np.nanmax(some, axis=0), P.time_maxima(plate, c).max(axis=0))

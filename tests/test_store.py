@@ -253,3 +253,19 @@ def test_exclusive_makes_a_second_process_wait(tmp_path):
         assert other.poll() is None  # still waiting
     waited = float(other.communicate(timeout=60)[0])
     assert waited >= 0.9
+
+
+def test_reading_an_entry_leaves_the_others_copies_valid(monkeypatch):
+    """A read by another process (its mark of use) does not change a freshly used entry's
+    file, so this process's copy is still used; an entry unused for longer is marked."""
+    path = store.save_arrays("plate", PAYLOAD, 1, {"a": np.arange(3.0)})
+    store.load_arrays("plate", PAYLOAD, 1)
+    before = os.stat(path).st_mtime_ns
+    store._touch(path)  # what another process's read does
+    assert os.stat(path).st_mtime_ns == before
+    monkeypatch.setattr(np, "load", lambda *a, **k: pytest.fail("the entry was read again"))
+    assert np.array_equal(store.load_arrays("plate", PAYLOAD, 1)["a"], np.arange(3.0))
+    old = before / 1e9 - 2 * store.TOUCH_INTERVAL_S
+    os.utime(path, (old, old))
+    store._touch(path)
+    assert os.stat(path).st_mtime > old + store.TOUCH_INTERVAL_S

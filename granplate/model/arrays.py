@@ -235,13 +235,14 @@ def plate_modal_arrays(s: Scenario, y: np.ndarray, pc: np.ndarray):
             material=s.material(s.plate.material),
         )
         omega2 = np.asarray(plate_model.omega, float) ** 2
-        phi_d = np.ascontiguousarray(plate_model.phi_drive, float)
-        load_modal = np.ascontiguousarray(plate_model.edge_load_modal, float)
-        resid = np.ascontiguousarray(plate_model.resid, float)
+        # copies: the loop writes into its arrays, the plate model is shared (build_plate keeps it)
+        phi_d = np.array(plate_model.phi_drive, float, order="C")
+        load_modal = np.array(plate_model.edge_load_modal, float, order="C")
+        resid = np.array(plate_model.resid, float, order="C")
         if face_contacts_possible(s, plate_model):
-            face_y = np.ascontiguousarray(plate_model.face_y, float)
-            phi_face = np.ascontiguousarray(plate_model.phi_face, float)
-            resid_face = np.ascontiguousarray(plate_model.resid_face, float)
+            face_y = np.array(plate_model.face_y, float, order="C")
+            phi_face = np.array(plate_model.phi_face, float, order="C")
+            resid_face = np.array(plate_model.resid_face, float, order="C")
     else:
         omega2 = np.zeros(0)
         phi_d = np.zeros((0, 0))

@@ -7,7 +7,8 @@ gap_ratio * min(R_i, R_j) (docs/model.md section 1, the topology is fixed):
 
     |c_j - c_i| - R_i - R_j <= gap_ratio * min(R_i, R_j)
 
-`contact_pairs` finds them with a k-d tree (scipy.spatial.cKDTree.query_pairs): every
+`contact_pairs` finds them with `setup.pairs.close_pairs` (a k-d tree, or all pairs for a
+few granules): every
 such pair has centres at most 2 R_max + gap_ratio R_max apart, so the tree returns a
 superset of candidates in O(N log N) for packings of bounded size ratio, and the exact
 test above (the same floating-point expression as the O(N^2) double loop,
@@ -20,7 +21,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.spatial import cKDTree
+
+from granplate.setup.pairs import close_pairs
 
 #: Relative margin on the k-d tree's search distance, so that rounding never drops a pair
 #: that the exact test would keep.
@@ -63,13 +65,11 @@ def search_distance(r: np.ndarray, gap_ratio: float) -> float:
 
 
 def candidate_pairs(x: np.ndarray, y: np.ndarray, distance: float, z: np.ndarray | None = None) -> np.ndarray:
-    """(n, 2) sorted pairs (i < j) of centres at most `distance` [m] apart (k-d tree)."""
+    """(n, 2) sorted pairs (i < j) of centres at most `distance` [m] apart
+    (setup.pairs.close_pairs: all pairs for a few centres, else a k-d tree)."""
     if len(x) < 2:
         return np.zeros((0, 2), np.int64)
-    tree = cKDTree(_centres(x, y, z))
-    pairs = tree.query_pairs(distance, output_type="ndarray").astype(np.int64)
-    order = np.lexsort((pairs[:, 1], pairs[:, 0]))
-    return pairs[order].reshape(-1, 2)
+    return close_pairs(_centres(x, y, z), distance)
 
 
 def contact_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: float,

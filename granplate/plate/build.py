@@ -454,6 +454,31 @@ def _stored_or_computed(
     return arrays
 
 
+#: Plates built in this process, most recent last: memo key -> PlateModel (the designs of a
+#: study that share a plate build it once per process).
+_BUILT: dict[str, "PlateModel"] = {}
+#: How many built plates a process keeps.
+BUILT_KEPT = 4
+
+
+def memo_key(plate: "Plate", material: Material, x0: float, contact_y: Sequence[float],
+             edge_load: tuple[float, float] | None, symmetry_line: bool) -> str:
+    """What identifies a built plate in this process: every input of build_plate, the
+    output settings and the basis choice included (floats written exactly via repr), and
+    the run store's directory (another store builds, and fills, its own)."""
+    fields = {k: repr(v) for k, v in sorted(dataclasses.asdict(plate).items())}
+    return repr((fields, material.name, repr(float(material.E)), repr(float(material.nu)),
+                 repr(float(material.rho)), repr(float(x0)), [repr(float(y)) for y in contact_y],
+                 None if edge_load is None else [repr(float(v)) for v in edge_load], bool(symmetry_line),
+                 getattr(skfem, "__version__", "?"), INTORDER, EDGE_LOAD_POINTS, PLATE_FORMAT,
+                 str(store.cache_directory())))
+
+
+def forget_built_plates() -> None:
+    """Drop the plates this process keeps in memory (the next build_plate reads the store)."""
+    _BUILT.clear()
+
+
 def build_plate(
     plate: "Plate",
     x0: float,
@@ -469,7 +494,9 @@ def build_plate(
     x0: the plate's left edge x [m]; contact_y: the y [m] of each granule contact on the
     left edge (each must be a node; one rigid layer per contact); edge_load = (y0_load, L)
     [m] for the half-sine line load on the left edge, or None; cache: read/write the
-    expensive arrays in the run store; material: the plate's Material (None: the
+    expensive arrays in the run store, and keep the built plate in this process's memory
+    (the last BUILT_KEPT plates, keyed by every input: the same plate asked again is the
+    same object, which callers must not modify); material: the plate's Material (None: the
     library's plate.material); symmetry_line: require (even ny) and return the nodes on
     y = y0 + height / 2 (False: symmetry_nodes is empty and ny may be odd).
 
@@ -483,6 +510,22 @@ def build_plate(
         material = LIBRARY[plate.material]
     x0 = float(x0)
     contact_y = [float(y) for y in contact_y]
+    if not cache:
+        return _build_plate(plate, x0, contact_y, edge_load, False, material, symmetry_line)
+    key = memo_key(plate, material, x0, contact_y, edge_load, symmetry_line)
+    built = _BUILT.pop(key, None)
+    if built is None:
+        built = _build_plate(plate, x0, contact_y, edge_load, True, material, symmetry_line)
+    _BUILT[key] = built  # most recent last
+    while len(_BUILT) > BUILT_KEPT:
+        _BUILT.pop(next(iter(_BUILT)))
+    return built
+
+
+def _build_plate(plate: "Plate", x0: float, contact_y: list[float], edge_load: tuple[float, float] | None,
+                 cache: bool, material: Material, symmetry_line: bool) -> PlateModel:
+    """build_plate without the process's memory: the mesh, reduction and operators built,
+    the expensive arrays from the run store (cache) or computed."""
     _check_plate(plate, x0)
 
     mesh = plate_mesh(x0, plate.y0, plate.width, plate.height, plate.nx, plate.ny)

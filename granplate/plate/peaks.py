@@ -18,9 +18,12 @@ positive definite is a norm of them), so the triangle inequality bounds it:
 for any time r (with vm_max(r) = 0, r "at rest", this is sum_i |c_i(t)| m_i); likewise
 the disc averages (non-negative weights) and |eps_yy| (linear), each with its own unit
 peaks m (`unit_peaks`: one pass over the unit coordinates, kept per plate). `peak_maxima`
-evaluates the maxima at every REFERENCE_STRIDE-th time, bounds every other time from its
-two nearest references, and evaluates exactly only the blocks whose bound exceeds the
-largest exact value found so far (largest bound first). The bounds carry a relative
+evaluates the maxima at every 64th time (REFERENCE_STRIDES), bounds every other time from
+its two nearest references, evaluates every 16th, then every 4th time inside the blocks
+whose bound still exceeds the largest reference value (tighter bounds, a higher floor;
+the sums of the bounds are compiled, `distance_peaks`), and evaluates
+exactly only the blocks whose bound exceeds the largest value found so far (largest bound
+first). The bounds carry a relative
 margin (BOUND_MARGIN, far above the round-off of the products) so that a skipped block
 provably holds no computed value above the maximum.
 """
@@ -29,13 +32,15 @@ from __future__ import annotations
 from typing import Callable
 
 import numpy as np
+from numba import njit
 
 from granplate.plate.stress import plane_stresses, von_mises_plane_stress
 
 #: Output times per exact block (the same blocks on every route).
 BLOCK = 32
-#: Every REFERENCE_STRIDE-th output time is evaluated to bound the times between.
-REFERENCE_STRIDE = 32
+#: The references' spacing [output times], coarse to fine: every 64th output time is
+#: evaluated to bound the times between, then every 16th and 4th inside the blocks still open.
+REFERENCE_STRIDES = (64, 16, 4)
 #: Relative margin of the bounds [-]: covers the round-off of the products (about
 #: n_modes x 1e-16 of the sum of absolute terms) many times over.
 BOUND_MARGIN = 1e-9
@@ -127,56 +132,108 @@ def _unit_rows(plate, first: int, stop: int, n_cols: int) -> np.ndarray:
     return out
 
 
+@njit(cache=True)
+def distance_peaks(c: np.ndarray, m: np.ndarray, rows: np.ndarray, refs: np.ndarray) -> np.ndarray:
+    """(len(rows), 3): sum_i |c[rows[k], i] - c[refs[k], i]| m[i] (m: (n, 3)) for each k (refs[k] < 0:
+    from rest, sum_i |c[rows[k], i]| m[i]): how far each maximum can move between the two
+    output times, the triangle inequality's term [Pa, Pa, -]."""
+    out = np.zeros((len(rows), 3))
+    for k in range(len(rows)):
+        a = rows[k]
+        b = refs[k]
+        s0 = s1 = s2 = 0.0
+        for i in range(c.shape[1]):
+            d = abs(c[a, i] - c[b, i]) if b >= 0 else abs(c[a, i])
+            s0 += d * m[i, 0]
+            s1 += d * m[i, 1]
+            s2 += d * m[i, 2]
+        out[k, 0] = s0
+        out[k, 1] = s1
+        out[k, 2] = s2
+    return out
+
+
+def rest_bounds(c: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """(time, 3): the bounds from rest, |c| m, at every output time."""
+    c = np.ascontiguousarray(c, dtype=float)
+    rows = np.arange(len(c))
+    return distance_peaks(c, np.ascontiguousarray(m, dtype=float), rows, np.full(len(c), -1))
+
+
 def reference_bounds(c: np.ndarray, m: np.ndarray, rows: np.ndarray, ref: np.ndarray,
                      ref_values: np.ndarray, rest: np.ndarray) -> np.ndarray:
     """(len(rows), 3) upper bounds of the three maxima at the output indices rows, from the
     values ref_values (n_ref, 3) at the sorted output indices ref: the smaller of the
     bounds from the nearest reference before and after and of rest (the bound from rest,
-    |c| m, at every output time), with the margin."""
+    |c| m, at every output time), with the margin (which also covers the sums' round-off)."""
     best = rest[rows]
     pos = np.searchsorted(ref, rows)
+    c = np.ascontiguousarray(c, dtype=float)
+    m = np.ascontiguousarray(m, dtype=float)
+    rows = np.asarray(rows, dtype=np.int64)
     for side in (np.clip(pos - 1, 0, len(ref) - 1), np.clip(pos, 0, len(ref) - 1)):
         r = ref[side]
-        bound = ref_values[side] + np.abs(c[rows] - c[r]) @ m + BOUND_MARGIN * rest[r]
+        bound = ref_values[side] + distance_peaks(c, m, rows, np.asarray(r, dtype=np.int64)) + BOUND_MARGIN * rest[r]
         best = np.minimum(best, bound)
     return best * (1.0 + BOUND_MARGIN) + BOUND_MARGIN * rest[rows]
 
 
-def peak_maxima(plate, c: np.ndarray, block: int = BLOCK, stride: int = REFERENCE_STRIDE) -> np.ndarray:
+def peak_maxima(plate, c: np.ndarray, block: int = BLOCK, strides: tuple[int, ...] = REFERENCE_STRIDES) -> np.ndarray:
     """(time, 3): block_maxima at the blocks that can hold a maximum over the run, NaN
     at the others (their values provably do not exceed the maximum). The maxima over
-    time (nanmax) equal those of time_maxima bit for bit."""
+    time (nanmax) equal those of time_maxima bit for bit.
+
+    strides: the references' spacing in output times, coarse to fine: every strides[0]-th
+    time first, then every finer stride inside the blocks still open (whose bound exceeds
+    the largest reference value), each level tightening the bounds and raising the floor."""
     n = len(c)
     out = np.full((n, 3), np.nan)
     if n == 0:
         return out
     m = unit_peaks(plate, c.shape[1])
-    rest = np.abs(c) @ m  # bounds from rest, every output time
-    ref = np.arange(0, n, stride)
-    if ref[-1] != n - 1:
-        ref = np.append(ref, n - 1)
-    ref_values = block_maxima(plate, np.ascontiguousarray(c[ref]))
-    floor = ref_values.max(axis=0) * (1.0 - BOUND_MARGIN)  # below the exact maximum
+    rest = rest_bounds(c, m)  # bounds from rest, every output time
     starts = block_starts(n, block)
-    upper = np.maximum.reduceat(rest * (1.0 + BOUND_MARGIN), starts, axis=0)  # (n_blocks, 3)
-    near = np.flatnonzero(np.any(upper > floor, axis=1))  # blocks the bound from rest leaves open
-    if len(near):
-        rows = np.concatenate([np.arange(starts[k], min(starts[k] + block, n)) for k in near])
-        bounds = reference_bounds(c, m, rows, ref, ref_values, rest)
-        upper[near] = np.maximum.reduceat(bounds, np.searchsorted(rows, starts[near]), axis=0)
-    scale = np.maximum(upper.max(axis=0), np.finfo(float).tiny)
-    best = np.full(3, -np.inf)
-    done = np.zeros(len(starts), dtype=bool)
+    stops = np.minimum(starts + block, n)
     known = np.zeros(n, dtype=bool)
-    known[ref] = True
     values = np.zeros((n, 3))
-    values[ref] = ref_values
+    upper = np.maximum.reduceat(rest * (1.0 + BOUND_MARGIN), starts, axis=0)  # (n_blocks, 3)
+    open_blocks = np.arange(len(starts))
+    floor = np.full(3, -np.inf)  # below the exact maximum: the largest reference value, less the margin
+    for level, stride in enumerate(strides):
+        if level == 0:
+            new = np.arange(0, n, stride)
+            if new[-1] != n - 1:
+                new = np.append(new, n - 1)
+        elif not len(open_blocks):
+            break
+        else:
+            new = np.concatenate([np.arange(starts[k], stops[k], stride) for k in open_blocks])
+            new = new[~known[new]]
+        if len(new):
+            values[new] = block_maxima(plate, np.ascontiguousarray(c[new]))
+            known[new] = True
+            floor = np.maximum(floor, values[new].max(axis=0) * (1.0 - BOUND_MARGIN))
+        open_blocks = open_blocks[np.any(upper[open_blocks] > floor, axis=1)]
+        if len(open_blocks):  # the bounds from the references, in the blocks still open
+            rows = np.concatenate([np.arange(starts[k], stops[k]) for k in open_blocks])
+            anchors = np.flatnonzero(known)
+            bounds = reference_bounds(c, m, rows, anchors, values[anchors], rest)
+            upper[open_blocks] = np.minimum(upper[open_blocks], np.maximum.reduceat(
+                bounds, np.searchsorted(rows, starts[open_blocks]), axis=0))
+            open_blocks = open_blocks[np.any(upper[open_blocks] > floor, axis=1)]
+    scale = np.maximum(upper.max(axis=0), np.finfo(float).tiny)
+    best = floor.copy()  # a block bounded by the floor holds no value up to the maximum
+    done = np.ones(len(starts), dtype=bool)
+    done[open_blocks] = False
+    if not len(open_blocks):  # every bound at the floor (a plate at rest): one block still gives the maxima
+        done[int(np.argmax((upper / scale).max(axis=1)))] = False
+        best = np.full(3, -np.inf)
     while True:
         open_ = ~done & np.any(upper > best, axis=1)
         if not open_.any():
             return out
         k = int(np.argmax(np.where(open_, (upper / scale).max(axis=1), -np.inf)))
-        rows = slice(starts[k], min(starts[k] + block, n))
+        rows = slice(starts[k], stops[k])
         out[rows] = values[rows] = block_maxima(plate, c[rows])
         known[rows] = True
         best = np.maximum(best, out[rows].max(axis=0))
@@ -184,5 +241,5 @@ def peak_maxima(plate, c: np.ndarray, block: int = BLOCK, stride: int = REFERENC
         anchors = np.flatnonzero(known)
         for j in (k - 1, k + 1):  # the evaluated rows bound their neighbours more tightly
             if 0 <= j < len(starts) and not done[j] and np.any(upper[j] > best):
-                nb = np.arange(starts[j], min(starts[j] + block, n))
+                nb = np.arange(starts[j], stops[j])
                 upper[j] = np.minimum(upper[j], reference_bounds(c, m, nb, anchors, values[anchors], rest).max(axis=0))

@@ -5,9 +5,13 @@ stresses (sigma_xx, sigma_yy, tau_xy) [Pa]; von Mises of plane stress is docs/mo
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import scipy.sparse as sp
-from skfem import Basis
+
+if TYPE_CHECKING:  # pragma: no cover
+    from skfem import Basis
 
 #: Gauss order for K, M and stress recovery: 3 x 3 = 9 points per element.
 INTORDER = 4

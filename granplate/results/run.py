@@ -82,7 +82,7 @@ def simulate(
             "status": rec.message,
         }
         info = {k: info[k] for k in ("wall_time_s", "setup_time_s", "first_call_time_s", "loop_time_s",
-                                     "loop_cpu_s", "n_steps", "n_iterations", "n_retries", "n_friction_bound",
+                                     "loop_cpu_s", "loop_thread_cpu_s", "n_steps", "n_iterations", "n_retries", "n_friction_bound",
                                      "status")}
         info["n_rebuilds"] = rec.contacts.n_rebuilds
         if rec.status == OK and summary_only:

@@ -20,7 +20,6 @@ from collections import Counter
 from typing import Any
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import granule_named, layout_packing, plane_offset, resolve, unit
@@ -28,6 +27,7 @@ from granplate.setup.layouts import (column_radii, half_pitch, hexagonal_offsets
                                      plane_gap_distance, plane_layers, plane_type, planes_per_cell,
                                      sites_per_cell, space_sites)
 from granplate.setup.fields import finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
+from granplate.setup.pairs import close_pairs
 from granplate.setup.plate_checks import check_plate_fields, check_plate_mesh
 from granplate.setup.plate_cost import MEMORY_SHARE, physical_memory
 from granplate.setup.materials import Material
@@ -604,14 +604,13 @@ def _centre(g: Granule, dimension: int) -> tuple[float, ...]:
 
 
 def _close_pairs(gs: tuple[Granule, ...], dimension: int = 2) -> list[tuple[int, int]]:
-    """Sorted pairs (i < j) of granules whose centres are at most 2 R_max apart (k-d tree
-    in the plane, or in space in 3D): every pair that can overlap, found in O(N log N)."""
+    """Sorted pairs (i < j) of granules whose centres are at most 2 R_max apart
+    (setup.pairs.close_pairs, in the plane or in space): every pair that can overlap."""
     if len(gs) < 2:
         return []
     xy = np.array([_centre(g, dimension) for g in gs], float)
     r_max = max(g.radius for g in gs)
-    pairs = cKDTree(xy).query_pairs(2.0 * r_max * (1.0 + 1e-9), output_type="ndarray")
-    return sorted(map(tuple, pairs.tolist()))
+    return [tuple(p) for p in close_pairs(xy, 2.0 * r_max * (1.0 + 1e-9)).tolist()]
 
 
 def _check_walls(s: Scenario) -> None:

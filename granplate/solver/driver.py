@@ -462,18 +462,41 @@ def _loop_chunks(times, model, arr: LoopArrays, should_stop, on_progress, lists)
     return _refresh(lists, arr.st, arr.w)
 
 
+def type_fingerprint(a) -> tuple | type:
+    """What numba's type of the argument `a` depends on, cheaply: a tuple's class and its
+    members', an array's dtype, dimensions, layout and flags, else the Python type."""
+    if isinstance(a, np.ndarray):
+        f = a.flags
+        return (np.ndarray, a.dtype.str, a.ndim, f.c_contiguous, f.f_contiguous, f.writeable, f.aligned)
+    if isinstance(a, tuple):
+        return (type(a), *(type_fingerprint(v) for v in a))
+    return type(a)
+
+
+#: (dispatcher id, argument fingerprints) already found compiled in this process.
+_KNOWN_COMPILED: set[tuple] = set()
+
+
 def is_compiled(dispatcher, args: tuple) -> bool:
     """Whether numba holds `dispatcher` compiled for these arguments' types, in memory or
     in its on-disk cache (an entry for this source and signature in the cache's index);
-    True when numba's cache cannot be asked (then nothing is said about compiling)."""
+    True when numba's cache cannot be asked (then nothing is said about compiling). An
+    answer True is kept for the arguments' fingerprint (typing them costs milliseconds)."""
+    known = (id(dispatcher), tuple(type_fingerprint(a) for a in args))
+    if known in _KNOWN_COMPILED:
+        return True
     try:
         sig = tuple(dispatcher.typeof_pyval(a) for a in args)
         if sig in dispatcher.overloads:
+            _KNOWN_COMPILED.add(known)
             return True
         cache = dispatcher._cache
-        return cache._index_key(sig, dispatcher.targetctx.codegen()) in cache._cache_file._load_index()
+        found = cache._index_key(sig, dispatcher.targetctx.codegen()) in cache._cache_file._load_index()
     except Exception:  # noqa: BLE001 - numba's cache internals: an unknown layout says nothing
         return True
+    if found:
+        _KNOWN_COMPILED.add(known)
+    return found
 
 
 def note_compile(model: Model, calls: list[tuple]) -> bool:
@@ -524,7 +547,7 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
         bar = tqdm(total=len(times) - 1, desc=model.scenario.name, unit="out", leave=False)
     polls = [should_stop] if should_stop is not None else []
     t2 = time.perf_counter()
-    c2 = time.process_time()
+    c2, c3 = time.process_time(), time.thread_time()
     try:
         with (stop_on_signals() if interruptible else _never()) as signalled:
             status = _loop_chunks(times, model, arr, lambda: signalled() or any(f() for f in polls),
@@ -537,6 +560,7 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
         "first_call_time_s": t_first,
         "loop_time_s": time.perf_counter() - t2,
         "loop_cpu_s": time.process_time() - c2,
+        "loop_thread_cpu_s": time.thread_time() - c3,
         "n_steps": int(st.count[S.C_STEPS]),
         "n_iterations": int(st.count[S.C_ITERS]),
         "n_retries": int(st.count[S.C_RETRIES]),

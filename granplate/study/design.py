@@ -88,7 +88,7 @@ def run_design(scenario_toml: str, full: bool = False) -> dict[str, Any]:
     numerically wrong, or any other error: a failing design never stops a sweep); summary
     is `metrics` of the run: gp.summary and EXTRA_METRICS (None on failure); elapsed_s the
     task's seconds on its worker, all included; timings the run's set-up, first-call and
-    loop seconds (`timings`), the summary's (summary_s: the result and its metrics after
+    loop seconds and the loop's CPU seconds (`timings`), the summary's (summary_s: the result and its metrics after
     the loop) and the task's CPU seconds (cpu_s; {} on failure); result the Dataset when full, else None (and then only
     what the summary reads is computed, unless the design keeps its plate fields at every
     output time, `keeps_every_field`, for the nodal stress).
@@ -115,10 +115,12 @@ def run_design(scenario_toml: str, full: bool = False) -> dict[str, Any]:
 
 def timings(ds) -> dict[str, float]:
     """Where a design's run spent its time [s]: set-up (the model), the loop's first call
-    (its initial state and output row, kernels loaded), the time loop."""
+    (its initial state and output row, kernels loaded), the time loop, and the loop's CPU
+    time in its thread (loop_cpu_s; the task's is cpu_s)."""
     return {"setup_s": float(ds.attrs.get("setup_time_s", 0.0)),
             "first_call_s": float(ds.attrs.get("first_call_time_s", 0.0)),
-            "loop_s": float(ds.attrs.get("loop_time_s", 0.0))}
+            "loop_s": float(ds.attrs.get("loop_time_s", 0.0)),
+            "loop_cpu_s": float(ds.attrs.get("loop_thread_cpu_s", ds.attrs.get("loop_cpu_s", 0.0)))}
 
 
 # ------------------------------------------------------------------------- records

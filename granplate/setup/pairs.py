@@ -1,0 +1,45 @@
+"""Pairs of points closer than a distance: the one search behind the neighbour lists and
+the overlap check of a scenario.
+
+`close_pairs` returns the sorted pairs (i, j), i < j, of points at most `distance` apart.
+A few points are compared all against all (ALL_PAIRS_MAX or fewer: microseconds, and
+scipy.spatial is not imported, which costs a fresh process about 0.15 s); more go through
+a k-d tree (scipy.spatial.cKDTree.query_pairs, O(N log N)). Both compare the squared
+distance with distance^2, so both return the same pairs in the same order.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+#: Up to this many points, every pair is compared (above: a k-d tree).
+ALL_PAIRS_MAX = 64
+
+
+def all_pairs(points: np.ndarray, distance: float) -> np.ndarray:
+    """(n_pairs, 2) sorted pairs (i < j) of the points (n, dim) [m] at most distance [m]
+    apart, every pair compared: |p_j - p_i|^2 <= distance^2."""
+    p = np.asarray(points, dtype=float)
+    diff = p[None, :, :] - p[:, None, :]
+    d2 = np.einsum("ijk,ijk->ij", diff, diff)
+    i, j = np.nonzero(np.triu(d2 <= float(distance) ** 2, 1))  # row-major: sorted (i, j)
+    return np.column_stack([i, j]).astype(np.int64).reshape(-1, 2)
+
+
+def tree_pairs(points: np.ndarray, distance: float) -> np.ndarray:
+    """The same pairs from a k-d tree (scipy.spatial.cKDTree.query_pairs), sorted (i, j)."""
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(np.asarray(points, dtype=float)).query_pairs(float(distance), output_type="ndarray")
+    pairs = pairs.astype(np.int64).reshape(-1, 2)
+    return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
+
+
+def close_pairs(points: np.ndarray, distance: float) -> np.ndarray:
+    """(n_pairs, 2) sorted pairs (i < j) of the points (n, dim) [m] at most distance [m]
+    apart: all pairs compared for ALL_PAIRS_MAX points or fewer, else a k-d tree."""
+    points = np.asarray(points, dtype=float)
+    if len(points) < 2:
+        return np.zeros((0, 2), np.int64)
+    if len(points) <= ALL_PAIRS_MAX:
+        return all_pairs(points, distance)
+    return tree_pairs(points, distance)
