@@ -19,16 +19,14 @@ from granplate.solid.mesh import face_facets
 AXIS_RTOL = 1e-6
 
 
-def face_dofs(basis: Basis, mesh: Mesh, name: str, field: str) -> np.ndarray:
-    """All dofs (3 per node) of the nodes on a named face, sorted."""
-    return np.sort(basis.get_dofs(face_facets(mesh, name, field)).all())
+def face_nodes(sbasis: Basis, mesh: Mesh, name: str, field: str) -> np.ndarray:
+    """The sorted nodes (scalar basis dofs: corners and mid-nodes) on a named face."""
+    return np.unique(sbasis.get_dofs(face_facets(mesh, name, field)).all())
 
 
-def face_node_dofs(basis: Basis, mesh: Mesh, name: str, field: str) -> np.ndarray:
+def face_node_dofs(sbasis: Basis, mesh: Mesh, name: str, field: str) -> np.ndarray:
     """(n_face_nodes, 3) dofs [x, y, z] of the nodes on a named face, by node index."""
-    dofs = face_dofs(basis, mesh, name, field)
-    nodes = np.unique(dofs // 3)
-    return 3 * nodes[:, None] + np.arange(3)
+    return 3 * face_nodes(sbasis, mesh, name, field)[:, None] + np.arange(3)
 
 
 def face_normal_axis(mesh: Mesh, name: str, field: str) -> int:
@@ -46,14 +44,14 @@ def face_normal_axis(mesh: Mesh, name: str, field: str) -> int:
     return axis
 
 
-def fixed_dofs(basis: Basis, mesh: Mesh, clamped: Sequence[str] = (), rollers: Sequence[str] = ()) -> np.ndarray:
-    """The sorted fixed dofs: every dof of the clamped faces' nodes, the normal dof of the
-    rollers' nodes (fields plate.clamped, plate.rollers)."""
-    parts = [face_dofs(basis, mesh, name, "plate.clamped") for name in clamped]
+def fixed_dofs(sbasis: Basis, mesh: Mesh, clamped: Sequence[str] = (), rollers: Sequence[str] = ()) -> np.ndarray:
+    """The sorted fixed dofs of the vector system on a scalar basis' nodes: every dof of
+    the clamped faces' nodes, the normal dof of the rollers' nodes (fields plate.clamped,
+    plate.rollers)."""
+    parts = [face_node_dofs(sbasis, mesh, name, "plate.clamped").ravel() for name in clamped]
     for name in rollers:
         axis = face_normal_axis(mesh, name, "plate.rollers")
-        nodes = face_node_dofs(basis, mesh, name, "plate.rollers")
-        parts.append(nodes[:, axis])
+        parts.append(face_node_dofs(sbasis, mesh, name, "plate.rollers")[:, axis])
     return np.unique(np.concatenate(parts)) if parts else np.zeros(0, dtype=np.int64)
 
 

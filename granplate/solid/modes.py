@@ -23,8 +23,10 @@ import scipy.linalg as la
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from granplate.solid.factor import factorised
+
 #: Eigenvalues asked for per shift-invert window.
-WINDOW_MODES = 40
+WINDOW_MODES = 60
 #: Seed of the start vector v0 of every window.
 V0_SEED = 20260
 #: The first shift is -FIRST_SHIFT_SHARE max_omega^2 (negative: K - sigma M is positive
@@ -65,16 +67,17 @@ def signed(Phi: np.ndarray) -> np.ndarray:
     return Phi * np.where(s == 0, 1.0, s)
 
 
-def shift_inverse(K: sp.spmatrix, M: sp.spmatrix, sigma: float) -> spla.LinearOperator:
-    """(K - sigma M)^-1 as a LinearOperator (one sparse LU)."""
-    lu = spla.splu(sp.csc_matrix(K - sigma * M), permc_spec="MMD_AT_PLUS_A")
-    return spla.LinearOperator(K.shape, matvec=lu.solve, dtype=float)
+def shift_inverse(K: sp.spmatrix, M: sp.spmatrix, sigma: float, xyz: np.ndarray) -> spla.LinearOperator:
+    """(K - sigma M)^-1 as a LinearOperator (one sparse LU, solid.factor)."""
+    return spla.LinearOperator(K.shape, matvec=factorised(K - sigma * M, xyz), dtype=float)
 
 
-def window(K: sp.spmatrix, M: sp.spmatrix, sigma: float, k: int, v0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The k eigenpairs (lambda = omega^2 ascending, vectors) nearest sigma."""
+def window(K: sp.spmatrix, M: sp.spmatrix, sigma: float, k: int, v0: np.ndarray,
+           xyz: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The k eigenpairs (lambda = omega^2 ascending, vectors) nearest sigma (xyz: each
+    dof's position [m], for the factorisation's ordering)."""
     vals, vecs = spla.eigsh(K, k=k, M=M, sigma=sigma, which="LM", v0=v0,
-                            OPinv=shift_inverse(K, M, sigma))
+                            OPinv=shift_inverse(K, M, sigma, xyz))
     order = np.argsort(vals)
     return vals[order], vecs[:, order]
 
@@ -90,10 +93,10 @@ def window_cut(vals: np.ndarray) -> float:
     return 0.5 * float(upper[i] + upper[i + 1])
 
 
-def eigenpairs_below(K: sp.spmatrix, M: sp.spmatrix, max_lambda: float, k: int = WINDOW_MODES,
-                     seed: int = V0_SEED) -> tuple[np.ndarray, np.ndarray]:
+def eigenpairs_below(K: sp.spmatrix, M: sp.spmatrix, max_lambda: float, xyz: np.ndarray,
+                     k: int = WINDOW_MODES, seed: int = V0_SEED) -> tuple[np.ndarray, np.ndarray]:
     """Every eigenpair with lambda <= max_lambda [rad^2/s^2] (ascending), over
-    shift-invert windows of k values (module docstring)."""
+    shift-invert windows of k values (module docstring); xyz (n, 3): each dof's position [m]."""
     n = K.shape[0]
     k = max(1, min(k, n - 2))
     v0 = np.random.default_rng(seed).standard_normal(n)
@@ -101,7 +104,7 @@ def eigenpairs_below(K: sp.spmatrix, M: sp.spmatrix, max_lambda: float, k: int =
     below = -np.inf  # every eigenvalue <= below has been kept
     kept_vals, kept_vecs = [], []
     for _ in range(MAX_WINDOWS):
-        vals, vecs = window(K, M, sigma, k, v0)
+        vals, vecs = window(K, M, sigma, k, v0, xyz)
         radius = float(np.max(np.abs(vals - sigma)))
         if sigma - radius > below * (1 + 1e-12) and np.isfinite(below):  # a gap: shift down
             sigma = 0.5 * (sigma + below)
@@ -123,14 +126,15 @@ def eigenpairs_below(K: sp.spmatrix, M: sp.spmatrix, max_lambda: float, k: int =
     return lam[order], vec[:, order]
 
 
-def modes_below(K: sp.spmatrix, M: sp.spmatrix, max_omega: float, rigid: np.ndarray | None = None,
-                k: int = WINDOW_MODES, seed: int = V0_SEED) -> tuple[np.ndarray, np.ndarray]:
+def modes_below(K: sp.spmatrix, M: sp.spmatrix, max_omega: float, xyz: np.ndarray,
+                rigid: np.ndarray | None = None, k: int = WINDOW_MODES,
+                seed: int = V0_SEED) -> tuple[np.ndarray, np.ndarray]:
     """(omega (n_modes,) [rad/s] ascending, Phi (n, n_modes) [kg^-1/2]) of every mode up
-    to max_omega [rad/s], M-orthonormal, signs fixed.
+    to max_omega [rad/s], M-orthonormal, signs fixed; xyz (n, 3): each dof's position [m].
 
     rigid: (n, 6) rigid-body displacements of a free body (rigid_body_modes), or None for a
     held one. A free body's first six modes are those, at omega = 0 exactly."""
-    lam, vec = eigenpairs_below(K, M, max_omega**2, k=k, seed=seed)
+    lam, vec = eigenpairs_below(K, M, max_omega**2, xyz, k=k, seed=seed)
     if rigid is None:
         return np.sqrt(np.maximum(lam, 0.0)), signed(vec)
     R = m_orthonormal(rigid, M)

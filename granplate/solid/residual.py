@@ -12,7 +12,7 @@ rigid part is projected out of the displacement, x = (I - Phi_r Phi_r^T M) K_s^-
 Then G = sum over every elastic mode of phi phi^T / omega^2, the kept modes' share is
 subtracted, and R holds what the truncation misses.
 
-One sparse LU of K (or of the supported K); G's columns over S come from block solves of
+One sparse LU of K (or of the supported K; solid.factor); G's columns over S come from block solves of
 CHUNK unit loads at a time (only the rows S kept), so memory stays at n CHUNK + |S|^2.
 """
 from __future__ import annotations
@@ -22,7 +22,8 @@ from typing import Callable
 import numpy as np
 import scipy.linalg as la
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
+
+from granplate.solid.factor import factorised
 
 #: Unit loads solved per block.
 CHUNK = 512
@@ -35,24 +36,23 @@ def support_dofs(rigid: np.ndarray) -> np.ndarray:
     return np.sort(piv[: rigid.shape[1]])
 
 
-def flexibility(K: sp.spmatrix, M: sp.spmatrix | None = None,
+def flexibility(K: sp.spmatrix, xyz: np.ndarray, M: sp.spmatrix | None = None,
                 rigid: np.ndarray | None = None) -> Callable[[np.ndarray], np.ndarray]:
     """x = G f for loads f (n, m) [N] -> (n, m) [m]: K^-1 f (held body, rigid None), or the
-    inertia-relief flexibility of a free body with M-orthonormal rigid modes rigid (n, 6)."""
-    K = sp.csc_matrix(K)
+    inertia-relief flexibility of a free body with M-orthonormal rigid modes rigid (n, 6);
+    xyz (n, 3): each dof's position [m] (the factorisation's ordering)."""
     if rigid is None:
-        lu = spla.splu(K, permc_spec="MMD_AT_PLUS_A")
-        return lambda f: lu.solve(np.asarray(f, dtype=float))
+        return factorised(K, xyz)
     n = K.shape[0]
     keep = np.setdiff1d(np.arange(n), support_dofs(rigid))
-    lu = spla.splu(sp.csc_matrix(sp.csr_matrix(K)[keep][:, keep]), permc_spec="MMD_AT_PLUS_A")
+    lu_solve = factorised(sp.csr_matrix(K)[keep][:, keep], xyz[keep])
     MR = M @ rigid
 
     def solve(f: np.ndarray) -> np.ndarray:
         f = np.asarray(f, dtype=float)
         balanced = f - MR @ (rigid.T @ f)
         x = np.zeros_like(balanced)
-        x[keep] = lu.solve(np.ascontiguousarray(balanced[keep]))
+        x[keep] = lu_solve(balanced[keep])
         return x - rigid @ (MR.T @ x)
 
     return solve
@@ -73,14 +73,15 @@ def flexibility_block(solve: Callable[[np.ndarray], np.ndarray], n: int, dofs: n
 
 
 def residual_compliance(K: sp.spmatrix, dofs: np.ndarray, Phi: np.ndarray, omega: np.ndarray,
-                        M: sp.spmatrix | None = None, rigid: np.ndarray | None = None,
+                        xyz: np.ndarray, M: sp.spmatrix | None = None, rigid: np.ndarray | None = None,
                         chunk: int = CHUNK) -> np.ndarray:
-    """R (|S|, |S|) [m/N] over the dofs S of the (reduced) system (module docstring).
+    """R (|S|, |S|) [m/N] over the dofs S of the (reduced) system (module docstring);
+    xyz (n, 3): each dof's position [m].
 
     Phi, omega: the kept modes (a free body's zero modes are left out of the sum);
     M, rigid: a free body's mass and M-orthonormal rigid modes (None: a held body)."""
     dofs = np.asarray(dofs, dtype=np.int64)
-    G = flexibility_block(flexibility(K, M, rigid), K.shape[0], dofs, chunk=chunk)
+    G = flexibility_block(flexibility(K, xyz, M, rigid), K.shape[0], dofs, chunk=chunk)
     elastic = omega > 0.0
     phi_s = Phi[dofs][:, elastic]
     R = G - (phi_s / omega[elastic] ** 2) @ phi_s.T
