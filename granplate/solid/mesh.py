@@ -90,8 +90,9 @@ def _read(path: Path, field: str):
         raise ScenarioError(field, str(path), "no such file: give a mesh file (Gmsh .msh) that exists")
     try:
         return meshio.read(str(path))
-    except Exception as exc:  # meshio raises many kinds; the user needs the one line
-        raise ScenarioError(field, str(path), f"cannot be read as a mesh ({type(exc).__name__}: {exc}); "
+    except (Exception, SystemExit) as exc:  # meshio raises many kinds, and exits on a file of no known format
+        why = "" if isinstance(exc, SystemExit) else f" ({type(exc).__name__}: {exc})"
+        raise ScenarioError(field, str(path), f"cannot be read as a mesh{why}; "
                             "give a Gmsh .msh file of hexahedra or tetrahedra") from None
 
 

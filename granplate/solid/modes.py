@@ -4,8 +4,8 @@
 Windows: each eigsh call asks for the `window` eigenvalues nearest a shift sigma (one
 sparse LU of K - sigma M); all eigenvalues within the farthest one's distance are then
 found. A window's values are kept up to a cut placed in the widest gap of its upper half
-(below its top, whose cluster may be incomplete); the next shift is placed so that its
-window reaches below that cut (checked, and moved down when it does not). The windows
+(below its top, whose cluster may be incomplete); the next shift is placed a quarter of a window's width above
+the cut, so that its window reaches below it (checked, and moved down when it does not). The windows
 stop once one reaches past max_omega^2.
 
 A body held nowhere (no clamp, no roller) keeps its six rigid-body modes (three
@@ -29,9 +29,9 @@ from granplate.solid.factor import factorised
 WINDOW_MODES = 60
 #: Seed of the start vector v0 of every window.
 V0_SEED = 20260
-#: The first shift is -FIRST_SHIFT_SHARE max_omega^2 (negative: K - sigma M is positive
-#: definite even for a free body).
-FIRST_SHIFT_SHARE = 1e-3
+#: The first shift is -FIRST_SHIFT_SHARE mean(diag K / diag M), far below the first
+#: elastic eigenvalue and negative: K - sigma M is positive definite even for a free body.
+FIRST_SHIFT_SHARE = 1e-8
 #: A free body's rigid-body eigenvalues must lie below this share of the first elastic one.
 RIGID_RTOL = 1e-6
 #: Windows before giving up (a guard against a cut-off far above the mesh's spectrum).
@@ -82,12 +82,13 @@ def window(K: sp.spmatrix, M: sp.spmatrix, sigma: float, k: int, v0: np.ndarray,
     return vals[order], vecs[:, order]
 
 
-def window_cut(vals: np.ndarray) -> float:
-    """A value inside the widest relative gap of the upper half of a window's sorted
-    eigenvalues, below its top."""
+def window_cut(vals: np.ndarray, below: float) -> float:
+    """A value inside the widest relative gap between a window's sorted eigenvalues above
+    `below` in its upper half, below its top (`below` itself when fewer than two lie there)."""
     upper = vals[len(vals) // 2:]
+    upper = upper[upper > below]
     if len(upper) < 2:
-        return float(vals[-1]) * (1 - 1e-9)
+        return below
     gaps = np.diff(upper) / np.maximum(np.abs(upper[1:]), 1e-300)
     i = int(np.argmax(gaps))
     return 0.5 * float(upper[i] + upper[i + 1])
@@ -100,7 +101,7 @@ def eigenpairs_below(K: sp.spmatrix, M: sp.spmatrix, max_lambda: float, xyz: np.
     n = K.shape[0]
     k = max(1, min(k, n - 2))
     v0 = np.random.default_rng(seed).standard_normal(n)
-    sigma = -FIRST_SHIFT_SHARE * max_lambda
+    sigma = -FIRST_SHIFT_SHARE * float(np.mean(K.diagonal() / M.diagonal()))
     below = -np.inf  # every eigenvalue <= below has been kept
     kept_vals, kept_vecs = [], []
     for _ in range(MAX_WINDOWS):
@@ -110,14 +111,14 @@ def eigenpairs_below(K: sp.spmatrix, M: sp.spmatrix, max_lambda: float, xyz: np.
             sigma = 0.5 * (sigma + below)
             continue
         done = vals[-1] > max_lambda or k >= n - 2
-        cut = max_lambda if done else window_cut(vals)
+        cut = max_lambda if done else window_cut(vals, below)
         take = (vals > below) & (vals <= cut)
         kept_vals.append(vals[take])
         kept_vecs.append(vecs[:, take])
         if done:
             break
         width = float(vals[-1] - vals[0])
-        below, sigma = cut, cut + 0.5 * width
+        below, sigma = cut, max(cut, float(vals[-1]) if cut == below else cut) + 0.25 * width
     else:  # pragma: no cover - guarded by the cost check's mode count
         raise RuntimeError(f"more than {MAX_WINDOWS} eigensolver windows below {max_lambda:.3g} rad^2/s^2")
     lam = np.concatenate(kept_vals)
