@@ -14,7 +14,7 @@ LAYERS = (
     ("version", "errors", "store"),
     ("setup",),
     ("physics",),
-    ("plate",),
+    ("plate", "solid"),
     ("model",),
     ("solver",),
     ("results",),
