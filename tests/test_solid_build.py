@@ -31,6 +31,14 @@ def test_build_is_stored_and_read_back(tmp_path, monkeypatch):
     assert set(a.faces) == {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"}
 
 
+def test_residual_on_demand_equals_the_stored_one():
+    """residual_block over a few of the top face's dofs equals those entries of the face's R."""
+    m = build_solid(SMALL, cache=False)
+    pick = np.array([0, 3, 5])
+    assert np.allclose(m.residual_block(m.surface_dofs[pick]), m.resid[np.ix_(pick, pick)], rtol=1e-10,
+                       atol=1e-10 * np.abs(m.resid).max())
+
+
 def test_too_big_is_refused_with_numbers():
     """A body over the memory allowed: one ScenarioError with dofs, GB and what to change."""
     with pytest.raises(ScenarioError, match=r"dofs.*GB.*fewer elements.*max_frequency") as e:

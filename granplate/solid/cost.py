@@ -7,8 +7,8 @@ Model (constants calibrated on the hex20 plates of `granplate bench --solid`, 2 
   nested-dissection separator (a cross-section normal to the longest side);
 - memory: LU_COPIES factorisations of BYTES_PER_ENTRY each, the Krylov and mode vectors
   (3 WINDOW n + n_modes n floats) and the residual compliance (n_surface^2 floats);
-- time: per window one factorisation (FACTOR_SECONDS n s^2) and SOLVES_PER_WINDOW solves
-  (SOLVE_SECONDS per LU entry each); the residual's block solves at BLOCK_SOLVE_SECONDS
+- time: per window one factorisation (FACTOR_SECONDS n s^2) and SOLVES_PER_VALUE solves per
+  eigenvalue asked (SOLVE_SECONDS per LU entry each); the residual's block solves at BLOCK_SOLVE_SECONDS
   per LU entry and load.
 The mode count is a Weyl estimate: a plate's flexural and in-plane modes over the two
 larger sides and the body's volume modes, an upper bound of what was measured.
@@ -26,7 +26,7 @@ LU_COPIES = 2.5
 FACTOR_SECONDS = 2.5e-10
 SOLVE_SECONDS = 4.0e-9
 BLOCK_SOLVE_SECONDS = 6.0e-10
-SOLVES_PER_WINDOW = 300
+SOLVES_PER_VALUE = 2.5
 #: Share of the machine's physical memory a solid may take.
 MEMORY_SHARE = 0.7
 
@@ -76,10 +76,10 @@ def estimate(n_dofs: int, separator: int, n_modes: int, n_surface: int, window: 
     n_surface dofs of a body of n_dofs dofs (module docstring)."""
     n_modes = min(n_modes, n_dofs)
     fill = FILL_PER_DOF_SEP * n_dofs * separator
-    windows = max(1, math.ceil(n_modes / max(1, window // 2)))
+    windows = 1 if window >= n_modes else max(1, math.ceil(n_modes / max(1, window // 2)))
     memory = (LU_COPIES * BYTES_PER_ENTRY * fill + 8.0 * n_dofs * (3 * window + n_modes)
               + 8.0 * n_surface**2)
-    seconds = (windows * (FACTOR_SECONDS * n_dofs * separator**2 + SOLVES_PER_WINDOW * SOLVE_SECONDS * fill)
+    seconds = (windows * (FACTOR_SECONDS * n_dofs * separator**2 + SOLVES_PER_VALUE * window * SOLVE_SECONDS * fill)
                + (n_surface > 0) * (FACTOR_SECONDS * n_dofs * separator**2
                                     + BLOCK_SOLVE_SECONDS * fill * n_surface))
     return SolidCost(n_dofs, separator, fill, n_modes, windows, memory, seconds)
