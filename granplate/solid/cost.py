@@ -6,10 +6,11 @@ Model (constants calibrated on the hex20 plates of `granplate bench --solid`, 2 
 - fill of one LU (solid.factor): FILL_PER_DOF_SEP n s entries, s the dofs of the largest
   nested-dissection separator (a cross-section normal to the longest side);
 - memory: LU_COPIES factorisations of BYTES_PER_ENTRY each, the Krylov and mode vectors
-  (3 WINDOW n + n_modes n floats) and the residual compliance (n_surface^2 floats);
+  (3 WINDOW n + n_modes n floats);
 - time: per window one factorisation (FACTOR_SECONDS n s^2) and SOLVES_PER_VALUE solves per
-  eigenvalue asked (SOLVE_SECONDS per LU entry each); the residual's block solves at BLOCK_SOLVE_SECONDS
-  per LU entry and load.
+  eigenvalue asked (SOLVE_SECONDS per LU entry each); the residual compliance over n_s
+  dofs: one more factorisation with those dofs last, whose dense trailing block and its
+  inverse cost DENSE_SECONDS n_s^3 and DENSE_BYTES n_s^2.
 The mode count is a Weyl estimate: a plate's flexural and in-plane modes over the two
 larger sides and the body's volume modes, an upper bound of what was measured.
 """
@@ -25,7 +26,8 @@ BYTES_PER_ENTRY = 12.0
 LU_COPIES = 2.5
 FACTOR_SECONDS = 2.5e-10
 SOLVE_SECONDS = 4.0e-9
-BLOCK_SOLVE_SECONDS = 6.0e-10
+DENSE_SECONDS = 2.5e-10
+DENSE_BYTES = 60.0
 SOLVES_PER_VALUE = 2.5
 #: Share of the machine's physical memory a solid may take.
 MEMORY_SHARE = 0.7
@@ -78,10 +80,10 @@ def estimate(n_dofs: int, separator: int, n_modes: int, n_surface: int, window: 
     fill = FILL_PER_DOF_SEP * n_dofs * separator
     windows = 1 if window >= n_modes else max(1, math.ceil(n_modes / max(1, window // 2)))
     memory = (LU_COPIES * BYTES_PER_ENTRY * fill + 8.0 * n_dofs * (3 * window + n_modes)
-              + 8.0 * n_surface**2)
+              + DENSE_BYTES * n_surface**2)
     seconds = (windows * (FACTOR_SECONDS * n_dofs * separator**2 + SOLVES_PER_VALUE * window * SOLVE_SECONDS * fill)
                + (n_surface > 0) * (FACTOR_SECONDS * n_dofs * separator**2
-                                    + BLOCK_SOLVE_SECONDS * fill * n_surface))
+                                    + DENSE_SECONDS * float(n_surface) ** 3))
     return SolidCost(n_dofs, separator, fill, n_modes, windows, memory, seconds)
 
 
