@@ -90,3 +90,29 @@ def test_bad_solid_fields_name_the_field(change, field, words):
     with pytest.raises(ScenarioError) as e:
         validate(scenario(**change))
     assert e.value.field == field and words in str(e.value), str(e.value)
+
+
+def test_build_from_a_gmsh_file(tmp_path):
+    """A Gmsh file's solid clamped on its group 'left': its faces by name, its modes, and a
+    clear refusal of a face the file does not name and of an element of the other cell type."""
+    from test_solid_mesh import write_msh
+
+    path = str(write_msh(tmp_path / "bar.msh"))
+    m = build_solid(Solid(mesh=path, clamped=("left",), max_frequency=2e3), surface=None, cache=False)
+    assert "left" in m.faces and m.n_modes >= 1 and not m.free
+    assert np.all(m.nodes[m.faces["left"], 0] == 0.0)
+    with pytest.raises(ScenarioError, match="must be one of 'left'") as e:
+        build_solid(Solid(mesh=path, clamped=("xmin",)), surface=None, cache=False)
+    assert e.value.field == "plate.clamped"
+    with pytest.raises(ScenarioError, match="does not fit the mesh file's cells"):
+        build_solid(Solid(mesh=path, element="tet10"), surface=None, cache=False)
+
+
+def test_free_body_build_keeps_rigid_modes_and_a_residual():
+    """A box held nowhere: six zero modes first, and the inertia-relief residual over its
+    top face equals the on-demand one."""
+    m = build_solid(Solid(size=(0.02, 0.01, 0.005), elements=(2, 2, 1), max_frequency=4e5), cache=False)
+    assert m.free and np.all(m.omega[:6] == 0.0) and m.omega[6] > 0.0
+    pick = np.array([0, 2, 7])
+    assert np.allclose(m.residual_block(m.surface_dofs[pick]), m.resid[np.ix_(pick, pick)], rtol=1e-9,
+                       atol=1e-9 * np.abs(m.resid).max())
