@@ -163,7 +163,9 @@ def test_force_loaded_granules_are_those_furthest_against_the_direction():
 @pytest.mark.parametrize("change,field,words", [
     ({"dimension": 4}, "dimension", "must be 2"),
     ({"dimension": 1}, "dimension", "or 3"),
-    ({"plate": {"x0": 0.1}}, "plate", "three-dimensional elastic bodies are not available yet"),
+    ({"plate": {"size": [0.1, 0.1, 0.005], "elements": [2, 2, 1]}}, "plate",
+     "the elastic solid is valid, but its coupling to the granules in 3D is not implemented yet"),
+    ({"plate": {"x0": 0.1}}, "plate.x0", "unknown"),
     ({"layout": {"kind": "hexagonal"}, "granules": None}, "layout.kind", "a packing of discs in the plane is 2D"),
     ({"load": {"kind": "line"}}, "load.kind", 'a line load q0 [N/m] is 2D; in 3D use kind = "force"'),
     ({"load": {"kind": "force", "direction": [0.0, 0.0, 0.0]}}, "load.direction", "nonzero"),

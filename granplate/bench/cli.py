@@ -37,6 +37,10 @@ def _cmd_bench(args) -> int:
         from granplate.bench import plastic
 
         return int(plastic.main(args))
+    if getattr(args, "solid", False):
+        from granplate.bench import solid
+
+        return int(solid.main(args))
     if getattr(args, "plates", False):
         from granplate.bench import plates
 
@@ -59,6 +63,11 @@ def register(subparsers) -> None:
     b.add_argument("--plates", action="store_true",
                    help="instead: the plate-scaling table (set-up time, peak memory, steel-r1 run "
                         "time per plate mesh, each in a fresh process with a cold plate cache)")
+    b.add_argument("--solid", action="store_true",
+                   help="instead: the 3D solid's set-up time and peak memory (a clamped 100 x 100 x 5 mm steel "
+                        "plate, modes below 100 kHz, with and without the top face's residual compliance), the "
+                        "cost per dof of hex20, hex27, tet10, and each element's first clamped frequency "
+                        "against Leissa (--quick: the element tables only)")
     b.add_argument("--meshes", help="with --plates: comma-separated NXxNY (default 4x40,8x80,16x160,32x320)")
     b.add_argument("--modes", dest="plate_modes", choices=("auto", "all", "truncated"), default=None,
                    help="with --plates: plate.modes of every mesh (default auto)")

@@ -28,7 +28,7 @@ from granplate.errors import ScenarioError
 from granplate.setup.fields import closest_name, string_in
 from granplate.setup.materials import LIBRARY, Material
 from granplate.setup.scenario import (LAYOUT_KINDS, NORMAL_LAWS, Box, Contact, Granule, Load,
-                                      PairCoefficients, Plate, Scenario, Solver, TimeSettings, Wall)
+                                      PairCoefficients, Plate, Scenario, Solid, Solver, TimeSettings, Wall)
 
 #: Fields that a table must give (everything else takes the dataclass default).
 REQUIRED: dict[type, tuple[str, ...]] = {
@@ -268,6 +268,8 @@ def from_dict(d: dict) -> Scenario:
         kw["layout"] = _layout(d["layout"])
     for key, cls in _TOP_TABLES.items():
         if d.get(key) is not None:
+            if key == "plate" and kw.get("dimension") == 3:
+                cls = Solid  # the [plate] of a 3D scenario is an elastic solid
             kw[key] = _table(key, d[key], cls)
     if "time" in kw:
         kw["time"] = _initial_step_within_max(kw["time"], d["time"])

@@ -295,6 +295,40 @@ class Plate:
         return self.element_height if self.rigid_layer_width is None else self.rigid_layer_width
 
 
+#: The solid's elements (Solid.element): 20-node serendipity and 27-node triquadratic
+#: hexahedra, 10-node tetrahedra.
+SOLID_ELEMENTS: tuple[str, ...] = ("hex20", "hex27", "tet10")
+#: The solid's default cut-off [Hz] (Solid.max_frequency). Provisional: the coupled 3D
+#: runs, once they exist, will measure which cut-off their contact forces need.
+SOLID_MAX_FREQUENCY = 1.0e5
+
+
+@dataclass(frozen=True)
+class Solid:
+    """The elastic solid of a `dimension = 3` scenario (its [plate] table), docs/model.md
+    section "The 3D solid".
+
+    A box: size [Lx, Ly, Lz] [m], elements [nx, ny, nz], origin [x, y, z] of its lowest
+    corner [m]; its faces are named xmin, xmax, ymin, ymax, zmin, zmax. Or mesh: a Gmsh
+    file of hexahedra or tetrahedra whose physical surface groups name the faces
+    (exclusive with size and elements). material: a material's name; element: "hex20",
+    "hex27" or "tet10"; clamped: faces with every dof fixed; rollers: faces whose normal
+    dof is fixed (flat, normal to an axis); free elsewhere (a body held nowhere keeps its
+    six rigid-body modes). max_frequency: the modes kept [Hz] (provisional default
+    SOLID_MAX_FREQUENCY).
+    """
+
+    size: tuple[float, float, float] | None = None
+    elements: tuple[int, int, int] | None = None
+    origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    mesh: str | None = None
+    material: str = "steel"
+    element: str = "hex20"
+    clamped: tuple[str, ...] = ()
+    rollers: tuple[str, ...] = ()
+    max_frequency: float = SOLID_MAX_FREQUENCY
+
+
 @dataclass(frozen=True)
 class Load:
     """The half-sine shock of docs/model.md section 5.
@@ -483,7 +517,7 @@ class Scenario:
     layout: Layout | LatticeLayout | ChainLayout | SpaceLattice | None = None
     granules: tuple[Granule, ...] = ()
     walls: tuple[Wall, ...] = ()
-    plate: Plate | None = None
+    plate: Plate | Solid | None = None
     load: Load = Load()
     contact: Contact = Contact()
     time: TimeSettings = TimeSettings()

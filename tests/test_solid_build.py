@@ -1,0 +1,118 @@
+"""build_solid: the arrays kept in the run store come back equal; the residual is over the
+top face's z dofs; a body too large is refused with its numbers; a 3D scenario's
+[plate] is a solid, checked field by field, and still refused to run."""
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pytest
+
+from granplate.errors import ScenarioError
+from granplate.setup import io as scenario_io
+from granplate.setup.scenario import SOLID_MAX_FREQUENCY, Solid
+from granplate.setup.validate import validate
+from granplate.solid.build import build_solid
+
+SMALL = Solid(size=(0.03, 0.02, 0.004), elements=(3, 2, 1), clamped=("xmin",), max_frequency=1e5)
+
+
+def test_build_is_stored_and_read_back(tmp_path, monkeypatch):
+    """A second build reads the run store's arrays: the same modes and residual bitwise."""
+    monkeypatch.setenv("GRANPLATE_CACHE", str(tmp_path))
+    a = build_solid(SMALL)
+    b = build_solid(SMALL)
+    assert a.arrays_key and a.arrays_key == b.arrays_key
+    assert np.array_equal(a.omega, b.omega) and np.array_equal(a.resid, b.resid)
+    assert any((tmp_path / "solid").iterdir())
+    z = a.nodes[a.dofs[a.surface_dofs] // 3, 2]
+    assert np.all(a.dofs[a.surface_dofs] % 3 == 2) and np.allclose(z, 0.004)
+    assert a.resid.shape == (len(a.surface_dofs),) * 2 and np.allclose(a.resid, a.resid.T)
+    assert set(a.faces) == {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"}
+
+
+def test_residual_on_demand_equals_the_stored_one():
+    """residual_block over a few of the top face's dofs equals those entries of the face's R."""
+    m = build_solid(SMALL, cache=False)
+    pick = np.array([0, 3, 5])
+    assert np.allclose(m.residual_block(m.surface_dofs[pick]), m.resid[np.ix_(pick, pick)], rtol=1e-10,
+                       atol=1e-10 * np.abs(m.resid).max())
+
+
+def test_too_big_is_refused_with_numbers():
+    """A body over the memory allowed: one ScenarioError with dofs, GB and what to change."""
+    with pytest.raises(ScenarioError, match=r"dofs.*GB.*fewer elements.*max_frequency") as e:
+        build_solid(SMALL, cache=False, memory=1e3)
+    assert e.value.field == "plate.elements"
+
+
+BASE = {"name": "solid", "dimension": 3,
+        "granules": [{"x": 0.01, "y": 0.01, "z": 0.02, "radius": 0.002, "material": "steel"}],
+        "plate": {"size": [0.03, 0.02, 0.004], "elements": [3, 2, 1], "clamped": ["xmin"]}}
+
+
+def scenario(**plate):
+    d = copy.deepcopy(BASE)
+    d["plate"].update(plate)
+    for k in [k for k, v in d["plate"].items() if v is None]:
+        del d["plate"][k]
+    return scenario_io.from_dict(d)
+
+
+def test_3d_plate_is_a_solid_with_defaults():
+    """The [plate] of a 3D scenario reads as a Solid: hex20, origin 0, the provisional cut-off."""
+    s = scenario()
+    assert isinstance(s.plate, Solid)
+    assert s.plate.element == "hex20" and s.plate.origin == (0.0, 0.0, 0.0)
+    assert s.plate.max_frequency == SOLID_MAX_FREQUENCY == 1e5
+
+
+def test_valid_solid_is_refused_to_run_with_the_reason():
+    """A valid solid: the refusal says the solid is valid and the coupling is not there."""
+    with pytest.raises(ScenarioError, match="solid is valid.*not implemented") as e:
+        validate(scenario())
+    assert e.value.field == "plate"
+
+
+@pytest.mark.parametrize("change,field,words", [
+    ({"element": "hex8"}, "plate.element", "'hex20', 'hex27', 'tet10'"),
+    ({"clamped": ["top"]}, "plate.clamped", "must be one of 'xmin'"),
+    ({"rollers": ["xmin"]}, "plate.rollers", "both clamped and on rollers"),
+    ({"elements": [3, 0, 1]}, "plate.elements[1]", "integer in [1, 1000]"),
+    ({"size": [0.03, -1.0, 0.004]}, "plate.size[1]", "> 0"),
+    ({"size": None}, "plate.size", "needs size"),
+    ({"mesh": "a.msh"}, "plate.mesh", "excludes plate.size"),
+    ({"max_frequency": 0.1}, "plate.max_frequency", "Hz"),
+    ({"material": "stel"}, "plate.material", "unknown material"),
+])
+def test_bad_solid_fields_name_the_field(change, field, words):
+    """Each bad solid field is one ScenarioError naming it and its allowed range."""
+    with pytest.raises(ScenarioError) as e:
+        validate(scenario(**change))
+    assert e.value.field == field and words in str(e.value), str(e.value)
+
+
+def test_build_from_a_gmsh_file(tmp_path):
+    """A Gmsh file's solid clamped on its group 'left': its faces by name, its modes, and a
+    clear refusal of a face the file does not name and of an element of the other cell type."""
+    from test_solid_mesh import write_msh
+
+    path = str(write_msh(tmp_path / "bar.msh"))
+    m = build_solid(Solid(mesh=path, clamped=("left",), max_frequency=2e3), surface=None, cache=False)
+    assert "left" in m.faces and m.n_modes >= 1 and not m.free
+    assert np.all(m.nodes[m.faces["left"], 0] == 0.0)
+    with pytest.raises(ScenarioError, match="must be one of 'left'") as e:
+        build_solid(Solid(mesh=path, clamped=("xmin",)), surface=None, cache=False)
+    assert e.value.field == "plate.clamped"
+    with pytest.raises(ScenarioError, match="does not fit the mesh file's cells"):
+        build_solid(Solid(mesh=path, element="tet10"), surface=None, cache=False)
+
+
+def test_free_body_build_keeps_rigid_modes_and_a_residual():
+    """A box held nowhere: six zero modes first, and the inertia-relief residual over its
+    top face equals the on-demand one."""
+    m = build_solid(Solid(size=(0.02, 0.01, 0.005), elements=(2, 2, 1), max_frequency=4e5), cache=False)
+    assert m.free and np.all(m.omega[:6] == 0.0) and m.omega[6] > 0.0
+    pick = np.array([0, 2, 7])
+    assert np.allclose(m.residual_block(m.surface_dofs[pick]), m.resid[np.ix_(pick, pick)], rtol=1e-9,
+                       atol=1e-9 * np.abs(m.resid).max())
