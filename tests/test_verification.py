@@ -262,15 +262,16 @@ def test_render_only_rebuilds_the_pages_from_the_json(tmp_path, capsys):
 
 def test_update_puts_refreshed_cases_in_place_and_keeps_the_rest(tmp_path, capsys):
     """`verify --case X --update` replaces X's result in validation.json, keeps every other
-    case and their order, and says in the provenance line which cases were refreshed."""
+    case, puts a registered case in the registry's order (cases it does not know last), and
+    says in the provenance line which cases were refreshed."""
     from granplate.verification import page
 
     old = _results()
     page.write_pages(tmp_path, old, full=True, seconds=21.5, generated="Made for a test.")
     assert cli.main(["verify", "--out", str(tmp_path), "--case", "patch-test", "--update", "-q"]) == 0
     results, full, seconds, generated = page.read_results(tmp_path / "validation.json")
-    assert [r.name for r in results] == [r.name for r in old] + ["patch-test"]
-    assert [r.as_dict() for r in results[:2]] == [r.as_dict() for r in old] and full and seconds == 21.5
+    assert [r.name for r in results] == ["patch-test"] + [r.name for r in old]
+    assert [r.as_dict() for r in results[1:]] == [r.as_dict() for r in old] and full and seconds == 21.5
     assert generated.startswith("Made for a test. Refreshed by") and "`patch-test`" in generated
     assert "patch-test" in (tmp_path / "validation.md").read_text()
     renamed = page.merge_results(results, [dataclasses.replace(results[0], title="again")])

@@ -57,14 +57,14 @@ def __getattr__(name: str):
 def all_cases() -> tuple:
     """Every registered case, in page order."""
     from . import (chain, conservation, coupled, dynamic, face_contacts, granular, lammps, plastic_cases, plate_cases,
-                   plate_mesh, space_cases)
+                   plate_mesh, solid_cases, space_cases)
 
     beside = lammps.cases()
     plane_lammps = tuple(c for c in beside if c.family != "space")
     space_lammps = tuple(c for c in beside if c.family == "space")
     return (granular.CASES + chain.CASES + dynamic.CASES + plane_lammps + plastic_cases.CASES + space_cases.CASES
             + space_lammps + plate_cases.CASES
-            + plate_mesh.CASES + conservation.CASES + face_contacts.CASES + coupled.CASES)
+            + plate_mesh.CASES + solid_cases.CASES + conservation.CASES + face_contacts.CASES + coupled.CASES)
 
 
 def case_names(full: bool = True) -> list[str]:
@@ -117,7 +117,7 @@ def run_suite(out: str | Path, full: bool = False, names: list[str] | None = Non
     if full and ctx.run_cache is not None:
         save_run_cache(cache_path, ctx.run_cache)
     if update and (out / "validation.json").is_file():
-        update_pages(out, results, time.perf_counter() - t0)
+        update_pages(out, results, time.perf_counter() - t0, order=case_names(full=True))
     else:
         write_pages(out, results, full or any(c.slow for c in cases), time.perf_counter() - t0)
     return results

@@ -14,6 +14,7 @@ import datetime as _dt
 import json
 import platform
 from pathlib import Path
+from typing import Sequence
 
 from granplate.results.criteria import Check
 from granplate.results.document import Block, details, summary, to_html, to_markdown
@@ -26,6 +27,7 @@ FAMILY_TITLES = {
     "plastic": "Contacts beyond the elastic limit",
     "space": "Spheres in space (dimension = 3)",
     "plate": "Plate: finite elements and time integration",
+    "solid": "The 3D elastic solid (dimension = 3)",
     "conservation": "Conservation",
     "coupled": "Coupled runs: convergence of the default settings",
 }
@@ -234,15 +236,20 @@ def merge_results(old: list[CaseResult], new: list[CaseResult]) -> list[CaseResu
     return kept + [r for r in new if r.name in fresh]
 
 
-def update_pages(out: Path, new: list[CaseResult], seconds: float) -> list[Path]:
+def update_pages(out: Path, new: list[CaseResult], seconds: float,
+                 order: Sequence[str] = ()) -> list[Path]:
     """`granplate verify --case ... --update`: the cases of `new` replace theirs in
     DIR/validation.json (the others kept as they were), and the pages are rebuilt; the
-    provenance line says which cases were refreshed, when, how long."""
+    provenance line says which cases were refreshed, when, how long; order: the cases' page
+    order (the registry's), which a new case takes its place in."""
     results, full, total, generated = read_results(Path(out) / "validation.json")
     when = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     names = ", ".join(f"`{r.name}`" for r in new)
     note = f"Refreshed by `granplate verify --case ... --update` on {when} ({seconds:.0f} s): {names}."
-    return write_pages(Path(out), merge_results(results, new), full, total,
+    merged = merge_results(results, new)
+    rank = {name: i for i, name in enumerate(order)}
+    merged.sort(key=lambda r: rank.get(r.name, len(rank)))  # stable: unknown names stay last
+    return write_pages(Path(out), merged, full, total,
                        f"{generated or generated_line(full, total)} {note}")
 
 
