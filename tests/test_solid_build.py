@@ -1,9 +1,10 @@
 """build_solid: the arrays kept in the run store come back equal; the residual is over the
 top face's z dofs; a body too large is refused with its numbers; a 3D scenario's
-[plate] is a solid, checked field by field, and still refused to run."""
+[plate] is a solid, checked field by field, valid, and still refused to run."""
 from __future__ import annotations
 
 import copy
+import math
 
 import numpy as np
 import pytest
@@ -67,10 +68,14 @@ def test_3d_plate_is_a_solid_with_defaults():
     assert s.plate.max_frequency == SOLID_MAX_FREQUENCY == 1e5
 
 
-def test_valid_solid_is_refused_to_run_with_the_reason():
-    """A valid solid: the refusal says the solid is valid and the coupling is not there."""
-    with pytest.raises(ScenarioError, match="solid is valid.*not implemented") as e:
-        validate(scenario())
+def test_valid_solid_validates_and_is_refused_to_run_with_the_reason():
+    """A valid solid validates; building its model refuses: the solid is valid, the coupling
+    is not there, `granplate show` draws it."""
+    from granplate.model import build_model
+
+    validate(scenario())
+    with pytest.raises(ScenarioError, match="solid is valid.*not implemented.*granplate show") as e:
+        build_model(scenario())
     assert e.value.field == "plate"
 
 
@@ -116,3 +121,49 @@ def test_free_body_build_keeps_rigid_modes_and_a_residual():
     pick = np.array([0, 2, 7])
     assert np.allclose(m.residual_block(m.surface_dofs[pick]), m.resid[np.ix_(pick, pick)], rtol=1e-9,
                        atol=1e-9 * np.abs(m.resid).max())
+
+
+def test_box_signed_distance_is_the_euclidean_distance_to_the_box():
+    """Outside: the distance to the nearest face, edge or corner (Pythagoras); inside: minus
+    the distance to the nearest face; zero on the surface."""
+    from granplate.setup.solid_checks import box_signed_distance
+
+    lo, hi = (0.0, 0.0, 0.0), (3.0, 2.0, 1.0)
+    assert box_signed_distance(lo, hi, (1.0, 1.0, 1.5)) == 0.5               # above the top face
+    assert box_signed_distance(lo, hi, (4.0, 1.0, 2.0)) == math.sqrt(2.0)    # off an edge
+    assert box_signed_distance(lo, hi, (-1.0, -2.0, 3.0)) == 3.0             # off a corner: sqrt(1+4+4)
+    assert box_signed_distance(lo, hi, (1.0, 1.0, 0.75)) == -0.25            # inside, nearest the top
+    assert box_signed_distance(lo, hi, (3.0, 0.5, 0.5)) == 0.0
+
+
+@pytest.mark.parametrize("z,ok", [(0.006, True), (0.006 * (1 - 1e-6), False), (0.0039, False), (0.003, False)])
+def test_a_granule_may_touch_the_solid_but_not_cross_it(z, ok):
+    """A sphere of radius 2 mm above the top face (z = 4 mm): touching (z = 6 mm) is valid; a
+    penetration by more than 1e-9 R names the granule, the overlap and what to move; a
+    centre inside the body is always refused."""
+    d = copy.deepcopy(BASE)
+    d["granules"][0]["z"] = z
+    s = scenario_io.from_dict(d)
+    if ok:
+        validate(s)
+        return
+    with pytest.raises(ScenarioError) as e:
+        validate(s)
+    msg = str(e.value)
+    assert e.value.field == "granules[0]" and "plate.origin" in msg and "\n" not in msg, msg
+    if z > 0.004:
+        assert "penetrates the elastic solid" in msg and f"by {0.006 - z:.6g} m" in msg, msg
+    else:
+        assert "centre inside the elastic solid" in msg and f"{0.004 - z:.6g} m below its surface" in msg, msg
+
+
+def test_a_granule_beside_the_box_is_clear_of_it():
+    """A sphere off the box's edge x = 30 mm, z = 4 mm by 1.5 mm along both: closer than its
+    radius to both face planes, but sqrt(2) 1.5 mm = 2.12 mm from the edge, its nearest
+    point: radius 2 mm is clear, radius 2.2 mm penetrates by 2.2 - 2.12 mm."""
+    d = copy.deepcopy(BASE)
+    d["granules"][0].update(x=0.0315, z=0.0055, radius=0.002)
+    validate(scenario_io.from_dict(d))
+    d["granules"][0].update(radius=0.0022)
+    with pytest.raises(ScenarioError, match=f"penetrates the elastic solid.* by {0.0022 - math.sqrt(2) * 0.0015:.6g} m"):
+        validate(scenario_io.from_dict(d))

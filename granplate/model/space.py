@@ -2,9 +2,10 @@
 granules' centres, velocities and spin vectors, their pair and wall contact lists and
 coefficients (the same laws and coefficients as the plane, `model.arrays`), the 3D shock
 (load.kind = "force": a half-sine total force shared by the loaded granules along a
-direction, docs/model.md section 5.4) and the loop's settings. No plate in space yet.
-`model.arrays.build_model` calls `build_space_model` for a scenario of dimension 3: the
-one place the model's dimension is decided.
+direction, docs/model.md section 5.4) and the loop's settings. A scenario with an elastic
+solid ([plate]) is valid but refused here (`check_buildable`): its coupling to the granules
+is not implemented yet. `model.arrays.build_model` calls `build_space_model` for a scenario
+of dimension 3: the one place the model's dimension is decided.
 """
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import math
 
 import numpy as np
 
+from granplate.errors import ScenarioError
 from granplate.model.contacts import contact_lists, fixed_wall_contacts
 from granplate.model.inputs import STATE_COLUMNS, Granular3, PlateArrays, no_history
 from granplate.physics.contact import N_COEF
@@ -93,8 +95,22 @@ def frictionless(s: Scenario) -> bool:
     return all(s.contact.for_pair(a, b)[1] == 0.0 for a in names for b in partners)
 
 
+#: Why a 3D scenario with an elastic solid does not run (yet).
+SOLID_NOT_COUPLED = ("the elastic solid is valid, but its coupling to the granules in 3D is not implemented "
+                     "yet: a 3D scenario runs granules, walls and a box (inspect the solid with "
+                     "granplate.solid.build_solid; inspect it with `granplate show`)")
+
+
+def check_buildable(s: Scenario) -> None:
+    """ScenarioError("plate", ...) for a scenario of dimension 3 with a [plate] (an elastic
+    solid): valid, drawn by `granplate show`, but not run (SOLID_NOT_COUPLED)."""
+    if s.dimension == 3 and s.plate is not None:
+        raise ScenarioError("plate", "[plate]", SOLID_NOT_COUPLED)
+
+
 def build_space_model(s: Scenario):
-    """The Model of a validated, resolved scenario of dimension 3."""
+    """The Model of a validated, resolved scenario of dimension 3 (check_buildable first)."""
+    check_buildable(s)
     from granplate.model.arrays import (
         Model, find_pairs_and_walls, loop_config, pair_coefficients, wall_arrays,
     )

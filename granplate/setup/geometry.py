@@ -22,7 +22,7 @@ import math
 
 from granplate.errors import ScenarioError
 from granplate.setup import layouts
-from granplate.setup.scenario import (BOX_WALLS, Box, ChainLayout, Granule, LatticeLayout, Layout, Scenario,
+from granplate.setup.scenario import (BOX_WALLS, Box, ChainLayout, Granule, LatticeLayout, Layout, Plate, Scenario,
                                       SpaceLattice, Wall)
 
 #: Labels of the paper's granules, in the order `paper_layout` returns them.
@@ -162,7 +162,8 @@ def resolve(scenario: Scenario) -> Scenario:
       plane 1's, when the load's direction is +x). A 3D layout with a `box` is a
       ScenarioError (the layout makes its walls). A layout together with
       explicit granules or walls is a ScenarioError (give one or the other).
-    - Without a layout, a plate needs an explicit `x0` (ScenarioError otherwise).
+    - Without a layout, a plate needs an explicit `x0` (ScenarioError otherwise); a 3D
+      solid (`Solid`) is placed by its own fields and left as it is.
     - Unlabelled granules get the label "g<i>", unlabelled walls "w<i>" (i: 0-based index).
     - In 3D (`dimension = 3`): a `box` becomes its six walls (`box_walls`), after the
       explicit walls, and `box` None; a wall given by a `point` gets offset = point . n
@@ -184,12 +185,12 @@ def resolve(scenario: Scenario) -> Scenario:
             raise ScenarioError("box", "[box]", "give either [layout] or [box], not both (a 3D "
                                 "layout generates the walls around it: layout.walls)")
         granules, walls, xp, column1 = layout_packing(scenario.layout, scenario.dimension)
-        if plate is not None and plate.x0 is None:
+        if isinstance(plate, Plate) and plate.x0 is None:
             plate = dataclasses.replace(plate, x0=xp)
         along_x = scenario.dimension == 2 or along_plus_x(load.direction)
         if scenario.layout.imperfections is not None and not load.granules and along_x:
             load = dataclasses.replace(load, granules=column1)
-    if plate is not None and plate.x0 is None:
+    if isinstance(plate, Plate) and plate.x0 is None:
         raise ScenarioError("plate.x0", None,
                             "must be given when the scenario has no [layout] "
                             "(the plate's lower-left corner x [m])")

@@ -1,11 +1,18 @@
 """Range checks of a 3D scenario's solid ([plate] when dimension = 3), each naming the
 field and its allowed range: the box or the mesh file, the material, the element, the
 faces held (names that exist, no face both clamped and on rollers), the cut-off. The
-mesh itself (cells, Jacobians, face groups) is checked when it is read (solid.mesh)."""
+mesh itself (cells, Jacobians, face groups) is checked when it is read (solid.mesh).
+
+The granules against the solid at t = 0 (`check_solid_clearance`, the one owner of the
+rule and its message): a granule may touch the solid but not cross its surface, and its
+centre never lies inside it. For a box the signed distance of a centre to the surface is
+in closed form (`box_signed_distance`); for a mesh file it is the surface's
+(solid.surface.closest_point), computed where the file is read."""
 from __future__ import annotations
 
+import math
 import numbers
-from typing import Any
+from typing import Any, Sequence
 
 from granplate.errors import ScenarioError
 from granplate.setup.fields import finite, material_exists, positive, string_in
@@ -77,3 +84,66 @@ def check_solid(s: Scenario) -> None:
     """A scenario's solid: its fields and its material."""
     check_solid_fields(s.plate)
     material_exists("plate.material", s.plate.material, s)
+
+
+def is_box(sd: Solid) -> bool:
+    """Whether the solid is a box (size and elements), not a mesh file."""
+    return sd.mesh is None
+
+
+def box_signed_distance(lower: Sequence[float], upper: Sequence[float], p: Sequence[float]) -> float:
+    """The signed distance [m] of point p [m] to the surface of the box lower..upper [m]:
+    outside, the Euclidean distance to the box (positive); inside, minus the distance to
+    the nearest face (negative); zero on the surface."""
+    gaps = [max(lo - x, 0.0, x - hi) for lo, hi, x in zip(lower, upper, p)]
+    outside = math.hypot(*gaps)
+    if outside > 0.0:
+        return outside
+    return -min(min(x - lo, hi - x) for lo, hi, x in zip(lower, upper, p))
+
+
+def box_corners(sd: Solid) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """(lower, upper) corners [m] of a box solid."""
+    lo = tuple(float(o) for o in sd.origin)
+    return lo, tuple(o + float(s) for o, s in zip(lo, sd.size))
+
+
+def solid_named(sd: Solid) -> str:
+    """The solid as a message names it: its box corners, or its mesh file."""
+    if is_box(sd):
+        lo, hi = box_corners(sd)
+        return f"the elastic solid (the box [{', '.join(f'{v:.6g}' for v in lo)}] .. " \
+               f"[{', '.join(f'{v:.6g}' for v in hi)}] m of plate.origin and plate.size)"
+    return f"the elastic solid (the surface of plate.mesh = {sd.mesh!r})"
+
+
+def check_solid_clearance(s: Scenario, distances: Sequence[float], named: dict[int, str], rtol: float) -> None:
+    """No granule of the resolved `s` crosses the solid's surface at t = 0.
+
+    distances: the signed distance [m] of each granule's centre to the surface (positive
+    outside); named: how messages name granule i; rtol: the tolerance on a penetration,
+    times the granule's radius. A centre inside the solid is always refused."""
+    what = solid_named(s.plate)
+    move = "plate.origin" if is_box(s.plate) else "the mesh"
+    for i, (g, d) in enumerate(zip(s.granules, distances)):
+        if d < 0.0:
+            raise ScenarioError(
+                f"granules[{i}]", g.label,
+                f"{named[i]} has its centre inside {what}, {-d:.6g} m below its surface, at t = 0; "
+                f"move the granule or the solid ({move}) so that the granule lies outside it "
+                f"(distance from its centre to the surface >= its radius {g.radius:.6g} m)")
+        pen = g.radius - d
+        if pen > rtol * g.radius:
+            raise ScenarioError(
+                f"granules[{i}]", g.label,
+                f"{named[i]} penetrates {what} by {pen:.6g} m at t = 0; a granule may touch the "
+                f"solid but not cross it: move the granule or the solid ({move}) so that the "
+                f"distance from its centre to the surface ({d:.6g} m) is at least its radius "
+                f"{g.radius:.6g} m")
+
+
+def box_distances(s: Scenario) -> list[float]:
+    """The signed distance [m] of each granule's centre to the surface of the box solid
+    of the resolved `s` (`box_signed_distance`)."""
+    lo, hi = box_corners(s.plate)
+    return [box_signed_distance(lo, hi, (g.x, g.y, g.z)) for g in s.granules]

@@ -29,12 +29,13 @@ from granplate.setup.layouts import (column_radii, half_pitch, hexagonal_offsets
 from granplate.setup.fields import finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
 from granplate.setup.pairs import close_pairs
 from granplate.setup.plate_checks import check_plate_fields, check_plate_mesh
-from granplate.setup.solid_checks import check_solid
+from granplate.setup.solid_checks import box_distances, check_solid, check_solid_clearance, is_box
 from granplate.setup.plate_cost import MEMORY_SHARE, physical_memory
 from granplate.setup.materials import Material
 from granplate.setup.scenario import (Solid, BOX_WALLS, LAYOUT_KINDS, LAYOUT_KINDS_BY_DIMENSION, NORMAL_LAWS,
                                       SPACE_LATTICE_KINDS, SQRT2_MINUS_1, ChainLayout, Granule,
-                                      Imperfections, LatticeLayout, Layout, Scenario, SpaceLattice)
+                                      Imperfections, LatticeLayout, Layout, Plate, Scenario,
+                                      SpaceLattice)
 
 #: Lever arms of the friction torque (Contact.torque_arm).
 TORQUE_ARMS: tuple[str, ...] = ("radius", "contact_point")
@@ -128,17 +129,20 @@ def _check_planar(s: Scenario) -> None:
                             + f", {SET_3D}")
     if isinstance(lay, ChainLayout) and lay.z is not None:
         raise ScenarioError("layout.z", lay.z, f"a chain's depth z is 3D: leave it out in 2D, {SET_3D}")
+    if isinstance(s.plate, Solid):
+        raise ScenarioError("plate", "[plate]", "an elastic solid (size, elements or mesh) is 3D: "
+                            f"in 2D the [plate] is a plane-stress plate (width, height, thickness), {SET_3D}")
 
 
 def _check_spatial(s: Scenario) -> None:
-    """A 3D scenario (as written): granules, walls and a box, or a 3D layout; no plate yet;
-    vector spins; walls as planes."""
+    """A 3D scenario (as written): granules, walls and a box, or a 3D layout; its [plate]
+    an elastic solid (setup.solid_checks); vector spins; walls as planes."""
     if s.plate is not None:
-        if isinstance(s.plate, Solid):
-            check_solid(s)
-        raise ScenarioError("plate", "[plate]", "the elastic solid is valid, but its coupling to the granules "
-                            "in 3D is not implemented yet: a 3D scenario runs granules, walls and a box "
-                            "(inspect the solid with granplate.solid.build_solid)")
+        if not isinstance(s.plate, Solid):
+            raise ScenarioError("plate", "[plate]", "in 3D the [plate] is an elastic solid (setup.scenario."
+                                "Solid: size, elements, origin or mesh, material, element, clamped, rollers, "
+                                "max_frequency), not a plane-stress plate: set dimension = 2 for a plate")
+        check_solid(s)
     lay = s.layout
     if lay is not None and isinstance(lay.kind, str) and lay.kind in LAYOUT_KINDS \
             and lay.kind not in LAYOUT_KINDS_BY_DIMENSION[3]:
@@ -545,7 +549,10 @@ def length_scale(s: Scenario) -> tuple[float, str]:
     granule radius or a plate element edge (width / nx, height / ny); its radii and plate
     sizes already checked to be positive numbers."""
     found = [(g.radius, f"granules[{i}].radius") for i, g in enumerate(s.granules)]
-    if s.plate is not None:
+    if isinstance(s.plate, Solid) and is_box(s.plate):
+        found += [(s.plate.size[k] / s.plate.elements[k], f"plate.size[{k}] / plate.elements[{k}]")
+                  for k in range(3)]
+    elif s.plate is not None:
         found += [(s.plate.width / s.plate.nx, "plate.width / plate.nx"),
                   (s.plate.height / s.plate.ny, "plate.height / plate.ny")]
     return min(found)
@@ -576,7 +583,9 @@ def _check_lengths(s: Scenario, boxed: bool = False) -> None:
                for path, w in zip(_wall_paths(s, boxed), s.walls)]
     values += [(f"walls[{k}].point[{c}]", x) for k, w in enumerate(s.walls) if w.point is not None
                for c, x in enumerate(w.point)]
-    if s.plate is not None:
+    if isinstance(s.plate, Solid) and is_box(s.plate):
+        values += [(f"plate.{f}[{k}]", getattr(s.plate, f)[k]) for f in ("origin", "size") for k in range(3)]
+    elif s.plate is not None:
         pl = s.plate
         values += [(f"plate.{f}", getattr(pl, f)) for f in ("x0", "y0", "width", "height", "thickness",
                                                             "rigid_layer_width")
@@ -660,14 +669,14 @@ def _check_wall_penetration(s: Scenario, named: dict[int, str]) -> None:
 
 def _check_plate(s: Scenario) -> None:
     pl = s.plate
-    if pl is None:
+    if not isinstance(pl, Plate):  # none, or a 3D solid (checked as written: _check_spatial)
         return
     check_plate_fields(pl, pl.x0)
     material_exists("plate.material", pl.material, s)
 def _check_plate_penetration(s: Scenario, named: dict[int, str]) -> None:
     """No granule crosses the plate's left edge at t = 0."""
     pl = s.plate
-    if pl is None:
+    if not isinstance(pl, Plate):
         return
     x0 = pl.x0
     for i, g in enumerate(s.granules):
@@ -678,6 +687,15 @@ def _check_plate_penetration(s: Scenario, named: dict[int, str]) -> None:
                     f"granules[{i}]", g.label,
                     f"{named[i]} penetrates the plate (left edge plate.x0 = {x0:.6g} m) by {pen:.6g} m at "
                     f"t = 0; granules must lie left of the plate (x + radius <= plate.x0)")
+
+
+def _check_solid_penetration(s: Scenario, named: dict[int, str]) -> None:
+    """No granule crosses the 3D solid's surface at t = 0, none has its centre inside it
+    (setup.solid_checks.check_solid_clearance, tolerance OVERLAP_RTOL x the radius, as
+    the plate's edge and the walls). A box in closed form; a mesh file's surface is
+    checked where the file is read (solid.clearance), not here."""
+    if isinstance(s.plate, Solid) and is_box(s.plate):
+        check_solid_clearance(s, box_distances(s), named, OVERLAP_RTOL)
 
 
 def _check_load(s: Scenario) -> None:
@@ -887,8 +905,8 @@ def output_bytes_per_second(s: Scenario) -> float:
     of the granules' states and the plate's modal coordinates per output_interval, a plate
     snapshot per field_interval (s resolved)."""
     t = s.time
-    n_dof = 0
-    if s.plate is not None:
+    n_dof = 0  # a 3D solid writes no fields yet (its coupling comes with its outputs)
+    if isinstance(s.plate, Plate):
         p = s.plate
         n_dof = 2 * ((p.nx + 1) * (p.ny + 1) + p.nx * (p.ny + 1) + p.ny * (p.nx + 1))
     row = OUTPUT_BYTES_PER_GRANULE * len(s.granules) + OUTPUT_BYTES_PER_DOF * n_dof + 400.0
@@ -956,12 +974,12 @@ def validate(scenario: Scenario) -> None:
     """Raise ScenarioError(field, value, allowed) for the first problem in `scenario`.
 
     Order: dimension, materials, the fields of the other dimension (2D: no z, vz, vector
-    omega, 3-component normal, point, box or force load; 3D: no plate or line load, a 3D layout kind,
-    vector omegas, walls as planes, the box), layout (as `layout.*`, before it is
+    omega, 3-component normal, point, box, solid or force load; 3D: no line load, the [plate] a
+    solid and its fields, a 3D layout kind, vector omegas, walls as planes, the box), layout (as `layout.*`, before it is
     expanded), then on the resolved
     scenario: granules (values, speeds, unique labels), walls (unit normals), plate, the
     range of every coordinate and size (`LENGTH_RANGE`), overlaps and penetrations at
-    t = 0, load, contact (and the yield strengths its normal laws need), plate mesh (rigid
+    t = 0 (walls, the plate's edge, a box solid's surface), load, contact (and the yield strengths its normal laws need), plate mesh (rigid
     layers of the contacts on nodes, patch contacts between nodes, n_modes), time, the
     outputs' memory, solver. A scenario with neither granules (nor a layout) nor a plate
     is refused.
@@ -981,7 +999,7 @@ def validate(scenario: Scenario) -> None:
     if s.layout is None and not s.granules and s.plate is None:
         raise ScenarioError("granules", (), "a scenario needs granules (or a [layout]) "
                             "or a [plate], or both; it has neither")
-    if s.plate is not None and s.plate.x0 is not None:
+    if isinstance(s.plate, Plate) and s.plate.x0 is not None:
         finite("plate.x0", s.plate.x0)
     r = resolve(s)
     _check_granules(r)
@@ -992,9 +1010,11 @@ def validate(scenario: Scenario) -> None:
     _check_overlaps(r, named)
     _check_wall_penetration(r, named)
     _check_plate_penetration(r, named)
+    _check_solid_penetration(r, named)
     _check_load(r)
     _check_contact(r)
-    check_plate_mesh(r, named)
+    if isinstance(r.plate, Plate):
+        check_plate_mesh(r, named)
     _check_time(r)
     _check_output_size(r)
     _check_solver(r)
