@@ -289,3 +289,93 @@ def test_cli_show_3d_time_outside_exits_2(box_file, capsys):
     assert main(["show", str(box_file), "--time", "1"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("granplate: error:") and "--time" in err and err.count("\n") == 1
+
+
+#: Two spheres resting on a clamped box solid (20 x 10 x 4 mm of 4 x 2 x 1 hex20 elements).
+ON_SOLID: dict = {
+    "name": "on-solid", "dimension": 3,
+    "granules": [{"label": "a", "x": 0.006, "y": 0.005, "z": 0.007, "radius": 0.003, "material": "steel"},
+                 {"label": "b", "x": 0.012, "y": 0.005, "z": 0.007, "radius": 0.003, "material": "ptfe"}],
+    "plate": {"size": [0.02, 0.01, 0.004], "elements": [4, 2, 1], "origin": [0.0, 0.0, 0.0],
+              "material": "bearing_steel", "clamped": ["xmin"]},
+    "load": {"kind": "none"},
+    "time": {"t_end": 1e-5, "output_interval": 1e-6, "field_interval": 1e-5},
+}
+
+
+def _collections(fig, prefix: str) -> dict:
+    return {c.get_gid().split(":")[1]: c for ax in fig.axes for c in ax.collections
+            if str(c.get_gid()).startswith(prefix + ":")}
+
+
+def _length(segments) -> float:
+    s = np.asarray(segments, float)
+    return float(np.linalg.norm(s[:, 1] - s[:, 0], axis=-1).sum())
+
+
+def test_show_draws_a_box_solid_its_edges_and_clamped_face():
+    """A box solid: its outline lies on the box's 12 edges, of total length 4 (Lx + Ly + Lz);
+    the clamped face xmin's outline is its perimeter 2 (Ly + Lz); each view draws their
+    projections in mm over a light fill, and the legend names material and element count."""
+    a = space.of_scenario(scenario_io.from_dict(copy.deepcopy(ON_SOLID)))
+    L = np.array([0.02, 0.01, 0.004])
+    assert _length(a.solid_edges) == pytest.approx(4.0 * L.sum(), rel=1e-12)
+    ends = a.solid_edges.reshape(-1, 3)
+    on_extremes = (np.isclose(ends, 0.0, atol=1e-15) | np.isclose(ends, L, atol=1e-15)).sum(axis=1)
+    assert np.all(on_extremes >= 2)  # on an edge of the box: two coordinates at a face
+    assert _length(a.clamped_edges) == pytest.approx(2.0 * (L[1] + L[2]), rel=1e-12)
+    assert np.allclose(a.clamped_edges[:, :, 0], 0.0)
+    fig = space.draw(a)
+    edges, clamped, fills = (_collections(fig, k) for k in ("solid-edges", "solid-clamped", "solid"))
+    assert set(edges) == set(clamped) == set(fills) == {"xy", "xz", "yz"}
+    for (u, v, _, _), view in zip(space.PROJECTIONS, ("xy", "xz", "yz")):
+        drawn = np.array(edges[view].get_segments())
+        assert np.allclose(drawn, a.solid_edges[:, :, [u, v]] * 1e3)
+        assert min(to_rgb(fills[view].get_facecolor()[0])) > 0.7  # filled lightly
+    texts = [t.get_text() for leg in fig.legends for t in leg.get_texts()]
+    assert "elastic solid: bearing_steel, 8 hex20 elements, clamped: xmin" in texts, texts
+    assert "clamped faces" in texts
+
+
+def _l_shaped_msh(path, size: float):
+    """Three cubes of side `size` [m] in an L (x-y plane: cells at (0,0), (1,0), (0,1)), the
+    face x = 0 as the group 'left'."""
+    pts = np.array([[x, y, z] for z in (0, 1) for y in (0, 1, 2) for x in (0, 1, 2)], float)
+    node = lambda x, y, z: int(np.flatnonzero((pts == [x, y, z]).all(axis=1))[0])  # noqa: E731
+    cube = lambda x, y: [node(x + dx, y + dy, dz) for dx, dy, dz in  # noqa: E731
+                         [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]]
+    quads = [[node(0, y, 0), node(0, y + 1, 0), node(0, y + 1, 1), node(0, y, 1)] for y in (0, 1)]
+    hexes = [cube(0, 0), cube(1, 0), cube(0, 1)]
+    m = meshio.Mesh(pts * size, [("hexahedron", np.array(hexes)), ("quad", np.array(quads))],
+                    cell_data={"gmsh:physical": [np.full(3, 2), np.full(2, 1)],
+                               "gmsh:geometrical": [np.full(3, 2), np.full(2, 1)]},
+                    field_data={"left": np.array([1, 2]), "body": np.array([2, 3])})
+    meshio.write(str(path), m, file_format="gmsh22", binary=False)
+    return str(path)
+
+
+@pytest.mark.parametrize("radius,ok", [(0.004, True), (0.006, False)])
+def test_show_draws_a_gmsh_solid_and_checks_its_surface(tmp_path, radius, ok):
+    """An L-shaped body of three 10 mm cubes: its outline is the L prism's 18 edges (22 cube
+    sides, one segment each), its clamped group 'left' outlined by its perimeter (6 sides); a sphere in
+    the notch, 5 mm from the body (inside its bounding box), is drawn with radius 4 mm and
+    refused with radius 6 mm, 1 mm too deep (the surface's signed distance, not the box's)."""
+    from granplate.errors import ScenarioError
+    from granplate.setup.validate import validate
+
+    d = copy.deepcopy(ON_SOLID)
+    d["plate"] = {"mesh": _l_shaped_msh(tmp_path / "l.msh", 0.01), "clamped": ["left"]}
+    d["granules"] = [{"label": "notch", "x": 0.015, "y": 0.015, "z": 0.005, "radius": radius,
+                      "material": "steel"}]
+    s = scenario_io.from_dict(d)
+    validate(s)  # a mesh file's surface is read where it is drawn (or built), not by validate
+    if not ok:
+        with pytest.raises(ScenarioError, match="'notch'.* penetrates the elastic solid .*by 0.001 m") as e:
+            space.of_scenario(s)
+        assert e.value.field == "granules[0]"
+        return
+    a = space.of_scenario(s)
+    assert _length(a.solid_edges) == pytest.approx(22 * 0.01, rel=1e-12) and len(a.solid_edges) == 22
+    assert _length(a.clamped_edges) == pytest.approx(6 * 0.01, rel=1e-12)
+    assert "3 hex20 elements" in a.solid_label
+    space.draw(a)

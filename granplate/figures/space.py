@@ -5,7 +5,11 @@ darkened with its distance from the viewer; the walls as their traces (a wall wh
 plane contains the viewing direction is a line: the six walls of a box draw its
 outline; an oblique plane is listed, not drawn); the contact network as lines between
 touching centres (and from a centre to its wall), width and colour by the normal force
-for a result. Axes in mm.
+for a result. An elastic solid ([plate] of a 3D scenario) is drawn under the spheres in each
+view: its boundary facets filled lightly, its outline (the edges where the surface creases:
+a box's 12 edges) and its clamped faces' outlines as thick lines, labelled with its
+material, element and element count; from its mesh alone (solid.mesh: the box, or the
+file read and checked), no modes built. Axes in mm.
 
     >>> from granplate.figures import space
     >>> fig = space.draw(space.of_scenario(scenario))        # before the run
@@ -21,12 +25,12 @@ s_i . n + R_i - offset for a wall (docs/model.md, the laws in space).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import xarray as xr
 from matplotlib.cm import ScalarMappable
-from matplotlib.collections import LineCollection
+from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.colors import Normalize, to_rgb
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
@@ -53,6 +57,15 @@ OPEN_FRACTION = 0.01
 KIND_COLOURS = {"granule": "0.1", "wall": "tab:purple"}
 KIND_NAMES = {"granule": "granule-granule", "wall": "granule-wall"}
 LOAD_COLOUR = "crimson"
+#: The solid: the fill's share of its material colour (the rest white), its outline and
+#: its clamped faces' outlines (colour, width [points]).
+SOLID_TINT = 0.25
+SOLID_EDGE = ("0.25", 1.0)
+CLAMPED_EDGE = ("tab:blue", 3.5)
+
+
+def _no_segments() -> np.ndarray:
+    return np.zeros((0, 2, 3))
 
 
 @dataclass(frozen=True)
@@ -64,7 +77,10 @@ class Assembly3D:
     mask of the granules it pushes; segments (nc, 2, 3) contact lines (centre to centre,
     centre to the wall's nearest point), kinds per segment ("granule", "wall"); forces:
     normal force per segment [N] or None (a scenario); time [s] and time_note: the
-    result time shown (None for a scenario).
+    result time shown (None for a scenario). The elastic solid of a scenario (empty
+    without one): solid_faces (nf, k, 3) its boundary facets' corners [m], solid_edges
+    (ne, 2, 3) its outline, clamped_edges (nc, 2, 3) the outlines of its clamped faces,
+    solid_label its material, element and element count, solid_material its material.
     """
 
     name: str
@@ -80,6 +96,11 @@ class Assembly3D:
     forces: np.ndarray | None = None
     time: float | None = None
     time_note: str = ""
+    solid_faces: np.ndarray = field(default_factory=lambda: np.zeros((0, 4, 3)))
+    solid_edges: np.ndarray = field(default_factory=_no_segments)
+    clamped_edges: np.ndarray = field(default_factory=_no_segments)
+    solid_label: str = ""
+    solid_material: str = ""
 
 
 # --------------------------------------------------------------------------------------
@@ -170,9 +191,38 @@ def positions(ds: xr.Dataset, upto: int | None = None) -> np.ndarray:
     return np.stack([ds[k].values[sl] for k in ("x", "y", "z")], axis=-1).astype(float)
 
 
+def solid_drawing(s: Scenario, written: Scenario | None = None) -> dict:
+    """The Assembly3D fields of the resolved scenario's elastic solid (none: {}; written:
+    the scenario as written, which names its granules in a message), from its
+    mesh alone (solid.build.solid_mesh: the box, or the file read and checked); a mesh
+    file's surface is checked against the granules here (solid.clearance), a box's was by
+    `validate`."""
+    from granplate.setup.scenario import Solid
+
+    sd = s.plate
+    if not isinstance(sd, Solid):
+        return {}
+    from granplate.setup.geometry import granule_named
+    from granplate.setup.validate import OVERLAP_RTOL
+    from granplate.solid.build import solid_mesh
+    from granplate.solid.clearance import check_clearance
+    from granplate.solid.mesh import boundary_polygons, outline_edges
+
+    mesh = solid_mesh(sd)
+    if sd.mesh is not None:
+        check_clearance(s, mesh, {i: granule_named(written or s, s, i) for i in range(len(s.granules))}, OVERLAP_RTOL)
+    clamped = [outline_edges(mesh, mesh.boundaries[name]) for name in sd.clamped]
+    held = f", clamped: {', '.join(sd.clamped)}" if sd.clamped else ", free"
+    held += f", rollers: {', '.join(sd.rollers)}" if sd.rollers else ""
+    return {"solid_faces": boundary_polygons(mesh), "solid_edges": outline_edges(mesh),
+            "clamped_edges": np.concatenate(clamped) if clamped else _no_segments(),
+            "solid_label": f"elastic solid: {sd.material}, {mesh.t.shape[1]} {sd.element} elements{held}",
+            "solid_material": sd.material}
+
+
 def of_scenario(scenario: Scenario) -> Assembly3D:
     """The 3D assembly of a scenario before its run: initial centres, the contacts
-    touching at t = 0 (no forces)."""
+    touching at t = 0 (no forces), its elastic solid (`solid_drawing`)."""
     from granplate.model.space import loaded_granules_3d
     from granplate.setup.geometry import resolve
 
@@ -185,6 +235,7 @@ def of_scenario(scenario: Scenario) -> Assembly3D:
         name=s.name, pos=pos, radius=r, labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
         materials=tuple(g.material for g in s.granules), walls=s.walls, load=s.load,
         loaded=loaded_granules_3d(s, pos[:, 0], pos[:, 1], pos[:, 2], r), segments=segs, kinds=kinds,
+        **solid_drawing(s, scenario),
     )
 
 
@@ -232,6 +283,10 @@ def bounds(a: Assembly3D, margin: float = 0.05) -> tuple[np.ndarray, np.ndarray]
     walls (a box), widened by margin times the largest side."""
     lo = (a.pos - a.radius[:, None]).min(axis=0) if len(a.radius) else np.zeros(3)
     hi = (a.pos + a.radius[:, None]).max(axis=0) if len(a.radius) else np.zeros(3)
+    if len(a.solid_edges):  # the solid bounds every axis
+        ends = a.solid_edges.reshape(-1, 3)
+        lo, hi = (np.minimum(lo, ends.min(axis=0)), np.maximum(hi, ends.max(axis=0))) if len(a.radius) \
+            else (ends.min(axis=0), ends.max(axis=0))
     for w in a.walls:  # an axis-aligned wall bounds its axis
         n = unit_normal(w)
         k = int(np.argmax(np.abs(n)))
@@ -279,6 +334,7 @@ def _draw_view(ax, a: Assembly3D, view: tuple, colours: dict, lo, hi) -> int:
     ax.set_ylabel(f"{AXIS_NAMES[v]} [mm]")
     toward = ("+" if sign > 0 else "-") + AXIS_NAMES[d]
     ax.set_title(f"{AXIS_NAMES[u]}-{AXIS_NAMES[v]}, seen from {toward}", fontsize=9, loc="left")
+    _draw_solid(ax, a, view, colours)
     drawn = 0
     inner = bounds(a, margin=0.0)
     for w in a.walls:
@@ -310,6 +366,29 @@ def _draw_view(ax, a: Assembly3D, view: tuple, colours: dict, lo, hi) -> int:
     return drawn
 
 
+def solid_fill(colour: str) -> tuple[float, float, float]:
+    """The solid's light fill: SOLID_TINT of its material colour, the rest white."""
+    return tuple(SOLID_TINT * c + (1.0 - SOLID_TINT) for c in to_rgb(colour))
+
+
+def _draw_solid(ax, a: Assembly3D, view: tuple, colours: dict) -> None:
+    """The solid in one view, under the spheres: its facets filled, its outline, its
+    clamped faces' outlines thick (gids solid, solid-edges, solid-clamped: VIEW)."""
+    if not len(a.solid_edges):
+        return
+    u, v, _, _ = view
+    uv = f"{AXIS_NAMES[u]}{AXIS_NAMES[v]}"
+    fill = solid_fill(colours.get(a.solid_material, "0.6"))
+    ax.add_collection(PolyCollection(a.solid_faces[:, :, [u, v]] * MM, facecolors=[fill], edgecolors="none",
+                                     zorder=0.5, gid=f"solid:{uv}"))
+    ax.add_collection(LineCollection(a.solid_edges[:, :, [u, v]] * MM, colors=SOLID_EDGE[0],
+                                     linewidths=SOLID_EDGE[1], zorder=0.8, gid=f"solid-edges:{uv}"))
+    if len(a.clamped_edges):
+        ax.add_collection(LineCollection(a.clamped_edges[:, :, [u, v]] * MM, colors=CLAMPED_EDGE[0],
+                                         linewidths=CLAMPED_EDGE[1], zorder=0.9, capstyle="butt",
+                                         gid=f"solid-clamped:{uv}"))
+
+
 def _title(a: Assembly3D) -> str:
     if a.time is None:
         return f"{a.name}: assembly before the run (in space; spheres darker with distance from the viewer)"
@@ -339,7 +418,13 @@ def _mark_loaded(axes, a: Assembly3D) -> None:
 
 def legend_handles(a: Assembly3D, colours: dict, oblique: list[str]) -> list:
     """Legend entries: materials, walls, contacts, load."""
-    handles = [Patch(fc=c, ec="0.1", label=f"{m} ({a.materials.count(m)} spheres)") for m, c in colours.items()]
+    handles = [Patch(fc=c, ec="0.1", label=f"{m} ({a.materials.count(m)} spheres)") for m, c in colours.items()
+               if m in a.materials]
+    if a.solid_label:
+        handles.append(Patch(fc=solid_fill(colours.get(a.solid_material, "0.6")), ec=SOLID_EDGE[0],
+                             label=a.solid_label))
+        if len(a.clamped_edges):
+            handles.append(Line2D([], [], color=CLAMPED_EDGE[0], lw=CLAMPED_EDGE[1], label="clamped faces"))
     if len(a.walls) > len(oblique):
         handles.append(Line2D([], [], color="0.2", lw=2.0, label="rigid walls seen edge-on"))
     if oblique:
@@ -365,7 +450,7 @@ def draw(a: Assembly3D, width: float = 13.0) -> Figure:
     span = (hi - lo) * MM
     fig = new_figure(width, min(max(width / 3.0 * span[1:].max() / max(span[:2].max(), 1e-12) + 2.2, 4.0), 9.0))
     axes = fig.subplots(1, 3, width_ratios=[span[0], span[0], span[1]])
-    colours = material_colours(a.materials)
+    colours = material_colours(a.materials + ((a.solid_material,) if a.solid_material else ()))
     for ax, view in zip(axes, PROJECTIONS):
         _draw_view(ax, a, view, colours, lo, hi)
     _mark_loaded(axes, a)

@@ -546,15 +546,18 @@ def _check_speeds(p: str, g: Granule, m: Material) -> None:
 
 def length_scale(s: Scenario) -> tuple[float, str]:
     """(h [m], the field it comes from): the smallest length of a resolved scenario, a
-    granule radius or a plate element edge (width / nx, height / ny); its radii and plate
-    sizes already checked to be positive numbers."""
+    granule radius or a plate element edge (width / nx, height / ny; a box solid's
+    size / elements along each axis); its radii and plate sizes already checked to be
+    positive numbers."""
     found = [(g.radius, f"granules[{i}].radius") for i, g in enumerate(s.granules)]
     if isinstance(s.plate, Solid) and is_box(s.plate):
         found += [(s.plate.size[k] / s.plate.elements[k], f"plate.size[{k}] / plate.elements[{k}]")
                   for k in range(3)]
-    elif s.plate is not None:
+    elif isinstance(s.plate, Plate):
         found += [(s.plate.width / s.plate.nx, "plate.width / plate.nx"),
                   (s.plate.height / s.plate.ny, "plate.height / plate.ny")]
+    if not found:  # a solid of a mesh file alone: no length known before the file is read
+        return math.inf, "no granule"
     return min(found)
 
 
@@ -585,7 +588,7 @@ def _check_lengths(s: Scenario, boxed: bool = False) -> None:
                for c, x in enumerate(w.point)]
     if isinstance(s.plate, Solid) and is_box(s.plate):
         values += [(f"plate.{f}[{k}]", getattr(s.plate, f)[k]) for f in ("origin", "size") for k in range(3)]
-    elif s.plate is not None:
+    elif isinstance(s.plate, Plate):
         pl = s.plate
         values += [(f"plate.{f}", getattr(pl, f)) for f in ("x0", "y0", "width", "height", "thickness",
                                                             "rigid_layer_width")

@@ -96,8 +96,10 @@ def _read(path: Path, field: str):
                             "give a Gmsh .msh file of hexahedra or tetrahedra") from None
 
 
-def _group_facets(m, mesh: Mesh, surface_type: str, field: str, path: str) -> dict[str, np.ndarray]:
-    """The named facet groups of a file: its physical groups of surface cells, mapped to
+def _group_facets(m, mesh: Mesh, surface_type: str, field: str, path: str,
+                  surface: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """The named facet groups of a file: its physical groups of surface cells (surface:
+    those cells renumbered as the mesh's points; None: as the file has them), mapped to
     the facets of the skfem mesh."""
     lookup = {tuple(f): i for i, f in enumerate(np.sort(mesh.facets, axis=0).T)}
     groups: dict[str, np.ndarray] = {}
@@ -105,7 +107,7 @@ def _group_facets(m, mesh: Mesh, surface_type: str, field: str, path: str) -> di
     if surface_type not in physical:
         return groups
     tags = physical[surface_type]
-    surface = m.cells_dict[surface_type]
+    surface = m.cells_dict[surface_type] if surface is None else surface
     for name, (tag, dim) in m.field_data.items():
         if int(dim) != 2:
             continue
@@ -143,14 +145,14 @@ def read_mesh(path: str | Path, field: str = "plate.mesh") -> Mesh:
         raise ScenarioError(field, str(path), "points must have three coordinates")
     check_cells(points, cells, field, str(path))
     t = cells.T[INV_HEX_MAPPING[:8]] if cell_type == "hexahedron" else cells.T
-    if used.size != points.shape[0]:  # drop geometry points no cell uses; renumber
-        renumber = -np.ones(points.shape[0], dtype=np.int64)
+    surface = None
+    if used.size != points.shape[0]:  # drop geometry points no cell uses; renumber (meshio's
+        renumber = -np.ones(points.shape[0], dtype=np.int64)  # cells_dict is a fresh dict per call)
         renumber[used] = np.arange(used.size)
         points, t = points[used], renumber[t]
-        m.cells_dict[FILE_CELLS[cell_type]] = renumber[np.asarray(m.cells_dict.get(FILE_CELLS[cell_type],
-                                                                                   np.zeros((0, 3), int)))]
+        surface = renumber[np.asarray(m.cells_dict.get(FILE_CELLS[cell_type], np.zeros((0, 3), int)), dtype=np.int64)]
     mesh = (MeshHex if cell_type == "hexahedron" else MeshTet)(np.ascontiguousarray(points.T), np.ascontiguousarray(t))
-    groups = _group_facets(m, mesh, FILE_CELLS[cell_type], field, str(path))
+    groups = _group_facets(m, mesh, FILE_CELLS[cell_type], field, str(path), surface)
     return mesh.with_boundaries(groups) if groups else mesh
 
 
@@ -166,3 +168,60 @@ def face_facets(mesh: Mesh, name: str, field: str) -> np.ndarray:
         raise ScenarioError(field, name, "no such face; the mesh names: "
                             + (", ".join(repr(n) for n in sorted(groups)) or "none"))
     return np.asarray(groups[name], dtype=np.int64)
+
+
+#: Two boundary facets that share an edge meet at a crease, drawn in an outline, when
+#: their normals differ by more than this angle [degrees].
+CREASE_DEGREES = 20.0
+
+
+def facet_normals(mesh: Mesh, facets: np.ndarray) -> np.ndarray:
+    """(n, 3) unit normals of boundary facets, pointing out of the body: the direction of
+    least spread of each facet's vertices (a plane fitted through them), turned away from
+    the centre of the cell it bounds."""
+    pts = mesh.p[:, mesh.facets[:, facets]].transpose(2, 1, 0)  # (n, vertices, 3)
+    centred = pts - pts.mean(axis=1, keepdims=True)
+    normals = np.linalg.svd(centred)[2][:, -1, :]
+    cells = mesh.f2t[0, facets]
+    outward = pts.mean(axis=1) - mesh.p[:, mesh.t[:, cells]].mean(axis=1).T
+    return normals * np.sign(np.sum(normals * outward, axis=1))[:, None]
+
+
+def boundary_polygons(mesh: Mesh) -> np.ndarray:
+    """(n, k, 3) the corners [m] of every boundary facet (k = 4 quadrilaterals, 3
+    triangles), in order around the facet (by angle about its centre in its plane): the
+    body's surface as polygons, for a drawing to fill."""
+    facets = mesh.boundary_facets()
+    pts = mesh.p[:, mesh.facets[:, facets]].transpose(2, 1, 0)
+    if len(facets) == 0:
+        return pts
+    centre = pts.mean(axis=1, keepdims=True)
+    normals = facet_normals(mesh, facets)
+    a = pts[:, 0] - centre[:, 0]
+    a /= np.linalg.norm(a, axis=1, keepdims=True)
+    b = np.cross(normals, a)
+    rel = pts - centre
+    angle = np.arctan2(np.sum(rel * b[:, None], axis=2), np.sum(rel * a[:, None], axis=2))
+    order = np.argsort(angle, axis=1)
+    return np.ascontiguousarray(np.take_along_axis(pts, order[:, :, None], axis=1))
+
+
+def outline_edges(mesh: Mesh, facets: np.ndarray | None = None) -> np.ndarray:
+    """(n, 2, 3) the end points [m] of the edges that outline a set of boundary facets (all
+    boundary facets by default): an edge of the set's facets where only one of them has
+    it (the set's border), or where the two that share it meet at a crease (normals apart
+    by more than CREASE_DEGREES): a box's 12 edges, a face's 4."""
+    facets = mesh.boundary_facets() if facets is None else np.asarray(facets, dtype=np.int64)
+    if len(facets) == 0:
+        return np.zeros((0, 2, 3))
+    normals = facet_normals(mesh, facets)
+    edges = mesh.f2e[:, facets]  # (edges per facet, n)
+    owners: dict[int, list[int]] = {}
+    for k in range(edges.shape[1]):
+        for e in edges[:, k]:
+            owners.setdefault(int(e), []).append(k)
+    cos_crease = np.cos(np.radians(CREASE_DEGREES))
+    drawn = sorted(e for e, ks in owners.items()
+                   if len(ks) != 2 or float(normals[ks[0]] @ normals[ks[1]]) < cos_crease)
+    ends = mesh.edges[:, np.array(drawn, dtype=np.int64)]  # (2, n)
+    return np.ascontiguousarray(mesh.p[:, ends].transpose(2, 1, 0))
