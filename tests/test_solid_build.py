@@ -167,3 +167,34 @@ def test_a_granule_beside_the_box_is_clear_of_it():
     d["granules"][0].update(radius=0.0022)
     with pytest.raises(ScenarioError, match=f"penetrates the elastic solid.* by {0.0022 - math.sqrt(2) * 0.0015:.6g} m"):
         validate(scenario_io.from_dict(d))
+
+
+def test_sweeps_and_optimisations_refuse_a_solid_before_a_worker_starts(tmp_path):
+    """A study whose base has a solid validates, and its sweep refuses at once (no cluster,
+    no record), naming the plate and `granplate show`."""
+    from granplate.study.spec import parse_study
+    from granplate.study.sweep import sweep
+
+    (tmp_path / "base.toml").write_text(scenario_io.dumps(scenario()))
+    study = parse_study({"base": "base.toml", "parameters": {"granules[0].z": [0.02, 0.03]}}, tmp_path)
+    with pytest.raises(ScenarioError, match="not implemented.*granplate show") as e:
+        sweep(study, tmp_path / "out", progress=False)
+    assert e.value.field == "plate" and not list((tmp_path / "out" / "designs").iterdir())
+
+
+def test_a_solid_alone_and_the_other_dimension_s_plate():
+    """A 3D scenario of a solid alone validates (nothing to touch it); a solid in 2D and a
+    plane-stress plate in 3D are refused naming the plate and the dimension."""
+    import dataclasses
+
+    from granplate.setup.scenario import Plate, Scenario
+
+    alone = dataclasses.replace(scenario(), granules=())
+    validate(alone)
+    validate(dataclasses.replace(alone, plate=Solid(mesh="any.msh")))  # its file is read when drawn or built
+    with pytest.raises(ScenarioError, match="elastic solid.*is 3D.*dimension = 3") as e:
+        validate(Scenario(plate=SMALL))
+    assert e.value.field == "plate"
+    with pytest.raises(ScenarioError, match="in 3D the \\[plate\\] is an elastic solid") as e:
+        validate(dataclasses.replace(alone, plate=Plate(x0=0.1)))
+    assert e.value.field == "plate"

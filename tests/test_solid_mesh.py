@@ -86,3 +86,20 @@ def test_bad_files_say_why(tmp_path):
     with pytest.raises(ScenarioError, match="no such face.*'left'") as e:
         face_facets(mesh, "top", "plate.clamped")
     assert e.value.field == "plate.clamped"
+
+
+def test_gmsh_file_with_an_unused_point_keeps_its_named_face(tmp_path):
+    """A geometry point no cell uses is dropped and the nodes renumbered: the group 'left'
+    is still the one quad at x = 0."""
+    pts = np.vstack([[9.0, 9.0, 9.0], POINTS])  # the unused point first: every index moves
+    hexes = np.array([_hex(0), _hex(1)]) + 1
+    quads = np.array([[_node(0, 0, 0), _node(0, 1, 0), _node(0, 1, 1), _node(0, 0, 1)]]) + 1
+    m = meshio.Mesh(pts, [("hexahedron", hexes), ("quad", quads)],
+                    cell_data={"gmsh:physical": [np.full(2, 2), np.full(1, 1)],
+                               "gmsh:geometrical": [np.full(2, 2), np.full(1, 1)]},
+                    field_data={"left": np.array([1, 2]), "body": np.array([2, 3])})
+    meshio.write(str(tmp_path / "extra.msh"), m, file_format="gmsh22", binary=False)
+    mesh = read_mesh(tmp_path / "extra.msh")
+    assert mesh.p.shape == (3, 12)
+    left = face_facets(mesh, "left", "plate.clamped")
+    assert len(left) == 1 and np.allclose(mesh.p[0, mesh.facets[:, left[0]]], 0.0)
