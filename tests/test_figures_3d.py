@@ -379,3 +379,16 @@ def test_show_draws_a_gmsh_solid_and_checks_its_surface(tmp_path, radius, ok):
     assert _length(a.clamped_edges) == pytest.approx(6 * 0.01, rel=1e-12)
     assert "3 hex20 elements" in a.solid_label
     space.draw(a)
+
+
+def test_cli_show_a_solid_and_run_refuses_it(tmp_path, capsys):
+    """`granplate show` of a 3D scenario with a solid writes its figure (status 0); `granplate
+    run` of it exits 2 with one line naming the plate and pointing to `granplate show`."""
+    toml = tmp_path / "on-solid.toml"
+    gp.dump(scenario_io.from_dict(copy.deepcopy(ON_SOLID)), toml)
+    assert main(["show", str(toml), "-o", str(tmp_path / "s.png")]) == 0
+    assert (tmp_path / "s.png").stat().st_size > 500
+    assert main(["run", str(toml), "-o", str(tmp_path / "r.nc"), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert "'plate'" in err and "inspect it with `granplate show`" in err and err.count("\n") == 1, err
+    assert not (tmp_path / "r.nc").exists()
