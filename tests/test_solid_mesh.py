@@ -103,3 +103,24 @@ def test_gmsh_file_with_an_unused_point_keeps_its_named_face(tmp_path):
     assert mesh.p.shape == (3, 12)
     left = face_facets(mesh, "left", "plate.clamped")
     assert len(left) == 1 and np.allclose(mesh.p[0, mesh.facets[:, left[0]]], 0.0)
+
+
+@pytest.mark.parametrize("tetrahedra", [False, True])
+def test_outline_of_a_box_is_its_twelve_edges(tetrahedra):
+    """A box's outline (hexahedra or tetrahedra, whose faces' diagonals lie flat) runs along
+    its 12 edges only: total length 4 (Lx + Ly + Lz), every end point on two of its faces;
+    the face xmin's outline is its perimeter 2 (Ly + Lz)."""
+    from granplate.solid.mesh import boundary_polygons, outline_edges
+
+    size = np.array([0.3, 0.2, 0.1])
+    mesh = box_mesh(size, [3, 2, 1], tetrahedra=tetrahedra)
+    edges = outline_edges(mesh)
+    length = lambda e: np.linalg.norm(e[:, 1] - e[:, 0], axis=1).sum()  # noqa: E731
+    assert length(edges) == pytest.approx(4.0 * size.sum(), rel=1e-12)
+    ends = edges.reshape(-1, 3)
+    assert np.all((np.isclose(ends, 0.0, atol=1e-15) | np.isclose(ends, size)).sum(axis=1) >= 2)
+    assert length(outline_edges(mesh, face_facets(mesh, "xmin", "f"))) == pytest.approx(2 * (0.2 + 0.1), rel=1e-12)
+    polygons = boundary_polygons(mesh)  # in order around each facet: their areas add up to the surface
+    area = sum(0.5 * np.linalg.norm(sum(np.cross(p[k], p[(k + 1) % len(p)]) for k in range(len(p))))
+               for p in polygons)
+    assert area == pytest.approx(2 * (0.3 * 0.2 + 0.3 * 0.1 + 0.2 * 0.1), rel=1e-12)
