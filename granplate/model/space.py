@@ -97,8 +97,8 @@ def frictionless(s: Scenario) -> bool:
 
 #: Why a 3D scenario with an elastic solid does not run (yet).
 SOLID_NOT_COUPLED = ("the elastic solid is valid, but its coupling to the granules in 3D is not implemented "
-                     "yet: a 3D scenario runs granules, walls and a box (inspect the solid with "
-                     "granplate.solid.build_solid; inspect it with `granplate show`)")
+                     "yet: a 3D scenario runs granules, walls and a box (inspect it with `granplate show`, "
+                     "or build its modes with granplate.solid.build_solid)")
 
 
 def check_buildable(s: Scenario) -> None:
