@@ -76,3 +76,15 @@ def test_rollers_fix_the_normal_dof_only():
     fixed = fixed_dofs(s, mesh, rollers=("zmin",))
     z = node_coordinates(s)[fixed // 3, 2]
     assert np.all(fixed % 3 == 2) and np.allclose(z, 0.0) and len(fixed) == 13
+
+
+def test_one_blas_thread_limits_and_restores():
+    """Inside one_blas_thread every BLAS library reports one thread; after it, its former count."""
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+    from granplate.solid.factor import one_blas_thread
+
+    before = [p["num_threads"] for p in threadpoolctl.threadpool_info() if p["user_api"] == "blas"]
+    with one_blas_thread():
+        inside = [p["num_threads"] for p in threadpoolctl.threadpool_info() if p["user_api"] == "blas"]
+    after = [p["num_threads"] for p in threadpoolctl.threadpool_info() if p["user_api"] == "blas"]
+    assert inside and all(n == 1 for n in inside) and after == before

@@ -23,7 +23,7 @@ import scipy.linalg as la
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from granplate.solid.factor import factorised
+from granplate.solid.factor import factorised, one_blas_thread
 
 #: Eigenvalues asked for per shift-invert window.
 WINDOW_MODES = 60
@@ -76,8 +76,9 @@ def window(K: sp.spmatrix, M: sp.spmatrix, sigma: float, k: int, v0: np.ndarray,
            xyz: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The k eigenpairs (lambda = omega^2 ascending, vectors) nearest sigma (xyz: each
     dof's position [m], for the factorisation's ordering)."""
-    vals, vecs = spla.eigsh(K, k=k, M=M, sigma=sigma, which="LM", v0=v0,
-                            OPinv=shift_inverse(K, M, sigma, xyz))
+    with one_blas_thread():
+        vals, vecs = spla.eigsh(K, k=k, M=M, sigma=sigma, which="LM", v0=v0,
+                                OPinv=shift_inverse(K, M, sigma, xyz))
     order = np.argsort(vals)
     return vals[order], vecs[:, order]
 

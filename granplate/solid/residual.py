@@ -28,7 +28,7 @@ import scipy.linalg as la
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from granplate.solid.factor import factorised
+from granplate.solid.factor import factorised, one_blas_thread
 
 #: Unit loads solved per block.
 CHUNK = 512
@@ -51,8 +51,9 @@ def schur_flexibility(K: sp.spmatrix, xyz: np.ndarray, dofs: np.ndarray) -> tupl
     K = sp.csr_matrix(K)
     interior = np.setdiff1d(np.arange(n), dofs)
     order = np.concatenate([interior[nested_dissection(K[interior][:, interior], xyz[interior])], dofs])
-    lu = spla.splu(sp.csc_matrix(K[order][:, order]), permc_spec="NATURAL", diag_pivot_thresh=0.0,
-                   options={"SymmetricMode": True})
+    with one_blas_thread():  # SuperLU's small blocks (solid.factor); the dense solves below threaded
+        lu = spla.splu(sp.csc_matrix(K[order][:, order]), permc_spec="NATURAL", diag_pivot_thresh=0.0,
+                       options={"SymmetricMode": True})
     if not (np.array_equal(lu.perm_r, np.arange(n)) and np.array_equal(lu.perm_c, np.arange(n))):
         raise RuntimeError("the factorisation reordered the dofs; the Schur complement is not its last block")
     m = len(dofs)
