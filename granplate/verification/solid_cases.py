@@ -189,7 +189,7 @@ def plate_frequencies(ctx: Context) -> CaseResult:
 
 def draw_plate_frequencies(p: dict):
     """lambda^2_1 against the element size, thin and thick, with the references."""
-    fig, axes = new_figure(ncols=2, width=9.0)
+    fig, axes = new_figure(ncols=2, width=5.0)
     for ax, key, meshes, ref, label in ((axes[0, 0], "thin", THIN_MESHES, p["mind_thin"], "a/h = 50"),
                                         (axes[0, 1], "thick", THICK_MESHES, p["mind_thick"], "a/h = 10")):
         size = [SIDE / n * 1e3 for n in meshes]
