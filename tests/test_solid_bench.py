@@ -22,3 +22,14 @@ def test_bench_row_of_a_tiny_plate():
     assert row["n_dofs"] > 0 and row["n_modes"] >= 1 and row["n_surface"] == 161  # 7 x 7 corners + 112 mid-sides off the clamps
     assert row["f1_hz"] == pytest.approx(leissa_frequency(0.1, 0.002), rel=0.06)
     assert "| hex20 | 8 x 8 x 1 |" in format_rows([row], accuracy=True)
+
+
+def test_plates_in_space_are_the_solid_rows(monkeypatch):
+    """`bench --plates --dimension 3` runs the solid's table (the plate rows in space)."""
+    from granplate import cli
+    from granplate.bench import solid
+
+    seen = []
+    monkeypatch.setattr(solid, "main", lambda args: seen.append(args.plates) or 0)
+    assert cli.main(["bench", "--plates", "--dimension", "3"]) == 0
+    assert seen == [True]

@@ -37,7 +37,7 @@ def _cmd_bench(args) -> int:
         from granplate.bench import plastic
 
         return int(plastic.main(args))
-    if getattr(args, "solid", False):
+    if getattr(args, "solid", False) or (getattr(args, "plates", False) and args.dimension == 3):
         from granplate.bench import solid
 
         return int(solid.main(args))
@@ -77,7 +77,8 @@ def register(subparsers) -> None:
                         "step, peak memory; LAMMPS's time to the same accuracy where it is installed)")
     b.add_argument("--dimension", type=int, default=None,
                    help="with --scaling: 2 (default: the plane, a hexagonal packing) or 3 (space: a launched "
-                        "FCC packing of 12 to 10,192 spheres, LAMMPS's 3D run side by side)")
+                        "FCC packing of 12 to 10,192 spheres, LAMMPS's 3D run side by side); with --plates 3: "
+                        "the 3D solid's rows, as --solid")
     b.add_argument("--sizes", help="with --scaling: comma-separated COLUMNSxROWS (default 4x3,8x13,32x32,56x54,100x100); "
                                    "with --dimension 3 FCC cells NXxNYxNZ (default 3x1x1,3x3x3,6x6x7,9x9x9,14x14x13)")
     b.add_argument("--scheme", default=None,
