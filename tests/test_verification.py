@@ -276,6 +276,9 @@ def test_update_puts_refreshed_cases_in_place_and_keeps_the_rest(tmp_path, capsy
     assert "patch-test" in (tmp_path / "validation.md").read_text()
     renamed = page.merge_results(results, [dataclasses.replace(results[0], title="again")])
     assert [r.title for r in renamed][0] == "again" and len(renamed) == len(results)
+    assert cli.main(["verify", "--out", str(tmp_path), "--case", "patch-test", "--update", "-q"]) == 0
+    again = page.read_results(tmp_path / "validation.json")[3]
+    assert again.count("Refreshed by") == 1, "a case refreshed again keeps only its latest note"
     capsys.readouterr()
     assert cli.main(["verify", "--out", str(tmp_path), "--update"]) == 2
     assert "--update" in capsys.readouterr().err

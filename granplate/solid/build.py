@@ -44,7 +44,7 @@ log = logging.getLogger(__name__)
 #: The run store's kind of the solid's arrays.
 STORE_KIND = "solid"
 #: Bump when anything that changes the stored arrays changes.
-SOLID_FORMAT = 1
+SOLID_FORMAT = 2
 #: Share of the machine's physical memory a solid may take.
 MEMORY_SHARE = 0.7
 #: One window holds WINDOW_MARGIN times the estimated modes (plus 10), at most MAX_WINDOW;

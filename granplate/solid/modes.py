@@ -14,7 +14,9 @@ the node coordinates and M-orthonormalised, the eigensolver's six near-zero mode
 dropped (their count is checked) and its elastic modes M-orthogonalised against them.
 
 Deterministic: every window starts from the same seeded start vector v0, and each mode's
-sign makes its largest-magnitude component positive.
+sign is the plate's rule (`plate.modes.fix_mode_signs`: a positive projection on a fixed
+reference vector, which holds for the symmetric and antisymmetric modes of a square plate,
+whose largest entries come in pairs of opposite sign).
 """
 from __future__ import annotations
 
@@ -23,6 +25,7 @@ import scipy.linalg as la
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from granplate.plate.modes import fix_mode_signs
 from granplate.solid.factor import factorised, one_blas_thread
 
 #: Eigenvalues asked for per shift-invert window.
@@ -56,15 +59,6 @@ def m_orthonormal(V: np.ndarray, M: sp.spmatrix) -> np.ndarray:
     """V's columns M-orthonormalised (Cholesky of V^T M V): V L^-T."""
     L = np.linalg.cholesky(V.T @ (M @ V))
     return la.solve_triangular(L, V.T, lower=True).T
-
-
-def signed(Phi: np.ndarray) -> np.ndarray:
-    """Each column's sign chosen so that its largest-magnitude component is positive."""
-    if Phi.shape[1] == 0:
-        return Phi
-    idx = np.argmax(np.abs(Phi), axis=0)
-    s = np.sign(Phi[idx, np.arange(Phi.shape[1])])
-    return Phi * np.where(s == 0, 1.0, s)
 
 
 def shift_inverse(K: sp.spmatrix, M: sp.spmatrix, sigma: float, xyz: np.ndarray) -> spla.LinearOperator:
@@ -138,7 +132,7 @@ def modes_below(K: sp.spmatrix, M: sp.spmatrix, max_omega: float, xyz: np.ndarra
     held one. A free body's first six modes are those, at omega = 0 exactly."""
     lam, vec = eigenpairs_below(K, M, max_omega**2, xyz, k=k, seed=seed)
     if rigid is None:
-        return np.sqrt(np.maximum(lam, 0.0)), signed(vec)
+        return np.sqrt(np.maximum(lam, 0.0)), fix_mode_signs(vec)
     R = m_orthonormal(rigid, M)
     n_rigid = R.shape[1]
     if len(lam) > n_rigid and not abs(lam[n_rigid - 1]) < RIGID_RTOL * lam[n_rigid]:
@@ -147,4 +141,4 @@ def modes_below(K: sp.spmatrix, M: sp.spmatrix, max_omega: float, xyz: np.ndarra
     E = E - R @ (R.T @ (M @ E))
     E = E / np.sqrt(np.einsum("ij,ij->j", E, M @ E))
     omega = np.concatenate([np.zeros(n_rigid), np.sqrt(lam[n_rigid:])])
-    return omega, np.hstack([signed(R), signed(E)])
+    return omega, np.hstack([fix_mode_signs(R), fix_mode_signs(E)])

@@ -13,6 +13,7 @@ from __future__ import annotations
 import datetime as _dt
 import json
 import platform
+import re
 from pathlib import Path
 from typing import Sequence
 
@@ -245,12 +246,24 @@ def update_pages(out: Path, new: list[CaseResult], seconds: float,
     results, full, total, generated = read_results(Path(out) / "validation.json")
     when = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     names = ", ".join(f"`{r.name}`" for r in new)
-    note = f"Refreshed by `granplate verify --case ... --update` on {when} ({seconds:.0f} s): {names}."
+    note = f"{REFRESHED} on {when} ({seconds:.0f} s): {names}."
     merged = merge_results(results, new)
     rank = {name: i for i, name in enumerate(order)}
     merged.sort(key=lambda r: rank.get(r.name, len(rank)))  # stable: unknown names stay last
-    return write_pages(Path(out), merged, full, total,
-                       f"{generated or generated_line(full, total)} {note}")
+    kept = superseded_refreshes_dropped(generated or generated_line(full, total), {r.name for r in new})
+    return write_pages(Path(out), merged, full, total, f"{kept} {note}")
+
+
+#: How the provenance line starts the note of a refresh.
+REFRESHED = "Refreshed by `granplate verify --case ... --update`"
+
+
+def superseded_refreshes_dropped(generated: str, names: set[str]) -> str:
+    """The provenance line without the earlier refresh notes whose cases are all among
+    `names` (refreshed again now): the line keeps one note per case's latest refresh."""
+    head, *notes = generated.split(" " + REFRESHED)
+    kept = [n for n in notes if not set(re.findall(r"`([^`]+)`", n.split(":", 1)[-1])) <= names]
+    return head + "".join(" " + REFRESHED + n for n in kept)
 
 
 def read_results(path: Path) -> tuple[list[CaseResult], bool, float, str | None]:

@@ -76,11 +76,13 @@ def frequency_parameters(model, h: float, count: int = 3) -> np.ndarray:
 
 
 def richardson(values: np.ndarray) -> tuple[float, float]:
-    """(limit, observed order) from three values on meshes halved in turn."""
-    d1, d2 = values[1] - values[0], values[2] - values[1]
-    ratio = d1 / d2
-    order = math.log2(abs(ratio))
-    return float(values[2] + d2 / (ratio - 1.0)), order
+    """(limit, observed order) from three values on meshes halved in turn
+    (`plate_mesh.observed_orders` and `plate_mesh.richardson`)."""
+    from .plate_mesh import observed_orders
+    from .plate_mesh import richardson as limit_at
+
+    order = observed_orders(list(values))[-1]
+    return limit_at(list(values), order), order
 
 
 def top_pressure_loads(model, pressure: float) -> np.ndarray:
