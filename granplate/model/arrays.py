@@ -18,7 +18,7 @@ from granplate.errors import ScenarioError
 from granplate.setup.geometry import resolve
 from granplate.physics.shock import shock_resultants
 from granplate.setup.materials import effective_modulus, softer_yield_strength, sphere_inertia, sphere_mass
-from granplate.setup.scenario import Scenario
+from granplate.setup.scenario import Plate, Scenario
 from granplate.setup.plate_checks import split_initial_contacts
 from granplate.setup.validate import validate
 
@@ -56,7 +56,8 @@ class Model:
     wall_contacts: (nw, 2) [granule, wall] likewise; plate_contacts: (nk,) granule index
     per rigid-layer contact (those on a face node at t = 0); initial_patches: the granules
     touching the face between nodes at t = 0, which the driver gives patch contacts before
-    the first step (docs/model.md section 3.5); plate: the PlateModel or None. The loop's lists are in `granular`
+    the first step (docs/model.md section 3.5); plate: the PlateModel or None; solid, body: an
+    elastic body in space (dimension 3) and its loop arrays, or None. The loop's lists are in `granular`
     (pair_ij, wall_i: with contact.detection = "dynamic" the Verlet lists at t = 0,
     rebuilt during the run by `granular_with_contacts`). materials: each granule's Material.
     """
@@ -73,6 +74,8 @@ class Model:
     plate_contacts: np.ndarray
     materials: tuple = ()
     initial_patches: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    solid: object | None = None  # an elastic body in space: the built solid (solid.build.SolidModel)
+    body: object | None = None  # and its arrays in the loop (model.inputs.BodyArrays)
 
     @property
     def n_granules(self) -> int:
@@ -262,6 +265,7 @@ def loop_config(s: Scenario, fres: np.ndarray, tres: np.ndarray, r: np.ndarray, 
     t = s.time
     sol = s.solver
     q0 = s.load.q0 if s.load.kind == "line" else 0.0
+    plate = s.plate if isinstance(s.plate, Plate) else None  # the plane's plate (an elastic solid: model.body)
     return Config(
         q0=float(q0), duration=float(s.load.duration), clip=bool(s.contact.clip_tensile),
         lambda_target=float(sol.lambda_target), rtol=float(sol.iteration_rtol),
@@ -277,12 +281,12 @@ def loop_config(s: Scenario, fres: np.ndarray, tres: np.ndarray, r: np.ndarray, 
         force_floor=force_floor(q0, fres, tres, r, mass, s, t.output_interval) if floor is None else float(floor),
         rebuild_move=rebuild_move(s.contact.skin, r),
         overlap_stop=float(s.contact.overlap_stop),
-        plate_x0=float(s.plate.x0) if s.plate is not None else math.inf,
-        plate_ylo=float(s.plate.y0) if s.plate is not None else 0.0,
-        plate_yhi=float(s.plate.y0 + s.plate.height) if s.plate is not None else 0.0,
+        plate_x0=float(plate.x0) if plate is not None else math.inf,
+        plate_ylo=float(plate.y0) if plate is not None else 0.0,
+        plate_yhi=float(plate.y0 + plate.height) if plate is not None else 0.0,
         split_friction=sol.granular_friction == "split",
         face_skin=float(s.contact.skin) if face else 0.0,
-        patch_width=float(s.plate.layer_width) if s.plate is not None else 0.0,
+        patch_width=float(plate.layer_width) if plate is not None else 0.0,
     )
 
 

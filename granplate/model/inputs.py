@@ -145,3 +145,87 @@ class Config(NamedTuple):
     face_skin: float = 0.0  # > 0: a granule within face_skin R of the face gets a patch contact (0: never)
     patch_width: float = 0.0  # width of a patch contact [m] (plate.rigid_layer_width)
     dimension: int = 2  # 2: the plane (state x, y, theta, vx, vy, omega); 3: space (x, y, z, vx, vy, vz, wx, wy, wz)
+
+
+#: columns of BodyArrays.geo, one row per granule and buffer (docs/model.md section 3.9):
+#: the closest point's face coordinates, the centre's signed distance to the undeformed
+#: surface [m], the outward unit normal there, the static (elastic) normal force in
+#: series with the residual compliance [N], the whole normal force with its damping [N],
+#: the damping part of it [N], the effective overlap [m], and 1.0 when the contact is in
+#: touch (0.0 otherwise).
+GEO_XI, GEO_ETA, GEO_DIST, GEO_NX, GEO_NY, GEO_NZ, GEO_NSTAT, GEO_N, GEO_DAMP, GEO_DELTA, GEO_TOUCH = range(11)
+N_GEO = 11
+
+
+class BodyArrays(NamedTuple):
+    """An elastic body in space (docs/model.md section 3.9) as the loop reads it: its
+    boundary's quadratic faces, its modes at their nodes, its residual compliance, each
+    granule's contact coefficients with it, and (per run) each granule's contact state.
+
+    face_nodes: (n_faces, n_fn, 3) [m] the faces' node coordinates (solid.surface);
+    face_rows: (n_faces, n_fn, 3) int the row of Phi of each node's x, y, z dof (-1:
+    fixed); face_resid: (n_faces, n_fn, 3) int the index of that dof in resid (-1: not
+    in the residual set S); neighbours: (n_faces, k) int faces sharing a corner (-1
+    padded); kind: (1,) int the face kind (solid.surface QUAD8, QUAD9, TRI6); phi:
+    (n_red, nm) the M-orthonormal modes [kg^-1/2]; omega: (nm,) [rad/s]; resid: (n_s,
+    n_s) [m/N] the residual compliance over S ((0, 0): none); box: (2, 3) [m] the lowest
+    and highest corner of the body's bounding box; coef: (ng, N_COEF) each granule's
+    contact coefficients with the body.
+
+    The state of one run (new_body_state copies it): face: (2, ng) int each granule's
+    closest face in the two buffers (t_n and the trial step's end; the seed of the next
+    search); geo: (2, ng, N_GEO); weights: (2, ng, n_fn) the closest point's shape
+    functions; fmodal, fdamp: (2, nm) the contact forces' and their damping parts'
+    modal projections Phi^T F [N kg^-1/2]; hist: (ng, N_HIST) each contact's history;
+    q, qd, qdp: (nm,) the trial step's modal displacement and velocity and the velocity
+    predicted for the force pass; static: (2,) the residual compliance's energy [J];
+    active: (ng,) int, rmat: (ng, ng) and rcol, rcoef: (ng, 3 n_fn) scratch of the
+    residual solve.
+    """
+
+    face_nodes: np.ndarray
+    face_rows: np.ndarray
+    face_resid: np.ndarray
+    neighbours: np.ndarray
+    kind: np.ndarray
+    phi: np.ndarray
+    omega: np.ndarray
+    resid: np.ndarray
+    box: np.ndarray
+    coef: np.ndarray
+    face: np.ndarray
+    geo: np.ndarray
+    weights: np.ndarray
+    fmodal: np.ndarray
+    fdamp: np.ndarray
+    hist: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdp: np.ndarray
+    static: np.ndarray
+    active: np.ndarray
+    rmat: np.ndarray
+    rcol: np.ndarray
+    rcoef: np.ndarray
+
+
+def no_body(ng: int, nm: int) -> BodyArrays:
+    """The BodyArrays of a run without an elastic body (no faces: the loop skips it)."""
+    z = np.zeros
+    i = np.int64
+    return BodyArrays(
+        face_nodes=z((0, 1, 3)), face_rows=np.zeros((0, 1, 3), i), face_resid=np.zeros((0, 1, 3), i),
+        neighbours=np.zeros((0, 1), i), kind=np.zeros(1, i), phi=z((0, nm)), omega=z(nm), resid=z((0, 0)),
+        box=z((2, 3)), coef=z((0, 5)), face=np.zeros((2, 0), i), geo=z((2, 0, N_GEO)), weights=z((2, 0, 1)),
+        fmodal=z((2, nm)), fdamp=z((2, nm)), hist=no_history(0), q=z(nm), qd=z(nm), qdp=z(nm), static=z(2),
+        active=np.zeros(0, i), rmat=z((0, 0)), rcol=np.zeros((0, 3), i), rcoef=z((0, 3)),
+    )
+
+
+def new_body_state(b: BodyArrays) -> BodyArrays:
+    """b with its per-run state (face onwards) copied, so that a run never writes into the
+    model's arrays; the geometry, modes and coefficients are shared."""
+    return b._replace(face=b.face.copy(), geo=b.geo.copy(), weights=b.weights.copy(), fmodal=b.fmodal.copy(),
+                      fdamp=b.fdamp.copy(), hist=b.hist.copy(), q=b.q.copy(), qd=b.qd.copy(), qdp=b.qdp.copy(),
+                      static=b.static.copy(), active=b.active.copy(), rmat=b.rmat.copy(), rcol=b.rcol.copy(),
+                      rcoef=b.rcoef.copy())

@@ -2,9 +2,8 @@
 granules' centres, velocities and spin vectors, their pair and wall contact lists and
 coefficients (the same laws and coefficients as the plane, `model.arrays`), the 3D shock
 (load.kind = "force": a half-sine total force shared by the loaded granules along a
-direction, docs/model.md section 5.4) and the loop's settings. A scenario with an elastic
-solid ([plate]) is valid but refused here (`check_buildable`): its coupling to the granules
-is not implemented yet. `model.arrays.build_model` calls `build_space_model` for a scenario
+direction, docs/model.md section 5.4), the elastic body of its [plate] (model.body) and
+the loop's settings. `model.arrays.build_model` calls `build_space_model` for a scenario
 of dimension 3: the one place the model's dimension is decided.
 """
 from __future__ import annotations
@@ -95,22 +94,9 @@ def frictionless(s: Scenario) -> bool:
     return all(s.contact.for_pair(a, b)[1] == 0.0 for a in names for b in partners)
 
 
-#: Why a 3D scenario with an elastic solid does not run (yet).
-SOLID_NOT_COUPLED = ("the elastic solid is valid, but its coupling to the granules in 3D is not implemented "
-                     "yet: a 3D scenario runs granules, walls and a box (inspect it with `granplate show`, "
-                     "or build its modes with granplate.solid.build_solid)")
-
-
-def check_buildable(s: Scenario) -> None:
-    """ScenarioError("plate", ...) for a scenario of dimension 3 with a [plate] (an elastic
-    solid): valid, drawn by `granplate show`, but not run (SOLID_NOT_COUPLED)."""
-    if s.dimension == 3 and s.plate is not None:
-        raise ScenarioError("plate", "[plate]", SOLID_NOT_COUPLED)
-
-
 def build_space_model(s: Scenario):
-    """The Model of a validated, resolved scenario of dimension 3 (check_buildable first)."""
-    check_buildable(s)
+    """The Model of a validated, resolved scenario of dimension 3, with its elastic body
+    (model.body) when it has a [plate]."""
     from granplate.model.arrays import (
         Model, find_pairs_and_walls, loop_config, pair_coefficients, wall_arrays,
     )
@@ -137,10 +123,17 @@ def build_space_model(s: Scenario):
                       floor=force_floor_3d(s, mass, r, shares, s.time.output_interval))._replace(
         q0=float(s.load.force) if s.load.kind == "force" else 0.0, dimension=3,
         split_friction=s.solver.granular_friction == "split" and not frictionless(s))
-    plate_arrays = PlateArrays(omega2=np.zeros(0), phi_d=np.zeros((0, 0)), load_modal=np.zeros(0))
+    solid, body = None, None
+    if s.plate is not None:
+        from granplate.model.body import build_body
+
+        solid, body = build_body(s, mats, r, mass)
+    nm = 0 if solid is None else solid.n_modes
+    omega2 = np.zeros(0) if solid is None else solid.omega ** 2
+    plate_arrays = PlateArrays(omega2=omega2, phi_d=np.zeros((0, nm)), load_modal=np.zeros(nm))
     return Model(
         scenario=s, labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
         granular=granular, plate_arrays=plate_arrays, config=cfg, plate=None,
         initial_state=initial_state_3d(s), pairs=pairs, wall_contacts=wc,
-        plate_contacts=np.zeros(0, np.int64), materials=tuple(mats),
+        plate_contacts=np.zeros(0, np.int64), materials=tuple(mats), solid=solid, body=body,
     )

@@ -111,3 +111,12 @@ def friction_along_slip(f_mag, speed, vsx, vsy, vsz):
 def arm_torque_3d(a, nx, ny, nz, fx, fy, fz):
     """The torque a n x f [N m] of the friction force f at arm a along the normal n."""
     return a * (ny * fz - nz * fy), a * (nz * fx - nx * fz), a * (nx * fy - ny * fx)
+
+
+@njit(cache=True)
+def surface_overlap(r, distance, u_n) -> float:
+    """Overlap [m] of a sphere of radius r whose centre lies `distance` [m] outside the
+    undeformed surface of an elastic body (signed: negative inside) whose surface moved
+    u_n [m] along its outward normal at the closest point: r - distance + u_n
+    (docs/model.md section 3.8)."""
+    return r - distance + u_n

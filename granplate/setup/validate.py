@@ -937,6 +937,10 @@ def _check_solver(s: Scenario) -> None:
     string_in("solver.granular_friction", sv.granular_friction, GRANULAR_FRICTIONS)
     if sv.scheme in GRANULAR_SCHEMES:
         _check_granular_scheme(s)
+    elif isinstance(s.plate, Solid):
+        raise ScenarioError("solver.scheme", sv.scheme, "an elastic solid in 3D is coupled to the granules by "
+                            "velocity Verlet with its modes turned exactly (docs/model.md section 3.9): set "
+                            "solver.scheme = \"verlet\" and solver.granular_friction = \"split\"")
     lam = finite("solver.lambda_target", sv.lambda_target, "must be in (0, 1)")
     if not 0.0 < lam < 1.0:
         raise ScenarioError("solver.lambda_target", sv.lambda_target, "must be in (0, 1)")
@@ -949,9 +953,10 @@ def _check_solver(s: Scenario) -> None:
 
 
 def _check_granular_scheme(s: Scenario) -> None:
-    """A scheme of the granules alone (GRANULAR_SCHEMES): no plate, friction split off."""
+    """A scheme of the granules alone (GRANULAR_SCHEMES): no plate (an elastic solid in
+    space is its own: docs/model.md section 3.9), friction split off."""
     sv = s.solver
-    if s.plate is not None:
+    if s.plate is not None and not isinstance(s.plate, Solid):
         raise ScenarioError("solver.scheme", sv.scheme, "integrates the granules alone (velocity Verlet): a scenario "
                             "with a [plate] needs \"implicit\" or \"paper\"")
     if sv.granular_friction != "split":

@@ -97,6 +97,7 @@ class RunRecord(NamedTuple):
     message: str
     info: dict
     contacts: ContactChanges
+    body: object = None  # the run's elastic body in space (model.inputs.BodyArrays, its last contact state) or None
 
 
 def output_times(t_end: float, dt_out: float) -> np.ndarray:
@@ -269,7 +270,7 @@ class LoopArrays:
             for k, y_k in enumerate(model.plate.contact_y[:nk]):
                 first, last = patch_weights(p.face_y, float(y_k), 0.0, self.w.wface)
                 set_face_weights(k, first, last, self.w)
-        self.sw = scheme(cfg.scheme).new_scratch(ng, nm, nk)
+        self.sw = scheme(cfg.scheme).new_scratch(ng, nm, nk, body=model.body)
         self.out = S.new_output(times, ng, nm, nk, nc)
         self.scheme = cfg.scheme
 
@@ -537,6 +538,7 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
                                          arr.sw, arr.out))])
     t1 = time.perf_counter()
     loop.initialise(st, lists.g, arr.p, cfg, w)
+    loop.start_scheme(arr.sw, st, lists.g, cfg)
     loop.record(0, st, lists.g, arr.p, w, arr.out)
     st.count[S.C_OUT] = 1
     t_first = time.perf_counter() - t1  # includes compiling / loading the loop
@@ -572,7 +574,7 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
         warnings.warn(f"{model.scenario.name}: {line}: Hertz's law assumes overlaps small against the radii.",
                       RuntimeWarning, stacklevel=2)
     return RunRecord(out=arr.out, n_valid=int(st.count[S.C_OUT]), status=status, message=message, info=info,
-                     contacts=lists.changes())
+                     contacts=lists.changes(), body=getattr(arr.sw, "body", None) if model.body is not None else None)
 
 
 @contextmanager

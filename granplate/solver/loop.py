@@ -22,7 +22,7 @@ from granplate.solver.ladder import level_step
 from granplate.solver.plate_modal import driving_dofs, modal_acceleration, plate_energy, step_matrices
 from granplate.solver.state import (
     A_FRIC, A_PLASTIC, A_SHOCK_G, A_SHOCK_P, A_VISC, C_FRICTION_BOUND, C_ITERS, C_LEVEL, C_OUT, C_RETRIES, C_STEPS, CUSTOM_H,
-    D_FRIC, D_PLASTIC, D_VISC, E_GRAN, KE_Z, E_IN_MAX, E_PLATE, E_POT, E_POTG, E_SHOCK, E_ZERO, ERR_BUFFER,
+    D_FRIC, D_PLASTIC, D_VISC, E_GRAN, KE_Z, E_IN_MAX, E_PLATE, E_POT, E_POTG, E_SHOCK, E_STATIC, E_ZERO, ERR_BUFFER,
     ERR_CONTACT, ERR_ENERGY, ERR_H, ERR_ITER, ERR_LAM, ERR_N, ERR_NAN, ERR_NOCONV, ERR_RESID,
     ERR_T, ERR_VT, H_LAST, KE_ROT, KE_X, KE_Y, N_LEVELS, OK, PAUSED, RES_LAST, RESID, RESID_MAX,
     S_DT_MAX, S_DT_MIN, S_ITERS, S_LAM_MAX, S_RETRIES, S_STEPS, T_NOW,
@@ -55,6 +55,18 @@ def initialise(st, g, p, cfg, w):
 
 
 @njit(cache=True)
+def start_scheme(sw, st, g, cfg):
+    """What the scheme adds at t = 0 after `initialise` (its hook `start`): an elastic
+    body's contact energies (solver.body) join E_pot, E_p and E_0."""
+    e_pot, e_static = S.start(sw, st.clock[T_NOW], st, g, cfg)
+    if e_pot != 0.0 or e_static != 0.0:
+        st.clock[E_POT] += e_pot
+        st.clock[E_STATIC] = e_static
+        st.clock[E_ZERO] += e_pot + e_static
+        st.clock[E_IN_MAX] = st.clock[E_ZERO]
+
+
+@njit(cache=True)
 def reset_interval(w):
     """Restart the per-output-interval maxima."""
     for k in range(w.lam_int.shape[0]):
@@ -72,7 +84,7 @@ def energy_terms(y, q, qd, force, clock, acc, g, omega2, resid):
     that tell the dimension: this runs every step.)"""
     kx, ky, kz, kr = kinetic_energies(y, g)
     eg = kx + ky + kz + kr + clock[E_POT]
-    ep = plate_energy(q, qd, force, omega2, resid)
+    ep = plate_energy(q, qd, force, omega2, resid) + clock[E_STATIC]
     eshock = acc[A_SHOCK_G] + acc[A_SHOCK_P]
     return eshock, eg, ep, kx, ky, kz, kr
 

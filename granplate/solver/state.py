@@ -11,6 +11,8 @@ from granplate.model.inputs import STATE_COLUMNS  # noqa: F401 - the state's col
 
 # clock (float64)
 T_NOW, H_LAST, E_IN_MAX, E_ZERO, E_POT, CUSTOM_H, F_SCALE, RES_LAST = 0, 1, 2, 3, 4, 5, 6, 7
+# the energy of an elastic body's residual compliance at its contacts [J] (solver.body; part of E_p)
+E_STATIC = 8
 N_CLOCK = 10
 # count (int64)
 C_STEPS, C_LEVEL, C_OUT, C_ITERS, C_RETRIES = 0, 1, 2, 3, 4

@@ -115,11 +115,6 @@ def sweep(study: Study, out: str | Path, *, client=None, workers: int | None = N
     n_before = sum(1 for k in keys if k not in missing)
     todo = list(missing.items())[: limit if limit is not None else None]
     report = SweepReport(len(keys), n_before, out=out)
-    if todo:  # a scenario the model cannot build yet is refused before a worker starts
-        from granplate.model.space import check_buildable
-
-        for _, i in todo:
-            check_buildable(study.scenario(i))
     try:
         if todo:
             with (nullcontext(client) if client is not None else dask_client(workers, scheduler)) as c:

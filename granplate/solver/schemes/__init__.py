@@ -1,7 +1,7 @@
 """The coupling schemes, one module each, behind one interface, and their registry.
 
 A scheme module defines NAME, a `Scratch` named tuple (its own scratch arrays),
-`new_scratch(ng, nm, nk)`, and eight compiled hooks, each taking its Scratch first:
+`new_scratch(ng, nm, nk, body=None)`, and nine compiled hooks, each taking its Scratch first:
 
     plan(sw, count, cfg, pos, rem) -> (level, h, slot, land)
     prepare_level(sw, h, p, slot)
@@ -11,8 +11,10 @@ A scheme module defines NAME, a `Scratch` named tuple (its own scratch arrays),
     next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg) -> (level, h_new)
     contact_placed(sw, k, st, p)
     contacts_moved(sw, t, st, p, cfg)
+    start(sw, t, st, g, cfg) -> (contact energy, residual energy) [J] at t = 0
 
-The last two keep the scheme's own driving-DOF state true when the plate contacts' rows
+`start` gives what the scheme's own bodies hold at t = 0 (an elastic body in space's
+contacts, solver.body; (0, 0) for the others). The two before it keep the scheme's own driving-DOF state true when the plate contacts' rows
 of Phi_d change between steps (solver/interface.py, docs/model.md section 3.5):
 `contact_placed` after plate contact k's rows were set with the modes held (a patch
 contact added), `contacts_moved` after loaded patch contacts moved (what depends on
@@ -154,3 +156,15 @@ def _contacts_moved(sw, t, st, p, cfg):
     fn = _hook_of(sw, "contacts_moved")
     if fn is not None:
         return lambda sw, t, st, p, cfg: fn(sw, t, st, p, cfg)
+
+
+def start(sw, t, st, g, cfg):
+    """The scheme's own energies at t = 0."""
+    raise NotImplementedError("compiled use only")
+
+
+@overload(start, inline="always")
+def _start(sw, t, st, g, cfg):
+    fn = _hook_of(sw, "start")
+    if fn is not None:
+        return lambda sw, t, st, g, cfg: fn(sw, t, st, g, cfg)

@@ -60,7 +60,7 @@ class Scratch(NamedTuple):
     qdn: np.ndarray
 
 
-def new_scratch(ng: int, nm: int, nk: int) -> Scratch:
+def new_scratch(ng: int, nm: int, nk: int, body=None) -> Scratch:
     """Scratch for ng granules, nm modes, nk plate contacts."""
     nd = 2 * nk
     z = np.zeros
@@ -255,3 +255,9 @@ def contacts_moved(sw, t, st, p, cfg):
     """Nothing: each step advances the modes from q, q' and the forces at t_n as they
     stand, with the contacts' rows of Phi_d of that step."""
     return
+
+
+@njit(cache=True)
+def start(sw, t, st, g, cfg):
+    """Nothing at t = 0 beyond the loop's own energies (no elastic body in space)."""
+    return 0.0, 0.0

@@ -36,7 +36,7 @@ class Scratch(NamedTuple):
     qdd_star: np.ndarray  # (nm,) known part of the modal acceleration at t + h
 
 
-def new_scratch(ng: int, nm: int, nk: int) -> Scratch:
+def new_scratch(ng: int, nm: int, nk: int, body=None) -> Scratch:
     """Scratch for ng granules, nm modes, nk plate contacts."""
     nd = 2 * nk
     return Scratch(astar=np.zeros(nd), anext=np.zeros(nd), aavg=np.zeros(nd), qdd_star=np.zeros(nm))
@@ -168,3 +168,9 @@ def contacts_moved(sw, t, st, p, cfg):
         for m in range(p.omega2.shape[0]):
             sa += p.phi_d[d, m] * st.qdd[m]
         st.a[d] = sa
+
+
+@njit(cache=True)
+def start(sw, t, st, g, cfg):
+    """Nothing at t = 0 beyond the loop's own energies (no elastic body in space)."""
+    return 0.0, 0.0

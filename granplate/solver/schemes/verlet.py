@@ -24,10 +24,15 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from granplate.model.inputs import STATE_COLUMNS
+from granplate.model.inputs import STATE_COLUMNS, BodyArrays, new_body_state, no_body
 from granplate.physics.contact import COEF_MU
+from granplate.solver import body as B
 from granplate.solver.dimension import friction_flow, normal_forces
 from granplate.solver.ladder import step_to_output
+from granplate.solver.state import E_STATIC, PARTNER_PLATE
+
+#: the partner code of a granule's contact with the elastic body (the plate's).
+PARTNER_BODY = PARTNER_PLATE
 
 NAME = "verlet"
 #: the state's leading columns that drift (x, y, theta in the plane; x, y, z in space),
@@ -49,13 +54,16 @@ class Scratch(NamedTuple):
     fdamp: np.ndarray  # (2, ng, N_COLUMNS) damping force on each granule [N] (velocity columns)
     fload: np.ndarray  # (2, ng, N_COLUMNS) shock load on each granule [N, N m]
     split: np.ndarray  # (5,) OWED, FORWARD, LAND, STARTED, CURRENT
+    body: BodyArrays  # the elastic body in space and this run's contacts on it (no faces: none)
 
 
-def new_scratch(ng: int, nm: int, nk: int) -> Scratch:
-    """Scratch for ng granules (nm modes, nk plate contacts: none are used)."""
+def new_scratch(ng: int, nm: int, nk: int, body: BodyArrays | None = None) -> Scratch:
+    """Scratch for ng granules and nm modes (nk plate contacts: none are used), with this
+    run's own copy of the elastic body's contact state (body None: no body)."""
     split = np.zeros(5)
     split[FORWARD] = 1.0
-    return Scratch(fdamp=np.zeros((2, ng, N_COLUMNS)), fload=np.zeros((2, ng, N_COLUMNS)), split=split)
+    b = no_body(ng, nm) if body is None else new_body_state(body)
+    return Scratch(fdamp=np.zeros((2, ng, N_COLUMNS)), fload=np.zeros((2, ng, N_COLUMNS)), split=split, body=b)
 
 
 @njit(cache=True)
@@ -132,41 +140,106 @@ def kick(y, acc, fdamp, fload, hk, dy):
 
 
 @njit(cache=True)
+def body_pass(y, sw, buf, q, qd, g, cfg, acc, fdamp):
+    """The elastic body's contact forces at (y, q, qd) into buffer buf (solver.body),
+    added to the granules' accelerations acc and damping forces fdamp; returns (their
+    stored energy, viscous power, plastic work, residual energy [J, W, J, J], largest
+    overlap / radius, its granule)."""
+    return B.contact_forces(y, q, qd, sw.body, buf, g.radius, g.mass, cfg.clip, acc, fdamp[buf], True)
+
+
+@njit(cache=True)
+def start(sw, t, st, g, cfg):
+    """The body's contact energies at t = 0 (state y, modes at rest or as set): (the
+    contacts' stored energy, the residual compliance's) [J]; (0, 0) without a body."""
+    if not B.has_body(sw.body):
+        return 0.0, 0.0
+    cur = int(sw.split[CURRENT])
+    e_pot, _, _, e_static, _, _ = body_pass(st.y, sw, cur, st.q, st.qd, g, cfg, st.k1, sw.fdamp)
+    return e_pot, e_static
+
+
+@njit(cache=True)
 def attempt(sw, t, h, slot, st, g, p, cfg, w):
     """One Verlet step from st.y into w.ynew (see the module docstring): the trial's
     accelerations at t + h into w.kend, the load's, damping's, friction's and plastic work
-    into w.dacc, the largest overlap into w.ovl_new / w.ovl_who. Always converged, one
+    into w.dacc, the largest overlap into w.ovl_new / w.ovl_who. With an elastic body
+    (solver.body) its modes take the same kicks from the contact forces and turn exactly
+    over h between them (into sw.body.q, qd, committed by `commit`). Always converged, one
     force pass. Returns (True, 1, -1, stored energy at t + h [J], 0)."""
     y = w.ynew
     for i in range(y.shape[0]):
         for c in range(y.shape[1]):
             y[i, c] = st.y[i, c]
+    b = sw.body
+    body = B.has_body(b)
+    if body:
+        for m in range(b.q.shape[0]):
+            b.q[m] = st.q[m]
+            b.qd[m] = st.qd[m]
     cur = int(sw.split[CURRENT])
     nxt = 1 - cur
     if sw.split[STARTED] == 0.0:  # the first step: t_n's forces, loads and damping (st.k1 as `initialise` has it)
         normal_forces(t, st.y, g, cfg, st.k1, sw.fdamp[cur], sw.fload[cur])
+        if body:
+            body_pass(st.y, sw, cur, st.q, st.qd, g, cfg, st.k1, sw.fdamp)
     hk = 0.5 * h
-    friction = has_friction(g)
+    friction = has_friction(g) or (body and body_friction(b))
     forward = sw.split[FORWARD] != 0.0
     fric = 0.0
     if friction:
         fric = friction_flow(y, sw.split[OWED] + hk, g, cfg, forward)
+        if body:
+            fric += B.friction_flow(y, b.qd, sw.split[OWED] + hk, b, cur, g.radius, g.mass, g.inertia,
+                                    cfg.arm_shrink, forward)
     wl, wd = kick_drift(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp)
+    if body:
+        wd += B.kick(b.qd, b.fmodal[cur], b.fdamp[cur], hk)
+        B.turn(b.q, b.qd, b.omega, h)
+        B.predicted_velocity(b, hk, cur)
     pr = normal_forces(t + h, w.ytmp, g, cfg, w.kend, sw.fdamp[nxt], sw.fload[nxt])
+    e_pot = pr.e_pot
+    p_visc = pr.p_visc
+    w_plastic = pr.w_plastic
+    ovl = pr.ovl
+    ovl_i = pr.ovl_i
+    ovl_j = pr.ovl_j
+    if body:
+        ep_b, pv_b, wp_b, _, ovl_b, i_b = body_pass(w.ytmp, sw, nxt, b.q, b.qdp, g, cfg, w.kend, sw.fdamp)
+        e_pot += ep_b
+        p_visc += pv_b
+        w_plastic += wp_b
+        if ovl_b > ovl:
+            ovl = ovl_b
+            ovl_i = i_b
+            ovl_j = PARTNER_BODY
     wl2, wd2 = kick(y, w.kend, sw.fdamp[nxt], sw.fload[nxt], hk, w.kend)
+    if body:
+        wd2 += B.kick(b.qd, b.fmodal[nxt], b.fdamp[nxt], hk)
     if friction and sw.split[LAND] != 0.0:  # an output time: the closing half step
         fric += friction_flow(y, hk, g, cfg, not forward)
+        if body:
+            fric += B.friction_flow(y, b.qd, hk, b, nxt, g.radius, g.mass, g.inertia, cfg.arm_shrink, not forward)
     w.dacc[0] = wl + wl2
     w.dacc[1] = -(wd + wd2)
     w.dacc[2] = fric
-    w.dacc[3] = pr.w_plastic
+    w.dacc[3] = w_plastic
     w.pend[0] = pr.p_shock
-    w.pend[1] = pr.p_visc
+    w.pend[1] = p_visc
     w.pend[2] = 0.0
-    w.ovl_new[0] = pr.ovl
-    w.ovl_who[0] = pr.ovl_i
-    w.ovl_who[1] = pr.ovl_j
-    return True, 1, -1, pr.e_pot, 0.0
+    w.ovl_new[0] = ovl
+    w.ovl_who[0] = ovl_i
+    w.ovl_who[1] = ovl_j
+    return True, 1, -1, e_pot, 0.0
+
+
+@njit(cache=True)
+def body_friction(b) -> bool:
+    """Whether any granule's contact with the body has a friction coefficient."""
+    for i in range(b.coef.shape[0]):
+        if b.coef[i, COEF_MU] != 0.0:
+            return True
+    return False
 
 
 @njit(cache=True)
@@ -180,6 +253,12 @@ def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
     """The trial's end forces become t_n's (the buffers swap); the friction owed is half
     this step, or nothing when it landed on an output time; each friction pass made
     reverses the order of the next. Returns the plate work: 0 (no plate)."""
+    b = sw.body
+    if B.has_body(b):  # the modes and the residual's energy at t + h
+        for m in range(b.q.shape[0]):
+            st.q[m] = b.q[m]
+            st.qd[m] = b.qd[m]
+        st.clock[E_STATIC] = b.static[1 - int(sw.split[CURRENT])]
     sw.split[CURRENT] = 1.0 - sw.split[CURRENT]
     sw.split[STARTED] = 1.0
     land = sw.split[LAND] != 0.0

@@ -1,0 +1,89 @@
+"""Scenario -> an elastic body's arrays in the loop (docs/model.md section 3.9): the solid
+built (solid.build_solid, cached in the run store) with its residual compliance over the
+normal dofs of the face the granules rest on, its boundary's quadratic faces with their
+rows of the modes, each granule's closest face at t = 0 (the seed of its search) and its
+contact coefficients with the body (the 2D plate contact's laws with the body's
+material: E* of both, the granule's mass as m*, the pair's friction).
+"""
+from __future__ import annotations
+
+from collections import Counter
+
+import numpy as np
+
+from granplate.model.inputs import N_GEO, BodyArrays, no_history
+from granplate.physics.contact import N_COEF, damping_coefficient, hertz_coefficient
+from granplate.setup.materials import effective_modulus
+from granplate.setup.scenario import Scenario
+
+
+def residual_face(s: Scenario, surface, mesh) -> tuple[str | None, str]:
+    """(the named face most granules are closest to, its dofs' components): a box face's
+    normal axis ("x", "y" or "z"), a mesh group's "xyz"; (None, "") without granules or
+    named faces."""
+    from granplate.solid.surface import closest_point
+
+    groups = {int(f): name for name, facets in (mesh.boundaries or {}).items() for f in np.asarray(facets)}
+    votes = Counter()
+    for g in s.granules:
+        face = closest_point(surface, (g.x, g.y, g.z)).face
+        name = groups.get(int(surface.facets[face]))
+        if name is not None:
+            votes[name] += 1
+    if not votes:
+        return None, ""
+    name = votes.most_common(1)[0][0]
+    if s.plate.mesh is None and name in ("xmin", "xmax", "ymin", "ymax", "zmin", "zmax"):
+        return name, name[0]
+    return name, "xyz"
+
+
+def body_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, body_material) -> np.ndarray:
+    """(ng, N_COEF) each granule's contact coefficients with the body: Hertz A with E* of
+    both materials and the granule's radius (the body flat there), damping with m* = m_i
+    (the body's mass much larger), the pair's friction and yield overlap."""
+    from granplate.model.arrays import coefficient_row, law_yield_overlap
+
+    coef = np.zeros((len(r), N_COEF))
+    for i, m in enumerate(mats):
+        alpha, mu, ks = s.contact.for_pair(m.name, body_material.name)
+        e_star = effective_modulus(m, body_material)
+        a = hertz_coefficient(e_star, float(r[i]))
+        coef[i] = coefficient_row(a, damping_coefficient(alpha, float(mass[i]), a), mu, ks,
+                                  law_yield_overlap(s, m, body_material, body_material.name, e_star, float(r[i])))
+    return coef
+
+
+def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
+    """(the SolidModel, its BodyArrays) of the scenario's elastic solid."""
+    from granplate.solid.boundary import reduced_index
+    from granplate.solid.build import build_solid, solid_mesh
+    from granplate.solid.fe import vector_basis
+    from granplate.solid.surface import boundary_surface, closest_point, face_neighbours
+
+    sd = s.plate
+    material = s.material(sd.material)
+    mesh = solid_mesh(sd)
+    surface = boundary_surface(vector_basis(mesh, sd.element))
+    face, components = residual_face(s, surface, mesh)
+    solid = build_solid(sd, material, surface=face, components=components or "z")
+    rows = reduced_index(solid.dofs, surface.dofs.ravel()).reshape(surface.dofs.shape)
+    where = np.full(len(solid.dofs), -1, np.int64)
+    where[solid.surface_dofs] = np.arange(len(solid.surface_dofs))
+    resid_index = np.where(rows >= 0, where[np.maximum(rows, 0)], -1)
+    ng, nm = len(r), solid.n_modes
+    n_fn = surface.dofs.shape[1]
+    seeds = np.array([closest_point(surface, (g.x, g.y, g.z)).face for g in s.granules], np.int64)
+    box = np.array([solid.nodes.min(axis=0), solid.nodes.max(axis=0)])
+    z = np.zeros
+    arrays = BodyArrays(
+        face_nodes=np.ascontiguousarray(surface.nodes), face_rows=np.ascontiguousarray(rows, np.int64),
+        face_resid=np.ascontiguousarray(resid_index, np.int64), neighbours=face_neighbours(surface),
+        kind=np.array([surface.kind], np.int64), phi=np.ascontiguousarray(solid.Phi), omega=solid.omega.copy(),
+        resid=np.ascontiguousarray(solid.resid), box=box, coef=body_coefficients(s, mats, r, mass, material),
+        face=np.vstack([seeds, seeds]), geo=z((2, ng, N_GEO)), weights=z((2, ng, n_fn)),
+        fmodal=z((2, nm)), fdamp=z((2, nm)), hist=no_history(ng), q=z(nm), qd=z(nm), qdp=z(nm), static=z(2),
+        active=np.zeros(ng, np.int64), rmat=z((ng, ng)), rcol=np.zeros((ng, 3 * n_fn), np.int64),
+        rcoef=z((ng, 3 * n_fn)),
+    )
+    return solid, arrays

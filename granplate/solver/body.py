@@ -1,0 +1,461 @@
+"""An elastic body in space in the time loop (docs/model.md section 3.9): the granules'
+contacts on its surface, their forces with the residual compliance in series, the
+friction there, and the body's modes kicked by the contact forces and turned exactly
+between kicks. The velocity-Verlet scheme (solver/schemes/verlet.py) calls these; the
+arrays are model.inputs.BodyArrays (`b`), whose per-granule state lives in two buffers
+(`buf`: t_n's and the trial step's end).
+
+A granule touches the body at the closest point of the undeformed surface to its centre
+(`slide_closest`, seeded with the last face), with the outward normal n there, the
+face's shape functions w_a as weights and the overlap
+
+    delta0 = R - d + n . u_c,   u_c = sum_a w_a u_a = sum_a w_a Phi_a q,
+
+(physics.space.surface_overlap). The dropped modes respond statically, u_s = R_S N over
+the residual dofs S (solid/residual.py), in series with the contact law's static force:
+delta = delta0 - sum_j R_kj N_j, N_k = F(delta_k), solved by Gauss-Seidel over the
+contacts in touch (each contact by Newton on its own overlap). The force on the granule
+is N n with N the law's whole force at (delta, its rate) (damping included); the body
+gets -N n at the point, on the modes Phi^T (w (x) -N n). Friction is split off as for
+granule pairs (solver.granular3d.friction_flow): an exact impulse along the slip, against
+the granule's and the body's mobility along it, booked as the kinetic energy it removes.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from granplate.model.inputs import (
+    GEO_DAMP, GEO_DELTA, GEO_DIST, GEO_ETA, GEO_N, GEO_NSTAT, GEO_NX, GEO_NY, GEO_NZ, GEO_TOUCH, GEO_XI,
+    HIST_END, HIST_MAX,
+)
+from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm
+from granplate.physics.laws import normal_law_force, normal_law_response, normal_law_slopes
+from granplate.physics.space import friction_along_slip, normal_rate_3d, slip_velocity_3d, surface_overlap
+from granplate.solid.surface import face_shape_functions, slide_closest
+from granplate.solver.granular import friction_impulse
+from granplate.solver.granular3d import VX, WX, X, apply_friction_impulse
+
+#: Gauss-Seidel sweeps of the residual solve at most, and its tolerance on the forces
+#: (relative to the largest); Newton steps per contact and their overlap tolerance.
+RESID_SWEEPS = 200
+RESID_RTOL = 1e-13
+NEWTON_STEPS = 60
+NEWTON_RTOL = 1e-14
+#: A granule is located on the surface when its centre lies within REACH radii of the
+#: body's bounding box (a surface that moves out of the box by more than REACH - 1 radii
+#: towards a granule would be missed).
+REACH = 2.0
+
+
+@njit(cache=True)
+def has_body(b) -> bool:
+    """Whether the run has an elastic body (faces to touch)."""
+    return b.face_nodes.shape[0] > 0
+
+
+@njit(cache=True)
+def near_box(b, x, y, z, reach) -> bool:
+    """Whether a centre lies within `reach` [m] of the body's bounding box."""
+    d2 = 0.0
+    for c, v in ((0, x), (1, y), (2, z)):
+        lo = b.box[0, c] - v
+        hi = v - b.box[1, c]
+        e = max(lo, hi, 0.0)
+        d2 += e * e
+    return d2 <= reach * reach
+
+
+@njit(cache=True)
+def locate(b, buf, i, p, out, N, dN) -> None:
+    """Granule i's closest point of the undeformed surface to centre p (3,) [m] into buffer
+    buf (face, face coordinates, signed distance, normal, weights), searched from the face
+    it last touched."""
+    seed = b.face[buf, i] if b.face[buf, i] >= 0 else b.face[1 - buf, i]
+    f = slide_closest(b.face_nodes, b.kind[0], b.neighbours, seed, p, out)
+    b.face[buf, i] = f
+    g = b.geo[buf, i]
+    g[GEO_XI] = out[0]
+    g[GEO_ETA] = out[1]
+    g[GEO_NX] = out[5]
+    g[GEO_NY] = out[6]
+    g[GEO_NZ] = out[7]
+    g[GEO_DIST] = out[8]
+    face_shape_functions(b.kind[0], out[0], out[1], N, dN)
+    for a in range(N.shape[0]):
+        b.weights[buf, i, a] = N[a]
+
+
+@njit(cache=True)
+def surface_motion(b, buf, i, q, qd):
+    """The surface's displacement and velocity at granule i's contact point (buffer buf):
+    sum_a w_a Phi_a q and sum_a w_a Phi_a qd, [m] and [m/s] (x, y, z each)."""
+    f = b.face[buf, i]
+    nm = q.shape[0]
+    u0 = u1 = u2 = 0.0
+    v0 = v1 = v2 = 0.0
+    for a in range(b.face_rows.shape[1]):
+        w = b.weights[buf, i, a]
+        if w == 0.0:
+            continue
+        for c in range(3):
+            row = b.face_rows[f, a, c]
+            if row < 0:
+                continue
+            su = 0.0
+            sv = 0.0
+            for m in range(nm):
+                phi = b.phi[row, m]
+                su += phi * q[m]
+                sv += phi * qd[m]
+            if c == 0:
+                u0 += w * su
+                v0 += w * sv
+            elif c == 1:
+                u1 += w * su
+                v1 += w * sv
+            else:
+                u2 += w * su
+                v2 += w * sv
+    return u0, u1, u2, v0, v1, v2
+
+
+@njit(cache=True)
+def spread(b, buf, i, fx, fy, fz, out, scale) -> None:
+    """out[m] += scale * (Phi^T f)_m for the force f [N] at granule i's contact point
+    (buffer buf), spread over the face's nodes by the weights."""
+    f = b.face[buf, i]
+    for a in range(b.face_rows.shape[1]):
+        w = b.weights[buf, i, a] * scale
+        if w == 0.0:
+            continue
+        for c in range(3):
+            row = b.face_rows[f, a, c]
+            if row < 0:
+                continue
+            fc = w * (fx if c == 0 else (fy if c == 1 else fz))
+            for m in range(out.shape[0]):
+                out[m] += b.phi[row, m] * fc
+
+
+@njit(cache=True)
+def static_overlap(target, r, c, delta_max, clip) -> float:
+    """The overlap delta [m] with delta + r F(delta) = target (F the law's static force,
+    r the contact's own residual compliance [m/N]): Newton from delta = target, which
+    converges from above for a convex increasing F; 0 when target <= 0."""
+    if target <= 0.0:
+        return 0.0
+    if r == 0.0:
+        return target
+    x = target
+    for _ in range(NEWTON_STEPS):
+        phi = x + r * normal_law_force(x, 0.0, c, delta_max, clip) - target
+        slope = 1.0 + r * normal_law_slopes(x, c, delta_max)[0]
+        dx = phi / slope
+        x_new = x - dx
+        if x_new <= 0.0:
+            x_new = 0.5 * x
+        if abs(x_new - x) <= NEWTON_RTOL * target:
+            return x_new
+        x = x_new
+    return x
+
+
+@njit(cache=True)
+def residual_rows(b, buf, i, k) -> int:
+    """Contact k (granule i) as a combination of the residual dofs: its normal n times the
+    weights on the dofs of S (rcol, rcoef row k). Returns how many terms."""
+    f = b.face[buf, i]
+    g = b.geo[buf, i]
+    nt = 0
+    for a in range(b.face_resid.shape[1]):
+        w = b.weights[buf, i, a]
+        for c in range(3):
+            s = b.face_resid[f, a, c]
+            if s < 0 or w == 0.0:
+                continue
+            b.rcol[k, nt] = s
+            b.rcoef[k, nt] = w * g[GEO_NX + c]
+            nt += 1
+    return nt
+
+
+@njit(cache=True)
+def residual_matrix(b, n_act, counts) -> None:
+    """rmat[k, j] = r_k^T R_S r_j [m/N] between the contacts in touch."""
+    for k in range(n_act):
+        for j in range(k, n_act):
+            s = 0.0
+            for e in range(counts[k]):
+                ce = b.rcoef[k, e]
+                row = b.rcol[k, e]
+                for e2 in range(counts[j]):
+                    s += ce * b.resid[row, b.rcol[j, e2]] * b.rcoef[j, e2]
+            b.rmat[k, j] = s
+            b.rmat[j, k] = s
+
+
+@njit(cache=True)
+def solve_static(b, buf, n_act, delta0, clip) -> float:
+    """The static normal forces N_k = F(delta0_k - sum_j R_kj N_j) of the n_act contacts in
+    touch (b.active[:n_act], overlaps delta0 [m] without the residual), by Gauss-Seidel
+    over them, each by `static_overlap`: into geo's GEO_NSTAT and GEO_DELTA. Returns the
+    residual compliance's energy 1/2 N^T R N [J]."""
+    g = b.geo[buf]
+    for k in range(n_act):
+        g[b.active[k], GEO_NSTAT] = 0.0
+    for _ in range(RESID_SWEEPS):
+        change = 0.0
+        largest = 0.0
+        for k in range(n_act):
+            i = b.active[k]
+            target = delta0[k]
+            for j in range(n_act):
+                if j != k:
+                    target -= b.rmat[k, j] * g[b.active[j], GEO_NSTAT]
+            x = static_overlap(target, b.rmat[k, k], b.coef[i], b.hist[i, HIST_MAX], clip)
+            n = normal_law_force(x, 0.0, b.coef[i], b.hist[i, HIST_MAX], clip) if x > 0.0 else 0.0
+            change = max(change, abs(n - g[i, GEO_NSTAT]))
+            largest = max(largest, n)
+            g[i, GEO_NSTAT] = n
+            g[i, GEO_DELTA] = x
+        if change <= RESID_RTOL * largest or n_act == 1:
+            break
+    e = 0.0
+    for k in range(n_act):
+        nk = g[b.active[k], GEO_NSTAT]
+        for j in range(n_act):
+            e += 0.5 * nk * b.rmat[k, j] * g[b.active[j], GEO_NSTAT]
+    return e
+
+
+@njit(cache=True)
+def contact_forces(y, q, qd, b, buf, radius, mass, clip, acc, fdamp, scale_acc):
+    """The body's contact forces at granule state y (ng, 9), modal displacement q and
+    velocity qd (nm,) into buffer buf: each granule within REACH R of the body's bounding
+    box located on its surface, the overlaps with the residual compliance in series
+    (`solve_static`), the law's forces (damping at the overlap rate against the surface's
+    velocity); acc[i, VX..VZ] gains N n / m_i (scale_acc True) or N n; fdamp[i, VX..VZ]
+    the damping part [N]; b.fmodal[buf], b.fdamp[buf] the modal projections of the forces
+    on the body. The contacts' overlaps go to hist[:, HIST_END].
+
+    Returns (stored elastic energy of the contacts [J], viscous power [W], plastic work past
+    the largest overlaps [J], the residual's energy [J], the largest overlap / radius, its
+    granule)."""
+    nm = q.shape[0]
+    for m in range(nm):
+        b.fmodal[buf, m] = 0.0
+        b.fdamp[buf, m] = 0.0
+    n_fn = b.face_nodes.shape[1]
+    out = np.empty(9)
+    N = np.empty(n_fn)
+    dN = np.empty((n_fn, 2))
+    p = np.empty(3)
+    ng = y.shape[0]
+    delta0 = np.empty(max(ng, 1))
+    counts = np.zeros(max(ng, 1), np.int64)
+    n_act = 0
+    g = b.geo[buf]
+    for i in range(ng):
+        g[i, GEO_TOUCH] = 0.0
+        g[i, GEO_N] = 0.0
+        g[i, GEO_NSTAT] = 0.0
+        g[i, GEO_DAMP] = 0.0
+        g[i, GEO_DELTA] = 0.0
+        b.hist[i, HIST_END] = 0.0
+        r = radius[i]
+        if not near_box(b, y[i, X], y[i, X + 1], y[i, X + 2], REACH * r):
+            continue
+        p[0] = y[i, X]
+        p[1] = y[i, X + 1]
+        p[2] = y[i, X + 2]
+        locate(b, buf, i, p, out, N, dN)
+        u0, u1, u2, _, _, _ = surface_motion(b, buf, i, q, qd)
+        d0 = surface_overlap(r, g[i, GEO_DIST], u0 * g[i, GEO_NX] + u1 * g[i, GEO_NY] + u2 * g[i, GEO_NZ])
+        if d0 <= 0.0:
+            continue
+        g[i, GEO_TOUCH] = 1.0
+        b.active[n_act] = i
+        delta0[n_act] = d0
+        n_act += 1
+    e_static = 0.0
+    if n_act > 0:
+        if b.resid.shape[0] > 0:
+            for k in range(n_act):
+                counts[k] = residual_rows(b, buf, b.active[k], k)
+            residual_matrix(b, n_act, counts)
+        else:
+            for k in range(n_act):
+                for j in range(n_act):
+                    b.rmat[k, j] = 0.0
+        e_static = solve_static(b, buf, n_act, delta0, clip)
+    e_pot = 0.0
+    p_visc = 0.0
+    w_plastic = 0.0
+    ovl = 0.0
+    ovl_i = -1
+    for k in range(n_act):
+        i = b.active[k]
+        r = radius[i]
+        delta = g[i, GEO_DELTA]
+        b.hist[i, HIST_END] = delta
+        if delta <= 0.0:
+            continue
+        nx = g[i, GEO_NX]
+        ny = g[i, GEO_NY]
+        nz = g[i, GEO_NZ]
+        _, _, _, v0, v1, v2 = surface_motion(b, buf, i, q, qd)
+        # the overlap's rate, with the normal from the granule into the body (-n)
+        ddot = normal_rate_3d(y[i, VX] - v0, y[i, VX + 1] - v1, y[i, VX + 2] - v2, -nx, -ny, -nz)
+        n, pv, ep, wp = normal_law_response(delta, ddot, b.coef[i], b.hist[i, HIST_MAX], clip)
+        g[i, GEO_N] = n
+        e_pot += ep
+        p_visc += pv
+        w_plastic += wp
+        d = pv / ddot if pv != 0.0 else 0.0
+        g[i, GEO_DAMP] = d
+        inv = 1.0 / mass[i] if scale_acc else 1.0
+        acc[i, VX] += n * nx * inv
+        acc[i, VX + 1] += n * ny * inv
+        acc[i, VX + 2] += n * nz * inv
+        fdamp[i, VX] += d * nx
+        fdamp[i, VX + 1] += d * ny
+        fdamp[i, VX + 2] += d * nz
+        spread(b, buf, i, -n * nx, -n * ny, -n * nz, b.fmodal[buf], 1.0)
+        if d != 0.0:
+            spread(b, buf, i, -d * nx, -d * ny, -d * nz, b.fdamp[buf], 1.0)
+        if delta > ovl * r:
+            ovl = delta / r
+            ovl_i = i
+    b.static[buf] = e_static
+    return e_pot, p_visc, w_plastic, e_static, ovl, ovl_i
+
+
+@njit(cache=True)
+def kick(qd, fmodal, fdamp, hk) -> float:
+    """The modes' half kick qd += hk Phi^T F (hk = h/2 [s]); returns the damping part's
+    work [J], hk F_d . (qd_before + qd_after)/2 (as the granules' kicks book theirs)."""
+    w = 0.0
+    for m in range(qd.shape[0]):
+        dv = hk * fmodal[m]
+        w += fdamp[m] * hk * (qd[m] + 0.5 * dv)
+        qd[m] += dv
+    return w
+
+
+@njit(cache=True)
+def turn(q, qd, omega, h) -> None:
+    """Each mode's free vibration over h [s], exactly: (q, qd) turned by omega h (a rigid-
+    body mode, omega = 0, drifts: q += h qd)."""
+    for m in range(q.shape[0]):
+        om = omega[m]
+        if om == 0.0:
+            q[m] += h * qd[m]
+            continue
+        c = math.cos(om * h)
+        s = math.sin(om * h)
+        q0 = q[m]
+        q[m] = c * q0 + s * qd[m] / om
+        qd[m] = -om * s * q0 + c * qd[m]
+
+
+@njit(cache=True)
+def predicted_velocity(b, hk, buf) -> None:
+    """The modal velocity the force pass reads, qdp = qd + hk Phi^T F_n (the velocity at
+    the step's end as the granules' is predicted, v + h/2 a_n)."""
+    for m in range(b.qd.shape[0]):
+        b.qdp[m] = b.qd[m] + hk * b.fmodal[buf, m]
+
+
+@njit(cache=True)
+def slip_row(b, buf, i, sx, sy, sz, row) -> float:
+    """row[m] = (Phi^T (w (x) s))_m, the modes' share of a unit impulse along s at granule
+    i's contact point; returns row . row, the body's mobility along s [kg^-1]."""
+    for m in range(row.shape[0]):
+        row[m] = 0.0
+    spread(b, buf, i, sx, sy, sz, row, 1.0)
+    mob = 0.0
+    for m in range(row.shape[0]):
+        mob += row[m] * row[m]
+    return mob
+
+
+@njit(cache=True)
+def friction_flow(y, qd, dt, b, buf, radius, mass, inertia, arm_shrink, forward) -> float:
+    """Friction alone over dt [s] at every contact in touch on the body (buffer buf, |N|
+    held), one after the other (forward or reversed): the exact impulse of
+    solver.granular.friction_impulse along the slip s = v_s / |v_s| against the mobility
+    1/m + a^2/I + |Phi^T (w (x) s)|^2, on the granule and, opposite, on the modes qd.
+    Returns the energy dissipated [J]: the kinetic energy the impulses removed."""
+    ng = y.shape[0]
+    nm = qd.shape[0]
+    row = np.empty(nm)
+    work = 0.0
+    g = b.geo[buf]
+    for kk in range(ng):
+        i = kk if forward else ng - 1 - kk
+        if g[i, GEO_TOUCH] == 0.0:
+            continue
+        c = b.coef[i]
+        if c[COEF_MU] == 0.0 or g[i, GEO_N] <= 0.0:
+            continue
+        nx = -g[i, GEO_NX]  # from the granule into the body
+        ny = -g[i, GEO_NY]
+        nz = -g[i, GEO_NZ]
+        a = contact_arm(radius[i], g[i, GEO_DELTA], arm_shrink)
+        _, _, _, v0, v1, v2 = surface_motion(b, buf, i, b.q, qd)
+        vsx, vsy, vsz = slip_velocity_3d(y[i, VX] - v0, y[i, VX + 1] - v1, y[i, VX + 2] - v2,
+                                         a * y[i, WX], a * y[i, WX + 1], a * y[i, WX + 2], nx, ny, nz)
+        speed = math.sqrt(vsx * vsx + vsy * vsy + vsz * vsz)
+        if speed == 0.0:
+            continue
+        sx = vsx / speed
+        sy = vsy / speed
+        sz = vsz / speed
+        mob = slip_row(b, buf, i, sx, sy, sz, row)
+        inv_m = 1.0 / mass[i]
+        inv_i = 1.0 / inertia[i]
+        imp, _ = friction_impulse(speed, g[i, GEO_N], c[COEF_MU], c[COEF_KS], inv_m + a * a * inv_i + mob, dt)
+        if imp == 0.0:
+            continue
+        ke0 = 0.0
+        for col in range(3):
+            ke0 += 0.5 * mass[i] * y[i, VX + col] ** 2 + 0.5 * inertia[i] * y[i, WX + col] ** 2
+        px, py, pz = friction_along_slip(imp, speed, vsx, vsy, vsz)
+        apply_friction_impulse(y, i, a, inv_m, inv_i, nx, ny, nz, px, py, pz, 1.0)
+        ke1 = 0.0
+        for col in range(3):
+            ke1 += 0.5 * mass[i] * y[i, VX + col] ** 2 + 0.5 * inertia[i] * y[i, WX + col] ** 2
+        dke = ke1 - ke0
+        for m in range(nm):  # the body gets -P = imp s
+            dv = imp * row[m]
+            dke += dv * (qd[m] + 0.5 * dv)
+            qd[m] += dv
+        work -= dke
+    return work
+
+
+@njit(cache=True)
+def replay(ys, qs, qds, b, radius, mass, clip, face_out, xi_out, force_out, normal_out) -> None:
+    """The body's contacts at recorded states (ys (nt, ng, 9), qs, qds (nt, nm)), one time
+    after the other (each search seeded by the last): face_out (nt, ng) the face touched
+    (-1: none), xi_out (nt, ng, 2) the point's face coordinates, force_out (nt, ng, 3) the
+    force on the body [N], normal_out (nt, ng) |N| [N]. Uses buffer 0 of b (a copy)."""
+    ng = ys.shape[1]
+    acc = np.zeros((ng, ys.shape[2]))
+    fdamp = np.zeros((ng, ys.shape[2]))
+    for o in range(ys.shape[0]):
+        contact_forces(ys[o], qs[o], qds[o], b, 0, radius, mass, clip, acc, fdamp, True)
+        for i in range(ng):
+            g = b.geo[0, i]
+            touching = g[GEO_TOUCH] != 0.0 and g[GEO_N] > 0.0
+            face_out[o, i] = b.face[0, i] if touching else -1
+            xi_out[o, i, 0] = g[GEO_XI]
+            xi_out[o, i, 1] = g[GEO_ETA]
+            n = g[GEO_N] if touching else 0.0
+            normal_out[o, i] = n
+            force_out[o, i, 0] = -n * g[GEO_NX]
+            force_out[o, i, 1] = -n * g[GEO_NY]
+            force_out[o, i, 2] = -n * g[GEO_NZ]
