@@ -56,6 +56,8 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "max_von_mises_disc": ("Pa", "largest von Mises stress averaged over a disc of radius plate.stress_radius (eq. 12, docs/model.md section 4.4)"),
     "max_eps_yy": ("1", "maximum over the plate's quadrature points of |eps_yy|"),
     "plate_vx_symmetry": ("m/s", "plate horizontal velocity along the symmetry line y = y0 + height/2"),
+    "body_q": ("kg^1/2 m", "the elastic body's modal coordinates (M-orthonormal modes; dimension = 3)"),
+    "body_qd": ("kg^1/2 m/s", "the elastic body's modal velocities (dimension = 3)"),
     "plate_ux": ("m", "plate nodal displacement, horizontal (at field_time)"),
     "plate_uy": ("m", "plate nodal displacement, vertical (at field_time)"),
     "plate_von_mises": ("Pa", "largest von Mises stress in each element (at field_time)"),
@@ -261,10 +263,14 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
                 n = n_done
                 info = {**info, "status": f"{INTERRUPTED_STATUS} at t = {out.t[n - 1]:.6e} s, "
                                           "while building the result."}
+    body_data: dict[str, xr.DataArray] = {}
+    body_coords: dict = {}
+    if model.solid is not None:
+        body_data, body_coords = body_outputs(model, out, n, summary_only)
     t = out.t[:n].copy()
     y = out.y[:n]
     e = out.energy[:n]
-    data: dict[str, xr.DataArray] = {}
+    data: dict[str, xr.DataArray] = dict(body_data)
     if not summary_only:
         for c, name in enumerate(STATE_VARIABLES[y.shape[2]]):
             data[name] = _var(name, ("time", "granule"), y[:, :, c].copy())
@@ -299,6 +305,7 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
             data[name] = _var(name, ("material_pair",), values)
         p_max, ratio = largest(py)
         info = {**info, "max_contact_pressure": p_max, "yield_onset_ratio": ratio}
+    coords.update(body_coords)
     if summary_only:
         data.update(plate_data)
         ds = xr.Dataset(data, coords=coords)
@@ -329,6 +336,24 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
         ds = ds.drop_dims("contact", errors="ignore")
     ds.attrs.update(_attrs(model, out, n, info, dumps(s)))
     return ds
+
+
+def body_outputs(model, out: K.Output, n: int, summary_only: bool) -> tuple[dict[str, xr.DataArray], dict]:
+    """An elastic body's outputs in space (docs/output.md): its contacts at the output
+    times (results.body_contacts), its modal coordinates and, from them, its fields
+    (results.body)."""
+    from granplate.results.body_contacts import body_contacts, contact_variables
+
+    contacts = body_contacts(model, out.y[:n], out.q[:n], out.qd[:n])
+    data: dict[str, xr.DataArray] = {}
+    coords: dict = {}
+    if not summary_only:
+        data.update(contact_variables(contacts))
+        data["body_q"] = _var("body_q", ("time", "mode"), out.q[:n].copy())
+        data["body_qd"] = _var("body_qd", ("time", "mode"), out.qd[:n].copy())
+        coords["mode_frequency"] = ("mode", model.solid.frequencies.copy(),
+                                    {"units": "Hz", "long_name": "the elastic body's natural frequencies"})
+    return data, coords
 
 
 def initial_energy(energy0: np.ndarray) -> float:

@@ -442,12 +442,17 @@ def replay(ys, qs, qds, b, radius, mass, clip, face_out, xi_out, force_out, norm
     """The body's contacts at recorded states (ys (nt, ng, 9), qs, qds (nt, nm)), one time
     after the other (each search seeded by the last): face_out (nt, ng) the face touched
     (-1: none), xi_out (nt, ng, 2) the point's face coordinates, force_out (nt, ng, 3) the
-    force on the body [N], normal_out (nt, ng) |N| [N]. Uses buffer 0 of b (a copy)."""
+    force on the body [N], normal_out (nt, ng) |N| [N]. Uses buffer 0 of b (a copy); an
+    elastic-plastic law's largest overlap is the largest at the recorded times so far."""
     ng = ys.shape[1]
     acc = np.zeros((ng, ys.shape[2]))
     fdamp = np.zeros((ng, ys.shape[2]))
+    for i in range(ng):
+        b.hist[i, HIST_MAX] = 0.0
     for o in range(ys.shape[0]):
         contact_forces(ys[o], qs[o], qds[o], b, 0, radius, mass, clip, acc, fdamp, True)
+        for i in range(ng):
+            b.hist[i, HIST_MAX] = max(b.hist[i, HIST_MAX], b.hist[i, HIST_END])
         for i in range(ng):
             g = b.geo[0, i]
             touching = g[GEO_TOUCH] != 0.0 and g[GEO_N] > 0.0

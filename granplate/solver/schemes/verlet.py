@@ -28,6 +28,7 @@ from granplate.model.inputs import STATE_COLUMNS, BodyArrays, new_body_state, no
 from granplate.physics.contact import COEF_MU
 from granplate.solver import body as B
 from granplate.solver.dimension import friction_flow, normal_forces
+from granplate.solver.granular import commit_history
 from granplate.solver.ladder import step_to_output
 from granplate.solver.state import E_STATIC, PARTNER_PLATE
 
@@ -156,6 +157,7 @@ def start(sw, t, st, g, cfg):
         return 0.0, 0.0
     cur = int(sw.split[CURRENT])
     e_pot, _, _, e_static, _, _ = body_pass(st.y, sw, cur, st.q, st.qd, g, cfg, st.k1, sw.fdamp)
+    commit_history(t, sw.body.hist)  # contacts start loaded at their overlaps at t = 0
     return e_pot, e_static
 
 
@@ -259,6 +261,7 @@ def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
             st.q[m] = b.q[m]
             st.qd[m] = b.qd[m]
         st.clock[E_STATIC] = b.static[1 - int(sw.split[CURRENT])]
+        commit_history(t + h, b.hist)
     sw.split[CURRENT] = 1.0 - sw.split[CURRENT]
     sw.split[STARTED] = 1.0
     land = sw.split[LAND] != 0.0
