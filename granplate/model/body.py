@@ -84,6 +84,7 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
         face=np.vstack([seeds, seeds]), geo=z((2, ng, N_GEO)), weights=z((2, ng, n_fn)),
         fmodal=z((2, nm)), fdamp=z((2, nm)), hist=no_history(ng), q=z(nm), qd=z(nm), qdp=z(nm), static=z(2),
         active=np.zeros(ng, np.int64), rmat=z((ng, ng)), rcol=np.zeros((ng, 3 * n_fn), np.int64),
-        rcoef=z((ng, 3 * n_fn)),
+        rcoef=z((ng, 3 * n_fn)), rnode=np.zeros((ng, 3 * n_fn), np.int64), dweights=z((ng, n_fn, 2)),
+        tangent=z((ng, 3, 2)),
     )
     return solid, arrays

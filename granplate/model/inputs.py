@@ -153,8 +153,11 @@ class Config(NamedTuple):
 #: series with the residual compliance [N], the whole normal force with its damping [N],
 #: the damping part of it [N], the effective overlap [m], and 1.0 when the contact is in
 #: touch (0.0 otherwise).
+#: Then the surface gradient of the normal displacement u_n [-] (the deformed surface's
+#: tilt, whose work the granule's force carries: docs/model.md section 3.9).
 GEO_XI, GEO_ETA, GEO_DIST, GEO_NX, GEO_NY, GEO_NZ, GEO_NSTAT, GEO_N, GEO_DAMP, GEO_DELTA, GEO_TOUCH = range(11)
-N_GEO = 11
+GEO_GX, GEO_GY, GEO_GZ = 11, 12, 13
+N_GEO = 14
 
 
 class BodyArrays(NamedTuple):
@@ -179,8 +182,10 @@ class BodyArrays(NamedTuple):
     modal projections Phi^T F [N kg^-1/2]; hist: (ng, N_HIST) each contact's history;
     q, qd, qdp: (nm,) the trial step's modal displacement and velocity and the velocity
     predicted for the force pass; static: (2,) the residual compliance's energy [J];
-    active: (ng,) int, rmat: (ng, ng) and rcol, rcoef: (ng, 3 n_fn) scratch of the
-    residual solve.
+    active: (ng,) int, rmat: (ng, ng) and rcol, rnode, rcoef: (ng, 3 n_fn) scratch of
+    the residual solve (each term's dof in S, its node 3 a + c, its weight); dweights: (ng,
+    n_fn, 2) the shape functions' face derivatives and tangent: (ng, 3, 2) the map from
+    face to space gradients, J (J^T J)^-1, at the last force pass.
     """
 
     face_nodes: np.ndarray
@@ -207,6 +212,9 @@ class BodyArrays(NamedTuple):
     rmat: np.ndarray
     rcol: np.ndarray
     rcoef: np.ndarray
+    rnode: np.ndarray
+    dweights: np.ndarray
+    tangent: np.ndarray
 
 
 def no_body(ng: int, nm: int) -> BodyArrays:
@@ -219,6 +227,7 @@ def no_body(ng: int, nm: int) -> BodyArrays:
         box=z((2, 3)), coef=z((0, 5)), face=np.zeros((2, 0), i), geo=z((2, 0, N_GEO)), weights=z((2, 0, 1)),
         fmodal=z((2, nm)), fdamp=z((2, nm)), hist=no_history(0), q=z(nm), qd=z(nm), qdp=z(nm), static=z(2),
         active=np.zeros(0, i), rmat=z((0, 0)), rcol=np.zeros((0, 3), i), rcoef=z((0, 3)),
+        rnode=np.zeros((0, 3), i), dweights=z((0, 1, 2)), tangent=z((0, 3, 2)),
     )
 
 
@@ -228,4 +237,5 @@ def new_body_state(b: BodyArrays) -> BodyArrays:
     return b._replace(face=b.face.copy(), geo=b.geo.copy(), weights=b.weights.copy(), fmodal=b.fmodal.copy(),
                       fdamp=b.fdamp.copy(), hist=b.hist.copy(), q=b.q.copy(), qd=b.qd.copy(), qdp=b.qdp.copy(),
                       static=b.static.copy(), active=b.active.copy(), rmat=b.rmat.copy(), rcol=b.rcol.copy(),
-                      rcoef=b.rcoef.copy())
+                      rcoef=b.rcoef.copy(), rnode=b.rnode.copy(), dweights=b.dweights.copy(),
+                      tangent=b.tangent.copy())

@@ -28,7 +28,8 @@ import numpy as np
 from numba import njit
 
 from granplate.model.inputs import (
-    GEO_DAMP, GEO_DELTA, GEO_DIST, GEO_ETA, GEO_N, GEO_NSTAT, GEO_NX, GEO_NY, GEO_NZ, GEO_TOUCH, GEO_XI,
+    GEO_DAMP, GEO_DELTA, GEO_DIST, GEO_ETA, GEO_GX, GEO_GY, GEO_GZ, GEO_N, GEO_NSTAT, GEO_NX, GEO_NY, GEO_NZ,
+    GEO_TOUCH, GEO_XI,
     HIST_END, HIST_MAX,
 )
 from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm
@@ -84,8 +85,33 @@ def locate(b, buf, i, p, out, N, dN) -> None:
     g[GEO_NZ] = out[7]
     g[GEO_DIST] = out[8]
     face_shape_functions(b.kind[0], out[0], out[1], N, dN)
+    X = b.face_nodes[f]
+    j00 = j01 = j10 = j11 = j20 = j21 = 0.0
     for a in range(N.shape[0]):
         b.weights[buf, i, a] = N[a]
+        b.dweights[i, a, 0] = dN[a, 0]
+        b.dweights[i, a, 1] = dN[a, 1]
+        j00 += X[a, 0] * dN[a, 0]
+        j01 += X[a, 0] * dN[a, 1]
+        j10 += X[a, 1] * dN[a, 0]
+        j11 += X[a, 1] * dN[a, 1]
+        j20 += X[a, 2] * dN[a, 0]
+        j21 += X[a, 2] * dN[a, 1]
+    # J (J^T J)^-1: a face gradient (d/dxi, d/deta) to the surface gradient in space
+    a00 = j00 * j00 + j10 * j10 + j20 * j20
+    a01 = j00 * j01 + j10 * j11 + j20 * j21
+    a11 = j01 * j01 + j11 * j11 + j21 * j21
+    det = a00 * a11 - a01 * a01
+    i00 = a11 / det
+    i01 = -a01 / det
+    i11 = a00 / det
+    t = b.tangent[i]
+    t[0, 0] = j00 * i00 + j01 * i01
+    t[0, 1] = j00 * i01 + j01 * i11
+    t[1, 0] = j10 * i00 + j11 * i01
+    t[1, 1] = j10 * i01 + j11 * i11
+    t[2, 0] = j20 * i00 + j21 * i01
+    t[2, 1] = j20 * i01 + j21 * i11
 
 
 @njit(cache=True)
@@ -120,6 +146,68 @@ def surface_motion(b, buf, i, q, qd):
                 u2 += w * su
                 v2 += w * sv
     return u0, u1, u2, v0, v1, v2
+
+
+@njit(cache=True)
+def normal_motion(b, buf, i, q) -> float:
+    """The surface's normal displacement u_n = n . u_c [m] at granule i's contact point
+    (buffer buf), and its surface gradient (the deformed surface's tilt, [-]) into geo's
+    GEO_GX..GEO_GZ: J (J^T J)^-1 sum_a grad_xi(N_a) n . u_a."""
+    f = b.face[buf, i]
+    g = b.geo[buf, i]
+    nm = q.shape[0]
+    un = 0.0
+    d0 = 0.0
+    d1 = 0.0
+    for a in range(b.face_rows.shape[1]):
+        ua = 0.0
+        for c in range(3):
+            row = b.face_rows[f, a, c]
+            nc = g[GEO_NX + c]
+            if row < 0 or nc == 0.0:
+                continue
+            s = 0.0
+            for m in range(nm):
+                s += b.phi[row, m] * q[m]
+            ua += nc * s
+        un += b.weights[buf, i, a] * ua
+        d0 += b.dweights[i, a, 0] * ua
+        d1 += b.dweights[i, a, 1] * ua
+    t = b.tangent[i]
+    g[GEO_GX] = t[0, 0] * d0 + t[0, 1] * d1
+    g[GEO_GY] = t[1, 0] * d0 + t[1, 1] * d1
+    g[GEO_GZ] = t[2, 0] * d0 + t[2, 1] * d1
+    return un
+
+
+@njit(cache=True)
+def residual_tilt(b, buf, k, n_act, counts, out) -> None:
+    """The residual's pull along the surface on contact k of the n_act in touch (their
+    static forces in geo's GEO_NSTAT): out (3,) = N_k J (J^T J)^-1 grad_xi(r_k)^T R_S sum_j
+    r_j N_j [N], the force -dPi/dx of the residual energy Pi = 1/2 N^T R N as r_k's
+    weights move with the granule (docs/model.md section 3.9)."""
+    i = b.active[k]
+    g = b.geo[buf]
+    d0 = 0.0
+    d1 = 0.0
+    for e in range(counts[k]):
+        s = b.rcol[k, e]
+        z = 0.0
+        for j in range(n_act):
+            nj = g[b.active[j], GEO_NSTAT]
+            if nj == 0.0:
+                continue
+            for e2 in range(counts[j]):
+                z += b.resid[s, b.rcol[j, e2]] * b.rcoef[j, e2] * nj
+        node = b.rnode[k, e]
+        nc = g[i, GEO_NX + node % 3]
+        d0 += z * b.dweights[i, node // 3, 0] * nc
+        d1 += z * b.dweights[i, node // 3, 1] * nc
+    nk = g[i, GEO_NSTAT]
+    t = b.tangent[i]
+    out[0] = nk * (t[0, 0] * d0 + t[0, 1] * d1)
+    out[1] = nk * (t[1, 0] * d0 + t[1, 1] * d1)
+    out[2] = nk * (t[2, 0] * d0 + t[2, 1] * d1)
 
 
 @njit(cache=True)
@@ -177,6 +265,7 @@ def residual_rows(b, buf, i, k) -> int:
             if s < 0 or w == 0.0:
                 continue
             b.rcol[k, nt] = s
+            b.rnode[k, nt] = 3 * a + c
             b.rcoef[k, nt] = w * g[GEO_NX + c]
             nt += 1
     return nt
@@ -272,8 +361,7 @@ def contact_forces(y, q, qd, b, buf, radius, mass, clip, acc, fdamp, scale_acc):
         p[1] = y[i, X + 1]
         p[2] = y[i, X + 2]
         locate(b, buf, i, p, out, N, dN)
-        u0, u1, u2, _, _, _ = surface_motion(b, buf, i, q, qd)
-        d0 = surface_overlap(r, g[i, GEO_DIST], u0 * g[i, GEO_NX] + u1 * g[i, GEO_NY] + u2 * g[i, GEO_NZ])
+        d0 = surface_overlap(r, g[i, GEO_DIST], normal_motion(b, buf, i, q))
         if d0 <= 0.0:
             continue
         g[i, GEO_TOUCH] = 1.0
@@ -281,8 +369,10 @@ def contact_forces(y, q, qd, b, buf, radius, mass, clip, acc, fdamp, scale_acc):
         delta0[n_act] = d0
         n_act += 1
     e_static = 0.0
+    resid = b.resid.shape[0] > 0
+    tilt = np.zeros(3)
     if n_act > 0:
-        if b.resid.shape[0] > 0:
+        if resid:
             for k in range(n_act):
                 counts[k] = residual_rows(b, buf, b.active[k], k)
             residual_matrix(b, n_act, counts)
@@ -317,9 +407,20 @@ def contact_forces(y, q, qd, b, buf, radius, mass, clip, acc, fdamp, scale_acc):
         d = pv / ddot if pv != 0.0 else 0.0
         g[i, GEO_DAMP] = d
         inv = 1.0 / mass[i] if scale_acc else 1.0
-        acc[i, VX] += n * nx * inv
-        acc[i, VX + 1] += n * ny * inv
-        acc[i, VX + 2] += n * nz * inv
+        # the whole force along n, and the static force's pull along the deformed surface's
+        # tilt and the residual's weights (what makes the contact's work exact)
+        ns = g[i, GEO_NSTAT]
+        tx = -ns * g[i, GEO_GX]
+        ty = -ns * g[i, GEO_GY]
+        tz = -ns * g[i, GEO_GZ]
+        if resid:
+            residual_tilt(b, buf, k, n_act, counts, tilt)
+            tx += tilt[0]
+            ty += tilt[1]
+            tz += tilt[2]
+        acc[i, VX] += (n * nx + tx) * inv
+        acc[i, VX + 1] += (n * ny + ty) * inv
+        acc[i, VX + 2] += (n * nz + tz) * inv
         fdamp[i, VX] += d * nx
         fdamp[i, VX + 1] += d * ny
         fdamp[i, VX + 2] += d * nz
