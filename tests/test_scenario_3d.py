@@ -191,19 +191,20 @@ def test_3d_refusals_name_the_field(change, field, words):
     assert "\n" not in msg
 
 
-def test_a_valid_solid_validates_and_is_refused_to_run():
-    """A box solid clear of the spheres validates; build_model and simulate refuse it, naming
-    the plate, saying the coupling is missing and that `granplate show` draws it."""
-    import granplate as gp
+def test_solid_needs_the_verlet_scheme_and_then_builds():
+    """A box solid with the default (implicit) scheme is refused naming solver.scheme; with
+    "verlet" it validates and build_model gives the body's modes and contact arrays."""
     from granplate.model import build_model
 
-    s = scenario_io.from_dict(base(plate={"size": [0.1, 0.1, 0.005], "elements": [2, 2, 1]}))
+    d = base(plate={"size": [0.1, 0.1, 0.005], "elements": [2, 2, 1], "max_frequency": 5e4})
+    e = refused(d)
+    assert e.field == "solver.scheme" and "verlet" in str(e)
+    d["solver"] = {"scheme": "verlet", "granular_friction": "split"}
+    s = scenario_io.from_dict(d)
     validate(s)
-    for run in (build_model, lambda x: gp.simulate(x, progress=False)):
-        with pytest.raises(ScenarioError, match="coupling to the granules in 3D is not implemented yet.*"
-                                                "inspect it with `granplate show`") as e:
-            run(s)
-        assert e.value.field == "plate"
+    m = build_model(s)
+    assert m.solid is not None and m.body.phi.shape[1] == m.solid.n_modes == len(m.plate_arrays.omega2)
+    assert m.body.coef.shape[0] == len(m.labels)
 
 
 def test_scalar_omega_in_3d_is_refused():

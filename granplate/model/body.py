@@ -64,6 +64,12 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
     sd = s.plate
     material = s.material(sd.material)
     mesh = solid_mesh(sd)
+    if sd.mesh is not None:  # a mesh file's surface against the granules (a box's: setup.validate)
+        from granplate.setup.geometry import granule_named
+        from granplate.setup.validate import OVERLAP_RTOL
+        from granplate.solid.clearance import check_clearance
+
+        check_clearance(s, mesh, {i: granule_named(s, s, i) for i in range(len(s.granules))}, OVERLAP_RTOL)
     surface = boundary_surface(vector_basis(mesh, sd.element))
     face, components = residual_face(s, surface, mesh)
     solid = build_solid(sd, material, surface=face, components=components or "z")
