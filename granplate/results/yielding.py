@@ -37,8 +37,18 @@ def contact_yield(model, peaks) -> list[tuple[str, float, float, float, float, s
     of `peaks` (solver.driver.ContactPeaks)."""
     s, mats, r, labels = model.scenario, model.materials, model.granular.radius, model.labels
     rows = []
+    body = s.material(s.plate.material) if getattr(model, "solid", None) is not None else None  # an elastic solid
     for i, j, d, t in zip(peaks.granule, peaks.partner, peaks.delta_max, peaks.time):
         a = mats[i]
+        if j == PARTNER_PLATE and body is not None:
+            b = body
+            e_star, r_star = effective_modulus(a, b), r[i]
+            pair, who, law = f"{a.name}-plate", f"{labels[i]}-plate", normal_law_of(s, a.name, b.name)
+            y = softer_yield_strength(a, b)
+            p0 = hertz_peak_pressure(e_star, r_star, float(d))
+            ratio = p0 / limiting_pressure(y) if y is not None else math.nan
+            rows.append((pair, p0, ratio, math.nan if y is None else float(y), float(t), who, law))
+            continue
         if j >= 0:
             b = mats[j]
             e_star, r_star = effective_modulus(a, b), r[i] * r[j] / (r[i] + r[j])

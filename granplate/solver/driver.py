@@ -56,10 +56,13 @@ class ContactPeaks(NamedTuple):
     time: np.ndarray  # (n,) [s]: when it was reached
 
 
-def contact_peaks(g, stores: tuple[dict, dict]) -> ContactPeaks:
-    """The ContactPeaks of the lists of g (pairs, walls, plate contacts) and of the
-    histories off the lists (stores: pairs by (i, j), walls by (i, wall))."""
+def contact_peaks(g, stores: tuple[dict, dict], body=None) -> ContactPeaks:
+    """The ContactPeaks of the lists of g (pairs, walls, plate contacts), of the histories
+    off the lists (stores: pairs by (i, j), walls by (i, wall)) and of each granule's
+    contact on an elastic body in space (body: BodyArrays, partner PARTNER_PLATE)."""
     rows = [(int(i), int(j), h) for (i, j), h in zip(g.pair_ij, g.pair_hist)]
+    if body is not None:
+        rows += [(int(i), S.PARTNER_PLATE, h) for i, h in enumerate(body.hist)]
     rows += [(int(i), -1 - int(w), h) for i, w, h in zip(g.wall_i, g.wall_w, g.wall_hist)]
     rows += [(int(i), S.PARTNER_PLATE, h) for i, h in zip(g.pc_i, g.pc_hist)]
     rows += [(i, j, h) for (i, j), h in stores[0].items()]
@@ -228,11 +231,12 @@ class ContactLists:
         self.n_rebuilds = 0  # rebuilds the loop asked for (REBUILD, dynamic detection)
         self.formed: list[tuple[int, float, float]] = []  # patch contacts: (granule, t [s], y [m])
 
-    def changes(self) -> ContactChanges:
-        """The patch contacts formed so far and the rebuilds, as a ContactChanges."""
+    def changes(self, body=None) -> ContactChanges:
+        """The patch contacts formed so far and the rebuilds, as a ContactChanges (with the
+        contacts on an elastic body in space, model.inputs.BodyArrays, among the peaks)."""
         i, t, y = zip(*self.formed) if self.formed else ((), (), ())
         return ContactChanges(granule=np.array(i, np.int64), time=np.array(t, float), y=np.array(y, float),
-                              n_rebuilds=self.n_rebuilds, peaks=contact_peaks(self.g, self.stores))
+                              n_rebuilds=self.n_rebuilds, peaks=contact_peaks(self.g, self.stores, body))
 
     def refresh(self, y: np.ndarray) -> Missed | None:
         """Rebuild (dynamic) or check (fixed) the lists at positions y[:, :2]; returns the
@@ -570,11 +574,12 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
         "overlap_warnings": overlap_warnings(model, w),
     }
     message = "ok" if status == S.OK else status_message(status, model, st)
+    body = getattr(arr.sw, "body", None) if model.body is not None else None
     for line in info["overlap_warnings"]:
         warnings.warn(f"{model.scenario.name}: {line}: Hertz's law assumes overlaps small against the radii.",
                       RuntimeWarning, stacklevel=2)
     return RunRecord(out=arr.out, n_valid=int(st.count[S.C_OUT]), status=status, message=message, info=info,
-                     contacts=lists.changes(), body=getattr(arr.sw, "body", None) if model.body is not None else None)
+                     contacts=lists.changes(body), body=body)
 
 
 @contextmanager
