@@ -68,15 +68,23 @@ def test_3d_plate_is_a_solid_with_defaults():
     assert s.plate.max_frequency == SOLID_MAX_FREQUENCY == 1e5
 
 
-def test_valid_solid_validates_and_is_refused_to_run_with_the_reason():
-    """A valid solid validates; building its model refuses: the solid is valid, the coupling
-    is not there, `granplate show` draws it."""
+def test_valid_solid_validates_and_builds_its_model_with_the_verlet_scheme():
+    """A scenario file with a solid and no [solver] scheme reads with scheme "verlet" (the
+    scheme that couples a solid), validates and builds its model with the body's arrays; the
+    same scenario told to use "implicit" is refused naming solver.scheme."""
+    import dataclasses
+
     from granplate.model import build_model
 
-    validate(scenario())
-    with pytest.raises(ScenarioError, match="solid is valid.*not implemented.*granplate show") as e:
-        build_model(scenario())
-    assert e.value.field == "plate"
+    s = scenario()
+    assert s.solver.scheme == "verlet"
+    validate(s)
+    m = build_model(s)
+    assert m.body is not None and m.body.phi.shape == (len(m.solid.dofs), m.solid.n_modes)
+    bad = dataclasses.replace(s, solver=dataclasses.replace(s.solver, scheme="implicit"))
+    with pytest.raises(ScenarioError, match="verlet") as e:
+        validate(bad)
+    assert e.value.field == "solver.scheme"
 
 
 @pytest.mark.parametrize("change,field,words", [
@@ -169,17 +177,19 @@ def test_a_granule_beside_the_box_is_clear_of_it():
         validate(scenario_io.from_dict(d))
 
 
-def test_sweeps_and_optimisations_refuse_a_solid_before_a_worker_starts(tmp_path):
-    """A study whose base has a solid validates, and its sweep refuses at once (no cluster,
-    no record), naming the plate and `granplate show`."""
+def test_a_study_of_a_solid_gives_designs_that_build(tmp_path):
+    """A study whose base has a solid: every design's scenario reads back with the verlet
+    scheme, validates and builds its model (the sweep runs them as any other)."""
+    from granplate.model import build_model
     from granplate.study.spec import parse_study
-    from granplate.study.sweep import sweep
 
     (tmp_path / "base.toml").write_text(scenario_io.dumps(scenario()))
-    study = parse_study({"base": "base.toml", "parameters": {"granules[0].z": [0.02, 0.03]}}, tmp_path)
-    with pytest.raises(ScenarioError, match="not implemented.*granplate show") as e:
-        sweep(study, tmp_path / "out", progress=False)
-    assert e.value.field == "plate" and not list((tmp_path / "out" / "designs").iterdir())
+    study = parse_study({"base": "base.toml", "parameters": {"granules[0].z": [0.0061, 0.007]}}, tmp_path)
+    for i in range(2):
+        s = study.scenario(i)
+        assert s.solver.scheme == "verlet"
+        validate(s)
+        assert build_model(s).body is not None
 
 
 def test_a_solid_alone_and_the_other_dimension_s_plate():

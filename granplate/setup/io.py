@@ -279,6 +279,9 @@ def from_dict(d: dict) -> Scenario:
         kw["walls"] = _walls(d["walls"], kw.get("dimension", 2))
     if kw.get("dimension") == 3 and d.get("load") is None:
         kw["load"] = Load(kind="none")  # the plane's default line load has no meaning in space
+    if isinstance(kw.get("plate"), Solid) and "scheme" not in (d.get("solver") or {}):
+        # an elastic solid in space is coupled by velocity Verlet (docs/model.md section 3.9)
+        kw["solver"] = dataclasses.replace(kw.get("solver", Solver()), scheme="verlet")
     return Scenario(**kw)
 
 
