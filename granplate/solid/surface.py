@@ -46,6 +46,9 @@ _TRI_NODES = np.array([[0, 0], [1, 0], [0, 1], [0.5, 0], [0.5, 0.5], [0, 0.5]], 
 #: Newton iterations of a projection, and its step tolerance in reference coordinates.
 _NEWTON_ITERATIONS = 30
 _NEWTON_TOL = 1e-14
+#: How far inside its face's edges (in reference coordinates) a foot lets
+#: `follow_closest` skip the neighbours.
+INTERIOR = 1e-6
 #: A face lies within this factor times its largest node distance of its nodes' centroid
 #: (room for the bulge of a curved quadratic face).
 _BULGE = 1.25
@@ -441,6 +444,21 @@ def slide_closest(nodes, kind, neighbours, face, p, out):
     out[0:5] = best_out
     contact_frame(nodes[face], kind, p, out)
     return face
+
+
+@njit(cache=True)
+def follow_closest(nodes, kind, neighbours, face, p, out):
+    """`slide_closest`, with a shortcut for a centre outside the body whose foot stays
+    inside its face (reference coordinates within INTERIOR of the face's edges): that foot
+    is the closest point of a convex body (a local minimum of the distance from outside a
+    convex set is the global one), and no neighbour is projected. Returns the face (out as
+    `slide_closest`'s). About a tenth of its cost on a face's interior."""
+    d2 = face_closest(nodes[face], kind, p, out)
+    if _inside(kind, out[0], out[1], -INTERIOR) and d2 > 0.0:
+        contact_frame(nodes[face], kind, p, out)
+        if out[8] > 0.0:
+            return face
+    return slide_closest(nodes, kind, neighbours, face, p, out)
 
 
 # --------------------------------------------------------------------------------------

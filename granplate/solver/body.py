@@ -35,7 +35,7 @@ from granplate.model.inputs import (
 from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm
 from granplate.physics.laws import normal_law_force, normal_law_response, normal_law_slopes
 from granplate.physics.space import friction_along_slip, normal_rate_3d, slip_velocity_3d, surface_overlap
-from granplate.solid.surface import face_shape_functions, slide_closest
+from granplate.solid.surface import face_shape_functions, follow_closest
 from granplate.solver.granular import friction_impulse
 from granplate.solver.granular3d import VX, WX, X, apply_friction_impulse
 
@@ -75,7 +75,7 @@ def locate(b, buf, i, p, out, N, dN) -> None:
     buf (face, face coordinates, signed distance, normal, weights), searched from the face
     it last touched."""
     seed = b.face[buf, i] if b.face[buf, i] >= 0 else b.face[1 - buf, i]
-    f = slide_closest(b.face_nodes, b.kind[0], b.neighbours, seed, p, out)
+    f = follow_closest(b.face_nodes, b.kind[0], b.neighbours, seed, p, out)
     b.face[buf, i] = f
     g = b.geo[buf, i]
     g[GEO_XI] = out[0]
