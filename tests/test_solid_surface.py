@@ -9,7 +9,7 @@ from skfem import Basis, ElementHex2, ElementHexS2, ElementTetP2, ElementVector,
 
 from granplate.errors import ScenarioError
 from granplate.solid.surface import (QUAD8, QUAD9, TRI6, boundary_surface, closest_point, face_closest,
-                                     face_neighbours, patch_weights, slide_closest)
+                                     face_neighbours, follow_closest, patch_weights, slide_closest)
 
 #: The unit cube [0, 1]^3 meshed in 2 x 2 x 2 hexes or 48 tets, with each quadratic element.
 ELEMENTS = {"hex20": (MeshHex, ElementHexS2, QUAD8), "hex27": (MeshHex, ElementHex2, QUAD9),
@@ -104,10 +104,12 @@ def box_basis(name: str) -> Basis:
     return Basis(mesh, ElementVector(element()))
 
 
+@pytest.mark.parametrize("follow", [False, True])
 @pytest.mark.parametrize("name", ["hex20", "tet10"])
-def test_sliding_projection_equals_brute_force(name):
+def test_sliding_projection_equals_brute_force(name, follow):
     """A seeded random walk around a box (outside and just inside): the compiled sliding
-    projection from the previous face gives the brute-force closest point over all faces."""
+    projection from the previous face (and `follow_closest`, which stays on a face whose
+    interior holds the foot) gives the brute-force closest point over all faces."""
     rng = np.random.default_rng(7)
     s = boundary_surface(box_basis(name))
     nb = face_neighbours(s)
@@ -123,7 +125,7 @@ def test_sliding_projection_equals_brute_force(name):
         if not (0.0 < outside < 0.3 or 0.0 < inside < 0.1):
             continue
         p = trial
-        face = slide_closest(s.nodes, s.kind, nb, face, p, out)
+        face = (follow_closest if follow else slide_closest)(s.nodes, s.kind, nb, face, p, out)
         d2, points = brute_force(s, p)
         assert np.isclose(out[8], outside if outside > 0 else -inside, rtol=1e-10, atol=1e-13)
         assert np.isclose(out[8] ** 2, d2, rtol=1e-10, atol=1e-14)
