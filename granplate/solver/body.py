@@ -181,28 +181,21 @@ def normal_motion(b, buf, i, q) -> float:
 
 
 @njit(cache=True)
-def residual_tilt(b, buf, k, n_act, counts, out) -> None:
-    """The residual's pull along the surface on contact k of the n_act in touch (their
-    static forces in geo's GEO_NSTAT): out (3,) = N_k J (J^T J)^-1 grad_xi(r_k)^T R_S sum_j
-    r_j N_j [N], the force -dPi/dx of the residual energy Pi = 1/2 N^T R N as r_k's
-    weights move with the granule (docs/model.md section 3.9)."""
+def residual_tilt(b, buf, k, counts, upos, z, out) -> None:
+    """The residual's pull along the surface on contact k (its static force in geo's
+    GEO_NSTAT; z = R_S sum_j r_j N_j on the touched dofs, `residual_load`): out (3,) =
+    N_k J (J^T J)^-1 grad_xi(r_k)^T z [N], the force -dPi/dx of the residual energy Pi =
+    1/2 N^T R N as r_k's weights move with the granule (docs/model.md section 3.9)."""
     i = b.active[k]
     g = b.geo[buf]
     d0 = 0.0
     d1 = 0.0
     for e in range(counts[k]):
-        s = b.rcol[k, e]
-        z = 0.0
-        for j in range(n_act):
-            nj = g[b.active[j], GEO_NSTAT]
-            if nj == 0.0:
-                continue
-            for e2 in range(counts[j]):
-                z += b.resid[s, b.rcol[j, e2]] * b.rcoef[j, e2] * nj
+        ze = z[upos[b.rcol[k, e]]]
         node = b.rnode[k, e]
         nc = g[i, GEO_NX + node % 3]
-        d0 += z * b.dweights[i, node // 3, 0] * nc
-        d1 += z * b.dweights[i, node // 3, 1] * nc
+        d0 += ze * b.dweights[i, node // 3, 0] * nc
+        d1 += ze * b.dweights[i, node // 3, 1] * nc
     nk = g[i, GEO_NSTAT]
     t = b.tangent[i]
     out[0] = nk * (t[0, 0] * d0 + t[0, 1] * d1)
@@ -272,18 +265,56 @@ def residual_rows(b, buf, i, k) -> int:
 
 
 @njit(cache=True)
-def residual_matrix(b, n_act, counts) -> None:
-    """rmat[k, j] = r_k^T R_S r_j [m/N] between the contacts in touch."""
+def touched_dofs(b, n_act, counts, upos, ulist) -> int:
+    """The residual dofs U the contacts in touch load: ulist[:n] (n returned), upos[s] their
+    position in it (upos all -1 on entry)."""
+    n = 0
     for k in range(n_act):
+        for e in range(counts[k]):
+            s = b.rcol[k, e]
+            if upos[s] < 0:
+                upos[s] = n
+                ulist[n] = s
+                n += 1
+    return n
+
+
+@njit(cache=True)
+def residual_matrix(b, n_act, counts, upos, ulist, n_u, row) -> None:
+    """rmat[k, j] = r_k^T R_S r_j [m/N] between the contacts in touch: for each k its row
+    r_k^T R_S over the touched dofs U, then its products with every r_j (j >= k)."""
+    for k in range(n_act):
+        for a in range(n_u):
+            row[a] = 0.0
+        for e in range(counts[k]):
+            ce = b.rcoef[k, e]
+            r = b.resid[b.rcol[k, e]]
+            for a in range(n_u):
+                row[a] += ce * r[ulist[a]]
         for j in range(k, n_act):
             s = 0.0
-            for e in range(counts[k]):
-                ce = b.rcoef[k, e]
-                row = b.rcol[k, e]
-                for e2 in range(counts[j]):
-                    s += ce * b.resid[row, b.rcol[j, e2]] * b.rcoef[j, e2]
+            for e2 in range(counts[j]):
+                s += row[upos[b.rcol[j, e2]]] * b.rcoef[j, e2]
             b.rmat[k, j] = s
             b.rmat[j, k] = s
+
+
+@njit(cache=True)
+def residual_load(b, buf, n_act, counts, ulist, upos, n_u, v, z) -> None:
+    """z = R_S v on the touched dofs U, v = sum_j r_j N_j (the static forces on S) [m]."""
+    g = b.geo[buf]
+    for a in range(n_u):
+        v[a] = 0.0
+    for k in range(n_act):
+        nk = g[b.active[k], GEO_NSTAT]
+        for e in range(counts[k]):
+            v[upos[b.rcol[k, e]]] += b.rcoef[k, e] * nk
+    for a in range(n_u):
+        r = b.resid[ulist[a]]
+        s = 0.0
+        for c in range(n_u):
+            s += r[ulist[c]] * v[c]
+        z[a] = s
 
 
 @njit(cache=True)
@@ -371,16 +402,25 @@ def contact_forces(y, q, qd, b, buf, radius, mass, clip, acc, fdamp, scale_acc):
     e_static = 0.0
     resid = b.resid.shape[0] > 0
     tilt = np.zeros(3)
+    n_s = b.resid.shape[0]
+    upos = np.full(n_s, -1, np.int64)
+    ulist = np.empty(n_s, np.int64)
+    n_u = 0
     if n_act > 0:
         if resid:
             for k in range(n_act):
                 counts[k] = residual_rows(b, buf, b.active[k], k)
-            residual_matrix(b, n_act, counts)
+            n_u = touched_dofs(b, n_act, counts, upos, ulist)
+            row = np.empty(n_u)
+            residual_matrix(b, n_act, counts, upos, ulist, n_u, row)
         else:
             for k in range(n_act):
                 for j in range(n_act):
                     b.rmat[k, j] = 0.0
         e_static = solve_static(b, buf, n_act, delta0, clip)
+    z = np.empty(n_u)
+    if resid and n_act > 0:
+        residual_load(b, buf, n_act, counts, ulist, upos, n_u, np.empty(n_u), z)
     e_pot = 0.0
     p_visc = 0.0
     w_plastic = 0.0
@@ -397,8 +437,11 @@ def contact_forces(y, q, qd, b, buf, radius, mass, clip, acc, fdamp, scale_acc):
         ny = g[i, GEO_NY]
         nz = g[i, GEO_NZ]
         _, _, _, v0, v1, v2 = surface_motion(b, buf, i, q, qd)
-        # the overlap's rate, with the normal from the granule into the body (-n)
+        # the overlap's rate, with the normal from the granule into the body (-n); the
+        # residual in series takes its share, d delta = d delta0 / (1 + R_kk F'(delta))
         ddot = normal_rate_3d(y[i, VX] - v0, y[i, VX + 1] - v1, y[i, VX + 2] - v2, -nx, -ny, -nz)
+        if resid and b.rmat[k, k] > 0.0:
+            ddot /= 1.0 + b.rmat[k, k] * normal_law_slopes(delta, b.coef[i], b.hist[i, HIST_MAX])[0]
         n, pv, ep, wp = normal_law_response(delta, ddot, b.coef[i], b.hist[i, HIST_MAX], clip)
         g[i, GEO_N] = n
         e_pot += ep
@@ -414,7 +457,7 @@ def contact_forces(y, q, qd, b, buf, radius, mass, clip, acc, fdamp, scale_acc):
         ty = -ns * g[i, GEO_GY]
         tz = -ns * g[i, GEO_GZ]
         if resid:
-            residual_tilt(b, buf, k, n_act, counts, tilt)
+            residual_tilt(b, buf, k, counts, upos, z, tilt)
             tx += tilt[0]
             ty += tilt[1]
             tz += tilt[2]
