@@ -68,8 +68,9 @@ def hunter_radiated_fraction(speed: float, young: float, rho: float) -> float:
     """W / (m v0^2 / 2) = 1.04 (v0 / c0)^(3/5), c0 = sqrt(E / rho): the share of a sphere's
     kinetic energy that the elastic waves radiated into a half-space carry away in a
     Hertzian impact (S. C. Hunter, J. Mech. Phys. Solids 5, 162, 1957, for a steel sphere
-    on a thick steel body; quoted by Johnson 1985, section 11.4). Small: 1 - e^2 of a
-    wave-radiation loss alone."""
+    on a thick steel body; the coefficient as Johnson 1985, section 11.4, quotes it, the
+    paper itself not at hand). Small: 1 - e^2 of a wave-radiation loss alone.
+    """
     return 1.04 * (speed / math.sqrt(young / rho)) ** 0.6
 
 
