@@ -25,6 +25,10 @@ the page this writes, regenerated with --full):
 - plate_mesh.py: the truncated modal basis against the full one (4 x 40; 8 x 80 with --full)
   and (slow, --full) the plate's mesh convergence to 32 x 320: the bare plate's E_shock from
   the modal closed form, steel-r1's plate share and disc-averaged stress, observed orders;
+- solid_cases.py: the 3D elastic solid: clamped plates' frequencies and statics against
+  Kirchhoff and Mindlin, and coupled sphere impacts against Hertz on growing blocks
+  (Hunter's radiation), Zener on a large thin plate, and all modes against truncated ones
+  with the residual compliance;
 - conservation.py: energy residual of every preset, momenta of a free assembly, forces
   equal minus the gradient of the contact energies;
 - coupled.py (slow, --full): convergence of the PTFE and steel presets under halving of
