@@ -115,12 +115,11 @@ def locate(b, buf, i, p, out, N, dN) -> None:
 
 
 @njit(cache=True)
-def surface_motion(b, buf, i, q, qd):
-    """The surface's displacement and velocity at granule i's contact point (buffer buf):
-    sum_a w_a Phi_a q and sum_a w_a Phi_a qd, [m] and [m/s] (x, y, z each)."""
+def surface_velocity(b, buf, i, qd):
+    """The surface's velocity at granule i's contact point (buffer buf), sum_a w_a Phi_a qd
+    [m/s] (x, y, z)."""
     f = b.face[buf, i]
-    nm = q.shape[0]
-    u0 = u1 = u2 = 0.0
+    nm = qd.shape[0]
     v0 = v1 = v2 = 0.0
     for a in range(b.face_rows.shape[1]):
         w = b.weights[buf, i, a]
@@ -130,22 +129,16 @@ def surface_motion(b, buf, i, q, qd):
             row = b.face_rows[f, a, c]
             if row < 0:
                 continue
-            su = 0.0
             sv = 0.0
             for m in range(nm):
-                phi = b.phi[row, m]
-                su += phi * q[m]
-                sv += phi * qd[m]
+                sv += b.phi[row, m] * qd[m]
             if c == 0:
-                u0 += w * su
                 v0 += w * sv
             elif c == 1:
-                u1 += w * su
                 v1 += w * sv
             else:
-                u2 += w * su
                 v2 += w * sv
-    return u0, u1, u2, v0, v1, v2
+    return v0, v1, v2
 
 
 @njit(cache=True)
@@ -219,6 +212,28 @@ def spread(b, buf, i, fx, fy, fz, out, scale) -> None:
             fc = w * (fx if c == 0 else (fy if c == 1 else fz))
             for m in range(out.shape[0]):
                 out[m] += b.phi[row, m] * fc
+
+
+@njit(cache=True)
+def spread_both(b, buf, i, nx, ny, nz, n, d, out, out_d) -> None:
+    """out += Phi^T (w (x) n N) and out_d += Phi^T (w (x) n D) in one pass over the rows:
+    a normal force N n and its damping part D n [N] at granule i's contact point."""
+    f = b.face[buf, i]
+    for a in range(b.face_rows.shape[1]):
+        w = b.weights[buf, i, a]
+        if w == 0.0:
+            continue
+        for c in range(3):
+            row = b.face_rows[f, a, c]
+            nc = nx if c == 0 else (ny if c == 1 else nz)
+            if row < 0 or nc == 0.0:
+                continue
+            fc = w * nc * n
+            fd = w * nc * d
+            for m in range(out.shape[0]):
+                phi = b.phi[row, m]
+                out[m] += phi * fc
+                out_d[m] += phi * fd
 
 
 @njit(cache=True)
@@ -436,7 +451,7 @@ def contact_forces(y, q, qd, b, buf, radius, mass, clip, acc, fdamp, scale_acc):
         nx = g[i, GEO_NX]
         ny = g[i, GEO_NY]
         nz = g[i, GEO_NZ]
-        _, _, _, v0, v1, v2 = surface_motion(b, buf, i, q, qd)
+        v0, v1, v2 = surface_velocity(b, buf, i, qd)
         # the overlap's rate, with the normal from the granule into the body (-n); the
         # residual in series takes its share, d delta = d delta0 / (1 + R_kk F'(delta))
         ddot = normal_rate_3d(y[i, VX] - v0, y[i, VX + 1] - v1, y[i, VX + 2] - v2, -nx, -ny, -nz)
@@ -467,9 +482,7 @@ def contact_forces(y, q, qd, b, buf, radius, mass, clip, acc, fdamp, scale_acc):
         fdamp[i, VX] += d * nx
         fdamp[i, VX + 1] += d * ny
         fdamp[i, VX + 2] += d * nz
-        spread(b, buf, i, -n * nx, -n * ny, -n * nz, b.fmodal[buf], 1.0)
-        if d != 0.0:
-            spread(b, buf, i, -d * nx, -d * ny, -d * nz, b.fdamp[buf], 1.0)
+        spread_both(b, buf, i, nx, ny, nz, -n, -d, b.fmodal[buf], b.fdamp[buf])
         if delta > ovl * r:
             ovl = delta / r
             ovl_i = i
@@ -549,7 +562,7 @@ def friction_flow(y, qd, dt, b, buf, radius, mass, inertia, arm_shrink, forward)
         ny = -g[i, GEO_NY]
         nz = -g[i, GEO_NZ]
         a = contact_arm(radius[i], g[i, GEO_DELTA], arm_shrink)
-        _, _, _, v0, v1, v2 = surface_motion(b, buf, i, b.q, qd)
+        v0, v1, v2 = surface_velocity(b, buf, i, qd)
         vsx, vsy, vsz = slip_velocity_3d(y[i, VX] - v0, y[i, VX + 1] - v1, y[i, VX + 2] - v2,
                                          a * y[i, WX], a * y[i, WX + 1], a * y[i, WX + 2], nx, ny, nz)
         speed = math.sqrt(vsx * vsx + vsy * vsy + vsz * vsz)
