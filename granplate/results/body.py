@@ -1,0 +1,231 @@
+"""The elastic body's fields after a run in space (dimension = 3): displacement, von Mises
+stress, the ball-averaged von Mises stress, at every output time, and snapshots.
+
+The body's displacement at output time t, on the reduced (free) dofs [m]:
+
+    u(t) = Phi q(t) + u_s(t),   u_s = G f - Phi_e diag(1/omega_e^2) Phi_e^T f,
+
+q (n_modes,) the modal coordinates [kg^1/2 m], f(t) the nodal forces of the contact forces
+on the body (`solid.loads.nodal_force_history`: each granule's force spread over its face's
+nodes by the face's shape functions at its contact point), G the static flexibility K^-1
+of a held body or the inertia-relief flexibility of a free one (`SolidModel._flexibility`,
+one factorisation), Phi_e, omega_e the kept elastic modes: u_s is the static residual of
+the modes the truncation drops. It is evaluated at EVERY output time where a contact force
+acts, exactly (no bound, no skipped time), as
+
+    u = Phi q_eff + G f,   q_eff = q - diag(1/omega_e^2) Phi_e^T f   (rigid modes: q),
+
+with G f from one of two routes, whichever solves fewer systems: G's columns at the dofs
+the run loads (those with a nodal force at some output time), solved once and multiplied
+by each time's forces, or one multi-right-hand-side solve per block of times (the loaded
+times only). The fixed dofs' displacement is 0.
+
+Per output time (`time`): `max_displacement`, the largest |u| over the nodes [m];
+`max_von_mises`, the largest von Mises stress over the quadrature points of every element
+[Pa] (`solid.stress`: the strains from the vector basis' strain operator, sigma = D eps);
+`max_von_mises_ball`, the largest mean of the von Mises stress over a ball of radius
+`ball_radius` about each point of the body's surface (`stress.surface_centres`, the
+boundary nodes), cut by the body, partial cells by a linear ramp (`stress.ball_operator`):
+the 3D analogue of the plate's disc average. At the field times (every field_stride-th
+output time and the last, `field_time`): the nodal displacement `body_ux/uy/uz`
+(field_time, body_node) [m] and the largest von Mises stress in each element
+`body_von_mises` (field_time, body_element) [Pa], with the nodes' coordinates
+`body_node_x/y/z` and the elements' nodes `body_element_nodes` in VTK's order
+(`solid.vtk_cells`; its attribute `cell_type` names meshio's cell type).
+
+Blocks of output times bound the memory (BLOCK_BYTES of strains and stresses at a time).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+import scipy.sparse as sp
+import xarray as xr
+
+from granplate.solid.factor import one_blas_thread
+from granplate.solid.fe import vector_basis
+from granplate.solid.loads import nodal_force_history
+from granplate.solid.stress import ball_operator, elasticity_matrix, strain_operator, surface_centres, von_mises
+from granplate.solid.surface import Surface, boundary_surface
+from granplate.solid.vtk_cells import MESHIO_CELLS, vtk_connectivity
+
+#: Bytes of strains, stresses and displacements one block of output times may hold.
+BLOCK_BYTES = 96 * 2**20
+#: Bytes the static responses to unit loads at the loaded dofs may hold (else: a solve per time).
+UNIT_BYTES = 256 * 2**20
+#: Unit loads solved per call.
+UNIT_CHUNK = 64
+
+#: name -> (units, description) of the body's variables.
+BODY_VARIABLES: dict[str, tuple[str, str]] = {
+    "max_von_mises": ("Pa", "largest von Mises stress over the body's quadrature points (modes and the static residual of the contact forces)"),
+    "max_von_mises_ball": ("Pa", "largest mean von Mises stress over a ball of radius ball_radius about a point of the body's surface, cut by the body"),
+    "max_displacement": ("m", "largest displacement magnitude over the body's nodes (modes and the static residual)"),
+    "body_ux": ("m", "body nodal displacement, x (at field_time)"),
+    "body_uy": ("m", "body nodal displacement, y (at field_time)"),
+    "body_uz": ("m", "body nodal displacement, z (at field_time)"),
+    "body_von_mises": ("Pa", "largest von Mises stress over each element's quadrature points (at field_time)"),
+}
+#: What summary_only keeps.
+BODY_SUMMARY = ("max_von_mises", "max_von_mises_ball", "max_displacement")
+
+
+@dataclass(frozen=True)
+class BodyOperators:
+    """What evaluating the body's fields needs, built once per solid and radius: the
+    boundary faces, the strain operator (6 n_points, 3 n_nodes), D [Pa], the ball
+    operator (n_centres, n_points), the elastic modes' mask."""
+
+    surface: Surface
+    strain: sp.csr_matrix
+    D: np.ndarray
+    ball: sp.csr_matrix
+    elastic: np.ndarray
+    n_qp: int
+
+
+def body_operators(solid, ball_radius: float, surface: Surface | None = None) -> BodyOperators:
+    """The operators of `body_data` for a built solid (SolidModel)."""
+    vb = vector_basis(solid.mesh, solid.element)
+    return BodyOperators(surface=boundary_surface(vb) if surface is None else surface,
+                         strain=strain_operator(vb), D=elasticity_matrix(solid.material.E, solid.material.nu),
+                         ball=ball_operator(solid.basis, surface_centres(solid.basis), ball_radius),
+                         elastic=solid.omega > 0.0, n_qp=int(solid.basis.dx.shape[1]))
+
+
+def field_indices(n: int, stride: int) -> np.ndarray:
+    """The output indices of the field snapshots: every stride-th of n, and the last."""
+    idx = np.arange(0, n, max(int(stride), 1))
+    return np.append(idx, n - 1) if n and idx[-1] != n - 1 else idx
+
+
+class StaticPart:
+    """x = G f [m] for the nodal forces of a block of times, by the cheaper route (module
+    docstring): G's columns at the loaded dofs, or one solve per loaded time."""
+
+    def __init__(self, solid, dofs: np.ndarray, n_loaded_times: int):
+        with one_blas_thread():
+            self.solve = solid._flexibility
+        self.n = len(solid.dofs)
+        self.dofs = dofs
+        self.columns = None
+        if 0 < len(dofs) <= n_loaded_times and len(dofs) * self.n * 8 <= UNIT_BYTES:
+            self.columns = np.empty((self.n, len(dofs)))
+            for start in range(0, len(dofs), UNIT_CHUNK):
+                cols = dofs[start:start + UNIT_CHUNK]
+                f = np.zeros((self.n, len(cols)))
+                f[cols, np.arange(len(cols))] = 1.0
+                with one_blas_thread():  # SuperLU's small blocks (solid.factor)
+                    self.columns[:, start:start + len(cols)] = self.solve(f)
+
+    def __call__(self, F: sp.csr_matrix) -> np.ndarray:
+        """(n_red, n_t) G f of forces F (n_t, n_red) [N]."""
+        out = np.zeros((self.n, F.shape[0]))
+        if F.nnz == 0:
+            return out
+        if self.columns is not None:
+            return self.columns @ F[:, self.dofs].T.toarray()
+        rows = np.flatnonzero(np.diff(F.indptr))
+        with one_blas_thread():
+            out[:, rows] = self.solve(F[rows].T.toarray())
+        return out
+
+
+def block_size(n_points: int, n_full: int) -> int:
+    """Output times per block: BLOCK_BYTES over the bytes one time needs (strains,
+    stresses and von Mises at the quadrature points, the displacements)."""
+    per_time = 8 * (13 * n_points + 3 * n_full)
+    return int(np.clip(BLOCK_BYTES // per_time, 1, 512))
+
+
+def _var(name: str, dims, data) -> xr.DataArray:
+    units, desc = BODY_VARIABLES[name]
+    return xr.DataArray(data, dims=dims, attrs={"units": units, "long_name": desc})
+
+
+def body_data(solid, q: np.ndarray, qd: np.ndarray, times: np.ndarray, contact_face: np.ndarray,
+              contact_xi: np.ndarray, contact_force: np.ndarray, field_stride: int, ball_radius: float,
+              summary_only: bool = False, should_stop: Callable[[], bool] | None = None,
+              operators: BodyOperators | None = None) -> tuple[dict[str, xr.DataArray], dict]:
+    """The body's data variables and coordinates for the result Dataset (module docstring).
+
+    solid: the built solid (solid.build.SolidModel); q, qd (n_t, n_modes): the modal
+    coordinates [kg^1/2 m] and velocities [kg^1/2 m/s] (qd is not needed by these fields);
+    times (n_t,) [s]; contact_face (n_t, n_g) int: the boundary face
+    (`surface.boundary_surface` of the solid's vector basis) each granule touches, -1 for
+    none; contact_xi (n_t, n_g, 2): the reference point on it; contact_force (n_t, n_g, 3)
+    [N]: the force on the body there; field_stride: output times between snapshots;
+    ball_radius [m]; summary_only: only the per-time maxima (BODY_SUMMARY), no
+    coordinates; should_stop: polled after each block of times: when it says yes, the
+    variables cover the output times computed so far (their `time` length says how many);
+    operators: `body_operators` built before (default: built here).
+
+    Returns (data variables, coordinates as name -> (dims, values, attrs))."""
+    q = np.asarray(q, float)
+    n_t = len(q)
+    if q.shape != (n_t, solid.n_modes):
+        raise ValueError(f"q must be (n_t, {solid.n_modes}), not {q.shape}")
+    if int(field_stride) < 1:
+        raise ValueError(f"field_stride must be a positive integer, not {field_stride}")
+    face = np.asarray(contact_face, np.int64).reshape(n_t, -1)
+    n_g = face.shape[1]
+    xi = np.asarray(contact_xi, float).reshape(n_t, n_g, 2)
+    force = np.asarray(contact_force, float).reshape(n_t, n_g, 3)
+    ops = body_operators(solid, ball_radius) if operators is None else operators
+    n_nodes = solid.nodes.shape[0]
+    n_full = 3 * n_nodes
+    n_points = ops.strain.shape[0] // 6
+    n_elem = n_points // ops.n_qp
+    phi_e = solid.Phi[:, ops.elastic] / solid.omega[ops.elastic] ** 2  # (n_red, n_elastic) [m/N]
+    F_all = nodal_force_history(ops.surface, solid.dofs, n_full, face, xi, force)  # (n_t, n_red) [N]
+    static = StaticPart(solid, np.unique(F_all.indices), int(np.sum(np.diff(F_all.indptr) > 0)))
+    fields = np.zeros(0, np.int64) if summary_only else field_indices(n_t, field_stride)
+    vm_max, ball_max, u_max = np.zeros(n_t), np.zeros(n_t), np.zeros(n_t)
+    u_field = np.zeros((len(fields), n_nodes, 3))
+    vm_field = np.zeros((len(fields), n_elem))
+    B = block_size(n_points, n_full)
+    done = 0
+    for start in range(0, n_t, B):
+        rows = slice(start, min(start + B, n_t))
+        F = F_all[rows]
+        q_eff = q[rows].copy()
+        q_eff[:, ops.elastic] -= np.asarray(F @ phi_e)
+        u_red = solid.Phi @ q_eff.T + static(F)  # (n_red, b)
+        u = np.zeros((n_full, u_red.shape[1]))
+        u[solid.dofs] = u_red
+        nodal = u.reshape(n_nodes, 3, -1)
+        u_max[rows] = np.sqrt(np.einsum("nck,nck->nk", nodal, nodal)).max(axis=0)
+        eps = (ops.strain @ u).reshape(6, -1)  # (6, n_points b): component, point, time
+        vm = von_mises(ops.D @ eps).reshape(n_points, -1)  # (n_points, b) [Pa]
+        vm_max[rows] = vm.max(axis=0)
+        ball_max[rows] = (ops.ball @ vm).max(axis=0) if ops.ball.shape[0] else 0.0
+        snaps = np.flatnonzero((fields >= rows.start) & (fields < rows.stop))
+        if len(snaps):
+            k = fields[snaps] - rows.start
+            u_field[snaps] = np.moveaxis(nodal[:, :, k], -1, 0)
+            vm_field[snaps] = vm[:, k].reshape(n_elem, ops.n_qp, len(k)).max(axis=1).T
+        done = rows.stop
+        if should_stop is not None and done < n_t and should_stop():
+            break
+    kept = int(np.sum(fields < done))
+    data = {"max_von_mises": _var("max_von_mises", ("time",), vm_max[:done]),
+            "max_von_mises_ball": _var("max_von_mises_ball", ("time",), ball_max[:done]),
+            "max_displacement": _var("max_displacement", ("time",), u_max[:done])}
+    data["max_von_mises_ball"].attrs["ball_radius"] = float(ball_radius)
+    if summary_only:
+        return data, {}
+    for c, axis in enumerate("xyz"):
+        data[f"body_u{axis}"] = _var(f"body_u{axis}", ("field_time", "body_node"), u_field[:kept, :, c].copy())
+    data["body_von_mises"] = _var("body_von_mises", ("field_time", "body_element"), vm_field[:kept])
+    coords = {"field_time": ("field_time", np.asarray(times, float)[fields[:kept]],
+                             {"units": "s", "long_name": "time of the body field snapshots"})}
+    for c, axis in enumerate("xyz"):
+        coords[f"body_node_{axis}"] = ("body_node", solid.nodes[:, c].copy(),
+                                       {"units": "m", "long_name": f"body node {axis}"})
+    coords["body_element_nodes"] = (("body_element", "body_element_node"), vtk_connectivity(solid.basis, solid.element),
+                                    {"long_name": f"body element nodes in VTK order (meshio cell type "
+                                                  f"{MESHIO_CELLS[solid.element]})",
+                                     "cell_type": MESHIO_CELLS[solid.element]})
+    return data, coords
