@@ -101,6 +101,17 @@ def field_indices(n: int, stride: int) -> np.ndarray:
     return np.append(idx, n - 1) if n and idx[-1] != n - 1 else idx
 
 
+def loaded_dofs(forces: Callable[[slice], sp.csr_matrix], n_t: int, block: int) -> tuple[np.ndarray, int]:
+    """(the reduced dofs with a nodal force at some output time, the number of output times
+    with any), from forces(rows) (b, n_red) [N] a block of times at a time."""
+    dofs, n_loaded = [], 0
+    for start in range(0, n_t, block):
+        F = forces(slice(start, min(start + block, n_t)))
+        dofs.append(np.unique(F.indices))
+        n_loaded += int(np.sum(np.diff(F.indptr) > 0))
+    return (np.unique(np.concatenate(dofs)) if dofs else np.zeros(0, np.int64)), n_loaded
+
+
 class StaticPart:
     """x = G f [m] for the nodal forces of a block of times, by the cheaper route (module
     docstring): G's columns at the loaded dofs, or one solve per loaded time."""
@@ -179,17 +190,21 @@ def body_data(solid, q: np.ndarray, qd: np.ndarray, times: np.ndarray, contact_f
     n_points = ops.strain.shape[0] // 6
     n_elem = n_points // ops.n_qp
     phi_e = solid.Phi[:, ops.elastic] / solid.omega[ops.elastic] ** 2  # (n_red, n_elastic) [m/N]
-    F_all = nodal_force_history(ops.surface, solid.dofs, n_full, face, xi, force)  # (n_t, n_red) [N]
-    static = StaticPart(solid, np.unique(F_all.indices), int(np.sum(np.diff(F_all.indptr) > 0)))
+    B = block_size(n_points, n_full)
+
+    def forces(rows: slice) -> sp.csr_matrix:  # (b, n_red) [N]
+        return nodal_force_history(ops.surface, solid.dofs, n_full, face[rows], xi[rows], force[rows])
+
+    loaded, n_loaded = loaded_dofs(forces, n_t, B)
+    static = StaticPart(solid, loaded, n_loaded)
     fields = np.zeros(0, np.int64) if summary_only else field_indices(n_t, field_stride)
     vm_max, ball_max, u_max = np.zeros(n_t), np.zeros(n_t), np.zeros(n_t)
     u_field = np.zeros((len(fields), n_nodes, 3))
     vm_field = np.zeros((len(fields), n_elem))
-    B = block_size(n_points, n_full)
     done = 0
     for start in range(0, n_t, B):
         rows = slice(start, min(start + B, n_t))
-        F = F_all[rows]
+        F = forces(rows)
         q_eff = q[rows].copy()
         q_eff[:, ops.elastic] -= np.asarray(F @ phi_e)
         u_red = solid.Phi @ q_eff.T + static(F)  # (n_red, b)

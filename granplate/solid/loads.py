@@ -53,4 +53,5 @@ def nodal_force_history(surface: Surface, dofs: np.ndarray, n_full: int, face: n
     keep = cols >= 0
     out = sp.coo_matrix((values.ravel()[keep], (rows[keep], cols[keep])), shape=(n_t, len(dofs))).tocsr()
     out.sum_duplicates()
+    out.eliminate_zeros()
     return out
