@@ -189,3 +189,25 @@ def test_vtk_order_mid_nodes_and_orientation(element):
     assert total == pytest.approx(0.03 * 0.02 * 0.01, rel=1e-12)
     faces, owner = boundary_faces(cells, element)
     assert len(faces) == len(mesh.boundary_facets()) and np.all(owner >= 0)
+
+
+def test_free_body_static_part_is_inertia_relief():
+    """A body held nowhere: quasi-static elastic modes plus the residual = the inertia-relief
+    displacement (I - Phi_r Phi_r^T M) K^+ (I - M Phi_r Phi_r^T) f, K^+ the dense pseudo-inverse."""
+    from granplate.solid.fe import mass_matrix
+
+    m = build_solid(Solid(size=SIZE, elements=(3, 3, 1), max_frequency=8e4), surface=None, cache=False)
+    assert m.free and np.all(m.omega[:6] == 0.0) and m.n_modes > 6
+    ops = body_operators(m, RADIUS)
+    face, xi, force, cp = contact(ops)
+    f = reduced_force(m, ops, cp)
+    q = np.zeros((N_T, m.n_modes))
+    q[:, 6:] = (m.Phi[:, 6:].T @ f) / m.omega[6:] ** 2
+    data, _ = body_data(m, q, q, TIMES, face, xi, force, 100, RADIUS, operators=ops)
+    K = dense_system(m)
+    M = mass_matrix(m.basis, m.material.rho)[m.dofs][:, m.dofs].toarray()
+    R = m.Phi[:, :6]
+    x = np.linalg.pinv(K, rcond=1e-12, hermitian=True) @ (f - M @ R @ (R.T @ f))
+    exact = full(m, x - R @ (R.T @ (M @ x))).reshape(-1, 3)
+    got = np.stack([data[f"body_u{c}"].values[-1] for c in "xyz"], axis=1)
+    assert np.abs(got - exact).max() <= 1e-7 * np.abs(exact).max()
