@@ -83,6 +83,8 @@ def test_netcdf_round_trip_and_export_command(result, tmp_path, capsys):
     assert "snapshots of the body" in capsys.readouterr().out
     body = meshio.read(tmp_path / "vtk" / "body_0002.vtu")
     assert np.array_equal(body.cell_data["von_mises"][0], result["body_von_mises"].values[2])
+    assert main(["show", str(path), "-o", str(tmp_path / "show.png")]) == 0
+    assert (tmp_path / "show.png").stat().st_size > 0
 
 
 def test_show_draws_the_deformed_body_coloured_by_von_mises(result):

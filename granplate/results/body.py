@@ -20,7 +20,8 @@ the run loads (those with a nodal force at some output time), solved once and mu
 by each time's forces, or one multi-right-hand-side solve per block of times (the loaded
 times only). The fixed dofs' displacement is 0.
 
-Per output time (`time`): `max_displacement`, the largest |u| over the nodes [m];
+Per output time (`time`): `max_displacement`, the largest |u| over the nodes [m] (a free
+body's rigid-body motion, its zero-frequency modes, included);
 `max_von_mises`, the largest von Mises stress over the quadrature points of every element
 [Pa] (`solid.stress`: the strains from the vector basis' strain operator, sigma = D eps);
 `max_von_mises_ball`, the largest mean of the von Mises stress over a ball of radius
@@ -62,7 +63,7 @@ UNIT_CHUNK = 64
 BODY_VARIABLES: dict[str, tuple[str, str]] = {
     "max_von_mises": ("Pa", "largest von Mises stress over the body's quadrature points (modes and the static residual of the contact forces)"),
     "max_von_mises_ball": ("Pa", "largest mean von Mises stress over a ball of radius ball_radius about a point of the body's surface, cut by the body"),
-    "max_displacement": ("m", "largest displacement magnitude over the body's nodes (modes and the static residual)"),
+    "max_displacement": ("m", "largest displacement magnitude over the body's nodes (modes, a free body's rigid-body motion included, and the static residual)"),
     "body_ux": ("m", "body nodal displacement, x (at field_time)"),
     "body_uy": ("m", "body nodal displacement, y (at field_time)"),
     "body_uz": ("m", "body nodal displacement, z (at field_time)"),
@@ -84,6 +85,7 @@ class BodyOperators:
     ball: sp.csr_matrix
     elastic: np.ndarray
     n_qp: int
+    radius: float
 
 
 def body_operators(solid, ball_radius: float, surface: Surface | None = None) -> BodyOperators:
@@ -92,7 +94,7 @@ def body_operators(solid, ball_radius: float, surface: Surface | None = None) ->
     return BodyOperators(surface=boundary_surface(vb) if surface is None else surface,
                          strain=strain_operator(vb), D=elasticity_matrix(solid.material.E, solid.material.nu),
                          ball=ball_operator(solid.basis, surface_centres(solid.basis), ball_radius),
-                         elastic=solid.omega > 0.0, n_qp=int(solid.basis.dx.shape[1]))
+                         elastic=solid.omega > 0.0, n_qp=int(solid.basis.dx.shape[1]), radius=float(ball_radius))
 
 
 def field_indices(n: int, stride: int) -> np.ndarray:
@@ -185,6 +187,8 @@ def body_data(solid, q: np.ndarray, qd: np.ndarray, times: np.ndarray, contact_f
     xi = np.asarray(contact_xi, float).reshape(n_t, n_g, 2)
     force = np.asarray(contact_force, float).reshape(n_t, n_g, 3)
     ops = body_operators(solid, ball_radius) if operators is None else operators
+    if ops.radius != float(ball_radius):
+        raise ValueError(f"the operators' ball radius {ops.radius} m is not ball_radius = {ball_radius} m")
     n_nodes = solid.nodes.shape[0]
     n_full = 3 * n_nodes
     n_points = ops.strain.shape[0] // 6
