@@ -189,6 +189,10 @@ def test_vtk_order_mid_nodes_and_orientation(element):
     assert total == pytest.approx(0.03 * 0.02 * 0.01, rel=1e-12)
     faces, owner = boundary_faces(cells, element)
     assert len(faces) == len(mesh.boundary_facets()) and np.all(owner >= 0)
+    p = node_coordinates(sb)[faces]  # (n_faces, k, 3): VTK's faces are outward
+    normal = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    centre = node_coordinates(sb)[cells[owner]].mean(axis=1)
+    assert np.all(np.sum(normal * (p.mean(axis=1) - centre), axis=1) > 0.0)
 
 
 def test_free_body_static_part_is_inertia_relief():

@@ -82,8 +82,8 @@ def vtk_connectivity(sbasis, element: str) -> np.ndarray:
     return np.ascontiguousarray(cells)
 
 
-#: Each VTK cell's faces by its corners, in order around the face (outward for a
-#: positively oriented cell is not needed: a drawing fills them).
+#: Each VTK cell's faces by their corners in order around the face: VTK's faces of
+#: vtkHexahedron and vtkTetra, outward (right-handed) for a positively oriented cell.
 VTK_FACES = {"hex": ((0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)),
              "tet": ((0, 2, 1), (0, 1, 3), (1, 2, 3), (0, 3, 2))}
 
