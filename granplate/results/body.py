@@ -35,6 +35,17 @@ output time and the last, `field_time`): the nodal displacement `body_ux/uy/uz`
 (`solid.vtk_cells`; its attribute `cell_type` names meshio's cell type).
 
 Blocks of output times bound the memory (BLOCK_BYTES of strains and stresses at a time).
+
+summary_only keeps the three maxima, exact in the blocks of output times that can hold the
+run's largest value and NaN in the others (as the plate's `plate.peaks`): the fields are
+linear in the coordinates c = (q_eff, the nodal forces at the loaded dofs), each maximum a
+seminorm of c, so max(t) <= max(r) + sum_i |c_i(t) - c_i(r)| peak_i from a reference time
+r (every REFERENCE_STRIDE-th output time, evaluated), peak_i the maximum of unit
+coordinate i's field; a block is evaluated while its bound exceeds the largest value found.
+The blocks are the full route's, so the values are the same bits and the largest over the
+run (nanmax) is the full route's. Where a solve per time is the cheaper route (no G
+columns), or modes near the output interval's Nyquist frequency loosen the bounds, every
+block is evaluated.
 """
 from __future__ import annotations
 
@@ -158,6 +169,90 @@ def _var(name: str, dims, data) -> xr.DataArray:
     return xr.DataArray(data, dims=dims, attrs={"units": units, "long_name": desc})
 
 
+#: Output times between the references the summary's bounds start from.
+REFERENCE_STRIDE = 8
+#: Relative margin of the bounds [-]: far above the round-off of the products.
+BOUND_MARGIN = 1e-9
+#: Output times per chunk of the bounds.
+BOUND_CHUNK = 4096
+#: Unit fields evaluated per pass when the unit peaks are computed.
+UNIT_BATCH = 32
+
+
+def coordinates(q: np.ndarray, forces: Callable, phi_e: np.ndarray, ops: BodyOperators, static: StaticPart,
+                block: int) -> np.ndarray:
+    """(n_t, n_modes + |S|): each output time's coordinates c in which the body's fields are
+    linear, u = [Phi, G_S] c: the effective modal coordinates q_eff and the nodal forces at
+    the loaded dofs S [N] (G's columns there: `StaticPart.columns`)."""
+    n_t = len(q)
+    n_s = len(static.dofs) if static.columns is not None else 0
+    c = np.zeros((n_t, q.shape[1] + n_s))
+    for start in range(0, n_t, block):
+        rows = slice(start, min(start + block, n_t))
+        F = forces(rows)
+        c[rows, :q.shape[1]] = q[rows]
+        c[rows, np.flatnonzero(ops.elastic)] -= np.asarray(F @ phi_e)
+        if n_s:
+            c[rows, q.shape[1]:] = F[:, static.dofs].toarray()
+    return c
+
+
+def unit_peaks(solid, ops: BodyOperators, static: StaticPart, maxima: Callable) -> np.ndarray:
+    """(n_modes + |S|, 3): the three maxima of each unit coordinate's field (a mode's shape,
+    G's column at a loaded dof): each maximum is a seminorm of the coordinates, so that
+    max(t) <= max(r) + sum_i |c_i(t) - c_i(r)| peak_i (the triangle inequality)."""
+    shapes = solid.Phi if static.columns is None else np.hstack([solid.Phi, static.columns])
+    n_nodes = solid.nodes.shape[0]
+    out = np.empty((shapes.shape[1], 3))
+    for start in range(0, shapes.shape[1], UNIT_BATCH):
+        cols = shapes[:, start:start + UNIT_BATCH]
+        u = np.zeros((3 * n_nodes, cols.shape[1]))
+        u[solid.dofs] = cols
+        vm = von_mises(ops.D @ (ops.strain @ u).reshape(6, -1)).reshape(-1, cols.shape[1])
+        out[start:start + cols.shape[1]] = maxima(u.reshape(n_nodes, 3, -1), vm)
+    return out
+
+
+def bounded_maxima(n_t: int, block: int, exact: Callable, c: np.ndarray, peaks: np.ndarray) -> np.ndarray:
+    """(n_t, 3): the exact maxima (exact(rows) -> (b, 3)) in the blocks of output times that
+    can hold the run's largest value, NaN in the others.
+
+    The maxima are evaluated at every REFERENCE_STRIDE-th output time (and the last); each
+    time is bounded from its nearer reference r by max(r) + sum_i |c_i(t) - c_i(r)| peak_i
+    (`unit_peaks`); blocks are evaluated largest bound first while a bound exceeds the
+    largest value found (or the largest reference value, less BOUND_MARGIN). The blocks are
+    the exact route's, so the values are the same bits."""
+    out = np.full((n_t, 3), np.nan)
+    if n_t == 0:
+        return out
+    refs = np.arange(0, n_t, REFERENCE_STRIDE)
+    if refs[-1] != n_t - 1:
+        refs = np.append(refs, n_t - 1)
+    ref_values = np.vstack([exact(refs[k:k + block]) for k in range(0, len(refs), block)])
+    at = np.searchsorted(refs, np.arange(n_t)).clip(0, len(refs) - 1)
+    bound = np.full((n_t, 3), np.inf)
+    for lo in range(0, n_t, BOUND_CHUNK):  # (in chunks of times: bounded memory)
+        rows = slice(lo, min(lo + BOUND_CHUNK, n_t))
+        for r in (at[rows], np.maximum(at[rows] - 1, 0)):  # the references on either side
+            bound[rows] = np.minimum(bound[rows], ref_values[r] + np.abs(c[rows] - c[refs[r]]) @ peaks)
+    starts = np.arange(0, n_t, block)
+    upper = np.maximum.reduceat(bound * (1.0 + BOUND_MARGIN), starts, axis=0)  # (n_blocks, 3)
+    best = ref_values.max(axis=0) * (1.0 - BOUND_MARGIN)
+    scale = np.maximum(upper.max(axis=0), np.finfo(float).tiny)
+    done = np.zeros(len(starts), dtype=bool)
+    if not np.any(upper > best):  # every bound at the floor (at rest): one block still gives the maxima
+        best = np.full(3, -np.inf)
+    while True:
+        open_ = ~done & np.any(upper > best, axis=1)
+        if not open_.any():
+            return out
+        k = int(np.argmax(np.where(open_, (upper / scale).max(axis=1), -np.inf)))
+        rows = slice(starts[k], min(starts[k] + block, n_t))
+        out[rows] = exact(rows)
+        best = np.maximum(best, out[rows].max(axis=0))
+        done[k] = True
+
+
 def body_data(solid, q: np.ndarray, qd: np.ndarray, times: np.ndarray, contact_face: np.ndarray,
               contact_xi: np.ndarray, contact_force: np.ndarray, field_stride: int, ball_radius: float,
               summary_only: bool = False, should_stop: Callable[[], bool] | None = None,
@@ -170,8 +265,9 @@ def body_data(solid, q: np.ndarray, qd: np.ndarray, times: np.ndarray, contact_f
     (`surface.boundary_surface` of the solid's vector basis) each granule touches, -1 for
     none; contact_xi (n_t, n_g, 2): the reference point on it; contact_force (n_t, n_g, 3)
     [N]: the force on the body there; field_stride: output times between snapshots;
-    ball_radius [m]; summary_only: only the per-time maxima (BODY_SUMMARY), no
-    coordinates; should_stop: polled after each block of times: when it says yes, the
+    ball_radius [m]; summary_only: only the per-time maxima (BODY_SUMMARY), exact where
+    they can reach the run's largest value, NaN elsewhere (module docstring), no
+    coordinates, should_stop not polled; should_stop: polled after each block of times: when it says yes, the
     variables cover the output times computed so far (their `time` length says how many);
     operators: `body_operators` built before (default: built here).
 
@@ -196,38 +292,52 @@ def body_data(solid, q: np.ndarray, qd: np.ndarray, times: np.ndarray, contact_f
     phi_e = solid.Phi[:, ops.elastic] / solid.omega[ops.elastic] ** 2  # (n_red, n_elastic) [m/N]
     B = block_size(n_points, n_full)
 
-    def forces(rows: slice) -> sp.csr_matrix:  # (b, n_red) [N]
+    def forces(rows) -> sp.csr_matrix:  # (b, n_red) [N] at output times rows (a slice or indices)
         return nodal_force_history(ops.surface, solid.dofs, n_full, face[rows], xi[rows], force[rows])
 
     loaded, n_loaded = loaded_dofs(forces, n_t, B)
     static = StaticPart(solid, loaded, n_loaded)
     fields = np.zeros(0, np.int64) if summary_only else field_indices(n_t, field_stride)
-    vm_max, ball_max, u_max = np.zeros(n_t), np.zeros(n_t), np.zeros(n_t)
-    u_field = np.zeros((len(fields), n_nodes, 3))
-    vm_field = np.zeros((len(fields), n_elem))
-    done = 0
-    for start in range(0, n_t, B):
-        rows = slice(start, min(start + B, n_t))
+
+    def evaluate(rows) -> tuple[np.ndarray, np.ndarray]:
+        """(nodal displacements (n_nodes, 3, b) [m], von Mises (n_points, b) [Pa]) at the
+        output times rows (a slice or indices)."""
         F = forces(rows)
         q_eff = q[rows].copy()
         q_eff[:, ops.elastic] -= np.asarray(F @ phi_e)
         u_red = solid.Phi @ q_eff.T + static(F)  # (n_red, b)
         u = np.zeros((n_full, u_red.shape[1]))
         u[solid.dofs] = u_red
-        nodal = u.reshape(n_nodes, 3, -1)
-        u_max[rows] = np.sqrt(np.einsum("nck,nck->nk", nodal, nodal)).max(axis=0)
         eps = (ops.strain @ u).reshape(6, -1)  # (6, n_points b): component, point, time
-        vm = von_mises(ops.D @ eps).reshape(n_points, -1)  # (n_points, b) [Pa]
-        vm_max[rows] = vm.max(axis=0)
-        ball_max[rows] = (ops.ball @ vm).max(axis=0) if ops.ball.shape[0] else 0.0
-        snaps = np.flatnonzero((fields >= rows.start) & (fields < rows.stop))
-        if len(snaps):
-            k = fields[snaps] - rows.start
-            u_field[snaps] = np.moveaxis(nodal[:, :, k], -1, 0)
-            vm_field[snaps] = vm[:, k].reshape(n_elem, ops.n_qp, len(k)).max(axis=1).T
-        done = rows.stop
-        if should_stop is not None and done < n_t and should_stop():
-            break
+        return u.reshape(n_nodes, 3, -1), von_mises(ops.D @ eps).reshape(n_points, -1)
+
+    def maxima(nodal: np.ndarray, vm: np.ndarray) -> np.ndarray:
+        """(b, 3): the largest von Mises, ball-averaged von Mises [Pa] and displacement [m]."""
+        ball = (ops.ball @ vm).max(axis=0) if ops.ball.shape[0] else np.zeros(vm.shape[1])
+        return np.column_stack([vm.max(axis=0), ball, np.sqrt(np.einsum("nck,nck->nk", nodal, nodal)).max(axis=0)])
+
+    if summary_only and (static.columns is not None or len(loaded) == 0):
+        every = bounded_maxima(n_t, B, lambda rows: maxima(*evaluate(rows)), coordinates(q, forces, phi_e, ops, static, B),
+                               unit_peaks(solid, ops, static, maxima))
+        vm_max, ball_max, u_max = every[:, 0], every[:, 1], every[:, 2]
+        done = n_t
+    else:
+        vm_max, ball_max, u_max = np.zeros(n_t), np.zeros(n_t), np.zeros(n_t)
+        u_field = np.zeros((len(fields), n_nodes, 3))
+        vm_field = np.zeros((len(fields), n_elem))
+        done = 0
+        for start in range(0, n_t, B):
+            rows = slice(start, min(start + B, n_t))
+            nodal, vm = evaluate(rows)
+            vm_max[rows], ball_max[rows], u_max[rows] = maxima(nodal, vm).T
+            snaps = np.flatnonzero((fields >= rows.start) & (fields < rows.stop))
+            if len(snaps):
+                k = fields[snaps] - rows.start
+                u_field[snaps] = np.moveaxis(nodal[:, :, k], -1, 0)
+                vm_field[snaps] = vm[:, k].reshape(n_elem, ops.n_qp, len(k)).max(axis=1).T
+            done = rows.stop
+            if should_stop is not None and done < n_t and should_stop():
+                break
     kept = int(np.sum(fields < done))
     data = {"max_von_mises": _var("max_von_mises", ("time",), vm_max[:done]),
             "max_von_mises_ball": _var("max_von_mises_ball", ("time",), ball_max[:done]),
