@@ -10,8 +10,9 @@ on the body (`solid.loads.nodal_force_history`: each granule's force spread over
 nodes by the face's shape functions at its contact point), G the static flexibility K^-1
 of a held body or the inertia-relief flexibility of a free one (`SolidModel._flexibility`,
 one factorisation), Phi_e, omega_e the kept elastic modes: u_s is the static residual of
-the modes the truncation drops. It is evaluated at EVERY output time where a contact force
-acts, exactly (no bound, no skipped time), as
+the modes the truncation drops. The full route evaluates it exactly at every output time
+where a contact force acts (no bound, no skipped time; summary_only below skips the
+blocks of times that provably cannot hold the run's largest value), as
 
     u = Phi q_eff + G f,   q_eff = q - diag(1/omega_e^2) Phi_e^T f   (rigid modes: q),
 
