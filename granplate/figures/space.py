@@ -307,7 +307,14 @@ def body_snapshot(ds: xr.Dataset, time: float | None) -> tuple[int, str]:
         raise ScenarioError("result", str(ds.attrs.get("scenario_name", "")), "has no body field snapshots")
     if time is None:
         k = int(np.argmax(np.asarray(ds["body_von_mises"].values).max(axis=1)))
-        return k, "the body's snapshot of the largest von Mises stress"
+        note = "the body's snapshot of the largest von Mises stress"
+        if "max_von_mises" in ds and ds["max_von_mises"].dims == ("time",) and ds.sizes.get("time", 0):
+            vm = np.asarray(ds["max_von_mises"].values, float)
+            i = int(np.nanargmax(vm))
+            if not np.isclose(float(ds["time"].values[i]), ft[k], rtol=0.0, atol=1e-15):
+                note += (f" (the peak, {vm[i] * MPA:.3g} MPa, between snapshots, at t = "
+                         f"{float(ds['time'].values[i]) * 1e3:.4g} ms)")
+        return k, note
     choose_time(ds, time)  # within the run
     return int(np.argmin(np.abs(ft - time))), "the body's snapshot nearest the requested time"
 
@@ -336,7 +343,7 @@ def body_drawing(ds: xr.Dataset, k: int, note: str) -> dict:
     t = float(ds["field_time"].values[k])
     return {"body_faces": nodes[faces] + scale * u[faces],
             "body_stress": np.asarray(ds["body_von_mises"].values[k], float)[owner],
-            "body_scale": scale, "body_largest": largest, "body_note": f"{note}, t = {t * 1e3:.4g} ms"}
+            "body_scale": scale, "body_largest": largest, "body_note": f"t = {t * 1e3:.4g} ms, {note}"}
 
 
 # --------------------------------------------------------------------------------------
