@@ -178,7 +178,8 @@ def test_interrupted(solid, ops):
     old = body.BLOCK_BYTES
     body.BLOCK_BYTES = 1
     try:
-        part, coords = body_data(solid, q, q, TIMES, face, xi, force, 4, RADIUS, operators=ops, should_stop=lambda: True)
+        part, coords = body_data(solid, q, q, TIMES, face, xi, force, 4, RADIUS, operators=ops,
+                                 should_stop=lambda: True)
     finally:
         body.BLOCK_BYTES = old
     assert part["max_von_mises"].sizes["time"] == 1 and part["body_ux"].sizes["field_time"] == 1

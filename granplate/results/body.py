@@ -318,8 +318,8 @@ def body_data(solid, q: np.ndarray, qd: np.ndarray, times: np.ndarray, contact_f
         return np.column_stack([vm.max(axis=0), ball, np.sqrt(np.einsum("nck,nck->nk", nodal, nodal)).max(axis=0)])
 
     if summary_only and (static.columns is not None or len(loaded) == 0):
-        every = bounded_maxima(n_t, B, lambda rows: maxima(*evaluate(rows)), coordinates(q, forces, phi_e, ops, static, B),
-                               unit_peaks(solid, ops, static, maxima))
+        every = bounded_maxima(n_t, B, lambda rows: maxima(*evaluate(rows)),
+                               coordinates(q, forces, phi_e, ops, static, B), unit_peaks(solid, ops, static, maxima))
         vm_max, ball_max, u_max = every[:, 0], every[:, 1], every[:, 2]
         done = n_t
     else:
