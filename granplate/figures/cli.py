@@ -127,8 +127,8 @@ def register(subparsers) -> None:
                    help="a scenario TOML file, a preset name, or a result .nc file")
     s.add_argument("-o", "--output", help="image file (.png, .pdf or .svg; default NAME.png)")
     s.add_argument("--time", type=_time, default=None,
-                   help="result only: the time shown [s] (default: the largest plate energy, or the last "
-                        "output without a plate)")
+                   help="result only: the time shown [s] (default: the largest plate energy; a 3D body: its "
+                        "snapshot of the largest von Mises stress; else the last output)")
     s.add_argument("--dpi", type=_dpi, default=PNG_DPI, help=f"resolution of a .png [dots per inch] "
                    f"(default {PNG_DPI})")
     s.set_defaults(func=_cmd_show)

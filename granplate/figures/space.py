@@ -15,6 +15,14 @@ file read and checked), no modes built. Axes in mm.
     >>> fig = space.draw(space.of_scenario(scenario))        # before the run
     >>> fig = space.draw(space.of_result(ds, time=2e-5))       # a result at t = 0.02 ms
 
+A result with an elastic body's fields (results.body: `body_ux`, ...) draws the body
+deformed at one of its field snapshots: its boundary faces (the faces of the stored VTK
+cells that one cell has, `solid.vtk_cells.boundary_faces`) at the nodes displaced by
+the displacement times a stated magnification, painted far to near, each coloured by its
+element's von Mises stress [MPa] (a colour bar), over the undeformed outline; the
+snapshot of the largest von Mises stress, or the one nearest `time`, with the spheres at
+the output nearest it.
+
 Contact forces of a result at one output time come from the stored centres and the run's
 own contact coefficients (`model.arrays.pair_coefficients`, `wall_arrays`: the run's
 materials and [[contact.pairs]]), through the run's normal law (`physics.laws`: Hertz, or
@@ -62,6 +70,11 @@ LOAD_COLOUR = "crimson"
 SOLID_TINT = 0.25
 SOLID_EDGE = ("0.25", 1.0)
 CLAMPED_EDGE = ("tab:blue", 3.5)
+#: The deformed body: its colour map, and the largest displacement drawn as this share of
+#: the body's largest side (the magnification rounded down to 1, 2 or 5 times a power of 10).
+BODY_CMAP = "viridis"
+BODY_DEFORMATION = 0.08
+MPA = 1e-6  # Pa -> MPa
 
 
 def _no_segments() -> np.ndarray:
@@ -81,6 +94,10 @@ class Assembly3D:
     without one): solid_faces (nf, k, 3) its boundary facets' corners [m], solid_edges
     (ne, 2, 3) its outline, clamped_edges (nc, 2, 3) the outlines of its clamped faces,
     solid_label its material, element and element count, solid_material its material.
+    A result's deformed body (empty without one): body_faces (nf, k, 3) its boundary
+    faces' corners displaced body_scale times [m], body_stress (nf,) the von Mises stress
+    of each face's element [Pa], body_largest the largest displacement [m], body_note
+    which snapshot.
     """
 
     name: str
@@ -101,6 +118,11 @@ class Assembly3D:
     clamped_edges: np.ndarray = field(default_factory=_no_segments)
     solid_label: str = ""
     solid_material: str = ""
+    body_faces: np.ndarray = field(default_factory=lambda: np.zeros((0, 4, 3)))
+    body_stress: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    body_scale: float = 1.0
+    body_largest: float = 0.0
+    body_note: str = ""
 
 
 # --------------------------------------------------------------------------------------
@@ -247,8 +269,17 @@ def of_result(ds: xr.Dataset, time: float | None = None) -> Assembly3D:
     from granplate.results.dataset import scenario_of
     from granplate.setup.geometry import resolve
 
+    from granplate.results.export import has_body
+
     s = resolve(scenario_of(ds))
+    body = {}
+    if has_body(ds):
+        k, body_note = body_snapshot(ds, time)
+        body = body_drawing(ds, k, body_note)
+        time = float(ds["field_time"].values[k])
     ti, note = choose_time(ds, time)
+    if body:
+        note = "the output nearest the body's snapshot"
     path = positions(ds, ti)
     pos = path[-1]
     r = np.asarray(ds["radius"].values, float)
@@ -260,7 +291,59 @@ def of_result(ds: xr.Dataset, time: float | None = None) -> Assembly3D:
         materials=tuple(str(v) for v in ds["material"].values), walls=s.walls, load=s.load,
         loaded=loaded_granules_3d(s, p0[:, 0], p0[:, 1], p0[:, 2], r), segments=segs, kinds=kinds,
         forces=contact_forces(s, path, r, pairs, wc), time=float(ds["time"].values[ti]), time_note=note,
+        **({k: v for k, v in solid_drawing(s).items() if k != "solid_faces"} if body else {}), **body,
     )
+
+
+def body_snapshot(ds: xr.Dataset, time: float | None) -> tuple[int, str]:
+    """(field snapshot index, note) of the body drawn: the largest von Mises stress, or the
+    snapshot nearest `time` [s] (within the run's output times, else a ScenarioError)."""
+    from granplate.figures.assembly import choose_time
+
+    ft = np.asarray(ds["field_time"].values, float)
+    if len(ft) == 0:
+        from granplate.errors import ScenarioError
+
+        raise ScenarioError("result", str(ds.attrs.get("scenario_name", "")), "has no body field snapshots")
+    if time is None:
+        k = int(np.argmax(np.asarray(ds["body_von_mises"].values).max(axis=1)))
+        note = "the body's snapshot of the largest von Mises stress"
+        if "max_von_mises" in ds and ds["max_von_mises"].dims == ("time",) and ds.sizes.get("time", 0):
+            vm = np.asarray(ds["max_von_mises"].values, float)
+            i = int(np.nanargmax(vm))
+            if not np.isclose(float(ds["time"].values[i]), ft[k], rtol=0.0, atol=1e-15):
+                note += (f" (the peak, {vm[i] * MPA:.3g} MPa, between snapshots, at t = "
+                         f"{float(ds['time'].values[i]) * 1e3:.4g} ms)")
+        return k, note
+    choose_time(ds, time)  # within the run
+    return int(np.argmin(np.abs(ft - time))), "the body's snapshot nearest the requested time"
+
+
+def magnification(largest: float, extent: float) -> float:
+    """The displacement magnification that draws `largest` [m] as about BODY_DEFORMATION of
+    `extent` [m], rounded down to 1, 2 or 5 times a power of ten (1 when nothing moved)."""
+    if not largest > 0.0:
+        return 1.0
+    raw = BODY_DEFORMATION * extent / largest
+    power = 10.0 ** np.floor(np.log10(raw))
+    return float(max(m for m in (1.0, 2.0, 5.0) if m * power <= raw * (1 + 1e-12)) * power)
+
+
+def body_drawing(ds: xr.Dataset, k: int, note: str) -> dict:
+    """The Assembly3D fields of the body at field snapshot k (module docstring)."""
+    from granplate.solid.vtk_cells import boundary_faces
+
+    cells = np.asarray(ds["body_element_nodes"].values, np.int64)
+    element = {20: "hex20", 27: "hex27", 10: "tet10"}[cells.shape[1]]
+    nodes = np.column_stack([ds[f"body_node_{c}"].values for c in "xyz"]).astype(float)
+    u = np.column_stack([ds[f"body_u{c}"].values[k] for c in "xyz"]).astype(float)
+    largest = float(np.linalg.norm(u, axis=1).max()) if len(u) else 0.0
+    scale = magnification(largest, float((nodes.max(axis=0) - nodes.min(axis=0)).max()))
+    faces, owner = boundary_faces(cells, element)
+    t = float(ds["field_time"].values[k])
+    return {"body_faces": nodes[faces] + scale * u[faces],
+            "body_stress": np.asarray(ds["body_von_mises"].values[k], float)[owner],
+            "body_scale": scale, "body_largest": largest, "body_note": f"t = {t * 1e3:.4g} ms, {note}"}
 
 
 # --------------------------------------------------------------------------------------
@@ -283,8 +366,8 @@ def bounds(a: Assembly3D, margin: float = 0.05) -> tuple[np.ndarray, np.ndarray]
     walls (a box), widened by margin times the largest side."""
     lo = (a.pos - a.radius[:, None]).min(axis=0) if len(a.radius) else np.zeros(3)
     hi = (a.pos + a.radius[:, None]).max(axis=0) if len(a.radius) else np.zeros(3)
-    if len(a.solid_edges):  # the solid bounds every axis
-        ends = a.solid_edges.reshape(-1, 3)
+    if len(a.solid_edges) or len(a.body_faces):  # the solid bounds every axis
+        ends = np.concatenate([a.solid_edges.reshape(-1, 3), a.body_faces.reshape(-1, 3)])
         lo, hi = (np.minimum(lo, ends.min(axis=0)), np.maximum(hi, ends.max(axis=0))) if len(a.radius) \
             else (ends.min(axis=0), ends.max(axis=0))
     for w in a.walls:  # an axis-aligned wall bounds its axis
@@ -374,22 +457,40 @@ def solid_fill(colour: str) -> tuple[float, float, float]:
 def _draw_solid(ax, a: Assembly3D, view: tuple, colours: dict) -> None:
     """The solid in one view, under the spheres: its facets filled, its outline, its
     clamped faces' outlines thick (gids solid, solid-edges, solid-clamped: VIEW)."""
+    u, v, d, sign = view
+    uv = f"{AXIS_NAMES[u]}{AXIS_NAMES[v]}"
+    if len(a.body_faces):  # the deformed body, far faces first
+        order = np.argsort(sign * a.body_faces[:, :, d].mean(axis=1), kind="stable")
+        cmap = body_colour_map(a)
+        ax.add_collection(PolyCollection(a.body_faces[order][:, :, [u, v]] * MM,
+                                         facecolors=cmap.to_rgba(a.body_stress[order] * MPA), edgecolors="0.35",
+                                         linewidths=0.15, zorder=0.7, gid=f"body:{uv}"))
     if not len(a.solid_edges):
         return
-    u, v, _, _ = view
-    uv = f"{AXIS_NAMES[u]}{AXIS_NAMES[v]}"
-    fill = solid_fill(colours.get(a.solid_material, "0.6"))
-    ax.add_collection(PolyCollection(a.solid_faces[:, :, [u, v]] * MM, facecolors=[fill], edgecolors="none",
-                                     zorder=0.5, gid=f"solid:{uv}"))
+    if not len(a.body_faces):
+        fill = solid_fill(colours.get(a.solid_material, "0.6"))
+        ax.add_collection(PolyCollection(a.solid_faces[:, :, [u, v]] * MM, facecolors=[fill], edgecolors="none",
+                                         zorder=0.5, gid=f"solid:{uv}"))
     ax.add_collection(LineCollection(a.solid_edges[:, :, [u, v]] * MM, colors=SOLID_EDGE[0],
-                                     linewidths=SOLID_EDGE[1], zorder=0.8, gid=f"solid-edges:{uv}"))
+                                     linewidths=SOLID_EDGE[1], linestyles="--" if len(a.body_faces) else "-",
+                                     zorder=0.8, gid=f"solid-edges:{uv}"))
     if len(a.clamped_edges):
         ax.add_collection(LineCollection(a.clamped_edges[:, :, [u, v]] * MM, colors=CLAMPED_EDGE[0],
                                          linewidths=CLAMPED_EDGE[1], zorder=0.9, capstyle="butt",
                                          gid=f"solid-clamped:{uv}"))
 
 
+def body_colour_map(a: Assembly3D) -> ScalarMappable:
+    """The von Mises stress [MPa] colours of the deformed body: 0 to its largest."""
+    top = float(a.body_stress.max()) * MPA if len(a.body_stress) else 0.0
+    return ScalarMappable(Normalize(0.0, top if top > 0 else 1.0), BODY_CMAP)
+
+
 def _title(a: Assembly3D) -> str:
+    if len(a.body_faces):
+        return (f"{a.name} at t = {a.time * 1e3:.4g} ms, {a.time_note} (in space)\n"
+                f"elastic body: {a.body_note}; displacements magnified x{a.body_scale:g} (largest "
+                f"{a.body_largest:.3g} m), coloured by von Mises stress [MPa]")
     if a.time is None:
         return f"{a.name}: assembly before the run (in space; spheres darker with distance from the viewer)"
     return (f"{a.name} at t = {a.time * 1e3:.4g} ms, {a.time_note} "
@@ -420,7 +521,13 @@ def legend_handles(a: Assembly3D, colours: dict, oblique: list[str]) -> list:
     """Legend entries: materials, walls, contacts, load."""
     handles = [Patch(fc=c, ec="0.1", label=f"{m} ({a.materials.count(m)} spheres)") for m, c in colours.items()
                if m in a.materials]
-    if a.solid_label:
+    if len(a.body_faces):
+        handles.append(Patch(fc=body_colour_map(a).to_rgba(0.5 * float(a.body_stress.max()) * MPA), ec="0.35",
+                             label=f"elastic body deformed x{a.body_scale:g}, coloured by von Mises stress"))
+        if a.solid_label:
+            handles.append(Line2D([], [], color=SOLID_EDGE[0], lw=SOLID_EDGE[1], ls="--",
+                                  label=f"undeformed outline; {a.solid_label}"))
+    elif a.solid_label:
         handles.append(Patch(fc=solid_fill(colours.get(a.solid_material, "0.6")), ec=SOLID_EDGE[0],
                              label=a.solid_label))
         if len(a.clamped_edges):
@@ -456,6 +563,9 @@ def draw(a: Assembly3D, width: float = 13.0) -> Figure:
     _mark_loaded(axes, a)
     oblique = [w.label or f"wall {k}" for k, w in enumerate(a.walls)
                if all(wall_trace(w, view, lo, hi) is None for view in PROJECTIONS)]
+    if len(a.body_faces):
+        fig.colorbar(body_colour_map(a), ax=list(axes), label="von Mises stress [MPa] (largest in each element)",
+                     orientation="horizontal", shrink=0.5, aspect=50, location="bottom")
     if a.forces is not None and len(a.segments):
         cmap = _force_style(np.asarray(a.forces, float))[3]
         fig.colorbar(cmap, ax=list(axes), label="contact normal force [N]", orientation="horizontal",

@@ -462,9 +462,15 @@ def _cmd_animate(args) -> int:
 
 def _cmd_export(args) -> int:
     from granplate.results.analysis import has_plate
-    from granplate.results.export import export_vtk, is_space
+    from granplate.results.export import export_vtk, has_body, is_space
 
     ds = _read(_existing(args.result))
+    if is_space(ds) and has_body(ds):
+        pvd = export_vtk(ds, args.vtk)
+        print(f"written {ds.sizes.get('field_time', 0)} snapshots of the body and {ds.sizes.get('granule', 0)} "
+              f"spheres; open {pvd} in ParaView (Warp By Vector: displacement; Glyph: sphere, scale array radius, "
+              f"factor 2)")
+        return 0
     if is_space(ds):
         pvd = export_vtk(ds, args.vtk)
         print(f"written {ds.sizes.get('time', 0)} output times of {ds.sizes.get('granule', 0)} spheres; open {pvd} "

@@ -26,6 +26,15 @@ result's sorted material names, listed in the .pvd's comment) and ``granule_inde
 ``NAME.pvd`` holding the times [s]. In ParaView: open NAME.pvd, Apply, then Filters >
 Glyph with Glyph Type "Sphere", Scale Array "radius", Scale Factor 2 (the sphere glyph's
 radius is 0.5) and Glyph Mode "All Points"; colour by speed or material_id.
+
+A run in space with an elastic body (the result holds `body_ux`, results.body) is written
+per body field snapshot (`field_time`) as ``body_NNNN.vtu``: the body's quadratic cells
+(VTK_QUADRATIC_HEXAHEDRON, VTK_TRIQUADRATIC_HEXAHEDRON or VTK_QUADRATIC_TETRA: meshio's
+"hexahedron20", "hexahedron27", "tetra10", by the nodes per cell) at the undeformed node
+coordinates [m], with point data ``displacement`` (3 components) [m] and cell data
+``von_mises`` (largest in each element) [Pa] ("Warp By Vector" shows it deformed); and
+``spheres_NNNN.vtu`` at the output nearest each snapshot; ``NAME.pvd`` holds both per
+time (part 0 = body, part 1 = spheres), ``NAME-body.pvd`` and ``NAME-spheres.pvd`` each.
 """
 from __future__ import annotations
 
@@ -105,6 +114,48 @@ def sphere_cloud(ds: xr.Dataset, i: int) -> meshio.Mesh:
     )
 
 
+#: The meshio cell type of a body's cells by their nodes.
+BODY_CELLS = {20: "hexahedron20", 27: "hexahedron27", 10: "tetra10"}
+
+
+def has_body(ds: xr.Dataset) -> bool:
+    """Whether a result holds the fields of an elastic body (a 3D run's solid)."""
+    return "body_ux" in ds.variables and "body_element_nodes" in ds.variables
+
+
+def body_mesh(ds: xr.Dataset, k: int) -> meshio.Mesh:
+    """The body at field snapshot k as a meshio Mesh (quadratic cells, displacement, von Mises)."""
+    pts = np.column_stack([ds[f"body_node_{c}"].values for c in "xyz"]).astype(float)
+    u = np.column_stack([ds[f"body_u{c}"].values[k] for c in "xyz"]).astype(float)
+    cells = np.asarray(ds["body_element_nodes"].values, dtype=np.int64)
+    return meshio.Mesh(pts, [(BODY_CELLS[cells.shape[1]], cells)], point_data={"displacement": u},
+                       cell_data={"von_mises": [np.asarray(ds["body_von_mises"].values[k], dtype=float)]})
+
+
+def export_body(ds: xr.Dataset, out_dir: str | Path, name: str | None = None) -> Path:
+    """Write the body and the spheres of 3D run `ds` at each body snapshot (field_time) into
+    out_dir (module docstring); returns the combined .pvd path."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    name = name or str(ds.attrs.get("scenario_name", "result"))
+    ft = np.asarray(ds["field_time"].values, dtype=float)
+    ti = an.time_indices(ds, ft) if ds.sizes.get("time", 0) else np.zeros(0, np.int64)
+    spheres = ds.sizes.get("granule", 0) > 0 and len(ti) == len(ft)
+    body_entries, sphere_entries = [], []
+    for k, t in enumerate(ft):
+        meshio.write(out / f"body_{k:04d}.vtu", body_mesh(ds, k))
+        body_entries.append((float(t), 0, f"body_{k:04d}.vtu"))
+        if spheres:
+            meshio.write(out / f"spheres_{k:04d}.vtu", sphere_cloud(ds, int(ti[k])))
+            sphere_entries.append((float(t), 1, f"spheres_{k:04d}.vtu"))
+    (out / f"{name}-body.pvd").write_text(pvd_text(body_entries))
+    if spheres:
+        (out / f"{name}-spheres.pvd").write_text(pvd_text([(t, 0, f) for t, _, f in sphere_entries]))
+    combined = out / f"{name}.pvd"
+    combined.write_text(pvd_text(sorted(body_entries + sphere_entries)))
+    return combined
+
+
 def export_spheres(ds: xr.Dataset, out_dir: str | Path, name: str | None = None) -> Path:
     """Write the spheres of 3D run `ds` into out_dir, one .vtu per output time, and the
     collection NAME.pvd (default: the scenario name); returns the .pvd path."""
@@ -143,10 +194,13 @@ def export_vtk(ds: xr.Dataset, out_dir: str | Path, name: str | None = None) -> 
 
     name: stem of the .pvd files (default: the scenario name). Snapshots are the
     result's field_time; granule states are taken at the output nearest to each. A run in
-    space is written by `export_spheres` (every output time).
+    space is written by `export_spheres` (every output time), or with an elastic body by
+    `export_body` (every body snapshot).
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    if is_space(ds) and has_body(ds):
+        return export_body(ds, out, name)
     if is_space(ds):
         return export_spheres(ds, out, name)
     name = name or str(ds.attrs.get("scenario_name", "result"))
