@@ -43,6 +43,8 @@ SUMMARY_ROWS = (
     ("yield_onset_ratio", "max p0 / (1.6 Y), yield onset", "-", "{:.3f}", 1.0),
     ("max_von_mises", "max von Mises stress", "MPa", "{:.2f}", 1e-6),
     ("max_von_mises_disc", "max von Mises, disc average", "MPa", "{:.2f}", 1e-6),
+    ("max_von_mises_ball", "max von Mises, ball average", "MPa", "{:.2f}", 1e-6),
+    ("max_displacement", "max displacement of the body", "um", "{:.4g}", 1e6),
     ("max_eps_yy", "max |eps_yy|", "-", "{:.3e}", 1.0),
     ("energy_residual_max", "max |energy residual|", "-", "{:.2e}", 1.0),
     ("n_steps", "time steps", "-", "{:d}", 1),

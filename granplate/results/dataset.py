@@ -203,7 +203,8 @@ def plate_fields(model, q: np.ndarray, qd: np.ndarray, times: np.ndarray,
 #: What a summary-only Dataset holds (`to_dataset(..., summary_only=True)`): what
 #: `summary` and the studies' metrics read.
 SUMMARY_VARIABLES = ("E_shock", "E_granular", "E_plate", "D_viscous", "D_friction", "D_plastic",
-                     "energy_residual_max", "max_von_mises", "max_von_mises_disc", "max_eps_yy")
+                     "energy_residual_max", "max_von_mises", "max_von_mises_disc", "max_eps_yy",
+                     "max_von_mises_ball", "max_displacement")
 
 
 class RunContacts(NamedTuple):
@@ -266,7 +267,11 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
     body_data: dict[str, xr.DataArray] = {}
     body_coords: dict = {}
     if model.solid is not None:
-        body_data, body_coords = body_outputs(model, out, n, summary_only)
+        body_data, body_coords, n_done = body_outputs(model, out, n, summary_only, should_stop)
+        if n_done < n:
+            n = n_done
+            info = {**info, "status": f"{INTERRUPTED_STATUS} at t = {out.t[n - 1]:.6e} s, "
+                                      "while building the result."}
     t = out.t[:n].copy()
     y = out.y[:n]
     e = out.energy[:n]
@@ -338,22 +343,39 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
     return ds
 
 
-def body_outputs(model, out: K.Output, n: int, summary_only: bool) -> tuple[dict[str, xr.DataArray], dict]:
+def stress_ball_radius(model) -> float:
+    """The radius [m] of the body's stress balls: plate.stress_radius, else a quarter of the
+    body's smallest extent."""
+    sd = model.scenario.plate
+    if sd.stress_radius is not None:
+        return float(sd.stress_radius)
+    nodes = model.solid.nodes
+    return 0.25 * float((nodes.max(axis=0) - nodes.min(axis=0)).min())
+
+
+def body_outputs(model, out: K.Output, n: int, summary_only: bool,
+                 should_stop: Callable[[], bool] | None = None) -> tuple[dict[str, xr.DataArray], dict, int]:
     """An elastic body's outputs in space (docs/output.md): its contacts at the output
-    times (results.body_contacts), its modal coordinates and, from them, its fields
-    (results.body)."""
+    times (results.body_contacts), its modal coordinates and, from them and the contacts'
+    static loads, its fields (results.body.body_data); and the output times they cover
+    (fewer than n when should_stop said yes)."""
+    from granplate.results.body import body_data
     from granplate.results.body_contacts import body_contacts, contact_variables
 
     contacts = body_contacts(model, out.y[:n], out.q[:n], out.qd[:n])
-    data: dict[str, xr.DataArray] = {}
-    coords: dict = {}
+    s = model.scenario
+    stride = max(1, int(round(s.time.field_interval / s.time.output_interval)))
+    data, coords = body_data(model.solid, out.q[:n], out.qd[:n], out.t[:n], contacts.face, contacts.xi,
+                             contacts.force, stride, stress_ball_radius(model), summary_only=summary_only,
+                             should_stop=should_stop)
+    n_done = data["max_von_mises"].shape[0] if "max_von_mises" in data else n
     if not summary_only:
-        data.update(contact_variables(contacts))
-        data["body_q"] = _var("body_q", ("time", "mode"), out.q[:n].copy())
-        data["body_qd"] = _var("body_qd", ("time", "mode"), out.qd[:n].copy())
+        data.update({k: v[:n_done] for k, v in contact_variables(contacts).items()})
+        data["body_q"] = _var("body_q", ("time", "mode"), out.q[:n_done].copy())
+        data["body_qd"] = _var("body_qd", ("time", "mode"), out.qd[:n_done].copy())
         coords["mode_frequency"] = ("mode", model.solid.frequencies.copy(),
                                     {"units": "Hz", "long_name": "the elastic body's natural frequencies"})
-    return data, coords
+    return data, coords, n_done
 
 
 def initial_energy(energy0: np.ndarray) -> float:
@@ -406,7 +428,7 @@ SUMMARY_UNITS: dict[str, object] = {
     "plastic_fraction": "1", "max_contact_pressure": "Pa", "yield_onset_ratio": "1",
     "contact_pairs": {"max_contact_pressure": "Pa", "yield_onset_ratio": "1", "yield_strength": "Pa", "time": "s"},
     "max_von_mises": "Pa", "max_von_mises_disc": "Pa", "max_eps_yy": "1", "energy_residual_max": "1",
-    "n_steps": "1", "wall_time_s": "s",
+    "n_steps": "1", "wall_time_s": "s", "max_von_mises_ball": "Pa", "max_displacement": "m",
 }
 
 
@@ -449,10 +471,12 @@ def summary(ds: xr.Dataset) -> dict:
         "max_von_mises": float(ds.max_von_mises.max()) if has_plate else None,
         "max_von_mises_disc": (float(ds.max_von_mises_disc.max())
                                if has_plate and "max_von_mises_disc" in ds else None),
-        "max_eps_yy": float(ds.max_eps_yy.max()) if has_plate else None,
+        "max_eps_yy": float(ds.max_eps_yy.max()) if has_plate and "max_eps_yy" in ds else None,
         "energy_residual_max": float(np.max(np.abs(ds.energy_residual_max))),
         "n_steps": int(info.get("n_steps", 0)),
         "wall_time_s": float(info.get("wall_time_s", 0.0)),
+        # an elastic solid in space: its largest ball-averaged stress and displacement
+        **{name: float(ds[name].max()) for name in ("max_von_mises_ball", "max_displacement") if name in ds},
     }
 
 

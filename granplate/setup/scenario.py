@@ -315,7 +315,8 @@ class Solid:
     "hex27" or "tet10"; clamped: faces with every dof fixed; rollers: faces whose normal
     dof is fixed (flat, normal to an axis); free elsewhere (a body held nowhere keeps its
     six rigid-body modes). max_frequency: the modes kept [Hz] (provisional default
-    SOLID_MAX_FREQUENCY).
+    SOLID_MAX_FREQUENCY). stress_radius: the radius [m] of the balls the body's stress is
+    averaged over (None: a quarter of the body's smallest extent; docs/model.md section 3.8).
     """
 
     size: tuple[float, float, float] | None = None
@@ -327,6 +328,7 @@ class Solid:
     clamped: tuple[str, ...] = ()
     rollers: tuple[str, ...] = ()
     max_frequency: float = SOLID_MAX_FREQUENCY
+    stress_radius: float | None = None
 
 
 @dataclass(frozen=True)

@@ -78,6 +78,12 @@ def check_solid_fields(sd: Solid) -> None:
     f = finite("plate.max_frequency", sd.max_frequency)
     if not lo <= f <= hi:
         raise ScenarioError("plate.max_frequency", sd.max_frequency, f"must be in [{lo:g}, {hi:g}] Hz")
+    if sd.stress_radius is not None:
+        r = finite("plate.stress_radius", sd.stress_radius, "must be > 0 [m] (or absent: a quarter of the "
+                   "body's smallest extent)")
+        if not r > 0.0:
+            raise ScenarioError("plate.stress_radius", sd.stress_radius, "must be > 0 [m] (or absent: a quarter "
+                                "of the body's smallest extent)")
 
 
 def check_solid(s: Scenario) -> None:
