@@ -71,7 +71,7 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
 
         check_clearance(s, mesh, {i: granule_named(s, s, i) for i in range(len(s.granules))}, OVERLAP_RTOL)
     surface = boundary_surface(vector_basis(mesh, sd.element))
-    face, components = residual_face(s, surface, mesh)
+    face, components = residual_face(s, surface, mesh) if sd.residual else (None, "")
     solid = build_solid(sd, material, surface=face, components=components or "z")
     rows = reduced_index(solid.dofs, surface.dofs.ravel()).reshape(surface.dofs.shape)
     where = np.full(len(solid.dofs), -1, np.int64)

@@ -317,6 +317,9 @@ class Solid:
     six rigid-body modes). max_frequency: the modes kept [Hz] (provisional default
     SOLID_MAX_FREQUENCY). stress_radius: the radius [m] of the balls the body's stress is
     averaged over (None: a quarter of the body's smallest extent; docs/model.md section 3.8).
+    residual: whether the contacts feel the static residual compliance of the modes above
+    max_frequency (docs/model.md section 3.9: in series with Hertz's law, it adds the mesh's
+    own compliance under a point load, which grows as the mesh is refined).
     """
 
     size: tuple[float, float, float] | None = None
@@ -329,6 +332,7 @@ class Solid:
     rollers: tuple[str, ...] = ()
     max_frequency: float = SOLID_MAX_FREQUENCY
     stress_radius: float | None = None
+    residual: bool = True
 
 
 @dataclass(frozen=True)

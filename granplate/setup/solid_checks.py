@@ -78,6 +78,8 @@ def check_solid_fields(sd: Solid) -> None:
     f = finite("plate.max_frequency", sd.max_frequency)
     if not lo <= f <= hi:
         raise ScenarioError("plate.max_frequency", sd.max_frequency, f"must be in [{lo:g}, {hi:g}] Hz")
+    if not isinstance(sd.residual, bool):
+        raise ScenarioError("plate.residual", sd.residual, "must be true or false")
     if sd.stress_radius is not None:
         r = finite("plate.stress_radius", sd.stress_radius, "must be > 0 [m] (or absent: a quarter of the "
                    "body's smallest extent)")
