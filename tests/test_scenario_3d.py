@@ -192,11 +192,13 @@ def test_3d_refusals_name_the_field(change, field, words):
 
 
 def test_solid_needs_the_verlet_scheme_and_then_builds():
-    """A box solid with the default (implicit) scheme is refused naming solver.scheme; with
-    "verlet" it validates and build_model gives the body's modes and contact arrays."""
+    """A box solid with the implicit scheme is refused naming solver.scheme; with "verlet"
+    (what a file that names no scheme gets) it validates and build_model gives the body's
+    modes and contact arrays."""
     from granplate.model import build_model
 
-    d = base(plate={"size": [0.1, 0.1, 0.005], "elements": [2, 2, 1], "max_frequency": 5e4})
+    d = base(plate={"size": [0.1, 0.1, 0.005], "elements": [2, 2, 1], "max_frequency": 5e4},
+             solver={"scheme": "implicit"})
     e = refused(d)
     assert e.field == "solver.scheme" and "verlet" in str(e)
     d["solver"] = {"scheme": "verlet", "granular_friction": "split"}

@@ -208,3 +208,17 @@ def test_a_solid_alone_and_the_other_dimension_s_plate():
     with pytest.raises(ScenarioError, match="in 3D the \\[plate\\] is an elastic solid") as e:
         validate(dataclasses.replace(alone, plate=Plate(x0=0.1)))
     assert e.value.field == "plate"
+
+
+def test_residual_off_builds_no_residual_and_bad_values_are_refused():
+    """plate.residual = false: the body's loop arrays hold no residual compliance (the modes
+    alone); a non-boolean and a non-positive stress_radius are refused naming the field."""
+    from granplate.model import build_model
+
+    m = build_model(scenario(residual=False))
+    assert m.body.resid.shape == (0, 0) and np.all(m.body.face_resid < 0)
+    assert build_model(scenario()).body.resid.shape[0] > 0
+    for change, field in (({"residual": 1}, "plate.residual"), ({"stress_radius": 0.0}, "plate.stress_radius")):
+        with pytest.raises(ScenarioError) as e:
+            validate(scenario(**change))
+        assert e.value.field == field
