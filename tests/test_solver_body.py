@@ -57,6 +57,12 @@ def model():
     return build_model(scenario_io.loads(DROP))
 
 
+@pytest.fixture(scope="module", params=[0.0, 0.004])
+def any_patch(request):
+    """The model with a point patch and with a disc patch of radius 4 mm (across a face edge)."""
+    return build_model(scenario_io.loads(DROP.replace('clamped = ["zmin"]', f'clamped = ["zmin"]\npatch_radius = {request.param}')))
+
+
 def forces(m, y, q, b=None):
     """(acc * m [N] on the granules (ng, 9), the contacts' energy, the residual's [J], b)."""
     b = new_body_state(m.body) if b is None else b
@@ -82,9 +88,10 @@ def test_hertz_force_at_a_known_overlap_with_the_residual_in_series(model):
     y = state(m, 2e-6)
     acc, e_pot, e_static, b = forces(m, y, np.zeros(m.solid.n_modes))
     delta0 = m.granular.radius[0] - (y[0, 2] - 0.01)
-    w = b.weights[0, 0]
-    f = b.face[0, 0]
-    sidx = b.face_resid[f, :, 2]
+    n = b.count[0, 0]  # a point patch: the closest point's face nodes
+    w = b.weights[0, 0, :n]
+    n_fn = b.face_resid.shape[1]
+    sidx = np.array([b.face_resid[k // n_fn, k % n_fn, 2] for k in b.entry[0, 0, :n]])
     r = float(w[sidx >= 0] @ m.solid.resid[np.ix_(sidx[sidx >= 0], sidx[sidx >= 0])] @ w[sidx >= 0])
     assert r > 0.0
     a = m.body.coef[0, COEF_A]
@@ -96,11 +103,12 @@ def test_hertz_force_at_a_known_overlap_with_the_residual_in_series(model):
     assert e_pot == pytest.approx(0.4 * a * delta**2.5, rel=1e-10)
 
 
-def test_forces_are_the_gradient_of_the_contact_potential(model):
+def test_forces_are_the_gradient_of_the_contact_potential(any_patch):
     """On a deformed body (modes displaced) the granule's force is -dPi/dx of Pi = E_Hertz +
-    1/2 N^T R N (central differences in x, y, z to 1e-6), the tilt and the residual's moving
-    weights included; without them the tangential force would be zero."""
-    m = model
+    1/2 N^T R N (central differences in x, y, z to 1e-5), the tilt and the residual's moving
+    weights included (a point patch and a disc patch); without them the tangential force
+    would be zero."""
+    m = any_patch
     rng = np.random.default_rng(3)
     q = rng.normal(size=m.solid.n_modes) * 2e-6 / np.maximum(1.0, np.arange(m.solid.n_modes))
     y = state(m, 1.5e-6)
@@ -120,9 +128,10 @@ def test_forces_are_the_gradient_of_the_contact_potential(model):
     np.testing.assert_allclose(acc[0, 3:6], -grad, rtol=1e-5, atol=1e-6 * abs(acc[0, 5]))
 
 
-def test_modal_force_is_the_work_conjugate_of_the_overlap(model):
-    """Phi^T F on the modes equals -dPi/dq (central differences in two modes' coordinates)."""
-    m = model
+def test_modal_force_is_the_work_conjugate_of_the_overlap(any_patch):
+    """Phi^T F on the modes equals -dPi/dq (central differences in two modes' coordinates),
+    for a point patch and a disc patch."""
+    m = any_patch
     q = np.zeros(m.solid.n_modes)
     y = state(m, 1.5e-6)
     _, _, _, b = forces(m, y, q)
@@ -136,6 +145,21 @@ def test_modal_force_is_the_work_conjugate_of_the_overlap(model):
             _, ep, es, _ = forces(m, y, qq)
             e.append(ep + es)
         assert fm[k] == pytest.approx(-(e[0] - e[1]) / (2 * h), rel=1e-5, abs=1e-8 * np.abs(fm).max())
+
+
+def test_disc_patch_weights_average_the_shape_functions(any_patch):
+    """A patch's weights sum to 1 and their first moment about the contact point is zero
+    (the disc rule is centred) on a flat face; a radius-0 patch is the point's face nodes."""
+    m = any_patch
+    y = state(m, 1e-6)
+    _, _, _, b = forces(m, y, np.zeros(m.solid.n_modes))
+    n = b.count[0, 0]
+    w = b.weights[0, 0, :n]
+    n_fn = b.face_nodes.shape[1]
+    x = np.array([b.face_nodes[k // n_fn, k % n_fn] for k in b.entry[0, 0, :n]])
+    assert w.sum() == pytest.approx(1.0, abs=1e-12)
+    np.testing.assert_allclose(w @ x[:, :2], y[0, :2], atol=1e-12)
+    assert n == (n_fn if m.body.patch[0] == 0.0 else 7 * n_fn)
 
 
 def test_modes_turn_exactly():

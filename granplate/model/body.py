@@ -54,6 +54,11 @@ def body_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, body_m
     return coef
 
 
+def patch_radius(s: Scenario) -> float:
+    """The contact patch's radius [m] (plate.patch_radius; 0: a point)."""
+    return float(s.plate.patch_radius)
+
+
 def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
     """(the SolidModel, its BodyArrays) of the scenario's elastic solid."""
     from granplate.solid.boundary import reduced_index
@@ -79,6 +84,9 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
     resid_index = np.where(rows >= 0, where[np.maximum(rows, 0)], -1)
     ng, nm = len(r), solid.n_modes
     n_fn = surface.dofs.shape[1]
+    from granplate.solver.body import PATCH_RULE
+
+    n_p = PATCH_RULE.shape[0] * n_fn
     seeds = np.array([closest_point(surface, (g.x, g.y, g.z)).face for g in s.granules], np.int64)
     box = np.array([solid.nodes.min(axis=0), solid.nodes.max(axis=0)])
     z = np.zeros
@@ -87,10 +95,10 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
         face_resid=np.ascontiguousarray(resid_index, np.int64), neighbours=face_neighbours(surface),
         kind=np.array([surface.kind], np.int64), phi=np.ascontiguousarray(solid.Phi), omega=solid.omega.copy(),
         resid=np.ascontiguousarray(solid.resid), box=box, coef=body_coefficients(s, mats, r, mass, material),
-        face=np.vstack([seeds, seeds]), geo=z((2, ng, N_GEO)), weights=z((2, ng, n_fn)),
-        fmodal=z((2, nm)), fdamp=z((2, nm)), hist=no_history(ng), q=z(nm), qd=z(nm), qdp=z(nm), static=z(2),
-        active=np.zeros(ng, np.int64), rmat=z((ng, ng)), rcol=np.zeros((ng, 3 * n_fn), np.int64),
-        rcoef=z((ng, 3 * n_fn)), rnode=np.zeros((ng, 3 * n_fn), np.int64), dweights=z((ng, n_fn, 2)),
-        tangent=z((ng, 3, 2)),
+        patch=np.array([patch_radius(s)]), face=np.vstack([seeds, seeds]), geo=z((2, ng, N_GEO)),
+        entry=np.zeros((2, ng, n_p), np.int64), weights=z((2, ng, n_p)), count=np.zeros((2, ng), np.int64),
+        grad=z((ng, n_p, 3)), fmodal=z((2, nm)), fdamp=z((2, nm)), hist=no_history(ng), q=z(nm), qd=z(nm),
+        qdp=z(nm), static=z(2), active=np.zeros(ng, np.int64), rmat=z((ng, ng)),
+        rcol=np.zeros((ng, 3 * n_p), np.int64), rcoef=z((ng, 3 * n_p)), rgrad=z((ng, 3 * n_p, 3)),
     )
     return solid, arrays

@@ -177,15 +177,16 @@ class BodyArrays(NamedTuple):
 
     The state of one run (new_body_state copies it): face: (2, ng) int each granule's
     closest face in the two buffers (t_n and the trial step's end; the seed of the next
-    search); geo: (2, ng, N_GEO); weights: (2, ng, n_fn) the closest point's shape
-    functions; fmodal, fdamp: (2, nm) the contact forces' and their damping parts'
+    search); geo: (2, ng, N_GEO); entry, weights: (2, ng, P) each contact's patch as
+    entries (face * n_fn + node, weight), count: (2, ng) how many (P = 7 n_fn: the patch
+    rule's points times a face's nodes), grad: (ng, P, 3) the weights' gradients in the
+    granule's position [1/m] at the last force pass; patch: (1,) the patch radius [m] (0:
+    a point); fmodal, fdamp: (2, nm) the contact forces' and their damping parts'
     modal projections Phi^T F [N kg^-1/2]; hist: (ng, N_HIST) each contact's history;
     q, qd, qdp: (nm,) the trial step's modal displacement and velocity and the velocity
     predicted for the force pass; static: (2,) the residual compliance's energy [J];
-    active: (ng,) int, rmat: (ng, ng) and rcol, rnode, rcoef: (ng, 3 n_fn) scratch of
-    the residual solve (each term's dof in S, its node 3 a + c, its weight); dweights: (ng,
-    n_fn, 2) the shape functions' face derivatives and tangent: (ng, 3, 2) the map from
-    face to space gradients, J (J^T J)^-1, at the last force pass.
+    active: (ng,) int, rmat: (ng, ng) and rcol, rcoef: (ng, 3 P), rgrad: (ng, 3 P, 3)
+    scratch of the residual solve (each term's dof in S, its weight, its gradient).
     """
 
     face_nodes: np.ndarray
@@ -198,9 +199,13 @@ class BodyArrays(NamedTuple):
     resid: np.ndarray
     box: np.ndarray
     coef: np.ndarray
+    patch: np.ndarray
     face: np.ndarray
     geo: np.ndarray
+    entry: np.ndarray
     weights: np.ndarray
+    count: np.ndarray
+    grad: np.ndarray
     fmodal: np.ndarray
     fdamp: np.ndarray
     hist: np.ndarray
@@ -212,9 +217,7 @@ class BodyArrays(NamedTuple):
     rmat: np.ndarray
     rcol: np.ndarray
     rcoef: np.ndarray
-    rnode: np.ndarray
-    dweights: np.ndarray
-    tangent: np.ndarray
+    rgrad: np.ndarray
 
 
 def no_body(ng: int, nm: int) -> BodyArrays:
@@ -224,18 +227,18 @@ def no_body(ng: int, nm: int) -> BodyArrays:
     return BodyArrays(
         face_nodes=z((0, 1, 3)), face_rows=np.zeros((0, 1, 3), i), face_resid=np.zeros((0, 1, 3), i),
         neighbours=np.zeros((0, 1), i), kind=np.zeros(1, i), phi=z((0, nm)), omega=z(nm), resid=z((0, 0)),
-        box=z((2, 3)), coef=z((0, 5)), face=np.zeros((2, 0), i), geo=z((2, 0, N_GEO)), weights=z((2, 0, 1)),
+        box=z((2, 3)), coef=z((0, 5)), patch=z(1), face=np.zeros((2, 0), i), geo=z((2, 0, N_GEO)),
+        entry=np.zeros((2, 0, 1), i), weights=z((2, 0, 1)), count=np.zeros((2, 0), i), grad=z((0, 1, 3)),
         fmodal=z((2, nm)), fdamp=z((2, nm)), hist=no_history(0), q=z(nm), qd=z(nm), qdp=z(nm), static=z(2),
-        active=np.zeros(0, i), rmat=z((0, 0)), rcol=np.zeros((0, 3), i), rcoef=z((0, 3)),
-        rnode=np.zeros((0, 3), i), dweights=z((0, 1, 2)), tangent=z((0, 3, 2)),
+        active=np.zeros(0, i), rmat=z((0, 0)), rcol=np.zeros((0, 3), i), rcoef=z((0, 3)), rgrad=z((0, 3, 3)),
     )
 
 
 def new_body_state(b: BodyArrays) -> BodyArrays:
     """b with its per-run state (face onwards) copied, so that a run never writes into the
     model's arrays; the geometry, modes and coefficients are shared."""
-    return b._replace(face=b.face.copy(), geo=b.geo.copy(), weights=b.weights.copy(), fmodal=b.fmodal.copy(),
+    return b._replace(face=b.face.copy(), geo=b.geo.copy(), entry=b.entry.copy(), weights=b.weights.copy(),
+                      count=b.count.copy(), grad=b.grad.copy(), fmodal=b.fmodal.copy(),
                       fdamp=b.fdamp.copy(), hist=b.hist.copy(), q=b.q.copy(), qd=b.qd.copy(), qdp=b.qdp.copy(),
                       static=b.static.copy(), active=b.active.copy(), rmat=b.rmat.copy(), rcol=b.rcol.copy(),
-                      rcoef=b.rcoef.copy(), rnode=b.rnode.copy(), dweights=b.dweights.copy(),
-                      tangent=b.tangent.copy())
+                      rcoef=b.rcoef.copy(), rgrad=b.rgrad.copy())

@@ -132,7 +132,8 @@ def solid_mesh(sd: Solid) -> skfem.Mesh:
 def cache_payload(sd: Solid, material: Material, surface: str | None, components: str) -> dict:
     """Every input of build_solid (a mesh file by its content's SHA-256)."""
     fields = dataclasses.asdict(sd)
-    fields.pop("stress_radius", None)  # the outputs' averaging, not the body
+    for name in ("stress_radius", "patch_radius"):  # the outputs' averaging and the contacts, not the body
+        fields.pop(name, None)
     if sd.mesh is not None:
         fields["mesh"] = hashlib.sha256(Path(sd.mesh).read_bytes()).hexdigest()
     return {"skfem": getattr(skfem, "__version__", "?"), "solid": fields,

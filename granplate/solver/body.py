@@ -45,6 +45,12 @@ RESID_SWEEPS = 200
 RESID_RTOL = 1e-13
 NEWTON_STEPS = 60
 NEWTON_RTOL = 1e-14
+#: The patch's disc rule (docs/model.md section 3.9): points (u, v) in units of the patch
+#: radius in the tangent plane and weights; Radon's seven points, exact for polynomials of
+#: degree 5 over the disc.
+PATCH_RULE = np.array([[0.0, 0.0, 0.25]] + [[math.sqrt(2.0 / 3.0) * math.cos(k * math.pi / 3.0),
+                                             math.sqrt(2.0 / 3.0) * math.sin(k * math.pi / 3.0), 0.125]
+                                            for k in range(6)])
 #: A granule is located on the surface when its centre lies within REACH radii of the
 #: body's bounding box (a surface that moves out of the box by more than REACH - 1 radii
 #: towards a granule would be missed).
@@ -70,10 +76,60 @@ def near_box(b, x, y, z, reach) -> bool:
 
 
 @njit(cache=True)
+def tangent_map(X, dN, t) -> None:
+    """t (3, 2) = J (J^T J)^-1, J = sum_a X_a grad_xi(N_a)^T the face's Jacobian at the
+    point of the shape functions' derivatives dN: a face gradient to the surface gradient
+    in space."""
+    j00 = j01 = j10 = j11 = j20 = j21 = 0.0
+    for a in range(dN.shape[0]):
+        j00 += X[a, 0] * dN[a, 0]
+        j01 += X[a, 0] * dN[a, 1]
+        j10 += X[a, 1] * dN[a, 0]
+        j11 += X[a, 1] * dN[a, 1]
+        j20 += X[a, 2] * dN[a, 0]
+        j21 += X[a, 2] * dN[a, 1]
+    a00 = j00 * j00 + j10 * j10 + j20 * j20
+    a01 = j00 * j01 + j10 * j11 + j20 * j21
+    a11 = j01 * j01 + j11 * j11 + j21 * j21
+    det = a00 * a11 - a01 * a01
+    i00 = a11 / det
+    i01 = -a01 / det
+    i11 = a00 / det
+    t[0, 0] = j00 * i00 + j01 * i01
+    t[0, 1] = j00 * i01 + j01 * i11
+    t[1, 0] = j10 * i00 + j11 * i01
+    t[1, 1] = j10 * i01 + j11 * i11
+    t[2, 0] = j20 * i00 + j21 * i01
+    t[2, 1] = j20 * i01 + j21 * i11
+
+
+@njit(cache=True)
+def patch_frame(nx, ny, nz):
+    """Two unit tangents (t1, t2) of the plane normal to n: t1 along e x n for the axis e
+    least aligned with n (constant over a flat face), t2 = n x t1."""
+    ax, ay, az = abs(nx), abs(ny), abs(nz)
+    if ax <= ay and ax <= az:  # e = x: e x n = (0, -nz, ny)
+        t1x, t1y, t1z = 0.0, -nz, ny
+    elif ay <= az:  # e = y: (nz, 0, -nx)
+        t1x, t1y, t1z = nz, 0.0, -nx
+    else:  # e = z: (-ny, nx, 0)
+        t1x, t1y, t1z = -ny, nx, 0.0
+    inv = 1.0 / math.sqrt(t1x * t1x + t1y * t1y + t1z * t1z)
+    t1x *= inv
+    t1y *= inv
+    t1z *= inv
+    return t1x, t1y, t1z, ny * t1z - nz * t1y, nz * t1x - nx * t1z, nx * t1y - ny * t1x
+
+
+@njit(cache=True)
 def locate(b, buf, i, p, out, N, dN) -> None:
-    """Granule i's closest point of the undeformed surface to centre p (3,) [m] into buffer
-    buf (face, face coordinates, signed distance, normal, weights), searched from the face
-    it last touched."""
+    """Granule i's contact on the undeformed surface (docs/model.md section 3.9), centre p
+    (3,) [m], into buffer buf: the closest point (face, face coordinates, signed distance,
+    outward normal: geo), searched from the face it last touched; and its patch: a disc of
+    radius b.patch[0] on the surface about that point, sampled by PATCH_RULE (its points
+    offset in the tangent plane, each located on the surface from the contact's face), as
+    entries (face node, weight = the rule's weight x the shape function there, and the
+    weight's gradient in the granule's position [1/m]). A radius 0 is the point patch."""
     seed = b.face[buf, i] if b.face[buf, i] >= 0 else b.face[1 - buf, i]
     f = follow_closest(b.face_nodes, b.kind[0], b.neighbours, seed, p, out)
     b.face[buf, i] = f
@@ -84,47 +140,52 @@ def locate(b, buf, i, p, out, N, dN) -> None:
     g[GEO_NY] = out[6]
     g[GEO_NZ] = out[7]
     g[GEO_DIST] = out[8]
-    face_shape_functions(b.kind[0], out[0], out[1], N, dN)
-    X = b.face_nodes[f]
-    j00 = j01 = j10 = j11 = j20 = j21 = 0.0
-    for a in range(N.shape[0]):
-        b.weights[buf, i, a] = N[a]
-        b.dweights[i, a, 0] = dN[a, 0]
-        b.dweights[i, a, 1] = dN[a, 1]
-        j00 += X[a, 0] * dN[a, 0]
-        j01 += X[a, 0] * dN[a, 1]
-        j10 += X[a, 1] * dN[a, 0]
-        j11 += X[a, 1] * dN[a, 1]
-        j20 += X[a, 2] * dN[a, 0]
-        j21 += X[a, 2] * dN[a, 1]
-    # J (J^T J)^-1: a face gradient (d/dxi, d/deta) to the surface gradient in space
-    a00 = j00 * j00 + j10 * j10 + j20 * j20
-    a01 = j00 * j01 + j10 * j11 + j20 * j21
-    a11 = j01 * j01 + j11 * j11 + j21 * j21
-    det = a00 * a11 - a01 * a01
-    i00 = a11 / det
-    i01 = -a01 / det
-    i11 = a00 / det
-    t = b.tangent[i]
-    t[0, 0] = j00 * i00 + j01 * i01
-    t[0, 1] = j00 * i01 + j01 * i11
-    t[1, 0] = j10 * i00 + j11 * i01
-    t[1, 1] = j10 * i01 + j11 * i11
-    t[2, 0] = j20 * i00 + j21 * i01
-    t[2, 1] = j20 * i01 + j21 * i11
+    radius = b.patch[0]
+    n_fn = N.shape[0]
+    n_samples = 1 if radius == 0.0 else PATCH_RULE.shape[0]
+    t1x, t1y, t1z, t2x, t2y, t2z = patch_frame(out[5], out[6], out[7])
+    q = np.empty(3)
+    o2 = np.empty(9)
+    t = np.empty((3, 2))
+    e = 0
+    for j in range(n_samples):
+        fj = f
+        if j == 0 and PATCH_RULE[0, 0] == 0.0 and PATCH_RULE[0, 1] == 0.0:
+            o2[0] = out[0]
+            o2[1] = out[1]
+        else:
+            u = radius * PATCH_RULE[j, 0]
+            v = radius * PATCH_RULE[j, 1]
+            q[0] = p[0] + u * t1x + v * t2x
+            q[1] = p[1] + u * t1y + v * t2y
+            q[2] = p[2] + u * t1z + v * t2z
+            fj = follow_closest(b.face_nodes, b.kind[0], b.neighbours, f, q, o2)
+        omega = 1.0 if n_samples == 1 else PATCH_RULE[j, 2]
+        face_shape_functions(b.kind[0], o2[0], o2[1], N, dN)
+        tangent_map(b.face_nodes[fj], dN, t)
+        for a in range(n_fn):
+            b.entry[buf, i, e] = fj * n_fn + a
+            b.weights[buf, i, e] = omega * N[a]
+            for c in range(3):
+                b.grad[i, e, c] = omega * (t[c, 0] * dN[a, 0] + t[c, 1] * dN[a, 1])
+            e += 1
+    b.count[buf, i] = e
 
 
 @njit(cache=True)
 def surface_velocity(b, buf, i, qd):
-    """The surface's velocity at granule i's contact point (buffer buf), sum_a w_a Phi_a qd
-    [m/s] (x, y, z)."""
-    f = b.face[buf, i]
+    """The surface's velocity at granule i's contact (buffer buf), its patch's weighted mean
+    sum_e w_e Phi_e qd [m/s] (x, y, z)."""
+    n_fn = b.face_rows.shape[1]
     nm = qd.shape[0]
-    v0 = v1 = v2 = 0.0
-    for a in range(b.face_rows.shape[1]):
-        w = b.weights[buf, i, a]
+    v = np.zeros(3)
+    for e in range(b.count[buf, i]):
+        w = b.weights[buf, i, e]
         if w == 0.0:
             continue
+        k = b.entry[buf, i, e]
+        f = k // n_fn
+        a = k - f * n_fn
         for c in range(3):
             row = b.face_rows[f, a, c]
             if row < 0:
@@ -132,44 +193,43 @@ def surface_velocity(b, buf, i, qd):
             sv = 0.0
             for m in range(nm):
                 sv += b.phi[row, m] * qd[m]
-            if c == 0:
-                v0 += w * sv
-            elif c == 1:
-                v1 += w * sv
-            else:
-                v2 += w * sv
-    return v0, v1, v2
+            v[c] += w * sv
+    return v[0], v[1], v[2]
 
 
 @njit(cache=True)
 def normal_motion(b, buf, i, q) -> float:
-    """The surface's normal displacement u_n = n . u_c [m] at granule i's contact point
-    (buffer buf), and its surface gradient (the deformed surface's tilt, [-]) into geo's
-    GEO_GX..GEO_GZ: J (J^T J)^-1 sum_a grad_xi(N_a) n . u_a."""
-    f = b.face[buf, i]
+    """The surface's normal displacement u_n = n . u_c [m] at granule i's contact (buffer
+    buf; u_c its patch's weighted mean), and its gradient in the granule's position (the
+    deformed surface's tilt, [-]) into geo's GEO_GX..GEO_GZ: sum_e grad(w_e) n . u_e."""
+    n_fn = b.face_rows.shape[1]
     g = b.geo[buf, i]
     nm = q.shape[0]
     un = 0.0
-    d0 = 0.0
-    d1 = 0.0
-    for a in range(b.face_rows.shape[1]):
+    gx = 0.0
+    gy = 0.0
+    gz = 0.0
+    for e in range(b.count[buf, i]):
+        k = b.entry[buf, i, e]
+        f = k // n_fn
+        a = k - f * n_fn
         ua = 0.0
         for c in range(3):
             row = b.face_rows[f, a, c]
             nc = g[GEO_NX + c]
             if row < 0 or nc == 0.0:
                 continue
-            s = 0.0
+            sq = 0.0
             for m in range(nm):
-                s += b.phi[row, m] * q[m]
-            ua += nc * s
-        un += b.weights[buf, i, a] * ua
-        d0 += b.dweights[i, a, 0] * ua
-        d1 += b.dweights[i, a, 1] * ua
-    t = b.tangent[i]
-    g[GEO_GX] = t[0, 0] * d0 + t[0, 1] * d1
-    g[GEO_GY] = t[1, 0] * d0 + t[1, 1] * d1
-    g[GEO_GZ] = t[2, 0] * d0 + t[2, 1] * d1
+                sq += b.phi[row, m] * q[m]
+            ua += nc * sq
+        un += b.weights[buf, i, e] * ua
+        gx += b.grad[i, e, 0] * ua
+        gy += b.grad[i, e, 1] * ua
+        gz += b.grad[i, e, 2] * ua
+    g[GEO_GX] = gx
+    g[GEO_GY] = gy
+    g[GEO_GZ] = gz
     return un
 
 
@@ -177,34 +237,36 @@ def normal_motion(b, buf, i, q) -> float:
 def residual_tilt(b, buf, k, counts, upos, z, out) -> None:
     """The residual's pull along the surface on contact k (its static force in geo's
     GEO_NSTAT; z = R_S sum_j r_j N_j on the touched dofs, `residual_load`): out (3,) =
-    N_k J (J^T J)^-1 grad_xi(r_k)^T z [N], the force -dPi/dx of the residual energy Pi =
-    1/2 N^T R N as r_k's weights move with the granule (docs/model.md section 3.9)."""
+    N_k grad(r_k)^T z [N], the force -dPi/dx of the residual energy Pi = 1/2 N^T R N as
+    r_k's weights move with the granule (docs/model.md section 3.9)."""
     i = b.active[k]
     g = b.geo[buf]
     d0 = 0.0
     d1 = 0.0
+    d2 = 0.0
     for e in range(counts[k]):
         ze = z[upos[b.rcol[k, e]]]
-        node = b.rnode[k, e]
-        nc = g[i, GEO_NX + node % 3]
-        d0 += ze * b.dweights[i, node // 3, 0] * nc
-        d1 += ze * b.dweights[i, node // 3, 1] * nc
+        d0 += ze * b.rgrad[k, e, 0]
+        d1 += ze * b.rgrad[k, e, 1]
+        d2 += ze * b.rgrad[k, e, 2]
     nk = g[i, GEO_NSTAT]
-    t = b.tangent[i]
-    out[0] = nk * (t[0, 0] * d0 + t[0, 1] * d1)
-    out[1] = nk * (t[1, 0] * d0 + t[1, 1] * d1)
-    out[2] = nk * (t[2, 0] * d0 + t[2, 1] * d1)
+    out[0] = nk * d0
+    out[1] = nk * d1
+    out[2] = nk * d2
 
 
 @njit(cache=True)
 def spread(b, buf, i, fx, fy, fz, out, scale) -> None:
-    """out[m] += scale * (Phi^T f)_m for the force f [N] at granule i's contact point
-    (buffer buf), spread over the face's nodes by the weights."""
-    f = b.face[buf, i]
-    for a in range(b.face_rows.shape[1]):
-        w = b.weights[buf, i, a] * scale
+    """out[m] += scale * (Phi^T f)_m for the force f [N] at granule i's contact (buffer
+    buf), spread over its patch's nodes by the weights."""
+    n_fn = b.face_rows.shape[1]
+    for e in range(b.count[buf, i]):
+        w = b.weights[buf, i, e] * scale
         if w == 0.0:
             continue
+        k = b.entry[buf, i, e]
+        f = k // n_fn
+        a = k - f * n_fn
         for c in range(3):
             row = b.face_rows[f, a, c]
             if row < 0:
@@ -217,12 +279,15 @@ def spread(b, buf, i, fx, fy, fz, out, scale) -> None:
 @njit(cache=True)
 def spread_both(b, buf, i, nx, ny, nz, n, d, out, out_d) -> None:
     """out += Phi^T (w (x) n N) and out_d += Phi^T (w (x) n D) in one pass over the rows:
-    a normal force N n and its damping part D n [N] at granule i's contact point."""
-    f = b.face[buf, i]
-    for a in range(b.face_rows.shape[1]):
-        w = b.weights[buf, i, a]
+    a normal force N n and its damping part D n [N] at granule i's contact."""
+    n_fn = b.face_rows.shape[1]
+    for e in range(b.count[buf, i]):
+        w = b.weights[buf, i, e]
         if w == 0.0:
             continue
+        k = b.entry[buf, i, e]
+        f = k // n_fn
+        a = k - f * n_fn
         for c in range(3):
             row = b.face_rows[f, a, c]
             nc = nx if c == 0 else (ny if c == 1 else nz)
@@ -261,20 +326,26 @@ def static_overlap(target, r, c, delta_max, clip) -> float:
 
 @njit(cache=True)
 def residual_rows(b, buf, i, k) -> int:
-    """Contact k (granule i) as a combination of the residual dofs: its normal n times the
-    weights on the dofs of S (rcol, rcoef row k). Returns how many terms."""
-    f = b.face[buf, i]
+    """Contact k (granule i) as a combination of the residual dofs: its normal n times its
+    patch's weights on the dofs of S (rcol, rcoef row k), and each term's gradient in the
+    granule's position (rgrad). Returns how many terms."""
+    n_fn = b.face_rows.shape[1]
     g = b.geo[buf, i]
     nt = 0
-    for a in range(b.face_resid.shape[1]):
-        w = b.weights[buf, i, a]
+    for e in range(b.count[buf, i]):
+        w = b.weights[buf, i, e]
+        kk = b.entry[buf, i, e]
+        f = kk // n_fn
+        a = kk - f * n_fn
         for c in range(3):
             s = b.face_resid[f, a, c]
-            if s < 0 or w == 0.0:
+            nc = g[GEO_NX + c]
+            if s < 0 or nc == 0.0:
                 continue
             b.rcol[k, nt] = s
-            b.rnode[k, nt] = 3 * a + c
-            b.rcoef[k, nt] = w * g[GEO_NX + c]
+            b.rcoef[k, nt] = w * nc
+            for d in range(3):
+                b.rgrad[k, nt, d] = b.grad[i, e, d] * nc
             nt += 1
     return nt
 
