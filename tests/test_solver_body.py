@@ -57,9 +57,9 @@ def model():
     return build_model(scenario_io.loads(DROP))
 
 
-@pytest.fixture(scope="module", params=[0.0, 0.004])
+@pytest.fixture(scope="module", params=[0.0, 0.006])
 def any_patch(request):
-    """The model with a point patch and with a disc patch of radius 4 mm (across a face edge)."""
+    """The model with a point patch and with a disc patch of radius 6 mm (across face edges)."""
     return build_model(scenario_io.loads(DROP.replace('clamped = ["zmin"]', f'clamped = ["zmin"]\npatch_radius = {request.param}')))
 
 
@@ -90,8 +90,7 @@ def test_hertz_force_at_a_known_overlap_with_the_residual_in_series(model):
     delta0 = m.granular.radius[0] - (y[0, 2] - 0.01)
     n = b.count[0, 0]  # a point patch: the closest point's face nodes
     w = b.weights[0, 0, :n]
-    n_fn = b.face_resid.shape[1]
-    sidx = np.array([b.face_resid[k // n_fn, k % n_fn, 2] for k in b.entry[0, 0, :n]])
+    sidx = b.node_resid[b.entry[0, 0, :n], 2]
     r = float(w[sidx >= 0] @ m.solid.resid[np.ix_(sidx[sidx >= 0], sidx[sidx >= 0])] @ w[sidx >= 0])
     assert r > 0.0
     a = m.body.coef[0, COEF_A]
@@ -148,18 +147,21 @@ def test_modal_force_is_the_work_conjugate_of_the_overlap(any_patch):
 
 
 def test_disc_patch_weights_average_the_shape_functions(any_patch):
-    """A patch's weights sum to 1 and their first moment about the contact point is zero
-    (the disc rule is centred) on a flat face; a radius-0 patch is the point's face nodes."""
+    """A patch's weights sum to 1: a radius-0 patch is the point's face nodes (whose weights
+    reproduce the point), a disc patch every surface node within its radius, weights >= 0."""
     m = any_patch
     y = state(m, 1e-6)
     _, _, _, b = forces(m, y, np.zeros(m.solid.n_modes))
     n = b.count[0, 0]
     w = b.weights[0, 0, :n]
-    n_fn = b.face_nodes.shape[1]
-    x = np.array([b.face_nodes[k // n_fn, k % n_fn] for k in b.entry[0, 0, :n]])
-    assert w.sum() == pytest.approx(1.0, abs=1e-12)
-    np.testing.assert_allclose(w @ x[:, :2], y[0, :2], atol=1e-12)
-    assert n == (n_fn if m.body.patch[0] == 0.0 else 7 * n_fn)
+    x = b.node_xyz[b.entry[0, 0, :n]]
+    assert w.sum() == pytest.approx(1.0, abs=1e-12) and np.all(w >= -1e-12 if m.body.patch[0] > 0 else True)
+    if m.body.patch[0] == 0.0:  # the face's shape functions reproduce the point
+        np.testing.assert_allclose(w @ x[:, :2], y[0, :2], atol=1e-12)
+        assert n == b.face_nodes.shape[1]
+    else:  # every node within the radius, none beyond
+        d = np.linalg.norm(b.node_xyz - np.array([y[0, 0], y[0, 1], 0.01]), axis=1)
+        assert set(b.entry[0, 0, :n]) == set(np.flatnonzero(d < m.body.patch[0]))
 
 
 def test_modes_turn_exactly():

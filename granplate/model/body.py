@@ -64,6 +64,7 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
     from granplate.solid.boundary import reduced_index
     from granplate.solid.build import build_solid, solid_mesh
     from granplate.solid.fe import vector_basis
+    from granplate.solid.patch import check_patch_radius, farthest_from_nodes, node_grid, patch_capacity, surface_nodes
     from granplate.solid.surface import boundary_surface, closest_point, face_neighbours
 
     sd = s.plate
@@ -78,24 +79,31 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
     surface = boundary_surface(vector_basis(mesh, sd.element))
     face, components = residual_face(s, surface, mesh) if sd.residual else (None, "")
     solid = build_solid(sd, material, surface=face, components=components or "z")
-    rows = reduced_index(solid.dofs, surface.dofs.ravel()).reshape(surface.dofs.shape)
+    sn = surface_nodes(surface)
+    rows = reduced_index(solid.dofs, (3 * sn.full[:, None] + np.arange(3)).ravel()).reshape(-1, 3)
     where = np.full(len(solid.dofs), -1, np.int64)
     where[solid.surface_dofs] = np.arange(len(solid.surface_dofs))
     resid_index = np.where(rows >= 0, where[np.maximum(rows, 0)], -1)
     ng, nm = len(r), solid.n_modes
-    n_fn = surface.dofs.shape[1]
-    from granplate.solver.body import PATCH_RULE
-
-    n_p = PATCH_RULE.shape[0] * n_fn
+    radius = patch_radius(s)
+    n_p = surface.dofs.shape[1]
+    grid = node_grid(sn.xyz, max(radius, 1e-12))
+    if radius > 0.0:
+        reach = farthest_from_nodes(surface, sn.xyz)
+        check_patch_radius(radius, reach)
+        n_p = max(n_p, patch_capacity(sn.xyz, radius, reach))
     seeds = np.array([closest_point(surface, (g.x, g.y, g.z)).face for g in s.granules], np.int64)
     box = np.array([solid.nodes.min(axis=0), solid.nodes.max(axis=0)])
     z = np.zeros
     arrays = BodyArrays(
-        face_nodes=np.ascontiguousarray(surface.nodes), face_rows=np.ascontiguousarray(rows, np.int64),
-        face_resid=np.ascontiguousarray(resid_index, np.int64), neighbours=face_neighbours(surface),
+        face_nodes=np.ascontiguousarray(surface.nodes), face_snode=sn.face_snode, node_xyz=sn.xyz,
+        node_area=sn.area, node_rows=np.ascontiguousarray(rows, np.int64),
+        node_resid=np.ascontiguousarray(resid_index, np.int64), grid=np.array([grid.cell]),
+        grid_origin=grid.origin, grid_shape=grid.shape, cell_start=grid.start, cell_nodes=grid.nodes,
+        neighbours=face_neighbours(surface),
         kind=np.array([surface.kind], np.int64), phi=np.ascontiguousarray(solid.Phi), omega=solid.omega.copy(),
         resid=np.ascontiguousarray(solid.resid), box=box, coef=body_coefficients(s, mats, r, mass, material),
-        patch=np.array([patch_radius(s)]), face=np.vstack([seeds, seeds]), geo=z((2, ng, N_GEO)),
+        patch=np.array([radius]), face=np.vstack([seeds, seeds]), geo=z((2, ng, N_GEO)),
         entry=np.zeros((2, ng, n_p), np.int64), weights=z((2, ng, n_p)), count=np.zeros((2, ng), np.int64),
         grad=z((ng, n_p, 3)), fmodal=z((2, nm)), fdamp=z((2, nm)), hist=no_history(ng), q=z(nm), qd=z(nm),
         qdp=z(nm), static=z(2), active=np.zeros(ng, np.int64), rmat=z((ng, ng)),

@@ -166,9 +166,13 @@ class BodyArrays(NamedTuple):
     granule's contact coefficients with it, and (per run) each granule's contact state.
 
     face_nodes: (n_faces, n_fn, 3) [m] the faces' node coordinates (solid.surface);
-    face_rows: (n_faces, n_fn, 3) int the row of Phi of each node's x, y, z dof (-1:
-    fixed); face_resid: (n_faces, n_fn, 3) int the index of that dof in resid (-1: not
-    in the residual set S); neighbours: (n_faces, k) int faces sharing a corner (-1
+    face_snode: (n_faces, n_fn) int each face node's surface node; node_xyz: (n_sn, 3)
+    [m] the surface nodes; node_area: (n_sn,) [m^2] each one's share of the surface;
+    node_rows: (n_sn, 3) int the row of Phi of its x, y, z dof (-1: fixed); node_resid:
+    (n_sn, 3) int the index of that dof in resid (-1: not in the residual set S); grid:
+    (1,) [m] the cell size of a grid over the surface nodes, grid_origin (3,) [m],
+    grid_shape (3,) int, cell_start (n_cells + 1,) int and cell_nodes (n_sn,) int its
+    nodes cell by cell (a disc patch's search); neighbours: (n_faces, k) int faces sharing a corner (-1
     padded); kind: (1,) int the face kind (solid.surface QUAD8, QUAD9, TRI6); phi:
     (n_red, nm) the M-orthonormal modes [kg^-1/2]; omega: (nm,) [rad/s]; resid: (n_s,
     n_s) [m/N] the residual compliance over S ((0, 0): none); box: (2, 3) [m] the lowest
@@ -179,7 +183,7 @@ class BodyArrays(NamedTuple):
     closest face in the two buffers (t_n and the trial step's end; the seed of the next
     search); geo: (2, ng, N_GEO); entry, weights: (2, ng, P) each contact's patch as
     entries (face * n_fn + node, weight), count: (2, ng) how many (P = 7 n_fn: the patch
-    rule's points times a face's nodes), grad: (ng, P, 3) the weights' gradients in the
+    surface nodes a patch can hold), grad: (ng, P, 3) the weights' gradients in the
     granule's position [1/m] at the last force pass; patch: (1,) the patch radius [m] (0:
     a point); fmodal, fdamp: (2, nm) the contact forces' and their damping parts'
     modal projections Phi^T F [N kg^-1/2]; hist: (ng, N_HIST) each contact's history;
@@ -190,8 +194,16 @@ class BodyArrays(NamedTuple):
     """
 
     face_nodes: np.ndarray
-    face_rows: np.ndarray
-    face_resid: np.ndarray
+    face_snode: np.ndarray
+    node_xyz: np.ndarray
+    node_area: np.ndarray
+    node_rows: np.ndarray
+    node_resid: np.ndarray
+    grid: np.ndarray
+    grid_origin: np.ndarray
+    grid_shape: np.ndarray
+    cell_start: np.ndarray
+    cell_nodes: np.ndarray
     neighbours: np.ndarray
     kind: np.ndarray
     phi: np.ndarray
@@ -225,7 +237,9 @@ def no_body(ng: int, nm: int) -> BodyArrays:
     z = np.zeros
     i = np.int64
     return BodyArrays(
-        face_nodes=z((0, 1, 3)), face_rows=np.zeros((0, 1, 3), i), face_resid=np.zeros((0, 1, 3), i),
+        face_nodes=z((0, 1, 3)), face_snode=np.zeros((0, 1), i), node_xyz=z((0, 3)), node_area=z(0),
+        node_rows=np.zeros((0, 3), i), node_resid=np.zeros((0, 3), i), grid=np.ones(1), grid_origin=z(3),
+        grid_shape=np.ones(3, i), cell_start=np.zeros(2, i), cell_nodes=np.zeros(0, i),
         neighbours=np.zeros((0, 1), i), kind=np.zeros(1, i), phi=z((0, nm)), omega=z(nm), resid=z((0, 0)),
         box=z((2, 3)), coef=z((0, 5)), patch=z(1), face=np.zeros((2, 0), i), geo=z((2, 0, N_GEO)),
         entry=np.zeros((2, 0, 1), i), weights=z((2, 0, 1)), count=np.zeros((2, 0), i), grad=z((0, 1, 3)),

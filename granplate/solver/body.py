@@ -45,12 +45,6 @@ RESID_SWEEPS = 200
 RESID_RTOL = 1e-13
 NEWTON_STEPS = 60
 NEWTON_RTOL = 1e-14
-#: The patch's disc rule (docs/model.md section 3.9): points (u, v) in units of the patch
-#: radius in the tangent plane and weights; Radon's seven points, exact for polynomials of
-#: degree 5 over the disc.
-PATCH_RULE = np.array([[0.0, 0.0, 0.25]] + [[math.sqrt(2.0 / 3.0) * math.cos(k * math.pi / 3.0),
-                                             math.sqrt(2.0 / 3.0) * math.sin(k * math.pi / 3.0), 0.125]
-                                            for k in range(6)])
 #: A granule is located on the surface when its centre lies within REACH radii of the
 #: body's bounding box (a surface that moves out of the box by more than REACH - 1 radii
 #: towards a granule would be missed).
@@ -125,11 +119,10 @@ def patch_frame(nx, ny, nz):
 def locate(b, buf, i, p, out, N, dN) -> None:
     """Granule i's contact on the undeformed surface (docs/model.md section 3.9), centre p
     (3,) [m], into buffer buf: the closest point (face, face coordinates, signed distance,
-    outward normal: geo), searched from the face it last touched; and its patch: a disc of
-    radius b.patch[0] on the surface about that point, sampled by PATCH_RULE (its points
-    offset in the tangent plane, each located on the surface from the contact's face), as
-    entries (face node, weight = the rule's weight x the shape function there, and the
-    weight's gradient in the granule's position [1/m]). A radius 0 is the point patch."""
+    outward normal: geo), searched from the face it last touched; and its patch as entries
+    (surface node, weight, the weight's gradient in the granule's position [1/m]): the
+    face's shape functions at the point (radius b.patch[0] = 0), or the disc of that
+    radius about the point (`disc_patch`)."""
     seed = b.face[buf, i] if b.face[buf, i] >= 0 else b.face[1 - buf, i]
     f = follow_closest(b.face_nodes, b.kind[0], b.neighbours, seed, p, out)
     b.face[buf, i] = f
@@ -140,54 +133,90 @@ def locate(b, buf, i, p, out, N, dN) -> None:
     g[GEO_NY] = out[6]
     g[GEO_NZ] = out[7]
     g[GEO_DIST] = out[8]
-    radius = b.patch[0]
-    n_fn = N.shape[0]
-    n_samples = 1 if radius == 0.0 else PATCH_RULE.shape[0]
-    t1x, t1y, t1z, t2x, t2y, t2z = patch_frame(out[5], out[6], out[7])
-    q = np.empty(3)
-    o2 = np.empty(9)
+    if b.patch[0] > 0.0:
+        disc_patch(b, buf, i, out[2], out[3], out[4], out[5], out[6], out[7])
+        return
+    face_shape_functions(b.kind[0], out[0], out[1], N, dN)
     t = np.empty((3, 2))
-    e = 0
-    for j in range(n_samples):
-        fj = f
-        if j == 0 and PATCH_RULE[0, 0] == 0.0 and PATCH_RULE[0, 1] == 0.0:
-            o2[0] = out[0]
-            o2[1] = out[1]
-        else:
-            u = radius * PATCH_RULE[j, 0]
-            v = radius * PATCH_RULE[j, 1]
-            q[0] = p[0] + u * t1x + v * t2x
-            q[1] = p[1] + u * t1y + v * t2y
-            q[2] = p[2] + u * t1z + v * t2z
-            fj = follow_closest(b.face_nodes, b.kind[0], b.neighbours, f, q, o2)
-        omega = 1.0 if n_samples == 1 else PATCH_RULE[j, 2]
-        face_shape_functions(b.kind[0], o2[0], o2[1], N, dN)
-        tangent_map(b.face_nodes[fj], dN, t)
-        for a in range(n_fn):
-            b.entry[buf, i, e] = fj * n_fn + a
-            b.weights[buf, i, e] = omega * N[a]
-            for c in range(3):
-                b.grad[i, e, c] = omega * (t[c, 0] * dN[a, 0] + t[c, 1] * dN[a, 1])
-            e += 1
-    b.count[buf, i] = e
+    tangent_map(b.face_nodes[f], dN, t)
+    for a in range(N.shape[0]):
+        b.entry[buf, i, a] = b.face_snode[f, a]
+        b.weights[buf, i, a] = N[a]
+        for c in range(3):
+            b.grad[i, a, c] = t[c, 0] * dN[a, 0] + t[c, 1] * dN[a, 1]
+    b.count[buf, i] = N.shape[0]
+
+
+@njit(cache=True)
+def disc_patch(b, buf, i, x0, x1, x2, nx, ny, nz) -> None:
+    """Granule i's patch of radius a = b.patch[0] about the surface point x [m] (normal n):
+    every surface node within a of x, weighted by its share of the surface times the kernel
+    (1 - r^2/a^2)^2 and normalised, so that the weights are smooth in x and, as the mesh is
+    refined, average the surface over the disc; their gradients in the granule's position
+    are the kernel's along the surface (I - n n^T). Nodes by the grid of cells of b.grid."""
+    a = b.patch[0]
+    cell = b.grid[0]
+    o0, o1, o2 = b.grid_origin[0], b.grid_origin[1], b.grid_origin[2]
+    s0, s1, s2 = b.grid_shape[0], b.grid_shape[1], b.grid_shape[2]
+    c0 = int((x0 - o0) / cell)
+    c1 = int((x1 - o1) / cell)
+    c2 = int((x2 - o2) / cell)
+    n = 0
+    total = 0.0
+    dt0 = dt1 = dt2 = 0.0
+    inv_a2 = 1.0 / (a * a)
+    for k0 in range(max(c0 - 1, 0), min(c0 + 2, s0)):
+        for k1 in range(max(c1 - 1, 0), min(c1 + 2, s1)):
+            for k2 in range(max(c2 - 1, 0), min(c2 + 2, s2)):
+                cid = (k0 * s1 + k1) * s2 + k2
+                for q in range(b.cell_start[cid], b.cell_start[cid + 1]):
+                    node = b.cell_nodes[q]
+                    d0 = b.node_xyz[node, 0] - x0
+                    d1 = b.node_xyz[node, 1] - x1
+                    d2 = b.node_xyz[node, 2] - x2
+                    rho2 = (d0 * d0 + d1 * d1 + d2 * d2) * inv_a2
+                    if rho2 >= 1.0 or n >= b.entry.shape[2]:
+                        continue
+                    one = 1.0 - rho2
+                    k = b.node_area[node] * one * one
+                    dk = b.node_area[node] * 4.0 * one * inv_a2  # dk/dx = dk * (X_node - x)
+                    b.entry[buf, i, n] = node
+                    b.weights[buf, i, n] = k
+                    b.grad[i, n, 0] = dk * d0
+                    b.grad[i, n, 1] = dk * d1
+                    b.grad[i, n, 2] = dk * d2
+                    total += k
+                    dt0 += dk * d0
+                    dt1 += dk * d1
+                    dt2 += dk * d2
+                    n += 1
+    b.count[buf, i] = n
+    inv = 1.0 / total
+    for e in range(n):
+        w = b.weights[buf, i, e] * inv
+        b.weights[buf, i, e] = w
+        g0 = (b.grad[i, e, 0] - w * dt0) * inv
+        g1 = (b.grad[i, e, 1] - w * dt1) * inv
+        g2 = (b.grad[i, e, 2] - w * dt2) * inv
+        gn = g0 * nx + g1 * ny + g2 * nz  # along the surface only: the foot moves tangentially
+        b.grad[i, e, 0] = g0 - gn * nx
+        b.grad[i, e, 1] = g1 - gn * ny
+        b.grad[i, e, 2] = g2 - gn * nz
 
 
 @njit(cache=True)
 def surface_velocity(b, buf, i, qd):
     """The surface's velocity at granule i's contact (buffer buf), its patch's weighted mean
     sum_e w_e Phi_e qd [m/s] (x, y, z)."""
-    n_fn = b.face_rows.shape[1]
     nm = qd.shape[0]
     v = np.zeros(3)
     for e in range(b.count[buf, i]):
         w = b.weights[buf, i, e]
         if w == 0.0:
             continue
-        k = b.entry[buf, i, e]
-        f = k // n_fn
-        a = k - f * n_fn
+        node = b.entry[buf, i, e]
         for c in range(3):
-            row = b.face_rows[f, a, c]
+            row = b.node_rows[node, c]
             if row < 0:
                 continue
             sv = 0.0
@@ -202,7 +231,6 @@ def normal_motion(b, buf, i, q) -> float:
     """The surface's normal displacement u_n = n . u_c [m] at granule i's contact (buffer
     buf; u_c its patch's weighted mean), and its gradient in the granule's position (the
     deformed surface's tilt, [-]) into geo's GEO_GX..GEO_GZ: sum_e grad(w_e) n . u_e."""
-    n_fn = b.face_rows.shape[1]
     g = b.geo[buf, i]
     nm = q.shape[0]
     un = 0.0
@@ -210,12 +238,10 @@ def normal_motion(b, buf, i, q) -> float:
     gy = 0.0
     gz = 0.0
     for e in range(b.count[buf, i]):
-        k = b.entry[buf, i, e]
-        f = k // n_fn
-        a = k - f * n_fn
+        node = b.entry[buf, i, e]
         ua = 0.0
         for c in range(3):
-            row = b.face_rows[f, a, c]
+            row = b.node_rows[node, c]
             nc = g[GEO_NX + c]
             if row < 0 or nc == 0.0:
                 continue
@@ -259,16 +285,13 @@ def residual_tilt(b, buf, k, counts, upos, z, out) -> None:
 def spread(b, buf, i, fx, fy, fz, out, scale) -> None:
     """out[m] += scale * (Phi^T f)_m for the force f [N] at granule i's contact (buffer
     buf), spread over its patch's nodes by the weights."""
-    n_fn = b.face_rows.shape[1]
     for e in range(b.count[buf, i]):
         w = b.weights[buf, i, e] * scale
         if w == 0.0:
             continue
-        k = b.entry[buf, i, e]
-        f = k // n_fn
-        a = k - f * n_fn
+        node = b.entry[buf, i, e]
         for c in range(3):
-            row = b.face_rows[f, a, c]
+            row = b.node_rows[node, c]
             if row < 0:
                 continue
             fc = w * (fx if c == 0 else (fy if c == 1 else fz))
@@ -280,16 +303,13 @@ def spread(b, buf, i, fx, fy, fz, out, scale) -> None:
 def spread_both(b, buf, i, nx, ny, nz, n, d, out, out_d) -> None:
     """out += Phi^T (w (x) n N) and out_d += Phi^T (w (x) n D) in one pass over the rows:
     a normal force N n and its damping part D n [N] at granule i's contact."""
-    n_fn = b.face_rows.shape[1]
     for e in range(b.count[buf, i]):
         w = b.weights[buf, i, e]
         if w == 0.0:
             continue
-        k = b.entry[buf, i, e]
-        f = k // n_fn
-        a = k - f * n_fn
+        node = b.entry[buf, i, e]
         for c in range(3):
-            row = b.face_rows[f, a, c]
+            row = b.node_rows[node, c]
             nc = nx if c == 0 else (ny if c == 1 else nz)
             if row < 0 or nc == 0.0:
                 continue
@@ -329,16 +349,13 @@ def residual_rows(b, buf, i, k) -> int:
     """Contact k (granule i) as a combination of the residual dofs: its normal n times its
     patch's weights on the dofs of S (rcol, rcoef row k), and each term's gradient in the
     granule's position (rgrad). Returns how many terms."""
-    n_fn = b.face_rows.shape[1]
     g = b.geo[buf, i]
     nt = 0
     for e in range(b.count[buf, i]):
         w = b.weights[buf, i, e]
-        kk = b.entry[buf, i, e]
-        f = kk // n_fn
-        a = kk - f * n_fn
+        node = b.entry[buf, i, e]
         for c in range(3):
-            s = b.face_resid[f, a, c]
+            s = b.node_resid[node, c]
             nc = g[GEO_NX + c]
             if s < 0 or nc == 0.0:
                 continue
