@@ -216,7 +216,7 @@ def test_residual_off_builds_no_residual_and_bad_values_are_refused():
     from granplate.model import build_model
 
     m = build_model(scenario(residual=False))
-    assert m.body.resid.shape == (0, 0) and np.all(m.body.face_resid < 0)
+    assert m.body.resid.shape == (0, 0) and np.all(m.body.node_resid < 0)
     assert build_model(scenario()).body.resid.shape[0] > 0
     for change, field in (({"residual": 1}, "plate.residual"), ({"stress_radius": 0.0}, "plate.stress_radius")):
         with pytest.raises(ScenarioError) as e:

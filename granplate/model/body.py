@@ -54,9 +54,20 @@ def body_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, body_m
     return coef
 
 
-def patch_radius(s: Scenario) -> float:
-    """The contact patch's radius [m] (plate.patch_radius; 0: a point)."""
-    return float(s.plate.patch_radius)
+#: The default patch radius as a share of the body's smallest extent.
+PATCH_SHARE = 0.25
+
+
+def patch_radius(s: Scenario, extent: np.ndarray, reach: float) -> float:
+    """The contact patch's radius [m]: plate.patch_radius (0: a point), else PATCH_SHARE of
+    the body's smallest extent (extent (3,) [m]), and at least the smallest the mesh
+    resolves (solid.patch.MIN_PATCH_RATIO x reach, the farthest a surface point lies from a
+    node)."""
+    from granplate.solid.patch import MIN_PATCH_RATIO
+
+    if s.plate.patch_radius is not None:
+        return float(s.plate.patch_radius)
+    return max(PATCH_SHARE * float(np.min(extent)), MIN_PATCH_RATIO * reach)
 
 
 def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
@@ -85,11 +96,11 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
     where[solid.surface_dofs] = np.arange(len(solid.surface_dofs))
     resid_index = np.where(rows >= 0, where[np.maximum(rows, 0)], -1)
     ng, nm = len(r), solid.n_modes
-    radius = patch_radius(s)
+    reach = farthest_from_nodes(surface, sn.xyz)
+    radius = patch_radius(s, sn.xyz.max(axis=0) - sn.xyz.min(axis=0), reach)
     n_p = surface.dofs.shape[1]
     grid = node_grid(sn.xyz, max(radius, 1e-12))
     if radius > 0.0:
-        reach = farthest_from_nodes(surface, sn.xyz)
         check_patch_radius(radius, reach)
         n_p = max(n_p, patch_capacity(sn.xyz, radius, reach))
     seeds = np.array([closest_point(surface, (g.x, g.y, g.z)).face for g in s.granules], np.int64)

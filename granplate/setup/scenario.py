@@ -320,7 +320,8 @@ class Solid:
     residual: whether the contacts feel the static residual compliance of the modes above
     max_frequency (docs/model.md section 3.9: in series with Hertz's law, it adds the mesh's
     own compliance under a point load, which grows as the mesh is refined). patch_radius:
-    the radius [m] of the disc of surface a contact's force is spread over (0: a point).
+    the radius [m] of the disc of surface a contact's force is spread over (0: a point;
+    None: a quarter of the body's smallest extent, at least what the mesh resolves).
     """
 
     size: tuple[float, float, float] | None = None
@@ -334,7 +335,7 @@ class Solid:
     max_frequency: float = SOLID_MAX_FREQUENCY
     stress_radius: float | None = None
     residual: bool = True
-    patch_radius: float = 0.0
+    patch_radius: float | None = None
 
 
 @dataclass(frozen=True)

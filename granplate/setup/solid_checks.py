@@ -78,9 +78,10 @@ def check_solid_fields(sd: Solid) -> None:
     f = finite("plate.max_frequency", sd.max_frequency)
     if not lo <= f <= hi:
         raise ScenarioError("plate.max_frequency", sd.max_frequency, f"must be in [{lo:g}, {hi:g}] Hz")
-    pr = finite("plate.patch_radius", sd.patch_radius, "must be >= 0 [m] (0: a point patch)")
-    if not pr >= 0.0:
-        raise ScenarioError("plate.patch_radius", sd.patch_radius, "must be >= 0 [m] (0: a point patch)")
+    if sd.patch_radius is not None:
+        pr = finite("plate.patch_radius", sd.patch_radius, "must be >= 0 [m] (0: a point patch)")
+        if not pr >= 0.0:
+            raise ScenarioError("plate.patch_radius", sd.patch_radius, "must be >= 0 [m] (0: a point patch)")
     if not isinstance(sd.residual, bool):
         raise ScenarioError("plate.residual", sd.residual, "must be true or false")
     if sd.stress_radius is not None:
