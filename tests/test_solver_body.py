@@ -220,3 +220,22 @@ def test_coupled_run_energy_balance_converges_as_h_squared():
     disc = scenario_io.loads(DROP.replace("patch_radius = 0.0", "patch_radius = 0.006"))
     ds = gp.simulate(disc, progress=False)
     assert float(np.abs(ds.energy_residual).max()) < 1e-5 and float(ds.body_contact_normal_force.max()) > 10.0
+
+
+def test_patch_loads_spread_each_force_whole(any_patch):
+    """The nodal forces of a recorded contact force over its patch sum to that force (each
+    component), on the dofs of the patch's nodes only."""
+    m = any_patch
+    if m.body.patch[0] == 0.0:
+        pytest.skip("a point patch's loads are results.body's own (solid.loads)")
+    b = new_body_state(m.body)
+    face = np.array([[m.body.face[0, 0]]])
+    xi = np.array([[[0.1, -0.2]]])
+    force = np.array([[[0.0, 0.0, -12.5]]])
+    room = 3 * b.entry.shape[2]
+    t, col, val = np.empty(room, np.int64), np.empty(room, np.int64), np.empty(room)
+    k = B.patch_loads(b, face, xi, force, t, col, val)
+    assert k > 3 and val[:k].sum() == pytest.approx(-12.5, rel=1e-12)
+    nodes = set(b.entry[0, 0, :b.count[0, 0]])
+    rows = {int(b.node_rows[n, 2]) for n in nodes}
+    assert set(col[:k][val[:k] != 0.0].tolist()) <= rows

@@ -257,7 +257,8 @@ def bounded_maxima(n_t: int, block: int, exact: Callable, c: np.ndarray, peaks: 
 def body_data(solid, q: np.ndarray, qd: np.ndarray, times: np.ndarray, contact_face: np.ndarray,
               contact_xi: np.ndarray, contact_force: np.ndarray, field_stride: int, ball_radius: float,
               summary_only: bool = False, should_stop: Callable[[], bool] | None = None,
-              operators: BodyOperators | None = None) -> tuple[dict[str, xr.DataArray], dict]:
+              operators: BodyOperators | None = None,
+              nodal_forces: Callable | None = None) -> tuple[dict[str, xr.DataArray], dict]:
     """The body's data variables and coordinates for the result Dataset (module docstring).
 
     solid: the built solid (solid.build.SolidModel); q, qd (n_t, n_modes): the modal
@@ -270,7 +271,10 @@ def body_data(solid, q: np.ndarray, qd: np.ndarray, times: np.ndarray, contact_f
     they can reach the run's largest value, NaN elsewhere (module docstring), no
     coordinates, should_stop not polled; should_stop: polled after each block of times: when it says yes, the
     variables cover the output times computed so far (their `time` length says how many);
-    operators: `body_operators` built before (default: built here).
+    operators: `body_operators` built before (default: built here); nodal_forces: rows ->
+    (b, n_red) [N] sparse, the nodal forces at those output times (default: each contact
+    force at its point, `solid.loads.nodal_force_history`; a run's disc patches spread
+    them over their nodes, results.body_contacts.patch_forces).
 
     Returns (data variables, coordinates as name -> (dims, values, attrs))."""
     q = np.asarray(q, float)
@@ -294,6 +298,8 @@ def body_data(solid, q: np.ndarray, qd: np.ndarray, times: np.ndarray, contact_f
     B = block_size(n_points, n_full)
 
     def forces(rows) -> sp.csr_matrix:  # (b, n_red) [N] at output times rows (a slice or indices)
+        if nodal_forces is not None:
+            return nodal_forces(rows)
         return nodal_force_history(ops.surface, solid.dofs, n_full, face[rows], xi[rows], force[rows])
 
     loaded, n_loaded = loaded_dofs(forces, n_t, B)

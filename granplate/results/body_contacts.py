@@ -37,6 +37,34 @@ def body_contacts(model, y: np.ndarray, q: np.ndarray, qd: np.ndarray) -> BodyCo
     return out
 
 
+def patch_forces(model, c: BodyContacts):
+    """rows -> (b, n_red) [N] sparse: the nodal forces of the contacts at those output
+    times spread over their disc patches (solver.body.patch_loads), or None for point
+    patches (results.body spreads those itself)."""
+    import scipy.sparse as sp
+
+    from granplate.solver.body import patch_loads
+
+    b = new_body_state(model.body)
+    if b.patch[0] == 0.0:
+        return None
+    n_red = b.phi.shape[0]
+    room = 3 * b.entry.shape[2]
+
+    def forces(rows):
+        face = np.ascontiguousarray(c.face[rows])
+        n_c = int((face >= 0).sum())
+        t = np.empty(n_c * room, np.int64)
+        col = np.empty(n_c * room, np.int64)
+        val = np.empty(n_c * room)
+        k = patch_loads(b, face, np.ascontiguousarray(c.xi[rows]), np.ascontiguousarray(c.force[rows]), t, col, val)
+        out = sp.coo_matrix((val[:k], (t[:k], col[:k])), shape=(face.shape[0], n_red)).tocsr()
+        out.sum_duplicates()
+        return out
+
+    return forces
+
+
 def contact_variables(c: BodyContacts) -> dict[str, xr.DataArray]:
     """The Dataset's records of the body's contacts."""
     return {

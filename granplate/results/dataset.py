@@ -360,14 +360,14 @@ def body_outputs(model, out: K.Output, n: int, summary_only: bool,
     static loads, its fields (results.body.body_data); and the output times they cover
     (fewer than n when should_stop said yes)."""
     from granplate.results.body import body_data
-    from granplate.results.body_contacts import body_contacts, contact_variables
+    from granplate.results.body_contacts import body_contacts, contact_variables, patch_forces
 
     contacts = body_contacts(model, out.y[:n], out.q[:n], out.qd[:n])
     s = model.scenario
     stride = max(1, int(round(s.time.field_interval / s.time.output_interval)))
     data, coords = body_data(model.solid, out.q[:n], out.qd[:n], out.t[:n], contacts.face, contacts.xi,
                              contacts.force, stride, stress_ball_radius(model), summary_only=summary_only,
-                             should_stop=should_stop)
+                             should_stop=should_stop, nodal_forces=patch_forces(model, contacts))
     n_done = data["max_von_mises"].shape[0] if "max_von_mises" in data else n
     if not summary_only:
         data.update({k: v[:n_done] for k, v in contact_variables(contacts).items()})

@@ -709,3 +709,47 @@ def replay(ys, qs, qds, b, radius, mass, clip, face_out, xi_out, force_out, norm
             force_out[o, i, 0] = -n * g[GEO_NX]
             force_out[o, i, 1] = -n * g[GEO_NY]
             force_out[o, i, 2] = -n * g[GEO_NZ]
+
+
+@njit(cache=True)
+def patch_loads(b, face, xi, force, out_t, out_col, out_val) -> int:
+    """The nodal forces of recorded contact forces spread over their disc patches (b.patch
+    > 0): face (nt, ng) the face each granule touches (-1: none), xi (nt, ng, 2) its point
+    there, force (nt, ng, 3) [N] the (normal) force on the body, whose direction gives the
+    surface's normal. Writes (time row, reduced dof, force [N]) triples into out_* (room for
+    every touching contact's b.entry.shape[2] x 3) and returns how many. Uses buffer 0 of b
+    (a copy)."""
+    n_fn = b.face_nodes.shape[1]
+    N = np.empty(n_fn)
+    dN = np.empty((n_fn, 2))
+    k = 0
+    for t in range(face.shape[0]):
+        for i in range(face.shape[1]):
+            f = face[t, i]
+            if f < 0:
+                continue
+            fx = force[t, i, 0]
+            fy = force[t, i, 1]
+            fz = force[t, i, 2]
+            mag = math.sqrt(fx * fx + fy * fy + fz * fz)
+            if mag == 0.0:
+                continue
+            face_shape_functions(b.kind[0], xi[t, i, 0], xi[t, i, 1], N, dN)
+            x0 = x1 = x2 = 0.0
+            for a in range(n_fn):
+                x0 += N[a] * b.face_nodes[f, a, 0]
+                x1 += N[a] * b.face_nodes[f, a, 1]
+                x2 += N[a] * b.face_nodes[f, a, 2]
+            disc_patch(b, 0, i, x0, x1, x2, -fx / mag, -fy / mag, -fz / mag)
+            for e in range(b.count[0, i]):
+                node = b.entry[0, i, e]
+                w = b.weights[0, i, e]
+                for c in range(3):
+                    row = b.node_rows[node, c]
+                    if row < 0:
+                        continue
+                    out_t[k] = t
+                    out_col[k] = row
+                    out_val[k] = w * (fx if c == 0 else (fy if c == 1 else fz))
+                    k += 1
+    return k
