@@ -452,9 +452,9 @@ def summary(ds: xr.Dataset) -> dict:
             return None
         return float(energy) / ref
 
-    return {
+    out = {
         "scenario": ds.attrs.get("scenario_name", ""),
-        "units": dict(SUMMARY_UNITS),
+        "units": {},
         "t_end": float(ds.time[-1]),
         "e_shock": e_shock,
         "e_initial": e0,
@@ -478,6 +478,8 @@ def summary(ds: xr.Dataset) -> dict:
         # an elastic solid in space: its largest ball-averaged stress and displacement
         **{name: float(ds[name].max()) for name in ("max_von_mises_ball", "max_displacement") if name in ds},
     }
+    out["units"] = {k: u for k, u in SUMMARY_UNITS.items() if k in out}  # every number's unit
+    return out
 
 
 def _finite(value) -> float | None:
