@@ -239,3 +239,17 @@ def test_patch_loads_spread_each_force_whole(any_patch):
     nodes = set(b.entry[0, 0, :b.count[0, 0]])
     rows = {int(b.node_rows[n, 2]) for n in nodes}
     assert set(col[:k][val[:k] != 0.0].tolist()) <= rows
+
+
+def test_summary_only_equals_the_full_result_with_a_body():
+    """A coupled run's summary from the summary-only Dataset (what a study stores) equals the
+    full Dataset's, the body's keys included."""
+    import granplate as gp
+
+    s = scenario_io.loads(DROP.replace("patch_radius = 0.0", "patch_radius = 0.006"))
+    full = gp.summary(gp.simulate(s, progress=False))
+    brief = gp.summary(gp.simulate(s, progress=False, summary_only=True))
+    for key in ("ep_max_fraction", "eg_max_fraction", "max_von_mises", "max_von_mises_ball", "max_displacement",
+                "energy_residual_max", "max_contact_pressure"):
+        assert brief[key] == pytest.approx(full[key], rel=1e-12), key
+    assert full["ep_max_fraction"] > 0.0 and full["units"]["max_von_mises_ball"] == "Pa"
