@@ -383,10 +383,12 @@ def touched_dofs(b, n_act, counts, upos, ulist) -> int:
 
 
 @njit(cache=True)
-def residual_matrix(b, n_act, counts, upos, ulist, n_u, row) -> None:
+def residual_matrix(b, n_act, counts, upos, ulist, n_u, rows) -> None:
     """rmat[k, j] = r_k^T R_S r_j [m/N] between the contacts in touch: for each k its row
-    r_k^T R_S over the touched dofs U, then its products with every r_j (j >= k)."""
+    r_k^T R_S over the touched dofs U (kept in rows[k], for `residual_load`), then its
+    products with every r_j (j >= k)."""
     for k in range(n_act):
+        row = rows[k]
         for a in range(n_u):
             row[a] = 0.0
         for e in range(counts[k]):
@@ -403,21 +405,19 @@ def residual_matrix(b, n_act, counts, upos, ulist, n_u, row) -> None:
 
 
 @njit(cache=True)
-def residual_load(b, buf, n_act, counts, ulist, upos, n_u, v, z) -> None:
-    """z = R_S v on the touched dofs U, v = sum_j r_j N_j (the static forces on S) [m]."""
+def residual_load(b, buf, n_act, rows, n_u, z) -> None:
+    """z = R_S sum_k r_k N_k on the touched dofs U [m] (N_k the static forces), from the
+    contacts' rows r_k^T R_S (R_S symmetric)."""
     g = b.geo[buf]
     for a in range(n_u):
-        v[a] = 0.0
+        z[a] = 0.0
     for k in range(n_act):
         nk = g[b.active[k], GEO_NSTAT]
-        for e in range(counts[k]):
-            v[upos[b.rcol[k, e]]] += b.rcoef[k, e] * nk
-    for a in range(n_u):
-        r = b.resid[ulist[a]]
-        s = 0.0
-        for c in range(n_u):
-            s += r[ulist[c]] * v[c]
-        z[a] = s
+        if nk == 0.0:
+            continue
+        row = rows[k]
+        for a in range(n_u):
+            z[a] += nk * row[a]
 
 
 @njit(cache=True)
@@ -509,13 +509,14 @@ def contact_forces(y, q, qd, b, buf, radius, mass, clip, acc, fdamp, scale_acc):
     upos = np.full(n_s, -1, np.int64)
     ulist = np.empty(n_s, np.int64)
     n_u = 0
+    rows = np.empty((0, 0))
     if n_act > 0:
         if resid:
             for k in range(n_act):
                 counts[k] = residual_rows(b, buf, b.active[k], k)
             n_u = touched_dofs(b, n_act, counts, upos, ulist)
-            row = np.empty(n_u)
-            residual_matrix(b, n_act, counts, upos, ulist, n_u, row)
+            rows = np.empty((n_act, n_u))
+            residual_matrix(b, n_act, counts, upos, ulist, n_u, rows)
         else:
             for k in range(n_act):
                 for j in range(n_act):
@@ -523,7 +524,7 @@ def contact_forces(y, q, qd, b, buf, radius, mass, clip, acc, fdamp, scale_acc):
         e_static = solve_static(b, buf, n_act, delta0, clip)
     z = np.empty(n_u)
     if resid and n_act > 0:
-        residual_load(b, buf, n_act, counts, ulist, upos, n_u, np.empty(n_u), z)
+        residual_load(b, buf, n_act, rows, n_u, z)
     e_pot = 0.0
     p_visc = 0.0
     w_plastic = 0.0
