@@ -60,8 +60,8 @@ def test_tables_format():
     lines = text.splitlines()
     assert len(lines) == 4 and "| drop | 1e+05 | 10 | 4.950% | -1.00% | 101.00 | +1.00% | 5000 |" in lines
     cost = {**_row(1e5, 0.3, 13.0), "case": "protector", "granules": 300, "mesh": [2, 20, 20], "n_dofs": 12255,
-            "dt": 2e-7, "setup_first_s": 9.6, "setup_cached_s": 0.38, "in_touch": 50, "energy_residual": 3.5e-5,
-            "fresh": True}
+            "dt": 2e-7, "setup_first_s": 9.6, "setup_uncached_s": 9.6, "setup_cached_s": 0.38, "in_touch": 50,
+            "energy_residual": 3.5e-5}
     line = C.format_cost([cost, {"case": "protector", "mesh": [2, 40, 40], "failed": "rc 1"}]).splitlines()
     assert "| protector | 300 | 2 x 20 x 20 | 12,255 | 10 | 1e+05 | 2e-07 | 9.6 | 0.38 | 100 |" in line[2]
     assert "rc 1" in line[3]
