@@ -49,13 +49,18 @@ MESHES: tuple[tuple[int, int, int], ...] = ((1, 10, 10), (2, 20, 20), (2, 40, 40
 FREQUENCIES: tuple[float, ...] = (5.0e4, 1.0e5, 2.0e5)
 SIZES: tuple[tuple[int, int, int], ...] = ((3, 1, 1), (3, 3, 3), (3, 5, 5))
 #: The cut-off table: the cut-offs measured [Hz] against a much higher one.
-CUTOFFS: tuple[float, ...] = (2.5e4, 5.0e4, 1.0e5, 2.0e5)
+CUTOFFS: tuple[float, ...] = (2.5e4, 5.0e4, 1.0e5, 1.5e5, 2.0e5)
 REFERENCE_CUTOFF = 3.0e5
 #: The sphere drop: impact speed [m/s], its step [s], simulated time [s] and output interval [s].
 DROP_SPEED = 1.0
 DROP_DT = 5.0e-8
 DROP_T_END = 1.0e-4
 DROP_OUTPUT = 1.0e-7
+#: The small sphere's drop: its radius [m], step [s] and simulated time [s] (a contact
+#: about 2.5 times shorter).
+SMALL_RADIUS = 0.002
+SMALL_DT = 2.0e-8
+SMALL_T_END = 5.0e-5
 #: The within of the chosen default: both measures within 1% of the reference.
 WITHIN = 0.01
 
@@ -86,15 +91,15 @@ def protector(cells=CELLS, mesh=MESH, max_frequency: float = MAX_FREQUENCY, dt: 
 
 
 def sphere_drop(mesh=MESH, max_frequency: float = MAX_FREQUENCY, dt: float = DROP_DT, t_end: float = DROP_T_END,
-                output_interval: float = DROP_OUTPUT):
-    """One steel sphere of RADIUS at DROP_SPEED along +x, touching the centre of the
+                output_interval: float = DROP_OUTPUT, radius: float = RADIUS):
+    """One steel sphere of `radius` [m] at DROP_SPEED along +x, touching the centre of the
     protector's plate (same mesh and clamps) at t = 0, no load."""
     from granplate.setup.scenario import Granule, Load, Scenario, Solid, Solver
 
     plate = Solid(size=(PLATE_THICKNESS, PLATE_SPAN, PLATE_SPAN), elements=tuple(mesh),
-                  origin=(RADIUS, -0.5 * PLATE_SPAN, -0.5 * PLATE_SPAN), material="steel",
+                  origin=(radius, -0.5 * PLATE_SPAN, -0.5 * PLATE_SPAN), material="steel",
                   clamped=PLATE_CLAMPS, max_frequency=max_frequency)
-    ball = Granule(0.0, 0.0, RADIUS, "steel", label="ball", z=0.0, vx=DROP_SPEED, omega=(0.0, 0.0, 0.0))
+    ball = Granule(0.0, 0.0, radius, "steel", label="ball", z=0.0, vx=DROP_SPEED, omega=(0.0, 0.0, 0.0))
     return Scenario(name="sphere-drop", dimension=3, granules=(ball,), plate=plate, load=Load(kind="none"),
                     time=_fixed_step(t_end, dt, output_interval),
                     solver=Solver(scheme="verlet", granular_friction="split"))
@@ -110,12 +115,13 @@ def _fixed_step(t_end: float, dt: float, output_interval: float):
 
 def scenario_of(spec: dict):
     """The scenario a row's spec names: {"case": "protector" | "drop", "mesh", "max_frequency",
-    "dt", "t_end", "cells"}."""
+    "dt", "t_end", "cells" (the protector's), "radius" (the drop's)}."""
     keys = {k: (tuple(v) if isinstance(v, list) else v) for k, v in spec.items()
-            if k in ("mesh", "max_frequency", "dt", "t_end", "cells")}
+            if k in ("mesh", "max_frequency", "dt", "t_end", "cells", "radius")}
     if spec.get("case", "protector") == "drop":
         keys.pop("cells", None)
         return sphere_drop(**keys)
+    keys.pop("radius", None)
     return protector(**keys)
 
 
@@ -186,9 +192,9 @@ def run_row(spec: dict, fresh: bool = False) -> dict:
     return row
 
 
-def us_per_step(row: dict) -> float:
-    """The loop's cost of one coupled step [us]."""
-    return 1e6 * row["loop_s"] / row["n_steps"] if row.get("n_steps") else math.nan
+def us_per_step(row: dict, key: str = "loop_s") -> float:
+    """The loop's cost of one coupled step [us]: wall clock (loop_s) or CPU (loop_cpu_s)."""
+    return 1e6 * row[key] / row["n_steps"] if row.get("n_steps") else math.nan
 
 
 def relative_change(value: float, reference: float) -> float:
@@ -218,17 +224,18 @@ def _mesh(row: dict) -> str:
 def format_cost(rows: list[dict]) -> str:
     """The cost table as Markdown: one row per run."""
     head = ("| case | spheres | mesh | free dofs | modes | cut-off [Hz] | dt [s] | set-up uncached [s] "
-            "| set-up cached [s] | steps | loop [s] | us/step | in touch | energy residual |")
+            "| set-up cached [s] | steps | loop [s] | us/step | CPU us/step | in touch | energy residual |")
     lines = [head, "|" + " ---: |" * (head.count("|") - 1)]
     for r in rows:
         if "failed" in r:
-            lines.append(f"| {r.get('case', 'protector')} | | {_mesh(r)} | {r['failed']} |" + " |" * 10)
+            lines.append(f"| {r.get('case', 'protector')} | | {_mesh(r)} | {r['failed']} |" + " |" * 11)
             continue
         uncached = r.get("setup_uncached_s")
         lines.append(f"| {r.get('case', 'protector')} | {r['granules']:,} | {_mesh(r)} | {_cell(r['n_dofs'], ',')} "
                      f"| {r['n_modes']} | {r['max_frequency']:.3g} | {r['dt']:.2g} | {_cell(uncached, '.1f')} "
                      f"| {r['setup_cached_s']:.2f} | {r['n_steps']:,} | {r['loop_s']:.1f} "
-                     f"| {us_per_step(r):.0f} | {r['in_touch']} | {r['energy_residual']:.1e} |")
+                     f"| {us_per_step(r):.0f} | {us_per_step(r, 'loop_cpu_s'):.0f} | {r['in_touch']} "
+                     f"| {r['energy_residual']:.1e} |")
     return "\n".join(lines)
 
 
@@ -287,15 +294,22 @@ def run_all(quick: bool = False, repeats: int = 1, log=print) -> dict:
     report["modes"] = [row(spec_of(max_frequency=f, t_end=t_end)) for f in FREQUENCIES if f != MAX_FREQUENCY]
     report["spheres"] = [row(spec_of(cells=c, t_end=t_end)) for c in SIZES if tuple(c) != CELLS]
     report["steps"] = [row(spec_of(dt=dt, t_end=t_end)) for dt in DTS if dt != DT]
-    for case in ("drop",) if quick else ("drop", "protector"):
-        kw = {} if case == "drop" else {"t_end": t_end}
-        log(f"coupled solid: cut-offs of the {case} ...")
-        rows = [run_row(spec_of(case, max_frequency=f, **kw)) for f in CUTOFFS]
-        ref = run_row(spec_of(case, max_frequency=REFERENCE_CUTOFF, **kw))
-        report[f"cutoff_{case}"] = {"rows": rows, "reference": ref,
-                                    "chosen": None if "failed" in ref else chosen_cutoff(
-                                        [r for r in rows if "failed" not in r], ref)}
+    cases = {"drop": ("drop", {}), "drop_small": ("drop", {"radius": SMALL_RADIUS, "dt": SMALL_DT,
+                                                            "t_end": SMALL_T_END}),
+             "protector": ("protector", {"t_end": t_end})}
+    for key in ("drop", "drop_small") if quick else ("drop", "drop_small", "protector"):
+        report[f"cutoff_{key}"] = cutoff_table(*cases[key], log=log)
     return report
+
+
+def cutoff_table(case: str, kw: dict, cutoffs=CUTOFFS, reference: float = REFERENCE_CUTOFF, log=print) -> dict:
+    """The cut-off table of one case (spec keywords kw): its rows, the reference's and the
+    chosen cut-off (`chosen_cutoff`)."""
+    log(f"coupled solid: cut-offs of the {case} {kw} ...")
+    rows = [run_row(spec_of(case, max_frequency=f, **kw)) for f in cutoffs]
+    ref = run_row(spec_of(case, max_frequency=reference, **kw))
+    return {"rows": rows, "reference": ref,
+            "chosen": None if "failed" in ref else chosen_cutoff([r for r in rows if "failed" not in r], ref)}
 
 
 def print_report(report: dict) -> None:
@@ -303,7 +317,7 @@ def print_report(report: dict) -> None:
     cost = [*report["cost"], *report["dofs"], *report["modes"], *report["spheres"], *report.get("steps", [])]
     print("\ncoupled cost\n")
     print(format_cost(cost))
-    for key in ("cutoff_drop", "cutoff_protector"):
+    for key in ("cutoff_drop", "cutoff_drop_small", "cutoff_protector"):
         if key in report:
             c = report[key]
             print(f"\n{key}\n")
