@@ -229,7 +229,7 @@ def format_cost(rows: list[dict]) -> str:
     lines = [head, "|" + " ---: |" * (head.count("|") - 1)]
     for r in rows:
         if "failed" in r:
-            lines.append(f"| {r.get('case', 'protector')} | | {_mesh(r)} | {r['failed']} |" + " |" * 11)
+            lines.append(f"| {r.get('case', 'protector')} | | {_mesh(r)} | {r['failed'][:200]} |" + " |" * 11)
             continue
         uncached = r.get("setup_uncached_s")
         lines.append(f"| {r.get('case', 'protector')} | {r['granules']:,} | {_mesh(r)} | {_cell(r['n_dofs'], ',')} "
