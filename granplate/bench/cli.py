@@ -77,7 +77,8 @@ def register(subparsers) -> None:
                         "clamped plate, 1 ms of velocity Verlet): set-up uncached and cached, loop, us per "
                         "step and its growth with the dofs, the modes and the spheres in touch; the plate's "
                         "peak energy share and peak contact force per cut-off, protector and sphere drop "
-                        "(--quick: a smoke run, 0.1 ms, no finest mesh, the drop's cut-offs against 100 kHz; --repeats: the timings' median)")
+                        "(--quick: a smoke run, 0.1 ms, no finest mesh, the drop's cut-offs against 100 kHz; "
+                        "--repeats: the timings' median)")
     b.add_argument("--meshes", help="with --plates: comma-separated NXxNY (default 4x40,8x80,16x160,32x320)")
     b.add_argument("--modes", dest="plate_modes", choices=("auto", "all", "truncated"), default=None,
                    help="with --plates: plate.modes of every mesh (default auto)")

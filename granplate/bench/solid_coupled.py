@@ -12,10 +12,11 @@ DROP_SPEED onto the plate's centre, without load.
 Each row runs in a fresh subprocess (bench.scaling.run_in_subprocess): set-up is
 `build_model` (the solid's build, with its modes and residual compliance; "uncached" in an
 empty run store, the first repeat's; "cached" the same build again from the store), loop
-and steps from the run's attributes. The tables: the cost of one coupled step on the protector; its growth with the
-dofs (MESHES), the modes (FREQUENCIES) and the spheres in touch (SIZES); the cut-off table
-(CUTOFFS against REFERENCE_CUTOFF): the plate's peak energy share max E_plate / E_in and
-the peak contact force on the body, each against the reference's.
+and steps from the run's attributes. The tables: the cost of one coupled step on the
+protector; its growth with the dofs (MESHES), the modes (FREQUENCIES), the spheres in
+touch (SIZES) and the step (DTS); the cut-off tables of the protector and of a 5 mm and a
+2 mm sphere's drop (CUTOFFS against REFERENCE_CUTOFF): the plate's peak energy share
+max E_plate / E_in and the peak contact force on the body, each against the reference's.
 """
 from __future__ import annotations
 
@@ -62,7 +63,7 @@ DROP_OUTPUT = 1.0e-7
 SMALL_RADIUS = 0.002
 SMALL_DT = 2.0e-8
 SMALL_T_END = 5.0e-5
-#: The within of the chosen default: both measures within 1% of the reference.
+#: The tolerance of the chosen cut-off: both measures within 1% of the reference's.
 WITHIN = 0.01
 
 
