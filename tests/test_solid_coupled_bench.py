@@ -84,3 +84,19 @@ def test_cli_routes_coupled(monkeypatch):
     monkeypatch.setattr(C, "main", lambda args: seen.append(args.coupled) or 0)
     assert cli.main(["bench", "--solid", "--coupled"]) == 0
     assert seen == [True]
+
+
+def test_profile_table_and_route(monkeypatch):
+    """The profile's table has a column per sub-pass; `--solid --coupled --profile` runs its main."""
+    from granplate import cli
+    from granplate.bench import solid_profile as P
+
+    row = {"mesh": [2, 20, 20], "n_dofs": 12255, "n_resid": 1121, "n_touch": 50, "step_cpu_us": 2341.0,
+           **{p + "_us": 10.0 for p in P.PASSES}}
+    lines = P.format_profile([row]).splitlines()
+    assert len(lines) == 3 and lines[0].count("[us]") == len(P.PASSES) + 1
+    assert lines[2].startswith("| 2 x 20 x 20 | 12,255 | 1,121 | 50 | 10 |") and lines[2].endswith("| 2,341 |")
+    seen = []
+    monkeypatch.setattr(P, "main", lambda args: seen.append(args.profile) or 0)
+    assert cli.main(["bench", "--solid", "--coupled", "--profile"]) == 0
+    assert seen == [True]

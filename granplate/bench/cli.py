@@ -37,6 +37,10 @@ def _cmd_bench(args) -> int:
         from granplate.bench import plastic
 
         return int(plastic.main(args))
+    if getattr(args, "solid", False) and getattr(args, "coupled", False) and getattr(args, "profile", False):
+        from granplate.bench import solid_profile
+
+        return int(solid_profile.main(args))
     if getattr(args, "solid", False) and getattr(args, "coupled", False):
         from granplate.bench import solid_coupled
 
@@ -79,6 +83,10 @@ def register(subparsers) -> None:
                         "peak energy share and peak contact force per cut-off, protector and sphere drop "
                         "(--quick: a smoke run, 0.1 ms, no finest mesh, the drop's cut-offs against 100 kHz; "
                         "--repeats: the timings' median)")
+    b.add_argument("--profile", action="store_true",
+                   help="with --solid --coupled: where the body's contact pass spends a step (closest point, "
+                        "surface motion, force spread, residual matrix, its solve), timed per sub-pass on the "
+                        "protector on each mesh")
     b.add_argument("--meshes", help="with --plates: comma-separated NXxNY (default 4x40,8x80,16x160,32x320)")
     b.add_argument("--modes", dest="plate_modes", choices=("auto", "all", "truncated"), default=None,
                    help="with --plates: plate.modes of every mesh (default auto)")
