@@ -61,11 +61,11 @@ def scenario(**plate):
 
 
 def test_3d_plate_is_a_solid_with_defaults():
-    """The [plate] of a 3D scenario reads as a Solid: hex20, origin 0, the provisional cut-off."""
+    """The [plate] of a 3D scenario reads as a Solid: hex20, origin 0, the measured default cut-off (150 kHz)."""
     s = scenario()
     assert isinstance(s.plate, Solid)
     assert s.plate.element == "hex20" and s.plate.origin == (0.0, 0.0, 0.0)
-    assert s.plate.max_frequency == SOLID_MAX_FREQUENCY == 1e5
+    assert s.plate.max_frequency == SOLID_MAX_FREQUENCY == 1.5e5
 
 
 def test_valid_solid_validates_and_builds_its_model_with_the_verlet_scheme():

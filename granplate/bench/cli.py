@@ -37,6 +37,14 @@ def _cmd_bench(args) -> int:
         from granplate.bench import plastic
 
         return int(plastic.main(args))
+    if getattr(args, "solid", False) and getattr(args, "coupled", False) and getattr(args, "profile", False):
+        from granplate.bench import solid_profile
+
+        return int(solid_profile.main(args))
+    if getattr(args, "solid", False) and getattr(args, "coupled", False):
+        from granplate.bench import solid_coupled
+
+        return int(solid_coupled.main(args))
     if getattr(args, "solid", False) or (getattr(args, "plates", False) and args.dimension == 3):
         from granplate.bench import solid
 
@@ -68,6 +76,17 @@ def register(subparsers) -> None:
                         "plate, modes below 100 kHz, with and without the top face's residual compliance), the "
                         "cost per dof of hex20, hex27, tet10, and each element's first clamped frequency "
                         "against Leissa (--quick: the element tables only)")
+    b.add_argument("--coupled", action="store_true",
+                   help="with --solid: the coupled runs instead (a 300-sphere FCC protector pressed on the "
+                        "clamped plate, 1 ms of velocity Verlet): set-up uncached and cached, loop, us per "
+                        "step and its growth with the dofs, the modes and the spheres in touch; the plate's "
+                        "peak energy share and peak contact force per cut-off, protector and sphere drop "
+                        "(--quick: a smoke run, 0.1 ms, no finest mesh, the drop's cut-offs against 100 kHz; "
+                        "--repeats: the timings' median)")
+    b.add_argument("--profile", action="store_true",
+                   help="with --solid --coupled: where the body's contact pass spends a step (closest point, "
+                        "surface motion, force spread, residual matrix, its solve), timed per sub-pass on the "
+                        "protector on each mesh")
     b.add_argument("--meshes", help="with --plates: comma-separated NXxNY (default 4x40,8x80,16x160,32x320)")
     b.add_argument("--modes", dest="plate_modes", choices=("auto", "all", "truncated"), default=None,
                    help="with --plates: plate.modes of every mesh (default auto)")
