@@ -24,6 +24,7 @@ from granplate.solver import body as B
 CALLS = 200
 #: The sub-passes, in the order of the table.
 PASSES = ("contact_forces", "near_box", "locate", "surface_motion", "spread", "residual_matrix", "solve_static")
+#: (solver.body's surface motion: normal_motion and surface_velocity)
 
 
 @njit
@@ -57,7 +58,7 @@ def _motion(b, act, q, qd, n):
     s = 0.0
     for _ in range(n):
         for i in act:
-            s += B.surface_motion(b, 0, i, q, qd)[0]
+            s += B.normal_motion(b, 0, i, q) + B.surface_velocity(b, 0, i, qd)[0]
     return s
 
 
@@ -72,20 +73,28 @@ def _spread(b, act, nm, n):
 
 @njit
 def _residual(b, act, n):
-    counts = np.zeros(max(act.shape[0], 1), np.int64)
+    n_act = act.shape[0]
+    counts = np.zeros(max(n_act, 1), np.int64)
+    n_s = b.resid.shape[0]
+    rmat = np.zeros((n_act, n_act))
     for _ in range(n):
-        for k in range(act.shape[0]):
+        upos = np.full(n_s, -1, np.int64)
+        ulist = np.empty(n_s, np.int64)
+        for k in range(n_act):
             counts[k] = B.residual_rows(b, 0, act[k], k)
-        B.residual_matrix(b, act.shape[0], counts)
+        n_u = B.touched_dofs(b, n_act, counts, upos, ulist)
+        rows = np.empty((n_act, n_u))
+        B.residual_matrix(b, n_act, counts, upos, ulist, n_u, rows, rmat)
+    return rmat
 
 
 @njit
-def _solve(b, act, delta0, n):
+def _solve(b, act, delta0, rmat, n):
     for k in range(act.shape[0]):
         b.active[k] = act[k]
     e = 0.0
     for _ in range(n):
-        e += B.solve_static(b, 0, act.shape[0], delta0, True)
+        e += B.solve_static(b, 0, act.shape[0], delta0, rmat, True)
     return e
 
 
@@ -138,7 +147,7 @@ def profile_contacts(spec: dict, calls: int = CALLS) -> dict:
     runs = {"contact_forces": (_whole, (y, q, qd, b, radius, mass, acc, fd)), "near_box": (_near, (b, y, radius)),
             "locate": (_locate, (b, y, radius)), "surface_motion": (_motion, (b, act, q, qd)),
             "spread": (_spread, (b, act, q.size)), "residual_matrix": (_residual, (b, act)),
-            "solve_static": (_solve, (b, act, delta0))}
+            "solve_static": (_solve, (b, act, delta0, _residual(b, act, 1)))}
     for name in PASSES:
         fn, args = runs[name]
         out[name + "_us"] = _cpu_us(fn, args, calls)

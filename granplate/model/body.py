@@ -117,7 +117,7 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
         patch=np.array([radius]), face=np.vstack([seeds, seeds]), geo=z((2, ng, N_GEO)),
         entry=np.zeros((2, ng, n_p), np.int64), weights=z((2, ng, n_p)), count=np.zeros((2, ng), np.int64),
         grad=z((ng, n_p, 3)), fmodal=z((2, nm)), fdamp=z((2, nm)), hist=no_history(ng), q=z(nm), qd=z(nm),
-        qdp=z(nm), static=z(2), active=np.zeros(ng, np.int64), rmat=z((ng, ng)),
+        qdp=z(nm), static=z(2), active=np.zeros(ng, np.int64),
         rcol=np.zeros((ng, 3 * n_p), np.int64), rcoef=z((ng, 3 * n_p)), rgrad=z((ng, 3 * n_p, 3)),
     )
     return solid, arrays

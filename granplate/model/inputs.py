@@ -189,7 +189,7 @@ class BodyArrays(NamedTuple):
     modal projections Phi^T F [N kg^-1/2]; hist: (ng, N_HIST) each contact's history;
     q, qd, qdp: (nm,) the trial step's modal displacement and velocity and the velocity
     predicted for the force pass; static: (2,) the residual compliance's energy [J];
-    active: (ng,) int, rmat: (ng, ng) and rcol, rcoef: (ng, 3 P), rgrad: (ng, 3 P, 3)
+    active: (ng,) int, and rcol, rcoef: (ng, 3 P), rgrad: (ng, 3 P, 3)
     scratch of the residual solve (each term's dof in S, its weight, its gradient).
     """
 
@@ -226,7 +226,6 @@ class BodyArrays(NamedTuple):
     qdp: np.ndarray
     static: np.ndarray
     active: np.ndarray
-    rmat: np.ndarray
     rcol: np.ndarray
     rcoef: np.ndarray
     rgrad: np.ndarray
@@ -244,7 +243,7 @@ def no_body(ng: int, nm: int) -> BodyArrays:
         box=z((2, 3)), coef=z((0, 5)), patch=z(1), face=np.zeros((2, 0), i), geo=z((2, 0, N_GEO)),
         entry=np.zeros((2, 0, 1), i), weights=z((2, 0, 1)), count=np.zeros((2, 0), i), grad=z((0, 1, 3)),
         fmodal=z((2, nm)), fdamp=z((2, nm)), hist=no_history(0), q=z(nm), qd=z(nm), qdp=z(nm), static=z(2),
-        active=np.zeros(0, i), rmat=z((0, 0)), rcol=np.zeros((0, 3), i), rcoef=z((0, 3)), rgrad=z((0, 3, 3)),
+        active=np.zeros(0, i), rcol=np.zeros((0, 3), i), rcoef=z((0, 3)), rgrad=z((0, 3, 3)),
     )
 
 
@@ -254,5 +253,5 @@ def new_body_state(b: BodyArrays) -> BodyArrays:
     return b._replace(face=b.face.copy(), geo=b.geo.copy(), entry=b.entry.copy(), weights=b.weights.copy(),
                       count=b.count.copy(), grad=b.grad.copy(), fmodal=b.fmodal.copy(),
                       fdamp=b.fdamp.copy(), hist=b.hist.copy(), q=b.q.copy(), qd=b.qd.copy(), qdp=b.qdp.copy(),
-                      static=b.static.copy(), active=b.active.copy(), rmat=b.rmat.copy(), rcol=b.rcol.copy(),
+                      static=b.static.copy(), active=b.active.copy(), rcol=b.rcol.copy(),
                       rcoef=b.rcoef.copy(), rgrad=b.rgrad.copy())

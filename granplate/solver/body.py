@@ -383,7 +383,7 @@ def touched_dofs(b, n_act, counts, upos, ulist) -> int:
 
 
 @njit(cache=True)
-def residual_matrix(b, n_act, counts, upos, ulist, n_u, rows) -> None:
+def residual_matrix(b, n_act, counts, upos, ulist, n_u, rows, rmat) -> None:
     """rmat[k, j] = r_k^T R_S r_j [m/N] between the contacts in touch: for each k its row
     r_k^T R_S over the touched dofs U (kept in rows[k], for `residual_load`), then its
     products with every r_j (j >= k)."""
@@ -400,8 +400,8 @@ def residual_matrix(b, n_act, counts, upos, ulist, n_u, rows) -> None:
             s = 0.0
             for e2 in range(counts[j]):
                 s += row[upos[b.rcol[j, e2]]] * b.rcoef[j, e2]
-            b.rmat[k, j] = s
-            b.rmat[j, k] = s
+            rmat[k, j] = s
+            rmat[j, k] = s
 
 
 @njit(cache=True)
@@ -421,7 +421,7 @@ def residual_load(b, buf, n_act, rows, n_u, z) -> None:
 
 
 @njit(cache=True)
-def solve_static(b, buf, n_act, delta0, clip) -> float:
+def solve_static(b, buf, n_act, delta0, rmat, clip) -> float:
     """The static normal forces N_k = F(delta0_k - sum_j R_kj N_j) of the n_act contacts in
     touch (b.active[:n_act], overlaps delta0 [m] without the residual), by Gauss-Seidel
     over them, each by `static_overlap`: into geo's GEO_NSTAT and GEO_DELTA. Returns the
@@ -437,8 +437,8 @@ def solve_static(b, buf, n_act, delta0, clip) -> float:
             target = delta0[k]
             for j in range(n_act):
                 if j != k:
-                    target -= b.rmat[k, j] * g[b.active[j], GEO_NSTAT]
-            x = static_overlap(target, b.rmat[k, k], b.coef[i], b.hist[i, HIST_MAX], clip)
+                    target -= rmat[k, j] * g[b.active[j], GEO_NSTAT]
+            x = static_overlap(target, rmat[k, k], b.coef[i], b.hist[i, HIST_MAX], clip)
             n = normal_law_force(x, 0.0, b.coef[i], b.hist[i, HIST_MAX], clip) if x > 0.0 else 0.0
             change = max(change, abs(n - g[i, GEO_NSTAT]))
             largest = max(largest, n)
@@ -450,7 +450,7 @@ def solve_static(b, buf, n_act, delta0, clip) -> float:
     for k in range(n_act):
         nk = g[b.active[k], GEO_NSTAT]
         for j in range(n_act):
-            e += 0.5 * nk * b.rmat[k, j] * g[b.active[j], GEO_NSTAT]
+            e += 0.5 * nk * rmat[k, j] * g[b.active[j], GEO_NSTAT]
     return e
 
 
@@ -510,18 +510,15 @@ def contact_forces(y, q, qd, b, buf, radius, mass, clip, acc, fdamp, scale_acc):
     ulist = np.empty(n_s, np.int64)
     n_u = 0
     rows = np.empty((0, 0))
+    rmat = np.zeros((n_act, n_act))  # R_kj between the contacts in touch [m/N]
     if n_act > 0:
         if resid:
             for k in range(n_act):
                 counts[k] = residual_rows(b, buf, b.active[k], k)
             n_u = touched_dofs(b, n_act, counts, upos, ulist)
             rows = np.empty((n_act, n_u))
-            residual_matrix(b, n_act, counts, upos, ulist, n_u, rows)
-        else:
-            for k in range(n_act):
-                for j in range(n_act):
-                    b.rmat[k, j] = 0.0
-        e_static = solve_static(b, buf, n_act, delta0, clip)
+            residual_matrix(b, n_act, counts, upos, ulist, n_u, rows, rmat)
+        e_static = solve_static(b, buf, n_act, delta0, rmat, clip)
     z = np.empty(n_u)
     if resid and n_act > 0:
         residual_load(b, buf, n_act, rows, n_u, z)
@@ -544,8 +541,8 @@ def contact_forces(y, q, qd, b, buf, radius, mass, clip, acc, fdamp, scale_acc):
         # the overlap's rate, with the normal from the granule into the body (-n); the
         # residual in series takes its share, d delta = d delta0 / (1 + R_kk F'(delta))
         ddot = normal_rate_3d(y[i, VX] - v0, y[i, VX + 1] - v1, y[i, VX + 2] - v2, -nx, -ny, -nz)
-        if resid and b.rmat[k, k] > 0.0:
-            ddot /= 1.0 + b.rmat[k, k] * normal_law_slopes(delta, b.coef[i], b.hist[i, HIST_MAX])[0]
+        if resid and rmat[k, k] > 0.0:
+            ddot /= 1.0 + rmat[k, k] * normal_law_slopes(delta, b.coef[i], b.hist[i, HIST_MAX])[0]
         n, pv, ep, wp = normal_law_response(delta, ddot, b.coef[i], b.hist[i, HIST_MAX], clip)
         g[i, GEO_N] = n
         e_pot += ep
