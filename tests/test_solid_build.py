@@ -222,3 +222,43 @@ def test_residual_off_builds_no_residual_and_bad_values_are_refused():
         with pytest.raises(ScenarioError) as e:
             validate(scenario(**change))
         assert e.value.field == field
+
+
+def test_rigid_patch_moves_rigidly_in_every_mode_and_under_a_load():
+    """A rigid patch (plate.rigid_patches) ties its surface nodes: in every kept mode their
+    motion is a rigid motion to within 1e-3 of its size (the tie's penalty, solid.tie.PENALTY
+    = 1e4); too small a patch is refused naming it; a granule on it meets a rigid body (E*
+    of the granule alone: a larger Hertz coefficient, and no damping)."""
+    import dataclasses
+
+    from granplate.model import build_model
+    from granplate.physics.contact import COEF_A, COEF_C
+    from granplate.setup.scenario import RigidPatch
+    from granplate.solid.patch import surface_nodes
+    from granplate.solid.fe import vector_basis
+    from granplate.solid.surface import boundary_surface
+    from granplate.solid.tie import patch_nodes, rigid_basis
+
+    patch = RigidPatch(centre=(0.01, 0.01, 0.004), radius=0.006)
+    s = scenario(rigid_patches=[{"centre": list(patch.centre), "radius": patch.radius}],
+                 max_frequency=2e5, elements=[4, 4, 1], size=[0.02, 0.02, 0.004])
+    s = dataclasses.replace(s, granules=(dataclasses.replace(s.granules[0], x=0.01, y=0.01, z=0.006),))
+    validate(s)
+    m = build_solid(s.plate, cache=False)
+    sn = surface_nodes(boundary_surface(vector_basis(m.mesh, m.element)))
+    nodes = patch_nodes(sn.xyz, sn.full, patch.centre, patch.radius, 0)
+    assert len(nodes) >= 5
+    full = (3 * nodes[:, None] + np.arange(3)).ravel()
+    rows = np.searchsorted(m.dofs, full)
+    Q = rigid_basis(m.nodes[nodes])
+    for k in range(m.n_modes):
+        u = m.Phi[rows, k]
+        assert np.linalg.norm(u - Q @ (Q.T @ u)) <= 1e-3 * np.linalg.norm(u) + 1e-300
+    body = build_model(s)
+    plain = build_model(dataclasses.replace(s, plate=dataclasses.replace(s.plate, rigid_patches=())))
+    assert body.body.coef[0, COEF_A] > plain.body.coef[0, COEF_A]  # a rigid partner: the granule's E* alone
+    assert body.body.coef[0, COEF_C] == 0.0 and plain.body.coef[0, COEF_C] > 0.0
+    tiny = scenario(rigid_patches=[{"centre": [0.01, 0.01, 0.004], "radius": 1e-4}])
+    with pytest.raises(ScenarioError) as e:
+        build_solid(tiny.plate, cache=False)
+    assert e.value.field == "plate.rigid_patches[0]"

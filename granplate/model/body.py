@@ -38,20 +38,34 @@ def residual_face(s: Scenario, surface, mesh) -> tuple[str | None, str]:
     return name, "xyz"
 
 
-def body_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, body_material) -> np.ndarray:
+def body_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, body_material,
+                      on_rigid: np.ndarray | None = None) -> np.ndarray:
     """(ng, N_COEF) each granule's contact coefficients with the body: Hertz A with E* of
     both materials and the granule's radius (the body flat there), damping with m* = m_i
-    (the body's mass much larger), the pair's friction and yield overlap."""
+    (the body's mass much larger), the pair's friction and yield overlap; a granule on a
+    rigid patch (on_rigid) meets a rigid body, the 2D rigid layer's law (E* of the granule
+    alone, m* = 0: no damping, docs/model.md section 3.4)."""
     from granplate.model.arrays import coefficient_row, law_yield_overlap
 
     coef = np.zeros((len(r), N_COEF))
     for i, m in enumerate(mats):
         alpha, mu, ks = s.contact.for_pair(m.name, body_material.name)
-        e_star = effective_modulus(m, body_material)
+        rigid = on_rigid is not None and bool(on_rigid[i])
+        other = None if rigid else body_material
+        e_star = effective_modulus(m, other)
         a = hertz_coefficient(e_star, float(r[i]))
-        coef[i] = coefficient_row(a, damping_coefficient(alpha, float(mass[i]), a), mu, ks,
-                                  law_yield_overlap(s, m, body_material, body_material.name, e_star, float(r[i])))
+        coef[i] = coefficient_row(a, damping_coefficient(alpha, 0.0 if rigid else float(mass[i]), a), mu, ks,
+                                  law_yield_overlap(s, m, other, body_material.name, e_star, float(r[i])))
     return coef
+
+
+def on_rigid_patches(s: Scenario, points: np.ndarray) -> np.ndarray:
+    """(ng,) bool: whether each granule's closest surface point at t = 0 (points (ng, 3) [m])
+    lies on one of the solid's rigid patches."""
+    on = np.zeros(len(points), bool)
+    for rp in s.plate.rigid_patches:
+        on |= np.linalg.norm(points - np.asarray(rp.centre, float), axis=1) <= rp.radius
+    return on
 
 
 #: The default patch radius as a share of the body's smallest extent.
@@ -103,7 +117,9 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
     if radius > 0.0:
         check_patch_radius(radius, reach)
         n_p = max(n_p, patch_capacity(sn.xyz, radius, reach))
-    seeds = np.array([closest_point(surface, (g.x, g.y, g.z)).face for g in s.granules], np.int64)
+    closest = [closest_point(surface, (g.x, g.y, g.z)) for g in s.granules]
+    seeds = np.array([c.face for c in closest], np.int64)
+    points = np.array([c.point for c in closest], float).reshape(-1, 3)
     box = np.array([solid.nodes.min(axis=0), solid.nodes.max(axis=0)])
     z = np.zeros
     arrays = BodyArrays(
@@ -113,7 +129,8 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
         grid_origin=grid.origin, grid_shape=grid.shape, cell_start=grid.start, cell_nodes=grid.nodes,
         neighbours=face_neighbours(surface),
         kind=np.array([surface.kind], np.int64), phi=np.ascontiguousarray(solid.Phi), omega=solid.omega.copy(),
-        resid=np.ascontiguousarray(solid.resid), box=box, coef=body_coefficients(s, mats, r, mass, material),
+        resid=np.ascontiguousarray(solid.resid), box=box,
+        coef=body_coefficients(s, mats, r, mass, material, on_rigid_patches(s, points)),
         patch=np.array([radius]), face=np.vstack([seeds, seeds]), geo=z((2, ng, N_GEO)),
         entry=np.zeros((2, ng, n_p), np.int64), weights=z((2, ng, n_p)), count=np.zeros((2, ng), np.int64),
         grad=z((ng, n_p, 3)), fmodal=z((2, nm)), fdamp=z((2, nm)), hist=no_history(ng), q=z(nm), qd=z(nm),

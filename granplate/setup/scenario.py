@@ -306,6 +306,16 @@ SOLID_MAX_FREQUENCY = 1.5e5
 
 
 @dataclass(frozen=True)
+class RigidPatch:
+    """A rigid patch tied to a solid's surface (docs/model.md section 3.9): the surface nodes
+    within `radius` [m] of `centre` [m] move as one rigid body; a granule touching it meets
+    a rigid body (E* of the granule alone, no damping: the 2D rigid layer's law)."""
+
+    centre: tuple[float, float, float]
+    radius: float
+
+
+@dataclass(frozen=True)
 class Solid:
     """The elastic solid of a `dimension = 3` scenario (its [plate] table), docs/model.md
     section "The 3D solid".
@@ -324,6 +334,7 @@ class Solid:
     own compliance under a point load, which grows as the mesh is refined). patch_radius:
     the radius [m] of the disc of surface a contact's force is spread over (0: a point;
     None: a quarter of the body's smallest extent, at least what the mesh resolves).
+    rigid_patches: patches of the surface tied rigid (RigidPatch), the paper's rigid layers in 3D.
     """
 
     size: tuple[float, float, float] | None = None
@@ -338,6 +349,7 @@ class Solid:
     stress_radius: float | None = None
     residual: bool = True
     patch_radius: float | None = None
+    rigid_patches: tuple[RigidPatch, ...] = ()
 
 
 @dataclass(frozen=True)

@@ -82,6 +82,13 @@ def check_solid_fields(sd: Solid) -> None:
         pr = finite("plate.patch_radius", sd.patch_radius, "must be >= 0 [m] (0: a point patch)")
         if not pr >= 0.0:
             raise ScenarioError("plate.patch_radius", sd.patch_radius, "must be >= 0 [m] (0: a point patch)")
+    for k, rp in enumerate(sd.rigid_patches):
+        path = f"plate.rigid_patches[{k}]"
+        if len(rp.centre) != 3 or not all(math.isfinite(float(c)) for c in rp.centre):
+            raise ScenarioError(f"{path}.centre", list(rp.centre), "must be three finite numbers [m]")
+        r = finite(f"{path}.radius", rp.radius, "must be > 0 [m]")
+        if not r > 0.0:
+            raise ScenarioError(f"{path}.radius", rp.radius, "must be > 0 [m]")
     if not isinstance(sd.residual, bool):
         raise ScenarioError("plate.residual", sd.residual, "must be true or false")
     if sd.stress_radius is not None:

@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Callable
 
 import numpy as np
+import scipy.sparse as sp
 import skfem
 
 from granplate import store
@@ -89,11 +90,12 @@ class SolidModel:
     mesh: skfem.Mesh = None
     basis: skfem.Basis = None
     arrays_key: str = ""
+    rigid_patches: tuple = ()  # setup.scenario.RigidPatch: the surface tied rigid there (solid.tie)
 
     @functools.cached_property
     def _flexibility(self) -> Callable[[np.ndarray], np.ndarray]:
         """The static (held) or inertia-relief (free) flexibility's solver, one LU."""
-        K = reduced(stiffness_matrix(self.basis, self.material.E, self.material.nu), self.dofs)
+        K = reduced(solid_stiffness(self.basis, self.mesh, self.element, self.material, self.rigid_patches), self.dofs)
         M = reduced(mass_matrix(self.basis, self.material.rho), self.dofs)
         return flexibility(K, self.nodes[self.dofs // 3], M, self.Phi[:, :6] if self.free else None)
 
@@ -115,6 +117,22 @@ class SolidModel:
     def frequencies(self) -> np.ndarray:
         """omega / 2 pi [Hz]."""
         return self.omega / (2.0 * np.pi)
+
+
+def solid_stiffness(sbasis: skfem.Basis, mesh: skfem.Mesh, element: str, material: Material,
+                    rigid_patches: tuple = ()) -> "sp.csr_matrix":
+    """K [N/m] on the full dofs, with the rigid patches' ties (solid.tie) added."""
+    K = stiffness_matrix(sbasis, material.E, material.nu)
+    if not rigid_patches:
+        return K
+    from granplate.solid.fe import vector_basis
+    from granplate.solid.patch import surface_nodes
+    from granplate.solid.surface import boundary_surface
+    from granplate.solid.tie import patch_nodes, tie_penalty
+
+    sn = surface_nodes(boundary_surface(vector_basis(mesh, element)))
+    nodes = [patch_nodes(sn.xyz, sn.full, rp.centre, rp.radius, k) for k, rp in enumerate(rigid_patches)]
+    return K + tie_penalty(K, node_coordinates(sbasis), nodes)
 
 
 def solid_mesh(sd: Solid) -> skfem.Mesh:
@@ -218,7 +236,7 @@ def build_solid(sd: Solid, material: Material | None = None, surface: str | None
     check_fits(cost, memory, seconds)
 
     def compute() -> dict:
-        K = reduced(stiffness_matrix(sbasis, material.E, material.nu), dofs)
+        K = reduced(solid_stiffness(sbasis, mesh, sd.element, material, sd.rigid_patches), dofs)
         M = reduced(mass_matrix(sbasis, material.rho), dofs)
         rigid = rigid_body_modes(nodes) if free else None
         omega, Phi = modes_below(K, M, 2.0 * np.pi * sd.max_frequency, xyz, rigid=rigid,
@@ -235,4 +253,5 @@ def build_solid(sd: Solid, material: Material | None = None, surface: str | None
     return SolidModel(nodes=nodes, dofs=arrays["dofs"], omega=arrays["omega"], Phi=arrays["Phi"],
                       surface_dofs=arrays["surface_dofs"], resid=arrays["resid"], faces=faces,
                       element=sd.element, material=material, free=free, cost=cost, mesh=mesh, basis=sbasis,
-                      arrays_key=store.key(STORE_KIND, payload, SOLID_FORMAT) if payload is not None else "")
+                      arrays_key=store.key(STORE_KIND, payload, SOLID_FORMAT) if payload is not None else "",
+                      rigid_patches=tuple(sd.rigid_patches))
