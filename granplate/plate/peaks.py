@@ -228,18 +228,36 @@ def peak_maxima(plate, c: np.ndarray, block: int = BLOCK, strides: tuple[int, ..
     if not len(open_blocks):  # every bound at the floor (a plate at rest): one block still gives the maxima
         done[int(np.argmax((upper / scale).max(axis=1)))] = False
         best = np.full(3, -np.inf)
-    while True:
-        open_ = ~done & np.any(upper > best, axis=1)
-        if not open_.any():
-            return out
-        k = int(np.argmax(np.where(open_, (upper / scale).max(axis=1), -np.inf)))
+    def evaluate(k: int) -> np.ndarray:
         rows = slice(starts[k], stops[k])
         out[rows] = values[rows] = block_maxima(plate, c[rows])
         known[rows] = True
-        best = np.maximum(best, out[rows].max(axis=0))
-        done[k] = True
+        return out[rows].max(axis=0)
+
+    def tighten(k: int, best: np.ndarray) -> None:  # the evaluated rows bound their neighbours more tightly
         anchors = np.flatnonzero(known)
-        for j in (k - 1, k + 1):  # the evaluated rows bound their neighbours more tightly
+        for j in (k - 1, k + 1):
             if 0 <= j < len(starts) and not done[j] and np.any(upper[j] > best):
                 nb = np.arange(starts[j], stops[j])
                 upper[j] = np.minimum(upper[j], reference_bounds(c, m, nb, anchors, values[anchors], rest).max(axis=0))
+
+    largest_bound_first(upper, best, done, scale, evaluate, tighten)
+    return out
+
+
+def largest_bound_first(upper: np.ndarray, best: np.ndarray, done: np.ndarray, scale: np.ndarray,
+                        evaluate: Callable[[int], np.ndarray],
+                        tighten: Callable[[int, np.ndarray], None] | None = None) -> None:
+    """Evaluate the blocks still open, the largest bound first (upper (n_blocks, 3) over
+    scale), while a block's bound exceeds the largest value found so far (best (3,)):
+    evaluate(k) -> block k's maxima (3,); tighten(k, best) may lower the others' bounds
+    after block k. done (n_blocks,) marks the blocks evaluated (or closed), in place."""
+    while True:
+        open_ = ~done & np.any(upper > best, axis=1)
+        if not open_.any():
+            return
+        k = int(np.argmax(np.where(open_, (upper / scale).max(axis=1), -np.inf)))
+        best = np.maximum(best, evaluate(k))
+        done[k] = True
+        if tighten is not None:
+            tighten(k, best)

@@ -57,6 +57,7 @@ import numpy as np
 import scipy.sparse as sp
 import xarray as xr
 
+from granplate.plate.peaks import BOUND_MARGIN, largest_bound_first
 from granplate.solid.factor import one_blas_thread
 from granplate.solid.fe import vector_basis
 from granplate.solid.loads import nodal_force_history
@@ -172,8 +173,6 @@ def _var(name: str, dims, data) -> xr.DataArray:
 
 #: Output times between the references the summary's bounds start from.
 REFERENCE_STRIDE = 8
-#: Relative margin of the bounds [-]: far above the round-off of the products.
-BOUND_MARGIN = 1e-9
 #: Output times per chunk of the bounds.
 BOUND_CHUNK = 4096
 #: Unit fields evaluated per pass when the unit peaks are computed.
@@ -243,15 +242,14 @@ def bounded_maxima(n_t: int, block: int, exact: Callable, c: np.ndarray, peaks: 
     done = np.zeros(len(starts), dtype=bool)
     if not np.any(upper > best):  # every bound at the floor (at rest): one block still gives the maxima
         best = np.full(3, -np.inf)
-    while True:
-        open_ = ~done & np.any(upper > best, axis=1)
-        if not open_.any():
-            return out
-        k = int(np.argmax(np.where(open_, (upper / scale).max(axis=1), -np.inf)))
+
+    def evaluate(k: int) -> np.ndarray:
         rows = slice(starts[k], min(starts[k] + block, n_t))
         out[rows] = exact(rows)
-        best = np.maximum(best, out[rows].max(axis=0))
-        done[k] = True
+        return out[rows].max(axis=0)
+
+    largest_bound_first(upper, best, done, scale, evaluate)
+    return out
 
 
 def body_data(solid, q: np.ndarray, qd: np.ndarray, times: np.ndarray, contact_face: np.ndarray,
