@@ -6,8 +6,9 @@ arrays are model.inputs.BodyArrays (`b`), whose per-granule state lives in two b
 (`buf`: t_n's and the trial step's end).
 
 A granule touches the body at the closest point of the undeformed surface to its centre
-(`slide_closest`, seeded with the last face), with the outward normal n there, the
-face's shape functions w_a as weights and the overlap
+(`follow_closest`, seeded with the last face), with the outward normal n there, its
+patch's weights w_a over surface nodes (a disc about the point, `disc_patch`, or the
+face's shape functions there) and the overlap
 
     delta0 = R - d + n . u_c,   u_c = sum_a w_a u_a = sum_a w_a Phi_a q,
 
@@ -15,8 +16,10 @@ face's shape functions w_a as weights and the overlap
 the residual dofs S (solid/residual.py), in series with the contact law's static force:
 delta = delta0 - sum_j R_kj N_j, N_k = F(delta_k), solved by Gauss-Seidel over the
 contacts in touch (each contact by Newton on its own overlap). The force on the granule
-is N n with N the law's whole force at (delta, its rate) (damping included); the body
-gets -N n at the point, on the modes Phi^T (w (x) -N n). Friction is split off as for
+is N n with N the law's whole force at (delta, its rate) (damping included), plus the
+static force's pull along the deformed surface's tilt and the residual's moving weights
+(the exact gradient of the contact's potential); the body gets -N n over the patch, on the
+modes Phi^T (w (x) -N n). Friction is split off as for
 granule pairs (solver.granular3d.friction_flow): an exact impulse along the slip, against
 the granule's and the body's mobility along it, booked as the kinetic energy it removes.
 """
