@@ -155,7 +155,7 @@ def _cmd_run(args) -> int:
 def _cmd_presets(args) -> int:
     from granplate.setup.presets import preset, preset_names
 
-    for name in preset_names():
+    for name in preset_names(True):
         print(f"{name:20s} {preset(name).description}")
     return 0
 

@@ -326,8 +326,6 @@ def _lay3(**kw):
 BAD = [
     ("3D kind in 2D", lambda: validate(Scenario(layout=SpaceLattice(kind="hcp"))), "layout.kind",
      "a lattice of spheres in space is 3D"),
-    ("2D kind in 3D", lambda: validate(_force_scenario(LatticeLayout(kind="square"))), "layout.kind",
-     "a packing of discs in the plane is 2D"),
     ("chain depth in 2D", lambda: validate(Scenario(layout=ChainLayout(z=0.01))), "layout.z",
      "a chain's depth z is 3D"),
     ("unknown kind", lambda: scenario_io.loads('dimension = 3\n[layout]\nkind = "diamond"\n'), "layout.kind",

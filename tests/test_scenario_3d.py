@@ -166,8 +166,6 @@ def test_force_loaded_granules_are_those_furthest_against_the_direction():
     ({"plate": {"size": [0.1, 0.1, 0.005], "elements": [2, 2, 1], "origin": [0.0, 0.0, 0.008]}},
      "granules[0]", "granule 'a'"),
     ({"plate": {"x0": 0.1}}, "plate.x0", "unknown"),
-    ({"layout": {"kind": "hexagonal"}, "granules": None}, "layout.kind", "a packing of discs in the plane is 2D"),
-    ({"load": {"kind": "line"}}, "load.kind", 'a line load q0 [N/m] is 2D; in 3D use kind = "force"'),
     ({"load": {"kind": "force", "direction": [0.0, 0.0, 0.0]}}, "load.direction", "nonzero"),
     ({"load": {"kind": "force", "direction": [1.0, math.nan, 0.0]}}, "load.direction", "finite"),
     ({"load": {"kind": "force", "force": -1.0}}, "load.force", ">= 0"),

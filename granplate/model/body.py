@@ -3,7 +3,8 @@ built (solid.build_solid, cached in the run store) with its residual compliance 
 normal dofs of the face the granules rest on, its boundary's quadratic faces with their
 rows of the modes, each granule's closest face at t = 0 (the seed of its search) and its
 contact coefficients with the body (the 2D plate contact's laws with the body's
-material: E* of both, the granule's mass as m*, the pair's friction).
+material: E* of both, the granule's mass as m*, the pair's friction), and the modal
+forces of a line load on the body (the bare plate's shock, solid.traction).
 """
 from __future__ import annotations
 
@@ -62,9 +63,11 @@ def body_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, body_m
 def on_rigid_patches(s: Scenario, points: np.ndarray) -> np.ndarray:
     """(ng,) bool: whether each granule's closest surface point at t = 0 (points (ng, 3) [m])
     lies on one of the solid's rigid patches."""
+    from granplate.solid.tie import in_patch
+
     on = np.zeros(len(points), bool)
     for rp in s.plate.rigid_patches:
-        on |= np.linalg.norm(points - np.asarray(rp.centre, float), axis=1) <= rp.radius
+        on |= in_patch(points, rp)
     return on
 
 
@@ -82,6 +85,20 @@ def patch_radius(s: Scenario, extent: np.ndarray, reach: float) -> float:
     if s.plate.patch_radius is not None:
         return float(s.plate.patch_radius)
     return max(PATCH_SHARE * float(np.min(extent)), MIN_PATCH_RATIO * reach)
+
+
+def modal_line_load(s: Scenario, surface, solid) -> np.ndarray:
+    """(nm,) Phi^T f: the modal forces per unit q0 of a line load on the body (load.kind
+    "line", target "plate": the bare plate's shock on the box's face xmin,
+    solid.traction); zeros for any other load."""
+    if not (s.load.kind == "line" and s.load.target == "plate"):
+        return np.zeros(solid.n_modes)
+    from granplate.solid.traction import face_xmin_line_load
+
+    sd = s.plate
+    f = face_xmin_line_load(surface, 3 * len(solid.nodes), float(sd.origin[0]), float(sd.size[2]),
+                            s.load.y0, s.load.length, 1e-9 * max(sd.size))
+    return np.ascontiguousarray(solid.Phi.T @ f[solid.dofs])
 
 
 def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
@@ -131,6 +148,7 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
         kind=np.array([surface.kind], np.int64), phi=np.ascontiguousarray(solid.Phi), omega=solid.omega.copy(),
         resid=np.ascontiguousarray(solid.resid), box=box,
         coef=body_coefficients(s, mats, r, mass, material, on_rigid_patches(s, points)),
+        load=modal_line_load(s, surface, solid),
         patch=np.array([radius]), face=np.vstack([seeds, seeds]), geo=z((2, ng, N_GEO)),
         entry=np.zeros((2, ng, n_p), np.int64), weights=z((2, ng, n_p)), count=np.zeros((2, ng), np.int64),
         grad=z((ng, n_p, 3)), fmodal=z((2, nm)), fdamp=z((2, nm)), hist=no_history(ng), q=z(nm), qd=z(nm),

@@ -177,7 +177,8 @@ class BodyArrays(NamedTuple):
     (n_red, nm) the M-orthonormal modes [kg^-1/2]; omega: (nm,) [rad/s]; resid: (n_s,
     n_s) [m/N] the residual compliance over S ((0, 0): none); box: (2, 3) [m] the lowest
     and highest corner of the body's bounding box; coef: (ng, N_COEF) each granule's
-    contact coefficients with the body.
+    contact coefficients with the body; load: (nm,) the modal projection Phi^T f of a
+    line load on the body's face xmin per unit q0 [N kg^-1/2 per N/m] (zeros: none).
 
     The state of one run (new_body_state copies it): face: (2, ng) int each granule's
     closest face in the two buffers (t_n and the trial step's end; the seed of the next
@@ -211,6 +212,7 @@ class BodyArrays(NamedTuple):
     resid: np.ndarray
     box: np.ndarray
     coef: np.ndarray
+    load: np.ndarray
     patch: np.ndarray
     face: np.ndarray
     geo: np.ndarray
@@ -240,7 +242,7 @@ def no_body(ng: int, nm: int) -> BodyArrays:
         node_rows=np.zeros((0, 3), i), node_resid=np.zeros((0, 3), i), grid=np.ones(1), grid_origin=z(3),
         grid_shape=np.ones(3, i), cell_start=np.zeros(2, i), cell_nodes=np.zeros(0, i),
         neighbours=np.zeros((0, 1), i), kind=np.zeros(1, i), phi=z((0, nm)), omega=z(nm), resid=z((0, 0)),
-        box=z((2, 3)), coef=z((0, 5)), patch=z(1), face=np.zeros((2, 0), i), geo=z((2, 0, N_GEO)),
+        box=z((2, 3)), coef=z((0, 5)), load=z(nm), patch=z(1), face=np.zeros((2, 0), i), geo=z((2, 0, N_GEO)),
         entry=np.zeros((2, 0, 1), i), weights=z((2, 0, 1)), count=np.zeros((2, 0), i), grad=z((0, 1, 3)),
         fmodal=z((2, nm)), fdamp=z((2, nm)), hist=no_history(0), q=z(nm), qd=z(nm), qdp=z(nm), static=z(2),
         active=np.zeros(0, i), rcol=np.zeros((0, 3), i), rcoef=z((0, 3)), rgrad=z((0, 3, 3)),

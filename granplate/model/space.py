@@ -2,7 +2,8 @@
 granules' centres, velocities and spin vectors, their pair and wall contact lists and
 coefficients (the same laws and coefficients as the plane, `model.arrays`), the 3D shock
 (load.kind = "force": a half-sine total force shared by the loaded granules along a
-direction, docs/model.md section 5.4), the elastic body of its [plate] (model.body) and
+direction, docs/model.md section 5.4; kind = "line": the plane's line load on a planar
+packing, section 5.1), the elastic body of its [plate] (model.body) and
 the loop's settings. `model.arrays.build_model` calls `build_space_model` for a scenario
 of dimension 3: the one place the model's dimension is decided.
 """
@@ -62,6 +63,29 @@ def shock_shares(s: Scenario, loaded: np.ndarray) -> np.ndarray:
     return out
 
 
+def shock_resultants_3d(s: Scenario, x, y, z, r) -> tuple[np.ndarray, np.ndarray]:
+    """(ng, 3) forces and (ng, 3) torques per unit amplitude on each granule [-, m]: a
+    "force" load's shares (`shock_shares`, no torque), or the planar line load of
+    docs/model.md section 5.1 on the granules it pushes (`model.arrays.loaded_granules`):
+    F_i / q0 along +x and tau_i / q0 about z, as in the plane (physics.shock)."""
+    ng = len(x)
+    if s.load.kind == "line":
+        from granplate.model.arrays import loaded_granules
+        from granplate.physics.shock import shock_resultants
+
+        f, tau = shock_resultants(y, r, loaded_granules(s, x, r), s.load.y0, s.load.length)
+        forces, torques = np.zeros((ng, 3)), np.zeros((ng, 3))
+        forces[:, 0], torques[:, 2] = f, tau
+        return forces, torques
+    return shock_shares(s, loaded_granules_3d(s, x, y, z, r)), np.zeros((ng, 3))
+
+
+def shock_amplitude(s: Scenario) -> float:
+    """The loop's shock amplitude: load.force [N] (kind "force"), load.q0 [N/m] (kind
+    "line"), else 0."""
+    return {"force": float(s.load.force), "line": float(s.load.q0)}.get(s.load.kind, 0.0)
+
+
 def initial_state_3d(s: Scenario) -> np.ndarray:
     """(ng, 9) x, y, z, vx, vy, vz, wx, wy, wz of every granule at t = 0."""
     y0 = np.zeros((len(s.granules), STATE_COLUMNS[3]))
@@ -78,7 +102,7 @@ def force_floor_3d(s: Scenario, mass: np.ndarray, r: np.ndarray, shares: np.ndar
 
     if len(r) == 0:
         return 0.0
-    shock = abs(s.load.force) * float(np.abs(shares).sum()) if s.load.kind == "force" else 0.0
+    shock = abs(shock_amplitude(s)) * float(np.abs(shares).sum())
     momentum = sum(m * (math.sqrt(g.vx**2 + g.vy**2 + g.vz**2) + rr * math.sqrt(sum(w * w for w in spin_vector(g.omega))))
                    for m, rr, g in zip(mass, r, s.granules))
     return FORCE_FLOOR_FRACTION * (shock + float(momentum) / out_dt)
@@ -109,19 +133,19 @@ def build_space_model(s: Scenario):
     pairs, wc = find_pairs_and_walls(s, x, y, r, z)
     loop_pairs, loop_wc = contact_lists(s.contact, s.walls, x, y, r, z)
     wall_geo, wall_coef = wall_arrays(s, mats, r, mass, loop_wc)
-    shares = shock_shares(s, loaded_granules_3d(s, x, y, z, r))
+    shares, torques = shock_resultants_3d(s, x, y, z, r)
     granular = Granular3(
         mass=mass, inertia=inertia, radius=r, pair_ij=loop_pairs,
         pair_coef=pair_coefficients(s, mats, r, mass, loop_pairs),
         wall_i=np.ascontiguousarray(loop_wc[:, 0]), wall_geo=wall_geo, wall_coef=wall_coef,
         wall_w=np.ascontiguousarray(loop_wc[:, 1]),
         pc_i=np.zeros(0, np.int64), pc_x=np.zeros(0), pc_coef=np.zeros((0, N_COEF)),
-        shock_force=shares, shock_torque=np.zeros_like(shares),
+        shock_force=shares, shock_torque=torques,
         pair_hist=no_history(len(loop_pairs)), wall_hist=no_history(len(loop_wc)), pc_hist=no_history(0),
     )
     cfg = loop_config(s, np.zeros(len(r)), np.zeros(len(r)), r, mass,
                       floor=force_floor_3d(s, mass, r, shares, s.time.output_interval))._replace(
-        q0=float(s.load.force) if s.load.kind == "force" else 0.0, dimension=3,
+        q0=shock_amplitude(s), dimension=3,
         split_friction=s.solver.granular_friction == "split" and not frictionless(s))
     solid, body = None, None
     if s.plate is not None:

@@ -22,8 +22,8 @@ import math
 
 from granplate.errors import ScenarioError
 from granplate.setup import layouts
-from granplate.setup.scenario import (BOX_WALLS, Box, ChainLayout, Granule, LatticeLayout, Layout, Plate, Scenario,
-                                      SpaceLattice, Wall)
+from granplate.setup.scenario import (BOX_WALLS, Box, ChainLayout, Granule, LatticeLayout, Layout, Plate, RigidPatch,
+                                      Scenario, Solid, SpaceLattice, Wall)
 
 #: Labels of the paper's granules, in the order `paper_layout` returns them.
 PAPER_LABELS: tuple[str, ...] = ("1", "2", "3", "4", "5", "6", "7", "8", "9",
@@ -76,7 +76,8 @@ def layout_packing(layout: Layout | LatticeLayout | ChainLayout | SpaceLattice,
                    dimension: int = 2) -> layouts.Packing:
     """The packing of any layout kind (paper, hexagonal, square, chain; sc, bcc, fcc, hcp in
     space), imperfections applied. `dimension`: the scenario's, which places a chain in the
-    plane or in space (a space lattice is always 3D)."""
+    plane or in space (a space lattice is always 3D); in space a planar packing lies in
+    the plane z = 0 (`layouts.planar_in_space`)."""
     if isinstance(layout, SpaceLattice):
         dimension = 3
         packing = layouts.space_packing(layout)
@@ -87,9 +88,10 @@ def layout_packing(layout: Layout | LatticeLayout | ChainLayout | SpaceLattice,
         packing = layouts.chain_packing(layout, dimension)
     else:
         packing = layouts.lattice_packing(layout)
+    planar = dimension == 3 and not isinstance(layout, SpaceLattice) and layout.kind != "chain"
     if layout.imperfections is not None:
-        packing = layouts.imperfect(packing, layout.imperfections, dimension)
-    return packing
+        packing = layouts.imperfect(packing, layout.imperfections, 2 if planar else dimension)
+    return layouts.planar_in_space(packing) if planar else packing
 
 
 def default_granule_label(index: int) -> str:
@@ -152,6 +154,46 @@ def force_loaded_granules(scenario: Scenario) -> tuple[str, ...]:
     return tuple(g.label for g, s in zip(gs, lead) if s <= first + tol)
 
 
+def solid_against(sd: Solid, granules: tuple[Granule, ...], xp: float) -> tuple[float, float, float]:
+    """The origin [m] of a box solid placed against a packing: its face xmin at the
+    packing's far side xp [m], centred on the packing's extent in y and z."""
+    ys = [v for g in granules for v in (g.y - g.radius, g.y + g.radius)]
+    zs = [v for g in granules for v in (g.z - g.radius, g.z + g.radius)]
+    cy = 0.5 * (min(ys) + max(ys)) if ys else 0.0
+    cz = 0.5 * (min(zs) + max(zs)) if zs else 0.0
+    return (float(xp), cy - 0.5 * float(sd.size[1]), cz - 0.5 * float(sd.size[2]))
+
+
+#: A granule touches the solid at t = 0 when its centre lies within (1 + TOUCH_RTOL) R of the box.
+TOUCH_RTOL = 1e-6
+
+
+def rigid_layers(sd: Solid, granules: tuple[Granule, ...]) -> tuple[RigidPatch, ...]:
+    """The paper's rigid layers on a placed box solid (docs/model.md section 4.2): at each
+    granule touching it at t = 0, a translation-only rigid patch across the box's z extent
+    (a strip along z through the contact point), sd.rigid_layer_width [m] wide along the
+    face (None: one element edge along the face's in-plane axis other than z). A granule
+    touching a face normal to z is a ScenarioError (a strip along z would cross it)."""
+    lo = [float(o) for o in sd.origin]
+    hi = [o + float(L) for o, L in zip(lo, sd.size)]
+    patches = []
+    for g in granules:
+        c = (g.x, g.y, g.z)
+        p = [min(max(v, a), b) for v, a, b in zip(c, lo, hi)]
+        d = math.dist(c, p)
+        if d > (1.0 + TOUCH_RTOL) * g.radius or d == 0.0:
+            continue
+        axis = max(range(3), key=lambda k: abs(c[k] - p[k]))
+        if axis == 2:
+            raise ScenarioError("plate.rigid_layers", True, f"granule {g.label or '?'} touches a face normal to z: "
+                                "the rigid layers lie across the solid's z extent, on its faces normal to x or y")
+        along = 1 - axis
+        w = sd.rigid_layer_width if sd.rigid_layer_width is not None else sd.size[along] / sd.elements[along]
+        patches.append(RigidPatch(centre=(p[0], p[1], p[2]), radius=0.5 * float(w) * (1.0 + TOUCH_RTOL),
+                                  axis=(0.0, 0.0, 1.0), rotates=False))
+    return tuple(patches)
+
+
 def resolve(scenario: Scenario) -> Scenario:
     """An equivalent, explicit scenario: layout expanded, plate placed, labels filled.
 
@@ -162,8 +204,10 @@ def resolve(scenario: Scenario) -> Scenario:
       plane 1's, when the load's direction is +x). A 3D layout with a `box` is a
       ScenarioError (the layout makes its walls). A layout together with
       explicit granules or walls is a ScenarioError (give one or the other).
-    - Without a layout, a plate needs an explicit `x0` (ScenarioError otherwise); a 3D
-      solid (`Solid`) is placed by its own fields and left as it is.
+    - Without a layout, a plate needs an explicit `x0` (ScenarioError otherwise). A 3D
+      box solid (`Solid`) without an `origin` is placed against the layout's packing
+      (`solid_against`), or at [0, 0, 0] without a layout; its `rigid_layers` become
+      explicit rigid patches (`rigid_layers`).
     - Unlabelled granules get the label "g<i>", unlabelled walls "w<i>" (i: 0-based index).
     - In 3D (`dimension = 3`): a `box` becomes its six walls (`box_walls`), after the
       explicit walls, and `box` None; a wall given by a `point` gets offset = point . n
@@ -173,6 +217,7 @@ def resolve(scenario: Scenario) -> Scenario:
     `validate`'s job; this function only builds.
     """
     granules, walls, plate, load = scenario.granules, scenario.walls, scenario.plate, scenario.load
+    xp = 0.0
     if scenario.layout is not None:
         if granules:
             raise ScenarioError("granules", f"{len(granules)} granules",
@@ -190,6 +235,12 @@ def resolve(scenario: Scenario) -> Scenario:
         along_x = scenario.dimension == 2 or along_plus_x(load.direction)
         if scenario.layout.imperfections is not None and not load.granules and along_x:
             load = dataclasses.replace(load, granules=column1)
+    if isinstance(plate, Solid) and plate.origin is None and plate.mesh is None:
+        plate = dataclasses.replace(plate, origin=solid_against(plate, granules, xp)
+                                    if scenario.layout is not None else (0.0, 0.0, 0.0))
+    if isinstance(plate, Solid) and plate.rigid_layers:
+        plate = dataclasses.replace(plate, rigid_layers=False, rigid_layer_width=None,
+                                    rigid_patches=plate.rigid_patches + rigid_layers(plate, granules))
     if isinstance(plate, Plate) and plate.x0 is None:
         raise ScenarioError("plate.x0", None,
                             "must be given when the scenario has no [layout] "

@@ -459,7 +459,7 @@ def load_scenario(path_or_preset: str | os.PathLike) -> Scenario:
     else:
         if not os.path.isfile(key):
             raise ScenarioError("file", key, "no such file or preset; presets are: "
-                                + ", ".join(presets.preset_names()))
+                                + ", ".join(presets.preset_names(True)))
         s = load(key)
     validate(s)
     return s

@@ -189,6 +189,16 @@ def lattice_packing(lay: LatticeLayout) -> Packing:
                    plate_x(granules), column1)
 
 
+def planar_in_space(packing: Packing) -> Packing:
+    """A planar packing (paper, hexagonal, square) lifted into space: its granules in the
+    plane z = 0 with spin vectors (0, 0, 0), its walls the planes through its lines
+    (normal (nx, ny, 0), the same offset [m])."""
+    granules = tuple(dataclasses.replace(g, z=0.0, omega=(0.0, 0.0, 0.0)) for g in packing.granules)
+    walls = tuple(dataclasses.replace(w, normal=(float(w.normal[0]), float(w.normal[1]), 0.0))
+                  for w in packing.walls)
+    return packing._replace(granules=granules, walls=walls)
+
+
 # --------------------------------------------------------------------------- chains
 
 def chain_radii(lay: ChainLayout) -> list[float]:

@@ -3,6 +3,7 @@
     preset("steel-r1")  ->  Scenario
     preset_names()      ->  ["bare-plate", "steel-r1", "steel-r05", "ptfe-r05",
                              "ptfe-r05-moderate", "ptfe-r05-weak"]
+    preset("3d-ptfe-r05")  ->  the 3D twin of ptfe-r05 (`twin_3d`; preset_names(True) lists them)
 
 All use the default plate (4 x 40 Q8 elements, top and bottom clamped), contact
 coefficients (mu 0.099, k_s 1000 s/m, alpha_n 6.313e-3, steel-PTFE 6.313e-2), time
@@ -17,7 +18,9 @@ from __future__ import annotations
 from typing import Callable
 
 from granplate.errors import ScenarioError
-from granplate.setup.scenario import Layout, Load, Plate, Scenario, Solver
+import dataclasses
+
+from granplate.setup.scenario import Layout, Load, Plate, Scenario, Solid, Solver, TimeSettings
 
 #: One line per preset, naming the paper figures it reproduces.
 DESCRIPTIONS: dict[str, str] = {
@@ -62,9 +65,44 @@ PRESETS: dict[str, Callable[[], Scenario]] = {
 }
 
 
-def preset_names() -> list[str]:
-    """The preset names, in the order of docs/model.md section 8."""
-    return list(PRESETS)
+#: The 3D twins' step [s]: velocity Verlet at a fixed step (docs/model.md section 6.5);
+#: E_shock moves by 5e-4 and the plate's peak share by 2e-3 of theirs from 1e-7 s.
+TWIN_DT = 2e-7
+#: The 3D twins' modes [Hz]: the bare plate's load acts on the body directly, so more of
+#: its modes are kept; with granules the rigid layers' residual compliance carries the rest.
+TWIN_MAX_FREQUENCY = {"bare-plate": 1e6}
+
+
+def twin_3d(plane: Scenario) -> Scenario:
+    """The 3D twin of a paper preset (docs/model.md section 8): the same granules in the
+    plane z = 0, the mid-plane of a 3D slab of the paper's plate (its width x height x
+    thickness, its elements with one through the thickness, hex20), clamped on ymin and
+    ymax, the rigid layers as translation-only rigid patches across the thickness, the same
+    line load on each loaded granule (or on the slab's face xmin), velocity Verlet."""
+    p = plane.plate
+    name = "3d-" + plane.name
+    solid = Solid(size=(p.width, p.height, p.thickness), elements=(p.nx, p.ny, 1), material=p.material,
+                  clamped=("ymin", "ymax"), rigid_layers=plane.layout is not None,
+                  max_frequency=TWIN_MAX_FREQUENCY.get(plane.name, Solid.max_frequency),
+                  origin=None if plane.layout is not None else (p.x0, p.y0, -0.5 * p.thickness))
+    return dataclasses.replace(
+        plane, name=name, description=f"3D twin of {plane.name}: " + plane.description, dimension=3, plate=solid,
+        time=dataclasses.replace(plane.time, dt_max=TWIN_DT, dt_initial=TWIN_DT),
+        solver=Solver(scheme="verlet", granular_friction="split"))
+
+
+for _name in list(PRESETS):
+    PRESETS["3d-" + _name] = (lambda n: lambda: twin_3d(PRESETS[n]()))(_name)
+    DESCRIPTIONS["3d-" + _name] = "3D twin of " + _name + ": " + DESCRIPTIONS[_name]
+
+#: The 2D presets (the paper's six cases), in order.
+PLANE_PRESETS: tuple[str, ...] = tuple(n for n in PRESETS if not n.startswith("3d-"))
+
+
+def preset_names(include_3d: bool = False) -> list[str]:
+    """The preset names, in the order of docs/model.md section 8 (with their 3D twins
+    "3d-NAME" after them when include_3d)."""
+    return list(PRESETS) if include_3d else list(PLANE_PRESETS)
 
 
 def preset(name: str) -> Scenario:

@@ -235,9 +235,10 @@ LAYOUT_KINDS: dict[str, type] = {
     "paper": Layout, "hexagonal": LatticeLayout, "square": LatticeLayout, "chain": ChainLayout,
     **{k: SpaceLattice for k in SPACE_LATTICE_KINDS},
 }
-#: The layout kinds of each dimension (`Scenario.dimension`); a chain is either.
+#: The layout kinds of each dimension (`Scenario.dimension`); a chain is either, and the
+#: planar packings (paper, hexagonal, square) lie in the plane z = 0 in space.
 LAYOUT_KINDS_BY_DIMENSION: dict[int, tuple[str, ...]] = {
-    2: ("paper", "hexagonal", "square", "chain"), 3: SPACE_LATTICE_KINDS + ("chain",),
+    2: ("paper", "hexagonal", "square", "chain"), 3: SPACE_LATTICE_KINDS + ("chain", "paper", "hexagonal", "square"),
 }
 
 
@@ -309,10 +310,18 @@ SOLID_MAX_FREQUENCY = 1.5e5
 class RigidPatch:
     """A rigid patch tied to a solid's surface (docs/model.md section 3.9): the surface nodes
     within `radius` [m] of `centre` [m] move as one rigid body; a granule touching it meets
-    a rigid body (E* of the granule alone, no damping: the 2D rigid layer's law)."""
+    a rigid body (E* of the granule alone, no damping: the 2D rigid layer's law).
+
+    axis: None (a disc: distance to the centre) or a direction [ax, ay, az] (a strip: the
+    nodes within `radius` of the line through `centre` along it, e.g. [0, 0, 1] across a
+    slab's thickness); rotates: whether the patch moves as a rigid body in all six motions
+    (true) or in translation only (false: the paper's rigid layer, whose rotation is
+    neglected)."""
 
     centre: tuple[float, float, float]
     radius: float
+    axis: tuple[float, float, float] | None = None
+    rotates: bool = True
 
 
 @dataclass(frozen=True)
@@ -335,11 +344,17 @@ class Solid:
     the radius [m] of the disc of surface a contact's force is spread over (0: a point;
     None: a quarter of the body's smallest extent, at least what the mesh resolves).
     rigid_patches: patches of the surface tied rigid (RigidPatch), the paper's rigid layers in 3D.
+    rigid_layers: the paper's rigid layers (docs/model.md section 4.2) for a planar packing
+    (granules in one plane z = const): `resolve` adds a translation-only rigid patch across
+    the solid's z extent at each granule touching it at t = 0, rigid_layer_width [m] wide
+    along the face (None: one element edge along y, as in 2D). origin None: placed against
+    a [layout]'s packing (its face xmin touching the packing's far side, centred on the
+    packing in y and z), else at [0, 0, 0].
     """
 
     size: tuple[float, float, float] | None = None
     elements: tuple[int, int, int] | None = None
-    origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    origin: tuple[float, float, float] | None = None
     mesh: str | None = None
     material: str = "steel"
     element: str = "hex20"
@@ -350,6 +365,8 @@ class Solid:
     residual: bool = True
     patch_radius: float | None = None
     rigid_patches: tuple[RigidPatch, ...] = ()
+    rigid_layers: bool = False
+    rigid_layer_width: float | None = None
 
 
 @dataclass(frozen=True)

@@ -44,8 +44,9 @@ def check_box(sd: Solid) -> None:
     for i, v in enumerate(_triple("plate.elements", sd.elements)):
         if not isinstance(v, numbers.Integral) or isinstance(v, bool) or not lo <= v <= hi:
             raise ScenarioError(f"plate.elements[{i}]", v, f"must be an integer in [{lo}, {hi}]")
-    for i, v in enumerate(_triple("plate.origin", sd.origin)):
-        finite(f"plate.origin[{i}]", v)
+    if sd.origin is not None:
+        for i, v in enumerate(_triple("plate.origin", sd.origin)):
+            finite(f"plate.origin[{i}]", v)
 
 
 def check_faces(sd: Solid, names: tuple[str, ...] | None) -> None:
@@ -89,6 +90,26 @@ def check_solid_fields(sd: Solid) -> None:
         r = finite(f"{path}.radius", rp.radius, "must be > 0 [m]")
         if not r > 0.0:
             raise ScenarioError(f"{path}.radius", rp.radius, "must be > 0 [m]")
+        if rp.axis is not None:
+            ax = rp.axis
+            if not isinstance(ax, tuple) or len(ax) != 3 or not all(
+                    isinstance(c, (int, float)) and not isinstance(c, bool) and math.isfinite(c) for c in ax) \
+                    or not any(c != 0.0 for c in ax):
+                raise ScenarioError(f"{path}.axis", list(ax) if isinstance(ax, tuple) else ax,
+                                    "must be three finite numbers, not all zero (the strip's direction), or absent (a disc)")
+        if not isinstance(rp.rotates, bool):
+            raise ScenarioError(f"{path}.rotates", rp.rotates, "must be true (six rigid motions) or false "
+                                "(translation only)")
+    if not isinstance(sd.rigid_layers, bool):
+        raise ScenarioError("plate.rigid_layers", sd.rigid_layers, "must be true or false")
+    if sd.rigid_layers and sd.mesh is not None:
+        raise ScenarioError("plate.rigid_layers", True, "the paper's rigid layers are placed on a box's face "
+                            "(plate.size); on a mesh file's solid give plate.rigid_patches")
+    if sd.rigid_layer_width is not None:
+        w = finite("plate.rigid_layer_width", sd.rigid_layer_width, "must be > 0 [m] (or absent: one element edge along y)")
+        if not w > 0.0:
+            raise ScenarioError("plate.rigid_layer_width", sd.rigid_layer_width,
+                                "must be > 0 [m] (or absent: one element edge along y)")
     if not isinstance(sd.residual, bool):
         raise ScenarioError("plate.residual", sd.residual, "must be true or false")
     if sd.stress_radius is not None:
@@ -123,7 +144,7 @@ def box_signed_distance(lower: Sequence[float], upper: Sequence[float], p: Seque
 
 def box_corners(sd: Solid) -> tuple[tuple[float, ...], tuple[float, ...]]:
     """(lower, upper) corners [m] of a box solid."""
-    lo = tuple(float(o) for o in sd.origin)
+    lo = tuple(float(o) for o in (sd.origin or (0.0, 0.0, 0.0)))
     return lo, tuple(o + float(s) for o, s in zip(lo, sd.size))
 
 

@@ -51,7 +51,7 @@ GRANULAR_SCHEMES: tuple[str, ...] = ("verlet",)
 GRANULAR_FRICTIONS: tuple[str, ...] = ("split", "rk4")
 #: Load kinds (Load.kind: "line" is 2D, "force" 3D) and targets (Load.target).
 LOAD_KINDS: tuple[str, ...] = ("line", "force", "none")
-LOAD_KINDS_BY_DIMENSION: dict[int, tuple[str, ...]] = {2: ("line", "none"), 3: ("force", "none")}
+LOAD_KINDS_BY_DIMENSION: dict[int, tuple[str, ...]] = {2: ("line", "none"), 3: ("force", "line", "none")}
 LOAD_TARGETS: tuple[str, ...] = ("granules", "plate")
 #: Plate edges that may be clamped (Plate.clamped_edges).
 
@@ -149,9 +149,9 @@ def _check_spatial(s: Scenario) -> None:
         raise ScenarioError("layout.kind", lay.kind, "a packing of discs in the plane is 2D: in 3D use "
                             "one of " + ", ".join(repr(k) for k in LAYOUT_KINDS_BY_DIMENSION[3])
                             + " (or list [[granules]])")
-    if s.load.kind == "line":
-        raise ScenarioError("load.kind", s.load.kind, "a line load q0 [N/m] is 2D; in 3D use "
-                            "kind = \"force\" (or \"none\")")
+    if s.load.kind == "line" and s.load.target == "plate" and isinstance(s.plate, Solid) and not is_box(s.plate):
+        raise ScenarioError("load.target", s.load.target, "a line load on a 3D solid acts on a box's face "
+                            "xmin (plate.size); a mesh file's solid takes loads through granules")
     for i, g in enumerate(s.granules):
         p = f"granules[{i}]"
         om = g.omega

@@ -45,7 +45,7 @@ log = logging.getLogger(__name__)
 #: The run store's kind of the solid's arrays.
 STORE_KIND = "solid"
 #: Bump when anything that changes the stored arrays changes.
-SOLID_FORMAT = 2
+SOLID_FORMAT = 3
 #: Share of the machine's physical memory a solid may take.
 MEMORY_SHARE = 0.7
 #: One window holds WINDOW_MARGIN times the estimated modes (plus 10), at most MAX_WINDOW;
@@ -126,13 +126,13 @@ def solid_stiffness(sbasis: skfem.Basis, mesh: skfem.Mesh, element: str, materia
     if not rigid_patches:
         return K
     from granplate.solid.fe import vector_basis
-    from granplate.solid.patch import surface_nodes
     from granplate.solid.surface import boundary_surface
-    from granplate.solid.tie import patch_nodes, tie_penalty
+    from granplate.solid.tie import facing_nodes, patch_nodes, tie_penalty
 
-    sn = surface_nodes(boundary_surface(vector_basis(mesh, element)))
-    nodes = [patch_nodes(sn.xyz, sn.full, rp.centre, rp.radius, k) for k, rp in enumerate(rigid_patches)]
-    return K + tie_penalty(K, node_coordinates(sbasis), nodes)
+    surface = boundary_surface(vector_basis(mesh, element))
+    nodes = [patch_nodes(*facing_nodes(surface, rp.centre), rp.centre, rp.radius, k, rp.axis)
+             for k, rp in enumerate(rigid_patches)]
+    return K + tie_penalty(K, node_coordinates(sbasis), nodes, [rp.rotates for rp in rigid_patches])
 
 
 def solid_mesh(sd: Solid) -> skfem.Mesh:
@@ -144,7 +144,7 @@ def solid_mesh(sd: Solid) -> skfem.Mesh:
                                 + ("'hex20' or 'hex27'" if isinstance(mesh, skfem.MeshHex) else "'tet10'"))
         check_faces(sd, face_names(mesh))
         return mesh
-    return box_mesh(sd.size, sd.elements, sd.origin, tetrahedra=not is_hexahedral(sd.element))
+    return box_mesh(sd.size, sd.elements, sd.origin or (0.0, 0.0, 0.0), tetrahedra=not is_hexahedral(sd.element))
 
 
 def cache_payload(sd: Solid, material: Material, surface: str | None, components: str) -> dict:

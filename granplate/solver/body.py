@@ -592,6 +592,21 @@ def kick(qd, fmodal, fdamp, hk) -> float:
 
 
 @njit(cache=True)
+def load_kick(qd, load, amp, hk) -> float:
+    """The modes' half kick by a load on the body, qd += hk amp Phi^T f (load = Phi^T f per
+    unit amplitude, amp the amplitude now); returns its work [J], the kinetic energy it
+    adds, hk amp load . (qd_before + qd_after)/2 (docs/model.md section 5.3)."""
+    w = 0.0
+    if amp == 0.0:
+        return w
+    for m in range(qd.shape[0]):
+        dv = hk * amp * load[m]
+        w += dv * (qd[m] + 0.5 * dv)
+        qd[m] += dv
+    return w
+
+
+@njit(cache=True)
 def turn(q, qd, omega, h) -> None:
     """Each mode's free vibration over h [s], exactly: (q, qd) turned by omega h (a rigid-
     body mode, omega = 0, drifts: q += h qd)."""

@@ -88,8 +88,10 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             for i in range(ng):
                 for c in range(3):
                     f = amp * g.shock_force[i, c]
+                    tq = amp * g.shock_torque[i, c]
                     dy[i, VX + c] += f
-                    p_shock += f * y[i, VX + c]
+                    dy[i, WX + c] += tq
+                    p_shock += f * y[i, VX + c] + tq * y[i, WX + c]
     half_shrink = 0.5 * cfg.arm_shrink
     for p in range(g.pair_ij.shape[0]):
         i = g.pair_ij[p, 0]
@@ -295,8 +297,8 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
     """The velocity-Verlet force pass in space (as solver.granular.normal_forces): shock
     and normal forces of every listed pair and wall contact at state y (no friction), the
     accelerations into acc[:, 3:9], each granule's damping force and shock load apart
-    (fdamp, fload [:, 3:6] [N]; no torques: normal forces and loads act through the
-    centres), the contacts' overlaps into HIST_END. Returns the ForceSums."""
+    (fdamp, fload [:, 3:9] [N, N m]; the normal forces act through the centres, a line
+    load's torques on the spins), the contacts' overlaps into HIST_END. Returns the ForceSums."""
     ng = y.shape[0]
     for i in range(ng):
         for c in range(3, 9):
@@ -316,9 +318,12 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
             for i in range(ng):
                 for c in range(3):
                     f = amp * g.shock_force[i, c]
+                    tq = amp * g.shock_torque[i, c]
                     fload[i, VX + c] = f
+                    fload[i, WX + c] = tq
                     acc[i, VX + c] += f
-                    p_shock += f * y[i, VX + c]
+                    acc[i, WX + c] += tq
+                    p_shock += f * y[i, VX + c] + tq * y[i, WX + c]
     for p in range(g.pair_ij.shape[0]):
         i = g.pair_ij[p, 0]
         j = g.pair_ij[p, 1]

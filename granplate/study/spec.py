@@ -252,7 +252,7 @@ def base_scenario(base: Any, folder: Path):
     """The validated base: a preset by name, else a scenario file (relative to folder)."""
     if not isinstance(base, str) or not base:
         raise ScenarioError("base", base, "expected a preset name or a scenario file, e.g. "
-                            "base = \"ptfe-r05\"; presets: " + ", ".join(gp.preset_names()))
+                            "base = \"ptfe-r05\"; presets: " + ", ".join(gp.preset_names(True)))
     if base in gp.preset_names():
         return gp.load_scenario(base)
     path = Path(base) if os.path.isabs(base) else folder / base

@@ -14,7 +14,8 @@ One step t -> t + h (fixed h = time.dt_max, cut to land on the output times):
    half step (in the reverse order) so that the recorded state is the whole step's.
 
 The work of each kick is booked exactly as the kinetic energy it adds: h/2 F v_mean for
-the damping part of the force (D_visc) and the load (E_shock), so eq. (11)'s residual is
+the damping part of the force (D_visc) and the load (E_shock; a line load on the elastic
+body kicks its modes the same way, at t_n and t_n + h), so eq. (11)'s residual is
 Verlet's own energy error, O(h^2), which the loop checks at every step.
 """
 from __future__ import annotations
@@ -26,6 +27,7 @@ from numba import njit
 
 from granplate.model.inputs import STATE_COLUMNS, BodyArrays, new_body_state, no_body
 from granplate.physics.contact import COEF_MU
+from granplate.physics.shock import time_profile
 from granplate.solver import body as B
 from granplate.solver.dimension import friction_flow, normal_forces
 from granplate.solver.granular import commit_history
@@ -196,6 +198,8 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
                                     cfg.arm_shrink, forward)
     wl, wd = kick_drift(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp)
     if body:
+        if cfg.load_on_plate:
+            wl += B.load_kick(b.qd, b.load, cfg.q0 * time_profile(t, cfg.duration), hk)
         wd += B.kick(b.qd, b.fmodal[cur], b.fdamp[cur], hk)
         B.turn(b.q, b.qd, b.omega, h)
         B.predicted_velocity(b, hk, cur)
@@ -218,6 +222,8 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
     wl2, wd2 = kick(y, w.kend, sw.fdamp[nxt], sw.fload[nxt], hk, w.kend)
     if body:
         wd2 += B.kick(b.qd, b.fmodal[nxt], b.fdamp[nxt], hk)
+        if cfg.load_on_plate:
+            wl2 += B.load_kick(b.qd, b.load, cfg.q0 * time_profile(t + h, cfg.duration), hk)
     if friction and sw.split[LAND] != 0.0:  # an output time: the closing half step
         fric += friction_flow(y, hk, g, cfg, not forward)
         if body:
@@ -227,6 +233,8 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
     w.dacc[2] = fric
     w.dacc[3] = w_plastic
     w.pend[0] = pr.p_shock
+    if body and cfg.load_on_plate:  # the body's load's power at t + h [W]
+        w.pend[0] += cfg.q0 * time_profile(t + h, cfg.duration) * np.dot(b.load, b.qd)
     w.pend[1] = p_visc
     w.pend[2] = 0.0
     w.ovl_new[0] = ovl
