@@ -13,6 +13,7 @@ from granplate.errors import ScenarioError
 from granplate.setup import io as scenario_io
 from granplate.setup.scenario import SOLID_MAX_FREQUENCY, Solid
 from granplate.setup.validate import validate
+from granplate.setup.geometry import resolve
 from granplate.solid.build import build_solid
 
 SMALL = Solid(size=(0.03, 0.02, 0.004), elements=(3, 2, 1), clamped=("xmin",), max_frequency=1e5)
@@ -61,10 +62,11 @@ def scenario(**plate):
 
 
 def test_3d_plate_is_a_solid_with_defaults():
-    """The [plate] of a 3D scenario reads as a Solid: hex20, origin 0, the measured default cut-off (150 kHz)."""
+    """The [plate] of a 3D scenario reads as a Solid: hex20, origin 0 once resolved, the measured default cut-off (150 kHz)."""
     s = scenario()
     assert isinstance(s.plate, Solid)
-    assert s.plate.element == "hex20" and s.plate.origin == (0.0, 0.0, 0.0)
+    assert s.plate.element == "hex20" and s.plate.origin is None  # placed by resolve
+    assert resolve(s).plate.origin == (0.0, 0.0, 0.0)  # no layout: at the origin
     assert s.plate.max_frequency == SOLID_MAX_FREQUENCY == 1.5e5
 
 
@@ -234,10 +236,9 @@ def test_rigid_patch_moves_rigidly_in_every_mode_and_under_a_load():
     from granplate.model import build_model
     from granplate.physics.contact import COEF_A, COEF_C
     from granplate.setup.scenario import RigidPatch
-    from granplate.solid.patch import surface_nodes
     from granplate.solid.fe import vector_basis
     from granplate.solid.surface import boundary_surface
-    from granplate.solid.tie import patch_nodes, rigid_basis
+    from granplate.solid.tie import facing_nodes, patch_nodes, rigid_basis
 
     patch = RigidPatch(centre=(0.01, 0.01, 0.004), radius=0.006)
     s = scenario(rigid_patches=[{"centre": list(patch.centre), "radius": patch.radius}],
@@ -245,8 +246,8 @@ def test_rigid_patch_moves_rigidly_in_every_mode_and_under_a_load():
     s = dataclasses.replace(s, granules=(dataclasses.replace(s.granules[0], x=0.01, y=0.01, z=0.006),))
     validate(s)
     m = build_solid(s.plate, cache=False)
-    sn = surface_nodes(boundary_surface(vector_basis(m.mesh, m.element)))
-    nodes = patch_nodes(sn.xyz, sn.full, patch.centre, patch.radius, 0)
+    surface = boundary_surface(vector_basis(m.mesh, m.element))
+    nodes = patch_nodes(*facing_nodes(surface, patch.centre), patch.centre, patch.radius, 0)  # face zmax's only
     assert len(nodes) >= 5
     full = (3 * nodes[:, None] + np.arange(3)).ravel()
     rows = np.searchsorted(m.dofs, full)
