@@ -42,8 +42,13 @@ def load_direction(s: Scenario) -> np.ndarray:
 
 def loaded_granules_3d(s: Scenario, x, y, z, r) -> np.ndarray:
     """Mask of the granules the 3D shock pushes: load.granules, or the granules whose
-    surface lies furthest against the load's direction (min of s.d - R within 1e-9 R_max)."""
+    surface lies furthest against the load's direction (min of s.d - R within 1e-9 R_max);
+    a line load's as in the plane (`model.arrays.loaded_granules`)."""
     n = len(x)
+    if s.load.kind == "line":
+        from granplate.model.arrays import loaded_granules
+
+        return loaded_granules(s, x, r)
     if s.load.kind != "force" or n == 0:
         return np.zeros(n, bool)
     if s.load.granules:

@@ -238,10 +238,12 @@ def design_figures(folder: Path, key: str, progress: bool = False) -> list[tuple
     ds = design_result(folder, key, progress)
     if ds is None:
         return []
-    from granplate.figures import assembly, run, show
+    from granplate.figures import assembly, run, show, space
 
-    made = [("assembly", _save(show.draw(assembly.of_scenario(gp.loads(ds.attrs["scenario_toml"])), width=5.0),
-                               fig_dir / f"{stem}-assembly.png"))]
+    scenario = gp.loads(ds.attrs["scenario_toml"])
+    drawing = space.draw(space.of_scenario(scenario)) if scenario.dimension == 3 else \
+        show.draw(assembly.of_scenario(scenario), width=5.0)
+    made = [("assembly", _save(drawing, fig_dir / f"{stem}-assembly.png"))]
     for name, fig in run.figures(ds).items():
         if name in DESIGN_FIGURES:
             made.append((name, _save(fig, fig_dir / f"{stem}-{name}.png")))

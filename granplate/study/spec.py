@@ -253,12 +253,12 @@ def base_scenario(base: Any, folder: Path):
     if not isinstance(base, str) or not base:
         raise ScenarioError("base", base, "expected a preset name or a scenario file, e.g. "
                             "base = \"ptfe-r05\"; presets: " + ", ".join(gp.preset_names(True)))
-    if base in gp.preset_names():
+    if base in gp.preset_names(True):
         return gp.load_scenario(base)
     path = Path(base) if os.path.isabs(base) else folder / base
     if not path.is_file():
         raise ScenarioError("base", base, f"no such preset or scenario file (looked for {path}); "
-                            "presets: " + ", ".join(gp.preset_names()))
+                            "presets: " + ", ".join(gp.preset_names(True)))
     try:
         return gp.load_scenario(path)
     except ScenarioError as err:
