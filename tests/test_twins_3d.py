@@ -83,3 +83,28 @@ def test_thin_limit_twin_matches_the_plane(name, t_end):
     assert b["e_shock"] == pytest.approx(a["e_shock"], rel=0.01)
     assert b["ep_max_fraction"] == pytest.approx(a["ep_max_fraction"], rel=0.02)
     assert abs(b["energy_residual_max"]) < 1e-4
+
+
+def test_granule_on_a_rigid_patch_reports_the_rigid_layers_pressure():
+    """A granule on a rigid patch meets a rigid body (E* of the granule alone), so its
+    Hertz peak pressure at a given overlap is the 2D rigid layer's; elsewhere on the body
+    it is E* of both materials (eq. P2 with the loop's own coefficients)."""
+    from granplate.physics.contact import COEF_A
+    from granplate.results.yielding import contact_yield
+    from granplate.solver.driver import ContactPeaks
+    from granplate.solver.state import PARTNER_PLATE
+
+    plane = build_model(resolve(preset("steel-r1")))
+    space = build_model(resolve(validated(preset("3d-steel-r1"))))
+    on = np.flatnonzero(space.body_rigid)
+    assert set(plane.plate_contacts) <= set(on)  # every rigid layer's granule (and those behind it)
+    i, d = int(plane.plate_contacts[2]), 2e-6
+    peaks = ContactPeaks(np.array([i]), np.array([PARTNER_PLATE]), np.array([d]), np.array([0.0]))
+    (row2,), (row3,) = contact_yield(plane, peaks), contact_yield(space, peaks)
+    assert row3[0] == row2[0] == "steel-plate"
+    assert row3[1] == pytest.approx(row2[1], rel=1e-12) and row3[2] == pytest.approx(row2[2], rel=1e-12)
+    # the loop's own Hertz coefficient is the rigid body's too
+    assert space.body.coef[i, COEF_A] == pytest.approx(plane.granular.pc_coef[2, COEF_A], rel=1e-12)
+    k = int(np.flatnonzero(~space.body_rigid)[0])
+    free = ContactPeaks(np.array([k]), np.array([PARTNER_PLATE]), np.array([d]), np.array([0.0]))
+    assert contact_yield(space, free)[0][1] < 0.75 * row2[1]  # E* of steel on steel: softer, lower p0

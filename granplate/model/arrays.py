@@ -76,6 +76,7 @@ class Model:
     initial_patches: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     solid: object | None = None  # an elastic body in space: the built solid (solid.build.SolidModel)
     body: object | None = None  # and its arrays in the loop (model.inputs.BodyArrays)
+    body_rigid: np.ndarray | None = None  # (ng,) bool: the granules on one of the body's rigid patches at t = 0
 
     @property
     def n_granules(self) -> int:

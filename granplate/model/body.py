@@ -102,7 +102,8 @@ def modal_line_load(s: Scenario, surface, solid) -> np.ndarray:
 
 
 def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
-    """(the SolidModel, its BodyArrays) of the scenario's elastic solid."""
+    """(the SolidModel, its BodyArrays, (ng,) bool: each granule on a rigid patch at t = 0)
+    of the scenario's elastic solid."""
     from granplate.solid.boundary import reduced_index
     from granplate.solid.build import build_solid, solid_mesh
     from granplate.solid.fe import vector_basis
@@ -138,6 +139,7 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
     seeds = np.array([c.face for c in closest], np.int64)
     points = np.array([c.point for c in closest], float).reshape(-1, 3)
     box = np.array([solid.nodes.min(axis=0), solid.nodes.max(axis=0)])
+    rigid = on_rigid_patches(s, points)
     z = np.zeros
     arrays = BodyArrays(
         face_nodes=np.ascontiguousarray(surface.nodes), face_snode=sn.face_snode, node_xyz=sn.xyz,
@@ -147,7 +149,7 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
         neighbours=face_neighbours(surface),
         kind=np.array([surface.kind], np.int64), phi=np.ascontiguousarray(solid.Phi), omega=solid.omega.copy(),
         resid=np.ascontiguousarray(solid.resid), box=box,
-        coef=body_coefficients(s, mats, r, mass, material, on_rigid_patches(s, points)),
+        coef=body_coefficients(s, mats, r, mass, material, rigid),
         load=modal_line_load(s, surface, solid),
         patch=np.array([radius]), face=np.vstack([seeds, seeds]), geo=z((2, ng, N_GEO)),
         entry=np.zeros((2, ng, n_p), np.int64), weights=z((2, ng, n_p)), count=np.zeros((2, ng), np.int64),
@@ -155,4 +157,4 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
         qdp=z(nm), static=z(2), active=np.zeros(ng, np.int64),
         rcol=np.zeros((ng, 3 * n_p), np.int64), rcoef=z((ng, 3 * n_p)), rgrad=z((ng, 3 * n_p, 3)),
     )
-    return solid, arrays
+    return solid, arrays, rigid

@@ -152,11 +152,11 @@ def build_space_model(s: Scenario):
                       floor=force_floor_3d(s, mass, r, shares, s.time.output_interval))._replace(
         q0=shock_amplitude(s), dimension=3,
         split_friction=s.solver.granular_friction == "split" and not frictionless(s))
-    solid, body = None, None
+    solid, body, rigid = None, None, np.zeros(len(r), bool)
     if s.plate is not None:
         from granplate.model.body import build_body
 
-        solid, body = build_body(s, mats, r, mass)
+        solid, body, rigid = build_body(s, mats, r, mass)
     nm = 0 if solid is None else solid.n_modes
     omega2 = np.zeros(0) if solid is None else solid.omega ** 2
     plate_arrays = PlateArrays(omega2=omega2, phi_d=np.zeros((0, nm)), load_modal=np.zeros(nm))
@@ -165,4 +165,5 @@ def build_space_model(s: Scenario):
         granular=granular, plate_arrays=plate_arrays, config=cfg, plate=None,
         initial_state=initial_state_3d(s), pairs=pairs, wall_contacts=wc,
         plate_contacts=np.zeros(0, np.int64), materials=tuple(mats), solid=solid, body=body,
+        body_rigid=rigid,
     )

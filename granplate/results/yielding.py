@@ -5,7 +5,9 @@ to the yield onset 1.6 Y of the softer body (eq. P1), gathered by material pair.
 A pair is labelled by its two materials, sorted ("ptfe-steel"), or by the granule's
 material and "wall" / "plate" for the rigid bodies, which enter the contact law with the
 granule's modulus and radius alone (E_k, R_k -> infinity, eq. 3) and so never yield: the
-granule does. The ratio is NaN where a Y it needs is unknown (summary: null).
+granule does. In space, a granule on one of an elastic body's rigid patches meets a rigid
+body likewise (the 2D rigid layer's law); elsewhere on the body, E* and Y are of both
+materials. The ratio is NaN where a Y it needs is unknown (summary: null).
 """
 from __future__ import annotations
 
@@ -41,9 +43,11 @@ def contact_yield(model, peaks) -> list[tuple[str, float, float, float, float, s
     for i, j, d, t in zip(peaks.granule, peaks.partner, peaks.delta_max, peaks.time):
         a = mats[i]
         if j == PARTNER_PLATE and body is not None:
-            b = body
+            # a granule on a rigid patch meets a rigid body (the loop's law: E* of the granule alone)
+            rigid = model.body_rigid is not None and bool(model.body_rigid[i])
+            b = None if rigid else body
             e_star, r_star = effective_modulus(a, b), r[i]
-            pair, who, law = f"{a.name}-plate", f"{labels[i]}-plate", normal_law_of(s, a.name, b.name)
+            pair, who, law = f"{a.name}-plate", f"{labels[i]}-plate", normal_law_of(s, a.name, body.name)
             y = softer_yield_strength(a, b)
             p0 = hertz_peak_pressure(e_star, r_star, float(d))
             ratio = p0 / limiting_pressure(y) if y is not None else math.nan
