@@ -169,6 +169,18 @@ def test_layers_set_radii_and_materials_plane_by_plane():
     validate(_force_scenario(STACK))
 
 
+def test_layers_counts_give_the_cells_along_x_when_cells0_is_zero():
+    """cells[0] = 0 with layers builds exactly the packing of cells[0] = the counts' sum, so a
+    study can vary one layer's count alone."""
+    import dataclasses
+
+    two = SpaceLattice(kind="fcc", cells=(0, 2, 2), radius=R,
+                       layers=(Layer(2), Layer(1, radius=0.8 * R, material="ptfe"), Layer(1)))
+    assert layout_packing(two) == layout_packing(dataclasses.replace(two, cells=(4, 2, 2)))
+    assert len(layout_packing(two).granules) == 4 * 4 * 2 * 2
+    validate(_force_scenario(two))
+
+
 def test_single_site_intruders_shrink_at_their_centres():
     """intruder_sites and intruder_every shrink exactly the chosen sites (radius x ratio, material),
     at their centres."""
@@ -349,6 +361,7 @@ BAD = [
      "layout.layers[0].radius", "of the largest layer radius"),
     ("layer counts", _lay3(cells=(3, 2, 2), layers=(Layer(1), Layer(1))), "layout.layers",
      "add up to layout.cells[0] = 3"),
+    ("no cells along x without layers", _lay3(cells=(0, 2, 2)), "layout.cells[0]", "must be an integer >= 1"),
     ("planes cannot touch", _lay3(kind="fcc", cells=(3, 2, 2),
                                   layers=(Layer(1), Layer(1, radius=0.5 * R), Layer(1))),
      "layout.layers[1].radius", "planes 3 and 4 cannot touch"),

@@ -287,6 +287,12 @@ def sites_per_cell(kind: str) -> int:
     return sum(len(s) for s in PLANE_SITES[kind])
 
 
+def cells_along_x(lay: SpaceLattice) -> int:
+    """The cells along x: cells[0], or with layers the sum of their counts (which cells[0]
+    equals, or cells[0] = 0 leaves to them)."""
+    return sum(ly.count for ly in lay.layers) if lay.layers else lay.cells[0]
+
+
 def cell_layers(lay: SpaceLattice) -> list[tuple[float, str]]:
     """(R [m], material) of each cell along x: the layers in order, each `count` times
     (radius, material None: the layout's), or one layer of radius, material."""

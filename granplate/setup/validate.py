@@ -23,8 +23,8 @@ import numpy as np
 
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import granule_named, layout_packing, plane_offset, resolve, unit
-from granplate.setup.layouts import (column_radii, half_pitch, hexagonal_offsets, lattice_sites, plane_clash,
-                                     plane_gap_distance, plane_layers, plane_type, planes_per_cell,
+from granplate.setup.layouts import (cells_along_x, column_radii, half_pitch, hexagonal_offsets, lattice_sites,
+                                     plane_clash, plane_gap_distance, plane_layers, plane_type, planes_per_cell,
                                      sites_per_cell, space_sites)
 from granplate.setup.fields import finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
 from granplate.setup.pairs import close_pairs
@@ -369,8 +369,14 @@ def _check_space_lattice(s: Scenario, lay: SpaceLattice) -> None:
         raise ScenarioError("layout.cells", cells, "must be three integers [nx, ny, nz] >= 1 (cells "
                             "along x, the load direction, y and z)")
     for k, n in enumerate(cells):
+        if k == 0 and n == 0 and lay.layers:
+            continue  # the layers' counts give the cells along x
         int_at_least(f"layout.cells[{k}]", n, 1)
-    n_sites = sites_per_cell(lay.kind) * cells[0] * cells[1] * cells[2]
+    if isinstance(lay.layers, tuple) and all(isinstance(ly.count, int) for ly in lay.layers):
+        n_x = cells_along_x(lay)
+    else:
+        n_x = cells[0]
+    n_sites = sites_per_cell(lay.kind) * n_x * cells[1] * cells[2]
     if n_sites > MAX_LAYOUT_SITES:
         raise ScenarioError("layout.cells", list(cells), f"makes {n_sites} sites ({sites_per_cell(lay.kind)} "
                             f"per {lay.kind} cell); allowed: at most {MAX_LAYOUT_SITES} sites")
@@ -396,7 +402,8 @@ def _check_space_lattice(s: Scenario, lay: SpaceLattice) -> None:
 
 
 def _check_layers(s: Scenario, lay: SpaceLattice) -> None:
-    """Each layer: count >= 1, radius (or None), material (or None); counts add up to cells[0]."""
+    """Each layer: count >= 1, radius (or None), material (or None); counts add up to cells[0]
+    (unless cells[0] is 0: then they give it)."""
     if not isinstance(lay.layers, tuple):
         raise ScenarioError("layout.layers", lay.layers, "must be a list of tables {count, radius, material}")
     for k, ly in enumerate(lay.layers):
@@ -412,10 +419,10 @@ def _check_layers(s: Scenario, lay: SpaceLattice) -> None:
             raise ScenarioError(f"layout.layers[{k}].radius", r, f"allowed: at least 1 / {LENGTH_RANGE:g} "
                                 f"of the largest layer radius {max(radii):.6g} m (a ratio of radii)")
     total = sum(ly.count for ly in lay.layers)
-    if lay.layers and total != lay.cells[0]:
+    if lay.layers and lay.cells[0] != 0 and total != lay.cells[0]:
         raise ScenarioError("layout.layers", [ly.count for ly in lay.layers],
                             f"the layers' counts add up to {total} cells; allowed: they add up to "
-                            f"layout.cells[0] = {lay.cells[0]} (the cells along x)")
+                            f"layout.cells[0] = {lay.cells[0]} (the cells along x; 0: as many as the layers' counts add up to)")
 
 
 def _layer_of_plane(lay: SpaceLattice, plane: int) -> int:
