@@ -290,6 +290,8 @@ BAD = [
      "unknown material"),
     ("intruder column out of range", _lat(columns=3, intruder_columns=(4,)),
      "layout.intruder_columns[0]", "must be a column number in 1..3"),
+    ("intruder column rule", _lat(columns=3, intruder_columns="evn"), "layout.intruder_columns",
+     "must be one of 'odd', 'even' (did you mean 'even'?)"),
     ("intruder every negative", _lat(intruder_every=-1), "layout.intruder_every",
      "must be an integer >= 0"),
     ("intruder site unknown", _lat(intruder_sites=("c2r5",)), "layout.intruder_sites[0]",
@@ -338,6 +340,18 @@ def test_bad_layouts_are_refused_naming_field_and_range(action, field, allowed):
 
 KINDS = [Layout(R2_ratio=0.5), *LATTICES, ChainLayout(count=5, taper=0.8, decorated_ratio=0.2),
          IMPERFECT]
+
+
+@pytest.mark.parametrize("columns,numbers", [(3, (2,)), (5, (2, 4)), (6, (2, 4, 6))])
+def test_even_intruder_columns_are_the_listed_even_columns(columns, numbers):
+    """intruder_columns = "even" builds the packing of the even column numbers listed, and a
+    scenario file carries the rule through a round trip (so a study varies columns alone)."""
+    kw = dict(kind="hexagonal", columns=columns, rows=5, radius=0.01, intruder_ratio=0.5, intruder_material="ptfe")
+    assert layout_packing(LatticeLayout(intruder_columns="even", **kw)) == \
+        layout_packing(LatticeLayout(intruder_columns=numbers, **kw))
+    s = Scenario(layout=LatticeLayout(intruder_columns="even", **kw))
+    assert scenario_io.loads(scenario_io.dumps(s)) == s
+    validate(s)
 
 
 @pytest.mark.parametrize("lay", KINDS, ids=lambda l: l.kind)

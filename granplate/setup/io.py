@@ -116,6 +116,8 @@ def _convert(path: str, value: Any, tp: Any) -> Any:
             return _convert(path, value, arrays[0])
         if (isinstance(value, numbers.Real) and not isinstance(value, bool)) and scalars == [float]:
             return float(value)
+        if isinstance(value, str) and scalars == [str]:  # a rule by name (layout.intruder_columns = "even")
+            return value
         raise ScenarioError(path, value, f"wrong type: expected {_type_name(tp)}")
     if tp is float:
         if isinstance(value, numbers.Real) and not isinstance(value, bool):

@@ -64,11 +64,23 @@ def site_label(column: int, row: int) -> str:
 
 # --------------------------------------------------------------------------- lattices
 
+#: intruder_columns given by a rule: the first intruder column and the step between them.
+INTRUDER_COLUMN_RULES: dict[str, int] = {"odd": 1, "even": 2}
+
+
+def intruder_column_numbers(lay: LatticeLayout) -> tuple[int, ...]:
+    """The intruder columns (1-based): intruder_columns as given, or every even / odd one."""
+    if isinstance(lay.intruder_columns, str):
+        return tuple(range(INTRUDER_COLUMN_RULES[lay.intruder_columns], lay.columns + 1, 2))
+    return lay.intruder_columns
+
+
 def column_radii(lay: LatticeLayout) -> list[float]:
     """R_c [m] of each column: column_radii (or radius), times intruder_ratio in the
     intruder columns."""
     radii = list(lay.column_radii) if lay.column_radii else [lay.radius] * lay.columns
-    return [r * lay.intruder_ratio if c + 1 in lay.intruder_columns else r
+    intruders = intruder_column_numbers(lay)
+    return [r * lay.intruder_ratio if c + 1 in intruders else r
             for c, r in enumerate(radii)]
 
 
@@ -76,7 +88,8 @@ def column_materials(lay: LatticeLayout) -> list[str]:
     """Material of each column: column_materials (or material); intruder columns take the
     intruder material."""
     mats = list(lay.column_materials) if lay.column_materials else [lay.material] * lay.columns
-    return [intruder_material(lay) if c + 1 in lay.intruder_columns else m
+    intruders = intruder_column_numbers(lay)
+    return [intruder_material(lay) if c + 1 in intruders else m
             for c, m in enumerate(mats)]
 
 

@@ -131,7 +131,8 @@ class LatticeLayout:
 
     radius [m], material: every column's, unless column_radii / column_materials (one per
     column) are given. intruder_columns: whole columns whose radius is intruder_ratio x the
-    column's radius (the offsets follow, as the paper's column 2); intruder_sites (labels
+    column's radius (the offsets follow, as the paper's column 2), or "even" / "odd": every
+    even (odd) column, the heavy / light alternation whatever `columns`; intruder_sites (labels
     "c{column}r{row}") and intruder_every = n (every n-th site in granule order, 0 = none):
     single sites whose granule is intruder_ratio (<= 1) x the site's radius, at its centre
     (loose when < 1). Intruders take intruder_material (None = material).
@@ -146,7 +147,7 @@ class LatticeLayout:
     column_materials: tuple[str, ...] = ()
     intruder_ratio: float = 1.0
     intruder_material: str | None = None
-    intruder_columns: tuple[int, ...] = ()
+    intruder_columns: tuple[int, ...] | str = ()
     intruder_sites: tuple[str, ...] = ()
     intruder_every: int = 0
     wall_material: str = "steel"

@@ -23,9 +23,9 @@ import numpy as np
 
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import granule_named, layout_packing, plane_offset, resolve, unit
-from granplate.setup.layouts import (cells_along_x, column_radii, half_pitch, hexagonal_offsets, lattice_sites,
-                                     plane_clash, plane_gap_distance, plane_layers, plane_type, planes_per_cell,
-                                     sites_per_cell, space_sites)
+from granplate.setup.layouts import (INTRUDER_COLUMN_RULES, cells_along_x, column_radii, half_pitch,
+                                     hexagonal_offsets, lattice_sites, plane_clash, plane_gap_distance,
+                                     plane_layers, plane_type, planes_per_cell, sites_per_cell, space_sites)
 from granplate.setup.fields import finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
 from granplate.setup.pairs import close_pairs
 from granplate.setup.plate_checks import check_plate_fields, check_plate_mesh
@@ -313,7 +313,9 @@ def _check_lattice_layout(s: Scenario, lay: LatticeLayout) -> None:
     for c, m in enumerate(lay.column_materials):
         material_exists(f"layout.column_materials[{c}]", m, s)
     layout_ratio("layout.intruder_ratio", lay.intruder_ratio)
-    for k, c in enumerate(lay.intruder_columns):
+    if isinstance(lay.intruder_columns, str):
+        string_in("layout.intruder_columns", lay.intruder_columns, tuple(INTRUDER_COLUMN_RULES))
+    for k, c in enumerate(() if isinstance(lay.intruder_columns, str) else lay.intruder_columns):
         if not isinstance(c, numbers.Integral) or isinstance(c, bool) or not 1 <= c <= lay.columns:
             raise ScenarioError(f"layout.intruder_columns[{k}]", c,
                                 f"must be a column number in 1..{lay.columns} (layout.columns)")
