@@ -149,3 +149,81 @@ def test_cli_plot_of_a_body_run(tmp_path, drop, capsys):
     assert written == sorted(f"drop-on-box-{n}.{e}" for n in BODY_FIGURES for e in ("png", "pdf"))
     assert "no contact-forces figure: the run's elastic body is a 3D solid: see body-contact-forces" in out
     assert "no stress-strain figure: eps_yy is a 2D plate strain; a 3D body has body-stress" in out
+
+
+# --------------------------------------------------------------------------------------
+# animate
+# --------------------------------------------------------------------------------------
+def _gif_frames(path) -> int:
+    from PIL import Image
+
+    with Image.open(path) as im:
+        return im.n_frames
+
+
+def test_frames_of_a_body_run_are_its_field_snapshots_on_one_scale(drop):
+    """The frames of a body run are its field snapshots: each at the nearest output, its
+    body the snapshot's displacement (one magnification for all, from the largest over the
+    frames) and element stresses (one colour scale, the largest over the frames), its
+    spheres where the run put them."""
+    from granplate.figures import space
+
+    times = space.frame_times(drop)
+    np.testing.assert_array_equal(times, drop.field_time.values)
+    idx = [0, 2, len(times) - 1]
+    frames = space.frames_of_result(drop, idx)
+    assert [a.time for a in frames] == pytest.approx(times[idx], abs=1e-15)
+    assert len({a.body_scale for a in frames}) == 1
+    stress = drop.body_von_mises.values[idx]
+    assert all(a.stress_top == stress.max() for a in frames)
+    for j, (a, k) in enumerate(zip(frames, idx)):
+        ti = int(np.argmin(np.abs(drop.time.values - times[k])))
+        np.testing.assert_array_equal(a.pos, space.positions(drop)[ti])
+        assert np.isin(a.body_stress, stress[j]).all() and a.body_stress.max() == stress[j].max()
+    largest = [float(np.linalg.norm(np.column_stack([drop[f"body_u{c}"].values[k] for c in "xyz"]), axis=1).max())
+               for k in idx]
+    assert [a.body_largest for a in frames] == pytest.approx(largest)
+    assert frames[0].body_scale == space.magnification(max(largest), 0.02)  # the box's largest side
+
+
+def test_the_animation_redraws_each_frame_where_the_run_was(drop):
+    """draw(f) puts every sphere of each view at frame f's projected centre [mm] and draws
+    the body's faces as frame f's; the title names the frame's time."""
+    from granplate.figures import space
+
+    frames = space.frames_of_result(drop, [0, 2, 4])
+    fig, draw = space.animation(frames)
+    for f, a in enumerate(frames):
+        draw(f)
+        for (u, v, _, _), view in zip(space.PROJECTIONS, ("xy", "xz", "yz")):
+            circles = {p.get_gid().split(":")[1]: p for ax in fig.axes for p in ax.patches
+                       if str(p.get_gid()).startswith("granule:") and p.get_gid().endswith(f":{view}")}
+            for i, lab in enumerate(a.labels):
+                assert circles[lab].center == pytest.approx((a.pos[i, u] * 1e3, a.pos[i, v] * 1e3))
+            (body,) = [c for ax in fig.axes for c in ax.collections if c.get_gid() == f"body:{view}"]
+            drawn = np.sort(np.concatenate([p.vertices[:-1].ravel() for p in body.get_paths()]))
+            faces = a.body_faces[:, :, [u, v]] * 1e3
+            np.testing.assert_allclose(drawn, np.sort(faces.ravel()), atol=1e-9)
+        assert f"t = {a.time * 1e3:.4g} ms" in fig._suptitle.get_text()
+
+
+@pytest.mark.parametrize("frames, expected", [(3, 3), (None, 5)])
+def test_animate_a_body_run_writes_its_frames(tmp_path, drop, frames, expected):
+    """A GIF of the body run holds one frame per field snapshot (5), thinned to --frames."""
+    from granplate.paper.animate import animate
+
+    written = animate(drop, tmp_path / "drop.gif", frames=frames)
+    assert written == tmp_path / "drop.gif" and _gif_frames(written) == expected
+
+
+def test_cli_animate_show_export_of_a_body_run(tmp_path, drop, capsys):
+    """`granplate animate` (a GIF of 3 frames), `show` and `export --vtk` of a 3D body
+    result: status 0, their files written, no traceback."""
+    path = write(drop, tmp_path / "drop.nc")
+    assert main(["animate", str(path), "-o", str(tmp_path / "m.gif"), "--frames", "3"]) == 0
+    assert _gif_frames(tmp_path / "m.gif") == 3
+    assert main(["show", str(path), "-o", str(tmp_path / "s.png")]) == 0
+    assert main(["export", str(path), "--vtk", str(tmp_path / "vtk")]) == 0
+    assert (tmp_path / "s.png").stat().st_size > 1000 and (tmp_path / "vtk" / "drop-on-box.pvd").is_file()
+    captured = capsys.readouterr()
+    assert "Traceback" not in captured.out + captured.err

@@ -527,7 +527,8 @@ def register(subparsers) -> None:
     a.add_argument("-o", "--output", help="output .mp4 (or .gif) (default SCENARIO.mp4)")
     a.add_argument("--frames", type=_positive_int, default=DEFAULT_FRAMES, help="at most this many frames")
     a.add_argument("--fps", type=_positive_int, default=15, help="frames per second")
-    a.add_argument("--magnify", type=float, default=125.0, help="displacement magnification")
+    a.add_argument("--magnify", type=float, default=125.0, help="the plate's displacement magnification "
+                   "(in the plane; in space an elastic body is magnified as `granplate show` does)")
     a.set_defaults(func=_cmd_animate)
 
     e = subparsers.add_parser("export", help="write a ParaView time series (VTK, .pvd) of a result")
