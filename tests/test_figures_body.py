@@ -79,6 +79,18 @@ def test_a_body_run_has_the_body_figures_and_not_the_plates(drop):
     assert run.missing("stress-strain", drop) == "eps_yy is a 2D plate strain; a 3D body has body-stress"
 
 
+def test_a_body_run_without_touching_granules_says_so(drop):
+    """No granule touched the body: body-contact-forces says so, contact-forces points to
+    no figure; without granules at all, both say the run has none."""
+    untouched = drop.assign(body_contact_normal_force=drop.body_contact_normal_force * 0.0)
+    assert run.missing("body-contact-forces", untouched) == "no granule touched the body"
+    assert run.missing("contact-forces", untouched) == "the run's elastic body is a 3D solid"
+    bare = drop.isel(granule=slice(0, 0))
+    assert run.missing("body-contact-forces", bare) == "the run has no granules"
+    assert run.missing("granule-speeds", bare) == "the run has no granules"
+    assert list(run.figures(bare)) == ["energies", "body-stress"]
+
+
 def test_body_stress_draws_the_runs_maxima_in_mpa_and_um(drop):
     """The body-stress curves are the Dataset's max_von_mises and max_von_mises_ball / 1e6
     [MPa] and max_displacement * 1e6 [um] against time * 1e3 [ms], on axes with units."""

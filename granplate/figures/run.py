@@ -302,7 +302,8 @@ def missing(name: str, ds: xr.Dataset) -> str | None:
     if ds.sizes.get("time", 0) == 0:
         return "the run has no output times"
     if name == "contact-forces" and has_body(ds):
-        return "the run's elastic body is a 3D solid: see body-contact-forces"
+        see = ": see body-contact-forces" if missing("body-contact-forces", ds) is None else ""
+        return "the run's elastic body is a 3D solid" + see
     if name == "contact-forces" and (ds.sizes.get("contact", 0) == 0 or "contact_normal_force" not in ds):
         return "the run has no plate contacts"
     if name == "stress-strain" and has_body(ds):
@@ -311,6 +312,8 @@ def missing(name: str, ds: xr.Dataset) -> str | None:
         return "the run has no plate"
     if name in ("body-stress", "body-contact-forces") and not has_body(ds):
         return "the run has no 3D elastic body"
+    if name == "body-contact-forces" and not an.has_granules(ds):
+        return "the run has no granules"
     if name == "body-contact-forces" and ("body_contact_normal_force" not in ds or not body_touching(ds)):
         return "no granule touched the body"
     if name == "granule-speeds" and not an.has_granules(ds):
