@@ -69,6 +69,15 @@ def test_bench_unknown_case_is_a_user_error(capsys):
     assert "unknown case" in capsys.readouterr().err
 
 
+def test_bench_of_a_3d_twin_says_why_not_and_where_instead(capsys):
+    """A 3D twin (a preset `granplate run` knows) is refused by the scheme benchmark with
+    one line that says why and names the coupled 3D bench, before anything runs."""
+    assert main(["bench", "--quick", "--cases", "steel-r1,3d-steel-r1"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("granplate: error: case(s) 3d-steel-r1: 3D twins") and err.count("\n") == 1
+    assert "bench --solid --coupled" in err and "unknown" not in err
+
+
 def test_scaling_rows_are_measured_and_documented(tmp_path):
     """`bench --scaling` on a 2 x 3 packing (5 granules, 7 touching pairs): one row per
     friction, every documented key, a small error against the RK4 reference, and LAMMPS

@@ -19,6 +19,9 @@ from granplate.setup.materials import LIBRARY, effective_modulus, sphere_mass
 from conftest import two_spheres
 from short_results import short_results
 
+#: The generic figures of a 2D run with granules and a plate, in order.
+PLATE_FIGURES = ["energies", "contact-forces", "stress-strain", "granule-speeds"]
+
 #: Two steel spheres approaching at 0.1 m/s each (no damping): their collision lasts
 #: about 84 us, so the run covers the largest overlap (~42 us) with outputs every 0.2 us.
 SPHERE_SPEED = 0.1
@@ -68,9 +71,13 @@ def _units_everywhere(fig):
 # Generic figures of a run
 # --------------------------------------------------------------------------------------
 def test_every_figure_of_a_paper_preset_draws_its_numbers(steel):
-    """steel-r1 has every quantity: four figures, each curve the dataset's own values."""
+    """steel-r1 has every quantity of a 2D run: its four figures, each curve the dataset's
+    own values; the 3D body's figures are skipped with their reason."""
     figs = run.figures(steel)
-    assert list(figs) == list(run.FIGURES)
+    assert list(figs) == PLATE_FIGURES
+    assert [n for n in run.FIGURES if n not in figs] == ["body-stress", "body-contact-forces"]
+    for name in ("body-stress", "body-contact-forces"):
+        assert run.missing(name, steel) == "the run has no 3D elastic body"
     for fig in figs.values():
         _units_everywhere(fig)
     e = figs["energies"]
@@ -101,6 +108,7 @@ def test_two_spheres_without_plate_skip_plate_figures(spheres):
     assert list(figs) == ["energies", "granule-speeds"]
     assert run.missing("contact-forces", spheres) == "the run has no plate contacts"
     assert run.missing("stress-strain", spheres) == "the run has no plate"
+    assert run.missing("body-stress", spheres) == "the run has no 3D elastic body"
     assert not [ln for ax in figs["energies"].axes for ln in ax.get_lines() if ln.get_gid() == "energy:plate"]
     assert "E_initial" in figs["energies"].axes[1].get_ylabel()  # no load: fractions of the initial energy
     for lab in ("a", "b"):
@@ -263,14 +271,16 @@ def test_cli_show_scenario_preset_and_result(tmp_path, files, capsys):
 
 
 def test_cli_plot_generic_figures(tmp_path, files, capsys):
-    """Without --figure: PNG + PDF per figure; figures a run lacks are a printed note."""
+    """Without --figure: PNG + PDF per figure; the figures a run lacks are a printed note,
+    one line per reason."""
     assert main(["plot", str(files["steel"]), str(files["spheres"]), "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     written = sorted(p.name for p in tmp_path.iterdir())
-    expected = [f"steel-r1-{n}.{e}" for n in run.FIGURES for e in ("png", "pdf")]
+    expected = [f"steel-r1-{n}.{e}" for n in PLATE_FIGURES for e in ("png", "pdf")]
     expected += [f"two-spheres-{n}.{e}" for n in ("energies", "granule-speeds") for e in ("png", "pdf")]
     assert written == sorted(expected)
     assert "no stress-strain figure: the run has no plate" in out
+    assert out.count("no body-stress, body-contact-forces figures: the run has no 3D elastic body") == 2
 
 
 @pytest.mark.parametrize("argv, words", [

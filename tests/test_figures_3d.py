@@ -258,6 +258,25 @@ def test_export_spheres_read_back(tmp_path, box):
 
 
 # --------------------------------------------------------------------------------------
+# animate
+# --------------------------------------------------------------------------------------
+@pytest.mark.parametrize("frames", [4, None])
+def test_animate_draws_the_output_times_of_a_run_without_a_body(tmp_path, box, frames):
+    """Without an elastic body the frames are the output times (all 21, or thinned to 4),
+    one GIF frame each, the contact forces on the largest force over the frames."""
+    from PIL import Image
+
+    from granplate.paper.animate import animate
+
+    np.testing.assert_array_equal(space.frame_times(box), box.time.values)
+    written = animate(box, tmp_path / "box.gif", frames=frames)
+    with Image.open(written) as im:
+        assert im.n_frames == (frames or box.sizes["time"])
+    drawn = space.frames_of_result(box, [0, 10, 15])
+    assert {a.force_top for a in drawn} == {max(float(a.forces.max()) for a in drawn)}
+
+
+# --------------------------------------------------------------------------------------
 # Command line
 # --------------------------------------------------------------------------------------
 def test_cli_run_show_plot_export_animate_in_space(tmp_path, box_scenario, box_file, capsys):

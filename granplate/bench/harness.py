@@ -238,6 +238,11 @@ def run(quick: bool = False, cases=None, repeats: int | None = None, t_end: floa
     t_start = time.perf_counter()
     if cases is None:
         cases = list(QUICK_CASES) if quick else gp.preset_names()
+    twins = [c for c in cases if c in gp.preset_names(include_3d=True) and c not in gp.preset_names()]
+    if twins:
+        raise ValueError(f"case(s) {', '.join(twins)}: 3D twins, which run under velocity Verlet alone, not the "
+                         f"plate schemes this benchmark compares ({', '.join(schemes())}); `granplate bench "
+                         f"--solid --coupled` times a coupled 3D run")
     unknown = [c for c in cases if c not in gp.preset_names()]
     if unknown:
         raise ValueError(f"unknown case(s) {', '.join(unknown)}; presets are: "

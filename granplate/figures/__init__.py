@@ -6,9 +6,10 @@
   load arrows, contact lines);
 - `space`: the same for an assembly in space (dimension = 3): three orthogonal
   projections, spheres depth-sorted and depth-shaded, walls as their traces, contact
-  lines with width by force;
+  lines with width by force, an elastic body deformed; the frames of `granplate animate`;
 - `run`: the generic figures of any result (energies, plate contact forces, plate
-  stress and strain, granule speeds), each skipped when the run lacks its quantities;
+  stress and strain, a 3D body's stress and contact forces, granule speeds), each
+  skipped when the run lacks its quantities;
 - `common`: the Figure factory, saving as PNG + PDF, time axes;
 - `cli`: the `granplate show` command and the generic `granplate plot RESULT`.
 

@@ -83,20 +83,34 @@ def result_paths(items: list[str]) -> list[Path]:
 
 def plot_results(items: list[str], out_dir: str) -> int:
     """Draw the generic figures of each result into out_dir as NAME-FIGURE.png and .pdf;
-    figures a run cannot have are skipped with a printed note. Returns the exit status 0."""
+    figures a run cannot have are skipped with a printed note, one line per reason
+    (`skipped_notes`). Returns the exit status 0."""
     from granplate.figures import run
 
     for path in result_paths(items):
         ds = _read_result(str(path))
         stem = ds.attrs.get("scenario_name") or path.stem
+        skipped = {}
         for name in run.FIGURES:
             why = run.missing(name, ds)
             if why is not None:
-                print(f"{path}: no {name} figure: {why}")
+                skipped[name] = why
                 continue
             for written in save_figure(run.FIGURES[name](ds), out_dir, f"{stem}-{name}"):
                 print(f"written {written}")
+        for line in skipped_notes(skipped):
+            print(f"{path}: {line}")
     return 0
+
+
+def skipped_notes(skipped: dict[str, str]) -> list[str]:
+    """One note per reason of the figures skipped ({figure: why}, in figure order):
+    "no stress-strain figure: the run has no plate", "no body-stress, body-contact-forces
+    figures: the run has no 3D elastic body"."""
+    by_reason: dict[str, list[str]] = {}
+    for name, why in skipped.items():
+        by_reason.setdefault(why, []).append(name)
+    return [f"no {', '.join(names)} figure{'s' if len(names) > 1 else ''}: {why}" for why, names in by_reason.items()]
 
 
 def _time(text: str) -> float:

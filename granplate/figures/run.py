@@ -3,6 +3,8 @@
 - energies: E_shock, E_granular (in space with its part KE_depth), E_plate, dissipation
   D_viscous + D_friction (+ D_plastic where contacts yielded) and their sum in J; the
   same as fractions of the energy put in; the energy-balance residual;
+- body-stress: a 3D body's largest von Mises stress and ball average [MPa], max |u| [um];
+- body-contact-forces: normal force of each granule on a 3D body [N];
 - contact-forces: normal and tangential force at each plate contact [N];
 - stress-strain: the plate's largest von Mises stress [MPa] and largest |eps_yy| [-];
 - granule-speeds: |v| of each granule [m/s], three components in space (beyond
@@ -217,10 +219,80 @@ def fig_granule_speeds(ds: xr.Dataset) -> Figure:
     return fig
 
 
+def has_body(ds: xr.Dataset) -> bool:
+    """Whether the result carries a 3D elastic body's stress and displacement history."""
+    return "max_displacement" in ds and "max_von_mises" in ds and "body_q" in ds
+
+
+def fig_body_stress(ds: xr.Dataset) -> Figure:
+    """The 3D body's largest von Mises stress and its ball average [MPa] (a) and its
+    largest displacement [um] (b), against time [ms]; a summary-only run's skipped blocks
+    of times (NaN) are gaps."""
+    fig = new_figure(7.5, 6.0)
+    a, b = fig.subplots(2, 1, sharex=True)
+    t = _t_ms(ds)
+    a.plot(t, ds["max_von_mises"].values / 1e6, color="tab:red", lw=1.3, label="largest over the body",
+           gid="max_von_mises")
+    if "max_von_mises_ball" in ds:
+        radius = ds["max_von_mises_ball"].attrs.get("ball_radius")
+        ball = f" (radius {float(radius) * 1e3:.3g} mm)" if radius is not None else ""
+        a.plot(t, ds["max_von_mises_ball"].values / 1e6, color="tab:orange", lw=1.1, ls="--",
+               label=f"largest ball average{ball}", gid="max_von_mises_ball")
+    a.set_ylabel("von Mises stress [MPa]")
+    a.set_title("(a) largest von Mises stress in the body", loc="left", fontsize=10)
+    a.legend(fontsize=8, frameon=False)
+    b.plot(t, ds["max_displacement"].values * 1e6, color="tab:blue", lw=1.3, gid="max_displacement")
+    b.set_ylabel("largest |u| [um]")
+    b.set_title("(b) largest displacement of the body", loc="left", fontsize=10)
+    for ax in (a, b):
+        time_axis(ax, _end_ms(ds))
+    a.set_xlabel("")
+    _caption(fig, ds, "body stress and displacement")
+    return fig
+
+
+def body_touching(ds: xr.Dataset) -> list[int]:
+    """Indices of the granules whose normal force on the 3D body is nonzero at some output
+    time, the largest peak force first."""
+    fn = np.nan_to_num(ds["body_contact_normal_force"].values)
+    touching = [k for k in range(fn.shape[1]) if np.any(fn[:, k] != 0.0)]
+    return sorted(touching, key=lambda k: -float(np.max(np.abs(fn[:, k]))))
+
+
+def fig_body_contact_forces(ds: xr.Dataset) -> Figure:
+    """Normal force [N] of each granule touching the 3D body against time [ms]; beyond
+    MAX_LABELLED touching granules: their min-max envelope and the FASTEST largest."""
+    fig = new_figure(9.0, 4.5)
+    ax = fig.add_subplot()
+    t = _t_ms(ds)
+    fn = np.nan_to_num(ds["body_contact_normal_force"].values)
+    labels = [str(g) for g in ds["granule"].values]
+    touching = body_touching(ds)
+    if len(touching) <= MAX_LABELLED:
+        shown = touching
+        which = "the granule" if len(touching) == 1 else f"each of the {len(touching)} granules"
+        ax.set_title(f"normal force of {which} touching the body", loc="left", fontsize=10)
+    else:
+        ax.fill_between(t, fn[:, touching].min(axis=1), fn[:, touching].max(axis=1), color="0.8",
+                        label=f"all {len(touching)} touching granules: min to max", gid="body-normal:envelope")
+        shown = touching[:FASTEST]
+        ax.set_title(f"normal force on the body: envelope of the {len(touching)} touching granules and the "
+                     f"{FASTEST} largest", loc="left", fontsize=10)
+    plot_curves(ax, t, [(f"granule {labels[k]}", fn[:, k], f"body-normal:{labels[k]}") for k in shown],
+                rtol=FORCE_COINCIDE, lw=1.2)
+    ax.set_ylabel("normal force on the body [N]")
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    time_axis(ax, _end_ms(ds))
+    _caption(fig, ds, "body contact forces")
+    return fig
+
+
 FIGURES = {
     "energies": fig_energies,
     "contact-forces": fig_contact_forces,
     "stress-strain": fig_stress_strain,
+    "body-stress": fig_body_stress,
+    "body-contact-forces": fig_body_contact_forces,
     "granule-speeds": fig_granule_speeds,
 }
 
@@ -229,10 +301,21 @@ def missing(name: str, ds: xr.Dataset) -> str | None:
     """Why the result cannot have figure `name` ("no plate", ...), None when it can."""
     if ds.sizes.get("time", 0) == 0:
         return "the run has no output times"
+    if name == "contact-forces" and has_body(ds):
+        see = ": see body-contact-forces" if missing("body-contact-forces", ds) is None else ""
+        return "the run's elastic body is a 3D solid" + see
     if name == "contact-forces" and (ds.sizes.get("contact", 0) == 0 or "contact_normal_force" not in ds):
         return "the run has no plate contacts"
+    if name == "stress-strain" and has_body(ds):
+        return "eps_yy is a 2D plate strain; a 3D body has body-stress"
     if name == "stress-strain" and not ("max_von_mises" in ds and an.has_plate(ds)):
         return "the run has no plate"
+    if name in ("body-stress", "body-contact-forces") and not has_body(ds):
+        return "the run has no 3D elastic body"
+    if name == "body-contact-forces" and not an.has_granules(ds):
+        return "the run has no granules"
+    if name == "body-contact-forces" and ("body_contact_normal_force" not in ds or not body_touching(ds)):
+        return "no granule touched the body"
     if name == "granule-speeds" and not an.has_granules(ds):
         return "the run has no granules"
     return None

@@ -23,6 +23,13 @@ element's von Mises stress [MPa] (a colour bar), over the undeformed outline; th
 snapshot of the largest von Mises stress, or the one nearest `time`, with the spheres at
 the output nearest it.
 
+An animation (`granplate animate`) draws the same views frame by frame:
+`frames_of_result(ds, indices)` the assemblies at `frame_times(ds)[indices]` (the body's
+field snapshots for a result with a body, else the output times), on one magnification
+of the body and one colour scale each for its stress and the contact forces;
+`animation(frames)` the figure laid out once over the region holding every frame, and
+the function that redraws it with frame f.
+
 Contact forces of a result at one output time come from the stored centres and the run's
 own contact coefficients (`model.arrays.pair_coefficients`, `wall_arrays`: the run's
 materials and [[contact.pairs]]), through the run's normal law (`physics.laws`: Hertz, or
@@ -33,6 +40,7 @@ s_i . n + R_i - offset for a wall (docs/model.md, the laws in space).
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -97,7 +105,9 @@ class Assembly3D:
     A result's deformed body (empty without one): body_faces (nf, k, 3) its boundary
     faces' corners displaced body_scale times [m], body_stress (nf,) the von Mises stress
     of each face's element [Pa], body_largest the largest displacement [m], body_note
-    which snapshot.
+    which snapshot. stress_top [Pa] and force_top [N]: the tops of the colour scales of
+    the body's stress and of the contact forces, shared by the frames of an animation
+    (None: this assembly's own largest).
     """
 
     name: str
@@ -123,6 +133,8 @@ class Assembly3D:
     body_scale: float = 1.0
     body_largest: float = 0.0
     body_note: str = ""
+    stress_top: float | None = None
+    force_top: float | None = None
 
 
 # --------------------------------------------------------------------------------------
@@ -265,21 +277,37 @@ def of_result(ds: xr.Dataset, time: float | None = None) -> Assembly3D:
     """The 3D assembly of a result at `time` [s] (None: the last output): centres and
     contact forces at the nearest output (module docstring)."""
     from granplate.figures.assembly import choose_time
-    from granplate.model.space import loaded_granules_3d
-    from granplate.results.dataset import scenario_of
-    from granplate.setup.geometry import resolve
-
     from granplate.results.export import has_body
 
-    s = resolve(scenario_of(ds))
-    body = {}
+    s, solid = _result_scenario(ds)
     if has_body(ds):
         k, body_note = body_snapshot(ds, time)
-        body = body_drawing(ds, k, body_note)
-        time = float(ds["field_time"].values[k])
+        ti, _ = choose_time(ds, float(ds["field_time"].values[k]))
+        return _assembly_at(ds, s, ti, "the output nearest the body's snapshot", solid,
+                            body_drawing(ds, k, body_note))
     ti, note = choose_time(ds, time)
-    if body:
-        note = "the output nearest the body's snapshot"
+    return _assembly_at(ds, s, ti, note)
+
+
+def _result_scenario(ds: xr.Dataset) -> tuple[Scenario, dict]:
+    """(the result's resolved scenario, its solid's drawing without the undeformed facets,
+    {} without a body's fields)."""
+    from granplate.results.dataset import scenario_of
+    from granplate.results.export import has_body
+    from granplate.setup.geometry import resolve
+
+    s = resolve(scenario_of(ds))
+    solid = {k: v for k, v in solid_drawing(s).items() if k != "solid_faces"} if has_body(ds) else {}
+    return s, solid
+
+
+def _assembly_at(ds: xr.Dataset, s: Scenario, ti: int, note: str, solid: dict | None = None,
+                 body: dict | None = None, **scales) -> Assembly3D:
+    """The result's assembly at output index ti: centres, the contacts touching there and
+    their forces; solid and body: the fields of `solid_drawing` and `body_drawing`;
+    scales: stress_top, force_top."""
+    from granplate.model.space import loaded_granules_3d
+
     path = positions(ds, ti)
     pos = path[-1]
     r = np.asarray(ds["radius"].values, float)
@@ -291,8 +319,47 @@ def of_result(ds: xr.Dataset, time: float | None = None) -> Assembly3D:
         materials=tuple(str(v) for v in ds["material"].values), walls=s.walls, load=s.load,
         loaded=loaded_granules_3d(s, p0[:, 0], p0[:, 1], p0[:, 2], r), segments=segs, kinds=kinds,
         forces=contact_forces(s, path, r, pairs, wc), time=float(ds["time"].values[ti]), time_note=note,
-        **({k: v for k, v in solid_drawing(s).items() if k != "solid_faces"} if body else {}), **body,
+        **(solid or {}), **(body or {}), **scales,
     )
+
+
+def frame_times(ds: xr.Dataset) -> np.ndarray:
+    """The times [s] an animation of a 3D result can draw: the body's field snapshots
+    (`field_time`) for a result with an elastic body's fields, else every output time."""
+    from granplate.results.export import has_body
+
+    return np.asarray(ds["field_time" if has_body(ds) else "time"].values, float)
+
+
+def frames_of_result(ds: xr.Dataset, indices) -> list[Assembly3D]:
+    """The assemblies of a 3D result at frame_times(ds)[indices], drawn with one region's
+    colour scales: with a body, its snapshots at those field times under one
+    magnification (the largest displacement over them drawn as BODY_DEFORMATION of the
+    body's largest side) and one stress scale, the spheres at the nearest outputs; the
+    contact forces on one scale (the largest over the frames)."""
+    from granplate.figures.assembly import choose_time
+
+    s, solid = _result_scenario(ds)
+    times = frame_times(ds)
+    indices = [int(k) for k in indices]
+    n = len(indices)
+    bodies: list[dict] = [{} for _ in indices]
+    scales: dict = {}
+    if solid:
+        nodes = np.column_stack([ds[f"body_node_{c}"].values for c in "xyz"]).astype(float)
+        u = np.stack([ds[f"body_u{c}"].values[indices] for c in "xyz"], axis=-1).astype(float)
+        largest = float(np.linalg.norm(u, axis=-1).max()) if u.size else 0.0
+        scale = magnification(largest, float((nodes.max(axis=0) - nodes.min(axis=0)).max()))
+        bodies = [body_drawing(ds, k, f"field snapshot {k + 1} of {len(times)}", scale) for k in indices]
+        vm = np.asarray(ds["body_von_mises"].values, float)[indices]
+        scales["stress_top"] = float(vm.max()) if vm.size else 0.0
+    frames = []
+    for f, (k, body) in enumerate(zip(indices, bodies)):
+        ti, _ = choose_time(ds, float(times[k]))
+        frames.append(_assembly_at(ds, s, ti, f"frame {f + 1} of {n}", solid, body))
+    top = max((float(a.forces.max()) for a in frames if a.forces is not None and len(a.forces)), default=0.0)
+    scales["force_top"] = top
+    return [dataclasses.replace(a, **scales) for a in frames]
 
 
 def body_snapshot(ds: xr.Dataset, time: float | None) -> tuple[int, str]:
@@ -329,8 +396,9 @@ def magnification(largest: float, extent: float) -> float:
     return float(max(m for m in (1.0, 2.0, 5.0) if m * power <= raw * (1 + 1e-12)) * power)
 
 
-def body_drawing(ds: xr.Dataset, k: int, note: str) -> dict:
-    """The Assembly3D fields of the body at field snapshot k (module docstring)."""
+def body_drawing(ds: xr.Dataset, k: int, note: str, scale: float | None = None) -> dict:
+    """The Assembly3D fields of the body at field snapshot k (module docstring); scale:
+    the displacements' magnification (None: `magnification` of this snapshot's largest)."""
     from granplate.solid.vtk_cells import boundary_faces
 
     cells = np.asarray(ds["body_element_nodes"].values, np.int64)
@@ -338,7 +406,8 @@ def body_drawing(ds: xr.Dataset, k: int, note: str) -> dict:
     nodes = np.column_stack([ds[f"body_node_{c}"].values for c in "xyz"]).astype(float)
     u = np.column_stack([ds[f"body_u{c}"].values[k] for c in "xyz"]).astype(float)
     largest = float(np.linalg.norm(u, axis=1).max()) if len(u) else 0.0
-    scale = magnification(largest, float((nodes.max(axis=0) - nodes.min(axis=0)).max()))
+    if scale is None:
+        scale = magnification(largest, float((nodes.max(axis=0) - nodes.min(axis=0)).max()))
     faces, owner = boundary_faces(cells, element)
     t = float(ds["field_time"].values[k])
     return {"body_faces": nodes[faces] + scale * u[faces],
@@ -394,11 +463,12 @@ def wall_trace(wall: Wall, view: tuple, lo: np.ndarray, hi: np.ndarray):
     return clip_line(n2 * float(wall.offset), np.array([-n2[1], n2[0]]), (lo[u], hi[u], lo[v], hi[v]))
 
 
-def _force_style(forces: np.ndarray):
-    """(widths, colours, styles, colour map) of the contact lines by normal force."""
+def _force_style(forces: np.ndarray, top: float | None = None):
+    """(widths, colours, styles, colour map, open, top) of the contact lines by normal
+    force, on the scale 0..top [N] (None: the largest of forces)."""
     from granplate.figures.show import FORCE_CMAP
 
-    f_max = float(forces.max()) if len(forces) else 0.0
+    f_max = top if top is not None else (float(forces.max()) if len(forces) else 0.0)
     cmap = ScalarMappable(Normalize(0.0, f_max if f_max > 0 else 1.0), FORCE_CMAP)
     open_ = forces <= OPEN_FRACTION * f_max
     widths = np.where(open_, 0.6, MAX_LINE_WIDTH * forces / (f_max if f_max > 0 else 1.0))
@@ -441,7 +511,7 @@ def _draw_view(ax, a: Assembly3D, view: tuple, colours: dict, lo, hi) -> int:
             lines = LineCollection(segs, colors=[KIND_COLOURS[k] for k in a.kinds], linewidths=1.2, zorder=z_top,
                                    gid=f"contacts:{AXIS_NAMES[u]}{AXIS_NAMES[v]}")
         else:
-            widths, cols, styles, *_ = _force_style(np.asarray(a.forces, float))
+            widths, cols, styles, *_ = _force_style(np.asarray(a.forces, float), a.force_top)
             lines = LineCollection(segs, colors=cols, linewidths=widths, linestyles=styles, zorder=z_top,
                                    capstyle="round", gid=f"contacts:{AXIS_NAMES[u]}{AXIS_NAMES[v]}")
         ax.add_collection(lines)
@@ -481,8 +551,12 @@ def _draw_solid(ax, a: Assembly3D, view: tuple, colours: dict) -> None:
 
 
 def body_colour_map(a: Assembly3D) -> ScalarMappable:
-    """The von Mises stress [MPa] colours of the deformed body: 0 to its largest."""
-    top = float(a.body_stress.max()) * MPA if len(a.body_stress) else 0.0
+    """The von Mises stress [MPa] colours of the deformed body: 0 to its largest (to
+    a.stress_top when set: an animation's scale)."""
+    if a.stress_top is not None:
+        top = a.stress_top * MPA
+    else:
+        top = float(a.body_stress.max()) * MPA if len(a.body_stress) else 0.0
     return ScalarMappable(Normalize(0.0, top if top > 0 else 1.0), BODY_CMAP)
 
 
@@ -497,7 +571,7 @@ def _title(a: Assembly3D) -> str:
             f"(in space; spheres darker with distance from the viewer)")
 
 
-def _load_text(a: Assembly3D) -> str | None:
+def _load_text(a: Assembly3D, series: bool = False) -> str | None:
     ld = a.load
     if ld.kind != "force" or not a.loaded.any():
         return None
@@ -505,7 +579,7 @@ def _load_text(a: Assembly3D) -> str | None:
     d = d / np.linalg.norm(d)
     text = (f"load: {ld.force:.4g} N half-sine, T = {ld.duration * 1e6:.3g} µs, along "
             f"({d[0]:.3g}, {d[1]:.3g}, {d[2]:.3g}), on {int(a.loaded.sum())} granule(s) (red outline)")
-    if a.time is not None and a.time > ld.duration:
+    if a.time is not None and a.time > ld.duration and not series:
         text += ", over at this time"
     return text
 
@@ -517,12 +591,14 @@ def _mark_loaded(axes, a: Assembly3D) -> None:
                                 ec=LOAD_COLOUR, lw=1.6, zorder=4 + 2 * len(a.radius), gid=f"load:{a.labels[i]}"))
 
 
-def legend_handles(a: Assembly3D, colours: dict, oblique: list[str]) -> list:
-    """Legend entries: materials, walls, contacts, load."""
+def legend_handles(a: Assembly3D, colours: dict, oblique: list[str], series: bool = False) -> list:
+    """Legend entries: materials, walls, contacts, load; series: the legend of every frame
+    of an animation (the contact forces on the scale a.force_top, no counts of the
+    contacts or remarks that hold at one time only)."""
     handles = [Patch(fc=c, ec="0.1", label=f"{m} ({a.materials.count(m)} spheres)") for m, c in colours.items()
                if m in a.materials]
     if len(a.body_faces):
-        handles.append(Patch(fc=body_colour_map(a).to_rgba(0.5 * float(a.body_stress.max()) * MPA), ec="0.35",
+        handles.append(Patch(fc=body_colour_map(a).to_rgba(0.5 * body_colour_map(a).norm.vmax), ec="0.35",
                              label=f"elastic body deformed x{a.body_scale:g}, coloured by von Mises stress"))
         if a.solid_label:
             handles.append(Line2D([], [], color=SOLID_EDGE[0], lw=SOLID_EDGE[1], ls="--",
@@ -536,16 +612,23 @@ def legend_handles(a: Assembly3D, colours: dict, oblique: list[str]) -> list:
         handles.append(Line2D([], [], color="0.2", lw=2.0, label="rigid walls seen edge-on"))
     if oblique:
         handles.append(Line2D([], [], color="none", label="oblique walls, not drawn: " + ", ".join(oblique)))
-    if len(a.segments) and a.forces is None:
+    if series:
+        if a.force_top:
+            _, _, _, cmap, _, f_max = _force_style(np.zeros(0), a.force_top)
+            handles += [Line2D([], [], color=cmap.to_rgba(f_max), lw=MAX_LINE_WIDTH,
+                               label=f"contact force, width ∝ force (widest over the frames: {f_max:.3g} N)"),
+                        Line2D([], [], color="0.45", lw=0.6, ls=":",
+                               label=f"contact below {OPEN_FRACTION:.0%} of the widest")]
+    elif len(a.segments) and a.forces is None:
         handles += [Line2D([], [], color=KIND_COLOURS[k], lw=1.2, label=f"contact {KIND_NAMES[k]} "
                            f"({a.kinds.count(k)})") for k in KIND_COLOURS if k in a.kinds]
     elif len(a.segments):
-        _, _, _, cmap, open_, f_max = _force_style(np.asarray(a.forces, float))
+        _, _, _, cmap, open_, f_max = _force_style(np.asarray(a.forces, float), a.force_top)
         handles += [Line2D([], [], color=cmap.to_rgba(f_max), lw=MAX_LINE_WIDTH,
                            label=f"contact force, width ∝ force (widest: {f_max:.3g} N)"),
                     Line2D([], [], color="0.45", lw=0.6, ls=":",
                            label=f"contact below {OPEN_FRACTION:.0%} of the largest ({int(open_.sum())})")]
-    text = _load_text(a)
+    text = _load_text(a, series)
     if text:
         handles.append(Patch(fc="none", ec=LOAD_COLOUR, lw=1.6, label=text))
     return handles
@@ -553,7 +636,13 @@ def legend_handles(a: Assembly3D, colours: dict, oblique: list[str]) -> list:
 
 def draw(a: Assembly3D, width: float = 13.0) -> Figure:
     """The three orthogonal projections of a 3D assembly (module docstring)."""
-    lo, hi = bounds(a)
+    return _figure(a, width, bounds(a), series=False)[0]
+
+
+def _figure(a: Assembly3D, width: float, region: tuple[np.ndarray, np.ndarray], series: bool):
+    """(figure, its three views, the material colours) of assembly a drawn over region
+    (lower, upper corners [m]); series: the legend of an animation's frames."""
+    lo, hi = region
     span = (hi - lo) * MM
     fig = new_figure(width, min(max(width / 3.0 * span[1:].max() / max(span[:2].max(), 1e-12) + 2.2, 4.0), 9.0))
     axes = fig.subplots(1, 3, width_ratios=[span[0], span[0], span[1]])
@@ -566,11 +655,32 @@ def draw(a: Assembly3D, width: float = 13.0) -> Figure:
     if len(a.body_faces):
         fig.colorbar(body_colour_map(a), ax=list(axes), label="von Mises stress [MPa] (largest in each element)",
                      orientation="horizontal", shrink=0.5, aspect=50, location="bottom")
-    if a.forces is not None and len(a.segments):
-        cmap = _force_style(np.asarray(a.forces, float))[3]
+    if a.forces is not None and (len(a.segments) or (series and a.force_top)):
+        cmap = _force_style(np.asarray(a.forces, float), a.force_top)[3]
         fig.colorbar(cmap, ax=list(axes), label="contact normal force [N]", orientation="horizontal",
                      shrink=0.5, aspect=50, location="bottom")
-    fig.legend(handles=legend_handles(a, colours, oblique), loc="outside lower center", ncols=2, fontsize=8,
-               frameon=False)
+    fig.legend(handles=legend_handles(a, colours, oblique, series), loc="outside lower center", ncols=2,
+               fontsize=8, frameon=False)
     fig.suptitle(_title(a), fontsize=10, x=0.01, ha="left")
-    return fig
+    return fig, axes, colours
+
+
+def animation(frames: list[Assembly3D], width: float = 13.0):
+    """(figure, draw) of an animation of the assemblies `frames` (`frames_of_result`):
+    the figure `draw` makes, over the region that holds every frame, laid out once for
+    the first frame; draw(f) redraws its three views and title with frame f."""
+    lo = np.min([bounds(a)[0] for a in frames], axis=0)
+    hi = np.max([bounds(a)[1] for a in frames], axis=0)
+    fig, axes, colours = _figure(frames[0], width, (lo, hi), series=True)
+    fig.canvas.draw()  # lay out once, then freeze the layout (re-solving it every frame is slow)
+    fig.set_layout_engine("none")
+
+    def draw_frame(f: int) -> None:
+        a = frames[f]
+        for ax, view in zip(axes, PROJECTIONS):
+            ax.cla()
+            _draw_view(ax, a, view, colours, lo, hi)
+        _mark_loaded(axes, a)
+        fig.suptitle(_title(a), fontsize=10, x=0.01, ha="left")  # the one title, its text replaced
+
+    return fig, draw_frame

@@ -9,10 +9,13 @@ Frames are the result's plate-field snapshots (`field_time`, every 20 us by defa
 thinned evenly to at most `frames`. MP4 goes through the ffmpeg binary of the pip
 package imageio-ffmpeg; without it (or when ffmpeg fails) a GIF is written with Pillow.
 
-A run in space (dimension = 3, no plate; `animate_space`, which `animate` calls for it)
-is drawn as the three orthogonal projections of `figures.space` per frame, spheres at
-their true positions (no magnification) coloured by speed and drawn far to near, walls as
-their traces; frames are the output times, thinned the same way.
+A run in space (dimension = 3; `animate_space`, which `animate` calls for it) is drawn
+per frame as `granplate show` draws it (`figures.space`): three orthogonal projections,
+spheres at their true positions coloured by material, drawn far to near and shaded by
+depth, walls as their traces, the contact network by force, an elastic body deformed and
+coloured by von Mises stress; frames are the body's field snapshots (`field_time`) for a
+run with an elastic body, else the output times, thinned the same way, on one region and
+one set of scales (the body's magnification, its stress, the contact forces).
 """
 from __future__ import annotations
 
@@ -214,60 +217,17 @@ def animate(
 
 def animate_space(ds: xr.Dataset, path: str | Path, *, frames: int | None = 120, fps: int = 15,
                   dpi: int = 90) -> Path:
-    """Write an animation of 3D run `ds` (three projections per frame, spheres coloured by
-    speed [m/s]) to `path` (.mp4, or .gif) and return the path written."""
+    """Write an animation of 3D run `ds` to `path` (.mp4, or .gif) and return the path
+    written: per frame the three projections `granplate show` draws (`figures.space`),
+    at the body's field snapshots for a run with an elastic body, else at the output
+    times, thinned evenly to at most `frames`; one region, one magnification of the body
+    and one colour scale each for its stress and the contact forces over all frames."""
     from granplate.figures import space
-    from granplate.figures.run import granule_speeds
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    ti = frame_indices(ds.sizes.get("time", 0), frames)
-    if ti.size == 0:
+    indices = frame_indices(len(space.frame_times(ds)), frames)
+    if indices.size == 0:
         raise ValueError("the result has no output times to animate")
-    a = space.of_result(ds, float(ds["time"].values[-1]))
-    pos = space.positions(ds)[ti]  # (frame, granule, 3) [m]
-    r = np.asarray(ds["radius"].values, float)
-    path_lo = (pos - r[None, :, None]).min(axis=(0, 1))
-    path_hi = (pos + r[None, :, None]).max(axis=(0, 1))
-    lo, hi = space.bounds(a)
-    lo, hi = np.minimum(lo, path_lo), np.maximum(hi, path_hi)
-    speed = granule_speeds(ds)[ti]
-    colours = ScalarMappable(Normalize(0.0, max(float(speed.max()), 1e-12)), "viridis")
-    span = (hi - lo) * 1e3
-    fig = Figure(figsize=(12.0, max(4.0 * span[1:].max() / max(span[:2].max(), 1e-12) + 1.6, 3.5)),
-                 layout="constrained")
-    FigureCanvasAgg(fig)
-    axes = fig.subplots(1, 3, width_ratios=[span[0], span[0], span[1]])
-    inner = space.bounds(a, margin=0.0)
-    circles = []
-    for ax, view in zip(axes, space.PROJECTIONS):
-        u, v, _, _ = view
-        ax.set_aspect("equal")
-        ax.set_xlim(lo[u] * 1e3, hi[u] * 1e3)
-        ax.set_ylim(lo[v] * 1e3, hi[v] * 1e3)
-        ax.set_xlabel(f"{space.AXIS_NAMES[u]} [mm]")
-        ax.set_ylabel(f"{space.AXIS_NAMES[v]} [mm]")
-        for wall in a.walls:
-            ends = space.wall_trace(wall, view, *inner)
-            if ends is not None:
-                ax.plot([ends[0][0] * 1e3, ends[1][0] * 1e3], [ends[0][1] * 1e3, ends[1][1] * 1e3], color="0.3", lw=2)
-        circles.append([ax.add_patch(Circle((0.0, 0.0), c * 1e3, ec="k", lw=0.5)) for c in r])
-    fig.colorbar(colours, ax=list(axes), label="sphere speed [m/s]", orientation="horizontal", shrink=0.5, aspect=50)
-    head = f"{ds.attrs.get('scenario_name', '')}: spheres in space (drawn far to near)"
-    label = fig.suptitle(head, fontsize=10, x=0.01, ha="left")
-    times = ds["time"].values[ti]
-
-    def draw(f: int) -> None:
-        rgba = colours.to_rgba(speed[f])
-        for row, (u, v, d, sign) in zip(circles, space.PROJECTIONS):
-            order = np.argsort(sign * pos[f, :, d], kind="stable")
-            for rank, i in enumerate(order):
-                row[i].set_center((pos[f, i, u] * 1e3, pos[f, i, v] * 1e3))
-                row[i].set_facecolor(rgba[i])
-                row[i].set_zorder(2 + rank)
-        label.set_text(f"{head},  t = {times[f] * 1e3:.4f} ms")
-
-    draw(0)
-    fig.canvas.draw()  # lay out once, then freeze the layout
-    fig.set_layout_engine("none")
-    return _save(fig, draw, len(ti), path, fps, dpi)
+    fig, draw = space.animation(space.frames_of_result(ds, indices))
+    return _save(fig, draw, len(indices), path, fps, dpi)

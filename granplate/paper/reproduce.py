@@ -518,7 +518,8 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("plot", help="draw the figures of any run, or one paper figure (--figure)")
     p.add_argument("results", nargs="+", help="result .nc file(s), or a directory holding PRESET.nc files")
     p.add_argument("--figure", default=None, help="a paper figure: 3, 4, 5, 6, 7, 8, A1 (or 'all'); without "
-                   "it: energies, contact forces, stress and strain, granule speeds of each result")
+                   "it: energies, contact forces, stress and strain (a 3D body's: body stress, body contact forces), "
+                   "granule speeds of each result")
     p.add_argument("--out", default=".", help="directory for the PNG and PDF (default .)")
     p.set_defaults(func=_cmd_plot)
 
@@ -527,7 +528,8 @@ def register(subparsers) -> None:
     a.add_argument("-o", "--output", help="output .mp4 (or .gif) (default SCENARIO.mp4)")
     a.add_argument("--frames", type=_positive_int, default=DEFAULT_FRAMES, help="at most this many frames")
     a.add_argument("--fps", type=_positive_int, default=15, help="frames per second")
-    a.add_argument("--magnify", type=float, default=125.0, help="displacement magnification")
+    a.add_argument("--magnify", type=float, default=125.0, help="the plate's displacement magnification "
+                   "(in the plane; in space an elastic body is magnified as `granplate show` does)")
     a.set_defaults(func=_cmd_animate)
 
     e = subparsers.add_parser("export", help="write a ParaView time series (VTK, .pvd) of a result")
