@@ -179,6 +179,42 @@ def test_a_granule_beside_the_box_is_clear_of_it():
         validate(scenario_io.from_dict(d))
 
 
+@pytest.mark.parametrize("wall,field,ok", [
+    ({"normal": [0, 0, -1], "offset": -0.004}, "walls[0]", False),  # along the face the granule meets
+    ({"normal": [0, 0, -1], "offset": -0.002}, "walls[0]", False),  # through the body
+    ({"normal": [0, 0, -2], "offset": -0.004}, "walls[0]", False),  # any normal's length: the unit normal's offset
+    ({"normal": [0, -1, 0], "offset": 0.0}, None, True),             # along a side face the granule does not meet
+    ({"normal": [0, 0, 1], "offset": 0.01}, None, True),             # above the granule, clear of the body
+])
+def test_a_wall_may_not_cross_the_solid_or_lie_on_the_face_a_granule_meets(wall, field, ok):
+    """A rigid wall through the box, or along the face a granule touches at t = 0 (the
+    granule then touches both at one point, and the wall would carry the solid's load), is
+    refused naming the wall; a wall along a face no granule meets is valid (the paper's
+    bottom wall along the clamped edge of its 3D twin)."""
+    d = copy.deepcopy(BASE)
+    d["granules"][0]["z"] = 0.006  # touching the top face z = 4 mm
+    d["walls"] = [wall]
+    s = scenario_io.from_dict(d)
+    if ok:
+        validate(s)
+        return
+    with pytest.raises(ScenarioError) as e:
+        validate(s)
+    assert e.value.field == field and "take the load the solid should" in str(e.value)
+
+
+def test_a_layouts_wall_on_the_plates_face_is_refused_naming_layout_walls():
+    """An fcc packing's default xmax wall lies on the face of the plate placed against it:
+    refused naming layout.walls and the list without it; walls = [] runs."""
+    d = {"name": "w", "dimension": 3, "layout": {"kind": "fcc", "cells": [1, 1, 1], "radius": 0.0025},
+         "plate": {"size": [0.004, 0.02, 0.02], "elements": [1, 2, 2], "clamped": ["ymin", "ymax"]}}
+    with pytest.raises(ScenarioError) as e:
+        validate(scenario_io.from_dict(d))
+    assert e.value.field == "layout.walls" and e.value.value == "xmax" and "'zmax']" in str(e.value)
+    d["layout"]["walls"] = []
+    validate(scenario_io.from_dict(d))
+
+
 def test_a_study_of_a_solid_gives_designs_that_build(tmp_path):
     """A study whose base has a solid: every design's scenario reads back with the verlet
     scheme, validates and builds its model (the sweep runs them as any other)."""

@@ -182,6 +182,27 @@ def check_solid_clearance(s: Scenario, distances: Sequence[float], named: dict[i
                 f"{g.radius:.6g} m")
 
 
+def wall_cuts_box(normal: Sequence[float], offset: float, lower: Sequence[float], upper: Sequence[float],
+                  tol: float) -> bool:
+    """Whether the wall plane n.x = offset [m] (n a unit normal) passes through the inside of
+    the box lower..upper [m], deeper than tol [m] (a plane along a face does not)."""
+    lo = sum(min(n * a, n * b) for n, a, b in zip(normal, lower, upper))
+    hi = sum(max(n * a, n * b) for n, a, b in zip(normal, lower, upper))
+    return lo + tol < offset < hi - tol
+
+
+def wall_contact_on_box(normal: Sequence[float], offset: float, centre: Sequence[float], radius: float,
+                        lower: Sequence[float], upper: Sequence[float], tol: float) -> bool:
+    """Whether a sphere (centre, radius [m]) within tol [m] of touching the wall n.x = offset
+    (n a unit normal, the sphere on the side n.x < offset) touches it at a point of the box
+    lower..upper's surface, within tol: the wall then lies on the face the sphere meets."""
+    gap = offset - sum(n * c for n, c in zip(normal, centre))
+    if abs(gap - radius) > tol:
+        return False
+    point = [c + gap * n for n, c in zip(normal, centre)]
+    return abs(box_signed_distance(lower, upper, point)) <= tol
+
+
 def box_distances(s: Scenario) -> list[float]:
     """The signed distance [m] of each granule's centre to the surface of the box solid
     of the resolved `s` (`box_signed_distance`)."""

@@ -29,7 +29,8 @@ from granplate.setup.layouts import (INTRUDER_COLUMN_RULES, cells_along_x, colum
 from granplate.setup.fields import finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
 from granplate.setup.pairs import close_pairs
 from granplate.setup.plate_checks import check_plate_fields, check_plate_mesh
-from granplate.setup.solid_checks import box_distances, check_solid, check_solid_clearance, is_box
+from granplate.setup.solid_checks import (box_corners, box_distances, check_solid, check_solid_clearance, is_box,
+                                         solid_named, wall_contact_on_box, wall_cuts_box)
 from granplate.setup.plate_cost import MEMORY_SHARE, physical_memory
 from granplate.setup.materials import Material
 from granplate.setup.scenario import (Solid, BOX_WALLS, LAYOUT_KINDS, LAYOUT_KINDS_BY_DIMENSION, NORMAL_LAWS,
@@ -710,6 +711,38 @@ def _check_solid_penetration(s: Scenario, named: dict[int, str]) -> None:
         check_solid_clearance(s, box_distances(s), named, OVERLAP_RTOL)
 
 
+def _check_walls_off_solid(s: Scenario, r: Scenario) -> None:
+    """No rigid wall of the resolved `r` passes through the 3D box solid, and none lies on the
+    face a granule meets at t = 0 (it touches both at one point): the wall would take the
+    load the solid should (the wall named as `s` places it: layout.walls, box or walls[k]).
+    A wall along a face no granule meets (the paper's bottom wall along a clamped edge) is
+    allowed."""
+    if not (isinstance(r.plate, Solid) and is_box(r.plate)):
+        return
+    lo, hi = box_corners(r.plate)
+    n_user = len(s.walls)
+    for k, w in enumerate(r.walls):
+        n = unit(w.normal)
+        tol = OVERLAP_RTOL * min((g.radius for g in r.granules), default=min(r.plate.size))
+        offset = w.offset  # along the unit normal, as _check_wall_penetration reads it
+        if not (wall_cuts_box(n, offset, lo, hi, tol)
+                or any(wall_contact_on_box(n, offset, (g.x, g.y, g.z), g.radius, lo, hi,
+                                           r.contact.neighbour_gap * g.radius) for g in r.granules)):
+            continue
+        if s.layout is not None:
+            path, value, fix = "layout.walls", w.label, (
+                f"leave {w.label!r} out of layout.walls (e.g. walls = "
+                f"{[b for b in BOX_WALLS if b != w.label]})")
+        elif k >= n_user:
+            path, value, fix = "box", w.label, "move the box's face or the solid (plate.origin)"
+        else:
+            path, value, fix = f"walls[{k}]", w.label, "move or remove the wall, or move the solid (plate.origin)"
+        raise ScenarioError(path, value, f"the rigid wall {w.label or k} (n = {list(w.normal)}, offset "
+                            f"{w.offset:.6g} m) passes through {solid_named(r.plate)} or lies on the face its "
+                            f"granules meet: a granule touching the solid there touches the wall too, which "
+                            f"would take the load the solid should; {fix}")
+
+
 def _check_load(s: Scenario) -> None:
     ld = s.load
     string_in("load.kind", ld.kind, LOAD_KINDS_BY_DIMENSION[s.dimension])
@@ -1028,6 +1061,7 @@ def validate(scenario: Scenario) -> None:
     _check_wall_penetration(r, named)
     _check_plate_penetration(r, named)
     _check_solid_penetration(r, named)
+    _check_walls_off_solid(s, r)
     _check_load(r)
     _check_contact(r)
     if isinstance(r.plate, Plate):
