@@ -28,7 +28,9 @@ from matplotlib.figure import Figure
 from granplate.figures.common import PNG_DPI, save_figure  # noqa: F401 - part of this module's interface
 from granplate.figures.common import new_figure as _new_figure
 from granplate.paper import plastic as _plastic
+from granplate.paper import space as _space
 from granplate.results import analysis as an
+from granplate.setup.presets import PLANE_PRESETS
 
 #: The granules whose velocities the paper plots (Figs. 4e-f, 5c).
 VELOCITY_GRANULES = ("3", "8", "C")
@@ -393,6 +395,35 @@ def fig_yielding(elastic: xr.Dataset, plastic: xr.Dataset) -> Figure:
     return fig
 
 
+def fig_3d(*datasets: xr.Dataset) -> Figure:
+    """The plate's share of the shock energy E_p / E_shock [-] over time [ms], each case in
+    2D (solid) and in 3D (its twin, dashed), one panel per case: the first half of
+    `datasets` are the 2D results, the second half their 3D twins in the same order."""
+    n = len(datasets) // 2
+    if n == 0 or len(datasets) != 2 * n:
+        raise ValueError(f"fig_3d takes the 2D results and their 3D twins, as many of each; got {len(datasets)}")
+    plane, space = datasets[:n], datasets[n:]
+    ncols = min(3, n)
+    nrows = -(-n // ncols)
+    fig = _new_figure(4.2 * ncols, 3.0 * nrows + 0.9)
+    axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
+    for k, (ax, a, b) in enumerate(zip(axes, plane, space)):
+        name = _name(a)
+        for tag, ds, ls, colour in (("2d", a, "-", COLOURS["plate"]), ("3d", b, "--", "black")):
+            ax.plot(an.times_ms(ds), an.normalised_energies(ds)["plate"], color=colour, ls=ls, lw=1.2,
+                    label=f"{tag.upper()}", gid=f"plate:{tag}:{name}")
+        ax.set_ylabel("$E_p$ / $E_{shock}$ [-]")
+        _time_axis(ax, a)
+        _label(ax, f"({'abcdefghijklmnopqrstuvwxyz'[k % 26]}) {name}")
+        ax.legend(fontsize=7, loc="best", framealpha=0.8)
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    _caption(fig, "The plate's energy over the shock energy put in, each case in 2D (plane stress, implicit "
+             "scheme; solid) and its 3D twin (a hex20 slab, velocity Verlet; dashed), docs/model.md section 8.1.",
+             *datasets)
+    return fig
+
+
 #: What a figure may need of a result: a test of the Dataset and its words.
 REQUIREMENTS: dict[str, tuple[Callable[[xr.Dataset], bool], str]] = {
     "plate": (an.has_plate, "a plate"),
@@ -430,9 +461,24 @@ EXTRA_FIGURES: dict[str, FigureSpec] = {
 }
 
 
+#: The figure of the report's section "The paper in 3D" (`granplate reproduce --3d`,
+#: granplate.paper.space): every preset, then its 3D twin, in preset order.
+SPACE_FIGURES: dict[str, FigureSpec] = {
+    _space.FIGURE_KEY: FigureSpec(fig_3d, (*PLANE_PRESETS, *(_space.twin_name(n) for n in PLANE_PRESETS)),
+                                  "the plate's energy share in 2D and 3D"),
+}
+
+
+def report_figures(plastic: bool = True, space: bool = False) -> dict[str, FigureSpec]:
+    """The figures `granplate reproduce` draws: the paper's, with `plastic` the yielding
+    contacts' (EXTRA_FIGURES), with `space` the 3D twins' (SPACE_FIGURES)."""
+    return {**FIGURES, **(EXTRA_FIGURES if plastic else {}), **(SPACE_FIGURES if space else {})}
+
+
 def figure_spec(key: str) -> FigureSpec:
-    """The spec of a paper figure (FIGURES) or of another figure of the report (EXTRA_FIGURES)."""
-    return FIGURES[key] if key in FIGURES else EXTRA_FIGURES[key]
+    """The spec of a paper figure (FIGURES) or of another figure of the report
+    (EXTRA_FIGURES, SPACE_FIGURES)."""
+    return {**FIGURES, **EXTRA_FIGURES, **SPACE_FIGURES}[key]
 
 
 def check_inputs(key: str, datasets: list[xr.Dataset]) -> None:
@@ -462,5 +508,5 @@ def figure_key(name: str) -> str:
 
 
 def figure_stem(key: str) -> str:
-    """File stem of a figure: fig3, figA1; fig-yielding for the report's own figures."""
+    """File stem of a figure: fig3, figA1; fig-yielding, fig-3d for the report's own figures."""
     return f"fig{key}" if key in FIGURES else f"fig-{key}"

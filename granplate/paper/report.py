@@ -20,6 +20,7 @@ import numpy as np
 
 from granplate.paper import checks as ck
 from granplate.paper import plastic
+from granplate.paper import space as sp
 from granplate.paper.discussion import (
     intensity_discussion, ptfe_discussion, stress_discussion, vertical_discussion,
 )
@@ -53,7 +54,7 @@ def run_rows(results: Results, records: dict[str, object] | None = None) -> list
             _pct(share["peak"]), _pct(share["final"]),
             f"{_max_vm(ds) / 1e6:.1f}",
             f"{float(ds['max_von_mises_disc'].max()) / 1e6:.1f}" if "max_von_mises_disc" in ds else "-",
-            f"{float(ds['max_eps_yy'].max()):.2e}",
+            f"{float(ds['max_eps_yy'].max()):.2e}" if "max_eps_yy" in ds else "-",
             *plastic.pressure_cells(ds),
             f"{an.max_energy_residual(ds):.1e}",
             f"{int(info.get('n_steps', 0)):,}",
@@ -112,9 +113,10 @@ def _ratio(r: float | None) -> str:
     return "-" if r is None or not np.isfinite(r) else f"{r:.2f}"
 
 
-def verdict_summary(rows: list[Check], results: Results, checks: Results, twins: Results | None = None) -> Block:
+def verdict_summary(rows: list[Check], results: Results, checks: Results, twins: Results | None = None,
+                    space: Results | None = None) -> Block:
     """The first screen: statements that hold, that do not, reported without a verdict;
-    the conclusions that hold; the runs behind them."""
+    the conclusions that hold; the runs behind them (the yielding-contact and 3D twins too)."""
     n_ok = sum(r.holds is True for r in rows)
     n_bad = sum(r.holds is False for r in rows)
     n_reported = len(rows) - n_ok - n_bad
@@ -123,7 +125,7 @@ def verdict_summary(rows: list[Check], results: Results, checks: Results, twins:
     headline = (f"{n_ok} of {n_ok + n_bad} judged statements hold"
                 + (f", {n_bad} do not" if n_bad else "")
                 + f"; {n_concl} of {len(verdicts)} of the paper's conclusions hold.")
-    n_runs = len(results) + len(checks or {}) + len(twins or {})
+    n_runs = len(results) + len(checks or {}) + len(twins or {}) + len(space or {})
     return summary(headline, [
         (str(n_ok), "statements hold", "yes" if n_ok else ""),
         (str(n_bad), "do not hold", "no" if n_bad else "yes"),
@@ -142,9 +144,11 @@ def build_report(
     animations: list[Path] | None = None,
     seconds: float | None = None,
     twins: Results | None = None,
+    space: Results | None = None,
 ) -> list[Block]:
     """The report as blocks: summary, comparison table, runs, discussion, the cases with
-    yielding contacts (twins: preset name -> the twin's Dataset; none: no section), figures."""
+    yielding contacts (twins: preset name -> the twin's Dataset; none: no section), the
+    cases in 3D (space: preset name -> its 3D twin's Dataset; none: no section), figures."""
     from granplate.version import __version__
     from granplate.paper.plots import FIGURES, figure_stem
 
@@ -152,11 +156,12 @@ def build_report(
     judged = [r for r in rows if r.holds is not None]
     n_ok = sum(r.holds for r in judged)
     blocks = [Block("h1", "granplate: reproduction of the paper's section 3 and appendices"),
-              verdict_summary(rows, results, checks, twins)]
+              verdict_summary(rows, results, checks, twins, space)]
     t_ends = sorted({float(d["time"].values[-1]) for d in results.values()})
     intro = (f"Made by granplate {__version__} from {len(results)} runs"
              + (f" and {len(checks)} check runs" if checks else "")
              + (f", {len(twins)} of them rerun with yielding contacts" if twins else "")
+             + (f", {len(space)} of them run again in 3D" if space else "")
              + (f" (this reproduce took {seconds:.0f} s; each run's own wall time is in the run table)"
                 if seconds is not None else "") + ". "
              f"{n_ok} of {len(judged)} judged statements hold. Every 'ours' value below is computed from the "
@@ -200,6 +205,7 @@ def build_report(
         blocks.append(Block("p", para))
     blocks += plastic.section(results, twins or {}, records=records,
                               figure=(figures or {}).get(plastic.FIGURE_KEY))
+    blocks += sp.section(results, space or {}, records=records, figure=(figures or {}).get(sp.FIGURE_KEY))
     if figures:
         blocks.append(Block("h2", "Figures"))
         for key in FIGURES:
@@ -232,7 +238,7 @@ def write_report(out_dir: str | Path, outcome) -> list[Path]:
     """Write out_dir/report.md and out_dir/report.html for a reproduce outcome.
 
     outcome: anything with .runs (RunRecord: name, path, status, kind; kind "plastic": a
-    preset's twin with yielding contacts), .figures
+    preset's twin with yielding contacts, "space": its 3D twin), .figures
     (key -> paths), .animations (paths) and .seconds.
     """
     from granplate.setup.presets import preset_names
@@ -245,10 +251,14 @@ def write_report(out_dir: str | Path, outcome) -> list[Path]:
     check_paths = {c.name: check_paths[c.name] for c in ck.CHECKS if c.name in check_paths}
     twin_paths = {plastic.twin_preset(r.name): r.path for r in done if r.kind == "plastic"}
     twin_paths = {n: twin_paths[n] for n in preset_names() if n in twin_paths}
+    space_paths = {sp.twin_preset(r.name): r.path for r in done if r.kind == "space"}
+    space_paths = {n: space_paths[n] for n in preset_names() if n in space_paths}
     results, checks, twins = load_results(presets), load_results(check_paths), load_results(twin_paths)
+    space = load_results(space_paths)
     records = {r.name: r for r in outcome.runs}
     blocks = build_report(results, checks, records=records, figures=outcome.figures,
-                          animations=outcome.animations, seconds=getattr(outcome, "seconds", None), twins=twins)
+                          animations=outcome.animations, seconds=getattr(outcome, "seconds", None), twins=twins,
+                          space=space)
     md, page = out / "report.md", out / "report.html"
     md.write_text(to_markdown(blocks, out))
     page.write_text(to_html(blocks, out))

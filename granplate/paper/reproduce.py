@@ -1,10 +1,12 @@
-"""Reproduce the paper: run the six presets (the sensitivity checks, and the cases with
-yielding contacts, `granplate.paper.plastic`) in parallel, reuse results that are still
-current, then draw every figure, both animations and the report. Also the CLI commands
-`reproduce`, `plot`, `animate` and `export`.
+"""Reproduce the paper: run the six presets (the sensitivity checks, the cases with
+yielding contacts, `granplate.paper.plastic`, and on request their 3D twins,
+`granplate.paper.space`) in parallel, reuse results that are still current, then draw
+every figure, both animations and the report. Also the CLI commands `reproduce`, `plot`,
+`animate` and `export`.
 
     granplate reproduce --out results            # everything (a few minutes on 2 cores)
     granplate reproduce --out results --no-plastic  # without the yielding-contact twins
+    granplate reproduce --out results --3d       # and the six cases in 3D
     granplate reproduce --out quick --t-end 1e-4 # shortened runs (a smoke test)
     granplate plot results/steel-r1.nc --figure A.1
     granplate plot results --figure 3            # a directory holding the presets' results
@@ -20,6 +22,7 @@ each figure or animation starts as soon as the results it needs are there.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 import warnings
@@ -39,14 +42,19 @@ DEFAULT_FRAMES = 120
 
 CHECK_MODES = ("fast", "all", "none")
 
+#: A 3D twin's cost per element against a 2D run's, for ordering the runs (a full-length
+#: twin takes about twice as long as its preset, writing its result included).
+SPACE_COST = 2.0
+
 
 # --------------------------------------------------------------------------------------
 # What to run
 # --------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Job:
-    """One simulation: `scenario` written to `path`; kind "preset", "check" or "plastic"
-    (a preset's twin with yielding contacts, named "plastic/PRESET")."""
+    """One simulation: `scenario` written to `path`; kind "preset", "check", "plastic"
+    (a preset's twin with yielding contacts, named "plastic/PRESET") or "space" (a
+    preset's 3D twin, named "3d/PRESET")."""
 
     name: str
     scenario: object
@@ -145,10 +153,13 @@ def is_current(path: str | Path, scenario) -> bool:
     return stored is not None and result_key(*stored) == result_key(*expected_identity(scenario))
 
 
-def plan(out_dir: Path, t_end: float | None = None, checks: str = "fast", plastic: bool = True) -> list[Job]:
-    """The presets (DIR/NAME.nc), the sensitivity checks (DIR/checks/NAME.nc) and, with
-    `plastic`, the presets' twins with yielding contacts (DIR/plastic/NAME.nc) to run."""
+def plan(out_dir: Path, t_end: float | None = None, checks: str = "fast", plastic: bool = True,
+         space: bool = False) -> list[Job]:
+    """The presets (DIR/NAME.nc), the sensitivity checks (DIR/checks/NAME.nc), with
+    `plastic` the presets' twins with yielding contacts (DIR/plastic/NAME.nc) and with
+    `space` their 3D twins (DIR/3d/NAME.nc) to run."""
     from granplate.paper import plastic as pl
+    from granplate.paper import space as sp
     from granplate.paper.checks import CHECKS, check_scenario
     from granplate.setup.presets import preset_names
 
@@ -163,6 +174,9 @@ def plan(out_dir: Path, t_end: float | None = None, checks: str = "fast", plasti
     if plastic:
         for n in pl.twin_presets():
             jobs.append(Job(pl.twin_name(n), pl.twin_scenario(n, t_end), out_dir / pl.TWIN_DIR / f"{n}.nc", "plastic"))
+    if space:
+        for n in sp.twin_presets():
+            jobs.append(Job(sp.twin_name(n), sp.twin_scenario(n, t_end), out_dir / sp.TWIN_DIR / f"{n}.nc", "space"))
     return jobs
 
 
@@ -212,13 +226,13 @@ def make_animation(path: Path, target: Path, frames: int | None) -> Path:
     return animate(read(path), target, frames=frames)
 
 
-def _products(figures: bool, animations: bool, plastic: bool = True) -> list:
+def _products(figures: bool, animations: bool, plastic: bool = True, space: bool = False) -> list:
     """The figures (each with the runs it takes; with `plastic`, the yielding-contact
-    figure too) and the Appendix B animations."""
+    figure too, with `space` the 3D twins') and the Appendix B animations."""
     from granplate.paper import plots
     from granplate.paper.runner import Product
 
-    specs = {**plots.FIGURES, **(plots.EXTRA_FIGURES if plastic else {})}
+    specs = plots.report_figures(plastic, space)
     out = [Product("figure", k, spec.presets) for k, spec in specs.items()] if figures else []
     return out + ([Product("animation", n, (n,)) for n in ANIMATED] if animations else [])
 
@@ -233,6 +247,7 @@ def reproduce(
     force: bool = False,
     checks: str = "fast",
     plastic: bool = True,
+    space: bool = False,
     figures: bool = True,
     animations: bool = True,
     frames: int | None = DEFAULT_FRAMES,
@@ -246,8 +261,10 @@ def reproduce(
     instead (its workers must see out_dir); client: an open Dask Client instead of
     either; force: run everything again; checks: "fast", "all" or "none" sensitivity
     runs; plastic: also run the presets with yielding contacts (the report's section
-    "Contacts that yield", granplate.paper.plastic); figures: draw the figures; animations / frames: the Appendix B animations and
-    their frame count; quiet: no progress.
+    "Contacts that yield", granplate.paper.plastic); space: also run the presets' 3D twins
+    (the report's section "The paper in 3D", granplate.paper.space); figures: draw the
+    figures; animations / frames: the Appendix B animations and their frame count; quiet:
+    no progress.
     """
     from contextlib import nullcontext
 
@@ -263,13 +280,13 @@ def reproduce(
     outcome = Outcome(out)
     available: dict[str, Path] = {}
     to_run: list[Job] = []
-    for job in plan(out, t_end, checks, plastic):
+    for job in plan(out, t_end, checks, plastic, space):
         if not force and is_current(job.path, job.scenario):
             outcome.runs.append(RunRecord(job.name, job.path, "reused", 0.0, "", job.kind))
             available[job.name] = job.path
         else:
             to_run.append(job)
-    products = _products(figures, animations, plastic)
+    products = _products(figures, animations, plastic, space)
     progress = Progress(len(to_run) + len(products), quiet)
     for rec in outcome.runs:
         progress.note(f"reused {rec.name} ({rec.path})")
@@ -290,7 +307,7 @@ def reproduce(
     finally:
         progress.close()
     if not figures:
-        outcome.figures.update(_earlier_figures(out / "figures", available, plastic))
+        outcome.figures.update(_earlier_figures(out / "figures", available, plastic, space))
     if not animations:
         outcome.animations += _earlier_animations(out / "animations", available)
     outcome.seconds = time.perf_counter() - t_start
@@ -304,12 +321,13 @@ def _up_to_date(target: Path, inputs: list[Path]) -> bool:
     return target.is_file() and all(target.stat().st_mtime >= p.stat().st_mtime for p in inputs)
 
 
-def _earlier_figures(fig_dir: Path, available: dict[str, Path], plastic: bool = True) -> dict[str, list[Path]]:
+def _earlier_figures(fig_dir: Path, available: dict[str, Path], plastic: bool = True,
+                     space: bool = False) -> dict[str, list[Path]]:
     """Figures drawn by an earlier reproduce from the same result files (for the report)."""
     from granplate.paper import plots
 
     found = {}
-    specs = {**plots.FIGURES, **(plots.EXTRA_FIGURES if plastic else {})}
+    specs = plots.report_figures(plastic, space)
     for key, spec in specs.items():
         files = [fig_dir / f"{plots.figure_stem(key)}{ext}" for ext in (".png", ".pdf")]
         if all(n in available for n in spec.presets) and all(
@@ -331,22 +349,32 @@ def _earlier_animations(anim_dir: Path, available: dict[str, Path]) -> list[Path
 
 
 def expected_cost(job: Job) -> float:
-    """A rough cost of a job for ordering: elements x simulated time, steel > PTFE."""
+    """A rough cost of a job for ordering: elements x simulated time, steel > PTFE; a 3D
+    twin (velocity Verlet at a fixed step) by SPACE_COST per element."""
     s = job.scenario
     plate = getattr(s, "plate", None)
-    elements = (plate.nx * plate.ny) if plate is not None else 1
+    if getattr(s, "dimension", 2) == 3:
+        elements = SPACE_COST * (math.prod(plate.elements) if plate is not None and plate.elements else 1)
+    else:
+        elements = (plate.nx * plate.ny) if plate is not None else 1
     stiff = 2.0 if (getattr(s, "layout", None) is not None and s.layout.intruder_material == "steel") else 1.0
     return elements * s.time.t_end * stiff
 
 
 def warm_up_scenarios(jobs: list[Job]) -> list[str]:
     """TOML texts to warm the workers up on: the cheapest job of each coupling scheme
-    (each scheme has its own compiled kernels)."""
+    (each scheme has its own compiled kernels); in space, of each scheme with granules
+    and without (the bare slab's load and the spheres' contacts are kernels of their own,
+    and the two build different bodies)."""
     from granplate.setup.io import dumps
 
-    first: dict[str, Job] = {}
+    first: dict[tuple, Job] = {}
     for job in sorted(jobs, key=expected_cost):
-        first.setdefault(job.scenario.solver.scheme, job)
+        s = job.scenario
+        key: tuple = (s.solver.scheme,)
+        if getattr(s, "dimension", 2) == 3:
+            key += (3, s.layout is not None or bool(s.granules))
+        first.setdefault(key, job)
     return [dumps(j.scenario) for j in first.values()]
 
 
@@ -411,7 +439,7 @@ def figure_inputs(key: str, inputs: list[str]) -> list[Path]:
 def _cmd_reproduce(args) -> int:
     outcome = reproduce(
         args.out, t_end=args.t_end, workers=args.workers, scheduler=args.scheduler, force=args.force,
-        checks=args.checks, plastic=not args.no_plastic,
+        checks=args.checks, plastic=not args.no_plastic, space=args.space,
         figures=not args.no_figures, animations=not args.no_animations, frames=args.frames, quiet=args.quiet,
     )
     reused = sum(r.status == "reused" for r in outcome.runs)
@@ -493,8 +521,8 @@ def _positive_int(text: str) -> int:
 def register(subparsers) -> None:
     """Add the `reproduce`, `plot`, `animate` and `export` commands."""
     r = subparsers.add_parser("reproduce", help="run the paper's six cases (and again with yielding "
-                              "contacts), draw every figure, both animations and the report (reusing "
-                              "unchanged results)")
+                              "contacts; with --3d in 3D too), draw every figure, both animations and the "
+                              "report (reusing unchanged results)")
     r.add_argument("--out", default=DEFAULT_OUT, help=f"output directory (default {DEFAULT_OUT})")
     r.add_argument("--t-end", type=float, default=None, help="shorten every run to this time [s]")
     r.add_argument("--workers", "--jobs", dest="workers", type=_positive_int, default=None,
@@ -509,6 +537,10 @@ def register(subparsers) -> None:
     r.add_argument("--no-plastic", action="store_true",
                    help="leave out the cases rerun with yielding contacts (the report's section "
                         "'Contacts that yield'; 5 more runs, about 10 s on 2 cores)")
+    r.add_argument("--3d", dest="space", action="store_true",
+                   help="also run the six cases' 3D twins (the presets 3d-NAME, into DIR/3d/NAME.nc) and "
+                        "set 2D and 3D side by side in the report's section 'The paper in 3D' and the "
+                        "figure fig-3d")
     r.add_argument("--frames", type=_positive_int, default=DEFAULT_FRAMES, help="animation frames (at most)")
     r.add_argument("--no-figures", action="store_true", help="skip the figures (runs and report only)")
     r.add_argument("--no-animations", action="store_true", help="skip the animations")

@@ -73,13 +73,15 @@ def _q(name: str) -> str:
 class Within(Criterion):
     """|value - ref| <= tol |ref| (relative) or <= tol (absolute=True).
 
-    ref is `of` when given, else the reference the check carries (the paper's value).
+    ref is `of` when given, else the reference the check carries, which `against` names
+    in the text (by default the paper's value).
     """
 
     tol: float
     of: float | None = None
     absolute: bool = False
     name: str = ""
+    against: str = "the paper's value"
 
     def _ref(self, reference: float | None) -> float:
         return float(self.of if self.of is not None else reference)
@@ -95,7 +97,7 @@ class Within(Criterion):
         return _finite(value) and not math.isnan(err) and err <= self.tol
 
     def text(self, reference: float | None = None) -> str:
-        of = "the paper's value" if self.of is None else f"{self.of:g}"
+        of = self.against if self.of is None else f"{self.of:g}"
         size = f"{self.tol:g}" if self.absolute else number_text(self.tol, percent=True)
         return f"{_q(self.name)}within {size} of {of}"
 
