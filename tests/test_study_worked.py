@@ -137,7 +137,8 @@ def test_comparison_refuses_tables_of_other_designs(tmp_path):
         m.read_tables(tmp_path / "failed.csv", STUDIES / PLASTIC / "results.csv")
 
 
-@pytest.mark.parametrize("name", [ELASTIC, PLASTIC, "calibration", "two-layer"])
+@pytest.mark.parametrize("name", [ELASTIC, PLASTIC, "calibration", "two-layer", "thick-plates", "thick-plates-face",
+                                  "protector-3d"])
 def test_committed_page_is_that_of_its_committed_table(name):
     """Each worked study's committed report.html is the interactive page the code writes
     from the committed table and figures, and its report_assets/ are the package's own

@@ -233,7 +233,7 @@ def build_solid(sd: Solid, material: Material | None = None, surface: str | None
     if memory is None:
         from granplate.setup.plate_cost import physical_memory
         memory = MEMORY_SHARE * physical_memory()
-    check_fits(cost, memory, seconds)
+    check_fits(cost, memory, seconds, list(sd.elements) if sd.mesh is None else sd.mesh)
 
     def compute() -> dict:
         K = reduced(solid_stiffness(sbasis, mesh, sd.element, material, sd.rigid_patches), dofs)

@@ -94,15 +94,16 @@ def estimate(n_dofs: int, separator: int, n_modes: int, n_surface: int, window: 
     return SolidCost(n_dofs, separator, fill, n_modes, windows, memory, seconds)
 
 
-def check_fits(cost: SolidCost, memory: float, seconds: float | None = None) -> None:
-    """ScenarioError (field plate.elements) when the solid would need more than `memory`
-    bytes (or, given, `seconds`), with the numbers and what to change."""
+def check_fits(cost: SolidCost, memory: float, seconds: float | None = None, elements: object = "") -> None:
+    """ScenarioError (field plate.elements, its value `elements`: the box's, or the mesh
+    file's) when the solid would need more than `memory` bytes (or, given, `seconds`), with
+    the numbers and what to change."""
     over_memory = memory > 0 and cost.memory > memory
     over_time = seconds is not None and cost.seconds > seconds
     if not (over_memory or over_time):
         return
     raise ScenarioError(
-        "plate.elements", "",
+        "plate.elements", elements,
         f"this solid ({cost.n_dofs} dofs, about {cost.n_modes} modes in {cost.windows} eigensolver windows, "
         f"{cost.fill / 1e6:.3g} M factor entries) needs about {cost.memory / 1e9:.3g} GB and {cost.seconds:.3g} s "
         f"to build; this machine allows {memory / 1e9:.3g} GB"

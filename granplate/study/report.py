@@ -53,7 +53,7 @@ NEGLIGIBLE = 1e-30
 #: Most rows of the designs table on the page (results.csv has them all).
 MAX_ROWS = 120
 #: Figures of a chosen design (granplate.figures.run names) besides its assembly.
-DESIGN_FIGURES: tuple[str, ...] = ("energies", "stress-strain")
+DESIGN_FIGURES: tuple[str, ...] = ("energies", "stress-strain", "body-stress")
 
 
 def fmt(v: Any, unit: str = "") -> str:
@@ -227,8 +227,9 @@ def design_result(folder: Path, key: str, progress: bool = False):
 
 
 def design_figures(folder: Path, key: str, progress: bool = False) -> list[tuple[str, Path]]:
-    """(caption, PNG) of a chosen design: its assembly, energies and plate stress, drawn
-    once (kept in DIR/report/ and reused by the next report)."""
+    """(caption, PNG) of a chosen design: its assembly, energies and the plate's stress
+    (a 3D body's: body-stress), drawn once (kept in DIR/report/ and reused by the next
+    report)."""
     fig_dir = folder / FIGURES
     stem = f"design-{key[:12]}"
     names = ("assembly",) + DESIGN_FIGURES

@@ -1,0 +1,88 @@
+"""The worked study of plates of real thickness (docs/studies/thick-plates*.toml) as
+committed: each table is of its study file and complete, the comparison on
+docs/studies.md is the script's output from the two tables, and the written conclusions
+quote only what the script computes. Nothing is run: the tables are read."""
+from __future__ import annotations
+
+import importlib.util
+import re
+import tomllib
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from granplate.study.spec import load_study
+
+STUDIES = Path(__file__).resolve().parent.parent / "docs" / "studies"
+NAMES = ("thick-plates", "thick-plates-face")
+BEGIN, END = "<!-- compare-thick-plates.py: begin -->\n", "\n<!-- compare-thick-plates.py: end -->"
+
+
+def compare_module():
+    """docs/studies/compare-thick-plates.py, imported from its file."""
+    spec = importlib.util.spec_from_file_location("compare_thick_plates", STUDIES / "compare-thick-plates.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_committed_table_is_of_its_study_file(name):
+    """Each committed table holds exactly its study file's designs (intruder material x the
+    thickness with its elements through it), all completed, their energy balance held, and
+    the folder's study.toml (the report's definition) is that file."""
+    study = load_study(STUDIES / f"{name}.toml")
+    rows = pd.read_csv(STUDIES / name / "results.csv")
+    assert len(rows) == len(study.designs) == 10
+    for (_, row), design in zip(rows.iterrows(), study.designs):
+        assert tuple(row[n] for n in study.names) == design
+        assert row["status"] == "ok" and abs(row["energy_residual_max"]) < 1e-4
+    assert (STUDIES / name / "study.toml").read_text() == (STUDIES / f"{name}.toml").read_text()
+    assert (STUDIES / name / "report.html").is_file()
+
+
+def test_the_in_plane_study_at_1_mm_is_the_3d_twin():
+    """The in-plane study's base is 3d-ptfe-r05, so its 1 mm designs are the twins of
+    ptfe-r05 and steel-r05: their plate's peak share is docs/model.md section 8.1's 3D
+    column (5.40% and 43.5%, to the 3 digits quoted there)."""
+    t = pd.read_csv(STUDIES / "thick-plates" / "results.csv").set_index(["layout.intruder_material", "plate.size[2]"])
+    assert round(100 * t.loc[("ptfe", 0.001), "ep_max_fraction"], 2) == 5.40
+    assert round(100 * t.loc[("steel", 0.001), "ep_max_fraction"], 1) == 43.5
+
+
+def test_page_shows_the_comparison_of_the_committed_tables():
+    """The part of docs/studies.md between its markers is the script's output from the
+    committed tables, as printed (no hand-copied number)."""
+    page = (STUDIES.parent / "studies.md").read_text()
+    assert BEGIN in page and END in page
+    assert page.split(BEGIN, 1)[1].split(END, 1)[0] == compare_module().comparison()
+
+
+#: A figure the conclusions quote: a percentage or a stress in MPa, or a ratio 0.xxx.
+FIGURE = r"(?<![\d.])(?:\d+(?:\.\d+)?%|\d+(?:\.\d+)? MPa|0\.\d+(?![\d%]))"
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_conclusion_quotes_only_the_comparison(name):
+    """Every figure of a study's written conclusion (its report page) is one that the
+    comparison computes from the tables."""
+    conclusion = " ".join(tomllib.loads((STUDIES / f"{name}.toml").read_text())["report"]["conclusion"].split())
+    quoted = set(re.findall(FIGURE, conclusion))
+    assert len(quoted) >= 6
+    computed = set(re.findall(FIGURE, " ".join(compare_module().comparison().split())))
+    assert quoted <= computed, quoted - computed
+
+
+def test_comparison_refuses_incomplete_tables(tmp_path):
+    """A table with a failed design, or a thickness without both intruder materials, is
+    refused, not compared."""
+    m = compare_module()
+    rows = (STUDIES / "thick-plates" / "results.csv").read_text().splitlines()
+    failed = rows[:2] + [rows[2].replace(",ok,", ",RuntimeError: boom,")] + rows[3:]
+    (tmp_path / "failed.csv").write_text("\n".join(failed) + "\n")
+    with pytest.raises(ValueError, match="did not complete"):
+        m.read_tables(tmp_path / "failed.csv", STUDIES / "thick-plates-face" / "results.csv")
+    (tmp_path / "short.csv").write_text("\n".join(rows[:-1]) + "\n")
+    with pytest.raises(ValueError, match="one steel and one ptfe"):
+        m.read_tables(tmp_path / "short.csv", STUDIES / "thick-plates-face" / "results.csv")
