@@ -135,6 +135,28 @@ def test_sliding_projection_equals_brute_force(name, follow):
     assert checked > 300 and corners > 20
 
 
+@pytest.mark.parametrize("name", ["hex20", "tet10"])
+def test_foot_on_an_edge_between_coplanar_faces_is_kept_without_sliding(name):
+    """A centre above a line of nodes of the flat top face (its foot on the edge shared by
+    two faces, as at the paper's rigid layers) keeps the seed face with the brute-force
+    foot and distance; a centre just past the seed face's edge, over its neighbour, still
+    slides to the neighbour (the edge's clamped foot is not along the seed face's normal)."""
+    s = boundary_surface(box_basis(name))
+    nb = face_neighbours(s)
+    out = np.empty(9)
+    p = np.array([1.0, 0.5, 0.7])  # above the line x = 1 (element edges) of the top face z = 0.5
+    seed = closest_point(s, p).face
+    assert follow_closest(s.nodes, s.kind, nb, seed, p, out) == seed
+    d2, points = brute_force(s, p)
+    assert out[8] == pytest.approx(0.2, rel=1e-12) and np.isclose(out[8] ** 2, d2, rtol=1e-12)
+    assert any(np.allclose(out[2:5], x, atol=1e-12) for x in points)
+    x_seed = s.nodes[seed][:, 0]
+    past = np.array([x_seed.max() + 0.05 if x_seed.max() < 1.5 else x_seed.min() - 0.05, 0.5, 0.7])
+    face = follow_closest(s.nodes, s.kind, nb, seed, past, out)
+    assert face != seed and np.isclose(out[8], 0.2, rtol=1e-12)
+    assert np.allclose(out[2:5], [past[0], past[1], 0.5], atol=1e-12)
+
+
 def test_curved_face_projection():
     """On a curved quad9 face (nodes on a cylinder of radius 1) the projection is the
     minimum over a dense grid of the face's reference points, and p - x is normal to it."""

@@ -33,6 +33,10 @@ def _cmd_bench(args) -> int:
         return int(friction.main(args))
     if getattr(args, "study", False):
         return _cmd_study(args)
+    if getattr(args, "twins", False):
+        from granplate.bench import twins
+
+        return int(twins.main(args))
     if getattr(args, "plastic", False):
         from granplate.bench import plastic
 
@@ -111,6 +115,11 @@ def register(subparsers) -> None:
     b.add_argument("--plastic", action="store_true",
                    help="instead: the loop time per step of the elastic-plastic normal law against Hertz's "
                         "(a 990-granule packing, ptfe-r05 and steel-r1 under both schemes)")
+    b.add_argument("--twins", action="store_true",
+                   help="instead: each paper case beside its 3D twin (3d-NAME): E_shock and the plate's peak "
+                        "share against the thin-limit targets, the twin's residual and step, the wall time of "
+                        "both (set-up and loop) and of the whole simulate call, medians of --repeats, timed "
+                        "alternately in one process (--cases, --t-end as for the presets)")
     b.add_argument("--study", action="store_true",
                    help="instead: the throughput of a design study on Dask (a ptfe-r05 sweep, 2 ms "
                         "each): core-seconds per design all included, overhead vs the loop")

@@ -8,7 +8,10 @@ forces of a line load on the body (the bare plate's shock, solid.traction).
 """
 from __future__ import annotations
 
+import hashlib
 from collections import Counter
+from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -101,34 +104,81 @@ def modal_line_load(s: Scenario, surface, solid) -> np.ndarray:
     return np.ascontiguousarray(solid.Phi.T @ f[solid.dofs])
 
 
+class SurfaceGeometry(NamedTuple):
+    """A solid's mesh and what the loop needs of its boundary, which depend on its geometry
+    alone: the quadratic faces, their neighbours, the surface nodes (solid.patch) and the
+    farthest a point of the surface lies from a node [m]."""
+
+    mesh: object
+    surface: object
+    neighbours: np.ndarray
+    nodes: object
+    reach: float
+
+
+#: Surface geometries built in this process, most recent last (the designs of a study that
+#: vary anything but the body's geometry, a benchmark's repeats, share one).
+_GEOMETRIES: dict[tuple, SurfaceGeometry] = {}
+#: How many a process keeps.
+GEOMETRIES_KEPT = 2
+
+
+def geometry_key(sd) -> tuple:
+    """What identifies a solid's geometry: a box's size, elements and (resolved) origin, or
+    a mesh file's content (SHA-256), and the element."""
+    if sd.mesh is not None:
+        return ("mesh", hashlib.sha256(Path(sd.mesh).read_bytes()).hexdigest(), sd.element)
+    return ("box", tuple(map(float, sd.size)), tuple(map(int, sd.elements)), tuple(map(float, sd.origin)), sd.element)
+
+
+def surface_geometry(sd) -> SurfaceGeometry:
+    """The solid's SurfaceGeometry, kept in this process by `geometry_key`."""
+    from granplate.solid.build import solid_mesh
+    from granplate.solid.fe import vector_basis
+    from granplate.solid.patch import farthest_from_nodes, surface_nodes
+    from granplate.solid.surface import boundary_surface, face_neighbours
+
+    key = geometry_key(sd)
+    if key in _GEOMETRIES:
+        _GEOMETRIES[key] = _GEOMETRIES.pop(key)  # most recent last
+        return _GEOMETRIES[key]
+    mesh = solid_mesh(sd)
+    surface = boundary_surface(vector_basis(mesh, sd.element))
+    sn = surface_nodes(surface)
+    geo = SurfaceGeometry(mesh=mesh, surface=surface, neighbours=face_neighbours(surface), nodes=sn,
+                          reach=farthest_from_nodes(surface, sn.xyz))
+    _GEOMETRIES[key] = geo
+    while len(_GEOMETRIES) > GEOMETRIES_KEPT:
+        _GEOMETRIES.pop(next(iter(_GEOMETRIES)))
+    return geo
+
+
 def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
     """(the SolidModel, its BodyArrays, (ng,) bool: each granule on a rigid patch at t = 0)
     of the scenario's elastic solid."""
     from granplate.solid.boundary import reduced_index
-    from granplate.solid.build import build_solid, solid_mesh
-    from granplate.solid.fe import vector_basis
-    from granplate.solid.patch import check_patch_radius, farthest_from_nodes, node_grid, patch_capacity, surface_nodes
-    from granplate.solid.surface import boundary_surface, closest_point, face_neighbours
+    from granplate.solid.build import build_solid
+    from granplate.solid.patch import check_patch_radius, node_grid, patch_capacity
+    from granplate.solid.surface import closest_point
 
     sd = s.plate
     material = s.material(sd.material)
-    mesh = solid_mesh(sd)
+    geo = surface_geometry(sd)
+    mesh, surface, sn = geo.mesh, geo.surface, geo.nodes
     if sd.mesh is not None:  # a mesh file's surface against the granules (a box's: setup.validate)
         from granplate.setup.geometry import granule_named
         from granplate.setup.validate import OVERLAP_RTOL
         from granplate.solid.clearance import check_clearance
 
         check_clearance(s, mesh, {i: granule_named(s, s, i) for i in range(len(s.granules))}, OVERLAP_RTOL)
-    surface = boundary_surface(vector_basis(mesh, sd.element))
     face, components = residual_face(s, surface, mesh) if sd.residual else (None, "")
     solid = build_solid(sd, material, surface=face, components=components or "z")
-    sn = surface_nodes(surface)
     rows = reduced_index(solid.dofs, (3 * sn.full[:, None] + np.arange(3)).ravel()).reshape(-1, 3)
     where = np.full(len(solid.dofs), -1, np.int64)
     where[solid.surface_dofs] = np.arange(len(solid.surface_dofs))
     resid_index = np.where(rows >= 0, where[np.maximum(rows, 0)], -1)
     ng, nm = len(r), solid.n_modes
-    reach = farthest_from_nodes(surface, sn.xyz)
+    reach = geo.reach
     radius = patch_radius(s, sn.xyz.max(axis=0) - sn.xyz.min(axis=0), reach)
     n_p = surface.dofs.shape[1]
     grid = node_grid(sn.xyz, max(radius, 1e-12))
@@ -146,7 +196,7 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
         node_area=sn.area, node_rows=np.ascontiguousarray(rows, np.int64),
         node_resid=np.ascontiguousarray(resid_index, np.int64), grid=np.array([grid.cell]),
         grid_origin=grid.origin, grid_shape=grid.shape, cell_start=grid.start, cell_nodes=grid.nodes,
-        neighbours=face_neighbours(surface),
+        neighbours=geo.neighbours,
         kind=np.array([surface.kind], np.int64), phi=np.ascontiguousarray(solid.Phi), omega=solid.omega.copy(),
         resid=np.ascontiguousarray(solid.resid), box=box,
         coef=body_coefficients(s, mats, r, mass, material, rigid),

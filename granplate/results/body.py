@@ -101,13 +101,30 @@ class BodyOperators:
     radius: float
 
 
+#: Operators built in this process, most recent last: (the solid's run-store key, ball
+#: radius) -> BodyOperators (a stored solid's runs share them: a study's designs, repeats).
+_BUILT: dict[tuple[str, float], BodyOperators] = {}
+#: How many operators a process keeps.
+BUILT_KEPT = 2
+
+
 def body_operators(solid, ball_radius: float, surface: Surface | None = None) -> BodyOperators:
-    """The operators of `body_data` for a built solid (SolidModel)."""
+    """The operators of `body_data` for a built solid (SolidModel); a stored solid's (its
+    arrays_key) kept in this process for the next run of the same solid and radius."""
+    memo = (solid.arrays_key, float(ball_radius)) if solid.arrays_key and surface is None else None
+    if memo is not None and memo in _BUILT:
+        _BUILT[memo] = _BUILT.pop(memo)  # most recent last
+        return _BUILT[memo]
     vb = vector_basis(solid.mesh, solid.element)
-    return BodyOperators(surface=boundary_surface(vb) if surface is None else surface,
-                         strain=strain_operator(vb), D=elasticity_matrix(solid.material.E, solid.material.nu),
-                         ball=ball_operator(solid.basis, surface_centres(solid.basis), ball_radius),
-                         elastic=solid.omega > 0.0, n_qp=int(solid.basis.dx.shape[1]), radius=float(ball_radius))
+    ops = BodyOperators(surface=boundary_surface(vb) if surface is None else surface,
+                        strain=strain_operator(vb), D=elasticity_matrix(solid.material.E, solid.material.nu),
+                        ball=ball_operator(solid.basis, surface_centres(solid.basis), ball_radius),
+                        elastic=solid.omega > 0.0, n_qp=int(solid.basis.dx.shape[1]), radius=float(ball_radius))
+    if memo is not None:
+        _BUILT[memo] = ops
+        while len(_BUILT) > BUILT_KEPT:
+            _BUILT.pop(next(iter(_BUILT)))
+    return ops
 
 
 def field_indices(n: int, stride: int) -> np.ndarray:

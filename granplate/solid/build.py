@@ -200,13 +200,27 @@ def _stored_or_computed(payload: dict | None, compute: Callable[[], dict]) -> di
     return arrays
 
 
+#: Solids built in this process, most recent last: run-store key and store directory ->
+#: SolidModel (a study's designs, a benchmark's repeats, reuse the object: its mesh, bases
+#: and flexibility factorisation, which callers must not modify).
+_BUILT: dict[tuple[str, str], SolidModel] = {}
+#: How many built solids a process keeps.
+BUILT_KEPT = 2
+
+
+def forget_built_solids() -> None:
+    """Drop the solids this process keeps in memory (the next build_solid reads the store)."""
+    _BUILT.clear()
+
+
 def build_solid(sd: Solid, material: Material | None = None, surface: str | None = "zmax",
                 components: str = "z", cache: bool = True, memory: float | None = None,
                 seconds: float | None = None) -> SolidModel:
     """Build the solid (module docstring).
 
     surface: the face whose dofs get the residual compliance (None: none);
-    components: which of its nodes' dofs ("z", "xyz", ...); cache: the run store;
+    components: which of its nodes' dofs ("z", "xyz", ...); cache: the run store, and the
+    last BUILT_KEPT solids kept in this process (the same inputs give the same object);
     memory [bytes] / seconds: the limits the estimate is checked against (memory None:
     MEMORY_SHARE of the machine's memory). ScenarioError for bad fields or a body too big.
     """
@@ -215,6 +229,29 @@ def build_solid(sd: Solid, material: Material | None = None, surface: str | None
         if sd.material not in LIBRARY:
             raise ScenarioError("plate.material", sd.material, f"allowed: one of {sorted(LIBRARY)}")
         material = LIBRARY[sd.material]
+    if memory is None:
+        from granplate.setup.plate_cost import physical_memory
+        memory = MEMORY_SHARE * physical_memory()
+    memo = None
+    if cache:
+        memo = (store.key(STORE_KIND, cache_payload(sd, material, surface, components), SOLID_FORMAT),
+                str(store.cache_directory()))
+        built = _BUILT.pop(memo, None)
+        if built is not None:
+            check_fits(built.cost, memory, seconds, list(sd.elements) if sd.mesh is None else sd.mesh)
+            _BUILT[memo] = built  # most recent last
+            return built
+    built = _build_solid(sd, material, surface, components, cache, memory, seconds)
+    if memo is not None:
+        _BUILT[memo] = built
+        while len(_BUILT) > BUILT_KEPT:
+            _BUILT.pop(next(iter(_BUILT)))
+    return built
+
+
+def _build_solid(sd: Solid, material: Material, surface: str | None, components: str, cache: bool,
+                 memory: float, seconds: float | None) -> SolidModel:
+    """build_solid without the process's memory."""
     mesh = solid_mesh(sd)
     sbasis = scalar_basis(mesh, sd.element)
     nodes = node_coordinates(sbasis)
@@ -230,9 +267,6 @@ def build_solid(sd: Solid, material: Material | None = None, surface: str | None
     surface_dofs = surface_dofs[surface_dofs >= 0]
     xyz = nodes[dofs // 3]
     cost = solid_cost(sd, material, len(dofs), xyz, len(surface_dofs))
-    if memory is None:
-        from granplate.setup.plate_cost import physical_memory
-        memory = MEMORY_SHARE * physical_memory()
     check_fits(cost, memory, seconds, list(sd.elements) if sd.mesh is None else sd.mesh)
 
     def compute() -> dict:

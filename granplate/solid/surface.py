@@ -49,6 +49,10 @@ _NEWTON_TOL = 1e-14
 #: How far inside its face's edges (in reference coordinates) a foot lets
 #: `follow_closest` skip the neighbours.
 INTERIOR = 1e-6
+#: A foot on its face's edge lets `follow_closest` skip the neighbours when the centre lies
+#: along the face's own normal there, to this cosine (1 - ALONG): the face's normal is then
+#: the direction from the foot to the centre, a supporting plane of a convex body.
+ALONG = 1e-12
 #: A face lies within this factor times its largest node distance of its nodes' centroid
 #: (room for the bulge of a curved quadratic face).
 _BULGE = 1.25
@@ -449,16 +453,28 @@ def slide_closest(nodes, kind, neighbours, face, p, out):
 @njit(cache=True)
 def follow_closest(nodes, kind, neighbours, face, p, out):
     """`slide_closest`, with a shortcut for a centre outside the body whose foot stays
-    inside its face (reference coordinates within INTERIOR of the face's edges): that foot
-    is the closest point of a convex body (a local minimum of the distance from outside a
-    convex set is the global one), and no neighbour is projected. Returns the face (out as
-    `slide_closest`'s). About a tenth of its cost on a face's interior."""
+    inside its face (reference coordinates within INTERIOR of the face's edges), or lies on
+    its edge with the centre along the face's normal there (to ALONG: a contact on a line
+    of nodes, as at the paper's rigid layers): that foot is the closest point of a convex
+    body (a local minimum of the distance from outside a convex set is the global one;
+    the face's normal at the foot is a supporting plane's), and no neighbour is projected.
+    Returns the face (out as `slide_closest`'s). About a tenth of its cost on a face."""
     d2 = face_closest(nodes[face], kind, p, out)
-    if _inside(kind, out[0], out[1], -INTERIOR) and d2 > 0.0:
+    if d2 > 0.0:
+        interior = _inside(kind, out[0], out[1], -INTERIOR)
         contact_frame(nodes[face], kind, p, out)
-        if out[8] > 0.0:
+        if out[8] > 0.0 and (interior or _along_normal(nodes[face], kind, out)):
             return face
     return slide_closest(nodes, kind, neighbours, face, p, out)
+
+
+@njit(cache=True)
+def _along_normal(X, kind, out) -> bool:
+    """Whether the unit direction out[5:8] from the foot (out[0:2]) to the centre is the
+    face's own outward normal there, to ALONG (`contact_frame`'s output)."""
+    nf = np.empty(3)
+    face_normal(X, kind, out[0], out[1], nf)
+    return out[5] * nf[0] + out[6] * nf[1] + out[7] * nf[2] >= 1.0 - ALONG
 
 
 # --------------------------------------------------------------------------------------
