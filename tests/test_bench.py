@@ -246,3 +246,34 @@ def test_lammps_accuracy_counts_round_off_as_equal():
     assert as_accurate(3.071253142600261e-05, ours)  # measured: 2e-14 relative above ours
     assert as_accurate(0.5 * ours, ours)
     assert not as_accurate(ours * (1 + 1e-6), ours)
+
+
+def test_twins_rows_are_measured_and_documented(tmp_path):
+    """`bench --twins` on ptfe-r05-weak shortened: one row whose keys are the documented
+    ones, its differences and ratios the quotients of its own figures, and the verdicts
+    the targets' (bench.twins.THIN_LIMIT, SPEED_TARGET) applied to them."""
+    from granplate.bench import twins
+
+    out = tmp_path / "twins.json"
+    assert main(["bench", "--twins", "--cases", "ptfe-r05-weak", "--t-end", "2e-5", "--repeats", "1",
+                 "--json", str(out)]) == 0
+    (row,) = json.loads(out.read_text())
+    text = (ROOT / "docs" / "benchmarks.md").read_text().split("(`granplate bench --twins`)")[1]
+    documented = set(re.findall(r"`([a-z_0-9]+)`", text.split("*JSON*")[1].split("\n## ")[0]))
+    assert set(row) <= documented, set(row) - documented
+    assert row["case"] == "ptfe-r05-weak" and row["t_end_s"] == 2e-5 and row["n_steps_3d"] > 0
+    assert row["e_shock_rel_diff"] == pytest.approx(row["e_shock_3d_j"] / row["e_shock_2d_j"] - 1.0)
+    assert row["wall_ratio"] == pytest.approx(row["wall_3d_s"] / row["wall_2d_s"])
+    assert row["within_speed_target"] == (row["wall_ratio"] <= twins.SPEED_TARGET)
+    assert row["within_thin_limit"] == (abs(row["e_shock_rel_diff"]) <= twins.THIN_LIMIT["e_shock"]
+                                        and abs(row["ep_max_fraction_rel_diff"]) <= twins.THIN_LIMIT["ep_max_fraction"])
+
+
+def test_twins_options_are_checked(capsys):
+    """An unknown case, a non-positive --t-end or --repeats is a user error naming it."""
+    assert main(["bench", "--twins", "--cases", "3d-ptfe-r05"]) == 2
+    assert "--cases 3d-ptfe-r05: unknown" in capsys.readouterr().err
+    assert main(["bench", "--twins", "--t-end", "0"]) == 2
+    assert "--t-end 0.0: must be > 0" in capsys.readouterr().err
+    assert main(["bench", "--twins", "--repeats", "0"]) == 2
+    assert "--repeats 0: must be >= 1" in capsys.readouterr().err
