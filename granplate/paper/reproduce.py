@@ -555,7 +555,9 @@ def register(subparsers) -> None:
     p.add_argument("--out", default=".", help="directory for the PNG and PDF (default .)")
     p.set_defaults(func=_cmd_plot)
 
-    a = subparsers.add_parser("animate", help="animate a result (granules, deformed plate, x125)")
+    a = subparsers.add_parser("animate", help="animate a result: in the plane the granules and the deformed "
+                                              "plate (x125); in space the three projections of granplate show, "
+                                              "the body deformed and coloured by stress")
     a.add_argument("result", help="a result .nc file")
     a.add_argument("-o", "--output", help="output .mp4 (or .gif) (default SCENARIO.mp4)")
     a.add_argument("--frames", type=_positive_int, default=DEFAULT_FRAMES, help="at most this many frames")
