@@ -239,3 +239,20 @@ def test_cli_animate_show_export_of_a_body_run(tmp_path, drop, capsys):
     assert (tmp_path / "s.png").stat().st_size > 1000 and (tmp_path / "vtk" / "drop-on-box.pvd").is_file()
     captured = capsys.readouterr()
     assert "Traceback" not in captured.out + captured.err
+
+
+def test_show_draws_the_granules_contact_on_the_body(drop):
+    """At an output where the ball presses the box, the drawing holds one granule-body
+    contact line, from the ball's centre one radius along the force on the body (down,
+    onto the top face), carrying that output's normal force; the sphere aloft has none."""
+    from granplate.figures import space
+
+    fn = np.nan_to_num(drop["body_contact_normal_force"].values)
+    ti = int(np.argmax(fn[:, 0]))
+    a = space._assembly_at(drop, space._result_scenario(drop)[0], ti, "test")
+    body = [k for k, kind in enumerate(a.kinds) if kind == "body"]
+    assert len(body) == 1
+    (k,) = body
+    assert a.forces[k] == pytest.approx(fn[ti, 0], rel=1e-12)
+    start, end = a.segments[k]
+    assert np.allclose(start, a.pos[0]) and end[2] == pytest.approx(a.pos[0, 2] - 0.0025, rel=1e-6)

@@ -70,8 +70,8 @@ MAX_LINE_WIDTH = 5.0
 #: Contacts below this fraction of the largest force are drawn thin and dotted.
 OPEN_FRACTION = 0.01
 #: Contact line colours by kind (a scenario: no forces).
-KIND_COLOURS = {"granule": "0.1", "wall": "tab:purple"}
-KIND_NAMES = {"granule": "granule-granule", "wall": "granule-wall"}
+KIND_COLOURS = {"granule": "0.1", "wall": "tab:purple", "body": "tab:blue"}
+KIND_NAMES = {"granule": "granule-granule", "wall": "granule-wall", "body": "granule-body"}
 LOAD_COLOUR = "crimson"
 #: The solid: the fill's share of its material colour (the rest white), its outline and
 #: its clamped faces' outlines (colour, width [points]).
@@ -96,7 +96,8 @@ class Assembly3D:
     pos (n, 3) centres and radius (n,); labels, materials per granule; walls: the
     resolved planes (box walls included); load and loaded: the scenario's load and the
     mask of the granules it pushes; segments (nc, 2, 3) contact lines (centre to centre,
-    centre to the wall's nearest point), kinds per segment ("granule", "wall"); forces:
+    centre to the wall's nearest point, centre to its contact on an elastic body), kinds
+    per segment ("granule", "wall", "body"); forces:
     normal force per segment [N] or None (a scenario); time [s] and time_note: the
     result time shown (None for a scenario). The elastic solid of a scenario (empty
     without one): solid_faces (nf, k, 3) its boundary facets' corners [m], solid_edges
@@ -167,6 +168,20 @@ def contact_segments(pos, walls, pairs, wall_contacts) -> tuple[np.ndarray, tupl
     segs += [(pos[i], wall_foot(pos[i], walls[w])) for i, w in wall_contacts]
     kinds = ("granule",) * len(pairs) + ("wall",) * len(wall_contacts)
     return np.asarray(segs, float).reshape(-1, 2, 3), kinds
+
+
+def body_contacts_at(ds: xr.Dataset, ti: int, pos: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(contact lines (nb, 2, 3) [m] from each granule touching the elastic body at output
+    ti to its contact, R along the force on the body; their normal forces (nb,) [N]), from
+    the result's body_contact_* (none without them)."""
+    if "body_contact_normal_force" not in ds or "body_contact_force" not in ds:
+        return _no_segments(), np.zeros(0)
+    fn = np.nan_to_num(np.asarray(ds["body_contact_normal_force"].values[ti], float))
+    f = np.nan_to_num(np.asarray(ds["body_contact_force"].values[ti], float))
+    norm = np.linalg.norm(f, axis=-1)
+    on = np.flatnonzero((fn > 0.0) & (norm > 0.0))
+    ends = pos[on] + r[on, None] * f[on] / norm[on, None]
+    return np.stack([pos[on], ends], axis=1).reshape(-1, 2, 3), fn[on]
 
 
 def pair_overlaps(pos: np.ndarray, r: np.ndarray, pairs: np.ndarray) -> np.ndarray:
@@ -313,12 +328,15 @@ def _assembly_at(ds: xr.Dataset, s: Scenario, ti: int, note: str, solid: dict | 
     r = np.asarray(ds["radius"].values, float)
     pairs, wc = touching(s, pos, r)
     segs, kinds = contact_segments(pos, s.walls, pairs, wc)
+    body_segs, body_forces = body_contacts_at(ds, ti, pos, r)
     p0 = path[0]
     return Assembly3D(
         name=s.name, pos=pos, radius=r, labels=tuple(str(v) for v in ds["granule"].values),
         materials=tuple(str(v) for v in ds["material"].values), walls=s.walls, load=s.load,
-        loaded=loaded_granules_3d(s, p0[:, 0], p0[:, 1], p0[:, 2], r), segments=segs, kinds=kinds,
-        forces=contact_forces(s, path, r, pairs, wc), time=float(ds["time"].values[ti]), time_note=note,
+        loaded=loaded_granules_3d(s, p0[:, 0], p0[:, 1], p0[:, 2], r), segments=np.concatenate([segs, body_segs]),
+        kinds=kinds + ("body",) * len(body_segs),
+        forces=np.concatenate([contact_forces(s, path, r, pairs, wc), body_forces]),
+        time=float(ds["time"].values[ti]), time_note=note,
         **(solid or {}), **(body or {}), **scales,
     )
 
