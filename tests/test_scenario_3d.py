@@ -195,7 +195,8 @@ def test_solid_needs_the_verlet_scheme_and_then_builds():
     modes and contact arrays."""
     from granplate.model import build_model
 
-    d = base(plate={"size": [0.1, 0.1, 0.005], "elements": [2, 2, 1], "max_frequency": 5e4},
+    d = base(plate={"size": [0.1, 0.1, 0.005], "elements": [2, 2, 1], "max_frequency": 5e4,
+                    "origin": [0.2, 0.2, 0.2]},  # clear of the box's and the tilted wall's planes
              solver={"scheme": "implicit"})
     e = refused(d)
     assert e.field == "solver.scheme" and "verlet" in str(e)
