@@ -86,3 +86,39 @@ def test_comparison_refuses_incomplete_tables(tmp_path):
     (tmp_path / "short.csv").write_text("\n".join(rows[:-1]) + "\n")
     with pytest.raises(ValueError, match="one steel and one ptfe"):
         m.read_tables(tmp_path / "short.csv", STUDIES / "thick-plates-face" / "results.csv")
+
+
+def test_protector_3d_conclusion_is_its_trials_table():
+    """The 3D optimisation's written conclusion (docs/studies/protector-3d.toml) quotes its
+    committed trials.csv: the best feasible design and its figures, the best feasible of
+    each middle layer, the mass range of the designs with two loaded cells, the counts."""
+    t = pd.read_csv(STUDIES / "protector-3d" / "trials.csv")
+    conclusion = " ".join(tomllib.loads((STUDIES / "protector-3d.toml").read_text())["report"]["conclusion"].split())
+    done = t[t["state"] == "COMPLETE"]
+    feasible = done[done["feasible"] == "yes"]
+    assert f"{len(t)} trials, {len(feasible)} feasible" in conclusion
+    best = feasible.loc[feasible["ep_max_fraction"].idxmin()]
+    assert (best["layout.layers[0].count"], best["layout.layers[1].material"], best["layout.layers[2].count"],
+            best["layout.layers[2].material"]) == (1, "ptfe", 2, "aluminium")
+    assert f"PTFE spheres of {1e3 * best['layout.layers[1].radius']:.2f} mm" in conclusion
+    assert f"({best['granular_mass']:.3f} kg): {100 * best['ep_max_fraction']:.4f}%" in conclusion
+    assert f"largest stress is {best['max_von_mises'] / 1e3:.0f} kPa" in conclusion
+    dominated = feasible[(feasible["ep_max_fraction"] >= best["ep_max_fraction"])
+                         & (feasible["max_von_mises"] >= best["max_von_mises"])]
+    assert len(dominated) == len(feasible)  # the front within the window is that one design
+
+    def best_of(rows):
+        return rows.loc[rows["ep_max_fraction"].idxmin()]
+
+    steel_back = best_of(feasible[(feasible["layout.layers[1].material"] == "ptfe")
+                                  & (feasible["layout.layers[2].material"] == "steel")])
+    assert f"{100 * steel_back['ep_max_fraction']:.4f}% ({steel_back['granular_mass']:.3f} kg)" in conclusion
+    alu = best_of(feasible[feasible["layout.layers[1].material"] == "aluminium"])
+    assert f"{100 * alu['ep_max_fraction']:.3f}% ({alu['granular_mass']:.3f} kg)" in conclusion
+    steel = feasible[feasible["layout.layers[1].material"] == "steel"].sort_values("layout.layers[1].radius")
+    for _, row in steel.iloc[[0, -1]].iterrows():
+        assert f"{100 * row['ep_max_fraction']:.3g}% at {1e3 * row['layout.layers[1].radius']:.2f} mm" in conclusion
+    two = done[done["layout.layers[0].count"] == 2]
+    assert (two["feasible"] == "no").all()
+    assert f"({two['granular_mass'].min():.2f} to {two['granular_mass'].max():.2f} kg)" in conclusion
+    assert f"{100 * two['ep_max_fraction'].min():.5f}% at {best_of(two)['granular_mass']:.3f} kg" in conclusion
