@@ -1,6 +1,9 @@
 """Shared fixtures: an isolated plate cache per session, small scenario builders."""
 from __future__ import annotations
 
+import importlib.util
+from pathlib import Path
+
 import pytest
 
 from granplate.setup.scenario import Contact, Granule, Load, Scenario, TimeSettings, Wall
@@ -41,3 +44,11 @@ def sphere_on_wall(vx: float, vy: float, radius: float = 0.01, mu: float = 0.099
         contact=Contact(alpha_n=alpha_n, mu=mu, pairs=()),
         time=TimeSettings(t_end=t_end, dt_initial=dt, dt_max=dt, output_interval=out, field_interval=out),
     )
+
+
+def script_module(path: Path, name: str):
+    """A script of docs/ (not a package module), imported from its file."""
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module

@@ -12,17 +12,16 @@ most), while every other metric stayed within 1.5e-9 of its value.
 """
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from conftest import script_module
+
 HERE = Path(__file__).parent / "golden"
-spec = importlib.util.spec_from_file_location("golden_presets", HERE / "presets.py")
-golden = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(golden)
+golden = script_module(HERE / "presets.py", "golden_presets")
 TABLE = json.loads((HERE / "presets.json").read_text())
 RTOL = 1e-9
 

@@ -4,7 +4,6 @@ docs/studies.md is the script's output from the two tables, and the written conc
 quote only what the script computes. Nothing is run: the tables are read."""
 from __future__ import annotations
 
-import importlib.util
 import re
 import tomllib
 from pathlib import Path
@@ -14,6 +13,8 @@ import pytest
 
 from granplate.study.spec import load_study
 
+from conftest import script_module
+
 STUDIES = Path(__file__).resolve().parent.parent / "docs" / "studies"
 NAMES = ("thick-plates", "thick-plates-face")
 BEGIN, END = "<!-- compare-thick-plates.py: begin -->\n", "\n<!-- compare-thick-plates.py: end -->"
@@ -21,10 +22,7 @@ BEGIN, END = "<!-- compare-thick-plates.py: begin -->\n", "\n<!-- compare-thick-
 
 def compare_module():
     """docs/studies/compare-thick-plates.py, imported from its file."""
-    spec = importlib.util.spec_from_file_location("compare_thick_plates", STUDIES / "compare-thick-plates.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return script_module(STUDIES / "compare-thick-plates.py", "compare_thick_plates")
 
 
 @pytest.mark.parametrize("name", NAMES)

@@ -6,7 +6,6 @@ run: the tables are read."""
 from __future__ import annotations
 
 import csv
-import importlib.util
 import re
 import tomllib
 from pathlib import Path
@@ -15,6 +14,8 @@ import pytest
 
 from granplate.study.spec import load_study
 
+from conftest import script_module
+
 STUDIES = Path(__file__).resolve().parent.parent / "docs" / "studies"
 ELASTIC, PLASTIC = "intruder-map", "intruder-map-plastic"
 BEGIN, END = "<!-- compare-intruder-maps.py: begin -->\n", "\n<!-- compare-intruder-maps.py: end -->"
@@ -22,10 +23,7 @@ BEGIN, END = "<!-- compare-intruder-maps.py: begin -->\n", "\n<!-- compare-intru
 
 def compare_module():
     """docs/studies/compare-intruder-maps.py, imported from its file."""
-    spec = importlib.util.spec_from_file_location("compare_intruder_maps", STUDIES / "compare-intruder-maps.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return script_module(STUDIES / "compare-intruder-maps.py", "compare_intruder_maps")
 
 
 def table(name: str) -> list[dict[str, str]]:

@@ -1,11 +1,11 @@
 """`granplate bench`: the command line of the benchmark harness (granplate.bench.harness)."""
 from __future__ import annotations
 
+from granplate.bench import write_report
+
 
 def _cmd_study(args) -> int:
-    import json
     import sys
-    from pathlib import Path
 
     from granplate.bench import study
 
@@ -16,9 +16,7 @@ def _cmd_study(args) -> int:
     report = study.run(args.designs or study.DEFAULT_DESIGNS, workers=args.workers, scheduler=args.scheduler,
                        t_end=args.t_end, log=lambda line: print(line, file=sys.stderr))
     print(study.format_report(report))
-    if args.json:
-        Path(args.json).write_text(json.dumps(report, indent=2) + "\n")
-        print(f"json: {args.json}")
+    write_report(args, report)
     return 0
 
 

@@ -22,9 +22,10 @@ over the granules' velocity components at t_end [m/s].
 from __future__ import annotations
 
 import dataclasses
-import json
 import sys
 import time
+
+from granplate.bench import write_report
 
 #: The packing: columns x rows of radius [m], the struck column's speed [m/s], t_end [s].
 PACKING = {"columns": 20, "rows": 50, "radius": 1e-3, "v0": 1.0, "t_end": 1e-4}
@@ -236,8 +237,5 @@ def main(args) -> int:
     print(format_lammps_table(cmp))
     for r in rows:
         r.pop("final")
-    if getattr(args, "json", None):
-        with open(args.json, "w") as fh:
-            fh.write(json.dumps({"rows": rows, "lammps": cmp}, indent=2) + "\n")
-        print(f"json: {args.json}")
+    write_report(args, {"rows": rows, "lammps": cmp})
     return 0

@@ -21,7 +21,8 @@ import statistics
 import subprocess
 import sys
 import time
-from pathlib import Path
+
+from granplate.bench import write_report
 
 
 #: The run store's kind of the converged reference summaries, and their format version.
@@ -321,9 +322,7 @@ def main(args) -> int:
         return 2
     print()
     print(format_table(report))
-    if args.json:
-        Path(args.json).write_text(json.dumps(report, indent=2) + "\n")
-        print(f"json: {args.json}")
+    write_report(args, report)
     return 0
 
 

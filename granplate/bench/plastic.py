@@ -21,10 +21,11 @@ KERNEL_CALLS.
 """
 from __future__ import annotations
 
-import json
 import statistics
 import sys
 import warnings
+
+from granplate.bench import write_report
 
 #: Timed repeats per case and law (medians), the simulated time of the presets [s], and
 #: the target ratio of the plastic law's loop time per step to Hertz's.
@@ -174,8 +175,5 @@ def main(args) -> int:
         return 2
     report = run(args.t_end, repeats, log=lambda line: print(line, file=sys.stderr))
     print(format_report(report))
-    if args.json:
-        with open(args.json, "w") as f:
-            f.write(json.dumps(report, indent=2) + "\n")
-        print(f"json: {args.json}")
+    write_report(args, report)
     return 0

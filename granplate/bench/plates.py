@@ -18,6 +18,7 @@ import tempfile
 import time
 
 from granplate.bench.harness import parse_pairs
+from granplate.bench import write_report
 
 #: Meshes (nx, ny) of the table, the paper's first.
 PLATE_MESHES: tuple[tuple[int, int], ...] = ((4, 40), (8, 80), (16, 160), (32, 320))
@@ -126,8 +127,5 @@ def main(args) -> int:
     rows = run_plates(meshes, modes, getattr(args, "t_end", None))
     print()
     print(format_plate_table(rows))
-    if getattr(args, "json", None):
-        with open(args.json, "w") as fh:
-            fh.write(json.dumps(rows, indent=2) + "\n")
-        print(f"json: {args.json}")
+    write_report(args, rows)
     return 1 if any("failed" in r for r in rows) else 0

@@ -26,6 +26,7 @@ import sys
 import time
 
 from granplate.bench.harness import parse_pairs
+from granplate.bench import write_report
 
 #: Packings (columns, rows) of the table: 10, 100, 1,008, 2,996 and 9,950 granules.
 SIZES: tuple[tuple[int, int], ...] = ((4, 3), (8, 13), (32, 32), (56, 54), (100, 100))
@@ -247,8 +248,5 @@ def main(args) -> int:
     rows = run_scaling(sizes, t_end=t_end, scheme=scheme, lammps=not getattr(args, "no_lammps", False))
     print()
     print(format_scaling_table(rows))
-    if getattr(args, "json", None):
-        with open(args.json, "w") as fh:
-            fh.write(json.dumps(rows, indent=2) + "\n")
-        print(f"json: {args.json}")
+    write_report(args, rows)
     return 1 if any("failed" in r or "failed" in (r.get("lammps") or {}) for r in rows) else 0

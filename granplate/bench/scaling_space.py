@@ -26,6 +26,7 @@ from granplate.bench.scaling import (
     FRICTIONS, LAMMPS_DT_START, LAMMPS_HALVINGS, RADIUS, REFERENCE_DT, SPEED, T_END, as_accurate, format_or_dash,
     per_contact_step_us, run_in_subprocess,
 )
+from granplate.bench import write_report
 
 #: FCC packings (cells along x, y, z) of the table: 12, 108, 1,008, 2,916 and 10,192 spheres.
 SIZES: tuple[tuple[int, int, int], ...] = ((3, 1, 1), (3, 3, 3), (6, 6, 7), (9, 9, 9), (14, 14, 13))
@@ -209,8 +210,6 @@ def parse_cells(text: str) -> list[tuple[int, int, int]]:
 def main(args, t_end: float, scheme: str) -> int:
     """`granplate bench --scaling --dimension 3 [--sizes 3x3x3,6x6x7] ...` (t_end and scheme
     checked by bench.scaling.main)."""
-    import json
-
     try:
         sizes = parse_cells(args.sizes) if getattr(args, "sizes", None) else SIZES
     except ValueError as err:
@@ -219,9 +218,6 @@ def main(args, t_end: float, scheme: str) -> int:
     rows = run_scaling_space(sizes, t_end=t_end, scheme=scheme, lammps=not getattr(args, "no_lammps", False))
     print()
     print(format_space_table(rows))
-    if getattr(args, "json", None):
-        with open(args.json, "w") as fh:
-            fh.write(json.dumps(rows, indent=2) + "\n")
-        print(f"json: {args.json}")
+    write_report(args, rows)
     return 1 if any("failed" in r or "failed" in (r.get("lammps") or {}) for r in rows) else 0
 

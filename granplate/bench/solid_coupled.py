@@ -20,10 +20,11 @@ max E_plate / E_in and the peak contact force on the body, each against the refe
 """
 from __future__ import annotations
 
-import json
 import math
 import statistics
 import sys
+
+from granplate.bench import write_report
 
 #: The spheres [m], their FCC cells (along x, y, z: 300 spheres) and the plate [m].
 RADIUS = 0.005
@@ -341,10 +342,7 @@ def main(args) -> int:
     report = run_all(quick=getattr(args, "quick", False), repeats=repeats,
                      log=lambda line: print(line, file=sys.stderr))
     print_report(report)
-    if getattr(args, "json", None):
-        with open(args.json, "w") as fh:
-            fh.write(json.dumps(report, indent=2) + "\n")
-        print(f"json: {args.json}")
+    write_report(args, report)
     return 0
 
 

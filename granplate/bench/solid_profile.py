@@ -11,7 +11,6 @@ Gauss-Seidel solve. CPU time per call [us].
 """
 from __future__ import annotations
 
-import json
 import sys
 import time
 
@@ -19,6 +18,7 @@ import numpy as np
 from numba import njit
 
 from granplate.solver import body as B
+from granplate.bench import write_report
 
 #: Calls per sub-pass timed (after one call that compiles it).
 CALLS = 200
@@ -186,8 +186,5 @@ def main(args) -> int:
     for r in rows:
         if "failed" in r:
             print(f"failed: {r['failed']}")
-    if getattr(args, "json", None):
-        with open(args.json, "w") as fh:
-            fh.write(json.dumps(rows, indent=2) + "\n")
-        print(f"json: {args.json}")
+    write_report(args, rows)
     return 1 if len(good) < len(rows) else 0

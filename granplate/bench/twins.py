@@ -18,6 +18,8 @@ import sys
 import time
 import warnings
 
+from granplate.bench import write_report
+
 #: The thin-limit targets: |3D / 2D - 1| of E_shock and of the plate's peak share.
 THIN_LIMIT = {"e_shock": 0.01, "ep_max_fraction": 0.02}
 #: The target of a twin's wall time over its 2D preset's.
@@ -120,8 +122,5 @@ def main(args) -> int:
         print(f"twins: {name} and 3d-{name} ...", file=sys.stderr)
         rows.append(bench_case(name, args.t_end, args.repeats or REPEATS))
     print(format_table(rows))
-    if args.json:
-        with open(args.json, "w") as fh:
-            fh.write(json.dumps(rows, indent=2) + "\n")
-        print(f"json: {args.json}")
+    write_report(args, rows)
     return 0
