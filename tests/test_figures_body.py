@@ -256,3 +256,15 @@ def test_show_draws_the_granules_contact_on_the_body(drop):
     assert a.forces[k] == pytest.approx(fn[ti, 0], rel=1e-12)
     start, end = a.segments[k]
     assert np.allclose(start, a.pos[0]) and end[2] == pytest.approx(a.pos[0, 2] - 0.0025, rel=1e-6)
+
+
+def test_energies_draw_the_bodys_energy_and_the_whole_balance(drop):
+    """The energy figure of a body run draws E_plate (the body's energy) and the sum
+    E_granular + E_plate + D, which is E_shock + E_initial to the run's residual."""
+    fig = run.fig_energies(drop)
+    body = _lines(fig, "energy:plate")
+    assert np.array_equal(body.get_ydata(), drop["E_plate"].values) and "elastic body" in body.get_label()
+    total = _lines(fig, "energy:total")
+    assert "E_{plate}" in total.get_label()
+    e_in = float(drop["E_granular"].values[0])  # the ball's kinetic energy, no load
+    assert np.allclose(total.get_ydata(), e_in, rtol=1e-4)

@@ -374,3 +374,24 @@ def test_heat_map_cells_are_legible(log_study):
     assert min(sizes) >= 8 and min(sizes) * P.DPI / 72 >= 11
     width, height = heat.get_size_inches()
     assert width >= P.HEAT_CELL[0] * 3 and height >= P.HEAT_CELL[1] * 3
+
+
+def test_field_units_are_the_scenario_docs_units():
+    """Every field the study pages give a unit has that unit in docs/scenario.md's tables
+    ("-" there is "1" here), and an indexed path takes its field's ("plate.size[2]": m)."""
+    import re
+    from collections import defaultdict
+    from pathlib import Path
+
+    from granplate.study.table import FIELD_UNITS, field_unit
+
+    doc = (Path(__file__).resolve().parent.parent / "docs" / "scenario.md").read_text()
+    documented = defaultdict(set)
+    for key, unit in re.findall(r"^\| `([A-Za-z_0-9]+)` \| ([^|]*?) \|", doc, flags=re.M):
+        documented[key].add("1" if unit.strip() == "-" else unit.strip())
+    checked = [k for k in FIELD_UNITS if k in documented]
+    assert len(checked) >= 35
+    for key in checked:
+        assert documented[key] == {FIELD_UNITS[key]}, key
+    assert (field_unit("plate.size[2]"), field_unit("plate.elements[0]"), field_unit("layout.layers[1].radius"),
+            field_unit("layout.layers[0].count")) == ("m", "1", "m", "1")

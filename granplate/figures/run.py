@@ -81,7 +81,7 @@ def plastic_work(ds: xr.Dataset) -> np.ndarray | None:
 def energy_curves(ds: xr.Dataset) -> dict[str, tuple[str, np.ndarray]]:
     """key -> (legend label, energy [J] over time) of the energy figure: E_shock when the
     load does work, E_granular with granules (in space also its part KE_depth, the
-    translation along z), E_plate with a plate, the dissipation D = D_viscous + D_friction
+    translation along z), E_plate with a plate or a 3D elastic body, the dissipation D = D_viscous + D_friction
     (+ D_plastic, also drawn alone, when contacts yielded), and the sum of those stored
     and dissipated."""
     out = {}
@@ -91,8 +91,9 @@ def energy_curves(ds: xr.Dataset) -> dict[str, tuple[str, np.ndarray]]:
     if an.has_granules(ds):
         out["granular"] = ("$E_{granular}$", ds["E_granular"].values)
         parts.append(("E_{granular}", ds["E_granular"].values))
-    if an.has_plate(ds):
-        out["plate"] = ("$E_{plate}$", ds["E_plate"].values)
+    if an.has_elastic_energy(ds):
+        body = "" if an.has_plate(ds) else ", the elastic body"
+        out["plate"] = ("$E_{plate}$" + body, ds["E_plate"].values)
         parts.append(("E_{plate}", ds["E_plate"].values))
     if "KE_depth" in ds:  # in space: the kinetic energy along z, a part of E_granular
         out["depth"] = ("$KE_{depth}$, translation along z (part of $E_{granular}$)", ds["KE_depth"].values)

@@ -65,6 +65,11 @@ def has_plate(ds: xr.Dataset) -> bool:
     return "E_plate" in ds and "node" in ds.dims
 
 
+def has_elastic_energy(ds: xr.Dataset) -> bool:
+    """Whether the run has an elastic plate or a 3D elastic body, whose energy is E_plate."""
+    return "E_plate" in ds and ("node" in ds.dims or "body_q" in ds)
+
+
 def normalised_energies(ds: xr.Dataset) -> dict[str, np.ndarray]:
     """E_g, E_p, E_g + E_p and E_g + E_p + D over time, each / reference_energy [-].
 

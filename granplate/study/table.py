@@ -19,6 +19,10 @@ FIELD_UNITS: dict[str, str] = {
     "E": "Pa", "nu": "1", "rho": "kg/m^3", "radius": "m", "x": "m", "y": "m", "vx": "m/s",
     "vy": "m/s", "width": "m", "height": "m", "thickness": "m", "mu": "1", "nx": "1", "ny": "1",
     "n_modes": "1", "rigid_layer_width": "m", "column_radii": "m", "alpha_n": "1",
+    # in space, and the layouts' counts
+    "z": "m", "vz": "m/s", "size": "m", "origin": "m", "elements": "1", "patch_radius": "m",
+    "stress_radius": "m", "max_frequency": "Hz", "force": "N", "Y": "Pa", "k_s": "s/m",
+    "count": "1", "cells": "1", "columns": "1", "rows": "1", "intruder_ratio": "1",
 }
 
 
