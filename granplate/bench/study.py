@@ -110,8 +110,12 @@ def run(n_designs: int = DEFAULT_DESIGNS, workers: int | None = None, scheduler:
         "loop_cpu_s_median": statistics.median(loop_cpu),
         "outside_loop_cpu_vs_loop_median": statistics.median(
             (c - lc + store_s) / lc for c, lc in zip(cpu, loop_cpu) if lc > 0),
+        "loop_cpu_s_mean": statistics.fmean(loop_cpu),
         "cpu_s_per_design": cpu_per_design,
         "extrapolated_hours_cpu": EXTRAPOLATE_DESIGNS * cpu_per_design / EXTRAPOLATE_CORES / 3600.0,
+        "extrapolated_hours_steady": (t_cluster + report.warm_up_s
+                                      + EXTRAPOLATE_DESIGNS * steady / EXTRAPOLATE_CORES) / 3600.0,
+        "extrapolated_hours_loop": EXTRAPOLATE_DESIGNS * statistics.fmean(loop_cpu) / EXTRAPOLATE_CORES / 3600.0,
         "core_s_per_design_target": TARGET_HOURS * 3600.0 * EXTRAPOLATE_CORES / EXTRAPOLATE_DESIGNS,
     }
 
@@ -138,6 +142,9 @@ def format_report(r: dict) -> str:
         f"(set-up, summary, store) {100 * r['outside_loop_cpu_vs_loop_median']:.0f}% of the loop's "
         f"(median over the designs); {r['cpu_s_per_design']:.3f} core-s per design (mean)",
         f"{r['extrapolated_designs']} designs on {r['extrapolated_cores']} cores: "
-        f"{r['extrapolated_hours']:.2f} h all included, {r['extrapolated_hours_cpu']:.2f} h at the tasks' CPU "
-        f"time (target {TARGET_HOURS:g} h: {r['core_s_per_design_target']:.2f} core-s per design)",
+        f"{r['extrapolated_hours']:.2f} h at this run's rate all included, {r['extrapolated_hours_steady']:.2f} h "
+        f"with the cluster start and warm-up once and the steady rate after, {r['extrapolated_hours_cpu']:.2f} h "
+        f"at the tasks' CPU time, {r['extrapolated_hours_loop']:.2f} h for the time loops alone "
+        f"(loop CPU {r['loop_cpu_s_mean']:.3f} s a design, mean; target {TARGET_HOURS:g} h: "
+        f"{r['core_s_per_design_target']:.2f} core-s per design)",
     ])
