@@ -197,3 +197,46 @@ def test_layout_fields_refused_by_name(name):
                         continue  # named; a granule placed on a clamp names the clamp
                     pytest.fail(f"{prefix}.{f.name} = {bad!r}: the error names another field: {err}")
     assert tried > 0
+
+
+#: How many of the 3D solid scenario's mutations that validation accepts are run.
+N_SOLID_RUNS = 6
+
+
+def _solid_cases_that_validate() -> list[tuple[str, object]]:
+    """Seeded (field, bad value) pairs of the 3D solid scenario (tests/test_scenario_3d.py)
+    that validation accepts: the ones that must then run."""
+    from test_scenario_3d import BAD_VALUES as BAD_3D, BASE_SOLID
+
+    product = list(itertools.product(numeric_fields(BASE_SOLID), BAD_3D))
+    order = np.random.default_rng(SEED + 2).permutation(len(product))
+    found = []
+    for k in order:
+        path, value = product[k]
+        try:
+            validate(from_dict(mutated(BASE_SOLID, path, value)))
+        except ScenarioError:
+            continue
+        found.append((path, value))
+        if len(found) == N_SOLID_RUNS:
+            break
+    return found
+
+
+def test_bad_numbers_a_solid_scenario_accepts_run():
+    """The 3D solid scenario's mutations that pass validation (a granule moved off the
+    plate, a friction or damping of 0, a yield stress of 1e300, ...) run 0.2 us with finite
+    energies: never a traceback or a hang after validation."""
+    from test_scenario_3d import BASE_SOLID
+
+    accepted = _solid_cases_that_validate()
+    assert len(accepted) == N_SOLID_RUNS
+    for path, value in accepted:
+        d = mutated(BASE_SOLID, path, value)
+        try:
+            ds = run_with_timeout(from_dict(d), RUN_TIMEOUT_S)
+        except SimulationError as err:  # pragma: no cover - what the test exists to catch
+            pytest.fail(f"{path} = {value!r} passed validation but the run failed: {err}")
+        for var in ("E_shock", "E_granular", "E_plate", "energy_residual"):
+            assert np.isfinite(ds[var].values).all(), (path, value, var)
+        assert float(ds.time[-1]) == pytest.approx(d["time"]["t_end"]), (path, value)

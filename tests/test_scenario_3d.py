@@ -374,6 +374,55 @@ def test_bad_number_in_3d_is_refused_by_name_or_valid(path, value):
         assert "\n" not in msg and names_field(msg, path), msg
 
 
+#: A sphere and a pair (one of a user material with a yield stress, spinning) against the
+#: face xmin of a small clamped solid plate, with friction and a pair override.
+BASE_SOLID: dict = {
+    "name": "fuzz-solid", "description": "two spheres against a small solid plate", "dimension": 3,
+    "materials": {"soft": {"E": 1e9, "nu": 0.3, "rho": 1200.0, "Y": 2e7}},
+    "granules": [
+        {"label": "a", "x": 0.0, "y": 0.01, "z": 0.01, "radius": 0.0025, "material": "steel", "vx": 1.0},
+        {"label": "b", "x": -0.006, "y": 0.01, "z": 0.01, "radius": 0.0025, "material": "soft", "vx": 1.0,
+         "omega": [0.0, 1.0, 0.0]},
+    ],
+    "plate": {"size": [0.004, 0.02, 0.02], "elements": [1, 2, 2], "origin": [0.0026, 0.0, 0.0],
+              "material": "steel", "clamped": ["ymin", "ymax"], "max_frequency": 1e5},
+    "contact": {"mu": 0.1, "k_s": 1000.0, "alpha_n": 6e-3,
+                "pairs": [{"materials": ["steel", "soft"], "alpha_n": 0.01, "mu": 0.2, "k_s": 500.0}]},
+    "time": {"t_end": 2e-7, "dt_max": 5e-8, "output_interval": 1e-7, "field_interval": 2e-7},
+    "solver": {"scheme": "verlet", "granular_friction": "split"},
+}
+
+
+def _example(name: str) -> dict:
+    import tomllib
+
+    with open(ROOT / "docs" / "examples" / f"{name}.toml", "rb") as f:
+        return tomllib.load(f)
+
+
+@pytest.mark.parametrize("path,value", [
+    *((("solid", p), v) for p, v in itertools.product(numeric_fields(BASE_SOLID), BAD_VALUES)),
+    *((("3d-fcc-protector", p), v) for p, v in itertools.product(numeric_fields(_example("3d-fcc-protector")),
+                                                                 BAD_VALUES))], ids=lambda v: repr(v))
+def test_bad_number_with_a_solid_is_refused_by_name_or_valid(path, value):
+    """Every numeric field of a 3D scenario with an elastic solid (its size, elements, origin,
+    cut-off; a layout placing the solid against it; a yield stress) set to -1, 0, NaN, inf,
+    1e300 or a string: valid, or one line naming that field (not one derived from it)."""
+    source, field = path
+    base = BASE_SOLID if source == "solid" else _example(source)
+    try:
+        validate(scenario_io.from_dict(mutated(base, field, value)))
+    except ScenarioError as err:
+        msg = str(err)
+        assert "\n" not in msg and names_field(msg, field), msg
+
+
+def test_a_dimension_out_of_range_is_named_before_the_tables():
+    """dimension = 5 with a 3D [plate]: the error is the dimension's, not the plate's fields."""
+    d = mutated(BASE_SOLID, "dimension", 5)
+    assert refused(d).field == "dimension"
+
+
 def test_a_3d_file_without_a_load_table_has_no_load():
     """A 3D file without [load] reads as load.kind = "none" (the plane's line load has no
     meaning in space), validates, and writes back to the same scenario."""

@@ -37,6 +37,17 @@ def int_at_least(path: str, v: Any, lo: int) -> None:
         raise ScenarioError(path, v, f"must be an integer >= {lo}")
 
 
+#: The dimensions a scenario may have: discs in the plane, spheres in space.
+DIMENSIONS: tuple[int, ...] = (2, 3)
+
+
+def check_dimension(d: Any) -> None:
+    """The top-level `dimension`: 2 or 3 (read first: it decides what the tables may hold)."""
+    if not isinstance(d, numbers.Integral) or isinstance(d, bool) or d not in DIMENSIONS:
+        raise ScenarioError("dimension", d, "must be 2 (discs in the plane, the default) or 3 "
+                            "(spheres in space)")
+
+
 def closest_name(name: str, allowed: list[str]) -> str | None:
     """The allowed name closest to a misspelled `name` (difflib's ratio >= 0.6), or None."""
     close = difflib.get_close_matches(str(name), allowed, n=1)

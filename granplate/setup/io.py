@@ -25,7 +25,7 @@ from typing import Any
 import tomli_w
 
 from granplate.errors import ScenarioError
-from granplate.setup.fields import closest_name, string_in
+from granplate.setup.fields import check_dimension, closest_name, string_in
 from granplate.setup.materials import LIBRARY, Material
 from granplate.setup.scenario import (LAYOUT_KINDS, NORMAL_LAWS, Box, Contact, Granule, Load,
                                       PairCoefficients, Plate, Scenario, Solid, Solver, TimeSettings, Wall)
@@ -262,6 +262,7 @@ def from_dict(d: dict) -> Scenario:
             kw[key] = _convert(key, d[key], str)
     if d.get("dimension") is not None:
         kw["dimension"] = _convert("dimension", d["dimension"], int)
+        check_dimension(kw["dimension"])
     if kw.get("dimension") == 3 and d.get("granules") is not None:
         _no_scalar_omega(d["granules"])
     if d.get("materials") is not None:

@@ -26,7 +26,7 @@ from granplate.setup.geometry import granule_named, layout_packing, plane_offset
 from granplate.setup.layouts import (INTRUDER_COLUMN_RULES, cells_along_x, column_radii, half_pitch,
                                      hexagonal_offsets, lattice_sites, plane_clash, plane_gap_distance,
                                      plane_layers, plane_type, planes_per_cell, sites_per_cell, space_sites)
-from granplate.setup.fields import finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
+from granplate.setup.fields import check_dimension, finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
 from granplate.setup.pairs import close_pairs
 from granplate.setup.plate_checks import check_plate_fields, check_plate_mesh
 from granplate.setup.solid_checks import (box_corners, box_distances, check_solid, check_solid_clearance, is_box,
@@ -64,8 +64,6 @@ E_MAX = 1e13
 RHO_MAX = 1e5
 #: Tolerance on |normal| - 1 for walls (2D; a 3D wall's normal may have any length > 0).
 NORMAL_TOL = 1e-9
-#: Scenario dimensions (Scenario.dimension): discs in the plane, spheres in space.
-DIMENSIONS: tuple[int, ...] = (2, 3)
 #: Relative tolerance of a 3D wall's offset against point . n when both are given.
 PLANE_RTOL = 1e-12
 #: Tolerance on the R2/R1 bounds.
@@ -90,10 +88,7 @@ MAX_LAYOUT_SITES = 1_000_000
 # --------------------------------------------------------------------------- sections
 
 def _check_dimension(s: Scenario) -> None:
-    d = s.dimension
-    if not isinstance(d, numbers.Integral) or isinstance(d, bool) or d not in DIMENSIONS:
-        raise ScenarioError("dimension", d, "must be 2 (discs in the plane, the default) or 3 "
-                            "(spheres in space)")
+    check_dimension(s.dimension)
 
 
 #: The end of every message refusing a 3D field in a 2D scenario.
@@ -597,7 +592,7 @@ def _check_lengths(s: Scenario, boxed: bool = False) -> None:
     values += [(f"walls[{k}].point[{c}]", x) for k, w in enumerate(s.walls) if w.point is not None
                for c, x in enumerate(w.point)]
     if isinstance(s.plate, Solid) and is_box(s.plate):
-        values += [(f"plate.{f}[{k}]", getattr(s.plate, f)[k]) for f in ("origin", "size") for k in range(3)]
+        values += [(f"plate.{f}[{k}]", getattr(s.plate, f)[k]) for f in ("size", "origin") for k in range(3)]
     elif isinstance(s.plate, Plate):
         pl = s.plate
         values += [(f"plate.{f}", getattr(pl, f)) for f in ("x0", "y0", "width", "height", "thickness",
