@@ -402,7 +402,8 @@ FRICTION_BOUND_HINT = (
     "{name}: friction at granule contacts, integrated inside RK4 (solver.granular_friction = "
     "\"rk4\", the presets' setting), sets the step on most steps so far (t = {t:.4g} s): the run "
     "is slow for stability, not accuracy. solver.granular_friction = \"split\" integrates that "
-    "friction exactly, at any step (docs/model.md section 6.4).")
+    "friction exactly at any step, but its splitting error is outside the step control: check a "
+    "result against a run with solver.implicit_dt_max halved (docs/model.md section 6.4).")
 
 
 def friction_bound(count: np.ndarray) -> bool:
