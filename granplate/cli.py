@@ -11,6 +11,7 @@ import importlib
 import json
 import logging
 import sys
+import warnings
 from pathlib import Path
 
 from granplate.errors import ScenarioError, SimulationError
@@ -235,6 +236,30 @@ def show_notes(quiet: bool) -> None:
     logger.setLevel(logging.WARNING if quiet else logging.INFO)
 
 
+#: The package's folder: a warning raised from one of its modules prints as one line.
+_PACKAGE_DIR = Path(__file__).resolve().parent
+
+
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Show a warning the library raises as one line, `granplate: warning: ...`, on stderr
+    (not the file, line and source that Python shows); any other warning as Python does."""
+    if _PACKAGE_DIR in Path(filename).resolve().parents:
+        print(f"granplate: warning: {message}", file=sys.stderr if file is None else file, flush=True)
+    else:
+        _PYTHON_SHOWWARNING(message, category, filename, lineno, file, line)
+
+
+def show_warnings() -> None:
+    """The library's warnings on stderr as one line each (this process's own command line)."""
+    global _PYTHON_SHOWWARNING
+    if warnings.showwarning is not _one_line_warning:
+        _PYTHON_SHOWWARNING = warnings.showwarning
+        warnings.showwarning = _one_line_warning
+
+
+_PYTHON_SHOWWARNING = warnings.showwarning
+
+
 def _value_options(parser: argparse.ArgumentParser) -> set[str]:
     """The option strings of `parser` and its subcommands that take a value (--t-end, -o...)."""
     found: set[str] = set()
@@ -280,8 +305,10 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(join_negative_values(parser, sys.argv[1:] if argv is None else list(argv)))
     show_notes(bool(getattr(args, "quiet", False)))
-    if argv is None and getattr(args, "func", None) is _cmd_run:  # this process is the run's own
-        keep_dask_out()
+    if argv is None:  # this process is the command line's own
+        show_warnings()
+        if getattr(args, "func", None) is _cmd_run:
+            keep_dask_out()
     try:
         if getattr(args, "t_end", None) is not None:
             positive("time.t_end", args.t_end)  # the field's own check, before any command runs

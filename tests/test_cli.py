@@ -244,3 +244,21 @@ def test_a_run_process_writes_its_result_without_loading_dask(tmp_path):
     done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "", f"loaded: {done.stdout.strip()}"
+
+
+def test_the_library_warnings_print_as_one_line():
+    """Truth: in the command line's own process, a warning raised from a granplate module
+    prints as the single line `granplate: warning: MESSAGE` (no file, line or source line),
+    and a warning from elsewhere as Python prints it."""
+    import subprocess
+    import sys
+
+    probe = ("import warnings\nfrom granplate.cli import show_warnings\nshow_warnings()\n"
+             "import granplate.setup.fields as f\n"
+             "warnings.warn_explicit('the library says so', UserWarning, f.__file__, 1)\n"
+             "warnings.warn_explicit('another package says so', UserWarning, '/elsewhere/x.py', 3)\n")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    lines = done.stderr.splitlines()
+    assert lines[0] == "granplate: warning: the library says so"
+    assert lines[1] == "/elsewhere/x.py:3: UserWarning: another package says so"
