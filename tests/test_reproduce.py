@@ -140,8 +140,12 @@ def test_cli_plot_animate_export(first, tmp_path, capsys):
     assert main(["plot", str(out / "steel-r05.nc"), str(out / "ptfe-r05.nc"), "--figure", "fig7",
                  "--out", str(tmp_path)]) == 0
     assert main(["plot", str(out / "steel-r1.nc"), "--figure", "A.1", "--out", str(tmp_path)]) == 0
+    capsys.readouterr()
     assert main(["animate", str(out / "ptfe-r05.nc"), "-o", str(tmp_path / "a.gif"), "--frames", "2"]) == 0
     assert (tmp_path / "a.gif").stat().st_size > 0
+    assert "2/2" in capsys.readouterr().err  # the frames' progress on stderr
+    assert main(["animate", str(out / "ptfe-r05.nc"), "-o", str(tmp_path / "b.gif"), "--frames", "2", "-q"]) == 0
+    assert "frame" not in capsys.readouterr().err
     assert main(["export", str(out / "steel-r1.nc"), "--vtk", str(tmp_path / "vtk")]) == 0
     assert (tmp_path / "vtk" / "steel-r1.pvd").is_file()
 

@@ -133,15 +133,19 @@ def _limits(ds: xr.Dataset, snaps: np.ndarray, ti: np.ndarray, magnify: float) -
     return x_lo - pad, x_hi + pad, y_lo - 2.0, y_hi + 2.0
 
 
-def _save(fig: Figure, draw, n_frames: int, path: Path, fps: int, dpi: int) -> Path:
-    """Render the frames into path (.mp4 through imageio-ffmpeg, else .gif); the path written."""
+def _save(fig: Figure, draw, n_frames: int, path: Path, fps: int, dpi: int, progress: bool = False) -> Path:
+    """Render the frames into path (.mp4 through imageio-ffmpeg, else .gif); the path
+    written. progress: a bar of the frames rendered on stderr."""
     import matplotlib
+    from tqdm import tqdm
 
     def write(writer, target: Path) -> Path:
-        with writer.saving(fig, str(target), dpi):
+        with writer.saving(fig, str(target), dpi), \
+                tqdm(total=n_frames, desc=target.name, unit="frame", leave=False, disable=not progress) as bar:
             for f in range(n_frames):
                 draw(f)
                 writer.grab_frame()  # one render per frame
+                bar.update(1)
         return target
 
     ffmpeg = _ffmpeg_path() if path.suffix.lower() == ".mp4" else None
@@ -163,15 +167,17 @@ def animate(
     fps: int = 15,
     magnify: float = MAGNIFY,
     dpi: int = 90,
+    progress: bool = False,
 ) -> Path:
     """Write an animation of run `ds` to `path` (.mp4, or .gif) and return the path written.
 
     frames: at most this many frames (None: every field snapshot); fps: frames per
-    second; magnify: displacement magnification [-] (unused in space); dpi: resolution.
+    second; magnify: displacement magnification [-] (unused in space); dpi: resolution;
+    progress: a bar of the frames rendered on stderr.
     An .mp4 path falls back to .gif (Pillow) when ffmpeg is not available or fails.
     """
     if "z" in ds.variables:
-        return animate_space(ds, path, frames=frames, fps=fps, dpi=dpi)
+        return animate_space(ds, path, frames=frames, fps=fps, dpi=dpi, progress=progress)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     snaps = frame_indices(ds.sizes.get("field_time", 0), frames)
@@ -212,11 +218,11 @@ def animate(
 
     fig.canvas.draw()  # lay out once, then freeze the layout (re-solving it every frame is slow)
     fig.set_layout_engine("none")
-    return _save(fig, draw, len(snaps), path, fps, dpi)
+    return _save(fig, draw, len(snaps), path, fps, dpi, progress)
 
 
 def animate_space(ds: xr.Dataset, path: str | Path, *, frames: int | None = 120, fps: int = 15,
-                  dpi: int = 90) -> Path:
+                  dpi: int = 90, progress: bool = False) -> Path:
     """Write an animation of 3D run `ds` to `path` (.mp4, or .gif) and return the path
     written: per frame the three projections `granplate show` draws (`figures.space`),
     at the body's field snapshots for a run with an elastic body, else at the output
@@ -230,4 +236,4 @@ def animate_space(ds: xr.Dataset, path: str | Path, *, frames: int | None = 120,
     if indices.size == 0:
         raise ValueError("the result has no output times to animate")
     fig, draw = space.animation(space.frames_of_result(ds, indices))
-    return _save(fig, draw, len(indices), path, fps, dpi)
+    return _save(fig, draw, len(indices), path, fps, dpi, progress)

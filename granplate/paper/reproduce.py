@@ -483,7 +483,8 @@ def _cmd_animate(args) -> int:
         raise ScenarioError("-o", str(target), "allowed: a .mp4 or .gif file name")
     if "z" not in ds.variables and ds.sizes.get("field_time", 0) == 0:  # (in space: every output time)
         raise ScenarioError("result", args.result, "has no plate-field snapshots to animate")
-    written = animate(ds, target, frames=args.frames, fps=args.fps, magnify=args.magnify)
+    written = animate(ds, target, frames=args.frames, fps=args.fps, magnify=args.magnify,
+                      progress=not args.quiet)
     print(f"written {written}")
     return 0
 
@@ -564,6 +565,7 @@ def register(subparsers) -> None:
     a.add_argument("--fps", type=_positive_int, default=15, help="frames per second")
     a.add_argument("--magnify", type=float, default=125.0, help="the plate's displacement magnification "
                    "(in the plane; in space an elastic body is magnified as `granplate show` does)")
+    a.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     a.set_defaults(func=_cmd_animate)
 
     e = subparsers.add_parser("export", help="write a ParaView time series (VTK, .pvd) of a result")
