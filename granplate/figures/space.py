@@ -497,6 +497,12 @@ def _force_style(forces: np.ndarray, top: float | None = None):
 def _draw_view(ax, a: Assembly3D, view: tuple, colours: dict, lo, hi) -> int:
     """One projection of the region lo..hi [m]; returns the number of walls drawn as lines
     (each clipped to the region without its margin: a box's walls meet at its corners)."""
+    _view_axes(ax, view, lo, hi)
+    return _view_content(ax, a, view, colours)
+
+
+def _view_axes(ax, view: tuple, lo, hi) -> None:
+    """A projection's axes: the region lo..hi [m] at equal scales, labels [mm], title, grid."""
     u, v, d, sign = view
     ax.set_aspect("equal")
     ax.set_xlim(lo[u] * MM, hi[u] * MM)
@@ -505,6 +511,13 @@ def _draw_view(ax, a: Assembly3D, view: tuple, colours: dict, lo, hi) -> int:
     ax.set_ylabel(f"{AXIS_NAMES[v]} [mm]")
     toward = ("+" if sign > 0 else "-") + AXIS_NAMES[d]
     ax.set_title(f"{AXIS_NAMES[u]}-{AXIS_NAMES[v]}, seen from {toward}", fontsize=9, loc="left")
+    ax.grid(True, lw=0.3, alpha=0.4)
+
+
+def _view_content(ax, a: Assembly3D, view: tuple, colours: dict) -> int:
+    """What one projection shows of assembly a: the solid, the walls, the spheres far to
+    near, the contacts; returns the number of walls drawn as lines."""
+    u, v, d, sign = view
     _draw_solid(ax, a, view, colours)
     drawn = 0
     inner = bounds(a, margin=0.0)
@@ -533,7 +546,6 @@ def _draw_view(ax, a: Assembly3D, view: tuple, colours: dict, lo, hi) -> int:
             lines = LineCollection(segs, colors=cols, linewidths=widths, linestyles=styles, zorder=z_top,
                                    capstyle="round", gid=f"contacts:{AXIS_NAMES[u]}{AXIS_NAMES[v]}")
         ax.add_collection(lines)
-    ax.grid(True, lw=0.3, alpha=0.4)
     return drawn
 
 
@@ -695,9 +707,10 @@ def animation(frames: list[Assembly3D], width: float = 13.0):
 
     def draw_frame(f: int) -> None:
         a = frames[f]
-        for ax, view in zip(axes, PROJECTIONS):
-            ax.cla()
-            _draw_view(ax, a, view, colours, lo, hi)
+        for ax, view in zip(axes, PROJECTIONS):  # the axes stay; what they show is replaced
+            for artist in [*ax.patches, *ax.collections, *ax.lines, *ax.texts]:
+                artist.remove()
+            _view_content(ax, a, view, colours)
         _mark_loaded(axes, a)
         fig.suptitle(_title(a), fontsize=10, x=0.01, ha="left")  # the one title, its text replaced
 
