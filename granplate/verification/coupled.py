@@ -1,7 +1,7 @@
 """Convergence studies of the coupled runs (slow: `granplate verify --full`).
 
 For the PTFE and the steel R2 = R1 presets, the plate's peak and final share of E_shock
-and the maximum von Mises stress are recomputed with every step halved (time.dt_max and
+and the maximum von Mises stress (its point peak and its disc average) are recomputed with every step halved (time.dt_max and
 solver.lambda_target, twice), the iteration tolerance halved (twice), the element size
 halved (at a fixed rigid-layer width) and with other rigid-layer widths. Observed orders
 come from three levels, p = log2 |Q1 - Q2| / |Q2 - Q3|; the error bar of the default
@@ -31,7 +31,11 @@ QUANTITIES: tuple[tuple[str, str, str, float], ...] = (
     ("ep_max_fraction", "plate energy, peak / E_shock", "-", 1.0),
     ("ep_final_fraction", "plate energy, final / E_shock", "-", 1.0),
     ("max_von_mises", "max von Mises stress", "MPa", 1e-6),
+    ("max_von_mises_disc", "max von Mises stress, disc average", "MPa", 1e-6),
 )
+#: Quantities whose mesh studies are not checked: the point peak of a singular stress has
+#: no mesh limit (its disc average, the next quantity, is the one checked; the tables keep both).
+NO_MESH_LIMIT: tuple[str, ...] = ("max_von_mises",)
 #: Relative accuracy asked of the default settings.
 TARGET = 0.01
 TARGET_WHY = ("the paper quotes these figures to two significant digits at most ('a little over "
@@ -242,6 +246,19 @@ def study_tables(results: dict, preset: str) -> str:
     return "\n".join(out)
 
 
+def _disc_lines(results: dict) -> list[str]:
+    """Per preset: the point peak and the disc average [MPa] on the w = 5 mm meshes."""
+    study = STUDIES[3]
+    lines = []
+    for name in PRESETS:
+        runs = results[(name, study.name)]
+        point = ", ".join(f"{r['max_von_mises'] / 1e6:.1f}" for r in runs)
+        disc = ", ".join(f"{r['max_von_mises_disc'] / 1e6:.2f}" for r in runs)
+        lines.append(f"{name} on {', '.join(lab for lab, _ in study.levels)} (w = 5 mm): disc average "
+                     f"{disc} MPa, point peak {point} MPa")
+    return lines
+
+
 def coupled_convergence(ctx: Context) -> CaseResult:
     """The studies above for both presets, with checks on the default settings."""
     results: dict = {}
@@ -255,6 +272,8 @@ def coupled_convergence(ctx: Context) -> CaseResult:
             runs = results[(name, study.name)]
             d, f = runs[study.default], runs[study.default + 1]
             for k, lab, u, sc in QUANTITIES:
+                if k in NO_MESH_LIMIT and study.name.startswith("element size"):
+                    continue
                 checks.append(Check(
                     f"{lab}, {name}: default vs {study.levels[study.default + 1][0]} ({study.name.split(' (')[0]})",
                     u, f[k] * sc, "the same run with the parameter halved", d[k] * sc, TARGET, TARGET_WHY))
@@ -276,7 +295,7 @@ def coupled_convergence(ctx: Context) -> CaseResult:
             "than 1%.")
     notes = [
         "Time step and iteration tolerance are converged far beyond the paper's precision: "
-        "halving the step changes the three figures by less than 1e-4 of their value, halving "
+        "halving the step changes each figure by less than 1e-4 of its value, halving "
         "the iteration tolerance by less than 1e-8.",
         "The mesh is not converged for the stress: the maximum von Mises stress grows under "
         "refinement instead of converging, because it sits in the element next to the end of a "
@@ -284,7 +303,13 @@ def coupled_convergence(ctx: Context) -> CaseResult:
         "coarsest mesh, next to a corner where a clamped edge meets the free left edge; a point "
         "value of a singular stress has no mesh limit, and the reported maximum is a property of "
         "the mesh (and of sampling at the Gauss points). Locations of the maximum (from the "
-        "plate snapshots): " + "; ".join(loc_lines) + ".",
+        "plate snapshots): " + "; ".join(loc_lines) + ". Its mesh studies are therefore reported, "
+        "not checked: there is no limit to check against.",
+        "The disc average of the stress (discs of plate.stress_radius, 2.5 mm by default, a "
+        "quarter of the plate's width, the same on every mesh; docs/model.md section 4.4) "
+        "converges where the point peak grows: " + "; ".join(_disc_lines(results)) + ". It is "
+        "the stress the mesh studies check; at the default rigid-layer width its error bar "
+        "(above) is beyond the 1% asked, and those checks fail.",
         "The peak plate-energy share of the steel packing is mesh-converged (0.6% at the default "
         "w, 0.05% at w = 5 mm). For PTFE it converges at a fixed w = 5 mm with order about 2, but "
         "the default 4 x 40 mesh is 10-20% below the refined value: that is its error bar. The "
@@ -305,7 +330,7 @@ def coupled_convergence(ctx: Context) -> CaseResult:
 def draw_coupled_convergence(p: dict):
     """The figure of coupled_convergence, from its numbers."""
     results = p["results"]
-    fig, axes = new_figure(ncols=3, width=4.2, height=3.6)
+    fig, axes = new_figure(ncols=len(QUANTITIES), width=3.6, height=3.6)
     mesh_study = STUDIES[3]
     for ax, (k, lab, u, sc) in zip(axes[0], QUANTITIES):
         for name, marker in zip(PRESETS, ("o", "s")):
