@@ -61,3 +61,22 @@ def test_a_continuous_radius_is_valid_and_a_geometric_failure_names_the_granule_
     status = D.run_design(gp.dumps(refused))["status"]
     assert status.startswith("ScenarioError: scenario field 'plate.n_modes' = 30: granule 'c2r")
     assert "layout.column_radii" in status and "contact 0" not in status and "plate.ny" not in status
+
+
+def test_a_design_keeps_its_warnings_and_prints_none():
+    """Truth: a design whose run warns (overlaps beyond a tiny contact.overlap_warn) returns
+    the warning as one line in its outcome, once however often it was raised, and none
+    escapes the task (a worker would print it); a run that does not warn keeps none."""
+    import warnings
+
+    s = gp.with_changes(gp.load_scenario("ptfe-r05"), {"time.t_end": 1e-5})
+    with warnings.catch_warnings(record=True) as leaked:
+        warnings.simplefilter("always")
+        noisy = D.run_design(gp.dumps(gp.with_changes(s, {"contact.overlap_warn": 1e-6})))
+        quiet = D.run_design(gp.dumps(s))
+    assert leaked == []
+    assert noisy["status"] == quiet["status"] == "ok"
+    assert len(noisy["warnings"]) == 1 and noisy["warnings"][0].startswith("RuntimeWarning: ptfe-r05: ")
+    assert "contact.overlap_warn" in noisy["warnings"][0] and "\n" not in noisy["warnings"][0]
+    assert quiet["warnings"] == []
+    assert D.make_record("k", {}, "", noisy)["warnings"] == noisy["warnings"]

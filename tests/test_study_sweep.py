@@ -279,3 +279,20 @@ def test_cli_optimize_with_failing_trials_exits_1_and_labels_its_bar(client, tmp
     assert rc == 1
     assert err.strip().splitlines()[-1] == "granplate: 2 of 2 trials of this run failed"
     assert "optimize:" in err and "sweep:" not in err
+
+
+def test_cli_sweep_says_how_many_designs_warned_and_keeps_their_warnings(client, tmp_path, capsys):
+    """Truth: of two designs one warns (overlaps beyond a tiny contact.overlap_warn): the
+    workers print nothing, the sweep's stderr says 1 of the 2 designs warned with that
+    design's warning, its record lists it, and the other's record has none."""
+    (tmp_path / "s.toml").write_text('base = "ptfe-r05"\n[set]\n"time.t_end" = 1e-5\n'
+                                     '[parameters]\n"contact.overlap_warn" = [0.05, 1e-6]\n')
+    rc = main(["sweep", str(tmp_path / "s.toml"), "--out", str(tmp_path / "o"),
+               "--scheduler", client.scheduler.address, "-q", "--no-report"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 0
+    assert err[-1].startswith("granplate: 1 of the 2 designs computed now warned (each record in designs/ "
+                              "lists its warnings); the first, design 1: RuntimeWarning: ptfe-r05: ")
+    ds = table(tmp_path / "o" / "results.nc")
+    records = [read_record(tmp_path / "o", k) for k in ds.key.values]
+    assert records[0]["warnings"] == [] and len(records[1]["warnings"]) == 1

@@ -33,6 +33,14 @@ def _report(out: str, enabled: bool, progress: bool) -> None:
     print(f"report: {page}")
 
 
+def _warned(report, computed: str) -> None:
+    """One line on stderr when designs computed now warned: how many, and the first warning
+    (each design's record, DIR/designs/KEY.json, lists its own)."""
+    if report.n_warned:
+        print(f"granplate: {report.n_warned} of the {report.n_computed} {computed} warned (each record in "
+              f"designs/ lists its warnings); the first, {report.first_warning}", file=sys.stderr)
+
+
 def _verdict(n_failed: int, n_lost: int, n_total: int, what: str) -> int:
     """The exit status of a study command, 1 when any design failed or was lost, 0 else;
     that case is said on the last line (stderr)."""
@@ -71,6 +79,7 @@ def _cmd_sweep(args) -> int:
         print(f"... and {len(report.lost) - MAX_LOST_LINES} more lost designs", file=sys.stderr)
     print(f"table: {report.out / RESULTS_NC}, {report.out / RESULTS_CSV}")
     _report(args.out, args.report, not args.quiet)
+    _warned(report, "designs computed now")
     return _verdict(report.n_failed, len(report.lost), report.n_designs, "designs")
 
 
@@ -97,6 +106,7 @@ def _cmd_optimize(args) -> int:
     out = report.out
     print(f"study: {out / DATABASE}; trials: {out / TRIALS_CSV}; Pareto front: {out / PARETO_CSV}, {out / PARETO_PNG}")
     _report(args.out, args.report, not args.quiet)
+    _warned(report, "trials computed now")
     return _verdict(report.n_failed, 0, args.trials - report.n_before, "trials of this run")
 
 

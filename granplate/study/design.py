@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import time
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -80,9 +81,33 @@ def failure_message(err: BaseException) -> str:
     return f"{type(err).__name__}: {err}".replace("\n", " ")
 
 
+#: At most this many distinct warnings of a design's run are kept in its record.
+MAX_WARNINGS = 5
+
+
+def run_warnings(caught: list) -> list[str]:
+    """The distinct warnings a design's run raised, one line each ("Category: message"),
+    at most MAX_WARNINGS, in the order raised."""
+    out: list[str] = []
+    for w in caught:
+        line = f"{w.category.__name__}: {w.message}".replace("\n", " ")
+        if line not in out:
+            out.append(line)
+    return out[:MAX_WARNINGS]
+
+
+def note_warnings(report, label: str, outcome: dict) -> None:
+    """Count a design whose run warned in a sweep's or an optimisation's report (n_warned),
+    and keep the first such warning (first_warning, "LABEL: warning")."""
+    if outcome.get("warnings"):
+        report.n_warned += 1
+        if not report.first_warning:
+            report.first_warning = f"{label}: {outcome['warnings'][0]}"
+
+
 def run_design(scenario_toml: str, full: bool = False) -> dict[str, Any]:
     """Simulate one design (runs on a worker): {"status", "summary", "elapsed_s",
-    "timings", "result"}.
+    "timings", "result", "warnings"}.
 
     status is "ok" or the failure message (a scenario the physics refuses, a run that goes
     numerically wrong, or any other error: a failing design never stops a sweep); summary
@@ -91,26 +116,31 @@ def run_design(scenario_toml: str, full: bool = False) -> dict[str, Any]:
     loop seconds and the loop's CPU seconds (`timings`), the summary's (summary_s: the result and its metrics after
     the loop) and the task's CPU seconds (cpu_s; {} on failure); result the Dataset when full, else None (and then only
     what the summary reads is computed, unless the design keeps its plate fields at every
-    output time, `keeps_every_field`, for the nodal stress).
+    output time, `keeps_every_field`, for the nodal stress); warnings the distinct warnings
+    the run raised (`run_warnings`), kept in the record instead of printed by the worker
+    (the sweep counts them).
     """
     t0, c0 = time.perf_counter(), time.thread_time()
     ds = summary = None
     after_loop = 0.0
-    try:
-        scenario = gp.loads(scenario_toml)
-        t1 = time.perf_counter()
-        ds = gp.simulate(scenario, progress=False, summary_only=not (full or keeps_every_field(scenario)))
-        summary = metrics(ds)
-        after_loop = time.perf_counter() - t1 - float(ds.attrs.get("wall_time_s", 0.0))
-        status = "ok"
-    except GranplateError as err:
-        status = failure_message(err)
-    except Exception as err:  # noqa: BLE001 - recorded as the design's failure
-        status = failure_message(err)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            scenario = gp.loads(scenario_toml)
+            t1 = time.perf_counter()
+            ds = gp.simulate(scenario, progress=False, summary_only=not (full or keeps_every_field(scenario)))
+            summary = metrics(ds)
+            after_loop = time.perf_counter() - t1 - float(ds.attrs.get("wall_time_s", 0.0))
+            status = "ok"
+        except GranplateError as err:
+            status = failure_message(err)
+        except Exception as err:  # noqa: BLE001 - recorded as the design's failure
+            status = failure_message(err)
     return {"status": status, "summary": summary, "elapsed_s": time.perf_counter() - t0,
             "timings": ({**timings(ds), "summary_s": after_loop, "cpu_s": time.thread_time() - c0}
                         if summary is not None else {}),
-            "result": ds if full and summary is not None else None}
+            "result": ds if full and summary is not None else None,
+            "warnings": run_warnings(caught)}
 
 
 def timings(ds) -> dict[str, float]:
@@ -134,7 +164,7 @@ def make_record(key: str, changes: dict, scenario_toml: str, outcome: dict) -> d
     return {"key": key, "granplate_version": gp.__version__, "status": outcome["status"],
             "changes": changes, "summary": outcome["summary"],
             "elapsed_s": outcome["elapsed_s"], "timings": outcome.get("timings", {}),
-            "scenario_toml": scenario_toml}
+            "warnings": outcome.get("warnings", []), "scenario_toml": scenario_toml}
 
 
 def write_record(out: str | Path, record: dict, result=None) -> Path:

@@ -78,7 +78,8 @@ class Optimization:
 
 @dataclass
 class OptimizeReport:
-    """Trials finished before this run, computed now, told from existing records, failed."""
+    """Trials finished before this run, computed now, told from existing records, failed;
+    the trials computed now whose run warned (n_warned) and the first of their warnings."""
 
     n_trials: int
     n_before: int
@@ -87,6 +88,8 @@ class OptimizeReport:
     n_failed: int = 0
     elapsed_s: float = 0.0
     warm_up_s: float = 0.0
+    n_warned: int = 0
+    first_warning: str = ""
     out: Path = Path(".")
 
 
@@ -340,6 +343,7 @@ def _search(client, study, opt: Optimization, out: Path, trials: int, progress: 
             record = D.make_record(key, changes, text, outcome)
             D.write_record(out, record)
             report.n_computed += 1
+            D.note_warnings(report, f"trial {trial.number}", outcome)
             finish(trial, record)
     finally:
         bar.close()

@@ -19,6 +19,7 @@ import dataclasses
 import hashlib
 import math
 import sys
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -214,7 +215,8 @@ def _save(fig, path: Path) -> Path:
 
 def design_result(folder: Path, key: str, progress: bool = False):
     """The full result of a design: its kept designs/KEY.nc, else a new run of its
-    scenario (the record's scenario_toml); None when it has no record."""
+    scenario (the record's scenario_toml; its warnings, which the record holds, not shown
+    again); None when it has no record."""
     record = D.read_record(folder, key)
     if record is None:
         return None
@@ -223,7 +225,9 @@ def design_result(folder: Path, key: str, progress: bool = False):
         return gp.read(nc)
     if progress:
         print(f"report: re-running design {key[:12]} for its figures", file=sys.stderr)
-    return gp.simulate(gp.loads(record["scenario_toml"]), progress=False)
+    with warnings.catch_warnings():  # what the run warns of is in its record already
+        warnings.simplefilter("ignore")
+        return gp.simulate(gp.loads(record["scenario_toml"]), progress=False)
 
 
 def design_figures(folder: Path, key: str, progress: bool = False) -> list[tuple[str, Path]]:

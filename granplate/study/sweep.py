@@ -40,7 +40,8 @@ class SweepReport:
     """What a sweep did: designs in the study, found already done, computed now, failed
     (among all recorded), lost (a task that did not come back: no record, a rerun retries);
     the seconds of the whole sweep, of the designs' tasks (compute_s), of writing their
-    records (store_s) and of the workers' warm-up."""
+    records (store_s) and of the workers' warm-up; the designs computed now whose run
+    warned (n_warned; each record lists its warnings) and the first of those warnings."""
 
     n_designs: int
     n_done_before: int
@@ -51,6 +52,8 @@ class SweepReport:
     compute_s: float = 0.0
     store_s: float = 0.0
     warm_up_s: float = 0.0
+    n_warned: int = 0
+    first_warning: str = ""
     out: Path = Path(".")
 
 
@@ -150,6 +153,7 @@ def _run(client, study: Study, out: Path, todo: list[tuple[str, int]], texts: li
             report.store_s += time.perf_counter() - t_store
             report.n_computed += 1
             report.compute_s += outcome["elapsed_s"]
+            D.note_warnings(report, f"design {i}", outcome)
             bar.update(1)
             if outcome["status"] != "ok":
                 bar.write(f"design {i} failed: {outcome['status']}", file=sys.stderr)
