@@ -255,14 +255,19 @@ def test_a_killed_worker_loses_no_design(tmp_path):
     assert undisturbed.n_computed == 12
 
 
+def cli_sweep(client, tmp_path: Path, capsys, parameter: str) -> tuple[int, list[str]]:
+    """`granplate sweep` (quiet, no report) of two 1e-5 s designs of ptfe-r05 varying one
+    parameter (a TOML line of [parameters]) into tmp_path/o: (exit status, stderr lines)."""
+    (tmp_path / "s.toml").write_text(f'base = "ptfe-r05"\n[set]\n"time.t_end" = 1e-5\n[parameters]\n{parameter}\n')
+    rc = main(["sweep", str(tmp_path / "s.toml"), "--out", str(tmp_path / "o"),
+               "--scheduler", client.scheduler.address, "-q", "--no-report"])
+    return rc, capsys.readouterr().err.strip().splitlines()
+
+
 def test_cli_sweep_with_a_failing_design_exits_1_and_says_how_many(client, tmp_path, capsys):
     """Truth: of two designs one has a negative load (refused when it runs): the sweep
     exits 1 and its last line says 1 of 2 designs failed."""
-    (tmp_path / "s.toml").write_text('base = "ptfe-r05"\n[set]\n"time.t_end" = 1e-5\n'
-                                     '[parameters]\n"load.q0" = [1e4, -1.0]\n')
-    rc = main(["sweep", str(tmp_path / "s.toml"), "--out", str(tmp_path / "o"),
-               "--scheduler", client.scheduler.address, "-q", "--no-report"])
-    err = capsys.readouterr().err.strip().splitlines()
+    rc, err = cli_sweep(client, tmp_path, capsys, '"load.q0" = [1e4, -1.0]')
     assert rc == 1
     assert err[-1] == "granplate: 1 of 2 designs failed"
 
@@ -285,11 +290,7 @@ def test_cli_sweep_says_how_many_designs_warned_and_keeps_their_warnings(client,
     """Truth: of two designs one warns (overlaps beyond a tiny contact.overlap_warn): the
     workers print nothing, the sweep's stderr says 1 of the 2 designs warned with that
     design's warning, its record lists it, and the other's record has none."""
-    (tmp_path / "s.toml").write_text('base = "ptfe-r05"\n[set]\n"time.t_end" = 1e-5\n'
-                                     '[parameters]\n"contact.overlap_warn" = [0.05, 1e-6]\n')
-    rc = main(["sweep", str(tmp_path / "s.toml"), "--out", str(tmp_path / "o"),
-               "--scheduler", client.scheduler.address, "-q", "--no-report"])
-    err = capsys.readouterr().err.strip().splitlines()
+    rc, err = cli_sweep(client, tmp_path, capsys, '"contact.overlap_warn" = [0.05, 1e-6]')
     assert rc == 0
     assert err[-1].startswith("granplate: 1 of the 2 designs computed now warned (each record in designs/ "
                               "lists its warnings); the first, design 1: RuntimeWarning: ptfe-r05: ")
