@@ -52,3 +52,8 @@ def script_module(path: Path, name: str):
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def section_titles(blocks) -> list[str]:
+    """The titles of a report's sections and subsections (its h2 and h3 blocks)."""
+    return [b.text for b in blocks if b.kind in ("h2", "h3")]

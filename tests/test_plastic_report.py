@@ -20,6 +20,7 @@ from granplate.results.dataset import pair_table, summary
 from granplate.setup.presets import preset, preset_names
 
 from short_results import T_END, short_results
+from conftest import section_titles
 
 
 @pytest.fixture(scope="module")
@@ -124,10 +125,9 @@ def test_run_table_shows_each_runs_largest_p0(elastic):
 
 def test_report_has_the_section_only_with_twins(elastic, twins):
     """build_report adds "Contacts that yield" when given twins, and not without them."""
-    titles = lambda blocks: [b.text for b in blocks if b.kind in ("h2", "h3")]  # noqa: E731
-    assert "Contacts that yield" not in titles(report.build_report(elastic, {}))
+    assert "Contacts that yield" not in section_titles(report.build_report(elastic, {}))
     blocks = report.build_report(elastic, {}, twins=twins)
-    assert "Contacts that yield" in titles(blocks)
+    assert "Contacts that yield" in section_titles(blocks)
     tables = [b for b in blocks if b.kind == "table" and b.header == pl.CASE_HEADER]
     assert len(tables) == 1 and tables[0].rows == tuple(pl.case_table(elastic, twins))
 

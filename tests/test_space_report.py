@@ -17,6 +17,7 @@ from granplate.paper import reproduce as rp
 from granplate.paper import space as sp
 from granplate.results.dataset import read, summary
 from granplate.setup.presets import preset_names
+from conftest import section_titles
 
 T_END = 2e-5  # the shock half over: every code path of both dimensions, seconds of work
 
@@ -207,9 +208,8 @@ def test_report_has_the_section_only_with_3d(run3d):
     out, _ = run3d
     plane = {n: read(out / f"{n}.nc") for n in preset_names()}
     space = {n: read(out / "3d" / f"{n}.nc") for n in preset_names()}
-    titles = lambda blocks: [b.text for b in blocks if b.kind in ("h2", "h3")]  # noqa: E731
-    assert "The paper in 3D" not in titles(report.build_report(plane, {}))
+    assert "The paper in 3D" not in section_titles(report.build_report(plane, {}))
     blocks = report.build_report(plane, {}, space=space)
-    assert "The paper in 3D" in titles(blocks)
+    assert "The paper in 3D" in section_titles(blocks)
     tables = [b for b in blocks if b.kind == "table" and b.header == sp.CASE_HEADER]
     assert len(tables) == 1 and tables[0].rows == tuple(sp.case_table(plane, space))

@@ -52,6 +52,17 @@ def _caption(fig: Figure, ds: xr.Dataset, what: str) -> None:
                   f"granplate {ds.attrs.get('granplate_version', '?')}", fontsize=7, color="0.35")
 
 
+def _finish(fig: Figure, ds: xr.Dataset, axes, what: str) -> Figure:
+    """Stacked panels over the run's time: each a time axis [ms], the x label on the lowest
+    only, and the caption (`_caption`); the figure."""
+    for ax in axes:
+        time_axis(ax, _end_ms(ds))
+    for ax in axes[:-1]:
+        ax.set_xlabel("")
+    _caption(fig, ds, what)
+    return fig
+
+
 def reference_label(ds: xr.Dataset) -> str:
     """The name of the energy the fractions are of: E_shock for a run from rest, E_initial
     for a run without a load, else E_shock + E_initial (see `analysis.reference_energy`)."""
@@ -137,12 +148,7 @@ def fig_energies(ds: xr.Dataset) -> Figure:
     c.set_title("(c) energy-balance residual (eq. 11): (E_p + E_g + D - E_shock - E_initial) / E_in",
                 loc="left", fontsize=9)
     c.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
-    for ax in (a, b, c):
-        time_axis(ax, _end_ms(ds))
-    a.set_xlabel("")
-    b.set_xlabel("")
-    _caption(fig, ds, "energies")
-    return fig
+    return _finish(fig, ds, (a, b, c), "energies")
 
 
 def fig_contact_forces(ds: xr.Dataset) -> Figure:
@@ -164,11 +170,7 @@ def fig_contact_forces(ds: xr.Dataset) -> Figure:
     b.set_title("(b) friction force on the plate (+y)", loc="left", fontsize=10)
     a.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False,
              title="contact: the granule\ntouching the plate", title_fontsize=8)
-    for ax in (a, b):
-        time_axis(ax, _end_ms(ds))
-    a.set_xlabel("")
-    _caption(fig, ds, "plate contact forces")
-    return fig
+    return _finish(fig, ds, (a, b), "plate contact forces")
 
 
 def fig_stress_strain(ds: xr.Dataset) -> Figure:
@@ -183,11 +185,7 @@ def fig_stress_strain(ds: xr.Dataset) -> Figure:
     b.set_ylabel("max |eps_yy| [-]")
     b.ticklabel_format(axis="y", style="sci", scilimits=(-3, 3))
     b.set_title("(b) largest |eps_yy| over the plate", loc="left", fontsize=10)
-    for ax in (a, b):
-        time_axis(ax, _end_ms(ds))
-    a.set_xlabel("")
-    _caption(fig, ds, "plate stress and strain")
-    return fig
+    return _finish(fig, ds, (a, b), "plate stress and strain")
 
 
 def granule_speeds(ds: xr.Dataset) -> np.ndarray:
@@ -215,9 +213,7 @@ def fig_granule_speeds(ds: xr.Dataset) -> Figure:
         ax.set_title(f"granule speeds: envelope and the {FASTEST} fastest granules", loc="left", fontsize=10)
     ax.set_ylabel("speed |v| [m/s]")
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
-    time_axis(ax, _end_ms(ds))
-    _caption(fig, ds, "granule speeds")
-    return fig
+    return _finish(fig, ds, (ax,), "granule speeds")
 
 
 def has_body(ds: xr.Dataset) -> bool:
@@ -245,11 +241,7 @@ def fig_body_stress(ds: xr.Dataset) -> Figure:
     b.plot(t, ds["max_displacement"].values * 1e6, color="tab:blue", lw=1.3, gid="max_displacement")
     b.set_ylabel("largest |u| [um]")
     b.set_title("(b) largest displacement of the body", loc="left", fontsize=10)
-    for ax in (a, b):
-        time_axis(ax, _end_ms(ds))
-    a.set_xlabel("")
-    _caption(fig, ds, "body stress and displacement")
-    return fig
+    return _finish(fig, ds, (a, b), "body stress and displacement")
 
 
 def body_touching(ds: xr.Dataset) -> list[int]:
@@ -283,9 +275,7 @@ def fig_body_contact_forces(ds: xr.Dataset) -> Figure:
                 rtol=FORCE_COINCIDE, lw=1.2)
     ax.set_ylabel("normal force on the body [N]")
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
-    time_axis(ax, _end_ms(ds))
-    _caption(fig, ds, "body contact forces")
-    return fig
+    return _finish(fig, ds, (ax,), "body contact forces")
 
 
 FIGURES = {
