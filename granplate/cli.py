@@ -1,4 +1,5 @@
-"""Command line: `granplate run | presets | preset`.
+"""Command line: `granplate run | presets | preset` (run, show, sweep, optimize, preset and
+resolve take `--set PATH=VALUE` to change a field by its dotted path).
 
 A user's mistake (bad scenario, unknown preset, missing file) prints one clear line and
 exits with status 2, never a traceback; a run that goes numerically wrong prints why,
@@ -15,6 +16,7 @@ import warnings
 from pathlib import Path
 
 from granplate.errors import ScenarioError, SimulationError
+from granplate.figures.cli import add_set_option
 from granplate.setup.fields import positive
 
 #: modules that add subcommands: each defines register(subparsers), adding parsers whose
@@ -124,10 +126,10 @@ def keep_dask_out() -> None:
 
 def _cmd_run(args) -> int:
     from granplate.results.dataset import summary
-    from granplate.setup.io import load_scenario
+    from granplate.setup.io import load_scenario, parse_settings
     from granplate.results.run import interrupted, simulate
 
-    scenario = load_scenario(args.scenario)
+    scenario = load_scenario(args.scenario, parse_settings(args.settings))
     out = Path(args.output) if args.output else Path(f"{scenario.name}.nc")
     try:
         ds = simulate(scenario, t_end=args.t_end, progress=not args.quiet)
@@ -163,11 +165,17 @@ def _cmd_presets(args) -> int:
 
 def _cmd_preset(args) -> int:
     from granplate.setup.presets import preset
-    from granplate.setup.io import dumps
+    from granplate.setup.io import dumps, parse_settings, with_changes
+    from granplate.setup.validate import validate
 
     from granplate.commands import emit_text
 
-    emit_text(dumps(preset(args.name)), args.output)
+    scenario = preset(args.name)
+    changes = parse_settings(args.settings)
+    if changes:
+        scenario = with_changes(scenario, changes)
+        validate(scenario)
+    emit_text(dumps(scenario), args.output)
     return 0
 
 
@@ -198,12 +206,14 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--summary", help="also write the summary as JSON to this file")
     r.add_argument("--t-end", type=float, default=None, help="simulated time [s] (overrides the scenario)")
     r.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    add_set_option(r)
     r.set_defaults(func=_cmd_run)
     ps = sub.add_parser("presets", help="list the built-in presets")
     ps.set_defaults(func=_cmd_presets)
     pr = sub.add_parser("preset", help="print a preset as TOML (to edit and run)")
     pr.add_argument("name")
     pr.add_argument("-o", "--output", help="write to this file instead of stdout")
+    add_set_option(pr, "the preset (the file written is the changed scenario)")
     pr.set_defaults(func=_cmd_preset)
     ca = sub.add_parser("cache", help="show or clear the on-disk cache (plate models, reused runs)")
     ca.add_argument("action", choices=("info", "clear"), help="info: entries and size per kind; clear: remove")

@@ -2,6 +2,7 @@
 
     granplate show steel-r1 -o steel-r1.png          # a preset, before the run
     granplate show my.toml                           # a scenario file
+    granplate show ptfe-r05 --set layout.R2_ratio=0.7  # a preset with a field changed
     granplate show steel-r1.nc --time 8e-5 -o t.png  # a result at t = 0.08 ms
     granplate plot steel-r1.nc --out figs            # figs/steel-r1-energies.png, ...
 
@@ -30,13 +31,24 @@ def _read_result(path: str):
         raise ScenarioError("result", path, f"not a readable netCDF result ({type(err).__name__})") from None
 
 
-def show_figure(target: str, time: float | None = None):
-    """The figure of a scenario (TOML file or preset name) or of a result file at `time`
-    [s]; (figure, default output name)."""
+def add_set_option(parser, what: str = "the scenario") -> None:
+    """The repeatable `--set PATH=VALUE` option (its texts in `args.settings`)."""
+    parser.add_argument("--set", dest="settings", action="append", default=[], metavar="PATH=VALUE",
+                        help=f"change a field of {what} by its dotted path, the value written as in "
+                             "TOML (load.q0=3e4, layout.intruder_material=\"steel\", "
+                             "granules[0].vx=1.5); repeatable; checked as the file is")
+
+
+def show_figure(target: str, time: float | None = None, changes: dict | None = None):
+    """The figure of a scenario (TOML file or preset name, with `changes` by dotted path) or
+    of a result file at `time` [s]; (figure, default output name)."""
     from granplate.figures import assembly, show, space
     from granplate.setup.io import load_scenario
 
     if Path(target).suffix.lower() in RESULT_SUFFIXES:
+        if changes:
+            raise ScenarioError("--set", ", ".join(changes), "allowed only with a scenario, not a "
+                                "result file (.nc)")
         ds = _read_result(target)
         if space.is_space(ds):
             a = space.of_result(ds, time)
@@ -45,7 +57,7 @@ def show_figure(target: str, time: float | None = None):
     else:
         if time is not None:
             raise ScenarioError("--time", time, "allowed only with a result file (.nc), not a scenario")
-        scenario = load_scenario(target)
+        scenario = load_scenario(target, changes)
         if scenario.dimension == 3:
             a = space.of_scenario(scenario)
             return space.draw(a), f"{a.name}.png"
@@ -54,7 +66,9 @@ def show_figure(target: str, time: float | None = None):
 
 
 def _cmd_show(args) -> int:
-    fig, default = show_figure(args.target, args.time)
+    from granplate.setup.io import parse_settings
+
+    fig, default = show_figure(args.target, args.time, parse_settings(args.settings))
     out = Path(args.output) if args.output else Path(default)
     if out.suffix.lower() not in (".png", ".pdf", ".svg"):
         raise ScenarioError("-o", str(out), "allowed: a .png, .pdf or .svg file name")
@@ -145,4 +159,5 @@ def register(subparsers) -> None:
                         "snapshot of the largest von Mises stress; else the last output)")
     s.add_argument("--dpi", type=_dpi, default=PNG_DPI, help=f"resolution of a .png [dots per inch] "
                    f"(default {PNG_DPI})")
+    add_set_option(s, "a scenario")
     s.set_defaults(func=_cmd_show)

@@ -6,7 +6,8 @@
   *shape* (unknown keys, missing required fields, wrong types), not the physics.
 - `load_scenario(name_or_path)`: a preset or a TOML file, validated (`validate`).
 - `with_changes(s, {"load.q0": 1e4, "layout.R2_ratio": 0.5})`: tweak by dotted paths; the
-  description then lists the changes.
+  description then lists the changes. `parse_settings(["load.q0=3e4"])`: the same changes
+  written PATH=VALUE with TOML values (the command line's `--set`).
 
 Every error is a `ScenarioError` naming the field by its dotted path (`plate.nx`,
 `granules[2].radius`, `materials.ptfe.nu`; array indices 0-based, in file order).
@@ -448,8 +449,10 @@ def dump(s: Scenario, path: str | os.PathLike, all_materials: bool = False) -> N
         f.write(dumps(s, all_materials=all_materials).encode("utf-8"))
 
 
-def load_scenario(path_or_preset: str | os.PathLike) -> Scenario:
-    """A validated scenario: the preset of that name, or else the TOML file at that path.
+def load_scenario(path_or_preset: str | os.PathLike,
+                  changes: dict[str, object] | None = None) -> Scenario:
+    """A validated scenario: the preset of that name, or else the TOML file at that path,
+    with `changes` (dotted path -> value, as `with_changes`) applied before it is validated.
 
     The scenario is returned as written (not resolved; `geometry.resolve` expands it).
     """
@@ -464,6 +467,8 @@ def load_scenario(path_or_preset: str | os.PathLike) -> Scenario:
             raise ScenarioError("file", key, "no such file or preset; presets are: "
                                 + ", ".join(presets.preset_names(True)))
         s = load(key)
+    if changes:
+        s = with_changes(s, changes)
     validate(s)
     return s
 
@@ -586,5 +591,49 @@ def with_changes(s: Scenario, changes: dict[str, object]) -> Scenario:
     return from_dict(d)
 
 
+# --------------------------------------------------------------------------- PATH=VALUE
+
+#: A bare word taken as a string when it is no TOML value (--set layout.intruder_material=ptfe).
+_BARE_WORD = re.compile(r"^[A-Za-z_][A-Za-z0-9_.+-]*$")
+
+
+def toml_value(path: str, text: str) -> Any:
+    """The value of field `path` written as a TOML literal: 3e4, 40, "steel", [1, 2], true.
+
+    Also taken: a number TOML itself refuses (.5, 5.) and a bare word as a string (steel).
+    Anything else is a ScenarioError naming the field.
+    """
+    try:
+        table = tomllib.loads(f"value = {text}")
+    except tomllib.TOMLDecodeError as e:
+        try:
+            return float(text)
+        except ValueError:
+            pass
+        if _BARE_WORD.match(text):
+            return text
+        raise ScenarioError(path, text, f"not a TOML value (a number, \"text\", [1, 2], true or "
+                            f"false): {e}") from None
+    if set(table) != {"value"}:
+        raise ScenarioError(path, text, "one TOML value expected (a number, \"text\", [1, 2], "
+                            "true or false)")
+    return table["value"]
+
+
+def parse_settings(items: list[str] | tuple[str, ...]) -> dict[str, object]:
+    """{dotted path: value} of "PATH=VALUE" texts (the command line's --set), in order (a
+    path given twice keeps its last value); values are TOML literals (`toml_value`)."""
+    changes: dict[str, object] = {}
+    for item in items:
+        path, sep, text = item.partition("=")
+        path, text = path.strip(), text.strip()
+        if not sep or not path:
+            raise ScenarioError("--set", item, "expected PATH=VALUE, e.g. load.q0=3e4 or "
+                                "layout.intruder_material=\"steel\"")
+        _split(path)
+        changes[path] = toml_value(path, text)
+    return changes
+
+
 __all__ = ["from_dict", "to_dict", "loads", "load", "dumps", "dump", "load_scenario",
-           "with_changes", "describe_changes", "CHANGED", "UNLISTED", "REQUIRED", "CHOICES", "MATERIAL_KEYS", "MATERIAL_REQUIRED", "MISSING"]
+           "with_changes", "describe_changes", "parse_settings", "toml_value", "CHANGED", "UNLISTED", "REQUIRED", "CHOICES", "MATERIAL_KEYS", "MATERIAL_REQUIRED", "MISSING"]

@@ -9,17 +9,27 @@ import shutil
 import sys
 from pathlib import Path
 
+from granplate.figures.cli import add_set_option
+
 #: Lost designs listed one by one (a lost scheduler loses every design not done).
 MAX_LOST_LINES = 5
 
 
-def keep_study_file(study_file: str, out: str) -> None:
-    """Copy the study file into the output folder (DIR/study.toml) for the report."""
+def keep_study_file(study_file: str, out: str, changes: dict | None = None) -> None:
+    """Copy the study file into the output folder (DIR/study.toml) for the report; with
+    `changes` (--set), the study as run: its table with them in [set], under a comment."""
+    import tomli_w
+
     from granplate.study.outcome import STUDY_FILE
+    from granplate.study.spec import read_document, with_settings
 
     Path(out).mkdir(parents=True, exist_ok=True)
     target = Path(out) / STUDY_FILE
-    if Path(study_file).resolve() != target.resolve():
+    if changes:
+        doc = with_settings(read_document(study_file), changes)
+        target.write_text(f"# {Path(study_file).name} with --set "
+                          + ", ".join(changes) + " (in [set] below)\n" + tomli_w.dumps(doc))
+    elif Path(study_file).resolve() != target.resolve():
         shutil.copyfile(study_file, target)
 
 
@@ -52,11 +62,13 @@ def _verdict(n_failed: int, n_lost: int, n_total: int, what: str) -> int:
 
 
 def _cmd_sweep(args) -> int:
+    from granplate.setup.io import parse_settings
     from granplate.study.spec import load_study
     from granplate.study.sweep import RESULTS_CSV, RESULTS_NC, sweep
 
-    study = load_study(args.study)
-    keep_study_file(args.study, args.out)
+    changes = parse_settings(args.settings)
+    study = load_study(args.study, changes)
+    keep_study_file(args.study, args.out, changes)
     if args.workers is not None and args.workers < 1:
         print(f"granplate: error: --workers = {args.workers}: must be >= 1", file=sys.stderr)
         return 2
@@ -86,12 +98,15 @@ def _cmd_sweep(args) -> int:
 def _cmd_optimize(args) -> int:
     from granplate.study.optimize import DATABASE, PARETO_CSV, PARETO_PNG, TRIALS_CSV, load_optimization, optimize
 
-    opt = load_optimization(args.study)
+    from granplate.setup.io import parse_settings
+
+    changes = parse_settings(args.settings)
+    opt = load_optimization(args.study, changes)
     for name, value in (("--trials", args.trials), ("--workers", args.workers)):
         if value is not None and value < 1:
             print(f"granplate: error: {name} = {value}: must be >= 1", file=sys.stderr)
             return 2
-    keep_study_file(args.study, args.out)
+    keep_study_file(args.study, args.out, changes)
     print(f"optimize {', '.join(f'{k} ({v})' for k, v in opt.objectives.items())} over "
           f"{', '.join(opt.space)} of {opt.base_name} -> {args.out}", file=sys.stderr)
     try:
@@ -136,6 +151,7 @@ def _cluster_options(p) -> None:
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     p.add_argument("--no-report", dest="report", action="store_false",
                    help="do not write the report page at the end (granplate study report DIR does)")
+    add_set_option(p, "the base scenario, as the study's [set] table does (overriding it there)")
 
 
 def register(sub) -> None:

@@ -158,10 +158,11 @@ def parse_optimization(doc: dict, folder: str | os.PathLike = ".") -> Optimizati
     return opt
 
 
-def load_optimization(path: str | os.PathLike) -> Optimization:
-    from granplate.study.spec import read_document
+def load_optimization(path: str | os.PathLike, changes: dict[str, Value] | None = None) -> Optimization:
+    """The Optimization of a TOML file, with `changes` added to its [set] table."""
+    from granplate.study.spec import read_document, with_settings
 
-    return parse_optimization(read_document(path), Path(path).parent)
+    return parse_optimization(with_settings(read_document(path), changes), Path(path).parent)
 
 
 # ------------------------------------------------------------------------- the search

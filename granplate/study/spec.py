@@ -333,6 +333,18 @@ def read_document(path: str | os.PathLike) -> dict:
         raise ScenarioError("study file", str(path), f"not valid TOML: {err}") from None
 
 
-def load_study(path: str | os.PathLike) -> Study:
-    """The Study of a TOML file (its base file, when relative, is beside it)."""
-    return parse_study(read_document(path), Path(path).parent)
+def with_settings(doc: dict, changes: dict[str, Value] | None) -> dict:
+    """The study file's table with `changes` (the command line's --set) added to its [set]
+    table, overriding the same paths there."""
+    if not changes:
+        return doc
+    fixed = doc.get("set", {})
+    if not isinstance(fixed, dict):
+        raise ScenarioError("set", fixed, "expected a table of dotted path = value")
+    return {**doc, "set": {**fixed, **changes}}
+
+
+def load_study(path: str | os.PathLike, changes: dict[str, Value] | None = None) -> Study:
+    """The Study of a TOML file (its base file, when relative, is beside it), with `changes`
+    added to its [set] table (`with_settings`)."""
+    return parse_study(with_settings(read_document(path), changes), Path(path).parent)
