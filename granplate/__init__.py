@@ -19,6 +19,15 @@ from granplate.setup.scenario import (  # noqa: E402
     Contact, Granule, Layout, Load, PairCoefficients, Plate, Scenario, Solver, TimeSettings, Wall,
 )
 
+#: The public API: the names above, and those loaded on first use below.
+__all__ = [
+    "__version__", "GranplateError", "ScenarioError", "SimulationError", "LIBRARY", "Material",
+    "Contact", "Granule", "Layout", "Load", "PairCoefficients", "Plate", "Scenario", "Solver",
+    "TimeSettings", "Wall",
+    "simulate", "build_model", "preset", "preset_names", "load_scenario", "loads", "dumps", "load",
+    "dump", "with_changes", "write", "read", "summary",
+]
+
 
 def __getattr__(name: str):
     # heavy modules (numba, scikit-fem, xarray) load on first use

@@ -16,8 +16,7 @@ from granplate.cli import main
 from granplate.errors import ScenarioError
 from granplate.setup import io as scenario_io
 from granplate.setup.geometry import layout_packing, resolve
-from granplate.setup.scenario import (BOX_WALLS, Box, ChainLayout, Imperfections, Layer, LatticeLayout,
-                                      Load, Scenario, SpaceLattice)
+from granplate.setup.scenario import (BOX_WALLS, Box, ChainLayout, Imperfections, Layer, Load, Scenario, SpaceLattice)
 from granplate.setup.validate import OVERLAP_RTOL, validate
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -18,7 +18,7 @@ from granplate.physics.contact import COEF_A, contact_energy
 from granplate.results.run import simulate
 from granplate.setup.materials import LIBRARY, effective_modulus, sphere_mass
 from granplate.setup.scenario import Wall
-from granplate.solver import driver, loop, state as S
+from granplate.solver import driver, state as S
 from granplate.solver.interface import move_patches
 from granplate.solver.plate_modal import plate_energy
 from granplate.verification.face_contacts import (

@@ -12,7 +12,7 @@ from granplate.setup import io as scenario_io
 from granplate.errors import ScenarioError
 from granplate.setup.materials import LIBRARY, Material
 from granplate.setup.presets import preset
-from granplate.setup.scenario import (Granule, Layout, Load, PairCoefficients, Plate, Scenario,
+from granplate.setup.scenario import (Granule, Load, PairCoefficients, Plate, Scenario,
                                 Solver, TimeSettings, Wall)
 from granplate.setup.validate import SCHEMES, validate
 

@@ -13,7 +13,7 @@ import pytest
 from scipy.optimize import brentq
 
 from granplate.model import build_model
-from granplate.model.inputs import GEO_NSTAT, HIST_MAX, new_body_state
+from granplate.model.inputs import new_body_state
 from granplate.physics.contact import COEF_A
 from granplate.setup import io as scenario_io
 from granplate.solver import body as B

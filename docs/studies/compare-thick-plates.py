@@ -116,7 +116,7 @@ def findings(tables: dict[str, pd.DataFrame]) -> list[str]:
     close = fr[fr > 0.5]
     far = fr[fr <= 0.5]
     out.append(
-        f"- **On the face, a thin plate bends and takes the shock whatever the intruders.** At "
+        "- **On the face, a thin plate bends and takes the shock whatever the intruders.** At "
         + (", ".join(mm(h) for h in close.index) or "no thickness")
         + f" PTFE intruders pass {', '.join(f'{r:.2f}' for r in close)} of steel's share "
         + f"({', '.join(pct(f.loc[h, 'ptfe']) + ' against ' + pct(f.loc[h, 'steel']) for h in close.index)}): "

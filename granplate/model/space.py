@@ -13,8 +13,7 @@ import math
 
 import numpy as np
 
-from granplate.errors import ScenarioError
-from granplate.model.contacts import contact_lists, fixed_wall_contacts
+from granplate.model.contacts import contact_lists
 from granplate.model.inputs import STATE_COLUMNS, Granular3, PlateArrays, no_history
 from granplate.physics.contact import N_COEF
 from granplate.setup.materials import sphere_inertia, sphere_mass

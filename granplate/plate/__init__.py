@@ -30,7 +30,7 @@ _EXPORTS: dict[str, tuple[str, ...]] = {
     "build": ("PLATE_FORMAT", "STORE_KIND", "PlateModel", "cache_payload", "build_plate"),
 }
 _MODULE_OF = {name: module for module, names in _EXPORTS.items() for name in names}
-__all__ = sorted(_MODULE_OF)
+__all__ = list(sorted(_MODULE_OF))
 
 
 def __getattr__(name: str):

@@ -9,7 +9,7 @@ import json
 import math
 from pathlib import Path
 from dataclasses import replace
-from typing import Callable, NamedTuple
+from typing import Any, Callable, NamedTuple
 
 import numpy as np
 import xarray as xr
@@ -140,7 +140,7 @@ class _Bar:
 
 def plate_fields(model, q: np.ndarray, qd: np.ndarray, times: np.ndarray,
                  force: np.ndarray | None = None, should_stop: Callable[[], bool] | None = None,
-                 progress: bool = False, plate=None) -> tuple[dict[str, xr.DataArray], int]:
+                 progress: bool = False, plate=None) -> tuple[dict[str, Any], int]:
     """Plate outputs computed from the modal coordinates after the run, and the number of
     output times they cover; force (time, 2 n_contacts) [N]: the contact forces on the
     plate, whose static part a truncated basis adds to the displacements and stresses
@@ -153,7 +153,7 @@ def plate_fields(model, q: np.ndarray, qd: np.ndarray, times: np.ndarray,
     contacts (`run_contacts`; default model.plate)."""
     plate = model.plate if plate is None else plate
     s = model.scenario
-    out: dict[str, xr.DataArray] = {}
+    out: dict[str, Any] = {}  # the variables, and "_field_time" (an array of times [s])
     qf = plate_coordinates(plate, q, force)
     n = len(times)
     bar = _Bar(progress, n, "stresses")
@@ -181,7 +181,7 @@ def plate_fields(model, q: np.ndarray, qd: np.ndarray, times: np.ndarray,
                 c = split_coordinates(plate, qf[idx[snaps]])
                 u[snaps] = plate.full_displacement(*c)
                 vm[snaps] = plate.von_mises(*c).max(axis=-1)
-            done, kept = rows.stop, (snaps[-1] + 1 if len(snaps) else kept)
+            done, kept = rows.stop, (int(snaps[-1]) + 1 if len(snaps) else kept)
             bar.update(rows.stop - rows.start)
             if should_stop is not None and done < n and should_stop():
                 break
@@ -214,7 +214,7 @@ class RunContacts(NamedTuple):
     granule: np.ndarray  # (nk,) int64: the granule of each plate contact
     y: np.ndarray  # (nk,) [m]: its height on the face (a patch contact's where it formed)
     time_formed: np.ndarray  # (nk,) [s]: when it formed (0 for the model's)
-    plate: object  # the plate with every contact's height (its truncated basis' static part reads them), or None
+    plate: Any  # the plate with every contact's height (its truncated basis' static part reads them), or None
 
 
 def run_contacts(model, contacts=None) -> RunContacts:

@@ -146,7 +146,7 @@ def _convert(path: str, value: Any, tp: Any) -> Any:
             raise ScenarioError(path, value, f"wrong length: expected {_type_name(tp)}")
         return tuple(_convert(f"{path}[{i}]", v, a) for i, (v, a) in
                      enumerate(zip(value, args)))
-    if dataclasses.is_dataclass(tp):
+    if isinstance(tp, type) and dataclasses.is_dataclass(tp):
         return _table(path, value, tp)
     raise TypeError(f"unsupported annotation {tp!r}")  # pragma: no cover
 

@@ -20,7 +20,7 @@ from typing import Callable
 from granplate.errors import ScenarioError
 import dataclasses
 
-from granplate.setup.scenario import Layout, Load, Plate, Scenario, Solid, Solver, TimeSettings
+from granplate.setup.scenario import Layout, Load, Plate, Scenario, Solid, Solver
 
 #: One line per preset, naming the paper figures it reproduces.
 DESCRIPTIONS: dict[str, str] = {
@@ -88,11 +88,12 @@ def twin_3d(plane: Scenario) -> Scenario:
     ymax, the rigid layers as translation-only rigid patches across the thickness, the same
     line load on each loaded granule (or on the slab's face xmin), velocity Verlet."""
     p = plane.plate
+    assert isinstance(p, Plate), f"{plane.name} has no plane plate"
     name = "3d-" + plane.name
     solid = Solid(size=(p.width, p.height, p.thickness), elements=(p.nx, p.ny, 1), material=p.material,
                   clamped=("ymin", "ymax"), rigid_layers=plane.layout is not None,
                   max_frequency=TWIN_MAX_FREQUENCY.get(plane.name, Solid.max_frequency),
-                  origin=None if plane.layout is not None else (p.x0, p.y0, -0.5 * p.thickness))
+                  origin=None if plane.layout is not None or p.x0 is None else (p.x0, p.y0, -0.5 * p.thickness))
     return dataclasses.replace(
         plane, name=name, description=f"3D twin of {plane.name}: " + plane.description, dimension=3, plate=solid,
         time=dataclasses.replace(plane.time, dt_max=TWIN_STEPS.get(plane.name, TWIN_DT),

@@ -490,7 +490,8 @@ class Contact:
         else `normal_law`. At a granule-wall or granule-plate contact, b is the wall's or
         the plate's material (a rigid body to the law: only the granule's Y matters)."""
         k = self.law_index(a, b)
-        return self.normal_law if k is None else self.pairs[k].normal_law
+        law = None if k is None else self.pairs[k].normal_law
+        return self.normal_law if law is None else law
 
 
 @dataclass(frozen=True)

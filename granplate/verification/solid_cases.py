@@ -172,7 +172,7 @@ def plate_frequencies(ctx: Context) -> CaseResult:
               "quadratic elements; the bending error falls at least as h^2", p_thin, 1.5,
               "a quadratic element's eigenvalue error falls as h^2 or faster (h^4 for smooth modes); "
               "1.5 allows for the pre-asymptotic coarse mesh.", kind="min"),
-        Check(f"lambda^2 of mode 1, a/h = 10, mesh limit (Richardson)", "-", float(mind_thick[0]),
+        Check("lambda^2 of mode 1, a/h = 10, mesh limit (Richardson)", "-", float(mind_thick[0]),
               "Mindlin plate, Ritz, kappa = 5/6", lim_thick, 0.02, MODEL_WHY),
         Check("observed order of lambda^2_1 under in-plane refinement, a/h = 10", "-", 2.0,
               "quadratic elements", p_thick, 1.5, "as for the thin plate.", kind="min"),
@@ -187,7 +187,7 @@ def plate_frequencies(ctx: Context) -> CaseResult:
     for n, lam in zip(THIN_MESHES, thin):
         rows.append(f"| {n} x {n} x {THIN_LAYERS} | {THIN * 1e3:g} | " + " | ".join(f"{v:.3f}" for v in lam) + " |")
     rows.append(f"| Mindlin (Ritz) | {THIN * 1e3:g} | " + " | ".join(f"{v:.3f}" for v in mind_thin) + " |")
-    rows.append(f"| Kirchhoff (Leissa) | - | " + " | ".join(f"{v:.2f}" for v in LEISSA_CCCC_SQUARE[:3]) + " |")
+    rows.append("| Kirchhoff (Leissa) | - | " + " | ".join(f"{v:.2f}" for v in LEISSA_CCCC_SQUARE[:3]) + " |")
     for n, lam in zip(THICK_MESHES, thick):
         rows.append(f"| {n} x {n} x {THICK_LAYERS} | {THICK * 1e3:g} | " + " | ".join(f"{v:.3f}" for v in lam) + " |")
     rows.append(f"| Mindlin (Ritz) | {THICK * 1e3:g} | " + " | ".join(f"{v:.3f}" for v in mind_thick) + " |")
@@ -475,7 +475,7 @@ def sphere_on_block(ctx: Context) -> CaseResult:
     rows.append(f"| Hertz | - | - | {ref.contact_time * 1e6:.4f} | 0 | 0 ({ref.peak_force:.3f} N) | "
                 f"0 ({ref.max_overlap * 1e6:.4f} um) | 1 | - | - |")
     notes = [("The contact time approaches Hertz's as the block grows: t_c / t_Hertz - 1 = "
-              + ", ".join(f"{e:+.2%}" for e in excess) + f" for L = "
+              + ", ".join(f"{e:+.2%}" for e in excess) + " for L = "
               + ", ".join(f"{L * 1e3:g}" for L in BLOCK_SIDES) + f" mm (log-log slope {slope:.2f} from 10 to "
               "80 mm). What remains is the FE's own compliance under the contact's point load in series "
               "with Hertz's (Hertz's E* already holds the body's local deformation, which the FE "
