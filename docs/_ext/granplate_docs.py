@@ -175,6 +175,14 @@ def refusals(base, path: str, values: tuple) -> list[str]:
     return said
 
 
+def markdown_text(doc: str) -> str:
+    """A docstring's plain text as Markdown paragraphs: backslashes and stars (E*, R*)
+    escaped outside backticks, so that nothing turns into emphasis."""
+    parts = re.split(r"(`[^`]*`)", doc)
+    return "".join(s if i % 2 else s.replace("\\", "\\\\").replace("*", "\\*").replace("<", "&lt;")
+                   for i, s in enumerate(parts))
+
+
 def _title(title: str) -> str:
     """A table's title with its TOML name as code: '[load]' -> '`[load]`'."""
     return re.sub(r"(\[+[^\]]+\]+(?: kind = [^(]+)?)", lambda m: f"`{m.group(1).strip()}` ", title).replace("  ", " ").strip()
@@ -194,8 +202,8 @@ def scenario_fields_page() -> str:
         "that reads it: names, types and defaults from the dataclasses of",
         "`granplate.setup.scenario`, units from `granplate.study.table.FIELD_UNITS`, and in the",
         "last column what the validator (`granplate.setup.validate`) answers when the key is set",
-        "out of range on a valid base scenario, word for word: the same checks a scenario file,",
-        "`granplate run --set` and `granplate.with_changes` go through. Limits that depend on",
+        "out of range on a valid base scenario, word for word: the same checks a scenario file",
+        "and `granplate.with_changes` go through. Limits that depend on",
         "other keys are quoted for the base scenario named under each table. The meaning of",
         "each key, with the reasoning behind its default, is in [Scenario files](../../scenario.md).",
         "",
@@ -204,7 +212,7 @@ def scenario_fields_page() -> str:
         out += [f"({anchor})=", f"## {_title(title)}", ""]
         doc = inspect.cleandoc(cls.__doc__ or "")
         if doc:
-            out += ["```text", doc, "```", ""]
+            out += [markdown_text(doc), ""]
         out += [f"Refusals probed on {what}.", "",
                 "| key | type | unit | default | refused when |", "| --- | --- | --- | --- | --- |"]
         for f in dataclasses.fields(cls):
