@@ -16,7 +16,8 @@ ROOT = DOCS.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(DOCS / "_ext"))
 os.environ["PYTHONPATH"] = os.pathsep.join([str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])])
-os.environ.setdefault("MPLBACKEND", "Agg")
+# the kernels draw inline (matplotlib-inline); a backend set outside would hide the figures
+os.environ.pop("MPLBACKEND", None)
 
 from granplate.version import __version__  # noqa: E402
 
