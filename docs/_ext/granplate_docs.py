@@ -265,9 +265,9 @@ FIGURES: dict[str, tuple[str, str]] = {
                  "the presets `bare-plate` and `steel-r1` (2 ms), drawn by `granplate reproduce --out results`"),
     "fig6.png": ("Paper Fig. 6: horizontal velocity maps, steel against PTFE intruders",
                  "the presets `steel-r05` and `ptfe-r05` (2 ms), `granplate plot results --figure 6`"),
-    "show-steel-r1.png": ("The paper's steel packing before a run: granules by material, walls, the plate "
-                          "and its rigid layers, the load", "`granplate show steel-r1 --dpi 80`"),
-    "show-steel-r1-result.png": ("A result: contact forces and the deformed plate at its largest energy",
+    "show-steel-r1.png": ("An assembly before a run: the paper's steel packing, granules by material, walls, "
+                          "the plate and its rigid layers, the load", "`granplate show steel-r1 --dpi 80`"),
+    "show-steel-r1-result.png": ("A result: the contact forces and the deformed plate at the largest plate energy",
                                  "`granplate run steel-r1` (2 ms), then `granplate show steel-r1.nc --dpi 80`"),
     "show-box-3d.png": ("A run in space: three depth-shaded projections, walls and contact forces",
                         "four spheres in a box (`BOX` of tests/test_figures_3d.py), "
@@ -287,8 +287,9 @@ def gallery_page(docs: Path = DOCS) -> str:
            "[Verification and validation](../../validation.md).", "", "## Runs and assemblies", ""]
     for name in sorted(p.name for p in (docs / "figures").glob("*.png")):
         what, made = FIGURES.get(name, ("", ""))
-        out += [f"### {what or name}", "", f"![{what or name}](../../figures/{name})", "",
-                f"Made by {made}." if made else "", ""]
+        head, _, rest = (what or name).partition(": ")
+        out += [f"### {head}", "", f"![{what or name}](../../figures/{name})", "",
+                f"{rest[:1].upper() + rest[1:]}." if rest else "", f"Made by {made}." if made else "", ""]
     cases = {c["figure"]: c for c in json.loads((docs / "validation.json").read_text())["cases"]
              if c.get("figure")}
     out += ["## Verification cases", ""]
