@@ -146,3 +146,26 @@ def test_readme_is_short_and_names_the_commands():
                     'python -m pip install ".[test]" && python -m pytest -q',
                     'python -m pip install ".[docs]" && python -m sphinx -W --keep-going -b html docs docs/_build/html'):
         assert f"```bash\n{command}\n```" in text, command
+
+
+def test_plain_docstrings_render_without_warnings():
+    """A docstring written as the package writes them (|v|, E*, hanging indents, a list,
+    a doctest, a trailing '::') becomes reStructuredText that docutils reads without a
+    warning once the site's docstring hook has passed over it."""
+    import io
+
+    from docutils.core import publish_doctree
+
+    mod = _ext()
+    lines = ["A sphere: |v| < sqrt(E* / rho), R* = R1 R2 / (R1 + R2).",
+             "    kind: \"line\" or *none*; see `geometry.resolve` for |x|",
+             "- a list item",
+             "  continued with an indent",
+             ">>> gp.preset('steel-r1')",
+             "1. first",
+             "ends with a colon::",
+             "    indented again"]
+    mod.plain_docstring(None, "function", "f", None, {}, lines)
+    errors = io.StringIO()
+    publish_doctree("\n".join(lines), settings_overrides={"warning_stream": errors, "report_level": 2})
+    assert errors.getvalue() == ""

@@ -394,12 +394,24 @@ def copy_explorers(app, exception) -> None:
 CODE = re.compile(r"(``?[^`]+``?)")
 
 
+#: line openings reStructuredText reads as a list, a doctest or a literal block
+MARKUP_START = re.compile(r"^(\s*)([-*+] |\d+[.)] |>>>|[a-z]\) )")
+
+
 def plain_docstring(app, what, name, obj, options, lines: list[str]) -> None:
-    """The package's docstrings are plain text with formulas (|v|, E*, 2 x R): escape the
-    characters reStructuredText would read as markup, outside backticks."""
+    """The package's docstrings are plain text with formulas (|v|, E*, 2 x R) and hanging
+    indents: read them as plain paragraphs. Outside backticks, the characters
+    reStructuredText would read as markup are escaped; a docstring without reST fields
+    (napoleon's sections become `:param ...:` lines) loses its indentation and its
+    list-like openings are escaped, so that no docstring can break the build."""
+    fields = any(line.lstrip().startswith((":", "..")) for line in lines)
     for k, line in enumerate(lines):
+        if not fields:
+            line = MARKUP_START.sub(lambda m: "\\" + m.group(2), line.strip())
+            if line.endswith("::"):
+                line = line[:-1]
         parts = CODE.split(line)
-        lines[k] = "".join(p if i % 2 else p.replace("\\", "\\\\").replace("|", "\\|").replace("*", "\\*")
+        lines[k] = "".join(p if i % 2 else p.replace("|", "\\|").replace("*", "\\*")
                            for i, p in enumerate(parts))
 
 
