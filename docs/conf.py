@@ -55,6 +55,9 @@ suppress_warnings = [
     "myst.domains",  # sphinx-argparse's domain cannot answer MyST's any-reference lookups
 ]
 
+# code blocks without a language (sample output) are drawn as plain text
+highlight_language = "none"
+
 # MyST
 myst_enable_extensions = ["colon_fence", "deflist", "attrs_inline"]
 myst_heading_anchors = 3
