@@ -1,5 +1,6 @@
 """The README cannot go stale: its Python blocks run as written, its sample summary is what
-`granplate run steel-r1` prints, and its sample error is the one a bad R2/R1 gets.
+`granplate run steel-r1` prints, and its sample error is the one a bad R2/R1 gets; the same
+for the copies in the getting-started page that reads them line by line.
 
 Truth: the package itself, run on the README's own text.
 """
@@ -13,6 +14,8 @@ import pytest
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 TEXT = README.read_text()
+#: the pages that show the sample summary and the sample error: the README and the first run
+SAMPLE_PAGES = [README, README.parent / "docs" / "getting-started" / "first-run.md"]
 PYTHON_BLOCKS = re.findall(r"```python\n(.*?)```", TEXT, re.S)
 
 
@@ -36,33 +39,36 @@ def test_python_block_runs(index, tmp_path, monkeypatch, capsys):
         assert comment.strip() in out
 
 
-def _sample_summary() -> list[str]:
-    m = re.search(r"<!-- summary: steel-r1 -->\n```\n(.*?)```", TEXT, re.S)
-    assert m, "README: the sample summary block is marked <!-- summary: steel-r1 -->"
+def _sample_summary(text: str) -> list[str]:
+    m = re.search(r"<!-- summary: steel-r1 -->\n```\n(.*?)```", text, re.S)
+    assert m, "the sample summary block is marked <!-- summary: steel-r1 -->"
     return m.group(1).splitlines()
 
 
 def test_sample_summary_is_what_a_run_prints():
-    """The README's sample summary equals the table of a steel-r1 run (all rows but the wall
-    time, which depends on the machine)."""
+    """The sample summary of the README and of the first-run page equals the table of a
+    steel-r1 run (all rows but the wall time, which depends on the machine)."""
     import granplate as gp
     from granplate.cli import format_summary
 
     got = format_summary(gp.summary(gp.simulate(gp.preset("steel-r1"), progress=False)))
-    want = [line for line in _sample_summary() if not line.startswith("wall time")]
-    assert want == [line for line in got.splitlines() if not line.startswith("wall time")]
+    got = [line for line in got.splitlines() if not line.startswith("wall time")]
+    for page in SAMPLE_PAGES:
+        want = [line for line in _sample_summary(page.read_text()) if not line.startswith("wall time")]
+        assert want == got, page.name
 
 
 def test_sample_error_is_the_real_message():
-    """The README's sample refusal of R2/R1 = 0.2 is the message validation gives."""
+    """The sample refusal of R2/R1 = 0.2 (README, first-run page) is the message validation gives."""
     import granplate as gp
     from granplate.setup.validate import validate
 
-    m = re.search(r"granplate: error: (scenario field 'layout.R2_ratio' = 0.2: .*)", TEXT)
-    assert m
     with pytest.raises(gp.ScenarioError) as err:
         validate(gp.with_changes(gp.preset("ptfe-r05"), {"layout.R2_ratio": 0.2}))
-    assert str(err.value) == m.group(1)
+    for page in SAMPLE_PAGES:
+        m = re.search(r"granplate: error: (scenario field 'layout.R2_ratio' = 0.2: .*)", page.read_text())
+        assert m, page.name
+        assert str(err.value) == m.group(1), page.name
 
 
 def test_model_citations_point_to_existing_sections():
@@ -71,7 +77,7 @@ def test_model_citations_point_to_existing_sections():
     root = README.parent
     headings = set(re.findall(r"^#{2,3} (\d+(?:\.\d+)?)[. ]", (root / "docs" / "model.md").read_text(), re.M))
     assert {"1", "2", "3", "4", "5", "6", "7", "8"} <= headings
-    files = [README, *(root / "docs").glob("*.md"), *(root / "granplate").rglob("*.py"),
+    files = [README, *(p for p in (root / "docs").rglob("*.md") if "_build" not in p.parts), *(root / "granplate").rglob("*.py"),
              *(root / "tests").glob("*.py")]
     cited = []
     for f in files:

@@ -23,6 +23,14 @@ FIELD_UNITS: dict[str, str] = {
     "z": "m", "vz": "m/s", "size": "m", "origin": "m", "elements": "1", "patch_radius": "m",
     "stress_radius": "m", "max_frequency": "Hz", "force": "N", "Y": "Pa", "k_s": "s/m",
     "count": "1", "cells": "1", "columns": "1", "rows": "1", "intruder_ratio": "1",
+    # every other number of a scenario (the generated reference of the site shows them)
+    "dimension": "1", "taper": "1", "dimer_ratio": "1", "decorated_ratio": "1", "seed": "1",
+    "radius_spread": "1", "jitter": "1", "vacancy_fraction": "1", "intruder_every": "1",
+    "omega": "rad/s", "offset": "m", "point": "m", "lower": "m", "upper": "m", "centre": "m",
+    "normal": "1", "direction": "1", "axis": "1", "x0": "m", "neighbour_gap": "1", "skin": "1",
+    "overlap_warn": "1", "overlap_stop": "1", "dt_min": "s", "lambda_target": "1",
+    "iteration_rtol": "1", "iteration_atol": "N", "max_iterations": "1", "energy_tol": "1",
+    "error_tol": "1", "implicit_dt_max": "s",
 }
 
 
