@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import logging
+import os
 import platform
 import time
 from dataclasses import dataclass
@@ -115,22 +116,25 @@ def estimate(sets: list[KernelSet]) -> float:
     return sum(compile_seconds(k.scheme, k.dimension) for k in sets)
 
 
-def compile_set(kernels: KernelSet) -> float:
-    """Run the set's short runs (compiling what they need); the seconds numba compiled."""
+def compile_set(kernels: KernelSet) -> tuple[float, float]:
+    """Run the set's short runs (compiling what they need); the seconds numba compiled, and
+    the process's CPU seconds meanwhile (compiling is single-threaded: on an idle machine
+    the two agree, on a shared one the CPU seconds are what the compile itself costs)."""
     from granplate.results.run import simulate
 
+    cpu = time.process_time()
     with compile_clock() as clock:
         for s in kernels.scenarios():
             simulate(s, t_end=min(s.time.t_end, SHORT_T_END), progress=False)
-    return clock.seconds
+    return clock.seconds, time.process_time() - cpu
 
 
 def compile_kernels(sets: list[KernelSet] | None = None,
-                    note: Callable[[str], None] | None = None) -> dict[str, float]:
+                    note: Callable[[str], None] | None = None, cpu: dict | None = None) -> dict[str, float]:
     """Compile the kernel sets not yet cached (default: every missing one), one line each
     through `note` (default: the "granplate" logger at INFO) with the measured estimate,
     scaled after the first set by how this machine's compile times compare with the
-    measured ones. {set name: seconds compiled}."""
+    measured ones. {set name: seconds compiled}; cpu, when given, gets the CPU seconds."""
     todo = missing() if sets is None else list(sets)
     say = note or log.info
     done: dict[str, float] = {}
@@ -145,7 +149,9 @@ def compile_kernels(sets: list[KernelSet] | None = None,
         left = scale * estimate(todo[i - 1:])
         say(f"compiling {i}/{len(todo)}: {k.what} (about {describe_seconds(scale * estimate([k]))}; "
             f"{describe_seconds(left)} left in all) ...")
-        done[k.name] = compile_set(k)
+        done[k.name], cpu_s = compile_set(k)
+        if cpu is not None:
+            cpu[k.name] = cpu_s
         spent += done[k.name]
         expected += estimate([k])
         scale = spent / expected if expected > 0 else 1.0
@@ -160,16 +166,20 @@ def measure(path: Path, note: Callable[[str], None] | None = None) -> dict:
     import numba
 
     t0 = time.perf_counter()
-    seconds = compile_kernels(list(KERNEL_SETS), note)
+    cpu: dict[str, float] = {}
+    wall = compile_kernels(list(KERNEL_SETS), note, cpu=cpu)
     data = {
-        "about": "seconds numba compiles each kernel set on a cold cache, the sets compiled in this "
-                 "order in one process (later sets reuse earlier ones' callees); written by "
-                 "`granplate compile --measure`",
-        "machine": f"{platform.machine()}, {platform.processor() or platform.system()}",
+        "about": "CPU seconds each kernel set takes to compile on a cold numba cache (compiling is "
+                 "single-threaded: the wall time on an idle core), the sets compiled in this order in "
+                 "one process (later sets reuse earlier ones' callees); wall_seconds: the wall time "
+                 "numba compiled, which a shared machine inflates; written by `granplate compile --measure`",
+        "machine": f"{platform.machine()}, {platform.processor() or platform.system()}, "
+                   f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at the end",
         "numba": numba.__version__,
         "order": [k.name for k in KERNEL_SETS],
-        "seconds": {k: round(v, 1) for k, v in seconds.items()},
-        "wall_s": round(time.perf_counter() - t0, 1),
+        "seconds": {k: round(v, 1) for k, v in cpu.items()},
+        "wall_seconds": {k: round(v, 1) for k, v in wall.items()},
+        "total_wall_s": round(time.perf_counter() - t0, 1),
     }
     Path(path).write_text(json.dumps(data, indent=2) + "\n")
     return data

@@ -35,7 +35,7 @@ from granplate.setup.plate_cost import MEMORY_SHARE, physical_memory
 from granplate.setup.materials import Material
 from granplate.setup.scenario import (Solid, BOX_WALLS, LAYOUT_KINDS, LAYOUT_KINDS_BY_DIMENSION, NORMAL_LAWS,
                                       SPACE_LATTICE_KINDS, SQRT2_MINUS_1, ChainLayout, Granule,
-                                      Imperfections, LatticeLayout, Layout, Plate, Scenario,
+                                      Imperfections, LatticeLayout, Layer, Layout, Plate, Scenario,
                                       SpaceLattice)
 
 #: Lever arms of the friction torque (Contact.torque_arm).
@@ -371,9 +371,11 @@ def _check_space_lattice(s: Scenario, lay: SpaceLattice) -> None:
         if k == 0 and n == 0 and (lay.layers or lay.planes is not None):
             continue  # the layers' counts or layout.planes give the planes along x
         int_at_least(f"layout.cells[{k}]", n, 1)
-    if isinstance(lay.layers, tuple) and all(isinstance(ly, Layer) for ly in lay.layers):
+    layers_ok = isinstance(lay.layers, tuple) and all(isinstance(ly, Layer) for ly in lay.layers)
+    if layers_ok:
         _check_layer_sizes(lay)
-    n_sites = sites_per_cell(lay.kind) * planes_along_x(lay) * cells[1] * cells[2] // planes_per_cell(lay.kind)
+    n_planes = planes_along_x(lay) if layers_ok else planes_per_cell(lay.kind) * cells[0]
+    n_sites = sites_per_cell(lay.kind) * n_planes * cells[1] * cells[2] // planes_per_cell(lay.kind)
     if n_sites > MAX_LAYOUT_SITES:
         raise ScenarioError("layout.cells", list(cells), f"makes {n_sites} sites ({sites_per_cell(lay.kind)} "
                             f"per {lay.kind} cell); allowed: at most {MAX_LAYOUT_SITES} sites")
