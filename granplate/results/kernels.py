@@ -21,7 +21,7 @@ from typing import Callable
 
 from granplate.setup.scenario import Scenario
 from granplate.solver.compiling import (compile_clock, compile_seconds, compiled_loops, describe_seconds,
-                                        set_name)
+                                        machine_slowdown, set_name)
 
 log = logging.getLogger(__name__)
 
@@ -122,10 +122,16 @@ def compile_set(kernels: KernelSet) -> tuple[float, float]:
     the two agree, on a shared one the CPU seconds are what the compile itself costs)."""
     from granplate.results.run import simulate
 
+    driver_log = logging.getLogger("granplate.solver.driver")
+    level = driver_log.level
+    driver_log.setLevel(logging.WARNING)  # this set's own line says what compiles
     cpu = time.process_time()
-    with compile_clock() as clock:
-        for s in kernels.scenarios():
-            simulate(s, t_end=min(s.time.t_end, SHORT_T_END), progress=False)
+    try:
+        with compile_clock() as clock:
+            for s in kernels.scenarios():
+                simulate(s, t_end=min(s.time.t_end, SHORT_T_END), progress=False)
+    finally:
+        driver_log.setLevel(level)
     return clock.seconds, time.process_time() - cpu
 
 
@@ -140,10 +146,12 @@ def compile_kernels(sets: list[KernelSet] | None = None,
     done: dict[str, float] = {}
     if not todo:
         return done
-    scale = 1.0
-    total = estimate(todo)
+    scale = machine_slowdown()
+    total = scale * estimate(todo)
+    busy = f", this machine busy {scale:.1f}x" if scale > 1.2 else ""
     say(f"compiling every scheme's kernels once, in the plane and in space: {len(todo)} sets, about "
-        f"{describe_seconds(total)} (measured; `granplate compile` does this ahead; cached afterwards)")
+        f"{describe_seconds(total)} ({describe_seconds(estimate(todo))} of CPU measured on a cold cache{busy}; "
+        f"`granplate compile` does this ahead; cached afterwards)")
     spent = expected = 0.0
     for i, k in enumerate(todo, 1):
         left = scale * estimate(todo[i - 1:])

@@ -15,6 +15,7 @@ the seconds spent compiling.
 from __future__ import annotations
 
 import json
+import os
 from contextlib import contextmanager
 from functools import lru_cache
 from pathlib import Path
@@ -120,14 +121,27 @@ def measured() -> dict:
         return {}
 
 
+def machine_slowdown() -> float:
+    """How many times longer than its CPU seconds a single-threaded compile takes here now:
+    the load average over the cores this process may use, at least 1 (an idle machine) and
+    at most 10; 1 where the system does not say."""
+    try:
+        cores = len(os.sched_getaffinity(0))
+        load = os.getloadavg()[0]
+    except (AttributeError, OSError):
+        return 1.0
+    return min(max(1.0, load / max(cores, 1)), 10.0)
+
+
 def set_name(scheme: str, dimension: int) -> str:
     """The kernel set's name in compile_seconds.json: "implicit-2d"."""
     return f"{scheme}-{dimension}d"
 
 
 def compile_seconds(scheme: str, dimension: int) -> float:
-    """Measured seconds to compile a kernel set on a cold cache, after the sets before it
-    in the measured order (they share callees); UNKNOWN_SECONDS without a measurement."""
+    """Measured CPU seconds to compile a kernel set on a cold cache, after the sets before
+    it in the measured order (they share callees); UNKNOWN_SECONDS without a measurement.
+    On an idle core the wall time; `machine_slowdown` scales it to this machine now."""
     return float(measured().get("seconds", {}).get(set_name(scheme, dimension), UNKNOWN_SECONDS))
 
 

@@ -22,7 +22,7 @@ from granplate.model.contacts import Missed, centre_coordinates, contact_lists, 
 from granplate.model.neighbours import verlet_pairs, verlet_walls
 from granplate.physics.contact import plate_overlap
 from granplate.solver import loop, state as S
-from granplate.solver.compiling import compile_calls, compile_seconds, describe_seconds
+from granplate.solver.compiling import compile_calls, compile_seconds, describe_seconds, machine_slowdown
 from granplate.plate.face import patch_weights
 from granplate.solver.interface import set_face_weights
 from granplate.solver.ladder import level_for
@@ -508,8 +508,10 @@ def note_compile(model: Model, calls: list[tuple]) -> bool:
         return False
     name, dim = model.scenario.solver.scheme, model.config.dimension
     where = "in space" if dim == 3 else "in the plane"
-    log.info(f"compiling the time loop of the {name} scheme {where} (about "
-             f"{describe_seconds(compile_seconds(name, dim))}, measured on a cold cache; cached afterwards) ...")
+    seconds, slow = compile_seconds(name, dim), machine_slowdown()
+    busy = f"; this machine is busy, {slow:.1f}x" if slow > 1.2 else ""
+    log.info(f"compiling the time loop of the {name} scheme {where} (about {describe_seconds(slow * seconds)}: "
+             f"{describe_seconds(seconds)} of CPU measured on a cold cache{busy}; cached afterwards) ...")
     return True
 
 
