@@ -157,13 +157,14 @@ def keep_dask_out() -> None:
 
 def _cmd_run(args) -> int:
     from granplate.results.dataset import summary
+    from granplate.results.kernels import compile_all_wanted
     from granplate.setup.io import load_scenario
     from granplate.results.run import interrupted, simulate
 
     scenario = load_scenario(args.scenario)
     out = Path(args.output) if args.output else Path(f"{scenario.name}.nc")
     try:
-        ds = simulate(scenario, t_end=args.t_end, progress=not args.quiet, compile_all=True)
+        ds = simulate(scenario, t_end=args.t_end, progress=not args.quiet, compile_all=compile_all_wanted())
     except SimulationError as err:
         print(f"granplate: run stopped: {err}", file=sys.stderr)
         if err.result is None:

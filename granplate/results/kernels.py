@@ -27,6 +27,15 @@ log = logging.getLogger(__name__)
 
 #: Simulated time of a kernel set's short runs [s]: one step or a few compile everything.
 SHORT_T_END = 1e-7
+#: Environment variable: "all" (default), the command line's first run that needs a kernel
+#: compiles every set; "own", a run compiles only its own kernels.
+COMPILE_ENV = "GRANPLATE_COMPILE"
+
+
+def compile_all_wanted() -> bool:
+    """Whether the command line's first run compiles every kernel set ($GRANPLATE_COMPILE is
+    not "own")."""
+    return os.environ.get(COMPILE_ENV, "all").strip().lower() != "own"
 
 
 def _plane_granules(scheme: str) -> list[Scenario]:
