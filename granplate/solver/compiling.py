@@ -123,14 +123,16 @@ def measured() -> dict:
 
 def machine_slowdown() -> float:
     """How many times longer than its CPU seconds a single-threaded compile takes here now:
-    the load average over the cores this process may use, at least 1 (an idle machine) and
-    at most 10; 1 where the system does not say."""
+    (the load average + 1, this process) over the cores it may use, at least 1 (an idle
+    machine) and at most 10; 1 where the system does not say. A rough guess (measured:
+    4.7x on 2 cores at load 5 to 8, set by set 3x to 9x); the estimates are corrected by
+    the compile itself after the first kernel set."""
     try:
         cores = len(os.sched_getaffinity(0))
         load = os.getloadavg()[0]
     except (AttributeError, OSError):
         return 1.0
-    return min(max(1.0, load / max(cores, 1)), 10.0)
+    return min(max(1.0, (load + 1.0) / max(cores, 1)), 10.0)
 
 
 def set_name(scheme: str, dimension: int) -> str:
