@@ -163,3 +163,17 @@ def test_estimates_read_in_minutes(seconds, text):
     from granplate.solver.compiling import describe_seconds
 
     assert describe_seconds(seconds) == text
+
+
+def test_a_set_that_cannot_compile_does_not_stop_the_others():
+    """A kernel set whose short run fails is reported and skipped; the next one compiles."""
+    from granplate.results.kernels import KernelSet, compile_kernels
+
+    def broken():
+        raise RuntimeError("no such scenario")
+
+    said = []
+    done = compile_kernels([KernelSet("paper", 3, broken), KernelSet("implicit", 2, lambda: [_tiny()])],
+                           note=said.append)
+    assert list(done) == ["implicit-2d"]
+    assert any("could not compile the paper scheme in space (RuntimeError: no such scenario)" in s for s in said)

@@ -166,7 +166,11 @@ def compile_kernels(sets: list[KernelSet] | None = None,
         left = scale * estimate(todo[i - 1:])
         say(f"compiling {i}/{len(todo)}: {k.what} (about {describe_seconds(scale * estimate([k]))}; "
             f"{describe_seconds(left)} left in all) ...")
-        done[k.name], cpu_s = compile_set(k)
+        try:
+            done[k.name], cpu_s = compile_set(k)
+        except Exception as err:  # noqa: BLE001 - a set that cannot compile must not stop the run asked for
+            say(f"could not compile {k.what} ({type(err).__name__}: {err}); its first run compiles what it needs")
+            continue
         if cpu is not None:
             cpu[k.name] = cpu_s
         spent += done[k.name]
