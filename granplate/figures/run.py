@@ -93,8 +93,8 @@ def plastic_work(ds: xr.Dataset) -> np.ndarray | None:
 def energy_curves(ds: xr.Dataset) -> dict[str, tuple[str, np.ndarray]]:
     """key -> (legend label, energy [J] over time) of the energy figure: E_shock when the
     load does work, E_initial (a constant) when the run starts with some, and with both
-    E_initial + E_shock, the line the balance closes on (eq. 11), E_granular with granules (in space also its part KE_depth, the
-    translation along z), E_plate with a plate or a 3D elastic body, the dissipation D = D_viscous + D_friction
+    E_initial + E_shock, the line the balance closes on (eq. 11), E_granular with granules
+    (in space also its part KE_depth, the translation along z), E_plate with a plate or a 3D elastic body, the dissipation D = D_viscous + D_friction
     (+ D_plastic, also drawn alone, when contacts yielded), and the sum of those stored
     and dissipated."""
     out = {}
