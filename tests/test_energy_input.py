@@ -108,3 +108,17 @@ def test_energies_figure_draws_the_line_the_balance_closes_on(ds):
     import matplotlib.pyplot as plt
 
     plt.close(fig)
+
+
+def test_fractions_panel_says_the_load_took_energy_back(ds):
+    """Panel (b) names the energy its fractions are of, and the work the load took back."""
+    from granplate.figures.run import fig_energies
+    from granplate.results.analysis import load_work
+
+    fig = fig_energies(ds)
+    title = fig.axes[1].get_title(loc="left")
+    taken = load_work(ds.E_shock.values)[1][-1]
+    assert "the energy put in" in title and f"it took {taken:.3g} J back" in title
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)

@@ -156,7 +156,11 @@ def fig_energies(ds: xr.Dataset) -> Figure:
     a.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     a.set_title("(a) energies", loc="left", fontsize=10)
     b.set_ylabel(f"energy / {reference_label(ds)} [-]")
-    b.set_title(f"(b) fractions of {reference_label(ds)} = {ref:.4g} J", loc="left", fontsize=10)
+    taken = float(an.load_work(ds["E_shock"].values)[1][-1]) if ds.sizes.get("time", 0) else 0.0
+    what = (f"{reference_label(ds)} = {ref:.4g} J" if taken <= NEGLIGIBLE * ref else
+            f"the energy put in, {reference_label(ds)} = {ref:.4g} J (E_shock: the work the load put in; "
+            f"it took {taken:.3g} J back)")
+    b.set_title(f"(b) fractions of {what}", loc="left", fontsize=10 if taken <= NEGLIGIBLE * ref else 8)
     c.plot(t, ds["energy_residual"].values, color="0.2", lw=1.0, gid="energy:residual")
     c.set_ylabel("residual [-]")
     c.set_title("(c) energy-balance residual (eq. 11): (E_p + E_g + D - E_shock - E_initial) / E_in",
