@@ -14,6 +14,9 @@ def _plate_cache(tmp_path_factory):
     import os
 
     os.environ.setdefault("GRANPLATE_CACHE", str(tmp_path_factory.mktemp("plate-cache")))
+    # each test compiles only the kernels it runs: the workers share numba's cache, and one
+    # `granplate run` compiling every scheme's would redo what the others compile meanwhile
+    os.environ.setdefault("GRANPLATE_COMPILE", "own")
     yield
 
 

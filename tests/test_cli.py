@@ -14,7 +14,7 @@ SUMMARY_KEYS = {
     "e_shock", "e_initial", "e_in", "ep_max_fraction", "ep_final_fraction", "eg_max_fraction",
     "eg_final_fraction", "dissipated_fraction", "max_von_mises", "max_von_mises_disc", "max_eps_yy",
     "energy_residual_max", "n_steps", "wall_time_s", "t_end", "plastic_fraction", "max_contact_pressure",
-    "yield_onset_ratio", "contact_pairs",
+    "yield_onset_ratio", "contact_pairs", "e_load_taken", "compile_time_s",
 }
 
 #: Two steel spheres (R = 1 cm) 0.4 mm apart closing at 2 m/s: no plate, no load.

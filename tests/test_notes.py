@@ -20,7 +20,8 @@ PROBE = textwrap.dedent("""
     from kernel import twice
 
     show_notes(quiet=False)
-    model = types.SimpleNamespace(scenario=types.SimpleNamespace(solver=types.SimpleNamespace(scheme="paper")))
+    model = types.SimpleNamespace(scenario=types.SimpleNamespace(solver=types.SimpleNamespace(scheme="paper")),
+                                  config=types.SimpleNamespace(dimension=2))
     args = (np.ones(3),)
     said = note_compile(model, [(twice, args)])
     twice(*args)
@@ -42,7 +43,7 @@ def test_compile_is_announced_only_when_numbas_cache_lacks_it(tmp_path):
     for r in runs:
         assert r.returncode == 0, r.stderr
     assert runs[0].stdout.split() == ["True", "True", "False"]
-    assert "granplate: compiling the time loop for the paper scheme" in runs[0].stderr
+    assert "granplate: compiling the time loop of the paper scheme in the plane (about " in runs[0].stderr
     assert runs[1].stdout.split() == ["False", "True", "False"]
     assert "compiling" not in runs[1].stderr
 

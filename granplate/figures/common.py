@@ -16,6 +16,19 @@ MATERIAL_COLOURS = {"steel": "#8fa3b8", "ptfe": "#f2c14e"}
 OTHER_COLOURS = ("#7fc97f", "#beaed4", "#fdc086", "#f0027f", "#bf5b17", "#66a61e")
 
 
+#: (unit, seconds) from the largest: a duration is written in the largest unit it reaches.
+DURATION_UNITS = (("s", 1.0), ("ms", 1e-3), ("µs", 1e-6), ("ns", 1e-9))
+
+
+def readable_duration(seconds: float) -> str:
+    """A duration [s] in the largest unit it reaches, 4 significant digits at most: 0.1 ->
+    "100 ms", 2e-5 -> "20 µs", 1.5 -> "1.5 s", 3e-10 -> "0.3 ns"."""
+    for unit, size in DURATION_UNITS:
+        if abs(seconds) >= size:
+            return f"{seconds / size:.4g} {unit}"
+    return f"{seconds / DURATION_UNITS[-1][1]:.4g} ns"
+
+
 def new_figure(width: float, height: float) -> Figure:
     """A Figure [inches] on the Agg canvas with constrained layout."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg

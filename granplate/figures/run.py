@@ -65,9 +65,10 @@ def _finish(fig: Figure, ds: xr.Dataset, axes, what: str) -> Figure:
 
 def reference_label(ds: xr.Dataset) -> str:
     """The name of the energy the fractions are of: E_shock for a run from rest, E_initial
-    for a run without a load, else E_shock + E_initial (see `analysis.reference_energy`)."""
+    for a run without a load, else E_shock + E_initial (see `analysis.reference_energy`;
+    E_shock the work the load put in)."""
     e0 = float(ds.attrs.get("E_initial", 0.0))
-    es = float(ds["E_shock"].values[-1]) if ds.sizes.get("time", 0) else 0.0
+    es = float(an.load_work(ds["E_shock"].values)[0][-1]) if ds.sizes.get("time", 0) else 0.0
     total = abs(e0) + abs(es)
     if abs(e0) <= NEGLIGIBLE * total:
         return "E_shock"
@@ -91,13 +92,22 @@ def plastic_work(ds: xr.Dataset) -> np.ndarray | None:
 
 def energy_curves(ds: xr.Dataset) -> dict[str, tuple[str, np.ndarray]]:
     """key -> (legend label, energy [J] over time) of the energy figure: E_shock when the
-    load does work, E_granular with granules (in space also its part KE_depth, the
-    translation along z), E_plate with a plate or a 3D elastic body, the dissipation D = D_viscous + D_friction
+    load does work, E_initial (a constant) when the run starts with some, and with both
+    E_initial + E_shock, the line the balance closes on (eq. 11), E_granular with granules
+    (in space also its part KE_depth, the translation along z), E_plate with a plate or a 3D elastic body, the dissipation D = D_viscous + D_friction
     (+ D_plastic, also drawn alone, when contacts yielded), and the sum of those stored
     and dissipated."""
     out = {}
-    if float(np.abs(ds["E_shock"].values).max()) > 0:
-        out["shock"] = ("$E_{shock}$, work of the load", ds["E_shock"].values)
+    e_shock = ds["E_shock"].values
+    e0 = float(ds.attrs.get("E_initial", 0.0))
+    scale = max(float(np.abs(e_shock).max()), abs(e0))
+    loaded = float(np.abs(e_shock).max()) > NEGLIGIBLE * scale
+    if loaded:
+        out["shock"] = ("$E_{shock}$, work of the load", e_shock)
+    if abs(e0) > NEGLIGIBLE * scale:  # the energy present at t = 0 (initial velocities)
+        out["initial"] = ("$E_{initial}$, energy at t = 0", np.full(len(e_shock), e0))
+        if loaded:  # what E_p + E_g + D closes on (eq. 11)
+            out["input"] = ("$E_{initial} + E_{shock}$, the energy in (the balance closes on it)", e0 + e_shock)
     parts = []
     if an.has_granules(ds):
         out["granular"] = ("$E_{granular}$", ds["E_granular"].values)
@@ -120,9 +130,10 @@ def energy_curves(ds: xr.Dataset) -> dict[str, tuple[str, np.ndarray]]:
     return out
 
 
-#: (colour, line style, width) per curve: E_shock wide and light, so that the sum drawn
-#: over it (equal up to the residual, panel c) leaves both visible.
-ENERGY_STYLE = {"shock": ("0.7", "-", 4.0), "granular": ("tab:blue", "-", 1.3), "plate": ("tab:red", "-", 1.3),
+#: (colour, line style, width) per curve: E_shock (or E_initial + E_shock) wide and light,
+#: so that the sum drawn over it (equal up to the residual, panel c) leaves both visible.
+ENERGY_STYLE = {"shock": ("0.7", "-", 4.0), "initial": ("0.3", ":", 1.3), "input": ("0.7", "-", 4.0),
+                "granular": ("tab:blue", "-", 1.3), "plate": ("tab:red", "-", 1.3),
                 "dissipated": ("tab:green", "-", 1.3), "total": ("tab:purple", "--", 1.3),
                 "depth": ("tab:cyan", ":", 1.3), "plastic": ("tab:olive", ":", 1.3)}
 
@@ -133,8 +144,11 @@ def fig_energies(ds: xr.Dataset) -> Figure:
     a, b, c = fig.subplots(3, 1, sharex=True, height_ratios=(1.0, 1.0, 0.6))
     t = _t_ms(ds)
     ref = an.reference_energy(ds)
-    for key, (label, e) in energy_curves(ds).items():
+    curves = energy_curves(ds)
+    for key, (label, e) in curves.items():
         colour, ls, lw = ENERGY_STYLE[key]
+        if key == "shock" and "input" in curves:  # the wide light line is then the input's
+            colour, ls, lw = "0.4", "--", 1.0
         a.plot(t, e, color=colour, ls=ls, lw=lw, label=label, gid=f"energy:{key}")
         b.plot(t, e / ref, color=colour, ls=ls, lw=lw, label=label, gid=f"fraction:{key}")
     a.set_ylabel("energy [J]")
@@ -142,7 +156,11 @@ def fig_energies(ds: xr.Dataset) -> Figure:
     a.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     a.set_title("(a) energies", loc="left", fontsize=10)
     b.set_ylabel(f"energy / {reference_label(ds)} [-]")
-    b.set_title(f"(b) fractions of {reference_label(ds)} = {ref:.4g} J", loc="left", fontsize=10)
+    taken = float(an.load_work(ds["E_shock"].values)[1][-1]) if ds.sizes.get("time", 0) else 0.0
+    what = (f"{reference_label(ds)} = {ref:.4g} J" if taken <= NEGLIGIBLE * ref else
+            f"the energy put in, {reference_label(ds)} = {ref:.4g} J (E_shock: the work the load put in; "
+            f"it took {taken:.3g} J back)")
+    b.set_title(f"(b) fractions of {what}", loc="left", fontsize=10 if taken <= NEGLIGIBLE * ref else 8)
     c.plot(t, ds["energy_residual"].values, color="0.2", lw=1.0, gid="energy:residual")
     c.set_ylabel("residual [-]")
     c.set_title("(c) energy-balance residual (eq. 11): (E_p + E_g + D - E_shock - E_initial) / E_in",

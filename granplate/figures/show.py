@@ -19,7 +19,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Patch, Polygon
 
 from granplate.figures.assembly import Assembly, load_profile
-from granplate.figures.common import material_colours, new_figure
+from granplate.figures.common import material_colours, new_figure, readable_duration
 
 MM = 1e3  # m -> mm
 
@@ -173,7 +173,7 @@ def _draw_contacts(fig: Figure, ax, a: Assembly) -> list:
 
 def _load_text(a: Assembly) -> str:
     ld = a.load
-    text = (f"load: q0 = {ld.q0 / 1e3:.4g} kN/m half-sine, T = {ld.duration * 1e6:.3g} µs,\n"
+    text = (f"load: q0 = {ld.q0 / 1e3:.4g} kN/m half-sine, T = {readable_duration(ld.duration)},\n"
             f"y = {ld.y0 * MM:.4g}-{(ld.y0 + ld.length) * MM:.4g} mm")
     if a.time is not None and a.time > ld.duration:
         text += " (over at this time)"

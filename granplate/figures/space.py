@@ -52,7 +52,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Patch
 
-from granplate.figures.common import material_colours, new_figure
+from granplate.figures.common import material_colours, new_figure, readable_duration
 from granplate.setup.scenario import Load, Scenario, Wall
 
 MM = 1e3  # m -> mm
@@ -269,9 +269,38 @@ def solid_drawing(s: Scenario, written: Scenario | None = None) -> dict:
             "solid_material": sd.material}
 
 
+def body_touching(s: Scenario, pos: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """Contact lines (nb, 2, 3) [m] from each granule of the resolved `s` touching its elastic
+    solid at t = 0 (the sphere's gap to the surface at most contact.neighbour_gap R, the
+    rule of the pairs) to the nearest point of the surface: a box's in closed form, a mesh
+    file's by `solid.surface.closest_point`. None without a solid."""
+    from granplate.setup.scenario import Solid
+    from granplate.setup.solid_checks import box_corners, box_signed_distance, is_box
+
+    sd = s.plate
+    if not isinstance(sd, Solid) or not len(pos):
+        return _no_segments()
+    if is_box(sd):
+        lo, hi = box_corners(sd)
+        near = np.clip(pos, lo, hi)
+        dist = np.array([box_signed_distance(lo, hi, p) for p in pos])
+    else:
+        from granplate.solid.build import solid_mesh
+        from granplate.solid.fe import vector_basis
+        from granplate.solid.surface import boundary_surface, closest_point
+
+        surface = boundary_surface(vector_basis(solid_mesh(sd), sd.element))
+        found = [closest_point(surface, p) for p in pos]
+        near = np.array([c.point for c in found], float)
+        dist = np.array([c.distance for c in found], float)
+    touch = dist - r <= s.contact.neighbour_gap * r
+    return np.stack([pos[touch], near[touch]], axis=1).reshape(-1, 2, 3)
+
+
 def of_scenario(scenario: Scenario) -> Assembly3D:
     """The 3D assembly of a scenario before its run: initial centres, the contacts
-    touching at t = 0 (no forces), its elastic solid (`solid_drawing`)."""
+    touching at t = 0 (no forces: granule pairs, walls and the elastic solid,
+    `body_touching`), its elastic solid (`solid_drawing`)."""
     from granplate.model.space import loaded_granules_3d
     from granplate.setup.geometry import resolve
 
@@ -280,10 +309,12 @@ def of_scenario(scenario: Scenario) -> Assembly3D:
     r = np.array([g.radius for g in s.granules], float)
     pairs, wc = touching(s, pos, r)
     segs, kinds = contact_segments(pos, s.walls, pairs, wc)
+    body = body_touching(s, pos, r)
     return Assembly3D(
         name=s.name, pos=pos, radius=r, labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
         materials=tuple(g.material for g in s.granules), walls=s.walls, load=s.load,
-        loaded=loaded_granules_3d(s, pos[:, 0], pos[:, 1], pos[:, 2], r), segments=segs, kinds=kinds,
+        loaded=loaded_granules_3d(s, pos[:, 0], pos[:, 1], pos[:, 2], r),
+        segments=np.concatenate([segs, body]), kinds=kinds + ("body",) * len(body),
         **solid_drawing(s, scenario),
     )
 
@@ -607,7 +638,7 @@ def _load_text(a: Assembly3D, series: bool = False) -> str | None:
         return None
     d = np.asarray(ld.direction, float)
     d = d / np.linalg.norm(d)
-    text = (f"load: {ld.force:.4g} N half-sine, T = {ld.duration * 1e6:.3g} µs, along "
+    text = (f"load: {ld.force:.4g} N half-sine, T = {readable_duration(ld.duration)}, along "
             f"({d[0]:.3g}, {d[1]:.3g}, {d[2]:.3g}), on {int(a.loaded.sum())} granule(s) (red outline)")
     if a.time is not None and a.time > ld.duration and not series:
         text += ", over at this time"

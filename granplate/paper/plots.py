@@ -75,9 +75,28 @@ def _t_end_ms(ds: xr.Dataset) -> float:
     return float(ds["time"].values[-1]) * 1e3
 
 
+def _normal_law(ds: xr.Dataset) -> str:
+    """The run's contact.normal_law, in words ("Hertz contacts", "Thornton contacts")."""
+    from granplate.results.dataset import scenario_of
+
+    try:
+        law = scenario_of(ds).contact.normal_law
+    except Exception:  # noqa: BLE001 - a result without its scenario: the law is unknown
+        return "contact law unknown"
+    return f"{str(law).capitalize()} contacts"
+
+
+def run_labels(datasets) -> list[str]:
+    """Each run's label in a caption: its name and t_end, and its contact law where two runs
+    share a name (a preset and its twin with yielding contacts)."""
+    names = [_name(d) for d in datasets]
+    return [f"{n} ({_normal_law(d) + ', ' if names.count(n) > 1 else ''}t_end = {_t_end_ms(d):.3g} ms)"
+            for n, d in zip(names, datasets)]
+
+
 def _caption(fig: Figure, text: str, *datasets: xr.Dataset) -> None:
     """A caption line under the panels: what is shown, and which runs it comes from."""
-    runs = ", ".join(f"{_name(d)} (t_end = {_t_end_ms(d):.3g} ms)" for d in datasets)
+    runs = ", ".join(run_labels(datasets))
     version = datasets[0].attrs.get("granplate_version", "?") if datasets else "?"
     full = f"{text}  Runs: {runs}; granplate {version}."
     width = int(fig.get_figwidth() * 15)

@@ -30,15 +30,37 @@ KINETIC_PARTS: dict[str, str] = {
 }
 
 
+def load_work(e_shock: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The load's work E_shock(t) [J] split into what it put in and what it took back,
+    both non-decreasing and non-negative, E_shock = put_in - taken: the sums of E_shock's
+    rises and of its falls between output times. A load takes energy back when its force
+    opposes the velocity of the granules it pushes (granules moving toward it, as with
+    initial velocities against the load): its power F . v is then negative."""
+    e = np.asarray(e_shock, dtype=float)
+    step = np.diff(e, prepend=0.0)
+    return np.cumsum(np.maximum(step, 0.0)), np.cumsum(np.maximum(-step, 0.0))
+
+
+def energy_put_in(ds: xr.Dataset) -> np.ndarray:
+    """E_initial + the load's work put in so far [J] over time (`load_work`): the energy
+    put into the run; E_p + E_g + D never exceeds it (eq. 11: they sum to E_initial +
+    E_shock, which the load's work taken back lowers)."""
+    e0 = float(ds.attrs.get("E_initial", 0.0))
+    if not ds.sizes.get("time", 0):
+        return np.zeros(0)
+    return e0 + load_work(ds["E_shock"].values)[0]
+
+
 def reference_energy(ds: xr.Dataset) -> float:
-    """The energy put in [J]: E_shock at the last output plus any initial energy.
+    """The energy put in [J]: E_initial plus the work the load put in (E_shock at the last
+    output for a load that never takes energy back, `load_work`).
 
     Every normalised quantity here divides by this number (the paper's "applied shock
-    energy"); 1.0 when the run put no energy in (avoids dividing by zero).
+    energy"), so no share of it exceeds 1 beyond the energy residual; 1.0 when the run put
+    no energy in (avoids dividing by zero).
     """
-    e0 = float(ds.attrs.get("E_initial", 0.0))
-    e_in = float(ds["E_shock"].values[-1]) if ds.sizes.get("time", 0) else 0.0
-    ref = e_in + e0
+    e = energy_put_in(ds)
+    ref = float(e[-1]) if len(e) else 0.0
     return ref if ref > 0 else 1.0
 
 

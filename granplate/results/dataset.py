@@ -422,25 +422,32 @@ def read(path: str | Path) -> xr.Dataset:
 #: Unit of every number in `summary` ("1": a pure number; the *_fraction values are
 #: fractions of e_in = e_shock + e_initial).
 SUMMARY_UNITS: dict[str, object] = {
-    "t_end": "s", "e_shock": "J", "e_initial": "J", "e_in": "J",
+    "t_end": "s", "e_shock": "J", "e_load_taken": "J", "e_initial": "J", "e_in": "J",
     "ep_max_fraction": "1", "ep_final_fraction": "1", "eg_max_fraction": "1",
     "eg_final_fraction": "1", "dissipated_fraction": "1",
     "plastic_fraction": "1", "max_contact_pressure": "Pa", "yield_onset_ratio": "1",
     "contact_pairs": {"max_contact_pressure": "Pa", "yield_onset_ratio": "1", "yield_strength": "Pa", "time": "s"},
     "max_von_mises": "Pa", "max_von_mises_disc": "Pa", "max_eps_yy": "1", "energy_residual_max": "1",
-    "n_steps": "1", "wall_time_s": "s", "max_von_mises_ball": "Pa", "max_displacement": "m",
+    "n_steps": "1", "wall_time_s": "s", "compile_time_s": "s", "max_von_mises_ball": "Pa", "max_displacement": "m",
 }
 
 
 def summary(ds: xr.Dataset) -> dict:
     """The headline figures of a run (the CLI's table and --summary JSON), units in "units".
 
-    Energies are fractions of e_in = e_shock + e_initial [J], the work of the load plus
-    the energy present at t = 0 (docs/output.md); they are None when e_in = 0. Plate
-    metrics are None for a run without a plate (not applicable, not zero).
+    Energies are fractions of e_in = e_shock + e_initial [J], the energy put in: the work
+    the load put in plus the energy present at t = 0 (docs/output.md); they are None when
+    e_in = 0. e_shock is E_shock at t_end unless the load also took energy back
+    (e_load_taken: its force against granules moving toward it, `analysis.load_work`),
+    so that neither is negative and no share exceeds 1 beyond the energy residual; the
+    energies at t_end add up to e_in - e_load_taken. Plate metrics are None for a run
+    without a plate (not applicable, not zero).
     """
+    from granplate.results.analysis import load_work
+
     e0 = float(ds.attrs.get("E_initial", 0.0))
-    e_shock = float(ds.E_shock[-1]) if ds.sizes["time"] else 0.0
+    put_in, taken = load_work(ds.E_shock.values) if ds.sizes["time"] else (np.zeros(1), np.zeros(1))
+    e_shock, e_taken = float(put_in[-1]), float(taken[-1])
     e_in = e_shock + e0
     ref = e_in if e_in > 0 else None
     has_plate = "max_von_mises" in ds
@@ -457,6 +464,7 @@ def summary(ds: xr.Dataset) -> dict:
         "units": {},
         "t_end": float(ds.time[-1]),
         "e_shock": e_shock,
+        "e_load_taken": e_taken,
         "e_initial": e0,
         "e_in": e_in,
         "ep_max_fraction": fraction(ds.E_plate.max(), plate=True),
@@ -474,7 +482,8 @@ def summary(ds: xr.Dataset) -> dict:
         "max_eps_yy": float(ds.max_eps_yy.max()) if has_plate and "max_eps_yy" in ds else None,
         "energy_residual_max": float(np.max(np.abs(ds.energy_residual_max))),
         "n_steps": int(info.get("n_steps", 0)),
-        "wall_time_s": float(info.get("wall_time_s", 0.0)),
+        "wall_time_s": float(info.get("wall_time_s", 0.0)),  # without compile_time_s
+        "compile_time_s": float(info.get("compile_time_s", 0.0)),  # numba compiling the kernels first
         # an elastic solid in space: its largest ball-averaged stress and displacement
         **{name: float(ds[name].max()) for name in ("max_von_mises_ball", "max_displacement") if name in ds},
     }

@@ -43,7 +43,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from granplate.setup.scenario import (BOX_WALLS, ChainLayout, Granule, Imperfections, LatticeLayout,
+from granplate.setup.scenario import (BOX_WALLS, ChainLayout, Granule, Imperfections, LatticeLayout, Layer,
                                       SpaceLattice, Wall)
 
 
@@ -300,26 +300,31 @@ def sites_per_cell(kind: str) -> int:
     return sum(len(s) for s in PLANE_SITES[kind])
 
 
-def cells_along_x(lay: SpaceLattice) -> int:
-    """The cells along x: cells[0], or with layers the sum of their counts (which cells[0]
-    equals, or cells[0] = 0 leaves to them)."""
-    return sum(ly.count for ly in lay.layers) if lay.layers else lay.cells[0]
+def layer_planes(kind: str, layer: Layer) -> int:
+    """The lattice planes of a layer: its `planes`, else `count` cells (1 when neither) of
+    planes_per_cell(kind) planes each."""
+    if layer.planes is not None:
+        return layer.planes
+    return planes_per_cell(kind) * (1 if layer.count is None else layer.count)
 
 
-def cell_layers(lay: SpaceLattice) -> list[tuple[float, str]]:
-    """(R [m], material) of each cell along x: the layers in order, each `count` times
-    (radius, material None: the layout's), or one layer of radius, material."""
-    if not lay.layers:
-        return [(lay.radius, lay.material)] * lay.cells[0]
-    return [(lay.radius if ly.radius is None else ly.radius,
-             lay.material if ly.material is None else ly.material)
-            for ly in lay.layers for _ in range(ly.count)]
+def planes_along_x(lay: SpaceLattice) -> int:
+    """The lattice planes along x: the layers' planes added up, else `planes`, else
+    cells[0] cells of planes_per_cell(kind) planes each."""
+    if lay.layers:
+        return sum(layer_planes(lay.kind, ly) for ly in lay.layers)
+    if lay.planes is not None:
+        return lay.planes
+    return planes_per_cell(lay.kind) * lay.cells[0]
 
 
 def plane_layers(lay: SpaceLattice) -> list[tuple[float, str]]:
     """(R_p [m], material) of each lattice plane p = 1.. along x."""
-    n = planes_per_cell(lay.kind)
-    return [rm for rm in cell_layers(lay) for _ in range(n)]
+    if not lay.layers:
+        return [(lay.radius, lay.material)] * planes_along_x(lay)
+    return [(lay.radius if ly.radius is None else ly.radius,
+             lay.material if ly.material is None else ly.material)
+            for ly in lay.layers for _ in range(layer_planes(lay.kind, ly))]
 
 
 def plane_gap_distance(kind: str, t: int, u: int, r_max: float) -> float:

@@ -190,13 +190,15 @@ SPACE_LATTICE_KINDS: tuple[str, ...] = ("sc", "bcc", "fcc", "hcp")
 
 @dataclass(frozen=True)
 class Layer:
-    """One layer of a `SpaceLattice`, `layout.layers[k]`: `count` cells along x (the load
-    direction) whose spheres have `radius` [m] (None = the layout's radius) and `material`
-    (None = the layout's material)."""
+    """One layer of a `SpaceLattice`, `layout.layers[k]`: `count` conventional cells along x
+    (the load direction; 2 lattice planes each for bcc, fcc and hcp, 1 for sc) or `planes`
+    lattice planes (any number, odd too; not both; neither: one cell) whose spheres have
+    `radius` [m] (None = the layout's radius) and `material` (None = the layout's material)."""
 
-    count: int = 1
+    count: int | None = None
     radius: float | None = None
     material: str | None = None
+    planes: int | None = None
 
 
 @dataclass(frozen=True)
@@ -212,7 +214,9 @@ class SpaceLattice:
     material (the counts add up to nx; empty = one layer of radius, material); the planes'
     spacing follows their radii so that neighbours in adjacent planes touch. Site labels
     "x{plane}y{row}z{site}" (1-based: plane along x, row along y in the plane, site along z
-    in the row). intruder_sites, intruder_every, intruder_ratio (<= 1), intruder_material: single
+    in the row). planes: the lattice planes along x instead of cells[0] (which is then 0; any
+    number, odd too: the stacking goes on plane by plane, ABA... for fcc's two plane types).
+    intruder_sites, intruder_every, intruder_ratio (<= 1), intruder_material: single
     sites shrunk at their centres, as in `LatticeLayout`. walls: which of the six walls
     (BOX_WALLS) enclose the packing, each touching its outermost surfaces, of wall_material.
     """
@@ -222,6 +226,7 @@ class SpaceLattice:
     radius: float = 0.01
     material: str = "steel"
     layers: tuple[Layer, ...] = ()
+    planes: int | None = None
     intruder_ratio: float = 1.0
     intruder_material: str | None = None
     intruder_sites: tuple[str, ...] = ()

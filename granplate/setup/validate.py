@@ -23,9 +23,9 @@ import numpy as np
 
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import granule_named, layout_packing, plane_offset, resolve, unit
-from granplate.setup.layouts import (INTRUDER_COLUMN_RULES, cells_along_x, column_radii, half_pitch,
+from granplate.setup.layouts import (INTRUDER_COLUMN_RULES, column_radii, layer_planes, half_pitch,
                                      hexagonal_offsets, lattice_sites, plane_clash, plane_gap_distance,
-                                     plane_layers, plane_type, planes_per_cell, sites_per_cell, space_sites)
+                                     plane_layers, plane_type, planes_along_x, planes_per_cell, sites_per_cell, space_sites)
 from granplate.setup.fields import check_dimension, finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
 from granplate.setup.pairs import close_pairs
 from granplate.setup.plate_checks import check_plate_fields, check_plate_mesh
@@ -35,7 +35,7 @@ from granplate.setup.plate_cost import MEMORY_SHARE, physical_memory
 from granplate.setup.materials import Material
 from granplate.setup.scenario import (Solid, BOX_WALLS, LAYOUT_KINDS, LAYOUT_KINDS_BY_DIMENSION, NORMAL_LAWS,
                                       SPACE_LATTICE_KINDS, SQRT2_MINUS_1, ChainLayout, Granule,
-                                      Imperfections, LatticeLayout, Layout, Plate, Scenario,
+                                      Imperfections, LatticeLayout, Layer, Layout, Plate, Scenario,
                                       SpaceLattice)
 
 #: Lever arms of the friction torque (Contact.torque_arm).
@@ -366,15 +366,16 @@ def _check_space_lattice(s: Scenario, lay: SpaceLattice) -> None:
     if not isinstance(cells, tuple) or len(cells) != 3:
         raise ScenarioError("layout.cells", cells, "must be three integers [nx, ny, nz] >= 1 (cells "
                             "along x, the load direction, y and z)")
+    _check_planes(lay)
     for k, n in enumerate(cells):
-        if k == 0 and n == 0 and lay.layers:
-            continue  # the layers' counts give the cells along x
+        if k == 0 and n == 0 and (lay.layers or lay.planes is not None):
+            continue  # the layers' counts or layout.planes give the planes along x
         int_at_least(f"layout.cells[{k}]", n, 1)
-    if isinstance(lay.layers, tuple) and all(isinstance(ly.count, int) for ly in lay.layers):
-        n_x = cells_along_x(lay)
-    else:
-        n_x = cells[0]
-    n_sites = sites_per_cell(lay.kind) * n_x * cells[1] * cells[2]
+    layers_ok = isinstance(lay.layers, tuple) and all(isinstance(ly, Layer) for ly in lay.layers)
+    if layers_ok:
+        _check_layer_sizes(lay)
+    n_planes = planes_along_x(lay) if layers_ok else planes_per_cell(lay.kind) * cells[0]
+    n_sites = sites_per_cell(lay.kind) * n_planes * cells[1] * cells[2] // planes_per_cell(lay.kind)
     if n_sites > MAX_LAYOUT_SITES:
         raise ScenarioError("layout.cells", list(cells), f"makes {n_sites} sites ({sites_per_cell(lay.kind)} "
                             f"per {lay.kind} cell); allowed: at most {MAX_LAYOUT_SITES} sites")
@@ -399,14 +400,44 @@ def _check_space_lattice(s: Scenario, lay: SpaceLattice) -> None:
                                      "z{site}: plane along x, row along y, site along z, from 1)")
 
 
-def _check_layers(s: Scenario, lay: SpaceLattice) -> None:
-    """Each layer: count >= 1, radius (or None), material (or None); counts add up to cells[0]
-    (unless cells[0] is 0: then they give it)."""
+def _check_planes(lay: SpaceLattice) -> None:
+    """layout.planes: an integer >= 1, instead of cells[0] and of the layers' sizes."""
+    if lay.planes is None:
+        return
+    int_at_least("layout.planes", lay.planes, 1)
+    if lay.layers:
+        raise ScenarioError("layout.planes", lay.planes, "give layout.planes or layout.layers, not both "
+                            "(with layers, each layer's count or planes sizes it)")
+    if isinstance(lay.cells, tuple) and lay.cells and lay.cells[0] != 0:
+        raise ScenarioError("layout.planes", lay.planes, f"give layout.planes (lattice planes along x) or "
+                            f"layout.cells[0] = {lay.cells[0]} (cells along x), not both: with planes write "
+                            f"cells = [0, ny, nz]")
+
+
+def _check_layer_sizes(lay: SpaceLattice) -> None:
+    """Each layer's size: count (cells) >= 1 or planes >= 1, not both."""
     if not isinstance(lay.layers, tuple):
-        raise ScenarioError("layout.layers", lay.layers, "must be a list of tables {count, radius, material}")
+        return
     for k, ly in enumerate(lay.layers):
         p = f"layout.layers[{k}]"
-        int_at_least(f"{p}.count", ly.count, 1)
+        if ly.count is not None and ly.planes is not None:
+            raise ScenarioError(f"{p}.planes", ly.planes, f"give {p}.count (cells along x, "
+                                f"{planes_per_cell(lay.kind)} lattice planes each for {lay.kind}) or {p}.planes "
+                                "(lattice planes), not both")
+        if ly.planes is not None:
+            int_at_least(f"{p}.planes", ly.planes, 1)
+        elif ly.count is not None:
+            int_at_least(f"{p}.count", ly.count, 1)
+
+
+def _check_layers(s: Scenario, lay: SpaceLattice) -> None:
+    """Each layer: its size (`_check_layer_sizes`), radius (or None), material (or None);
+    the planes add up to those of cells[0] (unless cells[0] is 0: then they give it)."""
+    if not isinstance(lay.layers, tuple):
+        raise ScenarioError("layout.layers", lay.layers, "must be a list of tables {count or planes, radius, "
+                            "material}")
+    for k, ly in enumerate(lay.layers):
+        p = f"layout.layers[{k}]"
         if ly.radius is not None:
             layout_radius(f"{p}.radius", ly.radius)
         if ly.material is not None:
@@ -416,19 +447,22 @@ def _check_layers(s: Scenario, lay: SpaceLattice) -> None:
         if not max(radii) <= LENGTH_RANGE * r:
             raise ScenarioError(f"layout.layers[{k}].radius", r, f"allowed: at least 1 / {LENGTH_RANGE:g} "
                                 f"of the largest layer radius {max(radii):.6g} m (a ratio of radii)")
-    total = sum(ly.count for ly in lay.layers)
-    if lay.layers and lay.cells[0] != 0 and total != lay.cells[0]:
-        raise ScenarioError("layout.layers", [ly.count for ly in lay.layers],
-                            f"the layers' counts add up to {total} cells; allowed: they add up to "
-                            f"layout.cells[0] = {lay.cells[0]} (the cells along x; 0: as many as the layers' counts add up to)")
+    n = planes_per_cell(lay.kind)
+    total = planes_along_x(lay)
+    if lay.layers and lay.cells[0] != 0 and total != n * lay.cells[0]:
+        raise ScenarioError("layout.layers", [ly.count if ly.planes is None else f"{ly.planes} planes"
+                                              for ly in lay.layers],
+                            f"the layers add up to {total} lattice planes ({total / n:g} cells); allowed: they "
+                            f"add up to layout.cells[0] = {lay.cells[0]} (the cells along x; 0: as many as "
+                            f"the layers' counts add up to)")
 
 
 def _layer_of_plane(lay: SpaceLattice, plane: int) -> int:
     """The index in layout.layers of the layer holding plane `plane` (0-based)."""
-    cell, acc = plane // planes_per_cell(lay.kind), 0
+    acc = 0
     for k, ly in enumerate(lay.layers):
-        acc += ly.count
-        if cell < acc:
+        acc += layer_planes(lay.kind, ly)
+        if plane < acc:
             return k
     return len(lay.layers) - 1  # pragma: no cover (the counts add up to cells[0])
 

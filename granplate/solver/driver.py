@@ -22,6 +22,7 @@ from granplate.model.contacts import Missed, centre_coordinates, contact_lists, 
 from granplate.model.neighbours import verlet_pairs, verlet_walls
 from granplate.physics.contact import plate_overlap
 from granplate.solver import loop, state as S
+from granplate.solver.compiling import compile_calls, compile_seconds, describe_seconds, machine_slowdown
 from granplate.plate.face import patch_weights
 from granplate.solver.interface import set_face_weights
 from granplate.solver.ladder import level_for
@@ -30,12 +31,6 @@ from granplate.solver.schemes import scheme
 #: wall-time target of one compiled chunk [s], and the step budget of the first one.
 CHUNK_SECONDS = 0.15
 FIRST_BUDGET = 64
-#: About how long [s] compiling the time loop of each scheme takes when numba's cache
-#: does not hold it (the first run after installing; docs/benchmarks.md, "Compiling the
-#: kernels"): implicit 73 s on 2 idle cores (97 s of CPU time on a loaded machine); paper
-#: 26 s of CPU time once the callees it shares with implicit are cached; verlet with an
-#: elastic body in space about 60 s.
-COMPILE_SECONDS = {"implicit": 75, "paper": 25, "verlet": 60}
 
 log = logging.getLogger(__name__)
 #: step attempts without the clock moving after which a run is stopped (every retry
@@ -507,14 +502,26 @@ def is_compiled(dispatcher, args: tuple) -> bool:
 
 
 def note_compile(model: Model, calls: list[tuple]) -> bool:
-    """Log (INFO) that the time loop is about to be compiled when any of `calls`
-    ((dispatcher, args)) is not compiled yet; True when it is not."""
+    """Log (INFO) that the time loop is about to be compiled, with the measured estimate,
+    when any of `calls` ((dispatcher, args)) is not compiled yet; True when it is not."""
     if all(is_compiled(f, args) for f, args in calls):
         return False
-    name = model.scenario.solver.scheme
-    log.info(f"compiling the time loop for the {name} scheme (first run after install; about "
-             f"{COMPILE_SECONDS.get(name, 60)} s on 2 idle cores; cached afterwards) ...")
+    name, dim = model.scenario.solver.scheme, model.config.dimension
+    where = "in space" if dim == 3 else "in the plane"
+    seconds, slow = compile_seconds(name, dim), machine_slowdown()
+    busy = f"; this machine is busy, {slow:.1f}x" if slow > 1.2 else ""
+    log.info(f"compiling the time loop of the {name} scheme {where} (about {describe_seconds(slow * seconds)}: "
+             f"{describe_seconds(seconds)} of CPU measured on a cold cache{busy}; cached afterwards) ...")
     return True
+
+
+def progress_bar(total: int, desc: str, file=None):
+    """The run's progress bar over its output times, started once the loop is compiled:
+    until the first output it shows no rate and no time left ("?"), never an estimate
+    made from the compile time."""
+    from tqdm import tqdm
+
+    return tqdm(total=total, desc=desc, unit="out", leave=False, file=file)
 
 
 def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool] | None = None,
@@ -538,11 +545,13 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
         attach_patches(model, lists, arr, model.initial_patches)  # touching between nodes at t = 0
         st, w = arr.st, arr.w  # grown
     st.count[S.C_LEVEL] = level_for(model.scenario.time.dt_initial, cfg)
-    note_compile(model, [(loop.initialise, (st, lists.g, arr.p, cfg, w)),
-                         (loop.record, (0, st, lists.g, arr.p, w, arr.out)),
-                         (loop.advance, (float(times[-1]), FIRST_BUDGET, lists.g, arr.p, cfg, st, arr.w,
-                                         arr.sw, arr.out))])
+    calls = [(loop.initialise, (st, lists.g, arr.p, cfg, w)),
+             (loop.start_scheme, (arr.sw, st, lists.g, cfg)),
+             (loop.record, (0, st, lists.g, arr.p, w, arr.out)),
+             (loop.advance, (float(times[-1]), FIRST_BUDGET, lists.g, arr.p, cfg, st, arr.w, arr.sw, arr.out))]
     t1 = time.perf_counter()
+    note_compile(model, calls)
+    compile_calls(calls)  # before the bar and the loop's clock: neither counts the compile
     loop.initialise(st, lists.g, arr.p, cfg, w)
     loop.start_scheme(arr.sw, st, lists.g, cfg)
     loop.record(0, st, lists.g, arr.p, w, arr.out)
@@ -550,9 +559,7 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
     t_first = time.perf_counter() - t1  # includes compiling / loading the loop
     bar = None
     if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=len(times) - 1, desc=model.scenario.name, unit="out", leave=False)
+        bar = progress_bar(len(times) - 1, model.scenario.name)
     polls = [should_stop] if should_stop is not None else []
     t2 = time.perf_counter()
     c2, c3 = time.process_time(), time.thread_time()

@@ -42,7 +42,7 @@ INPUTS_FILE = "inputs.sha256"
 #: Metrics of the heat maps and, without [objectives], those whose best design is drawn.
 HEADLINE: tuple[str, ...] = ("ep_max_fraction", "max_von_mises", "max_von_mises_disc")
 #: Metrics that say how the run went rather than what the design does (figures last).
-RUN_METRICS: tuple[str, ...] = ("t_end", "energy_residual_max", "n_steps", "wall_time_s")
+RUN_METRICS: tuple[str, ...] = ("t_end", "energy_residual_max", "n_steps", "wall_time_s", "compile_time_s")
 #: Metrics of the designs table besides the objectives, constraints and targets (the CSV
 #: table has them all).
 TABLE_METRICS: tuple[str, ...] = ("ep_max_fraction", "ep_final_fraction", "dissipated_fraction",
