@@ -22,7 +22,7 @@ FIELD_UNITS: dict[str, str] = {
     # in space, and the layouts' counts
     "z": "m", "vz": "m/s", "size": "m", "origin": "m", "elements": "1", "patch_radius": "m",
     "stress_radius": "m", "max_frequency": "Hz", "force": "N", "Y": "Pa", "k_s": "s/m",
-    "count": "1", "cells": "1", "columns": "1", "rows": "1", "intruder_ratio": "1",
+    "count": "1", "cells": "1", "planes": "1", "columns": "1", "rows": "1", "intruder_ratio": "1",
     # every other number of a scenario (the generated reference of the site shows them)
     "dimension": "1", "taper": "1", "dimer_ratio": "1", "decorated_ratio": "1", "seed": "1",
     "radius_spread": "1", "jitter": "1", "vacancy_fraction": "1", "intruder_every": "1",
