@@ -125,11 +125,17 @@ def law_coefficients(s: Scenario, a, b, b_name: str, e_star: float, r_star: floa
     rate (the sum of the radii; a diameter against a rigid body). Hertz: [inf, 0...];
     "thornton": [delta_y, 0...]; "johnson": delta_y, R* Y, C, 1 / (length rate_ref), h and
     kappa of the softer body (docs/model.md section 3.8; absent rate fields: rate-free)."""
+    if normal_law_of(s, a.name, b_name) == "johnson":
+        return johnson_columns(softer_material(a, b), e_star, r_star, length)
     out = np.zeros(COEF_KAPPA - COEF_DY + 1)
     out[0] = law_yield_overlap(s, a, b, b_name, e_star, r_star)
-    if normal_law_of(s, a.name, b_name) != "johnson":
-        return out
-    m = softer_material(a, b)
+    return out
+
+
+def johnson_columns(m, e_star: float, r_star: float, length: float) -> np.ndarray:
+    """The law "johnson"'s columns COEF_DY..COEF_KAPPA of a contact whose softer body is
+    of Material m (its Y known), E* [Pa], R* [m], `length` [m] (`law_coefficients`)."""
+    out = np.zeros(COEF_KAPPA - COEF_DY + 1)
     out[0] = contact_yield_overlap(e_star, r_star, m.Y)
     out[COEF_SY - COEF_DY] = r_star * m.Y
     if m.C is not None and m.rate_ref is not None:
