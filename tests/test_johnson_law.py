@@ -1,4 +1,4 @@
-"""The law "johnson" (docs/model.md section 3.8) against its closed forms: Hertz below
+"""The law "johnson" (docs/model.md section 3.10) against its closed forms: Hertz below
 yield, force and slope continuous at yield and at the bridge's end, the fully plastic
 line 2 pi R* h Y(rate) delta, unloading and reloading along the Hertz curve of the
 residual overlap, energy (stored + plastic work = work done, by quadrature), the rate

@@ -124,7 +124,7 @@ def law_coefficients(s: Scenario, a, b, b_name: str, e_star: float, r_star: floa
     `law_yield_overlap`), `length` [m] the length that makes the approach speed a strain
     rate (the sum of the radii; a diameter against a rigid body). Hertz: [inf, 0...];
     "thornton": [delta_y, 0...]; "johnson": delta_y, R* Y, C, 1 / (length rate_ref), h and
-    kappa of the softer body (docs/model.md section 3.8; absent rate fields: rate-free)."""
+    kappa of the softer body (docs/model.md section 3.10; absent rate fields: rate-free)."""
     if normal_law_of(s, a.name, b_name) == "johnson":
         return johnson_columns(softer_material(a, b), e_star, r_star, length)
     out = np.zeros(COEF_KAPPA - COEF_DY + 1)

@@ -1,6 +1,6 @@
 """The elastic-plastic normal law "johnson": Hertz to yield, Johnson's expanding-cavity
 mean pressure over the plastic contact disc up to the hardness, a rate-dependent yield
-strength (docs/model.md section 3.8).
+strength (docs/model.md section 3.10).
 
 Sources: the onset of yield at the Hertz peak pressure 1.6 Y (Johnson, Contact Mechanics,
 1985, section 6.2, as Thornton 1997); the mean pressure of an elastic-plastic indentation

@@ -41,7 +41,7 @@ def damping_coefficient(alpha_n: float, m_star: float, a: float) -> float:
 #: (eq. 3), friction coefficient mu [-], regularisation k_s [s/m] (eq. 5), and the yield
 #: overlap delta_y [m] of the elastic-plastic law (docs/model.md section 3.6, eq. P3;
 #: inf: the contact follows Hertz's law, eq. 2); then the law "johnson" (docs/model.md
-#: section 3.8; 0 in COEF_SY: Thornton's law where COEF_DY is finite): R* Y [N/m], the rate
+#: section 3.10; 0 in COEF_SY: Thornton's law where COEF_DY is finite): R* Y [N/m], the rate
 #: coefficient C [-], 1 / (L rate_ref) [s/m] with L the length that makes the approach speed a
 #: strain rate, the hardness ratio h [-] and the unloading factor kappa [-] (eqs. J1-J8).
 COEF_A, COEF_C, COEF_MU, COEF_KS, COEF_DY = 0, 1, 2, 3, 4

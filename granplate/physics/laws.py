@@ -1,6 +1,6 @@
 """The normal law of one contact, chosen by its coefficient row: Hertz's (eq. 2,
 `contact.normal_response`) when the row's yield overlap COEF_DY is infinite; else the
-law "johnson" (docs/model.md section 3.8, `cavity.johnson_normal_response`) when the row
+law "johnson" (docs/model.md section 3.10, `cavity.johnson_normal_response`) when the row
 holds its force scale COEF_SY, else the elastic-plastic law of Thornton (docs/model.md
 section 3.6, `plastic.yielding_normal_response`), each with the contact's history: its
 largest overlap delta_max and, for "johnson", the approach speed that fixed its yield

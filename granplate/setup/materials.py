@@ -13,7 +13,7 @@ class Material:
     Y: yield strength [Pa] (None: unknown). Y enters no elastic law: it says where Hertz
     stops holding (the onset of yield, docs/model.md section 3.6).
 
-    The law "johnson" (docs/model.md section 3.8) reads four more, all optional: C [-] and
+    The law "johnson" (docs/model.md section 3.10) reads four more, all optional: C [-] and
     rate_ref [1/s], the yield strength's rate dependence Y(rate) = Y [1 + C ln(rate /
     rate_ref)] (both or neither; None: rate-free); hardness_ratio [-], the fully plastic
     mean pressure over Y (None: DEFAULT_HARDNESS_RATIO); unloading_factor [-], kappa of
@@ -50,7 +50,7 @@ class Material:
 #:   measured sphere compressions (Phys. Rev. E 89, 032203, 2014), E, nu, rho, Y and the
 #:   rate coefficient C as the authors state them, rate_ref = 1e-3 per second (theirs);
 #:   hardness_ratio and unloading_factor are the law "johnson"'s defaults (docs/model.md
-#:   section 3.8 gives each value's source).
+#:   section 3.10 gives each value's source).
 LIBRARY: dict[str, Material] = {
     "steel": Material("steel", E=200e9, nu=0.30, rho=7850.0, Y=355e6),
     "bearing_steel": Material("bearing_steel", E=200e9, nu=0.30, rho=7850.0, Y=2.0e9),

@@ -237,7 +237,7 @@ def _check_materials(s: Scenario) -> None:
                                 "the densest solid, has 22,590)")
 
 
-#: Allowed ranges of the law "johnson"'s material fields (docs/model.md section 3.8):
+#: Allowed ranges of the law "johnson"'s material fields (docs/model.md section 3.10):
 #: C in [0, 1]; hardness_ratio in [1.5, 4] (above the cavity pressure where the law's bridge
 #: ends, 1.24; measured metals 2.6-3); unloading_factor in (0, 0.5] (beyond, the residual overlap of a contact just past yield
 #: would fall below zero).

@@ -330,7 +330,7 @@ def commit_history(t, hist, coef):
 @njit(cache=True)
 def fixing_speed(d: float, d_old: float, t: float, t_old: float) -> float:
     """The approach speed [m/s] that fixes a contact's yield strength (docs/model.md
-    section 3.8): the growth of its largest overlap over the accepted step, (d - d_old) /
+    section 3.10): the growth of its largest overlap over the accepted step, (d - d_old) /
     (t - t_old), from its previous largest overlap d_old reached at t_old; -1 (rate-free)
     when there is none (the contact passed yield in its first step in touch)."""
     if d_old > 0.0 and t > t_old:

@@ -33,7 +33,7 @@ MATERIALS = {"steel_440C": "steel_440c", "steel_302": "steel_302", "aluminium_20
 #: unloading fit, a fraction of the peak force
 SLOPE_BAND = (0.3, 0.9)
 UNLOAD_END = 0.3
-#: the law "johnson"'s unloading factor was fitted on this curve (docs/model.md section 3.8)
+#: the law "johnson"'s unloading factor was fitted on this curve (docs/model.md section 3.10)
 FITTED_ON = "force12_5"
 #: the targets: the loading slope within 20% of the measured one, residual / peak within 0.06
 SLOPE_RTOL = 0.2

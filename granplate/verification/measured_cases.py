@@ -1,6 +1,6 @@
 """Verification against measurement: the case `yield-measured`, Burgoyne & Daraio's 15
 compressions of two equal metal spheres (measured.py) against the laws "johnson" and
-"thornton" replayed along the measured overlap (docs/model.md sections 3.6, 3.8)."""
+"thornton" replayed along the measured overlap (docs/model.md sections 3.6, 3.10)."""
 from __future__ import annotations
 
 import math
