@@ -106,4 +106,4 @@ def yield_warning(name: str, py: PairYield) -> str | None:
             f"t = {py.time[k]:.4g} s, p0 = {py.pressure[k] / 1e6:.4g} MPa = {py.ratio[k]:.3g} x 1.6 Y "
             f"(Y = {py.yield_strength[k] / 1e6:.4g} MPa){more}. The elastic law no longer holds there; "
             f"contact.normal_law = \"johnson\" follows contacts that yield as measured (docs/model.md section "
-            f"3.8; \"thornton\", section 3.6).")
+            f"3.10; \"thornton\", section 3.6).")
