@@ -167,14 +167,19 @@ def replay_thornton(c: Curve) -> np.ndarray:
     return out
 
 
-def comparison(curves: list[Curve] | None = None) -> list[dict]:
-    """Per curve: the measured measures and those of both laws' replays, with the ratios
-    the targets judge (slope / measured, residual ratio - measured)."""
+def comparison(curves: list[Curve] | None = None, loop: bool = True) -> list[dict]:
+    """Per curve: the measured measures and those of the replays ("johnson" and "thornton"
+    directly from the laws; "loop": "johnson" through the loop's contact pass and history
+    commit, `replay_contact_pass`, unless loop=False), with the ratios the targets judge
+    (slope / measured, residual ratio - measured)."""
     rows = []
     for c in curves or load_curves():
         meas = measures(c.t, c.delta, c.force)
         row = {"name": c.name, "material": c.material, "measured": meas}
-        for law, f in (("johnson", replay_johnson(c, meas["speed"])), ("thornton", replay_thornton(c))):
+        replays = [("johnson", replay_johnson(c, meas["speed"])), ("thornton", replay_thornton(c))]
+        if loop:
+            replays.append(("loop", replay_contact_pass(c)))
+        for law, f in replays:
             got = measures(c.t, c.delta, f)
             got["slope_ratio"] = got["slope"] / meas["slope"]
             got["ratio_error"] = got["ratio"] - meas["ratio"]
@@ -182,3 +187,75 @@ def comparison(curves: list[Curve] | None = None) -> list[dict]:
             row[law] = got
         rows.append(row)
     return rows
+
+
+def two_spheres(material: str):
+    """A 3D scenario of two touching spheres (R = SPHERE_RADIUS, `material`) under the law
+    "johnson", undamped and frictionless: the measured test's contact, for the loop's own
+    contact pass (`replay_contact_pass`)."""
+    import granplate as gp
+
+    r = SPHERE_RADIUS
+    return gp.loads(f"""name = "two-spheres-{material}"
+dimension = 3
+[[granules]]
+label = "rear"
+x = 0.0
+y = 0.0
+z = 0.0
+radius = {r!r}
+material = "{material}"
+[[granules]]
+label = "front"
+x = {2 * r!r}
+y = 0.0
+z = 0.0
+radius = {r!r}
+material = "{material}"
+[load]
+kind = "none"
+[contact]
+alpha_n = 0.0
+mu = 0.0
+normal_law = "johnson"
+[solver]
+scheme = "verlet"
+""")
+
+
+def lead_in(c: Curve) -> tuple[np.ndarray, np.ndarray]:
+    """(t [s], delta [m]) of c with the approach before the record started: a straight line
+    from zero overlap at the record's first approach speed (over its first microsecond),
+    sampled as the record is. The record starts past the yield overlap; the loop fixes a
+    contact's yield strength from the overlap's growth in the step that first passes yield."""
+    dt = float(c.t[1] - c.t[0])
+    k = max(int(round(1e-6 / dt)), 1)
+    v = float((c.delta[k] - c.delta[0]) / (c.t[k] - c.t[0]))
+    n = int(math.ceil(c.delta[0] / (v * dt)))
+    t0 = c.t[0] - dt * np.arange(n, 0, -1)
+    return np.concatenate([t0, c.t]), np.concatenate([np.maximum(c.delta[0] - v * (c.t[0] - t0), 0.0), c.delta])
+
+
+def replay_contact_pass(c: Curve) -> np.ndarray:
+    """The force [N] of the time loop's own contact pass in space (`solver.granular3d.
+    normal_forces`, the velocity-Verlet force pass) and its history commit (`solver.granular.
+    commit_histories`: delta_max and the speed fixing the yield strength) on two spheres
+    whose overlap follows c's displacement after `lead_in`, sample by sample; at c's samples."""
+    from granplate.model.arrays import build_model
+    from granplate.solver.granular import commit_histories
+    from granplate.solver.granular3d import normal_forces
+
+    model = build_model(two_spheres(c.material))
+    g, cfg = model.granular, model.config
+    t, delta = lead_in(c)
+    rate = np.gradient(delta, t)
+    y = np.array(model.initial_state, float).copy()
+    acc, fdamp, fload = np.zeros_like(y), np.zeros_like(y), np.zeros_like(y)
+    out = np.zeros(len(t))
+    for k in range(len(t)):
+        y[0, 3] = rate[k]
+        y[1, 0] = 2.0 * SPHERE_RADIUS - delta[k]
+        normal_forces(float(t[k]), y, g, cfg, acc, fdamp, fload)
+        out[k] = abs(acc[1, 3]) * g.mass[1]
+        commit_histories(float(t[k]), g)
+    return out[len(t) - len(c.t):]
