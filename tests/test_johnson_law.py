@@ -31,7 +31,7 @@ def dy() -> float:
 
 
 def force(d: float, m: float = 0.0) -> float:
-    return johnson_state(d, m, ROW, V, 0.0)[0]
+    return johnson_state(d, m, ROW, PHI, 0.0)[0]
 
 
 def test_elastic_below_yield_is_hertz_bitwise():
@@ -39,7 +39,7 @@ def test_elastic_below_yield_is_hertz_bitwise():
     row = ROW.copy()
     row[COEF_C] = 123.0
     for d in np.linspace(0.05, 0.99, 7) * dy():
-        a = johnson_normal_response(d, 0.4, row, 0.9 * d, V, True)
+        a = johnson_normal_response(d, 0.4, row, 0.9 * d, PHI, True)
         assert a[:3] == normal_response(d, 0.4, row[0], row[COEF_C], True) and a[3] == 0.0
         assert force(d) == hertz_elastic(d, row[0])
 
@@ -48,7 +48,7 @@ def test_elastic_below_yield_is_hertz_bitwise():
 def test_force_and_slope_continuous_at_yield_and_bridge(x0):
     """Force and slope agree to 1e-7 either side of x = 1 (yield: Hertz's slope 3/2 A delta_y^(1/2)) and X_BRIDGE."""
     d0 = x0 * dy()
-    lo, hi = johnson_state(d0 * (1 - 1e-9), 0.0, ROW, V, 0.0), johnson_state(d0 * (1 + 1e-9), 0.0, ROW, V, 0.0)
+    lo, hi = johnson_state(d0 * (1 - 1e-9), 0.0, ROW, PHI, 0.0), johnson_state(d0 * (1 + 1e-9), 0.0, ROW, PHI, 0.0)
     assert hi[0] == pytest.approx(lo[0], rel=1e-7)
     assert hi[1] == pytest.approx(lo[1], rel=1e-7)
     if x0 == 1.0:
@@ -71,7 +71,7 @@ def test_unloading_and_reloading_follow_the_residual_hertz_curve():
     """From delta_max: F = F_max ((delta - delta_p) / (delta_max - delta_p))^(3/2), zero at and below delta_p,
     back to F_max on reloading, then on along the loading curve."""
     m = 300.0 * dy()
-    f_max, _, _, _, d_p = johnson_state(m, m, ROW, V, 0.0)
+    f_max, _, _, _, d_p = johnson_state(m, m, ROW, PHI, 0.0)
     assert 0.0 < d_p < m
     for s in (0.2, 0.5, 0.9):
         d = d_p + s * (m - d_p)
@@ -101,20 +101,28 @@ def test_energy_stored_plus_plastic_work_is_the_work_done(h, kappa):
 def test_response_books_the_plastic_work_past_the_largest_overlap():
     """normal_law_response's plastic work is W_p(delta) - W_p(delta_max) while loading, 0 below delta_max."""
     a, b = 40.0 * dy(), 55.0 * dy()
-    wa, wb = johnson_state(a, a, ROW, V, 0.0)[3], johnson_state(b, b, ROW, V, 0.0)[3]
-    assert normal_law_response(b, 1.0, ROW, a, V, True)[3] == pytest.approx(wb - wa, rel=1e-12)
-    assert normal_law_response(a, -1.0, ROW, b, V, True)[3] == 0.0
+    wa, wb = johnson_state(a, a, ROW, PHI, 0.0)[3], johnson_state(b, b, ROW, PHI, 0.0)[3]
+    assert normal_law_response(b, 1.0, ROW, a, PHI, True)[3] == pytest.approx(wb - wa, rel=1e-12)
+    assert normal_law_response(a, -1.0, ROW, b, PHI, True)[3] == 0.0
 
 
 def test_rate_dependence():
     """Y(rate) = Y [1 + C ln(rate / rate_ref)], rate = v / (2 R): the fully plastic force scales with it;
-    1 at or below the reference rate; an unset speed takes the current approach speed."""
+    1 at or below the reference rate; an unset rate factor takes the current approach speed's."""
     assert rate_factor(V, 0.025, ROW[7]) == pytest.approx(PHI, rel=1e-14)
     assert rate_factor(1e-9, 0.025, ROW[7]) == 1.0 and rate_factor(-1.0, 0.025, ROW[7]) == 1.0
     d = 5e-4
-    slow = johnson_state(d, 0.0, ROW, -1.0, 0.0)[0]
-    assert johnson_state(d, 0.0, ROW, V, 0.0)[0] == pytest.approx(PHI * slow, rel=1e-12)
-    assert johnson_state(d, 0.0, ROW, 0.0, V)[0] == johnson_state(d, 0.0, ROW, V, 0.0)[0]
+    slow = johnson_state(d, 0.0, ROW, 1.0, 0.0)[0]
+    assert johnson_state(d, 0.0, ROW, PHI, 0.0)[0] == pytest.approx(PHI * slow, rel=1e-12)
+    assert johnson_state(d, 0.0, ROW, 0.0, V)[0] == johnson_state(d, 0.0, ROW, PHI, 0.0)[0]
+
+
+def test_bridge_constants_hold_over_the_allowed_hardness_ratios():
+    """The cubic bridge's constants assume the cap lies beyond X_BRIDGE: true for every allowed h."""
+    from granplate.physics.cavity import H_BRIDGE, cavity_pressure
+    from granplate.setup.validate import HARDNESS_RATIO_RANGE
+
+    assert cavity_pressure(X_BRIDGE) == pytest.approx(H_BRIDGE) and H_BRIDGE < HARDNESS_RATIO_RANGE[0]
 
 
 def test_commit_rule_fixes_the_loading_speed_of_the_step():

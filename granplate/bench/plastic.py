@@ -119,7 +119,7 @@ def kernel_case(t_end: float | None = None) -> dict:
     from granplate.errors import YieldWarning
     from granplate.model.arrays import build_model, granular_with_contacts
     from granplate.model.contacts import contact_lists
-    from granplate.model.inputs import HIST_MAX, HIST_SPEED
+    from granplate.model.inputs import HIST_MAX, HIST_RATE
     from granplate.physics.contact import COEF_DY, pair_overlap
     from granplate.solver.granular import friction_flow, granular_rhs
 
@@ -145,8 +145,8 @@ def kernel_case(t_end: float | None = None) -> dict:
     jm = build_model(with_law(s, "johnson"))
     johnson = granular_with_contacts(jm, jm.granular, pairs, wc)
     johnson = johnson._replace(pair_hist=g.pair_hist.copy(), wall_hist=g.wall_hist.copy())
-    johnson.pair_hist[:, HIST_SPEED] = 1.0  # yield strengths fixed at 1 m/s
-    johnson.wall_hist[:, HIST_SPEED] = 1.0
+    johnson.pair_hist[:, HIST_RATE] = 1.3  # yield strengths fixed at 1.3 Y
+    johnson.wall_hist[:, HIST_RATE] = 1.3
     cfg = model.config
     ng = len(r)
     dy, ys = np.zeros((ng, 6)), np.zeros((ng, 6))

@@ -205,7 +205,7 @@ def elastic_forces(coef: np.ndarray, delta: np.ndarray, delta_max: np.ndarray) -
     at the rate-free yield strength: the drawing does not know each contact's rate)."""
     from granplate.physics.laws import normal_law_force
 
-    return np.array([normal_law_force(float(d), 0.0, c, float(max(m, d)), -1.0, False) if d > 0.0 else 0.0
+    return np.array([normal_law_force(float(d), 0.0, c, float(max(m, d)), 1.0, False) if d > 0.0 else 0.0
                      for d, c, m in zip(delta, coef, delta_max)], float)
 
 

@@ -21,9 +21,10 @@ A contact's coefficient row holds delta_y at the rate-free Y (COEF_DY), R* Y (CO
 the rate coefficient C (COEF_RC), 1 / (L rate_ref) with L the length over which the
 approach speed is a strain rate (COEF_RL: the sum of the two radii, or the diameter
 against a rigid body), h (COEF_H) and the unloading factor kappa (COEF_KAPPA). Its
-history holds the largest overlap delta_max and the approach speed v that fixes its yield
-strength: 0 while unset (then the current approach speed is used, which happens only while
-the contact is elastic), negative for a rate-free contact. Units: metres, newtons, joules.
+history holds the largest overlap delta_max and the rate factor phi = Y(rate) / Y fixed from
+the approach speed (`rate_factor`): 0 while unset (then the current approach speed gives it,
+which happens only while the contact is elastic), 1 for a rate-free contact. Units: metres,
+newtons, joules.
 """
 from __future__ import annotations
 
@@ -33,7 +34,7 @@ import numpy as np
 from numba import njit
 
 from granplate.physics.contact import (COEF_A, COEF_C, COEF_DY, COEF_H, COEF_KAPPA, COEF_RC, COEF_RL, COEF_SY,
-                                       normal_response)
+                                       normal_force, normal_response)
 
 #: the Hertz force and slope at yield in units of R* Y delta_y and R* Y (J2): F_y = 2/3 pi p_y
 #: R* delta_y and k_y = pi p_y R* with p_y = 1.6 Y
@@ -60,6 +61,26 @@ def hardness_overlap(h: float) -> float:
     return math.exp(2.0 * (1.5 * h - 1.0 - CAVITY_LOG0))
 
 
+def _bridge_constants():
+    """(c2, c3, loading work to X_BRIDGE) of the cubic bridge (J5, J6): the same for every
+    hardness ratio h the law accepts, since the cavity pressure at X_BRIDGE, 1.24 Y, lies
+    below any h >= 1.5 (validation's range), so the cap is never reached on the bridge."""
+    p = 2.0 / 3.0 * (1.0 + CAVITY_LOG0 + 0.5 * math.log(X_BRIDGE))
+    f1, k1 = 2.0 * math.pi * X_BRIDGE * p, 2.0 * math.pi * (p + 1.0 / 3.0)
+    span = X_BRIDGE - 1.0
+    secant = (f1 - F_YIELD) / span
+    c2 = (3.0 * secant - 2.0 * K_YIELD - k1) / span
+    c3 = (K_YIELD + k1 - 2.0 * secant) / (span * span)
+    w = 0.4 * F_YIELD + span * (F_YIELD + span * (0.5 * K_YIELD + span * (c2 / 3.0 + 0.25 * span * c3)))
+    return c2, c3, w
+
+
+#: the bridge's cubic coefficients and the loading work from 0 to X_BRIDGE (J5, J6)
+BRIDGE_C2, BRIDGE_C3, BRIDGE_WORK = _bridge_constants()
+#: the lowest hardness ratio for which the bridge constants hold (the cavity pressure at X_BRIDGE)
+H_BRIDGE = 2.0 / 3.0 * (1.0 + CAVITY_LOG0 + 0.5 * math.log(X_BRIDGE))
+
+
 @njit(cache=True)
 def cavity_force(x: float, h: float):
     """(f, df/dx) of the cavity curve f = 2 pi x min(h, p_m / Y) for x >= X_BRIDGE (J4)."""
@@ -70,50 +91,47 @@ def cavity_force(x: float, h: float):
 
 
 @njit(cache=True)
+def cavity_primitive(u: float) -> float:
+    """The integral of the uncapped cavity curve 2 pi x p_m(x) / Y from 0 to u (J6)."""
+    return 4.0 * math.pi / 3.0 * u * u * (0.5 * (1.0 + CAVITY_LOG0) + 0.25 * math.log(u) - 0.125)
+
+
+@njit(cache=True)
 def cavity_work(x: float, h: float) -> float:
-    """The integral of the cavity curve from 0 to x (J6; only differences are used)."""
+    """The integral of the cavity curve (J4) from X_BRIDGE to x >= X_BRIDGE (J6)."""
     xh = hardness_overlap(h)
     u = x if x < xh else xh
-    w = 4.0 * math.pi / 3.0 * ((1.0 + CAVITY_LOG0) * 0.5 * u * u + 0.25 * u * u * math.log(u) - 0.125 * u * u)
+    w = cavity_primitive(u) - cavity_primitive(X_BRIDGE)
     if x > xh:
         w += math.pi * h * (x * x - xh * xh)
     return w
 
 
 @njit(cache=True)
-def bridge_coefficients(h: float):
-    """(c2, c3) of the cubic f = F_YIELD + K_YIELD s + c2 s^2 + c3 s^3, s = x - 1, that
-    meets the cavity curve's force and slope at X_BRIDGE (J5)."""
-    f1, k1 = cavity_force(X_BRIDGE, h)
-    span = X_BRIDGE - 1.0
-    secant = (f1 - F_YIELD) / span
-    c2 = (3.0 * secant - 2.0 * K_YIELD - k1) / span
-    c3 = (K_YIELD + k1 - 2.0 * secant) / (span * span)
-    return c2, c3
+def loading_force(x: float, h: float):
+    """(f, df/dx) of the virgin loading curve at x >= 1 in the contact's units (J4, J5):
+    the cubic bridge up to X_BRIDGE, then the cavity curve."""
+    if x <= X_BRIDGE:
+        s = x - 1.0
+        return (F_YIELD + s * (K_YIELD + s * (BRIDGE_C2 + s * BRIDGE_C3)),
+                K_YIELD + s * (2.0 * BRIDGE_C2 + 3.0 * s * BRIDGE_C3))
+    return cavity_force(x, h)
+
+
+@njit(cache=True)
+def loading_work(x: float, h: float) -> float:
+    """The virgin loading curve's work from 0 to x >= 1 in the contact's units (J6)."""
+    if x <= X_BRIDGE:
+        s = x - 1.0
+        return 0.4 * F_YIELD + s * (F_YIELD + s * (0.5 * K_YIELD + s * (BRIDGE_C2 / 3.0 + 0.25 * s * BRIDGE_C3)))
+    return BRIDGE_WORK + cavity_work(x, h)
 
 
 @njit(cache=True)
 def loading_curve(x: float, h: float):
-    """(f, df/dx, work from 0) of the virgin loading curve at x >= 1 in the contact's
-    units (J2, J5, J6): the bridge up to X_BRIDGE, then the cavity curve."""
-    if x <= X_BRIDGE:
-        c2, c3 = bridge_coefficients(h)
-        s = x - 1.0
-        f = F_YIELD + s * (K_YIELD + s * (c2 + s * c3))
-        k = K_YIELD + s * (2.0 * c2 + 3.0 * s * c3)
-        w = 0.4 * F_YIELD + s * (F_YIELD + s * (0.5 * K_YIELD + s * (c2 / 3.0 + 0.25 * s * c3)))
-        return f, k, w
-    f, k = cavity_force(x, h)
-    w = bridge_work(h) + cavity_work(x, h) - cavity_work(X_BRIDGE, h)
-    return f, k, w
-
-
-@njit(cache=True)
-def bridge_work(h: float) -> float:
-    """The loading work from 0 to X_BRIDGE (Hertz to yield, then the cubic) (J6)."""
-    c2, c3 = bridge_coefficients(h)
-    s = X_BRIDGE - 1.0
-    return 0.4 * F_YIELD + s * (F_YIELD + s * (0.5 * K_YIELD + s * (c2 / 3.0 + 0.25 * s * c3)))
+    """(f, df/dx, work from 0) of the virgin loading curve at x >= 1 (J4-J6)."""
+    f, k = loading_force(x, h)
+    return f, k, loading_work(x, h)
 
 
 @njit(cache=True)
@@ -134,22 +152,22 @@ def rate_factor(speed: float, c: float, rl: float) -> float:
 
 
 @njit(cache=True)
-def contact_scales(coef, speed: float, delta_dot: float):
+def contact_scales(coef, rate: float, delta_dot: float):
     """(delta_y [m], force scale R* Y(rate) delta_y [N]) of a contact whose yield strength
-    is fixed by the approach speed `speed` [m/s] (0: not yet fixed, then delta_dot)."""
-    v = speed if speed != 0.0 else delta_dot
-    phi = rate_factor(v, coef[COEF_RC], coef[COEF_RL])
+    is fixed by the rate factor `rate` = Y(rate) / Y (0: not yet fixed, then the factor of
+    the approach speed delta_dot)."""
+    phi = rate if rate > 0.0 else rate_factor(delta_dot, coef[COEF_RC], coef[COEF_RL])
     dy = coef[COEF_DY] * phi * phi
     return dy, coef[COEF_SY] * phi * dy
 
 
 @njit(cache=True)
-def johnson_state(delta: float, delta_max: float, coef, speed: float, delta_dot: float):
+def johnson_state(delta: float, delta_max: float, coef, rate: float, delta_dot: float, work: bool = True):
     """The law at overlap delta with history delta_max (J8), for a contact past yield:
     (F [N], dF/d delta [N/m], stored elastic energy [J], plastic work W_p(max(delta,
-    delta_max)) [J], residual overlap delta_p [m]); an elastic history returns Hertz's
-    force, slope and energy with W_p = 0 and delta_p = 0."""
-    dy, sf = contact_scales(coef, speed, delta_dot)
+    delta_max)) [J] (0 without `work`), residual overlap delta_p [m]); an elastic history
+    returns Hertz's force, slope and energy with W_p = 0 and delta_p = 0."""
+    dy, sf = contact_scales(coef, rate, delta_dot)
     m = delta if delta > delta_max else delta_max
     if m <= dy:
         if delta <= 0.0:
@@ -159,9 +177,9 @@ def johnson_state(delta: float, delta_max: float, coef, speed: float, delta_dot:
         return a * delta * sq, 1.5 * a * sq, 0.4 * a * delta * delta * sq, 0.0, 0.0
     h = coef[COEF_H]
     xm = m / dy
-    fm, km, wm = loading_curve(xm, h)
+    fm, km = loading_force(xm, h)
     om = unloading_span(xm, fm, coef[COEF_KAPPA])
-    w_p = (wm - 0.4 * fm * om) * sf * dy
+    w_p = (loading_work(xm, h) - 0.4 * fm * om) * sf * dy if work else 0.0
     d_p = m - om * dy
     if delta >= m:
         return fm * sf, km * sf / dy, 0.4 * fm * om * sf * dy, w_p, d_p
@@ -174,25 +192,26 @@ def johnson_state(delta: float, delta_max: float, coef, speed: float, delta_dot:
 
 
 @njit(cache=True)
-def johnson_plastic_work(delta_max: float, coef, speed: float) -> float:
-    """W_p(delta_max) [J] (J8) of a contact whose yield strength is fixed by `speed`."""
-    return johnson_state(delta_max, delta_max, coef, speed, 0.0)[3]
+def johnson_plastic_work(delta_max: float, coef, rate: float) -> float:
+    """W_p(delta_max) [J] (J8) of a contact whose yield strength has the rate factor `rate`."""
+    return johnson_state(delta_max, delta_max, coef, rate, 0.0)[3]
 
 
 @njit(cache=True)
-def johnson_normal_response(delta: float, delta_dot: float, coef, delta_max: float, speed: float, clip: bool):
+def johnson_normal_response(delta: float, delta_dot: float, coef, delta_max: float, rate: float, clip: bool):
     """The law of one contact in touch (delta > 0) with damping on its elastic part, as
     Thornton's (P13): |N| = F + c (delta - delta_p)^(1/4) d(delta)/dt while delta >
     delta_p. Returns (|N| [N], viscous power [W], stored energy [J], plastic work done past
     delta_max [J]), as `plastic.yielding_normal_response`."""
-    dy, sf = contact_scales(coef, speed, delta_dot)
+    dy, sf = contact_scales(coef, rate, delta_dot)
     if delta <= dy and delta_max <= dy:  # an elastic history: Hertz, eqs. (2) and (9)
         n, pv, ep = normal_response(delta, delta_dot, coef[COEF_A], coef[COEF_C], clip)
         return n, pv, ep, 0.0
-    f, k, ep, wp_new, d_p = johnson_state(delta, delta_max, coef, speed, delta_dot)
+    loading = delta > delta_max
+    f, k, ep, wp_new, d_p = johnson_state(delta, delta_max, coef, rate, delta_dot, loading)
     w_p = 0.0
-    if delta > delta_max:
-        w_p = wp_new - johnson_state(delta_max, delta_max, coef, speed, delta_dot)[3]
+    if loading:
+        w_p = wp_new - johnson_state(delta_max, delta_max, coef, rate, delta_dot, True)[3]
     d_el = delta - d_p
     if d_el <= 0.0:
         return 0.0, 0.0, 0.0, w_p
@@ -203,16 +222,24 @@ def johnson_normal_response(delta: float, delta_dot: float, coef, delta_max: flo
 
 
 @njit(cache=True)
-def johnson_normal_force(delta: float, delta_dot: float, coef, delta_max: float, speed: float, clip: bool) -> float:
-    """|N| [N] of `johnson_normal_response` alone."""
-    return johnson_normal_response(delta, delta_dot, coef, delta_max, speed, clip)[0]
+def johnson_normal_force(delta: float, delta_dot: float, coef, delta_max: float, rate: float, clip: bool) -> float:
+    """|N| [N] of `johnson_normal_response` alone (no energies)."""
+    dy, sf = contact_scales(coef, rate, delta_dot)
+    if delta <= dy and delta_max <= dy:
+        return normal_force(delta, delta_dot, coef[COEF_A], coef[COEF_C], clip)[0]
+    f, k, ep, w_p, d_p = johnson_state(delta, delta_max, coef, rate, delta_dot, False)
+    d_el = delta - d_p
+    if d_el <= 0.0:
+        return 0.0
+    n = f + coef[COEF_C] * math.sqrt(math.sqrt(d_el)) * delta_dot
+    return 0.0 if clip and n < 0.0 else n
 
 
 @njit(cache=True)
-def johnson_normal_slopes(delta: float, coef, delta_max: float, speed: float):
+def johnson_normal_slopes(delta: float, coef, delta_max: float, rate: float):
     """dN/d(delta) [N/m] and dN/d(delta rate) [N s/m] in touch (the implicit scheme's
-    Newton); an unset rate is taken at the reference rate."""
-    f, k, ep, wp, d_p = johnson_state(delta, delta_max, coef, speed, 0.0)
+    Newton); an unset rate factor is taken as 1."""
+    f, k, ep, wp, d_p = johnson_state(delta, delta_max, coef, rate, 0.0, False)
     d_el = delta - d_p
     if d_el <= 0.0:
         return 0.0, 0.0
@@ -222,13 +249,15 @@ def johnson_normal_slopes(delta: float, coef, delta_max: float, speed: float):
 @njit(cache=True)
 def johnson_replay(delta: np.ndarray, coef, speed: float) -> np.ndarray:
     """The law's force [N] along an overlap history delta (n,) [m] from a virgin contact,
-    its yield strength fixed by `speed` [m/s] (no damping): the measured curves' replay."""
+    its yield strength fixed by the approach speed `speed` [m/s] (<= 0: rate-free; no
+    damping): the measured curves' replay."""
+    rate = rate_factor(speed, coef[COEF_RC], coef[COEF_RL])
     out = np.zeros(delta.shape[0])
     m = 0.0
     for i in range(delta.shape[0]):
         d = delta[i]
         if d > 0.0:
-            out[i] = johnson_state(d, m, coef, speed, 0.0)[0]
+            out[i] = johnson_state(d, m, coef, rate, 0.0, False)[0]
         if d > m:
             m = d
     return out

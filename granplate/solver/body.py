@@ -33,7 +33,7 @@ from numba import njit
 from granplate.model.inputs import (
     GEO_DAMP, GEO_DELTA, GEO_DIST, GEO_ETA, GEO_GX, GEO_GY, GEO_GZ, GEO_N, GEO_NSTAT, GEO_NX, GEO_NY, GEO_NZ,
     GEO_TOUCH, GEO_XI,
-    HIST_END, HIST_MAX, HIST_SPEED,
+    HIST_END, HIST_MAX, HIST_RATE,
 )
 from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm
 from granplate.physics.laws import normal_law_force, normal_law_response, normal_law_slopes
@@ -441,9 +441,9 @@ def solve_static(b, buf, n_act, delta0, rmat, clip) -> float:
             for j in range(n_act):
                 if j != k:
                     target -= rmat[k, j] * g[b.active[j], GEO_NSTAT]
-            x = static_overlap(target, rmat[k, k], b.coef[i], b.hist[i, HIST_MAX], b.hist[i, HIST_SPEED], clip)
+            x = static_overlap(target, rmat[k, k], b.coef[i], b.hist[i, HIST_MAX], b.hist[i, HIST_RATE], clip)
             n = normal_law_force(x, 0.0, b.coef[i],
-                                 b.hist[i, HIST_MAX], b.hist[i, HIST_SPEED], clip) if x > 0.0 else 0.0
+                                 b.hist[i, HIST_MAX], b.hist[i, HIST_RATE], clip) if x > 0.0 else 0.0
             change = max(change, abs(n - g[i, GEO_NSTAT]))
             largest = max(largest, n)
             g[i, GEO_NSTAT] = n
@@ -547,8 +547,8 @@ def contact_forces(y, q, qd, b, buf, radius, mass, clip, acc, fdamp, scale_acc):
         ddot = normal_rate_3d(y[i, VX] - v0, y[i, VX + 1] - v1, y[i, VX + 2] - v2, -nx, -ny, -nz)
         if resid and rmat[k, k] > 0.0:
             ddot /= 1.0 + rmat[k, k] * normal_law_slopes(delta, b.coef[i],
-                                                         b.hist[i, HIST_MAX], b.hist[i, HIST_SPEED])[0]
-        n, pv, ep, wp = normal_law_response(delta, ddot, b.coef[i], b.hist[i, HIST_MAX], b.hist[i, HIST_SPEED], clip)
+                                                         b.hist[i, HIST_MAX], b.hist[i, HIST_RATE])[0]
+        n, pv, ep, wp = normal_law_response(delta, ddot, b.coef[i], b.hist[i, HIST_MAX], b.hist[i, HIST_RATE], clip)
         g[i, GEO_N] = n
         e_pot += ep
         p_visc += pv
