@@ -11,9 +11,10 @@ import numpy as np
 from granplate.model.contacts import contact_lists, fixed_wall_contacts
 from granplate.model.inputs import HIST_MAX, Config, Granular, PlateArrays, no_history, scheme_number
 from granplate.physics.contact import (
-    COEF_A, COEF_C, COEF_DY, COEF_H, COEF_KAPPA, COEF_KS, COEF_MU, COEF_RC, COEF_RL, COEF_SY, N_COEF,
+    COEF_A, COEF_C, COEF_DY, COEF_H, COEF_KAPPA, COEF_KS, COEF_MU, COEF_RC, COEF_RL, COEF_SY, COEF_XH, N_COEF,
     damping_coefficient, hertz_coefficient,
 )
+from granplate.physics.cavity import hardness_overlap
 from granplate.physics.plastic import contact_yield_overlap
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import resolve
@@ -120,22 +121,22 @@ def law_yield_overlap(s: Scenario, a, b, b_name: str, e_star: float, r_star: flo
 
 
 def law_coefficients(s: Scenario, a, b, b_name: str, e_star: float, r_star: float, length: float) -> np.ndarray:
-    """The normal law's columns COEF_DY..COEF_KAPPA of a contact of material a with b (as
+    """The normal law's columns COEF_DY..COEF_XH of a contact of material a with b (as
     `law_yield_overlap`), `length` [m] the length that makes the approach speed a strain
     rate (the sum of the radii; a diameter against a rigid body). Hertz: [inf, 0...];
-    "thornton": [delta_y, 0...]; "johnson": delta_y, R* Y, C, 1 / (length rate_ref), h and
-    kappa of the softer body (docs/model.md section 3.10; absent rate fields: rate-free)."""
+    "thornton": [delta_y, 0...]; "johnson": delta_y, R* Y, C, 1 / (length rate_ref), h,
+    kappa and x_h of the softer body (docs/model.md section 3.10; absent rate fields: rate-free)."""
     if normal_law_of(s, a.name, b_name) == "johnson":
         return johnson_columns(softer_material(a, b), e_star, r_star, length)
-    out = np.zeros(COEF_KAPPA - COEF_DY + 1)
+    out = np.zeros(COEF_XH - COEF_DY + 1)
     out[0] = law_yield_overlap(s, a, b, b_name, e_star, r_star)
     return out
 
 
 def johnson_columns(m, e_star: float, r_star: float, length: float) -> np.ndarray:
-    """The law "johnson"'s columns COEF_DY..COEF_KAPPA of a contact whose softer body is
+    """The law "johnson"'s columns COEF_DY..COEF_XH of a contact whose softer body is
     of Material m (its Y known), E* [Pa], R* [m], `length` [m] (`law_coefficients`)."""
-    out = np.zeros(COEF_KAPPA - COEF_DY + 1)
+    out = np.zeros(COEF_XH - COEF_DY + 1)
     out[0] = contact_yield_overlap(e_star, r_star, m.Y)
     out[COEF_SY - COEF_DY] = r_star * m.Y
     if m.C is not None and m.rate_ref is not None:
@@ -143,6 +144,7 @@ def johnson_columns(m, e_star: float, r_star: float, length: float) -> np.ndarra
         out[COEF_RL - COEF_DY] = 1.0 / (length * m.rate_ref)
     out[COEF_H - COEF_DY] = DEFAULT_HARDNESS_RATIO if m.hardness_ratio is None else m.hardness_ratio
     out[COEF_KAPPA - COEF_DY] = DEFAULT_UNLOADING_FACTOR if m.unloading_factor is None else m.unloading_factor
+    out[COEF_XH - COEF_DY] = hardness_overlap(out[COEF_H - COEF_DY])
     return out
 
 

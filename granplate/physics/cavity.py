@@ -20,7 +20,8 @@ Hertz's force and slope at yield to the cavity curve's (force and slope continuo
 A contact's coefficient row holds delta_y at the rate-free Y (COEF_DY), R* Y (COEF_SY),
 the rate coefficient C (COEF_RC), 1 / (L rate_ref) with L the length over which the
 approach speed is a strain rate (COEF_RL: the sum of the two radii, or the diameter
-against a rigid body), h (COEF_H) and the unloading factor kappa (COEF_KAPPA). Its
+against a rigid body), h (COEF_H), the unloading factor kappa (COEF_KAPPA) and x_h
+(COEF_XH, `hardness_overlap(h)`). Its
 history holds the largest overlap delta_max and the rate factor phi = Y(rate) / Y fixed from
 the approach speed (`rate_factor`): 0 while unset (then the current approach speed gives it,
 which happens only while the contact is elastic), 1 for a rate-free contact. Units: metres,
@@ -34,7 +35,7 @@ import numpy as np
 from numba import njit
 
 from granplate.physics.contact import (COEF_A, COEF_C, COEF_DY, COEF_H, COEF_KAPPA, COEF_RC, COEF_RL, COEF_SY,
-                                       normal_force, normal_response)
+                                       COEF_XH, normal_force, normal_response)
 
 #: the Hertz force and slope at yield in units of R* Y delta_y and R* Y (J2): F_y = 2/3 pi p_y
 #: R* delta_y and k_y = pi p_y R* with p_y = 1.6 Y
@@ -82,11 +83,12 @@ H_BRIDGE = 2.0 / 3.0 * (1.0 + CAVITY_LOG0 + 0.5 * math.log(X_BRIDGE))
 
 
 @njit(cache=True)
-def cavity_force(x: float, h: float):
-    """(f, df/dx) of the cavity curve f = 2 pi x min(h, p_m / Y) for x >= X_BRIDGE (J4)."""
-    p = cavity_pressure(x)
-    if p >= h:
+def cavity_force(x: float, h: float, xh: float):
+    """(f, df/dx) of the cavity curve f = 2 pi x min(h, p_m / Y) for x >= X_BRIDGE (J4);
+    xh = `hardness_overlap(h)`, where the cap begins."""
+    if x >= xh:
         return 2.0 * math.pi * x * h, 2.0 * math.pi * h
+    p = cavity_pressure(x)
     return 2.0 * math.pi * x * p, 2.0 * math.pi * (p + 1.0 / 3.0)
 
 
@@ -97,9 +99,8 @@ def cavity_primitive(u: float) -> float:
 
 
 @njit(cache=True)
-def cavity_work(x: float, h: float) -> float:
+def cavity_work(x: float, h: float, xh: float) -> float:
     """The integral of the cavity curve (J4) from X_BRIDGE to x >= X_BRIDGE (J6)."""
-    xh = hardness_overlap(h)
     u = x if x < xh else xh
     w = cavity_primitive(u) - cavity_primitive(X_BRIDGE)
     if x > xh:
@@ -108,30 +109,31 @@ def cavity_work(x: float, h: float) -> float:
 
 
 @njit(cache=True)
-def loading_force(x: float, h: float):
+def loading_force(x: float, h: float, xh: float):
     """(f, df/dx) of the virgin loading curve at x >= 1 in the contact's units (J4, J5):
     the cubic bridge up to X_BRIDGE, then the cavity curve."""
     if x <= X_BRIDGE:
         s = x - 1.0
         return (F_YIELD + s * (K_YIELD + s * (BRIDGE_C2 + s * BRIDGE_C3)),
                 K_YIELD + s * (2.0 * BRIDGE_C2 + 3.0 * s * BRIDGE_C3))
-    return cavity_force(x, h)
+    return cavity_force(x, h, xh)
 
 
 @njit(cache=True)
-def loading_work(x: float, h: float) -> float:
+def loading_work(x: float, h: float, xh: float) -> float:
     """The virgin loading curve's work from 0 to x >= 1 in the contact's units (J6)."""
     if x <= X_BRIDGE:
         s = x - 1.0
         return 0.4 * F_YIELD + s * (F_YIELD + s * (0.5 * K_YIELD + s * (BRIDGE_C2 / 3.0 + 0.25 * s * BRIDGE_C3)))
-    return BRIDGE_WORK + cavity_work(x, h)
+    return BRIDGE_WORK + cavity_work(x, h, xh)
 
 
 @njit(cache=True)
 def loading_curve(x: float, h: float):
     """(f, df/dx, work from 0) of the virgin loading curve at x >= 1 (J4-J6)."""
-    f, k = loading_force(x, h)
-    return f, k, loading_work(x, h)
+    xh = hardness_overlap(h)
+    f, k = loading_force(x, h, xh)
+    return f, k, loading_work(x, h, xh)
 
 
 @njit(cache=True)
@@ -162,11 +164,36 @@ def contact_scales(coef, rate: float, delta_dot: float):
 
 
 @njit(cache=True)
-def johnson_state(delta: float, delta_max: float, coef, rate: float, delta_dot: float, work: bool = True):
-    """The law at overlap delta with history delta_max (J8), for a contact past yield:
-    (F [N], dF/d delta [N/m], stored elastic energy [J], plastic work W_p(max(delta,
-    delta_max)) [J] (0 without `work`), residual overlap delta_p [m]); an elastic history
-    returns Hertz's force, slope and energy with W_p = 0 and delta_p = 0."""
+def plastic_core(delta: float, m: float, dy: float, sf: float, h: float, kappa: float, xh: float):
+    """The law past yield (m = max(delta, delta_max) > delta_y) in SI units (J4-J8): (F [N],
+    dF/d delta [N/m], stored energy [J], residual overlap delta_p [m], F_max [N], the span
+    delta_max - delta_p [m]); dy = delta_y [m], sf = R* Y delta_y [N]."""
+    xm = m / dy
+    fm, km = loading_force(xm, h, xh)
+    w = unloading_span(xm, fm, kappa) * dy
+    fm *= sf
+    d_p = m - w
+    if delta >= m:
+        return fm, km * sf / dy, 0.4 * fm * w, d_p, fm, w
+    u = (delta - d_p) / w
+    if u <= 0.0:
+        return 0.0, 0.0, 0.0, d_p, fm, w
+    su = math.sqrt(u)
+    f = fm * u * su
+    return f, 1.5 * fm * su / w, 0.4 * f * (delta - d_p), d_p, fm, w
+
+
+@njit(cache=True)
+def plastic_work_of(m: float, fm: float, w: float, dy: float, sf: float, h: float, xh: float) -> float:
+    """W_p [J] at largest overlap m > delta_y with F_max = fm [N] and span w [m] (J8)."""
+    return loading_work(m / dy, h, xh) * sf * dy - 0.4 * fm * w
+
+
+@njit(cache=True)
+def johnson_state(delta: float, delta_max: float, coef, rate: float, delta_dot: float):
+    """The law at overlap delta with history delta_max (J8): (F [N], dF/d delta [N/m],
+    stored elastic energy [J], plastic work W_p(max(delta, delta_max)) [J], residual overlap
+    delta_p [m]); an elastic history gives Hertz's force, slope and energy, W_p = delta_p = 0."""
     dy, sf = contact_scales(coef, rate, delta_dot)
     m = delta if delta > delta_max else delta_max
     if m <= dy:
@@ -175,20 +202,9 @@ def johnson_state(delta: float, delta_max: float, coef, rate: float, delta_dot: 
         a = coef[COEF_A]
         sq = math.sqrt(delta)
         return a * delta * sq, 1.5 * a * sq, 0.4 * a * delta * delta * sq, 0.0, 0.0
-    h = coef[COEF_H]
-    xm = m / dy
-    fm, km = loading_force(xm, h)
-    om = unloading_span(xm, fm, coef[COEF_KAPPA])
-    w_p = (loading_work(xm, h) - 0.4 * fm * om) * sf * dy if work else 0.0
-    d_p = m - om * dy
-    if delta >= m:
-        return fm * sf, km * sf / dy, 0.4 * fm * om * sf * dy, w_p, d_p
-    u = (delta - d_p) / (om * dy)
-    if u <= 0.0:
-        return 0.0, 0.0, 0.0, w_p, d_p
-    su = math.sqrt(u)
-    f = fm * sf * u * su
-    return f, 1.5 * fm * sf * su / (om * dy), 0.4 * f * (delta - d_p), w_p, d_p
+    h, xh = coef[COEF_H], coef[COEF_XH]
+    f, k, ep, d_p, fm, w = plastic_core(delta, m, dy, sf, h, coef[COEF_KAPPA], xh)
+    return f, k, ep, plastic_work_of(m, fm, w, dy, sf, h, xh), d_p
 
 
 @njit(cache=True)
@@ -203,19 +219,24 @@ def johnson_normal_response(delta: float, delta_dot: float, coef, delta_max: flo
     Thornton's (P13): |N| = F + c (delta - delta_p)^(1/4) d(delta)/dt while delta >
     delta_p. Returns (|N| [N], viscous power [W], stored energy [J], plastic work done past
     delta_max [J]), as `plastic.yielding_normal_response`."""
+    c = coef[COEF_C]
     dy, sf = contact_scales(coef, rate, delta_dot)
     if delta <= dy and delta_max <= dy:  # an elastic history: Hertz, eqs. (2) and (9)
-        n, pv, ep = normal_response(delta, delta_dot, coef[COEF_A], coef[COEF_C], clip)
+        n, pv, ep = normal_response(delta, delta_dot, coef[COEF_A], c, clip)
         return n, pv, ep, 0.0
-    loading = delta > delta_max
-    f, k, ep, wp_new, d_p = johnson_state(delta, delta_max, coef, rate, delta_dot, loading)
+    h, kappa, xh = coef[COEF_H], coef[COEF_KAPPA], coef[COEF_XH]
+    m = delta if delta > delta_max else delta_max
+    f, k, ep, d_p, fm, w = plastic_core(delta, m, dy, sf, h, kappa, xh)
     w_p = 0.0
-    if loading:
-        w_p = wp_new - johnson_state(delta_max, delta_max, coef, rate, delta_dot, True)[3]
+    if delta > delta_max:  # loading past the largest overlap: the plastic work done since
+        w_p = plastic_work_of(m, fm, w, dy, sf, h, xh)
+        if delta_max > dy:
+            f0, k0, e0, p0, fm0, w0 = plastic_core(delta_max, delta_max, dy, sf, h, kappa, xh)
+            w_p -= plastic_work_of(delta_max, fm0, w0, dy, sf, h, xh)
     d_el = delta - d_p
     if d_el <= 0.0:
         return 0.0, 0.0, 0.0, w_p
-    n = f + coef[COEF_C] * math.sqrt(math.sqrt(d_el)) * delta_dot
+    n = f + c * math.sqrt(math.sqrt(d_el)) * delta_dot
     if clip and n < 0.0:
         n = 0.0
     return n, (n - f) * delta_dot, ep, w_p
@@ -224,14 +245,16 @@ def johnson_normal_response(delta: float, delta_dot: float, coef, delta_max: flo
 @njit(cache=True)
 def johnson_normal_force(delta: float, delta_dot: float, coef, delta_max: float, rate: float, clip: bool) -> float:
     """|N| [N] of `johnson_normal_response` alone (no energies)."""
+    c = coef[COEF_C]
     dy, sf = contact_scales(coef, rate, delta_dot)
     if delta <= dy and delta_max <= dy:
-        return normal_force(delta, delta_dot, coef[COEF_A], coef[COEF_C], clip)[0]
-    f, k, ep, w_p, d_p = johnson_state(delta, delta_max, coef, rate, delta_dot, False)
+        return normal_force(delta, delta_dot, coef[COEF_A], c, clip)[0]
+    m = delta if delta > delta_max else delta_max
+    f, k, ep, d_p, fm, w = plastic_core(delta, m, dy, sf, coef[COEF_H], coef[COEF_KAPPA], coef[COEF_XH])
     d_el = delta - d_p
     if d_el <= 0.0:
         return 0.0
-    n = f + coef[COEF_C] * math.sqrt(math.sqrt(d_el)) * delta_dot
+    n = f + c * math.sqrt(math.sqrt(d_el)) * delta_dot
     return 0.0 if clip and n < 0.0 else n
 
 
@@ -239,7 +262,7 @@ def johnson_normal_force(delta: float, delta_dot: float, coef, delta_max: float,
 def johnson_normal_slopes(delta: float, coef, delta_max: float, rate: float):
     """dN/d(delta) [N/m] and dN/d(delta rate) [N s/m] in touch (the implicit scheme's
     Newton); an unset rate factor is taken as 1."""
-    f, k, ep, wp, d_p = johnson_state(delta, delta_max, coef, rate, 0.0, False)
+    f, k, ep, wp, d_p = johnson_state(delta, delta_max, coef, rate, 0.0)
     d_el = delta - d_p
     if d_el <= 0.0:
         return 0.0, 0.0
@@ -257,7 +280,7 @@ def johnson_replay(delta: np.ndarray, coef, speed: float) -> np.ndarray:
     for i in range(delta.shape[0]):
         d = delta[i]
         if d > 0.0:
-            out[i] = johnson_state(d, m, coef, rate, 0.0, False)[0]
+            out[i] = johnson_state(d, m, coef, rate, 0.0)[0]
         if d > m:
             m = d
     return out
