@@ -46,7 +46,7 @@ def _refused(s: Scenario) -> ScenarioError:
 
 def test_default_law_is_hertz_everywhere():
     """The default contact and every preset select "hertz" for every pair of their materials."""
-    assert NORMAL_LAWS == ("hertz", "thornton")
+    assert NORMAL_LAWS == ("hertz", "thornton", "johnson")
     assert Contact().normal_law == "hertz"
     for name in PRESETS:
         c = preset(name).contact
@@ -118,7 +118,7 @@ def test_misspelled_law_is_refused_on_reading_with_a_suggestion(text, field):
     with pytest.raises(ScenarioError) as info:
         scenario_io.loads(text)
     assert info.value.field == field
-    assert "must be one of 'hertz', 'thornton' (did you mean 'thornton'?)" in str(info.value)
+    assert "must be one of 'hertz', 'thornton', 'johnson' (did you mean 'thornton'?)" in str(info.value)
 
 
 @pytest.mark.parametrize("contact, field, value", [
@@ -132,7 +132,7 @@ def test_unknown_law_in_python_is_refused_by_validate(contact, field, value):
     refused by validate, naming the field and the allowed values."""
     err = _refused(_scene(("steel", "steel"), **contact))
     assert err.field == field and err.value == value
-    assert "must be one of 'hertz', 'thornton'" in str(err)
+    assert "must be one of 'hertz', 'thornton', 'johnson'" in str(err)
     assert "did you mean" not in str(err)  # nothing close to suggest
 
 

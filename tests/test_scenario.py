@@ -91,7 +91,7 @@ BAD = [
     ("negative t_end", _with({"time.t_end": -1e-3}), "time.t_end", "must be > 0"),
     ("infinite t_end", _with({"time.t_end": math.inf}), "time.t_end", "must be > 0"),
     ("unknown material", _with({"layout.intruder_material": "wood"}),
-     "layout.intruder_material", "unknown material; defined materials are: bearing_steel, ptfe, steel"),
+     "layout.intruder_material", "unknown material; defined materials are: aluminium_2017, bearing_steel, ptfe, steel, steel_302, steel_440c"),
     ("unknown granule material",
      _granules(Granule(0, 0, 0.01, "wood", "a"), Granule(1, 0, 0.01, STEEL, "b")),
      "granules[0].material", "unknown material"),

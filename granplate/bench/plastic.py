@@ -1,13 +1,14 @@
-"""`granplate bench --plastic`: what the elastic-plastic normal law (docs/model.md
-section 3.6) costs in the time loop, against Hertz's law on the same scenario.
+"""`granplate bench --plastic`: what the elastic-plastic normal laws (docs/model.md
+sections 3.6 and 3.10) cost in the time loop, against Hertz's law on the same scenario.
 
 Cases: the 990-granule hexagonal packing of `bench --friction` (1 mm steel spheres, its
 first column launched at 1 m/s, mu = 0.099: granule-granule and granule-wall contacts
 dominate), and the presets ptfe-r05 and steel-r1 (plate contacts, both schemes' paths),
-each with contact.normal_law = "hertz" and "thornton". The laws take different paths
+each with contact.normal_law = "hertz", "thornton" and "johnson" (its materials given a
+rate coefficient, JOHNSON_RATE, so that the rate factor is computed). The laws take different paths
 (a yielding contact rebounds slower, so the step count differs), so the figure compared
 is the loop's CPU time per step, the median of REPEATS runs, each after a 1 us warm-up run
-(the compiled loop loaded), timed alternately hertz / thornton in this process. The
+(the compiled loop loaded), timed alternately law after law in this process. The
 target is at most PLASTIC_COST_TARGET times Hertz's per step.
 
 A packing that yields compacts: more of its contacts are in touch at a time than under
@@ -32,7 +33,10 @@ from granplate.bench import write_report
 REPEATS = 3
 PRESET_T_END = 5e-4
 PLASTIC_COST_TARGET = 1.2
-LAWS = ("hertz", "thornton")
+LAWS = ("hertz", "thornton", "johnson")
+PLASTIC_LAWS = LAWS[1:]
+#: the rate coefficient and reference rate [1/s] every material gets under "johnson" here
+JOHNSON_RATE = (0.02, 1e-3)
 KERNEL_CALLS = 200
 
 
@@ -69,22 +73,38 @@ def timed(s) -> dict:
 
 
 def bench_case(case: str, s, repeats: int = REPEATS) -> dict:
-    """Both laws on one scenario, alternately `repeats` times: median loop CPU time per step
-    [us] of each and their ratio (thornton / hertz)."""
+    """Every law on one scenario, alternately `repeats` times: median loop CPU time per step
+    [us] of each and their ratios to Hertz's ("ratio": the larger)."""
     import granplate as gp
 
     runs: dict[str, list[dict]] = {law: [] for law in LAWS}
     for _ in range(repeats):
         for law in LAWS:
-            runs[law].append(timed(gp.with_changes(s, {"contact.normal_law": law})))
+            runs[law].append(timed(with_law(s, law)))
     row: dict = {"case": case, "t_end_s": float(s.time.t_end)}
     for law in LAWS:
         per = [1e6 * r["loop_cpu_s"] / max(r["n_steps"], 1) for r in runs[law]]
         row[law] = {"us_per_step": statistics.median(per), "n_steps": runs[law][-1]["n_steps"],
                     "plastic_fraction": runs[law][-1]["plastic_fraction"],
                     "yield_onset_ratio": runs[law][-1]["yield_onset_ratio"]}
-    row["ratio"] = row["thornton"]["us_per_step"] / row["hertz"]["us_per_step"]
+    for law in PLASTIC_LAWS:
+        row[f"ratio_{law}"] = row[law]["us_per_step"] / row["hertz"]["us_per_step"]
+    row["ratio"] = max(row[f"ratio_{law}"] for law in PLASTIC_LAWS)
     return row
+
+
+def with_law(s, law: str):
+    """s under normal law `law` (under "johnson", every material given JOHNSON_RATE)."""
+    import dataclasses
+
+    import granplate as gp
+
+    s = gp.with_changes(s, {"contact.normal_law": law})
+    if law != "johnson":
+        return s
+    c, ref = JOHNSON_RATE
+    return dataclasses.replace(s, materials={k: dataclasses.replace(m, C=c, rate_ref=ref)
+                                             for k, m in s.materials.items()})
 
 
 def kernel_case(t_end: float | None = None) -> dict:
@@ -99,7 +119,7 @@ def kernel_case(t_end: float | None = None) -> dict:
     from granplate.errors import YieldWarning
     from granplate.model.arrays import build_model, granular_with_contacts
     from granplate.model.contacts import contact_lists
-    from granplate.model.inputs import HIST_MAX
+    from granplate.model.inputs import HIST_MAX, HIST_RATE
     from granplate.physics.contact import COEF_DY, pair_overlap
     from granplate.solver.granular import friction_flow, granular_rhs
 
@@ -122,12 +142,17 @@ def kernel_case(t_end: float | None = None) -> dict:
     elastic = g._replace(pair_coef=g.pair_coef.copy(), wall_coef=g.wall_coef.copy())
     elastic.pair_coef[:, COEF_DY] = np.inf
     elastic.wall_coef[:, COEF_DY] = np.inf
+    jm = build_model(with_law(s, "johnson"))
+    johnson = granular_with_contacts(jm, jm.granular, pairs, wc)
+    johnson = johnson._replace(pair_hist=g.pair_hist.copy(), wall_hist=g.wall_hist.copy())
+    johnson.pair_hist[:, HIST_RATE] = 1.3  # yield strengths fixed at 1.3 Y
+    johnson.wall_hist[:, HIST_RATE] = 1.3
     cfg = model.config
     ng = len(r)
     dy, ys = np.zeros((ng, 6)), np.zeros((ng, 6))
     e0 = np.zeros(0)
     out = {}
-    for law, gg in (("hertz", elastic), ("thornton", g)):
+    for law, gg in (("hertz", elastic), ("thornton", g), ("johnson", johnson)):
         times = []
         for _ in range(KERNEL_CALLS):
             ys[:] = y
@@ -137,7 +162,8 @@ def kernel_case(t_end: float | None = None) -> dict:
             times.append(time.perf_counter() - t0)
         out[law] = 1e6 * statistics.median(times)
     return {"case": f"kernel: packing state, {touch} of {len(g.pair_ij)} listed pairs in touch",
-            "hertz_us": out["hertz"], "thornton_us": out["thornton"], "ratio": out["thornton"] / out["hertz"]}
+            "hertz_us": out["hertz"], "thornton_us": out["thornton"], "johnson_us": out["johnson"],
+            "ratio": out["thornton"] / out["hertz"], "ratio_johnson": out["johnson"] / out["hertz"]}
 
 
 def run(t_end: float | None = None, repeats: int = REPEATS, log=print) -> dict:
@@ -154,17 +180,19 @@ def run(t_end: float | None = None, repeats: int = REPEATS, log=print) -> dict:
 
 def format_report(report: dict) -> str:
     """The table as text."""
-    lines = [f"{'case':28s} {'hertz us/step':>14s} {'thornton us/step':>17s} {'ratio':>6s}"
-             f" {'steps H':>8s} {'steps T':>8s} {'D_plastic/E_in':>15s}"]
+    lines = [f"{'case':28s} {'hertz us/step':>14s} {'thornton':>9s} {'ratio':>6s} {'johnson':>8s} {'ratio':>6s}"
+             f" {'steps H':>8s} {'steps T':>8s} {'steps J':>8s} {'D_plastic/E_in T':>17s} {'J':>7s}"]
     for r in report["rows"]:
-        h, t = r["hertz"], r["thornton"]
-        lines.append(f"{r['case']:28s} {h['us_per_step']:14.2f} {t['us_per_step']:17.2f} {r['ratio']:6.3f}"
-                     f" {h['n_steps']:8d} {t['n_steps']:8d} {t['plastic_fraction'] or 0.0:15.4f}")
+        h, t, j = r["hertz"], r["thornton"], r["johnson"]
+        lines.append(f"{r['case']:28s} {h['us_per_step']:14.2f} {t['us_per_step']:9.2f} {r['ratio_thornton']:6.3f}"
+                     f" {j['us_per_step']:8.2f} {r['ratio_johnson']:6.3f} {h['n_steps']:8d} {t['n_steps']:8d}"
+                     f" {j['n_steps']:8d} {t['plastic_fraction'] or 0.0:17.4f} {j['plastic_fraction'] or 0.0:7.4f}")
     lines.append(f"largest ratio {report['largest_ratio']:.3f} (target <= {report['target_ratio']:g}); "
                  f"loop CPU time per step, median of {report['repeats']} runs")
     k = report["kernel"]
-    lines.append(f"{k['case']}: hertz {k['hertz_us']:.1f} us, thornton {k['thornton_us']:.1f} us per evaluation, "
-                 f"ratio {k['ratio']:.3f} (median of {KERNEL_CALLS})")
+    lines.append(f"{k['case']}: hertz {k['hertz_us']:.1f} us, thornton {k['thornton_us']:.1f} us "
+                 f"(ratio {k['ratio']:.3f}), johnson {k['johnson_us']:.1f} us (ratio {k['ratio_johnson']:.3f}) per "
+                 f"evaluation (median of {KERNEL_CALLS})")
     return "\n".join(lines)
 
 

@@ -201,10 +201,11 @@ def wall_overlaps(pos: np.ndarray, r: np.ndarray, walls, wall_contacts: np.ndarr
 def elastic_forces(coef: np.ndarray, delta: np.ndarray, delta_max: np.ndarray) -> np.ndarray:
     """|N| [N] of each contact at overlap delta [m] (0 where apart) under the run's normal
     law (`physics.laws.normal_law_force`, coefficient rows coef, largest overlap so far
-    delta_max), at zero overlap rate: the elastic part of the force."""
+    delta_max), at zero overlap rate: the elastic part of the force (under the law "johnson"
+    at the rate-free yield strength: the drawing does not know each contact's rate)."""
     from granplate.physics.laws import normal_law_force
 
-    return np.array([normal_law_force(float(d), 0.0, c, float(max(m, d)), False) if d > 0.0 else 0.0
+    return np.array([normal_law_force(float(d), 0.0, c, float(max(m, d)), 1.0, False) if d > 0.0 else 0.0
                      for d, c, m in zip(delta, coef, delta_max)], float)
 
 

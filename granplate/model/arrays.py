@@ -11,13 +11,16 @@ import numpy as np
 from granplate.model.contacts import contact_lists, fixed_wall_contacts
 from granplate.model.inputs import HIST_MAX, Config, Granular, PlateArrays, no_history, scheme_number
 from granplate.physics.contact import (
-    COEF_A, COEF_C, COEF_DY, COEF_KS, COEF_MU, N_COEF, damping_coefficient, hertz_coefficient,
+    COEF_A, COEF_C, COEF_DY, COEF_H, COEF_KAPPA, COEF_KS, COEF_MU, COEF_RC, COEF_RL, COEF_SY, COEF_XH, N_COEF,
+    damping_coefficient, hertz_coefficient,
 )
+from granplate.physics.cavity import hardness_overlap
 from granplate.physics.plastic import contact_yield_overlap
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import resolve
 from granplate.physics.shock import shock_resultants
-from granplate.setup.materials import effective_modulus, softer_yield_strength, sphere_inertia, sphere_mass
+from granplate.setup.materials import (DEFAULT_HARDNESS_RATIO, DEFAULT_UNLOADING_FACTOR, effective_modulus,
+                                       softer_material, softer_yield_strength, sphere_inertia, sphere_mass)
 from granplate.setup.scenario import Plate, Scenario
 from granplate.setup.plate_checks import split_initial_contacts
 from granplate.setup.validate import validate
@@ -88,12 +91,15 @@ class Model:
         return tuple(self.labels[i] for i in self.plate_contacts)
 
 
-def coefficient_row(a: float, c: float, mu: float, k_s: float, delta_y: float = math.inf) -> np.ndarray:
+def coefficient_row(a: float, c: float, mu: float, k_s: float, law=math.inf) -> np.ndarray:
     """One row of pair_coef / wall_coef / pc_coef in the columns of physics.contact:
-    Hertz A [N/m^1.5], damping c, mu [-], k_s [s/m] (eqs. 3, 5) and the yield overlap
-    delta_y [m] (docs/model.md eq. P3; inf: Hertz's law)."""
+    Hertz A [N/m^1.5], damping c, mu [-], k_s [s/m] (eqs. 3, 5) and the normal law's
+    columns from COEF_DY on (`law_coefficients`), or the yield overlap delta_y [m] alone
+    (docs/model.md eq. P3; inf: Hertz's law)."""
     row = np.zeros(N_COEF)
-    row[COEF_A], row[COEF_C], row[COEF_MU], row[COEF_KS], row[COEF_DY] = a, c, mu, k_s, delta_y
+    row[COEF_A], row[COEF_C], row[COEF_MU], row[COEF_KS] = a, c, mu, k_s
+    law = np.atleast_1d(np.asarray(law, float))
+    row[COEF_DY:COEF_DY + len(law)] = law
     return row
 
 
@@ -109,9 +115,37 @@ def law_yield_overlap(s: Scenario, a, b, b_name: str, e_star: float, r_star: flo
     the yield overlap delta_y [m] (docs/model.md eqs. P1, P3) of the softer body under the
     elastic-plastic law "thornton", inf under Hertz's law. (Validation refuses "thornton"
     where the Y it needs is unknown.)"""
-    if normal_law_of(s, a.name, b_name) != "thornton":
+    if normal_law_of(s, a.name, b_name) not in ("thornton", "johnson"):
         return math.inf
     return contact_yield_overlap(e_star, r_star, softer_yield_strength(a, b))
+
+
+def law_coefficients(s: Scenario, a, b, b_name: str, e_star: float, r_star: float, length: float) -> np.ndarray:
+    """The normal law's columns COEF_DY..COEF_XH of a contact of material a with b (as
+    `law_yield_overlap`), `length` [m] the length that makes the approach speed a strain
+    rate (the sum of the radii; a diameter against a rigid body). Hertz: [inf, 0...];
+    "thornton": [delta_y, 0...]; "johnson": delta_y, R* Y, C, 1 / (length rate_ref), h,
+    kappa and x_h of the softer body (docs/model.md section 3.10; absent rate fields: rate-free)."""
+    if normal_law_of(s, a.name, b_name) == "johnson":
+        return johnson_columns(softer_material(a, b), e_star, r_star, length)
+    out = np.zeros(COEF_XH - COEF_DY + 1)
+    out[0] = law_yield_overlap(s, a, b, b_name, e_star, r_star)
+    return out
+
+
+def johnson_columns(m, e_star: float, r_star: float, length: float) -> np.ndarray:
+    """The law "johnson"'s columns COEF_DY..COEF_XH of a contact whose softer body is
+    of Material m (its Y known), E* [Pa], R* [m], `length` [m] (`law_coefficients`)."""
+    out = np.zeros(COEF_XH - COEF_DY + 1)
+    out[0] = contact_yield_overlap(e_star, r_star, m.Y)
+    out[COEF_SY - COEF_DY] = r_star * m.Y
+    if m.C is not None and m.rate_ref is not None:
+        out[COEF_RC - COEF_DY] = m.C
+        out[COEF_RL - COEF_DY] = 1.0 / (length * m.rate_ref)
+    out[COEF_H - COEF_DY] = DEFAULT_HARDNESS_RATIO if m.hardness_ratio is None else m.hardness_ratio
+    out[COEF_KAPPA - COEF_DY] = DEFAULT_UNLOADING_FACTOR if m.unloading_factor is None else m.unloading_factor
+    out[COEF_XH - COEF_DY] = hardness_overlap(out[COEF_H - COEF_DY])
+    return out
 
 
 def _granule_arrays(s: Scenario):
@@ -176,7 +210,8 @@ def pair_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, pairs:
         alpha, mu, ks = s.contact.for_pair(mats[i].name, mats[j].name)
         a = hertz_coefficient(e_star, r_star)
         pair_coef[p] = coefficient_row(a, damping_coefficient(alpha, m_star, a), mu, ks,
-                                       law_yield_overlap(s, mats[i], mats[j], mats[j].name, e_star, r_star))
+                                       law_coefficients(s, mats[i], mats[j], mats[j].name, e_star, r_star,
+                                                        r[i] + r[j]))
     return pair_coef
 
 
@@ -195,7 +230,7 @@ def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarr
         e_star = effective_modulus(mats[i], None)
         a = hertz_coefficient(e_star, r[i])
         wall_coef[k] = coefficient_row(a, damping_coefficient(alpha, mass[i], a), mu, ks,
-                                       law_yield_overlap(s, mats[i], None, wall.material, e_star, r[i]))
+                                       law_coefficients(s, mats[i], None, wall.material, e_star, r[i], 2.0 * r[i]))
     return wall_geo, wall_coef
 
 
@@ -208,7 +243,7 @@ def plate_contact_coefficients(s: Scenario, mats, r: np.ndarray, pc: np.ndarray)
         e_star = effective_modulus(mats[i], None)
         a = hertz_coefficient(e_star, r[i])
         pc_coef[k] = coefficient_row(a, damping_coefficient(alpha, 0.0, a), mu, ks,
-                                     law_yield_overlap(s, mats[i], None, s.plate.material, e_star, r[i]))
+                                     law_coefficients(s, mats[i], None, s.plate.material, e_star, r[i], 2.0 * r[i]))
     return pc_coef
 
 

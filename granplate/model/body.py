@@ -49,7 +49,7 @@ def body_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, body_m
     (the body's mass much larger), the pair's friction and yield overlap; a granule on a
     rigid patch (on_rigid) meets a rigid body, the 2D rigid layer's law (E* of the granule
     alone, m* = 0: no damping, docs/model.md section 3.4)."""
-    from granplate.model.arrays import coefficient_row, law_yield_overlap
+    from granplate.model.arrays import coefficient_row, law_coefficients
 
     coef = np.zeros((len(r), N_COEF))
     for i, m in enumerate(mats):
@@ -59,7 +59,8 @@ def body_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, body_m
         e_star = effective_modulus(m, other)
         a = hertz_coefficient(e_star, float(r[i]))
         coef[i] = coefficient_row(a, damping_coefficient(alpha, 0.0 if rigid else float(mass[i]), a), mu, ks,
-                                  law_yield_overlap(s, m, other, body_material.name, e_star, float(r[i])))
+                                  law_coefficients(s, m, other, body_material.name, e_star, float(r[i]),
+                                                   2.0 * float(r[i])))
     return coef
 
 

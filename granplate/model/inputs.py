@@ -35,9 +35,10 @@ STATE_COLUMNS = {2: 6, 3: 9}
 #: overlap so far delta_max [m] (the elastic-plastic law's history, docs/model.md section
 #: 3.6; for every law, its largest Hertz peak pressure), the time it was reached [s], and
 #: the overlap at the end of the last trial step [m] (taken into delta_max when the step is
-#: accepted).
-HIST_MAX, HIST_TIME, HIST_END = 0, 1, 2
-N_HIST = 3
+#: accepted), and the rate factor Y(rate) / Y [-] that fixed the yield strength of a contact
+#: under the law "johnson" (docs/model.md section 3.10: 0 while unset, 1 rate-free).
+HIST_MAX, HIST_TIME, HIST_END, HIST_RATE = 0, 1, 2, 3
+N_HIST = 4
 
 
 def no_history(n: int) -> np.ndarray:

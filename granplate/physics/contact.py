@@ -40,9 +40,14 @@ def damping_coefficient(alpha_n: float, m_star: float, a: float) -> float:
 #: Hertz coefficient A [N/m^1.5] (eq. 3), damping coefficient c with gamma = c delta^(1/4)
 #: (eq. 3), friction coefficient mu [-], regularisation k_s [s/m] (eq. 5), and the yield
 #: overlap delta_y [m] of the elastic-plastic law (docs/model.md section 3.6, eq. P3;
-#: inf: the contact follows Hertz's law, eq. 2).
+#: inf: the contact follows Hertz's law, eq. 2); then the law "johnson" (docs/model.md
+#: section 3.10; 0 in COEF_SY: Thornton's law where COEF_DY is finite): R* Y [N/m], the rate
+#: coefficient C [-], 1 / (L rate_ref) [s/m] with L the length that makes the approach speed a
+#: strain rate, the hardness ratio h [-], the unloading factor kappa [-] and x_h, the
+#: overlap over delta_y where the pressure reaches h Y (eqs. J1-J8).
 COEF_A, COEF_C, COEF_MU, COEF_KS, COEF_DY = 0, 1, 2, 3, 4
-N_COEF = 5
+COEF_SY, COEF_RC, COEF_RL, COEF_H, COEF_KAPPA, COEF_XH = 5, 6, 7, 8, 9, 10
+N_COEF = 11
 
 
 @njit(cache=True)

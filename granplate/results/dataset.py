@@ -44,7 +44,7 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "pair_yield_strength": ("Pa", "Y of the softer body of the pair (a wall or the plate's face: the granule's); NaN where unknown"),
     "pair_max_pressure_time": ("s", "when the contact of that largest p0 reached its largest overlap"),
     "pair_max_pressure_contact": ("1", "that contact: granule labels, or a granule and 'wall w' / 'plate'"),
-    "pair_normal_law": ("1", "the pair's normal law (contact.normal_law: hertz or thornton)"),
+    "pair_normal_law": ("1", "the pair's normal law (contact.normal_law: hertz, thornton or johnson)"),
     "E_contact": ("J", "elastic energy stored in all contacts (part of E_granular)"),
     "KE_horizontal": ("J", "granular kinetic energy, horizontal translation"),
     "KE_vertical": ("J", "granular kinetic energy, vertical translation"),

@@ -31,7 +31,7 @@ class PairYield(NamedTuple):
     yield_strength: np.ndarray  # [Pa] Y of the softer body; NaN where unknown
     time: np.ndarray  # [s] when that contact reached its largest overlap
     contact: tuple[str, ...]  # the contact: "c1r1-c2r1", "c1r1-wall left" (its label, else its index), "c3r1-plate"
-    law: tuple[str, ...]  # the pair's normal law ("hertz", "thornton")
+    law: tuple[str, ...]  # the pair's normal law ("hertz", "thornton", "johnson")
 
 
 def contact_yield(model, peaks) -> list[tuple[str, float, float, float, float, str, str]]:
@@ -105,4 +105,5 @@ def yield_warning(name: str, py: PairYield) -> str | None:
     return (f"{name}: Hertz contacts passed the onset of yield: pair {py.pair[k]}, contact {py.contact[k]} at "
             f"t = {py.time[k]:.4g} s, p0 = {py.pressure[k] / 1e6:.4g} MPa = {py.ratio[k]:.3g} x 1.6 Y "
             f"(Y = {py.yield_strength[k] / 1e6:.4g} MPa){more}. The elastic law no longer holds there; "
-            f"contact.normal_law = \"thornton\" follows contacts that yield (docs/model.md section 3.6).")
+            f"contact.normal_law = \"johnson\" follows contacts that yield as measured (docs/model.md section "
+            f"3.10; \"thornton\", section 3.6).")

@@ -38,8 +38,9 @@ REQUIRED: dict[type, tuple[str, ...]] = {
     Box: ("lower", "upper"),
     PairCoefficients: ("materials",),
 }
-#: Keys of a [materials.NAME] table: E, nu, rho required; Y optional (absent: unknown).
-MATERIAL_KEYS: tuple[str, ...] = ("E", "nu", "rho", "Y")
+#: Keys of a [materials.NAME] table: E, nu, rho required; Y optional (absent: unknown);
+#: the law "johnson"'s C, rate_ref, hardness_ratio, unloading_factor optional.
+MATERIAL_KEYS: tuple[str, ...] = ("E", "nu", "rho", "Y", "C", "rate_ref", "hardness_ratio", "unloading_factor")
 MATERIAL_REQUIRED: tuple[str, ...] = ("E", "nu", "rho")
 #: String fields whose value a file must take from a fixed list, checked on reading (a
 #: misspelled one is refused with the closest allowed value suggested).
@@ -347,8 +348,9 @@ def _layout_dict(layout: Any) -> dict:
 
 def _material_dict(m: Material) -> dict[str, float]:
     d = {"E": float(m.E), "nu": float(m.nu), "rho": float(m.rho)}
-    if m.Y is not None:
-        d["Y"] = float(m.Y)
+    for k in MATERIAL_KEYS[3:]:
+        if getattr(m, k) is not None:
+            d[k] = float(getattr(m, k))
     return d
 
 

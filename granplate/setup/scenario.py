@@ -404,8 +404,11 @@ class Load:
 #: Normal contact laws (`Contact.normal_law`, `PairCoefficients.normal_law`): "hertz",
 #: eq. (2)'s elastic law with eq. (3)'s damping; "thornton", Thornton's (1997)
 #: elastic-perfectly plastic law (docs/model.md section 3.6), which needs the yield
-#: strength Y of every body that can yield at the contact.
-NORMAL_LAWS: tuple[str, ...] = ("hertz", "thornton")
+#: strength Y of every body that can yield at the contact; "johnson", Hertz to yield,
+#: then Johnson's expanding-cavity mean pressure over the plastic contact disc up to the
+#: hardness, with a rate-dependent yield strength (docs/model.md section 3.10), which needs
+#: Y likewise.
+NORMAL_LAWS: tuple[str, ...] = ("hertz", "thornton", "johnson")
 
 
 @dataclass(frozen=True)
@@ -445,10 +448,10 @@ class Contact:
     plate contacts (fixed in both modes); overlap_warn, overlap_stop [-]: an overlap beyond
     this fraction of the smaller radius warns (Hertz assumes small overlaps) or stops the
     run; normal_law: the normal force law of pairs not listed in `pairs` (one of
-    NORMAL_LAWS: "hertz", eq. 2, or "thornton", elastic-perfectly plastic, docs/model.md
-    section 3.6; walls and the plate are rigid bodies to it, so a granule-wall or
-    granule-plate contact takes the law of the granule's material with the wall's or the
-    plate's, `law_for_pair`); torque_arm: lever arm of the friction torque,
+    NORMAL_LAWS: "hertz", eq. 2, "thornton", elastic-perfectly plastic, docs/model.md
+    section 3.6, or "johnson", elastic-plastic up to the hardness, section 3.10; walls and
+    the plate are rigid bodies to it, so a granule-wall or granule-plate contact takes the
+    law of the granule's material with the wall's or the plate's, `law_for_pair`); torque_arm: lever arm of the friction torque,
     "radius" (R_i, paper eq. 1, docs/model.md section 3.2) or "contact_point" (R_i - delta/2 for a
     pair, R_i - delta at a wall or plate: the true contact point, which conserves the
     angular momentum of a free assembly; with "radius" each sliding pair adds a couple

@@ -33,7 +33,7 @@ from numba import njit
 from granplate.model.inputs import (
     GEO_DAMP, GEO_DELTA, GEO_DIST, GEO_ETA, GEO_GX, GEO_GY, GEO_GZ, GEO_N, GEO_NSTAT, GEO_NX, GEO_NY, GEO_NZ,
     GEO_TOUCH, GEO_XI,
-    HIST_END, HIST_MAX,
+    HIST_END, HIST_MAX, HIST_RATE,
 )
 from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm
 from granplate.physics.laws import normal_law_force, normal_law_response, normal_law_slopes
@@ -325,7 +325,7 @@ def spread_both(b, buf, i, nx, ny, nz, n, d, out, out_d) -> None:
 
 
 @njit(cache=True)
-def static_overlap(target, r, c, delta_max, clip) -> float:
+def static_overlap(target, r, c, delta_max, speed, clip) -> float:
     """The overlap delta [m] with delta + r F(delta) = target (F the law's static force,
     r the contact's own residual compliance [m/N]): Newton from delta = target, which
     converges from above for a convex increasing F; 0 when target <= 0."""
@@ -335,8 +335,8 @@ def static_overlap(target, r, c, delta_max, clip) -> float:
         return target
     x = target
     for _ in range(NEWTON_STEPS):
-        phi = x + r * normal_law_force(x, 0.0, c, delta_max, clip) - target
-        slope = 1.0 + r * normal_law_slopes(x, c, delta_max)[0]
+        phi = x + r * normal_law_force(x, 0.0, c, delta_max, speed, clip) - target
+        slope = 1.0 + r * normal_law_slopes(x, c, delta_max, speed)[0]
         dx = phi / slope
         x_new = x - dx
         if x_new <= 0.0:
@@ -441,8 +441,9 @@ def solve_static(b, buf, n_act, delta0, rmat, clip) -> float:
             for j in range(n_act):
                 if j != k:
                     target -= rmat[k, j] * g[b.active[j], GEO_NSTAT]
-            x = static_overlap(target, rmat[k, k], b.coef[i], b.hist[i, HIST_MAX], clip)
-            n = normal_law_force(x, 0.0, b.coef[i], b.hist[i, HIST_MAX], clip) if x > 0.0 else 0.0
+            x = static_overlap(target, rmat[k, k], b.coef[i], b.hist[i, HIST_MAX], b.hist[i, HIST_RATE], clip)
+            n = normal_law_force(x, 0.0, b.coef[i],
+                                 b.hist[i, HIST_MAX], b.hist[i, HIST_RATE], clip) if x > 0.0 else 0.0
             change = max(change, abs(n - g[i, GEO_NSTAT]))
             largest = max(largest, n)
             g[i, GEO_NSTAT] = n
@@ -545,8 +546,9 @@ def contact_forces(y, q, qd, b, buf, radius, mass, clip, acc, fdamp, scale_acc):
         # residual in series takes its share, d delta = d delta0 / (1 + R_kk F'(delta))
         ddot = normal_rate_3d(y[i, VX] - v0, y[i, VX + 1] - v1, y[i, VX + 2] - v2, -nx, -ny, -nz)
         if resid and rmat[k, k] > 0.0:
-            ddot /= 1.0 + rmat[k, k] * normal_law_slopes(delta, b.coef[i], b.hist[i, HIST_MAX])[0]
-        n, pv, ep, wp = normal_law_response(delta, ddot, b.coef[i], b.hist[i, HIST_MAX], clip)
+            ddot /= 1.0 + rmat[k, k] * normal_law_slopes(delta, b.coef[i],
+                                                         b.hist[i, HIST_MAX], b.hist[i, HIST_RATE])[0]
+        n, pv, ep, wp = normal_law_response(delta, ddot, b.coef[i], b.hist[i, HIST_MAX], b.hist[i, HIST_RATE], clip)
         g[i, GEO_N] = n
         e_pot += ep
         p_visc += pv

@@ -17,12 +17,13 @@ from typing import NamedTuple
 
 from numba import njit
 
-from granplate.model.inputs import HIST_END, HIST_MAX, HIST_TIME
+from granplate.model.inputs import HIST_END, HIST_MAX, HIST_RATE, HIST_TIME
 from granplate.physics.contact import (
-    COEF_KS, COEF_MU, contact_arm, friction_magnitude, friction_power, friction_slope, pair_apart,
+    COEF_DY, COEF_KS, COEF_MU, COEF_RC, COEF_RL, COEF_SY, contact_arm, friction_magnitude, friction_power, friction_slope, pair_apart,
     pair_normal_rate, pair_overlap, pair_rates, plate_overlap, plate_rates, slip_after_friction, wall_overlap,
     wall_rates,
 )
+from granplate.physics.cavity import rate_factor
 from granplate.physics.laws import normal_law_force, normal_law_response
 from granplate.physics.shock import time_profile
 from granplate.solver.state import PARTNER_PLATE
@@ -120,7 +121,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         c = g.pair_coef[p]
         if split:  # the normal force alone: friction_flow applies the friction
             n, pv, ep, wp = normal_law_response(delta, pair_normal_rate(y[i, 3], y[i, 4], y[j, 3], y[j, 4], nx, nz),
-                                                c, g.pair_hist[p, HIST_MAX], cfg.clip)
+                                                c, g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip)
             w_plastic += wp
             fx = -n * nx
             fz = -n * nz
@@ -134,7 +135,8 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         ai = contact_arm(ri, delta, 0.5 * cfg.arm_shrink)
         aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
         ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
-        n, pv, ep, wp = normal_law_response(delta, ddot, c, g.pair_hist[p, HIST_MAX], cfg.clip)
+        n, pv, ep, wp = normal_law_response(delta, ddot, c,
+                                            g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip)
         f = friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS])
         pf = friction_power(f, vt)
         w_plastic += wp
@@ -167,7 +169,8 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             ovl_j = -1 - g.wall_w[w]
         c = g.wall_coef[w]
         if split:  # the normal force alone: friction_flow applies the friction
-            n, pv, ep, wp = normal_law_response(delta, y[i, 3] * nx + y[i, 4] * nz, c, g.wall_hist[w, HIST_MAX],
+            n, pv, ep, wp = normal_law_response(delta, y[i, 3] * nx + y[i, 4] * nz, c,
+                                                g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE],
                                                 cfg.clip)
             w_plastic += wp
             dy[i, 3] += -n * nx
@@ -177,7 +180,8 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             continue
         ai = contact_arm(ri, delta, cfg.arm_shrink)
         ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
-        n, pv, ep, wp = normal_law_response(delta, ddot, c, g.wall_hist[w, HIST_MAX], cfg.clip)
+        n, pv, ep, wp = normal_law_response(delta, ddot, c,
+                                            g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
         f = friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS])
         pf = friction_power(f, vt)
         w_plastic += wp
@@ -205,7 +209,8 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
                 ovl_i = i
                 ovl_j = PARTNER_PLATE
             c = g.pc_coef[k]
-            n, pv, ep, wp = normal_law_response(delta, ddot, c, g.pc_hist[k, HIST_MAX], cfg.clip)
+            n, pv, ep, wp = normal_law_response(delta, ddot, c,
+                                                g.pc_hist[k, HIST_MAX], g.pc_hist[k, HIST_RATE], cfg.clip)
             f = friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS])
             pf = friction_power(f, vt)
             w_plastic += wp
@@ -272,7 +277,7 @@ def friction_flow(y, dt, g, cfg, forward):
             ai = contact_arm(ri, delta, 0.5 * cfg.arm_shrink)
             aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
             ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
-            n = normal_law_force(delta, ddot, c, g.pair_hist[q, HIST_MAX], cfg.clip)
+            n = normal_law_force(delta, ddot, c, g.pair_hist[q, HIST_MAX], g.pair_hist[q, HIST_RATE], cfg.clip)
             inv_mi = 1.0 / g.mass[i]
             inv_mj = 1.0 / g.mass[j]
             inv_ii = ai / g.inertia[i]  # the spin change per unit impulse
@@ -297,7 +302,7 @@ def friction_flow(y, dt, g, cfg, forward):
                 continue
             ai = contact_arm(ri, delta, cfg.arm_shrink)
             ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
-            n = normal_law_force(delta, ddot, c, g.wall_hist[w, HIST_MAX], cfg.clip)
+            n = normal_law_force(delta, ddot, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
             inv_m = 1.0 / g.mass[i]
             inv_i = ai / g.inertia[i]
             imp, dw = friction_impulse(vt, n, c[COEF_MU], c[COEF_KS], inv_m + ai * inv_i, dt)
@@ -309,22 +314,39 @@ def friction_flow(y, dt, g, cfg, forward):
 
 
 @njit(cache=True)
-def commit_history(t, hist):
+def commit_history(t, hist, coef):
     """Take the accepted step's end overlaps (column HIST_END) into the contacts' largest
-    overlaps (HIST_MAX, reached at time t [s]: HIST_TIME) of one history array."""
+    overlaps (HIST_MAX, reached at time t [s]: HIST_TIME) of one history array, and fix the
+    yield strength of a contact under the law "johnson" (coefficient rows `coef`) in the step
+    where its largest overlap first passes the rate-free yield overlap: its rate factor
+    Y(rate) / Y (`cavity.rate_factor`) at `fixing_speed`."""
     for k in range(hist.shape[0]):
         d = hist[k, HIST_END]
         if d > hist[k, HIST_MAX]:
+            if hist[k, HIST_RATE] == 0.0 and coef[k, COEF_SY] > 0.0 and d > coef[k, COEF_DY]:
+                v = fixing_speed(d, hist[k, HIST_MAX], t, hist[k, HIST_TIME])
+                hist[k, HIST_RATE] = rate_factor(v, coef[k, COEF_RC], coef[k, COEF_RL])
             hist[k, HIST_MAX] = d
             hist[k, HIST_TIME] = t
 
 
 @njit(cache=True)
+def fixing_speed(d: float, d_old: float, t: float, t_old: float) -> float:
+    """The approach speed [m/s] that fixes a contact's yield strength (docs/model.md
+    section 3.10): the growth of its largest overlap over the accepted step, (d - d_old) /
+    (t - t_old), from its previous largest overlap d_old reached at t_old; -1 (rate-free)
+    when there is none (the contact passed yield in its first step in touch)."""
+    if d_old > 0.0 and t > t_old:
+        return (d - d_old) / (t - t_old)
+    return -1.0
+
+
+@njit(cache=True)
 def commit_histories(t, g):
     """`commit_history` of every contact kind of g (pairs, walls, plate contacts)."""
-    commit_history(t, g.pair_hist)
-    commit_history(t, g.wall_hist)
-    commit_history(t, g.pc_hist)
+    commit_history(t, g.pair_hist, g.pair_coef)
+    commit_history(t, g.wall_hist, g.wall_coef)
+    commit_history(t, g.pc_hist, g.pc_coef)
 
 
 @njit(cache=True)
@@ -409,7 +431,8 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
             ovl_i = i
             ovl_j = j
         ddot = pair_normal_rate(y[i, 3], y[i, 4], y[j, 3], y[j, 4], nx, nz)
-        n, pv, ep, wp = normal_law_response(delta, ddot, g.pair_coef[p], g.pair_hist[p, HIST_MAX], cfg.clip)
+        n, pv, ep, wp = normal_law_response(delta, ddot, g.pair_coef[p],
+                                            g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip)
         w_plastic += wp
         p_visc += pv
         e_pot += ep
@@ -439,7 +462,8 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
             ovl_i = i
             ovl_j = -1 - g.wall_w[w]
         ddot = y[i, 3] * nx + y[i, 4] * nz
-        n, pv, ep, wp = normal_law_response(delta, ddot, g.wall_coef[w], g.wall_hist[w, HIST_MAX], cfg.clip)
+        n, pv, ep, wp = normal_law_response(delta, ddot, g.wall_coef[w],
+                                            g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
         w_plastic += wp
         p_visc += pv
         e_pot += ep

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from granplate.model.inputs import HIST_END, HIST_MAX
+from granplate.model.inputs import HIST_END, HIST_MAX, HIST_RATE
 from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm, friction_magnitude
 from granplate.physics.laws import normal_law_force, normal_law_response
 from granplate.physics.shock import time_profile
@@ -113,7 +113,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         rvy = y[i, VY] - y[j, VY]
         rvz = y[i, VZ] - y[j, VZ]
         n, pv, ep, wp = normal_law_response(delta, normal_rate_3d(rvx, rvy, rvz, nx, ny, nz), c,
-                                            g.pair_hist[p, HIST_MAX], cfg.clip)
+                                            g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip)
         fnx = n * nx
         fny = n * ny
         fnz = n * nz
@@ -157,7 +157,8 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             ovl_j = -1 - g.wall_w[w]
         c = g.wall_coef[w]
         ddot = normal_rate_3d(y[i, VX], y[i, VY], y[i, VZ], nx, ny, nz)
-        n, pv, ep, wp = normal_law_response(delta, ddot, c, g.wall_hist[w, HIST_MAX], cfg.clip)
+        n, pv, ep, wp = normal_law_response(delta, ddot, c,
+                                            g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
         dy[i, VX] -= n * nx
         dy[i, VY] -= n * ny
         dy[i, VZ] -= n * nz
@@ -226,7 +227,7 @@ def friction_flow(y, dt, g, cfg, forward):
             speed = _speed(vsx, vsy, vsz)
             if speed == 0.0:
                 continue
-            n = normal_law_force(delta, ddot, c, g.pair_hist[q, HIST_MAX], cfg.clip)
+            n = normal_law_force(delta, ddot, c, g.pair_hist[q, HIST_MAX], g.pair_hist[q, HIST_RATE], cfg.clip)
             inv_mi = 1.0 / g.mass[i]
             inv_mj = 1.0 / g.mass[j]
             inv_ii = 1.0 / g.inertia[i]
@@ -253,7 +254,7 @@ def friction_flow(y, dt, g, cfg, forward):
             speed = _speed(vsx, vsy, vsz)
             if speed == 0.0:
                 continue
-            n = normal_law_force(delta, ddot, c, g.wall_hist[w, HIST_MAX], cfg.clip)
+            n = normal_law_force(delta, ddot, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
             inv_m = 1.0 / g.mass[i]
             inv_i = 1.0 / g.inertia[i]
             imp, dw = friction_impulse(speed, n, c[COEF_MU], c[COEF_KS], inv_m + a * a * inv_i, dt)
@@ -339,7 +340,8 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
             ovl_i = i
             ovl_j = j
         ddot = normal_rate_3d(y[i, VX] - y[j, VX], y[i, VY] - y[j, VY], y[i, VZ] - y[j, VZ], nx, ny, nz)
-        n, pv, ep, wp = normal_law_response(delta, ddot, g.pair_coef[p], g.pair_hist[p, HIST_MAX], cfg.clip)
+        n, pv, ep, wp = normal_law_response(delta, ddot, g.pair_coef[p],
+                                            g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip)
         w_plastic += wp
         p_visc += pv
         e_pot += ep
@@ -372,7 +374,8 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
             ovl_i = i
             ovl_j = -1 - g.wall_w[w]
         ddot = normal_rate_3d(y[i, VX], y[i, VY], y[i, VZ], nx, ny, nz)
-        n, pv, ep, wp = normal_law_response(delta, ddot, g.wall_coef[w], g.wall_hist[w, HIST_MAX], cfg.clip)
+        n, pv, ep, wp = normal_law_response(delta, ddot, g.wall_coef[w],
+                                            g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
         w_plastic += wp
         p_visc += pv
         e_pot += ep

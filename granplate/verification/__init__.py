@@ -16,6 +16,9 @@ the page this writes, regenerated with --full):
   sphere against Thornton's restitution, the yield velocity and overlap, the force-overlap
   loop measured from the trajectory, and Y -> infinity as Hertz (plastic.py: the closed
   forms and an independent integration);
+- measured_cases.py: yielding spheres against measurement (Burgoyne & Daraio's 15 sphere
+  compressions, CC BY 4.0, data/burgoyne2014/), the laws "johnson" and "thornton" replayed
+  along the measured overlap (measured.py: the measures and the replays);
 - plate_theory.py, plate_ritz.py, impact_theory.py: reference solutions for elastic bodies
   (Kirchhoff and Mindlin plate frequencies, Navier's and Timoshenko's deflections, an
   independent Ritz solver, Hertz's and Zener's impacts, flexural wave return times),
@@ -60,13 +63,14 @@ def __getattr__(name: str):
 
 def all_cases() -> tuple:
     """Every registered case, in page order."""
-    from . import (chain, conservation, coupled, dynamic, face_contacts, granular, lammps, plastic_cases, plate_cases,
-                   plate_mesh, solid_cases, space_cases)
+    from . import (chain, conservation, coupled, dynamic, face_contacts, granular, lammps, measured_cases, plastic_cases,
+                   plate_cases, plate_mesh, solid_cases, space_cases)
 
     beside = lammps.cases()
     plane_lammps = tuple(c for c in beside if c.family != "space")
     space_lammps = tuple(c for c in beside if c.family == "space")
-    return (granular.CASES + chain.CASES + dynamic.CASES + plane_lammps + plastic_cases.CASES + space_cases.CASES
+    return (granular.CASES + chain.CASES + dynamic.CASES + plane_lammps + plastic_cases.CASES + measured_cases.CASES
+            + space_cases.CASES
             + space_lammps + plate_cases.CASES
             + plate_mesh.CASES + solid_cases.CASES + conservation.CASES + face_contacts.CASES + coupled.CASES)
 

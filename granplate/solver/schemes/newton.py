@@ -16,7 +16,7 @@ import math
 
 from numba import njit
 
-from granplate.model.inputs import HIST_MAX
+from granplate.model.inputs import HIST_MAX, HIST_RATE
 from granplate.physics.contact import COEF_KS, COEF_MU, friction_magnitude, plate_overlap
 from granplate.physics.laws import normal_law_slopes
 
@@ -50,7 +50,7 @@ def law_jacobian(h, mmat, u_end, g, w, jac, rhs, vguess):
         n_d = 0.0  # dN/d(delta)
         n_v = 0.0  # dN/d(delta rate)
         if delta > 0.0 and w.normal_new[k] > 0.0:
-            n_d, n_v = normal_law_slopes(delta, c, g.pc_hist[k, HIST_MAX])
+            n_d, n_v = normal_law_slopes(delta, c, g.pc_hist[k, HIST_MAX], g.pc_hist[k, HIST_RATE])
         inv_m = 1.0 / g.mass[i]
         inv_t = inv_m + g.radius[i] * g.radius[i] / g.inertia[i]
         for e in range(nd):

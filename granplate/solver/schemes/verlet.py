@@ -159,7 +159,7 @@ def start(sw, t, st, g, cfg):
         return 0.0, 0.0
     cur = int(sw.split[CURRENT])
     e_pot, _, _, e_static, _, _ = body_pass(st.y, sw, cur, st.q, st.qd, g, cfg, st.k1, sw.fdamp)
-    commit_history(t, sw.body.hist)  # contacts start loaded at their overlaps at t = 0
+    commit_history(t, sw.body.hist, sw.body.coef)  # contacts start loaded at their overlaps at t = 0
     return e_pot, e_static
 
 
@@ -269,7 +269,7 @@ def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
             st.q[m] = b.q[m]
             st.qd[m] = b.qd[m]
         st.clock[E_STATIC] = b.static[1 - int(sw.split[CURRENT])]
-        commit_history(t + h, b.hist)
+        commit_history(t + h, b.hist, b.coef)
     sw.split[CURRENT] = 1.0 - sw.split[CURRENT]
     sw.split[STARTED] = 1.0
     land = sw.split[LAND] != 0.0
