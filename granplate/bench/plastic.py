@@ -75,7 +75,6 @@ def timed(s) -> dict:
 def bench_case(case: str, s, repeats: int = REPEATS) -> dict:
     """Every law on one scenario, alternately `repeats` times: median loop CPU time per step
     [us] of each and their ratios to Hertz's ("ratio": the larger)."""
-    import granplate as gp
 
     runs: dict[str, list[dict]] = {law: [] for law in LAWS}
     for _ in range(repeats):
