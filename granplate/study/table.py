@@ -31,6 +31,8 @@ FIELD_UNITS: dict[str, str] = {
     "overlap_warn": "1", "overlap_stop": "1", "dt_min": "s", "lambda_target": "1",
     "iteration_rtol": "1", "iteration_atol": "N", "max_iterations": "1", "energy_tol": "1",
     "error_tol": "1", "implicit_dt_max": "s",
+    # the measured yielding law (docs/model.md section 3.10)
+    "C": "1", "rate_ref": "1/s", "hardness_ratio": "1", "unloading_factor": "1",
 }
 
 
