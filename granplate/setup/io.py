@@ -14,6 +14,7 @@ Every error is a `ScenarioError` naming the field by its dotted path (`plate.nx`
 from __future__ import annotations
 
 import dataclasses
+import functools
 import numbers
 import os
 import re
@@ -163,22 +164,36 @@ def _check_keys(path: str, d: Any, allowed: list[str]) -> None:
                                 + ", ".join(allowed))
 
 
+@functools.cache
+def _fields_of(cls: type) -> tuple[dict[str, Any], list[str]]:
+    """The resolved annotations and the field names of dataclass `cls` (once per class:
+    resolving them costs as much as reading a table)."""
+    return typing.get_type_hints(cls), [f.name for f in dataclasses.fields(cls)]
+
+
 def _table(path: str, d: Any, cls: type) -> Any:
     """Build dataclass `cls` from table `d` (unknown keys refused, required ones checked)."""
-    hints = typing.get_type_hints(cls)
-    names = [f.name for f in dataclasses.fields(cls)]
+    hints, names = _fields_of(cls)
     _check_keys(path, d, names)
     kwargs = {}
+    required = REQUIRED.get(cls, ())
     for name in names:
-        fpath = f"{path}.{name}"
-        if d.get(name) is None:  # absent (or None in a Python dict): the default
-            if name in REQUIRED.get(cls, ()):
+        value = d.get(name)
+        if value is None:  # absent (or None in a Python dict): the default
+            if name in required:
+                fpath = f"{path}.{name}"
                 raise ScenarioError(fpath, MISSING, f"missing required field '{fpath}'")
             continue
-        kwargs[name] = _convert(fpath, d[name], hints[name])
+        tp = hints[name]
+        # a value of exactly its field's plain type is its own conversion (most of a table)
+        kwargs[name] = value if type(value) is tp and tp in _PLAIN else _convert(f"{path}.{name}", value, tp)
         if (cls, name) in CHOICES:
-            string_in(fpath, kwargs[name], CHOICES[cls, name])
+            string_in(f"{path}.{name}", kwargs[name], CHOICES[cls, name])
     return cls(**kwargs)
+
+
+#: Types whose values `_convert` returns unchanged (when of exactly that type).
+_PLAIN: frozenset[type] = frozenset({float, int, str, bool})
 
 
 def _materials(d: Any) -> dict[str, Material]:
@@ -247,12 +262,26 @@ def _initial_step_within_max(t: TimeSettings, given: dict) -> TimeSettings:
     return t
 
 
-def from_dict(d: dict) -> Scenario:
+def _granules_file(d: dict, dimension: int, base: str | os.PathLike | None) -> dict[str, Any]:
+    """The granules of a top-level `granules_file` (relative to `base`, the scenario file's
+    folder; None: the working directory), and the file's name as given."""
+    from granplate.setup.granules_file import read_granules
+
+    name = _convert("granules_file", d["granules_file"], str)
+    if d.get("granules") is not None:
+        raise ScenarioError("granules_file", name, "give either [[granules]] tables or granules_file, not both")
+    path = name if base is None or os.path.isabs(name) else os.path.join(base, name)
+    return {"granules": read_granules(path, dimension, name), "granules_file": name}
+
+
+def from_dict(d: dict, base: str | os.PathLike | None = None) -> Scenario:
     """A Scenario from a TOML-shaped dict; shape errors raise ScenarioError (no physics).
 
-    Top-level keys: name, description, dimension, materials, layout, granules, walls, box,
-    plate, load, contact, time, solver. Missing tables take the defaults (no layout, no
-    plate, no box; dimension 2; in 3D no load, `load.kind = "none"`).
+    Top-level keys: name, description, dimension, materials, layout, granules (or
+    granules_file: a CSV, NPZ or netCDF file of them, setup.granules_file, relative to
+    `base`, by default the working directory), walls, box, plate, load, contact, time,
+    solver. Missing tables take the defaults (no layout, no plate, no box; dimension 2;
+    in 3D no load, `load.kind = "none"`).
     """
     names = [f.name for f in dataclasses.fields(Scenario)]
     _check_keys("", d, names)
@@ -276,7 +305,9 @@ def from_dict(d: dict) -> Scenario:
             kw[key] = _table(key, d[key], cls)
     if "time" in kw:
         kw["time"] = _initial_step_within_max(kw["time"], d["time"])
-    if d.get("granules") is not None:
+    if d.get("granules_file") is not None:
+        kw.update(_granules_file(d, kw.get("dimension", 2), base))
+    elif d.get("granules") is not None:
         kw["granules"] = _convert("granules", d["granules"], tuple[Granule, ...])
     if d.get("walls") is not None:
         kw["walls"] = _walls(d["walls"], kw.get("dimension", 2))
@@ -400,13 +431,14 @@ def _without_defaults(table: dict, defaults: dict[str, Any]) -> dict:
 
 # --------------------------------------------------------------------------- TOML
 
-def loads(text: str) -> Scenario:
-    """A Scenario from TOML text (shape checked, physics not: see `validate`)."""
+def loads(text: str, base: str | os.PathLike | None = None) -> Scenario:
+    """A Scenario from TOML text (shape checked, physics not: see `validate`); base: the
+    folder a `granules_file` is relative to (None: the working directory)."""
     try:
         d = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise ScenarioError("toml", _excerpt(text, e), f"TOML syntax error: {e}") from None
-    return from_dict(d)
+    return from_dict(d, base)
 
 
 def _excerpt(text: str, e: tomllib.TOMLDecodeError) -> str:
@@ -434,7 +466,7 @@ def load(path: str | os.PathLike) -> Scenario:
         d = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise ScenarioError("file", str(path), f"TOML syntax error: {e}") from None
-    return from_dict(d)
+    return from_dict(d, os.path.dirname(os.path.abspath(path)))
 
 
 def dumps(s: Scenario, all_materials: bool = False) -> str:
