@@ -264,6 +264,9 @@ def write_granules(granules: tuple[Granule, ...], path: str | os.PathLike, dimen
     path = os.fspath(path)
     fmt = file_format(path)
     cols = granule_columns(granules, dimension)
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise ScenarioError("granules_file", path, f"cannot be written: no folder {folder}")
     if fmt == "csv":
         with open(path, "w", newline="", encoding="utf-8") as f:
             w = csv.writer(f)

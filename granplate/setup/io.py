@@ -474,6 +474,22 @@ def dumps(s: Scenario, all_materials: bool = False) -> str:
     return tomli_w.dumps(to_dict(s, all_materials=all_materials))
 
 
+def dumps_with_granules_file(s: Scenario, path: str | os.PathLike, base: str | os.PathLike | None = None,
+                             all_materials: bool = False) -> str:
+    """`s` as TOML text whose granules are in the file `path` (.csv, .npz or .nc, written
+    here by `setup.granules_file.write_granules`), named by `granules_file` relative to
+    `base` (the folder the TOML goes to; None: the working directory); reading the text
+    back (from that folder) gives a scenario equal to `s`."""
+    from granplate.setup.granules_file import write_granules
+
+    write_granules(s.granules, path, s.dimension)
+    d = to_dict(s, all_materials=all_materials)
+    d.pop("granules", None)
+    name = os.path.relpath(os.path.abspath(path), os.path.abspath(base) if base is not None else os.getcwd())
+    head = {k: d.pop(k) for k in ("name", "description", "dimension") if k in d}
+    return tomli_w.dumps({**head, "granules_file": name.replace(os.sep, "/"), **d})
+
+
 def dump(s: Scenario, path: str | os.PathLike, all_materials: bool = False) -> None:
     """Write `s` as TOML to `path`."""
     with open(path, "wb") as f:
@@ -618,5 +634,5 @@ def with_changes(s: Scenario, changes: dict[str, object]) -> Scenario:
     return from_dict(d)
 
 
-__all__ = ["from_dict", "to_dict", "loads", "load", "dumps", "dump", "load_scenario",
+__all__ = ["from_dict", "to_dict", "loads", "load", "dumps", "dumps_with_granules_file", "dump", "load_scenario",
            "with_changes", "describe_changes", "CHANGED", "UNLISTED", "REQUIRED", "CHOICES", "MATERIAL_KEYS", "MATERIAL_REQUIRED", "MISSING"]
