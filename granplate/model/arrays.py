@@ -213,31 +213,40 @@ def pair_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, pairs:
     and the pair's settings are computed once per pair of materials, and the yield overlap
     of an elastic-plastic pair pair by pair."""
     pairs = np.asarray(pairs, np.int64).reshape(-1, 2)
-    pair_coef = np.zeros((len(pairs), N_COEF))
     if not len(pairs):
-        return pair_coef
+        return np.zeros((0, N_COEF))
     r, mass = np.asarray(r, float), np.asarray(mass, float)
     kinds, kind = material_indices(mats)
     i, j = pairs[:, 0], pairs[:, 1]
     ri, rj, mi, mj = r[i], r[j], mass[i], mass[j]
     r_star = ri * rj / (ri + rj)
     m_star = mi * mj / (mi + mj)
-    combo = kind[i] * len(kinds) + kind[j]
-    e_star, alpha = np.empty(len(pairs)), np.empty(len(pairs))
+    del ri, rj, mi, mj
+    combos = [(0, kinds[0], kinds[0])] if len(kinds) == 1 else [
+        (c, kinds[c // len(kinds)], kinds[c % len(kinds)]) for c in np.unique(kind[i] * len(kinds) + kind[j]).tolist()]
+    combo = None if len(combos) == 1 else kind[i] * len(kinds) + kind[j]
+    # per pair of materials: E*, alpha_n, mu, k_s, whether the law is elastic-plastic (one value each when one pair)
+    e_star, alpha, mu, ks = (np.empty(len(pairs)) if combo is not None else 0.0 for _ in range(4))
     plastic = np.zeros(len(pairs), bool)
-    for c in np.unique(combo).tolist():
-        ka, kb = kinds[c // len(kinds)], kinds[c % len(kinds)]
+    for c, ka, kb in combos:
+        values = (effective_modulus(ka, kb), *s.contact.for_pair(ka.name, kb.name))
+        if combo is None:
+            e_star, alpha, mu, ks = values
+            plastic[:] = normal_law_of(s, ka.name, kb.name) == "thornton"
+            continue
         on = combo == c
-        e_star[on] = effective_modulus(ka, kb)
-        alpha[on], pair_coef[on, COEF_MU], pair_coef[on, COEF_KS] = s.contact.for_pair(ka.name, kb.name)
+        for column, v in zip((e_star, alpha, mu, ks), values):
+            column[on] = v
         plastic |= on & (normal_law_of(s, ka.name, kb.name) == "thornton")
     coef_a = 4.0 / 3.0 * e_star * np.sqrt(r_star)  # hertz_coefficient
+    pair_coef = np.empty((len(pairs), N_COEF))
     pair_coef[:, COEF_A] = coef_a
     pair_coef[:, COEF_C] = alpha * np.sqrt(m_star * coef_a)  # damping_coefficient
-    pair_coef[:, COEF_DY] = math.inf
+    pair_coef[:, COEF_MU], pair_coef[:, COEF_KS], pair_coef[:, COEF_DY] = mu, ks, math.inf
     for p in np.flatnonzero(plastic).tolist():
         a, b = mats[i[p]], mats[j[p]]
-        pair_coef[p, COEF_DY] = law_yield_overlap(s, a, b, b.name, float(e_star[p]), float(r_star[p]))
+        e_p = e_star if combo is None else float(e_star[p])
+        pair_coef[p, COEF_DY] = law_yield_overlap(s, a, b, b.name, e_p, float(r_star[p]))
     return pair_coef
 
 

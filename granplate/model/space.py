@@ -95,10 +95,9 @@ def initial_state_3d(s: Scenario) -> np.ndarray:
     """(ng, 9) x, y, z, vx, vy, vz, wx, wy, wz of every granule at t = 0."""
     g = s.granules
     y0 = np.zeros((len(g), STATE_COLUMNS[3]))
-    for c, f in enumerate(("x", "y", "z", "vx", "vy", "vz")):
-        y0[:, c] = [getattr(q, f) for q in g]
     if len(g):
-        y0[:, 6:] = [spin_vector(q.omega) for q in g]
+        y0[:, :6] = [(q.x, q.y, q.z, q.vx, q.vy, q.vz) for q in g]
+        y0[:, 6:] = [q.omega for q in g]  # three numbers each (validated): spin_vector's
     return y0
 
 

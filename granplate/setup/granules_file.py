@@ -167,6 +167,8 @@ def _number_column(cells: Any, col: str, name: str, required: bool) -> list[floa
 def _string_column(cells: Any, col: str, name: str, required: bool) -> list[str]:
     """A column of strings (an empty CSV cell: missing, or "" for a label)."""
     values = cells.tolist() if isinstance(cells, np.ndarray) else list(cells)
+    if set(map(type, values)) <= {str} and not (required and "" in values):
+        return values
     out = []
     for i, v in enumerate(values):
         if isinstance(v, bytes):

@@ -26,12 +26,22 @@ def all_pairs(points: np.ndarray, distance: float) -> np.ndarray:
 
 
 def tree_pairs(points: np.ndarray, distance: float) -> np.ndarray:
-    """The same pairs from a k-d tree (scipy.spatial.cKDTree.query_pairs), sorted (i, j)."""
+    """The same pairs from a k-d tree (scipy.spatial.cKDTree.query_pairs), sorted (i, j).
+
+    The tree is built by splitting at the middle of each node's extent, not its median,
+    and without shrinking nodes to their points (`balanced_tree=False,
+    compact_nodes=False`: the same pairs; for a million spheres of a packing, a third of
+    the time); the pairs are sorted by the one key i n + j."""
     from scipy.spatial import cKDTree
 
-    pairs = cKDTree(np.asarray(points, dtype=float)).query_pairs(float(distance), output_type="ndarray")
-    pairs = pairs.astype(np.int64).reshape(-1, 2)
-    return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
+    points = np.asarray(points, dtype=float)
+    tree = cKDTree(points, balanced_tree=False, compact_nodes=False)
+    pairs = tree.query_pairs(float(distance), output_type="ndarray").astype(np.int64).reshape(-1, 2)
+    key = pairs[:, 0] * len(points) + pairs[:, 1]  # i < j < n: one integer per pair, in (i, j) order
+    key.sort()
+    out = np.empty((len(key), 2), np.int64)
+    np.divmod(key, len(points), out=(out[:, 0], out[:, 1]))
+    return out
 
 
 def close_pairs(points: np.ndarray, distance: float) -> np.ndarray:

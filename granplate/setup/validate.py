@@ -517,9 +517,24 @@ def _floats(values: list) -> np.ndarray | None:
     return np.array(values, float)
 
 
+#: The granules whose columns `_column` holds (a strong reference: identity is the key) and
+#: the columns, by field; emptied when `validate` returns.
+_COLUMNS: list = [None, {}]
+
+
+def _column(gs: tuple[Granule, ...], field: str) -> np.ndarray | None:
+    """The granules' `field` as `_floats` gives it, extracted once per validation."""
+    if _COLUMNS[0] is not gs:
+        _COLUMNS[:] = [gs, {}]
+    cols = _COLUMNS[1]
+    if field not in cols:
+        cols[field] = _floats([getattr(g, field) for g in gs])
+    return cols[field]
+
+
 def _planar_granules(gs: tuple[Granule, ...]) -> bool:
     """Whether every granule has z = vz = 0.0 and a number omega (`_check_planar` passes)."""
-    cols = [_floats([getattr(g, f) for g in gs]) for f in ("z", "vz", "omega")]
+    cols = [_column(gs, f) for f in ("z", "vz", "omega")]
     return all(c is not None for c in cols) and not cols[0].any() and not cols[1].any()
 
 
@@ -529,7 +544,7 @@ def _granule_columns(s: Scenario) -> dict[str, np.ndarray] | None:
     gs = s.granules
     names = ("x", "y", "z", "radius", "vx", "vy", "vz") if s.dimension == 3 else ("x", "y", "radius", "vx", "vy",
                                                                                    "omega")
-    cols = {f: _floats([getattr(g, f) for g in gs]) for f in names}
+    cols = {f: _column(gs, f) for f in names}
     if s.dimension == 3:
         spins = [g.omega for g in gs]
         if set(map(type, spins)) != {tuple} or set(map(len, spins)) != {3}:
@@ -634,11 +649,16 @@ def _smallest_radius(s: Scenario) -> list[tuple[float, str]]:
     """[(R, path)]: the granule radius that `length_scale`'s min picks, with the path
     that breaks its ties (the smallest string), or every (radius, path) pair when one is
     not a Python float."""
-    r = _floats([g.radius for g in s.granules]) if s.granules else None
+    r = _column(s.granules, "radius") if s.granules else None
     if r is None or not np.isfinite(r).all():
         return [(g.radius, _granule(s, i, "radius")) for i, g in enumerate(s.granules)]
     r_min = float(r.min())
-    return [(r_min, min(_granule(s, int(i), "radius") for i in np.flatnonzero(r == r_min)))]
+    ties = np.flatnonzero(r == r_min).tolist()
+    if len(ties) > 1:  # the path that sorts first: its number is all that differs (and what follows it)
+        # (granule_path: `granules[i].radius`, or `FILE, row i+1, column radius`)
+        after, shift = ("]", 0) if s.granules_file is None else (",", 1)
+        ties = [min(ties, key=lambda i: str(i + shift) + after)]
+    return [(r_min, _granule(s, ties[0], "radius"))]
 
 
 def _wall_paths(s: Scenario, boxed: bool) -> list[str]:
@@ -660,7 +680,7 @@ def _check_lengths(s: Scenario, boxed: bool = False) -> None:
            f"farther out, round-off of a coordinate (2.2e-16 |x|) exceeds the {OVERLAP_RTOL:g} h "
            "overlap tolerance at t = 0")
     coords = ("x", "y", "z", "radius") if s.dimension == 3 else ("x", "y", "radius")
-    cols = [_floats([getattr(g, f) for g in s.granules]) for f in coords] if s.granules else []
+    cols = [_column(s.granules, f) for f in coords] if s.granules else []
     inside = all(c is not None and (np.abs(c) <= limit).all() for c in cols)
     values = [] if inside else [(_granule(s, i, f), getattr(g, f)) for i, g in enumerate(s.granules)
                                 for f in coords]
@@ -720,8 +740,8 @@ def _overlapping_pairs(gs: tuple[Granule, ...], dimension: int = 2) -> list[tupl
     """The pairs of `_close_pairs` (sorted) that may overlap beyond the tolerance: those
     whose overlap from numpy's distance comes within DISTANCE_MARGIN of it (the check then
     measures each with math.dist, as for every pair)."""
-    centres = [_floats([getattr(g, f) for g in gs]) for f in ("x", "y", "z")[:dimension]] if len(gs) > 1 else []
-    r = _floats([g.radius for g in gs]) if len(gs) > 1 else None
+    centres = [_column(gs, f) for f in ("x", "y", "z")[:dimension]] if len(gs) > 1 else []
+    r = _column(gs, "radius") if len(gs) > 1 else None
     if r is None or any(c is None for c in centres):
         return _close_pairs(gs, dimension)
     points = np.column_stack(centres)
@@ -777,7 +797,7 @@ def _check_wall_penetration(s: Scenario, named: dict[int, str]) -> None:
 def _may_cross_wall(s: Scenario, n: tuple[float, ...], offset: float) -> bool:
     """Whether a granule may cross the wall {p . n = offset} (numpy: the same operations on
     the same doubles as `_check_wall_penetration`; True when a value is not a Python float)."""
-    cols = [_floats([getattr(g, f) for g in s.granules]) for f in ("x", "y", "z", "radius")]
+    cols = [_column(s.granules, f) for f in ("x", "y", "z", "radius")]
     if not s.granules or any(c is None for c in cols) or not all(is_number(c) for c in (*n, offset)):
         return bool(s.granules)
     x, y, z, r = cols
@@ -1142,6 +1162,15 @@ def validate(scenario: Scenario) -> None:
     """
     if _passed_before(scenario):
         return
+    try:
+        _validate(scenario)
+    finally:
+        _COLUMNS[:] = [None, {}]
+    _LAST_PASSED[:] = [weakref.ref(scenario), dict(scenario.materials)]
+
+
+def _validate(scenario: Scenario) -> None:
+    """`validate`'s checks, in its order."""
     s = scenario
     if not isinstance(s.name, str):
         raise ScenarioError("name", s.name, "must be a string")
@@ -1177,7 +1206,6 @@ def validate(scenario: Scenario) -> None:
     _check_time(r)
     _check_output_size(r)
     _check_solver(r)
-    _LAST_PASSED[:] = [weakref.ref(scenario), dict(scenario.materials)]
 
 
 #: The scenario that passed `validate` last (a weak reference) and its materials then.
