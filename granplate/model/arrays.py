@@ -128,7 +128,11 @@ def masses_and_inertias(r: np.ndarray, rho: np.ndarray) -> tuple[np.ndarray, np.
     r, rho = np.asarray(r, float), np.asarray(rho, float)
     if not len(r):
         return np.zeros(0), np.zeros(0)
-    kinds, which = np.unique(np.column_stack([r, rho]), axis=0, return_inverse=True)
+    if (rho == rho[0]).all():  # one density: the distinct radii (a sort of numbers, not of rows)
+        radii, which = np.unique(r, return_inverse=True)
+        kinds = np.column_stack([radii, np.full(len(radii), rho[0])])
+    else:
+        kinds, which = np.unique(np.column_stack([r, rho]), axis=0, return_inverse=True)
     mass = np.array([sphere_mass(k[0], k[1]) for k in kinds], float)  # numpy scalars, as granule by granule
     inertia = np.array([sphere_inertia(k[0], k[1]) for k in kinds], float)
     which = which.reshape(-1)

@@ -10,6 +10,7 @@ of dimension 3: the one place the model's dimension is decided.
 from __future__ import annotations
 
 import math
+import operator
 
 import numpy as np
 
@@ -96,8 +97,8 @@ def initial_state_3d(s: Scenario) -> np.ndarray:
     g = s.granules
     y0 = np.zeros((len(g), STATE_COLUMNS[3]))
     if len(g):
-        y0[:, :6] = [(q.x, q.y, q.z, q.vx, q.vy, q.vz) for q in g]
-        y0[:, 6:] = [q.omega for q in g]  # three numbers each (validated): spin_vector's
+        y0[:, :6] = np.array(list(map(operator.attrgetter("x", "y", "z", "vx", "vy", "vz"), g)), float)
+        y0[:, 6:] = np.array(list(map(operator.attrgetter("omega"), g)), float)  # three numbers each (validated)
     return y0
 
 

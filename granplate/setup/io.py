@@ -462,11 +462,14 @@ def load(path: str | os.PathLike) -> Scenario:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as e:
         raise ScenarioError("file", str(path), f"not UTF-8 text: {e}") from None
-    try:
-        d = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise ScenarioError("file", str(path), f"TOML syntax error: {e}") from None
-    return from_dict(d, os.path.dirname(os.path.abspath(path)))
+    from granplate.setup.granules_file import collector_paused
+
+    with collector_paused():  # [[granules]] tables: a dict and a Granule each
+        try:
+            d = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as e:
+            raise ScenarioError("file", str(path), f"TOML syntax error: {e}") from None
+        return from_dict(d, os.path.dirname(os.path.abspath(path)))
 
 
 def dumps(s: Scenario, all_materials: bool = False) -> str:

@@ -16,6 +16,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
+import operator
 import weakref
 from collections import Counter
 from typing import Any
@@ -528,7 +529,7 @@ def _column(gs: tuple[Granule, ...], field: str) -> np.ndarray | None:
         _COLUMNS[:] = [gs, {}]
     cols = _COLUMNS[1]
     if field not in cols:
-        cols[field] = _floats([getattr(g, field) for g in gs])
+        cols[field] = _floats(list(map(operator.attrgetter(field), gs)))
     return cols[field]
 
 
@@ -546,7 +547,7 @@ def _granule_columns(s: Scenario) -> dict[str, np.ndarray] | None:
                                                                                    "omega")
     cols = {f: _column(gs, f) for f in names}
     if s.dimension == 3:
-        spins = [g.omega for g in gs]
+        spins = list(map(operator.attrgetter("omega"), gs))
         if set(map(type, spins)) != {tuple} or set(map(len, spins)) != {3}:
             return None
         flat = _floats([w for om in spins for w in om])
@@ -561,8 +562,8 @@ def _granules_pass(s: Scenario) -> bool:
     comparisons on the same doubles); False when one may not."""
     gs = s.granules
     cols = _granule_columns(s)
-    mats = [g.material for g in gs]
-    labels = [g.label for g in gs]
+    mats = list(map(operator.attrgetter("material"), gs))
+    labels = list(map(operator.attrgetter("label"), gs))
     if cols is None or set(map(type, mats)) != {str} or set(map(type, labels)) != {str}:
         return False
     if len(set(labels)) != len(labels) or not set(mats) <= set(s.materials):
@@ -633,6 +634,9 @@ def length_scale(s: Scenario) -> tuple[float, str]:
     granule radius or a plate element edge (width / nx, height / ny; a box solid's
     size / elements along each axis); its radii and plate sizes already checked to be
     positive numbers."""
+    key = ("length_scale", id(s))  # once per validation of the resolved scenario
+    if _COLUMNS[0] is s.granules and key in _COLUMNS[1]:
+        return _COLUMNS[1][key]
     found = _smallest_radius(s)
     if isinstance(s.plate, Solid) and is_box(s.plate):
         found += [(s.plate.size[k] / s.plate.elements[k], f"plate.size[{k}] / plate.elements[{k}]")
@@ -642,6 +646,8 @@ def length_scale(s: Scenario) -> tuple[float, str]:
                   (s.plate.height / s.plate.ny, "plate.height / plate.ny")]
     if not found:  # a solid of a mesh file alone: no length known before the file is read
         return math.inf, "no granule"
+    if _COLUMNS[0] is s.granules:
+        _COLUMNS[1][key] = min(found)
     return min(found)
 
 
@@ -657,7 +663,7 @@ def _smallest_radius(s: Scenario) -> list[tuple[float, str]]:
     if len(ties) > 1:  # the path that sorts first: its number is all that differs (and what follows it)
         # (granule_path: `granules[i].radius`, or `FILE, row i+1, column radius`)
         after, shift = ("]", 0) if s.granules_file is None else (",", 1)
-        ties = [min(ties, key=lambda i: str(i + shift) + after)]
+        ties = [int(min([f"{i + shift}{after}" for i in ties])[:-1]) - shift]
     return [(r_min, _granule(s, ties[0], "radius"))]
 
 
