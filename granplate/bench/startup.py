@@ -13,8 +13,9 @@ process's start is timed by the parent, the first step by the loop's stop poll, 
 the driver calls just before its first step (`solver.driver.run`'s should_stop), and the
 run ends there. Reported per row (medians over the repeats): the process's start to its
 imports done, the scenario read and validated, the model built, the loop's arrays and
-compiled code ready, the total to the first step; the peak resident memory, and bytes
-per sphere (the peak above the two-sphere row's, per sphere).
+compiled code ready, the total to the first step and the process's CPU time to it (user
+and system: what the wall time would be on a machine no other process shares); the peak
+resident memory, and bytes per sphere (the peak above the two-sphere row's, per sphere).
 """
 from __future__ import annotations
 
@@ -78,7 +79,7 @@ def write_scenario(s, folder: str, fmt: str) -> tuple[str, int]:
 #: The child process: what `granplate run FILE` does up to the first step, each stage timed.
 CHILD = """
 import time, json, resource, sys
-t0 = time.time()
+t0, c0 = time.time(), time.process_time()
 from granplate import cli
 cli.keep_dask_out()
 from granplate.results.run import simulate
@@ -93,10 +94,11 @@ t3 = time.time()
 first = []
 def at_first_step():
     first.append(time.time())
+    first.append(time.process_time())
     return True
 driver.run(model, should_stop=at_first_step, interruptible=False)
 peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-print("@@RESULT " + json.dumps({"t0": t0, "imported": t1, "read": t2, "built": t3, "first_step": first[0],
+print("@@RESULT " + json.dumps({"t0": t0, "imported": t1, "read": t2, "built": t3, "first_step": first[0], "cpu_s": first[1] - c0,
                                 "peak_bytes": peak, "spheres": len(model.labels), "pairs": len(model.granular.pair_ij)}))
 """
 
@@ -112,7 +114,7 @@ def time_row(path: str) -> dict:
             return {"spheres": r["spheres"], "pairs": r["pairs"], "peak_bytes": r["peak_bytes"],
                     "import_s": r["imported"] - start, "read_s": r["read"] - r["imported"],
                     "build_s": r["built"] - r["read"], "loop_start_s": r["first_step"] - r["built"],
-                    "first_step_s": r["first_step"] - start}
+                    "first_step_s": r["first_step"] - start, "cpu_s": r["cpu_s"]}
     return {"failed": f"rc {p.returncode}: {(p.stderr.strip().splitlines() or [''])[-1]}"}
 
 
@@ -135,7 +137,7 @@ def run_startup(rows=DEFAULT_ROWS, repeats: int = REPEATS, log=print) -> list[di
             if failed:
                 row["failed"] = failed[0]["failed"]
             else:
-                for k in ("import_s", "read_s", "build_s", "loop_start_s", "first_step_s", "peak_bytes"):
+                for k in ("import_s", "read_s", "build_s", "loop_start_s", "first_step_s", "cpu_s", "peak_bytes"):
                     row[k] = statistics.median(r[k] for r in runs)
                 row["pairs"] = runs[0]["pairs"]
             out.append(row)
@@ -150,17 +152,18 @@ def run_startup(rows=DEFAULT_ROWS, repeats: int = REPEATS, log=print) -> list[di
 def format_startup_table(rows: list[dict]) -> str:
     """The start-up table as Markdown."""
     lines = ["| spheres | given as | file [MB] | imports [s] | read + validate [s] | model [s] | loop ready [s] "
-             "| to first step [s] | beyond 2 spheres [s] | peak [MiB] | bytes per sphere |",
-             "|" + " ---: |" * 11]
+             "| to first step [s] | its CPU time [s] | beyond 2 spheres [s] | peak [MiB] | bytes per sphere |",
+             "|" + " ---: |" * 12]
     for r in rows:
         given = "[[granules]]" if r["format"] == "toml" else f"granules_file .{r['format']}"
         if "failed" in r:
-            lines.append(f"| {r['spheres']:,} | {given} | | {r['failed']} |" + " |" * 7)
+            lines.append(f"| {r['spheres']:,} | {given} | | {r['failed']} |" + " |" * 8)
             continue
         extra = (f"{r['beyond_two_s']:.2f} | {r['peak_bytes'] / 2**20:.0f} | {r['bytes_per_sphere']:.0f}"
                  if "beyond_two_s" in r else f"- | {r['peak_bytes'] / 2**20:.0f} | -")
         lines.append(f"| {r['spheres']:,} | {given} | {r['file_bytes'] / 1e6:.2f} | {r['import_s']:.2f} "
                      f"| {r['read_s']:.2f} | {r['build_s']:.2f} | {r['loop_start_s']:.2f} | {r['first_step_s']:.2f} "
+                     f"| {r['cpu_s']:.2f} "
                      f"| {extra} |")
     return "\n".join(lines)
 

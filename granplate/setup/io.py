@@ -16,6 +16,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import numbers
+import operator
 import os
 import re
 import tomllib
@@ -486,8 +487,11 @@ def dumps_with_granules_file(s: Scenario, path: str | os.PathLike, base: str | o
     from granplate.setup.granules_file import write_granules
 
     write_granules(s.granules, path, s.dimension)
-    d = to_dict(s, all_materials=all_materials)
-    d.pop("granules", None)
+    d = to_dict(dataclasses.replace(s, granules=()), all_materials=all_materials)  # (a table per granule: slow)
+    used = dict.fromkeys(map(operator.attrgetter("material"), s.granules))
+    mats = {**d.get("materials", {}), **{m: _material_dict(s.materials[m]) for m in used if m in s.materials}}
+    if mats:
+        d["materials"] = dict(sorted(mats.items()))
     name = os.path.relpath(os.path.abspath(path), os.path.abspath(base) if base is not None else os.getcwd())
     head = {k: d.pop(k) for k in ("name", "description", "dimension") if k in d}
     return tomli_w.dumps({**head, "granules_file": name.replace(os.sep, "/"), **d})
