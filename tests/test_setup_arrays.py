@@ -24,7 +24,7 @@ def _scenario(n: int = 300, seed: int = 3) -> Scenario:
     rng = np.random.default_rng(seed)
     names = ["steel", "ptfe", "glass"] if "glass" in LIBRARY else ["steel", "ptfe", "aluminium"]
     names = [m for m in names if m in LIBRARY][:3]
-    side = int(round(n ** (1 / 3))) + 1
+    side = round(n ** (1 / 3)) + 1
     granules = []
     for k in range(n):
         c = np.array([k % side, (k // side) % side, k // side**2], float) * 2.0e-3 + 1.5e-3

@@ -251,7 +251,7 @@ def _granules_of(raw: dict[str, Any], dimension: int, name: str) -> tuple[Granul
         else:
             cols[k] = _number_column(cells, k, name, k in REQUIRED_COLUMNS)
     zeros = [0.0] * n
-    get = lambda k: cols.get(k, zeros)  # noqa: E731
+    get = lambda k: cols.get(k, zeros)
     labels = cols.get("label", [""] * n)
     if dimension == 2:
         _planar_spins(cols, name)

@@ -103,7 +103,6 @@ def _check_planar(s: Scenario) -> None:
     if s.box is not None:
         raise ScenarioError("box", "[box]", f"a box of six walls is 3D: give [[walls]] in 2D, {SET_3D}")
     for i, g in enumerate(() if _planar_granules(s.granules) else s.granules):
-        p = _granule(s, i)
         for f in ("z", "vz"):
             v = getattr(g, f)
             if not (is_number(v) and v == 0.0):
@@ -583,7 +582,6 @@ def _check_granules(s: Scenario) -> None:
         return
     seen: dict[str, int] = {}
     for i, g in enumerate(s.granules):
-        p = _granule(s, i)
         finite(_granule(s, i, "x"), g.x)
         finite(_granule(s, i, "y"), g.y)
         if s.dimension == 3:
