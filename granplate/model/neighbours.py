@@ -60,7 +60,8 @@ def brute_force_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: fl
 
 
 def search_distance(r: np.ndarray, gap_ratio: float) -> float:
-    """Largest centre distance [m] of a potential contact: (2 + gap_ratio) R_max, plus margin."""
+    """Largest centre distance [m] of a potential contact: (2 + gap_ratio) R_max, plus margin
+    (as setup.pairs.contact_search_distance)."""
     return (2.0 + gap_ratio) * float(r.max()) * (1.0 + SEARCH_MARGIN)
 
 

@@ -17,7 +17,7 @@ import numpy as np
 from granplate.errors import ScenarioError
 from granplate.model.contacts import contact_lists, fixed_wall_contacts
 from granplate.model.inputs import STATE_COLUMNS, Granular3, PlateArrays, no_history
-from granplate.model.neighbours import candidate_pairs, search_distance, verlet_distance
+from granplate.setup.pairs import contact_search_distance, superset_pairs
 from granplate.physics.contact import N_COEF
 from granplate.setup.scenario import Scenario
 
@@ -135,14 +135,14 @@ def frictionless(s: Scenario) -> bool:
 
 def shared_candidates(s: Scenario, x, y, z, r) -> np.ndarray | None:
     """One k-d tree search for both the pairs touching at t = 0 and the loop's Verlet list
-    (each keeps its own pairs of these by its exact test): the sorted pairs within the
-    larger of their search distances, or None for fewer than two granules."""
+    (each keeps its own pairs of these by its exact test): sorted pairs holding every pair
+    within the larger of their search distances (the one validation kept, when it searched
+    the same centres that far: setup.pairs.superset_pairs), or None for fewer than two."""
     if len(r) < 2:
         return None
-    distance = search_distance(r, s.contact.neighbour_gap)
-    if s.contact.detection == "dynamic":
-        distance = max(distance, verlet_distance(r, s.contact.skin))
-    return candidate_pairs(x, y, distance, z)
+    c = s.contact
+    distance = contact_search_distance(float(r.max()), c.neighbour_gap, c.skin, c.detection == "dynamic")
+    return superset_pairs(np.column_stack([x, y, z]), distance)  # validation's search, when it kept it
 
 
 def build_space_model(s: Scenario):

@@ -53,3 +53,42 @@ def close_pairs(points: np.ndarray, distance: float) -> np.ndarray:
     if len(points) <= ALL_PAIRS_MAX:
         return all_pairs(points, distance)
     return tree_pairs(points, distance)
+
+
+#: Relative margin on a search distance, so that rounding never drops a pair an exact test
+#: at the nominal distance would keep (model.neighbours.SEARCH_MARGIN).
+SEARCH_MARGIN = 1e-9
+
+
+def contact_search_distance(r_max: float, neighbour_gap: float, skin: float, dynamic: bool) -> float:
+    """The distance [m] one search at t = 0 covers for both the pairs touching within
+    neighbour_gap, (2 + gap) R_max, and (dynamic detection) the Verlet list's 2 R_max (1 +
+    skin), with the search margin: model.neighbours' `search_distance` and
+    `verlet_distance`, whichever is larger."""
+    distance = (2.0 + neighbour_gap) * r_max * (1.0 + SEARCH_MARGIN)
+    if dynamic:
+        distance = max(distance, 2.0 * r_max * (1.0 + skin) * (1.0 + SEARCH_MARGIN))
+    return distance
+
+
+#: The search `superset_pairs` kept for the next one: its points, distance and pairs.
+_KEPT: list = []
+
+
+def superset_pairs(points: np.ndarray, distance: float, keep: bool = False) -> np.ndarray:
+    """(n_pairs, 2) sorted pairs (i < j) holding every pair of the points at most
+    `distance` [m] apart, and perhaps more: the search kept from before when it was of the
+    same points at a distance at least as large (then handed over and forgotten), else
+    `close_pairs`. keep: remember this search for the next call (validation's overlap
+    check keeps its search for the model's lists, which filter the pairs by their own
+    exact tests: one k-d tree for a run's set-up)."""
+    points = np.asarray(points, dtype=float)
+    if _KEPT:
+        kept_points, kept_distance, kept_pairs = _KEPT
+        _KEPT.clear()
+        if kept_distance >= distance and kept_points.shape == points.shape and np.array_equal(kept_points, points):
+            return kept_pairs
+    pairs = close_pairs(points, distance)
+    if keep:
+        _KEPT[:] = [points.copy(), float(distance), pairs]
+    return pairs

@@ -30,7 +30,7 @@ from granplate.setup.layouts import (INTRUDER_COLUMN_RULES, cells_along_x, colum
                                      plane_layers, plane_type, planes_per_cell, sites_per_cell, space_sites)
 from granplate.setup.fields import check_dimension, finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
 from granplate.setup.granules_file import granule_path
-from granplate.setup.pairs import close_pairs
+from granplate.setup.pairs import close_pairs, contact_search_distance, superset_pairs
 from granplate.setup.plate_checks import check_plate_fields, check_plate_mesh
 from granplate.setup.solid_checks import (box_corners, box_distances, check_solid, check_solid_clearance, is_box,
                                          solid_named, wall_contact_on_box, wall_cuts_box)
@@ -708,7 +708,7 @@ def _check_overlaps(s: Scenario, named: dict[int, str]) -> None:
     """Granules may touch but not overlap at t = 0 (k-d tree over the centres; the
     coordinates are within LENGTH_RANGE x h, so its squared distances cannot overflow)."""
     gs = s.granules
-    for i, j in _overlapping_pairs(gs, s.dimension):
+    for i, j in _overlapping_pairs(gs, s.dimension, s.contact):
         gi, gj = gs[i], gs[j]
         dist = math.dist(_centre(gi, s.dimension), _centre(gj, s.dimension))
         overlap = gi.radius + gj.radius - dist
@@ -740,16 +740,32 @@ def _close_pairs(gs: tuple[Granule, ...], dimension: int = 2) -> list[tuple[int,
 DISTANCE_MARGIN = 1e-12
 
 
-def _overlapping_pairs(gs: tuple[Granule, ...], dimension: int = 2) -> list[tuple[int, int]]:
+#: The largest contact.neighbour_gap and contact.skin for which the overlap check searches as
+#: far as the model's lists and keeps its search for them (`_overlapping_pairs`).
+SHARED_SEARCH_MAX = 1.0
+
+
+def _overlapping_pairs(gs: tuple[Granule, ...], dimension: int = 2, contact=None) -> list[tuple[int, int]]:
     """The pairs of `_close_pairs` (sorted) that may overlap beyond the tolerance: those
     whose overlap from numpy's distance comes within DISTANCE_MARGIN of it (the check then
-    measures each with math.dist, as for every pair)."""
+    measures each with math.dist, as for every pair). contact: the scenario's [contact],
+    whose searches at t = 0 the model makes next (its search is kept for them when its
+    gap and skin are numbers up to SHARED_SEARCH_MAX, so that it stays a search of
+    neighbours; else None)."""
+    if contact is not None and not all(is_number(v) and 0.0 <= v <= SHARED_SEARCH_MAX
+                                       for v in (contact.neighbour_gap, contact.skin)):
+        contact = None
     centres = [_column(gs, f) for f in ("x", "y", "z")[:dimension]] if len(gs) > 1 else []
     r = _column(gs, "radius") if len(gs) > 1 else None
     if r is None or any(c is None for c in centres):
         return _close_pairs(gs, dimension)
     points = np.column_stack(centres)
-    pairs = close_pairs(points, 2.0 * float(r.max()) * (1.0 + 1e-9))
+    c = contact
+    # one search for this check and the model's lists (setup.pairs.superset_pairs): every
+    # pair within 2 R_max, and within what the lists need, which keep it for themselves
+    share = (contact_search_distance(float(r.max()), c.neighbour_gap, c.skin, c.detection == "dynamic")
+             if contact is not None else 0.0)
+    pairs = superset_pairs(points, max(2.0 * float(r.max()) * (1.0 + 1e-9), share), keep=contact is not None)
     i, j = pairs[:, 0], pairs[:, 1]
     dist = np.sqrt(((points[j] - points[i]) ** 2).sum(axis=1))
     overlap = r[i] + r[j] - dist
