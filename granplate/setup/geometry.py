@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import threading
 import weakref
 
 from granplate.errors import ScenarioError
@@ -219,15 +220,21 @@ def resolve(scenario: Scenario) -> Scenario:
     `validate`'s job; this function only builds. The last scenario resolved is remembered
     (by identity: it is frozen), so that validating and building a run resolve it once.
     """
-    if _LAST_RESOLVED and _LAST_RESOLVED[0]() is scenario:
-        return _LAST_RESOLVED[1]
+    if _LAST.pair and _LAST.pair[0]() is scenario:
+        return _LAST.pair[1]
     resolved = _expanded(scenario)
-    _LAST_RESOLVED[:] = [weakref.ref(scenario), resolved]
+    _LAST.pair[:] = [weakref.ref(scenario), resolved]
     return resolved
 
 
-#: The scenario resolved last (a weak reference) and its resolved form.
-_LAST_RESOLVED: list = []
+class _LastResolved(threading.local):
+    """The scenario this thread resolved last (a weak reference) and its resolved form."""
+
+    def __init__(self):
+        self.pair: list = []
+
+
+_LAST = _LastResolved()
 
 
 def _expanded(scenario: Scenario) -> Scenario:

@@ -9,6 +9,8 @@ distance with distance^2, so both return the same pairs in the same order.
 """
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 
 #: Up to this many points, every pair is compared (above: a k-d tree).
@@ -71,8 +73,14 @@ def contact_search_distance(r_max: float, neighbour_gap: float, skin: float, dyn
     return distance
 
 
-#: The search `superset_pairs` kept for the next one: its points, distance and pairs.
-_KEPT: list = []
+class _Kept(threading.local):
+    """The search `superset_pairs` kept for this thread's next one: points, distance, pairs."""
+
+    def __init__(self):
+        self.search: list = []
+
+
+_KEPT_BY_THREAD = _Kept()
 
 
 def superset_pairs(points: np.ndarray, distance: float, keep: bool = False) -> np.ndarray:
@@ -83,12 +91,13 @@ def superset_pairs(points: np.ndarray, distance: float, keep: bool = False) -> n
     check keeps its search for the model's lists, which filter the pairs by their own
     exact tests: one k-d tree for a run's set-up)."""
     points = np.asarray(points, dtype=float)
-    if _KEPT:
-        kept_points, kept_distance, kept_pairs = _KEPT
-        _KEPT.clear()
+    kept = _KEPT_BY_THREAD.search
+    if kept:
+        kept_points, kept_distance, kept_pairs = kept
+        kept.clear()
         if kept_distance >= distance and kept_points.shape == points.shape and np.array_equal(kept_points, points):
             return kept_pairs
     pairs = close_pairs(points, distance)
     if keep:
-        _KEPT[:] = [points.copy(), float(distance), pairs]
+        kept[:] = [points.copy(), float(distance), pairs]
     return pairs

@@ -17,6 +17,7 @@ import dataclasses
 import math
 import numbers
 import operator
+import threading
 import weakref
 from collections import Counter
 from typing import Any
@@ -517,16 +518,25 @@ def _floats(values: list) -> np.ndarray | None:
     return np.array(values, float)
 
 
-#: The granules whose columns `_column` holds (a strong reference: identity is the key) and
-#: the columns, by field; emptied when `validate` returns.
-_COLUMNS: list = [None, {}]
+class _PerThread(threading.local):
+    """What one thread's validation keeps (threads validate scenarios side by side):
+    `columns`, the granules whose columns `_column` holds (a strong reference: identity
+    is the key) and the columns by field, emptied when `validate` returns; `passed`, the
+    scenario that passed last (a weak reference) and its materials then."""
+
+    def __init__(self):
+        self.columns: list = [None, {}]
+        self.passed: list = []
+
+
+_THREAD = _PerThread()
 
 
 def _column(gs: tuple[Granule, ...], field: str) -> np.ndarray | None:
     """The granules' `field` as `_floats` gives it, extracted once per validation."""
-    if _COLUMNS[0] is not gs:
-        _COLUMNS[:] = [gs, {}]
-    cols = _COLUMNS[1]
+    if _THREAD.columns[0] is not gs:
+        _THREAD.columns[:] = [gs, {}]
+    cols = _THREAD.columns[1]
     if field not in cols:
         cols[field] = _floats(list(map(operator.attrgetter(field), gs)))
     return cols[field]
@@ -633,8 +643,8 @@ def length_scale(s: Scenario) -> tuple[float, str]:
     size / elements along each axis); its radii and plate sizes already checked to be
     positive numbers."""
     key = ("length_scale", id(s))  # once per validation of the resolved scenario
-    if _COLUMNS[0] is s.granules and key in _COLUMNS[1]:
-        return _COLUMNS[1][key]
+    if _THREAD.columns[0] is s.granules and key in _THREAD.columns[1]:
+        return _THREAD.columns[1][key]
     found = _smallest_radius(s)
     if isinstance(s.plate, Solid) and is_box(s.plate):
         found += [(s.plate.size[k] / s.plate.elements[k], f"plate.size[{k}] / plate.elements[{k}]")
@@ -644,8 +654,8 @@ def length_scale(s: Scenario) -> tuple[float, str]:
                   (s.plate.height / s.plate.ny, "plate.height / plate.ny")]
     if not found:  # a solid of a mesh file alone: no length known before the file is read
         return math.inf, "no granule"
-    if _COLUMNS[0] is s.granules:
-        _COLUMNS[1][key] = min(found)
+    if _THREAD.columns[0] is s.granules:
+        _THREAD.columns[1][key] = min(found)
     return min(found)
 
 
@@ -1185,8 +1195,8 @@ def validate(scenario: Scenario) -> None:
     try:
         _validate(scenario)
     finally:
-        _COLUMNS[:] = [None, {}]
-    _LAST_PASSED[:] = [weakref.ref(scenario), dict(scenario.materials)]
+        _THREAD.columns[:] = [None, {}]
+    _THREAD.passed[:] = [weakref.ref(scenario), dict(scenario.materials)]
 
 
 def _validate(scenario: Scenario) -> None:
@@ -1228,16 +1238,13 @@ def _validate(scenario: Scenario) -> None:
     _check_solver(r)
 
 
-#: The scenario that passed `validate` last (a weak reference) and its materials then.
-_LAST_PASSED: list = []
-
 
 def _passed_before(scenario: Scenario) -> bool:
     """Whether `scenario` is the very object that passed last, with the same materials (a
     frozen scenario cannot change otherwise): a run validates it once, not on loading and
     again on building its model."""
-    return (bool(_LAST_PASSED) and _LAST_PASSED[0]() is scenario
-            and isinstance(scenario.materials, dict) and scenario.materials == _LAST_PASSED[1])
+    return (bool(_THREAD.passed) and _THREAD.passed[0]() is scenario
+            and isinstance(scenario.materials, dict) and scenario.materials == _THREAD.passed[1])
 
 
 def validated(scenario: Scenario) -> Scenario:
