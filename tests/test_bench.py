@@ -277,3 +277,24 @@ def test_twins_options_are_checked(capsys):
     assert "--t-end 0.0: must be > 0" in capsys.readouterr().err
     assert main(["bench", "--twins", "--repeats", "0"]) == 2
     assert "--repeats 0: must be >= 1" in capsys.readouterr().err
+
+
+def test_startup_rows_are_measured_and_documented(tmp_path, capsys):
+    """`bench --startup` on one FCC cell in its box (4 touching spheres, 6 pairs) from a CSV
+    beside the two-sphere baseline: each row timed to the first step in a fresh process, its
+    stages adding up to no more than the total, every key documented; bad options refused."""
+    out = tmp_path / "startup.json"
+    assert main(["bench", "--startup", "--sizes", "1x1x1", "--formats", "csv", "--repeats", "1",
+                 "--json", str(out)]) == 0
+    rows = json.loads(out.read_text())
+    text = (ROOT / "docs" / "benchmarks.md").read_text().split("### Start-up JSON")[1].split("\n## ")[0]
+    documented = {k for line in text.splitlines() if line.startswith("| `")
+                  for k in re.findall(r"`([a-z_0-9]+)`", line.split("|")[1])}
+    assert [(r["spheres"], r["format"], r["pairs"]) for r in rows] == [(2, "toml", 1), (4, "csv", 6)]
+    for r in rows:
+        assert set(r) <= documented, set(r) - documented
+        stages = r["import_s"] + r["read_s"] + r["build_s"] + r["loop_start_s"]
+        assert 0.0 < stages <= r["first_step_s"] + 1e-9 and r["peak_bytes"] > 1e7 and r["file_bytes"] > 0
+    assert rows[1]["beyond_two_s"] == pytest.approx(rows[1]["first_step_s"] - rows[0]["first_step_s"])
+    assert main(["bench", "--startup", "--formats", "xls"]) == 2
+    assert "--formats item 'xls': allowed toml, csv, npz, nc" in capsys.readouterr().err

@@ -21,6 +21,10 @@ def _cmd_study(args) -> int:
 
 
 def _cmd_bench(args) -> int:
+    if getattr(args, "startup", False):
+        from granplate.bench import startup
+
+        return int(startup.main(args))
     if getattr(args, "scaling", False):
         from granplate.bench import scaling
 
@@ -106,6 +110,12 @@ def register(subparsers) -> None:
                    help="with --scaling: solver.scheme of granplate's runs, any registered scheme (default implicit)")
     b.add_argument("--no-lammps", dest="no_lammps", action="store_true",
                    help="with --scaling or --friction: leave LAMMPS out even where it is installed")
+    b.add_argument("--startup", action="store_true",
+                   help="instead: a run's start, from its process's start to its first step, and its peak memory "
+                        "(a launched frictionless FCC block in a box, velocity Verlet): two spheres, then "
+                        "10,192 (--sizes NXxNYxNZ cells) as [[granules]] tables and as each granules_file "
+                        "format (--formats toml,csv,npz,nc); medians of --repeats fresh processes (default 3)")
+    b.add_argument("--formats", help="with --startup: comma-separated toml,csv,npz,nc (default all)")
     b.add_argument("--friction", action="store_true",
                    help="instead: steps and time with the granules' friction split off or inside RK4 "
                         "(a 990-granule packing, ptfe-r05 under q0 = 1e7 N/m), and the packing side by "

@@ -156,6 +156,23 @@ def _granule_arrays(s: Scenario):
     return x, y, r, rho
 
 
+def masses_and_inertias(r: np.ndarray, rho: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(ng,) masses [kg] and moments of inertia [kg m^2] of spheres of radii r [m] and
+    densities rho [kg/m^3]: `sphere_mass` and `sphere_inertia` once per distinct (r, rho)."""
+    r, rho = np.asarray(r, float), np.asarray(rho, float)
+    if not len(r):
+        return np.zeros(0), np.zeros(0)
+    if (rho == rho[0]).all():  # one density: the distinct radii (a sort of numbers, not of rows)
+        radii, which = np.unique(r, return_inverse=True)
+        kinds = np.column_stack([radii, np.full(len(radii), rho[0])])
+    else:
+        kinds, which = np.unique(np.column_stack([r, rho]), axis=0, return_inverse=True)
+    mass = np.array([sphere_mass(k[0], k[1]) for k in kinds], float)  # numpy scalars, as granule by granule
+    inertia = np.array([sphere_inertia(k[0], k[1]) for k in kinds], float)
+    which = which.reshape(-1)
+    return mass[which], inertia[which]
+
+
 def find_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: float) -> np.ndarray:
     """Potential granule-granule contacts: pairs whose initial surface gap is at most
     gap_ratio * min(R_i, R_j) (the topology is fixed, docs/model.md section 1)."""
@@ -169,12 +186,13 @@ def find_wall_contacts(s: Scenario, x, y, r, z=None) -> np.ndarray:
     return fixed_wall_contacts(s.walls, x, y, r, s.contact.neighbour_gap, z)
 
 
-def find_pairs_and_walls(s: Scenario, x, y, r, z=None) -> tuple[np.ndarray, np.ndarray]:
+def find_pairs_and_walls(s: Scenario, x, y, r, z=None, candidates=None) -> tuple[np.ndarray, np.ndarray]:
     """The pairs and (granule, wall) contacts touching at t = 0 (within contact.neighbour_gap;
-    z: the centres' third coordinate in space, None in the plane)."""
+    z: the centres' third coordinate in space, None in the plane; candidates: sorted pairs
+    holding every pair within the search distance, `model.neighbours.contact_pairs`)."""
     from granplate.model.neighbours import contact_pairs
 
-    return contact_pairs(x, y, r, s.contact.neighbour_gap, z), find_wall_contacts(s, x, y, r, z)
+    return contact_pairs(x, y, r, s.contact.neighbour_gap, z, candidates), find_wall_contacts(s, x, y, r, z)
 
 
 def find_plate_contacts(s: Scenario) -> tuple[np.ndarray, np.ndarray]:
@@ -200,37 +218,120 @@ def loaded_granules(s: Scenario, x, r) -> np.ndarray:
     return np.abs(left - left.min()) <= 1e-9 * r.max()
 
 
+def pair_coefficient_row(s: Scenario, a, b, ri: float, rj: float, mi: float, mj: float) -> np.ndarray:
+    """The coefficient row of one pair of granules of Materials a and b, radii ri, rj [m] and
+    masses mi, mj [kg]: E*, R*, m* of the two (eqs. 3-4), the pair's alpha_n, mu, k_s and
+    normal law (`pair_coefficients` gives the same numbers for many pairs at once)."""
+    e_star = effective_modulus(a, b)
+    r_star = ri * rj / (ri + rj)
+    m_star = mi * mj / (mi + mj)
+    alpha, mu, ks = s.contact.for_pair(a.name, b.name)
+    coef_a = hertz_coefficient(e_star, r_star)
+    return coefficient_row(coef_a, damping_coefficient(alpha, m_star, coef_a), mu, ks,
+                           law_coefficients(s, a, b, b.name, e_star, r_star, ri + rj))
+
+
+def material_indices(mats) -> tuple[list, np.ndarray]:
+    """The distinct Materials of `mats` (one per granule, by name) and each granule's index
+    among them."""
+    index: dict[str, int] = {}
+    kinds = []
+    for m in mats:
+        if m.name not in index:
+            index[m.name] = len(kinds)
+            kinds.append(m)
+    return kinds, np.array([index[m.name] for m in mats], np.int64).reshape(-1)
+
+
 def pair_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, pairs: np.ndarray) -> np.ndarray:
-    """(np, N_COEF) coefficients of the granule pairs: E*, R*, m* of the two (eqs. 3-4)."""
+    """(np, N_COEF) coefficients of the granule pairs: E*, R*, m* of the two (eqs. 3-4).
+
+    The rows of `pair_coefficient_row`, bit for bit: numpy does its operations on the same
+    doubles in the same order (products, quotients, square roots, correctly rounded), E*
+    and the pair's settings are computed once per pair of materials, and the yield overlap
+    of an elastic-plastic pair pair by pair."""
+    pairs = np.asarray(pairs, np.int64).reshape(-1, 2)
+    if not len(pairs):
+        return np.zeros((0, N_COEF))
+    r, mass = np.asarray(r, float), np.asarray(mass, float)
+    kinds, kind = material_indices(mats)
+    i, j = pairs[:, 0], pairs[:, 1]
+    ri, rj, mi, mj = r[i], r[j], mass[i], mass[j]
+    r_star = ri * rj / (ri + rj)
+    m_star = mi * mj / (mi + mj)
+    del ri, rj, mi, mj
+    combos = [(0, kinds[0], kinds[0])] if len(kinds) == 1 else [
+        (c, kinds[c // len(kinds)], kinds[c % len(kinds)]) for c in np.unique(kind[i] * len(kinds) + kind[j]).tolist()]
+    combo = None if len(combos) == 1 else kind[i] * len(kinds) + kind[j]
+    # per pair of materials: E*, alpha_n, mu, k_s, whether the law is elastic-plastic (one value each when one pair)
+    e_star, alpha, mu, ks = (np.empty(len(pairs)) if combo is not None else 0.0 for _ in range(4))
+    plastic = np.zeros(len(pairs), bool)
+    for c, ka, kb in combos:
+        values = (effective_modulus(ka, kb), *s.contact.for_pair(ka.name, kb.name))
+        if combo is None:
+            e_star, alpha, mu, ks = values
+            plastic[:] = normal_law_of(s, ka.name, kb.name) != "hertz"
+            continue
+        on = combo == c
+        for column, v in zip((e_star, alpha, mu, ks), values):
+            column[on] = v
+        plastic |= on & (normal_law_of(s, ka.name, kb.name) != "hertz")
+    coef_a = 4.0 / 3.0 * e_star * np.sqrt(r_star)  # hertz_coefficient
     pair_coef = np.zeros((len(pairs), N_COEF))
-    for p, (i, j) in enumerate(pairs):
-        e_star = effective_modulus(mats[i], mats[j])
-        r_star = r[i] * r[j] / (r[i] + r[j])
-        m_star = mass[i] * mass[j] / (mass[i] + mass[j])
-        alpha, mu, ks = s.contact.for_pair(mats[i].name, mats[j].name)
-        a = hertz_coefficient(e_star, r_star)
-        pair_coef[p] = coefficient_row(a, damping_coefficient(alpha, m_star, a), mu, ks,
-                                       law_coefficients(s, mats[i], mats[j], mats[j].name, e_star, r_star,
-                                                        r[i] + r[j]))
+    pair_coef[:, COEF_A] = coef_a
+    pair_coef[:, COEF_C] = alpha * np.sqrt(m_star * coef_a)  # damping_coefficient
+    pair_coef[:, COEF_MU], pair_coef[:, COEF_KS], pair_coef[:, COEF_DY] = mu, ks, math.inf
+    for p in np.flatnonzero(plastic).tolist():
+        a, b = mats[i[p]], mats[j[p]]
+        e_p = e_star if combo is None else float(e_star[p])
+        pair_coef[p, COEF_DY:COEF_XH + 1] = law_coefficients(s, a, b, b.name, e_p, float(r_star[p]),
+                                                             float(r[i[p]] + r[j[p]]))
     return pair_coef
+
+
+def wall_coefficient_row(s: Scenario, a, wall_material: str, ri: float, mi: float) -> np.ndarray:
+    """The coefficient row of a granule of Material a, radius ri [m], mass mi [kg] against a
+    rigid wall of `wall_material` (R* = R, m* = m)."""
+    alpha, mu, ks = s.contact.for_pair(a.name, wall_material)
+    e_star = effective_modulus(a, None)
+    coef_a = hertz_coefficient(e_star, ri)
+    return coefficient_row(coef_a, damping_coefficient(alpha, mi, coef_a), mu, ks,
+                           law_coefficients(s, a, None, wall_material, e_star, ri, 2.0 * ri))
 
 
 def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarray):
     """(nw, d + 1) [nx, ny, (nz,) offset] with the unit outward normal (d = the scenario's
-    dimension), and (nw, N_COEF) coefficients against a rigid body (R* = R, m* = m)."""
+    dimension), and (nw, N_COEF) coefficients against a rigid body (R* = R, m* = m): the
+    rows of `wall_coefficient_row`, bit for bit (as `pair_coefficients`)."""
     wc = np.asarray(wc, np.int64).reshape(-1, 2)
     wall_geo = np.zeros((len(wc), s.dimension + 1))
     wall_coef = np.zeros((len(wc), N_COEF))
-    for k, (i, w) in enumerate(wc):
-        wall = s.walls[w]
+    if not len(wc):
+        return wall_geo, wall_coef
+    r, mass = np.asarray(r, float), np.asarray(mass, float)
+    kinds, kind = material_indices(mats)
+    i, w = wc[:, 0], wc[:, 1]
+    e_star, alpha = np.empty(len(wc)), np.empty(len(wc))
+    plastic = np.zeros(len(wc), bool)
+    for k in np.unique(w).tolist():
+        wall = s.walls[k]
         nrm = np.asarray(wall.normal, float)
-        nrm = nrm / np.linalg.norm(nrm)
-        wall_geo[k] = (*nrm, wall.offset)
-        alpha, mu, ks = s.contact.for_pair(mats[i].name, wall.material)
-        e_star = effective_modulus(mats[i], None)
-        a = hertz_coefficient(e_star, r[i])
-        wall_coef[k] = coefficient_row(a, damping_coefficient(alpha, mass[i], a), mu, ks,
-                                       law_coefficients(s, mats[i], None, wall.material, e_star, r[i], 2.0 * r[i]))
+        at = w == k
+        wall_geo[at] = (*(nrm / np.linalg.norm(nrm)), wall.offset)
+        for c in np.unique(kind[i[at]]).tolist():
+            on = at & (kind[i] == c)
+            e_star[on] = effective_modulus(kinds[c], None)
+            alpha[on], wall_coef[on, COEF_MU], wall_coef[on, COEF_KS] = s.contact.for_pair(kinds[c].name,
+                                                                                         wall.material)
+            plastic |= on & (normal_law_of(s, kinds[c].name, wall.material) != "hertz")
+    ri = r[i]
+    coef_a = 4.0 / 3.0 * e_star * np.sqrt(ri)  # hertz_coefficient with R* = R
+    wall_coef[:, COEF_A] = coef_a
+    wall_coef[:, COEF_C] = alpha * np.sqrt(mass[i] * coef_a)  # damping_coefficient with m* = m
+    wall_coef[:, COEF_DY] = math.inf
+    for p in np.flatnonzero(plastic).tolist():
+        wall_coef[p, COEF_DY:COEF_XH + 1] = law_coefficients(s, mats[i[p]], None, s.walls[w[p]].material,
+                                                             float(e_star[p]), float(ri[p]), 2.0 * float(ri[p]))
     return wall_geo, wall_coef
 
 
@@ -354,8 +455,7 @@ def build_model(scenario: Scenario) -> Model:
         return build_space_model(s)
     x, y, r, rho = _granule_arrays(s)
     mats = [s.material(g.material) for g in s.granules]
-    mass = np.array([sphere_mass(ri, rhoi) for ri, rhoi in zip(r, rho)])
-    inertia = np.array([sphere_inertia(ri, rhoi) for ri, rhoi in zip(r, rho)])
+    mass, inertia = masses_and_inertias(r, rho)
     pairs = find_pairs(x, y, r, s.contact.neighbour_gap)
     wc = find_wall_contacts(s, x, y, r)
     loop_pairs, loop_wc = contact_lists(s.contact, s.walls, x, y, r)

@@ -51,25 +51,29 @@ def wall_planes(walls, dimension: int = 2) -> tuple[np.ndarray, np.ndarray]:
 
 
 def fixed_wall_contacts(walls, x, y, r, gap_ratio: float, z=None) -> np.ndarray:
-    """(granule, wall) pairs whose initial gap is at most gap_ratio * R, sorted (wall, granule)."""
-    out = []
+    """(granule, wall) pairs whose initial gap is at most gap_ratio * R, sorted (wall, granule)
+    (each gap the same doubles in the same order as granule by granule: offset - s.n - R)."""
+    x, y, r = (np.asarray(a, float) for a in (x, y, r))
+    out = [np.zeros((0, 2), np.int64)]
     for w, wall in enumerate(walls):
-        for i in range(len(x)):
-            gap = wall.offset - normal_coordinates(x[i], y[i], None if z is None else z[i], wall.normal) - r[i]
-            if gap <= gap_ratio * r[i]:
-                out.append((i, w))
-    return np.array(out, np.int64).reshape(-1, 2)
+        gap = wall.offset - normal_coordinates(x, y, None if z is None else np.asarray(z, float), wall.normal) - r
+        i = np.flatnonzero(gap <= gap_ratio * r)
+        out.append(np.column_stack([i, np.full(len(i), w)]).astype(np.int64))
+    return np.concatenate(out).reshape(-1, 2)
 
 
-def contact_lists(contact, walls, x, y, r, z=None) -> tuple[np.ndarray, np.ndarray]:
+def contact_lists(contact, walls, x, y, r, z=None, candidates=None) -> tuple[np.ndarray, np.ndarray]:
     """The loop's (np, 2) granule pairs and (nw, 2) [granule, wall] contacts for the
     positions x, y (and z in space) [m] under the scenario's `contact` settings: the
-    Verlet lists (detection = "dynamic") or the pairs within neighbour_gap (detection = "fixed")."""
+    Verlet lists (detection = "dynamic") or the pairs within neighbour_gap (detection = "fixed");
+    candidates: sorted pairs holding every pair the list's search would find (shared
+    with another search of the same positions), or None."""
     if contact.detection == "fixed":
-        return (contact_pairs(x, y, r, contact.neighbour_gap, z),
+        return (contact_pairs(x, y, r, contact.neighbour_gap, z, candidates),
                 fixed_wall_contacts(walls, x, y, r, contact.neighbour_gap, z))
     normals, offsets = wall_planes(walls, 2 if z is None else 3)
-    return verlet_pairs(x, y, r, contact.skin, z), verlet_walls(x, y, r, normals, offsets, contact.skin, z)
+    return (verlet_pairs(x, y, r, contact.skin, z, candidates),
+            verlet_walls(x, y, r, normals, offsets, contact.skin, z))
 
 
 def pair_keys(pairs: np.ndarray, n: int) -> np.ndarray:

@@ -60,7 +60,8 @@ def brute_force_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: fl
 
 
 def search_distance(r: np.ndarray, gap_ratio: float) -> float:
-    """Largest centre distance [m] of a potential contact: (2 + gap_ratio) R_max, plus margin."""
+    """Largest centre distance [m] of a potential contact: (2 + gap_ratio) R_max, plus margin
+    (as setup.pairs.contact_search_distance)."""
     return (2.0 + gap_ratio) * float(r.max()) * (1.0 + SEARCH_MARGIN)
 
 
@@ -72,29 +73,57 @@ def candidate_pairs(x: np.ndarray, y: np.ndarray, distance: float, z: np.ndarray
     return close_pairs(_centres(x, y, z), distance)
 
 
+#: Relative margin within which numpy's distance of a pair cannot decide `is_contact` the
+#: way math.hypot does (their roundings differ by a few units of 1e-16): such a pair is
+#: decided by `is_contact` itself.
+DECIDE_MARGIN = 1e-12
+
+
+def contacts_among(cand: np.ndarray, x, y, r, gap_ratio: float, z=None) -> np.ndarray:
+    """The mask of the candidate pairs (n, 2) that `is_contact` keeps, decided by numpy
+    for every pair but those within DECIDE_MARGIN of the limit (those by `is_contact`)."""
+    i, j = cand[:, 0], cand[:, 1]
+    dist = centre_distances(x, y, z, i, j)
+    ri, rj = r[i], r[j]
+    gap, limit = dist - ri - rj, gap_ratio * np.minimum(ri, rj)
+    band = DECIDE_MARGIN * (dist + ri + rj)
+    keep = gap <= limit - band
+    for p in np.flatnonzero(~keep & ~(gap > limit + band)).tolist():
+        a, b = int(i[p]), int(j[p])
+        keep[p] = is_contact(x[b] - x[a], y[b] - y[a], r[a], r[b], gap_ratio, None if z is None else z[b] - z[a])
+    return keep
+
+
 def contact_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: float,
-                  z: np.ndarray | None = None) -> np.ndarray:
+                  z: np.ndarray | None = None, candidates: np.ndarray | None = None) -> np.ndarray:
     """(n_pairs, 2) potential contacts, sorted (i, j) with i < j, in O(N log N).
 
     Same pairs in the same order as `brute_force_pairs`: the k-d tree gives candidates and
-    `is_contact` decides each one exactly as the double loop does.
+    `is_contact` decides each one as the double loop does (`contacts_among`). candidates:
+    sorted pairs that hold every pair within `search_distance` (from a search at a larger
+    distance, shared with `verlet_pairs`), else searched here.
     """
     x, y, r = (np.asarray(a, float) for a in (x, y, r))
     if len(x) < 2:
         return np.zeros((0, 2), np.int64)
-    cand = candidate_pairs(x, y, search_distance(r, gap_ratio), z)
-    keep = [is_contact(x[j] - x[i], y[j] - y[i], r[i], r[j], gap_ratio, None if z is None else z[j] - z[i])
-            for i, j in cand.tolist()]
-    return cand[np.array(keep, bool)].reshape(-1, 2)
+    cand = candidate_pairs(x, y, search_distance(r, gap_ratio), z) if candidates is None else candidates
+    return cand[contacts_among(cand, x, y, r, gap_ratio, z)].reshape(-1, 2)
 
 
-def verlet_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, skin: float, z: np.ndarray | None = None) -> np.ndarray:
+def verlet_distance(r: np.ndarray, skin: float) -> float:
+    """The search distance of `verlet_pairs`: 2 R_max (1 + skin), plus margin [m]."""
+    return 2.0 * float(r.max()) * (1.0 + skin) * (1.0 + SEARCH_MARGIN)
+
+
+def verlet_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, skin: float, z: np.ndarray | None = None,
+                 candidates: np.ndarray | None = None) -> np.ndarray:
     """(n_pairs, 2) pairs whose centres are at most (R_i + R_j)(1 + skin) apart, sorted
-    (i, j) with i < j, in O(N log N) (the Verlet list of docs/model.md section 1.3)."""
+    (i, j) with i < j, in O(N log N) (the Verlet list of docs/model.md section 1.3);
+    candidates: as `contact_pairs`', holding every pair within `verlet_distance`."""
     x, y, r = (np.asarray(a, float) for a in (x, y, r))
     if len(x) < 2:
         return np.zeros((0, 2), np.int64)
-    cand = candidate_pairs(x, y, 2.0 * float(r.max()) * (1.0 + skin) * (1.0 + SEARCH_MARGIN), z)
+    cand = candidate_pairs(x, y, verlet_distance(r, skin), z) if candidates is None else candidates
     i, j = cand[:, 0], cand[:, 1]
     keep = centre_distances(x, y, z, i, j) <= (r[i] + r[j]) * (1.0 + skin)
     return np.ascontiguousarray(cand[keep]).reshape(-1, 2)
@@ -105,9 +134,9 @@ def verlet_walls(x: np.ndarray, y: np.ndarray, r: np.ndarray, normals: np.ndarra
     """(n, 2) [granule, wall] whose gap offset - s.n - R is at most skin R (granules
     beyond the wall included), sorted (wall, granule); normals: (nw, 2 or 3) unit outward."""
     x, y, r = (np.asarray(a, float) for a in (x, y, r))
-    out = []
+    out = [np.zeros((0, 2), np.int64)]
     for w in range(len(offsets)):
         gap = offsets[w] - normal_coordinates(x, y, z, normals[w]) - r
-        for i in np.flatnonzero(gap <= skin * r):
-            out.append((int(i), w))
-    return np.array(out, np.int64).reshape(-1, 2)
+        i = np.flatnonzero(gap <= skin * r)
+        out.append(np.column_stack([i, np.full(len(i), w)]).astype(np.int64))
+    return np.concatenate(out).reshape(-1, 2)

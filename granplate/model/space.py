@@ -10,13 +10,14 @@ of dimension 3: the one place the model's dimension is decided.
 from __future__ import annotations
 
 import math
+import operator
 
 import numpy as np
 
 from granplate.model.contacts import contact_lists
 from granplate.model.inputs import STATE_COLUMNS, Granular3, PlateArrays, no_history
+from granplate.setup.pairs import contact_search_distance, superset_pairs
 from granplate.physics.contact import N_COEF
-from granplate.setup.materials import sphere_inertia, sphere_mass
 from granplate.setup.scenario import Scenario
 
 
@@ -92,23 +93,32 @@ def shock_amplitude(s: Scenario) -> float:
 
 def initial_state_3d(s: Scenario) -> np.ndarray:
     """(ng, 9) x, y, z, vx, vy, vz, wx, wy, wz of every granule at t = 0."""
-    y0 = np.zeros((len(s.granules), STATE_COLUMNS[3]))
-    for i, g in enumerate(s.granules):
-        y0[i, :6] = (g.x, g.y, g.z, g.vx, g.vy, g.vz)
-        y0[i, 6:] = spin_vector(g.omega)
+    g = s.granules
+    y0 = np.zeros((len(g), STATE_COLUMNS[3]))
+    if len(g):
+        y0[:, :6] = np.array(list(map(operator.attrgetter("x", "y", "z", "vx", "vy", "vz"), g)), float)
+        y0[:, 6:] = np.array(list(map(operator.attrgetter("omega"), g)), float)  # three numbers each (validated)
     return y0
 
 
-def force_floor_3d(s: Scenario, mass: np.ndarray, r: np.ndarray, shares: np.ndarray, out_dt: float) -> float:
+def granule_momentum(m: float, r: float, g) -> float:
+    """m (|v| + R |omega|) [kg m/s] of granule g of mass m [kg] and radius r [m]."""
+    return m * (math.sqrt(g.vx**2 + g.vy**2 + g.vz**2) + r * math.sqrt(sum(w * w for w in spin_vector(g.omega))))
+
+
+def force_floor_3d(s: Scenario, mass: np.ndarray, r: np.ndarray, shares: np.ndarray, out_dt: float,
+                   state: np.ndarray | None = None) -> float:
     """The implicit scheme's smallest force scale [N] (as model.arrays.force_floor): a
-    fraction of the shock's peak force plus the initial momentum per output interval."""
+    fraction of the shock's peak force plus the initial momentum per output interval
+    (the sum over the granules in their order; those at rest add nothing, so only the
+    moving ones, by `state`'s velocities and spins when given, are summed)."""
     from granplate.model.arrays import FORCE_FLOOR_FRACTION
 
     if len(r) == 0:
         return 0.0
     shock = abs(shock_amplitude(s)) * float(np.abs(shares).sum())
-    momentum = sum(m * (math.sqrt(g.vx**2 + g.vy**2 + g.vz**2) + rr * math.sqrt(sum(w * w for w in spin_vector(g.omega))))
-                   for m, rr, g in zip(mass, r, s.granules))
+    moving = range(len(r)) if state is None else np.flatnonzero((state[:, 3:] != 0.0).any(axis=1)).tolist()
+    momentum = sum(granule_momentum(mass[i], r[i], s.granules[i]) for i in moving)
     return FORCE_FLOOR_FRACTION * (shock + float(momentum) / out_dt)
 
 
@@ -122,20 +132,33 @@ def frictionless(s: Scenario) -> bool:
     return all(s.contact.for_pair(a, b)[1] == 0.0 for a in names for b in partners)
 
 
+def shared_candidates(s: Scenario, x, y, z, r) -> np.ndarray | None:
+    """One k-d tree search for both the pairs touching at t = 0 and the loop's Verlet list
+    (each keeps its own pairs of these by its exact test): sorted pairs holding every pair
+    within the larger of their search distances (the one validation kept, when it searched
+    the same centres that far: setup.pairs.superset_pairs), or None for fewer than two."""
+    if len(r) < 2:
+        return None
+    c = s.contact
+    distance = contact_search_distance(float(r.max()), c.neighbour_gap, c.skin, c.detection == "dynamic")
+    return superset_pairs(np.column_stack([x, y, z]), distance)  # validation's search, when it kept it
+
+
 def build_space_model(s: Scenario):
     """The Model of a validated, resolved scenario of dimension 3, with its elastic body
     (model.body) when it has a [plate]."""
     from granplate.model.arrays import (
-        Model, find_pairs_and_walls, loop_config, pair_coefficients, wall_arrays,
+        Model, find_pairs_and_walls, loop_config, masses_and_inertias, pair_coefficients, wall_arrays,
     )
 
     x, y, z, r = centres(s)
     mats = [s.material(g.material) for g in s.granules]
     rho = np.array([m.rho for m in mats], float)
-    mass = np.array([sphere_mass(ri, rhoi) for ri, rhoi in zip(r, rho)])
-    inertia = np.array([sphere_inertia(ri, rhoi) for ri, rhoi in zip(r, rho)])
-    pairs, wc = find_pairs_and_walls(s, x, y, r, z)
-    loop_pairs, loop_wc = contact_lists(s.contact, s.walls, x, y, r, z)
+    mass, inertia = masses_and_inertias(r, rho)
+    cand = shared_candidates(s, x, y, z, r)
+    pairs, wc = find_pairs_and_walls(s, x, y, r, z, cand)
+    loop_pairs, loop_wc = contact_lists(s.contact, s.walls, x, y, r, z, cand)
+    state = initial_state_3d(s)
     wall_geo, wall_coef = wall_arrays(s, mats, r, mass, loop_wc)
     shares, torques = shock_resultants_3d(s, x, y, z, r)
     granular = Granular3(
@@ -148,7 +171,7 @@ def build_space_model(s: Scenario):
         pair_hist=no_history(len(loop_pairs)), wall_hist=no_history(len(loop_wc)), pc_hist=no_history(0),
     )
     cfg = loop_config(s, np.zeros(len(r)), np.zeros(len(r)), r, mass,
-                      floor=force_floor_3d(s, mass, r, shares, s.time.output_interval))._replace(
+                      floor=force_floor_3d(s, mass, r, shares, s.time.output_interval, state))._replace(
         q0=shock_amplitude(s), dimension=3,
         split_friction=s.solver.granular_friction == "split" and not frictionless(s))
     solid, body, rigid = None, None, np.zeros(len(r), bool)
@@ -162,7 +185,7 @@ def build_space_model(s: Scenario):
     return Model(
         scenario=s, labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
         granular=granular, plate_arrays=plate_arrays, config=cfg, plate=None,
-        initial_state=initial_state_3d(s), pairs=pairs, wall_contacts=wc,
+        initial_state=state, pairs=pairs, wall_contacts=wc,
         plate_contacts=np.zeros(0, np.int64), materials=tuple(mats), solid=solid, body=body,
         body_rigid=rigid,
     )

@@ -19,9 +19,12 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import threading
+import weakref
 
 from granplate.errors import ScenarioError
 from granplate.setup import layouts
+from granplate.setup.granules_file import granule_path
 from granplate.setup.scenario import (BOX_WALLS, Box, ChainLayout, Granule, LatticeLayout, Layout, Plate, RigidPatch,
                                       Scenario, Solid, SpaceLattice, Wall)
 
@@ -214,8 +217,28 @@ def resolve(scenario: Scenario) -> Scenario:
       (`plane_offset`); a granule's default scalar omega 0 becomes (0, 0, 0).
 
     Idempotent: resolving a resolved scenario returns an equal scenario. Range checks are
-    `validate`'s job; this function only builds.
+    `validate`'s job; this function only builds. The last scenario resolved is remembered
+    (by identity: it is frozen), so that validating and building a run resolve it once.
     """
+    if _LAST.pair and _LAST.pair[0]() is scenario:
+        return _LAST.pair[1]
+    resolved = _expanded(scenario)
+    _LAST.pair[:] = [weakref.ref(scenario), resolved]
+    return resolved
+
+
+class _LastResolved(threading.local):
+    """The scenario this thread resolved last (a weak reference) and its resolved form."""
+
+    def __init__(self):
+        self.pair: list = []
+
+
+_LAST = _LastResolved()
+
+
+def _expanded(scenario: Scenario) -> Scenario:
+    """`resolve`'s work, on every call."""
     granules, walls, plate, load = scenario.granules, scenario.walls, scenario.plate, scenario.load
     xp = 0.0
     if scenario.layout is not None:
@@ -253,12 +276,19 @@ def resolve(scenario: Scenario) -> Scenario:
                       if w.offset is None and w.point is not None else w for w in walls)
         if box is not None:
             walls, box = walls + box_walls(box), None
-    granules = tuple(g if g.label else dataclasses.replace(g, label=default_granule_label(i))
-                     for i, g in enumerate(granules))
+    granules = tuple(g if g.label else _relabelled(g, default_granule_label(i)) for i, g in enumerate(granules))
     walls = tuple(w if w.label else dataclasses.replace(w, label=default_wall_label(i))
                   for i, w in enumerate(walls))
     return dataclasses.replace(scenario, layout=None, granules=granules, walls=walls,
                                plate=plate, load=load, box=box)
+
+
+def _relabelled(g: Granule, label: str) -> Granule:
+    """`dataclasses.replace(g, label=label)`, a copy of its fields without a call of the
+    frozen dataclass's `__init__` (a million granules in a fraction of a second)."""
+    new = object.__new__(type(g))
+    new.__dict__.update(g.__dict__, label=label)
+    return new
 
 
 #: The fields of each layout kind that place its granules (materials do not), in the
@@ -282,7 +312,7 @@ def placing_fields(scenario: Scenario, index: int) -> tuple[str, ...]:
     lay = scenario.layout
     if lay is None:
         coords = ("x", "y", "z", "radius") if scenario.dimension == 3 else ("x", "y", "radius")
-        return tuple(f"granules[{index}].{f}" for f in coords)
+        return tuple(granule_path(scenario.granules_file, index, f, scenario.dimension) for f in coords)
     primary = "R1" if isinstance(lay, Layout) else "radius"
     default = type(lay)()
     return tuple(f"layout.{f}" for f in PLACING_FIELDS[type(lay)]

@@ -15,7 +15,9 @@ Every error is a `ScenarioError` naming the field by its dotted path (`plate.nx`
 from __future__ import annotations
 
 import dataclasses
+import functools
 import numbers
+import operator
 import os
 import re
 import tomllib
@@ -165,22 +167,36 @@ def _check_keys(path: str, d: Any, allowed: list[str]) -> None:
                                 + ", ".join(allowed))
 
 
+@functools.cache
+def _fields_of(cls: type) -> tuple[dict[str, Any], list[str]]:
+    """The resolved annotations and the field names of dataclass `cls` (once per class:
+    resolving them costs as much as reading a table)."""
+    return typing.get_type_hints(cls), [f.name for f in dataclasses.fields(cls)]
+
+
 def _table(path: str, d: Any, cls: type) -> Any:
     """Build dataclass `cls` from table `d` (unknown keys refused, required ones checked)."""
-    hints = typing.get_type_hints(cls)
-    names = [f.name for f in dataclasses.fields(cls)]
+    hints, names = _fields_of(cls)
     _check_keys(path, d, names)
     kwargs = {}
+    required = REQUIRED.get(cls, ())
     for name in names:
-        fpath = f"{path}.{name}"
-        if d.get(name) is None:  # absent (or None in a Python dict): the default
-            if name in REQUIRED.get(cls, ()):
+        value = d.get(name)
+        if value is None:  # absent (or None in a Python dict): the default
+            if name in required:
+                fpath = f"{path}.{name}"
                 raise ScenarioError(fpath, MISSING, f"missing required field '{fpath}'")
             continue
-        kwargs[name] = _convert(fpath, d[name], hints[name])
+        tp = hints[name]
+        # a value of exactly its field's plain type is its own conversion (most of a table)
+        kwargs[name] = value if type(value) is tp and tp in _PLAIN else _convert(f"{path}.{name}", value, tp)
         if (cls, name) in CHOICES:
-            string_in(fpath, kwargs[name], CHOICES[cls, name])
+            string_in(f"{path}.{name}", kwargs[name], CHOICES[cls, name])
     return cls(**kwargs)
+
+
+#: Types whose values `_convert` returns unchanged (when of exactly that type).
+_PLAIN: frozenset[type] = frozenset({float, int, str, bool})
 
 
 def _materials(d: Any) -> dict[str, Material]:
@@ -249,12 +265,26 @@ def _initial_step_within_max(t: TimeSettings, given: dict) -> TimeSettings:
     return t
 
 
-def from_dict(d: dict) -> Scenario:
+def _granules_file(d: dict, dimension: int, base: str | os.PathLike | None) -> dict[str, Any]:
+    """The granules of a top-level `granules_file` (relative to `base`, the scenario file's
+    folder; None: the working directory), and the file's name as given."""
+    from granplate.setup.granules_file import read_granules
+
+    name = _convert("granules_file", d["granules_file"], str)
+    if d.get("granules") is not None:
+        raise ScenarioError("granules_file", name, "give either [[granules]] tables or granules_file, not both")
+    path = name if base is None or os.path.isabs(name) else os.path.join(base, name)
+    return {"granules": read_granules(path, dimension, name), "granules_file": name}
+
+
+def from_dict(d: dict, base: str | os.PathLike | None = None) -> Scenario:
     """A Scenario from a TOML-shaped dict; shape errors raise ScenarioError (no physics).
 
-    Top-level keys: name, description, dimension, materials, layout, granules, walls, box,
-    plate, load, contact, time, solver. Missing tables take the defaults (no layout, no
-    plate, no box; dimension 2; in 3D no load, `load.kind = "none"`).
+    Top-level keys: name, description, dimension, materials, layout, granules (or
+    granules_file: a CSV, NPZ or netCDF file of them, setup.granules_file, relative to
+    `base`, by default the working directory), walls, box, plate, load, contact, time,
+    solver. Missing tables take the defaults (no layout, no plate, no box; dimension 2;
+    in 3D no load, `load.kind = "none"`).
     """
     names = [f.name for f in dataclasses.fields(Scenario)]
     _check_keys("", d, names)
@@ -278,7 +308,9 @@ def from_dict(d: dict) -> Scenario:
             kw[key] = _table(key, d[key], cls)
     if "time" in kw:
         kw["time"] = _initial_step_within_max(kw["time"], d["time"])
-    if d.get("granules") is not None:
+    if d.get("granules_file") is not None:
+        kw.update(_granules_file(d, kw.get("dimension", 2), base))
+    elif d.get("granules") is not None:
         kw["granules"] = _convert("granules", d["granules"], tuple[Granule, ...])
     if d.get("walls") is not None:
         kw["walls"] = _walls(d["walls"], kw.get("dimension", 2))
@@ -403,13 +435,14 @@ def _without_defaults(table: dict, defaults: dict[str, Any]) -> dict:
 
 # --------------------------------------------------------------------------- TOML
 
-def loads(text: str) -> Scenario:
-    """A Scenario from TOML text (shape checked, physics not: see `validate`)."""
+def loads(text: str, base: str | os.PathLike | None = None) -> Scenario:
+    """A Scenario from TOML text (shape checked, physics not: see `validate`); base: the
+    folder a `granules_file` is relative to (None: the working directory)."""
     try:
         d = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise ScenarioError("toml", _excerpt(text, e), f"TOML syntax error: {e}") from None
-    return from_dict(d)
+    return from_dict(d, base)
 
 
 def _excerpt(text: str, e: tomllib.TOMLDecodeError) -> str:
@@ -433,16 +466,38 @@ def load(path: str | os.PathLike) -> Scenario:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as e:
         raise ScenarioError("file", str(path), f"not UTF-8 text: {e}") from None
-    try:
-        d = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise ScenarioError("file", str(path), f"TOML syntax error: {e}") from None
-    return from_dict(d)
+    from granplate.setup.granules_file import collector_paused
+
+    with collector_paused():  # [[granules]] tables: a dict and a Granule each
+        try:
+            d = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as e:
+            raise ScenarioError("file", str(path), f"TOML syntax error: {e}") from None
+        return from_dict(d, os.path.dirname(os.path.abspath(path)))
 
 
 def dumps(s: Scenario, all_materials: bool = False) -> str:
     """`s` as TOML text (see `to_dict` for which materials are written)."""
     return tomli_w.dumps(to_dict(s, all_materials=all_materials))
+
+
+def dumps_with_granules_file(s: Scenario, path: str | os.PathLike, base: str | os.PathLike | None = None,
+                             all_materials: bool = False) -> str:
+    """`s` as TOML text whose granules are in the file `path` (.csv, .npz or .nc, written
+    here by `setup.granules_file.write_granules`), named by `granules_file` relative to
+    `base` (the folder the TOML goes to; None: the working directory); reading the text
+    back (from that folder) gives a scenario equal to `s`."""
+    from granplate.setup.granules_file import write_granules
+
+    write_granules(s.granules, path, s.dimension)
+    d = to_dict(dataclasses.replace(s, granules=()), all_materials=all_materials)  # (a table per granule: slow)
+    used = dict.fromkeys(map(operator.attrgetter("material"), s.granules))
+    mats = {**d.get("materials", {}), **{m: _material_dict(s.materials[m]) for m in used if m in s.materials}}
+    if mats:
+        d["materials"] = dict(sorted(mats.items()))
+    name = os.path.relpath(os.path.abspath(path), os.path.abspath(base) if base is not None else os.getcwd())
+    head = {k: d.pop(k) for k in ("name", "description", "dimension") if k in d}
+    return tomli_w.dumps({**head, "granules_file": name.replace(os.sep, "/"), **d})
 
 
 def dump(s: Scenario, path: str | os.PathLike, all_materials: bool = False) -> None:
@@ -637,5 +692,5 @@ def parse_settings(items: list[str] | tuple[str, ...]) -> dict[str, object]:
     return changes
 
 
-__all__ = ["from_dict", "to_dict", "loads", "load", "dumps", "dump", "load_scenario",
+__all__ = ["from_dict", "to_dict", "loads", "load", "dumps", "dumps_with_granules_file", "dump", "load_scenario",
            "with_changes", "describe_changes", "parse_settings", "toml_value", "CHANGED", "UNLISTED", "REQUIRED", "CHOICES", "MATERIAL_KEYS", "MATERIAL_REQUIRED", "MISSING"]

@@ -559,6 +559,10 @@ class Scenario:
 
     dimension: 2 (discs in the plane, the paper's model; the default) or 3 (spheres in
     space: granules, walls and an optional `box`, or a 3D `layout`; no plate yet).
+    granules_file: the file the granules were read from (`granules_file = "PATH"`, as the
+    scenario gives it; setup.granules_file), so that messages name its rows and columns;
+    None for [[granules]] tables. Not part of the scenario's value: a scenario read from a
+    file equals the same one given as tables, and is written as tables (`io.to_dict`).
     """
 
     name: str = "custom"
@@ -574,6 +578,7 @@ class Scenario:
     solver: Solver = Solver()
     dimension: int = 2
     box: Box | None = None
+    granules_file: str | None = field(default=None, compare=False)
 
     def material(self, name: str) -> Material:
         """The material called `name` (file-defined ones override the library)."""

@@ -16,6 +16,7 @@ from typing import Any, Sequence
 
 from granplate.errors import ScenarioError
 from granplate.setup.fields import finite, material_exists, positive, string_in
+from granplate.setup.granules_file import granule_path
 from granplate.setup.scenario import SOLID_ELEMENTS, Scenario, Solid
 
 #: Box faces (solid.mesh.BOX_FACES, repeated here: setup sits below the solid layer).
@@ -168,14 +169,14 @@ def check_solid_clearance(s: Scenario, distances: Sequence[float], named: dict[i
     for i, (g, d) in enumerate(zip(s.granules, distances)):
         if d < 0.0:
             raise ScenarioError(
-                f"granules[{i}]", g.label,
+                granule_path(s.granules_file, i, None, s.dimension), g.label,
                 f"{named[i]} has its centre inside {what}, {-d:.6g} m below its surface, at t = 0; "
                 f"move the granule or the solid ({move}) so that the granule lies outside it "
                 f"(distance from its centre to the surface >= its radius {g.radius:.6g} m)")
         pen = g.radius - d
         if pen > rtol * g.radius:
             raise ScenarioError(
-                f"granules[{i}]", g.label,
+                granule_path(s.granules_file, i, None, s.dimension), g.label,
                 f"{named[i]} penetrates {what} by {pen:.6g} m at t = 0; a granule may touch the "
                 f"solid but not cross it: move the granule or the solid ({move}) so that the "
                 f"distance from its centre to the surface ({d:.6g} m) is at least its radius "

@@ -16,6 +16,9 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
+import operator
+import threading
+import weakref
 from collections import Counter
 from typing import Any
 
@@ -27,7 +30,8 @@ from granplate.setup.layouts import (INTRUDER_COLUMN_RULES, column_radii, layer_
                                      hexagonal_offsets, lattice_sites, plane_clash, plane_gap_distance,
                                      plane_layers, plane_type, planes_along_x, planes_per_cell, sites_per_cell, space_sites)
 from granplate.setup.fields import check_dimension, finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
-from granplate.setup.pairs import close_pairs
+from granplate.setup.granules_file import granule_path
+from granplate.setup.pairs import close_pairs, contact_search_distance, superset_pairs
 from granplate.setup.plate_checks import check_plate_fields, check_plate_mesh
 from granplate.setup.solid_checks import (box_corners, box_distances, check_solid, check_solid_clearance, is_box,
                                          solid_named, wall_contact_on_box, wall_cuts_box)
@@ -99,14 +103,13 @@ def _check_planar(s: Scenario) -> None:
     """A 2D scenario (as written) uses none of the 3D fields."""
     if s.box is not None:
         raise ScenarioError("box", "[box]", f"a box of six walls is 3D: give [[walls]] in 2D, {SET_3D}")
-    for i, g in enumerate(s.granules):
-        p = f"granules[{i}]"
+    for i, g in enumerate(() if _planar_granules(s.granules) else s.granules):
         for f in ("z", "vz"):
             v = getattr(g, f)
             if not (is_number(v) and v == 0.0):
-                raise ScenarioError(f"{p}.{f}", v, f"must be 0 in 2D (discs in the plane), {SET_3D}")
+                raise ScenarioError(_granule(s, i, f), v, f"must be 0 in 2D (discs in the plane), {SET_3D}")
         if isinstance(g.omega, tuple):
-            raise ScenarioError(f"{p}.omega", list(g.omega), "must be a number in 2D (the spin "
+            raise ScenarioError(_granule(s, i, "omega"), list(g.omega), "must be a number in 2D (the spin "
                                 f"about z [rad/s]); a vector [wx, wy, wz] is 3D: {SET_3D}")
     for k, w in enumerate(s.walls):
         p = f"walls[{k}]"
@@ -148,15 +151,16 @@ def _check_spatial(s: Scenario) -> None:
     if s.load.kind == "line" and s.load.target == "plate" and isinstance(s.plate, Solid) and not is_box(s.plate):
         raise ScenarioError("load.target", s.load.target, "a line load on a 3D solid acts on a box's face "
                             "xmin (plate.size); a mesh file's solid takes loads through granules")
-    for i, g in enumerate(s.granules):
-        p = f"granules[{i}]"
+    spins = [g.omega for g in s.granules]
+    vectors = set(map(type, spins)) <= {tuple} and set(map(len, spins)) <= {3}
+    for i, g in enumerate(() if vectors else s.granules):
         om = g.omega
         if not isinstance(om, tuple):
             if is_number(om) and om == 0.0:
                 continue  # the default: resolve makes it (0, 0, 0)
-            raise ScenarioError(f"{p}.omega", om, "omega is a vector [wx, wy, wz] in 3D (rad/s)")
+            raise ScenarioError(_granule(s, i, "omega"), om, "omega is a vector [wx, wy, wz] in 3D (rad/s)")
         if len(om) != 3:
-            raise ScenarioError(f"{p}.omega", list(om), "omega is a vector [wx, wy, wz] in 3D (rad/s): "
+            raise ScenarioError(_granule(s, i, "omega"), list(om), "omega is a vector [wx, wy, wz] in 3D (rad/s): "
                                 "three numbers")
     for k, w in enumerate(s.walls):
         _check_plane(f"walls[{k}]", w)
@@ -573,27 +577,111 @@ def _check_imperfections(imp: Imperfections, sites: tuple[Granule, ...]) -> None
                                 + ", ".join(list(g.label for g in sites)[:3]) + ", ...)")
 
 
+def _granule(s: Scenario, i: int, field: str | None = None) -> str:
+    """How messages name granule i of `s` (or its field): `granules[i].field`, or the row
+    and column of its granules_file (setup.granules_file.granule_path)."""
+    return granule_path(s.granules_file, i, field, s.dimension)
+
+
+def _floats(values: list) -> np.ndarray | None:
+    """`values` as an array when every one is a Python float (else None: the checks then go
+    granule by granule, as their messages need)."""
+    if set(map(type, values)) != {float}:
+        return None
+    return np.array(values, float)
+
+
+class _PerThread(threading.local):
+    """What one thread's validation keeps (threads validate scenarios side by side):
+    `columns`, the granules whose columns `_column` holds (a strong reference: identity
+    is the key) and the columns by field, emptied when `validate` returns; `passed`, the
+    scenario that passed last (a weak reference) and its materials then."""
+
+    def __init__(self):
+        self.columns: list = [None, {}]
+        self.passed: list = []
+
+
+_THREAD = _PerThread()
+
+
+def _column(gs: tuple[Granule, ...], field: str) -> np.ndarray | None:
+    """The granules' `field` as `_floats` gives it, extracted once per validation."""
+    if _THREAD.columns[0] is not gs:
+        _THREAD.columns[:] = [gs, {}]
+    cols = _THREAD.columns[1]
+    if field not in cols:
+        cols[field] = _floats(list(map(operator.attrgetter(field), gs)))
+    return cols[field]
+
+
+def _planar_granules(gs: tuple[Granule, ...]) -> bool:
+    """Whether every granule has z = vz = 0.0 and a number omega (`_check_planar` passes)."""
+    cols = [_column(gs, f) for f in ("z", "vz", "omega")]
+    return all(c is not None for c in cols) and not cols[0].any() and not cols[1].any()
+
+
+def _granule_columns(s: Scenario) -> dict[str, np.ndarray] | None:
+    """The granules' numbers by field (3D: omega as (n, 3)), or None when one is not a
+    Python float (or, in 3D, an omega not three of them)."""
+    gs = s.granules
+    names = ("x", "y", "z", "radius", "vx", "vy", "vz") if s.dimension == 3 else ("x", "y", "radius", "vx", "vy",
+                                                                                   "omega")
+    cols = {f: _column(gs, f) for f in names}
+    if s.dimension == 3:
+        spins = list(map(operator.attrgetter("omega"), gs))
+        if set(map(type, spins)) != {tuple} or set(map(len, spins)) != {3}:
+            return None
+        flat = _floats([w for om in spins for w in om])
+        cols["omega"] = None if flat is None else flat.reshape(-1, 3)
+    else:
+        cols["omega"] = None if cols["omega"] is None else cols["omega"][:, None]
+    return None if any(c is None for c in cols.values()) else cols
+
+
+def _granules_pass(s: Scenario) -> bool:
+    """Whether every granule passes `_check_granules` (numpy over the columns: the same
+    comparisons on the same doubles); False when one may not."""
+    gs = s.granules
+    cols = _granule_columns(s)
+    mats = list(map(operator.attrgetter("material"), gs))
+    labels = list(map(operator.attrgetter("label"), gs))
+    if cols is None or set(map(type, mats)) != {str} or set(map(type, labels)) != {str}:
+        return False
+    if len(set(labels)) != len(labels) or not set(mats) <= set(s.materials):
+        return False
+    with np.errstate(all="ignore"):
+        if not all(np.isfinite(c).all() for c in cols.values()) or not (cols["radius"] > 0.0).all():
+            return False
+        speed = {m: bar_wave_speed(s.material(m)) for m in set(mats)}
+        c = np.array([speed[m] for m in mats], float)
+        speeds = [np.abs(cols[f]) for f in (("vx", "vy", "vz") if s.dimension == 3 else ("vx", "vy"))]
+        speeds += [np.abs(w) * cols["radius"] for w in cols["omega"].T]
+        return all((v < c).all() for v in speeds)
+
+
 def _check_granules(s: Scenario) -> None:
+    if _granules_pass(s):
+        return
     seen: dict[str, int] = {}
     for i, g in enumerate(s.granules):
-        p = f"granules[{i}]"
-        finite(f"{p}.x", g.x)
-        finite(f"{p}.y", g.y)
+        finite(_granule(s, i, "x"), g.x)
+        finite(_granule(s, i, "y"), g.y)
         if s.dimension == 3:
-            finite(f"{p}.z", g.z)
-        positive(f"{p}.radius", g.radius)
+            finite(_granule(s, i, "z"), g.z)
+        positive(_granule(s, i, "radius"), g.radius)
         for f in ("vx", "vy") + (("vz",) if s.dimension == 3 else ("omega",)):
-            finite(f"{p}.{f}", getattr(g, f))
+            finite(_granule(s, i, f), getattr(g, f))
         if s.dimension == 3:
             for k, w in enumerate(g.omega):
-                finite(f"{p}.omega[{k}]", w)
-        material_exists(f"{p}.material", g.material, s)
-        _check_speeds(p, g, s.material(g.material))
+                finite(_granule(s, i, f"omega[{k}]"), w)
+        material_exists(_granule(s, i, "material"), g.material, s)
+        _check_speeds(s, i, g, s.material(g.material))
         if not isinstance(g.label, str):
-            raise ScenarioError(f"{p}.label", g.label, "must be a string")
+            raise ScenarioError(_granule(s, i, "label"), g.label, "must be a string")
         if g.label in seen:
-            raise ScenarioError(f"{p}.label", g.label,
-                                f"labels must be unique; granules[{seen[g.label]}] has it too")
+            raise ScenarioError(_granule(s, i, "label"), g.label,
+                                f"labels must be unique; {_granule(s, seen[g.label])} has it too")
         seen[g.label] = i
 
 
@@ -602,7 +690,7 @@ def bar_wave_speed(m: Material) -> float:
     return math.sqrt(m.E / m.rho)
 
 
-def _check_speeds(p: str, g: Granule, m: Material) -> None:
+def _check_speeds(s: Scenario, i: int, g: Granule, m: Material) -> None:
     """|vx|, |vy| (|vz|) and the surface speed |omega| R (each component in 3D) below the
     wave speed of the granule's material: Hertz's law is quasi-static and holds for impact
     speeds far below it."""
@@ -616,7 +704,7 @@ def _check_speeds(p: str, g: Granule, m: Material) -> None:
     for f, speed, value in checks:
         if not speed < c:
             unit = f"|{f}| x radius" if f.startswith("omega") else f"|{f}|"
-            raise ScenarioError(f"{p}.{f}", value,
+            raise ScenarioError(_granule(s, i, f), value,
                                 f"allowed: {unit} < sqrt(E / rho) = {c:.6g} m/s, the elastic "
                                 f"wave speed of material '{m.name}' (Hertz's contact law is "
                                 "quasi-static: it holds for speeds far below it)")
@@ -627,7 +715,10 @@ def length_scale(s: Scenario) -> tuple[float, str]:
     granule radius or a plate element edge (width / nx, height / ny; a box solid's
     size / elements along each axis); its radii and plate sizes already checked to be
     positive numbers."""
-    found = [(g.radius, f"granules[{i}].radius") for i, g in enumerate(s.granules)]
+    key = ("length_scale", id(s))  # once per validation of the resolved scenario
+    if _THREAD.columns[0] is s.granules and key in _THREAD.columns[1]:
+        return _THREAD.columns[1][key]
+    found = _smallest_radius(s)
     if isinstance(s.plate, Solid) and is_box(s.plate):
         found += [(s.plate.size[k] / s.plate.elements[k], f"plate.size[{k}] / plate.elements[{k}]")
                   for k in range(3)]
@@ -636,7 +727,25 @@ def length_scale(s: Scenario) -> tuple[float, str]:
                   (s.plate.height / s.plate.ny, "plate.height / plate.ny")]
     if not found:  # a solid of a mesh file alone: no length known before the file is read
         return math.inf, "no granule"
+    if _THREAD.columns[0] is s.granules:
+        _THREAD.columns[1][key] = min(found)
     return min(found)
+
+
+def _smallest_radius(s: Scenario) -> list[tuple[float, str]]:
+    """[(R, path)]: the granule radius that `length_scale`'s min picks, with the path
+    that breaks its ties (the smallest string), or every (radius, path) pair when one is
+    not a Python float."""
+    r = _column(s.granules, "radius") if s.granules else None
+    if r is None or not np.isfinite(r).all():
+        return [(g.radius, _granule(s, i, "radius")) for i, g in enumerate(s.granules)]
+    r_min = float(r.min())
+    ties = np.flatnonzero(r == r_min).tolist()
+    if len(ties) > 1:  # the path that sorts first: its number is all that differs (and what follows it)
+        # (granule_path: `granules[i].radius`, or `FILE, row i+1, column radius`)
+        after, shift = ("]", 0) if s.granules_file is None else (",", 1)
+        ties = [int(min([f"{i + shift}{after}" for i in ties])[:-1]) - shift]
+    return [(r_min, _granule(s, ties[0], "radius"))]
 
 
 def _wall_paths(s: Scenario, boxed: bool) -> list[str]:
@@ -658,8 +767,10 @@ def _check_lengths(s: Scenario, boxed: bool = False) -> None:
            f"farther out, round-off of a coordinate (2.2e-16 |x|) exceeds the {OVERLAP_RTOL:g} h "
            "overlap tolerance at t = 0")
     coords = ("x", "y", "z", "radius") if s.dimension == 3 else ("x", "y", "radius")
-    values = [(f"granules[{i}].{f}", getattr(g, f)) for i, g in enumerate(s.granules)
-              for f in coords]
+    cols = [_column(s.granules, f) for f in coords] if s.granules else []
+    inside = all(c is not None and (np.abs(c) <= limit).all() for c in cols)
+    values = [] if inside else [(_granule(s, i, f), getattr(g, f)) for i, g in enumerate(s.granules)
+                                for f in coords]
     values += [(path, -w.offset if ".lower[" in path else w.offset)  # box.lower: offset -x0
                for path, w in zip(_wall_paths(s, boxed), s.walls)]
     values += [(f"walls[{k}].point[{c}]", x) for k, w in enumerate(s.walls) if w.point is not None
@@ -680,14 +791,14 @@ def _check_overlaps(s: Scenario, named: dict[int, str]) -> None:
     """Granules may touch but not overlap at t = 0 (k-d tree over the centres; the
     coordinates are within LENGTH_RANGE x h, so its squared distances cannot overflow)."""
     gs = s.granules
-    for i, j in _close_pairs(gs, s.dimension):
+    for i, j in _overlapping_pairs(gs, s.dimension, s.contact):
         gi, gj = gs[i], gs[j]
         dist = math.dist(_centre(gi, s.dimension), _centre(gj, s.dimension))
         overlap = gi.radius + gj.radius - dist
         if overlap > OVERLAP_RTOL * min(gi.radius, gj.radius):
             raise ScenarioError(
-                f"granules[{i}]", gi.label,
-                f"{named[i]} overlaps {named[j]} (granules[{j}]) by {overlap:.6g} m at t = 0; "
+                _granule(s, i), gi.label,
+                f"{named[i]} overlaps {named[j]} ({_granule(s, j)}) by {overlap:.6g} m at t = 0; "
                 f"granules may touch but not overlap (tolerance "
                 f"{OVERLAP_RTOL:g} x the smaller radius)")
 
@@ -705,6 +816,44 @@ def _close_pairs(gs: tuple[Granule, ...], dimension: int = 2) -> list[tuple[int,
     xy = np.array([_centre(g, dimension) for g in gs], float)
     r_max = max(g.radius for g in gs)
     return [tuple(p) for p in close_pairs(xy, 2.0 * r_max * (1.0 + 1e-9)).tolist()]
+
+
+#: Relative margin on the numpy distances of `_overlapping_pairs` (their rounding against
+#: math.dist's is a few units of 1e-16): a pair within it is checked by math.dist.
+DISTANCE_MARGIN = 1e-12
+
+
+#: The largest contact.neighbour_gap and contact.skin for which the overlap check searches as
+#: far as the model's lists and keeps its search for them (`_overlapping_pairs`).
+SHARED_SEARCH_MAX = 1.0
+
+
+def _overlapping_pairs(gs: tuple[Granule, ...], dimension: int = 2, contact=None) -> list[tuple[int, int]]:
+    """The pairs of `_close_pairs` (sorted) that may overlap beyond the tolerance: those
+    whose overlap from numpy's distance comes within DISTANCE_MARGIN of it (the check then
+    measures each with math.dist, as for every pair). contact: the scenario's [contact],
+    whose searches at t = 0 the model makes next (its search is kept for them when its
+    gap and skin are numbers up to SHARED_SEARCH_MAX, so that it stays a search of
+    neighbours; else None)."""
+    if contact is not None and not all(is_number(v) and 0.0 <= v <= SHARED_SEARCH_MAX
+                                       for v in (contact.neighbour_gap, contact.skin)):
+        contact = None
+    centres = [_column(gs, f) for f in ("x", "y", "z")[:dimension]] if len(gs) > 1 else []
+    r = _column(gs, "radius") if len(gs) > 1 else None
+    if r is None or any(c is None for c in centres):
+        return _close_pairs(gs, dimension)
+    points = np.column_stack(centres)
+    c = contact
+    # one search for this check and the model's lists (setup.pairs.superset_pairs): every
+    # pair within 2 R_max, and within what the lists need, which keep it for themselves
+    share = (contact_search_distance(float(r.max()), c.neighbour_gap, c.skin, c.detection == "dynamic")
+             if contact is not None else 0.0)
+    pairs = superset_pairs(points, max(2.0 * float(r.max()) * (1.0 + 1e-9), share), keep=contact is not None)
+    i, j = pairs[:, 0], pairs[:, 1]
+    dist = np.sqrt(((points[j] - points[i]) ** 2).sum(axis=1))
+    overlap = r[i] + r[j] - dist
+    may = overlap > OVERLAP_RTOL * np.minimum(r[i], r[j]) - DISTANCE_MARGIN * (r[i] + r[j] + dist)
+    return [tuple(p) for p in pairs[may].tolist()]
 
 
 def _check_walls(s: Scenario) -> None:
@@ -738,14 +887,26 @@ def _check_wall_penetration(s: Scenario, named: dict[int, str]) -> None:
         n = w.normal
         if s.dimension == 3:
             n = unit(n)
-        for i, g in enumerate(s.granules):
+        for i, g in enumerate(s.granules if _may_cross_wall(s, n, w.offset) else ()):
             depth = g.x * n[0] + g.y * n[1] + (g.z * n[2] if s.dimension == 3 else 0.0)
             pen = depth + g.radius - w.offset
             if pen > OVERLAP_RTOL * g.radius:
                 raise ScenarioError(
-                    f"granules[{i}]", g.label,
+                    _granule(s, i), g.label,
                     f"{named[i]} penetrates wall '{w.label}' (walls[{k}]) by {pen:.6g} m at t = 0; "
                     f"a granule may touch a wall but not cross it")
+
+
+def _may_cross_wall(s: Scenario, n: tuple[float, ...], offset: float) -> bool:
+    """Whether a granule may cross the wall {p . n = offset} (numpy: the same operations on
+    the same doubles as `_check_wall_penetration`; True when a value is not a Python float)."""
+    cols = [_column(s.granules, f) for f in ("x", "y", "z", "radius")]
+    if not s.granules or any(c is None for c in cols) or not all(is_number(c) for c in (*n, offset)):
+        return bool(s.granules)
+    x, y, z, r = cols
+    depth = x * n[0] + y * n[1] + (z * n[2] if s.dimension == 3 else 0.0)
+    with np.errstate(all="ignore"):
+        return not (depth + r - offset <= OVERLAP_RTOL * r).all()
 
 
 def _check_plate(s: Scenario) -> None:
@@ -765,7 +926,7 @@ def _check_plate_penetration(s: Scenario, named: dict[int, str]) -> None:
             pen = g.x + g.radius - x0
             if pen > OVERLAP_RTOL * g.radius:
                 raise ScenarioError(
-                    f"granules[{i}]", g.label,
+                    _granule(s, i), g.label,
                     f"{named[i]} penetrates the plate (left edge plate.x0 = {x0:.6g} m) by {pen:.6g} m at "
                     f"t = 0; granules must lie left of the plate (x + radius <= plate.x0)")
 
@@ -1102,6 +1263,17 @@ def validate(scenario: Scenario) -> None:
     outputs' memory, solver. A scenario with neither granules (nor a layout) nor a plate
     is refused.
     """
+    if _passed_before(scenario):
+        return
+    try:
+        _validate(scenario)
+    finally:
+        _THREAD.columns[:] = [None, {}]
+    _THREAD.passed[:] = [weakref.ref(scenario), dict(scenario.materials)]
+
+
+def _validate(scenario: Scenario) -> None:
+    """`validate`'s checks, in its order."""
     s = scenario
     if not isinstance(s.name, str):
         raise ScenarioError("name", s.name, "must be a string")
@@ -1137,6 +1309,15 @@ def validate(scenario: Scenario) -> None:
     _check_time(r)
     _check_output_size(r)
     _check_solver(r)
+
+
+
+def _passed_before(scenario: Scenario) -> bool:
+    """Whether `scenario` is the very object that passed last, with the same materials (a
+    frozen scenario cannot change otherwise): a run validates it once, not on loading and
+    again on building its model."""
+    return (bool(_THREAD.passed) and _THREAD.passed[0]() is scenario
+            and isinstance(scenario.materials, dict) and scenario.materials == _THREAD.passed[1])
 
 
 def validated(scenario: Scenario) -> Scenario:
