@@ -31,8 +31,9 @@ TAB_T, TAB_V, TAB_I = range(3)
 @njit(cache=True)
 def table_terms(t, tab, n):
     """(integral from 0, value, slope) at t of the piecewise-linear table tab[:n] (columns
-    TAB_T, TAB_V, TAB_I: its times, values and their integral from 0 at each time)."""
-    if t <= tab[0, TAB_T]:
+    TAB_T, TAB_V, TAB_I: its times, values and their integral from 0 at each time); at a
+    point, the slope of the segment after it."""
+    if t < tab[0, TAB_T]:
         v0 = tab[0, TAB_V]
         return v0 * t, v0, 0.0
     last = n - 1

@@ -16,7 +16,9 @@ from __future__ import annotations
 from numba import njit
 
 from granplate.model.inputs import DR_A, DR_F, DR_P, DR_PD, DR_REF, DR_S, DR_V
+from granplate.model.inputs import HIST_MAX
 from granplate.physics.drives import KIND_FORCE, drive_motion
+from granplate.physics.laws import normal_law_response
 
 #: the first velocity column of a granule's state (both dimensions)
 V0 = 3
@@ -92,7 +94,8 @@ def finish_pass(y, acc, g):
     gravity on every granule; each driven granule's acceleration along its direction
     made the prescribed one (or the prescribed force added), the force that takes
     (mass x the acceleration it changes) and its power recorded; a driven wall's power.
-    Returns (the drives' power, gravity's) [W]."""
+    Returns (the power of the granules' drives and of the contact damping forces at the
+    driven walls' velocities, gravity's power) [W]."""
     ng = y.shape[0]
     p_grav = 0.0
     for c in range(g.gravity.shape[0]):
@@ -114,9 +117,10 @@ def finish_pass(y, acc, g):
                 acc[i, V0 + c] += da * g.drive_dir[k, c]
             now[DR_F] = m * da
             now[DR_P] = now[DR_F] * along(y, i, g, k)
-        else:
+            power += now[DR_P]
+        else:  # a wall: its elastic work is booked exactly (`wall_shift_energy`), its damping's here
             now[DR_P] = now[DR_F] * now[DR_V]
-        power += now[DR_P]
+            power += now[DR_PD]
     return power, p_grav
 
 
@@ -201,3 +205,31 @@ def drive_displacement(y, g, k):
     for c in range(g.drive_dir.shape[1]):
         x += (y[i, c] - g.drive_x0[k, c]) * g.drive_dir[k, c]
     return x
+
+
+@njit(cache=True)
+def wall_shift_energy(y, g, clip, t0, t1):
+    """The elastic work of the driven walls over [t0, t1] [s], exact: the change of their
+    contacts' stored energy as each moves from where it is at t0 to where it is at t1
+    with the granules held at y (the granules' own moves are the kicks' and RK4's)."""
+    if g.wall_drive.shape[0] == 0:
+        return 0.0
+    d = g.drive_dir.shape[1]
+    work = 0.0
+    for w in range(g.wall_i.shape[0]):
+        k = g.wall_drive[g.wall_w[w]]
+        if k < 0:
+            continue
+        i = g.wall_i[w]
+        ne = wall_normal_dot(g, w, k)
+        xn = 0.0  # (the overlap as the force passes compute it, to the last bit: physics.contact.wall_overlap)
+        for c in range(d):
+            xn += y[i, c] * g.wall_geo[w, c]
+        for side in range(2):
+            s, _, _ = drive_motion(t1 if side else t0, g.drive_kind[k], g.drive_prof[k], g.drive_par[k],
+                                   g.drive_tab[k], g.drive_tlen[k])
+            delta = xn + g.radius[i] - (g.wall_geo[w, d] + s * ne)
+            if delta > 0.0:
+                _, _, ep, _ = normal_law_response(delta, 0.0, g.wall_coef[w], g.wall_hist[w, HIST_MAX], clip)
+                work += ep if side else -ep
+    return work

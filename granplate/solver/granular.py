@@ -172,10 +172,10 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             ovl_j = -1 - g.wall_w[w]
         c = g.wall_coef[w]
         if split:  # the normal force alone: friction_flow applies the friction
-            n, pv, ep, wp = normal_law_response(delta, y[i, 3] * nx + y[i, 4] * nz - vn, c, g.wall_hist[w, HIST_MAX],
-                                                cfg.clip)
+            rate_n = y[i, 3] * nx + y[i, 4] * nz - vn
+            n, pv, ep, wp = normal_law_response(delta, rate_n, c, g.wall_hist[w, HIST_MAX], cfg.clip)
             w_plastic += wp
-            book_wall(g, w, kd, n, 0.0)
+            book_wall(g, w, kd, n, pv / rate_n if pv != 0.0 else 0.0)
             dy[i, 3] += -n * nx
             dy[i, 4] += -n * nz
             p_visc += pv
@@ -184,7 +184,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         ai = contact_arm(ri, delta, cfg.arm_shrink)
         ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
         n, pv, ep, wp = normal_law_response(delta, ddot - vn, c, g.wall_hist[w, HIST_MAX], cfg.clip)
-        book_wall(g, w, kd, n, 0.0)
+        book_wall(g, w, kd, n, pv / (ddot - vn) if pv != 0.0 else 0.0)
         f = friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS])
         pf = friction_power(f, vt)
         w_plastic += wp

@@ -161,7 +161,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         c = g.wall_coef[w]
         ddot = normal_rate_3d(y[i, VX], y[i, VY], y[i, VZ], nx, ny, nz) - vn
         n, pv, ep, wp = normal_law_response(delta, ddot, c, g.wall_hist[w, HIST_MAX], cfg.clip)
-        book_wall(g, w, kd, n, 0.0)
+        book_wall(g, w, kd, n, pv / ddot if pv != 0.0 else 0.0)
         dy[i, VX] -= n * nx
         dy[i, VY] -= n * ny
         dy[i, VZ] -= n * nz

@@ -8,7 +8,7 @@ from __future__ import annotations
 from numba import njit
 
 from granplate.solver.dimension import friction_flow, granular_rhs, plate_friction_held
-from granplate.solver.drives import hold_drives
+from granplate.solver.drives import hold_drives, wall_shift_energy
 
 #: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps h
 #: times the friction relaxation rate of every contact that RK4 integrates below this bound.
@@ -106,9 +106,10 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     if split:  # friction over [t + h/2, t + h]
         fric_split += friction_flow(w.ynew, hh, g, cfg, False)
         w.dacc[2] += fric_split
-    # the drives' work (RK4's quadrature of their power, and the impulse that gives the driven granules
-    # their prescribed velocity at t + h) and gravity's
-    w.dacc[5] = h6 * (p1[3] + 2.0 * p2.p_drive + 2.0 * p3.p_drive + p4.p_drive) + hold_drives(t + h, w.ynew, g)
+    # the drives' work (RK4's quadrature of their power, the impulse that gives the driven granules
+    # their prescribed velocity at t + h, the driven walls' elastic work exactly) and gravity's
+    w.dacc[5] = (h6 * (p1[3] + 2.0 * p2.p_drive + 2.0 * p3.p_drive + p4.p_drive) + hold_drives(t + h, w.ynew, g)
+                 + wall_shift_energy(w.ynew, g, cfg.clip, t, t + h))
     w.dacc[4] = h6 * (p1[4] + 2.0 * p2.p_grav + 2.0 * p3.p_grav + p4.p_grav)
     pe = granular_rhs(t + h, w.ynew, stage[2], stage[3], g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar,
                       split, True)

@@ -18,8 +18,9 @@ the damping part of the force (D_visc) and the load (E_shock; a line load on the
 body kicks its modes the same way, at t_n and t_n + h), so eq. (11)'s residual is
 Verlet's own energy error, O(h^2), which the loop checks at every step. Gravity and the
 drives (solver.drives) join each force pass; the drive forces' kicks are booked the same
-way (gravity's too), a driven wall's work and the damping at its velocity by the
-trapezoidal rule over the step, and the impulse that gives a driven granule
+way (gravity's too), a driven wall's elastic work exactly (the change of its contacts'
+energy as it moves), the damping at its velocity by the trapezoidal rule over the step
+(in the drive's work and in D_visc alike), and the impulse that gives a driven granule
 its prescribed velocity at t + h as the kinetic energy it adds.
 """
 from __future__ import annotations
@@ -34,7 +35,8 @@ from granplate.physics.contact import COEF_MU
 from granplate.physics.shock import time_profile
 from granplate.solver import body as B
 from granplate.solver.dimension import friction_flow, normal_forces
-from granplate.solver.drives import drive_kick_work, finish_pass, gravity_kick_work, hold_drives, wall_powers
+from granplate.solver.drives import (drive_kick_work, finish_pass, gravity_kick_work, hold_drives, wall_powers,
+                                    wall_shift_energy)
 from granplate.solver.granular import commit_history
 from granplate.solver.ladder import step_to_output
 from granplate.solver.state import E_STATIC, PARTNER_PLATE
@@ -193,7 +195,7 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
         if body:
             body_pass(st.y, sw, cur, st.q, st.qd, g, cfg, st.k1, sw.fdamp)
         finish_pass(st.y, st.k1, g)
-    pw0, pd0 = wall_powers(g)  # the driven walls' power at t_n
+    _, pd0 = wall_powers(g)  # the damping power at the driven walls' velocities at t_n
     hk = 0.5 * h
     friction = has_friction(g) or (body and body_friction(b))
     forward = sw.split[FORWARD] != 0.0
@@ -229,7 +231,7 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
             ovl_i = i_b
             ovl_j = PARTNER_BODY
     finish_pass(w.ytmp, w.kend, g)  # gravity and the drives
-    pw1, pd1 = wall_powers(g)
+    _, pd1 = wall_powers(g)
     w_drive += drive_kick_work(y, w.kend, g, hk)
     w_grav += gravity_kick_work(y, w.kend, g, hk)
     wl2, wd2 = kick(y, w.kend, sw.fdamp[nxt], sw.fload[nxt], hk, w.kend)
@@ -241,7 +243,8 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
         fric += friction_flow(y, hk, g, cfg, not forward)
         if body:
             fric += B.friction_flow(y, b.qd, hk, b, nxt, g.radius, g.mass, g.inertia, cfg.arm_shrink, not forward)
-    w_drive += hold_drives(t + h, y, g) + hk * (pw0 + pw1)  # the granules' drives' impulses, the walls' work
+    # the granules' drives' impulses; the walls' elastic work (exact) and their damping's (booked in D too)
+    w_drive += hold_drives(t + h, y, g) + wall_shift_energy(y, g, cfg.clip, t, t + h) + hk * (pd0 + pd1)
     w.dacc[0] = wl + wl2
     w.dacc[1] = -(wd + wd2) + hk * (pd0 + pd1)  # (a driven wall: the damping at the relative velocity)
     w.dacc[2] = fric
