@@ -72,7 +72,8 @@ def test_free_fall_and_undamped_bounce_under_gravity():
 
 
 def squeeze(scheme: str):
-    """A sphere resting on the floor, a top wall moved down at 0.01 m/s from 0.1 um above it."""
+    """A sphere resting on the floor, a top wall moved down at 0.01 m/s from 0.1 um above it
+    (steps of 20 ns: the squeezed sphere rings against two stiffening contacts)."""
     top = 2.0 * R + 1e-7
     d = base(granules=[{"label": "s", "x": 0.0, "y": R, "radius": R, "material": "steel"}],
              walls=[{"label": "floor", "normal": [0.0, -1.0], "offset": 0.0},
@@ -80,9 +81,9 @@ def squeeze(scheme: str):
              drives=[{"target": "wall top", "kind": "velocity", "direction": [0.0, -1.0], "profile": "constant",
                       "value": 0.01}])
     d["solver"]["scheme"] = scheme
-    d["time"].update(output_interval=1e-6, field_interval=1e-6)
+    d["time"].update(output_interval=1e-6, field_interval=1e-6, dt_max=2e-8, dt_initial=2e-8)
     if scheme == "implicit":
-        d["solver"]["implicit_dt_max"] = 1e-7
+        d["solver"]["implicit_dt_max"] = 2e-8
     return gp.simulate(from_dict(d)), top
 
 
@@ -137,7 +138,7 @@ def table_displacement(t: np.ndarray, v: float) -> np.ndarray:
     """The integral of the velocity table of `pair` [m] (closed form)."""
     return np.where(t < 2e-5, 0.5 * v * t**2 / 2e-5,
                     np.where(t < 1.2e-4, v * (t - 1e-5),
-                             np.where(t < 1.4e-4, v * 1.1e-4 - 0.5 * v * (1.4e-4 - t) ** 2 / 2e-5, v * 1.2e-4)))
+                             np.where(t < 1.4e-4, v * 1.2e-4 - 0.5 * v * (1.4e-4 - t) ** 2 / 2e-5, v * 1.2e-4)))
 
 
 @pytest.mark.parametrize("dimension", [2, 3])
@@ -150,7 +151,8 @@ def test_sphere_pair_compressed_by_a_velocity_table(dimension):
     ds = pair(dimension, v)
     t = ds.time.values
     s_b = ds.drive_displacement.sel(drive="granule B").values
-    np.testing.assert_allclose(s_b, table_displacement(t, v), rtol=0, atol=1e-6 * v * 1.2e-4)
+    # (to within a h^2 per corner of the table: a step's end may fall a round-off short of a corner)
+    np.testing.assert_allclose(s_b, table_displacement(t, v), rtol=0, atol=3 * (v / 2e-5) * 1e-7**2)
     np.testing.assert_allclose(ds.drive_displacement.sel(drive="granule A").values, 0.0, atol=1e-15)
     xyz = np.stack([ds[c].values for c in ("x", "y", "z")[:dimension]], axis=-1)
     overlap = np.maximum(2.0 * R - np.linalg.norm(xyz[:, 1] - xyz[:, 0], axis=-1), 0.0)
@@ -164,8 +166,9 @@ def test_sphere_pair_compressed_by_a_velocity_table(dimension):
     np.testing.assert_allclose(ds.drive_force.sel(drive="granule B").values[inner], (n + m * accel)[inner],
                                rtol=1e-6, atol=1e-6 * n.max())
     assert float(np.abs(ds.energy_residual_max).max()) < 1e-4
-    # all the work the drive did is stored in the contact once B stops
-    assert float(ds.E_drive[-1]) == pytest.approx(0.4 * hertz_pair(R) * (v * 1.2e-4) ** 2.5, rel=1e-6)
+    # all the work the drives did is stored in the contact once B stops: 2/5 A delta^2.5 at the
+    # recorded overlap, to within the run's energy tolerance
+    assert float(ds.E_drive[-1]) == pytest.approx(0.4 * hertz_pair(R) * overlap[-1] ** 2.5, rel=1e-4)
 
 
 def test_force_drive_pushes_a_free_granule():
@@ -281,3 +284,32 @@ def test_driven_chain_example_runs():
     t = ds.time.values
     np.testing.assert_allclose(ds.drive_displacement.values[:, 0], 2e-6 * np.sin(np.pi * t / 1e-4), rtol=0,
                                atol=1e-18)
+
+
+def test_bad_numbers_in_drives_and_gravity_refused_by_name():
+    """NaN, infinity or a string in any number of [gravity] or [[drives]] is refused before
+    anything runs, in one line naming the field (or its list: drives[1].times for
+    drives[1].times[2])."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from field_paths import mutated, numeric_fields
+
+    d = base(granules=[{"label": "a", "x": 0.0, "y": R, "radius": R, "material": "steel"}],
+             walls=[{"label": "floor", "normal": [0.0, -1.0], "offset": 0.0}],
+             gravity={"g": [0.0, -G]},
+             drives=[{"target": "granule a", "kind": "force", "direction": [1.0, 0.0], "profile": "harmonic",
+                      "value": 1.0, "amplitude": 0.5, "frequency": 1e4},
+                     {"target": "wall floor", "kind": "velocity", "direction": [0.0, 1.0], "profile": "table",
+                      "times": [0.0, 1e-5, 2e-5], "values": [0.0, -0.01, 0.0]}])
+    validate(from_dict(d))
+    paths = [p for p in numeric_fields(d) if p.startswith(("drives", "gravity"))]
+    assert len(paths) >= 15
+    for path in paths:
+        for value in (math.nan, math.inf, "x"):
+            with pytest.raises(ScenarioError) as e:
+                validate(from_dict(mutated(d, path, value)))
+            msg = str(e.value)
+            assert path.split("[")[0] in msg and "\n" not in msg, (path, msg)
+            assert e.value.field in (path, path.rsplit("[", 1)[0]), (path, msg)

@@ -208,28 +208,37 @@ def drive_displacement(y, g, k):
 
 
 @njit(cache=True)
-def wall_shift_energy(y, g, clip, t0, t1):
-    """The elastic work of the driven walls over [t0, t1] [s], exact: the change of their
-    contacts' stored energy as each moves from where it is at t0 to where it is at t1
-    with the granules held at y (the granules' own moves are the kicks' and RK4's)."""
+def wall_contact_energy(y, g, w, k, clip, t):
+    """The stored energy [J] of wall contact w (driven by drive k) with the granule at
+    state y and the wall where it is at t [s] (the overlap as the force passes compute
+    it, to the last bit: physics.contact.wall_overlap)."""
+    d = g.drive_dir.shape[1]
+    i = g.wall_i[w]
+    xn = 0.0
+    for c in range(d):
+        xn += y[i, c] * g.wall_geo[w, c]
+    s, _, _ = drive_motion(t, g.drive_kind[k], g.drive_prof[k], g.drive_par[k], g.drive_tab[k], g.drive_tlen[k])
+    delta = xn + g.radius[i] - (g.wall_geo[w, d] + s * wall_normal_dot(g, w, k))
+    if delta <= 0.0:
+        return 0.0
+    _, _, ep, _ = normal_law_response(delta, 0.0, g.wall_coef[w], g.wall_hist[w, HIST_MAX], clip)
+    return ep
+
+
+@njit(cache=True)
+def wall_shift_energy(y0, y1, g, clip, t0, t1):
+    """The elastic work of the driven walls over a step from t0 to t1 [s], in which the
+    granules move from state y0 to y1: the change of their contacts' stored energy as each
+    wall moves from where it is at t0 to where it is at t1, the granules held at y0 and at
+    y1 in turn, averaged (the symmetric split of the stored energy's change between the
+    walls' moves and the granules', second order in the step)."""
     if g.wall_drive.shape[0] == 0:
         return 0.0
-    d = g.drive_dir.shape[1]
     work = 0.0
     for w in range(g.wall_i.shape[0]):
         k = g.wall_drive[g.wall_w[w]]
         if k < 0:
             continue
-        i = g.wall_i[w]
-        ne = wall_normal_dot(g, w, k)
-        xn = 0.0  # (the overlap as the force passes compute it, to the last bit: physics.contact.wall_overlap)
-        for c in range(d):
-            xn += y[i, c] * g.wall_geo[w, c]
-        for side in range(2):
-            s, _, _ = drive_motion(t1 if side else t0, g.drive_kind[k], g.drive_prof[k], g.drive_par[k],
-                                   g.drive_tab[k], g.drive_tlen[k])
-            delta = xn + g.radius[i] - (g.wall_geo[w, d] + s * ne)
-            if delta > 0.0:
-                _, _, ep, _ = normal_law_response(delta, 0.0, g.wall_coef[w], g.wall_hist[w, HIST_MAX], clip)
-                work += ep if side else -ep
+        work += 0.5 * (wall_contact_energy(y1, g, w, k, clip, t1) - wall_contact_energy(y1, g, w, k, clip, t0)
+                       + wall_contact_energy(y0, g, w, k, clip, t1) - wall_contact_energy(y0, g, w, k, clip, t0))
     return work

@@ -109,7 +109,7 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     # the drives' work (RK4's quadrature of their power, the impulse that gives the driven granules
     # their prescribed velocity at t + h, the driven walls' elastic work exactly) and gravity's
     w.dacc[5] = (h6 * (p1[3] + 2.0 * p2.p_drive + 2.0 * p3.p_drive + p4.p_drive) + hold_drives(t + h, w.ynew, g)
-                 + wall_shift_energy(w.ynew, g, cfg.clip, t, t + h))
+                 + wall_shift_energy(st.y, w.ynew, g, cfg.clip, t, t + h))
     w.dacc[4] = h6 * (p1[4] + 2.0 * p2.p_grav + 2.0 * p3.p_grav + p4.p_grav)
     pe = granular_rhs(t + h, w.ynew, stage[2], stage[3], g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar,
                       split, True)

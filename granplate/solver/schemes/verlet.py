@@ -244,7 +244,7 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
         if body:
             fric += B.friction_flow(y, b.qd, hk, b, nxt, g.radius, g.mass, g.inertia, cfg.arm_shrink, not forward)
     # the granules' drives' impulses; the walls' elastic work (exact) and their damping's (booked in D too)
-    w_drive += hold_drives(t + h, y, g) + wall_shift_energy(y, g, cfg.clip, t, t + h) + hk * (pd0 + pd1)
+    w_drive += hold_drives(t + h, y, g) + wall_shift_energy(st.y, y, g, cfg.clip, t, t + h) + hk * (pd0 + pd1)
     w.dacc[0] = wl + wl2
     w.dacc[1] = -(wd + wd2) + hk * (pd0 + pd1)  # (a driven wall: the damping at the relative velocity)
     w.dacc[2] = fric
