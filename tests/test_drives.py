@@ -284,6 +284,11 @@ def test_driven_chain_example_runs():
     t = ds.time.values
     np.testing.assert_allclose(ds.drive_displacement.values[:, 0], 2e-6 * np.sin(np.pi * t / 1e-4), rtol=0,
                                atol=1e-18)
+    from granplate.figures import run as figures
+
+    fig = figures.figures(ds)["wall-forces"]
+    drawn = [ln.get_ydata() for ln in fig.axes[0].get_lines()]
+    np.testing.assert_array_equal(drawn[list(ds.wall.values).index("xmax")], piston)
 
 
 def test_bad_numbers_in_drives_and_gravity_refused_by_name():
