@@ -87,7 +87,7 @@ def squeeze(scheme: str):
     return gp.simulate(from_dict(d)), top
 
 
-@pytest.mark.parametrize("scheme", ["verlet", "implicit"])
+@pytest.mark.parametrize("scheme", ["verlet", "implicit", "paper"])
 def test_wall_moved_into_a_sphere_gives_hertz_at_the_overlap(scheme):
     """The moving wall's position is offset - v t (the prescribed motion); its force and
     the floor's equal Hertz's A delta^1.5 at their overlaps (wall_force is the contact
@@ -112,7 +112,7 @@ def test_wall_moved_into_a_sphere_gives_hertz_at_the_overlap(scheme):
     assert float(ds.E_drive[-1]) == pytest.approx(work[-1], rel=1e-2)
 
 
-def pair(dimension: int, table_v: float = 0.05):
+def pair(dimension: int, table_v: float = 0.05, scheme: str = "verlet"):
     """Two equal steel spheres touching along x: A held (velocity 0), B pushed towards A by
     a velocity table (0 -> table_v over 20 us, held to 120 us, back to 0 at 140 us)."""
     z = {"z": 0.0} if dimension == 3 else {}
@@ -131,6 +131,7 @@ def pair(dimension: int, table_v: float = 0.05):
         d["time"]["t_end"] = 1.6e-4
     d["time"]["output_interval"] = 2e-6
     d["time"]["field_interval"] = 2e-6
+    d["solver"].update(scheme=scheme, implicit_dt_max=1e-7)
     return gp.simulate(from_dict(d))
 
 
@@ -141,14 +142,14 @@ def table_displacement(t: np.ndarray, v: float) -> np.ndarray:
                              np.where(t < 1.4e-4, v * 1.2e-4 - 0.5 * v * (1.4e-4 - t) ** 2 / 2e-5, v * 1.2e-4)))
 
 
-@pytest.mark.parametrize("dimension", [2, 3])
-def test_sphere_pair_compressed_by_a_velocity_table(dimension):
+@pytest.mark.parametrize("dimension, scheme", [(2, "verlet"), (3, "verlet"), (2, "implicit")])
+def test_sphere_pair_compressed_by_a_velocity_table(dimension, scheme):
     """The pushed sphere's displacement is the table's integral; the held one stays put;
     the held sphere's drive force is the contact force on it, Hertz's A delta^1.5 at the
     overlap delta = B's displacement, and the pushing drive's is that plus m a (its
     acceleration, v / 20 us on the ramps); eq. (11) holds with the drives' work."""
     v = 0.05
-    ds = pair(dimension, v)
+    ds = pair(dimension, v, scheme)
     t = ds.time.values
     s_b = ds.drive_displacement.sel(drive="granule B").values
     # (to within a h^2 per corner of the table: a step's end may fall a round-off short of a corner)
