@@ -241,6 +241,8 @@ BAD = [
      "drives[1].target"),
     ({"drives": [{"target": "granule a", "kind": "speed", "direction": [1.0, 0.0], "profile": "constant"}]},
      "drives[0].kind"),
+    ({"drives": [{"target": "granule a", "kind": "velocity", "direction": [1.0, 0.0], "profile": "table",
+                  "file": "no-such-file.csv"}]}, "drives[0].file"),
     ({"gravity": {"g": [0.0, -9.81, 0.0]}}, "gravity.g"),
     ({"gravity": {"g": [0.0, math.inf]}}, "gravity.g"),
 ]

@@ -129,6 +129,9 @@ def _profile_fields(p: str, d: Drive) -> None:
     """The fields the profile reads are numbers of the right kind; the others keep their
     defaults (a field the profile would ignore is refused, not silently dropped)."""
     used = PROFILE_FIELDS[d.profile]
+    if d.file is not None:
+        raise ScenarioError(f"{p}.file", d.file, "is read when the scenario is loaded from TOML (setup.io); a "
+                            "Drive built in Python gives times and values instead")
     for name, default in _DEFAULTS.items():
         value = getattr(d, name)
         if name not in used and value != default and not (name in ("times", "values") and value == ()):
