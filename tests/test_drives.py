@@ -13,10 +13,9 @@ import pytest
 import granplate as gp
 from granplate.errors import ScenarioError
 from granplate.setup.io import dumps, from_dict, loads
-from granplate.setup.validate import validate
-
 from granplate.setup.materials import LIBRARY
 from granplate.setup.presets import PRESETS, preset
+from granplate.setup.validate import validate
 
 R = 0.005
 G = 9.81
@@ -262,7 +261,7 @@ def test_gravity_with_a_plate_refused():
     """Gravity with a plate is refused (the plate's own weight is not modelled), naming gravity.g."""
     from granplate.setup.io import to_dict
 
-    d = to_dict(preset(sorted(PRESETS)[0]))
+    d = to_dict(preset(min(PRESETS)))
     d["gravity"] = {"g": [0.0, -9.81]}
     with pytest.raises(ScenarioError) as e:
         validate(from_dict(d))

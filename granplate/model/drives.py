@@ -7,8 +7,18 @@ from __future__ import annotations
 import numpy as np
 
 from granplate.model.inputs import N_DRIVE
-from granplate.physics.drives import N_PAR, PAR_AMPLITUDE, PAR_DURATION, PAR_FREQUENCY, PAR_VALUE, TAB_I, TAB_T, TAB_V
-from granplate.physics.drives import KIND_FORCE, drive_motion
+from granplate.physics.drives import (
+    KIND_FORCE,
+    N_PAR,
+    PAR_AMPLITUDE,
+    PAR_DURATION,
+    PAR_FREQUENCY,
+    PAR_VALUE,
+    TAB_I,
+    TAB_T,
+    TAB_V,
+    drive_motion,
+)
 from granplate.setup.scenario import DRIVE_KINDS, DRIVE_PROFILES, Scenario
 
 

@@ -10,7 +10,13 @@ from typing import Any
 
 from granplate.errors import ScenarioError
 from granplate.setup.fields import closest_name, finite, is_number, string_in
-from granplate.setup.scenario import DRIVE_KINDS, DRIVE_PROFILES, DRIVE_TARGETS, Drive, Scenario
+from granplate.setup.scenario import (
+    DRIVE_KINDS,
+    DRIVE_PROFILES,
+    DRIVE_TARGETS,
+    Drive,
+    Scenario,
+)
 
 #: the largest |g| [m/s^2] a scenario may ask for (a centrifuge's 10^5 g)
 GRAVITY_MAX = 1e6

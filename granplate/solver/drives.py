@@ -15,8 +15,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from granplate.model.inputs import DR_A, DR_F, DR_P, DR_PD, DR_REF, DR_S, DR_V
-from granplate.model.inputs import HIST_MAX
+from granplate.model.inputs import DR_A, DR_F, DR_P, DR_PD, DR_REF, DR_S, DR_V, HIST_MAX
 from granplate.physics.drives import KIND_FORCE, drive_motion
 from granplate.physics.laws import normal_law_response
 
