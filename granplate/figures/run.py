@@ -8,7 +8,9 @@
 - contact-forces: normal and tangential force at each plate contact [N];
 - stress-strain: the plate's largest von Mises stress [MPa] and largest |eps_yy| [-];
 - granule-speeds: |v| of each granule [m/s], three components in space (beyond
-  MAX_LABELLED granules: the min-max envelope, the median and the fastest few, labelled).
+  MAX_LABELLED granules: the min-max envelope, the median and the fastest few, labelled);
+- wall-forces: a run with drives or gravity: the normal force on each wall [N], each
+  drive's force [N] and displacement [um].
 
 `missing(name, ds)` says why a run cannot have a figure (no plate, no contacts, no
 granules), None when it can; `figures(ds)` builds those it can. Time in ms throughout.
@@ -296,6 +298,38 @@ def fig_body_contact_forces(ds: xr.Dataset) -> Figure:
     return _finish(fig, ds, (ax,), "body contact forces")
 
 
+def fig_wall_forces(ds: xr.Dataset) -> Figure:
+    """The normal force each wall receives (a) [N]; with drives, the force each applies
+    along its direction (b) [N] and its displacement (c) [um] (docs/model.md section 3.11)."""
+    drives = "drive_force" in ds
+    walls = "wall_force" in ds
+    n = int(walls) + 2 * int(drives)
+    fig = new_figure(9.0, 2.6 * n + 0.8)
+    axes = list(np.atleast_1d(fig.subplots(n, 1, sharex=True)))
+    t = _t_ms(ds)
+    k = 0
+    if walls:
+        ax = axes[k]
+        for j, lab in enumerate(ds["wall"].values):
+            ax.plot(t, ds["wall_force"].values[:, j], lw=1.2, label=str(lab))
+        ax.set_ylabel("wall force [N]")
+        ax.set_title(f"({'abc'[k]}) normal force on each wall (compression > 0)", loc="left", fontsize=10)
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, title="wall",
+                  title_fontsize=8)
+        k += 1
+    if drives:
+        for j, lab in enumerate(ds["drive"].values):
+            axes[k].plot(t, ds["drive_force"].values[:, j], lw=1.2, label=str(lab))
+            axes[k + 1].plot(t, 1e6 * ds["drive_displacement"].values[:, j], lw=1.2, label=str(lab))
+        axes[k].set_ylabel("drive force [N]")
+        axes[k].set_title(f"({'abc'[k]}) force each drive applies along its direction", loc="left", fontsize=10)
+        axes[k + 1].set_ylabel("displacement [um]")
+        axes[k + 1].set_title(f"({'abc'[k + 1]}) displacement along the drive's direction", loc="left", fontsize=10)
+        axes[k].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, title="drive",
+                       title_fontsize=8)
+    return _finish(fig, ds, axes, "wall and drive forces")
+
+
 FIGURES = {
     "energies": fig_energies,
     "contact-forces": fig_contact_forces,
@@ -303,6 +337,7 @@ FIGURES = {
     "body-stress": fig_body_stress,
     "body-contact-forces": fig_body_contact_forces,
     "granule-speeds": fig_granule_speeds,
+    "wall-forces": fig_wall_forces,
 }
 
 
@@ -327,6 +362,10 @@ def missing(name: str, ds: xr.Dataset) -> str | None:
         return "no granule touched the body"
     if name == "granule-speeds" and not an.has_granules(ds):
         return "the run has no granules"
+    if name == "wall-forces" and "drive_force" not in ds and "E_gravity" not in ds:
+        return "the run has no drives or gravity (its walls' forces are the Dataset's wall_force)"
+    if name == "wall-forces" and "wall_force" not in ds and "drive_force" not in ds:
+        return "the run has no walls or drives"
     return None
 
 

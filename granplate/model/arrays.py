@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from granplate.model.contacts import contact_lists, fixed_wall_contacts
+from granplate.model.drives import drive_fields, driven_initial_state
 from granplate.model.inputs import HIST_MAX, Config, Granular, PlateArrays, no_history, scheme_number
 from granplate.physics.contact import (
     COEF_A, COEF_C, COEF_DY, COEF_H, COEF_KAPPA, COEF_KS, COEF_MU, COEF_RC, COEF_RL, COEF_SY, COEF_XH, N_COEF,
@@ -475,11 +476,14 @@ def build_model(scenario: Scenario) -> Model:
         pc_coef=plate_contact_coefficients(s, mats, r, pc), shock_force=fres, shock_torque=tres,
         pair_hist=no_history(len(loop_pairs)), wall_hist=no_history(len(loop_wc)), pc_hist=no_history(len(pc)),
     )
+    drives = drive_fields(s, np.column_stack([x, y]))
+    granular = granular._replace(**drives)
     return Model(
         scenario=s, labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
         granular=granular, plate_arrays=plate_arrays,
         config=loop_config(s, fres, tres, r, mass, face=len(plate_arrays.face_y) > 0),
-        plate=plate_model, initial_state=initial_state(s, x, y), pairs=pairs, wall_contacts=wc,
+        plate=plate_model, initial_state=driven_initial_state(initial_state(s, x, y), drives), pairs=pairs,
+        wall_contacts=wc,
         plate_contacts=pc, materials=tuple(mats), initial_patches=patches,
     )
 

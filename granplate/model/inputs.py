@@ -41,6 +41,16 @@ HIST_MAX, HIST_TIME, HIST_END, HIST_RATE = 0, 1, 2, 3
 N_HIST = 4
 
 
+#: columns of Granular.drive_now, each drive's state at the last force pass: its
+#: displacement s [m], velocity v [m/s] and acceleration a [m/s^2] along its direction (a
+#: force drive: its force in DR_A), the force F [N] the drive applies on its body along
+#: the direction, its power F v [W], the power of the contact damping forces on the
+#: granules at the wall's velocity [W] (a wall's), and a wall's displacement when the
+#: contact list was last built [m].
+DR_S, DR_V, DR_A, DR_F, DR_P, DR_PD, DR_REF = range(7)
+N_DRIVE = 7
+
+
 def no_history(n: int) -> np.ndarray:
     """A zero history for n contacts ((n, N_HIST), columns HIST_*)."""
     return np.zeros((n, N_HIST))
@@ -61,6 +71,16 @@ class Granular(NamedTuple):
     there is no patch contact (the loop then skips them at no cost); pair_hist,
     wall_hist, pc_hist: (np, N_HIST), (nw, N_HIST), (nk, N_HIST) each contact's history
     (columns HIST_*), this run's own (the loop updates them in place).
+
+    Gravity and drives (docs/model.md section 3.11; empty: none): gravity (d,) [m/s^2];
+    per drive: drive_target (nD,) int, the granule i >= 0 or the wall -1 - w it drives;
+    drive_kind, drive_prof (nD,) int (physics.drives KIND_*, PROFILE_*); drive_dir (nD,
+    d) its unit direction; drive_par (nD, N_PAR) its profile's parameters; drive_tab (nD,
+    L, 3) and drive_tlen (nD,) int its table (physics.drives TAB_*); drive_x0 (nD, d) its
+    granule's centre at t = 0 [m]; drive_now (nD, N_DRIVE) its state at the last force
+    pass (columns DR_*, this run's own). wall_drive (n_walls,) int: the drive of each
+    scenario wall or -1 (empty: no wall is driven); wall_load (n_walls,): the normal force
+    each wall received at the last force pass [N] (this run's own).
     """
 
     mass: np.ndarray
@@ -81,6 +101,18 @@ class Granular(NamedTuple):
     pair_hist: np.ndarray = no_history(0)
     wall_hist: np.ndarray = no_history(0)
     pc_hist: np.ndarray = no_history(0)
+    gravity: np.ndarray = np.zeros(0)
+    drive_target: np.ndarray = np.zeros(0, np.int64)
+    drive_kind: np.ndarray = np.zeros(0, np.int64)
+    drive_prof: np.ndarray = np.zeros(0, np.int64)
+    drive_dir: np.ndarray = np.zeros((0, 2))
+    drive_par: np.ndarray = np.zeros((0, 4))
+    drive_tab: np.ndarray = np.zeros((0, 1, 3))
+    drive_tlen: np.ndarray = np.zeros(0, np.int64)
+    drive_x0: np.ndarray = np.zeros((0, 2))
+    drive_now: np.ndarray = np.zeros((0, N_DRIVE))
+    wall_drive: np.ndarray = np.zeros(0, np.int64)
+    wall_load: np.ndarray = np.zeros(0)
 
 
 #: Flat arrays of a granular medium in space (docs/model.md section 3.7), with the fields of

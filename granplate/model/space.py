@@ -147,6 +147,7 @@ def shared_candidates(s: Scenario, x, y, z, r) -> np.ndarray | None:
 def build_space_model(s: Scenario):
     """The Model of a validated, resolved scenario of dimension 3, with its elastic body
     (model.body) when it has a [plate]."""
+    from granplate.model.drives import drive_fields, driven_initial_state
     from granplate.model.arrays import (
         Model, find_pairs_and_walls, loop_config, masses_and_inertias, pair_coefficients, wall_arrays,
     )
@@ -170,6 +171,8 @@ def build_space_model(s: Scenario):
         shock_force=shares, shock_torque=torques,
         pair_hist=no_history(len(loop_pairs)), wall_hist=no_history(len(loop_wc)), pc_hist=no_history(0),
     )
+    drives = drive_fields(s, np.column_stack([x, y, z]))
+    granular = granular._replace(**drives)
     cfg = loop_config(s, np.zeros(len(r)), np.zeros(len(r)), r, mass,
                       floor=force_floor_3d(s, mass, r, shares, s.time.output_interval, state))._replace(
         q0=shock_amplitude(s), dimension=3,
@@ -185,7 +188,7 @@ def build_space_model(s: Scenario):
     return Model(
         scenario=s, labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
         granular=granular, plate_arrays=plate_arrays, config=cfg, plate=None,
-        initial_state=state, pairs=pairs, wall_contacts=wc,
+        initial_state=driven_initial_state(state, drives), pairs=pairs, wall_contacts=wc,
         plate_contacts=np.zeros(0, np.int64), materials=tuple(mats), solid=solid, body=body,
         body_rigid=rigid,
     )

@@ -70,6 +70,11 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "dt_max": ("s", "largest time step since the previous output"),
     "n_steps": ("1", "time steps taken so far"),
     "n_iterations": ("1", "interface iterations taken so far"),
+    "E_gravity": ("J", "work of gravity on the granules, sum of m g . (x - x(0)) (docs/model.md section 3.11)"),
+    "E_drive": ("J", "work of the drives on the granules (docs/model.md section 3.11)"),
+    "wall_force": ("N", "normal force each wall receives from the granules (positive in compression)"),
+    "drive_force": ("N", "force each drive applies on its wall or granule along its direction"),
+    "drive_displacement": ("m", "displacement of each drive's wall or granule along its direction since t = 0"),
     "contact_time_formed": ("s", "time each plate contact formed: 0 for those at t = 0, a patch contact's when its granule came within contact.skin R of the face"),
 }
 
@@ -289,6 +294,10 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
             continue
         if not summary_only or name in SUMMARY_VARIABLES:
             data[name] = _var(name, ("time",), e[:, col].copy())
+    if s.gravity is not None:
+        data["E_gravity"] = _var("E_gravity", ("time",), e[:, K.E_GRAVITY].copy())
+    if s.drives:
+        data["E_drive"] = _var("E_drive", ("time",), e[:, K.E_DRIVE].copy())
     nk = len(axis.granule)
     coords = {
         "time": ("time", t, {"units": "s", "long_name": "time"}),
@@ -326,6 +335,7 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
     data["n_steps"] = _var("n_steps", ("time",), out.stats[:n, K.S_STEPS].astype(np.int64))
     data["n_iterations"] = _var("n_iterations", ("time",), out.stats[:n, K.S_ITERS].astype(np.int64))
     data["contact_time_formed"] = _var("contact_time_formed", ("contact",), axis.time_formed)
+    data.update(wall_and_drive_outputs(model, out, n, coords))
     if model.plate is not None:
         ft = plate_data.pop("_field_time")
         data.update(plate_data)
@@ -432,11 +442,30 @@ SUMMARY_UNITS: dict[str, object] = {
 }
 
 
+def wall_and_drive_outputs(model, out: K.Output, n: int, coords: dict) -> dict[str, xr.DataArray]:
+    """wall_force (time, wall) and drive_force, drive_displacement (time, drive), with the
+    coordinates `wall` (the walls' labels, or "wall K") and `drive` (the drives' names)
+    added to coords; none for a run without walls or drives."""
+    s = model.scenario
+    data: dict[str, xr.DataArray] = {}
+    if s.walls:
+        coords["wall"] = ("wall", np.array([w.label or f"wall {k + 1}" for k, w in enumerate(s.walls)], dtype=str),
+                          {"long_name": "wall label"})
+        data["wall_force"] = _var("wall_force", ("time", "wall"), out.wall_force[:n].copy())
+    if s.drives:
+        coords["drive"] = ("drive", np.array([d.name for d in s.drives], dtype=str),
+                           {"long_name": "drive (its label, or its target)"})
+        data["drive_force"] = _var("drive_force", ("time", "drive"), out.drive[:n, :, 0].copy())
+        data["drive_displacement"] = _var("drive_displacement", ("time", "drive"), out.drive[:n, :, 1].copy())
+    return data
+
+
 def summary(ds: xr.Dataset) -> dict:
     """The headline figures of a run (the CLI's table and --summary JSON), units in "units".
 
     Energies are fractions of e_in = e_shock + e_initial [J], the energy put in: the work
-    the load put in plus the energy present at t = 0 (docs/output.md); they are None when
+    the load put in plus the energy present at t = 0 (and the work of gravity and the
+    drives, when the run has them; docs/output.md); they are None when
     e_in = 0. e_shock is E_shock at t_end unless the load also took energy back
     (e_load_taken: its force against granules moving toward it, `analysis.load_work`),
     so that neither is negative and no share exceeds 1 beyond the energy residual; the
@@ -449,6 +478,9 @@ def summary(ds: xr.Dataset) -> dict:
     put_in, taken = load_work(ds.E_shock.values) if ds.sizes["time"] else (np.zeros(1), np.zeros(1))
     e_shock, e_taken = float(put_in[-1]), float(taken[-1])
     e_in = e_shock + e0
+    for name in ("E_gravity", "E_drive"):  # the work of gravity and the drives (when the run has them)
+        if name in ds and ds.sizes["time"]:
+            e_in += float(ds[name][-1])
     ref = e_in if e_in > 0 else None
     has_plate = "max_von_mises" in ds
     info = json.loads(ds.attrs.get("run_info", "{}"))

@@ -30,8 +30,9 @@ import tomli_w
 from granplate.errors import ScenarioError
 from granplate.setup.fields import check_dimension, closest_name, string_in
 from granplate.setup.materials import LIBRARY, Material
-from granplate.setup.scenario import (LAYOUT_KINDS, NORMAL_LAWS, Box, Contact, Granule, Load,
-                                      PairCoefficients, Plate, Scenario, Solid, Solver, TimeSettings, Wall)
+from granplate.setup.scenario import (DRIVE_KINDS, DRIVE_PROFILES, LAYOUT_KINDS, NORMAL_LAWS, Box, Contact, Drive,
+                                      Granule, Gravity, Load, PairCoefficients, Plate, Scenario, Solid, Solver,
+                                      TimeSettings, Wall)
 
 #: Fields that a table must give (everything else takes the dataclass default).
 REQUIRED: dict[type, tuple[str, ...]] = {
@@ -39,6 +40,8 @@ REQUIRED: dict[type, tuple[str, ...]] = {
     Wall: ("normal",),  # and offset, or (3D) point: `_walls`
     Box: ("lower", "upper"),
     PairCoefficients: ("materials",),
+    Gravity: ("g",),
+    Drive: ("target", "kind", "direction", "profile"),
 }
 #: Keys of a [materials.NAME] table: E, nu, rho required; Y optional (absent: unknown);
 #: the law "johnson"'s C, rate_ref, hardness_ratio, unloading_factor optional.
@@ -49,6 +52,8 @@ MATERIAL_REQUIRED: tuple[str, ...] = ("E", "nu", "rho")
 CHOICES: dict[tuple[type, str], tuple[str, ...]] = {
     (Contact, "normal_law"): NORMAL_LAWS,
     (PairCoefficients, "normal_law"): NORMAL_LAWS,
+    (Drive, "kind"): DRIVE_KINDS,
+    (Drive, "profile"): DRIVE_PROFILES,
 }
 #: Fields left out of a written table when they hold this default (written, they would
 #: change the text, and so the stored results' keys, of every scenario written before).
@@ -60,6 +65,9 @@ UNWRITTEN_DEFAULTS_2D: dict[str, dict[str, Any]] = {
     "load": {"force": 0.0, "direction": [1.0, 0.0, 0.0]},
     "granules": {"z": 0.0, "vz": 0.0},
 }
+#: A drive's fields left out of a written [[drives]] table when they hold their default.
+DRIVE_DEFAULTS: dict[str, Any] = {"value": 0.0, "amplitude": 0.0, "frequency": 0.0, "duration": 0.0,
+                                  "times": [], "values": [], "label": ""}
 #: The order of a 3D granule's keys as written (its centre, then its velocities).
 GRANULE_KEYS_3D: tuple[str, ...] = ("x", "y", "z", "radius", "material", "label", "vx", "vy", "vz", "omega")
 
@@ -223,7 +231,7 @@ def _materials(d: Any) -> dict[str, Material]:
 
 _TOP_TABLES: dict[str, type] = {
     "plate": Plate, "load": Load, "contact": Contact,
-    "time": TimeSettings, "solver": Solver, "box": Box,
+    "time": TimeSettings, "solver": Solver, "box": Box, "gravity": Gravity,
 }
 
 
@@ -236,6 +244,38 @@ def _walls(value: Any, dimension: Any) -> tuple[Wall, ...]:
             raise ScenarioError(f"walls[{i}].offset", MISSING,
                                 f"missing required field 'walls[{i}].offset'{alt}")
     return walls
+
+
+def _drives(value: Any, base: str | os.PathLike | None) -> tuple[Drive, ...]:
+    """The [[drives]] tables; a table given as a CSV `file` (relative to the scenario's
+    folder, `base`) is read into times and values."""
+    drives = _convert("drives", value, tuple[Drive, ...])
+    return tuple(_drive_table_file(f"drives[{k}]", d, base) if d.file is not None else d
+                 for k, d in enumerate(drives))
+
+
+def _drive_table_file(path: str, d: Drive, base: str | os.PathLike | None) -> Drive:
+    """`d` with its `file` (two columns: time [s], value; a header line allowed) read into
+    times and values."""
+    if d.times or d.values:
+        raise ScenarioError(f"{path}.file", d.file, "give either a file or times and values, not both")
+    name = os.path.join(base, d.file) if base is not None and not os.path.isabs(d.file) else d.file
+    try:
+        with open(name, encoding="utf-8") as f:
+            lines = [ln.strip() for ln in f if ln.strip() and not ln.lstrip().startswith("#")]
+    except OSError as e:
+        raise ScenarioError(f"{path}.file", d.file, f"cannot be read: {e.strerror or e}") from None
+    rows = []
+    for n, ln in enumerate(lines):
+        cells = [c.strip() for c in ln.replace(";", ",").split(",")] if ("," in ln or ";" in ln) else ln.split()
+        try:
+            t, v = float(cells[0]), float(cells[1])
+        except (ValueError, IndexError):
+            if n == 0:  # a header
+                continue
+            raise ScenarioError(f"{path}.file", d.file, f"line {n + 1} ({ln!r}) is not two numbers: time, value") from None
+        rows.append((t, v))
+    return dataclasses.replace(d, file=None, times=tuple(t for t, _ in rows), values=tuple(v for _, v in rows))
 
 
 def _no_scalar_omega(granules: Any) -> None:
@@ -283,8 +323,9 @@ def from_dict(d: dict, base: str | os.PathLike | None = None) -> Scenario:
     Top-level keys: name, description, dimension, materials, layout, granules (or
     granules_file: a CSV, NPZ or netCDF file of them, setup.granules_file, relative to
     `base`, by default the working directory), walls, box, plate, load, contact, time,
-    solver. Missing tables take the defaults (no layout, no plate, no box; dimension 2;
-    in 3D no load, `load.kind = "none"`).
+    solver, gravity, drives. Missing tables take the defaults (no layout, no plate, no box,
+    no gravity, no drives; dimension 2; in 3D no load, `load.kind = "none"`). `base` is
+    also the folder a drive's CSV `file` is relative to.
     """
     names = [f.name for f in dataclasses.fields(Scenario)]
     _check_keys("", d, names)
@@ -314,6 +355,8 @@ def from_dict(d: dict, base: str | os.PathLike | None = None) -> Scenario:
         kw["granules"] = _convert("granules", d["granules"], tuple[Granule, ...])
     if d.get("walls") is not None:
         kw["walls"] = _walls(d["walls"], kw.get("dimension", 2))
+    if d.get("drives") is not None:
+        kw["drives"] = _drives(d["drives"], base)
     if kw.get("dimension") == 3 and d.get("load") is None:
         kw["load"] = Load(kind="none")  # the plane's default line load has no meaning in space
     if isinstance(kw.get("plate"), Solid) and "scheme" not in (d.get("solver") or {}):
@@ -421,6 +464,10 @@ def to_dict(s: Scenario, all_materials: bool = False) -> dict:
     for key in ("load", "contact", "time", "solver"):
         d[key] = _without_defaults(_plain(getattr(s, key)),
                                    {**UNWRITTEN_DEFAULTS.get(key, {}), **flat.get(key, {})})
+    if s.gravity is not None:  # (absent: not written, so that every scenario without it is written as before)
+        d["gravity"] = _plain(s.gravity)
+    if s.drives:
+        d["drives"] = [_without_defaults(x, DRIVE_DEFAULTS) for x in _plain(s.drives)]
     return d
 
 

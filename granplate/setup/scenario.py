@@ -553,6 +553,59 @@ class Solver:
     granular_friction: str = "split"
 
 
+#: What a drive prescribes along its direction (`Drive.kind`).
+DRIVE_KINDS: tuple[str, ...] = ("displacement", "velocity", "force")
+#: A drive's time profiles (`Drive.profile`; docs/scenario.md, section "Drives").
+DRIVE_PROFILES: tuple[str, ...] = ("constant", "ramp", "half-sine", "harmonic", "table")
+#: The two kinds of body a drive moves (`Drive.target` = "wall LABEL" or "granule LABEL").
+DRIVE_TARGETS: tuple[str, ...] = ("wall", "granule")
+
+
+@dataclass(frozen=True)
+class Gravity:
+    """A uniform body force on every granule: the acceleration g [m/s^2], [gx, gy] in the
+    plane, [gx, gy, gz] in space (docs/model.md section 3.11)."""
+
+    g: tuple[float, ...] = ()
+
+
+@dataclass(frozen=True)
+class Drive:
+    """Prescribed motion of a wall or a granule, or a prescribed force on a granule, along
+    a unit `direction` (docs/model.md section 3.11).
+
+    target: "wall LABEL" or "granule LABEL" (the `label` of a [[walls]] or [[granules]]
+    entry, or of a wall or granule a layout made); kind: "displacement" [m], "velocity"
+    [m/s] or "force" [N] along the direction; profile: the time profile P(t) of that
+    quantity, with its fields: "constant" (value), "ramp" (value reached at duration,
+    held after), "half-sine" (amplitude sin(pi t / duration) over the duration, 0 after),
+    "harmonic" (value + amplitude sin(2 pi frequency t)), "table" (linear between the
+    points times [s], values; the first value before them, the last after; or read from
+    the CSV `file` of two columns, time and value, which the reader turns into times and
+    values). A displacement drive moves its body by P(t) - P(0) from where the scenario
+    puts it; a velocity drive sets the body's velocity along the direction to P(t) from
+    t = 0 on. label: the drive's name in the Dataset (default: the target).
+    """
+
+    target: str
+    kind: str = "velocity"
+    direction: tuple[float, ...] = ()
+    profile: str = "constant"
+    value: float = 0.0
+    amplitude: float = 0.0
+    frequency: float = 0.0
+    duration: float = 0.0
+    times: tuple[float, ...] = ()
+    values: tuple[float, ...] = ()
+    file: str | None = None
+    label: str = ""
+
+    @property
+    def name(self) -> str:
+        """The drive's name in the Dataset: its label, or its target."""
+        return self.label or self.target
+
+
 @dataclass(frozen=True)
 class Scenario:
     """A complete run definition. Either `layout` or explicit `granules`/`walls`.
@@ -563,6 +616,8 @@ class Scenario:
     scenario gives it; setup.granules_file), so that messages name its rows and columns;
     None for [[granules]] tables. Not part of the scenario's value: a scenario read from a
     file equals the same one given as tables, and is written as tables (`io.to_dict`).
+    gravity: a body force on every granule (None: none); drives: prescribed motions of
+    walls and granules and prescribed forces on granules (docs/model.md section 3.11).
     """
 
     name: str = "custom"
@@ -579,6 +634,8 @@ class Scenario:
     dimension: int = 2
     box: Box | None = None
     granules_file: str | None = field(default=None, compare=False)
+    gravity: Gravity | None = None
+    drives: tuple[Drive, ...] = ()
 
     def material(self, name: str) -> Material:
         """The material called `name` (file-defined ones override the library)."""

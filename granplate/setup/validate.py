@@ -29,6 +29,7 @@ from granplate.setup.geometry import granule_named, layout_packing, plane_offset
 from granplate.setup.layouts import (INTRUDER_COLUMN_RULES, column_radii, layer_planes, half_pitch,
                                      hexagonal_offsets, lattice_sites, plane_clash, plane_gap_distance,
                                      plane_layers, plane_type, planes_along_x, planes_per_cell, sites_per_cell, space_sites)
+from granplate.setup.drive_checks import check_drives, check_gravity
 from granplate.setup.fields import check_dimension, finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
 from granplate.setup.granules_file import granule_path
 from granplate.setup.pairs import close_pairs, contact_search_distance, superset_pairs
@@ -1260,7 +1261,7 @@ def validate(scenario: Scenario) -> None:
     range of every coordinate and size (`LENGTH_RANGE`), overlaps and penetrations at
     t = 0 (walls, the plate's edge, a box solid's surface), load, contact (and the yield strengths its normal laws need), plate mesh (rigid
     layers of the contacts on nodes, patch contacts between nodes, n_modes), time, the
-    outputs' memory, solver. A scenario with neither granules (nor a layout) nor a plate
+    outputs' memory, solver, gravity and drives. A scenario with neither granules (nor a layout) nor a plate
     is refused.
     """
     if _passed_before(scenario):
@@ -1309,6 +1310,21 @@ def _validate(scenario: Scenario) -> None:
     _check_time(r)
     _check_output_size(r)
     _check_solver(r)
+    _check_drives(r)
+
+
+def _check_drives(s: Scenario) -> None:
+    """[gravity] and [[drives]] (setup.drive_checks): a harmonic drive's period held to
+    the scheme's largest step, the speeds a drive asks for below the slowest wave speed."""
+    check_gravity(s)
+    if not s.drives:
+        return
+    if not isinstance(s.drives, tuple):
+        raise ScenarioError("drives", s.drives, "must be a list of [[drives]] tables")
+    step = s.solver.implicit_dt_max if s.solver.scheme == "implicit" else s.time.dt_max
+    used = {g.material for g in s.granules} | {w.material for w in s.walls}
+    speed = min((bar_wave_speed(s.material(m)) for m in used if m in s.materials), default=math.inf)
+    check_drives(s, float(step), speed)
 
 
 

@@ -5,6 +5,7 @@ when the steps have collapsed), and return a plain record of the output buffers.
 """
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 import signal
@@ -17,7 +18,7 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from granplate.model.arrays import Model, granular_with_contacts, granular_with_patch_contacts
-from granplate.model.inputs import HIST_MAX, HIST_TIME, no_history
+from granplate.model.inputs import DR_REF, DR_S, HIST_MAX, HIST_TIME, no_history
 from granplate.model.contacts import Missed, centre_coordinates, contact_lists, missed_contacts, wall_planes
 from granplate.model.neighbours import verlet_pairs, verlet_walls
 from granplate.physics.contact import plate_overlap
@@ -210,6 +211,16 @@ def overlap_warnings(model: Model, w: S.Work) -> list[str]:
     return out
 
 
+def wall_offsets_now(g, normals: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """The walls' offsets [m] with each driven wall moved as far as the last force pass
+    put it (its displacement along its direction, projected on its normal)."""
+    out = offsets.copy()
+    for w, k in enumerate(g.wall_drive):
+        if k >= 0:
+            out[w] += g.drive_now[k, DR_S] * float(normals[w] @ g.drive_dir[k])
+    return out
+
+
 class ContactLists:
     """The loop's contact lists during a run: rebuilt (detection = "dynamic") or checked
     (fixed) from the granules' positions, between compiled chunks (model/contacts.py),
@@ -220,7 +231,8 @@ class ContactLists:
         g = model.granular
         # this run's own histories (the loop updates them in place)
         self.g = g._replace(pair_hist=no_history(len(g.pair_ij)), wall_hist=no_history(len(g.wall_i)),
-                            pc_hist=no_history(len(g.pc_i)))
+                            pc_hist=no_history(len(g.pc_i)), drive_now=g.drive_now.copy(),
+                            wall_load=g.wall_load.copy())
         self.known: dict = {}
         self.stores: tuple[dict, dict] = ({}, {})  # histories of the pairs and wall contacts off the lists
         self.planes = wall_planes(model.scenario.walls, model.config.dimension)
@@ -243,10 +255,15 @@ class ContactLists:
         c = m.scenario.contact
         fixed = c.detection == "fixed"
         normals, offsets = self.planes
+        walls = m.scenario.walls
+        if len(g.wall_drive):  # driven walls where they are now (docs/model.md section 3.11)
+            offsets = wall_offsets_now(g, normals, offsets)
+            walls = tuple(dataclasses.replace(wall, offset=float(o)) for wall, o in zip(walls, offsets))
+            g.drive_now[:, DR_REF] = g.drive_now[:, DR_S]
         if fixed:
             cand_p, cand_w = verlet_pairs(x, yy, r, 0.0, z), verlet_walls(x, yy, r, normals, offsets, 0.0, z)
         else:
-            cand_p, cand_w = contact_lists(c, m.scenario.walls, x, yy, r, z)
+            cand_p, cand_w = contact_lists(c, walls, x, yy, r, z)
         cur_w = np.column_stack([g.wall_i, g.wall_w]).astype(np.int64)
         missed = missed_contacts(g.pair_ij, cur_w, cand_p, cand_w, normals, offsets, x, yy, r, z)
         if not fixed:
@@ -271,7 +288,7 @@ class LoopArrays:
                 first, last = patch_weights(p.face_y, float(y_k), 0.0, self.w.wface)
                 set_face_weights(k, first, last, self.w)
         self.sw = scheme(cfg.scheme).new_scratch(ng, nm, nk, body=model.body)
-        self.out = S.new_output(times, ng, nm, nk, nc)
+        self.out = S.new_output(times, ng, nm, nk, nc, len(g.wall_load), len(g.drive_target))
         self.scheme = cfg.scheme
 
     def grow(self, nk_new: int) -> None:
@@ -284,7 +301,8 @@ class LoopArrays:
         self.st = _copied(st, S.new_state(ng, nm, nk_new, nc))
         self.w = _copied(w, S.new_work(ng, nm, nk_new, len(w.wface), nc))
         self.sw = _copied(self.sw, scheme(self.scheme).new_scratch(ng, nm, nk_new))
-        self.out = _copied(self.out, S.new_output(self.out.target, ng, nm, nk_new, nc))
+        self.out = _copied(self.out, S.new_output(self.out.target, ng, nm, nk_new, nc, self.out.wall_force.shape[1],
+                                                  self.out.drive.shape[1]))
         phi_d = np.zeros((2 * nk_new, nm))
         phi_d[: self.p.phi_d.shape[0]] = self.p.phi_d
         self.p = self.p._replace(phi_d=phi_d)

@@ -26,6 +26,7 @@ from granplate.physics.contact import (
 from granplate.physics.cavity import rate_factor
 from granplate.physics.laws import normal_law_force, normal_law_response
 from granplate.physics.shock import time_profile
+from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_motion
 from granplate.solver.state import PARTNER_PLATE
 
 
@@ -44,6 +45,8 @@ class ForceSums(NamedTuple):
     ovl_j: int  # its partner: granule j, wall -1 - w or PARTNER_PLATE (-1 with no overlap)
     rate_plate: float  # largest slip relaxation rate of a plate contact [1/s] (0 with hold)
     w_plastic: float  # plastic work done past the contacts' largest overlaps so far [J] (docs/model.md eq. P10)
+    p_drive: float  # power of the drives [W] (solver.drives.finish_pass; 0 in the Verlet force pass)
+    p_grav: float  # power of gravity [W] (likewise)
 
 
 @njit(cache=True)
@@ -81,6 +84,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         dy[i, 3] = 0.0
         dy[i, 4] = 0.0
         dy[i, 5] = 0.0
+    begin_pass(t, g)
     p_shock = 0.0
     p_visc = 0.0
     p_fric = 0.0
@@ -153,12 +157,13 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         p_visc += pv
         p_fric += pf
         e_pot += ep
-    for w in range(g.wall_i.shape[0]):  # rigid walls
+    for w in range(g.wall_i.shape[0]):  # rigid walls (a driven one moving along its normal at vn)
         i = g.wall_i[w]
         ri = g.radius[i]
         nx = g.wall_geo[w, 0]
         nz = g.wall_geo[w, 1]
-        delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, g.wall_geo[w, 2])
+        shift, vn, kd = wall_motion(g, w)
+        delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, g.wall_geo[w, 2] + shift)
         if record:
             g.wall_hist[w, HIST_END] = max(delta, 0.0)
         if delta <= 0.0:
@@ -169,10 +174,11 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             ovl_j = -1 - g.wall_w[w]
         c = g.wall_coef[w]
         if split:  # the normal force alone: friction_flow applies the friction
-            n, pv, ep, wp = normal_law_response(delta, y[i, 3] * nx + y[i, 4] * nz, c,
-                                                g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE],
-                                                cfg.clip)
+            rate_n = y[i, 3] * nx + y[i, 4] * nz - vn
+            n, pv, ep, wp = normal_law_response(delta, rate_n, c, g.wall_hist[w, HIST_MAX],
+                                            g.wall_hist[w, HIST_RATE], cfg.clip)
             w_plastic += wp
+            book_wall(g, w, kd, n, pv / rate_n if pv != 0.0 else 0.0)
             dy[i, 3] += -n * nx
             dy[i, 4] += -n * nz
             p_visc += pv
@@ -180,8 +186,9 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             continue
         ai = contact_arm(ri, delta, cfg.arm_shrink)
         ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
-        n, pv, ep, wp = normal_law_response(delta, ddot, c,
-                                            g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
+        n, pv, ep, wp = normal_law_response(delta, ddot - vn, c, g.wall_hist[w, HIST_MAX],
+                                            g.wall_hist[w, HIST_RATE], cfg.clip)
+        book_wall(g, w, kd, n, pv / (ddot - vn) if pv != 0.0 else 0.0)
         f = friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS])
         pf = friction_power(f, vt)
         w_plastic += wp
@@ -235,7 +242,8 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         dy[i, 3] /= g.mass[i]
         dy[i, 4] /= g.mass[i]
         dy[i, 5] /= g.inertia[i]
-    return ForceSums(p_shock, p_visc, p_fric, e_pot, rate, ovl, ovl_i, ovl_j, rate_plate, w_plastic)
+    p_drive, p_grav = finish_pass(y, dy, g)
+    return ForceSums(p_shock, p_visc, p_fric, e_pot, rate, ovl, ovl_i, ovl_j, rate_plate, w_plastic, p_drive, p_grav)
 
 
 @njit(cache=True)
@@ -290,19 +298,21 @@ def friction_flow(y, dt, g, cfg, forward):
             y[j, 4] += imp * nx * inv_mj
             y[j, 5] -= imp * inv_ij
             work += dw
-        else:  # wall contact w, the wall at rest
+        else:  # wall contact w (a driven wall where the last force pass put it; it moves along its normal)
             w = q - n_p
             i = g.wall_i[w]
             ri = g.radius[i]
             nx = g.wall_geo[w, 0]
             nz = g.wall_geo[w, 1]
-            delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, g.wall_geo[w, 2])
+            shift, vn, _ = wall_motion(g, w)
+            delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, g.wall_geo[w, 2] + shift)
             c = g.wall_coef[w]
             if delta <= 0.0 or c[COEF_MU] == 0.0:
                 continue
             ai = contact_arm(ri, delta, cfg.arm_shrink)
             ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
-            n = normal_law_force(delta, ddot, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
+            n = normal_law_force(delta, ddot - vn, c, g.wall_hist[w, HIST_MAX],
+                                            g.wall_hist[w, HIST_RATE], cfg.clip)
             inv_m = 1.0 / g.mass[i]
             inv_i = ai / g.inertia[i]
             imp, dw = friction_impulse(vt, n, c[COEF_MU], c[COEF_KS], inv_m + ai * inv_i, dt)
@@ -396,6 +406,7 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
             acc[i, c] = 0.0
             fdamp[i, c] = 0.0
             fload[i, c] = 0.0
+    begin_pass(t, g)
     p_shock = 0.0
     p_visc = 0.0
     e_pot = 0.0
@@ -453,7 +464,8 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
         ri = g.radius[i]
         nx = g.wall_geo[w, 0]
         nz = g.wall_geo[w, 1]
-        delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, g.wall_geo[w, 2])
+        shift, vn, kd = wall_motion(g, w)
+        delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, g.wall_geo[w, 2] + shift)
         g.wall_hist[w, HIST_END] = max(delta, 0.0)
         if delta <= 0.0:
             continue
@@ -461,20 +473,22 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
             ovl = delta / ri
             ovl_i = i
             ovl_j = -1 - g.wall_w[w]
-        ddot = y[i, 3] * nx + y[i, 4] * nz
-        n, pv, ep, wp = normal_law_response(delta, ddot, g.wall_coef[w],
-                                            g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
+        ddot = y[i, 3] * nx + y[i, 4] * nz - vn
+        n, pv, ep, wp = normal_law_response(delta, ddot, g.wall_coef[w], g.wall_hist[w, HIST_MAX],
+                                            g.wall_hist[w, HIST_RATE], cfg.clip)
         w_plastic += wp
         p_visc += pv
         e_pot += ep
         acc[i, 3] -= n * nx
         acc[i, 4] -= n * nz
+        d = 0.0
         if pv != 0.0:
             d = pv / ddot
             fdamp[i, 3] -= d * nx
             fdamp[i, 4] -= d * nz
+        book_wall(g, w, kd, n, d)
     for i in range(ng):
         acc[i, 3] /= g.mass[i]
         acc[i, 4] /= g.mass[i]
         acc[i, 5] /= g.inertia[i]
-    return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic)
+    return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)

@@ -16,6 +16,7 @@ from granplate.physics.shock import time_profile
 from granplate.physics.space import (
     arm_torque_3d, friction_along_slip, normal_rate_3d, pair_contact_3d, slip_velocity_3d, wall_overlap_3d,
 )
+from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_motion
 from granplate.solver.granular import ForceSums, friction_impulse, slip_relaxation_rate
 
 #: state columns of a granule in space
@@ -73,6 +74,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             dy[i, c] = y[i, 3 + c]
         for c in range(3, 9):
             dy[i, c] = 0.0
+    begin_pass(t, g)
     p_shock = 0.0
     p_visc = 0.0
     p_fric = 0.0
@@ -146,7 +148,8 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         nx = g.wall_geo[w, 0]
         ny = g.wall_geo[w, 1]
         nz = g.wall_geo[w, 2]
-        delta = wall_overlap_3d(y[i, X], y[i, Y], y[i, Z], ri, nx, ny, nz, g.wall_geo[w, 3])
+        shift, vn, kd = wall_motion(g, w)
+        delta = wall_overlap_3d(y[i, X], y[i, Y], y[i, Z], ri, nx, ny, nz, g.wall_geo[w, 3] + shift)
         if record:
             g.wall_hist[w, HIST_END] = max(delta, 0.0)
         if delta <= 0.0:
@@ -156,9 +159,10 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             ovl_i = i
             ovl_j = -1 - g.wall_w[w]
         c = g.wall_coef[w]
-        ddot = normal_rate_3d(y[i, VX], y[i, VY], y[i, VZ], nx, ny, nz)
-        n, pv, ep, wp = normal_law_response(delta, ddot, c,
-                                            g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
+        ddot = normal_rate_3d(y[i, VX], y[i, VY], y[i, VZ], nx, ny, nz) - vn
+        n, pv, ep, wp = normal_law_response(delta, ddot, c, g.wall_hist[w, HIST_MAX],
+                                            g.wall_hist[w, HIST_RATE], cfg.clip)
+        book_wall(g, w, kd, n, pv / ddot if pv != 0.0 else 0.0)
         dy[i, VX] -= n * nx
         dy[i, VY] -= n * ny
         dy[i, VZ] -= n * nz
@@ -181,7 +185,8 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         for c in range(3):
             dy[i, VX + c] *= inv_m
             dy[i, WX + c] *= inv_i
-    return ForceSums(p_shock, p_visc, p_fric, e_pot, rate, ovl, ovl_i, ovl_j, 0.0, w_plastic)
+    p_drive, p_grav = finish_pass(y, dy, g)
+    return ForceSums(p_shock, p_visc, p_fric, e_pot, rate, ovl, ovl_i, ovl_j, 0.0, w_plastic, p_drive, p_grav)
 
 
 @njit(cache=True)
@@ -245,7 +250,8 @@ def friction_flow(y, dt, g, cfg, forward):
             nx = g.wall_geo[w, 0]
             ny = g.wall_geo[w, 1]
             nz = g.wall_geo[w, 2]
-            delta = wall_overlap_3d(y[i, X], y[i, Y], y[i, Z], ri, nx, ny, nz, g.wall_geo[w, 3])
+            shift, vn, _ = wall_motion(g, w)  # (a driven wall where the last force pass put it)
+            delta = wall_overlap_3d(y[i, X], y[i, Y], y[i, Z], ri, nx, ny, nz, g.wall_geo[w, 3] + shift)
             c = g.wall_coef[w]
             if delta <= 0.0 or c[COEF_MU] == 0.0:
                 continue
@@ -254,7 +260,8 @@ def friction_flow(y, dt, g, cfg, forward):
             speed = _speed(vsx, vsy, vsz)
             if speed == 0.0:
                 continue
-            n = normal_law_force(delta, ddot, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
+            n = normal_law_force(delta, ddot - vn, c, g.wall_hist[w, HIST_MAX],
+                                            g.wall_hist[w, HIST_RATE], cfg.clip)
             inv_m = 1.0 / g.mass[i]
             inv_i = 1.0 / g.inertia[i]
             imp, dw = friction_impulse(speed, n, c[COEF_MU], c[COEF_KS], inv_m + a * a * inv_i, dt)
@@ -306,6 +313,7 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
             acc[i, c] = 0.0
             fdamp[i, c] = 0.0
             fload[i, c] = 0.0
+    begin_pass(t, g)
     p_shock = 0.0
     p_visc = 0.0
     e_pot = 0.0
@@ -365,7 +373,8 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
         nx = g.wall_geo[w, 0]
         ny = g.wall_geo[w, 1]
         nz = g.wall_geo[w, 2]
-        delta = wall_overlap_3d(y[i, X], y[i, Y], y[i, Z], ri, nx, ny, nz, g.wall_geo[w, 3])
+        shift, vn, kd = wall_motion(g, w)
+        delta = wall_overlap_3d(y[i, X], y[i, Y], y[i, Z], ri, nx, ny, nz, g.wall_geo[w, 3] + shift)
         g.wall_hist[w, HIST_END] = max(delta, 0.0)
         if delta <= 0.0:
             continue
@@ -373,22 +382,24 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
             ovl = delta / ri
             ovl_i = i
             ovl_j = -1 - g.wall_w[w]
-        ddot = normal_rate_3d(y[i, VX], y[i, VY], y[i, VZ], nx, ny, nz)
-        n, pv, ep, wp = normal_law_response(delta, ddot, g.wall_coef[w],
-                                            g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
+        ddot = normal_rate_3d(y[i, VX], y[i, VY], y[i, VZ], nx, ny, nz) - vn
+        n, pv, ep, wp = normal_law_response(delta, ddot, g.wall_coef[w], g.wall_hist[w, HIST_MAX],
+                                            g.wall_hist[w, HIST_RATE], cfg.clip)
         w_plastic += wp
         p_visc += pv
         e_pot += ep
         acc[i, VX] -= n * nx
         acc[i, VY] -= n * ny
         acc[i, VZ] -= n * nz
+        d = 0.0
         if pv != 0.0:
             d = pv / ddot
             fdamp[i, VX] -= d * nx
             fdamp[i, VY] -= d * ny
             fdamp[i, VZ] -= d * nz
+        book_wall(g, w, kd, n, d)
     for i in range(ng):
         for c in range(3):
             acc[i, VX + c] /= g.mass[i]
             acc[i, WX + c] /= g.inertia[i]
-    return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic)
+    return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)

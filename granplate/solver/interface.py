@@ -206,4 +206,6 @@ def move_patches(st, g, p, cfg, w):
         st.p1[0] = pr.p_shock
         st.p1[1] = pr.p_visc
         st.p1[2] = pr.p_fric
+        st.p1[3] = pr.p_drive
+        st.p1[4] = pr.p_grav
     return moved

@@ -20,8 +20,10 @@ from granplate.solver.rk4 import RK4_FRICTION_LIMIT
 from granplate.solver.interface import accept_contacts, contact_modulus, first_guess, move_patches, place_patch
 from granplate.solver.ladder import level_step
 from granplate.solver.plate_modal import driving_dofs, modal_acceleration, plate_energy, step_matrices
+from granplate.model.inputs import DR_F
+from granplate.solver.drives import drive_displacement, walls_moved
 from granplate.solver.state import (
-    A_FRIC, A_PLASTIC, A_SHOCK_G, A_SHOCK_P, A_VISC, C_FRICTION_BOUND, C_ITERS, C_LEVEL, C_OUT, C_RETRIES, C_STEPS, CUSTOM_H,
+    A_DRIVE, A_GRAVITY, E_DRIVE, E_GRAVITY, REBUILD, A_FRIC, A_PLASTIC, A_SHOCK_G, A_SHOCK_P, A_VISC, C_FRICTION_BOUND, C_ITERS, C_LEVEL, C_OUT, C_RETRIES, C_STEPS, CUSTOM_H,
     D_FRIC, D_PLASTIC, D_VISC, E_GRAN, KE_Z, E_IN_MAX, E_PLATE, E_POT, E_POTG, E_SHOCK, E_STATIC, E_ZERO, ERR_BUFFER,
     ERR_CONTACT, ERR_ENERGY, ERR_H, ERR_ITER, ERR_LAM, ERR_N, ERR_NAN, ERR_NOCONV, ERR_RESID,
     ERR_T, ERR_VT, H_LAST, KE_ROT, KE_X, KE_Y, N_LEVELS, OK, PAUSED, RES_LAST, RESID, RESID_MAX,
@@ -41,6 +43,8 @@ def initialise(st, g, p, cfg, w):
     st.p1[0] = pr.p_shock
     st.p1[1] = pr.p_visc
     st.p1[2] = pr.p_fric
+    st.p1[3] = pr.p_drive
+    st.p1[4] = pr.p_grav
     st.clock[E_POT] = pr.e_pot
     modal_acceleration(st.clock[T_NOW], st, p, cfg, st.force)
     driving_dofs(st, p)
@@ -80,6 +84,7 @@ def reset_interval(w):
 @njit(cache=True)
 def energy_terms(y, q, qd, force, clock, acc, g, omega2, resid):
     """The terms of eq. (11) at t_n: (E_shock, E_g, E_p, KE_x, KE_y, KE_z, KE_rot) [J]
+    (E_in: `energy_in`)
     (KE_z = 0 in the plane). (Arrays, not the state tuples, but for the granular arrays g
     that tell the dimension: this runs every step.)"""
     kx, ky, kz, kr = kinetic_energies(y, g)
@@ -90,11 +95,18 @@ def energy_terms(y, q, qd, force, clock, acc, g, omega2, resid):
 
 
 @njit(cache=True)
+def energy_in(clock, eshock, acc):
+    """E_in of eq. (11) [J]: the energy at t = 0, the shock's work, and gravity's and the
+    drives' work (docs/model.md section 3.11)."""
+    return clock[E_ZERO] + eshock + (acc[A_GRAVITY] + acc[A_DRIVE])
+
+
+@njit(cache=True)
 def record(o, st, g, p, w, out):
     """Write the state at t_n into output row o and restart the interval maxima."""
     eshock, eg, ep, kx, ky, kz, kr = energy_terms(st.y, st.q, st.qd, st.force, st.clock, st.acc, g, p.omega2,
                                                   p.resid)
-    e_in = st.clock[E_ZERO] + eshock
+    e_in = energy_in(st.clock, eshock, st.acc)
     denom = max(st.clock[E_IN_MAX], 1e-300)
     out.t[o] = st.clock[T_NOW]
     for i in range(st.y.shape[0]):
@@ -114,6 +126,13 @@ def record(o, st, g, p, w, out):
     e[RESID] = energy_residual(energy_total(eg, ep, st.acc[A_VISC], st.acc[A_FRIC], st.acc[A_PLASTIC]), e_in, denom)
     e[RESID_MAX] = w.res_int[0]
     e[E_POTG] = st.clock[E_POT]
+    e[E_GRAVITY] = st.acc[A_GRAVITY]
+    e[E_DRIVE] = st.acc[A_DRIVE]
+    for w_ in range(g.wall_load.shape[0]):
+        out.wall_force[o, w_] = g.wall_load[w_]
+    for k in range(g.drive_target.shape[0]):
+        out.drive[o, k, 0] = g.drive_now[k, DR_F]
+        out.drive[o, k, 1] = drive_displacement(st.y, g, k)
     for m in range(st.q.shape[0]):
         out.q[o, m] = st.q[m]
         out.qd[o, m] = st.qd[m]
@@ -164,7 +183,7 @@ def check_energy(h, y, q, qd, force, clock, acc, g, omega2, resid, energy_tol, r
     res_int); returns OK, ERR_NAN or ERR_ENERGY (above energy_tol) with err filled.
     (Arrays, not the state tuples: this runs every step.)"""
     eshock, eg, ep, kx, ky, kz, kr = energy_terms(y, q, qd, force, clock, acc, g, omega2, resid)
-    e_in = clock[E_ZERO] + eshock
+    e_in = energy_in(clock, eshock, acc)
     if e_in > clock[E_IN_MAX]:
         clock[E_IN_MAX] = e_in
     total = energy_total(eg, ep, acc[A_VISC], acc[A_FRIC], acc[A_PLASTIC])
@@ -211,12 +230,14 @@ def accept_granular(t, h, land, t_out, plate_work, e_pot, st, w):
             st.y[i, c] = w.ynew[i, c]
             st.k0[i, c] = st.k1[i, c]
             st.k1[i, c] = w.kend[i, c]
-    for c in range(3):
+    for c in range(5):
         st.p1[c] = w.pend[c]
     st.acc[A_SHOCK_G] += w.dacc[0]
     st.acc[A_VISC] += w.dacc[1]
     st.acc[A_FRIC] += w.dacc[2]
     st.acc[A_PLASTIC] += w.dacc[3]
+    st.acc[A_GRAVITY] += w.dacc[4]
+    st.acc[A_DRIVE] += w.dacc[5]
     st.acc[A_SHOCK_P] += plate_work
     st.clock[E_POT] = e_pot
     st.clock[T_NOW] = t_out if land else t + h
@@ -288,6 +309,8 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
                                 cfg.rebuild_move, cfg.face_skin, cfg.dimension, st.err)
         if status != OK:
             return status
+        if g.wall_drive.shape[0] > 0 and cfg.rebuild_move > 0.0 and walls_moved(g, cfg.rebuild_move):
+            return REBUILD  # a driven wall moved as far as a granule may before the list is rebuilt
     return OK if st.clock[T_NOW] >= t_stop - 1e-9 * cfg.dt_min else PAUSED
 
 

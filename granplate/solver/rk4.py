@@ -8,6 +8,7 @@ from __future__ import annotations
 from numba import njit
 
 from granplate.solver.dimension import friction_flow, granular_rhs, plate_friction_held
+from granplate.solver.drives import hold_drives, wall_shift_energy
 
 #: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps h
 #: times the friction relaxation rate of every contact that RK4 integrates below this bound.
@@ -23,6 +24,10 @@ def no_granules_step(h, p1, dacc, pend, ovl_new, ovl_who):
         dacc[c] = h6 * (p1[c] + 2.0 * 0.0 + 2.0 * 0.0 + 0.0)
         pend[c] = 0.0
     dacc[3] = 0.0
+    dacc[4] = 0.0
+    dacc[5] = 0.0
+    pend[3] = 0.0
+    pend[4] = 0.0
     ovl_new[0] = 0.0
     ovl_who[0] = -1
     ovl_who[1] = -1
@@ -40,10 +45,11 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     Stage 1 reuses st.k1/st.p1 (first same as last), unless hold (the plate-contact
     friction held at w.fbar over the step; in the plane only, solver.dimension) or the
     split (the friction half step moves the velocities) changes it. Writes w.ynew,
-    w.kend (without the split friction), w.fnew
+    w.kend (without the split friction; with gravity and the drives, solver.drives), w.fnew
     (forces on the plate at t + h), w.normal_new, w.slip_new, w.pend (powers at t + h) and
     w.dacc (shock, viscous, friction work over the step, and the plastic work past the
-    contacts' largest overlaps, whose end overlaps go into their histories' HIST_END), w.ovl_new and w.ovl_who (the
+    contacts' largest overlaps, whose end overlaps go into their histories' HIST_END; the work of
+    gravity and of the drives), w.ovl_new and w.ovl_who (the
     largest relative overlap at t + h and its contact). Returns (stored contact energy at
     t + h [J], largest slip relaxation rate at t + h of a contact whose friction RK4
     integrates [1/s]: with cfg.split_friction the plate contacts unless hold, 0 with hold;
@@ -70,6 +76,8 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
         w.p1h[0] = pr.p_shock
         w.p1h[1] = pr.p_visc
         w.p1h[2] = pr.p_fric
+        w.p1h[3] = pr.p_drive
+        w.p1h[4] = pr.p_grav
         k1 = w.k1h
         p1 = w.p1h
     hh = 0.5 * h
@@ -98,12 +106,19 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     if split:  # friction over [t + h/2, t + h]
         fric_split += friction_flow(w.ynew, hh, g, cfg, False)
         w.dacc[2] += fric_split
+    # the drives' work (RK4's quadrature of their power, the impulse that gives the driven granules
+    # their prescribed velocity at t + h, the driven walls' elastic work exactly) and gravity's
+    w.dacc[5] = (h6 * (p1[3] + 2.0 * p2.p_drive + 2.0 * p3.p_drive + p4.p_drive) + hold_drives(t + h, w.ynew, g)
+                 + wall_shift_energy(st.y, w.ynew, g, cfg.clip, t, t + h))
+    w.dacc[4] = h6 * (p1[4] + 2.0 * p2.p_grav + 2.0 * p3.p_grav + p4.p_grav)
     pe = granular_rhs(t + h, w.ynew, stage[2], stage[3], g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar,
                       split, True)
     w.dacc[3] = pe.w_plastic
     w.pend[0] = pe.p_shock
     w.pend[1] = pe.p_visc
     w.pend[2] = pe.p_fric
+    w.pend[3] = pe.p_drive
+    w.pend[4] = pe.p_grav
     w.ovl_new[0] = pe.ovl
     w.ovl_who[0] = pe.ovl_i
     w.ovl_who[1] = pe.ovl_j

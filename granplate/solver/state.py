@@ -23,12 +23,15 @@ N_COUNT = 8
 # acc (float64): integrated powers, and the plastic work (docs/model.md eq. P10) booked
 # as each contact loaded past its largest overlap
 A_SHOCK_G, A_VISC, A_FRIC, A_SHOCK_P, A_PLASTIC = 0, 1, 2, 3, 4
-N_ACC = 5
+# the work of gravity and of the drives [J] (docs/model.md section 3.11), inputs of eq. (11)
+A_GRAVITY, A_DRIVE = 5, 6
+N_ACC = 7
 # energy output columns
 (
     E_SHOCK, E_GRAN, E_PLATE, D_VISC, D_FRIC, KE_X, KE_Y, KE_ROT, RESID, RESID_MAX, E_POTG, D_PLASTIC, KE_Z,
 ) = range(13)
-N_ENERGY = 13
+E_GRAVITY, E_DRIVE = 13, 14
+N_ENERGY = 15
 # step-statistics output columns
 S_STEPS, S_DT_MIN, S_DT_MAX, S_ITERS, S_RETRIES, S_LAM_MAX = range(6)
 N_STEPSTAT = 6
@@ -70,7 +73,7 @@ class State(NamedTuple):
     k1: np.ndarray  # (ng, 6) time derivative at t_n
     k0: np.ndarray  # (ng, 6) time derivative at t_n-1
     pforce: np.ndarray  # (nd,) the force the plate moved with over the last step
-    p1: np.ndarray  # (3,) shock, viscous, friction power at t_n
+    p1: np.ndarray  # (5,) shock, viscous, friction, drive, gravity power at t_n
     normal: np.ndarray  # (nk,) |N| at plate contacts
     slip: np.ndarray  # (nk,) tangential slip rate at plate contacts
     clock: np.ndarray
@@ -96,9 +99,10 @@ class Work(NamedTuple):
     stage: np.ndarray  # (4, nd) driving-DOF u, v at t + h/2 and u, v at t + h
     fnew: np.ndarray  # (nd,) interface forces at the end of the trial step
     fscratch: np.ndarray
-    pend: np.ndarray  # (3,) shock, viscous, friction power at the end
-    dacc: np.ndarray  # (4,) their integrals over the step, and the plastic work past the largest overlaps
-    p1h: np.ndarray  # (3,) stage-1 powers when the plate friction is held
+    pend: np.ndarray  # (5,) shock, viscous, friction, drive, gravity power at the end
+    dacc: np.ndarray  # (6,) the first three's integrals over the step, the plastic work past the largest
+    # overlaps, the work of gravity and of the drives (with their impulses)
+    p1h: np.ndarray  # (5,) stage-1 powers when the plate friction is held
     normal_new: np.ndarray  # (nk,) |N| and slip rate at the end of the trial step
     slip_new: np.ndarray
     nscratch: np.ndarray
@@ -137,6 +141,8 @@ class Output(NamedTuple):
     lam: np.ndarray  # (no, nk) max |lambda| over the interval ending here
     iters: np.ndarray  # (no, nk) max iterations to converge over the interval
     stats: np.ndarray  # (no, N_STEPSTAT)
+    wall_force: np.ndarray  # (no, n_walls) the normal force each wall receives [N]
+    drive: np.ndarray  # (no, n_drives, 2) each drive's force [N] and displacement [m] along its direction
 
 
 def new_state(ng: int, nm: int, nk: int, nc: int = 6) -> State:
@@ -146,7 +152,7 @@ def new_state(ng: int, nm: int, nk: int, nc: int = 6) -> State:
     return State(
         y=z((ng, nc)), acc=z(N_ACC), q=z(nm), qd=z(nm), qdd=z(nm), u=z(nd), v=z(nd),
         a=z(nd), force=z(nd), force_prev=z(nd), k1=z((ng, nc)), k0=z((ng, nc)), pforce=z(nd),
-        p1=z(3), normal=z(nk), slip=z(nk), clock=z(N_CLOCK),
+        p1=z(5), normal=z(nk), slip=z(nk), clock=z(N_CLOCK),
         count=np.zeros(N_COUNT, np.int64), err=z(N_ERR),
     )
 
@@ -159,7 +165,7 @@ def new_work(ng: int, nm: int, nk: int, n_face: int = 0, nc: int = 6) -> Work:
     return Work(
         ytmp=z((ng, nc)), ynew=z((ng, nc)), k1h=z((ng, nc)), k2=z((ng, nc)), k3=z((ng, nc)),
         k4=z((ng, nc)), kend=z((ng, nc)), up=z(nd), vp=z(nd), fguess=z(nd), fbar=z(nk),
-        stage=z((4, nd)), fnew=z(nd), fscratch=z(nd), pend=z(3), dacc=z(4), p1h=z(3),
+        stage=z((4, nd)), fnew=z(nd), fscratch=z(nd), pend=z(5), dacc=z(6), p1h=z(5),
         normal_new=z(nk), slip_new=z(nk), nscratch=z(nk), sscratch=z(nk),
         conv_iter=np.zeros(nk, np.int64), dmode=z((N_LEVELS + 1, nm)),
         gmat=z((N_LEVELS + 1, nd, nd)), g_ok=np.zeros(N_LEVELS + 1, np.int64),
@@ -170,8 +176,10 @@ def new_work(ng: int, nm: int, nk: int, n_face: int = 0, nc: int = 6) -> Work:
     )
 
 
-def new_output(times: np.ndarray, ng: int, nm: int, nk: int, nc: int = 6) -> Output:
-    """Output buffers for the given output times (nc state columns per granule)."""
+def new_output(times: np.ndarray, ng: int, nm: int, nk: int, nc: int = 6, n_walls: int = 0,
+               n_drives: int = 0) -> Output:
+    """Output buffers for the given output times (nc state columns per granule, n_walls
+    walls, n_drives drives)."""
     z = np.zeros
     n_out = len(times)
     return Output(
@@ -179,4 +187,5 @@ def new_output(times: np.ndarray, ng: int, nm: int, nk: int, nc: int = 6) -> Out
         energy=z((n_out, N_ENERGY)), q=z((n_out, nm)), qd=z((n_out, nm)),
         force=z((n_out, nk, 2)), slip=z((n_out, nk)), lam=z((n_out, nk)),
         iters=np.zeros((n_out, nk), np.int64), stats=z((n_out, N_STEPSTAT)),
+        wall_force=z((n_out, n_walls)), drive=z((n_out, n_drives, 2)),
     )

@@ -34,7 +34,7 @@ from granplate.solver.plate_modal import (
 )
 from granplate.solver.schemes.newton import held_friction, newton_update
 from granplate.solver.state import (
-    A_FRIC, A_PLASTIC, A_SHOCK_G, A_SHOCK_P, A_VISC, C_LEVEL, E_IN_MAX, E_ZERO, F_SCALE, H_LAST, N_LEVELS,
+    A_DRIVE, A_GRAVITY, A_FRIC, A_PLASTIC, A_SHOCK_G, A_SHOCK_P, A_VISC, C_LEVEL, E_IN_MAX, E_ZERO, F_SCALE, H_LAST, N_LEVELS,
     RES_LAST,
 )
 
@@ -188,7 +188,8 @@ def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
     fric_work = held_friction_work(st, g, cfg, w)
     work, ep_new = exact_correct(t, h, st, p, cfg, sw.mcoef[slot], w.fguess, sw.qn, sw.qdn)
     kx, ky, kz, kr = kinetic_energies(w.ynew, g)
-    e_in = st.clock[E_ZERO] + st.acc[A_SHOCK_G] + w.dacc[0] + st.acc[A_SHOCK_P] + work
+    e_in = (st.clock[E_ZERO] + st.acc[A_SHOCK_G] + w.dacc[0] + st.acc[A_SHOCK_P] + work
+            + (st.acc[A_GRAVITY] + w.dacc[4] + st.acc[A_DRIVE] + w.dacc[5]))
     total = (kx + ky + kz + kr + e_pot + ep_new + st.acc[A_VISC] + w.dacc[1]
              + st.acc[A_FRIC] + w.dacc[2] + fric_work + st.acc[A_PLASTIC] + w.dacc[3])
     denom = max(st.clock[E_IN_MAX], e_in)

@@ -16,7 +16,12 @@ One step t -> t + h (fixed h = time.dt_max, cut to land on the output times):
 The work of each kick is booked exactly as the kinetic energy it adds: h/2 F v_mean for
 the damping part of the force (D_visc) and the load (E_shock; a line load on the elastic
 body kicks its modes the same way, at t_n and t_n + h), so eq. (11)'s residual is
-Verlet's own energy error, O(h^2), which the loop checks at every step.
+Verlet's own energy error, O(h^2), which the loop checks at every step. Gravity and the
+drives (solver.drives) join each force pass; the drive forces' kicks are booked the same
+way (gravity's too), a driven wall's elastic work exactly (the change of its contacts'
+energy as it moves), the damping at its velocity by the trapezoidal rule over the step
+(in the drive's work and in D_visc alike), and the impulse that gives a driven granule
+its prescribed velocity at t + h as the kinetic energy it adds.
 """
 from __future__ import annotations
 
@@ -30,6 +35,8 @@ from granplate.physics.contact import COEF_MU
 from granplate.physics.shock import time_profile
 from granplate.solver import body as B
 from granplate.solver.dimension import friction_flow, normal_forces
+from granplate.solver.drives import (drive_kick_work, finish_pass, gravity_kick_work, hold_drives, wall_powers,
+                                    wall_shift_energy)
 from granplate.solver.granular import commit_history
 from granplate.solver.ladder import step_to_output
 from granplate.solver.state import E_STATIC, PARTNER_PLATE
@@ -187,6 +194,8 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
         normal_forces(t, st.y, g, cfg, st.k1, sw.fdamp[cur], sw.fload[cur])
         if body:
             body_pass(st.y, sw, cur, st.q, st.qd, g, cfg, st.k1, sw.fdamp)
+        finish_pass(st.y, st.k1, g)
+    _, pd0 = wall_powers(g)  # the damping power at the driven walls' velocities at t_n
     hk = 0.5 * h
     friction = has_friction(g) or (body and body_friction(b))
     forward = sw.split[FORWARD] != 0.0
@@ -196,6 +205,8 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
         if body:
             fric += B.friction_flow(y, b.qd, sw.split[OWED] + hk, b, cur, g.radius, g.mass, g.inertia,
                                     cfg.arm_shrink, forward)
+    w_drive = drive_kick_work(y, st.k1, g, hk)
+    w_grav = gravity_kick_work(y, st.k1, g, hk)
     wl, wd = kick_drift(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp)
     if body:
         if cfg.load_on_plate:
@@ -219,6 +230,10 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
             ovl = ovl_b
             ovl_i = i_b
             ovl_j = PARTNER_BODY
+    finish_pass(w.ytmp, w.kend, g)  # gravity and the drives
+    _, pd1 = wall_powers(g)
+    w_drive += drive_kick_work(y, w.kend, g, hk)
+    w_grav += gravity_kick_work(y, w.kend, g, hk)
     wl2, wd2 = kick(y, w.kend, sw.fdamp[nxt], sw.fload[nxt], hk, w.kend)
     if body:
         wd2 += B.kick(b.qd, b.fmodal[nxt], b.fdamp[nxt], hk)
@@ -228,10 +243,16 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
         fric += friction_flow(y, hk, g, cfg, not forward)
         if body:
             fric += B.friction_flow(y, b.qd, hk, b, nxt, g.radius, g.mass, g.inertia, cfg.arm_shrink, not forward)
+    # the granules' drives' impulses; the walls' elastic work (exact) and their damping's (booked in D too)
+    w_drive += hold_drives(t + h, y, g) + wall_shift_energy(st.y, y, g, cfg.clip, t, t + h) + hk * (pd0 + pd1)
     w.dacc[0] = wl + wl2
-    w.dacc[1] = -(wd + wd2)
+    w.dacc[1] = -(wd + wd2) + hk * (pd0 + pd1)  # (a driven wall: the damping at the relative velocity)
     w.dacc[2] = fric
     w.dacc[3] = w_plastic
+    w.dacc[4] = w_grav
+    w.dacc[5] = w_drive
+    w.pend[3] = 0.0
+    w.pend[4] = 0.0
     w.pend[0] = pr.p_shock
     if body and cfg.load_on_plate:  # the body's load's power at t + h [W]
         w.pend[0] += cfg.q0 * time_profile(t + h, cfg.duration) * np.dot(b.load, b.qd)

@@ -1,0 +1,204 @@
+"""Checks of [gravity] and [[drives]] (docs/scenario.md, sections "Gravity" and "Drives"):
+each raises ScenarioError(field, value, allowed) before anything runs. The one owner of
+the rules a drive's fields obey; `validate` calls `check_gravity` and `check_drives` on
+the resolved scenario.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from granplate.errors import ScenarioError
+from granplate.setup.fields import closest_name, finite, is_number, string_in
+from granplate.setup.scenario import (
+    DRIVE_KINDS,
+    DRIVE_PROFILES,
+    DRIVE_TARGETS,
+    Drive,
+    Scenario,
+)
+
+#: the largest |g| [m/s^2] a scenario may ask for (a centrifuge's 10^5 g)
+GRAVITY_MAX = 1e6
+#: a drive's direction must have unit length within this
+UNIT_TOL = 1e-9
+#: a harmonic drive's period must hold at least this many of the scheme's largest steps
+STEPS_PER_PERIOD = 20
+#: the fields each profile reads (every other field of the drive must keep its default)
+PROFILE_FIELDS: dict[str, tuple[str, ...]] = {
+    "constant": ("value",),
+    "ramp": ("value", "duration"),
+    "half-sine": ("amplitude", "duration"),
+    "harmonic": ("value", "amplitude", "frequency"),
+    "table": ("times", "values"),
+}
+_DEFAULTS = {"value": 0.0, "amplitude": 0.0, "frequency": 0.0, "duration": 0.0, "times": (), "values": ()}
+
+
+def granule_labels(s: Scenario) -> list[str]:
+    """Each granule's label as results name it (its label, or its 1-based index)."""
+    return [g.label or str(i + 1) for i, g in enumerate(s.granules)]
+
+
+def check_gravity(s: Scenario) -> None:
+    """[gravity] g: one finite component per dimension, |g| <= GRAVITY_MAX, and no plate
+    (the elastic body's own weight is not modelled yet: its static sag would have to be
+    taken out of the contacts at t = 0)."""
+    if s.gravity is None:
+        return
+    g = s.gravity.g
+    names = "[gx, gy]" if s.dimension == 2 else "[gx, gy, gz]"
+    if not isinstance(g, tuple) or len(g) != s.dimension or not all(is_number(c) and math.isfinite(c) for c in g):
+        raise ScenarioError("gravity.g", list(g) if isinstance(g, tuple) else g,
+                            f"must be {s.dimension} finite numbers {names} [m/s^2] (dimension = {s.dimension})")
+    if not math.hypot(*g) <= GRAVITY_MAX:
+        raise ScenarioError("gravity.g", list(g), f"allowed |g| <= {GRAVITY_MAX:g} m/s^2")
+    if s.plate is not None:
+        raise ScenarioError("gravity.g", list(g), "gravity acts on the granules alone: a scenario with a [plate] "
+                            "cannot have it yet (the plate's own weight, and the static sag it would start "
+                            "from, are not modelled); leave out [gravity] or the [plate]")
+
+
+def check_drives(s: Scenario, step_max: float, wave_speed: float) -> None:
+    """Every [[drives]] entry of the resolved scenario s: its target (a known wall or
+    granule, driven once), kind, direction (a unit vector; a wall's along its normal),
+    profile and the fields that profile reads (and no other), the peak speed it asks for
+    below `wave_speed` [m/s] (Hertz's law is quasi-static), a harmonic's period at least
+    STEPS_PER_PERIOD steps of `step_max` [s]."""
+    seen: dict[str, int] = {}
+    for k, d in enumerate(s.drives):
+        p = f"drives[{k}]"
+        if not isinstance(d, Drive):
+            raise ScenarioError(p, d, "must be a table of a drive's fields")
+        kind, index = drive_target(s, p, d.target)
+        if d.target in seen:
+            raise ScenarioError(f"{p}.target", d.target, f"drives[{seen[d.target]}] drives it already; "
+                                "a body takes one drive")
+        seen[d.target] = k
+        string_in(f"{p}.kind", d.kind, DRIVE_KINDS)
+        direction = _unit(f"{p}.direction", d.direction, s.dimension)
+        if kind == "wall":
+            _wall_drive(p, d, s.walls[index], direction)
+        string_in(f"{p}.profile", d.profile, DRIVE_PROFILES)
+        _profile_fields(p, d)
+        _profile_values(p, d, step_max, wave_speed)
+        if not isinstance(d.label, str):
+            raise ScenarioError(f"{p}.label", d.label, "must be a string")
+
+
+def drive_target(s: Scenario, p: str, target: Any) -> tuple[str, int]:
+    """("wall" or "granule", its index in the resolved scenario) of a drive's target
+    "wall LABEL" or "granule LABEL"."""
+    parts = target.split(None, 1) if isinstance(target, str) else []
+    if len(parts) != 2 or parts[0] not in DRIVE_TARGETS:
+        raise ScenarioError(f"{p}.target", target, "must be \"wall LABEL\" or \"granule LABEL\" (the label of a "
+                            "[[walls]] or [[granules]] entry)")
+    kind, label = parts[0], parts[1].strip()
+    labels = [w.label for w in s.walls] if kind == "wall" else granule_labels(s)
+    if label not in labels:
+        near = closest_name(label, labels)
+        hint = f" (did you mean '{kind} {near}'?)" if near else ""
+        known = ", ".join(repr(x) for x in labels[:12]) + (", ..." if len(labels) > 12 else "")
+        raise ScenarioError(f"{p}.target", target, f"no {kind} is labelled {label!r}{hint}; the {kind}s' labels: "
+                            + (known or "none"))
+    return kind, labels.index(label)
+
+
+def _unit(path: str, v: Any, dimension: int) -> tuple[float, ...]:
+    """A direction of `dimension` finite components and unit length (within UNIT_TOL)."""
+    if (not isinstance(v, tuple) or len(v) != dimension
+            or not all(is_number(c) and math.isfinite(c) for c in v)):
+        raise ScenarioError(path, list(v) if isinstance(v, tuple) else v,
+                            f"must be {dimension} finite numbers (a unit vector; dimension = {dimension})")
+    norm = math.hypot(*v)
+    if abs(norm - 1.0) > UNIT_TOL:
+        raise ScenarioError(path, list(v), f"must be a unit vector (|direction| = {norm:.12g}; allowed 1 "
+                            f"within {UNIT_TOL:g})")
+    return v
+
+
+def _wall_drive(p: str, d: Drive, wall, direction: tuple[float, ...]) -> None:
+    """A wall is moved, never pushed (it has no mass), along its own normal (sliding a
+    plane along itself would change only friction, which a moving wall does not carry)."""
+    if d.kind == "force":
+        raise ScenarioError(f"{p}.kind", d.kind, "a wall has no mass: it takes a \"displacement\" or \"velocity\" "
+                            "drive; to push with a force, drive a granule (a piston)")
+    n = [float(c) for c in wall.normal]
+    norm = math.hypot(*n)
+    cos = sum(a * b for a, b in zip(n, direction)) / norm
+    if abs(abs(cos) - 1.0) > UNIT_TOL:
+        raise ScenarioError(f"{p}.direction", list(direction), f"a wall moves along its normal: allowed "
+                            f"{[c / norm for c in n]} or its opposite (wall {wall.label!r})")
+
+
+def _profile_fields(p: str, d: Drive) -> None:
+    """The fields the profile reads are numbers of the right kind; the others keep their
+    defaults (a field the profile would ignore is refused, not silently dropped)."""
+    used = PROFILE_FIELDS[d.profile]
+    if d.file is not None:
+        raise ScenarioError(f"{p}.file", d.file, "is read when the scenario is loaded from TOML (setup.io); a "
+                            "Drive built in Python gives times and values instead")
+    for name, default in _DEFAULTS.items():
+        value = getattr(d, name)
+        if name not in used and value != default and not (name in ("times", "values") and value == ()):
+            raise ScenarioError(f"{p}.{name}", value, f"not read by profile {d.profile!r}, which reads "
+                                + ", ".join(used))
+    for name in used:
+        if name in ("times", "values"):
+            continue
+        finite(f"{p}.{name}", getattr(d, name))
+
+
+def _profile_values(p: str, d: Drive, step_max: float, wave_speed: float) -> None:
+    """Durations and frequencies in range, the table's times increasing, and the peak
+    speed the drive asks for below the wave speed."""
+    speed = 0.0  # the largest speed [m/s] a motion drive asks for
+    if d.profile in ("ramp", "half-sine"):
+        if not d.duration > 0.0:
+            raise ScenarioError(f"{p}.duration", d.duration, "must be > 0 [s]")
+    if d.profile == "constant":
+        speed = abs(d.value) if d.kind == "velocity" else 0.0
+    elif d.profile == "ramp":
+        speed = abs(d.value) if d.kind == "velocity" else abs(d.value) / d.duration
+    elif d.profile == "half-sine":
+        speed = abs(d.amplitude) * (1.0 if d.kind == "velocity" else math.pi / d.duration)
+    elif d.profile == "harmonic":
+        f_max = 1.0 / (STEPS_PER_PERIOD * step_max)
+        if not 0.0 < d.frequency <= f_max:
+            raise ScenarioError(f"{p}.frequency", d.frequency, f"allowed 0 < frequency <= {f_max:.6g} Hz (a period "
+                                f"of at least {STEPS_PER_PERIOD} steps of {step_max:g} s)")
+        if d.kind == "velocity":
+            speed = abs(d.value) + abs(d.amplitude)
+        else:
+            speed = 2.0 * math.pi * d.frequency * abs(d.amplitude)
+    else:
+        speed = _table_speed(p, d)
+    if d.kind != "force" and not speed < wave_speed:
+        field = {"constant": "value", "ramp": "value", "half-sine": "amplitude", "harmonic": "amplitude",
+                 "table": "values"}[d.profile]
+        raise ScenarioError(f"{p}.{field}", getattr(d, field), f"asks for a speed of {speed:.6g} m/s; allowed "
+                            f"below {wave_speed:.6g} m/s, the slowest elastic wave speed sqrt(E / rho) of the "
+                            "materials (Hertz's law is quasi-static)")
+
+
+def _table_speed(p: str, d: Drive) -> float:
+    """A table's checks (two or more points, finite, times >= 0 and increasing) and the
+    largest speed it asks for [m/s]."""
+    t, v = d.times, d.values
+    for name, xs in (("times", t), ("values", v)):
+        if not isinstance(xs, tuple) or not all(is_number(x) and math.isfinite(x) for x in xs):
+            raise ScenarioError(f"{p}.{name}", xs, "must be a list of finite numbers")
+    if len(t) < 2 or len(t) != len(v):
+        raise ScenarioError(f"{p}.times", list(t), f"must hold two or more times, as many as values "
+                            f"({len(t)} times, {len(v)} values)")
+    if t[0] < 0.0:
+        raise ScenarioError(f"{p}.times", list(t), "must start at t >= 0 [s]")
+    for a, (t0, t1) in enumerate(zip(t[:-1], t[1:])):
+        if not t1 > t0:
+            raise ScenarioError(f"{p}.times", list(t), f"must increase: times[{a + 1}] = {t1!r} is not after "
+                                f"times[{a}] = {t0!r}")
+    if d.kind == "velocity":
+        return max(abs(x) for x in v)
+    if d.kind == "displacement":
+        return max(abs(v1 - v0) / (t1 - t0) for t0, t1, v0, v1 in zip(t[:-1], t[1:], v[:-1], v[1:]))
+    return 0.0

@@ -1,0 +1,243 @@
+"""Gravity and drives in the time loop (docs/model.md section 3.11), in either dimension
+(the translational velocity columns start at 3 in both; d = the directions' length).
+
+Every force pass (the RK4 derivative, the Verlet force pass) starts with `begin_pass`
+(the drives' motion at its time, the walls' loads zeroed), lets the wall contacts use
+their wall's motion (`wall_motion`) and book their forces (`book_wall`), and ends with
+`finish_pass`: gravity on every granule, and on each driven granule the force that gives
+it its prescribed acceleration along the direction (or the prescribed force), which is
+the force the drive applies, recorded with its power. After a step, `hold_drives` sets a
+driven granule's velocity along its direction to the prescribed one (the drive's
+impulse, its work booked); the schemes book the drives' work and gravity's (RK4's
+quadrature of their powers; Verlet's kicks, `drive_kick_work`, `gravity_kick_work`).
+"""
+from __future__ import annotations
+
+from numba import njit
+
+from granplate.model.inputs import DR_A, DR_F, DR_P, DR_PD, DR_REF, DR_S, DR_V, HIST_MAX
+from granplate.physics.drives import KIND_FORCE, drive_motion
+from granplate.physics.laws import normal_law_response
+
+#: the first velocity column of a granule's state (both dimensions)
+V0 = 3
+
+
+@njit(cache=True)
+def begin_pass(t, g):
+    """The drives' motion at t [s] into drive_now (DR_S, DR_V, DR_A; a force drive's
+    force in DR_A), their forces and powers zeroed, and the walls' loads zeroed."""
+    for w in range(g.wall_load.shape[0]):
+        g.wall_load[w] = 0.0
+    for k in range(g.drive_target.shape[0]):
+        s, v, a = drive_motion(t, g.drive_kind[k], g.drive_prof[k], g.drive_par[k], g.drive_tab[k],
+                               g.drive_tlen[k])
+        now = g.drive_now[k]
+        now[DR_S] = s
+        now[DR_V] = v
+        now[DR_A] = a
+        now[DR_F] = 0.0
+        now[DR_P] = 0.0
+        now[DR_PD] = 0.0
+
+
+@njit(cache=True)
+def wall_normal_dot(g, w, k):
+    """n . e of wall contact w's outward normal n and drive k's direction e (+-1)."""
+    ne = 0.0
+    for c in range(g.drive_dir.shape[1]):
+        ne += g.wall_geo[w, c] * g.drive_dir[k, c]
+    return ne
+
+
+@njit(cache=True)
+def wall_motion(g, w):
+    """(the shift of wall contact w's offset [m], its wall's velocity along the outward
+    normal [m/s], its drive or -1) at the last `begin_pass`."""
+    if g.wall_drive.shape[0] == 0:
+        return 0.0, 0.0, -1
+    k = g.wall_drive[g.wall_w[w]]
+    if k < 0:
+        return 0.0, 0.0, -1
+    ne = wall_normal_dot(g, w, k)
+    return g.drive_now[k, DR_S] * ne, g.drive_now[k, DR_V] * ne, k
+
+
+@njit(cache=True)
+def book_wall(g, w, k, n, damp):
+    """Wall contact w's normal force n [N] (its damping part damp [N]) on its wall's load
+    and, for a driven wall (drive k >= 0), on the force the drive applies along its
+    direction (the contact forces on the granules, -n n . e) and on the damping forces'
+    power at the wall's velocity [W]."""
+    if g.wall_load.shape[0] > 0:
+        g.wall_load[g.wall_w[w]] += n
+    if k >= 0:
+        ne = wall_normal_dot(g, w, k)
+        g.drive_now[k, DR_F] -= n * ne
+        g.drive_now[k, DR_PD] -= damp * g.drive_now[k, DR_V] * ne
+
+
+@njit(cache=True)
+def along(a, i, g, k):
+    """The component of row i of the state (or derivative) a's velocity columns along
+    drive k's direction."""
+    x = 0.0
+    for c in range(g.drive_dir.shape[1]):
+        x += a[i, V0 + c] * g.drive_dir[k, c]
+    return x
+
+
+@njit(cache=True)
+def finish_pass(y, acc, g):
+    """End a force pass at state y with the accelerations acc (every other force in):
+    gravity on every granule; each driven granule's acceleration along its direction
+    made the prescribed one (or the prescribed force added), the force that takes
+    (mass x the acceleration it changes) and its power recorded; a driven wall's power.
+    Returns (the power of the granules' drives and of the contact damping forces at the
+    driven walls' velocities, gravity's power) [W]."""
+    ng = y.shape[0]
+    p_grav = 0.0
+    for c in range(g.gravity.shape[0]):
+        gc = g.gravity[c]
+        for i in range(ng):
+            acc[i, V0 + c] += gc
+            p_grav += g.mass[i] * gc * y[i, V0 + c]
+    power = 0.0
+    for k in range(g.drive_target.shape[0]):
+        now = g.drive_now[k]
+        i = g.drive_target[k]
+        if i >= 0:
+            m = g.mass[i]
+            if g.drive_kind[k] == KIND_FORCE:
+                da = now[DR_A] / m
+            else:
+                da = now[DR_A] - along(acc, i, g, k)
+            for c in range(g.drive_dir.shape[1]):
+                acc[i, V0 + c] += da * g.drive_dir[k, c]
+            now[DR_F] = m * da
+            now[DR_P] = now[DR_F] * along(y, i, g, k)
+            power += now[DR_P]
+        else:  # a wall: its elastic work is booked exactly (`wall_shift_energy`), its damping's here
+            now[DR_P] = now[DR_F] * now[DR_V]
+            power += now[DR_PD]
+    return power, p_grav
+
+
+@njit(cache=True)
+def hold_drives(t, y, g):
+    """Each granule under a displacement or velocity drive: its velocity along the
+    direction set to the prescribed one at t [s] (the drive's impulse). Returns its work,
+    the kinetic energy it adds [J]."""
+    work = 0.0
+    for k in range(g.drive_target.shape[0]):
+        i = g.drive_target[k]
+        if i < 0 or g.drive_kind[k] == KIND_FORCE:
+            continue
+        _, v, _ = drive_motion(t, g.drive_kind[k], g.drive_prof[k], g.drive_par[k], g.drive_tab[k], g.drive_tlen[k])
+        dv = v - along(y, i, g, k)
+        if dv == 0.0:
+            continue
+        v_old = along(y, i, g, k)
+        for c in range(g.drive_dir.shape[1]):
+            y[i, V0 + c] += dv * g.drive_dir[k, c]
+        work += 0.5 * g.mass[i] * (v * v - v_old * v_old)
+    return work
+
+
+@njit(cache=True)
+def gravity_kick_work(y, acc, g, hk):
+    """The work of gravity over a Verlet half kick of hk [s] from velocities y with
+    accelerations acc: hk m g . (v + hk a / 2) [J], the kinetic energy its share of the
+    kick adds."""
+    work = 0.0
+    for c in range(g.gravity.shape[0]):
+        gc = g.gravity[c]
+        for i in range(y.shape[0]):
+            work += hk * g.mass[i] * gc * (y[i, V0 + c] + 0.5 * hk * acc[i, V0 + c])
+    return work
+
+
+@njit(cache=True)
+def drive_kick_work(y, acc, g, hk):
+    """The work of the driven granules' drive forces (drive_now DR_F) over a Verlet half
+    kick of hk [s] from velocities y with accelerations acc: hk F (v + hk a / 2) along
+    each direction [J], the kinetic energy the force's share of the kick adds."""
+    work = 0.0
+    for k in range(g.drive_target.shape[0]):
+        i = g.drive_target[k]
+        if i >= 0:
+            work += hk * g.drive_now[k, DR_F] * (along(y, i, g, k) + 0.5 * hk * along(acc, i, g, k))
+    return work
+
+
+@njit(cache=True)
+def wall_powers(g):
+    """(the driven walls' power F v [W], the contact damping forces' power at their
+    velocity [W]) at the last force pass."""
+    p = 0.0
+    pd = 0.0
+    for k in range(g.drive_target.shape[0]):
+        if g.drive_target[k] < 0:
+            p += g.drive_now[k, DR_P]
+            pd += g.drive_now[k, DR_PD]
+    return p, pd
+
+
+@njit(cache=True)
+def walls_moved(g, limit):
+    """Whether a driven wall moved farther than limit [m] since the contact list was
+    built (drive_now DR_REF, set by the driver)."""
+    for k in range(g.drive_target.shape[0]):
+        if g.drive_target[k] < 0 and abs(g.drive_now[k, DR_S] - g.drive_now[k, DR_REF]) > limit:
+            return True
+    return False
+
+
+@njit(cache=True)
+def drive_displacement(y, g, k):
+    """Drive k's displacement along its direction [m]: its granule's centre from t = 0
+    (the state y), or its wall's prescribed displacement."""
+    i = g.drive_target[k]
+    if i < 0:
+        return g.drive_now[k, DR_S]
+    x = 0.0
+    for c in range(g.drive_dir.shape[1]):
+        x += (y[i, c] - g.drive_x0[k, c]) * g.drive_dir[k, c]
+    return x
+
+
+@njit(cache=True)
+def wall_contact_energy(y, g, w, k, clip, t):
+    """The stored energy [J] of wall contact w (driven by drive k) with the granule at
+    state y and the wall where it is at t [s] (the overlap as the force passes compute
+    it, to the last bit: physics.contact.wall_overlap)."""
+    d = g.drive_dir.shape[1]
+    i = g.wall_i[w]
+    xn = 0.0
+    for c in range(d):
+        xn += y[i, c] * g.wall_geo[w, c]
+    s, _, _ = drive_motion(t, g.drive_kind[k], g.drive_prof[k], g.drive_par[k], g.drive_tab[k], g.drive_tlen[k])
+    delta = xn + g.radius[i] - (g.wall_geo[w, d] + s * wall_normal_dot(g, w, k))
+    if delta <= 0.0:
+        return 0.0
+    _, _, ep, _ = normal_law_response(delta, 0.0, g.wall_coef[w], g.wall_hist[w, HIST_MAX], clip)
+    return ep
+
+
+@njit(cache=True)
+def wall_shift_energy(y0, y1, g, clip, t0, t1):
+    """The elastic work of the driven walls over a step from t0 to t1 [s], in which the
+    granules move from state y0 to y1: the change of their contacts' stored energy as each
+    wall moves from where it is at t0 to where it is at t1, the granules held at y0 and at
+    y1 in turn, averaged (the symmetric split of the stored energy's change between the
+    walls' moves and the granules', second order in the step)."""
+    if g.wall_drive.shape[0] == 0:
+        return 0.0
+    work = 0.0
+    for w in range(g.wall_i.shape[0]):
+        k = g.wall_drive[g.wall_w[w]]
+        if k < 0:
+            continue
+        work += 0.5 * (wall_contact_energy(y1, g, w, k, clip, t1) - wall_contact_energy(y1, g, w, k, clip, t0)
+                       + wall_contact_energy(y0, g, w, k, clip, t1) - wall_contact_energy(y0, g, w, k, clip, t0))
+    return work
