@@ -259,7 +259,8 @@ def _drive_table_file(path: str, d: Drive, base: str | os.PathLike | None) -> Dr
     times and values."""
     if d.times or d.values:
         raise ScenarioError(f"{path}.file", d.file, "give either a file or times and values, not both")
-    name = os.path.join(base, d.file) if base is not None and not os.path.isabs(d.file) else d.file
+    given = str(d.file)
+    name = os.path.join(os.fspath(base), given) if base is not None and not os.path.isabs(given) else given
     try:
         with open(name, encoding="utf-8") as f:
             lines = [ln.strip() for ln in f if ln.strip() and not ln.lstrip().startswith("#")]

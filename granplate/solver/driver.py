@@ -277,7 +277,7 @@ class LoopArrays:
     this run's own), the state, the shared and the scheme's scratch and the outputs."""
 
     def __init__(self, model: Model, times: np.ndarray, nk: int):
-        p, cfg = model.plate_arrays, model.config
+        g, p, cfg = model.granular, model.plate_arrays, model.config
         ng, nm = model.n_granules, len(p.omega2)
         nc = S.STATE_COLUMNS[cfg.dimension]
         self.p = p._replace(phi_d=p.phi_d.copy(), resid=p.resid.copy()) if cfg.face_skin > 0.0 else p
