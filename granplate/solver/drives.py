@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from granplate.model.inputs import DR_A, DR_F, DR_P, DR_PD, DR_REF, DR_S, DR_V, HIST_MAX
+from granplate.model.inputs import DR_A, DR_F, DR_P, DR_PD, DR_REF, DR_S, DR_V, HIST_MAX, HIST_RATE
 from granplate.physics.drives import KIND_FORCE, drive_motion
 from granplate.physics.laws import normal_law_response
 
@@ -220,7 +220,8 @@ def wall_contact_energy(y, g, w, k, clip, t):
     delta = xn + g.radius[i] - (g.wall_geo[w, d] + s * wall_normal_dot(g, w, k))
     if delta <= 0.0:
         return 0.0
-    _, _, ep, _ = normal_law_response(delta, 0.0, g.wall_coef[w], g.wall_hist[w, HIST_MAX], clip)
+    _, _, ep, _ = normal_law_response(delta, 0.0, g.wall_coef[w], g.wall_hist[w, HIST_MAX],
+                                      g.wall_hist[w, HIST_RATE], clip)
     return ep
 
 
