@@ -4,6 +4,7 @@ Build it with ``python -m sphinx -W --keep-going -b html docs docs/_build/html``
 (``python -m pip install ".[docs]"`` first). Why Sphinx + the PyData theme + MyST is said
 in docs/about-docs.md.
 """
+
 from __future__ import annotations
 
 import os
@@ -38,7 +39,13 @@ extensions = [
 source_suffix = {".md": "myst-nb", ".ipynb": "myst-nb"}
 root_doc = "index"
 exclude_patterns = [
-    "_build", "_generated_src", "studies", "examples", "Thumbs.db", ".DS_Store", "**.ipynb_checkpoints",
+    "_build",
+    "_generated_src",
+    "studies",
+    "examples",
+    "Thumbs.db",
+    ".DS_Store",
+    "**.ipynb_checkpoints",
 ]
 # warnings are errors (-W) and every cross-reference must resolve
 nitpicky = True

@@ -9,6 +9,7 @@ Data flow: Scenario -> Model (arrays) -> compiled time loop -> xarray Dataset ->
     >>> ds = gp.simulate(s, t_end=2e-4)
     >>> gp.summary(ds)["ep_max_fraction"]
 """
+
 from __future__ import annotations
 
 from granplate.version import __version__  # noqa: E402,F401
@@ -16,16 +17,49 @@ from granplate.version import __version__  # noqa: E402,F401
 from granplate.errors import GranplateError, ScenarioError, SimulationError  # noqa: E402
 from granplate.setup.materials import LIBRARY, Material  # noqa: E402
 from granplate.setup.scenario import (  # noqa: E402
-    Contact, Granule, Layout, Load, PairCoefficients, Plate, Scenario, Solver, TimeSettings, Wall,
+    Contact,
+    Granule,
+    Layout,
+    Load,
+    PairCoefficients,
+    Plate,
+    Scenario,
+    Solver,
+    TimeSettings,
+    Wall,
 )
 
 #: The public API: the names above, and those loaded on first use below.
 __all__ = [
-    "__version__", "GranplateError", "ScenarioError", "SimulationError", "LIBRARY", "Material",
-    "Contact", "Granule", "Layout", "Load", "PairCoefficients", "Plate", "Scenario", "Solver",
-    "TimeSettings", "Wall",
-    "simulate", "build_model", "preset", "preset_names", "load_scenario", "loads", "dumps", "load",
-    "dump", "with_changes", "write", "read", "summary",
+    "__version__",
+    "GranplateError",
+    "ScenarioError",
+    "SimulationError",
+    "LIBRARY",
+    "Material",
+    "Contact",
+    "Granule",
+    "Layout",
+    "Load",
+    "PairCoefficients",
+    "Plate",
+    "Scenario",
+    "Solver",
+    "TimeSettings",
+    "Wall",
+    "simulate",
+    "build_model",
+    "preset",
+    "preset_names",
+    "load_scenario",
+    "loads",
+    "dumps",
+    "load",
+    "dump",
+    "with_changes",
+    "write",
+    "read",
+    "summary",
 ]
 
 
@@ -33,17 +67,22 @@ def __getattr__(name: str):
     # heavy modules (numba, scikit-fem, xarray) load on first use
     if name in ("simulate",):
         from granplate.results.run import simulate
+
         return simulate
     if name in ("build_model",):
         from granplate.model.arrays import build_model
+
         return build_model
     if name in ("preset", "preset_names"):
         from granplate.setup import presets
+
         return getattr(presets, name)
     if name in ("load_scenario", "loads", "dumps", "load", "dump", "with_changes"):
         from granplate.setup import io as scenario_io
+
         return getattr(scenario_io, name)
     if name in ("write", "read", "summary"):
         from granplate.results import dataset
+
         return getattr(dataset, name)
     raise AttributeError(f"module 'granplate' has no attribute {name!r}")

@@ -5,6 +5,7 @@ A user's mistake (bad scenario, unknown preset, missing file) prints one clear l
 exits with status 2, never a traceback; a run that goes numerically wrong prints why,
 keeps what it computed (written to -o) and exits with status 3.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -23,10 +24,10 @@ from granplate.setup.fields import positive
 #: `func(args) -> int` runs the command (ScenarioError is reported as a user error).
 COMMAND_MODULES = (
     "granplate.paper.reproduce",  # reproduce, plot, animate, export
-    "granplate.figures.cli",    # show
-    "granplate.verification",   # verify
-    "granplate.study.cli",      # sweep, optimize
-    "granplate.bench.cli",      # bench
+    "granplate.figures.cli",  # show
+    "granplate.verification",  # verify
+    "granplate.study.cli",  # sweep, optimize
+    "granplate.bench.cli",  # bench
     "granplate.commands.resolve",  # resolve
 )
 
@@ -77,8 +78,14 @@ def reference_name(summary: dict) -> str:
 
 
 #: The fractions of the summary (shares of e_in) and their names in a note.
-SHARES = ("ep_max_fraction", "ep_final_fraction", "eg_max_fraction", "eg_final_fraction",
-          "dissipated_fraction", "plastic_fraction")
+SHARES = (
+    "ep_max_fraction",
+    "ep_final_fraction",
+    "eg_max_fraction",
+    "eg_final_fraction",
+    "dissipated_fraction",
+    "plastic_fraction",
+)
 
 
 def summary_notes(summary: dict) -> list[str]:
@@ -87,15 +94,20 @@ def summary_notes(summary: dict) -> list[str]:
     notes = []
     taken = summary.get("e_load_taken") or 0.0
     if not _negligible(summary, "e_load_taken") and taken > 0:
-        notes.append(f"note: the load put in E_shock = {summary['e_shock']:.4e} J and took {taken:.4e} J back: "
-                     f"its force opposed the velocity of granules moving toward it (negative power F . v), so "
-                     f"the energies at t_end add up to E_in - {taken:.4e} J = {summary['e_in'] - taken:.4e} J.")
+        notes.append(
+            f"note: the load put in E_shock = {summary['e_shock']:.4e} J and took {taken:.4e} J back: "
+            f"its force opposed the velocity of granules moving toward it (negative power F . v), so "
+            f"the energies at t_end add up to E_in - {taken:.4e} J = {summary['e_in'] - taken:.4e} J."
+        )
     over = {k: summary[k] for k in SHARES if (summary.get(k) or 0.0) > 1.0}
     if over:
         excess = max(over.values()) - 1.0
         residual = summary.get("energy_residual_max") or 0.0
-        why = ("within the energy residual, the balance's round-off" if excess <= 1.01 * residual
-               else "beyond the energy residual: the balance does not close")
+        why = (
+            "within the energy residual, the balance's round-off"
+            if excess <= 1.01 * residual
+            else "beyond the energy residual: the balance does not close"
+        )
         notes.append(f"note: {', '.join(over)} above 1 by {excess:.1e}, {why} (max |residual| {residual:.1e}).")
     return notes
 
@@ -129,8 +141,10 @@ def format_summary(summary: dict) -> str:
         lines += ["", f"{'material pair (normal law)':{width}s} {'max p0 [MPa]':>14s}  p0 / (1.6 Y)   contact, time"]
         for p in pairs:
             ratio = "unknown Y" if p["yield_onset_ratio"] is None else f"{p['yield_onset_ratio']:.3f}"
-            lines.append(f"{p['pair'] + ' (' + p['normal_law'] + ')':{width}s} {p['max_contact_pressure'] * 1e-6:>14.4g}"
-                         f"  {ratio:>12s}   {p['contact']}, {p['time']:.4g} s")
+            lines.append(
+                f"{p['pair'] + ' (' + p['normal_law'] + ')':{width}s} {p['max_contact_pressure'] * 1e-6:>14.4g}"
+                f"  {ratio:>12s}   {p['contact']}, {p['time']:.4g} s"
+            )
     notes = summary_notes(summary)
     return "\n".join(lines + ([""] + notes if notes else []))
 
@@ -172,12 +186,13 @@ def _cmd_run(args) -> int:
         if err.result is None:
             return 3
         stopped = _write_result(err.result, out)
-        print(f"granplate: the result so far is written to {out} (its 'status' attribute says why "
-              f"the run stopped)", file=sys.stderr)
+        print(
+            f"granplate: the result so far is written to {out} (its 'status' attribute says why the run stopped)",
+            file=sys.stderr,
+        )
         return 130 if stopped or interrupted(err.result) else 3
     if _write_result(ds, out):
-        print(f"granplate: interrupted while writing the result; it is written in full to {out}",
-              file=sys.stderr)
+        print(f"granplate: interrupted while writing the result; it is written in full to {out}", file=sys.stderr)
         return 130
     s = summary(ds)
     print(f"{scenario.name}: {scenario.description}".rstrip(": "))
@@ -236,8 +251,9 @@ def _cmd_cache(args) -> int:
         print(f"removed {n} entries from {store.cache_directory()}")
         return 0
     table = store.info()
-    print(f"cache directory: {store.cache_directory()} (cap {store.max_bytes() / 2**20:.0f} MiB, "
-          f"${store.MAX_BYTES_ENV})")
+    print(
+        f"cache directory: {store.cache_directory()} (cap {store.max_bytes() / 2**20:.0f} MiB, ${store.MAX_BYTES_ENV})"
+    )
     print(f"{'kind':20s} {'entries':>8s} {'MiB':>10s}")
     for kind, row in sorted(table.items()):
         print(f"{kind:20s} {row['entries']:8d} {row['bytes'] / 2**20:10.2f}")
@@ -247,7 +263,9 @@ def _cmd_cache(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="granplate", description="Granular media against an elastic plate: shock-mitigation simulator.")
+    p = argparse.ArgumentParser(
+        prog="granplate", description="Granular media against an elastic plate: shock-mitigation simulator."
+    )
     sub = p.add_subparsers(dest="command", required=True)
     r = sub.add_parser("run", help="run a scenario file or a preset")
     r.add_argument("scenario", help="a scenario TOML file or a preset name (see 'granplate presets')")
@@ -257,11 +275,17 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     add_set_option(r)
     r.set_defaults(func=_cmd_run)
-    co = sub.add_parser("compile", help="compile every scheme's kernels once, in the plane and in space "
-                                        "(the first run does it otherwise)")
-    co.add_argument("--measure", metavar="FILE", default=None,
-                    help="compile every kernel set and write the seconds each took to FILE (JSON; "
-                         "point NUMBA_CACHE_DIR at an empty folder first)")
+    co = sub.add_parser(
+        "compile",
+        help="compile every scheme's kernels once, in the plane and in space (the first run does it otherwise)",
+    )
+    co.add_argument(
+        "--measure",
+        metavar="FILE",
+        default=None,
+        help="compile every kernel set and write the seconds each took to FILE (JSON; "
+        "point NUMBA_CACHE_DIR at an empty folder first)",
+    )
     co.set_defaults(func=_cmd_compile)
     ps = sub.add_parser("presets", help="list the built-in presets")
     ps.set_defaults(func=_cmd_presets)

@@ -4,6 +4,7 @@
 is allowed, and is raised before any computation starts. `SimulationError` is a run that
 went numerically wrong; it carries the partial result computed so far.
 """
+
 from __future__ import annotations
 
 from typing import Any

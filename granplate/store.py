@@ -17,6 +17,7 @@ entry marks it used; beyond
 ``$GRANPLATE_CACHE_MAX_BYTES`` (default 2 GiB) the least recently used entries are
 removed after each save.
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -258,13 +259,19 @@ def load_netcdf(kind: str, payload: Any, fmt: int, label: str = "") -> Any | Non
 def _entries(kind: str | None = None) -> list[tuple[str, Path]]:
     """(kind, path) of every entry (temporary files of writes in progress excluded)."""
     root = cache_directory()
-    kinds = [root / kind] if kind is not None else (sorted(p for p in root.iterdir() if p.is_dir())
-                                                    if root.is_dir() else [])
+    kinds = (
+        [root / kind]
+        if kind is not None
+        else (sorted(p for p in root.iterdir() if p.is_dir()) if root.is_dir() else [])
+    )
     out = []
     for folder in kinds:
         if folder.is_dir():
-            out += [(folder.name, p) for p in sorted(folder.iterdir())
-                    if p.is_file() and not p.name.endswith((TMP_SUFFIX, LOCK_SUFFIX))]
+            out += [
+                (folder.name, p)
+                for p in sorted(folder.iterdir())
+                if p.is_file() and not p.name.endswith((TMP_SUFFIX, LOCK_SUFFIX))
+            ]
     return out
 
 
@@ -302,8 +309,9 @@ def max_bytes() -> int:
     try:
         return int(float(env))
     except ValueError:
-        warnings.warn(f"granplate: {MAX_BYTES_ENV}={env!r} is not a number of bytes; "
-                      f"using {DEFAULT_MAX_BYTES}", stacklevel=2)
+        warnings.warn(
+            f"granplate: {MAX_BYTES_ENV}={env!r} is not a number of bytes; using {DEFAULT_MAX_BYTES}", stacklevel=2
+        )
         return DEFAULT_MAX_BYTES
 
 

@@ -9,6 +9,7 @@ is missing the tests using it skip and say which one; `.ci/run` installs them.
 browser log; `open_page(driver, path)` loads a local file and waits until the document is
 complete.
 """
+
 from __future__ import annotations
 
 import shutil
@@ -22,9 +23,18 @@ import pytest
 CHROMIUM = "/usr/bin/chromium"
 CHROMEDRIVER = "/usr/bin/chromedriver"
 #: the flags that keep a headless Chromium off the network and quiet.
-FLAGS = ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync",
-         "--disable-dev-shm-usage", "--window-size=1280,900")
+FLAGS = (
+    "--headless=new",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--disable-dev-shm-usage",
+    "--window-size=1280,900",
+)
 
 
 def missing() -> str:
@@ -100,6 +110,15 @@ def requested_urls(driver) -> list[str]:
 def external_requests(driver) -> list[str]:
     """The requested URLs that would leave the machine (not file:, data:, blob:, the
     browser's own chrome: pages or localhost)."""
-    local = ("file:", "data:", "blob:", "about:", "chrome:", "chrome-untrusted:", "devtools:", "http://localhost",
-             "http://127.0.0.1")
+    local = (
+        "file:",
+        "data:",
+        "blob:",
+        "about:",
+        "chrome:",
+        "chrome-untrusted:",
+        "devtools:",
+        "http://localhost",
+        "http://127.0.0.1",
+    )
     return [u for u in requested_urls(driver) if not u.startswith(local)]

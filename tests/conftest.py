@@ -1,4 +1,5 @@
 """Shared fixtures: an isolated plate cache per session, small scenario builders."""
+
 from __future__ import annotations
 
 import importlib.util
@@ -20,8 +21,16 @@ def _plate_cache(tmp_path_factory):
     yield
 
 
-def two_spheres(v: float, alpha_n: float = 0.0, radius: float = 0.01, material: str = "steel",
-                dt: float = 1e-8, t_end: float = 1e-4, out: float = 1e-7, **contact) -> Scenario:
+def two_spheres(
+    v: float,
+    alpha_n: float = 0.0,
+    radius: float = 0.01,
+    material: str = "steel",
+    dt: float = 1e-8,
+    t_end: float = 1e-4,
+    out: float = 1e-7,
+    **contact,
+) -> Scenario:
     """Two identical spheres approaching head-on, each at speed v [m/s], just touching."""
     return Scenario(
         name="two-spheres",
@@ -35,9 +44,16 @@ def two_spheres(v: float, alpha_n: float = 0.0, radius: float = 0.01, material: 
     )
 
 
-def sphere_on_wall(vx: float, vy: float, radius: float = 0.01, mu: float = 0.099,
-                   alpha_n: float = 0.0, dt: float = 1e-8, t_end: float = 1e-4,
-                   out: float = 1e-7) -> Scenario:
+def sphere_on_wall(
+    vx: float,
+    vy: float,
+    radius: float = 0.01,
+    mu: float = 0.099,
+    alpha_n: float = 0.0,
+    dt: float = 1e-8,
+    t_end: float = 1e-4,
+    out: float = 1e-7,
+) -> Scenario:
     """A sphere touching the rigid floor y = 0 with velocity (vx, vy) [m/s]."""
     return Scenario(
         name="sphere-on-wall",

@@ -1,5 +1,6 @@
 """Dotted field paths of a TOML-shaped scenario dict, for the fuzz tests (tests/test_fuzz.py,
 tests/test_scenario_3d.py): every numeric field's path, and a copy with one field set."""
+
 from __future__ import annotations
 
 import copy

@@ -1,5 +1,6 @@
 """Shortened runs of the six presets, made once per test session and shared by the
 figure, report and export tests (importable because pytest puts tests/ on sys.path)."""
+
 from __future__ import annotations
 
 import functools

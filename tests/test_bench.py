@@ -1,4 +1,5 @@
 """The benchmark harness on one tiny case: the JSON report has every documented key."""
+
 from __future__ import annotations
 
 import json
@@ -90,8 +91,12 @@ def test_scaling_rows_are_measured_and_documented(tmp_path):
     rows = json.loads(out.read_text())
     assert [r["mu"] for r in rows] == list(scaling.FRICTIONS)
     text = (ROOT / "docs" / "benchmarks.md").read_text().split("### Scaling JSON")[1]
-    documented = {k for line in text.splitlines() if line.startswith("| `")
-                  for k in re.findall(r"`([a-z_0-9]+)`", line.split("|")[1])}
+    documented = {
+        k
+        for line in text.splitlines()
+        if line.startswith("| `")
+        for k in re.findall(r"`([a-z_0-9]+)`", line.split("|")[1])
+    }
     for r in rows:
         assert {"granules", "contacts", "setup_s", "loop_s", "n_steps", "rss_peak_mib"} <= documented
         assert set(r) - {"lammps"} <= documented | {"error"}, set(r) - documented
@@ -126,15 +131,21 @@ def test_scaling_in_space_rows_are_measured_and_documented(tmp_path):
     from granplate.verification import lammps as L
 
     out = tmp_path / "scaling3.json"
-    assert main(["bench", "--scaling", "--dimension", "3", "--sizes", "1x1x1", "--t-end", "4e-6",
-                 "--json", str(out)]) == 0
+    assert (
+        main(["bench", "--scaling", "--dimension", "3", "--sizes", "1x1x1", "--t-end", "4e-6", "--json", str(out)]) == 0
+    )
     rows = json.loads(out.read_text())
     assert [r["mu"] for r in rows] == list(scaling.FRICTIONS)
     text = (ROOT / "docs" / "benchmarks.md").read_text().split("### Scaling in space JSON")[1].split("\n## ")[0]
-    documented = {k for line in text.splitlines() if line.startswith("| `")
-                  for k in re.findall(r"`([a-z_0-9]+)`", line.split("|")[1])}
-    lammps_keys = set(re.findall(r"`([a-z_0-9]+)`", next(line for line in text.splitlines()
-                                                        if line.startswith("| `lammps`"))))
+    documented = {
+        k
+        for line in text.splitlines()
+        if line.startswith("| `")
+        for k in re.findall(r"`([a-z_0-9]+)`", line.split("|")[1])
+    }
+    lammps_keys = set(
+        re.findall(r"`([a-z_0-9]+)`", next(line for line in text.splitlines() if line.startswith("| `lammps`")))
+    )
     for r in rows:
         assert set(r) - {"lammps"} <= documented, set(r) - documented
         assert r["dimension"] == 3 and r["cells"] == [1, 1, 1]
@@ -209,8 +220,12 @@ def test_bench_friction_table_runs_every_case(capsys, monkeypatch, tmp_path):
         return
     assert "loop time granplate / LAMMPS" in out
     text = (ROOT / "docs" / "benchmarks.md").read_text().split("### Friction JSON")[1]
-    documented = {k for line in text.splitlines() if line.startswith("| `")
-                  for k in re.findall(r"`([a-z_0-9]+)`", line.split("|")[1])}
+    documented = {
+        k
+        for line in text.splitlines()
+        if line.startswith("| `")
+        for k in re.findall(r"`([a-z_0-9]+)`", line.split("|")[1])
+    }
     assert set(cmp) <= documented and set(cmp["granplate"]) <= documented, set(cmp["granplate"]) - documented
     assert set(cmp["lammps"]) <= documented and set(cmp["verlet"]) <= documented
     assert cmp["loop_ratio"] == pytest.approx(cmp["granplate"]["loop_s"] / cmp["lammps"]["loop_s"])
@@ -227,8 +242,7 @@ def test_bench_study_json_has_documented_keys(tmp_path):
     """`granplate bench --study` on a tiny study: every design computed, the JSON has every
     documented key, and the shares are consistent (loop + overhead = the whole)."""
     out = tmp_path / "study.json"
-    assert main(["bench", "--study", "--designs", "4", "--workers", "2", "--t-end", "1e-5",
-                 "--json", str(out)]) == 0
+    assert main(["bench", "--study", "--designs", "4", "--workers", "2", "--t-end", "1e-5", "--json", str(out)]) == 0
     report = json.loads(out.read_text())
     keys = documented_keys()["study"]
     assert keys == set(report), keys ^ set(report)
@@ -255,8 +269,10 @@ def test_twins_rows_are_measured_and_documented(tmp_path):
     from granplate.bench import twins
 
     out = tmp_path / "twins.json"
-    assert main(["bench", "--twins", "--cases", "ptfe-r05-weak", "--t-end", "2e-5", "--repeats", "1",
-                 "--json", str(out)]) == 0
+    assert (
+        main(["bench", "--twins", "--cases", "ptfe-r05-weak", "--t-end", "2e-5", "--repeats", "1", "--json", str(out)])
+        == 0
+    )
     (row,) = json.loads(out.read_text())
     text = (ROOT / "docs" / "benchmarks.md").read_text().split("(`granplate bench --twins`)")[1]
     documented = set(re.findall(r"`([a-z_0-9]+)`", text.split("*JSON*")[1].split("\n## ")[0]))
@@ -265,8 +281,10 @@ def test_twins_rows_are_measured_and_documented(tmp_path):
     assert row["e_shock_rel_diff"] == pytest.approx(row["e_shock_3d_j"] / row["e_shock_2d_j"] - 1.0)
     assert row["wall_ratio"] == pytest.approx(row["wall_3d_s"] / row["wall_2d_s"])
     assert row["within_speed_target"] == (row["wall_ratio"] <= twins.SPEED_TARGET)
-    assert row["within_thin_limit"] == (abs(row["e_shock_rel_diff"]) <= twins.THIN_LIMIT["e_shock"]
-                                        and abs(row["ep_max_fraction_rel_diff"]) <= twins.THIN_LIMIT["ep_max_fraction"])
+    assert row["within_thin_limit"] == (
+        abs(row["e_shock_rel_diff"]) <= twins.THIN_LIMIT["e_shock"]
+        and abs(row["ep_max_fraction_rel_diff"]) <= twins.THIN_LIMIT["ep_max_fraction"]
+    )
 
 
 def test_twins_options_are_checked(capsys):
@@ -284,12 +302,17 @@ def test_startup_rows_are_measured_and_documented(tmp_path, capsys):
     beside the two-sphere baseline: each row timed to the first step in a fresh process, its
     stages adding up to no more than the total, every key documented; bad options refused."""
     out = tmp_path / "startup.json"
-    assert main(["bench", "--startup", "--sizes", "1x1x1", "--formats", "csv", "--repeats", "1",
-                 "--json", str(out)]) == 0
+    assert (
+        main(["bench", "--startup", "--sizes", "1x1x1", "--formats", "csv", "--repeats", "1", "--json", str(out)]) == 0
+    )
     rows = json.loads(out.read_text())
     text = (ROOT / "docs" / "benchmarks.md").read_text().split("### Start-up JSON")[1].split("\n## ")[0]
-    documented = {k for line in text.splitlines() if line.startswith("| `")
-                  for k in re.findall(r"`([a-z_0-9]+)`", line.split("|")[1])}
+    documented = {
+        k
+        for line in text.splitlines()
+        if line.startswith("| `")
+        for k in re.findall(r"`([a-z_0-9]+)`", line.split("|")[1])
+    }
     assert [(r["spheres"], r["format"], r["pairs"]) for r in rows] == [(2, "toml", 1), (4, "csv", 6)]
     for r in rows:
         assert set(r) <= documented, set(r) - documented

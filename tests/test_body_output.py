@@ -2,6 +2,7 @@
 the body's quadratic cells and the spheres per snapshot into one .pvd that meshio reads back
 with the Dataset's numbers; `show` draws the body deformed (magnification in the title),
 coloured by von Mises [MPa] at the snapshot of the largest stress, with a colour bar."""
+
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
@@ -28,10 +29,15 @@ N_T = 21
 def result():
     """A synthetic 3D result: one sphere resting on the top face, pressing on it with a
     force that grows and falls, the modes at rest, snapshots every 5th output."""
-    s = scenario_io.from_dict({"name": "body-out", "dimension": 3, "plate": SOLID,
-                               "granules": [{"label": "a", "x": 0.03, "y": 0.02, "z": 0.01 + R + 1e-5,
-                                             "radius": R, "material": "steel"}],
-                               "time": {"t_end": 2e-4, "output_interval": 1e-5, "field_interval": 5e-5}})
+    s = scenario_io.from_dict(
+        {
+            "name": "body-out",
+            "dimension": 3,
+            "plate": SOLID,
+            "granules": [{"label": "a", "x": 0.03, "y": 0.02, "z": 0.01 + R + 1e-5, "radius": R, "material": "steel"}],
+            "time": {"t_end": 2e-4, "output_interval": 1e-5, "field_interval": 5e-5},
+        }
+    )
     solid = build_solid(s.plate, surface=None, cache=False)
     ops = body_operators(solid, 0.005)
     t = np.linspace(0.0, 2e-4, N_T)
@@ -42,13 +48,30 @@ def result():
     force[:, 0, 2] = -100.0 * np.sin(np.pi * t / 2e-4)
     q = np.zeros((N_T, solid.n_modes))
     data, coords = body_data(solid, q, q, t, face, xi, force, 5, 0.005, operators=ops)
-    g = {"x": 0.03, "y": 0.02, "z": 0.01 + R, "vx": 0.0, "vy": 0.0, "vz": 0.0,
-         "omega_x": 0.0, "omega_y": 0.0, "omega_z": 0.0}
-    spheres = {k: xr.DataArray(np.full((N_T, 1), v), dims=("time", "granule"), attrs={"units": "m"})
-               for k, v in g.items()}
-    ds = xr.Dataset({**spheres, **data}, coords={
-        "time": ("time", t, {"units": "s"}), "granule": ("granule", np.array(["a"])),
-        "radius": ("granule", np.array([R])), "material": ("granule", np.array(["steel"])), **coords})
+    g = {
+        "x": 0.03,
+        "y": 0.02,
+        "z": 0.01 + R,
+        "vx": 0.0,
+        "vy": 0.0,
+        "vz": 0.0,
+        "omega_x": 0.0,
+        "omega_y": 0.0,
+        "omega_z": 0.0,
+    }
+    spheres = {
+        k: xr.DataArray(np.full((N_T, 1), v), dims=("time", "granule"), attrs={"units": "m"}) for k, v in g.items()
+    }
+    ds = xr.Dataset(
+        {**spheres, **data},
+        coords={
+            "time": ("time", t, {"units": "s"}),
+            "granule": ("granule", np.array(["a"])),
+            "radius": ("granule", np.array([R])),
+            "material": ("granule", np.array(["steel"])),
+            **coords,
+        },
+    )
     ds.attrs.update({"scenario_name": "body-out", "scenario_toml": scenario_io.dumps(s)})
     return ds
 

@@ -1,5 +1,6 @@
 """Command line: runs a preset and a custom file, writes the JSON summary, lists and
 prints presets, and refuses bad input with one clear line (no traceback)."""
+
 from __future__ import annotations
 
 import json
@@ -11,10 +12,27 @@ from granplate.cli import main
 from granplate.setup.io import load
 
 SUMMARY_KEYS = {
-    "e_shock", "e_initial", "e_in", "ep_max_fraction", "ep_final_fraction", "eg_max_fraction",
-    "eg_final_fraction", "dissipated_fraction", "max_von_mises", "max_von_mises_disc", "max_eps_yy",
-    "energy_residual_max", "n_steps", "wall_time_s", "t_end", "plastic_fraction", "max_contact_pressure",
-    "yield_onset_ratio", "contact_pairs", "e_load_taken", "compile_time_s",
+    "e_shock",
+    "e_initial",
+    "e_in",
+    "ep_max_fraction",
+    "ep_final_fraction",
+    "eg_max_fraction",
+    "eg_final_fraction",
+    "dissipated_fraction",
+    "max_von_mises",
+    "max_von_mises_disc",
+    "max_eps_yy",
+    "energy_residual_max",
+    "n_steps",
+    "wall_time_s",
+    "t_end",
+    "plastic_fraction",
+    "max_contact_pressure",
+    "yield_onset_ratio",
+    "contact_pairs",
+    "e_load_taken",
+    "compile_time_s",
 }
 
 #: Two steel spheres (R = 1 cm) 0.4 mm apart closing at 2 m/s: no plate, no load.
@@ -84,9 +102,9 @@ def test_run_without_plate_or_load(tmp_path, capsys):
     assert main(["run", str(f), "-o", str(tmp_path / "r.nc"), "--summary", str(js), "-q"]) == 0
     text = capsys.readouterr().out
     s = json.loads(js.read_text())
-    mass = 4.0 / 3.0 * math.pi * 0.01 ** 3 * 7850.0
+    mass = 4.0 / 3.0 * math.pi * 0.01**3 * 7850.0
     assert s["e_shock"] == 0.0
-    assert s["e_initial"] == pytest.approx(mass * 1.0 ** 2, rel=1e-12)
+    assert s["e_initial"] == pytest.approx(mass * 1.0**2, rel=1e-12)
     assert s["e_in"] == s["e_initial"]
     for k in ("ep_max_fraction", "ep_final_fraction", "max_von_mises", "max_von_mises_disc", "max_eps_yy"):
         assert s[k] is None, k
@@ -103,8 +121,7 @@ def test_format_summary_names_the_reference_energy():
     """With both a load and initial motion the fractions are of E_in, shown as a row."""
     from granplate.cli import format_summary
 
-    s = {"e_shock": 1e-3, "e_initial": 3e-3, "e_in": 4e-3, "ep_max_fraction": 0.25,
-         "max_von_mises": 2.5e7}
+    s = {"e_shock": 1e-3, "e_initial": 3e-3, "e_in": 4e-3, "ep_max_fraction": 0.25, "max_von_mises": 2.5e7}
     text = format_summary(s)
     assert "E_in = E_shock + E_initial" in text and "4.0000e-03" in text
     assert "plate energy, peak / E_in" in text and "0.2500" in text
@@ -118,7 +135,9 @@ def test_preset_as_toml_runs_like_the_preset(tmp_path, capsys):
     assert load(f).load.q0 == 2000.0
     a, b = tmp_path / "a.json", tmp_path / "b.json"
     assert main(["run", str(f), "--t-end", "1e-5", "-o", str(tmp_path / "a.nc"), "--summary", str(a), "-q"]) == 0
-    assert main(["run", "ptfe-r05-weak", "--t-end", "1e-5", "-o", str(tmp_path / "b.nc"), "--summary", str(b), "-q"]) == 0
+    assert (
+        main(["run", "ptfe-r05-weak", "--t-end", "1e-5", "-o", str(tmp_path / "b.nc"), "--summary", str(b), "-q"]) == 0
+    )
     sa, sb = json.loads(a.read_text()), json.loads(b.read_text())
     for k in ("e_shock", "ep_max_fraction", "max_von_mises", "n_steps"):
         assert sa[k] == sb[k]
@@ -206,21 +225,23 @@ def test_cache_info_and_clear(tmp_path, monkeypatch, capsys):
 HEAVY_MODULES = ("matplotlib", "dask", "distributed", "optuna")
 
 
-@pytest.mark.parametrize("code", [
-    "import granplate",
-    "import granplate.cli",
-    "import granplate.cli, contextlib, io\n"
-    "with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):\n"
-    "    granplate.cli.main(['--help'])",
-])
+@pytest.mark.parametrize(
+    "code",
+    [
+        "import granplate",
+        "import granplate.cli",
+        "import granplate.cli, contextlib, io\n"
+        "with contextlib.redirect_stdout(io.StringIO()), contextlib.suppress(SystemExit):\n"
+        "    granplate.cli.main(['--help'])",
+    ],
+)
 def test_start_up_imports_no_heavy_module(code):
     """Truth: a fresh interpreter's sys.modules after `import granplate`, `import
     granplate.cli` and `granplate --help` holds none of matplotlib, dask, distributed, optuna."""
     import subprocess
     import sys
 
-    probe = code + "\nimport sys\nprint(' '.join(m for m in sys.modules if m.split('.')[0] in %r))" % (
-        HEAVY_MODULES,)
+    probe = code + "\nimport sys\nprint(' '.join(m for m in sys.modules if m.split('.')[0] in %r))" % (HEAVY_MODULES,)
     done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     loaded = done.stdout.strip().splitlines()[-1] if done.stdout.strip() else ""
@@ -235,12 +256,14 @@ def test_a_run_process_writes_its_result_without_loading_dask(tmp_path):
     import sys
 
     path = tmp_path / "r.nc"
-    probe = ("import sys\nfrom granplate.cli import keep_dask_out\nkeep_dask_out()\n"
-             "import numpy as np, xarray as xr\n"
-             f"xr.Dataset({{'a': ('t', np.arange(3.0))}}).to_netcdf({str(path)!r})\n"
-             f"back = xr.load_dataset({str(path)!r})\nassert back.a.values.tolist() == [0.0, 1.0, 2.0]\n"
-             "print(' '.join(m for m, v in sys.modules.items() if v is not None and m.split('.')[0] in "
-             "('dask', 'distributed')))")
+    probe = (
+        "import sys\nfrom granplate.cli import keep_dask_out\nkeep_dask_out()\n"
+        "import numpy as np, xarray as xr\n"
+        f"xr.Dataset({{'a': ('t', np.arange(3.0))}}).to_netcdf({str(path)!r})\n"
+        f"back = xr.load_dataset({str(path)!r})\nassert back.a.values.tolist() == [0.0, 1.0, 2.0]\n"
+        "print(' '.join(m for m, v in sys.modules.items() if v is not None and m.split('.')[0] in "
+        "('dask', 'distributed')))"
+    )
     done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "", f"loaded: {done.stdout.strip()}"
@@ -253,10 +276,12 @@ def test_the_library_warnings_print_as_one_line():
     import subprocess
     import sys
 
-    probe = ("import warnings\nfrom granplate.cli import show_warnings\nshow_warnings()\n"
-             "import granplate.setup.fields as f\n"
-             "warnings.warn_explicit('the library says so', UserWarning, f.__file__, 1)\n"
-             "warnings.warn_explicit('another package says so', UserWarning, '/elsewhere/x.py', 3)\n")
+    probe = (
+        "import warnings\nfrom granplate.cli import show_warnings\nshow_warnings()\n"
+        "import granplate.setup.fields as f\n"
+        "warnings.warn_explicit('the library says so', UserWarning, f.__file__, 1)\n"
+        "warnings.warn_explicit('another package says so', UserWarning, '/elsewhere/x.py', 3)\n"
+    )
     done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     lines = done.stderr.splitlines()

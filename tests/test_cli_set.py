@@ -1,6 +1,7 @@
 """`--set PATH=VALUE` on the command line: the changed scenario is exactly
 `gp.with_changes` of the base (the Python API's one implementation), values are read as
 TOML literals, and a mistake gets the very message the same mistake in a file gets."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -21,27 +22,37 @@ def _error(capsys) -> str:
     return capsys.readouterr().err.strip()
 
 
-@pytest.mark.parametrize("text, value", [
-    ("load.q0=3e4", 3e4), ("load.q0 = 30000", 30000), ("load.q0=.5", 0.5),
-    ('layout.intruder_material="steel"', "steel"), ("layout.intruder_material=steel", "steel"),
-    ("plate.size=[1, 2.5]", [1, 2.5]), ("solver.adaptive=true", True),
-    ('description="a=b"', "a=b"),  # split at the first '='
-])
+@pytest.mark.parametrize(
+    "text, value",
+    [
+        ("load.q0=3e4", 3e4),
+        ("load.q0 = 30000", 30000),
+        ("load.q0=.5", 0.5),
+        ('layout.intruder_material="steel"', "steel"),
+        ("layout.intruder_material=steel", "steel"),
+        ("plate.size=[1, 2.5]", [1, 2.5]),
+        ("solver.adaptive=true", True),
+        ('description="a=b"', "a=b"),  # split at the first '='
+    ],
+)
 def test_values_are_toml_literals(text, value):
     """Each value is what TOML reads (numbers, "strings", [arrays], booleans); a bare word
     is a string, a number TOML refuses (.5) still a number."""
-    (path, got), = parse_settings([text]).items()
+    ((path, got),) = parse_settings([text]).items()
     assert path == text.partition("=")[0].strip()
     assert got == value and type(got) is type(value)
 
 
-@pytest.mark.parametrize("text, field, words", [
-    ("load.q0", "--set", "expected PATH=VALUE"),
-    ("=3", "--set", "expected PATH=VALUE"),
-    ("load.q0=[1,", "load.q0", "not a TOML value"),
-    ("load.q0=3\nx = 1", "load.q0", "one TOML value"),
-    ("load..q0=3", "load..q0", "not a dotted field path"),
-])
+@pytest.mark.parametrize(
+    "text, field, words",
+    [
+        ("load.q0", "--set", "expected PATH=VALUE"),
+        ("=3", "--set", "expected PATH=VALUE"),
+        ("load.q0=[1,", "load.q0", "not a TOML value"),
+        ("load.q0=3\nx = 1", "load.q0", "one TOML value"),
+        ("load..q0=3", "load..q0", "not a dotted field path"),
+    ],
+)
 def test_malformed_settings_are_refused_by_name(text, field, words):
     with pytest.raises(ScenarioError) as err:
         parse_settings([text])
@@ -63,12 +74,15 @@ def test_run_with_set_runs_the_changed_scenario(tmp_path, capsys):
     assert ran.time.t_end == 1e-5 and dataclasses.replace(ran, time=expected.time) == expected
 
 
-@pytest.mark.parametrize("field, text, in_file", [
-    ("load.q00", "3e4", "[load]\nq00 = 3e4\n"),        # unknown field: the closest suggested
-    ("load.q0", "-3e4", "[load]\nq0 = -3e4\n"),         # outside its range (validate)
-    ("plate.nx", "3.5", "[plate]\nnx = 3.5\n"),         # wrong type
-    ("layout.intruder_material", '"stel"', '[layout]\nintruder_material = "stel"\n'),
-])
+@pytest.mark.parametrize(
+    "field, text, in_file",
+    [
+        ("load.q00", "3e4", "[load]\nq00 = 3e4\n"),  # unknown field: the closest suggested
+        ("load.q0", "-3e4", "[load]\nq0 = -3e4\n"),  # outside its range (validate)
+        ("plate.nx", "3.5", "[plate]\nnx = 3.5\n"),  # wrong type
+        ("layout.intruder_material", '"stel"', '[layout]\nintruder_material = "stel"\n'),
+    ],
+)
 def test_a_mistake_gets_the_message_it_gets_in_a_file(tmp_path, capsys, field, text, in_file):
     """The same mistake written in a scenario file and given by --set: the same one line,
     exit status 2, before anything runs."""
@@ -82,8 +96,12 @@ def test_a_mistake_gets_the_message_it_gets_in_a_file(tmp_path, capsys, field, t
     assert main(["show", str(bad), "-o", str(tmp_path / "a.png")]) == 2
     from_file = _error(capsys)
     assert from_file.startswith(f"granplate: error: scenario field '{field}'")
-    for command in (["run", "ptfe-r05", "-q"], ["show", "ptfe-r05", "-o", str(tmp_path / "b.png")],
-                    ["preset", "ptfe-r05"], ["resolve", "ptfe-r05"]):
+    for command in (
+        ["run", "ptfe-r05", "-q"],
+        ["show", "ptfe-r05", "-o", str(tmp_path / "b.png")],
+        ["preset", "ptfe-r05"],
+        ["resolve", "ptfe-r05"],
+    ):
         assert main([*command, "--set", f"{field}={text}"]) == 2
         assert _error(capsys) == from_file, command
     assert not list(tmp_path.glob("*.png"))
@@ -140,7 +158,7 @@ def test_study_set_mistake_gets_the_message_of_its_set_table(tmp_path, capsys, c
     """A wrong path by --set on sweep/optimize: exit 2 with the message the same line in
     the study's [set] table gets, before any design runs."""
     path = tmp_path / "s.toml"
-    path.write_text(doc.replace('[set]\n', '[set]\n"load.q00" = 1\n'))
+    path.write_text(doc.replace("[set]\n", '[set]\n"load.q00" = 1\n'))
     extra = ["--trials", "1"] if command == "optimize" else []
     assert main([command, str(path), "--out", str(tmp_path / "a"), *extra]) == 2
     from_file = _error(capsys)

@@ -3,6 +3,7 @@ seconds are counted apart from the run's wall time, the progress bar starts afte
 compile and shows no time left before its first output. Truth: numba's own compile events
 (a function compiled on purpose inside the clock), the order of the driver's calls, and
 tqdm's rendering of a bar that has not moved."""
+
 from __future__ import annotations
 
 import io
@@ -58,8 +59,17 @@ def test_loop_signatures_name_their_scheme_and_dimension():
     from granplate.solver.schemes import implicit, verlet
 
     def sig(g, sw):
-        return (None, None, types.SimpleNamespace(instance_class=g), None, None, None, None,
-                types.SimpleNamespace(instance_class=sw), None)
+        return (
+            None,
+            None,
+            types.SimpleNamespace(instance_class=g),
+            None,
+            None,
+            None,
+            None,
+            types.SimpleNamespace(instance_class=sw),
+            None,
+        )
 
     assert loop_key(sig(Granular3, verlet.Scratch)) == ("verlet", 3)
     assert loop_key(sig(Granular, implicit.Scratch)) == ("implicit", 2)
@@ -126,8 +136,11 @@ def test_the_bar_starts_after_the_compile_and_shows_no_time_left_before_an_outpu
     order = []
     compile_calls, progress_bar = driver.compile_calls, driver.progress_bar
     monkeypatch.setattr(driver, "compile_calls", lambda calls: (order.append("compile"), compile_calls(calls)))
-    monkeypatch.setattr(driver, "progress_bar",
-                        lambda total, desc: (order.append("bar"), progress_bar(total, desc, file=io.StringIO()))[1])
+    monkeypatch.setattr(
+        driver,
+        "progress_bar",
+        lambda total, desc: (order.append("bar"), progress_bar(total, desc, file=io.StringIO()))[1],
+    )
     from granplate.results.run import simulate
 
     simulate(_tiny(), progress=True)
@@ -173,7 +186,8 @@ def test_a_set_that_cannot_compile_does_not_stop_the_others():
         raise RuntimeError("no such scenario")
 
     said = []
-    done = compile_kernels([KernelSet("paper", 3, broken), KernelSet("implicit", 2, lambda: [_tiny()])],
-                           note=said.append)
+    done = compile_kernels(
+        [KernelSet("paper", 3, broken), KernelSet("implicit", 2, lambda: [_tiny()])], note=said.append
+    )
     assert list(done) == ["implicit-2d"]
     assert any("could not compile the paper scheme in space (RuntimeError: no such scenario)" in s for s in said)

@@ -1,5 +1,6 @@
 """Contact laws (paper eqs. 2-6) against Hertz's closed forms and the damping law's
 restitution; the compiled functions are the ones the time loop uses."""
+
 from __future__ import annotations
 
 import math
@@ -104,6 +105,7 @@ def restitution_ode(alpha_n: float) -> float:
 
     def sep(_, z):
         return z[0]
+
     sep.terminal, sep.direction = True, -1
     sol = solve_ivp(rhs, (0.0, 10.0), [1e-300, 1.0], events=sep, rtol=1e-12, atol=1e-14, first_step=1e-6)
     return -sol.y_events[0][0][1]
@@ -146,8 +148,9 @@ def test_slip_after_friction_solves_the_friction_ode(v0, decay):
     mu, k_s, n, inv_m = 0.1, 1000.0, 50.0, 100.0
     dt = decay / (mu * k_s * n * inv_m)  # decay = stick relaxation rate x dt
     got = C.slip_after_friction(v0, n, mu, k_s, inv_m, dt)
-    sol = solve_ivp(lambda t, v: -inv_m * mu * n * np.tanh(k_s * v), (0.0, dt), [v0], method="Radau",
-                    rtol=1e-12, atol=1e-15)
+    sol = solve_ivp(
+        lambda t, v: -inv_m * mu * n * np.tanh(k_s * v), (0.0, dt), [v0], method="Radau", rtol=1e-12, atol=1e-15
+    )
     assert got == pytest.approx(sol.y[0, -1], rel=1e-7, abs=1e-12)
     assert 0.0 <= got / v0 <= 1.0
     if abs(k_s * v0) > 30.0 and inv_m * mu * n * dt < abs(v0) / 2:  # gross slip: Coulomb deceleration

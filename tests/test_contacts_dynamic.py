@@ -1,6 +1,7 @@
 """Contacts that form and open during a run (docs/model.md section 1.3), against Hertz's
 closed forms, an independent integrator and the energy balance; and every way two bodies
 could interpenetrate silently stops the run instead."""
+
 from __future__ import annotations
 
 import math
@@ -29,10 +30,15 @@ M = sphere_mass(R, STEEL.rho)
 def scenario(granules, walls=(), t_end=1e-3, dt=1e-8, out=1e-7, plate=None, **contact) -> Scenario:
     """Granules and walls, no load; contact settings as given (no material-pair overrides)."""
     contact.setdefault("pairs", ())
-    return Scenario(name="contacts", granules=tuple(granules), walls=tuple(walls), plate=plate,
-                    load=Load(kind="none"), contact=Contact(**contact),
-                    time=TimeSettings(t_end=t_end, dt_initial=dt, dt_max=dt, output_interval=out,
-                                      field_interval=out))
+    return Scenario(
+        name="contacts",
+        granules=tuple(granules),
+        walls=tuple(walls),
+        plate=plate,
+        load=Load(kind="none"),
+        contact=Contact(**contact),
+        time=TimeSettings(t_end=t_end, dt_initial=dt, dt_max=dt, output_interval=out, field_interval=out),
+    )
 
 
 def crossings(t, f):
@@ -43,9 +49,15 @@ def crossings(t, f):
 
 def head_on(gap: float, v: float, alpha_n: float, t_end: float, **contact) -> Scenario:
     """Two steel spheres of radius R, `gap` [m] apart, flying at each other at v [m/s] each."""
-    return scenario([Granule(x=0.0, y=0.0, radius=R, material="steel", label="left", vx=v),
-                     Granule(x=2 * R + gap, y=0.0, radius=R, material="steel", label="right", vx=-v)],
-                    t_end=t_end, alpha_n=alpha_n, **contact)
+    return scenario(
+        [
+            Granule(x=0.0, y=0.0, radius=R, material="steel", label="left", vx=v),
+            Granule(x=2 * R + gap, y=0.0, radius=R, material="steel", label="right", vx=-v),
+        ],
+        t_end=t_end,
+        alpha_n=alpha_n,
+        **contact,
+    )
 
 
 def test_verlet_list_holds_the_fixed_pairs_and_is_exact():
@@ -55,8 +67,12 @@ def test_verlet_list_holds_the_fixed_pairs_and_is_exact():
     x, y = rng.uniform(0, 0.1, 60), rng.uniform(0, 0.1, 60)
     r = rng.uniform(0.004, 0.008, 60)
     got = verlet_pairs(x, y, r, 0.1)
-    want = [(i, j) for i in range(60) for j in range(i + 1, 60)
-            if math.hypot(x[j] - x[i], y[j] - y[i]) <= (r[i] + r[j]) * 1.1]
+    want = [
+        (i, j)
+        for i in range(60)
+        for j in range(i + 1, 60)
+        if math.hypot(x[j] - x[i], y[j] - y[i]) <= (r[i] + r[j]) * 1.1
+    ]
     assert got.tolist() == [list(p) for p in want]
     fixed = {tuple(p) for p in brute_force_pairs(x, y, r, 0.05).tolist()}
     assert fixed <= {tuple(p) for p in got.tolist()}
@@ -96,9 +112,15 @@ def test_oblique_impact_restitution_and_friction_bound():
     one; no damping and frictionless gives no tangential impulse at all."""
     b, v = 0.6 * 2 * R, 5.0  # impact parameter [m], speed [m/s]
     for mu in (0.3, 0.0):
-        s = scenario([Granule(x=0.0, y=0.0, radius=R, material="steel", label="a", vx=v),
-                      Granule(x=0.0165, y=b, radius=R, material="steel", label="b")],
-                     t_end=3e-4, mu=mu, alpha_n=0.0)
+        s = scenario(
+            [
+                Granule(x=0.0, y=0.0, radius=R, material="steel", label="a", vx=v),
+                Granule(x=0.0165, y=b, radius=R, material="steel", label="b"),
+            ],
+            t_end=3e-4,
+            mu=mu,
+            alpha_n=0.0,
+        )
         ds = simulate(s, progress=False)
         x, y = ds.x.values, ds.y.values
         dist = np.hypot(x[:, 1] - x[:, 0], y[:, 1] - y[:, 0])
@@ -123,10 +145,13 @@ def test_bouncing_between_two_walls_has_the_hertz_period():
     free flight plus two Hertz sphere-on-wall contact times; neither wall touches at t = 0."""
     v, free = 10.0, 0.5e-3
     L = 2 * R + free
-    s = scenario([Granule(x=L / 2, y=0.0, radius=R, material="steel", label="s", vx=v)],
-                 walls=[Wall(normal=(-1.0, 0.0), offset=0.0, label="left"),
-                        Wall(normal=(1.0, 0.0), offset=L, label="right")],
-                 t_end=3.2e-4, alpha_n=0.0, mu=0.0)
+    s = scenario(
+        [Granule(x=L / 2, y=0.0, radius=R, material="steel", label="s", vx=v)],
+        walls=[Wall(normal=(-1.0, 0.0), offset=0.0, label="left"), Wall(normal=(1.0, 0.0), offset=L, label="right")],
+        t_end=3.2e-4,
+        alpha_n=0.0,
+        mu=0.0,
+    )
     assert len(build_model(s).granular.wall_i) == 2  # in the Verlet list, not touching
     ds = simulate(s, progress=False)
     t = ds.time.values
@@ -145,7 +170,7 @@ def _reference_rhs(m, r, coef):
 
     def rhs(_t, z):
         pos = z[: 2 * n].reshape(n, 2)
-        vel = z[2 * n:].reshape(n, 2)
+        vel = z[2 * n :].reshape(n, 2)
         acc = np.zeros((n, 2))
         for (i, j), (a, c) in coef.items():
             d = pos[j] - pos[i]
@@ -166,11 +191,13 @@ def _reference_rhs(m, r, coef):
 def test_loose_packing_against_an_independent_integrator():
     """Five granules of two sizes with gaps (none touching at t = 0), frictionless and
     damped: positions and velocities equal scipy's DOP853 on the same equations."""
-    gs = [Granule(x=0.0, y=0.0, radius=R, material="steel", label="1", vx=5.0),
-          Granule(x=0.0195, y=0.002, radius=0.008, material="steel", label="2"),
-          Granule(x=0.0205, y=-0.0155, radius=0.006, material="steel", label="3", vy=2.0),
-          Granule(x=0.038, y=-0.003, radius=R, material="steel", label="4", vy=0.3),
-          Granule(x=0.034, y=0.0185, radius=0.007, material="steel", label="5", vx=-3.0, vy=-2.0)]
+    gs = [
+        Granule(x=0.0, y=0.0, radius=R, material="steel", label="1", vx=5.0),
+        Granule(x=0.0195, y=0.002, radius=0.008, material="steel", label="2"),
+        Granule(x=0.0205, y=-0.0155, radius=0.006, material="steel", label="3", vy=2.0),
+        Granule(x=0.038, y=-0.003, radius=R, material="steel", label="4", vy=0.3),
+        Granule(x=0.034, y=0.0185, radius=0.007, material="steel", label="5", vx=-3.0, vy=-2.0),
+    ]
     s = scenario(gs, t_end=1e-3, mu=0.0, alpha_n=0.05)
     m_ = build_model(s)
     assert len(m_.pairs) == 0  # loose: nothing within neighbour_gap at t = 0
@@ -201,8 +228,11 @@ def test_huge_shock_stops_on_the_overlap_limit():
     s = replace(s, load=replace(s.load, q0=5e8))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        with pytest.raises(SimulationError, match=r"granule '\w+' .* and granule '\w+' overlap by .*"
-                                                  r"beyond contact.overlap_stop = 0.2") as err:
+        with pytest.raises(
+            SimulationError,
+            match=r"granule '\w+' .* and granule '\w+' overlap by .*"
+            r"beyond contact.overlap_stop = 0.2",
+        ) as err:
             simulate(s, t_end=2e-5, progress=False)
     assert err.value.result is not None
 
@@ -211,8 +241,12 @@ def test_huge_shock_stops_on_the_overlap_limit():
 def test_granule_through_a_wall_stops_the_run():
     """A sphere thrown at a wall far too fast for Hertz's small-overlap assumption stops
     the run naming the wall; a huge step that jumps past the wall stops it too."""
-    s = scenario([Granule(x=0.0, y=0.0, radius=R, material="steel", label="s", vx=400.0)],
-                 walls=[Wall(normal=(1.0, 0.0), offset=0.02, label="right")], t_end=1e-4, mu=0.0)
+    s = scenario(
+        [Granule(x=0.0, y=0.0, radius=R, material="steel", label="s", vx=400.0)],
+        walls=[Wall(normal=(1.0, 0.0), offset=0.02, label="right")],
+        t_end=1e-4,
+        mu=0.0,
+    )
     with pytest.raises(SimulationError, match=r"granule 's' .* and wall 0 .* overlap by"):
         simulate(s, progress=False)
     fast = replace(s, time=replace(s.time, dt_initial=1e-4, dt_max=1e-4, output_interval=1e-4, field_interval=1e-4))
@@ -233,10 +267,19 @@ def test_granule_reaching_the_plate_without_a_plate_contact_stops_the_run():
     plate (beyond neighbour_gap R) that flies into it stops the run, naming it, the time
     and the place (with dynamic detection it gets a patch contact: test_patch_contacts.py)."""
     plate = Plate(x0=0.03, y0=0.0, height=0.1, ny=40)
-    s = scenario([Granule(x=0.03 - R - 1e-3, y=0.05, radius=R, material="steel", label="g", vx=2.0)],
-                 t_end=1e-3, dt=1e-7, out=1e-6, plate=plate, detection="fixed")
-    with pytest.raises(SimulationError, match=r"granule 'g' \(at x = .* y = 0.05 m\) reached the plate's face "
-                                              r"at t = 5.0\d*e-04 s") as err:
+    s = scenario(
+        [Granule(x=0.03 - R - 1e-3, y=0.05, radius=R, material="steel", label="g", vx=2.0)],
+        t_end=1e-3,
+        dt=1e-7,
+        out=1e-6,
+        plate=plate,
+        detection="fixed",
+    )
+    with pytest.raises(
+        SimulationError,
+        match=r"granule 'g' \(at x = .* y = 0.05 m\) reached the plate's face "
+        r"at t = 5.0\d*e-04 s",
+    ) as err:
         simulate(s, progress=False)
     assert err.value.result.time.values[-1] == pytest.approx(5e-4, abs=2e-6)
 
@@ -255,20 +298,29 @@ def test_contact_lists_modes():
 def test_paper_preset_is_bitwise_the_same_under_both_detections():
     """steel-r1's contacts are those at t = 0: the Verlet list adds only pairs that never
     touch, summed in the same order, so every output is bitwise that of the fixed topology."""
-    runs = [simulate(replace(preset("steel-r1"), contact=replace(preset("steel-r1").contact, detection=d)),
-                     t_end=5e-5, progress=False) for d in ("fixed", "dynamic")]
+    runs = [
+        simulate(
+            replace(preset("steel-r1"), contact=replace(preset("steel-r1").contact, detection=d)),
+            t_end=5e-5,
+            progress=False,
+        )
+        for d in ("fixed", "dynamic")
+    ]
     for name in ("x", "y", "vx", "vy", "omega", "E_granular", "E_plate", "D_viscous", "D_friction"):
         np.testing.assert_array_equal(runs[0][name].values, runs[1][name].values, err_msg=name)
 
 
-@pytest.mark.parametrize("field, value, words", [
-    ("detection", "sometimes", "must be one of 'dynamic', 'fixed'"),
-    ("skin", 0.0, "must be > 0"),
-    ("skin", 1.5, "at most 1"),
-    ("overlap_warn", -0.1, "must be > 0"),
-    ("overlap_stop", 0.01, "must lie in [contact.overlap_warn = 0.05, 1)"),
-    ("overlap_stop", 1.0, "must lie in"),
-])
+@pytest.mark.parametrize(
+    "field, value, words",
+    [
+        ("detection", "sometimes", "must be one of 'dynamic', 'fixed'"),
+        ("skin", 0.0, "must be > 0"),
+        ("skin", 1.5, "at most 1"),
+        ("overlap_warn", -0.1, "must be > 0"),
+        ("overlap_stop", 0.01, "must lie in [contact.overlap_warn = 0.05, 1)"),
+        ("overlap_stop", 1.0, "must lie in"),
+    ],
+)
 def test_contact_detection_fields_are_checked(field, value, words):
     """Each new contact field is range-checked, the message naming it."""
     from granplate.errors import ScenarioError

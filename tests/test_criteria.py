@@ -1,6 +1,7 @@
 """Each criterion passes where its rule holds and fails where it does not (including at
 its edges and on NaN), and writes the rule it applies as text; a Check carries the
 verdict, and the verification kinds map to the same criteria."""
+
 from __future__ import annotations
 
 import math
@@ -8,8 +9,19 @@ import math
 import pytest
 
 from granplate.results.criteria import (
-    Above, AllOf, AtLeast, AtMost, AtMostSetting, Below, Between, Check, Increasing, Item, ReportedOnly,
-    Within, criterion_of_kind,
+    Above,
+    AllOf,
+    AtLeast,
+    AtMost,
+    AtMostSetting,
+    Below,
+    Between,
+    Check,
+    Increasing,
+    Item,
+    ReportedOnly,
+    Within,
+    criterion_of_kind,
 )
 
 
@@ -70,10 +82,18 @@ def test_check_verdicts():
     assert c.error == pytest.approx(1.0)
 
 
-@pytest.mark.parametrize("kind, tol, ours, ok", [
-    ("rel", 1e-3, 2.002, True), ("rel", 1e-3, 2.01, False), ("abs", 0.03, 2.02, True),
-    ("max", 1e-10, 1e-12, True), ("max", 1e-10, 1e-9, False), ("min", 1.0, 1.7, True), ("min", 1.0, 0.5, False),
-])
+@pytest.mark.parametrize(
+    "kind, tol, ours, ok",
+    [
+        ("rel", 1e-3, 2.002, True),
+        ("rel", 1e-3, 2.01, False),
+        ("abs", 0.03, 2.02, True),
+        ("max", 1e-10, 1e-12, True),
+        ("max", 1e-10, 1e-9, False),
+        ("min", 1.0, 1.7, True),
+        ("min", 1.0, 0.5, False),
+    ],
+)
 def test_verification_kinds(kind, tol, ours, ok):
     c = Check("q", "-", 2.0, "s", ours, criterion_of_kind(kind, tol))
     assert c.passed is ok and c.kind == kind and c.tolerance == tol

@@ -6,6 +6,7 @@ that exist, every README link resolves.
 Truth: Sphinx itself (-W: any warning fails, nitpicky cross-references, the tutorials
 executed), the package's argparse parser, the file system.
 """
+
 from __future__ import annotations
 
 import importlib.util
@@ -22,8 +23,16 @@ DOCS = ROOT / "docs"
 #: pages whose shell blocks a newcomer types as written
 COMMAND_PAGES = sorted([*(DOCS / "getting-started").glob("*.md"), *(DOCS / "how-to").glob("*.md")])
 #: files a command of those pages writes before a later command reads it
-WRITTEN_BY_AN_EARLIER_COMMAND = {"steel-r1.nc", "my.toml", "softer.toml", "fcc.nc", "ptfe-r05.nc", "results",
-                                 "my-assembly.toml", "q0-r2"}
+WRITTEN_BY_AN_EARLIER_COMMAND = {
+    "steel-r1.nc",
+    "my.toml",
+    "softer.toml",
+    "fcc.nc",
+    "ptfe-r05.nc",
+    "results",
+    "my-assembly.toml",
+    "q0-r2",
+}
 
 
 def _ext():
@@ -91,8 +100,9 @@ def test_relative_links_resolve():
 def test_broken_link_is_found(tmp_path):
     """The link check finds a link to a missing file (and ignores web links and anchors)."""
     mod = _ext()
-    (tmp_path / "a.md").write_text("[ok](b.md) [web](https://example.org) [here](#x) [bad](missing.md)\n"
-                                   "```\n[in code](nowhere.md)\n```\n")
+    (tmp_path / "a.md").write_text(
+        "[ok](b.md) [web](https://example.org) [here](#x) [bad](missing.md)\n```\n[in code](nowhere.md)\n```\n"
+    )
     (tmp_path / "b.md").write_text("# b\n")
     assert mod.broken_links(tmp_path) == [("a.md", "missing.md")]
 
@@ -107,8 +117,18 @@ def test_scenario_reference_covers_every_key():
     for _, anchor, cls, *_ in mod._tables():
         section = re.split(r"\n\([a-z-]+\)=\n", page.split(f"({anchor})=")[1])[0]
         for f in dataclasses.fields(cls):
-            if cls.__name__ == "Scenario" and f.name in ("materials", "layout", "granules", "walls", "plate",
-                                                         "load", "contact", "time", "solver", "box"):
+            if cls.__name__ == "Scenario" and f.name in (
+                "materials",
+                "layout",
+                "granules",
+                "walls",
+                "plate",
+                "load",
+                "contact",
+                "time",
+                "solver",
+                "box",
+            ):
                 continue
             if (cls.__name__, f.name) == ("Material", "name"):
                 continue
@@ -120,18 +140,43 @@ def test_scenario_reference_covers_every_key():
     assert "must be in [0.41421356, 1] (sqrt(2)-1 <= R2/R1 <= 1)" in page
 
 
-@pytest.mark.skipif(importlib.util.find_spec("sphinx") is None or importlib.util.find_spec("myst_nb") is None,
-                    reason="sphinx and myst-nb are not installed (python -m pip install '.[docs]')")
+@pytest.mark.skipif(
+    importlib.util.find_spec("sphinx") is None or importlib.util.find_spec("myst_nb") is None,
+    reason="sphinx and myst-nb are not installed (python -m pip install '.[docs]')",
+)
 def test_site_builds_without_warnings(tmp_path):
     """`python -m sphinx -W --keep-going -b html docs OUT` succeeds: no warning (broken
     reference, missing file, docstring markup), every tutorial executed without error."""
     out = tmp_path / "html"
-    proc = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html",
-                           "-d", str(tmp_path / "doctrees"), str(DOCS), str(out)],
-                          capture_output=True, text=True, cwd=ROOT, timeout=900)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "sphinx",
+            "-W",
+            "--keep-going",
+            "-q",
+            "-b",
+            "html",
+            "-d",
+            str(tmp_path / "doctrees"),
+            str(DOCS),
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=900,
+    )
     assert proc.returncode == 0, proc.stderr[-4000:]
-    for page in ("index.html", "reference/api.html", "reference/cli.html", "reference/generated/scenario-fields.html",
-                 "tutorials/paper-energies.html", "studies/intruder-map/report.html"):
+    for page in (
+        "index.html",
+        "reference/api.html",
+        "reference/cli.html",
+        "reference/generated/scenario-fields.html",
+        "tutorials/paper-energies.html",
+        "studies/intruder-map/report.html",
+    ):
         assert (out / page).exists(), page
     tutorial = (out / "tutorials" / "paper-energies.html").read_text()
     assert "largest |energy residual| over the run" in tutorial  # the cell's printed output is on the page
@@ -143,9 +188,11 @@ def test_readme_is_short_and_names_the_commands():
     the set-up, test and docs-build commands exactly as CI and the docs run them."""
     text = (ROOT / "README.md").read_text()
     assert len(text.splitlines()) <= 120
-    for command in ("python -m pip install . && granplate reproduce --out results",
-                    'python -m pip install ".[test]" && python -m pytest -q',
-                    'python -m pip install ".[docs]" && python -m sphinx -W --keep-going -b html docs docs/_build/html'):
+    for command in (
+        "python -m pip install . && granplate reproduce --out results",
+        'python -m pip install ".[test]" && python -m pytest -q',
+        'python -m pip install ".[docs]" && python -m sphinx -W --keep-going -b html docs docs/_build/html',
+    ):
         assert f"```bash\n{command}\n```" in text, command
 
 
@@ -158,14 +205,16 @@ def test_plain_docstrings_render_without_warnings():
     from docutils.core import publish_doctree
 
     mod = _ext()
-    lines = ["A sphere: |v| < sqrt(E* / rho), R* = R1 R2 / (R1 + R2).",
-             "    kind: \"line\" or *none*; see `geometry.resolve` for |x|",
-             "- a list item",
-             "  continued with an indent",
-             ">>> gp.preset('steel-r1')",
-             "1. first",
-             "ends with a colon::",
-             "    indented again"]
+    lines = [
+        "A sphere: |v| < sqrt(E* / rho), R* = R1 R2 / (R1 + R2).",
+        '    kind: "line" or *none*; see `geometry.resolve` for |x|',
+        "- a list item",
+        "  continued with an indent",
+        ">>> gp.preset('steel-r1')",
+        "1. first",
+        "ends with a colon::",
+        "    indented again",
+    ]
     mod.plain_docstring(None, "function", "f", None, {}, lines)
     errors = io.StringIO()
     publish_doctree("\n".join(lines), settings_overrides={"warning_stream": errors, "report_level": 2})

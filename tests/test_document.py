@@ -2,6 +2,7 @@
 Markdown and HTML, verdict cells are coloured, links and anchors survive, figures are
 embedded or linked as asked, summaries and details render in both, and every HTML table
 is boxed and sortable by an inlined script (tests/test_pages_browser.py runs it)."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -11,12 +12,15 @@ from granplate.results.document import TABLE_SCRIPT, Block, details, markdown_to
 
 def _blocks(png: Path) -> list[Block]:
     return [
-        Block("h1", "Title"), Block("h3", "A case", anchor="case-a"),
+        Block("h1", "Title"),
+        Block("h3", "A case", anchor="case-a"),
         Block("p", "See [case](#case-a) and **this** `code`."),
         Block("table", header=("case", "result"), rows=(("a | b", "pass"), ("c", "**FAIL**"))),
-        Block("quote", "a note"), Block("code", "Traceback\n  x"),
+        Block("quote", "a note"),
+        Block("code", "Traceback\n  x"),
         Block("markdown", "#### Study\n\n| h | e |\n|---|---|\n| 1 | 2 |"),
-        Block("figure", "Fig. 1", path=png), Block("image", "linked", path=Path("figs/x.png")),
+        Block("figure", "Fig. 1", path=png),
+        Block("image", "linked", path=Path("figs/x.png")),
     ]
 
 
@@ -24,8 +28,16 @@ def test_markdown_of_every_kind(tmp_path):
     png = tmp_path / "f.png"
     png.write_bytes(b"\x89PNG fake")
     md = to_markdown(_blocks(png), tmp_path)
-    for piece in ('<a id="case-a"></a>\n\n### A case', "| a \\| b | pass |", "| c | **FAIL** |", "> a note",
-                  "```\nTraceback\n  x\n```", "#### Study", "![Fig. 1](f.png)", "![linked](figs/x.png)"):
+    for piece in (
+        '<a id="case-a"></a>\n\n### A case',
+        "| a \\| b | pass |",
+        "| c | **FAIL** |",
+        "> a note",
+        "```\nTraceback\n  x\n```",
+        "#### Study",
+        "![Fig. 1](f.png)",
+        "![linked](figs/x.png)",
+    ):
         assert piece in md, piece
 
 
@@ -59,7 +71,7 @@ def test_details_block_hides_its_content_until_opened(tmp_path):
     assert "<details><summary>Tolerances (2 checks)</summary>\n\n- a: why\n\n| x |\n|---|\n| 1 |\n\n</details>" in md
     page = to_html([b], tmp_path)
     assert page.count("<details>") == 1 and "<details open" not in page
-    inside = page[page.index("<details>"):page.index("</details>")]
+    inside = page[page.index("<details>") : page.index("</details>")]
     assert "<summary>Tolerances (2 checks)</summary>" in inside and "<li>a: why</li>" in inside
     assert "<table>" in inside
 
@@ -78,8 +90,10 @@ def test_every_table_is_boxed_and_sortable_with_the_script_inlined(tmp_path):
 
 def test_markdown_of_existing_blocks_is_unchanged(tmp_path):
     """The Markdown of a table, paragraph and heading is what the docs pages hold."""
-    md = to_markdown([Block("h2", "Results"), Block("table", header=("a", "b"), rows=(("1", "x | y"),)),
-                      Block("p", "text")], tmp_path)
+    md = to_markdown(
+        [Block("h2", "Results"), Block("table", header=("a", "b"), rows=(("1", "x | y"),)), Block("p", "text")],
+        tmp_path,
+    )
     assert md == "## Results\n\n| a | b |\n|---|---|\n| 1 | x \\| y |\n\ntext\n"
 
 

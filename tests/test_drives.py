@@ -3,6 +3,7 @@ undamped bounce, Hertz's law at the overlap of a sphere squeezed by a moving wal
 a sphere pair compressed by a velocity table, the recorded drive and wall forces equal to
 the contact forces, eq. (11)'s balance with gravity and drives at every step; bad input
 refused naming the field."""
+
 from __future__ import annotations
 
 import math
@@ -39,11 +40,13 @@ def hertz_pair(r: float) -> float:
 
 def base(**extra) -> dict:
     """A frictionless, undamped plane scenario without a load (extra: top-level tables)."""
-    d = {"name": "drives", "load": {"kind": "none"},
-         "contact": {"mu": 0.0, "alpha_n": 0.0, "pairs": []},
-         "time": {"t_end": 2e-4, "dt_max": 1e-7, "dt_initial": 1e-7, "output_interval": 1e-5,
-                  "field_interval": 1e-5},
-         "solver": {"scheme": "verlet"}}
+    d = {
+        "name": "drives",
+        "load": {"kind": "none"},
+        "contact": {"mu": 0.0, "alpha_n": 0.0, "pairs": []},
+        "time": {"t_end": 2e-4, "dt_max": 1e-7, "dt_initial": 1e-7, "output_interval": 1e-5, "field_interval": 1e-5},
+        "solver": {"scheme": "verlet"},
+    }
     d.update(extra)
     return d
 
@@ -53,12 +56,13 @@ def test_free_fall_and_undamped_bounce_under_gravity():
     damping it bounces back to its starting height (energy conserved), and eq. (11) with
     gravity's work holds at every step."""
     gap = 2e-4
-    d = base(granules=[{"label": "ball", "x": 0.0, "y": R + gap, "radius": R, "material": "steel"}],
-             walls=[{"label": "floor", "normal": [0.0, -1.0], "offset": 0.0}],
-             gravity={"g": [0.0, -G]})
+    d = base(
+        granules=[{"label": "ball", "x": 0.0, "y": R + gap, "radius": R, "material": "steel"}],
+        walls=[{"label": "floor", "normal": [0.0, -1.0], "offset": 0.0}],
+        gravity={"g": [0.0, -G]},
+    )
     t_fall = math.sqrt(2.0 * gap / G)
-    d["time"].update(t_end=2.0 * t_fall + 2e-4, output_interval=5e-5, field_interval=5e-5, dt_max=2e-7,
-                     dt_initial=2e-7)
+    d["time"].update(t_end=2.0 * t_fall + 2e-4, output_interval=5e-5, field_interval=5e-5, dt_max=2e-7, dt_initial=2e-7)
     ds = gp.simulate(from_dict(d))
     t, y = ds.time.values, ds.y.values[:, 0]
     free = t < 0.95 * t_fall
@@ -74,11 +78,16 @@ def squeeze(scheme: str):
     """A sphere resting on the floor, a top wall moved down at 0.01 m/s from 0.1 um above it
     (steps of 20 ns: the squeezed sphere rings against two stiffening contacts)."""
     top = 2.0 * R + 1e-7
-    d = base(granules=[{"label": "s", "x": 0.0, "y": R, "radius": R, "material": "steel"}],
-             walls=[{"label": "floor", "normal": [0.0, -1.0], "offset": 0.0},
-                    {"label": "top", "normal": [0.0, 1.0], "offset": top}],
-             drives=[{"target": "wall top", "kind": "velocity", "direction": [0.0, -1.0], "profile": "constant",
-                      "value": 0.01}])
+    d = base(
+        granules=[{"label": "s", "x": 0.0, "y": R, "radius": R, "material": "steel"}],
+        walls=[
+            {"label": "floor", "normal": [0.0, -1.0], "offset": 0.0},
+            {"label": "top", "normal": [0.0, 1.0], "offset": top},
+        ],
+        drives=[
+            {"target": "wall top", "kind": "velocity", "direction": [0.0, -1.0], "profile": "constant", "value": 0.01}
+        ],
+    )
     d["solver"]["scheme"] = scheme
     d["time"].update(output_interval=1e-6, field_interval=1e-6, dt_max=2e-8, dt_initial=2e-8)
     if scheme == "implicit":
@@ -102,8 +111,9 @@ def test_wall_moved_into_a_sphere_gives_hertz_at_the_overlap(scheme):
     wf = ds.wall_force.sel(wall="top").values
     assert wf.max() > 1.0  # squeezed
     np.testing.assert_allclose(wf, a * d_top**1.5, rtol=1e-9, atol=1e-9 * wf.max())
-    np.testing.assert_allclose(ds.wall_force.sel(wall="floor").values, a * d_floor**1.5, rtol=1e-9,
-                               atol=1e-9 * wf.max())
+    np.testing.assert_allclose(
+        ds.wall_force.sel(wall="floor").values, a * d_floor**1.5, rtol=1e-9, atol=1e-9 * wf.max()
+    )
     np.testing.assert_allclose(ds.drive_force.values[:, 0], wf, rtol=1e-12, atol=1e-12 * wf.max())
     assert float(np.abs(ds.energy_residual_max).max()) < 1e-4
     # the drive's work: int F v dt from the recorded force (trapezoid over the outputs)
@@ -115,14 +125,30 @@ def pair(dimension: int, table_v: float = 0.05, scheme: str = "verlet"):
     """Two equal steel spheres touching along x: A held (velocity 0), B pushed towards A by
     a velocity table (0 -> table_v over 20 us, held to 120 us, back to 0 at 140 us)."""
     z = {"z": 0.0} if dimension == 3 else {}
-    vec = (lambda *c: list(c[:dimension]))
-    d = base(granules=[{"label": "A", "x": 0.0, "y": 0.0, "radius": R, "material": "steel", **z},
-                       {"label": "B", "x": 2.0 * R, "y": 0.0, "radius": R, "material": "steel", **z}],
-             drives=[{"target": "granule A", "kind": "velocity", "direction": vec(1.0, 0.0, 0.0),
-                      "profile": "constant", "value": 0.0},
-                     {"target": "granule B", "kind": "velocity", "direction": vec(-1.0, 0.0, 0.0),
-                      "profile": "table", "times": [0.0, 2e-5, 1.2e-4, 1.4e-4],
-                      "values": [0.0, table_v, table_v, 0.0]}])
+    vec = lambda *c: list(c[:dimension])
+    d = base(
+        granules=[
+            {"label": "A", "x": 0.0, "y": 0.0, "radius": R, "material": "steel", **z},
+            {"label": "B", "x": 2.0 * R, "y": 0.0, "radius": R, "material": "steel", **z},
+        ],
+        drives=[
+            {
+                "target": "granule A",
+                "kind": "velocity",
+                "direction": vec(1.0, 0.0, 0.0),
+                "profile": "constant",
+                "value": 0.0,
+            },
+            {
+                "target": "granule B",
+                "kind": "velocity",
+                "direction": vec(-1.0, 0.0, 0.0),
+                "profile": "table",
+                "times": [0.0, 2e-5, 1.2e-4, 1.4e-4],
+                "values": [0.0, table_v, table_v, 0.0],
+            },
+        ],
+    )
     if dimension == 3:
         d["dimension"] = 3
         d["time"]["t_end"] = 1.6e-4
@@ -136,9 +162,15 @@ def pair(dimension: int, table_v: float = 0.05, scheme: str = "verlet"):
 
 def table_displacement(t: np.ndarray, v: float) -> np.ndarray:
     """The integral of the velocity table of `pair` [m] (closed form)."""
-    return np.where(t < 2e-5, 0.5 * v * t**2 / 2e-5,
-                    np.where(t < 1.2e-4, v * (t - 1e-5),
-                             np.where(t < 1.4e-4, v * 1.2e-4 - 0.5 * v * (1.4e-4 - t) ** 2 / 2e-5, v * 1.2e-4)))
+    return np.where(
+        t < 2e-5,
+        0.5 * v * t**2 / 2e-5,
+        np.where(
+            t < 1.2e-4,
+            v * (t - 1e-5),
+            np.where(t < 1.4e-4, v * 1.2e-4 - 0.5 * v * (1.4e-4 - t) ** 2 / 2e-5, v * 1.2e-4),
+        ),
+    )
 
 
 @pytest.mark.parametrize("dimension, scheme", [(2, "verlet"), (3, "verlet"), (2, "implicit")])
@@ -163,8 +195,9 @@ def test_sphere_pair_compressed_by_a_velocity_table(dimension, scheme):
     accel = np.where(t < 2e-5, v / 2e-5, np.where(t < 1.2e-4, 0.0, np.where(t < 1.4e-4, -v / 2e-5, 0.0)))
     m = float(ds.mass[1])
     inner = np.min(np.abs(t[:, None] - np.array([0.0, 2e-5, 1.2e-4, 1.4e-4])[None, :]), axis=1) > 1e-6
-    np.testing.assert_allclose(ds.drive_force.sel(drive="granule B").values[inner], (n + m * accel)[inner],
-                               rtol=1e-6, atol=1e-6 * n.max())
+    np.testing.assert_allclose(
+        ds.drive_force.sel(drive="granule B").values[inner], (n + m * accel)[inner], rtol=1e-6, atol=1e-6 * n.max()
+    )
     assert float(np.abs(ds.energy_residual_max).max()) < 1e-4
     # all the work the drives did is stored in the contact once B stops: 2/5 A delta^2.5 at the
     # recorded overlap, to within the run's energy tolerance
@@ -174,9 +207,10 @@ def test_sphere_pair_compressed_by_a_velocity_table(dimension, scheme):
 def test_force_drive_pushes_a_free_granule():
     """A constant force F on a free granule: x = F t^2 / (2 m), and its work F x is the
     drive's (E_drive)."""
-    d = base(granules=[{"label": "p", "x": 0.0, "y": 0.0, "radius": R, "material": "steel"}],
-             drives=[{"target": "granule p", "kind": "force", "direction": [0.6, 0.8], "profile": "constant",
-                      "value": 2.0}])
+    d = base(
+        granules=[{"label": "p", "x": 0.0, "y": 0.0, "radius": R, "material": "steel"}],
+        drives=[{"target": "granule p", "kind": "force", "direction": [0.6, 0.8], "profile": "constant", "value": 2.0}],
+    )
     ds = gp.simulate(from_dict(d))
     t, m = ds.time.values, float(ds.mass[0])
     s = 2.0 * t**2 / (2.0 * m)
@@ -189,11 +223,21 @@ def test_force_drive_pushes_a_free_granule():
 def test_scenario_with_drives_round_trips_and_reads_a_csv_table(tmp_path):
     """Gravity and drives survive TOML writing and reading; a table from a CSV file equals
     the inline one; a scenario without them is written as before (no new keys)."""
-    d = base(granules=[{"label": "a", "x": 0.0, "y": R, "radius": R, "material": "steel"}],
-             walls=[{"label": "floor", "normal": [0.0, -1.0], "offset": 0.0}],
-             gravity={"g": [0.0, -G]},
-             drives=[{"target": "granule a", "kind": "displacement", "direction": [1.0, 0.0], "profile": "table",
-                      "times": [0.0, 1e-4], "values": [0.0, 1e-6]}])
+    d = base(
+        granules=[{"label": "a", "x": 0.0, "y": R, "radius": R, "material": "steel"}],
+        walls=[{"label": "floor", "normal": [0.0, -1.0], "offset": 0.0}],
+        gravity={"g": [0.0, -G]},
+        drives=[
+            {
+                "target": "granule a",
+                "kind": "displacement",
+                "direction": [1.0, 0.0],
+                "profile": "table",
+                "times": [0.0, 1e-4],
+                "values": [0.0, 1e-6],
+            }
+        ],
+    )
     s = from_dict(d)
     assert loads(dumps(s)) == s
     (tmp_path / "t.csv").write_text("time,value\n0,0\n1e-4,1e-6\n")
@@ -205,43 +249,173 @@ def test_scenario_with_drives_round_trips_and_reads_a_csv_table(tmp_path):
 
 
 BAD = [
-    ({"drives": [{"target": "wall roof", "kind": "velocity", "direction": [0.0, -1.0], "profile": "constant"}]},
-     "drives[0].target"),
-    ({"drives": [{"target": "granule zz", "kind": "velocity", "direction": [1.0, 0.0], "profile": "constant"}]},
-     "drives[0].target"),
-    ({"drives": [{"target": "piston a", "kind": "velocity", "direction": [1.0, 0.0], "profile": "constant"}]},
-     "drives[0].target"),
-    ({"drives": [{"target": "granule a", "kind": "velocity", "direction": [1.0, 0.0], "profile": "table",
-                  "times": [0.0, 2e-5, 1e-5], "values": [0.0, 1.0, 0.0]}]}, "drives[0].times"),
-    ({"drives": [{"target": "granule a", "kind": "velocity", "direction": [1.0, 0.0], "profile": "table",
-                  "times": [0.0, 1e-5], "values": [0.0]}]}, "drives[0].times"),
-    ({"drives": [{"target": "granule a", "kind": "force", "direction": [1.0, 0.0], "profile": "harmonic",
-                  "amplitude": 1.0, "frequency": 1e9}]}, "drives[0].frequency"),
-    ({"drives": [{"target": "granule a", "kind": "force", "direction": [1.0, 0.0], "profile": "harmonic",
-                  "amplitude": 1.0, "frequency": 0.0}]}, "drives[0].frequency"),
-    ({"drives": [{"target": "granule a", "kind": "displacement", "direction": [1.0, 0.0], "profile": "harmonic",
-                  "amplitude": 1.0, "frequency": 1e5}]}, "drives[0].amplitude"),
-    ({"drives": [{"target": "granule a", "kind": "velocity", "direction": [1.0, 0.0], "profile": "half-sine",
-                  "amplitude": 1e4, "duration": 1e-5}]}, "drives[0].amplitude"),
-    ({"drives": [{"target": "granule a", "kind": "velocity", "direction": [1.0, 1.0], "profile": "constant"}]},
-     "drives[0].direction"),
-    ({"drives": [{"target": "granule a", "kind": "velocity", "direction": [1.0, 0.0, 0.0], "profile": "constant"}]},
-     "drives[0].direction"),
-    ({"drives": [{"target": "wall floor", "kind": "force", "direction": [0.0, -1.0], "profile": "constant"}]},
-     "drives[0].kind"),
-    ({"drives": [{"target": "wall floor", "kind": "velocity", "direction": [1.0, 0.0], "profile": "constant"}]},
-     "drives[0].direction"),
-    ({"drives": [{"target": "granule a", "kind": "velocity", "direction": [1.0, 0.0], "profile": "ramp",
-                  "value": 0.1}]}, "drives[0].duration"),
-    ({"drives": [{"target": "granule a", "kind": "velocity", "direction": [1.0, 0.0], "profile": "constant",
-                  "frequency": 10.0}]}, "drives[0].frequency"),
-    ({"drives": [{"target": "granule a", "kind": "velocity", "direction": [1.0, 0.0], "profile": "constant"},
-                 {"target": "granule a", "kind": "force", "direction": [0.0, 1.0], "profile": "constant"}]},
-     "drives[1].target"),
-    ({"drives": [{"target": "granule a", "kind": "speed", "direction": [1.0, 0.0], "profile": "constant"}]},
-     "drives[0].kind"),
-    ({"drives": [{"target": "granule a", "kind": "velocity", "direction": [1.0, 0.0], "profile": "table",
-                  "file": "no-such-file.csv"}]}, "drives[0].file"),
+    (
+        {"drives": [{"target": "wall roof", "kind": "velocity", "direction": [0.0, -1.0], "profile": "constant"}]},
+        "drives[0].target",
+    ),
+    (
+        {"drives": [{"target": "granule zz", "kind": "velocity", "direction": [1.0, 0.0], "profile": "constant"}]},
+        "drives[0].target",
+    ),
+    (
+        {"drives": [{"target": "piston a", "kind": "velocity", "direction": [1.0, 0.0], "profile": "constant"}]},
+        "drives[0].target",
+    ),
+    (
+        {
+            "drives": [
+                {
+                    "target": "granule a",
+                    "kind": "velocity",
+                    "direction": [1.0, 0.0],
+                    "profile": "table",
+                    "times": [0.0, 2e-5, 1e-5],
+                    "values": [0.0, 1.0, 0.0],
+                }
+            ]
+        },
+        "drives[0].times",
+    ),
+    (
+        {
+            "drives": [
+                {
+                    "target": "granule a",
+                    "kind": "velocity",
+                    "direction": [1.0, 0.0],
+                    "profile": "table",
+                    "times": [0.0, 1e-5],
+                    "values": [0.0],
+                }
+            ]
+        },
+        "drives[0].times",
+    ),
+    (
+        {
+            "drives": [
+                {
+                    "target": "granule a",
+                    "kind": "force",
+                    "direction": [1.0, 0.0],
+                    "profile": "harmonic",
+                    "amplitude": 1.0,
+                    "frequency": 1e9,
+                }
+            ]
+        },
+        "drives[0].frequency",
+    ),
+    (
+        {
+            "drives": [
+                {
+                    "target": "granule a",
+                    "kind": "force",
+                    "direction": [1.0, 0.0],
+                    "profile": "harmonic",
+                    "amplitude": 1.0,
+                    "frequency": 0.0,
+                }
+            ]
+        },
+        "drives[0].frequency",
+    ),
+    (
+        {
+            "drives": [
+                {
+                    "target": "granule a",
+                    "kind": "displacement",
+                    "direction": [1.0, 0.0],
+                    "profile": "harmonic",
+                    "amplitude": 1.0,
+                    "frequency": 1e5,
+                }
+            ]
+        },
+        "drives[0].amplitude",
+    ),
+    (
+        {
+            "drives": [
+                {
+                    "target": "granule a",
+                    "kind": "velocity",
+                    "direction": [1.0, 0.0],
+                    "profile": "half-sine",
+                    "amplitude": 1e4,
+                    "duration": 1e-5,
+                }
+            ]
+        },
+        "drives[0].amplitude",
+    ),
+    (
+        {"drives": [{"target": "granule a", "kind": "velocity", "direction": [1.0, 1.0], "profile": "constant"}]},
+        "drives[0].direction",
+    ),
+    (
+        {"drives": [{"target": "granule a", "kind": "velocity", "direction": [1.0, 0.0, 0.0], "profile": "constant"}]},
+        "drives[0].direction",
+    ),
+    (
+        {"drives": [{"target": "wall floor", "kind": "force", "direction": [0.0, -1.0], "profile": "constant"}]},
+        "drives[0].kind",
+    ),
+    (
+        {"drives": [{"target": "wall floor", "kind": "velocity", "direction": [1.0, 0.0], "profile": "constant"}]},
+        "drives[0].direction",
+    ),
+    (
+        {
+            "drives": [
+                {"target": "granule a", "kind": "velocity", "direction": [1.0, 0.0], "profile": "ramp", "value": 0.1}
+            ]
+        },
+        "drives[0].duration",
+    ),
+    (
+        {
+            "drives": [
+                {
+                    "target": "granule a",
+                    "kind": "velocity",
+                    "direction": [1.0, 0.0],
+                    "profile": "constant",
+                    "frequency": 10.0,
+                }
+            ]
+        },
+        "drives[0].frequency",
+    ),
+    (
+        {
+            "drives": [
+                {"target": "granule a", "kind": "velocity", "direction": [1.0, 0.0], "profile": "constant"},
+                {"target": "granule a", "kind": "force", "direction": [0.0, 1.0], "profile": "constant"},
+            ]
+        },
+        "drives[1].target",
+    ),
+    (
+        {"drives": [{"target": "granule a", "kind": "speed", "direction": [1.0, 0.0], "profile": "constant"}]},
+        "drives[0].kind",
+    ),
+    (
+        {
+            "drives": [
+                {
+                    "target": "granule a",
+                    "kind": "velocity",
+                    "direction": [1.0, 0.0],
+                    "profile": "table",
+                    "file": "no-such-file.csv",
+                }
+            ]
+        },
+        "drives[0].file",
+    ),
     ({"gravity": {"g": [0.0, -9.81, 0.0]}}, "gravity.g"),
     ({"gravity": {"g": [0.0, math.inf]}}, "gravity.g"),
 ]
@@ -250,8 +424,11 @@ BAD = [
 @pytest.mark.parametrize("extra, field", BAD, ids=[f for _, f in BAD])
 def test_bad_drive_or_gravity_refused_naming_the_field(extra, field):
     """Each bad [[drives]] or [gravity] entry is refused before anything runs, naming it."""
-    d = base(granules=[{"label": "a", "x": 0.0, "y": R, "radius": R, "material": "steel"}],
-             walls=[{"label": "floor", "normal": [0.0, -1.0], "offset": 0.0}], **extra)
+    d = base(
+        granules=[{"label": "a", "x": 0.0, "y": R, "radius": R, "material": "steel"}],
+        walls=[{"label": "floor", "normal": [0.0, -1.0], "offset": 0.0}],
+        **extra,
+    )
     with pytest.raises(ScenarioError) as e:
         validate(from_dict(d))
     assert e.value.field == field, str(e.value)
@@ -277,15 +454,13 @@ def test_driven_chain_example_runs():
     from granplate.setup.io import load_scenario, with_changes
 
     s = load_scenario(str(Path(__file__).resolve().parents[1] / "docs" / "examples" / "driven-chain.toml"))
-    ds = gp.simulate(with_changes(s, {"time.t_end": 1e-4, "time.output_interval": 5e-6,
-                                      "time.field_interval": 5e-6}))
+    ds = gp.simulate(with_changes(s, {"time.t_end": 1e-4, "time.output_interval": 5e-6, "time.field_interval": 5e-6}))
     assert float(np.abs(ds.energy_residual_max).max()) < 1e-4
     piston = ds.wall_force.sel(wall="xmax").values
     assert piston.max() > 1.0
     np.testing.assert_allclose(ds.drive_force.values[:, 0], piston, rtol=1e-12, atol=1e-12 * piston.max())
     t = ds.time.values
-    np.testing.assert_allclose(ds.drive_displacement.values[:, 0], 2e-6 * np.sin(np.pi * t / 1e-4), rtol=0,
-                               atol=1e-18)
+    np.testing.assert_allclose(ds.drive_displacement.values[:, 0], 2e-6 * np.sin(np.pi * t / 1e-4), rtol=0, atol=1e-18)
     from granplate.figures import run as figures
 
     fig = figures.figures(ds)["wall-forces"]
@@ -303,13 +478,30 @@ def test_bad_numbers_in_drives_and_gravity_refused_by_name():
     sys.path.insert(0, str(Path(__file__).parent))
     from field_paths import mutated, numeric_fields
 
-    d = base(granules=[{"label": "a", "x": 0.0, "y": R, "radius": R, "material": "steel"}],
-             walls=[{"label": "floor", "normal": [0.0, -1.0], "offset": 0.0}],
-             gravity={"g": [0.0, -G]},
-             drives=[{"target": "granule a", "kind": "force", "direction": [1.0, 0.0], "profile": "harmonic",
-                      "value": 1.0, "amplitude": 0.5, "frequency": 1e4},
-                     {"target": "wall floor", "kind": "velocity", "direction": [0.0, 1.0], "profile": "table",
-                      "times": [0.0, 1e-5, 2e-5], "values": [0.0, -0.01, 0.0]}])
+    d = base(
+        granules=[{"label": "a", "x": 0.0, "y": R, "radius": R, "material": "steel"}],
+        walls=[{"label": "floor", "normal": [0.0, -1.0], "offset": 0.0}],
+        gravity={"g": [0.0, -G]},
+        drives=[
+            {
+                "target": "granule a",
+                "kind": "force",
+                "direction": [1.0, 0.0],
+                "profile": "harmonic",
+                "value": 1.0,
+                "amplitude": 0.5,
+                "frequency": 1e4,
+            },
+            {
+                "target": "wall floor",
+                "kind": "velocity",
+                "direction": [0.0, 1.0],
+                "profile": "table",
+                "times": [0.0, 1e-5, 2e-5],
+                "values": [0.0, -0.01, 0.0],
+            },
+        ],
+    )
     validate(from_dict(d))
     paths = [p for p in numeric_fields(d) if p.startswith(("drives", "gravity"))]
     assert len(paths) >= 15

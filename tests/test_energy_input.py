@@ -1,6 +1,7 @@
 """The energy put in, with a load and initial velocities combined: truth is the energy
 balance of eq. (11), E_p + E_g + D = E_initial + E_shock(t), and the sign of the load's
 power F . v (negative while the loaded disc moves toward the load)."""
+
 from __future__ import annotations
 
 import matplotlib
@@ -86,8 +87,9 @@ def test_a_share_above_one_gets_a_note():
     """Truth: the summary table says why when a share exceeds 1 (here by round-off)."""
     from granplate.cli import summary_notes
 
-    notes = summary_notes({"e_in": 1.0, "e_shock": 1.0, "e_load_taken": 0.0, "eg_max_fraction": 1.0 + 1e-8,
-                           "energy_residual_max": 2e-8})
+    notes = summary_notes(
+        {"e_in": 1.0, "e_shock": 1.0, "e_load_taken": 0.0, "eg_max_fraction": 1.0 + 1e-8, "energy_residual_max": 2e-8}
+    )
     assert len(notes) == 1 and "eg_max_fraction above 1" in notes[0] and "within the energy residual" in notes[0]
     assert summary_notes({"e_in": 1.0, "e_shock": 1.0, "e_load_taken": 0.0, "eg_max_fraction": 0.99}) == []
 

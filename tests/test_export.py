@@ -1,6 +1,7 @@
 """The VTK export reads back with meshio: quadratic quads carrying the plate's
 displacement and von Mises stress, granules as points with radius and velocity, and a
 .pvd collection listing every snapshot time."""
+
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET

@@ -2,6 +2,7 @@
 contact network: every figure builds for a paper preset and for a two-sphere run without
 a plate, the network has exactly the model's contacts, the drawn forces are Hertz's, and
 the commands write their files or exit 2 with one clear line."""
+
 from __future__ import annotations
 
 import math
@@ -92,9 +93,12 @@ def test_every_figure_of_a_paper_preset_draws_its_numbers(steel):
     np.testing.assert_allclose(_lines(e, "energy:plate")[0].get_xdata()[-1], 1e3 * float(steel.time[-1]))
     c = figs["contact-forces"]
     for k, lab in enumerate(steel.contact.values):
-        np.testing.assert_array_equal(_lines(c, f"normal:{lab}")[0].get_ydata(), steel.contact_normal_force.values[:, k])
-        np.testing.assert_array_equal(_lines(c, f"tangential:{lab}")[0].get_ydata(),
-                                      steel.contact_tangential_force.values[:, k])
+        np.testing.assert_array_equal(
+            _lines(c, f"normal:{lab}")[0].get_ydata(), steel.contact_normal_force.values[:, k]
+        )
+        np.testing.assert_array_equal(
+            _lines(c, f"tangential:{lab}")[0].get_ydata(), steel.contact_tangential_force.values[:, k]
+        )
     s = figs["stress-strain"]
     np.testing.assert_allclose(_lines(s, "max_von_mises")[0].get_ydata(), steel.max_von_mises.values / 1e6)
     assert "MPa" in _lines(s, "max_von_mises")[0].axes.get_ylabel()
@@ -114,8 +118,10 @@ def test_two_spheres_without_plate_skip_plate_figures(spheres):
     assert "E_initial" in figs["energies"].axes[1].get_ylabel()  # no load: fractions of the initial energy
     for lab in ("a", "b"):
         k = list(spheres.granule.values).index(lab)
-        np.testing.assert_allclose(_lines(figs["granule-speeds"], f"speed:{lab}")[0].get_ydata(),
-                                   np.hypot(spheres.vx.values[:, k], spheres.vy.values[:, k]))
+        np.testing.assert_allclose(
+            _lines(figs["granule-speeds"], f"speed:{lab}")[0].get_ydata(),
+            np.hypot(spheres.vx.values[:, k], spheres.vy.values[:, k]),
+        )
     for fig in figs.values():
         _units_everywhere(fig)
 
@@ -263,8 +269,12 @@ def test_label_size_follows_the_radius():
 def test_cli_show_scenario_preset_and_result(tmp_path, files, capsys):
     toml = tmp_path / "two.toml"
     gp.dump(two_spheres(SPHERE_SPEED), toml)
-    for target, out in ((str(toml), "a.png"), ("steel-r1", "b.png"), (str(files["steel"]), "c.png"),
-                        (str(files["spheres"]), "d.pdf")):
+    for target, out in (
+        (str(toml), "a.png"),
+        ("steel-r1", "b.png"),
+        (str(files["steel"]), "c.png"),
+        (str(files["spheres"]), "d.pdf"),
+    ):
         assert main(["show", target, "-o", str(tmp_path / out)]) == 0
         assert (tmp_path / out).stat().st_size > 1000
     assert main(["show", str(files["steel"]), "--time", "4e-5", "-o", str(tmp_path / "e.png")]) == 0
@@ -284,11 +294,14 @@ def test_cli_plot_generic_figures(tmp_path, files, capsys):
     assert out.count("no body-stress, body-contact-forces figures: the run has no 3D elastic body") == 2
 
 
-@pytest.mark.parametrize("argv, words", [
-    (["show", "no-such.nc"], ("no-such.nc", "no such file")),
-    (["show", "no-such-preset"], ("no-such-preset", "no such file or preset")),
-    (["plot", "no-such.nc"], ("no-such.nc", "no such file")),
-])
+@pytest.mark.parametrize(
+    "argv, words",
+    [
+        (["show", "no-such.nc"], ("no-such.nc", "no such file")),
+        (["show", "no-such-preset"], ("no-such-preset", "no such file or preset")),
+        (["plot", "no-such.nc"], ("no-such.nc", "no such file")),
+    ],
+)
 def test_cli_bad_input_exits_2(argv, words, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err
@@ -310,8 +323,10 @@ def test_show_result_draws_contacts_formed_during_the_run():
 
     s = Scenario(
         name="head-on",
-        granules=(Granule(x=0.01, y=0.05, radius=0.01, material="steel", label="a", vx=1.0),
-                  Granule(x=0.031, y=0.05, radius=0.01, material="steel", label="b", vx=-1.0)),
+        granules=(
+            Granule(x=0.01, y=0.05, radius=0.01, material="steel", label="a", vx=1.0),
+            Granule(x=0.031, y=0.05, radius=0.01, material="steel", label="b", vx=-1.0),
+        ),
         load=Load(kind="none"),
         time=TimeSettings(t_end=6e-4, output_interval=2e-6, field_interval=2e-6),
     )
@@ -332,8 +347,9 @@ def test_energies_of_a_yielding_impact_count_the_plastic_work():
     plastic = ds.D_plastic.values
     assert run.has_plastic_work(ds) and plastic[-1] > 0.1 * float(ds.attrs["E_initial"])
     e = run.fig_energies(ds)
-    np.testing.assert_array_equal(_lines(e, "energy:dissipated")[0].get_ydata(),
-                                  ds.D_viscous.values + ds.D_friction.values + plastic)
+    np.testing.assert_array_equal(
+        _lines(e, "energy:dissipated")[0].get_ydata(), ds.D_viscous.values + ds.D_friction.values + plastic
+    )
     total = _lines(e, "energy:total")[0].get_ydata()
     e_in = float(ds.attrs["E_initial"])
     assert np.max(np.abs(total - e_in)) / e_in <= np.max(np.abs(ds.energy_residual.values)) + 1e-12

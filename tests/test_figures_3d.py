@@ -3,6 +3,7 @@ spheres at their true positions and radii, depth-sorted and depth-shaded, the bo
 walls at its faces, the model's contact network, and forces that are Hertz's closed form;
 `plot` draws the run's own energies and 3D speeds and skips the plate figures; `export`
 writes every output time as spheres that meshio reads back; `animate` and `run` work."""
+
 from __future__ import annotations
 
 import copy
@@ -31,8 +32,17 @@ BOX: dict = {
     "description": "four spheres in a box, one pushed",
     "dimension": 3,
     "granules": [
-        {"label": "a", "x": 0.012, "y": 0.01, "z": 0.01, "radius": 0.01, "material": "steel",
-         "vx": 1.0, "vz": -0.3, "omega": [1.0, -2.0, 3.0]},
+        {
+            "label": "a",
+            "x": 0.012,
+            "y": 0.01,
+            "z": 0.01,
+            "radius": 0.01,
+            "material": "steel",
+            "vx": 1.0,
+            "vz": -0.3,
+            "omega": [1.0, -2.0, 3.0],
+        },
         {"label": "b", "x": 0.032, "y": 0.01, "z": 0.01, "radius": 0.01, "material": "steel"},
         {"label": "c", "x": 0.022, "y": 0.0274, "z": 0.01, "radius": 0.01, "material": "ptfe"},
         {"label": "d", "x": 0.022, "y": 0.016, "z": 0.027, "radius": 0.009, "material": "ptfe"},
@@ -55,13 +65,27 @@ def head_on_scenario():
     c = np.array([0.05, 0.05, 0.05])
     a, b = c - RADIUS * DIRECTION, c + RADIUS * DIRECTION
     va, vb = HEAD_ON_SPEED * DIRECTION, -HEAD_ON_SPEED * DIRECTION
-    granule = lambda lab, p, v: {"label": lab, "x": p[0], "y": p[1], "z": p[2], "vx": v[0], "vy": v[1],  # noqa: E731
-                                 "vz": v[2], "radius": RADIUS, "material": "steel"}
-    return scenario_io.from_dict({
-        "name": "head-on-3d", "dimension": 3, "granules": [granule("a", a, va), granule("b", b, vb)],
-        "load": {"kind": "none"}, "contact": {"alpha_n": 0.0, "mu": 0.0},
-        "time": {"t_end": 5e-5, "output_interval": 2e-7, "field_interval": 1e-5},
-    })
+    granule = lambda lab, p, v: {
+        "label": lab,
+        "x": p[0],
+        "y": p[1],
+        "z": p[2],
+        "vx": v[0],
+        "vy": v[1],  # noqa: E731
+        "vz": v[2],
+        "radius": RADIUS,
+        "material": "steel",
+    }
+    return scenario_io.from_dict(
+        {
+            "name": "head-on-3d",
+            "dimension": 3,
+            "granules": [granule("a", a, va), granule("b", b, vb)],
+            "load": {"kind": "none"},
+            "contact": {"alpha_n": 0.0, "mu": 0.0},
+            "time": {"t_end": 5e-5, "output_interval": 2e-7, "field_interval": 1e-5},
+        }
+    )
 
 
 @pytest.fixture(scope="module")
@@ -85,13 +109,21 @@ def box_file(tmp_path_factory, box):
 
 
 def _circles(fig, view: str):
-    return {p.get_gid().split(":")[1]: p for ax in fig.axes for p in ax.patches
-            if str(p.get_gid()).startswith("granule:") and p.get_gid().endswith(f":{view}")}
+    return {
+        p.get_gid().split(":")[1]: p
+        for ax in fig.axes
+        for p in ax.patches
+        if str(p.get_gid()).startswith("granule:") and p.get_gid().endswith(f":{view}")
+    }
 
 
 def _wall_lines(fig, view: str):
-    return {ln.get_gid().split(":")[1]: ln for ax in fig.axes for ln in ax.get_lines()
-            if str(ln.get_gid()).startswith("wall:") and ln.get_gid().endswith(f":{view}")}
+    return {
+        ln.get_gid().split(":")[1]: ln
+        for ax in fig.axes
+        for ln in ax.get_lines()
+        if str(ln.get_gid()).startswith("wall:") and ln.get_gid().endswith(f":{view}")
+    }
 
 
 # --------------------------------------------------------------------------------------
@@ -108,9 +140,11 @@ def test_show_scenario_projections_radii_depth_and_walls(box_scenario):
     colours = material_colours(a.materials)
     g = {d["label"]: d for d in BOX["granules"]}
     lo, hi = BOX["box"]["lower"], BOX["box"]["upper"]
-    for (u, v, d, sign), view, seen in ((space.PROJECTIONS[0], "xy", ("xmin", "xmax", "ymin", "ymax")),
-                                        (space.PROJECTIONS[1], "xz", ("xmin", "xmax", "zmin", "zmax")),
-                                        (space.PROJECTIONS[2], "yz", ("ymin", "ymax", "zmin", "zmax"))):
+    for (u, v, d, sign), view, seen in (
+        (space.PROJECTIONS[0], "xy", ("xmin", "xmax", "ymin", "ymax")),
+        (space.PROJECTIONS[1], "xz", ("xmin", "xmax", "zmin", "zmax")),
+        (space.PROJECTIONS[2], "yz", ("ymin", "ymax", "zmin", "zmax")),
+    ):
         circles = _circles(fig, view)
         assert set(circles) == set(g)
         axis = "xyz"
@@ -124,7 +158,8 @@ def test_show_scenario_projections_radii_depth_and_walls(box_scenario):
         near, far = by_depth[-1], by_depth[0]
         assert circles[near].get_facecolor()[:3] == pytest.approx(to_rgb(colours[g[near]["material"]]))
         assert circles[far].get_facecolor()[:3] == pytest.approx(
-            [c * (1 - space.DEPTH_DARKEN) for c in to_rgb(colours[g[far]["material"]])])
+            [c * (1 - space.DEPTH_DARKEN) for c in to_rgb(colours[g[far]["material"]])]
+        )
         walls = _wall_lines(fig, view)
         assert set(walls) == set(seen)
         for lab, ln in walls.items():  # each face of the box, corner to corner
@@ -203,9 +238,10 @@ def test_plot_draws_the_runs_energies_and_3d_speeds(box):
     assert run.missing("stress-strain", box) == "the run has no plate"
     lines = {ln.get_gid(): ln for ax in figs["energies"].axes for ln in ax.get_lines()}
     np.testing.assert_array_equal(lines["energy:depth"].get_ydata(), box.KE_depth.values)
-    np.testing.assert_allclose(lines["energy:total"].get_ydata(),
-                               box.E_granular.values + box.D_viscous.values + box.D_friction.values
-                               + box.D_plastic.values)
+    np.testing.assert_allclose(
+        lines["energy:total"].get_ydata(),
+        box.E_granular.values + box.D_viscous.values + box.D_friction.values + box.D_plastic.values,
+    )
     assert "energy:plate" not in lines and "energy:plastic" not in lines  # Hertz: no plastic work
     speeds = {ln.get_gid(): ln for ax in figs["granule-speeds"].axes for ln in ax.get_lines()}
     for k, lab in enumerate(box.granule.values):
@@ -219,16 +255,21 @@ def test_plot_shows_the_plastic_work_of_yielding_contacts(box_scenario):
     the sum of the stored and dissipated energies is E_granular + D (the run's own)."""
     import dataclasses
 
-    s = dataclasses.replace(box_scenario, contact=dataclasses.replace(box_scenario.contact, normal_law="thornton"),
-                            time=dataclasses.replace(box_scenario.time, t_end=3.2e-5))
+    s = dataclasses.replace(
+        box_scenario,
+        contact=dataclasses.replace(box_scenario.contact, normal_law="thornton"),
+        time=dataclasses.replace(box_scenario.time, t_end=3.2e-5),
+    )
     ds = gp.simulate(s, progress=False)
     assert float(ds.D_plastic.values[-1]) > 0.0
     lines = {ln.get_gid(): ln for ax in run.fig_energies(ds).axes for ln in ax.get_lines()}
     np.testing.assert_array_equal(lines["energy:plastic"].get_ydata(), ds.D_plastic.values)
-    np.testing.assert_allclose(lines["energy:dissipated"].get_ydata(),
-                               ds.D_viscous.values + ds.D_friction.values + ds.D_plastic.values)
+    np.testing.assert_allclose(
+        lines["energy:dissipated"].get_ydata(), ds.D_viscous.values + ds.D_friction.values + ds.D_plastic.values
+    )
     residual = (lines["energy:total"].get_ydata() - ds.E_shock.values - ds.attrs["E_initial"]) / (
-        float(ds.E_shock.values[-1]) + ds.attrs["E_initial"])
+        float(ds.E_shock.values[-1]) + ds.attrs["E_initial"]
+    )
     assert np.abs(residual).max() < 1e-6  # the drawn sum balances what was put in (eq. 11)
 
 
@@ -251,8 +292,9 @@ def test_export_spheres_read_back(tmp_path, box):
         np.testing.assert_allclose(m.points, np.stack([box.x[i], box.y[i], box.z[i]], axis=1))
         np.testing.assert_allclose(m.point_data["radius"], box.radius.values)
         np.testing.assert_allclose(m.point_data["velocity"], np.stack([box.vx[i], box.vy[i], box.vz[i]], axis=1))
-        np.testing.assert_allclose(m.point_data["angular_velocity"],
-                                   np.stack([box.omega_x[i], box.omega_y[i], box.omega_z[i]], axis=1))
+        np.testing.assert_allclose(
+            m.point_data["angular_velocity"], np.stack([box.omega_x[i], box.omega_y[i], box.omega_z[i]], axis=1)
+        )
         assert [names[k] for k in m.point_data["material_id"]] == [str(v) for v in box.material.values]
     assert "0 = ptfe, 1 = steel" in pvd.read_text()
 
@@ -290,12 +332,14 @@ def test_cli_run_show_plot_export_animate_in_space(tmp_path, box_scenario, box_f
     assert "granular energy, peak / E_in" in out and res.stat().st_size > 0
     s = json.loads(summ.read_text())
     assert s["scenario"] == "box-3d" and s["ep_max_fraction"] is None and 0 < s["eg_max_fraction"] <= 1.0 + 1e-9
-    for argv, made in ((["show", str(toml), "-o", str(tmp_path / "a.png")], "a.png"),
-                       (["show", str(res), "-o", str(tmp_path / "b.pdf")], "b.pdf"),
-                       (["show", str(box_file), "--time", "3e-5", "-o", str(tmp_path / "c.png")], "c.png"),
-                       (["plot", str(box_file), "--out", str(tmp_path / "figs")], "figs/box-3d-energies.png"),
-                       (["export", str(box_file), "--vtk", str(tmp_path / "vtk")], "vtk/box-3d.pvd"),
-                       (["animate", str(box_file), "-o", str(tmp_path / "m.gif"), "--frames", "3"], "m.gif")):
+    for argv, made in (
+        (["show", str(toml), "-o", str(tmp_path / "a.png")], "a.png"),
+        (["show", str(res), "-o", str(tmp_path / "b.pdf")], "b.pdf"),
+        (["show", str(box_file), "--time", "3e-5", "-o", str(tmp_path / "c.png")], "c.png"),
+        (["plot", str(box_file), "--out", str(tmp_path / "figs")], "figs/box-3d-energies.png"),
+        (["export", str(box_file), "--vtk", str(tmp_path / "vtk")], "vtk/box-3d.pvd"),
+        (["animate", str(box_file), "-o", str(tmp_path / "m.gif"), "--frames", "3"], "m.gif"),
+    ):
         assert main(argv) == 0, argv
         assert (tmp_path / made).stat().st_size > 500, made
     captured = capsys.readouterr()
@@ -312,19 +356,31 @@ def test_cli_show_3d_time_outside_exits_2(box_file, capsys):
 
 #: Two spheres resting on a clamped box solid (20 x 10 x 4 mm of 4 x 2 x 1 hex20 elements).
 ON_SOLID: dict = {
-    "name": "on-solid", "dimension": 3,
-    "granules": [{"label": "a", "x": 0.006, "y": 0.005, "z": 0.007, "radius": 0.003, "material": "steel"},
-                 {"label": "b", "x": 0.012, "y": 0.005, "z": 0.007, "radius": 0.003, "material": "ptfe"}],
-    "plate": {"size": [0.02, 0.01, 0.004], "elements": [4, 2, 1], "origin": [0.0, 0.0, 0.0],
-              "material": "bearing_steel", "clamped": ["xmin"]},
+    "name": "on-solid",
+    "dimension": 3,
+    "granules": [
+        {"label": "a", "x": 0.006, "y": 0.005, "z": 0.007, "radius": 0.003, "material": "steel"},
+        {"label": "b", "x": 0.012, "y": 0.005, "z": 0.007, "radius": 0.003, "material": "ptfe"},
+    ],
+    "plate": {
+        "size": [0.02, 0.01, 0.004],
+        "elements": [4, 2, 1],
+        "origin": [0.0, 0.0, 0.0],
+        "material": "bearing_steel",
+        "clamped": ["xmin"],
+    },
     "load": {"kind": "none"},
     "time": {"t_end": 1e-5, "output_interval": 1e-6, "field_interval": 1e-5},
 }
 
 
 def _collections(fig, prefix: str) -> dict:
-    return {c.get_gid().split(":")[1]: c for ax in fig.axes for c in ax.collections
-            if str(c.get_gid()).startswith(prefix + ":")}
+    return {
+        c.get_gid().split(":")[1]: c
+        for ax in fig.axes
+        for c in ax.collections
+        if str(c.get_gid()).startswith(prefix + ":")
+    }
 
 
 def _length(segments) -> float:
@@ -361,14 +417,18 @@ def _l_shaped_msh(path, size: float):
     face x = 0 as the group 'left'."""
     pts = np.array([[x, y, z] for z in (0, 1) for y in (0, 1, 2) for x in (0, 1, 2)], float)
     node = lambda x, y, z: int(np.flatnonzero((pts == [x, y, z]).all(axis=1))[0])  # noqa: E731
-    cube = lambda x, y: [node(x + dx, y + dy, dz) for dx, dy, dz in  # noqa: E731
-                         [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]]
+    cube = lambda x, y: [
+        node(x + dx, y + dy, dz)
+        for dx, dy, dz in [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]  # noqa: E731
+    ]
     quads = [[node(0, y, 0), node(0, y + 1, 0), node(0, y + 1, 1), node(0, y, 1)] for y in (0, 1)]
     hexes = [cube(0, 0), cube(1, 0), cube(0, 1)]
-    m = meshio.Mesh(pts * size, [("hexahedron", np.array(hexes)), ("quad", np.array(quads))],
-                    cell_data={"gmsh:physical": [np.full(3, 2), np.full(2, 1)],
-                               "gmsh:geometrical": [np.full(3, 2), np.full(2, 1)]},
-                    field_data={"left": np.array([1, 2]), "body": np.array([2, 3])})
+    m = meshio.Mesh(
+        pts * size,
+        [("hexahedron", np.array(hexes)), ("quad", np.array(quads))],
+        cell_data={"gmsh:physical": [np.full(3, 2), np.full(2, 1)], "gmsh:geometrical": [np.full(3, 2), np.full(2, 1)]},
+        field_data={"left": np.array([1, 2]), "body": np.array([2, 3])},
+    )
     meshio.write(str(path), m, file_format="gmsh22", binary=False)
     return str(path)
 
@@ -384,8 +444,7 @@ def test_show_draws_a_gmsh_solid_and_checks_its_surface(tmp_path, radius, ok):
 
     d = copy.deepcopy(ON_SOLID)
     d["plate"] = {"mesh": _l_shaped_msh(tmp_path / "l.msh", 0.01), "clamped": ["left"]}
-    d["granules"] = [{"label": "notch", "x": 0.015, "y": 0.015, "z": 0.005, "radius": radius,
-                      "material": "steel"}]
+    d["granules"] = [{"label": "notch", "x": 0.015, "y": 0.015, "z": 0.005, "radius": radius, "material": "steel"}]
     s = scenario_io.from_dict(d)
     validate(s)  # a mesh file's surface is read where it is drawn (or built), not by validate
     if not ok:

@@ -3,6 +3,7 @@ body-stress figure draws the run's own largest von Mises stress, ball average an
 displacement, body-contact-forces the normal force of exactly the granules that touched
 the body, every axis with its unit; a 2D run skips the body figures and a 3D body run the
 plate's figures, each with a one-line reason."""
+
 from __future__ import annotations
 
 import copy
@@ -24,13 +25,19 @@ from conftest import two_spheres
 #: box (4 x 4 x 1 hex20 elements) clamped on its face xmin, its contact lasting about
 #: 18 us; a second sphere hangs above the box and never touches it.
 DROP: dict = {
-    "name": "drop-on-box", "dimension": 3,
+    "name": "drop-on-box",
+    "dimension": 3,
     "granules": [
         {"label": "ball", "x": 0.01, "y": 0.01, "z": 0.0065, "radius": 0.0025, "material": "steel", "vz": -1.0},
         {"label": "aloft", "x": 0.004, "y": 0.004, "z": 0.012, "radius": 0.002, "material": "steel"},
     ],
-    "plate": {"size": [0.02, 0.02, 0.004], "elements": [4, 4, 1], "origin": [0.0, 0.0, 0.0],
-              "material": "steel", "clamped": ["xmin"]},
+    "plate": {
+        "size": [0.02, 0.02, 0.004],
+        "elements": [4, 4, 1],
+        "origin": [0.0, 0.0, 0.0],
+        "material": "steel",
+        "clamped": ["xmin"],
+    },
     "load": {"kind": "none"},
     "time": {"t_end": 4e-5, "output_interval": 1e-6, "field_interval": 1e-5},
 }
@@ -96,9 +103,11 @@ def test_body_stress_draws_the_runs_maxima_in_mpa_and_um(drop):
     [MPa] and max_displacement * 1e6 [um] against time * 1e3 [ms], on axes with units."""
     fig = run.fig_body_stress(drop)
     t_ms = drop.time.values * 1e3
-    for gid, values in (("max_von_mises", drop.max_von_mises.values / 1e6),
-                        ("max_von_mises_ball", drop.max_von_mises_ball.values / 1e6),
-                        ("max_displacement", drop.max_displacement.values * 1e6)):
+    for gid, values in (
+        ("max_von_mises", drop.max_von_mises.values / 1e6),
+        ("max_von_mises_ball", drop.max_von_mises_ball.values / 1e6),
+        ("max_displacement", drop.max_displacement.values * 1e6),
+    ):
         line = _lines(fig, gid)
         np.testing.assert_array_equal(line.get_ydata(), values)
         np.testing.assert_array_equal(line.get_xdata(), t_ms)
@@ -113,8 +122,9 @@ def test_body_contact_forces_draw_the_touching_granules(drop):
     fig = run.fig_body_contact_forces(drop)
     gids = {ln.get_gid() for ax in fig.axes for ln in ax.get_lines()}
     assert gids == {"body-normal:ball"}
-    np.testing.assert_array_equal(_lines(fig, "body-normal:ball").get_ydata(),
-                                  drop.body_contact_normal_force.values[:, 0])
+    np.testing.assert_array_equal(
+        _lines(fig, "body-normal:ball").get_ydata(), drop.body_contact_normal_force.values[:, 0]
+    )
     assert "[N]" in fig.axes[0].get_ylabel()
     _units_everywhere(fig)
 
@@ -145,10 +155,19 @@ def test_a_2d_run_refuses_the_body_figures():
 
 def test_skipped_figures_are_one_note_per_reason():
     """Figures skipped for the same reason share one line, in figure order."""
-    notes = skipped_notes({"contact-forces": "no plate contacts", "stress-strain": "no plate",
-                           "body-stress": "no body", "body-contact-forces": "no body"})
-    assert notes == ["no contact-forces figure: no plate contacts", "no stress-strain figure: no plate",
-                     "no body-stress, body-contact-forces figures: no body"]
+    notes = skipped_notes(
+        {
+            "contact-forces": "no plate contacts",
+            "stress-strain": "no plate",
+            "body-stress": "no body",
+            "body-contact-forces": "no body",
+        }
+    )
+    assert notes == [
+        "no contact-forces figure: no plate contacts",
+        "no stress-strain figure: no plate",
+        "no body-stress, body-contact-forces figures: no body",
+    ]
 
 
 def test_cli_plot_of_a_body_run(tmp_path, drop, capsys):
@@ -192,8 +211,9 @@ def test_frames_of_a_body_run_are_its_field_snapshots_on_one_scale(drop):
         ti = int(np.argmin(np.abs(drop.time.values - times[k])))
         np.testing.assert_array_equal(a.pos, space.positions(drop)[ti])
         assert np.isin(a.body_stress, stress[j]).all() and a.body_stress.max() == stress[j].max()
-    largest = [float(np.linalg.norm(np.column_stack([drop[f"body_u{c}"].values[k] for c in "xyz"]), axis=1).max())
-               for k in idx]
+    largest = [
+        float(np.linalg.norm(np.column_stack([drop[f"body_u{c}"].values[k] for c in "xyz"]), axis=1).max()) for k in idx
+    ]
     assert [a.body_largest for a in frames] == pytest.approx(largest)
     assert frames[0].body_scale == space.magnification(max(largest), 0.02)  # the box's largest side
 
@@ -208,8 +228,12 @@ def test_the_animation_redraws_each_frame_where_the_run_was(drop):
     for f, a in enumerate(frames):
         draw(f)
         for (u, v, _, _), view in zip(space.PROJECTIONS, ("xy", "xz", "yz")):
-            circles = {p.get_gid().split(":")[1]: p for ax in fig.axes for p in ax.patches
-                       if str(p.get_gid()).startswith("granule:") and p.get_gid().endswith(f":{view}")}
+            circles = {
+                p.get_gid().split(":")[1]: p
+                for ax in fig.axes
+                for p in ax.patches
+                if str(p.get_gid()).startswith("granule:") and p.get_gid().endswith(f":{view}")
+            }
             for i, lab in enumerate(a.labels):
                 assert circles[lab].center == pytest.approx((a.pos[i, u] * 1e3, a.pos[i, v] * 1e3))
             (body,) = [c for ax in fig.axes for c in ax.collections if c.get_gid() == f"body:{view}"]

@@ -1,5 +1,6 @@
 """Bad numbers anywhere in a scenario: a clean run or one line naming the field, never a
 traceback or a hang (docs/scenario.md, "Reading and checking")."""
+
 from __future__ import annotations
 
 import itertools
@@ -36,17 +37,47 @@ BASE: dict = {
         {"label": "left", "normal": [-1.0, 0.0], "offset": 0.0},
         {"label": "bottom", "normal": [0.0, -1.0], "offset": 0.0, "material": "soft"},
     ],
-    "plate": {"width": 0.005, "height": 0.04, "thickness": 0.001, "x0": 0.03, "y0": 0.0,
-              "nx": 2, "ny": 8, "rigid_layer_width": 0.004, "n_modes": 0,
-              "max_frequency": 1e6, "stress_radius": 0.002},
+    "plate": {
+        "width": 0.005,
+        "height": 0.04,
+        "thickness": 0.001,
+        "x0": 0.03,
+        "y0": 0.0,
+        "nx": 2,
+        "ny": 8,
+        "rigid_layer_width": 0.004,
+        "n_modes": 0,
+        "max_frequency": 1e6,
+        "stress_radius": 0.002,
+    },
     "load": {"q0": 5e4, "duration": 1e-5, "length": 0.04, "y0": 0.0},
-    "contact": {"mu": 0.1, "k_s": 1000.0, "alpha_n": 6e-3, "neighbour_gap": 0.05, "skin": 0.1,
-                "overlap_warn": 0.05, "overlap_stop": 0.2,
-                "pairs": [{"materials": ["steel", "soft"], "alpha_n": 0.01, "mu": 0.2, "k_s": 500.0}]},
-    "time": {"t_end": 2e-6, "dt_initial": 4e-8, "dt_max": 4e-8, "dt_min": 1e-13,
-             "output_interval": 1e-6, "field_interval": 2e-6},
-    "solver": {"lambda_target": 0.5, "iteration_rtol": 1e-9, "iteration_atol": 1e-10,
-               "max_iterations": 60, "energy_tol": 1e-4, "error_tol": 1e-3, "implicit_dt_max": 1e-6},
+    "contact": {
+        "mu": 0.1,
+        "k_s": 1000.0,
+        "alpha_n": 6e-3,
+        "neighbour_gap": 0.05,
+        "skin": 0.1,
+        "overlap_warn": 0.05,
+        "overlap_stop": 0.2,
+        "pairs": [{"materials": ["steel", "soft"], "alpha_n": 0.01, "mu": 0.2, "k_s": 500.0}],
+    },
+    "time": {
+        "t_end": 2e-6,
+        "dt_initial": 4e-8,
+        "dt_max": 4e-8,
+        "dt_min": 1e-13,
+        "output_interval": 1e-6,
+        "field_interval": 2e-6,
+    },
+    "solver": {
+        "lambda_target": 0.5,
+        "iteration_rtol": 1e-9,
+        "iteration_atol": 1e-10,
+        "max_iterations": 60,
+        "energy_tol": 1e-4,
+        "error_tol": 1e-3,
+        "implicit_dt_max": 1e-6,
+    },
 }
 #: The bad values every numeric field is tried with.
 BAD_VALUES: tuple = (-1, 0, math.nan, math.inf, 1e300, "x")
@@ -54,8 +85,12 @@ SEED = 20240601
 N_CASES = 45
 #: Cases always tried: a granule far out (the neighbour search's overflow), outputs that
 #: cannot fit, a snapshot stride no integer holds, a damping that overflows the forces.
-ALWAYS: tuple = (("granules[1].y", 1e300), ("time.t_end", 1e300), ("time.field_interval", 1e300),
-                 ("contact.pairs[0].alpha_n", 1e300))
+ALWAYS: tuple = (
+    ("granules[1].y", 1e300),
+    ("time.t_end", 1e300),
+    ("time.field_interval", 1e300),
+    ("contact.pairs[0].alpha_n", 1e300),
+)
 N_CLI_CASES = 3
 #: A run of 2 us of this scenario takes well under a second once the kernels are compiled;
 #: the limit also covers their first compilation (1-3 min on a loaded machine).
@@ -102,8 +137,9 @@ def test_base_scenario_runs():
     assert len(numeric_fields(BASE)) * len(BAD_VALUES) >= 200
 
 
-@pytest.mark.parametrize("path,value", [*ALWAYS, *(c for c in cases(N_CASES, SEED) if c not in ALWAYS)],
-                         ids=lambda v: repr(v))
+@pytest.mark.parametrize(
+    "path,value", [*ALWAYS, *(c for c in cases(N_CASES, SEED) if c not in ALWAYS)], ids=lambda v: repr(v)
+)
 def test_bad_number_is_refused_by_name_or_runs(path, value):
     """Any field set to -1, 0, NaN, inf, 1e300 or a string: a one-line ScenarioError naming
     the field before anything runs, or a 2 us run that ends with finite energies."""
@@ -144,8 +180,13 @@ def test_command_line_reports_bad_numbers_in_one_line(tmp_path):
         f = tmp_path / f"case{k}.toml"
         f.write_text(tomli_w.dumps(mutated(BASE, path, value)))
         out = tmp_path / f"case{k}.nc"
-        p = subprocess.run([sys.executable, "-m", "granplate.cli", "run", str(f), "-q", "-o", str(out)],
-                           capture_output=True, text=True, timeout=120, env=env)
+        p = subprocess.run(
+            [sys.executable, "-m", "granplate.cli", "run", str(f), "-q", "-o", str(out)],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            env=env,
+        )
         lines = p.stderr.strip().splitlines()
         assert p.returncode == 2, (path, value, p.stderr)
         assert len(lines) == 1 and lines[0].startswith("granplate: error: "), p.stderr
@@ -154,8 +195,19 @@ def test_command_line_reports_bad_numbers_in_one_line(tmp_path):
 
 
 #: Every layout kind, from its worked example (docs/examples) and the paper's preset.
-LAYOUT_SOURCES: tuple[str, ...] = ("paper", "hexagonal", "square", "chain", "imperfect",
-                                   "intruder-lattice", "3d-sc", "3d-bcc", "3d-fcc", "3d-hcp", "3d-chain")
+LAYOUT_SOURCES: tuple[str, ...] = (
+    "paper",
+    "hexagonal",
+    "square",
+    "chain",
+    "imperfect",
+    "intruder-lattice",
+    "3d-sc",
+    "3d-bcc",
+    "3d-fcc",
+    "3d-hcp",
+    "3d-chain",
+)
 LAYOUT_BAD_VALUES: tuple = (-1.0, 0.0, math.nan, math.inf, 1e300, 1e-300, "x")
 
 
@@ -163,6 +215,7 @@ def _layout_scenario(name: str):
     from pathlib import Path
 
     from granplate.setup.io import load_scenario
+
     if name == "paper":
         return gp.preset("steel-r1")
     return load_scenario(Path(__file__).resolve().parents[1] / "docs" / "examples" / f"{name}.toml")
@@ -174,13 +227,19 @@ def test_layout_fields_refused_by_name(name):
     accepted by validation or refused naming that field: never an overflow in the layout's
     expansion, never a derived granule field blamed instead."""
     import dataclasses
+
     s = _layout_scenario(name)
     lay = s.layout
     tables = [("layout", lay, lambda v: dataclasses.replace(lay, **v))]
     if lay.imperfections is not None:
         imp = lay.imperfections
-        tables.append(("layout.imperfections", imp,
-                       lambda v: dataclasses.replace(lay, imperfections=dataclasses.replace(imp, **v))))
+        tables.append(
+            (
+                "layout.imperfections",
+                imp,
+                lambda v: dataclasses.replace(lay, imperfections=dataclasses.replace(imp, **v)),
+            )
+        )
     tried = 0
     for prefix, table, rebuild in tables:
         for f in dataclasses.fields(table):

@@ -1,4 +1,5 @@
 """The paper's packing (docs/model.md section 1) and scenario resolution."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -66,7 +67,10 @@ def test_layout_order_labels_materials_and_walls():
     assert [g.y for g in gs[:5]] == pytest.approx([0.09, 0.07, 0.05, 0.03, 0.01])
     assert [g.y for g in gs[5:9]] == pytest.approx([0.08, 0.06, 0.04, 0.02])
     assert [(w.label, w.normal, w.offset) for w in walls] == [
-        ("left", (-1.0, 0.0), 0.0), ("bottom", (0.0, -1.0), 0.0), ("top", (0.0, 1.0), 0.1)]
+        ("left", (-1.0, 0.0), 0.0),
+        ("bottom", (0.0, -1.0), 0.0),
+        ("top", (0.0, 1.0), 0.1),
+    ]
     d = column_offset(0.01, 0.005)
     assert xp == pytest.approx(0.01 + 2 * d + 0.01, abs=1e-15)
 
@@ -95,9 +99,10 @@ def test_resolve_expands_layout_and_places_plate():
 
 def test_resolve_labels_unlabelled_granules_and_walls():
     """Unlabelled granules/walls get 'g<i>'/'w<i>' labels; labelled ones keep theirs."""
-    s = Scenario(granules=(Granule(0.0, 0.0, 0.01, "steel"),
-                           Granule(0.03, 0.0, 0.01, "steel", label="b")),
-                 walls=(Wall((-1.0, 0.0), 0.01),))
+    s = Scenario(
+        granules=(Granule(0.0, 0.0, 0.01, "steel"), Granule(0.03, 0.0, 0.01, "steel", label="b")),
+        walls=(Wall((-1.0, 0.0), 0.01),),
+    )
     r = resolve(s)
     assert [g.label for g in r.granules] == ["g0", "b"]
     assert [w.label for w in r.walls] == ["w0"]

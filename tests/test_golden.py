@@ -10,6 +10,7 @@ so a change of build moves it by a large share of its own value (measured from n
 0.60 / numpy 2.0 to numba 0.68 / numpy 2.4: up to 71% of 1.8e-13, 1.5e-11 of E_shock at
 most), while every other metric stayed within 1.5e-9 of its value.
 """
+
 from __future__ import annotations
 
 import json

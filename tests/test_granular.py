@@ -3,6 +3,7 @@ book exactly the kinetic energy they remove, a sphere striking a wall with spin 
 it rolling as the impulse balance demands, a sphere squeezed between two walls loses all
 its kinetic energy to friction with the balance exact to round-off, and in a packing
 friction no longer sets the step."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -16,7 +17,14 @@ from granplate.results.run import simulate
 from granplate.setup.geometry import resolve
 from granplate.setup.materials import LIBRARY, sphere_mass
 from granplate.setup.scenario import (
-    Contact, Granule, LatticeLayout, Load, Scenario, Solver, TimeSettings, Wall,
+    Contact,
+    Granule,
+    LatticeLayout,
+    Load,
+    Scenario,
+    Solver,
+    TimeSettings,
+    Wall,
 )
 from granplate.physics.contact import COEF_A, COEF_KS, hertz_elastic
 from granplate.solver.granular import friction_flow, kinetic_energies, slip_relaxation_rate
@@ -24,28 +32,42 @@ from granplate.solver.granular import friction_flow, kinetic_energies, slip_rela
 R = 0.01
 
 
-def single(granule: Granule, walls, t_end: float, friction: str, scheme: str = "implicit", mu: float = 0.5,
-           out: float = 1e-5) -> Scenario:
+def single(
+    granule: Granule, walls, t_end: float, friction: str, scheme: str = "implicit", mu: float = 0.5, out: float = 1e-5
+) -> Scenario:
     """One steel sphere among rigid walls, no load."""
-    return Scenario(name="friction", granules=(granule,), walls=tuple(walls), load=Load(kind="none"),
-                    contact=Contact(mu=mu, pairs=()),
-                    time=TimeSettings(t_end=t_end, dt_initial=1e-8, dt_max=4e-8, output_interval=out,
-                                      field_interval=out),
-                    solver=Solver(scheme=scheme, granular_friction=friction))
+    return Scenario(
+        name="friction",
+        granules=(granule,),
+        walls=tuple(walls),
+        load=Load(kind="none"),
+        contact=Contact(mu=mu, pairs=()),
+        time=TimeSettings(t_end=t_end, dt_initial=1e-8, dt_max=4e-8, output_interval=out, field_interval=out),
+        solver=Solver(scheme=scheme, granular_friction=friction),
+    )
 
 
-def packing(mu: float, friction: str = "split", cols: int = 4, rows: int = 6, t_end: float = 2e-5,
-            implicit_dt_max: float = 1e-6) -> Scenario:
+def packing(
+    mu: float, friction: str = "split", cols: int = 4, rows: int = 6, t_end: float = 2e-5, implicit_dt_max: float = 1e-6
+) -> Scenario:
     """A hexagonal packing of 1 mm steel spheres in its walls, column 1 launched at 1 m/s."""
-    s = resolve(Scenario(
-        name="packing", layout=LatticeLayout(kind="hexagonal", columns=cols, rows=rows, radius=1e-3),
-        load=Load(kind="none"), contact=Contact(mu=mu),
-        time=TimeSettings(t_end=t_end, dt_initial=1e-8, dt_max=4e-8, output_interval=t_end / 4,
-                          field_interval=t_end / 4),
-        solver=Solver(granular_friction=friction, implicit_dt_max=implicit_dt_max)))
+    s = resolve(
+        Scenario(
+            name="packing",
+            layout=LatticeLayout(kind="hexagonal", columns=cols, rows=rows, radius=1e-3),
+            load=Load(kind="none"),
+            contact=Contact(mu=mu),
+            time=TimeSettings(
+                t_end=t_end, dt_initial=1e-8, dt_max=4e-8, output_interval=t_end / 4, field_interval=t_end / 4
+            ),
+            solver=Solver(granular_friction=friction, implicit_dt_max=implicit_dt_max),
+        )
+    )
     left = min(g.x - g.radius for g in s.granules)
-    return dataclasses.replace(s, granules=tuple(
-        dataclasses.replace(g, vx=1.0) if abs(g.x - g.radius - left) < 1e-9 else g for g in s.granules))
+    return dataclasses.replace(
+        s,
+        granules=tuple(dataclasses.replace(g, vx=1.0) if abs(g.x - g.radius - left) < 1e-9 else g for g in s.granules),
+    )
 
 
 def test_friction_half_step_books_the_kinetic_energy_it_removes():
@@ -102,8 +124,7 @@ def test_squeezed_sphere_loses_its_kinetic_energy_to_friction_exactly():
     (A scenario cannot start overlapped: the model of a sphere touching both walls gets a
     radius 50 um larger, so that it starts pressed by both.)"""
     ball = Granule(x=R, y=0.0, radius=R, material="steel", label="s", vy=0.3, omega=50.0)
-    walls = [Wall(normal=(-1.0, 0.0), offset=0.0, label="left"),
-             Wall(normal=(1.0, 0.0), offset=2 * R, label="right")]
+    walls = [Wall(normal=(-1.0, 0.0), offset=0.0, label="left"), Wall(normal=(1.0, 0.0), offset=2 * R, label="right")]
     s = single(ball, walls, 2e-4, "split", mu=0.2, out=2e-5)
     model = build_model(s)
     model.granular.radius[0] = R + 5e-5
@@ -115,8 +136,13 @@ def test_squeezed_sphere_loses_its_kinetic_energy_to_friction_exactly():
     assert np.all(np.diff(ds.D_friction.values) >= 0.0)
     assert float(np.max(np.abs(ds.energy_residual.values))) < 1e-12
     g = model.granular  # RK4 on this friction would need t_end x its stick relaxation rate steps
-    rate = slip_relaxation_rate(hertz_elastic(5e-5, g.wall_coef[0, COEF_A]), 0.0, 0.2, g.wall_coef[0, COEF_KS],
-                                1.0 / m + g.radius[0] ** 2 / inertia)
+    rate = slip_relaxation_rate(
+        hertz_elastic(5e-5, g.wall_coef[0, COEF_A]),
+        0.0,
+        0.2,
+        g.wall_coef[0, COEF_KS],
+        1.0 / m + g.radius[0] ** 2 / inertia,
+    )
     assert 50 * ds.attrs["n_steps"] < 2e-4 * rate
 
 
@@ -126,8 +152,12 @@ def test_friction_no_longer_sets_the_step_in_a_packing():
     final velocities and friction work agree with a run of 16x smaller steps."""
     steps = {}
     runs = {}
-    for key, mu, friction, dt_max in [("frictionless", 0.0, "split", 1e-6), ("split", 0.099, "split", 1e-6),
-                                      ("rk4", 0.099, "rk4", 1e-6), ("fine", 0.099, "split", 5e-6 / 2**11)]:
+    for key, mu, friction, dt_max in [
+        ("frictionless", 0.0, "split", 1e-6),
+        ("split", 0.099, "split", 1e-6),
+        ("rk4", 0.099, "rk4", 1e-6),
+        ("fine", 0.099, "split", 5e-6 / 2**11),
+    ]:
         runs[key] = simulate(packing(mu, friction, implicit_dt_max=dt_max), progress=False)
         steps[key] = runs[key].attrs["n_steps"]
     assert steps["split"] <= 1.5 * steps["frictionless"]
@@ -150,8 +180,13 @@ def test_strong_shock_takes_the_steps_of_the_frictionless_run():
     from granplate.setup.io import with_changes
     from granplate.setup.presets import preset
 
-    base = {"load.q0": 1e7, "time.t_end": 1.6e-4, "time.field_interval": 2e-5, "contact.overlap_stop": 0.5,
-            "solver.granular_friction": "split"}
+    base = {
+        "load.q0": 1e7,
+        "time.t_end": 1.6e-4,
+        "time.field_interval": 2e-5,
+        "contact.overlap_stop": 0.5,
+        "solver.granular_friction": "split",
+    }
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # overlaps beyond contact.overlap_warn
         ds = simulate(with_changes(preset("ptfe-r05"), base), progress=False)
@@ -189,8 +224,9 @@ def test_force_sums_name_the_stored_energy_and_the_largest_overlap(split):
 
     a = Granule(x=R + 1e-5, y=0.0, radius=R, material="steel", label="a")
     b = Granule(x=3 * R + 2e-5, y=0.0, radius=R, material="steel", label="b")
-    s = dataclasses.replace(single(a, [Wall(normal=(-1.0, 0.0), offset=0.0, label="left")], 1e-5, "split"),
-                            granules=(a, b))
+    s = dataclasses.replace(
+        single(a, [Wall(normal=(-1.0, 0.0), offset=0.0, label="left")], 1e-5, "split"), granules=(a, b)
+    )
     model = build_model(s)
     g, cfg = model.granular, model.config
     assert g.pair_ij.shape[0] == 1 and g.wall_i.tolist() == [0]

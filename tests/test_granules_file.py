@@ -1,6 +1,7 @@
 """Granules from a file (granules_file: CSV, NPZ, netCDF): the truth is the same scenario
 given as [[granules]] tables (equal scenario, the same run bit for bit, the same messages
 with the row and column named), and a result's state at its last output time."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -83,7 +84,7 @@ def _with_file(tmp_path, text: str, ext: str, dimension: int) -> str:
     write_granules(s.granules, tmp_path / f"granules.{ext}", dimension)
     head, _, _ = text.partition("[[granules]]")
     rest = text.partition("[solver]")[2]
-    body = head.replace('name = ', f'granules_file = "granules.{ext}"\nname = ', 1)
+    body = head.replace("name = ", f'granules_file = "granules.{ext}"\nname = ', 1)
     return body + ("[solver]" + rest if rest else "")
 
 
@@ -119,15 +120,19 @@ def _error(fn) -> ScenarioError:
     return e.value
 
 
-def _csv(tmp_path, rows: list[str], header="x,y,z,radius,material,label,vx,vy,vz,omega_x,omega_y,omega_z",
-         dimension=3) -> str:
+def _csv(
+    tmp_path, rows: list[str], header="x,y,z,radius,material,label,vx,vy,vz,omega_x,omega_y,omega_z", dimension=3
+) -> str:
     (tmp_path / "g.csv").write_text("\n".join([header] + rows) + "\n")
     text = HEAD_3D if dimension == 3 else 'name = "two"\n'
     return text.replace("name = ", 'granules_file = "g.csv"\nname = ', 1) + (TAIL_3D if dimension == 3 else "")
 
 
-GOOD = ["0.005,0.01,0.01,0.002,steel,a,0,0,0,0,0,0", "0.0095,0.0101,0.0099,0.0025,ptfe,b,0,0,0,0,0,0",
-        "0.02,0.01,0.01,0.003,steel,c,0,0,0,0,0,0"]
+GOOD = [
+    "0.005,0.01,0.01,0.002,steel,a,0,0,0,0,0,0",
+    "0.0095,0.0101,0.0099,0.0025,ptfe,b,0,0,0,0,0,0",
+    "0.02,0.01,0.01,0.003,steel,c,0,0,0,0,0,0",
+]
 
 
 def _bad(row: int, cell: int, value: str) -> list[str]:
@@ -136,15 +141,18 @@ def _bad(row: int, cell: int, value: str) -> list[str]:
     return [",".join(r) for r in rows]
 
 
-@pytest.mark.parametrize("row,cell,value,column,allowed", [
-    (2, 3, "-0.001", "radius", "must be > 0"),
-    (1, 0, "abc", "x", "wrong type: expected a number"),
-    (0, 4, "", "material", None),  # missing required cell
-    (2, 4, "stel", "material", "unknown material; defined materials are: "),
-    (1, 6, "1e9", "vx", "allowed: |vx| < sqrt(E / rho)"),
-    (2, 9, "nan", "omega_x", "must be a finite number"),
-    (1, 5, "a", "label", "labels must be unique; "),
-])
+@pytest.mark.parametrize(
+    "row,cell,value,column,allowed",
+    [
+        (2, 3, "-0.001", "radius", "must be > 0"),
+        (1, 0, "abc", "x", "wrong type: expected a number"),
+        (0, 4, "", "material", None),  # missing required cell
+        (2, 4, "stel", "material", "unknown material; defined materials are: "),
+        (1, 6, "1e9", "vx", "allowed: |vx| < sqrt(E / rho)"),
+        (2, 9, "nan", "omega_x", "must be a finite number"),
+        (1, 5, "a", "label", "labels must be unique; "),
+    ],
+)
 def test_a_bad_row_is_named_as_its_table_would_be(tmp_path, row, cell, value, column, allowed):
     rows = _bad(row, cell, value)
     (tmp_path / "s.toml").write_text(_csv(tmp_path, rows))
@@ -173,9 +181,12 @@ def _tables_of(rows: list[str]) -> str:
                 return repr(float(v)) if v.strip().lower() != "nan" else "nan"
             except ValueError:
                 return f'"{v}"'
-        out.append(f"[[granules]]\nx = {num(x)}\ny = {num(y)}\nz = {num(z)}\nradius = {num(rad)}\n"
-                   f'material = "{mat}"\nlabel = "{lab}"\nvx = {num(vx)}\nvy = {num(vy)}\nvz = {num(vz)}\n'
-                   f"omega = [{num(ox)}, {num(oy)}, {num(oz)}]\n")
+
+        out.append(
+            f"[[granules]]\nx = {num(x)}\ny = {num(y)}\nz = {num(z)}\nradius = {num(rad)}\n"
+            f'material = "{mat}"\nlabel = "{lab}"\nvx = {num(vx)}\nvy = {num(vy)}\nvz = {num(vz)}\n'
+            f"omega = [{num(ox)}, {num(oy)}, {num(oz)}]\n"
+        )
     return "\n".join(out)
 
 
@@ -185,12 +196,14 @@ def test_overlaps_and_columns_are_named_by_row(tmp_path):
     err = _error(lambda: load_scenario(tmp_path / "s.toml"))
     assert err.field == "g.csv, row 1" and "(g.csv, row 2) by " in err.allowed
     assert "placed by g.csv, row 1, column x, g.csv, row 1, column y" in err.allowed
-    (tmp_path / "s.toml").write_text(_csv(tmp_path, GOOD, header="x,y,z,raduis,material,label,vx,vy,vz,"
-                                                                  "omega_x,omega_y,omega_z"))
+    (tmp_path / "s.toml").write_text(
+        _csv(tmp_path, GOOD, header="x,y,z,raduis,material,label,vx,vy,vz,omega_x,omega_y,omega_z")
+    )
     err = _error(lambda: load_scenario(tmp_path / "s.toml"))
     assert err.field == "g.csv, column raduis" and "did you mean 'radius'?" in err.allowed
-    (tmp_path / "s.toml").write_text(_csv(tmp_path, [",".join(r.split(",")[:3] + r.split(",")[4:6]) for r in GOOD],
-                                          header="x,y,z,material,label"))
+    (tmp_path / "s.toml").write_text(
+        _csv(tmp_path, [",".join(r.split(",")[:3] + r.split(",")[4:6]) for r in GOOD], header="x,y,z,material,label")
+    )
     err = _error(lambda: load_scenario(tmp_path / "s.toml"))
     assert err.field == "g.csv, column radius" and "missing required column" in err.allowed
 
@@ -201,12 +214,14 @@ def test_the_plane_takes_omega_z_and_refuses_the_third_dimension(tmp_path):
     (tmp_path / "s.toml").write_text(_csv(tmp_path, rows, header=header, dimension=2))
     s = load(tmp_path / "s.toml")
     assert s.granules[0].omega == 2.5 and s.dimension == 2
-    (tmp_path / "s.toml").write_text(_csv(tmp_path, [rows[0], rows[1].replace(",0,0,0,0,0", ",0,0,0.5,0,0")],
-                                          header=header, dimension=2))
+    (tmp_path / "s.toml").write_text(
+        _csv(tmp_path, [rows[0], rows[1].replace(",0,0,0,0,0", ",0,0,0.5,0,0")], header=header, dimension=2)
+    )
     err = _error(lambda: load_scenario(tmp_path / "s.toml"))
     assert err.field == "g.csv, row 2, column z" and err.allowed.startswith("must be 0 in 2D")
-    (tmp_path / "s.toml").write_text(_csv(tmp_path, [rows[0].replace(",0,0,0,0,2.5", ",0,0,0,1,2.5"), rows[1]],
-                                          header=header, dimension=2))
+    (tmp_path / "s.toml").write_text(
+        _csv(tmp_path, [rows[0].replace(",0,0,0,0,2.5", ",0,0,0,1,2.5"), rows[1]], header=header, dimension=2)
+    )
     err = _error(lambda: load(tmp_path / "s.toml"))
     assert err.field == "g.csv, row 1, column omega_x" and "omega_z" in err.allowed
 
@@ -234,7 +249,7 @@ def test_a_result_seeds_a_scenario_at_its_last_output_time(tmp_path):
     from granplate.results.seed import seeded_scenario
 
     # two spheres flying apart with spins: never in contact, so the seed is a valid start
-    text = TABLES_3D.replace("vx = 1.5", "vx = -1.5").replace("material = \"ptfe\"", "material = \"ptfe\"\nvz = 0.5")
+    text = TABLES_3D.replace("vx = 1.5", "vx = -1.5").replace('material = "ptfe"', 'material = "ptfe"\nvz = 0.5')
     from granplate.results.dataset import write
 
     ds = gp.simulate(loads(text), progress=False)
@@ -246,6 +261,17 @@ def test_a_result_seeds_a_scenario_at_its_last_output_time(tmp_path):
             assert v == float(ds[k].values[-1, i])
         assert g.omega == tuple(float(ds[f"omega_{c}"].values[-1, i]) for c in "xyz")
     assert seed.granules[0].omega == (10.0, -20.0, 30.0) and seed.granules[0].x < 0.005  # free flight
-    assert main(["resolve", str(tmp_path / "r.nc"), "--granules-file", str(tmp_path / "g.nc"),
-                 "-o", str(tmp_path / "s.toml")]) == 0
+    assert (
+        main(
+            [
+                "resolve",
+                str(tmp_path / "r.nc"),
+                "--granules-file",
+                str(tmp_path / "g.nc"),
+                "-o",
+                str(tmp_path / "s.toml"),
+            ]
+        )
+        == 0
+    )
     assert load_scenario(tmp_path / "s.toml") == seed

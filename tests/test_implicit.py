@@ -1,5 +1,6 @@
 """The "implicit" coupling scheme against the paper's fixed-point scheme (its converged
 reference at small steps): same physics, far fewer steps, no stick chatter."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -13,7 +14,9 @@ def pressed_and_sheared(scheme: str) -> Scenario:
     """A sphere driven onto the plate (0.05 m/s) while sliding slowly along it (0.1 mm/s):
     the contact sticks and slips as the plate vibrates under it."""
     return Scenario(
-        name="stick", load=Load(kind="none"), plate=Plate(x0=0.02),
+        name="stick",
+        load=Load(kind="none"),
+        plate=Plate(x0=0.02),
         granules=(Granule(x=0.01, y=0.05, radius=0.01, material="steel", label="s", vx=0.05, vy=1e-4),),
         time=TimeSettings(t_end=2.5e-4, output_interval=5e-7, field_interval=5e-5),
         solver=Solver(scheme=scheme),
@@ -97,8 +100,12 @@ def test_newmark_mode_coefficients_are_newmark():
     q1 = q0 + h * v0 + h * h / 4 * (a0 + a1)
     v1 = v0 + h / 2 * (a0 + a1)
     b = K.MC_STRIDE
-    assert row[b + K.MC_QQ] * q0 + row[b + K.MC_QV] * v0 + row[b + K.MC_QF0] * f0 + row[b + K.MC_QF1] * f1 == pytest.approx(q1, rel=1e-12)
-    assert row[b + K.MC_VQ] * q0 + row[b + K.MC_VV] * v0 + row[b + K.MC_VF0] * f0 + row[b + K.MC_VF1] * f1 == pytest.approx(v1, rel=1e-12)
+    assert row[b + K.MC_QQ] * q0 + row[b + K.MC_QV] * v0 + row[b + K.MC_QF0] * f0 + row[
+        b + K.MC_QF1
+    ] * f1 == pytest.approx(q1, rel=1e-12)
+    assert row[b + K.MC_VQ] * q0 + row[b + K.MC_VV] * v0 + row[b + K.MC_VF0] * f0 + row[
+        b + K.MC_VF1
+    ] * f1 == pytest.approx(v1, rel=1e-12)
 
 
 def test_implicit_steps_tile_the_output_interval():

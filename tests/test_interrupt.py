@@ -1,5 +1,6 @@
 """A run can be stopped: a stop request or SIGINT ends the compiled loop between chunks
 (each bounded by a step budget of about CHUNK_SECONDS), and the result so far is kept."""
+
 from __future__ import annotations
 
 import os
@@ -78,7 +79,10 @@ def test_cli_ctrl_c_writes_partial_file(tmp_path):
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     proc = subprocess.Popen(
         [sys.executable, "-m", "granplate.cli", "run", str(scenario), "-o", str(out)],
-        stderr=subprocess.PIPE, stdout=subprocess.PIPE, env=env, cwd=tmp_path,
+        stderr=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        env=env,
+        cwd=tmp_path,
     )
     seen = b""
     deadline = time.monotonic() + 300  # a cold numba cache compiles first

@@ -3,6 +3,7 @@ yield, force and slope continuous at yield and at the bridge's end, the fully pl
 line 2 pi R* h Y(rate) delta, unloading and reloading along the Hertz curve of the
 residual overlap, energy (stored + plastic work = work done, by quadrature), the rate
 dependence, the commit rule, and bad material fields refused by name."""
+
 from __future__ import annotations
 
 import math
@@ -14,8 +15,15 @@ from scipy.integrate import quad
 import granplate as gp
 from granplate.errors import ScenarioError
 from granplate.setup.validate import validate
-from granplate.physics.cavity import (X_BRIDGE, hardness_overlap, johnson_normal_response, johnson_state,
-                                      loading_curve, rate_factor, unloading_span)
+from granplate.physics.cavity import (
+    X_BRIDGE,
+    hardness_overlap,
+    johnson_normal_response,
+    johnson_state,
+    loading_curve,
+    rate_factor,
+    unloading_span,
+)
 from granplate.physics.contact import COEF_C, COEF_DY, hertz_elastic, normal_response
 from granplate.physics.laws import normal_law_response
 from granplate.solver.granular import fixing_speed
@@ -86,15 +94,22 @@ def test_energy_stored_plus_plastic_work_is_the_work_done(h, kappa):
     stored energy at x_m plus W_p(x_m); the unloading returns the stored energy; W_p never decreases."""
     for xm in (1.5, 3.0, 30.0, 3000.0):
         f, k, w = loading_curve(xm, h)
-        work = quad(lambda x: loading_curve(x, h)[0] if x >= 1.0 else loading_curve(1.0, h)[0] * x**1.5,
-                    0.0, xm, points=[p for p in (1.0, X_BRIDGE, hardness_overlap(h)) if p < xm], limit=200)[0]
+        work = quad(
+            lambda x: loading_curve(x, h)[0] if x >= 1.0 else loading_curve(1.0, h)[0] * x**1.5,
+            0.0,
+            xm,
+            points=[p for p in (1.0, X_BRIDGE, hardness_overlap(h)) if p < xm],
+            limit=200,
+        )[0]
         assert w == pytest.approx(work, rel=1e-8)
         om = unloading_span(xm, f, kappa)
         back = quad(lambda x: f * ((x - (xm - om)) / om) ** 1.5, xm - om, xm)[0]
         assert back == pytest.approx(0.4 * f * om, rel=1e-9)
     xs = np.geomspace(1.0, 1e5, 3000)
-    wp = [loading_curve(x, h)[2] - 0.4 * loading_curve(x, h)[0] * unloading_span(x, loading_curve(x, h)[0], kappa)
-          for x in xs]
+    wp = [
+        loading_curve(x, h)[2] - 0.4 * loading_curve(x, h)[0] * unloading_span(x, loading_curve(x, h)[0], kappa)
+        for x in xs
+    ]
     assert np.all(np.diff(wp) >= -1e-12 * np.abs(wp[1:]))
 
 
@@ -134,22 +149,36 @@ def test_commit_rule_fixes_the_loading_speed_of_the_step():
 MAT = "[materials.m]\nE = 2e11\nnu = 0.3\nrho = 7800\nY = 6e8\n"
 
 
-@pytest.mark.parametrize("extra, field", [("C = 0.02\n", "materials.m.rate_ref"), ("rate_ref = 1e-3\n", "materials.m.C"),
-                                          ("C = -0.1\nrate_ref = 1e-3\n", "materials.m.C"),
-                                          ("C = 0.02\nrate_ref = 0\n", "materials.m.rate_ref"),
-                                          ("hardness_ratio = 9\n", "materials.m.hardness_ratio"),
-                                          ("unloading_factor = 0.75\n", "materials.m.unloading_factor")])
+@pytest.mark.parametrize(
+    "extra, field",
+    [
+        ("C = 0.02\n", "materials.m.rate_ref"),
+        ("rate_ref = 1e-3\n", "materials.m.C"),
+        ("C = -0.1\nrate_ref = 1e-3\n", "materials.m.C"),
+        ("C = 0.02\nrate_ref = 0\n", "materials.m.rate_ref"),
+        ("hardness_ratio = 9\n", "materials.m.hardness_ratio"),
+        ("unloading_factor = 0.75\n", "materials.m.unloading_factor"),
+    ],
+)
 def test_bad_material_fields_are_refused_by_name(extra, field):
-    text = MAT + extra + ('[[granules]]\nlabel = "a"\nx = 0.0\ny = 0.0\nradius = 0.01\nmaterial = "m"\n'
-                          '[load]\nkind = "none"\n[contact]\nnormal_law = "johnson"\n')
+    text = (
+        MAT
+        + extra
+        + (
+            '[[granules]]\nlabel = "a"\nx = 0.0\ny = 0.0\nradius = 0.01\nmaterial = "m"\n'
+            '[load]\nkind = "none"\n[contact]\nnormal_law = "johnson"\n'
+        )
+    )
     with pytest.raises(ScenarioError) as e:
         validate(gp.loads(text))
     assert e.value.field == field
 
 
 def test_unknown_law_lists_johnson_and_johnson_needs_y():
-    base = ('[[granules]]\nlabel = "a"\nx = 0.0\ny = 0.0\nradius = 0.01\nmaterial = "steel"\n'
-            '[[granules]]\nlabel = "b"\nx = 0.03\ny = 0.0\nradius = 0.01\nmaterial = "m"\n[load]\nkind = "none"\n')
+    base = (
+        '[[granules]]\nlabel = "a"\nx = 0.0\ny = 0.0\nradius = 0.01\nmaterial = "steel"\n'
+        '[[granules]]\nlabel = "b"\nx = 0.03\ny = 0.0\nradius = 0.01\nmaterial = "m"\n[load]\nkind = "none"\n'
+    )
     with pytest.raises(ScenarioError, match="johnson"):
         gp.loads(base + '[materials.m]\nE = 2e11\nnu = 0.3\nrho = 7800\n[contact]\nnormal_law = "jonson"\n')
     with pytest.raises(ScenarioError) as e:
@@ -162,6 +191,8 @@ def test_built_in_materials_round_trip():
     from granplate.setup.materials import LIBRARY
 
     assert (LIBRARY["steel_440c"].Y, LIBRARY["steel_302"].C, LIBRARY["aluminium_2017"].E) == (1896e6, 0.025, 76e9)
-    s = gp.loads(MAT + "C = 0.02\nrate_ref = 0.001\nhardness_ratio = 3\nunloading_factor = 0.3\n"
-                 '[[granules]]\nlabel = "a"\nx = 0.0\ny = 0.0\nradius = 0.01\nmaterial = "m"\n[load]\nkind = "none"\n')
+    s = gp.loads(
+        MAT + "C = 0.02\nrate_ref = 0.001\nhardness_ratio = 3\nunloading_factor = 0.3\n"
+        '[[granules]]\nlabel = "a"\nx = 0.0\ny = 0.0\nradius = 0.01\nmaterial = "m"\n[load]\nkind = "none"\n'
+    )
     assert gp.loads(gp.dumps(s)).material("m") == s.material("m")

@@ -2,6 +2,7 @@
 law's energy closed form (restitution e^2 = stored / kinetic at the largest overlap where the
 loading work equals 1/2 m* v^2), eq. (11) with D_plastic at every step (damped, frictional,
 in the plane and in space), the history across list rebuilds, the yield report's law."""
+
 from __future__ import annotations
 
 import math
@@ -23,14 +24,25 @@ MASS = 4.0 / 3.0 * math.pi * R**3 * MAT.rho
 V = 1.0  # [m/s]
 
 
-def impact(kind: str, *, skin: float = 0.1, alpha_n: float = 0.0, mu: float = 0.0, vy: float = 0.0,
-           dimension: int = 2, law: str = "johnson") -> gp.Scenario:
+def impact(
+    kind: str,
+    *,
+    skin: float = 0.1,
+    alpha_n: float = 0.0,
+    mu: float = 0.0,
+    vy: float = 0.0,
+    dimension: int = 2,
+    law: str = "johnson",
+) -> gp.Scenario:
     """A steel_302 sphere (R = 5 mm) touching a rigid wall or an equal sphere at rest at t = 0, moving into
     it at V along x."""
     z = "z = 0.0\n" if dimension == 3 else ""
-    other = (f'[[walls]]\nlabel = "left"\nnormal = [-1.0, 0.0{", 0.0" if dimension == 3 else ""}]\noffset = 0.0\n'
-             'material = "steel_302"\n' if kind == "wall" else
-             f'[[granules]]\nlabel = "b"\nx = {-R}\ny = 0.0\n{z}radius = {R}\nmaterial = "steel_302"\n')
+    other = (
+        f'[[walls]]\nlabel = "left"\nnormal = [-1.0, 0.0{", 0.0" if dimension == 3 else ""}]\noffset = 0.0\n'
+        'material = "steel_302"\n'
+        if kind == "wall"
+        else f'[[granules]]\nlabel = "b"\nx = {-R}\ny = 0.0\n{z}radius = {R}\nmaterial = "steel_302"\n'
+    )
     text = f"""name = "johnson-{kind}"
 dimension = {dimension}
 [[granules]]

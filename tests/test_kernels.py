@@ -1,5 +1,6 @@
 """The compiled loop's parts as units: the plate compliance G(h) of criterion (8), the
 dense solve of the Newton step, each scheme's single step, and the scheme registry."""
+
 from __future__ import annotations
 
 import math
@@ -54,15 +55,42 @@ def one_mode_run(scheme: str, omega_h: float, n_steps: int = 1, budget: int = 10
     w = 2 * math.pi * 1000.0
     h = omega_h / w
     ei, ef = np.zeros(0, np.int64), np.zeros(0)
-    g = Granular(mass=ef, inertia=ef, radius=ef, pair_ij=np.zeros((0, 2), np.int64),
-                 pair_coef=np.zeros((0, N_COEF)), wall_i=ei, wall_geo=np.zeros((0, 3)),
-                 wall_coef=np.zeros((0, N_COEF)), wall_w=ei, pc_i=ei, pc_x=ef, pc_coef=np.zeros((0, N_COEF)),
-                 shock_force=ef, shock_torque=ef)
+    g = Granular(
+        mass=ef,
+        inertia=ef,
+        radius=ef,
+        pair_ij=np.zeros((0, 2), np.int64),
+        pair_coef=np.zeros((0, N_COEF)),
+        wall_i=ei,
+        wall_geo=np.zeros((0, 3)),
+        wall_coef=np.zeros((0, N_COEF)),
+        wall_w=ei,
+        pc_i=ei,
+        pc_x=ef,
+        pc_coef=np.zeros((0, N_COEF)),
+        shock_force=ef,
+        shock_torque=ef,
+    )
     p = PlateArrays(omega2=np.array([w * w]), phi_d=np.zeros((0, 1)), load_modal=np.zeros(1))
-    cfg = Config(q0=0.0, duration=1.0, clip=True, lambda_target=0.5, rtol=1e-9, atol=1e-10,
-                 max_iter=10, energy_tol=1.0, dt_max=h, dt_min=h * 1e-3, out_dt=n_steps * h, t_end=n_steps * h,
-                 load_on_plate=False, arm_shrink=0.0, scheme=scheme_number(scheme),
-                 error_tol=1e-3, force_floor=0.0)
+    cfg = Config(
+        q0=0.0,
+        duration=1.0,
+        clip=True,
+        lambda_target=0.5,
+        rtol=1e-9,
+        atol=1e-10,
+        max_iter=10,
+        energy_tol=1.0,
+        dt_max=h,
+        dt_min=h * 1e-3,
+        out_dt=n_steps * h,
+        t_end=n_steps * h,
+        load_on_plate=False,
+        arm_shrink=0.0,
+        scheme=scheme_number(scheme),
+        error_tol=1e-3,
+        force_floor=0.0,
+    )
     st, w_, out = S.new_state(0, 1, 0), S.new_work(0, 1, 0), S.new_output(np.array([0.0, n_steps * h]), 0, 1, 0)
     sw = schemes.scheme(scheme).new_scratch(0, 1, 0)
     st.q[0] = 1.0
@@ -116,8 +144,17 @@ def test_registry_names_and_refusals():
     for i, name in enumerate(SCHEME_NAMES):
         mod = schemes.scheme(name)
         assert schemes.scheme(i) is mod and mod.NAME == name
-        for hook in ("plan", "prepare_level", "attempt", "judge", "commit", "next_level", "contact_placed",
-                     "contacts_moved", "new_scratch"):
+        for hook in (
+            "plan",
+            "prepare_level",
+            "attempt",
+            "judge",
+            "commit",
+            "next_level",
+            "contact_placed",
+            "contacts_moved",
+            "new_scratch",
+        ):
             assert callable(getattr(mod, hook))
     with pytest.raises(ValueError, match="allowed paper, implicit"):
         schemes.scheme("leapfrog")

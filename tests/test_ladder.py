@@ -1,6 +1,7 @@
 """The implicit scheme's dyadic steps (solver/ladder.py): they tile the output interval,
 never go below dt_min, and a position that the rounding of t has pushed off the grid is
 brought back on it by one odd step, so the clock always moves on."""
+
 from __future__ import annotations
 
 import numpy as np

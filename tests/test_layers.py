@@ -1,5 +1,6 @@
 """The package's layers import only downward (docs/architecture.md): read every import of
 every module, top-level and inside functions, and fail on an arrow that points up."""
+
 from __future__ import annotations
 
 import ast
@@ -87,8 +88,11 @@ def test_imports_point_downward():
 def test_architecture_lists_every_module():
     """docs/architecture.md's layer table names every module of the package (a module in a
     folder below a subpackage, such as solver/schemes/, through its folder)."""
-    table = [line for line in (PACKAGE.parent / "docs" / "architecture.md").read_text().splitlines()
-             if line.startswith("| `")]
+    table = [
+        line
+        for line in (PACKAGE.parent / "docs" / "architecture.md").read_text().splitlines()
+        if line.startswith("| `")
+    ]
     rows = {name.strip(" `"): line for line in table for name in line.split("|")[1].split(",")}
     missing = []
     for path, module in all_modules():
@@ -96,13 +100,16 @@ def test_architecture_lists_every_module():
         if not parts:
             continue
         if len(parts) == 1:  # a top-level module, or a subpackage's __init__
-            if path.name != "__init__.py" and not any(f"`{parts[0]}.py`" in r or f"`{parts[0]}`" in r
-                                                     for r in table):
+            if path.name != "__init__.py" and not any(f"`{parts[0]}.py`" in r or f"`{parts[0]}`" in r for r in table):
                 missing.append(module)
             continue
         row = rows.get(parts[0], "")
-        named = (f"`{parts[1]}`" in row or f"`{parts[1]}.py`" in row or f"`{parts[1]}/`" in row
-                 or any(f"`{parts[0]}/{parts[1]}.py`" in r for r in table))
+        named = (
+            f"`{parts[1]}`" in row
+            or f"`{parts[1]}.py`" in row
+            or f"`{parts[1]}/`" in row
+            or any(f"`{parts[0]}/{parts[1]}.py`" in r for r in table)
+        )
         if path.name != "__init__.py" or len(parts) > 2:
             if not (named or f"{parts[1]}/" in row):
                 missing.append(module)

@@ -1,5 +1,6 @@
 """Layout kinds (hexagonal, square, chain, intruders, imperfections): geometry against truth,
 validation messages, reproducible seeds, the resolve command, the examples and a short run."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -15,8 +16,7 @@ from granplate.model.arrays import build_model
 from granplate.setup import io as scenario_io
 from granplate.setup.geometry import layout_packing, paper_layout, resolve
 from granplate.setup.presets import preset
-from granplate.setup.scenario import (ChainLayout, Imperfections, LatticeLayout, Layout, Load,
-                                      Plate, Scenario)
+from granplate.setup.scenario import ChainLayout, Imperfections, LatticeLayout, Layout, Load, Plate, Scenario
 from granplate.setup.validate import validate
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "docs" / "examples"
@@ -38,18 +38,20 @@ def _touch(a, b):
 
 def _no_overlaps(granules):
     for i, a in enumerate(granules):
-        for b in granules[i + 1:]:
+        for b in granules[i + 1 :]:
             assert _dist(a, b) >= (a.radius + b.radius) * (1.0 - REL), (a.label, b.label)
 
 
 def _expected_lattice_pairs(lay: LatticeLayout) -> set[tuple[str, str]]:
     """The touching pairs a perfect lattice must have, from its topology alone."""
-    radii = [lay.radius * (lay.intruder_ratio if c + 1 in lay.intruder_columns else 1.0)
-             for c in range(lay.columns)] if not lay.column_radii else list(lay.column_radii)
+    radii = (
+        [lay.radius * (lay.intruder_ratio if c + 1 in lay.intruder_columns else 1.0) for c in range(lay.columns)]
+        if not lay.column_radii
+        else list(lay.column_radii)
+    )
     a = max(radii)
     hexagonal = lay.kind == "hexagonal"
-    n_rows = [lay.rows - 1 if hexagonal and c % 2 == 0 else lay.rows
-              for c in range(1, lay.columns + 1)]
+    n_rows = [lay.rows - 1 if hexagonal and c % 2 == 0 else lay.rows for c in range(1, lay.columns + 1)]
     pairs = set()
     for c in range(1, lay.columns + 1):
         if radii[c - 1] == a:  # vertical neighbours touch in the columns of the largest radius
@@ -68,7 +70,7 @@ def _expected_lattice_pairs(lay: LatticeLayout) -> set[tuple[str, str]]:
 def _touching_pairs(granules) -> set[tuple[str, str]]:
     out = set()
     for i, a in enumerate(granules):
-        for b in granules[i + 1:]:
+        for b in granules[i + 1 :]:
             if _dist(a, b) <= (a.radius + b.radius) * (1.0 + 1e-9):
                 out.add((a.label, b.label))
     return out
@@ -77,10 +79,16 @@ def _touching_pairs(granules) -> set[tuple[str, str]]:
 LATTICES = [
     LatticeLayout(kind="hexagonal", columns=3, rows=5),
     LatticeLayout(kind="hexagonal", columns=6, rows=4, radius=0.002),
-    LatticeLayout(kind="hexagonal", columns=5, rows=5, column_radii=(0.01, 0.008, 0.01, 0.006, 0.009),
-                  column_materials=("steel", "ptfe", "steel", "ptfe", "steel")),
-    LatticeLayout(kind="hexagonal", columns=5, rows=6, intruder_columns=(2, 4), intruder_ratio=0.5,
-                  intruder_material="ptfe"),
+    LatticeLayout(
+        kind="hexagonal",
+        columns=5,
+        rows=5,
+        column_radii=(0.01, 0.008, 0.01, 0.006, 0.009),
+        column_materials=("steel", "ptfe", "steel", "ptfe", "steel"),
+    ),
+    LatticeLayout(
+        kind="hexagonal", columns=5, rows=6, intruder_columns=(2, 4), intruder_ratio=0.5, intruder_material="ptfe"
+    ),
     LatticeLayout(kind="square", columns=4, rows=3),
     LatticeLayout(kind="square", columns=4, rows=5, column_radii=(0.01, 0.007, 0.012, 0.005)),
 ]
@@ -127,12 +135,15 @@ def test_lattice_counts_walls_and_plate(lay):
 def test_paper_packing_is_an_intruder_lattice(ratio):
     """A 3 x 5 hexagonal lattice with intruder column 2 gives exactly paper_layout's granules
     (positions, radii, materials bitwise; labels c1r1.. for 1..9, A..E) and plate x."""
-    paper, walls, xp = paper_layout(Layout(R2_ratio=ratio, heavy_material="steel",
-                                           intruder_material="ptfe"))
-    lattice = layout_packing(LatticeLayout(columns=3, rows=5, radius=0.01, intruder_columns=(2,),
-                                           intruder_ratio=ratio, intruder_material="ptfe"))
-    assert [(g.x, g.y, g.radius, g.material) for g in lattice.granules] == \
-        [(g.x, g.y, g.radius, g.material) for g in paper]
+    paper, walls, xp = paper_layout(Layout(R2_ratio=ratio, heavy_material="steel", intruder_material="ptfe"))
+    lattice = layout_packing(
+        LatticeLayout(
+            columns=3, rows=5, radius=0.01, intruder_columns=(2,), intruder_ratio=ratio, intruder_material="ptfe"
+        )
+    )
+    assert [(g.x, g.y, g.radius, g.material) for g in lattice.granules] == [
+        (g.x, g.y, g.radius, g.material) for g in paper
+    ]
     assert lattice.plate_x == xp
     assert [w.normal for w in lattice.walls] == [w.normal for w in walls]
     assert [w.offset for w in lattice.walls] == pytest.approx([w.offset for w in walls], rel=REL)
@@ -152,8 +163,9 @@ def test_single_site_intruders():
     at their centres."""
     base = LatticeLayout(columns=3, rows=4)
     perfect = _by_label(layout_packing(base).granules)
-    lay = dataclasses.replace(base, intruder_sites=("c1r2",), intruder_every=4, intruder_ratio=0.5,
-                              intruder_material="ptfe")
+    lay = dataclasses.replace(
+        base, intruder_sites=("c1r2",), intruder_every=4, intruder_ratio=0.5, intruder_material="ptfe"
+    )
     gs = layout_packing(lay).granules
     order = [g.label for g in gs]
     chosen = {"c1r2"} | {order[k - 1] for k in range(4, len(order) + 1, 4)}
@@ -197,17 +209,19 @@ def test_decorated_chain():
     _no_overlaps(gs)
 
 
-IMPERFECT = LatticeLayout(columns=6, rows=6, radius=0.01,
-                          imperfections=Imperfections(seed=11, radius_spread=0.05, jitter=0.03,
-                                                      vacancy_fraction=0.1))
+IMPERFECT = LatticeLayout(
+    columns=6,
+    rows=6,
+    radius=0.01,
+    imperfections=Imperfections(seed=11, radius_spread=0.05, jitter=0.03, vacancy_fraction=0.1),
+)
 
 
 def test_imperfections_reproducible_and_seed_dependent():
     """The same seed gives the same granules; a different seed different ones."""
     a = layout_packing(IMPERFECT).granules
     assert layout_packing(IMPERFECT).granules == a
-    other = dataclasses.replace(IMPERFECT, imperfections=dataclasses.replace(
-        IMPERFECT.imperfections, seed=12))
+    other = dataclasses.replace(IMPERFECT, imperfections=dataclasses.replace(IMPERFECT.imperfections, seed=12))
     assert layout_packing(other).granules != a
 
 
@@ -230,10 +244,8 @@ def test_zero_imperfections_and_explicit_vacancies():
     """Zero amplitudes give back the perfect packing; listed vacancies are removed, also from the
     loaded column, which resolve hands to the load."""
     zero = dataclasses.replace(IMPERFECT, imperfections=Imperfections(seed=5))
-    assert layout_packing(zero).granules == layout_packing(
-        dataclasses.replace(IMPERFECT, imperfections=None)).granules
-    holes = dataclasses.replace(IMPERFECT, imperfections=Imperfections(seed=5,
-                                                                       vacancies=("c1r2", "c3r3")))
+    assert layout_packing(zero).granules == layout_packing(dataclasses.replace(IMPERFECT, imperfections=None)).granules
+    holes = dataclasses.replace(IMPERFECT, imperfections=Imperfections(seed=5, vacancies=("c1r2", "c3r3")))
     labels = {g.label for g in layout_packing(holes).granules}
     assert "c1r2" not in labels and "c3r3" not in labels and len(labels) == 6 * 6 - 3 - 2
     r = resolve(Scenario(layout=holes))
@@ -242,8 +254,7 @@ def test_zero_imperfections_and_explicit_vacancies():
 
 def test_paper_layout_with_imperfections():
     """Imperfections apply to the paper's kind too (labels 1..9, A..E), and keep its walls and plate x."""
-    lay = Layout(R2_ratio=0.5, imperfections=Imperfections(seed=1, radius_spread=0.02,
-                                                             vacancies=("7",)))
+    lay = Layout(R2_ratio=0.5, imperfections=Imperfections(seed=1, radius_spread=0.02, vacancies=("7",)))
     p = layout_packing(lay)
     _, walls, xp = paper_layout(Layout(R2_ratio=0.5))
     assert [g.label for g in p.granules] == list("12345689ABCDE")
@@ -252,6 +263,7 @@ def test_paper_layout_with_imperfections():
 
 
 # --------------------------------------------------------------------------- validation
+
 
 def _lat(**kw):
     return lambda: validate(Scenario(layout=LatticeLayout(**kw)))
@@ -266,64 +278,102 @@ def _imp(**kw):
 
 
 BAD = [
-    ("unknown kind", lambda: scenario_io.loads('[layout]\nkind = "cubic"\n'), "layout.kind",
-     "must be one of 'paper', 'hexagonal', 'square', 'chain'"),
+    (
+        "unknown kind",
+        lambda: scenario_io.loads('[layout]\nkind = "cubic"\n'),
+        "layout.kind",
+        "must be one of 'paper', 'hexagonal', 'square', 'chain'",
+    ),
     ("kind of the wrong class", _lat(kind="chain"), "layout.kind", "must have kind one of"),
-    ("chain field on a lattice", lambda: scenario_io.loads('[layout]\nkind = "square"\ncount = 3\n'),
-     "layout.count", "unknown field 'layout.count'"),
+    (
+        "chain field on a lattice",
+        lambda: scenario_io.loads('[layout]\nkind = "square"\ncount = 3\n'),
+        "layout.count",
+        "unknown field 'layout.count'",
+    ),
     ("zero columns", _lat(columns=0), "layout.columns", "must be an integer >= 1"),
     ("one hexagonal row", _lat(rows=1), "layout.rows", "must be an integer >= 2"),
     ("negative radius", _lat(radius=-0.01), "layout.radius", "must be > 0"),
     ("unknown material", _lat(material="wood"), "layout.material", "unknown material"),
-    ("unknown wall material", _lat(wall_material="wood"), "layout.wall_material",
-     "unknown material"),
-    ("column_radii length", _lat(columns=3, column_radii=(0.01, 0.01)), "layout.column_radii",
-     "must be empty or a list of 3 values"),
-    ("column radius zero", _lat(columns=2, column_radii=(0.01, 0.0)), "layout.column_radii[1]",
-     "must be > 0"),
-    ("column_materials length", _lat(columns=2, column_materials=("steel",)),
-     "layout.column_materials", "must be empty or a list of 2 values"),
-    ("column material unknown", _lat(columns=2, column_materials=("steel", "wood")),
-     "layout.column_materials[1]", "unknown material"),
+    ("unknown wall material", _lat(wall_material="wood"), "layout.wall_material", "unknown material"),
+    (
+        "column_radii length",
+        _lat(columns=3, column_radii=(0.01, 0.01)),
+        "layout.column_radii",
+        "must be empty or a list of 3 values",
+    ),
+    ("column radius zero", _lat(columns=2, column_radii=(0.01, 0.0)), "layout.column_radii[1]", "must be > 0"),
+    (
+        "column_materials length",
+        _lat(columns=2, column_materials=("steel",)),
+        "layout.column_materials",
+        "must be empty or a list of 2 values",
+    ),
+    (
+        "column material unknown",
+        _lat(columns=2, column_materials=("steel", "wood")),
+        "layout.column_materials[1]",
+        "unknown material",
+    ),
     ("intruder ratio zero", _lat(intruder_ratio=0.0), "layout.intruder_ratio", "must be > 0"),
-    ("intruder material", _lat(intruder_material="wood"), "layout.intruder_material",
-     "unknown material"),
-    ("intruder column out of range", _lat(columns=3, intruder_columns=(4,)),
-     "layout.intruder_columns[0]", "must be a column number in 1..3"),
-    ("intruder column rule", _lat(columns=3, intruder_columns="evn"), "layout.intruder_columns",
-     "must be one of 'odd', 'even' (did you mean 'even'?)"),
-    ("intruder every negative", _lat(intruder_every=-1), "layout.intruder_every",
-     "must be an integer >= 0"),
-    ("intruder site unknown", _lat(intruder_sites=("c2r5",)), "layout.intruder_sites[0]",
-     "no such site"),
-    ("site intruder larger than its site", _lat(intruder_sites=("c1r1",), intruder_ratio=1.5),
-     "layout.intruder_ratio", "must be in (0, 1] with intruder_sites or intruder_every"),
-    ("columns cannot touch", _lat(columns=3, column_radii=(0.002, 0.002, 0.01)),
-     "layout.column_radii", "columns 1 and 2 cannot touch"),
-    ("intruder column too small", _lat(columns=3, intruder_columns=(2,), intruder_ratio=0.3),
-     "layout.intruder_ratio", "columns 1 and 3 overlap"),
+    ("intruder material", _lat(intruder_material="wood"), "layout.intruder_material", "unknown material"),
+    (
+        "intruder column out of range",
+        _lat(columns=3, intruder_columns=(4,)),
+        "layout.intruder_columns[0]",
+        "must be a column number in 1..3",
+    ),
+    (
+        "intruder column rule",
+        _lat(columns=3, intruder_columns="evn"),
+        "layout.intruder_columns",
+        "must be one of 'odd', 'even' (did you mean 'even'?)",
+    ),
+    ("intruder every negative", _lat(intruder_every=-1), "layout.intruder_every", "must be an integer >= 0"),
+    ("intruder site unknown", _lat(intruder_sites=("c2r5",)), "layout.intruder_sites[0]", "no such site"),
+    (
+        "site intruder larger than its site",
+        _lat(intruder_sites=("c1r1",), intruder_ratio=1.5),
+        "layout.intruder_ratio",
+        "must be in (0, 1] with intruder_sites or intruder_every",
+    ),
+    (
+        "columns cannot touch",
+        _lat(columns=3, column_radii=(0.002, 0.002, 0.01)),
+        "layout.column_radii",
+        "columns 1 and 2 cannot touch",
+    ),
+    (
+        "intruder column too small",
+        _lat(columns=3, intruder_columns=(2,), intruder_ratio=0.3),
+        "layout.intruder_ratio",
+        "columns 1 and 3 overlap",
+    ),
     ("chain count", _chn(count=0), "layout.count", "must be an integer >= 1"),
     ("chain radius", _chn(radius=0.0), "layout.radius", "must be > 0"),
     ("chain taper", _chn(taper=0.0), "layout.taper", "must be > 0"),
     ("chain dimer ratio", _chn(dimer_ratio=-1.0), "layout.dimer_ratio", "must be > 0"),
     ("chain decoration", _chn(decorated_ratio=-0.1), "layout.decorated_ratio", "must be >= 0"),
-    ("chain dimer material", _chn(dimer_material="wood"), "layout.dimer_material",
-     "unknown material"),
-    ("chain decoration material", _chn(decorated_material="wood"), "layout.decorated_material",
-     "unknown material"),
+    ("chain dimer material", _chn(dimer_material="wood"), "layout.dimer_material", "unknown material"),
+    ("chain decoration material", _chn(decorated_material="wood"), "layout.decorated_material", "unknown material"),
     ("chain y", _chn(y=math.inf), "layout.y", "must be a finite number"),
     ("seed negative", _imp(seed=-1), "layout.imperfections.seed", "must be an integer >= 0"),
     ("spread 1", _imp(radius_spread=1.0), "layout.imperfections.radius_spread", "must be in [0, 1)"),
     ("jitter negative", _imp(jitter=-0.1), "layout.imperfections.jitter", "must be in [0, 1)"),
-    ("vacancy fraction", _imp(vacancy_fraction=1.0), "layout.imperfections.vacancy_fraction",
-     "must be in [0, 1)"),
-    ("spread + jitter", _imp(radius_spread=0.6, jitter=0.5), "layout.imperfections.jitter",
-     "radius_spread + jitter must be < 1"),
-    ("unknown vacancy", _imp(vacancies=("c9r9",)), "layout.imperfections.vacancies[0]",
-     "no such site"),
-    ("layout and granules", lambda: validate(dataclasses.replace(
-        resolve(Scenario(layout=LatticeLayout())), layout=LatticeLayout())), "granules",
-     "either [layout] or [[granules]]"),
+    ("vacancy fraction", _imp(vacancy_fraction=1.0), "layout.imperfections.vacancy_fraction", "must be in [0, 1)"),
+    (
+        "spread + jitter",
+        _imp(radius_spread=0.6, jitter=0.5),
+        "layout.imperfections.jitter",
+        "radius_spread + jitter must be < 1",
+    ),
+    ("unknown vacancy", _imp(vacancies=("c9r9",)), "layout.imperfections.vacancies[0]", "no such site"),
+    (
+        "layout and granules",
+        lambda: validate(dataclasses.replace(resolve(Scenario(layout=LatticeLayout())), layout=LatticeLayout())),
+        "granules",
+        "either [layout] or [[granules]]",
+    ),
 ]
 
 
@@ -338,8 +388,7 @@ def test_bad_layouts_are_refused_naming_field_and_range(action, field, allowed):
 
 # --------------------------------------------------------------------------- TOML, resolve, examples
 
-KINDS = [Layout(R2_ratio=0.5), *LATTICES, ChainLayout(count=5, taper=0.8, decorated_ratio=0.2),
-         IMPERFECT]
+KINDS = [Layout(R2_ratio=0.5), *LATTICES, ChainLayout(count=5, taper=0.8, decorated_ratio=0.2), IMPERFECT]
 
 
 @pytest.mark.parametrize("columns,numbers", [(3, (2,)), (5, (2, 4)), (6, (2, 4, 6))])
@@ -347,8 +396,9 @@ def test_even_intruder_columns_are_the_listed_even_columns(columns, numbers):
     """intruder_columns = "even" builds the packing of the even column numbers listed, and a
     scenario file carries the rule through a round trip (so a study varies columns alone)."""
     kw = dict(kind="hexagonal", columns=columns, rows=5, radius=0.01, intruder_ratio=0.5, intruder_material="ptfe")
-    assert layout_packing(LatticeLayout(intruder_columns="even", **kw)) == \
-        layout_packing(LatticeLayout(intruder_columns=numbers, **kw))
+    assert layout_packing(LatticeLayout(intruder_columns="even", **kw)) == layout_packing(
+        LatticeLayout(intruder_columns=numbers, **kw)
+    )
     s = Scenario(layout=LatticeLayout(intruder_columns="even", **kw))
     assert scenario_io.loads(scenario_io.dumps(s)) == s
     validate(s)
@@ -360,21 +410,33 @@ def test_toml_round_trip_every_kind(lay):
     s = Scenario(layout=lay)
     text = scenario_io.dumps(s)
     assert scenario_io.loads(text) == s
-    layout_text = text[text.index("[layout]"):text.index("[load]")]
+    layout_text = text[text.index("[layout]") : text.index("[load]")]
     assert ("kind =" in layout_text) == (lay.kind != "paper")
 
 
 def test_preset_output_has_no_kind_line():
     """`granplate preset` output is unchanged: the paper's layout writes no kind line."""
-    assert "kind = \"paper\"" not in scenario_io.dumps(preset("steel-r1"))
+    assert 'kind = "paper"' not in scenario_io.dumps(preset("steel-r1"))
 
 
 def _same_model(a, b):
     ma, mb = build_model(a), build_model(b)
     assert ma.labels == mb.labels
     np.testing.assert_array_equal(ma.initial_state, mb.initial_state)
-    for f in ("mass", "inertia", "radius", "pair_ij", "pair_coef", "wall_i", "wall_geo",
-              "wall_coef", "pc_i", "pc_x", "shock_force", "shock_torque"):
+    for f in (
+        "mass",
+        "inertia",
+        "radius",
+        "pair_ij",
+        "pair_coef",
+        "wall_i",
+        "wall_geo",
+        "wall_coef",
+        "pc_i",
+        "pc_x",
+        "shock_force",
+        "shock_torque",
+    ):
         np.testing.assert_array_equal(getattr(ma.granular, f), getattr(mb.granular, f), err_msg=f)
 
 
@@ -410,9 +472,11 @@ def test_short_run_of_a_small_hexagonal_protector_balances_energy():
     E_p + E_g + D = E_shock (energy residual below 1e-4)."""
     from granplate.results.run import simulate
 
-    s = Scenario(layout=LatticeLayout(columns=4, rows=3, radius=0.01,
-                                      column_materials=("steel", "ptfe", "steel", "ptfe")),
-                 plate=Plate(height=0.06, ny=24), load=Load(y0=0.01, length=0.04))
+    s = Scenario(
+        layout=LatticeLayout(columns=4, rows=3, radius=0.01, column_materials=("steel", "ptfe", "steel", "ptfe")),
+        plate=Plate(height=0.06, ny=24),
+        load=Load(y0=0.01, length=0.04),
+    )
     validate(s)
     ds = simulate(s, t_end=2e-5, progress=False)
     assert float(ds.E_shock[-1]) > 0

@@ -1,6 +1,7 @@
 """Layouts in space (sc, bcc, fcc, hcp lattices, chains, intruders, imperfections): geometry
 against the textbook lattices and closed forms, validation messages, reproducible seeds, the
 resolve round trip, the examples and a short run."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -16,7 +17,7 @@ from granplate.cli import main
 from granplate.errors import ScenarioError
 from granplate.setup import io as scenario_io
 from granplate.setup.geometry import layout_packing, resolve
-from granplate.setup.scenario import (BOX_WALLS, Box, ChainLayout, Imperfections, Layer, Load, Scenario, SpaceLattice)
+from granplate.setup.scenario import BOX_WALLS, Box, ChainLayout, Imperfections, Layer, Load, Scenario, SpaceLattice
 from granplate.setup.validate import OVERLAP_RTOL, validate
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -42,8 +43,11 @@ def _textbook_lattice(kind: str, r: float, n: int) -> np.ndarray:
     written from the textbook bases (x the stacking axis), independently of the package."""
     if kind in ("sc", "bcc", "fcc"):
         a = {"sc": 2.0 * r, "bcc": 4.0 * r / math.sqrt(3.0), "fcc": 2.0 * math.sqrt(2.0) * r}[kind]
-        basis = {"sc": [(0, 0, 0)], "bcc": [(0, 0, 0), (0.5, 0.5, 0.5)],
-                 "fcc": [(0, 0, 0), (0, 0.5, 0.5), (0.5, 0, 0.5), (0.5, 0.5, 0)]}[kind]
+        basis = {
+            "sc": [(0, 0, 0)],
+            "bcc": [(0, 0, 0), (0.5, 0.5, 0.5)],
+            "fcc": [(0, 0, 0), (0, 0.5, 0.5), (0.5, 0, 0.5), (0.5, 0.5, 0)],
+        }[kind]
         cells = np.array(list(itertools.product(range(-n, n + 1), repeat=3)), float)
         return np.concatenate([(cells + np.array(b)) * a for b in basis])
     a, c = 2.0 * r, 4.0 * math.sqrt(2.0 / 3.0) * r  # hcp: triangular nets in (y, z), ABAB along x
@@ -92,8 +96,10 @@ def test_bulk_neighbours_touch_at_2r(kind):
     assert touching.max() == BULK_NEIGHBOURS[kind]
 
 
-@pytest.mark.parametrize("kind,edge", [("sc", 2.0), ("bcc", 4.0 / math.sqrt(3.0)),
-                                       ("fcc", 2.0 * math.sqrt(2.0)), ("hcp", 4.0 * math.sqrt(2.0 / 3.0))])
+@pytest.mark.parametrize(
+    "kind,edge",
+    [("sc", 2.0), ("bcc", 4.0 / math.sqrt(3.0)), ("fcc", 2.0 * math.sqrt(2.0)), ("hcp", 4.0 * math.sqrt(2.0 / 3.0))],
+)
 def test_cell_edge_along_x(kind, edge):
     """The conventional cell's edge along x: 2R (sc), 4R / sqrt(3) (bcc), 2 sqrt(2) R (fcc),
     c = 4 sqrt(2/3) R (hcp), between a site and the same site one cell further."""
@@ -126,12 +132,16 @@ def test_walls_subset_opens_the_other_sides():
 
 
 def _plane_of(label: str) -> int:
-    return int(label[1:label.index("y")])
+    return int(label[1 : label.index("y")])
 
 
 #: The paper's stack in space: heavy / light-intruder / heavy, one cell each.
-STACK = SpaceLattice(kind="fcc", cells=(3, 3, 3), radius=R,
-                     layers=(Layer(1), Layer(1, radius=0.8 * R, material="ptfe"), Layer(1, material="steel")))
+STACK = SpaceLattice(
+    kind="fcc",
+    cells=(3, 3, 3),
+    radius=R,
+    layers=(Layer(1), Layer(1, radius=0.8 * R, material="ptfe"), Layer(1, material="steel")),
+)
 
 
 def test_layers_set_radii_and_materials_plane_by_plane():
@@ -160,8 +170,11 @@ def test_layers_set_radii_and_materials_plane_by_plane():
 
     def touching_planes(label):
         c = by_label[label]
-        return sorted(_plane_of(gs[j].label) for j in tree.query_ball_point(x[c], 2.0 * R * (1 + 1e-9))
-                      if j != c and abs(np.linalg.norm(x[j] - x[c]) - r[j] - r[c]) < REL * R)
+        return sorted(
+            _plane_of(gs[j].label)
+            for j in tree.query_ball_point(x[c], 2.0 * R * (1 + 1e-9))
+            if j != c and abs(np.linalg.norm(x[j] - x[c]) - r[j] - r[c]) < REL * R
+        )
 
     assert touching_planes("x3y3z2") == [2] * 4 + [4] * 4  # light: loose in its own plane
     assert touching_planes("x2y3z2") == [1] * 4 + [2] * 4 + [3] * 4  # heavy: 12 neighbours
@@ -173,8 +186,9 @@ def test_layers_counts_give_the_cells_along_x_when_cells0_is_zero():
     study can vary one layer's count alone."""
     import dataclasses
 
-    two = SpaceLattice(kind="fcc", cells=(0, 2, 2), radius=R,
-                       layers=(Layer(2), Layer(1, radius=0.8 * R, material="ptfe"), Layer(1)))
+    two = SpaceLattice(
+        kind="fcc", cells=(0, 2, 2), radius=R, layers=(Layer(2), Layer(1, radius=0.8 * R, material="ptfe"), Layer(1))
+    )
     assert layout_packing(two) == layout_packing(dataclasses.replace(two, cells=(4, 2, 2)))
     assert len(layout_packing(two).granules) == 4 * 4 * 2 * 2
     validate(_force_scenario(two))
@@ -185,8 +199,9 @@ def test_single_site_intruders_shrink_at_their_centres():
     at their centres."""
     base = SpaceLattice(kind="bcc", cells=(2, 2, 2), radius=R)
     perfect = {g.label: g for g in layout_packing(base).granules}
-    lay = dataclasses.replace(base, intruder_sites=("x2y1z1",), intruder_every=5, intruder_ratio=0.5,
-                              intruder_material="ptfe")
+    lay = dataclasses.replace(
+        base, intruder_sites=("x2y1z1",), intruder_every=5, intruder_ratio=0.5, intruder_material="ptfe"
+    )
     gs = layout_packing(lay).granules
     order = [g.label for g in gs]
     chosen = {"x2y1z1"} | {order[k - 1] for k in range(5, len(order) + 1, 5)}
@@ -200,13 +215,13 @@ def test_single_site_intruders_shrink_at_their_centres():
 def test_chain_in_space_touches_between_two_walls():
     """A tapered, decorated dimer chain in 3D: consecutive spheres touch along x at y = z = R_max
     (or the given y, z), radii as in 2D, walls xmin and xmax touch the ends."""
-    lay = ChainLayout(count=5, radius=R, taper=0.9, dimer_ratio=0.6, dimer_material="ptfe",
-                      decorated_ratio=0.3)
+    lay = ChainLayout(count=5, radius=R, taper=0.9, dimer_ratio=0.6, dimer_material="ptfe", decorated_ratio=0.3)
     p = layout_packing(lay, dimension=3)
     flat = layout_packing(lay)
     gs = p.granules
-    assert [(g.label, g.x, g.radius, g.material) for g in gs] == \
-        [(g.label, g.x, g.radius, g.material) for g in flat.granules]
+    assert [(g.label, g.x, g.radius, g.material) for g in gs] == [
+        (g.label, g.x, g.radius, g.material) for g in flat.granules
+    ]
     assert all(g.y == g.z == R for g in gs)
     for a, b in zip(gs[:-1], gs[1:]):
         assert b.x - a.x == pytest.approx(a.radius + b.radius, rel=REL)
@@ -217,9 +232,12 @@ def test_chain_in_space_touches_between_two_walls():
     validate(_force_scenario(lay))
 
 
-IMPERFECT = SpaceLattice(kind="fcc", cells=(4, 4, 4), radius=R,
-                         imperfections=Imperfections(seed=3, radius_spread=0.05, jitter=0.03,
-                                                     vacancy_fraction=0.1))
+IMPERFECT = SpaceLattice(
+    kind="fcc",
+    cells=(4, 4, 4),
+    radius=R,
+    imperfections=Imperfections(seed=3, radius_spread=0.05, jitter=0.03, vacancy_fraction=0.1),
+)
 
 
 def test_imperfections_reproducible_and_seed_dependent():
@@ -260,20 +278,25 @@ def test_zero_imperfections_and_vacancies_and_the_loaded_plane():
     force along +x plane 1's remaining labels (not along another direction)."""
     zero = dataclasses.replace(IMPERFECT, imperfections=Imperfections(seed=5))
     assert layout_packing(zero).granules == layout_packing(dataclasses.replace(IMPERFECT, imperfections=None)).granules
-    holes = dataclasses.replace(IMPERFECT, cells=(2, 2, 2),
-                                imperfections=Imperfections(seed=5, jitter=0.01, vacancies=("x1y1z1", "x3y2z2")))
+    holes = dataclasses.replace(
+        IMPERFECT, cells=(2, 2, 2), imperfections=Imperfections(seed=5, jitter=0.01, vacancies=("x1y1z1", "x3y2z2"))
+    )
     labels = [g.label for g in layout_packing(holes).granules]
     assert "x1y1z1" not in labels and "x3y2z2" not in labels and len(labels) == 32 - 2
     r = resolve(_force_scenario(holes))
     plane1 = tuple(lab for lab in labels if lab.startswith("x1y"))
     assert r.load.granules == plane1 and len(plane1) == 7
-    sideways = resolve(Scenario(dimension=3, layout=holes,
-                                load=Load(kind="force", force=1.0, direction=(0.0, 0.0, 1.0))))
+    sideways = resolve(
+        Scenario(dimension=3, layout=holes, load=Load(kind="force", force=1.0, direction=(0.0, 0.0, 1.0)))
+    )
     assert sideways.load.granules == ()
 
 
-@pytest.mark.parametrize("lay", [STACK, IMPERFECT, SpaceLattice(kind="hcp", walls=("xmin",)),
-                                 ChainLayout(count=3, z=0.05)], ids=["stack", "imperfect", "hcp", "chain"])
+@pytest.mark.parametrize(
+    "lay",
+    [STACK, IMPERFECT, SpaceLattice(kind="hcp", walls=("xmin",)), ChainLayout(count=3, z=0.05)],
+    ids=["stack", "imperfect", "hcp", "chain"],
+)
 def test_toml_round_trip_and_resolve(lay):
     """dumps then loads gives the same scenario; the resolved scenario, written and read back,
     validates and holds the layout's spheres and walls."""
@@ -319,8 +342,7 @@ def test_short_run_of_the_stack_balances_energy():
     1e-6, the loaded plane moves along +x, the far plane has not moved yet at that time."""
     from granplate.results.run import simulate
 
-    lay = SpaceLattice(kind="sc", cells=(3, 2, 2), radius=0.005,
-                       layers=(Layer(1), Layer(1, material="ptfe"), Layer(1)))
+    lay = SpaceLattice(kind="sc", cells=(3, 2, 2), radius=0.005, layers=(Layer(1), Layer(1, material="ptfe"), Layer(1)))
     s = _force_scenario(lay)
     validate(s)
     ds = simulate(s, t_end=2e-6, progress=False)
@@ -335,50 +357,109 @@ def _lay3(**kw):
 
 
 BAD = [
-    ("3D kind in 2D", lambda: validate(Scenario(layout=SpaceLattice(kind="hcp"))), "layout.kind",
-     "a lattice of spheres in space is 3D"),
-    ("chain depth in 2D", lambda: validate(Scenario(layout=ChainLayout(z=0.01))), "layout.z",
-     "a chain's depth z is 3D"),
-    ("unknown kind", lambda: scenario_io.loads('dimension = 3\n[layout]\nkind = "diamond"\n'), "layout.kind",
-     "'sc', 'bcc', 'fcc', 'hcp'"),
-    ("2D field on a space lattice", lambda: scenario_io.loads('dimension = 3\n[layout]\nkind = "sc"\nrows = 3\n'),
-     "layout.rows", "unknown field 'layout.rows'"),
-    ("cells length", lambda: scenario_io.loads('dimension = 3\n[layout]\nkind = "sc"\ncells = [2, 2]\n'),
-     "layout.cells", "wrong length"),
+    (
+        "3D kind in 2D",
+        lambda: validate(Scenario(layout=SpaceLattice(kind="hcp"))),
+        "layout.kind",
+        "a lattice of spheres in space is 3D",
+    ),
+    (
+        "chain depth in 2D",
+        lambda: validate(Scenario(layout=ChainLayout(z=0.01))),
+        "layout.z",
+        "a chain's depth z is 3D",
+    ),
+    (
+        "unknown kind",
+        lambda: scenario_io.loads('dimension = 3\n[layout]\nkind = "diamond"\n'),
+        "layout.kind",
+        "'sc', 'bcc', 'fcc', 'hcp'",
+    ),
+    (
+        "2D field on a space lattice",
+        lambda: scenario_io.loads('dimension = 3\n[layout]\nkind = "sc"\nrows = 3\n'),
+        "layout.rows",
+        "unknown field 'layout.rows'",
+    ),
+    (
+        "cells length",
+        lambda: scenario_io.loads('dimension = 3\n[layout]\nkind = "sc"\ncells = [2, 2]\n'),
+        "layout.cells",
+        "wrong length",
+    ),
     ("zero cells", _lay3(cells=(2, 0, 2)), "layout.cells[1]", "must be an integer >= 1"),
     ("too many sites", _lay3(cells=(100, 100, 100)), "layout.cells", "at most 1000000 sites"),
     ("radius", _lay3(radius=-1.0), "layout.radius", "must be > 0"),
     ("material", _lay3(material="wood"), "layout.material", "unknown material"),
     ("wall material", _lay3(wall_material="wood"), "layout.wall_material", "unknown material"),
-    ("layer count", _lay3(cells=(2, 2, 2), layers=(Layer(0), Layer(2))), "layout.layers[0].count",
-     "must be an integer >= 1"),
-    ("layer radius", _lay3(cells=(2, 2, 2), layers=(Layer(1, radius=0.0), Layer(1))), "layout.layers[0].radius",
-     "must be > 0"),
-    ("layer material", _lay3(cells=(2, 2, 2), layers=(Layer(1), Layer(1, material="wood"))),
-     "layout.layers[1].material", "unknown material"),
-    ("layer radius ratio", _lay3(kind="sc", cells=(2, 2, 2), layers=(Layer(1, radius=1e-9), Layer(1, radius=1.0))),
-     "layout.layers[0].radius", "of the largest layer radius"),
-    ("layer counts", _lay3(cells=(3, 2, 2), layers=(Layer(1), Layer(1))), "layout.layers",
-     "add up to layout.cells[0] = 3"),
+    (
+        "layer count",
+        _lay3(cells=(2, 2, 2), layers=(Layer(0), Layer(2))),
+        "layout.layers[0].count",
+        "must be an integer >= 1",
+    ),
+    (
+        "layer radius",
+        _lay3(cells=(2, 2, 2), layers=(Layer(1, radius=0.0), Layer(1))),
+        "layout.layers[0].radius",
+        "must be > 0",
+    ),
+    (
+        "layer material",
+        _lay3(cells=(2, 2, 2), layers=(Layer(1), Layer(1, material="wood"))),
+        "layout.layers[1].material",
+        "unknown material",
+    ),
+    (
+        "layer radius ratio",
+        _lay3(kind="sc", cells=(2, 2, 2), layers=(Layer(1, radius=1e-9), Layer(1, radius=1.0))),
+        "layout.layers[0].radius",
+        "of the largest layer radius",
+    ),
+    (
+        "layer counts",
+        _lay3(cells=(3, 2, 2), layers=(Layer(1), Layer(1))),
+        "layout.layers",
+        "add up to layout.cells[0] = 3",
+    ),
     ("no cells along x without layers", _lay3(cells=(0, 2, 2)), "layout.cells[0]", "must be an integer >= 1"),
-    ("planes cannot touch", _lay3(kind="fcc", cells=(3, 2, 2),
-                                  layers=(Layer(1), Layer(1, radius=0.5 * R), Layer(1))),
-     "layout.layers[1].radius", "planes 3 and 4 cannot touch"),
-    ("planes overlap", _lay3(kind="bcc", cells=(2, 2, 2), layers=(Layer(1, radius=1.1 * R), Layer(1))),
-     "layout.layers[1].radius", "overlap by"),
+    (
+        "planes cannot touch",
+        _lay3(kind="fcc", cells=(3, 2, 2), layers=(Layer(1), Layer(1, radius=0.5 * R), Layer(1))),
+        "layout.layers[1].radius",
+        "planes 3 and 4 cannot touch",
+    ),
+    (
+        "planes overlap",
+        _lay3(kind="bcc", cells=(2, 2, 2), layers=(Layer(1, radius=1.1 * R), Layer(1))),
+        "layout.layers[1].radius",
+        "overlap by",
+    ),
     ("wall name", _lay3(walls=("xmin", "top")), "layout.walls[1]", "must be one of 'xmin'"),
     ("wall twice", _lay3(walls=("xmin", "xmin")), "layout.walls[1]", "each wall at most once"),
     ("intruder ratio", _lay3(intruder_ratio=0.0), "layout.intruder_ratio", "must be > 0"),
     ("intruder material", _lay3(intruder_material="wood"), "layout.intruder_material", "unknown material"),
     ("intruder site", _lay3(intruder_sites=("c1r1",)), "layout.intruder_sites[0]", "no such site"),
-    ("large site intruder", _lay3(intruder_every=2, intruder_ratio=1.5), "layout.intruder_ratio",
-     "must be in (0, 1] with intruder_sites or intruder_every"),
+    (
+        "large site intruder",
+        _lay3(intruder_every=2, intruder_ratio=1.5),
+        "layout.intruder_ratio",
+        "must be in (0, 1] with intruder_sites or intruder_every",
+    ),
     ("intruder every", _lay3(intruder_every=-1), "layout.intruder_every", "must be an integer >= 0"),
-    ("vacancy", _lay3(imperfections=Imperfections(vacancies=("x9y9z9",))), "layout.imperfections.vacancies[0]",
-     "no such site"),
+    (
+        "vacancy",
+        _lay3(imperfections=Imperfections(vacancies=("x9y9z9",))),
+        "layout.imperfections.vacancies[0]",
+        "no such site",
+    ),
     ("jitter", _lay3(imperfections=Imperfections(jitter=1.0)), "layout.imperfections.jitter", "must be in [0, 1)"),
-    ("layout and box", lambda: validate(_force_scenario(SpaceLattice(), box=Box((0, 0, 0), (1, 1, 1)))),
-     "box", "give either [layout] or [box]"),
+    (
+        "layout and box",
+        lambda: validate(_force_scenario(SpaceLattice(), box=Box((0, 0, 0), (1, 1, 1)))),
+        "box",
+        "give either [layout] or [box]",
+    ),
     ("chain z", lambda: validate(_force_scenario(ChainLayout(z=math.inf))), "layout.z", "must be a finite number"),
 ]
 

@@ -2,14 +2,23 @@
 the data's summary.csv from the curves, and the law "johnson" replayed along the 15 measured
 overlaps meets the targets (loading slope within 20%, residual / peak within 0.06), predicted with
 one parameter fitted on one curve; Thornton's law does not."""
+
 from __future__ import annotations
 
 import math
 
 import pytest
 
-from granplate.verification.measured import (FITTED_ON, RATIO_ATOL, SLOPE_RTOL, approach_speed, comparison,
-                                             load_curves, measures, replay_johnson)
+from granplate.verification.measured import (
+    FITTED_ON,
+    RATIO_ATOL,
+    SLOPE_RTOL,
+    approach_speed,
+    comparison,
+    load_curves,
+    measures,
+    replay_johnson,
+)
 from granplate.verification.measured_cases import measured_checks
 
 

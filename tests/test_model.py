@@ -1,4 +1,5 @@
 """build_model: the loop's arrays from a scenario, against hand-computed values."""
+
 from __future__ import annotations
 
 import math

@@ -2,6 +2,7 @@
 solid listed before a run, distinct run captions, radius vs diameter in every example.
 Truth: unit arithmetic, the examples' own geometry (the last plane of spheres rests on the
 plate's face), and the scenarios the runs were made from."""
+
 from __future__ import annotations
 
 import re
@@ -14,8 +15,10 @@ ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = sorted((ROOT / "docs" / "examples").glob("*.toml"))
 
 
-@pytest.mark.parametrize("seconds, text", [(0.1, "100 ms"), (2e-5, "20 µs"), (1.5, "1.5 s"), (1e-3, "1 ms"),
-                                           (3e-10, "0.3 ns"), (1.25e-4, "125 µs")])
+@pytest.mark.parametrize(
+    "seconds, text",
+    [(0.1, "100 ms"), (2e-5, "20 µs"), (1.5, "1.5 s"), (1e-3, "1 ms"), (3e-10, "0.3 ns"), (1.25e-4, "125 µs")],
+)
 def test_durations_are_written_in_the_largest_unit_they_reach(seconds, text):
     """0.1 s is 100 ms (it used to read "1e+05 µs")."""
     from granplate.figures.common import readable_duration
@@ -68,8 +71,10 @@ def test_runs_of_one_name_are_told_apart_by_their_contact_law():
     plastic = with_changes(elastic, {"contact.normal_law": "thornton"})
     labels = run_labels([result(elastic), result(plastic)])
     assert labels == ["ptfe-r05 (Hertz contacts, t_end = 2 ms)", "ptfe-r05 (Thornton contacts, t_end = 2 ms)"]
-    assert run_labels([result(elastic), result(preset("steel-r1"))]) == ["ptfe-r05 (t_end = 2 ms)",
-                                                                         "steel-r1 (t_end = 2 ms)"]
+    assert run_labels([result(elastic), result(preset("steel-r1"))]) == [
+        "ptfe-r05 (t_end = 2 ms)",
+        "steel-r1 (t_end = 2 ms)",
+    ]
 
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.name)

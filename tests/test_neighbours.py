@@ -1,4 +1,5 @@
 """The O(N log N) neighbour search against the O(N^2) double loop (same pairs, same order)."""
+
 from __future__ import annotations
 
 import numpy as np

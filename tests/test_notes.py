@@ -1,6 +1,7 @@
 """What the library announces before a slow step: the time loop's compile is announced
 exactly when numba's on-disk cache does not hold it (a fresh cache, then a second
 process), and a plate build by the time setup.plate_cost estimates for it."""
+
 from __future__ import annotations
 
 import os
@@ -33,13 +34,26 @@ def test_compile_is_announced_only_when_numbas_cache_lacks_it(tmp_path):
     """Truth: numba's cache of a new function is empty in the first process (announced,
     then compiled and cached) and holds it in the second (not announced); another
     argument type is not compiled in either."""
-    (tmp_path / "kernel.py").write_text("from numba import njit\n\n\n@njit(cache=True)\n"
-                                        "def twice(x):\n    return 2.0 * x\n")
+    (tmp_path / "kernel.py").write_text(
+        "from numba import njit\n\n\n@njit(cache=True)\ndef twice(x):\n    return 2.0 * x\n"
+    )
     (tmp_path / "probe.py").write_text(PROBE)
-    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache"),
-           "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
-    runs = [subprocess.run([sys.executable, str(tmp_path / "probe.py")], capture_output=True, text=True,
-                           env=env, cwd=tmp_path, timeout=300) for _ in range(2)]
+    env = {
+        **os.environ,
+        "NUMBA_CACHE_DIR": str(tmp_path / "cache"),
+        "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")]),
+    }
+    runs = [
+        subprocess.run(
+            [sys.executable, str(tmp_path / "probe.py")],
+            capture_output=True,
+            text=True,
+            env=env,
+            cwd=tmp_path,
+            timeout=300,
+        )
+        for _ in range(2)
+    ]
     for r in runs:
         assert r.returncode == 0, r.stderr
     assert runs[0].stdout.split() == ["True", "True", "False"]

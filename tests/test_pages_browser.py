@@ -3,6 +3,7 @@ they load with no JavaScript error and no request leaving the machine, their tab
 numerically by a numeric column both ways (by click and by keyboard), a details block
 opens on click, the first screen is not blank, and nothing is cut off or overlaps, even
 in a narrow window. Skips, saying why, where no browser can run (tests/browser.py)."""
+
 from __future__ import annotations
 
 import io
@@ -57,8 +58,8 @@ def _open(driver, path: Path) -> None:
 
 def _column(driver, table, col: int) -> list[str]:
     return driver.execute_script(
-        "return Array.from(arguments[0].tBodies[0].rows).map(r => r.cells[arguments[1]].textContent.trim())",
-        table, col)
+        "return Array.from(arguments[0].tBodies[0].rows).map(r => r.cells[arguments[1]].textContent.trim())", table, col
+    )
 
 
 def _header(driver, label: str):
@@ -89,8 +90,10 @@ def test_page_loads_with_no_error_and_no_request_off_the_machine(browser, pages,
     assert n_tables > 1 and n_sortable == n_heads > 0
 
 
-@pytest.mark.parametrize("page, label", [("verification", "time [s]"), ("verification", "error"),
-                                         ("report", "E_shock [J]"), ("report", "plate peak")])
+@pytest.mark.parametrize(
+    "page, label",
+    [("verification", "time [s]"), ("verification", "error"), ("report", "E_shock [J]"), ("report", "plate peak")],
+)
 def test_a_numeric_column_sorts_numerically_both_ways(browser, pages, page, label):
     """A click sorts the column ascending by value (not as text: scientific notation and
     percentages), a second click descending, blanks ("-") last both ways; the header says
@@ -111,7 +114,7 @@ def test_a_numeric_column_sorts_numerically_both_ways(browser, pages, page, labe
     down = _numbers(down_cells)
     assert down == sorted(before, reverse=True) and th.get_attribute("aria-sort") == "descending"
     n_blank = len(cells) - len(before)
-    assert all(c in ("", "-", "nan") for c in down_cells[len(down_cells) - n_blank:])
+    assert all(c in ("", "-", "nan") for c in down_cells[len(down_cells) - n_blank :])
     button.send_keys(Keys.ENTER)
     assert _numbers(_column(browser, table, col)) == up and th.get_attribute("aria-sort") == "ascending"
     assert console_errors(browser) == []

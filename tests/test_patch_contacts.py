@@ -5,6 +5,7 @@ across a patch move), the truncated basis against the full one, the fixed detect
 error kept, and the record of when and where each contact formed; granules touching the
 face between nodes at t = 0 (patch contacts from the start) against the same granule
 reaching the face during the run."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -22,7 +23,12 @@ from granplate.solver import driver, state as S
 from granplate.solver.interface import move_patches
 from granplate.solver.plate_modal import plate_energy
 from granplate.verification.face_contacts import (
-    R, STIFF_THICKNESS, X0, bounce, drop_scenario, node_spacing,
+    R,
+    STIFF_THICKNESS,
+    X0,
+    bounce,
+    drop_scenario,
+    node_spacing,
 )
 from granplate.verification.granular import hertz_reference
 
@@ -123,8 +129,11 @@ def test_fixed_detection_still_stops_at_the_plate():
     flies into the plate stops the run, naming it and what to change."""
     s = drop_scenario(0.05, gap=1e-3, t_end=1.5e-3)
     s = s.__class__(**{**s.__dict__, "contact": s.contact.__class__(pairs=(), detection="fixed")})
-    with pytest.raises(SimulationError, match=r"granule 'g' \(at x = .* y = 0.05 m\) reached the plate's face "
-                                              r"at t = 1.0\d*e-03 s.*detection = \"dynamic\""):
+    with pytest.raises(
+        SimulationError,
+        match=r"granule 'g' \(at x = .* y = 0.05 m\) reached the plate's face "
+        r"at t = 1.0\d*e-03 s.*detection = \"dynamic\"",
+    ):
         simulate(s, progress=False)
 
 
@@ -207,8 +216,11 @@ def test_patch_contacts_need_every_mode_or_the_static_correction():
     model = build_model(s)
     assert model.plate.n_modes < model.plate.n_red and not model.plate.truncated
     assert model.config.face_skin == 0.0 and len(model.plate_arrays.face_y) == 0
-    with pytest.raises(SimulationError, match=r"granule 'g' .* reached the plate's face .*plate.n_modes = 0"
-                                              r".*plate.modes = \"truncated\""):
+    with pytest.raises(
+        SimulationError,
+        match=r"granule 'g' .* reached the plate's face .*plate.n_modes = 0"
+        r".*plate.modes = \"truncated\"",
+    ):
         simulate(s, model=model, progress=False)
 
 
@@ -247,7 +259,9 @@ def test_a_patch_contact_added_starts_from_the_modes(scheme):
     st.q[:], st.qd[:], st.qdd[:] = (rng.normal(size=st.q.shape) * scale * f for f in (1e-9, 1e-6, 1e-3))
     assert driver.add_patch_contacts(model, lists, arr) == 1
     st, p = arr.st, arr.p
-    assert np.allclose(st.u, p.phi_d @ st.q, rtol=1e-12, atol=0) and np.allclose(st.v, p.phi_d @ st.qd, rtol=1e-12, atol=0)
+    assert np.allclose(st.u, p.phi_d @ st.q, rtol=1e-12, atol=0) and np.allclose(
+        st.v, p.phi_d @ st.qd, rtol=1e-12, atol=0
+    )
     expected = p.phi_d @ st.qdd if scheme == "paper" else np.zeros(2)
     assert np.abs(expected).max() > 0 or scheme == "implicit"
     assert np.allclose(st.a, expected, rtol=1e-12, atol=0)
@@ -313,8 +327,11 @@ def test_patches_at_t0_refused_only_where_patches_are_impossible():
         build_model(s)
     s = drop_scenario(BETWEEN, gap=0.0)
     s = dataclasses.replace(s, contact=dataclasses.replace(s.contact, detection="fixed"))
-    with pytest.raises(ScenarioError, match=r"'contact.detection' = 'fixed': granule 'g' \(placed by "
-                                            r"granules\[0\].x, granules\[0\].y, granules\[0\].radius"):
+    with pytest.raises(
+        ScenarioError,
+        match=r"'contact.detection' = 'fixed': granule 'g' \(placed by "
+        r"granules\[0\].x, granules\[0\].y, granules\[0\].radius",
+    ):
         build_model(s)
 
 
@@ -324,8 +341,7 @@ def test_continuous_layout_radius_builds_and_a_remaining_refusal_names_the_granu
     from granplate.errors import ScenarioError
     from granplate.setup.scenario import LatticeLayout, Plate, Scenario
 
-    s = Scenario(layout=LatticeLayout(columns=2, radius=0.0093, column_radii=(0.0093, 0.0071)),
-                 plate=Plate(height=0.1))
+    s = Scenario(layout=LatticeLayout(columns=2, radius=0.0093, column_radii=(0.0093, 0.0071)), plate=Plate(height=0.1))
     model = build_model(s)
     assert len(model.initial_patches) == 4 and len(model.plate_contacts) == 0
     bad = dataclasses.replace(s, plate=Plate(height=0.1, clamped_edges=("left",)))

@@ -1,5 +1,6 @@
 """The compiled contact laws and the energy residual against plain NumPy written from the
 paper's equations (2)-(6), (8), (9) and (11), independently of the compiled code."""
+
 from __future__ import annotations
 
 import math

@@ -2,6 +2,7 @@
 truth is the lattice sized in cells, whose first planes an odd count of planes reproduces
 site for site (fcc: two planes a cell, stacked ABAB), and the rule that a size is given
 one way only."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -17,8 +18,9 @@ R = 0.005
 
 
 def _sites(lay) -> list[tuple]:
-    return sorted((round(g.x, 12), round(g.y, 12), round(g.z, 12), g.radius, g.material)
-                  for g in layout_packing(lay).granules)
+    return sorted(
+        (round(g.x, 12), round(g.y, 12), round(g.z, 12), g.radius, g.material) for g in layout_packing(lay).granules
+    )
 
 
 def _scenario(lay) -> Scenario:
@@ -41,8 +43,13 @@ def test_an_odd_number_of_planes_is_the_first_planes_of_the_cells(kind):
 def test_layers_in_planes_mix_with_layers_in_cells():
     """A layer of 3 planes then one cell of smaller PTFE spheres: 5 planes, the radii and
     materials plane by plane."""
-    lay = SpaceLattice(kind="fcc", cells=(0, 2, 2), radius=R, walls=(),
-                       layers=(Layer(planes=3), Layer(count=1, radius=0.8 * R, material="ptfe")))
+    lay = SpaceLattice(
+        kind="fcc",
+        cells=(0, 2, 2),
+        radius=R,
+        walls=(),
+        layers=(Layer(planes=3), Layer(count=1, radius=0.8 * R, material="ptfe")),
+    )
     by_x: dict[float, set] = {}
     for x, _, _, r, m in _sites(lay):
         by_x.setdefault(x, set()).add((r, m))
@@ -50,14 +57,23 @@ def test_layers_in_planes_mix_with_layers_in_cells():
     validate(_scenario(lay))
 
 
-@pytest.mark.parametrize("lay, field, names", [
-    (SpaceLattice(kind="fcc", cells=(2, 2, 2), planes=3), "layout.planes", "layout.cells[0]"),
-    (SpaceLattice(kind="fcc", cells=(0, 2, 2), planes=3, layers=(Layer(count=1),)), "layout.planes",
-     "layout.layers"),
-    (SpaceLattice(kind="fcc", cells=(0, 2, 2), layers=(Layer(count=1, planes=3),)), "layout.layers[0].planes",
-     "layout.layers[0].count"),
-    (SpaceLattice(kind="fcc", cells=(0, 2, 2), planes=0), "layout.planes", "integer >= 1"),
-])
+@pytest.mark.parametrize(
+    "lay, field, names",
+    [
+        (SpaceLattice(kind="fcc", cells=(2, 2, 2), planes=3), "layout.planes", "layout.cells[0]"),
+        (
+            SpaceLattice(kind="fcc", cells=(0, 2, 2), planes=3, layers=(Layer(count=1),)),
+            "layout.planes",
+            "layout.layers",
+        ),
+        (
+            SpaceLattice(kind="fcc", cells=(0, 2, 2), layers=(Layer(count=1, planes=3),)),
+            "layout.layers[0].planes",
+            "layout.layers[0].count",
+        ),
+        (SpaceLattice(kind="fcc", cells=(0, 2, 2), planes=0), "layout.planes", "integer >= 1"),
+    ],
+)
 def test_a_size_given_two_ways_is_refused_naming_both(lay, field, names):
     """Refused before anything runs, the message naming both fields."""
     with pytest.raises(ScenarioError) as err:

@@ -1,6 +1,7 @@
 """The elastic-plastic normal law (granplate.physics.plastic, docs/model.md section 3.6)
 against Thornton's equations written here in his own variables (E*, R*, p_y), against
 Hertz, and against the work done along load paths (numerical quadrature)."""
+
 from __future__ import annotations
 
 import math
@@ -87,8 +88,7 @@ def test_infinite_yield_strength_is_hertz():
         for d_y in (big, math.inf):
             for hist in (0.0, 0.5 * d, 1e-4):
                 assert P.plastic_force(a, d_y, d, hist) == pytest.approx(hertz, rel=1e-14, abs=0.0)
-                assert P.plastic_elastic_energy(a, d_y, d, hist) == pytest.approx(
-                    0.4 * hertz * d, rel=1e-14, abs=0.0)
+                assert P.plastic_elastic_energy(a, d_y, d, hist) == pytest.approx(0.4 * hertz * d, rel=1e-14, abs=0.0)
                 assert P.plastic_work(a, d_y, max(d, hist)) == 0.0
         assert P.plastic_force(a, math.inf, d, 1e-4) == a * d * math.sqrt(d)  # bitwise
 
@@ -102,14 +102,16 @@ def test_force_continuous_at_yield_and_at_largest_overlap():
     f_y = thornton(D_Y)["F_y"]
     assert below == pytest.approx(f_y, rel=3e-9) and above == pytest.approx(f_y, rel=3e-9)
     assert P.plastic_force_slope(A, D_Y, D_Y * (1 - eps), 0.0) == pytest.approx(
-        P.plastic_force_slope(A, D_Y, D_Y * (1 + eps), 0.0), rel=1e-8)
+        P.plastic_force_slope(A, D_Y, D_Y * (1 + eps), 0.0), rel=1e-8
+    )
     for ratio in (1.2, 7.0, 300.0):
         m = ratio * D_Y
         f_max = thornton(m)["F_max"]
         assert P.plastic_force(A, D_Y, m * (1 - 1e-12), m) == pytest.approx(f_max, rel=1e-10)
         assert P.plastic_force(A, D_Y, m, m) == pytest.approx(f_max, rel=1e-12)
         assert P.plastic_elastic_energy(A, D_Y, m * (1 - 1e-12), m) == pytest.approx(
-            P.plastic_elastic_energy(A, D_Y, m, m), rel=1e-10)
+            P.plastic_elastic_energy(A, D_Y, m, m), rel=1e-10
+        )
 
 
 def fd(f, x: float, h: float) -> float:
@@ -156,8 +158,10 @@ def test_load_unload_loop_area_is_the_plastic_work(ratio):
     stored energy: the work of unloading is U(delta_max)."""
     m = ratio * D_Y
     d_p = P.residual_overlap(D_Y, m)
-    load = sum(quad(lambda x: P.plastic_force(A, D_Y, x, x), lo, hi, epsabs=0, epsrel=1e-13)[0]
-               for lo, hi in ((0.0, min(D_Y, m)), (min(D_Y, m), m)))
+    load = sum(
+        quad(lambda x: P.plastic_force(A, D_Y, x, x), lo, hi, epsabs=0, epsrel=1e-13)[0]
+        for lo, hi in ((0.0, min(D_Y, m)), (min(D_Y, m), m))
+    )
     unload = quad(lambda x: P.plastic_force(A, D_Y, x, m), d_p, m, epsabs=0, epsrel=1e-13)[0]
     assert unload == pytest.approx(P.plastic_elastic_energy(A, D_Y, m, m), rel=1e-10)
     assert load - unload == pytest.approx(P.plastic_work(A, D_Y, m), rel=1e-8)

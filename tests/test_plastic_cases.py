@@ -1,5 +1,6 @@
 """The verification case `plastic-impact` (yielding impacts simulated by the time loop):
 it passes with figures off, and its checks fail when the truth or the loop is wrong."""
+
 from __future__ import annotations
 
 import math
@@ -68,8 +69,13 @@ def test_loop_checks_fail_on_a_tampered_loop(pair_runs):
     m["force"] = np.concatenate([m["force"][:k], 0.99 * m["force"][k:]])
     m["force_after"] *= 0.99
     failing = [c.quantity for c in P.loop_checks({("pair", 10.0): m}, consts) if not c.passed]
-    for start in ("loop area / D_plastic", "loop area / (1/2 m* v^2", "unloading continuous at delta_max",
-                  "force at the turn", "measured force vs the law"):
+    for start in (
+        "loop area / D_plastic",
+        "loop area / (1/2 m* v^2",
+        "unloading continuous at delta_max",
+        "force at the turn",
+        "measured force vs the law",
+    ):
         assert any(q.startswith(start) for q in failing), start
     m = dict(runs["pair", 10.0])
     lo, hi = m["separation"]

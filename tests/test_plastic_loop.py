@@ -1,6 +1,7 @@
 """The elastic-plastic law (docs/model.md section 3.6) in the time loop: impacts against
 Thornton's closed forms, the contact history across list rebuilds, the plastic work in
 eq. (11), Y -> infinity as Hertz bitwise, and how the runs report yield."""
+
 from __future__ import annotations
 
 import math
@@ -24,9 +25,20 @@ Y = 355e6  # [Pa] structural steel
 MASS = 4.0 / 3.0 * math.pi * R**3 * RHO
 
 
-def impact(kind: str, ratio: float, *, law: str = "thornton", scheme: str = "paper", skin: float = 0.1,
-           y_strength: float = Y, alpha_n: float = 0.0, mu: float = 0.0, vy: float = 0.0, t_end: float = 2e-4,
-           dt: float = 2e-8) -> tuple[gp.Scenario, float]:
+def impact(
+    kind: str,
+    ratio: float,
+    *,
+    law: str = "thornton",
+    scheme: str = "paper",
+    skin: float = 0.1,
+    y_strength: float = Y,
+    alpha_n: float = 0.0,
+    mu: float = 0.0,
+    vy: float = 0.0,
+    t_end: float = 2e-4,
+    dt: float = 2e-8,
+) -> tuple[gp.Scenario, float]:
     """A steel sphere (R = 1 cm) touching a rigid wall ("wall") or an equal sphere at rest
     ("pair") at t = 0 and moving into it at `ratio` times Thornton's yield velocity (P11)
     of a steel of Y = 355 MPa (its material's Y is y_strength);
@@ -38,8 +50,11 @@ def impact(kind: str, ratio: float, *, law: str = "thornton", scheme: str = "pap
         e_star, r_star, m_star = effective_modulus(steel, steel), R / 2, MASS / 2
     v_y = thornton_yield_velocity(e_star, r_star, m_star, 1.6 * Y)  # (of the structural steel, whatever y_strength)
     v = ratio * v_y
-    other = ('[[walls]]\nlabel = "left"\nnormal = [-1.0, 0.0]\noffset = 0.0\nmaterial = "steel"\n' if kind == "wall" else
-             f'[[granules]]\nlabel = "b"\nx = {-R}\ny = 0.0\nradius = {R}\nmaterial = "steel"\n')
+    other = (
+        '[[walls]]\nlabel = "left"\nnormal = [-1.0, 0.0]\noffset = 0.0\nmaterial = "steel"\n'
+        if kind == "wall"
+        else f'[[granules]]\nlabel = "b"\nx = {-R}\ny = 0.0\nradius = {R}\nmaterial = "steel"\n'
+    )
     text = f"""
 name = "plastic-{kind}"
 [materials.steel]

@@ -3,6 +3,7 @@ the Thornton law and nothing else changed, the section's numbers are each result
 `summary`, its verdicts the statement checks judged on the twins, the run table's p0
 columns the Dataset's per-pair pressures, and plastic work appears exactly where a
 contact passed the yield onset."""
+
 from __future__ import annotations
 
 import warnings

@@ -1,6 +1,7 @@
 """Head-on impacts with Thornton's elastic-plastic law (granplate.verification.plastic):
 the independent integration against Thornton's and Johnson's closed forms, and against
 the plastic work of granplate.physics.plastic."""
+
 from __future__ import annotations
 
 import math
@@ -21,8 +22,13 @@ def pair(a, b, r_a: float, r_b: float | None) -> tuple[float, float, float, floa
     m1 = sphere_mass(r_a, a.rho)
     if r_b is None:
         return m1, math.inf, effective_modulus(a, None), r_a, 1.6 * softer_yield_strength(a, None)
-    return (m1, sphere_mass(r_b, b.rho), effective_modulus(a, b), r_a * r_b / (r_a + r_b),
-            1.6 * softer_yield_strength(a, b))
+    return (
+        m1,
+        sphere_mass(r_b, b.rho),
+        effective_modulus(a, b),
+        r_a * r_b / (r_a + r_b),
+        1.6 * softer_yield_strength(a, b),
+    )
 
 
 CASES = {

@@ -1,4 +1,5 @@
 """Tests of granplate.plate: the plane-stress Q8 plate, rigid layers, modes, cache."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -92,9 +93,7 @@ def test_clamped_strip_matches_timoshenko_beam():
     k = 10 * (1 + nu) / (12 + 11 * nu)
     strip = Plate(width=0.01, height=0.1, nx=4, ny=40, clamped_edges=("top", "bottom"), n_modes=12)
     fe = bending_frequencies(gp.build_plate(strip, 0.0, [], cache=False))
-    coarse = bending_frequencies(
-        gp.build_plate(dataclasses.replace(strip, nx=2, ny=20), 0.0, [], cache=False)
-    )
+    coarse = bending_frequencies(gp.build_plate(dataclasses.replace(strip, nx=2, ny=20), 0.0, [], cache=False))
     timo = timoshenko_clamped_frequencies(E, G, rho, k, 0.1, 0.01)
     beta_l = np.array([4.730040745, 7.853204624, 10.99560784])
     euler = beta_l**2 / 0.1**2 * math.sqrt(E * 0.01**2 / (12 * rho)) / (2 * np.pi)
@@ -285,7 +284,9 @@ def test_modes_energy_and_compliance(paper_plate):
     for dt in (4e-8, 1e-6):
         inv = np.linalg.inv(M_r + dt**2 * K_r / 4)
         idx = m.drive_dofs.ravel()
-        np.testing.assert_allclose(m.compliance(dt), inv[np.ix_(idx, idx)], rtol=1e-7, atol=1e-9 * abs(inv[np.ix_(idx, idx)]).max())
+        np.testing.assert_allclose(
+            m.compliance(dt), inv[np.ix_(idx, idx)], rtol=1e-7, atol=1e-9 * abs(inv[np.ix_(idx, idx)]).max()
+        )
     # tangential c_k at the paper's step: ~1e5 1/kg (effective mass ~1e-5 kg)
     c_t = np.diag(m.compliance(4e-8))[1::2]
     assert np.all((5e4 < c_t) & (c_t < 2e5))
@@ -381,8 +382,13 @@ def test_validation_refuses_contacts_and_layers_on_clamps():
 def test_reduced_dof_count_matches_the_built_plate(clamped):
     """validate's count of reduced dofs = the built plate's n_red, for several clamps and layers."""
     contacts = () if "left" in clamped else (0.05, 0.025)
-    for plate in (Plate(nx=2, ny=10, clamped_edges=clamped), Plate(nx=3, ny=12, clamped_edges=clamped, rigid_layer_width=0.02)):
-        s = plate_scenario(contacts, **{k: getattr(plate, k) for k in ("nx", "ny", "clamped_edges", "rigid_layer_width")})
+    for plate in (
+        Plate(nx=2, ny=10, clamped_edges=clamped),
+        Plate(nx=3, ny=12, clamped_edges=clamped, rigid_layer_width=0.02),
+    ):
+        s = plate_scenario(
+            contacts, **{k: getattr(plate, k) for k in ("nx", "ny", "clamped_edges", "rigid_layer_width")}
+        )
         n_slaved = sum(len(m) for _, m in plate_checks.rigid_layers(s.plate, list(contacts)))
         m = gp.build_plate(s.plate, X0, contacts, cache=False, symmetry_line=False)
         assert plate_checks.reduced_dof_count(s.plate, n_slaved) == m.n_red
@@ -561,8 +567,10 @@ def test_the_plate_package_loads_its_members_on_first_use():
     needs) load without scikit-fem; asking the package for build_plate loads it."""
     import subprocess
 
-    probe = ("import sys\nimport granplate.plate.peaks\nprint('skfem' in sys.modules)\n"
-             "from granplate.plate import build_plate\nprint('skfem' in sys.modules)")
+    probe = (
+        "import sys\nimport granplate.plate.peaks\nprint('skfem' in sys.modules)\n"
+        "from granplate.plate import build_plate\nprint('skfem' in sys.modules)"
+    )
     done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     assert done.stdout.split() == ["False", "True"]

@@ -1,6 +1,7 @@
 """The plate's face and its patch weights (granplate/plate/face.py, docs/model.md section
 3.5): consistent nodal weights of a uniform traction against exact integrals, and the
 face's mode shapes against the full modes."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -20,7 +21,7 @@ def edge_interpolant(face_y: np.ndarray, values: np.ndarray, y: np.ndarray) -> n
     out = np.empty_like(y)
     for j, yy in enumerate(y):
         e = min(int(np.searchsorted(face_y, yy, side="right") - 1) // 2, (len(face_y) - 1) // 2 - 1)
-        ys, vs = face_y[2 * e: 2 * e + 3], values[2 * e: 2 * e + 3]
+        ys, vs = face_y[2 * e : 2 * e + 3], values[2 * e : 2 * e + 3]
         out[j] = sum(vs[a] * np.prod([(yy - ys[b]) / (ys[a] - ys[b]) for b in range(3) if b != a]) for a in range(3))
     return out
 
@@ -46,7 +47,7 @@ def test_centred_patch_is_symmetric_and_linear_fields_give_the_centre():
     averages to its value at the patch centre (uniform traction: the centroid)."""
     w = patch_weight_vector(FACE_Y, 0.05, 0.0025)
     k = int(np.argmin(abs(FACE_Y - 0.05)))
-    np.testing.assert_allclose(w[k - 3: k + 4], w[k - 3: k + 4][::-1], atol=1e-15)
+    np.testing.assert_allclose(w[k - 3 : k + 4], w[k - 3 : k + 4][::-1], atol=1e-15)
     for y_c in (0.05, 0.0504375, 0.0731):
         assert patch_weight_vector(FACE_Y, y_c, 0.0025) @ FACE_Y == pytest.approx(y_c, rel=1e-14)
 

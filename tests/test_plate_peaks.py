@@ -1,5 +1,6 @@
 """The plate maxima over output times (granplate.plate.peaks): the bound that lets a
 summary skip output times, and the skipping itself."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -35,7 +36,11 @@ def synthetic_run(plate, n: int, spike: int | None) -> np.ndarray:
     t = np.arange(n)[:, None]
     k = np.arange(plate.n_modes)[None, :]
     amp = 1e-6 * np.exp(-k / 4.0) * rng.uniform(0.5, 1.0, size=(1, plate.n_modes))
-    c = amp * np.sin(0.05 * t * (1 + k) + rng.uniform(0, 6, size=(1, plate.n_modes))) * np.exp(-((t - n / 2) / (n / 4)) ** 2)
+    c = (
+        amp
+        * np.sin(0.05 * t * (1 + k) + rng.uniform(0, 6, size=(1, plate.n_modes)))
+        * np.exp(-(((t - n / 2) / (n / 4)) ** 2))
+    )
     if spike is not None:
         c[spike, plate.n_modes // 2] += 50 * float(np.abs(c).max())
     return np.ascontiguousarray(c)
@@ -60,7 +65,7 @@ def test_time_maxima_stop_after_a_block(plate):
     c = synthetic_run(plate, 100, None)
     part = P.time_maxima(plate, c, should_stop=lambda: True)
     assert len(part) == P.BLOCK
-    assert np.array_equal(part, P.time_maxima(plate, c)[:P.BLOCK])
+    assert np.array_equal(part, P.time_maxima(plate, c)[: P.BLOCK])
 
 
 def test_distance_peaks_is_the_weighted_distance(plate):

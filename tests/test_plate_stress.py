@@ -1,6 +1,7 @@
 """The disc-averaged von Mises stress (granplate.plate.stress, docs/model.md section 4.4)
 against closed-form means over discs, half discs and quarter discs, and against a field
 with the rigid-punch singularity r^(-1/2), whose point peak has no mesh limit."""
+
 from __future__ import annotations
 
 import math
@@ -10,7 +11,11 @@ import pytest
 
 from granplate import plate as gp
 from granplate.plate.stress import (
-    DISC_CENTRE_SPACING, disc_average_operator, disc_centres, max_disc_average, quadrature_points,
+    DISC_CENTRE_SPACING,
+    disc_average_operator,
+    disc_centres,
+    max_disc_average,
+    quadrature_points,
 )
 
 WIDTH, HEIGHT, RADIUS = 0.01, 0.1, 0.0025

@@ -1,6 +1,7 @@
 """Reference solutions for elastic plates and sphere impacts (granplate.verification:
 plate_theory, plate_ritz, impact_theory) against their published numbers, closed forms,
 limits and energy balances."""
+
 from __future__ import annotations
 
 import math
@@ -16,6 +17,7 @@ STEEL = {"young": 210e9, "poisson": 0.3, "rho": 7800.0}
 
 
 # --------------------------------------------------------------------------- Kirchhoff frequencies
+
 
 def test_ritz_simply_supported_equals_navier():
     """Ritz on a simply supported square and on a 1 x 1.5 rectangle gives Navier's
@@ -52,6 +54,7 @@ def test_ritz_converges_from_above():
 def test_free_square_has_three_rigid_modes():
     """A free plate has exactly three rigid-body modes (w = 1, x, y), all of zero frequency."""
     from scipy.linalg import eigh
+
     values = eigh(*R.kirchhoff_matrices("F", 1.0, 0.3, 8), eigvals_only=True)
     assert np.sum(np.abs(values) < 1e-8 * values.max()) == 3
 
@@ -66,6 +69,7 @@ def test_kirchhoff_frequency_units():
 
 
 # --------------------------------------------------------------------------- Mindlin
+
 
 def test_mindlin_ss_tends_to_kirchhoff():
     """Mindlin's simply supported root tends to Kirchhoff's pi^2 (m^2 + n^2) as h/a -> 0,
@@ -131,6 +135,7 @@ def test_shear_frequency_parameter():
 
 # --------------------------------------------------------------------------- statics
 
+
 def test_navier_uniform_matches_timoshenko():
     """Timoshenko & Woinowsky-Krieger ch. 5, simply supported square, uniform load:
     w_max = 0.00406 q a^4 / D (the patch series with the patch the whole plate)."""
@@ -151,8 +156,10 @@ def test_small_patch_tends_to_point_load():
     gap falling with the patch (a 2 x 1 rectangle, load off centre, sampled elsewhere)."""
     a, b, x0, y0 = 2.0, 1.0, 0.7, 0.4
     point = T.navier_point_deflection(1.2, 0.5, a, b, 1.0, 1.0, x0, y0, terms=300)
-    gaps = [abs(T.navier_patch_deflection(1.2, 0.5, a, b, 1.0, 1.0 / s**2, s, s, x0, y0, terms=300) - point)
-            for s in (0.2, 0.1, 0.05)]
+    gaps = [
+        abs(T.navier_patch_deflection(1.2, 0.5, a, b, 1.0, 1.0 / s**2, s, s, x0, y0, terms=300) - point)
+        for s in (0.2, 0.1, 0.05)
+    ]
     assert gaps[0] > gaps[1] > gaps[2] and gaps[2] < 1e-3 * point
 
 
@@ -183,10 +190,12 @@ def test_ritz_point_load_converges_from_below():
 
 # --------------------------------------------------------------------------- Hertz
 
+
 def test_hertz_time_constant_is_johnsons():
     """Johnson 1985 section 11.4: t_c = 2.94 delta_max / v0; the exact constant (4/5) B(2/5, 1/2)
     rounds to it, and equals 2 int_0^1 dx / sqrt(1 - x^(5/2)) by quadrature."""
     from scipy.integrate import quad
+
     assert round(I.HERTZ_TIME_CONSTANT, 2) == 2.94
     integral, _ = quad(lambda x: 1 / math.sqrt(1 - x**2.5), 0, 1, limit=200)
     assert I.HERTZ_TIME_CONSTANT == pytest.approx(2 * integral, rel=1e-8)
@@ -215,6 +224,7 @@ def test_effective_modulus():
 
 
 # --------------------------------------------------------------------------- Zener
+
 
 def test_zener_energy_balance():
     """Kinetic + Hertz + dashpot energy = the initial 1/2 m v0^2 at every step, lambda = 0 to 5."""
@@ -259,8 +269,12 @@ def test_zener_depends_on_lambda_alone():
         k = I.hertz_stiffness(e_star, r)
         mobility = I.plate_point_mobility(T.flexural_rigidity(STEEL["young"], h, STEEL["poisson"]), STEEL["rho"], h)
         lam = I.zener_inelasticity(m, speed, k, mobility)
-        assert lam == pytest.approx(I.zener_inelasticity_sphere(r, STEEL["rho"], e_star, speed, h, STEEL["young"],
-                                                                STEEL["poisson"], STEEL["rho"]), rel=1e-12)
+        assert lam == pytest.approx(
+            I.zener_inelasticity_sphere(
+                r, STEEL["rho"], e_star, speed, h, STEEL["young"], STEEL["poisson"], STEEL["rho"]
+            ),
+            rel=1e-12,
+        )
         assert I.zener_impact_si(m, speed, k, mobility) == pytest.approx(I.zener_restitution(lam), abs=1e-8)
 
 
@@ -283,6 +297,7 @@ def test_bad_arguments_are_refused_by_name():
 
 
 # --------------------------------------------------------------------------- flexural waves
+
 
 def test_flexural_group_velocity_is_d_omega_dk():
     """c_g = d omega / dk of omega = k^2 sqrt(D / (rho h)), by central differences in k, and

@@ -1,5 +1,6 @@
 """The truncated plate basis with static correction (docs/model.md section 4.5) against
 the full one, and the plate's size checks (granplate.setup.plate_cost)."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -42,7 +43,7 @@ def truncated() -> gp.PlateModel:
 
 
 def test_auto_keeps_the_paper_mesh_dense(full):
-    """"auto" gives the paper's 4 x 40 mesh every mode, without a static part."""
+    """ "auto" gives the paper's 4 x 40 mesh every mode, without a static part."""
     assert full.n_modes == full.n_red and not full.truncated and full.resid.shape == (0, 0)
     assert plate_cost.basis_kind("auto", full.n_red) == "all"
     assert plate_cost.basis_kind("auto", plate_cost.DENSE_DOF_LIMIT + 1) == "truncated"
@@ -103,8 +104,9 @@ def test_static_displacement_field_is_exact(full, truncated):
 
 def _steel(t_end: float, **plate) -> object:
     s = preset("steel-r1")
-    return dataclasses.replace(s, plate=dataclasses.replace(s.plate, **plate),
-                               time=dataclasses.replace(s.time, t_end=t_end))
+    return dataclasses.replace(
+        s, plate=dataclasses.replace(s.plate, **plate), time=dataclasses.replace(s.time, t_end=t_end)
+    )
 
 
 def test_short_run_agrees_with_the_full_basis():
@@ -117,8 +119,15 @@ def test_short_run_agrees_with_the_full_basis():
     ds = simulate(_steel(5e-4, modes="truncated", max_frequency=3e5), progress=False)
     t = summary(ds)
     assert t["energy_residual_max"] <= preset("steel-r1").solver.energy_tol
-    for key in ("ep_max_fraction", "ep_final_fraction", "eg_max_fraction", "dissipated_fraction",
-                "max_von_mises", "max_eps_yy", "e_shock"):
+    for key in (
+        "ep_max_fraction",
+        "ep_final_fraction",
+        "eg_max_fraction",
+        "dissipated_fraction",
+        "max_von_mises",
+        "max_eps_yy",
+        "e_shock",
+    ):
         assert t[key] == pytest.approx(f[key], rel=5e-3), key
     assert f["ep_max_fraction"] > 0.05  # the plate took part
 
@@ -126,8 +135,9 @@ def test_short_run_agrees_with_the_full_basis():
 def test_truncated_plate_is_refused_where_unsupported():
     """The paper scheme and a load on the plate's edge are refused, naming the field and why."""
     s = preset("steel-r1")
-    bad = dataclasses.replace(s, plate=dataclasses.replace(s.plate, modes="truncated"),
-                              solver=dataclasses.replace(s.solver, scheme="paper"))
+    bad = dataclasses.replace(
+        s, plate=dataclasses.replace(s.plate, modes="truncated"), solver=dataclasses.replace(s.solver, scheme="paper")
+    )
     with pytest.raises(ScenarioError, match="solver.scheme") as refused:
         validate(bad)
     # the refusal says why (the massless static part defeats criterion (8)) and what to use
@@ -160,12 +170,23 @@ def test_bench_plate_table_helpers():
     assert parse_meshes("4x40, 8X80") == [(4, 40), (8, 80)]
     with pytest.raises(ValueError, match="--meshes"):
         parse_meshes("4x")
-    table = format_plate_table([
-        {"mesh": "4 x 40", "modes": "auto", "setup_s": 2.5, "rss_setup_mib": 180.0, "n_red": 1082,
-         "n_modes": 1082, "truncated": False, "run_s": 16.0, "rss_peak_mib": 220.0,
-         "summary": {"max_von_mises": 43.6e6, "max_von_mises_disc": 30.3e6}},
-        {"mesh": "64 x 640", "modes": "all", "refused": "scenario field 'plate.modes'"},
-    ])
+    table = format_plate_table(
+        [
+            {
+                "mesh": "4 x 40",
+                "modes": "auto",
+                "setup_s": 2.5,
+                "rss_setup_mib": 180.0,
+                "n_red": 1082,
+                "n_modes": 1082,
+                "truncated": False,
+                "run_s": 16.0,
+                "rss_peak_mib": 220.0,
+                "summary": {"max_von_mises": 43.6e6, "max_von_mises_disc": 30.3e6},
+            },
+            {"mesh": "64 x 640", "modes": "all", "refused": "scenario field 'plate.modes'"},
+        ]
+    )
     assert "| 4 x 40 | all | 1,082 | 1082 | 2.5 | 180 | 16.0 | 220 | 43.6 | 30.3 |" in table
     assert "plate.modes" in table.splitlines()[-1]
 
@@ -177,8 +198,7 @@ def test_bench_plates_command(tmp_path, capsys):
     from granplate.cli import main
 
     out = tmp_path / "plates.json"
-    rc = main(["bench", "--plates", "--meshes", "2x20", "--modes", "truncated", "--t-end", "1e-5",
-               "--json", str(out)])
+    rc = main(["bench", "--plates", "--meshes", "2x20", "--modes", "truncated", "--t-end", "1e-5", "--json", str(out)])
     assert rc == 0
     (row,) = json.loads(out.read_text())
     assert row["truncated"] and 0 < row["n_modes"] < row["n_red"] == 290
@@ -191,8 +211,7 @@ def test_plate_basis_fields_round_trip_through_toml():
     from granplate.setup import io as scenario_io
 
     s = preset("steel-r1")
-    s = dataclasses.replace(s, plate=dataclasses.replace(s.plate, nx=8, ny=80, modes="truncated",
-                                                         max_frequency=5e5))
+    s = dataclasses.replace(s, plate=dataclasses.replace(s.plate, nx=8, ny=80, modes="truncated", max_frequency=5e5))
     text = scenario_io.dumps(s)
     assert 'modes = "truncated"' in text and "max_frequency = 500000.0" in text
     assert scenario_io.loads(text) == s

@@ -1,5 +1,6 @@
 """Every paper figure draws its datasets' own numbers (no copies, no typed-in values),
 with units on its axes and a caption, and is written as PNG and PDF."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -62,9 +63,15 @@ def test_fig3_draws_stress_and_energies(runs):
     np.testing.assert_array_equal(vm[1].get_ydata(), steel.max_von_mises.values / 1e6)
     np.testing.assert_array_equal(vm[1].get_xdata(), steel.time.values * 1e3)
     np.testing.assert_allclose(_lines(fig, "energy:plate")[0].get_ydata(), _normalised(steel, "E_plate"), rtol=1e-12)
-    np.testing.assert_allclose(_lines(fig, "energy:granular")[0].get_ydata(), _normalised(steel, "E_granular"), rtol=1e-12)
-    total = _normalised(steel, "E_plate") + _normalised(steel, "E_granular") + _normalised(steel, "D_viscous") \
+    np.testing.assert_allclose(
+        _lines(fig, "energy:granular")[0].get_ydata(), _normalised(steel, "E_granular"), rtol=1e-12
+    )
+    total = (
+        _normalised(steel, "E_plate")
+        + _normalised(steel, "E_granular")
+        + _normalised(steel, "D_viscous")
         + _normalised(steel, "D_friction")
+    )
     np.testing.assert_allclose(_lines(fig, "energy:total")[0].get_ydata(), total, rtol=1e-12)
     _check_axes_and_caption(fig)
     assert "bare-plate" in plots.caption_of(fig) and "steel-r1" in plots.caption_of(fig)
@@ -75,8 +82,9 @@ def test_fig3_follows_a_changed_dataset(runs):
     steel = runs["steel-r1"].copy(deep=True)
     steel["E_plate"] = steel["E_plate"] * 0.5
     fig = plots.fig_3(runs["bare-plate"], steel)
-    np.testing.assert_allclose(_lines(fig, "energy:plate")[0].get_ydata(),
-                               0.5 * _normalised(runs["steel-r1"], "E_plate"), rtol=1e-12)
+    np.testing.assert_allclose(
+        _lines(fig, "energy:plate")[0].get_ydata(), 0.5 * _normalised(runs["steel-r1"], "E_plate"), rtol=1e-12
+    )
 
 
 def test_fig4_two_sizes_energies_kinetic_velocities(runs):
@@ -85,7 +93,11 @@ def test_fig4_two_sizes_energies_kinetic_velocities(runs):
     fig = plots.fig_4(r1, r05)
     for k, ds in enumerate((r1, r05)):
         np.testing.assert_allclose(_lines(fig, "energy:plate")[k].get_ydata(), _normalised(ds, "E_plate"), rtol=1e-12)
-        for part, var in (("horizontal", "KE_horizontal"), ("vertical", "KE_vertical"), ("rotational", "KE_rotational")):
+        for part, var in (
+            ("horizontal", "KE_horizontal"),
+            ("vertical", "KE_vertical"),
+            ("rotational", "KE_rotational"),
+        ):
             np.testing.assert_allclose(_lines(fig, f"kinetic:{part}")[k].get_ydata(), ds[var].values * 1e3, rtol=1e-12)
         for lab in ("3", "8", "C"):
             np.testing.assert_array_equal(_lines(fig, f"vx:{lab}")[k].get_ydata(), ds.vx.sel(granule=lab).values)
@@ -110,11 +122,13 @@ def test_fig6_space_time_maps(runs):
     for k, ds in enumerate((steel, ptfe)):
         for c, labels in enumerate((list("12345"), list("6789"), list("ABCDE")), start=1):
             mesh = _meshes(fig, f"vx:column{c}")[k]
-            np.testing.assert_array_equal(np.asarray(mesh.get_array()).reshape(len(ds.time), -1),
-                                          ds.vx.sel(granule=labels).values)
+            np.testing.assert_array_equal(
+                np.asarray(mesh.get_array()).reshape(len(ds.time), -1), ds.vx.sel(granule=labels).values
+            )
         plate = _meshes(fig, "vx:plate")[k]
-        np.testing.assert_array_equal(np.asarray(plate.get_array()).reshape(len(ds.time), -1),
-                                      ds.plate_vx_symmetry.values)
+        np.testing.assert_array_equal(
+            np.asarray(plate.get_array()).reshape(len(ds.time), -1), ds.plate_vx_symmetry.values
+        )
     _check_axes_and_caption(fig)
 
 
@@ -134,7 +148,9 @@ def test_fig8_three_intensities(runs):
     fig = plots.fig_8(*cases)
     for k, ds in enumerate(cases):
         np.testing.assert_allclose(_lines(fig, "energy:plate")[k].get_ydata(), _normalised(ds, "E_plate"), rtol=1e-12)
-        np.testing.assert_allclose(_lines(fig, "energy-zoom:plate")[k].get_ydata(), _normalised(ds, "E_plate"), rtol=1e-12)
+        np.testing.assert_allclose(
+            _lines(fig, "energy-zoom:plate")[k].get_ydata(), _normalised(ds, "E_plate"), rtol=1e-12
+        )
     assert "q0 = 2 kN/m" in fig.axes[0].get_title(loc="left")
     _check_axes_and_caption(fig)
 
@@ -144,8 +160,9 @@ def test_figA1_local_map_modulus(runs):
     ds = runs["steel-r1"]
     fig = plots.fig_A1(ds)
     for lab in ("A", "B", "C"):
-        np.testing.assert_array_equal(_lines(fig, f"lambda:{lab}")[0].get_ydata(),
-                                      ds.local_map_modulus.sel(contact=lab).values)
+        np.testing.assert_array_equal(
+            _lines(fig, f"lambda:{lab}")[0].get_ydata(), ds.local_map_modulus.sel(contact=lab).values
+        )
     _check_axes_and_caption(fig)
 
 
@@ -157,7 +174,9 @@ def test_save_writes_png_and_pdf(runs, tmp_path):
     assert paths[1].read_bytes()[:4] == b"%PDF"
 
 
-@pytest.mark.parametrize("name, key", [("3", "3"), ("fig4", "4"), ("Fig. 5", "5"), ("A.1", "A1"), ("a1", "A1"), ("figA1", "A1")])
+@pytest.mark.parametrize(
+    "name, key", [("3", "3"), ("fig4", "4"), ("Fig. 5", "5"), ("A.1", "A1"), ("a1", "A1"), ("figA1", "A1")]
+)
 def test_figure_names(name, key):
     """Figure names are read loosely; every figure names the presets it needs."""
     assert plots.figure_key(name) == key

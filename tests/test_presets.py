@@ -1,4 +1,5 @@
 """The paper's six cases as presets (docs/model.md section 8)."""
+
 from __future__ import annotations
 
 import pytest
@@ -10,8 +11,7 @@ from granplate.setup.presets import DESCRIPTIONS, preset, preset_names
 from granplate.setup.scenario import Contact, Plate, Solver, TimeSettings
 from granplate.setup.validate import validate
 
-NAMES = ["bare-plate", "steel-r1", "steel-r05", "ptfe-r05", "ptfe-r05-moderate",
-         "ptfe-r05-weak"]
+NAMES = ["bare-plate", "steel-r1", "steel-r05", "ptfe-r05", "ptfe-r05-moderate", "ptfe-r05-weak"]
 
 
 def test_exactly_the_six_paper_cases():
@@ -45,9 +45,17 @@ def test_presets_are_valid_with_paper_defaults(name):
     assert s.solver == Solver(granular_friction="rk4")
 
 
-@pytest.mark.parametrize("name, q0", [
-    ("bare-plate", 50_000.0), ("steel-r1", 50_000.0), ("steel-r05", 50_000.0),
-    ("ptfe-r05", 50_000.0), ("ptfe-r05-moderate", 10_000.0), ("ptfe-r05-weak", 2_000.0)])
+@pytest.mark.parametrize(
+    "name, q0",
+    [
+        ("bare-plate", 50_000.0),
+        ("steel-r1", 50_000.0),
+        ("steel-r05", 50_000.0),
+        ("ptfe-r05", 50_000.0),
+        ("ptfe-r05-moderate", 10_000.0),
+        ("ptfe-r05-weak", 2_000.0),
+    ],
+)
 def test_shock_intensities(name, q0):
     """q0 is 50 kN/m for the main cases, 10 kN/m and 2 kN/m for the moderate and weak ones."""
     assert preset(name).load.q0 == q0
@@ -58,9 +66,13 @@ def test_setups():
     b = preset("bare-plate")
     assert b.granules == () and b.walls == () and b.layout is None
     assert b.plate == Plate(x0=0.0) and b.load.target == "plate"
-    expected = {"steel-r1": (1.0, "steel"), "steel-r05": (0.5, "steel"),
-                "ptfe-r05": (0.5, "ptfe"), "ptfe-r05-moderate": (0.5, "ptfe"),
-                "ptfe-r05-weak": (0.5, "ptfe")}
+    expected = {
+        "steel-r1": (1.0, "steel"),
+        "steel-r05": (0.5, "steel"),
+        "ptfe-r05": (0.5, "ptfe"),
+        "ptfe-r05-moderate": (0.5, "ptfe"),
+        "ptfe-r05-weak": (0.5, "ptfe"),
+    }
     for n, (ratio, mat) in expected.items():
         s = preset(n)
         assert (s.layout.R2_ratio, s.layout.intruder_material) == (ratio, mat)
@@ -78,8 +90,7 @@ def test_preset_by_name_and_unknown_name():
 def test_with_changes_tweaks_a_preset():
     """with_changes sets dotted paths on a preset and leaves the rest equal."""
     s = preset("steel-r1")
-    t = scenario_io.with_changes(s, {"load.q0": 1e4, "time.t_end": 1e-4,
-                                     "layout.R2_ratio": 0.5, "plate.ny": 80})
+    t = scenario_io.with_changes(s, {"load.q0": 1e4, "time.t_end": 1e-4, "layout.R2_ratio": 0.5, "plate.ny": 80})
     assert (t.load.q0, t.time.t_end, t.layout.R2_ratio, t.plate.ny) == (1e4, 1e-4, 0.5, 80)
     assert t.contact == s.contact and t.materials == s.materials
     assert scenario_io.with_changes(s, {}) == s

@@ -4,6 +4,7 @@ for the copies in the getting-started page that reads them line by line.
 
 Truth: the package itself, run on the README's own text.
 """
+
 from __future__ import annotations
 
 import re
@@ -77,8 +78,12 @@ def test_model_citations_point_to_existing_sections():
     root = README.parent
     headings = set(re.findall(r"^#{2,3} (\d+(?:\.\d+)?)[. ]", (root / "docs" / "model.md").read_text(), re.M))
     assert {"1", "2", "3", "4", "5", "6", "7", "8"} <= headings
-    files = [README, *(p for p in (root / "docs").rglob("*.md") if "_build" not in p.parts), *(root / "granplate").rglob("*.py"),
-             *(root / "tests").glob("*.py")]
+    files = [
+        README,
+        *(p for p in (root / "docs").rglob("*.md") if "_build" not in p.parts),
+        *(root / "granplate").rglob("*.py"),
+        *(root / "tests").glob("*.py"),
+    ]
     cited = []
     for f in files:
         for m in re.finditer(r"docs/model\.md,? sections? (\d+(?:\.\d+)?)(?:-(\d+))?", f.read_text()):

@@ -1,6 +1,7 @@
 """The report's table is computed from the result datasets (change a dataset and the
 table changes), missing runs are marked, and report.md / report.html are written with
 the figures embedded."""
+
 from __future__ import annotations
 
 import base64
@@ -64,7 +65,10 @@ def test_ordering_statement_follows_the_data(runs):
     """Swap the weak and strong runs: 'share grows with intensity' no longer holds."""
     rows = report.statements(runs)
     swapped = dict(runs)
-    swapped["ptfe-r05-weak"], swapped["ptfe-r05"] = runs["ptfe-r05"].copy(deep=True), runs["ptfe-r05-weak"].copy(deep=True)
+    swapped["ptfe-r05-weak"], swapped["ptfe-r05"] = (
+        runs["ptfe-r05"].copy(deep=True),
+        runs["ptfe-r05-weak"].copy(deep=True),
+    )
     for ds in (swapped["ptfe-r05-weak"],):
         ds["E_plate"] = ds["E_plate"] + 0.5 * float(ds.E_shock[-1])  # the "weak" run now gives most to the plate
     r = _row(report.statements(swapped), "The plate's share grows with the shock intensity (peak share)")
@@ -173,8 +177,13 @@ def test_every_sensitivity_run_is_discussed():
     from granplate.paper import checks as ck
     from granplate.paper import discussion as dn
 
-    groups = (list(dn.STRESS_CHECKS) + ck.runs_of(dn.STEEL, "sampling") + list(dn.PTFE_NUMERIC)
-              + list(dn.PTFE_PLATE) + ck.runs_of(dn.BARE, "sampling", "mesh"))
+    groups = (
+        list(dn.STRESS_CHECKS)
+        + ck.runs_of(dn.STEEL, "sampling")
+        + list(dn.PTFE_NUMERIC)
+        + list(dn.PTFE_PLATE)
+        + ck.runs_of(dn.BARE, "sampling", "mesh")
+    )
     assert sorted(groups) == sorted(c.name for c in ck.CHECKS)
     with pytest.raises(ValueError, match="role"):
         ck.SensitivityRun("x", "steel-r1", role="colour")

@@ -2,6 +2,7 @@
 report with the cases rerun with yielding contacts), reuse of unchanged results (a second
 run simulates nothing; a changed scenario or version is run again), `--no-plastic`, and
 the plot / animate / export commands."""
+
 from __future__ import annotations
 
 import pytest
@@ -124,8 +125,24 @@ def test_plan_checks_modes(tmp_path):
 def test_no_plastic_leaves_the_twins_out(first, capsys):
     """`--no-plastic`: no twin runs, no yielding figure, and the report has no section."""
     out, _ = first
-    assert main(["reproduce", "--out", str(out), "--t-end", str(T_END), "--checks", "none", "--no-plastic",
-                 "--no-figures", "--no-animations", "-q"]) == 0
+    assert (
+        main(
+            [
+                "reproduce",
+                "--out",
+                str(out),
+                "--t-end",
+                str(T_END),
+                "--checks",
+                "none",
+                "--no-plastic",
+                "--no-figures",
+                "--no-animations",
+                "-q",
+            ]
+        )
+        == 0
+    )
     assert "runs: 0 ran, 6 reused" in capsys.readouterr().out
     md = (out / "report.md").read_text()
     assert "## Contacts that yield" not in md and "fig-yielding" not in md
@@ -137,8 +154,10 @@ def test_cli_plot_animate_export(first, tmp_path, capsys):
     out, _ = first
     assert main(["plot", str(out), "--figure", "3", "--out", str(tmp_path)]) == 0
     assert (tmp_path / "fig3.png").is_file() and (tmp_path / "fig3.pdf").is_file()
-    assert main(["plot", str(out / "steel-r05.nc"), str(out / "ptfe-r05.nc"), "--figure", "fig7",
-                 "--out", str(tmp_path)]) == 0
+    assert (
+        main(["plot", str(out / "steel-r05.nc"), str(out / "ptfe-r05.nc"), "--figure", "fig7", "--out", str(tmp_path)])
+        == 0
+    )
     assert main(["plot", str(out / "steel-r1.nc"), "--figure", "A.1", "--out", str(tmp_path)]) == 0
     capsys.readouterr()
     assert main(["animate", str(out / "ptfe-r05.nc"), "-o", str(tmp_path / "a.gif"), "--frames", "2"]) == 0
@@ -150,15 +169,18 @@ def test_cli_plot_animate_export(first, tmp_path, capsys):
     assert (tmp_path / "vtk" / "steel-r1.pvd").is_file()
 
 
-@pytest.mark.parametrize("argv", [
-    ["plot", "NOPE.nc", "--figure", "3"],
-    ["plot", "{out}/steel-r1.nc", "--figure", "9"],
-    ["plot", "{out}/steel-r1.nc", "--figure", "3"],      # needs two results
-    ["plot", "{out}/report.md", "--figure", "A1"],       # not a result
-    ["animate", "NOPE.nc"],
-    ["animate", "{out}/steel-r1.nc", "-o", "x.avi"],
-    ["export", "NOPE.nc", "--vtk", "v"],
-])
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["plot", "NOPE.nc", "--figure", "3"],
+        ["plot", "{out}/steel-r1.nc", "--figure", "9"],
+        ["plot", "{out}/steel-r1.nc", "--figure", "3"],  # needs two results
+        ["plot", "{out}/report.md", "--figure", "A1"],  # not a result
+        ["animate", "NOPE.nc"],
+        ["animate", "{out}/steel-r1.nc", "-o", "x.avi"],
+        ["export", "NOPE.nc", "--vtk", "v"],
+    ],
+)
 def test_cli_user_mistakes_exit_2(first, argv, capsys):
     """A user's mistake prints one line and exits 2, no traceback."""
     out, _ = first

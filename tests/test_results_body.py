@@ -3,6 +3,7 @@ displacement at field times is Phi q plus the static residual from a dense solve
 quasi-static modal response plus the residual is K^-1 f; the per-time maxima are those of
 the fields evaluated time by time; a uniform stress's ball average is that stress; the
 VTK node order puts the mid-nodes at VTK's edge midpoints in positively oriented cells."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -28,8 +29,9 @@ RADIUS = 0.008
 
 @pytest.fixture(scope="module")
 def solid():
-    m = build_solid(Solid(size=SIZE, elements=(4, 4, 2), clamped=("xmin",), max_frequency=8e4),
-                    surface=None, cache=False)
+    m = build_solid(
+        Solid(size=SIZE, elements=(4, 4, 2), clamped=("xmin",), max_frequency=8e4), surface=None, cache=False
+    )
     assert 10 <= m.n_modes <= 40
     return m
 
@@ -94,8 +96,11 @@ def test_displacement_is_modes_plus_the_static_residual(solid, ops):
 def test_quasi_static_modes_plus_residual_is_the_static_solution(solid, ops, element):
     """q = diag(1/omega^2) Phi^T f (every kept mode quasi-static) plus the residual = K^-1 f to 1e-8."""
     if element != "hex20":
-        solid = build_solid(Solid(size=SIZE, elements=(3, 3, 1), element=element, clamped=("xmin",),
-                                  max_frequency=8e4), surface=None, cache=False)
+        solid = build_solid(
+            Solid(size=SIZE, elements=(3, 3, 1), element=element, clamped=("xmin",), max_frequency=8e4),
+            surface=None,
+            cache=False,
+        )
         ops = body_operators(solid, RADIUS)
     face, xi, force, cp = contact(ops)
     f = reduced_force(solid, ops, cp)
@@ -127,8 +132,9 @@ def test_maxima_equal_the_fields_time_by_time(solid, ops, off):
         vm = von_mises(D @ (op @ u).reshape(6, -1))
         assert data["max_von_mises"].values[k] == pytest.approx(vm.max(), rel=1e-9)
         assert data["max_von_mises_ball"].values[k] == pytest.approx((ops.ball @ vm).max(), rel=1e-9)
-        assert data["max_displacement"].values[k] == pytest.approx(np.linalg.norm(u.reshape(-1, 3), axis=1).max(),
-                                                                   rel=1e-9)
+        assert data["max_displacement"].values[k] == pytest.approx(
+            np.linalg.norm(u.reshape(-1, 3), axis=1).max(), rel=1e-9
+        )
     assert data["max_von_mises"].attrs["units"] == "Pa" and data["max_von_mises"].attrs["long_name"]
 
 
@@ -178,8 +184,9 @@ def test_interrupted(solid, ops):
     old = body.BLOCK_BYTES
     body.BLOCK_BYTES = 1
     try:
-        part, coords = body_data(solid, q, q, TIMES, face, xi, force, 4, RADIUS, operators=ops,
-                                 should_stop=lambda: True)
+        part, coords = body_data(
+            solid, q, q, TIMES, face, xi, force, 4, RADIUS, operators=ops, should_stop=lambda: True
+        )
     finally:
         body.BLOCK_BYTES = old
     assert part["max_von_mises"].sizes["time"] == 1 and part["body_ux"].sizes["field_time"] == 1

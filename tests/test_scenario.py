@@ -1,4 +1,5 @@
 """Scenario input: TOML/dict reading, validation messages, round trips (docs/scenario.md)."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -12,8 +13,7 @@ from granplate.setup import io as scenario_io
 from granplate.errors import ScenarioError
 from granplate.setup.materials import LIBRARY, Material
 from granplate.setup.presets import preset
-from granplate.setup.scenario import (Granule, Load, PairCoefficients, Plate, Scenario,
-                                Solver, TimeSettings, Wall)
+from granplate.setup.scenario import Granule, Load, PairCoefficients, Plate, Scenario, Solver, TimeSettings, Wall
 from granplate.setup.validate import SCHEMES, validate
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "scenario.md"
@@ -21,10 +21,11 @@ DOC = Path(__file__).resolve().parents[1] / "docs" / "scenario.md"
 
 def _two_spheres(**changes) -> Scenario:
     """Two steel spheres flying at each other, no plate, no load."""
-    s = Scenario(name="two-spheres",
-                 granules=(Granule(0.0, 0.0, 0.01, "steel", "a", vx=1.0),
-                           Granule(0.03, 0.0, 0.01, "steel", "b", vx=-1.0)),
-                 load=Load(kind="none"))
+    s = Scenario(
+        name="two-spheres",
+        granules=(Granule(0.0, 0.0, 0.01, "steel", "a", vx=1.0), Granule(0.03, 0.0, 0.01, "steel", "b", vx=-1.0)),
+        load=Load(kind="none"),
+    )
     return dataclasses.replace(s, **changes)
 
 
@@ -45,123 +46,203 @@ def _toml(text, validated=False):
 STEEL = "steel"
 BAD = [
     # (id, action, field path in the message, allowed range in the message)
-    ("zero radius", _granules(Granule(0, 0, 0.0, STEEL, "a"), Granule(1, 0, 0.01, STEEL, "b")),
-     "granules[0].radius", "must be > 0"),
+    (
+        "zero radius",
+        _granules(Granule(0, 0, 0.0, STEEL, "a"), Granule(1, 0, 0.01, STEEL, "b")),
+        "granules[0].radius",
+        "must be > 0",
+    ),
     ("negative modulus", _with({"materials.ptfe.E": -5e9}), "materials.ptfe.E", "must be > 0"),
-    ("nu = 0.5", _with({"materials.steel.nu": 0.5}), "materials.steel.nu",
-     "must be in (-1, 0.5)"),
-    ("nu = -1", _with({"materials.ptfe.nu": -1.0}), "materials.ptfe.nu",
-     "must be in (-1, 0.5)"),
-    ("R2_ratio 0.3", _with({"layout.R2_ratio": 0.3}), "layout.R2_ratio",
-     "must be in [0.41421356, 1] (sqrt(2)-1 <= R2/R1 <= 1)"),
-    ("R2_ratio 1.2", _with({"layout.R2_ratio": 1.2}), "layout.R2_ratio",
-     "must be in [0.41421356, 1] (sqrt(2)-1 <= R2/R1 <= 1)"),
-    ("overlapping granules",
-     _granules(Granule(0, 0, 0.01, STEEL, "a"), Granule(0.015, 0, 0.01, STEEL, "b")),
-     "granules[0]", "overlaps granule 'b'"),
-    ("granule through a wall",
-     _granules(Granule(0.005, 0.05, 0.01, STEEL, "a"), walls=(Wall((-1.0, 0.0), 0.0, "left"),)),
-     "granules[0]", "penetrates wall 'left'"),
-    ("granule through the plate", _with({"plate.x0": 0.05}), "granules[9]",
-     "penetrates the plate"),
-    ("unknown field", _toml("[plate]\nnxx = 4\n"), "plate.nxx",
-     "unknown field 'plate.nxx'; did you mean 'plate.nx'? allowed: width, height"),
-    ("missing field", _toml('[[granules]]\nx = 0\ny = 0\nradius = 0.01\nmaterial = "steel"\n'
-                            '[[granules]]\nx = 0\ny = 0.1\nmaterial = "steel"\n'),
-     "granules[1].radius", "missing required field 'granules[1].radius'"),
+    ("nu = 0.5", _with({"materials.steel.nu": 0.5}), "materials.steel.nu", "must be in (-1, 0.5)"),
+    ("nu = -1", _with({"materials.ptfe.nu": -1.0}), "materials.ptfe.nu", "must be in (-1, 0.5)"),
+    (
+        "R2_ratio 0.3",
+        _with({"layout.R2_ratio": 0.3}),
+        "layout.R2_ratio",
+        "must be in [0.41421356, 1] (sqrt(2)-1 <= R2/R1 <= 1)",
+    ),
+    (
+        "R2_ratio 1.2",
+        _with({"layout.R2_ratio": 1.2}),
+        "layout.R2_ratio",
+        "must be in [0.41421356, 1] (sqrt(2)-1 <= R2/R1 <= 1)",
+    ),
+    (
+        "overlapping granules",
+        _granules(Granule(0, 0, 0.01, STEEL, "a"), Granule(0.015, 0, 0.01, STEEL, "b")),
+        "granules[0]",
+        "overlaps granule 'b'",
+    ),
+    (
+        "granule through a wall",
+        _granules(Granule(0.005, 0.05, 0.01, STEEL, "a"), walls=(Wall((-1.0, 0.0), 0.0, "left"),)),
+        "granules[0]",
+        "penetrates wall 'left'",
+    ),
+    ("granule through the plate", _with({"plate.x0": 0.05}), "granules[9]", "penetrates the plate"),
+    (
+        "unknown field",
+        _toml("[plate]\nnxx = 4\n"),
+        "plate.nxx",
+        "unknown field 'plate.nxx'; did you mean 'plate.nx'? allowed: width, height",
+    ),
+    (
+        "missing field",
+        _toml(
+            '[[granules]]\nx = 0\ny = 0\nradius = 0.01\nmaterial = "steel"\n'
+            '[[granules]]\nx = 0\ny = 0.1\nmaterial = "steel"\n'
+        ),
+        "granules[1].radius",
+        "missing required field 'granules[1].radius'",
+    ),
     ("zero yield strength", _with({"materials.ptfe.Y": 0.0}), "materials.ptfe.Y", "must be > 0"),
-    ("negative yield strength", _with({"materials.steel.Y": -355e6}), "materials.steel.Y",
-     "must be > 0"),
-    ("NaN yield strength", _toml("[materials.wood]\nE = 1e10\nnu = 0.3\nrho = 600\nY = nan\n"
-                                 "[[granules]]\nx = 0\ny = 0\nradius = 0.01\nmaterial = \"wood\"\n"
-                                 "[load]\nkind = \"none\"\n", validated=True),
-     "materials.wood.Y", "must be > 0 (a finite number)"),
-    ("infinite yield strength", _with({"materials.steel.Y": math.inf}), "materials.steel.Y",
-     "must be > 0 (a finite number)"),
-    ("text yield strength", _toml('[materials.steel]\nE = 2e11\nnu = 0.3\nrho = 7850\nY = "hard"\n'),
-     "materials.steel.Y", "wrong type: expected a number"),
-    ("missing material key", _toml("[materials.wood]\nE = 1e10\nnu = 0.3\n"),
-     "materials.wood.rho", "missing required field"),
-    ("wrong type string", _toml('[load]\nq0 = "strong"\n'), "load.q0",
-     "wrong type: expected a number"),
-    ("wrong type bool", _toml("[time]\nt_end = true\n"), "time.t_end",
-     "wrong type: expected a number"),
-    ("float for an integer", _toml("[plate]\nny = 40.5\n"), "plate.ny",
-     "expected an integer"),
+    ("negative yield strength", _with({"materials.steel.Y": -355e6}), "materials.steel.Y", "must be > 0"),
+    (
+        "NaN yield strength",
+        _toml(
+            "[materials.wood]\nE = 1e10\nnu = 0.3\nrho = 600\nY = nan\n"
+            '[[granules]]\nx = 0\ny = 0\nradius = 0.01\nmaterial = "wood"\n'
+            '[load]\nkind = "none"\n',
+            validated=True,
+        ),
+        "materials.wood.Y",
+        "must be > 0 (a finite number)",
+    ),
+    (
+        "infinite yield strength",
+        _with({"materials.steel.Y": math.inf}),
+        "materials.steel.Y",
+        "must be > 0 (a finite number)",
+    ),
+    (
+        "text yield strength",
+        _toml('[materials.steel]\nE = 2e11\nnu = 0.3\nrho = 7850\nY = "hard"\n'),
+        "materials.steel.Y",
+        "wrong type: expected a number",
+    ),
+    (
+        "missing material key",
+        _toml("[materials.wood]\nE = 1e10\nnu = 0.3\n"),
+        "materials.wood.rho",
+        "missing required field",
+    ),
+    ("wrong type string", _toml('[load]\nq0 = "strong"\n'), "load.q0", "wrong type: expected a number"),
+    ("wrong type bool", _toml("[time]\nt_end = true\n"), "time.t_end", "wrong type: expected a number"),
+    ("float for an integer", _toml("[plate]\nny = 40.5\n"), "plate.ny", "expected an integer"),
     ("negative t_end", _with({"time.t_end": -1e-3}), "time.t_end", "must be > 0"),
     ("infinite t_end", _with({"time.t_end": math.inf}), "time.t_end", "must be > 0"),
-    ("unknown material", _with({"layout.intruder_material": "wood"}),
-     "layout.intruder_material", "unknown material; defined materials are: aluminium_2017, bearing_steel, ptfe, steel, steel_302, steel_440c"),
-    ("unknown granule material",
-     _granules(Granule(0, 0, 0.01, "wood", "a"), Granule(1, 0, 0.01, STEEL, "b")),
-     "granules[0].material", "unknown material"),
-    ("unknown pair material", _with({"contact.pairs": [{"materials": ["steel", "oak"]}]}),
-     "contact.pairs[0].materials[1]", "unknown material"),
-    ("unknown preset or file", lambda: scenario_io.load_scenario("steel-r3"), "file",
-     "no such file or preset; presets are: bare-plate, steel-r1"),
-    ("duplicate labels",
-     _granules(Granule(0, 0, 0.01, STEEL, "a"), Granule(1, 0, 0.01, STEEL, "a")),
-     "granules[1].label", "unique"),
+    (
+        "unknown material",
+        _with({"layout.intruder_material": "wood"}),
+        "layout.intruder_material",
+        "unknown material; defined materials are: aluminium_2017, bearing_steel, ptfe, steel, steel_302, steel_440c",
+    ),
+    (
+        "unknown granule material",
+        _granules(Granule(0, 0, 0.01, "wood", "a"), Granule(1, 0, 0.01, STEEL, "b")),
+        "granules[0].material",
+        "unknown material",
+    ),
+    (
+        "unknown pair material",
+        _with({"contact.pairs": [{"materials": ["steel", "oak"]}]}),
+        "contact.pairs[0].materials[1]",
+        "unknown material",
+    ),
+    (
+        "unknown preset or file",
+        lambda: scenario_io.load_scenario("steel-r3"),
+        "file",
+        "no such file or preset; presets are: bare-plate, steel-r1",
+    ),
+    (
+        "duplicate labels",
+        _granules(Granule(0, 0, 0.01, STEEL, "a"), Granule(1, 0, 0.01, STEEL, "a")),
+        "granules[1].label",
+        "unique",
+    ),
     ("q0 negative", _with({"load.q0": -1.0}), "load.q0", "must be >= 0"),
     ("load kind", _with({"load.kind": "point"}), "load.kind", "'line', 'none'"),
     ("load target", _with({"load.target": "wall"}), "load.target", "'granules', 'plate'"),
-    ("load on a missing plate", lambda: validate(_two_spheres(load=Load(target="plate"))),
-     "load.target", "needs a [plate]"),
-    ("load on missing granules",
-     lambda: validate(Scenario(plate=Plate(x0=0.0), load=Load(target="granules"))),
-     "load.target", "needs granules"),
-    ("loaded label unknown", _with({"load.granules": ["2", "Z"]}), "load.granules[1]",
-     "no granule has this label"),
+    (
+        "load on a missing plate",
+        lambda: validate(_two_spheres(load=Load(target="plate"))),
+        "load.target",
+        "needs a [plate]",
+    ),
+    (
+        "load on missing granules",
+        lambda: validate(Scenario(plate=Plate(x0=0.0), load=Load(target="granules"))),
+        "load.target",
+        "needs granules",
+    ),
+    ("loaded label unknown", _with({"load.granules": ["2", "Z"]}), "load.granules[1]", "no granule has this label"),
     ("load duration", _with({"load.duration": 0.0}), "load.duration", "must be > 0"),
     ("load length", _with({"load.length": -0.05}), "load.length", "must be > 0"),
-    ("non-unit wall normal",
-     _granules(Granule(0.02, 0, 0.01, STEEL, "a"), Granule(0.05, 0, 0.01, STEEL, "b"),
-               walls=(Wall((-1.0, 0.1), 0.0, "left"),)),
-     "walls[0].normal", "must be a unit vector"),
+    (
+        "non-unit wall normal",
+        _granules(
+            Granule(0.02, 0, 0.01, STEEL, "a"),
+            Granule(0.05, 0, 0.01, STEEL, "b"),
+            walls=(Wall((-1.0, 0.1), 0.0, "left"),),
+        ),
+        "walls[0].normal",
+        "must be a unit vector",
+    ),
     ("plate thickness", _with({"plate.thickness": 0.0}), "plate.thickness", "must be > 0"),
     ("plate width", _with({"plate.width": -0.01}), "plate.width", "must be > 0"),
     ("plate nx", _with({"plate.nx": 0}), "plate.nx", "must be an integer >= 1"),
-    ("clamped edge", _with({"plate.clamped_edges": ["top", "front"]}), "plate.clamped_edges",
-     "must be a subset of 'top', 'bottom', 'left', 'right'"),
+    (
+        "clamped edge",
+        _with({"plate.clamped_edges": ["top", "front"]}),
+        "plate.clamped_edges",
+        "must be a subset of 'top', 'bottom', 'left', 'right'",
+    ),
     ("n_modes", _with({"plate.n_modes": -1}), "plate.n_modes", "must be an integer >= 0"),
-    ("rigid layer", _with({"plate.rigid_layer_width": 0.0}), "plate.rigid_layer_width",
-     "must be > 0"),
-    ("plate without position", lambda: validate(Scenario(plate=Plate(), load=Load("none"))),
-     "plate.x0", "must be given"),
+    ("rigid layer", _with({"plate.rigid_layer_width": 0.0}), "plate.rigid_layer_width", "must be > 0"),
+    (
+        "plate without position",
+        lambda: validate(Scenario(plate=Plate(), load=Load("none"))),
+        "plate.x0",
+        "must be given",
+    ),
     ("dt order", _with({"time.dt_initial": 1e-7}), "time.dt_initial", "must be <= time.dt_max"),
-    ("dt_min", _with({"time.dt_min": 1e-7, "time.dt_max": 1e-6}), "time.dt_min",
-     "must be <= time.dt_initial"),
-    ("output interval", _with({"time.t_end": 1e-7}), "time.output_interval",
-     "must be <= time.t_end"),
-    ("field interval", _with({"time.field_interval": 2.5e-6}), "time.field_interval",
-     "whole multiple"),
+    ("dt_min", _with({"time.dt_min": 1e-7, "time.dt_max": 1e-6}), "time.dt_min", "must be <= time.dt_initial"),
+    ("output interval", _with({"time.t_end": 1e-7}), "time.output_interval", "must be <= time.t_end"),
+    ("field interval", _with({"time.field_interval": 2.5e-6}), "time.field_interval", "whole multiple"),
     ("scheme", _with({"solver.scheme": "monolithic"}), "solver.scheme", "'paper'"),
-    ("granular friction", _with({"solver.granular_friction": "explicit"}), "solver.granular_friction",
-     "'split', 'rk4'"),
-    ("lambda_target", _with({"solver.lambda_target": 1.0}), "solver.lambda_target",
-     "must be in (0, 1)"),
-    ("iteration tolerance", _with({"solver.iteration_rtol": 0.0}), "solver.iteration_rtol",
-     "must be > 0"),
-    ("max iterations", _with({"solver.max_iterations": 0}), "solver.max_iterations",
-     "must be an integer >= 1"),
+    (
+        "granular friction",
+        _with({"solver.granular_friction": "explicit"}),
+        "solver.granular_friction",
+        "'split', 'rk4'",
+    ),
+    ("lambda_target", _with({"solver.lambda_target": 1.0}), "solver.lambda_target", "must be in (0, 1)"),
+    ("iteration tolerance", _with({"solver.iteration_rtol": 0.0}), "solver.iteration_rtol", "must be > 0"),
+    ("max iterations", _with({"solver.max_iterations": 0}), "solver.max_iterations", "must be an integer >= 1"),
     ("energy tol", _with({"solver.energy_tol": -1e-4}), "solver.energy_tol", "must be > 0"),
     ("mu", _with({"contact.mu": -0.1}), "contact.mu", "must be >= 0"),
     ("k_s", _with({"contact.k_s": 0.0}), "contact.k_s", "must be > 0"),
     ("alpha_n", _with({"contact.alpha_n": -1.0}), "contact.alpha_n", "must be >= 0"),
-    ("neighbour gap", _with({"contact.neighbour_gap": -0.1}), "contact.neighbour_gap",
-     "must be >= 0"),
+    ("neighbour gap", _with({"contact.neighbour_gap": -0.1}), "contact.neighbour_gap", "must be >= 0"),
     ("layout R1", _with({"layout.R1": 0.0}), "layout.R1", "must be > 0"),
-    ("nothing to simulate", lambda: validate(Scenario(load=Load(kind="none"))), "granules",
-     "needs granules (or a [layout]) or a [plate]"),
-    ("layout and granules", lambda: validate(dataclasses.replace(
-        preset("steel-r1"), granules=(Granule(0.5, 0.5, 0.01, STEEL),))),
-     "granules", "either [layout] or [[granules]]"),
+    (
+        "nothing to simulate",
+        lambda: validate(Scenario(load=Load(kind="none"))),
+        "granules",
+        "needs granules (or a [layout]) or a [plate]",
+    ),
+    (
+        "layout and granules",
+        lambda: validate(dataclasses.replace(preset("steel-r1"), granules=(Granule(0.5, 0.5, 0.01, STEEL),))),
+        "granules",
+        "either [layout] or [[granules]]",
+    ),
     ("toml syntax", _toml("[plate\nnx = 4\n"), "toml", "TOML syntax error"),
 ]
 
 
-@pytest.mark.parametrize("action, field, allowed", [b[1:] for b in BAD],
-                         ids=[b[0] for b in BAD])
+@pytest.mark.parametrize("action, field, allowed", [b[1:] for b in BAD], ids=[b[0] for b in BAD])
 def test_bad_input_is_refused_with_field_and_allowed_range(action, field, allowed):
     """Each bad input raises a ScenarioError whose message names the field path and what is allowed."""
     with pytest.raises(ScenarioError) as info:
@@ -175,12 +256,12 @@ def test_bad_input_is_refused_with_field_and_allowed_range(action, field, allowe
 def test_valid_scenarios_pass():
     """The two-sphere impact, a layout at sqrt(2)-1 and at the 1e-12 tolerance, and exact touches all validate."""
     validate(_two_spheres())
-    validate(scenario_io.with_changes(preset("steel-r1"),
-                                      {"layout.R2_ratio": math.sqrt(2.0) - 1.0}))
+    validate(scenario_io.with_changes(preset("steel-r1"), {"layout.R2_ratio": math.sqrt(2.0) - 1.0}))
     validate(scenario_io.with_changes(preset("steel-r1"), {"layout.R2_ratio": 1.0 + 5e-13}))
     validate(scenario_io.with_changes(preset("ptfe-r05"), {"plate.ny": 80, "plate.nx": 8}))
-    touching = _two_spheres(granules=(Granule(0.0, 0.0, 0.01, STEEL, "a"),
-                                      Granule(0.02 - 5e-12, 0.0, 0.01, STEEL, "b")))
+    touching = _two_spheres(
+        granules=(Granule(0.0, 0.0, 0.01, STEEL, "a"), Granule(0.02 - 5e-12, 0.0, 0.01, STEEL, "b"))
+    )
     validate(touching)
 
 
@@ -208,17 +289,26 @@ def test_dict_round_trip_of_a_custom_scenario():
     mats = dict(LIBRARY)
     mats["rubber"] = Material("rubber", E=1e7, nu=0.49, rho=1100.0)
     s = Scenario(
-        name="everything", description="all tables",
+        name="everything",
+        description="all tables",
         materials=mats,
-        granules=(Granule(0.01, 0.01, 0.01, "rubber", "a", vx=2.0, vy=-1.0, omega=3.0),
-                  Granule(0.03, 0.01, 0.01, "steel", "b")),
+        granules=(
+            Granule(0.01, 0.01, 0.01, "rubber", "a", vx=2.0, vy=-1.0, omega=3.0),
+            Granule(0.03, 0.01, 0.01, "steel", "b"),
+        ),
         walls=(Wall((-1.0, 0.0), 0.0, "left"), Wall((0.0, -1.0), 0.0, "floor", "rubber")),
-        plate=Plate(x0=0.04, nx=2, ny=20, rigid_layer_width=0.004,
-                    clamped_edges=("top", "bottom", "right"), n_modes=30),
+        plate=Plate(
+            x0=0.04, nx=2, ny=20, rigid_layer_width=0.004, clamped_edges=("top", "bottom", "right"), n_modes=30
+        ),
         load=Load(target="granules", q0=1234.5, granules=("a",)),
-        contact=dataclasses.replace(preset("steel-r1").contact, pairs=(
-            PairCoefficients(("steel", "rubber"), alpha_n=0.1, mu=0.3, k_s=50.0),
-            PairCoefficients(("steel", "steel"), mu=0.2)), clip_tensile=False),
+        contact=dataclasses.replace(
+            preset("steel-r1").contact,
+            pairs=(
+                PairCoefficients(("steel", "rubber"), alpha_n=0.1, mu=0.3, k_s=50.0),
+                PairCoefficients(("steel", "steel"), mu=0.2),
+            ),
+            clip_tensile=False,
+        ),
         time=TimeSettings(t_end=1e-4, output_interval=1e-6, field_interval=1e-5),
         solver=Solver(lambda_target=0.3, max_iterations=10),
     )
@@ -232,8 +322,7 @@ def test_dict_round_trip_of_a_custom_scenario():
 
 def test_ints_accepted_for_floats_and_defaults_filled():
     """Integers are accepted where floats go, and absent fields take the dataclass defaults."""
-    s = scenario_io.loads('[[granules]]\nx = 0\ny = 1\nradius = 1\nmaterial = "steel"\n'
-                          '[load]\nq0 = 50000\n')
+    s = scenario_io.loads('[[granules]]\nx = 0\ny = 1\nradius = 1\nmaterial = "steel"\n[load]\nq0 = 50000\n')
     g = s.granules[0]
     assert (g.x, g.y, g.radius) == (0.0, 1.0, 1.0) and isinstance(g.x, float)
     assert s.load == Load(q0=50_000.0) and isinstance(s.load.q0, float)
@@ -243,8 +332,9 @@ def test_ints_accepted_for_floats_and_defaults_filled():
 
 def test_user_material_overrides_library():
     """A [materials.steel] table overrides the library's steel; new names are added."""
-    s = scenario_io.loads("[materials.steel]\nE = 2.1e11\nnu = 0.29\nrho = 7800\n"
-                          "[materials.glass]\nE = 6.3e10\nnu = 0.23\nrho = 2500\n")
+    s = scenario_io.loads(
+        "[materials.steel]\nE = 2.1e11\nnu = 0.29\nrho = 7800\n[materials.glass]\nE = 6.3e10\nnu = 0.23\nrho = 2500\n"
+    )
     assert s.material("steel") == Material("steel", 2.1e11, 0.29, 7800.0)
     assert s.material("glass").rho == 2500.0 and s.material("ptfe") == LIBRARY["ptfe"]
 
@@ -252,8 +342,10 @@ def test_user_material_overrides_library():
 def test_yield_strength_is_optional_and_round_trips():
     """Y is read, written back by dumps (a preset's TOML round-trips it), absent means
     unknown (None), and the library's materials carry their documented Y."""
-    s = scenario_io.loads("[materials.glass]\nE = 6.3e10\nnu = 0.23\nrho = 2500\n"
-                          "[materials.wood]\nE = 1e10\nnu = 0.3\nrho = 600\nY = 4e7\n")
+    s = scenario_io.loads(
+        "[materials.glass]\nE = 6.3e10\nnu = 0.23\nrho = 2500\n"
+        "[materials.wood]\nE = 1e10\nnu = 0.3\nrho = 600\nY = 4e7\n"
+    )
     assert s.material("glass").Y is None and s.material("wood").Y == 4e7
     assert scenario_io.loads(scenario_io.dumps(s, all_materials=True)) == s
     text = scenario_io.dumps(preset("ptfe-r05"))
@@ -311,14 +403,14 @@ def test_with_changes_states_the_changes_in_the_description():
     s = preset("steel-r1")
     t = scenario_io.with_changes(s, {"load.q0": 1e12, "layout.intruder_material": "ptfe"})
     assert t.name == s.name
-    assert t.description == s.description + ('; changed: load.q0 = 1e+12, '
-                                             'layout.intruder_material = "ptfe"')
+    assert t.description == s.description + ('; changed: load.q0 = 1e+12, layout.intruder_material = "ptfe"')
     # a second round merges: a field changed again shows its latest value, in its first place
-    u = scenario_io.with_changes(t, {"load.q0": 2e4, "plate": None,
-                                     "plate.clamped_edges": None, "name": "mine"})
+    u = scenario_io.with_changes(t, {"load.q0": 2e4, "plate": None, "plate.clamped_edges": None, "name": "mine"})
     assert u.name == "mine"
-    assert u.description == (s.description + '; changed: load.q0 = 20000, layout.intruder_material = '
-                              '"ptfe", plate = removed, plate.clamped_edges = removed')
+    assert u.description == (
+        s.description + "; changed: load.q0 = 20000, layout.intruder_material = "
+        '"ptfe", plate = removed, plate.clamped_edges = removed'
+    )
     # the TOML text carries it, and reading it back changes nothing
     assert scenario_io.loads(scenario_io.dumps(u)) == u
 
@@ -337,8 +429,7 @@ def test_with_changes_description_edge_cases():
     assert once.description == "changed: granules[0].vx = 2.5, contact.clip_tensile = false"
     twice = scenario_io.with_changes(once, {"granules[0].vx": 3.0})
     assert twice.description == "changed: granules[0].vx = 3, contact.clip_tensile = false"
-    lists = scenario_io.with_changes(preset("steel-r1"), {"plate.clamped_edges": ["top", "right"],
-                                                          "plate.ny": 80})
+    lists = scenario_io.with_changes(preset("steel-r1"), {"plate.clamped_edges": ["top", "right"], "plate.ny": 80})
     assert lists.description.endswith('changed: plate.clamped_edges = ["top", "right"], plate.ny = 80')
     again = scenario_io.with_changes(lists, {"plate.ny": 40})
     assert again.description.endswith('changed: plate.clamped_edges = ["top", "right"], plate.ny = 40')
@@ -355,21 +446,28 @@ def test_docs_python_example_runs(tmp_path, monkeypatch, capsys):
     assert (tmp_path / "my_case.toml").exists()
 
 
-@pytest.mark.parametrize("text, field, near", [
-    ('nmae = "x"', "nmae", "name"),
-    ('[layout]\nR2_ratoi = 0.5', "layout.R2_ratoi", "layout.R2_ratio"),
-    ('[layout]\nkind = "chain"\ncuont = 3', "layout.cuont", "layout.count"),
-    ('[layout.imperfections]\njiter = 0.1', "layout.imperfections.jiter", "layout.imperfections.jitter"),
-    ('[plate]\nnxx = 4', "plate.nxx", "plate.nx"),
-    ('[contact]\nskn = 0.1', "contact.skn", "contact.skin"),
-    ('[[contact.pairs]]\nmaterials = ["steel", "ptfe"]\nmuu = 0.2', "contact.pairs[0].muu", "contact.pairs[0].mu"),
-    ('[materials.foam]\nE = 1e6\nnu = 0.2\nrh = 30.0', "materials.foam.rh", "materials.foam.rho"),
-    ('[[granules]]\nx = 0\ny = 0\nmaterial = "steel"\nradius = 0.01\nraduis = 0.01', "granules[0].raduis", "granules[0].radius"),
-    ('[[walls]]\nnormal = [1.0, 0.0]\noffset = 0.0\nofset = 1.0', "walls[0].ofset", "walls[0].offset"),
-    ('[load]\nduraton = 1e-5', "load.duraton", "load.duration"),
-    ('[time]\nt_edn = 1e-4', "time.t_edn", "time.t_end"),
-    ('[solver]\nshceme = "paper"', "solver.shceme", "solver.scheme"),
-])
+@pytest.mark.parametrize(
+    "text, field, near",
+    [
+        ('nmae = "x"', "nmae", "name"),
+        ("[layout]\nR2_ratoi = 0.5", "layout.R2_ratoi", "layout.R2_ratio"),
+        ('[layout]\nkind = "chain"\ncuont = 3', "layout.cuont", "layout.count"),
+        ("[layout.imperfections]\njiter = 0.1", "layout.imperfections.jiter", "layout.imperfections.jitter"),
+        ("[plate]\nnxx = 4", "plate.nxx", "plate.nx"),
+        ("[contact]\nskn = 0.1", "contact.skn", "contact.skin"),
+        ('[[contact.pairs]]\nmaterials = ["steel", "ptfe"]\nmuu = 0.2', "contact.pairs[0].muu", "contact.pairs[0].mu"),
+        ("[materials.foam]\nE = 1e6\nnu = 0.2\nrh = 30.0", "materials.foam.rh", "materials.foam.rho"),
+        (
+            '[[granules]]\nx = 0\ny = 0\nmaterial = "steel"\nradius = 0.01\nraduis = 0.01',
+            "granules[0].raduis",
+            "granules[0].radius",
+        ),
+        ("[[walls]]\nnormal = [1.0, 0.0]\noffset = 0.0\nofset = 1.0", "walls[0].ofset", "walls[0].offset"),
+        ("[load]\nduraton = 1e-5", "load.duraton", "load.duration"),
+        ("[time]\nt_edn = 1e-4", "time.t_edn", "time.t_end"),
+        ('[solver]\nshceme = "paper"', "solver.shceme", "solver.scheme"),
+    ],
+)
 def test_unknown_field_suggests_the_closest_name(text, field, near):
     """A misspelled key in any table: the error names it, suggests the closest allowed
     name (difflib) with its dotted path, and still lists the allowed ones."""
@@ -393,8 +491,11 @@ def test_far_coordinates_and_fast_granules_are_refused_with_the_range():
     the smallest length: each named, with the bound derived from the scenario."""
     g = (Granule(0.0, 0.0, 0.01, "steel", "a"), Granule(0.03, 0.0, 0.01, "steel", "b"))
     far = dataclasses.replace(g[1], x=1e300)
-    with pytest.raises(ScenarioError, match=r"'granules\[1\]\.x'.*\|value\| <= 10000 m, 1e\+06 x the "
-                       r"smallest length of the scenario, h = 0\.01 m \(granules\[0\]\.radius\)"):
+    with pytest.raises(
+        ScenarioError,
+        match=r"'granules\[1\]\.x'.*\|value\| <= 10000 m, 1e\+06 x the "
+        r"smallest length of the scenario, h = 0\.01 m \(granules\[0\]\.radius\)",
+    ):
         validate(_two_spheres(granules=(g[0], far)))
     wall = Wall((1.0, 0.0), 1.0e5, "far")
     with pytest.raises(ScenarioError, match=r"'walls\[0\]\.offset'"):

@@ -1,5 +1,6 @@
 """The scenario side of three-dimensional assemblies (`dimension = 3`): fields, reading and
 writing, the box, the force load, the checks before a run, and 2D left exactly as it was."""
+
 from __future__ import annotations
 
 import copy
@@ -32,8 +33,17 @@ BASE: dict = {
     "dimension": 3,
     "materials": {"soft": {"E": 1e9, "nu": 0.3, "rho": 1200.0}},
     "granules": [
-        {"label": "a", "x": 0.02, "y": 0.02, "z": 0.02, "radius": 0.01, "material": "steel",
-         "vx": 0.1, "vz": -0.1, "omega": [1.0, -2.0, 3.0]},
+        {
+            "label": "a",
+            "x": 0.02,
+            "y": 0.02,
+            "z": 0.02,
+            "radius": 0.01,
+            "material": "steel",
+            "vx": 0.1,
+            "vz": -0.1,
+            "omega": [1.0, -2.0, 3.0],
+        },
         {"label": "b", "x": 0.045, "y": 0.02, "z": 0.025, "radius": 0.01, "material": "soft"},
     ],
     "walls": [{"label": "tilted", "normal": [1.0, 1.0, 0.0], "point": [0.06, 0.03, 0.0]}],
@@ -149,9 +159,11 @@ def test_wall_point_and_offset():
 
 def test_force_loaded_granules_are_those_furthest_against_the_direction():
     """Default force-loaded granules: the smallest s . d - R (ties within 1e-9 R_max), or load.granules."""
-    gs = (Granule(x=0.02, y=0.0, z=0.0, radius=0.01, material="steel", label="p"),
-          Granule(x=0.015, y=0.1, z=0.0, radius=0.005, material="steel", label="q"),
-          Granule(x=0.05, y=0.0, z=0.2, radius=0.01, material="steel", label="r"))
+    gs = (
+        Granule(x=0.02, y=0.0, z=0.0, radius=0.01, material="steel", label="p"),
+        Granule(x=0.015, y=0.1, z=0.0, radius=0.005, material="steel", label="q"),
+        Granule(x=0.05, y=0.0, z=0.2, radius=0.01, material="steel", label="r"),
+    )
     s = Scenario(dimension=3, granules=gs, load=Load(kind="force", force=1.0))
     assert force_loaded_granules(s) == ("p", "q")  # both reach x = 0.01
     up = dataclasses.replace(s, load=Load(kind="force", force=1.0, direction=(0.0, 0.0, -3.0)))
@@ -160,25 +172,34 @@ def test_force_loaded_granules_are_those_furthest_against_the_direction():
     assert force_loaded_granules(given) == ("r",)
 
 
-@pytest.mark.parametrize("change,field,words", [
-    ({"dimension": 4}, "dimension", "must be 2"),
-    ({"dimension": 1}, "dimension", "or 3"),
-    ({"plate": {"size": [0.1, 0.1, 0.005], "elements": [2, 2, 1], "origin": [0.0, 0.0, 0.008]}},
-     "granules[0]", "granule 'a'"),
-    ({"plate": {"x0": 0.1}}, "plate.x0", "unknown"),
-    ({"load": {"kind": "force", "direction": [0.0, 0.0, 0.0]}}, "load.direction", "nonzero"),
-    ({"load": {"kind": "force", "direction": [1.0, math.nan, 0.0]}}, "load.direction", "finite"),
-    ({"load": {"kind": "force", "force": -1.0}}, "load.force", ">= 0"),
-    ({"load": {"kind": "force", "force": 1e300}}, "load.force", "E h^2"),
-    ({"load": {"kind": "force", "granules": ["zz"]}}, "load.granules[0]", "no granule"),
-    ({"walls": [{"normal": [1.0, 0.0], "offset": 0.1}]}, "walls[0].normal", "[nx, ny, nz]"),
-    ({"walls": [{"normal": [0.0, 0.0, 0.0], "offset": 0.1}]}, "walls[0].normal", "nonzero"),
-    ({"walls": [{"normal": [0.0, math.inf, 0.0], "offset": 0.1}]}, "walls[0].normal", "finite"),
-    ({"walls": [{"normal": [0.0, 0.0, 1.0], "point": [0.0, math.nan, 0.0]}]}, "walls[0].point", "finite"),
-    ({"box": {"lower": [0.0, 0.05, 0.0], "upper": [0.1, 0.04, 0.04]}}, "box.upper", "lower < upper"),
-    ({"box": {"lower": [0.0, 0.0, 0.0], "upper": [0.1, 0.04, 0.04], "material": "stel"}}, "box.material",
-     "unknown material"),
-])
+@pytest.mark.parametrize(
+    "change,field,words",
+    [
+        ({"dimension": 4}, "dimension", "must be 2"),
+        ({"dimension": 1}, "dimension", "or 3"),
+        (
+            {"plate": {"size": [0.1, 0.1, 0.005], "elements": [2, 2, 1], "origin": [0.0, 0.0, 0.008]}},
+            "granules[0]",
+            "granule 'a'",
+        ),
+        ({"plate": {"x0": 0.1}}, "plate.x0", "unknown"),
+        ({"load": {"kind": "force", "direction": [0.0, 0.0, 0.0]}}, "load.direction", "nonzero"),
+        ({"load": {"kind": "force", "direction": [1.0, math.nan, 0.0]}}, "load.direction", "finite"),
+        ({"load": {"kind": "force", "force": -1.0}}, "load.force", ">= 0"),
+        ({"load": {"kind": "force", "force": 1e300}}, "load.force", "E h^2"),
+        ({"load": {"kind": "force", "granules": ["zz"]}}, "load.granules[0]", "no granule"),
+        ({"walls": [{"normal": [1.0, 0.0], "offset": 0.1}]}, "walls[0].normal", "[nx, ny, nz]"),
+        ({"walls": [{"normal": [0.0, 0.0, 0.0], "offset": 0.1}]}, "walls[0].normal", "nonzero"),
+        ({"walls": [{"normal": [0.0, math.inf, 0.0], "offset": 0.1}]}, "walls[0].normal", "finite"),
+        ({"walls": [{"normal": [0.0, 0.0, 1.0], "point": [0.0, math.nan, 0.0]}]}, "walls[0].point", "finite"),
+        ({"box": {"lower": [0.0, 0.05, 0.0], "upper": [0.1, 0.04, 0.04]}}, "box.upper", "lower < upper"),
+        (
+            {"box": {"lower": [0.0, 0.0, 0.0], "upper": [0.1, 0.04, 0.04], "material": "stel"}},
+            "box.material",
+            "unknown material",
+        ),
+    ],
+)
 def test_3d_refusals_name_the_field(change, field, words):
     """Each bad 3D input is one ScenarioError naming the field and what is allowed."""
     d = base(**change)
@@ -195,9 +216,15 @@ def test_solid_needs_the_verlet_scheme_and_then_builds():
     modes and contact arrays."""
     from granplate.model import build_model
 
-    d = base(plate={"size": [0.1, 0.1, 0.005], "elements": [2, 2, 1], "max_frequency": 5e4,
-                    "origin": [0.2, 0.2, 0.2]},  # clear of the box's and the tilted wall's planes
-             solver={"scheme": "implicit"})
+    d = base(
+        plate={
+            "size": [0.1, 0.1, 0.005],
+            "elements": [2, 2, 1],
+            "max_frequency": 5e4,
+            "origin": [0.2, 0.2, 0.2],
+        },  # clear of the box's and the tilted wall's planes
+        solver={"scheme": "implicit"},
+    )
     e = refused(d)
     assert e.field == "solver.scheme" and "verlet" in str(e)
     d["solver"] = {"scheme": "verlet", "granular_friction": "split"}
@@ -220,13 +247,16 @@ def test_scalar_omega_in_3d_is_refused():
     assert "'granules[1].omega'" in msg and "omega is a vector [wx, wy, wz] in 3D" in msg
 
 
-@pytest.mark.parametrize("make,field", [
-    (lambda g, w: (dataclasses.replace(g, z=0.001), w), "granules[0].z"),
-    (lambda g, w: (dataclasses.replace(g, vz=1.0), w), "granules[0].vz"),
-    (lambda g, w: (dataclasses.replace(g, omega=(0.0, 0.0, 1.0)), w), "granules[0].omega"),
-    (lambda g, w: (g, dataclasses.replace(w, normal=(-1.0, 0.0, 0.0))), "walls[0].normal"),
-    (lambda g, w: (g, dataclasses.replace(w, point=(0.0, 0.0, 0.0))), "walls[0].point"),
-])
+@pytest.mark.parametrize(
+    "make,field",
+    [
+        (lambda g, w: (dataclasses.replace(g, z=0.001), w), "granules[0].z"),
+        (lambda g, w: (dataclasses.replace(g, vz=1.0), w), "granules[0].vz"),
+        (lambda g, w: (dataclasses.replace(g, omega=(0.0, 0.0, 1.0)), w), "granules[0].omega"),
+        (lambda g, w: (g, dataclasses.replace(w, normal=(-1.0, 0.0, 0.0))), "walls[0].normal"),
+        (lambda g, w: (g, dataclasses.replace(w, point=(0.0, 0.0, 0.0))), "walls[0].point"),
+    ],
+)
 def test_2d_refuses_the_3d_fields(make, field):
     """A 2D scenario with z, vz, a vector omega, a 3-component normal or a point: refused, naming
     the field and "set dimension = 3"."""
@@ -247,10 +277,17 @@ def test_2d_refuses_a_box_and_a_force_load():
 
 def test_spheres_apart_in_z_do_not_overlap():
     """Two spheres at the same (x, y) but 2.5 R apart in z are valid in 3D; closer in z, they overlap."""
+
     def two(dz):
-        return Scenario(dimension=3, load=Load(kind="none"),
-                        granules=(Granule(0.0, 0.0, 0.01, "steel", label="a", z=0.0),
-                                  Granule(0.0, 0.0, 0.01, "steel", label="b", z=dz)))
+        return Scenario(
+            dimension=3,
+            load=Load(kind="none"),
+            granules=(
+                Granule(0.0, 0.0, 0.01, "steel", label="a", z=0.0),
+                Granule(0.0, 0.0, 0.01, "steel", label="b", z=dz),
+            ),
+        )
+
     validate(two(0.025))
     validate(two(0.02))  # touching
     msg = str(refused(two(0.015)))
@@ -259,9 +296,15 @@ def test_spheres_apart_in_z_do_not_overlap():
 
 def test_wall_contact_in_3d_uses_the_unit_normal():
     """A sphere touching a plane of non-unit normal is valid; past it by 1 mm it is refused with 1 mm."""
+
     def on(z):
-        return Scenario(dimension=3, load=Load(kind="none"), walls=(Wall((0.0, 0.0, -7.0), 0.0),),
-                        granules=(Granule(0.3, -0.2, 0.01, "steel", z=z),))
+        return Scenario(
+            dimension=3,
+            load=Load(kind="none"),
+            walls=(Wall((0.0, 0.0, -7.0), 0.0),),
+            granules=(Granule(0.3, -0.2, 0.01, "steel", z=z),),
+        )
+
     validate(on(0.01))
     msg = str(refused(on(0.009)))
     assert "penetrates wall" in msg and "0.001 m" in msg
@@ -362,8 +405,7 @@ def names_field(message: str, path: str) -> bool:
     return path.startswith("box.") and "penetrates wall" in message
 
 
-@pytest.mark.parametrize("path,value", list(itertools.product(numeric_fields(BASE), BAD_VALUES)),
-                         ids=lambda v: repr(v))
+@pytest.mark.parametrize("path,value", list(itertools.product(numeric_fields(BASE), BAD_VALUES)), ids=lambda v: repr(v))
 def test_bad_number_in_3d_is_refused_by_name_or_valid(path, value):
     """Every numeric field of a 3D scenario (z, vz, omega components, normals, points, the box,
     the force) set to -1, 0, NaN, inf, 1e300 or a string: valid, or one line naming the field."""
@@ -377,17 +419,37 @@ def test_bad_number_in_3d_is_refused_by_name_or_valid(path, value):
 #: A sphere and a pair (one of a user material with a yield stress, spinning) against the
 #: face xmin of a small clamped solid plate, with friction and a pair override.
 BASE_SOLID: dict = {
-    "name": "fuzz-solid", "description": "two spheres against a small solid plate", "dimension": 3,
+    "name": "fuzz-solid",
+    "description": "two spheres against a small solid plate",
+    "dimension": 3,
     "materials": {"soft": {"E": 1e9, "nu": 0.3, "rho": 1200.0, "Y": 2e7}},
     "granules": [
         {"label": "a", "x": 0.0, "y": 0.01, "z": 0.01, "radius": 0.0025, "material": "steel", "vx": 1.0},
-        {"label": "b", "x": -0.006, "y": 0.01, "z": 0.01, "radius": 0.0025, "material": "soft", "vx": 1.0,
-         "omega": [0.0, 1.0, 0.0]},
+        {
+            "label": "b",
+            "x": -0.006,
+            "y": 0.01,
+            "z": 0.01,
+            "radius": 0.0025,
+            "material": "soft",
+            "vx": 1.0,
+            "omega": [0.0, 1.0, 0.0],
+        },
     ],
-    "plate": {"size": [0.004, 0.02, 0.02], "elements": [1, 2, 2], "origin": [0.0026, 0.0, 0.0],
-              "material": "steel", "clamped": ["ymin", "ymax"], "max_frequency": 1e5},
-    "contact": {"mu": 0.1, "k_s": 1000.0, "alpha_n": 6e-3,
-                "pairs": [{"materials": ["steel", "soft"], "alpha_n": 0.01, "mu": 0.2, "k_s": 500.0}]},
+    "plate": {
+        "size": [0.004, 0.02, 0.02],
+        "elements": [1, 2, 2],
+        "origin": [0.0026, 0.0, 0.0],
+        "material": "steel",
+        "clamped": ["ymin", "ymax"],
+        "max_frequency": 1e5,
+    },
+    "contact": {
+        "mu": 0.1,
+        "k_s": 1000.0,
+        "alpha_n": 6e-3,
+        "pairs": [{"materials": ["steel", "soft"], "alpha_n": 0.01, "mu": 0.2, "k_s": 500.0}],
+    },
     "time": {"t_end": 2e-7, "dt_max": 5e-8, "output_interval": 1e-7, "field_interval": 2e-7},
     "solver": {"scheme": "verlet", "granular_friction": "split"},
 }
@@ -400,10 +462,17 @@ def _example(name: str) -> dict:
         return tomllib.load(f)
 
 
-@pytest.mark.parametrize("path,value", [
-    *((("solid", p), v) for p, v in itertools.product(numeric_fields(BASE_SOLID), BAD_VALUES)),
-    *((("3d-fcc-protector", p), v) for p, v in itertools.product(numeric_fields(_example("3d-fcc-protector")),
-                                                                 BAD_VALUES))], ids=lambda v: repr(v))
+@pytest.mark.parametrize(
+    "path,value",
+    [
+        *((("solid", p), v) for p, v in itertools.product(numeric_fields(BASE_SOLID), BAD_VALUES)),
+        *(
+            (("3d-fcc-protector", p), v)
+            for p, v in itertools.product(numeric_fields(_example("3d-fcc-protector")), BAD_VALUES)
+        ),
+    ],
+    ids=lambda v: repr(v),
+)
 def test_bad_number_with_a_solid_is_refused_by_name_or_valid(path, value):
     """Every numeric field of a 3D scenario with an elastic solid (its size, elements, origin,
     cut-off; a layout placing the solid against it; a yield stress) set to -1, 0, NaN, inf,
@@ -428,8 +497,9 @@ def test_a_3d_file_without_a_load_table_has_no_load():
     meaning in space), validates, and writes back to the same scenario."""
     from granplate.setup.validate import validate
 
-    s = scenario_io.loads('dimension = 3\n[[granules]]\nx = 0.0\ny = 0.0\nz = 0.0\nradius = 0.01\n'
-                          'material = "steel"\nvx = 1.0\n')
+    s = scenario_io.loads(
+        'dimension = 3\n[[granules]]\nx = 0.0\ny = 0.0\nz = 0.0\nradius = 0.01\nmaterial = "steel"\nvx = 1.0\n'
+    )
     assert s.load.kind == "none"
     validate(s)
     assert scenario_io.loads(scenario_io.dumps(s)) == s

@@ -1,4 +1,5 @@
 """The half-sine shock (docs/model.md section 5): resultants on granules and their sum."""
+
 from __future__ import annotations
 
 import numpy as np

@@ -1,5 +1,6 @@
 """End-to-end runs: the energy balance (eq. 11) for every preset, the paper's E_shock,
 sliding-to-rolling, netCDF round trip, and runs that go wrong stop with a message."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -21,7 +22,9 @@ def short_runs():
     return {name: gp.simulate(preset(name), t_end=SHORT, progress=False) for name in preset_names()}
 
 
-@pytest.mark.parametrize("name", ["bare-plate", "steel-r1", "steel-r05", "ptfe-r05", "ptfe-r05-moderate", "ptfe-r05-weak"])
+@pytest.mark.parametrize(
+    "name", ["bare-plate", "steel-r1", "steel-r05", "ptfe-r05", "ptfe-r05-moderate", "ptfe-r05-weak"]
+)
 def test_energy_balance_every_preset(short_runs, name):
     """E_p + E_g + D = E_shock at every output time, to the default tolerance 1e-4."""
     ds = short_runs[name]
@@ -109,8 +112,15 @@ def test_step_control_keeps_local_maps_contractive():
     assert float(lam.max()) < 1.0
 
 
-@pytest.mark.parametrize("name,changes", [("ptfe-r05", {}), ("bare-plate", {}), ("steel-r05", {"solver.scheme": "paper"}),
-                                          ("ptfe-r05", {"plate.modes": "truncated"})])
+@pytest.mark.parametrize(
+    "name,changes",
+    [
+        ("ptfe-r05", {}),
+        ("bare-plate", {}),
+        ("steel-r05", {"solver.scheme": "paper"}),
+        ("ptfe-r05", {"plate.modes": "truncated"}),
+    ],
+)
 def test_summary_only_run_gives_the_full_runs_summary(short_runs, name, changes):
     """A summary-only run (no plate fields) has gp.summary and granule masses bit for bit
     equal to those of the whole Dataset, with a full or a truncated plate basis."""

@@ -1,5 +1,6 @@
 """`granplate bench --solid`'s row: a build in a fresh process reports its dofs, modes and
 the first clamped frequency; Leissa's closed form as the bench writes it."""
+
 from __future__ import annotations
 
 import math
@@ -19,7 +20,9 @@ def test_bench_row_of_a_tiny_plate():
     """An 8 x 8 x 1 hex20 plate: dofs, a mode, the top face's z dofs and a table row."""
     row = bench_solid("hex20", (8, 8, 1), (0.1, 0.1, 0.002), residual=True, max_frequency=5e3)
     assert "failed" not in row and "refused" not in row, row
-    assert row["n_dofs"] > 0 and row["n_modes"] >= 1 and row["n_surface"] == 161  # 7 x 7 corners + 112 mid-sides off the clamps
+    assert (
+        row["n_dofs"] > 0 and row["n_modes"] >= 1 and row["n_surface"] == 161
+    )  # 7 x 7 corners + 112 mid-sides off the clamps
     assert row["f1_hz"] == pytest.approx(leissa_frequency(0.1, 0.002), rel=0.06)
     assert "| hex20 | 8 x 8 x 1 |" in format_rows([row], accuracy=True)
 

@@ -1,6 +1,7 @@
 """build_solid: the arrays kept in the run store come back equal; the residual is over the
 top face's z dofs; a body too large is refused with its numbers; a 3D scenario's
 [plate] is a solid, checked field by field, valid, and still refused to run."""
+
 from __future__ import annotations
 
 import copy
@@ -37,8 +38,12 @@ def test_residual_on_demand_equals_the_stored_one():
     """residual_block over a few of the top face's dofs equals those entries of the face's R."""
     m = build_solid(SMALL, cache=False)
     pick = np.array([0, 3, 5])
-    assert np.allclose(m.residual_block(m.surface_dofs[pick]), m.resid[np.ix_(pick, pick)], rtol=1e-10,
-                       atol=1e-10 * np.abs(m.resid).max())
+    assert np.allclose(
+        m.residual_block(m.surface_dofs[pick]),
+        m.resid[np.ix_(pick, pick)],
+        rtol=1e-10,
+        atol=1e-10 * np.abs(m.resid).max(),
+    )
 
 
 def test_too_big_is_refused_with_numbers():
@@ -48,9 +53,12 @@ def test_too_big_is_refused_with_numbers():
     assert e.value.field == "plate.elements"
 
 
-BASE = {"name": "solid", "dimension": 3,
-        "granules": [{"x": 0.01, "y": 0.01, "z": 0.02, "radius": 0.002, "material": "steel"}],
-        "plate": {"size": [0.03, 0.02, 0.004], "elements": [3, 2, 1], "clamped": ["xmin"]}}
+BASE = {
+    "name": "solid",
+    "dimension": 3,
+    "granules": [{"x": 0.01, "y": 0.01, "z": 0.02, "radius": 0.002, "material": "steel"}],
+    "plate": {"size": [0.03, 0.02, 0.004], "elements": [3, 2, 1], "clamped": ["xmin"]},
+}
 
 
 def refusal(d: dict) -> ScenarioError | None:
@@ -98,17 +106,20 @@ def test_valid_solid_validates_and_builds_its_model_with_the_verlet_scheme():
     assert e.value.field == "solver.scheme"
 
 
-@pytest.mark.parametrize("change,field,words", [
-    ({"element": "hex8"}, "plate.element", "'hex20', 'hex27', 'tet10'"),
-    ({"clamped": ["top"]}, "plate.clamped", "must be one of 'xmin'"),
-    ({"rollers": ["xmin"]}, "plate.rollers", "both clamped and on rollers"),
-    ({"elements": [3, 0, 1]}, "plate.elements[1]", "integer in [1, 1000]"),
-    ({"size": [0.03, -1.0, 0.004]}, "plate.size[1]", "> 0"),
-    ({"size": None}, "plate.size", "needs size"),
-    ({"mesh": "a.msh"}, "plate.mesh", "excludes plate.size"),
-    ({"max_frequency": 0.1}, "plate.max_frequency", "Hz"),
-    ({"material": "stel"}, "plate.material", "unknown material"),
-])
+@pytest.mark.parametrize(
+    "change,field,words",
+    [
+        ({"element": "hex8"}, "plate.element", "'hex20', 'hex27', 'tet10'"),
+        ({"clamped": ["top"]}, "plate.clamped", "must be one of 'xmin'"),
+        ({"rollers": ["xmin"]}, "plate.rollers", "both clamped and on rollers"),
+        ({"elements": [3, 0, 1]}, "plate.elements[1]", "integer in [1, 1000]"),
+        ({"size": [0.03, -1.0, 0.004]}, "plate.size[1]", "> 0"),
+        ({"size": None}, "plate.size", "needs size"),
+        ({"mesh": "a.msh"}, "plate.mesh", "excludes plate.size"),
+        ({"max_frequency": 0.1}, "plate.max_frequency", "Hz"),
+        ({"material": "stel"}, "plate.material", "unknown material"),
+    ],
+)
 def test_bad_solid_fields_name_the_field(change, field, words):
     """Each bad solid field is one ScenarioError naming it and its allowed range."""
     with pytest.raises(ScenarioError) as e:
@@ -138,8 +149,12 @@ def test_free_body_build_keeps_rigid_modes_and_a_residual():
     m = build_solid(Solid(size=(0.02, 0.01, 0.005), elements=(2, 2, 1), max_frequency=4e5), cache=False)
     assert m.free and np.all(m.omega[:6] == 0.0) and m.omega[6] > 0.0
     pick = np.array([0, 2, 7])
-    assert np.allclose(m.residual_block(m.surface_dofs[pick]), m.resid[np.ix_(pick, pick)], rtol=1e-9,
-                       atol=1e-9 * np.abs(m.resid).max())
+    assert np.allclose(
+        m.residual_block(m.surface_dofs[pick]),
+        m.resid[np.ix_(pick, pick)],
+        rtol=1e-9,
+        atol=1e-9 * np.abs(m.resid).max(),
+    )
 
 
 def test_box_signed_distance_is_the_euclidean_distance_to_the_box():
@@ -148,10 +163,10 @@ def test_box_signed_distance_is_the_euclidean_distance_to_the_box():
     from granplate.setup.solid_checks import box_signed_distance
 
     lo, hi = (0.0, 0.0, 0.0), (3.0, 2.0, 1.0)
-    assert box_signed_distance(lo, hi, (1.0, 1.0, 1.5)) == 0.5               # above the top face
-    assert box_signed_distance(lo, hi, (4.0, 1.0, 2.0)) == math.sqrt(2.0)    # off an edge
-    assert box_signed_distance(lo, hi, (-1.0, -2.0, 3.0)) == 3.0             # off a corner: sqrt(1+4+4)
-    assert box_signed_distance(lo, hi, (1.0, 1.0, 0.75)) == -0.25            # inside, nearest the top
+    assert box_signed_distance(lo, hi, (1.0, 1.0, 1.5)) == 0.5  # above the top face
+    assert box_signed_distance(lo, hi, (4.0, 1.0, 2.0)) == math.sqrt(2.0)  # off an edge
+    assert box_signed_distance(lo, hi, (-1.0, -2.0, 3.0)) == 3.0  # off a corner: sqrt(1+4+4)
+    assert box_signed_distance(lo, hi, (1.0, 1.0, 0.75)) == -0.25  # inside, nearest the top
     assert box_signed_distance(lo, hi, (3.0, 0.5, 0.5)) == 0.0
 
 
@@ -182,17 +197,22 @@ def test_a_granule_beside_the_box_is_clear_of_it():
     d["granules"][0].update(x=0.0315, z=0.0055, radius=0.002)
     validate(scenario_io.from_dict(d))
     d["granules"][0].update(radius=0.0022)
-    with pytest.raises(ScenarioError, match=f"penetrates the elastic solid.* by {0.0022 - math.sqrt(2) * 0.0015:.6g} m"):
+    with pytest.raises(
+        ScenarioError, match=f"penetrates the elastic solid.* by {0.0022 - math.sqrt(2) * 0.0015:.6g} m"
+    ):
         validate(scenario_io.from_dict(d))
 
 
-@pytest.mark.parametrize("wall,field,ok", [
-    ({"normal": [0, 0, -1], "offset": -0.004}, "walls[0]", False),  # along the face the granule meets
-    ({"normal": [0, 0, -1], "offset": -0.002}, "walls[0]", False),  # through the body
-    ({"normal": [0, 0, -2], "offset": -0.004}, "walls[0]", False),  # any normal's length: the unit normal's offset
-    ({"normal": [0, -1, 0], "offset": 0.0}, None, True),             # along a side face the granule does not meet
-    ({"normal": [0, 0, 1], "offset": 0.01}, None, True),             # above the granule, clear of the body
-])
+@pytest.mark.parametrize(
+    "wall,field,ok",
+    [
+        ({"normal": [0, 0, -1], "offset": -0.004}, "walls[0]", False),  # along the face the granule meets
+        ({"normal": [0, 0, -1], "offset": -0.002}, "walls[0]", False),  # through the body
+        ({"normal": [0, 0, -2], "offset": -0.004}, "walls[0]", False),  # any normal's length: the unit normal's offset
+        ({"normal": [0, -1, 0], "offset": 0.0}, None, True),  # along a side face the granule does not meet
+        ({"normal": [0, 0, 1], "offset": 0.01}, None, True),  # above the granule, clear of the body
+    ],
+)
 def test_a_wall_may_not_cross_the_solid_or_lie_on_the_face_a_granule_meets(wall, field, ok):
     """A rigid wall through the box, or along the face a granule touches at t = 0 (the
     granule then touches both at one point, and the wall would carry the solid's load), is
@@ -209,8 +229,12 @@ def test_a_wall_may_not_cross_the_solid_or_lie_on_the_face_a_granule_meets(wall,
 def test_a_layouts_wall_on_the_plates_face_is_refused_naming_layout_walls():
     """An fcc packing's default xmax wall lies on the face of the plate placed against it:
     refused naming layout.walls and the list without it; walls = [] runs."""
-    d = {"name": "w", "dimension": 3, "layout": {"kind": "fcc", "cells": [1, 1, 1], "radius": 0.0025},
-         "plate": {"size": [0.004, 0.02, 0.02], "elements": [1, 2, 2], "clamped": ["ymin", "ymax"]}}
+    d = {
+        "name": "w",
+        "dimension": 3,
+        "layout": {"kind": "fcc", "cells": [1, 1, 1], "radius": 0.0025},
+        "plate": {"size": [0.004, 0.02, 0.02], "elements": [1, 2, 2], "clamped": ["ymin", "ymax"]},
+    }
     with pytest.raises(ScenarioError) as e:
         validate(scenario_io.from_dict(d))
     assert e.value.field == "layout.walls" and e.value.value == "xmax" and "'zmax']" in str(e.value)
@@ -280,8 +304,12 @@ def test_rigid_patch_moves_rigidly_in_every_mode_and_under_a_load():
     from granplate.solid.tie import facing_nodes, patch_nodes, rigid_basis
 
     patch = RigidPatch(centre=(0.01, 0.01, 0.004), radius=0.006)
-    s = scenario(rigid_patches=[{"centre": list(patch.centre), "radius": patch.radius}],
-                 max_frequency=2e5, elements=[4, 4, 1], size=[0.02, 0.02, 0.004])
+    s = scenario(
+        rigid_patches=[{"centre": list(patch.centre), "radius": patch.radius}],
+        max_frequency=2e5,
+        elements=[4, 4, 1],
+        size=[0.02, 0.02, 0.004],
+    )
     s = dataclasses.replace(s, granules=(dataclasses.replace(s.granules[0], x=0.01, y=0.01, z=0.006),))
     validate(s)
     m = build_solid(s.plate, cache=False)

@@ -1,4 +1,5 @@
 """The 3D solid's verification cases: their pieces against exact results."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -36,6 +37,7 @@ def test_coarse_clamped_plate_is_near_leissa():
 
 
 # --------------------------------------------------------------------------- impacts
+
 
 def test_hunter_fraction_is_its_closed_form():
     """Hunter's radiated share 1.04 (v0 / c0)^(3/5): 1.04 at v0 = c0, and v0^(3/5) scaling."""

@@ -1,5 +1,6 @@
 """`granplate bench --solid --coupled`'s pure parts: the scenarios it builds validate and
 put the plate where the stack ends, its tables and its choice of cut-off (no run)."""
+
 from __future__ import annotations
 
 import math
@@ -39,8 +40,17 @@ def test_spec_names_its_scenario():
 
 
 def _row(f, share, force, **kw):
-    return {"case": "drop", "max_frequency": f, "n_modes": 10, "plate_share": share, "peak_force_n": force,
-            "n_steps": 100, "loop_s": 0.5, "loop_cpu_s": 0.25, **kw}
+    return {
+        "case": "drop",
+        "max_frequency": f,
+        "n_modes": 10,
+        "plate_share": share,
+        "peak_force_n": force,
+        "n_steps": 100,
+        "loop_s": 0.5,
+        "loop_cpu_s": 0.25,
+        **kw,
+    }
 
 
 def test_chosen_cutoff_is_the_lowest_within_on_both():
@@ -59,12 +69,23 @@ def test_tables_format():
     text = C.format_cutoffs([_row(1e5, 0.0495, 101.0)], ref)
     lines = text.splitlines()
     assert len(lines) == 4 and "| drop | 1e+05 | 10 | 4.950% | -1.00% | 101.00 | +1.00% | 5000 |" in lines
-    cost = {**_row(1e5, 0.3, 13.0), "case": "protector", "granules": 300, "mesh": [2, 20, 20], "n_dofs": 12255,
-            "dt": 2e-7, "setup_first_s": 9.6, "setup_uncached_s": 9.6, "setup_cached_s": 0.38, "in_touch": 50,
-            "energy_residual": 3.5e-5}
+    cost = {
+        **_row(1e5, 0.3, 13.0),
+        "case": "protector",
+        "granules": 300,
+        "mesh": [2, 20, 20],
+        "n_dofs": 12255,
+        "dt": 2e-7,
+        "setup_first_s": 9.6,
+        "setup_uncached_s": 9.6,
+        "setup_cached_s": 0.38,
+        "in_touch": 50,
+        "energy_residual": 3.5e-5,
+    }
     line = C.format_cost([cost, {"case": "protector", "mesh": [2, 40, 40], "failed": "rc 1"}]).splitlines()
-    assert ("| protector | 300 | 2 x 20 x 20 | 12,255 | 10 | 1e+05 | 2e-07 | 9.6 | 0.38 | 100 | 0.5 | 5000 | 2500 "
-            "| 50 |") in line[2]
+    assert (
+        "| protector | 300 | 2 x 20 x 20 | 12,255 | 10 | 1e+05 | 2e-07 | 9.6 | 0.38 | 100 | 0.5 | 5000 | 2500 | 50 |"
+    ) in line[2]
     assert "rc 1" in line[3]
     assert math.isclose(C.us_per_step(cost), 5000.0)
 
@@ -91,8 +112,14 @@ def test_profile_table_and_route(monkeypatch):
     from granplate import cli
     from granplate.bench import solid_profile as P
 
-    row = {"mesh": [2, 20, 20], "n_dofs": 12255, "n_resid": 1121, "n_touch": 50, "step_cpu_us": 2341.0,
-           **{p + "_us": 10.0 for p in P.PASSES}}
+    row = {
+        "mesh": [2, 20, 20],
+        "n_dofs": 12255,
+        "n_resid": 1121,
+        "n_touch": 50,
+        "step_cpu_us": 2341.0,
+        **{p + "_us": 10.0 for p in P.PASSES},
+    }
     lines = P.format_profile([row]).splitlines()
     assert len(lines) == 3 and lines[0].count("[us]") == len(P.PASSES) + 1
     assert lines[2].startswith("| 2 x 20 x 20 | 12,255 | 1,121 | 50 | 10 |") and lines[2].endswith("| 2,341 |")

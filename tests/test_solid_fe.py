@@ -1,12 +1,20 @@
 """The solid's elements: the NumPy assembly equals scikit-fem's linear_elasticity and
 vector mass forms; the mass integrates to the body's mass; rigid motions cost no energy."""
+
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from granplate.solid.fe import (mass_matrix, node_coordinates, reference_mass, reference_stiffness, scalar_basis,
-                                stiffness_matrix, vector_basis)
+from granplate.solid.fe import (
+    mass_matrix,
+    node_coordinates,
+    reference_mass,
+    reference_stiffness,
+    scalar_basis,
+    stiffness_matrix,
+    vector_basis,
+)
 from granplate.solid.mesh import box_mesh
 from granplate.solid.modes import rigid_body_modes
 

@@ -1,5 +1,6 @@
 """The solid's meshes: a box's named faces, a Gmsh file's physical groups, and each bad
 input refused with one message naming the field."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -19,8 +20,10 @@ def _node(x, y, z):
 
 
 def _hex(x0):
-    return [_node(x0 + dx, y, z) for (dx, y, z) in
-            [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]]
+    return [
+        _node(x0 + dx, y, z)
+        for (dx, y, z) in [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]
+    ]
 
 
 def write_msh(path, hexes=None, quads=None, groups=None, cell_type="hexahedron"):
@@ -29,8 +32,12 @@ def write_msh(path, hexes=None, quads=None, groups=None, cell_type="hexahedron")
     groups = {"left": [1, 2], "body": [2, 3]} if groups is None else groups
     cells = [(cell_type, np.array(hexes)), ("quad", np.array(quads))]
     phys = [np.full(len(hexes), 2), np.full(len(quads), 1)]
-    m = meshio.Mesh(POINTS, cells, cell_data={"gmsh:physical": phys, "gmsh:geometrical": phys},
-                    field_data={k: np.array(v) for k, v in groups.items()})
+    m = meshio.Mesh(
+        POINTS,
+        cells,
+        cell_data={"gmsh:physical": phys, "gmsh:geometrical": phys},
+        field_data={k: np.array(v) for k, v in groups.items()},
+    )
     meshio.write(str(path), m, file_format="gmsh22", binary=False)
     return path
 
@@ -70,8 +77,9 @@ def test_bad_files_say_why(tmp_path):
     with pytest.raises(ScenarioError, match="no such file"):
         read_mesh(tmp_path / "absent.msh")
     wedge = tmp_path / "wedge.msh"
-    meshio.write(str(wedge), meshio.Mesh(POINTS, [("wedge", np.array([[0, 1, 3, 6, 7, 9]]))]),
-                 file_format="gmsh22", binary=False)
+    meshio.write(
+        str(wedge), meshio.Mesh(POINTS, [("wedge", np.array([[0, 1, 3, 6, 7, 9]]))]), file_format="gmsh22", binary=False
+    )
     with pytest.raises(ScenarioError, match="no supported volume cells"):
         read_mesh(wedge)
     flipped = _hex(0)
@@ -94,10 +102,12 @@ def test_gmsh_file_with_an_unused_point_keeps_its_named_face(tmp_path):
     pts = np.vstack([[9.0, 9.0, 9.0], POINTS])  # the unused point first: every index moves
     hexes = np.array([_hex(0), _hex(1)]) + 1
     quads = np.array([[_node(0, 0, 0), _node(0, 1, 0), _node(0, 1, 1), _node(0, 0, 1)]]) + 1
-    m = meshio.Mesh(pts, [("hexahedron", hexes), ("quad", quads)],
-                    cell_data={"gmsh:physical": [np.full(2, 2), np.full(1, 1)],
-                               "gmsh:geometrical": [np.full(2, 2), np.full(1, 1)]},
-                    field_data={"left": np.array([1, 2]), "body": np.array([2, 3])})
+    m = meshio.Mesh(
+        pts,
+        [("hexahedron", hexes), ("quad", quads)],
+        cell_data={"gmsh:physical": [np.full(2, 2), np.full(1, 1)], "gmsh:geometrical": [np.full(2, 2), np.full(1, 1)]},
+        field_data={"left": np.array([1, 2]), "body": np.array([2, 3])},
+    )
     meshio.write(str(tmp_path / "extra.msh"), m, file_format="gmsh22", binary=False)
     mesh = read_mesh(tmp_path / "extra.msh")
     assert mesh.p.shape == (3, 12)
@@ -121,6 +131,5 @@ def test_outline_of_a_box_is_its_twelve_edges(tetrahedra):
     assert np.all((np.isclose(ends, 0.0, atol=1e-15) | np.isclose(ends, size)).sum(axis=1) >= 2)
     assert length(outline_edges(mesh, face_facets(mesh, "xmin", "f"))) == pytest.approx(2 * (0.2 + 0.1), rel=1e-12)
     polygons = boundary_polygons(mesh)  # in order around each facet: their areas add up to the surface
-    area = sum(0.5 * np.linalg.norm(sum(np.cross(p[k], p[(k + 1) % len(p)]) for k in range(len(p))))
-               for p in polygons)
+    area = sum(0.5 * np.linalg.norm(sum(np.cross(p[k], p[(k + 1) % len(p)]) for k in range(len(p)))) for p in polygons)
     assert area == pytest.approx(2 * (0.3 * 0.2 + 0.3 * 0.1 + 0.2 * 0.1), rel=1e-12)

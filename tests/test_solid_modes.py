@@ -1,5 +1,6 @@
 """The solid's modes: a free body's six rigid-body modes at zero exactly, M-orthonormal
 modes, the windows against a dense eigensolver, a clamped thin plate against Leissa."""
+
 from __future__ import annotations
 
 import numpy as np

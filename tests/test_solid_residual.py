@@ -1,6 +1,7 @@
 """The residual compliance: modal truncation plus R equals the full static solution on
 the chosen dofs, R vanishes with every mode kept, and a free body's inertia-relief
 flexibility equals the dense constrained solution."""
+
 from __future__ import annotations
 
 import numpy as np

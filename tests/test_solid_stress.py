@@ -1,6 +1,7 @@
 """The solid's stress recovery (granplate.solid.stress) against closed forms: uniaxial
 stress and pure shear exactly at every quadrature point, the ball mean of a linear field at
 the centre, and the ball mean's convergence to the exact one under refinement."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -8,10 +9,25 @@ import pytest
 from skfem import Basis, ElementHex2, ElementHexS2, ElementTetP2, ElementVector, MeshHex, MeshTet
 
 from granplate.errors import ScenarioError
-from granplate.solid.stress import (ball_average_operator, ball_operator, max_ball_von_mises, ball_mean, ball_von_mises, elasticity_matrix,
-                                    max_von_mises, modal_unit_stresses, point_spacing, quadrature_points,
-                                    quadrature_weights, strain_operator, strains, stresses,
-                                    surface_centres, von_mises, von_mises_of_ball_mean)
+from granplate.solid.stress import (
+    ball_average_operator,
+    ball_operator,
+    max_ball_von_mises,
+    ball_mean,
+    ball_von_mises,
+    elasticity_matrix,
+    max_von_mises,
+    modal_unit_stresses,
+    point_spacing,
+    quadrature_points,
+    quadrature_weights,
+    strain_operator,
+    strains,
+    stresses,
+    surface_centres,
+    von_mises,
+    von_mises_of_ball_mean,
+)
 
 E, NU = 200e9, 0.3
 ELEMENTS = {"hex20": (MeshHex, ElementHexS2), "hex27": (MeshHex, ElementHex2), "tet10": (MeshTet, ElementTetP2)}
@@ -77,8 +93,9 @@ def test_ball_mean_of_a_linear_field_is_its_centre_value():
     ball = ball_average_operator(points, weights, centre, 0.2, point_spacing(basis))
     x = centre.T
     grad = 1e-3 * np.array([[2 * x[0], x[2], x[1]], [-x[2], 2 * x[1], -x[0]], [x[1], x[0], 2 * x[2]]])
-    eps_c = np.stack([grad[0, 0], grad[1, 1], grad[2, 2], grad[1, 2] + grad[2, 1],
-                      grad[0, 2] + grad[2, 0], grad[0, 1] + grad[1, 0]])
+    eps_c = np.stack(
+        [grad[0, 0], grad[1, 1], grad[2, 2], grad[1, 2] + grad[2, 1], grad[0, 2] + grad[2, 0], grad[0, 1] + grad[1, 0]]
+    )
     assert np.allclose(ball_mean(ball, sigma), D @ eps_c, rtol=0, atol=1e-12 * E * 1e-3)
     # von Mises is a norm: the von Mises of the mean never exceeds the mean von Mises
     assert np.all(von_mises_of_ball_mean(ball, sigma) <= ball_von_mises(ball, sigma) * (1 + 1e-12))
@@ -88,9 +105,13 @@ def exact_field(x):
     """A smooth displacement [m] outside the element space, and its gradient."""
     a = 1e-3
     u = a * np.stack([np.sin(2 * x[0] + x[1]), np.cos(x[0] - x[2]), np.sin(x[1] * x[2])])
-    g = a * np.array([[2 * np.cos(2 * x[0] + x[1]), np.cos(2 * x[0] + x[1]), 0 * x[0]],
-                      [-np.sin(x[0] - x[2]), 0 * x[0], np.sin(x[0] - x[2])],
-                      [0 * x[0], x[2] * np.cos(x[1] * x[2]), x[1] * np.cos(x[1] * x[2])]])
+    g = a * np.array(
+        [
+            [2 * np.cos(2 * x[0] + x[1]), np.cos(2 * x[0] + x[1]), 0 * x[0]],
+            [-np.sin(x[0] - x[2]), 0 * x[0], np.sin(x[0] - x[2])],
+            [0 * x[0], x[2] * np.cos(x[1] * x[2]), x[1] * np.cos(x[1] * x[2])],
+        ]
+    )
     return u, g
 
 
@@ -122,8 +143,9 @@ def test_ball_mean_converges_under_refinement():
     for refine in (1, 2, 3):
         basis = basis_of("hex20", refine, intorder=4)
         sigma = stresses(D, strains(strain_operator(basis), interpolate(basis, lambda x: exact_field(x)[0])))
-        ball = ball_average_operator(quadrature_points(basis), quadrature_weights(basis), centre[None],
-                                     radius, point_spacing(basis))
+        ball = ball_average_operator(
+            quadrature_points(basis), quadrature_weights(basis), centre[None], radius, point_spacing(basis)
+        )
         errors.append(abs(ball_von_mises(ball, sigma)[0] - exact) / exact)
     order = np.polyfit(np.log([1, 0.5, 0.25]), np.log(errors), 1)[0]
     assert errors[2] < errors[1] < errors[0] and errors[-1] < 3e-3 and order > 1.8, (errors, order)
@@ -140,8 +162,10 @@ def test_surface_maximum_of_a_uniform_field():
     """A uniform uniaxial stress: every ball mean about the surface nodes, cut or not, is E eps,
     so the surface maximum is E eps; a radius <= 0 is a ScenarioError naming it."""
     basis = basis_of("hex27")
-    sigma = stresses(elasticity_matrix(E, NU), strains(strain_operator(basis), interpolate(
-        basis, lambda x: 1e-3 * np.stack([x[0], -NU * x[1], -NU * x[2]]))))
+    sigma = stresses(
+        elasticity_matrix(E, NU),
+        strains(strain_operator(basis), interpolate(basis, lambda x: 1e-3 * np.stack([x[0], -NU * x[1], -NU * x[2]]))),
+    )
     for partial in (True, False):
         ball = ball_operator(basis, surface_centres(basis), 0.2, partial_cells=partial)
         assert np.allclose(ball_von_mises(ball, sigma), E * 1e-3, rtol=1e-12)

@@ -1,6 +1,7 @@
 """The solid's boundary surface (granplate.solid.surface) against geometry: feet of
 perpendiculars, distances to edges and corners, exact interpolation by the face weights,
 and the sliding projection against the brute-force closest point."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -8,12 +9,25 @@ import pytest
 from skfem import Basis, ElementHex2, ElementHexS2, ElementTetP2, ElementVector, MeshHex, MeshTet
 
 from granplate.errors import ScenarioError
-from granplate.solid.surface import (QUAD8, QUAD9, TRI6, boundary_surface, closest_point, face_closest,
-                                     face_neighbours, follow_closest, patch_weights, slide_closest)
+from granplate.solid.surface import (
+    QUAD8,
+    QUAD9,
+    TRI6,
+    boundary_surface,
+    closest_point,
+    face_closest,
+    face_neighbours,
+    follow_closest,
+    patch_weights,
+    slide_closest,
+)
 
 #: The unit cube [0, 1]^3 meshed in 2 x 2 x 2 hexes or 48 tets, with each quadratic element.
-ELEMENTS = {"hex20": (MeshHex, ElementHexS2, QUAD8), "hex27": (MeshHex, ElementHex2, QUAD9),
-            "tet10": (MeshTet, ElementTetP2, TRI6)}
+ELEMENTS = {
+    "hex20": (MeshHex, ElementHexS2, QUAD8),
+    "hex27": (MeshHex, ElementHex2, QUAD9),
+    "tet10": (MeshTet, ElementTetP2, TRI6),
+}
 
 
 def cube_basis(name: str, refine: int = 1) -> Basis:
@@ -85,8 +99,10 @@ def test_weights_interpolate_quadratic_fields(cube):
     quadratic field (in the element space) exactly at the point, so sum_k w_k F . u_k = F . u."""
     _, _, s = cube
     rng = np.random.default_rng(1)
-    fields = (lambda x: 1.0 + 2.0 * x[..., 0] - 3.0 * x[..., 1] + 0.5 * x[..., 2],
-              lambda x: x[..., 0] ** 2 - 2.0 * x[..., 1] * x[..., 2] + x[..., 0] * x[..., 1] + x[..., 2])
+    fields = (
+        lambda x: 1.0 + 2.0 * x[..., 0] - 3.0 * x[..., 1] + 0.5 * x[..., 2],
+        lambda x: x[..., 0] ** 2 - 2.0 * x[..., 1] * x[..., 2] + x[..., 0] * x[..., 1] + x[..., 2],
+    )
     for _ in range(10):
         p = rng.uniform(-0.3, 1.3, 3)
         cp = closest_point(s, p)
@@ -164,6 +180,7 @@ def test_curved_face_projection():
     angle, height = 0.4 * ref[:, 0], 0.5 * ref[:, 1]
     X = np.stack([np.cos(angle), np.sin(angle), height], axis=1)
     from granplate.solid.surface import face_normal, face_shape_functions
+
     g = np.linspace(-1, 1, 801)
     N, dN = np.empty(9), np.empty((9, 2))
     grid = []
@@ -199,8 +216,14 @@ def test_named_groups_and_bad_input():
 @pytest.mark.parametrize("kind", [QUAD8, QUAD9, TRI6])
 def test_shape_functions_are_nodal_and_their_derivatives_match_differences(kind):
     """N_k(node j) = delta_kj, and dN, d2N equal central differences of N and dN."""
-    from granplate.solid.surface import NODES_PER_FACE, _QUAD_NODES, _TRI_NODES, face_shape_functions, \
-        face_shape_hessians
+    from granplate.solid.surface import (
+        NODES_PER_FACE,
+        _QUAD_NODES,
+        _TRI_NODES,
+        face_shape_functions,
+        face_shape_hessians,
+    )
+
     n = NODES_PER_FACE[kind]
     ref = (_TRI_NODES if kind == TRI6 else _QUAD_NODES)[:n]
     N, dN, d2N = np.empty(n), np.empty((n, 2)), np.empty((n, 3))

@@ -4,6 +4,7 @@ gradient of the contact's potential (finite differences), the modes' projection 
 work-conjugate of the surface motion, the exact free vibration of the modes, friction
 booked as the kinetic energy it removes, and a coupled run's energy balance converging as
 h^2."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -69,8 +70,9 @@ def forces(m, y, q, b=None):
     b = new_body_state(m.body) if b is None else b
     acc = np.zeros_like(y)
     fd = np.zeros_like(y)
-    e_pot, _, _, e_static, _, _ = B.contact_forces(y, q, np.zeros_like(q), b, 0, m.granular.radius,
-                                                   m.granular.mass, False, acc, fd, False)
+    e_pot, _, _, e_static, _, _ = B.contact_forces(
+        y, q, np.zeros_like(q), b, 0, m.granular.radius, m.granular.mass, False, acc, fd, False
+    )
     return acc, e_pot, e_static, b
 
 
@@ -193,7 +195,7 @@ def test_friction_books_the_kinetic_energy_it_removes(model):
     mass, inertia = m.granular.mass[0], m.granular.inertia[0]
 
     def ke(y, qd):
-        return 0.5 * mass * (y[0, 3:6] ** 2).sum() + 0.5 * inertia * (y[0, 6:9] ** 2).sum() + 0.5 * (qd ** 2).sum()
+        return 0.5 * mass * (y[0, 3:6] ** 2).sum() + 0.5 * inertia * (y[0, 6:9] ** 2).sum() + 0.5 * (qd**2).sum()
 
     before = ke(y, qd)
     slip0 = y[0, 3] - m.granular.radius[0] * y[0, 7]
@@ -212,8 +214,9 @@ def test_coupled_run_energy_balance_converges_as_h_squared():
     s = scenario_io.loads(DROP)
     res = []
     for dt in (2e-8, 1e-8):
-        ds = gp.simulate(dataclasses.replace(s, time=dataclasses.replace(s.time, dt_max=dt, dt_initial=dt)),
-                         progress=False)
+        ds = gp.simulate(
+            dataclasses.replace(s, time=dataclasses.replace(s.time, dt_max=dt, dt_initial=dt)), progress=False
+        )
         assert ds.attrs["status"] == "ok"
         assert float(ds.body_contact_normal_force.max()) > 10.0  # it did hit
         res.append(float(np.abs(ds.energy_residual).max()))
@@ -236,7 +239,7 @@ def test_patch_loads_spread_each_force_whole():
     t, col, val = np.empty(room, np.int64), np.empty(room, np.int64), np.empty(room)
     k = B.patch_loads(b, face, xi, force, t, col, val)
     assert k > 3 and val[:k].sum() == pytest.approx(-12.5, rel=1e-12)
-    nodes = set(b.entry[0, 0, :b.count[0, 0]])
+    nodes = set(b.entry[0, 0, : b.count[0, 0]])
     rows = {int(b.node_rows[n, 2]) for n in nodes}
     assert set(col[:k][val[:k] != 0.0].tolist()) <= rows
 
@@ -249,7 +252,14 @@ def test_summary_only_equals_the_full_result_with_a_body():
     s = scenario_io.loads(DROP.replace("patch_radius = 0.0", "patch_radius = 0.006"))
     full = gp.summary(gp.simulate(s, progress=False))
     brief = gp.summary(gp.simulate(s, progress=False, summary_only=True))
-    for key in ("ep_max_fraction", "eg_max_fraction", "max_von_mises", "max_von_mises_ball", "max_displacement",
-                "energy_residual_max", "max_contact_pressure"):
+    for key in (
+        "ep_max_fraction",
+        "eg_max_fraction",
+        "max_von_mises",
+        "max_von_mises_ball",
+        "max_displacement",
+        "energy_residual_max",
+        "max_contact_pressure",
+    ):
         assert brief[key] == pytest.approx(full[key], rel=1e-12), key
     assert full["ep_max_fraction"] > 0.0 and full["units"]["max_von_mises_ball"] == "Pa"

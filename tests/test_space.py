@@ -2,6 +2,7 @@
 impact with out-of-plane spins and a wall against the independent scipy integrator of
 the 3D laws, eq. (11) at every step, the elastic-plastic law's restitution (Thornton),
 and the guards of the plane in space."""
+
 from __future__ import annotations
 
 import math
@@ -151,8 +152,16 @@ field_interval = 1e-6
 def test_overlap_beyond_the_stop_in_space_names_the_granules():
     """Two spheres closing at 500 m/s reach contact.overlap_stop: the run stops naming both
     granules and keeps what it computed."""
-    s = gp.with_changes(oblique(t_end=2e-5), {"granules[0].vx": 500.0, "granules[1].vx": 0.0,
-                                              "granules[1].x": 0.0202, "granules[1].y": 0.0, "granules[1].z": 0.0})
+    s = gp.with_changes(
+        oblique(t_end=2e-5),
+        {
+            "granules[0].vx": 500.0,
+            "granules[1].vx": 0.0,
+            "granules[1].x": 0.0202,
+            "granules[1].y": 0.0,
+            "granules[1].z": 0.0,
+        },
+    )
     with pytest.raises(SimulationError, match="granule 'a'.*granule 'b'.*overlap_stop") as err:
         quiet(s)
     assert err.value.result.sizes["time"] >= 1

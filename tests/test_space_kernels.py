@@ -2,6 +2,7 @@
 laws: a state in the plane z = 0 with spins along z gives the plane's forces, torques,
 powers and energies (docs/model.md section 3.7); the slip vector and friction torques
 against their definitions; the split friction's exact relaxation in space."""
+
 from __future__ import annotations
 
 import math
@@ -13,7 +14,12 @@ import granplate as gp
 from granplate.model.arrays import build_model
 from granplate.model.inputs import Granular3, no_history
 from granplate.physics.space import (
-    arm_torque_3d, friction_along_slip, friction_vector_3d, pair_contact_3d, pair_overlap_3d, slip_velocity_3d,
+    arm_torque_3d,
+    friction_along_slip,
+    friction_vector_3d,
+    pair_contact_3d,
+    pair_overlap_3d,
+    slip_velocity_3d,
 )
 from granplate.solver import granular as plane, granular3d as space
 
@@ -33,8 +39,14 @@ def planar_state():
     y[:, 3:5] = rng.normal(0.0, 0.5, (ng, 2))
     y[:, 5] = rng.normal(0.0, 50.0, ng)
     e = np.zeros(0, np.int64)
-    g = g._replace(pc_i=e, pc_x=np.zeros(0), pc_coef=np.zeros((0, g.pc_coef.shape[1])), pc_hist=no_history(0),
-                   pair_hist=no_history(len(g.pair_ij)), wall_hist=no_history(len(g.wall_i)))
+    g = g._replace(
+        pc_i=e,
+        pc_x=np.zeros(0),
+        pc_coef=np.zeros((0, g.pc_coef.shape[1])),
+        pc_hist=no_history(0),
+        pair_hist=no_history(len(g.pair_ij)),
+        wall_hist=no_history(len(g.wall_i)),
+    )
     return m, g, y
 
 
@@ -43,8 +55,14 @@ def lifted(g, y):
     wall_geo = np.zeros((len(g.wall_i), 4))
     wall_geo[:, :2] = g.wall_geo[:, :2]
     wall_geo[:, 3] = g.wall_geo[:, 2]
-    g3 = Granular3(**{**g._asdict(), "wall_geo": wall_geo, "shock_force": np.zeros((len(g.radius), 3)),
-                      "shock_torque": np.zeros((len(g.radius), 3))})
+    g3 = Granular3(
+        **{
+            **g._asdict(),
+            "wall_geo": wall_geo,
+            "shock_force": np.zeros((len(g.radius), 3)),
+            "shock_torque": np.zeros((len(g.radius), 3)),
+        }
+    )
     y3 = np.zeros((len(y), 9))
     y3[:, 0:2] = y[:, 0:2]
     y3[:, 3:5] = y[:, 3:5]
@@ -145,6 +163,7 @@ def test_friction_is_split_off_in_space_only_where_a_contact_has_friction():
     s = launched_fcc((1, 1, 1))
     assert not build_model(s).config.split_friction
     assert build_model(launched_fcc((1, 1, 1), mu=0.099)).config.split_friction
-    s = dataclasses.replace(s, contact=dataclasses.replace(
-        s.contact, pairs=(PairCoefficients(materials=("steel", "steel"), mu=0.2),)))
+    s = dataclasses.replace(
+        s, contact=dataclasses.replace(s.contact, pairs=(PairCoefficients(materials=("steel", "steel"), mu=0.2),))
+    )
     assert build_model(s).config.split_friction

@@ -3,6 +3,7 @@ the six 3D twins at DIR/3d/NAME.nc, the section's table is each pair of results'
 `summary`, the thin-limit verdicts are the criteria's (a difference past its target
 fails), the figure draws each run's own plate share, and the report without --3d is
 as before."""
+
 from __future__ import annotations
 
 import json
@@ -22,8 +23,9 @@ from conftest import section_titles
 T_END = 2e-5  # the shock half over: every code path of both dimensions, seconds of work
 
 
-def fabricated(name: str, e_shock: float, peak: float, vm: float = 1e8, residual: float = 1e-6,
-               wall: float = 1.0, n: int = 21) -> xr.Dataset:
+def fabricated(
+    name: str, e_shock: float, peak: float, vm: float = 1e8, residual: float = 1e-6, wall: float = 1.0, n: int = 21
+) -> xr.Dataset:
     """A small result with what `summary` reads: E_shock ramps to e_shock [J], the plate's
     energy rises to peak * e_shock and falls, the rest stays in the granules."""
     t = np.linspace(0.0, 1e-3, n)
@@ -32,13 +34,23 @@ def fabricated(name: str, e_shock: float, peak: float, vm: float = 1e8, residual
     ep[n // 2] = peak * e_shock
     zero = np.zeros(n)
     return xr.Dataset(
-        {"E_shock": ("time", e), "E_plate": ("time", ep), "E_granular": ("time", e - ep),
-         "D_viscous": ("time", zero), "D_friction": ("time", zero), "D_plastic": ("time", zero),
-         "max_von_mises": ("time", vm * np.sin(np.pi * t / t[-1])),
-         "energy_residual_max": ("time", np.full(n, residual))},
+        {
+            "E_shock": ("time", e),
+            "E_plate": ("time", ep),
+            "E_granular": ("time", e - ep),
+            "D_viscous": ("time", zero),
+            "D_friction": ("time", zero),
+            "D_plastic": ("time", zero),
+            "max_von_mises": ("time", vm * np.sin(np.pi * t / t[-1])),
+            "energy_residual_max": ("time", np.full(n, residual)),
+        },
         coords={"time": t},
-        attrs={"scenario_name": name, "granplate_version": "test",
-               "run_info": json.dumps({"wall_time_s": wall, "n_steps": 100, "status": "ok"})})
+        attrs={
+            "scenario_name": name,
+            "granplate_version": "test",
+            "run_info": json.dumps({"wall_time_s": wall, "n_steps": 100, "status": "ok"}),
+        },
+    )
 
 
 @pytest.fixture(scope="module")
@@ -86,11 +98,13 @@ def test_case_table_is_each_pairs_summary(pair):
         r = rows[n]
         assert r[col("E_shock 2D / 3D [J]")] == f"{a['e_shock']:.4e} / {b['e_shock']:.4e}"
         assert r[col("E_shock 3D vs 2D")] == f"{100 * (b['e_shock'] / a['e_shock'] - 1):+.2f}%" == "+0.05%"
-        assert r[col("plate peak 2D / 3D")] == (f"{100 * a['ep_max_fraction']:#.4g}% / "
-                                                 f"{100 * b['ep_max_fraction']:#.4g}%")
+        assert r[col("plate peak 2D / 3D")] == (
+            f"{100 * a['ep_max_fraction']:#.4g}% / {100 * b['ep_max_fraction']:#.4g}%"
+        )
         assert r[col("plate peak 3D vs 2D")] == "-0.50%"
-        assert r[col("max von Mises 2D / 3D [MPa]")] == (f"{a['max_von_mises'] / 1e6:.1f} / "
-                                                          f"{b['max_von_mises'] / 1e6:.1f}")
+        assert r[col("max von Mises 2D / 3D [MPa]")] == (
+            f"{a['max_von_mises'] / 1e6:.1f} / {b['max_von_mises'] / 1e6:.1f}"
+        )
         assert r[col("max abs(energy residual) 2D / 3D")] == "1.0e-06 / 3.0e-07"
         assert r[col("wall time 2D / 3D [s]")] == f"{a['wall_time_s']:.1f} / {b['wall_time_s']:.1f}"
         assert r[col("wall time 3D / 2D")] == f"{b['wall_time_s'] / a['wall_time_s']:.1f}"
@@ -158,8 +172,9 @@ def test_section_holds_the_table_and_the_verdicts(pair):
 @pytest.fixture(scope="module")
 def run3d(tmp_path_factory):
     out = tmp_path_factory.mktemp("repro3d")
-    outcome = rp.reproduce(out, t_end=T_END, workers=2, checks="none", plastic=False, space=True,
-                           animations=False, quiet=True)
+    outcome = rp.reproduce(
+        out, t_end=T_END, workers=2, checks="none", plastic=False, space=True, animations=False, quiet=True
+    )
     return out, outcome
 
 
@@ -190,14 +205,24 @@ def test_second_reproduce_3d_reuses_the_twins(run3d):
     has no 3D section."""
     out, outcome = run3d
     stamps = {r.name: r.path.stat().st_mtime_ns for r in outcome.runs}
-    again = rp.reproduce(out, t_end=T_END, workers=1, checks="none", plastic=False, space=True,
-                         figures=False, animations=False, quiet=True)
+    again = rp.reproduce(
+        out,
+        t_end=T_END,
+        workers=1,
+        checks="none",
+        plastic=False,
+        space=True,
+        figures=False,
+        animations=False,
+        quiet=True,
+    )
     assert again.ok and {r.status for r in again.runs} == {"reused"}
     assert {r.name: r.path.stat().st_mtime_ns for r in again.runs} == stamps
     assert "## The paper in 3D" in (out / "report.md").read_text()
     assert "fig-3d.png" in (out / "report.md").read_text()  # the earlier figure, still current
-    plain = rp.reproduce(out, t_end=T_END, workers=1, checks="none", plastic=False,
-                         figures=False, animations=False, quiet=True)
+    plain = rp.reproduce(
+        out, t_end=T_END, workers=1, checks="none", plastic=False, figures=False, animations=False, quiet=True
+    )
     assert {r.kind for r in plain.runs} == {"preset"}
     assert "The paper in 3D" not in (out / "report.md").read_text()
 

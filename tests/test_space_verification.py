@@ -1,6 +1,7 @@
 """The verification of spheres in space (granplate.verification.space_cases; the cases
 themselves run in tests/test_verification.py): the helpers against geometry, and the
 conservation check shown able to fail."""
+
 from __future__ import annotations
 
 import numpy as np

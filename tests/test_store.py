@@ -1,5 +1,6 @@
 """Tests of granplate.store: the one run store behind every cache (plate, reproduce,
 verification, bench reference)."""
+
 from __future__ import annotations
 
 import json
@@ -12,7 +13,7 @@ import xarray as xr
 from granplate import store
 from granplate.version import __version__
 
-PAYLOAD = {"scenario_toml": "name = \"x\"\n", "t_end": repr(1e-4), "n": [1, 2.5, None]}
+PAYLOAD = {"scenario_toml": 'name = "x"\n', "t_end": repr(1e-4), "n": [1, 2.5, None]}
 
 
 @pytest.fixture(autouse=True)
@@ -27,7 +28,7 @@ def sample_dataset() -> xr.Dataset:
     return xr.Dataset(
         {"E": ("time", np.sin(t * 1e4)), "n": ("time", np.arange(5, dtype=np.int64))},
         coords={"time": t},
-        attrs={"scenario_toml": "name = \"x\"\n", "granplate_version": __version__},
+        attrs={"scenario_toml": 'name = "x"\n', "granplate_version": __version__},
     )
 
 
@@ -56,7 +57,9 @@ def test_key_is_the_sha256_of_kind_format_version_and_payload():
 def test_entries_live_under_the_cache_directory_by_kind(tmp_path, monkeypatch):
     """$GRANPLATE_CACHE/KIND/[LABEL-]KEY.EXT; without the variable, ~/.cache/granplate."""
     path = store.save_json("bench-reference", PAYLOAD, 1, {"a": 1}, label="bare-plate")
-    assert path == tmp_path / "store" / "bench-reference" / f"bare-plate-{store.key('bench-reference', PAYLOAD, 1)}.json"
+    assert (
+        path == tmp_path / "store" / "bench-reference" / f"bare-plate-{store.key('bench-reference', PAYLOAD, 1)}.json"
+    )
     monkeypatch.delenv(store.CACHE_ENV)
     monkeypatch.setenv("HOME", str(tmp_path / "home"))
     assert store.cache_directory() == tmp_path / "home" / ".cache" / "granplate"
@@ -240,14 +243,15 @@ def test_exclusive_makes_a_second_process_wait(tmp_path):
     import sys
     import time
 
-    code = ("import sys, time; from granplate import store\n"
-            "print('ready', flush=True)\n"
-            "t0 = time.perf_counter()\n"
-            "with store.exclusive('plate', {'n': 1}, 1):\n"
-            "    print(time.perf_counter() - t0, flush=True)\n")
+    code = (
+        "import sys, time; from granplate import store\n"
+        "print('ready', flush=True)\n"
+        "t0 = time.perf_counter()\n"
+        "with store.exclusive('plate', {'n': 1}, 1):\n"
+        "    print(time.perf_counter() - t0, flush=True)\n"
+    )
     with store.exclusive("plate", {"n": 1}, 1):
-        other = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True,
-                                 env={**os.environ})
+        other = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True, env={**os.environ})
         assert other.stdout.readline().strip() == "ready"
         time.sleep(1.0)
         assert other.poll() is None  # still waiting

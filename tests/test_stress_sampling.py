@@ -1,6 +1,7 @@
 """The report's stress checks sample von Mises through the plate's own recovery: at the
 Gauss points it equals what the simulator stored, and a linear displacement field (a
 uniform strain, exact in Q8) gives the closed-form plane-stress stress at every node."""
+
 from __future__ import annotations
 
 import numpy as np

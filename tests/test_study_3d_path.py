@@ -3,6 +3,7 @@ done as written: `granplate preset 3d-ptfe-r05 > my.toml`, its [layout] replaced
 documented hexagonal table, the documented study file beside it. Truth: the documented
 layout is the twin's packing (granules and the placed slab with its rigid layers equal),
 and every design of the study validates, with the columns and intruders it names."""
+
 from __future__ import annotations
 
 import re

@@ -3,6 +3,7 @@ granules' masses) makes that design infeasible, above it feasible; Optuna's
 constraints_func sees the same verdict, the Pareto front keeps only feasible trials and
 pareto.csv and the report list the excluded better trial as infeasible; mistakes in a
 [constraints] table are named before anything runs."""
+
 from __future__ import annotations
 
 import csv
@@ -15,7 +16,13 @@ from granplate.errors import ScenarioError
 from granplate.study import design as D
 from granplate.study.constraints import Bound, is_feasible, parse_constraints, violations
 from granplate.study.optimize import (
-    PARETO_CSV, TRIALS_CSV, feasible_text, open_study, parse_optimization, tell, write_outputs,
+    PARETO_CSV,
+    TRIALS_CSV,
+    feasible_text,
+    open_study,
+    parse_optimization,
+    tell,
+    write_outputs,
 )
 
 #: The paper's packing: 10 heavy granules of R1 and 4 intruders of R2 = ratio R1 (spheres).
@@ -24,7 +31,7 @@ R1 = 0.01
 
 def packing_mass(ratio: float, intruder_rho: float, heavy_rho: float = 7850.0) -> float:
     """Mass [kg] of the paper's 14 granules: 4/3 pi R^3 rho each."""
-    sphere = lambda r, rho: 4.0 / 3.0 * math.pi * r ** 3 * rho  # noqa: E731
+    sphere = lambda r, rho: 4.0 / 3.0 * math.pi * r**3 * rho  # noqa: E731
     return 10 * sphere(R1, heavy_rho) + 4 * sphere(ratio * R1, intruder_rho)
 
 
@@ -34,8 +41,7 @@ def records(tmp_path_factory):
     folder = tmp_path_factory.mktemp("records")
     out = {}
     for material in ("steel", "ptfe"):
-        s = gp.with_changes(gp.load_scenario("ptfe-r05"), {"time.t_end": 2e-6,
-                                                          "layout.intruder_material": material})
+        s = gp.with_changes(gp.load_scenario("ptfe-r05"), {"time.t_end": 2e-6, "layout.intruder_material": material})
         text = gp.dumps(s)
         key = D.design_key(text)
         outcome = D.run_design(text)
@@ -65,10 +71,13 @@ def test_mass_metric_is_the_closed_form_and_bounds_around_it_decide_feasibility(
 
 def test_infeasible_trial_is_left_off_the_front_and_reported(records, tmp_path):
     steel, ptfe = (records[m]["summary"]["granular_mass"] for m in ("steel", "ptfe"))
-    doc = {"base": "ptfe-r05", "set": {"time.t_end": 2e-6},
-           "parameters": {"layout.intruder_material": ["steel", "ptfe"]},
-           "objectives": {"granular_mass": "minimize"},
-           "constraints": {"granular_mass": {"min": (steel + ptfe) / 2}}}
+    doc = {
+        "base": "ptfe-r05",
+        "set": {"time.t_end": 2e-6},
+        "parameters": {"layout.intruder_material": ["steel", "ptfe"]},
+        "objectives": {"granular_mass": "minimize"},
+        "constraints": {"granular_mass": {"min": (steel + ptfe) / 2}},
+    }
     opt = parse_optimization(doc)
     study = open_study(opt, tmp_path, seed=0)
     for material in ("steel", "ptfe"):
@@ -93,7 +102,8 @@ def test_infeasible_trial_is_left_off_the_front_and_reported(records, tmp_path):
 
     (tmp_path / "study.toml").write_text(
         'base = "ptfe-r05"\n[objectives]\n"granular_mass" = "minimize"\n'
-        f'[constraints]\n"granular_mass" = {{min = {(steel + ptfe) / 2!r}}}\n')
+        f'[constraints]\n"granular_mass" = {{min = {(steel + ptfe) / 2!r}}}\n'
+    )
     out = read_outcome(tmp_path)
     assert out.kind == "optimization" and [r.feasible for r in out.rows] == [True, False]
     # ... and its page: the front is the feasible trial, the other one marked infeasible
@@ -113,9 +123,12 @@ def test_trials_table_while_the_search_runs_counts_the_trials_left(records, tmp_
     from granplate.study.explorer import counts
     from granplate.study.outcome import read_outcome
 
-    doc = {"base": "ptfe-r05", "set": {"time.t_end": 2e-6},
-           "parameters": {"layout.intruder_material": ["steel", "ptfe"]},
-           "objectives": {"granular_mass": "minimize"}}
+    doc = {
+        "base": "ptfe-r05",
+        "set": {"time.t_end": 2e-6},
+        "parameters": {"layout.intruder_material": ["steel", "ptfe"]},
+        "objectives": {"granular_mass": "minimize"},
+    }
     opt = parse_optimization(doc)
     study = open_study(opt, tmp_path, seed=0)
     for material in ("steel", "ptfe"):
@@ -130,14 +143,17 @@ def test_trials_table_while_the_search_runs_counts_the_trials_left(records, tmp_
     assert (c["total"], c["done"], c["failed"], c["left"]) == (5, 2, 0, 3)
 
 
-@pytest.mark.parametrize("table, field, words", [
-    ({"mass": {"max": 1.0}}, "constraints.mass", "unknown metric"),
-    ({"granular_mass": {"maximum": 1.0}}, "constraints.granular_mass.maximum", "allowed: min, max"),
-    ({"granular_mass": {"min": 2.0, "max": 1.0}}, "constraints.granular_mass.max", "must be >= min"),
-    ({"granular_mass": {"max": "heavy"}}, "constraints.granular_mass.max", "finite number"),
-    ({"granular_mass": {}}, "constraints.granular_mass", "{max = b}"),
-    ([1.0], "constraints", "table"),
-])
+@pytest.mark.parametrize(
+    "table, field, words",
+    [
+        ({"mass": {"max": 1.0}}, "constraints.mass", "unknown metric"),
+        ({"granular_mass": {"maximum": 1.0}}, "constraints.granular_mass.maximum", "allowed: min, max"),
+        ({"granular_mass": {"min": 2.0, "max": 1.0}}, "constraints.granular_mass.max", "must be >= min"),
+        ({"granular_mass": {"max": "heavy"}}, "constraints.granular_mass.max", "finite number"),
+        ({"granular_mass": {}}, "constraints.granular_mass", "{max = b}"),
+        ([1.0], "constraints", "table"),
+    ],
+)
 def test_constraint_mistakes_name_the_field_and_what_is_allowed(table, field, words):
     with pytest.raises(ScenarioError) as err:
         parse_constraints(table, D.metric_units())
@@ -145,8 +161,12 @@ def test_constraint_mistakes_name_the_field_and_what_is_allowed(table, field, wo
 
 
 def test_optimize_refuses_a_bad_constraint_before_running():
-    doc = {"base": "ptfe-r05", "parameters": {"load.q0": [1e3, 2e3]},
-           "objectives": {"ep_max_fraction": "minimize"}, "constraints": {"granular_mass": {"max": -math.inf}}}
+    doc = {
+        "base": "ptfe-r05",
+        "parameters": {"load.q0": [1e3, 2e3]},
+        "objectives": {"ep_max_fraction": "minimize"},
+        "constraints": {"granular_mass": {"max": -math.inf}},
+    }
     with pytest.raises(ScenarioError) as err:
         parse_optimization(doc)
     assert err.value.field == "constraints.granular_mass.max"

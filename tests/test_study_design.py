@@ -1,6 +1,7 @@
 """A design's extra metrics: the protector's mass, and the nodal stress only for a run that
 keeps the plate fields at every output (else no value, never a maximum over a sparser
 sampling), equal then to the largest nodal von Mises of the stored displacements."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -26,8 +27,7 @@ def test_nodal_stress_only_with_fields_at_every_output(runs):
     assert m["units"]["max_von_mises_nodes"] == "Pa"
     assert D.metrics(sparse)["max_von_mises_nodes"] is None
     # the Gauss points of the same displacements give the simulator's own maximum
-    np.testing.assert_allclose(stress_series(every, "gauss").max(), float(every["max_von_mises"].max()),
-                               rtol=1e-9)
+    np.testing.assert_allclose(stress_series(every, "gauss").max(), float(every["max_von_mises"].max()), rtol=1e-9)
 
 
 def test_a_design_with_fields_at_every_output_gets_its_nodal_stress(runs):
@@ -43,7 +43,7 @@ def test_a_design_with_fields_at_every_output_gets_its_nodal_stress(runs):
 def test_mass_is_the_sum_of_the_granules_masses(runs):
     _, sparse = runs
     r1, rho = 0.01, 7850.0
-    assert D.metrics(sparse)["granular_mass"] == pytest.approx(14 * 4 / 3 * np.pi * r1 ** 3 * rho, rel=1e-12)
+    assert D.metrics(sparse)["granular_mass"] == pytest.approx(14 * 4 / 3 * np.pi * r1**3 * rho, rel=1e-12)
 
 
 def test_a_continuous_radius_is_valid_and_a_geometric_failure_names_the_granule_and_the_field():

@@ -3,6 +3,7 @@ file collapsed, plotly.js beside the page and no address off the machine, one da
 equal to the study's table, units and log axes as the study gives them, WebGL and a page
 under 20 MB for 10,000 designs, and the live page of a running sweep counting its
 designs done, failed and left (`--watch`)."""
+
 from __future__ import annotations
 
 import html
@@ -45,18 +46,36 @@ def synthetic_outcome(n: int, folder: Path, seed: int = 0) -> StudyOutcome:
         kind = ("hexagonal", "square")[i % 2]
         E = float(10 ** rng.uniform(8.5, 11.5))
         r = float(rng.uniform(0.005, 0.01))
-        metrics = {"ep_max_fraction": 0.1 + 0.3 * (r - 0.005) / 0.005 * (1.2 if kind == "square" else 1.0),
-                   "max_von_mises": 2e7 * (E / 1e10) ** 0.2 / (r / 0.005),
-                   "granular_mass": 0.08 + 4.0 * r + 0.01 * (kind == "square"),
-                   "dissipated_fraction": float(rng.uniform(0.2, 0.6))}
+        metrics = {
+            "ep_max_fraction": 0.1 + 0.3 * (r - 0.005) / 0.005 * (1.2 if kind == "square" else 1.0),
+            "max_von_mises": 2e7 * (E / 1e10) ** 0.2 / (r / 0.005),
+            "granular_mass": 0.08 + 4.0 * r + 0.01 * (kind == "square"),
+            "dissipated_fraction": float(rng.uniform(0.2, 0.6)),
+        }
         ok = i % 97 != 5
-        rows.append(Row(i, {"layout.kind": kind, "materials.steel.E": E, "layout.R1": r},
-                        metrics if ok else {}, "ok" if ok else "SimulationError: synthetic", f"{i:064x}",
-                        is_feasible(violations((bound,), metrics)) if ok else None))
-    return StudyOutcome(folder, "optimization", "two-layer-base.toml", {}, ("layout.kind", "materials.steel.E",
-                        "layout.R1"), rows, list(rows[0].metrics), D.metric_units(),
-                        objectives={"ep_max_fraction": "minimize", "max_von_mises": "minimize"},
-                        constraints=(bound,), log_parameters=frozenset({"materials.steel.E"}))
+        rows.append(
+            Row(
+                i,
+                {"layout.kind": kind, "materials.steel.E": E, "layout.R1": r},
+                metrics if ok else {},
+                "ok" if ok else "SimulationError: synthetic",
+                f"{i:064x}",
+                is_feasible(violations((bound,), metrics)) if ok else None,
+            )
+        )
+    return StudyOutcome(
+        folder,
+        "optimization",
+        "two-layer-base.toml",
+        {},
+        ("layout.kind", "materials.steel.E", "layout.R1"),
+        rows,
+        list(rows[0].metrics),
+        D.metric_units(),
+        objectives={"ep_max_fraction": "minimize", "max_von_mises": "minimize"},
+        constraints=(bound,),
+        log_parameters=frozenset({"materials.steel.E"}),
+    )
 
 
 @pytest.fixture(scope="module")
@@ -151,15 +170,17 @@ def test_log_parameters_are_on_log_axes(tmp_path):
     others are not."""
     out = synthetic_outcome(40, tmp_path)
     fig = X.metric_figure(out, "ep_max_fraction")
-    types = {fig["layout"][k]["title"]["text"]: fig["layout"][k].get("type") for k in fig["layout"]
-             if k.startswith("xaxis")}
+    types = {
+        fig["layout"][k]["title"]["text"]: fig["layout"][k].get("type") for k in fig["layout"] if k.startswith("xaxis")
+    }
     assert types == {"materials.steel.E [MPa]": "log", "layout.R1 [m]": None, "layout.kind": "category"}
     dims = {d["name"]: d for d in X.parcoords_figure(out)["data"][0]["dimensions"]}
     E = dims["materials.steel.E"]
     rows = X.parcoords_figure(out)["rows"]
-    np.testing.assert_allclose(E["values"], [np.log10(out.rows[i].params["materials.steel.E"] * 1e-6) for i in rows],
-                               rtol=1e-6)
-    assert [float(t) for t in E["ticktext"]] == pytest.approx([10 ** t for t in E["tickvals"]], rel=1e-2)
+    np.testing.assert_allclose(
+        E["values"], [np.log10(out.rows[i].params["materials.steel.E"] * 1e-6) for i in rows], rtol=1e-6
+    )
+    assert [float(t) for t in E["ticktext"]] == pytest.approx([10**t for t in E["tickvals"]], rel=1e-2)
     assert "tickvals" not in dims["layout.R1"]
     assert dims["granular_mass"]["label"] == "granular_mass [kg] in 0.1 .. 0.12"
 
@@ -177,20 +198,29 @@ def test_log_study_of_the_report_tests_draws_the_modulus_on_a_log_axis_in_mpa(tm
     for i, (E, q0) in enumerate(study.designs):
         text = gp.dumps(study.scenario(i))
         keys.append(D.design_key(text))
-        summary = {"ep_max_fraction": q0 / 1e5 * (E / 1e9) ** 0.3, "max_von_mises": 1e4 * q0,
-                   "units": D.metric_units()}
-        D.write_record(tmp_path, D.make_record(keys[-1], study.changes(i), text,
-                                               {"status": "ok", "summary": summary, "elapsed_s": 0.0}))
+        summary = {"ep_max_fraction": q0 / 1e5 * (E / 1e9) ** 0.3, "max_von_mises": 1e4 * q0, "units": D.metric_units()}
+        D.write_record(
+            tmp_path,
+            D.make_record(keys[-1], study.changes(i), text, {"status": "ok", "summary": summary, "elapsed_s": 0.0}),
+        )
     write_table(study, tmp_path, keys)
     (tmp_path / "study.toml").write_text(LOG_TOML)
-    figures = blob(X.explorer_html(read_outcome(tmp_path), X.explorer_data(read_outcome(tmp_path)),
-                                   X.explorer_figures(read_outcome(tmp_path)), []), "study-figures")
+    figures = blob(
+        X.explorer_html(
+            read_outcome(tmp_path),
+            X.explorer_data(read_outcome(tmp_path)),
+            X.explorer_figures(read_outcome(tmp_path)),
+            [],
+        ),
+        "study-figures",
+    )
     layout = figures["metric"]["layout"]
     axis = next(layout[k] for k in layout if k.startswith("xaxis") and "materials" in layout[k]["title"]["text"])
     assert axis["title"]["text"] == "materials.ptfe.E [MPa]" and axis["type"] == "log"
-    xs = sorted({x for t in figures["metric"]["data"] if t["xaxis"] == axis["anchor"].replace("y", "x")
-                 for x in t["x"]})
-    np.testing.assert_allclose(xs, [1e3, 1e3 * 10 ** 0.5, 1e4], rtol=1e-6)
+    xs = sorted(
+        {x for t in figures["metric"]["data"] if t["xaxis"] == axis["anchor"].replace("y", "x") for x in t["x"]}
+    )
+    np.testing.assert_allclose(xs, [1e3, 1e3 * 10**0.5, 1e4], rtol=1e-6)
 
 
 def test_pareto_view_has_every_feasible_design_and_the_front(tmp_path):
@@ -275,8 +305,10 @@ def test_watch_waits_for_an_optimisation_s_first_table_and_refuses_a_folder_with
     from granplate.errors import ScenarioError
     from granplate.study.watch import WAITING
 
-    (tmp_path / "study.toml").write_text('base = "ptfe-r05"\n[parameters]\n"load.q0" = {range = [1e3, 4e3]}\n'
-                                         '[objectives]\n"ep_max_fraction" = "minimize"\n')
+    (tmp_path / "study.toml").write_text(
+        'base = "ptfe-r05"\n[parameters]\n"load.q0" = {range = [1e3, 4e3]}\n'
+        '[objectives]\n"ep_max_fraction" = "minimize"\n'
+    )
     lines: list[str] = []
     assert watch(tmp_path, every=0.0, echo=lines.append, rounds=3)["total"] == 0
     assert lines == [WAITING] and not (tmp_path / PAGE).exists()

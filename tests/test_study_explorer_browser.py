@@ -4,6 +4,7 @@ points as feasible designs, a click shows that design's numbers, a filter change
 visible count, a screenshot is not blank; the worked studies' committed pages render their
 plots; a 10,000-design page opens in a few seconds. Where no browser can run, they skip
 and say why."""
+
 from __future__ import annotations
 
 import io
@@ -47,8 +48,10 @@ def opened(browser, small):
 def loaded(opened):
     """The small page as loaded: every filter off ('show all'), no panel, at its top."""
     driver, out = opened
-    driver.execute_script("document.getElementById('panel').hidden = true; window.scrollTo(0, 0);"
-                          "document.getElementById('reset').click();")
+    driver.execute_script(
+        "document.getElementById('panel').hidden = true; window.scrollTo(0, 0);"
+        "document.getElementById('reset').click();"
+    )
     all_shown = "return document.getElementById('shown').textContent.indexOf('%d of') === 0" % N_SMALL
     wait_for(driver, all_shown)
     return driver, out
@@ -79,8 +82,9 @@ def test_front_view_has_as_many_points_as_feasible_designs(loaded):
     completed design."""
     driver, out = loaded
     feasible = sum(1 for r in out.rows if r.ok and r.feasible)
-    n = driver.execute_script("return document.querySelectorAll('#fig-main .scatterlayer .trace')[0]"
-                              ".querySelectorAll('path.point').length")
+    n = driver.execute_script(
+        "return document.querySelectorAll('#fig-main .scatterlayer .trace')[0].querySelectorAll('path.point').length"
+    )
     assert n == feasible > 0
 
 
@@ -108,15 +112,17 @@ def test_hovering_and_clicking_a_design_shows_its_numbers(loaded):
     wait_for(driver, "return !document.getElementById('panel').hidden")
     title = driver.find_element("id", "panel-title")
     assert title.get_attribute("data-design") == str(out.rows[i].number)
-    values = {e.get_attribute("data-metric"): e.text
-              for e in driver.find_elements("css selector", "#panel .metric-value")}
+    values = {
+        e.get_attribute("data-metric"): e.text for e in driver.find_elements("css selector", "#panel .metric-value")
+    }
     assert values["ep_max_fraction"] == f"{out.rows[i].metrics['ep_max_fraction']:.4g}"
     assert values["max_von_mises"] == f"{out.rows[i].metrics['max_von_mises'] * 1e-6:.4g} MPa"
     driver.find_element("css selector", "#panel .close").click()
     assert not driver.find_element("id", "panel").is_displayed()
     # the table sorts by a metric's column: the least max_von_mises first, then the most
-    header = next(th for th in driver.find_elements("css selector", "#designs thead th")
-                  if th.text.startswith("max_von_mises"))
+    header = next(
+        th for th in driver.find_elements("css selector", "#designs thead th") if th.text.startswith("max_von_mises")
+    )
     column = int(header.get_attribute("data-col"))
     driver.execute_script("arguments[0].scrollIntoView({block: 'center'})", header)
     header.click()
@@ -144,14 +150,18 @@ def test_filters_change_the_visible_count(loaded):
     assert shown_count(driver) == feasible < N_SMALL
     assert len(driver.find_elements("css selector", "#designs tbody tr")) == feasible
     # the parallel coordinates show it: the lines filtered out are faint (colour 0.5)
-    faint = driver.execute_script("return document.getElementById('fig-parcoords').data[0].line.color"
-                                  ".filter(function (c) { return c === 0.5; }).length")
+    faint = driver.execute_script(
+        "return document.getElementById('fig-parcoords').data[0].line.color"
+        ".filter(function (c) { return c === 0.5; }).length"
+    )
     assert faint == sum(1 for r in out.rows if r.ok) - feasible
     # brush the radius axis (layout.R1, in m) to its lower half
-    driver.execute_script("var pc = document.getElementById('fig-parcoords');"
-                          "var k = pc.data[0].dimensions.findIndex(function (d) { return d.name === 'layout.R1'; });"
-                          "var u = {}; u['dimensions[' + k + '].constraintrange'] = [[0.004, 0.0075]];"
-                          "Plotly.restyle(pc, u);")
+    driver.execute_script(
+        "var pc = document.getElementById('fig-parcoords');"
+        "var k = pc.data[0].dimensions.findIndex(function (d) { return d.name === 'layout.R1'; });"
+        "var u = {}; u['dimensions[' + k + '].constraintrange'] = [[0.004, 0.0075]];"
+        "Plotly.restyle(pc, u);"
+    )
     both = sum(1 for r in out.rows if r.ok and r.feasible and r.params["layout.R1"] <= 0.0075)
     wait_for(driver, f"return document.getElementById('shown').textContent.indexOf('{both} of') === 0")
     assert shown_count(driver) == both < feasible
@@ -167,8 +177,9 @@ def test_a_box_drawn_on_the_front_filters_the_table(loaded):
     driver, _ = loaded
     drag = driver.find_element("css selector", "#fig-main .nsewdrag")
     w, h = drag.size["width"], drag.size["height"]
-    ActionChains(driver).move_to_element_with_offset(drag, -w // 2 + 5, -h // 2 + 5).click_and_hold() \
-        .move_by_offset(w // 3, h // 2).move_by_offset(w // 6, h // 2 - 10).release().perform()
+    ActionChains(driver).move_to_element_with_offset(drag, -w // 2 + 5, -h // 2 + 5).click_and_hold().move_by_offset(
+        w // 3, h // 2
+    ).move_by_offset(w // 6, h // 2 - 10).release().perform()
     wait_for(driver, f"return document.getElementById('shown').textContent.indexOf('{N_SMALL} of') !== 0")
     n = shown_count(driver)
     assert 0 < n < N_SMALL
@@ -206,15 +217,21 @@ def test_a_large_study_opens_in_a_few_seconds(browser, tmp_path):
     console_errors(browser)
     t0 = time.monotonic()
     open_page(browser, page, timeout=LARGE_LOAD_S)
-    wait_for(browser, "return document.querySelectorAll('#fig-main canvas').length > 0 && "
-                      "document.querySelectorAll('#designs tbody tr').length > 0", LARGE_LOAD_S)
+    wait_for(
+        browser,
+        "return document.querySelectorAll('#fig-main canvas').length > 0 && "
+        "document.querySelectorAll('#designs tbody tr').length > 0",
+        LARGE_LOAD_S,
+    )
     seconds = time.monotonic() - t0
     t1 = time.monotonic()
     browser.execute_script("document.getElementById('fig-parcoords').scrollIntoView()")
     wait_for(browser, "return document.querySelectorAll('#fig-parcoords canvas').length > 0", 4 * LARGE_LOAD_S)
     later = time.monotonic() - t1
-    print(f"10,000-design page: {page.stat().st_size / 1e6:.1f} MB, first screen in {seconds:.1f} s, "
-          f"parallel coordinates in {later:.1f} s more")
+    print(
+        f"10,000-design page: {page.stat().st_size / 1e6:.1f} MB, first screen in {seconds:.1f} s, "
+        f"parallel coordinates in {later:.1f} s more"
+    )
     assert seconds < LARGE_LOAD_S
     assert console_errors(browser) == []
 
@@ -225,21 +242,30 @@ def test_a_filter_blanks_the_heat_map_cells_of_the_designs_it_hides(browser):
     blank; 'show all' brings every cell back."""
     console_errors(browser)
     open_page(browser, STUDIES / "intruder-map" / "report.html")
-    wait_for(browser, "var d = document.getElementById('fig-heat'); return d.data && d.data.some("
-                      "function (t) { return t.type === 'heatmap'; }) && document.getElementById('fig-parcoords').data")
+    wait_for(
+        browser,
+        "var d = document.getElementById('fig-heat'); return d.data && d.data.some("
+        "function (t) { return t.type === 'heatmap'; }) && document.getElementById('fig-parcoords').data",
+    )
     total = shown_count(browser)
-    blank = ("var d = document.getElementById('fig-heat'); var n = 0; d.data.forEach(function (t) {"
-             " if (t.type !== 'heatmap') { return; } t.z.forEach(function (row, r) { row.forEach(function (v, c) {"
-             " if (v === null && t.customdata[r][c] >= 0) { n += 1; } }); }); }); return n;")
-    hidden_cells = ("var s = new Set(Array.from(document.querySelectorAll('#designs tbody tr')).map(function (tr) {"
-                    " return tr.getAttribute('data-i'); })); var d = document.getElementById('fig-heat'); var n = 0;"
-                    " d.data.forEach(function (t) { if (t.type !== 'heatmap') { return; } t.customdata.forEach("
-                    " function (row) { row.forEach(function (i) { if (i >= 0 && !s.has(String(i))) { n += 1; } }); }); });"
-                    " return n;")
+    blank = (
+        "var d = document.getElementById('fig-heat'); var n = 0; d.data.forEach(function (t) {"
+        " if (t.type !== 'heatmap') { return; } t.z.forEach(function (row, r) { row.forEach(function (v, c) {"
+        " if (v === null && t.customdata[r][c] >= 0) { n += 1; } }); }); }); return n;"
+    )
+    hidden_cells = (
+        "var s = new Set(Array.from(document.querySelectorAll('#designs tbody tr')).map(function (tr) {"
+        " return tr.getAttribute('data-i'); })); var d = document.getElementById('fig-heat'); var n = 0;"
+        " d.data.forEach(function (t) { if (t.type !== 'heatmap') { return; } t.customdata.forEach("
+        " function (row) { row.forEach(function (i) { if (i >= 0 && !s.has(String(i))) { n += 1; } }); }); });"
+        " return n;"
+    )
     assert browser.execute_script(blank) == 0
-    browser.execute_script("var pc = document.getElementById('fig-parcoords'); var v = pc.data[0].dimensions[0].values;"
-                           "var lo = Math.min.apply(null, v), hi = Math.max.apply(null, v);"
-                           "Plotly.restyle(pc, {'dimensions[0].constraintrange': [[lo, lo + 0.5 * (hi - lo)]]});")
+    browser.execute_script(
+        "var pc = document.getElementById('fig-parcoords'); var v = pc.data[0].dimensions[0].values;"
+        "var lo = Math.min.apply(null, v), hi = Math.max.apply(null, v);"
+        "Plotly.restyle(pc, {'dimensions[0].constraintrange': [[lo, lo + 0.5 * (hi - lo)]]});"
+    )
     wait_for(browser, f"return document.getElementById('shown').textContent.indexOf('{total} of') !== 0")
     n_blank = browser.execute_script(blank)
     assert n_blank > 0

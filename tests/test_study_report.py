@@ -3,6 +3,7 @@ of the parameters, its figures show exactly those values (one figure per varying
 units on every axis; the heat map of a 2-parameter grid cell by cell; the failures with
 their messages); built at the end of a tiny real sweep by the CLI; the [report] targets
 judge each combination of the choices by its own designs."""
+
 from __future__ import annotations
 
 import html
@@ -23,7 +24,7 @@ from granplate.study.spec import parse_study
 from granplate.study.sweep import write_table
 from granplate.study.targets import judge, parse_report_table
 
-STUDY_TOML = '''base = "ptfe-r05"
+STUDY_TOML = """base = "ptfe-r05"
 [set]
 "time.t_end" = 1e-6
 [parameters]
@@ -32,7 +33,7 @@ STUDY_TOML = '''base = "ptfe-r05"
 [objectives]
 "ep_max_fraction" = "minimize"
 "max_von_mises" = "minimize"
-'''
+"""
 #: The synthetic design that fails, and its message.
 FAILED = 4
 MESSAGE = "SimulationError: synthetic failure of design 4 at t = 1e-07 s"
@@ -40,8 +41,13 @@ MESSAGE = "SimulationError: synthetic failure of design 4 at t = 1e-07 s"
 
 def known_metrics(q0: float, r2: float) -> dict:
     """The synthetic metrics of a design: simple functions of its parameters."""
-    return {"ep_max_fraction": q0 / 1e4 * r2, "max_von_mises": 1e3 * q0 / r2,
-            "granular_mass": 0.1 + r2, "t_end": 1e-6, "n_steps": int(q0 / 100)}
+    return {
+        "ep_max_fraction": q0 / 1e4 * r2,
+        "max_von_mises": 1e3 * q0 / r2,
+        "granular_mass": 0.1 + r2,
+        "t_end": 1e-6,
+        "n_steps": int(q0 / 100),
+    }
 
 
 def synthetic(folder: Path):
@@ -55,8 +61,11 @@ def synthetic(folder: Path):
         key = D.design_key(text)
         keys.append(key)
         summary = {**known_metrics(q0, r2), "units": D.metric_units()}
-        outcome = {"status": MESSAGE if i == FAILED else "ok",
-                   "summary": None if i == FAILED else summary, "elapsed_s": 0.0}
+        outcome = {
+            "status": MESSAGE if i == FAILED else "ok",
+            "summary": None if i == FAILED else summary,
+            "elapsed_s": 0.0,
+        }
         D.write_record(folder, D.make_record(key, study.changes(i), text, outcome))
     write_table(study, folder, keys)
     (folder / "study.toml").write_text(STUDY_TOML)
@@ -95,9 +104,11 @@ def test_one_figure_per_varying_metric_with_its_unit(synthetic_report):
         assert [ax.get_xlabel() for ax in fig.axes] == ["load.q0 [N/m]", "layout.R2_ratio [-]"]
         # the points drawn are the metric's values (Pa in MPa), failed design left out
         drawn = np.concatenate([ln.get_ydata() for ln in fig.axes[0].get_lines()])
-        expected = [known_metrics(q0, r2)[metric] * (1e-6 if unit == "MPa" else 1)
-                    for i, (q0, r2) in enumerate(zip(out.values("load.q0"), out.values("layout.R2_ratio")))
-                    if i != FAILED]
+        expected = [
+            known_metrics(q0, r2)[metric] * (1e-6 if unit == "MPa" else 1)
+            for i, (q0, r2) in enumerate(zip(out.values("load.q0"), out.values("layout.R2_ratio")))
+            if i != FAILED
+        ]
         np.testing.assert_allclose(np.sort(drawn[np.isfinite(drawn)]), np.sort(expected), rtol=1e-12)
     # constant metrics are named, not drawn
     assert not (folder / FIGURES / "metric-t_end.png").exists()
@@ -126,8 +137,7 @@ def test_heat_maps_of_three_parameters_are_one_panel_per_value_of_the_third(tmp_
     for r in out.rows:  # a third parameter, crossing the grid: two copies of each design
         r.params["contact.mu"] = 0.1
     rows = list(out.rows)
-    out.rows = rows + [type(r)(r.number + 6, {**r.params, "contact.mu": 0.2}, r.metrics, r.status, r.key)
-                       for r in rows]
+    out.rows = rows + [type(r)(r.number + 6, {**r.params, "contact.mu": 0.2}, r.metrics, r.status, r.key) for r in rows]
     out.names = out.names + ("contact.mu",)
     fig = P.fig_heatmap(out, "max_von_mises")
     panels = [ax for ax in fig.axes if ax.images]
@@ -177,14 +187,15 @@ def test_pareto_front_is_the_undominated_designs(synthetic_report):
     # minimise (q0 R2 / 1e4, 1e3 q0 / R2): at fixed q0 the two trade off, so the front
     # is every design not beaten in both by another: checked by brute force
     pts = {i: (r.metrics["ep_max_fraction"], r.metrics["max_von_mises"]) for i, r in enumerate(out.rows) if r.ok}
-    brute = [i for i, p in pts.items()
-             if not any(q[0] <= p[0] and q[1] <= p[1] and q != p for q in pts.values())]
+    brute = [i for i, p in pts.items() if not any(q[0] <= p[0] and q[1] <= p[1] and q != p for q in pts.values())]
     assert pareto_front(out) == brute and brute
 
 
 def test_cli_writes_the_report_at_the_end_of_a_tiny_real_sweep(tmp_path, capsys):
-    (tmp_path / "s.toml").write_text('base = "ptfe-r05"\n[set]\n"time.t_end" = 2e-5\n'
-                                     '[parameters]\n"load.q0" = [-1.0, 2e4]\n"layout.R2_ratio" = [0.5, 1.0]\n')
+    (tmp_path / "s.toml").write_text(
+        'base = "ptfe-r05"\n[set]\n"time.t_end" = 2e-5\n'
+        '[parameters]\n"load.q0" = [-1.0, 2e4]\n"layout.R2_ratio" = [0.5, 1.0]\n'
+    )
     out = tmp_path / "out"
     assert main(["sweep", str(tmp_path / "s.toml"), "--out", str(out), "--workers", "1", "-q"]) == 1
     assert f"report: {out / PAGE}" in capsys.readouterr().out
@@ -198,8 +209,15 @@ def test_cli_writes_the_report_at_the_end_of_a_tiny_real_sweep(tmp_path, capsys)
     assert main(["study", "report", str(out), "-q"]) == 0
     assert (out / PAGE).read_text() == page
     # the sweep again: nothing to compute, no cluster, nothing redrawn
-    drawn = {p: p.stat().st_mtime_ns for p in [out / PAGE, out / "report.md", *(out / FIGURES).glob("*.p[nd][gf]"),
-                                               *(out / "report_assets").iterdir()]}
+    drawn = {
+        p: p.stat().st_mtime_ns
+        for p in [
+            out / PAGE,
+            out / "report.md",
+            *(out / FIGURES).glob("*.p[nd][gf]"),
+            *(out / "report_assets").iterdir(),
+        ]
+    }
     assert main(["sweep", str(tmp_path / "s.toml"), "--out", str(out), "--workers", "1", "-q"]) == 1
     assert "computed: 0," in capsys.readouterr().out
     assert {p: p.stat().st_mtime_ns for p in drawn} == drawn
@@ -250,20 +268,34 @@ def test_report_of_a_folder_without_a_study_is_a_clear_error(tmp_path, capsys):
 
 # ------------------------------------------------------------------------- targets
 
+
 def test_targets_judge_each_combination_of_the_choices():
-    table = parse_report_table({"conclusion": " In words. ", "targets": [
-        {"label": "stress", "metric": ["max_von_mises", "max_von_mises_nodes"], "value": 10.0,
-         "within": 0.1, "where": {"case": "steel"}},
-        {"label": "share", "metric": "ep_max_fraction", "value": 1.0, "within": 0.5,
-         "where": {"case": "ptfe"}}]}, ("mesh", "case"))
+    table = parse_report_table(
+        {
+            "conclusion": " In words. ",
+            "targets": [
+                {
+                    "label": "stress",
+                    "metric": ["max_von_mises", "max_von_mises_nodes"],
+                    "value": 10.0,
+                    "within": 0.1,
+                    "where": {"case": "steel"},
+                },
+                {"label": "share", "metric": "ep_max_fraction", "value": 1.0, "within": 0.5, "where": {"case": "ptfe"}},
+            ],
+        },
+        ("mesh", "case"),
+    )
     targets = table.targets
     assert table.conclusion == "In words."
     assert targets[0].metrics == ("max_von_mises", "max_von_mises_nodes") and targets[1].within == 0.5
     designs = [{"mesh": m, "case": c} for m in (40, 80) for c in ("steel", "ptfe")]
-    values = [{"max_von_mises": 8.0, "max_von_mises_nodes": 10.5},   # mesh 40 steel: nodes hold
-              {"ep_max_fraction": 1.4},                              # mesh 40 ptfe: holds
-              {"max_von_mises": 8.5, "max_von_mises_nodes": 7.0},    # mesh 80 steel: neither
-              {"ep_max_fraction": 1.6}]                              # mesh 80 ptfe: no
+    values = [
+        {"max_von_mises": 8.0, "max_von_mises_nodes": 10.5},  # mesh 40 steel: nodes hold
+        {"ep_max_fraction": 1.4},  # mesh 40 ptfe: holds
+        {"max_von_mises": 8.5, "max_von_mises_nodes": 7.0},  # mesh 80 steel: neither
+        {"ep_max_fraction": 1.6},
+    ]  # mesh 80 ptfe: no
     rows = judge(targets, ("mesh", "case"), designs, values)
     assert [params for params, _ in rows] == [{"mesh": 40}, {"mesh": 80}]
     (_, (s40, p40)), (_, (s80, p80)) = rows
@@ -276,13 +308,18 @@ def test_targets_judge_each_combination_of_the_choices():
     assert [p for p, _ in judge(targets, ("mesh", "case", "ratio"), zipped, values)] == [{"mesh": 40}, {"mesh": 80}]
 
 
-@pytest.mark.parametrize("table, field", [
-    ({"targets": [{"metric": "nope", "value": 1.0}]}, "report.targets[0].metric"),
-    ({"targets": [{"metric": "ep_max_fraction", "value": 0.0}]}, "report.targets[0].value"),
-    ({"targets": [{"metric": "ep_max_fraction", "value": 0.1, "where": {"x.y": 1}}]},
-     "report.targets[0].where.x.y"),
-    ({"conclusions": "typo"}, "report.conclusions"),
-])
+@pytest.mark.parametrize(
+    "table, field",
+    [
+        ({"targets": [{"metric": "nope", "value": 1.0}]}, "report.targets[0].metric"),
+        ({"targets": [{"metric": "ep_max_fraction", "value": 0.0}]}, "report.targets[0].value"),
+        (
+            {"targets": [{"metric": "ep_max_fraction", "value": 0.1, "where": {"x.y": 1}}]},
+            "report.targets[0].where.x.y",
+        ),
+        ({"conclusions": "typo"}, "report.conclusions"),
+    ],
+)
 def test_report_table_mistakes_name_the_field(table, field):
     with pytest.raises(ScenarioError) as err:
         parse_report_table(table, ("load.q0",))
@@ -292,9 +329,11 @@ def test_report_table_mistakes_name_the_field(table, field):
 def test_page_judges_the_targets_and_draws_the_designs_that_meet_them(tmp_path):
     synthetic(tmp_path)
     # ep_max_fraction = q0 / 1e4 x R2 is 0.1 only for (q0 2000, R2 0.5): design 2
-    (tmp_path / "study.toml").write_text(STUDY_TOML + '[report]\nconclusion = "Only one."\n'
-                                         '[[report.targets]]\nmetric = "ep_max_fraction"\nvalue = 0.1\n'
-                                         'within = 0.01\nwhere = {"layout.R2_ratio" = 0.5}\n')
+    (tmp_path / "study.toml").write_text(
+        STUDY_TOML + '[report]\nconclusion = "Only one."\n'
+        '[[report.targets]]\nmetric = "ep_max_fraction"\nvalue = 0.1\n'
+        'within = 0.01\nwhere = {"layout.R2_ratio" = 0.5}\n'
+    )
     out = read_outcome(tmp_path)
     assert target_designs(out) == [2]
     page = write_report(tmp_path).read_text()
@@ -303,13 +342,13 @@ def test_page_judges_the_targets_and_draws_the_designs_that_meet_them(tmp_path):
     assert '"why":"meets the targets' in page
 
 
-LOG_TOML = '''base = "ptfe-r05"
+LOG_TOML = """base = "ptfe-r05"
 [set]
 "time.t_end" = 1e-6
 [parameters]
 "materials.ptfe.E" = {range = [1e9, 1e10], num = 3, log = true}
 "load.q0" = [1000.0, 2000.0, 4000.0]
-'''
+"""
 
 
 @pytest.fixture(scope="module")
@@ -324,10 +363,11 @@ def log_study(tmp_path_factory):
     for i, (E, q0) in enumerate(study.designs):
         text = gp.dumps(study.scenario(i))
         keys.append(D.design_key(text))
-        summary = {"ep_max_fraction": q0 / 1e5 * (E / 1e9) ** 0.3, "max_von_mises": 1e4 * q0,
-                   "units": D.metric_units()}
-        D.write_record(folder, D.make_record(keys[-1], study.changes(i), text,
-                                             {"status": "ok", "summary": summary, "elapsed_s": 0.0}))
+        summary = {"ep_max_fraction": q0 / 1e5 * (E / 1e9) ** 0.3, "max_von_mises": 1e4 * q0, "units": D.metric_units()}
+        D.write_record(
+            folder,
+            D.make_record(keys[-1], study.changes(i), text, {"status": "ok", "summary": summary, "elapsed_s": 0.0}),
+        )
     write_table(study, folder, keys)
     (folder / "study.toml").write_text(LOG_TOML)
     return read_outcome(folder)
@@ -337,7 +377,7 @@ def test_axis_labels_name_the_unit_of_the_values_drawn(log_study):
     """An axis labelled [MPa] carries values in MPa: the modulus 1e9..1e10 Pa is drawn at
     1e3..1e4 on the metric figure's x axis and in the heat map's tick labels."""
     out = log_study
-    E_mpa = [1e3, 1e3 * 10 ** 0.5, 1e4]
+    E_mpa = [1e3, 1e3 * 10**0.5, 1e4]
     fig = P.fig_metric(out, "ep_max_fraction")
     ax = next(a for a in fig.axes if a.get_xlabel().startswith("materials.ptfe.E"))
     assert ax.get_xlabel() == "materials.ptfe.E [MPa]"
@@ -347,8 +387,11 @@ def test_axis_labels_name_the_unit_of_the_values_drawn(log_study):
     assert lo < E_mpa[0] and E_mpa[-1] < hi < 1e5
     heat = P.fig_heatmap(out, "max_von_mises")
     panel = heat.axes[0]
-    axis, ticks = ((panel.get_xlabel(), panel.get_xticklabels()) if panel.get_xlabel().startswith("materials")
-                   else (panel.get_ylabel(), panel.get_yticklabels()))
+    axis, ticks = (
+        (panel.get_xlabel(), panel.get_xticklabels())
+        if panel.get_xlabel().startswith("materials")
+        else (panel.get_ylabel(), panel.get_yticklabels())
+    )
     assert axis == "materials.ptfe.E [MPa]"
     np.testing.assert_allclose([float(t.get_text()) for t in ticks], E_mpa, rtol=1e-3)
     cells = sorted(float(t.get_text()) for t in panel.texts if t.get_gid() == "cell-max_von_mises")
@@ -393,5 +436,9 @@ def test_field_units_are_the_scenario_docs_units():
     assert len(checked) >= 35
     for key in checked:
         assert documented[key] == {FIELD_UNITS[key]}, key
-    assert (field_unit("plate.size[2]"), field_unit("plate.elements[0]"), field_unit("layout.layers[1].radius"),
-            field_unit("layout.layers[0].count")) == ("m", "1", "m", "1")
+    assert (
+        field_unit("plate.size[2]"),
+        field_unit("plate.elements[0]"),
+        field_unit("layout.layers[1].radius"),
+        field_unit("layout.layers[0].count"),
+    ) == ("m", "1", "m", "1")

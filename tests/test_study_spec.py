@@ -1,6 +1,7 @@
 """Study files expand to the designs they describe (each parameter form, checked against
 hand-written or scipy-computed values) and refuse mistakes before anything runs, naming
 the field and what is allowed."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -43,8 +44,7 @@ def test_documented_study_files_are_the_ones_shown_and_valid(name):
     else:
         from granplate.study.optimize import load_optimization
 
-        assert list(load_optimization(DOCS / "studies" / name).objectives) == ["ep_max_fraction",
-                                                                              "granular_mass"]
+        assert list(load_optimization(DOCS / "studies" / name).objectives) == ["ep_max_fraction", "granular_mass"]
 
 
 def test_range_linear_and_log():
@@ -58,19 +58,28 @@ def test_range_linear_and_log():
 
 
 def test_zip_varies_together_and_multiplies_the_grid():
-    s = study(parameters={"load.q0": [1e3, 2e3]},
-              zip={"layout.R2_ratio": [0.5, 1.0, 0.75], "contact.mu": [0.1, 0.2, 0.3]})
+    s = study(
+        parameters={"load.q0": [1e3, 2e3]}, zip={"layout.R2_ratio": [0.5, 1.0, 0.75], "contact.mu": [0.1, 0.2, 0.3]}
+    )
     assert s.names == ("load.q0", "layout.R2_ratio", "contact.mu")
-    assert s.designs == ((1e3, 0.5, 0.1), (1e3, 1.0, 0.2), (1e3, 0.75, 0.3),
-                         (2e3, 0.5, 0.1), (2e3, 1.0, 0.2), (2e3, 0.75, 0.3))
+    assert s.designs == (
+        (1e3, 0.5, 0.1),
+        (1e3, 1.0, 0.2),
+        (1e3, 0.75, 0.3),
+        (2e3, 0.5, 0.1),
+        (2e3, 1.0, 0.2),
+        (2e3, 0.75, 0.3),
+    )
 
 
 def test_latin_hypercube_is_seeded_and_stratified():
     form = {"sample": "latin_hypercube", "n": 8, "seed": 3}
-    s = study(parameters={"load.q0": {**form, "low": 1e3, "high": 9e3},
-                          "contact.mu": {**form, "low": 0.0, "high": 0.4}})
-    again = study(parameters={"load.q0": {**form, "low": 1e3, "high": 9e3},
-                              "contact.mu": {**form, "low": 0.0, "high": 0.4}})
+    s = study(
+        parameters={"load.q0": {**form, "low": 1e3, "high": 9e3}, "contact.mu": {**form, "low": 0.0, "high": 0.4}}
+    )
+    again = study(
+        parameters={"load.q0": {**form, "low": 1e3, "high": 9e3}, "contact.mu": {**form, "low": 0.0, "high": 0.4}}
+    )
     assert s.designs == again.designs and len(s.designs) == 8
     from scipy.stats import qmc
 
@@ -84,10 +93,9 @@ def test_latin_hypercube_is_seeded_and_stratified():
 
 
 def test_uniform_sample_and_log_bounds():
-    s = study(parameters={"load.q0": {"sample": "uniform", "n": 5, "seed": 0, "low": 1e2,
-                                      "high": 1e4, "log": True}})
+    s = study(parameters={"load.q0": {"sample": "uniform", "n": 5, "seed": 0, "low": 1e2, "high": 1e4, "log": True}})
     u = np.random.default_rng(0).random((5, 1))[:, 0]
-    assert np.allclose([d[0] for d in s.designs], 1e2 * 100.0 ** u, rtol=1e-12, atol=0)
+    assert np.allclose([d[0] for d in s.designs], 1e2 * 100.0**u, rtol=1e-12, atol=0)
 
 
 def test_relative_base_file_is_found_beside_the_study(tmp_path):
@@ -97,30 +105,57 @@ def test_relative_base_file_is_found_beside_the_study(tmp_path):
     assert s.base.load.q0 == 123.0 and s.scenario(0).contact.mu == 0.1
 
 
-@pytest.mark.parametrize("doc, field, words", [
-    ({"base": "nope"}, "base", "no such preset or scenario file"),
-    ({"base": 3}, "base", "preset name or a scenario file"),
-    ({"parameters": {"load.q0": []}}, "parameters.load.q0", "empty list"),
-    ({"parameters": {"load.qq": [1.0]}}, "load.qq", "unknown field 'load.qq'"),
-    ({"parameters": {"load.q0": ["a"]}}, "load.q0", "expected a number"),
-    ({"zip": {"load.q0": [1.0, 2.0], "contact.mu": [0.1]}}, "zip", "same length"),
-    ({"parameters": {"load.q0": {"range": [1.0], "num": 3}}}, "parameters.load.q0.range", "two numbers"),
-    ({"parameters": {"load.q0": {"range": [1.0, 2.0], "num": 0}}}, "parameters.load.q0.num", ">= 1"),
-    ({"parameters": {"load.q0": {"range": [0.0, 2.0], "num": 2, "log": True}}}, "parameters.load.q0.range", "a > 0"),
-    ({"parameters": {"load.q0": {"range": [1.0, 2.0], "nun": 2}}}, "parameters.load.q0.nun", "allowed: range, num, log"),
-    ({"parameters": {"load.q0": {"sample": "sobol", "low": 0, "high": 1, "n": 2, "seed": 0}}},
-     "parameters.load.q0.sample", "uniform, latin_hypercube"),
-    ({"parameters": {"load.q0": {"sample": "uniform", "low": 0, "high": 1, "n": 2}}},
-     "parameters.load.q0.seed", "integer >= 0"),
-    ({"parameters": {"load.q0": {"sample": "uniform", "low": 2, "high": 1, "n": 2, "seed": 0}}},
-     "parameters.load.q0.high", "must be > low"),
-    ({"parameters": {"load.q0": {"sample": "uniform", "low": 0, "high": 1, "n": 2, "seed": 0},
-                     "contact.mu": {"sample": "uniform", "low": 0, "high": 1, "n": 3, "seed": 0}}},
-     "parameters.contact.mu", "drawn together"),
-    ({"set": {"time.t_end": 2e-5}, "parameters": {"time.t_end": [1e-5]}}, "time.t_end", "either fixed"),
-    ({"set": {"load.nope": 1.0}}, "set: load.nope", "unknown field"),
-    ({"sets": {}}, "sets", "allowed: base, set, parameters, zip"),
-])
+@pytest.mark.parametrize(
+    "doc, field, words",
+    [
+        ({"base": "nope"}, "base", "no such preset or scenario file"),
+        ({"base": 3}, "base", "preset name or a scenario file"),
+        ({"parameters": {"load.q0": []}}, "parameters.load.q0", "empty list"),
+        ({"parameters": {"load.qq": [1.0]}}, "load.qq", "unknown field 'load.qq'"),
+        ({"parameters": {"load.q0": ["a"]}}, "load.q0", "expected a number"),
+        ({"zip": {"load.q0": [1.0, 2.0], "contact.mu": [0.1]}}, "zip", "same length"),
+        ({"parameters": {"load.q0": {"range": [1.0], "num": 3}}}, "parameters.load.q0.range", "two numbers"),
+        ({"parameters": {"load.q0": {"range": [1.0, 2.0], "num": 0}}}, "parameters.load.q0.num", ">= 1"),
+        (
+            {"parameters": {"load.q0": {"range": [0.0, 2.0], "num": 2, "log": True}}},
+            "parameters.load.q0.range",
+            "a > 0",
+        ),
+        (
+            {"parameters": {"load.q0": {"range": [1.0, 2.0], "nun": 2}}},
+            "parameters.load.q0.nun",
+            "allowed: range, num, log",
+        ),
+        (
+            {"parameters": {"load.q0": {"sample": "sobol", "low": 0, "high": 1, "n": 2, "seed": 0}}},
+            "parameters.load.q0.sample",
+            "uniform, latin_hypercube",
+        ),
+        (
+            {"parameters": {"load.q0": {"sample": "uniform", "low": 0, "high": 1, "n": 2}}},
+            "parameters.load.q0.seed",
+            "integer >= 0",
+        ),
+        (
+            {"parameters": {"load.q0": {"sample": "uniform", "low": 2, "high": 1, "n": 2, "seed": 0}}},
+            "parameters.load.q0.high",
+            "must be > low",
+        ),
+        (
+            {
+                "parameters": {
+                    "load.q0": {"sample": "uniform", "low": 0, "high": 1, "n": 2, "seed": 0},
+                    "contact.mu": {"sample": "uniform", "low": 0, "high": 1, "n": 3, "seed": 0},
+                }
+            },
+            "parameters.contact.mu",
+            "drawn together",
+        ),
+        ({"set": {"time.t_end": 2e-5}, "parameters": {"time.t_end": [1e-5]}}, "time.t_end", "either fixed"),
+        ({"set": {"load.nope": 1.0}}, "set: load.nope", "unknown field"),
+        ({"sets": {}}, "sets", "allowed: base, set, parameters, zip"),
+    ],
+)
 def test_validation_names_the_field(doc, field, words):
     with pytest.raises(ScenarioError) as err:
         parse_study({"base": "ptfe-r05", **doc})
@@ -138,34 +173,53 @@ def test_study_file_errors(tmp_path):
 
 # ------------------------------------------------------------------------- optimize
 
+
 def test_optimize_search_space():
     from optuna.distributions import CategoricalDistribution, FloatDistribution, IntDistribution
 
     from granplate.study.optimize import parse_optimization
 
-    opt = parse_optimization({**BASE, "parameters": {
-        "load.q0": {"range": [1e3, 5e4], "log": True}, "plate.ny": {"range": [20, 40]},
-        "contact.mu": [0.05, 0.2]}, "objectives": {"ep_max_fraction": "minimize",
-                                                   "granular_mass": "minimize"}})
+    opt = parse_optimization(
+        {
+            **BASE,
+            "parameters": {
+                "load.q0": {"range": [1e3, 5e4], "log": True},
+                "plate.ny": {"range": [20, 40]},
+                "contact.mu": [0.05, 0.2],
+            },
+            "objectives": {"ep_max_fraction": "minimize", "granular_mass": "minimize"},
+        }
+    )
     assert opt.space["load.q0"] == FloatDistribution(1e3, 5e4, log=True)
     assert opt.space["plate.ny"] == IntDistribution(20, 40)
     assert opt.space["contact.mu"] == CategoricalDistribution([0.05, 0.2])
     assert opt.scenario({"load.q0": 2e3}).load.q0 == 2e3 and opt.scenario({}).time.t_end == 2e-5
 
 
-@pytest.mark.parametrize("doc, field, words", [
-    ({"parameters": {"load.q0": [1.0]}}, "objectives", "at least one"),
-    ({"parameters": {"load.q0": [1.0]}, "objectives": {"nope": "minimize"}}, "objectives.nope",
-     "unknown metric"),
-    ({"parameters": {"load.q0": [1.0]}, "objectives": {"ep_max_fraction": "least"}},
-     "objectives.ep_max_fraction", "minimize, maximize"),
-    ({"parameters": {"load.q0": {"range": [1.0, 2.0], "num": 3}}, "objectives": {"e_in": "maximize"}},
-     "parameters.load.q0.num", "searched continuously"),
-    ({"parameters": {"load.q0": {"sample": "uniform"}}, "objectives": {"e_in": "maximize"}},
-     "parameters.load.q0", "categorical"),
-    ({"parameters": {"load.qq": [1.0]}, "objectives": {"e_in": "maximize"}}, "load.qq", "unknown field"),
-    ({"zip": {"load.q0": [1.0]}, "objectives": {"e_in": "maximize"}}, "zip", "allowed: base, set"),
-])
+@pytest.mark.parametrize(
+    "doc, field, words",
+    [
+        ({"parameters": {"load.q0": [1.0]}}, "objectives", "at least one"),
+        ({"parameters": {"load.q0": [1.0]}, "objectives": {"nope": "minimize"}}, "objectives.nope", "unknown metric"),
+        (
+            {"parameters": {"load.q0": [1.0]}, "objectives": {"ep_max_fraction": "least"}},
+            "objectives.ep_max_fraction",
+            "minimize, maximize",
+        ),
+        (
+            {"parameters": {"load.q0": {"range": [1.0, 2.0], "num": 3}}, "objectives": {"e_in": "maximize"}},
+            "parameters.load.q0.num",
+            "searched continuously",
+        ),
+        (
+            {"parameters": {"load.q0": {"sample": "uniform"}}, "objectives": {"e_in": "maximize"}},
+            "parameters.load.q0",
+            "categorical",
+        ),
+        ({"parameters": {"load.qq": [1.0]}, "objectives": {"e_in": "maximize"}}, "load.qq", "unknown field"),
+        ({"zip": {"load.q0": [1.0]}, "objectives": {"e_in": "maximize"}}, "zip", "allowed: base, set"),
+    ],
+)
 def test_optimize_validation_names_the_field(doc, field, words):
     from granplate.study.optimize import parse_optimization
 

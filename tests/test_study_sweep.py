@@ -2,6 +2,7 @@
 one by one (gp.simulate + gp.summary); an interrupted sweep resumes, computing only the
 missing designs, to the same table; a failing design is recorded with its message while
 the others complete; the CLI runs the documented smallest study through --scheduler."""
+
 from __future__ import annotations
 
 import json
@@ -22,9 +23,11 @@ from granplate.study.design import design_key, read_record
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 #: 10 loads x 5 friction coefficients = 50 designs of one plate, 2e-5 s each.
-STUDY = {"base": "ptfe-r05", "set": {"time.t_end": 2e-5},
-         "parameters": {"load.q0": {"range": [5e3, 5e4], "num": 10},
-                        "contact.mu": [0.05, 0.099, 0.2, 0.3, 0.4]}}
+STUDY = {
+    "base": "ptfe-r05",
+    "set": {"time.t_end": 2e-5},
+    "parameters": {"load.q0": {"range": [5e3, 5e4], "num": 10}, "contact.mu": [0.05, 0.099, 0.2, 0.3, 0.4]},
+}
 #: Summary entries that are not reproducible numbers of the design.
 NOT_COMPARED = ("wall_time_s", "compile_time_s", "scenario", "units", "contact_pairs")
 
@@ -33,8 +36,7 @@ NOT_COMPARED = ("wall_time_s", "compile_time_s", "scenario", "units", "contact_p
 def client():
     from distributed import Client, LocalCluster
 
-    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                           dashboard_address=None)
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
     with Client(cluster) as c:
         yield c
     cluster.close()
@@ -45,12 +47,19 @@ def one_by_one(texts: list[str], tmp_path: Path) -> list[dict]:
     one thread, as a Dask worker's does (a multi-threaded BLAS sums in another order: the
     stress may then differ in its last bit)."""
     (tmp_path / "designs.json").write_text(json.dumps(texts))
-    code = ("import json, sys, granplate as gp\n"
-            "texts = json.load(open(sys.argv[1]))\n"
-            "print(json.dumps([gp.summary(gp.simulate(gp.loads(t), progress=False)) for t in texts]))\n")
+    code = (
+        "import json, sys, granplate as gp\n"
+        "texts = json.load(open(sys.argv[1]))\n"
+        "print(json.dumps([gp.summary(gp.simulate(gp.loads(t), progress=False)) for t in texts]))\n"
+    )
     env = {**os.environ, **{k: "1" for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")}}
-    done = subprocess.run([sys.executable, "-c", code, str(tmp_path / "designs.json")], env=env,
-                          capture_output=True, text=True, check=True)
+    done = subprocess.run(
+        [sys.executable, "-c", code, str(tmp_path / "designs.json")],
+        env=env,
+        capture_output=True,
+        text=True,
+        check=True,
+    )
     return json.loads(done.stdout)
 
 
@@ -91,14 +100,13 @@ def test_sweep_equals_designs_run_one_by_one_and_resumes(client, tmp_path):
             if name in NOT_COMPARED:
                 continue
             got = resumed[name].values[i]
-            assert (np.isnan(got) if value is None else got == value), (i, name, got, value)
+            assert np.isnan(got) if value is None else got == value, (i, name, got, value)
     assert resumed["max_von_mises"].attrs["units"] == "Pa"
     assert resumed["load.q0"].attrs["units"] == "N/m"
 
 
 def test_failing_design_is_recorded_and_the_others_complete(client, tmp_path):
-    study = parse_study({"base": "ptfe-r05", "set": {"time.t_end": 1e-5},
-                         "parameters": {"load.q0": [1e4, -1.0, 2e4]}})
+    study = parse_study({"base": "ptfe-r05", "set": {"time.t_end": 1e-5}, "parameters": {"load.q0": [1e4, -1.0, 2e4]}})
     report = sweep(study, tmp_path, client=client, full=True, progress=False)
     assert (report.n_computed, report.n_failed) == (3, 1)
     ds = table(tmp_path / "results.nc")
@@ -121,8 +129,17 @@ def test_failing_design_is_recorded_and_the_others_complete(client, tmp_path):
 
 def test_cli_runs_the_smallest_study_on_an_existing_scheduler(client, tmp_path, capsys):
     out = tmp_path / "out"
-    rc = main(["sweep", str(DOCS / "studies" / "smallest.toml"), "--out", str(out),
-               "--scheduler", client.scheduler.address, "-q"])
+    rc = main(
+        [
+            "sweep",
+            str(DOCS / "studies" / "smallest.toml"),
+            "--out",
+            str(out),
+            "--scheduler",
+            client.scheduler.address,
+            "-q",
+        ]
+    )
     assert rc == 0
     ds = table(out / "results.nc")
     assert ds.sizes["design"] == 9 and list(ds.status.values) == ["ok"] * 9
@@ -140,9 +157,12 @@ def test_cli_refuses_a_bad_study_before_running(tmp_path, capsys):
 
 # ------------------------------------------------------------------------- optimize
 
-OPTIMIZE = {"base": "ptfe-r05", "set": {"time.t_end": 1e-5},
-            "parameters": {"load.q0": {"range": [1e3, 5e4], "log": True}, "contact.mu": [0.05, 0.2]},
-            "objectives": {"eg_max_fraction": "minimize", "dissipated_fraction": "maximize"}}
+OPTIMIZE = {
+    "base": "ptfe-r05",
+    "set": {"time.t_end": 1e-5},
+    "parameters": {"load.q0": {"range": [1e3, 5e4], "log": True}, "contact.mu": [0.05, 0.2]},
+    "objectives": {"eg_max_fraction": "minimize", "dissipated_fraction": "maximize"},
+}
 
 
 def dominated(a: list[float], b: list[float]) -> bool:
@@ -179,8 +199,11 @@ def test_optimize_resumes_from_its_database(client, tmp_path):
     # the Pareto front: no trial dominates a front member; every undominated trial is on it
     rows = list(csv.DictReader(open(tmp_path / "trials.csv")))
     front = {int(r["trial"]) for r in csv.DictReader(open(tmp_path / "pareto.csv"))}
-    points = {int(r["trial"]): [float(r["eg_max_fraction"]), float(r["dissipated_fraction"])]
-              for r in rows if r["state"] == "COMPLETE"}
+    points = {
+        int(r["trial"]): [float(r["eg_max_fraction"]), float(r["dissipated_fraction"])]
+        for r in rows
+        if r["state"] == "COMPLETE"
+    }
     undominated = {n for n, p in points.items() if not any(dominated(p, q) for q in points.values())}
     assert front == undominated and front
     assert (tmp_path / "pareto.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -192,13 +215,19 @@ def test_ctrl_c_keeps_finished_designs_and_a_rerun_computes_only_the_rest(client
     import time
 
     study = tmp_path / "s.toml"
-    study.write_text('base = "ptfe-r05"\n[set]\n"time.t_end" = 2e-4\n[parameters]\n'
-                     '"load.q0" = {range = [5e3, 5e4], num = 10}\n"contact.mu" = [0.05, 0.1, 0.2]\n')
+    study.write_text(
+        'base = "ptfe-r05"\n[set]\n"time.t_end" = 2e-4\n[parameters]\n'
+        '"load.q0" = {range = [5e3, 5e4], num = 10}\n"contact.mu" = [0.05, 0.1, 0.2]\n'
+    )
     out = tmp_path / "out"
-    p = subprocess.Popen([sys.executable, "-m", "granplate.cli", "sweep", str(study), "--out", str(out),
-                          "--workers", "2", "-q"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                         text=True, start_new_session=True,
-                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    p = subprocess.Popen(
+        [sys.executable, "-m", "granplate.cli", "sweep", str(study), "--out", str(out), "--workers", "2", "-q"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
     deadline = time.monotonic() + 120
     while len(list((out / "designs").glob("*.json"))) < 3 and time.monotonic() < deadline:
         time.sleep(0.05)
@@ -227,8 +256,9 @@ def test_a_killed_worker_loses_no_design(tmp_path):
 
     from granplate.results.engine import worker_pids
 
-    study = parse_study({"base": "ptfe-r05", "set": {"time.t_end": 1e-4},
-                         "parameters": {"load.q0": {"range": [1e4, 5e4], "num": 12}}})
+    study = parse_study(
+        {"base": "ptfe-r05", "set": {"time.t_end": 1e-4}, "parameters": {"load.q0": {"range": [1e4, 5e4], "num": 12}}}
+    )
     cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
     killed: list[int] = []
     with Client(cluster) as c:
@@ -250,8 +280,9 @@ def test_a_killed_worker_loses_no_design(tmp_path):
     cluster.close()
     assert killed and 1 <= killed[0] < 12, "the worker was not killed during the sweep"
     assert (report.n_computed, report.n_failed, report.lost) == (12, 0, [])
-    xr.testing.assert_identical(comparable(table(tmp_path / "a" / "results.nc")),
-                                comparable(table(tmp_path / "b" / "results.nc")))
+    xr.testing.assert_identical(
+        comparable(table(tmp_path / "a" / "results.nc")), comparable(table(tmp_path / "b" / "results.nc"))
+    )
     assert undisturbed.n_computed == 12
 
 
@@ -259,8 +290,18 @@ def cli_sweep(client, tmp_path: Path, capsys, parameter: str) -> tuple[int, list
     """`granplate sweep` (quiet, no report) of two 1e-5 s designs of ptfe-r05 varying one
     parameter (a TOML line of [parameters]) into tmp_path/o: (exit status, stderr lines)."""
     (tmp_path / "s.toml").write_text(f'base = "ptfe-r05"\n[set]\n"time.t_end" = 1e-5\n[parameters]\n{parameter}\n')
-    rc = main(["sweep", str(tmp_path / "s.toml"), "--out", str(tmp_path / "o"),
-               "--scheduler", client.scheduler.address, "-q", "--no-report"])
+    rc = main(
+        [
+            "sweep",
+            str(tmp_path / "s.toml"),
+            "--out",
+            str(tmp_path / "o"),
+            "--scheduler",
+            client.scheduler.address,
+            "-q",
+            "--no-report",
+        ]
+    )
     return rc, capsys.readouterr().err.strip().splitlines()
 
 
@@ -275,11 +316,24 @@ def test_cli_sweep_with_a_failing_design_exits_1_and_says_how_many(client, tmp_p
 def test_cli_optimize_with_failing_trials_exits_1_and_labels_its_bar(client, tmp_path, capsys):
     """Truth: every trial's design has a negative load, so both trials fail: optimize exits
     1, its last line says 2 of 2 trials failed, and its progress bar reads "optimize"."""
-    (tmp_path / "o.toml").write_text('base = "ptfe-r05"\n[set]\n"time.t_end" = 1e-5\n'
-                                     '[parameters]\n"load.q0" = [-1.0, -2.0]\n'
-                                     '[objectives]\n"ep_max_fraction" = "minimize"\n')
-    rc = main(["optimize", str(tmp_path / "o.toml"), "--out", str(tmp_path / "o"), "--trials", "2",
-               "--scheduler", client.scheduler.address, "--no-report"])
+    (tmp_path / "o.toml").write_text(
+        'base = "ptfe-r05"\n[set]\n"time.t_end" = 1e-5\n'
+        '[parameters]\n"load.q0" = [-1.0, -2.0]\n'
+        '[objectives]\n"ep_max_fraction" = "minimize"\n'
+    )
+    rc = main(
+        [
+            "optimize",
+            str(tmp_path / "o.toml"),
+            "--out",
+            str(tmp_path / "o"),
+            "--trials",
+            "2",
+            "--scheduler",
+            client.scheduler.address,
+            "--no-report",
+        ]
+    )
     err = capsys.readouterr().err
     assert rc == 1
     assert err.strip().splitlines()[-1] == "granplate: 2 of 2 trials of this run failed"
@@ -292,8 +346,10 @@ def test_cli_sweep_says_how_many_designs_warned_and_keeps_their_warnings(client,
     design's warning, its record lists it, and the other's record has none."""
     rc, err = cli_sweep(client, tmp_path, capsys, '"contact.overlap_warn" = [0.05, 1e-6]')
     assert rc == 0
-    assert err[-1].startswith("granplate: 1 of the 2 designs computed now warned (each record in designs/ "
-                              "lists its warnings); the first, design 1: RuntimeWarning: ptfe-r05: ")
+    assert err[-1].startswith(
+        "granplate: 1 of the 2 designs computed now warned (each record in designs/ "
+        "lists its warnings); the first, design 1: RuntimeWarning: ptfe-r05: "
+    )
     ds = table(tmp_path / "o" / "results.nc")
     records = [read_record(tmp_path / "o", k) for k in ds.key.values]
     assert records[0]["warnings"] == [] and len(records[1]["warnings"]) == 1

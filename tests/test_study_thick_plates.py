@@ -2,6 +2,7 @@
 committed: each table is of its study file and complete, the comparison on
 docs/studies.md is the script's output from the two tables, and the written conclusions
 quote only what the script computes. Nothing is run: the tables are read."""
+
 from __future__ import annotations
 
 import re
@@ -53,8 +54,10 @@ def test_the_in_plane_study_at_1_mm_is_the_3d_twin():
     for i, (material, h, _) in enumerate(study.designs):
         if h != 0.001:
             continue
-        twin = gp.with_changes(gp.preset("3d-steel-r05" if material == "steel" else "3d-ptfe-r05"),
-                               {"time.dt_max": 2e-7, "time.dt_initial": 2e-7, "plate.stress_radius": 0.0025})
+        twin = gp.with_changes(
+            gp.preset("3d-steel-r05" if material == "steel" else "3d-ptfe-r05"),
+            {"time.dt_max": 2e-7, "time.dt_initial": 2e-7, "plate.stress_radius": 0.0025},
+        )
         a, b = resolve(study.scenario(i)), resolve(twin)
         assert dataclasses.replace(a, name="", description="") == dataclasses.replace(b, name="", description="")
 
@@ -106,20 +109,26 @@ def test_protector_3d_conclusion_is_its_trials_table():
     feasible = done[done["feasible"] == "yes"]
     assert f"{len(t)} trials, {len(feasible)} feasible" in conclusion
     best = feasible.loc[feasible["ep_max_fraction"].idxmin()]
-    assert (best["layout.layers[0].count"], best["layout.layers[1].material"], best["layout.layers[2].count"],
-            best["layout.layers[2].material"]) == (1, "ptfe", 2, "aluminium")
+    assert (
+        best["layout.layers[0].count"],
+        best["layout.layers[1].material"],
+        best["layout.layers[2].count"],
+        best["layout.layers[2].material"],
+    ) == (1, "ptfe", 2, "aluminium")
     assert f"PTFE spheres of {1e3 * best['layout.layers[1].radius']:.2f} mm" in conclusion
     assert f"({best['granular_mass']:.3f} kg): {100 * best['ep_max_fraction']:.4f}%" in conclusion
     assert f"largest stress is {best['max_von_mises'] / 1e3:.0f} kPa" in conclusion
-    dominated = feasible[(feasible["ep_max_fraction"] >= best["ep_max_fraction"])
-                         & (feasible["max_von_mises"] >= best["max_von_mises"])]
+    dominated = feasible[
+        (feasible["ep_max_fraction"] >= best["ep_max_fraction"]) & (feasible["max_von_mises"] >= best["max_von_mises"])
+    ]
     assert len(dominated) == len(feasible)  # the front within the window is that one design
 
     def best_of(rows):
         return rows.loc[rows["ep_max_fraction"].idxmin()]
 
-    steel_back = best_of(feasible[(feasible["layout.layers[1].material"] == "ptfe")
-                                  & (feasible["layout.layers[2].material"] == "steel")])
+    steel_back = best_of(
+        feasible[(feasible["layout.layers[1].material"] == "ptfe") & (feasible["layout.layers[2].material"] == "steel")]
+    )
     assert f"{100 * steel_back['ep_max_fraction']:.4f}% ({steel_back['granular_mass']:.3f} kg)" in conclusion
     alu = best_of(feasible[feasible["layout.layers[1].material"] == "aluminium"])
     assert f"{100 * alu['ep_max_fraction']:.3f}% ({alu['granular_mass']:.3f} kg)" in conclusion

@@ -3,6 +3,7 @@ committed: each table is of its study file, the twin differs from the elastic ma
 normal law alone, the designs that never reach the yield onset are Hertz's in both, and
 the comparison and conclusion on the pages are what the committed tables give. Nothing is
 run: the tables are read."""
+
 from __future__ import annotations
 
 import csv
@@ -76,8 +77,14 @@ def test_contacts_below_the_yield_onset_are_hertz_in_both_tables():
     below = [i for i, r in enumerate(elastic) if float(r["yield_onset_ratio"]) <= 1.0]
     assert below  # the map has such designs (PTFE intruders at the weakest shock)
     for i in below:
-        for metric in ("ep_max_fraction", "eg_max_fraction", "dissipated_fraction", "max_von_mises",
-                       "max_contact_pressure", "n_steps"):
+        for metric in (
+            "ep_max_fraction",
+            "eg_max_fraction",
+            "dissipated_fraction",
+            "max_von_mises",
+            "max_contact_pressure",
+            "n_steps",
+        ):
             assert elastic[i][metric] == plastic[i][metric], (i, metric)
     for e, p in zip(elastic, plastic):
         assert float(e["plastic_fraction"]) == 0.0
@@ -135,8 +142,9 @@ def test_comparison_refuses_tables_of_other_designs(tmp_path):
         m.read_tables(tmp_path / "failed.csv", STUDIES / PLASTIC / "results.csv")
 
 
-@pytest.mark.parametrize("name", [ELASTIC, PLASTIC, "calibration", "two-layer", "thick-plates", "thick-plates-face",
-                                  "protector-3d"])
+@pytest.mark.parametrize(
+    "name", [ELASTIC, PLASTIC, "calibration", "two-layer", "thick-plates", "thick-plates-face", "protector-3d"]
+)
 def test_committed_page_is_that_of_its_committed_table(name):
     """Each worked study's committed report.html is the interactive page the code writes
     from the committed table and figures, and its report_assets/ are the package's own

@@ -1,6 +1,7 @@
 """The paper's presets in 3D (setup.presets.twin_3d): planar packings in space, the solid
 placed against them, rigid layers as translation-only strips, the line load in space, and
 the thin-limit agreement with the 2D presets."""
+
 import math
 
 import numpy as np

@@ -1,5 +1,6 @@
 """The verification suite (granplate.verification): every fast case passes against its
 independent reference, the page is written, `granplate verify` exits non-zero on failure."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -35,8 +36,7 @@ def test_fast_case(name, ctx):
         assert c.why and c.source, c
     failing = {(name, c.quantity) for c in result.checks if not c.passed}
     expected = {k for k in KNOWN_FAILURES if k[0] == name}
-    assert failing == expected, [(c.quantity, c.ours, c.reference, c.tolerance)
-                                 for c in result.checks if not c.passed]
+    assert failing == expected, [(c.quantity, c.ours, c.reference, c.tolerance) for c in result.checks if not c.passed]
 
 
 #: Quick cases whose checks are run without drawing (plate, contacts, conservation).
@@ -175,8 +175,10 @@ def test_long_runs_on_dask_are_kept_and_then_only_read(tmp_path, monkeypatch):
     monkeypatch.setattr(long_runs, "long_runs", lambda: runs)
     monkeypatch.setenv("GRANPLATE_CACHE", str(tmp_path / "store"))  # an empty run store (the workers inherit it)
     ctx = Context(out=tmp_path, full=True, run_cache={})
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
-            Client(cluster) as client:
+    with (
+        LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster,
+        Client(cluster) as client,
+    ):
         assert long_runs.compute_missing(ctx, client=client) == 2
         assert long_runs.compute_missing(ctx, client=client) == 0
     stored = json.loads((tmp_path / "validation-runs.json").read_text())
@@ -200,8 +202,9 @@ def test_observed_orders_and_richardson_recover_a_known_rate():
     orders = observed_orders(q)
     assert orders == pytest.approx([2.0, 2.0], rel=1e-9)
     assert richardson(q, orders[-1]) == pytest.approx(1.5, rel=1e-12)
-    table = convergence_table("q", [("q", "-", q, 1.0), ("wobbly", "-", [1.0, 0.9, 0.95, 0.94], 1.0)],
-                              ((1, 1), (2, 2), (4, 4), (8, 8)))
+    table = convergence_table(
+        "q", [("q", "-", q, 1.0), ("wobbly", "-", [1.0, 0.9, 0.95, 0.94], 1.0)], ((1, 1), (2, 2), (4, 4), (8, 8))
+    )
     assert "| q [-] | 1.8 | 1.575 | 1.51875 | 1.5046875 | p = 2.00, 2.00 | 1.5 |" in table
     assert "(not monotone) | - |" in table
 
@@ -209,12 +212,25 @@ def test_observed_orders_and_richardson_recover_a_known_rate():
 def _results() -> list[CaseResult]:
     """A passing case with long tolerance reasons and a failing one with a note and a table."""
     why = "a reason long enough to be collapsed on the page " * 20
-    good = CaseResult("good", "plate", "A good case", "Runs well.",
-                      [Check(f"x{i}", "m", 1.0, "closed form", 1.0, 1e-9, why) for i in range(3)],
-                      notes=["a short note"], seconds=1.5)
-    bad = CaseResult("bad", "granular", "A bad case", "Runs badly.",
-                     [Check("y", "-", 1.0, "theory", 2.0, 1e-3, "short"), Check("z", "-", 1.0, "theory", 1.0, 1e-3, "short")],
-                     notes=["why it fails " * 100], tables=["| h | v |\n|---|---|\n| 1 | 2 |"], seconds=20.0)
+    good = CaseResult(
+        "good",
+        "plate",
+        "A good case",
+        "Runs well.",
+        [Check(f"x{i}", "m", 1.0, "closed form", 1.0, 1e-9, why) for i in range(3)],
+        notes=["a short note"],
+        seconds=1.5,
+    )
+    bad = CaseResult(
+        "bad",
+        "granular",
+        "A bad case",
+        "Runs badly.",
+        [Check("y", "-", 1.0, "theory", 2.0, 1e-3, "short"), Check("z", "-", 1.0, "theory", 1.0, 1e-3, "short")],
+        notes=["why it fails " * 100],
+        tables=["| h | v |\n|---|---|\n| 1 | 2 |"],
+        seconds=20.0,
+    )
     return [good, bad]
 
 
@@ -226,17 +242,25 @@ def test_page_opens_on_the_counts_then_the_failures_then_the_cases():
 
     blocks = page.page_blocks(_results(), full=False, seconds=21.5, generated="Made for a test.")
     assert blocks[1].kind == "summary" and blocks[1].text == "2 cases, 5 checks: 1 of 5 checks fail, in 1 of 2 cases."
-    assert blocks[1].rows[:3] == (("1 / 2", "cases pass", "no"), ("4 / 5", "checks pass", "no"), ("1", "check fails", "no"))
+    assert blocks[1].rows[:3] == (
+        ("1 / 2", "cases pass", "no"),
+        ("4 / 5", "checks pass", "no"),
+        ("1", "check fails", "no"),
+    )
     h2 = [b.text for b in blocks if b.kind == "h2"]
     assert h2[:3] == ["Failures", "Cases", "Results"]
     tables = [b for b in blocks if b.kind == "table"]
     assert [r[1] for r in tables[0].rows] == ["y"] and len(tables[2].rows) == 5
-    assert tables[1].rows == (("[good](#good)", "A good case", "3", "0", "1.5", "pass"),
-                              ("[bad](#bad)", "A bad case", "2", "1", "20.0", "**FAIL**"))
+    assert tables[1].rows == (
+        ("[good](#good)", "A good case", "3", "0", "1.5", "pass"),
+        ("[bad](#bad)", "A bad case", "2", "1", "20.0", "**FAIL**"),
+    )
     collapsed = [b for b in blocks if b.kind == "details"]
     assert [b.text for b in collapsed] == ["Tolerances: the reason for each (3 checks)"]
     assert any(b.text == "Tolerances:" for b in blocks) and any(b.kind == "quote" for b in blocks)
-    assert any(b.kind == "quote" and b.text.startswith("why it fails") for b in blocks), "a failing case's notes stay open"
+    assert any(b.kind == "quote" and b.text.startswith("why it fails") for b in blocks), (
+        "a failing case's notes stay open"
+    )
 
 
 def test_render_only_rebuilds_the_pages_from_the_json(tmp_path, capsys):

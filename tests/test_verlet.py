@@ -1,6 +1,7 @@
 """The velocity-Verlet scheme of the granules (solver.scheme = "verlet", docs/model.md
 section 6.5): LAMMPS's algorithm to round-off, second order with damping and friction, its
 energy balance, the plastic law and the loop's guards under it, and its refusals."""
+
 from __future__ import annotations
 
 import dataclasses
@@ -21,8 +22,11 @@ needs_lammps = pytest.mark.skipif(bool(L.unavailable()), reason=L.unavailable() 
 
 def with_step(s: Scenario, scheme: str, dt: float) -> Scenario:
     """Scenario s with `scheme` at the fixed step dt [s]."""
-    return dataclasses.replace(s, solver=dataclasses.replace(s.solver, scheme=scheme),
-                               time=dataclasses.replace(s.time, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt)))
+    return dataclasses.replace(
+        s,
+        solver=dataclasses.replace(s.solver, scheme=scheme),
+        time=dataclasses.replace(s.time, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt)),
+    )
 
 
 def quiet_run(s: Scenario):
@@ -32,19 +36,35 @@ def quiet_run(s: Scenario):
         return simulate(s, progress=False)
 
 
-def oblique_pair(t_end: float = 2e-5, normal_law: str = "hertz", speed: float = 1.0, mu: float = 0.05,
-                 alpha_n: float = 0.05) -> Scenario:
+def oblique_pair(
+    t_end: float = 2e-5, normal_law: str = "hertz", speed: float = 1.0, mu: float = 0.05, alpha_n: float = 0.05
+) -> Scenario:
     """Two 1 mm steel spheres touching at t = 0, line of centres at 0.3 rad, meeting at
     ~1.25 speed [m/s] and sliding ~0.66 m/s, with spins; damped (alpha_n), friction mu."""
     d, phi = 2e-3, 0.3
-    gs = (Granule(x=0.0, y=0.0, radius=1e-3, material="steel", label="a", vx=0.5 * speed, vy=0.5 * speed,
-                  omega=300.0),
-          Granule(x=d * np.cos(phi), y=d * np.sin(phi), radius=1e-3, material="steel", label="b", vx=-0.5 * speed,
-                  vy=-0.5 * speed, omega=-100.0))
+    gs = (
+        Granule(x=0.0, y=0.0, radius=1e-3, material="steel", label="a", vx=0.5 * speed, vy=0.5 * speed, omega=300.0),
+        Granule(
+            x=d * np.cos(phi),
+            y=d * np.sin(phi),
+            radius=1e-3,
+            material="steel",
+            label="b",
+            vx=-0.5 * speed,
+            vy=-0.5 * speed,
+            omega=-100.0,
+        ),
+    )
     out = t_end / 4
-    return Scenario(name="oblique-pair", granules=gs, plate=None, load=Load(kind="none"),
-                    contact=Contact(mu=mu, alpha_n=alpha_n, pairs=(), normal_law=normal_law),
-                    time=TimeSettings(t_end=t_end, output_interval=out, field_interval=out), solver=Solver(energy_tol=1e-3))
+    return Scenario(
+        name="oblique-pair",
+        granules=gs,
+        plate=None,
+        load=Load(kind="none"),
+        contact=Contact(mu=mu, alpha_n=alpha_n, pairs=(), normal_law=normal_law),
+        time=TimeSettings(t_end=t_end, output_interval=out, field_interval=out),
+        solver=Solver(energy_tol=1e-3),
+    )
 
 
 def pressed_pair(t_end: float = 4e-6, mu: float = 0.05, count: int = 2) -> Scenario:
@@ -55,15 +75,29 @@ def pressed_pair(t_end: float = 4e-6, mu: float = 0.05, count: int = 2) -> Scena
     and loaded: the motion is smooth."""
     d, phi = 2e-3, 0.3
     nx, ny = np.cos(phi), np.sin(phi)
-    gs = tuple(Granule(x=k * d * nx, y=k * d * ny, radius=1e-3, material="steel", label="abc"[k],
-                       vx=-0.5 * sign * ny, vy=0.5 * sign * nx, omega=spin)
-               for k, sign, spin in ((0, 1.0, 300.0), (1, -1.0, -100.0), (2, 1.0, 50.0))[:count])
+    gs = tuple(
+        Granule(
+            x=k * d * nx,
+            y=k * d * ny,
+            radius=1e-3,
+            material="steel",
+            label="abc"[k],
+            vx=-0.5 * sign * ny,
+            vy=0.5 * sign * nx,
+            omega=spin,
+        )
+        for k, sign, spin in ((0, 1.0, 300.0), (1, -1.0, -100.0), (2, 1.0, 50.0))[:count]
+    )
     out = t_end / 4
-    return Scenario(name="pressed-pair", granules=gs, plate=None,
-                    load=Load(kind="line", target="granules", q0=2e4, duration=1e-5, length=0.1, y0=-0.05,
-                              granules=("a",)),
-                    contact=Contact(mu=mu, alpha_n=0.05, pairs=()),
-                    time=TimeSettings(t_end=t_end, output_interval=out, field_interval=out), solver=Solver(energy_tol=1e-3))
+    return Scenario(
+        name="pressed-pair",
+        granules=gs,
+        plate=None,
+        load=Load(kind="line", target="granules", q0=2e4, duration=1e-5, length=0.1, y0=-0.05, granules=("a",)),
+        contact=Contact(mu=mu, alpha_n=0.05, pairs=()),
+        time=TimeSettings(t_end=t_end, output_interval=out, field_interval=out),
+        solver=Solver(energy_tol=1e-3),
+    )
 
 
 def final_state(ds) -> np.ndarray:
@@ -75,12 +109,20 @@ def final_state(ds) -> np.ndarray:
 def small_packing(mu: float, t_end: float = 2e-5) -> Scenario:
     """A 6 x 8 hexagonal packing between walls, damped (the default alpha_n), friction mu,
     its first column launched at 1 m/s."""
-    s = resolve(Scenario(name="small-packing", layout=LatticeLayout(kind="hexagonal", columns=6, rows=8, radius=1e-3),
-                         load=Load(kind="none"), contact=Contact(mu=mu),
-                         time=TimeSettings(t_end=t_end, output_interval=t_end / 5, field_interval=t_end / 5)))
+    s = resolve(
+        Scenario(
+            name="small-packing",
+            layout=LatticeLayout(kind="hexagonal", columns=6, rows=8, radius=1e-3),
+            load=Load(kind="none"),
+            contact=Contact(mu=mu),
+            time=TimeSettings(t_end=t_end, output_interval=t_end / 5, field_interval=t_end / 5),
+        )
+    )
     left = min(g.x - g.radius for g in s.granules)
-    return dataclasses.replace(s, granules=tuple(
-        dataclasses.replace(g, vx=1.0) if abs(g.x - g.radius - left) < 1e-9 else g for g in s.granules))
+    return dataclasses.replace(
+        s,
+        granules=tuple(dataclasses.replace(g, vx=1.0) if abs(g.x - g.radius - left) < 1e-9 else g for g in s.granules),
+    )
 
 
 @needs_lammps
@@ -122,8 +164,10 @@ def test_second_order_with_damping_and_friction(count):
     s = pressed_pair(count=count)
     ref = quiet_run(with_step(s, "paper", 2.5e-9))
     assert float(ref.D_friction.values[-1]) > 0.0 and float(ref.D_viscous.values[-1]) > 0.0
-    errors = [np.abs(final_state(quiet_run(with_step(s, "verlet", dt))) - final_state(ref)).max()
-              for dt in (1e-7, 5e-8, 2.5e-8)]
+    errors = [
+        np.abs(final_state(quiet_run(with_step(s, "verlet", dt))) - final_state(ref)).max()
+        for dt in (1e-7, 5e-8, 2.5e-8)
+    ]
     assert errors[0] > 1e-5  # a step that the motion resolves, not round-off
     assert np.log2(np.array(errors[:-1]) / np.array(errors[1:])) == pytest.approx([2.0, 2.0], abs=0.1)
 

@@ -12,6 +12,7 @@ Generated before the sources are read (``builder-inited``), into docs/reference/
 - ``dataset-variables.md``: the result Dataset's variables, from
   ``granplate.results.dataset.VARIABLES``, and the summary's units, from ``SUMMARY_UNITS``.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -74,29 +75,72 @@ def _tables() -> list[tuple[str, str, type, str, Any, str]]:
     ex = DOCS / "examples"
     resolved = resolve(steel)
     twin = gp.preset("3d-steel-r1")
-    patched = gp.with_changes(twin, {"plate.rigid_layers": False, "plate.rigid_patches": [
-        {"centre": [0.0305, 0.05, 0.0], "radius": 0.003, "axis": [0.0, 0.0, 1.0], "rotates": False}]})
+    patched = gp.with_changes(
+        twin,
+        {
+            "plate.rigid_layers": False,
+            "plate.rigid_patches": [
+                {"centre": [0.0305, 0.05, 0.0], "radius": 0.003, "axis": [0.0, 0.0, 1.0], "rotates": False}
+            ],
+        },
+    )
     return [
         ("Top level", "top-level", S.Scenario, "", steel, "the preset steel-r1"),
         ("[materials.NAME]", "materials", Material, "materials.steel", steel, "steel-r1's steel"),
         ('[layout] kind = "paper"', "layout-paper", S.Layout, "layout", steel, "steel-r1"),
-        ('[layout] kind = "hexagonal" or "square"', "layout-lattice", S.LatticeLayout, "layout",
-         gp.load_scenario(ex / "hexagonal.toml"), "docs/examples/hexagonal.toml"),
-        ('[layout] kind = "chain"', "layout-chain", S.ChainLayout, "layout",
-         gp.load_scenario(ex / "chain.toml"), "docs/examples/chain.toml"),
-        ('[layout] kind = "sc", "bcc", "fcc" or "hcp" (3D)', "layout-space", S.SpaceLattice, "layout",
-         gp.load_scenario(ex / "3d-fcc.toml"), "docs/examples/3d-fcc.toml"),
-        ("[[layout.layers]] (3D lattices)", "layout-layers", S.Layer, "layout.layers[0]",
-         gp.load_scenario(ex / "3d-fcc.toml"), "docs/examples/3d-fcc.toml"),
-        ("[layout.imperfections]", "imperfections", S.Imperfections, "layout.imperfections",
-         gp.load_scenario(ex / "imperfect.toml"), "docs/examples/imperfect.toml"),
+        (
+            '[layout] kind = "hexagonal" or "square"',
+            "layout-lattice",
+            S.LatticeLayout,
+            "layout",
+            gp.load_scenario(ex / "hexagonal.toml"),
+            "docs/examples/hexagonal.toml",
+        ),
+        (
+            '[layout] kind = "chain"',
+            "layout-chain",
+            S.ChainLayout,
+            "layout",
+            gp.load_scenario(ex / "chain.toml"),
+            "docs/examples/chain.toml",
+        ),
+        (
+            '[layout] kind = "sc", "bcc", "fcc" or "hcp" (3D)',
+            "layout-space",
+            S.SpaceLattice,
+            "layout",
+            gp.load_scenario(ex / "3d-fcc.toml"),
+            "docs/examples/3d-fcc.toml",
+        ),
+        (
+            "[[layout.layers]] (3D lattices)",
+            "layout-layers",
+            S.Layer,
+            "layout.layers[0]",
+            gp.load_scenario(ex / "3d-fcc.toml"),
+            "docs/examples/3d-fcc.toml",
+        ),
+        (
+            "[layout.imperfections]",
+            "imperfections",
+            S.Imperfections,
+            "layout.imperfections",
+            gp.load_scenario(ex / "imperfect.toml"),
+            "docs/examples/imperfect.toml",
+        ),
         ("[[granules]]", "granules", S.Granule, "granules[0]", resolved, "steel-r1 written out"),
         ("[[walls]]", "walls", S.Wall, "walls[0]", resolved, "steel-r1 written out"),
         ("[box] (3D)", "box", S.Box, "box", gp.loads(BOX_BASE), "two spheres in a box"),
         ("[plate] (2D): the plate", "plate", S.Plate, "plate", steel, "steel-r1"),
         ("[plate] (3D): the elastic solid", "solid", S.Solid, "plate", twin, "the preset 3d-steel-r1"),
-        ("[[plate.rigid_patches]] (3D)", "rigid-patches", S.RigidPatch, "plate.rigid_patches[0]",
-         patched, "3d-steel-r1 with one rigid strip"),
+        (
+            "[[plate.rigid_patches]] (3D)",
+            "rigid-patches",
+            S.RigidPatch,
+            "plate.rigid_patches[0]",
+            patched,
+            "3d-steel-r1 with one rigid strip",
+        ),
         ("[load]", "load", S.Load, "load", steel, "steel-r1"),
         ("[contact]", "contact", S.Contact, "contact", steel, "steel-r1"),
         ("[[contact.pairs]]", "contact-pairs", S.PairCoefficients, "contact.pairs[0]", steel, "steel-r1"),
@@ -179,13 +223,18 @@ def markdown_text(doc: str) -> str:
     """A docstring's plain text as Markdown paragraphs: backslashes and stars (E*, R*)
     escaped outside backticks, so that nothing turns into emphasis."""
     parts = re.split(r"(`[^`]*`)", doc)
-    return "".join(s if i % 2 else s.replace("\\", "\\\\").replace("*", "\\*").replace("<", "&lt;")
-                   for i, s in enumerate(parts))
+    return "".join(
+        s if i % 2 else s.replace("\\", "\\\\").replace("*", "\\*").replace("<", "&lt;") for i, s in enumerate(parts)
+    )
 
 
 def _title(title: str) -> str:
     """A table's title with its TOML name as code: '[load]' -> '`[load]`'."""
-    return re.sub(r"(\[+[^\]]+\]+(?: kind = [^(]+)?)", lambda m: f"`{m.group(1).strip()}` ", title).replace("  ", " ").strip()
+    return (
+        re.sub(r"(\[+[^\]]+\]+(?: kind = [^(]+)?)", lambda m: f"`{m.group(1).strip()}` ", title)
+        .replace("  ", " ")
+        .strip()
+    )
 
 
 def _cell(text: str) -> str:
@@ -197,7 +246,8 @@ def scenario_fields_page() -> str:
     from granplate.study.table import field_unit
 
     out = [
-        "# Scenario keys (generated)", "",
+        "# Scenario keys (generated)",
+        "",
         "Every table and key of a scenario file, generated when the site is built from the code",
         "that reads it: names, types and defaults from the dataclasses of",
         "`granplate.setup.scenario`, units from `granplate.study.table.FIELD_UNITS`, and in the",
@@ -213,13 +263,27 @@ def scenario_fields_page() -> str:
         doc = inspect.cleandoc(cls.__doc__ or "")
         if doc:
             out += [markdown_text(doc), ""]
-        out += [f"Refusals probed on {what}.", "",
-                "| key | type | unit | default | refused when |", "| --- | --- | --- | --- | --- |"]
+        out += [
+            f"Refusals probed on {what}.",
+            "",
+            "| key | type | unit | default | refused when |",
+            "| --- | --- | --- | --- | --- |",
+        ]
         for f in dataclasses.fields(cls):
             if (cls.__name__, f.name) == ("Material", "name"):  # the table's name, not a key
                 continue
-            if cls.__name__ == "Scenario" and f.name in ("materials", "layout", "granules", "walls", "plate",
-                                                         "load", "contact", "time", "solver", "box"):
+            if cls.__name__ == "Scenario" and f.name in (
+                "materials",
+                "layout",
+                "granules",
+                "walls",
+                "plate",
+                "load",
+                "contact",
+                "time",
+                "solver",
+                "box",
+            ):
                 continue
             if f.name == "pairs" or (f.name == "layers" and cls.__name__ == "SpaceLattice"):
                 refused = []
@@ -228,8 +292,10 @@ def scenario_fields_page() -> str:
                 refused = refusals(base, path, probes(f.type))
             unit = field_unit(f.name) or ""
             unit = "-" if unit == "1" else unit
-            out.append(f"| `{f.name}` | {toml_type(f.type)} | {unit} | {_cell(default_text(f))} | "
-                       f"{_cell('; '.join(refused))} |")
+            out.append(
+                f"| `{f.name}` | {toml_type(f.type)} | {unit} | {_cell(default_text(f))} | "
+                f"{_cell('; '.join(refused))} |"
+            )
         out.append("")
     return "\n".join(out)
 
@@ -239,39 +305,58 @@ def dataset_variables_page() -> str:
     from granplate.results.dataset import SUMMARY_UNITS, VARIABLES
 
     out = [
-        "# Result variables (generated)", "",
+        "# Result variables (generated)",
+        "",
         "The data variables a run's Dataset (`granplate.simulate`, `granplate run -o FILE.nc`)",
         "can hold, with their units and descriptions, generated from",
         "`granplate.results.dataset.VARIABLES` (the table that writes the `units` and",
         "`description` attributes of the Dataset itself). A run holds the ones its scenario",
         "has (the plate's only with a plate, z, vz and the spin vector only in 3D); the",
         "coordinates, the attributes and how to read each are in",
-        "[Result dataset](../../output.md).", "",
-        "| variable | unit | description |", "| --- | --- | --- |",
+        "[Result dataset](../../output.md).",
+        "",
+        "| variable | unit | description |",
+        "| --- | --- | --- |",
     ]
     out += [f"| `{k}` | {_cell(u) or '-'} | {_cell(d)} |" for k, (u, d) in VARIABLES.items()]
-    out += ["", "## The summary's numbers", "",
-            "`granplate.summary(ds)` (and `granplate run --summary FILE.json`) gives these numbers;",
-            "their units, from `granplate.results.dataset.SUMMARY_UNITS`, travel in",
-            "`summary[\"units\"]`.", "", "| key | unit |", "| --- | --- |"]
+    out += [
+        "",
+        "## The summary's numbers",
+        "",
+        "`granplate.summary(ds)` (and `granplate run --summary FILE.json`) gives these numbers;",
+        "their units, from `granplate.results.dataset.SUMMARY_UNITS`, travel in",
+        '`summary["units"]`.',
+        "",
+        "| key | unit |",
+        "| --- | --- |",
+    ]
     out += [f"| `{k}` | {_cell(str(u))} |" for k, u in SUMMARY_UNITS.items()]
     return "\n".join(out) + "\n"
 
 
 #: the figures of docs/figures/: file -> (what it shows, the scenario and command that made it)
 FIGURES: dict[str, tuple[str, str]] = {
-    "fig3.png": ("Paper Fig. 3: the largest von Mises stress without and with granules, and the "
-                 "energies normalised by E_shock",
-                 "the presets `bare-plate` and `steel-r1` (2 ms), drawn by `granplate reproduce --out results`"),
-    "fig6.png": ("Paper Fig. 6: horizontal velocity maps, steel against PTFE intruders",
-                 "the presets `steel-r05` and `ptfe-r05` (2 ms), `granplate plot results --figure 6`"),
-    "show-steel-r1.png": ("An assembly before a run: the paper's steel packing, granules by material, walls, "
-                          "the plate and its rigid layers, the load", "`granplate show steel-r1 --dpi 80`"),
-    "show-steel-r1-result.png": ("A result: the contact forces and the deformed plate at the largest plate energy",
-                                 "`granplate run steel-r1` (2 ms), then `granplate show steel-r1.nc --dpi 80`"),
-    "show-box-3d.png": ("A run in space: three depth-shaded projections, walls and contact forces",
-                        "four spheres in a box (`BOX` of tests/test_figures_3d.py), "
-                        "`granplate show box-3d.nc --time 3e-5 --dpi 80`"),
+    "fig3.png": (
+        "Paper Fig. 3: the largest von Mises stress without and with granules, and the energies normalised by E_shock",
+        "the presets `bare-plate` and `steel-r1` (2 ms), drawn by `granplate reproduce --out results`",
+    ),
+    "fig6.png": (
+        "Paper Fig. 6: horizontal velocity maps, steel against PTFE intruders",
+        "the presets `steel-r05` and `ptfe-r05` (2 ms), `granplate plot results --figure 6`",
+    ),
+    "show-steel-r1.png": (
+        "An assembly before a run: the paper's steel packing, granules by material, walls, "
+        "the plate and its rigid layers, the load",
+        "`granplate show steel-r1 --dpi 80`",
+    ),
+    "show-steel-r1-result.png": (
+        "A result: the contact forces and the deformed plate at the largest plate energy",
+        "`granplate run steel-r1` (2 ms), then `granplate show steel-r1.nc --dpi 80`",
+    ),
+    "show-box-3d.png": (
+        "A run in space: three depth-shaded projections, walls and contact forces",
+        "four spheres in a box (`BOX` of tests/test_figures_3d.py), `granplate show box-3d.nc --time 3e-5 --dpi 80`",
+    ),
 }
 
 
@@ -280,26 +365,41 @@ def gallery_page(docs: Path = DOCS) -> str:
     with the scenario (or verification case) that made it."""
     import json
 
-    out = ["# Gallery", "",
-           "Every figure shipped with the documentation, with the scenario and command that",
-           "made it. The verification figures are drawn by `granplate verify` from the numbers",
-           "of each case; their cases, references and tolerances are in",
-           "[Verification and validation](../../validation.md).", "", "## Runs and assemblies", ""]
+    out = [
+        "# Gallery",
+        "",
+        "Every figure shipped with the documentation, with the scenario and command that",
+        "made it. The verification figures are drawn by `granplate verify` from the numbers",
+        "of each case; their cases, references and tolerances are in",
+        "[Verification and validation](../../validation.md).",
+        "",
+        "## Runs and assemblies",
+        "",
+    ]
     for name in sorted(p.name for p in (docs / "figures").glob("*.png")):
         what, made = FIGURES.get(name, ("", ""))
         head, _, rest = (what or name).partition(": ")
-        out += [f"### {head}", "", f"![{what or name}](../../figures/{name})", "",
-                f"{rest[:1].upper() + rest[1:]}." if rest else "", f"Made by {made}." if made else "", ""]
-    cases = {c["figure"]: c for c in json.loads((docs / "validation.json").read_text())["cases"]
-             if c.get("figure")}
+        out += [
+            f"### {head}",
+            "",
+            f"![{what or name}](../../figures/{name})",
+            "",
+            f"{rest[:1].upper() + rest[1:]}." if rest else "",
+            f"Made by {made}." if made else "",
+            "",
+        ]
+    cases = {c["figure"]: c for c in json.loads((docs / "validation.json").read_text())["cases"] if c.get("figure")}
     out += ["## Verification cases", ""]
     for name in sorted(p.name for p in (docs / "validation-figures").glob("*.png")):
         case = cases.get(name)
         title = case["title"] if case else name
         out += [f"### {title}", "", f"![{title}](../../validation-figures/{name})", ""]
         if case:
-            out += [f"The verification case `{case['name']}` (`granplate verify --case {case['name']}`), "
-                    f"{'passing' if case.get('passed') else 'failing'}.", ""]
+            out += [
+                f"The verification case `{case['name']}` (`granplate verify --case {case['name']}`), "
+                f"{'passing' if case.get('passed') else 'failing'}.",
+                "",
+            ]
     return "\n".join(out) + "\n"
 
 
@@ -411,8 +511,7 @@ def plain_docstring(app, what, name, obj, options, lines: list[str]) -> None:
             if line.endswith("::"):
                 line = line[:-1]
         parts = CODE.split(line)
-        lines[k] = "".join(p if i % 2 else p.replace("|", "\\|").replace("*", "\\*")
-                           for i, p in enumerate(parts))
+        lines[k] = "".join(p if i % 2 else p.replace("|", "\\|").replace("*", "\\*") for i, p in enumerate(parts))
 
 
 def setup(app):

@@ -8,6 +8,7 @@ docs/studies/intruder-map-plastic/results.csv): the comparison of docs/studies.m
 Nothing is run: the numbers are the tables'. Fractions are of the shock's work e_in
 (docs/output.md), shown in percent; stresses in MPa.
 """
+
 from __future__ import annotations
 
 import sys
@@ -87,26 +88,31 @@ def facts(t: pd.DataFrame) -> list[str]:
     loads = sorted(t["load.q0"].unique())
     passed = t[t["yield_onset_ratio_e"] > 1.0]
     below = t[t["yield_onset_ratio_e"] <= 1.0]
-    same = all((below[f"{m}_e"] == below[f"{m}_p"]).all()
-               for m in ("ep_max_fraction", "max_von_mises", "dissipated_fraction", "n_steps"))
+    same = all(
+        (below[f"{m}_e"] == below[f"{m}_p"]).all()
+        for m in ("ep_max_fraction", "max_von_mises", "dissipated_fraction", "n_steps")
+    )
     below_names = sorted(below["layout.R2_ratio"].unique())
     kept_peak = (passed["ep_max_fraction_p"] / passed["ep_max_fraction_e"] - 1.0).abs() < 1e-3
-    out.append(f"**Yield in the elastic map.** {len(passed)} of its {len(t)} designs press some "
-               f"contact past the yield onset p0 = 1.6 Y (`yield_onset_ratio` "
-               f"{span(t['yield_onset_ratio_e'], ratio)}); the {len(below)} that do not "
-               f"({'/'.join(sorted(below['layout.intruder_material'].unique()))} intruders of R2/R1 = "
-               f"{', '.join(f'{r:.2f}' for r in below_names)} at "
-               f"{', '.join(f'{q * 1e-3:g}' for q in sorted(below['load.q0'].unique()))} kN/m) are "
-               f"{'the same, to the last digit,' if same else 'not the same'} in the twin: Thornton's "
-               f"law is Hertz's below p_y. Of the {len(passed)} that yield, {int(kept_peak.sum())} keep their "
-               f"plate's peak share within 0.1%: they yield after that peak.")
+    out.append(
+        f"**Yield in the elastic map.** {len(passed)} of its {len(t)} designs press some "
+        f"contact past the yield onset p0 = 1.6 Y (`yield_onset_ratio` "
+        f"{span(t['yield_onset_ratio_e'], ratio)}); the {len(below)} that do not "
+        f"({'/'.join(sorted(below['layout.intruder_material'].unique()))} intruders of R2/R1 = "
+        f"{', '.join(f'{r:.2f}' for r in below_names)} at "
+        f"{', '.join(f'{q * 1e-3:g}' for q in sorted(below['load.q0'].unique()))} kN/m) are "
+        f"{'the same, to the last digit,' if same else 'not the same'} in the twin: Thornton's "
+        f"law is Hertz's below p_y. Of the {len(passed)} that yield, {int(kept_peak.sum())} keep their "
+        f"plate's peak share within 0.1%: they yield after that peak."
+    )
     top = t[t["load.q0"] == loads[-1]]
-    per_load = ", ".join(f"{span(t.loc[t['load.q0'] == q, 'plastic_fraction_p'])} at {q * 1e-3:g} kN/m"
-                         for q in loads)
-    out.append(f"**Plastic work.** The share of the shock's work spent yielding contacts "
-               f"(`plastic_fraction`) is {per_load}. At {loads[-1] * 1e-3:g} kN/m the dissipated share "
-               f"(`dissipated_fraction`, plastic work included) is {span(top['dissipated_fraction_p'])}, "
-               f"against {span(top['dissipated_fraction_e'])} with elastic contacts.")
+    per_load = ", ".join(f"{span(t.loc[t['load.q0'] == q, 'plastic_fraction_p'])} at {q * 1e-3:g} kN/m" for q in loads)
+    out.append(
+        f"**Plastic work.** The share of the shock's work spent yielding contacts "
+        f"(`plastic_fraction`) is {per_load}. At {loads[-1] * 1e-3:g} kN/m the dissipated share "
+        f"(`dissipated_fraction`, plastic work included) is {span(top['dissipated_fraction_p'])}, "
+        f"against {span(top['dissipated_fraction_e'])} with elastic contacts."
+    )
     columns = t.sort_values("load.q0").groupby(["layout.R2_ratio", "layout.intruder_material"])
     first, last = columns.first(), columns.last()
     grows_e = last["ep_max_fraction_e"] > first["ep_max_fraction_e"]
@@ -114,17 +120,19 @@ def facts(t: pd.DataFrame) -> list[str]:
     is_ptfe = first.index.get_level_values("layout.intruder_material") == "ptfe"
     big = first.index.get_level_values("layout.R2_ratio") > SMALLEST
     top_heavy = top[top["layout.intruder_material"] != "ptfe"]
-    out.append(f"**The share against the shock.** Elastic, the plate's peak "
-               f"share is larger at {loads[-1] * 1e-3:g} than at {loads[0] * 1e-3:g} kN/m for "
-               f"{int(grows_e.sum())} of the {len(grows_e)} radius-material combinations of the map; "
-               f"yielding, it is smaller for {int(falls_p[~(is_ptfe & big)].sum())} of the "
-               f"{int((~(is_ptfe & big)).sum())} with steel or aluminium intruders or the smallest ones "
-               f"(R2/R1 = {SMALLEST:.2f}), and still larger for {int((~falls_p[is_ptfe & big]).sum())} of "
-               f"the {int((is_ptfe & big).sum())} with larger PTFE intruders. "
-               f"At {loads[-1] * 1e-3:g} kN/m steel and aluminium intruders pass "
-               f"{span(top_heavy['ep_max_fraction_p'])} instead of {span(top_heavy['ep_max_fraction_e'])}, "
-               f"the plate's largest stress {span(top_heavy['max_von_mises_p'], mpa)} instead of "
-               f"{span(top_heavy['max_von_mises_e'], mpa)}.")
+    out.append(
+        f"**The share against the shock.** Elastic, the plate's peak "
+        f"share is larger at {loads[-1] * 1e-3:g} than at {loads[0] * 1e-3:g} kN/m for "
+        f"{int(grows_e.sum())} of the {len(grows_e)} radius-material combinations of the map; "
+        f"yielding, it is smaller for {int(falls_p[~(is_ptfe & big)].sum())} of the "
+        f"{int((~(is_ptfe & big)).sum())} with steel or aluminium intruders or the smallest ones "
+        f"(R2/R1 = {SMALLEST:.2f}), and still larger for {int((~falls_p[is_ptfe & big]).sum())} of "
+        f"the {int((is_ptfe & big).sum())} with larger PTFE intruders. "
+        f"At {loads[-1] * 1e-3:g} kN/m steel and aluminium intruders pass "
+        f"{span(top_heavy['ep_max_fraction_p'])} instead of {span(top_heavy['ep_max_fraction_e'])}, "
+        f"the plate's largest stress {span(top_heavy['max_von_mises_p'], mpa)} instead of "
+        f"{span(top_heavy['max_von_mises_e'], mpa)}."
+    )
     ptfe = t[(t["layout.intruder_material"] == "ptfe") & (t["layout.R2_ratio"] > SMALLEST)]
     steel = t[t["layout.intruder_material"] == "steel"]
     paired = ptfe.merge(steel, on=["layout.R2_ratio", "load.q0"], suffixes=("", "_steel"))
@@ -132,31 +140,40 @@ def facts(t: pd.DataFrame) -> list[str]:
     to_steel_e = paired["ep_max_fraction_e"] / paired["ep_max_fraction_e_steel"]
     to_steel_p = paired["ep_max_fraction_p"] / paired["ep_max_fraction_p_steel"]
     lighter = t[t["layout.R2_ratio"] > SMALLEST]
-    least = all(g.loc[g["layout.intruder_material"] == "ptfe", "ep_max_fraction_p"].iloc[0]
-                < g.loc[g["layout.intruder_material"] != "ptfe", "ep_max_fraction_p"].min()
-                for _, g in lighter.groupby(["layout.R2_ratio", "load.q0"]))
+    least = all(
+        g.loc[g["layout.intruder_material"] == "ptfe", "ep_max_fraction_p"].iloc[0]
+        < g.loc[g["layout.intruder_material"] != "ptfe", "ep_max_fraction_p"].min()
+        for _, g in lighter.groupby(["layout.R2_ratio", "load.q0"])
+    )
     narrows = bool((to_steel_p > to_steel_e).all())
     small = t[t["layout.R2_ratio"] == SMALLEST]
-    out.append(f"**The PTFE intruders' localisation {'survives' if least else 'does not always survive'}** "
-               f"where the elastic map has it: from "
-               f"R2/R1 = {ptfe['layout.R2_ratio'].min():.2f} up, PTFE intruders "
-               f"{'pass less than steel and aluminium ones at every radius and load' if least else 'do not always pass the least'}, "
-               f"{span(ptfe['ep_max_fraction_p'])} of the shock (elastic: {span(ptfe['ep_max_fraction_e'])}). "
-               f"The heavy intruders' plastic work {'narrows' if narrows else 'does not always narrow'} the gap: "
-               f"at {loads[-1] * 1e-3:g} kN/m PTFE intruders pass {span(to_steel_p, ratio)} times the share of "
-               f"steel ones of the same radius (elastic: {span(to_steel_e, ratio)}). At R2/R1 = {SMALLEST:.2f} "
-               f"there is none to keep: {span(small['ep_max_fraction_p'])} whatever the material and load "
-               f"(elastic: {span(small['ep_max_fraction_e'])}).")
+    out.append(
+        f"**The PTFE intruders' localisation {'survives' if least else 'does not always survive'}** "
+        f"where the elastic map has it: from "
+        f"R2/R1 = {ptfe['layout.R2_ratio'].min():.2f} up, PTFE intruders "
+        f"{'pass less than steel and aluminium ones at every radius and load' if least else 'do not always pass the least'}, "
+        f"{span(ptfe['ep_max_fraction_p'])} of the shock (elastic: {span(ptfe['ep_max_fraction_e'])}). "
+        f"The heavy intruders' plastic work {'narrows' if narrows else 'does not always narrow'} the gap: "
+        f"at {loads[-1] * 1e-3:g} kN/m PTFE intruders pass {span(to_steel_p, ratio)} times the share of "
+        f"steel ones of the same radius (elastic: {span(to_steel_e, ratio)}). At R2/R1 = {SMALLEST:.2f} "
+        f"there is none to keep: {span(small['ep_max_fraction_p'])} whatever the material and load "
+        f"(elastic: {span(small['ep_max_fraction_e'])})."
+    )
     moves = []
     for metric, label, fmt in (("ep_max_fraction", "least peak share", pct), ("max_von_mises", "least stress", mpa)):
         for q in loads:
             e, p = best(t, metric, "_e", q), best(t, metric, "_p", q)
             where = design_name(e) if design_name(e) == design_name(p) else f"{design_name(e)} -> {design_name(p)}"
             moves.append(f"{label} at {q * 1e-3:g} kN/m: {where}, {fmt(e[metric + '_e'])} -> {fmt(p[metric + '_p'])}")
-    kept = all(design_name(best(t, m, "_e", q)) == design_name(best(t, m, "_p", q))
-               for m in ("ep_max_fraction", "max_von_mises") for q in loads)
-    out.append(f"**The best design {'does not move' if kept else 'moves'}** (per load, elastic -> "
-               f"yielding): " + "; ".join(moves) + ".")
+    kept = all(
+        design_name(best(t, m, "_e", q)) == design_name(best(t, m, "_p", q))
+        for m in ("ep_max_fraction", "max_von_mises")
+        for q in loads
+    )
+    out.append(
+        f"**The best design {'does not move' if kept else 'moves'}** (per load, elastic -> "
+        f"yielding): " + "; ".join(moves) + "."
+    )
     return [f"- {f}" for f in out]
 
 

@@ -13,6 +13,7 @@ averaged over a ball about a point of the plate's surface (`max_von_mises_ball`,
 disc), which converges under mesh refinement where the largest stress at a quadrature
 point does not.
 """
+
 from __future__ import annotations
 
 import sys
@@ -76,8 +77,11 @@ def pair(t: pd.DataFrame, metric: str) -> pd.DataFrame:
 def share_table(tables: dict[str, pd.DataFrame]) -> list[str]:
     """Per thickness and loading: the plate's peak share and largest stress with steel and
     with PTFE intruders, and PTFE's share over steel's."""
-    head = ["h"] + [f"{LOADINGS[k]}: {what}" for k in tables
-                    for what in ("peak share steel / PTFE", "PTFE / steel", "ball-averaged stress steel / PTFE")]
+    head = ["h"] + [
+        f"{LOADINGS[k]}: {what}"
+        for k in tables
+        for what in ("peak share steel / PTFE", "PTFE / steel", "ball-averaged stress steel / PTFE")
+    ]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     shares = {k: pair(t, "ep_max_fraction") for k, t in tables.items()}
     stresses = {k: pair(t, STRESS) for k, t in tables.items()}
@@ -85,8 +89,11 @@ def share_table(tables: dict[str, pd.DataFrame]) -> list[str]:
         cells = [mm(h)]
         for k in tables:
             s, v = shares[k].loc[h], stresses[k].loc[h]
-            cells += [f"{pct(s['steel'])} / {pct(s['ptfe'])}", f"{s['ptfe'] / s['steel']:.3f}",
-                      f"{mpa(v['steel'])} / {mpa(v['ptfe'])}"]
+            cells += [
+                f"{pct(s['steel'])} / {pct(s['ptfe'])}",
+                f"{s['ptfe'] / s['steel']:.3f}",
+                f"{mpa(v['steel'])} / {mpa(v['ptfe'])}",
+            ]
         lines.append("| " + " | ".join(cells) + " |")
     return lines
 
@@ -110,7 +117,8 @@ def findings(tables: dict[str, pd.DataFrame]) -> list[str]:
         f"{ratio.min():.3f} to {ratio.max():.3f} over the range, "
         + ("less at every thickness" if (p["ptfe"] < p["steel"]).all() else "not less at every thickness")
         + (", the ratio falling as the slab thickens" if ratio.is_monotonic_decreasing else "")
-        + ".")
+        + "."
+    )
     f = sh["face"]
     fr = f["ptfe"] / f["steel"]
     close = fr[fr > 0.5]
@@ -121,10 +129,15 @@ def findings(tables: dict[str, pd.DataFrame]) -> list[str]:
         + f" PTFE intruders pass {', '.join(f'{r:.2f}' for r in close)} of steel's share "
         + f"({', '.join(pct(f.loc[h, 'ptfe']) + ' against ' + pct(f.loc[h, 'steel']) for h in close.index)}): "
         "the compliant plate lets the whole packing push into it, and the intruders hold back little. "
-        + (f"From {mm(far.index[0])} the localisation returns: PTFE passes "
-           f"{', '.join(f'{r:.3g}' for r in far)} of steel's share at "
-           f"{', '.join(mm(h) for h in far.index)} ({pct(f.loc[far.index[-1], 'ptfe'])} against "
-           f"{pct(f.loc[far.index[-1], 'steel'])} at {mm(far.index[-1])})." if len(far) else ""))
+        + (
+            f"From {mm(far.index[0])} the localisation returns: PTFE passes "
+            f"{', '.join(f'{r:.3g}' for r in far)} of steel's share at "
+            f"{', '.join(mm(h) for h in far.index)} ({pct(f.loc[far.index[-1], 'ptfe'])} against "
+            f"{pct(f.loc[far.index[-1], 'steel'])} at {mm(far.index[-1])})."
+            if len(far)
+            else ""
+        )
+    )
     both = sh["face"] / sh["in_plane"]
     more = [h for h in both.index if (both.loc[h] > 1.0).any()]
     out.append(
@@ -134,15 +147,18 @@ def findings(tables: dict[str, pd.DataFrame]) -> list[str]:
         f"more than in plane only at {', '.join(mm(h) for h in more) or 'no thickness'}, where the plate "
         f"bends; at {mm(thick)} {both.loc[thick, 'steel']:.2f} (steel) and {both.loc[thick, 'ptfe']:.3g} (PTFE) "
         f"times: the 100 x 100 mm plate has ten times the mass of the 10 x 100 mm slab loaded in "
-        f"plane, and its bending stiffness grows as the cube of its thickness.")
+        f"plane, and its bending stiffness grows as the cube of its thickness."
+    )
     best = {k: sh[k].stack().idxmin() for k in sh}
     out.append(
         "- **The best protector of each table** (least peak share): "
-        + "; ".join(f"{LOADINGS[k]}: {b[1]} intruders on the {mm(b[0])} plate, {pct(sh[k].loc[b])}"
-                    for k, b in best.items())
+        + "; ".join(
+            f"{LOADINGS[k]}: {b[1]} intruders on the {mm(b[0])} plate, {pct(sh[k].loc[b])}" for k, b in best.items()
+        )
         + ". PTFE intruders are the better choice at every thickness of both tables"
         + ("" if all((sh[k]["ptfe"] <= sh[k]["steel"]).all() for k in sh) else " but one")
-        + ".")
+        + "."
+    )
     return out
 
 

@@ -19,6 +19,7 @@ both), and each one's error against its own converged run (granplate: the "rk4" 
 own error is ~3e-5 m/s; LAMMPS: its step / LAMMPS_REF_DIVISOR): the largest |v - v_ref|
 over the granules' velocity components at t_end [m/s].
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -47,18 +48,27 @@ def packing_scenario(mu: float, friction: str, t_end: float | None = None):
     from granplate.setup.scenario import Contact, LatticeLayout, Load, Scenario, Solver, TimeSettings
 
     t_end = PACKING["t_end"] if t_end is None else float(t_end)
-    s = resolve(Scenario(
-        name="friction-packing",
-        layout=LatticeLayout(kind="hexagonal", columns=PACKING["columns"], rows=PACKING["rows"],
-                             radius=PACKING["radius"]),
-        load=Load(kind="none"), contact=Contact(mu=mu),
-        time=TimeSettings(t_end=t_end, dt_initial=1e-8, dt_max=4e-8, output_interval=t_end / 10,
-                          field_interval=t_end / 10),
-        solver=Solver(granular_friction=friction)))
+    s = resolve(
+        Scenario(
+            name="friction-packing",
+            layout=LatticeLayout(
+                kind="hexagonal", columns=PACKING["columns"], rows=PACKING["rows"], radius=PACKING["radius"]
+            ),
+            load=Load(kind="none"),
+            contact=Contact(mu=mu),
+            time=TimeSettings(
+                t_end=t_end, dt_initial=1e-8, dt_max=4e-8, output_interval=t_end / 10, field_interval=t_end / 10
+            ),
+            solver=Solver(granular_friction=friction),
+        )
+    )
     left = min(g.x - g.radius for g in s.granules)
-    return dataclasses.replace(s, granules=tuple(
-        dataclasses.replace(g, vx=PACKING["v0"]) if abs(g.x - g.radius - left) < 1e-9 else g
-        for g in s.granules))
+    return dataclasses.replace(
+        s,
+        granules=tuple(
+            dataclasses.replace(g, vx=PACKING["v0"]) if abs(g.x - g.radius - left) < 1e-9 else g for g in s.granules
+        ),
+    )
 
 
 def strong_scenario(friction: str, t_end: float | None = None):
@@ -66,28 +76,40 @@ def strong_scenario(friction: str, t_end: float | None = None):
     import granplate as gp
 
     t_end = STRONG["t_end"][friction] if t_end is None else float(t_end)
-    return gp.with_changes(gp.preset("ptfe-r05"), {
-        "load.q0": STRONG["q0"], "contact.overlap_stop": STRONG["overlap_stop"],
-        "solver.granular_friction": friction, "time.t_end": t_end,
-        "time.output_interval": min(1e-6, t_end), "time.field_interval": min(2e-5, t_end)})
+    return gp.with_changes(
+        gp.preset("ptfe-r05"),
+        {
+            "load.q0": STRONG["q0"],
+            "contact.overlap_stop": STRONG["overlap_stop"],
+            "solver.granular_friction": friction,
+            "time.t_end": t_end,
+            "time.output_interval": min(1e-6, t_end),
+            "time.field_interval": min(2e-5, t_end),
+        },
+    )
 
 
 def verlet_scenario(t_end: float | None = None):
     """The packing with mu = 0.099 under solver.scheme = "verlet" at the fixed step VERLET_DT."""
     s = packing_scenario(0.099, "split", t_end)
-    return dataclasses.replace(s, solver=dataclasses.replace(s.solver, scheme="verlet"),
-                               time=dataclasses.replace(s.time, dt_initial=VERLET_DT, dt_max=VERLET_DT))
+    return dataclasses.replace(
+        s,
+        solver=dataclasses.replace(s.solver, scheme="verlet"),
+        time=dataclasses.replace(s.time, dt_initial=VERLET_DT, dt_max=VERLET_DT),
+    )
 
 
 def cases(t_end: float | None = None) -> list[tuple[str, str, object]]:
     """(case, treatment, scenario) of the table; t_end overrides every run's [s]."""
     free = packing_scenario(0.0, "split", t_end)
     n = len(free.granules)
-    return [(f"packing {n}, mu 0", "-", free),
-            (f"packing {n}, mu 0.099", "split", packing_scenario(0.099, "split", t_end)),
-            (f"packing {n}, mu 0.099", "rk4", packing_scenario(0.099, "rk4", t_end)),
-            ("ptfe-r05, q0 1e7", "split", strong_scenario("split", t_end)),
-            ("ptfe-r05, q0 1e7", "rk4", strong_scenario("rk4", t_end))]
+    return [
+        (f"packing {n}, mu 0", "-", free),
+        (f"packing {n}, mu 0.099", "split", packing_scenario(0.099, "split", t_end)),
+        (f"packing {n}, mu 0.099", "rk4", packing_scenario(0.099, "rk4", t_end)),
+        ("ptfe-r05, q0 1e7", "split", strong_scenario("split", t_end)),
+        ("ptfe-r05, q0 1e7", "rk4", strong_scenario("rk4", t_end)),
+    ]
 
 
 def timed_run(s):
@@ -99,8 +121,10 @@ def timed_run(s):
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # overlaps beyond overlap_warn
-        gp.simulate(gp.with_changes(s, {"time.t_end": 1e-6, "time.output_interval": 1e-6,
-                                        "time.field_interval": 1e-6}), progress=False)
+        gp.simulate(
+            gp.with_changes(s, {"time.t_end": 1e-6, "time.output_interval": 1e-6, "time.field_interval": 1e-6}),
+            progress=False,
+        )
         t0 = time.perf_counter()
         ds = gp.simulate(s, progress=False)
         return ds, time.perf_counter() - t0
@@ -122,12 +146,17 @@ def bench_run(case: str, friction: str, s) -> dict:
     """Steps, wall time and friction work of one run (after a 1 us warm-up); the final
     velocities under the key "final" (not part of the table or the JSON)."""
     ds, wall = timed_run(s)
-    return {"case": case, "friction": friction, "t_end_s": float(s.time.t_end),
-            "n_steps": int(ds.attrs["n_steps"]), "wall_s": wall,
-            "steps_per_ms": int(ds.attrs["n_steps"]) / (1e3 * float(s.time.t_end)),
-            "d_friction_J": float(ds.D_friction.values[-1]),
-            "energy_residual_max": float(abs(ds.energy_residual.values).max()),
-            "final": final_velocities(ds)}
+    return {
+        "case": case,
+        "friction": friction,
+        "t_end_s": float(s.time.t_end),
+        "n_steps": int(ds.attrs["n_steps"]),
+        "wall_s": wall,
+        "steps_per_ms": int(ds.attrs["n_steps"]) / (1e3 * float(s.time.t_end)),
+        "d_friction_J": float(ds.D_friction.values[-1]),
+        "energy_residual_max": float(abs(ds.energy_residual.values).max()),
+        "final": final_velocities(ds),
+    }
 
 
 def listed_contacts(s) -> int:
@@ -144,15 +173,24 @@ def per_contact_step_us(loop_s: float, n_steps: int, contacts: int) -> float:
     return 1e6 * loop_s / (n_steps * contacts)
 
 
-def code_row(code: str, law: str, runs: list[tuple[float, float]], n_steps: int, t_end: float, error: float,
-             contacts: int) -> dict:
+def code_row(
+    code: str, law: str, runs: list[tuple[float, float]], n_steps: int, t_end: float, error: float, contacts: int
+) -> dict:
     """One code's row of the side-by-side table from its (loop wall, loop CPU) times [s]."""
     import statistics
 
     walls, cpus = [r[0] for r in runs], [r[1] for r in runs]
-    row = {"code": code, "law": law, "dt_s": t_end / n_steps, "n_steps": n_steps,
-           "loop_s": statistics.median(walls), "loop_s_all": walls,
-           "loop_cpu_s": statistics.median(cpus), "loop_cpu_s_all": cpus, "error_m_s": error}
+    row = {
+        "code": code,
+        "law": law,
+        "dt_s": t_end / n_steps,
+        "n_steps": n_steps,
+        "loop_s": statistics.median(walls),
+        "loop_s_all": walls,
+        "loop_cpu_s": statistics.median(cpus),
+        "loop_cpu_s_all": cpus,
+        "error_m_s": error,
+    }
     row["us_per_contact_step"] = per_contact_step_us(row["loop_s"], n_steps, contacts)
     row["cpu_us_per_contact_step"] = per_contact_step_us(row["loop_cpu_s"], n_steps, contacts)
     return row
@@ -182,14 +220,31 @@ def lammps_comparison(t_end: float | None, reference: dict, log=print) -> dict:
         lm = L.run_granular(s, LAMMPS_DT, t)
         theirs.append((lm["loop_time_s"], lm["loop_cpu_s"]))
     rows = {
-        "granplate": code_row("granplate", "tanh (eq. 5), split", ours, int(ds.attrs["n_steps"]), t,
-                              velocity_error(final_velocities(ds), reference), contacts),
-        "verlet": code_row("granplate", "tanh (eq. 5), verlet", verlet, int(dv.attrs["n_steps"]), t,
-                           velocity_error(final_velocities(dv), reference), contacts),
-        "lammps": code_row("LAMMPS", "Mindlin", theirs, int(lm["n_steps"]), t, velocity_error(lm, lref), contacts)}
-    ratio = {f"{key}{name}": rows[r][field] / rows["lammps"][field]
-             for r, key in (("granplate", ""), ("verlet", "verlet_"))
-             for name, field in (("loop_ratio", "loop_s"), ("cpu_ratio", "loop_cpu_s"))}
+        "granplate": code_row(
+            "granplate",
+            "tanh (eq. 5), split",
+            ours,
+            int(ds.attrs["n_steps"]),
+            t,
+            velocity_error(final_velocities(ds), reference),
+            contacts,
+        ),
+        "verlet": code_row(
+            "granplate",
+            "tanh (eq. 5), verlet",
+            verlet,
+            int(dv.attrs["n_steps"]),
+            t,
+            velocity_error(final_velocities(dv), reference),
+            contacts,
+        ),
+        "lammps": code_row("LAMMPS", "Mindlin", theirs, int(lm["n_steps"]), t, velocity_error(lm, lref), contacts),
+    }
+    ratio = {
+        f"{key}{name}": rows[r][field] / rows["lammps"][field]
+        for r, key in (("granplate", ""), ("verlet", "verlet_"))
+        for name, field in (("loop_ratio", "loop_s"), ("cpu_ratio", "loop_cpu_s"))
+    }
     return {"contacts": contacts, "t_end_s": t, **rows, **ratio}
 
 
@@ -198,8 +253,10 @@ def format_friction_table(rows: list[dict]) -> str:
     head = f"{'case':<24} {'friction':<8} {'t_end [s]':>9} {'steps':>9} {'steps/ms':>10} {'wall [s]':>9} {'D_fric [J]':>11}"
     lines = [head, "-" * len(head)]
     for r in rows:
-        lines.append(f"{r['case']:<24} {r['friction']:<8} {r['t_end_s']:>9.2g} {r['n_steps']:>9d} "
-                     f"{r['steps_per_ms']:>10.3g} {r['wall_s']:>9.2f} {r['d_friction_J']:>11.4e}")
+        lines.append(
+            f"{r['case']:<24} {r['friction']:<8} {r['t_end_s']:>9.2g} {r['n_steps']:>9d} "
+            f"{r['steps_per_ms']:>10.3g} {r['wall_s']:>9.2f} {r['d_friction_J']:>11.4e}"
+        )
     return "\n".join(lines)
 
 
@@ -207,16 +264,26 @@ def format_lammps_table(cmp: dict) -> str:
     """The side-by-side comparison as a plain-text table (or why it was left out)."""
     if "skipped" in cmp:
         return f"LAMMPS comparison skipped: {cmp['skipped']}"
-    head = (f"{'code':<10} {'friction law':<20} {'dt [s]':>9} {'steps':>7} {'loop [s]':>9} "
-            f"{'us/(contact step)':>17} {'CPU [s]':>8} {'CPU us/(c. step)':>16} {'error [m/s]':>11}")
-    lines = [f"packing with mu 0.099 side by side ({cmp['contacts']} listed contacts, t_end {cmp['t_end_s']:g} s, "
-             f"median of {len(cmp['granplate']['loop_s_all'])} alternate runs each)", head, "-" * len(head)]
+    head = (
+        f"{'code':<10} {'friction law':<20} {'dt [s]':>9} {'steps':>7} {'loop [s]':>9} "
+        f"{'us/(contact step)':>17} {'CPU [s]':>8} {'CPU us/(c. step)':>16} {'error [m/s]':>11}"
+    )
+    lines = [
+        f"packing with mu 0.099 side by side ({cmp['contacts']} listed contacts, t_end {cmp['t_end_s']:g} s, "
+        f"median of {len(cmp['granplate']['loop_s_all'])} alternate runs each)",
+        head,
+        "-" * len(head),
+    ]
     for r in (cmp["granplate"], cmp["verlet"], cmp["lammps"]):
-        lines.append(f"{r['code']:<10} {r['law']:<20} {r['dt_s']:>9.3g} {r['n_steps']:>7d} {r['loop_s']:>9.3f} "
-                     f"{r['us_per_contact_step']:>17.3f} {r['loop_cpu_s']:>8.3f} {r['cpu_us_per_contact_step']:>16.3f} "
-                     f"{r['error_m_s']:>11.2e}")
-    lines.append(f"loop time granplate / LAMMPS: {cmp['loop_ratio']:.2f} (wall), {cmp['cpu_ratio']:.2f} (CPU); "
-                 f"verlet / LAMMPS: {cmp['verlet_loop_ratio']:.2f} (wall), {cmp['verlet_cpu_ratio']:.2f} (CPU)")
+        lines.append(
+            f"{r['code']:<10} {r['law']:<20} {r['dt_s']:>9.3g} {r['n_steps']:>7d} {r['loop_s']:>9.3f} "
+            f"{r['us_per_contact_step']:>17.3f} {r['loop_cpu_s']:>8.3f} {r['cpu_us_per_contact_step']:>16.3f} "
+            f"{r['error_m_s']:>11.2e}"
+        )
+    lines.append(
+        f"loop time granplate / LAMMPS: {cmp['loop_ratio']:.2f} (wall), {cmp['cpu_ratio']:.2f} (CPU); "
+        f"verlet / LAMMPS: {cmp['verlet_loop_ratio']:.2f} (wall), {cmp['verlet_cpu_ratio']:.2f} (CPU)"
+    )
     return "\n".join(lines)
 
 

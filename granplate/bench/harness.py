@@ -11,6 +11,7 @@ Run it as ``granplate bench [--quick] [--json FILE] [--cases A,B] [--repeats N]`
 ``python -m granplate.bench.harness ...``. The JSON keys are documented in
 ``docs/benchmarks.md``.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -47,6 +48,7 @@ SCHEMA_VERSION = 1
 
 # --------------------------------------------------------------------------- scenarios
 
+
 def case_scenario(case: str, scheme: str, t_end: float | None):
     """The benchmarked scenario: preset `case`, scheme `scheme`, t_end (None: preset's)."""
     import granplate as gp
@@ -69,12 +71,15 @@ def reference_scenario(case: str, t_end: float | None):
 
     s = case_scenario(case, "paper", t_end)
     dt_max = s.time.dt_max / 4.0
-    return gp.with_changes(s, {
-        "time.dt_max": dt_max,
-        "time.dt_initial": min(s.time.dt_initial, dt_max),
-        "solver.lambda_target": 0.25,
-        "solver.iteration_rtol": min(s.solver.iteration_rtol / 100.0, 1e-11),
-    })
+    return gp.with_changes(
+        s,
+        {
+            "time.dt_max": dt_max,
+            "time.dt_initial": min(s.time.dt_initial, dt_max),
+            "solver.lambda_target": 0.25,
+            "solver.iteration_rtol": min(s.solver.iteration_rtol / 100.0, 1e-11),
+        },
+    )
 
 
 def reference_payload(s) -> dict:
@@ -94,8 +99,10 @@ def reference_summary(case: str, t_end: float | None, log=print) -> dict:
     summ = store.load_json(REFERENCE_KIND, payload, REFERENCE_FORMAT, label=case)
     if summ is not None:
         return summ
-    log(f"  reference run for {case} (t_end {s.time.t_end:g} s), kept in the run store "
-        f"({store.cache_directory() / REFERENCE_KIND}) ...")
+    log(
+        f"  reference run for {case} (t_end {s.time.t_end:g} s), kept in the run store "
+        f"({store.cache_directory() / REFERENCE_KIND}) ..."
+    )
     ds = gp.simulate(s, progress=False)
     summ = gp.summary(ds)
     summ["n_iterations"] = int(ds.attrs.get("n_iterations", 0)) if "n_iterations" in ds.attrs else None
@@ -105,10 +112,18 @@ def reference_summary(case: str, t_end: float | None, log=print) -> dict:
 
 # --------------------------------------------------------------------------- worker
 
+
 def _run_info(ds) -> dict:
     info = json.loads(ds.attrs.get("run_info", "{}"))
-    for k in ("wall_time_s", "setup_time_s", "first_call_time_s", "loop_time_s",
-              "n_steps", "n_iterations", "n_retries"):
+    for k in (
+        "wall_time_s",
+        "setup_time_s",
+        "first_call_time_s",
+        "loop_time_s",
+        "n_steps",
+        "n_iterations",
+        "n_retries",
+    ):
         if k in ds.attrs:
             info[k] = ds.attrs[k]
     return info
@@ -121,6 +136,7 @@ def _worker(spec: dict) -> dict:
     t0 = time.perf_counter()
     import granplate as gp
     import numpy as np
+
     t_import = time.perf_counter() - t0
 
     if spec["kind"] == "compile":
@@ -136,10 +152,14 @@ def _worker(spec: dict) -> dict:
             ds = gp.simulate(s, progress=False)
             again.append(time.perf_counter() - t1)
             kernel_again.append(float(ds.attrs.get("first_call_time_s", float("nan"))))
-        return {"import_time_s": t_import, "first_call_s": first, "repeat_call_s": min(again),
-                "compile_time_s": first - min(again),
-                "kernel_load_time_s": kernel_first - min(kernel_again),
-                "setup_first_call_s": setup_first}
+        return {
+            "import_time_s": t_import,
+            "first_call_s": first,
+            "repeat_call_s": min(again),
+            "compile_time_s": first - min(again),
+            "kernel_load_time_s": kernel_first - min(kernel_again),
+            "setup_first_call_s": setup_first,
+        }
 
     # warm-up: a tiny run of the same case loads (or compiles) the kernels
     gp.simulate(case_scenario(spec["case"], spec["scheme"], TINY_T_END), progress=False)
@@ -155,12 +175,18 @@ def _worker(spec: dict) -> dict:
         dts = np.asarray(ds.dt_min.values, dtype=float)[1:] if "dt_min" in ds else np.array([])
         dts = dts[np.isfinite(dts) & (dts > 0)]  # the t = 0 record carries no step
         dt_min = float(dts.min()) if dts.size else float("nan")
-        runs.append({"wall_s": wall, "loop_s": float(info.get("loop_time_s", wall)),
-                     "setup_s": float(info.get("setup_time_s", 0.0)),
-                     "n_steps": int(info.get("n_steps", 0)),
-                     "n_iterations": int(info.get("n_iterations", 0)),
-                     "n_retries": int(info.get("n_retries", 0)),
-                     "dt_min": dt_min, "t_end": float(ds.time[-1])})
+        runs.append(
+            {
+                "wall_s": wall,
+                "loop_s": float(info.get("loop_time_s", wall)),
+                "setup_s": float(info.get("setup_time_s", 0.0)),
+                "n_steps": int(info.get("n_steps", 0)),
+                "n_iterations": int(info.get("n_iterations", 0)),
+                "n_retries": int(info.get("n_retries", 0)),
+                "dt_min": dt_min,
+                "t_end": float(ds.time[-1]),
+            }
+        )
         summ = gp.summary(ds)
         del ds
     rss_peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
@@ -168,18 +194,20 @@ def _worker(spec: dict) -> dict:
 
 
 def _spawn(spec: dict) -> dict:
-    code = ("import sys, json; "
-            "from granplate.bench.harness import _worker; "
-            "print('@@RESULT ' + json.dumps(_worker(json.loads(sys.stdin.read()))))")
-    p = subprocess.run([sys.executable, "-c", code], input=json.dumps(spec), capture_output=True,
-                       text=True)
+    code = (
+        "import sys, json; "
+        "from granplate.bench.harness import _worker; "
+        "print('@@RESULT ' + json.dumps(_worker(json.loads(sys.stdin.read()))))"
+    )
+    p = subprocess.run([sys.executable, "-c", code], input=json.dumps(spec), capture_output=True, text=True)
     for line in p.stdout.splitlines():
         if line.startswith("@@RESULT "):
-            return json.loads(line[len("@@RESULT "):])
+            return json.loads(line[len("@@RESULT ") :])
     raise RuntimeError(f"benchmark worker failed ({spec}): rc {p.returncode}\n{p.stderr[-3000:]}")
 
 
 # --------------------------------------------------------------------------- harness
+
 
 def _rel_error(x: float, ref: float) -> float:
     if ref == 0.0:
@@ -231,8 +259,7 @@ def schemes() -> tuple[str, ...]:
     return tuple(s for s in SCHEMES if s not in GRANULAR_SCHEMES)
 
 
-def run(quick: bool = False, cases=None, repeats: int | None = None, t_end: float | None = None,
-        log=print) -> dict:
+def run(quick: bool = False, cases=None, repeats: int | None = None, t_end: float | None = None, log=print) -> dict:
     """Run the benchmark and return the JSON-ready report."""
     import granplate as gp
 
@@ -241,13 +268,14 @@ def run(quick: bool = False, cases=None, repeats: int | None = None, t_end: floa
         cases = list(QUICK_CASES) if quick else gp.preset_names()
     twins = [c for c in cases if c in gp.preset_names(include_3d=True) and c not in gp.preset_names()]
     if twins:
-        raise ValueError(f"case(s) {', '.join(twins)}: 3D twins, which run under velocity Verlet alone, not the "
-                         f"plate schemes this benchmark compares ({', '.join(schemes())}); `granplate bench "
-                         f"--solid --coupled` times a coupled 3D run")
+        raise ValueError(
+            f"case(s) {', '.join(twins)}: 3D twins, which run under velocity Verlet alone, not the "
+            f"plate schemes this benchmark compares ({', '.join(schemes())}); `granplate bench "
+            f"--solid --coupled` times a coupled 3D run"
+        )
     unknown = [c for c in cases if c not in gp.preset_names()]
     if unknown:
-        raise ValueError(f"unknown case(s) {', '.join(unknown)}; presets are: "
-                         + ", ".join(gp.preset_names()))
+        raise ValueError(f"unknown case(s) {', '.join(unknown)}; presets are: " + ", ".join(gp.preset_names()))
     if repeats is None:
         repeats = QUICK_REPEATS if quick else FULL_REPEATS
     if t_end is None and quick:
@@ -272,9 +300,12 @@ def run(quick: bool = False, cases=None, repeats: int | None = None, t_end: floa
         "schemes": list(sch),
         "cases": list(cases),
         "metrics": list(METRICS),
-        "machine": {"platform": platform.platform(), "python": platform.python_version(),
-                    "processor": platform.processor() or platform.machine(),
-                    "cpu_count": os.cpu_count()},
+        "machine": {
+            "platform": platform.platform(),
+            "python": platform.python_version(),
+            "processor": platform.processor() or platform.machine(),
+            "cpu_count": os.cpu_count(),
+        },
         "compile": compile_info,
         "results": results,
         "total_time_s": time.perf_counter() - t_start,
@@ -283,27 +314,33 @@ def run(quick: bool = False, cases=None, repeats: int | None = None, t_end: floa
 
 # --------------------------------------------------------------------------- output
 
-HEADER = (f"{'case':18s} {'scheme':7s} {'wall s':>8s} {'steps':>9s} {'dt mean':>9s} {'dt min':>9s} "
-          f"{'us/step':>8s} {'it/step':>7s} {'err E_sh':>9s} {'err Epmx':>9s} {'err Epfn':>9s} "
-          f"{'err vM':>9s} {'err eyy':>9s} {'RSS MiB':>8s}")
+HEADER = (
+    f"{'case':18s} {'scheme':7s} {'wall s':>8s} {'steps':>9s} {'dt mean':>9s} {'dt min':>9s} "
+    f"{'us/step':>8s} {'it/step':>7s} {'err E_sh':>9s} {'err Epmx':>9s} {'err Epfn':>9s} "
+    f"{'err vM':>9s} {'err eyy':>9s} {'RSS MiB':>8s}"
+)
 
 
 def _row(r: dict) -> str:
     e = r["rel_error"]
-    return (f"{r['case']:18s} {r['scheme']:7s} {r['wall_time_s']:8.3f} {r['n_steps']:9d} "
-            f"{r['dt_mean_s']:9.2e} {r['dt_min_s']:9.2e} {r['us_per_step']:8.2f} "
-            f"{r['iterations_per_step']:7.2f} {e['e_shock']:9.2e} {e['ep_max_fraction']:9.2e} "
-            f"{e['ep_final_fraction']:9.2e} {e['max_von_mises']:9.2e} {e['max_eps_yy']:9.2e} "
-            f"{r['peak_rss_mib']:8.1f}")
+    return (
+        f"{r['case']:18s} {r['scheme']:7s} {r['wall_time_s']:8.3f} {r['n_steps']:9d} "
+        f"{r['dt_mean_s']:9.2e} {r['dt_min_s']:9.2e} {r['us_per_step']:8.2f} "
+        f"{r['iterations_per_step']:7.2f} {e['e_shock']:9.2e} {e['ep_max_fraction']:9.2e} "
+        f"{e['ep_final_fraction']:9.2e} {e['max_von_mises']:9.2e} {e['max_eps_yy']:9.2e} "
+        f"{r['peak_rss_mib']:8.1f}"
+    )
 
 
 def format_table(report: dict) -> str:
     lines = [HEADER, "-" * len(HEADER)]
     lines += [_row(r) for r in report["results"]]
     for scheme, c in report["compile"].items():
-        lines.append(f"compile/cache-load ({scheme}): {c['compile_time_s']:.3f} s "
-                     f"(first call {c['first_call_s']:.3f} s, repeat {c['repeat_call_s']:.4f} s, "
-                     f"kernels alone {c['kernel_load_time_s']:.3f} s, import {c['import_time_s']:.2f} s)")
+        lines.append(
+            f"compile/cache-load ({scheme}): {c['compile_time_s']:.3f} s "
+            f"(first call {c['first_call_s']:.3f} s, repeat {c['repeat_call_s']:.4f} s, "
+            f"kernels alone {c['kernel_load_time_s']:.3f} s, import {c['import_time_s']:.2f} s)"
+        )
     lines.append(f"total benchmark time: {report['total_time_s']:.1f} s ({report['mode']} mode)")
     return "\n".join(lines)
 
@@ -315,8 +352,7 @@ def main(args) -> int:
         print("granplate: error: --repeats must be >= 1", file=sys.stderr)
         return 2
     try:
-        report = run(quick=args.quick, cases=cases, repeats=args.repeats,
-                     t_end=getattr(args, "t_end", None))
+        report = run(quick=args.quick, cases=cases, repeats=args.repeats, t_end=getattr(args, "t_end", None))
     except ValueError as err:
         print(f"granplate: error: {err}", file=sys.stderr)
         return 2
@@ -327,12 +363,17 @@ def main(args) -> int:
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--quick", action="store_true",
-                   help=f"a subset ({', '.join(QUICK_CASES)}) at t_end {QUICK_T_END:g} s, 1 repeat")
+    p.add_argument(
+        "--quick", action="store_true", help=f"a subset ({', '.join(QUICK_CASES)}) at t_end {QUICK_T_END:g} s, 1 repeat"
+    )
     p.add_argument("--json", metavar="FILE", help="write the report as JSON to FILE")
     p.add_argument("--cases", help="comma-separated presets (default: all; quick: a subset)")
-    p.add_argument("--repeats", type=int, default=None,
-                   help=f"timed repeats per case, median reported (default {FULL_REPEATS}, quick {QUICK_REPEATS})")
+    p.add_argument(
+        "--repeats",
+        type=int,
+        default=None,
+        help=f"timed repeats per case, median reported (default {FULL_REPEATS}, quick {QUICK_REPEATS})",
+    )
     p.add_argument("--t-end", dest="t_end", type=float, default=None, help=argparse.SUPPRESS)
 
 
@@ -348,8 +389,7 @@ def parse_pairs(text: str, flag: str, form: str, example: str, min_second: int =
     out = []
     for item in text.split(","):
         parts = item.strip().lower().split("x")
-        if (len(parts) != 2 or not all(p.strip().isdigit() and int(p) >= 1 for p in parts)
-                or int(parts[1]) < min_second):
+        if len(parts) != 2 or not all(p.strip().isdigit() and int(p) >= 1 for p in parts) or int(parts[1]) < min_second:
             rows = f" ({form.split('x')[1]} >= {min_second})" if min_second > 1 else ""
             raise ValueError(f"{flag} item {item!r}: allowed {form} with integers >= 1{rows}, e.g. {example}")
         out.append((int(parts[0]), int(parts[1])))

@@ -20,6 +20,7 @@ above its overlap (all on their unloading curves, the plastic law's general bran
 the Hertz coefficients and with the plastic ones: us per evaluation, median of
 KERNEL_CALLS.
 """
+
 from __future__ import annotations
 
 import statistics
@@ -50,9 +51,20 @@ def cases(t_end: float | None = None) -> list[tuple[str, object]]:
     out = [(f"packing {len(packing.granules)}, mu 0.099", packing)]
     for name in ("ptfe-r05", "steel-r1"):
         for scheme in ("paper", "implicit"):
-            out.append((f"{name}, {scheme}", gp.with_changes(gp.preset(name), {
-                "solver.scheme": scheme, "time.t_end": t, "time.output_interval": min(1e-6, t),
-                "time.field_interval": min(2e-5, t)})))
+            out.append(
+                (
+                    f"{name}, {scheme}",
+                    gp.with_changes(
+                        gp.preset(name),
+                        {
+                            "solver.scheme": scheme,
+                            "time.t_end": t,
+                            "time.output_interval": min(1e-6, t),
+                            "time.field_interval": min(2e-5, t),
+                        },
+                    ),
+                )
+            )
     return out
 
 
@@ -64,12 +76,19 @@ def timed(s) -> dict:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", YieldWarning)
         warnings.simplefilter("ignore", RuntimeWarning)  # overlaps beyond overlap_warn
-        gp.simulate(gp.with_changes(s, {"time.t_end": 1e-6, "time.output_interval": 1e-6,
-                                        "time.field_interval": 1e-6}), summary_only=True, progress=False)
+        gp.simulate(
+            gp.with_changes(s, {"time.t_end": 1e-6, "time.output_interval": 1e-6, "time.field_interval": 1e-6}),
+            summary_only=True,
+            progress=False,
+        )
         ds = gp.simulate(s, summary_only=True, progress=False)
     summ = gp.summary(ds)
-    return {"loop_cpu_s": float(ds.attrs["loop_cpu_s"]), "n_steps": int(ds.attrs["n_steps"]),
-            "plastic_fraction": summ["plastic_fraction"], "yield_onset_ratio": summ["yield_onset_ratio"]}
+    return {
+        "loop_cpu_s": float(ds.attrs["loop_cpu_s"]),
+        "n_steps": int(ds.attrs["n_steps"]),
+        "plastic_fraction": summ["plastic_fraction"],
+        "yield_onset_ratio": summ["yield_onset_ratio"],
+    }
 
 
 def bench_case(case: str, s, repeats: int = REPEATS) -> dict:
@@ -83,9 +102,12 @@ def bench_case(case: str, s, repeats: int = REPEATS) -> dict:
     row: dict = {"case": case, "t_end_s": float(s.time.t_end)}
     for law in LAWS:
         per = [1e6 * r["loop_cpu_s"] / max(r["n_steps"], 1) for r in runs[law]]
-        row[law] = {"us_per_step": statistics.median(per), "n_steps": runs[law][-1]["n_steps"],
-                    "plastic_fraction": runs[law][-1]["plastic_fraction"],
-                    "yield_onset_ratio": runs[law][-1]["yield_onset_ratio"]}
+        row[law] = {
+            "us_per_step": statistics.median(per),
+            "n_steps": runs[law][-1]["n_steps"],
+            "plastic_fraction": runs[law][-1]["plastic_fraction"],
+            "yield_onset_ratio": runs[law][-1]["yield_onset_ratio"],
+        }
     for law in PLASTIC_LAWS:
         row[f"ratio_{law}"] = row[law]["us_per_step"] / row["hertz"]["us_per_step"]
     row["ratio"] = max(row[f"ratio_{law}"] for law in PLASTIC_LAWS)
@@ -102,8 +124,9 @@ def with_law(s, law: str):
     if law != "johnson":
         return s
     c, ref = JOHNSON_RATE
-    return dataclasses.replace(s, materials={k: dataclasses.replace(m, C=c, rate_ref=ref)
-                                             for k, m in s.materials.items()})
+    return dataclasses.replace(
+        s, materials={k: dataclasses.replace(m, C=c, rate_ref=ref) for k, m in s.materials.items()}
+    )
 
 
 def kernel_case(t_end: float | None = None) -> dict:
@@ -160,9 +183,14 @@ def kernel_case(t_end: float | None = None) -> dict:
             friction_flow(ys, 1e-9, gg, cfg, True)
             times.append(time.perf_counter() - t0)
         out[law] = 1e6 * statistics.median(times)
-    return {"case": f"kernel: packing state, {touch} of {len(g.pair_ij)} listed pairs in touch",
-            "hertz_us": out["hertz"], "thornton_us": out["thornton"], "johnson_us": out["johnson"],
-            "ratio": out["thornton"] / out["hertz"], "ratio_johnson": out["johnson"] / out["hertz"]}
+    return {
+        "case": f"kernel: packing state, {touch} of {len(g.pair_ij)} listed pairs in touch",
+        "hertz_us": out["hertz"],
+        "thornton_us": out["thornton"],
+        "johnson_us": out["johnson"],
+        "ratio": out["thornton"] / out["hertz"],
+        "ratio_johnson": out["johnson"] / out["hertz"],
+    }
 
 
 def run(t_end: float | None = None, repeats: int = REPEATS, log=print) -> dict:
@@ -173,25 +201,38 @@ def run(t_end: float | None = None, repeats: int = REPEATS, log=print) -> dict:
         rows.append(bench_case(case, s, repeats))
     log("bench --plastic: kernel on one packing state ...")
     kernel = kernel_case(t_end)
-    return {"repeats": repeats, "target_ratio": PLASTIC_COST_TARGET, "rows": rows, "kernel": kernel,
-            "largest_ratio": max(r["ratio"] for r in rows)}
+    return {
+        "repeats": repeats,
+        "target_ratio": PLASTIC_COST_TARGET,
+        "rows": rows,
+        "kernel": kernel,
+        "largest_ratio": max(r["ratio"] for r in rows),
+    }
 
 
 def format_report(report: dict) -> str:
     """The table as text."""
-    lines = [f"{'case':28s} {'hertz us/step':>14s} {'thornton':>9s} {'ratio':>6s} {'johnson':>8s} {'ratio':>6s}"
-             f" {'steps H':>8s} {'steps T':>8s} {'steps J':>8s} {'D_plastic/E_in T':>17s} {'J':>7s}"]
+    lines = [
+        f"{'case':28s} {'hertz us/step':>14s} {'thornton':>9s} {'ratio':>6s} {'johnson':>8s} {'ratio':>6s}"
+        f" {'steps H':>8s} {'steps T':>8s} {'steps J':>8s} {'D_plastic/E_in T':>17s} {'J':>7s}"
+    ]
     for r in report["rows"]:
         h, t, j = r["hertz"], r["thornton"], r["johnson"]
-        lines.append(f"{r['case']:28s} {h['us_per_step']:14.2f} {t['us_per_step']:9.2f} {r['ratio_thornton']:6.3f}"
-                     f" {j['us_per_step']:8.2f} {r['ratio_johnson']:6.3f} {h['n_steps']:8d} {t['n_steps']:8d}"
-                     f" {j['n_steps']:8d} {t['plastic_fraction'] or 0.0:17.4f} {j['plastic_fraction'] or 0.0:7.4f}")
-    lines.append(f"largest ratio {report['largest_ratio']:.3f} (target <= {report['target_ratio']:g}); "
-                 f"loop CPU time per step, median of {report['repeats']} runs")
+        lines.append(
+            f"{r['case']:28s} {h['us_per_step']:14.2f} {t['us_per_step']:9.2f} {r['ratio_thornton']:6.3f}"
+            f" {j['us_per_step']:8.2f} {r['ratio_johnson']:6.3f} {h['n_steps']:8d} {t['n_steps']:8d}"
+            f" {j['n_steps']:8d} {t['plastic_fraction'] or 0.0:17.4f} {j['plastic_fraction'] or 0.0:7.4f}"
+        )
+    lines.append(
+        f"largest ratio {report['largest_ratio']:.3f} (target <= {report['target_ratio']:g}); "
+        f"loop CPU time per step, median of {report['repeats']} runs"
+    )
     k = report["kernel"]
-    lines.append(f"{k['case']}: hertz {k['hertz_us']:.1f} us, thornton {k['thornton_us']:.1f} us "
-                 f"(ratio {k['ratio']:.3f}), johnson {k['johnson_us']:.1f} us (ratio {k['ratio_johnson']:.3f}) per "
-                 f"evaluation (median of {KERNEL_CALLS})")
+    lines.append(
+        f"{k['case']}: hertz {k['hertz_us']:.1f} us, thornton {k['thornton_us']:.1f} us "
+        f"(ratio {k['ratio']:.3f}), johnson {k['johnson_us']:.1f} us (ratio {k['ratio_johnson']:.3f}) per "
+        f"evaluation (median of {KERNEL_CALLS})"
+    )
     return "\n".join(lines)
 
 

@@ -8,6 +8,7 @@ machine) is reported with the refusal instead of figures. The table also gives t
 Gauss-point peak von Mises stress, which grows with the mesh (a singular point value), and
 its disc-averaged stress, which converges (docs/model.md section 4.4).
 """
+
 from __future__ import annotations
 
 import json
@@ -55,8 +56,13 @@ def _plate_worker(spec: dict) -> dict:
         return {"refused": str(err)}
     setup = time.perf_counter() - t0
     rss_setup = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    out = {"setup_s": setup, "rss_setup_mib": rss_setup / 1024.0, "n_red": int(model.plate.n_red),
-           "n_modes": int(model.plate.n_modes), "truncated": bool(model.plate.truncated)}
+    out = {
+        "setup_s": setup,
+        "rss_setup_mib": rss_setup / 1024.0,
+        "n_red": int(model.plate.n_red),
+        "n_modes": int(model.plate.n_modes),
+        "truncated": bool(model.plate.truncated),
+    }
     if spec["run"]:
         t1 = time.perf_counter()
         ds = gp.simulate(s, model=model, progress=False)
@@ -70,24 +76,32 @@ def _plate_worker(spec: dict) -> dict:
 def bench_plate(nx: int, ny: int, modes: str = "auto", t_end: float | None = None, run: bool = True) -> dict:
     """One mesh in a fresh subprocess with an empty run store (see the module docstring)."""
     spec = {"nx": nx, "ny": ny, "modes": modes, "t_end": t_end, "run": run}
-    code = ("import sys, json; from granplate.bench.plates import _plate_worker; "
-            "print('@@RESULT ' + json.dumps(_plate_worker(json.loads(sys.stdin.read()))))")
+    code = (
+        "import sys, json; from granplate.bench.plates import _plate_worker; "
+        "print('@@RESULT ' + json.dumps(_plate_worker(json.loads(sys.stdin.read()))))"
+    )
     with tempfile.TemporaryDirectory(prefix="granplate-plate-bench-") as cache:
         env = dict(os.environ, GRANPLATE_CACHE=cache)
-        p = subprocess.run([sys.executable, "-c", code], input=json.dumps(spec), capture_output=True,
-                           text=True, env=env)
+        p = subprocess.run(
+            [sys.executable, "-c", code], input=json.dumps(spec), capture_output=True, text=True, env=env
+        )
     for line in p.stdout.splitlines():
         if line.startswith("@@RESULT "):
-            return {"mesh": f"{nx} x {ny}", "modes": modes, **json.loads(line[len("@@RESULT "):])}
-    return {"mesh": f"{nx} x {ny}", "modes": modes,
-            "failed": f"rc {p.returncode}: {p.stderr.strip().splitlines()[-1:] or ''}"}
+            return {"mesh": f"{nx} x {ny}", "modes": modes, **json.loads(line[len("@@RESULT ") :])}
+    return {
+        "mesh": f"{nx} x {ny}",
+        "modes": modes,
+        "failed": f"rc {p.returncode}: {p.stderr.strip().splitlines()[-1:] or ''}",
+    }
 
 
 def format_plate_table(rows: list[dict]) -> str:
     """The plate-scaling table as Markdown."""
-    lines = ["| mesh | basis | reduced dofs | modes | set-up [s] | memory after set-up [MiB] "
-             "| run [s] | peak memory [MiB] | peak von Mises [MPa] | disc-averaged [MPa] |",
-             "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
+    lines = [
+        "| mesh | basis | reduced dofs | modes | set-up [s] | memory after set-up [MiB] "
+        "| run [s] | peak memory [MiB] | peak von Mises [MPa] | disc-averaged [MPa] |",
+        "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
     for r in rows:
         if "refused" in r or "failed" in r:
             lines.append(f"| {r['mesh']} | {r['modes']} | | | | | | {r.get('refused') or r.get('failed')} |")
@@ -96,13 +110,16 @@ def format_plate_table(rows: list[dict]) -> str:
         run = f"{r['run_s']:.1f}" if "run_s" in r else "-"
         stress = [(r.get("summary") or {}).get(k) for k in ("max_von_mises", "max_von_mises_disc")]
         mpa = " | ".join("-" if v is None else f"{v / 1e6:.1f}" for v in stress)
-        lines.append(f"| {r['mesh']} | {basis} | {r['n_red']:,} | {r['n_modes']} | {r['setup_s']:.1f} "
-                     f"| {r['rss_setup_mib']:.0f} | {run} | {r['rss_peak_mib']:.0f} | {mpa} |")
+        lines.append(
+            f"| {r['mesh']} | {basis} | {r['n_red']:,} | {r['n_modes']} | {r['setup_s']:.1f} "
+            f"| {r['rss_setup_mib']:.0f} | {run} | {r['rss_peak_mib']:.0f} | {mpa} |"
+        )
     return "\n".join(lines)
 
 
-def run_plates(meshes=PLATE_MESHES, modes: str = "auto", t_end: float | None = None, run: bool = True,
-               log=print) -> list[dict]:
+def run_plates(
+    meshes=PLATE_MESHES, modes: str = "auto", t_end: float | None = None, run: bool = True, log=print
+) -> list[dict]:
     """The table's rows, one subprocess per mesh."""
     rows = []
     for nx, ny in meshes:

@@ -16,6 +16,7 @@ fixed step of REFERENCE_DT, run in the same process after the memory is read. LA
 (another fresh subprocess) runs the same packing at steps LAMMPS_DT_START, halved until
 its error against the same v_ref is at most ours; its row is the first step that reaches it.
 """
+
 from __future__ import annotations
 
 import json
@@ -85,22 +86,45 @@ def _ours_worker(spec: dict) -> dict:
     from granplate.verification.lammps import launched_hexagon
 
     _warm_up()
-    s = launched_hexagon(spec["columns"], spec["rows"], radius=RADIUS, speed=SPEED, mu=spec["mu"],
-                         t_end=spec["t_end"], scheme=spec["scheme"])
+    s = launched_hexagon(
+        spec["columns"],
+        spec["rows"],
+        radius=RADIUS,
+        speed=SPEED,
+        mu=spec["mu"],
+        t_end=spec["t_end"],
+        scheme=spec["scheme"],
+    )
     t0 = time.perf_counter()
     model = build_model(s)
     setup = time.perf_counter() - t0
     ds = simulate(s, model=model, progress=False)
-    out = {"granules": len(s.granules), "contacts": int(len(model.pairs)), "setup_s": setup,
-           "n_steps": int(ds.attrs["n_steps"]), "loop_s": float(ds.attrs["loop_time_s"]),
-           "rss_peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
-           "energy_residual": float(np.abs(ds.energy_residual.values).max())}
+    out = {
+        "granules": len(s.granules),
+        "contacts": int(len(model.pairs)),
+        "setup_s": setup,
+        "n_steps": int(ds.attrs["n_steps"]),
+        "loop_s": float(ds.attrs["loop_time_s"]),
+        "rss_peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+        "energy_residual": float(np.abs(ds.energy_residual.values).max()),
+    }
     if spec["mu"] == 0.0:
-        ref = simulate(launched_hexagon(spec["columns"], spec["rows"], radius=RADIUS, speed=SPEED, t_end=spec["t_end"],
-                                        scheme="paper", dt=REFERENCE_DT), progress=False)
+        ref = simulate(
+            launched_hexagon(
+                spec["columns"],
+                spec["rows"],
+                radius=RADIUS,
+                speed=SPEED,
+                t_end=spec["t_end"],
+                scheme="paper",
+                dt=REFERENCE_DT,
+            ),
+            progress=False,
+        )
         out["reference"] = {"vx": ref.vx.values[-1].tolist(), "vy": ref.vy.values[-1].tolist()}
-        out["error"] = _max_error(ds.vx.values[-1], ds.vy.values[-1],
-                                  {k: np.array(v) for k, v in out["reference"].items()})
+        out["error"] = _max_error(
+            ds.vx.values[-1], ds.vy.values[-1], {k: np.array(v) for k, v in out["reference"].items()}
+        )
     return out
 
 
@@ -123,25 +147,39 @@ def _lammps_worker(spec: dict) -> dict:
     for _ in range(LAMMPS_HALVINGS + 1):
         res = L.run_hertz(s, dt, spec["t_end"])
         err = _max_error(res["vx"][-1], res["vy"][-1], ref)
-        tried.append({"dt_s": dt, "n_steps": res["n_steps"], "setup_s": res["setup_time_s"],
-                      "loop_s": res["loop_time_s"], "error": err})
+        tried.append(
+            {
+                "dt_s": dt,
+                "n_steps": res["n_steps"],
+                "setup_s": res["setup_time_s"],
+                "loop_s": res["loop_time_s"],
+                "error": err,
+            }
+        )
         if as_accurate(err, spec["error"]):
             break
         dt /= 2.0
-    return {**tried[-1], "reached": as_accurate(tried[-1]["error"], spec["error"]), "tried": tried,
-            "rss_peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0}
+    return {
+        **tried[-1],
+        "reached": as_accurate(tried[-1]["error"], spec["error"]),
+        "tried": tried,
+        "rss_peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+    }
 
 
 def run_in_subprocess(module: str, worker: str, spec: dict) -> dict:
     """Run `worker` (a function of granplate.bench.`module`) on `spec` in a fresh Python
     process; its result, or {"failed": the last line of its error}."""
-    code = (f"import sys, json; from granplate.bench import {module}; "
-            f"print('@@RESULT ' + json.dumps({module}.{worker}(json.loads(sys.stdin.read()))))")
-    p = subprocess.run([sys.executable, "-c", code], input=json.dumps(spec), capture_output=True, text=True,
-                       env=dict(os.environ))
+    code = (
+        f"import sys, json; from granplate.bench import {module}; "
+        f"print('@@RESULT ' + json.dumps({module}.{worker}(json.loads(sys.stdin.read()))))"
+    )
+    p = subprocess.run(
+        [sys.executable, "-c", code], input=json.dumps(spec), capture_output=True, text=True, env=dict(os.environ)
+    )
     for line in p.stdout.splitlines():
         if line.startswith("@@RESULT "):
-            return json.loads(line[len("@@RESULT "):])
+            return json.loads(line[len("@@RESULT ") :])
     return {"failed": f"rc {p.returncode}: {(p.stderr.strip().splitlines() or [''])[-1]}"}
 
 
@@ -150,23 +188,32 @@ def per_contact_step_us(loop_s: float, n_steps: int, contacts: int) -> float:
     return 1e6 * loop_s / (n_steps * contacts) if n_steps and contacts else math.nan
 
 
-def run_scaling(sizes=SIZES, frictions=FRICTIONS, t_end: float = T_END, scheme: str = "implicit",
-                lammps: bool = True, log=print) -> list[dict]:
+def run_scaling(
+    sizes=SIZES, frictions=FRICTIONS, t_end: float = T_END, scheme: str = "implicit", lammps: bool = True, log=print
+) -> list[dict]:
     """The table's rows: one per (size, mu), each measured in fresh subprocesses."""
     rows = []
     for columns, rows_ in sizes:
         for mu in frictions:
             log(f"scaling: {granule_count(columns, rows_)} granules, mu = {mu:g} ...")
             spec = {"columns": columns, "rows": rows_, "mu": mu, "t_end": t_end, "scheme": scheme}
-            row = {"dimension": 2, "columns": columns, "rows": rows_, "mu": mu, "scheme": scheme, "t_end_s": t_end,
-                   **run_in_subprocess("scaling", "_ours_worker", spec)}
+            row = {
+                "dimension": 2,
+                "columns": columns,
+                "rows": rows_,
+                "mu": mu,
+                "scheme": scheme,
+                "t_end_s": t_end,
+                **run_in_subprocess("scaling", "_ours_worker", spec),
+            }
             if "failed" not in row:
                 row["us_per_step"] = 1e6 * row["loop_s"] / row["n_steps"]
                 row["us_per_contact_step"] = per_contact_step_us(row["loop_s"], row["n_steps"], row["contacts"])
             if lammps and mu == 0.0 and "error" in row:
                 log(f"scaling: {row['granules']} granules, LAMMPS ...")
-                lm = run_in_subprocess("scaling", "_lammps_worker",
-                                       {**spec, "error": row["error"], "reference": row["reference"]})
+                lm = run_in_subprocess(
+                    "scaling", "_lammps_worker", {**spec, "error": row["error"], "reference": row["reference"]}
+                )
                 if "loop_s" in lm:
                     lm["us_per_contact_step"] = per_contact_step_us(lm["loop_s"], lm["n_steps"], row["contacts"])
                 row["lammps"] = lm
@@ -182,14 +229,15 @@ def format_or_dash(v, fmt: str) -> str:
 
 def format_scaling_table(rows: list[dict]) -> str:
     """The scaling table as Markdown (LAMMPS columns on the frictionless rows)."""
-    lines = ["| granules | contacts | mu | set-up [s] | steps | loop [s] | us/step | us/(contact step) "
-             "| peak [MiB] | error | LAMMPS dt [s] | LAMMPS steps | LAMMPS loop [s] | LAMMPS us/(contact step) "
-             "| LAMMPS error |",
-             "|" + " ---: |" * 15]
+    lines = [
+        "| granules | contacts | mu | set-up [s] | steps | loop [s] | us/step | us/(contact step) "
+        "| peak [MiB] | error | LAMMPS dt [s] | LAMMPS steps | LAMMPS loop [s] | LAMMPS us/(contact step) "
+        "| LAMMPS error |",
+        "|" + " ---: |" * 15,
+    ]
     for r in rows:
         if "failed" in r:
-            lines.append(f"| {granule_count(r['columns'], r['rows']):,} | | {r['mu']:g} | {r['failed']} |"
-                         + " |" * 11)
+            lines.append(f"| {granule_count(r['columns'], r['rows']):,} | | {r['mu']:g} | {r['failed']} |" + " |" * 11)
             continue
         lm = r.get("lammps") or {}
         if "skipped" in lm or not lm:
@@ -197,13 +245,18 @@ def format_scaling_table(rows: list[dict]) -> str:
         elif "failed" in lm:
             lcols = [lm["failed"]] + ["-"] * 4
         else:
-            lcols = [format_or_dash(lm["dt_s"], ".2e") + ("" if lm["reached"] else " (not reached)"),
-                     f"{lm['n_steps']:,}", format_or_dash(lm["loop_s"], ".3g"),
-                     format_or_dash(lm["us_per_contact_step"], ".3f"), format_or_dash(lm["error"], ".1e")]
-        lines.append(f"| {r['granules']:,} | {r['contacts']:,} | {r['mu']:g} | {r['setup_s']:.3f} | {r['n_steps']:,} "
-                     f"| {r['loop_s']:.3g} | {r['us_per_step']:.1f} | {r['us_per_contact_step']:.3f} "
-                     f"| {r['rss_peak_mib']:.0f} | {format_or_dash(r.get('error'), '.1e')} | "
-                     + " | ".join(lcols) + " |")
+            lcols = [
+                format_or_dash(lm["dt_s"], ".2e") + ("" if lm["reached"] else " (not reached)"),
+                f"{lm['n_steps']:,}",
+                format_or_dash(lm["loop_s"], ".3g"),
+                format_or_dash(lm["us_per_contact_step"], ".3f"),
+                format_or_dash(lm["error"], ".1e"),
+            ]
+        lines.append(
+            f"| {r['granules']:,} | {r['contacts']:,} | {r['mu']:g} | {r['setup_s']:.3f} | {r['n_steps']:,} "
+            f"| {r['loop_s']:.3g} | {r['us_per_step']:.1f} | {r['us_per_contact_step']:.3f} "
+            f"| {r['rss_peak_mib']:.0f} | {format_or_dash(r.get('error'), '.1e')} | " + " | ".join(lcols) + " |"
+        )
     return "\n".join(lines)
 
 

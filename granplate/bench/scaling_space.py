@@ -17,14 +17,24 @@ error max |v - v_ref| / SPEED over the spheres' three velocity components at t_e
 (another fresh subprocess) runs the same packing at steps from LAMMPS_DT_START, halved until
 its error against the same v_ref is at most ours.
 """
+
 from __future__ import annotations
 
 import dataclasses
 import sys
 
 from granplate.bench.scaling import (
-    FRICTIONS, LAMMPS_DT_START, LAMMPS_HALVINGS, RADIUS, REFERENCE_DT, SPEED, T_END, as_accurate, format_or_dash,
-    per_contact_step_us, run_in_subprocess,
+    FRICTIONS,
+    LAMMPS_DT_START,
+    LAMMPS_HALVINGS,
+    RADIUS,
+    REFERENCE_DT,
+    SPEED,
+    T_END,
+    as_accurate,
+    format_or_dash,
+    per_contact_step_us,
+    run_in_subprocess,
 )
 from granplate.bench import write_report
 
@@ -39,8 +49,15 @@ def sphere_count(cells: tuple[int, int, int]) -> int:
     return FCC_SITES * cells[0] * cells[1] * cells[2]
 
 
-def launched_fcc(cells: tuple[int, int, int], radius: float = RADIUS, speed: float = SPEED, mu: float = 0.0,
-                 t_end: float = T_END, scheme: str = "implicit", dt: float | None = None):
+def launched_fcc(
+    cells: tuple[int, int, int],
+    radius: float = RADIUS,
+    speed: float = SPEED,
+    mu: float = 0.0,
+    t_end: float = T_END,
+    scheme: str = "implicit",
+    dt: float | None = None,
+):
     """A free FCC packing of touching steel spheres (radius [m], `cells` conventional cells,
     no walls, no plate, no load) whose first lattice plane (x smallest) moves at `speed`
     [m/s] in +x. Undamped, friction mu, dynamic detection; `scheme` with its own step, or
@@ -56,9 +73,16 @@ def launched_fcc(cells: tuple[int, int, int], radius: float = RADIUS, speed: flo
     if dt is not None:
         time_settings = dataclasses.replace(time_settings, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt))
     name = "fcc-" + "x".join(str(c) for c in cells)
-    return Scenario(name=name, dimension=3, granules=granules, plate=None, load=Load(kind="none"),
-                    contact=Contact(mu=mu, alpha_n=0.0, pairs=(), detection="dynamic"), time=time_settings,
-                    solver=Solver(scheme=scheme))
+    return Scenario(
+        name=name,
+        dimension=3,
+        granules=granules,
+        plate=None,
+        load=Load(kind="none"),
+        contact=Contact(mu=mu, alpha_n=0.0, pairs=(), detection="dynamic"),
+        time=time_settings,
+        solver=Solver(scheme=scheme),
+    )
 
 
 def _warm_up(scheme: str) -> None:
@@ -73,8 +97,7 @@ def max_error_3d(v: tuple, ref: dict) -> float:
     """max |v - v_ref| / SPEED over the spheres' vx, vy, vz at t_end (v: the three arrays)."""
     import numpy as np
 
-    return float(max(np.abs(np.asarray(vc) - np.asarray(ref[k])).max() for vc, k in zip(v, ("vx", "vy", "vz")))
-                 / SPEED)
+    return float(max(np.abs(np.asarray(vc) - np.asarray(ref[k])).max() for vc, k in zip(v, ("vx", "vy", "vz"))) / SPEED)
 
 
 def _ours_worker(spec: dict) -> dict:
@@ -97,11 +120,16 @@ def _ours_worker(spec: dict) -> dict:
     model = build_model(s)
     setup = time.perf_counter() - t0
     ds = simulate(s, model=model, progress=False)
-    out = {"granules": len(s.granules), "contacts": int(len(model.pairs)), "setup_s": setup,
-           "n_steps": int(ds.attrs["n_steps"]), "loop_s": float(ds.attrs["loop_time_s"]),
-           "loop_cpu_s": float(ds.attrs["loop_cpu_s"]),
-           "rss_peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
-           "energy_residual": float(np.abs(ds.energy_residual.values).max())}
+    out = {
+        "granules": len(s.granules),
+        "contacts": int(len(model.pairs)),
+        "setup_s": setup,
+        "n_steps": int(ds.attrs["n_steps"]),
+        "loop_s": float(ds.attrs["loop_time_s"]),
+        "loop_cpu_s": float(ds.attrs["loop_cpu_s"]),
+        "rss_peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+        "energy_residual": float(np.abs(ds.energy_residual.values).max()),
+    }
     if spec["mu"] == 0.0:
         ref = simulate(launched_fcc(cells, t_end=spec["t_end"], scheme="paper", dt=REFERENCE_DT), progress=False)
         out["reference"] = {k: ref[k].values[-1].tolist() for k in ("vx", "vy", "vz")}
@@ -128,34 +156,53 @@ def _lammps_worker(spec: dict) -> dict:
         res = L.run_hertz_3d(s, dt, spec["t_end"])
         cpu = time.process_time() - c0
         err = max_error_3d(tuple(res[k][-1] for k in ("vx", "vy", "vz")), spec["reference"])
-        tried.append({"dt_s": dt, "n_steps": res["n_steps"], "setup_s": res["setup_time_s"],
-                      "loop_s": res["loop_time_s"], "cpu_s": cpu, "error": err})
+        tried.append(
+            {
+                "dt_s": dt,
+                "n_steps": res["n_steps"],
+                "setup_s": res["setup_time_s"],
+                "loop_s": res["loop_time_s"],
+                "cpu_s": cpu,
+                "error": err,
+            }
+        )
         if as_accurate(err, spec["error"]):
             break
         dt /= 2.0
-    return {**tried[-1], "reached": as_accurate(tried[-1]["error"], spec["error"]), "tried": tried,
-            "rss_peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0}
+    return {
+        **tried[-1],
+        "reached": as_accurate(tried[-1]["error"], spec["error"]),
+        "tried": tried,
+        "rss_peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+    }
 
 
-def run_scaling_space(sizes=SIZES, frictions=FRICTIONS, t_end: float = T_END, scheme: str = "implicit",
-                      lammps: bool = True, log=print) -> list[dict]:
+def run_scaling_space(
+    sizes=SIZES, frictions=FRICTIONS, t_end: float = T_END, scheme: str = "implicit", lammps: bool = True, log=print
+) -> list[dict]:
     """The 3D table's rows: one per (size, mu), each measured in fresh subprocesses."""
     rows = []
     for cells in sizes:
         for mu in frictions:
             log(f"scaling in space: {sphere_count(cells)} spheres, mu = {mu:g} ...")
             spec = {"cells": list(cells), "mu": mu, "t_end": t_end, "scheme": scheme}
-            row = {"dimension": 3, "cells": list(cells), "mu": mu, "scheme": scheme, "t_end_s": t_end,
-                   **run_in_subprocess("scaling_space", "_ours_worker", spec)}
+            row = {
+                "dimension": 3,
+                "cells": list(cells),
+                "mu": mu,
+                "scheme": scheme,
+                "t_end_s": t_end,
+                **run_in_subprocess("scaling_space", "_ours_worker", spec),
+            }
             if "failed" not in row:
                 row["us_per_step"] = 1e6 * row["loop_s"] / row["n_steps"]
                 row["us_per_contact_step"] = per_contact_step_us(row["loop_s"], row["n_steps"], row["contacts"])
-                row["cpu_us_per_contact_step"] = per_contact_step_us(row["loop_cpu_s"], row["n_steps"],
-                                                                     row["contacts"])
+                row["cpu_us_per_contact_step"] = per_contact_step_us(row["loop_cpu_s"], row["n_steps"], row["contacts"])
             if lammps and mu == 0.0 and "error" in row:
                 log(f"scaling in space: {row['granules']} spheres, LAMMPS ...")
-                lm = run_in_subprocess("scaling_space", "_lammps_worker",
-                                       {**spec, "error": row["error"], "reference": row["reference"]})
+                lm = run_in_subprocess(
+                    "scaling_space", "_lammps_worker", {**spec, "error": row["error"], "reference": row["reference"]}
+                )
                 if "loop_s" in lm:
                     lm["us_per_contact_step"] = per_contact_step_us(lm["loop_s"], lm["n_steps"], row["contacts"])
                     lm["cpu_us_per_contact_step"] = per_contact_step_us(lm["cpu_s"], lm["n_steps"], row["contacts"])
@@ -167,10 +214,12 @@ def run_scaling_space(sizes=SIZES, frictions=FRICTIONS, t_end: float = T_END, sc
 
 def format_space_table(rows: list[dict]) -> str:
     """The 3D scaling table as Markdown (LAMMPS columns on the frictionless rows)."""
-    lines = ["| spheres | cells | contacts | mu | set-up [s] | steps | loop [s] | us/step | us/(contact step) "
-             "| CPU us/(contact step) | peak [MiB] | error | LAMMPS dt [s] | LAMMPS steps | LAMMPS loop [s] "
-             "| LAMMPS us/(contact step) | LAMMPS CPU us/(contact step) | LAMMPS error |",
-             "|" + " ---: |" * 18]
+    lines = [
+        "| spheres | cells | contacts | mu | set-up [s] | steps | loop [s] | us/step | us/(contact step) "
+        "| CPU us/(contact step) | peak [MiB] | error | LAMMPS dt [s] | LAMMPS steps | LAMMPS loop [s] "
+        "| LAMMPS us/(contact step) | LAMMPS CPU us/(contact step) | LAMMPS error |",
+        "|" + " ---: |" * 18,
+    ]
     for r in rows:
         cells = "x".join(str(c) for c in r["cells"])
         if "failed" in r:
@@ -182,15 +231,20 @@ def format_space_table(rows: list[dict]) -> str:
         elif "failed" in lm:
             lcols = [lm["failed"]] + ["-"] * 5
         else:
-            lcols = [format_or_dash(lm["dt_s"], ".2e") + ("" if lm["reached"] else " (not reached)"),
-                     f"{lm['n_steps']:,}", format_or_dash(lm["loop_s"], ".3g"),
-                     format_or_dash(lm["us_per_contact_step"], ".3f"),
-                     format_or_dash(lm["cpu_us_per_contact_step"], ".3f"), format_or_dash(lm["error"], ".1e")]
-        lines.append(f"| {r['granules']:,} | {cells} | {r['contacts']:,} | {r['mu']:g} | {r['setup_s']:.3f} "
-                     f"| {r['n_steps']:,} | {r['loop_s']:.3g} | {r['us_per_step']:.1f} "
-                     f"| {r['us_per_contact_step']:.3f} | {r['cpu_us_per_contact_step']:.3f} "
-                     f"| {r['rss_peak_mib']:.0f} | {format_or_dash(r.get('error'), '.1e')} | "
-                     + " | ".join(lcols) + " |")
+            lcols = [
+                format_or_dash(lm["dt_s"], ".2e") + ("" if lm["reached"] else " (not reached)"),
+                f"{lm['n_steps']:,}",
+                format_or_dash(lm["loop_s"], ".3g"),
+                format_or_dash(lm["us_per_contact_step"], ".3f"),
+                format_or_dash(lm["cpu_us_per_contact_step"], ".3f"),
+                format_or_dash(lm["error"], ".1e"),
+            ]
+        lines.append(
+            f"| {r['granules']:,} | {cells} | {r['contacts']:,} | {r['mu']:g} | {r['setup_s']:.3f} "
+            f"| {r['n_steps']:,} | {r['loop_s']:.3g} | {r['us_per_step']:.1f} "
+            f"| {r['us_per_contact_step']:.3f} | {r['cpu_us_per_contact_step']:.3f} "
+            f"| {r['rss_peak_mib']:.0f} | {format_or_dash(r.get('error'), '.1e')} | " + " | ".join(lcols) + " |"
+        )
     return "\n".join(lines)
 
 
@@ -201,8 +255,9 @@ def parse_cells(text: str) -> list[tuple[int, int, int]]:
     for item in text.split(","):
         parts = item.strip().lower().split("x")
         if len(parts) != 3 or not all(p.strip().isdigit() and int(p) >= 1 for p in parts):
-            raise ValueError(f"--sizes item {item!r}: allowed NXxNYxNZ (FCC cells along x, y, z) with "
-                             "integers >= 1, e.g. 6x6x7")
+            raise ValueError(
+                f"--sizes item {item!r}: allowed NXxNYxNZ (FCC cells along x, y, z) with integers >= 1, e.g. 6x6x7"
+            )
         out.append((int(parts[0]), int(parts[1]), int(parts[2])))
     return out
 
@@ -220,4 +275,3 @@ def main(args, t_end: float, scheme: str) -> int:
     print(format_space_table(rows))
     write_report(args, rows)
     return 1 if any("failed" in r or "failed" in (r.get("lammps") or {}) for r in rows) else 0
-

@@ -9,6 +9,7 @@ store (set-up time; peak resident memory, ru_maxrss):
 - locking and accuracy: the first clamped frequency of a thin square plate (a = 100 mm,
   h = 2 mm) against Leissa's lambda^2 = 35.99, per element.
 """
+
 from __future__ import annotations
 
 import json
@@ -29,8 +30,13 @@ PLATE_ROWS = (("hex20", (40, 40, 2), False), ("hex20", (40, 40, 2), True))
 ELEMENT_ROWS = (("hex20", (20, 20, 2)), ("hex27", (17, 17, 1)), ("tet10", (17, 17, 1)))
 #: The thin plate of the accuracy table [m] and its meshes per element.
 THIN_SIZE = (0.1, 0.1, 0.002)
-THIN_ROWS = (("hex20", (10, 10, 1)), ("hex20", (20, 20, 1)), ("hex27", (10, 10, 1)),
-             ("tet10", (10, 10, 1)), ("tet10", (20, 20, 1)))
+THIN_ROWS = (
+    ("hex20", (10, 10, 1)),
+    ("hex20", (20, 20, 1)),
+    ("hex27", (10, 10, 1)),
+    ("tet10", (10, 10, 1)),
+    ("tet10", (20, 20, 1)),
+)
 LEISSA_CLAMPED = 35.99
 
 
@@ -42,33 +48,58 @@ def _worker(spec: dict) -> dict:
     from granplate.setup.scenario import Solid
     from granplate.solid.build import build_solid
 
-    sd = Solid(size=tuple(spec["size"]), elements=tuple(spec["elements"]), element=spec["element"],
-               clamped=tuple(spec["clamped"]), max_frequency=spec["max_frequency"])
+    sd = Solid(
+        size=tuple(spec["size"]),
+        elements=tuple(spec["elements"]),
+        element=spec["element"],
+        clamped=tuple(spec["clamped"]),
+        max_frequency=spec["max_frequency"],
+    )
     t0 = time.perf_counter()
     try:
         m = build_solid(sd, surface="zmax" if spec["residual"] else None)
     except ScenarioError as err:
         return {"refused": str(err)}
-    return {"setup_s": time.perf_counter() - t0, "rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
-            "n_dofs": int(len(m.dofs)), "n_modes": int(m.n_modes), "n_surface": int(len(m.surface_dofs)),
-            "f1_hz": float(m.frequencies[0]), "estimate_s": float(m.cost.seconds),
-            "estimate_mib": float(m.cost.memory / 2**20)}
+    return {
+        "setup_s": time.perf_counter() - t0,
+        "rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+        "n_dofs": int(len(m.dofs)),
+        "n_modes": int(m.n_modes),
+        "n_surface": int(len(m.surface_dofs)),
+        "f1_hz": float(m.frequencies[0]),
+        "estimate_s": float(m.cost.seconds),
+        "estimate_mib": float(m.cost.memory / 2**20),
+    }
 
 
-def bench_solid(element: str, elements, size=PLATE_SIZE, residual: bool = False,
-                max_frequency: float = PLATE_MAX_FREQUENCY) -> dict:
+def bench_solid(
+    element: str, elements, size=PLATE_SIZE, residual: bool = False, max_frequency: float = PLATE_MAX_FREQUENCY
+) -> dict:
     """One build in a fresh subprocess with an empty run store."""
-    spec = {"element": element, "elements": list(elements), "size": list(size), "clamped": list(PLATE_CLAMPS),
-            "max_frequency": max_frequency, "residual": residual}
-    code = ("import sys, json; from granplate.bench.solid import _worker; "
-            "print('@@RESULT ' + json.dumps(_worker(json.loads(sys.stdin.read()))))")
+    spec = {
+        "element": element,
+        "elements": list(elements),
+        "size": list(size),
+        "clamped": list(PLATE_CLAMPS),
+        "max_frequency": max_frequency,
+        "residual": residual,
+    }
+    code = (
+        "import sys, json; from granplate.bench.solid import _worker; "
+        "print('@@RESULT ' + json.dumps(_worker(json.loads(sys.stdin.read()))))"
+    )
     with tempfile.TemporaryDirectory(prefix="granplate-solid-bench-") as cache:
-        p = subprocess.run([sys.executable, "-c", code], input=json.dumps(spec), capture_output=True, text=True,
-                           env=dict(os.environ, GRANPLATE_CACHE=cache))
+        p = subprocess.run(
+            [sys.executable, "-c", code],
+            input=json.dumps(spec),
+            capture_output=True,
+            text=True,
+            env=dict(os.environ, GRANPLATE_CACHE=cache),
+        )
     row = {"element": element, "mesh": " x ".join(str(n) for n in elements), "residual": residual}
     for line in p.stdout.splitlines():
         if line.startswith("@@RESULT "):
-            return {**row, **json.loads(line[len("@@RESULT "):])}
+            return {**row, **json.loads(line[len("@@RESULT ") :])}
     return {**row, "failed": f"rc {p.returncode}: {p.stderr.strip().splitlines()[-1:] or ''}"}
 
 
@@ -88,9 +119,11 @@ def format_rows(rows: list[dict], accuracy: bool = False) -> str:
         if "refused" in r or "failed" in r:
             lines.append(f"| {r['element']} | {r['mesh']} | {r.get('refused') or r.get('failed')} |")
             continue
-        line = (f"| {r['element']} | {r['mesh']} | {r['n_dofs']:,} | {r['n_modes']} | {r['n_surface']:,} "
-                f"| {r['setup_s']:.1f} | {r['estimate_s']:.1f} | {r['rss_mib']:.0f} | {r['estimate_mib']:.0f} "
-                f"| {1e6 * r['setup_s'] / r['n_dofs']:.0f} |")
+        line = (
+            f"| {r['element']} | {r['mesh']} | {r['n_dofs']:,} | {r['n_modes']} | {r['n_surface']:,} "
+            f"| {r['setup_s']:.1f} | {r['estimate_s']:.1f} | {r['rss_mib']:.0f} | {r['estimate_mib']:.0f} "
+            f"| {1e6 * r['setup_s'] / r['n_dofs']:.0f} |"
+        )
         if accuracy:
             line += f" {r['f1_hz']:.1f} | {r['f1_hz'] / f_ref:.4f} |"
         lines.append(line)

@@ -18,6 +18,7 @@ touch (SIZES) and the step (DTS); the cut-off tables of the protector and of a 5
 2 mm sphere's drop (CUTOFFS against REFERENCE_CUTOFF): the plate's peak energy share
 max E_plate / E_in and the peak contact force on the body, each against the reference's.
 """
+
 from __future__ import annotations
 
 import math
@@ -68,8 +69,15 @@ SMALL_T_END = 5.0e-5
 WITHIN = 0.01
 
 
-def protector(cells=CELLS, mesh=MESH, max_frequency: float = MAX_FREQUENCY, dt: float = DT,
-              t_end: float = T_END, output_interval: float = OUTPUT_INTERVAL, element: str = "hex20"):
+def protector(
+    cells=CELLS,
+    mesh=MESH,
+    max_frequency: float = MAX_FREQUENCY,
+    dt: float = DT,
+    t_end: float = T_END,
+    output_interval: float = OUTPUT_INTERVAL,
+    element: str = "hex20",
+):
     """The protector scenario (module docstring): `cells` FCC cells of steel spheres of
     RADIUS, the plate's face xmin against the last plane's surfaces, centred on the stack in
     y and z; `mesh` the plate's elements (x, y, z), `max_frequency` [Hz] its cut-off; fixed
@@ -82,45 +90,84 @@ def protector(cells=CELLS, mesh=MESH, max_frequency: float = MAX_FREQUENCY, dt: 
     x_face = max(g.x + g.radius for g in granules)
     cy = 0.5 * (min(g.y for g in granules) + max(g.y for g in granules))
     cz = 0.5 * (min(g.z for g in granules) + max(g.z for g in granules))
-    plate = Solid(size=(PLATE_THICKNESS, PLATE_SPAN, PLATE_SPAN), elements=tuple(mesh),
-                  origin=(x_face, cy - 0.5 * PLATE_SPAN, cz - 0.5 * PLATE_SPAN), material="steel",
-                  element=element, clamped=PLATE_CLAMPS, max_frequency=max_frequency)
-    load = Load(kind="force", force=FORCE, duration=DURATION, direction=(1.0, 0.0, 0.0),
-                granules=tuple(packing.column1))
+    plate = Solid(
+        size=(PLATE_THICKNESS, PLATE_SPAN, PLATE_SPAN),
+        elements=tuple(mesh),
+        origin=(x_face, cy - 0.5 * PLATE_SPAN, cz - 0.5 * PLATE_SPAN),
+        material="steel",
+        element=element,
+        clamped=PLATE_CLAMPS,
+        max_frequency=max_frequency,
+    )
+    load = Load(
+        kind="force", force=FORCE, duration=DURATION, direction=(1.0, 0.0, 0.0), granules=tuple(packing.column1)
+    )
     name = "protector-" + "x".join(str(c) for c in cells)
-    return Scenario(name=name, dimension=3, granules=granules, plate=plate, load=load,
-                    time=_fixed_step(t_end, dt, output_interval), solver=Solver(scheme="verlet",
-                                                                                granular_friction="split"))
+    return Scenario(
+        name=name,
+        dimension=3,
+        granules=granules,
+        plate=plate,
+        load=load,
+        time=_fixed_step(t_end, dt, output_interval),
+        solver=Solver(scheme="verlet", granular_friction="split"),
+    )
 
 
-def sphere_drop(mesh=MESH, max_frequency: float = MAX_FREQUENCY, dt: float = DROP_DT, t_end: float = DROP_T_END,
-                output_interval: float = DROP_OUTPUT, radius: float = RADIUS):
+def sphere_drop(
+    mesh=MESH,
+    max_frequency: float = MAX_FREQUENCY,
+    dt: float = DROP_DT,
+    t_end: float = DROP_T_END,
+    output_interval: float = DROP_OUTPUT,
+    radius: float = RADIUS,
+):
     """One steel sphere of `radius` [m] at DROP_SPEED along +x, touching the centre of the
     protector's plate (same mesh and clamps) at t = 0, no load."""
     from granplate.setup.scenario import Granule, Load, Scenario, Solid, Solver
 
-    plate = Solid(size=(PLATE_THICKNESS, PLATE_SPAN, PLATE_SPAN), elements=tuple(mesh),
-                  origin=(radius, -0.5 * PLATE_SPAN, -0.5 * PLATE_SPAN), material="steel",
-                  clamped=PLATE_CLAMPS, max_frequency=max_frequency)
+    plate = Solid(
+        size=(PLATE_THICKNESS, PLATE_SPAN, PLATE_SPAN),
+        elements=tuple(mesh),
+        origin=(radius, -0.5 * PLATE_SPAN, -0.5 * PLATE_SPAN),
+        material="steel",
+        clamped=PLATE_CLAMPS,
+        max_frequency=max_frequency,
+    )
     ball = Granule(0.0, 0.0, radius, "steel", label="ball", z=0.0, vx=DROP_SPEED, omega=(0.0, 0.0, 0.0))
-    return Scenario(name="sphere-drop", dimension=3, granules=(ball,), plate=plate, load=Load(kind="none"),
-                    time=_fixed_step(t_end, dt, output_interval),
-                    solver=Solver(scheme="verlet", granular_friction="split"))
+    return Scenario(
+        name="sphere-drop",
+        dimension=3,
+        granules=(ball,),
+        plate=plate,
+        load=Load(kind="none"),
+        time=_fixed_step(t_end, dt, output_interval),
+        solver=Solver(scheme="verlet", granular_friction="split"),
+    )
 
 
 def _fixed_step(t_end: float, dt: float, output_interval: float):
     """TimeSettings of a fixed step dt [s] (dt_initial = dt_max = dt)."""
     from granplate.setup.scenario import TimeSettings
 
-    return TimeSettings(t_end=t_end, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt),
-                        output_interval=output_interval, field_interval=max(output_interval, t_end / 20.0))
+    return TimeSettings(
+        t_end=t_end,
+        dt_initial=dt,
+        dt_max=dt,
+        dt_min=min(1e-13, dt),
+        output_interval=output_interval,
+        field_interval=max(output_interval, t_end / 20.0),
+    )
 
 
 def scenario_of(spec: dict):
     """The scenario a row's spec names: {"case": "protector" | "drop", "mesh", "max_frequency",
     "dt", "t_end", "cells" (the protector's), "radius" (the drop's)}."""
-    keys = {k: (tuple(v) if isinstance(v, list) else v) for k, v in spec.items()
-            if k in ("mesh", "max_frequency", "dt", "t_end", "cells", "radius")}
+    keys = {
+        k: (tuple(v) if isinstance(v, list) else v)
+        for k, v in spec.items()
+        if k in ("mesh", "max_frequency", "dt", "t_end", "cells", "radius")
+    }
     if spec.get("case", "protector") == "drop":
         keys.pop("cells", None)
         return sphere_drop(**keys)
@@ -136,13 +183,17 @@ def run_measures(ds) -> dict:
 
     e_in = float(ds.E_shock.values[-1]) + float(ds.attrs.get("E_initial", 0.0))
     normal = ds.body_contact_normal_force.values
-    return {"n_steps": int(ds.attrs["n_steps"]), "loop_s": float(ds.attrs["loop_time_s"]),
-            "loop_cpu_s": float(ds.attrs["loop_cpu_s"]), "n_modes": int(ds.sizes.get("mode", 0)),
-            "plate_share": float(ds.E_plate.values.max() / e_in) if e_in > 0.0 else math.nan,
-            "peak_force_n": float(normal.max()) if normal.size else 0.0,
-            "in_touch": int((normal > 0.0).sum(axis=1).max()) if normal.size else 0,
-            "energy_residual": float(np.abs(ds.energy_residual_max.values).max()),
-            "e_in_j": e_in}
+    return {
+        "n_steps": int(ds.attrs["n_steps"]),
+        "loop_s": float(ds.attrs["loop_time_s"]),
+        "loop_cpu_s": float(ds.attrs["loop_cpu_s"]),
+        "n_modes": int(ds.sizes.get("mode", 0)),
+        "plate_share": float(ds.E_plate.values.max() / e_in) if e_in > 0.0 else math.nan,
+        "peak_force_n": float(normal.max()) if normal.size else 0.0,
+        "in_touch": int((normal > 0.0).sum(axis=1).max()) if normal.size else 0,
+        "energy_residual": float(np.abs(ds.energy_residual_max.values).max()),
+        "e_in_j": e_in,
+    }
 
 
 def _worker(spec: dict) -> dict:
@@ -166,8 +217,14 @@ def _worker(spec: dict) -> dict:
     again = time.perf_counter() - t0
     ds = simulate(s, model=model, progress=False)
     dofs = int(len(model.solid.dofs)) if model.solid is not None else None
-    return {"granules": len(s.granules), "setup_first_s": first, "setup_cached_s": again, "n_dofs": dofs,
-            "rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, **run_measures(ds)}
+    return {
+        "granules": len(s.granules),
+        "setup_first_s": first,
+        "setup_cached_s": again,
+        "n_dofs": dofs,
+        "rss_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+        **run_measures(ds),
+    }
 
 
 def run_row(spec: dict, fresh: bool = False) -> dict:
@@ -209,9 +266,12 @@ def chosen_cutoff(rows: list[dict], reference: dict, within: float = WITHIN) -> 
     """The lowest cut-off [Hz] whose peak energy share and peak contact force are both
     within `within` (relative) of the reference's, and stay so at every higher cut-off of
     `rows`; None when none is."""
-    ok = [r["max_frequency"] for r in rows
-          if abs(relative_change(r["plate_share"], reference["plate_share"])) <= within
-          and abs(relative_change(r["peak_force_n"], reference["peak_force_n"])) <= within]
+    ok = [
+        r["max_frequency"]
+        for r in rows
+        if abs(relative_change(r["plate_share"], reference["plate_share"])) <= within
+        and abs(relative_change(r["peak_force_n"], reference["peak_force_n"])) <= within
+    ]
     fine = sorted(f for f in ok if all(g in ok for g in (r["max_frequency"] for r in rows) if g >= f))
     return fine[0] if fine else None
 
@@ -226,35 +286,43 @@ def _mesh(row: dict) -> str:
 
 def format_cost(rows: list[dict]) -> str:
     """The cost table as Markdown: one row per run."""
-    head = ("| case | spheres | mesh | free dofs | modes | cut-off [Hz] | dt [s] | set-up uncached [s] "
-            "| set-up cached [s] | steps | loop [s] | us/step | CPU us/step | in touch | energy residual |")
+    head = (
+        "| case | spheres | mesh | free dofs | modes | cut-off [Hz] | dt [s] | set-up uncached [s] "
+        "| set-up cached [s] | steps | loop [s] | us/step | CPU us/step | in touch | energy residual |"
+    )
     lines = [head, "|" + " ---: |" * (head.count("|") - 1)]
     for r in rows:
         if "failed" in r:
             lines.append(f"| {r.get('case', 'protector')} | | {_mesh(r)} | {r['failed'][:200]} |" + " |" * 11)
             continue
         uncached = r.get("setup_uncached_s")
-        lines.append(f"| {r.get('case', 'protector')} | {r['granules']:,} | {_mesh(r)} | {_cell(r['n_dofs'], ',')} "
-                     f"| {r['n_modes']} | {r['max_frequency']:.3g} | {r['dt']:.2g} | {_cell(uncached, '.1f')} "
-                     f"| {r['setup_cached_s']:.2f} | {r['n_steps']:,} | {r['loop_s']:.1f} "
-                     f"| {us_per_step(r):.0f} | {us_per_step(r, 'loop_cpu_s'):.0f} | {r['in_touch']} "
-                     f"| {r['energy_residual']:.1e} |")
+        lines.append(
+            f"| {r.get('case', 'protector')} | {r['granules']:,} | {_mesh(r)} | {_cell(r['n_dofs'], ',')} "
+            f"| {r['n_modes']} | {r['max_frequency']:.3g} | {r['dt']:.2g} | {_cell(uncached, '.1f')} "
+            f"| {r['setup_cached_s']:.2f} | {r['n_steps']:,} | {r['loop_s']:.1f} "
+            f"| {us_per_step(r):.0f} | {us_per_step(r, 'loop_cpu_s'):.0f} | {r['in_touch']} "
+            f"| {r['energy_residual']:.1e} |"
+        )
     return "\n".join(lines)
 
 
 def format_cutoffs(rows: list[dict], reference: dict) -> str:
     """The cut-off table as Markdown: each cut-off's modes, peak energy share and peak
     contact force, each against the reference's."""
-    lines = ["| case | cut-off [Hz] | modes | plate's peak share | vs reference | peak force [N] | vs reference "
-             "| us/step |", "|" + " ---: |" * 8]
+    lines = [
+        "| case | cut-off [Hz] | modes | plate's peak share | vs reference | peak force [N] | vs reference | us/step |",
+        "|" + " ---: |" * 8,
+    ]
     for r in [*rows, reference]:
         if "failed" in r:
             lines.append(f"| {r.get('case')} | {r['max_frequency']:.3g} | {r['failed']} |" + " |" * 5)
             continue
         ds = relative_change(r["plate_share"], reference["plate_share"])
         df = relative_change(r["peak_force_n"], reference["peak_force_n"])
-        lines.append(f"| {r.get('case')} | {r['max_frequency']:.3g} | {r['n_modes']} | {100 * r['plate_share']:.3f}% "
-                     f"| {100 * ds:+.2f}% | {r['peak_force_n']:.2f} | {100 * df:+.2f}% | {us_per_step(r):.0f} |")
+        lines.append(
+            f"| {r.get('case')} | {r['max_frequency']:.3g} | {r['n_modes']} | {100 * r['plate_share']:.3f}% "
+            f"| {100 * ds:+.2f}% | {r['peak_force_n']:.2f} | {100 * df:+.2f}% | {us_per_step(r):.0f} |"
+        )
     return "\n".join(lines)
 
 
@@ -303,9 +371,11 @@ def run_all(quick: bool = False, repeats: int = 1, log=print) -> dict:
     if quick:
         report["cutoff_drop"] = cutoff_table("drop", {}, CUTOFFS[:2], MAX_FREQUENCY, log=log)
         return report
-    cases = {"drop": ("drop", {}), "drop_small": ("drop", {"radius": SMALL_RADIUS, "dt": SMALL_DT,
-                                                            "t_end": SMALL_T_END}),
-             "protector": ("protector", {"t_end": t_end})}
+    cases = {
+        "drop": ("drop", {}),
+        "drop_small": ("drop", {"radius": SMALL_RADIUS, "dt": SMALL_DT, "t_end": SMALL_T_END}),
+        "protector": ("protector", {"t_end": t_end}),
+    }
     for key, (case, kw) in cases.items():
         report[f"cutoff_{key}"] = cutoff_table(case, kw, log=log)
     return report
@@ -317,8 +387,11 @@ def cutoff_table(case: str, kw: dict, cutoffs=CUTOFFS, reference: float = REFERE
     log(f"coupled solid: cut-offs of the {case} {kw} ...")
     rows = [run_row(spec_of(case, max_frequency=f, **kw)) for f in cutoffs]
     ref = run_row(spec_of(case, max_frequency=reference, **kw))
-    return {"rows": rows, "reference": ref,
-            "chosen": None if "failed" in ref else chosen_cutoff([r for r in rows if "failed" not in r], ref)}
+    return {
+        "rows": rows,
+        "reference": ref,
+        "chosen": None if "failed" in ref else chosen_cutoff([r for r in rows if "failed" not in r], ref),
+    }
 
 
 def print_report(report: dict) -> None:
@@ -339,10 +412,9 @@ def main(args) -> int:
     run_all's report, each table a list of rows, each cut-off table its rows, reference and
     chosen cut-off)."""
     repeats = getattr(args, "repeats", None) or 1
-    report = run_all(quick=getattr(args, "quick", False), repeats=repeats,
-                     log=lambda line: print(line, file=sys.stderr))
+    report = run_all(
+        quick=getattr(args, "quick", False), repeats=repeats, log=lambda line: print(line, file=sys.stderr)
+    )
     print_report(report)
     write_report(args, report)
     return 0
-
-

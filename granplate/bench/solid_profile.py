@@ -9,6 +9,7 @@ each sub-pass `calls` times: the whole pass, the bounding-box test, the closest 
 spread onto the modes, the residual matrix between the contacts in touch and its
 Gauss-Seidel solve. CPU time per call [us].
 """
+
 from __future__ import annotations
 
 import sys
@@ -141,13 +142,23 @@ def profile_contacts(spec: dict, calls: int = CALLS) -> dict:
     B.contact_forces(y, q, qd, b, 0, radius, mass, True, acc, fd, True)  # the faces seeded at this state
     act = np.array([i for i in range(len(y)) if b.geo[0, i, GEO_TOUCH] != 0.0], np.int64)
     delta0 = np.array([b.geo[0, i, GEO_DELTA] for i in act]) + 1e-7
-    out = {"n_near": int(_near(b, y, radius, 1)), "n_touch": int(len(act)), "n_modes": int(q.size),
-           "n_resid": int(b.resid.shape[0]), "n_dofs": int(len(model.solid.dofs)),
-           "step_cpu_us": 1e6 * float(ds.attrs["loop_cpu_s"]) / int(ds.attrs["n_steps"])}
-    runs = {"contact_forces": (_whole, (y, q, qd, b, radius, mass, acc, fd)), "near_box": (_near, (b, y, radius)),
-            "locate": (_locate, (b, y, radius)), "surface_motion": (_motion, (b, act, q, qd)),
-            "spread": (_spread, (b, act, q.size)), "residual_matrix": (_residual, (b, act)),
-            "solve_static": (_solve, (b, act, delta0, _residual(b, act, 1)))}
+    out = {
+        "n_near": int(_near(b, y, radius, 1)),
+        "n_touch": int(len(act)),
+        "n_modes": int(q.size),
+        "n_resid": int(b.resid.shape[0]),
+        "n_dofs": int(len(model.solid.dofs)),
+        "step_cpu_us": 1e6 * float(ds.attrs["loop_cpu_s"]) / int(ds.attrs["n_steps"]),
+    }
+    runs = {
+        "contact_forces": (_whole, (y, q, qd, b, radius, mass, acc, fd)),
+        "near_box": (_near, (b, y, radius)),
+        "locate": (_locate, (b, y, radius)),
+        "surface_motion": (_motion, (b, act, q, qd)),
+        "spread": (_spread, (b, act, q.size)),
+        "residual_matrix": (_residual, (b, act)),
+        "solve_static": (_solve, (b, act, delta0, _residual(b, act, 1))),
+    }
     for name in PASSES:
         fn, args = runs[name]
         out[name + "_us"] = _cpu_us(fn, args, calls)
@@ -156,13 +167,19 @@ def profile_contacts(spec: dict, calls: int = CALLS) -> dict:
 
 def format_profile(rows: list[dict]) -> str:
     """The profile table as Markdown: one row per mesh."""
-    head = ("| mesh | free dofs | residual dofs | in touch | " + " | ".join(f"{p} [us]" for p in PASSES)
-            + " | whole step [us] |")
+    head = (
+        "| mesh | free dofs | residual dofs | in touch | "
+        + " | ".join(f"{p} [us]" for p in PASSES)
+        + " | whole step [us] |"
+    )
     lines = [head, "|" + " ---: |" * (head.count("|") - 1)]
     for r in rows:
         mesh = " x ".join(str(n) for n in r["mesh"])
-        lines.append(f"| {mesh} | {r['n_dofs']:,} | {r['n_resid']:,} | {r['n_touch']} | "
-                     + " | ".join(f"{r[p + '_us']:,.0f}" for p in PASSES) + f" | {r['step_cpu_us']:,.0f} |")
+        lines.append(
+            f"| {mesh} | {r['n_dofs']:,} | {r['n_resid']:,} | {r['n_touch']} | "
+            + " | ".join(f"{r[p + '_us']:,.0f}" for p in PASSES)
+            + f" | {r['step_cpu_us']:,.0f} |"
+        )
     return "\n".join(lines)
 
 

@@ -17,6 +17,7 @@ compiled code ready, the total to the first step and the process's CPU time to i
 and system: what the wall time would be on a machine no other process shares); the peak
 resident memory, and bytes per sphere (the peak above the two-sphere row's, per sphere).
 """
+
 from __future__ import annotations
 
 import json
@@ -30,7 +31,12 @@ import time
 #: Rows of the default table: (cells, format). 2 spheres in tables (the baseline), 10,192 as
 #: tables and as each file format.
 DEFAULT_ROWS: tuple[tuple[tuple[int, int, int] | None, str], ...] = (
-    (None, "toml"), ((14, 14, 13), "toml"), ((14, 14, 13), "csv"), ((14, 14, 13), "npz"), ((14, 14, 13), "nc"))
+    (None, "toml"),
+    ((14, 14, 13), "toml"),
+    ((14, 14, 13), "csv"),
+    ((14, 14, 13), "npz"),
+    ((14, 14, 13), "nc"),
+)
 #: Formats a row may take: the TOML's own tables, or a granules_file of that extension.
 FORMATS: tuple[str, ...] = ("toml", "csv", "npz", "nc")
 #: Sphere radius [m], launch speed [m/s], fixed step [s] and simulated time [s].
@@ -47,13 +53,22 @@ def boxed_fcc(cells: tuple[int, int, int] | None):
     from granplate.setup.geometry import box_walls, layout_packing, resolve
     from granplate.setup.scenario import Box, Contact, Granule, Load, Scenario, Solver, SpaceLattice, TimeSettings
 
-    time_settings = TimeSettings(t_end=T_END, dt_initial=DT, dt_max=DT, dt_min=DT, output_interval=T_END / 10,
-                                 field_interval=T_END / 10)
-    common = dict(dimension=3, plate=None, load=Load(kind="none"), time=time_settings,
-                  contact=Contact(mu=0.0, alpha_n=0.0, pairs=(), detection="dynamic"), solver=Solver(scheme="verlet"))
+    time_settings = TimeSettings(
+        t_end=T_END, dt_initial=DT, dt_max=DT, dt_min=DT, output_interval=T_END / 10, field_interval=T_END / 10
+    )
+    common = dict(
+        dimension=3,
+        plate=None,
+        load=Load(kind="none"),
+        time=time_settings,
+        contact=Contact(mu=0.0, alpha_n=0.0, pairs=(), detection="dynamic"),
+        solver=Solver(scheme="verlet"),
+    )
     if cells is None:
-        granules = (Granule(RADIUS, RADIUS, RADIUS, "steel", "a", vx=SPEED, omega=(0.0, 0.0, 0.0), z=RADIUS),
-                    Granule(3 * RADIUS, RADIUS, RADIUS, "steel", "b", omega=(0.0, 0.0, 0.0), z=RADIUS))
+        granules = (
+            Granule(RADIUS, RADIUS, RADIUS, "steel", "a", vx=SPEED, omega=(0.0, 0.0, 0.0), z=RADIUS),
+            Granule(3 * RADIUS, RADIUS, RADIUS, "steel", "b", omega=(0.0, 0.0, 0.0), z=RADIUS),
+        )
         box = Box((0.0, 0.0, 0.0), (4 * RADIUS, 2 * RADIUS, 2 * RADIUS))
         return resolve(Scenario(name="two-spheres", granules=granules, walls=box_walls(box), **common))
     packing = layout_packing(SpaceLattice(kind="fcc", cells=tuple(cells), radius=RADIUS))
@@ -110,11 +125,18 @@ def time_row(path: str) -> dict:
     p = subprocess.run([sys.executable, "-c", CHILD, path], capture_output=True, text=True, env=dict(os.environ))
     for line in p.stdout.splitlines():
         if line.startswith("@@RESULT "):
-            r = json.loads(line[len("@@RESULT "):])
-            return {"spheres": r["spheres"], "pairs": r["pairs"], "peak_bytes": r["peak_bytes"],
-                    "import_s": r["imported"] - start, "read_s": r["read"] - r["imported"],
-                    "build_s": r["built"] - r["read"], "loop_start_s": r["first_step"] - r["built"],
-                    "first_step_s": r["first_step"] - start, "cpu_s": r["cpu_s"]}
+            r = json.loads(line[len("@@RESULT ") :])
+            return {
+                "spheres": r["spheres"],
+                "pairs": r["pairs"],
+                "peak_bytes": r["peak_bytes"],
+                "import_s": r["imported"] - start,
+                "read_s": r["read"] - r["imported"],
+                "build_s": r["built"] - r["read"],
+                "loop_start_s": r["first_step"] - r["built"],
+                "first_step_s": r["first_step"] - start,
+                "cpu_s": r["cpu_s"],
+            }
     return {"failed": f"rc {p.returncode}: {(p.stderr.strip().splitlines() or [''])[-1]}"}
 
 
@@ -132,8 +154,13 @@ def run_startup(rows=DEFAULT_ROWS, repeats: int = REPEATS, log=print) -> list[di
             log(f"start-up: {len(s.granules):,} spheres from {fmt} ...")
             runs = [time_row(path) for _ in range(repeats)]
             failed = [r for r in runs if "failed" in r]
-            row = {"cells": list(cells) if cells else None, "format": fmt, "spheres": len(s.granules),
-                   "file_bytes": size, "repeats": repeats}
+            row = {
+                "cells": list(cells) if cells else None,
+                "format": fmt,
+                "spheres": len(s.granules),
+                "file_bytes": size,
+                "repeats": repeats,
+            }
             if failed:
                 row["failed"] = failed[0]["failed"]
             else:
@@ -151,20 +178,27 @@ def run_startup(rows=DEFAULT_ROWS, repeats: int = REPEATS, log=print) -> list[di
 
 def format_startup_table(rows: list[dict]) -> str:
     """The start-up table as Markdown."""
-    lines = ["| spheres | given as | file [MB] | imports [s] | read + validate [s] | model [s] | loop ready [s] "
-             "| to first step [s] | its CPU time [s] | beyond 2 spheres [s] | peak [MiB] | bytes per sphere |",
-             "|" + " ---: |" * 12]
+    lines = [
+        "| spheres | given as | file [MB] | imports [s] | read + validate [s] | model [s] | loop ready [s] "
+        "| to first step [s] | its CPU time [s] | beyond 2 spheres [s] | peak [MiB] | bytes per sphere |",
+        "|" + " ---: |" * 12,
+    ]
     for r in rows:
         given = "[[granules]]" if r["format"] == "toml" else f"granules_file .{r['format']}"
         if "failed" in r:
             lines.append(f"| {r['spheres']:,} | {given} | | {r['failed']} |" + " |" * 8)
             continue
-        extra = (f"{r['beyond_two_s']:.2f} | {r['peak_bytes'] / 2**20:.0f} | {r['bytes_per_sphere']:.0f}"
-                 if "beyond_two_s" in r else f"- | {r['peak_bytes'] / 2**20:.0f} | -")
-        lines.append(f"| {r['spheres']:,} | {given} | {r['file_bytes'] / 1e6:.2f} | {r['import_s']:.2f} "
-                     f"| {r['read_s']:.2f} | {r['build_s']:.2f} | {r['loop_start_s']:.2f} | {r['first_step_s']:.2f} "
-                     f"| {r['cpu_s']:.2f} "
-                     f"| {extra} |")
+        extra = (
+            f"{r['beyond_two_s']:.2f} | {r['peak_bytes'] / 2**20:.0f} | {r['bytes_per_sphere']:.0f}"
+            if "beyond_two_s" in r
+            else f"- | {r['peak_bytes'] / 2**20:.0f} | -"
+        )
+        lines.append(
+            f"| {r['spheres']:,} | {given} | {r['file_bytes'] / 1e6:.2f} | {r['import_s']:.2f} "
+            f"| {r['read_s']:.2f} | {r['build_s']:.2f} | {r['loop_start_s']:.2f} | {r['first_step_s']:.2f} "
+            f"| {r['cpu_s']:.2f} "
+            f"| {extra} |"
+        )
     return "\n".join(lines)
 
 

@@ -10,6 +10,7 @@ runs after a 1 us warm-up run of each (the compiled loops loaded, the plate and 
 read from the run store). The speed target is a twin's wall time at most SPEED_TARGET
 times its 2D preset's.
 """
+
 from __future__ import annotations
 
 import json
@@ -40,9 +41,14 @@ def timed_run(s) -> dict:
         ds = gp.simulate(s, progress=False)
         whole = time.perf_counter() - t0
     info = json.loads(ds.attrs.get("run_info", "{}"))
-    return {"summary": gp.summary(ds), "wall_s": float(info.get("wall_time_s", whole)),
-            "loop_cpu_s": float(info.get("loop_cpu_s", float("nan"))), "simulate_s": whole,
-            "n_steps": int(info.get("n_steps", 0)), "dt_s": float(s.time.dt_max)}
+    return {
+        "summary": gp.summary(ds),
+        "wall_s": float(info.get("wall_time_s", whole)),
+        "loop_cpu_s": float(info.get("loop_cpu_s", float("nan"))),
+        "simulate_s": whole,
+        "n_steps": int(info.get("n_steps", 0)),
+        "dt_s": float(s.time.dt_max),
+    }
 
 
 def bench_case(name: str, t_end: float | None = None, repeats: int = REPEATS) -> dict:
@@ -58,16 +64,26 @@ def bench_case(name: str, t_end: float | None = None, repeats: int = REPEATS) ->
     for _ in range(max(int(repeats), 1)):
         runs["2d"].append(timed_run(plane))
         runs["3d"].append(timed_run(space))
-    med = {d: {k: statistics.median(r[k] for r in rs) for k in ("wall_s", "loop_cpu_s", "simulate_s")}
-           for d, rs in runs.items()}
+    med = {
+        d: {k: statistics.median(r[k] for r in rs) for k in ("wall_s", "loop_cpu_s", "simulate_s")}
+        for d, rs in runs.items()
+    }
     a, b = runs["2d"][-1]["summary"], runs["3d"][-1]["summary"]
     diff = {m: (b[m] / a[m] - 1.0 if a[m] else float("nan")) for m in THIN_LIMIT}
-    row = {"case": name, "t_end_s": float(space.time.t_end),
-           "e_shock_2d_j": a["e_shock"], "e_shock_3d_j": b["e_shock"], "e_shock_rel_diff": diff["e_shock"],
-           "ep_max_fraction_2d": a["ep_max_fraction"], "ep_max_fraction_3d": b["ep_max_fraction"],
-           "ep_max_fraction_rel_diff": diff["ep_max_fraction"],
-           "energy_residual_3d": b["energy_residual_max"], "dt_3d_s": runs["3d"][-1]["dt_s"],
-           "n_steps_3d": runs["3d"][-1]["n_steps"], "repeats": len(runs["2d"])}
+    row = {
+        "case": name,
+        "t_end_s": float(space.time.t_end),
+        "e_shock_2d_j": a["e_shock"],
+        "e_shock_3d_j": b["e_shock"],
+        "e_shock_rel_diff": diff["e_shock"],
+        "ep_max_fraction_2d": a["ep_max_fraction"],
+        "ep_max_fraction_3d": b["ep_max_fraction"],
+        "ep_max_fraction_rel_diff": diff["ep_max_fraction"],
+        "energy_residual_3d": b["energy_residual_max"],
+        "dt_3d_s": runs["3d"][-1]["dt_s"],
+        "n_steps_3d": runs["3d"][-1]["n_steps"],
+        "repeats": len(runs["2d"]),
+    }
     for d in ("2d", "3d"):
         row[f"wall_{d}_s"] = med[d]["wall_s"]
         row[f"loop_cpu_{d}_s"] = med[d]["loop_cpu_s"]
@@ -81,8 +97,10 @@ def bench_case(name: str, t_end: float | None = None, repeats: int = REPEATS) ->
 
 def format_table(rows: list[dict]) -> str:
     """The table as Markdown: agreement, then cost."""
-    head = ("| case | E_shock 2D / 3D [J] | diff | peak share 2D / 3D | diff | residual 3D | dt 3D [us] | "
-            "wall 2D / 3D [s] | ratio | simulate 2D / 3D [s] | ratio |")
+    head = (
+        "| case | E_shock 2D / 3D [J] | diff | peak share 2D / 3D | diff | residual 3D | dt 3D [us] | "
+        "wall 2D / 3D [s] | ratio | simulate 2D / 3D [s] | ratio |"
+    )
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
     for r in rows:
         lines.append(
@@ -90,13 +108,16 @@ def format_table(rows: list[dict]) -> str:
             f"{r['ep_max_fraction_2d']:.4g} / {r['ep_max_fraction_3d']:.4g} | {100 * r['ep_max_fraction_rel_diff']:+.2f}% | "
             f"{r['energy_residual_3d']:.1e} | {1e6 * r['dt_3d_s']:.1f} | "
             f"{r['wall_2d_s']:.2f} / {r['wall_3d_s']:.2f} | {r['wall_ratio']:.2f} | "
-            f"{r['simulate_2d_s']:.2f} / {r['simulate_3d_s']:.2f} | {r['simulate_ratio']:.2f} |")
+            f"{r['simulate_2d_s']:.2f} / {r['simulate_3d_s']:.2f} | {r['simulate_ratio']:.2f} |"
+        )
     ok = sum(r["within_thin_limit"] for r in rows)
     fast = sum(r["within_speed_target"] for r in rows)
     lines.append("")
-    lines.append(f"thin limit (E_shock within {100 * THIN_LIMIT['e_shock']:g}%, peak share within "
-                 f"{100 * THIN_LIMIT['ep_max_fraction']:g}%): {ok} of {len(rows)} cases; wall time at most "
-                 f"{SPEED_TARGET:g}x the 2D preset's: {fast} of {len(rows)}")
+    lines.append(
+        f"thin limit (E_shock within {100 * THIN_LIMIT['e_shock']:g}%, peak share within "
+        f"{100 * THIN_LIMIT['ep_max_fraction']:g}%): {ok} of {len(rows)} cases; wall time at most "
+        f"{SPEED_TARGET:g}x the 2D preset's: {fast} of {len(rows)}"
+    )
     return "\n".join(lines)
 
 
@@ -108,8 +129,10 @@ def main(args) -> int:
     cases = names if not args.cases else [c.strip() for c in args.cases.split(",") if c.strip()]
     unknown = [c for c in cases if c not in names]
     if unknown:
-        print(f"granplate: error: --cases {','.join(unknown)}: unknown; the paper's cases are: "
-              + ", ".join(names), file=sys.stderr)
+        print(
+            f"granplate: error: --cases {','.join(unknown)}: unknown; the paper's cases are: " + ", ".join(names),
+            file=sys.stderr,
+        )
         return 2
     if args.t_end is not None and not args.t_end > 0.0:
         print(f"granplate: error: --t-end {args.t_end}: must be > 0 [s]", file=sys.stderr)

@@ -1,4 +1,5 @@
 """Command-line subcommands in their own modules (registered through cli.COMMAND_MODULES)."""
+
 from __future__ import annotations
 
 import sys

@@ -8,6 +8,7 @@ the granules to F instead, and the TOML names it (`granules_file`, relative to t
 written, or to the working directory when printed). A result (a granplate netCDF file)
 gives its scenario with the granules at its last output time (`results.seed`).
 """
+
 from __future__ import annotations
 
 import os
@@ -43,8 +44,9 @@ def resolved_scenario(name_or_path: str, changes: dict | None = None):
     return resolve(load_scenario(name_or_path, changes))
 
 
-def resolved_toml(name_or_path: str, granules_file: str | None = None, toml_path: str | None = None,
-                  changes: dict | None = None) -> str:
+def resolved_toml(
+    name_or_path: str, granules_file: str | None = None, toml_path: str | None = None, changes: dict | None = None
+) -> str:
     """The resolved scenario `name_or_path` (with `changes` by dotted path) as TOML text;
     with `granules_file`, its granules
     written to that file and named by the TOML (relative to the folder of `toml_path`, the
@@ -54,8 +56,9 @@ def resolved_toml(name_or_path: str, granules_file: str | None = None, toml_path
     s = resolved_scenario(name_or_path, changes)
     if granules_file is None:
         return dumps(s)
-    return dumps_with_granules_file(s, granules_file, os.path.dirname(os.path.abspath(toml_path))
-                                    if toml_path else None)
+    return dumps_with_granules_file(
+        s, granules_file, os.path.dirname(os.path.abspath(toml_path)) if toml_path else None
+    )
 
 
 def _cmd_resolve(args) -> int:
@@ -72,12 +75,19 @@ def _cmd_resolve(args) -> int:
 
 def register(sub) -> None:
     """Add the `resolve` subcommand."""
-    p = sub.add_parser("resolve", help="print a scenario with its layout written out as "
-                       "[[granules]] and [[walls]] (TOML)")
-    p.add_argument("scenario", help="a scenario TOML file, a preset name, or a result (.nc: its scenario "
-                   "with the granules at its last output time)")
+    p = sub.add_parser(
+        "resolve", help="print a scenario with its layout written out as [[granules]] and [[walls]] (TOML)"
+    )
+    p.add_argument(
+        "scenario",
+        help="a scenario TOML file, a preset name, or a result (.nc: its scenario "
+        "with the granules at its last output time)",
+    )
     p.add_argument("-o", "--output", help="write to this file instead of stdout")
     add_set_option(p)
-    p.add_argument("--granules-file", help="write the granules to this file (.csv, .npz or .nc) and name it "
-                   "in the TOML (granules_file) instead of [[granules]] tables")
+    p.add_argument(
+        "--granules-file",
+        help="write the granules to this file (.csv, .npz or .nc) and name it "
+        "in the TOML (granules_file) instead of [[granules]] tables",
+    )
     p.set_defaults(func=_cmd_resolve)

@@ -17,6 +17,7 @@ Contact forces at a time of a result:
 The damping part gamma d(delta)/dt is left out of the first two: they are the elastic,
 reversible part of the force (the whole force at the instant of largest overlap).
 """
+
 from __future__ import annotations
 
 import math
@@ -103,8 +104,11 @@ def hertz_elastic_force(e_star: float, r_star: float, delta: float) -> float:
     return hertz_coefficient(e_star, r_star) * max(delta, 0.0) ** 1.5
 
 
-def contact_lists(scenario: Scenario, x: np.ndarray | None = None, y: np.ndarray | None = None,
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def contact_lists(
+    scenario: Scenario,
+    x: np.ndarray | None = None,
+    y: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The contact network: (pairs (np, 2), wall contacts (nw, 2) [granule, wall], plate
     contacts (nk,) granule indices). Without positions: the model's lists at t = 0; with
     positions x, y [m] (a result at some time): the pairs and wall contacts touching there
@@ -115,16 +119,19 @@ def contact_lists(scenario: Scenario, x: np.ndarray | None = None, y: np.ndarray
     from granplate.model.neighbours import contact_pairs
 
     model = build_model(scenario)
-    plate = np.concatenate([np.asarray(model.plate_contacts, int).reshape(-1),
-                            np.asarray(model.initial_patches, int).reshape(-1)])
+    plate = np.concatenate(
+        [np.asarray(model.plate_contacts, int).reshape(-1), np.asarray(model.initial_patches, int).reshape(-1)]
+    )
     if x is None:
-        return (np.asarray(model.pairs, int).reshape(-1, 2),
-                np.asarray(model.wall_contacts, int).reshape(-1, 2), plate)
+        return (np.asarray(model.pairs, int).reshape(-1, 2), np.asarray(model.wall_contacts, int).reshape(-1, 2), plate)
     s = model.scenario
     r = np.asarray(model.granular.radius, float)
     gap = s.contact.neighbour_gap
-    return (np.asarray(contact_pairs(x, y, r, gap), int).reshape(-1, 2),
-            np.asarray(fixed_wall_contacts(s.walls, x, y, r, gap), int).reshape(-1, 2), plate)
+    return (
+        np.asarray(contact_pairs(x, y, r, gap), int).reshape(-1, 2),
+        np.asarray(fixed_wall_contacts(s.walls, x, y, r, gap), int).reshape(-1, 2),
+        plate,
+    )
 
 
 def wall_foot(x: float, y: float, wall: Wall) -> tuple[float, float]:
@@ -189,8 +196,11 @@ def load_profile(load: Load, y: np.ndarray) -> np.ndarray:
 def grid_elements(x0: float, y0: float, width: float, height: float, nx: int, ny: int) -> np.ndarray:
     """Element outlines (nx ny, 4, 2) [m] of the structured nx x ny plate mesh."""
     xs, ys = np.linspace(x0, x0 + width, nx + 1), np.linspace(y0, y0 + height, ny + 1)
-    out = [((xs[i], ys[j]), (xs[i + 1], ys[j]), (xs[i + 1], ys[j + 1]), (xs[i], ys[j + 1]))
-           for i in range(nx) for j in range(ny)]
+    out = [
+        ((xs[i], ys[j]), (xs[i + 1], ys[j]), (xs[i + 1], ys[j + 1]), (xs[i], ys[j + 1]))
+        for i in range(nx)
+        for j in range(ny)
+    ]
     return np.asarray(out, float)
 
 
@@ -216,8 +226,9 @@ def scenario_plate(s: Scenario, plate_contacts, y) -> PlateDrawing | None:
     if p is None:
         return None
     elements = grid_elements(p.x0, p.y0, p.width, p.height, p.nx, p.ny)
-    layers = tuple(np.array([[p.x0, lo], [p.x0, hi]]) for lo, hi in layer_spans([y[i] for i in plate_contacts],
-                                                                             p.layer_width))
+    layers = tuple(
+        np.array([[p.x0, lo], [p.x0, hi]]) for lo, hi in layer_spans([y[i] for i in plate_contacts], p.layer_width)
+    )
     return PlateDrawing((p.x0, p.y0, p.width, p.height), elements, layers, clamped_edges=tuple(p.clamped_edges))
 
 
@@ -244,8 +255,9 @@ def result_plate(s: Scenario, ds: xr.Dataset, t: float) -> PlateDrawing | None:
     for lo, hi in layer_spans(ys, p.layer_width):
         band = np.flatnonzero(left & (y_nodes >= lo - 1e-9 * p.height) & (y_nodes <= hi + 1e-9 * p.height))
         layers.append(xy[band[np.argsort(y_nodes[band])]])
-    return PlateDrawing((p.x0, p.y0, p.width, p.height), elements, tuple(layers), magnify, deformed, umax,
-                        tuple(p.clamped_edges))
+    return PlateDrawing(
+        (p.x0, p.y0, p.width, p.height), elements, tuple(layers), magnify, deformed, umax, tuple(p.clamped_edges)
+    )
 
 
 # --------------------------------------------------------------------------------------
@@ -285,8 +297,9 @@ def choose_time(ds: xr.Dataset, time: float | None) -> tuple[int, str]:
             best = int(snaps[np.argmax(ep[snaps])])
             if best == peak:
                 return best, "time of the largest plate energy"
-            return best, (f"the plate snapshot of largest plate energy; the peak, between snapshots, "
-                           f"is at {t[peak] * 1e3:.4g} ms")
+            return best, (
+                f"the plate snapshot of largest plate energy; the peak, between snapshots, is at {t[peak] * 1e3:.4g} ms"
+            )
         return peak, "time of the largest plate energy"
     return len(t) - 1, "last output time (no plate)"
 
@@ -308,10 +321,18 @@ def of_scenario(scenario: Scenario) -> Assembly:
     r = np.array([g.radius for g in s.granules], float)
     segs, kinds = contact_segments(x, y, r, s.walls, pairs, walls, plate)
     return Assembly(
-        name=s.name, x=x, y=y, radius=r, labels=tuple(g.label for g in s.granules),
-        materials=tuple(g.material for g in s.granules), walls=s.walls,
-        plate=scenario_plate(s, plate, y), load=s.load, loaded=loaded_granules(s, x, r),
-        segments=segs, kinds=kinds,
+        name=s.name,
+        x=x,
+        y=y,
+        radius=r,
+        labels=tuple(g.label for g in s.granules),
+        materials=tuple(g.material for g in s.granules),
+        walls=s.walls,
+        plate=scenario_plate(s, plate, y),
+        load=s.load,
+        loaded=loaded_granules(s, x, r),
+        segments=segs,
+        kinds=kinds,
     )
 
 
@@ -327,10 +348,19 @@ def of_result(ds: xr.Dataset, time: float | None = None) -> Assembly:
     r = np.asarray(ds["radius"].values, float)
     segs, kinds = contact_segments(x, y, r, s.walls, pairs, walls, plate)
     return Assembly(
-        name=s.name, x=x, y=y, radius=r, labels=tuple(str(v) for v in ds["granule"].values),
-        materials=tuple(str(v) for v in ds["material"].values), walls=s.walls,
-        plate=result_plate(s, ds, t), load=s.load,
+        name=s.name,
+        x=x,
+        y=y,
+        radius=r,
+        labels=tuple(str(v) for v in ds["granule"].values),
+        materials=tuple(str(v) for v in ds["material"].values),
+        walls=s.walls,
+        plate=result_plate(s, ds, t),
+        load=s.load,
         loaded=loaded_granules(s, np.asarray(ds["x"].values[0], float), r),
-        segments=segs, kinds=kinds, forces=contact_forces(s, ds, ti, pairs, walls, plate),
-        time=t, time_note=note,
+        segments=segs,
+        kinds=kinds,
+        forces=contact_forces(s, ds, ti, pairs, walls, plate),
+        time=t,
+        time_note=note,
     )

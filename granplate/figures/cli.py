@@ -9,6 +9,7 @@
 A user's mistake (no such file, --time outside the run) is a ScenarioError: the command
 line prints one line and exits with status 2.
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -33,10 +34,16 @@ def _read_result(path: str):
 
 def add_set_option(parser, what: str = "the scenario") -> None:
     """The repeatable `--set PATH=VALUE` option (its texts in `args.settings`)."""
-    parser.add_argument("--set", dest="settings", action="append", default=[], metavar="PATH=VALUE",
-                        help=f"change a field of {what} by its dotted path, the value written as in "
-                             "TOML (load.q0=3e4, layout.intruder_material=\"steel\", "
-                             "granules[0].vx=1.5); repeatable; checked as the file is")
+    parser.add_argument(
+        "--set",
+        dest="settings",
+        action="append",
+        default=[],
+        metavar="PATH=VALUE",
+        help=f"change a field of {what} by its dotted path, the value written as in "
+        'TOML (load.q0=3e4, layout.intruder_material="steel", '
+        "granules[0].vx=1.5); repeatable; checked as the file is",
+    )
 
 
 def show_figure(target: str, time: float | None = None, changes: dict | None = None):
@@ -47,8 +54,7 @@ def show_figure(target: str, time: float | None = None, changes: dict | None = N
 
     if Path(target).suffix.lower() in RESULT_SUFFIXES:
         if changes:
-            raise ScenarioError("--set", ", ".join(changes), "allowed only with a scenario, not a "
-                                "result file (.nc)")
+            raise ScenarioError("--set", ", ".join(changes), "allowed only with a scenario, not a result file (.nc)")
         ds = _read_result(target)
         if space.is_space(ds):
             a = space.of_result(ds, time)
@@ -151,13 +157,19 @@ def _dpi(text: str) -> int:
 def register(subparsers) -> None:
     """Add the `show` command."""
     s = subparsers.add_parser("show", help="draw an assembly: a scenario, a preset or a result at one time")
-    s.add_argument("target", metavar="SCENARIO_OR_RESULT",
-                   help="a scenario TOML file, a preset name, or a result .nc file")
+    s.add_argument(
+        "target", metavar="SCENARIO_OR_RESULT", help="a scenario TOML file, a preset name, or a result .nc file"
+    )
     s.add_argument("-o", "--output", help="image file (.png, .pdf or .svg; default NAME.png)")
-    s.add_argument("--time", type=_time, default=None,
-                   help="result only: the time shown [s] (default: the largest plate energy; a 3D body: its "
-                        "snapshot of the largest von Mises stress; else the last output)")
-    s.add_argument("--dpi", type=_dpi, default=PNG_DPI, help=f"resolution of a .png [dots per inch] "
-                   f"(default {PNG_DPI})")
+    s.add_argument(
+        "--time",
+        type=_time,
+        default=None,
+        help="result only: the time shown [s] (default: the largest plate energy; a 3D body: its "
+        "snapshot of the largest von Mises stress; else the last output)",
+    )
+    s.add_argument(
+        "--dpi", type=_dpi, default=PNG_DPI, help=f"resolution of a .png [dots per inch] (default {PNG_DPI})"
+    )
     add_set_option(s, "a scenario")
     s.set_defaults(func=_cmd_show)

@@ -1,4 +1,5 @@
 """Shared pieces of every figure: the Figure factory, saving, time axes, colours."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -101,7 +102,16 @@ def plot_curves(ax, t, curves: list[tuple[str, object, str]], rtol: float = COIN
             marker = MARKERS[k_marker % len(MARKERS)]
             k_marker += 1
             same = f"= {twin[0]}" if twin[1] <= COINCIDE * top else f"~ {twin[0]} within {rtol:.0%} of the peak"
-            lines += ax.plot(t, y, label=f"{label} ({same})", gid=gid, ls="--", marker=marker,
-                             markevery=max(len(y) // 12, 1), markersize=4, **style)
+            lines += ax.plot(
+                t,
+                y,
+                label=f"{label} ({same})",
+                gid=gid,
+                ls="--",
+                marker=marker,
+                markevery=max(len(y) // 12, 1),
+                markersize=4,
+                **style,
+            )
         drawn.append((label, y))
     return lines

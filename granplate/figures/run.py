@@ -19,6 +19,7 @@ granules), None when it can; `figures(ds)` builds those it can. Time in ms throu
     >>> for name, fig in run.figures(ds).items():
     ...     save_figure(fig, "out", f"{ds.attrs['scenario_name']}-{name}")
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -50,8 +51,12 @@ def _end_ms(ds: xr.Dataset) -> float:
 
 def _caption(fig: Figure, ds: xr.Dataset, what: str) -> None:
     fig.suptitle(f"{scenario_name(ds)}: {what}", fontsize=11, x=0.01, ha="left")
-    fig.supxlabel(f"run {scenario_name(ds)}, t_end = {_end_ms(ds):.4g} ms, scheme {ds.attrs.get('scheme', '?')}, "
-                  f"granplate {ds.attrs.get('granplate_version', '?')}", fontsize=7, color="0.35")
+    fig.supxlabel(
+        f"run {scenario_name(ds)}, t_end = {_end_ms(ds):.4g} ms, scheme {ds.attrs.get('scheme', '?')}, "
+        f"granplate {ds.attrs.get('granplate_version', '?')}",
+        fontsize=7,
+        color="0.35",
+    )
 
 
 def _finish(fig: Figure, ds: xr.Dataset, axes, what: str) -> Figure:
@@ -134,10 +139,17 @@ def energy_curves(ds: xr.Dataset) -> dict[str, tuple[str, np.ndarray]]:
 
 #: (colour, line style, width) per curve: E_shock (or E_initial + E_shock) wide and light,
 #: so that the sum drawn over it (equal up to the residual, panel c) leaves both visible.
-ENERGY_STYLE = {"shock": ("0.7", "-", 4.0), "initial": ("0.3", ":", 1.3), "input": ("0.7", "-", 4.0),
-                "granular": ("tab:blue", "-", 1.3), "plate": ("tab:red", "-", 1.3),
-                "dissipated": ("tab:green", "-", 1.3), "total": ("tab:purple", "--", 1.3),
-                "depth": ("tab:cyan", ":", 1.3), "plastic": ("tab:olive", ":", 1.3)}
+ENERGY_STYLE = {
+    "shock": ("0.7", "-", 4.0),
+    "initial": ("0.3", ":", 1.3),
+    "input": ("0.7", "-", 4.0),
+    "granular": ("tab:blue", "-", 1.3),
+    "plate": ("tab:red", "-", 1.3),
+    "dissipated": ("tab:green", "-", 1.3),
+    "total": ("tab:purple", "--", 1.3),
+    "depth": ("tab:cyan", ":", 1.3),
+    "plastic": ("tab:olive", ":", 1.3),
+}
 
 
 def fig_energies(ds: xr.Dataset) -> Figure:
@@ -159,14 +171,18 @@ def fig_energies(ds: xr.Dataset) -> Figure:
     a.set_title("(a) energies", loc="left", fontsize=10)
     b.set_ylabel(f"energy / {reference_label(ds)} [-]")
     taken = float(an.load_work(ds["E_shock"].values)[1][-1]) if ds.sizes.get("time", 0) else 0.0
-    what = (f"{reference_label(ds)} = {ref:.4g} J" if taken <= NEGLIGIBLE * ref else
-            f"the energy put in, {reference_label(ds)} = {ref:.4g} J (E_shock: the work the load put in; "
-            f"it took {taken:.3g} J back)")
+    what = (
+        f"{reference_label(ds)} = {ref:.4g} J"
+        if taken <= NEGLIGIBLE * ref
+        else f"the energy put in, {reference_label(ds)} = {ref:.4g} J (E_shock: the work the load put in; "
+        f"it took {taken:.3g} J back)"
+    )
     b.set_title(f"(b) fractions of {what}", loc="left", fontsize=10 if taken <= NEGLIGIBLE * ref else 8)
     c.plot(t, ds["energy_residual"].values, color="0.2", lw=1.0, gid="energy:residual")
     c.set_ylabel("residual [-]")
-    c.set_title("(c) energy-balance residual (eq. 11): (E_p + E_g + D - E_shock - E_initial) / E_in",
-                loc="left", fontsize=9)
+    c.set_title(
+        "(c) energy-balance residual (eq. 11): (E_p + E_g + D - E_shock - E_initial) / E_in", loc="left", fontsize=9
+    )
     c.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
     return _finish(fig, ds, (a, b, c), "energies")
 
@@ -180,16 +196,32 @@ def fig_contact_forces(ds: xr.Dataset) -> Figure:
     t = _t_ms(ds)
     labels = [str(c) for c in ds["contact"].values]
     fn, ft = ds["contact_normal_force"].values, ds["contact_tangential_force"].values
-    plot_curves(a, t, [(f"contact {lab}", fn[:, k], f"normal:{lab}") for k, lab in enumerate(labels)],
-                rtol=FORCE_COINCIDE, lw=1.2)
-    plot_curves(b, t, [(f"contact {lab}", ft[:, k], f"tangential:{lab}") for k, lab in enumerate(labels)],
-                rtol=FORCE_COINCIDE, lw=1.2)
+    plot_curves(
+        a,
+        t,
+        [(f"contact {lab}", fn[:, k], f"normal:{lab}") for k, lab in enumerate(labels)],
+        rtol=FORCE_COINCIDE,
+        lw=1.2,
+    )
+    plot_curves(
+        b,
+        t,
+        [(f"contact {lab}", ft[:, k], f"tangential:{lab}") for k, lab in enumerate(labels)],
+        rtol=FORCE_COINCIDE,
+        lw=1.2,
+    )
     a.set_ylabel("normal force [N]")
     a.set_title("(a) normal force on the plate (+x)", loc="left", fontsize=10)
     b.set_ylabel("tangential force [N]")
     b.set_title("(b) friction force on the plate (+y)", loc="left", fontsize=10)
-    a.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False,
-             title="contact: the granule\ntouching the plate", title_fontsize=8)
+    a.legend(
+        fontsize=8,
+        loc="upper left",
+        bbox_to_anchor=(1.01, 1.0),
+        frameon=False,
+        title="contact: the granule\ntouching the plate",
+        title_fontsize=8,
+    )
     return _finish(fig, ds, (a, b), "plate contact forces")
 
 
@@ -225,8 +257,14 @@ def fig_granule_speeds(ds: xr.Dataset) -> Figure:
         plot_curves(ax, t, [(f"granule {lab}", v[:, k], f"speed:{lab}") for k, lab in enumerate(labels)], lw=1.2)
         ax.set_title("speed of each granule", loc="left", fontsize=10)
     else:
-        ax.fill_between(t, v.min(axis=1), v.max(axis=1), color="0.8", label=f"all {len(labels)} granules: min to max",
-                        gid="speed:envelope")
+        ax.fill_between(
+            t,
+            v.min(axis=1),
+            v.max(axis=1),
+            color="0.8",
+            label=f"all {len(labels)} granules: min to max",
+            gid="speed:envelope",
+        )
         ax.plot(t, np.median(v, axis=1), color="0.3", lw=1.0, ls="--", label="median", gid="speed:median")
         fastest = np.argsort(-v.max(axis=0), kind="stable")[:FASTEST]
         plot_curves(ax, t, [(f"granule {labels[k]}", v[:, k], f"speed:{labels[k]}") for k in fastest], lw=1.2)
@@ -248,13 +286,21 @@ def fig_body_stress(ds: xr.Dataset) -> Figure:
     fig = new_figure(7.5, 6.0)
     a, b = fig.subplots(2, 1, sharex=True)
     t = _t_ms(ds)
-    a.plot(t, ds["max_von_mises"].values / 1e6, color="tab:red", lw=1.3, label="largest over the body",
-           gid="max_von_mises")
+    a.plot(
+        t, ds["max_von_mises"].values / 1e6, color="tab:red", lw=1.3, label="largest over the body", gid="max_von_mises"
+    )
     if "max_von_mises_ball" in ds:
         radius = ds["max_von_mises_ball"].attrs.get("ball_radius")
         ball = f" (radius {float(radius) * 1e3:.3g} mm)" if radius is not None else ""
-        a.plot(t, ds["max_von_mises_ball"].values / 1e6, color="tab:orange", lw=1.1, ls="--",
-               label=f"largest ball average{ball}", gid="max_von_mises_ball")
+        a.plot(
+            t,
+            ds["max_von_mises_ball"].values / 1e6,
+            color="tab:orange",
+            lw=1.1,
+            ls="--",
+            label=f"largest ball average{ball}",
+            gid="max_von_mises_ball",
+        )
     a.set_ylabel("von Mises stress [MPa]")
     a.set_title("(a) largest von Mises stress in the body", loc="left", fontsize=10)
     a.legend(fontsize=8, frameon=False)
@@ -286,13 +332,27 @@ def fig_body_contact_forces(ds: xr.Dataset) -> Figure:
         which = "the granule" if len(touching) == 1 else f"each of the {len(touching)} granules"
         ax.set_title(f"normal force of {which} touching the body", loc="left", fontsize=10)
     else:
-        ax.fill_between(t, fn[:, touching].min(axis=1), fn[:, touching].max(axis=1), color="0.8",
-                        label=f"all {len(touching)} touching granules: min to max", gid="body-normal:envelope")
+        ax.fill_between(
+            t,
+            fn[:, touching].min(axis=1),
+            fn[:, touching].max(axis=1),
+            color="0.8",
+            label=f"all {len(touching)} touching granules: min to max",
+            gid="body-normal:envelope",
+        )
         shown = touching[:FASTEST]
-        ax.set_title(f"normal force on the body: envelope of the {len(touching)} touching granules and the "
-                     f"{FASTEST} largest", loc="left", fontsize=10)
-    plot_curves(ax, t, [(f"granule {labels[k]}", fn[:, k], f"body-normal:{labels[k]}") for k in shown],
-                rtol=FORCE_COINCIDE, lw=1.2)
+        ax.set_title(
+            f"normal force on the body: envelope of the {len(touching)} touching granules and the {FASTEST} largest",
+            loc="left",
+            fontsize=10,
+        )
+    plot_curves(
+        ax,
+        t,
+        [(f"granule {labels[k]}", fn[:, k], f"body-normal:{labels[k]}") for k in shown],
+        rtol=FORCE_COINCIDE,
+        lw=1.2,
+    )
     ax.set_ylabel("normal force on the body [N]")
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     return _finish(fig, ds, (ax,), "body contact forces")
@@ -314,8 +374,9 @@ def fig_wall_forces(ds: xr.Dataset) -> Figure:
             ax.plot(t, ds["wall_force"].values[:, j], lw=1.2, label=str(lab))
         ax.set_ylabel("wall force [N]")
         ax.set_title(f"({'abc'[k]}) normal force on each wall (compression > 0)", loc="left", fontsize=10)
-        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, title="wall",
-                  title_fontsize=8)
+        ax.legend(
+            fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, title="wall", title_fontsize=8
+        )
         k += 1
     if drives:
         for j, lab in enumerate(ds["drive"].values):
@@ -325,8 +386,9 @@ def fig_wall_forces(ds: xr.Dataset) -> Figure:
         axes[k].set_title(f"({'abc'[k]}) force each drive applies along its direction", loc="left", fontsize=10)
         axes[k + 1].set_ylabel("displacement [um]")
         axes[k + 1].set_title(f"({'abc'[k + 1]}) displacement along the drive's direction", loc="left", fontsize=10)
-        axes[k].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, title="drive",
-                       title_fontsize=8)
+        axes[k].legend(
+            fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, title="drive", title_fontsize=8
+        )
     return _finish(fig, ds, axes, "wall and drive forces")
 
 

@@ -7,6 +7,7 @@ the normal force for a result). Axes in mm, equal aspect.
     >>> fig = show.draw(assembly.of_scenario(gp.preset("steel-r1")))
     >>> fig.savefig("steel-r1.png", dpi=150, bbox_inches="tight")   # the legend is beside the axes
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -89,8 +90,18 @@ def _draw_walls(ax, a: Assembly, box) -> list:
         if ends is None:
             continue
         p, q = ends
-        ax.add_patch(Polygon([p, q, q + width * n, p + width * n], closed=True, fill=False, hatch="///",
-                             ec="0.4", lw=0, zorder=1, gid=f"wall-hatch:{wall.label}"))
+        ax.add_patch(
+            Polygon(
+                [p, q, q + width * n, p + width * n],
+                closed=True,
+                fill=False,
+                hatch="///",
+                ec="0.4",
+                lw=0,
+                zorder=1,
+                gid=f"wall-hatch:{wall.label}",
+            )
+        )
         drawn += ax.plot([p[0], q[0]], [p[1], q[1]], color="0.2", lw=2.0, zorder=2, gid=f"wall:{wall.label}")
     return drawn
 
@@ -99,31 +110,64 @@ def _draw_plate(ax, a: Assembly) -> None:
     p = a.plate
     if p is None:
         return
-    mesh = PolyCollection(p.elements * MM, facecolors="#e3e9f0", edgecolors="0.45", linewidths=0.3,
-                          zorder=1, gid="plate:mesh")
+    mesh = PolyCollection(
+        p.elements * MM, facecolors="#e3e9f0", edgecolors="0.45", linewidths=0.3, zorder=1, gid="plate:mesh"
+    )
     ax.add_collection(mesh)
     if p.deformed:
         x0, y0, w, h = (v * MM for v in p.rectangle)
-        ax.add_patch(Polygon([(x0, y0), (x0 + w, y0), (x0 + w, y0 + h), (x0, y0 + h)], closed=True, fill=False,
-                             ls="--", lw=0.7, ec="0.3", zorder=2, gid="plate:undeformed"))
+        ax.add_patch(
+            Polygon(
+                [(x0, y0), (x0 + w, y0), (x0 + w, y0 + h), (x0, y0 + h)],
+                closed=True,
+                fill=False,
+                ls="--",
+                lw=0.7,
+                ec="0.3",
+                zorder=2,
+                gid="plate:undeformed",
+            )
+        )
     x0, y0, w, h = (v * MM for v in p.rectangle)
     t = 0.08 * w  # the clamp's drawn thickness [mm]
-    strips = {"top": [(x0, y0 + h), (x0 + w, y0 + h), (x0 + w, y0 + h + t), (x0, y0 + h + t)],
-              "bottom": [(x0, y0), (x0 + w, y0), (x0 + w, y0 - t), (x0, y0 - t)],
-              "left": [(x0, y0), (x0, y0 + h), (x0 - t, y0 + h), (x0 - t, y0)],
-              "right": [(x0 + w, y0), (x0 + w, y0 + h), (x0 + w + t, y0 + h), (x0 + w + t, y0)]}
+    strips = {
+        "top": [(x0, y0 + h), (x0 + w, y0 + h), (x0 + w, y0 + h + t), (x0, y0 + h + t)],
+        "bottom": [(x0, y0), (x0 + w, y0), (x0 + w, y0 - t), (x0, y0 - t)],
+        "left": [(x0, y0), (x0, y0 + h), (x0 - t, y0 + h), (x0 - t, y0)],
+        "right": [(x0 + w, y0), (x0 + w, y0 + h), (x0 + w + t, y0 + h), (x0 + w + t, y0)],
+    }
     for edge in p.clamped_edges:
-        ax.add_patch(Polygon(strips[edge], closed=True, fc="0.35", ec="0.35", hatch="xxxx", lw=0.5, zorder=2,
-                             gid=f"plate:clamped:{edge}"))
+        ax.add_patch(
+            Polygon(
+                strips[edge],
+                closed=True,
+                fc="0.35",
+                ec="0.35",
+                hatch="xxxx",
+                lw=0.5,
+                zorder=2,
+                gid=f"plate:clamped:{edge}",
+            )
+        )
     for k, layer in enumerate(p.rigid_layers):
-        ax.plot(layer[:, 0] * MM, layer[:, 1] * MM, color="darkred", lw=4, solid_capstyle="butt", zorder=3,
-                gid=f"plate:rigid-layer:{k}")
+        ax.plot(
+            layer[:, 0] * MM,
+            layer[:, 1] * MM,
+            color="darkred",
+            lw=4,
+            solid_capstyle="butt",
+            zorder=3,
+            gid=f"plate:rigid-layer:{k}",
+        )
 
 
 def _draw_granules(ax, a: Assembly, colours: dict[str, str]) -> None:
     for x, y, r, lab, mat in zip(a.x, a.y, a.radius, a.labels, a.materials):
-        ax.add_patch(Circle((x * MM, y * MM), r * MM, fc=colours[mat], ec="0.15", lw=0.6, alpha=0.9, zorder=4,
-                            gid=f"granule:{lab}"))
+        ax.add_patch(
+            Circle(
+                (x * MM, y * MM), r * MM, fc=colours[mat], ec="0.15", lw=0.6, alpha=0.9, zorder=4, gid=f"granule:{lab}"
+            )
+        )
 
 
 def _draw_labels(fig: Figure, ax, a: Assembly) -> int:
@@ -136,8 +180,18 @@ def _draw_labels(fig: Figure, ax, a: Assembly) -> int:
         if size == 0.0:
             skipped += 1
             continue
-        ax.text(x * MM, y * MM, lab, ha="center", va="center", fontsize=size, zorder=6, gid=f"label:{lab}",
-                color="black", bbox={"boxstyle": "round,pad=0.05", "fc": "white", "ec": "none", "alpha": 0.6})
+        ax.text(
+            x * MM,
+            y * MM,
+            lab,
+            ha="center",
+            va="center",
+            fontsize=size,
+            zorder=6,
+            gid=f"label:{lab}",
+            color="black",
+            bbox={"boxstyle": "round,pad=0.05", "fc": "white", "ec": "none", "alpha": 0.6},
+        )
     return skipped
 
 
@@ -150,8 +204,11 @@ def _draw_contacts(fig: Figure, ax, a: Assembly) -> list:
         colours = [KIND_COLOURS[k] for k in a.kinds]
         lines = LineCollection(segs, colors=colours, linewidths=1.2, zorder=5, gid="contacts")
         ax.add_collection(lines)
-        return [Line2D([], [], color=KIND_COLOURS[k], lw=1.2, label=f"contact {KIND_NAMES[k]} "
-                       f"({a.kinds.count(k)})") for k in KIND_COLOURS if k in a.kinds]
+        return [
+            Line2D([], [], color=KIND_COLOURS[k], lw=1.2, label=f"contact {KIND_NAMES[k]} ({a.kinds.count(k)})")
+            for k in KIND_COLOURS
+            if k in a.kinds
+        ]
     f = np.asarray(a.forces, float)
     f_max = float(f.max()) if len(f) else 0.0
     norm = Normalize(0.0, f_max if f_max > 0 else 1.0)
@@ -160,21 +217,45 @@ def _draw_contacts(fig: Figure, ax, a: Assembly) -> list:
     widths = np.where(open_, 0.6, MAX_LINE_WIDTH * f / (f_max if f_max > 0 else 1.0))
     colours = [(0.45, 0.45, 0.45, 1.0) if o else cmap.to_rgba(v) for o, v in zip(open_, f)]
     styles = [":" if o else "-" for o in open_]
-    lines = LineCollection(segs, colors=colours, linewidths=widths, linestyles=styles, zorder=5, gid="contacts",
-                           capstyle="round")
+    lines = LineCollection(
+        segs, colors=colours, linewidths=widths, linestyles=styles, zorder=5, gid="contacts", capstyle="round"
+    )
     ax.add_collection(lines)
-    fig.colorbar(cmap, ax=ax, label="contact normal force [N]", orientation="horizontal", shrink=0.6,
-                 pad=0.02, aspect=40, location="bottom")
-    return [Line2D([], [], color=cmap.to_rgba(f_max), lw=MAX_LINE_WIDTH,
-                   label=f"contact force, width ∝ force\n(widest: {f_max:.3g} N)"),
-            Line2D([], [], color="0.45", lw=0.6, ls=":",
-                   label=f"contact below {OPEN_FRACTION:.0%} of the largest ({int(open_.sum())})")]
+    fig.colorbar(
+        cmap,
+        ax=ax,
+        label="contact normal force [N]",
+        orientation="horizontal",
+        shrink=0.6,
+        pad=0.02,
+        aspect=40,
+        location="bottom",
+    )
+    return [
+        Line2D(
+            [],
+            [],
+            color=cmap.to_rgba(f_max),
+            lw=MAX_LINE_WIDTH,
+            label=f"contact force, width ∝ force\n(widest: {f_max:.3g} N)",
+        ),
+        Line2D(
+            [],
+            [],
+            color="0.45",
+            lw=0.6,
+            ls=":",
+            label=f"contact below {OPEN_FRACTION:.0%} of the largest ({int(open_.sum())})",
+        ),
+    ]
 
 
 def _load_text(a: Assembly) -> str:
     ld = a.load
-    text = (f"load: q0 = {ld.q0 / 1e3:.4g} kN/m half-sine, T = {readable_duration(ld.duration)},\n"
-            f"y = {ld.y0 * MM:.4g}-{(ld.y0 + ld.length) * MM:.4g} mm")
+    text = (
+        f"load: q0 = {ld.q0 / 1e3:.4g} kN/m half-sine, T = {readable_duration(ld.duration)},\n"
+        f"y = {ld.y0 * MM:.4g}-{(ld.y0 + ld.length) * MM:.4g} mm"
+    )
     if a.time is not None and a.time > ld.duration:
         text += " (over at this time)"
     return text
@@ -187,8 +268,11 @@ def _draw_load(ax, a: Assembly, arrow_len: float) -> list:
     if ld.kind == "none":
         return []
     if ld.target == "granules":
-        idx = [i for i in np.flatnonzero(a.loaded)
-               if a.y[i] + a.radius[i] > ld.y0 and a.y[i] - a.radius[i] < ld.y0 + ld.length]
+        idx = [
+            i
+            for i in np.flatnonzero(a.loaded)
+            if a.y[i] + a.radius[i] > ld.y0 and a.y[i] - a.radius[i] < ld.y0 + ld.length
+        ]
         if not idx:
             return []
         tips = [((a.x[i] - a.radius[i]) * MM, a.y[i] * MM) for i in idx]
@@ -202,11 +286,24 @@ def _draw_load(ax, a: Assembly, arrow_len: float) -> list:
         return []
     for k, ((tx, ty), sh) in enumerate(zip(tips, shape)):
         length = arrow_len * max(float(sh), 0.25)
-        ax.annotate("", xy=(tx, ty), xytext=(tx - length, ty), zorder=7, gid=f"load:arrow:{k}",
-                    arrowprops={"arrowstyle": "-|>", "color": LOAD_COLOUR, "lw": 1.8, "mutation_scale": 12})
+        ax.annotate(
+            "",
+            xy=(tx, ty),
+            xytext=(tx - length, ty),
+            zorder=7,
+            gid=f"load:arrow:{k}",
+            arrowprops={"arrowstyle": "-|>", "color": LOAD_COLOUR, "lw": 1.8, "mutation_scale": 12},
+        )
     bar_x = min(t[0] for t in tips) - arrow_len * 1.15
-    ax.plot([bar_x, bar_x], [ld.y0 * MM, (ld.y0 + ld.length) * MM], color=LOAD_COLOUR, lw=3,
-            solid_capstyle="butt", zorder=7, gid="load:range")
+    ax.plot(
+        [bar_x, bar_x],
+        [ld.y0 * MM, (ld.y0 + ld.length) * MM],
+        color=LOAD_COLOUR,
+        lw=3,
+        solid_capstyle="butt",
+        zorder=7,
+        gid="load:range",
+    )
     return [Line2D([], [], color=LOAD_COLOUR, lw=1.8, marker=">", label=_load_text(a))]
 
 
@@ -217,9 +314,10 @@ def _title(a: Assembly) -> str:
     lines = [f"{head} at t = {a.time * 1e3:.4g} ms", a.time_note]
     if a.plate is not None:
         if a.plate.deformed:
-            lines.append(f"plate displacements magnified x{a.plate.magnify:g} (largest "
-                         f"{a.plate.largest_displacement:.3g} m)"
-                         + ("; granules at true positions" if len(a.x) else ""))
+            lines.append(
+                f"plate displacements magnified x{a.plate.magnify:g} (largest "
+                f"{a.plate.largest_displacement:.3g} m)" + ("; granules at true positions" if len(a.x) else "")
+            )
         else:
             lines.append("plate undeformed: no plate-field snapshot at this time")
     return "\n".join(lines)
@@ -248,8 +346,9 @@ def draw(a: Assembly, width: float = 8.0) -> Figure:
     if a.plate is not None:
         handles.append(Patch(fc="#e3e9f0", ec="0.45", label="plate, element edges"))
         if a.plate.clamped_edges:
-            handles.append(Patch(fc="0.35", ec="0.35", hatch="xxxx",
-                                 label="plate clamped: " + ", ".join(a.plate.clamped_edges)))
+            handles.append(
+                Patch(fc="0.35", ec="0.35", hatch="xxxx", label="plate clamped: " + ", ".join(a.plate.clamped_edges))
+            )
         if a.plate.rigid_layers:
             handles.append(Line2D([], [], color="darkred", lw=4, label=f"rigid layers ({len(a.plate.rigid_layers)})"))
     handles += _draw_contacts(fig, ax, a)
@@ -258,6 +357,13 @@ def draw(a: Assembly, width: float = 8.0) -> Figure:
     ax.set_title(_title(a), fontsize=10, loc="left")
     skipped = _draw_labels(fig, ax, a)
     if skipped:
-        ax.text(1.0, -0.08, f"{skipped} labels too small to draw", transform=ax.transAxes, ha="right",
-                fontsize=7, color="0.4")
+        ax.text(
+            1.0,
+            -0.08,
+            f"{skipped} labels too small to draw",
+            transform=ax.transAxes,
+            ha="right",
+            fontsize=7,
+            color="0.4",
+        )
     return fig

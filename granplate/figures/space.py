@@ -38,6 +38,7 @@ time as its history), at zero overlap rate: the elastic part of the force, as th
 plane's drawing (`figures.assembly`). Overlaps: R_i + R_j - |s_j - s_i| for a pair,
 s_i . n + R_i - offset for a wall (docs/model.md, the laws in space).
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -205,8 +206,13 @@ def elastic_forces(coef: np.ndarray, delta: np.ndarray, delta_max: np.ndarray) -
     at the rate-free yield strength: the drawing does not know each contact's rate)."""
     from granplate.physics.laws import normal_law_force
 
-    return np.array([normal_law_force(float(d), 0.0, c, float(max(m, d)), 1.0, False) if d > 0.0 else 0.0
-                     for d, c, m in zip(delta, coef, delta_max)], float)
+    return np.array(
+        [
+            normal_law_force(float(d), 0.0, c, float(max(m, d)), 1.0, False) if d > 0.0 else 0.0
+            for d, c, m in zip(delta, coef, delta_max)
+        ],
+        float,
+    )
 
 
 def contact_forces(s: Scenario, positions: np.ndarray, r: np.ndarray, pairs, wall_contacts) -> np.ndarray:
@@ -264,10 +270,13 @@ def solid_drawing(s: Scenario, written: Scenario | None = None) -> dict:
     clamped = [outline_edges(mesh, mesh.boundaries[name]) for name in sd.clamped]
     held = f", clamped: {', '.join(sd.clamped)}" if sd.clamped else ", free"
     held += f", rollers: {', '.join(sd.rollers)}" if sd.rollers else ""
-    return {"solid_faces": boundary_polygons(mesh), "solid_edges": outline_edges(mesh),
-            "clamped_edges": np.concatenate(clamped) if clamped else _no_segments(),
-            "solid_label": f"elastic solid: {sd.material}, {mesh.t.shape[1]} {sd.element} elements{held}",
-            "solid_material": sd.material}
+    return {
+        "solid_faces": boundary_polygons(mesh),
+        "solid_edges": outline_edges(mesh),
+        "clamped_edges": np.concatenate(clamped) if clamped else _no_segments(),
+        "solid_label": f"elastic solid: {sd.material}, {mesh.t.shape[1]} {sd.element} elements{held}",
+        "solid_material": sd.material,
+    }
 
 
 def body_touching(s: Scenario, pos: np.ndarray, r: np.ndarray) -> np.ndarray:
@@ -312,10 +321,16 @@ def of_scenario(scenario: Scenario) -> Assembly3D:
     segs, kinds = contact_segments(pos, s.walls, pairs, wc)
     body = body_touching(s, pos, r)
     return Assembly3D(
-        name=s.name, pos=pos, radius=r, labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
-        materials=tuple(g.material for g in s.granules), walls=s.walls, load=s.load,
+        name=s.name,
+        pos=pos,
+        radius=r,
+        labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
+        materials=tuple(g.material for g in s.granules),
+        walls=s.walls,
+        load=s.load,
         loaded=loaded_granules_3d(s, pos[:, 0], pos[:, 1], pos[:, 2], r),
-        segments=np.concatenate([segs, body]), kinds=kinds + ("body",) * len(body),
+        segments=np.concatenate([segs, body]),
+        kinds=kinds + ("body",) * len(body),
         **solid_drawing(s, scenario),
     )
 
@@ -330,8 +345,7 @@ def of_result(ds: xr.Dataset, time: float | None = None) -> Assembly3D:
     if has_body(ds):
         k, body_note = body_snapshot(ds, time)
         ti, _ = choose_time(ds, float(ds["field_time"].values[k]))
-        return _assembly_at(ds, s, ti, "the output nearest the body's snapshot", solid,
-                            body_drawing(ds, k, body_note))
+        return _assembly_at(ds, s, ti, "the output nearest the body's snapshot", solid, body_drawing(ds, k, body_note))
     ti, note = choose_time(ds, time)
     return _assembly_at(ds, s, ti, note)
 
@@ -348,8 +362,9 @@ def _result_scenario(ds: xr.Dataset) -> tuple[Scenario, dict]:
     return s, solid
 
 
-def _assembly_at(ds: xr.Dataset, s: Scenario, ti: int, note: str, solid: dict | None = None,
-                 body: dict | None = None, **scales) -> Assembly3D:
+def _assembly_at(
+    ds: xr.Dataset, s: Scenario, ti: int, note: str, solid: dict | None = None, body: dict | None = None, **scales
+) -> Assembly3D:
     """The result's assembly at output index ti: centres, the contacts touching there and
     their forces; solid and body: the fields of `solid_drawing` and `body_drawing`;
     scales: stress_top, force_top."""
@@ -363,13 +378,22 @@ def _assembly_at(ds: xr.Dataset, s: Scenario, ti: int, note: str, solid: dict | 
     body_segs, body_forces = body_contacts_at(ds, ti, pos, r)
     p0 = path[0]
     return Assembly3D(
-        name=s.name, pos=pos, radius=r, labels=tuple(str(v) for v in ds["granule"].values),
-        materials=tuple(str(v) for v in ds["material"].values), walls=s.walls, load=s.load,
-        loaded=loaded_granules_3d(s, p0[:, 0], p0[:, 1], p0[:, 2], r), segments=np.concatenate([segs, body_segs]),
+        name=s.name,
+        pos=pos,
+        radius=r,
+        labels=tuple(str(v) for v in ds["granule"].values),
+        materials=tuple(str(v) for v in ds["material"].values),
+        walls=s.walls,
+        load=s.load,
+        loaded=loaded_granules_3d(s, p0[:, 0], p0[:, 1], p0[:, 2], r),
+        segments=np.concatenate([segs, body_segs]),
         kinds=kinds + ("body",) * len(body_segs),
         forces=np.concatenate([contact_forces(s, path, r, pairs, wc), body_forces]),
-        time=float(ds["time"].values[ti]), time_note=note,
-        **(solid or {}), **(body or {}), **scales,
+        time=float(ds["time"].values[ti]),
+        time_note=note,
+        **(solid or {}),
+        **(body or {}),
+        **scales,
     )
 
 
@@ -429,8 +453,10 @@ def body_snapshot(ds: xr.Dataset, time: float | None) -> tuple[int, str]:
             vm = np.asarray(ds["max_von_mises"].values, float)
             i = int(np.nanargmax(vm))
             if not np.isclose(float(ds["time"].values[i]), ft[k], rtol=0.0, atol=1e-15):
-                note += (f" (the peak, {vm[i] * MPA:.3g} MPa, between snapshots, at t = "
-                         f"{float(ds['time'].values[i]) * 1e3:.4g} ms)")
+                note += (
+                    f" (the peak, {vm[i] * MPA:.3g} MPa, between snapshots, at t = "
+                    f"{float(ds['time'].values[i]) * 1e3:.4g} ms)"
+                )
         return k, note
     choose_time(ds, time)  # within the run
     return int(np.argmin(np.abs(ft - time))), "the body's snapshot nearest the requested time"
@@ -460,9 +486,13 @@ def body_drawing(ds: xr.Dataset, k: int, note: str, scale: float | None = None) 
         scale = magnification(largest, float((nodes.max(axis=0) - nodes.min(axis=0)).max()))
     faces, owner = boundary_faces(cells, element)
     t = float(ds["field_time"].values[k])
-    return {"body_faces": nodes[faces] + scale * u[faces],
-            "body_stress": np.asarray(ds["body_von_mises"].values[k], float)[owner],
-            "body_scale": scale, "body_largest": largest, "body_note": f"t = {t * 1e3:.4g} ms, {note}"}
+    return {
+        "body_faces": nodes[faces] + scale * u[faces],
+        "body_stress": np.asarray(ds["body_von_mises"].values[k], float)[owner],
+        "body_scale": scale,
+        "body_largest": largest,
+        "body_note": f"t = {t * 1e3:.4g} ms, {note}",
+    }
 
 
 # --------------------------------------------------------------------------------------
@@ -487,8 +517,11 @@ def bounds(a: Assembly3D, margin: float = 0.05) -> tuple[np.ndarray, np.ndarray]
     hi = (a.pos + a.radius[:, None]).max(axis=0) if len(a.radius) else np.zeros(3)
     if len(a.solid_edges) or len(a.body_faces):  # the solid bounds every axis
         ends = np.concatenate([a.solid_edges.reshape(-1, 3), a.body_faces.reshape(-1, 3)])
-        lo, hi = (np.minimum(lo, ends.min(axis=0)), np.maximum(hi, ends.max(axis=0))) if len(a.radius) \
+        lo, hi = (
+            (np.minimum(lo, ends.min(axis=0)), np.maximum(hi, ends.max(axis=0)))
+            if len(a.radius)
             else (ends.min(axis=0), ends.max(axis=0))
+        )
     for w in a.walls:  # an axis-aligned wall bounds its axis
         n = unit_normal(w)
         k = int(np.argmax(np.abs(n)))
@@ -557,26 +590,52 @@ def _view_content(ax, a: Assembly3D, view: tuple, colours: dict) -> int:
         ends = wall_trace(w, view, *inner)
         if ends is not None:
             p, q = ends
-            ax.plot([p[0] * MM, q[0] * MM], [p[1] * MM, q[1] * MM], color="0.2", lw=2.0, zorder=1,
-                    gid=f"wall:{w.label}:{AXIS_NAMES[u]}{AXIS_NAMES[v]}")
+            ax.plot(
+                [p[0] * MM, q[0] * MM],
+                [p[1] * MM, q[1] * MM],
+                color="0.2",
+                lw=2.0,
+                zorder=1,
+                gid=f"wall:{w.label}:{AXIS_NAMES[u]}{AXIS_NAMES[v]}",
+            )
             drawn += 1
     depth = sign * a.pos[:, d] if len(a.radius) else np.zeros(0)
     frac = depth_fraction(depth)
     order = np.argsort(depth, kind="stable")  # far first, near last (on top)
     for rank, i in enumerate(order):
-        ax.add_patch(Circle((a.pos[i, u] * MM, a.pos[i, v] * MM), a.radius[i] * MM,
-                            fc=shaded(colours[a.materials[i]], frac[i]), ec="0.1", lw=0.6, zorder=2 + rank,
-                            gid=f"granule:{a.labels[i]}:{AXIS_NAMES[u]}{AXIS_NAMES[v]}"))
+        ax.add_patch(
+            Circle(
+                (a.pos[i, u] * MM, a.pos[i, v] * MM),
+                a.radius[i] * MM,
+                fc=shaded(colours[a.materials[i]], frac[i]),
+                ec="0.1",
+                lw=0.6,
+                zorder=2 + rank,
+                gid=f"granule:{a.labels[i]}:{AXIS_NAMES[u]}{AXIS_NAMES[v]}",
+            )
+        )
     if len(a.segments):
         segs = a.segments[:, :, [u, v]] * MM
         z_top = 3 + len(a.radius)
         if a.forces is None:
-            lines = LineCollection(segs, colors=[KIND_COLOURS[k] for k in a.kinds], linewidths=1.2, zorder=z_top,
-                                   gid=f"contacts:{AXIS_NAMES[u]}{AXIS_NAMES[v]}")
+            lines = LineCollection(
+                segs,
+                colors=[KIND_COLOURS[k] for k in a.kinds],
+                linewidths=1.2,
+                zorder=z_top,
+                gid=f"contacts:{AXIS_NAMES[u]}{AXIS_NAMES[v]}",
+            )
         else:
             widths, cols, styles, *_ = _force_style(np.asarray(a.forces, float), a.force_top)
-            lines = LineCollection(segs, colors=cols, linewidths=widths, linestyles=styles, zorder=z_top,
-                                   capstyle="round", gid=f"contacts:{AXIS_NAMES[u]}{AXIS_NAMES[v]}")
+            lines = LineCollection(
+                segs,
+                colors=cols,
+                linewidths=widths,
+                linestyles=styles,
+                zorder=z_top,
+                capstyle="round",
+                gid=f"contacts:{AXIS_NAMES[u]}{AXIS_NAMES[v]}",
+            )
         ax.add_collection(lines)
     return drawn
 
@@ -594,22 +653,46 @@ def _draw_solid(ax, a: Assembly3D, view: tuple, colours: dict) -> None:
     if len(a.body_faces):  # the deformed body, far faces first
         order = np.argsort(sign * a.body_faces[:, :, d].mean(axis=1), kind="stable")
         cmap = body_colour_map(a)
-        ax.add_collection(PolyCollection(a.body_faces[order][:, :, [u, v]] * MM,
-                                         facecolors=cmap.to_rgba(a.body_stress[order] * MPA), edgecolors="0.35",
-                                         linewidths=0.15, zorder=0.7, gid=f"body:{uv}"))
+        ax.add_collection(
+            PolyCollection(
+                a.body_faces[order][:, :, [u, v]] * MM,
+                facecolors=cmap.to_rgba(a.body_stress[order] * MPA),
+                edgecolors="0.35",
+                linewidths=0.15,
+                zorder=0.7,
+                gid=f"body:{uv}",
+            )
+        )
     if not len(a.solid_edges):
         return
     if not len(a.body_faces):
         fill = solid_fill(colours.get(a.solid_material, "0.6"))
-        ax.add_collection(PolyCollection(a.solid_faces[:, :, [u, v]] * MM, facecolors=[fill], edgecolors="none",
-                                         zorder=0.5, gid=f"solid:{uv}"))
-    ax.add_collection(LineCollection(a.solid_edges[:, :, [u, v]] * MM, colors=SOLID_EDGE[0],
-                                     linewidths=SOLID_EDGE[1], linestyles="--" if len(a.body_faces) else "-",
-                                     zorder=0.8, gid=f"solid-edges:{uv}"))
+        ax.add_collection(
+            PolyCollection(
+                a.solid_faces[:, :, [u, v]] * MM, facecolors=[fill], edgecolors="none", zorder=0.5, gid=f"solid:{uv}"
+            )
+        )
+    ax.add_collection(
+        LineCollection(
+            a.solid_edges[:, :, [u, v]] * MM,
+            colors=SOLID_EDGE[0],
+            linewidths=SOLID_EDGE[1],
+            linestyles="--" if len(a.body_faces) else "-",
+            zorder=0.8,
+            gid=f"solid-edges:{uv}",
+        )
+    )
     if len(a.clamped_edges):
-        ax.add_collection(LineCollection(a.clamped_edges[:, :, [u, v]] * MM, colors=CLAMPED_EDGE[0],
-                                         linewidths=CLAMPED_EDGE[1], zorder=0.9, capstyle="butt",
-                                         gid=f"solid-clamped:{uv}"))
+        ax.add_collection(
+            LineCollection(
+                a.clamped_edges[:, :, [u, v]] * MM,
+                colors=CLAMPED_EDGE[0],
+                linewidths=CLAMPED_EDGE[1],
+                zorder=0.9,
+                capstyle="butt",
+                gid=f"solid-clamped:{uv}",
+            )
+        )
 
 
 def body_colour_map(a: Assembly3D) -> ScalarMappable:
@@ -624,13 +707,16 @@ def body_colour_map(a: Assembly3D) -> ScalarMappable:
 
 def _title(a: Assembly3D) -> str:
     if len(a.body_faces):
-        return (f"{a.name} at t = {a.time * 1e3:.4g} ms, {a.time_note} (in space)\n"
-                f"elastic body: {a.body_note}; displacements magnified x{a.body_scale:g} (largest "
-                f"{a.body_largest:.3g} m), coloured by von Mises stress [MPa]")
+        return (
+            f"{a.name} at t = {a.time * 1e3:.4g} ms, {a.time_note} (in space)\n"
+            f"elastic body: {a.body_note}; displacements magnified x{a.body_scale:g} (largest "
+            f"{a.body_largest:.3g} m), coloured by von Mises stress [MPa]"
+        )
     if a.time is None:
         return f"{a.name}: assembly before the run (in space; spheres darker with distance from the viewer)"
-    return (f"{a.name} at t = {a.time * 1e3:.4g} ms, {a.time_note} "
-            f"(in space; spheres darker with distance from the viewer)")
+    return (
+        f"{a.name} at t = {a.time * 1e3:.4g} ms, {a.time_note} (in space; spheres darker with distance from the viewer)"
+    )
 
 
 def _load_text(a: Assembly3D, series: bool = False) -> str | None:
@@ -639,8 +725,10 @@ def _load_text(a: Assembly3D, series: bool = False) -> str | None:
         return None
     d = np.asarray(ld.direction, float)
     d = d / np.linalg.norm(d)
-    text = (f"load: {ld.force:.4g} N half-sine, T = {readable_duration(ld.duration)}, along "
-            f"({d[0]:.3g}, {d[1]:.3g}, {d[2]:.3g}), on {int(a.loaded.sum())} granule(s) (red outline)")
+    text = (
+        f"load: {ld.force:.4g} N half-sine, T = {readable_duration(ld.duration)}, along "
+        f"({d[0]:.3g}, {d[1]:.3g}, {d[2]:.3g}), on {int(a.loaded.sum())} granule(s) (red outline)"
+    )
     if a.time is not None and a.time > ld.duration and not series:
         text += ", over at this time"
     return text
@@ -649,25 +737,46 @@ def _load_text(a: Assembly3D, series: bool = False) -> str | None:
 def _mark_loaded(axes, a: Assembly3D) -> None:
     for ax, (u, v, _, _) in zip(axes, PROJECTIONS):
         for i in np.flatnonzero(a.loaded):
-            ax.add_patch(Circle((a.pos[i, u] * MM, a.pos[i, v] * MM), a.radius[i] * MM, fill=False,
-                                ec=LOAD_COLOUR, lw=1.6, zorder=4 + 2 * len(a.radius), gid=f"load:{a.labels[i]}"))
+            ax.add_patch(
+                Circle(
+                    (a.pos[i, u] * MM, a.pos[i, v] * MM),
+                    a.radius[i] * MM,
+                    fill=False,
+                    ec=LOAD_COLOUR,
+                    lw=1.6,
+                    zorder=4 + 2 * len(a.radius),
+                    gid=f"load:{a.labels[i]}",
+                )
+            )
 
 
 def legend_handles(a: Assembly3D, colours: dict, oblique: list[str], series: bool = False) -> list:
     """Legend entries: materials, walls, contacts, load; series: the legend of every frame
     of an animation (the contact forces on the scale a.force_top, no counts of the
     contacts or remarks that hold at one time only)."""
-    handles = [Patch(fc=c, ec="0.1", label=f"{m} ({a.materials.count(m)} spheres)") for m, c in colours.items()
-               if m in a.materials]
+    handles = [
+        Patch(fc=c, ec="0.1", label=f"{m} ({a.materials.count(m)} spheres)")
+        for m, c in colours.items()
+        if m in a.materials
+    ]
     if len(a.body_faces):
-        handles.append(Patch(fc=body_colour_map(a).to_rgba(0.5 * body_colour_map(a).norm.vmax), ec="0.35",
-                             label=f"elastic body deformed x{a.body_scale:g}, coloured by von Mises stress"))
+        handles.append(
+            Patch(
+                fc=body_colour_map(a).to_rgba(0.5 * body_colour_map(a).norm.vmax),
+                ec="0.35",
+                label=f"elastic body deformed x{a.body_scale:g}, coloured by von Mises stress",
+            )
+        )
         if a.solid_label:
-            handles.append(Line2D([], [], color=SOLID_EDGE[0], lw=SOLID_EDGE[1], ls="--",
-                                  label=f"undeformed outline; {a.solid_label}"))
+            handles.append(
+                Line2D(
+                    [], [], color=SOLID_EDGE[0], lw=SOLID_EDGE[1], ls="--", label=f"undeformed outline; {a.solid_label}"
+                )
+            )
     elif a.solid_label:
-        handles.append(Patch(fc=solid_fill(colours.get(a.solid_material, "0.6")), ec=SOLID_EDGE[0],
-                             label=a.solid_label))
+        handles.append(
+            Patch(fc=solid_fill(colours.get(a.solid_material, "0.6")), ec=SOLID_EDGE[0], label=a.solid_label)
+        )
         if len(a.clamped_edges):
             handles.append(Line2D([], [], color=CLAMPED_EDGE[0], lw=CLAMPED_EDGE[1], label="clamped faces"))
     if len(a.walls) > len(oblique):
@@ -677,19 +786,41 @@ def legend_handles(a: Assembly3D, colours: dict, oblique: list[str], series: boo
     if series:
         if a.force_top:
             _, _, _, cmap, _, f_max = _force_style(np.zeros(0), a.force_top)
-            handles += [Line2D([], [], color=cmap.to_rgba(f_max), lw=MAX_LINE_WIDTH,
-                               label=f"contact force, width ∝ force (widest over the frames: {f_max:.3g} N)"),
-                        Line2D([], [], color="0.45", lw=0.6, ls=":",
-                               label=f"contact below {OPEN_FRACTION:.0%} of the widest")]
+            handles += [
+                Line2D(
+                    [],
+                    [],
+                    color=cmap.to_rgba(f_max),
+                    lw=MAX_LINE_WIDTH,
+                    label=f"contact force, width ∝ force (widest over the frames: {f_max:.3g} N)",
+                ),
+                Line2D([], [], color="0.45", lw=0.6, ls=":", label=f"contact below {OPEN_FRACTION:.0%} of the widest"),
+            ]
     elif len(a.segments) and a.forces is None:
-        handles += [Line2D([], [], color=KIND_COLOURS[k], lw=1.2, label=f"contact {KIND_NAMES[k]} "
-                           f"({a.kinds.count(k)})") for k in KIND_COLOURS if k in a.kinds]
+        handles += [
+            Line2D([], [], color=KIND_COLOURS[k], lw=1.2, label=f"contact {KIND_NAMES[k]} ({a.kinds.count(k)})")
+            for k in KIND_COLOURS
+            if k in a.kinds
+        ]
     elif len(a.segments):
         _, _, _, cmap, open_, f_max = _force_style(np.asarray(a.forces, float), a.force_top)
-        handles += [Line2D([], [], color=cmap.to_rgba(f_max), lw=MAX_LINE_WIDTH,
-                           label=f"contact force, width ∝ force (widest: {f_max:.3g} N)"),
-                    Line2D([], [], color="0.45", lw=0.6, ls=":",
-                           label=f"contact below {OPEN_FRACTION:.0%} of the largest ({int(open_.sum())})")]
+        handles += [
+            Line2D(
+                [],
+                [],
+                color=cmap.to_rgba(f_max),
+                lw=MAX_LINE_WIDTH,
+                label=f"contact force, width ∝ force (widest: {f_max:.3g} N)",
+            ),
+            Line2D(
+                [],
+                [],
+                color="0.45",
+                lw=0.6,
+                ls=":",
+                label=f"contact below {OPEN_FRACTION:.0%} of the largest ({int(open_.sum())})",
+            ),
+        ]
     text = _load_text(a, series)
     if text:
         handles.append(Patch(fc="none", ec=LOAD_COLOUR, lw=1.6, label=text))
@@ -712,17 +843,39 @@ def _figure(a: Assembly3D, width: float, region: tuple[np.ndarray, np.ndarray], 
     for ax, view in zip(axes, PROJECTIONS):
         _draw_view(ax, a, view, colours, lo, hi)
     _mark_loaded(axes, a)
-    oblique = [w.label or f"wall {k}" for k, w in enumerate(a.walls)
-               if all(wall_trace(w, view, lo, hi) is None for view in PROJECTIONS)]
+    oblique = [
+        w.label or f"wall {k}"
+        for k, w in enumerate(a.walls)
+        if all(wall_trace(w, view, lo, hi) is None for view in PROJECTIONS)
+    ]
     if len(a.body_faces):
-        fig.colorbar(body_colour_map(a), ax=list(axes), label="von Mises stress [MPa] (largest in each element)",
-                     orientation="horizontal", shrink=0.5, aspect=50, location="bottom")
+        fig.colorbar(
+            body_colour_map(a),
+            ax=list(axes),
+            label="von Mises stress [MPa] (largest in each element)",
+            orientation="horizontal",
+            shrink=0.5,
+            aspect=50,
+            location="bottom",
+        )
     if a.forces is not None and (len(a.segments) or (series and a.force_top)):
         cmap = _force_style(np.asarray(a.forces, float), a.force_top)[3]
-        fig.colorbar(cmap, ax=list(axes), label="contact normal force [N]", orientation="horizontal",
-                     shrink=0.5, aspect=50, location="bottom")
-    fig.legend(handles=legend_handles(a, colours, oblique, series), loc="outside lower center", ncols=2,
-               fontsize=8, frameon=False)
+        fig.colorbar(
+            cmap,
+            ax=list(axes),
+            label="contact normal force [N]",
+            orientation="horizontal",
+            shrink=0.5,
+            aspect=50,
+            location="bottom",
+        )
+    fig.legend(
+        handles=legend_handles(a, colours, oblique, series),
+        loc="outside lower center",
+        ncols=2,
+        fontsize=8,
+        frameon=False,
+    )
     fig.suptitle(_title(a), fontsize=10, x=0.01, ha="left")
     return fig, axes, colours
 

@@ -1,6 +1,7 @@
 """Scenario -> model arrays: contact topology, coefficients (eqs. 3-4), load resultants
 and the plate's modal model, built once per run (the plate part is cached on disk).
 """
+
 from __future__ import annotations
 
 import math
@@ -12,16 +13,35 @@ from granplate.model.contacts import contact_lists, fixed_wall_contacts
 from granplate.model.drives import drive_fields, driven_initial_state
 from granplate.model.inputs import HIST_MAX, Config, Granular, PlateArrays, no_history, scheme_number
 from granplate.physics.contact import (
-    COEF_A, COEF_C, COEF_DY, COEF_H, COEF_KAPPA, COEF_KS, COEF_MU, COEF_RC, COEF_RL, COEF_SY, COEF_XH, N_COEF,
-    damping_coefficient, hertz_coefficient,
+    COEF_A,
+    COEF_C,
+    COEF_DY,
+    COEF_H,
+    COEF_KAPPA,
+    COEF_KS,
+    COEF_MU,
+    COEF_RC,
+    COEF_RL,
+    COEF_SY,
+    COEF_XH,
+    N_COEF,
+    damping_coefficient,
+    hertz_coefficient,
 )
 from granplate.physics.cavity import hardness_overlap
 from granplate.physics.plastic import contact_yield_overlap
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import resolve
 from granplate.physics.shock import shock_resultants
-from granplate.setup.materials import (DEFAULT_HARDNESS_RATIO, DEFAULT_UNLOADING_FACTOR, effective_modulus,
-                                       softer_material, softer_yield_strength, sphere_inertia, sphere_mass)
+from granplate.setup.materials import (
+    DEFAULT_HARDNESS_RATIO,
+    DEFAULT_UNLOADING_FACTOR,
+    effective_modulus,
+    softer_material,
+    softer_yield_strength,
+    sphere_inertia,
+    sphere_mass,
+)
 from granplate.setup.scenario import Plate, Scenario
 from granplate.setup.plate_checks import split_initial_contacts
 from granplate.setup.validate import validate
@@ -31,16 +51,16 @@ from granplate.setup.validate import validate
 FORCE_FLOOR_FRACTION = 1e-2
 
 
-def force_floor(q0: float, fres: np.ndarray, tres: np.ndarray, r: np.ndarray, mass: np.ndarray,
-                s: Scenario, out_dt: float) -> float:
+def force_floor(
+    q0: float, fres: np.ndarray, tres: np.ndarray, r: np.ndarray, mass: np.ndarray, s: Scenario, out_dt: float
+) -> float:
     """The implicit scheme's smallest force scale [N]: FORCE_FLOOR_FRACTION of the shock's
     peak resultant (q0 times the load resultants, torques over radii) plus the granules'
     initial momentum per output interval (for runs driven by initial velocities)."""
     if len(r) == 0:
         return 0.0
     shock = abs(q0) * float(np.abs(fres).sum() + np.abs(tres / r).sum())
-    momentum = sum(m * (math.hypot(gr.vx, gr.vy) + rr * abs(gr.omega))
-                   for m, rr, gr in zip(mass, r, s.granules))
+    momentum = sum(m * (math.hypot(gr.vx, gr.vy) + rr * abs(gr.omega)) for m, rr, gr in zip(mass, r, s.granules))
     return FORCE_FLOOR_FRACTION * (shock + float(momentum) / out_dt)
 
 
@@ -100,7 +120,7 @@ def coefficient_row(a: float, c: float, mu: float, k_s: float, law=math.inf) -> 
     row = np.zeros(N_COEF)
     row[COEF_A], row[COEF_C], row[COEF_MU], row[COEF_KS] = a, c, mu, k_s
     law = np.atleast_1d(np.asarray(law, float))
-    row[COEF_DY:COEF_DY + len(law)] = law
+    row[COEF_DY : COEF_DY + len(law)] = law
     return row
 
 
@@ -228,8 +248,13 @@ def pair_coefficient_row(s: Scenario, a, b, ri: float, rj: float, mi: float, mj:
     m_star = mi * mj / (mi + mj)
     alpha, mu, ks = s.contact.for_pair(a.name, b.name)
     coef_a = hertz_coefficient(e_star, r_star)
-    return coefficient_row(coef_a, damping_coefficient(alpha, m_star, coef_a), mu, ks,
-                           law_coefficients(s, a, b, b.name, e_star, r_star, ri + rj))
+    return coefficient_row(
+        coef_a,
+        damping_coefficient(alpha, m_star, coef_a),
+        mu,
+        ks,
+        law_coefficients(s, a, b, b.name, e_star, r_star, ri + rj),
+    )
 
 
 def material_indices(mats) -> tuple[list, np.ndarray]:
@@ -261,8 +286,14 @@ def pair_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, pairs:
     r_star = ri * rj / (ri + rj)
     m_star = mi * mj / (mi + mj)
     del ri, rj, mi, mj
-    combos = [(0, kinds[0], kinds[0])] if len(kinds) == 1 else [
-        (c, kinds[c // len(kinds)], kinds[c % len(kinds)]) for c in np.unique(kind[i] * len(kinds) + kind[j]).tolist()]
+    combos = (
+        [(0, kinds[0], kinds[0])]
+        if len(kinds) == 1
+        else [
+            (c, kinds[c // len(kinds)], kinds[c % len(kinds)])
+            for c in np.unique(kind[i] * len(kinds) + kind[j]).tolist()
+        ]
+    )
     combo = None if len(combos) == 1 else kind[i] * len(kinds) + kind[j]
     # per pair of materials: E*, alpha_n, mu, k_s, whether the law is elastic-plastic (one value each when one pair)
     e_star, alpha, mu, ks = (np.empty(len(pairs)) if combo is not None else 0.0 for _ in range(4))
@@ -285,8 +316,9 @@ def pair_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, pairs:
     for p in np.flatnonzero(plastic).tolist():
         a, b = mats[i[p]], mats[j[p]]
         e_p = e_star if combo is None else float(e_star[p])
-        pair_coef[p, COEF_DY:COEF_XH + 1] = law_coefficients(s, a, b, b.name, e_p, float(r_star[p]),
-                                                             float(r[i[p]] + r[j[p]]))
+        pair_coef[p, COEF_DY : COEF_XH + 1] = law_coefficients(
+            s, a, b, b.name, e_p, float(r_star[p]), float(r[i[p]] + r[j[p]])
+        )
     return pair_coef
 
 
@@ -296,8 +328,13 @@ def wall_coefficient_row(s: Scenario, a, wall_material: str, ri: float, mi: floa
     alpha, mu, ks = s.contact.for_pair(a.name, wall_material)
     e_star = effective_modulus(a, None)
     coef_a = hertz_coefficient(e_star, ri)
-    return coefficient_row(coef_a, damping_coefficient(alpha, mi, coef_a), mu, ks,
-                           law_coefficients(s, a, None, wall_material, e_star, ri, 2.0 * ri))
+    return coefficient_row(
+        coef_a,
+        damping_coefficient(alpha, mi, coef_a),
+        mu,
+        ks,
+        law_coefficients(s, a, None, wall_material, e_star, ri, 2.0 * ri),
+    )
 
 
 def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarray):
@@ -322,8 +359,7 @@ def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarr
         for c in np.unique(kind[i[at]]).tolist():
             on = at & (kind[i] == c)
             e_star[on] = effective_modulus(kinds[c], None)
-            alpha[on], wall_coef[on, COEF_MU], wall_coef[on, COEF_KS] = s.contact.for_pair(kinds[c].name,
-                                                                                         wall.material)
+            alpha[on], wall_coef[on, COEF_MU], wall_coef[on, COEF_KS] = s.contact.for_pair(kinds[c].name, wall.material)
             plastic |= on & (normal_law_of(s, kinds[c].name, wall.material) != "hertz")
     ri = r[i]
     coef_a = 4.0 / 3.0 * e_star * np.sqrt(ri)  # hertz_coefficient with R* = R
@@ -331,8 +367,9 @@ def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarr
     wall_coef[:, COEF_C] = alpha * np.sqrt(mass[i] * coef_a)  # damping_coefficient with m* = m
     wall_coef[:, COEF_DY] = math.inf
     for p in np.flatnonzero(plastic).tolist():
-        wall_coef[p, COEF_DY:COEF_XH + 1] = law_coefficients(s, mats[i[p]], None, s.walls[w[p]].material,
-                                                             float(e_star[p]), float(ri[p]), 2.0 * float(ri[p]))
+        wall_coef[p, COEF_DY : COEF_XH + 1] = law_coefficients(
+            s, mats[i[p]], None, s.walls[w[p]].material, float(e_star[p]), float(ri[p]), 2.0 * float(ri[p])
+        )
     return wall_geo, wall_coef
 
 
@@ -344,8 +381,13 @@ def plate_contact_coefficients(s: Scenario, mats, r: np.ndarray, pc: np.ndarray)
         alpha, mu, ks = s.contact.for_pair(mats[i].name, s.plate.material)
         e_star = effective_modulus(mats[i], None)
         a = hertz_coefficient(e_star, r[i])
-        pc_coef[k] = coefficient_row(a, damping_coefficient(alpha, 0.0, a), mu, ks,
-                                     law_coefficients(s, mats[i], None, s.plate.material, e_star, r[i], 2.0 * r[i]))
+        pc_coef[k] = coefficient_row(
+            a,
+            damping_coefficient(alpha, 0.0, a),
+            mu,
+            ks,
+            law_coefficients(s, mats[i], None, s.plate.material, e_star, r[i], 2.0 * r[i]),
+        )
     return pc_coef
 
 
@@ -354,8 +396,12 @@ def face_contacts_possible(s: Scenario, plate_model) -> bool:
     dynamic detection, granules, and a plate integrated in all its modes or in the
     truncated basis, whose static correction covers every face dof (section 4.5; a dense
     basis cut to plate.n_modes has none)."""
-    return (s.contact.detection == "dynamic" and plate_model is not None and len(s.granules) > 0
-            and (plate_model.n_modes == plate_model.n_red or plate_model.truncated))
+    return (
+        s.contact.detection == "dynamic"
+        and plate_model is not None
+        and len(s.granules) > 0
+        and (plate_model.n_modes == plate_model.n_red or plate_model.truncated)
+    )
 
 
 def plate_modal_arrays(s: Scenario, y: np.ndarray, pc: np.ndarray):
@@ -372,7 +418,10 @@ def plate_modal_arrays(s: Scenario, y: np.ndarray, pc: np.ndarray):
         if s.load.kind == "line" and s.load.target == "plate":
             edge = (s.load.y0, s.load.length)
         plate_model = build_plate(
-            s.plate, s.plate.x0, [float(y[i]) for i in pc], edge_load=edge,
+            s.plate,
+            s.plate.x0,
+            [float(y[i]) for i in pc],
+            edge_load=edge,
             material=s.material(s.plate.material),
         )
         omega2 = np.asarray(plate_model.omega, float) ** 2
@@ -391,12 +440,26 @@ def plate_modal_arrays(s: Scenario, y: np.ndarray, pc: np.ndarray):
         resid = np.zeros((0, 0))
     if phi_d.shape != (2 * nk, len(omega2)):
         phi_d = phi_d.reshape(2 * nk, len(omega2))
-    return plate_model, PlateArrays(omega2=omega2, phi_d=phi_d, load_modal=load_modal, resid=resid,
-                                    face_y=face_y, phi_face=phi_face, resid_face=resid_face)
+    return plate_model, PlateArrays(
+        omega2=omega2,
+        phi_d=phi_d,
+        load_modal=load_modal,
+        resid=resid,
+        face_y=face_y,
+        phi_face=phi_face,
+        resid_face=resid_face,
+    )
 
 
-def loop_config(s: Scenario, fres: np.ndarray, tres: np.ndarray, r: np.ndarray, mass: np.ndarray,
-                face: bool = False, floor: float | None = None) -> Config:
+def loop_config(
+    s: Scenario,
+    fres: np.ndarray,
+    tres: np.ndarray,
+    r: np.ndarray,
+    mass: np.ndarray,
+    face: bool = False,
+    floor: float | None = None,
+) -> Config:
     """The loop's scalar settings from the scenario's load, contact, time and solver;
     face: whether granules may get patch contacts during the run; floor: the implicit
     scheme's force floor [N] when given (else `force_floor` of the plane's load)."""
@@ -405,13 +468,20 @@ def loop_config(s: Scenario, fres: np.ndarray, tres: np.ndarray, r: np.ndarray, 
     q0 = s.load.q0 if s.load.kind == "line" else 0.0
     plate = s.plate if isinstance(s.plate, Plate) else None  # the plane's plate (an elastic solid: model.body)
     return Config(
-        q0=float(q0), duration=float(s.load.duration), clip=bool(s.contact.clip_tensile),
-        lambda_target=float(sol.lambda_target), rtol=float(sol.iteration_rtol),
-        atol=float(sol.iteration_atol), max_iter=int(sol.max_iterations),
+        q0=float(q0),
+        duration=float(s.load.duration),
+        clip=bool(s.contact.clip_tensile),
+        lambda_target=float(sol.lambda_target),
+        rtol=float(sol.iteration_rtol),
+        atol=float(sol.iteration_atol),
+        max_iter=int(sol.max_iterations),
         energy_tol=float(sol.energy_tol),
-        dt_max=float(implicit_step_max(sol.implicit_dt_max, t.output_interval) if sol.scheme == "implicit"
-                     else t.dt_max), dt_min=float(t.dt_min),
-        out_dt=float(t.output_interval), t_end=float(t.t_end),
+        dt_max=float(
+            implicit_step_max(sol.implicit_dt_max, t.output_interval) if sol.scheme == "implicit" else t.dt_max
+        ),
+        dt_min=float(t.dt_min),
+        out_dt=float(t.output_interval),
+        t_end=float(t.t_end),
         load_on_plate=bool(s.load.kind == "line" and s.load.target == "plate"),
         arm_shrink=1.0 if s.contact.torque_arm == "contact_point" else 0.0,
         scheme=scheme_number(sol.scheme),
@@ -465,26 +535,45 @@ def build_model(scenario: Scenario) -> Model:
     fres, tres = shock_resultants(y, r, loaded_granules(s, x, r), s.load.y0, s.load.length)
     plate_model, plate_arrays = plate_modal_arrays(s, y, pc)
     if len(patches) and len(plate_arrays.face_y) == 0:  # pragma: no cover - guarded by validation
-        raise ScenarioError("contact.detection", s.contact.detection,
-                            "granules touching the face between nodes at t = 0 need patch contacts")
+        raise ScenarioError(
+            "contact.detection",
+            s.contact.detection,
+            "granules touching the face between nodes at t = 0 need patch contacts",
+        )
     granular = Granular(
-        mass=mass, inertia=inertia, radius=r, pair_ij=loop_pairs,
+        mass=mass,
+        inertia=inertia,
+        radius=r,
+        pair_ij=loop_pairs,
         pair_coef=pair_coefficients(s, mats, r, mass, loop_pairs),
-        wall_i=np.ascontiguousarray(loop_wc[:, 0]), wall_geo=wall_geo, wall_coef=wall_coef,
+        wall_i=np.ascontiguousarray(loop_wc[:, 0]),
+        wall_geo=wall_geo,
+        wall_coef=wall_coef,
         wall_w=np.ascontiguousarray(loop_wc[:, 1]),
-        pc_i=pc, pc_x=np.full(len(pc), float(s.plate.x0) if s.plate is not None else 0.0),
-        pc_coef=plate_contact_coefficients(s, mats, r, pc), shock_force=fres, shock_torque=tres,
-        pair_hist=no_history(len(loop_pairs)), wall_hist=no_history(len(loop_wc)), pc_hist=no_history(len(pc)),
+        pc_i=pc,
+        pc_x=np.full(len(pc), float(s.plate.x0) if s.plate is not None else 0.0),
+        pc_coef=plate_contact_coefficients(s, mats, r, pc),
+        shock_force=fres,
+        shock_torque=tres,
+        pair_hist=no_history(len(loop_pairs)),
+        wall_hist=no_history(len(loop_wc)),
+        pc_hist=no_history(len(pc)),
     )
     drives = drive_fields(s, np.column_stack([x, y]))
     granular = granular._replace(**drives)
     return Model(
-        scenario=s, labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
-        granular=granular, plate_arrays=plate_arrays,
+        scenario=s,
+        labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
+        granular=granular,
+        plate_arrays=plate_arrays,
         config=loop_config(s, fres, tres, r, mass, face=len(plate_arrays.face_y) > 0),
-        plate=plate_model, initial_state=driven_initial_state(initial_state(s, x, y), drives), pairs=pairs,
+        plate=plate_model,
+        initial_state=driven_initial_state(initial_state(s, x, y), drives),
+        pairs=pairs,
         wall_contacts=wc,
-        plate_contacts=pc, materials=tuple(mats), initial_patches=patches,
+        plate_contacts=pc,
+        materials=tuple(mats),
+        initial_patches=patches,
     )
 
 
@@ -508,8 +597,14 @@ def carried_history(old_keys: list, old_hist: np.ndarray, new_keys: list, store:
     return out
 
 
-def granular_with_contacts(model: Model, g: Granular, pairs: np.ndarray, wc: np.ndarray,
-                           known: dict | None = None, stores: tuple[dict, dict] | None = None) -> Granular:
+def granular_with_contacts(
+    model: Model,
+    g: Granular,
+    pairs: np.ndarray,
+    wc: np.ndarray,
+    known: dict | None = None,
+    stores: tuple[dict, dict] | None = None,
+) -> Granular:
     """`g` with the contact lists pairs (np, 2) and wc (nw, 2) [granule, wall], their
     coefficients and their histories carried over (`carried_history`; stores: the pairs'
     and the walls' histories off the list, keyed (i, j) and (i, wall), updated); known:
@@ -529,11 +624,16 @@ def granular_with_contacts(model: Model, g: Granular, pairs: np.ndarray, wc: np.
     old_pairs = [(int(i), int(j)) for i, j in g.pair_ij]
     old_walls = [(int(i), int(w)) for i, w in zip(g.wall_i, g.wall_w)]
     new_walls = [(int(i), int(w)) for i, w in wc]
-    return g._replace(pair_ij=np.ascontiguousarray(pairs, np.int64).reshape(-1, 2), pair_coef=pair_coef,
-                      wall_i=np.ascontiguousarray(wc[:, 0]), wall_geo=wall_geo, wall_coef=wall_coef,
-                      wall_w=np.ascontiguousarray(wc[:, 1]),
-                      pair_hist=carried_history(old_pairs, g.pair_hist, keys, stores[0]),
-                      wall_hist=carried_history(old_walls, g.wall_hist, new_walls, stores[1]))
+    return g._replace(
+        pair_ij=np.ascontiguousarray(pairs, np.int64).reshape(-1, 2),
+        pair_coef=pair_coef,
+        wall_i=np.ascontiguousarray(wc[:, 0]),
+        wall_geo=wall_geo,
+        wall_coef=wall_coef,
+        wall_w=np.ascontiguousarray(wc[:, 1]),
+        pair_hist=carried_history(old_pairs, g.pair_hist, keys, stores[0]),
+        wall_hist=carried_history(old_walls, g.wall_hist, new_walls, stores[1]),
+    )
 
 
 def granular_with_patch_contacts(model: Model, g: Granular, new: np.ndarray) -> Granular:
@@ -546,8 +646,9 @@ def granular_with_patch_contacts(model: Model, g: Granular, new: np.ndarray) -> 
     return g._replace(
         pc_i=np.concatenate([g.pc_i, new]).astype(np.int64),
         pc_x=np.concatenate([g.pc_x, np.full(len(new), float(s.plate.x0))]),
-        pc_coef=np.ascontiguousarray(np.vstack([g.pc_coef.reshape(-1, N_COEF),
-                                                plate_contact_coefficients(s, mats, g.radius, new)])),
+        pc_coef=np.ascontiguousarray(
+            np.vstack([g.pc_coef.reshape(-1, N_COEF), plate_contact_coefficients(s, mats, g.radius, new)])
+        ),
         pc_patch=np.concatenate([patch, np.ones(len(new), np.int64)]),
         pc_hist=np.vstack([g.pc_hist.reshape(-1, g.pc_hist.shape[1]), no_history(len(new))]),
     )

@@ -6,6 +6,7 @@ contact coefficients with the body (the 2D plate contact's laws with the body's
 material: E* of both, the granule's mass as m*, the pair's friction), and the modal
 forces of a line load on the body (the bare plate's shock, solid.traction).
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -42,8 +43,9 @@ def residual_face(s: Scenario, surface, mesh) -> tuple[str | None, str]:
     return name, "xyz"
 
 
-def body_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, body_material,
-                      on_rigid: np.ndarray | None = None) -> np.ndarray:
+def body_coefficients(
+    s: Scenario, mats, r: np.ndarray, mass: np.ndarray, body_material, on_rigid: np.ndarray | None = None
+) -> np.ndarray:
     """(ng, N_COEF) each granule's contact coefficients with the body: Hertz A with E* of
     both materials and the granule's radius (the body flat there), damping with m* = m_i
     (the body's mass much larger), the pair's friction and yield overlap; a granule on a
@@ -58,9 +60,13 @@ def body_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, body_m
         other = None if rigid else body_material
         e_star = effective_modulus(m, other)
         a = hertz_coefficient(e_star, float(r[i]))
-        coef[i] = coefficient_row(a, damping_coefficient(alpha, 0.0 if rigid else float(mass[i]), a), mu, ks,
-                                  law_coefficients(s, m, other, body_material.name, e_star, float(r[i]),
-                                                   2.0 * float(r[i])))
+        coef[i] = coefficient_row(
+            a,
+            damping_coefficient(alpha, 0.0 if rigid else float(mass[i]), a),
+            mu,
+            ks,
+            law_coefficients(s, m, other, body_material.name, e_star, float(r[i]), 2.0 * float(r[i])),
+        )
     return coef
 
 
@@ -100,8 +106,15 @@ def modal_line_load(s: Scenario, surface, solid) -> np.ndarray:
     from granplate.solid.traction import face_xmin_line_load
 
     sd = s.plate
-    f = face_xmin_line_load(surface, 3 * len(solid.nodes), float(sd.origin[0]), float(sd.size[2]),
-                            s.load.y0, s.load.length, 1e-9 * max(sd.size))
+    f = face_xmin_line_load(
+        surface,
+        3 * len(solid.nodes),
+        float(sd.origin[0]),
+        float(sd.size[2]),
+        s.load.y0,
+        s.load.length,
+        1e-9 * max(sd.size),
+    )
     return np.ascontiguousarray(solid.Phi.T @ f[solid.dofs])
 
 
@@ -146,8 +159,13 @@ def surface_geometry(sd) -> SurfaceGeometry:
     mesh = solid_mesh(sd)
     surface = boundary_surface(vector_basis(mesh, sd.element))
     sn = surface_nodes(surface)
-    geo = SurfaceGeometry(mesh=mesh, surface=surface, neighbours=face_neighbours(surface), nodes=sn,
-                          reach=farthest_from_nodes(surface, sn.xyz))
+    geo = SurfaceGeometry(
+        mesh=mesh,
+        surface=surface,
+        neighbours=face_neighbours(surface),
+        nodes=sn,
+        reach=farthest_from_nodes(surface, sn.xyz),
+    )
     _GEOMETRIES[key] = geo
     while len(_GEOMETRIES) > GEOMETRIES_KEPT:
         _GEOMETRIES.pop(next(iter(_GEOMETRIES)))
@@ -193,19 +211,42 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
     rigid = on_rigid_patches(s, points)
     z = np.zeros
     arrays = BodyArrays(
-        face_nodes=np.ascontiguousarray(surface.nodes), face_snode=sn.face_snode, node_xyz=sn.xyz,
-        node_area=sn.area, node_rows=np.ascontiguousarray(rows, np.int64),
-        node_resid=np.ascontiguousarray(resid_index, np.int64), grid=np.array([grid.cell]),
-        grid_origin=grid.origin, grid_shape=grid.shape, cell_start=grid.start, cell_nodes=grid.nodes,
+        face_nodes=np.ascontiguousarray(surface.nodes),
+        face_snode=sn.face_snode,
+        node_xyz=sn.xyz,
+        node_area=sn.area,
+        node_rows=np.ascontiguousarray(rows, np.int64),
+        node_resid=np.ascontiguousarray(resid_index, np.int64),
+        grid=np.array([grid.cell]),
+        grid_origin=grid.origin,
+        grid_shape=grid.shape,
+        cell_start=grid.start,
+        cell_nodes=grid.nodes,
         neighbours=geo.neighbours,
-        kind=np.array([surface.kind], np.int64), phi=np.ascontiguousarray(solid.Phi), omega=solid.omega.copy(),
-        resid=np.ascontiguousarray(solid.resid), box=box,
+        kind=np.array([surface.kind], np.int64),
+        phi=np.ascontiguousarray(solid.Phi),
+        omega=solid.omega.copy(),
+        resid=np.ascontiguousarray(solid.resid),
+        box=box,
         coef=body_coefficients(s, mats, r, mass, material, rigid),
         load=modal_line_load(s, surface, solid),
-        patch=np.array([radius]), face=np.vstack([seeds, seeds]), geo=z((2, ng, N_GEO)),
-        entry=np.zeros((2, ng, n_p), np.int64), weights=z((2, ng, n_p)), count=np.zeros((2, ng), np.int64),
-        grad=z((ng, n_p, 3)), fmodal=z((2, nm)), fdamp=z((2, nm)), hist=no_history(ng), q=z(nm), qd=z(nm),
-        qdp=z(nm), static=z(2), active=np.zeros(ng, np.int64),
-        rcol=np.zeros((ng, 3 * n_p), np.int64), rcoef=z((ng, 3 * n_p)), rgrad=z((ng, 3 * n_p, 3)),
+        patch=np.array([radius]),
+        face=np.vstack([seeds, seeds]),
+        geo=z((2, ng, N_GEO)),
+        entry=np.zeros((2, ng, n_p), np.int64),
+        weights=z((2, ng, n_p)),
+        count=np.zeros((2, ng), np.int64),
+        grad=z((ng, n_p, 3)),
+        fmodal=z((2, nm)),
+        fdamp=z((2, nm)),
+        hist=no_history(ng),
+        q=z(nm),
+        qd=z(nm),
+        qdp=z(nm),
+        static=z(2),
+        active=np.zeros(ng, np.int64),
+        rcol=np.zeros((ng, 3 * n_p), np.int64),
+        rcoef=z((ng, 3 * n_p)),
+        rgrad=z((ng, 3 * n_p, 3)),
     )
     return solid, arrays, rigid

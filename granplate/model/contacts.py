@@ -17,6 +17,7 @@ overlaps.
 Both lists are sorted, pairs by (i, j) and wall contacts by (wall, granule), so that the
 touching pairs of a packing are summed in the same order whatever the mode.
 """
+
 from __future__ import annotations
 
 from typing import NamedTuple
@@ -69,11 +70,15 @@ def contact_lists(contact, walls, x, y, r, z=None, candidates=None) -> tuple[np.
     candidates: sorted pairs holding every pair the list's search would find (shared
     with another search of the same positions), or None."""
     if contact.detection == "fixed":
-        return (contact_pairs(x, y, r, contact.neighbour_gap, z, candidates),
-                fixed_wall_contacts(walls, x, y, r, contact.neighbour_gap, z))
+        return (
+            contact_pairs(x, y, r, contact.neighbour_gap, z, candidates),
+            fixed_wall_contacts(walls, x, y, r, contact.neighbour_gap, z),
+        )
     normals, offsets = wall_planes(walls, 2 if z is None else 3)
-    return (verlet_pairs(x, y, r, contact.skin, z, candidates),
-            verlet_walls(x, y, r, normals, offsets, contact.skin, z))
+    return (
+        verlet_pairs(x, y, r, contact.skin, z, candidates),
+        verlet_walls(x, y, r, normals, offsets, contact.skin, z),
+    )
 
 
 def pair_keys(pairs: np.ndarray, n: int) -> np.ndarray:
@@ -81,8 +86,7 @@ def pair_keys(pairs: np.ndarray, n: int) -> np.ndarray:
     return pairs[:, 0] * n + pairs[:, 1]
 
 
-def missed_contacts(pairs, wall_contacts, cand_pairs, cand_walls, normals, offsets,
-                    x, y, r, z=None) -> list[Missed]:
+def missed_contacts(pairs, wall_contacts, cand_pairs, cand_walls, normals, offsets, x, y, r, z=None) -> list[Missed]:
     """Overlapping pairs of the candidate lists that are not in the loop's lists, largest
     overlap first."""
     n = len(x)
@@ -91,12 +95,16 @@ def missed_contacts(pairs, wall_contacts, cand_pairs, cand_walls, normals, offse
         i, j = cand_pairs[:, 0], cand_pairs[:, 1]
         delta = r[i] + r[j] - centre_distances(x, y, z, i, j)
         new = ~np.isin(pair_keys(cand_pairs, n), pair_keys(pairs, n))
-        out += [Missed(int(a), int(b), float(d)) for a, b, d in zip(i[new & (delta > 0)], j[new & (delta > 0)],
-                                                                     delta[new & (delta > 0)])]
+        out += [
+            Missed(int(a), int(b), float(d))
+            for a, b, d in zip(i[new & (delta > 0)], j[new & (delta > 0)], delta[new & (delta > 0)])
+        ]
     if len(cand_walls):
         i, w = cand_walls[:, 0], cand_walls[:, 1]
         delta = normal_coordinates(x[i], y[i], None if z is None else z[i], normals[w].T) + r[i] - offsets[w]
         new = ~np.isin(i * len(offsets) + w, wall_contacts[:, 0] * len(offsets) + wall_contacts[:, 1])
-        out += [Missed(int(a), -1 - int(b), float(d)) for a, b, d in zip(i[new & (delta > 0)], w[new & (delta > 0)],
-                                                                          delta[new & (delta > 0)])]
+        out += [
+            Missed(int(a), -1 - int(b), float(d))
+            for a, b, d in zip(i[new & (delta > 0)], w[new & (delta > 0)], delta[new & (delta > 0)])
+        ]
     return sorted(out, key=lambda m: -m.overlap)

@@ -2,6 +2,7 @@
 gravity, drive_* and wall_* fields; docs/model.md section 3.11), and the initial
 velocities a displacement or velocity drive prescribes.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -61,10 +62,14 @@ def drive_fields(s: Scenario, centres: np.ndarray) -> dict:
     direction = np.zeros((nd, d))
     x0 = np.zeros((nd, d))
     for k, dr in enumerate(s.drives):
-        par[k, [PAR_VALUE, PAR_AMPLITUDE, PAR_FREQUENCY, PAR_DURATION]] = (dr.value, dr.amplitude, dr.frequency,
-                                                                        dr.duration)
+        par[k, [PAR_VALUE, PAR_AMPLITUDE, PAR_FREQUENCY, PAR_DURATION]] = (
+            dr.value,
+            dr.amplitude,
+            dr.frequency,
+            dr.duration,
+        )
         rows = drive_table(dr.times, dr.values)
-        tab[k, :len(rows)] = rows
+        tab[k, : len(rows)] = rows
         tlen[k] = len(rows)
         direction[k] = np.asarray(dr.direction, float) / np.linalg.norm(dr.direction)
         if target[k] >= 0:
@@ -74,9 +79,14 @@ def drive_fields(s: Scenario, centres: np.ndarray) -> dict:
         wall_drive[-1 - target[k]] = k
     return dict(
         gravity=np.asarray(s.gravity.g, float) if s.gravity is not None else np.zeros(0),
-        drive_target=target, drive_kind=np.array([DRIVE_KINDS.index(x.kind) for x in s.drives], np.int64),
+        drive_target=target,
+        drive_kind=np.array([DRIVE_KINDS.index(x.kind) for x in s.drives], np.int64),
         drive_prof=np.array([DRIVE_PROFILES.index(x.profile) for x in s.drives], np.int64),
-        drive_dir=direction, drive_par=par, drive_tab=tab, drive_tlen=tlen, drive_x0=x0,
+        drive_dir=direction,
+        drive_par=par,
+        drive_tab=tab,
+        drive_tlen=tlen,
+        drive_x0=x0,
         drive_now=np.zeros((nd, N_DRIVE)),
         wall_drive=wall_drive if (target < 0).any() else np.zeros(0, np.int64),
         wall_load=np.zeros(n_walls),
@@ -91,9 +101,15 @@ def driven_initial_state(y0: np.ndarray, fields: dict) -> np.ndarray:
     for k, i in enumerate(fields["drive_target"]):
         if i < 0 or fields["drive_kind"][k] == KIND_FORCE:
             continue
-        _, v, _ = drive_motion(0.0, fields["drive_kind"][k], fields["drive_prof"][k], fields["drive_par"][k],
-                               fields["drive_tab"][k], fields["drive_tlen"][k])
+        _, v, _ = drive_motion(
+            0.0,
+            fields["drive_kind"][k],
+            fields["drive_prof"][k],
+            fields["drive_par"][k],
+            fields["drive_tab"][k],
+            fields["drive_tlen"][k],
+        )
         e = fields["drive_dir"][k]
-        vel = y0[i, 3:3 + d]
-        y0[i, 3:3 + d] = vel + (v - float(vel @ e)) * e
+        vel = y0[i, 3 : 3 + d]
+        y0[i, 3 : 3 + d] = vel + (v - float(vel @ e)) * e
     return y0

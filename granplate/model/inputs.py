@@ -4,6 +4,7 @@ and the scalar settings, as numba-friendly named tuples built once by `build_mod
 Coefficient columns of pair_coef, wall_coef and pc_coef are named in
 granplate.physics.contact (COEF_A, COEF_C, COEF_MU, COEF_KS, COEF_DY).
 """
+
 from __future__ import annotations
 
 from typing import NamedTuple
@@ -271,22 +272,65 @@ def no_body(ng: int, nm: int) -> BodyArrays:
     z = np.zeros
     i = np.int64
     return BodyArrays(
-        face_nodes=z((0, 1, 3)), face_snode=np.zeros((0, 1), i), node_xyz=z((0, 3)), node_area=z(0),
-        node_rows=np.zeros((0, 3), i), node_resid=np.zeros((0, 3), i), grid=np.ones(1), grid_origin=z(3),
-        grid_shape=np.ones(3, i), cell_start=np.zeros(2, i), cell_nodes=np.zeros(0, i),
-        neighbours=np.zeros((0, 1), i), kind=np.zeros(1, i), phi=z((0, nm)), omega=z(nm), resid=z((0, 0)),
-        box=z((2, 3)), coef=z((0, 5)), load=z(nm), patch=z(1), face=np.zeros((2, 0), i), geo=z((2, 0, N_GEO)),
-        entry=np.zeros((2, 0, 1), i), weights=z((2, 0, 1)), count=np.zeros((2, 0), i), grad=z((0, 1, 3)),
-        fmodal=z((2, nm)), fdamp=z((2, nm)), hist=no_history(0), q=z(nm), qd=z(nm), qdp=z(nm), static=z(2),
-        active=np.zeros(0, i), rcol=np.zeros((0, 3), i), rcoef=z((0, 3)), rgrad=z((0, 3, 3)),
+        face_nodes=z((0, 1, 3)),
+        face_snode=np.zeros((0, 1), i),
+        node_xyz=z((0, 3)),
+        node_area=z(0),
+        node_rows=np.zeros((0, 3), i),
+        node_resid=np.zeros((0, 3), i),
+        grid=np.ones(1),
+        grid_origin=z(3),
+        grid_shape=np.ones(3, i),
+        cell_start=np.zeros(2, i),
+        cell_nodes=np.zeros(0, i),
+        neighbours=np.zeros((0, 1), i),
+        kind=np.zeros(1, i),
+        phi=z((0, nm)),
+        omega=z(nm),
+        resid=z((0, 0)),
+        box=z((2, 3)),
+        coef=z((0, 5)),
+        load=z(nm),
+        patch=z(1),
+        face=np.zeros((2, 0), i),
+        geo=z((2, 0, N_GEO)),
+        entry=np.zeros((2, 0, 1), i),
+        weights=z((2, 0, 1)),
+        count=np.zeros((2, 0), i),
+        grad=z((0, 1, 3)),
+        fmodal=z((2, nm)),
+        fdamp=z((2, nm)),
+        hist=no_history(0),
+        q=z(nm),
+        qd=z(nm),
+        qdp=z(nm),
+        static=z(2),
+        active=np.zeros(0, i),
+        rcol=np.zeros((0, 3), i),
+        rcoef=z((0, 3)),
+        rgrad=z((0, 3, 3)),
     )
 
 
 def new_body_state(b: BodyArrays) -> BodyArrays:
     """b with its per-run state (face onwards) copied, so that a run never writes into the
     model's arrays; the geometry, modes and coefficients are shared."""
-    return b._replace(face=b.face.copy(), geo=b.geo.copy(), entry=b.entry.copy(), weights=b.weights.copy(),
-                      count=b.count.copy(), grad=b.grad.copy(), fmodal=b.fmodal.copy(),
-                      fdamp=b.fdamp.copy(), hist=b.hist.copy(), q=b.q.copy(), qd=b.qd.copy(), qdp=b.qdp.copy(),
-                      static=b.static.copy(), active=b.active.copy(), rcol=b.rcol.copy(),
-                      rcoef=b.rcoef.copy(), rgrad=b.rgrad.copy())
+    return b._replace(
+        face=b.face.copy(),
+        geo=b.geo.copy(),
+        entry=b.entry.copy(),
+        weights=b.weights.copy(),
+        count=b.count.copy(),
+        grad=b.grad.copy(),
+        fmodal=b.fmodal.copy(),
+        fdamp=b.fdamp.copy(),
+        hist=b.hist.copy(),
+        q=b.q.copy(),
+        qd=b.qd.copy(),
+        qdp=b.qdp.copy(),
+        static=b.static.copy(),
+        active=b.active.copy(),
+        rcol=b.rcol.copy(),
+        rcoef=b.rcoef.copy(),
+        rgrad=b.rgrad.copy(),
+    )

@@ -16,6 +16,7 @@ test above (the same floating-point expression as the O(N^2) double loop,
 the double loop's. Every function takes the centres as x, y and, in space, z (None in the
 plane: the plane's expressions are kept as they are).
 """
+
 from __future__ import annotations
 
 import math
@@ -54,8 +55,9 @@ def _centres(x, y, z) -> np.ndarray:
 def brute_force_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: float) -> np.ndarray:
     """(n_pairs, 2) potential contacts by the O(N^2) double loop (the reference)."""
     n = len(x)
-    out = [(i, j) for i in range(n) for j in range(i + 1, n)
-           if is_contact(x[j] - x[i], y[j] - y[i], r[i], r[j], gap_ratio)]
+    out = [
+        (i, j) for i in range(n) for j in range(i + 1, n) if is_contact(x[j] - x[i], y[j] - y[i], r[i], r[j], gap_ratio)
+    ]
     return np.array(out, np.int64).reshape(-1, 2)
 
 
@@ -94,8 +96,14 @@ def contacts_among(cand: np.ndarray, x, y, r, gap_ratio: float, z=None) -> np.nd
     return keep
 
 
-def contact_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, gap_ratio: float,
-                  z: np.ndarray | None = None, candidates: np.ndarray | None = None) -> np.ndarray:
+def contact_pairs(
+    x: np.ndarray,
+    y: np.ndarray,
+    r: np.ndarray,
+    gap_ratio: float,
+    z: np.ndarray | None = None,
+    candidates: np.ndarray | None = None,
+) -> np.ndarray:
     """(n_pairs, 2) potential contacts, sorted (i, j) with i < j, in O(N log N).
 
     Same pairs in the same order as `brute_force_pairs`: the k-d tree gives candidates and
@@ -115,8 +123,14 @@ def verlet_distance(r: np.ndarray, skin: float) -> float:
     return 2.0 * float(r.max()) * (1.0 + skin) * (1.0 + SEARCH_MARGIN)
 
 
-def verlet_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, skin: float, z: np.ndarray | None = None,
-                 candidates: np.ndarray | None = None) -> np.ndarray:
+def verlet_pairs(
+    x: np.ndarray,
+    y: np.ndarray,
+    r: np.ndarray,
+    skin: float,
+    z: np.ndarray | None = None,
+    candidates: np.ndarray | None = None,
+) -> np.ndarray:
     """(n_pairs, 2) pairs whose centres are at most (R_i + R_j)(1 + skin) apart, sorted
     (i, j) with i < j, in O(N log N) (the Verlet list of docs/model.md section 1.3);
     candidates: as `contact_pairs`', holding every pair within `verlet_distance`."""
@@ -129,8 +143,15 @@ def verlet_pairs(x: np.ndarray, y: np.ndarray, r: np.ndarray, skin: float, z: np
     return np.ascontiguousarray(cand[keep]).reshape(-1, 2)
 
 
-def verlet_walls(x: np.ndarray, y: np.ndarray, r: np.ndarray, normals: np.ndarray, offsets: np.ndarray,
-                 skin: float, z: np.ndarray | None = None) -> np.ndarray:
+def verlet_walls(
+    x: np.ndarray,
+    y: np.ndarray,
+    r: np.ndarray,
+    normals: np.ndarray,
+    offsets: np.ndarray,
+    skin: float,
+    z: np.ndarray | None = None,
+) -> np.ndarray:
     """(n, 2) [granule, wall] whose gap offset - s.n - R is at most skin R (granules
     beyond the wall included), sorted (wall, granule); normals: (nw, 2 or 3) unit outward."""
     x, y, r = (np.asarray(a, float) for a in (x, y, r))

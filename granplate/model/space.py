@@ -7,6 +7,7 @@ packing, section 5.1), the elastic body of its [plate] (model.body) and
 the loop's settings. `model.arrays.build_model` calls `build_space_model` for a scenario
 of dimension 3: the one place the model's dimension is decided.
 """
+
 from __future__ import annotations
 
 import math
@@ -24,8 +25,12 @@ from granplate.setup.scenario import Scenario
 def centres(s: Scenario) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """x, y, z [m] and radii [m] of the granules."""
     g = s.granules
-    return (np.array([q.x for q in g], float), np.array([q.y for q in g], float),
-            np.array([q.z for q in g], float), np.array([q.radius for q in g], float))
+    return (
+        np.array([q.x for q in g], float),
+        np.array([q.y for q in g], float),
+        np.array([q.z for q in g], float),
+        np.array([q.radius for q in g], float),
+    )
 
 
 def spin_vector(omega) -> tuple[float, float, float]:
@@ -106,8 +111,9 @@ def granule_momentum(m: float, r: float, g) -> float:
     return m * (math.sqrt(g.vx**2 + g.vy**2 + g.vz**2) + r * math.sqrt(sum(w * w for w in spin_vector(g.omega))))
 
 
-def force_floor_3d(s: Scenario, mass: np.ndarray, r: np.ndarray, shares: np.ndarray, out_dt: float,
-                   state: np.ndarray | None = None) -> float:
+def force_floor_3d(
+    s: Scenario, mass: np.ndarray, r: np.ndarray, shares: np.ndarray, out_dt: float, state: np.ndarray | None = None
+) -> float:
     """The implicit scheme's smallest force scale [N] (as model.arrays.force_floor): a
     fraction of the shock's peak force plus the initial momentum per output interval
     (the sum over the granules in their order; those at rest add nothing, so only the
@@ -149,7 +155,12 @@ def build_space_model(s: Scenario):
     (model.body) when it has a [plate]."""
     from granplate.model.drives import drive_fields, driven_initial_state
     from granplate.model.arrays import (
-        Model, find_pairs_and_walls, loop_config, masses_and_inertias, pair_coefficients, wall_arrays,
+        Model,
+        find_pairs_and_walls,
+        loop_config,
+        masses_and_inertias,
+        pair_coefficients,
+        wall_arrays,
     )
 
     x, y, z, r = centres(s)
@@ -163,32 +174,57 @@ def build_space_model(s: Scenario):
     wall_geo, wall_coef = wall_arrays(s, mats, r, mass, loop_wc)
     shares, torques = shock_resultants_3d(s, x, y, z, r)
     granular = Granular3(
-        mass=mass, inertia=inertia, radius=r, pair_ij=loop_pairs,
+        mass=mass,
+        inertia=inertia,
+        radius=r,
+        pair_ij=loop_pairs,
         pair_coef=pair_coefficients(s, mats, r, mass, loop_pairs),
-        wall_i=np.ascontiguousarray(loop_wc[:, 0]), wall_geo=wall_geo, wall_coef=wall_coef,
+        wall_i=np.ascontiguousarray(loop_wc[:, 0]),
+        wall_geo=wall_geo,
+        wall_coef=wall_coef,
         wall_w=np.ascontiguousarray(loop_wc[:, 1]),
-        pc_i=np.zeros(0, np.int64), pc_x=np.zeros(0), pc_coef=np.zeros((0, N_COEF)),
-        shock_force=shares, shock_torque=torques,
-        pair_hist=no_history(len(loop_pairs)), wall_hist=no_history(len(loop_wc)), pc_hist=no_history(0),
+        pc_i=np.zeros(0, np.int64),
+        pc_x=np.zeros(0),
+        pc_coef=np.zeros((0, N_COEF)),
+        shock_force=shares,
+        shock_torque=torques,
+        pair_hist=no_history(len(loop_pairs)),
+        wall_hist=no_history(len(loop_wc)),
+        pc_hist=no_history(0),
     )
     drives = drive_fields(s, np.column_stack([x, y, z]))
     granular = granular._replace(**drives)
-    cfg = loop_config(s, np.zeros(len(r)), np.zeros(len(r)), r, mass,
-                      floor=force_floor_3d(s, mass, r, shares, s.time.output_interval, state))._replace(
-        q0=shock_amplitude(s), dimension=3,
-        split_friction=s.solver.granular_friction == "split" and not frictionless(s))
+    cfg = loop_config(
+        s,
+        np.zeros(len(r)),
+        np.zeros(len(r)),
+        r,
+        mass,
+        floor=force_floor_3d(s, mass, r, shares, s.time.output_interval, state),
+    )._replace(
+        q0=shock_amplitude(s), dimension=3, split_friction=s.solver.granular_friction == "split" and not frictionless(s)
+    )
     solid, body, rigid = None, None, np.zeros(len(r), bool)
     if s.plate is not None:
         from granplate.model.body import build_body
 
         solid, body, rigid = build_body(s, mats, r, mass)
     nm = 0 if solid is None else solid.n_modes
-    omega2 = np.zeros(0) if solid is None else solid.omega ** 2
+    omega2 = np.zeros(0) if solid is None else solid.omega**2
     plate_arrays = PlateArrays(omega2=omega2, phi_d=np.zeros((0, nm)), load_modal=np.zeros(nm))
     return Model(
-        scenario=s, labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
-        granular=granular, plate_arrays=plate_arrays, config=cfg, plate=None,
-        initial_state=driven_initial_state(state, drives), pairs=pairs, wall_contacts=wc,
-        plate_contacts=np.zeros(0, np.int64), materials=tuple(mats), solid=solid, body=body,
+        scenario=s,
+        labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
+        granular=granular,
+        plate_arrays=plate_arrays,
+        config=cfg,
+        plate=None,
+        initial_state=driven_initial_state(state, drives),
+        pairs=pairs,
+        wall_contacts=wc,
+        plate_contacts=np.zeros(0, np.int64),
+        materials=tuple(mats),
+        solid=solid,
+        body=body,
         body_rigid=rigid,
     )

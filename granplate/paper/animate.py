@@ -17,6 +17,7 @@ coloured by von Mises stress; frames are the body's field snapshots (`field_time
 run with an elastic body, else the output times, thinned the same way, on one region and
 one set of scales (the body's magnification, its stress, the contact forces).
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -83,12 +84,14 @@ def _plate_artist(fig: Figure, ax, ds: xr.Dataset, snaps: np.ndarray, magnify: f
     """The deformed plate mesh coloured by element von Mises stress [MPa]; (artist, stresses)."""
     vm = ds["plate_von_mises"].values[snaps] / 1e6
     norm = Normalize(0.0, max(float(vm.max()), 1e-9))
-    plate = PolyCollection(plate_polygons(ds, int(snaps[0]), magnify), cmap="inferno_r", norm=norm,
-                           edgecolors="0.35", linewidths=0.3)
+    plate = PolyCollection(
+        plate_polygons(ds, int(snaps[0]), magnify), cmap="inferno_r", norm=norm, edgecolors="0.35", linewidths=0.3
+    )
     plate.set_array(vm[0])
     ax.add_collection(plate)
-    fig.colorbar(plate, ax=ax, label="plate von Mises stress [MPa]", orientation="horizontal",
-                 shrink=0.9, pad=0.01, aspect=35)
+    fig.colorbar(
+        plate, ax=ax, label="plate von Mises stress [MPa]", orientation="horizontal", shrink=0.9, pad=0.01, aspect=35
+    )
     return plate, vm
 
 
@@ -100,10 +103,19 @@ def _granule_artists(fig: Figure, ax, ds: xr.Dataset, ti: np.ndarray):
     circles, texts = [], []
     for a, b, c, lab in zip(x0, y0, r, ds["granule"].values):
         circles.append(ax.add_patch(Circle((a * 1e3, b * 1e3), c * 1e3, ec="k", lw=0.5)))
-        texts.append(ax.text(a * 1e3, b * 1e3, str(lab), ha="center", va="center", fontsize=7, color="w",
-                             bbox={"boxstyle": "circle,pad=0.1", "fc": "0.2", "ec": "none", "alpha": 0.6}))
-    fig.colorbar(colours, ax=ax, label="granule speed [m/s]", orientation="horizontal",
-                 shrink=0.9, pad=0.01, aspect=35)
+        texts.append(
+            ax.text(
+                a * 1e3,
+                b * 1e3,
+                str(lab),
+                ha="center",
+                va="center",
+                fontsize=7,
+                color="w",
+                bbox={"boxstyle": "circle,pad=0.1", "fc": "0.2", "ec": "none", "alpha": 0.6},
+            )
+        )
+    fig.colorbar(colours, ax=ax, label="granule speed [m/s]", orientation="horizontal", shrink=0.9, pad=0.01, aspect=35)
     return circles, texts, speed, colours
 
 
@@ -140,8 +152,10 @@ def _save(fig: Figure, draw, n_frames: int, path: Path, fps: int, dpi: int, prog
     from tqdm import tqdm
 
     def write(writer, target: Path) -> Path:
-        with writer.saving(fig, str(target), dpi), \
-                tqdm(total=n_frames, desc=target.name, unit="frame", leave=False, disable=not progress) as bar:
+        with (
+            writer.saving(fig, str(target), dpi),
+            tqdm(total=n_frames, desc=target.name, unit="frame", leave=False, disable=not progress) as bar,
+        ):
             for f in range(n_frames):
                 draw(f)
                 writer.grab_frame()  # one render per frame
@@ -221,8 +235,9 @@ def animate(
     return _save(fig, draw, len(snaps), path, fps, dpi, progress)
 
 
-def animate_space(ds: xr.Dataset, path: str | Path, *, frames: int | None = 120, fps: int = 15,
-                  dpi: int = 90, progress: bool = False) -> Path:
+def animate_space(
+    ds: xr.Dataset, path: str | Path, *, frames: int | None = 120, fps: int = 15, dpi: int = 90, progress: bool = False
+) -> Path:
     """Write an animation of 3D run `ds` to `path` (.mp4, or .gif) and return the path
     written: per frame the three projections `granplate show` draws (`figures.space`),
     at the body's field snapshots for a run with an elastic body, else at the output

@@ -11,12 +11,14 @@ points the simulator uses), from the nodal displacements a result stores, by the
 own strain operator and plane-stress law (`granplate.plate`), to show how much the
 "maximum stress in the plate" depends on where it is sampled.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 import numpy as np
 import xarray as xr
+
 
 @dataclass(frozen=True)
 class SensitivityRun:
@@ -52,42 +54,125 @@ STRESS_WINDOW = 5e-4
 
 #: Every check the report knows how to discuss.
 CHECKS: tuple[SensitivityRun, ...] = (
-    SensitivityRun("steel-r1-fields", "steel-r1", {"time.field_interval": 1e-6}, STRESS_WINDOW,
-          "plate displacements at every output, to evaluate von Mises at the element nodes",
-          baseline="steel-r1", role="sampling"),
-    SensitivityRun("bare-plate-fields", "bare-plate", {"time.field_interval": 1e-6}, STRESS_WINDOW,
-          "plate displacements at every output, to evaluate von Mises at the element nodes",
-          baseline="bare-plate", role="sampling"),
-    SensitivityRun("steel-r1-ny80", "steel-r1",
-          {"plate.ny": 80, "plate.rigid_layer_width": 0.0025, "time.field_interval": 1e-6},
-          STRESS_WINDOW, "mesh 2x finer along y (1.25 mm elements), same 2.5 mm rigid layer",
-          baseline="steel-r1", role="mesh"),
-    SensitivityRun("steel-r1-ny80-w1.25", "steel-r1", {"plate.ny": 80}, STRESS_WINDOW,
-          "mesh 2x finer along y, rigid layer one (fine) element edge = 1.25 mm",
-          baseline="steel-r1", role="layer"),
-    SensitivityRun("steel-r1-w5", "steel-r1", {"plate.rigid_layer_width": 0.005}, STRESS_WINDOW,
-          "rigid layer 5 mm wide (two element edges) on the default mesh",
-          baseline="steel-r1", role="layer"),
-    SensitivityRun("steel-r1-dt2", "steel-r1", {"time.dt_max": 2e-8, "time.dt_initial": 2e-8},
-          STRESS_WINDOW, "time step halved (dt_max = 2e-8 s)", baseline="steel-r1", role="numerics"),
-    SensitivityRun("bare-plate-ny80", "bare-plate", {"plate.ny": 80}, None,
-          "bare plate, mesh 2x finer along y", baseline="bare-plate", role="mesh"),
-    SensitivityRun("ptfe-r05-dt2", "ptfe-r05", {"time.dt_max": 2e-8, "time.dt_initial": 2e-8}, None,
-          "time step halved (dt_max = 2e-8 s)", baseline="ptfe-r05", role="numerics"),
-    SensitivityRun("ptfe-r05-raw-eq2", "ptfe-r05", {"contact.clip_tensile": False}, None,
-          "the paper's raw eq. (2): the damped normal force may pull", baseline="ptfe-r05", role="model"),
-    SensitivityRun("ptfe-r05-alpha-steel", "ptfe-r05", {"contact.pairs[0].alpha_n": 6.313e-3}, None,
-          "steel-PTFE damping alpha_n = 6.313e-3 (the steel value) instead of 6.313e-2",
-          baseline="ptfe-r05", role="model"),
-    SensitivityRun("ptfe-r05-ny80", "ptfe-r05", {"plate.ny": 80, "plate.rigid_layer_width": 0.0025}, None,
-          "mesh 2x finer along y, same 2.5 mm rigid layer", baseline="ptfe-r05", role="mesh"),
-    SensitivityRun("steel-r1-ny160", "steel-r1",
-          {"plate.ny": 160, "plate.rigid_layer_width": 0.0025, "time.field_interval": 1e-6},
-          STRESS_WINDOW, "mesh 4x finer along y (0.625 mm elements), same 2.5 mm rigid layer",
-          baseline="steel-r1", role="mesh", slow=True),
-    SensitivityRun("ptfe-r05-ny80-w1.25", "ptfe-r05", {"plate.ny": 80}, None,
-          "mesh 2x finer along y, rigid layer one (fine) element edge = 1.25 mm",
-          baseline="ptfe-r05", role="layer", slow=True),
+    SensitivityRun(
+        "steel-r1-fields",
+        "steel-r1",
+        {"time.field_interval": 1e-6},
+        STRESS_WINDOW,
+        "plate displacements at every output, to evaluate von Mises at the element nodes",
+        baseline="steel-r1",
+        role="sampling",
+    ),
+    SensitivityRun(
+        "bare-plate-fields",
+        "bare-plate",
+        {"time.field_interval": 1e-6},
+        STRESS_WINDOW,
+        "plate displacements at every output, to evaluate von Mises at the element nodes",
+        baseline="bare-plate",
+        role="sampling",
+    ),
+    SensitivityRun(
+        "steel-r1-ny80",
+        "steel-r1",
+        {"plate.ny": 80, "plate.rigid_layer_width": 0.0025, "time.field_interval": 1e-6},
+        STRESS_WINDOW,
+        "mesh 2x finer along y (1.25 mm elements), same 2.5 mm rigid layer",
+        baseline="steel-r1",
+        role="mesh",
+    ),
+    SensitivityRun(
+        "steel-r1-ny80-w1.25",
+        "steel-r1",
+        {"plate.ny": 80},
+        STRESS_WINDOW,
+        "mesh 2x finer along y, rigid layer one (fine) element edge = 1.25 mm",
+        baseline="steel-r1",
+        role="layer",
+    ),
+    SensitivityRun(
+        "steel-r1-w5",
+        "steel-r1",
+        {"plate.rigid_layer_width": 0.005},
+        STRESS_WINDOW,
+        "rigid layer 5 mm wide (two element edges) on the default mesh",
+        baseline="steel-r1",
+        role="layer",
+    ),
+    SensitivityRun(
+        "steel-r1-dt2",
+        "steel-r1",
+        {"time.dt_max": 2e-8, "time.dt_initial": 2e-8},
+        STRESS_WINDOW,
+        "time step halved (dt_max = 2e-8 s)",
+        baseline="steel-r1",
+        role="numerics",
+    ),
+    SensitivityRun(
+        "bare-plate-ny80",
+        "bare-plate",
+        {"plate.ny": 80},
+        None,
+        "bare plate, mesh 2x finer along y",
+        baseline="bare-plate",
+        role="mesh",
+    ),
+    SensitivityRun(
+        "ptfe-r05-dt2",
+        "ptfe-r05",
+        {"time.dt_max": 2e-8, "time.dt_initial": 2e-8},
+        None,
+        "time step halved (dt_max = 2e-8 s)",
+        baseline="ptfe-r05",
+        role="numerics",
+    ),
+    SensitivityRun(
+        "ptfe-r05-raw-eq2",
+        "ptfe-r05",
+        {"contact.clip_tensile": False},
+        None,
+        "the paper's raw eq. (2): the damped normal force may pull",
+        baseline="ptfe-r05",
+        role="model",
+    ),
+    SensitivityRun(
+        "ptfe-r05-alpha-steel",
+        "ptfe-r05",
+        {"contact.pairs[0].alpha_n": 6.313e-3},
+        None,
+        "steel-PTFE damping alpha_n = 6.313e-3 (the steel value) instead of 6.313e-2",
+        baseline="ptfe-r05",
+        role="model",
+    ),
+    SensitivityRun(
+        "ptfe-r05-ny80",
+        "ptfe-r05",
+        {"plate.ny": 80, "plate.rigid_layer_width": 0.0025},
+        None,
+        "mesh 2x finer along y, same 2.5 mm rigid layer",
+        baseline="ptfe-r05",
+        role="mesh",
+    ),
+    SensitivityRun(
+        "steel-r1-ny160",
+        "steel-r1",
+        {"plate.ny": 160, "plate.rigid_layer_width": 0.0025, "time.field_interval": 1e-6},
+        STRESS_WINDOW,
+        "mesh 4x finer along y (0.625 mm elements), same 2.5 mm rigid layer",
+        baseline="steel-r1",
+        role="mesh",
+        slow=True,
+    ),
+    SensitivityRun(
+        "ptfe-r05-ny80-w1.25",
+        "ptfe-r05",
+        {"plate.ny": 80},
+        None,
+        "mesh 2x finer along y, rigid layer one (fine) element edge = 1.25 mm",
+        baseline="ptfe-r05",
+        role="layer",
+        slow=True,
+    ),
 )
 
 
@@ -137,8 +222,7 @@ def stress_operator(ds: xr.Dataset, where: str = "nodes"):
     """
     from skfem import Basis
 
-    from granplate.plate import (node_coordinates, plane_stress_matrix, plate_mesh, q8_basis,
-                                 strain_operator)
+    from granplate.plate import node_coordinates, plane_stress_matrix, plate_mesh, q8_basis, strain_operator
     from granplate.results.dataset import scenario_of
 
     if where not in SAMPLING:
@@ -167,7 +251,7 @@ def stress_series(ds: xr.Dataset, where: str = "nodes", chunk: int = 200) -> np.
     ux, uy = np.asarray(ds["plate_ux"].values), np.asarray(ds["plate_uy"].values)
     out = []
     for i in range(0, len(ux), chunk):
-        x_full = np.stack([ux[i:i + chunk], uy[i:i + chunk]], axis=-1).reshape(len(ux[i:i + chunk]), -1)
+        x_full = np.stack([ux[i : i + chunk], uy[i : i + chunk]], axis=-1).reshape(len(ux[i : i + chunk]), -1)
         exx, eyy, gxy = (op @ x_full.T).reshape(3, -1, x_full.shape[0])
         sxx, syy, sxy = (D[a, 0] * exx + D[a, 1] * eyy + D[a, 2] * gxy for a in range(3))
         out.append(von_mises_plane_stress(sxx, syy, sxy).max(axis=0))

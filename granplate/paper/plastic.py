@@ -17,6 +17,7 @@ elastic verdicts, and the contact pressures per material pair.
     >>> twins = {n: gp.simulate(twin_scenario(n)) for n in twin_presets()}
     >>> blocks = section(elastic_results, twins)
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -40,6 +41,7 @@ FIGURE_CASE = "ptfe-r05"
 
 #: Key of the section's figure among the products of `granplate reproduce`.
 FIGURE_KEY = "yielding"
+
 
 def twin_name(preset: str) -> str:
     """The run name of a preset's twin: "plastic/NAME"."""
@@ -164,8 +166,16 @@ def pressure_cells(ds: xr.Dataset) -> list[str]:
     return [f"{w['max_contact_pressure'] / 1e6:.1f} ({w['pair']})", f"{w['yield_onset_ratio']:.2f}"]
 
 
-PAIR_HEADER = ("run", "material pair", "normal law", "Y [MPa]", "largest p0 [MPa]", "p0 / (1.6 Y)",
-               "at t [ms]", "contact")
+PAIR_HEADER = (
+    "run",
+    "material pair",
+    "normal law",
+    "Y [MPa]",
+    "largest p0 [MPa]",
+    "p0 / (1.6 Y)",
+    "at t [ms]",
+    "contact",
+)
 
 
 def pair_rows(results: Results) -> list[tuple[str, ...]]:
@@ -175,14 +185,31 @@ def pair_rows(results: Results) -> list[tuple[str, ...]]:
     for name, ds in results.items():
         for r in pair_table(ds):
             y, ratio = r["yield_strength"], r["yield_onset_ratio"]
-            rows.append((name, r["pair"], r["normal_law"], _mpa(y), _mpa(r["max_contact_pressure"]),
-                         "-" if ratio is None else f"{ratio:.2f}", f"{r['time'] * 1e3:.3f}", r["contact"]))
+            rows.append(
+                (
+                    name,
+                    r["pair"],
+                    r["normal_law"],
+                    _mpa(y),
+                    _mpa(r["max_contact_pressure"]),
+                    "-" if ratio is None else f"{ratio:.2f}",
+                    f"{r['time'] * 1e3:.3f}",
+                    r["contact"],
+                )
+            )
     return rows
 
 
-CASE_HEADER = ("case", "E_shock [J]", "plate peak", "plate at t_end",
-               "max von Mises [MPa]", "disc-averaged von Mises [MPa]", "D_plastic / E_shock",
-               "largest p0 / (1.6 Y)")
+CASE_HEADER = (
+    "case",
+    "E_shock [J]",
+    "plate peak",
+    "plate at t_end",
+    "max von Mises [MPa]",
+    "disc-averaged von Mises [MPa]",
+    "D_plastic / E_shock",
+    "largest p0 / (1.6 Y)",
+)
 
 
 def case_table(results: Results, twins: Results) -> list[tuple[str, ...]]:
@@ -191,21 +218,30 @@ def case_table(results: Results, twins: Results) -> list[tuple[str, ...]]:
     for c in case_rows(results, twins):
         e, y = c["elastic"], c["yielding"]
         el_ds, pl_ds = results[c["case"]], (results if c["own_twin"] else twins)[c["case"]]
-        rows.append((
-            c["case"] + (" (its own twin)" if c["own_twin"] else ""),
-            _both(f"{e['e_shock']:.3e}", f"{y['e_shock']:.3e}"),
-            _both(_pct(e["ep_max_fraction"]), _pct(y["ep_max_fraction"])),
-            _both(_pct(e["ep_final_fraction"]), _pct(y["ep_final_fraction"])),
-            _both(_mpa(e["max_von_mises"]), _mpa(y["max_von_mises"])),
-            _both(_mpa(e["max_von_mises_disc"]), _mpa(y["max_von_mises_disc"])),
-            _pct(y["plastic_fraction"]),
-            _both(_ratio_text(el_ds), _ratio_text(pl_ds)),
-        ))
+        rows.append(
+            (
+                c["case"] + (" (its own twin)" if c["own_twin"] else ""),
+                _both(f"{e['e_shock']:.3e}", f"{y['e_shock']:.3e}"),
+                _both(_pct(e["ep_max_fraction"]), _pct(y["ep_max_fraction"])),
+                _both(_pct(e["ep_final_fraction"]), _pct(y["ep_final_fraction"])),
+                _both(_mpa(e["max_von_mises"]), _mpa(y["max_von_mises"])),
+                _both(_mpa(e["max_von_mises_disc"]), _mpa(y["max_von_mises_disc"])),
+                _pct(y["plastic_fraction"]),
+                _both(_ratio_text(el_ds), _ratio_text(pl_ds)),
+            )
+        )
     return rows
 
 
-STATEMENT_HEADER = ("#", "statement", "ours, elastic", "holds (elastic)", "ours, yielding", "holds (yielding)",
-                    "with yielding contacts")
+STATEMENT_HEADER = (
+    "#",
+    "statement",
+    "ours, elastic",
+    "holds (elastic)",
+    "ours, yielding",
+    "holds (yielding)",
+    "with yielding contacts",
+)
 
 
 def _holds(h: bool | None) -> str:
@@ -214,8 +250,10 @@ def _holds(h: bool | None) -> str:
 
 def statement_table(pairs: list[tuple[Check, Check]]) -> list[tuple[str, ...]]:
     """The statements side by side: ours and the verdict, elastic and yielding, and what moved."""
-    return [(str(i + 1), e.quantity, e.ours_text, _holds(e.holds), y.ours_text, _holds(y.holds),
-             movement(e.holds, y.holds)) for i, (e, y) in enumerate(pairs)]
+    return [
+        (str(i + 1), e.quantity, e.ours_text, _holds(e.holds), y.ours_text, _holds(y.holds), movement(e.holds, y.holds))
+        for i, (e, y) in enumerate(pairs)
+    ]
 
 
 def _granule_materials(ds: xr.Dataset) -> list[str]:
@@ -231,20 +269,23 @@ def choices_text(twins: Results) -> str:
         s = scenario_of(ds)
         for n in _granule_materials(ds):
             mats[n] = s.material(n).Y
-    stated = ", ".join(f"`{n}` Y = {_mpa(y)} MPa" if y is not None else f"`{n}` (Y unknown)"
-                       for n, y in sorted(mats.items()))
-    return (f"Each case with granules is run again with `contact.normal_law = \"thornton\"` (Thornton's "
-            f"elastic-perfectly plastic law, docs/model.md section 3.6) on every contact and the built-in "
-            f"materials as they are: granules {stated} (`steel` is a structural S355, `ptfe` unfilled PTFE; "
-            f"docs/model.md section 2). Walls and the plate's face are rigid bodies to the law: at a "
-            f"granule-wall or granule-plate contact the granule yields, at its own Y. Everything else is the "
-            f"preset's (damping, friction, plate, time step). The bare plate has no contacts: it is its own "
-            f"twin (its elastic result stands in both columns; it is not run again). "
-            f"p0 is the largest Hertz peak pressure (2/pi) E* sqrt(delta/R*) over a pair's contacts, from "
-            f"each contact's largest overlap (eq. P2); 1.6 Y is the onset of yield (eq. P1). Past 1 in an "
-            f"elastic run, its contacts are outside the Hertz law's validity; in a yielding run the ratio "
-            f"says how far past the onset the largest overlap went. Shares are of the energy put in, "
-            f"E_shock (the presets start at rest).")
+    stated = ", ".join(
+        f"`{n}` Y = {_mpa(y)} MPa" if y is not None else f"`{n}` (Y unknown)" for n, y in sorted(mats.items())
+    )
+    return (
+        f'Each case with granules is run again with `contact.normal_law = "thornton"` (Thornton\'s '
+        f"elastic-perfectly plastic law, docs/model.md section 3.6) on every contact and the built-in "
+        f"materials as they are: granules {stated} (`steel` is a structural S355, `ptfe` unfilled PTFE; "
+        f"docs/model.md section 2). Walls and the plate's face are rigid bodies to the law: at a "
+        f"granule-wall or granule-plate contact the granule yields, at its own Y. Everything else is the "
+        f"preset's (damping, friction, plate, time step). The bare plate has no contacts: it is its own "
+        f"twin (its elastic result stands in both columns; it is not run again). "
+        f"p0 is the largest Hertz peak pressure (2/pi) E* sqrt(delta/R*) over a pair's contacts, from "
+        f"each contact's largest overlap (eq. P2); 1.6 Y is the onset of yield (eq. P1). Past 1 in an "
+        f"elastic run, its contacts are outside the Hertz law's validity; in a yielding run the ratio "
+        f"says how far past the onset the largest overlap went. Shares are of the energy put in, "
+        f"E_shock (the presets start at rest)."
+    )
 
 
 def _list(names: list[str]) -> str:
@@ -258,11 +299,13 @@ def verdict_text(pairs: list[tuple[Check, Check]]) -> str:
         moves.setdefault(movement(e.holds, y.holds), []).append(f"#{i + 1} {e.quantity}")
     judged = sum(len(v) for k, v in moves.items() if k != "-")
     count = {k: len(moves.get(k, [])) for k in ("still holds", "still does not hold", "no longer holds", "now holds")}
-    return (f"Of the {judged} statements judged both ways: still hold {count['still holds']}, still do not hold "
-            f"{count['still does not hold']}; with yielding contacts, no longer hold {count['no longer holds']} "
-            f"({_list(moves.get('no longer holds', []))}), now hold {count['now holds']} "
-            f"({_list(moves.get('now holds', []))}). The verdicts are the comparison table's criteria judged on "
-            f"the twins' results.")
+    return (
+        f"Of the {judged} statements judged both ways: still hold {count['still holds']}, still do not hold "
+        f"{count['still does not hold']}; with yielding contacts, no longer hold {count['no longer holds']} "
+        f"({_list(moves.get('no longer holds', []))}), now hold {count['now holds']} "
+        f"({_list(moves.get('now holds', []))}). The verdicts are the comparison table's criteria judged on "
+        f"the twins' results."
+    )
 
 
 def section(
@@ -285,11 +328,15 @@ def section(
     blocks = [Block("h2", "Contacts that yield"), Block("p", choices_text(twins))]
     t_ends = [float(d["time"].values[-1]) for d in twins.values()]
     if t_ends and max(t_ends) < 2e-3 * 0.999:
-        blocks.append(Block("p", f"**The twins were shortened (t_end = {max(t_ends) * 1e3:.3g} ms instead of "
-                                 f"2 ms).**"))
-    blocks.append(Block("p", "Case by case; each cell: elastic / yielding contacts, computed by `granplate.summary` "
-                             "from both result files. D_plastic: the plastic work of the yielding run by t_end "
-                             "(eq. 11)."))
+        blocks.append(Block("p", f"**The twins were shortened (t_end = {max(t_ends) * 1e3:.3g} ms instead of 2 ms).**"))
+    blocks.append(
+        Block(
+            "p",
+            "Case by case; each cell: elastic / yielding contacts, computed by `granplate.summary` "
+            "from both result files. D_plastic: the plastic work of the yielding run by t_end "
+            "(eq. 11).",
+        )
+    )
     blocks.append(Block("table", header=CASE_HEADER, rows=tuple(case_table(results, twins))))
     blocks.append(Block("h3", "The paper's conclusions with yielding contacts"))
     blocks.append(Block("p", "\n".join(f"- {line}" for line in conclusions([y for _, y in pairs]))))
@@ -307,8 +354,12 @@ def section(
     blocks.append(Block("table", header=PAIR_HEADER, rows=tuple(pair_rows(both))))
     png = [p for p in (figure or []) if Path(p).suffix == ".png"]
     if png:
-        blocks.append(Block("figure", f"The plate's energy and where the shock energy goes, {FIGURE_CASE} with "
-                                      f"elastic and yielding contacts ({Path(png[0]).stem}.png / .pdf)",
-                            path=Path(png[0])))
+        blocks.append(
+            Block(
+                "figure",
+                f"The plate's energy and where the shock energy goes, {FIGURE_CASE} with "
+                f"elastic and yielding contacts ({Path(png[0]).stem}.png / .pdf)",
+                path=Path(png[0]),
+            )
+        )
     return blocks
-

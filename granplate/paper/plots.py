@@ -14,6 +14,7 @@ global state, no display needed). Every plotted line / image carries a `gid` nam
 what it shows (e.g. "energy:plate", "vx:3", "vx:column1"), which the tests use to check
 that a figure shows its dataset's own numbers.
 """
+
 from __future__ import annotations
 
 import textwrap
@@ -40,9 +41,16 @@ LAMBDA_CONTACTS = ("A", "B", "C")
 
 #: Line colours, fixed per quantity so the figures read alike.
 COLOURS = {
-    "granular": "tab:blue", "plate": "tab:red", "sum": "tab:purple", "total": "black",
-    "horizontal": "tab:blue", "vertical": "tab:orange", "rotational": "tab:green",
-    "3": "tab:blue", "8": "tab:orange", "C": "tab:green",
+    "granular": "tab:blue",
+    "plate": "tab:red",
+    "sum": "tab:purple",
+    "total": "black",
+    "horizontal": "tab:blue",
+    "vertical": "tab:orange",
+    "rotational": "tab:green",
+    "3": "tab:blue",
+    "8": "tab:orange",
+    "C": "tab:green",
 }
 STYLES = {"total": "--", "sum": "-."}
 #: Two curves of a panel coincide when they differ by less than this fraction of its
@@ -90,8 +98,10 @@ def run_labels(datasets) -> list[str]:
     """Each run's label in a caption: its name and t_end, and its contact law where two runs
     share a name (a preset and its twin with yielding contacts)."""
     names = [_name(d) for d in datasets]
-    return [f"{n} ({_normal_law(d) + ', ' if names.count(n) > 1 else ''}t_end = {_t_end_ms(d):.3g} ms)"
-            for n, d in zip(names, datasets)]
+    return [
+        f"{n} ({_normal_law(d) + ', ' if names.count(n) > 1 else ''}t_end = {_t_end_ms(d):.3g} ms)"
+        for n, d in zip(names, datasets)
+    ]
 
 
 def _caption(fig: Figure, text: str, *datasets: xr.Dataset) -> None:
@@ -160,8 +170,13 @@ def velocity_panel(ax, ds: xr.Dataset, component: str, labels=VELOCITY_GRANULES,
         label, style = f"granule {lab}", {"ls": "-"}
         if same is not None:
             label += f" (= granule {same}{', both ~0' if np.max(np.abs(y)) <= tiny else ''})"
-            style = {"ls": (0, (4, 3)), "marker": MARKERS[k % len(MARKERS)], "ms": 3.5,
-                     "markevery": max(1, len(t) // 15), "zorder": 3}
+            style = {
+                "ls": (0, (4, 3)),
+                "marker": MARKERS[k % len(MARKERS)],
+                "ms": 3.5,
+                "markevery": max(1, len(t) // 15),
+                "zorder": 3,
+            }
         (line,) = ax.plot(t, y, color=COLOURS.get(lab), lw=0.9, label=label, gid=f"{component}:{lab}", **style)
         if same is not None:
             lines[same].set_linewidth(2.4)  # the curve underneath shows around the dashes
@@ -193,9 +208,14 @@ def fig_3(bare: xr.Dataset, granular: xr.Dataset) -> Figure:
     _label(ax["b"], f"(b) with granules ({_name(granular)})")
     energy_panel(ax["c"], granular)
     _label(ax["c"], f"(c) normalised energies ({_name(granular)})")
-    _caption(fig, "Fig. 3. Maximum von Mises stress in the plate, shock on the bare plate (a) and on "
-             "the granular medium (b); (c) energies of the granular medium, the plate, their sum and "
-             "the sum with dissipation D, over the shock energy E_shock.", bare, granular)
+    _caption(
+        fig,
+        "Fig. 3. Maximum von Mises stress in the plate, shock on the bare plate (a) and on "
+        "the granular medium (b); (c) energies of the granular medium, the plate, their sum and "
+        "the sum with dissipation D, over the shock energy E_shock.",
+        bare,
+        granular,
+    )
     return fig
 
 
@@ -215,11 +235,16 @@ def fig_4(same_size: xr.Dataset, small: xr.Dataset) -> Figure:
         _label(ax[g], f"({g}) vertical velocities, {tag}")
     for row in (("c", "d"), ("e", "f"), ("g", "h")):
         _share_y(ax[row[0]], ax[row[1]])
-    _caption(fig, "Fig. 4. Two intruder sizes, R2 = R1 (left) and R2 = 0.5 R1 (right): (a, b) energies "
-             "over E_shock; (c, d) kinetic energy of the granular medium, horizontal / vertical / "
-             "rotational; (e, f) horizontal and (g, h) vertical velocities of granules 3, 8 and C (the "
-             "paper's panels e-f). A curve equal to another (3 and C: no vertical motion, by symmetry) "
-             "is dashed with markers.", same_size, small)
+    _caption(
+        fig,
+        "Fig. 4. Two intruder sizes, R2 = R1 (left) and R2 = 0.5 R1 (right): (a, b) energies "
+        "over E_shock; (c, d) kinetic energy of the granular medium, horizontal / vertical / "
+        "rotational; (e, f) horizontal and (g, h) vertical velocities of granules 3, 8 and C (the "
+        "paper's panels e-f). A curve equal to another (3 and C: no vertical motion, by symmetry) "
+        "is dashed with markers.",
+        same_size,
+        small,
+    )
     return fig
 
 
@@ -243,10 +268,14 @@ def fig_5(ptfe: xr.Dataset) -> Figure:
     _label(ax["c"], "(c) horizontal velocities")
     velocity_panel(ax["d"], ptfe, "vy")
     _label(ax["d"], "(d) vertical velocities")
-    _caption(fig, "Fig. 5. PTFE intruders, R2 = 0.5 R1: (a) energies over E_shock; (b) kinetic energy "
-             "of the granular medium, horizontal / vertical / rotational; (c) horizontal and (d) vertical "
-             "velocities of granules 3, 8 and C (the paper's panel c). A curve equal to another (3 and C: no "
-             "vertical motion, by symmetry) is dashed with markers.", ptfe)
+    _caption(
+        fig,
+        "Fig. 5. PTFE intruders, R2 = 0.5 R1: (a) energies over E_shock; (b) kinetic energy "
+        "of the granular medium, horizontal / vertical / rotational; (c) horizontal and (d) vertical "
+        "velocities of granules 3, 8 and C (the paper's panel c). A curve equal to another (3 and C: no "
+        "vertical motion, by symmetry) is dashed with markers.",
+        ptfe,
+    )
     return fig
 
 
@@ -290,9 +319,14 @@ def fig_6(steel: xr.Dataset, ptfe: xr.Dataset) -> Figure:
         axes[0].set_ylabel("time [ms]")
         sub.colorbar(mesh, ax=list(axes), label="horizontal velocity [m/s]", shrink=0.95, pad=0.01)
         sub.suptitle(f"({letter}) {_name(ds)}", x=0.02, ha="left", fontsize=10)
-    _caption(fig, "Fig. 6. Horizontal velocity over time of every granule (columns 1, 2, 3; granules top "
-             "to bottom) and along the plate's symmetry line y = H/2: (a) steel intruders, (b) PTFE "
-             "intruders, both R2 = 0.5 R1; one colour scale per row.", steel, ptfe)
+    _caption(
+        fig,
+        "Fig. 6. Horizontal velocity over time of every granule (columns 1, 2, 3; granules top "
+        "to bottom) and along the plate's symmetry line y = H/2: (a) steel intruders, (b) PTFE "
+        "intruders, both R2 = 0.5 R1; one colour scale per row.",
+        steel,
+        ptfe,
+    )
     return fig
 
 
@@ -305,8 +339,13 @@ def fig_7(steel: xr.Dataset, ptfe: xr.Dataset) -> Figure:
         _time_axis(ax, ds)
         _label(ax, f"({letter}) {_name(ds)}")
     axes[0].set_ylabel(r"max $|\varepsilon_{yy}|$ in the plate [$10^{-6}$]")
-    _caption(fig, "Fig. 7. Maximum vertical strain |eps_yy| in the plate (microstrain), (a) steel "
-             "intruders, (b) PTFE intruders, both R2 = 0.5 R1; same vertical scale.", steel, ptfe)
+    _caption(
+        fig,
+        "Fig. 7. Maximum vertical strain |eps_yy| in the plate (microstrain), (a) steel "
+        "intruders, (b) PTFE intruders, both R2 = 0.5 R1; same vertical scale.",
+        steel,
+        ptfe,
+    )
     return fig
 
 
@@ -321,8 +360,13 @@ def fig_8(weak: xr.Dataset, moderate: xr.Dataset, strong: xr.Dataset) -> Figure:
         q0 = _q0(ds)
         _label(ax, f"({letter}) {word}: q0 = {q0 / 1e3:g} kN/m")
         inset = ax.inset_axes([0.33, 0.2, 0.62, 0.36])
-        inset.plot(an.times_ms(ds), an.normalised_energies(ds)["plate"], color=COLOURS["plate"], lw=1.0,
-                   gid="energy-zoom:plate")
+        inset.plot(
+            an.times_ms(ds),
+            an.normalised_energies(ds)["plate"],
+            color=COLOURS["plate"],
+            lw=1.0,
+            gid="energy-zoom:plate",
+        )
         inset.set_ylim(0.0, ep_top)
         inset.set_xlim(0.0, _t_end_ms(ds))
         inset.set_title("plate $E_p$ / $E_{shock}$ [-], zoom", fontsize=7)
@@ -333,8 +377,14 @@ def fig_8(weak: xr.Dataset, moderate: xr.Dataset, strong: xr.Dataset) -> Figure:
         ax.set_ylabel("")
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="outside upper center", ncols=len(labels), fontsize=8)
-    _caption(fig, "Fig. 8. Energies over E_shock for PTFE intruders (R2 = 0.5 R1) under (a) weak, "
-             "(b) moderate and (c) strong shocks.", weak, moderate, strong)
+    _caption(
+        fig,
+        "Fig. 8. Energies over E_shock for PTFE intruders (R2 = 0.5 R1) under (a) weak, "
+        "(b) moderate and (c) strong shocks.",
+        weak,
+        moderate,
+        strong,
+    )
     return fig
 
 
@@ -379,13 +429,20 @@ def fig_A1(steel: xr.Dataset) -> Figure:
     axes[0].legend(fontsize=7, loc="upper right")
     axes[-1].set_xlabel("time [ms]")
     axes[-1].set_xlim(0.0, t[-1])
-    _caption(fig, "Fig. A.1. Largest modulus (per output interval) of the eigenvalue of the frictional "
-             "local map, eq. (8), at the plate contacts of granules A, B and C; below 1 the paper's "
-             "fixed-point iteration converges" + ("; the adaptive time step holds it near the target."
-                                                  if paper else
-                                                  ". This run used the implicit scheme (Newton), which needs "
-                                                  "no such bound: its steps give |λ| >> 1; run with "
-                                                  "solver.scheme = \"paper\" for the paper's figure."), steel)
+    _caption(
+        fig,
+        "Fig. A.1. Largest modulus (per output interval) of the eigenvalue of the frictional "
+        "local map, eq. (8), at the plate contacts of granules A, B and C; below 1 the paper's "
+        "fixed-point iteration converges"
+        + (
+            "; the adaptive time step holds it near the target."
+            if paper
+            else ". This run used the implicit scheme (Newton), which needs "
+            "no such bound: its steps give |λ| >> 1; run with "
+            'solver.scheme = "paper" for the paper\'s figure.'
+        ),
+        steel,
+    )
     return fig
 
 
@@ -396,21 +453,46 @@ def fig_yielding(elastic: xr.Dataset, plastic: xr.Dataset) -> Figure:
     ax = fig.subplot_mosaic("ab")
     runs = (("elastic", elastic, "-"), ("yielding", plastic, "--"))
     for tag, ds, ls in runs:
-        ax["a"].plot(an.times_ms(ds), np.asarray(ds["E_plate"].values) * 1e3, color=COLOURS["plate"], ls=ls,
-                     lw=1.2, label=f"$E_p$, {tag} contacts", gid=f"plate:{tag}")
-        ax["b"].plot(an.times_ms(ds), np.asarray(ds["E_granular"].values) * 1e3, color=COLOURS["granular"],
-                     ls=ls, lw=1.2, label=f"$E_g$, {tag} contacts", gid=f"granular:{tag}")
-    ax["b"].plot(an.times_ms(plastic), np.asarray(plastic["D_plastic"].values) * 1e3, color="tab:brown",
-                 ls="--", lw=1.2, label="$D_{plastic}$, yielding contacts", gid="plastic:yielding")
+        ax["a"].plot(
+            an.times_ms(ds),
+            np.asarray(ds["E_plate"].values) * 1e3,
+            color=COLOURS["plate"],
+            ls=ls,
+            lw=1.2,
+            label=f"$E_p$, {tag} contacts",
+            gid=f"plate:{tag}",
+        )
+        ax["b"].plot(
+            an.times_ms(ds),
+            np.asarray(ds["E_granular"].values) * 1e3,
+            color=COLOURS["granular"],
+            ls=ls,
+            lw=1.2,
+            label=f"$E_g$, {tag} contacts",
+            gid=f"granular:{tag}",
+        )
+    ax["b"].plot(
+        an.times_ms(plastic),
+        np.asarray(plastic["D_plastic"].values) * 1e3,
+        color="tab:brown",
+        ls="--",
+        lw=1.2,
+        label="$D_{plastic}$, yielding contacts",
+        gid="plastic:yielding",
+    )
     for key, text in (("a", "(a) plate energy"), ("b", "(b) granular energy and plastic work")):
         _time_axis(ax[key], elastic)
         ax[key].set_ylabel("energy [mJ]")
         ax[key].legend(fontsize=7, loc="best", framealpha=0.8)
         _label(ax[key], f"{text}, {_name(elastic)}")
-    _caption(fig, "The plate's energy (a) and the granular energy with the plastic work (b), elastic "
-             "(Hertz, solid) and yielding (Thornton, contact.normal_law = \"thornton\", dashed) contacts; the "
-             "second run is the first's twin with yielding contacts.",
-             elastic, plastic)
+    _caption(
+        fig,
+        "The plate's energy (a) and the granular energy with the plastic work (b), elastic "
+        '(Hertz, solid) and yielding (Thornton, contact.normal_law = "thornton", dashed) contacts; the '
+        "second run is the first's twin with yielding contacts.",
+        elastic,
+        plastic,
+    )
     return fig
 
 
@@ -429,31 +511,49 @@ def fig_3d(*datasets: xr.Dataset) -> Figure:
     for k, (ax, a, b) in enumerate(zip(axes, plane, space)):
         name = _name(a)
         for tag, ds, ls, colour in (("2d", a, "-", COLOURS["plate"]), ("3d", b, "--", "black")):
-            ax.plot(an.times_ms(ds), an.normalised_energies(ds)["plate"], color=colour, ls=ls, lw=1.2,
-                    label=f"{tag.upper()}", gid=f"plate:{tag}:{name}")
+            ax.plot(
+                an.times_ms(ds),
+                an.normalised_energies(ds)["plate"],
+                color=colour,
+                ls=ls,
+                lw=1.2,
+                label=f"{tag.upper()}",
+                gid=f"plate:{tag}:{name}",
+            )
         ax.set_ylabel("$E_p$ / $E_{shock}$ [-]")
         _time_axis(ax, a)
         _label(ax, f"({'abcdefghijklmnopqrstuvwxyz'[k % 26]}) {name}")
         ax.legend(fontsize=7, loc="best", framealpha=0.8)
     for ax in axes[n:]:
         ax.set_visible(False)
-    _caption(fig, "The plate's energy over the shock energy put in, each case in 2D (plane stress, implicit "
-             "scheme; solid) and its 3D twin (a hex20 slab, velocity Verlet; dashed), docs/model.md section 8.1.",
-             *datasets)
+    _caption(
+        fig,
+        "The plate's energy over the shock energy put in, each case in 2D (plane stress, implicit "
+        "scheme; solid) and its 3D twin (a hex20 slab, velocity Verlet; dashed), docs/model.md section 8.1.",
+        *datasets,
+    )
     return fig
 
 
 #: What a figure may need of a result: a test of the Dataset and its words.
 REQUIREMENTS: dict[str, tuple[Callable[[xr.Dataset], bool], str]] = {
     "plate": (an.has_plate, "a plate"),
-    "velocity granules": (lambda ds: an.has_granules(ds) and all(
-        lab in {str(g) for g in ds["granule"].values} for lab in VELOCITY_GRANULES),
-        "granules " + ", ".join(VELOCITY_GRANULES[:-1]) + " and " + VELOCITY_GRANULES[-1]),
-    "columns and symmetry line": (lambda ds: an.has_granules(ds) and ds.sizes.get("x_symmetry", 0) > 0,
-                                  "granules and the plate's symmetry line"),
-    "lambda contacts": (lambda ds: "contact" in ds.dims and all(
-        lab in {str(c) for c in ds["contact"].values} for lab in LAMBDA_CONTACTS),
-        "plate contacts " + ", ".join(LAMBDA_CONTACTS[:-1]) + " and " + LAMBDA_CONTACTS[-1]),
+    "velocity granules": (
+        lambda ds: (
+            an.has_granules(ds) and all(lab in {str(g) for g in ds["granule"].values} for lab in VELOCITY_GRANULES)
+        ),
+        "granules " + ", ".join(VELOCITY_GRANULES[:-1]) + " and " + VELOCITY_GRANULES[-1],
+    ),
+    "columns and symmetry line": (
+        lambda ds: an.has_granules(ds) and ds.sizes.get("x_symmetry", 0) > 0,
+        "granules and the plate's symmetry line",
+    ),
+    "lambda contacts": (
+        lambda ds: (
+            "contact" in ds.dims and all(lab in {str(c) for c in ds["contact"].values} for lab in LAMBDA_CONTACTS)
+        ),
+        "plate contacts " + ", ".join(LAMBDA_CONTACTS[:-1]) + " and " + LAMBDA_CONTACTS[-1],
+    ),
 }
 
 _GRANULAR = ("plate", "velocity granules")
@@ -463,28 +563,37 @@ FIGURES: dict[str, FigureSpec] = {
     "3": FigureSpec(fig_3, ("bare-plate", "steel-r1"), "von Mises stress and energies, bare plate vs granules"),
     "4": FigureSpec(fig_4, ("steel-r1", "steel-r05"), "two intruder sizes", _GRANULAR),
     "5": FigureSpec(fig_5, ("ptfe-r05",), "PTFE intruders", _GRANULAR),
-    "6": FigureSpec(fig_6, ("steel-r05", "ptfe-r05"), "space-time maps of horizontal velocity",
-                    ("plate", "columns and symmetry line")),
+    "6": FigureSpec(
+        fig_6,
+        ("steel-r05", "ptfe-r05"),
+        "space-time maps of horizontal velocity",
+        ("plate", "columns and symmetry line"),
+    ),
     "7": FigureSpec(fig_7, ("steel-r05", "ptfe-r05"), "maximum eps_yy in the plate"),
     "8": FigureSpec(fig_8, ("ptfe-r05-weak", "ptfe-r05-moderate", "ptfe-r05"), "three shock intensities"),
-    "A1": FigureSpec(fig_A1, ("steel-r1",), "local-map eigenvalue modulus at contacts A, B, C",
-                     ("plate", "lambda contacts")),
+    "A1": FigureSpec(
+        fig_A1, ("steel-r1",), "local-map eigenvalue modulus at contacts A, B, C", ("plate", "lambda contacts")
+    ),
 }
 
 
 #: Figures of the report that are not the paper's: key -> spec ("yielding": the PTFE
 #: headline case with elastic and yielding contacts, granplate.paper.plastic).
 EXTRA_FIGURES: dict[str, FigureSpec] = {
-    _plastic.FIGURE_KEY: FigureSpec(fig_yielding, (_plastic.FIGURE_CASE, _plastic.twin_name(_plastic.FIGURE_CASE)),
-                                    "plate energy with elastic and yielding contacts (PTFE intruders)"),
+    _plastic.FIGURE_KEY: FigureSpec(
+        fig_yielding,
+        (_plastic.FIGURE_CASE, _plastic.twin_name(_plastic.FIGURE_CASE)),
+        "plate energy with elastic and yielding contacts (PTFE intruders)",
+    ),
 }
 
 
 #: The figure of the report's section "The paper in 3D" (`granplate reproduce --3d`,
 #: granplate.paper.space): every preset, then its 3D twin, in preset order.
 SPACE_FIGURES: dict[str, FigureSpec] = {
-    _space.FIGURE_KEY: FigureSpec(fig_3d, (*PLANE_PRESETS, *(_space.twin_name(n) for n in PLANE_PRESETS)),
-                                  "the plate's energy share in 2D and 3D"),
+    _space.FIGURE_KEY: FigureSpec(
+        fig_3d, (*PLANE_PRESETS, *(_space.twin_name(n) for n in PLANE_PRESETS)), "the plate's energy share in 2D and 3D"
+    ),
 }
 
 
@@ -509,9 +618,13 @@ def check_inputs(key: str, datasets: list[xr.Dataset]) -> None:
     for ds in datasets:
         lacking = [REQUIREMENTS[n][1] for n in spec.needs if not REQUIREMENTS[n][0](ds)]
         if lacking:
-            raise ScenarioError("--figure", key, f"figure {key} ({spec.title}) needs results with "
-                                f"{' and '.join(lacking)}, as the paper's {', '.join(spec.presets)} have; "
-                                f"result '{_name(ds)}' has not")
+            raise ScenarioError(
+                "--figure",
+                key,
+                f"figure {key} ({spec.title}) needs results with "
+                f"{' and '.join(lacking)}, as the paper's {', '.join(spec.presets)} have; "
+                f"result '{_name(ds)}' has not",
+            )
 
 
 def figure_key(name: str) -> str:

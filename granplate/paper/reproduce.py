@@ -19,6 +19,7 @@ Runs, figures and animations are tasks of the distributed engine (`granplate.res
 a local cluster of `--workers` processes, or an existing one by `--scheduler ADDRESS`);
 each figure or animation starts as soon as the results it needs are there.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -153,8 +154,9 @@ def is_current(path: str | Path, scenario) -> bool:
     return stored is not None and result_key(*stored) == result_key(*expected_identity(scenario))
 
 
-def plan(out_dir: Path, t_end: float | None = None, checks: str = "fast", plastic: bool = True,
-         space: bool = False) -> list[Job]:
+def plan(
+    out_dir: Path, t_end: float | None = None, checks: str = "fast", plastic: bool = True, space: bool = False
+) -> list[Job]:
     """The presets (DIR/NAME.nc), the sensitivity checks (DIR/checks/NAME.nc), with
     `plastic` the presets' twins with yielding contacts (DIR/plastic/NAME.nc) and with
     `space` their 3D twins (DIR/3d/NAME.nc) to run."""
@@ -295,12 +297,17 @@ def reproduce(
         if to_run or products:
             own = client is None
             if own:
-                progress.note(f"connecting to the cluster at {scheduler}" if scheduler
-                              else f"starting {n_workers} local Dask workers")
-            with (engine.dask_client(n_workers, scheduler) if own else nullcontext(client)) as c:
+                progress.note(
+                    f"connecting to the cluster at {scheduler}"
+                    if scheduler
+                    else f"starting {n_workers} local Dask workers"
+                )
+            with engine.dask_client(n_workers, scheduler) if own else nullcontext(client) as c:
                 if to_run:
-                    progress.note("warming the workers up (compiling the kernels where they are not cached "
-                                  "yet, building the plates)")
+                    progress.note(
+                        "warming the workers up (compiling the kernels where they are not cached "
+                        "yet, building the plates)"
+                    )
                     seconds = engine.warm_workers(c, warm_up_scenarios(to_run))
                     progress.note(f"workers warm after {seconds:.1f} s; running {len(to_run)} runs")
                 Driver(c, outcome, products, available, progress, frames).run(to_run)
@@ -321,8 +328,9 @@ def _up_to_date(target: Path, inputs: list[Path]) -> bool:
     return target.is_file() and all(target.stat().st_mtime >= p.stat().st_mtime for p in inputs)
 
 
-def _earlier_figures(fig_dir: Path, available: dict[str, Path], plastic: bool = True,
-                     space: bool = False) -> dict[str, list[Path]]:
+def _earlier_figures(
+    fig_dir: Path, available: dict[str, Path], plastic: bool = True, space: bool = False
+) -> dict[str, list[Path]]:
     """Figures drawn by an earlier reproduce from the same result files (for the report)."""
     from granplate.paper import plots
 
@@ -331,7 +339,8 @@ def _earlier_figures(fig_dir: Path, available: dict[str, Path], plastic: bool = 
     for key, spec in specs.items():
         files = [fig_dir / f"{plots.figure_stem(key)}{ext}" for ext in (".png", ".pdf")]
         if all(n in available for n in spec.presets) and all(
-                _up_to_date(f, [available[n] for n in spec.presets]) for f in files):
+            _up_to_date(f, [available[n] for n in spec.presets]) for f in files
+        ):
             found[key] = files
     return found
 
@@ -430,7 +439,8 @@ def figure_inputs(key: str, inputs: list[str]) -> list[Path]:
     if len(files) == len(need):
         return files
     raise ScenarioError(
-        "--figure", key,
+        "--figure",
+        key,
         f"figure {key} takes {len(need)} result(s): {', '.join(need)} (files named by their scenario, "
         f"in this order, or a directory holding NAME.nc); got {len(files)}",
     )
@@ -438,14 +448,25 @@ def figure_inputs(key: str, inputs: list[str]) -> list[Path]:
 
 def _cmd_reproduce(args) -> int:
     outcome = reproduce(
-        args.out, t_end=args.t_end, workers=args.workers, scheduler=args.scheduler, force=args.force,
-        checks=args.checks, plastic=not args.no_plastic, space=args.space,
-        figures=not args.no_figures, animations=not args.no_animations, frames=args.frames, quiet=args.quiet,
+        args.out,
+        t_end=args.t_end,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        force=args.force,
+        checks=args.checks,
+        plastic=not args.no_plastic,
+        space=args.space,
+        figures=not args.no_figures,
+        animations=not args.no_animations,
+        frames=args.frames,
+        quiet=args.quiet,
     )
     reused = sum(r.status == "reused" for r in outcome.runs)
     ran = sum(r.status == "ran" for r in outcome.runs)
-    print(f"runs: {ran} ran, {reused} reused; figures: {len(outcome.figures)}; "
-          f"animations: {len(outcome.animations)}; {outcome.seconds:.1f} s")
+    print(
+        f"runs: {ran} ran, {reused} reused; figures: {len(outcome.figures)}; "
+        f"animations: {len(outcome.animations)}; {outcome.seconds:.1f} s"
+    )
     for p in outcome.report:
         print(f"report: {p}")
     for line in outcome.problems:
@@ -465,8 +486,9 @@ def _cmd_plot(args) -> int:
         try:
             key = plots.figure_key(name)
         except KeyError:
-            raise ScenarioError("--figure", name, "allowed: " + ", ".join(plots.FIGURES) + " (or 'all'; "
-                                "'fig3', 'A.1' also work)") from None
+            raise ScenarioError(
+                "--figure", name, "allowed: " + ", ".join(plots.FIGURES) + " (or 'all'; 'fig3', 'A.1' also work)"
+            ) from None
         paths = figure_inputs(key, args.results)
         plots.check_inputs(key, [_read(p) for p in paths])  # clear errors for unfit files
         for written in make_figure(key, paths, Path(args.out)):
@@ -483,8 +505,7 @@ def _cmd_animate(args) -> int:
         raise ScenarioError("-o", str(target), "allowed: a .mp4 or .gif file name")
     if "z" not in ds.variables and ds.sizes.get("field_time", 0) == 0:  # (in space: every output time)
         raise ScenarioError("result", args.result, "has no plate-field snapshots to animate")
-    written = animate(ds, target, frames=args.frames, fps=args.fps, magnify=args.magnify,
-                      progress=not args.quiet)
+    written = animate(ds, target, frames=args.frames, fps=args.fps, magnify=args.magnify, progress=not args.quiet)
     print(f"written {written}")
     return 0
 
@@ -496,14 +517,18 @@ def _cmd_export(args) -> int:
     ds = _read(_existing(args.result))
     if is_space(ds) and has_body(ds):
         pvd = export_vtk(ds, args.vtk)
-        print(f"written {ds.sizes.get('field_time', 0)} snapshots of the body and {ds.sizes.get('granule', 0)} "
-              f"spheres; open {pvd} in ParaView (Warp By Vector: displacement; Glyph: sphere, scale array radius, "
-              f"factor 2)")
+        print(
+            f"written {ds.sizes.get('field_time', 0)} snapshots of the body and {ds.sizes.get('granule', 0)} "
+            f"spheres; open {pvd} in ParaView (Warp By Vector: displacement; Glyph: sphere, scale array radius, "
+            f"factor 2)"
+        )
         return 0
     if is_space(ds):
         pvd = export_vtk(ds, args.vtk)
-        print(f"written {ds.sizes.get('time', 0)} output times of {ds.sizes.get('granule', 0)} spheres; open {pvd} "
-              f"in ParaView (Glyph: sphere, scale array radius, factor 2)")
+        print(
+            f"written {ds.sizes.get('time', 0)} output times of {ds.sizes.get('granule', 0)} spheres; open {pvd} "
+            f"in ParaView (Glyph: sphere, scale array radius, factor 2)"
+        )
         return 0
     if not has_plate(ds):
         raise ScenarioError("result", args.result, "has no plate to export")
@@ -521,27 +546,51 @@ def _positive_int(text: str) -> int:
 
 def register(subparsers) -> None:
     """Add the `reproduce`, `plot`, `animate` and `export` commands."""
-    r = subparsers.add_parser("reproduce", help="run the paper's six cases (and again with yielding "
-                              "contacts; with --3d in 3D too), draw every figure, both animations and the "
-                              "report (reusing unchanged results)")
+    r = subparsers.add_parser(
+        "reproduce",
+        help="run the paper's six cases (and again with yielding "
+        "contacts; with --3d in 3D too), draw every figure, both animations and the "
+        "report (reusing unchanged results)",
+    )
     r.add_argument("--out", default=DEFAULT_OUT, help=f"output directory (default {DEFAULT_OUT})")
     r.add_argument("--t-end", type=float, default=None, help="shorten every run to this time [s]")
-    r.add_argument("--workers", "--jobs", dest="workers", type=_positive_int, default=None,
-                   help="worker processes of the local Dask cluster (default: the number of cores)")
-    r.add_argument("--scheduler", metavar="ADDRESS", default=None,
-                   help="run on an existing Dask cluster (e.g. tcp://host:8786) instead; its "
-                        "workers must see the output directory")
+    r.add_argument(
+        "--workers",
+        "--jobs",
+        dest="workers",
+        type=_positive_int,
+        default=None,
+        help="worker processes of the local Dask cluster (default: the number of cores)",
+    )
+    r.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        default=None,
+        help="run on an existing Dask cluster (e.g. tcp://host:8786) instead; its "
+        "workers must see the output directory",
+    )
     r.add_argument("--force", action="store_true", help="run everything again, even unchanged results")
-    r.add_argument("--checks", choices=CHECK_MODES, default="fast",
-                   help="sensitivity runs for the report's discussion: fast (default, ~1 min on "
-                        "2 cores), all (adds finer meshes, ~3 min), none")
-    r.add_argument("--no-plastic", action="store_true",
-                   help="leave out the cases rerun with yielding contacts (the report's section "
-                        "'Contacts that yield'; 5 more runs, about 10 s on 2 cores)")
-    r.add_argument("--3d", dest="space", action="store_true",
-                   help="also run the six cases' 3D twins (the presets 3d-NAME, into DIR/3d/NAME.nc) and "
-                        "set 2D and 3D side by side in the report's section 'The paper in 3D' and the "
-                        "figure fig-3d")
+    r.add_argument(
+        "--checks",
+        choices=CHECK_MODES,
+        default="fast",
+        help="sensitivity runs for the report's discussion: fast (default, ~1 min on "
+        "2 cores), all (adds finer meshes, ~3 min), none",
+    )
+    r.add_argument(
+        "--no-plastic",
+        action="store_true",
+        help="leave out the cases rerun with yielding contacts (the report's section "
+        "'Contacts that yield'; 5 more runs, about 10 s on 2 cores)",
+    )
+    r.add_argument(
+        "--3d",
+        dest="space",
+        action="store_true",
+        help="also run the six cases' 3D twins (the presets 3d-NAME, into DIR/3d/NAME.nc) and "
+        "set 2D and 3D side by side in the report's section 'The paper in 3D' and the "
+        "figure fig-3d",
+    )
     r.add_argument("--frames", type=_positive_int, default=DEFAULT_FRAMES, help="animation frames (at most)")
     r.add_argument("--no-figures", action="store_true", help="skip the figures (runs and report only)")
     r.add_argument("--no-animations", action="store_true", help="skip the animations")
@@ -550,21 +599,33 @@ def register(subparsers) -> None:
 
     p = subparsers.add_parser("plot", help="draw the figures of any run, or one paper figure (--figure)")
     p.add_argument("results", nargs="+", help="result .nc file(s), or a directory holding PRESET.nc files")
-    p.add_argument("--figure", default=None, help="a paper figure: 3, 4, 5, 6, 7, 8, A1 (or 'all'); without "
-                   "it: energies, contact forces, stress and strain (a 3D body's: body stress, body contact forces), "
-                   "granule speeds of each result")
+    p.add_argument(
+        "--figure",
+        default=None,
+        help="a paper figure: 3, 4, 5, 6, 7, 8, A1 (or 'all'); without "
+        "it: energies, contact forces, stress and strain (a 3D body's: body stress, body contact forces), "
+        "granule speeds of each result",
+    )
     p.add_argument("--out", default=".", help="directory for the PNG and PDF (default .)")
     p.set_defaults(func=_cmd_plot)
 
-    a = subparsers.add_parser("animate", help="animate a result: in the plane the granules and the deformed "
-                                              "plate (x125); in space the three projections of granplate show, "
-                                              "the body deformed and coloured by stress")
+    a = subparsers.add_parser(
+        "animate",
+        help="animate a result: in the plane the granules and the deformed "
+        "plate (x125); in space the three projections of granplate show, "
+        "the body deformed and coloured by stress",
+    )
     a.add_argument("result", help="a result .nc file")
     a.add_argument("-o", "--output", help="output .mp4 (or .gif) (default SCENARIO.mp4)")
     a.add_argument("--frames", type=_positive_int, default=DEFAULT_FRAMES, help="at most this many frames")
     a.add_argument("--fps", type=_positive_int, default=15, help="frames per second")
-    a.add_argument("--magnify", type=float, default=125.0, help="the plate's displacement magnification "
-                   "(in the plane; in space an elastic body is magnified as `granplate show` does)")
+    a.add_argument(
+        "--magnify",
+        type=float,
+        default=125.0,
+        help="the plate's displacement magnification "
+        "(in the plane; in space an elastic body is magnified as `granplate show` does)",
+    )
     a.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     a.set_defaults(func=_cmd_animate)
 

@@ -5,6 +5,7 @@ runs longest first and each figure or animation as soon as the runs it needs are
 The tasks read and write the output folder, so the workers of a cluster given by
 `--scheduler` must see it (the same machine, or a shared file system).
 """
+
 from __future__ import annotations
 
 import sys
@@ -13,7 +14,13 @@ from pathlib import Path
 
 from granplate.results import engine
 from granplate.paper.reproduce import (
-    Job, Outcome, RunRecord, expected_cost, make_animation, make_figure, run_job,
+    Job,
+    Outcome,
+    RunRecord,
+    expected_cost,
+    make_animation,
+    make_figure,
+    run_job,
 )
 
 
@@ -73,8 +80,15 @@ class Product:
 class Driver:
     """Runs the jobs on a Dask client and starts each figure / animation once its runs are in."""
 
-    def __init__(self, client, outcome: Outcome, products: list[Product],
-                 available: dict[str, Path], progress: Progress, frames: int | None):
+    def __init__(
+        self,
+        client,
+        outcome: Outcome,
+        products: list[Product],
+        available: dict[str, Path],
+        progress: Progress,
+        frames: int | None,
+    ):
         from distributed import as_completed
 
         self.client, self.outcome, self.products = client, outcome, products
@@ -110,8 +124,9 @@ class Driver:
                 if prod.kind == "figure":
                     self.submit(prod.kind, prod, make_figure, prod.key, paths, out / "figures")
                 else:
-                    self.submit(prod.kind, prod, make_animation, paths[0],
-                                out / "animations" / f"{prod.key}.mp4", self.frames)
+                    self.submit(
+                        prod.kind, prod, make_animation, paths[0], out / "animations" / f"{prod.key}.mp4", self.frames
+                    )
 
     def finish(self, fut) -> None:
         """Record one finished task (a run, a figure or an animation)."""

@@ -16,6 +16,7 @@ granplate.results.criteria), the twins' run table and the figure.
     >>> twins = {n: gp.simulate(twin_scenario(n)) for n in twin_presets()}
     >>> blocks = section(plane_results, twins)
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -110,10 +111,24 @@ def thin_limit_checks(results: Results, twins: Results) -> list[tuple[str, Check
     for c in case_rows(results, twins):
         for t in TARGETS:
             a, b = c["plane"][t.key], c["space"][t.key]
-            out.append((c["case"], Check(
-                quantity=t.quantity, unit=t.unit, reference=a, source=SOURCE, ours=b, criterion=t.criterion,
-                judged=a is not None, reference_text=_value(a, t.key), ours_text=_value(b, t.key),
-                ratio=None if a in (None, 0.0) or b is None else b / a, key=f"{c['case']}:{t.key}")))
+            out.append(
+                (
+                    c["case"],
+                    Check(
+                        quantity=t.quantity,
+                        unit=t.unit,
+                        reference=a,
+                        source=SOURCE,
+                        ours=b,
+                        criterion=t.criterion,
+                        judged=a is not None,
+                        reference_text=_value(a, t.key),
+                        ours_text=_value(b, t.key),
+                        ratio=None if a in (None, 0.0) or b is None else b / a,
+                        key=f"{c['case']}:{t.key}",
+                    ),
+                )
+            )
     return out
 
 
@@ -146,9 +161,17 @@ def _ratio(a: float | None, b: float | None) -> str:
     return "-" if not a or b is None else f"{b / a:.1f}"
 
 
-CASE_HEADER = ("case", "E_shock 2D / 3D [J]", "E_shock 3D vs 2D", "plate peak 2D / 3D", "plate peak 3D vs 2D",
-               "max von Mises 2D / 3D [MPa]", "max abs(energy residual) 2D / 3D", "wall time 2D / 3D [s]",
-               "wall time 3D / 2D")
+CASE_HEADER = (
+    "case",
+    "E_shock 2D / 3D [J]",
+    "E_shock 3D vs 2D",
+    "plate peak 2D / 3D",
+    "plate peak 3D vs 2D",
+    "max von Mises 2D / 3D [MPa]",
+    "max abs(energy residual) 2D / 3D",
+    "wall time 2D / 3D [s]",
+    "wall time 3D / 2D",
+)
 
 
 def case_table(results: Results, twins: Results) -> list[tuple[str, ...]]:
@@ -157,17 +180,19 @@ def case_table(results: Results, twins: Results) -> list[tuple[str, ...]]:
     rows = []
     for c in case_rows(results, twins):
         a, b = c["plane"], c["space"]
-        rows.append((
-            c["case"],
-            _both(_value(a["e_shock"], "e_shock"), _value(b["e_shock"], "e_shock")),
-            _diff(difference(a["e_shock"], b["e_shock"])),
-            _both(_value(a["ep_max_fraction"], "ep_max_fraction"), _value(b["ep_max_fraction"], "ep_max_fraction")),
-            _diff(difference(a["ep_max_fraction"], b["ep_max_fraction"])),
-            _both(_mpa(a["max_von_mises"]), _mpa(b["max_von_mises"])),
-            _both(f"{a['energy_residual_max']:.1e}", f"{b['energy_residual_max']:.1e}"),
-            _both(f"{a['wall_time_s']:.1f}", f"{b['wall_time_s']:.1f}"),
-            _ratio(a["wall_time_s"], b["wall_time_s"]),
-        ))
+        rows.append(
+            (
+                c["case"],
+                _both(_value(a["e_shock"], "e_shock"), _value(b["e_shock"], "e_shock")),
+                _diff(difference(a["e_shock"], b["e_shock"])),
+                _both(_value(a["ep_max_fraction"], "ep_max_fraction"), _value(b["ep_max_fraction"], "ep_max_fraction")),
+                _diff(difference(a["ep_max_fraction"], b["ep_max_fraction"])),
+                _both(_mpa(a["max_von_mises"]), _mpa(b["max_von_mises"])),
+                _both(f"{a['energy_residual_max']:.1e}", f"{b['energy_residual_max']:.1e}"),
+                _both(f"{a['wall_time_s']:.1f}", f"{b['wall_time_s']:.1f}"),
+                _ratio(a["wall_time_s"], b["wall_time_s"]),
+            )
+        )
     return rows
 
 
@@ -181,19 +206,33 @@ def _holds(h: bool | None) -> str:
 def check_table(checks: list[tuple[str, Check]]) -> list[tuple[str, ...]]:
     """One row per case and target: both values, the difference, the target's text and
     the verdict."""
-    return [(str(i + 1), case, c.quantity, c.reference_text, c.ours_text, _diff(difference(c.reference, c.ours)),
-             c.rule, _holds(c.holds)) for i, (case, c) in enumerate(checks)]
+    return [
+        (
+            str(i + 1),
+            case,
+            c.quantity,
+            c.reference_text,
+            c.ours_text,
+            _diff(difference(c.reference, c.ours)),
+            c.rule,
+            _holds(c.holds),
+        )
+        for i, (case, c) in enumerate(checks)
+    ]
 
 
 def verdict_text(checks: list[tuple[str, Check]]) -> str:
     """A paragraph: how many differences are within their targets, and which are not."""
     n_ok = sum(c.holds is True for _, c in checks)
-    missed = [f"{case} {c.quantity} ({_diff(difference(c.reference, c.ours))})" for case, c in checks
-              if c.holds is False]
+    missed = [
+        f"{case} {c.quantity} ({_diff(difference(c.reference, c.ours))})" for case, c in checks if c.holds is False
+    ]
     unjudged = [f"{case} {c.quantity}" for case, c in checks if c.holds is None]
     targets = ", ".join(f"{t.quantity} within {100 * t.tol:g}%" for t in TARGETS)
-    text = (f"**{n_ok} of {len(checks)} differences are within the thin-limit targets** ({targets} of the 2D "
-            f"run's; {SOURCE}).")
+    text = (
+        f"**{n_ok} of {len(checks)} differences are within the thin-limit targets** ({targets} of the 2D "
+        f"run's; {SOURCE})."
+    )
     if missed:
         text += " Outside them: " + "; ".join(missed) + "."
     if unjudged:
@@ -203,31 +242,35 @@ def verdict_text(checks: list[tuple[str, Check]]) -> str:
 
 def choices_text() -> str:
     """What the 3D twins are."""
-    return ("Each case is run again in space as its preset's 3D twin (`granplate preset 3d-NAME`, "
-            f"{SOURCE}): the same packing of spheres in the plane z = 0, the paper's plate as a 3D slab of hex20 "
-            "elements (one through its 1 mm thickness) clamped on ymin and ymax, the rigid layers as "
-            "translation-only strips across the thickness tying only the face the granules touch, the same line "
-            "load (on each loaded granule its 2D resultants; on the bare plate a traction on the slab's face), "
-            "velocity Verlet at a fixed step (0.2 us for the steel packings, 0.4 to 0.5 us where the contacts "
-            "allow it) and the slab's modes below a cut-off with the residual "
-            "compliance at the contacts. Everything else is the preset's. In the thin limit the 3D twin should "
-            "give the 2D run's numbers; the table sets them side by side, each cell 2D / 3D, computed by "
-            "`granplate.summary` from both result files. Wall time: the run's own as recorded in the result (the "
-            "model's set-up and the time loop; building and writing the result file not included).")
+    return (
+        "Each case is run again in space as its preset's 3D twin (`granplate preset 3d-NAME`, "
+        f"{SOURCE}): the same packing of spheres in the plane z = 0, the paper's plate as a 3D slab of hex20 "
+        "elements (one through its 1 mm thickness) clamped on ymin and ymax, the rigid layers as "
+        "translation-only strips across the thickness tying only the face the granules touch, the same line "
+        "load (on each loaded granule its 2D resultants; on the bare plate a traction on the slab's face), "
+        "velocity Verlet at a fixed step (0.2 us for the steel packings, 0.4 to 0.5 us where the contacts "
+        "allow it) and the slab's modes below a cut-off with the residual "
+        "compliance at the contacts. Everything else is the preset's. In the thin limit the 3D twin should "
+        "give the 2D run's numbers; the table sets them side by side, each cell 2D / 3D, computed by "
+        "`granplate.summary` from both result files. Wall time: the run's own as recorded in the result (the "
+        "model's set-up and the time loop; building and writing the result file not included)."
+    )
 
 
 def causes_text() -> str:
     """Where the differences between 2D and 3D come from (docs/model.md section 8.1)."""
-    return ("Where the differences come from: E_shock, because velocity Verlet samples the load at its kicks "
-            "(50 per pulse at 0.2 us, 20 at 0.5 us: the difference grows as the step squared) where the 2D "
-            "implicit scheme integrates it "
-            "adaptively; the plate's energy, because the 3D slab is not the plane-stress plate (its in-plane "
-            "modes lie 0.2% above the plane-stress plate's) and because the rigid layers tie only the slab's face "
-            "(a patch that also tied the side faces stiffened the slab and cut the PTFE case's peak share by "
-            "10%). The largest von Mises stress of the bare plate differs more: at the loaded face's clamped "
-            "corners plane stress is singular and the slab's stress there is not the plane's. Wall times: the "
-            "2D runs integrate implicitly with an adaptive step, the 3D twins explicitly at a fixed step, so "
-            f"their ratio is the cost of going to space at these settings, not a benchmark ({SOURCE}).")
+    return (
+        "Where the differences come from: E_shock, because velocity Verlet samples the load at its kicks "
+        "(50 per pulse at 0.2 us, 20 at 0.5 us: the difference grows as the step squared) where the 2D "
+        "implicit scheme integrates it "
+        "adaptively; the plate's energy, because the 3D slab is not the plane-stress plate (its in-plane "
+        "modes lie 0.2% above the plane-stress plate's) and because the rigid layers tie only the slab's face "
+        "(a patch that also tied the side faces stiffened the slab and cut the PTFE case's peak share by "
+        "10%). The largest von Mises stress of the bare plate differs more: at the loaded face's clamped "
+        "corners plane stress is singular and the slab's stress there is not the plane's. Wall times: the "
+        "2D runs integrate implicitly with an adaptive step, the 3D twins explicitly at a fixed step, so "
+        f"their ratio is the cost of going to space at these settings, not a benchmark ({SOURCE})."
+    )
 
 
 def section(
@@ -248,19 +291,32 @@ def section(
     blocks = [Block("h2", "The paper in 3D"), Block("p", choices_text())]
     t_ends = [float(d["time"].values[-1]) for d in twins.values()]
     if t_ends and max(t_ends) < 2e-3 * 0.999:
-        blocks.append(Block("p", f"**The 3D twins were shortened (t_end = {max(t_ends) * 1e3:.3g} ms instead of "
-                                 f"2 ms): the thin-limit targets are set for full runs.**"))
+        blocks.append(
+            Block(
+                "p",
+                f"**The 3D twins were shortened (t_end = {max(t_ends) * 1e3:.3g} ms instead of "
+                f"2 ms): the thin-limit targets are set for full runs.**",
+            )
+        )
     blocks.append(Block("table", header=CASE_HEADER, rows=tuple(case_table(results, twins))))
     blocks.append(Block("p", verdict_text(checks)))
     blocks.append(Block("table", header=CHECK_HEADER, rows=tuple(check_table(checks))))
     blocks.append(Block("p", causes_text()))
     named = {twin_name(n): ds for n, ds in twins.items()}
-    blocks.append(details(f"The 3D twins' runs: {len(named)} runs",
-                          [Block("table", header=tuple(RUN_HEADER),
-                                 rows=tuple(tuple(r) for r in run_rows(named, records)))]))
+    blocks.append(
+        details(
+            f"The 3D twins' runs: {len(named)} runs",
+            [Block("table", header=tuple(RUN_HEADER), rows=tuple(tuple(r) for r in run_rows(named, records)))],
+        )
+    )
     png = [p for p in (figure or []) if Path(p).suffix == ".png"]
     if png:
-        blocks.append(Block("figure", f"The plate's share of the shock energy, each case in 2D (solid) and 3D "
-                                      f"(dashed) ({Path(png[0]).stem}.png / .pdf)", path=Path(png[0])))
+        blocks.append(
+            Block(
+                "figure",
+                f"The plate's share of the shock energy, each case in 2D (solid) and 3D "
+                f"(dashed) ({Path(png[0]).stem}.png / .pdf)",
+                path=Path(png[0]),
+            )
+        )
     return blocks
-

@@ -27,6 +27,7 @@ the approach speed (`rate_factor`): 0 while unset (then the current approach spe
 which happens only while the contact is elastic), 1 for a rate-free contact. Units: metres,
 newtons, joules.
 """
+
 from __future__ import annotations
 
 import math
@@ -34,8 +35,19 @@ import math
 import numpy as np
 from numba import njit
 
-from granplate.physics.contact import (COEF_A, COEF_C, COEF_DY, COEF_H, COEF_KAPPA, COEF_RC, COEF_RL, COEF_SY,
-                                       COEF_XH, normal_force, normal_response)
+from granplate.physics.contact import (
+    COEF_A,
+    COEF_C,
+    COEF_DY,
+    COEF_H,
+    COEF_KAPPA,
+    COEF_RC,
+    COEF_RL,
+    COEF_SY,
+    COEF_XH,
+    normal_force,
+    normal_response,
+)
 
 #: the Hertz force and slope at yield in units of R* Y delta_y and R* Y (J2): F_y = 2/3 pi p_y
 #: R* delta_y and k_y = pi p_y R* with p_y = 1.6 Y
@@ -114,8 +126,10 @@ def loading_force(x: float, h: float, xh: float):
     the cubic bridge up to X_BRIDGE, then the cavity curve."""
     if x <= X_BRIDGE:
         s = x - 1.0
-        return (F_YIELD + s * (K_YIELD + s * (BRIDGE_C2 + s * BRIDGE_C3)),
-                K_YIELD + s * (2.0 * BRIDGE_C2 + 3.0 * s * BRIDGE_C3))
+        return (
+            F_YIELD + s * (K_YIELD + s * (BRIDGE_C2 + s * BRIDGE_C3)),
+            K_YIELD + s * (2.0 * BRIDGE_C2 + 3.0 * s * BRIDGE_C3),
+        )
     return cavity_force(x, h, xh)
 
 
@@ -284,4 +298,3 @@ def johnson_replay(delta: np.ndarray, coef, speed: float) -> np.ndarray:
         if d > m:
             m = d
     return out
-

@@ -14,6 +14,7 @@ at zero (docs/model.md section 3.2); `clip=False` gives the paper's raw eq. (2) 
 Friction (eq. 5): |f| = mu |N| tanh(k_s v_t), opposed to the slip rate v_t (eq. 6); on a
 sphere it also gives a torque -|f| R (both spheres spin against the slip).
 """
+
 from __future__ import annotations
 
 import math
@@ -90,8 +91,9 @@ def pair_normal_rate(vxi: float, vyi: float, vxj: float, vyj: float, nx: float, 
 
 
 @njit(cache=True)
-def pair_rates(vxi: float, vyi: float, wi: float, vxj: float, vyj: float, wj: float,
-               nx: float, nz: float, ai: float, aj: float):
+def pair_rates(
+    vxi: float, vyi: float, wi: float, vxj: float, vyj: float, wj: float, nx: float, nz: float, ai: float, aj: float
+):
     """Overlap rate d(delta)/dt and slip rate v_t (eq. 6) of spheres i, j [m/s].
 
     t = (-nz, nx); v_t = (v_i - v_j).t + a_i omega_i + a_j omega_j with the arms a_i, a_j.
@@ -243,8 +245,7 @@ def normal_response(delta: float, delta_dot: float, a: float, c: float, clip: bo
 
 
 @njit(cache=True)
-def contact_response(delta: float, delta_dot: float, v_t: float, a: float, c: float,
-                     mu: float, k_s: float, clip: bool):
+def contact_response(delta: float, delta_dot: float, v_t: float, a: float, c: float, mu: float, k_s: float, clip: bool):
     """The whole law of one contact in touch (delta > 0), eqs. (2)-(5) and (9)-(10).
 
     Returns (|N|, signed friction f, viscous power, friction power, stored energy);

@@ -11,6 +11,7 @@ and `profile_terms` gives its integral from 0, its value, slope and curvature at
 displacement drive moves its body by s = P(t) - P(0) (velocity P', acceleration P''); a
 velocity drive by s = int_0^t P (velocity P, acceleration P'); a force drive pushes with P.
 """
+
 from __future__ import annotations
 
 import math
@@ -70,7 +71,12 @@ def profile_terms(t, pid, par, tab, n):
         T = par[PAR_DURATION]
         k = math.pi / T
         if t <= T:
-            return a / k * (1.0 - math.cos(k * t)), a * math.sin(k * t), a * k * math.cos(k * t), -a * k * k * math.sin(k * t)
+            return (
+                a / k * (1.0 - math.cos(k * t)),
+                a * math.sin(k * t),
+                a * k * math.cos(k * t),
+                -a * k * k * math.sin(k * t),
+            )
         return 2.0 * a / k, 0.0, 0.0, 0.0
     if pid == PROFILE_HARMONIC:
         w = 2.0 * math.pi * par[PAR_FREQUENCY]

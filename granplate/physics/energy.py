@@ -6,6 +6,7 @@ judged relative to a scale (the largest E_in met so far). The stored energies ar
 (9)-(10) (contact.contact_energy, the granules' and the plate's kinetic energies); D_plastic is
 the plastic work of yielding contacts (docs/model.md section 3.6, eq. P10), zero under Hertz's law.
 """
+
 from __future__ import annotations
 
 from numba import njit

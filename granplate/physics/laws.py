@@ -11,6 +11,7 @@ granule-plate, granule-body), so that a new normal law is one branch here and co
 columns. An infinite COEF_DY takes the Hertz branch unchanged: elastic runs stay bitwise
 what they were before the plastic laws existed.
 """
+
 from __future__ import annotations
 
 import math
@@ -18,8 +19,15 @@ import math
 from numba import njit
 
 from granplate.physics.cavity import johnson_normal_force, johnson_normal_response, johnson_normal_slopes
-from granplate.physics.contact import (COEF_A, COEF_C, COEF_DY, COEF_SY, normal_force, normal_force_slopes,
-                                       normal_response)
+from granplate.physics.contact import (
+    COEF_A,
+    COEF_C,
+    COEF_DY,
+    COEF_SY,
+    normal_force,
+    normal_force_slopes,
+    normal_response,
+)
 from granplate.physics.plastic import yielding_normal_force, yielding_normal_response, yielding_normal_slopes
 
 

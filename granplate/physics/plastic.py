@@ -25,6 +25,7 @@ the contact, then `updated_max_overlap` once the state is accepted; the energy b
 uses `plastic_elastic_energy` (stored, part of E_granular) and `plastic_work`
 (dissipated). `contact_yield_overlap` gives delta_y from E*, R* and the softer body's Y.
 """
+
 from __future__ import annotations
 
 import math
@@ -227,8 +228,9 @@ def plastic_work(a: float, delta_y: float, delta_max: float) -> float:
 
 
 @njit(cache=True)
-def yielding_normal_response(delta: float, delta_dot: float, a: float, c: float, delta_y: float,
-                             delta_max: float, clip: bool):
+def yielding_normal_response(
+    delta: float, delta_dot: float, a: float, c: float, delta_y: float, delta_max: float, clip: bool
+):
     """The elastic-plastic law of one contact in touch (delta > 0) with the paper's
     damping (P13): |N| = F(delta, delta_max) (P8) + c (delta - delta_p)^(1/4) d(delta)/dt
     while delta > delta_p, 0 at or below the residual overlap delta_p; with clip, |N| >= 0.
@@ -260,8 +262,9 @@ def yielding_normal_response(delta: float, delta_dot: float, a: float, c: float,
 
 
 @njit(cache=True)
-def yielding_normal_force(delta: float, delta_dot: float, a: float, c: float, delta_y: float,
-                          delta_max: float, clip: bool) -> float:
+def yielding_normal_force(
+    delta: float, delta_dot: float, a: float, c: float, delta_y: float, delta_max: float, clip: bool
+) -> float:
     """|N| [N] of `yielding_normal_response` alone (no energies: what friction needs)."""
     m = updated_max_overlap(delta, delta_max)
     if m <= delta_y:

@@ -6,6 +6,7 @@ On granules the line load pushes +x on the left surface of each loaded granule o
 below). On the bare plate the same q acts on the left edge as consistent nodal forces
 (plate.py).
 """
+
 from __future__ import annotations
 
 import math

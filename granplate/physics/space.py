@@ -15,6 +15,7 @@ f_i = -mu |N| tanh(k_s |v_s|) v_s / |v_s| and -f_i on j, with torques a_i n x f_
 a_j n x f_i on j. In the plane z = 0 with spins along z this is eq. (6) of the plane:
 v_s = v_t t with t = (-n_y, n_x, 0), and the torques are -f a along z.
 """
+
 from __future__ import annotations
 
 import math
@@ -85,9 +86,7 @@ def slip_velocity_3d(vx, vy, vz, sx, sy, sz, nx, ny, nz):
     relative velocity (vx, vy, vz) = v_i - v_j plus (sx, sy, sz) x n, where s = a_i w_i +
     a_j w_j [m/s] (a_i w_i against a wall). Returns (v_sx, v_sy, v_sz)."""
     vn = vx * nx + vy * ny + vz * nz
-    return (vx - vn * nx + sy * nz - sz * ny,
-            vy - vn * ny + sz * nx - sx * nz,
-            vz - vn * nz + sx * ny - sy * nx)
+    return (vx - vn * nx + sy * nz - sz * ny, vy - vn * ny + sz * nx - sx * nz, vz - vn * nz + sx * ny - sy * nx)
 
 
 @njit(cache=True)

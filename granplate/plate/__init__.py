@@ -11,6 +11,7 @@ Its members load on first use (module `__getattr__`): `from granplate.plate.peak
 ...` does not import scikit-fem, and `from granplate.plate import build_plate` imports
 what a build needs.
 """
+
 from __future__ import annotations
 
 import importlib
@@ -18,13 +19,31 @@ import importlib
 #: module -> the names the package gives from it
 _EXPORTS: dict[str, tuple[str, ...]] = {
     "errors": ("PlateError",),
-    "stress": ("INTORDER", "plane_stress_matrix", "von_mises_plane_stress", "voigt_strain",
-        "strain_operator", "quadrature_points", "gauss_point_strains", "plane_stresses",
-        "disc_centres", "disc_average_operator", "max_disc_average"),
-    "fe": ("plate_mesh", "q8_basis", "assemble_stiffness", "assemble_mass", "node_coordinates",
-        "vtk_elements"),
-    "constraints": ("GEOMETRY_RTOL", "EDGES", "nodes_on_line", "edge_nodes", "clamped_dofs",
-        "symmetry_line_nodes", "rigid_layer_nodes", "rigid_layer_map", "reduce_matrix"),
+    "stress": (
+        "INTORDER",
+        "plane_stress_matrix",
+        "von_mises_plane_stress",
+        "voigt_strain",
+        "strain_operator",
+        "quadrature_points",
+        "gauss_point_strains",
+        "plane_stresses",
+        "disc_centres",
+        "disc_average_operator",
+        "max_disc_average",
+    ),
+    "fe": ("plate_mesh", "q8_basis", "assemble_stiffness", "assemble_mass", "node_coordinates", "vtk_elements"),
+    "constraints": (
+        "GEOMETRY_RTOL",
+        "EDGES",
+        "nodes_on_line",
+        "edge_nodes",
+        "clamped_dofs",
+        "symmetry_line_nodes",
+        "rigid_layer_nodes",
+        "rigid_layer_map",
+        "reduce_matrix",
+    ),
     "modes": ("modal_basis", "sign_reference", "fix_mode_signs", "transverse_mode_frequencies"),
     "load": ("EDGE_LOAD_POINTS", "half_sine_line_load", "edge_load_vector"),
     "build": ("PLATE_FORMAT", "STORE_KIND", "PlateModel", "cache_payload", "build_plate"),

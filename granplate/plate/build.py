@@ -12,6 +12,7 @@ coordinates. The expensive part of `build_plate` (assembly and the dense general
 eigenproblem) is kept in the run store (`granplate.store`, kind "plate"), keyed by every
 input (`cache_payload`).
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -55,8 +56,13 @@ from granplate.plate.stress import (
 )
 from granplate.setup.materials import LIBRARY, Material
 from granplate.setup.plate_checks import check_layers_off_clamps, check_mode_count, check_plate_fields
-from granplate.setup.plate_cost import (DEFAULT_MAX_FREQUENCY, basis_kind, build_estimate, check_fits,
-                                        truncation_supported)
+from granplate.setup.plate_cost import (
+    DEFAULT_MAX_FREQUENCY,
+    basis_kind,
+    build_estimate,
+    check_fits,
+    truncation_supported,
+)
 
 if TYPE_CHECKING:  # pragma: no cover
     from granplate.setup.scenario import Plate
@@ -72,9 +78,12 @@ def build_note(plate: "Plate", kind: str, n_red: int, n_face: int) -> str | None
     seconds = build_estimate(kind, n_red, n_face)[1]
     if seconds < NOTE_BUILD_SECONDS:
         return None
-    what = (f"all {n_red} modes (dense)" if kind == "all" else
-            f"modes below {plate.max_frequency or DEFAULT_MAX_FREQUENCY:.3g} Hz and the static correction "
-            f"({n_red} dofs)")
+    what = (
+        f"all {n_red} modes (dense)"
+        if kind == "all"
+        else f"modes below {plate.max_frequency or DEFAULT_MAX_FREQUENCY:.3g} Hz and the static correction "
+        f"({n_red} dofs)"
+    )
     return f"building the {plate.nx} x {plate.ny} plate: {what} (about {seconds:.0f} s; cached afterwards) ..."
 
 
@@ -240,10 +249,11 @@ class PlateModel:
         contact_y[n_layers:] [m/N], columns [p0 x, p0 y, p1 x, ...]: (K_r^-1 - Phi
         diag(1/omega^2) Phi^T) E^T w per unit force, E = face_rows (docs/model.md section
         4.5); one sparse factorisation of K_r, computed once per model."""
-        heights = self.contact_y[self.psi.shape[1] // 2:]
+        heights = self.contact_y[self.psi.shape[1] // 2 :]
         units = np.eye(2 * len(heights))
-        f_red = np.asarray(face_rows(self.T, self.face_nodes).T
-                           @ face_forces(self.face_y, heights, self.patch_width, units).T)
+        f_red = np.asarray(
+            face_rows(self.T, self.face_nodes).T @ face_forces(self.face_y, heights, self.patch_width, units).T
+        )
         K_r = sp.csc_matrix(reduce_matrix(self.stiffness_matrix(), self.T))
         return spla.splu(K_r).solve(f_red) - self.Phi @ ((self.Phi.T @ f_red) / self.omega[:, None] ** 2)
 
@@ -377,8 +387,9 @@ def _compute_arrays(
     if kind == "truncated":
         max_omega = 2.0 * np.pi * float(plate.max_frequency or DEFAULT_MAX_FREQUENCY)
         expected = weyl_mode_count(plate.width * plate.height, material.E, material.nu, material.rho, max_omega)
-        Phi, omega, psi, resid_face = truncated_modal_basis(K_r, M_r, drive, max_omega, plate.n_modes, expected,
-                                                            face=face_rows(T, face))
+        Phi, omega, psi, resid_face = truncated_modal_basis(
+            K_r, M_r, drive, max_omega, plate.n_modes, expected, face=face_rows(T, face)
+        )
     else:
         Phi, omega = modal_basis(K_r, M_r, plate.n_modes)
         psi = np.zeros((T.shape[1], 0))
@@ -402,16 +413,20 @@ def _compute_arrays(
     }
 
 
-def _arrays_fit(arrays: dict[str, np.ndarray], n_full: int, n_red: int, n_modes: int | None, n_rows: int,
-                n_face: int = 0) -> bool:
+def _arrays_fit(
+    arrays: dict[str, np.ndarray], n_full: int, n_red: int, n_modes: int | None, n_rows: int, n_face: int = 0
+) -> bool:
     """Whether cached arrays are all there, with the shapes this build needs (n_modes
     None: any number, the truncated basis', which also needs psi and the (2 n_face,
     2 n_face) resid_face)."""
     if not all(name in arrays for name in _CACHED_ARRAYS):
         return False
-    if n_modes is None and not ("psi" in arrays and arrays["psi"].shape[0] == n_red
-                                and "resid_face" in arrays
-                                and arrays["resid_face"].shape == (2 * n_face, 2 * n_face)):
+    if n_modes is None and not (
+        "psi" in arrays
+        and arrays["psi"].shape[0] == n_red
+        and "resid_face" in arrays
+        and arrays["resid_face"].shape == (2 * n_face, 2 * n_face)
+    ):
         return False
     n_modes = arrays["omega"].shape[0] if n_modes is None else n_modes
     return (
@@ -461,17 +476,36 @@ _BUILT: dict[str, "PlateModel"] = {}
 BUILT_KEPT = 4
 
 
-def memo_key(plate: "Plate", material: Material, x0: float, contact_y: Sequence[float],
-             edge_load: tuple[float, float] | None, symmetry_line: bool) -> str:
+def memo_key(
+    plate: "Plate",
+    material: Material,
+    x0: float,
+    contact_y: Sequence[float],
+    edge_load: tuple[float, float] | None,
+    symmetry_line: bool,
+) -> str:
     """What identifies a built plate in this process: every input of build_plate, the
     output settings and the basis choice included (floats written exactly via repr), and
     the run store's directory (another store builds, and fills, its own)."""
     fields = {k: repr(v) for k, v in sorted(dataclasses.asdict(plate).items())}
-    return repr((fields, material.name, repr(float(material.E)), repr(float(material.nu)),
-                 repr(float(material.rho)), repr(float(x0)), [repr(float(y)) for y in contact_y],
-                 None if edge_load is None else [repr(float(v)) for v in edge_load], bool(symmetry_line),
-                 getattr(skfem, "__version__", "?"), INTORDER, EDGE_LOAD_POINTS, PLATE_FORMAT,
-                 str(store.cache_directory())))
+    return repr(
+        (
+            fields,
+            material.name,
+            repr(float(material.E)),
+            repr(float(material.nu)),
+            repr(float(material.rho)),
+            repr(float(x0)),
+            [repr(float(y)) for y in contact_y],
+            None if edge_load is None else [repr(float(v)) for v in edge_load],
+            bool(symmetry_line),
+            getattr(skfem, "__version__", "?"),
+            INTORDER,
+            EDGE_LOAD_POINTS,
+            PLATE_FORMAT,
+            str(store.cache_directory()),
+        )
+    )
 
 
 def forget_built_plates() -> None:
@@ -522,8 +556,15 @@ def build_plate(
     return built
 
 
-def _build_plate(plate: "Plate", x0: float, contact_y: list[float], edge_load: tuple[float, float] | None,
-                 cache: bool, material: Material, symmetry_line: bool) -> PlateModel:
+def _build_plate(
+    plate: "Plate",
+    x0: float,
+    contact_y: list[float],
+    edge_load: tuple[float, float] | None,
+    cache: bool,
+    material: Material,
+    symmetry_line: bool,
+) -> PlateModel:
     """build_plate without the process's memory: the mesh, reduction and operators built,
     the expensive arrays from the run store (cache) or computed."""
     _check_plate(plate, x0)
@@ -536,8 +577,9 @@ def _build_plate(plate: "Plate", x0: float, contact_y: list[float], edge_load: t
     T, drive_dofs = _reduction(node_xy, plate, x0, contact_y, n_full)
     n_red = T.shape[1]
     _check_plate(plate, x0, n_modes_max=n_red)
-    kind = basis_kind(getattr(plate, "modes", "all"), n_red,
-                      truncation_supported(plate.clamped_edges, edge_load is not None))
+    kind = basis_kind(
+        getattr(plate, "modes", "all"), n_red, truncation_supported(plate.clamped_edges, edge_load is not None)
+    )
     n_modes = None if kind == "truncated" and not plate.n_modes else (plate.n_modes or n_red)
     n_elem, n_qp = basis.dx.shape
     D = plane_stress_matrix(material.E, material.nu)

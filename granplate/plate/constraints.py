@@ -4,6 +4,7 @@ A full displacement vector is x_full = T @ x_red: clamped dofs are removed and e
 node of a contact's rigid layer copies its driving node's dofs (a multi-point
 constraint); a matrix A reduces to T^T A T.
 """
+
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Sequence

@@ -5,6 +5,7 @@ ScenarioError naming the scenario field); a PlateError reaches only a direct cal
 the plate layer that passed inconsistent inputs. Both come from the same checks
 (`granplate.setup.plate_checks`): `plate_inputs` reports theirs as a PlateError.
 """
+
 from __future__ import annotations
 
 import contextlib

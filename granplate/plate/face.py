@@ -9,6 +9,7 @@ force's work on the plate is F . du_c: the transfer is work-consistent.
 
 `patch_weights` is compiled: the time loop calls it when a patch moves.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -45,8 +46,11 @@ def face_forces(face_y: np.ndarray, patch_y: np.ndarray, width: float, force: np
     patch contacts at heights patch_y (n_patch,) [m] of `width` [m] carrying `force`
     (..., 2 n_patch) [N] ordered [p0 x, p0 y, p1 x, ...]: each spread as w F."""
     patch_y = np.asarray(patch_y, dtype=float)
-    W = np.stack([patch_weight_vector(face_y, y, width) for y in patch_y]) if len(patch_y) else \
-        np.zeros((0, len(face_y)))
+    W = (
+        np.stack([patch_weight_vector(face_y, y, width) for y in patch_y])
+        if len(patch_y)
+        else np.zeros((0, len(face_y)))
+    )
     f = np.asarray(force, dtype=float).reshape(np.shape(force)[:-1] + (len(patch_y), 2))
     nodal = np.einsum("kn,...kc->...nc", W, f)
     return nodal.reshape(nodal.shape[:-2] + (2 * len(face_y),))

@@ -7,6 +7,7 @@ is in SI units: metres, kilograms, seconds, newtons, pascals. Node n has dofs 2n
 2n + 1 (y); nodes are the mesh corners followed by the edge midpoints (scikit-fem's dof
 numbering).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -65,7 +66,6 @@ def node_coordinates(basis: Basis) -> np.ndarray:
         and basis.N == 2 * (n_vertices + facet.shape[1])
     ):
         raise RuntimeError("unexpected scikit-fem dof numbering for ElementVector(ElementQuadS2())")
-
 
     return np.ascontiguousarray(basis.doflocs[:, ::2].T)
 

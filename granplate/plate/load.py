@@ -1,4 +1,5 @@
 """The shock on the plate: consistent nodal forces of the half-sine line load on its left edge."""
+
 from __future__ import annotations
 
 import numpy as np

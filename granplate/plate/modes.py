@@ -1,4 +1,5 @@
 """Modes of the plate: the generalized eigenproblem K_r phi = omega^2 M_r phi and its sign rule."""
+
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
@@ -48,8 +49,13 @@ def weyl_mode_count(area: float, E: float, nu: float, rho: float, omega: float) 
 
 
 def truncated_modal_basis(
-    K_r: sp.spmatrix, M_r: sp.spmatrix, drive: np.ndarray, max_omega: float, n_modes: int = 0,
-    expected: float = 0.0, face: sp.spmatrix | None = None,
+    K_r: sp.spmatrix,
+    M_r: sp.spmatrix,
+    drive: np.ndarray,
+    max_omega: float,
+    n_modes: int = 0,
+    expected: float = 0.0,
+    face: sp.spmatrix | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The modes up to max_omega [rad/s] (or the n_modes lowest when n_modes > 0) and the
     static residual shapes at the driving dofs (docs/model.md section 4.5).
@@ -79,8 +85,7 @@ def truncated_modal_basis(
     k = min(k, n - 1)
     while True:
         ncv = min(n, k + max(k // 2, 20))
-        lam, Phi = spla.eigsh(K, k=k, M=M, sigma=0.0, which="LM", OPinv=opinv, v0=v0, tol=EIGSH_TOL,
-                              ncv=ncv)
+        lam, Phi = spla.eigsh(K, k=k, M=M, sigma=0.0, which="LM", OPinv=opinv, v0=v0, tol=EIGSH_TOL, ncv=ncv)
         order = np.argsort(lam)
         lam, Phi = lam[order], Phi[:, order]
         omega = np.sqrt(np.maximum(lam, 0.0))

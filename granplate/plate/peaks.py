@@ -27,6 +27,7 @@ first). The bounds carry a relative
 margin (BOUND_MARGIN, far above the round-off of the products) so that a skipped block
 provably holds no computed value above the maximum.
 """
+
 from __future__ import annotations
 
 from typing import Callable
@@ -51,7 +52,7 @@ MAXIMA = ("max_von_mises", "max_von_mises_disc", "max_eps_yy")
 def split_coordinates(plate, c: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
     """(modal coordinates, contact forces or None) of the coordinates c (time, n_modes [+ 2
     n_contacts forces of a truncated basis])."""
-    return c[:, :plate.n_modes], (c[:, plate.n_modes:] if c.shape[1] > plate.n_modes else None)
+    return c[:, : plate.n_modes], (c[:, plate.n_modes :] if c.shape[1] > plate.n_modes else None)
 
 
 def block_maxima(plate, c: np.ndarray) -> np.ndarray:
@@ -62,8 +63,10 @@ def block_maxima(plate, c: np.ndarray) -> np.ndarray:
         return np.zeros((0, 3))
     exx, eyy, gxy = plate.strains(*split_coordinates(plate, c))
     vm = von_mises_plane_stress(*plane_stresses(plate.D, exx, eyy, gxy))
-    return np.stack([vm.reshape(len(c), -1).max(axis=1), plate.max_disc_von_mises(vm),
-                     np.abs(eyy).reshape(len(c), -1).max(axis=1)], axis=1)
+    return np.stack(
+        [vm.reshape(len(c), -1).max(axis=1), plate.max_disc_von_mises(vm), np.abs(eyy).reshape(len(c), -1).max(axis=1)],
+        axis=1,
+    )
 
 
 def block_starts(n: int, block: int = BLOCK) -> np.ndarray:
@@ -71,8 +74,9 @@ def block_starts(n: int, block: int = BLOCK) -> np.ndarray:
     return np.arange(0, n, block)
 
 
-def time_maxima(plate, c: np.ndarray, should_stop: Callable[[], bool] | None = None,
-                on_block: Callable[[int], None] | None = None) -> np.ndarray:
+def time_maxima(
+    plate, c: np.ndarray, should_stop: Callable[[], bool] | None = None, on_block: Callable[[int], None] | None = None
+) -> np.ndarray:
     """The three maxima (time, 3) at every output time (block by block). should_stop:
     polled after each block; when it says yes, the rows computed so far are returned
     (at least one block). on_block(n_rows): called after each block."""
@@ -84,7 +88,7 @@ def time_maxima(plate, c: np.ndarray, should_stop: Callable[[], bool] | None = N
         if on_block is not None:
             on_block(rows.stop - rows.start)
         if should_stop is not None and rows.stop < n and should_stop():
-            return out[:rows.stop]
+            return out[: rows.stop]
     return out
 
 
@@ -128,7 +132,7 @@ def _unit_rows(plate, first: int, stop: int, n_cols: int) -> np.ndarray:
         j = min(i + 4 * BLOCK, stop)
         e = np.zeros((j - i, n_cols))
         e[np.arange(j - i), np.arange(i, j)] = 1.0
-        out[i - first:j - first] = block_maxima(plate, e)
+        out[i - first : j - first] = block_maxima(plate, e)
     return out
 
 
@@ -160,8 +164,9 @@ def rest_bounds(c: np.ndarray, m: np.ndarray) -> np.ndarray:
     return distance_peaks(c, np.ascontiguousarray(m, dtype=float), rows, np.full(len(c), -1))
 
 
-def reference_bounds(c: np.ndarray, m: np.ndarray, rows: np.ndarray, ref: np.ndarray,
-                     ref_values: np.ndarray, rest: np.ndarray) -> np.ndarray:
+def reference_bounds(
+    c: np.ndarray, m: np.ndarray, rows: np.ndarray, ref: np.ndarray, ref_values: np.ndarray, rest: np.ndarray
+) -> np.ndarray:
     """(len(rows), 3) upper bounds of the three maxima at the output indices rows, from the
     values ref_values (n_ref, 3) at the sorted output indices ref: the smaller of the
     bounds from the nearest reference before and after and of rest (the bound from rest,
@@ -218,8 +223,9 @@ def peak_maxima(plate, c: np.ndarray, block: int = BLOCK, strides: tuple[int, ..
             rows = np.concatenate([np.arange(starts[k], stops[k]) for k in open_blocks])
             anchors = np.flatnonzero(known)
             bounds = reference_bounds(c, m, rows, anchors, values[anchors], rest)
-            upper[open_blocks] = np.minimum(upper[open_blocks], np.maximum.reduceat(
-                bounds, np.searchsorted(rows, starts[open_blocks]), axis=0))
+            upper[open_blocks] = np.minimum(
+                upper[open_blocks], np.maximum.reduceat(bounds, np.searchsorted(rows, starts[open_blocks]), axis=0)
+            )
             open_blocks = open_blocks[np.any(upper[open_blocks] > floor, axis=1)]
     scale = np.maximum(upper.max(axis=0), np.finfo(float).tiny)
     best = floor.copy()  # a block bounded by the floor holds no value up to the maximum
@@ -228,6 +234,7 @@ def peak_maxima(plate, c: np.ndarray, block: int = BLOCK, strides: tuple[int, ..
     if not len(open_blocks):  # every bound at the floor (a plate at rest): one block still gives the maxima
         done[int(np.argmax((upper / scale).max(axis=1)))] = False
         best = np.full(3, -np.inf)
+
     def evaluate(k: int) -> np.ndarray:
         rows = slice(starts[k], stops[k])
         out[rows] = values[rows] = block_maxima(plate, c[rows])
@@ -245,9 +252,14 @@ def peak_maxima(plate, c: np.ndarray, block: int = BLOCK, strides: tuple[int, ..
     return out
 
 
-def largest_bound_first(upper: np.ndarray, best: np.ndarray, done: np.ndarray, scale: np.ndarray,
-                        evaluate: Callable[[int], np.ndarray],
-                        tighten: Callable[[int, np.ndarray], None] | None = None) -> None:
+def largest_bound_first(
+    upper: np.ndarray,
+    best: np.ndarray,
+    done: np.ndarray,
+    scale: np.ndarray,
+    evaluate: Callable[[int], np.ndarray],
+    tighten: Callable[[int, np.ndarray], None] | None = None,
+) -> None:
     """Evaluate the blocks still open, the largest bound first (upper (n_blocks, 3) over
     scale), while a block's bound exceeds the largest value found so far (best (3,)):
     evaluate(k) -> block k's maxima (3,); tighten(k, best) may lower the others' bounds

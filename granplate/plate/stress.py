@@ -3,6 +3,7 @@
 Strains are (eps_xx, eps_yy, gamma_xy) with gamma_xy the engineering shear strain [-];
 stresses (sigma_xx, sigma_yy, tau_xy) [Pa]; von Mises of plane stress is docs/model.md section 4.4, eq. 12.
 """
+
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
@@ -22,9 +23,7 @@ def plane_stress_matrix(E: float, nu: float) -> np.ndarray:
 
     Acts on (eps_xx, eps_yy, gamma_xy) with gamma_xy the engineering shear strain.
     """
-    return E / (1.0 - nu**2) * np.array(
-        [[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, 0.5 * (1.0 - nu)]]
-    )
+    return E / (1.0 - nu**2) * np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, 0.5 * (1.0 - nu)]])
 
 
 def von_mises_plane_stress(sxx: np.ndarray, syy: np.ndarray, sxy: np.ndarray) -> np.ndarray:
@@ -72,9 +71,7 @@ def strain_operator(basis: Basis) -> sp.csr_matrix:
     rows = np.broadcast_to(rows, data.shape)
     cols3 = np.broadcast_to(cols, data.shape)
     keep = data != 0.0
-    op = sp.coo_matrix(
-        (data[keep], (rows[keep], cols3[keep])), shape=(3 * n_elem * n_qp, basis.N)
-    ).tocsr()
+    op = sp.coo_matrix((data[keep], (rows[keep], cols3[keep])), shape=(3 * n_elem * n_qp, basis.N)).tocsr()
     op.sum_duplicates()
     op.sort_indices()
     return op
@@ -105,6 +102,7 @@ def plane_stresses(
 
     Terms whose coefficient is zero (the shear coupling of an isotropic D) are left out:
     adding them changes no value (x + 0 = x)."""
+
     def row(i: int) -> np.ndarray:
         out = None
         for j, eps in enumerate((exx, eyy, gxy)):
@@ -134,8 +132,7 @@ def disc_centres(x0: float, y0: float, width: float, height: float, spacing: flo
     return np.stack([cx.ravel(), cy.ravel()], axis=1)
 
 
-def disc_average_operator(points: np.ndarray, weights: np.ndarray, centres: np.ndarray,
-                          radius: float) -> sp.csr_matrix:
+def disc_average_operator(points: np.ndarray, weights: np.ndarray, centres: np.ndarray, radius: float) -> sp.csr_matrix:
     """Sparse (n_centres, n_points) map from values at the quadrature points to their
     mean over the disc of `radius` [m] about each centre, cut by the plate:
     row c = w_i [|x_i - c| <= radius] / sum of those w_i, the quadrature of

@@ -9,6 +9,7 @@ numbers from here, so a figure and the table that quotes it can never disagree.
     >>> e = analysis.normalised_energies(ds)   # dict of arrays, fractions of E_shock
     >>> analysis.plate_share(ds)["peak"]       # the plate's peak share of E_shock
 """
+
 from __future__ import annotations
 
 import numpy as np

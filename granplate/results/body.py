@@ -48,6 +48,7 @@ run (nanmax) is the full route's. Where a solve per time is the cheaper route (n
 columns), or modes near the output interval's Nyquist frequency loosen the bounds, every
 block is evaluated.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -74,9 +75,18 @@ UNIT_CHUNK = 64
 
 #: name -> (units, description) of the body's variables.
 BODY_VARIABLES: dict[str, tuple[str, str]] = {
-    "max_von_mises": ("Pa", "largest von Mises stress over the body's quadrature points (modes and the static residual of the contact forces)"),
-    "max_von_mises_ball": ("Pa", "largest mean von Mises stress over a ball of radius ball_radius about a point of the body's surface, cut by the body"),
-    "max_displacement": ("m", "largest displacement magnitude over the body's nodes (modes, a free body's rigid-body motion included, and the static residual)"),
+    "max_von_mises": (
+        "Pa",
+        "largest von Mises stress over the body's quadrature points (modes and the static residual of the contact forces)",
+    ),
+    "max_von_mises_ball": (
+        "Pa",
+        "largest mean von Mises stress over a ball of radius ball_radius about a point of the body's surface, cut by the body",
+    ),
+    "max_displacement": (
+        "m",
+        "largest displacement magnitude over the body's nodes (modes, a free body's rigid-body motion included, and the static residual)",
+    ),
     "body_ux": ("m", "body nodal displacement, x (at field_time)"),
     "body_uy": ("m", "body nodal displacement, y (at field_time)"),
     "body_uz": ("m", "body nodal displacement, z (at field_time)"),
@@ -116,10 +126,15 @@ def body_operators(solid, ball_radius: float, surface: Surface | None = None) ->
         _BUILT[memo] = _BUILT.pop(memo)  # most recent last
         return _BUILT[memo]
     vb = vector_basis(solid.mesh, solid.element)
-    ops = BodyOperators(surface=boundary_surface(vb) if surface is None else surface,
-                        strain=strain_operator(vb), D=elasticity_matrix(solid.material.E, solid.material.nu),
-                        ball=ball_operator(solid.basis, surface_centres(solid.basis), ball_radius),
-                        elastic=solid.omega > 0.0, n_qp=int(solid.basis.dx.shape[1]), radius=float(ball_radius))
+    ops = BodyOperators(
+        surface=boundary_surface(vb) if surface is None else surface,
+        strain=strain_operator(vb),
+        D=elasticity_matrix(solid.material.E, solid.material.nu),
+        ball=ball_operator(solid.basis, surface_centres(solid.basis), ball_radius),
+        elastic=solid.omega > 0.0,
+        n_qp=int(solid.basis.dx.shape[1]),
+        radius=float(ball_radius),
+    )
     if memo is not None:
         _BUILT[memo] = ops
         while len(_BUILT) > BUILT_KEPT:
@@ -157,11 +172,11 @@ class StaticPart:
         if 0 < len(dofs) <= n_loaded_times and len(dofs) * self.n * 8 <= UNIT_BYTES:
             self.columns = np.empty((self.n, len(dofs)))
             for start in range(0, len(dofs), UNIT_CHUNK):
-                cols = dofs[start:start + UNIT_CHUNK]
+                cols = dofs[start : start + UNIT_CHUNK]
                 f = np.zeros((self.n, len(cols)))
                 f[cols, np.arange(len(cols))] = 1.0
                 with one_blas_thread():  # SuperLU's small blocks (solid.factor)
-                    self.columns[:, start:start + len(cols)] = self.solve(f)
+                    self.columns[:, start : start + len(cols)] = self.solve(f)
 
     def __call__(self, F: sp.csr_matrix) -> np.ndarray:
         """(n_red, n_t) G f of forces F (n_t, n_red) [N]."""
@@ -196,8 +211,9 @@ BOUND_CHUNK = 4096
 UNIT_BATCH = 32
 
 
-def coordinates(q: np.ndarray, forces: Callable, phi_e: np.ndarray, ops: BodyOperators, static: StaticPart,
-                block: int) -> np.ndarray:
+def coordinates(
+    q: np.ndarray, forces: Callable, phi_e: np.ndarray, ops: BodyOperators, static: StaticPart, block: int
+) -> np.ndarray:
     """(n_t, n_modes + |S|): each output time's coordinates c in which the body's fields are
     linear, u = [Phi, G_S] c: the effective modal coordinates q_eff and the nodal forces at
     the loaded dofs S [N] (G's columns there: `StaticPart.columns`)."""
@@ -207,10 +223,10 @@ def coordinates(q: np.ndarray, forces: Callable, phi_e: np.ndarray, ops: BodyOpe
     for start in range(0, n_t, block):
         rows = slice(start, min(start + block, n_t))
         F = forces(rows)
-        c[rows, :q.shape[1]] = q[rows]
+        c[rows, : q.shape[1]] = q[rows]
         c[rows, np.flatnonzero(ops.elastic)] -= np.asarray(F @ phi_e)
         if n_s:
-            c[rows, q.shape[1]:] = F[:, static.dofs].toarray()
+            c[rows, q.shape[1] :] = F[:, static.dofs].toarray()
     return c
 
 
@@ -222,11 +238,11 @@ def unit_peaks(solid, ops: BodyOperators, static: StaticPart, maxima: Callable) 
     n_nodes = solid.nodes.shape[0]
     out = np.empty((shapes.shape[1], 3))
     for start in range(0, shapes.shape[1], UNIT_BATCH):
-        cols = shapes[:, start:start + UNIT_BATCH]
+        cols = shapes[:, start : start + UNIT_BATCH]
         u = np.zeros((3 * n_nodes, cols.shape[1]))
         u[solid.dofs] = cols
         vm = von_mises(ops.D @ (ops.strain @ u).reshape(6, -1)).reshape(-1, cols.shape[1])
-        out[start:start + cols.shape[1]] = maxima(u.reshape(n_nodes, 3, -1), vm)
+        out[start : start + cols.shape[1]] = maxima(u.reshape(n_nodes, 3, -1), vm)
     return out
 
 
@@ -245,7 +261,7 @@ def bounded_maxima(n_t: int, block: int, exact: Callable, c: np.ndarray, peaks: 
     refs = np.arange(0, n_t, REFERENCE_STRIDE)
     if refs[-1] != n_t - 1:
         refs = np.append(refs, n_t - 1)
-    ref_values = np.vstack([exact(refs[k:k + block]) for k in range(0, len(refs), block)])
+    ref_values = np.vstack([exact(refs[k : k + block]) for k in range(0, len(refs), block)])
     at = np.searchsorted(refs, np.arange(n_t)).clip(0, len(refs) - 1)
     bound = np.full((n_t, 3), np.inf)
     for lo in range(0, n_t, BOUND_CHUNK):  # (in chunks of times: bounded memory)
@@ -269,11 +285,21 @@ def bounded_maxima(n_t: int, block: int, exact: Callable, c: np.ndarray, peaks: 
     return out
 
 
-def body_data(solid, q: np.ndarray, qd: np.ndarray, times: np.ndarray, contact_face: np.ndarray,
-              contact_xi: np.ndarray, contact_force: np.ndarray, field_stride: int, ball_radius: float,
-              summary_only: bool = False, should_stop: Callable[[], bool] | None = None,
-              operators: BodyOperators | None = None,
-              nodal_forces: Callable | None = None) -> tuple[dict[str, xr.DataArray], dict]:
+def body_data(
+    solid,
+    q: np.ndarray,
+    qd: np.ndarray,
+    times: np.ndarray,
+    contact_face: np.ndarray,
+    contact_xi: np.ndarray,
+    contact_force: np.ndarray,
+    field_stride: int,
+    ball_radius: float,
+    summary_only: bool = False,
+    should_stop: Callable[[], bool] | None = None,
+    operators: BodyOperators | None = None,
+    nodal_forces: Callable | None = None,
+) -> tuple[dict[str, xr.DataArray], dict]:
     """The body's data variables and coordinates for the result Dataset (module docstring).
 
     solid: the built solid (solid.build.SolidModel); q, qd (n_t, n_modes): the modal
@@ -339,8 +365,13 @@ def body_data(solid, q: np.ndarray, qd: np.ndarray, times: np.ndarray, contact_f
         return np.column_stack([vm.max(axis=0), ball, np.sqrt(np.einsum("nck,nck->nk", nodal, nodal)).max(axis=0)])
 
     if summary_only and (static.columns is not None or len(loaded) == 0):
-        every = bounded_maxima(n_t, B, lambda rows: maxima(*evaluate(rows)),
-                               coordinates(q, forces, phi_e, ops, static, B), unit_peaks(solid, ops, static, maxima))
+        every = bounded_maxima(
+            n_t,
+            B,
+            lambda rows: maxima(*evaluate(rows)),
+            coordinates(q, forces, phi_e, ops, static, B),
+            unit_peaks(solid, ops, static, maxima),
+        )
         vm_max, ball_max, u_max = every[:, 0], every[:, 1], every[:, 2]
         done = n_t
     else:
@@ -361,22 +392,36 @@ def body_data(solid, q: np.ndarray, qd: np.ndarray, times: np.ndarray, contact_f
             if should_stop is not None and done < n_t and should_stop():
                 break
     kept = int(np.sum(fields < done))
-    data = {"max_von_mises": _var("max_von_mises", ("time",), vm_max[:done]),
-            "max_von_mises_ball": _var("max_von_mises_ball", ("time",), ball_max[:done]),
-            "max_displacement": _var("max_displacement", ("time",), u_max[:done])}
+    data = {
+        "max_von_mises": _var("max_von_mises", ("time",), vm_max[:done]),
+        "max_von_mises_ball": _var("max_von_mises_ball", ("time",), ball_max[:done]),
+        "max_displacement": _var("max_displacement", ("time",), u_max[:done]),
+    }
     data["max_von_mises_ball"].attrs["ball_radius"] = float(ball_radius)
     if summary_only:
         return data, {}
     for c, axis in enumerate("xyz"):
         data[f"body_u{axis}"] = _var(f"body_u{axis}", ("field_time", "body_node"), u_field[:kept, :, c].copy())
     data["body_von_mises"] = _var("body_von_mises", ("field_time", "body_element"), vm_field[:kept])
-    coords = {"field_time": ("field_time", np.asarray(times, float)[fields[:kept]],
-                             {"units": "s", "long_name": "time of the body field snapshots"})}
+    coords = {
+        "field_time": (
+            "field_time",
+            np.asarray(times, float)[fields[:kept]],
+            {"units": "s", "long_name": "time of the body field snapshots"},
+        )
+    }
     for c, axis in enumerate("xyz"):
-        coords[f"body_node_{axis}"] = ("body_node", solid.nodes[:, c].copy(),
-                                       {"units": "m", "long_name": f"body node {axis}"})
-    coords["body_element_nodes"] = (("body_element", "body_element_node"), vtk_connectivity(solid.basis, solid.element),
-                                    {"long_name": f"body element nodes in VTK order (meshio cell type "
-                                                  f"{MESHIO_CELLS[solid.element]})",
-                                     "cell_type": MESHIO_CELLS[solid.element]})
+        coords[f"body_node_{axis}"] = (
+            "body_node",
+            solid.nodes[:, c].copy(),
+            {"units": "m", "long_name": f"body node {axis}"},
+        )
+    coords["body_element_nodes"] = (
+        ("body_element", "body_element_node"),
+        vtk_connectivity(solid.basis, solid.element),
+        {
+            "long_name": f"body element nodes in VTK order (meshio cell type {MESHIO_CELLS[solid.element]})",
+            "cell_type": MESHIO_CELLS[solid.element],
+        },
+    )
     return data, coords

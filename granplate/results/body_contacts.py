@@ -3,6 +3,7 @@
 contact pass (solver.body.replay): which face each granule touches and where, the force
 on the body and its normal magnitude. What the body's fields (results.body) spread as
 static loads, and the Dataset's per-granule contact records."""
+
 from __future__ import annotations
 
 from typing import NamedTuple
@@ -27,13 +28,27 @@ def body_contacts(model, y: np.ndarray, q: np.ndarray, qd: np.ndarray) -> BodyCo
     from granplate.solver.body import replay
 
     nt, ng = y.shape[0], y.shape[1]
-    out = BodyContacts(face=np.full((nt, ng), -1, np.int64), xi=np.zeros((nt, ng, 2)),
-                       force=np.zeros((nt, ng, 3)), normal=np.zeros((nt, ng)))
+    out = BodyContacts(
+        face=np.full((nt, ng), -1, np.int64),
+        xi=np.zeros((nt, ng, 2)),
+        force=np.zeros((nt, ng, 3)),
+        normal=np.zeros((nt, ng)),
+    )
     if nt and ng:
         b = new_body_state(model.body)
-        replay(np.ascontiguousarray(y), np.ascontiguousarray(q), np.ascontiguousarray(qd), b,
-               model.granular.radius, model.granular.mass, model.config.clip, out.face, out.xi, out.force,
-               out.normal)
+        replay(
+            np.ascontiguousarray(y),
+            np.ascontiguousarray(q),
+            np.ascontiguousarray(qd),
+            b,
+            model.granular.radius,
+            model.granular.mass,
+            model.config.clip,
+            out.face,
+            out.xi,
+            out.force,
+            out.normal,
+        )
     return out
 
 
@@ -68,12 +83,24 @@ def patch_forces(model, c: BodyContacts):
 def contact_variables(c: BodyContacts) -> dict[str, xr.DataArray]:
     """The Dataset's records of the body's contacts."""
     return {
-        "body_contact_normal_force": xr.DataArray(c.normal, dims=("time", "granule"), attrs={
-            "units": "N", "long_name": "normal force of each granule's contact on the elastic body (0: none)"}),
-        "body_contact_force": xr.DataArray(c.force, dims=("time", "granule", "component"), attrs={
-            "units": "N", "long_name": "force on the elastic body at each granule's contact (x, y, z)"}),
-        "body_contact_face": xr.DataArray(c.face, dims=("time", "granule"), attrs={
-            "long_name": "boundary face each granule touches (solid.surface order; -1: none)"}),
-        "body_contact_xi": xr.DataArray(c.xi, dims=("time", "granule", "face_coordinate"), attrs={
-            "long_name": "the contact point's reference coordinates on its face"}),
+        "body_contact_normal_force": xr.DataArray(
+            c.normal,
+            dims=("time", "granule"),
+            attrs={"units": "N", "long_name": "normal force of each granule's contact on the elastic body (0: none)"},
+        ),
+        "body_contact_force": xr.DataArray(
+            c.force,
+            dims=("time", "granule", "component"),
+            attrs={"units": "N", "long_name": "force on the elastic body at each granule's contact (x, y, z)"},
+        ),
+        "body_contact_face": xr.DataArray(
+            c.face,
+            dims=("time", "granule"),
+            attrs={"long_name": "boundary face each granule touches (solid.surface order; -1: none)"},
+        ),
+        "body_contact_xi": xr.DataArray(
+            c.xi,
+            dims=("time", "granule", "face_coordinate"),
+            attrs={"long_name": "the contact point's reference coordinates on its face"},
+        ),
     }

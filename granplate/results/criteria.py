@@ -12,6 +12,7 @@ A *check* is one number of ours against a reference under a criterion: a verific
 case's comparison with a closed form, or a statement of the paper with our value
 (granplate.paper.statements). Both are rendered by granplate.results.document.
 """
+
 from __future__ import annotations
 
 import math
@@ -329,9 +330,18 @@ class Check:
 
     def as_dict(self) -> dict:
         """Plain dict (for JSON): the fields, kind, tolerance, error and passed."""
-        return {"quantity": self.quantity, "unit": self.unit, "reference": self.reference,
-                "source": self.source, "ours": self.ours, "tolerance": self.tolerance, "why": self.why,
-                "kind": self.kind, "error": float(self.error), "passed": bool(self.passed)}
+        return {
+            "quantity": self.quantity,
+            "unit": self.unit,
+            "reference": self.reference,
+            "source": self.source,
+            "ours": self.ours,
+            "tolerance": self.tolerance,
+            "why": self.why,
+            "kind": self.kind,
+            "error": float(self.error),
+            "passed": bool(self.passed),
+        }
 
 
 def criterion_of_kind(kind: str, tolerance: float) -> Criterion:

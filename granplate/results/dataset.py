@@ -3,6 +3,7 @@
 Every name is documented in docs/output.md. The scenario (as TOML), the package version
 and the solver's figures travel in the attributes, so any figure can be traced back.
 """
+
 from __future__ import annotations
 
 import json
@@ -34,14 +35,26 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "omega_y": ("rad/s", "granule spin vector, y component (dimension = 3)"),
     "omega_z": ("rad/s", "granule spin vector, z component (dimension = 3)"),
     "E_shock": ("J", "work of the applied shock, int sum(F_i vx_i + tau_i omega_i) dt or int F.dx/dt (bare plate)"),
-    "E_granular": ("J", "granular energy E_g: kinetic (translation, rotation) + 2/5 A delta^5/2 of every granule, wall and plate contact (eq. 9)"),
+    "E_granular": (
+        "J",
+        "granular energy E_g: kinetic (translation, rotation) + 2/5 A delta^5/2 of every granule, wall and plate contact (eq. 9)",
+    ),
     "E_plate": ("J", "plate energy E_p = 1/2 v^T M v + 1/2 x^T K x (eq. 9)"),
     "D_viscous": ("J", "energy dissipated by the damping part of the normal forces (eq. 10)"),
     "D_friction": ("J", "energy dissipated by friction (eq. 10)"),
     "D_plastic": ("J", "plastic work of the contacts that yield (docs/model.md eq. P10; 0 under Hertz's law)"),
-    "pair_max_contact_pressure": ("Pa", "largest Hertz peak pressure p0 = (2/pi) E* sqrt(delta/R*) over the pair's contacts and the run (docs/model.md eq. P2)"),
-    "pair_yield_onset_ratio": ("1", "that p0 over the yield onset 1.6 Y of the softer body (eq. P1); NaN where Y is unknown"),
-    "pair_yield_strength": ("Pa", "Y of the softer body of the pair (a wall or the plate's face: the granule's); NaN where unknown"),
+    "pair_max_contact_pressure": (
+        "Pa",
+        "largest Hertz peak pressure p0 = (2/pi) E* sqrt(delta/R*) over the pair's contacts and the run (docs/model.md eq. P2)",
+    ),
+    "pair_yield_onset_ratio": (
+        "1",
+        "that p0 over the yield onset 1.6 Y of the softer body (eq. P1); NaN where Y is unknown",
+    ),
+    "pair_yield_strength": (
+        "Pa",
+        "Y of the softer body of the pair (a wall or the plate's face: the granule's); NaN where unknown",
+    ),
     "pair_max_pressure_time": ("s", "when the contact of that largest p0 reached its largest overlap"),
     "pair_max_pressure_contact": ("1", "that contact: granule labels, or a granule and 'wall w' / 'plate'"),
     "pair_normal_law": ("1", "the pair's normal law (contact.normal_law: hertz, thornton or johnson)"),
@@ -50,10 +63,16 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "KE_vertical": ("J", "granular kinetic energy, vertical translation"),
     "KE_rotational": ("J", "granular kinetic energy, rotation"),
     "KE_depth": ("J", "granular kinetic energy, translation along z (dimension = 3)"),
-    "energy_residual": ("1", "(E_p + E_g + D - E_shock - E_initial) / max over past times of (E_shock + E_initial), eq. 11"),
+    "energy_residual": (
+        "1",
+        "(E_p + E_g + D - E_shock - E_initial) / max over past times of (E_shock + E_initial), eq. 11",
+    ),
     "energy_residual_max": ("1", "largest |energy_residual| over the steps since the previous output"),
     "max_von_mises": ("Pa", "maximum over the plate's quadrature points of the plane-stress von Mises stress (eq. 12)"),
-    "max_von_mises_disc": ("Pa", "largest von Mises stress averaged over a disc of radius plate.stress_radius (eq. 12, docs/model.md section 4.4)"),
+    "max_von_mises_disc": (
+        "Pa",
+        "largest von Mises stress averaged over a disc of radius plate.stress_radius (eq. 12, docs/model.md section 4.4)",
+    ),
     "max_eps_yy": ("1", "maximum over the plate's quadrature points of |eps_yy|"),
     "plate_vx_symmetry": ("m/s", "plate horizontal velocity along the symmetry line y = y0 + height/2"),
     "body_q": ("kg^1/2 m", "the elastic body's modal coordinates (M-orthonormal modes; dimension = 3)"),
@@ -75,7 +94,10 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "wall_force": ("N", "normal force each wall receives from the granules (positive in compression)"),
     "drive_force": ("N", "force each drive applies on its wall or granule along its direction"),
     "drive_displacement": ("m", "displacement of each drive's wall or granule along its direction since t = 0"),
-    "contact_time_formed": ("s", "time each plate contact formed: 0 for those at t = 0, a patch contact's when its granule came within contact.skin R of the face"),
+    "contact_time_formed": (
+        "s",
+        "time each plate contact formed: 0 for those at t = 0, a patch contact's when its granule came within contact.skin R of the face",
+    ),
 }
 
 
@@ -143,9 +165,16 @@ class _Bar:
             self.bar.close()
 
 
-def plate_fields(model, q: np.ndarray, qd: np.ndarray, times: np.ndarray,
-                 force: np.ndarray | None = None, should_stop: Callable[[], bool] | None = None,
-                 progress: bool = False, plate=None) -> tuple[dict[str, Any], int]:
+def plate_fields(
+    model,
+    q: np.ndarray,
+    qd: np.ndarray,
+    times: np.ndarray,
+    force: np.ndarray | None = None,
+    should_stop: Callable[[], bool] | None = None,
+    progress: bool = False,
+    plate=None,
+) -> tuple[dict[str, Any], int]:
     """Plate outputs computed from the modal coordinates after the run, and the number of
     output times they cover; force (time, 2 n_contacts) [N]: the contact forces on the
     plate, whose static part a truncated basis adds to the displacements and stresses
@@ -207,9 +236,20 @@ def plate_fields(model, q: np.ndarray, qd: np.ndarray, times: np.ndarray,
 
 #: What a summary-only Dataset holds (`to_dataset(..., summary_only=True)`): what
 #: `summary` and the studies' metrics read.
-SUMMARY_VARIABLES = ("E_shock", "E_granular", "E_plate", "D_viscous", "D_friction", "D_plastic",
-                     "energy_residual_max", "max_von_mises", "max_von_mises_disc", "max_eps_yy",
-                     "max_von_mises_ball", "max_displacement")
+SUMMARY_VARIABLES = (
+    "E_shock",
+    "E_granular",
+    "E_plate",
+    "D_viscous",
+    "D_friction",
+    "D_plastic",
+    "energy_residual_max",
+    "max_von_mises",
+    "max_von_mises_disc",
+    "max_eps_yy",
+    "max_von_mises_ball",
+    "max_displacement",
+)
 
 
 class RunContacts(NamedTuple):
@@ -237,9 +277,16 @@ def run_contacts(model, contacts=None) -> RunContacts:
     return RunContacts(granule=granule, y=y, time_formed=t, plate=plate)
 
 
-def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = False,
-               contacts=None, should_stop: Callable[[], bool] | None = None,
-               progress: bool = False) -> xr.Dataset:
+def to_dataset(
+    model,
+    out: K.Output,
+    n: int,
+    info: dict,
+    summary_only: bool = False,
+    contacts=None,
+    should_stop: Callable[[], bool] | None = None,
+    progress: bool = False,
+) -> xr.Dataset:
     """Build the result Dataset from the first n output rows.
 
     summary_only: only the variables `summary` reads (SUMMARY_VARIABLES, the time and
@@ -263,20 +310,29 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
             for col, name in enumerate(("max_von_mises", "max_von_mises_disc", "max_eps_yy")):
                 plate_data[name] = _var(name, ("time",), every[:, col].copy())
         else:
-            plate_data, n_done = plate_fields(model, out.q[:n], out.qd[:n], out.t[:n], force,
-                                              should_stop=should_stop, progress=progress, plate=axis.plate)
+            plate_data, n_done = plate_fields(
+                model,
+                out.q[:n],
+                out.qd[:n],
+                out.t[:n],
+                force,
+                should_stop=should_stop,
+                progress=progress,
+                plate=axis.plate,
+            )
             if n_done < n:
                 n = n_done
-                info = {**info, "status": f"{INTERRUPTED_STATUS} at t = {out.t[n - 1]:.6e} s, "
-                                          "while building the result."}
+                info = {
+                    **info,
+                    "status": f"{INTERRUPTED_STATUS} at t = {out.t[n - 1]:.6e} s, while building the result.",
+                }
     body_data: dict[str, xr.DataArray] = {}
     body_coords: dict = {}
     if model.solid is not None:
         body_data, body_coords, n_done = body_outputs(model, out, n, summary_only, should_stop)
         if n_done < n:
             n = n_done
-            info = {**info, "status": f"{INTERRUPTED_STATUS} at t = {out.t[n - 1]:.6e} s, "
-                                      "while building the result."}
+            info = {**info, "status": f"{INTERRUPTED_STATUS} at t = {out.t[n - 1]:.6e} s, while building the result."}
     t = out.t[:n].copy()
     y = out.y[:n]
     e = out.energy[:n]
@@ -285,10 +341,19 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
         for c, name in enumerate(STATE_VARIABLES[y.shape[2]]):
             data[name] = _var(name, ("time", "granule"), y[:, :, c].copy())
     for col, name in (
-        (K.E_SHOCK, "E_shock"), (K.E_GRAN, "E_granular"), (K.E_PLATE, "E_plate"),
-        (K.D_VISC, "D_viscous"), (K.D_FRIC, "D_friction"), (K.D_PLASTIC, "D_plastic"), (K.E_POTG, "E_contact"),
-        (K.KE_X, "KE_horizontal"), (K.KE_Y, "KE_vertical"), (K.KE_ROT, "KE_rotational"),
-        (K.RESID, "energy_residual"), (K.RESID_MAX, "energy_residual_max"), (K.KE_Z, "KE_depth"),
+        (K.E_SHOCK, "E_shock"),
+        (K.E_GRAN, "E_granular"),
+        (K.E_PLATE, "E_plate"),
+        (K.D_VISC, "D_viscous"),
+        (K.D_FRIC, "D_friction"),
+        (K.D_PLASTIC, "D_plastic"),
+        (K.E_POTG, "E_contact"),
+        (K.KE_X, "KE_horizontal"),
+        (K.KE_Y, "KE_vertical"),
+        (K.KE_ROT, "KE_rotational"),
+        (K.RESID, "energy_residual"),
+        (K.RESID_MAX, "energy_residual_max"),
+        (K.KE_Z, "KE_depth"),
     ):
         if name == "KE_depth" and y.shape[2] != 9:  # (in space only)
             continue
@@ -302,20 +367,40 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
     coords = {
         "time": ("time", t, {"units": "s", "long_name": "time"}),
         "granule": ("granule", np.array(model.labels, dtype=str), {"long_name": "granule label (paper numbering)"}),
-        **({} if summary_only else {"contact": ("contact", np.array([model.labels[i] for i in axis.granule], dtype=str),
-                                                {"long_name": "granule at each plate contact"})}),
+        **(
+            {}
+            if summary_only
+            else {
+                "contact": (
+                    "contact",
+                    np.array([model.labels[i] for i in axis.granule], dtype=str),
+                    {"long_name": "granule at each plate contact"},
+                )
+            }
+        ),
         "radius": ("granule", model.granular.radius.copy(), {"units": "m", "long_name": "granule radius"}),
         "mass": ("granule", model.granular.mass.copy(), {"units": "kg", "long_name": "granule mass"}),
-        "material": ("granule", np.array([g.material for g in s.granules], dtype=str), {"long_name": "granule material"}),
+        "material": (
+            "granule",
+            np.array([g.material for g in s.granules], dtype=str),
+            {"long_name": "granule material"},
+        ),
     }
     py = pair_yield(model, contacts.peaks) if contacts is not None and contacts.peaks is not None else None
     if py is not None:
-        coords["material_pair"] = ("material_pair", np.array(py.pair, dtype=str),
-                                   {"long_name": "material pair of contacts (docs/model.md section 3.6)"})
-        for name, values in (("pair_max_contact_pressure", py.pressure), ("pair_yield_onset_ratio", py.ratio),
-                             ("pair_yield_strength", py.yield_strength), ("pair_max_pressure_time", py.time),
-                             ("pair_max_pressure_contact", np.array(py.contact, dtype=str)),
-                             ("pair_normal_law", np.array(py.law, dtype=str))):
+        coords["material_pair"] = (
+            "material_pair",
+            np.array(py.pair, dtype=str),
+            {"long_name": "material pair of contacts (docs/model.md section 3.6)"},
+        )
+        for name, values in (
+            ("pair_max_contact_pressure", py.pressure),
+            ("pair_yield_onset_ratio", py.ratio),
+            ("pair_yield_strength", py.yield_strength),
+            ("pair_max_pressure_time", py.time),
+            ("pair_max_pressure_contact", np.array(py.contact, dtype=str)),
+            ("pair_normal_law", np.array(py.law, dtype=str)),
+        ):
             data[name] = _var(name, ("material_pair",), values)
         p_max, ratio = largest(py)
         info = {**info, "max_contact_pressure": p_max, "yield_onset_ratio": ratio}
@@ -343,9 +428,21 @@ def to_dataset(model, out: K.Output, n: int, info: dict, summary_only: bool = Fa
         coords["field_time"] = ("field_time", ft, {"units": "s", "long_name": "time of the plate field snapshots"})
         coords["node_x"] = ("node", plate.node_xy[:, 0].copy(), {"units": "m", "long_name": "plate node x"})
         coords["node_y"] = ("node", plate.node_xy[:, 1].copy(), {"units": "m", "long_name": "plate node y"})
-        coords["x_symmetry"] = ("x_symmetry", plate.node_xy[np.asarray(plate.symmetry_nodes), 0].copy(), {"units": "m", "long_name": "x along the plate's symmetry line"})
-        data["element_nodes"] = xr.DataArray(np.asarray(plate.elements, np.int64), dims=("element", "element_node"), attrs={"long_name": "plate element connectivity (VTK quadratic quad order)"})
-        data["contact_y"] = xr.DataArray(np.asarray(plate.contact_y, float), dims=("contact",), attrs={"units": "m", "long_name": "y of each plate contact"})
+        coords["x_symmetry"] = (
+            "x_symmetry",
+            plate.node_xy[np.asarray(plate.symmetry_nodes), 0].copy(),
+            {"units": "m", "long_name": "x along the plate's symmetry line"},
+        )
+        data["element_nodes"] = xr.DataArray(
+            np.asarray(plate.elements, np.int64),
+            dims=("element", "element_node"),
+            attrs={"long_name": "plate element connectivity (VTK quadratic quad order)"},
+        )
+        data["contact_y"] = xr.DataArray(
+            np.asarray(plate.contact_y, float),
+            dims=("contact",),
+            attrs={"units": "m", "long_name": "y of each plate contact"},
+        )
     ds = xr.Dataset(data, coords=coords)
     if nk == 0:
         ds = ds.drop_dims("contact", errors="ignore")
@@ -363,8 +460,9 @@ def stress_ball_radius(model) -> float:
     return 0.25 * float((nodes.max(axis=0) - nodes.min(axis=0)).min())
 
 
-def body_outputs(model, out: K.Output, n: int, summary_only: bool,
-                 should_stop: Callable[[], bool] | None = None) -> tuple[dict[str, xr.DataArray], dict, int]:
+def body_outputs(
+    model, out: K.Output, n: int, summary_only: bool, should_stop: Callable[[], bool] | None = None
+) -> tuple[dict[str, xr.DataArray], dict, int]:
     """An elastic body's outputs in space (docs/output.md): its contacts at the output
     times (results.body_contacts), its modal coordinates and, from them and the contacts'
     static loads, its fields (results.body.body_data); and the output times they cover
@@ -375,16 +473,30 @@ def body_outputs(model, out: K.Output, n: int, summary_only: bool,
     contacts = body_contacts(model, out.y[:n], out.q[:n], out.qd[:n])
     s = model.scenario
     stride = max(1, int(round(s.time.field_interval / s.time.output_interval)))
-    data, coords = body_data(model.solid, out.q[:n], out.qd[:n], out.t[:n], contacts.face, contacts.xi,
-                             contacts.force, stride, stress_ball_radius(model), summary_only=summary_only,
-                             should_stop=should_stop, nodal_forces=patch_forces(model, contacts))
+    data, coords = body_data(
+        model.solid,
+        out.q[:n],
+        out.qd[:n],
+        out.t[:n],
+        contacts.face,
+        contacts.xi,
+        contacts.force,
+        stride,
+        stress_ball_radius(model),
+        summary_only=summary_only,
+        should_stop=should_stop,
+        nodal_forces=patch_forces(model, contacts),
+    )
     n_done = data["max_von_mises"].shape[0] if "max_von_mises" in data else n
     if not summary_only:
         data.update({k: v[:n_done] for k, v in contact_variables(contacts).items()})
         data["body_q"] = _var("body_q", ("time", "mode"), out.q[:n_done].copy())
         data["body_qd"] = _var("body_qd", ("time", "mode"), out.qd[:n_done].copy())
-        coords["mode_frequency"] = ("mode", model.solid.frequencies.copy(),
-                                    {"units": "Hz", "long_name": "the elastic body's natural frequencies"})
+        coords["mode_frequency"] = (
+            "mode",
+            model.solid.frequencies.copy(),
+            {"units": "Hz", "long_name": "the elastic body's natural frequencies"},
+        )
     return data, coords, n_done
 
 
@@ -432,13 +544,29 @@ def read(path: str | Path) -> xr.Dataset:
 #: Unit of every number in `summary` ("1": a pure number; the *_fraction values are
 #: fractions of e_in = e_shock + e_initial).
 SUMMARY_UNITS: dict[str, object] = {
-    "t_end": "s", "e_shock": "J", "e_load_taken": "J", "e_initial": "J", "e_in": "J",
-    "ep_max_fraction": "1", "ep_final_fraction": "1", "eg_max_fraction": "1",
-    "eg_final_fraction": "1", "dissipated_fraction": "1",
-    "plastic_fraction": "1", "max_contact_pressure": "Pa", "yield_onset_ratio": "1",
+    "t_end": "s",
+    "e_shock": "J",
+    "e_load_taken": "J",
+    "e_initial": "J",
+    "e_in": "J",
+    "ep_max_fraction": "1",
+    "ep_final_fraction": "1",
+    "eg_max_fraction": "1",
+    "eg_final_fraction": "1",
+    "dissipated_fraction": "1",
+    "plastic_fraction": "1",
+    "max_contact_pressure": "Pa",
+    "yield_onset_ratio": "1",
     "contact_pairs": {"max_contact_pressure": "Pa", "yield_onset_ratio": "1", "yield_strength": "Pa", "time": "s"},
-    "max_von_mises": "Pa", "max_von_mises_disc": "Pa", "max_eps_yy": "1", "energy_residual_max": "1",
-    "n_steps": "1", "wall_time_s": "s", "compile_time_s": "s", "max_von_mises_ball": "Pa", "max_displacement": "m",
+    "max_von_mises": "Pa",
+    "max_von_mises_disc": "Pa",
+    "max_eps_yy": "1",
+    "energy_residual_max": "1",
+    "n_steps": "1",
+    "wall_time_s": "s",
+    "compile_time_s": "s",
+    "max_von_mises_ball": "Pa",
+    "max_displacement": "m",
 }
 
 
@@ -449,12 +577,18 @@ def wall_and_drive_outputs(model, out: K.Output, n: int, coords: dict) -> dict[s
     s = model.scenario
     data: dict[str, xr.DataArray] = {}
     if s.walls:
-        coords["wall"] = ("wall", np.array([w.label or f"wall {k + 1}" for k, w in enumerate(s.walls)], dtype=str),
-                          {"long_name": "wall label"})
+        coords["wall"] = (
+            "wall",
+            np.array([w.label or f"wall {k + 1}" for k, w in enumerate(s.walls)], dtype=str),
+            {"long_name": "wall label"},
+        )
         data["wall_force"] = _var("wall_force", ("time", "wall"), out.wall_force[:n].copy())
     if s.drives:
-        coords["drive"] = ("drive", np.array([d.name for d in s.drives], dtype=str),
-                           {"long_name": "drive (its label, or its target)"})
+        coords["drive"] = (
+            "drive",
+            np.array([d.name for d in s.drives], dtype=str),
+            {"long_name": "drive (its label, or its target)"},
+        )
         data["drive_force"] = _var("drive_force", ("time", "drive"), out.drive[:n, :, 0].copy())
         data["drive_displacement"] = _var("drive_displacement", ("time", "drive"), out.drive[:n, :, 1].copy())
     return data
@@ -509,8 +643,9 @@ def summary(ds: xr.Dataset) -> dict:
         "yield_onset_ratio": _finite(ds.attrs.get("yield_onset_ratio")),
         "contact_pairs": pair_table(ds),
         "max_von_mises": float(ds.max_von_mises.max()) if has_plate else None,
-        "max_von_mises_disc": (float(ds.max_von_mises_disc.max())
-                               if has_plate and "max_von_mises_disc" in ds else None),
+        "max_von_mises_disc": (
+            float(ds.max_von_mises_disc.max()) if has_plate and "max_von_mises_disc" in ds else None
+        ),
         "max_eps_yy": float(ds.max_eps_yy.max()) if has_plate and "max_eps_yy" in ds else None,
         "energy_residual_max": float(np.max(np.abs(ds.energy_residual_max))),
         "n_steps": int(info.get("n_steps", 0)),
@@ -537,13 +672,18 @@ def pair_table(ds: xr.Dataset) -> list[dict]:
     time [s], contact, normal_law); empty for a result without them."""
     if "material_pair" not in ds.coords:
         return []
-    return [{"pair": str(ds.material_pair.values[k]),
-             "max_contact_pressure": float(ds.pair_max_contact_pressure.values[k]),
-             "yield_onset_ratio": _finite(ds.pair_yield_onset_ratio.values[k]),
-             "yield_strength": _finite(ds.pair_yield_strength.values[k]),
-             "time": float(ds.pair_max_pressure_time.values[k]),
-             "contact": str(ds.pair_max_pressure_contact.values[k]),
-             "normal_law": str(ds.pair_normal_law.values[k])} for k in range(ds.sizes["material_pair"])]
+    return [
+        {
+            "pair": str(ds.material_pair.values[k]),
+            "max_contact_pressure": float(ds.pair_max_contact_pressure.values[k]),
+            "yield_onset_ratio": _finite(ds.pair_yield_onset_ratio.values[k]),
+            "yield_strength": _finite(ds.pair_yield_strength.values[k]),
+            "time": float(ds.pair_max_pressure_time.values[k]),
+            "contact": str(ds.pair_max_pressure_contact.values[k]),
+            "normal_law": str(ds.pair_normal_law.values[k]),
+        }
+        for k in range(ds.sizes["material_pair"])
+    ]
 
 
 def scenario_of(ds: xr.Dataset):
@@ -556,6 +696,7 @@ def scenario_of(ds: xr.Dataset):
 
     text = ds.attrs.get("scenario_toml")
     if not text:
-        raise ScenarioError("result attribute scenario_toml", None,
-                            "missing: not a result written by granplate.simulate")
+        raise ScenarioError(
+            "result attribute scenario_toml", None, "missing: not a result written by granplate.simulate"
+        )
     return loads(str(text))

@@ -15,6 +15,7 @@ key figures as cards; a "details" block is a summary line whose content opens on
     ...           Block("table", header=("a", "b"), rows=(("1", "2"),))]
     >>> to_markdown(blocks, Path("."))
 """
+
 from __future__ import annotations
 
 import base64
@@ -277,8 +278,10 @@ def _html_summary(b: Block) -> str:
     for c in b.rows:
         tone = c[2] if len(c) > 2 and c[2] in ("yes", "no") else ""
         cls = f"card {tone}" if tone else "card"
-        cards.append(f"<div class='{cls}'><span class='value'>{_html_inline(c[0])}</span>"
-                     f"<span class='label'>{_html_inline(c[1])}</span></div>")
+        cards.append(
+            f"<div class='{cls}'><span class='value'>{_html_inline(c[0])}</span>"
+            f"<span class='label'>{_html_inline(c[1])}</span></div>"
+        )
     headline = f"<p class='headline'>{_html_inline(b.text)}</p>" if b.text else ""
     return f"<section class='summary'>{headline}<div class='cards'>{''.join(cards)}</div></section>"
 
@@ -299,8 +302,10 @@ def _html_media(b: Block, base: Path, embed: bool, embed_limit: int) -> str:
         return f"<p><a href='{html.escape(_relative(p, base))}'>{alt}</a></p>"
     data = base64.b64encode(p.read_bytes()).decode("ascii")
     if b.kind == "media" and p.suffix.lower() != ".gif":
-        return (f"<figure><video controls loop src='data:video/mp4;base64,{data}'></video>"
-                f"<figcaption>{alt}</figcaption></figure>")
+        return (
+            f"<figure><video controls loop src='data:video/mp4;base64,{data}'></video>"
+            f"<figcaption>{alt}</figcaption></figure>"
+        )
     mime = "image/gif" if p.suffix.lower() == ".gif" else "image/png"
     caption = _html_inline(b.text) if b.kind == "figure" else alt
     return f"<figure><img alt='{alt}' src='data:{mime};base64,{data}'><figcaption>{caption}</figcaption></figure>"
@@ -339,11 +344,14 @@ def _html_block(b: Block, base: Path, embed: bool, embed_limit: int) -> str:
 def to_html(blocks: list[Block], base: Path, embed: bool = True, embed_limit: int = 20_000_000) -> str:
     """Render blocks as one HTML page; figures and animations embedded when `embed`
     (animations over embed_limit bytes are linked), else linked relative to `base`."""
-    parts = ["<!DOCTYPE html>", "<html lang='en'><head><meta charset='utf-8'>",
-             f"<title>{html.escape(blocks[0].text if blocks else 'granplate report')}</title>",
-             "<meta name='viewport' content='width=device-width, initial-scale=1'>",
-             "<link rel='icon' href='data:,'>",
-             f"<style>{_CSS}</style></head><body>"]
+    parts = [
+        "<!DOCTYPE html>",
+        "<html lang='en'><head><meta charset='utf-8'>",
+        f"<title>{html.escape(blocks[0].text if blocks else 'granplate report')}</title>",
+        "<meta name='viewport' content='width=device-width, initial-scale=1'>",
+        "<link rel='icon' href='data:,'>",
+        f"<style>{_CSS}</style></head><body>",
+    ]
     parts += [h for h in (_html_block(b, base, embed, embed_limit) for b in blocks) if h]
     parts.append(f"<script>{TABLE_SCRIPT}</script>")
     parts.append("</body></html>")

@@ -16,6 +16,7 @@ Tasks are pure functions of plain data (a scenario's TOML text in, a summary or 
 path out); callers gather them with `distributed.as_completed` and write each result as
 it arrives, so an interruption loses only the tasks in flight.
 """
+
 from __future__ import annotations
 
 import logging
@@ -72,8 +73,9 @@ def dask_client(workers: int | None = None, scheduler: str | None = None) -> Ite
     # heartbeat as an error with a traceback; a design's own failure is its record's status,
     # and a task that does not come back is reported as lost by the sweep.
     with sigint_ignored():
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.CRITICAL)
+        cluster = LocalCluster(
+            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=logging.CRITICAL
+        )
     try:
         with Client(cluster) as client:
             yield client
@@ -108,8 +110,10 @@ def warm_workers(client, scenario_tomls: list[str]) -> float:
     for group in (first, rest):
         # asked of its worker, not bound to it: a worker lost while warming up must not
         # leave a task that waits for it forever
-        futures = [client.submit(warm_up, list(scenario_tomls), workers=[w], allow_other_workers=True,
-                                 pure=False) for w in group]
+        futures = [
+            client.submit(warm_up, list(scenario_tomls), workers=[w], allow_other_workers=True, pure=False)
+            for w in group
+        ]
         client.gather(futures, errors="skip")
         for f in futures:
             f.release()

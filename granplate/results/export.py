@@ -36,6 +36,7 @@ coordinates [m], with point data ``displacement`` (3 components) [m] and cell da
 ``spheres_NNNN.vtu`` at the output nearest each snapshot; ``NAME.pvd`` holds both per
 time (part 0 = body, part 1 = spheres), ``NAME-body.pvd`` and ``NAME-spheres.pvd`` each.
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -59,7 +60,8 @@ def plate_mesh(ds: xr.Dataset, k: int) -> meshio.Mesh:
     u = _points3(ds["plate_ux"].values[k], ds["plate_uy"].values[k])
     cells = [("quad8", np.asarray(ds["element_nodes"].values, dtype=np.int64))]
     return meshio.Mesh(
-        pts, cells,
+        pts,
+        cells,
         point_data={"displacement": u},
         cell_data={"von_mises": [np.asarray(ds["plate_von_mises"].values[k], dtype=float)]},
     )
@@ -128,8 +130,12 @@ def body_mesh(ds: xr.Dataset, k: int) -> meshio.Mesh:
     pts = np.column_stack([ds[f"body_node_{c}"].values for c in "xyz"]).astype(float)
     u = np.column_stack([ds[f"body_u{c}"].values[k] for c in "xyz"]).astype(float)
     cells = np.asarray(ds["body_element_nodes"].values, dtype=np.int64)
-    return meshio.Mesh(pts, [(BODY_CELLS[cells.shape[1]], cells)], point_data={"displacement": u},
-                       cell_data={"von_mises": [np.asarray(ds["body_von_mises"].values[k], dtype=float)]})
+    return meshio.Mesh(
+        pts,
+        [(BODY_CELLS[cells.shape[1]], cells)],
+        point_data={"displacement": u},
+        cell_data={"von_mises": [np.asarray(ds["body_von_mises"].values[k], dtype=float)]},
+    )
 
 
 def export_body(ds: xr.Dataset, out_dir: str | Path, name: str | None = None) -> Path:
@@ -176,8 +182,7 @@ def export_spheres(ds: xr.Dataset, out_dir: str | Path, name: str | None = None)
 def pvd_text(entries: list[tuple[float, int, str]]) -> str:
     """A ParaView collection file listing (time [s], part, file name) entries."""
     rows = "\n".join(
-        f'    <DataSet timestep="{t!r}" group="" part="{part}" file={quoteattr(name)}/>'
-        for t, part, name in entries
+        f'    <DataSet timestep="{t!r}" group="" part="{part}" file={quoteattr(name)}/>' for t, part, name in entries
     )
     return (
         '<?xml version="1.0"?>\n'

@@ -8,6 +8,7 @@ result need. Each `KernelSet` is one such pair with the short runs that compile 
 line each with the measured estimate (solver/compile_seconds.json), corrected as it goes
 by how this machine compares with the one measured. `measure` writes that file.
 """
+
 from __future__ import annotations
 
 import json
@@ -20,8 +21,14 @@ from pathlib import Path
 from typing import Callable
 
 from granplate.setup.scenario import Scenario
-from granplate.solver.compiling import (compile_clock, compile_seconds, compiled_loops, describe_seconds,
-                                        machine_slowdown, set_name)
+from granplate.solver.compiling import (
+    compile_clock,
+    compile_seconds,
+    compiled_loops,
+    describe_seconds,
+    machine_slowdown,
+    set_name,
+)
 
 log = logging.getLogger(__name__)
 
@@ -43,8 +50,11 @@ def _plane_granules(scheme: str) -> list[Scenario]:
     from granplate.setup.presets import preset
 
     if scheme == "verlet":  # the granules alone
-        return [with_changes(preset("steel-r1"), {"plate": None, "solver.scheme": "verlet",
-                                                  "solver.granular_friction": "split"})]
+        return [
+            with_changes(
+                preset("steel-r1"), {"plate": None, "solver.scheme": "verlet", "solver.granular_friction": "split"}
+            )
+        ]
     return [with_changes(preset("steel-r1"), {"solver.scheme": scheme})]
 
 
@@ -144,8 +154,9 @@ def compile_set(kernels: KernelSet) -> tuple[float, float]:
     return clock.seconds, time.process_time() - cpu
 
 
-def compile_kernels(sets: list[KernelSet] | None = None,
-                    note: Callable[[str], None] | None = None, cpu: dict | None = None) -> dict[str, float]:
+def compile_kernels(
+    sets: list[KernelSet] | None = None, note: Callable[[str], None] | None = None, cpu: dict | None = None
+) -> dict[str, float]:
     """Compile the kernel sets not yet cached (default: every missing one), one line each
     through `note` (default: the "granplate" logger at INFO) with the measured estimate,
     scaled after the first set by how this machine's compile times compare with the
@@ -158,14 +169,18 @@ def compile_kernels(sets: list[KernelSet] | None = None,
     scale = machine_slowdown()
     total = scale * estimate(todo)
     busy = f", this machine busy {scale:.1f}x" if scale > 1.2 else ""
-    say(f"compiling every scheme's kernels once, in the plane and in space: {len(todo)} sets, about "
+    say(
+        f"compiling every scheme's kernels once, in the plane and in space: {len(todo)} sets, about "
         f"{describe_seconds(total)} ({describe_seconds(estimate(todo))} of CPU measured on a cold cache{busy}; "
-        f"`granplate compile` does this ahead; cached afterwards)")
+        f"`granplate compile` does this ahead; cached afterwards)"
+    )
     spent = expected = 0.0
     for i, k in enumerate(todo, 1):
-        left = scale * estimate(todo[i - 1:])
-        say(f"compiling {i}/{len(todo)}: {k.what} (about {describe_seconds(scale * estimate([k]))}; "
-            f"{describe_seconds(left)} left in all) ...")
+        left = scale * estimate(todo[i - 1 :])
+        say(
+            f"compiling {i}/{len(todo)}: {k.what} (about {describe_seconds(scale * estimate([k]))}; "
+            f"{describe_seconds(left)} left in all) ..."
+        )
         try:
             done[k.name], cpu_s = compile_set(k)
         except Exception as err:  # noqa: BLE001 - a set that cannot compile must not stop the run asked for
@@ -191,11 +206,11 @@ def measure(path: Path, note: Callable[[str], None] | None = None) -> dict:
     wall = compile_kernels(list(KERNEL_SETS), note, cpu=cpu)
     data = {
         "about": "CPU seconds each kernel set takes to compile on a cold numba cache (compiling is "
-                 "single-threaded: the wall time on an idle core), the sets compiled in this order in "
-                 "one process (later sets reuse earlier ones' callees); wall_seconds: the wall time "
-                 "numba compiled, which a shared machine inflates; written by `granplate compile --measure`",
+        "single-threaded: the wall time on an idle core), the sets compiled in this order in "
+        "one process (later sets reuse earlier ones' callees); wall_seconds: the wall time "
+        "numba compiled, which a shared machine inflates; written by `granplate compile --measure`",
         "machine": f"{platform.machine()}, {platform.processor() or platform.system()}, "
-                   f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at the end",
+        f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at the end",
         "numba": numba.__version__,
         "order": [k.name for k in KERNEL_SETS],
         "seconds": {k: round(v, 1) for k, v in cpu.items()},

@@ -1,8 +1,9 @@
 """Simulate a scenario and return the result Dataset.
 
-    >>> import granplate
-    >>> ds = granplate.simulate(granplate.preset("steel-r1"), t_end=1e-4)
+>>> import granplate
+>>> ds = granplate.simulate(granplate.preset("steel-r1"), t_end=1e-4)
 """
+
 from __future__ import annotations
 
 import json
@@ -27,11 +28,15 @@ def yield_note(ds) -> None:
 
     if "material_pair" not in ds.coords or ds.sizes["material_pair"] == 0:
         return
-    py = PairYield(pair=tuple(str(v) for v in ds.material_pair.values),
-                   pressure=ds.pair_max_contact_pressure.values, ratio=ds.pair_yield_onset_ratio.values,
-                   yield_strength=ds.pair_yield_strength.values, time=ds.pair_max_pressure_time.values,
-                   contact=tuple(str(v) for v in ds.pair_max_pressure_contact.values),
-                   law=tuple(str(v) for v in ds.pair_normal_law.values))
+    py = PairYield(
+        pair=tuple(str(v) for v in ds.material_pair.values),
+        pressure=ds.pair_max_contact_pressure.values,
+        ratio=ds.pair_yield_onset_ratio.values,
+        yield_strength=ds.pair_yield_strength.values,
+        time=ds.pair_max_pressure_time.values,
+        contact=tuple(str(v) for v in ds.pair_max_pressure_contact.values),
+        law=tuple(str(v) for v in ds.pair_normal_law.values),
+    )
     line = yield_warning(ds.attrs.get("scenario_name", ""), py)
     if line is not None:
         warnings.warn(line, YieldWarning, stacklevel=3)
@@ -83,8 +88,7 @@ def simulate(
         return _simulate(scenario, progress, model, summary_only, clock)
 
 
-def _simulate(scenario: Scenario, progress: bool | None, model: Model | None, summary_only: bool,
-              clock: CompileClock):
+def _simulate(scenario: Scenario, progress: bool | None, model: Model | None, summary_only: bool, clock: CompileClock):
     """simulate's run, its compile seconds counted by clock."""
     t0, c0 = time.perf_counter(), clock.now()
     if model is None:
@@ -101,15 +105,34 @@ def _simulate(scenario: Scenario, progress: bool | None, model: Model | None, su
             **rec.info,
             "status": rec.message,
         }
-        info = {k: info[k] for k in ("wall_time_s", "compile_time_s", "setup_time_s", "first_call_time_s",
-                                     "loop_time_s", "loop_cpu_s", "loop_thread_cpu_s", "n_steps", "n_iterations",
-                                     "n_retries", "n_friction_bound", "status")}
+        info = {
+            k: info[k]
+            for k in (
+                "wall_time_s",
+                "compile_time_s",
+                "setup_time_s",
+                "first_call_time_s",
+                "loop_time_s",
+                "loop_cpu_s",
+                "loop_thread_cpu_s",
+                "n_steps",
+                "n_iterations",
+                "n_retries",
+                "n_friction_bound",
+                "status",
+            )
+        }
         info["n_rebuilds"] = rec.contacts.n_rebuilds
         if rec.status == OK and summary_only:
-            return _with_compile_time(to_dataset(model, rec.out, rec.n_valid, info, summary_only=True,
-                                                 contacts=rec.contacts), clock)
-        ds = _with_compile_time(to_dataset(model, rec.out, rec.n_valid, info, contacts=rec.contacts,
-                                           should_stop=stop_requested, progress=progress), clock)
+            return _with_compile_time(
+                to_dataset(model, rec.out, rec.n_valid, info, summary_only=True, contacts=rec.contacts), clock
+            )
+        ds = _with_compile_time(
+            to_dataset(
+                model, rec.out, rec.n_valid, info, contacts=rec.contacts, should_stop=stop_requested, progress=progress
+            ),
+            clock,
+        )
     yield_note(ds)
     if rec.status != OK or interrupted(ds):
         n = ds.sizes["time"]

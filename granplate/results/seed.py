@@ -13,6 +13,7 @@ time when they are apart, or let them part first.
 `granules_at(ds, time=-1)`: those granules alone, for `setup.granules_file.write_granules`
 (`granplate resolve RESULT.nc --granules-file FILE` writes them with the scenario).
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -42,8 +43,10 @@ def granules_at(ds, time: int = -1) -> tuple[Granule, ...]:
         spins = list(zip(*(_row(ds, k, time) for k in ("omega_x", "omega_y", "omega_z"))))
     else:
         z, vz, spins = [0.0] * len(x), [0.0] * len(x), _row(ds, "omega", time)
-    return tuple(dataclasses.replace(g, x=x[i], y=y[i], z=z[i], vx=vx[i], vy=vy[i], vz=vz[i], omega=spins[i])
-                 for i, g in enumerate(s.granules))
+    return tuple(
+        dataclasses.replace(g, x=x[i], y=y[i], z=z[i], vx=vx[i], vy=vy[i], vz=vz[i], omega=spins[i])
+        for i, g in enumerate(s.granules)
+    )
 
 
 def seeded_scenario(ds, time: int = -1) -> Scenario:

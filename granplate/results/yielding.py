@@ -9,6 +9,7 @@ granule does. In space, a granule on one of an elastic body's rigid patches meet
 body likewise (the 2D rigid layer's law); elsewhere on the body, E* and Y are of both
 materials. The ratio is NaN where a Y it needs is unknown (summary: null).
 """
+
 from __future__ import annotations
 
 import math
@@ -56,7 +57,11 @@ def contact_yield(model, peaks) -> list[tuple[str, float, float, float, float, s
         if j >= 0:
             b = mats[j]
             e_star, r_star = effective_modulus(a, b), r[i] * r[j] / (r[i] + r[j])
-            pair, who, law = "-".join(sorted((a.name, b.name))), f"{labels[i]}-{labels[j]}", normal_law_of(s, a.name, b.name)
+            pair, who, law = (
+                "-".join(sorted((a.name, b.name))),
+                f"{labels[i]}-{labels[j]}",
+                normal_law_of(s, a.name, b.name),
+            )
         else:
             e_star, r_star = effective_modulus(a, None), r[i]
             if j == PARTNER_PLATE:
@@ -64,7 +69,11 @@ def contact_yield(model, peaks) -> list[tuple[str, float, float, float, float, s
             else:
                 w = -1 - j
                 wall = s.walls[w]
-                pair, who, law = f"{a.name}-wall", f"{labels[i]}-wall {wall.label or w}", normal_law_of(s, a.name, wall.material)
+                pair, who, law = (
+                    f"{a.name}-wall",
+                    f"{labels[i]}-wall {wall.label or w}",
+                    normal_law_of(s, a.name, wall.material),
+                )
         y = softer_yield_strength(a, b if j >= 0 else None)
         p0 = hertz_peak_pressure(e_star, r_star, float(d))
         ratio = p0 / limiting_pressure(y) if y is not None else math.nan
@@ -80,9 +89,15 @@ def pair_yield(model, peaks) -> PairYield:
             best[row[0]] = row
     rows = [best[k] for k in sorted(best)]
     col = list(zip(*rows)) if rows else [()] * 7
-    return PairYield(pair=tuple(col[0]), pressure=np.array(col[1], float), ratio=np.array(col[2], float),
-                     yield_strength=np.array(col[3], float), time=np.array(col[4], float),
-                     contact=tuple(col[5]), law=tuple(col[6]))
+    return PairYield(
+        pair=tuple(col[0]),
+        pressure=np.array(col[1], float),
+        ratio=np.array(col[2], float),
+        yield_strength=np.array(col[3], float),
+        time=np.array(col[4], float),
+        contact=tuple(col[5]),
+        law=tuple(col[6]),
+    )
 
 
 def largest(py: PairYield) -> tuple[float, float]:
@@ -102,8 +117,10 @@ def yield_warning(name: str, py: PairYield) -> str | None:
         return None
     k = max(over, key=lambda q: py.ratio[q])
     more = f" ({len(over) - 1} other pair(s) too)" if len(over) > 1 else ""
-    return (f"{name}: Hertz contacts passed the onset of yield: pair {py.pair[k]}, contact {py.contact[k]} at "
-            f"t = {py.time[k]:.4g} s, p0 = {py.pressure[k] / 1e6:.4g} MPa = {py.ratio[k]:.3g} x 1.6 Y "
-            f"(Y = {py.yield_strength[k] / 1e6:.4g} MPa){more}. The elastic law no longer holds there; "
-            f"contact.normal_law = \"johnson\" follows contacts that yield as measured (docs/model.md section "
-            f"3.10; \"thornton\", section 3.6).")
+    return (
+        f"{name}: Hertz contacts passed the onset of yield: pair {py.pair[k]}, contact {py.contact[k]} at "
+        f"t = {py.time[k]:.4g} s, p0 = {py.pressure[k] / 1e6:.4g} MPa = {py.ratio[k]:.3g} x 1.6 Y "
+        f"(Y = {py.yield_strength[k] / 1e6:.4g} MPa){more}. The elastic law no longer holds there; "
+        f'contact.normal_law = "johnson" follows contacts that yield as measured (docs/model.md section '
+        f'3.10; "thornton", section 3.6).'
+    )

@@ -3,6 +3,7 @@ each raises ScenarioError(field, value, allowed) before anything runs. The one o
 the rules a drive's fields obey; `validate` calls `check_gravity` and `check_drives` on
 the resolved scenario.
 """
+
 from __future__ import annotations
 
 import math
@@ -49,14 +50,21 @@ def check_gravity(s: Scenario) -> None:
     g = s.gravity.g
     names = "[gx, gy]" if s.dimension == 2 else "[gx, gy, gz]"
     if not isinstance(g, tuple) or len(g) != s.dimension or not all(is_number(c) and math.isfinite(c) for c in g):
-        raise ScenarioError("gravity.g", list(g) if isinstance(g, tuple) else g,
-                            f"must be {s.dimension} finite numbers {names} [m/s^2] (dimension = {s.dimension})")
+        raise ScenarioError(
+            "gravity.g",
+            list(g) if isinstance(g, tuple) else g,
+            f"must be {s.dimension} finite numbers {names} [m/s^2] (dimension = {s.dimension})",
+        )
     if not math.hypot(*g) <= GRAVITY_MAX:
         raise ScenarioError("gravity.g", list(g), f"allowed |g| <= {GRAVITY_MAX:g} m/s^2")
     if s.plate is not None:
-        raise ScenarioError("gravity.g", list(g), "gravity acts on the granules alone: a scenario with a [plate] "
-                            "cannot have it yet (the plate's own weight, and the static sag it would start "
-                            "from, are not modelled); leave out [gravity] or the [plate]")
+        raise ScenarioError(
+            "gravity.g",
+            list(g),
+            "gravity acts on the granules alone: a scenario with a [plate] "
+            "cannot have it yet (the plate's own weight, and the static sag it would start "
+            "from, are not modelled); leave out [gravity] or the [plate]",
+        )
 
 
 def check_drives(s: Scenario, step_max: float, wave_speed: float) -> None:
@@ -72,8 +80,9 @@ def check_drives(s: Scenario, step_max: float, wave_speed: float) -> None:
             raise ScenarioError(p, d, "must be a table of a drive's fields")
         kind, index = drive_target(s, p, d.target)
         if d.target in seen:
-            raise ScenarioError(f"{p}.target", d.target, f"drives[{seen[d.target]}] drives it already; "
-                                "a body takes one drive")
+            raise ScenarioError(
+                f"{p}.target", d.target, f"drives[{seen[d.target]}] drives it already; a body takes one drive"
+            )
         seen[d.target] = k
         string_in(f"{p}.kind", d.kind, DRIVE_KINDS)
         direction = _unit(f"{p}.direction", d.direction, s.dimension)
@@ -91,29 +100,36 @@ def drive_target(s: Scenario, p: str, target: Any) -> tuple[str, int]:
     "wall LABEL" or "granule LABEL"."""
     parts = target.split(None, 1) if isinstance(target, str) else []
     if len(parts) != 2 or parts[0] not in DRIVE_TARGETS:
-        raise ScenarioError(f"{p}.target", target, "must be \"wall LABEL\" or \"granule LABEL\" (the label of a "
-                            "[[walls]] or [[granules]] entry)")
+        raise ScenarioError(
+            f"{p}.target",
+            target,
+            'must be "wall LABEL" or "granule LABEL" (the label of a [[walls]] or [[granules]] entry)',
+        )
     kind, label = parts[0], parts[1].strip()
     labels = [w.label for w in s.walls] if kind == "wall" else granule_labels(s)
     if label not in labels:
         near = closest_name(label, labels)
         hint = f" (did you mean '{kind} {near}'?)" if near else ""
         known = ", ".join(repr(x) for x in labels[:12]) + (", ..." if len(labels) > 12 else "")
-        raise ScenarioError(f"{p}.target", target, f"no {kind} is labelled {label!r}{hint}; the {kind}s' labels: "
-                            + (known or "none"))
+        raise ScenarioError(
+            f"{p}.target", target, f"no {kind} is labelled {label!r}{hint}; the {kind}s' labels: " + (known or "none")
+        )
     return kind, labels.index(label)
 
 
 def _unit(path: str, v: Any, dimension: int) -> tuple[float, ...]:
     """A direction of `dimension` finite components and unit length (within UNIT_TOL)."""
-    if (not isinstance(v, tuple) or len(v) != dimension
-            or not all(is_number(c) and math.isfinite(c) for c in v)):
-        raise ScenarioError(path, list(v) if isinstance(v, tuple) else v,
-                            f"must be {dimension} finite numbers (a unit vector; dimension = {dimension})")
+    if not isinstance(v, tuple) or len(v) != dimension or not all(is_number(c) and math.isfinite(c) for c in v):
+        raise ScenarioError(
+            path,
+            list(v) if isinstance(v, tuple) else v,
+            f"must be {dimension} finite numbers (a unit vector; dimension = {dimension})",
+        )
     norm = math.hypot(*v)
     if abs(norm - 1.0) > UNIT_TOL:
-        raise ScenarioError(path, list(v), f"must be a unit vector (|direction| = {norm:.12g}; allowed 1 "
-                            f"within {UNIT_TOL:g})")
+        raise ScenarioError(
+            path, list(v), f"must be a unit vector (|direction| = {norm:.12g}; allowed 1 within {UNIT_TOL:g})"
+        )
     return v
 
 
@@ -121,14 +137,21 @@ def _wall_drive(p: str, d: Drive, wall, direction: tuple[float, ...]) -> None:
     """A wall is moved, never pushed (it has no mass), along its own normal (sliding a
     plane along itself would change only friction, which a moving wall does not carry)."""
     if d.kind == "force":
-        raise ScenarioError(f"{p}.kind", d.kind, "a wall has no mass: it takes a \"displacement\" or \"velocity\" "
-                            "drive; to push with a force, drive a granule (a piston)")
+        raise ScenarioError(
+            f"{p}.kind",
+            d.kind,
+            'a wall has no mass: it takes a "displacement" or "velocity" '
+            "drive; to push with a force, drive a granule (a piston)",
+        )
     n = [float(c) for c in wall.normal]
     norm = math.hypot(*n)
     cos = sum(a * b for a, b in zip(n, direction)) / norm
     if abs(abs(cos) - 1.0) > UNIT_TOL:
-        raise ScenarioError(f"{p}.direction", list(direction), f"a wall moves along its normal: allowed "
-                            f"{[c / norm for c in n]} or its opposite (wall {wall.label!r})")
+        raise ScenarioError(
+            f"{p}.direction",
+            list(direction),
+            f"a wall moves along its normal: allowed {[c / norm for c in n]} or its opposite (wall {wall.label!r})",
+        )
 
 
 def _profile_fields(p: str, d: Drive) -> None:
@@ -136,13 +159,18 @@ def _profile_fields(p: str, d: Drive) -> None:
     defaults (a field the profile would ignore is refused, not silently dropped)."""
     used = PROFILE_FIELDS[d.profile]
     if d.file is not None:
-        raise ScenarioError(f"{p}.file", d.file, "is read when the scenario is loaded from TOML (setup.io); a "
-                            "Drive built in Python gives times and values instead")
+        raise ScenarioError(
+            f"{p}.file",
+            d.file,
+            "is read when the scenario is loaded from TOML (setup.io); a "
+            "Drive built in Python gives times and values instead",
+        )
     for name, default in _DEFAULTS.items():
         value = getattr(d, name)
         if name not in used and value != default and not (name in ("times", "values") and value == ()):
-            raise ScenarioError(f"{p}.{name}", value, f"not read by profile {d.profile!r}, which reads "
-                                + ", ".join(used))
+            raise ScenarioError(
+                f"{p}.{name}", value, f"not read by profile {d.profile!r}, which reads " + ", ".join(used)
+            )
     for name in used:
         if name in ("times", "values"):
             continue
@@ -165,8 +193,12 @@ def _profile_values(p: str, d: Drive, step_max: float, wave_speed: float) -> Non
     elif d.profile == "harmonic":
         f_max = 1.0 / (STEPS_PER_PERIOD * step_max)
         if not 0.0 < d.frequency <= f_max:
-            raise ScenarioError(f"{p}.frequency", d.frequency, f"allowed 0 < frequency <= {f_max:.6g} Hz (a period "
-                                f"of at least {STEPS_PER_PERIOD} steps of {step_max:g} s)")
+            raise ScenarioError(
+                f"{p}.frequency",
+                d.frequency,
+                f"allowed 0 < frequency <= {f_max:.6g} Hz (a period "
+                f"of at least {STEPS_PER_PERIOD} steps of {step_max:g} s)",
+            )
         if d.kind == "velocity":
             speed = abs(d.value) + abs(d.amplitude)
         else:
@@ -174,11 +206,20 @@ def _profile_values(p: str, d: Drive, step_max: float, wave_speed: float) -> Non
     else:
         speed = _table_speed(p, d)
     if d.kind != "force" and not speed < wave_speed:
-        field = {"constant": "value", "ramp": "value", "half-sine": "amplitude", "harmonic": "amplitude",
-                 "table": "values"}[d.profile]
-        raise ScenarioError(f"{p}.{field}", getattr(d, field), f"asks for a speed of {speed:.6g} m/s; allowed "
-                            f"below {wave_speed:.6g} m/s, the slowest elastic wave speed sqrt(E / rho) of the "
-                            "materials (Hertz's law is quasi-static)")
+        field = {
+            "constant": "value",
+            "ramp": "value",
+            "half-sine": "amplitude",
+            "harmonic": "amplitude",
+            "table": "values",
+        }[d.profile]
+        raise ScenarioError(
+            f"{p}.{field}",
+            getattr(d, field),
+            f"asks for a speed of {speed:.6g} m/s; allowed "
+            f"below {wave_speed:.6g} m/s, the slowest elastic wave speed sqrt(E / rho) of the "
+            "materials (Hertz's law is quasi-static)",
+        )
 
 
 def _table_speed(p: str, d: Drive) -> float:
@@ -189,14 +230,16 @@ def _table_speed(p: str, d: Drive) -> float:
         if not isinstance(xs, tuple) or not all(is_number(x) and math.isfinite(x) for x in xs):
             raise ScenarioError(f"{p}.{name}", xs, "must be a list of finite numbers")
     if len(t) < 2 or len(t) != len(v):
-        raise ScenarioError(f"{p}.times", list(t), f"must hold two or more times, as many as values "
-                            f"({len(t)} times, {len(v)} values)")
+        raise ScenarioError(
+            f"{p}.times", list(t), f"must hold two or more times, as many as values ({len(t)} times, {len(v)} values)"
+        )
     if t[0] < 0.0:
         raise ScenarioError(f"{p}.times", list(t), "must start at t >= 0 [s]")
     for a, (t0, t1) in enumerate(zip(t[:-1], t[1:])):
         if not t1 > t0:
-            raise ScenarioError(f"{p}.times", list(t), f"must increase: times[{a + 1}] = {t1!r} is not after "
-                                f"times[{a}] = {t0!r}")
+            raise ScenarioError(
+                f"{p}.times", list(t), f"must increase: times[{a + 1}] = {t1!r} is not after times[{a}] = {t0!r}"
+            )
     if d.kind == "velocity":
         return max(abs(x) for x in v)
     if d.kind == "displacement":

@@ -1,4 +1,5 @@
 """Checks of single scenario fields: each raises ScenarioError(field, value, allowed)."""
+
 from __future__ import annotations
 
 import difflib
@@ -44,8 +45,7 @@ DIMENSIONS: tuple[int, ...] = (2, 3)
 def check_dimension(d: Any) -> None:
     """The top-level `dimension`: 2 or 3 (read first: it decides what the tables may hold)."""
     if not isinstance(d, numbers.Integral) or isinstance(d, bool) or d not in DIMENSIONS:
-        raise ScenarioError("dimension", d, "must be 2 (discs in the plane, the default) or 3 "
-                            "(spheres in space)")
+        raise ScenarioError("dimension", d, "must be 2 (discs in the plane, the default) or 3 (spheres in space)")
 
 
 def closest_name(name: str, allowed: list[str]) -> str | None:
@@ -64,5 +64,4 @@ def string_in(path: str, v: Any, allowed: tuple[str, ...]) -> None:
 
 def material_exists(path: str, name: Any, s: Scenario) -> None:
     if not isinstance(name, str) or name not in s.materials:
-        raise ScenarioError(path, name, "unknown material; defined materials are: "
-                            + ", ".join(sorted(s.materials)))
+        raise ScenarioError(path, name, "unknown material; defined materials are: " + ", ".join(sorted(s.materials)))

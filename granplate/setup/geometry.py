@@ -15,6 +15,7 @@ Geometry (origin at the bottom-left corner of the granular domain, x to the righ
     plate left edge:   xp = R1 + 2d + R1
     walls:             x = 0 (left), y = 0 (bottom), y = 10 R1 (top)
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -25,12 +26,23 @@ import weakref
 from granplate.errors import ScenarioError
 from granplate.setup import layouts
 from granplate.setup.granules_file import granule_path
-from granplate.setup.scenario import (BOX_WALLS, Box, ChainLayout, Granule, LatticeLayout, Layout, Plate, RigidPatch,
-                                      Scenario, Solid, SpaceLattice, Wall)
+from granplate.setup.scenario import (
+    BOX_WALLS,
+    Box,
+    ChainLayout,
+    Granule,
+    LatticeLayout,
+    Layout,
+    Plate,
+    RigidPatch,
+    Scenario,
+    Solid,
+    SpaceLattice,
+    Wall,
+)
 
 #: Labels of the paper's granules, in the order `paper_layout` returns them.
-PAPER_LABELS: tuple[str, ...] = ("1", "2", "3", "4", "5", "6", "7", "8", "9",
-                                 "A", "B", "C", "D", "E")
+PAPER_LABELS: tuple[str, ...] = ("1", "2", "3", "4", "5", "6", "7", "8", "9", "A", "B", "C", "D", "E")
 #: Labels of the three walls `paper_layout` returns, in order.
 PAPER_WALLS: tuple[str, ...] = ("left", "bottom", "top")
 
@@ -71,12 +83,11 @@ def paper_layout(layout: Layout) -> tuple[tuple[Granule, ...], tuple[Wall, ...],
         Wall((0.0, -1.0), 0.0, label="bottom", material=wm),
         Wall((0.0, 1.0), 10.0 * R1, label="top", material=wm),
     )
-    xp = (x3 + R1)
+    xp = x3 + R1
     return tuple(granules), walls, xp
 
 
-def layout_packing(layout: Layout | LatticeLayout | ChainLayout | SpaceLattice,
-                   dimension: int = 2) -> layouts.Packing:
+def layout_packing(layout: Layout | LatticeLayout | ChainLayout | SpaceLattice, dimension: int = 2) -> layouts.Packing:
     """The packing of any layout kind (paper, hexagonal, square, chain; sc, bcc, fcc, hcp in
     space), imperfections applied. `dimension`: the scenario's, which places a chain in the
     plane or in space (a space lattice is always 3D); in space a planar packing lies in
@@ -115,9 +126,14 @@ def unit(v: tuple[float, ...]) -> tuple[float, ...]:
 
 def along_plus_x(direction: object) -> bool:
     """Whether a load direction is +x (the layers' stacking direction): (d, 0, 0), d > 0."""
-    return (isinstance(direction, tuple) and len(direction) == 3 and direction[1:] == (0.0, 0.0)
-            and isinstance(direction[0], (int, float)) and not isinstance(direction[0], bool)
-            and direction[0] > 0.0)
+    return (
+        isinstance(direction, tuple)
+        and len(direction) == 3
+        and direction[1:] == (0.0, 0.0)
+        and isinstance(direction[0], (int, float))
+        and not isinstance(direction[0], bool)
+        and direction[0] > 0.0
+    )
 
 
 def plane_offset(normal: tuple[float, ...], point: tuple[float, ...]) -> float:
@@ -131,10 +147,15 @@ def box_walls(box: Box) -> tuple[Wall, ...]:
     walls = []
     for axis in range(3):
         e = tuple(1.0 if k == axis else 0.0 for k in range(3))
-        walls.append(Wall(tuple(-1.0 if k == axis else 0.0 for k in range(3)), 0.0 - float(box.lower[axis]),
-                          label=BOX_WALLS[2 * axis], material=box.material))
-        walls.append(Wall(e, float(box.upper[axis]), label=BOX_WALLS[2 * axis + 1],
-                          material=box.material))
+        walls.append(
+            Wall(
+                tuple(-1.0 if k == axis else 0.0 for k in range(3)),
+                0.0 - float(box.lower[axis]),
+                label=BOX_WALLS[2 * axis],
+                material=box.material,
+            )
+        )
+        walls.append(Wall(e, float(box.upper[axis]), label=BOX_WALLS[2 * axis + 1], material=box.material))
     return tuple(walls)
 
 
@@ -188,12 +209,22 @@ def rigid_layers(sd: Solid, granules: tuple[Granule, ...]) -> tuple[RigidPatch, 
             continue
         axis = max(range(3), key=lambda k: abs(c[k] - p[k]))
         if axis == 2:
-            raise ScenarioError("plate.rigid_layers", True, f"granule {g.label or '?'} touches a face normal to z: "
-                                "the rigid layers lie across the solid's z extent, on its faces normal to x or y")
+            raise ScenarioError(
+                "plate.rigid_layers",
+                True,
+                f"granule {g.label or '?'} touches a face normal to z: "
+                "the rigid layers lie across the solid's z extent, on its faces normal to x or y",
+            )
         along = 1 - axis
         w = sd.rigid_layer_width if sd.rigid_layer_width is not None else sd.size[along] / sd.elements[along]
-        patches.append(RigidPatch(centre=(p[0], p[1], p[2]), radius=0.5 * float(w) * (1.0 + TOUCH_RTOL),
-                                  axis=(0.0, 0.0, 1.0), rotates=False))
+        patches.append(
+            RigidPatch(
+                centre=(p[0], p[1], p[2]),
+                radius=0.5 * float(w) * (1.0 + TOUCH_RTOL),
+                axis=(0.0, 0.0, 1.0),
+                rotates=False,
+            )
+        )
     return tuple(patches)
 
 
@@ -243,15 +274,21 @@ def _expanded(scenario: Scenario) -> Scenario:
     xp = 0.0
     if scenario.layout is not None:
         if granules:
-            raise ScenarioError("granules", f"{len(granules)} granules",
-                                "give either [layout] or [[granules]], not both")
+            raise ScenarioError(
+                "granules", f"{len(granules)} granules", "give either [layout] or [[granules]], not both"
+            )
         if walls:
-            raise ScenarioError("walls", f"{len(walls)} walls",
-                                "give either [layout] or [[walls]], not both "
-                                "(the layout generates the left, bottom and top walls)")
+            raise ScenarioError(
+                "walls",
+                f"{len(walls)} walls",
+                "give either [layout] or [[walls]], not both (the layout generates the left, bottom and top walls)",
+            )
         if scenario.box is not None:
-            raise ScenarioError("box", "[box]", "give either [layout] or [box], not both (a 3D "
-                                "layout generates the walls around it: layout.walls)")
+            raise ScenarioError(
+                "box",
+                "[box]",
+                "give either [layout] or [box], not both (a 3D layout generates the walls around it: layout.walls)",
+            )
         granules, walls, xp, column1 = layout_packing(scenario.layout, scenario.dimension)
         if isinstance(plate, Plate) and plate.x0 is None:
             plate = dataclasses.replace(plate, x0=xp)
@@ -259,28 +296,37 @@ def _expanded(scenario: Scenario) -> Scenario:
         if scenario.layout.imperfections is not None and not load.granules and along_x:
             load = dataclasses.replace(load, granules=column1)
     if isinstance(plate, Solid) and plate.origin is None and plate.mesh is None:
-        plate = dataclasses.replace(plate, origin=solid_against(plate, granules, xp)
-                                    if scenario.layout is not None else (0.0, 0.0, 0.0))
+        plate = dataclasses.replace(
+            plate, origin=solid_against(plate, granules, xp) if scenario.layout is not None else (0.0, 0.0, 0.0)
+        )
     if isinstance(plate, Solid) and plate.rigid_layers:
-        plate = dataclasses.replace(plate, rigid_layers=False, rigid_layer_width=None,
-                                    rigid_patches=plate.rigid_patches + rigid_layers(plate, granules))
+        plate = dataclasses.replace(
+            plate,
+            rigid_layers=False,
+            rigid_layer_width=None,
+            rigid_patches=plate.rigid_patches + rigid_layers(plate, granules),
+        )
     if isinstance(plate, Plate) and plate.x0 is None:
-        raise ScenarioError("plate.x0", None,
-                            "must be given when the scenario has no [layout] "
-                            "(the plate's lower-left corner x [m])")
+        raise ScenarioError(
+            "plate.x0", None, "must be given when the scenario has no [layout] (the plate's lower-left corner x [m])"
+        )
     box = scenario.box
     if scenario.dimension == 3:
-        granules = tuple(dataclasses.replace(g, omega=(0.0, 0.0, 0.0))
-                         if not isinstance(g.omega, tuple) and g.omega == 0.0 else g for g in granules)
-        walls = tuple(dataclasses.replace(w, offset=plane_offset(w.normal, w.point))
-                      if w.offset is None and w.point is not None else w for w in walls)
+        granules = tuple(
+            dataclasses.replace(g, omega=(0.0, 0.0, 0.0)) if not isinstance(g.omega, tuple) and g.omega == 0.0 else g
+            for g in granules
+        )
+        walls = tuple(
+            dataclasses.replace(w, offset=plane_offset(w.normal, w.point))
+            if w.offset is None and w.point is not None
+            else w
+            for w in walls
+        )
         if box is not None:
             walls, box = walls + box_walls(box), None
     granules = tuple(g if g.label else _relabelled(g, default_granule_label(i)) for i, g in enumerate(granules))
-    walls = tuple(w if w.label else dataclasses.replace(w, label=default_wall_label(i))
-                  for i, w in enumerate(walls))
-    return dataclasses.replace(scenario, layout=None, granules=granules, walls=walls,
-                               plate=plate, load=load, box=box)
+    walls = tuple(w if w.label else dataclasses.replace(w, label=default_wall_label(i)) for i, w in enumerate(walls))
+    return dataclasses.replace(scenario, layout=None, granules=granules, walls=walls, plate=plate, load=load, box=box)
 
 
 def _relabelled(g: Granule, label: str) -> Granule:
@@ -295,11 +341,29 @@ def _relabelled(g: Granule, label: str) -> Granule:
 #: order a message lists them; the kind's radius is always listed.
 PLACING_FIELDS: dict[type, tuple[str, ...]] = {
     Layout: ("R1", "R2_ratio", "imperfections"),
-    LatticeLayout: ("kind", "columns", "rows", "radius", "column_radii", "intruder_ratio", "intruder_columns",
-                    "intruder_sites", "intruder_every", "imperfections"),
+    LatticeLayout: (
+        "kind",
+        "columns",
+        "rows",
+        "radius",
+        "column_radii",
+        "intruder_ratio",
+        "intruder_columns",
+        "intruder_sites",
+        "intruder_every",
+        "imperfections",
+    ),
     ChainLayout: ("count", "radius", "taper", "dimer_ratio", "decorated_ratio", "y", "z", "imperfections"),
-    SpaceLattice: ("kind", "cells", "radius", "layers", "intruder_ratio", "intruder_sites",
-                   "intruder_every", "imperfections"),
+    SpaceLattice: (
+        "kind",
+        "cells",
+        "radius",
+        "layers",
+        "intruder_ratio",
+        "intruder_sites",
+        "intruder_every",
+        "imperfections",
+    ),
 }
 
 
@@ -315,14 +379,17 @@ def placing_fields(scenario: Scenario, index: int) -> tuple[str, ...]:
         return tuple(granule_path(scenario.granules_file, index, f, scenario.dimension) for f in coords)
     primary = "R1" if isinstance(lay, Layout) else "radius"
     default = type(lay)()
-    return tuple(f"layout.{f}" for f in PLACING_FIELDS[type(lay)]
-                 if f == primary or getattr(lay, f) != getattr(default, f))
+    return tuple(
+        f"layout.{f}" for f in PLACING_FIELDS[type(lay)] if f == primary or getattr(lay, f) != getattr(default, f)
+    )
 
 
 def granule_named(scenario: Scenario, resolved: Scenario, index: int) -> str:
-    """"granule 'LABEL' (placed by FIELDS; centre (x, y), radius R [m])" for messages
+    """ "granule 'LABEL' (placed by FIELDS; centre (x, y), radius R [m])" for messages
     ((x, y, z) in 3D)."""
     g = resolved.granules[index]
     centre = f"{g.x:.6g}, {g.y:.6g}" + (f", {g.z:.6g}" if scenario.dimension == 3 else "")
-    return (f"granule '{g.label}' (placed by {', '.join(placing_fields(scenario, index))}; centre "
-            f"({centre}) m, radius {g.radius:.6g} m)")
+    return (
+        f"granule '{g.label}' (placed by {', '.join(placing_fields(scenario, index))}; centre "
+        f"({centre}) m, radius {g.radius:.6g} m)"
+    )

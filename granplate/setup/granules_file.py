@@ -25,6 +25,7 @@ after the header); a field is named "FILE, row N, column C" where a table's woul
 `write_granules` writes the same three formats (floats as their shortest exact text in a
 CSV), so that a scenario read back from its file equals the one written.
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -49,8 +50,20 @@ NUMBER_COLUMNS: tuple[str, ...] = ("x", "y", "z", "radius", "vx", "vy", "vz", "o
 #: Columns of strings.
 STRING_COLUMNS: tuple[str, ...] = ("material", "label")
 #: Every column, in the order they are written (2D: without those of COLUMNS_3D_ONLY).
-COLUMNS: tuple[str, ...] = ("x", "y", "z", "radius", "material", "label", "vx", "vy", "vz",
-                            "omega_x", "omega_y", "omega_z")
+COLUMNS: tuple[str, ...] = (
+    "x",
+    "y",
+    "z",
+    "radius",
+    "material",
+    "label",
+    "vx",
+    "vy",
+    "vz",
+    "omega_x",
+    "omega_y",
+    "omega_z",
+)
 #: Columns that are zero (or absent) in 2D.
 COLUMNS_3D_ONLY: tuple[str, ...] = ("z", "vz", "omega_x", "omega_y")
 
@@ -75,11 +88,10 @@ def column_of(field: str, dimension: int) -> str:
 
 
 def file_format(path: str) -> str:
-    """"csv", "npz" or "netcdf" from the file's extension (ScenarioError otherwise)."""
+    """ "csv", "npz" or "netcdf" from the file's extension (ScenarioError otherwise)."""
     ext = os.path.splitext(str(path))[1].lower()
     if ext not in FORMATS:
-        raise ScenarioError("granules_file", str(path), "must end in " + ", ".join(FORMATS)
-                            + " (CSV, NPZ or netCDF)")
+        raise ScenarioError("granules_file", str(path), "must end in " + ", ".join(FORMATS) + " (CSV, NPZ or netCDF)")
     return FORMATS[ext]
 
 
@@ -99,14 +111,16 @@ def collector_paused():
 
 # --------------------------------------------------------------------------- reading
 
+
 def _read_csv(path: str, name: str) -> dict[str, list]:
     """Columns of a CSV file as lists of strings ("" for an empty cell)."""
     with open(path, newline="", encoding="utf-8") as f:
         rows = csv.reader(f)
         header = next(rows, None)
         if not header:
-            raise ScenarioError("granules_file", name, "empty file: expected a header line of column "
-                                "names (" + ", ".join(COLUMNS) + ")")
+            raise ScenarioError(
+                "granules_file", name, "empty file: expected a header line of column names (" + ", ".join(COLUMNS) + ")"
+            )
         header = [h.strip() for h in header]
         cols: list[list[str]] = [[] for _ in header]
         width = len(header)
@@ -114,8 +128,11 @@ def _read_csv(path: str, name: str) -> dict[str, list]:
             if len(row) != width:
                 if not any(c.strip() for c in row):
                     continue  # a blank line
-                raise ScenarioError(f"{name}, row {n + 1}", row, f"has {len(row)} cells; the header "
-                                    f"names {width} columns: " + ", ".join(header))
+                raise ScenarioError(
+                    f"{name}, row {n + 1}",
+                    row,
+                    f"has {len(row)} cells; the header names {width} columns: " + ", ".join(header),
+                )
             for c, cell in zip(cols, row):
                 c.append(cell)
     return dict(zip(header, cols))
@@ -126,8 +143,11 @@ def _read_npz(path: str, name: str) -> dict[str, np.ndarray]:
         with np.load(path, allow_pickle=False) as z:
             return {k: z[k] for k in z.files}
     except ValueError as err:
-        raise ScenarioError("granules_file", name, f"not read as NPZ of plain arrays ({err}); save "
-                            "names as fixed-width strings, not Python objects") from None
+        raise ScenarioError(
+            "granules_file",
+            name,
+            f"not read as NPZ of plain arrays ({err}); save names as fixed-width strings, not Python objects",
+        ) from None
 
 
 def _read_netcdf(path: str, name: str) -> dict[str, np.ndarray]:
@@ -206,8 +226,7 @@ def _check_columns(cols: dict[str, Any], name: str) -> int:
         if k not in allowed:
             near = closest_name(k, allowed)
             hint = "" if near is None else f"did you mean '{near}'? "
-            raise ScenarioError(f"{name}, column {k}", k, f"unknown column '{k}'; {hint}allowed: "
-                                + ", ".join(allowed))
+            raise ScenarioError(f"{name}, column {k}", k, f"unknown column '{k}'; {hint}allowed: " + ", ".join(allowed))
     for k in REQUIRED_COLUMNS:
         if k not in cols:
             raise ScenarioError(f"{name}, column {k}", None, f"missing required column '{k}'")
@@ -218,8 +237,7 @@ def _check_columns(cols: dict[str, Any], name: str) -> int:
     n = lengths["x"][0]
     for k, shape in lengths.items():
         if shape[0] != n:
-            raise ScenarioError(f"{name}, column {k}", f"{shape[0]} rows", f"must have as many rows as "
-                                f"column x ({n})")
+            raise ScenarioError(f"{name}, column {k}", f"{shape[0]} rows", f"must have as many rows as column x ({n})")
     return n
 
 
@@ -228,8 +246,12 @@ def _planar_spins(cols: dict[str, list], name: str) -> None:
     for col in ("omega_x", "omega_y"):
         for i, v in enumerate(cols.get(col, ())):
             if v != 0.0:
-                raise ScenarioError(f"{name}, row {i + 1}, column {col}", v, "must be 0 in 2D (discs in the "
-                                    "plane spin about z: omega_z), or set dimension = 3 (spheres in space)")
+                raise ScenarioError(
+                    f"{name}, row {i + 1}, column {col}",
+                    v,
+                    "must be 0 in 2D (discs in the "
+                    "plane spin about z: omega_z), or set dimension = 3 (spheres in space)",
+                )
 
 
 def read_granules(path: str, dimension: int, name: str | None = None) -> tuple[Granule, ...]:
@@ -258,20 +280,41 @@ def _granules_of(raw: dict[str, Any], dimension: int, name: str) -> tuple[Granul
         spins: Any = get("omega_z")
     else:
         spins = list(zip(get("omega_x"), get("omega_y"), get("omega_z")))
-    return tuple(map(Granule, cols["x"], cols["y"], cols["radius"], cols["material"], labels,
-                     get("vx"), get("vy"), spins, get("z"), get("vz")))
+    return tuple(
+        map(
+            Granule,
+            cols["x"],
+            cols["y"],
+            cols["radius"],
+            cols["material"],
+            labels,
+            get("vx"),
+            get("vy"),
+            spins,
+            get("z"),
+            get("vz"),
+        )
+    )
 
 
 # --------------------------------------------------------------------------- writing
+
 
 def granule_columns(granules: tuple[Granule, ...], dimension: int) -> dict[str, list]:
     """The columns of `granules` as written (2D: without COLUMNS_3D_ONLY; omega_z the spin)."""
     spins = [g.spin() for g in granules]
     cols: dict[str, list] = {
-        "x": [g.x for g in granules], "y": [g.y for g in granules], "z": [g.z for g in granules],
-        "radius": [g.radius for g in granules], "material": [g.material for g in granules],
-        "label": [g.label for g in granules], "vx": [g.vx for g in granules], "vy": [g.vy for g in granules],
-        "vz": [g.vz for g in granules], "omega_x": [w[0] for w in spins], "omega_y": [w[1] for w in spins],
+        "x": [g.x for g in granules],
+        "y": [g.y for g in granules],
+        "z": [g.z for g in granules],
+        "radius": [g.radius for g in granules],
+        "material": [g.material for g in granules],
+        "label": [g.label for g in granules],
+        "vx": [g.vx for g in granules],
+        "vy": [g.vy for g in granules],
+        "vz": [g.vz for g in granules],
+        "omega_x": [w[0] for w in spins],
+        "omega_y": [w[1] for w in spins],
         "omega_z": [w[2] for w in spins],
     }
     return {k: v for k, v in cols.items() if dimension == 3 or k not in COLUMNS_3D_ONLY}
@@ -297,8 +340,7 @@ def write_granules(granules: tuple[Granule, ...], path: str | os.PathLike, dimen
             for row in zip(*cols.values()):
                 w.writerow([_csv_cell(v) for v in row])
         return
-    arrays = {k: (np.array(v, dtype=str) if k in STRING_COLUMNS else np.array(v, dtype=float))
-              for k, v in cols.items()}
+    arrays = {k: (np.array(v, dtype=str) if k in STRING_COLUMNS else np.array(v, dtype=float)) for k, v in cols.items()}
     if fmt == "npz":
         with open(path, "wb") as f:
             np.savez(f, **arrays)
@@ -306,8 +348,13 @@ def write_granules(granules: tuple[Granule, ...], path: str | os.PathLike, dimen
     import xarray as xr
 
     ds = xr.Dataset({k: (("granule",), v.astype(object) if k in STRING_COLUMNS else v) for k, v in arrays.items()})
-    units = {"material": None, "label": None, **{k: "m" for k in ("x", "y", "z", "radius")},
-             **{k: "m/s" for k in ("vx", "vy", "vz")}, **{k: "rad/s" for k in ("omega_x", "omega_y", "omega_z")}}
+    units = {
+        "material": None,
+        "label": None,
+        **{k: "m" for k in ("x", "y", "z", "radius")},
+        **{k: "m/s" for k in ("vx", "vy", "vz")},
+        **{k: "rad/s" for k in ("omega_x", "omega_y", "omega_z")},
+    }
     for k in ds.data_vars:
         if units.get(k):
             ds[k].attrs["units"] = units[k]

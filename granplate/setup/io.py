@@ -12,6 +12,7 @@
 Every error is a `ScenarioError` naming the field by its dotted path (`plate.nx`,
 `granules[2].radius`, `materials.ptfe.nu`; array indices 0-based, in file order).
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -30,9 +31,25 @@ import tomli_w
 from granplate.errors import ScenarioError
 from granplate.setup.fields import check_dimension, closest_name, string_in
 from granplate.setup.materials import LIBRARY, Material
-from granplate.setup.scenario import (DRIVE_KINDS, DRIVE_PROFILES, LAYOUT_KINDS, NORMAL_LAWS, Box, Contact, Drive,
-                                      Granule, Gravity, Load, PairCoefficients, Plate, Scenario, Solid, Solver,
-                                      TimeSettings, Wall)
+from granplate.setup.scenario import (
+    DRIVE_KINDS,
+    DRIVE_PROFILES,
+    LAYOUT_KINDS,
+    NORMAL_LAWS,
+    Box,
+    Contact,
+    Drive,
+    Granule,
+    Gravity,
+    Load,
+    PairCoefficients,
+    Plate,
+    Scenario,
+    Solid,
+    Solver,
+    TimeSettings,
+    Wall,
+)
 
 #: Fields that a table must give (everything else takes the dataclass default).
 REQUIRED: dict[type, tuple[str, ...]] = {
@@ -66,8 +83,15 @@ UNWRITTEN_DEFAULTS_2D: dict[str, dict[str, Any]] = {
     "granules": {"z": 0.0, "vz": 0.0},
 }
 #: A drive's fields left out of a written [[drives]] table when they hold their default.
-DRIVE_DEFAULTS: dict[str, Any] = {"value": 0.0, "amplitude": 0.0, "frequency": 0.0, "duration": 0.0,
-                                  "times": [], "values": [], "label": ""}
+DRIVE_DEFAULTS: dict[str, Any] = {
+    "value": 0.0,
+    "amplitude": 0.0,
+    "frequency": 0.0,
+    "duration": 0.0,
+    "times": [],
+    "values": [],
+    "label": "",
+}
 #: The order of a 3D granule's keys as written (its centre, then its velocities).
 GRANULE_KEYS_3D: tuple[str, ...] = ("x", "y", "z", "radius", "material", "label", "vx", "vy", "vz", "omega")
 
@@ -83,6 +107,7 @@ MISSING = _Missing()
 
 
 # --------------------------------------------------------------------------- dict -> Scenario
+
 
 def _type_name(tp: Any) -> str:
     if tp is float:
@@ -107,8 +132,7 @@ def _type_name(tp: Any) -> str:
 
 
 def _plural(tp: Any) -> str:
-    return {float: "numbers", int: "integers", str: "strings", bool: "booleans"}.get(
-        tp, "tables")
+    return {float: "numbers", int: "integers", str: "strings", bool: "booleans"}.get(tp, "tables")
 
 
 def _convert(path: str, value: Any, tp: Any) -> Any:
@@ -155,8 +179,7 @@ def _convert(path: str, value: Any, tp: Any) -> Any:
             return tuple(_convert(f"{path}[{i}]", v, args[0]) for i, v in enumerate(value))
         if len(value) != len(args):
             raise ScenarioError(path, value, f"wrong length: expected {_type_name(tp)}")
-        return tuple(_convert(f"{path}[{i}]", v, a) for i, (v, a) in
-                     enumerate(zip(value, args)))
+        return tuple(_convert(f"{path}[{i}]", v, a) for i, (v, a) in enumerate(zip(value, args)))
     if isinstance(tp, type) and dataclasses.is_dataclass(tp):
         return _table(path, value, tp)
     raise TypeError(f"unsupported annotation {tp!r}")  # pragma: no cover
@@ -171,8 +194,7 @@ def _check_keys(path: str, d: Any, allowed: list[str]) -> None:
             full = f"{path}.{k}" if path else str(k)
             near = closest_name(k, allowed)
             hint = "" if near is None else f"did you mean '{f'{path}.{near}' if path else near}'? "
-            raise ScenarioError(full, d[k], f"unknown field '{full}'; {hint}allowed: "
-                                + ", ".join(allowed))
+            raise ScenarioError(full, d[k], f"unknown field '{full}'; {hint}allowed: " + ", ".join(allowed))
 
 
 @functools.cache
@@ -210,8 +232,7 @@ _PLAIN: frozenset[type] = frozenset({float, int, str, bool})
 def _materials(d: Any) -> dict[str, Material]:
     """The library updated by the [materials.NAME] tables of `d`."""
     if not isinstance(d, dict):
-        raise ScenarioError("materials", d, "wrong type: expected a table of "
-                            "[materials.NAME] tables")
+        raise ScenarioError("materials", d, "wrong type: expected a table of [materials.NAME] tables")
     out = dict(LIBRARY)
     for name, t in d.items():
         p = f"materials.{name}"
@@ -230,8 +251,13 @@ def _materials(d: Any) -> dict[str, Material]:
 
 
 _TOP_TABLES: dict[str, type] = {
-    "plate": Plate, "load": Load, "contact": Contact,
-    "time": TimeSettings, "solver": Solver, "box": Box, "gravity": Gravity,
+    "plate": Plate,
+    "load": Load,
+    "contact": Contact,
+    "time": TimeSettings,
+    "solver": Solver,
+    "box": Box,
+    "gravity": Gravity,
 }
 
 
@@ -241,8 +267,7 @@ def _walls(value: Any, dimension: Any) -> tuple[Wall, ...]:
     for i, w in enumerate(walls):
         if w.offset is None and w.point is None:
             alt = f" (or 'walls[{i}].point' in 3D)" if dimension == 3 else ""
-            raise ScenarioError(f"walls[{i}].offset", MISSING,
-                                f"missing required field 'walls[{i}].offset'{alt}")
+            raise ScenarioError(f"walls[{i}].offset", MISSING, f"missing required field 'walls[{i}].offset'{alt}")
     return walls
 
 
@@ -250,8 +275,7 @@ def _drives(value: Any, base: str | os.PathLike | None) -> tuple[Drive, ...]:
     """The [[drives]] tables; a table given as a CSV `file` (relative to the scenario's
     folder, `base`) is read into times and values."""
     drives = _convert("drives", value, tuple[Drive, ...])
-    return tuple(_drive_table_file(f"drives[{k}]", d, base) if d.file is not None else d
-                 for k, d in enumerate(drives))
+    return tuple(_drive_table_file(f"drives[{k}]", d, base) if d.file is not None else d for k, d in enumerate(drives))
 
 
 def _drive_table_file(path: str, d: Drive, base: str | os.PathLike | None) -> Drive:
@@ -274,7 +298,9 @@ def _drive_table_file(path: str, d: Drive, base: str | os.PathLike | None) -> Dr
         except (ValueError, IndexError):
             if n == 0:  # a header
                 continue
-            raise ScenarioError(f"{path}.file", d.file, f"line {n + 1} ({ln!r}) is not two numbers: time, value") from None
+            raise ScenarioError(
+                f"{path}.file", d.file, f"line {n + 1} ({ln!r}) is not two numbers: time, value"
+            ) from None
         rows.append((t, v))
     return dataclasses.replace(d, file=None, times=tuple(t for t, _ in rows), values=tuple(v for _, v in rows))
 
@@ -283,8 +309,7 @@ def _no_scalar_omega(granules: Any) -> None:
     """A 3D file's granules give omega as a vector [wx, wy, wz] (or not at all)."""
     for i, g in enumerate(granules if isinstance(granules, list) else ()):
         if isinstance(g, dict) and isinstance(g.get("omega"), numbers.Real):
-            raise ScenarioError(f"granules[{i}].omega", g["omega"],
-                                "omega is a vector [wx, wy, wz] in 3D (rad/s)")
+            raise ScenarioError(f"granules[{i}].omega", g["omega"], "omega is a vector [wx, wy, wz] in 3D (rad/s)")
 
 
 def _layout(d: Any) -> Any:
@@ -293,8 +318,7 @@ def _layout(d: Any) -> Any:
         raise ScenarioError("layout", d, "wrong type: expected a table")
     kind = d.get("kind", "paper")
     if kind not in LAYOUT_KINDS:
-        raise ScenarioError("layout.kind", kind, "must be one of "
-                            + ", ".join(repr(k) for k in LAYOUT_KINDS))
+        raise ScenarioError("layout.kind", kind, "must be one of " + ", ".join(repr(k) for k in LAYOUT_KINDS))
     return _table("layout", d, LAYOUT_KINDS[kind])
 
 
@@ -368,11 +392,15 @@ def from_dict(d: dict, base: str | os.PathLike | None = None) -> Scenario:
 
 # --------------------------------------------------------------------------- Scenario -> dict
 
+
 def _plain(value: Any) -> Any:
     """Dataclasses -> dicts without None entries; tuples -> lists."""
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return {f.name: _plain(getattr(value, f.name)) for f in dataclasses.fields(value)
-                if getattr(value, f.name) is not None}
+        return {
+            f.name: _plain(getattr(value, f.name))
+            for f in dataclasses.fields(value)
+            if getattr(value, f.name) is not None
+        }
     if isinstance(value, (tuple, list)):
         return [_plain(v) for v in value]
     if isinstance(value, bool) or isinstance(value, str):
@@ -446,8 +474,11 @@ def to_dict(s: Scenario, all_materials: bool = False) -> dict:
         d["dimension"] = s.dimension
     flat = UNWRITTEN_DEFAULTS_2D if s.dimension == 2 else {"granules": {"omega": 0.0}}
     used = _used_materials(s)
-    mats = {name: _material_dict(m) for name, m in sorted(s.materials.items())
-            if all_materials or name in used or LIBRARY.get(name) != m}
+    mats = {
+        name: _material_dict(m)
+        for name, m in sorted(s.materials.items())
+        if all_materials or name in used or LIBRARY.get(name) != m
+    }
     if mats:
         d["materials"] = mats
     if s.layout is not None:
@@ -463,8 +494,7 @@ def to_dict(s: Scenario, all_materials: bool = False) -> dict:
     if s.plate is not None:
         d["plate"] = _plain(s.plate)
     for key in ("load", "contact", "time", "solver"):
-        d[key] = _without_defaults(_plain(getattr(s, key)),
-                                   {**UNWRITTEN_DEFAULTS.get(key, {}), **flat.get(key, {})})
+        d[key] = _without_defaults(_plain(getattr(s, key)), {**UNWRITTEN_DEFAULTS.get(key, {}), **flat.get(key, {})})
     if s.gravity is not None:  # (absent: not written, so that every scenario without it is written as before)
         d["gravity"] = _plain(s.gravity)
     if s.drives:
@@ -482,6 +512,7 @@ def _without_defaults(table: dict, defaults: dict[str, Any]) -> dict:
 
 
 # --------------------------------------------------------------------------- TOML
+
 
 def loads(text: str, base: str | os.PathLike | None = None) -> Scenario:
     """A Scenario from TOML text (shape checked, physics not: see `validate`); base: the
@@ -529,8 +560,9 @@ def dumps(s: Scenario, all_materials: bool = False) -> str:
     return tomli_w.dumps(to_dict(s, all_materials=all_materials))
 
 
-def dumps_with_granules_file(s: Scenario, path: str | os.PathLike, base: str | os.PathLike | None = None,
-                             all_materials: bool = False) -> str:
+def dumps_with_granules_file(
+    s: Scenario, path: str | os.PathLike, base: str | os.PathLike | None = None, all_materials: bool = False
+) -> str:
     """`s` as TOML text whose granules are in the file `path` (.csv, .npz or .nc, written
     here by `setup.granules_file.write_granules`), named by `granules_file` relative to
     `base` (the folder the TOML goes to; None: the working directory); reading the text
@@ -554,8 +586,7 @@ def dump(s: Scenario, path: str | os.PathLike, all_materials: bool = False) -> N
         f.write(dumps(s, all_materials=all_materials).encode("utf-8"))
 
 
-def load_scenario(path_or_preset: str | os.PathLike,
-                  changes: dict[str, object] | None = None) -> Scenario:
+def load_scenario(path_or_preset: str | os.PathLike, changes: dict[str, object] | None = None) -> Scenario:
     """A validated scenario: the preset of that name, or else the TOML file at that path,
     with `changes` (dotted path -> value, as `with_changes`) applied before it is validated.
 
@@ -569,8 +600,9 @@ def load_scenario(path_or_preset: str | os.PathLike,
         s = presets.preset(key)
     else:
         if not os.path.isfile(key):
-            raise ScenarioError("file", key, "no such file or preset; presets are: "
-                                + ", ".join(presets.preset_names(True)))
+            raise ScenarioError(
+                "file", key, "no such file or preset; presets are: " + ", ".join(presets.preset_names(True))
+            )
         s = load(key)
     if changes:
         s = with_changes(s, changes)
@@ -588,8 +620,7 @@ def _split(path: str) -> list[str | int]:
     for part in path.split("."):
         m = _STEP.match(part)
         if not m:
-            raise ScenarioError(path, part, "not a dotted field path such as 'load.q0' or "
-                                "'granules[2].vx'")
+            raise ScenarioError(path, part, "not a dotted field path such as 'load.q0' or 'granules[2].vx'")
         steps.append(m.group(1))
         steps += [int(i) for i in re.findall(r"\[(\d+)\]", m.group(2))]
     return steps
@@ -634,7 +665,7 @@ def describe_changes(description: str, changes: dict[str, object]) -> str:
         return description
     head = CHANGED.lstrip("; ")
     if description.startswith(head):  # an empty description with changes listed
-        base, sep, tail = "", head, description[len(head):]
+        base, sep, tail = "", head, description[len(head) :]
     else:
         base, sep, tail = description.partition(CHANGED)
     items: dict[str, str] = {}
@@ -670,13 +701,13 @@ def with_changes(s: Scenario, changes: dict[str, object]) -> Scenario:
             nxt = steps[k + 1]
             if isinstance(step, int):
                 if not isinstance(node, list) or not 0 <= step < len(node):
-                    raise ScenarioError(path, value, f"index [{step}] out of range "
-                                        f"({len(node) if isinstance(node, list) else 0} items)")
+                    raise ScenarioError(
+                        path, value, f"index [{step}] out of range ({len(node) if isinstance(node, list) else 0} items)"
+                    )
                 node = node[step]
                 continue
             if not isinstance(node, dict):
-                raise ScenarioError(path, value, f"'{step}' is inside something that "
-                                    "is not a table")
+                raise ScenarioError(path, value, f"'{step}' is inside something that is not a table")
             if node.get(step) is None:
                 if isinstance(nxt, int):
                     raise ScenarioError(path, value, f"there is no array '{step}' to index")
@@ -717,11 +748,9 @@ def toml_value(path: str, text: str) -> Any:
             pass
         if _BARE_WORD.match(text):
             return text
-        raise ScenarioError(path, text, f"not a TOML value (a number, \"text\", [1, 2], true or "
-                            f"false): {e}") from None
+        raise ScenarioError(path, text, f'not a TOML value (a number, "text", [1, 2], true or false): {e}') from None
     if set(table) != {"value"}:
-        raise ScenarioError(path, text, "one TOML value expected (a number, \"text\", [1, 2], "
-                            "true or false)")
+        raise ScenarioError(path, text, 'one TOML value expected (a number, "text", [1, 2], true or false)')
     return table["value"]
 
 
@@ -733,12 +762,32 @@ def parse_settings(items: list[str] | tuple[str, ...]) -> dict[str, object]:
         path, sep, text = item.partition("=")
         path, text = path.strip(), text.strip()
         if not sep or not path:
-            raise ScenarioError("--set", item, "expected PATH=VALUE, e.g. load.q0=3e4 or "
-                                "layout.intruder_material=\"steel\"")
+            raise ScenarioError(
+                "--set", item, 'expected PATH=VALUE, e.g. load.q0=3e4 or layout.intruder_material="steel"'
+            )
         _split(path)
         changes[path] = toml_value(path, text)
     return changes
 
 
-__all__ = ["from_dict", "to_dict", "loads", "load", "dumps", "dumps_with_granules_file", "dump", "load_scenario",
-           "with_changes", "describe_changes", "parse_settings", "toml_value", "CHANGED", "UNLISTED", "REQUIRED", "CHOICES", "MATERIAL_KEYS", "MATERIAL_REQUIRED", "MISSING"]
+__all__ = [
+    "from_dict",
+    "to_dict",
+    "loads",
+    "load",
+    "dumps",
+    "dumps_with_granules_file",
+    "dump",
+    "load_scenario",
+    "with_changes",
+    "describe_changes",
+    "parse_settings",
+    "toml_value",
+    "CHANGED",
+    "UNLISTED",
+    "REQUIRED",
+    "CHOICES",
+    "MATERIAL_KEYS",
+    "MATERIAL_REQUIRED",
+    "MISSING",
+]

@@ -35,6 +35,7 @@ sqrt(2) R, 2R / sqrt(3)), so that they touch: with one radius, d = 2R (sc), 2R /
 x_1 = R_1; the packing is then shifted so that its lowest surfaces are at x = y = z = 0,
 and the walls touch its outermost surfaces.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -43,8 +44,16 @@ from typing import NamedTuple
 
 import numpy as np
 
-from granplate.setup.scenario import (BOX_WALLS, ChainLayout, Granule, Imperfections, LatticeLayout, Layer,
-                                      SpaceLattice, Wall)
+from granplate.setup.scenario import (
+    BOX_WALLS,
+    ChainLayout,
+    Granule,
+    Imperfections,
+    LatticeLayout,
+    Layer,
+    SpaceLattice,
+    Wall,
+)
 
 
 class Packing(NamedTuple):
@@ -80,8 +89,7 @@ def column_radii(lay: LatticeLayout) -> list[float]:
     intruder columns."""
     radii = list(lay.column_radii) if lay.column_radii else [lay.radius] * lay.columns
     intruders = intruder_column_numbers(lay)
-    return [r * lay.intruder_ratio if c + 1 in intruders else r
-            for c, r in enumerate(radii)]
+    return [r * lay.intruder_ratio if c + 1 in intruders else r for c, r in enumerate(radii)]
 
 
 def column_materials(lay: LatticeLayout) -> list[str]:
@@ -89,8 +97,7 @@ def column_materials(lay: LatticeLayout) -> list[str]:
     intruder material."""
     mats = list(lay.column_materials) if lay.column_materials else [lay.material] * lay.columns
     intruders = intruder_column_numbers(lay)
-    return [intruder_material(lay) if c + 1 in intruders else m
-            for c, m in enumerate(mats)]
+    return [intruder_material(lay) if c + 1 in intruders else m for c, m in enumerate(mats)]
 
 
 def intruder_material(lay: LatticeLayout) -> str:
@@ -106,8 +113,7 @@ def half_pitch(radii: list[float]) -> float:
 def hexagonal_offsets(radii: list[float], a: float) -> list[float]:
     """d_c = sqrt((R_c + R_c+1)^2 - a^2) [m]: neighbours of columns c and c+1, a apart in y,
     touch (the paper's column_offset with a = R1). NaN when R_c + R_c+1 < a."""
-    return [math.sqrt((ri + rj) ** 2 - a**2) if ri + rj >= a else math.nan
-            for ri, rj in zip(radii[:-1], radii[1:])]
+    return [math.sqrt((ri + rj) ** 2 - a**2) if ri + rj >= a else math.nan for ri, rj in zip(radii[:-1], radii[1:])]
 
 
 def square_offsets(radii: list[float]) -> list[float]:
@@ -149,9 +155,11 @@ def lattice_sites(lay: LatticeLayout) -> list[Granule]:
     radii, mats = column_radii(lay), column_materials(lay)
     a = half_pitch(radii)
     xs = column_x(radii[0], column_offsets(lay))
-    return [Granule(xs[c - 1], row_y(lay, c, k, a), radii[c - 1], mats[c - 1],
-                    label=site_label(c, k))
-            for c in range(1, lay.columns + 1) for k in range(1, rows_in_column(lay, c) + 1)]
+    return [
+        Granule(xs[c - 1], row_y(lay, c, k, a), radii[c - 1], mats[c - 1], label=site_label(c, k))
+        for c in range(1, lay.columns + 1)
+        for k in range(1, rows_in_column(lay, c) + 1)
+    ]
 
 
 def intruder_sites(lay: LatticeLayout, labels: list[str]) -> set[str]:
@@ -168,8 +176,10 @@ def place_intruders(lay: LatticeLayout, sites: list[Granule]) -> list[Granule]:
     """Sites chosen as intruders take radius intruder_ratio x R and the intruder material."""
     chosen = intruder_sites(lay, [g.label for g in sites])
     mat = intruder_material(lay)
-    return [dataclasses.replace(g, radius=g.radius * lay.intruder_ratio, material=mat)
-            if g.label in chosen else g for g in sites]
+    return [
+        dataclasses.replace(g, radius=g.radius * lay.intruder_ratio, material=mat) if g.label in chosen else g
+        for g in sites
+    ]
 
 
 def to_origin(granules: list[Granule]) -> list[Granule]:
@@ -184,9 +194,11 @@ def to_origin(granules: list[Granule]) -> list[Granule]:
 def enclosing_walls(granules: list[Granule], material: str) -> tuple[Wall, ...]:
     """Walls `left` (x = 0), `bottom` (y = 0) and `top` (y = max(y + R)), granules at the origin."""
     top = max(g.y + g.radius for g in granules)
-    return (Wall((-1.0, 0.0), 0.0, label="left", material=material),
-            Wall((0.0, -1.0), 0.0, label="bottom", material=material),
-            Wall((0.0, 1.0), top, label="top", material=material))
+    return (
+        Wall((-1.0, 0.0), 0.0, label="left", material=material),
+        Wall((0.0, -1.0), 0.0, label="bottom", material=material),
+        Wall((0.0, 1.0), top, label="top", material=material),
+    )
 
 
 def plate_x(granules: list[Granule] | tuple[Granule, ...]) -> float:
@@ -198,8 +210,7 @@ def lattice_packing(lay: LatticeLayout) -> Packing:
     """A hexagonal or square packing (see the module docstring)."""
     granules = to_origin(place_intruders(lay, lattice_sites(lay)))
     column1 = tuple(site_label(1, k) for k in range(1, rows_in_column(lay, 1) + 1))
-    return Packing(tuple(granules), enclosing_walls(granules, lay.wall_material),
-                   plate_x(granules), column1)
+    return Packing(tuple(granules), enclosing_walls(granules, lay.wall_material), plate_x(granules), column1)
 
 
 def planar_in_space(packing: Packing) -> Packing:
@@ -207,17 +218,16 @@ def planar_in_space(packing: Packing) -> Packing:
     plane z = 0 with spin vectors (0, 0, 0), its walls the planes through its lines
     (normal (nx, ny, 0), the same offset [m])."""
     granules = tuple(dataclasses.replace(g, z=0.0, omega=(0.0, 0.0, 0.0)) for g in packing.granules)
-    walls = tuple(dataclasses.replace(w, normal=(float(w.normal[0]), float(w.normal[1]), 0.0))
-                  for w in packing.walls)
+    walls = tuple(dataclasses.replace(w, normal=(float(w.normal[0]), float(w.normal[1]), 0.0)) for w in packing.walls)
     return packing._replace(granules=granules, walls=walls)
 
 
 # --------------------------------------------------------------------------- chains
 
+
 def chain_radii(lay: ChainLayout) -> list[float]:
     """R_k [m] = radius taper^(k-1), times dimer_ratio for even k (k = 1..count)."""
-    return [lay.radius * lay.taper**k * (lay.dimer_ratio if k % 2 else 1.0)
-            for k in range(lay.count)]
+    return [lay.radius * lay.taper**k * (lay.dimer_ratio if k % 2 else 1.0) for k in range(lay.count)]
 
 
 def chain_materials(lay: ChainLayout) -> list[str]:
@@ -254,14 +264,17 @@ def chain_packing(lay: ChainLayout, dimension: int = 2) -> Packing:
     y = max(radii) if lay.y is None else lay.y
     if dimension == 3:
         z = max(radii) if lay.z is None else lay.z
-        granules = tuple(Granule(x, y, r, m, label=lab, z=z, omega=(0.0, 0.0, 0.0))
-                         for (lab, r, m), x in zip(beads, touching_x(radii)))
+        granules = tuple(
+            Granule(x, y, r, m, label=lab, z=z, omega=(0.0, 0.0, 0.0))
+            for (lab, r, m), x in zip(beads, touching_x(radii))
+        )
         end = plate_x(granules)
-        walls = (Wall((-1.0, 0.0, 0.0), 0.0, label="xmin", material=lay.wall_material),
-                 Wall((1.0, 0.0, 0.0), end, label="xmax", material=lay.wall_material))
+        walls = (
+            Wall((-1.0, 0.0, 0.0), 0.0, label="xmin", material=lay.wall_material),
+            Wall((1.0, 0.0, 0.0), end, label="xmax", material=lay.wall_material),
+        )
         return Packing(granules, walls, end, ("c1",))
-    granules = tuple(Granule(x, y, r, m, label=lab)
-                     for (lab, r, m), x in zip(beads, touching_x(radii)))
+    granules = tuple(Granule(x, y, r, m, label=lab) for (lab, r, m), x in zip(beads, touching_x(radii)))
     walls = (Wall((-1.0, 0.0), 0.0, label="left", material=lay.wall_material),)
     return Packing(granules, walls, plate_x(granules), ("c1",))
 
@@ -322,18 +335,24 @@ def plane_layers(lay: SpaceLattice) -> list[tuple[float, str]]:
     """(R_p [m], material) of each lattice plane p = 1.. along x."""
     if not lay.layers:
         return [(lay.radius, lay.material)] * planes_along_x(lay)
-    return [(lay.radius if ly.radius is None else ly.radius,
-             lay.material if ly.material is None else ly.material)
-            for ly in lay.layers for _ in range(layer_planes(lay.kind, ly))]
+    return [
+        (lay.radius if ly.radius is None else ly.radius, lay.material if ly.material is None else ly.material)
+        for ly in lay.layers
+        for _ in range(layer_planes(lay.kind, ly))
+    ]
 
 
 def plane_gap_distance(kind: str, t: int, u: int, r_max: float) -> float:
     """rho [m]: the in-plane distance from a site of plane type t to the nearest site of
     plane type u (0 when they are the same type), on the net of the largest radius r_max."""
     ly, lz = (c * r_max for c in PLANE_CELL[kind])
-    return min(math.hypot((fu[0] - ft[0] + iy) * ly, (fu[1] - ft[1] + iz) * lz)
-               for ft in PLANE_SITES[kind][t] for fu in PLANE_SITES[kind][u]
-               for iy in (-1, 0, 1) for iz in (-1, 0, 1))
+    return min(
+        math.hypot((fu[0] - ft[0] + iy) * ly, (fu[1] - ft[1] + iz) * lz)
+        for ft in PLANE_SITES[kind][t]
+        for fu in PLANE_SITES[kind][u]
+        for iy in (-1, 0, 1)
+        for iz in (-1, 0, 1)
+    )
 
 
 def plane_type(kind: str, plane: int) -> int:
@@ -363,15 +382,13 @@ def plane_clash(kind: str, radii: list[float]) -> tuple[int, int, float] | None:
         for q in range(p + 2, len(radii)):
             if not xs[q] - xs[p] < 2.0 * r_max:
                 break  # farther planes are farther apart still
-            gap = math.hypot(xs[q] - xs[p], rho[plane_type(kind, p), plane_type(kind, q)]) \
-                - radii[p] - radii[q]
+            gap = math.hypot(xs[q] - xs[p], rho[plane_type(kind, p), plane_type(kind, q)]) - radii[p] - radii[q]
             if gap < -1e-9 * min(radii[p], radii[q]):
                 return p, q, -gap
     return None
 
 
-def plane_sites(lay: SpaceLattice, plane: int, x: float, radius: float, material: str,
-                r_max: float) -> list[Granule]:
+def plane_sites(lay: SpaceLattice, plane: int, x: float, radius: float, material: str, r_max: float) -> list[Granule]:
     """The sites of plane `plane` (0-based) at x [m], row by row (y increasing), each row
     along z: ny x nz in-plane cells of the net of r_max."""
     ly, lz = (c * r_max for c in PLANE_CELL[lay.kind])
@@ -384,9 +401,21 @@ def plane_sites(lay: SpaceLattice, plane: int, x: float, radius: float, material
         for fy, fz in sorted(sites):
             row = j * per_row + ranks[fy] + 1
             for k in range(nz):
-                found.append((row, k + 1, Granule(x, (j + fy) * ly, radius, material,
-                                                  label=space_site_label(plane + 1, row, k + 1),
-                                                  z=(k + fz) * lz, omega=(0.0, 0.0, 0.0))))
+                found.append(
+                    (
+                        row,
+                        k + 1,
+                        Granule(
+                            x,
+                            (j + fy) * ly,
+                            radius,
+                            material,
+                            label=space_site_label(plane + 1, row, k + 1),
+                            z=(k + fz) * lz,
+                            omega=(0.0, 0.0, 0.0),
+                        ),
+                    )
+                )
     return [g for _, _, g in sorted(found, key=lambda e: (e[0], e[1]))]
 
 
@@ -396,8 +425,7 @@ def space_sites(lay: SpaceLattice) -> list[Granule]:
     radii = [r for r, _ in layers]
     r_max = max(radii)
     xs = column_x(radii[0], plane_spacings(lay.kind, radii))
-    return [g for p, ((r, m), x) in enumerate(zip(layers, xs))
-            for g in plane_sites(lay, p, x, r, m, r_max)]
+    return [g for p, ((r, m), x) in enumerate(zip(layers, xs)) for g in plane_sites(lay, p, x, r, m, r_max)]
 
 
 def to_corner(granules: list[Granule]) -> list[Granule]:
@@ -408,8 +436,9 @@ def to_corner(granules: list[Granule]) -> list[Granule]:
     return [dataclasses.replace(g, x=g.x - dx, y=g.y - dy, z=g.z - dz) for g in granules]
 
 
-def enclosing_box(granules: list[Granule] | tuple[Granule, ...], labels: tuple[str, ...],
-                  material: str) -> tuple[Wall, ...]:
+def enclosing_box(
+    granules: list[Granule] | tuple[Granule, ...], labels: tuple[str, ...], material: str
+) -> tuple[Wall, ...]:
     """The walls `labels` (of BOX_WALLS, in that order) touching the spheres' outermost
     surfaces: "xmin" normal -e_x, offset -min(x - R); "xmax" +e_x, max(x + R); and so on."""
     walls = []
@@ -429,19 +458,20 @@ def space_packing(lay: SpaceLattice) -> Packing:
     """An sc, bcc, fcc or hcp packing (see the module docstring); column1: plane 1's labels."""
     granules = to_corner(place_intruders(lay, space_sites(lay)))
     first = tuple(g.label for g in granules if g.label.startswith("x1y"))
-    return Packing(tuple(granules), enclosing_box(granules, lay.walls, lay.wall_material),
-                   plate_x(granules), first)
+    return Packing(tuple(granules), enclosing_box(granules, lay.walls, lay.wall_material), plate_x(granules), first)
 
 
 # --------------------------------------------------------------------------- imperfections
+
 
 def imperfect_radii(radii: np.ndarray, imp: Imperfections, u: np.ndarray) -> np.ndarray:
     """R (1 - jitter - radius_spread u) [m], u uniform in [0, 1)."""
     return radii * (1.0 - imp.jitter - imp.radius_spread * u)
 
 
-def jitter_offsets(radii: np.ndarray, imp: Imperfections, u_angle: np.ndarray,
-                   u_radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def jitter_offsets(
+    radii: np.ndarray, imp: Imperfections, u_angle: np.ndarray, u_radius: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """(dx, dy) [m] uniform within the disc of radius jitter R (polar draw)."""
     rho = imp.jitter * radii * np.sqrt(u_radius)
     theta = 2.0 * math.pi * u_angle
@@ -455,9 +485,9 @@ def vacant(labels: list[str], imp: Imperfections, rng: np.random.Generator) -> s
     return {labels[int(k)] for k in drawn} | set(imp.vacancies)
 
 
-def jitter_offsets_3d(radii: np.ndarray, imp: Imperfections, u_azimuth: np.ndarray,
-                      u_radius: np.ndarray, u_polar: np.ndarray
-                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def jitter_offsets_3d(
+    radii: np.ndarray, imp: Imperfections, u_azimuth: np.ndarray, u_radius: np.ndarray, u_polar: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(dx, dy, dz) [m] uniform within the ball of radius jitter R: distance jitter R u^(1/3),
     direction uniform on the sphere (azimuth 2 pi u, cos(polar) = 2 u - 1)."""
     rho = imp.jitter * radii * np.cbrt(u_radius)
@@ -488,9 +518,11 @@ def imperfect(packing: Packing, imp: Imperfections, dimension: int = 2) -> Packi
         dx, dy = jitter_offsets(r0, imp, u_a, u_d)
     labels = [g.label for g in gs]
     gone = vacant(labels, imp, rng)
-    moved = ((lambda g, k: {"z": g.z + float(dz[k])}) if dimension == 3 else (lambda g, k: {}))
-    granules = tuple(dataclasses.replace(g, x=g.x + float(dx[k]), y=g.y + float(dy[k]),
-                                         radius=float(radii[k]), **moved(g, k))
-                     for k, g in enumerate(gs) if g.label not in gone)
+    moved = (lambda g, k: {"z": g.z + float(dz[k])}) if dimension == 3 else (lambda g, k: {})
+    granules = tuple(
+        dataclasses.replace(g, x=g.x + float(dx[k]), y=g.y + float(dy[k]), radius=float(radii[k]), **moved(g, k))
+        for k, g in enumerate(gs)
+        if g.label not in gone
+    )
     column1 = tuple(lab for lab in packing.column1 if lab not in gone)
     return packing._replace(granules=granules, column1=column1)

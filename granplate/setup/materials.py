@@ -1,4 +1,5 @@
 """Materials and the effective contact properties of paper eq. (4)."""
+
 from __future__ import annotations
 
 import math

@@ -7,6 +7,7 @@ scipy.spatial is not imported, which costs a fresh process about 0.15 s); more g
 a k-d tree (scipy.spatial.cKDTree.query_pairs, O(N log N)). Both compare the squared
 distance with distance^2, so both return the same pairs in the same order.
 """
+
 from __future__ import annotations
 
 import threading

@@ -9,6 +9,7 @@ so no matrix is assembled.
 These checks are the only ones: the plate layer (`plate.constraints`, `plate.build`) calls
 them on its own inputs and reports their ScenarioError as a PlateError.
 """
+
 from __future__ import annotations
 
 from typing import Sequence
@@ -45,18 +46,22 @@ def check_plate_fields(p: Plate, x0: float) -> None:
     if p.stress_radius is not None:
         positive("plate.stress_radius", p.stress_radius)
         if p.stress_radius > max(p.width, p.height):
-            raise ScenarioError("plate.stress_radius", p.stress_radius,
-                                f"allowed: 0 < r <= max(plate.width, plate.height) = "
-                                f"{max(p.width, p.height):g} m (a disc larger than the plate "
-                                "averages over all of it)")
+            raise ScenarioError(
+                "plate.stress_radius",
+                p.stress_radius,
+                f"allowed: 0 < r <= max(plate.width, plate.height) = "
+                f"{max(p.width, p.height):g} m (a disc larger than the plate "
+                "averages over all of it)",
+            )
 
 
 def check_clamped_edges(p: Plate) -> None:
     """`plate.clamped_edges` is a tuple of names from PLATE_EDGES."""
     edges = p.clamped_edges
     if not isinstance(edges, tuple) or not all(isinstance(e, str) and e in PLATE_EDGES for e in edges):
-        raise ScenarioError("plate.clamped_edges", edges,
-                            "must be a subset of " + ", ".join(repr(e) for e in PLATE_EDGES))
+        raise ScenarioError(
+            "plate.clamped_edges", edges, "must be a subset of " + ", ".join(repr(e) for e in PLATE_EDGES)
+        )
 
 
 def check_mode_count(p: Plate, n_red: int) -> None:
@@ -80,8 +85,7 @@ def plate_contact_heights(s: Scenario) -> list[float]:
 def facing_granules(s: Scenario) -> list[int]:
     """Indices of the granules facing the plate's left edge at t = 0 (`faces_plate`), in
     granule order (s resolved, with a plate): its plate contacts at t = 0."""
-    return [i for i, g in enumerate(s.granules)
-            if faces_plate(s.plate, s.contact.neighbour_gap, g.x, g.y, g.radius)]
+    return [i for i, g in enumerate(s.granules) if faces_plate(s.plate, s.contact.neighbour_gap, g.x, g.y, g.radius)]
 
 
 def on_face_node(p: Plate, y: float) -> bool:
@@ -138,9 +142,11 @@ def check_symmetry_row(p: Plate) -> None:
     """An even `plate.ny`, so that the symmetry line is a row of element edges."""
     if p.ny % 2:
         raise ScenarioError(
-            "plate.ny", p.ny,
+            "plate.ny",
+            p.ny,
             f"must be even so that the symmetry line y = y0 + height/2 = {p.y0 + p.height / 2:g} m "
-            "is a row of element edges (with Q8 nodes along it)")
+            "is a row of element edges (with Q8 nodes along it)",
+        )
 
 
 def _contact_node(p: Plate, name: str, yk: float, left_y: np.ndarray) -> int:
@@ -149,10 +155,12 @@ def _contact_node(p: Plate, name: str, yk: float, left_y: np.ndarray) -> int:
     at = np.flatnonzero(np.abs(left_y - yk) <= NODE_RTOL * p.height)
     if at.size != 1:
         raise ScenarioError(
-            "plate.ny", p.ny,
+            "plate.ny",
+            p.ny,
             f"the rigid layer of {name} at y={yk:g} m is not on a mesh node; the left-edge node "
             f"spacing is height/(2 ny) = {p.height / (2 * p.ny):g} m; allowed: a layer at a multiple "
-            "of height/(2 ny) above plate.y0")
+            "of height/(2 ny) above plate.y0",
+        )
     return int(at[0])
 
 
@@ -160,8 +168,9 @@ def _names(n: int, names: Sequence[str] | None) -> list[str]:
     return list(names) if names is not None else [f"contact {k}" for k in range(n)]
 
 
-def rigid_layers(p: Plate, contact_y: Sequence[float], left_y: np.ndarray | None = None,
-                 names: Sequence[str] | None = None) -> list[tuple[int, list[int]]]:
+def rigid_layers(
+    p: Plate, contact_y: Sequence[float], left_y: np.ndarray | None = None, names: Sequence[str] | None = None
+) -> list[tuple[int, list[int]]]:
     """(driving node, other layer nodes) of each rigid-layer contact at the heights
     contact_y [m], as indices into left_y [m] (the heights of the left-edge nodes, in any
     order; None: `left_edge_node_heights`); refuses a contact off the left edge or between
@@ -175,27 +184,34 @@ def rigid_layers(p: Plate, contact_y: Sequence[float], left_y: np.ndarray | None
     for k, yk in enumerate(contact_y):
         if not (p.y0 - tol <= yk <= p.y0 + p.height + tol):
             raise ScenarioError(
-                "plate.y0", p.y0,
-                f"{names[k]} at y={yk:g} m lies outside the plate's left edge "
-                f"[{p.y0:g}, {p.y0 + p.height:g}] m")
+                "plate.y0",
+                p.y0,
+                f"{names[k]} at y={yk:g} m lies outside the plate's left edge [{p.y0:g}, {p.y0 + p.height:g}] m",
+            )
         at = _contact_node(p, names[k], yk, left_y)
         members = [int(n) for n in np.flatnonzero(np.abs(left_y - yk) <= half + tol)]
         for n in members:
             if n in owner:
                 j = owner[n]
                 raise ScenarioError(
-                    "plate.rigid_layer_width", p.rigid_layer_width,
+                    "plate.rigid_layer_width",
+                    p.rigid_layer_width,
                     f"the rigid layers of {names[j]} at y={contact_y[j]:g} m and {names[k]} at y={yk:g} m "
                     f"share the node at y={left_y[n]:g} m with w = {p.layer_width:g} m; "
-                    "allowed: w smaller than the distance between neighbouring contacts")
+                    "allowed: w smaller than the distance between neighbouring contacts",
+                )
             owner[n] = k
         layers.append((at, [n for n in members if n != at]))
     return layers
 
 
-def check_layers_off_clamps(p: Plate, contact_y: Sequence[float],
-                            layers: Sequence[tuple[int, Sequence[int]]], clamped: set[int],
-                            names: Sequence[str] | None = None) -> None:
+def check_layers_off_clamps(
+    p: Plate,
+    contact_y: Sequence[float],
+    layers: Sequence[tuple[int, Sequence[int]]],
+    clamped: set[int],
+    names: Sequence[str] | None = None,
+) -> None:
     """Refuse a contact on a clamped node, or a rigid layer that reaches one: layers as
     `rigid_layers` gives them and clamped, in the same node numbering (the plate layer's
     mesh nodes, or the indices of `clamped_left_nodes`); names as in `rigid_layers`."""
@@ -204,14 +220,18 @@ def check_layers_off_clamps(p: Plate, contact_y: Sequence[float],
         at = int(at)
         if at in clamped:
             raise ScenarioError(
-                "plate.clamped_edges", p.clamped_edges,
+                "plate.clamped_edges",
+                p.clamped_edges,
                 f"{names[k]} touches the plate at y={contact_y[k]:g} m, on a clamped node; allowed: "
-                "contacts on free parts of the left edge only")
+                "contacts on free parts of the left edge only",
+            )
         if any(int(n) in clamped for n in members):
             raise ScenarioError(
-                "plate.rigid_layer_width", p.rigid_layer_width,
+                "plate.rigid_layer_width",
+                p.rigid_layer_width,
                 f"the rigid layer of {names[k]} at y={contact_y[k]:g} m (w = {p.layer_width:g} m) "
-                "reaches a clamped node; allowed: a width that keeps every layer off the clamped edges")
+                "reaches a clamped node; allowed: a width that keeps every layer off the clamped edges",
+            )
 
 
 def patches_possible(s: Scenario, n_red: int, kind: str) -> bool:
@@ -228,14 +248,19 @@ def _check_patches_at_start(s: Scenario, between: list[int], n_red: int, kind: s
     p, i = s.plate, between[0]
     fixed = s.contact.detection == "fixed"
     field, value = ("contact.detection", "fixed") if fixed else ("plate.n_modes", p.n_modes)
-    why = ("contacts with fixed detection are those of t = 0 on rigid layers, which sit on nodes" if fixed else
-           "a dense basis cut to plate.n_modes has no static correction over the face")
+    why = (
+        "contacts with fixed detection are those of t = 0 on rigid layers, which sit on nodes"
+        if fixed
+        else "a dense basis cut to plate.n_modes has no static correction over the face"
+    )
     raise ScenarioError(
-        field, value,
+        field,
+        value,
         f"{names[i]} touches the plate's face at y={s.granules[i].y:g} m between face nodes (spacing "
         f"height/(2 ny) = {p.height / (2 * p.ny):g} m), which takes a patch contact (docs/model.md "
         f"section 3.5), and {why}; allowed: contact.detection = 'dynamic' with plate.n_modes = 0 "
-        "(all modes, or plate.modes = 'truncated'), or the granule's contact on a node")
+        "(all modes, or plate.modes = 'truncated'), or the granule's contact on a node",
+    )
 
 
 def check_plate_mesh(s: Scenario, names: dict[int, str] | None = None) -> None:
@@ -266,7 +291,8 @@ def check_truncated_plate(s: Scenario) -> None:
     p = s.plate
     if s.solver.scheme != "implicit":
         raise ScenarioError(
-            "solver.scheme", s.solver.scheme,
+            "solver.scheme",
+            s.solver.scheme,
             f"the truncated plate basis (plate.modes = {p.modes!r}, here with more than the "
             "dense limit of reduced dofs) is supported by the 'implicit' scheme only. Its static "
             "residual compliance R has no mass, so inside a step of the paper scheme the contact "
@@ -275,14 +301,19 @@ def check_truncated_plate(s: Scenario) -> None:
             "criterion (8)'s step control would make it worse, not better (steel-r1 on 8 x 80: "
             "R_tt = 1.4e-9 m/N and |N| up to 47 N give ~160 at the paper's 4e-8 s). Allowed: "
             "solver.scheme = 'implicit' (Newton on the interface forces, stable for any |lambda|), "
-            "or plate.modes = 'all' where the dense basis fits (8 x 80: about 1 GB, 1 minute)")
+            "or plate.modes = 'all' where the dense basis fits (8 x 80: about 1 GB, 1 minute)",
+        )
     if s.load.kind == "line" and s.load.target == "plate":
         raise ScenarioError(
-            "load.target", s.load.target,
+            "load.target",
+            s.load.target,
             "the truncated plate basis has a static correction at the contacts only, not for a "
-            "load on the plate's edge; allowed: load.target = 'granules', or plate.modes = 'all'")
+            "load on the plate's edge; allowed: load.target = 'granules', or plate.modes = 'all'",
+        )
     if not p.clamped_edges:
         raise ScenarioError(
-            "plate.clamped_edges", p.clamped_edges,
+            "plate.clamped_edges",
+            p.clamped_edges,
             "the truncated plate basis needs a plate held by at least one clamped edge (its static "
-            "compliance); allowed: a non-empty subset of top, bottom, left, right, or plate.modes = 'all'")
+            "compliance); allowed: a non-empty subset of top, bottom, left, right, or plate.modes = 'all'",
+        )

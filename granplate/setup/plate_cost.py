@@ -14,6 +14,7 @@ Two bases (Plate.modes):
 4 x 80 has about 2,200), "truncated" above where the plate supports it (at least one
 clamped edge, no load on its edge), else "all".
 """
+
 from __future__ import annotations
 
 import os
@@ -71,8 +72,10 @@ def build_estimate(kind: str, n_red: int, n_face: int = 0) -> tuple[float, float
     (n_face: the face's nodes, whose residual compliance the truncated basis keeps)."""
     if kind == "all":
         return DENSE_BYTES_PER_DOF2 * n_red**2, DENSE_SECONDS_PER_DOF3 * n_red**3
-    return (TRUNCATED_BYTES_PER_DOF * n_red + FACE_BYTES_PER_DOF2 * (2 * n_face) ** 2,
-            TRUNCATED_SECONDS_PER_DOF * n_red)
+    return (
+        TRUNCATED_BYTES_PER_DOF * n_red + FACE_BYTES_PER_DOF2 * (2 * n_face) ** 2,
+        TRUNCATED_SECONDS_PER_DOF * n_red,
+    )
 
 
 def check_fits(kind: str, n_red: int, modes: str, memory: float | None = None, n_face: int = 0) -> None:
@@ -84,10 +87,15 @@ def check_fits(kind: str, n_red: int, modes: str, memory: float | None = None, n
     need, seconds = build_estimate(kind, n_red, n_face)
     if memory <= 0.0 or need <= memory:
         return
-    hint = ("use plate.modes = \"truncated\" (or \"auto\"), or fewer elements (plate.nx, plate.ny)"
-            if kind == "all" else "use fewer elements (plate.nx, plate.ny)")
+    hint = (
+        'use plate.modes = "truncated" (or "auto"), or fewer elements (plate.nx, plate.ny)'
+        if kind == "all"
+        else "use fewer elements (plate.nx, plate.ny)"
+    )
     raise ScenarioError(
-        "plate.modes", modes,
+        "plate.modes",
+        modes,
         f"the {kind!r} modal basis of this plate ({n_red} reduced dofs) needs about "
         f"{need / 1e9:.3g} GB and {seconds:.3g} s to build; this machine allows "
-        f"{memory / 1e9:.3g} GB; {hint}")
+        f"{memory / 1e9:.3g} GB; {hint}",
+    )

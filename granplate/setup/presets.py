@@ -13,6 +13,7 @@ were computed with. `granplate preset NAME` prints a preset as TOML. Each
 description names the paper figures the preset reproduces; a preset changed by
 `with_changes` keeps its name, and its description gains "; changed: PATH = VALUE, ...".
 """
+
 from __future__ import annotations
 
 from typing import Callable
@@ -28,8 +29,7 @@ DESCRIPTIONS: dict[str, str] = {
     "steel-r1": "Steel packing, R2 = R1, q0 = 50 kN/m on column 1 (paper Fig. 2b, 3, 4a, A.1)",
     "steel-r05": "Steel packing, R2 = 0.5 R1, q0 = 50 kN/m (paper Fig. 4b, 6a, 7a)",
     "ptfe-r05": "PTFE intruders, R2 = 0.5 R1, q0 = 50 kN/m (paper Fig. 5, 6b, 7b, 8c)",
-    "ptfe-r05-moderate": "PTFE intruders, R2 = 0.5 R1, moderate shock q0 = 10 kN/m "
-                         "(paper Fig. 8b)",
+    "ptfe-r05-moderate": "PTFE intruders, R2 = 0.5 R1, moderate shock q0 = 10 kN/m (paper Fig. 8b)",
     "ptfe-r05-weak": "PTFE intruders, R2 = 0.5 R1, weak shock q0 = 2 kN/m (paper Fig. 8a)",
 }
 
@@ -39,15 +39,26 @@ PRESET_SOLVER = Solver(granular_friction="rk4")
 
 
 def _bare_plate() -> Scenario:
-    return Scenario(name="bare-plate", description=DESCRIPTIONS["bare-plate"],
-                    plate=Plate(x0=0.0), load=Load(target="plate", q0=50_000.0), solver=PRESET_SOLVER)
+    return Scenario(
+        name="bare-plate",
+        description=DESCRIPTIONS["bare-plate"],
+        plate=Plate(x0=0.0),
+        load=Load(target="plate", q0=50_000.0),
+        solver=PRESET_SOLVER,
+    )
 
 
 def _packing(name: str, ratio: float, intruder: str, q0: float) -> Callable[[], Scenario]:
     def make() -> Scenario:
-        return Scenario(name=name, description=DESCRIPTIONS[name],
-                        layout=Layout(R2_ratio=ratio, intruder_material=intruder),
-                        plate=Plate(), load=Load(target="granules", q0=q0), solver=PRESET_SOLVER)
+        return Scenario(
+            name=name,
+            description=DESCRIPTIONS[name],
+            layout=Layout(R2_ratio=ratio, intruder_material=intruder),
+            plate=Plate(),
+            load=Load(target="granules", q0=q0),
+            solver=PRESET_SOLVER,
+        )
+
     make.__doc__ = DESCRIPTIONS[name]
     return make
 
@@ -90,15 +101,26 @@ def twin_3d(plane: Scenario) -> Scenario:
     p = plane.plate
     assert isinstance(p, Plate), f"{plane.name} has no plane plate"
     name = "3d-" + plane.name
-    solid = Solid(size=(p.width, p.height, p.thickness), elements=(p.nx, p.ny, 1), material=p.material,
-                  clamped=("ymin", "ymax"), rigid_layers=plane.layout is not None,
-                  max_frequency=TWIN_MAX_FREQUENCY.get(plane.name, Solid.max_frequency),
-                  origin=None if plane.layout is not None or p.x0 is None else (p.x0, p.y0, -0.5 * p.thickness))
+    solid = Solid(
+        size=(p.width, p.height, p.thickness),
+        elements=(p.nx, p.ny, 1),
+        material=p.material,
+        clamped=("ymin", "ymax"),
+        rigid_layers=plane.layout is not None,
+        max_frequency=TWIN_MAX_FREQUENCY.get(plane.name, Solid.max_frequency),
+        origin=None if plane.layout is not None or p.x0 is None else (p.x0, p.y0, -0.5 * p.thickness),
+    )
     return dataclasses.replace(
-        plane, name=name, description=f"3D twin of {plane.name}: " + plane.description, dimension=3, plate=solid,
-        time=dataclasses.replace(plane.time, dt_max=TWIN_STEPS.get(plane.name, TWIN_DT),
-                                 dt_initial=TWIN_STEPS.get(plane.name, TWIN_DT)),
-        solver=Solver(scheme="verlet", granular_friction="split"))
+        plane,
+        name=name,
+        description=f"3D twin of {plane.name}: " + plane.description,
+        dimension=3,
+        plate=solid,
+        time=dataclasses.replace(
+            plane.time, dt_max=TWIN_STEPS.get(plane.name, TWIN_DT), dt_initial=TWIN_STEPS.get(plane.name, TWIN_DT)
+        ),
+        solver=Solver(scheme="verlet", granular_friction="split"),
+    )
 
 
 for _name in list(PRESETS):
@@ -120,6 +142,5 @@ def preset(name: str) -> Scenario:
     try:
         make = PRESETS[name]
     except (KeyError, TypeError):
-        raise ScenarioError("preset", name, "unknown preset; presets are: "
-                            + ", ".join(PRESETS)) from None
+        raise ScenarioError("preset", name, "unknown preset; presets are: " + ", ".join(PRESETS)) from None
     return make()

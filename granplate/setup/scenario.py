@@ -6,6 +6,7 @@ from a `LatticeLayout`, chains from a `ChainLayout`, sc, bcc, fcc and hcp lattic
 spheres in space from a `SpaceLattice`; any other assembly is given granule by granule. Validation (`validate`) refuses bad input before anything runs,
 with a `ScenarioError` naming the field, the value and what is allowed.
 """
+
 from __future__ import annotations
 
 import math
@@ -238,13 +239,17 @@ class SpaceLattice:
 
 #: `[layout] kind` -> the dataclass that holds that kind's fields.
 LAYOUT_KINDS: dict[str, type] = {
-    "paper": Layout, "hexagonal": LatticeLayout, "square": LatticeLayout, "chain": ChainLayout,
+    "paper": Layout,
+    "hexagonal": LatticeLayout,
+    "square": LatticeLayout,
+    "chain": ChainLayout,
     **{k: SpaceLattice for k in SPACE_LATTICE_KINDS},
 }
 #: The layout kinds of each dimension (`Scenario.dimension`); a chain is either, and the
 #: planar packings (paper, hexagonal, square) lie in the plane z = 0 in space.
 LAYOUT_KINDS_BY_DIMENSION: dict[int, tuple[str, ...]] = {
-    2: ("paper", "hexagonal", "square", "chain"), 3: SPACE_LATTICE_KINDS + ("chain", "paper", "hexagonal", "square"),
+    2: ("paper", "hexagonal", "square", "chain"),
+    3: SPACE_LATTICE_KINDS + ("chain", "paper", "hexagonal", "square"),
 }
 
 
@@ -461,9 +466,7 @@ class Contact:
     mu: float = 0.099
     k_s: float = 1000.0
     alpha_n: float = 6.313e-3
-    pairs: tuple[PairCoefficients, ...] = (
-        PairCoefficients(("steel", "ptfe"), alpha_n=6.313e-2),
-    )
+    pairs: tuple[PairCoefficients, ...] = (PairCoefficients(("steel", "ptfe"), alpha_n=6.313e-2),)
     clip_tensile: bool = True
     neighbour_gap: float = 0.05
     torque_arm: str = "radius"

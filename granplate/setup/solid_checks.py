@@ -8,6 +8,7 @@ rule and its message): a granule may touch the solid but not cross its surface, 
 centre never lies inside it. For a box the signed distance of a centre to the surface is
 in closed form (`box_signed_distance`); for a mesh file it is the surface's
 (solid.surface.closest_point), computed where the file is read."""
+
 from __future__ import annotations
 
 import math
@@ -37,8 +38,11 @@ def check_box(sd: Solid) -> None:
     """size, elements and origin of a box."""
     if sd.size is None or sd.elements is None:
         missing = "plate.size" if sd.size is None else "plate.elements"
-        raise ScenarioError(missing, None, "a 3D [plate] needs size [Lx, Ly, Lz] (m) and elements "
-                            "[nx, ny, nz], or a mesh file (plate.mesh)")
+        raise ScenarioError(
+            missing,
+            None,
+            "a 3D [plate] needs size [Lx, Ly, Lz] (m) and elements [nx, ny, nz], or a mesh file (plate.mesh)",
+        )
     for i, v in enumerate(_triple("plate.size", sd.size)):
         positive(f"plate.size[{i}]", v)
     lo, hi = ELEMENTS_RANGE
@@ -66,8 +70,9 @@ def check_solid_fields(sd: Solid) -> None:
     """Every field of a solid but its material (which needs the scenario)."""
     if sd.mesh is not None:
         if sd.size is not None or sd.elements is not None:
-            raise ScenarioError("plate.mesh", sd.mesh, "a mesh file excludes plate.size and plate.elements: "
-                                "give one or the other")
+            raise ScenarioError(
+                "plate.mesh", sd.mesh, "a mesh file excludes plate.size and plate.elements: give one or the other"
+            )
         if not isinstance(sd.mesh, str) or not sd.mesh:
             raise ScenarioError("plate.mesh", sd.mesh, "must be a file name (Gmsh .msh)")
         names = None
@@ -93,32 +98,52 @@ def check_solid_fields(sd: Solid) -> None:
             raise ScenarioError(f"{path}.radius", rp.radius, "must be > 0 [m]")
         if rp.axis is not None:
             ax = rp.axis
-            if not isinstance(ax, tuple) or len(ax) != 3 or not all(
-                    isinstance(c, (int, float)) and not isinstance(c, bool) and math.isfinite(c) for c in ax) \
-                    or not any(c != 0.0 for c in ax):
-                raise ScenarioError(f"{path}.axis", list(ax) if isinstance(ax, tuple) else ax,
-                                    "must be three finite numbers, not all zero (the strip's direction), or absent (a disc)")
+            if (
+                not isinstance(ax, tuple)
+                or len(ax) != 3
+                or not all(isinstance(c, (int, float)) and not isinstance(c, bool) and math.isfinite(c) for c in ax)
+                or not any(c != 0.0 for c in ax)
+            ):
+                raise ScenarioError(
+                    f"{path}.axis",
+                    list(ax) if isinstance(ax, tuple) else ax,
+                    "must be three finite numbers, not all zero (the strip's direction), or absent (a disc)",
+                )
         if not isinstance(rp.rotates, bool):
-            raise ScenarioError(f"{path}.rotates", rp.rotates, "must be true (six rigid motions) or false "
-                                "(translation only)")
+            raise ScenarioError(
+                f"{path}.rotates", rp.rotates, "must be true (six rigid motions) or false (translation only)"
+            )
     if not isinstance(sd.rigid_layers, bool):
         raise ScenarioError("plate.rigid_layers", sd.rigid_layers, "must be true or false")
     if sd.rigid_layers and sd.mesh is not None:
-        raise ScenarioError("plate.rigid_layers", True, "the paper's rigid layers are placed on a box's face "
-                            "(plate.size); on a mesh file's solid give plate.rigid_patches")
+        raise ScenarioError(
+            "plate.rigid_layers",
+            True,
+            "the paper's rigid layers are placed on a box's face "
+            "(plate.size); on a mesh file's solid give plate.rigid_patches",
+        )
     if sd.rigid_layer_width is not None:
-        w = finite("plate.rigid_layer_width", sd.rigid_layer_width, "must be > 0 [m] (or absent: one element edge along y)")
+        w = finite(
+            "plate.rigid_layer_width", sd.rigid_layer_width, "must be > 0 [m] (or absent: one element edge along y)"
+        )
         if not w > 0.0:
-            raise ScenarioError("plate.rigid_layer_width", sd.rigid_layer_width,
-                                "must be > 0 [m] (or absent: one element edge along y)")
+            raise ScenarioError(
+                "plate.rigid_layer_width", sd.rigid_layer_width, "must be > 0 [m] (or absent: one element edge along y)"
+            )
     if not isinstance(sd.residual, bool):
         raise ScenarioError("plate.residual", sd.residual, "must be true or false")
     if sd.stress_radius is not None:
-        r = finite("plate.stress_radius", sd.stress_radius, "must be > 0 [m] (or absent: a quarter of the "
-                   "body's smallest extent)")
+        r = finite(
+            "plate.stress_radius",
+            sd.stress_radius,
+            "must be > 0 [m] (or absent: a quarter of the body's smallest extent)",
+        )
         if not r > 0.0:
-            raise ScenarioError("plate.stress_radius", sd.stress_radius, "must be > 0 [m] (or absent: a quarter "
-                                "of the body's smallest extent)")
+            raise ScenarioError(
+                "plate.stress_radius",
+                sd.stress_radius,
+                "must be > 0 [m] (or absent: a quarter of the body's smallest extent)",
+            )
 
 
 def check_solid(s: Scenario) -> None:
@@ -153,8 +178,10 @@ def solid_named(sd: Solid) -> str:
     """The solid as a message names it: its box corners, or its mesh file."""
     if is_box(sd):
         lo, hi = box_corners(sd)
-        return f"the elastic solid (the box [{', '.join(f'{v:.6g}' for v in lo)}] .. " \
-               f"[{', '.join(f'{v:.6g}' for v in hi)}] m of plate.origin and plate.size)"
+        return (
+            f"the elastic solid (the box [{', '.join(f'{v:.6g}' for v in lo)}] .. "
+            f"[{', '.join(f'{v:.6g}' for v in hi)}] m of plate.origin and plate.size)"
+        )
     return f"the elastic solid (the surface of plate.mesh = {sd.mesh!r})"
 
 
@@ -169,22 +196,27 @@ def check_solid_clearance(s: Scenario, distances: Sequence[float], named: dict[i
     for i, (g, d) in enumerate(zip(s.granules, distances)):
         if d < 0.0:
             raise ScenarioError(
-                granule_path(s.granules_file, i, None, s.dimension), g.label,
+                granule_path(s.granules_file, i, None, s.dimension),
+                g.label,
                 f"{named[i]} has its centre inside {what}, {-d:.6g} m below its surface, at t = 0; "
                 f"move the granule or the solid ({move}) so that the granule lies outside it "
-                f"(distance from its centre to the surface >= its radius {g.radius:.6g} m)")
+                f"(distance from its centre to the surface >= its radius {g.radius:.6g} m)",
+            )
         pen = g.radius - d
         if pen > rtol * g.radius:
             raise ScenarioError(
-                granule_path(s.granules_file, i, None, s.dimension), g.label,
+                granule_path(s.granules_file, i, None, s.dimension),
+                g.label,
                 f"{named[i]} penetrates {what} by {pen:.6g} m at t = 0; a granule may touch the "
                 f"solid but not cross it: move the granule or the solid ({move}) so that the "
                 f"distance from its centre to the surface ({d:.6g} m) is at least its radius "
-                f"{g.radius:.6g} m")
+                f"{g.radius:.6g} m",
+            )
 
 
-def wall_cuts_box(normal: Sequence[float], offset: float, lower: Sequence[float], upper: Sequence[float],
-                  tol: float) -> bool:
+def wall_cuts_box(
+    normal: Sequence[float], offset: float, lower: Sequence[float], upper: Sequence[float], tol: float
+) -> bool:
     """Whether the wall plane n.x = offset [m] (n a unit normal) passes through the inside of
     the box lower..upper [m], deeper than tol [m] (a plane along a face does not)."""
     lo = sum(min(n * a, n * b) for n, a, b in zip(normal, lower, upper))
@@ -192,8 +224,15 @@ def wall_cuts_box(normal: Sequence[float], offset: float, lower: Sequence[float]
     return lo + tol < offset < hi - tol
 
 
-def wall_contact_on_box(normal: Sequence[float], offset: float, centre: Sequence[float], radius: float,
-                        lower: Sequence[float], upper: Sequence[float], tol: float) -> bool:
+def wall_contact_on_box(
+    normal: Sequence[float],
+    offset: float,
+    centre: Sequence[float],
+    radius: float,
+    lower: Sequence[float],
+    upper: Sequence[float],
+    tol: float,
+) -> bool:
     """Whether a sphere (centre, radius [m]) within tol [m] of touching the wall n.x = offset
     (n a unit normal, the sphere on the side n.x < offset) touches it at a point of the box
     lower..upper's surface, within tol: the wall then lies on the face the sphere meets."""

@@ -11,6 +11,7 @@ The plate's fields and mesh are checked too, before anything is built (setup.pla
 the one owner of those rules: the plate layer runs the same checks on a direct caller's
 inputs); single fields are checked by setup.fields.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -26,22 +27,66 @@ import numpy as np
 
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import granule_named, layout_packing, plane_offset, resolve, unit
-from granplate.setup.layouts import (INTRUDER_COLUMN_RULES, column_radii, layer_planes, half_pitch,
-                                     hexagonal_offsets, lattice_sites, plane_clash, plane_gap_distance,
-                                     plane_layers, plane_type, planes_along_x, planes_per_cell, sites_per_cell, space_sites)
+from granplate.setup.layouts import (
+    INTRUDER_COLUMN_RULES,
+    column_radii,
+    layer_planes,
+    half_pitch,
+    hexagonal_offsets,
+    lattice_sites,
+    plane_clash,
+    plane_gap_distance,
+    plane_layers,
+    plane_type,
+    planes_along_x,
+    planes_per_cell,
+    sites_per_cell,
+    space_sites,
+)
 from granplate.setup.drive_checks import check_drives, check_gravity
-from granplate.setup.fields import check_dimension, finite, int_at_least, is_number, material_exists, nonneg, positive, string_in
+from granplate.setup.fields import (
+    check_dimension,
+    finite,
+    int_at_least,
+    is_number,
+    material_exists,
+    nonneg,
+    positive,
+    string_in,
+)
 from granplate.setup.granules_file import granule_path
 from granplate.setup.pairs import close_pairs, contact_search_distance, superset_pairs
 from granplate.setup.plate_checks import check_plate_fields, check_plate_mesh
-from granplate.setup.solid_checks import (box_corners, box_distances, check_solid, check_solid_clearance, is_box,
-                                         solid_named, wall_contact_on_box, wall_cuts_box)
+from granplate.setup.solid_checks import (
+    box_corners,
+    box_distances,
+    check_solid,
+    check_solid_clearance,
+    is_box,
+    solid_named,
+    wall_contact_on_box,
+    wall_cuts_box,
+)
 from granplate.setup.plate_cost import MEMORY_SHARE, physical_memory
 from granplate.setup.materials import Material
-from granplate.setup.scenario import (Solid, BOX_WALLS, LAYOUT_KINDS, LAYOUT_KINDS_BY_DIMENSION, NORMAL_LAWS,
-                                      SPACE_LATTICE_KINDS, SQRT2_MINUS_1, ChainLayout, Granule,
-                                      Imperfections, LatticeLayout, Layer, Layout, Plate, Scenario,
-                                      SpaceLattice)
+from granplate.setup.scenario import (
+    Solid,
+    BOX_WALLS,
+    LAYOUT_KINDS,
+    LAYOUT_KINDS_BY_DIMENSION,
+    NORMAL_LAWS,
+    SPACE_LATTICE_KINDS,
+    SQRT2_MINUS_1,
+    ChainLayout,
+    Granule,
+    Imperfections,
+    LatticeLayout,
+    Layer,
+    Layout,
+    Plate,
+    Scenario,
+    SpaceLattice,
+)
 
 #: Lever arms of the friction torque (Contact.torque_arm).
 TORQUE_ARMS: tuple[str, ...] = ("radius", "contact_point")
@@ -92,6 +137,7 @@ MAX_LAYOUT_SITES = 1_000_000
 
 # --------------------------------------------------------------------------- sections
 
+
 def _check_dimension(s: Scenario) -> None:
     check_dimension(s.dimension)
 
@@ -110,28 +156,42 @@ def _check_planar(s: Scenario) -> None:
             if not (is_number(v) and v == 0.0):
                 raise ScenarioError(_granule(s, i, f), v, f"must be 0 in 2D (discs in the plane), {SET_3D}")
         if isinstance(g.omega, tuple):
-            raise ScenarioError(_granule(s, i, "omega"), list(g.omega), "must be a number in 2D (the spin "
-                                f"about z [rad/s]); a vector [wx, wy, wz] is 3D: {SET_3D}")
+            raise ScenarioError(
+                _granule(s, i, "omega"),
+                list(g.omega),
+                f"must be a number in 2D (the spin about z [rad/s]); a vector [wx, wy, wz] is 3D: {SET_3D}",
+            )
     for k, w in enumerate(s.walls):
         p = f"walls[{k}]"
         if isinstance(w.normal, tuple) and len(w.normal) == 3:
-            raise ScenarioError(f"{p}.normal", list(w.normal), "has 3 components, a plane of 3D: "
-                                f"give [nx, ny] in 2D, {SET_3D}")
+            raise ScenarioError(
+                f"{p}.normal", list(w.normal), f"has 3 components, a plane of 3D: give [nx, ny] in 2D, {SET_3D}"
+            )
         if w.point is not None:
             raise ScenarioError(f"{p}.point", w.point, f"a point on a plane is 3D: give offset in 2D, {SET_3D}")
     if s.load.kind == "force":
-        raise ScenarioError("load.kind", s.load.kind, "a total force [N] along a direction is 3D; "
-                            f"in 2D use kind = \"line\" (q0 [N/m]) or \"none\", {SET_3D}")
+        raise ScenarioError(
+            "load.kind",
+            s.load.kind,
+            f'a total force [N] along a direction is 3D; in 2D use kind = "line" (q0 [N/m]) or "none", {SET_3D}',
+        )
     lay = s.layout
     if lay is not None and isinstance(lay.kind, str) and lay.kind in SPACE_LATTICE_KINDS:
-        raise ScenarioError("layout.kind", lay.kind, "a lattice of spheres in space is 3D: in 2D use "
-                            "one of " + ", ".join(repr(k) for k in LAYOUT_KINDS_BY_DIMENSION[2])
-                            + f", {SET_3D}")
+        raise ScenarioError(
+            "layout.kind",
+            lay.kind,
+            "a lattice of spheres in space is 3D: in 2D use "
+            "one of " + ", ".join(repr(k) for k in LAYOUT_KINDS_BY_DIMENSION[2]) + f", {SET_3D}",
+        )
     if isinstance(lay, ChainLayout) and lay.z is not None:
         raise ScenarioError("layout.z", lay.z, f"a chain's depth z is 3D: leave it out in 2D, {SET_3D}")
     if isinstance(s.plate, Solid):
-        raise ScenarioError("plate", "[plate]", "an elastic solid (size, elements or mesh) is 3D: "
-                            f"in 2D the [plate] is a plane-stress plate (width, height, thickness), {SET_3D}")
+        raise ScenarioError(
+            "plate",
+            "[plate]",
+            "an elastic solid (size, elements or mesh) is 3D: "
+            f"in 2D the [plate] is a plane-stress plate (width, height, thickness), {SET_3D}",
+        )
 
 
 def _check_spatial(s: Scenario) -> None:
@@ -139,19 +199,34 @@ def _check_spatial(s: Scenario) -> None:
     an elastic solid (setup.solid_checks); vector spins; walls as planes."""
     if s.plate is not None:
         if not isinstance(s.plate, Solid):
-            raise ScenarioError("plate", "[plate]", "in 3D the [plate] is an elastic solid (setup.scenario."
-                                "Solid: size, elements, origin or mesh, material, element, clamped, rollers, "
-                                "max_frequency), not a plane-stress plate: set dimension = 2 for a plate")
+            raise ScenarioError(
+                "plate",
+                "[plate]",
+                "in 3D the [plate] is an elastic solid (setup.scenario."
+                "Solid: size, elements, origin or mesh, material, element, clamped, rollers, "
+                "max_frequency), not a plane-stress plate: set dimension = 2 for a plate",
+            )
         check_solid(s)
     lay = s.layout
-    if lay is not None and isinstance(lay.kind, str) and lay.kind in LAYOUT_KINDS \
-            and lay.kind not in LAYOUT_KINDS_BY_DIMENSION[3]:
-        raise ScenarioError("layout.kind", lay.kind, "a packing of discs in the plane is 2D: in 3D use "
-                            "one of " + ", ".join(repr(k) for k in LAYOUT_KINDS_BY_DIMENSION[3])
-                            + " (or list [[granules]])")
+    if (
+        lay is not None
+        and isinstance(lay.kind, str)
+        and lay.kind in LAYOUT_KINDS
+        and lay.kind not in LAYOUT_KINDS_BY_DIMENSION[3]
+    ):
+        raise ScenarioError(
+            "layout.kind",
+            lay.kind,
+            "a packing of discs in the plane is 2D: in 3D use "
+            "one of " + ", ".join(repr(k) for k in LAYOUT_KINDS_BY_DIMENSION[3]) + " (or list [[granules]])",
+        )
     if s.load.kind == "line" and s.load.target == "plate" and isinstance(s.plate, Solid) and not is_box(s.plate):
-        raise ScenarioError("load.target", s.load.target, "a line load on a 3D solid acts on a box's face "
-                            "xmin (plate.size); a mesh file's solid takes loads through granules")
+        raise ScenarioError(
+            "load.target",
+            s.load.target,
+            "a line load on a 3D solid acts on a box's face "
+            "xmin (plate.size); a mesh file's solid takes loads through granules",
+        )
     spins = [g.omega for g in s.granules]
     vectors = set(map(type, spins)) <= {tuple} and set(map(len, spins)) <= {3}
     for i, g in enumerate(() if vectors else s.granules):
@@ -161,8 +236,9 @@ def _check_spatial(s: Scenario) -> None:
                 continue  # the default: resolve makes it (0, 0, 0)
             raise ScenarioError(_granule(s, i, "omega"), om, "omega is a vector [wx, wy, wz] in 3D (rad/s)")
         if len(om) != 3:
-            raise ScenarioError(_granule(s, i, "omega"), list(om), "omega is a vector [wx, wy, wz] in 3D (rad/s): "
-                                "three numbers")
+            raise ScenarioError(
+                _granule(s, i, "omega"), list(om), "omega is a vector [wx, wy, wz] in 3D (rad/s): three numbers"
+            )
     for k, w in enumerate(s.walls):
         _check_plane(f"walls[{k}]", w)
     if s.box is not None:
@@ -172,8 +248,7 @@ def _check_spatial(s: Scenario) -> None:
 def _vector3(path: str, v: Any, what: str) -> tuple[float, float, float]:
     """Three finite numbers, or a ScenarioError naming `path` (`what`: the vector, in words)."""
     if not isinstance(v, tuple) or len(v) != 3 or not all(is_number(c) and math.isfinite(c) for c in v):
-        raise ScenarioError(path, list(v) if isinstance(v, tuple) else v,
-                            f"must be three finite numbers {what}")
+        raise ScenarioError(path, list(v) if isinstance(v, tuple) else v, f"must be three finite numbers {what}")
     return v
 
 
@@ -189,12 +264,14 @@ def _check_plane(p: str, w: Any) -> None:
     """A 3D wall: a nonzero normal [nx, ny, nz] and offset, or point, or both agreeing."""
     n = w.normal
     if isinstance(n, tuple) and len(n) == 2:
-        raise ScenarioError(f"{p}.normal", list(n), "has 2 components, a line of 2D: in 3D give "
-                            "[nx, ny, nz] (a plane's normal)")
+        raise ScenarioError(
+            f"{p}.normal", list(n), "has 2 components, a line of 2D: in 3D give [nx, ny, nz] (a plane's normal)"
+        )
     _direction(f"{p}.normal", n, "[nx, ny, nz]")
     if w.offset is None and w.point is None:
-        raise ScenarioError(f"{p}.offset", None, f"give the plane's offset [m] or a point on it, "
-                            f"{p}.point = [x, y, z] [m]")
+        raise ScenarioError(
+            f"{p}.offset", None, f"give the plane's offset [m] or a point on it, {p}.point = [x, y, z] [m]"
+        )
     if w.offset is not None:
         finite(f"{p}.offset", w.offset)
     if w.point is None:
@@ -204,10 +281,13 @@ def _check_plane(p: str, w: Any) -> None:
         through = plane_offset(n, w.point)
         scale = max(abs(w.offset), math.hypot(*w.point))
         if not abs(w.offset - through) <= PLANE_RTOL * scale:
-            raise ScenarioError(f"{p}.point", list(w.point),
-                                f"lies on the plane of offset {through:.15g} m (point . n, n the unit "
-                                f"normal), not {p}.offset = {w.offset!r} m; give one of the two, or "
-                                f"both agreeing within {PLANE_RTOL:g} relative")
+            raise ScenarioError(
+                f"{p}.point",
+                list(w.point),
+                f"lies on the plane of offset {through:.15g} m (point . n, n the unit "
+                f"normal), not {p}.offset = {w.offset!r} m; give one of the two, or "
+                f"both agreeing within {PLANE_RTOL:g} relative",
+            )
 
 
 def _check_box(s: Scenario) -> None:
@@ -216,8 +296,12 @@ def _check_box(s: Scenario) -> None:
     hi = _vector3("box.upper", b.upper, "[x1, y1, z1] [m]")
     for k, axis in enumerate("xyz"):
         if not lo[k] < hi[k]:
-            raise ScenarioError("box.upper", list(hi), f"must exceed box.lower = {list(lo)} along "
-                                f"every axis ({axis}: {hi[k]!r} <= {lo[k]!r}); allowed: lower < upper")
+            raise ScenarioError(
+                "box.upper",
+                list(hi),
+                f"must exceed box.lower = {list(lo)} along "
+                f"every axis ({axis}: {hi[k]!r} <= {lo[k]!r}); allowed: lower < upper",
+            )
     material_exists("box.material", b.material, s)
 
 
@@ -228,8 +312,9 @@ def _check_materials(s: Scenario) -> None:
         p = f"materials.{name}"
         positive(f"{p}.E", m.E)
         if m.E > E_MAX:
-            raise ScenarioError(f"{p}.E", m.E, f"must be in (0, {E_MAX:g}] Pa (diamond, the "
-                                "stiffest solid, has 1.2e12)")
+            raise ScenarioError(
+                f"{p}.E", m.E, f"must be in (0, {E_MAX:g}] Pa (diamond, the stiffest solid, has 1.2e12)"
+            )
         finite(f"{p}.nu", m.nu, "must be in (-1, 0.5) (a finite number)")
         if not -1.0 < m.nu < 0.5:
             raise ScenarioError(f"{p}.nu", m.nu, "must be in (-1, 0.5)")
@@ -238,8 +323,9 @@ def _check_materials(s: Scenario) -> None:
             positive(f"{p}.Y", m.Y)
         _check_johnson_fields(p, m)
         if m.rho > RHO_MAX:
-            raise ScenarioError(f"{p}.rho", m.rho, f"must be in (0, {RHO_MAX:g}] kg/m^3 (osmium, "
-                                "the densest solid, has 22,590)")
+            raise ScenarioError(
+                f"{p}.rho", m.rho, f"must be in (0, {RHO_MAX:g}] kg/m^3 (osmium, the densest solid, has 22,590)"
+            )
 
 
 #: Allowed ranges of the law "johnson"'s material fields (docs/model.md section 3.10):
@@ -256,28 +342,44 @@ def _check_johnson_fields(p: str, m: Material) -> None:
     if m.C is not None:
         finite(f"{p}.C", m.C)
         if not 0.0 <= m.C <= RATE_COEFFICIENT_MAX:
-            raise ScenarioError(f"{p}.C", m.C, f"must be in [0, {RATE_COEFFICIENT_MAX:g}] (the yield "
-                                "strength's rate coefficient, Y(rate) = Y [1 + C ln(rate / rate_ref)])")
+            raise ScenarioError(
+                f"{p}.C",
+                m.C,
+                f"must be in [0, {RATE_COEFFICIENT_MAX:g}] (the yield "
+                "strength's rate coefficient, Y(rate) = Y [1 + C ln(rate / rate_ref)])",
+            )
         if m.rate_ref is None:
-            raise ScenarioError(f"{p}.rate_ref", None, f"missing: {p}.C = {m.C!r} needs the reference "
-                                "strain rate rate_ref [1/s] (give both or neither)")
+            raise ScenarioError(
+                f"{p}.rate_ref",
+                None,
+                f"missing: {p}.C = {m.C!r} needs the reference strain rate rate_ref [1/s] (give both or neither)",
+            )
     if m.rate_ref is not None:
         positive(f"{p}.rate_ref", m.rate_ref)
         if m.C is None:
-            raise ScenarioError(f"{p}.C", None, f"missing: {p}.rate_ref = {m.rate_ref!r} needs the rate "
-                                "coefficient C (give both or neither)")
+            raise ScenarioError(
+                f"{p}.C",
+                None,
+                f"missing: {p}.rate_ref = {m.rate_ref!r} needs the rate coefficient C (give both or neither)",
+            )
     if m.hardness_ratio is not None:
         lo, hi = HARDNESS_RATIO_RANGE
         finite(f"{p}.hardness_ratio", m.hardness_ratio)
         if not lo <= m.hardness_ratio <= hi:
-            raise ScenarioError(f"{p}.hardness_ratio", m.hardness_ratio, f"must be in [{lo:g}, {hi:g}] "
-                                "(the fully plastic mean pressure over Y; Tabor's metals: 2.8)")
+            raise ScenarioError(
+                f"{p}.hardness_ratio",
+                m.hardness_ratio,
+                f"must be in [{lo:g}, {hi:g}] (the fully plastic mean pressure over Y; Tabor's metals: 2.8)",
+            )
     if m.unloading_factor is not None:
         finite(f"{p}.unloading_factor", m.unloading_factor)
         if not 0.0 < m.unloading_factor <= UNLOADING_FACTOR_MAX:
-            raise ScenarioError(f"{p}.unloading_factor", m.unloading_factor,
-                                f"must be in (0, {UNLOADING_FACTOR_MAX:g}] (the elastic unloading span's factor; Hertz's 3/4 "
-                                "would leave a negative residual overlap just past yield)")
+            raise ScenarioError(
+                f"{p}.unloading_factor",
+                m.unloading_factor,
+                f"must be in (0, {UNLOADING_FACTOR_MAX:g}] (the elastic unloading span's factor; Hertz's 3/4 "
+                "would leave a negative residual overlap just past yield)",
+            )
 
 
 def _check_layout(s: Scenario) -> None:
@@ -286,9 +388,12 @@ def _check_layout(s: Scenario) -> None:
         return
     string_in("layout.kind", lay.kind, tuple(LAYOUT_KINDS))
     if not isinstance(lay, LAYOUT_KINDS[lay.kind]):
-        raise ScenarioError("layout.kind", lay.kind,
-                            f"a {type(lay).__name__} must have kind one of " + ", ".join(
-                                repr(k) for k, c in LAYOUT_KINDS.items() if isinstance(lay, c)))
+        raise ScenarioError(
+            "layout.kind",
+            lay.kind,
+            f"a {type(lay).__name__} must have kind one of "
+            + ", ".join(repr(k) for k, c in LAYOUT_KINDS.items() if isinstance(lay, c)),
+        )
     if lay.kind == "paper":
         _check_paper_layout(s, lay)
     elif lay.kind == "chain":
@@ -298,8 +403,9 @@ def _check_layout(s: Scenario) -> None:
     else:
         _check_lattice_layout(s, lay)
     if lay.imperfections is not None:
-        _check_imperfections(lay.imperfections, layout_packing(
-            dataclasses.replace(lay, imperfections=None), s.dimension).granules)
+        _check_imperfections(
+            lay.imperfections, layout_packing(dataclasses.replace(lay, imperfections=None), s.dimension).granules
+        )
 
 
 def layout_radius(path: str, value: Any) -> None:
@@ -317,25 +423,27 @@ def layout_ratio(path: str, value: Any, power: int = 1) -> None:
     positive(path, value)
     if not power * abs(math.log(float(value))) <= math.log(LENGTH_RANGE):
         what = "value" if power == 1 else f"value^{power} (the last radius over the first)"
-        raise ScenarioError(path, value, f"allowed: {what} within {1.0 / LENGTH_RANGE:g} .. "
-                            f"{LENGTH_RANGE:g} (a ratio of radii)")
+        raise ScenarioError(
+            path, value, f"allowed: {what} within {1.0 / LENGTH_RANGE:g} .. {LENGTH_RANGE:g} (a ratio of radii)"
+        )
 
 
 def _check_paper_layout(s: Scenario, lay: Layout) -> None:
     layout_radius("layout.R1", lay.R1)
-    r = finite("layout.R2_ratio", lay.R2_ratio,
-                f"must be in [{SQRT2_MINUS_1:.8f}, 1] (sqrt(2)-1 <= R2/R1 <= 1)")
+    r = finite("layout.R2_ratio", lay.R2_ratio, f"must be in [{SQRT2_MINUS_1:.8f}, 1] (sqrt(2)-1 <= R2/R1 <= 1)")
     if not (SQRT2_MINUS_1 - RATIO_TOL <= r <= 1.0 + RATIO_TOL):
-        raise ScenarioError("layout.R2_ratio", lay.R2_ratio,
-                            f"must be in [{SQRT2_MINUS_1:.8f}, 1] (sqrt(2)-1 <= R2/R1 <= 1)")
+        raise ScenarioError(
+            "layout.R2_ratio", lay.R2_ratio, f"must be in [{SQRT2_MINUS_1:.8f}, 1] (sqrt(2)-1 <= R2/R1 <= 1)"
+        )
     for f in ("heavy_material", "intruder_material", "wall_material"):
         material_exists(f"layout.{f}", getattr(lay, f), s)
 
 
 def _list_of_columns(path: str, values: Any, columns: int) -> None:
     if not isinstance(values, tuple) or (values and len(values) != columns):
-        raise ScenarioError(path, values, f"must be empty or a list of {columns} values "
-                            "(one per column, layout.columns)")
+        raise ScenarioError(
+            path, values, f"must be empty or a list of {columns} values (one per column, layout.columns)"
+        )
 
 
 def _check_lattice_layout(s: Scenario, lay: LatticeLayout) -> None:
@@ -357,12 +465,14 @@ def _check_lattice_layout(s: Scenario, lay: LatticeLayout) -> None:
         string_in("layout.intruder_columns", lay.intruder_columns, tuple(INTRUDER_COLUMN_RULES))
     for k, c in enumerate(() if isinstance(lay.intruder_columns, str) else lay.intruder_columns):
         if not isinstance(c, numbers.Integral) or isinstance(c, bool) or not 1 <= c <= lay.columns:
-            raise ScenarioError(f"layout.intruder_columns[{k}]", c,
-                                f"must be a column number in 1..{lay.columns} (layout.columns)")
+            raise ScenarioError(
+                f"layout.intruder_columns[{k}]", c, f"must be a column number in 1..{lay.columns} (layout.columns)"
+            )
     int_at_least("layout.intruder_every", lay.intruder_every, 0)
     sites = [g.label for g in lattice_sites(dataclasses.replace(lay, intruder_columns=()))]
-    check_intruder_sites(lay, sites, f"c1r1..c{lay.columns}r{lay.rows} "
-                                     "(column, row from the top; even hexagonal columns have rows - 1)")
+    check_intruder_sites(
+        lay, sites, f"c1r1..c{lay.columns}r{lay.rows} (column, row from the top; even hexagonal columns have rows - 1)"
+    )
     _check_column_offsets(lay)
 
 
@@ -374,9 +484,12 @@ def check_intruder_sites(lay, sites: list[str], names: str) -> None:
         if lab not in known:
             raise ScenarioError(f"layout.intruder_sites[{k}]", lab, f"no such site; sites are {names}")
     if (lay.intruder_sites or lay.intruder_every) and lay.intruder_ratio > 1.0:
-        raise ScenarioError("layout.intruder_ratio", lay.intruder_ratio,
-                            "must be in (0, 1] with intruder_sites or intruder_every "
-                            "(a single-site intruder larger than its site overlaps its neighbours)")
+        raise ScenarioError(
+            "layout.intruder_ratio",
+            lay.intruder_ratio,
+            "must be in (0, 1] with intruder_sites or intruder_every "
+            "(a single-site intruder larger than its site overlaps its neighbours)",
+        )
 
 
 def _check_column_offsets(lay: LatticeLayout) -> None:
@@ -390,26 +503,35 @@ def _check_column_offsets(lay: LatticeLayout) -> None:
     d = hexagonal_offsets(radii, a)
     for c in range(len(radii) - 1):
         if not radii[c] + radii[c + 1] >= a:
-            raise ScenarioError(what, value,
-                                f"columns {c + 1} and {c + 2} cannot touch: R_{c + 1} + R_{c + 2} = "
-                                f"{radii[c] + radii[c + 1]:.6g} m < the largest radius {a:.6g} m; "
-                                "allowed: R_c + R_c+1 >= max R (hexagonal packing)")
+            raise ScenarioError(
+                what,
+                value,
+                f"columns {c + 1} and {c + 2} cannot touch: R_{c + 1} + R_{c + 2} = "
+                f"{radii[c] + radii[c + 1]:.6g} m < the largest radius {a:.6g} m; "
+                "allowed: R_c + R_c+1 >= max R (hexagonal packing)",
+            )
     for c in range(len(radii) - 2):
         gap = d[c] + d[c + 1] - radii[c] - radii[c + 2]
         if gap < -OVERLAP_RTOL * min(radii[c], radii[c + 2]):
-            raise ScenarioError(what, value,
-                                f"columns {c + 1} and {c + 3} overlap by {-gap:.6g} m (column "
-                                f"{c + 2} too small to hold them apart); allowed: "
-                                "d_c + d_c+1 >= R_c + R_c+2 with d_c = sqrt((R_c + R_c+1)^2 - a^2), "
-                                "e.g. R_c+1 >= (sqrt(2) - 1) R_c for equal outer columns")
+            raise ScenarioError(
+                what,
+                value,
+                f"columns {c + 1} and {c + 3} overlap by {-gap:.6g} m (column "
+                f"{c + 2} too small to hold them apart); allowed: "
+                "d_c + d_c+1 >= R_c + R_c+2 with d_c = sqrt((R_c + R_c+1)^2 - a^2), "
+                "e.g. R_c+1 >= (sqrt(2) - 1) R_c for equal outer columns",
+            )
 
 
 def _check_space_lattice(s: Scenario, lay: SpaceLattice) -> None:
     """A space lattice's fields, then its planes: neighbours reach each other, nothing else overlaps."""
     cells = lay.cells
     if not isinstance(cells, tuple) or len(cells) != 3:
-        raise ScenarioError("layout.cells", cells, "must be three integers [nx, ny, nz] >= 1 (cells "
-                            "along x, the load direction, y and z)")
+        raise ScenarioError(
+            "layout.cells",
+            cells,
+            "must be three integers [nx, ny, nz] >= 1 (cells along x, the load direction, y and z)",
+        )
     _check_planes(lay)
     for k, n in enumerate(cells):
         if k == 0 and n == 0 and (lay.layers or lay.planes is not None):
@@ -421,8 +543,12 @@ def _check_space_lattice(s: Scenario, lay: SpaceLattice) -> None:
     n_planes = planes_along_x(lay) if layers_ok else planes_per_cell(lay.kind) * cells[0]
     n_sites = sites_per_cell(lay.kind) * n_planes * cells[1] * cells[2] // planes_per_cell(lay.kind)
     if n_sites > MAX_LAYOUT_SITES:
-        raise ScenarioError("layout.cells", list(cells), f"makes {n_sites} sites ({sites_per_cell(lay.kind)} "
-                            f"per {lay.kind} cell); allowed: at most {MAX_LAYOUT_SITES} sites")
+        raise ScenarioError(
+            "layout.cells",
+            list(cells),
+            f"makes {n_sites} sites ({sites_per_cell(lay.kind)} "
+            f"per {lay.kind} cell); allowed: at most {MAX_LAYOUT_SITES} sites",
+        )
     layout_radius("layout.radius", lay.radius)
     for f in ("material", "wall_material"):
         material_exists(f"layout.{f}", getattr(lay, f), s)
@@ -430,8 +556,11 @@ def _check_space_lattice(s: Scenario, lay: SpaceLattice) -> None:
         material_exists("layout.intruder_material", lay.intruder_material, s)
     _check_layers(s, lay)
     if not isinstance(lay.walls, tuple):
-        raise ScenarioError("layout.walls", lay.walls, "must be a list of wall names, a subset of "
-                            + ", ".join(repr(w) for w in BOX_WALLS))
+        raise ScenarioError(
+            "layout.walls",
+            lay.walls,
+            "must be a list of wall names, a subset of " + ", ".join(repr(w) for w in BOX_WALLS),
+        )
     for k, w in enumerate(lay.walls):
         string_in(f"layout.walls[{k}]", w, BOX_WALLS)
         if w in lay.walls[:k]:
@@ -440,8 +569,11 @@ def _check_space_lattice(s: Scenario, lay: SpaceLattice) -> None:
     int_at_least("layout.intruder_every", lay.intruder_every, 0)
     _check_space_planes(lay)
     sites = [g.label for g in space_sites(lay)]
-    check_intruder_sites(lay, sites, f"{sites[0]}..{sites[-1]} (x{{plane}}y{{row}}"
-                                     "z{site}: plane along x, row along y, site along z, from 1)")
+    check_intruder_sites(
+        lay,
+        sites,
+        f"{sites[0]}..{sites[-1]} (x{{plane}}y{{row}}z{{site}}: plane along x, row along y, site along z, from 1)",
+    )
 
 
 def _check_planes(lay: SpaceLattice) -> None:
@@ -450,12 +582,19 @@ def _check_planes(lay: SpaceLattice) -> None:
         return
     int_at_least("layout.planes", lay.planes, 1)
     if lay.layers:
-        raise ScenarioError("layout.planes", lay.planes, "give layout.planes or layout.layers, not both "
-                            "(with layers, each layer's count or planes sizes it)")
+        raise ScenarioError(
+            "layout.planes",
+            lay.planes,
+            "give layout.planes or layout.layers, not both (with layers, each layer's count or planes sizes it)",
+        )
     if isinstance(lay.cells, tuple) and lay.cells and lay.cells[0] != 0:
-        raise ScenarioError("layout.planes", lay.planes, f"give layout.planes (lattice planes along x) or "
-                            f"layout.cells[0] = {lay.cells[0]} (cells along x), not both: with planes write "
-                            f"cells = [0, ny, nz]")
+        raise ScenarioError(
+            "layout.planes",
+            lay.planes,
+            f"give layout.planes (lattice planes along x) or "
+            f"layout.cells[0] = {lay.cells[0]} (cells along x), not both: with planes write "
+            f"cells = [0, ny, nz]",
+        )
 
 
 def _check_layer_sizes(lay: SpaceLattice) -> None:
@@ -465,9 +604,13 @@ def _check_layer_sizes(lay: SpaceLattice) -> None:
     for k, ly in enumerate(lay.layers):
         p = f"layout.layers[{k}]"
         if ly.count is not None and ly.planes is not None:
-            raise ScenarioError(f"{p}.planes", ly.planes, f"give {p}.count (cells along x, "
-                                f"{planes_per_cell(lay.kind)} lattice planes each for {lay.kind}) or {p}.planes "
-                                "(lattice planes), not both")
+            raise ScenarioError(
+                f"{p}.planes",
+                ly.planes,
+                f"give {p}.count (cells along x, "
+                f"{planes_per_cell(lay.kind)} lattice planes each for {lay.kind}) or {p}.planes "
+                "(lattice planes), not both",
+            )
         if ly.planes is not None:
             int_at_least(f"{p}.planes", ly.planes, 1)
         elif ly.count is not None:
@@ -478,8 +621,7 @@ def _check_layers(s: Scenario, lay: SpaceLattice) -> None:
     """Each layer: its size (`_check_layer_sizes`), radius (or None), material (or None);
     the planes add up to those of cells[0] (unless cells[0] is 0: then they give it)."""
     if not isinstance(lay.layers, tuple):
-        raise ScenarioError("layout.layers", lay.layers, "must be a list of tables {count or planes, radius, "
-                            "material}")
+        raise ScenarioError("layout.layers", lay.layers, "must be a list of tables {count or planes, radius, material}")
     for k, ly in enumerate(lay.layers):
         p = f"layout.layers[{k}]"
         if ly.radius is not None:
@@ -489,16 +631,22 @@ def _check_layers(s: Scenario, lay: SpaceLattice) -> None:
     radii = [lay.radius if ly.radius is None else ly.radius for ly in lay.layers]
     for k, r in enumerate(radii):
         if not max(radii) <= LENGTH_RANGE * r:
-            raise ScenarioError(f"layout.layers[{k}].radius", r, f"allowed: at least 1 / {LENGTH_RANGE:g} "
-                                f"of the largest layer radius {max(radii):.6g} m (a ratio of radii)")
+            raise ScenarioError(
+                f"layout.layers[{k}].radius",
+                r,
+                f"allowed: at least 1 / {LENGTH_RANGE:g} "
+                f"of the largest layer radius {max(radii):.6g} m (a ratio of radii)",
+            )
     n = planes_per_cell(lay.kind)
     total = planes_along_x(lay)
     if lay.layers and lay.cells[0] != 0 and total != n * lay.cells[0]:
-        raise ScenarioError("layout.layers", [ly.count if ly.planes is None else f"{ly.planes} planes"
-                                              for ly in lay.layers],
-                            f"the layers add up to {total} lattice planes ({total / n:g} cells); allowed: they "
-                            f"add up to layout.cells[0] = {lay.cells[0]} (the cells along x; 0: as many as "
-                            f"the layers' counts add up to)")
+        raise ScenarioError(
+            "layout.layers",
+            [ly.count if ly.planes is None else f"{ly.planes} planes" for ly in lay.layers],
+            f"the layers add up to {total} lattice planes ({total / n:g} cells); allowed: they "
+            f"add up to layout.cells[0] = {lay.cells[0]} (the cells along x; 0: as many as "
+            f"the layers' counts add up to)",
+        )
 
 
 def _layer_of_plane(lay: SpaceLattice, plane: int) -> int:
@@ -522,20 +670,26 @@ def _check_space_planes(lay: SpaceLattice) -> None:
         rho = plane_gap_distance(lay.kind, plane_type(lay.kind, p), plane_type(lay.kind, p + 1), r_max)
         if not radii[p] + radii[p + 1] >= rho:
             k = _layer_of_plane(lay, p if radii[p] < radii[p + 1] else p + 1)
-            raise ScenarioError(f"layout.layers[{k}].radius", min(radii[p], radii[p + 1]),
-                                f"planes {p + 1} and {p + 2} cannot touch: R_p + R_p+1 = "
-                                f"{radii[p] + radii[p + 1]:.6g} m < {rho:.6g} m, the in-plane distance to "
-                                f"the next plane's sites on the {lay.kind} net of the largest radius "
-                                f"{r_max:.6g} m; allowed: R_p + R_p+1 >= that distance")
+            raise ScenarioError(
+                f"layout.layers[{k}].radius",
+                min(radii[p], radii[p + 1]),
+                f"planes {p + 1} and {p + 2} cannot touch: R_p + R_p+1 = "
+                f"{radii[p] + radii[p + 1]:.6g} m < {rho:.6g} m, the in-plane distance to "
+                f"the next plane's sites on the {lay.kind} net of the largest radius "
+                f"{r_max:.6g} m; allowed: R_p + R_p+1 >= that distance",
+            )
     clash = plane_clash(lay.kind, radii)
     if clash is not None:
         p, q, overlap = clash
         thin = min(range(p + 1, q), key=lambda m: radii[m])
         k = _layer_of_plane(lay, thin)
-        raise ScenarioError(f"layout.layers[{k}].radius", radii[thin],
-                            f"planes {p + 1} and {q + 1} overlap by {overlap:.6g} m: plane {thin + 1} "
-                            f"between them (radius {radii[thin]:.6g} m) is too small to hold them apart; "
-                            "allowed: a radius that keeps every pair of planes apart")
+        raise ScenarioError(
+            f"layout.layers[{k}].radius",
+            radii[thin],
+            f"planes {p + 1} and {q + 1} overlap by {overlap:.6g} m: plane {thin + 1} "
+            f"between them (radius {radii[thin]:.6g} m) is too small to hold them apart; "
+            "allowed: a radius that keeps every pair of planes apart",
+        )
 
 
 def _check_chain_layout(s: Scenario, lay: ChainLayout) -> None:
@@ -554,8 +708,11 @@ def _check_chain_layout(s: Scenario, lay: ChainLayout) -> None:
         if v is not None:
             finite(f"layout.{f}", v)
             if not abs(float(v)) <= LENGTH_RANGE * lay.radius:
-                raise ScenarioError(f"layout.{f}", v, f"allowed: |{f}| <= {LENGTH_RANGE:g} x layout.radius "
-                                    f"= {LENGTH_RANGE * lay.radius:.6g} m")
+                raise ScenarioError(
+                    f"layout.{f}",
+                    v,
+                    f"allowed: |{f}| <= {LENGTH_RANGE:g} x layout.radius = {LENGTH_RANGE * lay.radius:.6g} m",
+                )
 
 
 def _check_imperfections(imp: Imperfections, sites: tuple[Granule, ...]) -> None:
@@ -566,16 +723,23 @@ def _check_imperfections(imp: Imperfections, sites: tuple[Granule, ...]) -> None
         if not 0.0 <= v < 1.0:
             raise ScenarioError(f"{p}.{f}", v, "must be in [0, 1)")
     if not imp.radius_spread + imp.jitter < 1.0:
-        raise ScenarioError(f"{p}.jitter", imp.jitter,
-                            f"radius_spread + jitter must be < 1 (radius_spread = "
-                            f"{imp.radius_spread!r}: the smallest radius R (1 - jitter - "
-                            "radius_spread) must stay > 0)")
+        raise ScenarioError(
+            f"{p}.jitter",
+            imp.jitter,
+            f"radius_spread + jitter must be < 1 (radius_spread = "
+            f"{imp.radius_spread!r}: the smallest radius R (1 - jitter - "
+            "radius_spread) must stay > 0)",
+        )
     labels = {g.label for g in sites}
     for k, lab in enumerate(imp.vacancies):
         if lab not in labels:
-            raise ScenarioError(f"{p}.vacancies[{k}]", lab,
-                                "no such site in the perfect packing (labels such as "
-                                + ", ".join(list(g.label for g in sites)[:3]) + ", ...)")
+            raise ScenarioError(
+                f"{p}.vacancies[{k}]",
+                lab,
+                "no such site in the perfect packing (labels such as "
+                + ", ".join(list(g.label for g in sites)[:3])
+                + ", ...)",
+            )
 
 
 def _granule(s: Scenario, i: int, field: str | None = None) -> str:
@@ -626,8 +790,9 @@ def _granule_columns(s: Scenario) -> dict[str, np.ndarray] | None:
     """The granules' numbers by field (3D: omega as (n, 3)), or None when one is not a
     Python float (or, in 3D, an omega not three of them)."""
     gs = s.granules
-    names = ("x", "y", "z", "radius", "vx", "vy", "vz") if s.dimension == 3 else ("x", "y", "radius", "vx", "vy",
-                                                                                   "omega")
+    names = (
+        ("x", "y", "z", "radius", "vx", "vy", "vz") if s.dimension == 3 else ("x", "y", "radius", "vx", "vy", "omega")
+    )
     cols = {f: _column(gs, f) for f in names}
     if s.dimension == 3:
         spins = list(map(operator.attrgetter("omega"), gs))
@@ -681,8 +846,9 @@ def _check_granules(s: Scenario) -> None:
         if not isinstance(g.label, str):
             raise ScenarioError(_granule(s, i, "label"), g.label, "must be a string")
         if g.label in seen:
-            raise ScenarioError(_granule(s, i, "label"), g.label,
-                                f"labels must be unique; {_granule(s, seen[g.label])} has it too")
+            raise ScenarioError(
+                _granule(s, i, "label"), g.label, f"labels must be unique; {_granule(s, seen[g.label])} has it too"
+            )
         seen[g.label] = i
 
 
@@ -705,10 +871,13 @@ def _check_speeds(s: Scenario, i: int, g: Granule, m: Material) -> None:
     for f, speed, value in checks:
         if not speed < c:
             unit = f"|{f}| x radius" if f.startswith("omega") else f"|{f}|"
-            raise ScenarioError(_granule(s, i, f), value,
-                                f"allowed: {unit} < sqrt(E / rho) = {c:.6g} m/s, the elastic "
-                                f"wave speed of material '{m.name}' (Hertz's contact law is "
-                                "quasi-static: it holds for speeds far below it)")
+            raise ScenarioError(
+                _granule(s, i, f),
+                value,
+                f"allowed: {unit} < sqrt(E / rho) = {c:.6g} m/s, the elastic "
+                f"wave speed of material '{m.name}' (Hertz's contact law is "
+                "quasi-static: it holds for speeds far below it)",
+            )
 
 
 def length_scale(s: Scenario) -> tuple[float, str]:
@@ -721,11 +890,12 @@ def length_scale(s: Scenario) -> tuple[float, str]:
         return _THREAD.columns[1][key]
     found = _smallest_radius(s)
     if isinstance(s.plate, Solid) and is_box(s.plate):
-        found += [(s.plate.size[k] / s.plate.elements[k], f"plate.size[{k}] / plate.elements[{k}]")
-                  for k in range(3)]
+        found += [(s.plate.size[k] / s.plate.elements[k], f"plate.size[{k}] / plate.elements[{k}]") for k in range(3)]
     elif isinstance(s.plate, Plate):
-        found += [(s.plate.width / s.plate.nx, "plate.width / plate.nx"),
-                  (s.plate.height / s.plate.ny, "plate.height / plate.ny")]
+        found += [
+            (s.plate.width / s.plate.nx, "plate.width / plate.nx"),
+            (s.plate.height / s.plate.ny, "plate.height / plate.ny"),
+        ]
     if not found:  # a solid of a mesh file alone: no length known before the file is read
         return math.inf, "no granule"
     if _THREAD.columns[0] is s.granules:
@@ -764,25 +934,34 @@ def _check_lengths(s: Scenario, boxed: bool = False) -> None:
     boxed: the last six walls are the expanded box (named as its corners' fields)."""
     h, what = length_scale(s)
     limit = LENGTH_RANGE * h
-    why = (f"{LENGTH_RANGE:g} x the smallest length of the scenario, h = {h:.6g} m ({what}): "
-           f"farther out, round-off of a coordinate (2.2e-16 |x|) exceeds the {OVERLAP_RTOL:g} h "
-           "overlap tolerance at t = 0")
+    why = (
+        f"{LENGTH_RANGE:g} x the smallest length of the scenario, h = {h:.6g} m ({what}): "
+        f"farther out, round-off of a coordinate (2.2e-16 |x|) exceeds the {OVERLAP_RTOL:g} h "
+        "overlap tolerance at t = 0"
+    )
     coords = ("x", "y", "z", "radius") if s.dimension == 3 else ("x", "y", "radius")
     cols = [_column(s.granules, f) for f in coords] if s.granules else []
     inside = all(c is not None and (np.abs(c) <= limit).all() for c in cols)
-    values = [] if inside else [(_granule(s, i, f), getattr(g, f)) for i, g in enumerate(s.granules)
-                                for f in coords]
-    values += [(path, -w.offset if ".lower[" in path else w.offset)  # box.lower: offset -x0
-               for path, w in zip(_wall_paths(s, boxed), s.walls)]
-    values += [(f"walls[{k}].point[{c}]", x) for k, w in enumerate(s.walls) if w.point is not None
-               for c, x in enumerate(w.point)]
+    values = [] if inside else [(_granule(s, i, f), getattr(g, f)) for i, g in enumerate(s.granules) for f in coords]
+    values += [
+        (path, -w.offset if ".lower[" in path else w.offset)  # box.lower: offset -x0
+        for path, w in zip(_wall_paths(s, boxed), s.walls)
+    ]
+    values += [
+        (f"walls[{k}].point[{c}]", x)
+        for k, w in enumerate(s.walls)
+        if w.point is not None
+        for c, x in enumerate(w.point)
+    ]
     if isinstance(s.plate, Solid) and is_box(s.plate):
         values += [(f"plate.{f}[{k}]", getattr(s.plate, f)[k]) for f in ("size", "origin") for k in range(3)]
     elif isinstance(s.plate, Plate):
         pl = s.plate
-        values += [(f"plate.{f}", getattr(pl, f)) for f in ("x0", "y0", "width", "height", "thickness",
-                                                            "rigid_layer_width")
-                   if getattr(pl, f) is not None]
+        values += [
+            (f"plate.{f}", getattr(pl, f))
+            for f in ("x0", "y0", "width", "height", "thickness", "rigid_layer_width")
+            if getattr(pl, f) is not None
+        ]
     for path, v in values:
         if not abs(v) <= limit:
             raise ScenarioError(path, v, f"allowed: |value| <= {limit:.6g} m, {why}")
@@ -798,10 +977,12 @@ def _check_overlaps(s: Scenario, named: dict[int, str]) -> None:
         overlap = gi.radius + gj.radius - dist
         if overlap > OVERLAP_RTOL * min(gi.radius, gj.radius):
             raise ScenarioError(
-                _granule(s, i), gi.label,
+                _granule(s, i),
+                gi.label,
                 f"{named[i]} overlaps {named[j]} ({_granule(s, j)}) by {overlap:.6g} m at t = 0; "
                 f"granules may touch but not overlap (tolerance "
-                f"{OVERLAP_RTOL:g} x the smaller radius)")
+                f"{OVERLAP_RTOL:g} x the smaller radius)",
+            )
 
 
 def _centre(g: Granule, dimension: int) -> tuple[float, ...]:
@@ -836,8 +1017,9 @@ def _overlapping_pairs(gs: tuple[Granule, ...], dimension: int = 2, contact=None
     whose searches at t = 0 the model makes next (its search is kept for them when its
     gap and skin are numbers up to SHARED_SEARCH_MAX, so that it stays a search of
     neighbours; else None)."""
-    if contact is not None and not all(is_number(v) and 0.0 <= v <= SHARED_SEARCH_MAX
-                                       for v in (contact.neighbour_gap, contact.skin)):
+    if contact is not None and not all(
+        is_number(v) and 0.0 <= v <= SHARED_SEARCH_MAX for v in (contact.neighbour_gap, contact.skin)
+    ):
         contact = None
     centres = [_column(gs, f) for f in ("x", "y", "z")[:dimension]] if len(gs) > 1 else []
     r = _column(gs, "radius") if len(gs) > 1 else None
@@ -847,8 +1029,11 @@ def _overlapping_pairs(gs: tuple[Granule, ...], dimension: int = 2, contact=None
     c = contact
     # one search for this check and the model's lists (setup.pairs.superset_pairs): every
     # pair within 2 R_max, and within what the lists need, which keep it for themselves
-    share = (contact_search_distance(float(r.max()), c.neighbour_gap, c.skin, c.detection == "dynamic")
-             if contact is not None else 0.0)
+    share = (
+        contact_search_distance(float(r.max()), c.neighbour_gap, c.skin, c.detection == "dynamic")
+        if contact is not None
+        else 0.0
+    )
     pairs = superset_pairs(points, max(2.0 * float(r.max()) * (1.0 + 1e-9), share), keep=contact is not None)
     i, j = pairs[:, 0], pairs[:, 1]
     dist = np.sqrt(((points[j] - points[i]) ** 2).sum(axis=1))
@@ -864,21 +1049,19 @@ def _check_walls(s: Scenario) -> None:
         n = w.normal
         if s.dimension == 3:
             _check_plane(p, w)
-        elif (not isinstance(n, tuple) or len(n) != 2
-                or not all(is_number(c) and math.isfinite(c) for c in n)):
+        elif not isinstance(n, tuple) or len(n) != 2 or not all(is_number(c) and math.isfinite(c) for c in n):
             raise ScenarioError(f"{p}.normal", n, "must be two finite numbers [nx, ny]")
         elif abs(math.hypot(n[0], n[1]) - 1.0) > NORMAL_TOL:
             norm = math.hypot(n[0], n[1])
-            raise ScenarioError(f"{p}.normal", n,
-                                f"must be a unit vector (|normal| = {norm:.12g}; "
-                                f"allowed 1 within {NORMAL_TOL:g})")
+            raise ScenarioError(
+                f"{p}.normal", n, f"must be a unit vector (|normal| = {norm:.12g}; allowed 1 within {NORMAL_TOL:g})"
+            )
         finite(f"{p}.offset", w.offset)
         material_exists(f"{p}.material", w.material, s)
         if not isinstance(w.label, str):
             raise ScenarioError(f"{p}.label", w.label, "must be a string")
         if w.label in seen:
-            raise ScenarioError(f"{p}.label", w.label,
-                                f"labels must be unique; walls[{seen[w.label]}] has it too")
+            raise ScenarioError(f"{p}.label", w.label, f"labels must be unique; walls[{seen[w.label]}] has it too")
         seen[w.label] = k
 
 
@@ -893,9 +1076,11 @@ def _check_wall_penetration(s: Scenario, named: dict[int, str]) -> None:
             pen = depth + g.radius - w.offset
             if pen > OVERLAP_RTOL * g.radius:
                 raise ScenarioError(
-                    _granule(s, i), g.label,
+                    _granule(s, i),
+                    g.label,
                     f"{named[i]} penetrates wall '{w.label}' (walls[{k}]) by {pen:.6g} m at t = 0; "
-                    f"a granule may touch a wall but not cross it")
+                    f"a granule may touch a wall but not cross it",
+                )
 
 
 def _may_cross_wall(s: Scenario, n: tuple[float, ...], offset: float) -> bool:
@@ -916,6 +1101,8 @@ def _check_plate(s: Scenario) -> None:
         return
     check_plate_fields(pl, pl.x0)
     material_exists("plate.material", pl.material, s)
+
+
 def _check_plate_penetration(s: Scenario, named: dict[int, str]) -> None:
     """No granule crosses the plate's left edge at t = 0."""
     pl = s.plate
@@ -927,9 +1114,11 @@ def _check_plate_penetration(s: Scenario, named: dict[int, str]) -> None:
             pen = g.x + g.radius - x0
             if pen > OVERLAP_RTOL * g.radius:
                 raise ScenarioError(
-                    _granule(s, i), g.label,
+                    _granule(s, i),
+                    g.label,
                     f"{named[i]} penetrates the plate (left edge plate.x0 = {x0:.6g} m) by {pen:.6g} m at "
-                    f"t = 0; granules must lie left of the plate (x + radius <= plate.x0)")
+                    f"t = 0; granules must lie left of the plate (x + radius <= plate.x0)",
+                )
 
 
 def _check_solid_penetration(s: Scenario, named: dict[int, str]) -> None:
@@ -955,22 +1144,32 @@ def _check_walls_off_solid(s: Scenario, r: Scenario) -> None:
         n = unit(w.normal)
         tol = OVERLAP_RTOL * min((g.radius for g in r.granules), default=min(r.plate.size))
         offset = w.offset  # along the unit normal, as _check_wall_penetration reads it
-        if not (wall_cuts_box(n, offset, lo, hi, tol)
-                or any(wall_contact_on_box(n, offset, (g.x, g.y, g.z), g.radius, lo, hi,
-                                           r.contact.neighbour_gap * g.radius) for g in r.granules)):
+        if not (
+            wall_cuts_box(n, offset, lo, hi, tol)
+            or any(
+                wall_contact_on_box(n, offset, (g.x, g.y, g.z), g.radius, lo, hi, r.contact.neighbour_gap * g.radius)
+                for g in r.granules
+            )
+        ):
             continue
         if s.layout is not None:
-            path, value, fix = "layout.walls", w.label, (
-                f"leave {w.label!r} out of layout.walls (e.g. walls = "
-                f"{[b for b in BOX_WALLS if b != w.label]})")
+            path, value, fix = (
+                "layout.walls",
+                w.label,
+                (f"leave {w.label!r} out of layout.walls (e.g. walls = {[b for b in BOX_WALLS if b != w.label]})"),
+            )
         elif k >= n_user:
             path, value, fix = "box", w.label, "move the box's face or the solid (plate.origin)"
         else:
             path, value, fix = f"walls[{k}]", w.label, "move or remove the wall, or move the solid (plate.origin)"
-        raise ScenarioError(path, value, f"the rigid wall {w.label or k} (n = {list(w.normal)}, offset "
-                            f"{w.offset:.6g} m) passes through {solid_named(r.plate)} or lies on the face its "
-                            f"granules meet: a granule touching the solid there touches the wall too, which "
-                            f"would take the load the solid should; {fix}")
+        raise ScenarioError(
+            path,
+            value,
+            f"the rigid wall {w.label or k} (n = {list(w.normal)}, offset "
+            f"{w.offset:.6g} m) passes through {solid_named(r.plate)} or lies on the face its "
+            f"granules meet: a granule touching the solid there touches the wall too, which "
+            f"would take the load the solid should; {fix}",
+        )
 
 
 def _check_load(s: Scenario) -> None:
@@ -982,12 +1181,15 @@ def _check_load(s: Scenario) -> None:
         raise ScenarioError("load.q0", ld.q0, "must be >= 0 [N/m]")
     e_max, h = _stiffest_modulus(s), length_scale(s)[0]
     if ld.kind == "line" and not q0 <= e_max * h:
-        raise ScenarioError("load.q0", ld.q0,
-                            f"allowed: 0 <= q0 <= E h = {e_max * h:.6g} N/m, E = {e_max:.6g} Pa the "
-                            f"largest Young's modulus of the granules and plate, h = {h:.6g} m the "
-                            "smallest length (a granule radius or plate element edge): a larger "
-                            "line load presses on h harder than E, far beyond Hertz's small "
-                            "overlaps and linear elasticity")
+        raise ScenarioError(
+            "load.q0",
+            ld.q0,
+            f"allowed: 0 <= q0 <= E h = {e_max * h:.6g} N/m, E = {e_max:.6g} Pa the "
+            f"largest Young's modulus of the granules and plate, h = {h:.6g} m the "
+            "smallest length (a granule radius or plate element edge): a larger "
+            "line load presses on h harder than E, far beyond Hertz's small "
+            "overlaps and linear elasticity",
+        )
     positive("load.duration", ld.duration)
     positive("load.length", ld.length)
     finite("load.y0", ld.y0)
@@ -996,34 +1198,42 @@ def _check_load(s: Scenario) -> None:
         raise ScenarioError("load.force", ld.force, "must be >= 0 [N]")
     if ld.kind == "force":
         if not force <= e_max * h * h:
-            raise ScenarioError("load.force", ld.force,
-                                f"allowed: 0 <= force <= E h^2 = {e_max * h * h:.6g} N, E = {e_max:.6g} Pa "
-                                f"the largest Young's modulus of the granules, h = {h:.6g} m the "
-                                "smallest radius: a larger force presses on h^2 harder than E, far "
-                                "beyond Hertz's small overlaps")
+            raise ScenarioError(
+                "load.force",
+                ld.force,
+                f"allowed: 0 <= force <= E h^2 = {e_max * h * h:.6g} N, E = {e_max:.6g} Pa "
+                f"the largest Young's modulus of the granules, h = {h:.6g} m the "
+                "smallest radius: a larger force presses on h^2 harder than E, far "
+                "beyond Hertz's small overlaps",
+            )
         _direction("load.direction", ld.direction, "[dx, dy, dz]")
         if ld.target != "granules":
-            raise ScenarioError("load.target", ld.target, "a force load acts on granules: "
-                                "use target = \"granules\"")
+            raise ScenarioError("load.target", ld.target, 'a force load acts on granules: use target = "granules"')
     if not isinstance(ld.granules, tuple) or not all(isinstance(x, str) for x in ld.granules):
         raise ScenarioError("load.granules", ld.granules, "must be a list of granule labels")
     labels = {g.label for g in s.granules}
     for i, lab in enumerate(ld.granules):
         if lab not in labels:
-            raise ScenarioError(f"load.granules[{i}]", lab,
-                                "no granule has this label; labels are: "
-                                + ", ".join(g.label for g in s.granules))
+            raise ScenarioError(
+                f"load.granules[{i}]",
+                lab,
+                "no granule has this label; labels are: " + ", ".join(g.label for g in s.granules),
+            )
     if ld.kind == "force" and not s.granules:
-        raise ScenarioError("load.kind", ld.kind, "a force load needs [[granules]]; use kind = \"none\"")
+        raise ScenarioError("load.kind", ld.kind, 'a force load needs [[granules]]; use kind = "none"')
     if ld.kind == "line":
         if ld.target == "plate" and s.plate is None:
-            raise ScenarioError("load.target", ld.target,
-                                "a load on the plate needs a [plate]; use target = "
-                                "\"granules\" or kind = \"none\"")
+            raise ScenarioError(
+                "load.target",
+                ld.target,
+                'a load on the plate needs a [plate]; use target = "granules" or kind = "none"',
+            )
         if ld.target == "granules" and not s.granules:
-            raise ScenarioError("load.target", ld.target,
-                                "a load on the granules needs granules (or a [layout]); "
-                                "use target = \"plate\" or kind = \"none\"")
+            raise ScenarioError(
+                "load.target",
+                ld.target,
+                'a load on the granules needs granules (or a [layout]); use target = "plate" or kind = "none"',
+            )
 
 
 def _stiffest_modulus(s: Scenario) -> float:
@@ -1050,8 +1260,12 @@ def _damping(path: str, alpha_n: Any) -> None:
         return
     nonneg(path, alpha_n)
     if alpha_n > ALPHA_N_MAX:
-        raise ScenarioError(path, alpha_n, f"must be in [0, {ALPHA_N_MAX:g}] (eq. 3's damping "
-                            "coefficient; near 2 a contact is already critically damped)")
+        raise ScenarioError(
+            path,
+            alpha_n,
+            f"must be in [0, {ALPHA_N_MAX:g}] (eq. 3's damping "
+            "coefficient; near 2 a contact is already critically damped)",
+        )
 
 
 def _friction(path: str, mu: Any, k_s: Any) -> None:
@@ -1059,14 +1273,21 @@ def _friction(path: str, mu: Any, k_s: Any) -> None:
     if mu is not None:
         nonneg(f"{path}.mu", mu)
         if mu > MU_MAX:
-            raise ScenarioError(f"{path}.mu", mu, f"must be in [0, {MU_MAX:g}] (a Coulomb "
-                                "coefficient; real dry pairs stay below about 2)")
+            raise ScenarioError(
+                f"{path}.mu",
+                mu,
+                f"must be in [0, {MU_MAX:g}] (a Coulomb coefficient; real dry pairs stay below about 2)",
+            )
     if k_s is not None:
         positive(f"{path}.k_s", k_s)
         if k_s > KS_MAX:
-            raise ScenarioError(f"{path}.k_s", k_s, f"must be in (0, {KS_MAX:g}] s/m (a smoothing "
-                                "slip rate 1/k_s of at least 1 um/s; sharper, friction is a step no "
-                                "time step resolves)")
+            raise ScenarioError(
+                f"{path}.k_s",
+                k_s,
+                f"must be in (0, {KS_MAX:g}] s/m (a smoothing "
+                "slip rate 1/k_s of at least 1 um/s; sharper, friction is a step no "
+                "time step resolves)",
+            )
 
 
 def _check_contact(s: Scenario) -> None:
@@ -1075,8 +1296,11 @@ def _check_contact(s: Scenario) -> None:
     _damping("contact.alpha_n", c.alpha_n)
     nonneg("contact.neighbour_gap", c.neighbour_gap)
     if c.neighbour_gap > 1.0:
-        raise ScenarioError("contact.neighbour_gap", c.neighbour_gap,
-                            "must be at most 1 (a gap of at most the smaller radius, as contact.skin)")
+        raise ScenarioError(
+            "contact.neighbour_gap",
+            c.neighbour_gap,
+            "must be at most 1 (a gap of at most the smaller radius, as contact.skin)",
+        )
     string_in("contact.torque_arm", c.torque_arm, TORQUE_ARMS)
     string_in("contact.detection", c.detection, DETECTIONS)
     string_in("contact.normal_law", c.normal_law, NORMAL_LAWS)
@@ -1085,12 +1309,14 @@ def _check_contact(s: Scenario) -> None:
         raise ScenarioError("contact.skin", c.skin, "must be at most 1 (a fraction of R_i + R_j)")
     positive("contact.overlap_warn", c.overlap_warn)
     if not c.overlap_warn < 1.0:
-        raise ScenarioError("contact.overlap_warn", c.overlap_warn,
-                            "must be in (0, 1) (a fraction of the smaller radius)")
+        raise ScenarioError(
+            "contact.overlap_warn", c.overlap_warn, "must be in (0, 1) (a fraction of the smaller radius)"
+        )
     positive("contact.overlap_stop", c.overlap_stop)
     if not c.overlap_warn <= c.overlap_stop < 1.0:
-        raise ScenarioError("contact.overlap_stop", c.overlap_stop,
-                            f"must lie in [contact.overlap_warn = {c.overlap_warn:g}, 1)")
+        raise ScenarioError(
+            "contact.overlap_stop", c.overlap_stop, f"must lie in [contact.overlap_warn = {c.overlap_warn:g}, 1)"
+        )
     if not isinstance(c.clip_tensile, bool):
         raise ScenarioError("contact.clip_tensile", c.clip_tensile, "must be true or false")
     for i, pc in enumerate(c.pairs):
@@ -1119,7 +1345,7 @@ def possible_contacts(s: Scenario) -> list[tuple[str, str, str]]:
     for i, a in enumerate(mats):
         if count[a] > 1:
             found.append(("granule-granule", a, a))
-        found += [("granule-granule", a, b) for b in mats[i + 1:]]
+        found += [("granule-granule", a, b) for b in mats[i + 1 :]]
     found += [("granule-wall", a, b) for a in mats for b in dict.fromkeys(w.material for w in s.walls)]
     if s.plate is not None:
         found += [("granule-plate", a, s.plate.material) for a in mats]
@@ -1139,8 +1365,11 @@ def _check_yield_strengths(s: Scenario) -> None:
             if s.material(m).Y is None:
                 k = c.law_index(a, b)
                 path = "contact.normal_law" if k is None else f"contact.pairs[{k}].normal_law"
-                raise ScenarioError(path, law, f"needs the yield strength of material '{m}' "
-                                    f"({kind} contacts {a}-{b}): set materials.{m}.Y [Pa]")
+                raise ScenarioError(
+                    path,
+                    law,
+                    f"needs the yield strength of material '{m}' ({kind} contacts {a}-{b}): set materials.{m}.Y [Pa]",
+                )
 
 
 def _check_time(s: Scenario) -> None:
@@ -1148,22 +1377,24 @@ def _check_time(s: Scenario) -> None:
     for f in ("t_end", "dt_initial", "dt_max", "dt_min", "output_interval", "field_interval"):
         positive(f"time.{f}", getattr(t, f))
     if t.dt_min > t.dt_initial:
-        raise ScenarioError("time.dt_min", t.dt_min,
-                            f"must be <= time.dt_initial = {t.dt_initial!r} "
-                            "(dt_min <= dt_initial <= dt_max)")
+        raise ScenarioError(
+            "time.dt_min", t.dt_min, f"must be <= time.dt_initial = {t.dt_initial!r} (dt_min <= dt_initial <= dt_max)"
+        )
     if t.dt_initial > t.dt_max:
-        raise ScenarioError("time.dt_initial", t.dt_initial,
-                            f"must be <= time.dt_max = {t.dt_max!r} "
-                            "(dt_min <= dt_initial <= dt_max)")
+        raise ScenarioError(
+            "time.dt_initial", t.dt_initial, f"must be <= time.dt_max = {t.dt_max!r} (dt_min <= dt_initial <= dt_max)"
+        )
     if t.output_interval > t.t_end:
-        raise ScenarioError("time.output_interval", t.output_interval,
-                            f"must be <= time.t_end = {t.t_end!r}")
+        raise ScenarioError("time.output_interval", t.output_interval, f"must be <= time.t_end = {t.t_end!r}")
     r = t.field_interval / t.output_interval
     n = round(r)
     if n < 1 or abs(r - n) > INTERVAL_RTOL * r or n > 2**53:
-        raise ScenarioError("time.field_interval", t.field_interval,
-                            f"must be a whole multiple n of time.output_interval = "
-                            f"{t.output_interval!r}, 1 <= n <= 2^53 (beyond, every double is whole)")
+        raise ScenarioError(
+            "time.field_interval",
+            t.field_interval,
+            f"must be a whole multiple n of time.output_interval = "
+            f"{t.output_interval!r}, 1 <= n <= 2^53 (beyond, every double is whole)",
+        )
 
 
 #: Bytes kept per output time, per granule (its state in the buffers, the Dataset and
@@ -1195,12 +1426,14 @@ def _check_output_size(s: Scenario) -> None:
     t = s.time
     if memory > 0.0 and not t.t_end <= t_max:
         raise ScenarioError(
-            "time.t_end", t.t_end,
+            "time.t_end",
+            t.t_end,
             f"allowed: t_end <= {t_max:.3g} s with these output intervals: the outputs would need "
             f"about {t.t_end / t_max * (memory / 1e9):.3g} GB ({t.t_end / t.output_interval:.3g} "
             f"output times, time.output_interval = {t.output_interval!r} s; "
             f"{t.t_end / t.field_interval:.3g} plate snapshots, time.field_interval = "
-            f"{t.field_interval!r} s), this machine allows {memory / 1e9:.3g} GB")
+            f"{t.field_interval!r} s), this machine allows {memory / 1e9:.3g} GB",
+        )
 
 
 def _check_solver(s: Scenario) -> None:
@@ -1210,9 +1443,13 @@ def _check_solver(s: Scenario) -> None:
     if sv.scheme in GRANULAR_SCHEMES:
         _check_granular_scheme(s)
     elif isinstance(s.plate, Solid):
-        raise ScenarioError("solver.scheme", sv.scheme, "an elastic solid in 3D is coupled to the granules by "
-                            "velocity Verlet with its modes turned exactly (docs/model.md section 3.9): set "
-                            "solver.scheme = \"verlet\" and solver.granular_friction = \"split\"")
+        raise ScenarioError(
+            "solver.scheme",
+            sv.scheme,
+            "an elastic solid in 3D is coupled to the granules by "
+            "velocity Verlet with its modes turned exactly (docs/model.md section 3.9): set "
+            'solver.scheme = "verlet" and solver.granular_friction = "split"',
+        )
     lam = finite("solver.lambda_target", sv.lambda_target, "must be in (0, 1)")
     if not 0.0 < lam < 1.0:
         raise ScenarioError("solver.lambda_target", sv.lambda_target, "must be in (0, 1)")
@@ -1229,14 +1466,22 @@ def _check_granular_scheme(s: Scenario) -> None:
     space is its own: docs/model.md section 3.9), friction split off."""
     sv = s.solver
     if s.plate is not None and not isinstance(s.plate, Solid):
-        raise ScenarioError("solver.scheme", sv.scheme, "integrates the granules alone (velocity Verlet): a scenario "
-                            "with a [plate] needs \"implicit\" or \"paper\"")
+        raise ScenarioError(
+            "solver.scheme",
+            sv.scheme,
+            'integrates the granules alone (velocity Verlet): a scenario with a [plate] needs "implicit" or "paper"',
+        )
     if sv.granular_friction != "split":
-        raise ScenarioError("solver.granular_friction", sv.granular_friction, "must be \"split\" with solver.scheme "
-                            f"= {sv.scheme!r} (its friction is split off exactly, never inside the step)")
+        raise ScenarioError(
+            "solver.granular_friction",
+            sv.granular_friction,
+            'must be "split" with solver.scheme '
+            f"= {sv.scheme!r} (its friction is split off exactly, never inside the step)",
+        )
 
 
 # --------------------------------------------------------------------------- entry point
+
 
 class _GranuleNames(dict):
     """Granule i of the resolved scenario as messages name it (`geometry.granule_named`:
@@ -1288,8 +1533,9 @@ def _validate(scenario: Scenario) -> None:
         _check_spatial(s)
     _check_layout(s)
     if s.layout is None and not s.granules and s.plate is None:
-        raise ScenarioError("granules", (), "a scenario needs granules (or a [layout]) "
-                            "or a [plate], or both; it has neither")
+        raise ScenarioError(
+            "granules", (), "a scenario needs granules (or a [layout]) or a [plate], or both; it has neither"
+        )
     if isinstance(s.plate, Plate) and s.plate.x0 is not None:
         finite("plate.x0", s.plate.x0)
     r = resolve(s)
@@ -1327,13 +1573,16 @@ def _check_drives(s: Scenario) -> None:
     check_drives(s, float(step), speed)
 
 
-
 def _passed_before(scenario: Scenario) -> bool:
     """Whether `scenario` is the very object that passed last, with the same materials (a
     frozen scenario cannot change otherwise): a run validates it once, not on loading and
     again on building its model."""
-    return (bool(_THREAD.passed) and _THREAD.passed[0]() is scenario
-            and isinstance(scenario.materials, dict) and scenario.materials == _THREAD.passed[1])
+    return (
+        bool(_THREAD.passed)
+        and _THREAD.passed[0]() is scenario
+        and isinstance(scenario.materials, dict)
+        and scenario.materials == _THREAD.passed[1]
+    )
 
 
 def validated(scenario: Scenario) -> Scenario:

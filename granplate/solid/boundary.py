@@ -4,6 +4,7 @@ face's normal fixed), free elsewhere; and the reduced system's dof map.
 A roller's face must be flat and normal to a coordinate axis (a box's faces are); its
 normal is that axis.
 """
+
 from __future__ import annotations
 
 from typing import Sequence
@@ -39,8 +40,11 @@ def face_normal_axis(mesh: Mesh, name: str, field: str) -> int:
     axis = int(np.argmax(np.abs(normal).sum(axis=0)))
     off = np.delete(np.abs(normal), axis, axis=1).max()
     if off > AXIS_RTOL:
-        raise ScenarioError(field, name, "a roller's face must be flat and normal to x, y or z "
-                            f"(this one's normals tilt by up to {off:.3g})")
+        raise ScenarioError(
+            field,
+            name,
+            f"a roller's face must be flat and normal to x, y or z (this one's normals tilt by up to {off:.3g})",
+        )
     return axis
 
 

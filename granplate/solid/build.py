@@ -14,6 +14,7 @@ z dofs): a granule pressing on the face loads mainly those, and |S| is a third o
 face's dofs, a ninth of the dense matrix and a third of the solves. `components="xyz"`
 keeps all three.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -119,8 +120,9 @@ class SolidModel:
         return self.omega / (2.0 * np.pi)
 
 
-def solid_stiffness(sbasis: skfem.Basis, mesh: skfem.Mesh, element: str, material: Material,
-                    rigid_patches: tuple = ()) -> "sp.csr_matrix":
+def solid_stiffness(
+    sbasis: skfem.Basis, mesh: skfem.Mesh, element: str, material: Material, rigid_patches: tuple = ()
+) -> "sp.csr_matrix":
     """K [N/m] on the full dofs, with the rigid patches' ties (solid.tie) added."""
     K = stiffness_matrix(sbasis, material.E, material.nu)
     if not rigid_patches:
@@ -130,8 +132,10 @@ def solid_stiffness(sbasis: skfem.Basis, mesh: skfem.Mesh, element: str, materia
     from granplate.solid.tie import facing_nodes, patch_nodes, tie_penalty
 
     surface = boundary_surface(vector_basis(mesh, element))
-    nodes = [patch_nodes(*facing_nodes(surface, rp.centre), rp.centre, rp.radius, k, rp.axis)
-             for k, rp in enumerate(rigid_patches)]
+    nodes = [
+        patch_nodes(*facing_nodes(surface, rp.centre), rp.centre, rp.radius, k, rp.axis)
+        for k, rp in enumerate(rigid_patches)
+    ]
     return K + tie_penalty(K, node_coordinates(sbasis), nodes, [rp.rotates for rp in rigid_patches])
 
 
@@ -140,8 +144,12 @@ def solid_mesh(sd: Solid) -> skfem.Mesh:
     if sd.mesh is not None:
         mesh = read_mesh(sd.mesh)
         if is_hexahedral(sd.element) != isinstance(mesh, skfem.MeshHex):
-            raise ScenarioError("plate.element", sd.element, "does not fit the mesh file's cells: use "
-                                + ("'hex20' or 'hex27'" if isinstance(mesh, skfem.MeshHex) else "'tet10'"))
+            raise ScenarioError(
+                "plate.element",
+                sd.element,
+                "does not fit the mesh file's cells: use "
+                + ("'hex20' or 'hex27'" if isinstance(mesh, skfem.MeshHex) else "'tet10'"),
+            )
         check_faces(sd, face_names(mesh))
         return mesh
     return box_mesh(sd.size, sd.elements, sd.origin or (0.0, 0.0, 0.0), tetrahedra=not is_hexahedral(sd.element))
@@ -154,9 +162,13 @@ def cache_payload(sd: Solid, material: Material, surface: str | None, components
         fields.pop(name, None)
     if sd.mesh is not None:
         fields["mesh"] = hashlib.sha256(Path(sd.mesh).read_bytes()).hexdigest()
-    return {"skfem": getattr(skfem, "__version__", "?"), "solid": fields,
-            "material": [material.name, repr(float(material.E)), repr(float(material.nu)), repr(float(material.rho))],
-            "surface": surface, "components": components}
+    return {
+        "skfem": getattr(skfem, "__version__", "?"),
+        "solid": fields,
+        "material": [material.name, repr(float(material.E)), repr(float(material.nu)), repr(float(material.rho))],
+        "surface": surface,
+        "components": components,
+    }
 
 
 def solid_cost(sd: Solid, material: Material, n_dofs: int, xyz: np.ndarray, n_surface: int) -> SolidCost:
@@ -213,9 +225,15 @@ def forget_built_solids() -> None:
     _BUILT.clear()
 
 
-def build_solid(sd: Solid, material: Material | None = None, surface: str | None = "zmax",
-                components: str = "z", cache: bool = True, memory: float | None = None,
-                seconds: float | None = None) -> SolidModel:
+def build_solid(
+    sd: Solid,
+    material: Material | None = None,
+    surface: str | None = "zmax",
+    components: str = "z",
+    cache: bool = True,
+    memory: float | None = None,
+    seconds: float | None = None,
+) -> SolidModel:
     """Build the solid (module docstring).
 
     surface: the face whose dofs get the residual compliance (None: none);
@@ -231,11 +249,14 @@ def build_solid(sd: Solid, material: Material | None = None, surface: str | None
         material = LIBRARY[sd.material]
     if memory is None:
         from granplate.setup.plate_cost import physical_memory
+
         memory = MEMORY_SHARE * physical_memory()
     memo = None
     if cache:
-        memo = (store.key(STORE_KIND, cache_payload(sd, material, surface, components), SOLID_FORMAT),
-                str(store.cache_directory()))
+        memo = (
+            store.key(STORE_KIND, cache_payload(sd, material, surface, components), SOLID_FORMAT),
+            str(store.cache_directory()),
+        )
         built = _BUILT.pop(memo, None)
         if built is not None:
             check_fits(built.cost, memory, seconds, list(sd.elements) if sd.mesh is None else sd.mesh)
@@ -249,8 +270,15 @@ def build_solid(sd: Solid, material: Material | None = None, surface: str | None
     return built
 
 
-def _build_solid(sd: Solid, material: Material, surface: str | None, components: str, cache: bool,
-                 memory: float, seconds: float | None) -> SolidModel:
+def _build_solid(
+    sd: Solid,
+    material: Material,
+    surface: str | None,
+    components: str,
+    cache: bool,
+    memory: float,
+    seconds: float | None,
+) -> SolidModel:
     """build_solid without the process's memory."""
     mesh = solid_mesh(sd)
     sbasis = scalar_basis(mesh, sd.element)
@@ -273,19 +301,36 @@ def _build_solid(sd: Solid, material: Material, surface: str | None, components:
         K = reduced(solid_stiffness(sbasis, mesh, sd.element, material, sd.rigid_patches), dofs)
         M = reduced(mass_matrix(sbasis, material.rho), dofs)
         rigid = rigid_body_modes(nodes) if free else None
-        omega, Phi = modes_below(K, M, 2.0 * np.pi * sd.max_frequency, xyz, rigid=rigid,
-                                 k=window_size(cost.n_modes, len(dofs), bool(sd.clamped)))
+        omega, Phi = modes_below(
+            K,
+            M,
+            2.0 * np.pi * sd.max_frequency,
+            xyz,
+            rigid=rigid,
+            k=window_size(cost.n_modes, len(dofs), bool(sd.clamped)),
+        )
         resid = np.zeros((0, 0))
         if surface_dofs.size:
-            resid = residual_compliance(K, surface_dofs, Phi, omega, xyz, M=M,
-                                        rigid=Phi[:, :6] if free else None)
+            resid = residual_compliance(K, surface_dofs, Phi, omega, xyz, M=M, rigid=Phi[:, :6] if free else None)
         return {"omega": omega, "Phi": Phi, "dofs": dofs, "surface_dofs": surface_dofs, "resid": resid}
 
     payload = cache_payload(sd, material, surface, components) if cache else None
     arrays = _stored_or_computed(payload, compute)
     faces = {name: face_nodes(sbasis, mesh, name, "plate") for name in face_names(mesh)}
-    return SolidModel(nodes=nodes, dofs=arrays["dofs"], omega=arrays["omega"], Phi=arrays["Phi"],
-                      surface_dofs=arrays["surface_dofs"], resid=arrays["resid"], faces=faces,
-                      element=sd.element, material=material, free=free, cost=cost, mesh=mesh, basis=sbasis,
-                      arrays_key=store.key(STORE_KIND, payload, SOLID_FORMAT) if payload is not None else "",
-                      rigid_patches=tuple(sd.rigid_patches))
+    return SolidModel(
+        nodes=nodes,
+        dofs=arrays["dofs"],
+        omega=arrays["omega"],
+        Phi=arrays["Phi"],
+        surface_dofs=arrays["surface_dofs"],
+        resid=arrays["resid"],
+        faces=faces,
+        element=sd.element,
+        material=material,
+        free=free,
+        cost=cost,
+        mesh=mesh,
+        basis=sbasis,
+        arrays_key=store.key(STORE_KIND, payload, SOLID_FORMAT) if payload is not None else "",
+        rigid_patches=tuple(sd.rigid_patches),
+    )

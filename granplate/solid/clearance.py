@@ -3,6 +3,7 @@ each centre to the body's surface (`surface.closest_point`: the boundary's quadr
 faces, positive outside), refused by the rule of `setup.solid_checks.check_solid_clearance`
 (a granule may touch the solid, not cross it; no centre inside). A box solid is checked
 in closed form by `setup.validate`; a mesh file needs its surface, read here."""
+
 from __future__ import annotations
 
 import numpy as np

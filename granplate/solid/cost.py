@@ -21,6 +21,7 @@ measured, memory 2.5 GB and 3.7 GB against 1.8 GB and 3.2 GB, without and with t
 residual compliance); on meshes of about 10,000 dofs it is about half the measured time
 (fixed costs dominate there), which no refusal depends on.
 """
+
 from __future__ import annotations
 
 import math
@@ -56,8 +57,9 @@ def box_dofs(elements: tuple[int, int, int], element: str) -> tuple[int, int]:
     """(dofs, separator dofs) of a box of nx x ny x nz elements (before supports)."""
     nx, ny, nz = (int(n) for n in elements)
     if element == "hex20":
-        nodes = lambda a, b, c: ((a + 1) * (b + 1) * (c + 1) + a * (b + 1) * (c + 1)
-                                 + (a + 1) * b * (c + 1) + (a + 1) * (b + 1) * c)
+        nodes = lambda a, b, c: (
+            (a + 1) * (b + 1) * (c + 1) + a * (b + 1) * (c + 1) + (a + 1) * b * (c + 1) + (a + 1) * (b + 1) * c
+        )
         plane = lambda b, c: (b + 1) * (c + 1) + b * (c + 1) + (b + 1) * c
     else:  # hex27 and tet10: the triquadratic node lattice
         nodes = lambda a, b, c: (2 * a + 1) * (2 * b + 1) * (2 * c + 1)
@@ -86,11 +88,10 @@ def estimate(n_dofs: int, separator: int, n_modes: int, n_surface: int, window: 
     n_modes = min(n_modes, n_dofs)
     fill = FILL_PER_DOF_SEP * n_dofs * separator
     windows = 1 if window >= n_modes else max(1, math.ceil(n_modes / max(1, window // 2)))
-    memory = (LU_COPIES * BYTES_PER_ENTRY * fill + 8.0 * n_dofs * (3 * window + n_modes)
-              + DENSE_BYTES * n_surface**2)
-    seconds = (windows * (FACTOR_SECONDS * n_dofs * separator**2 + SOLVES_PER_VALUE * window * SOLVE_SECONDS * fill)
-               + (n_surface > 0) * (FACTOR_SECONDS * n_dofs * separator**2
-                                    + DENSE_SECONDS * float(n_surface) ** 3))
+    memory = LU_COPIES * BYTES_PER_ENTRY * fill + 8.0 * n_dofs * (3 * window + n_modes) + DENSE_BYTES * n_surface**2
+    seconds = windows * (FACTOR_SECONDS * n_dofs * separator**2 + SOLVES_PER_VALUE * window * SOLVE_SECONDS * fill) + (
+        n_surface > 0
+    ) * (FACTOR_SECONDS * n_dofs * separator**2 + DENSE_SECONDS * float(n_surface) ** 3)
     return SolidCost(n_dofs, separator, fill, n_modes, windows, memory, seconds)
 
 
@@ -103,9 +104,11 @@ def check_fits(cost: SolidCost, memory: float, seconds: float | None = None, ele
     if not (over_memory or over_time):
         return
     raise ScenarioError(
-        "plate.elements", elements,
+        "plate.elements",
+        elements,
         f"this solid ({cost.n_dofs} dofs, about {cost.n_modes} modes in {cost.windows} eigensolver windows, "
         f"{cost.fill / 1e6:.3g} M factor entries) needs about {cost.memory / 1e9:.3g} GB and {cost.seconds:.3g} s "
         f"to build; this machine allows {memory / 1e9:.3g} GB"
         + (f" and {seconds:.3g} s" if seconds is not None else "")
-        + "; use fewer elements (plate.elements) or a lower plate.max_frequency")
+        + "; use fewer elements (plate.elements) or a lower plate.max_frequency",
+    )

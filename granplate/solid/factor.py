@@ -12,6 +12,7 @@ load: a solve 0.055 s against 0.060 s, the Schur-complement factorisation 15.8 s
 18.2 s, the eigensolver's work between solves several times faster). The dense
 triangular solves of the residual compliance keep every thread.
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -67,8 +68,12 @@ def factorised(A: sp.spmatrix, xyz: np.ndarray) -> Callable[[np.ndarray], np.nda
     """x = A^-1 b for b (n,) or (n, m), from one SuperLU factorisation of the symmetric A
     under nested_dissection(A, xyz)."""
     order = nested_dissection(A, xyz)
-    lu = spla.splu(sp.csc_matrix(sp.csr_matrix(A)[order][:, order]), permc_spec="NATURAL",
-                   diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+    lu = spla.splu(
+        sp.csc_matrix(sp.csr_matrix(A)[order][:, order]),
+        permc_spec="NATURAL",
+        diag_pivot_thresh=0.0,
+        options={"SymmetricMode": True},
+    )
 
     def solve(b: np.ndarray) -> np.ndarray:
         b = np.asarray(b, dtype=float)

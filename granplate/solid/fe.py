@@ -5,6 +5,7 @@ Elements (`ELEMENTS`): "hex20" (ElementHexS2, 20-node serendipity), "hex27" (Ele
 27-node triquadratic), "tet10" (ElementTetP2, 10-node). Each node n of the vector basis
 has the dofs 3n (x), 3n + 1 (y), 3n + 2 (z).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -26,7 +27,9 @@ def is_hexahedral(element: str) -> bool:
 
 def _check_cells(mesh: Mesh, element: str) -> None:
     if is_hexahedral(element) != isinstance(mesh, MeshHex):
-        raise ValueError(f"element {element!r} needs a {'hexahedral' if is_hexahedral(element) else 'tetrahedral'} mesh")
+        raise ValueError(
+            f"element {element!r} needs a {'hexahedral' if is_hexahedral(element) else 'tetrahedral'} mesh"
+        )
 
 
 def vector_basis(mesh: Mesh, element: str) -> Basis:

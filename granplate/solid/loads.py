@@ -6,6 +6,7 @@ the work-consistent weights, the face's shape functions). Summed over the granul
 row per output time, on the reduced dofs (a dof held by a clamp or a roller takes no
 load: its reaction balances it).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -27,8 +28,9 @@ def _weights(kind, xi, n_nodes):
     return w
 
 
-def nodal_force_history(surface: Surface, dofs: np.ndarray, n_full: int, face: np.ndarray,
-                        xi: np.ndarray, force: np.ndarray) -> sp.csr_matrix:
+def nodal_force_history(
+    surface: Surface, dofs: np.ndarray, n_full: int, face: np.ndarray, xi: np.ndarray, force: np.ndarray
+) -> sp.csr_matrix:
     """(n_t, n_red) [N]: the nodal forces on the reduced dofs at each output time.
 
     surface: the boundary faces (`surface.boundary_surface`); dofs (n_red,): the full dof

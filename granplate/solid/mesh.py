@@ -6,6 +6,7 @@ A box names its six faces xmin, xmax, ymin, ymax, zmin, zmax. A file (Gmsh .msh)
 its surfaces by physical groups of quadrilaterals (hexahedra) or triangles (tetrahedra).
 Every problem is a ScenarioError naming the field (`plate.mesh`, `plate.size`, ...).
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -21,8 +22,7 @@ BOX_FACES: tuple[str, ...] = ("xmin", "xmax", "ymin", "ymax", "zmin", "zmax")
 #: The cell types a mesh file may hold (linear cells; the element supplies mid-nodes).
 FILE_CELLS: dict[str, str] = {"hexahedron": "quad", "tetra": "triangle"}
 #: Reference coordinates of the 8 corners of a hexahedron in meshio/VTK order.
-VTK_HEX_CORNERS = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0],
-                            [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]])
+VTK_HEX_CORNERS = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]])
 #: An element whose smallest corner Jacobian is below this share of the mean element's
 #: volume is degenerate.
 DEGENERATE_RTOL = 1e-8
@@ -33,8 +33,9 @@ def face_axis(name: str) -> int:
     return "xyz".index(name[0])
 
 
-def box_mesh(size: Sequence[float], elements: Sequence[int], origin: Sequence[float] = (0.0, 0.0, 0.0),
-             tetrahedra: bool = False) -> Mesh:
+def box_mesh(
+    size: Sequence[float], elements: Sequence[int], origin: Sequence[float] = (0.0, 0.0, 0.0), tetrahedra: bool = False
+) -> Mesh:
     """A box [origin, origin + size] [m] of nx x ny x nz hexahedra (tetrahedra: each cube
     cut into tetrahedra) with its six faces named (BOX_FACES)."""
     axes = [np.linspace(o, o + s, int(n) + 1) for o, s, n in zip(origin, size, elements)]
@@ -77,9 +78,13 @@ def check_cells(points: np.ndarray, cells: np.ndarray, field: str, value: object
     if bad.size:
         c = int(bad[0])
         kind = "inverted" if jac[c].min() < -DEGENERATE_RTOL * scale else "degenerate"
-        raise ScenarioError(field, value, f"{bad.size} cell(s) are inverted or degenerate (first: cell {c}, "
-                            f"{kind}, smallest corner Jacobian {jac[c].min():.3g} m^3 against a mean of "
-                            f"{scale:.3g}); fix the mesh's node order or shape")
+        raise ScenarioError(
+            field,
+            value,
+            f"{bad.size} cell(s) are inverted or degenerate (first: cell {c}, "
+            f"{kind}, smallest corner Jacobian {jac[c].min():.3g} m^3 against a mean of "
+            f"{scale:.3g}); fix the mesh's node order or shape",
+        )
 
 
 def _read(path: Path, field: str):
@@ -92,12 +97,14 @@ def _read(path: Path, field: str):
         return meshio.read(str(path))
     except (Exception, SystemExit) as exc:  # meshio raises many kinds, and exits on a file of no known format
         why = "" if isinstance(exc, SystemExit) else f" ({type(exc).__name__}: {exc})"
-        raise ScenarioError(field, str(path), f"cannot be read as a mesh{why}; "
-                            "give a Gmsh .msh file of hexahedra or tetrahedra") from None
+        raise ScenarioError(
+            field, str(path), f"cannot be read as a mesh{why}; give a Gmsh .msh file of hexahedra or tetrahedra"
+        ) from None
 
 
-def _group_facets(m, mesh: Mesh, surface_type: str, field: str, path: str,
-                  surface: np.ndarray | None = None) -> dict[str, np.ndarray]:
+def _group_facets(
+    m, mesh: Mesh, surface_type: str, field: str, path: str, surface: np.ndarray | None = None
+) -> dict[str, np.ndarray]:
     """The named facet groups of a file: its physical groups of surface cells (surface:
     those cells renumbered as the mesh's points; None: as the file has them), mapped to
     the facets of the skfem mesh."""
@@ -115,8 +122,9 @@ def _group_facets(m, mesh: Mesh, surface_type: str, field: str, path: str,
         for cell in surface[tags == tag]:
             f = lookup.get(tuple(np.sort(cell)))
             if f is None:
-                raise ScenarioError(field, path, f"surface group {name!r} has a {surface_type} that is not a "
-                                    "face of the volume cells")
+                raise ScenarioError(
+                    field, path, f"surface group {name!r} has a {surface_type} that is not a face of the volume cells"
+                )
             facets.append(f)
         groups[str(name)] = np.array(sorted(facets), dtype=np.int64)
     return groups
@@ -132,9 +140,13 @@ def read_mesh(path: str | Path, field: str = "plate.mesh") -> Mesh:
     m = _read(path, field)
     found = [c for c in m.cells_dict if c in FILE_CELLS]
     if not found:
-        raise ScenarioError(field, str(path), f"holds no supported volume cells (found {sorted(m.cells_dict)}); "
-                            "allowed: " + " or ".join(FILE_CELLS) + " (linear cells: the element "
-                            "supplies the mid-nodes)")
+        raise ScenarioError(
+            field,
+            str(path),
+            f"holds no supported volume cells (found {sorted(m.cells_dict)}); "
+            "allowed: " + " or ".join(FILE_CELLS) + " (linear cells: the element "
+            "supplies the mid-nodes)",
+        )
     if len(found) > 1:
         raise ScenarioError(field, str(path), "holds both hexahedra and tetrahedra; one cell type per mesh")
     cell_type = found[0]
@@ -165,8 +177,9 @@ def face_facets(mesh: Mesh, name: str, field: str) -> np.ndarray:
     """The facets of a named face (ScenarioError naming `field` when it does not exist)."""
     groups = mesh.boundaries or {}
     if name not in groups:
-        raise ScenarioError(field, name, "no such face; the mesh names: "
-                            + (", ".join(repr(n) for n in sorted(groups)) or "none"))
+        raise ScenarioError(
+            field, name, "no such face; the mesh names: " + (", ".join(repr(n) for n in sorted(groups)) or "none")
+        )
     return np.asarray(groups[name], dtype=np.int64)
 
 
@@ -221,7 +234,6 @@ def outline_edges(mesh: Mesh, facets: np.ndarray | None = None) -> np.ndarray:
         for e in edges[:, k]:
             owners.setdefault(int(e), []).append(k)
     cos_crease = np.cos(np.radians(CREASE_DEGREES))
-    drawn = sorted(e for e, ks in owners.items()
-                   if len(ks) != 2 or float(normals[ks[0]] @ normals[ks[1]]) < cos_crease)
+    drawn = sorted(e for e, ks in owners.items() if len(ks) != 2 or float(normals[ks[0]] @ normals[ks[1]]) < cos_crease)
     ends = mesh.edges[:, np.array(drawn, dtype=np.int64)]  # (2, n)
     return np.ascontiguousarray(mesh.p[:, ends].transpose(2, 1, 0))

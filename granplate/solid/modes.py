@@ -18,6 +18,7 @@ sign is the plate's rule (`plate.modes.fix_mode_signs`: a positive projection on
 reference vector, which holds for the symmetric and antisymmetric modes of a square plate,
 whose largest entries come in pairs of opposite sign).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -66,13 +67,13 @@ def shift_inverse(K: sp.spmatrix, M: sp.spmatrix, sigma: float, xyz: np.ndarray)
     return spla.LinearOperator(K.shape, matvec=factorised(K - sigma * M, xyz), dtype=float)
 
 
-def window(K: sp.spmatrix, M: sp.spmatrix, sigma: float, k: int, v0: np.ndarray,
-           xyz: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def window(
+    K: sp.spmatrix, M: sp.spmatrix, sigma: float, k: int, v0: np.ndarray, xyz: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """The k eigenpairs (lambda = omega^2 ascending, vectors) nearest sigma (xyz: each
     dof's position [m], for the factorisation's ordering)."""
     with one_blas_thread():
-        vals, vecs = spla.eigsh(K, k=k, M=M, sigma=sigma, which="LM", v0=v0,
-                                OPinv=shift_inverse(K, M, sigma, xyz))
+        vals, vecs = spla.eigsh(K, k=k, M=M, sigma=sigma, which="LM", v0=v0, OPinv=shift_inverse(K, M, sigma, xyz))
     order = np.argsort(vals)
     return vals[order], vecs[:, order]
 
@@ -80,7 +81,7 @@ def window(K: sp.spmatrix, M: sp.spmatrix, sigma: float, k: int, v0: np.ndarray,
 def window_cut(vals: np.ndarray, below: float) -> float:
     """A value inside the widest relative gap between a window's sorted eigenvalues above
     `below` in its upper half, below its top (`below` itself when fewer than two lie there)."""
-    upper = vals[len(vals) // 2:]
+    upper = vals[len(vals) // 2 :]
     upper = upper[upper > below]
     if len(upper) < 2:
         return below
@@ -89,8 +90,9 @@ def window_cut(vals: np.ndarray, below: float) -> float:
     return 0.5 * float(upper[i] + upper[i + 1])
 
 
-def eigenpairs_below(K: sp.spmatrix, M: sp.spmatrix, max_lambda: float, xyz: np.ndarray,
-                     k: int = WINDOW_MODES, seed: int = V0_SEED) -> tuple[np.ndarray, np.ndarray]:
+def eigenpairs_below(
+    K: sp.spmatrix, M: sp.spmatrix, max_lambda: float, xyz: np.ndarray, k: int = WINDOW_MODES, seed: int = V0_SEED
+) -> tuple[np.ndarray, np.ndarray]:
     """Every eigenpair with lambda <= max_lambda [rad^2/s^2] (ascending), over
     shift-invert windows of k values (module docstring); xyz (n, 3): each dof's position [m]."""
     n = K.shape[0]
@@ -122,9 +124,15 @@ def eigenpairs_below(K: sp.spmatrix, M: sp.spmatrix, max_lambda: float, xyz: np.
     return lam[order], vec[:, order]
 
 
-def modes_below(K: sp.spmatrix, M: sp.spmatrix, max_omega: float, xyz: np.ndarray,
-                rigid: np.ndarray | None = None, k: int = WINDOW_MODES,
-                seed: int = V0_SEED) -> tuple[np.ndarray, np.ndarray]:
+def modes_below(
+    K: sp.spmatrix,
+    M: sp.spmatrix,
+    max_omega: float,
+    xyz: np.ndarray,
+    rigid: np.ndarray | None = None,
+    k: int = WINDOW_MODES,
+    seed: int = V0_SEED,
+) -> tuple[np.ndarray, np.ndarray]:
     """(omega (n_modes,) [rad/s] ascending, Phi (n, n_modes) [kg^-1/2]) of every mode up
     to max_omega [rad/s], M-orthonormal, signs fixed; xyz (n, 3): each dof's position [m].
 
@@ -136,7 +144,7 @@ def modes_below(K: sp.spmatrix, M: sp.spmatrix, max_omega: float, xyz: np.ndarra
     R = m_orthonormal(rigid, M)
     n_rigid = R.shape[1]
     if len(lam) > n_rigid and not abs(lam[n_rigid - 1]) < RIGID_RTOL * lam[n_rigid]:
-        raise RuntimeError(f"a free body should have {n_rigid} zero eigenvalues; found {lam[:n_rigid + 1]}")
+        raise RuntimeError(f"a free body should have {n_rigid} zero eigenvalues; found {lam[: n_rigid + 1]}")
     E = vec[:, n_rigid:]
     E = E - R @ (R.T @ (M @ E))
     E = E / np.sqrt(np.einsum("ij,ij->j", E, M @ E))

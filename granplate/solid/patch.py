@@ -2,6 +2,7 @@
 node's share of the surface, a grid of cells over them (the compiled search of the nodes
 within a patch, solver.body.disc_patch), how many nodes a patch can hold, and the
 smallest radius whose every patch holds one."""
+
 from __future__ import annotations
 
 from typing import NamedTuple
@@ -114,8 +115,11 @@ def check_patch_radius(radius: float, reach: float) -> None:
     patch would hold no node, or one node alone."""
     smallest = MIN_PATCH_RATIO * reach
     if 0.0 < radius < smallest:
-        raise ScenarioError("plate.patch_radius", radius,
-                            f"must be 0 (a point patch) or at least {smallest:.4g} m on this mesh: "
-                            f"{MIN_PATCH_RATIO:g} x the farthest a point of the surface lies from a node "
-                            f"({reach:.4g} m), so that every patch averages several nodes; refine the mesh for "
-                            "a smaller patch")
+        raise ScenarioError(
+            "plate.patch_radius",
+            radius,
+            f"must be 0 (a point patch) or at least {smallest:.4g} m on this mesh: "
+            f"{MIN_PATCH_RATIO:g} x the farthest a point of the surface lies from a node "
+            f"({reach:.4g} m), so that every patch averages several nodes; refine the mesh for "
+            "a smaller patch",
+        )

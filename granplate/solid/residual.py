@@ -19,6 +19,7 @@ triangular solves), with no solve per dof of S. On the 40 x 40 x 2 hex20 plate's
 top-face z dofs: 29 s, against 380 s for block solves of unit loads (`flexibility_block`,
 kept for a few dofs on demand: `SolidModel.residual_block`).
 """
+
 from __future__ import annotations
 
 from typing import Callable
@@ -52,13 +53,17 @@ def schur_flexibility(K: sp.spmatrix, xyz: np.ndarray, dofs: np.ndarray) -> tupl
     interior = np.setdiff1d(np.arange(n), dofs)
     order = np.concatenate([interior[nested_dissection(K[interior][:, interior], xyz[interior])], dofs])
     with one_blas_thread():  # SuperLU's small blocks (solid.factor); the dense solves below threaded
-        lu = spla.splu(sp.csc_matrix(K[order][:, order]), permc_spec="NATURAL", diag_pivot_thresh=0.0,
-                       options={"SymmetricMode": True})
+        lu = spla.splu(
+            sp.csc_matrix(K[order][:, order]),
+            permc_spec="NATURAL",
+            diag_pivot_thresh=0.0,
+            options={"SymmetricMode": True},
+        )
     if not (np.array_equal(lu.perm_r, np.arange(n)) and np.array_equal(lu.perm_c, np.arange(n))):
         raise RuntimeError("the factorisation reordered the dofs; the Schur complement is not its last block")
     m = len(dofs)
-    L = lu.L[n - m:, n - m:].toarray()
-    U = lu.U[n - m:, n - m:].toarray()
+    L = lu.L[n - m :, n - m :].toarray()
+    U = lu.U[n - m :, n - m :].toarray()
     G = la.solve_triangular(U, la.solve_triangular(L, np.eye(m), lower=True, unit_diagonal=True))
 
     def solve(b: np.ndarray) -> np.ndarray:
@@ -70,8 +75,9 @@ def schur_flexibility(K: sp.spmatrix, xyz: np.ndarray, dofs: np.ndarray) -> tupl
     return 0.5 * (G + G.T), solve
 
 
-def flexibility(K: sp.spmatrix, xyz: np.ndarray, M: sp.spmatrix | None = None,
-                rigid: np.ndarray | None = None) -> Callable[[np.ndarray], np.ndarray]:
+def flexibility(
+    K: sp.spmatrix, xyz: np.ndarray, M: sp.spmatrix | None = None, rigid: np.ndarray | None = None
+) -> Callable[[np.ndarray], np.ndarray]:
     """x = G f for loads f (n, m) [N] -> (n, m) [m]: K^-1 f (held body, rigid None), or the
     inertia-relief flexibility of a free body with M-orthonormal rigid modes rigid (n, 6);
     xyz (n, 3): each dof's position [m] (the factorisation's ordering)."""
@@ -92,23 +98,34 @@ def flexibility(K: sp.spmatrix, xyz: np.ndarray, M: sp.spmatrix | None = None,
     return solve
 
 
-def flexibility_block(solve: Callable[[np.ndarray], np.ndarray], n: int, dofs: np.ndarray,
-                      columns: np.ndarray | None = None, chunk: int = CHUNK) -> np.ndarray:
+def flexibility_block(
+    solve: Callable[[np.ndarray], np.ndarray],
+    n: int,
+    dofs: np.ndarray,
+    columns: np.ndarray | None = None,
+    chunk: int = CHUNK,
+) -> np.ndarray:
     """G[dofs, columns] [m/N] (columns: a subset of dofs, default all), from unit loads
     solved chunk at a time."""
     columns = dofs if columns is None else columns
     out = np.empty((len(dofs), len(columns)))
     for start in range(0, len(columns), chunk):
-        cols = columns[start:start + chunk]
+        cols = columns[start : start + chunk]
         f = np.zeros((n, len(cols)))
         f[cols, np.arange(len(cols))] = 1.0
-        out[:, start:start + len(cols)] = solve(f)[dofs]
+        out[:, start : start + len(cols)] = solve(f)[dofs]
     return out
 
 
-def residual_compliance(K: sp.spmatrix, dofs: np.ndarray, Phi: np.ndarray, omega: np.ndarray,
-                        xyz: np.ndarray, M: sp.spmatrix | None = None,
-                        rigid: np.ndarray | None = None) -> np.ndarray:
+def residual_compliance(
+    K: sp.spmatrix,
+    dofs: np.ndarray,
+    Phi: np.ndarray,
+    omega: np.ndarray,
+    xyz: np.ndarray,
+    M: sp.spmatrix | None = None,
+    rigid: np.ndarray | None = None,
+) -> np.ndarray:
     """R (|S|, |S|) [m/N] over the dofs S of the (reduced) system (module docstring);
     xyz (n, 3): each dof's position [m].
 

@@ -14,6 +14,7 @@ sphere is weighted by a linear ramp across a band one quadrature-point spacing w
 partial cell), so the averaged volume converges smoothly under refinement instead of
 jumping as points cross the sphere.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -63,8 +64,9 @@ def strain_operator(basis: Basis) -> sp.csr_matrix:
                 rows.append(c * n_points + point[keep])
                 cols.append(col[keep])
                 data.append(eps[c][keep])
-    op = sp.coo_matrix((np.concatenate(data), (np.concatenate(rows), np.concatenate(cols))),
-                       shape=(6 * n_points, basis.N)).tocsr()
+    op = sp.coo_matrix(
+        (np.concatenate(data), (np.concatenate(rows), np.concatenate(cols))), shape=(6 * n_points, basis.N)
+    ).tocsr()
     op.sum_duplicates()
     op.sort_indices()
     return op
@@ -133,8 +135,9 @@ def ball_weight(distance: np.ndarray, radius: float, spacing: np.ndarray) -> np.
     return np.where(spacing > 0.0, ramp, inside)
 
 
-def ball_average_operator(points: np.ndarray, weights: np.ndarray, centres: np.ndarray,
-                          radius: float, spacing: np.ndarray | float = 0.0) -> sp.csr_matrix:
+def ball_average_operator(
+    points: np.ndarray, weights: np.ndarray, centres: np.ndarray, radius: float, spacing: np.ndarray | float = 0.0
+) -> sp.csr_matrix:
     """Sparse (n_centres, n_points) map from values at the quadrature points to their mean
     over the ball of `radius` [m] about each centre, cut by the body: row c = w_i b_i /
     sum(w b), b_i = `ball_weight` (the partial cells, `spacing` [m] per point: `point_spacing`;

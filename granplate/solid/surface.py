@@ -24,6 +24,7 @@ patch with its granule: it projects the centre onto the patch's face and the fac
 share a corner with it, and walks to the nearest until it stays, so a patch crosses
 faces, edges and corners without Python per step.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -262,8 +263,18 @@ def face_closest(X, kind, p, out):
     returns the squared distance [m^2].
     """
     n = X.shape[0]
-    return _face_closest(X, kind, p, out, np.empty(n), np.empty((n, 2)), np.empty((n, 3)), np.empty(3),
-                         np.empty((3, 2)), np.empty((3, 3)))
+    return _face_closest(
+        X,
+        kind,
+        p,
+        out,
+        np.empty(n),
+        np.empty((n, 2)),
+        np.empty((n, 3)),
+        np.empty(3),
+        np.empty((3, 2)),
+        np.empty((3, 3)),
+    )
 
 
 @njit(cache=True)
@@ -485,8 +496,9 @@ def _kind_of(element) -> int:
     name = type(element).__name__
     kinds = {"ElementHexS2": QUAD8, "ElementHex2": QUAD9, "ElementTetP2": TRI6}
     if name not in kinds:
-        raise ScenarioError("solid.element", name,
-                            "one of ElementHexS2 (hex20), ElementHex2 (hex27), ElementTetP2 (tet10)")
+        raise ScenarioError(
+            "solid.element", name, "one of ElementHexS2 (hex20), ElementHex2 (hex27), ElementTetP2 (tet10)"
+        )
     return kinds[name]
 
 
@@ -499,11 +511,12 @@ def _reference_faces(kind: int, doflocs: np.ndarray) -> list[tuple[np.ndarray, n
     two) - 1), the tet's the unit simplex (faces x = 0, y = 0, z = 0, x + y + z = 1)."""
     faces = []
     if kind == TRI6:
-        planes = [(lambda q: q[:, 2], np.array([0, 0, 0.]), np.array([1, 0, 0.]), np.array([0, 1, 0.])),
-                  (lambda q: q[:, 1], np.array([0, 0, 0.]), np.array([1, 0, 0.]), np.array([0, 0, 1.])),
-                  (lambda q: q[:, 0], np.array([0, 0, 0.]), np.array([0, 1, 0.]), np.array([0, 0, 1.])),
-                  (lambda q: 1.0 - q.sum(axis=1), np.array([0, 0, 1.]), np.array([1, 0, -1.]),
-                   np.array([0, 1, -1.]))]
+        planes = [
+            (lambda q: q[:, 2], np.array([0, 0, 0.0]), np.array([1, 0, 0.0]), np.array([0, 1, 0.0])),
+            (lambda q: q[:, 1], np.array([0, 0, 0.0]), np.array([1, 0, 0.0]), np.array([0, 0, 1.0])),
+            (lambda q: q[:, 0], np.array([0, 0, 0.0]), np.array([0, 1, 0.0]), np.array([0, 0, 1.0])),
+            (lambda q: 1.0 - q.sum(axis=1), np.array([0, 0, 1.0]), np.array([1, 0, -1.0]), np.array([0, 1, -1.0])),
+        ]
         ref = _TRI_NODES
         n_vertices = 4
     else:
@@ -548,8 +561,9 @@ def boundary_surface(basis, groups: tuple[str, ...] | None = None) -> Surface:
     mesh = basis.mesh
     element = getattr(basis.elem, "elem", None)
     if element is None or getattr(basis.elem, "dim", None) != 3:
-        raise ScenarioError("solid.element", type(basis.elem).__name__,
-                            "a 3-component ElementVector of a quadratic solid element")
+        raise ScenarioError(
+            "solid.element", type(basis.elem).__name__, "a 3-component ElementVector of a quadratic solid element"
+        )
     kind = _kind_of(element)
     if groups is None:
         facets = mesh.boundary_facets()
@@ -557,13 +571,15 @@ def boundary_surface(basis, groups: tuple[str, ...] | None = None) -> Surface:
         named = mesh.boundaries or {}
         unknown = [g for g in groups if g not in named]
         if unknown:
-            raise ScenarioError("solid.surface_groups", unknown,
-                                f"facet groups of the mesh: {sorted(named)}")
+            raise ScenarioError("solid.surface_groups", unknown, f"facet groups of the mesh: {sorted(named)}")
         facets = np.unique(np.concatenate([np.asarray(named[g]) for g in groups]))
         inner = facets[mesh.f2t[1, facets] >= 0]
         if len(inner):
-            raise ScenarioError("solid.surface_groups", list(groups),
-                                f"groups of boundary facets (facets {inner[:5].tolist()} are inside the body)")
+            raise ScenarioError(
+                "solid.surface_groups",
+                list(groups),
+                f"groups of boundary facets (facets {inner[:5].tolist()} are inside the body)",
+            )
     facets = np.asarray(facets, dtype=np.int64)
     elements = mesh.f2t[0, facets].astype(np.int64)
     ref_faces = _reference_faces(kind, np.asarray(element.doflocs, float))
@@ -646,8 +662,13 @@ def closest_point(surface: Surface, point) -> ClosestPoint:
         if d2 < best:
             best, best_face, best_out = d2, f, scratch.copy()
     contact_frame(surface.nodes[best_face], surface.kind, p, best_out)
-    return ClosestPoint(face=int(best_face), xi=best_out[0:2].copy(), point=best_out[2:5].copy(),
-                        normal=best_out[5:8].copy(), distance=float(best_out[8]))
+    return ClosestPoint(
+        face=int(best_face),
+        xi=best_out[0:2].copy(),
+        point=best_out[2:5].copy(),
+        normal=best_out[5:8].copy(),
+        distance=float(best_out[8]),
+    )
 
 
 def patch_weights(surface: Surface, face: int, xi) -> tuple[np.ndarray, np.ndarray]:

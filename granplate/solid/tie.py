@@ -6,6 +6,7 @@ K. A deformation of the patch costs kappa times its squared norm, a rigid motion
 kappa = PENALTY x the largest diagonal entry of K there, so the patch's own deformation is
 about 1/PENALTY of the surface's under the same load, and its stiffest modes lie far above
 any cut-off (their static response is the residual compliance's)."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -34,18 +35,22 @@ def in_patch(points: np.ndarray, patch) -> np.ndarray:
     return patch_distance(points, patch.centre, patch.axis) <= patch.radius
 
 
-def patch_nodes(surface_xyz: np.ndarray, surface_full: np.ndarray, centre, radius: float,
-                index: int, axis=None) -> np.ndarray:
+def patch_nodes(
+    surface_xyz: np.ndarray, surface_full: np.ndarray, centre, radius: float, index: int, axis=None
+) -> np.ndarray:
     """The mesh nodes (full ids) of the surface nodes within `radius` [m] of `centre` [m]
     (of the line through it along `axis`, when given); ScenarioError naming
     plate.rigid_patches[index] when fewer than MIN_NODES."""
     d = patch_distance(surface_xyz, centre, axis)
     nodes = surface_full[d <= radius]
     if len(nodes) < MIN_NODES:
-        raise ScenarioError(f"plate.rigid_patches[{index}]", {"centre": list(centre), "radius": radius},
-                            f"holds {len(nodes)} surface node(s): a rigid patch needs at least {MIN_NODES}; "
-                            f"move its centre onto the surface or widen its radius (the nearest surface node is "
-                            f"{d.min():.4g} m from the centre)")
+        raise ScenarioError(
+            f"plate.rigid_patches[{index}]",
+            {"centre": list(centre), "radius": radius},
+            f"holds {len(nodes)} surface node(s): a rigid patch needs at least {MIN_NODES}; "
+            f"move its centre onto the surface or widen its radius (the nearest surface node is "
+            f"{d.min():.4g} m from the centre)",
+        )
     return np.sort(nodes)
 
 
@@ -91,8 +96,9 @@ def rigid_basis(xyz: np.ndarray, rotates: bool = True) -> np.ndarray:
     return Q[:, s > 1e-12 * s.max()]
 
 
-def tie_penalty(K: sp.spmatrix, xyz_nodes: np.ndarray, patches: list[np.ndarray],
-                rotates: list[bool] | None = None) -> sp.csr_matrix:
+def tie_penalty(
+    K: sp.spmatrix, xyz_nodes: np.ndarray, patches: list[np.ndarray], rotates: list[bool] | None = None
+) -> sp.csr_matrix:
     """The penalties of the rigid patches (each an array of mesh nodes; rotates[k]: whether
     patch k may rotate, default all) on the full dofs of K (nodes' coordinates xyz_nodes
     (n_nodes, 3) [m]), as a sparse matrix to add to K."""

@@ -4,6 +4,7 @@ evenly over the face's extent along z, a traction t_x = q / L_z [Pa] in +x, turn
 consistent nodal forces f_a = integral of N_a t_x dA over the face's quadratic faces
 (Gauss quadrature of the face: 3 x 3 points on a quadrilateral, 6 on a triangle).
 """
+
 from __future__ import annotations
 
 import math
@@ -20,8 +21,14 @@ QUAD_POINTS = tuple((a, b, wa * wb) for a, wa in zip(_G3, _W3) for b, wb in zip(
 #: Fix's 6-point rule, degree 4; the weights sum to its area 1/2).
 _A, _B = 0.445948490915965, 0.091576213509771
 _WA, _WB = 0.5 * 0.223381589678011, 0.5 * 0.109951743655322
-TRI_POINTS = ((_A, _A, _WA), (1.0 - 2.0 * _A, _A, _WA), (_A, 1.0 - 2.0 * _A, _WA),
-              (_B, _B, _WB), (1.0 - 2.0 * _B, _B, _WB), (_B, 1.0 - 2.0 * _B, _WB))
+TRI_POINTS = (
+    (_A, _A, _WA),
+    (1.0 - 2.0 * _A, _A, _WA),
+    (_A, 1.0 - 2.0 * _A, _WA),
+    (_B, _B, _WB),
+    (1.0 - 2.0 * _B, _B, _WB),
+    (_B, 1.0 - 2.0 * _B, _WB),
+)
 
 
 def space_profile(y: float, y0: float, length: float) -> float:
@@ -31,8 +38,9 @@ def space_profile(y: float, y0: float, length: float) -> float:
     return math.sin(math.pi * (y - y0) / length)
 
 
-def face_xmin_line_load(surface: Surface, n_full: int, x_face: float, depth: float, y0: float,
-                        length: float, tol: float) -> np.ndarray:
+def face_xmin_line_load(
+    surface: Surface, n_full: int, x_face: float, depth: float, y0: float, length: float, tol: float
+) -> np.ndarray:
     """(n_full,) the consistent nodal forces [N] per unit q0 [N/m] of the line load on the
     faces lying in the plane x = x_face [m] (within tol [m]): the traction
     sin(pi (y - y0) / L) / depth [Pa per N/m] along +x, depth [m] the solid's extent along z."""

@@ -19,6 +19,7 @@ positively oriented (the corners 0, 1, 3 and 4 of a hex, 0, 1, 2 and 3 of a tet,
 right-handed frame); an element whose map reverses orientation takes the order of the
 mirrored reference (r and s swapped), checked per element from its corners.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -26,10 +27,9 @@ import numpy as np
 #: The element names' meshio cell types.
 MESHIO_CELLS = {"hex20": "hexahedron20", "hex27": "hexahedron27", "tet10": "tetra10"}
 
-_HEX_CORNERS = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0],
-                         [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], float)
+_HEX_CORNERS = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], float)
 _HEX_EDGES = ((0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7))
-_HEX_FACES = np.array([[0, .5, .5], [1, .5, .5], [.5, 0, .5], [.5, 1, .5], [.5, .5, 0], [.5, .5, 1]])
+_HEX_FACES = np.array([[0, 0.5, 0.5], [1, 0.5, 0.5], [0.5, 0, 0.5], [0.5, 1, 0.5], [0.5, 0.5, 0], [0.5, 0.5, 1]])
 _TET_CORNERS = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
 _TET_EDGES = ((0, 1), (1, 2), (2, 0), (0, 3), (1, 3), (2, 3))
 
@@ -41,7 +41,7 @@ def _with_edges(corners: np.ndarray, edges) -> np.ndarray:
 #: VTK's reference nodes (n, 3) per element name (module docstring).
 VTK_REFERENCE: dict[str, np.ndarray] = {
     "hex20": _with_edges(_HEX_CORNERS, _HEX_EDGES),
-    "hex27": np.vstack([_with_edges(_HEX_CORNERS, _HEX_EDGES), _HEX_FACES, [[.5, .5, .5]]]),
+    "hex27": np.vstack([_with_edges(_HEX_CORNERS, _HEX_EDGES), _HEX_FACES, [[0.5, 0.5, 0.5]]]),
     "tet10": _with_edges(_TET_CORNERS, _TET_EDGES),
 }
 #: The corners spanning a cell's frame at corner 0 (VTK order): a hex's 1, 3, 4, a tet's 1, 2, 3.
@@ -84,8 +84,10 @@ def vtk_connectivity(sbasis, element: str) -> np.ndarray:
 
 #: Each VTK cell's faces by their corners in order around the face: VTK's faces of
 #: vtkHexahedron and vtkTetra, outward (right-handed) for a positively oriented cell.
-VTK_FACES = {"hex": ((0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)),
-             "tet": ((0, 2, 1), (0, 1, 3), (1, 2, 3), (0, 3, 2))}
+VTK_FACES = {
+    "hex": ((0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)),
+    "tet": ((0, 2, 1), (0, 1, 3), (1, 2, 3), (0, 3, 2)),
+}
 
 
 def boundary_faces(cells: np.ndarray, element: str) -> tuple[np.ndarray, np.ndarray]:

@@ -23,6 +23,7 @@ modes Phi^T (w (x) -N n). Friction is split off as for
 granule pairs (solver.granular3d.friction_flow): an exact impulse along the slip, against
 the granule's and the body's mobility along it, booked as the kinetic energy it removes.
 """
+
 from __future__ import annotations
 
 import math
@@ -31,9 +32,23 @@ import numpy as np
 from numba import njit
 
 from granplate.model.inputs import (
-    GEO_DAMP, GEO_DELTA, GEO_DIST, GEO_ETA, GEO_GX, GEO_GY, GEO_GZ, GEO_N, GEO_NSTAT, GEO_NX, GEO_NY, GEO_NZ,
-    GEO_TOUCH, GEO_XI,
-    HIST_END, HIST_MAX, HIST_RATE,
+    GEO_DAMP,
+    GEO_DELTA,
+    GEO_DIST,
+    GEO_ETA,
+    GEO_GX,
+    GEO_GY,
+    GEO_GZ,
+    GEO_N,
+    GEO_NSTAT,
+    GEO_NX,
+    GEO_NY,
+    GEO_NZ,
+    GEO_TOUCH,
+    GEO_XI,
+    HIST_END,
+    HIST_MAX,
+    HIST_RATE,
 )
 from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm
 from granplate.physics.laws import normal_law_force, normal_law_response, normal_law_slopes
@@ -442,8 +457,7 @@ def solve_static(b, buf, n_act, delta0, rmat, clip) -> float:
                 if j != k:
                     target -= rmat[k, j] * g[b.active[j], GEO_NSTAT]
             x = static_overlap(target, rmat[k, k], b.coef[i], b.hist[i, HIST_MAX], b.hist[i, HIST_RATE], clip)
-            n = normal_law_force(x, 0.0, b.coef[i],
-                                 b.hist[i, HIST_MAX], b.hist[i, HIST_RATE], clip) if x > 0.0 else 0.0
+            n = normal_law_force(x, 0.0, b.coef[i], b.hist[i, HIST_MAX], b.hist[i, HIST_RATE], clip) if x > 0.0 else 0.0
             change = max(change, abs(n - g[i, GEO_NSTAT]))
             largest = max(largest, n)
             g[i, GEO_NSTAT] = n
@@ -546,8 +560,7 @@ def contact_forces(y, q, qd, b, buf, radius, mass, clip, acc, fdamp, scale_acc):
         # residual in series takes its share, d delta = d delta0 / (1 + R_kk F'(delta))
         ddot = normal_rate_3d(y[i, VX] - v0, y[i, VX + 1] - v1, y[i, VX + 2] - v2, -nx, -ny, -nz)
         if resid and rmat[k, k] > 0.0:
-            ddot /= 1.0 + rmat[k, k] * normal_law_slopes(delta, b.coef[i],
-                                                         b.hist[i, HIST_MAX], b.hist[i, HIST_RATE])[0]
+            ddot /= 1.0 + rmat[k, k] * normal_law_slopes(delta, b.coef[i], b.hist[i, HIST_MAX], b.hist[i, HIST_RATE])[0]
         n, pv, ep, wp = normal_law_response(delta, ddot, b.coef[i], b.hist[i, HIST_MAX], b.hist[i, HIST_RATE], clip)
         g[i, GEO_N] = n
         e_pot += ep
@@ -669,8 +682,17 @@ def friction_flow(y, qd, dt, b, buf, radius, mass, inertia, arm_shrink, forward)
         nz = -g[i, GEO_NZ]
         a = contact_arm(radius[i], g[i, GEO_DELTA], arm_shrink)
         v0, v1, v2 = surface_velocity(b, buf, i, qd)
-        vsx, vsy, vsz = slip_velocity_3d(y[i, VX] - v0, y[i, VX + 1] - v1, y[i, VX + 2] - v2,
-                                         a * y[i, WX], a * y[i, WX + 1], a * y[i, WX + 2], nx, ny, nz)
+        vsx, vsy, vsz = slip_velocity_3d(
+            y[i, VX] - v0,
+            y[i, VX + 1] - v1,
+            y[i, VX + 2] - v2,
+            a * y[i, WX],
+            a * y[i, WX + 1],
+            a * y[i, WX + 2],
+            nx,
+            ny,
+            nz,
+        )
         speed = math.sqrt(vsx * vsx + vsy * vsy + vsz * vsz)
         if speed == 0.0:
             continue

@@ -12,6 +12,7 @@ the seconds spent compiling.
   cache, measured (`compile_seconds.json`, written by `granplate compile --measure`).
 - `compile_calls`: compile (or load) dispatchers for given arguments before a clock starts.
 """
+
 from __future__ import annotations
 
 import json

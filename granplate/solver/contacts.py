@@ -6,14 +6,26 @@ the run stops), and granules without a plate contact near the plate's face: with
 cfg.face_skin R of it the chunk ends and the driver gives them a patch contact
 (docs/model.md section 3.5); one that reaches the face without a contact stops the run.
 """
+
 from __future__ import annotations
 
 from numba import njit
 
 from granplate.physics.contact import plate_overlap
 from granplate.solver.state import (
-    ERR_CONTACT, ERR_ITER, ERR_JUMP, ERR_N, ERR_OVERLAP, ERR_PLATE_REACH, ERR_RESID, ERR_T, ERR_VT,
-    NEW_PLATE, OK, PARTNER_PLATE, REBUILD,
+    ERR_CONTACT,
+    ERR_ITER,
+    ERR_JUMP,
+    ERR_N,
+    ERR_OVERLAP,
+    ERR_PLATE_REACH,
+    ERR_RESID,
+    ERR_T,
+    ERR_VT,
+    NEW_PLATE,
+    OK,
+    PARTNER_PLATE,
+    REBUILD,
 )
 
 
@@ -50,8 +62,26 @@ def plate_face(u):
 
 
 @njit(cache=True)
-def watch_contacts(t, y, u, radius, plate_free, yref, ovl, ovl_with, ovl_new, ovl_who, overlap_stop,
-                   plate_x0, plate_ylo, plate_yhi, rebuild_move, face_skin, ndim, err):
+def watch_contacts(
+    t,
+    y,
+    u,
+    radius,
+    plate_free,
+    yref,
+    ovl,
+    ovl_with,
+    ovl_new,
+    ovl_who,
+    overlap_stop,
+    plate_x0,
+    plate_ylo,
+    plate_yhi,
+    rebuild_move,
+    face_skin,
+    ndim,
+    err,
+):
     """Check the state after an accepted step; returns OK, REBUILD (the list must be
     rebuilt: a granule moved rebuild_move since it was built, at yref), NEW_PLATE (a
     granule without a plate contact is within face_skin R of the undeformed face: it needs
@@ -90,5 +120,5 @@ def watch_contacts(t, y, u, radius, plate_free, yref, ovl, ovl_with, ovl_new, ov
                 status = REBUILD
                 jump = rebuild_move + radius[i]
                 if d2 > jump * jump:
-                    return stop(ERR_JUMP, t, err, i, -1, d2 ** 0.5, d2 ** 0.5 / radius[i])
+                    return stop(ERR_JUMP, t, err, i, -1, d2**0.5, d2**0.5 / radius[i])
     return status

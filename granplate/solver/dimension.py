@@ -11,6 +11,7 @@ both dimensions and nothing else asks which one it is.
 Adding a dimension-specific granular function: write it in both modules with the same
 signature and add a stub and its overload here.
 """
+
 from __future__ import annotations
 
 from numba.extending import overload
@@ -65,7 +66,8 @@ def _granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, sp
     if m is not None:
         fn = m.granular_rhs
         return lambda t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, split, record: fn(
-            t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, split, record)
+            t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, split, record
+        )
 
 
 @overload(friction_flow, inline="always")
@@ -100,6 +102,7 @@ def _kinetic_energies(y, g):
         def plane_energies(y, g):
             kx, ky, kr = fn(y, g.mass, g.inertia)
             return kx, ky, 0.0, kr
+
         return plane_energies
     if _module_of(g) is space:
         fn3 = space.kinetic_energies

@@ -3,6 +3,7 @@ chunks (each bounded by output times and by a step budget calibrated to a wall-t
 target, so progress shows and a stop request is honoured within about a second, even
 when the steps have collapsed), and return a plain record of the output buffers.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -65,10 +66,12 @@ def contact_peaks(g, stores: tuple[dict, dict], body=None) -> ContactPeaks:
     rows += [(i, j, h) for (i, j), h in stores[0].items()]
     rows += [(i, -1 - w, h) for (i, w), h in stores[1].items()]
     rows = [r for r in rows if r[2][HIST_MAX] > 0.0]
-    return ContactPeaks(granule=np.array([r[0] for r in rows], np.int64),
-                        partner=np.array([r[1] for r in rows], np.int64),
-                        delta_max=np.array([r[2][HIST_MAX] for r in rows], float),
-                        time=np.array([r[2][HIST_TIME] for r in rows], float))
+    return ContactPeaks(
+        granule=np.array([r[0] for r in rows], np.int64),
+        partner=np.array([r[1] for r in rows], np.int64),
+        delta_max=np.array([r[2][HIST_MAX] for r in rows], float),
+        time=np.array([r[2][HIST_TIME] for r in rows], float),
+    )
 
 
 class ContactChanges(NamedTuple):
@@ -164,34 +167,50 @@ def contact_message(status: int, model: Model, st: S.State) -> str:
     i = int(e[S.ERR_CONTACT])
     who = f"granule '{model.labels[i]}'"
     other = partner_name(model, int(e[S.ERR_ITER]))
-    where = "(at " + ", ".join(f"{name} = {v:.6g} m" for name, v in zip("xyz", st.y[i, :cfg.dimension])) + ")"
+    where = "(at " + ", ".join(f"{name} = {v:.6g} m" for name, v in zip("xyz", st.y[i, : cfg.dimension])) + ")"
     if status == S.ERR_OVERLAP:
-        return (f"{who} {where} and {other} overlap by {e[S.ERR_N]:.4g} m at t = {t:.6e} s, "
-                f"{e[S.ERR_RESID]:.3g} of the smaller radius, beyond contact.overlap_stop = "
-                f"{c.overlap_stop:g}: Hertz's law assumes small overlaps. Lower the load or "
-                f"time.dt_max, or stiffen the contact.")
+        return (
+            f"{who} {where} and {other} overlap by {e[S.ERR_N]:.4g} m at t = {t:.6e} s, "
+            f"{e[S.ERR_RESID]:.3g} of the smaller radius, beyond contact.overlap_stop = "
+            f"{c.overlap_stop:g}: Hertz's law assumes small overlaps. Lower the load or "
+            f"time.dt_max, or stiffen the contact."
+        )
     if status == S.ERR_MISSED:
-        how = ("it is not one of the fixed contacts (contact.detection = \"fixed\"); use "
-               "detection = \"dynamic\"" if c.detection == "fixed" else
-               "the contact formed unseen within one step: lower time.dt_max or raise contact.skin")
-        return (f"{who} {where} and {other} interpenetrate by {e[S.ERR_N]:.4g} m at t = {t:.6e} s "
-                f"and no contact accounts for it: {how}.")
+        how = (
+            'it is not one of the fixed contacts (contact.detection = "fixed"); use detection = "dynamic"'
+            if c.detection == "fixed"
+            else "the contact formed unseen within one step: lower time.dt_max or raise contact.skin"
+        )
+        return (
+            f"{who} {where} and {other} interpenetrate by {e[S.ERR_N]:.4g} m at t = {t:.6e} s "
+            f"and no contact accounts for it: {how}."
+        )
     if status == S.ERR_PLATE_REACH:
         if cfg.face_skin > 0.0:
-            why = ("it came from farther than contact.skin R within one step, so its patch contact "
-                   "formed unseen: lower time.dt_max or raise contact.skin")
+            why = (
+                "it came from farther than contact.skin R within one step, so its patch contact "
+                "formed unseen: lower time.dt_max or raise contact.skin"
+            )
         elif c.detection == "fixed":
-            why = (f"with contact.detection = \"fixed\" plate contacts are those at t = 0 (within "
-                   f"contact.neighbour_gap = {c.neighbour_gap:g} R of the plate); use detection = \"dynamic\"")
+            why = (
+                f'with contact.detection = "fixed" plate contacts are those at t = 0 (within '
+                f'contact.neighbour_gap = {c.neighbour_gap:g} R of the plate); use detection = "dynamic"'
+            )
         else:
-            why = ("contacts forming on the plate's face need every mode or the truncated basis' "
-                   "static correction; use plate.n_modes = 0 (with plate.modes = \"all\"), or "
-                   "plate.modes = \"truncated\" (a dense basis cut to plate.n_modes keeps plate "
-                   "contacts to those at t = 0)")
-        return (f"{who} {where} reached the plate's face at t = {t:.6e} s (overlap "
-                f"{e[S.ERR_N]:.4g} m) but has no plate contact: {why}.")
-    return (f"{who} {where} moved {e[S.ERR_N]:.4g} m ({e[S.ERR_RESID]:.3g} radii) in one step at "
-            f"t = {t:.6e} s: contacts may have been passed through. Lower time.dt_max.")
+            why = (
+                "contacts forming on the plate's face need every mode or the truncated basis' "
+                'static correction; use plate.n_modes = 0 (with plate.modes = "all"), or '
+                'plate.modes = "truncated" (a dense basis cut to plate.n_modes keeps plate '
+                "contacts to those at t = 0)"
+            )
+        return (
+            f"{who} {where} reached the plate's face at t = {t:.6e} s (overlap "
+            f"{e[S.ERR_N]:.4g} m) but has no plate contact: {why}."
+        )
+    return (
+        f"{who} {where} moved {e[S.ERR_N]:.4g} m ({e[S.ERR_RESID]:.3g} radii) in one step at "
+        f"t = {t:.6e} s: contacts may have been passed through. Lower time.dt_max."
+    )
 
 
 def overlap_warnings(model: Model, w: S.Work) -> list[str]:
@@ -206,8 +225,10 @@ def overlap_warnings(model: Model, w: S.Work) -> list[str]:
         if key in seen:
             continue
         seen.add(key)
-        out.append(f"granule '{model.labels[i]}' and {partner_name(model, j)}: overlap "
-                   f"{w.ovl[i]:.3g} of the smaller radius (contact.overlap_warn = {lim:g})")
+        out.append(
+            f"granule '{model.labels[i]}' and {partner_name(model, j)}: overlap "
+            f"{w.ovl[i]:.3g} of the smaller radius (contact.overlap_warn = {lim:g})"
+        )
     return out
 
 
@@ -230,9 +251,13 @@ class ContactLists:
         self.model = model
         g = model.granular
         # this run's own histories (the loop updates them in place)
-        self.g = g._replace(pair_hist=no_history(len(g.pair_ij)), wall_hist=no_history(len(g.wall_i)),
-                            pc_hist=no_history(len(g.pc_i)), drive_now=g.drive_now.copy(),
-                            wall_load=g.wall_load.copy())
+        self.g = g._replace(
+            pair_hist=no_history(len(g.pair_ij)),
+            wall_hist=no_history(len(g.wall_i)),
+            pc_hist=no_history(len(g.pc_i)),
+            drive_now=g.drive_now.copy(),
+            wall_load=g.wall_load.copy(),
+        )
         self.known: dict = {}
         self.stores: tuple[dict, dict] = ({}, {})  # histories of the pairs and wall contacts off the lists
         self.planes = wall_planes(model.scenario.walls, model.config.dimension)
@@ -243,8 +268,13 @@ class ContactLists:
         """The patch contacts formed so far and the rebuilds, as a ContactChanges (with the
         contacts on an elastic body in space, model.inputs.BodyArrays, among the peaks)."""
         i, t, y = zip(*self.formed) if self.formed else ((), (), ())
-        return ContactChanges(granule=np.array(i, np.int64), time=np.array(t, float), y=np.array(y, float),
-                              n_rebuilds=self.n_rebuilds, peaks=contact_peaks(self.g, self.stores, body))
+        return ContactChanges(
+            granule=np.array(i, np.int64),
+            time=np.array(t, float),
+            y=np.array(y, float),
+            n_rebuilds=self.n_rebuilds,
+            peaks=contact_peaks(self.g, self.stores, body),
+        )
 
     def refresh(self, y: np.ndarray) -> Missed | None:
         """Rebuild (dynamic) or check (fixed) the lists at positions y[:, :2]; returns the
@@ -301,8 +331,10 @@ class LoopArrays:
         self.st = _copied(st, S.new_state(ng, nm, nk_new, nc))
         self.w = _copied(w, S.new_work(ng, nm, nk_new, len(w.wface), nc))
         self.sw = _copied(self.sw, scheme(self.scheme).new_scratch(ng, nm, nk_new))
-        self.out = _copied(self.out, S.new_output(self.out.target, ng, nm, nk_new, nc, self.out.wall_force.shape[1],
-                                                  self.out.drive.shape[1]))
+        self.out = _copied(
+            self.out,
+            S.new_output(self.out.target, ng, nm, nk_new, nc, self.out.wall_force.shape[1], self.out.drive.shape[1]),
+        )
         phi_d = np.zeros((2 * nk_new, nm))
         phi_d[: self.p.phi_d.shape[0]] = self.p.phi_d
         self.p = self.p._replace(phi_d=phi_d)
@@ -318,8 +350,9 @@ class LoopArrays:
 def _copied(old: tuple, new: tuple) -> tuple:
     """`new` (a named tuple of arrays) with each array's leading block taken from `old`'s."""
     for a, b in zip(old, new):
-        b[tuple(slice(0, min(m, n)) for m, n in zip(a.shape, b.shape))] = \
-            a[tuple(slice(0, min(m, n)) for m, n in zip(a.shape, b.shape))]
+        b[tuple(slice(0, min(m, n)) for m, n in zip(a.shape, b.shape))] = a[
+            tuple(slice(0, min(m, n)) for m, n in zip(a.shape, b.shape))
+        ]
     return new
 
 
@@ -413,10 +446,11 @@ FRICTION_BOUND_SHARE = 0.5
 FRICTION_BOUND_MIN_STEPS = 5000
 FRICTION_BOUND_HINT = (
     "{name}: friction at granule contacts, integrated inside RK4 (solver.granular_friction = "
-    "\"rk4\", the presets' setting), sets the step on most steps so far (t = {t:.4g} s): the run "
-    "is slow for stability, not accuracy. solver.granular_friction = \"split\" integrates that "
+    '"rk4", the presets\' setting), sets the step on most steps so far (t = {t:.4g} s): the run '
+    'is slow for stability, not accuracy. solver.granular_friction = "split" integrates that '
     "friction exactly at any step, but its splitting error is outside the step control: check a "
-    "result against a run with solver.implicit_dt_max halved (docs/model.md section 6.4).")
+    "result against a run with solver.implicit_dt_max halved (docs/model.md section 6.4)."
+)
 
 
 def friction_bound(count: np.ndarray) -> bool:
@@ -465,8 +499,11 @@ def _loop_chunks(times, model, arr: LoopArrays, should_stop, on_progress, lists)
             on_progress(int(st.count[S.C_OUT] - before))
             if not warned and friction_bound(st.count):
                 warned = True
-                warnings.warn(FRICTION_BOUND_HINT.format(name=model.scenario.name, t=st.clock[S.T_NOW]),
-                              RuntimeWarning, stacklevel=4)
+                warnings.warn(
+                    FRICTION_BOUND_HINT.format(name=model.scenario.name, t=st.clock[S.T_NOW]),
+                    RuntimeWarning,
+                    stacklevel=4,
+                )
             if status in (S.REBUILD, S.NEW_PLATE) and cfg.face_skin > 0.0:
                 add_patch_contacts(model, lists, arr)
             if status == S.REBUILD and not fixed:
@@ -528,8 +565,10 @@ def note_compile(model: Model, calls: list[tuple]) -> bool:
     where = "in space" if dim == 3 else "in the plane"
     seconds, slow = compile_seconds(name, dim), machine_slowdown()
     busy = f"; this machine is busy, {slow:.1f}x" if slow > 1.2 else ""
-    log.info(f"compiling the time loop of the {name} scheme {where} (about {describe_seconds(slow * seconds)}: "
-             f"{describe_seconds(seconds)} of CPU measured on a cold cache{busy}; cached afterwards) ...")
+    log.info(
+        f"compiling the time loop of the {name} scheme {where} (about {describe_seconds(slow * seconds)}: "
+        f"{describe_seconds(seconds)} of CPU measured on a cold cache{busy}; cached afterwards) ..."
+    )
     return True
 
 
@@ -542,8 +581,9 @@ def progress_bar(total: int, desc: str, file=None):
     return tqdm(total=total, desc=desc, unit="out", leave=False, file=file)
 
 
-def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool] | None = None,
-        interruptible: bool = True) -> RunRecord:
+def run(
+    model: Model, *, progress: bool = False, should_stop: Callable[[], bool] | None = None, interruptible: bool = True
+) -> RunRecord:
     """Run the time loop of `model` to its t_end.
 
     progress: a bar on stderr; should_stop: polled between chunks (a stop request);
@@ -563,10 +603,12 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
         attach_patches(model, lists, arr, model.initial_patches)  # touching between nodes at t = 0
         st, w = arr.st, arr.w  # grown
     st.count[S.C_LEVEL] = level_for(model.scenario.time.dt_initial, cfg)
-    calls = [(loop.initialise, (st, lists.g, arr.p, cfg, w)),
-             (loop.start_scheme, (arr.sw, st, lists.g, cfg)),
-             (loop.record, (0, st, lists.g, arr.p, w, arr.out)),
-             (loop.advance, (float(times[-1]), FIRST_BUDGET, lists.g, arr.p, cfg, st, arr.w, arr.sw, arr.out))]
+    calls = [
+        (loop.initialise, (st, lists.g, arr.p, cfg, w)),
+        (loop.start_scheme, (arr.sw, st, lists.g, cfg)),
+        (loop.record, (0, st, lists.g, arr.p, w, arr.out)),
+        (loop.advance, (float(times[-1]), FIRST_BUDGET, lists.g, arr.p, cfg, st, arr.w, arr.sw, arr.out)),
+    ]
     t1 = time.perf_counter()
     note_compile(model, calls)
     compile_calls(calls)  # before the bar and the loop's clock: neither counts the compile
@@ -582,9 +624,15 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
     t2 = time.perf_counter()
     c2, c3 = time.process_time(), time.thread_time()
     try:
-        with (stop_on_signals() if interruptible else _never()) as signalled:
-            status = _loop_chunks(times, model, arr, lambda: signalled() or any(f() for f in polls),
-                                  bar.update if bar is not None else (lambda n: None), lists)
+        with stop_on_signals() if interruptible else _never() as signalled:
+            status = _loop_chunks(
+                times,
+                model,
+                arr,
+                lambda: signalled() or any(f() for f in polls),
+                bar.update if bar is not None else (lambda n: None),
+                lists,
+            )
     finally:
         if bar is not None:
             bar.close()
@@ -603,10 +651,20 @@ def run(model: Model, *, progress: bool = False, should_stop: Callable[[], bool]
     message = "ok" if status == S.OK else status_message(status, model, st)
     body = getattr(arr.sw, "body", None) if model.body is not None else None
     for line in info["overlap_warnings"]:
-        warnings.warn(f"{model.scenario.name}: {line}: Hertz's law assumes overlaps small against the radii.",
-                      RuntimeWarning, stacklevel=2)
-    return RunRecord(out=arr.out, n_valid=int(st.count[S.C_OUT]), status=status, message=message, info=info,
-                     contacts=lists.changes(body), body=body)
+        warnings.warn(
+            f"{model.scenario.name}: {line}: Hertz's law assumes overlaps small against the radii.",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    return RunRecord(
+        out=arr.out,
+        n_valid=int(st.count[S.C_OUT]),
+        status=status,
+        message=message,
+        info=info,
+        contacts=lists.changes(body),
+        body=body,
+    )
 
 
 @contextmanager

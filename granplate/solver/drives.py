@@ -11,6 +11,7 @@ driven granule's velocity along its direction to the prescribed one (the drive's
 impulse, its work booked); the schemes book the drives' work and gravity's (RK4's
 quadrature of their powers; Verlet's kicks, `drive_kick_work`, `gravity_kick_work`).
 """
+
 from __future__ import annotations
 
 from numba import njit
@@ -30,8 +31,7 @@ def begin_pass(t, g):
     for w in range(g.wall_load.shape[0]):
         g.wall_load[w] = 0.0
     for k in range(g.drive_target.shape[0]):
-        s, v, a = drive_motion(t, g.drive_kind[k], g.drive_prof[k], g.drive_par[k], g.drive_tab[k],
-                               g.drive_tlen[k])
+        s, v, a = drive_motion(t, g.drive_kind[k], g.drive_prof[k], g.drive_par[k], g.drive_tab[k], g.drive_tlen[k])
         now = g.drive_now[k]
         now[DR_S] = s
         now[DR_V] = v
@@ -220,8 +220,9 @@ def wall_contact_energy(y, g, w, k, clip, t):
     delta = xn + g.radius[i] - (g.wall_geo[w, d] + s * wall_normal_dot(g, w, k))
     if delta <= 0.0:
         return 0.0
-    _, _, ep, _ = normal_law_response(delta, 0.0, g.wall_coef[w], g.wall_hist[w, HIST_MAX],
-                                      g.wall_hist[w, HIST_RATE], clip)
+    _, _, ep, _ = normal_law_response(
+        delta, 0.0, g.wall_coef[w], g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], clip
+    )
     return ep
 
 
@@ -239,6 +240,10 @@ def wall_shift_energy(y0, y1, g, clip, t0, t1):
         k = g.wall_drive[g.wall_w[w]]
         if k < 0:
             continue
-        work += 0.5 * (wall_contact_energy(y1, g, w, k, clip, t1) - wall_contact_energy(y1, g, w, k, clip, t0)
-                       + wall_contact_energy(y0, g, w, k, clip, t1) - wall_contact_energy(y0, g, w, k, clip, t0))
+        work += 0.5 * (
+            wall_contact_energy(y1, g, w, k, clip, t1)
+            - wall_contact_energy(y1, g, w, k, clip, t0)
+            + wall_contact_energy(y0, g, w, k, clip, t1)
+            - wall_contact_energy(y0, g, w, k, clip, t0)
+        )
     return work

@@ -11,6 +11,7 @@ contact by contact (`friction_flow`), RK4 of every other force, the other half o
 friction in the reverse contact order; stable for any step. Without it, RK4 integrates
 every force and the step control keeps h times that rate within rk4.RK4_FRICTION_LIMIT.
 """
+
 from __future__ import annotations
 
 from typing import NamedTuple
@@ -19,8 +20,24 @@ from numba import njit
 
 from granplate.model.inputs import HIST_END, HIST_MAX, HIST_RATE, HIST_TIME
 from granplate.physics.contact import (
-    COEF_DY, COEF_KS, COEF_MU, COEF_RC, COEF_RL, COEF_SY, contact_arm, friction_magnitude, friction_power, friction_slope, pair_apart,
-    pair_normal_rate, pair_overlap, pair_rates, plate_overlap, plate_rates, slip_after_friction, wall_overlap,
+    COEF_DY,
+    COEF_KS,
+    COEF_MU,
+    COEF_RC,
+    COEF_RL,
+    COEF_SY,
+    contact_arm,
+    friction_magnitude,
+    friction_power,
+    friction_slope,
+    pair_apart,
+    pair_normal_rate,
+    pair_overlap,
+    pair_rates,
+    plate_overlap,
+    plate_rates,
+    slip_after_friction,
+    wall_overlap,
     wall_rates,
 )
 from granplate.physics.cavity import rate_factor
@@ -124,8 +141,14 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             ovl_j = j
         c = g.pair_coef[p]
         if split:  # the normal force alone: friction_flow applies the friction
-            n, pv, ep, wp = normal_law_response(delta, pair_normal_rate(y[i, 3], y[i, 4], y[j, 3], y[j, 4], nx, nz),
-                                                c, g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip)
+            n, pv, ep, wp = normal_law_response(
+                delta,
+                pair_normal_rate(y[i, 3], y[i, 4], y[j, 3], y[j, 4], nx, nz),
+                c,
+                g.pair_hist[p, HIST_MAX],
+                g.pair_hist[p, HIST_RATE],
+                cfg.clip,
+            )
             w_plastic += wp
             fx = -n * nx
             fz = -n * nz
@@ -139,13 +162,22 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         ai = contact_arm(ri, delta, 0.5 * cfg.arm_shrink)
         aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
         ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
-        n, pv, ep, wp = normal_law_response(delta, ddot, c,
-                                            g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip)
+        n, pv, ep, wp = normal_law_response(
+            delta, ddot, c, g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip
+        )
         f = friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS])
         pf = friction_power(f, vt)
         w_plastic += wp
-        rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + 1.0 / g.mass[j]
-                                              + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]))
+        rate = max(
+            rate,
+            slip_relaxation_rate(
+                n,
+                vt,
+                c[COEF_MU],
+                c[COEF_KS],
+                1.0 / g.mass[i] + 1.0 / g.mass[j] + ai * ai / g.inertia[i] + aj * aj / g.inertia[j],
+            ),
+        )
         fx = -n * nx + f * nz  # on i: -n nvec - f tvec, tvec = (-nz, nx); on j the opposite
         fz = -n * nz - f * nx
         dy[i, 3] += fx
@@ -175,8 +207,9 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         c = g.wall_coef[w]
         if split:  # the normal force alone: friction_flow applies the friction
             rate_n = y[i, 3] * nx + y[i, 4] * nz - vn
-            n, pv, ep, wp = normal_law_response(delta, rate_n, c, g.wall_hist[w, HIST_MAX],
-                                            g.wall_hist[w, HIST_RATE], cfg.clip)
+            n, pv, ep, wp = normal_law_response(
+                delta, rate_n, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip
+            )
             w_plastic += wp
             book_wall(g, w, kd, n, pv / rate_n if pv != 0.0 else 0.0)
             dy[i, 3] += -n * nx
@@ -186,8 +219,9 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             continue
         ai = contact_arm(ri, delta, cfg.arm_shrink)
         ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
-        n, pv, ep, wp = normal_law_response(delta, ddot - vn, c, g.wall_hist[w, HIST_MAX],
-                                            g.wall_hist[w, HIST_RATE], cfg.clip)
+        n, pv, ep, wp = normal_law_response(
+            delta, ddot - vn, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip
+        )
         book_wall(g, w, kd, n, pv / (ddot - vn) if pv != 0.0 else 0.0)
         f = friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS])
         pf = friction_power(f, vt)
@@ -216,14 +250,17 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
                 ovl_i = i
                 ovl_j = PARTNER_PLATE
             c = g.pc_coef[k]
-            n, pv, ep, wp = normal_law_response(delta, ddot, c,
-                                                g.pc_hist[k, HIST_MAX], g.pc_hist[k, HIST_RATE], cfg.clip)
+            n, pv, ep, wp = normal_law_response(
+                delta, ddot, c, g.pc_hist[k, HIST_MAX], g.pc_hist[k, HIST_RATE], cfg.clip
+            )
             f = friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS])
             pf = friction_power(f, vt)
             w_plastic += wp
             if not hold:  # the granule side only: the plate side of this map is criterion (8)
-                rate_plate = max(rate_plate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS],
-                                                                  1.0 / g.mass[i] + ai * ai / g.inertia[i]))
+                rate_plate = max(
+                    rate_plate,
+                    slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i]),
+                )
             dy[i, 3] -= n
             p_visc += pv
             e_pot += ep
@@ -311,8 +348,7 @@ def friction_flow(y, dt, g, cfg, forward):
                 continue
             ai = contact_arm(ri, delta, cfg.arm_shrink)
             ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
-            n = normal_law_force(delta, ddot - vn, c, g.wall_hist[w, HIST_MAX],
-                                            g.wall_hist[w, HIST_RATE], cfg.clip)
+            n = normal_law_force(delta, ddot - vn, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
             inv_m = 1.0 / g.mass[i]
             inv_i = ai / g.inertia[i]
             imp, dw = friction_impulse(vt, n, c[COEF_MU], c[COEF_KS], inv_m + ai * inv_i, dt)
@@ -442,8 +478,9 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
             ovl_i = i
             ovl_j = j
         ddot = pair_normal_rate(y[i, 3], y[i, 4], y[j, 3], y[j, 4], nx, nz)
-        n, pv, ep, wp = normal_law_response(delta, ddot, g.pair_coef[p],
-                                            g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip)
+        n, pv, ep, wp = normal_law_response(
+            delta, ddot, g.pair_coef[p], g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip
+        )
         w_plastic += wp
         p_visc += pv
         e_pot += ep
@@ -474,8 +511,9 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
             ovl_i = i
             ovl_j = -1 - g.wall_w[w]
         ddot = y[i, 3] * nx + y[i, 4] * nz - vn
-        n, pv, ep, wp = normal_law_response(delta, ddot, g.wall_coef[w], g.wall_hist[w, HIST_MAX],
-                                            g.wall_hist[w, HIST_RATE], cfg.clip)
+        n, pv, ep, wp = normal_law_response(
+            delta, ddot, g.wall_coef[w], g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip
+        )
         w_plastic += wp
         p_visc += pv
         e_pot += ep

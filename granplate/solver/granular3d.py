@@ -5,6 +5,7 @@ kinetic energies. The same signatures as solver.granular (the plane), so that th
 step and the time loop are the same code (solver.dimension picks the module from the
 granular arrays' type). No plate contacts in space yet: the plate arguments are unused.
 """
+
 from __future__ import annotations
 
 from numba import njit
@@ -14,7 +15,12 @@ from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm, friction_ma
 from granplate.physics.laws import normal_law_force, normal_law_response
 from granplate.physics.shock import time_profile
 from granplate.physics.space import (
-    arm_torque_3d, friction_along_slip, normal_rate_3d, pair_contact_3d, slip_velocity_3d, wall_overlap_3d,
+    arm_torque_3d,
+    friction_along_slip,
+    normal_rate_3d,
+    pair_contact_3d,
+    slip_velocity_3d,
+    wall_overlap_3d,
 )
 from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_motion
 from granplate.solver.granular import ForceSums, friction_impulse, slip_relaxation_rate
@@ -36,8 +42,17 @@ def pair_slip(y, i, j, nx, ny, nz, ai, aj):
     rvy = y[i, VY] - y[j, VY]
     rvz = y[i, VZ] - y[j, VZ]
     ddot = normal_rate_3d(rvx, rvy, rvz, nx, ny, nz)
-    vs = slip_velocity_3d(rvx, rvy, rvz, ai * y[i, WX] + aj * y[j, WX], ai * y[i, WY] + aj * y[j, WY],
-                          ai * y[i, WZ] + aj * y[j, WZ], nx, ny, nz)
+    vs = slip_velocity_3d(
+        rvx,
+        rvy,
+        rvz,
+        ai * y[i, WX] + aj * y[j, WX],
+        ai * y[i, WY] + aj * y[j, WY],
+        ai * y[i, WZ] + aj * y[j, WZ],
+        nx,
+        ny,
+        nz,
+    )
     return ddot, vs[0], vs[1], vs[2]
 
 
@@ -114,8 +129,14 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         rvx = y[i, VX] - y[j, VX]
         rvy = y[i, VY] - y[j, VY]
         rvz = y[i, VZ] - y[j, VZ]
-        n, pv, ep, wp = normal_law_response(delta, normal_rate_3d(rvx, rvy, rvz, nx, ny, nz), c,
-                                            g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip)
+        n, pv, ep, wp = normal_law_response(
+            delta,
+            normal_rate_3d(rvx, rvy, rvz, nx, ny, nz),
+            c,
+            g.pair_hist[p, HIST_MAX],
+            g.pair_hist[p, HIST_RATE],
+            cfg.clip,
+        )
         fnx = n * nx
         fny = n * ny
         fnz = n * nz
@@ -132,16 +153,33 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             continue
         ai = contact_arm(ri, delta, half_shrink)
         aj = contact_arm(rj, delta, half_shrink)
-        vsx, vsy, vsz = slip_velocity_3d(rvx, rvy, rvz, ai * y[i, WX] + aj * y[j, WX], ai * y[i, WY] + aj * y[j, WY],
-                                         ai * y[i, WZ] + aj * y[j, WZ], nx, ny, nz)
+        vsx, vsy, vsz = slip_velocity_3d(
+            rvx,
+            rvy,
+            rvz,
+            ai * y[i, WX] + aj * y[j, WX],
+            ai * y[i, WY] + aj * y[j, WY],
+            ai * y[i, WZ] + aj * y[j, WZ],
+            nx,
+            ny,
+            nz,
+        )
         speed = _speed(vsx, vsy, vsz)
         f_mag = friction_magnitude(n, speed, c[COEF_MU], c[COEF_KS])
         fx, fy, fz = friction_along_slip(f_mag, speed, vsx, vsy, vsz)
         add_friction(dy, i, ai, nx, ny, nz, fx, fy, fz, 1.0)
         add_friction(dy, j, aj, nx, ny, nz, fx, fy, fz, -1.0)
         p_fric += f_mag * speed
-        rate = max(rate, slip_relaxation_rate(n, speed, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + 1.0 / g.mass[j]
-                                              + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]))
+        rate = max(
+            rate,
+            slip_relaxation_rate(
+                n,
+                speed,
+                c[COEF_MU],
+                c[COEF_KS],
+                1.0 / g.mass[i] + 1.0 / g.mass[j] + ai * ai / g.inertia[i] + aj * aj / g.inertia[j],
+            ),
+        )
     for w in range(g.wall_i.shape[0]):
         i = g.wall_i[w]
         ri = g.radius[i]
@@ -160,8 +198,9 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             ovl_j = -1 - g.wall_w[w]
         c = g.wall_coef[w]
         ddot = normal_rate_3d(y[i, VX], y[i, VY], y[i, VZ], nx, ny, nz) - vn
-        n, pv, ep, wp = normal_law_response(delta, ddot, c, g.wall_hist[w, HIST_MAX],
-                                            g.wall_hist[w, HIST_RATE], cfg.clip)
+        n, pv, ep, wp = normal_law_response(
+            delta, ddot, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip
+        )
         book_wall(g, w, kd, n, pv / ddot if pv != 0.0 else 0.0)
         dy[i, VX] -= n * nx
         dy[i, VY] -= n * ny
@@ -237,8 +276,9 @@ def friction_flow(y, dt, g, cfg, forward):
             inv_mj = 1.0 / g.mass[j]
             inv_ii = 1.0 / g.inertia[i]
             inv_ij = 1.0 / g.inertia[j]
-            imp, dw = friction_impulse(speed, n, c[COEF_MU], c[COEF_KS],
-                                       inv_mi + inv_mj + ai * ai * inv_ii + aj * aj * inv_ij, dt)
+            imp, dw = friction_impulse(
+                speed, n, c[COEF_MU], c[COEF_KS], inv_mi + inv_mj + ai * ai * inv_ii + aj * aj * inv_ij, dt
+            )
             px, py, pz = friction_along_slip(imp, speed, vsx, vsy, vsz)
             apply_friction_impulse(y, i, ai, inv_mi, inv_ii, nx, ny, nz, px, py, pz, 1.0)
             apply_friction_impulse(y, j, aj, inv_mj, inv_ij, nx, ny, nz, px, py, pz, -1.0)
@@ -260,8 +300,7 @@ def friction_flow(y, dt, g, cfg, forward):
             speed = _speed(vsx, vsy, vsz)
             if speed == 0.0:
                 continue
-            n = normal_law_force(delta, ddot - vn, c, g.wall_hist[w, HIST_MAX],
-                                            g.wall_hist[w, HIST_RATE], cfg.clip)
+            n = normal_law_force(delta, ddot - vn, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
             inv_m = 1.0 / g.mass[i]
             inv_i = 1.0 / g.inertia[i]
             imp, dw = friction_impulse(speed, n, c[COEF_MU], c[COEF_KS], inv_m + a * a * inv_i, dt)
@@ -348,8 +387,9 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
             ovl_i = i
             ovl_j = j
         ddot = normal_rate_3d(y[i, VX] - y[j, VX], y[i, VY] - y[j, VY], y[i, VZ] - y[j, VZ], nx, ny, nz)
-        n, pv, ep, wp = normal_law_response(delta, ddot, g.pair_coef[p],
-                                            g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip)
+        n, pv, ep, wp = normal_law_response(
+            delta, ddot, g.pair_coef[p], g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip
+        )
         w_plastic += wp
         p_visc += pv
         e_pot += ep
@@ -383,8 +423,9 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
             ovl_i = i
             ovl_j = -1 - g.wall_w[w]
         ddot = normal_rate_3d(y[i, VX], y[i, VY], y[i, VZ], nx, ny, nz) - vn
-        n, pv, ep, wp = normal_law_response(delta, ddot, g.wall_coef[w], g.wall_hist[w, HIST_MAX],
-                                            g.wall_hist[w, HIST_RATE], cfg.clip)
+        n, pv, ep, wp = normal_law_response(
+            delta, ddot, g.wall_coef[w], g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip
+        )
         w_plastic += wp
         p_visc += pv
         e_pot += ep

@@ -6,6 +6,7 @@ Nothing here depends on the scheme: what a scheme derives from the contacts' row
 Phi_d is its own (its hooks `contact_placed` and `contacts_moved`, solver/schemes),
 called by the loop and the driver after these functions change the rows.
 """
+
 from __future__ import annotations
 
 from numba import njit
@@ -52,8 +53,9 @@ def forces_converged(it, rtol, atol, fnew, fguess, conv_iter):
 @njit(cache=True)
 def contact_modulus(k, h, gm, g, normal, slip):
     """|lambda| of eq. (8) at plate contact k for step h (gm: G(h))."""
-    return local_map_modulus(g.pc_coef[k, COEF_MU], g.pc_coef[k, COEF_KS], normal[k], h,
-                             gm[2 * k + 1, 2 * k + 1], slip[k])
+    return local_map_modulus(
+        g.pc_coef[k, COEF_MU], g.pc_coef[k, COEF_KS], normal[k], h, gm[2 * k + 1, 2 * k + 1], slip[k]
+    )
 
 
 @njit(cache=True)
@@ -66,8 +68,9 @@ def accept_contacts(h, gm, pc_coef, normal_new, slip_new, conv_iter, normal, sli
     for k in range(normal.shape[0]):
         normal[k] = normal_new[k]
         slip[k] = slip_new[k]
-        lam = local_map_modulus(pc_coef[k, COEF_MU], pc_coef[k, COEF_KS], normal[k], h,
-                                gm[2 * k + 1, 2 * k + 1], slip[k])
+        lam = local_map_modulus(
+            pc_coef[k, COEF_MU], pc_coef[k, COEF_KS], normal[k], h, gm[2 * k + 1, 2 * k + 1], slip[k]
+        )
         lam_int[k] = max(lam_int[k], lam)
         it_int[k] = max(it_int[k], conv_iter[k] if conv_iter[k] > 0 else 1)
         lam_max = max(lam_max, lam)
@@ -201,8 +204,22 @@ def move_patches(st, g, p, cfg, w):
         for s in range(w.g_ok.shape[0]):
             w.g_ok[s] = 0
         st.clock[CUSTOM_H] = -1.0
-        pr = granular_rhs(st.clock[T_NOW], st.y, st.u, st.v, g, cfg, st.k1, w.fscratch, w.nscratch, w.sscratch,
-                          False, w.fbar, False, False)
+        pr = granular_rhs(
+            st.clock[T_NOW],
+            st.y,
+            st.u,
+            st.v,
+            g,
+            cfg,
+            st.k1,
+            w.fscratch,
+            w.nscratch,
+            w.sscratch,
+            False,
+            w.fbar,
+            False,
+            False,
+        )
         st.p1[0] = pr.p_shock
         st.p1[1] = pr.p_visc
         st.p1[2] = pr.p_fric

@@ -1,6 +1,7 @@
 """The ladder of time steps h_l = dt_max 2^(-l/4): G(h) and a scheme's per-step matrices
 are computed once per level and kept, so changing the step never refactors the plate.
 """
+
 from __future__ import annotations
 
 import math

@@ -5,6 +5,7 @@ scheme's hooks are picked at compile time from its scratch type (solver/schemes)
 Everything here is numba-compiled (cached on disk), takes only arrays and named tuples
 of arrays, allocates nothing per step and runs no Python per step.
 """
+
 from __future__ import annotations
 
 import math
@@ -23,11 +24,64 @@ from granplate.solver.plate_modal import driving_dofs, modal_acceleration, plate
 from granplate.model.inputs import DR_F
 from granplate.solver.drives import drive_displacement, walls_moved
 from granplate.solver.state import (
-    A_DRIVE, A_GRAVITY, E_DRIVE, E_GRAVITY, REBUILD, A_FRIC, A_PLASTIC, A_SHOCK_G, A_SHOCK_P, A_VISC, C_FRICTION_BOUND, C_ITERS, C_LEVEL, C_OUT, C_RETRIES, C_STEPS, CUSTOM_H,
-    D_FRIC, D_PLASTIC, D_VISC, E_GRAN, KE_Z, E_IN_MAX, E_PLATE, E_POT, E_POTG, E_SHOCK, E_STATIC, E_ZERO, ERR_BUFFER,
-    ERR_CONTACT, ERR_ENERGY, ERR_H, ERR_ITER, ERR_LAM, ERR_N, ERR_NAN, ERR_NOCONV, ERR_RESID,
-    ERR_T, ERR_VT, H_LAST, KE_ROT, KE_X, KE_Y, N_LEVELS, OK, PAUSED, RES_LAST, RESID, RESID_MAX,
-    S_DT_MAX, S_DT_MIN, S_ITERS, S_LAM_MAX, S_RETRIES, S_STEPS, T_NOW,
+    A_DRIVE,
+    A_GRAVITY,
+    E_DRIVE,
+    E_GRAVITY,
+    REBUILD,
+    A_FRIC,
+    A_PLASTIC,
+    A_SHOCK_G,
+    A_SHOCK_P,
+    A_VISC,
+    C_FRICTION_BOUND,
+    C_ITERS,
+    C_LEVEL,
+    C_OUT,
+    C_RETRIES,
+    C_STEPS,
+    CUSTOM_H,
+    D_FRIC,
+    D_PLASTIC,
+    D_VISC,
+    E_GRAN,
+    KE_Z,
+    E_IN_MAX,
+    E_PLATE,
+    E_POT,
+    E_POTG,
+    E_SHOCK,
+    E_STATIC,
+    E_ZERO,
+    ERR_BUFFER,
+    ERR_CONTACT,
+    ERR_ENERGY,
+    ERR_H,
+    ERR_ITER,
+    ERR_LAM,
+    ERR_N,
+    ERR_NAN,
+    ERR_NOCONV,
+    ERR_RESID,
+    ERR_T,
+    ERR_VT,
+    H_LAST,
+    KE_ROT,
+    KE_X,
+    KE_Y,
+    N_LEVELS,
+    OK,
+    PAUSED,
+    RES_LAST,
+    RESID,
+    RESID_MAX,
+    S_DT_MAX,
+    S_DT_MIN,
+    S_ITERS,
+    S_LAM_MAX,
+    S_RETRIES,
+    S_STEPS,
+    T_NOW,
 )
 
 
@@ -37,8 +91,22 @@ def initialise(st, g, p, cfg, w):
     granules' derivative as every step's end one (without the split-off friction); the
     contacts' histories start at their overlaps at t = 0 (a contact that starts beyond
     its yield overlap starts loaded there: no plastic work is booked for it)."""
-    pr = granular_rhs(st.clock[T_NOW], st.y, st.u, st.v, g, cfg, st.k1, st.force, st.normal, st.slip, False, w.fbar,
-                      cfg.split_friction, True)
+    pr = granular_rhs(
+        st.clock[T_NOW],
+        st.y,
+        st.u,
+        st.v,
+        g,
+        cfg,
+        st.k1,
+        st.force,
+        st.normal,
+        st.slip,
+        False,
+        w.fbar,
+        cfg.split_friction,
+        True,
+    )
     commit_histories(st.clock[T_NOW], g)
     st.p1[0] = pr.p_shock
     st.p1[1] = pr.p_visc
@@ -104,8 +172,7 @@ def energy_in(clock, eshock, acc):
 @njit(cache=True)
 def record(o, st, g, p, w, out):
     """Write the state at t_n into output row o and restart the interval maxima."""
-    eshock, eg, ep, kx, ky, kz, kr = energy_terms(st.y, st.q, st.qd, st.force, st.clock, st.acc, g, p.omega2,
-                                                  p.resid)
+    eshock, eg, ep, kx, ky, kz, kr = energy_terms(st.y, st.q, st.qd, st.force, st.clock, st.acc, g, p.omega2, p.resid)
     e_in = energy_in(st.clock, eshock, st.acc)
     denom = max(st.clock[E_IN_MAX], 1e-300)
     out.t[o] = st.clock[T_NOW]
@@ -287,16 +354,18 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
         plate_work = S.commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w)
         accept_granular(t, h, land, out.target[o], plate_work, e_pot, st, w)
         commit_histories(st.clock[T_NOW], g)
-        lam_max = accept_contacts(h, w.gmat[slot], g.pc_coef, w.normal_new, w.slip_new, w.conv_iter,
-                                  st.normal, st.slip, w.lam_int, w.it_int)
+        lam_max = accept_contacts(
+            h, w.gmat[slot], g.pc_coef, w.normal_new, w.slip_new, w.conv_iter, st.normal, st.slip, w.lam_int, w.it_int
+        )
         new_level, h_new = S.next_level(sw, h, slot, level, err, lam_max, rate, st.clock[T_NOW], cfg)
         if not cfg.split_friction and rate * h > 0.5 * RK4_FRICTION_LIMIT:  # the step was at RK4's friction bound
             st.count[C_FRICTION_BOUND] += 1
         if level_step(new_level, cfg) < cfg.dt_min:
             return step_too_small(st.clock[T_NOW], h_new, it, worst_contact(w), lam_max, st.normal, st.slip, st)
         st.count[C_LEVEL] = new_level
-        status = check_energy(h, st.y, st.q, st.qd, st.force, st.clock, st.acc, g, p.omega2,
-                              p.resid, cfg.energy_tol, w.res_int, st.err)
+        status = check_energy(
+            h, st.y, st.q, st.qd, st.force, st.clock, st.acc, g, p.omega2, p.resid, cfg.energy_tol, w.res_int, st.err
+        )
         if status != OK:
             return status
         if land:
@@ -304,9 +373,26 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
             st.count[C_OUT] = o + 1
         if g.pc_patch.shape[0] > 0 and move_patches(st, g, p, cfg, w):  # patch contacts follow their granules
             S.contacts_moved(sw, st.clock[T_NOW], st, p, cfg)
-        status = watch_contacts(st.clock[T_NOW], st.y, st.u, g.radius, w.plate_free, w.yref, w.ovl, w.ovl_with,
-                                w.ovl_new, w.ovl_who, cfg.overlap_stop, cfg.plate_x0, cfg.plate_ylo, cfg.plate_yhi,
-                                cfg.rebuild_move, cfg.face_skin, cfg.dimension, st.err)
+        status = watch_contacts(
+            st.clock[T_NOW],
+            st.y,
+            st.u,
+            g.radius,
+            w.plate_free,
+            w.yref,
+            w.ovl,
+            w.ovl_with,
+            w.ovl_new,
+            w.ovl_who,
+            cfg.overlap_stop,
+            cfg.plate_x0,
+            cfg.plate_ylo,
+            cfg.plate_yhi,
+            cfg.rebuild_move,
+            cfg.face_skin,
+            cfg.dimension,
+            st.err,
+        )
         if status != OK:
             return status
         if g.wall_drive.shape[0] > 0 and cfg.rebuild_move > 0.0 and walls_moved(g, cfg.rebuild_move):

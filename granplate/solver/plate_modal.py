@@ -7,6 +7,7 @@ response of the modes it drops at the driving DOFs: u_d = Phi_d q + R F, with en
 1/2 F^T R F; G(h) gains 4 R / h^2. The functions marked "static part" add it; with every
 mode kept p.resid is (0, 0) and they add nothing.
 """
+
 from __future__ import annotations
 
 import math

@@ -3,6 +3,7 @@ prescribes (docs/model.md section 6), in either dimension: the granular derivati
 split-off friction and energies come from solver.dimension (the plane's solver.granular
 or space's solver.granular3d).
 """
+
 from __future__ import annotations
 
 from numba import njit
@@ -71,8 +72,9 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
         fric_split = friction_flow(w.ynew, 0.5 * h, g, cfg, True)
         y0 = w.ynew
     if plate_friction_held(hold, g) or split:
-        pr = granular_rhs(t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar,
-                          split, False)
+        pr = granular_rhs(
+            t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
+        )
         w.p1h[0] = pr.p_shock
         w.p1h[1] = pr.p_visc
         w.p1h[2] = pr.p_fric
@@ -84,18 +86,21 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     for i in range(ng):
         for c in range(nc):
             w.ytmp[i, c] = y0[i, c] + hh * k1[i, c]
-    p2 = granular_rhs(t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k2, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar,
-                      split, False)
+    p2 = granular_rhs(
+        t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k2, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
+    )
     for i in range(ng):
         for c in range(nc):
             w.ytmp[i, c] = y0[i, c] + hh * w.k2[i, c]
-    p3 = granular_rhs(t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k3, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar,
-                      split, False)
+    p3 = granular_rhs(
+        t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k3, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
+    )
     for i in range(ng):
         for c in range(nc):
             w.ytmp[i, c] = y0[i, c] + h * w.k3[i, c]
-    p4 = granular_rhs(t + h, w.ytmp, stage[2], stage[3], g, cfg, w.k4, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar,
-                      split, False)
+    p4 = granular_rhs(
+        t + h, w.ytmp, stage[2], stage[3], g, cfg, w.k4, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
+    )
     h6 = h / 6.0
     for i in range(ng):
         for c in range(nc):  # (y0 may be w.ynew itself: each entry is read before it is written)
@@ -108,11 +113,15 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
         w.dacc[2] += fric_split
     # the drives' work (RK4's quadrature of their power, the impulse that gives the driven granules
     # their prescribed velocity at t + h, the driven walls' elastic work exactly) and gravity's
-    w.dacc[5] = (h6 * (p1[3] + 2.0 * p2.p_drive + 2.0 * p3.p_drive + p4.p_drive) + hold_drives(t + h, w.ynew, g)
-                 + wall_shift_energy(st.y, w.ynew, g, cfg.clip, t, t + h))
+    w.dacc[5] = (
+        h6 * (p1[3] + 2.0 * p2.p_drive + 2.0 * p3.p_drive + p4.p_drive)
+        + hold_drives(t + h, w.ynew, g)
+        + wall_shift_energy(st.y, w.ynew, g, cfg.clip, t, t + h)
+    )
     w.dacc[4] = h6 * (p1[4] + 2.0 * p2.p_grav + 2.0 * p3.p_grav + p4.p_grav)
-    pe = granular_rhs(t + h, w.ynew, stage[2], stage[3], g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar,
-                      split, True)
+    pe = granular_rhs(
+        t + h, w.ynew, stage[2], stage[3], g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar, split, True
+    )
     w.dacc[3] = pe.w_plastic
     w.pend[0] = pe.p_shock
     w.pend[1] = pe.p_visc
@@ -125,7 +134,6 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     if not cfg.split_friction:
         return pe.e_pot, max(pe.rate, pe.rate_plate)
     return pe.e_pot, 0.0 if hold else pe.rate_plate  # a held plate-contact friction is not RK4's
-
 
 
 @njit(cache=True)

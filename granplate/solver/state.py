@@ -1,6 +1,7 @@
 """The loop's state, shared scratch and output buffers, and the layouts of their small
 bookkeeping arrays (named columns). Allocated once per run, updated in place.
 """
+
 from __future__ import annotations
 
 from typing import NamedTuple
@@ -28,7 +29,19 @@ A_GRAVITY, A_DRIVE = 5, 6
 N_ACC = 7
 # energy output columns
 (
-    E_SHOCK, E_GRAN, E_PLATE, D_VISC, D_FRIC, KE_X, KE_Y, KE_ROT, RESID, RESID_MAX, E_POTG, D_PLASTIC, KE_Z,
+    E_SHOCK,
+    E_GRAN,
+    E_PLATE,
+    D_VISC,
+    D_FRIC,
+    KE_X,
+    KE_Y,
+    KE_ROT,
+    RESID,
+    RESID_MAX,
+    E_POTG,
+    D_PLASTIC,
+    KE_Z,
 ) = range(13)
 E_GRAVITY, E_DRIVE = 13, 14
 N_ENERGY = 15
@@ -53,7 +66,7 @@ PARTNER_PLATE = -(1 << 40)
 
 #: time steps live on a ladder h_l = dt_max 2^(-l/4), l < N_LEVELS; slot N_LEVELS of the
 #: per-level arrays holds an odd step (one that lands on an output time).
-LEVEL_RATIO = 2.0 ** -0.25
+LEVEL_RATIO = 2.0**-0.25
 N_LEVELS = 200
 
 
@@ -150,10 +163,25 @@ def new_state(ng: int, nm: int, nk: int, nc: int = 6) -> State:
     nd = 2 * nk
     z = np.zeros
     return State(
-        y=z((ng, nc)), acc=z(N_ACC), q=z(nm), qd=z(nm), qdd=z(nm), u=z(nd), v=z(nd),
-        a=z(nd), force=z(nd), force_prev=z(nd), k1=z((ng, nc)), k0=z((ng, nc)), pforce=z(nd),
-        p1=z(5), normal=z(nk), slip=z(nk), clock=z(N_CLOCK),
-        count=np.zeros(N_COUNT, np.int64), err=z(N_ERR),
+        y=z((ng, nc)),
+        acc=z(N_ACC),
+        q=z(nm),
+        qd=z(nm),
+        qdd=z(nm),
+        u=z(nd),
+        v=z(nd),
+        a=z(nd),
+        force=z(nd),
+        force_prev=z(nd),
+        k1=z((ng, nc)),
+        k0=z((ng, nc)),
+        pforce=z(nd),
+        p1=z(5),
+        normal=z(nk),
+        slip=z(nk),
+        clock=z(N_CLOCK),
+        count=np.zeros(N_COUNT, np.int64),
+        err=z(N_ERR),
     )
 
 
@@ -163,29 +191,67 @@ def new_work(ng: int, nm: int, nk: int, n_face: int = 0, nc: int = 6) -> Work:
     nd = 2 * nk
     z = np.zeros
     return Work(
-        ytmp=z((ng, nc)), ynew=z((ng, nc)), k1h=z((ng, nc)), k2=z((ng, nc)), k3=z((ng, nc)),
-        k4=z((ng, nc)), kend=z((ng, nc)), up=z(nd), vp=z(nd), fguess=z(nd), fbar=z(nk),
-        stage=z((4, nd)), fnew=z(nd), fscratch=z(nd), pend=z(5), dacc=z(6), p1h=z(5),
-        normal_new=z(nk), slip_new=z(nk), nscratch=z(nk), sscratch=z(nk),
-        conv_iter=np.zeros(nk, np.int64), dmode=z((N_LEVELS + 1, nm)),
-        gmat=z((N_LEVELS + 1, nd, nd)), g_ok=np.zeros(N_LEVELS + 1, np.int64),
-        lam_int=z(nk), it_int=np.zeros(nk, np.int64), dt_int=z(2), res_int=z(1),
-        yref=z((ng, 3)), ovl=z(ng), ovl_with=np.zeros(ng, np.int64), plate_free=np.zeros(ng, np.int64),
-        ovl_new=z(1), ovl_who=np.full(2, -1, np.int64), wface=z(n_face), patch_y=z(nk),
-        pweight=z((nk, n_face)), prange=np.zeros((nk, 2), np.int64),
+        ytmp=z((ng, nc)),
+        ynew=z((ng, nc)),
+        k1h=z((ng, nc)),
+        k2=z((ng, nc)),
+        k3=z((ng, nc)),
+        k4=z((ng, nc)),
+        kend=z((ng, nc)),
+        up=z(nd),
+        vp=z(nd),
+        fguess=z(nd),
+        fbar=z(nk),
+        stage=z((4, nd)),
+        fnew=z(nd),
+        fscratch=z(nd),
+        pend=z(5),
+        dacc=z(6),
+        p1h=z(5),
+        normal_new=z(nk),
+        slip_new=z(nk),
+        nscratch=z(nk),
+        sscratch=z(nk),
+        conv_iter=np.zeros(nk, np.int64),
+        dmode=z((N_LEVELS + 1, nm)),
+        gmat=z((N_LEVELS + 1, nd, nd)),
+        g_ok=np.zeros(N_LEVELS + 1, np.int64),
+        lam_int=z(nk),
+        it_int=np.zeros(nk, np.int64),
+        dt_int=z(2),
+        res_int=z(1),
+        yref=z((ng, 3)),
+        ovl=z(ng),
+        ovl_with=np.zeros(ng, np.int64),
+        plate_free=np.zeros(ng, np.int64),
+        ovl_new=z(1),
+        ovl_who=np.full(2, -1, np.int64),
+        wface=z(n_face),
+        patch_y=z(nk),
+        pweight=z((nk, n_face)),
+        prange=np.zeros((nk, 2), np.int64),
     )
 
 
-def new_output(times: np.ndarray, ng: int, nm: int, nk: int, nc: int = 6, n_walls: int = 0,
-               n_drives: int = 0) -> Output:
+def new_output(
+    times: np.ndarray, ng: int, nm: int, nk: int, nc: int = 6, n_walls: int = 0, n_drives: int = 0
+) -> Output:
     """Output buffers for the given output times (nc state columns per granule, n_walls
     walls, n_drives drives)."""
     z = np.zeros
     n_out = len(times)
     return Output(
-        target=np.asarray(times, float).copy(), t=z(n_out), y=z((n_out, ng, nc)),
-        energy=z((n_out, N_ENERGY)), q=z((n_out, nm)), qd=z((n_out, nm)),
-        force=z((n_out, nk, 2)), slip=z((n_out, nk)), lam=z((n_out, nk)),
-        iters=np.zeros((n_out, nk), np.int64), stats=z((n_out, N_STEPSTAT)),
-        wall_force=z((n_out, n_walls)), drive=z((n_out, n_drives, 2)),
+        target=np.asarray(times, float).copy(),
+        t=z(n_out),
+        y=z((n_out, ng, nc)),
+        energy=z((n_out, N_ENERGY)),
+        q=z((n_out, nm)),
+        qd=z((n_out, nm)),
+        force=z((n_out, nk, 2)),
+        slip=z((n_out, nk)),
+        lam=z((n_out, nk)),
+        iters=np.zeros((n_out, nk), np.int64),
+        stats=z((n_out, N_STEPSTAT)),
+        wall_force=z((n_out, n_walls)),
+        drive=z((n_out, n_drives, 2)),
     )

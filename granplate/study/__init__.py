@@ -9,6 +9,7 @@
     >>> from granplate.study import load_study, sweep
     >>> report = sweep(load_study("study.toml"), "out", workers=2)
 """
+
 from __future__ import annotations
 
 from granplate.study.spec import Study, load_study, parse_study  # noqa: F401

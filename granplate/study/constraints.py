@@ -9,6 +9,7 @@ gives Optuna one constraint value (its `constraints_func` convention: <= 0 feasi
 the violation relative to the bound's size, (v - max) / |max| or (min - v) / |min|
 (/ 1 for a bound of 0), so that bounds of different units weigh alike in the sampler.
 """
+
 from __future__ import annotations
 
 import math

@@ -6,6 +6,7 @@ granplate version: the same design in a rerun (or in another study) has the same
 and another granplate version computes it again. Records are written atomically, one
 per design as soon as it is in, so a killed sweep keeps every finished design.
 """
+
 from __future__ import annotations
 
 import json
@@ -27,10 +28,13 @@ DESIGNS = "designs"
 #: Metrics a study adds to gp.summary: name -> (unit, meaning).
 EXTRA_METRICS: dict[str, tuple[str, str]] = {
     "granular_mass": ("kg", "total mass of the granules (the protector)"),
-    "max_von_mises_nodes": ("Pa", "largest von Mises stress at the plate's element nodes instead "
-                                  "of its Gauss points (docs/model.md 4.4), from the stored plate "
-                                  "displacements; only for a run that keeps them at every output "
-                                  "(time.field_interval = time.output_interval), else null"),
+    "max_von_mises_nodes": (
+        "Pa",
+        "largest von Mises stress at the plate's element nodes instead "
+        "of its Gauss points (docs/model.md 4.4), from the stored plate "
+        "displacements; only for a run that keeps them at every output "
+        "(time.field_interval = time.output_interval), else null",
+    ),
 }
 
 
@@ -130,31 +134,43 @@ def run_design(scenario_toml: str, full: bool = False) -> dict[str, Any]:
             t1 = time.perf_counter()
             ds = gp.simulate(scenario, progress=False, summary_only=not (full or keeps_every_field(scenario)))
             summary = metrics(ds)
-            after_loop = (time.perf_counter() - t1 - float(ds.attrs.get("wall_time_s", 0.0))
-                          - float(ds.attrs.get("compile_time_s", 0.0)))  # wall_time_s leaves compiling out
+            after_loop = (
+                time.perf_counter()
+                - t1
+                - float(ds.attrs.get("wall_time_s", 0.0))
+                - float(ds.attrs.get("compile_time_s", 0.0))
+            )  # wall_time_s leaves compiling out
             status = "ok"
         except GranplateError as err:
             status = failure_message(err)
         except Exception as err:  # noqa: BLE001 - recorded as the design's failure
             status = failure_message(err)
-    return {"status": status, "summary": summary, "elapsed_s": time.perf_counter() - t0,
-            "timings": ({**timings(ds), "summary_s": after_loop, "cpu_s": time.thread_time() - c0}
-                        if summary is not None else {}),
-            "result": ds if full and summary is not None else None,
-            "warnings": run_warnings(caught)}
+    return {
+        "status": status,
+        "summary": summary,
+        "elapsed_s": time.perf_counter() - t0,
+        "timings": (
+            {**timings(ds), "summary_s": after_loop, "cpu_s": time.thread_time() - c0} if summary is not None else {}
+        ),
+        "result": ds if full and summary is not None else None,
+        "warnings": run_warnings(caught),
+    }
 
 
 def timings(ds) -> dict[str, float]:
     """Where a design's run spent its time [s]: set-up (the model), the loop's first call
     (its initial state and output row, kernels loaded), the time loop, and the loop's CPU
     time in its thread (loop_cpu_s; the task's is cpu_s)."""
-    return {"setup_s": float(ds.attrs.get("setup_time_s", 0.0)),
-            "first_call_s": float(ds.attrs.get("first_call_time_s", 0.0)),
-            "loop_s": float(ds.attrs.get("loop_time_s", 0.0)),
-            "loop_cpu_s": float(ds.attrs.get("loop_thread_cpu_s", ds.attrs.get("loop_cpu_s", 0.0)))}
+    return {
+        "setup_s": float(ds.attrs.get("setup_time_s", 0.0)),
+        "first_call_s": float(ds.attrs.get("first_call_time_s", 0.0)),
+        "loop_s": float(ds.attrs.get("loop_time_s", 0.0)),
+        "loop_cpu_s": float(ds.attrs.get("loop_thread_cpu_s", ds.attrs.get("loop_cpu_s", 0.0))),
+    }
 
 
 # ------------------------------------------------------------------------- records
+
 
 def record_path(out: str | Path, key: str, suffix: str = ".json") -> Path:
     return Path(out) / DESIGNS / f"{key}{suffix}"
@@ -162,10 +178,17 @@ def record_path(out: str | Path, key: str, suffix: str = ".json") -> Path:
 
 def make_record(key: str, changes: dict, scenario_toml: str, outcome: dict) -> dict:
     """The JSON record of a finished design."""
-    return {"key": key, "granplate_version": gp.__version__, "status": outcome["status"],
-            "changes": changes, "summary": outcome["summary"],
-            "elapsed_s": outcome["elapsed_s"], "timings": outcome.get("timings", {}),
-            "warnings": outcome.get("warnings", []), "scenario_toml": scenario_toml}
+    return {
+        "key": key,
+        "granplate_version": gp.__version__,
+        "status": outcome["status"],
+        "changes": changes,
+        "summary": outcome["summary"],
+        "elapsed_s": outcome["elapsed_s"],
+        "timings": outcome.get("timings", {}),
+        "warnings": outcome.get("warnings", []),
+        "scenario_toml": scenario_toml,
+    }
 
 
 def write_record(out: str | Path, record: dict, result=None) -> Path:

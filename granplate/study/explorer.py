@@ -14,6 +14,7 @@ designs the scatter plots are WebGL (`scattergl`).
     >>> from granplate.study.explorer import write_explorer
     >>> write_explorer(read_outcome("q0-r2"), {})        # -> q0-r2/report.html
 """
+
 from __future__ import annotations
 
 import html
@@ -48,11 +49,16 @@ DRAWN_DIGITS = 7
 #: Colours of the page's views: designs, the Pareto front, infeasible designs, best designs.
 COLOURS = {"design": "#4c78a8", "front": "#d62728", "infeasible": "#9e9e9e"}
 #: Colour and marker of the best design of each objective, in the objectives' order.
-BEST_MARKERS: tuple[tuple[str, str], ...] = (("#ff7f0e", "star"), ("#2ca02c", "diamond"), ("#9467bd", "square"),
-                                             ("#8c564b", "triangle-up"))
+BEST_MARKERS: tuple[tuple[str, str], ...] = (
+    ("#ff7f0e", "star"),
+    ("#2ca02c", "diamond"),
+    ("#9467bd", "square"),
+    ("#8c564b", "triangle-up"),
+)
 
 
 # ------------------------------------------------------------------------- data
+
 
 def _plain(v: Any) -> Any:
     """A value for JSON: numbers as they are (NaN and inf: None), text as text."""
@@ -78,8 +84,13 @@ def counts(out: StudyOutcome) -> dict[str, int]:
     left (not run yet) and, with constraints, infeasible."""
     done = sum(r.ok for r in out.rows)
     failed = sum(not r.ok and r.status != "not run" for r in out.rows)
-    return {"total": len(out.rows), "done": done, "failed": failed, "left": len(out.rows) - done - failed,
-            "infeasible": sum(r.feasible is False for r in out.rows)}
+    return {
+        "total": len(out.rows),
+        "done": done,
+        "failed": failed,
+        "left": len(out.rows) - done - failed,
+        "infeasible": sum(r.feasible is False for r in out.rows),
+    }
 
 
 def quantity(out: StudyOutcome, name: str) -> dict[str, Any]:
@@ -91,8 +102,11 @@ def quantity(out: StudyOutcome, name: str) -> dict[str, Any]:
     if name in out.names:
         values = out.values(name)
         levels = P.distinct(values)
-        entry.update(numeric=P.is_numeric(values), log=P.is_log(out, name, levels),
-                     levels=[_plain(v) for v in levels] if not P.is_numeric(values) else [])
+        entry.update(
+            numeric=P.is_numeric(values),
+            log=P.is_log(out, name, levels),
+            levels=[_plain(v) for v in levels] if not P.is_numeric(values) else [],
+        )
     else:
         entry.update(numeric=True, log=False, levels=[])
     return entry
@@ -104,8 +118,12 @@ def table_metrics(out: StudyOutcome, drawn: list[str]) -> list[str]:
     drawn; the others are in each design's panel and the CSV table."""
     from granplate.study.report import TABLE_METRICS
 
-    wanted = (set(out.objectives) | {b.metric for b in out.constraints} | set(TABLE_METRICS)
-              | {m for t in out.report.targets for m in t.metrics})
+    wanted = (
+        set(out.objectives)
+        | {b.metric for b in out.constraints}
+        | set(TABLE_METRICS)
+        | {m for t in out.report.targets for m in t.metrics}
+    )
     return [m for m in drawn if m in wanted]
 
 
@@ -130,16 +148,25 @@ def design_entries(out: StudyOutcome, figures: dict[int, list[tuple[str, Path]]]
     for i, r in enumerate(out.rows):
         record = D.record_path(out.folder, r.key) if r.key else None
         result = D.record_path(out.folder, r.key, ".nc") if r.key else None
-        entries.append({
-            "i": i, "number": r.number, "key": r.key, "status": r.status, "ok": r.ok, "feasible": r.feasible,
-            "front": i in front, "best": [m for m, j in best.items() if j == i], "why": chosen.get(i, ""),
-            "same_as": first[i] if first[i] != i else None,
-            "params": {n: _plain(r.params.get(n)) for n in out.names},
-            "metrics": {m: _plain(r.metrics.get(m)) for m in out.metrics if r.metrics.get(m) is not None},
-            "figures": [[caption, _relative(out.folder, p)] for caption, p in figures.get(i, [])],
-            "record": _relative(out.folder, record) if record is not None and record.is_file() else None,
-            "result": _relative(out.folder, result) if result is not None and result.is_file() else None,
-        })
+        entries.append(
+            {
+                "i": i,
+                "number": r.number,
+                "key": r.key,
+                "status": r.status,
+                "ok": r.ok,
+                "feasible": r.feasible,
+                "front": i in front,
+                "best": [m for m, j in best.items() if j == i],
+                "why": chosen.get(i, ""),
+                "same_as": first[i] if first[i] != i else None,
+                "params": {n: _plain(r.params.get(n)) for n in out.names},
+                "metrics": {m: _plain(r.metrics.get(m)) for m in out.metrics if r.metrics.get(m) is not None},
+                "figures": [[caption, _relative(out.folder, p)] for caption, p in figures.get(i, [])],
+                "record": _relative(out.folder, record) if record is not None and record.is_file() else None,
+                "result": _relative(out.folder, result) if result is not None and result.is_file() else None,
+            }
+        )
     return entries
 
 
@@ -151,20 +178,28 @@ def explorer_data(out: StudyOutcome, figures: dict[int, list[tuple[str, Path]]] 
 
     drawn, _ = shown_metrics(out)
     return {
-        "title": out.folder.name, "kind": out.kind, "base": out.base, "version": gp.__version__,
+        "title": out.folder.name,
+        "kind": out.kind,
+        "base": out.base,
+        "version": gp.__version__,
         "counts": counts(out),
         "parameters": [quantity(out, n) for n in out.names],
         "metrics": [quantity(out, m) for m in out.metrics],
-        "drawn": drawn, "table": table_metrics(out, drawn),
-        "objectives": dict(out.objectives), "directions": directions(out),
-        "constraints": [{"metric": b.metric, "low": b.low, "high": b.high, "text": b.text(out.unit(b.metric))}
-                        for b in out.constraints],
+        "drawn": drawn,
+        "table": table_metrics(out, drawn),
+        "objectives": dict(out.objectives),
+        "directions": directions(out),
+        "constraints": [
+            {"metric": b.metric, "low": b.low, "high": b.high, "text": b.text(out.unit(b.metric))}
+            for b in out.constraints
+        ],
         "gl": len(out.rows) > SCATTERGL_ABOVE,
         "designs": design_entries(out, figures or {}),
     }
 
 
 # ------------------------------------------------------------------------- figures
+
 
 def scatter_type(out: StudyOutcome) -> str:
     """'scattergl' above SCATTERGL_ABOVE designs, else 'scatter' (SVG)."""
@@ -180,8 +215,12 @@ def axis_title(out: StudyOutcome, name: str, way: str = "") -> str:
 
 def _axis(out: StudyOutcome, name: str, way: str = "") -> dict[str, Any]:
     """A plotly axis of a quantity: its title with unit, log where the parameter is."""
-    axis: dict[str, Any] = {"title": {"text": axis_title(out, name, way)}, "automargin": True,
-                            "zeroline": False, "gridcolor": "#e5e5e5"}
+    axis: dict[str, Any] = {
+        "title": {"text": axis_title(out, name, way)},
+        "automargin": True,
+        "zeroline": False,
+        "gridcolor": "#e5e5e5",
+    }
     if name in out.names:
         values = out.values(name)
         if not P.is_numeric(values):
@@ -197,15 +236,28 @@ def _values(out: StudyOutcome, name: str, rows: list[int]) -> list[Any]:
     """The drawn values (unit drawn) of a parameter or metric over rows."""
     factor = P.scaled(out, name)[0]
     if name in out.names:
-        return [_drawn(out.rows[i].params.get(name), factor) if not isinstance(out.rows[i].params.get(name), str)
-                else out.rows[i].params.get(name) for i in rows]
+        return [
+            _drawn(out.rows[i].params.get(name), factor)
+            if not isinstance(out.rows[i].params.get(name), str)
+            else out.rows[i].params.get(name)
+            for i in rows
+        ]
     return [_drawn(out.rows[i].metrics.get(name), factor) for i in rows]
 
 
-def _points(kind: str, name: str, x: list, y: list, rows: list[int], colour: str, symbol: str = "circle",
-            size: int = 7, **extra) -> dict[str, Any]:
-    return {"type": kind, "mode": "markers", "name": name, "x": x, "y": y, "customdata": rows,
-            "marker": {"color": colour, "symbol": symbol, "size": size, "line": {"width": 0}}, **extra}
+def _points(
+    kind: str, name: str, x: list, y: list, rows: list[int], colour: str, symbol: str = "circle", size: int = 7, **extra
+) -> dict[str, Any]:
+    return {
+        "type": kind,
+        "mode": "markers",
+        "name": name,
+        "x": x,
+        "y": y,
+        "customdata": rows,
+        "marker": {"color": colour, "symbol": symbol, "size": size, "line": {"width": 0}},
+        **extra,
+    }
 
 
 def pareto_figure(out: StudyOutcome) -> dict[str, Any] | None:
@@ -229,28 +281,54 @@ def pareto_figure(out: StudyOutcome) -> dict[str, Any] | None:
 
     ok = [i for i in done if out.rows[i].feasible is not False]
     bad = [i for i in done if out.rows[i].feasible is False]
-    traces = [_points(kind, "designs" + (" (feasible)" if out.constraints else ""), *xy(ok), ok,
-                      COLOURS["design"], meta="designs")]
+    traces = [
+        _points(
+            kind, "designs" + (" (feasible)" if out.constraints else ""), *xy(ok), ok, COLOURS["design"], meta="designs"
+        )
+    ]
     if bad:
-        traces.append(_points(kind, "infeasible (constraints)", *xy(bad), bad, COLOURS["infeasible"],
-                              "x", meta="infeasible"))
+        traces.append(
+            _points(kind, "infeasible (constraints)", *xy(bad), bad, COLOURS["infeasible"], "x", meta="infeasible")
+        )
     front = pareto_front(out)
     if front:
         order = sorted(front, key=lambda i: xy([i])[0][0])
         x, y = xy(order)
-        traces.append({**_points(kind, "Pareto front", x, y, order, COLOURS["front"], size=10),
-                       "mode": "lines+markers" if two else "markers", "line": {"color": COLOURS["front"]},
-                       "meta": "front"})
+        traces.append(
+            {
+                **_points(kind, "Pareto front", x, y, order, COLOURS["front"], size=10),
+                "mode": "lines+markers" if two else "markers",
+                "line": {"color": COLOURS["front"]},
+                "meta": "front",
+            }
+        )
     for k, (m, i) in enumerate(best_designs(out).items()):
         x, y = xy([i])
         colour, symbol = BEST_MARKERS[k % len(BEST_MARKERS)]
-        traces.append({**_points(kind, f"best {m}: {'trial' if out.kind == 'optimization' else 'design'} "
-                                       f"{out.rows[i].number}", x, y, [i], colour, symbol, 15),
-                       "meta": "best"})
-    layout = {"xaxis": _axis(out, names[0], out.objectives[names[0]]) if two else {"title": {"text": "design"}},
-              "yaxis": _axis(out, names[1] if two else names[0], out.objectives[names[1] if two else names[0]]),
-              "legend": {"orientation": "h", "y": -0.18}, "margin": {"t": 30, "r": 10},
-              "dragmode": "select", "hovermode": "closest", "title": {"text": ""}}
+        traces.append(
+            {
+                **_points(
+                    kind,
+                    f"best {m}: {'trial' if out.kind == 'optimization' else 'design'} {out.rows[i].number}",
+                    x,
+                    y,
+                    [i],
+                    colour,
+                    symbol,
+                    15,
+                ),
+                "meta": "best",
+            }
+        )
+    layout = {
+        "xaxis": _axis(out, names[0], out.objectives[names[0]]) if two else {"title": {"text": "design"}},
+        "yaxis": _axis(out, names[1] if two else names[0], out.objectives[names[1] if two else names[0]]),
+        "legend": {"orientation": "h", "y": -0.18},
+        "margin": {"t": 30, "r": 10},
+        "dragmode": "select",
+        "hovermode": "closest",
+        "title": {"text": ""},
+    }
     return {"data": traces, "layout": layout}
 
 
@@ -278,9 +356,14 @@ def metric_figure(out: StudyOutcome, metric: str | None = None) -> dict[str, Any
     ncol = min(len(names), 4)
     nrow = math.ceil(len(names) / ncol)
     gap = 0.07
-    layout: dict[str, Any] = {"showlegend": bool(bad), "hovermode": "closest", "dragmode": "select",
-                              "margin": {"t": 20, "r": 10}, "height": 330 * nrow,
-                              "legend": {"orientation": "h", "y": 1.08}}
+    layout: dict[str, Any] = {
+        "showlegend": bool(bad),
+        "hovermode": "closest",
+        "dragmode": "select",
+        "margin": {"t": 20, "r": 10},
+        "height": 330 * nrow,
+        "legend": {"orientation": "h", "y": 1.08},
+    }
     traces = []
     for k, name in enumerate(names):
         row, col = divmod(k, ncol)
@@ -293,12 +376,27 @@ def metric_figure(out: StudyOutcome, metric: str | None = None) -> dict[str, Any
         layout[f"yaxis{suffix}"] = {**_axis(out, metric), "domain": [y0, y1], "anchor": f"x{suffix}"}
         if col:
             layout[f"yaxis{suffix}"]["title"] = {"text": ""}
-        for rows, label, colour, symbol in ((ok, "designs", COLOURS["design"], "circle"),
-                                            (bad, "infeasible (constraints)", COLOURS["infeasible"], "x")):
+        for rows, label, colour, symbol in (
+            (ok, "designs", COLOURS["design"], "circle"),
+            (bad, "infeasible (constraints)", COLOURS["infeasible"], "x"),
+        ):
             if rows:
-                traces.append(_points(kind, label, _values(out, name, rows), _values(out, metric, rows), rows,
-                                      colour, symbol, 7, xaxis=f"x{suffix}", yaxis=f"y{suffix}",
-                                      showlegend=k == 0, meta={"parameter": name}))
+                traces.append(
+                    _points(
+                        kind,
+                        label,
+                        _values(out, name, rows),
+                        _values(out, metric, rows),
+                        rows,
+                        colour,
+                        symbol,
+                        7,
+                        xaxis=f"x{suffix}",
+                        yaxis=f"y{suffix}",
+                        showlegend=k == 0,
+                        meta={"parameter": name},
+                    )
+                )
     return {"data": traces, "layout": layout, "metric": metric, "parameters": names}
 
 
@@ -307,7 +405,7 @@ def _log_dimension(values: list[float]) -> dict[str, Any]:
     logs = [math.log10(v) for v in values]
     lo, hi = math.floor(min(logs)), math.ceil(max(logs))
     ticks = [t for t in np.arange(lo, hi + 1e-9, 1.0 if hi - lo > 1 else 0.25)]
-    return {"values": logs, "tickvals": ticks, "ticktext": [f"{10 ** t:.3g}" for t in ticks]}
+    return {"values": logs, "tickvals": ticks, "ticktext": [f"{10**t:.3g}" for t in ticks]}
 
 
 def parcoords_metrics(out: StudyOutcome) -> list[str]:
@@ -317,10 +415,13 @@ def parcoords_metrics(out: StudyOutcome) -> list[str]:
 
     drawn, _ = shown_metrics(out)
     done = [r for r in out.rows if r.ok and r.metrics]
-    first = (list(out.objectives) + [b.metric for b in out.constraints]
-             + [m for t in out.report.targets for m in t.metrics] + list(HEADLINE))
-    return [m for m in dict.fromkeys(first) if m in drawn
-            and all(_plain(r.metrics.get(m)) is not None for r in done)]
+    first = (
+        list(out.objectives)
+        + [b.metric for b in out.constraints]
+        + [m for t in out.report.targets for m in t.metrics]
+        + list(HEADLINE)
+    )
+    return [m for m in dict.fromkeys(first) if m in drawn and all(_plain(r.metrics.get(m)) is not None for r in done)]
 
 
 def parcoords_figure(out: StudyOutcome) -> dict[str, Any] | None:
@@ -338,12 +439,14 @@ def parcoords_figure(out: StudyOutcome) -> dict[str, Any] | None:
         values = [out.rows[i].params.get(name) for i in rows]
         if not P.is_numeric(values):
             levels = [str(v) for v in P.distinct(out.values(name))]
-            dim = {"values": [levels.index(str(v)) for v in values], "tickvals": list(range(len(levels))),
-                   "ticktext": levels}
+            dim = {
+                "values": [levels.index(str(v)) for v in values],
+                "tickvals": list(range(len(levels))),
+                "ticktext": levels,
+            }
         else:
             shown_values = [_drawn(v, P.scaled(out, name)[0]) for v in values]
-            dim = (_log_dimension(shown_values) if P.is_log(out, name, P.distinct(values))
-                   else {"values": shown_values})
+            dim = _log_dimension(shown_values) if P.is_log(out, name, P.distinct(values)) else {"values": shown_values}
         dims.append({**dim, "label": axis_title(out, name), "name": name})
     bounds = {b.metric: b for b in out.constraints}
     for m in metrics:
@@ -351,16 +454,30 @@ def parcoords_figure(out: StudyOutcome) -> dict[str, Any] | None:
         label = axis_title(out, m, out.objectives.get(m, ""))
         if m in bounds:
             b = bounds[m]
-            label += " in " + (f"{level_label(b.low * factor) if b.low is not None else '-inf'} .. "
-                               f"{level_label(b.high * factor) if b.high is not None else 'inf'}")
+            label += " in " + (
+                f"{level_label(b.low * factor) if b.low is not None else '-inf'} .. "
+                f"{level_label(b.high * factor) if b.high is not None else 'inf'}"
+            )
         dims.append({"values": _values(out, m, rows), "label": label, "name": m})
     feasible = [0 if out.rows[i].feasible is False else 1 for i in rows]
-    line = {"color": feasible, "cmin": 0, "cmax": 1, "showscale": False,  # 0.5: filtered out elsewhere
-            "colorscale": [[0, COLOURS["infeasible"]], [0.45, COLOURS["infeasible"]], [0.5, "#ececec"],
-                           [0.55, COLOURS["design"]], [1, COLOURS["design"]]]}
-    return {"data": [{"type": "parcoords", "dimensions": dims, "line": line,
-                      "labelangle": -12, "labelside": "top"}],
-            "layout": {"margin": {"t": 90, "l": 70, "r": 70, "b": 30}, "height": 460}, "rows": rows}
+    line = {
+        "color": feasible,
+        "cmin": 0,
+        "cmax": 1,
+        "showscale": False,  # 0.5: filtered out elsewhere
+        "colorscale": [
+            [0, COLOURS["infeasible"]],
+            [0.45, COLOURS["infeasible"]],
+            [0.5, "#ececec"],
+            [0.55, COLOURS["design"]],
+            [1, COLOURS["design"]],
+        ],
+    }
+    return {
+        "data": [{"type": "parcoords", "dimensions": dims, "line": line, "labelangle": -12, "labelside": "top"}],
+        "layout": {"margin": {"t": 90, "l": 70, "r": 70, "b": 30}, "height": 460},
+        "rows": rows,
+    }
 
 
 def level_label(v: Any) -> str:
@@ -414,29 +531,51 @@ def heat_figure(out: StudyOutcome) -> dict[str, Any] | None:
                     b = [str(v) for v in xl].index(str(r.params.get(xn)))
                     z[a][b] = _drawn(r.metrics.get(m), factor) if r.ok else None
                     cell[a][b] = i
-            where = ", ".join(f"{n} = {P._with_unit(out, n, v)}" for n, v in
-                              list(zip(others, combo)) + list(fixed.items()))
+            where = ", ".join(
+                f"{n} = {P._with_unit(out, n, v)}" for n, v in list(zip(others, combo)) + list(fixed.items())
+            )
             index.append({"metric": m, "slice": where})
-            traces.append({"type": "heatmap", "x": tick(xn, xl), "y": tick(yn, yl), "z": z, "customdata": cell,
-                           "text": [[P._cell_text(v) if v is not None else "" for v in row] for row in z],
-                           "texttemplate": "%{text}", "colorscale": "Viridis", "visible": not traces,
-                           "colorbar": {"title": {"text": f"{m} [{unit}]", "side": "right"}},
-                           "name": f"{m} {where}".strip(), "hoverongaps": False, "xgap": 1, "ygap": 1})
-    layout = {"xaxis": {**_axis(out, xn), "type": "category"}, "yaxis": {**_axis(out, yn), "type": "category"},
-              "margin": {"t": 20, "r": 10}}
+            traces.append(
+                {
+                    "type": "heatmap",
+                    "x": tick(xn, xl),
+                    "y": tick(yn, yl),
+                    "z": z,
+                    "customdata": cell,
+                    "text": [[P._cell_text(v) if v is not None else "" for v in row] for row in z],
+                    "texttemplate": "%{text}",
+                    "colorscale": "Viridis",
+                    "visible": not traces,
+                    "colorbar": {"title": {"text": f"{m} [{unit}]", "side": "right"}},
+                    "name": f"{m} {where}".strip(),
+                    "hoverongaps": False,
+                    "xgap": 1,
+                    "ygap": 1,
+                }
+            )
+    layout = {
+        "xaxis": {**_axis(out, xn), "type": "category"},
+        "yaxis": {**_axis(out, yn), "type": "category"},
+        "margin": {"t": 20, "r": 10},
+    }
     return {"data": traces, "layout": layout, "index": index, "x": xn, "y": yn, "others": others}
 
 
 def explorer_figures(out: StudyOutcome) -> dict[str, Any]:
     """The page's figures as plotly JSON: pareto, parcoords, metric, heat (None: the
     study has no such view), and which of them is the first screen's ('main')."""
-    figs = {"pareto": pareto_figure(out), "parcoords": parcoords_figure(out), "metric": metric_figure(out),
-            "heat": heat_figure(out)}
+    figs = {
+        "pareto": pareto_figure(out),
+        "parcoords": parcoords_figure(out),
+        "metric": metric_figure(out),
+        "heat": heat_figure(out),
+    }
     figs["main"] = "pareto" if figs["pareto"] else "heat" if figs["heat"] else "metric" if figs["metric"] else None
     return figs
 
 
 # ------------------------------------------------------------------------- the page
+
 
 def plotly_source() -> Path:
     """plotly.min.js as the plotly package ships it."""
@@ -452,8 +591,11 @@ def plotly_version() -> str:
 
 
 def _copy(source: Path, target: Path) -> None:
-    if not (target.is_file() and target.stat().st_size == source.stat().st_size
-            and target.read_bytes() == source.read_bytes()):
+    if not (
+        target.is_file()
+        and target.stat().st_size == source.stat().st_size
+        and target.read_bytes() == source.read_bytes()
+    ):
         shutil.copyfile(source, target)
 
 
@@ -463,9 +605,11 @@ def copy_assets(folder: Path) -> Path:
     assets = Path(folder) / ASSETS
     assets.mkdir(parents=True, exist_ok=True)
     _copy(plotly_source(), assets / PLOTLY_JS)
-    note = (f"{PLOTLY_JS}: plotly.js v{plotly_version()}, copied from the plotly Python package.\n"
-            "Copyright Plotly, Inc. Licensed under the MIT license (https://github.com/plotly/plotly.js).\n"
-            "explorer.js, explorer.css: granplate's study page, MIT license.\n")
+    note = (
+        f"{PLOTLY_JS}: plotly.js v{plotly_version()}, copied from the plotly Python package.\n"
+        "Copyright Plotly, Inc. Licensed under the MIT license (https://github.com/plotly/plotly.js).\n"
+        "explorer.js, explorer.css: granplate's study page, MIT license.\n"
+    )
     if not (assets / PLOTLY_NOTE).is_file() or (assets / PLOTLY_NOTE).read_text() != note:
         (assets / PLOTLY_NOTE).write_text(note)
     for name in OWN_ASSETS:
@@ -486,10 +630,16 @@ def _inline(text: str) -> str:
 def _table(header: tuple[str, ...], rows: tuple[tuple[str, ...], ...], cls: str = "") -> str:
     head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
     verdicts = {"yes": "yes", "pass": "yes", "no": "no", "FAIL": "no"}
-    body = "".join("<tr>" + "".join((f"<td class='{verdicts[c]}'>" if c in verdicts else "<td>") + f"{_inline(c)}</td>"
-                                    for c in r) + "</tr>" for r in rows)
-    return (f"<div class='table-wrap'><table class='{cls}'><thead><tr>{head}</tr></thead>"
-            f"<tbody>{body}</tbody></table></div>")
+    body = "".join(
+        "<tr>"
+        + "".join((f"<td class='{verdicts[c]}'>" if c in verdicts else "<td>") + f"{_inline(c)}</td>" for c in r)
+        + "</tr>"
+        for r in rows
+    )
+    return (
+        f"<div class='table-wrap'><table class='{cls}'><thead><tr>{head}</tr></thead>"
+        f"<tbody>{body}</tbody></table></div>"
+    )
 
 
 def _blocks_html(blocks) -> str:
@@ -519,12 +669,14 @@ def _json(value: Any) -> str:
 def counts_text(c: dict[str, int], kind: str) -> str:
     """'80 trials: 80 done, 0 failed, 0 left (12 infeasible)'."""
     what = "trials" if kind == "optimization" else "designs"
-    return (f"{c['total']} {what}: {c['done']} done, {c['failed']} failed, {c['left']} left"
-            + (f" ({c['infeasible']} infeasible)" if c["infeasible"] else ""))
+    return f"{c['total']} {what}: {c['done']} done, {c['failed']} failed, {c['left']} left" + (
+        f" ({c['infeasible']} infeasible)" if c["infeasible"] else ""
+    )
 
 
-def explorer_html(out: StudyOutcome, data: dict[str, Any], figures: dict[str, Any], paper_figures: list[Path],
-                  live: bool = False) -> str:
+def explorer_html(
+    out: StudyOutcome, data: dict[str, Any], figures: dict[str, Any], paper_figures: list[Path], live: bool = False
+) -> str:
     """The page: the answer first (counts, conclusion, best designs, the main figure, the
     targets' verdicts), then the views to explore, the table, failures, the study file
     (collapsed) and the figures for papers; `live`: it reloads itself every REFRESH_S seconds while
@@ -538,22 +690,35 @@ def explorer_html(out: StudyOutcome, data: dict[str, Any], figures: dict[str, An
     conclusion = "".join(f"<p>{_inline(p.strip())}</p>" for p in out.report.conclusion.split("\n\n") if p.strip())
     running = " <span class='live'>(running: this page reloads as designs arrive)</span>" if refresh else ""
     main = figures.get("main")
-    main_title = {"pareto": "Pareto front of the objectives", "heat": "Heat map",
-                  "metric": "Metrics against the parameters"}.get(main or "", "")
+    main_title = {
+        "pareto": "Pareto front of the objectives",
+        "heat": "Heat map",
+        "metric": "Metrics against the parameters",
+    }.get(main or "", "")
     targets = R._targets(out)
-    targets = [b for b in targets if b.kind != "h2" and not (b.kind == "h3" and b.text == "Conclusion")
-               and not (b.kind == "p" and out.report.conclusion and b.text.strip() in out.report.conclusion)]
+    targets = [
+        b
+        for b in targets
+        if b.kind != "h2"
+        and not (b.kind == "h3" and b.text == "Conclusion")
+        and not (b.kind == "p" and out.report.conclusion and b.text.strip() in out.report.conclusion)
+    ]
     failures = R._failures(out)
     definition = R._definition(out)
-    paper = "".join(f"<li><a href='{html.escape(_relative(out.folder, p))}'>{html.escape(p.name)}</a></li>"
-                    for p in paper_figures)
+    paper = "".join(
+        f"<li><a href='{html.escape(_relative(out.folder, p))}'>{html.escape(p.name)}</a></li>" for p in paper_figures
+    )
     parts = [
-        "<!DOCTYPE html>", "<html lang='en'><head><meta charset='utf-8'>", refresh,
+        "<!DOCTYPE html>",
+        "<html lang='en'><head><meta charset='utf-8'>",
+        refresh,
         "<meta name='viewport' content='width=device-width, initial-scale=1'>",
         f"<title>{html.escape(title)}</title>",
         f"<link rel='stylesheet' href='{ASSETS}/explorer.css'>",
-        f"<script src='{ASSETS}/{PLOTLY_JS}'></script>", "</head><body>",
-        "<header>", f"<h1>{html.escape(title)}</h1>",
+        f"<script src='{ASSETS}/{PLOTLY_JS}'></script>",
+        "</head><body>",
+        "<header>",
+        f"<h1>{html.escape(title)}</h1>",
         f"<p class='counts'><span id='counts'>{html.escape(counts_text(c, out.kind))}</span>{running}. "
         f"Made by granplate {html.escape(gp.__version__)}; the whole table is "
         f"<code>{'trials.csv' if out.kind == 'optimization' else 'results.csv'}</code>; "
@@ -563,10 +728,15 @@ def explorer_html(out: StudyOutcome, data: dict[str, Any], figures: dict[str, An
         "<section id='answer'>",
         "<div class='answer-text'>",
         (f"<div id='conclusion' class='conclusion'><h2>Conclusion</h2>{conclusion}</div>" if conclusion else ""),
-        "<h2>Best designs</h2><div id='best'></div>", "</div>",
+        "<h2>Best designs</h2><div id='best'></div>",
+        "</div>",
         f"<div class='answer-plot'><h2>{main_title}</h2>",
-        ("<div class='heat-choice'><label>metric <select id='heat-metric'></select></label> "
-         "<label id='heat-slice-label'>slice <select id='heat-slice'></select></label></div>" if main == "heat" else ""),
+        (
+            "<div class='heat-choice'><label>metric <select id='heat-metric'></select></label> "
+            "<label id='heat-slice-label'>slice <select id='heat-slice'></select></label></div>"
+            if main == "heat"
+            else ""
+        ),
         "<div id='fig-main' class='plot main-plot'></div></div>",
         "</section>",
         (f"<section id='targets'><h2>Targets</h2>{_blocks_html(targets)}</section>" if targets else ""),
@@ -574,21 +744,36 @@ def explorer_html(out: StudyOutcome, data: dict[str, Any], figures: dict[str, An
         "<div class='filterbar'><span id='shown'></span> <label><input type='checkbox' id='only-feasible'> "
         "feasible only</label> <label><input type='checkbox' id='only-front'> on the front only</label> "
         "<button id='reset' type='button'>show all</button></div>",
-        ("<h3>Parallel coordinates: parameters to objectives</h3><div id='fig-parcoords' class='plot'></div>"
-         if figures.get("parcoords") else ""),
-        ("<h3>Metrics against the parameters</h3><label>metric <select id='metric-choice'></select></label>"
-         "<div id='fig-metric' class='plot'></div>" if figures.get("metric") else ""),
-        ("<h3>Heat maps</h3><label>metric <select id='heat-metric'></select></label> "
-         "<label id='heat-slice-label'>slice <select id='heat-slice'></select></label>"
-         "<div id='fig-heat' class='plot'></div>" if figures.get("heat") and main != "heat" else ""),
+        (
+            "<h3>Parallel coordinates: parameters to objectives</h3><div id='fig-parcoords' class='plot'></div>"
+            if figures.get("parcoords")
+            else ""
+        ),
+        (
+            "<h3>Metrics against the parameters</h3><label>metric <select id='metric-choice'></select></label>"
+            "<div id='fig-metric' class='plot'></div>"
+            if figures.get("metric")
+            else ""
+        ),
+        (
+            "<h3>Heat maps</h3><label>metric <select id='heat-metric'></select></label> "
+            "<label id='heat-slice-label'>slice <select id='heat-slice'></select></label>"
+            "<div id='fig-heat' class='plot'></div>"
+            if figures.get("heat") and main != "heat"
+            else ""
+        ),
         "<h3>Designs</h3><p class='hint'>Click a column to sort, a row for the design's panel.</p>",
         "<div class='table-wrap' id='table-wrap'><table id='designs'></table></div>",
         "</section>",
         f"<section id='failures'>{_blocks_html(failures)}</section>",
         f"<details id='study'><summary>The study: its definition and the study file as run</summary>"
         f"{_blocks_html(definition)}</details>",
-        (f"<details id='paper-figures'><summary>Figures for papers (PNG, PDF)</summary><ul>{paper}</ul>"
-         "<p>and the same page as Markdown: <a href='report.md'>report.md</a>.</p></details>" if paper else ""),
+        (
+            f"<details id='paper-figures'><summary>Figures for papers (PNG, PDF)</summary><ul>{paper}</ul>"
+            "<p>and the same page as Markdown: <a href='report.md'>report.md</a>.</p></details>"
+            if paper
+            else ""
+        ),
         "<aside id='panel' class='panel' hidden></aside>",
         f"<script id='study-data' type='application/json'>{_json(data)}</script>",
         f"<script id='study-figures' type='application/json'>{_json(figures)}</script>",
@@ -598,16 +783,20 @@ def explorer_html(out: StudyOutcome, data: dict[str, Any], figures: dict[str, An
     return "\n".join(p for p in parts if p) + "\n"
 
 
-def write_explorer(out: StudyOutcome, design_figures: dict[int, list[tuple[str, Path]]] | None = None,
-                   paper_figures: list[Path] | None = None, live: bool = False, page: Path | None = None) -> Path:
+def write_explorer(
+    out: StudyOutcome,
+    design_figures: dict[int, list[tuple[str, Path]]] | None = None,
+    paper_figures: list[Path] | None = None,
+    live: bool = False,
+    page: Path | None = None,
+) -> Path:
     """Write the page (DIR/report.html unless `page`) and its assets folder beside it; the
     page (rewritten only when its text changes)."""
     from granplate.store import atomic_write
 
     page = Path(page) if page is not None else out.folder / "report.html"
     copy_assets(page.parent)
-    text = explorer_html(out, explorer_data(out, design_figures), explorer_figures(out), paper_figures or [],
-                         live)
+    text = explorer_html(out, explorer_data(out, design_figures), explorer_figures(out), paper_figures or [], live)
     if not (page.is_file() and page.read_text() == text):
         atomic_write(page, lambda tmp: tmp.write_text(text))
     return page

@@ -23,6 +23,7 @@ from Optuna 5 on, the sampler's `constraints_func` before (deprecated in 5); an
 infeasible trial is complete but marked infeasible, and the Pareto front is that of the
 feasible trials.
 """
+
 from __future__ import annotations
 
 import csv
@@ -107,11 +108,13 @@ def distribution(field: str, spec: Any):
                 raise ScenarioError(f"{where}[{k}]", v, "expected a number, a string or true/false")
         return CategoricalDistribution(spec)
     if not isinstance(spec, dict) or "range" not in spec:
-        raise ScenarioError(where, spec, "to optimize: a list of values (categorical) or "
-                            "{range = [a, b], log = false} (continuous)")
+        raise ScenarioError(
+            where, spec, "to optimize: a list of values (categorical) or {range = [a, b], log = false} (continuous)"
+        )
     if "num" in spec:
-        raise ScenarioError(f"{where}.num", spec["num"], "not used by optimize: a range is searched "
-                            "continuously (remove num)")
+        raise ScenarioError(
+            f"{where}.num", spec["num"], "not used by optimize: a range is searched continuously (remove num)"
+        )
     ends = range_values(where, {**spec, "num": 2})  # checks the range and log
     log = bool(spec.get("log", False))
     if all(isinstance(e, int) and not isinstance(e, bool) for e in spec["range"]):
@@ -127,8 +130,9 @@ def parse_optimization(doc: dict, folder: str | os.PathLike = ".") -> Optimizati
     raw, fixed = base_and_fixed(doc, folder)
     parameters = doc.get("parameters", {})
     if not isinstance(parameters, dict) or not parameters:
-        raise ScenarioError("parameters", parameters, "expected a table of dotted path = list or "
-                            "{range = [a, b]}, at least one")
+        raise ScenarioError(
+            "parameters", parameters, "expected a table of dotted path = list or {range = [a, b]}, at least one"
+        )
     space = {f: distribution(f, spec) for f, spec in parameters.items()}
     for f in space:
         if f in fixed:
@@ -136,8 +140,11 @@ def parse_optimization(doc: dict, folder: str | os.PathLike = ".") -> Optimizati
     objectives = doc.get("objectives")
     units = D.metric_units()
     if not isinstance(objectives, dict) or not objectives:
-        raise ScenarioError("objectives", objectives, "expected a table of metric = \"minimize\" | "
-                            "\"maximize\", at least one; metrics: " + ", ".join(units))
+        raise ScenarioError(
+            "objectives",
+            objectives,
+            'expected a table of metric = "minimize" | "maximize", at least one; metrics: ' + ", ".join(units),
+        )
     for name, direction in objectives.items():
         if name not in units:
             raise ScenarioError(f"objectives.{name}", direction, "unknown metric; allowed: " + ", ".join(units))
@@ -166,6 +173,7 @@ def load_optimization(path: str | os.PathLike, changes: dict[str, Value] | None 
 
 
 # ------------------------------------------------------------------------- the search
+
 
 def objective_values(opt: Optimization, record: dict) -> list[float] | None:
     """The objectives of a design's record, or None when it failed or one is missing."""
@@ -203,16 +211,23 @@ def open_study(opt: Optimization, out: Path, seed: int):
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     by_sampler = bool(opt.constraints) and not trial_constraints()
     sampler = optuna.samplers.TPESampler(seed=seed, constraints_func=stored_constraints if by_sampler else None)
-    study = optuna.create_study(storage=f"sqlite:///{out / DATABASE}", study_name=STUDY_NAME,
-                                directions=list(opt.objectives.values()), load_if_exists=True,
-                                sampler=sampler)
+    study = optuna.create_study(
+        storage=f"sqlite:///{out / DATABASE}",
+        study_name=STUDY_NAME,
+        directions=list(opt.objectives.values()),
+        load_if_exists=True,
+        sampler=sampler,
+    )
     for name, value in (("objectives", list(opt.objectives)), ("constraints", constraint_texts(opt))):
         stored = study.user_attrs.get(name)
         if stored is None:
             study.set_user_attr(name, value)
         elif stored != value:
-            raise ScenarioError(name, value, f"{out / DATABASE} was made with {name} {stored}: use "
-                                f"another --out folder for other {name}")
+            raise ScenarioError(
+                name,
+                value,
+                f"{out / DATABASE} was made with {name} {stored}: use another --out folder for other {name}",
+            )
     return study
 
 
@@ -232,8 +247,11 @@ def finished(study) -> int:
     (not those an interruption cut short, whose parameters run again)."""
     from optuna.trial import TrialState
 
-    return sum(1 for t in study.get_trials(deepcopy=False, states=(TrialState.COMPLETE, TrialState.FAIL))
-               if "status" in t.user_attrs)
+    return sum(
+        1
+        for t in study.get_trials(deepcopy=False, states=(TrialState.COMPLETE, TrialState.FAIL))
+        if "status" in t.user_attrs
+    )
 
 
 def tell(study, opt: Optimization, trial, record: dict) -> bool:
@@ -258,9 +276,17 @@ def tell(study, opt: Optimization, trial, record: dict) -> bool:
     return True
 
 
-def optimize(opt: Optimization, out: str | Path, trials: int, *, client=None,
-             workers: int | None = None, scheduler: str | None = None, seed: int = 0,
-             progress: bool = True) -> OptimizeReport:
+def optimize(
+    opt: Optimization,
+    out: str | Path,
+    trials: int,
+    *,
+    client=None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    seed: int = 0,
+    progress: bool = True,
+) -> OptimizeReport:
     """Run the Optuna study in out/optuna.db until it has `trials` finished trials (those
     of earlier runs count), the designs on Dask; then write trials.csv, pareto.csv and
     pareto.png."""
@@ -274,7 +300,7 @@ def optimize(opt: Optimization, out: str | Path, trials: int, *, client=None,
     report = OptimizeReport(trials, finished(study), out=out)
     try:
         if report.n_before < trials:
-            with (dask_client(workers, scheduler) if client is None else nullcontext(client)) as c:
+            with dask_client(workers, scheduler) if client is None else nullcontext(client) as c:
                 report.warm_up_s = warm_workers(c, gp.dumps(opt.scenario({})))
                 _search(c, study, opt, out, trials, progress, report)
     finally:
@@ -283,8 +309,7 @@ def optimize(opt: Optimization, out: str | Path, trials: int, *, client=None,
     return report
 
 
-def _search(client, study, opt: Optimization, out: Path, trials: int, progress: bool,
-            report: OptimizeReport) -> None:
+def _search(client, study, opt: Optimization, out: Path, trials: int, progress: bool, report: OptimizeReport) -> None:
     """Keep one trial per worker thread in flight until `trials` are finished."""
     from distributed import as_completed
 
@@ -321,8 +346,7 @@ def _search(client, study, opt: Optimization, out: Path, trials: int, progress: 
                     report.n_reused += 1
                     finish(trial, record)
                     continue
-                fut = client.submit(D.run_design, text, False, key=f"trial-{trial.number}-{key}",
-                                    pure=False)
+                fut = client.submit(D.run_design, text, False, key=f"trial-{trial.number}-{key}", pure=False)
                 running[fut] = (trial, key, text, {**opt.fixed, **changes})
                 pending.add(fut)
             if not running:
@@ -354,29 +378,40 @@ def _search(client, study, opt: Optimization, out: Path, trials: int, progress: 
 
 # ------------------------------------------------------------------------- outputs
 
+
 def constrained_only(opt: Optimization) -> list[str]:
     """The constrained metrics that are not objectives (their own columns in the CSVs)."""
     return list(dict.fromkeys(b.metric for b in opt.constraints if b.metric not in opt.objectives))
 
 
 def feasible_text(trial) -> str:
-    """"yes" / "no" for a completed trial of a constrained study, "" otherwise."""
+    """ "yes" / "no" for a completed trial of a constrained study, "" otherwise."""
     ok = is_feasible(trial.user_attrs.get("constraints")) if trial.values is not None else None
     return "" if ok is None else ("yes" if ok else "no")
 
 
 def _rows(study, opt: Optimization, trials) -> tuple[list[str], list[list[Any]]]:
     extra = constrained_only(opt)
-    header = (["trial", "state"] + list(opt.space) + list(opt.objectives) + extra
-              + (["feasible"] if opt.constraints else []) + ["status", "key"])
+    header = (
+        ["trial", "state"]
+        + list(opt.space)
+        + list(opt.objectives)
+        + extra
+        + (["feasible"] if opt.constraints else [])
+        + ["status", "key"]
+    )
     rows = []
     for t in trials:
         values = list(t.values) if t.values is not None else [None] * len(opt.objectives)
         constrained = t.user_attrs.get("constrained", {})
-        rows.append([t.number, t.state.name] + [t.params.get(f) for f in opt.space] + values
-                    + [constrained.get(m) for m in extra]
-                    + ([feasible_text(t)] if opt.constraints else [])
-                    + [t.user_attrs.get("status", ""), t.user_attrs.get("key", "")])
+        rows.append(
+            [t.number, t.state.name]
+            + [t.params.get(f) for f in opt.space]
+            + values
+            + [constrained.get(m) for m in extra]
+            + ([feasible_text(t)] if opt.constraints else [])
+            + [t.user_attrs.get("status", ""), t.user_attrs.get("key", "")]
+        )
     return header, rows
 
 
@@ -456,21 +491,26 @@ def plot_front(opt: Optimization, complete: list, front: list, path: Path) -> No
     bad = [t for t in complete if feasible_text(t) == "no"]
     complete = [t for t in complete if feasible_text(t) != "no"]
     if len(names) >= 2:
-        ax.scatter([t.values[0] for t in complete], [t.values[1] for t in complete], s=14,
-                   color="0.7", label="trials")
+        ax.scatter([t.values[0] for t in complete], [t.values[1] for t in complete], s=14, color="0.7", label="trials")
         if bad:
-            ax.scatter([t.values[0] for t in bad], [t.values[1] for t in bad], s=18, marker="x",
-                       color="0.45", label="infeasible (constraints)")
+            ax.scatter(
+                [t.values[0] for t in bad],
+                [t.values[1] for t in bad],
+                s=18,
+                marker="x",
+                color="0.45",
+                label="infeasible (constraints)",
+            )
         pts = sorted((t.values[0], t.values[1]) for t in front)
         ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", color="C3", ms=5, label="Pareto front")
         ax.set_xlabel(f"{axis_label(names[0])} ({opt.objectives[names[0]]})")
         ax.set_ylabel(f"{axis_label(names[1])} ({opt.objectives[names[1]]})")
     else:
-        ax.plot([t.number for t in complete], [t.values[0] for t in complete], "o", color="0.6",
-                ms=4, label="trials")
+        ax.plot([t.number for t in complete], [t.values[0] for t in complete], "o", color="0.6", ms=4, label="trials")
         if bad:
-            ax.plot([t.number for t in bad], [t.values[0] for t in bad], "x", color="0.45",
-                    label="infeasible (constraints)")
+            ax.plot(
+                [t.number for t in bad], [t.values[0] for t in bad], "x", color="0.45", label="infeasible (constraints)"
+            )
         ax.plot([t.number for t in front], [t.values[0] for t in front], "o", color="C3", label="best")
         ax.set_xlabel("trial")
         ax.set_ylabel(f"{axis_label(names[0])} ({opt.objectives[names[0]]})")

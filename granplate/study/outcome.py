@@ -7,6 +7,7 @@ file as it was run, DIR/study.toml (written by `granplate sweep` and `granplate
 optimize`), from which the report takes the definition, the objectives, the
 constraints and the [report] table.
 """
+
 from __future__ import annotations
 
 import csv
@@ -131,9 +132,20 @@ def _metrics_of(summaries: list[dict]) -> tuple[list[str], dict[str, str]]:
     return names, units
 
 
-def _sweep_outcome(folder: Path, doc: dict, names: tuple[str, ...], numbers: list[int],
-                   params: list[dict[str, Any]], table: list[dict[str, Any]], statuses: list[str],
-                   keys: list[str], units: dict[str, str], base: str, fixed: dict, version: str) -> StudyOutcome:
+def _sweep_outcome(
+    folder: Path,
+    doc: dict,
+    names: tuple[str, ...],
+    numbers: list[int],
+    params: list[dict[str, Any]],
+    table: list[dict[str, Any]],
+    statuses: list[str],
+    keys: list[str],
+    units: dict[str, str],
+    base: str,
+    fixed: dict,
+    version: str,
+) -> StudyOutcome:
     """A sweep's outcome from its table's columns: each design's metrics from its record in
     DIR/designs, else (a folder kept without its records) the table's own values."""
     summaries = []
@@ -143,10 +155,11 @@ def _sweep_outcome(folder: Path, doc: dict, names: tuple[str, ...], numbers: lis
             s = {m: v for m, v in values.items() if v is not None}
         summaries.append(s)
     metrics, metric_units = _metrics_of(summaries)
-    rows = [Row(numbers[i], params[i], {m: summaries[i].get(m) for m in metrics}, statuses[i], keys[i])
-            for i in range(len(keys))]
-    return StudyOutcome(folder, "sweep", base, fixed, names, rows, metrics, {**metric_units, **units},
-                        version=version)
+    rows = [
+        Row(numbers[i], params[i], {m: summaries[i].get(m) for m in metrics}, statuses[i], keys[i])
+        for i in range(len(keys))
+    ]
+    return StudyOutcome(folder, "sweep", base, fixed, names, rows, metrics, {**metric_units, **units}, version=version)
 
 
 def _read_sweep(folder: Path, doc: dict) -> StudyOutcome:
@@ -159,14 +172,25 @@ def _read_sweep(folder: Path, doc: dict) -> StudyOutcome:
     keys = [str(k) for k in ds["key"].values]
     columns = [v for v in ds.data_vars if v not in names and v not in ("status", "key")]
     n = ds.sizes["design"]
-    table = [{m: (None if isinstance(v := ds[m].values[i].item(), float) and np.isnan(v) else v)
-              for m in columns} for i in range(n)]
+    table = [
+        {m: (None if isinstance(v := ds[m].values[i].item(), float) and np.isnan(v) else v) for m in columns}
+        for i in range(n)
+    ]
     units = {n_: ds[n_].attrs["units"] for n_ in names if "units" in ds[n_].attrs}
-    return _sweep_outcome(folder, doc, names, [int(d) for d in ds["design"].values],
-                          [{n_: ds[n_].values[i].item() for n_ in names} for i in range(n)], table,
-                          [str(s) for s in ds["status"].values], keys, units,
-                          str(ds.attrs.get("base", doc.get("base", ""))), json.loads(ds.attrs.get("fixed", "{}")),
-                          str(ds.attrs.get("granplate_version", "")))
+    return _sweep_outcome(
+        folder,
+        doc,
+        names,
+        [int(d) for d in ds["design"].values],
+        [{n_: ds[n_].values[i].item() for n_ in names} for i in range(n)],
+        table,
+        [str(s) for s in ds["status"].values],
+        keys,
+        units,
+        str(ds.attrs.get("base", doc.get("base", ""))),
+        json.loads(ds.attrs.get("fixed", "{}")),
+        str(ds.attrs.get("granplate_version", "")),
+    )
 
 
 def _read_sweep_csv(folder: Path, doc: dict) -> StudyOutcome:
@@ -183,11 +207,20 @@ def _read_sweep_csv(folder: Path, doc: dict) -> StudyOutcome:
     col = {h: j for j, h in enumerate(header)}
     metrics = [h for h in header[end:] if h not in ("status", "key")]
     units = {n: u for n in names if (u := field_unit(n))}
-    return _sweep_outcome(folder, doc, names, [int(r[0]) for r in body],
-                          [{n: _value(r[col[n]]) for n in names} for r in body],
-                          [{m: (_value(r[col[m]]) if r[col[m]] != "" else None) for m in metrics} for r in body],
-                          [r[col["status"]] for r in body], [r[col["key"]] for r in body], units,
-                          str(doc.get("base", "")), dict(doc.get("set", {})), "")
+    return _sweep_outcome(
+        folder,
+        doc,
+        names,
+        [int(r[0]) for r in body],
+        [{n: _value(r[col[n]]) for n in names} for r in body],
+        [{m: (_value(r[col[m]]) if r[col[m]] != "" else None) for m in metrics} for r in body],
+        [r[col["status"]] for r in body],
+        [r[col["key"]] for r in body],
+        units,
+        str(doc.get("base", "")),
+        dict(doc.get("set", {})),
+        "",
+    )
 
 
 def _read_live_sweep(folder: Path, doc: dict) -> StudyOutcome:
@@ -201,9 +234,20 @@ def _read_live_sweep(folder: Path, doc: dict) -> StudyOutcome:
     keys = [D.design_key(gp.dumps(study.scenario(i))) for i in range(len(study.designs))]
     records = [D.read_record(folder, k) for k in keys]
     units = {n: u for n in study.names if (u := field_unit(n))}
-    return _sweep_outcome(folder, doc, tuple(study.names), list(range(len(keys))),
-                          [dict(zip(study.names, d)) for d in study.designs], [{} for _ in keys],
-                          [status_of(r) for r in records], keys, units, study.base_name, dict(study.fixed), "")
+    return _sweep_outcome(
+        folder,
+        doc,
+        tuple(study.names),
+        list(range(len(keys))),
+        [dict(zip(study.names, d)) for d in study.designs],
+        [{} for _ in keys],
+        [status_of(r) for r in records],
+        keys,
+        units,
+        study.base_name,
+        dict(study.fixed),
+        "",
+    )
 
 
 def _read_trials(folder: Path, doc: dict) -> StudyOutcome:
@@ -229,11 +273,18 @@ def _read_trials(folder: Path, doc: dict) -> StudyOutcome:
         state = r[col["state"]]
         status = r[col["status"]] or ("not run" if state != "COMPLETE" else "ok")
         feasible = {"yes": True, "no": False}.get(r[col["feasible"]]) if "feasible" in col else None
-        rows.append(Row(int(r[0]), {n: _value(r[col[n]]) for n in names if r[col[n]] != ""},
-                        {m: s.get(m) for m in metrics} if s else {}, status, k, feasible))
+        rows.append(
+            Row(
+                int(r[0]),
+                {n: _value(r[col[n]]) for n in names if r[col[n]] != ""},
+                {m: s.get(m) for m in metrics} if s else {},
+                status,
+                k,
+                feasible,
+            )
+        )
     fixed = dict(doc.get("set", {}))
-    return StudyOutcome(folder, "optimization", str(doc.get("base", "")), fixed, names, rows,
-                        metrics, units)
+    return StudyOutcome(folder, "optimization", str(doc.get("base", "")), fixed, names, rows, metrics, units)
 
 
 def _read_table(folder: Path, doc: dict) -> StudyOutcome:
@@ -244,8 +295,11 @@ def _read_table(folder: Path, doc: dict) -> StudyOutcome:
         return _read_sweep(folder, doc)
     if (folder / SWEEP_CSV).is_file():
         return _read_sweep_csv(folder, doc)
-    raise ScenarioError("study folder", str(folder), f"no {SWEEP_TABLE} (granplate sweep) nor "
-                        f"{TRIALS_TABLE} (granplate optimize): run a study into it first")
+    raise ScenarioError(
+        "study folder",
+        str(folder),
+        f"no {SWEEP_TABLE} (granplate sweep) nor {TRIALS_TABLE} (granplate optimize): run a study into it first",
+    )
 
 
 def read_outcome(folder: str | Path, live: bool = False) -> StudyOutcome:
@@ -269,11 +323,21 @@ def read_outcome(folder: str | Path, live: bool = False) -> StudyOutcome:
     out.study_text = text
     out.log_parameters = log_parameters(doc.get("parameters"))
     if out.constraints:  # a sweep's designs are judged here; a trial's verdict is Optuna's
-        out.rows = [r if r.feasible is not None or not r.metrics else
-                    Row(r.number, r.params, r.metrics, r.status, r.key,
-                        is_feasible(violations(out.constraints, r.metrics)) if r.ok else None)
-                    for r in out.rows]
+        out.rows = [
+            r
+            if r.feasible is not None or not r.metrics
+            else Row(
+                r.number,
+                r.params,
+                r.metrics,
+                r.status,
+                r.key,
+                is_feasible(violations(out.constraints, r.metrics)) if r.ok else None,
+            )
+            for r in out.rows
+        ]
     if not out.version:
-        out.version = next((str(rec["granplate_version"]) for r in out.rows
-                            if r.key and (rec := D.read_record(folder, r.key))), "")
+        out.version = next(
+            (str(rec["granplate_version"]) for r in out.rows if r.key and (rec := D.read_record(folder, r.key))), ""
+        )
     return out

@@ -7,6 +7,7 @@ parameter spaced with `log = true` is drawn on a log axis.
 Figures are `matplotlib.figure.Figure` objects on the Agg canvas (granplate.figures.common);
 the drawn quantities carry a `gid` naming them, for the tests.
 """
+
 from __future__ import annotations
 
 import itertools
@@ -117,7 +118,7 @@ def varied(out: StudyOutcome) -> list[str]:
 
 def companions(out: StudyOutcome, name: str) -> list[str]:
     """The parameters that vary together with `name` (after it in the study)."""
-    later = out.names[out.names.index(name) + 1:]
+    later = out.names[out.names.index(name) + 1 :]
     return [n for n in later if len(distinct(out.values(n))) > 1 and tied(out, name, n)]
 
 
@@ -169,8 +170,7 @@ def fig_metric(out: StudyOutcome, metric: str) -> Figure:
         if grid and others:
             # one line per combination of the others, coloured by the one with fewest values
             # (a named choice, such as a material, before a number)
-            hue = min(others, key=lambda n: (len(distinct(out.values(n))), is_numeric(out.values(n)),
-                                             others.index(n)))
+            hue = min(others, key=lambda n: (len(distinct(out.values(n))), is_numeric(out.values(n)), others.index(n)))
             colours = {str(v): f"C{k % 10}" for k, v in enumerate(distinct(out.values(hue)))}
             groups: dict[tuple, list[int]] = {}
             for i, r in enumerate(out.rows):
@@ -179,25 +179,45 @@ def fig_metric(out: StudyOutcome, metric: str) -> Figure:
             for g, idx in groups.items():
                 idx = sorted(idx, key=lambda i: x[i])
                 value = str(g[others.index(hue)])
-                text = (f"{hue.rsplit('.', 1)[-1]} = {_with_unit(out, hue, g[others.index(hue)])}"
-                        if value not in named else None)
+                text = (
+                    f"{hue.rsplit('.', 1)[-1]} = {_with_unit(out, hue, g[others.index(hue)])}"
+                    if value not in named
+                    else None
+                )
                 named.add(value)
-                ax.plot(x[idx], y[idx], "o-", ms=3, lw=1, color=colours[value], alpha=0.8, label=text,
-                        gid=f"{metric}-vs-{name}")
+                ax.plot(
+                    x[idx],
+                    y[idx],
+                    "o-",
+                    ms=3,
+                    lw=1,
+                    color=colours[value],
+                    alpha=0.8,
+                    label=text,
+                    gid=f"{metric}-vs-{name}",
+                )
             if len(colours) <= MAX_LEGEND:
                 ax.legend(fontsize=6, loc="best")
         else:
             ok = ~infeasible
             ax.plot(x[ok], y[ok], "o", ms=4, color="C0", gid=f"{metric}-vs-{name}")
         if infeasible.any():
-            ax.plot(x[infeasible], y[infeasible], "x", ms=5, color="0.4", label="infeasible",
-                    gid=f"{metric}-vs-{name}-infeasible")
+            ax.plot(
+                x[infeasible],
+                y[infeasible],
+                "x",
+                ms=5,
+                color="0.4",
+                label="infeasible",
+                gid=f"{metric}-vs-{name}-infeasible",
+            )
         _x_axis(ax, out, name, levels)
         ax.set_ylabel(label(out, metric), fontsize=8)
         ax.tick_params(labelsize=7)
         ax.grid(True, lw=0.3, alpha=0.5)
-    fig.suptitle(f"{metric} against the parameters ({sum(np.isfinite(y))} of {len(y)} designs with a value)",
-                 fontsize=9)
+    fig.suptitle(
+        f"{metric} against the parameters ({sum(np.isfinite(y))} of {len(y)} designs with a value)", fontsize=9
+    )
     return fig
 
 
@@ -207,8 +227,7 @@ def heat_axes(out: StudyOutcome) -> tuple[str, str, list[str]] | None:
     names = varied(out)
     if len(names) < 2 or not is_grid(out, tuple(names)):
         return None
-    ranked = sorted(names, key=lambda n: (-len(distinct(out.values(n))), not is_numeric(out.values(n)),
-                                          names.index(n)))
+    ranked = sorted(names, key=lambda n: (-len(distinct(out.values(n))), not is_numeric(out.values(n)), names.index(n)))
     x, y = ranked[0], ranked[1]
     return x, y, [n for n in names if n not in (x, y)]
 
@@ -260,21 +279,32 @@ def fig_heatmap(out: StudyOutcome, metric: str) -> Figure | None:
         z = np.full((len(yl), len(xl)), np.nan)
         for i, r in enumerate(out.rows):
             if all(str(r.params.get(n)) == str(v) for n, v in zip(others, combo)):
-                z[[str(v) for v in yl].index(str(r.params.get(yn))),
-                  [str(v) for v in xl].index(str(r.params.get(xn)))] = values[i]
-        image = ax.imshow(z, origin="lower", aspect="auto", cmap="viridis", vmin=lo, vmax=hi,
-                          gid=f"heatmap-{metric}")
+                z[
+                    [str(v) for v in yl].index(str(r.params.get(yn))), [str(v) for v in xl].index(str(r.params.get(xn)))
+                ] = values[i]
+        image = ax.imshow(z, origin="lower", aspect="auto", cmap="viridis", vmin=lo, vmax=hi, gid=f"heatmap-{metric}")
         for (a, b), v in np.ndenumerate(z):
-            ax.text(b, a, _cell_text(v), ha="center", va="center", fontsize=HEAT_FONT,
-                    color="w" if np.isfinite(v) and v < (lo + hi) / 2 else "k", gid=f"cell-{metric}")
-        ax.set_xticks(range(len(xl)), [_tick(v) for v in scaled_values(out, xn, xl)], fontsize=HEAT_FONT,
-                      rotation=30 if len(xl) > 6 else 0)
+            ax.text(
+                b,
+                a,
+                _cell_text(v),
+                ha="center",
+                va="center",
+                fontsize=HEAT_FONT,
+                color="w" if np.isfinite(v) and v < (lo + hi) / 2 else "k",
+                gid=f"cell-{metric}",
+            )
+        ax.set_xticks(
+            range(len(xl)),
+            [_tick(v) for v in scaled_values(out, xn, xl)],
+            fontsize=HEAT_FONT,
+            rotation=30 if len(xl) > 6 else 0,
+        )
         ax.set_yticks(range(len(yl)), [_tick(v) for v in scaled_values(out, yn, yl)], fontsize=HEAT_FONT)
         ax.set_xlabel(label(out, xn), fontsize=HEAT_FONT)
         ax.set_ylabel(label(out, yn), fontsize=HEAT_FONT)
         if others:
-            ax.set_title("\n".join(f"{n} = {_with_unit(out, n, v)}" for n, v in zip(others, combo)),
-                         fontsize=HEAT_FONT)
+            ax.set_title("\n".join(f"{n} = {_with_unit(out, n, v)}" for n, v in zip(others, combo)), fontsize=HEAT_FONT)
     for k in range(len(combos), nrow * ncol):
         grid[k // ncol][k % ncol].set_visible(False)
     if image is not None:
@@ -309,8 +339,14 @@ def fig_pareto(out: StudyOutcome, front: list[int], chosen: dict[str, int]) -> F
     bad = [i for i in done if out.rows[i].feasible is False]
     ax.scatter(*zip(*[xy(i) for i in ok]) if ok else ([], []), s=14, color="0.6", label="trials", gid="trials")
     if bad:
-        ax.scatter(*zip(*[xy(i) for i in bad]), s=22, marker="x", color="0.35",
-                   label="infeasible (constraints)", gid="infeasible")
+        ax.scatter(
+            *zip(*[xy(i) for i in bad]),
+            s=22,
+            marker="x",
+            color="0.35",
+            label="infeasible (constraints)",
+            gid="infeasible",
+        )
     if front:
         pts = sorted(xy(i) for i in front)
         ax.plot(*zip(*pts), "o-" if two else "o", color="C3", ms=5, label="Pareto front", gid="front")

@@ -13,6 +13,7 @@ by granplate.results.document, like the reproduction and verification pages.
     >>> from granplate.study.report import write_report
     >>> write_report("q0-r2")          # -> q0-r2/report.html, report.md, report/*.png|pdf
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -45,9 +46,16 @@ HEADLINE: tuple[str, ...] = ("ep_max_fraction", "max_von_mises", "max_von_mises_
 RUN_METRICS: tuple[str, ...] = ("t_end", "energy_residual_max", "n_steps", "wall_time_s", "compile_time_s")
 #: Metrics of the designs table besides the objectives, constraints and targets (the CSV
 #: table has them all).
-TABLE_METRICS: tuple[str, ...] = ("ep_max_fraction", "ep_final_fraction", "dissipated_fraction",
-                                  "max_von_mises", "max_von_mises_disc", "max_von_mises_nodes", "max_eps_yy",
-                                  "granular_mass")
+TABLE_METRICS: tuple[str, ...] = (
+    "ep_max_fraction",
+    "ep_final_fraction",
+    "dissipated_fraction",
+    "max_von_mises",
+    "max_von_mises_disc",
+    "max_von_mises_nodes",
+    "max_eps_yy",
+    "granular_mass",
+)
 #: Values this small [SI units] are round-off of a quantity that is zero (e_initial of a
 #: run from rest): a metric with no larger value is not drawn.
 NEGLIGIBLE = 1e-30
@@ -88,6 +96,7 @@ def shown_metrics(out: StudyOutcome) -> tuple[list[str], list[str]]:
 
 # ------------------------------------------------------------------------- choices
 
+
 def directions(out: StudyOutcome) -> dict[str, str]:
     """The objectives, else the headline metrics to minimise (those the study has)."""
     if out.objectives:
@@ -127,8 +136,7 @@ def pareto_front(out: StudyOutcome) -> list[int]:
     pts = values[rows]
     if len(names) == 2:
         return [rows[k] for k in sorted(_front_2d(pts))]
-    return [i for i, p in zip(rows, pts)
-            if not np.any(np.all(pts <= p, axis=1) & np.any(pts < p, axis=1))]
+    return [i for i, p in zip(rows, pts) if not np.any(np.all(pts <= p, axis=1) & np.any(pts < p, axis=1))]
 
 
 def _front_2d(pts: np.ndarray) -> list[int]:
@@ -246,8 +254,11 @@ def design_figures(folder: Path, key: str, progress: bool = False) -> list[tuple
     from granplate.figures import assembly, run, show, space
 
     scenario = gp.loads(ds.attrs["scenario_toml"])
-    drawing = space.draw(space.of_scenario(scenario)) if scenario.dimension == 3 else \
-        show.draw(assembly.of_scenario(scenario), width=5.0)
+    drawing = (
+        space.draw(space.of_scenario(scenario))
+        if scenario.dimension == 3
+        else show.draw(assembly.of_scenario(scenario), width=5.0)
+    )
     made = [("assembly", _save(drawing, fig_dir / f"{stem}-assembly.png"))]
     for name, fig in run.figures(ds).items():
         if name in DESIGN_FIGURES:
@@ -257,12 +268,15 @@ def design_figures(folder: Path, key: str, progress: bool = False) -> list[tuple
 
 # ------------------------------------------------------------------------- the page
 
+
 def _definition(out: StudyOutcome) -> list[Block]:
     blocks = [Block("h2", "The study")]
     rows = [("base", out.base or "-", "")]
     rows += [(f"[set] {k}", str(v), out.unit(k)) for k, v in out.fixed.items()]
-    rows += [(f"parameter {n}", ", ".join(fmt(v, out.unit(n)) for v in P.distinct(out.values(n))),
-              P.shown(out.unit(n))[1]) for n in out.names]
+    rows += [
+        (f"parameter {n}", ", ".join(fmt(v, out.unit(n)) for v in P.distinct(out.values(n))), P.shown(out.unit(n))[1])
+        for n in out.names
+    ]
     rows += [(f"objective {m}", way, P.shown(out.unit(m))[1]) for m, way in out.objectives.items()]
     rows += [("constraint", b.text(out.unit(b.metric)), "") for b in out.constraints]
     blocks.append(Block("table", header=("", "value(s)", "unit"), rows=tuple(rows)))
@@ -283,7 +297,9 @@ def _with_unit(v: Any, unit: str) -> str:
     """'4000 N/m', '15.3 MPa', 'ptfe' (no unit for a dimensionless or text value)."""
     shown_unit = P.shown(unit)[1]
     text = fmt(v, unit)
-    return text if shown_unit == "-" or not isinstance(v, (int, float)) or isinstance(v, bool) else f"{text} {shown_unit}"
+    return (
+        text if shown_unit == "-" or not isinstance(v, (int, float)) or isinstance(v, bool) else f"{text} {shown_unit}"
+    )
 
 
 def target_designs(out: StudyOutcome) -> list[int]:
@@ -311,14 +327,21 @@ def chosen_designs(out: StudyOutcome, best: dict[str, int]) -> dict[int, str]:
 
 
 def _designs_table(out: StudyOutcome, metrics: list[str], chosen: dict[str, int], front: list[int]) -> Block:
-    wanted = (set(out.objectives) | {b.metric for b in out.constraints} | set(TABLE_METRICS)
-              | {m for t in out.report.targets for m in t.metrics})
+    wanted = (
+        set(out.objectives)
+        | {b.metric for b in out.constraints}
+        | set(TABLE_METRICS)
+        | {m for t in out.report.targets for m in t.metrics}
+    )
     cols = [m for m in metrics if m in wanted]
     header = ("design",) + tuple(_head(out, n) for n in out.names) + tuple(_head(out, m) for m in cols)
     header += (("feasible",) if out.constraints else ()) + ("status",)
     first = same_design(out)
-    marks = {i: [f"best {m}" for m, j in chosen.items() if first[j] == i]
-             + (["front"] if any(first[j] == i for j in front) else []) for i in range(len(out.rows))}
+    marks = {
+        i: [f"best {m}" for m, j in chosen.items() if first[j] == i]
+        + (["front"] if any(first[j] == i for j in front) else [])
+        for i in range(len(out.rows))
+    }
     repeats = {i: sum(1 for j in first.values() if j == i) for i in set(first.values())}
     rows = []
     for i, r in enumerate(out.rows):
@@ -326,12 +349,18 @@ def _designs_table(out: StudyOutcome, metrics: list[str], chosen: dict[str, int]
             continue  # a trial of a design listed above
         if len(rows) == MAX_ROWS:
             break
-        name = str(r.number) + (f" (x{repeats[i]} trials)" if repeats[i] > 1 else "") \
+        name = (
+            str(r.number)
+            + (f" (x{repeats[i]} trials)" if repeats[i] > 1 else "")
             + (f" ({', '.join(marks[i])})" if marks[i] else "")
-        rows.append((name,) + tuple(fmt(r.params.get(n), out.unit(n)) for n in out.names)
-                    + tuple(fmt(r.metrics.get(m), out.unit(m)) for m in cols)
-                    + (({True: "yes", False: "no", None: "-"}[r.feasible],) if out.constraints else ())
-                    + ("ok" if r.ok else "failed" if r.status != "not run" else "not run",))
+        )
+        rows.append(
+            (name,)
+            + tuple(fmt(r.params.get(n), out.unit(n)) for n in out.names)
+            + tuple(fmt(r.metrics.get(m), out.unit(m)) for m in cols)
+            + (({True: "yes", False: "no", None: "-"}[r.feasible],) if out.constraints else ())
+            + ("ok" if r.ok else "failed" if r.status != "not run" else "not run",)
+        )
     return Block("table", header=header, rows=tuple(rows))
 
 
@@ -345,14 +374,21 @@ def _targets(out: StudyOutcome) -> list[Block]:
         values = [r.metrics if r.ok else {} for r in out.rows]
         rows_ = judge(t.targets, out.names, designs, values)
         keep = list(rows_[0][0]) if rows_ else []
-        lines = [f"- **{x.label}**: {' or '.join(x.metrics)} within {100 * x.within:.0f}% of "
-                 f"{fmt(x.value, out.unit(x.metrics[0]))} {P.shown(out.unit(x.metrics[0]))[1]}"
-                 + (f", for {', '.join(f'{k} = {v}' for k, v in x.where)}" if x.where else "")
-                 for x in t.targets]
-        blocks.append(Block("p", "Each row is one combination of the choices (the parameters no target "
-                                 "restricts); a target takes the design of the row that matches it, and "
-                                 "holds when its metric (the closest of its alternatives) is within the "
-                                 "tolerance:"))
+        lines = [
+            f"- **{x.label}**: {' or '.join(x.metrics)} within {100 * x.within:.0f}% of "
+            f"{fmt(x.value, out.unit(x.metrics[0]))} {P.shown(out.unit(x.metrics[0]))[1]}"
+            + (f", for {', '.join(f'{k} = {v}' for k, v in x.where)}" if x.where else "")
+            for x in t.targets
+        ]
+        blocks.append(
+            Block(
+                "p",
+                "Each row is one combination of the choices (the parameters no target "
+                "restricts); a target takes the design of the row that matches it, and "
+                "holds when its metric (the closest of its alternatives) is within the "
+                "tolerance:",
+            )
+        )
         blocks.append(Block("p", "\n".join(lines)))
         header = tuple(_head(out, n) for n in keep)
         for k in range(len(t.targets)):
@@ -364,8 +400,11 @@ def _targets(out: StudyOutcome) -> list[Block]:
             n_all += every
             cells = tuple(fmt(params[n], out.unit(n)) for n in keep)
             for x, v in zip(t.targets, verdicts):
-                cells += (v.metric, f"{fmt(v.value, out.unit(v.metric))} {P.shown(out.unit(v.metric))[1]}",
-                          {True: "yes", False: "no", None: "-"}[v.holds])
+                cells += (
+                    v.metric,
+                    f"{fmt(v.value, out.unit(v.metric))} {P.shown(out.unit(v.metric))[1]}",
+                    {True: "yes", False: "no", None: "-"}[v.holds],
+                )
             body.append(cells + ("pass" if every else "FAIL",))
         blocks.append(Block("table", header=header, rows=tuple(body)))
         blocks.append(Block("p", f"**{n_all} of {len(rows_)} combinations meet every target.**"))
@@ -382,11 +421,20 @@ def _failures(out: StudyOutcome) -> list[Block]:
     blocks = [Block("h2", "Failures")]
     if not bad:
         return blocks + [Block("p", "None: every design ran to its end.")]
-    blocks.append(Block("p", f"{len(bad)} of {len(out.rows)} designs have no result: the message is the "
-                             "failure's (or \"not run\": not computed yet, rerun the same command)."))
-    blocks.append(Block("table", header=("design",) + out.names + ("message",),
-                        rows=tuple((str(r.number),) + tuple(fmt(r.params.get(n)) for n in out.names)
-                                   + (r.status,) for r in bad)))
+    blocks.append(
+        Block(
+            "p",
+            f"{len(bad)} of {len(out.rows)} designs have no result: the message is the "
+            'failure\'s (or "not run": not computed yet, rerun the same command).',
+        )
+    )
+    blocks.append(
+        Block(
+            "table",
+            header=("design",) + out.names + ("message",),
+            rows=tuple((str(r.number),) + tuple(fmt(r.params.get(n)) for n in out.names) + (r.status,) for r in bad),
+        )
+    )
     return blocks
 
 
@@ -396,84 +444,161 @@ def build_report(out: StudyOutcome, progress: bool = False, fresh: bool = False)
     fig_dir = out.folder / FIGURES
     if not fresh:
         (fig_dir / INPUTS_FILE).unlink(missing_ok=True)
-        for stale in (*fig_dir.glob("metric-*.p[nd][gf]"), *fig_dir.glob("heatmap-*.p[nd][gf]"),
-                      fig_dir / "pareto-front.png", fig_dir / "pareto-front.pdf"):
+        for stale in (
+            *fig_dir.glob("metric-*.p[nd][gf]"),
+            *fig_dir.glob("heatmap-*.p[nd][gf]"),
+            fig_dir / "pareto-front.png",
+            fig_dir / "pareto-front.pdf",
+        ):
             stale.unlink(missing_ok=True)  # drawn again below, or no longer part of the study
     n_ok = sum(r.ok for r in out.rows)
     n_failed = sum(not r.ok and r.status != "not run" for r in out.rows)
     n_bad = sum(r.feasible is False for r in out.rows)
     what = "optimisation" if out.kind == "optimization" else "sweep"
     blocks = [Block("h1", f"Study report: {out.folder.name} ({what} of {out.base or 'a scenario'})")]
-    blocks.append(Block("p", f"{len(out.rows)} {'trials' if out.kind == 'optimization' else 'designs'}: "
-                             f"{n_ok} ran, {n_failed} failed, {len(out.rows) - n_ok - n_failed} not run"
-                             + (f"; {n_bad} infeasible (constraints)" if out.constraints else "")
-                             + f". Made by granplate {gp.__version__} from the records of granplate "
-                             f"{out.version or '?'}; the figures are PNG and PDF files in `{FIGURES}/` beside "
-                             f"this page, the interactive page is `{PAGE}`; the whole table is `{'trials.csv' if out.kind == 'optimization' else 'results.csv'}`."
-                             " Metrics are those of the run summary (docs/output.md), with their units; Pa "
-                             "are shown in MPa, dimensionless quantities as [-]."))
+    blocks.append(
+        Block(
+            "p",
+            f"{len(out.rows)} {'trials' if out.kind == 'optimization' else 'designs'}: "
+            f"{n_ok} ran, {n_failed} failed, {len(out.rows) - n_ok - n_failed} not run"
+            + (f"; {n_bad} infeasible (constraints)" if out.constraints else "")
+            + f". Made by granplate {gp.__version__} from the records of granplate "
+            f"{out.version or '?'}; the figures are PNG and PDF files in `{FIGURES}/` beside "
+            f"this page, the interactive page is `{PAGE}`; the whole table is `{'trials.csv' if out.kind == 'optimization' else 'results.csv'}`."
+            " Metrics are those of the run summary (docs/output.md), with their units; Pa "
+            "are shown in MPa, dimensionless quantities as [-].",
+        )
+    )
     blocks += _definition(out)
     drawn, left = shown_metrics(out)
     chosen = best_designs(out)
     front = pareto_front(out)
     blocks += _targets(out)
     blocks.append(Block("h2", "Designs"))
-    blocks.append(Block("p", "The main metrics of each design (every metric is in the CSV table)"
-                        + (f"; the first {MAX_ROWS} designs" if len(out.rows) > MAX_ROWS else "")
-                        + (". A design the optimiser asked for more than once is listed once, with "
-                           "its first trial" if out.kind == "optimization" else "") + "."))
+    blocks.append(
+        Block(
+            "p",
+            "The main metrics of each design (every metric is in the CSV table)"
+            + (f"; the first {MAX_ROWS} designs" if len(out.rows) > MAX_ROWS else "")
+            + (
+                ". A design the optimiser asked for more than once is listed once, with its first trial"
+                if out.kind == "optimization"
+                else ""
+            )
+            + ".",
+        )
+    )
     blocks.append(_designs_table(out, drawn, chosen, front))
     if out.objectives:
         blocks.append(Block("h2", "Pareto front"))
         path = _figure(fig_dir / "pareto-front.png", lambda: P.fig_pareto(out, front, chosen), fresh)
         if path is not None:
-            blocks.append(Block("figure", "The trials and the Pareto front of the feasible ones"
-                                          + (" (crosses: infeasible)" if out.constraints else "")
-                                          + "; axes in the objectives' units", path=path))
+            blocks.append(
+                Block(
+                    "figure",
+                    "The trials and the Pareto front of the feasible ones"
+                    + (" (crosses: infeasible)" if out.constraints else "")
+                    + "; axes in the objectives' units",
+                    path=path,
+                )
+            )
         first = same_design(out)
         on_front = list(dict.fromkeys(first[i] for i in front))
-        blocks.append(Block("p", "On the front: " + (", ".join(
-            f"{'trial' if out.kind == 'optimization' else 'design'} {out.rows[i].number}"
-            + (f" (and {n - 1} more trials of the same design)" if (n := sum(first[j] == i for j in front)) > 1 else "")
-            for i in on_front) or "no feasible design") + "."))
+        blocks.append(
+            Block(
+                "p",
+                "On the front: "
+                + (
+                    ", ".join(
+                        f"{'trial' if out.kind == 'optimization' else 'design'} {out.rows[i].number}"
+                        + (
+                            f" (and {n - 1} more trials of the same design)"
+                            if (n := sum(first[j] == i for j in front)) > 1
+                            else ""
+                        )
+                        for i in on_front
+                    )
+                    or "no feasible design"
+                )
+                + ".",
+            )
+        )
     blocks.append(Block("h2", "Metrics against the parameters"))
     if left:
-        blocks.append(Block("p", "Not drawn (the same for every design, or no design has it): "
-                                 + ", ".join(f"`{m}`" for m in left) + "."))
+        blocks.append(
+            Block(
+                "p",
+                "Not drawn (the same for every design, or no design has it): "
+                + ", ".join(f"`{m}`" for m in left)
+                + ".",
+            )
+        )
     for m in drawn:
-        blocks.append(Block("figure", f"{m} [{P.shown(out.unit(m))[1]}] against each parameter",
-                            path=_figure(fig_dir / f"metric-{m}.png", lambda: P.fig_metric(out, m), fresh)))
+        blocks.append(
+            Block(
+                "figure",
+                f"{m} [{P.shown(out.unit(m))[1]}] against each parameter",
+                path=_figure(fig_dir / f"metric-{m}.png", lambda: P.fig_metric(out, m), fresh),
+            )
+        )
     heat = P.heat_axes(out)
     if heat is not None:
         blocks.append(Block("h2", "Heat maps"))
-        blocks.append(Block("p", f"Over {heat[0]} and {heat[1]}"
-                                 + (f", one panel per value of {', '.join(heat[2])}" if heat[2] else "") + "."))
+        blocks.append(
+            Block(
+                "p",
+                f"Over {heat[0]} and {heat[1]}"
+                + (f", one panel per value of {', '.join(heat[2])}" if heat[2] else "")
+                + ".",
+            )
+        )
         targets = [m for t in out.report.targets for m in t.metrics]
         for m in dict.fromkeys(list(out.objectives) + list(HEADLINE) + targets):
             if m in drawn:
                 path = _figure(fig_dir / f"heatmap-{m}.png", lambda: P.fig_heatmap(out, m), fresh)
                 if path is not None:
-                    blocks.append(Block("figure", f"{m} [{P.shown(out.unit(m))[1]}] over {heat[0]} and {heat[1]}",
-                                        path=path))
+                    blocks.append(
+                        Block("figure", f"{m} [{P.shown(out.unit(m))[1]}] over {heat[0]} and {heat[1]}", path=path)
+                    )
     picks = chosen_designs(out, chosen)
     if picks:
         blocks.append(Block("h2", "Chosen designs"))
-        blocks.append(Block("p", ("the best feasible design for each "
-                                  + ("objective" if out.objectives else "headline metric") if chosen else "")
-                                 + (("; " if chosen else "") + "the designs of the first combination that "
-                                    "meets every target" if any("meets" in w for w in picks.values()) else "")
-                                 + "; their figures are drawn from their full results (re-run when the "
-                                 "study did not keep them, `--full`)."))
+        blocks.append(
+            Block(
+                "p",
+                (
+                    "the best feasible design for each " + ("objective" if out.objectives else "headline metric")
+                    if chosen
+                    else ""
+                )
+                + (
+                    ("; " if chosen else "") + "the designs of the first combination that meets every target"
+                    if any("meets" in w for w in picks.values())
+                    else ""
+                )
+                + "; their figures are drawn from their full results (re-run when the "
+                "study did not keep them, `--full`).",
+            )
+        )
         intro = blocks[-1].text
         blocks[-1] = Block("p", intro[:1].upper() + intro[1:])
         for i, why in picks.items():
             r = out.rows[i]
             blocks.append(Block("h3", f"Design {r.number}: {why}"))
-            metrics = [m for m in dict.fromkeys(list(directions(out)) + [m for t in out.report.targets
-                                                                      for m in t.metrics]) if m in r.metrics]
-            blocks.append(Block("p", ", ".join(f"{n} = {_with_unit(r.params.get(n), out.unit(n))}" for n in out.names)
-                                + "; " + ", ".join(f"{m} = {_with_unit(r.metrics.get(m), out.unit(m))}"
-                                                   for m in metrics) + "."))
+            metrics = [
+                m
+                for m in dict.fromkeys(list(directions(out)) + [m for t in out.report.targets for m in t.metrics])
+                if m in r.metrics
+            ]
+            blocks.append(
+                Block(
+                    "p",
+                    ", ".join(f"{n} = {_with_unit(r.params.get(n), out.unit(n))}" for n in out.names)
+                    + "; "
+                    + ", ".join(f"{m} = {_with_unit(r.metrics.get(m), out.unit(m))}" for m in metrics)
+                    + ".",
+                )
+            )
             for name, path in design_figures(out.folder, r.key, progress):
                 blocks.append(Block("figure", f"design {r.number}: {name}", path=path))
     drawn_keys = {out.rows[i].key[:12] for i in picks}
@@ -520,9 +645,15 @@ def write_report(folder: str | Path, progress: bool = False, live: bool = False)
 def kept_figures(out: StudyOutcome) -> dict[int, list[tuple[str, Path]]]:
     """row -> (caption, PNG) of each chosen design whose figures are already in
     DIR/report/ (nothing drawn, nothing re-run)."""
-    return {i: [(n, p) for n in ("assembly",) + DESIGN_FIGURES
-                if (p := out.folder / FIGURES / f"design-{out.rows[i].key[:12]}-{n}.png").is_file()]
-            for i in chosen_designs(out, best_designs(out)) if out.rows[i].key}
+    return {
+        i: [
+            (n, p)
+            for n in ("assembly",) + DESIGN_FIGURES
+            if (p := out.folder / FIGURES / f"design-{out.rows[i].key[:12]}-{n}.png").is_file()
+        ]
+        for i in chosen_designs(out, best_designs(out))
+        if out.rows[i].key
+    }
 
 
 def write_live_page(folder: str | Path, live: bool = True) -> tuple[Path, dict[str, int]]:

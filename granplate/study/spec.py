@@ -18,6 +18,7 @@ field and what is allowed. Every design's changes are applied to the base here, 
 unknown dotted path or a value of the wrong type is found now; a value the physics refuses
 (a negative load, say) is that design's failure, recorded when it runs.
 """
+
 from __future__ import annotations
 
 import itertools
@@ -33,8 +34,7 @@ import granplate as gp
 from granplate.errors import ScenarioError
 
 #: Top-level keys of a study file.
-STUDY_KEYS: tuple[str, ...] = ("base", "set", "parameters", "zip", "objectives", "constraints",
-                               "report")
+STUDY_KEYS: tuple[str, ...] = ("base", "set", "parameters", "zip", "objectives", "constraints", "report")
 #: Keys of a range form {range = [a, b], num = n, log = false}.
 RANGE_KEYS: tuple[str, ...] = ("range", "num", "log")
 #: Keys of a sample form {sample = METHOD, low, high, n, seed, log = false}.
@@ -78,6 +78,7 @@ class Study:
 
 # ------------------------------------------------------------------------- value forms
 
+
 def _number(field: str, v: Any, what: str) -> float:
     if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
         raise ScenarioError(field, v, f"{what}: expected a finite number")
@@ -99,8 +100,11 @@ def _check_keys(field: str, d: dict, allowed: tuple[str, ...]) -> None:
 def _plain_list(field: str, values: Any) -> list[Value]:
     """A list of values (numbers, strings, booleans), not empty."""
     if not isinstance(values, list):
-        raise ScenarioError(field, values, "expected a list of values, {range = [a, b], num = n} "
-                            "or {sample = \"latin_hypercube\", low, high, n, seed}")
+        raise ScenarioError(
+            field,
+            values,
+            'expected a list of values, {range = [a, b], num = n} or {sample = "latin_hypercube", low, high, n, seed}',
+        )
     if not values:
         raise ScenarioError(field, values, "empty list: give at least one value")
     for k, v in enumerate(values):
@@ -144,8 +148,9 @@ def _sample_settings(field: str, form: dict) -> tuple[str, int, int, bool, float
     n = _positive_int(f"{field}.n", form.get("n"))
     seed = form.get("seed")
     if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
-        raise ScenarioError(f"{field}.seed", seed, "expected an integer >= 0 (the sample is "
-                            "reproducible only with a seed)")
+        raise ScenarioError(
+            f"{field}.seed", seed, "expected an integer >= 0 (the sample is reproducible only with a seed)"
+        )
     log = form.get("log", False)
     if not isinstance(log, bool):
         raise ScenarioError(f"{field}.log", log, "expected true or false")
@@ -179,9 +184,13 @@ def sample_values(forms: dict[str, dict]) -> list[tuple[float, ...]]:
     first_field, first = next(iter(settings.items()))
     for f, s in settings.items():
         if s[:3] != first[:3]:
-            raise ScenarioError(f, forms[f], "sampled parameters are drawn together: sample, n and "
-                                f"seed must be those of {first_field} ({first[0]!r}, n = {first[1]}, "
-                                f"seed = {first[2]})")
+            raise ScenarioError(
+                f,
+                forms[f],
+                "sampled parameters are drawn together: sample, n and "
+                f"seed must be those of {first_field} ({first[0]!r}, n = {first[1]}, "
+                f"seed = {first[2]})",
+            )
     method, n, seed = first[:3]
     u = sample_points(method, n, len(settings), seed)
     cols = []
@@ -194,6 +203,7 @@ def sample_values(forms: dict[str, dict]) -> list[tuple[float, ...]]:
 
 
 # ------------------------------------------------------------------------- the grid
+
 
 def log_parameters(parameters: Any) -> frozenset[str]:
     """The parameters given in a range or sample form with `log = true` (drawn on log axes)."""
@@ -229,8 +239,7 @@ def axes(parameters: dict, zipped: dict) -> tuple[list[tuple[str, ...]], list[li
         n = {len(v) for v in lists.values()}
         if len(n) > 1:
             lengths = ", ".join(f"{f}: {len(v)}" for f, v in lists.items())
-            raise ScenarioError("zip", lengths, "the lists of [zip] vary together: they must "
-                                "have the same length")
+            raise ScenarioError("zip", lengths, "the lists of [zip] vary together: they must have the same length")
         fields.append(tuple(lists))
         points.append(list(zip(*lists.values())))
     if sampled:
@@ -248,17 +257,25 @@ def grid(fields: list[tuple[str, ...]], points: list[list[tuple]]) -> tuple[tupl
 
 # ------------------------------------------------------------------------- the file
 
+
 def base_scenario(base: Any, folder: Path):
     """The validated base: a preset by name, else a scenario file (relative to folder)."""
     if not isinstance(base, str) or not base:
-        raise ScenarioError("base", base, "expected a preset name or a scenario file, e.g. "
-                            "base = \"ptfe-r05\"; presets: " + ", ".join(gp.preset_names(True)))
+        raise ScenarioError(
+            "base",
+            base,
+            "expected a preset name or a scenario file, e.g. "
+            'base = "ptfe-r05"; presets: ' + ", ".join(gp.preset_names(True)),
+        )
     if base in gp.preset_names(True):
         return gp.load_scenario(base)
     path = Path(base) if os.path.isabs(base) else folder / base
     if not path.is_file():
-        raise ScenarioError("base", base, f"no such preset or scenario file (looked for {path}); "
-                            "presets: " + ", ".join(gp.preset_names(True)))
+        raise ScenarioError(
+            "base",
+            base,
+            f"no such preset or scenario file (looked for {path}); presets: " + ", ".join(gp.preset_names(True)),
+        )
     try:
         return gp.load_scenario(path)
     except ScenarioError as err:
@@ -304,8 +321,14 @@ def parse_study(doc: dict, folder: str | os.PathLike = ".") -> Study:
 
     parse_constraints(doc.get("constraints"), metric_units())  # used by the report
     parse_report_table(doc.get("report"), names)
-    study = Study(str(doc["base"]), raw, fixed, names, tuple(designs),
-                  {k: v for k, v in doc.items() if k not in ("base", "set", "parameters", "zip")})
+    study = Study(
+        str(doc["base"]),
+        raw,
+        fixed,
+        names,
+        tuple(designs),
+        {k: v for k, v in doc.items() if k not in ("base", "set", "parameters", "zip")},
+    )
     for i in range(len(designs)):
         try:
             study.scenario(i)

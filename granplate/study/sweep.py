@@ -11,6 +11,7 @@ is in, so an interrupted sweep, a killed worker or a lost scheduler loses only t
 in flight, and a rerun computes only the designs without a record. The table (results.nc,
 results.csv) is written at the end, and also when the sweep is interrupted.
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -66,8 +67,9 @@ def progress_bar(total: int, initial: int, enabled: bool, desc: str = "sweep", u
     """A tqdm bar with ETA on stderr, labelled `desc`, counting `unit`s."""
     from tqdm import tqdm
 
-    return tqdm(total=total, initial=initial, desc=desc, unit=unit, file=sys.stderr,
-                disable=not enabled, dynamic_ncols=True)
+    return tqdm(
+        total=total, initial=initial, desc=desc, unit=unit, file=sys.stderr, disable=not enabled, dynamic_ncols=True
+    )
 
 
 def table_inputs_hash(study: Study, keys: list[str], records: list, attrs: dict) -> str:
@@ -83,13 +85,22 @@ def write_table(study: Study, out: Path, keys: list[str]) -> Path:
     from granplate.store import atomic_write
 
     records = [D.read_record(out, k) for k in keys]
-    attrs = {"base": study.base_name, "fixed": T.attrs_json(study.fixed),
-             "parameters": T.attrs_json(list(study.names)), "granplate_version": gp.__version__,
-             "n_designs": len(keys), "n_ok": sum(1 for r in records if r and r["status"] == "ok")}
+    attrs = {
+        "base": study.base_name,
+        "fixed": T.attrs_json(study.fixed),
+        "parameters": T.attrs_json(list(study.names)),
+        "granplate_version": gp.__version__,
+        "n_designs": len(keys),
+        "n_ok": sum(1 for r in records if r and r["status"] == "ok"),
+    }
     digest = table_inputs_hash(study, keys, records, attrs)
     stored = out / RESULTS_HASH
-    if ((out / RESULTS_NC).is_file() and (out / RESULTS_CSV).is_file() and stored.is_file()
-            and stored.read_text().strip() == digest):
+    if (
+        (out / RESULTS_NC).is_file()
+        and (out / RESULTS_CSV).is_file()
+        and stored.is_file()
+        and stored.read_text().strip() == digest
+    ):
         return out / RESULTS_NC
     stored.unlink(missing_ok=True)
     ds = T.to_dataset(study.names, study.designs, keys, records, attrs)
@@ -99,9 +110,17 @@ def write_table(study: Study, out: Path, keys: list[str]) -> Path:
     return out / RESULTS_NC
 
 
-def sweep(study: Study, out: str | Path, *, client=None, workers: int | None = None,
-          scheduler: str | None = None, full: bool = False, limit: int | None = None,
-          progress: bool = True) -> SweepReport:
+def sweep(
+    study: Study,
+    out: str | Path,
+    *,
+    client=None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    full: bool = False,
+    limit: int | None = None,
+    progress: bool = True,
+) -> SweepReport:
     """Compute the designs of `study` that have no record in out/designs, then write the
     table. client: an open Dask Client to use (else one is made from workers/scheduler,
     see `dask_client`); full: keep each design's whole result (designs/KEY.nc); limit:
@@ -120,7 +139,7 @@ def sweep(study: Study, out: str | Path, *, client=None, workers: int | None = N
     report = SweepReport(len(keys), n_before, out=out)
     try:
         if todo:
-            with (nullcontext(client) if client is not None else dask_client(workers, scheduler)) as c:
+            with nullcontext(client) if client is not None else dask_client(workers, scheduler) as c:
                 report.warm_up_s = warm_workers(c, texts[todo[0][1]])
                 _run(c, study, out, todo, texts, keys, full, progress, report)
     finally:
@@ -130,13 +149,21 @@ def sweep(study: Study, out: str | Path, *, client=None, workers: int | None = N
     return report
 
 
-def _run(client, study: Study, out: Path, todo: list[tuple[str, int]], texts: list[str],
-         keys: list[str], full: bool, progress: bool, report: SweepReport) -> None:
+def _run(
+    client,
+    study: Study,
+    out: Path,
+    todo: list[tuple[str, int]],
+    texts: list[str],
+    keys: list[str],
+    full: bool,
+    progress: bool,
+    report: SweepReport,
+) -> None:
     """Submit the designs, write each record as it comes in (cancel the rest on interrupt)."""
     from distributed import as_completed
 
-    futures = {client.submit(D.run_design, texts[i], full, key=f"design-{k}", pure=False): (k, i)
-               for k, i in todo}
+    futures = {client.submit(D.run_design, texts[i], full, key=f"design-{k}", pure=False): (k, i) for k, i in todo}
     bar = progress_bar(len(set(keys)), len(set(keys)) - len(todo), progress)
     try:
         for fut in as_completed(futures):
@@ -148,8 +175,7 @@ def _run(client, study: Study, out: Path, todo: list[tuple[str, int]], texts: li
                 bar.update(1)
                 continue
             t_store = time.perf_counter()
-            D.write_record(out, D.make_record(k, study.changes(i), texts[i], outcome),
-                           outcome.get("result"))
+            D.write_record(out, D.make_record(k, study.changes(i), texts[i], outcome), outcome.get("result"))
             report.store_s += time.perf_counter() - t_store
             report.n_computed += 1
             report.compute_s += outcome["elapsed_s"]

@@ -1,6 +1,7 @@
 """The table of a study: one row per design, its parameters, its summary metrics and its
 status, as an xarray Dataset (results.nc, units in attrs) and as CSV (results.csv).
 """
+
 from __future__ import annotations
 
 import csv
@@ -14,25 +15,90 @@ NOT_METRICS: tuple[str, ...] = ("scenario", "units", "contact_pairs")
 NOT_RUN = "not run"
 #: Units of scenario fields by their last dotted-path step (the others have none in attrs).
 FIELD_UNITS: dict[str, str] = {
-    "q0": "N/m", "duration": "s", "length": "m", "y0": "m", "t_end": "s", "dt_initial": "s",
-    "dt_max": "s", "output_interval": "s", "field_interval": "s", "R1": "m", "R2_ratio": "1",
-    "E": "Pa", "nu": "1", "rho": "kg/m^3", "radius": "m", "x": "m", "y": "m", "vx": "m/s",
-    "vy": "m/s", "width": "m", "height": "m", "thickness": "m", "mu": "1", "nx": "1", "ny": "1",
-    "n_modes": "1", "rigid_layer_width": "m", "column_radii": "m", "alpha_n": "1",
+    "q0": "N/m",
+    "duration": "s",
+    "length": "m",
+    "y0": "m",
+    "t_end": "s",
+    "dt_initial": "s",
+    "dt_max": "s",
+    "output_interval": "s",
+    "field_interval": "s",
+    "R1": "m",
+    "R2_ratio": "1",
+    "E": "Pa",
+    "nu": "1",
+    "rho": "kg/m^3",
+    "radius": "m",
+    "x": "m",
+    "y": "m",
+    "vx": "m/s",
+    "vy": "m/s",
+    "width": "m",
+    "height": "m",
+    "thickness": "m",
+    "mu": "1",
+    "nx": "1",
+    "ny": "1",
+    "n_modes": "1",
+    "rigid_layer_width": "m",
+    "column_radii": "m",
+    "alpha_n": "1",
     # in space, and the layouts' counts
-    "z": "m", "vz": "m/s", "size": "m", "origin": "m", "elements": "1", "patch_radius": "m",
-    "stress_radius": "m", "max_frequency": "Hz", "force": "N", "Y": "Pa", "k_s": "s/m",
-    "count": "1", "cells": "1", "planes": "1", "columns": "1", "rows": "1", "intruder_ratio": "1",
+    "z": "m",
+    "vz": "m/s",
+    "size": "m",
+    "origin": "m",
+    "elements": "1",
+    "patch_radius": "m",
+    "stress_radius": "m",
+    "max_frequency": "Hz",
+    "force": "N",
+    "Y": "Pa",
+    "k_s": "s/m",
+    "count": "1",
+    "cells": "1",
+    "planes": "1",
+    "columns": "1",
+    "rows": "1",
+    "intruder_ratio": "1",
     # every other number of a scenario (the generated reference of the site shows them)
-    "dimension": "1", "taper": "1", "dimer_ratio": "1", "decorated_ratio": "1", "seed": "1",
-    "radius_spread": "1", "jitter": "1", "vacancy_fraction": "1", "intruder_every": "1",
-    "omega": "rad/s", "offset": "m", "point": "m", "lower": "m", "upper": "m", "centre": "m",
-    "normal": "1", "direction": "1", "axis": "1", "x0": "m", "neighbour_gap": "1", "skin": "1",
-    "overlap_warn": "1", "overlap_stop": "1", "dt_min": "s", "lambda_target": "1",
-    "iteration_rtol": "1", "iteration_atol": "N", "max_iterations": "1", "energy_tol": "1",
-    "error_tol": "1", "implicit_dt_max": "s",
+    "dimension": "1",
+    "taper": "1",
+    "dimer_ratio": "1",
+    "decorated_ratio": "1",
+    "seed": "1",
+    "radius_spread": "1",
+    "jitter": "1",
+    "vacancy_fraction": "1",
+    "intruder_every": "1",
+    "omega": "rad/s",
+    "offset": "m",
+    "point": "m",
+    "lower": "m",
+    "upper": "m",
+    "centre": "m",
+    "normal": "1",
+    "direction": "1",
+    "axis": "1",
+    "x0": "m",
+    "neighbour_gap": "1",
+    "skin": "1",
+    "overlap_warn": "1",
+    "overlap_stop": "1",
+    "dt_min": "s",
+    "lambda_target": "1",
+    "iteration_rtol": "1",
+    "iteration_atol": "N",
+    "max_iterations": "1",
+    "energy_tol": "1",
+    "error_tol": "1",
+    "implicit_dt_max": "s",
     # the measured yielding law (docs/model.md section 3.10)
-    "C": "1", "rate_ref": "1/s", "hardness_ratio": "1", "unloading_factor": "1",
+    "C": "1",
+    "rate_ref": "1/s",
+    "hardness_ratio": "1",
+    "unloading_factor": "1",
 }
 
 
@@ -58,8 +124,9 @@ def status_of(record: dict | None) -> str:
     return NOT_RUN if record is None else str(record["status"])
 
 
-def to_dataset(names: tuple[str, ...], designs, keys: list[str], records: list[dict | None],
-               attrs: dict[str, Any] | None = None):
+def to_dataset(
+    names: tuple[str, ...], designs, keys: list[str], records: list[dict | None], attrs: dict[str, Any] | None = None
+):
     """The study's Dataset, indexed by `design` (0, 1, ... in study order): one variable per
     parameter and per summary metric (NaN where a design has no value), `status` ("ok",
     the failure message, or "not run") and `key` (the design's record name)."""
@@ -83,8 +150,11 @@ def to_dataset(names: tuple[str, ...], designs, keys: list[str], records: list[d
         else:
             col = np.array([np.nan if v is None else v for v in values], dtype=float)
         data[m] = ("design", col, {"long_name": f"metric {m}", **({"units": units[m]} if m in units else {})})
-    data["status"] = ("design", np.array([status_of(r) for r in records], dtype=str),
-                      {"long_name": "\"ok\", the failure message, or \"not run\""})
+    data["status"] = (
+        "design",
+        np.array([status_of(r) for r in records], dtype=str),
+        {"long_name": '"ok", the failure message, or "not run"'},
+    )
     data["key"] = ("design", np.array(keys, dtype=str), {"long_name": "record designs/KEY.json"})
     return xr.Dataset(data, coords={"design": np.arange(n)}, attrs=dict(attrs or {}))
 

@@ -16,6 +16,7 @@ names (nor zipped with one it names). Within a group, a target takes the design 
 given: e.g. two ways to sample the same quantity). A group meets the targets when every
 target holds: `judge` returns one row per group.
 """
+
 from __future__ import annotations
 
 import math
@@ -76,8 +77,9 @@ def _target(k: int, t: Any, units: dict[str, str], names: tuple[str, ...] | None
     metric = t.get("metric")
     metrics = tuple(metric) if isinstance(metric, list) else (metric,)
     if not metrics or any(m not in units for m in metrics):
-        raise ScenarioError(f"{where}.metric", metric, "expected a metric or a list of metrics; "
-                            "allowed: " + ", ".join(units))
+        raise ScenarioError(
+            f"{where}.metric", metric, "expected a metric or a list of metrics; allowed: " + ", ".join(units)
+        )
     value, within = t.get("value"), t.get("within", 0.1)
     for key, v in (("value", value), ("within", within)):
         if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v) or v == 0:
@@ -89,8 +91,9 @@ def _target(k: int, t: Any, units: dict[str, str], names: tuple[str, ...] | None
         raise ScenarioError(f"{where}.where", match, "expected a table of parameter = value")
     for field in match:
         if names is not None and field not in names:
-            raise ScenarioError(f"{where}.where.{field}", match[field], "not a parameter of the "
-                                "study; parameters: " + ", ".join(names))
+            raise ScenarioError(
+                f"{where}.where.{field}", match[field], "not a parameter of the study; parameters: " + ", ".join(names)
+            )
     label = t.get("label", " or ".join(metrics))
     if not isinstance(label, str):
         raise ScenarioError(f"{where}.label", label, "expected a string")
@@ -144,8 +147,7 @@ def _verdict(target: Target, rows: list[tuple[int, dict[str, Any], dict[str, Any
     return Verdict(None, target.metrics[0], None, None)
 
 
-def choices(targets: tuple[Target, ...], names: tuple[str, ...],
-            designs: list[dict[str, Any]] = ()) -> tuple[str, ...]:
+def choices(targets: tuple[Target, ...], names: tuple[str, ...], designs: list[dict[str, Any]] = ()) -> tuple[str, ...]:
     """The parameters no target's `where` names, nor follow from those it names (a
     parameter zipped with them): what a group of designs shares."""
     named = [k for t in targets for k, _ in t.where]
@@ -162,8 +164,9 @@ def choices(targets: tuple[Target, ...], names: tuple[str, ...],
     return tuple(n for n in names if n not in named and not tied(n))
 
 
-def judge(targets: tuple[Target, ...], names: tuple[str, ...], designs: list[dict[str, Any]],
-          values: list[dict[str, Any]]) -> list[tuple[dict[str, Any], list[Verdict]]]:
+def judge(
+    targets: tuple[Target, ...], names: tuple[str, ...], designs: list[dict[str, Any]], values: list[dict[str, Any]]
+) -> list[tuple[dict[str, Any], list[Verdict]]]:
     """One row per group of designs sharing the choice parameters (in design order):
     (the choices' values, one Verdict per target). designs[i]: design i's parameter
     values; values[i]: its metrics (None where it has none)."""

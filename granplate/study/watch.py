@@ -6,6 +6,7 @@ writes the full report (figures, Markdown) once none is left (docs/studies.md).
     >>> from granplate.study.watch import watch
     >>> watch("q0-r2", every=5.0)      # returns the final counts; Ctrl-C stops it
 """
+
 from __future__ import annotations
 
 import time
@@ -25,10 +26,16 @@ def folder_state(folder: Path) -> tuple:
     """What the page is drawn from, cheaply: the records' names, sizes and times, and the
     tables' and study file's times (a change in any means a new page)."""
     designs = Path(folder) / D.DESIGNS
-    records = sorted((p.name, p.stat().st_size, p.stat().st_mtime_ns) for p in designs.glob("*.json")) \
-        if designs.is_dir() else []
-    tables = [(n, (Path(folder) / n).stat().st_mtime_ns) for n in ("study.toml", "trials.csv", "results.nc",
-                                                                    "results.csv") if (Path(folder) / n).is_file()]
+    records = (
+        sorted((p.name, p.stat().st_size, p.stat().st_mtime_ns) for p in designs.glob("*.json"))
+        if designs.is_dir()
+        else []
+    )
+    tables = [
+        (n, (Path(folder) / n).stat().st_mtime_ns)
+        for n in ("study.toml", "trials.csv", "results.nc", "results.csv")
+        if (Path(folder) / n).is_file()
+    ]
     return tuple(records), tuple(tables)
 
 
@@ -37,8 +44,13 @@ def counts_line(c: dict[str, int]) -> str:
     return f"watch: {c['done']} done, {c['failed']} failed, {c['left']} left of {c['total']}"
 
 
-def watch(folder: str | Path, every: float = EVERY_S, echo: Callable[[str], None] = print,
-          rounds: int | None = None, final: bool = True) -> dict[str, int]:
+def watch(
+    folder: str | Path,
+    every: float = EVERY_S,
+    echo: Callable[[str], None] = print,
+    rounds: int | None = None,
+    final: bool = True,
+) -> dict[str, int]:
     """Poll `folder` every `every` seconds; on a change write the live page and echo the
     counts; once no design is left (or after `rounds` looks), write the final page (the
     full report when `final`, else the page without its reload) and return the counts.

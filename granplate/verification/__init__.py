@@ -45,6 +45,7 @@ the page this writes, regenerated with --full):
 
 Simulated cases are scenario files in `granplate/verification/scenarios/`.
 """
+
 from __future__ import annotations
 
 import sys
@@ -52,27 +53,52 @@ import time
 from pathlib import Path
 
 
-
 def __getattr__(name: str):
     # the CLI imports this package to register `verify`: keep that import light
     if name in ("Case", "CaseResult", "Check", "Context", "run_case"):
         from . import base
+
         return getattr(base, name)
     raise AttributeError(f"module 'granplate.verification' has no attribute {name!r}")
 
 
 def all_cases() -> tuple:
     """Every registered case, in page order."""
-    from . import (chain, conservation, coupled, dynamic, face_contacts, granular, lammps, measured_cases, plastic_cases,
-                   plate_cases, plate_mesh, solid_cases, space_cases)
+    from . import (
+        chain,
+        conservation,
+        coupled,
+        dynamic,
+        face_contacts,
+        granular,
+        lammps,
+        measured_cases,
+        plastic_cases,
+        plate_cases,
+        plate_mesh,
+        solid_cases,
+        space_cases,
+    )
 
     beside = lammps.cases()
     plane_lammps = tuple(c for c in beside if c.family != "space")
     space_lammps = tuple(c for c in beside if c.family == "space")
-    return (granular.CASES + chain.CASES + dynamic.CASES + plane_lammps + plastic_cases.CASES + measured_cases.CASES
-            + space_cases.CASES
-            + space_lammps + plate_cases.CASES
-            + plate_mesh.CASES + solid_cases.CASES + conservation.CASES + face_contacts.CASES + coupled.CASES)
+    return (
+        granular.CASES
+        + chain.CASES
+        + dynamic.CASES
+        + plane_lammps
+        + plastic_cases.CASES
+        + measured_cases.CASES
+        + space_cases.CASES
+        + space_lammps
+        + plate_cases.CASES
+        + plate_mesh.CASES
+        + solid_cases.CASES
+        + conservation.CASES
+        + face_contacts.CASES
+        + coupled.CASES
+    )
 
 
 def case_names(full: bool = True) -> list[str]:
@@ -88,9 +114,17 @@ def get_case(name: str):
     raise KeyError(f"no verification case {name!r}; cases are: {', '.join(case_names())}")
 
 
-def run_suite(out: str | Path, full: bool = False, names: list[str] | None = None,
-              log=None, *, workers: int | None = None, scheduler: str | None = None,
-              client=None, update: bool = False) -> list:
+def run_suite(
+    out: str | Path,
+    full: bool = False,
+    names: list[str] | None = None,
+    log=None,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    client=None,
+    update: bool = False,
+) -> list:
     """Run the suite (or the cases `names`), write the pages into `out`, return the results.
 
     full: include the slow cases (and the full-length preset runs, computed first on Dask:
@@ -139,15 +173,28 @@ def _cmd_verify(args) -> int:
         print(f"granplate: error: --workers = {args.workers}: must be >= 1", file=sys.stderr)
         return 2
     if args.render_only:
-        clash = [flag for flag, on in (("--case", args.case), ("--full", args.full), ("--list", args.list),
-                                       ("--update", args.update)) if on]
+        clash = [
+            flag
+            for flag, on in (
+                ("--case", args.case),
+                ("--full", args.full),
+                ("--list", args.list),
+                ("--update", args.update),
+            )
+            if on
+        ]
         if clash:
-            print(f"granplate: error: --render-only runs no case: {', '.join(clash)} cannot go with it", file=sys.stderr)
+            print(
+                f"granplate: error: --render-only runs no case: {', '.join(clash)} cannot go with it", file=sys.stderr
+            )
             return 2
         return _render_only(Path(args.out))
     if args.update and not args.case:
-        print("granplate: error: --update merges the cases given by --case into DIR/validation.json: "
-              "give at least one --case", file=sys.stderr)
+        print(
+            "granplate: error: --update merges the cases given by --case into DIR/validation.json: "
+            "give at least one --case",
+            file=sys.stderr,
+        )
         return 2
     if args.list:
         for case in all_cases():
@@ -161,14 +208,23 @@ def _cmd_verify(args) -> int:
     except KeyError as err:
         print(f"granplate: error: {err.args[0]}", file=sys.stderr)
         return 2
-    results = run_suite(args.out, full=args.full, names=names, log=None if args.quiet else log,
-                        workers=args.workers, scheduler=args.scheduler, update=args.update)
+    results = run_suite(
+        args.out,
+        full=args.full,
+        names=names,
+        log=None if args.quiet else log,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        update=args.update,
+    )
     n_bad = sum(1 for r in results if not r.passed)
     n_checks = sum(len(r.checks) for r in results)
     bad_checks = sum(1 for r in results for c in r.checks if not c.passed)
     out = Path(args.out)
-    print(f"{len(results)} cases, {n_checks} checks: "
-          + ("all pass" if n_bad == 0 else f"{bad_checks} checks fail in {n_bad} cases"))
+    print(
+        f"{len(results)} cases, {n_checks} checks: "
+        + ("all pass" if n_bad == 0 else f"{bad_checks} checks fail in {n_bad} cases")
+    )
     print(f"page: {out / 'validation.md'} (and validation.html)")
     return 0 if n_bad == 0 else 1
 
@@ -179,8 +235,10 @@ def _render_only(out: Path) -> int:
 
     source = out / "validation.json"
     if not source.is_file():
-        print(f"granplate: error: --render-only: {source} not found (run `granplate verify --out {out}` first)",
-              file=sys.stderr)
+        print(
+            f"granplate: error: --render-only: {source} not found (run `granplate verify --out {out}` first)",
+            file=sys.stderr,
+        )
         return 2
     try:
         paths = render_pages(out)
@@ -194,31 +252,53 @@ def _render_only(out: Path) -> int:
 def register(subparsers) -> None:
     """Add `granplate verify` to the CLI's subparsers."""
     p = subparsers.add_parser(
-        "verify", help="run the verification suite and write the validation page",
+        "verify",
+        help="run the verification suite and write the validation page",
         description="Run the verification suite (each part of the simulator against "
-                    "independent truth) and write DIR/validation.md and DIR/validation.html. "
-                    "Exits with status 1 when a case fails.")
-    p.add_argument("--out", default="out/verification", metavar="DIR",
-                   help="output folder for the page, its figures and data (default: out/verification)")
-    p.add_argument("--full", action="store_true",
-                   help="also run the slow convergence studies of the coupled runs (minutes; "
-                        "their runs are cached in DIR/validation-runs.json)")
-    p.add_argument("--workers", type=int, default=None, metavar="N",
-                   help="with --full: worker processes of the local Dask cluster that computes "
-                        "the full-length runs (default: the number of cores)")
-    p.add_argument("--scheduler", metavar="ADDRESS", default=None,
-                   help="with --full: compute the full-length runs on an existing Dask cluster")
-    p.add_argument("--case", action="append", metavar="NAME",
-                   help="run only this case (repeatable; see --list)")
-    p.add_argument("--update", action="store_true",
-                   help="with --case: put the cases run into DIR/validation.json in place of their "
-                        "earlier results, keep the other cases, and rebuild the pages")
+        "independent truth) and write DIR/validation.md and DIR/validation.html. "
+        "Exits with status 1 when a case fails.",
+    )
+    p.add_argument(
+        "--out",
+        default="out/verification",
+        metavar="DIR",
+        help="output folder for the page, its figures and data (default: out/verification)",
+    )
+    p.add_argument(
+        "--full",
+        action="store_true",
+        help="also run the slow convergence studies of the coupled runs (minutes; "
+        "their runs are cached in DIR/validation-runs.json)",
+    )
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        metavar="N",
+        help="with --full: worker processes of the local Dask cluster that computes "
+        "the full-length runs (default: the number of cores)",
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        default=None,
+        help="with --full: compute the full-length runs on an existing Dask cluster",
+    )
+    p.add_argument("--case", action="append", metavar="NAME", help="run only this case (repeatable; see --list)")
+    p.add_argument(
+        "--update",
+        action="store_true",
+        help="with --case: put the cases run into DIR/validation.json in place of their "
+        "earlier results, keep the other cases, and rebuild the pages",
+    )
     p.add_argument("--list", action="store_true", help="list the cases and exit")
-    p.add_argument("--render-only", action="store_true",
-                   help="run no case: rebuild DIR/validation.md and DIR/validation.html from DIR/validation.json")
+    p.add_argument(
+        "--render-only",
+        action="store_true",
+        help="run no case: rebuild DIR/validation.md and DIR/validation.html from DIR/validation.json",
+    )
     p.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
     p.set_defaults(func=_cmd_verify)
 
 
-__all__ = ["run_suite", "all_cases", "case_names", "get_case", "register", "Case", "CaseResult",
-           "Check", "Context"]
+__all__ = ["run_suite", "all_cases", "case_names", "get_case", "register", "Case", "CaseResult", "Check", "Context"]

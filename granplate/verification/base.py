@@ -16,6 +16,7 @@ Check kinds (how `error` and `passed` are computed):
   ideal value, usually 0);
 - "min": a lower bound: error = ours, passes when ours >= tolerance.
 """
+
 from __future__ import annotations
 
 import math
@@ -37,8 +38,16 @@ FIGURE_DIR = "validation-figures"
 EPS = float(np.finfo(float).eps)
 
 
-def Check(quantity: str, unit: str, reference: float, source: str, ours: float, tolerance: float,  # noqa: N802
-          why: str, kind: str = "rel") -> criteria.Check:
+def Check(
+    quantity: str,
+    unit: str,
+    reference: float,
+    source: str,
+    ours: float,
+    tolerance: float,  # noqa: N802
+    why: str,
+    kind: str = "rel",
+) -> criteria.Check:
     """One number against its reference: a granplate.results.criteria.Check whose
     criterion is given by `kind` and `tolerance` (see the module docstring).
 
@@ -76,12 +85,18 @@ class CaseResult:
     plot: dict[str, Any] = field(default_factory=dict, repr=False)
 
     @classmethod
-    def of(cls, description: str, checks: Sequence[criteria.Check], *, notes: Sequence[str] = (),
-           tables: Sequence[str] = (), plot: dict[str, Any] | None = None) -> "CaseResult":
+    def of(
+        cls,
+        description: str,
+        checks: Sequence[criteria.Check],
+        *,
+        notes: Sequence[str] = (),
+        tables: Sequence[str] = (),
+        plot: dict[str, Any] | None = None,
+    ) -> "CaseResult":
         """What a case's run returns: its description, checks, notes, tables and the
         numbers of its figure (name, family, title and figure filled in by `run_case`)."""
-        return cls("", "", "", description, list(checks), None, list(notes), list(tables),
-                   plot=dict(plot or {}))
+        return cls("", "", "", description, list(checks), None, list(notes), list(tables), plot=dict(plot or {}))
 
     @property
     def passed(self) -> bool:
@@ -91,21 +106,39 @@ class CaseResult:
     def as_dict(self) -> dict:
         """Plain dict (for JSON): everything the page shows (`from_dict` reads it back)."""
         return {
-            "name": self.name, "family": self.family, "title": self.title,
-            "passed": self.passed, "seconds": self.seconds, "crashed": self.crashed,
-            "figure": self.figure, "checks": [c.as_dict() for c in self.checks],
-            "description": self.description, "notes": list(self.notes), "tables": list(self.tables),
+            "name": self.name,
+            "family": self.family,
+            "title": self.title,
+            "passed": self.passed,
+            "seconds": self.seconds,
+            "crashed": self.crashed,
+            "figure": self.figure,
+            "checks": [c.as_dict() for c in self.checks],
+            "description": self.description,
+            "notes": list(self.notes),
+            "tables": list(self.tables),
         }
 
     @classmethod
     def from_dict(cls, d: dict) -> "CaseResult":
         """The result `as_dict` wrote (checks judged again from their numbers; a file
         written before description, notes and tables were stored has none)."""
-        checks = [Check(c["quantity"], c["unit"], c["reference"], c["source"], c["ours"], c["tolerance"],
-                        c["why"], c["kind"]) for c in d.get("checks", [])]
-        return cls(d["name"], d.get("family", ""), d.get("title", d["name"]), d.get("description", ""),
-                   checks, d.get("figure"), list(d.get("notes", [])), list(d.get("tables", [])),
-                   float(d.get("seconds", 0.0)), d.get("crashed"))
+        checks = [
+            Check(c["quantity"], c["unit"], c["reference"], c["source"], c["ours"], c["tolerance"], c["why"], c["kind"])
+            for c in d.get("checks", [])
+        ]
+        return cls(
+            d["name"],
+            d.get("family", ""),
+            d.get("title", d["name"]),
+            d.get("description", ""),
+            checks,
+            d.get("figure"),
+            list(d.get("notes", [])),
+            list(d.get("tables", [])),
+            float(d.get("seconds", 0.0)),
+            d.get("crashed"),
+        )
 
 
 @dataclass(frozen=True)
@@ -163,10 +196,10 @@ def run_case(case: Case, ctx: Context) -> CaseResult:
 
 # --------------------------------------------------------------------------- scenarios
 
+
 def scenario_text(name: str) -> str:
     """The TOML text of verification scenario `name` (package data)."""
-    return (resources.files("granplate.verification") / "scenarios" / f"{name}.toml").read_text(
-        encoding="utf-8")
+    return (resources.files("granplate.verification") / "scenarios" / f"{name}.toml").read_text(encoding="utf-8")
 
 
 def scenario_names() -> list[str]:
@@ -191,8 +224,15 @@ def step_changes(dt: float, t_end: float, out: float | None = None) -> dict:
     """Dotted-path changes setting a fixed step dt, the end time and the output interval
     (the paper scheme, whose step is time.dt_max where criterion (8) does not bind)."""
     out = dt if out is None else out
-    return {"solver.scheme": "paper", "time.dt_max": dt, "time.dt_initial": dt, "time.dt_min": min(1e-13, dt),
-            "time.t_end": t_end, "time.output_interval": out, "time.field_interval": out}
+    return {
+        "solver.scheme": "paper",
+        "time.dt_max": dt,
+        "time.dt_initial": dt,
+        "time.dt_min": min(1e-13, dt),
+        "time.t_end": t_end,
+        "time.output_interval": out,
+        "time.field_interval": out,
+    }
 
 
 def simulate(scenario):
@@ -203,6 +243,7 @@ def simulate(scenario):
 
 
 # --------------------------------------------------------------------------- numerics
+
 
 def parabolic_peak(t: np.ndarray, y: np.ndarray) -> tuple[float, float]:
     """Time and value of the maximum of samples y(t), refined by a parabola through the
@@ -246,8 +287,9 @@ def new_figure(ncols: int = 1, nrows: int = 1, width: float = 6.4, height: float
     matplotlib.use("Agg", force=True)
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(nrows, ncols, figsize=(width * ncols if ncols > 1 else width, height * nrows),
-                             squeeze=False)
+    fig, axes = plt.subplots(
+        nrows, ncols, figsize=(width * ncols if ncols > 1 else width, height * nrows), squeeze=False
+    )
     return fig, axes
 
 

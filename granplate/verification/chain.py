@@ -1,5 +1,6 @@
 """Verification: a striker on a chain of spheres, against Nesterenko's solitary wave and
 an independent 1-D Hertz chain integrated by scipy's `solve_ivp` (DOP853)."""
+
 from __future__ import annotations
 
 import math
@@ -7,23 +8,33 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .base import (Case, CaseResult, Check, Context, load_case_scenario, loglog_slope, new_figure,
-                   parabolic_peak, simulate, step_changes)
+from .base import (
+    Case,
+    CaseResult,
+    Check,
+    Context,
+    load_case_scenario,
+    loglog_slope,
+    new_figure,
+    parabolic_peak,
+    simulate,
+    step_changes,
+)
 from .granular import _material, sphere_mass
 
 CHAIN_WINDOW = (8, 20)  # beads (striker = 0) where the solitary wave is measured
 
 
-def _chain_measure(t: np.ndarray, vx: np.ndarray, x: np.ndarray | None, radius: float,
-                   window: tuple[int, int] = CHAIN_WINDOW) -> dict:
+def _chain_measure(
+    t: np.ndarray, vx: np.ndarray, x: np.ndarray | None, radius: float, window: tuple[int, int] = CHAIN_WINDOW
+) -> dict:
     """Speed [beads / time unit], mean peak velocity and mean peak overlap over the window."""
     idx = np.arange(window[0], window[1] + 1)
     tp = np.empty(len(idx))
     vm = np.empty(len(idx))
     for k, i in enumerate(idx):
         tp[k], vm[k] = parabolic_peak(t, vx[:, i])
-    out = {"beads_per_time": 1.0 / float(np.polyfit(idx, tp, 1)[0]), "v_max": float(vm.mean()),
-           "peak_times": tp}
+    out = {"beads_per_time": 1.0 / float(np.polyfit(idx, tp, 1)[0]), "v_max": float(vm.mean()), "peak_times": tp}
     if x is not None:
         dm = np.empty(len(idx))
         for k, i in enumerate(idx):
@@ -81,55 +92,99 @@ def striker_chain(ctx: Context) -> CaseResult:
         ds = simulate(s)
         meas = _chain_measure(ds.time.values, ds.vx.values, ds.x.values, radius)
         V = meas["beads_per_time"] * a_spacing
-        res[v0] = {"V": V, "v_max": meas["v_max"], "delta_max": meas["delta_max"],
-                   "F_max": A * meas["delta_max"] ** 1.5, "T": T, "ds": ds,
-                   "V_ref": a_spacing * ref["beads_per_time"] / T}
+        res[v0] = {
+            "V": V,
+            "v_max": meas["v_max"],
+            "delta_max": meas["delta_max"],
+            "F_max": A * meas["delta_max"] ** 1.5,
+            "T": T,
+            "ds": ds,
+            "V_ref": a_spacing * ref["beads_per_time"] / T,
+        }
     r1 = res[1.0]
     v_lw = (16.0 / 25.0) ** 0.2 * c**0.8 * r1["v_max"] ** 0.2
     checks = [
-        Check("solitary-wave speed V_s, striker 1 m/s", "m/s", v_lw,
-              "Nesterenko (2001), long-wave: V_s = (16/25)^(1/5) c0^(4/5) v_m^(1/5), v_m ours",
-              r1["V"], 0.02,
-              "2%, the discrete wave is known to run about 1% slower than the "
-              "long-wave (continuum) compacton of the same amplitude; the independent discrete "
-              "solution below gives that offset exactly."),
-        Check("solitary-wave speed V_s, striker 1 m/s", "m/s", r1["V_ref"],
-              "independent discrete chain (scipy DOP853, rtol 1e-12)", r1["V"], 1e-6,
-              "peak times and values are parabola-interpolated from samples every T/100 (error "
-              "~(T/100 / pulse width)^3 ~ 1e-7) and RK4 at h = 10 ns ~ T/2500 is accurate to "
-              "~1e-8: 1e-6 bounds both."),
-        Check("peak particle velocity / striker velocity", "-", ref["v_ratio"],
-              "independent discrete chain (scipy DOP853, rtol 1e-12)", r1["v_max"] / 1.0, 1e-6,
-              "as above."),
+        Check(
+            "solitary-wave speed V_s, striker 1 m/s",
+            "m/s",
+            v_lw,
+            "Nesterenko (2001), long-wave: V_s = (16/25)^(1/5) c0^(4/5) v_m^(1/5), v_m ours",
+            r1["V"],
+            0.02,
+            "2%, the discrete wave is known to run about 1% slower than the "
+            "long-wave (continuum) compacton of the same amplitude; the independent discrete "
+            "solution below gives that offset exactly.",
+        ),
+        Check(
+            "solitary-wave speed V_s, striker 1 m/s",
+            "m/s",
+            r1["V_ref"],
+            "independent discrete chain (scipy DOP853, rtol 1e-12)",
+            r1["V"],
+            1e-6,
+            "peak times and values are parabola-interpolated from samples every T/100 (error "
+            "~(T/100 / pulse width)^3 ~ 1e-7) and RK4 at h = 10 ns ~ T/2500 is accurate to "
+            "~1e-8: 1e-6 bounds both.",
+        ),
+        Check(
+            "peak particle velocity / striker velocity",
+            "-",
+            ref["v_ratio"],
+            "independent discrete chain (scipy DOP853, rtol 1e-12)",
+            r1["v_max"] / 1.0,
+            1e-6,
+            "as above.",
+        ),
     ]
     F = np.array([res[v]["F_max"] for v in speeds])
     V = np.array([res[v]["V"] for v in speeds])
     vm = np.array([res[v]["v_max"] for v in speeds])
-    checks.append(Check("exponent of V_s against peak contact force, 0.1-10 m/s", "-", 1.0 / 6.0,
-                        "Nesterenko: V_s ~ F_m^(1/6) (Hertz law, no precompression)",
-                        loglog_slope(F, V), 1e-6,
-                        "the Hertz chain is exactly self-similar, so only the numerical errors of "
-                        "V_s and F_m (<= 1e-7 each at every speed, as above; h/T goes from 1/4000 to "
-                        "1/1600 at the fixed h = 10 ns) enter the slope, divided by ln(F ratio) ~ 14: "
-                        "1e-6 bounds them.", kind="abs"))
-    checks.append(Check("exponent of V_s against peak particle velocity, 0.1-10 m/s", "-", 0.2,
-                        "Nesterenko: V_s ~ v_m^(1/5)", loglog_slope(vm, V), 1e-6,
-                        "as above.", kind="abs"))
+    checks.append(
+        Check(
+            "exponent of V_s against peak contact force, 0.1-10 m/s",
+            "-",
+            1.0 / 6.0,
+            "Nesterenko: V_s ~ F_m^(1/6) (Hertz law, no precompression)",
+            loglog_slope(F, V),
+            1e-6,
+            "the Hertz chain is exactly self-similar, so only the numerical errors of "
+            "V_s and F_m (<= 1e-7 each at every speed, as above; h/T goes from 1/4000 to "
+            "1/1600 at the fixed h = 10 ns) enter the slope, divided by ln(F ratio) ~ 14: "
+            "1e-6 bounds them.",
+            kind="abs",
+        )
+    )
+    checks.append(
+        Check(
+            "exponent of V_s against peak particle velocity, 0.1-10 m/s",
+            "-",
+            0.2,
+            "Nesterenko: V_s ~ v_m^(1/5)",
+            loglog_slope(vm, V),
+            1e-6,
+            "as above.",
+            kind="abs",
+        )
+    )
     offset = r1["V_ref"] / v_lw - 1.0
 
-    desc = ("A steel striker (R = 10 mm) hits a chain of 24 touching steel spheres without "
-            "precompression and without damping (`striker-chain.toml`, h = 10 ns). A single "
-            "solitary wave forms within a few beads; its speed is fitted from the times of "
-            f"peak velocity of beads {CHAIN_WINDOW[0]}-{CHAIN_WINDOW[1]}. Long-wave theory "
-            "(Nesterenko 2001, Dynamics of Heterogeneous Materials, ch. 1): with c0^2 = "
-            "2E/(pi rho (1 - nu^2)), V_s = (2/sqrt 5) c0 xi_m^(1/4) = (16/25)^(1/5) c0^(4/5) "
-            "v_m^(1/5), xi_m the peak strain and v_m the peak particle velocity, so V_s ~ "
-            "F_m^(1/6). An independent scipy integration of the 1-D chain gives the exact "
-            "discrete speed and amplitude.")
-    notes = [f"Discreteness offset (independent discrete solution vs long-wave theory at the same "
-             f"v_m): {offset * 100:+.2f}%; granplate vs long-wave: {(r1['V'] / v_lw - 1) * 100:+.2f}%.",
-             f"Peak particle velocity {ref['v_ratio']:.4f} of the striker's (equal masses): the "
-             "striker hands most of its momentum to one wave and rebounds slowly."]
+    desc = (
+        "A steel striker (R = 10 mm) hits a chain of 24 touching steel spheres without "
+        "precompression and without damping (`striker-chain.toml`, h = 10 ns). A single "
+        "solitary wave forms within a few beads; its speed is fitted from the times of "
+        f"peak velocity of beads {CHAIN_WINDOW[0]}-{CHAIN_WINDOW[1]}. Long-wave theory "
+        "(Nesterenko 2001, Dynamics of Heterogeneous Materials, ch. 1): with c0^2 = "
+        "2E/(pi rho (1 - nu^2)), V_s = (2/sqrt 5) c0 xi_m^(1/4) = (16/25)^(1/5) c0^(4/5) "
+        "v_m^(1/5), xi_m the peak strain and v_m the peak particle velocity, so V_s ~ "
+        "F_m^(1/6). An independent scipy integration of the 1-D chain gives the exact "
+        "discrete speed and amplitude."
+    )
+    notes = [
+        f"Discreteness offset (independent discrete solution vs long-wave theory at the same "
+        f"v_m): {offset * 100:+.2f}%; granplate vs long-wave: {(r1['V'] / v_lw - 1) * 100:+.2f}%.",
+        f"Peak particle velocity {ref['v_ratio']:.4f} of the striker's (equal masses): the "
+        "striker hands most of its momentum to one wave and rebounds slowly.",
+    ]
     return CaseResult.of(desc, checks, notes=notes, plot={"ds": r1["ds"], "F": F, "V": V, "vm": vm, "c": c})
 
 
@@ -149,8 +204,7 @@ def draw_striker_chain(p: dict):
     ax.loglog(F, V, "o", label="granplate, striker 0.1 / 1 / 10 m/s")
     ff = np.geomspace(F.min() / 1.5, F.max() * 1.5, 20)
     ax.loglog(ff, V[1] * (ff / F[1]) ** (1 / 6), "--", label="slope 1/6")
-    ax.loglog(F, [(16 / 25) ** 0.2 * c**0.8 * v ** 0.2 for v in vm], "s", mfc="none",
-              label="long-wave theory (same v_m)")
+    ax.loglog(F, [(16 / 25) ** 0.2 * c**0.8 * v**0.2 for v in vm], "s", mfc="none", label="long-wave theory (same v_m)")
     ax.set_xlabel("peak contact force F_m [N]")
     ax.set_ylabel("solitary-wave speed V_s [m/s]")
     ax.legend(fontsize=7)
@@ -158,6 +212,11 @@ def draw_striker_chain(p: dict):
 
 
 CASES: tuple[Case, ...] = (
-    Case("striker-chain", "granular", "Striker on a chain: Nesterenko's solitary wave", striker_chain,
-         draw=draw_striker_chain),
+    Case(
+        "striker-chain",
+        "granular",
+        "Striker on a chain: Nesterenko's solitary wave",
+        striker_chain,
+        draw=draw_striker_chain,
+    ),
 )

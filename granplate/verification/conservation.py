@@ -6,6 +6,7 @@ The energy residual (E_p + E_g + D - E_shock - E_0) / max(E_in) is an output of 
 shrinks when the step is halved: a term missing from the bookkeeping would leave a
 residual that does not.
 """
+
 from __future__ import annotations
 
 import math
@@ -14,35 +15,44 @@ import numpy as np
 
 from granplate.solver.schemes.implicit import ENERGY_STEP_FRACTION
 from granplate.setup.scenario import Solver
-from .base import (EPS, Case, CaseResult, Check, Context, load_case_scenario, new_figure,
-                   observed_order, simulate)
+from .base import EPS, Case, CaseResult, Check, Context, load_case_scenario, new_figure, observed_order, simulate
 
 #: Shortened run of the fast suite [s]: the 10 µs shock and the first arrivals at the plate.
 SHORT_T_END = 5e-5
 #: Largest energy residual accepted at the default step.
 RESIDUAL_TOL = 1e-6
-RESIDUAL_WHY = ("one part per million, a hundred times below the simulator's own abort "
-                "threshold (solver.energy_tol = 1e-4) and far above the values seen (1e-10 ... "
-                "1e-8); the order row below shows that what remains is discretisation error.")
+RESIDUAL_WHY = (
+    "one part per million, a hundred times below the simulator's own abort "
+    "threshold (solver.energy_tol = 1e-4) and far above the values seen (1e-10 ... "
+    "1e-8); the order row below shows that what remains is discretisation error."
+)
 
 
 #: The implicit scheme's step control lets the residual grow by solver.energy_tol times
 #: schemes.implicit.ENERGY_STEP_FRACTION over a run.
 IMPLICIT_RESIDUAL_TOL = Solver().energy_tol * ENERGY_STEP_FRACTION
-IMPLICIT_RESIDUAL_WHY = ("the implicit scheme picks its step so that the residual grows by at most "
-                         f"solver.energy_tol x ENERGY_STEP_FRACTION = {Solver().energy_tol:g} x "
-                         f"{ENERGY_STEP_FRACTION:g} over a run (its "
-                         "accuracy, not a stability limit, sets the step, so the residual is larger "
-                         "than the paper scheme's at its tiny steps, and its order is not a step "
-                         "property).")
+IMPLICIT_RESIDUAL_WHY = (
+    "the implicit scheme picks its step so that the residual grows by at most "
+    f"solver.energy_tol x ENERGY_STEP_FRACTION = {Solver().energy_tol:g} x "
+    f"{ENERGY_STEP_FRACTION:g} over a run (its "
+    "accuracy, not a stability limit, sets the step, so the residual is larger "
+    "than the paper scheme's at its tiny steps, and its order is not a step "
+    "property)."
+)
 
 
 def _halved(s):
     """The scenario with every step halved: dt_max, dt_initial and the eq. (8) target."""
     from granplate.setup.io import with_changes
 
-    return with_changes(s, {"time.dt_max": s.time.dt_max / 2, "time.dt_initial": s.time.dt_initial / 2,
-                            "solver.lambda_target": s.solver.lambda_target / 2})
+    return with_changes(
+        s,
+        {
+            "time.dt_max": s.time.dt_max / 2,
+            "time.dt_initial": s.time.dt_initial / 2,
+            "solver.lambda_target": s.solver.lambda_target / 2,
+        },
+    )
 
 
 def _residual(ds) -> float:
@@ -62,9 +72,18 @@ def energy_residual(ctx: Context) -> CaseResult:
     for name in preset_names():
         # the default (implicit) scheme: its step control holds the residual's growth
         r_imp = _residual(simulate_short(preset(name)))
-        checks.append(Check(f"max |energy residual|, {name}, 50 µs, implicit scheme", "-", 0.0,
-                            "exact balance E_p + E_g + D = E_shock (docs/model.md section 7)", r_imp,
-                            IMPLICIT_RESIDUAL_TOL, IMPLICIT_RESIDUAL_WHY, kind="max"))
+        checks.append(
+            Check(
+                f"max |energy residual|, {name}, 50 µs, implicit scheme",
+                "-",
+                0.0,
+                "exact balance E_p + E_g + D = E_shock (docs/model.md section 7)",
+                r_imp,
+                IMPLICIT_RESIDUAL_TOL,
+                IMPLICIT_RESIDUAL_WHY,
+                kind="max",
+            )
+        )
         # the paper scheme: size and order under step halving
         s = with_changes(preset(name), {"solver.scheme": "paper"})
         ds = simulate_short(s)
@@ -73,43 +92,82 @@ def energy_residual(ctx: Context) -> CaseResult:
         series[name] = ds
         n_steps = int(ds.n_steps.values[-1]) if "n_steps" in ds else 0
         if s.layout is None and not s.granules:  # bare plate: Newmark's exact energy identity
-            checks.append(Check(f"max |energy residual|, {name}, 50 µs", "-", 0.0,
-                                "Newmark average acceleration + trapezoidal load work: exact balance",
-                                r1, max(n_steps, 1) * EPS * 10,
-                                "for a linear undamped system the average-acceleration rule with "
-                                "the trapezoidal work of the load conserves energy exactly; only "
-                                "round-off accumulates (10 eps per step).", kind="max"))
+            checks.append(
+                Check(
+                    f"max |energy residual|, {name}, 50 µs",
+                    "-",
+                    0.0,
+                    "Newmark average acceleration + trapezoidal load work: exact balance",
+                    r1,
+                    max(n_steps, 1) * EPS * 10,
+                    "for a linear undamped system the average-acceleration rule with "
+                    "the trapezoidal work of the load conserves energy exactly; only "
+                    "round-off accumulates (10 eps per step).",
+                    kind="max",
+                )
+            )
             continue
-        checks.append(Check(f"max |energy residual|, {name}, 50 µs", "-", 0.0,
-                            "exact balance E_p + E_g + D = E_shock (docs/model.md section 7)", r1,
-                            RESIDUAL_TOL, RESIDUAL_WHY, kind="max"))
-        checks.append(Check(f"observed order of the residual, {name}, h -> h/2", "-", 1.0,
-                            "consistency: the residual vanishes as h -> 0", observed_order(r1, r2),
-                            1.0, "any consistent bookkeeping gives order >= 1; expected between 5/4 "
-                            "(t^(1/4) onset of the damping force, see Chung & Ooi test 3) and 2 "
-                            "(trapezoidal interface work on the plate side).", kind="min"))
+        checks.append(
+            Check(
+                f"max |energy residual|, {name}, 50 µs",
+                "-",
+                0.0,
+                "exact balance E_p + E_g + D = E_shock (docs/model.md section 7)",
+                r1,
+                RESIDUAL_TOL,
+                RESIDUAL_WHY,
+                kind="max",
+            )
+        )
+        checks.append(
+            Check(
+                f"observed order of the residual, {name}, h -> h/2",
+                "-",
+                1.0,
+                "consistency: the residual vanishes as h -> 0",
+                observed_order(r1, r2),
+                1.0,
+                "any consistent bookkeeping gives order >= 1; expected between 5/4 "
+                "(t^(1/4) onset of the damping force, see Chung & Ooi test 3) and 2 "
+                "(trapezoidal interface work on the plate side).",
+                kind="min",
+            )
+        )
     if ctx.full:
         from .coupled import study_run
 
         for name, s_full in full_runs():
             summ = study_run(ctx, s_full)
             full_rows.append((name, summ))
-            checks.append(Check(f"max |energy residual|, {name}, full 2 ms run", "-", 0.0,
-                                "exact balance E_p + E_g + D = E_shock (docs/model.md section 7)",
-                                summ["energy_residual_max"], RESIDUAL_TOL, RESIDUAL_WHY, kind="max"))
-    desc = ("Every preset (`granplate presets`) is run for 50 µs (the shock and the first "
-            "arrivals at the plate) with the default (implicit) scheme, and with the paper "
-            "scheme at its default settings and again with every step halved "
-            "(time.dt_max, time.dt_initial and solver.lambda_target halved); the largest "
-            "per-step residual |E_p + E_g + D - E_shock - E_0| / max(E_in) is reported. "
-            + ("With --full the full 2 ms runs are checked too." if ctx.full else
-               "The full 2 ms runs are checked by `granplate verify --full`."))
+            checks.append(
+                Check(
+                    f"max |energy residual|, {name}, full 2 ms run",
+                    "-",
+                    0.0,
+                    "exact balance E_p + E_g + D = E_shock (docs/model.md section 7)",
+                    summ["energy_residual_max"],
+                    RESIDUAL_TOL,
+                    RESIDUAL_WHY,
+                    kind="max",
+                )
+            )
+    desc = (
+        "Every preset (`granplate presets`) is run for 50 µs (the shock and the first "
+        "arrivals at the plate) with the default (implicit) scheme, and with the paper "
+        "scheme at its default settings and again with every step halved "
+        "(time.dt_max, time.dt_initial and solver.lambda_target halved); the largest "
+        "per-step residual |E_p + E_g + D - E_shock - E_0| / max(E_in) is reported. "
+        + (
+            "With --full the full 2 ms runs are checked too."
+            if ctx.full
+            else "The full 2 ms runs are checked by `granplate verify --full`."
+        )
+    )
     res = CaseResult.of(desc, checks, plot={"series": series})
     if full_rows:
         lines = ["| preset | E_shock [J] | max abs residual, 2 ms | steps |", "|---|---|---|---|"]
         for name, summ in full_rows:
-            lines.append(f"| {name} | {summ['e_shock']:.4e} | {summ['energy_residual_max']:.2e} | "
-                         f"{summ['n_steps']} |")
+            lines.append(f"| {name} | {summ['e_shock']:.4e} | {summ['energy_residual_max']:.2e} | {summ['n_steps']} |")
         res.tables.append("\n".join(lines))
     return res
 
@@ -146,6 +204,7 @@ def simulate_short(s):
 
 
 # --------------------------------------------------------------------------- momenta
+
 
 def _momenta(ds) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, float]:
     """(p_x, p_y, L_z about the origin) over time, and their scales sum m|v|, sum |m r x v| + |I w|."""
@@ -197,28 +256,61 @@ def free_assembly(ctx: Context) -> CaseResult:
     s_fric = load_case_scenario("free-assembly")
     s_free = load_case_scenario("free-assembly", {"contact.mu": 0.0})
     s_arm = load_case_scenario("free-assembly", {"contact.torque_arm": "contact_point"})
-    runs = {"friction": simulate(s_fric), "frictionless": simulate(s_free),
-            "friction, contact-point arm": simulate(s_arm)}
+    runs = {
+        "friction": simulate(s_fric),
+        "frictionless": simulate(s_free),
+        "friction, contact-point arm": simulate(s_arm),
+    }
     n_steps = int(runs["friction"].n_steps.values[-1])
     tol = n_steps * EPS
-    roundoff_why = (f"pairwise forces cancel exactly, so only round-off accumulates: {n_steps} "
-                    f"steps x eps = {tol:.1e} (worst case, linear growth).")
+    roundoff_why = (
+        f"pairwise forces cancel exactly, so only round-off accumulates: {n_steps} "
+        f"steps x eps = {tol:.1e} (worst case, linear growth)."
+    )
     checks = []
     mom = {k: _momenta(ds) for k, ds in runs.items()}
     for k in ("friction", "frictionless", "friction, contact-point arm"):
         px, py, L, ps, Ls = mom[k]
         drift = float(max(np.abs(px - px[0]).max(), np.abs(py - py[0]).max()) / ps)
-        checks.append(Check(f"linear momentum drift / sum m|v|, {k}", "-", 0.0,
-                            "Newton's third law: conserved", drift, tol, roundoff_why, kind="max"))
+        checks.append(
+            Check(
+                f"linear momentum drift / sum m|v|, {k}",
+                "-",
+                0.0,
+                "Newton's third law: conserved",
+                drift,
+                tol,
+                roundoff_why,
+                kind="max",
+            )
+        )
     px, py, L, ps, Ls = mom["frictionless"]
-    checks.append(Check("angular momentum drift / scale, frictionless (mu = 0)", "-", 0.0,
-                        "central forces: conserved", float(np.abs(L - L[0]).max() / Ls), tol,
-                        roundoff_why, kind="max"))
+    checks.append(
+        Check(
+            "angular momentum drift / scale, frictionless (mu = 0)",
+            "-",
+            0.0,
+            "central forces: conserved",
+            float(np.abs(L - L[0]).max() / Ls),
+            tol,
+            roundoff_why,
+            kind="max",
+        )
+    )
     px, py, L, ps, Ls = mom["friction, contact-point arm"]
     L_drift = float(np.abs(L - L[0]).max() / Ls)
-    checks.append(Check("angular momentum drift / scale, with friction (mu = 0.3), "
-                        "contact.torque_arm = contact_point", "-", 0.0,
-                        "conserved to round-off", L_drift, tol, roundoff_why, kind="max"))
+    checks.append(
+        Check(
+            "angular momentum drift / scale, with friction (mu = 0.3), contact.torque_arm = contact_point",
+            "-",
+            0.0,
+            "conserved to round-off",
+            L_drift,
+            tol,
+            roundoff_why,
+            kind="max",
+        )
+    )
     model = build_model(s_fric)
     ds = runs["friction"]
     state = np.stack([ds[k].values for k in ("x", "y", "theta", "vx", "vy", "omega")], axis=-1)
@@ -229,19 +321,32 @@ def free_assembly(ctx: Context) -> CaseResult:
         defect[n] = couple
         if scale > 0:
             worst = max(worst, abs(dL - couple) / scale)
-    checks.append(Check("dL/dt + sum f delta, every output, / sum of torque terms", "-", 0.0,
-                        "eq. (1), docs/model.md section 3.1: torque arm R leaves the couple -f delta per pair", worst,
-                        100 * EPS, "both sides evaluated at the same state: round-off of a sum of "
-                        "~20 terms (100 eps).", kind="max"))
+    checks.append(
+        Check(
+            "dL/dt + sum f delta, every output, / sum of torque terms",
+            "-",
+            0.0,
+            "eq. (1), docs/model.md section 3.1: torque arm R leaves the couple -f delta per pair",
+            worst,
+            100 * EPS,
+            "both sides evaluated at the same state: round-off of a sum of ~20 terms (100 eps).",
+            kind="max",
+        )
+    )
     L_fric = mom["friction"][2]
     L_change = float(L_fric[-1] - L_fric[0])
-    impulse = float(np.trapezoid(defect, ds.time.values)) if hasattr(np, "trapezoid") else float(
-        np.trapz(defect, ds.time.values))
-    desc = ("Four steel spheres (R = 8-10 mm) with spins collide obliquely in free space, no "
-            "walls, plate or load (`free-assembly.toml`: mu = 0.3, alpha_n = 0.05, h = 10 ns, 1 ms, "
-            "several collisions with sliding and damping), and the same with mu = 0. Linear "
-            "momentum sum m v and angular momentum about the origin sum m (x v_y - y v_x) + I "
-            "omega are evaluated at every output (1 µs).")
+    impulse = (
+        float(np.trapezoid(defect, ds.time.values))
+        if hasattr(np, "trapezoid")
+        else float(np.trapz(defect, ds.time.values))
+    )
+    desc = (
+        "Four steel spheres (R = 8-10 mm) with spins collide obliquely in free space, no "
+        "walls, plate or load (`free-assembly.toml`: mu = 0.3, alpha_n = 0.05, h = 10 ns, 1 ms, "
+        "several collisions with sliding and damping), and the same with mu = 0. Linear "
+        "momentum sum m v and angular momentum about the origin sum m (x v_y - y v_x) + I "
+        "omega are evaluated at every output (1 µs)."
+    )
     notes = [
         "With the torques of the paper's eq. (1) (docs/model.md section 3, the default "
         "contact.torque_arm = radius) angular momentum is not conserved when friction acts: "
@@ -307,10 +412,12 @@ def _gradient(fun, x0: np.ndarray, eta: float) -> np.ndarray:
     """4th-order central differences of a scalar function."""
     grad = np.zeros_like(x0)
     for k in range(x0.size):
+
         def at(s):
             x = x0.copy()
             x.flat[k] += s
             return fun(x)
+
         grad.flat[k] = (8 * (at(eta) - at(-eta)) - (at(2 * eta) - at(-2 * eta))) / (12 * eta)
     return grad
 
@@ -329,7 +436,8 @@ def force_gradient(ctx: Context) -> CaseResult:
     d_min = min(
         [g.radius[i] + g.radius[j] - math.hypot(*(y[j, :2] - y[i, :2])) for i, j in g.pair_ij]
         + [float(y[i, 0] * geo[0] + y[i, 1] * geo[1] + g.radius[i] - geo[2]) for i, geo in zip(g.wall_i, g.wall_geo)]
-        + [float(y[i, 0] + g.radius[i] - (g.pc_x[k] + up[2 * k])) for k, i in enumerate(g.pc_i)])
+        + [float(y[i, 0] + g.radius[i] - (g.pc_x[k] + up[2 * k])) for k, i in enumerate(g.pc_i)]
+    )
     if not d_min > 0:
         raise RuntimeError(f"force-gradient assembly not in overlap everywhere (min delta {d_min:g})")
 
@@ -347,28 +455,55 @@ def force_gradient(ctx: Context) -> CaseResult:
     scale = float(np.abs(forces).max())
     err_g = float(np.abs(forces + grad_pos).max() / scale)
     err_p = float(np.abs(fplate + grad_u).max() / scale)
-    why = ("4th-order central differences with eta ~ 1e-3 delta_min, a power of two so that "
-           "x +- eta is exact: truncation ~(eta/delta)^4 ~ 1e-12, round-off ~eps E/(eta F) ~ "
-           "1e-12; tolerance 1e-10.")
+    why = (
+        "4th-order central differences with eta ~ 1e-3 delta_min, a power of two so that "
+        "x +- eta is exact: truncation ~(eta/delta)^4 ~ 1e-12, round-off ~eps E/(eta F) ~ "
+        "1e-12; tolerance 1e-10."
+    )
     checks = [
-        Check("max |F + dE/dx| / max |F|, granules (2 pairs, 2 walls, 1 plate)", "-", 0.0,
-              "F = -grad E, E = sum 2/5 A delta^(5/2) (eq. 9)", err_g, 1e-10, why, kind="max"),
-        Check("max |F_plate + dE/du| / max |F|, plate contact", "-", 0.0,
-              "force on the plate = -dE/du at the driving dofs", err_p, 1e-10, why, kind="max"),
-        Check("max |torque| / (max |F| R), at rest", "-", 0.0,
-              "normal forces are central: no torque without slip", float(np.abs(torques).max() / (scale * g.radius.max())),
-              EPS, "at zero velocity the friction is mu |N| tanh(0) = 0 exactly.", kind="max"),
+        Check(
+            "max |F + dE/dx| / max |F|, granules (2 pairs, 2 walls, 1 plate)",
+            "-",
+            0.0,
+            "F = -grad E, E = sum 2/5 A delta^(5/2) (eq. 9)",
+            err_g,
+            1e-10,
+            why,
+            kind="max",
+        ),
+        Check(
+            "max |F_plate + dE/du| / max |F|, plate contact",
+            "-",
+            0.0,
+            "force on the plate = -dE/du at the driving dofs",
+            err_p,
+            1e-10,
+            why,
+            kind="max",
+        ),
+        Check(
+            "max |torque| / (max |F| R), at rest",
+            "-",
+            0.0,
+            "normal forces are central: no torque without slip",
+            float(np.abs(torques).max() / (scale * g.radius.max())),
+            EPS,
+            "at zero velocity the friction is mu |N| tanh(0) = 0 exactly.",
+            kind="max",
+        ),
     ]
     etas = 2.0 ** np.round(np.log2(np.geomspace(1e-7, 0.3, 20) * d_min))
     errs = [float(np.abs(forces + _gradient(e_pos, y[:, 0:2].copy(), e)).max() / scale) for e in etas]
-    desc = ("A static assembly (`force-gradient.toml`: three spheres, steel and PTFE, touching "
-            "each other, a left and a bottom wall, and a 2 x 20 plate through a rigid layer) is "
-            "pressed into overlap by displacing the granules and the plate contact by a few "
-            f"µm (smallest overlap {d_min:.2e} m), at rest. The forces returned by the compiled "
-            "`solver.granular.granular_rhs` are compared with minus the finite-difference gradient of "
-            "the contact energy it returns (sum 2/5 A delta^(5/2) over every pair, wall and "
-            "plate contact), with respect to every granule coordinate and the plate's "
-            "driving displacement.")
+    desc = (
+        "A static assembly (`force-gradient.toml`: three spheres, steel and PTFE, touching "
+        "each other, a left and a bottom wall, and a 2 x 20 plate through a rigid layer) is "
+        "pressed into overlap by displacing the granules and the plate contact by a few "
+        f"µm (smallest overlap {d_min:.2e} m), at rest. The forces returned by the compiled "
+        "`solver.granular.granular_rhs` are compared with minus the finite-difference gradient of "
+        "the contact energy it returns (sum 2/5 A delta^(5/2) over every pair, wall and "
+        "plate contact), with respect to every granule coordinate and the plate's "
+        "driving displacement."
+    )
     return CaseResult.of(desc, checks, plot={"etas": etas, "d_min": d_min, "errs": errs, "eta": eta})
 
 
@@ -387,10 +522,15 @@ def draw_force_gradient(p: dict):
 
 
 CASES: tuple[Case, ...] = (
-    Case("energy-residual", "conservation", "Energy residual of every preset", energy_residual,
-         draw=draw_energy_residual),
-    Case("free-assembly", "conservation", "Momenta of a free assembly", free_assembly,
-         draw=draw_free_assembly),
-    Case("force-gradient", "conservation", "Forces = minus the gradient of the contact energies", force_gradient,
-         draw=draw_force_gradient),
+    Case(
+        "energy-residual", "conservation", "Energy residual of every preset", energy_residual, draw=draw_energy_residual
+    ),
+    Case("free-assembly", "conservation", "Momenta of a free assembly", free_assembly, draw=draw_free_assembly),
+    Case(
+        "force-gradient",
+        "conservation",
+        "Forces = minus the gradient of the contact energies",
+        force_gradient,
+        draw=draw_force_gradient,
+    ),
 )

@@ -13,6 +13,7 @@ Runs are expensive (5-150 s each), so their summaries are kept in the run store
 the store's key of the scenario, the end time and the package version: a second `--full`
 run only computes what changed (like pystencils' parameter studies).
 """
+
 from __future__ import annotations
 
 import json
@@ -38,9 +39,11 @@ QUANTITIES: tuple[tuple[str, str, str, float], ...] = (
 NO_MESH_LIMIT: tuple[str, ...] = ("max_von_mises",)
 #: Relative accuracy asked of the default settings.
 TARGET = 0.01
-TARGET_WHY = ("the paper quotes these figures to two significant digits at most ('a little over "
-              "50%', 'about 10%', '~80 MPa'); a numerical error below 1% of the value leaves them "
-              "unchanged.")
+TARGET_WHY = (
+    "the paper quotes these figures to two significant digits at most ('a little over "
+    "50%', 'about 10%', '~80 MPa'); a numerical error below 1% of the value leaves them "
+    "unchanged."
+)
 
 
 @dataclass(frozen=True)
@@ -59,30 +62,54 @@ W_DEFAULT = 0.0025
 #: The studies run the paper scheme, which takes the dense basis only ("auto" would give
 #: 8 x 80 the truncated one; docs/model.md section 4.5).
 STUDIES: tuple[Study, ...] = (
-    Study("time step (time.dt_max and solver.lambda_target halved)", (
-        ("40 ns, lambda 0.5 (default)", {}),
-        ("20 ns, lambda 0.25", {"time.dt_max": 2e-8, "time.dt_initial": 2e-8, "solver.lambda_target": 0.25}),
-        ("10 ns, lambda 0.125", {"time.dt_max": 1e-8, "time.dt_initial": 1e-8, "solver.lambda_target": 0.125}),
-    ), 0, check=True),
-    Study("iteration tolerance (solver.iteration_rtol and _atol halved)", (
-        ("1e-9, 1e-10 N (default)", {}),
-        ("5e-10, 5e-11 N", {"solver.iteration_rtol": 5e-10, "solver.iteration_atol": 5e-11}),
-        ("2.5e-10, 2.5e-11 N", {"solver.iteration_rtol": 2.5e-10, "solver.iteration_atol": 2.5e-11}),
-    ), 0, check=True),
-    Study("element size, default rigid layer w = 2.5 mm", (
-        ("4 x 40 (default)", {}),
-        ("8 x 80", {"plate.nx": 8, "plate.ny": 80, "plate.rigid_layer_width": W_DEFAULT, "plate.modes": "all"}),
-    ), 0, check=True),
-    Study("element size at a fixed rigid layer w = 5 mm (three levels)", (
-        ("2 x 20", {"plate.nx": 2, "plate.ny": 20, "plate.rigid_layer_width": 0.005}),
-        ("4 x 40", {"plate.rigid_layer_width": 0.005}),
-        ("8 x 80", {"plate.nx": 8, "plate.ny": 80, "plate.rigid_layer_width": 0.005, "plate.modes": "all"}),
-    ), None),
-    Study("rigid-layer width on the 4 x 40 mesh (a model parameter, not a discretisation)", (
-        ("w -> 0 (driving node only)", {"plate.rigid_layer_width": 1e-4}),
-        ("w = 2.5 mm (default)", {}),
-        ("w = 5 mm", {"plate.rigid_layer_width": 0.005}),
-    ), 1, refinement=False),
+    Study(
+        "time step (time.dt_max and solver.lambda_target halved)",
+        (
+            ("40 ns, lambda 0.5 (default)", {}),
+            ("20 ns, lambda 0.25", {"time.dt_max": 2e-8, "time.dt_initial": 2e-8, "solver.lambda_target": 0.25}),
+            ("10 ns, lambda 0.125", {"time.dt_max": 1e-8, "time.dt_initial": 1e-8, "solver.lambda_target": 0.125}),
+        ),
+        0,
+        check=True,
+    ),
+    Study(
+        "iteration tolerance (solver.iteration_rtol and _atol halved)",
+        (
+            ("1e-9, 1e-10 N (default)", {}),
+            ("5e-10, 5e-11 N", {"solver.iteration_rtol": 5e-10, "solver.iteration_atol": 5e-11}),
+            ("2.5e-10, 2.5e-11 N", {"solver.iteration_rtol": 2.5e-10, "solver.iteration_atol": 2.5e-11}),
+        ),
+        0,
+        check=True,
+    ),
+    Study(
+        "element size, default rigid layer w = 2.5 mm",
+        (
+            ("4 x 40 (default)", {}),
+            ("8 x 80", {"plate.nx": 8, "plate.ny": 80, "plate.rigid_layer_width": W_DEFAULT, "plate.modes": "all"}),
+        ),
+        0,
+        check=True,
+    ),
+    Study(
+        "element size at a fixed rigid layer w = 5 mm (three levels)",
+        (
+            ("2 x 20", {"plate.nx": 2, "plate.ny": 20, "plate.rigid_layer_width": 0.005}),
+            ("4 x 40", {"plate.rigid_layer_width": 0.005}),
+            ("8 x 80", {"plate.nx": 8, "plate.ny": 80, "plate.rigid_layer_width": 0.005, "plate.modes": "all"}),
+        ),
+        None,
+    ),
+    Study(
+        "rigid-layer width on the 4 x 40 mesh (a model parameter, not a discretisation)",
+        (
+            ("w -> 0 (driving node only)", {"plate.rigid_layer_width": 1e-4}),
+            ("w = 2.5 mm (default)", {}),
+            ("w = 5 mm", {"plate.rigid_layer_width": 0.005}),
+        ),
+        1,
+        refinement=False,
+    ),
 )
 
 
@@ -211,7 +238,13 @@ def study_tables(results: dict, preset: str) -> str:
     out = [f"#### {preset}"]
     for study in STUDIES:
         runs = results[(preset, study.name)]
-        head = "| " + study.name + " | " + " | ".join(f"{lab} [{u}]" for _, lab, u, _ in QUANTITIES) + " | steps | wall [s] |"
+        head = (
+            "| "
+            + study.name
+            + " | "
+            + " | ".join(f"{lab} [{u}]" for _, lab, u, _ in QUANTITIES)
+            + " | steps | wall [s] |"
+        )
         out += ["", head, "|---" * (len(QUANTITIES) + 3) + "|"]
         for (label, _), summ in zip(study.levels, runs):
             vals = " | ".join(_fmt(summ[k], u, sc) for k, _, u, sc in QUANTITIES)
@@ -254,8 +287,10 @@ def _disc_lines(results: dict) -> list[str]:
         runs = results[(name, study.name)]
         point = ", ".join(f"{r['max_von_mises'] / 1e6:.1f}" for r in runs)
         disc = ", ".join(f"{r['max_von_mises_disc'] / 1e6:.2f}" for r in runs)
-        lines.append(f"{name} on {', '.join(lab for lab, _ in study.levels)} (w = 5 mm): disc average "
-                     f"{disc} MPa, point peak {point} MPa")
+        lines.append(
+            f"{name} on {', '.join(lab for lab, _ in study.levels)} (w = 5 mm): disc average "
+            f"{disc} MPa, point peak {point} MPa"
+        )
     return lines
 
 
@@ -274,25 +309,37 @@ def coupled_convergence(ctx: Context) -> CaseResult:
             for k, lab, u, sc in QUANTITIES:
                 if k in NO_MESH_LIMIT and study.name.startswith("element size"):
                     continue
-                checks.append(Check(
-                    f"{lab}, {name}: default vs {study.levels[study.default + 1][0]} ({study.name.split(' (')[0]})",
-                    u, f[k] * sc, "the same run with the parameter halved", d[k] * sc, TARGET, TARGET_WHY))
+                checks.append(
+                    Check(
+                        f"{lab}, {name}: default vs {study.levels[study.default + 1][0]} ({study.name.split(' (')[0]})",
+                        u,
+                        f[k] * sc,
+                        "the same run with the parameter halved",
+                        d[k] * sc,
+                        TARGET,
+                        TARGET_WHY,
+                    )
+                )
     tables = [study_tables(results, name) for name in PRESETS]
     loc_lines = []
     for name in PRESETS:
         for study, w in zip(STUDIES[2:4], ("w = 2.5 mm", "w = 5 mm")):
             for (label, _), summ in zip(study.levels, results[(name, study.name)]):
                 x, y = summ.get("vm_location", [math.nan, math.nan])
-                loc_lines.append(f"{name}, {label} ({w}): "
-                                 f"{summ['max_von_mises'] / 1e6:.1f} MPa, element at x - x0 = "
-                                 f"{x * 1e3:.2f} mm, y = {y * 1e3:.2f} mm")
-    desc = ("Full 2 ms runs of `ptfe-r05` and `steel-r1` with one numerical parameter changed at a "
-            "time (results cached in `validation-runs.json`). The step study halves time.dt_max "
-            "and solver.lambda_target together, so that every step halves (the eq. (8) step "
-            "control sets most steps below dt_max); the mesh is refined at a fixed physical "
-            "rigid-layer width, since the default width is one element edge and would shrink "
-            "with the mesh. Checks ask that halving a parameter changes each figure by less "
-            "than 1%.")
+                loc_lines.append(
+                    f"{name}, {label} ({w}): "
+                    f"{summ['max_von_mises'] / 1e6:.1f} MPa, element at x - x0 = "
+                    f"{x * 1e3:.2f} mm, y = {y * 1e3:.2f} mm"
+                )
+    desc = (
+        "Full 2 ms runs of `ptfe-r05` and `steel-r1` with one numerical parameter changed at a "
+        "time (results cached in `validation-runs.json`). The step study halves time.dt_max "
+        "and solver.lambda_target together, so that every step halves (the eq. (8) step "
+        "control sets most steps below dt_max); the mesh is refined at a fixed physical "
+        "rigid-layer width, since the default width is one element edge and would shrink "
+        "with the mesh. Checks ask that halving a parameter changes each figure by less "
+        "than 1%."
+    )
     notes = [
         "Time step and iteration tolerance are converged far beyond the paper's precision: "
         "halving the step changes each figure by less than 1e-4 of its value, halving "
@@ -321,8 +368,10 @@ def coupled_convergence(ctx: Context) -> CaseResult:
     ]
     unique = {id(s): s for runs in results.values() for s in runs}
     total = sum(s["wall_time_s"] for s in unique.values())
-    notes.append(f"The {len(unique)} distinct runs took {total:.0f} s of wall time when computed "
-                 "(a second `--full` takes them from validation-runs.json).")
+    notes.append(
+        f"The {len(unique)} distinct runs took {total:.0f} s of wall time when computed "
+        "(a second `--full` takes them from validation-runs.json)."
+    )
     res = CaseResult.of(desc, checks, plot={"results": results}, notes=notes, tables=tables)
     return res
 
@@ -338,8 +387,9 @@ def draw_coupled_convergence(p: dict):
             ref = runs[1][k]
             ax.plot([5.0, 2.5, 1.25], [r[k] / ref for r in runs], marker + "-", label=f"{name}, w = 5 mm")
             dflt = results[(name, STUDIES[2].name)]
-            ax.plot([2.5, 1.25], [r[k] / dflt[0][k] for r in dflt], marker + "--", mfc="none",
-                    label=f"{name}, w = 2.5 mm")
+            ax.plot(
+                [2.5, 1.25], [r[k] / dflt[0][k] for r in dflt], marker + "--", mfc="none", label=f"{name}, w = 2.5 mm"
+            )
         ax.set_xscale("log")
         ax.minorticks_off()
         ax.set_xticks([1.25, 2.5, 5.0], ["1.25", "2.5", "5"])
@@ -351,6 +401,12 @@ def draw_coupled_convergence(p: dict):
 
 
 CASES: tuple[Case, ...] = (
-    Case("coupled-convergence", "coupled", "Coupled runs: convergence and error bars of the default settings",
-         coupled_convergence, draw=draw_coupled_convergence, slow=True),
+    Case(
+        "coupled-convergence",
+        "coupled",
+        "Coupled runs: convergence and error bars of the default settings",
+        coupled_convergence,
+        draw=draw_coupled_convergence,
+        slow=True,
+    ),
 )

@@ -9,6 +9,7 @@ tight tolerances) of the contact laws of docs/model.md section 3 (eqs. 2-6) over
 pair and every (granule, wall), written here from the equations with the coefficients
 computed here from the material constants.
 """
+
 from __future__ import annotations
 
 import math
@@ -16,8 +17,7 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .base import (Case, CaseResult, Check, Context, load_case_scenario, new_figure,
-                   simulate)
+from .base import Case, CaseResult, Check, Context, load_case_scenario, new_figure, simulate
 from .granular import HERTZ_SOURCE, HERTZ_TC, ODE_SOURCE, hertz_reference, impact_ode, plane_modulus, sphere_mass
 
 #: Source line of the independent integrator.
@@ -28,6 +28,7 @@ HERTZ_TC_SCALE = HERTZ_TC * (15.0 / 16.0) ** 0.4
 
 
 # --------------------------------------------------------------------------- closed forms
+
 
 def hertz_contact_time(m_star: float, r_star: float, e_star: float, v: float) -> float:
     """Elastic Hertz contact time [s] at approach speed v [m/s]:
@@ -45,6 +46,7 @@ def effective(mat_i, mat_j, r_i: float, r_j: float | None) -> tuple[float, float
 
 
 # --------------------------------------------------------------------------- the independent integrator
+
 
 def reference_bodies(s) -> dict:
     """Masses, inertias, radii and the contact coefficients of every pair and every
@@ -67,9 +69,21 @@ def reference_bodies(s) -> dict:
     walls = [(np.array(w.normal, float) / np.hypot(*w.normal), float(w.offset)) for w in s.walls]
     a_wall = np.array([4.0 / 3.0 * plane_modulus(mt.E, mt.nu) * math.sqrt(ri) for mt, ri in zip(mats, r)])
     c_wall = s.contact.alpha_n * np.sqrt(m * a_wall)
-    return {"r": r, "m": m, "inertia": 0.4 * m * r * r, "i": ii, "j": jj, "a": a_pair, "c": c_pair,
-            "walls": walls, "a_wall": a_wall, "c_wall": c_wall, "mu": s.contact.mu, "k_s": s.contact.k_s,
-            "clip": s.contact.clip_tensile}
+    return {
+        "r": r,
+        "m": m,
+        "inertia": 0.4 * m * r * r,
+        "i": ii,
+        "j": jj,
+        "a": a_pair,
+        "c": c_pair,
+        "walls": walls,
+        "a_wall": a_wall,
+        "c_wall": c_wall,
+        "mu": s.contact.mu,
+        "k_s": s.contact.k_s,
+        "clip": s.contact.clip_tensile,
+    }
 
 
 def normal_force(a: np.ndarray, c: np.ndarray, delta: np.ndarray, rate: np.ndarray, clip: bool) -> np.ndarray:
@@ -89,7 +103,7 @@ def reference_rhs(b: dict):
     mu, ks, clip = b["mu"], b["k_s"], b["clip"]
 
     def rhs(_t, z):
-        x, y, vx, vy, w = z[:n], z[n:2 * n], z[3 * n:4 * n], z[4 * n:5 * n], z[5 * n:]
+        x, y, vx, vy, w = z[:n], z[n : 2 * n], z[3 * n : 4 * n], z[4 * n : 5 * n], z[5 * n :]
         fx, fy, tq = np.zeros(n), np.zeros(n), np.zeros(n)
         dx, dy = x[j] - x[i], y[j] - y[i]
         dist = np.hypot(dx, dy)
@@ -109,7 +123,7 @@ def reference_rhs(b: dict):
             np.add.at(fy, b_, f_n * ny_ + f_t * nx_)
             np.add.at(tq, a_, -f_t * r[a_])
             np.add.at(tq, b_, -f_t * r[b_])
-        for (wn, off) in b["walls"]:
+        for wn, off in b["walls"]:
             delta_w = x * wn[0] + y * wn[1] + r - off
             if (delta_w > 0.0).any():
                 rate = vx * wn[0] + vy * wn[1]
@@ -131,10 +145,26 @@ def reference_motion(s, times: np.ndarray, rtol: float = 1e-11, max_step: float 
     at `times` [s]."""
     b = reference_bodies(s)
     g = s.granules
-    z0 = np.concatenate([[q.x for q in g], [q.y for q in g], np.zeros(len(g)),
-                         [q.vx for q in g], [q.vy for q in g], [q.omega for q in g]])
-    sol = solve_ivp(reference_rhs(b), (0.0, float(times[-1])), z0, method="DOP853", rtol=rtol, atol=1e-15,
-                    t_eval=times, max_step=max_step)
+    z0 = np.concatenate(
+        [
+            [q.x for q in g],
+            [q.y for q in g],
+            np.zeros(len(g)),
+            [q.vx for q in g],
+            [q.vy for q in g],
+            [q.omega for q in g],
+        ]
+    )
+    sol = solve_ivp(
+        reference_rhs(b),
+        (0.0, float(times[-1])),
+        z0,
+        method="DOP853",
+        rtol=rtol,
+        atol=1e-15,
+        t_eval=times,
+        max_step=max_step,
+    )
     if not sol.success:
         raise RuntimeError(f"reference integrator failed: {sol.message}")
     return sol.y.T.reshape(len(times), 6, len(g))
@@ -148,11 +178,13 @@ def crossings(t: np.ndarray, f: np.ndarray) -> np.ndarray:
 
 # --------------------------------------------------------------------------- two spheres from a gap
 
-GAP_WHY = ("the contact starts inside a step, where the force grows like t^(3/2): RK4's "
-           "error is then O(h^(5/2)) per impact (chung-ooi-1), (h/t_c)^(5/2) = 5e-10 at "
-           "h = 10 ns = t_c/5300, and the zero crossings of the overlap are interpolated from "
-           "samples every step, where the overlap is linear in t to O(t^(7/2)): 1e-8 leaves a "
-           "factor of 20.")
+GAP_WHY = (
+    "the contact starts inside a step, where the force grows like t^(3/2): RK4's "
+    "error is then O(h^(5/2)) per impact (chung-ooi-1), (h/t_c)^(5/2) = 5e-10 at "
+    "h = 10 ns = t_c/5300, and the zero crossings of the overlap are interpolated from "
+    "samples every step, where the overlap is linear in t to O(t^(7/2)): 1e-8 leaves a "
+    "factor of 20."
+)
 
 
 def _gap_run(alpha: float) -> dict:
@@ -168,9 +200,20 @@ def _gap_run(alpha: float) -> dict:
     overlap = a.radius + b.radius - (ds.x.values[:, 1] - ds.x.values[:, 0])
     cross = crossings(t, overlap)
     v_after = ds.vx.values[-1, 1] - ds.vx.values[-1, 0]
-    return {"scenario": s, "t": t, "overlap": overlap, "t_in": float(cross[0]), "t_out": float(cross[1]),
-            "e": float(v_after / v), "v": v, "gap": gap, "m_star": m_star, "r_star": r_star, "e_star": e_star,
-            "residual": float(np.abs(ds.energy_residual.values).max())}
+    return {
+        "scenario": s,
+        "t": t,
+        "overlap": overlap,
+        "t_in": float(cross[0]),
+        "t_out": float(cross[1]),
+        "e": float(v_after / v),
+        "v": v,
+        "gap": gap,
+        "m_star": m_star,
+        "r_star": r_star,
+        "e_star": e_star,
+        "residual": float(np.abs(ds.energy_residual.values).max()),
+    }
 
 
 def gap_head_on(ctx: Context) -> CaseResult:
@@ -186,35 +229,76 @@ def gap_head_on(ctx: Context) -> CaseResult:
     length = (dm["m_star"] * dm["v"] ** 2 / a_coef) ** 0.4
     tc_damped = (s_end + sol.y[0, -1] / e_ref) * length / dm["v"]
     checks = [
-        Check("first touch t = gap / v", "s", el["gap"] / el["v"], "free flight", el["t_in"], 1e-9,
-              "free flight is integrated exactly by RK4 (constant velocity); only the linear "
-              "interpolation of the overlap's crossing (curvature zero before contact) remains."),
-        Check("contact time, elastic", "s", tc_ref, HERTZ_SOURCE + ": 2.868 (m*^2/(R* E*^2 v))^(1/5)",
-              el["t_out"] - el["t_in"], 1e-8, GAP_WHY),
-        Check("elastic restitution |1 - e|", "-", 0.0, "no damping: e = 1", abs(1.0 - el["e"]), 1e-8,
-              GAP_WHY, kind="max"),
-        Check(f"restitution, alpha_n = {alpha:g}", "-", e_ref, ODE_SOURCE, dm["e"], alpha * (1 / 5300) ** 1.25,
-              "the damping force grows like t^(1/4) at contact onset, so RK4's error in e is "
-              "O(alpha (h/t_c)^(5/4)) (chung-ooi-3)."),
-        Check(f"contact time, alpha_n = {alpha:g}", "s", tc_damped, ODE_SOURCE + " (force zero + free separation)",
-              dm["t_out"] - dm["t_in"], 1e-5,
-              "after the force vanishes the overlap closes at the exit speed, whose error is "
-              "O(alpha (h/t_c)^(5/4)) = 1e-6 (chung-ooi-3); 1e-5 bounds its effect on the last, "
-              "force-free part of the contact."),
-        Check("energy residual, both runs", "-", 0.0, "eq. (11): E_g + D = E_initial",
-              max(el["residual"], dm["residual"]), 1e-8,
-              "RK4's energy error over one impact at h = t_c/5300 is ~1e-10; 1e-8 is a factor "
-              "100 above it and 1e4 below energy_tol.", kind="max"),
+        Check(
+            "first touch t = gap / v",
+            "s",
+            el["gap"] / el["v"],
+            "free flight",
+            el["t_in"],
+            1e-9,
+            "free flight is integrated exactly by RK4 (constant velocity); only the linear "
+            "interpolation of the overlap's crossing (curvature zero before contact) remains.",
+        ),
+        Check(
+            "contact time, elastic",
+            "s",
+            tc_ref,
+            HERTZ_SOURCE + ": 2.868 (m*^2/(R* E*^2 v))^(1/5)",
+            el["t_out"] - el["t_in"],
+            1e-8,
+            GAP_WHY,
+        ),
+        Check(
+            "elastic restitution |1 - e|", "-", 0.0, "no damping: e = 1", abs(1.0 - el["e"]), 1e-8, GAP_WHY, kind="max"
+        ),
+        Check(
+            f"restitution, alpha_n = {alpha:g}",
+            "-",
+            e_ref,
+            ODE_SOURCE,
+            dm["e"],
+            alpha * (1 / 5300) ** 1.25,
+            "the damping force grows like t^(1/4) at contact onset, so RK4's error in e is "
+            "O(alpha (h/t_c)^(5/4)) (chung-ooi-3).",
+        ),
+        Check(
+            f"contact time, alpha_n = {alpha:g}",
+            "s",
+            tc_damped,
+            ODE_SOURCE + " (force zero + free separation)",
+            dm["t_out"] - dm["t_in"],
+            1e-5,
+            "after the force vanishes the overlap closes at the exit speed, whose error is "
+            "O(alpha (h/t_c)^(5/4)) = 1e-6 (chung-ooi-3); 1e-5 bounds its effect on the last, "
+            "force-free part of the contact.",
+        ),
+        Check(
+            "energy residual, both runs",
+            "-",
+            0.0,
+            "eq. (11): E_g + D = E_initial",
+            max(el["residual"], dm["residual"]),
+            1e-8,
+            "RK4's energy error over one impact at h = t_c/5300 is ~1e-10; 1e-8 is a factor "
+            "100 above it and 1e4 below energy_tol.",
+            kind="max",
+        ),
     ]
-    desc = ("Two steel spheres (R = 10 mm) start 1.23 mm apart and fly at each other at 1 m/s each "
-            "(`gap-head-on.toml`, `contact.detection = \"dynamic\"`, h = 10 ns, about t_c/5300): the "
-            "pair is in the Verlet list but not touching at t = 0. The first touch must come at "
-            "gap / v, the contact must last Hertz's t_c = 2.868 (m*^2 / (R* E*^2 v))^(1/5) (E*, "
-            "R*, m* computed here from the material constants), and the spheres must leave at "
-            "e = 1 without damping; with alpha_n = 0.05 the restitution and the contact time "
-            "(until the overlap closes) come from the normalised damped-impact ODE.")
-    return CaseResult.of(desc, checks, plot={"el": el, "dm": dm, "alpha": alpha, "tc_ref": tc_ref},
-                         notes=[f"Contact time: Hertz {tc_ref:.6e} s; damped (alpha_n = {alpha:g}) {tc_damped:.6e} s."])
+    desc = (
+        "Two steel spheres (R = 10 mm) start 1.23 mm apart and fly at each other at 1 m/s each "
+        '(`gap-head-on.toml`, `contact.detection = "dynamic"`, h = 10 ns, about t_c/5300): the '
+        "pair is in the Verlet list but not touching at t = 0. The first touch must come at "
+        "gap / v, the contact must last Hertz's t_c = 2.868 (m*^2 / (R* E*^2 v))^(1/5) (E*, "
+        "R*, m* computed here from the material constants), and the spheres must leave at "
+        "e = 1 without damping; with alpha_n = 0.05 the restitution and the contact time "
+        "(until the overlap closes) come from the normalised damped-impact ODE."
+    )
+    return CaseResult.of(
+        desc,
+        checks,
+        plot={"el": el, "dm": dm, "alpha": alpha, "tc_ref": tc_ref},
+        notes=[f"Contact time: Hertz {tc_ref:.6e} s; damped (alpha_n = {alpha:g}) {tc_damped:.6e} s."],
+    )
 
 
 def draw_gap_head_on(p: dict):
@@ -236,6 +320,7 @@ def draw_gap_head_on(p: dict):
 
 # --------------------------------------------------------------------------- oblique impact
 
+
 def oblique_gap(ctx: Context) -> CaseResult:
     """A spinning sphere hits a resting one off-centre from a gap, with friction and
     damping: velocities and spins after impact against the independent integrator."""
@@ -243,8 +328,9 @@ def oblique_gap(ctx: Context) -> CaseResult:
     ds = simulate(s)
     t = ds.time.values
     ref = reference_motion(s, t)
-    ours = np.stack([ds.x.values, ds.y.values, np.zeros_like(ds.x.values), ds.vx.values, ds.vy.values,
-                     ds.omega.values], axis=1)
+    ours = np.stack(
+        [ds.x.values, ds.y.values, np.zeros_like(ds.x.values), ds.vx.values, ds.vy.values, ds.omega.values], axis=1
+    )
     a, b = s.granules
     v0 = math.hypot(a.vx, a.vy)
     r = a.radius
@@ -253,42 +339,77 @@ def oblique_gap(ctx: Context) -> CaseResult:
     k = int(np.argmin(dist))
     nvec = np.array([ds.x.values[k, 1] - ds.x.values[k, 0], ds.y.values[k, 1] - ds.y.values[k, 0]]) / dist[k]
     tvec = np.array([-nvec[1], nvec[0]])
-    slip = ((ds.vx.values[:, 0] - ds.vx.values[:, 1]) * tvec[0] + (ds.vy.values[:, 0] - ds.vy.values[:, 1]) * tvec[1]
-            + r * ds.omega.values[:, 0] + b.radius * ds.omega.values[:, 1])
+    slip = (
+        (ds.vx.values[:, 0] - ds.vx.values[:, 1]) * tvec[0]
+        + (ds.vy.values[:, 0] - ds.vy.values[:, 1]) * tvec[1]
+        + r * ds.omega.values[:, 0]
+        + b.radius * ds.omega.values[:, 1]
+    )
     vel_err = float(np.abs(ours[-1, 3:5] - ref[-1, 3:5]).max() / v0)
     spin_err = float(np.abs(ours[-1, 5] - ref[-1, 5]).max() * r / v0)
     pos_err = float(np.abs(ours[:, :2] - ref[:, :2]).max() / r)
-    why = ("RK4 at h = 5 ns (t_c = 56 µs at the normal approach speed 1.6 m/s: h = t_c/11000) with "
-           "the contact starting inside a step: the error of the impulse is O(alpha (h/t_c)^(5/4)) "
-           "~ 5e-7 relative (damping onset, chung-ooi-3; measured 7e-7) and O((h/t_c)^(5/2)) from the "
-           "Hertz onset; the reference integrates to rtol 1e-11; 1e-5 leaves a factor of 10 for the "
-           "constant.")
+    why = (
+        "RK4 at h = 5 ns (t_c = 56 µs at the normal approach speed 1.6 m/s: h = t_c/11000) with "
+        "the contact starting inside a step: the error of the impulse is O(alpha (h/t_c)^(5/4)) "
+        "~ 5e-7 relative (damping onset, chung-ooi-3; measured 7e-7) and O((h/t_c)^(5/2)) from the "
+        "Hertz onset; the reference integrates to rtol 1e-11; 1e-5 leaves a factor of 10 for the "
+        "constant."
+    )
     checks = [
-        Check("contact forms during the run", "-", 1.0, "none at t = 0, a contact later",
-              float((not touching[0]) and touching.any() and not touching[-1]), 0.0,
-              "the pair must touch and separate", kind="abs"),
+        Check(
+            "contact forms during the run",
+            "-",
+            1.0,
+            "none at t = 0, a contact later",
+            float((not touching[0]) and touching.any() and not touching[-1]),
+            0.0,
+            "the pair must touch and separate",
+            kind="abs",
+        ),
         Check("velocities after impact, max |v - v_ref| / v0", "-", 0.0, IVP_SOURCE, vel_err, 1e-5, why, kind="max"),
-        Check("spins after impact, max R |omega - omega_ref| / v0", "-", 0.0, IVP_SOURCE, spin_err, 1e-5, why,
-              kind="max"),
-        Check("positions over the run, max |s - s_ref| / R", "-", 0.0, IVP_SOURCE, pos_err, 1e-7,
-              why + " Positions integrate the velocity error over 0.1 ms: v0 x 1e-5 x 1e-4 s / R = 2e-7 at most.",
-              kind="max"),
-        Check("slip keeps its sign (gross sliding)", "-", 1.0, "mu (1 + e) J_n (7/2) / m* below the initial slip",
-              float(np.all(np.sign(slip[touching]) == np.sign(slip[k]))), 0.0,
-              "the case is built to slide throughout, where tanh(k_s v_t) = sign(v_t) and the reference is not stiff",
-              kind="abs"),
+        Check(
+            "spins after impact, max R |omega - omega_ref| / v0", "-", 0.0, IVP_SOURCE, spin_err, 1e-5, why, kind="max"
+        ),
+        Check(
+            "positions over the run, max |s - s_ref| / R",
+            "-",
+            0.0,
+            IVP_SOURCE,
+            pos_err,
+            1e-7,
+            why + " Positions integrate the velocity error over 0.1 ms: v0 x 1e-5 x 1e-4 s / R = 2e-7 at most.",
+            kind="max",
+        ),
+        Check(
+            "slip keeps its sign (gross sliding)",
+            "-",
+            1.0,
+            "mu (1 + e) J_n (7/2) / m* below the initial slip",
+            float(np.all(np.sign(slip[touching]) == np.sign(slip[k]))),
+            0.0,
+            "the case is built to slide throughout, where tanh(k_s v_t) = sign(v_t) and the reference is not stiff",
+            kind="abs",
+        ),
     ]
-    desc = ("A steel sphere (R = 10 mm) spinning at 30 rad/s flies at 2 m/s into a resting one, "
-            "off-centre (impact parameter 12 mm), from a gap (`oblique-gap.toml`, dynamic "
-            "detection, mu = 0.08, k_s = 1000 s/m, alpha_n = 0.05, h = 5 ns). Every velocity "
-            "and spin over the run is compared with an independent solve_ivp (DOP853, rtol 1e-11) "
-            "of the same contact equations (Hertz + damping along the line of centres, "
-            "tanh-Coulomb friction on the slip rate with torque arms R, docs/model.md 3.2), "
-            "written in this module from the equations.")
-    return CaseResult.of(desc, checks, plot={"t": t, "ds": ds, "s": s, "ref": ref}, notes=[
-        f"After impact: ours v_a = ({ours[-1, 3, 0]:.8f}, {ours[-1, 4, 0]:.8f}) m/s, "
-        f"omega_a = {ours[-1, 5, 0]:.6f} rad/s; "
-        f"reference ({ref[-1, 3, 0]:.8f}, {ref[-1, 4, 0]:.8f}) m/s, {ref[-1, 5, 0]:.6f} rad/s."])
+    desc = (
+        "A steel sphere (R = 10 mm) spinning at 30 rad/s flies at 2 m/s into a resting one, "
+        "off-centre (impact parameter 12 mm), from a gap (`oblique-gap.toml`, dynamic "
+        "detection, mu = 0.08, k_s = 1000 s/m, alpha_n = 0.05, h = 5 ns). Every velocity "
+        "and spin over the run is compared with an independent solve_ivp (DOP853, rtol 1e-11) "
+        "of the same contact equations (Hertz + damping along the line of centres, "
+        "tanh-Coulomb friction on the slip rate with torque arms R, docs/model.md 3.2), "
+        "written in this module from the equations."
+    )
+    return CaseResult.of(
+        desc,
+        checks,
+        plot={"t": t, "ds": ds, "s": s, "ref": ref},
+        notes=[
+            f"After impact: ours v_a = ({ours[-1, 3, 0]:.8f}, {ours[-1, 4, 0]:.8f}) m/s, "
+            f"omega_a = {ours[-1, 5, 0]:.6f} rad/s; "
+            f"reference ({ref[-1, 3, 0]:.8f}, {ref[-1, 4, 0]:.8f}) m/s, {ref[-1, 5, 0]:.6f} rad/s."
+        ],
+    )
 
 
 def draw_oblique_gap(p: dict):
@@ -315,6 +436,7 @@ def draw_oblique_gap(p: dict):
 
 
 # --------------------------------------------------------------------------- between two walls
+
 
 def _bounces(t: np.ndarray, x: np.ndarray, vx: np.ndarray, centre: float) -> np.ndarray:
     """Times the sphere passes the middle moving right [s]."""
@@ -353,34 +475,76 @@ def wall_bounce(ctx: Context) -> CaseResult:
     k_imp = np.arange(len(ratio))  # impacts before each pass of the middle
     decay_err = float(np.abs(ratio / e_ref**k_imp - 1.0).max())
     checks = [
-        Check(f"period, mean of {len(periods)} (elastic)", "s", period_ref,
-              HERTZ_SOURCE + ": 2 gap / v + 2 t_c", float(periods.mean()), 2e-8,
-              "each wall impact starts inside a step: O((h/t_c)^(5/2)) = 1e-8 of t_c from the Hertz "
-              "onset (h = 20 ns = t_c/1700), i.e. 4e-9 of the period; the passes of the middle are "
-              "interpolated in free flight, exactly: 2e-8 leaves a factor of 5."),
-        Check("period spread max |T_k / T_mean - 1|", "-", 0.0, "elastic: every period equal",
-              float(np.abs(periods / periods.mean() - 1.0).max()), 2e-8,
-              "each impact's error is of the size of the period's (above)", kind="max"),
-        Check(f"kinetic energy in free flight over {len(ups)} bounces, max |E/E_0 - 1|", "-", 0.0,
-              "no damping: energy conserved", energy_drift, 1e-7,
-              "RK4's error per impact at h = t_c/1700 is O((h/t_c)^(5/2)) = 1e-8 (onset inside a "
-              "step), with either sign; 1e-7 bounds it over ~20 impacts.", kind="max"),
-        Check(f"speed after k impacts / e^k, alpha_n = {alpha:g}, max over {len(ratio)} passes", "-", 0.0,
-              ODE_SOURCE + ": e independent of the speed", decay_err, 20 * alpha * (1 / 1700) ** 1.25,
-              "each impact errs by O(alpha (h/t_c)^(5/4)) (chung-ooi-3); the errors add over up to "
-              "20 impacts.", kind="max"),
+        Check(
+            f"period, mean of {len(periods)} (elastic)",
+            "s",
+            period_ref,
+            HERTZ_SOURCE + ": 2 gap / v + 2 t_c",
+            float(periods.mean()),
+            2e-8,
+            "each wall impact starts inside a step: O((h/t_c)^(5/2)) = 1e-8 of t_c from the Hertz "
+            "onset (h = 20 ns = t_c/1700), i.e. 4e-9 of the period; the passes of the middle are "
+            "interpolated in free flight, exactly: 2e-8 leaves a factor of 5.",
+        ),
+        Check(
+            "period spread max |T_k / T_mean - 1|",
+            "-",
+            0.0,
+            "elastic: every period equal",
+            float(np.abs(periods / periods.mean() - 1.0).max()),
+            2e-8,
+            "each impact's error is of the size of the period's (above)",
+            kind="max",
+        ),
+        Check(
+            f"kinetic energy in free flight over {len(ups)} bounces, max |E/E_0 - 1|",
+            "-",
+            0.0,
+            "no damping: energy conserved",
+            energy_drift,
+            1e-7,
+            "RK4's error per impact at h = t_c/1700 is O((h/t_c)^(5/2)) = 1e-8 (onset inside a "
+            "step), with either sign; 1e-7 bounds it over ~20 impacts.",
+            kind="max",
+        ),
+        Check(
+            f"speed after k impacts / e^k, alpha_n = {alpha:g}, max over {len(ratio)} passes",
+            "-",
+            0.0,
+            ODE_SOURCE + ": e independent of the speed",
+            decay_err,
+            20 * alpha * (1 / 1700) ** 1.25,
+            "each impact errs by O(alpha (h/t_c)^(5/4)) (chung-ooi-3); the errors add over up to 20 impacts.",
+            kind="max",
+        ),
     ]
-    desc = ("A steel sphere (R = 10 mm) at 10 m/s between two walls whose distance exceeds its "
-            "diameter by 0.5 mm (`wall-bounce.toml`, dynamic detection, h = 20 ns): every wall "
-            "contact forms during the run. Without damping the period must be the free flight "
-            "2 gap / v plus two Hertz sphere-on-wall contact times, and the kinetic energy in "
-            "free flight must stay constant over all bounces; with alpha_n = 0.02 each impact "
-            "multiplies the speed by the same e (the normalised ODE: e does not depend on the "
-            "speed).")
-    plot = {"t": t, "ds": ds, "centre": centre, "dd": dd, "xd": xd,
-            "alpha": alpha, "free": free, "k_imp": k_imp, "ratio": ratio, "e_ref": e_ref}
-    return CaseResult.of(desc, checks, plot=plot,
-                         notes=[f"Elastic: {len(ups)} passes, period {periods.mean():.9e} s vs {period_ref:.9e} s."])
+    desc = (
+        "A steel sphere (R = 10 mm) at 10 m/s between two walls whose distance exceeds its "
+        "diameter by 0.5 mm (`wall-bounce.toml`, dynamic detection, h = 20 ns): every wall "
+        "contact forms during the run. Without damping the period must be the free flight "
+        "2 gap / v plus two Hertz sphere-on-wall contact times, and the kinetic energy in "
+        "free flight must stay constant over all bounces; with alpha_n = 0.02 each impact "
+        "multiplies the speed by the same e (the normalised ODE: e does not depend on the "
+        "speed)."
+    )
+    plot = {
+        "t": t,
+        "ds": ds,
+        "centre": centre,
+        "dd": dd,
+        "xd": xd,
+        "alpha": alpha,
+        "free": free,
+        "k_imp": k_imp,
+        "ratio": ratio,
+        "e_ref": e_ref,
+    }
+    return CaseResult.of(
+        desc,
+        checks,
+        plot=plot,
+        notes=[f"Elastic: {len(ups)} passes, period {periods.mean():.9e} s vs {period_ref:.9e} s."],
+    )
 
 
 def draw_wall_bounce(p: dict):
@@ -415,8 +579,9 @@ LOOSE_BOX = 0.07
 LOOSE_SEED = 7
 
 
-def loose_packing(count: int = LOOSE_COUNT, seed: int = LOOSE_SEED, t_end: float = 4e-3, dt: float = 2e-8,
-                  alpha_n: float = 0.0):
+def loose_packing(
+    count: int = LOOSE_COUNT, seed: int = LOOSE_SEED, t_end: float = 4e-3, dt: float = 2e-8, alpha_n: float = 0.0
+):
     """`count` steel spheres of radii 4-8 mm at seeded random sites in a closed box of
     side LOOSE_BOX sqrt(count / LOOSE_COUNT) [m] (the same area per granule), none touching
     anything at t = 0 (gaps >= 0.3 mm), random velocities up to 3 m/s, frictionless,
@@ -432,13 +597,23 @@ def loose_packing(count: int = LOOSE_COUNT, seed: int = LOOSE_SEED, t_end: float
         if all(math.hypot(x - g.x, y - g.y) > r + g.radius + 3e-4 for g in gs):
             vx, vy = (float(v) for v in rng.uniform(-3.0, 3.0, 2))
             gs.append(Granule(x=x, y=y, radius=r, material="steel", label=f"g{len(gs)}", vx=vx, vy=vy))
-    walls = (Wall(normal=(-1.0, 0.0), offset=0.0, label="left"), Wall(normal=(1.0, 0.0), offset=side, label="right"),
-             Wall(normal=(0.0, -1.0), offset=0.0, label="bottom"), Wall(normal=(0.0, 1.0), offset=side, label="top"))
-    return Scenario(name="loose-packing", granules=tuple(gs), walls=walls, load=Load(kind="none"),
-                    contact=Contact(mu=0.0, alpha_n=alpha_n, pairs=(), detection="dynamic"),
-                    time=TimeSettings(t_end=t_end, dt_initial=dt, dt_max=dt, output_interval=t_end / 100,
-                                      field_interval=t_end / 100),
-                    solver=_paper_solver())
+    walls = (
+        Wall(normal=(-1.0, 0.0), offset=0.0, label="left"),
+        Wall(normal=(1.0, 0.0), offset=side, label="right"),
+        Wall(normal=(0.0, -1.0), offset=0.0, label="bottom"),
+        Wall(normal=(0.0, 1.0), offset=side, label="top"),
+    )
+    return Scenario(
+        name="loose-packing",
+        granules=tuple(gs),
+        walls=walls,
+        load=Load(kind="none"),
+        contact=Contact(mu=0.0, alpha_n=alpha_n, pairs=(), detection="dynamic"),
+        time=TimeSettings(
+            t_end=t_end, dt_initial=dt, dt_max=dt, output_interval=t_end / 100, field_interval=t_end / 100
+        ),
+        solver=_paper_solver(),
+    )
 
 
 def _paper_solver():
@@ -464,38 +639,64 @@ def loose_packing_case(ctx: Context) -> CaseResult:
     v_scale = 3.0
     pos_err = float(np.abs(np.stack([ds.x.values, ds.y.values], 1) - ref[:, :2]).max())
     vel_err = float(np.abs(np.stack([ds.vx.values, ds.vy.values], 1) - ref[:, 3:5]).max() / v_scale)
-    why = ("RK4 at h = 20 ns (about t_c/1000 of the fastest impact) with every contact starting "
-           "inside a step: O((h/t_c)^(5/2)) ~ 3e-8 of the impact per impact, carried and amplified "
-           "by the collisions that follow (measured: 6e-10 m and 1.6e-6 of 3 m/s with 16 granules, "
-           "5e-10 m and 1.0e-5 with 30); mid-contact samples turn a position error into a force error times the "
-           "contact stiffness, hence the looser bound on velocities.")
+    why = (
+        "RK4 at h = 20 ns (about t_c/1000 of the fastest impact) with every contact starting "
+        "inside a step: O((h/t_c)^(5/2)) ~ 3e-8 of the impact per impact, carried and amplified "
+        "by the collisions that follow (measured: 6e-10 m and 1.6e-6 of 3 m/s with 16 granules, "
+        "5e-10 m and 1.0e-5 with 30); mid-contact samples turn a position error into a force error times the "
+        "contact stiffness, hence the looser bound on velocities."
+    )
     checks = [
         Check(f"positions, max over {n} granules and the run", "m", 0.0, IVP_SOURCE, pos_err, 2e-8, why, kind="max"),
         Check("velocities, max |v - v_ref| / 3 m/s", "-", 0.0, IVP_SOURCE, vel_err, 5e-5, why, kind="max"),
-        Check("pairs that touched during the run (none at t = 0)", "-", 5.0, "contacts must form",
-              float(pairs_met), 5.0, "a packing test needs several collisions", kind="min"),
-        Check("energy residual", "-", 0.0, "eq. (11)", float(np.abs(ds.energy_residual.values).max()), 1e-7,
-              "RK4's energy error over a few tens of impacts at h = 20 ns.", kind="max"),
+        Check(
+            "pairs that touched during the run (none at t = 0)",
+            "-",
+            5.0,
+            "contacts must form",
+            float(pairs_met),
+            5.0,
+            "a packing test needs several collisions",
+            kind="min",
+        ),
+        Check(
+            "energy residual",
+            "-",
+            0.0,
+            "eq. (11)",
+            float(np.abs(ds.energy_residual.values).max()),
+            1e-7,
+            "RK4's energy error over a few tens of impacts at h = 20 ns.",
+            kind="max",
+        ),
     ]
-    desc = (f"{n} steel spheres (R = 4-8 mm, seed {LOOSE_SEED}) at random sites in a closed "
-            f"{side * 1e3:.0f} mm box, none touching anything at t = 0, with random "
-            "velocities up to 3 m/s, frictionless and undamped (damping is checked by the "
-            "cases above), dynamic detection, "
-            f"h = 20 ns, {t[-1] * 1e3:g} ms "
-            f"({'--full' if ctx.full else f'quick; {LOOSE_COUNT_FULL} granules with --full'}). "
-            "Every position and velocity is compared, at 100 output times, with an independent "
-            "solve_ivp (DOP853, rtol 1e-11, steps <= 1 µs) of the Hertz law over all pairs and all walls, "
-            "written in this module from the equations (no neighbour list: every pair is tested "
-            "at every evaluation).")
+    desc = (
+        f"{n} steel spheres (R = 4-8 mm, seed {LOOSE_SEED}) at random sites in a closed "
+        f"{side * 1e3:.0f} mm box, none touching anything at t = 0, with random "
+        "velocities up to 3 m/s, frictionless and undamped (damping is checked by the "
+        "cases above), dynamic detection, "
+        f"h = 20 ns, {t[-1] * 1e3:g} ms "
+        f"({'--full' if ctx.full else f'quick; {LOOSE_COUNT_FULL} granules with --full'}). "
+        "Every position and velocity is compared, at 100 output times, with an independent "
+        "solve_ivp (DOP853, rtol 1e-11, steps <= 1 µs) of the Hertz law over all pairs and all walls, "
+        "written in this module from the equations (no neighbour list: every pair is tested "
+        "at every evaluation)."
+    )
     plot = {"n": n, "ds": ds, "ref": ref, "s": s, "r": r, "side": side, "t": t}
-    return CaseResult.of(desc, checks, plot=plot,
-                         notes=[f"{pairs_met} pairs touched; largest velocity error {vel_err * v_scale:.2e} m/s, "
-                                f"position error {pos_err:.2e} m.",
-                                "The comparison stops at 4 ms: a box of colliding spheres is a chaotic billiard, "
-                                "which amplifies any difference exponentially with the number of successive "
-                                "collisions (measured: the 16-granule box at 20 ms differs by 0.5 m/s, granplate "
-                                "keeping its energy balance to 1e-8), so a longer run compares the amplification, not the "
-                                "integrators."])
+    return CaseResult.of(
+        desc,
+        checks,
+        plot=plot,
+        notes=[
+            f"{pairs_met} pairs touched; largest velocity error {vel_err * v_scale:.2e} m/s, "
+            f"position error {pos_err:.2e} m.",
+            "The comparison stops at 4 ms: a box of colliding spheres is a chaotic billiard, "
+            "which amplifies any difference exponentially with the number of successive "
+            "collisions (measured: the 16-granule box at 20 ms differs by 0.5 m/s, granplate "
+            "keeping its energy balance to 1e-8), so a longer run compares the amplification, not the "
+            "integrators.",
+        ],
+    )
 
 
 def draw_loose_packing_case(p: dict):
@@ -508,8 +709,9 @@ def draw_loose_packing_case(p: dict):
     for k in range(n):
         ax.plot(ds.x.values[:, k] * 1e3, ds.y.values[:, k] * 1e3, "-", lw=0.8)
         ax.plot(ref[::5, 0, k] * 1e3, ref[::5, 1, k] * 1e3, ".", ms=2, color="k")
-        ax.add_patch(Circle((s.granules[k].x * 1e3, s.granules[k].y * 1e3), r[k] * 1e3, fill=False, lw=0.5,
-                            color="0.5"))
+        ax.add_patch(
+            Circle((s.granules[k].x * 1e3, s.granules[k].y * 1e3), r[k] * 1e3, fill=False, lw=0.5, color="0.5")
+        )
     ax.set_aspect("equal")
     ax.set_xlim(0, side * 1e3)
     ax.set_ylim(0, side * 1e3)
@@ -524,12 +726,32 @@ def draw_loose_packing_case(p: dict):
 
 
 CASES: tuple[Case, ...] = (
-    Case("gap-head-on", "contacts", "Two spheres from a gap: meeting time, Hertz contact time, restitution",
-         gap_head_on, draw=draw_gap_head_on),
-    Case("oblique-gap", "contacts", "Oblique impact from a gap with friction and spin vs an independent integrator",
-         oblique_gap, draw=draw_oblique_gap),
-    Case("wall-bounce", "contacts", "A sphere bouncing between two walls: period, energy, speed decay",
-         wall_bounce, draw=draw_wall_bounce),
-    Case("loose-packing", "contacts", "A loose box of spheres vs an independent integrator over all pairs",
-         loose_packing_case, draw=draw_loose_packing_case),
+    Case(
+        "gap-head-on",
+        "contacts",
+        "Two spheres from a gap: meeting time, Hertz contact time, restitution",
+        gap_head_on,
+        draw=draw_gap_head_on,
+    ),
+    Case(
+        "oblique-gap",
+        "contacts",
+        "Oblique impact from a gap with friction and spin vs an independent integrator",
+        oblique_gap,
+        draw=draw_oblique_gap,
+    ),
+    Case(
+        "wall-bounce",
+        "contacts",
+        "A sphere bouncing between two walls: period, energy, speed decay",
+        wall_bounce,
+        draw=draw_wall_bounce,
+    ),
+    Case(
+        "loose-packing",
+        "contacts",
+        "A loose box of spheres vs an independent integrator over all pairs",
+        loose_packing_case,
+        draw=draw_loose_packing_case,
+    ),
 )

@@ -19,6 +19,7 @@ tests hold the integration to is exact: the energy balance of the model, e -> 1 
 lambda -> 0, and the first-order loss 1 - e^2 = c lambda with c from the rigid impact
 in closed form (`zener_first_order_loss`).
 """
+
 from __future__ import annotations
 
 import math
@@ -35,8 +36,8 @@ HERTZ_TIME_CONSTANT = 0.8 * float(beta_function(0.4, 0.5))
 
 # --------------------------------------------------------------------------- Hertz
 
-def effective_modulus(young_1: float, poisson_1: float, young_2: float = math.inf,
-                      poisson_2: float = 0.0) -> float:
+
+def effective_modulus(young_1: float, poisson_1: float, young_2: float = math.inf, poisson_2: float = 0.0) -> float:
     """E* [Pa]: 1 / E* = (1 - nu1^2) / E1 + (1 - nu2^2) / E2 (Johnson 1985, section 4.2);
     E2 = inf: a rigid flat."""
     second = 0.0 if math.isinf(young_2) else (1.0 - poisson_2**2) / young_2
@@ -77,6 +78,7 @@ def hunter_radiated_fraction(speed: float, young: float, rho: float) -> float:
 class HertzImpact(NamedTuple):
     """An integrated elastic impact: contact time [s], largest overlap [m], peak force [N],
     rebound speed [m/s]."""
+
     contact_time: float
     max_overlap: float
     peak_force: float
@@ -94,9 +96,18 @@ def hertz_impact(mass: float, speed: float, e_star: float, radius: float, rtol: 
 
     def separated(_t, s):
         return s[0]
+
     separated.terminal, separated.direction = True, -1.0
-    sol = solve_ivp(rhs, (0.0, 10.0 * scale_t), [0.0, speed], method="DOP853", rtol=rtol,
-                    atol=[1e-14 * speed * scale_t, 1e-14 * speed], events=separated, dense_output=True)
+    sol = solve_ivp(
+        rhs,
+        (0.0, 10.0 * scale_t),
+        [0.0, speed],
+        method="DOP853",
+        rtol=rtol,
+        atol=[1e-14 * speed * scale_t, 1e-14 * speed],
+        events=separated,
+        dense_output=True,
+    )
     t_c = float(sol.t_events[0][0])
     times = np.linspace(0.0, t_c, 2001)
     x_max = float(np.max(sol.sol(times)[0]))
@@ -104,6 +115,7 @@ def hertz_impact(mass: float, speed: float, e_star: float, radius: float, rtol: 
 
 
 # --------------------------------------------------------------------------- Zener's thin plate
+
 
 def plate_point_mobility(rigidity: float, rho: float, thickness: float) -> float:
     """Y = 1 / (8 sqrt(D rho h)) [m / (N s)]: the velocity of an infinite thin plate at a
@@ -119,18 +131,31 @@ def zener_inelasticity(mass: float, speed: float, stiffness: float, mobility: fl
     return stiffness**0.4 * mass**0.6 * speed**0.2 * mobility
 
 
-def zener_inelasticity_sphere(radius: float, rho_sphere: float, e_star: float, speed: float,
-                              thickness: float, young_plate: float, poisson_plate: float,
-                              rho_plate: float) -> float:
+def zener_inelasticity_sphere(
+    radius: float,
+    rho_sphere: float,
+    e_star: float,
+    speed: float,
+    thickness: float,
+    young_plate: float,
+    poisson_plate: float,
+    rho_plate: float,
+) -> float:
     """lambda of a solid sphere on a plate, written out from `zener_inelasticity`:
     lambda = pi^(3/5) / sqrt(3) (R / H)^2 (v0 / c)^(1/5) (rho_s / rho_p)^(3/5)
     (E* / E_p)^(2/5) sqrt(1 - nu_p^2), H the plate's thickness, c = sqrt(E_p / rho_p).
     In Zener's notation (1941) the plate is 2h thick, so (R / H)^2 reads (R / 2h)^2; the
     material factors are derived here from the model's equations, not copied."""
     c = math.sqrt(young_plate / rho_plate)
-    return (math.pi**0.6 / math.sqrt(3.0) * (radius / thickness) ** 2 * (speed / c) ** 0.2
-            * (rho_sphere / rho_plate) ** 0.6 * (e_star / young_plate) ** 0.4
-            * math.sqrt(1.0 - poisson_plate**2))
+    return (
+        math.pi**0.6
+        / math.sqrt(3.0)
+        * (radius / thickness) ** 2
+        * (speed / c) ** 0.2
+        * (rho_sphere / rho_plate) ** 0.6
+        * (e_star / young_plate) ** 0.4
+        * math.sqrt(1.0 - poisson_plate**2)
+    )
 
 
 def zener_scales(mass: float, speed: float, stiffness: float) -> tuple[float, float]:
@@ -151,6 +176,7 @@ class ZenerImpact(NamedTuple):
     """Zener's impact in non-dimensional units (overlap (m v0^2/k)^(2/5), time that over v0,
     energy m v0^2): restitution e, contact time, peak force s^(3/2), and the trajectory
     (tau, overlap s, sphere velocity u, dissipated energy) at the integrator's steps."""
+
     restitution: float
     contact_time: float
     peak_force: float
@@ -175,18 +201,34 @@ def zener_impact(inelasticity: float, rtol: float = 1e-10) -> ZenerImpact:
 
     def separated(_t, y):
         return y[0]
+
     separated.terminal, separated.direction = True, -1.0
 
     def deepest(_t, y):  # s' = 0: the largest overlap, where the force peaks
         return y[1] - lam * max(y[0], 0.0) ** 1.5
+
     deepest.direction = -1.0
-    sol = solve_ivp(rhs, (0.0, 50.0 + 20.0 * lam), [0.0, 1.0, 0.0], method="DOP853", rtol=rtol,
-                    atol=1e-13, events=(separated, deepest))
+    sol = solve_ivp(
+        rhs,
+        (0.0, 50.0 + 20.0 * lam),
+        [0.0, 1.0, 0.0],
+        method="DOP853",
+        rtol=rtol,
+        atol=1e-13,
+        events=(separated, deepest),
+    )
     if not sol.t_events[0].size:
         raise RuntimeError(f"no separation found for lambda = {lam}")
     tau, y = sol.t, sol.y
-    return ZenerImpact(float(-sol.y_events[0][0][1]), float(sol.t_events[0][0]),
-                       float(sol.y_events[1][0][0]) ** 1.5, tau, y[0], y[1], y[2])
+    return ZenerImpact(
+        float(-sol.y_events[0][0][1]),
+        float(sol.t_events[0][0]),
+        float(sol.y_events[1][0][0]) ** 1.5,
+        tau,
+        y[0],
+        y[1],
+        y[2],
+    )
 
 
 def zener_restitution(inelasticity: float) -> float:
@@ -200,8 +242,7 @@ def zener_energy(impact: ZenerImpact) -> np.ndarray:
     return 0.5 * impact.velocity**2 + 0.4 * np.maximum(impact.overlap, 0.0) ** 2.5 + impact.dissipated
 
 
-def zener_impact_si(mass: float, speed: float, stiffness: float, mobility: float,
-                    rtol: float = 1e-10) -> float:
+def zener_impact_si(mass: float, speed: float, stiffness: float, mobility: float, rtol: float = 1e-10) -> float:
     """The restitution of Zener's model integrated in SI units: m y'' = -F,
     F = k (y - w)^(3/2), w' = Y F (y the sphere's and w the plate's displacement [m])."""
     t_scale = (mass * speed**2 / stiffness) ** 0.4 / speed
@@ -212,13 +253,22 @@ def zener_impact_si(mass: float, speed: float, stiffness: float, mobility: float
 
     def separated(_t, s):
         return s[0] - s[2]
+
     separated.terminal, separated.direction = True, -1.0
-    sol = solve_ivp(rhs, (0.0, 200.0 * t_scale), [0.0, speed, 0.0], method="DOP853", rtol=rtol,
-                    atol=[1e-14 * speed * t_scale, 1e-14 * speed, 1e-14 * speed * t_scale], events=separated)
+    sol = solve_ivp(
+        rhs,
+        (0.0, 200.0 * t_scale),
+        [0.0, speed, 0.0],
+        method="DOP853",
+        rtol=rtol,
+        atol=[1e-14 * speed * t_scale, 1e-14 * speed, 1e-14 * speed * t_scale],
+        events=separated,
+    )
     return float(-sol.y_events[0][0][1] / speed)
 
 
 # --------------------------------------------------------------------------- flexural waves
+
 
 def flexural_phase_velocity(omega: float, rigidity: float, rho: float, thickness: float) -> float:
     """c = sqrt(omega) (D / (rho h))^(1/4) [m/s]: omega = k^2 sqrt(D / (rho h)) for a

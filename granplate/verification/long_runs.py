@@ -8,6 +8,7 @@ Dask tasks (`coupled.run_summary`, longest first), and keeps each summary as it 
 the cases then only read them. An interruption keeps every finished run, and a run that
 fails is left to its case (which computes it again and reports the failure).
 """
+
 from __future__ import annotations
 
 from typing import Callable
@@ -36,8 +37,14 @@ def expected_cost(scenario) -> float:
     return elements * scenario.time.t_end / scenario.time.dt_max
 
 
-def compute_missing(ctx: Context, *, client=None, workers: int | None = None,
-                    scheduler: str | None = None, log: Callable[[str], None] | None = None) -> int:
+def compute_missing(
+    ctx: Context,
+    *,
+    client=None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    log: Callable[[str], None] | None = None,
+) -> int:
     """Compute the long runs neither ctx.run_cache nor the run store holds, on the Dask
     cluster (client, else a local one of `workers` or the one at `scheduler`); the number
     computed."""
@@ -56,12 +63,17 @@ def compute_missing(ctx: Context, *, client=None, workers: int | None = None,
     if log:
         log(f"verify: {len(missing)} full-length runs to compute on Dask ...")
     n = 0
-    with (nullcontext(client) if client is not None else
-          engine.dask_client(min(workers or engine.available_cores(), len(missing)), scheduler)) as c:
+    with (
+        nullcontext(client)
+        if client is not None
+        else engine.dask_client(min(workers or engine.available_cores(), len(missing)), scheduler)
+    ) as c:
         texts = [dumps(s) for s in missing]
         engine.warm_workers(c, texts[-1:])  # the cheapest: compiles the paper scheme's kernels
-        futures = {c.submit(run_summary, text, pure=False, priority=len(texts) - i): s
-                   for i, (s, text) in enumerate(zip(missing, texts))}
+        futures = {
+            c.submit(run_summary, text, pure=False, priority=len(texts) - i): s
+            for i, (s, text) in enumerate(zip(missing, texts))
+        }
         try:
             for fut in as_completed(futures):
                 s = futures.pop(fut)
@@ -69,8 +81,10 @@ def compute_missing(ctx: Context, *, client=None, workers: int | None = None,
                     summ = fut.result()
                 except Exception as err:  # noqa: BLE001 - its case runs it again and reports
                     if log:
-                        log(f"verify: a full-length run failed ({type(err).__name__}: {err}); "
-                            "its case will run it again")
+                        log(
+                            f"verify: a full-length run failed ({type(err).__name__}: {err}); "
+                            "its case will run it again"
+                        )
                     continue
                 keep_run(ctx, s, summ)
                 n += 1

@@ -16,6 +16,7 @@ strength fixed by the measured approach speed, `cavity.johnson_replay`; Thornton
 its rate-free Y, `plastic.plastic_force`), the force is computed, and the same measures are
 taken from it. Functions, no plotting (tests/test_measured_contacts.py).
 """
+
 from __future__ import annotations
 
 import csv
@@ -39,15 +40,18 @@ FITTED_ON = "force12_5"
 SLOPE_RTOL = 0.2
 RATIO_ATOL = 0.06
 
-CITATION = ("H. A. Burgoyne and C. Daraio, \"Strain-rate-dependent model for the dynamic compression of "
-            "elastoplastic spheres\", Phys. Rev. E 89, 032203 (2014); data from the authors' repository "
-            "Daraio-lab/Burgoyne_PRE_2014 (GitHub), licence CC BY 4.0 "
-            "(https://creativecommons.org/licenses/by/4.0/).")
+CITATION = (
+    'H. A. Burgoyne and C. Daraio, "Strain-rate-dependent model for the dynamic compression of '
+    "elastoplastic spheres\", Phys. Rev. E 89, 032203 (2014); data from the authors' repository "
+    "Daraio-lab/Burgoyne_PRE_2014 (GitHub), licence CC BY 4.0 "
+    "(https://creativecommons.org/licenses/by/4.0/)."
+)
 
 
 class Curve(NamedTuple):
     """One measured record: name, material (granplate's name), time [s], displacement [m],
     force [N], and its summary.csv row (dict of strings)."""
+
     name: str
     material: str
     t: np.ndarray
@@ -81,7 +85,7 @@ def slope_band(force: np.ndarray) -> np.ndarray:
     k = int(np.argmax(force))
     lo, hi = SLOPE_BAND
     m = np.zeros(len(force), bool)
-    m[:k + 1] = True
+    m[: k + 1] = True
     return m & (force >= lo * force[k]) & (force <= hi * force[k])
 
 
@@ -115,8 +119,12 @@ def residual_ratio(delta: np.ndarray, force: np.ndarray) -> float:
 
 def measures(t: np.ndarray, delta: np.ndarray, force: np.ndarray) -> dict:
     """{"slope" [N/m], "ratio" [-], "speed" [m/s], "peak" [N]} of one curve."""
-    return {"slope": loading_slope(delta, force), "ratio": residual_ratio(delta, force),
-            "speed": approach_speed(t, delta, force), "peak": float(np.max(force))}
+    return {
+        "slope": loading_slope(delta, force),
+        "ratio": residual_ratio(delta, force),
+        "speed": approach_speed(t, delta, force),
+        "peak": float(np.max(force)),
+    }
 
 
 def contact_of(material: str):
@@ -258,4 +266,4 @@ def replay_contact_pass(c: Curve) -> np.ndarray:
         normal_forces(float(t[k]), y, g, cfg, acc, fdamp, fload)
         out[k] = abs(acc[1, 3]) * g.mass[1]
         commit_histories(float(t[k]), g)
-    return out[len(t) - len(c.t):]
+    return out[len(t) - len(c.t) :]

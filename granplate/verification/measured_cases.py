@@ -1,6 +1,7 @@
 """Verification against measurement: the case `yield-measured`, Burgoyne & Daraio's 15
 compressions of two equal metal spheres (measured.py) against the laws "johnson" and
 "thornton" replayed along the measured overlap (docs/model.md sections 3.6, 3.10)."""
+
 from __future__ import annotations
 
 import math
@@ -10,11 +11,15 @@ import numpy as np
 from .base import Case, CaseResult, Check, Context, new_figure
 from .measured import CITATION, FITTED_ON, RATIO_ATOL, SLOPE_RTOL, comparison
 
-SLOPE_WHY = ("The target: the plastic loading slope within 20% of each measured one, predicted from E, nu, Y "
-             "and C of the authors' table (the data's absolute scale is uncertain by a factor of 2, the slope "
-             "is scale-free).")
-RATIO_WHY = ("The target: residual / peak displacement within 0.06 of the measured one; the law's one fitted "
-             f"parameter, the unloading factor kappa = 0.40, was fitted on {FITTED_ON} alone.")
+SLOPE_WHY = (
+    "The target: the plastic loading slope within 20% of each measured one, predicted from E, nu, Y "
+    "and C of the authors' table (the data's absolute scale is uncertain by a factor of 2, the slope "
+    "is scale-free)."
+)
+RATIO_WHY = (
+    "The target: residual / peak displacement within 0.06 of the measured one; the law's one fitted "
+    f"parameter, the unloading factor kappa = 0.40, was fitted on {FITTED_ON} alone."
+)
 
 
 #: the replays judged: the law's kernel directly, and through the loop's contact pass
@@ -30,59 +35,95 @@ def measured_checks(rows: list[dict]) -> list[Check]:
             if key not in r:
                 continue
             m, j = r["measured"], r[key]
-            checks.append(Check(f"loading slope, {r['name']} ({r['material']}), {how}", "N/m", m["slope"],
-                                "measured (least squares, 30-90% of the peak force)", j["slope"], SLOPE_RTOL,
-                                SLOPE_WHY))
+            checks.append(
+                Check(
+                    f"loading slope, {r['name']} ({r['material']}), {how}",
+                    "N/m",
+                    m["slope"],
+                    "measured (least squares, 30-90% of the peak force)",
+                    j["slope"],
+                    SLOPE_RTOL,
+                    SLOPE_WHY,
+                )
+            )
             if not math.isnan(m["ratio"]):
-                checks.append(Check(f"residual / peak displacement, {r['name']}, {how}", "-", m["ratio"],
-                                    "measured (Hertzian unloading fit)", j["ratio"], RATIO_ATOL, RATIO_WHY,
-                                    kind="abs"))
+                checks.append(
+                    Check(
+                        f"residual / peak displacement, {r['name']}, {how}",
+                        "-",
+                        m["ratio"],
+                        "measured (Hertzian unloading fit)",
+                        j["ratio"],
+                        RATIO_ATOL,
+                        RATIO_WHY,
+                        kind="abs",
+                    )
+                )
     return checks
 
 
 def measured_table(rows: list[dict]) -> str:
     """The slope and residual table: measured, "johnson", "thornton"."""
-    out = ["| curve | material | rate [1/s] | slope measured [kN/mm] | johnson / measured (law; loop) | "
-           "thornton / measured | residual/peak measured | johnson (law; loop) | thornton |",
-           "|---|---|---|---|---|---|---|---|---|"]
+    out = [
+        "| curve | material | rate [1/s] | slope measured [kN/mm] | johnson / measured (law; loop) | "
+        "thornton / measured | residual/peak measured | johnson (law; loop) | thornton |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
         m, j, t, lp = r["measured"], r["johnson"], r["thornton"], r.get("loop")
-        fmt = (lambda v: "-" if math.isnan(v) else f"{v:.3f}")
+        fmt = lambda v: "-" if math.isnan(v) else f"{v:.3f}"
         loop_slope = f"; {lp['slope_ratio']:.2f}" if lp else ""
         loop_ratio = f"; {fmt(lp['ratio'])}" if lp else ""
-        out.append(f"| {r['name']}{' (fitted)' if r['name'] == FITTED_ON else ''} | {r['material']} | "
-                   f"{m['speed'] / (2 * 3.175e-3):.0f} | {m['slope'] / 1e6:.1f} | {j['slope_ratio']:.2f}{loop_slope} | "
-                   f"{t['slope_ratio']:.2f} | {fmt(m['ratio'])} | {fmt(j['ratio'])}{loop_ratio} | {fmt(t['ratio'])} |")
+        out.append(
+            f"| {r['name']}{' (fitted)' if r['name'] == FITTED_ON else ''} | {r['material']} | "
+            f"{m['speed'] / (2 * 3.175e-3):.0f} | {m['slope'] / 1e6:.1f} | {j['slope_ratio']:.2f}{loop_slope} | "
+            f"{t['slope_ratio']:.2f} | {fmt(m['ratio'])} | {fmt(j['ratio'])}{loop_ratio} | {fmt(t['ratio'])} |"
+        )
     return "\n".join(out)
 
 
 def yield_measured(ctx: Context) -> CaseResult:
     """The 15 curves replayed along the measured overlap by both laws."""
     rows = comparison()
-    desc = ("Fifteen measured compressions of two equal spheres (R = 3.175 mm) of AISI 440C steel, AISI 302 "
-            "steel and aluminium 2017 in a split Hopkinson bar, far into the plastic range at strain rates of "
-            "340-800 per second, loading and unloading. Each law is replayed directly along the measured "
-            "overlap: the curve's displacement history drives the law's compiled kernel from a virgin contact "
-            "(\"johnson\" with its yield strength fixed by the curve's measured approach speed over (2 R), "
-            "\"thornton\" with its rate-free Y), and the computed force is measured as the data's summary "
-            "measures the measured one: the loading slope dF/d(delta) by least squares between 30% and 90% of "
-            "the peak force, the residual displacement from a Hertzian unloading fit from the peak to 30% of "
-            "it, over the displacement at the peak. Materials: the built-in steel_440c, steel_302 and "
-            "aluminium_2017 (E, nu, rho, Y, C of the authors' table). The same law is also replayed through the "
-            "time loop's own contact pass in space and its history commit (two touching spheres of the "
-            "material, the rear one's position set sample by sample to the measured overlap after a lead-in "
-            "from zero at the record's first approach speed; the loop fixes the yield strength from the "
-            "overlap's growth in the step that first passes yield). Source: " + CITATION)
-    notes = [f"The law \"johnson\" has one fitted parameter, the unloading factor kappa = 0.40, fitted on {FITTED_ON} "
-             "(440C, 12.5 psi) and used unchanged for all three metals; the hardness ratio 2.8 is Tabor's. "
-             "Everything else comes from the authors' table.",
-             "Thornton's law (pressure capped at 1.6 Y over a Hertz disc) is 3-5 times too soft in the plastic slope "
-             "and leaves too large a residual overlap; it is drawn for comparison and not judged.",
-             "A replay through the whole time loop with a prescribed granule motion (a sphere pushed along the "
-             "line of centres by the measured approach, integrated in time) needs the prescribed motions of "
-             "drives; the contact pass and history commit replayed here are the loop's own."]
-    plot = {"curves": [{"name": r["name"], "material": r["material"], "delta": r["delta"], "measured": r["force_meas"],
-                        "johnson": r["johnson"]["force"], "thornton": r["thornton"]["force"]} for r in _with_data(rows)]}
+    desc = (
+        "Fifteen measured compressions of two equal spheres (R = 3.175 mm) of AISI 440C steel, AISI 302 "
+        "steel and aluminium 2017 in a split Hopkinson bar, far into the plastic range at strain rates of "
+        "340-800 per second, loading and unloading. Each law is replayed directly along the measured "
+        "overlap: the curve's displacement history drives the law's compiled kernel from a virgin contact "
+        '("johnson" with its yield strength fixed by the curve\'s measured approach speed over (2 R), '
+        '"thornton" with its rate-free Y), and the computed force is measured as the data\'s summary '
+        "measures the measured one: the loading slope dF/d(delta) by least squares between 30% and 90% of "
+        "the peak force, the residual displacement from a Hertzian unloading fit from the peak to 30% of "
+        "it, over the displacement at the peak. Materials: the built-in steel_440c, steel_302 and "
+        "aluminium_2017 (E, nu, rho, Y, C of the authors' table). The same law is also replayed through the "
+        "time loop's own contact pass in space and its history commit (two touching spheres of the "
+        "material, the rear one's position set sample by sample to the measured overlap after a lead-in "
+        "from zero at the record's first approach speed; the loop fixes the yield strength from the "
+        "overlap's growth in the step that first passes yield). Source: " + CITATION
+    )
+    notes = [
+        f'The law "johnson" has one fitted parameter, the unloading factor kappa = 0.40, fitted on {FITTED_ON} '
+        "(440C, 12.5 psi) and used unchanged for all three metals; the hardness ratio 2.8 is Tabor's. "
+        "Everything else comes from the authors' table.",
+        "Thornton's law (pressure capped at 1.6 Y over a Hertz disc) is 3-5 times too soft in the plastic slope "
+        "and leaves too large a residual overlap; it is drawn for comparison and not judged.",
+        "A replay through the whole time loop with a prescribed granule motion (a sphere pushed along the "
+        "line of centres by the measured approach, integrated in time) needs the prescribed motions of "
+        "drives; the contact pass and history commit replayed here are the loop's own.",
+    ]
+    plot = {
+        "curves": [
+            {
+                "name": r["name"],
+                "material": r["material"],
+                "delta": r["delta"],
+                "measured": r["force_meas"],
+                "johnson": r["johnson"]["force"],
+                "thornton": r["thornton"]["force"],
+            }
+            for r in _with_data(rows)
+        ]
+    }
     for r in rows:
         for law in ("johnson", "thornton", "loop"):
             r.get(law, {}).pop("force", None)
@@ -109,10 +150,8 @@ def draw_yield_measured(p: dict):
         for k, c in enumerate(x for x in p["curves"] if x["material"] == mat):
             d = np.asarray(c["delta"]) * 1e3
             ax.plot(d, np.asarray(c["measured"]) / 1e3, "-", color="0.55", lw=1.6, label="measured" if first else None)
-            ax.plot(d, np.asarray(c["johnson"]) / 1e3, "-", color=f"C{k}", lw=0.9,
-                    label="johnson" if first else None)
-            ax.plot(d, np.asarray(c["thornton"]) / 1e3, ":", color=f"C{k}", lw=0.9,
-                    label="thornton" if first else None)
+            ax.plot(d, np.asarray(c["johnson"]) / 1e3, "-", color=f"C{k}", lw=0.9, label="johnson" if first else None)
+            ax.plot(d, np.asarray(c["thornton"]) / 1e3, ":", color=f"C{k}", lw=0.9, label="thornton" if first else None)
             first = False
         ax.set_xlabel("displacement [mm]")
         ax.set_ylabel("force [kN]")
@@ -122,6 +161,11 @@ def draw_yield_measured(p: dict):
 
 
 CASES: tuple[Case, ...] = (
-    Case("yield-measured", "plastic", "Yielding spheres against measurement (Burgoyne & Daraio 2014)",
-         yield_measured, draw=draw_yield_measured),
+    Case(
+        "yield-measured",
+        "plastic",
+        "Yielding spheres against measurement (Burgoyne & Daraio 2014)",
+        yield_measured,
+        draw=draw_yield_measured,
+    ),
 )

@@ -19,6 +19,7 @@ P12 agree to the integrator's tolerance. These are functions with tests
 (tests/test_plastic_verification.py); the case `plastic-impact` (plastic_cases.py) holds
 the time loop's yielding impacts against them.
 """
+
 from __future__ import annotations
 
 import math
@@ -30,6 +31,7 @@ JOHNSON_YIELD = 26.0
 
 
 # --------------------------------------------------------------------------- closed forms
+
 
 def yield_overlap(e_star: float, r_star: float, p_y: float) -> float:
     """delta_y = (pi p_y / (2 E*))^2 R* [m]: the overlap where Hertz's p0 reaches p_y."""
@@ -55,11 +57,15 @@ def thornton_restitution(speed_ratio: float) -> float:
     if speed_ratio <= 1.0:
         return 1.0
     r = 1.0 / speed_ratio
-    return (math.sqrt(6.0 * math.sqrt(3.0) / 5.0) * math.sqrt(1.0 - r * r / 6.0)
-            * (r / (r + 2.0 * math.sqrt(6.0 / 5.0 - r * r / 5.0))) ** 0.25)
+    return (
+        math.sqrt(6.0 * math.sqrt(3.0) / 5.0)
+        * math.sqrt(1.0 - r * r / 6.0)
+        * (r / (r + 2.0 * math.sqrt(6.0 / 5.0 - r * r / 5.0))) ** 0.25
+    )
 
 
 # --------------------------------------------------------------------------- the law, Thornton's variables
+
 
 def _hertz(e_star: float, radius: float, delta: float) -> float:
     """Hertz's force 4/3 E* sqrt(R) delta^(3/2) [N] of radius R; 0 for delta <= 0."""
@@ -80,8 +86,8 @@ def _unloading(e_star: float, r_star: float, p_y: float, delta_max: float) -> tu
 
 # --------------------------------------------------------------------------- the impact
 
-def impact(m1: float, m2: float, e_star: float, r_star: float, p_y: float, v: float,
-           rtol: float = 1e-12) -> dict:
+
+def impact(m1: float, m2: float, e_star: float, r_star: float, p_y: float, v: float, rtol: float = 1e-12) -> dict:
     """Head-on impact at relative speed v [m/s] of body 1 (mass m1) on body 2 (mass m2;
     math.inf: a rigid wall), both free, the contact (E*, R*, p_y) following Thornton's law
     without damping; integrated body by body (positions x1, x2, velocities v1, v2) with
@@ -99,6 +105,7 @@ def impact(m1: float, m2: float, e_star: float, r_star: float, p_y: float, v: fl
             x1, v1, x2, v2 = z
             n = force(x1 - x2)  # overlap: body 1 moves +x into body 2
             return [v1, -n / m1, v2, 0.0 if wall else n / m2]
+
         return f
 
     def run(force, z0, events, scale, max_step=math.inf):
@@ -106,8 +113,9 @@ def impact(m1: float, m2: float, e_star: float, r_star: float, p_y: float, v: fl
             ev.terminal = True
         t_end = 1e3 * scale / v
         atol = [1e-14 * scale, 1e-14 * v] * 2
-        sol = solve_ivp(rhs(force), (0.0, t_end), z0, method="DOP853", rtol=rtol, atol=atol,
-                        events=events, max_step=max_step)
+        sol = solve_ivp(
+            rhs(force), (0.0, t_end), z0, method="DOP853", rtol=rtol, atol=atol, events=events, max_step=max_step
+        )
         if sol.status != 1:
             raise RuntimeError(f"impact: a leg ended without its event ({sol.message})")
         hit = next(k for k, te in enumerate(sol.t_events) if len(te))
@@ -118,10 +126,12 @@ def impact(m1: float, m2: float, e_star: float, r_star: float, p_y: float, v: fl
 
     def approach_ends(_t, z):  # largest overlap: the relative velocity turns
         return z[1] - z[3]
+
     approach_ends.direction = -1
 
     def yields(_t, z):
         return (z[0] - z[2]) - d_y
+
     yields.direction = 1
 
     # 1: Hertz until yield or the largest overlap; short steps so that an overlap just
@@ -144,9 +154,18 @@ def impact(m1: float, m2: float, e_star: float, r_star: float, p_y: float, v: fl
     # 3: elastic unloading, Hertz of radius R_p from delta_p, until the force vanishes
     def separates(_t, z):
         return (z[0] - z[2]) - d_p
+
     separates.direction = -1
     z, t3, _ = run(lambda d: _hertz(e_star, r_p, d - d_p), z, [separates], delta_max)
     t += t3
     ke1 = 0.5 * m1 * z[1] ** 2 + (0.0 if wall else 0.5 * m2 * z[3] ** 2)
-    return {"e": (z[3] - z[1]) / v, "delta_max": delta_max, "delta_p": d_p, "R_p": r_p,
-            "t_c": t, "kinetic_before": ke0, "kinetic_after": ke1, "plastic": plastic}
+    return {
+        "e": (z[3] - z[1]) / v,
+        "delta_max": delta_max,
+        "delta_p": d_p,
+        "R_p": r_p,
+        "t_c": t,
+        "kinetic_before": ke0,
+        "kinetic_after": ke1,
+        "plastic": plastic,
+    }

@@ -10,6 +10,7 @@ the code the simulator runs. tests/test_plate.py checks the same assembly in oth
 The clamped strip is the paper's plate: 0.1 m long (y), h = 0.01 m deep (x), thickness
 1 mm, steel, top and bottom edges clamped; L/h = 10.
 """
+
 from __future__ import annotations
 
 import math
@@ -37,6 +38,7 @@ def cowper_shear_coefficient(nu: float) -> float:
 
 
 # --------------------------------------------------------------------------- patch test
+
 
 def distorted_mesh(nx: int = 4, ny: int = 5, seed: int = 3):
     """A 1 x 1.2 rectangle whose interior vertices are moved by up to 25% of a cell."""
@@ -79,25 +81,52 @@ def patch_test(ctx: Context) -> CaseResult:
     kd = Kii.toarray()
     cond = float(np.linalg.cond(kd))
     tol = 100.0 * cond * EPS
-    why = (f"the linear field lies in the Q8 space on any straight-sided quadrilateral, so the "
-           f"error is round-off only: cond(K_ii) eps = {cond * EPS:.1e}; tolerance 100 cond eps.")
+    why = (
+        f"the linear field lies in the Q8 space on any straight-sided quadrilateral, so the "
+        f"error is round-off only: cond(K_ii) eps = {cond * EPS:.1e}; tolerance 100 cond eps."
+    )
     checks = [
-        Check("max nodal displacement error / max |u| (distorted mesh)", "-", 0.0,
-              "exact linear field u = a + B x", err_u, tol, why, kind="max"),
-        Check("max strain error at the Gauss points / max |strain|", "-", 0.0,
-              "exact constant strain of the linear field", err_eps, tol, why, kind="max"),
-        Check("interior nodal forces of the linear field / max nodal force", "-", 0.0,
-              "constant stress is self-equilibrated inside the patch", interior_force, 1e3 * EPS,
-              "assembly of a constant stress cancels at interior nodes up to round-off of the "
-              "quadrature sums (~1e3 eps).", kind="max"),
+        Check(
+            "max nodal displacement error / max |u| (distorted mesh)",
+            "-",
+            0.0,
+            "exact linear field u = a + B x",
+            err_u,
+            tol,
+            why,
+            kind="max",
+        ),
+        Check(
+            "max strain error at the Gauss points / max |strain|",
+            "-",
+            0.0,
+            "exact constant strain of the linear field",
+            err_eps,
+            tol,
+            why,
+            kind="max",
+        ),
+        Check(
+            "interior nodal forces of the linear field / max nodal force",
+            "-",
+            0.0,
+            "constant stress is self-equilibrated inside the patch",
+            interior_force,
+            1e3 * EPS,
+            "assembly of a constant stress cancels at interior nodes up to round-off of the "
+            "quadrature sums (~1e3 eps).",
+            kind="max",
+        ),
     ]
-    desc = ("A 1 x 1.2 patch of 4 x 5 Q8 elements whose interior vertices are moved at random by "
-            "up to 25% of a cell (straight edges, mid-side nodes at edge midpoints), assembled "
-            "with `plate.q8_basis`, `plate.assemble_stiffness` (plane stress, steel) and "
-            "`plate.strain_operator`. The boundary nodes take the linear field u = a + B x; the "
-            "interior is solved for. A conforming element passes when the interior nodes "
-            "reproduce the linear field and every Gauss point the constant strain, up to "
-            "round-off (Irons' patch test).")
+    desc = (
+        "A 1 x 1.2 patch of 4 x 5 Q8 elements whose interior vertices are moved at random by "
+        "up to 25% of a cell (straight edges, mid-side nodes at edge midpoints), assembled "
+        "with `plate.q8_basis`, `plate.assemble_stiffness` (plane stress, steel) and "
+        "`plate.strain_operator`. The boundary nodes take the linear field u = a + B x; the "
+        "interior is solved for. A conforming element passes when the interior nodes "
+        "reproduce the linear field and every Gauss point the constant strain, up to "
+        "round-off (Irons' patch test)."
+    )
     return CaseResult.of(desc, checks, plot={"mesh": mesh, "u": u, "exact": exact, "xy": xy})
 
 
@@ -120,6 +149,7 @@ def draw_patch_test(p: dict):
 
 
 # --------------------------------------------------------------------------- clamped strip
+
 
 def _strip(nx: int, ny: int):
     """Basis, K, M, node coordinates and free dofs of the clamped strip (top/bottom clamped)."""
@@ -170,9 +200,11 @@ def strip_static(nx: int, ny: int, body: float) -> tuple[np.ndarray, np.ndarray,
     return xy[axis, 1], u[2 * axis], float(u[2 * mid])
 
 
-MODEL_FORM_WHY = ("Timoshenko theory neglects terms of relative order (h/L)^2 = 1% (transverse "
-                  "normal stress, warping restrained at the 2-D clamps); the 4 x 40 mesh is "
-                  "converged to 0.2% (finer meshes, see the note), so the tolerance is (h/L)^2.")
+MODEL_FORM_WHY = (
+    "Timoshenko theory neglects terms of relative order (h/L)^2 = 1% (transverse "
+    "normal stress, warping restrained at the 2-D clamps); the 4 x 40 mesh is "
+    "converged to 0.2% (finer meshes, see the note), so the tolerance is (h/L)^2."
+)
 
 
 def strip_deflection(ctx: Context) -> CaseResult:
@@ -185,21 +217,33 @@ def strip_deflection(ctx: Context) -> CaseResult:
     EI = st.E * STRIP_THICKNESS * STRIP_DEPTH**3 / 12.0
     w_euler = q * STRIP_LENGTH**4 / (384.0 * EI)
     fine = {n: strip_static(n, 10 * n, body)[2] for n in (8, 16)}
-    checks = [Check("mid-span deflection, 4 x 40 mesh", "m", w_ref,
-                    "Timoshenko beam, clamped-clamped, uniform load, Cowper k", w_mid,
-                    (STRIP_DEPTH / STRIP_LENGTH) ** 2, MODEL_FORM_WHY)]
-    desc = ("The paper's plate as a clamped-clamped strip (0.1 m x 0.01 m, 1 mm thick, steel, "
-            "plane stress, top and bottom edges clamped) under a uniform body force along x "
-            f"(q = {q:g} N/m per unit length), assembled with the plate module's functions on "
-            "the default 4 x 40 mesh and solved statically. The deflection of the neutral axis "
-            "at mid-span is compared with Timoshenko beam theory, w = q L^4/(384 EI) + "
-            "q L^2/(8 k G A), k = 10(1 + nu)/(12 + 11 nu) (Cowper 1966).")
-    notes = [f"Mid-span deflection: 4 x 40 {w_mid:.6e} m, 8 x 80 {fine[8]:.6e} m, 16 x 160 "
-             f"{fine[16]:.6e} m (Timoshenko {w_ref:.6e} m, Euler-Bernoulli {w_euler:.6e} m, "
-             f"{(w_mid / w_euler - 1) * 100:+.1f}% off: the shear term matters at L/h = 10). The "
-             "mesh error falls only as h^1.5: the stress is singular at the four corners where "
-             "a clamped edge meets a free one, which caps the rate below the smooth-solution "
-             "rates of the convergence case."]
+    checks = [
+        Check(
+            "mid-span deflection, 4 x 40 mesh",
+            "m",
+            w_ref,
+            "Timoshenko beam, clamped-clamped, uniform load, Cowper k",
+            w_mid,
+            (STRIP_DEPTH / STRIP_LENGTH) ** 2,
+            MODEL_FORM_WHY,
+        )
+    ]
+    desc = (
+        "The paper's plate as a clamped-clamped strip (0.1 m x 0.01 m, 1 mm thick, steel, "
+        "plane stress, top and bottom edges clamped) under a uniform body force along x "
+        f"(q = {q:g} N/m per unit length), assembled with the plate module's functions on "
+        "the default 4 x 40 mesh and solved statically. The deflection of the neutral axis "
+        "at mid-span is compared with Timoshenko beam theory, w = q L^4/(384 EI) + "
+        "q L^2/(8 k G A), k = 10(1 + nu)/(12 + 11 nu) (Cowper 1966)."
+    )
+    notes = [
+        f"Mid-span deflection: 4 x 40 {w_mid:.6e} m, 8 x 80 {fine[8]:.6e} m, 16 x 160 "
+        f"{fine[16]:.6e} m (Timoshenko {w_ref:.6e} m, Euler-Bernoulli {w_euler:.6e} m, "
+        f"{(w_mid / w_euler - 1) * 100:+.1f}% off: the shear term matters at L/h = 10). The "
+        "mesh error falls only as h^1.5: the stress is singular at the four corners where "
+        "a clamped edge meets a free one, which caps the rate below the smooth-solution "
+        "rates of the convergence case."
+    ]
     return CaseResult.of(desc, checks, plot={"q": q, "EI": EI, "y": y, "w": w}, notes=notes)
 
 
@@ -245,14 +289,14 @@ def timoshenko_clamped_frequencies(n: int = 3) -> np.ndarray:
         pa, pb = al + r / al, be - r / be  # section rotation Psi from W
         ch, sh = math.cosh(al * L), math.sinh(al * L)
         co, si = math.cos(be * L), math.sin(be * L)
-        m = np.array([[1.0, 0.0, 1.0, 0.0], [0.0, pa, 0.0, pb],
-                      [ch, sh, co, si], [pa * sh, pa * ch, -pb * si, pb * co]])
+        m = np.array(
+            [[1.0, 0.0, 1.0, 0.0], [0.0, pa, 0.0, pb], [ch, sh, co, si], [pa * sh, pa * ch, -pb * si, pb * co]]
+        )
         return float(np.linalg.det(m) / ch)
 
     ws = np.linspace(2 * math.pi * 300.0, 2 * math.pi * 60e3, 4000)
     d = np.array([det(w) for w in ws])
-    roots = [brentq(det, ws[i], ws[i + 1], xtol=1e-9)
-             for i in np.flatnonzero(np.sign(d[:-1]) != np.sign(d[1:]))]
+    roots = [brentq(det, ws[i], ws[i + 1], xtol=1e-9) for i in np.flatnonzero(np.sign(d[:-1]) != np.sign(d[1:]))]
     return np.array(roots[:n]) / (2.0 * math.pi)
 
 
@@ -261,8 +305,7 @@ def strip_bending_frequencies(nx: int, ny: int, n: int = 3) -> np.ndarray:
     from granplate import plate as gp
     from granplate.setup.scenario import Plate
 
-    strip = Plate(width=STRIP_DEPTH, height=STRIP_LENGTH, thickness=STRIP_THICKNESS, nx=nx, ny=ny,
-                  n_modes=4 * n + 4)
+    strip = Plate(width=STRIP_DEPTH, height=STRIP_LENGTH, thickness=STRIP_THICKNESS, nx=nx, ny=ny, n_modes=4 * n + 4)
     return gp.transverse_mode_frequencies(gp.build_plate(strip, 0.0, [], cache=False), n)
 
 
@@ -274,20 +317,32 @@ def strip_frequencies(ctx: Context) -> CaseResult:
     timo = timoshenko_clamped_frequencies()
     beta_l = np.array([4.730040745, 7.853204624, 10.99560784])
     euler = beta_l**2 / STRIP_LENGTH**2 * math.sqrt(st.E * STRIP_DEPTH**2 / (12 * st.rho)) / (2 * math.pi)
-    checks = [Check(f"bending frequency {i + 1}, 4 x 40 mesh", "Hz", float(timo[i]),
-                    "Timoshenko beam, clamped-clamped, Cowper k (determinant roots)", float(fe[i]),
-                    (STRIP_DEPTH / STRIP_LENGTH) ** 2, MODEL_FORM_WHY) for i in range(3)]
-    desc = ("Modes of the clamped strip built by `plate.build_plate` (the simulator's own "
-            "reduction and generalised eigen-solve; 4 x 40 default mesh), keeping the lowest "
-            "modes whose kinetic energy is mostly along x (bending). Reference: the "
-            "clamped-clamped Timoshenko beam with Cowper's shear coefficient, frequencies from "
-            "the roots of the 4 x 4 boundary determinant.")
-    finer = (f"8 x 80 {np.array2string(fine, precision=1)}" if fine is not None
-             else "8 x 80 with --full")
-    notes = [f"Frequencies [Hz]: 4 x 40 {np.array2string(fe, precision=1)}, {finer}, "
-             f"Timoshenko {np.array2string(timo, precision=1)}, "
-             f"Euler-Bernoulli {np.array2string(euler, precision=1)} "
-             f"({np.array2string((fe / euler - 1) * 100, precision=1)}% off)."]
+    checks = [
+        Check(
+            f"bending frequency {i + 1}, 4 x 40 mesh",
+            "Hz",
+            float(timo[i]),
+            "Timoshenko beam, clamped-clamped, Cowper k (determinant roots)",
+            float(fe[i]),
+            (STRIP_DEPTH / STRIP_LENGTH) ** 2,
+            MODEL_FORM_WHY,
+        )
+        for i in range(3)
+    ]
+    desc = (
+        "Modes of the clamped strip built by `plate.build_plate` (the simulator's own "
+        "reduction and generalised eigen-solve; 4 x 40 default mesh), keeping the lowest "
+        "modes whose kinetic energy is mostly along x (bending). Reference: the "
+        "clamped-clamped Timoshenko beam with Cowper's shear coefficient, frequencies from "
+        "the roots of the 4 x 4 boundary determinant."
+    )
+    finer = f"8 x 80 {np.array2string(fine, precision=1)}" if fine is not None else "8 x 80 with --full"
+    notes = [
+        f"Frequencies [Hz]: 4 x 40 {np.array2string(fe, precision=1)}, {finer}, "
+        f"Timoshenko {np.array2string(timo, precision=1)}, "
+        f"Euler-Bernoulli {np.array2string(euler, precision=1)} "
+        f"({np.array2string((fe / euler - 1) * 100, precision=1)}% off)."
+    ]
     return CaseResult.of(desc, checks, plot={"timo": timo, "euler": euler, "fe": fe}, notes=notes)
 
 
@@ -309,6 +364,7 @@ def draw_strip_frequencies(p: dict):
 
 # --------------------------------------------------------------------------- convergence
 
+
 def _manufactured(E: float, nu: float):
     """Exact field u = (sin pi x sin pi y, sin pi x sin 2 pi y) on [0, 1]^2 (zero on the
     boundary), its gradient and the body force f = -div sigma(u) (plane stress)."""
@@ -321,12 +377,16 @@ def _manufactured(E: float, nu: float):
         return s(pi * x) * s(pi * y), s(pi * x) * s(2 * pi * y)
 
     def grad(x, y):
-        return (pi * c(pi * x) * s(pi * y), pi * s(pi * x) * c(pi * y),
-                pi * c(pi * x) * s(2 * pi * y), 2 * pi * s(pi * x) * c(2 * pi * y))
+        return (
+            pi * c(pi * x) * s(pi * y),
+            pi * s(pi * x) * c(pi * y),
+            pi * c(pi * x) * s(2 * pi * y),
+            2 * pi * s(pi * x) * c(2 * pi * y),
+        )
 
     def body(x, y):
-        dsxx_dx = C * (-pi**2 * s(pi * x) * s(pi * y) + nu * 2 * pi**2 * c(pi * x) * c(2 * pi * y))
-        dsxy_dy = g * (-pi**2 * s(pi * x) * s(pi * y) + 2 * pi**2 * c(pi * x) * c(2 * pi * y))
+        dsxx_dx = C * (-(pi**2) * s(pi * x) * s(pi * y) + nu * 2 * pi**2 * c(pi * x) * c(2 * pi * y))
+        dsxy_dy = g * (-(pi**2) * s(pi * x) * s(pi * y) + 2 * pi**2 * c(pi * x) * c(2 * pi * y))
         dsxy_dx = g * (pi**2 * c(pi * x) * c(pi * y) - pi**2 * s(pi * x) * s(2 * pi * y))
         dsyy_dy = C * (nu * pi**2 * c(pi * x) * c(pi * y) - 4 * pi**2 * s(pi * x) * s(2 * pi * y))
         return -(dsxx_dx + dsxy_dy), -(dsxy_dx + dsyy_dy)
@@ -381,27 +441,52 @@ def q8_convergence(ctx: Context) -> CaseResult:
     h = 1.0 / np.array(ns)
     p_l2 = loglog_slope(h, errs[:, 0])
     p_en = loglog_slope(h, errs[:, 1])
-    why = ("asymptotic rates of a complete quadratic space on rectangles (Ciarlet 1978); over "
-           "h = 1/4 ... 1/32 the pre-asymptotic terms of relative size O(h) shift the fitted "
-           "slope by less than 0.05.")
+    why = (
+        "asymptotic rates of a complete quadratic space on rectangles (Ciarlet 1978); over "
+        "h = 1/4 ... 1/32 the pre-asymptotic terms of relative size O(h) shift the fitted "
+        "slope by less than 0.05."
+    )
     checks = [
-        Check("log-log slope of the L2 error, h = 1/4 ... 1/32", "-", 3.0, "FE theory: O(h^(p+1)), p = 2",
-              p_l2, 0.05, why, kind="abs"),
-        Check("log-log slope of the energy-norm error, h = 1/4 ... 1/32", "-", 2.0, "FE theory: O(h^p), p = 2",
-              p_en, 0.05, why, kind="abs"),
+        Check(
+            "log-log slope of the L2 error, h = 1/4 ... 1/32",
+            "-",
+            3.0,
+            "FE theory: O(h^(p+1)), p = 2",
+            p_l2,
+            0.05,
+            why,
+            kind="abs",
+        ),
+        Check(
+            "log-log slope of the energy-norm error, h = 1/4 ... 1/32",
+            "-",
+            2.0,
+            "FE theory: O(h^p), p = 2",
+            p_en,
+            0.05,
+            why,
+            kind="abs",
+        ),
     ]
-    desc = ("Method of manufactured solutions: u = (sin pi x sin pi y, sin pi x sin 2 pi y) on "
-            "the unit square (zero on the boundary), plane stress (E = 1, nu = 0.3), body force "
-            "f = -div sigma(u) derived by hand (and checked by finite differences while writing "
-            "this case). Meshes of 4^2 ... 32^2 Q8 elements assembled with the plate module's "
-            "functions; errors integrated with a 10th-order Gauss rule.")
-    notes = ["Local orders (L2, energy): " + ", ".join(
-        f"{math.log(errs[i, 0] / errs[i + 1, 0], 2):.3f} / {math.log(errs[i, 1] / errs[i + 1, 1], 2):.3f}"
-        for i in range(len(ns) - 1)) + ".",
+    desc = (
+        "Method of manufactured solutions: u = (sin pi x sin pi y, sin pi x sin 2 pi y) on "
+        "the unit square (zero on the boundary), plane stress (E = 1, nu = 0.3), body force "
+        "f = -div sigma(u) derived by hand (and checked by finite differences while writing "
+        "this case). Meshes of 4^2 ... 32^2 Q8 elements assembled with the plate module's "
+        "functions; errors integrated with a 10th-order Gauss rule."
+    )
+    notes = [
+        "Local orders (L2, energy): "
+        + ", ".join(
+            f"{math.log(errs[i, 0] / errs[i + 1, 0], 2):.3f} / {math.log(errs[i, 1] / errs[i + 1, 1], 2):.3f}"
+            for i in range(len(ns) - 1)
+        )
+        + ".",
         "On the clamped strip the stresses are singular at the corners where a clamped edge meets "
         "a free one, so its mid-span deflection converges more slowly (about h^1.5, see the "
         "strip case); serendipity elements also lose one order on non-affine (distorted) "
-        "meshes, which the plate never uses (its mesh is rectangular)."]
+        "meshes, which the plate never uses (its mesh is rectangular).",
+    ]
     return CaseResult.of(desc, checks, plot={"h": h, "errs": errs, "p_l2": p_l2, "p_en": p_en}, notes=notes)
 
 
@@ -422,6 +507,7 @@ def draw_q8_convergence(p: dict):
 
 # --------------------------------------------------------------------------- Newmark
 
+
 def newmark_oscillator(omega_h: float, n_periods: float = 20.0) -> tuple[np.ndarray, np.ndarray]:
     """Free vibration of one mode (omega = 2 pi 1 kHz, q(0) = 1) stepped by the simulator's
     compiled `plate_modal.newmark_predict` / `newmark_correct`. Returns (q_n, energy_n)."""
@@ -432,9 +518,21 @@ def newmark_oscillator(omega_h: float, n_periods: float = 20.0) -> tuple[np.ndar
     w = 2.0 * math.pi * 1000.0
     h = omega_h / w
     p = PlateArrays(omega2=np.array([w * w]), phi_d=np.zeros((0, 1)), load_modal=np.zeros(1))
-    cfg = Config(q0=0.0, duration=1.0, clip=True, lambda_target=0.5, rtol=1e-9, atol=1e-10,
-                   max_iter=1, energy_tol=1.0, dt_max=h, dt_min=h, out_dt=h, t_end=1.0,
-                   load_on_plate=False)
+    cfg = Config(
+        q0=0.0,
+        duration=1.0,
+        clip=True,
+        lambda_target=0.5,
+        rtol=1e-9,
+        atol=1e-10,
+        max_iter=1,
+        energy_tol=1.0,
+        dt_max=h,
+        dt_min=h,
+        out_dt=h,
+        t_end=1.0,
+        load_on_plate=False,
+    )
     st = new_state(0, 1, 0)
     st.q[0], st.qd[0], st.qdd[0] = 1.0, 0.0, -w * w
     dmode = np.zeros(1)
@@ -467,32 +565,68 @@ def newmark_elongation(ctx: Context) -> CaseResult:
     exact = {x: x / (2.0 * math.atan(x / 2.0)) - 1.0 for x in whs}
     checks = []
     for x in (0.1, 0.4):
-        checks.append(Check(f"period elongation, omega h = {x:g}", "-", exact[x],
-                            "exact: omega_bar h = 2 atan(omega h / 2) (trapezoidal rule)",
-                            elong[x], 1e-8,
-                            "the elongation is read from the recurrence q_(n+1) + q_(n-1) = 2 cos(omega_bar h) "
-                            "q_n by least squares, exact up to round-off of ~2000 steps (1e-12) "
-                            "amplified by 1/(omega h)^2 in the relative error.", kind="rel"))
-        checks.append(Check(f"period elongation vs (omega h)^2/12, omega h = {x:g}", "-", x * x / 12.0,
-                            "leading term (omega h)^2/12", elong[x], x * x / 15.0 * 1.05,
-                            "T_bar/T = 1 + (omega h)^2/12 - (omega h)^4/180 + ...: the neglected term "
-                            "is (omega h)^2/15 of the leading one (5% margin).", kind="rel"))
+        checks.append(
+            Check(
+                f"period elongation, omega h = {x:g}",
+                "-",
+                exact[x],
+                "exact: omega_bar h = 2 atan(omega h / 2) (trapezoidal rule)",
+                elong[x],
+                1e-8,
+                "the elongation is read from the recurrence q_(n+1) + q_(n-1) = 2 cos(omega_bar h) "
+                "q_n by least squares, exact up to round-off of ~2000 steps (1e-12) "
+                "amplified by 1/(omega h)^2 in the relative error.",
+                kind="rel",
+            )
+        )
+        checks.append(
+            Check(
+                f"period elongation vs (omega h)^2/12, omega h = {x:g}",
+                "-",
+                x * x / 12.0,
+                "leading term (omega h)^2/12",
+                elong[x],
+                x * x / 15.0 * 1.05,
+                "T_bar/T = 1 + (omega h)^2/12 - (omega h)^4/180 + ...: the neglected term "
+                "is (omega h)^2/15 of the leading one (5% margin).",
+                kind="rel",
+            )
+        )
     slope = loglog_slope(list(whs), [elong[x] for x in whs])
-    checks.append(Check("log-log slope of the elongation, omega h = 0.05 ... 0.4", "-", 2.0,
-                        "second-order phase error", slope, 0.05,
-                        "the (omega h)^4 term lowers the local slope by (4/15)(omega h)^2, at most "
-                        "0.043 at omega h = 0.4.", kind="abs"))
+    checks.append(
+        Check(
+            "log-log slope of the elongation, omega h = 0.05 ... 0.4",
+            "-",
+            2.0,
+            "second-order phase error",
+            slope,
+            0.05,
+            "the (omega h)^4 term lowers the local slope by (4/15)(omega h)^2, at most 0.043 at omega h = 0.4.",
+            kind="abs",
+        )
+    )
     drift = max(float(np.abs(runs[x][1] / runs[x][1][0] - 1.0).max()) for x in whs)
     nsteps = max(len(runs[x][0]) for x in whs)
-    checks.append(Check("energy drift max |E_n/E_0 - 1| (undamped mode)", "-", 0.0,
-                        "average acceleration conserves energy exactly", drift, nsteps * EPS,
-                        f"only round-off may accumulate: {nsteps} steps x eps.", kind="max"))
-    desc = ("One undamped mode (f = 1 kHz, q(0) = 1) advanced for 20 periods by the compiled "
-            "`newmark_predict` and `newmark_correct` (solver/plate_modal.py) that advance every plate mode "
-            "in a run (beta = 1/4, gamma = 1/2, no interface force), at omega h = 0.05 ... 0.4. "
-            "The numerical frequency is read exactly from the three-term recurrence of the "
-            "sequence. At the simulator's step (40 ns) the plate's first bending mode has "
-            "omega h ~ 1e-3: elongation 1e-7.")
+    checks.append(
+        Check(
+            "energy drift max |E_n/E_0 - 1| (undamped mode)",
+            "-",
+            0.0,
+            "average acceleration conserves energy exactly",
+            drift,
+            nsteps * EPS,
+            f"only round-off may accumulate: {nsteps} steps x eps.",
+            kind="max",
+        )
+    )
+    desc = (
+        "One undamped mode (f = 1 kHz, q(0) = 1) advanced for 20 periods by the compiled "
+        "`newmark_predict` and `newmark_correct` (solver/plate_modal.py) that advance every plate mode "
+        "in a run (beta = 1/4, gamma = 1/2, no interface force), at omega h = 0.05 ... 0.4. "
+        "The numerical frequency is read exactly from the three-term recurrence of the "
+        "sequence. At the simulator's step (40 ns) the plate's first bending mode has "
+        "omega h ~ 1e-3: elongation 1e-7."
+    )
     return CaseResult.of(desc, checks, plot={"whs": whs, "elong": elong})
 
 
@@ -513,12 +647,32 @@ def draw_newmark_elongation(p: dict):
 
 CASES: tuple[Case, ...] = (
     Case("patch-test", "plate", "Patch test on a distorted Q8 mesh", patch_test, draw=draw_patch_test),
-    Case("strip-deflection", "plate", "Clamped strip: static mid-span deflection vs Timoshenko", strip_deflection,
-         draw=draw_strip_deflection),
-    Case("strip-frequencies", "plate", "Clamped strip: first three bending frequencies vs Timoshenko", strip_frequencies,
-         draw=draw_strip_frequencies),
-    Case("q8-convergence", "plate", "Q8 convergence rates (manufactured solution)", q8_convergence,
-         draw=draw_q8_convergence),
-    Case("newmark-elongation", "plate", "Newmark period elongation vs (omega h)^2/12", newmark_elongation,
-         draw=draw_newmark_elongation),
+    Case(
+        "strip-deflection",
+        "plate",
+        "Clamped strip: static mid-span deflection vs Timoshenko",
+        strip_deflection,
+        draw=draw_strip_deflection,
+    ),
+    Case(
+        "strip-frequencies",
+        "plate",
+        "Clamped strip: first three bending frequencies vs Timoshenko",
+        strip_frequencies,
+        draw=draw_strip_frequencies,
+    ),
+    Case(
+        "q8-convergence",
+        "plate",
+        "Q8 convergence rates (manufactured solution)",
+        q8_convergence,
+        draw=draw_q8_convergence,
+    ),
+    Case(
+        "newmark-elongation",
+        "plate",
+        "Newmark period elongation vs (omega h)^2/12",
+        newmark_elongation,
+        draw=draw_newmark_elongation,
+    ),
 )

@@ -12,6 +12,7 @@
 The runs' summaries are kept like the coupled studies' (`coupled.study_run`: the run store
 and DIR/validation-runs.json), so a second `--full` only computes what changed.
 """
+
 from __future__ import annotations
 
 import math
@@ -35,14 +36,23 @@ STEEL_QUANTITIES: tuple[tuple[str, str, str, float], ...] = (
 )
 #: Summary metrics the truncated basis must reproduce.
 SUMMARY_METRICS: tuple[str, ...] = (
-    "e_shock", "ep_max_fraction", "ep_final_fraction", "eg_max_fraction", "eg_final_fraction",
-    "dissipated_fraction", "max_von_mises", "max_von_mises_disc", "max_eps_yy",
+    "e_shock",
+    "ep_max_fraction",
+    "ep_final_fraction",
+    "eg_max_fraction",
+    "eg_final_fraction",
+    "dissipated_fraction",
+    "max_von_mises",
+    "max_von_mises_disc",
+    "max_eps_yy",
 )
 #: Agreement asked of the truncated basis on every summary metric [-].
 TRUNCATED_RTOL = 5e-3
-TRUNCATED_WHY = ("the dropped modes (above plate.max_frequency) are far stiffer than anything the "
-                 "contacts excite and the static correction restores their compliance at the contacts; "
-                 "what remains is their dynamic part, measured at most 0.4% (docs/benchmarks.md).")
+TRUNCATED_WHY = (
+    "the dropped modes (above plate.max_frequency) are far stiffer than anything the "
+    "contacts excite and the static correction restores their compliance at the contacts; "
+    "what remains is their dynamic part, measured at most 0.4% (docs/benchmarks.md)."
+)
 #: Agreement asked of the two finest meshes on the converging quantities [-].
 MESH_RTOL = 0.01
 
@@ -102,7 +112,9 @@ def bare_plate_energy(nx: int, ny: int) -> dict:
     f_r = model.T.T @ model.edge_load_full
     static = float(f_r @ spla.spsolve(K_r, f_r))
     missed = max(static - float(np.sum(model.edge_load_modal**2 / model.omega**2)), 0.0)
-    tail = 2.0 * q0**2 * (math.pi / T) ** 2 / float(model.omega[-1]) ** 2 * missed if model.n_modes < model.n_red else 0.0
+    tail = (
+        2.0 * q0**2 * (math.pi / T) ** 2 / float(model.omega[-1]) ** 2 * missed if model.n_modes < model.n_red else 0.0
+    )
     return {"e_shock": energy, "tail_bound": tail, "n_modes": int(model.n_modes), "n_red": int(model.n_red)}
 
 
@@ -122,6 +134,7 @@ def _stored_bare_energy(nx: int, ny: int) -> dict:
 
 
 # --------------------------------------------------------------------------- orders
+
 
 def observed_orders(values: list[float]) -> list[float]:
     """p = log2 |Q_i - Q_i+1| / |Q_i+1 - Q_i+2| for each three consecutive levels (h halved)."""
@@ -166,8 +179,10 @@ def convergence_table(label: str, rows: list[tuple[str, str, list[float], float]
 
 # --------------------------------------------------------------------------- the steel runs
 
-def steel_scenario(nx: int, ny: int, t_end: float = WINDOW, modes: str = "auto",
-                   layer_width: float | None = LAYER_WIDTH):
+
+def steel_scenario(
+    nx: int, ny: int, t_end: float = WINDOW, modes: str = "auto", layer_width: float | None = LAYER_WIDTH
+):
     """steel-r1 on an nx x ny mesh to t_end [s], with a rigid layer layer_width [m] wide
     (None: the preset's, one element edge)."""
     from granplate.setup.io import with_changes
@@ -190,45 +205,83 @@ def plate_mesh_convergence(ctx: Context) -> CaseResult:
     # the closed form against the solver on the preset's mesh (the shock is over at 10 us)
     sim = study_run(ctx, with_changes(preset("bare-plate"), {"time.t_end": 2e-5}))
     checks = [
-        Check("bare plate E_shock, 4 x 40: run vs modal closed form", "J", e_bare[0],
-              "sum over modes of 1/2 q0^2 L_m^2 |P(omega_m)|^2 (the pulse's spectrum, exact)",
-              sim["e_shock"], 2e-4,
-              "the implicit scheme integrates modes with omega h <= 1 exactly and the stiffer ones by "
-              "Newmark, whose period error (omega h)^2/12 touches modes the 10 us pulse barely excites."),
-        Check("bare plate E_p(t_end) / E_shock, 4 x 40 run", "-", 1.0,
-              "eq. (11) without dissipation: all the work stays in the plate", sim["ep_final_fraction"],
-              1e-4, "solver.energy_tol bounds the energy residual of every step."),
-        Check(f"bare plate E_shock: {MESHES[-2][0]} x {MESHES[-2][1]} vs {MESHES[-1][0]} x {MESHES[-1][1]}",
-              "J", e_bare[-1], "the finest mesh", e_bare[-2], MESH_RTOL,
-              "a global energy of a smooth load converges fast; 1% is the study's target."),
+        Check(
+            "bare plate E_shock, 4 x 40: run vs modal closed form",
+            "J",
+            e_bare[0],
+            "sum over modes of 1/2 q0^2 L_m^2 |P(omega_m)|^2 (the pulse's spectrum, exact)",
+            sim["e_shock"],
+            2e-4,
+            "the implicit scheme integrates modes with omega h <= 1 exactly and the stiffer ones by "
+            "Newmark, whose period error (omega h)^2/12 touches modes the 10 us pulse barely excites.",
+        ),
+        Check(
+            "bare plate E_p(t_end) / E_shock, 4 x 40 run",
+            "-",
+            1.0,
+            "eq. (11) without dissipation: all the work stays in the plate",
+            sim["ep_final_fraction"],
+            1e-4,
+            "solver.energy_tol bounds the energy residual of every step.",
+        ),
+        Check(
+            f"bare plate E_shock: {MESHES[-2][0]} x {MESHES[-2][1]} vs {MESHES[-1][0]} x {MESHES[-1][1]}",
+            "J",
+            e_bare[-1],
+            "the finest mesh",
+            e_bare[-2],
+            MESH_RTOL,
+            "a global energy of a smooth load converges fast; 1% is the study's target.",
+        ),
     ]
     for key, lab, unit, sc in STEEL_QUANTITIES[:2]:
-        checks.append(Check(f"steel-r1 {lab}: {MESHES[-2][0]} x {MESHES[-2][1]} vs {MESHES[-1][0]} x {MESHES[-1][1]}",
-                            unit, steel[-1][key] * sc, "the finest mesh", steel[-2][key] * sc, MESH_RTOL,
-                            "a converging quantity moves by less than 1% over the last halving of h."))
+        checks.append(
+            Check(
+                f"steel-r1 {lab}: {MESHES[-2][0]} x {MESHES[-2][1]} vs {MESHES[-1][0]} x {MESHES[-1][1]}",
+                unit,
+                steel[-1][key] * sc,
+                "the finest mesh",
+                steel[-2][key] * sc,
+                MESH_RTOL,
+                "a converging quantity moves by less than 1% over the last halving of h.",
+            )
+        )
     grow = steel[-1]["max_von_mises"] / steel[0]["max_von_mises"]
-    checks.append(Check("steel-r1 Gauss-point peak: finest / coarsest mesh", "-", 1.0,
-                        "a singular stress (rigid punch, ~rho^(-1/2)) has no mesh limit", grow, 1.5,
-                        "h shrinks 8x: a point value of a rho^(-1/2) field grows ~sqrt(8) = 2.8x; it "
-                        "must at least grow 1.5x, or the singularity (and the need for the disc "
-                        "average) is not there.", kind="min"))
+    checks.append(
+        Check(
+            "steel-r1 Gauss-point peak: finest / coarsest mesh",
+            "-",
+            1.0,
+            "a singular stress (rigid punch, ~rho^(-1/2)) has no mesh limit",
+            grow,
+            1.5,
+            "h shrinks 8x: a point value of a rho^(-1/2) field grows ~sqrt(8) = 2.8x; it "
+            "must at least grow 1.5x, or the singularity (and the need for the disc "
+            "average) is not there.",
+            kind="min",
+        )
+    )
     rows = [("bare plate E_shock (modal closed form)", "J", e_bare, 1.0)]
     rows += [(f"steel-r1 {lab}", unit, [r[key] for r in steel], sc) for key, lab, unit, sc in STEEL_QUANTITIES]
     table = convergence_table("quantity", rows, MESHES)
     dofs = "| reduced dofs | " + " | ".join(f"{b['n_red']:,}" for b in bare) + " | | |"
     table += "\n" + dofs
-    desc = ("The plate refined from 4 x 40 to 32 x 320 elements (2.5 to 0.31 mm) at a fixed rigid-layer "
-            f"width w = {LAYER_WIDTH * 1e3:g} mm. Bare plate: E_shock from the modes alone (each mode's energy "
-            "after the 10 us half-sine pulse, 1/2 q0^2 L_m^2 |P(omega_m)|^2; the dense basis on 4 x 40, the "
-            "truncated one below 1 MHz above, with a bound on the dropped modes' share), checked against "
-            "the solver's run on 4 x 40; after the pulse the plate's energy is E_shock. steel-r1: runs to "
-            f"{WINDOW * 1e3:g} ms (the plate's energy and stress peak inside it) with the default basis "
-            "(dense on 4 x 40, truncated above). Observed orders from three consecutive meshes, the last "
-            "one giving the Richardson limit.")
-    notes = ["Dropped modes' share of the bare-plate E_shock, upper bound: "
-             + ", ".join(f"{nx} x {ny}: {b['tail_bound'] / b['e_shock']:.1e}" for (nx, ny), b in zip(MESHES, bare))
-             + " (relative).",
-             _stress_note([r["max_von_mises"] for r in steel], [r["max_von_mises_disc"] for r in steel])]
+    desc = (
+        "The plate refined from 4 x 40 to 32 x 320 elements (2.5 to 0.31 mm) at a fixed rigid-layer "
+        f"width w = {LAYER_WIDTH * 1e3:g} mm. Bare plate: E_shock from the modes alone (each mode's energy "
+        "after the 10 us half-sine pulse, 1/2 q0^2 L_m^2 |P(omega_m)|^2; the dense basis on 4 x 40, the "
+        "truncated one below 1 MHz above, with a bound on the dropped modes' share), checked against "
+        "the solver's run on 4 x 40; after the pulse the plate's energy is E_shock. steel-r1: runs to "
+        f"{WINDOW * 1e3:g} ms (the plate's energy and stress peak inside it) with the default basis "
+        "(dense on 4 x 40, truncated above). Observed orders from three consecutive meshes, the last "
+        "one giving the Richardson limit."
+    )
+    notes = [
+        "Dropped modes' share of the bare-plate E_shock, upper bound: "
+        + ", ".join(f"{nx} x {ny}: {b['tail_bound'] / b['e_shock']:.1e}" for (nx, ny), b in zip(MESHES, bare))
+        + " (relative).",
+        _stress_note([r["max_von_mises"] for r in steel], [r["max_von_mises_disc"] for r in steel]),
+    ]
     return CaseResult.of(desc, checks, plot={"rows": rows, "steel": steel}, notes=notes, tables=[table])
 
 
@@ -256,18 +309,21 @@ def draw_plate_mesh_convergence(p: dict):
 def _stress_note(peak: list[float], disc: list[float]) -> str:
     """What the steel run's two stresses do per halving of the element, in numbers."""
     steps = ", ".join(f"{100 * (b / a - 1):+.1f}%" for a, b in zip(disc, disc[1:]))
-    return (f"Per halving of the element the Gauss-point peak grows "
-            f"{', '.join(f'{b / a:.2f}x' for a, b in zip(peak, peak[1:]))} (rho^(-1/2) and stronger next to "
-            f"a rigid layer's end and at the clamped corners: a property of the mesh), while the "
-            f"disc-averaged stress (docs/model.md section 4.4) moves {steps}: bounded, within "
-            f"{100 * (max(disc) / min(disc) - 1):.1f}% over the whole refinement. Where its changes do not "
-            "shrink from one halving to the next, no asymptotic order is claimed: the Gauss-point "
-            "quadrature of a disc cut through elements converges erratically, not at a fixed rate "
-            "(the mean of rho^2 over a disc errs by -14%, +0.7%, +1.6% on 4 x 40, 8 x 80, 16 x 160; "
-            "tests/test_plate_stress.py).")
+    return (
+        f"Per halving of the element the Gauss-point peak grows "
+        f"{', '.join(f'{b / a:.2f}x' for a, b in zip(peak, peak[1:]))} (rho^(-1/2) and stronger next to "
+        f"a rigid layer's end and at the clamped corners: a property of the mesh), while the "
+        f"disc-averaged stress (docs/model.md section 4.4) moves {steps}: bounded, within "
+        f"{100 * (max(disc) / min(disc) - 1):.1f}% over the whole refinement. Where its changes do not "
+        "shrink from one halving to the next, no asymptotic order is claimed: the Gauss-point "
+        "quadrature of a disc cut through elements converges erratically, not at a fixed rate "
+        "(the mean of rho^2 over a disc errs by -14%, +0.7%, +1.6% on 4 x 40, 8 x 80, 16 x 160; "
+        "tests/test_plate_stress.py)."
+    )
 
 
 # --------------------------------------------------------------------------- truncated basis
+
 
 def truncated_agreement(ctx: Context, meshes, t_end: float) -> CaseResult:
     """Every summary metric of steel-r1 with the truncated basis against the full one."""
@@ -277,21 +333,33 @@ def truncated_agreement(ctx: Context, meshes, t_end: float) -> CaseResult:
         trunc = study_run(ctx, steel_scenario(nx, ny, t_end, "truncated", None))
         diffs[(nx, ny)] = [trunc[k] / full[k] - 1 for k in SUMMARY_METRICS]
         for k in SUMMARY_METRICS:
-            checks.append(Check(f"{k}, {nx} x {ny}, {t_end * 1e3:g} ms", "-", full[k],
-                                "the same run with every mode (dense basis)", trunc[k], TRUNCATED_RTOL,
-                                TRUNCATED_WHY))
+            checks.append(
+                Check(
+                    f"{k}, {nx} x {ny}, {t_end * 1e3:g} ms",
+                    "-",
+                    full[k],
+                    "the same run with every mode (dense basis)",
+                    trunc[k],
+                    TRUNCATED_RTOL,
+                    TRUNCATED_WHY,
+                )
+            )
         table.append(f"| {nx} x {ny} | " + " | ".join(f"{100 * d:+.3f}%" for d in diffs[(nx, ny)]) + " |")
     head = "| mesh | " + " | ".join(SUMMARY_METRICS) + " |"
     tables = ["\n".join([head, "|---" * (len(SUMMARY_METRICS) + 1) + "|"] + table)]
-    desc = ("steel-r1 (its rigid layer one element edge wide) run twice on each mesh, implicit scheme: with every "
-            "mode (plate.modes = \"all\", the exact full system) and with the modes below 1 MHz plus the "
-            "static residual compliance at the contacts (plate.modes = \"truncated\", docs/model.md "
-            "section 4.5). Every summary metric must agree within 0.5%.")
-    notes = ["The most sensitive metric is ep_final_fraction, the plate's free vibration left at the "
-             "end, a few per cent of E_shock. With the layer fixed at 2.5 mm on 8 x 80 (two element "
-             "edges) instead of one edge, the truncated basis put it 1.04% low over 2 ms (0.019270 against "
-             "0.019472, 2e-4 of E_shock), the other metrics within 0.12% (measured): raise "
-             "plate.max_frequency where that share matters."]
+    desc = (
+        "steel-r1 (its rigid layer one element edge wide) run twice on each mesh, implicit scheme: with every "
+        'mode (plate.modes = "all", the exact full system) and with the modes below 1 MHz plus the '
+        'static residual compliance at the contacts (plate.modes = "truncated", docs/model.md '
+        "section 4.5). Every summary metric must agree within 0.5%."
+    )
+    notes = [
+        "The most sensitive metric is ep_final_fraction, the plate's free vibration left at the "
+        "end, a few per cent of E_shock. With the layer fixed at 2.5 mm on 8 x 80 (two element "
+        "edges) instead of one edge, the truncated basis put it 1.04% low over 2 ms (0.019270 against "
+        "0.019472, 2e-4 of E_shock), the other metrics within 0.12% (measured): raise "
+        "plate.max_frequency where that share matters."
+    ]
     return CaseResult.of(desc, checks, plot={"meshes": meshes, "diffs": diffs}, notes=notes, tables=tables)
 
 
@@ -302,8 +370,12 @@ def draw_truncated_agreement(p: dict):
     ax = axes[0, 0]
     x = np.arange(len(SUMMARY_METRICS))
     for j, mesh in enumerate(meshes):
-        ax.bar(x + 0.8 * j / len(meshes), 100 * np.array(diffs[mesh]), width=0.8 / len(meshes),
-               label=f"{mesh[0]} x {mesh[1]}")
+        ax.bar(
+            x + 0.8 * j / len(meshes),
+            100 * np.array(diffs[mesh]),
+            width=0.8 / len(meshes),
+            label=f"{mesh[0]} x {mesh[1]}",
+        )
     ax.axhline(100 * TRUNCATED_RTOL, color="k", lw=0.6, ls="--")
     ax.axhline(-100 * TRUNCATED_RTOL, color="k", lw=0.6, ls="--")
     ax.set_xticks(x, SUMMARY_METRICS, rotation=45, ha="right", fontsize=7)
@@ -323,10 +395,27 @@ def truncated_basis_fine(ctx: Context) -> CaseResult:
 
 
 CASES: tuple[Case, ...] = (
-    Case("truncated-basis", "plate", "Truncated modal basis vs the full one, 4 x 40 (0.5 ms)", truncated_basis,
-         draw=draw_truncated_agreement),
-    Case("truncated-basis-8x80", "plate", "Truncated modal basis vs the full one, 4 x 40 and 8 x 80 (2 ms)",
-         truncated_basis_fine, slow=True, draw=draw_truncated_agreement),
-    Case("plate-mesh-convergence", "plate", "Plate mesh convergence to 32 x 320: energies and stresses",
-         plate_mesh_convergence, slow=True, draw=draw_plate_mesh_convergence),
+    Case(
+        "truncated-basis",
+        "plate",
+        "Truncated modal basis vs the full one, 4 x 40 (0.5 ms)",
+        truncated_basis,
+        draw=draw_truncated_agreement,
+    ),
+    Case(
+        "truncated-basis-8x80",
+        "plate",
+        "Truncated modal basis vs the full one, 4 x 40 and 8 x 80 (2 ms)",
+        truncated_basis_fine,
+        slow=True,
+        draw=draw_truncated_agreement,
+    ),
+    Case(
+        "plate-mesh-convergence",
+        "plate",
+        "Plate mesh convergence to 32 x 320: energies and stresses",
+        plate_mesh_convergence,
+        slow=True,
+        draw=draw_plate_mesh_convergence,
+    ),
 )

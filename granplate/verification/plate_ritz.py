@@ -16,6 +16,7 @@ Nothing here uses granplate's finite elements: it is the truth the plate tables 
 `plate_theory` are checked with, and that a 3D body's verification can use where no
 closed form exists (the clamped and free plates).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -60,9 +61,12 @@ def kirchhoff_matrices(edges: str, aspect: float, nu: float, n_terms: int) -> tu
     g = {(p, q): gram(phi, phi, p, q) for p in range(3) for q in range(3)}
     sx, sy = 2.0, 2.0 / aspect  # d/dx = sx d/dxi, d/dy = sy d/deta
     area = aspect / 4.0  # dx dy = (a b / 4) dxi deta
-    k = area * (sx**4 * np.kron(g[2, 2], g[0, 0]) + sy**4 * np.kron(g[0, 0], g[2, 2])
-                + nu * sx**2 * sy**2 * (np.kron(g[2, 0], g[0, 2]) + np.kron(g[0, 2], g[2, 0]))
-                + 2.0 * (1.0 - nu) * sx**2 * sy**2 * np.kron(g[1, 1], g[1, 1]))
+    k = area * (
+        sx**4 * np.kron(g[2, 2], g[0, 0])
+        + sy**4 * np.kron(g[0, 0], g[2, 2])
+        + nu * sx**2 * sy**2 * (np.kron(g[2, 0], g[0, 2]) + np.kron(g[0, 2], g[2, 0]))
+        + 2.0 * (1.0 - nu) * sx**2 * sy**2 * np.kron(g[1, 1], g[1, 1])
+    )
     m = area * np.kron(g[0, 0], g[0, 0])
     return k, m
 
@@ -75,16 +79,18 @@ def _parameters(k: np.ndarray, m: np.ndarray, count: int) -> np.ndarray:
     return np.sqrt(elastic[:count])
 
 
-def kirchhoff_frequency_parameters(edges: str, count: int = 6, aspect: float = 1.0, nu: float = 0.3,
-                                   n_terms: int = 12) -> np.ndarray:
+def kirchhoff_frequency_parameters(
+    edges: str, count: int = 6, aspect: float = 1.0, nu: float = 0.3, n_terms: int = 12
+) -> np.ndarray:
     """The `count` lowest lambda^2 = omega a^2 sqrt(rho h / D) of a Kirchhoff plate with
     all edges `edges` ("C", "S", "F"), b / a = aspect (Ritz upper bounds; a free plate's
     three rigid-body modes are left out)."""
     return _parameters(*kirchhoff_matrices(edges, aspect, nu, n_terms), count)
 
 
-def kirchhoff_centre_deflection(edges: str, load: str, aspect: float = 1.0, nu: float = 0.3,
-                                n_terms: int = 12) -> float:
+def kirchhoff_centre_deflection(
+    edges: str, load: str, aspect: float = 1.0, nu: float = 0.3, n_terms: int = 12
+) -> float:
     """The centre deflection of a Kirchhoff plate under a uniform load ("uniform": as
     w D / (q a^4)) or a central point load ("point": as w D / (P a^2)); edges "C" or "S"."""
     _check_edges(edges)
@@ -103,8 +109,9 @@ def kirchhoff_centre_deflection(edges: str, load: str, aspect: float = 1.0, nu: 
     return float(np.kron(at_centre, at_centre) @ solve(k, f, assume_a="pos"))
 
 
-def mindlin_matrices(edges: str, h_over_a: float, nu: float = 0.3, kappa: float = 5.0 / 6.0,
-                     n_terms: int = 10) -> tuple[np.ndarray, np.ndarray]:
+def mindlin_matrices(
+    edges: str, h_over_a: float, nu: float = 0.3, kappa: float = 5.0 / 6.0, n_terms: int = 10
+) -> tuple[np.ndarray, np.ndarray]:
     """(K, M) of a square Mindlin plate (a = D = rho h = 1, thickness h = h_over_a) in the
     fields (w, psi_x, psi_y) from U = 1/2 int D [psi_x,x^2 + psi_y,y^2 + 2 nu psi_x,x psi_y,y
     + (1 - nu)/2 (psi_x,y + psi_y,x)^2] + kappa G h [(w_x + psi_x)^2 + (w_y + psi_y)^2] dA and
@@ -134,10 +141,16 @@ def mindlin_matrices(edges: str, h_over_a: float, nu: float = 0.3, kappa: float 
         return area * s ** (sum(d1) + sum(d2)) * np.kron(gx, gy)
 
     # bending: psi_x,x = x(1,0); psi_y,y = y(0,1); twist psi_x,y + psi_y,x
-    kxx = (block("x", (1, 0), "x", (1, 0)) + (1 - nu) / 2 * block("x", (0, 1), "x", (0, 1))
-           + shear * block("x", (0, 0), "x", (0, 0)))
-    kyy = (block("y", (0, 1), "y", (0, 1)) + (1 - nu) / 2 * block("y", (1, 0), "y", (1, 0))
-           + shear * block("y", (0, 0), "y", (0, 0)))
+    kxx = (
+        block("x", (1, 0), "x", (1, 0))
+        + (1 - nu) / 2 * block("x", (0, 1), "x", (0, 1))
+        + shear * block("x", (0, 0), "x", (0, 0))
+    )
+    kyy = (
+        block("y", (0, 1), "y", (0, 1))
+        + (1 - nu) / 2 * block("y", (1, 0), "y", (1, 0))
+        + shear * block("y", (0, 0), "y", (0, 0))
+    )
     kxy = nu * block("x", (1, 0), "y", (0, 1)) + (1 - nu) / 2 * block("x", (0, 1), "y", (1, 0))
     kww = shear * (block("w", (1, 0), "w", (1, 0)) + block("w", (0, 1), "w", (0, 1)))
     kwx = shear * block("w", (1, 0), "x", (0, 0))
@@ -145,22 +158,26 @@ def mindlin_matrices(edges: str, h_over_a: float, nu: float = 0.3, kappa: float 
     k = np.block([[kww, kwx, kwy], [kwx.T, kxx, kxy], [kwy.T, kxy.T, kyy]])
     rot = h_over_a**2 / 12.0
     zero = np.zeros((n * n, n * n))
-    m = np.block([[block("w", (0, 0), "w", (0, 0)), zero, zero],
-                  [zero, rot * block("x", (0, 0), "x", (0, 0)), zero],
-                  [zero, zero, rot * block("y", (0, 0), "y", (0, 0))]])
+    m = np.block(
+        [
+            [block("w", (0, 0), "w", (0, 0)), zero, zero],
+            [zero, rot * block("x", (0, 0), "x", (0, 0)), zero],
+            [zero, zero, rot * block("y", (0, 0), "y", (0, 0))],
+        ]
+    )
     return k, m
 
 
-def mindlin_frequency_parameters(edges: str, h_over_a: float, count: int = 6, nu: float = 0.3,
-                                 kappa: float = 5.0 / 6.0, n_terms: int = 10) -> np.ndarray:
+def mindlin_frequency_parameters(
+    edges: str, h_over_a: float, count: int = 6, nu: float = 0.3, kappa: float = 5.0 / 6.0, n_terms: int = 10
+) -> np.ndarray:
     """The `count` lowest lambda^2 = omega a^2 sqrt(rho h / D) of a square Mindlin plate
     with all edges `edges` (Ritz upper bounds). The polynomial basis locks in shear for
     h/a below about 0.005 (12 terms): the thin limit is `kirchhoff_frequency_parameters`."""
     return _parameters(*mindlin_matrices(edges, h_over_a, nu, kappa, n_terms), count)
 
 
-def point_load_deflection_extrapolated(edges: str, aspect: float = 1.0, nu: float = 0.3,
-                                       n_terms: int = 32) -> float:
+def point_load_deflection_extrapolated(edges: str, aspect: float = 1.0, nu: float = 0.3, n_terms: int = 32) -> float:
     """The centre deflection under a central point load as w D / (P a^2), Richardson-
     extrapolated from n_terms / 2 and n_terms terms: the point load's Ritz deflection
     converges from below as n^-2 (its curvature is singular at the load), so

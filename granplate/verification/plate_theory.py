@@ -18,6 +18,7 @@ non-dimensional parameters their sources tabulate:
 The plates no closed form covers (clamped, free, clamped Mindlin) are computed by the
 independent Ritz solver `plate_ritz`; the tests hold each against the other.
 """
+
 from __future__ import annotations
 
 import math
@@ -43,6 +44,7 @@ TIMOSHENKO_CENTRE_DEFLECTION = {
 
 
 # --------------------------------------------------------------------------- Kirchhoff
+
 
 def flexural_rigidity(young: float, thickness: float, poisson: float) -> float:
     """D = E h^3 / (12 (1 - nu^2)) [N m]."""
@@ -70,8 +72,10 @@ def ss_frequency_parameters(count: int, aspect: float = 1.0) -> np.ndarray:
 
 # --------------------------------------------------------------------------- Mindlin, simply supported
 
-def mindlin_ss_matrices(m: int, n: int, h_over_a: float, aspect: float = 1.0, nu: float = 0.3,
-                        kappa: float = 5.0 / 6.0) -> tuple[np.ndarray, np.ndarray]:
+
+def mindlin_ss_matrices(
+    m: int, n: int, h_over_a: float, aspect: float = 1.0, nu: float = 0.3, kappa: float = 5.0 / 6.0
+) -> tuple[np.ndarray, np.ndarray]:
     """(K, M), 3 x 3, of Navier's mode (m, n) of a simply supported Mindlin plate in units
     a = D = rho h = 1: w = W sin(alpha x) sin(beta y), psi_x = X cos(alpha x) sin(beta y),
     psi_y = Y sin(alpha x) cos(beta y), alpha = m pi / a, beta = n pi / b, put into Mindlin's
@@ -84,15 +88,20 @@ def mindlin_ss_matrices(m: int, n: int, h_over_a: float, aspect: float = 1.0, nu
         raise ValueError(f"h_over_a must be > 0, not {h_over_a!r}")
     alpha, beta = m * math.pi, n * math.pi / aspect
     s = 6.0 * kappa * (1.0 - nu) / h_over_a**2
-    k = np.array([[s * (alpha**2 + beta**2), s * alpha, s * beta],
-                  [s * alpha, alpha**2 + (1 - nu) / 2 * beta**2 + s, (1 + nu) / 2 * alpha * beta],
-                  [s * beta, (1 + nu) / 2 * alpha * beta, beta**2 + (1 - nu) / 2 * alpha**2 + s]])
+    k = np.array(
+        [
+            [s * (alpha**2 + beta**2), s * alpha, s * beta],
+            [s * alpha, alpha**2 + (1 - nu) / 2 * beta**2 + s, (1 + nu) / 2 * alpha * beta],
+            [s * beta, (1 + nu) / 2 * alpha * beta, beta**2 + (1 - nu) / 2 * alpha**2 + s],
+        ]
+    )
     rot = h_over_a**2 / 12.0
     return k, np.diag([1.0, rot, rot])
 
 
-def mindlin_ss_frequency_parameter(m: int, n: int, h_over_a: float, aspect: float = 1.0, nu: float = 0.3,
-                                   kappa: float = 5.0 / 6.0) -> float:
+def mindlin_ss_frequency_parameter(
+    m: int, n: int, h_over_a: float, aspect: float = 1.0, nu: float = 0.3, kappa: float = 5.0 / 6.0
+) -> float:
     """lambda^2 = omega a^2 sqrt(rho h / D) of the flexural (lowest) root of Mindlin's
     cubic for mode (m, n) of a simply supported rectangle (hard supports: w = 0, the
     rotation along the edge = 0); tends to pi^2 (m^2 + n^2 (a/b)^2) as h / a -> 0. From
@@ -101,8 +110,9 @@ def mindlin_ss_frequency_parameter(m: int, n: int, h_over_a: float, aspect: floa
     return mindlin_ss_roots(m, n, h_over_a, aspect, nu, kappa)[0]
 
 
-def mindlin_ss_roots(m: int, n: int, h_over_a: float, aspect: float = 1.0, nu: float = 0.3,
-                     kappa: float = 5.0 / 6.0) -> tuple[float, float, float]:
+def mindlin_ss_roots(
+    m: int, n: int, h_over_a: float, aspect: float = 1.0, nu: float = 0.3, kappa: float = 5.0 / 6.0
+) -> tuple[float, float, float]:
     """The three lambda^2 of mode (m, n) in closed form (units a = D = rho h = 1,
     k^2 = alpha^2 + beta^2, S = 6 kappa (1 - nu) / (h/a)^2, r = (h/a)^2 / 12): the rotations
     split into a gradient and a curl. The curl (thickness-twist) root is
@@ -124,12 +134,14 @@ def mindlin_ss_roots(m: int, n: int, h_over_a: float, aspect: float = 1.0, nu: f
     return math.sqrt(flexural), math.sqrt(shear), math.sqrt(twist)
 
 
-def mindlin_ss_frequency_parameters(count: int, h_over_a: float, aspect: float = 1.0, nu: float = 0.3,
-                                    kappa: float = 5.0 / 6.0) -> np.ndarray:
+def mindlin_ss_frequency_parameters(
+    count: int, h_over_a: float, aspect: float = 1.0, nu: float = 0.3, kappa: float = 5.0 / 6.0
+) -> np.ndarray:
     """The `count` lowest flexural lambda^2 of a simply supported Mindlin rectangle."""
     top = count + 2
-    values = sorted(mindlin_ss_frequency_parameter(m, n, h_over_a, aspect, nu, kappa)
-                    for m in range(1, top) for n in range(1, top))
+    values = sorted(
+        mindlin_ss_frequency_parameter(m, n, h_over_a, aspect, nu, kappa) for m in range(1, top) for n in range(1, top)
+    )
     return np.array(values[:count])
 
 
@@ -141,14 +153,25 @@ def shear_frequency_parameter(parameter: float, h_over_a: float, nu: float = 0.3
 
 # --------------------------------------------------------------------------- statics (Navier)
 
+
 def _indices(terms: int) -> np.ndarray:
     """1, 2, ..., terms as floats (the even terms vanish at a centred load by sin(k pi / 2))."""
     return np.arange(1, terms + 1, dtype=float)
 
 
-def navier_patch_deflection(x: float, y: float, a: float, b: float, rigidity: float, q0: float,
-                            u: float, v: float, x0: float | None = None, y0: float | None = None,
-                            terms: int = 200) -> float:
+def navier_patch_deflection(
+    x: float,
+    y: float,
+    a: float,
+    b: float,
+    rigidity: float,
+    q0: float,
+    u: float,
+    v: float,
+    x0: float | None = None,
+    y0: float | None = None,
+    terms: int = 200,
+) -> float:
     """w(x, y) [m] of a simply supported rectangle a x b under a uniform pressure q0 [Pa]
     on a patch u x v centred at (x0, y0) (default: the plate's centre), Navier's series
     (Timoshenko & Woinowsky-Krieger 1959, ch. 5, eqs. for a load over a rectangle):
@@ -159,14 +182,30 @@ def navier_patch_deflection(x: float, y: float, a: float, b: float, rigidity: fl
     y0 = b / 2 if y0 is None else y0
     m = _indices(terms)[:, None]
     n = _indices(terms)[None, :]
-    q = (16.0 * q0 / (math.pi**2 * m * n) * np.sin(m * math.pi * x0 / a) * np.sin(n * math.pi * y0 / b)
-         * np.sin(m * math.pi * u / (2 * a)) * np.sin(n * math.pi * v / (2 * b)))
+    q = (
+        16.0
+        * q0
+        / (math.pi**2 * m * n)
+        * np.sin(m * math.pi * x0 / a)
+        * np.sin(n * math.pi * y0 / b)
+        * np.sin(m * math.pi * u / (2 * a))
+        * np.sin(n * math.pi * v / (2 * b))
+    )
     shape = np.sin(m * math.pi * x / a) * np.sin(n * math.pi * y / b)
     return float(np.sum(q * shape / (math.pi**4 * rigidity * (m**2 / a**2 + n**2 / b**2) ** 2)))
 
 
-def navier_point_deflection(x: float, y: float, a: float, b: float, rigidity: float, force: float,
-                            x0: float | None = None, y0: float | None = None, terms: int = 400) -> float:
+def navier_point_deflection(
+    x: float,
+    y: float,
+    a: float,
+    b: float,
+    rigidity: float,
+    force: float,
+    x0: float | None = None,
+    y0: float | None = None,
+    terms: int = 400,
+) -> float:
     """w(x, y) [m] of a simply supported rectangle under a point force P [N] at (x0, y0):
     Navier's series with q_mn = 4 P / (a b) sin(m pi x0 / a) sin(n pi y0 / b)
     (Timoshenko & Woinowsky-Krieger 1959, ch. 5); the patch series as u, v -> 0."""

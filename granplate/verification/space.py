@@ -5,6 +5,7 @@ with its damping and the tanh-Coulomb friction on the slip velocity vector
 v_s = (v_i - v_j)_t + (R_i w_i + R_j w_j) x n, with torques R n x f, coefficients
 computed here from the material constants (the paper's torque arm R).
 """
+
 from __future__ import annotations
 
 import math
@@ -15,8 +16,10 @@ from scipy.integrate import solve_ivp
 from .dynamic import effective, normal_force
 
 #: Source line of the independent integrator in space.
-IVP_SOURCE_3D = ("scipy DOP853 of the 3D laws (Hertz with damping, tanh-Coulomb on the slip vector, "
-                 "torques R n x f) over every pair and wall (rtol 1e-11), written independently")
+IVP_SOURCE_3D = (
+    "scipy DOP853 of the 3D laws (Hertz with damping, tanh-Coulomb on the slip vector, "
+    "torques R n x f) over every pair and wall (rtol 1e-11), written independently"
+)
 
 
 def reference_bodies_3d(s) -> dict:
@@ -35,9 +38,21 @@ def reference_bodies_3d(s) -> dict:
         c_pair[k] = s.contact.alpha_n * math.sqrt(mi * mj / (mi + mj) * a_pair[k])
     walls = [(np.array(w.normal, float) / np.linalg.norm(w.normal), float(w.offset)) for w in s.walls]
     a_wall = np.array([4.0 / 3.0 * effective(mt, None, ri, None)[0] * math.sqrt(ri) for mt, ri in zip(mats, r)])
-    return {"r": r, "m": m, "inertia": 0.4 * m * r * r, "i": ii, "j": jj, "a": a_pair, "c": c_pair,
-            "walls": walls, "a_wall": a_wall, "c_wall": s.contact.alpha_n * np.sqrt(m * a_wall),
-            "mu": s.contact.mu, "k_s": s.contact.k_s, "clip": s.contact.clip_tensile}
+    return {
+        "r": r,
+        "m": m,
+        "inertia": 0.4 * m * r * r,
+        "i": ii,
+        "j": jj,
+        "a": a_pair,
+        "c": c_pair,
+        "walls": walls,
+        "a_wall": a_wall,
+        "c_wall": s.contact.alpha_n * np.sqrt(m * a_wall),
+        "mu": s.contact.mu,
+        "k_s": s.contact.k_s,
+        "clip": s.contact.clip_tensile,
+    }
 
 
 def _friction(mu, k_s, f_n, vs):
@@ -93,10 +108,23 @@ def reference_motion_3d(s, times: np.ndarray, rtol: float = 1e-11, max_step: flo
     [s]) at `times` [s]."""
     b = reference_bodies_3d(s)
     g = s.granules
-    z0 = np.concatenate([np.array([[q.x, q.y, q.z] for q in g]).ravel(), np.array([[q.vx, q.vy, q.vz] for q in g]).ravel(),
-                         np.array([q.spin() for q in g], float).ravel()])
-    sol = solve_ivp(reference_rhs_3d(b), (0.0, float(times[-1])), z0, method="DOP853", rtol=rtol, atol=1e-15,
-                    t_eval=times, max_step=max_step)
+    z0 = np.concatenate(
+        [
+            np.array([[q.x, q.y, q.z] for q in g]).ravel(),
+            np.array([[q.vx, q.vy, q.vz] for q in g]).ravel(),
+            np.array([q.spin() for q in g], float).ravel(),
+        ]
+    )
+    sol = solve_ivp(
+        reference_rhs_3d(b),
+        (0.0, float(times[-1])),
+        z0,
+        method="DOP853",
+        rtol=rtol,
+        atol=1e-15,
+        t_eval=times,
+        max_step=max_step,
+    )
     if not sol.success:
         raise RuntimeError(f"reference integrator failed: {sol.message}")
     n = len(g)

@@ -7,6 +7,7 @@
 The fingerprint is the run summary (without wall time) plus the energies at ten output
 times and the granules' final centres, so a refactoring that moves any result shows.
 """
+
 from __future__ import annotations
 
 import json
@@ -20,9 +21,17 @@ SCHEMES = ("paper", "implicit")
 #: The summary's numbers in the fingerprint (not the wall time; keys added to the summary
 #: later join only when presets.json is regenerated).
 FINGERPRINT_SUMMARY_KEYS = (
-    "t_end", "e_shock", "ep_max_fraction", "ep_final_fraction", "eg_max_fraction",
-    "eg_final_fraction", "dissipated_fraction", "max_von_mises", "max_eps_yy",
-    "energy_residual_max", "n_steps",
+    "t_end",
+    "e_shock",
+    "ep_max_fraction",
+    "ep_final_fraction",
+    "eg_max_fraction",
+    "eg_final_fraction",
+    "dissipated_fraction",
+    "max_von_mises",
+    "max_eps_yy",
+    "energy_residual_max",
+    "n_steps",
 )
 
 

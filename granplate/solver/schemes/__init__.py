@@ -26,6 +26,7 @@ on disk; no Python and no function pointer per step). Hooks called every step ta
 only the arrays they need: a call that passes the big state tuples costs ~0.4 us. Adding a scheme: write its module
 and add it to SCHEMES (and its name to model.inputs.SCHEME_NAMES).
 """
+
 from __future__ import annotations
 
 from types import ModuleType
@@ -125,7 +126,8 @@ def _judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
     fn = _hook_of(sw, "judge")
     if fn is not None:
         return lambda sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w: fn(
-            sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w)
+            sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w
+        )
 
 
 @overload(commit, inline="always")
@@ -133,7 +135,8 @@ def _commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
     fn = _hook_of(sw, "commit")
     if fn is not None:
         return lambda sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w: fn(
-            sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w)
+            sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w
+        )
 
 
 @overload(next_level, inline="always")
@@ -141,7 +144,8 @@ def _next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg):
     fn = _hook_of(sw, "next_level")
     if fn is not None:
         return lambda sw, h, slot, level, err, lam_max, rate, t_now, cfg: fn(
-            sw, h, slot, level, err, lam_max, rate, t_now, cfg)
+            sw, h, slot, level, err, lam_max, rate, t_now, cfg
+        )
 
 
 @overload(contact_placed, inline="always")

@@ -13,6 +13,7 @@ One step t -> t + h:
    the interface and granule forces from their extrapolation) and the growth of the
    energy residual (eq. 11); steps are output_interval / 2^k and tile every interval.
 """
+
 from __future__ import annotations
 
 import math
@@ -27,14 +28,37 @@ from granplate.solver.dimension import force_error, kinetic_energies
 from granplate.solver.rk4 import rk4_granular_step, rk4_limit
 from granplate.solver.interface import forces_converged
 from granplate.solver.ladder import (
-    dyadic_level, dyadic_round, level_for, level_step, position_tolerance, realign_step, step_to_output,
+    dyadic_level,
+    dyadic_round,
+    level_for,
+    level_step,
+    position_tolerance,
+    realign_step,
+    step_to_output,
 )
 from granplate.solver.plate_modal import (
-    N_MCOEF, exact_correct, exact_matrices, exact_predict, modal_coefficients, static_matrices,
+    N_MCOEF,
+    exact_correct,
+    exact_matrices,
+    exact_predict,
+    modal_coefficients,
+    static_matrices,
 )
 from granplate.solver.schemes.newton import held_friction, newton_update
 from granplate.solver.state import (
-    A_DRIVE, A_GRAVITY, A_FRIC, A_PLASTIC, A_SHOCK_G, A_SHOCK_P, A_VISC, C_LEVEL, E_IN_MAX, E_ZERO, F_SCALE, H_LAST, N_LEVELS,
+    A_DRIVE,
+    A_GRAVITY,
+    A_FRIC,
+    A_PLASTIC,
+    A_SHOCK_G,
+    A_SHOCK_P,
+    A_VISC,
+    C_LEVEL,
+    E_IN_MAX,
+    E_ZERO,
+    F_SCALE,
+    H_LAST,
+    N_LEVELS,
     RES_LAST,
 )
 
@@ -64,9 +88,16 @@ def new_scratch(ng: int, nm: int, nk: int, body=None) -> Scratch:
     """Scratch for ng granules, nm modes, nk plate contacts."""
     nd = 2 * nk
     z = np.zeros
-    return Scratch(ustar=z((4, nd)), jac=z((nd, nd)), rhs=z(nd), vguess=z(nk),
-                   mcoef=z((N_LEVELS + 1, nm, N_MCOEF)), mmat=z((N_LEVELS + 1, 4, nd, nd)),
-                   qn=z(nm), qdn=z(nm))
+    return Scratch(
+        ustar=z((4, nd)),
+        jac=z((nd, nd)),
+        rhs=z(nd),
+        vguess=z(nk),
+        mcoef=z((N_LEVELS + 1, nm, N_MCOEF)),
+        mmat=z((N_LEVELS + 1, 4, nd, nd)),
+        qn=z(nm),
+        qdn=z(nm),
+    )
 
 
 @njit(cache=True)
@@ -188,10 +219,29 @@ def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
     fric_work = held_friction_work(st, g, cfg, w)
     work, ep_new = exact_correct(t, h, st, p, cfg, sw.mcoef[slot], w.fguess, sw.qn, sw.qdn)
     kx, ky, kz, kr = kinetic_energies(w.ynew, g)
-    e_in = (st.clock[E_ZERO] + st.acc[A_SHOCK_G] + w.dacc[0] + st.acc[A_SHOCK_P] + work
-            + (st.acc[A_GRAVITY] + w.dacc[4] + st.acc[A_DRIVE] + w.dacc[5]))
-    total = (kx + ky + kz + kr + e_pot + ep_new + st.acc[A_VISC] + w.dacc[1]
-             + st.acc[A_FRIC] + w.dacc[2] + fric_work + st.acc[A_PLASTIC] + w.dacc[3])
+    e_in = (
+        st.clock[E_ZERO]
+        + st.acc[A_SHOCK_G]
+        + w.dacc[0]
+        + st.acc[A_SHOCK_P]
+        + work
+        + (st.acc[A_GRAVITY] + w.dacc[4] + st.acc[A_DRIVE] + w.dacc[5])
+    )
+    total = (
+        kx
+        + ky
+        + kz
+        + kr
+        + e_pot
+        + ep_new
+        + st.acc[A_VISC]
+        + w.dacc[1]
+        + st.acc[A_FRIC]
+        + w.dacc[2]
+        + fric_work
+        + st.acc[A_PLASTIC]
+        + w.dacc[3]
+    )
     denom = max(st.clock[E_IN_MAX], e_in)
     d_res = 0.0
     if denom > 0.0 and math.isfinite(total):

@@ -10,6 +10,7 @@ so the contacts are coupled through the plate as they are physically; the granul
 response over the step enters on the diagonal (normal force linear over the step:
 h^2/(6 m), h/(2 m); held friction: h (1/m + R^2/I)).
 """
+
 from __future__ import annotations
 
 import math

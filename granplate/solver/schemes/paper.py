@@ -11,6 +11,7 @@ One step t -> t + h:
    through it, recompute F_n+1; repeat until it agrees to rtol |F| + atol;
 3. advance every mode with the converged forces (newmark_correct).
 """
+
 from __future__ import annotations
 
 from typing import NamedTuple

@@ -23,6 +23,7 @@ energy as it moves), the damping at its velocity by the trapezoidal rule over th
 (in the drive's work and in D_visc alike), and the impulse that gives a driven granule
 its prescribed velocity at t + h as the kinetic energy it adds.
 """
+
 from __future__ import annotations
 
 from typing import NamedTuple
@@ -35,8 +36,14 @@ from granplate.physics.contact import COEF_MU
 from granplate.physics.shock import time_profile
 from granplate.solver import body as B
 from granplate.solver.dimension import friction_flow, normal_forces
-from granplate.solver.drives import (drive_kick_work, finish_pass, gravity_kick_work, hold_drives, wall_powers,
-                                    wall_shift_energy)
+from granplate.solver.drives import (
+    drive_kick_work,
+    finish_pass,
+    gravity_kick_work,
+    hold_drives,
+    wall_powers,
+    wall_shift_energy,
+)
 from granplate.solver.granular import commit_history
 from granplate.solver.ladder import step_to_output
 from granplate.solver.state import E_STATIC, PARTNER_PLATE
@@ -203,8 +210,9 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
     if friction:
         fric = friction_flow(y, sw.split[OWED] + hk, g, cfg, forward)
         if body:
-            fric += B.friction_flow(y, b.qd, sw.split[OWED] + hk, b, cur, g.radius, g.mass, g.inertia,
-                                    cfg.arm_shrink, forward)
+            fric += B.friction_flow(
+                y, b.qd, sw.split[OWED] + hk, b, cur, g.radius, g.mass, g.inertia, cfg.arm_shrink, forward
+            )
     w_drive = drive_kick_work(y, st.k1, g, hk)
     w_grav = gravity_kick_work(y, st.k1, g, hk)
     wl, wd = kick_drift(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp)
