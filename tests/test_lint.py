@@ -1,6 +1,7 @@
 """The code passes its lint (ruff, the rules of [tool.ruff] in pyproject.toml) and the type
 check of its public API (mypy, [tool.mypy]): each tool run as CI runs it, on the
 repository, its findings printed when it fails."""
+
 from __future__ import annotations
 
 import importlib.util
@@ -17,9 +18,8 @@ def _run(tool: str, *args: str) -> None:
     """Run `python -m TOOL ARGS` in the repository; skip when the tool is not installed
     (it comes with the test extra: pip install ".[test]")."""
     if importlib.util.find_spec(tool) is None:
-        pytest.skip(f"{tool} is not installed (pip install \".[test]\" installs it)")
-    done = subprocess.run([sys.executable, "-m", tool, *args], cwd=ROOT, capture_output=True, text=True,
-                          timeout=600)
+        pytest.skip(f'{tool} is not installed (pip install ".[test]" installs it)')
+    done = subprocess.run([sys.executable, "-m", tool, *args], cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, f"{tool} {' '.join(args)} found:\n{done.stdout}{done.stderr}"
 
 
