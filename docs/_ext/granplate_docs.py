@@ -64,6 +64,10 @@ scheme = "verlet"
 """
 
 
+#: The Scenario fields that are tables of their own (each gets its own section).
+SCENARIO_TABLES = ("materials", "layout", "granules", "walls", "plate", "load", "contact", "time", "solver", "box")
+
+
 def _tables() -> list[tuple[str, str, type, str, Any, str]]:
     """(title, anchor, dataclass, dotted prefix, base scenario, what the base is)."""
     import granplate as gp
@@ -272,18 +276,7 @@ def scenario_fields_page() -> str:
         for f in dataclasses.fields(cls):
             if (cls.__name__, f.name) == ("Material", "name"):  # the table's name, not a key
                 continue
-            if cls.__name__ == "Scenario" and f.name in (
-                "materials",
-                "layout",
-                "granules",
-                "walls",
-                "plate",
-                "load",
-                "contact",
-                "time",
-                "solver",
-                "box",
-            ):
+            if cls.__name__ == "Scenario" and f.name in SCENARIO_TABLES:
                 continue
             if f.name == "pairs" or (f.name == "layers" and cls.__name__ == "SpaceLattice"):
                 refused = []
