@@ -37,7 +37,9 @@ SUMMARY_ROWS = (
     ("e_shock", "E_shock, work of the load", "J", "{:.4e}", 1.0),
     ("e_load_taken", "  of it taken back by the load", "J", "{:.4e}", 1.0),
     ("e_initial", "E_initial, energy at t = 0", "J", "{:.4e}", 1.0),
-    ("e_in", "E_in = E_shock + E_initial", "J", "{:.4e}", 1.0),
+    ("e_gravity", "E_gravity, work of gravity", "J", "{:.4e}", 1.0),
+    ("e_drive", "E_drive, work of the drives", "J", "{:.4e}", 1.0),
+    ("e_in", "E_in, the energy put in (their sum)", "J", "{:.4e}", 1.0),
     ("ep_max_fraction", "plate energy, peak / {ref}", "-", "{:.4f}", 1.0),
     ("ep_final_fraction", "plate energy, final / {ref}", "-", "{:.4f}", 1.0),
     ("eg_max_fraction", "granular energy, peak / {ref}", "-", "{:.4f}", 1.0),
@@ -67,13 +69,14 @@ def _negligible(summary: dict, key: str) -> bool:
 
 
 def reference_name(summary: dict) -> str:
-    """The energy the summary's fractions are of, by name: e_in = e_shock + e_initial is
-    "E_shock" when the run starts at rest (the paper's cases), "E_initial" without a load,
-    else "E_in"."""
-    if _negligible(summary, "e_initial"):
-        return "E_shock"
-    if _negligible(summary, "e_shock"):
+    """The energy the summary's fractions are of, by name: e_in = e_shock + e_initial +
+    e_gravity + e_drive is "E_shock" when only the load puts energy in (the paper's cases),
+    "E_initial" when only the state at t = 0 does, else "E_in"."""
+    terms = [k for k in ("e_shock", "e_initial", "e_gravity", "e_drive") if not _negligible(summary, k)]
+    if terms == ["e_initial"]:
         return "E_initial"
+    if terms in (["e_shock"], []):
+        return "E_shock"
     return "E_in"
 
 
@@ -121,7 +124,7 @@ def format_summary(summary: dict) -> str:
     some (E_shock is then the work it put in).
     """
     ref = reference_name(summary)
-    hidden = {"e_initial"} if ref == "E_shock" else set()
+    hidden = {k for k in ("e_initial", "e_gravity", "e_drive") if _negligible(summary, k)}
     if ref != "E_in":
         hidden.add("e_in")
     if _negligible(summary, "e_load_taken"):

@@ -124,3 +124,29 @@ def test_fractions_panel_says_the_load_took_energy_back(ds):
     import matplotlib.pyplot as plt
 
     plt.close(fig)
+
+
+def test_drive_and_gravity_work_count_as_energy_put_in():
+    """Truth: eq. (11) with gravity and drives, E_p + E_g + D = E_0 + E_shock + E_gravity +
+    E_drive: the summary's shares are of that sum (none above 1), its table names it E_in,
+    and the energies figure's input line is what the stored and dissipated energies add up to."""
+    import warnings
+    from pathlib import Path
+
+    import granplate as gp
+    from granplate.cli import format_summary, reference_name
+    from granplate.figures.run import energy_curves
+
+    s = gp.load_scenario(str(Path(__file__).parents[1] / "docs" / "examples" / "driven-chain.toml"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds = gp.simulate(s, t_end=1e-4, progress=False)
+    summ = gp.summary(ds)
+    assert summ["e_drive"] > 0.0 and summ["e_gravity"] != 0.0
+    assert summ["e_in"] == pytest.approx(summ["e_shock"] + summ["e_initial"] + summ["e_gravity"] + summ["e_drive"])
+    assert reference_name(summ) == "E_in" and "E_drive, work of the drives" in format_summary(summ)
+    residual = summ["energy_residual_max"]
+    assert max(summ["eg_max_fraction"], summ["dissipated_fraction"]) <= 1.0 + residual
+    curves = energy_curves(ds)
+    gap = np.abs(curves["total"][1] - curves["input"][1]).max()
+    assert gap <= 2 * residual * np.abs(curves["input"][1]).max()

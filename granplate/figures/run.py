@@ -77,6 +77,8 @@ def reference_label(ds: xr.Dataset) -> str:
     e0 = float(ds.attrs.get("E_initial", 0.0))
     es = float(an.load_work(ds["E_shock"].values)[0][-1]) if ds.sizes.get("time", 0) else 0.0
     total = abs(e0) + abs(es)
+    if "E_gravity" in ds or "E_drive" in ds:  # gravity and the drives put energy in too
+        return "E_in"
     if abs(e0) <= NEGLIGIBLE * total:
         return "E_shock"
     if abs(es) <= NEGLIGIBLE * total:
@@ -115,6 +117,14 @@ def energy_curves(ds: xr.Dataset) -> dict[str, tuple[str, np.ndarray]]:
         out["initial"] = ("$E_{initial}$, energy at t = 0", np.full(len(e_shock), e0))
         if loaded:  # what E_p + E_g + D closes on (eq. 11)
             out["input"] = ("$E_{initial} + E_{shock}$, the energy in (the balance closes on it)", e0 + e_shock)
+    if "E_gravity" in ds or "E_drive" in ds:  # their work, and the line the balance closes on (eq. 11)
+        for name, label in (
+            ("E_gravity", "$E_{gravity}$, work of gravity"),
+            ("E_drive", "$E_{drive}$, work of the drives"),
+        ):
+            if name in ds:
+                out[name.lower()[2:]] = (label, ds[name].values)
+        out["input"] = ("$E_{in}$, the energy in (the balance closes on it)", e0 + e_shock + an.body_force_work(ds))
     parts = []
     if an.has_granules(ds):
         out["granular"] = ("$E_{granular}$", ds["E_granular"].values)
@@ -148,6 +158,8 @@ ENERGY_STYLE = {
     "dissipated": ("tab:green", "-", 1.3),
     "total": ("tab:purple", "--", 1.3),
     "depth": ("tab:cyan", ":", 1.3),
+    "gravity": ("tab:brown", ":", 1.3),
+    "drive": ("tab:orange", ":", 1.3),
     "plastic": ("tab:olive", ":", 1.3),
 }
 

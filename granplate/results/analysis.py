@@ -43,13 +43,19 @@ def load_work(e_shock: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def energy_put_in(ds: xr.Dataset) -> np.ndarray:
-    """E_initial + the load's work put in so far [J] over time (`load_work`): the energy
-    put into the run; E_p + E_g + D never exceeds it (eq. 11: they sum to E_initial +
+    """E_initial + the load's work put in so far + the work of gravity and the drives [J] over
+    time (`load_work`, `body_force_work`): the energy put into the run; E_p + E_g + D never exceeds it (eq. 11: they sum to E_initial +
     E_shock, which the load's work taken back lowers)."""
     e0 = float(ds.attrs.get("E_initial", 0.0))
     if not ds.sizes.get("time", 0):
         return np.zeros(0)
-    return e0 + load_work(ds["E_shock"].values)[0]
+    return e0 + load_work(ds["E_shock"].values)[0] + body_force_work(ds)
+
+
+def body_force_work(ds: xr.Dataset) -> np.ndarray | float:
+    """The work of gravity and the drives so far [J] over time (E_gravity + E_drive, eq. 11;
+    0.0 for a run without them)."""
+    return sum((ds[name].values for name in ("E_gravity", "E_drive") if name in ds), 0.0)
 
 
 def reference_energy(ds: xr.Dataset) -> float:

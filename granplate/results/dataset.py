@@ -548,6 +548,8 @@ SUMMARY_UNITS: dict[str, object] = {
     "e_shock": "J",
     "e_load_taken": "J",
     "e_initial": "J",
+    "e_gravity": "J",
+    "e_drive": "J",
     "e_in": "J",
     "ep_max_fraction": "1",
     "ep_final_fraction": "1",
@@ -597,9 +599,9 @@ def wall_and_drive_outputs(model, out: K.Output, n: int, coords: dict) -> dict[s
 def summary(ds: xr.Dataset) -> dict:
     """The headline figures of a run (the CLI's table and --summary JSON), units in "units".
 
-    Energies are fractions of e_in = e_shock + e_initial [J], the energy put in: the work
-    the load put in plus the energy present at t = 0 (and the work of gravity and the
-    drives, when the run has them; docs/output.md); they are None when
+    Energies are fractions of e_in = e_shock + e_initial + e_gravity + e_drive [J], the
+    energy put in: the work the load put in, the energy present at t = 0 and the work of
+    gravity and the drives at t_end (0 for a run without them; docs/output.md); they are None when
     e_in = 0. e_shock is E_shock at t_end unless the load also took energy back
     (e_load_taken: its force against granules moving toward it, `analysis.load_work`),
     so that neither is negative and no share exceeds 1 beyond the energy residual; the
@@ -611,10 +613,11 @@ def summary(ds: xr.Dataset) -> dict:
     e0 = float(ds.attrs.get("E_initial", 0.0))
     put_in, taken = load_work(ds.E_shock.values) if ds.sizes["time"] else (np.zeros(1), np.zeros(1))
     e_shock, e_taken = float(put_in[-1]), float(taken[-1])
-    e_in = e_shock + e0
-    for name in ("E_gravity", "E_drive"):  # the work of gravity and the drives (when the run has them)
-        if name in ds and ds.sizes["time"]:
-            e_in += float(ds[name][-1])
+    # the work of gravity and the drives at t_end (0 for a run without them)
+    e_gravity, e_drive = (
+        float(ds[name][-1]) if name in ds and ds.sizes["time"] else 0.0 for name in ("E_gravity", "E_drive")
+    )
+    e_in = e_shock + e0 + e_gravity + e_drive
     ref = e_in if e_in > 0 else None
     has_plate = "max_von_mises" in ds
     info = json.loads(ds.attrs.get("run_info", "{}"))
@@ -632,6 +635,8 @@ def summary(ds: xr.Dataset) -> dict:
         "e_shock": e_shock,
         "e_load_taken": e_taken,
         "e_initial": e0,
+        "e_gravity": e_gravity,
+        "e_drive": e_drive,
         "e_in": e_in,
         "ep_max_fraction": fraction(ds.E_plate.max(), plate=True),
         "ep_final_fraction": fraction(ds.E_plate[-1], plate=True),
