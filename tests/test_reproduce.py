@@ -162,7 +162,7 @@ def test_cli_plot_animate_export(first, tmp_path, capsys):
     capsys.readouterr()
     assert main(["animate", str(out / "ptfe-r05.nc"), "-o", str(tmp_path / "a.gif"), "--frames", "2"]) == 0
     assert (tmp_path / "a.gif").stat().st_size > 0
-    assert "2/2" in capsys.readouterr().err  # the frames' progress on stderr
+    assert "/2 [" in capsys.readouterr().err  # the frames' progress bar on stderr (out of 2; its last refresh is timed)
     assert main(["animate", str(out / "ptfe-r05.nc"), "-o", str(tmp_path / "b.gif"), "--frames", "2", "-q"]) == 0
     assert "frame" not in capsys.readouterr().err
     assert main(["export", str(out / "steel-r1.nc"), "--vtk", str(tmp_path / "vtk")]) == 0
