@@ -175,20 +175,23 @@ def replay_thornton(c: Curve) -> np.ndarray:
     return out
 
 
-def comparison(curves: list[Curve] | None = None, loop: bool = True) -> list[dict]:
+def comparison(curves: list[Curve] | None = None, loop: bool = True, drives: bool = False) -> list[dict]:
     """Per curve: the measured measures and those of the replays ("johnson" and "thornton"
     directly from the laws; "loop": "johnson" through the loop's contact pass and history
-    commit, `replay_contact_pass`, unless loop=False), with the ratios the targets judge
-    (slope / measured, residual ratio - measured)."""
+    commit, `replay_contact_pass`, unless loop=False; "drives": the whole time loop with the
+    test's motion prescribed by drives, `replay_drives`, if drives=True), with the ratios the
+    targets judge (slope / measured, residual ratio - measured)."""
     rows = []
     for c in curves or load_curves():
         meas = measures(c.t, c.delta, c.force)
         row = {"name": c.name, "material": c.material, "measured": meas}
-        replays = [("johnson", replay_johnson(c, meas["speed"])), ("thornton", replay_thornton(c))]
+        replays = [("johnson", c.delta, replay_johnson(c, meas["speed"])), ("thornton", c.delta, replay_thornton(c))]
         if loop:
-            replays.append(("loop", replay_contact_pass(c)))
-        for law, f in replays:
-            got = measures(c.t, c.delta, f)
+            replays.append(("loop", c.delta, replay_contact_pass(c)))
+        if drives:
+            replays.append(("drives", *replay_drives(c)))
+        for law, d, f in replays:
+            got = measures(c.t, d, f)
             got["slope_ratio"] = got["slope"] / meas["slope"]
             got["ratio_error"] = got["ratio"] - meas["ratio"]
             got["force"] = f
@@ -267,3 +270,52 @@ def replay_contact_pass(c: Curve) -> np.ndarray:
         out[k] = abs(acc[1, 3]) * g.mass[1]
         commit_histories(float(t[k]), g)
     return out[len(t) - len(c.t) :]
+
+
+def driven_test(c: Curve):
+    """The measured test as a scenario: `two_spheres` of c's material, the rear sphere held by
+    a velocity drive of value 0, the front one pushed toward it along the line of centres by a
+    velocity table, the rate of c's displacement after `lead_in` (the spheres touch at t = 0);
+    the velocity-Verlet step a tenth of the record's sampling, an output per sample."""
+    import dataclasses
+
+    from granplate.setup.scenario import Drive
+
+    t, d = lead_in(c)
+    t = t - t[0]
+    dt = float(np.mean(np.diff(t)))
+    n = len(t) - 1
+    drives = (
+        Drive(target="granule rear", kind="velocity", direction=(1.0, 0.0, 0.0), value=0.0),
+        Drive(
+            target="granule front",
+            kind="velocity",
+            direction=(-1.0, 0.0, 0.0),
+            profile="table",
+            times=tuple(float(x) for x in t),
+            values=tuple(float(x) for x in np.gradient(d, t)),
+        ),
+    )
+    s = two_spheres(c.material)
+    step = dataclasses.replace(
+        s.time, t_end=n * dt, dt_initial=dt / 10, dt_max=dt / 10, output_interval=dt, field_interval=n * dt
+    )
+    return dataclasses.replace(s, name=f"driven-{c.name}", drives=drives, time=step)
+
+
+def replay_drives(c: Curve) -> tuple[np.ndarray, np.ndarray]:
+    """(displacement [m], force [N]) over c's samples, read from the whole time loop's Dataset:
+    the front sphere's drive_displacement and the held rear sphere's drive_force (the contact
+    force, as a load cell on the fixed side reads it; the pushing drive's force adds the front
+    sphere's inertia) of `driven_test`: the measured test replayed as it was done."""
+    import warnings
+
+    from granplate.results.run import simulate
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # overlaps past overlap_warn: the test's own
+        ds = simulate(driven_test(c))
+    n = len(c.t)
+    x = ds["drive_displacement"].sel(drive="granule front").values[-n:]
+    f = ds["drive_force"].sel(drive="granule rear").values[-n:]
+    return np.ascontiguousarray(x), np.ascontiguousarray(f)
