@@ -1,9 +1,12 @@
-"""The intruder map with elastic contacts against its twin with contacts that yield,
-computed from the two committed tables (docs/studies/intruder-map/results.csv and
-docs/studies/intruder-map-plastic/results.csv): the comparison of docs/studies.md,
-"The intruder map with contacts that yield", printed as the Markdown that page shows.
+"""The intruder map with elastic contacts against its twins with contacts that yield,
+computed from the committed tables (docs/studies/intruder-map/results.csv against
+docs/studies/intruder-map-plastic/results.csv, Thornton's law, or
+docs/studies/intruder-map-johnson/results.csv, the law "johnson"): the comparisons of
+docs/studies.md, "The intruder map with contacts that yield", printed as the Markdown that
+page shows.
 
-    python docs/studies/compare-intruder-maps.py
+    python docs/studies/compare-intruder-maps.py            # Thornton's law
+    python docs/studies/compare-intruder-maps.py johnson    # the law "johnson"
 
 Nothing is run: the numbers are the tables'. Fractions are of the shock's work e_in
 (docs/output.md), shown in percent; stresses in MPa.
@@ -19,6 +22,9 @@ import pandas as pd
 HERE = Path(__file__).resolve().parent
 ELASTIC = HERE / "intruder-map" / "results.csv"
 PLASTIC = HERE / "intruder-map-plastic" / "results.csv"
+#: The yielding twins' tables by normal law, and how the text names the law.
+TWINS = {"thornton": PLASTIC, "johnson": HERE / "intruder-map-johnson" / "results.csv"}
+LAW_NAMES = {"thornton": "Thornton's law", "johnson": 'the law "johnson"'}
 #: The varied parameters (in the study files' order) and the columns compared.
 KEYS = ["layout.R2_ratio", "layout.intruder_material", "load.q0"]
 MATERIALS = ["steel", "aluminium", "ptfe"]
@@ -82,16 +88,17 @@ def design_name(row: pd.Series) -> str:
     return f"{row['layout.intruder_material']} R2/R1 = {row['layout.R2_ratio']:.2f}"
 
 
-def facts(t: pd.DataFrame) -> list[str]:
-    """The comparison's findings, one Markdown bullet each, every number from the tables."""
+def facts(t: pd.DataFrame, law: str = "thornton") -> list[str]:
+    """The comparison's findings, one Markdown bullet each, every number from the tables
+    (the twin's normal law `law` named in the text)."""
     out = []
     loads = sorted(t["load.q0"].unique())
     passed = t[t["yield_onset_ratio_e"] > 1.0]
     below = t[t["yield_onset_ratio_e"] <= 1.0]
-    same = all(
-        (below[f"{m}_e"] == below[f"{m}_p"]).all()
-        for m in ("ep_max_fraction", "max_von_mises", "dissipated_fraction", "n_steps")
-    )
+    metrics = ("ep_max_fraction", "max_von_mises", "dissipated_fraction", "n_steps")
+    same = all((below[f"{m}_e"] == below[f"{m}_p"]).all() for m in metrics)
+    close = all(((below[f"{m}_e"] - below[f"{m}_p"]).abs() <= 1e-9 * below[f"{m}_e"].abs()).all() for m in metrics)
+    alike = "the same, to the last digit," if same else "the same to round-off (1e-9)" if close else "not the same"
     below_names = sorted(below["layout.R2_ratio"].unique())
     kept_peak = (passed["ep_max_fraction_p"] / passed["ep_max_fraction_e"] - 1.0).abs() < 1e-3
     out.append(
@@ -101,8 +108,8 @@ def facts(t: pd.DataFrame) -> list[str]:
         f"({'/'.join(sorted(below['layout.intruder_material'].unique()))} intruders of R2/R1 = "
         f"{', '.join(f'{r:.2f}' for r in below_names)} at "
         f"{', '.join(f'{q * 1e-3:g}' for q in sorted(below['load.q0'].unique()))} kN/m) are "
-        f"{'the same, to the last digit,' if same else 'not the same'} in the twin: Thornton's "
-        f"law is Hertz's below p_y. Of the {len(passed)} that yield, {int(kept_peak.sum())} keep their "
+        f"{alike} in the twin: {LAW_NAMES[law]} "
+        f"is Hertz's below p_y. Of the {len(passed)} that yield, {int(kept_peak.sum())} keep their "
         f"plate's peak share within 0.1%: they yield after that peak."
     )
     top = t[t["load.q0"] == loads[-1]]
@@ -177,11 +184,15 @@ def facts(t: pd.DataFrame) -> list[str]:
     return [f"- {f}" for f in out]
 
 
-def comparison(t: pd.DataFrame | None = None) -> str:
-    """The Markdown that docs/studies.md shows: the share table and the findings."""
-    t = read_tables() if t is None else t
-    return "\n".join(share_table(t) + [""] + facts(t))
+def comparison(t: pd.DataFrame | None = None, law: str = "thornton") -> str:
+    """The Markdown that docs/studies.md shows for the twin of normal law `law`: the share
+    table and the findings."""
+    t = read_tables(ELASTIC, TWINS[law]) if t is None else t
+    return "\n".join(share_table(t) + [""] + facts(t, law))
 
 
 if __name__ == "__main__":
-    sys.stdout.write(comparison() + "\n")
+    law = sys.argv[1] if len(sys.argv) > 1 else "thornton"
+    if law not in TWINS:
+        sys.exit(f"compare-intruder-maps.py: the law {law!r} has no twin table; allowed: {', '.join(TWINS)}")
+    sys.stdout.write(comparison(law=law) + "\n")
