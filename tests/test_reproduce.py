@@ -28,18 +28,20 @@ def first(tmp_path_factory):
 
 
 def test_reproduce_makes_everything(first):
-    """Six presets, the fast checks and five yielding twins run; 8 figures (PNG + PDF),
+    """Six presets, the fast checks and five yielding twins per law run; 8 figures (PNG + PDF),
     2 animations, report."""
     out, outcome = first
     assert outcome.ok, outcome.problems
     assert {r.name for r in outcome.runs if r.kind == "preset"} == set(preset_names())
-    assert {r.name for r in outcome.runs if r.kind == "plastic"} == {pl.twin_name(n) for n in pl.twin_presets()}
+    for law, folder in pl.TWIN_LAWS.items():
+        assert {r.name for r in outcome.runs if r.kind == folder} == {pl.twin_name(n, law) for n in pl.twin_presets()}
     assert all(r.status == "ran" for r in outcome.runs)
     for name in preset_names():
         assert read(out / f"{name}.nc").time.values[-1] == pytest.approx(T_END)
     for name in pl.twin_presets():
-        twin = read(out / "plastic" / f"{name}.nc")
-        assert twin.time.values[-1] == pytest.approx(T_END) and set(twin.pair_normal_law.values) == {"thornton"}
+        for law, folder in pl.TWIN_LAWS.items():
+            twin = read(out / folder / f"{name}.nc")
+            assert twin.time.values[-1] == pytest.approx(T_END) and set(twin.pair_normal_law.values) == {law}
     for key in [*FIGURES, *EXTRA_FIGURES]:
         assert (out / "figures" / f"{figure_stem(key)}.png").stat().st_size > 0
         assert (out / "figures" / f"{figure_stem(key)}.pdf").stat().st_size > 0
@@ -58,9 +60,11 @@ def test_yielding_section_shows_the_twins_summaries(first):
     md = (out / "report.md").read_text().split("## Contacts that yield")[1]
     for name in pl.twin_presets():
         e, y = summary(read(out / f"{name}.nc")), summary(read(out / "plastic" / f"{name}.nc"))
+        m = summary(read(out / "johnson" / f"{name}.nc"))
         row = next(line for line in md.splitlines() if line.startswith(f"| {name} |"))
-        assert f"| {100 * e['ep_max_fraction']:.1f}% / {100 * y['ep_max_fraction']:.1f}% |" in row
-        assert f"| {100 * y['plastic_fraction']:.1f}% |" in row
+        shares = " / ".join(f"{100 * x['ep_max_fraction']:.1f}%" for x in (e, y, m))
+        assert f"| {shares} |" in row
+        assert f"| {100 * y['plastic_fraction']:.1f}% / {100 * m['plastic_fraction']:.1f}% |" in row
     assert "bare-plate (its own twin)" in md
 
 
@@ -116,7 +120,8 @@ def test_plan_checks_modes(tmp_path):
     """--checks picks the sensitivity runs; the twins come with every mode, or not at all."""
     names = lambda mode, plastic=False: {j.name for j in rp.plan(tmp_path, 1e-5, mode, plastic)}  # noqa: E731
     assert names("none") == set(preset_names())
-    assert names("none", True) == set(preset_names()) | {pl.twin_name(n) for n in pl.twin_presets()}
+    twins = {pl.twin_name(n, law) for law in pl.TWIN_LAWS for n in pl.twin_presets()}
+    assert names("none", True) == set(preset_names()) | twins
     assert names("fast") < names("all")
     with pytest.raises(Exception):
         rp.plan(tmp_path, None, "sometimes")

@@ -446,52 +446,48 @@ def fig_A1(steel: xr.Dataset) -> Figure:
     return fig
 
 
-def fig_yielding(elastic: xr.Dataset, plastic: xr.Dataset) -> Figure:
-    """The plate's energy E_p [mJ] over time with elastic (Hertz) and yielding (Thornton)
-    contacts (a), and where the shock energy goes in each: E_g and D_plastic [mJ] (b)."""
+def fig_yielding(elastic: xr.Dataset, plastic: xr.Dataset, measured: xr.Dataset | None = None) -> Figure:
+    """The plate's energy E_p [mJ] over time with elastic (Hertz) and yielding (Thornton;
+    and the law "johnson" where `measured` is given) contacts (a), and where the shock
+    energy goes in each: E_g and D_plastic [mJ] (b)."""
     fig = _new_figure(10.0, 4.2)
     ax = fig.subplot_mosaic("ab")
-    runs = (("elastic", elastic, "-"), ("yielding", plastic, "--"))
+    runs = [("elastic", elastic, "-"), ("thornton", plastic, "--")]
+    if measured is not None:
+        runs.append(("johnson", measured, ":"))
     for tag, ds, ls in runs:
-        ax["a"].plot(
-            an.times_ms(ds),
-            np.asarray(ds["E_plate"].values) * 1e3,
-            color=COLOURS["plate"],
-            ls=ls,
-            lw=1.2,
-            label=f"$E_p$, {tag} contacts",
-            gid=f"plate:{tag}",
-        )
+        for key, var, colour in (("a", "E_plate", "plate"), ("b", "E_granular", "granular")):
+            ax[key].plot(
+                an.times_ms(ds),
+                np.asarray(ds[var].values) * 1e3,
+                color=COLOURS[colour],
+                ls=ls,
+                lw=1.2,
+                label=f"${'E_p' if key == 'a' else 'E_g'}$, {tag} contacts",
+                gid=f"{colour}:{tag}",
+            )
+    for tag, ds, ls in runs[1:]:
         ax["b"].plot(
             an.times_ms(ds),
-            np.asarray(ds["E_granular"].values) * 1e3,
-            color=COLOURS["granular"],
+            np.asarray(ds["D_plastic"].values) * 1e3,
+            color="tab:brown",
             ls=ls,
             lw=1.2,
-            label=f"$E_g$, {tag} contacts",
-            gid=f"granular:{tag}",
+            label=f"$D_{{plastic}}$, {tag} contacts",
+            gid=f"plastic:{tag}",
         )
-    ax["b"].plot(
-        an.times_ms(plastic),
-        np.asarray(plastic["D_plastic"].values) * 1e3,
-        color="tab:brown",
-        ls="--",
-        lw=1.2,
-        label="$D_{plastic}$, yielding contacts",
-        gid="plastic:yielding",
-    )
     for key, text in (("a", "(a) plate energy"), ("b", "(b) granular energy and plastic work")):
         _time_axis(ax[key], elastic)
         ax[key].set_ylabel("energy [mJ]")
         ax[key].legend(fontsize=7, loc="best", framealpha=0.8)
         _label(ax[key], f"{text}, {_name(elastic)}")
+    third = ' and the law "johnson" (contact.normal_law = "johnson", dotted)' if measured is not None else ""
     _caption(
         fig,
         "The plate's energy (a) and the granular energy with the plastic work (b), elastic "
-        '(Hertz, solid) and yielding (Thornton, contact.normal_law = "thornton", dashed) contacts; the '
-        "second run is the first's twin with yielding contacts.",
-        elastic,
-        plastic,
+        '(Hertz, solid) and yielding contacts: Thornton\'s law (contact.normal_law = "thornton", dashed)'
+        f"{third}; the later runs are the first's twins with yielding contacts.",
+        *(ds for _, ds, _ in runs),
     )
     return fig
 
@@ -582,7 +578,11 @@ FIGURES: dict[str, FigureSpec] = {
 EXTRA_FIGURES: dict[str, FigureSpec] = {
     _plastic.FIGURE_KEY: FigureSpec(
         fig_yielding,
-        (_plastic.FIGURE_CASE, _plastic.twin_name(_plastic.FIGURE_CASE)),
+        (
+            _plastic.FIGURE_CASE,
+            _plastic.twin_name(_plastic.FIGURE_CASE),
+            _plastic.twin_name(_plastic.FIGURE_CASE, _plastic.MEASURED_LAW),
+        ),
         "plate energy with elastic and yielding contacts (PTFE intruders)",
     ),
 }

@@ -174,9 +174,11 @@ def build_report(
     seconds: float | None = None,
     twins: Results | None = None,
     space: Results | None = None,
+    measured: Results | None = None,
 ) -> list[Block]:
     """The report as blocks: summary, comparison table, runs, discussion, the cases with
-    yielding contacts (twins: preset name -> the twin's Dataset; none: no section), the
+    yielding contacts (twins: preset name -> the Thornton twin's Dataset; none: no section;
+    measured: the twins under the law that matches measurement, plastic.MEASURED_LAW), the
     cases in 3D (space: preset name -> its 3D twin's Dataset; none: no section), figures."""
     from granplate.version import __version__
     from granplate.paper.plots import FIGURES, figure_stem
@@ -193,6 +195,7 @@ def build_report(
         f"Made by granplate {__version__} from {len(results)} runs"
         + (f" and {len(checks)} check runs" if checks else "")
         + (f", {len(twins)} of them rerun with yielding contacts" if twins else "")
+        + (f" (and again with the law {plastic.MEASURED_LAW!r})" if twins and measured else "")
         + (f", {len(space)} of them run again in 3D" if space else "")
         + (
             f" (this reproduce took {seconds:.0f} s; each run's own wall time is in the run table)"
@@ -281,7 +284,9 @@ def build_report(
         + vertical_discussion(results)
     ):
         blocks.append(Block("p", para))
-    blocks += plastic.section(results, twins or {}, records=records, figure=(figures or {}).get(plastic.FIGURE_KEY))
+    blocks += plastic.section(
+        results, twins or {}, measured=measured, records=records, figure=(figures or {}).get(plastic.FIGURE_KEY)
+    )
     blocks += sp.section(results, space or {}, records=records, figure=(figures or {}).get(sp.FIGURE_KEY))
     if figures:
         blocks.append(Block("h2", "Figures"))
@@ -320,7 +325,8 @@ def write_report(out_dir: str | Path, outcome) -> list[Path]:
     """Write out_dir/report.md and out_dir/report.html for a reproduce outcome.
 
     outcome: anything with .runs (RunRecord: name, path, status, kind; kind "plastic": a
-    preset's twin with yielding contacts, "space": its 3D twin), .figures
+    preset's twin with Thornton's yielding contacts, "johnson": with the law "johnson",
+    "space": its 3D twin), .figures
     (key -> paths), .animations (paths) and .seconds.
     """
     from granplate.setup.presets import preset_names
@@ -333,8 +339,11 @@ def write_report(out_dir: str | Path, outcome) -> list[Path]:
     }
     check_paths = {r.name: r.path for r in done if r.kind == "check"}
     check_paths = {c.name: check_paths[c.name] for c in ck.CHECKS if c.name in check_paths}
-    twin_paths = {plastic.twin_preset(r.name): r.path for r in done if r.kind == "plastic"}
+    twin_paths = {plastic.twin_preset(r.name): r.path for r in done if r.kind == plastic.TWIN_DIR}
     twin_paths = {n: twin_paths[n] for n in preset_names() if n in twin_paths}
+    law_dir = plastic.TWIN_LAWS[plastic.MEASURED_LAW]
+    measured_paths = {plastic.twin_preset(r.name): r.path for r in done if r.kind == law_dir}
+    measured = load_results({n: measured_paths[n] for n in preset_names() if n in measured_paths})
     space_paths = {sp.twin_preset(r.name): r.path for r in done if r.kind == "space"}
     space_paths = {n: space_paths[n] for n in preset_names() if n in space_paths}
     results, checks, twins = load_results(presets), load_results(check_paths), load_results(twin_paths)
@@ -348,6 +357,7 @@ def write_report(out_dir: str | Path, outcome) -> list[Path]:
         animations=outcome.animations,
         seconds=getattr(outcome, "seconds", None),
         twins=twins,
+        measured=measured,
         space=space,
     )
     md, page = out / "report.md", out / "report.html"

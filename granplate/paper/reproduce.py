@@ -158,7 +158,8 @@ def plan(
     out_dir: Path, t_end: float | None = None, checks: str = "fast", plastic: bool = True, space: bool = False
 ) -> list[Job]:
     """The presets (DIR/NAME.nc), the sensitivity checks (DIR/checks/NAME.nc), with
-    `plastic` the presets' twins with yielding contacts (DIR/plastic/NAME.nc) and with
+    `plastic` the presets' twins with yielding contacts (Thornton's: DIR/plastic/NAME.nc,
+    the law "johnson": DIR/johnson/NAME.nc; each job's kind is its folder) and with
     `space` their 3D twins (DIR/3d/NAME.nc) to run."""
     from granplate.paper import plastic as pl
     from granplate.paper import space as sp
@@ -174,8 +175,11 @@ def plan(
                 continue
             jobs.append(Job(c.name, check_scenario(c, t_end), out_dir / "checks" / f"{c.name}.nc", "check"))
     if plastic:
-        for n in pl.twin_presets():
-            jobs.append(Job(pl.twin_name(n), pl.twin_scenario(n, t_end), out_dir / pl.TWIN_DIR / f"{n}.nc", "plastic"))
+        for law, folder in pl.TWIN_LAWS.items():
+            for n in pl.twin_presets():
+                jobs.append(
+                    Job(pl.twin_name(n, law), pl.twin_scenario(n, t_end, law), out_dir / folder / f"{n}.nc", folder)
+                )
     if space:
         for n in sp.twin_presets():
             jobs.append(Job(sp.twin_name(n), sp.twin_scenario(n, t_end), out_dir / sp.TWIN_DIR / f"{n}.nc", "space"))
