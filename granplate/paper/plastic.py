@@ -366,6 +366,15 @@ def _list(names: list[str]) -> str:
     return "; ".join(names) if names else "none"
 
 
+def _moves_of(pairs: list[tuple[Check, Check]]) -> str:
+    """What moves with a law's twins, in short: "no longer hold N (...), now hold M (...)."."""
+    moves: dict[str, list[str]] = {}
+    for i, (e, y) in enumerate(pairs):
+        moves.setdefault(movement(e.holds, y.holds), []).append(f"#{i + 1}")
+    lost, won = moves.get("no longer holds", []), moves.get("now holds", [])
+    return f"no longer hold {len(lost)} ({_list(lost)}), now hold {len(won)} ({_list(won)})."
+
+
 def verdict_text(pairs: list[tuple[Check, Check]], law: str = "thornton") -> str:
     """A paragraph: how many judged statements still hold, and which ones move, with the
     twins of normal law `law`."""
@@ -458,6 +467,11 @@ def _verdict_blocks(results: Results, twins: Results, measured: Results, pairs, 
     return [
         Block("h3", "The paper's conclusions with the law that matches measurement"),
         Block("p", "\n".join(f"- {line}" for line in conclusions([m for _, _, m in triples]))),
-        Block("p", verdict_text(by_law, MEASURED_LAW) + " " + verdict_text(pairs, "thornton")),
+        Block(
+            "p",
+            verdict_text(by_law, MEASURED_LAW).replace(
+                " The verdicts", " Under Thornton's law: " + _moves_of(pairs) + " The verdicts"
+            ),
+        ),
         Block("table", header=TRIPLE_HEADER, rows=tuple(triple_table(triples))),
     ]
