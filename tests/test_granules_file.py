@@ -275,3 +275,26 @@ def test_a_result_seeds_a_scenario_at_its_last_output_time(tmp_path):
         == 0
     )
     assert load_scenario(tmp_path / "s.toml") == seed
+
+
+@pytest.mark.parametrize("text, dimension", [(TABLES_3D, 3), (TABLES_2D, 2)])
+def test_a_result_of_many_granules_keeps_them_beside_its_toml(tmp_path, monkeypatch, text, dimension):
+    """A scenario of more granules than GRANULES_IN_TOML_MAX keeps them out of the result's
+    scenario_toml, in variables: read back through netCDF, `scenario_of` is the scenario run (the
+    one given, resolved), and the TOML's comment (count, digest) changes when a granule does."""
+    import dataclasses
+
+    import granplate as gp
+    from granplate.results import dataset as D
+
+    monkeypatch.setattr(D, "GRANULES_IN_TOML_MAX", 1)
+    s = loads(text)
+    ds = gp.simulate(s, progress=False)
+    assert ds.attrs["scenario_granules"] == "variables" and "[[granules]]" not in ds.attrs["scenario_toml"]
+    path = tmp_path / "r.nc"
+    D.write(ds, path)
+    assert D.scenario_of(D.read(path)) == resolve(s)
+    moved = dataclasses.replace(s, granules=(dataclasses.replace(s.granules[0], vx=0.5), *s.granules[1:]))
+    other = gp.simulate(moved, t_end=1e-6, progress=False)
+    assert other.attrs["scenario_toml"] != ds.attrs["scenario_toml"]
+    assert D.scenario_of(other).granules == resolve(moved).granules

@@ -298,8 +298,6 @@ def to_dataset(
     formed). progress: a bar per phase of the plate outputs; should_stop: polled while
     they are computed: when it says yes, the Dataset holds the output times computed so
     far and its status says "interrupted by the user at t = ..."."""
-    from granplate.setup.io import dumps
-
     s = model.scenario
     axis = run_contacts(model, contacts)
     plate_data: dict[str, xr.DataArray] = {}
@@ -408,8 +406,7 @@ def to_dataset(
     if summary_only:
         data.update(plate_data)
         ds = xr.Dataset(data, coords=coords)
-        ds.attrs.update(_attrs(model, out, n, info, dumps(s)))
-        return ds
+        return _with_scenario(ds, _attrs(model, out, n, info), s)
     data["contact_normal_force"] = _var("contact_normal_force", ("time", "contact"), out.force[:n, :, 0].copy())
     data["contact_tangential_force"] = _var("contact_tangential_force", ("time", "contact"), out.force[:n, :, 1].copy())
     data["contact_slip_rate"] = _var("contact_slip_rate", ("time", "contact"), out.slip[:n].copy())
@@ -446,7 +443,40 @@ def to_dataset(
     ds = xr.Dataset(data, coords=coords)
     if nk == 0:
         ds = ds.drop_dims("contact", errors="ignore")
-    ds.attrs.update(_attrs(model, out, n, info, dumps(s)))
+    return _with_scenario(ds, _attrs(model, out, n, info), s)
+
+
+#: Scenarios with more granules than this keep them out of the result's scenario_toml, as the
+#: variables `scenario_granule_COLUMN` (dimension scenario_granule, the columns of a
+#: granules file): a million [[granules]] tables would take a minute to write and read back.
+GRANULES_IN_TOML_MAX = 10_000
+GRANULE_VARIABLE = "scenario_granule_"
+
+
+def _with_scenario(ds: xr.Dataset, attrs: dict, s) -> xr.Dataset:
+    """ds with its attributes and the scenario it was made from: `scenario_toml`, its
+    granules inside (up to GRANULES_IN_TOML_MAX) or beside it as variables, the TOML then
+    ending in a comment with their count and digest (so that two scenarios' texts differ
+    when their granules do: reproduce and the studies compare them)."""
+    import hashlib
+
+    from granplate.setup.granules_file import granule_columns
+    from granplate.setup.io import dumps
+
+    if len(s.granules) <= GRANULES_IN_TOML_MAX:
+        ds.attrs.update({**attrs, "scenario_toml": dumps(s)})
+        return ds
+    cols = granule_columns(s.granules, s.dimension)
+    digest = hashlib.sha256()
+    for k, v in cols.items():
+        arr = np.asarray(v, dtype=str if k in ("material", "label") else float)
+        digest.update(k.encode() + arr.tobytes())
+        ds[GRANULE_VARIABLE + k] = xr.DataArray(
+            arr, dims=("scenario_granule",), attrs={"long_name": f"the scenario's granules: column {k}"}
+        )
+    text = dumps(replace(s, granules=()))
+    note = f"# granules: {len(s.granules)} in the variables {GRANULE_VARIABLE}*, sha256 {digest.hexdigest()}\n"
+    ds.attrs.update({**attrs, "scenario_toml": text + note, "scenario_granules": "variables"})
     return ds
 
 
@@ -509,13 +539,13 @@ def initial_energy(energy0: np.ndarray) -> float:
     return float(energy0[K.KE_X] + energy0[K.KE_Y] + energy0[K.KE_ROT] + energy0[K.KE_Z])
 
 
-def _attrs(model, out: K.Output, n: int, info: dict, scenario_toml: str) -> dict:
-    """The result's attributes: scenario, version, scheme, E_initial and the run's figures."""
+def _attrs(model, out: K.Output, n: int, info: dict) -> dict:
+    """The result's attributes: version, scheme, E_initial and the run's figures (the
+    scenario: `_with_scenario`)."""
     s = model.scenario
     attrs = {
         "title": f"granplate result: {s.name}",
         "scenario_name": s.name,
-        "scenario_toml": scenario_toml,
         "granplate_version": __version__,
         "scheme": s.solver.scheme,
         "conventions": "SI units; see docs/output.md",
@@ -704,4 +734,10 @@ def scenario_of(ds: xr.Dataset):
         raise ScenarioError(
             "result attribute scenario_toml", None, "missing: not a result written by granplate.simulate"
         )
-    return loads(str(text))
+    s = loads(str(text))
+    if ds.attrs.get("scenario_granules") != "variables":
+        return s
+    from granplate.setup.granules_file import granules_of_columns
+
+    cols = {k[len(GRANULE_VARIABLE) :]: ds[k].values for k in ds.data_vars if str(k).startswith(GRANULE_VARIABLE)}
+    return replace(s, granules=granules_of_columns(cols, s.dimension, "the result's scenario_granule_*"))

@@ -263,6 +263,13 @@ def read_granules(path: str, dimension: int, name: str | None = None) -> tuple[G
         return _granules_of(read_columns(str(path), name), dimension, name)
 
 
+def granules_of_columns(raw: dict[str, Any], dimension: int, name: str) -> tuple[Granule, ...]:
+    """The granules of columns `raw` (column name -> sequence, as a file's; `name`: where
+    they come from, for messages), as `read_granules` turns a file's columns into them."""
+    with collector_paused():
+        return _granules_of(raw, dimension, name)
+
+
 def _granules_of(raw: dict[str, Any], dimension: int, name: str) -> tuple[Granule, ...]:
     """The granules of a file's columns `raw` (`read_granules`)."""
     n = _check_columns(raw, name)

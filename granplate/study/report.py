@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 import granplate as gp
+from granplate.results.dataset import scenario_of
 from granplate.results.document import Block, to_markdown
 from granplate.study import design as D
 from granplate.study import plots as P
@@ -253,7 +254,7 @@ def design_figures(folder: Path, key: str, progress: bool = False) -> list[tuple
         return []
     from granplate.figures import assembly, run, show, space
 
-    scenario = gp.loads(ds.attrs["scenario_toml"])
+    scenario = scenario_of(ds)
     drawing = (
         space.draw(space.of_scenario(scenario))
         if scenario.dimension == 3
