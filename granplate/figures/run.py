@@ -28,6 +28,7 @@ from matplotlib.figure import Figure
 
 from granplate.figures.common import new_figure, plot_curves, scenario_name, time_axis
 from granplate.results import analysis as an
+from granplate.results.dataset import has_solid
 
 #: Beyond this many granules the speeds are drawn as an envelope.
 MAX_LABELLED = 8
@@ -287,8 +288,9 @@ def fig_granule_speeds(ds: xr.Dataset) -> Figure:
 
 
 def has_body(ds: xr.Dataset) -> bool:
-    """Whether the result carries a 3D elastic body's stress and displacement history."""
-    return "max_displacement" in ds and "max_von_mises" in ds and "body_q" in ds
+    """Whether the result carries a 3D elastic body's stress and displacement history
+    (`results.dataset.has_solid`)."""
+    return has_solid(ds)
 
 
 def fig_body_stress(ds: xr.Dataset) -> Figure:

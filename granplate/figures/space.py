@@ -55,6 +55,7 @@ from matplotlib.patches import Circle, Patch
 
 from granplate.figures.common import material_colours, new_figure, readable_duration
 from granplate.setup.scenario import Load, Scenario, Wall
+from granplate.results.dataset import dimension_of
 
 MM = 1e3  # m -> mm
 
@@ -237,8 +238,8 @@ def contact_forces(s: Scenario, positions: np.ndarray, r: np.ndarray, pairs, wal
 # Builders
 # --------------------------------------------------------------------------------------
 def is_space(ds: xr.Dataset) -> bool:
-    """Whether a result is of a 3D run (it stores z)."""
-    return "z" in ds.variables
+    """Whether a result is of a 3D run (`results.dataset.dimension_of`)."""
+    return dimension_of(ds) == 3
 
 
 def positions(ds: xr.Dataset, upto: int | None = None) -> np.ndarray:

@@ -33,6 +33,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
 from granplate.results import analysis as an
+from granplate.results.dataset import dimension_of
 
 #: The paper's magnification of displacements in its animations.
 MAGNIFY = 125.0
@@ -190,7 +191,7 @@ def animate(
     progress: a bar of the frames rendered on stderr.
     An .mp4 path falls back to .gif (Pillow) when ffmpeg is not available or fails.
     """
-    if "z" in ds.variables:
+    if dimension_of(ds) == 3:
         return animate_space(ds, path, frames=frames, fps=fps, dpi=dpi, progress=progress)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)

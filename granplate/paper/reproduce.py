@@ -502,12 +502,13 @@ def _cmd_plot(args) -> int:
 
 def _cmd_animate(args) -> int:
     from granplate.paper.animate import animate
+    from granplate.results.dataset import dimension_of
 
     ds = _read(_existing(args.result))
     target = Path(args.output) if args.output else Path(f"{ds.attrs.get('scenario_name', 'result')}.mp4")
     if target.suffix.lower() not in (".mp4", ".gif"):
         raise ScenarioError("-o", str(target), "allowed: a .mp4 or .gif file name")
-    if "z" not in ds.variables and ds.sizes.get("field_time", 0) == 0:  # (in space: every output time)
+    if dimension_of(ds) == 2 and ds.sizes.get("field_time", 0) == 0:  # (in space: every output time)
         raise ScenarioError("result", args.result, "has no plate-field snapshots to animate")
     written = animate(ds, target, frames=args.frames, fps=args.fps, magnify=args.magnify, progress=not args.quiet)
     print(f"written {written}")

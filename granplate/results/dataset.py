@@ -547,6 +547,8 @@ def _attrs(model, out: K.Output, n: int, info: dict) -> dict:
         "title": f"granplate result: {s.name}",
         "scenario_name": s.name,
         "granplate_version": __version__,
+        "dimension": int(s.dimension),
+        "elastic_body": "solid" if model.solid is not None else "plate" if model.plate is not None else "none",
         "scheme": s.solver.scheme,
         "conventions": "SI units; see docs/output.md",
         "run_info": json.dumps(info),
@@ -719,6 +721,31 @@ def pair_table(ds: xr.Dataset) -> list[dict]:
         }
         for k in range(ds.sizes["material_pair"])
     ]
+
+
+def dimension_of(ds: xr.Dataset) -> int:
+    """A result's dimension, 2 or 3: its attribute `dimension` (results of granplate before
+    0.2.1, without it: 3 where it has the depth z)."""
+    d = ds.attrs.get("dimension")
+    return int(d) if d is not None else 3 if "z" in ds.variables else 2
+
+
+def elastic_body_of(ds: xr.Dataset) -> str:
+    """A result's elastic body: "plate" (the plane's modal plate), "solid" (a 3D elastic body)
+    or "none", from its attribute `elastic_body` (older results: from its variables)."""
+    b = ds.attrs.get("elastic_body")
+    if b is not None:
+        return str(b)
+    if "body_ux" in ds.variables or "body_q" in ds.variables:
+        return "solid"
+    return "plate" if "node" in ds.dims else "none"
+
+
+def has_solid(ds: xr.Dataset) -> bool:
+    """Whether a result holds a 3D elastic body's fields: its body is a solid
+    (`elastic_body_of`) and its displacement history is stored (a summary-only result keeps
+    the maxima alone)."""
+    return elastic_body_of(ds) == "solid" and "body_q" in ds.variables and "body_ux" in ds.variables
 
 
 def scenario_of(ds: xr.Dataset):

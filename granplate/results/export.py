@@ -47,6 +47,7 @@ import numpy as np
 import xarray as xr
 
 from granplate.results import analysis as an
+from granplate.results.dataset import dimension_of, has_solid
 
 
 def _points3(x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -86,8 +87,8 @@ def granule_cloud(ds: xr.Dataset, i: int) -> meshio.Mesh:
 
 
 def is_space(ds: xr.Dataset) -> bool:
-    """Whether a result is of a run in space (it stores z)."""
-    return "z" in ds.variables
+    """Whether a result is of a run in space (`results.dataset.dimension_of`)."""
+    return dimension_of(ds) == 3
 
 
 def material_names(ds: xr.Dataset) -> list[str]:
@@ -121,8 +122,9 @@ BODY_CELLS = {20: "hexahedron20", 27: "hexahedron27", 10: "tetra10"}
 
 
 def has_body(ds: xr.Dataset) -> bool:
-    """Whether a result holds the fields of an elastic body (a 3D run's solid)."""
-    return "body_ux" in ds.variables and "body_element_nodes" in ds.variables
+    """Whether a result holds the fields of an elastic body (a 3D run's solid;
+    `results.dataset.has_solid`)."""
+    return has_solid(ds)
 
 
 def body_mesh(ds: xr.Dataset, k: int) -> meshio.Mesh:
