@@ -1,0 +1,128 @@
+"""The rules of [time] and [solver]: steps and intervals, the size of the output a run
+would write against the machine's memory, the scheme and its granular friction.
+"""
+
+from __future__ import annotations
+
+from granplate.errors import ScenarioError
+from granplate.setup.fields import finite, int_at_least, positive, string_in
+from granplate.setup.plate_cost import MEMORY_SHARE, physical_memory
+from granplate.setup.scenario import Solid, Plate, Scenario
+
+
+#: Coupling schemes the solver knows (Solver.scheme).
+SCHEMES: tuple[str, ...] = ("paper", "implicit", "verlet")
+#: Schemes of the granules alone: a scenario with a [plate] is refused with them.
+GRANULAR_SCHEMES: tuple[str, ...] = ("verlet",)
+#: Treatments of the granule-granule and granule-wall friction (Solver.granular_friction).
+GRANULAR_FRICTIONS: tuple[str, ...] = ("split", "rk4")
+#: Relative tolerance for field_interval being a multiple of output_interval.
+INTERVAL_RTOL = 1e-9
+
+
+def _check_time(s: Scenario) -> None:
+    t = s.time
+    for f in ("t_end", "dt_initial", "dt_max", "dt_min", "output_interval", "field_interval"):
+        positive(f"time.{f}", getattr(t, f))
+    if t.dt_min > t.dt_initial:
+        raise ScenarioError(
+            "time.dt_min", t.dt_min, f"must be <= time.dt_initial = {t.dt_initial!r} (dt_min <= dt_initial <= dt_max)"
+        )
+    if t.dt_initial > t.dt_max:
+        raise ScenarioError(
+            "time.dt_initial", t.dt_initial, f"must be <= time.dt_max = {t.dt_max!r} (dt_min <= dt_initial <= dt_max)"
+        )
+    if t.output_interval > t.t_end:
+        raise ScenarioError("time.output_interval", t.output_interval, f"must be <= time.t_end = {t.t_end!r}")
+    r = t.field_interval / t.output_interval
+    n = round(r)
+    if n < 1 or abs(r - n) > INTERVAL_RTOL * r or n > 2**53:
+        raise ScenarioError(
+            "time.field_interval",
+            t.field_interval,
+            f"must be a whole multiple n of time.output_interval = "
+            f"{t.output_interval!r}, 1 <= n <= 2^53 (beyond, every double is whole)",
+        )
+
+
+#: Bytes kept per output time, per granule (its state in the buffers, the Dataset and
+#: the file written: 3 copies of 6 numbers and a few per contact) and per plate dof (the
+#: modal coordinates and their rates, 3 copies), and per plate snapshot and plate dof
+#: (displacements, strains and stresses at the nodes, 3 copies).
+OUTPUT_BYTES_PER_GRANULE = 3 * 8 * 12
+OUTPUT_BYTES_PER_DOF = 3 * 8 * 2
+FIELD_BYTES_PER_DOF = 3 * 8 * 4
+
+
+def output_bytes_per_second(s: Scenario) -> float:
+    """About the memory [bytes] a run's outputs take per second of simulated time: a row
+    of the granules' states and the plate's modal coordinates per output_interval, a plate
+    snapshot per field_interval (s resolved)."""
+    t = s.time
+    n_dof = 0  # a 3D solid writes no fields yet (its coupling comes with its outputs)
+    if isinstance(s.plate, Plate):
+        p = s.plate
+        n_dof = 2 * ((p.nx + 1) * (p.ny + 1) + p.nx * (p.ny + 1) + p.ny * (p.nx + 1))
+    row = OUTPUT_BYTES_PER_GRANULE * len(s.granules) + OUTPUT_BYTES_PER_DOF * n_dof + 400.0
+    return row / t.output_interval + FIELD_BYTES_PER_DOF * n_dof / t.field_interval
+
+
+def _check_output_size(s: Scenario) -> None:
+    """The outputs of t_end fit in MEMORY_SHARE of the machine's memory."""
+    memory = MEMORY_SHARE * physical_memory()
+    t_max = memory / output_bytes_per_second(s)
+    t = s.time
+    if memory > 0.0 and not t.t_end <= t_max:
+        raise ScenarioError(
+            "time.t_end",
+            t.t_end,
+            f"allowed: t_end <= {t_max:.3g} s with these output intervals: the outputs would need "
+            f"about {t.t_end / t_max * (memory / 1e9):.3g} GB ({t.t_end / t.output_interval:.3g} "
+            f"output times, time.output_interval = {t.output_interval!r} s; "
+            f"{t.t_end / t.field_interval:.3g} plate snapshots, time.field_interval = "
+            f"{t.field_interval!r} s), this machine allows {memory / 1e9:.3g} GB",
+        )
+
+
+def _check_solver(s: Scenario) -> None:
+    sv = s.solver
+    string_in("solver.scheme", sv.scheme, SCHEMES)
+    string_in("solver.granular_friction", sv.granular_friction, GRANULAR_FRICTIONS)
+    if sv.scheme in GRANULAR_SCHEMES:
+        _check_granular_scheme(s)
+    elif isinstance(s.plate, Solid):
+        raise ScenarioError(
+            "solver.scheme",
+            sv.scheme,
+            "an elastic solid in 3D is coupled to the granules by "
+            "velocity Verlet with its modes turned exactly (docs/model.md section 3.9): set "
+            'solver.scheme = "verlet" and solver.granular_friction = "split"',
+        )
+    lam = finite("solver.lambda_target", sv.lambda_target, "must be in (0, 1)")
+    if not 0.0 < lam < 1.0:
+        raise ScenarioError("solver.lambda_target", sv.lambda_target, "must be in (0, 1)")
+    positive("solver.iteration_rtol", sv.iteration_rtol)
+    positive("solver.iteration_atol", sv.iteration_atol)
+    int_at_least("solver.max_iterations", sv.max_iterations, 1)
+    positive("solver.energy_tol", sv.energy_tol)
+    positive("solver.error_tol", sv.error_tol)
+    positive("solver.implicit_dt_max", sv.implicit_dt_max)
+
+
+def _check_granular_scheme(s: Scenario) -> None:
+    """A scheme of the granules alone (GRANULAR_SCHEMES): no plate (an elastic solid in
+    space is its own: docs/model.md section 3.9), friction split off."""
+    sv = s.solver
+    if s.plate is not None and not isinstance(s.plate, Solid):
+        raise ScenarioError(
+            "solver.scheme",
+            sv.scheme,
+            'integrates the granules alone (velocity Verlet): a scenario with a [plate] needs "implicit" or "paper"',
+        )
+    if sv.granular_friction != "split":
+        raise ScenarioError(
+            "solver.granular_friction",
+            sv.granular_friction,
+            'must be "split" with solver.scheme '
+            f"= {sv.scheme!r} (its friction is split off exactly, never inside the step)",
+        )
