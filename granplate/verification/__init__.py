@@ -3,6 +3,8 @@
 Every part of the simulator is checked against independent truth (docs/validation.md is
 the page this writes, regenerated with --full):
 
+- gravity_cases.py: a ball dropped on a floor under gravity (free fall, damped bounce
+  against an independent integration, the energy balance with gravity's work);
 - granular.py: Chung & Ooi (2011) tests 1-4, sliding to rolling; chain.py: Nesterenko's solitary
   wave on a striker-hit chain;
 - dynamic.py: contacts that form during the run (two spheres from a gap, an oblique impact,
@@ -71,6 +73,7 @@ def all_cases() -> tuple:
         dynamic,
         face_contacts,
         granular,
+        gravity_cases,
         lammps,
         measured_cases,
         plastic_cases,
@@ -85,6 +88,7 @@ def all_cases() -> tuple:
     space_lammps = tuple(c for c in beside if c.family == "space")
     return (
         granular.CASES
+        + gravity_cases.CASES
         + chain.CASES
         + dynamic.CASES
         + plane_lammps
