@@ -106,11 +106,17 @@ def summary_notes(summary: dict) -> list[str]:
     if over:
         excess = max(over.values()) - 1.0
         residual = summary.get("energy_residual_max") or 0.0
-        why = (
-            "within the energy residual, the balance's round-off"
-            if excess <= 1.01 * residual
-            else "beyond the energy residual: the balance does not close"
-        )
+        e_in, e_max = summary.get("e_in") or 0.0, summary.get("e_in_max") or 0.0
+        lent = max(e_max / e_in - 1.0, 0.0) if e_in > 0 else 0.0  # put in, then taken back by t_end
+        if excess <= 1.01 * residual:
+            why = "within the energy residual, the balance's round-off"
+        elif excess <= 1.01 * (lent + residual):
+            why = (
+                f"within the energy put in at its largest, E_in_max = {e_max:.4e} J (gravity or a drive "
+                "put in more before t_end than by t_end, and took it back)"
+            )
+        else:
+            why = "beyond the energy residual: the balance does not close"
         notes.append(f"note: {', '.join(over)} above 1 by {excess:.1e}, {why} (max |residual| {residual:.1e}).")
     return notes
 

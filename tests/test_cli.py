@@ -15,6 +15,7 @@ SUMMARY_KEYS = {
     "e_shock",
     "e_initial",
     "e_in",
+    "e_in_max",
     "ep_max_fraction",
     "ep_final_fraction",
     "eg_max_fraction",

@@ -518,12 +518,14 @@ def initial_state(s: Scenario, x: np.ndarray, y: np.ndarray) -> np.ndarray:
 def build_model(scenario: Scenario) -> Model:
     """Validate, resolve and turn a scenario into the loop's arrays (in space, dimension =
     3: `model.space.build_space_model`)."""
+    from granplate.model.static import precompressed
+
     validate(scenario)
     s = resolve(scenario)
     if s.dimension == 3:
         from granplate.model.space import build_space_model
 
-        return build_space_model(s)
+        return precompressed(build_space_model(s))
     x, y, r, rho = _granule_arrays(s)
     mats = [s.material(g.material) for g in s.granules]
     mass, inertia = masses_and_inertias(r, rho)
@@ -561,7 +563,7 @@ def build_model(scenario: Scenario) -> Model:
     )
     drives = drive_fields(s, np.column_stack([x, y]))
     granular = granular._replace(**drives)
-    return Model(
+    model = Model(
         scenario=s,
         labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),
         granular=granular,
@@ -575,6 +577,7 @@ def build_model(scenario: Scenario) -> Model:
         materials=tuple(mats),
         initial_patches=patches,
     )
+    return precompressed(model)
 
 
 def carried_history(old_keys: list, old_hist: np.ndarray, new_keys: list, store: dict) -> np.ndarray:

@@ -530,12 +530,16 @@ def body_outputs(
     return data, coords, n_done
 
 
-def initial_energy(energy0: np.ndarray) -> float:
+def initial_energy(energy0: np.ndarray, stored: bool = False) -> float:
     """E_initial [J]: the kinetic energy of the initial velocities, 1/2 m v^2 + 1/2 I omega^2
     summed over the granules (the first output row's KE_x + KE_y + KE_rot, + KE_z in space), exactly 0 for a
     run from rest. The plate starts undeformed and at rest; contacts that touch at t = 0
     (overlaps within validation's 1e-9 R) hold only the round-off energy of their overlaps
-    (~1e-33 J), which is not energy put in (it stays in the loop's eq. (11) reference)."""
+    (~1e-33 J), which is not energy put in (it stays in the loop's eq. (11) reference).
+    stored: a precompressed run (docs/model.md section 3.12), whose contacts start with the
+    static state's elastic energy: E_initial is then the whole E_g + E_p at t = 0."""
+    if stored:
+        return float(energy0[K.E_GRAN] + energy0[K.E_PLATE])
     return float(energy0[K.KE_X] + energy0[K.KE_Y] + energy0[K.KE_ROT] + energy0[K.KE_Z])
 
 
@@ -552,7 +556,7 @@ def _attrs(model, out: K.Output, n: int, info: dict) -> dict:
         "scheme": s.solver.scheme,
         "conventions": "SI units; see docs/output.md",
         "run_info": json.dumps(info),
-        "E_initial": initial_energy(out.energy[0]) if n else 0.0,
+        "E_initial": initial_energy(out.energy[0], s.precompression is not None) if n else 0.0,
     }
     attrs.update(info)
     return attrs
@@ -583,6 +587,7 @@ SUMMARY_UNITS: dict[str, object] = {
     "e_gravity": "J",
     "e_drive": "J",
     "e_in": "J",
+    "e_in_max": "J",
     "ep_max_fraction": "1",
     "ep_final_fraction": "1",
     "eg_max_fraction": "1",
@@ -640,7 +645,7 @@ def summary(ds: xr.Dataset) -> dict:
     energies at t_end add up to e_in - e_load_taken. Plate metrics are None for a run
     without a plate (not applicable, not zero).
     """
-    from granplate.results.analysis import load_work
+    from granplate.results.analysis import energy_put_in, load_work
 
     e0 = float(ds.attrs.get("E_initial", 0.0))
     put_in, taken = load_work(ds.E_shock.values) if ds.sizes["time"] else (np.zeros(1), np.zeros(1))
@@ -670,6 +675,7 @@ def summary(ds: xr.Dataset) -> dict:
         "e_gravity": e_gravity,
         "e_drive": e_drive,
         "e_in": e_in,
+        "e_in_max": float(np.max(energy_put_in(ds))) if ds.sizes["time"] else e_in,
         "ep_max_fraction": fraction(ds.E_plate.max(), plate=True),
         "ep_final_fraction": fraction(ds.E_plate[-1], plate=True),
         "eg_max_fraction": fraction(ds.E_granular.max()),

@@ -34,6 +34,7 @@ from granplate.setup.materials import LIBRARY, Material
 from granplate.setup.scenario import (
     DRIVE_KINDS,
     DRIVE_PROFILES,
+    PRECOMPRESSION_MODES,
     LAYOUT_KINDS,
     NORMAL_LAWS,
     Box,
@@ -44,6 +45,7 @@ from granplate.setup.scenario import (
     Load,
     PairCoefficients,
     Plate,
+    Precompression,
     Scenario,
     Solid,
     Solver,
@@ -59,6 +61,7 @@ REQUIRED: dict[type, tuple[str, ...]] = {
     PairCoefficients: ("materials",),
     Gravity: ("g",),
     Drive: ("target", "kind", "direction", "profile"),
+    Precompression: ("target", "force"),
 }
 #: Keys of a [materials.NAME] table: E, nu, rho required; Y optional (absent: unknown);
 #: the law "johnson"'s C, rate_ref, hardness_ratio, unloading_factor optional.
@@ -71,6 +74,7 @@ CHOICES: dict[tuple[type, str], tuple[str, ...]] = {
     (PairCoefficients, "normal_law"): NORMAL_LAWS,
     (Drive, "kind"): DRIVE_KINDS,
     (Drive, "profile"): DRIVE_PROFILES,
+    (Precompression, "mode"): PRECOMPRESSION_MODES,
 }
 #: Fields left out of a written table when they hold this default (written, they would
 #: change the text, and so the stored results' keys, of every scenario written before).
@@ -258,6 +262,7 @@ _TOP_TABLES: dict[str, type] = {
     "solver": Solver,
     "box": Box,
     "gravity": Gravity,
+    "precompression": Precompression,
 }
 
 
@@ -499,6 +504,8 @@ def to_dict(s: Scenario, all_materials: bool = False) -> dict:
         d["gravity"] = _plain(s.gravity)
     if s.drives:
         d["drives"] = [_without_defaults(x, DRIVE_DEFAULTS) for x in _plain(s.drives)]
+    if s.precompression is not None:
+        d["precompression"] = _plain(s.precompression)
     return d
 
 

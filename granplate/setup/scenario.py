@@ -560,6 +560,8 @@ class Solver:
 DRIVE_KINDS: tuple[str, ...] = ("displacement", "velocity", "force")
 #: A drive's time profiles (`Drive.profile`; docs/scenario.md, section "Drives").
 DRIVE_PROFILES: tuple[str, ...] = ("constant", "ramp", "half-sine", "harmonic", "table")
+#: How a precompressing wall behaves during the run (Precompression.mode).
+PRECOMPRESSION_MODES: tuple[str, ...] = ("frozen",)
 #: The two kinds of body a drive moves (`Drive.target` = "wall LABEL" or "granule LABEL").
 DRIVE_TARGETS: tuple[str, ...] = ("wall", "granule")
 
@@ -570,6 +572,22 @@ class Gravity:
     plane, [gx, gy, gz] in space (docs/model.md section 3.11)."""
 
     g: tuple[float, ...] = ()
+
+
+@dataclass(frozen=True)
+class Precompression:
+    """Static precompression before t = 0 (docs/model.md section 3.12): the wall `target`
+    ("wall LABEL") is pushed into the assembly with the force `force` [N] along its inward
+    normal and the granules (with gravity, if given, and the other walls fixed) are brought
+    to static equilibrium, to a residual force of `tolerance` x force on every granule and
+    on the wall, in at most `max_iterations` steps of the minimiser. mode: "frozen" (the wall
+    then stays where equilibrium left it: displacement-controlled during the run)."""
+
+    target: str = ""
+    force: float = 0.0
+    mode: str = "frozen"
+    tolerance: float = 1e-8
+    max_iterations: int = 20000
 
 
 @dataclass(frozen=True)
@@ -620,7 +638,8 @@ class Scenario:
     None for [[granules]] tables. Not part of the scenario's value: a scenario read from a
     file equals the same one given as tables, and is written as tables (`io.to_dict`).
     gravity: a body force on every granule (None: none); drives: prescribed motions of
-    walls and granules and prescribed forces on granules (docs/model.md section 3.11).
+    walls and granules and prescribed forces on granules (docs/model.md section 3.11);
+    precompression: the static state the run starts from (None: as given; section 3.12).
     """
 
     name: str = "custom"
@@ -639,6 +658,7 @@ class Scenario:
     granules_file: str | None = field(default=None, compare=False)
     gravity: Gravity | None = None
     drives: tuple[Drive, ...] = ()
+    precompression: Precompression | None = None
 
     def material(self, name: str) -> Material:
         """The material called `name` (file-defined ones override the library)."""

@@ -28,6 +28,7 @@ from typing import Any
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import granule_named, plane_offset, resolve, unit
 from granplate.setup.drive_checks import check_drives, check_gravity
+from granplate.setup.precompression_checks import check_precompression
 from granplate.setup.fields import (
     check_dimension,
     finite,
@@ -447,9 +448,11 @@ def _validate(scenario: Scenario) -> None:
 
 
 def _check_drives(s: Scenario) -> None:
-    """[gravity] and [[drives]] (setup.drive_checks): a harmonic drive's period held to
-    the scheme's largest step, the speeds a drive asks for below the slowest wave speed."""
+    """[gravity], [[drives]] (setup.drive_checks) and [precompression]
+    (setup.precompression_checks): a harmonic drive's period held to the scheme's largest
+    step, the speeds a drive asks for below the slowest wave speed."""
     check_gravity(s)
+    check_precompression(s)
     if not s.drives:
         return
     if not isinstance(s.drives, tuple):

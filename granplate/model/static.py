@@ -1,0 +1,216 @@
+"""Static precompression (docs/model.md section 3.12): the assembly at rest under a wall's
+force, the state a precompressed run starts from.
+
+The granules' centres X and the target wall's offset o minimise the potential energy
+
+    Pi(X, o) = sum over contacts (2/5) A delta^(5/2) - sum_i m_i g . x_i + F o     (S1)
+
+(Hertz's energy of eq. 9 at every granule-granule and granule-wall contact in the model's
+lists, gravity's potential, and the servo's: the wall, whose unit normal n points out of the
+assembly, is pushed inwards with the force F, so its offset o along n falls while the
+contacts on it carry less than F). At the minimum every granule's net force vanishes and
+the wall's contacts carry F:
+
+    sum_j A delta_ij^(3/2) n_ij + sum_walls A delta^(3/2) (-n) + m_i g = 0,
+    sum over the wall's contacts A delta^(3/2) = F                                  (S2)
+
+Its gradient is the residual of (S2). It is minimised by L-BFGS (scipy) from the given
+positions, then polished by Newton steps on the contacts' normal stiffness 3/2 A
+delta^(1/2) n n^T (a positive semi-definite matrix, the transverse geometric terms left
+out, so that every step descends) until the largest residual force is below tolerance x F.
+Granules a drive holds stay where they are. The laws of friction do not enter: the static
+state is frictionless (friction needs a history that precompression does not have).
+
+Pure functions of the model's arrays (no I/O): `static_state` returns the equilibrium and
+`precompressed` the model that starts from it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import NamedTuple
+
+import numpy as np
+
+from granplate.errors import SimulationError
+from granplate.physics.contact import COEF_A
+
+
+class StaticState(NamedTuple):
+    """The static equilibrium of `static_state`.
+
+    positions: (ng, d) the granules' centres [m]; offset: the target wall's offset along its
+    unit normal [m] (shifted from `offset0` by the precompression); residual: the largest
+    net force on a granule or the wall over F [-]; iterations: the minimiser's and Newton's
+    steps; wall_force: the force the wall's contacts carry [N] (F to the residual)."""
+
+    positions: np.ndarray
+    offset: float
+    offset0: float
+    residual: float
+    iterations: int
+    wall_force: float
+
+
+def _contact_terms(x: np.ndarray, o: float, g, wall: int):
+    """Overlaps, forces, slopes and normals of every listed pair and wall contact at centres x
+    and target-wall offset o: (pairs: i, j, delta, f, k, n) and (walls: i, delta, f, k, n,
+    on_target)."""
+    r = g.radius
+    i, j = g.pair_ij[:, 0], g.pair_ij[:, 1]
+    d = x[i] - x[j]
+    dist = np.linalg.norm(d, axis=1)
+    n = d / np.where(dist > 0.0, dist, 1.0)[:, None]
+    delta = np.maximum(r[i] + r[j] - dist, 0.0)
+    a = g.pair_coef[:, COEF_A]
+    f, k = a * delta**1.5, 1.5 * a * np.sqrt(delta)
+    d_ = x.shape[1]
+    wi = g.wall_i
+    wn = g.wall_geo[:, :d_]
+    off = np.where(g.wall_w == wall, o, g.wall_geo[:, d_])
+    wdelta = np.maximum(r[wi] + np.einsum("kd,kd->k", x[wi], wn) - off, 0.0)
+    wa = g.wall_coef[:, COEF_A]
+    wf, wk = wa * wdelta**1.5, 1.5 * wa * np.sqrt(wdelta)
+    return (i, j, delta, f, k, n, a), (wi, wdelta, wf, wk, wn, g.wall_w == wall, wa)
+
+
+def energy_and_forces(x: np.ndarray, o: float, g, wall: int, force: float):
+    """(Pi [J] of (S1), the net force on every granule (ng, d) [N], the net force on the wall
+    along its inward normal [N]) at centres x and offset o: minus the gradient of Pi."""
+    (i, j, delta, f, _, n, a), (wi, wdelta, wf, _, wn, on, wa) = _contact_terms(x, o, g, wall)
+    mass = g.mass
+    grav = np.asarray(g.gravity, float) if len(g.gravity) else np.zeros(x.shape[1])
+    e = 0.4 * (np.sum(a * delta**2.5) + np.sum(wa * wdelta**2.5)) - float(np.sum(mass[:, None] * x * grav)) + force * o
+    net = np.zeros_like(x)
+    np.add.at(net, i, f[:, None] * n)
+    np.add.at(net, j, -f[:, None] * n)
+    np.add.at(net, wi, -wf[:, None] * wn)
+    net += mass[:, None] * grav
+    on_wall = float(np.sum(wf[on])) - force  # the contacts push the wall out, the servo in
+    return e, net, on_wall
+
+
+def _normal_stiffness(x: np.ndarray, o: float, g, wall: int, free: np.ndarray):
+    """The contacts' normal stiffness over the free granules' coordinates and the wall's
+    offset (the last unknown), as a sparse matrix: 3/2 A delta^(1/2) n n^T blocks (S1's
+    Hessian without the transverse geometric terms)."""
+    from scipy.sparse import coo_matrix
+
+    (i, j, _, _, k, n, _), (wi, _, _, wk, wn, on, _) = _contact_terms(x, o, g, wall)
+    d = x.shape[1]
+    index = -np.ones(len(g.mass), np.int64)
+    index[free] = np.arange(int(free.sum()))
+    size = int(free.sum()) * d + 1
+    rows, cols, vals = [], [], []
+
+    def block(a, b, kk, nn, sign):
+        ok = (a >= 0) & (b >= 0) & (kk > 0.0)
+        for p in range(d):
+            for q in range(d):
+                rows.append(a[ok] * d + p)
+                cols.append(b[ok] * d + q)
+                vals.append(sign * kk[ok] * nn[ok, p] * nn[ok, q])
+
+    ii, jj = index[i], index[j]
+    block(ii, ii, k, n, 1.0)
+    block(jj, jj, k, n, 1.0)
+    block(ii, jj, k, n, -1.0)
+    block(jj, ii, k, n, -1.0)
+    wii = index[wi]
+    block(wii, wii, wk, wn, 1.0)
+    last = size - 1
+    sel = on & (wii >= 0) & (wk > 0.0)
+    for p in range(d):  # d delta / d x = n, d delta / d o = -1
+        rows += [wii[sel] * d + p, np.full(sel.sum(), last)]
+        cols += [np.full(sel.sum(), last), wii[sel] * d + p]
+        vals += [-wk[sel] * wn[sel, p], -wk[sel] * wn[sel, p]]
+    rows.append(np.array([last]))
+    cols.append(np.array([last]))
+    vals.append(np.array([float(np.sum(wk[on]))]))
+    return coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(size, size)).tocsc()
+
+
+def static_state(
+    g, x0: np.ndarray, wall: int, offset0: float, force: float, tolerance: float = 1e-8, max_iterations: int = 20000
+) -> StaticState:
+    """The static equilibrium (S2) of the granular arrays g (model.inputs.Granular or
+    Granular3) from centres x0 (ng, d) [m], the wall `wall` (index in the scenario's walls,
+    offset0 [m] along its unit normal) pushed in with `force` [N]; converged when the largest
+    net force on a granule or on the wall is at most tolerance x force. SimulationError with
+    the residual reached (its `partial` the StaticState) when it does not converge."""
+    from scipy.optimize import minimize
+    from scipy.sparse import identity
+    from scipy.sparse.linalg import spsolve
+
+    d = x0.shape[1]
+    held = np.zeros(len(g.mass), bool)
+    held[g.drive_target[g.drive_target >= 0]] = True
+    free = ~held
+    a_min = float(np.min(g.wall_coef[g.wall_w == wall, COEF_A])) if np.any(g.wall_w == wall) else 1.0
+    scale = (force / a_min) ** (2.0 / 3.0)  # the overlap F makes at the wall [m]: the unknowns' unit
+
+    def unpack(z):
+        x = x0.copy()
+        x[free] += z[:-1].reshape(-1, d) * scale
+        return x, offset0 + z[-1] * scale
+
+    def fun(z):
+        x, o = unpack(z)
+        e, net, on_wall = energy_and_forces(x, o, g, wall, force)
+        grad = np.concatenate([-net[free].ravel(), [-on_wall]]) * scale
+        return e / (force * scale), grad / (force * scale)
+
+    def residual(z):
+        _, net, on_wall = energy_and_forces(*unpack(z), g, wall, force)
+        return max(float(np.max(np.abs(net[free]), initial=0.0)), abs(on_wall)) / force
+
+    z = np.zeros(int(free.sum()) * d + 1)
+    res = minimize(fun, z, jac=True, method="L-BFGS-B", options={"maxiter": max_iterations, "gtol": 1e-14, "ftol": 0.0})
+    z, steps = res.x, int(res.nit)
+    for _ in range(50):  # Newton on the normal stiffness, with a halving line search
+        if residual(z) <= tolerance or steps >= max_iterations:
+            break
+        x, o = unpack(z)
+        _, net, on_wall = energy_and_forces(x, o, g, wall, force)
+        h = _normal_stiffness(x, o, g, wall, free) * scale
+        rhs = np.concatenate([net[free].ravel(), [on_wall]])
+        dz = spsolve(h + identity(h.shape[0], format="csc") * (1e-12 * float(abs(h).max())), rhs)
+        r0, t = residual(z), 1.0
+        while t > 1e-6 and residual(z + t * dz) >= r0:
+            t *= 0.5
+        z = z + t * dz
+        steps += 1
+    x, o = unpack(z)
+    _, net, on_wall = energy_and_forces(x, o, g, wall, force)
+    state = StaticState(x, float(o), float(offset0), residual(z), steps, float(on_wall + force))
+    if state.residual > tolerance:
+        raise SimulationError(
+            f"precompression: no static equilibrium to a residual of {tolerance:g} x force after {steps} steps "
+            f"(reached {state.residual:.3g}); give more precompression.max_iterations, a looser "
+            "precompression.tolerance, or check that every granule rests on a path of contacts to a wall",
+            state,
+        )
+    return state
+
+
+def precompressed(model):
+    """The model whose run starts from its scenario's [precompression] static state: the
+    granules' centres moved to it, the target wall's offset with them (frozen there during
+    the run); the model itself when the scenario has none."""
+    from granplate.setup.precompression_checks import precompression_wall
+
+    p = model.scenario.precompression
+    if p is None:
+        return model
+    g = model.granular
+    d = g.wall_geo.shape[1] - 1
+    wall = precompression_wall(model.scenario)
+    rows = g.wall_w == wall
+    offset0 = float(g.wall_geo[rows, d][0]) if np.any(rows) else 0.0
+    x0 = np.ascontiguousarray(model.initial_state[:, :d])
+    st = static_state(g, x0, wall, offset0, float(p.force), float(p.tolerance), int(p.max_iterations))
+    y0 = model.initial_state.copy()
+    y0[:, :d] = st.positions
+    geo = g.wall_geo.copy()
+    geo[rows, d] = st.offset
+    return dataclasses.replace(model, initial_state=y0, granular=g._replace(wall_geo=geo))
