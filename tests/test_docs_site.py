@@ -87,24 +87,53 @@ def test_commands_parse(page: Path):
 
 def test_relative_links_resolve():
     """Every relative link or image of every Markdown page under docs/ and of the README
-    points at a file that exists (the check the site build runs, and the README's)."""
+    points at a file that exists, and at an anchor of that page where it names one (the
+    check the site build runs, and the README's, which the site does not build)."""
     mod = _ext()
     mod.generate()  # the reference pages the build generates, which pages link to
     assert mod.broken_links(DOCS) == []
     text = mod.FENCE.sub("", (ROOT / "README.md").read_text())
-    targets = [t for t in mod.LINK.findall(text) if not re.match(r"^[a-z]+:", t)]
-    assert targets
-    assert [t for t in targets if not (ROOT / t.split("#")[0]).exists()] == []
+    assert [t for t in mod.LINK.findall(text) if not re.match(r"^[a-z]+:", t)]
+    assert mod.broken_targets(ROOT / "README.md") == []
 
 
 def test_broken_link_is_found(tmp_path):
-    """The link check finds a link to a missing file (and ignores web links and anchors)."""
+    """The link check finds a link to a missing file or to a missing anchor (and ignores
+    web links and code); headings, repeated headings, labels and HTML ids are anchors."""
     mod = _ext()
     (tmp_path / "a.md").write_text(
-        "[ok](b.md) [web](https://example.org) [here](#x) [bad](missing.md)\n```\n[in code](nowhere.md)\n```\n"
+        '# A\n\n## Step 1: `run` it\n\n## Step 1: `run` it\n\n(my-label)=\n<a id="case-x"></a>\n\n'
+        "[ok](b.md) [web](https://example.org) [bad](missing.md) [sec](b.md#the-section-31)\n"
+        "[here](#step-1-run-it) [again](#step-1-run-it-1) [label](#my-label) [html](#case-x)\n"
+        "[no anchor](#nowhere) [no anchor there](b.md#nowhere) [too deep](b.md#deep)\n"
+        "```\n[in code](nowhere.md)\n```\n"
     )
-    (tmp_path / "b.md").write_text("# b\n")
-    assert mod.broken_links(tmp_path) == [("a.md", "missing.md")]
+    (tmp_path / "b.md").write_text("# b\n\n### The section (3.1)\n\n#### Deep\n")
+    assert mod.broken_links(tmp_path) == [
+        ("a.md", "missing.md"),
+        ("a.md", "#nowhere"),
+        ("a.md", "b.md#nowhere"),
+        ("a.md", "b.md#deep"),
+    ]
+
+
+#: where the package and the tests name a page of docs/, and a numbered section of the model
+DOC_PATH = re.compile(r"docs/([A-Za-z0-9_/-]+\.(?:md|toml|json|py))")
+MODEL_SECTION = re.compile(r"docs/model\.md,? sections? (\d+(?:\.\d+)?)")
+
+
+def test_pages_the_package_names_exist():
+    """Every docs/ file that the package's messages and docstrings (and the tests) name
+    exists, and every "docs/model.md section N.M" they cite is a numbered heading there."""
+    headings = set(re.findall(r"^#{2,4} (\d+(?:\.\d+)?)[. ]", (DOCS / "model.md").read_text(), re.M))
+    assert {"3.6", "4.4", "7"} <= headings
+    missing_files, missing_sections = set(), set()
+    for source in [*(ROOT / "granplate").rglob("*.py"), *(ROOT / "tests").glob("*.py")]:
+        text = source.read_text()
+        missing_files |= {f"{source.name}: docs/{m}" for m in DOC_PATH.findall(text) if not (DOCS / m).exists()}
+        missing_sections |= {f"{source.name}: section {m}" for m in MODEL_SECTION.findall(text) if m not in headings}
+    assert sorted(missing_files) == []
+    assert sorted(missing_sections) == []
 
 
 def test_scenario_reference_covers_every_key():

@@ -415,23 +415,70 @@ LINK = re.compile(r"\]\(\s*<?([^)\s>]+)>?(?:\s+\"[^\"]*\")?\s*\)")
 FENCE = re.compile(r"^(```|~~~|:::).*?^\1", re.M | re.S)
 
 
+#: a heading of a Markdown page, with its level
+HEADING = re.compile(r"^(#{1,6})[ \t]+(.*?)[ \t]*#*[ \t]*$", re.M)
+#: an explicit MyST target, ``(name)=`` on a line of its own
+MYST_LABEL = re.compile(r"^\(([^)\s]+)\)=[ \t]*$", re.M)
+#: an ``{include}`` directive's file
+INCLUDE = re.compile(r"^(?:```|:::)\{include\}[ \t]+(\S+)", re.M)
+#: the deepest heading level that gets an anchor (conf.py's myst_heading_anchors)
+ANCHOR_LEVELS = 3
+
+
+def anchors(page: Path) -> set[str]:
+    """The anchors a link `page#name` may name: the slugs MyST gives headings of levels 1
+    to ANCHOR_LEVELS (GitHub's rule: lowercased, punctuation dropped, spaces as dashes, a
+    repeat numbered -1, -2, ...), explicit ``(name)=`` targets, raw HTML ``<a id=...>``, and
+    those of the files the page includes (all of them: a superset of an included range)."""
+    from myst_parser.slugs import github_slugify
+
+    raw = page.read_text()
+    found: set[str] = set()
+    for included in INCLUDE.findall(raw):
+        if (page.parent / included).is_file():
+            found |= anchors(page.parent / included)
+    text = FENCE.sub("", raw)
+    found |= set(HTML_ID.findall(text)) | set(MYST_LABEL.findall(text))
+    counts: dict[str, int] = {}
+    for level, title in HEADING.findall(text):
+        if len(level) > ANCHOR_LEVELS:
+            continue
+        title = re.sub(r"\[([^\]]*)\]\([^)]*\)", r"\1", title)  # a link's text
+        slug = github_slugify(title)
+        found.add(f"{slug}-{counts[slug]}" if counts.get(slug) else slug)
+        counts[slug] = counts.get(slug, 0) + 1
+    return found
+
+
+def broken_targets(page: Path) -> list[str]:
+    """The relative links and images of one Markdown page (code left out) whose file does
+    not exist, or whose `#anchor` in a Markdown page (this one for a bare `#anchor`) is no
+    anchor there (see `anchors`); web and mail links are not checked (no network)."""
+    text = FENCE.sub("", page.read_text())
+    text = re.sub(r"`[^`\n]*`", "", text)
+    bad = []
+    for target in LINK.findall(text):
+        if re.match(r"^[a-z][a-z0-9+.-]*:", target):
+            continue
+        file, _, anchor = target.partition("#")
+        path = page.parent / file if file else page
+        if not path.exists():
+            bad.append(target)
+        elif anchor and path.suffix == ".md" and anchor not in anchors(path):
+            bad.append(target)
+    return bad
+
+
 def broken_links(docs: Path = DOCS, exclude: tuple[str, ...] = ("_build",)) -> list[tuple[str, str]]:
-    """Every relative link or image of the Markdown pages under `docs` whose target file does
-    not exist, as (page, target); web links, mail links and anchors within a page are not
-    files and are left to Sphinx (a heading anchor that does not exist warns there)."""
+    """Every relative link or image of the Markdown pages under `docs` whose target file or
+    anchor does not exist, as (page, target) (`broken_targets`); the site build checks
+    them too (MyST warns for an anchor it cannot find), this check also runs without it."""
     bad = []
     for page in sorted(docs.rglob("*.md")):
         rel = page.relative_to(docs)
         if rel.parts[0] in exclude or rel.parts[0] == "studies":
             continue
-        text = FENCE.sub("", page.read_text())
-        text = re.sub(r"`[^`\n]*`", "", text)
-        for target in LINK.findall(text):
-            if re.match(r"^[a-z][a-z0-9+.-]*:", target) or target.startswith("#"):
-                continue
-            file = target.split("#", 1)[0]
-            if not (page.parent / file).exists():
-                bad.append((str(rel), target))
+        bad += [(str(rel), target) for target in broken_targets(page)]
     return bad
 
 
