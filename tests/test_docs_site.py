@@ -256,3 +256,29 @@ def test_result_variables_page_matches_a_run():
             continue
         unit = var.attrs.get("units") or "-"
         assert f"| `{name}` | {unit} |" in page, (name, unit)
+
+
+def test_gallery_shows_each_figure_with_its_scenario(tmp_path):
+    """Every committed figure of docs/figures/ is in the gallery with the command that drew
+    it and each scenario it was made from (a preset written as TOML, or a file of docs/);
+    the 3D box's file is the scenario the 3D figure tests draw (`BOX`)."""
+    import copy
+
+    from granplate.setup import io
+    from granplate.setup.presets import preset
+
+    mod = _ext()
+    page = mod.gallery_page(DOCS, tmp_path)
+    for name in sorted(p.name for p in (DOCS / "figures").glob("*.png")):
+        what, made, sources = mod.FIGURES[name]
+        assert f"](../../figures/{name})" in page and made and sources, name
+        for source in sources:
+            if source.endswith(".toml"):
+                assert f"```{{literalinclude}} ../../{source}" in page and (DOCS / source).is_file()
+            else:
+                written = tmp_path / mod.GALLERY_SCENARIOS / f"{source}.toml"
+                assert io.loads(written.read_text()) == preset(source)
+    sys.path.insert(0, str(ROOT / "tests"))
+    from test_figures_3d import BOX
+
+    assert io.dumps(io.load_scenario(DOCS / "gallery" / "box-3d.toml")) == io.dumps(io.from_dict(copy.deepcopy(BOX)))

@@ -327,60 +327,89 @@ def dataset_variables_page() -> str:
     return "\n".join(out) + "\n"
 
 
-#: the figures of docs/figures/: file -> (what it shows, the scenario and command that made it)
-FIGURES: dict[str, tuple[str, str]] = {
+#: the figures of docs/figures/ (committed PNGs, redrawn by the command given): file ->
+#: (what it shows, the command that made it, the scenarios it was made from: a preset's
+#: name, or a TOML file under docs/)
+FIGURES: dict[str, tuple[str, str, tuple[str, ...]]] = {
     "fig3.png": (
         "Paper Fig. 3: the largest von Mises stress without and with granules, and the energies normalised by E_shock",
-        "the presets `bare-plate` and `steel-r1` (2 ms), drawn by `granplate reproduce --out results`",
+        "`granplate reproduce --out results` (the presets at their 2 ms)",
+        ("bare-plate", "steel-r1"),
     ),
     "fig6.png": (
         "Paper Fig. 6: horizontal velocity maps, steel against PTFE intruders",
-        "the presets `steel-r05` and `ptfe-r05` (2 ms), `granplate plot results --figure 6`",
+        "`granplate reproduce --out results`, then `granplate plot results --figure 6`",
+        ("steel-r05", "ptfe-r05"),
     ),
     "show-steel-r1.png": (
         "An assembly before a run: the paper's steel packing, granules by material, walls, "
         "the plate and its rigid layers, the load",
         "`granplate show steel-r1 --dpi 80`",
+        ("steel-r1",),
     ),
     "show-steel-r1-result.png": (
         "A result: the contact forces and the deformed plate at the largest plate energy",
-        "`granplate run steel-r1` (2 ms), then `granplate show steel-r1.nc --dpi 80`",
+        "`granplate run steel-r1 -o steel-r1.nc`, then `granplate show steel-r1.nc --dpi 80`",
+        ("steel-r1",),
     ),
     "show-box-3d.png": (
         "A run in space: three depth-shaded projections, walls and contact forces",
-        "four spheres in a box (`BOX` of tests/test_figures_3d.py), `granplate show box-3d.nc --time 3e-5 --dpi 80`",
+        "`granplate run docs/gallery/box-3d.toml -o box-3d.nc`, then `granplate show box-3d.nc --time 3e-5 --dpi 80`",
+        ("gallery/box-3d.toml",),
     ),
 }
+#: where the gallery writes the presets' scenarios as TOML (beside the generated page)
+GALLERY_SCENARIOS = "scenarios"
 
 
-def gallery_page(docs: Path = DOCS) -> str:
-    """The Markdown of the gallery: every figure of docs/figures/ and docs/validation-figures/
-    with the scenario (or verification case) that made it."""
+def scenario_block(source: str, generated: Path = GENERATED, docs: Path = DOCS) -> list[str]:
+    """The Markdown that shows one scenario of a figure, folded: a TOML file of docs/ as it
+    is, or a preset as `granplate preset NAME` writes it (written now, beside the page)."""
+    if source.endswith(".toml"):
+        path, label = f"../../{source}", f"`docs/{source}`"
+    else:
+        from granplate.setup.io import dumps
+        from granplate.setup.presets import preset
+
+        _write_if_changed(generated / GALLERY_SCENARIOS / f"{source}.toml", dumps(preset(source)))
+        path, label = f"{GALLERY_SCENARIOS}/{source}.toml", f"the preset `{source}` (`granplate preset {source}`)"
+    return [
+        f"<details><summary>The scenario: {label}</summary>",
+        "",
+        f"```{{literalinclude}} {path}",
+        ":language: toml",
+        "```",
+        "",
+        "</details>",
+        "",
+    ]
+
+
+def gallery_page(docs: Path = DOCS, generated: Path = GENERATED) -> str:
+    """The Markdown of the gallery: every figure of docs/figures/ with the command and the
+    scenarios that made it, and every figure of docs/validation-figures/ with its case."""
     import json
 
     out = [
         "# Gallery",
         "",
-        "Every figure shipped with the documentation, with the scenario and command that",
-        "made it. The verification figures are drawn by `granplate verify` from the numbers",
-        "of each case; their cases, references and tolerances are in",
-        "[Verification and validation](../../validation.md).",
+        "Every figure shipped with the documentation (committed PNGs, small), with the",
+        "command that drew it and the scenario it was made from, unfolded below each figure:",
+        "run the command to draw it again. The verification figures are drawn by",
+        "`granplate verify` from the numbers of each case; their cases, references and",
+        "tolerances are in [Verification and validation](../../validation.md).",
         "",
         "## Runs and assemblies",
         "",
     ]
     for name in sorted(p.name for p in (docs / "figures").glob("*.png")):
-        what, made = FIGURES.get(name, ("", ""))
+        what, made, sources = FIGURES.get(name, ("", "", ()))
         head, _, rest = (what or name).partition(": ")
-        out += [
-            f"### {head}",
-            "",
-            f"![{what or name}](../../figures/{name})",
-            "",
-            f"{rest[:1].upper() + rest[1:]}." if rest else "",
-            f"Made by {made}." if made else "",
-            "",
-        ]
+        out += [f"### {head}", "", f"![{what or name}](../../figures/{name})", ""]
+        out += [f"{rest[:1].upper() + rest[1:]}." if rest else "", ""]
+        out += [f"Made by {made}.", ""] if made else []
+        for source in sources:
+            out += scenario_block(source, generated, docs)
     cases = {c["figure"]: c for c in json.loads((docs / "validation.json").read_text())["cases"] if c.get("figure")}
     out += ["## Verification cases", ""]
     for name in sorted(p.name for p in (docs / "validation-figures").glob("*.png")):
