@@ -282,3 +282,29 @@ def test_gallery_shows_each_figure_with_its_scenario(tmp_path):
     from test_figures_3d import BOX
 
     assert io.dumps(io.load_scenario(DOCS / "gallery" / "box-3d.toml")) == io.dumps(io.from_dict(copy.deepcopy(BOX)))
+
+
+#: a MyST include of part of a page: its file, and the text after which and before which it cuts
+INCLUDE_PART = re.compile(r"```\{include\} (\S+)\n((?::[a-z-]+:.*\n)*)```")
+
+
+def test_included_parts_are_found_in_their_pages():
+    """Every part of a long page that an explanation or how-to includes (by the headings it
+    starts after and ends before) is found there, start before end, and is not empty: a
+    heading renamed in docs/model.md or docs/scenario.md is caught here before the build."""
+    parts = 0
+    for page in sorted(DOCS.rglob("*.md")):
+        if "_build" in page.parts:
+            continue
+        for target, options in INCLUDE_PART.findall(page.read_text()):
+            opts = dict(re.findall(r"^:([a-z-]+):\s*(.*)$", options, re.M))
+            text = (page.parent / target).read_text()
+            start, end = (opts.get(k, "").strip().strip("'\"") for k in ("start-after", "end-before"))
+            i = text.find(start) if start else 0
+            assert i >= 0, f"{page.relative_to(DOCS)}: {start!r} is not in {target}"
+            rest = text[i + len(start) :]
+            j = rest.find(end) if end else len(rest)
+            assert j >= 0, f"{page.relative_to(DOCS)}: {end!r} is not after {start!r} in {target}"
+            assert rest[:j].strip(), f"{page.relative_to(DOCS)}: the part of {target} is empty"
+            parts += 1
+    assert parts >= 9
