@@ -366,13 +366,14 @@ def scenario_block(source: str, generated: Path = GENERATED, docs: Path = DOCS) 
     """The Markdown that shows one scenario of a figure, folded: a TOML file of docs/ as it
     is, or a preset as `granplate preset NAME` writes it (written now, beside the page)."""
     if source.endswith(".toml"):
-        path, label = f"../../{source}", f"`docs/{source}`"
+        path, label = f"../../{source}", f"<code>docs/{source}</code>"
     else:
         from granplate.setup.io import dumps
         from granplate.setup.presets import preset
 
         _write_if_changed(generated / GALLERY_SCENARIOS / f"{source}.toml", dumps(preset(source)))
-        path, label = f"{GALLERY_SCENARIOS}/{source}.toml", f"the preset `{source}` (`granplate preset {source}`)"
+        path = f"{GALLERY_SCENARIOS}/{source}.toml"
+        label = f"the preset <code>{source}</code> (<code>granplate preset {source}</code>)"
     return [
         f"<details><summary>The scenario: {label}</summary>",
         "",
@@ -394,7 +395,7 @@ def gallery_page(docs: Path = DOCS, generated: Path = GENERATED) -> str:
         "# Gallery",
         "",
         "Every figure shipped with the documentation (committed PNGs, small), with the",
-        "command that drew it and the scenario it was made from, unfolded below each figure:",
+        "command that drew it and the scenario it was made from (open it below the figure):",
         "run the command to draw it again. The verification figures are drawn by",
         "`granplate verify` from the numbers of each case; their cases, references and",
         "tolerances are in [Verification and validation](../../validation.md).",
