@@ -87,24 +87,53 @@ def test_commands_parse(page: Path):
 
 def test_relative_links_resolve():
     """Every relative link or image of every Markdown page under docs/ and of the README
-    points at a file that exists (the check the site build runs, and the README's)."""
+    points at a file that exists, and at an anchor of that page where it names one (the
+    check the site build runs, and the README's, which the site does not build)."""
     mod = _ext()
     mod.generate()  # the reference pages the build generates, which pages link to
     assert mod.broken_links(DOCS) == []
     text = mod.FENCE.sub("", (ROOT / "README.md").read_text())
-    targets = [t for t in mod.LINK.findall(text) if not re.match(r"^[a-z]+:", t)]
-    assert targets
-    assert [t for t in targets if not (ROOT / t.split("#")[0]).exists()] == []
+    assert [t for t in mod.LINK.findall(text) if not re.match(r"^[a-z]+:", t)]
+    assert mod.broken_targets(ROOT / "README.md") == []
 
 
 def test_broken_link_is_found(tmp_path):
-    """The link check finds a link to a missing file (and ignores web links and anchors)."""
+    """The link check finds a link to a missing file or to a missing anchor (and ignores
+    web links and code); headings, repeated headings, labels and HTML ids are anchors."""
     mod = _ext()
     (tmp_path / "a.md").write_text(
-        "[ok](b.md) [web](https://example.org) [here](#x) [bad](missing.md)\n```\n[in code](nowhere.md)\n```\n"
+        '# A\n\n## Step 1: `run` it\n\n## Step 1: `run` it\n\n(my-label)=\n<a id="case-x"></a>\n\n'
+        "[ok](b.md) [web](https://example.org) [bad](missing.md) [sec](b.md#the-section-31)\n"
+        "[here](#step-1-run-it) [again](#step-1-run-it-1) [label](#my-label) [html](#case-x)\n"
+        "[no anchor](#nowhere) [no anchor there](b.md#nowhere) [too deep](b.md#deep)\n"
+        "```\n[in code](nowhere.md)\n```\n"
     )
-    (tmp_path / "b.md").write_text("# b\n")
-    assert mod.broken_links(tmp_path) == [("a.md", "missing.md")]
+    (tmp_path / "b.md").write_text("# b\n\n### The section (3.1)\n\n#### Deep\n")
+    assert mod.broken_links(tmp_path) == [
+        ("a.md", "missing.md"),
+        ("a.md", "#nowhere"),
+        ("a.md", "b.md#nowhere"),
+        ("a.md", "b.md#deep"),
+    ]
+
+
+#: where the package and the tests name a page of docs/, and a numbered section of the model
+DOC_PATH = re.compile(r"docs/([A-Za-z0-9_/-]+\.(?:md|toml|json|py))")
+MODEL_SECTION = re.compile(r"docs/model\.md,? sections? (\d+(?:\.\d+)?)")
+
+
+def test_pages_the_package_names_exist():
+    """Every docs/ file that the package's messages and docstrings (and the tests) name
+    exists, and every "docs/model.md section N.M" they cite is a numbered heading there."""
+    headings = set(re.findall(r"^#{2,4} (\d+(?:\.\d+)?)[. ]", (DOCS / "model.md").read_text(), re.M))
+    assert {"3.6", "4.4", "7"} <= headings
+    missing_files, missing_sections = set(), set()
+    for source in [*(ROOT / "granplate").rglob("*.py"), *(ROOT / "tests").glob("*.py")]:
+        text = source.read_text()
+        missing_files |= {f"{source.name}: docs/{m}" for m in DOC_PATH.findall(text) if not (DOCS / m).exists()}
+        missing_sections |= {f"{source.name}: section {m}" for m in MODEL_SECTION.findall(text) if m not in headings}
+    assert sorted(missing_files) == []
+    assert sorted(missing_sections) == []
 
 
 def test_scenario_reference_covers_every_key():
@@ -227,3 +256,55 @@ def test_result_variables_page_matches_a_run():
             continue
         unit = var.attrs.get("units") or "-"
         assert f"| `{name}` | {unit} |" in page, (name, unit)
+
+
+def test_gallery_shows_each_figure_with_its_scenario(tmp_path):
+    """Every committed figure of docs/figures/ is in the gallery with the command that drew
+    it and each scenario it was made from (a preset written as TOML, or a file of docs/);
+    the 3D box's file is the scenario the 3D figure tests draw (`BOX`)."""
+    import copy
+
+    from granplate.setup import io
+    from granplate.setup.presets import preset
+
+    mod = _ext()
+    page = mod.gallery_page(DOCS, tmp_path)
+    for name in sorted(p.name for p in (DOCS / "figures").glob("*.png")):
+        what, made, sources = mod.FIGURES[name]
+        assert f"](../../figures/{name})" in page and made and sources, name
+        for source in sources:
+            if source.endswith(".toml"):
+                assert f"```{{literalinclude}} ../../{source}" in page and (DOCS / source).is_file()
+            else:
+                written = tmp_path / mod.GALLERY_SCENARIOS / f"{source}.toml"
+                assert io.loads(written.read_text()) == preset(source)
+    sys.path.insert(0, str(ROOT / "tests"))
+    from test_figures_3d import BOX
+
+    assert io.dumps(io.load_scenario(DOCS / "gallery" / "box-3d.toml")) == io.dumps(io.from_dict(copy.deepcopy(BOX)))
+
+
+#: a MyST include of part of a page: its file, and the text after which and before which it cuts
+INCLUDE_PART = re.compile(r"```\{include\} (\S+)\n((?::[a-z-]+:.*\n)*)```")
+
+
+def test_included_parts_are_found_in_their_pages():
+    """Every part of a long page that an explanation or how-to includes (by the headings it
+    starts after and ends before) is found there, start before end, and is not empty: a
+    heading renamed in docs/model.md or docs/scenario.md is caught here before the build."""
+    parts = 0
+    for page in sorted(DOCS.rglob("*.md")):
+        if "_build" in page.parts:
+            continue
+        for target, options in INCLUDE_PART.findall(page.read_text()):
+            opts = dict(re.findall(r"^:([a-z-]+):\s*(.*)$", options, re.M))
+            text = (page.parent / target).read_text()
+            start, end = (opts.get(k, "").strip().strip("'\"") for k in ("start-after", "end-before"))
+            i = text.find(start) if start else 0
+            assert i >= 0, f"{page.relative_to(DOCS)}: {start!r} is not in {target}"
+            rest = text[i + len(start) :]
+            j = rest.find(end) if end else len(rest)
+            assert j >= 0, f"{page.relative_to(DOCS)}: {end!r} is not after {start!r} in {target}"
+            assert rest[:j].strip(), f"{page.relative_to(DOCS)}: the part of {target} is empty"
+            parts += 1
+    assert parts >= 9

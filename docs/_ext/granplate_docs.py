@@ -327,60 +327,90 @@ def dataset_variables_page() -> str:
     return "\n".join(out) + "\n"
 
 
-#: the figures of docs/figures/: file -> (what it shows, the scenario and command that made it)
-FIGURES: dict[str, tuple[str, str]] = {
+#: the figures of docs/figures/ (committed PNGs, redrawn by the command given): file ->
+#: (what it shows, the command that made it, the scenarios it was made from: a preset's
+#: name, or a TOML file under docs/)
+FIGURES: dict[str, tuple[str, str, tuple[str, ...]]] = {
     "fig3.png": (
         "Paper Fig. 3: the largest von Mises stress without and with granules, and the energies normalised by E_shock",
-        "the presets `bare-plate` and `steel-r1` (2 ms), drawn by `granplate reproduce --out results`",
+        "`granplate reproduce --out results` (the presets at their 2 ms)",
+        ("bare-plate", "steel-r1"),
     ),
     "fig6.png": (
         "Paper Fig. 6: horizontal velocity maps, steel against PTFE intruders",
-        "the presets `steel-r05` and `ptfe-r05` (2 ms), `granplate plot results --figure 6`",
+        "`granplate reproduce --out results`, then `granplate plot results --figure 6`",
+        ("steel-r05", "ptfe-r05"),
     ),
     "show-steel-r1.png": (
         "An assembly before a run: the paper's steel packing, granules by material, walls, "
         "the plate and its rigid layers, the load",
         "`granplate show steel-r1 --dpi 80`",
+        ("steel-r1",),
     ),
     "show-steel-r1-result.png": (
         "A result: the contact forces and the deformed plate at the largest plate energy",
-        "`granplate run steel-r1` (2 ms), then `granplate show steel-r1.nc --dpi 80`",
+        "`granplate run steel-r1 -o steel-r1.nc`, then `granplate show steel-r1.nc --dpi 80`",
+        ("steel-r1",),
     ),
     "show-box-3d.png": (
         "A run in space: three depth-shaded projections, walls and contact forces",
-        "four spheres in a box (`BOX` of tests/test_figures_3d.py), `granplate show box-3d.nc --time 3e-5 --dpi 80`",
+        "`granplate run docs/gallery/box-3d.toml -o box-3d.nc`, then `granplate show box-3d.nc --time 3e-5 --dpi 80`",
+        ("gallery/box-3d.toml",),
     ),
 }
+#: where the gallery writes the presets' scenarios as TOML (beside the generated page)
+GALLERY_SCENARIOS = "scenarios"
 
 
-def gallery_page(docs: Path = DOCS) -> str:
-    """The Markdown of the gallery: every figure of docs/figures/ and docs/validation-figures/
-    with the scenario (or verification case) that made it."""
+def scenario_block(source: str, generated: Path = GENERATED, docs: Path = DOCS) -> list[str]:
+    """The Markdown that shows one scenario of a figure, folded: a TOML file of docs/ as it
+    is, or a preset as `granplate preset NAME` writes it (written now, beside the page)."""
+    if source.endswith(".toml"):
+        path, label = f"../../{source}", f"<code>docs/{source}</code>"
+    else:
+        from granplate.setup.io import dumps
+        from granplate.setup.presets import preset
+
+        _write_if_changed(generated / GALLERY_SCENARIOS / f"{source}.toml", dumps(preset(source)))
+        path = f"{GALLERY_SCENARIOS}/{source}.toml"
+        label = f"the preset <code>{source}</code> (<code>granplate preset {source}</code>)"
+    return [
+        f"<details><summary>The scenario: {label}</summary>",
+        "",
+        f"```{{literalinclude}} {path}",
+        ":language: toml",
+        "```",
+        "",
+        "</details>",
+        "",
+    ]
+
+
+def gallery_page(docs: Path = DOCS, generated: Path = GENERATED) -> str:
+    """The Markdown of the gallery: every figure of docs/figures/ with the command and the
+    scenarios that made it, and every figure of docs/validation-figures/ with its case."""
     import json
 
     out = [
         "# Gallery",
         "",
-        "Every figure shipped with the documentation, with the scenario and command that",
-        "made it. The verification figures are drawn by `granplate verify` from the numbers",
-        "of each case; their cases, references and tolerances are in",
-        "[Verification and validation](../../validation.md).",
+        "Every figure shipped with the documentation (committed PNGs, small), with the",
+        "command that drew it and the scenario it was made from (open it below the figure):",
+        "run the command to draw it again. The verification figures are drawn by",
+        "`granplate verify` from the numbers of each case; their cases, references and",
+        "tolerances are in [Verification and validation](../../validation.md).",
         "",
         "## Runs and assemblies",
         "",
     ]
     for name in sorted(p.name for p in (docs / "figures").glob("*.png")):
-        what, made = FIGURES.get(name, ("", ""))
+        what, made, sources = FIGURES.get(name, ("", "", ()))
         head, _, rest = (what or name).partition(": ")
-        out += [
-            f"### {head}",
-            "",
-            f"![{what or name}](../../figures/{name})",
-            "",
-            f"{rest[:1].upper() + rest[1:]}." if rest else "",
-            f"Made by {made}." if made else "",
-            "",
-        ]
+        out += [f"### {head}", "", f"![{what or name}](../../figures/{name})", ""]
+        out += [f"{rest[:1].upper() + rest[1:]}." if rest else "", ""]
+        out += [f"Made by {made}.", ""] if made else []
+        for source in sources:
+            out += scenario_block(source, generated, docs)
     cases = {c["figure"]: c for c in json.loads((docs / "validation.json").read_text())["cases"] if c.get("figure")}
     out += ["## Verification cases", ""]
     for name in sorted(p.name for p in (docs / "validation-figures").glob("*.png")):
@@ -415,23 +445,70 @@ LINK = re.compile(r"\]\(\s*<?([^)\s>]+)>?(?:\s+\"[^\"]*\")?\s*\)")
 FENCE = re.compile(r"^(```|~~~|:::).*?^\1", re.M | re.S)
 
 
+#: a heading of a Markdown page, with its level
+HEADING = re.compile(r"^(#{1,6})[ \t]+(.*?)[ \t]*#*[ \t]*$", re.M)
+#: an explicit MyST target, ``(name)=`` on a line of its own
+MYST_LABEL = re.compile(r"^\(([^)\s]+)\)=[ \t]*$", re.M)
+#: an ``{include}`` directive's file
+INCLUDE = re.compile(r"^(?:```|:::)\{include\}[ \t]+(\S+)", re.M)
+#: the deepest heading level that gets an anchor (conf.py's myst_heading_anchors)
+ANCHOR_LEVELS = 3
+
+
+def anchors(page: Path) -> set[str]:
+    """The anchors a link `page#name` may name: the slugs MyST gives headings of levels 1
+    to ANCHOR_LEVELS (GitHub's rule: lowercased, punctuation dropped, spaces as dashes, a
+    repeat numbered -1, -2, ...), explicit ``(name)=`` targets, raw HTML ``<a id=...>``, and
+    those of the files the page includes (all of them: a superset of an included range)."""
+    from myst_parser.slugs import github_slugify
+
+    raw = page.read_text()
+    found: set[str] = set()
+    for included in INCLUDE.findall(raw):
+        if (page.parent / included).is_file():
+            found |= anchors(page.parent / included)
+    text = FENCE.sub("", raw)
+    found |= set(HTML_ID.findall(text)) | set(MYST_LABEL.findall(text))
+    counts: dict[str, int] = {}
+    for level, title in HEADING.findall(text):
+        if len(level) > ANCHOR_LEVELS:
+            continue
+        title = re.sub(r"\[([^\]]*)\]\([^)]*\)", r"\1", title)  # a link's text
+        slug = github_slugify(title)
+        found.add(f"{slug}-{counts[slug]}" if counts.get(slug) else slug)
+        counts[slug] = counts.get(slug, 0) + 1
+    return found
+
+
+def broken_targets(page: Path) -> list[str]:
+    """The relative links and images of one Markdown page (code left out) whose file does
+    not exist, or whose `#anchor` in a Markdown page (this one for a bare `#anchor`) is no
+    anchor there (see `anchors`); web and mail links are not checked (no network)."""
+    text = FENCE.sub("", page.read_text())
+    text = re.sub(r"`[^`\n]*`", "", text)
+    bad = []
+    for target in LINK.findall(text):
+        if re.match(r"^[a-z][a-z0-9+.-]*:", target):
+            continue
+        file, _, anchor = target.partition("#")
+        path = page.parent / file if file else page
+        if not path.exists():
+            bad.append(target)
+        elif anchor and path.suffix == ".md" and anchor not in anchors(path):
+            bad.append(target)
+    return bad
+
+
 def broken_links(docs: Path = DOCS, exclude: tuple[str, ...] = ("_build",)) -> list[tuple[str, str]]:
-    """Every relative link or image of the Markdown pages under `docs` whose target file does
-    not exist, as (page, target); web links, mail links and anchors within a page are not
-    files and are left to Sphinx (a heading anchor that does not exist warns there)."""
+    """Every relative link or image of the Markdown pages under `docs` whose target file or
+    anchor does not exist, as (page, target) (`broken_targets`); the site build checks
+    them too (MyST warns for an anchor it cannot find), this check also runs without it."""
     bad = []
     for page in sorted(docs.rglob("*.md")):
         rel = page.relative_to(docs)
         if rel.parts[0] in exclude or rel.parts[0] == "studies":
             continue
-        text = FENCE.sub("", page.read_text())
-        text = re.sub(r"`[^`\n]*`", "", text)
-        for target in LINK.findall(text):
-            if re.match(r"^[a-z][a-z0-9+.-]*:", target) or target.startswith("#"):
-                continue
-            file = target.split("#", 1)[0]
-            if not (page.parent / file).exists():
-                bad.append((str(rel), target))
+        bad += [(str(rel), target) for target in broken_targets(page)]
     return bad
 
 
