@@ -29,6 +29,7 @@ COMMAND_MODULES = (
     "granplate.study.cli",  # sweep, optimize
     "granplate.bench.cli",  # bench
     "granplate.commands.resolve",  # resolve
+    "granplate.commands.modes",  # modes
 )
 
 #: (summary key, label, unit shown, format, scale to the unit shown). "{ref}" in a label

@@ -1,0 +1,130 @@
+"""Linear modes of an assembly about its static state (docs/model.md section 3.13).
+
+Small motions u of the granules' centres about the static state (the scenario's
+[precompression] equilibrium, `model.static`, or the positions given) obey M u'' + K u = 0,
+with M the granules' masses (translations; without friction a contact exerts no torque, so
+spins decouple with zero stiffness) and K the contacts' normal stiffness
+
+    K = sum over contacts k_c (e_i - e_j)(e_i - e_j)^T (x) n n^T,   k_c = dN/d delta = (3/2) A delta^(1/2)   (M1)
+
+(a wall contact: e_i alone; the granule-granule and granule-wall contacts in touch at the
+static state). The transverse stiffness of the contact forces (-N/|d| (I - n n^T), which
+makes a compressed straight chain neutral or unstable sideways) is left out, as the linear
+theory of granular crystals does. The frequencies are f = sqrt(lambda) / (2 pi) of the
+generalised eigenproblem K v = lambda M v (scipy: dense `eigh` up to DENSE_MAX unknowns,
+else `eigsh` in shift-invert about 0 with a fixed start vector for the lowest `count`).
+Directions without stiffness (a granule free to slide sideways, rattlers) give lambda = 0:
+`zero_modes` counts them. Contacts with no overlap carry no stiffness: an assembly that is
+not precompressed (and not under gravity) has only zero modes.
+
+For a monatomic chain of masses m and contact stiffness k the modes fill the acoustic band
+up to the cut-off f_c = (1/pi) sqrt(k/m); a diatomic chain (masses m1 > m2) has an acoustic
+band up to sqrt(2k/m1)/(2 pi), a gap, and an optical band from sqrt(2k/m2)/(2 pi) to
+sqrt(2k (1/m1 + 1/m2))/(2 pi) (`chain_band_edges`).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from granplate.physics.contact import COEF_A
+
+#: the most unknowns solved densely (all modes); beyond, the lowest `count` by eigsh
+DENSE_MAX = 3000
+#: lambda below this fraction of the largest is a zero mode
+ZERO_RTOL = 1e-10
+
+
+class Modes(NamedTuple):
+    """frequencies: (n,) [Hz], ascending, zero modes included (as 0); shapes: (n, ng, d) the
+    M-orthonormal mode shapes [kg^-1/2]; zero_modes: how many have no stiffness;
+    contacts: the contacts in touch that give K."""
+
+    frequencies: np.ndarray
+    shapes: np.ndarray
+    zero_modes: int
+    contacts: int
+
+
+def stiffness_matrix(g, x: np.ndarray):
+    """K of (M1) over the granules' centres x (ng, d) [m] of the granular arrays g, as a sparse
+    (ng d, ng d) matrix [N/m], and the number of contacts in touch."""
+    from scipy.sparse import coo_matrix
+
+    d = x.shape[1]
+    i, j = g.pair_ij[:, 0], g.pair_ij[:, 1]
+    dv = x[i] - x[j]
+    dist = np.linalg.norm(dv, axis=1)
+    n = dv / np.where(dist > 0.0, dist, 1.0)[:, None]
+    delta = np.maximum(g.radius[i] + g.radius[j] - dist, 0.0)
+    k = 1.5 * g.pair_coef[:, COEF_A] * np.sqrt(delta)
+    wi = g.wall_i
+    wn = g.wall_geo[:, :d]
+    wdelta = np.maximum(g.radius[wi] + np.einsum("kd,kd->k", x[wi], wn) - g.wall_geo[:, d], 0.0)
+    wk = 1.5 * g.wall_coef[:, COEF_A] * np.sqrt(wdelta)
+    rows, cols, vals = [], [], []
+    for p in range(d):
+        for q in range(d):
+            kp = k * n[:, p] * n[:, q]
+            for a, b, sign in ((i, i, 1.0), (j, j, 1.0), (i, j, -1.0), (j, i, -1.0)):
+                rows.append(a * d + p)
+                cols.append(b * d + q)
+                vals.append(sign * kp)
+            rows.append(wi * d + p)
+            cols.append(wi * d + q)
+            vals.append(wk * wn[:, p] * wn[:, q])
+    size = len(g.mass) * d
+    K = coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(size, size)).tocsr()
+    return K, int(np.count_nonzero(delta > 0.0) + np.count_nonzero(wdelta > 0.0))
+
+
+def linear_modes(model, count: int | None = None) -> Modes:
+    """The modes (M1) of a built model (`model.arrays.build_model`: precompressed when its
+    scenario says so) about its initial positions; `count`: the lowest count (None: all, up to
+    DENSE_MAX unknowns)."""
+    from scipy.linalg import eigh
+
+    g = model.granular
+    d = g.wall_geo.shape[1] - 1
+    x = np.ascontiguousarray(model.initial_state[:, :d])
+    K, touching = stiffness_matrix(g, x)
+    m = np.repeat(g.mass, d)
+    size = len(m)
+    w = 1.0 / np.sqrt(m)
+    if size <= DENSE_MAX:
+        lam, v = eigh((K.toarray() * w[:, None]) * w[None, :])
+    else:
+        from scipy.sparse import diags
+        from scipy.sparse.linalg import eigsh
+
+        want = min(count or 50, size - 2)
+        sym = diags(w) @ K @ diags(w)
+        v0 = np.ones(size) / math.sqrt(size)  # a fixed start vector: the same modes on every run
+        lam, v = eigsh(sym.tocsc(), k=want, sigma=-1e-9 * float(abs(sym).max()), which="LM", v0=v0)
+        order = np.argsort(lam)
+        lam, v = lam[order], v[:, order]
+    top = float(np.max(np.abs(lam))) if len(lam) else 0.0
+    zero = np.abs(lam) <= ZERO_RTOL * max(top, 1e-300)
+    lam = np.where(zero, 0.0, lam)
+    freq = np.sqrt(np.maximum(lam, 0.0)) / (2.0 * math.pi)
+    shapes = (v * w[:, None]).T.reshape(len(lam), len(g.mass), d)
+    if count is not None:
+        freq, shapes = freq[:count], shapes[:count]
+    return Modes(freq, shapes, int(np.count_nonzero(zero)), touching)
+
+
+def chain_band_edges(k: float, m1: float, m2: float | None = None) -> dict[str, float]:
+    """The band edges [Hz] of an infinite chain of contact stiffness k [N/m]: monatomic (m2
+    None) its cut-off (1/pi) sqrt(k/m1); diatomic (masses m1, m2) the acoustic band's top, the
+    optical band's bottom and top."""
+    if m2 is None:
+        return {"cutoff": math.sqrt(k / m1) / math.pi}
+    heavy, light = max(m1, m2), min(m1, m2)
+    return {
+        "acoustic_top": math.sqrt(2.0 * k / heavy) / (2.0 * math.pi),
+        "optical_bottom": math.sqrt(2.0 * k / light) / (2.0 * math.pi),
+        "optical_top": math.sqrt(2.0 * k * (1.0 / m1 + 1.0 / m2)) / (2.0 * math.pi),
+    }
