@@ -5,6 +5,8 @@ the page this writes, regenerated with --full):
 
 - gravity_cases.py: a ball dropped on a floor under gravity (free fall, damped bounce
   against an independent integration, the energy balance with gravity's work);
+- precompression_cases.py: precompressed chains (the static state against statics, the
+  linear modes against the band edges, Nesterenko's solitary-wave speed against amplitude);
 - granular.py: Chung & Ooi (2011) tests 1-4, sliding to rolling; chain.py: Nesterenko's solitary
   wave on a striker-hit chain;
 - dynamic.py: contacts that form during the run (two spheres from a gap, an oblique impact,
@@ -79,6 +81,7 @@ def all_cases() -> tuple:
         plastic_cases,
         plate_cases,
         plate_mesh,
+        precompression_cases,
         solid_cases,
         space_cases,
     )
@@ -89,6 +92,7 @@ def all_cases() -> tuple:
     return (
         granular.CASES
         + gravity_cases.CASES
+        + precompression_cases.CASES
         + chain.CASES
         + dynamic.CASES
         + plane_lammps
