@@ -14,6 +14,7 @@ from granplate.physics.drives import (
     PAR_AMPLITUDE,
     PAR_DURATION,
     PAR_FREQUENCY,
+    PAR_FREQUENCY_END,
     PAR_VALUE,
     TAB_I,
     TAB_T,
@@ -62,11 +63,12 @@ def drive_fields(s: Scenario, centres: np.ndarray) -> dict:
     direction = np.zeros((nd, d))
     x0 = np.zeros((nd, d))
     for k, dr in enumerate(s.drives):
-        par[k, [PAR_VALUE, PAR_AMPLITUDE, PAR_FREQUENCY, PAR_DURATION]] = (
+        par[k, [PAR_VALUE, PAR_AMPLITUDE, PAR_FREQUENCY, PAR_DURATION, PAR_FREQUENCY_END]] = (
             dr.value,
             dr.amplitude,
             dr.frequency,
             dr.duration,
+            dr.frequency_end,
         )
         rows = drive_table(dr.times, dr.values)
         tab[k, : len(rows)] = rows

@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 
+from granplate.physics.drives import N_PAR
 from granplate.setup.validate import SCHEMES
 
 #: the coupling schemes (setup.validate.SCHEMES), numbered in this order (Config.scheme);
@@ -107,7 +108,7 @@ class Granular(NamedTuple):
     drive_kind: np.ndarray = np.zeros(0, np.int64)
     drive_prof: np.ndarray = np.zeros(0, np.int64)
     drive_dir: np.ndarray = np.zeros((0, 2))
-    drive_par: np.ndarray = np.zeros((0, 4))
+    drive_par: np.ndarray = np.zeros((0, N_PAR))
     drive_tab: np.ndarray = np.zeros((0, 1, 3))
     drive_tlen: np.ndarray = np.zeros(0, np.int64)
     drive_x0: np.ndarray = np.zeros((0, 2))

@@ -7,6 +7,9 @@ The profile P(t) [m, m/s or N] is one of
     half-sine  P = amplitude sin(pi t / T) for t <= T, 0 after
     harmonic   P = value + amplitude sin(2 pi f t)
     table      linear between the points (t_k, P_k); P_0 before them, the last after
+    chirp      P = amplitude sin(phi(t)) for t <= T, P(T) after, phi = 2 pi (f0 t + (f1 - f0) t^2 / (2 T)):
+               the frequency phi' / (2 pi) swept linearly from f0 to f1 (no integral: a
+               displacement or a force drive only)
 and `profile_terms` gives its integral from 0, its value, slope and curvature at t. A
 displacement drive moves its body by s = P(t) - P(0) (velocity P', acceleration P''); a
 velocity drive by s = int_0^t P (velocity P, acceleration P'); a force drive pushes with P.
@@ -19,12 +22,13 @@ import math
 from numba import njit
 
 #: profile ids (the order of setup.scenario.DRIVE_PROFILES)
-PROFILE_CONSTANT, PROFILE_RAMP, PROFILE_HALF_SINE, PROFILE_HARMONIC, PROFILE_TABLE = range(5)
+PROFILE_CONSTANT, PROFILE_RAMP, PROFILE_HALF_SINE, PROFILE_HARMONIC, PROFILE_TABLE, PROFILE_CHIRP = range(6)
 #: drive kinds (the order of setup.scenario.DRIVE_KINDS)
 KIND_DISPLACEMENT, KIND_VELOCITY, KIND_FORCE = range(3)
-#: columns of a drive's parameters: value, amplitude, frequency [Hz], duration [s]
-PAR_VALUE, PAR_AMPLITUDE, PAR_FREQUENCY, PAR_DURATION = range(4)
-N_PAR = 4
+#: columns of a drive's parameters: value, amplitude, frequency [Hz], duration [s], the
+#: chirp's end frequency [Hz]
+PAR_VALUE, PAR_AMPLITUDE, PAR_FREQUENCY, PAR_DURATION, PAR_FREQUENCY_END = range(5)
+N_PAR = 5
 #: columns of a drive's table: the times [s], the values, the integral of the values from 0
 TAB_T, TAB_V, TAB_I = range(3)
 
@@ -83,8 +87,24 @@ def profile_terms(t, pid, par, tab, n):
         s = math.sin(w * t)
         c = math.cos(w * t)
         return value * t + a / w * (1.0 - c), value + a * s, a * w * c, -a * w * w * s
+    if pid == PROFILE_CHIRP:
+        return chirp_terms(t, a, par[PAR_FREQUENCY], par[PAR_FREQUENCY_END], par[PAR_DURATION])
     integral, v, slope = table_terms(t, tab, n)
     return integral, v, slope, 0.0
+
+
+@njit(cache=True)
+def chirp_terms(t, a, f0, f1, T):
+    """(0, P, P', P'') of the chirp P = a sin(phi), phi = 2 pi (f0 t + (f1 - f0) t^2 / (2 T)),
+    for t <= T; held at P(T) after, so that a displacement stays continuous (its integral is
+    not computed: 0)."""
+    if t > T:
+        return 0.0, a * math.sin(2.0 * math.pi * (f0 * T + 0.5 * (f1 - f0) * T)), 0.0, 0.0
+    phi = 2.0 * math.pi * (f0 * t + 0.5 * (f1 - f0) * t * t / T)
+    w = 2.0 * math.pi * (f0 + (f1 - f0) * t / T)
+    dw = 2.0 * math.pi * (f1 - f0) / T
+    s, c = math.sin(phi), math.cos(phi)
+    return 0.0, a * s, a * w * c, a * (dw * c - w * w * s)
 
 
 @njit(cache=True)

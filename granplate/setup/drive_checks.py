@@ -32,8 +32,17 @@ PROFILE_FIELDS: dict[str, tuple[str, ...]] = {
     "half-sine": ("amplitude", "duration"),
     "harmonic": ("value", "amplitude", "frequency"),
     "table": ("times", "values"),
+    "chirp": ("amplitude", "frequency", "frequency_end", "duration"),
 }
-_DEFAULTS = {"value": 0.0, "amplitude": 0.0, "frequency": 0.0, "duration": 0.0, "times": (), "values": ()}
+_DEFAULTS = {
+    "value": 0.0,
+    "amplitude": 0.0,
+    "frequency": 0.0,
+    "duration": 0.0,
+    "frequency_end": 0.0,
+    "times": (),
+    "values": (),
+}
 
 
 def granule_labels(s: Scenario) -> list[str]:
@@ -181,7 +190,7 @@ def _profile_values(p: str, d: Drive, step_max: float, wave_speed: float) -> Non
     """Durations and frequencies in range, the table's times increasing, and the peak
     speed the drive asks for below the wave speed."""
     speed = 0.0  # the largest speed [m/s] a motion drive asks for
-    if d.profile in ("ramp", "half-sine"):
+    if d.profile in ("ramp", "half-sine", "chirp"):
         if not d.duration > 0.0:
             raise ScenarioError(f"{p}.duration", d.duration, "must be > 0 [s]")
     if d.profile == "constant":
@@ -190,15 +199,20 @@ def _profile_values(p: str, d: Drive, step_max: float, wave_speed: float) -> Non
         speed = abs(d.value) if d.kind == "velocity" else abs(d.value) / d.duration
     elif d.profile == "half-sine":
         speed = abs(d.amplitude) * (1.0 if d.kind == "velocity" else math.pi / d.duration)
-    elif d.profile == "harmonic":
-        f_max = 1.0 / (STEPS_PER_PERIOD * step_max)
-        if not 0.0 < d.frequency <= f_max:
+    elif d.profile == "chirp":
+        if d.kind == "velocity":
             raise ScenarioError(
-                f"{p}.frequency",
-                d.frequency,
-                f"allowed 0 < frequency <= {f_max:.6g} Hz (a period "
-                f"of at least {STEPS_PER_PERIOD} steps of {step_max:g} s)",
+                f"{p}.kind",
+                d.kind,
+                "a chirp prescribes a displacement or a force (its velocity's integral, a Fresnel "
+                'integral, is not computed): use kind = "displacement"',
             )
+        for name in ("frequency", "frequency_end"):
+            _frequency_in_range(f"{p}.{name}", getattr(d, name), step_max)
+        f_top = max(d.frequency, d.frequency_end)
+        speed = 2.0 * math.pi * abs(d.amplitude) * (f_top + abs(d.frequency_end - d.frequency) / 2.0)
+    elif d.profile == "harmonic":
+        _frequency_in_range(f"{p}.frequency", d.frequency, step_max)
         if d.kind == "velocity":
             speed = abs(d.value) + abs(d.amplitude)
         else:
@@ -212,6 +226,7 @@ def _profile_values(p: str, d: Drive, step_max: float, wave_speed: float) -> Non
             "half-sine": "amplitude",
             "harmonic": "amplitude",
             "table": "values",
+            "chirp": "amplitude",
         }[d.profile]
         raise ScenarioError(
             f"{p}.{field}",
@@ -219,6 +234,17 @@ def _profile_values(p: str, d: Drive, step_max: float, wave_speed: float) -> Non
             f"asks for a speed of {speed:.6g} m/s; allowed "
             f"below {wave_speed:.6g} m/s, the slowest elastic wave speed sqrt(E / rho) of the "
             "materials (Hertz's law is quasi-static)",
+        )
+
+
+def _frequency_in_range(path: str, f: float, step_max: float) -> None:
+    """0 < f <= the frequency whose period holds STEPS_PER_PERIOD of the scheme's largest steps."""
+    f_max = 1.0 / (STEPS_PER_PERIOD * step_max)
+    if not 0.0 < f <= f_max:
+        raise ScenarioError(
+            path,
+            f,
+            f"allowed 0 < frequency <= {f_max:.6g} Hz (a period of at least {STEPS_PER_PERIOD} steps of {step_max:g} s)",
         )
 
 

@@ -92,6 +92,7 @@ DRIVE_DEFAULTS: dict[str, Any] = {
     "amplitude": 0.0,
     "frequency": 0.0,
     "duration": 0.0,
+    "frequency_end": 0.0,
     "times": [],
     "values": [],
     "label": "",

@@ -559,7 +559,7 @@ class Solver:
 #: What a drive prescribes along its direction (`Drive.kind`).
 DRIVE_KINDS: tuple[str, ...] = ("displacement", "velocity", "force")
 #: A drive's time profiles (`Drive.profile`; docs/scenario.md, section "Drives").
-DRIVE_PROFILES: tuple[str, ...] = ("constant", "ramp", "half-sine", "harmonic", "table")
+DRIVE_PROFILES: tuple[str, ...] = ("constant", "ramp", "half-sine", "harmonic", "table", "chirp")
 #: How a precompressing wall behaves during the run (Precompression.mode).
 PRECOMPRESSION_MODES: tuple[str, ...] = ("frozen",)
 #: The two kinds of body a drive moves (`Drive.target` = "wall LABEL" or "granule LABEL").
@@ -603,7 +603,9 @@ class Drive:
     "harmonic" (value + amplitude sin(2 pi frequency t)), "table" (linear between the
     points times [s], values; the first value before them, the last after; or read from
     the CSV `file` of two columns, time and value, which the reader turns into times and
-    values). A displacement drive moves its body by P(t) - P(0) from where the scenario
+    values), "chirp" (amplitude sin(phi(t)) over the duration, its frequency swept linearly
+    from `frequency` to `frequency_end` [Hz], held at its last value after; a displacement or
+    a force). A displacement drive moves its body by P(t) - P(0) from where the scenario
     puts it; a velocity drive sets the body's velocity along the direction to P(t) from
     t = 0 on. label: the drive's name in the Dataset (default: the target).
     """
@@ -616,6 +618,7 @@ class Drive:
     amplitude: float = 0.0
     frequency: float = 0.0
     duration: float = 0.0
+    frequency_end: float = 0.0
     times: tuple[float, ...] = ()
     values: tuple[float, ...] = ()
     file: str | None = None
