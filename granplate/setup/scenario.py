@@ -273,7 +273,7 @@ class PouredLayout:
     container: tuple[float, ...] = ()
     wall_material: str = "steel"
     g: tuple[float, ...] = ()
-    settle_tolerance: float = 1e-4
+    settle_tolerance: float = 1e-9
     settle_damping: float = 1.0
     settle_time: float = 2.0
 
