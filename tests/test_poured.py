@@ -67,7 +67,7 @@ def test_settled_packing_carries_its_weight_on_the_floor(store_dir, dimension):
 def test_same_seed_same_packing_and_the_store_is_reused(store_dir, monkeypatch, tmp_path_factory):
     """The same seed settles to the same packing (in a fresh store); a second resolve reads
     the store and does not settle again."""
-    s = poured(2, count=16)
+    s = poured(2, count=10)
     first = resolve(s).granules
     monkeypatch.setattr(pouring, "_SETTLER", [lambda *a: pytest.fail("settled again")])
     again = resolve(dataclasses.replace(s, name="again")).granules
@@ -143,3 +143,13 @@ def test_no_gravity_is_refused():
     with pytest.raises(ScenarioError) as err:
         validate(s)
     assert err.value.field == "layout.g"
+
+
+def test_a_settling_that_does_not_converge_says_so_and_keeps_its_state(store_dir):
+    """Too short a settle_time: refused naming it, with the residual, the state kept."""
+    s = poured(2, count=8)
+    s = dataclasses.replace(s, layout=dataclasses.replace(s.layout, settle_time=1e-4))
+    with pytest.raises(ScenarioError) as err:
+        resolve(s)
+    assert err.value.field == "layout.settle_time" and "kinetic energy / gravity's work" in str(err.value)
+    assert list((store_dir / "poured-partial").glob("*.npz"))

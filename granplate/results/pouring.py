@@ -3,7 +3,7 @@
 `settle(scenario, layout)`: the layout's granules in their loose column
 (`setup.pouring.loose_column`), the container's walls and the pouring gravity make a
 generated scenario of the velocity-Verlet scheme; `simulate` runs it in chunks of
-SETTLE_CHUNK_STEPS steps, each chunk starting from the last one's end state, until the
+`chunk_steps` steps, each chunk starting from the last one's end state, until the
 kinetic energy is at most settle_tolerance x the work gravity has done: first with the
 contact damping alpha_n = settle_damping, then with the scenario's own contact
 coefficients (so that the packing rests with the real material). The settled centres and
@@ -31,8 +31,10 @@ log = logging.getLogger("granplate")
 
 #: Steps per contact duration (Hertz's, at the speed of a fall through the column).
 STEPS_PER_CONTACT = 30
-#: Steps of one chunk of the settling (one progress line each).
-SETTLE_CHUNK_STEPS = 40000
+#: Granule-steps of one chunk of the settling (one progress line each), and the bounds of
+#: its steps.
+CHUNK_GRANULE_STEPS = 20_000_000
+CHUNK_STEPS = (2000, 40000)
 #: Output rows per chunk (the end state is the last).
 CHUNK_OUTPUTS = 4
 
@@ -62,6 +64,11 @@ def _per_layer(lay: PouredLayout, dimension: int, g: tuple[float, ...]) -> int:
     return int(np.prod([max(1, int(size[k] // h)) for k in range(dimension) if k != axis]))
 
 
+def chunk_steps(count: int) -> int:
+    """Steps of one chunk: CHUNK_GRANULE_STEPS / count within CHUNK_STEPS."""
+    return int(min(max(CHUNK_GRANULE_STEPS // max(count, 1), CHUNK_STEPS[0]), CHUNK_STEPS[1]))
+
+
 def loose_scenario(s: Scenario, lay: PouredLayout, alpha_n: float | None) -> Scenario:
     """The generated scenario of the settling: the loose column, the container, the pouring
     gravity, the Verlet scheme at `settling_step`, no plate and no load; alpha_n: the
@@ -86,7 +93,7 @@ def loose_scenario(s: Scenario, lay: PouredLayout, alpha_n: float | None) -> Sce
     if alpha_n is not None:
         contact = dataclasses.replace(contact, alpha_n=alpha_n, pairs=())
     dt = settling_step(s, lay, g)
-    t = dt * SETTLE_CHUNK_STEPS
+    t = dt * chunk_steps(lay.count)
     return Scenario(
         name=f"{s.name}-pouring",
         dimension=s.dimension,
