@@ -387,6 +387,18 @@ PLACING_FIELDS: dict[type, tuple[str, ...]] = {
         "intruder_every",
         "imperfections",
     ),
+    PouredLayout: (
+        "count",
+        "radius_range",
+        "distribution",
+        "sizes",
+        "fractions",
+        "mean",
+        "std",
+        "seed",
+        "container",
+        "g",
+    ),
 }
 
 
@@ -400,7 +412,10 @@ def placing_fields(scenario: Scenario, index: int) -> tuple[str, ...]:
     if lay is None:
         coords = ("x", "y", "z", "radius") if scenario.dimension == 3 else ("x", "y", "radius")
         return tuple(granule_path(scenario.granules_file, index, f, scenario.dimension) for f in coords)
-    primary = "R1" if isinstance(lay, Layout) else "radius"
+    if isinstance(lay, PouredLayout) and isinstance(lay.count, int) and index >= lay.count:  # a striker
+        coords = ("x", "y", "z", "radius") if scenario.dimension == 3 else ("x", "y", "radius")
+        return tuple(f"granules[{index - lay.count}].{f}" for f in coords)
+    primary = {Layout: "R1", PouredLayout: "radius_range"}.get(type(lay), "radius")
     default = type(lay)()
     return tuple(
         f"layout.{f}" for f in PLACING_FIELDS[type(lay)] if f == primary or getattr(lay, f) != getattr(default, f)

@@ -1137,7 +1137,7 @@ def _check_plate_penetration(s: Scenario, named: dict[int, str]) -> None:
     for i, g in enumerate(s.granules):
         if pl.y0 <= g.y <= pl.y0 + pl.height:
             pen = g.x + g.radius - x0
-            if pen > OVERLAP_RTOL * g.radius:
+            if pen > start_overlap(s) * g.radius:
                 raise ScenarioError(
                     _granule(s, i),
                     g.label,
