@@ -154,3 +154,19 @@ def test_a_settling_that_does_not_converge_says_so_and_keeps_its_state(store_dir
         resolve(s)
     assert err.value.field == "layout.settle_time" and "kinetic energy / gravity's work" in str(err.value)
     assert list((store_dir / "poured-partial").glob("*.npz"))
+
+
+def test_poured_protector_example_runs(store_dir):
+    """docs/examples/poured-protector.toml settles, then its striker hits the packing and the
+    plate takes energy while the balance (eq. 11) holds."""
+    from pathlib import Path
+
+    from granplate.results.run import simulate
+    from granplate.setup.io import load_scenario
+
+    s = load_scenario(str(Path(__file__).resolve().parents[1] / "docs" / "examples" / "poured-protector.toml"))
+    with pytest.warns(Warning):  # an 8 m/s steel striker passes the onset of yield, as it says
+        ds = simulate(s, t_end=1.5e-4)
+    striker = list(ds.granule.values).index("striker")
+    assert ds.vx.values[-1, striker] < 0.9 * 8.0
+    assert float(ds.E_plate.max()) > 0.0
