@@ -156,6 +156,7 @@ def test_a_settling_that_does_not_converge_says_so_and_keeps_its_state(store_dir
     assert list((store_dir / "poured-partial").glob("*.npz"))
 
 
+@pytest.mark.slow
 def test_poured_protector_example_runs(store_dir):
     """docs/examples/poured-protector.toml settles, then its striker hits the packing and the
     plate takes energy while the balance (eq. 11) holds."""

@@ -75,7 +75,10 @@ def chunk_steps(count: int) -> int:
 def loose_scenario(s: Scenario, lay: PouredLayout, alpha_n: float | None) -> Scenario:
     """The generated scenario of the settling: the loose column, the container, the pouring
     gravity, the Verlet scheme at `settling_step`, no plate and no load; alpha_n: the
-    contact damping of every pair (None: the scenario's own coefficients)."""
+    contact damping of every pair, without friction (None: the scenario's own coefficients).
+    The regularised friction (mu tanh(k_s v), docs/model.md section 3.2) holds no static
+    load without creeping, so the damped phase settles a frictionless packing, a true
+    equilibrium, which friction at rest (v = 0) leaves one."""
     g = pouring.pour_gravity(s, lay)
     radii = pouring.poured_radii(lay)
     c = pouring.loose_column(lay, s.dimension, g, radii)
@@ -94,7 +97,7 @@ def loose_scenario(s: Scenario, lay: PouredLayout, alpha_n: float | None) -> Sce
     )
     contact = dataclasses.replace(s.contact, overlap_start=None, detection="dynamic")
     if alpha_n is not None:
-        contact = dataclasses.replace(contact, alpha_n=alpha_n, pairs=())
+        contact = dataclasses.replace(contact, alpha_n=alpha_n, mu=0.0, pairs=())
     dt = settling_step(s, lay, g)
     t = dt * chunk_steps(lay.count)
     return Scenario(
