@@ -256,7 +256,7 @@ class PouredLayout:
     wall_material labelled as a [box]'s, and settled under gravity g [m/s^2] (empty: the
     scenario's [gravity]; one of them is needed, along a coordinate axis) until the
     kinetic energy is at most settle_tolerance x the work gravity did, first with the
-    contact damping settle_damping, then with the scenario's own. settle_time [s]: the
+    contact damping settle_damping and no friction, then with the scenario's own. settle_time [s]: the
     longest settling simulated. The settled packing is kept in the run store.
     """
 
