@@ -19,7 +19,7 @@ import numpy as np
 
 from granplate import store
 from granplate.errors import ScenarioError
-from granplate.setup.fields import finite, is_number, positive, string_in
+from granplate.setup.fields import is_number, positive, string_in
 from granplate.setup.scenario import BOX_WALLS, POURED_DISTRIBUTIONS, PouredLayout, Scenario, Wall
 
 #: The run store's kind and format of a settled packing.
@@ -30,6 +30,10 @@ STORE_FORMAT = 1
 CELL_GAP = 0.2
 #: The fractions of a discrete distribution sum to 1 within this.
 FRACTION_TOL = 1e-9
+#: A poured layout's radii [m] (as every layout's: setup.validate.LAYOUT_RADIUS_RANGE).
+RADIUS_RANGE = (1e-9, 1e3)
+#: The container's sides at most this many largest radii (the loose column's cells are counted).
+CONTAINER_MAX = 1e4
 #: The most granules a poured packing may hold.
 COUNT_MAX = 1_000_000
 #: A truncated normal or lognormal draw gives up after this many rounds of redraws.
@@ -52,8 +56,12 @@ def check_poured(s: Scenario, lay: PouredLayout) -> None:
     rr = lay.radius_range
     if not (isinstance(rr, tuple) and len(rr) == 2 and all(is_number(v) for v in rr)):
         raise ScenarioError("layout.radius_range", rr, "must be two numbers [min, max] [m]")
-    positive("layout.radius_range[0]", rr[0])
-    finite("layout.radius_range[1]", rr[1])
+    for k in (0, 1):
+        positive(f"layout.radius_range[{k}]", rr[k])
+        if not RADIUS_RANGE[0] <= rr[k] <= RADIUS_RANGE[1]:
+            raise ScenarioError(
+                f"layout.radius_range[{k}]", rr[k], f"allowed: {RADIUS_RANGE[0]:g} m <= radius <= {RADIUS_RANGE[1]:g} m"
+            )
     if not rr[0] <= rr[1]:
         raise ScenarioError("layout.radius_range", list(rr), "must be [min, max] with min <= max")
     string_in("layout.distribution", lay.distribution, POURED_DISTRIBUTIONS)
@@ -68,6 +76,8 @@ def check_poured(s: Scenario, lay: PouredLayout) -> None:
             raise ScenarioError("layout.container", lay.container, f"must be {s.dimension} lengths [m] (or left out)")
         for k, v in enumerate(lay.container):
             positive(f"layout.container[{k}]", v)
+            if not v <= CONTAINER_MAX * rr[1]:
+                raise ScenarioError(f"layout.container[{k}]", v, f"allowed: <= {CONTAINER_MAX:g} x radius_range[1]")
             if not v >= 2.0 * rr[1]:
                 raise ScenarioError(f"layout.container[{k}]", v, "must hold the largest granule: >= 2 radius_range[1]")
     pour_gravity(s, lay)
