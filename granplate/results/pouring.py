@@ -10,7 +10,8 @@ coefficients (so that the packing rests with the real material). The settled cen
 radii go to the run store (`setup.pouring.STORE_KIND`); a settling that does not converge
 within settle_time keeps what it reached in the store under the kind "poured-partial"
 and stops with the residual kinetic energy and what to change. Importing this module
-registers `settle` with `setup.pouring`.
+registers `settle` with `setup.pouring` (`granplate/__init__.py` does, so every import of
+granplate has it).
 """
 
 from __future__ import annotations

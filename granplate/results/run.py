@@ -15,7 +15,6 @@ from dataclasses import replace
 from granplate.errors import SimulationError, YieldWarning
 from granplate.model.arrays import Model, build_model
 from granplate.results.dataset import to_dataset
-import granplate.results.pouring  # noqa: F401  (registers the settling of poured layouts)
 from granplate.setup.scenario import Scenario
 from granplate.solver.compiling import CompileClock, compile_clock
 from granplate.solver.driver import INTERRUPTED_STATUS, run as run_loop, stop_on_signals

@@ -4,8 +4,8 @@ the loose column the granules are dropped from, and the settled packing read fro
 run store.
 
 The settling itself needs the time loop, a layer above this one: `results.pouring`
-registers it here (`register_settler`) when it is imported, which the command line and
-`results.run` do. `poured_packing` asks the run store first and settles only what it
+registers it here (`register_settler`) when it is imported, which `import granplate`
+(the package's root, and so any import of granplate) does. `poured_packing` asks the run store first and settles only what it
 does not hold.
 """
 
@@ -243,7 +243,7 @@ def settled_arrays(s: Scenario, lay: PouredLayout) -> dict[str, np.ndarray]:
             "layout.kind",
             "poured",
             "the settled packing is not in the run store and no settler is loaded: "
-            "import granplate.results.pouring (the command line does) or run `granplate resolve`",
+            "register one (granplate.results.pouring does when imported, as `import granplate` does)",
         )
     return _SETTLER[0](s, lay)
 
