@@ -16,6 +16,7 @@ from granplate.version import __version__  # noqa: E402,F401
 
 from granplate.errors import GranplateError, ScenarioError, SimulationError  # noqa: E402
 from granplate.setup.materials import LIBRARY, Material  # noqa: E402
+import granplate.results.pouring  # noqa: E402,F401  (registers the settling of poured layouts with setup.pouring)
 from granplate.setup.scenario import (  # noqa: E402
     Contact,
     Granule,

@@ -404,6 +404,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(join_negative_values(parser, sys.argv[1:] if argv is None else list(argv)))
     show_notes(bool(getattr(args, "quiet", False)))
+
     if argv is None:  # this process is the command line's own
         show_warnings()
         if getattr(args, "func", None) is _cmd_run:

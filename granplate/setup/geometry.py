@@ -24,16 +24,18 @@ import threading
 import weakref
 
 from granplate.errors import ScenarioError
-from granplate.setup import layouts
+from granplate.setup import layouts, pouring
 from granplate.setup.granules_file import granule_path
 from granplate.setup.scenario import (
     BOX_WALLS,
     Box,
     ChainLayout,
+    Contact,
     Granule,
     LatticeLayout,
     Layout,
     Plate,
+    PouredLayout,
     RigidPatch,
     Scenario,
     Solid,
@@ -272,8 +274,9 @@ def _expanded(scenario: Scenario) -> Scenario:
     """`resolve`'s work, on every call."""
     granules, walls, plate, load = scenario.granules, scenario.walls, scenario.plate, scenario.load
     xp = 0.0
+    contact = scenario.contact
     if scenario.layout is not None:
-        if granules:
+        if granules and not isinstance(scenario.layout, PouredLayout):
             raise ScenarioError(
                 "granules", f"{len(granules)} granules", "give either [layout] or [[granules]], not both"
             )
@@ -289,11 +292,14 @@ def _expanded(scenario: Scenario) -> Scenario:
                 "[box]",
                 "give either [layout] or [box], not both (a 3D layout generates the walls around it: layout.walls)",
             )
-        granules, walls, xp, column1 = layout_packing(scenario.layout, scenario.dimension)
+        if isinstance(scenario.layout, PouredLayout):
+            granules, walls, xp, contact = _poured(scenario, scenario.layout)
+        else:
+            granules, walls, xp, column1 = layout_packing(scenario.layout, scenario.dimension)
         if isinstance(plate, Plate) and plate.x0 is None:
             plate = dataclasses.replace(plate, x0=xp)
         along_x = scenario.dimension == 2 or along_plus_x(load.direction)
-        if scenario.layout.imperfections is not None and not load.granules and along_x:
+        if getattr(scenario.layout, "imperfections", None) is not None and not load.granules and along_x:
             load = dataclasses.replace(load, granules=column1)
     if isinstance(plate, Solid) and plate.origin is None and plate.mesh is None:
         plate = dataclasses.replace(
@@ -326,7 +332,24 @@ def _expanded(scenario: Scenario) -> Scenario:
             walls, box = walls + box_walls(box), None
     granules = tuple(g if g.label else _relabelled(g, default_granule_label(i)) for i, g in enumerate(granules))
     walls = tuple(w if w.label else dataclasses.replace(w, label=default_wall_label(i)) for i, w in enumerate(walls))
-    return dataclasses.replace(scenario, layout=None, granules=granules, walls=walls, plate=plate, load=load, box=box)
+    return dataclasses.replace(
+        scenario, layout=None, granules=granules, walls=walls, plate=plate, load=load, box=box, contact=contact
+    )
+
+
+def _poured(scenario: Scenario, lay: PouredLayout) -> tuple[tuple[Granule, ...], tuple[Wall, ...], float, Contact]:
+    """A poured layout's settled granules (then the scenario's own [[granules]]: a striker),
+    its walls, the plate's x0 and the [contact] whose overlap_start holds the settled
+    contacts (`pouring.poured_granules`; docs/scenario.md, "Poured packings")."""
+    granules, walls, xp, overlap = pouring.poured_granules(scenario, lay)
+    c = scenario.contact
+    if overlap > 0.0 and c.overlap_start is None:
+        c = dataclasses.replace(c, overlap_start=float(f"{overlap * (1.0 + POURED_OVERLAP_MARGIN):.3e}"))
+    return granules + tuple(scenario.granules), walls, xp, c
+
+
+#: The resolved form of a poured packing allows its settled overlaps plus this share.
+POURED_OVERLAP_MARGIN = 0.01
 
 
 def _relabelled(g: Granule, label: str) -> Granule:
@@ -364,6 +387,18 @@ PLACING_FIELDS: dict[type, tuple[str, ...]] = {
         "intruder_every",
         "imperfections",
     ),
+    PouredLayout: (
+        "count",
+        "radius_range",
+        "distribution",
+        "sizes",
+        "fractions",
+        "mean",
+        "std",
+        "seed",
+        "container",
+        "g",
+    ),
 }
 
 
@@ -377,7 +412,10 @@ def placing_fields(scenario: Scenario, index: int) -> tuple[str, ...]:
     if lay is None:
         coords = ("x", "y", "z", "radius") if scenario.dimension == 3 else ("x", "y", "radius")
         return tuple(granule_path(scenario.granules_file, index, f, scenario.dimension) for f in coords)
-    primary = "R1" if isinstance(lay, Layout) else "radius"
+    if isinstance(lay, PouredLayout) and isinstance(lay.count, int) and index >= lay.count:  # a striker
+        coords = ("x", "y", "z", "radius") if scenario.dimension == 3 else ("x", "y", "radius")
+        return tuple(f"granules[{index - lay.count}].{f}" for f in coords)
+    primary = {Layout: "R1", PouredLayout: "radius_range"}.get(type(lay), "radius")
     default = type(lay)()
     return tuple(
         f"layout.{f}" for f in PLACING_FIELDS[type(lay)] if f == primary or getattr(lay, f) != getattr(default, f)

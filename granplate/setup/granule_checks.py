@@ -12,7 +12,7 @@ import numpy as np
 
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import unit
-from granplate.setup.fields import finite, is_number, material_exists, positive
+from granplate.setup.fields import finite, is_number, material_exists, nonneg, positive
 from granplate.setup.pairs import close_pairs, contact_search_distance, superset_pairs
 from granplate.setup.solid_checks import is_box
 from granplate.setup.materials import Material
@@ -175,18 +175,36 @@ def _check_overlaps(s: Scenario, named: dict[int, str]) -> None:
     """Granules may touch but not overlap at t = 0 (k-d tree over the centres; the
     coordinates are within LENGTH_RANGE x h, so its squared distances cannot overflow)."""
     gs = s.granules
-    for i, j in _overlapping_pairs(gs, s.dimension, s.contact):
+    tol = start_overlap(s)
+    for i, j in _overlapping_pairs(gs, s.dimension, s.contact, tol):
         gi, gj = gs[i], gs[j]
         dist = math.dist(_centre(gi, s.dimension), _centre(gj, s.dimension))
         overlap = gi.radius + gj.radius - dist
-        if overlap > OVERLAP_RTOL * min(gi.radius, gj.radius):
+        if overlap > tol * min(gi.radius, gj.radius):
             raise ScenarioError(
                 _granule(s, i),
                 gi.label,
                 f"{named[i]} overlaps {named[j]} ({_granule(s, j)}) by {overlap:.6g} m at t = 0; "
                 f"granules may touch but not overlap (tolerance "
-                f"{OVERLAP_RTOL:g} x the smaller radius)",
+                f"{tol:g} x the smaller radius, contact.overlap_start)",
             )
+
+
+def start_overlap(s: Scenario) -> float:
+    """The overlap allowed at t = 0, a fraction of the smaller radius [-]: contact.overlap_start
+    (checked here: in [0, contact.overlap_warn]) or OVERLAP_RTOL when it is None."""
+    v = s.contact.overlap_start
+    if v is None:
+        return OVERLAP_RTOL
+    nonneg("contact.overlap_start", v)
+    warn = s.contact.overlap_warn
+    if is_number(warn) and not float(v) <= warn:
+        raise ScenarioError(
+            "contact.overlap_start",
+            v,
+            f"must lie in [0, contact.overlap_warn = {warn:g}] (a fraction of the smaller radius)",
+        )
+    return max(OVERLAP_RTOL, float(v))
 
 
 def _centre(g: Granule, dimension: int) -> tuple[float, ...]:
@@ -212,7 +230,9 @@ DISTANCE_MARGIN = 1e-12
 SHARED_SEARCH_MAX = 1.0
 
 
-def _overlapping_pairs(gs: tuple[Granule, ...], dimension: int = 2, contact=None) -> list[tuple[int, int]]:
+def _overlapping_pairs(
+    gs: tuple[Granule, ...], dimension: int = 2, contact=None, tol: float = OVERLAP_RTOL
+) -> list[tuple[int, int]]:
     """The pairs of `_close_pairs` (sorted) that may overlap beyond the tolerance: those
     whose overlap from numpy's distance comes within DISTANCE_MARGIN of it (the check then
     measures each with math.dist, as for every pair). contact: the scenario's [contact],
@@ -240,7 +260,7 @@ def _overlapping_pairs(gs: tuple[Granule, ...], dimension: int = 2, contact=None
     i, j = pairs[:, 0], pairs[:, 1]
     dist = np.sqrt(((points[j] - points[i]) ** 2).sum(axis=1))
     overlap = r[i] + r[j] - dist
-    may = overlap > OVERLAP_RTOL * np.minimum(r[i], r[j]) - DISTANCE_MARGIN * (r[i] + r[j] + dist)
+    may = overlap > tol * np.minimum(r[i], r[j]) - DISTANCE_MARGIN * (r[i] + r[j] + dist)
     return [tuple(p) for p in pairs[may].tolist()]
 
 
@@ -253,7 +273,7 @@ def _check_wall_penetration(s: Scenario, named: dict[int, str]) -> None:
         for i, g in enumerate(s.granules if _may_cross_wall(s, n, w.offset) else ()):
             depth = g.x * n[0] + g.y * n[1] + (g.z * n[2] if s.dimension == 3 else 0.0)
             pen = depth + g.radius - w.offset
-            if pen > OVERLAP_RTOL * g.radius:
+            if pen > start_overlap(s) * g.radius:
                 raise ScenarioError(
                     _granule(s, i),
                     g.label,
@@ -271,7 +291,7 @@ def _may_cross_wall(s: Scenario, n: tuple[float, ...], offset: float) -> bool:
     x, y, z, r = cols
     depth = x * n[0] + y * n[1] + (z * n[2] if s.dimension == 3 else 0.0)
     with np.errstate(all="ignore"):
-        return not (depth + r - offset <= OVERLAP_RTOL * r).all()
+        return not (depth + r - offset <= start_overlap(s) * r).all()
 
 
 def _check_plate_penetration(s: Scenario, named: dict[int, str]) -> None:
@@ -283,7 +303,7 @@ def _check_plate_penetration(s: Scenario, named: dict[int, str]) -> None:
     for i, g in enumerate(s.granules):
         if pl.y0 <= g.y <= pl.y0 + pl.height:
             pen = g.x + g.radius - x0
-            if pen > OVERLAP_RTOL * g.radius:
+            if pen > start_overlap(s) * g.radius:
                 raise ScenarioError(
                     _granule(s, i),
                     g.label,

@@ -30,6 +30,7 @@ from granplate.setup.layouts import (
     space_sites,
 )
 from granplate.setup.fields import finite, int_at_least, material_exists, nonneg, positive, string_in
+from granplate.setup.pouring import check_poured
 from granplate.setup.scenario import (
     BOX_WALLS,
     LAYOUT_KINDS,
@@ -40,6 +41,7 @@ from granplate.setup.scenario import (
     LatticeLayout,
     Layer,
     Layout,
+    PouredLayout,
     Scenario,
     SpaceLattice,
 )
@@ -70,6 +72,9 @@ def _check_layout(s: Scenario) -> None:
             f"a {type(lay).__name__} must have kind one of "
             + ", ".join(repr(k) for k, c in LAYOUT_KINDS.items() if isinstance(lay, c)),
         )
+    if isinstance(lay, PouredLayout):
+        check_poured(s, lay)
+        return
     if lay.kind == "paper":
         _check_paper_layout(s, lay)
     elif lay.kind == "chain":

@@ -237,6 +237,47 @@ class SpaceLattice:
     imperfections: Imperfections | None = None
 
 
+#: Size distributions of a poured packing (`PouredLayout.distribution`).
+POURED_DISTRIBUTIONS: tuple[str, ...] = ("uniform", "discrete", "normal", "lognormal")
+
+
+@dataclass(frozen=True)
+class PouredLayout:
+    """A poured packing, `kind = "poured"` (2D and 3D; docs/scenario.md, "Poured packings";
+    the settling: docs/model.md section 3.14).
+
+    count granules of `material`, radii drawn with numpy.random.default_rng(seed) from
+    `distribution`: "uniform" in radius_range = [min, max] [m]; "discrete": the radii
+    `sizes` [m] with the number fractions `fractions` (summing to 1); "normal" or
+    "lognormal": the radius' mean and std [m], cut to radius_range (draws outside it are
+    drawn again). They are placed at random (seeded, apart) in a loose column above the
+    floor of a container, the box [0, container] [m] open on the side gravity comes from
+    (empty container: a footprint of ceil(count^(1/d)) largest diameters a side), walls of
+    wall_material labelled as a [box]'s, and settled under gravity g [m/s^2] (empty: the
+    scenario's [gravity]; one of them is needed, along a coordinate axis) until the
+    kinetic energy is at most settle_tolerance x the work gravity did, first with the
+    contact damping settle_damping and no friction, then with the scenario's own. settle_time [s]: the
+    longest settling simulated. The settled packing is kept in the run store.
+    """
+
+    kind: str = "poured"
+    count: int = 100
+    radius_range: tuple[float, float] = (0.001, 0.001)
+    distribution: str = "uniform"
+    sizes: tuple[float, ...] = ()
+    fractions: tuple[float, ...] = ()
+    mean: float | None = None
+    std: float | None = None
+    seed: int = 0
+    material: str = "steel"
+    container: tuple[float, ...] = ()
+    wall_material: str = "steel"
+    g: tuple[float, ...] = ()
+    settle_tolerance: float = 1e-9
+    settle_damping: float = 1.0
+    settle_time: float = 2.0
+
+
 #: `[layout] kind` -> the dataclass that holds that kind's fields.
 LAYOUT_KINDS: dict[str, type] = {
     "paper": Layout,
@@ -244,12 +285,13 @@ LAYOUT_KINDS: dict[str, type] = {
     "square": LatticeLayout,
     "chain": ChainLayout,
     **{k: SpaceLattice for k in SPACE_LATTICE_KINDS},
+    "poured": PouredLayout,
 }
 #: The layout kinds of each dimension (`Scenario.dimension`); a chain is either, and the
 #: planar packings (paper, hexagonal, square) lie in the plane z = 0 in space.
 LAYOUT_KINDS_BY_DIMENSION: dict[int, tuple[str, ...]] = {
-    2: ("paper", "hexagonal", "square", "chain"),
-    3: SPACE_LATTICE_KINDS + ("chain", "paper", "hexagonal", "square"),
+    2: ("paper", "hexagonal", "square", "chain", "poured"),
+    3: SPACE_LATTICE_KINDS + ("chain", "paper", "hexagonal", "square", "poured"),
 }
 
 
@@ -452,7 +494,10 @@ class Contact:
     the initial gap, as a fraction of the smaller radius, of the fixed pairs and of the
     plate contacts (fixed in both modes); overlap_warn, overlap_stop [-]: an overlap beyond
     this fraction of the smaller radius warns (Hertz assumes small overlaps) or stops the
-    run; normal_law: the normal force law of pairs not listed in `pairs` (one of
+    run; overlap_start [-]: the largest overlap of two granules, or of a granule and a
+    wall, allowed at t = 0, a fraction of the smaller radius (None: touching, within
+    round-off; a poured packing's resolved form sets it to hold its settled contacts,
+    at most overlap_warn); normal_law: the normal force law of pairs not listed in `pairs` (one of
     NORMAL_LAWS: "hertz", eq. 2, "thornton", elastic-perfectly plastic, docs/model.md
     section 3.6, or "johnson", elastic-plastic up to the hardness, section 3.10; walls and
     the plate are rigid bodies to it, so a granule-wall or granule-plate contact takes the
@@ -474,6 +519,7 @@ class Contact:
     skin: float = 0.1
     overlap_warn: float = 0.05
     overlap_stop: float = 0.2
+    overlap_start: float | None = None
     normal_law: str = "hertz"
 
     def for_pair(self, a: str, b: str) -> tuple[float, float, float]:
@@ -648,7 +694,7 @@ class Scenario:
     name: str = "custom"
     description: str = ""
     materials: dict[str, Material] = field(default_factory=lambda: dict(LIBRARY))
-    layout: Layout | LatticeLayout | ChainLayout | SpaceLattice | None = None
+    layout: Layout | LatticeLayout | ChainLayout | SpaceLattice | PouredLayout | None = None
     granules: tuple[Granule, ...] = ()
     walls: tuple[Wall, ...] = ()
     plate: Plate | Solid | None = None
