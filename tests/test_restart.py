@@ -74,5 +74,5 @@ def test_mismatched_restart_refused_by_field(plate_runs):
     fewer = dataclasses.replace(r, granules=r.granules[:-1])
     with pytest.raises(ScenarioError, match=r"'granules' = 14: granules; the result has 15"):
         simulate(fewer, start_from=first)
-    with pytest.raises(ScenarioError, match=r"'start.time' = 3e-05.*available: t = 5e-05"):
+    with pytest.raises(ScenarioError, match=r"'from_time' = 3e-05.*available: t = 5e-05"):
         simulate(s, start_from=first, start_time=3e-5)

@@ -53,7 +53,7 @@ def check_restart(ds: xr.Dataset, scenario, time: float | None = None) -> None:
 
     if "restart_time" not in ds.attrs:
         raise ScenarioError(
-            "start.from",
+            "from",
             "a result",
             "holds no restart state (a run that did not finish, or made before restarts were stored)",
         )
@@ -61,7 +61,7 @@ def check_restart(ds: xr.Dataset, scenario, time: float | None = None) -> None:
     if time is not None and not np.isclose(time, t1, rtol=1e-12, atol=0.0):
         span = f"[{float(ds.time[0])!r}, {float(ds.time[-1])!r}] s"
         raise ScenarioError(
-            "start.time",
+            "from_time",
             time,
             f"not a restart time of the result; available: t = {t1!r} s (its last output time; its outputs span {span})",
         )

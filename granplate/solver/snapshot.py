@@ -3,8 +3,8 @@
 
 `capture(arr, lists)`: every array a continued run needs, keyed by a path such as
 "st.y" (the State), "w.ovl" (the shared scratch), "sw.split" or "sw.body.x" (the scheme's
-scratch and the elastic body's state), "p.phi_d" (the plate's modal arrays of this run),
-"g.pair_hist" (the contact lists and each contact's history: largest overlap, rate
+scratch and the elastic body's state), "p.phi_d" (the plate's contact rows of this run;
+its other modal arrays are the model's), "g.pair_hist" (the contact lists and each contact's history: largest overlap, rate
 factor, friction state), "stores.pair_key" / "stores.pair_hist" (the histories of the
 contacts off the lists). The per-level caches (G(h) and the modal coefficients per step
 level) are left out: they are recomputed, to the same numbers, when a level is first used.
@@ -41,8 +41,9 @@ def _store_arrays(store: dict, n_hist: int) -> tuple[np.ndarray, np.ndarray]:
 def capture(arr, lists) -> dict[str, np.ndarray]:
     """The run's state now (module docstring), as arrays keyed by path."""
     out: dict[str, np.ndarray] = {}
-    for prefix, tup in (("st", arr.st), ("w", arr.w), ("sw", arr.sw), ("p", arr.p), ("g", lists.g)):
+    for prefix, tup in (("st", arr.st), ("w", arr.w), ("sw", arr.sw), ("g", lists.g)):
         _flat(prefix, tup, out)
+    out["p.phi_d"], out["p.resid"] = arr.p.phi_d.copy(), arr.p.resid.copy()  # the rest of p: the model's
     n_hist = lists.g.pair_hist.shape[1]
     for name, store in zip(("pair", "wall"), lists.stores):
         out[f"stores.{name}_key"], out[f"stores.{name}_hist"] = _store_arrays(store, n_hist)
