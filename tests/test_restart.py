@@ -33,6 +33,7 @@ def same_end(straight, restarted) -> None:
     """Every output variable at t2 and every stored loop array (State, plate modes,
     contact histories) equal bitwise."""
     assert float(restarted.time[0]) == T1 and float(restarted.time[-1]) == T2
+    assert restarted.attrs["E_initial"] == straight.attrs["E_initial"]  # the balance's E_0: the first run's
     for name, v in straight.data_vars.items():
         if "time" in v.dims and v.dims[0] == "time" and name in restarted:
             a, b = v.isel(time=-1).values, restarted[name].isel(time=-1).values

@@ -94,7 +94,11 @@ def simulate(
 
             if needs_compiling(scenario):
                 compile_kernels()
-        return _simulate(scenario, progress, model, summary_only, clock, start)
+        ds = _simulate(scenario, progress, model, summary_only, clock, start)
+    if start_from is not None:  # the energies go on from the first run's t = 0 (docs/model.md section 7)
+        ds.attrs["E_initial"] = start_from.attrs.get("E_initial", 0.0)
+        ds.attrs["restarted_at"] = float(start_from.attrs["restart_time"])
+    return ds
 
 
 def _simulate(
