@@ -6,7 +6,8 @@
 scratch and the elastic body's state), "p.phi_d" (the plate's contact rows of this run;
 its other modal arrays are the model's), "g.pair_hist" (the contact lists and each contact's history: largest overlap, rate
 factor, friction state), "stores.pair_key" / "stores.pair_hist" (the histories of the
-contacts off the lists). The per-level caches (G(h) and the modal coefficients per step
+contacts off the lists). The elastic body's model arrays (faces, modes, residual
+compliance) are the model's and are not stored; its contact state is. The per-level caches (G(h) and the modal coefficients per step
 level) are left out: they are recomputed, to the same numbers, when a level is first used.
 `restore(snap, arr, lists)`: the same arrays put back in place of a fresh run's.
 """
@@ -19,13 +20,19 @@ from granplate.solver.state import CUSTOM_H
 
 #: per-level caches, recomputed on first use (their `ok` flags are cleared on restore)
 CACHES = frozenset({"w.dmode", "w.gmat", "sw.mcoef", "sw.mmat"})
+#: the elastic body's model arrays (the same in every run of the model: not stored)
+BODY_MODEL = (
+    "face_nodes face_snode node_xyz node_area node_rows node_resid grid grid_origin grid_shape "
+    "cell_start cell_nodes neighbours kind phi omega resid box coef load"
+).split()
+LEFT_OUT = CACHES | {f"sw.body.{name}" for name in BODY_MODEL}
 
 
 def _flat(prefix: str, tup, out: dict[str, np.ndarray]) -> None:
     for name, value in zip(tup._fields, tup):
         key = f"{prefix}.{name}"
         if isinstance(value, np.ndarray):
-            if key not in CACHES:
+            if key not in LEFT_OUT:
                 out[key] = value.copy()
         elif isinstance(value, tuple) and hasattr(value, "_fields"):
             _flat(key, value, out)
