@@ -189,8 +189,20 @@ def _cmd_run(args) -> int:
 
     scenario = load_scenario(args.scenario, parse_settings(args.settings))
     out = Path(args.output) if args.output else Path(f"{scenario.name}.nc")
+    start = None
+    if args.start_from:
+        from granplate.results.dataset import read
+
+        start = read(args.start_from)
     try:
-        ds = simulate(scenario, t_end=args.t_end, progress=not args.quiet, compile_all=compile_all_wanted())
+        ds = simulate(
+            scenario,
+            t_end=args.t_end,
+            progress=not args.quiet,
+            compile_all=compile_all_wanted(),
+            start_from=start,
+            start_time=args.from_time,
+        )
     except SimulationError as err:
         print(f"granplate: run stopped: {err}", file=sys.stderr)
         if err.result is None:
@@ -283,6 +295,19 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--summary", help="also write the summary as JSON to this file")
     r.add_argument("--t-end", type=float, default=None, help="simulated time [s] (overrides the scenario)")
     r.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    r.add_argument(
+        "--from",
+        dest="start_from",
+        metavar="RESULT",
+        default=None,
+        help="restart from this result's last output time (a result netCDF file of the same granules)",
+    )
+    r.add_argument(
+        "--from-time",
+        type=float,
+        default=None,
+        help="the restart time [s] (must be the result's last output time, its stored state)",
+    )
     add_set_option(r)
     r.set_defaults(func=_cmd_run)
     co = sub.add_parser(

@@ -14,6 +14,7 @@ from dataclasses import replace
 
 from granplate.errors import SimulationError, YieldWarning
 from granplate.model.arrays import Model, build_model
+from granplate.results.restart import check_restart, restart_state, with_restart
 from granplate.results.dataset import to_dataset
 from granplate.setup.scenario import Scenario
 from granplate.solver.compiling import CompileClock, compile_clock
@@ -63,6 +64,8 @@ def simulate(
     model: Model | None = None,
     summary_only: bool = False,
     compile_all: bool = False,
+    start_from=None,
+    start_time: float | None = None,
 ):
     """Simulate `scenario` and return an xarray Dataset (see docs/output.md).
 
@@ -75,20 +78,32 @@ def simulate(
     The result's wall_time_s leaves out the seconds numba compiled, which it states as
     compile_time_s. Raises SimulationError (with the partial, whole Dataset in `.result`,
     its `status` attribute saying why) when the run goes numerically wrong or is stopped
-    by SIGINT/SIGTERM (Ctrl-C).
+    by SIGINT/SIGTERM (Ctrl-C). start_from: a result (Dataset) to restart from at its last
+    output time (start_time [s], when given, must be that time; docs/how-to/restart.md):
+    checked against the scenario (results.restart.check_restart) before anything runs.
     """
     if t_end is not None:
         scenario = with_t_end(scenario, t_end)
+    start = None
+    if start_from is not None:
+        check_restart(start_from, scenario, start_time)
+        start = restart_state(start_from)
     with compile_clock() as clock:
         if compile_all:
             from granplate.results.kernels import compile_kernels, needs_compiling
 
             if needs_compiling(scenario):
                 compile_kernels()
-        return _simulate(scenario, progress, model, summary_only, clock)
+        ds = _simulate(scenario, progress, model, summary_only, clock, start)
+    if start_from is not None:  # the energies go on from the first run's t = 0 (docs/model.md section 7)
+        ds.attrs["E_initial"] = start_from.attrs.get("E_initial", 0.0)
+        ds.attrs["restarted_at"] = float(start_from.attrs["restart_time"])
+    return ds
 
 
-def _simulate(scenario: Scenario, progress: bool | None, model: Model | None, summary_only: bool, clock: CompileClock):
+def _simulate(
+    scenario: Scenario, progress: bool | None, model: Model | None, summary_only: bool, clock: CompileClock, start=None
+):
     """simulate's run, its compile seconds counted by clock."""
     t0, c0 = time.perf_counter(), clock.now()
     if model is None:
@@ -97,7 +112,7 @@ def _simulate(scenario: Scenario, progress: bool | None, model: Model | None, su
     if progress is None:
         progress = sys.stderr.isatty()
     with stop_on_signals() as stop_requested:  # a signal after the loop stops building the result
-        rec = run_loop(model, progress=progress)
+        rec = run_loop(model, progress=progress, start=start)
         info = {
             "wall_time_s": time.perf_counter() - t0 - (clock.now() - c0),
             "compile_time_s": clock.now(),
@@ -133,6 +148,8 @@ def _simulate(scenario: Scenario, progress: bool | None, model: Model | None, su
             ),
             clock,
         )
+        if rec.snapshot is not None:
+            ds = with_restart(ds, rec.snapshot)
     yield_note(ds)
     if rec.status != OK or interrupted(ds):
         n = ds.sizes["time"]

@@ -23,7 +23,7 @@ from granplate.model.inputs import DR_REF, DR_S, HIST_MAX, HIST_TIME, no_history
 from granplate.model.contacts import Missed, centre_coordinates, contact_lists, missed_contacts, wall_planes
 from granplate.model.neighbours import verlet_pairs, verlet_walls
 from granplate.physics.contact import plate_overlap
-from granplate.solver import loop, state as S
+from granplate.solver import loop, snapshot, state as S
 from granplate.solver.compiling import compile_calls, compile_seconds, describe_seconds, machine_slowdown
 from granplate.plate.face import patch_weights
 from granplate.solver.interface import set_face_weights
@@ -101,6 +101,7 @@ class RunRecord(NamedTuple):
     info: dict
     contacts: ContactChanges
     body: object = None  # the run's elastic body in space (model.inputs.BodyArrays, its last contact state) or None
+    snapshot: dict | None = None  # the loop's state at the end (solver.snapshot.capture), for a restart
 
 
 def output_times(t_end: float, dt_out: float) -> np.ndarray:
@@ -582,13 +583,22 @@ def progress_bar(total: int, desc: str, file=None):
 
 
 def run(
-    model: Model, *, progress: bool = False, should_stop: Callable[[], bool] | None = None, interruptible: bool = True
+    model: Model,
+    *,
+    progress: bool = False,
+    should_stop: Callable[[], bool] | None = None,
+    interruptible: bool = True,
+    start: dict | None = None,
 ) -> RunRecord:
     """Run the time loop of `model` to its t_end.
 
     progress: a bar on stderr; should_stop: polled between chunks (a stop request);
-    interruptible: SIGINT/SIGTERM stop the run between chunks (main thread only).
+    interruptible: SIGINT/SIGTERM stop the run between chunks (main thread only);
+    start: a restart (solver.snapshot.capture of a run of the same model ended at one of
+    this run's output times t1): the loop goes on from there, its outputs from t1 on.
     """
+    if start is not None:
+        return _run_from(model, start, progress, should_stop, interruptible)
     g, cfg = model.granular, model.config
     times = output_times(cfg.t_end, cfg.out_dt)
     arr = LoopArrays(model, times, len(model.plate_contacts))
@@ -616,6 +626,36 @@ def run(
     loop.start_scheme(arr.sw, st, lists.g, cfg)
     loop.record(0, st, lists.g, arr.p, w, arr.out)
     st.count[S.C_OUT] = 1
+    return _finish(model, times, arr, lists, t1, progress, should_stop, interruptible)
+
+
+def _run_from(model: Model, start: dict, progress: bool, should_stop, interruptible: bool) -> RunRecord:
+    """`run` from a captured state at an output time t1 (its clock): the outputs are the
+    output times from t1 on, the first one the captured state itself."""
+    cfg = model.config
+    all_times = output_times(cfg.t_end, cfg.out_dt)
+    t1 = float(start["st.clock"][S.T_NOW])
+    o1 = int(np.argmin(np.abs(all_times - t1)))
+    times = all_times[o1:]
+    arr = LoopArrays(model, times, len(start["st.normal"]))
+    lists = ContactLists(model)
+    snapshot.restore(start, arr, lists)
+    st = arr.st
+    calls = [
+        (loop.record, (0, st, lists.g, arr.p, arr.w, arr.out)),
+        (loop.advance, (float(times[-1]), FIRST_BUDGET, lists.g, arr.p, cfg, st, arr.w, arr.sw, arr.out)),
+    ]
+    c1 = time.perf_counter()
+    note_compile(model, calls)
+    compile_calls(calls)
+    loop.record(0, st, lists.g, arr.p, arr.w, arr.out)
+    st.count[S.C_OUT] = 1
+    return _finish(model, times, arr, lists, c1, progress, should_stop, interruptible)
+
+
+def _finish(model: Model, times, arr: LoopArrays, lists: ContactLists, t1: float, progress, should_stop, interruptible):
+    """The loop from the first output on (its first call timed from t1 [perf_counter s]),
+    and the run's record."""
     t_first = time.perf_counter() - t1  # includes compiling / loading the loop
     bar = None
     if progress:
@@ -664,6 +704,7 @@ def run(
         info=info,
         contacts=lists.changes(body),
         body=body,
+        snapshot=snapshot.capture(arr, lists) if status == S.OK else None,
     )
 
 

@@ -1,0 +1,84 @@
+"""The loop's whole state at the end of a run, as named arrays, and a run started from it
+(a restart, docs/how-to/restart.md).
+
+`capture(arr, lists)`: every array a continued run needs, keyed by a path such as
+"st.y" (the State), "w.ovl" (the shared scratch), "sw.split" or "sw.body.x" (the scheme's
+scratch and the elastic body's state), "p.phi_d" (the plate's contact rows of this run;
+its other modal arrays are the model's), "g.pair_hist" (the contact lists and each contact's history: largest overlap, rate
+factor, friction state), "stores.pair_key" / "stores.pair_hist" (the histories of the
+contacts off the lists). The elastic body's model arrays (faces, modes, residual
+compliance) are the model's and are not stored; its contact state is. The per-level caches (G(h) and the modal coefficients per step
+level) are left out: they are recomputed, to the same numbers, when a level is first used.
+`restore(snap, arr, lists)`: the same arrays put back in place of a fresh run's.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from granplate.solver.state import CUSTOM_H
+
+#: per-level caches, recomputed on first use (their `ok` flags are cleared on restore)
+CACHES = frozenset({"w.dmode", "w.gmat", "sw.mcoef", "sw.mmat"})
+#: the elastic body's model arrays (the same in every run of the model: not stored)
+BODY_MODEL = (
+    "face_nodes face_snode node_xyz node_area node_rows node_resid grid grid_origin grid_shape "
+    "cell_start cell_nodes neighbours kind phi omega resid box coef load"
+).split()
+LEFT_OUT = CACHES | {f"sw.body.{name}" for name in BODY_MODEL}
+
+
+def _flat(prefix: str, tup, out: dict[str, np.ndarray]) -> None:
+    for name, value in zip(tup._fields, tup):
+        key = f"{prefix}.{name}"
+        if isinstance(value, np.ndarray):
+            if key not in LEFT_OUT:
+                out[key] = value.copy()
+        elif isinstance(value, tuple) and hasattr(value, "_fields"):
+            _flat(key, value, out)
+
+
+def _store_arrays(store: dict, n_hist: int) -> tuple[np.ndarray, np.ndarray]:
+    keys = sorted(store)
+    k = np.array(keys, np.int64).reshape(-1, 2)
+    h = np.array([store[key] for key in keys], float).reshape(-1, n_hist)
+    return k, h
+
+
+def capture(arr, lists) -> dict[str, np.ndarray]:
+    """The run's state now (module docstring), as arrays keyed by path."""
+    out: dict[str, np.ndarray] = {}
+    for prefix, tup in (("st", arr.st), ("w", arr.w), ("sw", arr.sw), ("g", lists.g)):
+        _flat(prefix, tup, out)
+    out["p.phi_d"], out["p.resid"] = arr.p.phi_d.copy(), arr.p.resid.copy()  # the rest of p: the model's
+    n_hist = lists.g.pair_hist.shape[1]
+    for name, store in zip(("pair", "wall"), lists.stores):
+        out[f"stores.{name}_key"], out[f"stores.{name}_hist"] = _store_arrays(store, n_hist)
+    return out
+
+
+def _rebuilt(prefix: str, tup, snap: dict[str, np.ndarray]):
+    values = {}
+    for name, value in zip(tup._fields, tup):
+        key = f"{prefix}.{name}"
+        if key in snap:
+            values[name] = np.array(snap[key], dtype=value.dtype if isinstance(value, np.ndarray) else None)
+        elif isinstance(value, tuple) and hasattr(value, "_fields"):
+            values[name] = _rebuilt(key, value, snap)
+    return tup._replace(**values)
+
+
+def restore(snap: dict[str, np.ndarray], arr, lists) -> None:
+    """Put the captured arrays in place of `arr`'s (a driver.LoopArrays) and `lists`'s
+    (a driver.ContactLists); the per-level caches start empty."""
+    arr.st = _rebuilt("st", arr.st, snap)
+    arr.w = _rebuilt("w", arr.w, snap)
+    arr.sw = _rebuilt("sw", arr.sw, snap)
+    arr.p = _rebuilt("p", arr.p, snap)
+    arr.w.g_ok[:] = 0
+    arr.st.clock[CUSTOM_H] = -1.0  # the odd step's matrices too
+    lists.g = _rebuilt("g", lists.g, snap)
+    lists.stores = tuple(
+        {(int(i), int(j)): np.array(h) for (i, j), h in zip(snap[f"stores.{n}_key"], snap[f"stores.{n}_hist"])}
+        for n in ("pair", "wall")
+    )

@@ -1,0 +1,96 @@
+"""Restart from a result: a run restarted at t1 from a result's stored state and continued
+to t2 equals the run straight to t2 bitwise (granules, energies, the plate's modal state,
+the contacts' histories), with yielding (Thornton) contacts and friction, for the implicit
+scheme with a 2D plate and velocity Verlet in 3D; mismatched restarts are refused by field."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import granplate as gp
+from granplate.errors import ScenarioError
+from granplate.results.dataset import read, write
+from granplate.results.restart import restart_state
+from granplate.results.run import simulate
+from granplate.setup.geometry import resolve
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "docs" / "examples"
+T1, T2 = 5e-5, 1e-4
+
+
+def yielding(example: str, scheme: str) -> gp.Scenario:
+    """The example with Thornton's yielding law, friction mu = 0.3, outputs every 10 us."""
+    text = (EXAMPLES / example).read_text()
+    extra = f'output_interval = 1e-5\n\n[contact]\nnormal_law = "thornton"\nmu = 0.3\n\n[solver]\nscheme = "{scheme}"\n'
+    return gp.loads(text.replace("[time]\nt_end = 1e-4\n", "[time]\nt_end = 1e-4\n" + extra))
+
+
+def same_end(straight, restarted) -> None:
+    """Every output variable at t2 and every stored loop array (State, plate modes,
+    contact histories) equal bitwise."""
+    assert float(restarted.time[0]) == T1 and float(restarted.time[-1]) == T2
+    assert restarted.attrs["E_initial"] == straight.attrs["E_initial"]  # the balance's E_0: the first run's
+    for name, v in straight.data_vars.items():
+        if "time" in v.dims and v.dims[0] == "time" and name in restarted:
+            a, b = v.isel(time=-1).values, restarted[name].isel(time=-1).values
+            np.testing.assert_array_equal(a, b, err_msg=str(name))
+    s0, s1 = restart_state(straight), restart_state(restarted)
+    for key in ("st.y", "st.q", "st.qd", "st.acc", "g.pair_hist", "g.wall_hist", "g.pc_hist"):
+        np.testing.assert_array_equal(s0[key], s1[key], err_msg=key)
+
+
+@pytest.fixture(scope="module")
+def plate_runs(tmp_path_factory):
+    s = yielding("chain.toml", "implicit")
+    first = simulate(s, t_end=T1)
+    path = write(first, tmp_path_factory.mktemp("restart") / "first.nc")
+    return s, simulate(s), first, read(path)
+
+
+def test_implicit_2d_plate_restart_equals_straight_run(plate_runs):
+    s, straight, first, from_file = plate_runs
+    assert float(straight.D_plastic[-1]) > 0.0 and float(straight.D_friction[-1]) > 0.0  # yield, friction
+    same_end(straight, simulate(s, start_from=from_file))
+
+
+@pytest.mark.filterwarnings("ignore:.*overlap_warn")
+def test_verlet_3d_restart_equals_straight_run():
+    s = yielding("3d-chain.toml", "verlet")
+    s = dataclasses.replace(s, load=dataclasses.replace(s.load, force=2000.0))
+    straight = simulate(s)
+    assert float(straight.D_plastic[-1]) > 0.0
+    same_end(straight, simulate(s, start_from=simulate(s, t_end=T1)))
+
+
+def test_mismatched_restart_refused_by_field(plate_runs):
+    s, _, first, _ = plate_runs
+    r = resolve(s)
+    bigger = dataclasses.replace(r, granules=(dataclasses.replace(r.granules[0], radius=0.011), *r.granules[1:]))
+    with pytest.raises(ScenarioError, match=r"granules\[0\]\.radius"):
+        simulate(bigger, start_from=first)
+    fewer = dataclasses.replace(r, granules=r.granules[:-1])
+    with pytest.raises(ScenarioError, match=r"'granules' = 14: granules; the result has 15"):
+        simulate(fewer, start_from=first)
+    with pytest.raises(ScenarioError, match=r"'from_time' = 3e-05.*available: t = 5e-05"):
+        simulate(s, start_from=first, start_time=3e-5)
+
+
+def test_verlet_3d_elastic_body_restart_equals_straight_run_to_round_off():
+    """An fcc packing on an elastic solid (modes and residual compliance), yielding
+    contacts with friction: the restarted run ends where the straight one does to
+    round-off (the body's contact search is re-seeded at the restart: not bitwise)."""
+    text = (EXAMPLES / "3d-fcc-on-plate.toml").read_text()
+    s = gp.loads(text.replace("[solver]\n", '[contact]\nnormal_law = "thornton"\nmu = 0.3\n\n[solver]\n'))
+    straight = simulate(s, t_end=4e-5)
+    restarted = simulate(s, t_end=4e-5, start_from=simulate(s, t_end=2e-5))
+    assert float(straight.D_plastic[-1]) > 0.0 and float(straight.D_friction[-1]) > 0.0
+    for name in ("x", "y", "z", "vx", "vy", "vz", "E_granular", "E_plate", "E_shock", "D_plastic", "D_friction"):
+        a, b = straight[name].isel(time=-1).values, restarted[name].isel(time=-1).values
+        np.testing.assert_allclose(b, a, rtol=0.0, atol=1e-9 * float(np.max(np.abs(a))), err_msg=name)
+    s0, s1 = restart_state(straight), restart_state(restarted)
+    for key in ("st.q", "st.qd", "sw.body.hist"):
+        np.testing.assert_allclose(s1[key], s0[key], rtol=0.0, atol=1e-9 * max(float(np.max(np.abs(s0[key]))), 1e-300))
