@@ -59,3 +59,23 @@ def test_unknown_signal_is_refused_naming_the_allowed_ones():
         spectra.signal(_result(), "wall_force:side")
     with pytest.raises(ScenarioError, match="4 output times"):
         spectra.sample_interval(np.arange(3.0))
+
+
+def test_plot_figure_spectrum_writes_figure_and_csv(tmp_path):
+    """`granplate plot RESULT --figure spectrum --signal --reference` writes PNG, PDF and a CSV whose peak is the sine's."""
+    from granplate.cli import main
+
+    ds = _result()
+    ds.attrs["scenario_name"] = "sine"
+    path = tmp_path / "sine.nc"
+    ds.to_netcdf(path)
+    args = ["plot", str(path), "--figure", "spectrum", "--signal", "wall_force:top", "--reference", "wall_force:bottom"]
+    assert main([*args, "--out", str(tmp_path)]) == 0
+    assert (tmp_path / "sine-spectrum.png").is_file() and (tmp_path / "sine-spectrum.pdf").is_file()
+    data = np.loadtxt(tmp_path / "sine-spectrum.csv", delimiter=",", skiprows=1)
+    k = int(np.argmax(data[:, 1]))
+    assert (
+        data[k, 0] == pytest.approx(ds.attrs["f0"])
+        and data[k, 1] == pytest.approx(0.5)
+        and data[k, 2] == pytest.approx(0.25)
+    )

@@ -485,6 +485,11 @@ def _cmd_plot(args) -> int:
         from granplate.figures.cli import plot_results
 
         return plot_results(args.results, args.out)
+    if args.figure == "spectrum":  # the spectra of any run's recorded signals
+        from granplate.figures.cli import result_paths
+        from granplate.figures.spectrum import plot_spectra
+
+        return plot_spectra(result_paths(args.results), args.signal or [], args.reference, args.out)
     names = list(plots.FIGURES) if args.figure.lower() == "all" else [args.figure]
     for name in names:
         try:
@@ -607,9 +612,24 @@ def register(subparsers) -> None:
     p.add_argument(
         "--figure",
         default=None,
-        help="a paper figure: 3, 4, 5, 6, 7, 8, A1 (or 'all'); without "
+        help="a paper figure: 3, 4, 5, 6, 7, 8, A1 (or 'all'); 'spectrum': the amplitude spectra of "
+        "any result's recorded signals (with --signal, --reference), drawn and written as CSV; without "
         "it: energies, contact forces, stress and strain (a 3D body's: body stress, body contact forces), "
         "granule speeds of each result",
+    )
+    p.add_argument(
+        "--signal",
+        action="append",
+        default=None,
+        metavar="VARIABLE:LABEL",
+        help="--figure spectrum: a signal, e.g. wall_force:bottom or drive_displacement:piston "
+        "(repeatable; default every wall and drive signal)",
+    )
+    p.add_argument(
+        "--reference",
+        default=None,
+        metavar="VARIABLE:LABEL",
+        help="--figure spectrum: the input signal; adds each signal's transmission |X / X_ref|",
     )
     p.add_argument("--out", default=".", help="directory for the PNG and PDF (default .)")
     p.set_defaults(func=_cmd_plot)
