@@ -1,6 +1,6 @@
 """The spectrum figure of a result (`granplate plot RESULT --figure spectrum`): the
 amplitude spectrum of each chosen signal (a) in its units against frequency [kHz], and
-with a reference signal the transmission |X_out / X_ref| (b) [1] on a log scale; the
+with a reference signal the transmission abs(X_out / X_ref) (b) [1] on a log scale; the
 numbers are written beside it as CSV (`granplate.results.spectra`, docs/output.md)."""
 
 from __future__ import annotations

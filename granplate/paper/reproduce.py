@@ -629,7 +629,7 @@ def register(subparsers) -> None:
         "--reference",
         default=None,
         metavar="VARIABLE:LABEL",
-        help="--figure spectrum: the input signal; adds each signal's transmission |X / X_ref|",
+        help="--figure spectrum: the input signal; adds each signal's transmission abs(X / X_ref)",
     )
     p.add_argument("--out", default=".", help="directory for the PNG and PDF (default .)")
     p.set_defaults(func=_cmd_plot)

@@ -9,7 +9,7 @@ a bin frequency reads a (docs/output.md, "Spectra"):
     X(f_k) = (2 / sum_n w_n) |sum_n w_n x_n exp(-2 pi i k n / N)|,  w_n = Hann window,
 
 with its mean removed first (a static preload would otherwise leak into the low bins).
-The transmission between an output and a reference signal is |X_out(f) / X_in(f)| with
+The transmission between an output and a reference signal is abs(X_out(f) / X_in(f)) with
 the same window; bins where the reference is below `floor` times its peak are NaN.
 """
 
@@ -79,7 +79,7 @@ def amplitude_spectrum(x: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray
 
 
 def transmission(x_out: np.ndarray, x_in: np.ndarray, dt: float, floor: float = 1e-3) -> tuple[np.ndarray, np.ndarray]:
-    """Frequencies [Hz] and |X_out / X_in| of two equally sampled signals (same Hann
+    """Frequencies [Hz] and abs(X_out / X_in) of two equally sampled signals (same Hann
     window); NaN where the reference's amplitude is below floor times its peak."""
     f, a_out = amplitude_spectrum(x_out, dt)
     _, a_in = amplitude_spectrum(x_in, dt)
