@@ -749,9 +749,9 @@ def elastic_body_of(ds: xr.Dataset) -> str:
 
 def has_solid(ds: xr.Dataset) -> bool:
     """Whether a result holds a 3D elastic body's fields: its body is a solid
-    (`elastic_body_of`) and its displacement history is stored (a summary-only result keeps
-    the maxima alone)."""
-    return elastic_body_of(ds) == "solid" and "body_q" in ds.variables and "body_ux" in ds.variables
+    (`elastic_body_of`) and its displacement snapshots are stored (a summary-only result
+    keeps the maxima alone)."""
+    return elastic_body_of(ds) == "solid" and "body_ux" in ds.variables
 
 
 def scenario_of(ds: xr.Dataset):

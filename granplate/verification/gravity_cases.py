@@ -198,6 +198,7 @@ CASES: tuple[Case, ...] = (
         "granular",
         "A ball dropped on a floor under gravity: free fall and damped bounce",
         gravity_bounce,
+        slow=True,
         draw=draw_gravity_bounce,
     ),
 )

@@ -234,7 +234,8 @@ def solitary_wave_speed(ctx: Context) -> CaseResult:
             "the case's design",
             max(ratios) / min(ratios),
             10.0,
-            "",
+            "Nesterenko's closed form is to be held over at least a decade of amplitudes, from nearly "
+            "linear waves to strongly nonlinear ones",
             kind="min",
         )
     )
@@ -307,6 +308,7 @@ CASES: tuple[Case, ...] = (
         "granular",
         "Nesterenko's solitary wave in a precompressed chain: speed against amplitude",
         solitary_wave_speed,
+        slow=True,
         draw=draw_solitary_wave_speed,
     ),
 )
