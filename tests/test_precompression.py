@@ -178,3 +178,41 @@ def test_the_struck_chain_example_runs_and_records_its_floor():
     assert float(np.max(np.abs(ds["energy_residual"].values))) <= s.solver.energy_tol
     sm = summary(ds)
     assert sm["eg_max_fraction"] <= sm["e_in_max"] / sm["e_in"] + 1e-6
+
+
+def _spheres(xs, extra=""):
+    body = "".join(f'[[granules]]\nx = {x!r}\ny = {y!r}\nz = 0.0\nradius = 0.005\nmaterial = "steel"\n' for x, y in xs)
+    return gp.loads('name = "paths"\ndimension = 3\n' + body + extra)
+
+
+WALLS = """
+[[walls]]
+label = "floor"
+normal = [-1.0, 0.0, 0.0]
+offset = 0.0
+[[walls]]
+label = "top"
+normal = [1.0, 0.0, 0.0]
+offset = 0.02
+[precompression]
+target = "wall top"
+force = 10.0
+"""
+
+
+def test_a_force_with_no_path_to_a_support_is_refused():
+    """Two spheres pressed by the top wall and touching nothing else: the force has no path to
+    a support, refused naming precompression.target before minimising."""
+    s = _spheres([(0.015, 0.0), (0.005, 0.0)], WALLS.replace("offset = 0.0\n", "offset = 0.05\n", 1))
+    with pytest.raises(ScenarioError, match="no path to a support") as e:
+        build_model(s)
+    assert e.value.field == "precompression.target"
+
+
+def test_granules_that_would_fall_are_refused():
+    """Under gravity, a sphere beside the pressed chain resting on nothing would fall through:
+    refused naming gravity.g."""
+    s = _spheres([(0.005, 0.0), (0.015, 0.0), (0.009, 0.05)], WALLS + "[gravity]\ng = [-9.81, 0.0, 0.0]\n")
+    with pytest.raises(ScenarioError, match="fall through") as e:
+        build_model(s)
+    assert e.value.field == "gravity.g"

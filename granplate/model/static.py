@@ -32,7 +32,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from granplate.errors import SimulationError
+from granplate.errors import ScenarioError, SimulationError
 from granplate.physics.contact import COEF_A
 
 
@@ -130,19 +130,69 @@ def _normal_stiffness(x: np.ndarray, o: float, g, wall: int, free: np.ndarray):
     return coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(size, size)).tocsc()
 
 
+def unsupported_granules(g, wall: int, gravity: bool) -> tuple[np.ndarray, np.ndarray]:
+    """The granules the static state cannot hold, by the contact lists' graph (pairs and
+    wall contacts within the lists' reach): (those in a group of granules touching the target
+    wall but no other wall or held granule: the force has no path to a support; under
+    gravity, those in a group touching no wall and no held granule: they would fall)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    n = len(g.mass)
+    i, j = g.pair_ij[:, 0], g.pair_ij[:, 1]
+    adj = coo_matrix((np.ones(len(i)), (i, j)), shape=(n, n))
+    _, label = connected_components(adj, directed=False)
+    support = np.zeros(n, bool)
+    support[g.wall_i[g.wall_w != wall]] = True
+    support[g.drive_target[g.drive_target >= 0]] = True
+    pushed = np.zeros(n, bool)
+    pushed[g.wall_i[g.wall_w == wall]] = True
+    held_groups = np.unique(label[support])
+    free_group = ~np.isin(label, held_groups)
+    no_path = free_group & np.isin(label, np.unique(label[pushed]))
+    falling = free_group & ~pushed if gravity else np.zeros(n, bool)
+    return np.flatnonzero(no_path), np.flatnonzero(falling)
+
+
 def static_state(
-    g, x0: np.ndarray, wall: int, offset0: float, force: float, tolerance: float = 1e-8, max_iterations: int = 20000
+    g,
+    x0: np.ndarray,
+    wall: int,
+    offset0: float,
+    force: float,
+    tolerance: float = 1e-8,
+    max_iterations: int = 20000,
+    target: str = "",
 ) -> StaticState:
     """The static equilibrium (S2) of the granular arrays g (model.inputs.Granular or
     Granular3) from centres x0 (ng, d) [m], the wall `wall` (index in the scenario's walls,
     offset0 [m] along its unit normal) pushed in with `force` [N]; converged when the largest
-    net force on a granule or on the wall is at most tolerance x force. SimulationError with
-    the residual reached (its `partial` the StaticState) when it does not converge."""
+    net force on a granule or on the wall is at most tolerance x force. ScenarioError naming
+    the field (`target`, the precompression's, or gravity.g) before minimising when the
+    contacts give the force no path to a support or granules would fall (`unsupported_granules`);
+    SimulationError with the residual reached (its `result` the StaticState) when it does not
+    converge."""
     from scipy.optimize import minimize
     from scipy.sparse import identity
     from scipy.sparse.linalg import spsolve
 
     d = x0.shape[1]
+    no_path, falling = unsupported_granules(g, wall, bool(len(g.gravity)) and bool(np.any(g.gravity != 0.0)))
+    if len(no_path):
+        raise ScenarioError(
+            "precompression.target",
+            target or f"wall {wall}",
+            f"its force has no path to a support: granules {', '.join(str(k + 1) for k in no_path[:5])} "
+            "touch it but, through their contacts, no other wall or held granule (close the packing "
+            "against a wall opposite it)",
+        )
+    if len(falling):
+        raise ScenarioError(
+            "gravity.g",
+            list(g.gravity),
+            f"granules {', '.join(str(k + 1) for k in falling[:5])} rest on no wall, directly or through "
+            "their contacts: under gravity they would fall through (give them a floor)",
+        )
     held = np.zeros(len(g.mass), bool)
     held[g.drive_target[g.drive_target >= 0]] = True
     free = ~held
@@ -208,7 +258,7 @@ def precompressed(model):
     rows = g.wall_w == wall
     offset0 = float(g.wall_geo[rows, d][0]) if np.any(rows) else 0.0
     x0 = np.ascontiguousarray(model.initial_state[:, :d])
-    st = static_state(g, x0, wall, offset0, float(p.force), float(p.tolerance), int(p.max_iterations))
+    st = static_state(g, x0, wall, offset0, float(p.force), float(p.tolerance), int(p.max_iterations), str(p.target))
     y0 = model.initial_state.copy()
     y0[:, :d] = st.positions
     geo = g.wall_geo.copy()
