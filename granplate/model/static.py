@@ -52,7 +52,7 @@ class StaticState(NamedTuple):
     wall_force: float
 
 
-def _contact_terms(x: np.ndarray, o: float, g, wall: int):
+def contact_terms(x: np.ndarray, o: float, g, wall: int):
     """Overlaps, forces, slopes and normals of every listed pair and wall contact at centres x
     and target-wall offset o: (pairs: i, j, delta, f, k, n) and (walls: i, delta, f, k, n,
     on_target)."""
@@ -77,7 +77,7 @@ def _contact_terms(x: np.ndarray, o: float, g, wall: int):
 def energy_and_forces(x: np.ndarray, o: float, g, wall: int, force: float):
     """(Pi [J] of (S1), the net force on every granule (ng, d) [N], the net force on the wall
     along its inward normal [N]) at centres x and offset o: minus the gradient of Pi."""
-    (i, j, delta, f, _, n, a), (wi, wdelta, wf, _, wn, on, wa) = _contact_terms(x, o, g, wall)
+    (i, j, delta, f, _, n, a), (wi, wdelta, wf, _, wn, on, wa) = contact_terms(x, o, g, wall)
     mass = g.mass
     grav = np.asarray(g.gravity, float) if len(g.gravity) else np.zeros(x.shape[1])
     e = 0.4 * (np.sum(a * delta**2.5) + np.sum(wa * wdelta**2.5)) - float(np.sum(mass[:, None] * x * grav)) + force * o
@@ -96,7 +96,7 @@ def _normal_stiffness(x: np.ndarray, o: float, g, wall: int, free: np.ndarray):
     Hessian without the transverse geometric terms)."""
     from scipy.sparse import coo_matrix
 
-    (i, j, _, _, k, n, _), (wi, _, _, wk, wn, on, _) = _contact_terms(x, o, g, wall)
+    (i, j, _, _, k, n, _), (wi, _, _, wk, wn, on, _) = contact_terms(x, o, g, wall)
     d = x.shape[1]
     index = -np.ones(len(g.mass), np.int64)
     index[free] = np.arange(int(free.sum()))

@@ -30,7 +30,6 @@ from typing import NamedTuple
 
 import numpy as np
 
-from granplate.physics.contact import COEF_A
 
 #: the most unknowns solved densely (all modes); beyond, the lowest `count` by eigsh
 DENSE_MAX = 3000
@@ -54,17 +53,11 @@ def stiffness_matrix(g, x: np.ndarray):
     (ng d, ng d) matrix [N/m], and the number of contacts in touch."""
     from scipy.sparse import coo_matrix
 
+    from granplate.model.static import contact_terms
+
     d = x.shape[1]
-    i, j = g.pair_ij[:, 0], g.pair_ij[:, 1]
-    dv = x[i] - x[j]
-    dist = np.linalg.norm(dv, axis=1)
-    n = dv / np.where(dist > 0.0, dist, 1.0)[:, None]
-    delta = np.maximum(g.radius[i] + g.radius[j] - dist, 0.0)
-    k = 1.5 * g.pair_coef[:, COEF_A] * np.sqrt(delta)
-    wi = g.wall_i
-    wn = g.wall_geo[:, :d]
-    wdelta = np.maximum(g.radius[wi] + np.einsum("kd,kd->k", x[wi], wn) - g.wall_geo[:, d], 0.0)
-    wk = 1.5 * g.wall_coef[:, COEF_A] * np.sqrt(wdelta)
+    # every wall at its own offset (no wall is the servo's: index -1)
+    (i, j, delta, _, k, n, _), (wi, wdelta, _, wk, wn, _, _) = contact_terms(x, 0.0, g, -1)
     rows, cols, vals = [], [], []
     for p in range(d):
         for q in range(d):
