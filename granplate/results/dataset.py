@@ -602,6 +602,7 @@ SUMMARY_UNITS: dict[str, object] = {
     "max_eps_yy": "1",
     "energy_residual_max": "1",
     "n_steps": "1",
+    "threads": "1",
     "wall_time_s": "s",
     "compile_time_s": "s",
     "max_von_mises_ball": "Pa",
@@ -692,6 +693,7 @@ def summary(ds: xr.Dataset) -> dict:
         "max_eps_yy": float(ds.max_eps_yy.max()) if has_plate and "max_eps_yy" in ds else None,
         "energy_residual_max": float(np.max(np.abs(ds.energy_residual_max))),
         "n_steps": int(info.get("n_steps", 0)),
+        "threads": int(info.get("threads", 1)),  # the loop's threads (solver.threads)
         "wall_time_s": float(info.get("wall_time_s", 0.0)),  # without compile_time_s
         "compile_time_s": float(info.get("compile_time_s", 0.0)),  # numba compiling the kernels first
         # an elastic solid in space: its largest ball-averaged stress and displacement

@@ -131,6 +131,7 @@ def _simulate(
                 "loop_cpu_s",
                 "loop_thread_cpu_s",
                 "n_steps",
+                "threads",
                 "n_iterations",
                 "n_retries",
                 "n_friction_bound",

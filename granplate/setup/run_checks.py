@@ -5,6 +5,7 @@ would write against the machine's memory, the scheme and its granular friction.
 from __future__ import annotations
 
 from granplate.errors import ScenarioError
+from granplate.setup.threads import check_threads
 from granplate.setup.fields import finite, int_at_least, positive, string_in
 from granplate.setup.plate_cost import MEMORY_SHARE, physical_memory
 from granplate.setup.scenario import Solid, Plate, Scenario
@@ -107,6 +108,7 @@ def _check_solver(s: Scenario) -> None:
     positive("solver.energy_tol", sv.energy_tol)
     positive("solver.error_tol", sv.error_tol)
     positive("solver.implicit_dt_max", sv.implicit_dt_max)
+    check_threads(sv.threads)
 
 
 def _check_granular_scheme(s: Scenario) -> None:

@@ -588,7 +588,10 @@ class Solver:
     time.output_interval / 2^k; time.dt_max bounds the "paper" scheme);
     granular_friction: friction at granule-granule and granule-wall contacts, "split"
     (a step too large for RK4 on it takes it apart: exact friction half steps around RK4
-    of the other forces) or "rk4" (always in RK4, the step cut to keep RK4 stable on it).
+    of the other forces) or "rk4" (always in RK4, the step cut to keep RK4 stable on it);
+    threads: how many cores the "verlet" scheme's loop uses (an integer from 1 to the
+    machine's cores; absent: every core for an assembly of at least PARALLEL_MIN_GRANULES
+    granules, else 1; 1: the serial loop; docs/model.md section 6.6).
     """
 
     scheme: str = "implicit"
@@ -600,6 +603,7 @@ class Solver:
     error_tol: float = 1e-3
     implicit_dt_max: float = 1e-6
     granular_friction: str = "split"
+    threads: int | None = None
 
 
 #: What a drive prescribes along its direction (`Drive.kind`).

@@ -17,7 +17,7 @@ from __future__ import annotations
 from numba.extending import overload
 
 from granplate.model.inputs import Granular, Granular3
-from granplate.solver import granular as plane, granular3d as space
+from granplate.solver import blocks, granular as plane, granular3d as space
 
 _MODULES = {Granular: plane, Granular3: space}
 
@@ -40,6 +40,12 @@ def friction_flow(y, dt, g, cfg, forward):
 def normal_forces(t, y, g, cfg, acc, fdamp, fload):
     """The velocity-Verlet force pass: shock and normal forces alone, the damping force and
     load of each granule apart (solver.granular.normal_forces)."""
+    raise NotImplementedError("compiled use only")
+
+
+def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
+    """The velocity-Verlet force pass with the granule pairs in blocks on every core
+    (solver.blocks) in space; the plane's serial pass (its pairs are not cut into blocks)."""
     raise NotImplementedError("compiled use only")
 
 
@@ -84,6 +90,16 @@ def _normal_forces(t, y, g, cfg, acc, fdamp, fload):
     if m is not None:
         fn = m.normal_forces
         return lambda t, y, g, cfg, acc, fdamp, fload: fn(t, y, g, cfg, acc, fdamp, fload)
+
+
+@overload(normal_forces_blocks, inline="always")
+def _normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
+    if _module_of(g) is plane:
+        fn = plane.normal_forces
+        return lambda t, y, g, cfg, acc, fdamp, fload, fpar, spar: fn(t, y, g, cfg, acc, fdamp, fload)
+    if _module_of(g) is space:
+        fb = blocks.normal_forces_blocks
+        return lambda t, y, g, cfg, acc, fdamp, fload, fpar, spar: fb(t, y, g, cfg, acc, fdamp, fload, fpar, spar)
 
 
 @overload(plate_friction_held, inline="always")

@@ -58,20 +58,26 @@ def contact_peaks(g, stores: tuple[dict, dict], body=None) -> ContactPeaks:
     """The ContactPeaks of the lists of g (pairs, walls, plate contacts), of the histories
     off the lists (stores: pairs by (i, j), walls by (i, wall)) and of each granule's
     contact on an elastic body in space (body: BodyArrays, partner PARTNER_PLATE)."""
-    rows = [(int(i), int(j), h) for (i, j), h in zip(g.pair_ij, g.pair_hist)]
+    parts = [(g.pair_ij[:, 0], g.pair_ij[:, 1], g.pair_hist)]
     if body is not None:
-        rows += [(int(i), S.PARTNER_PLATE, h) for i, h in enumerate(body.hist)]
-    rows += [(int(i), -1 - int(w), h) for i, w, h in zip(g.wall_i, g.wall_w, g.wall_hist)]
-    rows += [(int(i), S.PARTNER_PLATE, h) for i, h in zip(g.pc_i, g.pc_hist)]
-    rows += [(i, j, h) for (i, j), h in stores[0].items()]
-    rows += [(i, -1 - w, h) for (i, w), h in stores[1].items()]
-    rows = [r for r in rows if r[2][HIST_MAX] > 0.0]
-    return ContactPeaks(
-        granule=np.array([r[0] for r in rows], np.int64),
-        partner=np.array([r[1] for r in rows], np.int64),
-        delta_max=np.array([r[2][HIST_MAX] for r in rows], float),
-        time=np.array([r[2][HIST_TIME] for r in rows], float),
-    )
+        parts.append((np.arange(len(body.hist)), np.full(len(body.hist), S.PARTNER_PLATE), body.hist))
+    parts.append((g.wall_i, -1 - g.wall_w, g.wall_hist))
+    parts.append((g.pc_i, np.full(len(g.pc_i), S.PARTNER_PLATE), g.pc_hist))
+    for store, sign in ((stores[0], 1), (stores[1], -1)):
+        if store:
+            k = np.array(list(store), np.int64).reshape(-1, 2)
+            parts.append((k[:, 0], k[:, 1] if sign > 0 else -1 - k[:, 1], np.array(list(store.values()))))
+    granule = np.concatenate([np.asarray(a, np.int64) for a, _, _ in parts])
+    partner = np.concatenate([np.asarray(b, np.int64) for _, b, _ in parts])
+    peak = np.concatenate([_column(h, len(a), HIST_MAX) for a, _, h in parts])
+    when = np.concatenate([_column(h, len(a), HIST_TIME) for a, _, h in parts])
+    on = peak > 0.0
+    return ContactPeaks(granule=granule[on], partner=partner[on], delta_max=peak[on], time=when[on])
+
+
+def _column(h, n: int, c: int) -> np.ndarray:
+    """Column c of n history rows h (none: an empty column)."""
+    return np.asarray(h, float).reshape(n, -1)[:, c] if n else np.zeros(0)
 
 
 class ContactChanges(NamedTuple):
@@ -318,9 +324,10 @@ class LoopArrays:
             for k, y_k in enumerate(model.plate.contact_y[:nk]):
                 first, last = patch_weights(p.face_y, float(y_k), 0.0, self.w.wface)
                 set_face_weights(k, first, last, self.w)
-        self.sw = scheme(cfg.scheme).new_scratch(ng, nm, nk, body=model.body)
+        self.sw = scheme(cfg.scheme).new_scratch(ng, nm, nk, body=model.body, threads=cfg.threads)
         self.out = S.new_output(times, ng, nm, nk, nc, len(g.wall_load), len(g.drive_target))
         self.scheme = cfg.scheme
+        self.sw_threads = cfg.threads
 
     def grow(self, nk_new: int) -> None:
         """Room for nk_new plate contacts: every array reallocated with the old values
@@ -331,7 +338,7 @@ class LoopArrays:
         nc = st.y.shape[1]
         self.st = _copied(st, S.new_state(ng, nm, nk_new, nc))
         self.w = _copied(w, S.new_work(ng, nm, nk_new, len(w.wface), nc))
-        self.sw = _copied(self.sw, scheme(self.scheme).new_scratch(ng, nm, nk_new))
+        self.sw = _copied(self.sw, scheme(self.scheme).new_scratch(ng, nm, nk_new, threads=self.sw_threads))
         self.out = _copied(
             self.out,
             S.new_output(self.out.target, ng, nm, nk_new, nc, self.out.wall_force.shape[1], self.out.drive.shape[1]),
@@ -664,7 +671,7 @@ def _finish(model: Model, times, arr: LoopArrays, lists: ContactLists, t1: float
     t2 = time.perf_counter()
     c2, c3 = time.process_time(), time.thread_time()
     try:
-        with stop_on_signals() if interruptible else _never() as signalled:
+        with stop_on_signals() if interruptible else _never() as signalled, numba_threads(model.config.threads):
             status = _loop_chunks(
                 times,
                 model,
@@ -683,6 +690,7 @@ def _finish(model: Model, times, arr: LoopArrays, lists: ContactLists, t1: float
         "loop_cpu_s": time.process_time() - c2,
         "loop_thread_cpu_s": time.thread_time() - c3,
         "n_steps": int(st.count[S.C_STEPS]),
+        "threads": int(model.config.threads),
         "n_iterations": int(st.count[S.C_ITERS]),
         "n_retries": int(st.count[S.C_RETRIES]),
         "n_friction_bound": int(st.count[S.C_FRICTION_BOUND]),
@@ -706,6 +714,23 @@ def _finish(model: Model, times, arr: LoopArrays, lists: ContactLists, t1: float
         body=body,
         snapshot=snapshot.capture(arr, lists) if status == S.OK else None,
     )
+
+
+@contextmanager
+def numba_threads(n: int):
+    """Numba's parallel loops on n threads inside the block (solver.blocks), the count
+    before restored after it; 1: nothing changes (the serial loop starts no thread)."""
+    if n <= 1:
+        yield
+        return
+    import numba
+
+    before = numba.get_num_threads()
+    numba.set_num_threads(n)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(before)
 
 
 @contextmanager

@@ -367,13 +367,19 @@ def commit_history(t, hist, coef):
     where its largest overlap first passes the rate-free yield overlap: its rate factor
     Y(rate) / Y (`cavity.rate_factor`) at `fixing_speed`."""
     for k in range(hist.shape[0]):
-        d = hist[k, HIST_END]
-        if d > hist[k, HIST_MAX]:
-            if hist[k, HIST_RATE] == 0.0 and coef[k, COEF_SY] > 0.0 and d > coef[k, COEF_DY]:
-                v = fixing_speed(d, hist[k, HIST_MAX], t, hist[k, HIST_TIME])
-                hist[k, HIST_RATE] = rate_factor(v, coef[k, COEF_RC], coef[k, COEF_RL])
-            hist[k, HIST_MAX] = d
-            hist[k, HIST_TIME] = t
+        commit_history_row(t, hist, coef, k)
+
+
+@njit(cache=True)
+def commit_history_row(t, hist, coef, k):
+    """`commit_history` of contact k alone."""
+    d = hist[k, HIST_END]
+    if d > hist[k, HIST_MAX]:
+        if hist[k, HIST_RATE] == 0.0 and coef[k, COEF_SY] > 0.0 and d > coef[k, COEF_DY]:
+            v = fixing_speed(d, hist[k, HIST_MAX], t, hist[k, HIST_TIME])
+            hist[k, HIST_RATE] = rate_factor(v, coef[k, COEF_RC], coef[k, COEF_RL])
+        hist[k, HIST_MAX] = d
+        hist[k, HIST_TIME] = t
 
 
 @njit(cache=True)

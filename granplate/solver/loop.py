@@ -14,6 +14,7 @@ from numba import njit
 
 from granplate.physics.energy import energy_residual, energy_total
 from granplate.solver import schemes as S
+from granplate.solver.blocks import accept_rows, commit_histories_blocks
 from granplate.solver.contacts import watch_contacts
 from granplate.solver.dimension import granular_rhs, kinetic_energies
 from granplate.solver.granular import commit_histories
@@ -288,15 +289,17 @@ def needs_matrices(h, slot, clock, g_ok):
 
 
 @njit(cache=True)
-def accept_granular(t, h, land, t_out, plate_work, e_pot, st, w):
-    """Take the trial step's granule state, derivatives and work (with the plastic work of
-    the contacts loaded past their largest overlaps) into the state and move the clock
-    (onto the output time when the step lands on it)."""
-    for i in range(st.y.shape[0]):
-        for c in range(st.y.shape[1]):
-            st.y[i, c] = w.ynew[i, c]
-            st.k0[i, c] = st.k1[i, c]
-            st.k1[i, c] = w.kend[i, c]
+def accept_granular(t, h, land, t_out, plate_work, e_pot, st, w, rows):
+    """Take the trial step's granule state, derivatives (unless `rows` is False: taken
+    already) and work (with the plastic work of the contacts loaded past their largest
+    overlaps) into the state and move the clock (onto the output time when the step lands
+    on it)."""
+    if rows:
+        for i in range(st.y.shape[0]):
+            for c in range(st.y.shape[1]):
+                st.y[i, c] = w.ynew[i, c]
+                st.k0[i, c] = st.k1[i, c]
+                st.k1[i, c] = w.kend[i, c]
     for c in range(5):
         st.p1[c] = w.pend[c]
     st.acc[A_SHOCK_G] += w.dacc[0]
@@ -352,8 +355,13 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
             st.count[C_LEVEL] = retry
             continue
         plate_work = S.commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w)
-        accept_granular(t, h, land, out.target[o], plate_work, e_pot, st, w)
-        commit_histories(st.clock[T_NOW], g)
+        if cfg.threads > 1:  # the copies and the pairs' histories on every core (solver.blocks)
+            accept_rows(st.y, st.k0, st.k1, w.ynew, w.kend)
+            accept_granular(t, h, land, out.target[o], plate_work, e_pot, st, w, False)
+            commit_histories_blocks(st.clock[T_NOW], g)
+        else:
+            accept_granular(t, h, land, out.target[o], plate_work, e_pot, st, w, True)
+            commit_histories(st.clock[T_NOW], g)
         lam_max = accept_contacts(
             h, w.gmat[slot], g.pc_coef, w.normal_new, w.slip_new, w.conv_iter, st.normal, st.slip, w.lam_int, w.it_int
         )

@@ -25,7 +25,10 @@ BODY_MODEL = (
     "face_nodes face_snode node_xyz node_area node_rows node_resid grid grid_origin grid_shape "
     "cell_start cell_nodes neighbours kind phi omega resid box coef load"
 ).split()
-LEFT_OUT = CACHES | {f"sw.body.{name}" for name in BODY_MODEL}
+#: the threaded passes' block buffers (solver.blocks: rewritten by every force pass, and
+#: sized by the thread count, which a restart may change)
+BLOCKS = frozenset({"sw.fpar", "sw.spar"})
+LEFT_OUT = CACHES | BLOCKS | {f"sw.body.{name}" for name in BODY_MODEL}
 
 
 def _flat(prefix: str, tup, out: dict[str, np.ndarray]) -> None:

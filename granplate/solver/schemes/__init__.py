@@ -1,7 +1,7 @@
 """The coupling schemes, one module each, behind one interface, and their registry.
 
 A scheme module defines NAME, a `Scratch` named tuple (its own scratch arrays),
-`new_scratch(ng, nm, nk, body=None)`, and nine compiled hooks, each taking its Scratch first:
+`new_scratch(ng, nm, nk, body=None, threads=1)`, and nine compiled hooks, each taking its Scratch first:
 
     plan(sw, count, cfg, pos, rem) -> (level, h, slot, land)
     prepare_level(sw, h, p, slot)

@@ -84,7 +84,7 @@ class Scratch(NamedTuple):
     qdn: np.ndarray
 
 
-def new_scratch(ng: int, nm: int, nk: int, body=None) -> Scratch:
+def new_scratch(ng: int, nm: int, nk: int, body=None, threads: int = 1) -> Scratch:
     """Scratch for ng granules, nm modes, nk plate contacts."""
     nd = 2 * nk
     z = np.zeros

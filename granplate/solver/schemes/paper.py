@@ -37,7 +37,7 @@ class Scratch(NamedTuple):
     qdd_star: np.ndarray  # (nm,) known part of the modal acceleration at t + h
 
 
-def new_scratch(ng: int, nm: int, nk: int, body=None) -> Scratch:
+def new_scratch(ng: int, nm: int, nk: int, body=None, threads: int = 1) -> Scratch:
     """Scratch for ng granules, nm modes, nk plate contacts."""
     nd = 2 * nk
     return Scratch(astar=np.zeros(nd), anext=np.zeros(nd), aavg=np.zeros(nd), qdd_star=np.zeros(nm))

@@ -35,7 +35,8 @@ from granplate.model.inputs import STATE_COLUMNS, BodyArrays, new_body_state, no
 from granplate.physics.contact import COEF_MU
 from granplate.physics.shock import time_profile
 from granplate.solver import body as B
-from granplate.solver.dimension import friction_flow, normal_forces
+from granplate.solver.blocks import N_FPAR, N_SPAR, copy_rows, kick_blocks, kick_drift_blocks
+from granplate.solver.dimension import friction_flow, normal_forces, normal_forces_blocks
 from granplate.solver.drives import (
     drive_kick_work,
     finish_pass,
@@ -72,15 +73,26 @@ class Scratch(NamedTuple):
     fload: np.ndarray  # (2, ng, N_COLUMNS) shock load on each granule [N, N m]
     split: np.ndarray  # (5,) OWED, FORWARD, LAND, STARTED, CURRENT
     body: BodyArrays  # the elastic body in space and this run's contacts on it (no faces: none)
+    fpar: np.ndarray  # (nb, ng, N_FPAR) each block's forces on the granules [N] (solver.blocks; (0, 0, 0): serial)
+    spar: np.ndarray  # (nb, N_SPAR) each block's sums (solver.blocks)
 
 
-def new_scratch(ng: int, nm: int, nk: int, body: BodyArrays | None = None) -> Scratch:
+def new_scratch(ng: int, nm: int, nk: int, body: BodyArrays | None = None, threads: int = 1) -> Scratch:
     """Scratch for ng granules and nm modes (nk plate contacts: none are used), with this
-    run's own copy of the elastic body's contact state (body None: no body)."""
+    run's own copy of the elastic body's contact state (body None: no body), and the
+    buffers of `threads` blocks (solver.blocks) when it is over 1."""
     split = np.zeros(5)
     split[FORWARD] = 1.0
     b = no_body(ng, nm) if body is None else new_body_state(body)
-    return Scratch(fdamp=np.zeros((2, ng, N_COLUMNS)), fload=np.zeros((2, ng, N_COLUMNS)), split=split, body=b)
+    nb = threads if threads > 1 else 0
+    return Scratch(
+        fdamp=np.zeros((2, ng, N_COLUMNS)),
+        fload=np.zeros((2, ng, N_COLUMNS)),
+        split=split,
+        body=b,
+        fpar=np.zeros((nb, ng if nb else 0, N_FPAR)),
+        spar=np.zeros((nb, N_SPAR)),
+    )
 
 
 @njit(cache=True)
@@ -157,6 +169,15 @@ def kick(y, acc, fdamp, fload, hk, dy):
 
 
 @njit(cache=True)
+def force_pass(t, y, g, cfg, acc, fdamp, fload, sw):
+    """The force pass at (t, y): in blocks on every core when the scratch has blocks
+    (solver.blocks), else serially. Returns the ForceSums."""
+    if sw.spar.shape[0] > 0:
+        return normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar)
+    return normal_forces(t, y, g, cfg, acc, fdamp, fload)
+
+
+@njit(cache=True)
 def body_pass(y, sw, buf, q, qd, g, cfg, acc, fdamp):
     """The elastic body's contact forces at (y, q, qd) into buffer buf (solver.body),
     added to the granules' accelerations acc and damping forces fdamp; returns (their
@@ -186,9 +207,12 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
     over h between them (into sw.body.q, qd, committed by `commit`). Always converged, one
     force pass. Returns (True, 1, -1, stored energy at t + h [J], 0)."""
     y = w.ynew
-    for i in range(y.shape[0]):
-        for c in range(y.shape[1]):
-            y[i, c] = st.y[i, c]
+    if sw.spar.shape[0] > 0:
+        copy_rows(y, st.y)
+    else:
+        for i in range(y.shape[0]):
+            for c in range(y.shape[1]):
+                y[i, c] = st.y[i, c]
     b = sw.body
     body = B.has_body(b)
     if body:
@@ -198,7 +222,7 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
     cur = int(sw.split[CURRENT])
     nxt = 1 - cur
     if sw.split[STARTED] == 0.0:  # the first step: t_n's forces, loads and damping (st.k1 as `initialise` has it)
-        normal_forces(t, st.y, g, cfg, st.k1, sw.fdamp[cur], sw.fload[cur])
+        force_pass(t, st.y, g, cfg, st.k1, sw.fdamp[cur], sw.fload[cur], sw)
         if body:
             body_pass(st.y, sw, cur, st.q, st.qd, g, cfg, st.k1, sw.fdamp)
         finish_pass(st.y, st.k1, g)
@@ -215,14 +239,17 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
             )
     w_drive = drive_kick_work(y, st.k1, g, hk)
     w_grav = gravity_kick_work(y, st.k1, g, hk)
-    wl, wd = kick_drift(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp)
+    if sw.spar.shape[0] > 0:
+        wl, wd = kick_drift_blocks(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, sw.spar)
+    else:
+        wl, wd = kick_drift(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp)
     if body:
         if cfg.load_on_plate:
             wl += B.load_kick(b.qd, b.load, cfg.q0 * time_profile(t, cfg.duration), hk)
         wd += B.kick(b.qd, b.fmodal[cur], b.fdamp[cur], hk)
         B.turn(b.q, b.qd, b.omega, h)
         B.predicted_velocity(b, hk, cur)
-    pr = normal_forces(t + h, w.ytmp, g, cfg, w.kend, sw.fdamp[nxt], sw.fload[nxt])
+    pr = force_pass(t + h, w.ytmp, g, cfg, w.kend, sw.fdamp[nxt], sw.fload[nxt], sw)
     e_pot = pr.e_pot
     p_visc = pr.p_visc
     w_plastic = pr.w_plastic
@@ -242,7 +269,10 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
     _, pd1 = wall_powers(g)
     w_drive += drive_kick_work(y, w.kend, g, hk)
     w_grav += gravity_kick_work(y, w.kend, g, hk)
-    wl2, wd2 = kick(y, w.kend, sw.fdamp[nxt], sw.fload[nxt], hk, w.kend)
+    if sw.spar.shape[0] > 0:
+        wl2, wd2 = kick_blocks(y, w.kend, sw.fdamp[nxt], sw.fload[nxt], hk, w.kend, N_DRIFT, sw.spar)
+    else:
+        wl2, wd2 = kick(y, w.kend, sw.fdamp[nxt], sw.fload[nxt], hk, w.kend)
     if body:
         wd2 += B.kick(b.qd, b.fmodal[nxt], b.fdamp[nxt], hk)
         if cfg.load_on_plate:

@@ -1,0 +1,317 @@
+"""The velocity-Verlet passes on every core (`solver.threads`, docs/model.md section 6.6):
+the contacts and the granules cut into `nb` fixed blocks, one per thread, each block's
+forces and sums kept apart and then added in block order.
+
+Each block k takes the contiguous range `block_range(k, nb, n)` of the pair list (or of
+the granules), whatever thread runs it, and writes only its own slice of the buffers
+(`fpar[k]`, `spar[k]`), so a run is bitwise the same for a given number of blocks however
+the threads are scheduled, and it differs from the serial loop (`solver.threads = 1`,
+solver.granular3d.normal_forces) only by the order in which each granule's contact forces
+and the energy sums are added: round-off. The contact laws, the overlaps and the largest
+overlap (its first occurrence in pair order, as the serial pass finds it) are the same
+numbers. The wall contacts, few beside the pairs, run serially after the blocks, in the
+serial order, because a wall's load and a driven wall's force are shared sums.
+
+Numba's parallel loops (`prange`) run the blocks; numba's thread count is set by the driver
+(`numba.set_num_threads`) for the run.
+"""
+
+from __future__ import annotations
+
+from numba import njit, prange
+
+from granplate.model.inputs import HIST_END, HIST_MAX, HIST_RATE
+from granplate.physics.laws import normal_law_response
+from granplate.physics.shock import time_profile
+from granplate.physics.space import normal_rate_3d, pair_contact_3d, wall_overlap_3d
+from granplate.solver.drives import begin_pass, book_wall, wall_motion
+from granplate.solver.granular import ForceSums, commit_history, commit_history_row
+
+#: columns of a block's buffer row fpar[k, i]: the normal force on granule i (x, y, z) [N]
+#: and its damping part (x, y, z) [N].
+F_X, F_DX = 0, 3
+N_FPAR = 6
+#: columns of a block's sums spar[k]: viscous power [W], stored energy [J], plastic work
+#: [J], the largest overlap / smaller radius [-], its granule and its partner (as floats),
+#: and the kicks' load and damping work [J].
+S_VISC, S_EPOT, S_PLASTIC, S_OVL, S_OVL_I, S_OVL_J, S_WLOAD, S_WDAMP = range(8)
+N_SPAR = 8
+
+
+@njit(cache=True)
+def block_range(k, nb, n):
+    """The items [lo, hi) of block k of nb over n items (contiguous, sizes within one)."""
+    return (k * n) // nb, ((k + 1) * n) // nb
+
+
+@njit(cache=True, parallel=True)
+def pair_forces_blocks(y, g, cfg, fpar, spar):
+    """The normal forces of every listed granule pair at state y (space), block by block:
+    block k's pairs' forces on their granules into fpar[k] (zeroed first), its viscous
+    power, stored energy, plastic work and largest overlap into spar[k]; each pair's
+    overlap into HIST_END (as solver.granular3d.normal_forces)."""
+    nb = fpar.shape[0]
+    n_p = g.pair_ij.shape[0]
+    ng = y.shape[0]
+    for k in prange(nb):
+        f = fpar[k]
+        for i in range(ng):
+            for c in range(N_FPAR):
+                f[i, c] = 0.0
+        p_visc = 0.0
+        e_pot = 0.0
+        w_plastic = 0.0
+        ovl = 0.0
+        ovl_i = -1
+        ovl_j = -1
+        lo, hi = block_range(k, nb, n_p)
+        for p in range(lo, hi):
+            i = g.pair_ij[p, 0]
+            j = g.pair_ij[p, 1]
+            ri = g.radius[i]
+            rj = g.radius[j]
+            g.pair_hist[p, HIST_END] = 0.0
+            delta, nx, ny, nz = pair_contact_3d(y[i, 0], y[i, 1], y[i, 2], ri, y[j, 0], y[j, 1], y[j, 2], rj)
+            if delta <= 0.0:
+                continue
+            g.pair_hist[p, HIST_END] = delta
+            if delta > ovl * min(ri, rj):
+                ovl = delta / min(ri, rj)
+                ovl_i = i
+                ovl_j = j
+            ddot = normal_rate_3d(y[i, 3] - y[j, 3], y[i, 4] - y[j, 4], y[i, 5] - y[j, 5], nx, ny, nz)
+            n, pv, ep, wp = normal_law_response(
+                delta, ddot, g.pair_coef[p], g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip
+            )
+            w_plastic += wp
+            p_visc += pv
+            e_pot += ep
+            f[i, F_X] -= n * nx
+            f[i, F_X + 1] -= n * ny
+            f[i, F_X + 2] -= n * nz
+            f[j, F_X] += n * nx
+            f[j, F_X + 1] += n * ny
+            f[j, F_X + 2] += n * nz
+            if pv != 0.0:  # the damping part of |N|, pv / ddot
+                d = pv / ddot
+                f[i, F_DX] -= d * nx
+                f[i, F_DX + 1] -= d * ny
+                f[i, F_DX + 2] -= d * nz
+                f[j, F_DX] += d * nx
+                f[j, F_DX + 1] += d * ny
+                f[j, F_DX + 2] += d * nz
+        spar[k, S_VISC] = p_visc
+        spar[k, S_EPOT] = e_pot
+        spar[k, S_PLASTIC] = w_plastic
+        spar[k, S_OVL] = ovl
+        spar[k, S_OVL_I] = ovl_i
+        spar[k, S_OVL_J] = ovl_j
+
+
+@njit(cache=True, parallel=True)
+def gather_blocks(fpar, acc, fdamp, v0):
+    """Each granule's forces from the blocks, added in block order, into acc and fdamp's
+    columns v0, v0 + 1, v0 + 2 (the velocity columns)."""
+    nb = fpar.shape[0]
+    for i in prange(fpar.shape[1]):
+        for c in range(3):
+            s = 0.0
+            d = 0.0
+            for k in range(nb):
+                s += fpar[k, i, F_X + c]
+                d += fpar[k, i, F_DX + c]
+            acc[i, v0 + c] += s
+            fdamp[i, v0 + c] += d
+
+
+@njit(cache=True, parallel=True)
+def clear_rows(acc, fdamp, fload, c0):
+    """Zero the columns from c0 on of acc, fdamp and fload, granule by granule."""
+    for i in prange(acc.shape[0]):
+        for c in range(c0, acc.shape[1]):
+            acc[i, c] = 0.0
+            fdamp[i, c] = 0.0
+            fload[i, c] = 0.0
+
+
+@njit(cache=True, parallel=True)
+def divide_by_inertia(acc, mass, inertia):
+    """Forces and torques into accelerations (space: columns 3-5 and 6-8)."""
+    for i in prange(acc.shape[0]):
+        for c in range(3):
+            acc[i, 3 + c] /= mass[i]
+            acc[i, 6 + c] /= inertia[i]
+
+
+@njit(cache=True)
+def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
+    """solver.granular3d.normal_forces on every core: the shock (serial), the pairs in
+    blocks (`pair_forces_blocks`), their forces gathered in block order, then the walls in
+    the serial order. Returns the ForceSums (sums over the blocks in block order; the
+    largest overlap's first occurrence in the serial order)."""
+    ng = y.shape[0]
+    clear_rows(acc, fdamp, fload, 3)
+    begin_pass(t, g)
+    p_shock = 0.0
+    if not cfg.load_on_plate:
+        amp = cfg.q0 * time_profile(t, cfg.duration)
+        if amp != 0.0:
+            for i in range(ng):
+                for c in range(3):
+                    f = amp * g.shock_force[i, c]
+                    tq = amp * g.shock_torque[i, c]
+                    fload[i, 3 + c] = f
+                    fload[i, 6 + c] = tq
+                    acc[i, 3 + c] += f
+                    acc[i, 6 + c] += tq
+                    p_shock += f * y[i, 3 + c] + tq * y[i, 6 + c]
+    pair_forces_blocks(y, g, cfg, fpar, spar)
+    gather_blocks(fpar, acc, fdamp, 3)
+    p_visc = 0.0
+    e_pot = 0.0
+    w_plastic = 0.0
+    ovl = 0.0
+    ovl_i = -1
+    ovl_j = -1
+    for k in range(fpar.shape[0]):
+        p_visc += spar[k, S_VISC]
+        e_pot += spar[k, S_EPOT]
+        w_plastic += spar[k, S_PLASTIC]
+        if spar[k, S_OVL] > ovl:
+            ovl = spar[k, S_OVL]
+            ovl_i = int(spar[k, S_OVL_I])
+            ovl_j = int(spar[k, S_OVL_J])
+    for w in range(g.wall_i.shape[0]):
+        i = g.wall_i[w]
+        ri = g.radius[i]
+        nx = g.wall_geo[w, 0]
+        ny = g.wall_geo[w, 1]
+        nz = g.wall_geo[w, 2]
+        shift, vn, kd = wall_motion(g, w)
+        delta = wall_overlap_3d(y[i, 0], y[i, 1], y[i, 2], ri, nx, ny, nz, g.wall_geo[w, 3] + shift)
+        g.wall_hist[w, HIST_END] = max(delta, 0.0)
+        if delta <= 0.0:
+            continue
+        if delta > ovl * ri:
+            ovl = delta / ri
+            ovl_i = i
+            ovl_j = -1 - g.wall_w[w]
+        ddot = normal_rate_3d(y[i, 3], y[i, 4], y[i, 5], nx, ny, nz) - vn
+        n, pv, ep, wp = normal_law_response(
+            delta, ddot, g.wall_coef[w], g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip
+        )
+        w_plastic += wp
+        p_visc += pv
+        e_pot += ep
+        acc[i, 3] -= n * nx
+        acc[i, 4] -= n * ny
+        acc[i, 5] -= n * nz
+        d = 0.0
+        if pv != 0.0:
+            d = pv / ddot
+            fdamp[i, 3] -= d * nx
+            fdamp[i, 4] -= d * ny
+            fdamp[i, 5] -= d * nz
+        book_wall(g, w, kd, n, d)
+    divide_by_inertia(acc, g.mass, g.inertia)
+    return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
+
+
+@njit(cache=True, parallel=True)
+def kick_drift_blocks(y, acc, fdamp, fload, h, ypred, n_drift, spar):
+    """solver.schemes.verlet.kick_drift in blocks of granules (each granule's update is
+    the serial one's, bit for bit; the work sums per block into spar[k], S_WLOAD and
+    S_WDAMP). Returns (the load's work, the damping force's work) [J], summed in block order."""
+    nb = spar.shape[0]
+    ng = y.shape[0]
+    hk = 0.5 * h
+    for k in prange(nb):
+        w_load = 0.0
+        w_damp = 0.0
+        lo, hi = block_range(k, nb, ng)
+        for i in range(lo, hi):
+            for c in range(n_drift, y.shape[1]):
+                v0 = y[i, c]
+                dv = hk * acc[i, c]
+                v1 = v0 + dv
+                vm = hk * (v0 + 0.5 * dv)
+                w_load += fload[i, c] * vm
+                w_damp += fdamp[i, c] * vm
+                y[i, c] = v1
+                ypred[i, c] = v1 + dv
+            for c in range(n_drift):
+                y[i, c] += h * y[i, c + n_drift]
+                ypred[i, c] = y[i, c]
+        spar[k, S_WLOAD] = w_load
+        spar[k, S_WDAMP] = w_damp
+    return work_sums(spar)
+
+
+@njit(cache=True, parallel=True)
+def kick_blocks(y, acc, fdamp, fload, hk, dy, n_drift, spar):
+    """solver.schemes.verlet.kick in blocks of granules, as `kick_drift_blocks`."""
+    nb = spar.shape[0]
+    ng = y.shape[0]
+    for k in prange(nb):
+        w_load = 0.0
+        w_damp = 0.0
+        lo, hi = block_range(k, nb, ng)
+        for i in range(lo, hi):
+            for c in range(n_drift, y.shape[1]):
+                v0 = y[i, c]
+                dv = hk * acc[i, c]
+                vm = hk * (v0 + 0.5 * dv)
+                w_load += fload[i, c] * vm
+                w_damp += fdamp[i, c] * vm
+                y[i, c] = v0 + dv
+            for c in range(n_drift):
+                dy[i, c] = y[i, c + n_drift]
+        spar[k, S_WLOAD] = w_load
+        spar[k, S_WDAMP] = w_damp
+    return work_sums(spar)
+
+
+@njit(cache=True)
+def work_sums(spar):
+    """(the load's work, the damping force's work) [J] of the blocks, in block order."""
+    w_load = 0.0
+    w_damp = 0.0
+    for k in range(spar.shape[0]):
+        w_load += spar[k, S_WLOAD]
+        w_damp += spar[k, S_WDAMP]
+    return w_load, w_damp
+
+
+@njit(cache=True, parallel=True)
+def copy_rows(dst, src):
+    """dst[:] = src, granule by granule on every core."""
+    for i in prange(src.shape[0]):
+        for c in range(src.shape[1]):
+            dst[i, c] = src[i, c]
+
+
+@njit(cache=True, parallel=True)
+def accept_rows(y, k0, k1, ynew, kend):
+    """The accepted step's state and derivatives (solver.loop.accept_granular's copies:
+    y = ynew, k0 = k1, k1 = kend), granule by granule on every core."""
+    for i in prange(y.shape[0]):
+        for c in range(y.shape[1]):
+            y[i, c] = ynew[i, c]
+            k0[i, c] = k1[i, c]
+            k1[i, c] = kend[i, c]
+
+
+@njit(cache=True, parallel=True)
+def commit_pair_histories(t, hist, coef):
+    """solver.granular.commit_history of the pairs, contact by contact on every core (each
+    row on its own: the same numbers)."""
+    for k in prange(hist.shape[0]):
+        commit_history_row(t, hist, coef, k)
+
+
+@njit(cache=True)
+def commit_histories_blocks(t, g):
+    """solver.granular.commit_histories with the pairs on every core."""
+    commit_pair_histories(t, g.pair_hist, g.pair_coef)
+    commit_history(t, g.wall_hist, g.wall_coef)
+    commit_history(t, g.pc_hist, g.pc_coef)

@@ -1,0 +1,114 @@
+"""The velocity-Verlet loop on several threads (solver.blocks, solver.threads): the same
+physics as the serial loop to round-off, bitwise repeatable, the energy balance held."""
+
+from __future__ import annotations
+
+import dataclasses
+import warnings
+
+import numpy as np
+import pytest
+
+from granplate.bench.scaling_space import launched_fcc
+from granplate.errors import ScenarioError, YieldWarning
+from granplate.model.arrays import build_model
+from granplate.results.run import simulate
+from granplate.setup.scenario import Wall
+from granplate.setup.threads import PARALLEL_MIN_GRANULES, available_threads, check_threads, loop_threads
+from granplate.setup.validate import validate
+from granplate.solver import granular3d
+from granplate.solver.blocks import N_FPAR, N_SPAR, normal_forces_blocks
+from granplate.solver.driver import ContactLists
+from granplate.model.inputs import HIST_END
+
+THREADS = min(2, available_threads())
+
+
+def packing(threads: int | None, mu: float = 0.3):
+    """A struck FCC packing (48 spheres) against a wall, damped, with friction, verlet, `threads`."""
+    s = launched_fcc((3, 2, 2), mu=mu, t_end=12e-6, scheme="verlet")
+    floor = Wall(normal=(1.0, 0.0, 0.0), offset=float(max(g.x + g.radius for g in s.granules)), label="floor")
+    contact = dataclasses.replace(s.contact, alpha_n=0.3)  # damped: D_viscous is booked too
+    return dataclasses.replace(
+        s, walls=(floor,), contact=contact, solver=dataclasses.replace(s.solver, threads=threads)
+    )
+
+
+def run(s):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", YieldWarning)
+        return simulate(s, progress=False)
+
+
+@pytest.fixture(scope="module")
+def runs():
+    return {n: run(packing(n)) for n in (1, THREADS)} | {"again": run(packing(THREADS))}
+
+
+def test_threads_equal_the_serial_loop_to_round_off(runs):
+    """Positions, velocities and energies on THREADS threads are the serial run's within
+    1e-12 of their scale (only the order of the force sums differs)."""
+    one, many = runs[1], runs[THREADS]
+    assert many.attrs["threads"] == THREADS and one.attrs["threads"] == 1
+    for name in ("x", "y", "z", "vx", "vy", "vz", "omega_x", "E_granular", "D_viscous", "D_friction"):
+        a, b = one[name].values, many[name].values
+        assert np.abs(a - b).max() <= 1e-12 * max(np.abs(a).max(), 1e-30), name
+    assert one.wall_force.values.max() > 1.0 and one.D_friction.values[-1] > 0.0 and one.D_viscous.values[-1] > 0.0
+    np.testing.assert_allclose(many.wall_force.values, one.wall_force.values, rtol=1e-10, atol=1e-9)
+
+
+def test_threaded_run_is_bitwise_repeatable(runs):
+    """Two runs on the same number of threads give the same bits (fixed blocks, whatever
+    the scheduling)."""
+    for name in ("x", "vx", "vz", "E_granular", "wall_force"):
+        assert np.array_equal(runs[THREADS][name].values, runs["again"][name].values), name
+
+
+def test_threaded_run_keeps_the_energy_balance(runs):
+    """Eq. (11) holds on several threads as on one: the residual within solver.energy_tol
+    and within 1e-9 of the serial run's."""
+    a, b = runs[1].energy_residual.values, runs[THREADS].energy_residual.values
+    assert np.abs(b).max() < 1e-4
+    assert np.abs(a - b).max() < 1e-9
+
+
+@pytest.mark.parametrize("nb", [1, 3, 7])
+def test_block_force_pass_equals_the_serial_pass(nb):
+    """normal_forces_blocks with nb blocks (any count, whatever the threads) gives the
+    serial pass's accelerations to round-off and its overlaps and largest overlap exactly."""
+    s = packing(1, mu=0.0)
+    m = build_model(s)
+    lists = ContactLists(m)
+    lists.refresh(m.initial_state)
+    g, cfg = lists.g, m.config
+    rng = np.random.default_rng(7)
+    y = m.initial_state.copy()
+    y[:, :3] += rng.normal(0.0, 2e-6, (len(y), 3))  # overlaps of a few um, some pairs apart
+    y[:, 3:6] += rng.normal(0.0, 0.1, (len(y), 3))
+    ng = len(y)
+    acc0, fd0, fl0 = (np.zeros((ng, 9)) for _ in range(3))
+    serial = granular3d.normal_forces(0.0, y, g, cfg, acc0, fd0, fl0)
+    end0 = g.pair_hist[:, HIST_END].copy()
+    acc1, fd1, fl1 = (np.zeros((ng, 9)) for _ in range(3))
+    blocks = normal_forces_blocks(0.0, y, g, cfg, acc1, fd1, fl1, np.zeros((nb, ng, N_FPAR)), np.zeros((nb, N_SPAR)))
+    assert np.array_equal(g.pair_hist[:, HIST_END], end0)
+    assert (blocks.ovl, blocks.ovl_i, blocks.ovl_j) == (serial.ovl, serial.ovl_i, serial.ovl_j)
+    assert serial.ovl > 0.0
+    scale = np.abs(acc0).max()
+    assert np.abs(acc1 - acc0).max() <= 1e-13 * scale
+    assert blocks.e_pot == pytest.approx(serial.e_pot, rel=1e-13)
+
+
+def test_threads_field_is_checked_and_resolved():
+    """solver.threads: an integer from 1 to the machine's threads, named when refused;
+    absent means every core from PARALLEL_MIN_GRANULES granules on, for verlet only."""
+    n = available_threads()
+    for bad in (0, -1, n + 1, 1.5, True, "2"):
+        with pytest.raises(ScenarioError, match="solver.threads"):
+            check_threads(bad)
+    with pytest.raises(ScenarioError, match="solver.threads"):
+        validate(packing(n + 1))
+    assert loop_threads(None, PARALLEL_MIN_GRANULES, "verlet") == n
+    assert loop_threads(None, PARALLEL_MIN_GRANULES - 1, "verlet") == 1
+    assert loop_threads(2, 10, "implicit") == 1
+    assert build_model(packing(None)).config.threads == 1  # 48 spheres: serial
