@@ -109,18 +109,16 @@ def chain_model(count: int, dimer_ratio: float = 1.0) -> LinearChain:
 
 
 def band_edges(chain: LinearChain) -> dict[str, float]:
-    """The bulk band edges [Hz] of the chain's pairs: the monatomic cut-off (1/pi) sqrt(k/m),
-    or the dimer's acoustic top sqrt(2k/m_heavy) / (2 pi) and optical bottom sqrt(2k/m_light) /
-    (2 pi) (Herbold et al. 2009)."""
-    k = float(chain.stiffness[1])
+    """The bulk band edges [Hz] of the chain's pairs (`results.modes.chain_band_edges`, the closed
+    forms): the monatomic cut-off (1/pi) sqrt(k/m), or the dimer's acoustic top
+    sqrt(2k/m_heavy) / (2 pi) and optical bottom sqrt(2k/m_light) / (2 pi) (Herbold et al. 2009)."""
+    from granplate.results.modes import chain_band_edges
+
     m = chain.masses
     if np.allclose(m, m[0]):
-        return {"cutoff": math.sqrt(k / m[0]) / math.pi}
-    heavy, light = float(m.max()), float(m.min())
-    return {
-        "acoustic_top": math.sqrt(2.0 * k / heavy) / (2.0 * math.pi),
-        "optical_bottom": math.sqrt(2.0 * k / light) / (2.0 * math.pi),
-    }
+        return chain_band_edges(float(chain.stiffness[1]), float(m[0]))
+    edges = chain_band_edges(float(chain.stiffness[1]), float(m[0]), float(m[1]))
+    return {"acoustic_top": edges["acoustic_top"], "optical_bottom": edges["optical_bottom"]}
 
 
 def driven_response(count: int, frequency: float, settle: float, window: float, dimer_ratio: float = 1.0) -> dict:
