@@ -7,6 +7,9 @@ the page this writes, regenerated with --full):
   against an independent integration, the energy balance with gravity's work);
 - precompression_cases.py: precompressed chains (the static state against statics, the
   linear modes against the band edges, Nesterenko's solitary-wave speed against amplitude);
+  driven_chain_cases.py: a chain and a dimer chain driven harmonically below and above their
+  band edges against the linear response (chain_response.py: the chain's stiffness and
+  damping at the static overlaps, its steady state, free decay and transfer matrix);
 - granular.py: Chung & Ooi (2011) tests 1-4, sliding to rolling; chain.py: Nesterenko's solitary
   wave on a striker-hit chain;
 - dynamic.py: contacts that form during the run (two spheres from a gap, an oblique impact,
@@ -72,6 +75,7 @@ def all_cases() -> tuple:
         chain,
         conservation,
         coupled,
+        driven_chain_cases,
         dynamic,
         face_contacts,
         granular,
@@ -93,6 +97,7 @@ def all_cases() -> tuple:
         granular.CASES
         + gravity_cases.CASES
         + precompression_cases.CASES
+        + driven_chain_cases.CASES
         + chain.CASES
         + dynamic.CASES
         + plane_lammps
