@@ -112,3 +112,18 @@ def test_threads_field_is_checked_and_resolved():
     assert loop_threads(None, PARALLEL_MIN_GRANULES - 1, "verlet") == 1
     assert loop_threads(2, 10, "implicit") == 1
     assert build_model(packing(None)).config.threads == 1  # 48 spheres: serial
+
+
+def _numba_threads() -> int:
+    import numba
+
+    return int(numba.config.NUMBA_NUM_THREADS)
+
+
+def test_study_workers_run_one_thread_each():
+    """A local Dask cluster's workers run numba on one thread, so designs that leave
+    solver.threads out do not oversubscribe the cores the workers share."""
+    from granplate.results.engine import dask_client
+
+    with dask_client(workers=1) as client:
+        assert client.submit(_numba_threads, pure=False).result() == 1

@@ -150,6 +150,11 @@ def register(subparsers) -> None:
         help="with --scaling: solver.scheme of granplate's runs, any registered scheme (default implicit)",
     )
     b.add_argument(
+        "--threads",
+        help="with --scaling --dimension 3: comma-separated thread counts, a row each (solver.threads; "
+        "LAMMPS on as many MPI processes); default 1 and every core for --scheme verlet, else 1",
+    )
+    b.add_argument(
         "--no-lammps",
         dest="no_lammps",
         action="store_true",

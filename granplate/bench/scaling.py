@@ -20,6 +20,7 @@ its error against the same v_ref is at most ours; its row is the first step that
 from __future__ import annotations
 
 import json
+import shutil
 import math
 import os
 import subprocess
@@ -167,16 +168,32 @@ def _lammps_worker(spec: dict) -> dict:
     }
 
 
-def run_in_subprocess(module: str, worker: str, spec: dict) -> dict:
+def run_in_subprocess(module: str, worker: str, spec: dict, processes: int = 1) -> dict:
     """Run `worker` (a function of granplate.bench.`module`) on `spec` in a fresh Python
-    process; its result, or {"failed": the last line of its error}."""
-    code = (
-        f"import sys, json; from granplate.bench import {module}; "
-        f"print('@@RESULT ' + json.dumps({module}.{worker}(json.loads(sys.stdin.read()))))"
-    )
-    p = subprocess.run(
-        [sys.executable, "-c", code], input=json.dumps(spec), capture_output=True, text=True, env=dict(os.environ)
-    )
+    process (processes > 1: that many MPI processes by the environment's `mpirun`, each
+    running the worker, rank 0's result kept); its result, or {"failed": the last line of
+    its error}."""
+    if processes > 1:
+        mpirun = shutil.which("mpirun", path=os.path.dirname(sys.executable)) or shutil.which("mpirun")
+        if mpirun is None:
+            return {"skipped": "no mpirun beside this Python or on the PATH (pip install mpich)"}
+        code = (
+            f"import os, json; from granplate.bench import {module}; r = {module}.{worker}("
+            "json.loads(os.environ['GRANPLATE_BENCH_SPEC'])); "
+            "print('@@RESULT ' + json.dumps(r)) if os.environ.get('PMI_RANK', '0') == '0' else None"
+        )
+        env = dict(os.environ, GRANPLATE_BENCH_SPEC=json.dumps(spec))
+        p = subprocess.run(
+            [mpirun, "-np", str(processes), sys.executable, "-c", code], capture_output=True, text=True, env=env
+        )
+    else:
+        code = (
+            f"import sys, json; from granplate.bench import {module}; "
+            f"print('@@RESULT ' + json.dumps({module}.{worker}(json.loads(sys.stdin.read()))))"
+        )
+        p = subprocess.run(
+            [sys.executable, "-c", code], input=json.dumps(spec), capture_output=True, text=True, env=dict(os.environ)
+        )
     for line in p.stdout.splitlines():
         if line.startswith("@@RESULT "):
             return json.loads(line[len("@@RESULT ") :])

@@ -116,6 +116,7 @@ def _ours_worker(spec: dict) -> dict:
     _warm_up(spec["scheme"])
     cells = tuple(spec["cells"])
     s = launched_fcc(cells, mu=spec["mu"], t_end=spec["t_end"], scheme=spec["scheme"])
+    s = dataclasses.replace(s, solver=dataclasses.replace(s.solver, threads=spec.get("threads")))
     t0 = time.perf_counter()
     model = build_model(s)
     setup = time.perf_counter() - t0
@@ -129,10 +130,14 @@ def _ours_worker(spec: dict) -> dict:
         "loop_cpu_s": float(ds.attrs["loop_cpu_s"]),
         "rss_peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
         "energy_residual": float(np.abs(ds.energy_residual.values).max()),
+        "threads": int(ds.attrs.get("threads", 1)),
     }
     if spec["mu"] == 0.0:
-        ref = simulate(launched_fcc(cells, t_end=spec["t_end"], scheme="paper", dt=REFERENCE_DT), progress=False)
-        out["reference"] = {k: ref[k].values[-1].tolist() for k in ("vx", "vy", "vz")}
+        if spec.get("reference") is None:
+            ref = simulate(launched_fcc(cells, t_end=spec["t_end"], scheme="paper", dt=REFERENCE_DT), progress=False)
+            out["reference"] = {k: ref[k].values[-1].tolist() for k in ("vx", "vy", "vz")}
+        else:
+            out["reference"] = spec["reference"]
         out["error"] = max_error_3d(tuple(ds[k].values[-1] for k in ("vx", "vy", "vz")), out["reference"])
     return out
 
@@ -178,52 +183,79 @@ def _lammps_worker(spec: dict) -> dict:
 
 
 def run_scaling_space(
-    sizes=SIZES, frictions=FRICTIONS, t_end: float = T_END, scheme: str = "implicit", lammps: bool = True, log=print
+    sizes=SIZES,
+    frictions=FRICTIONS,
+    t_end: float = T_END,
+    scheme: str = "implicit",
+    lammps: bool = True,
+    log=print,
+    threads: tuple[int, ...] = (1,),
 ) -> list[dict]:
-    """The 3D table's rows: one per (size, mu), each measured in fresh subprocesses."""
+    """The 3D table's rows: one per (size, mu, thread count), each measured in fresh
+    subprocesses; `speedup` is the loop's time on one thread over this row's. LAMMPS runs
+    the frictionless rows on as many MPI processes as the row has threads (`mpirun -np N`,
+    its shrink-wrapped box cut into N domains)."""
     rows = []
     for cells in sizes:
         for mu in frictions:
-            log(f"scaling in space: {sphere_count(cells)} spheres, mu = {mu:g} ...")
-            spec = {"cells": list(cells), "mu": mu, "t_end": t_end, "scheme": scheme}
-            row = {
-                "dimension": 3,
-                "cells": list(cells),
-                "mu": mu,
-                "scheme": scheme,
-                "t_end_s": t_end,
-                **run_in_subprocess("scaling_space", "_ours_worker", spec),
-            }
-            if "failed" not in row:
-                row["us_per_step"] = 1e6 * row["loop_s"] / row["n_steps"]
-                row["us_per_contact_step"] = per_contact_step_us(row["loop_s"], row["n_steps"], row["contacts"])
-                row["cpu_us_per_contact_step"] = per_contact_step_us(row["loop_cpu_s"], row["n_steps"], row["contacts"])
-            if lammps and mu == 0.0 and "error" in row:
-                log(f"scaling in space: {row['granules']} spheres, LAMMPS ...")
-                lm = run_in_subprocess(
-                    "scaling_space", "_lammps_worker", {**spec, "error": row["error"], "reference": row["reference"]}
-                )
-                if "loop_s" in lm:
-                    lm["us_per_contact_step"] = per_contact_step_us(lm["loop_s"], lm["n_steps"], row["contacts"])
-                    lm["cpu_us_per_contact_step"] = per_contact_step_us(lm["cpu_s"], lm["n_steps"], row["contacts"])
-                row["lammps"] = lm
-            row.pop("reference", None)
-            rows.append(row)
+            reference, one_thread = None, None
+            for n in threads:
+                log(f"scaling in space: {sphere_count(cells)} spheres, mu = {mu:g}, {n} thread(s) ...")
+                row = _space_row(cells, mu, t_end, scheme, n, reference, lammps, log)
+                reference = row.pop("reference", reference)
+                if n == 1 and "loop_s" in row:
+                    one_thread = row["loop_s"]
+                if one_thread is not None and "loop_s" in row:
+                    row["speedup"] = one_thread / row["loop_s"]
+                rows.append(row)
     return rows
+
+
+def _space_row(cells, mu: float, t_end: float, scheme: str, n: int, reference, lammps: bool, log) -> dict:
+    """One row of the 3D table: granplate on n threads and (frictionless, `lammps`) LAMMPS
+    on n MPI processes to the same accuracy."""
+    spec = {"cells": list(cells), "mu": mu, "t_end": t_end, "scheme": scheme, "threads": n, "reference": reference}
+    row = {
+        "dimension": 3,
+        "cells": list(cells),
+        "mu": mu,
+        "scheme": scheme,
+        "t_end_s": t_end,
+        **run_in_subprocess("scaling_space", "_ours_worker", spec),
+    }
+    row["threads"] = n
+    if "failed" not in row:
+        row["us_per_step"] = 1e6 * row["loop_s"] / row["n_steps"]
+        row["us_per_contact_step"] = per_contact_step_us(row["loop_s"], row["n_steps"], row["contacts"])
+        row["cpu_us_per_contact_step"] = per_contact_step_us(row["loop_cpu_s"], row["n_steps"], row["contacts"])
+    if lammps and mu == 0.0 and "error" in row:
+        log(f"scaling in space: {row['granules']} spheres, LAMMPS on {n} process(es) ...")
+        lm = run_in_subprocess(
+            "scaling_space", "_lammps_worker", {**spec, "error": row["error"], "reference": row["reference"]}, n
+        )
+        if "loop_s" in lm:
+            lm["us_per_contact_step"] = per_contact_step_us(lm["loop_s"], lm["n_steps"], row["contacts"])
+            lm["cpu_us_per_contact_step"] = per_contact_step_us(lm["cpu_s"], lm["n_steps"], row["contacts"])
+        lm["processes"] = n
+        row["lammps"] = lm
+    return row
 
 
 def format_space_table(rows: list[dict]) -> str:
     """The 3D scaling table as Markdown (LAMMPS columns on the frictionless rows)."""
     lines = [
-        "| spheres | cells | contacts | mu | set-up [s] | steps | loop [s] | us/step | us/(contact step) "
-        "| CPU us/(contact step) | peak [MiB] | error | LAMMPS dt [s] | LAMMPS steps | LAMMPS loop [s] "
-        "| LAMMPS us/(contact step) | LAMMPS CPU us/(contact step) | LAMMPS error |",
-        "|" + " ---: |" * 18,
+        "| spheres | cells | contacts | mu | threads | set-up [s] | steps | loop [s] | speed-up | us/step "
+        "| us/(contact step) | CPU us/(contact step) | peak [MiB] | error | LAMMPS dt [s] | LAMMPS steps "
+        "| LAMMPS loop [s] | LAMMPS us/(contact step) | LAMMPS CPU us/(contact step) | LAMMPS error |",
+        "|" + " ---: |" * 20,
     ]
     for r in rows:
         cells = "x".join(str(c) for c in r["cells"])
         if "failed" in r:
-            lines.append(f"| {sphere_count(r['cells']):,} | {cells} | | {r['mu']:g} | {r['failed']} |" + " |" * 13)
+            lines.append(
+                f"| {sphere_count(r['cells']):,} | {cells} | | {r['mu']:g} | {r.get('threads', 1)} | {r['failed']} |"
+                + " |" * 14
+            )
             continue
         lm = r.get("lammps") or {}
         if "skipped" in lm or not lm:
@@ -240,8 +272,9 @@ def format_space_table(rows: list[dict]) -> str:
                 format_or_dash(lm["error"], ".1e"),
             ]
         lines.append(
-            f"| {r['granules']:,} | {cells} | {r['contacts']:,} | {r['mu']:g} | {r['setup_s']:.3f} "
-            f"| {r['n_steps']:,} | {r['loop_s']:.3g} | {r['us_per_step']:.1f} "
+            f"| {r['granules']:,} | {cells} | {r['contacts']:,} | {r['mu']:g} | {r.get('threads', 1)} "
+            f"| {r['setup_s']:.3f} | {r['n_steps']:,} | {r['loop_s']:.3g} | {format_or_dash(r.get('speedup'), '.2f')} "
+            f"| {r['us_per_step']:.1f} "
             f"| {r['us_per_contact_step']:.3f} | {r['cpu_us_per_contact_step']:.3f} "
             f"| {r['rss_peak_mib']:.0f} | {format_or_dash(r.get('error'), '.1e')} | " + " | ".join(lcols) + " |"
         )
@@ -262,6 +295,24 @@ def parse_cells(text: str) -> list[tuple[int, int, int]]:
     return out
 
 
+def parse_threads(text: str | None, scheme: str) -> tuple[int, ...]:
+    """'1,2' -> (1, 2) (ValueError naming the bad item and the range); None: 1 and every
+    core for a threaded scheme (setup.threads.THREADED_SCHEMES), else 1 alone."""
+    from granplate.setup.threads import THREADED_SCHEMES, available_threads
+
+    n = available_threads()
+    if text is None:
+        return (1, n) if scheme in THREADED_SCHEMES and n > 1 else (1,)
+    out = []
+    for item in text.split(","):
+        if not item.strip().isdigit() or not 1 <= int(item) <= n:
+            raise ValueError(
+                f"--threads item {item!r}: allowed integers from 1 to {n} (this machine's cores), e.g. 1,{n}"
+            )
+        out.append(int(item))
+    return tuple(out)
+
+
 def main(args, t_end: float, scheme: str) -> int:
     """`granplate bench --scaling --dimension 3 [--sizes 3x3x3,6x6x7] ...` (t_end and scheme
     checked by bench.scaling.main)."""
@@ -270,7 +321,14 @@ def main(args, t_end: float, scheme: str) -> int:
     except ValueError as err:
         print(f"granplate: error: {err}", file=sys.stderr)
         return 2
-    rows = run_scaling_space(sizes, t_end=t_end, scheme=scheme, lammps=not getattr(args, "no_lammps", False))
+    try:
+        threads = parse_threads(getattr(args, "threads", None), scheme)
+    except ValueError as err:
+        print(f"granplate: error: {err}", file=sys.stderr)
+        return 2
+    rows = run_scaling_space(
+        sizes, t_end=t_end, scheme=scheme, lammps=not getattr(args, "no_lammps", False), threads=threads
+    )
     print()
     print(format_space_table(rows))
     write_report(args, rows)

@@ -57,7 +57,9 @@ def sigint_ignored() -> Iterator[None]:
 def dask_client(workers: int | None = None, scheduler: str | None = None) -> Iterator:
     """A Dask Client: of the cluster at scheduler's address, else of a new LocalCluster of
     `workers` processes (default: the cores this process may use), one thread each; closed
-    on exit. Local workers ignore Ctrl-C (it reaches the driver alone)."""
+    on exit. Local workers ignore Ctrl-C (it reaches the driver alone) and run numba's
+    parallel loops on one thread (NUMBA_NUM_THREADS = 1: `solver.threads` absent means one
+    there), so that workers and threads do not share the same cores."""
     from distributed import Client, LocalCluster
 
     if scheduler:
@@ -74,7 +76,12 @@ def dask_client(workers: int | None = None, scheduler: str | None = None) -> Ite
     # and a task that does not come back is reported as lost by the sweep.
     with sigint_ignored():
         cluster = LocalCluster(
-            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=logging.CRITICAL
+            n_workers=n,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            silence_logs=logging.CRITICAL,
+            env={"NUMBA_NUM_THREADS": "1"},
         )
     try:
         with Client(cluster) as client:

@@ -38,8 +38,9 @@ def check_threads(v: Any) -> None:
         raise ScenarioError(
             "solver.threads",
             v,
-            f"must be an integer from 1 to {n} (this machine's cores), or absent (every core for "
-            f"{PARALLEL_MIN_GRANULES} granules and more)",
+            f"must be an integer from 1 to {n} (the cores numba may use here: NUMBA_NUM_THREADS; a "
+            f"design study's workers have one each), or absent (every core for {PARALLEL_MIN_GRANULES} "
+            "granules and more)",
         )
 
 

@@ -18,7 +18,14 @@ Numba's parallel loops (`prange`) run the blocks; numba's thread count is set by
 
 from __future__ import annotations
 
-from numba import njit, prange
+import os
+
+# OpenMP's threads sleep between the passes rather than spin (read once, when the threading
+# layer loads with these kernels): a spinning thread holds a core that the step's serial
+# part, or another process on a shared machine, needs. A user's own OMP_WAIT_POLICY is kept.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+from numba import njit, prange  # noqa: E402
 
 from granplate.model.inputs import HIST_END, HIST_MAX, HIST_RATE
 from granplate.physics.laws import normal_law_response
