@@ -316,7 +316,7 @@ def needs_matrices(h, slot, clock, g_ok):
 def accept_granular(t, h, land, t_out, plate_work, e_pot, st, w):
     """Take the trial step's granule state, derivatives and work (with the plastic work of
     the contacts loaded past their largest overlaps) into the state and move the clock
-    (onto the output time when the step lands on it)."""
+    (onto t_out, the output or sensor sample time, when the step lands on it)."""
     for i in range(st.y.shape[0]):
         for c in range(st.y.shape[1]):
             st.y[i, c] = w.ynew[i, c]
@@ -344,7 +344,8 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
     """Advance from st.clock[T_NOW] to t_stop (an output time) with the scheme whose
     scratch is sw, trying at most max_attempts steps. Returns a status: OK, PAUSED
     (budget spent; call again) or an error, with st.err filled and the state the last
-    accepted one. After every accepted step the patch contacts follow their granules
+    accepted one. Steps land on the output times and on the sensors' sample times
+    (out.sensor_target; `record_sensors` at each). After every accepted step the patch contacts follow their granules
     (interface.move_patches, then the scheme's hook contacts_moved) and the contact
     watch runs (solver/contacts.py): REBUILD asks the driver to rebuild the contact
     list, NEW_PLATE to add a patch contact, and to call again."""
