@@ -345,9 +345,9 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
     scratch is sw, trying at most max_attempts steps. Returns a status: OK, PAUSED
     (budget spent; call again) or an error, with st.err filled and the state the last
     accepted one. Steps land on the output times and on the sensors' sample times
-    (out.sensor_target; `record_sensors` at each). After every accepted step the patch contacts follow their granules
-    (interface.move_patches, then the scheme's hook contacts_moved) and the contact
-    watch runs (solver/contacts.py): REBUILD asks the driver to rebuild the contact
+    (out.sensor_target; `record_sensors` at each). After every accepted step the patch
+    contacts follow their granules (interface.move_patches, then the scheme's hook
+    contacts_moved) and the contact watch runs (solver/contacts.py): REBUILD asks the driver to rebuild the contact
     list, NEW_PLATE to add a patch contact, and to call again."""
     for _ in range(max_attempts):
         t = st.clock[T_NOW]
