@@ -294,3 +294,52 @@ def test_a_restarted_run_samples_its_sensors_as_the_straight_run():
     later = straight["sensor_time"].values >= t[0] - 1e-9 * 1e-7  # (t1: the first run's end, to rounding)
     np.testing.assert_allclose(t, straight["sensor_time"].values[later], rtol=0.0, atol=1e-9 * 1e-7)
     np.testing.assert_array_equal(restarted["sensor_force"].values, straight["sensor_force"].values[later])
+
+
+BLOCK_DROP = """
+name = "sensed-drop"
+dimension = 3
+[[granules]]
+label = "ball"
+x = 0.0103
+y = 0.0096
+z = 0.01201
+radius = 0.002
+material = "steel"
+vz = -1.0
+[plate]
+size = [0.02, 0.02, 0.01]
+elements = [3, 3, 2]
+material = "steel"
+clamped = ["zmin"]
+patch_radius = 0.0
+max_frequency = 1.5e5
+[load]
+kind = "none"
+[contact]
+alpha_n = 0.0
+mu = 0.0
+[time]
+t_end = 2.4e-5
+dt_max = 2e-8
+output_interval = 1e-6
+field_interval = 2.4e-5
+sensor_interval = 2e-7
+[solver]
+scheme = "verlet"
+granular_friction = "split"
+[[sensors]]
+granule = "ball"
+"""
+
+
+def test_a_sphere_on_an_elastic_solid_reads_half_its_contact_force():
+    """A steel sphere dropped on a clamped steel block (an elastic solid in space): its one
+    contact is the body's, so at every output time it reads half the body contact's normal
+    force, which the result replays from the recorded state."""
+    ds = gp.simulate(gp.loads(BLOCK_DROP), progress=False)
+    fn = ds["body_contact_normal_force"].sel(granule="ball").values
+    assert fn.max() > 10.0
+    shared = np.isin(ds["sensor_time"].values, ds["time"].values)
+    assert shared.sum() == ds.sizes["time"] and ds.sizes["sensor_time"] == 121
+    np.testing.assert_allclose(ds["sensor_force"].values[shared, 0], 0.5 * fn, rtol=1e-9, atol=1e-9 * fn.max())

@@ -11,7 +11,7 @@ import math
 from granplate.errors import ScenarioError
 from granplate.setup.drive_checks import granule_labels
 from granplate.setup.fields import closest_name, finite
-from granplate.setup.scenario import Scenario, Sensor, Solid
+from granplate.setup.scenario import Scenario, Sensor
 
 #: the most values (samples x sensors) a run's sensors may record: 2^26 float64 numbers,
 #: 512 MiB in each of the loop's buffer, the Dataset and the file written.
@@ -34,8 +34,7 @@ def n_sensor_samples(t_end: float, interval: float) -> int:
 def check_sensors(s: Scenario) -> None:
     """time.sensor_interval (finite, > 0, at most time.t_end) and every [[sensors]] entry
     of the resolved scenario s: its granule (a known label), its name (a string, unique
-    among the sensors), the run's samples x sensors within MAX_SENSOR_VALUES, and a run
-    whose contacts a sensor can read (no elastic solid in space)."""
+    among the sensors) and the run's samples x sensors within MAX_SENSOR_VALUES."""
     dt = s.time.sensor_interval
     if dt is not None:
         x = finite("time.sensor_interval", dt, "must be a finite number > 0 [s] (absent: time.output_interval)")
@@ -64,13 +63,6 @@ def check_sensors(s: Scenario) -> None:
                 f"sensors[{seen[sensor.label]}] is named {sensor.label!r} already; give each sensor its own `name`",
             )
         seen[sensor.label] = k
-    if isinstance(s.plate, Solid):
-        raise ScenarioError(
-            "sensors",
-            [x.label for x in s.sensors],
-            "a sensor reads the granule-granule and granule-wall contacts: a run on an elastic solid in "
-            "space (a 3D [plate]) cannot have sensors yet; leave out [[sensors]] or the [plate]",
-        )
     n = n_sensor_samples(s.time.t_end, sensor_interval(s)) * len(s.sensors)
     if n > MAX_SENSOR_VALUES:
         field = "time.sensor_interval" if dt is not None else "sensors"

@@ -658,7 +658,7 @@ def run(
         (loop.initialise, (st, lists.g, arr.p, cfg, w)),
         (loop.start_scheme, (arr.sw, st, lists.g, cfg)),
         (loop.record, (0, st, lists.g, arr.p, w, arr.out)),
-        *sensor_calls(st, lists.g, cfg, arr.out),
+        *sensor_calls(arr.sw, st, lists.g, cfg, arr.out),
         (loop.advance, (float(times[-1]), FIRST_BUDGET, lists.g, arr.p, cfg, st, arr.w, arr.sw, arr.out)),
     ]
     t1 = time.perf_counter()
@@ -667,21 +667,21 @@ def run(
     loop.initialise(st, lists.g, arr.p, cfg, w)
     loop.start_scheme(arr.sw, st, lists.g, cfg)
     loop.record(0, st, lists.g, arr.p, w, arr.out)
-    first_sensor_sample(st, lists.g, cfg, arr.out)
+    first_sensor_sample(arr.sw, st, lists.g, cfg, arr.out)
     st.count[S.C_OUT] = 1
     return _finish(model, times, arr, lists, t1, progress, should_stop, interruptible)
 
 
-def sensor_calls(st: S.State, g, cfg, out: S.Output) -> list[tuple]:
+def sensor_calls(sw, st: S.State, g, cfg, out: S.Output) -> list[tuple]:
     """The compiled call a run with sensors makes from Python (its first sample), to
     compile before the loop's clock starts; none without sensors."""
-    return [(loop.record_sensors, (st, g, cfg, out))] if len(out.sensor_granule) else []
+    return [(loop.record_sensors, (sw, st, g, cfg, out))] if len(out.sensor_granule) else []
 
 
-def first_sensor_sample(st: S.State, g, cfg, out: S.Output) -> None:
+def first_sensor_sample(sw, st: S.State, g, cfg, out: S.Output) -> None:
     """The sensors' sample at the run's first output time, when it is a sample time."""
     if len(out.sensor_target) and out.sensor_target[0] <= st.clock[S.T_NOW]:
-        loop.record_sensors(st, g, cfg, out)
+        loop.record_sensors(sw, st, g, cfg, out)
 
 
 def _run_from(model: Model, start: dict, progress: bool, should_stop, interruptible: bool) -> RunRecord:
@@ -698,14 +698,14 @@ def _run_from(model: Model, start: dict, progress: bool, should_stop, interrupti
     st = arr.st
     calls = [
         (loop.record, (0, st, lists.g, arr.p, arr.w, arr.out)),
-        *sensor_calls(st, lists.g, cfg, arr.out),
+        *sensor_calls(arr.sw, st, lists.g, cfg, arr.out),
         (loop.advance, (float(times[-1]), FIRST_BUDGET, lists.g, arr.p, cfg, st, arr.w, arr.sw, arr.out)),
     ]
     c1 = time.perf_counter()
     note_compile(model, calls)
     compile_calls(calls)
     loop.record(0, st, lists.g, arr.p, arr.w, arr.out)
-    first_sensor_sample(st, lists.g, cfg, arr.out)
+    first_sensor_sample(arr.sw, st, lists.g, cfg, arr.out)
     st.count[S.C_OUT] = 1
     return _finish(model, times, arr, lists, c1, progress, should_stop, interruptible)
 

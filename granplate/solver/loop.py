@@ -222,12 +222,14 @@ def record(o, st, g, p, w, out):
 
 
 @njit(cache=True)
-def record_sensors(st, g, cfg, out):
+def record_sensors(sw, st, g, cfg, out):
     """Write every sensor's reading at t_n into the next sensor row (docs/model.md section
     3.15): half the sum of the normal forces on its granule, of its pair and wall contacts
-    (`sensor_loads`) and of its plate contacts (their |N| at t_n)."""
+    (`sensor_loads`), of its plate contacts (their |N| at t_n) and of its contact with the
+    scheme's own body (the hook body_sensor_loads of the scheme whose scratch is sw)."""
     s = out.sensor_n[0]
     sensor_loads(st.y, g, cfg, out.sensor_load)
+    S.body_sensor_loads(sw, out.sensor_load)
     for k in range(g.pc_i.shape[0]):
         out.sensor_load[g.pc_i[k]] += 0.5 * st.normal[k]
     out.sensor_t[s] = st.clock[T_NOW]
@@ -397,7 +399,7 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
             return status
         if land:
             if out.sensor_n[0] < out.sensor_target.shape[0] and out.sensor_target[out.sensor_n[0]] <= t_land:
-                record_sensors(st, g, cfg, out)
+                record_sensors(sw, st, g, cfg, out)
             if on_output:
                 record(o, st, g, p, w, out)
                 st.count[C_OUT] = o + 1
