@@ -343,3 +343,15 @@ def test_a_sphere_on_an_elastic_solid_reads_half_its_contact_force():
     shared = np.isin(ds["sensor_time"].values, ds["time"].values)
     assert shared.sum() == ds.sizes["time"] and ds.sizes["sensor_time"] == 121
     np.testing.assert_allclose(ds["sensor_force"].values[shared, 0], 0.5 * fn, rtol=1e-9, atol=1e-9 * fn.max())
+
+
+def test_the_sensor_figure_draws_each_sensors_samples():
+    """granplate plot's sensor-forces figure: one curve per sensor, its samples against
+    sensor_time in ms."""
+    from granplate.figures import run as figures
+
+    ds = gp.simulate(_impact(), progress=False)
+    fig = figures.figures(ds)["sensor-forces"]
+    lines = {ln.get_label(): ln for ln in fig.axes[0].get_lines()}
+    np.testing.assert_array_equal(lines["striker"].get_ydata(), ds["sensor_force"].sel(sensor="striker").values)
+    np.testing.assert_allclose(lines["lone"].get_xdata(), 1e3 * ds["sensor_time"].values)
