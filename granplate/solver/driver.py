@@ -128,7 +128,7 @@ def sensor_times(t_first: float, t_end: float, interval: float, times: np.ndarra
     for cand in (j - 1, j):
         near = np.abs(times[cand] - ts) <= SNAP_RTOL * interval
         ts = np.where(near, times[cand], ts)
-    ts = np.minimum(ts, t_end)
+    ts = np.unique(np.minimum(ts, t_end))  # (one step lands on each: none twice)
     return ts[ts >= t_first - SNAP_RTOL * interval]
 
 
@@ -667,7 +667,7 @@ def run(
     loop.initialise(st, lists.g, arr.p, cfg, w)
     loop.start_scheme(arr.sw, st, lists.g, cfg)
     loop.record(0, st, lists.g, arr.p, w, arr.out)
-    first_sensor_sample(arr.sw, st, lists.g, cfg, arr.out)
+    first_sensor_sample(model, arr.sw, st, lists.g, arr.out)
     st.count[S.C_OUT] = 1
     return _finish(model, times, arr, lists, t1, progress, should_stop, interruptible)
 
@@ -678,10 +678,13 @@ def sensor_calls(sw, st: S.State, g, cfg, out: S.Output) -> list[tuple]:
     return [(loop.record_sensors, (sw, st, g, cfg, out))] if len(out.sensor_granule) else []
 
 
-def first_sensor_sample(sw, st: S.State, g, cfg, out: S.Output) -> None:
-    """The sensors' sample at the run's first output time, when it is a sample time."""
-    if len(out.sensor_target) and out.sensor_target[0] <= st.clock[S.T_NOW]:
-        loop.record_sensors(sw, st, g, cfg, out)
+def first_sensor_sample(model: Model, sw, st: S.State, g, out: S.Output) -> None:
+    """The sensors' sample at the run's first output time, when it is a sample time (to
+    SNAP_RTOL intervals: a restart's clock is the first run's end, to its rounding)."""
+    if not len(out.sensor_target):
+        return
+    if out.sensor_target[0] <= st.clock[S.T_NOW] + SNAP_RTOL * sensor_interval(model.scenario):
+        loop.record_sensors(sw, st, g, model.config, out)
 
 
 def _run_from(model: Model, start: dict, progress: bool, should_stop, interruptible: bool) -> RunRecord:
@@ -705,7 +708,7 @@ def _run_from(model: Model, start: dict, progress: bool, should_stop, interrupti
     note_compile(model, calls)
     compile_calls(calls)
     loop.record(0, st, lists.g, arr.p, arr.w, arr.out)
-    first_sensor_sample(arr.sw, st, lists.g, cfg, arr.out)
+    first_sensor_sample(model, arr.sw, st, lists.g, arr.out)
     st.count[S.C_OUT] = 1
     return _finish(model, times, arr, lists, c1, progress, should_stop, interruptible)
 
