@@ -76,7 +76,13 @@ def test_every_figure_of_a_paper_preset_draws_its_numbers(steel):
     own values; the 3D body's figures are skipped with their reason."""
     figs = run.figures(steel)
     assert list(figs) == PLATE_FIGURES
-    assert [n for n in run.FIGURES if n not in figs] == ["body-stress", "body-contact-forces", "wall-forces"]
+    assert [n for n in run.FIGURES if n not in figs] == [
+        "body-stress",
+        "body-contact-forces",
+        "wall-forces",
+        "sensor-forces",
+    ]
+    assert run.missing("sensor-forces", steel) == "the run has no [[sensors]]"
     assert run.missing("wall-forces", steel).startswith("the run has no drives or gravity")
     for name in ("body-stress", "body-contact-forces"):
         assert run.missing(name, steel) == "the run has no 3D elastic body"

@@ -162,7 +162,8 @@ def test_a_minimisation_that_does_not_converge_says_its_residual():
 def test_the_struck_chain_example_runs_and_records_its_floor():
     """docs/examples/struck-chain.toml (20 beads on a floor under gravity, 10 N from the top, the
     top bead struck): the floor carries 10 N plus the chain's weight at t = 0, and more once the
-    wave arrives; eq. (11) holds to solver.energy_tol; the summary's shares above 1 stay within
+    wave arrives; the sensor bead b10 reads 10 N plus the weight of the 10 beads above it and
+    half its own, and more as the wave passes; eq. (11) holds to solver.energy_tol; the summary's shares above 1 stay within
     the largest energy put in (gravity lends energy to the struck bead and takes it back)."""
     from pathlib import Path
 
@@ -175,6 +176,9 @@ def test_the_struck_chain_example_runs_and_records_its_floor():
     floor = ds["wall_force"].sel(wall="floor").values
     assert floor[0] == pytest.approx(10.0 + m * 9.81, rel=1e-7)
     assert floor.max() > 2.0 * floor[0]
+    mid = ds["sensor_force"].sel(sensor="b10").values  # the 11th bead from the top, sampled at 10 MHz
+    assert mid[0] == pytest.approx(10.0 + 10.5 * m / 20 * 9.81, rel=1e-7)
+    assert mid.max() > 2.0 * mid[0] and ds.sizes["sensor_time"] == 4001
     assert float(np.max(np.abs(ds["energy_residual"].values))) <= s.solver.energy_tol
     sm = summary(ds)
     assert sm["eg_max_fraction"] <= sm["e_in_max"] / sm["e_in"] + 1e-6

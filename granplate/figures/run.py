@@ -406,6 +406,20 @@ def fig_wall_forces(ds: xr.Dataset) -> Figure:
     return _finish(fig, ds, axes, "wall and drive forces")
 
 
+def fig_sensor_forces(ds: xr.Dataset) -> Figure:
+    """Each sensor's reading [N] (`sensor_force`: half the sum of the normal contact forces
+    on its granule, docs/model.md section 3.15) on the sensors' own time axis [ms]."""
+    fig = new_figure(9.0, 3.4)
+    ax = fig.subplots(1, 1)
+    t = 1e3 * ds["sensor_time"].values
+    for j, lab in enumerate(ds["sensor"].values):
+        ax.plot(t, ds["sensor_force"].values[:, j], lw=1.0, label=str(lab))
+    ax.set_ylabel("sensor force [N]")
+    ax.set_title("each sensor's reading: the mean of the forces on a chain bead's two faces", loc="left", fontsize=10)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, title="sensor", title_fontsize=8)
+    return _finish(fig, ds, (ax,), "sensor forces")
+
+
 FIGURES = {
     "energies": fig_energies,
     "contact-forces": fig_contact_forces,
@@ -414,6 +428,7 @@ FIGURES = {
     "body-contact-forces": fig_body_contact_forces,
     "granule-speeds": fig_granule_speeds,
     "wall-forces": fig_wall_forces,
+    "sensor-forces": fig_sensor_forces,
 }
 
 
@@ -442,6 +457,8 @@ def missing(name: str, ds: xr.Dataset) -> str | None:
         return "the run has no drives or gravity (its walls' forces are the Dataset's wall_force)"
     if name == "wall-forces" and "wall_force" not in ds and "drive_force" not in ds:
         return "the run has no walls or drives"
+    if name == "sensor-forces" and ds.sizes.get("sensor_time", 0) == 0:
+        return "the run has no [[sensors]]"
     return None
 
 

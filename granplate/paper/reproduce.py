@@ -622,8 +622,9 @@ def register(subparsers) -> None:
         action="append",
         default=None,
         metavar="VARIABLE:LABEL",
-        help="--figure spectrum: a signal, e.g. wall_force:bottom or drive_displacement:piston "
-        "(repeatable; default every wall and drive signal)",
+        help="--figure spectrum: a signal, e.g. wall_force:bottom, drive_displacement:piston or "
+        "sensor_force:NAME (repeatable, on one time axis; default every wall and drive signal, or "
+        "every sensor of a run with no walls or drives)",
     )
     p.add_argument(
         "--reference",

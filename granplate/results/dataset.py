@@ -94,6 +94,10 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "wall_force": ("N", "normal force each wall receives from the granules (positive in compression)"),
     "drive_force": ("N", "force each drive applies on its wall or granule along its direction"),
     "drive_displacement": ("m", "displacement of each drive's wall or granule along its direction since t = 0"),
+    "sensor_force": (
+        "N",
+        "each sensor's reading: half the sum of the normal contact forces on its granule (compression positive; docs/model.md section 3.15)",
+    ),
     "contact_time_formed": (
         "s",
         "time each plate contact formed: 0 for those at t = 0, a patch contact's when its granule came within contact.skin R of the face",
@@ -418,6 +422,7 @@ def to_dataset(
     data["n_iterations"] = _var("n_iterations", ("time",), out.stats[:n, K.S_ITERS].astype(np.int64))
     data["contact_time_formed"] = _var("contact_time_formed", ("contact",), axis.time_formed)
     data.update(wall_and_drive_outputs(model, out, n, coords))
+    data.update(sensor_outputs(model, out, float(t[-1]) if n else -math.inf, coords))
     if model.plate is not None:
         ft = plate_data.pop("_field_time")
         data.update(plate_data)
@@ -632,6 +637,28 @@ def wall_and_drive_outputs(model, out: K.Output, n: int, coords: dict) -> dict[s
         data["drive_force"] = _var("drive_force", ("time", "drive"), out.drive[:n, :, 0].copy())
         data["drive_displacement"] = _var("drive_displacement", ("time", "drive"), out.drive[:n, :, 1].copy())
     return data
+
+
+def sensor_outputs(model, out: K.Output, t_last: float, coords: dict) -> dict[str, xr.DataArray]:
+    """sensor_force (sensor_time, sensor) of the samples recorded up to t_last [s] (the
+    Dataset's last output time), with the coordinates `sensor_time` (its own time axis)
+    and `sensor` (the sensors' names) added to coords; none for a run without sensors."""
+    s = model.scenario
+    if not s.sensors:
+        return {}
+    n = int(out.sensor_n[0])
+    n = int(np.searchsorted(out.sensor_t[:n], t_last, side="right"))
+    coords["sensor_time"] = (
+        "sensor_time",
+        out.sensor_t[:n].copy(),
+        {"units": "s", "long_name": "the sensors' sample times (time.sensor_interval)"},
+    )
+    coords["sensor"] = (
+        "sensor",
+        np.array([x.label for x in s.sensors], dtype=str),
+        {"long_name": "sensor (its name, or its granule's label)"},
+    )
+    return {"sensor_force": _var("sensor_force", ("sensor_time", "sensor"), out.sensor_force[:n].copy())}
 
 
 def summary(ds: xr.Dataset) -> dict:

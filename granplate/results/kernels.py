@@ -45,17 +45,31 @@ def compile_all_wanted() -> bool:
     return os.environ.get(COMPILE_ENV, "all").strip().lower() != "own"
 
 
+def _with_sensor(s: Scenario) -> Scenario:
+    """`s` with a force sensor in its first granule (docs/model.md section 3.15), so that
+    its short run compiles the sensors' read too."""
+    from dataclasses import replace
+
+    from granplate.setup.drive_checks import granule_labels
+    from granplate.setup.geometry import resolve
+    from granplate.setup.scenario import Sensor
+
+    return replace(s, sensors=(Sensor(granule=granule_labels(resolve(s))[0]),))
+
+
 def _plane_granules(scheme: str) -> list[Scenario]:
     from granplate.setup.io import with_changes
     from granplate.setup.presets import preset
 
     if scheme == "verlet":  # the granules alone
         return [
-            with_changes(
-                preset("steel-r1"), {"plate": None, "solver.scheme": "verlet", "solver.granular_friction": "split"}
+            _with_sensor(
+                with_changes(
+                    preset("steel-r1"), {"plate": None, "solver.scheme": "verlet", "solver.granular_friction": "split"}
+                )
             )
         ]
-    return [with_changes(preset("steel-r1"), {"solver.scheme": scheme})]
+    return [_with_sensor(with_changes(preset("steel-r1"), {"solver.scheme": scheme}))]
 
 
 #: A small fcc packing in space, the granules alone (a box of walls).
@@ -81,11 +95,12 @@ def _space_granules(scheme: str) -> list[Scenario]:
     from granplate.setup.io import loads, with_changes
     from granplate.setup.presets import preset
 
-    if scheme != "verlet":  # the granules alone, in a box
-        return [loads(_FCC.format(scheme=scheme))]
+    alone = _with_sensor(loads(_FCC.format(scheme=scheme)))  # the granules alone, in a box, a sensor in one
+    if scheme != "verlet":
+        return [alone]
     on_plate = with_changes(preset("3d-steel-r1"), {"plate.elements": [2, 8, 1]})
     bare = with_changes(preset("3d-bare-plate"), {"plate.elements": [2, 8, 1]})
-    return [on_plate, bare]  # the granules alone in space run the same loop, its body empty
+    return [on_plate, bare, alone]  # the granules alone in space run the same loop, its body empty
 
 
 @dataclass(frozen=True)

@@ -1,8 +1,10 @@
 """Spectra of recorded signals and the transmission between two of them.
 
 A signal is one column of a time-indexed Dataset variable: `wall_force` (time, wall),
-`drive_force` or `drive_displacement` (time, drive), named "VARIABLE:LABEL"
-(e.g. "wall_force:bottom", "drive_displacement:piston"). The spectrum is the one-sided
+`drive_force` or `drive_displacement` (time, drive), `sensor_force` (sensor_time, sensor:
+on the sensors' own time axis), named "VARIABLE:LABEL" (e.g. "wall_force:bottom",
+"drive_displacement:piston", "sensor_force:b10"). The signals of one table share their
+sample times. The spectrum is the one-sided
 amplitude spectrum of the (periodic) Hann-windowed signal, scaled so that a sine of amplitude a at
 a bin frequency reads a (docs/output.md, "Spectra"):
 
@@ -20,7 +22,7 @@ import xarray as xr
 
 from granplate.errors import ScenarioError
 
-SIGNAL_VARIABLES = ("wall_force", "drive_force", "drive_displacement")
+SIGNAL_VARIABLES = ("wall_force", "drive_force", "drive_displacement", "sensor_force")
 WINDOW = "hann"
 
 
@@ -90,18 +92,35 @@ def transmission(x_out: np.ndarray, x_in: np.ndarray, dt: float, floor: float = 
 
 
 def spectrum_table(ds: xr.Dataset, names: list[str], reference: str | None = None) -> xr.Dataset:
-    """The spectra of the named signals (and, with a reference, each one's transmission
+    """The spectra of the named signals (none: every signal on the first one's time axis;
+    all on the same sample times) (and, with a reference, each one's transmission
     relative to it) as a Dataset on a `frequency` [Hz] coordinate: `amplitude` (signal,
     frequency) in each signal's units and `transmission` (signal, frequency) [1]."""
-    if not names:
+    if not names:  # every signal on the first one's time axis
         names = signal_names(ds)
+        axis = ds[names[0].partition(":")[0]].dims[0] if names else None
+        names = [n for n in names if ds[n.partition(":")[0]].dims[0] == axis]
     if not names:
         raise ScenarioError("--signal", "none", "the run records no wall, drive or sensor signal")
     rows, units, trans = [], [], []
     f = np.zeros(0)
-    ref = signal(ds, reference)[1] if reference else None
+    t0 = None
+    if reference:
+        t0, ref, _ = signal(ds, reference)
+    else:
+        ref = None
     for name in names:
         t, x, unit = signal(ds, name)
+        if t0 is None:
+            t0 = t
+        elif t.shape != t0.shape or not np.allclose(t, t0, rtol=0.0, atol=1e-9 * float(np.ptp(t0) or 1.0)):
+            first = reference if reference else names[0]
+            raise ScenarioError(
+                "--signal",
+                name,
+                f"its samples are not those of {first} ({t.size} against {t0.size} times): signals on "
+                "different time axes (the output's `time`, the sensors' `sensor_time`) go in separate spectra",
+            )
         dt = sample_interval(t)
         f, amp = amplitude_spectrum(x, dt)
         rows.append(amp)

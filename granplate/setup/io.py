@@ -47,6 +47,7 @@ from granplate.setup.scenario import (
     Plate,
     Precompression,
     Scenario,
+    Sensor,
     Solid,
     Solver,
     TimeSettings,
@@ -62,6 +63,7 @@ REQUIRED: dict[type, tuple[str, ...]] = {
     Gravity: ("g",),
     Drive: ("target", "kind", "direction", "profile"),
     Precompression: ("target", "force"),
+    Sensor: ("granule",),
 }
 #: Keys of a [materials.NAME] table: E, nu, rho required; Y optional (absent: unknown);
 #: the law "johnson"'s C, rate_ref, hardness_ratio, unloading_factor optional.
@@ -354,7 +356,7 @@ def from_dict(d: dict, base: str | os.PathLike | None = None) -> Scenario:
     Top-level keys: name, description, dimension, materials, layout, granules (or
     granules_file: a CSV, NPZ or netCDF file of them, setup.granules_file, relative to
     `base`, by default the working directory), walls, box, plate, load, contact, time,
-    solver, gravity, drives. Missing tables take the defaults (no layout, no plate, no box,
+    solver, gravity, drives, sensors. Missing tables take the defaults (no layout, no plate, no box,
     no gravity, no drives; dimension 2; in 3D no load, `load.kind = "none"`). `base` is
     also the folder a drive's CSV `file` is relative to.
     """
@@ -388,6 +390,8 @@ def from_dict(d: dict, base: str | os.PathLike | None = None) -> Scenario:
         kw["walls"] = _walls(d["walls"], kw.get("dimension", 2))
     if d.get("drives") is not None:
         kw["drives"] = _drives(d["drives"], base)
+    if d.get("sensors") is not None:
+        kw["sensors"] = _convert("sensors", d["sensors"], tuple[Sensor, ...])
     if kw.get("dimension") == 3 and d.get("load") is None:
         kw["load"] = Load(kind="none")  # the plane's default line load has no meaning in space
     if isinstance(kw.get("plate"), Solid) and "scheme" not in (d.get("solver") or {}):
@@ -507,6 +511,8 @@ def to_dict(s: Scenario, all_materials: bool = False) -> dict:
         d["drives"] = [_without_defaults(x, DRIVE_DEFAULTS) for x in _plain(s.drives)]
     if s.precompression is not None:
         d["precompression"] = _plain(s.precompression)
+    if s.sensors:  # (none: not written, so that every scenario without them is written as before)
+        d["sensors"] = [_without_defaults(x, {"name": ""}) for x in _plain(s.sensors)]
     return d
 
 

@@ -556,7 +556,9 @@ class TimeSettings:
     """Time settings [s]: end time, initial/max/min step, output intervals.
 
     output_interval: scalar outputs and granule states; field_interval: plate
-    displacement snapshots (a multiple of output_interval).
+    displacement snapshots (a multiple of output_interval); sensor_interval: the
+    [[sensors]]' samples (None: output_interval), landed on by the steps like the
+    output times.
     """
 
     t_end: float = 2e-3
@@ -565,6 +567,7 @@ class TimeSettings:
     dt_min: float = 1e-13
     output_interval: float = 1e-6
     field_interval: float = 2e-5
+    sensor_interval: float | None = None
 
 
 @dataclass(frozen=True)
@@ -681,6 +684,25 @@ class Drive:
 
 
 @dataclass(frozen=True)
+class Sensor:
+    """A force sensor embedded in a granule (docs/model.md section 3.15): it reads half
+    the sum of the normal contact forces on that granule [N], every time.sensor_interval.
+
+    granule: the `label` of a [[granules]] entry (or of a granule a layout made; an
+    unlabelled granule's label is its 1-based index, "3"); name: the sensor's name in the
+    Dataset (default: the granule's label).
+    """
+
+    granule: str
+    name: str = ""
+
+    @property
+    def label(self) -> str:
+        """The sensor's name in the Dataset: its name, or its granule's label."""
+        return self.name or self.granule
+
+
+@dataclass(frozen=True)
 class Scenario:
     """A complete run definition. Either `layout` or explicit `granules`/`walls`.
 
@@ -692,7 +714,8 @@ class Scenario:
     file equals the same one given as tables, and is written as tables (`io.to_dict`).
     gravity: a body force on every granule (None: none); drives: prescribed motions of
     walls and granules and prescribed forces on granules (docs/model.md section 3.11);
-    precompression: the static state the run starts from (None: as given; section 3.12).
+    precompression: the static state the run starts from (None: as given; section 3.12);
+    sensors: force sensors in granules, sampled every time.sensor_interval (section 3.15).
     """
 
     name: str = "custom"
@@ -712,6 +735,7 @@ class Scenario:
     gravity: Gravity | None = None
     drives: tuple[Drive, ...] = ()
     precompression: Precompression | None = None
+    sensors: tuple[Sensor, ...] = ()
 
     def material(self, name: str) -> Material:
         """The material called `name` (file-defined ones override the library)."""

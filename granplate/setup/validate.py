@@ -28,6 +28,7 @@ from typing import Any
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import granule_named, plane_offset, resolve, unit
 from granplate.setup.drive_checks import check_drives, check_gravity
+from granplate.setup.sensor_checks import check_sensors
 from granplate.setup.precompression_checks import check_precompression
 from granplate.setup.fields import (
     check_dimension,
@@ -394,7 +395,7 @@ def validate(scenario: Scenario) -> None:
     range of every coordinate and size (`LENGTH_RANGE`), overlaps and penetrations at
     t = 0 (walls, the plate's edge, a box solid's surface), load, contact (and the yield strengths its normal laws need), plate mesh (rigid
     layers of the contacts on nodes, patch contacts between nodes, n_modes), time, the
-    outputs' memory, solver, gravity and drives. A scenario with neither granules (nor a layout) nor a plate
+    outputs' memory, solver, gravity, drives and sensors. A scenario with neither granules (nor a layout) nor a plate
     is refused.
     """
     if _passed_before(scenario):
@@ -445,6 +446,7 @@ def _validate(scenario: Scenario) -> None:
     _check_output_size(r)
     _check_solver(r)
     _check_drives(r)
+    check_sensors(r)
 
 
 def _check_drives(s: Scenario) -> None:

@@ -76,6 +76,18 @@ def has_body(b) -> bool:
 
 
 @njit(cache=True)
+def sensor_loads(b, buf, load):
+    """Add half the normal force [N] of each granule's contact with the body, as the force
+    pass into buffer buf left it, to its sensor reading load[i] (docs/model.md section
+    3.15); nothing without a body."""
+    if not has_body(b):
+        return
+    for i in range(load.shape[0]):
+        if b.geo[buf, i, GEO_TOUCH] != 0.0:
+            load[i] += 0.5 * b.geo[buf, i, GEO_N]
+
+
+@njit(cache=True)
 def near_box(b, x, y, z, reach) -> bool:
     """Whether a centre lies within `reach` [m] of the body's bounding box."""
     d2 = 0.0

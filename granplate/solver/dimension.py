@@ -49,6 +49,12 @@ def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
     raise NotImplementedError("compiled use only")
 
 
+def sensor_loads(y, g, cfg, load):
+    """Every granule's sensor reading [N]: half the sum of its pair and wall contacts'
+    normal forces (solver.granular.sensor_loads)."""
+    raise NotImplementedError("compiled use only")
+
+
 def plate_friction_held(hold, g):
     """Whether a step holds plate-contact friction that changes its first stage: `hold` in
     the plane; never in space (no plate contacts there yet), so that the step reuses the
@@ -100,6 +106,14 @@ def _normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
     if _module_of(g) is space:
         fb = blocks.normal_forces_blocks
         return lambda t, y, g, cfg, acc, fdamp, fload, fpar, spar: fb(t, y, g, cfg, acc, fdamp, fload, fpar, spar)
+
+
+@overload(sensor_loads, inline="always")
+def _sensor_loads(y, g, cfg, load):
+    m = _module_of(g)
+    if m is not None:
+        fn = m.sensor_loads
+        return lambda y, g, cfg, load: fn(y, g, cfg, load)
 
 
 @overload(plate_friction_held, inline="always")

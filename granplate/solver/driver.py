@@ -29,6 +29,7 @@ from granplate.plate.face import patch_weights
 from granplate.solver.interface import set_face_weights
 from granplate.solver.ladder import level_for
 from granplate.solver.schemes import scheme
+from granplate.setup.sensor_checks import n_sensor_samples, sensor_granules, sensor_interval
 
 #: wall-time target of one compiled chunk [s], and the step budget of the first one.
 CHUNK_SECONDS = 0.15
@@ -116,6 +117,35 @@ def output_times(t_end: float, dt_out: float) -> np.ndarray:
     t = np.arange(n + 1) * dt_out
     t[-1] = t_end
     return t
+
+
+#: a sensor's sample time within this fraction of the sensor interval of an output time
+#: is that output time (one step lands on both).
+SNAP_RTOL = 1e-9
+
+
+def sensor_times(t_first: float, t_end: float, interval: float, times: np.ndarray) -> np.ndarray:
+    """The sensors' sample times k * interval in [t_first, t_end] [s] (docs/model.md
+    section 3.15), each within SNAP_RTOL intervals of an output time (`times`) taken as
+    that output time, so that the steps land on both at once."""
+    k = np.arange(n_sensor_samples(t_end, interval))
+    ts = k * interval
+    j = np.clip(np.searchsorted(times, ts), 1, len(times) - 1) if len(times) > 1 else np.zeros(len(ts), int)
+    for cand in (j - 1, j):
+        near = np.abs(times[cand] - ts) <= SNAP_RTOL * interval
+        ts = np.where(near, times[cand], ts)
+    ts = np.unique(np.minimum(ts, t_end))  # (one step lands on each: none twice)
+    return ts[ts >= t_first - SNAP_RTOL * interval]
+
+
+def sensor_setup(model: Model, times: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """(the sample times from the run's first output time on, each sensor's granule) of
+    the model's [[sensors]], or (None, None) without sensors."""
+    s = model.scenario
+    if not s.sensors:
+        return None, None
+    ts = sensor_times(float(times[0]), float(model.config.t_end), sensor_interval(s), times)
+    return ts, np.asarray(sensor_granules(s), np.int64)
 
 
 def status_message(status: int, model: Model, st: S.State) -> str:
@@ -325,7 +355,8 @@ class LoopArrays:
                 first, last = patch_weights(p.face_y, float(y_k), 0.0, self.w.wface)
                 set_face_weights(k, first, last, self.w)
         self.sw = scheme(cfg.scheme).new_scratch(ng, nm, nk, body=model.body, threads=cfg.threads)
-        self.out = S.new_output(times, ng, nm, nk, nc, len(g.wall_load), len(g.drive_target))
+        ts, gs = sensor_setup(model, times)
+        self.out = S.new_output(times, ng, nm, nk, nc, len(g.wall_load), len(g.drive_target), ts, gs)
         self.scheme = cfg.scheme
         self.sw_threads = cfg.threads
 
@@ -341,7 +372,17 @@ class LoopArrays:
         self.sw = _copied(self.sw, scheme(self.scheme).new_scratch(ng, nm, nk_new, threads=self.sw_threads))
         self.out = _copied(
             self.out,
-            S.new_output(self.out.target, ng, nm, nk_new, nc, self.out.wall_force.shape[1], self.out.drive.shape[1]),
+            S.new_output(
+                self.out.target,
+                ng,
+                nm,
+                nk_new,
+                nc,
+                self.out.wall_force.shape[1],
+                self.out.drive.shape[1],
+                self.out.sensor_target,
+                self.out.sensor_granule,
+            ),
         )
         phi_d = np.zeros((2 * nk_new, nm))
         phi_d[: self.p.phi_d.shape[0]] = self.p.phi_d
@@ -624,6 +665,7 @@ def run(
         (loop.initialise, (st, lists.g, arr.p, cfg, w)),
         (loop.start_scheme, (arr.sw, st, lists.g, cfg)),
         (loop.record, (0, st, lists.g, arr.p, w, arr.out)),
+        *sensor_calls(arr.sw, st, lists.g, cfg, arr.out),
         (loop.advance, (float(times[-1]), FIRST_BUDGET, lists.g, arr.p, cfg, st, arr.w, arr.sw, arr.out)),
     ]
     t1 = time.perf_counter()
@@ -632,8 +674,24 @@ def run(
     loop.initialise(st, lists.g, arr.p, cfg, w)
     loop.start_scheme(arr.sw, st, lists.g, cfg)
     loop.record(0, st, lists.g, arr.p, w, arr.out)
+    first_sensor_sample(model, arr.sw, st, lists.g, arr.out)
     st.count[S.C_OUT] = 1
     return _finish(model, times, arr, lists, t1, progress, should_stop, interruptible)
+
+
+def sensor_calls(sw, st: S.State, g, cfg, out: S.Output) -> list[tuple]:
+    """The compiled call a run with sensors makes from Python (its first sample), to
+    compile before the loop's clock starts; none without sensors."""
+    return [(loop.record_sensors, (sw, st, g, cfg, out))] if len(out.sensor_granule) else []
+
+
+def first_sensor_sample(model: Model, sw, st: S.State, g, out: S.Output) -> None:
+    """The sensors' sample at the run's first output time, when it is a sample time (to
+    SNAP_RTOL intervals: a restart's clock is the first run's end, to its rounding)."""
+    if not len(out.sensor_target):
+        return
+    if out.sensor_target[0] <= st.clock[S.T_NOW] + SNAP_RTOL * sensor_interval(model.scenario):
+        loop.record_sensors(sw, st, g, model.config, out)
 
 
 def _run_from(model: Model, start: dict, progress: bool, should_stop, interruptible: bool) -> RunRecord:
@@ -650,12 +708,14 @@ def _run_from(model: Model, start: dict, progress: bool, should_stop, interrupti
     st = arr.st
     calls = [
         (loop.record, (0, st, lists.g, arr.p, arr.w, arr.out)),
+        *sensor_calls(arr.sw, st, lists.g, cfg, arr.out),
         (loop.advance, (float(times[-1]), FIRST_BUDGET, lists.g, arr.p, cfg, st, arr.w, arr.sw, arr.out)),
     ]
     c1 = time.perf_counter()
     note_compile(model, calls)
     compile_calls(calls)
     loop.record(0, st, lists.g, arr.p, arr.w, arr.out)
+    first_sensor_sample(model, arr.sw, st, lists.g, arr.out)
     st.count[S.C_OUT] = 1
     return _finish(model, times, arr, lists, c1, progress, should_stop, interruptible)
 

@@ -536,3 +536,39 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
         acc[i, 4] /= g.mass[i]
         acc[i, 5] /= g.inertia[i]
     return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
+
+
+@njit(cache=True)
+def sensor_loads(y, g, cfg, load):
+    """Every granule's sensor reading at state y [N] into load (ng,): half the sum of the
+    normal forces N (eqs. 2-4, compression positive, with their damping at the state's
+    velocities and each contact's history) of its listed pair and wall contacts
+    (docs/model.md section 3.15; the plate contacts' the caller adds). Reads, never
+    writes, the contacts' histories and the walls' loads: run at the sample times alone."""
+    for i in range(load.shape[0]):
+        load[i] = 0.0
+    for p in range(g.pair_ij.shape[0]):
+        i = g.pair_ij[p, 0]
+        j = g.pair_ij[p, 1]
+        ri = g.radius[i]
+        rj = g.radius[j]
+        if pair_apart(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj):
+            continue
+        delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
+        if delta <= 0.0:
+            continue
+        ddot = pair_normal_rate(y[i, 3], y[i, 4], y[j, 3], y[j, 4], nx, nz)
+        n = normal_law_force(delta, ddot, g.pair_coef[p], g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip)
+        load[i] += 0.5 * n
+        load[j] += 0.5 * n
+    for w in range(g.wall_i.shape[0]):
+        i = g.wall_i[w]
+        nx = g.wall_geo[w, 0]
+        nz = g.wall_geo[w, 1]
+        shift, vn, _ = wall_motion(g, w)
+        delta = wall_overlap(y[i, 0], y[i, 1], g.radius[i], nx, nz, g.wall_geo[w, 2] + shift)
+        if delta <= 0.0:
+            continue
+        ddot = y[i, 3] * nx + y[i, 4] * nz - vn
+        n = normal_law_force(delta, ddot, g.wall_coef[w], g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
+        load[i] += 0.5 * n

@@ -444,3 +444,36 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
             acc[i, VX + c] /= g.mass[i]
             acc[i, WX + c] /= g.inertia[i]
     return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
+
+
+@njit(cache=True)
+def sensor_loads(y, g, cfg, load):
+    """Every granule's sensor reading at state y [N] into load (ng,), as
+    solver.granular.sensor_loads in space: half the sum of the normal forces of its
+    listed pair and wall contacts (docs/model.md section 3.15)."""
+    for i in range(load.shape[0]):
+        load[i] = 0.0
+    for p in range(g.pair_ij.shape[0]):
+        i = g.pair_ij[p, 0]
+        j = g.pair_ij[p, 1]
+        delta, nx, ny, nz = pair_contact_3d(
+            y[i, X], y[i, Y], y[i, Z], g.radius[i], y[j, X], y[j, Y], y[j, Z], g.radius[j]
+        )
+        if delta <= 0.0:
+            continue
+        ddot = normal_rate_3d(y[i, VX] - y[j, VX], y[i, VY] - y[j, VY], y[i, VZ] - y[j, VZ], nx, ny, nz)
+        n = normal_law_force(delta, ddot, g.pair_coef[p], g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip)
+        load[i] += 0.5 * n
+        load[j] += 0.5 * n
+    for w in range(g.wall_i.shape[0]):
+        i = g.wall_i[w]
+        nx = g.wall_geo[w, 0]
+        ny = g.wall_geo[w, 1]
+        nz = g.wall_geo[w, 2]
+        shift, vn, _ = wall_motion(g, w)
+        delta = wall_overlap_3d(y[i, X], y[i, Y], y[i, Z], g.radius[i], nx, ny, nz, g.wall_geo[w, 3] + shift)
+        if delta <= 0.0:
+            continue
+        ddot = normal_rate_3d(y[i, VX], y[i, VY], y[i, VZ], nx, ny, nz) - vn
+        n = normal_law_force(delta, ddot, g.wall_coef[w], g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
+        load[i] += 0.5 * n

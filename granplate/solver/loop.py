@@ -16,7 +16,7 @@ from granplate.physics.energy import energy_residual, energy_total
 from granplate.solver import schemes as S
 from granplate.solver.blocks import accept_rows, commit_histories_blocks
 from granplate.solver.contacts import watch_contacts
-from granplate.solver.dimension import granular_rhs, kinetic_energies
+from granplate.solver.dimension import granular_rhs, kinetic_energies, sensor_loads
 from granplate.solver.granular import commit_histories
 from granplate.solver.rk4 import RK4_FRICTION_LIMIT
 from granplate.solver.interface import accept_contacts, contact_modulus, first_guess, move_patches, place_patch
@@ -223,6 +223,33 @@ def record(o, st, g, p, w, out):
 
 
 @njit(cache=True)
+def record_sensors(sw, st, g, cfg, out):
+    """Write every sensor's reading at t_n into the next sensor row (docs/model.md section
+    3.15): half the sum of the normal forces on its granule, of its pair and wall contacts
+    (`sensor_loads`), of its plate contacts (their |N| at t_n) and of its contact with the
+    scheme's own body (the hook body_sensor_loads of the scheme whose scratch is sw)."""
+    s = out.sensor_n[0]
+    sensor_loads(st.y, g, cfg, out.sensor_load)
+    S.body_sensor_loads(sw, out.sensor_load)
+    for k in range(g.pc_i.shape[0]):
+        out.sensor_load[g.pc_i[k]] += 0.5 * st.normal[k]
+    out.sensor_t[s] = st.clock[T_NOW]
+    for j in range(out.sensor_granule.shape[0]):
+        out.sensor_force[s, j] = out.sensor_load[out.sensor_granule[j]]
+    out.sensor_n[0] = s + 1
+
+
+@njit(cache=True)
+def next_landing(t_out, out):
+    """The next time a step must land on [s]: the next output time t_out, or the next
+    sensor sample time when it comes first; and whether it is t_out."""
+    s = out.sensor_n[0]
+    if s < out.sensor_target.shape[0] and out.sensor_target[s] < t_out:
+        return out.sensor_target[s], False
+    return t_out, True
+
+
+@njit(cache=True)
 def fail(status, err, t, h, contact, n, vt, lam, resid, it):
     """Fill the failure record err (st.err: time, contact, |N|, slip, |lambda|, step,
     residual, iterations) and return `status`."""
@@ -292,8 +319,8 @@ def needs_matrices(h, slot, clock, g_ok):
 def accept_granular(t, h, land, t_out, plate_work, e_pot, st, w, rows):
     """Take the trial step's granule state, derivatives (unless `rows` is False: taken
     already) and work (with the plastic work of the contacts loaded past their largest
-    overlaps) into the state and move the clock (onto the output time when the step lands
-    on it)."""
+    overlaps) into the state and move the clock (onto t_out, the output or sensor sample time,
+    when the step lands on it)."""
     if rows:
         for i in range(st.y.shape[0]):
             for c in range(st.y.shape[1]):
@@ -322,9 +349,10 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
     """Advance from st.clock[T_NOW] to t_stop (an output time) with the scheme whose
     scratch is sw, trying at most max_attempts steps. Returns a status: OK, PAUSED
     (budget spent; call again) or an error, with st.err filled and the state the last
-    accepted one. After every accepted step the patch contacts follow their granules
-    (interface.move_patches, then the scheme's hook contacts_moved) and the contact
-    watch runs (solver/contacts.py): REBUILD asks the driver to rebuild the contact
+    accepted one. Steps land on the output times and on the sensors' sample times
+    (out.sensor_target; `record_sensors` at each). After every accepted step the patch
+    contacts follow their granules (interface.move_patches, then the scheme's hook
+    contacts_moved) and the contact watch runs (solver/contacts.py): REBUILD asks the driver to rebuild the contact
     list, NEW_PLATE to add a patch contact, and to call again."""
     for _ in range(max_attempts):
         t = st.clock[T_NOW]
@@ -333,7 +361,8 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
         o = st.count[C_OUT]
         if o >= out.t.shape[0]:
             return ERR_BUFFER
-        level, h, slot, land = S.plan(sw, st.count, cfg, t - out.target[o - 1], out.target[o] - t)
+        t_land, on_output = next_landing(out.target[o], out)
+        level, h, slot, land = S.plan(sw, st.count, cfg, t - out.target[o - 1], t_land - t)
         if not land and t + h <= t:  # a step too small to move the clock: it would spin
             return step_too_small(t, h, 0, -1, 0.0, st.normal, st.slip, st)
         if needs_matrices(h, slot, st.clock, w.g_ok):
@@ -357,10 +386,10 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
         plate_work = S.commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w)
         if cfg.threads > 1:  # the copies and the pairs' histories on every core (solver.blocks)
             accept_rows(st.y, st.k0, st.k1, w.ynew, w.kend)
-            accept_granular(t, h, land, out.target[o], plate_work, e_pot, st, w, False)
+            accept_granular(t, h, land, t_land, plate_work, e_pot, st, w, False)
             commit_histories_blocks(st.clock[T_NOW], g)
         else:
-            accept_granular(t, h, land, out.target[o], plate_work, e_pot, st, w, True)
+            accept_granular(t, h, land, t_land, plate_work, e_pot, st, w, True)
             commit_histories(st.clock[T_NOW], g)
         lam_max = accept_contacts(
             h, w.gmat[slot], g.pc_coef, w.normal_new, w.slip_new, w.conv_iter, st.normal, st.slip, w.lam_int, w.it_int
@@ -377,8 +406,11 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
         if status != OK:
             return status
         if land:
-            record(o, st, g, p, w, out)
-            st.count[C_OUT] = o + 1
+            if out.sensor_n[0] < out.sensor_target.shape[0] and out.sensor_target[out.sensor_n[0]] <= t_land:
+                record_sensors(sw, st, g, cfg, out)
+            if on_output:
+                record(o, st, g, p, w, out)
+                st.count[C_OUT] = o + 1
         if g.pc_patch.shape[0] > 0 and move_patches(st, g, p, cfg, w):  # patch contacts follow their granules
             S.contacts_moved(sw, st.clock[T_NOW], st, p, cfg)
         status = watch_contacts(

@@ -156,6 +156,12 @@ class Output(NamedTuple):
     stats: np.ndarray  # (no, N_STEPSTAT)
     wall_force: np.ndarray  # (no, n_walls) the normal force each wall receives [N]
     drive: np.ndarray  # (no, n_drives, 2) each drive's force [N] and displacement [m] along its direction
+    sensor_target: np.ndarray  # (ns,) the sensors' sample times [s], set by the caller (empty: no sensors)
+    sensor_t: np.ndarray  # (ns,) the times reached (equal to sensor_target)
+    sensor_force: np.ndarray  # (ns, n_sensors) each sensor's reading [N] (docs/model.md section 3.15)
+    sensor_granule: np.ndarray  # (n_sensors,) int: each sensor's granule
+    sensor_load: np.ndarray  # (ng,) scratch: every granule's reading at a sample time [N]
+    sensor_n: np.ndarray  # (1,) int: samples recorded
 
 
 def new_state(ng: int, nm: int, nk: int, nc: int = 6) -> State:
@@ -234,12 +240,23 @@ def new_work(ng: int, nm: int, nk: int, n_face: int = 0, nc: int = 6) -> Work:
 
 
 def new_output(
-    times: np.ndarray, ng: int, nm: int, nk: int, nc: int = 6, n_walls: int = 0, n_drives: int = 0
+    times: np.ndarray,
+    ng: int,
+    nm: int,
+    nk: int,
+    nc: int = 6,
+    n_walls: int = 0,
+    n_drives: int = 0,
+    sensor_times: np.ndarray | None = None,
+    sensor_granules: np.ndarray | None = None,
 ) -> Output:
     """Output buffers for the given output times (nc state columns per granule, n_walls
-    walls, n_drives drives)."""
+    walls, n_drives drives) and the sensors' sample times of the sensors in the granules
+    `sensor_granules` (None: no sensors)."""
     z = np.zeros
     n_out = len(times)
+    gs = np.zeros(0, np.int64) if sensor_granules is None else np.asarray(sensor_granules, np.int64)
+    ts = np.zeros(0) if sensor_times is None or len(gs) == 0 else np.asarray(sensor_times, float)
     return Output(
         target=np.asarray(times, float).copy(),
         t=z(n_out),
@@ -254,4 +271,10 @@ def new_output(
         stats=z((n_out, N_STEPSTAT)),
         wall_force=z((n_out, n_walls)),
         drive=z((n_out, n_drives, 2)),
+        sensor_target=ts.copy(),
+        sensor_t=z(len(ts)),
+        sensor_force=z((len(ts), len(gs))),
+        sensor_granule=gs.copy(),
+        sensor_load=z(ng),
+        sensor_n=np.zeros(1, np.int64),
     )

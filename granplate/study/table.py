@@ -24,6 +24,7 @@ FIELD_UNITS: dict[str, str] = {
     "dt_max": "s",
     "output_interval": "s",
     "field_interval": "s",
+    "sensor_interval": "s",
     "R1": "m",
     "R2_ratio": "1",
     "E": "Pa",

@@ -13,6 +13,13 @@ A scheme module defines NAME, a `Scratch` named tuple (its own scratch arrays),
     contacts_moved(sw, t, st, p, cfg)
     start(sw, t, st, g, cfg) -> (contact energy, residual energy) [J] at t = 0
 
+and one optional hook, absent from a scheme whose bodies are the granules and the plate
+alone (then it adds nothing):
+
+    body_sensor_loads(sw, load)   half the normal force of each granule's contact with the
+                                  scheme's own body (an elastic solid in space) added to
+                                  its sensor reading load[i] [N] (docs/model.md section 3.15)
+
 `start` gives what the scheme's own bodies hold at t = 0 (an elastic body in space's
 contacts, solver.body; (0, 0) for the others). The two before it keep the scheme's own driving-DOF state true when the plate contacts' rows
 of Phi_d change between steps (solver/interface.py, docs/model.md section 3.5):
@@ -172,3 +179,19 @@ def _start(sw, t, st, g, cfg):
     fn = _hook_of(sw, "start")
     if fn is not None:
         return lambda sw, t, st, g, cfg: fn(sw, t, st, g, cfg)
+
+
+def body_sensor_loads(sw, load):
+    """The scheme's own body's share of the sensors' readings (none where it has no hook)."""
+    raise NotImplementedError("compiled use only")
+
+
+@overload(body_sensor_loads, inline="always")
+def _body_sensor_loads(sw, load):
+    module = _BY_SCRATCH.get(getattr(sw, "instance_class", None))
+    if module is None:
+        return None
+    fn = getattr(module, "body_sensor_loads", None)
+    if fn is None:
+        return lambda sw, load: None
+    return lambda sw, load: fn(sw, load)

@@ -303,6 +303,13 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
 
 
 @njit(cache=True)
+def body_sensor_loads(sw, load):
+    """The elastic body's share of the sensors' readings at t_n (load (ng,) [N]): half the
+    normal force of each granule's contact with it, from the force pass of t_n's buffer."""
+    B.sensor_loads(sw.body, int(sw.split[CURRENT]), load)
+
+
+@njit(cache=True)
 def body_friction(b) -> bool:
     """Whether any granule's contact with the body has a friction coefficient."""
     for i in range(b.coef.shape[0]):
