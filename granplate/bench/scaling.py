@@ -25,6 +25,7 @@ import math
 import os
 import subprocess
 import sys
+import tempfile
 import time
 
 from granplate.bench.harness import parse_pairs
@@ -179,13 +180,17 @@ def run_in_subprocess(module: str, worker: str, spec: dict, processes: int = 1) 
             return {"skipped": "no mpirun beside this Python or on the PATH (pip install mpich)"}
         code = (
             f"import os, json; from granplate.bench import {module}; r = {module}.{worker}("
-            "json.loads(os.environ['GRANPLATE_BENCH_SPEC'])); "
+            "json.loads(open(os.environ['GRANPLATE_BENCH_SPEC']).read())); "
             "print('@@RESULT ' + json.dumps(r)) if os.environ.get('PMI_RANK', '0') == '0' else None"
         )
-        env = dict(os.environ, GRANPLATE_BENCH_SPEC=json.dumps(spec))
-        p = subprocess.run(
-            [mpirun, "-np", str(processes), sys.executable, "-c", code], capture_output=True, text=True, env=env
-        )
+        with tempfile.TemporaryDirectory() as folder:  # every rank reads the spec from one file
+            path = os.path.join(folder, "spec.json")
+            with open(path, "w") as f:
+                json.dump(spec, f)
+            env = dict(os.environ, GRANPLATE_BENCH_SPEC=path)
+            p = subprocess.run(
+                [mpirun, "-np", str(processes), sys.executable, "-c", code], capture_output=True, text=True, env=env
+            )
     else:
         code = (
             f"import sys, json; from granplate.bench import {module}; "

@@ -23,6 +23,14 @@ def time_profile(t: float, duration: float) -> float:
     return math.sin(math.pi * t / duration)
 
 
+@njit(cache=True)
+def shock_amplitude(t: float, cfg) -> float:
+    """The shock's amplitude at t [s]: cfg.q0 (its peak, [N/m] on a line, [N] as a total
+    force) times the half-sine `time_profile` of cfg.duration; the one call every kernel
+    makes for it."""
+    return cfg.q0 * time_profile(t, cfg.duration)
+
+
 def _primitives(u: float, y0: float, yc: float, length: float) -> tuple[float, float]:
     """Antiderivatives in u = pi (y - y0) / L of sin(u) dy and (y - yc) sin(u) dy."""
     s = length / math.pi

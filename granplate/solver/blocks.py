@@ -20,16 +20,18 @@ from __future__ import annotations
 
 import os
 
-# OpenMP's threads sleep between the passes rather than spin (read once, when the threading
-# layer loads with these kernels): a spinning thread holds a core that the step's serial
-# part, or another process on a shared machine, needs. A user's own OMP_WAIT_POLICY is kept.
-os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+# OpenMP's idle threads spin about 30,000 turns (tens of microseconds: the gap between two
+# passes of a step) before they sleep, not GNU OpenMP's default 300,000: a thread spinning
+# on holds a core that the step's serial part, or another process on a shared machine,
+# needs. Read once, when the threading layer loads with these kernels; a user's own
+# GOMP_SPINCOUNT or OMP_WAIT_POLICY is kept. Measured in docs/benchmarks.md.
+os.environ.setdefault("GOMP_SPINCOUNT", "30000")
 
 from numba import njit, prange  # noqa: E402
 
 from granplate.model.inputs import HIST_END, HIST_MAX, HIST_RATE
 from granplate.physics.laws import normal_law_response
-from granplate.physics.shock import time_profile
+from granplate.physics.shock import shock_amplitude
 from granplate.physics.space import normal_rate_3d, pair_contact_3d, wall_overlap_3d
 from granplate.solver.drives import begin_pass, book_wall, wall_motion
 from granplate.solver.granular import ForceSums, commit_history, commit_history_row
@@ -161,7 +163,7 @@ def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
     begin_pass(t, g)
     p_shock = 0.0
     if not cfg.load_on_plate:
-        amp = cfg.q0 * time_profile(t, cfg.duration)
+        amp = shock_amplitude(t, cfg)
         if amp != 0.0:
             for i in range(ng):
                 for c in range(3):

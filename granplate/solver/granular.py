@@ -42,7 +42,7 @@ from granplate.physics.contact import (
 )
 from granplate.physics.cavity import rate_factor
 from granplate.physics.laws import normal_law_force, normal_law_response
-from granplate.physics.shock import time_profile
+from granplate.physics.shock import shock_amplitude
 from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_motion
 from granplate.solver.state import PARTNER_PLATE
 
@@ -113,7 +113,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
     ovl_j = -1
     w_plastic = 0.0
     if not cfg.load_on_plate:  # the shock on the loaded granules
-        amp = cfg.q0 * time_profile(t, cfg.duration)
+        amp = shock_amplitude(t, cfg)
         if amp != 0.0:
             for i in range(ng):
                 fx = amp * g.shock_force[i]
@@ -457,7 +457,7 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
     ovl_j = -1
     w_plastic = 0.0
     if not cfg.load_on_plate:
-        amp = cfg.q0 * time_profile(t, cfg.duration)
+        amp = shock_amplitude(t, cfg)
         if amp != 0.0:
             for i in range(ng):
                 fx = amp * g.shock_force[i]

@@ -13,7 +13,7 @@ from numba import njit
 from granplate.model.inputs import HIST_END, HIST_MAX, HIST_RATE
 from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm, friction_magnitude
 from granplate.physics.laws import normal_law_force, normal_law_response
-from granplate.physics.shock import time_profile
+from granplate.physics.shock import shock_amplitude
 from granplate.physics.space import (
     arm_torque_3d,
     friction_along_slip,
@@ -100,7 +100,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
     ovl_j = -1
     w_plastic = 0.0
     if not cfg.load_on_plate:
-        amp = cfg.q0 * time_profile(t, cfg.duration)
+        amp = shock_amplitude(t, cfg)
         if amp != 0.0:
             for i in range(ng):
                 for c in range(3):
@@ -361,7 +361,7 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
     ovl_j = -1
     w_plastic = 0.0
     if not cfg.load_on_plate:
-        amp = cfg.q0 * time_profile(t, cfg.duration)
+        amp = shock_amplitude(t, cfg)
         if amp != 0.0:
             for i in range(ng):
                 for c in range(3):

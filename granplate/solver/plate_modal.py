@@ -14,7 +14,7 @@ import math
 
 from numba import njit
 
-from granplate.physics.shock import time_profile
+from granplate.physics.shock import shock_amplitude
 
 
 @njit(cache=True)
@@ -23,7 +23,7 @@ def edge_load_amplitudes(t, h, cfg):
     the shock acts on the granules)."""
     if not cfg.load_on_plate:
         return 0.0, 0.0
-    return cfg.q0 * time_profile(t, cfg.duration), cfg.q0 * time_profile(t + h, cfg.duration)
+    return shock_amplitude(t, cfg), shock_amplitude(t + h, cfg)
 
 
 @njit(cache=True)
@@ -54,7 +54,7 @@ def newmark_predict(t, h, st, p, cfg, dmode, qdd_star, astar):
     nd = p.phi_d.shape[0]
     amp = 0.0
     if cfg.load_on_plate:
-        amp = cfg.q0 * time_profile(t + h, cfg.duration)
+        amp = shock_amplitude(t + h, cfg)
     for m in range(nm):
         qt = st.q[m] + h * st.qd[m] + 0.25 * h * h * st.qdd[m]
         qdd_star[m] = (amp * p.load_modal[m] - p.omega2[m] * qt) * dmode[m]
@@ -357,7 +357,7 @@ def modal_acceleration(t, st, p, cfg, force):
     """q'' = L(t) + Phi_d^T F - omega^2 q for every mode, into st.qdd (at t = 0)."""
     amp = 0.0
     if cfg.load_on_plate:
-        amp = cfg.q0 * time_profile(t, cfg.duration)
+        amp = shock_amplitude(t, cfg)
     for m in range(p.omega2.shape[0]):
         proj = 0.0
         for d in range(p.phi_d.shape[0]):

@@ -33,7 +33,7 @@ from numba import njit
 
 from granplate.model.inputs import STATE_COLUMNS, BodyArrays, new_body_state, no_body
 from granplate.physics.contact import COEF_MU
-from granplate.physics.shock import time_profile
+from granplate.physics.shock import shock_amplitude
 from granplate.solver import body as B
 from granplate.solver.blocks import N_FPAR, N_SPAR, copy_rows, kick_blocks, kick_drift_blocks
 from granplate.solver.dimension import friction_flow, normal_forces, normal_forces_blocks
@@ -245,7 +245,7 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
         wl, wd = kick_drift(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp)
     if body:
         if cfg.load_on_plate:
-            wl += B.load_kick(b.qd, b.load, cfg.q0 * time_profile(t, cfg.duration), hk)
+            wl += B.load_kick(b.qd, b.load, shock_amplitude(t, cfg), hk)
         wd += B.kick(b.qd, b.fmodal[cur], b.fdamp[cur], hk)
         B.turn(b.q, b.qd, b.omega, h)
         B.predicted_velocity(b, hk, cur)
@@ -276,7 +276,7 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
     if body:
         wd2 += B.kick(b.qd, b.fmodal[nxt], b.fdamp[nxt], hk)
         if cfg.load_on_plate:
-            wl2 += B.load_kick(b.qd, b.load, cfg.q0 * time_profile(t + h, cfg.duration), hk)
+            wl2 += B.load_kick(b.qd, b.load, shock_amplitude(t + h, cfg), hk)
     if friction and sw.split[LAND] != 0.0:  # an output time: the closing half step
         fric += friction_flow(y, hk, g, cfg, not forward)
         if body:
@@ -293,7 +293,7 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
     w.pend[4] = 0.0
     w.pend[0] = pr.p_shock
     if body and cfg.load_on_plate:  # the body's load's power at t + h [W]
-        w.pend[0] += cfg.q0 * time_profile(t + h, cfg.duration) * np.dot(b.load, b.qd)
+        w.pend[0] += shock_amplitude(t + h, cfg) * np.dot(b.load, b.qd)
     w.pend[1] = p_visc
     w.pend[2] = 0.0
     w.ovl_new[0] = ovl
