@@ -18,6 +18,9 @@ def _plate_cache(tmp_path_factory):
     # each test compiles only the kernels it runs: the workers share numba's cache, and one
     # `granplate run` compiling every scheme's would redo what the others compile meanwhile
     os.environ.setdefault("GRANPLATE_COMPILE", "own")
+    # the suite's workers share the cores: large verlet runs leave solver.threads at one
+    # thread (tests/test_blocks.py sets it where threads are what it checks)
+    os.environ.setdefault("GRANPLATE_THREADS", "1")
     yield
 
 

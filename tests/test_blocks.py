@@ -99,16 +99,24 @@ def test_block_force_pass_equals_the_serial_pass(nb):
     assert blocks.e_pot == pytest.approx(serial.e_pot, rel=1e-13)
 
 
-def test_threads_field_is_checked_and_resolved():
+def test_threads_field_is_checked_and_resolved(monkeypatch):
     """solver.threads: an integer from 1 to the machine's threads, named when refused;
-    absent means every core from PARALLEL_MIN_GRANULES granules on, for verlet only."""
+    absent means every core (or GRANPLATE_THREADS) from PARALLEL_MIN_GRANULES granules on,
+    for verlet only."""
     n = available_threads()
     for bad in (0, -1, n + 1, 1.5, True, "2"):
         with pytest.raises(ScenarioError, match="solver.threads"):
             check_threads(bad)
     with pytest.raises(ScenarioError, match="solver.threads"):
         validate(packing(n + 1))
+    monkeypatch.delenv("GRANPLATE_THREADS", raising=False)
     assert loop_threads(None, PARALLEL_MIN_GRANULES, "verlet") == n
+    monkeypatch.setenv("GRANPLATE_THREADS", "1")
+    assert loop_threads(None, PARALLEL_MIN_GRANULES, "verlet") == 1
+    monkeypatch.setenv("GRANPLATE_THREADS", "zero")
+    with pytest.raises(ScenarioError, match="GRANPLATE_THREADS"):
+        loop_threads(None, PARALLEL_MIN_GRANULES, "verlet")
+    monkeypatch.delenv("GRANPLATE_THREADS")
     assert loop_threads(None, PARALLEL_MIN_GRANULES - 1, "verlet") == 1
     assert loop_threads(2, 10, "implicit") == 1
     assert build_model(packing(None)).config.threads == 1  # 48 spheres: serial

@@ -5,12 +5,16 @@ The velocity-Verlet loop cuts its contacts and granules into one block per threa
 assembly's whole step does not cover, so a scenario that does not say `solver.threads`
 runs on every core only from PARALLEL_MIN_GRANULES granules on; the other schemes run
 serially. The machine's cores are numba's thread count (the environment variable
-NUMBA_NUM_THREADS lowers it; a design study's workers run one thread each).
+NUMBA_NUM_THREADS lowers it; a design study's workers run one thread each). Where several
+processes share the cores (a test suite's workers, a user's own pool of runs), the
+environment variable GRANPLATE_THREADS sets what an absent `solver.threads` means (e.g. 1):
+threads that wait for a core another process holds make every pass slow.
 """
 
 from __future__ import annotations
 
 import numbers
+import os
 from typing import Any
 
 from granplate.errors import ScenarioError
@@ -44,11 +48,25 @@ def check_threads(v: Any) -> None:
         )
 
 
+def default_threads() -> int:
+    """What an absent `solver.threads` means from PARALLEL_MIN_GRANULES granules on: the
+    environment variable GRANPLATE_THREADS (an integer >= 1, at most the machine's
+    threads), else every core."""
+    text = os.environ.get("GRANPLATE_THREADS", "").strip()
+    n = available_threads()
+    if not text:
+        return n
+    if not text.isdigit() or int(text) < 1:
+        raise ScenarioError("GRANPLATE_THREADS", text, f"must be an integer from 1 to {n} (unset: every core)")
+    return min(int(text), n)
+
+
 def loop_threads(requested: int | None, n_granules: int, scheme: str) -> int:
-    """The threads the loop runs on: `requested` for a threaded scheme (absent: every core
-    from PARALLEL_MIN_GRANULES granules on, else 1); 1 for the other schemes."""
+    """The threads the loop runs on: `requested` for a threaded scheme (absent:
+    `default_threads()` from PARALLEL_MIN_GRANULES granules on, else 1); 1 for the other
+    schemes."""
     if scheme not in THREADED_SCHEMES:
         return 1
     if requested is None:
-        return available_threads() if n_granules >= PARALLEL_MIN_GRANULES else 1
+        return default_threads() if n_granules >= PARALLEL_MIN_GRANULES else 1
     return int(requested)
