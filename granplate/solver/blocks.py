@@ -13,7 +13,10 @@ numbers. The wall contacts, few beside the pairs, run serially after the blocks,
 serial order, because a wall's load and a driven wall's force are shared sums.
 
 Numba's parallel loops (`prange`) run the blocks; numba's thread count is set by the driver
-(`numba.set_num_threads`) for the run.
+(`numba.set_num_threads`) for the run. The parallel functions are not cached on their own:
+numba's cache of a parallel function, written by two processes compiling it at once (a
+test suite's workers, a study's), can pair pieces of the two compilations and crash the
+next process that loads it. Their code is compiled into the cached loop that calls them.
 """
 
 from __future__ import annotations
@@ -53,7 +56,7 @@ def block_range(k, nb, n):
     return (k * n) // nb, ((k + 1) * n) // nb
 
 
-@njit(cache=True, parallel=True)
+@njit(parallel=True)
 def pair_forces_blocks(y, g, cfg, fpar, spar):
     """The normal forces of every listed granule pair at state y (space), block by block:
     block k's pairs' forces on their granules into fpar[k] (zeroed first), its viscous
@@ -117,7 +120,7 @@ def pair_forces_blocks(y, g, cfg, fpar, spar):
         spar[k, S_OVL_J] = ovl_j
 
 
-@njit(cache=True, parallel=True)
+@njit(parallel=True)
 def gather_blocks(fpar, acc, fdamp, v0):
     """Each granule's forces from the blocks, added in block order, into acc and fdamp's
     columns v0, v0 + 1, v0 + 2 (the velocity columns)."""
@@ -133,7 +136,7 @@ def gather_blocks(fpar, acc, fdamp, v0):
             fdamp[i, v0 + c] += d
 
 
-@njit(cache=True, parallel=True)
+@njit(parallel=True)
 def clear_rows(acc, fdamp, fload, c0):
     """Zero the columns from c0 on of acc, fdamp and fload, granule by granule."""
     for i in prange(acc.shape[0]):
@@ -143,7 +146,7 @@ def clear_rows(acc, fdamp, fload, c0):
             fload[i, c] = 0.0
 
 
-@njit(cache=True, parallel=True)
+@njit(parallel=True)
 def divide_by_inertia(acc, mass, inertia):
     """Forces and torques into accelerations (space: columns 3-5 and 6-8)."""
     for i in prange(acc.shape[0]):
@@ -226,7 +229,7 @@ def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
     return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
 
 
-@njit(cache=True, parallel=True)
+@njit(parallel=True)
 def kick_drift_blocks(y, acc, fdamp, fload, h, ypred, n_drift, spar):
     """solver.schemes.verlet.kick_drift in blocks of granules (each granule's update is
     the serial one's, bit for bit; the work sums per block into spar[k], S_WLOAD and
@@ -256,7 +259,7 @@ def kick_drift_blocks(y, acc, fdamp, fload, h, ypred, n_drift, spar):
     return work_sums(spar)
 
 
-@njit(cache=True, parallel=True)
+@njit(parallel=True)
 def kick_blocks(y, acc, fdamp, fload, hk, dy, n_drift, spar):
     """solver.schemes.verlet.kick in blocks of granules, as `kick_drift_blocks`."""
     nb = spar.shape[0]
@@ -291,7 +294,7 @@ def work_sums(spar):
     return w_load, w_damp
 
 
-@njit(cache=True, parallel=True)
+@njit(parallel=True)
 def copy_rows(dst, src):
     """dst[:] = src, granule by granule on every core."""
     for i in prange(src.shape[0]):
@@ -299,7 +302,7 @@ def copy_rows(dst, src):
             dst[i, c] = src[i, c]
 
 
-@njit(cache=True, parallel=True)
+@njit(parallel=True)
 def accept_rows(y, k0, k1, ynew, kend):
     """The accepted step's state and derivatives (solver.loop.accept_granular's copies:
     y = ynew, k0 = k1, k1 = kend), granule by granule on every core."""
@@ -310,7 +313,7 @@ def accept_rows(y, k0, k1, ynew, kend):
             k1[i, c] = kend[i, c]
 
 
-@njit(cache=True, parallel=True)
+@njit(parallel=True)
 def commit_pair_histories(t, hist, coef):
     """solver.granular.commit_history of the pairs, contact by contact on every core (each
     row on its own: the same numbers)."""
