@@ -26,6 +26,7 @@ SUMMARY_KEYS = {
     "max_eps_yy",
     "energy_residual_max",
     "n_steps",
+    "threads",
     "wall_time_s",
     "t_end",
     "plastic_fraction",
