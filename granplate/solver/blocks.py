@@ -34,10 +34,11 @@ from numba import njit, prange  # noqa: E402
 
 from granplate.model.inputs import HIST_END, HIST_MAX, HIST_RATE
 from granplate.physics.laws import normal_law_response
-from granplate.physics.shock import shock_amplitude
-from granplate.physics.space import normal_rate_3d, pair_contact_3d, wall_overlap_3d
-from granplate.solver.drives import begin_pass, book_wall, wall_motion
+from granplate.physics.space import normal_rate_3d, pair_contact_3d
+from granplate.solver.drives import begin_pass
 from granplate.solver.granular import ForceSums, commit_history, commit_history_row
+from granplate.solver.granular3d import shock_loads, wall_forces
+from granplate.solver.kicks import kick, kick_drift
 
 #: columns of a block's buffer row fpar[k, i]: the normal force on granule i (x, y, z) [N]
 #: and its damping part (x, y, z) [N].
@@ -161,22 +162,11 @@ def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
     blocks (`pair_forces_blocks`), their forces gathered in block order, then the walls in
     the serial order. Returns the ForceSums (sums over the blocks in block order; the
     largest overlap's first occurrence in the serial order)."""
-    ng = y.shape[0]
     clear_rows(acc, fdamp, fload, 3)
     begin_pass(t, g)
     p_shock = 0.0
     if not cfg.load_on_plate:
-        amp = shock_amplitude(t, cfg)
-        if amp != 0.0:
-            for i in range(ng):
-                for c in range(3):
-                    f = amp * g.shock_force[i, c]
-                    tq = amp * g.shock_torque[i, c]
-                    fload[i, 3 + c] = f
-                    fload[i, 6 + c] = tq
-                    acc[i, 3 + c] += f
-                    acc[i, 6 + c] += tq
-                    p_shock += f * y[i, 3 + c] + tq * y[i, 6 + c]
+        p_shock = shock_loads(t, y, g, cfg, acc, fload)
     pair_forces_blocks(y, g, cfg, fpar, spar)
     gather_blocks(fpar, acc, fdamp, 3)
     p_visc = 0.0
@@ -193,93 +183,32 @@ def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
             ovl = spar[k, S_OVL]
             ovl_i = int(spar[k, S_OVL_I])
             ovl_j = int(spar[k, S_OVL_J])
-    for w in range(g.wall_i.shape[0]):
-        i = g.wall_i[w]
-        ri = g.radius[i]
-        nx = g.wall_geo[w, 0]
-        ny = g.wall_geo[w, 1]
-        nz = g.wall_geo[w, 2]
-        shift, vn, kd = wall_motion(g, w)
-        delta = wall_overlap_3d(y[i, 0], y[i, 1], y[i, 2], ri, nx, ny, nz, g.wall_geo[w, 3] + shift)
-        g.wall_hist[w, HIST_END] = max(delta, 0.0)
-        if delta <= 0.0:
-            continue
-        if delta > ovl * ri:
-            ovl = delta / ri
-            ovl_i = i
-            ovl_j = -1 - g.wall_w[w]
-        ddot = normal_rate_3d(y[i, 3], y[i, 4], y[i, 5], nx, ny, nz) - vn
-        n, pv, ep, wp = normal_law_response(
-            delta, ddot, g.wall_coef[w], g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip
-        )
-        w_plastic += wp
-        p_visc += pv
-        e_pot += ep
-        acc[i, 3] -= n * nx
-        acc[i, 4] -= n * ny
-        acc[i, 5] -= n * nz
-        d = 0.0
-        if pv != 0.0:
-            d = pv / ddot
-            fdamp[i, 3] -= d * nx
-            fdamp[i, 4] -= d * ny
-            fdamp[i, 5] -= d * nz
-        book_wall(g, w, kd, n, d)
+    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
+        y, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
+    )
     divide_by_inertia(acc, g.mass, g.inertia)
     return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
 
 
 @njit(parallel=True)
 def kick_drift_blocks(y, acc, fdamp, fload, h, ypred, n_drift, spar):
-    """solver.schemes.verlet.kick_drift in blocks of granules (each granule's update is
-    the serial one's, bit for bit; the work sums per block into spar[k], S_WLOAD and
-    S_WDAMP). Returns (the load's work, the damping force's work) [J], summed in block order."""
+    """solver.kicks.kick_drift over blocks of granules (each granule's update is the serial
+    one's, bit for bit; the work sums per block into spar[k], S_WLOAD and S_WDAMP). Returns
+    (the load's work, the damping force's work) [J], summed in block order."""
     nb = spar.shape[0]
-    ng = y.shape[0]
-    hk = 0.5 * h
     for k in prange(nb):
-        w_load = 0.0
-        w_damp = 0.0
-        lo, hi = block_range(k, nb, ng)
-        for i in range(lo, hi):
-            for c in range(n_drift, y.shape[1]):
-                v0 = y[i, c]
-                dv = hk * acc[i, c]
-                v1 = v0 + dv
-                vm = hk * (v0 + 0.5 * dv)
-                w_load += fload[i, c] * vm
-                w_damp += fdamp[i, c] * vm
-                y[i, c] = v1
-                ypred[i, c] = v1 + dv
-            for c in range(n_drift):
-                y[i, c] += h * y[i, c + n_drift]
-                ypred[i, c] = y[i, c]
-        spar[k, S_WLOAD] = w_load
-        spar[k, S_WDAMP] = w_damp
+        lo, hi = block_range(k, nb, y.shape[0])
+        spar[k, S_WLOAD], spar[k, S_WDAMP] = kick_drift(y, acc, fdamp, fload, h, ypred, n_drift, lo, hi)
     return work_sums(spar)
 
 
 @njit(parallel=True)
 def kick_blocks(y, acc, fdamp, fload, hk, dy, n_drift, spar):
-    """solver.schemes.verlet.kick in blocks of granules, as `kick_drift_blocks`."""
+    """solver.kicks.kick over blocks of granules, as `kick_drift_blocks`."""
     nb = spar.shape[0]
-    ng = y.shape[0]
     for k in prange(nb):
-        w_load = 0.0
-        w_damp = 0.0
-        lo, hi = block_range(k, nb, ng)
-        for i in range(lo, hi):
-            for c in range(n_drift, y.shape[1]):
-                v0 = y[i, c]
-                dv = hk * acc[i, c]
-                vm = hk * (v0 + 0.5 * dv)
-                w_load += fload[i, c] * vm
-                w_damp += fdamp[i, c] * vm
-                y[i, c] = v0 + dv
-            for c in range(n_drift):
-                dy[i, c] = y[i, c + n_drift]
-        spar[k, S_WLOAD] = w_load
-        spar[k, S_WDAMP] = w_damp
+        lo, hi = block_range(k, nb, y.shape[0])
+        spar[k, S_WLOAD], spar[k, S_WDAMP] = kick(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi)
     return work_sums(spar)
 
 

@@ -361,17 +361,7 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
     ovl_j = -1
     w_plastic = 0.0
     if not cfg.load_on_plate:
-        amp = shock_amplitude(t, cfg)
-        if amp != 0.0:
-            for i in range(ng):
-                for c in range(3):
-                    f = amp * g.shock_force[i, c]
-                    tq = amp * g.shock_torque[i, c]
-                    fload[i, VX + c] = f
-                    fload[i, WX + c] = tq
-                    acc[i, VX + c] += f
-                    acc[i, WX + c] += tq
-                    p_shock += f * y[i, VX + c] + tq * y[i, WX + c]
+        p_shock = shock_loads(t, y, g, cfg, acc, fload)
     for p in range(g.pair_ij.shape[0]):
         i = g.pair_ij[p, 0]
         j = g.pair_ij[p, 1]
@@ -407,38 +397,9 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
             fdamp[j, VX] += d * nx
             fdamp[j, VY] += d * ny
             fdamp[j, VZ] += d * nz
-    for w in range(g.wall_i.shape[0]):
-        i = g.wall_i[w]
-        ri = g.radius[i]
-        nx = g.wall_geo[w, 0]
-        ny = g.wall_geo[w, 1]
-        nz = g.wall_geo[w, 2]
-        shift, vn, kd = wall_motion(g, w)
-        delta = wall_overlap_3d(y[i, X], y[i, Y], y[i, Z], ri, nx, ny, nz, g.wall_geo[w, 3] + shift)
-        g.wall_hist[w, HIST_END] = max(delta, 0.0)
-        if delta <= 0.0:
-            continue
-        if delta > ovl * ri:
-            ovl = delta / ri
-            ovl_i = i
-            ovl_j = -1 - g.wall_w[w]
-        ddot = normal_rate_3d(y[i, VX], y[i, VY], y[i, VZ], nx, ny, nz) - vn
-        n, pv, ep, wp = normal_law_response(
-            delta, ddot, g.wall_coef[w], g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip
-        )
-        w_plastic += wp
-        p_visc += pv
-        e_pot += ep
-        acc[i, VX] -= n * nx
-        acc[i, VY] -= n * ny
-        acc[i, VZ] -= n * nz
-        d = 0.0
-        if pv != 0.0:
-            d = pv / ddot
-            fdamp[i, VX] -= d * nx
-            fdamp[i, VY] -= d * ny
-            fdamp[i, VZ] -= d * nz
-        book_wall(g, w, kd, n, d)
+    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
+        y, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
+    )
     for i in range(ng):
         for c in range(3):
             acc[i, VX + c] /= g.mass[i]
@@ -477,3 +438,65 @@ def sensor_loads(y, g, cfg, load):
         ddot = normal_rate_3d(y[i, VX], y[i, VY], y[i, VZ], nx, ny, nz) - vn
         n = normal_law_force(delta, ddot, g.wall_coef[w], g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
         load[i] += 0.5 * n
+
+
+@njit(cache=True)
+def shock_loads(t, y, g, cfg, acc, fload):
+    """The shock's force and torque on every loaded granule at t (eq. 12 resultants times
+    `shock_amplitude`) into fload and added to acc (velocity and spin columns); returns its
+    power [W] (0 when the amplitude is 0)."""
+    p_shock = 0.0
+    amp = shock_amplitude(t, cfg)
+    if amp != 0.0:
+        for i in range(y.shape[0]):
+            for c in range(3):
+                f = amp * g.shock_force[i, c]
+                tq = amp * g.shock_torque[i, c]
+                fload[i, VX + c] = f
+                fload[i, WX + c] = tq
+                acc[i, VX + c] += f
+                acc[i, WX + c] += tq
+                p_shock += f * y[i, VX + c] + tq * y[i, WX + c]
+    return p_shock
+
+
+@njit(cache=True)
+def wall_forces(y, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j):
+    """The velocity-Verlet pass's wall contacts at state y, one after another (a wall's
+    load and a driven wall's force are shared sums): their normal forces added to acc and
+    their damping parts to fdamp, each contact's overlap into HIST_END, booked on its wall
+    and drive; the running sums (viscous power, stored energy, plastic work) and the
+    largest overlap continued from the values given. Returns them."""
+    for w in range(g.wall_i.shape[0]):
+        i = g.wall_i[w]
+        ri = g.radius[i]
+        nx = g.wall_geo[w, 0]
+        ny = g.wall_geo[w, 1]
+        nz = g.wall_geo[w, 2]
+        shift, vn, kd = wall_motion(g, w)
+        delta = wall_overlap_3d(y[i, X], y[i, Y], y[i, Z], ri, nx, ny, nz, g.wall_geo[w, 3] + shift)
+        g.wall_hist[w, HIST_END] = max(delta, 0.0)
+        if delta <= 0.0:
+            continue
+        if delta > ovl * ri:
+            ovl = delta / ri
+            ovl_i = i
+            ovl_j = -1 - g.wall_w[w]
+        ddot = normal_rate_3d(y[i, VX], y[i, VY], y[i, VZ], nx, ny, nz) - vn
+        n, pv, ep, wp = normal_law_response(
+            delta, ddot, g.wall_coef[w], g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip
+        )
+        w_plastic += wp
+        p_visc += pv
+        e_pot += ep
+        acc[i, VX] -= n * nx
+        acc[i, VY] -= n * ny
+        acc[i, VZ] -= n * nz
+        d = 0.0
+        if pv != 0.0:
+            d = pv / ddot
+            fdamp[i, VX] -= d * nx
+            fdamp[i, VY] -= d * ny
+            fdamp[i, VZ] -= d * nz
+        book_wall(g, w, kd, n, d)
+    return p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j

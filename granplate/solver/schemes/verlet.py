@@ -46,6 +46,7 @@ from granplate.solver.drives import (
     wall_shift_energy,
 )
 from granplate.solver.granular import commit_history
+from granplate.solver.kicks import kick, kick_drift
 from granplate.solver.ladder import step_to_output
 from granplate.solver.state import E_STATIC, PARTNER_PLATE
 
@@ -124,51 +125,6 @@ def has_friction(g) -> bool:
 
 
 @njit(cache=True)
-def kick_drift(y, acc, fdamp, fload, h, ypred):
-    """The first half kick v += h/2 a (every column from N_DRIFT on), the drift x += h v
-    (the columns before), and the state the force pass reads into ypred: the new
-    positions, and the velocities predicted at the end, v + h/2 a. Returns (the load's
-    work, the damping force's work) of the kick [J]: h/2 F (v_before + v_after)/2."""
-    hk = 0.5 * h
-    w_load = 0.0
-    w_damp = 0.0
-    for i in range(y.shape[0]):
-        for c in range(N_DRIFT, y.shape[1]):
-            v0 = y[i, c]
-            dv = hk * acc[i, c]
-            v1 = v0 + dv
-            vm = hk * (v0 + 0.5 * dv)
-            w_load += fload[i, c] * vm
-            w_damp += fdamp[i, c] * vm
-            y[i, c] = v1
-            ypred[i, c] = v1 + dv
-        for c in range(N_DRIFT):
-            y[i, c] += h * y[i, c + N_DRIFT]
-            ypred[i, c] = y[i, c]
-    return w_load, w_damp
-
-
-@njit(cache=True)
-def kick(y, acc, fdamp, fload, hk, dy):
-    """The closing half kick v += hk a (hk = h/2); dy (the loop's derivative at the end of
-    the step) gets the end velocities as the rates of the drifting columns. Returns the
-    load's and the damping force's work [J] as `kick_drift`."""
-    w_load = 0.0
-    w_damp = 0.0
-    for i in range(y.shape[0]):
-        for c in range(N_DRIFT, y.shape[1]):
-            v0 = y[i, c]
-            dv = hk * acc[i, c]
-            vm = hk * (v0 + 0.5 * dv)
-            w_load += fload[i, c] * vm
-            w_damp += fdamp[i, c] * vm
-            y[i, c] = v0 + dv
-        for c in range(N_DRIFT):
-            dy[i, c] = y[i, c + N_DRIFT]
-    return w_load, w_damp
-
-
-@njit(cache=True)
 def force_pass(t, y, g, cfg, acc, fdamp, fload, sw):
     """The force pass at (t, y): in blocks on every core when the scratch has blocks
     (solver.blocks), else serially. Returns the ForceSums."""
@@ -242,7 +198,7 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
     if sw.spar.shape[0] > 0:
         wl, wd = kick_drift_blocks(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, sw.spar)
     else:
-        wl, wd = kick_drift(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp)
+        wl, wd = kick_drift(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, 0, y.shape[0])
     if body:
         if cfg.load_on_plate:
             wl += B.load_kick(b.qd, b.load, shock_amplitude(t, cfg), hk)
@@ -272,7 +228,7 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
     if sw.spar.shape[0] > 0:
         wl2, wd2 = kick_blocks(y, w.kend, sw.fdamp[nxt], sw.fload[nxt], hk, w.kend, N_DRIFT, sw.spar)
     else:
-        wl2, wd2 = kick(y, w.kend, sw.fdamp[nxt], sw.fload[nxt], hk, w.kend)
+        wl2, wd2 = kick(y, w.kend, sw.fdamp[nxt], sw.fload[nxt], hk, w.kend, N_DRIFT, 0, y.shape[0])
     if body:
         wd2 += B.kick(b.qd, b.fmodal[nxt], b.fdamp[nxt], hk)
         if cfg.load_on_plate:

@@ -1,0 +1,52 @@
+"""The velocity-Verlet kicks and drift over a range of granules (docs/model.md section
+6.5): the serial loop takes every granule, the threaded one (solver.blocks) one block each.
+"""
+
+from __future__ import annotations
+
+from numba import njit
+
+
+@njit(cache=True)
+def kick_drift(y, acc, fdamp, fload, h, ypred, n_drift, lo, hi):
+    """Granules lo..hi-1: the first half kick v += h/2 a (every column from n_drift on),
+    the drift x += h v (the columns before), and the state the force pass reads into ypred:
+    the new positions, and the velocities predicted at the end, v + h/2 a. Returns (the
+    load's work, the damping force's work) of the kick [J]: h/2 F (v_before + v_after)/2."""
+    hk = 0.5 * h
+    w_load = 0.0
+    w_damp = 0.0
+    for i in range(lo, hi):
+        for c in range(n_drift, y.shape[1]):
+            v0 = y[i, c]
+            dv = hk * acc[i, c]
+            v1 = v0 + dv
+            vm = hk * (v0 + 0.5 * dv)
+            w_load += fload[i, c] * vm
+            w_damp += fdamp[i, c] * vm
+            y[i, c] = v1
+            ypred[i, c] = v1 + dv
+        for c in range(n_drift):
+            y[i, c] += h * y[i, c + n_drift]
+            ypred[i, c] = y[i, c]
+    return w_load, w_damp
+
+
+@njit(cache=True)
+def kick(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi):
+    """Granules lo..hi-1: the closing half kick v += hk a (hk = h/2); dy (the loop's
+    derivative at the end of the step) gets the end velocities as the rates of the
+    drifting columns. Returns the load's and the damping force's work [J] as `kick_drift`."""
+    w_load = 0.0
+    w_damp = 0.0
+    for i in range(lo, hi):
+        for c in range(n_drift, y.shape[1]):
+            v0 = y[i, c]
+            dv = hk * acc[i, c]
+            vm = hk * (v0 + 0.5 * dv)
+            w_load += fload[i, c] * vm
+            w_damp += fdamp[i, c] * vm
+            y[i, c] = v0 + dv
+        for c in range(n_drift):
+            dy[i, c] = y[i, c + n_drift]
+    return w_load, w_damp
