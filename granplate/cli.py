@@ -300,13 +300,14 @@ def build_parser() -> argparse.ArgumentParser:
         dest="start_from",
         metavar="RESULT",
         default=None,
-        help="restart from this result's last output time (a result netCDF file of the same granules)",
+        help="restart from this result's last output time, or --from-time (a result netCDF file of the same granules)",
     )
     r.add_argument(
         "--from-time",
         type=float,
         default=None,
-        help="the restart time [s] (must be the result's last output time, its stored state)",
+        help="the restart time [s]: one at which the result stores the loop's state (its end, and every "
+        "time.restart_interval before)",
     )
     add_set_option(r)
     r.set_defaults(func=_cmd_run)

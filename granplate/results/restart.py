@@ -1,16 +1,20 @@
 """Restart from a result (docs/how-to/restart.md): the loop's state at a result's last
-output time, stored in its Dataset as `restart_*` variables, and a run of a scenario that
-goes on from it.
+output time, stored in its Dataset as `restart_*` variables, and at earlier output times
+(time.restart_interval) as `restart_t<k>_*` variables, and a run of a scenario that goes
+on from one of them.
 
-`with_restart(ds, snap)`: ds with the captured state (solver.snapshot) added, each array
-a variable `restart_<path>` (dots of the path as "__") on dimensions of its own.
-`restart_state(ds)`: those arrays back, keyed by path. `check_restart(ds, scenario, time)`:
-refuses (ScenarioError naming the field) a result whose granules differ from the
-scenario's (count, radii, materials, dimension) or a chosen time that is not the result's
-stored restart time.
+`with_restart(ds, snap, earlier)`: ds with the captured states (solver.snapshot) added,
+each array a variable `restart_<path>` (the last) or `restart_t<k>_<path>` (the k-th of
+the attribute `restart_times`; dots of the path as "__") on dimensions of its own.
+`restart_times(ds)`: the times [s] a state is stored at. `restart_state(ds, time)`: one
+state's arrays back, keyed by path. `check_restart(ds, scenario, time)`: refuses
+(ScenarioError naming the field) a result whose granules differ from the scenario's
+(count, radii, materials, dimension) or a chosen time at which no state is stored.
 """
 
 from __future__ import annotations
+
+import re
 
 import numpy as np
 import xarray as xr
@@ -18,53 +22,111 @@ import xarray as xr
 from granplate.errors import ScenarioError
 
 PREFIX = "restart_"
+#: the names of the states stored before the last: restart_t<k>_<path>
+EARLIER = re.compile(r"^restart_t(\d+)_")
 
 
-def _name(path: str) -> str:
-    return PREFIX + path.replace(".", "__")
+def _name(path: str, prefix: str = PREFIX) -> str:
+    return prefix + path.replace(".", "__")
 
 
-def with_restart(ds: xr.Dataset, snap: dict[str, np.ndarray]) -> xr.Dataset:
-    """ds with the loop's state at its last output time (module docstring)."""
+def _variables(snap: dict[str, np.ndarray], prefix: str, what: str) -> dict[str, xr.DataArray]:
     data = {}
     for path, a in snap.items():
-        name = _name(path)
+        name = _name(path, prefix)
         dims = tuple(f"{name}_{k}" for k in range(a.ndim))
-        data[name] = xr.DataArray(a, dims=dims, attrs={"long_name": f"restart state: {path}"})
+        data[name] = xr.DataArray(a, dims=dims, attrs={"long_name": f"restart state{what}: {path}"})
+    return data
+
+
+def with_restart(ds: xr.Dataset, snap: dict[str, np.ndarray] | None, earlier=()) -> xr.Dataset:
+    """ds with the loop's state at its last output time (snap; None: a run that stopped)
+    and at the earlier restart times (module docstring)."""
+    data: dict[str, xr.DataArray] = {}
+    times = []
+    for k, state in enumerate(earlier):
+        t = float(state["st.clock"][0])
+        times.append(t)
+        data.update(_variables(state, f"{PREFIX}t{k}_", f" at t = {t!r} s"))
+    if snap is not None:
+        data.update(_variables(snap, PREFIX, ""))
+        times.append(float(snap["st.clock"][0]))
+    if not times:
+        return ds
     out = ds.assign(data)
-    out.attrs["restart_time"] = float(snap["st.clock"][0])
+    if snap is not None:
+        out.attrs["restart_time"] = times[-1]
+    out.attrs["restart_times"] = np.array(times, float)
     return out
 
 
-def restart_state(ds: xr.Dataset) -> dict[str, np.ndarray]:
-    """The captured arrays of a result made by `with_restart`, keyed by path."""
+def restart_times(ds: xr.Dataset) -> list[float]:
+    """The output times [s] at which `ds` holds the loop's state, ascending (the last one,
+    `restart_time`, only for a run that finished)."""
+    if "restart_times" in ds.attrs:
+        return [float(t) for t in np.atleast_1d(ds.attrs["restart_times"])]
+    return [float(ds.attrs["restart_time"])] if "restart_time" in ds.attrs else []
+
+
+def _prefix_at(ds: xr.Dataset, index: int) -> str:
+    """The variables' prefix of the state at restart_times(ds)[index]."""
+    last = "restart_time" in ds.attrs and index == len(restart_times(ds)) - 1
+    return PREFIX if last else f"{PREFIX}t{index}_"
+
+
+def stored_time(ds: xr.Dataset, time: float | None) -> int:
+    """The index in restart_times(ds) of `time` [s] (to 1e-12 relative; None: the last),
+    or -1 when no state is stored there."""
+    times = restart_times(ds)
+    if time is None:
+        return len(times) - 1
+    near = [k for k, t in enumerate(times) if np.isclose(time, t, rtol=1e-12, atol=0.0)]
+    return near[0] if near else -1
+
+
+def restart_state(ds: xr.Dataset, time: float | None = None) -> dict[str, np.ndarray]:
+    """The captured arrays of the state stored at `time` [s] (None: the last), keyed by path."""
+    k = stored_time(ds, time)
+    if k < 0:
+        raise KeyError(f"no restart state at t = {time!r} s")
+    prefix = _prefix_at(ds, k)
+    earlier = prefix != PREFIX
     return {
-        str(k)[len(PREFIX) :].replace("__", "."): np.array(ds[k].values)
-        for k in ds.data_vars
-        if str(k).startswith(PREFIX)
+        str(name)[len(prefix) :].replace("__", "."): np.array(ds[name].values)
+        for name in ds.data_vars
+        if str(name).startswith(prefix) and (earlier or not EARLIER.match(str(name)))
     }
 
 
-def check_restart(ds: xr.Dataset, scenario, time: float | None = None) -> None:
+def check_restart(
+    ds: xr.Dataset, scenario, time: float | None = None, from_field: str = "from", time_field: str = "from_time"
+) -> float:
     """Refuse a restart of `scenario` from result `ds` before anything runs: no stored
-    state, a chosen time [s] other than the stored one, or granules that differ."""
+    state, a chosen time [s] at which none is stored, or granules that differ (the
+    fields named from_field, time_field: the command line's, or the scenario's
+    [restart]); returns the restart time [s]."""
     from granplate.results.dataset import scenario_of
     from granplate.setup.geometry import resolve
 
-    if "restart_time" not in ds.attrs:
+    times = restart_times(ds)
+    if not times:
         raise ScenarioError(
-            "from",
+            from_field,
             "a result",
             "holds no restart state (a run that did not finish, or made before restarts were stored)",
         )
-    t1 = float(ds.attrs["restart_time"])
-    if time is not None and not np.isclose(time, t1, rtol=1e-12, atol=0.0):
+    k = stored_time(ds, time)
+    if k < 0:
         span = f"[{float(ds.time[0])!r}, {float(ds.time[-1])!r}] s"
+        listed = ", ".join(repr(t) for t in times)
+        last = " (the last: its end)" if "restart_time" in ds.attrs else " (the run stopped before its end)"
         raise ScenarioError(
-            "from_time",
+            time_field,
             time,
-            f"not a restart time of the result; available: t = {t1!r} s (its last output time; its outputs span {span})",
+            f"not a restart time of the result; available: t = {listed} s{last}; its outputs span {span} "
+            "(time.restart_interval stores earlier ones)",
         )
+    t1 = times[k]
     if not t1 < scenario.time.t_end:
         raise ScenarioError("time.t_end", scenario.time.t_end, f"must exceed the restart time {t1!r} s")
     if scenario.precompression is not None:
@@ -90,3 +152,4 @@ def check_restart(ds: xr.Dataset, scenario, time: float | None = None) -> None:
         va, vb = getattr(getattr(old, sec), key), getattr(getattr(new, sec), key)
         if va != vb:
             raise ScenarioError(field, vb, f"must be the result's, {va!r} (a restart keeps it)")
+    return t1

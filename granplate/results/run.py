@@ -79,15 +79,16 @@ def simulate(
     compile_time_s. Raises SimulationError (with the partial, whole Dataset in `.result`,
     its `status` attribute saying why) when the run goes numerically wrong or is stopped
     by SIGINT/SIGTERM (Ctrl-C). start_from: a result (Dataset) to restart from at its last
-    output time (start_time [s], when given, must be that time; docs/how-to/restart.md):
-    checked against the scenario (results.restart.check_restart) before anything runs.
+    output time, or at start_time [s], one of its stored restart times (time.restart_interval;
+    docs/how-to/restart.md): checked against the scenario (results.restart.check_restart)
+    before anything runs.
     """
     if t_end is not None:
         scenario = with_t_end(scenario, t_end)
     start = None
     if start_from is not None:
-        check_restart(start_from, scenario, start_time)
-        start = restart_state(start_from)
+        t1 = check_restart(start_from, scenario, start_time)
+        start = restart_state(start_from, t1)
     with compile_clock() as clock:
         if compile_all:
             from granplate.results.kernels import compile_kernels, needs_compiling
@@ -97,7 +98,7 @@ def simulate(
         ds = _simulate(scenario, progress, model, summary_only, clock, start)
     if start_from is not None:  # the energies go on from the first run's t = 0 (docs/model.md section 7)
         ds.attrs["E_initial"] = start_from.attrs.get("E_initial", 0.0)
-        ds.attrs["restarted_at"] = float(start_from.attrs["restart_time"])
+        ds.attrs["restarted_at"] = t1
     return ds
 
 
@@ -149,8 +150,7 @@ def _simulate(
             ),
             clock,
         )
-        if rec.snapshot is not None:
-            ds = with_restart(ds, rec.snapshot)
+        ds = with_restart(ds, rec.snapshot, rec.earlier)
     yield_note(ds)
     if rec.status != OK or interrupted(ds):
         n = ds.sizes["time"]

@@ -4,6 +4,8 @@ would write against the machine's memory, the scheme and its granular friction.
 
 from __future__ import annotations
 
+import math
+
 from granplate.errors import ScenarioError
 from granplate.setup.threads import check_threads
 from granplate.setup.fields import finite, int_at_least, positive, string_in
@@ -43,6 +45,41 @@ def _check_time(s: Scenario) -> None:
             t.field_interval,
             f"must be a whole multiple n of time.output_interval = "
             f"{t.output_interval!r}, 1 <= n <= 2^53 (beyond, every double is whole)",
+        )
+    _check_restart_interval(t)
+
+
+#: The most loop states a result stores before its end time (time.restart_interval).
+MAX_RESTART_STATES = 20
+
+
+def restart_steps(t) -> int:
+    """time.restart_interval in output intervals (TimeSettings t; 0: none)."""
+    return 0 if t.restart_interval is None else round(t.restart_interval / t.output_interval)
+
+
+def _check_restart_interval(t) -> None:
+    """time.restart_interval: a whole multiple of output_interval, at most MAX_RESTART_STATES
+    states before t_end."""
+    if t.restart_interval is None:
+        return
+    positive("time.restart_interval", t.restart_interval)
+    dt = float(t.restart_interval)
+    r = dt / t.output_interval
+    n = round(r)
+    if n < 1 or abs(r - n) > INTERVAL_RTOL * r:
+        raise ScenarioError(
+            "time.restart_interval",
+            dt,
+            f"must be a whole multiple of time.output_interval = {t.output_interval!r} s (absent: the end only)",
+        )
+    count = (math.ceil(t.t_end / t.output_interval - 1e-9) - 1) // n  # output times k n before the last
+    if count > MAX_RESTART_STATES:
+        raise ScenarioError(
+            "time.restart_interval",
+            dt,
+            f"would store {count} loop states before time.t_end = {t.t_end!r} s, allowed at most "
+            f"{MAX_RESTART_STATES}: raise it to at least {t.t_end / (MAX_RESTART_STATES + 1)!r} s",
         )
 
 

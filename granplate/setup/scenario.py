@@ -558,7 +558,9 @@ class TimeSettings:
     output_interval: scalar outputs and granule states; field_interval: plate
     displacement snapshots (a multiple of output_interval); sensor_interval: the
     [[sensors]]' samples (None: output_interval), landed on by the steps like the
-    output times.
+    output times; restart_interval: the loop's whole state is also stored at the output
+    times k restart_interval before t_end (a multiple of output_interval; None: at t_end
+    only; docs/how-to/restart.md).
     """
 
     t_end: float = 2e-3
@@ -568,6 +570,7 @@ class TimeSettings:
     output_interval: float = 1e-6
     field_interval: float = 2e-5
     sensor_interval: float | None = None
+    restart_interval: float | None = None
 
 
 @dataclass(frozen=True)

@@ -29,6 +29,7 @@ from granplate.plate.face import patch_weights
 from granplate.solver.interface import set_face_weights
 from granplate.solver.ladder import level_for
 from granplate.solver.schemes import scheme
+from granplate.setup.run_checks import restart_steps
 from granplate.setup.sensor_checks import n_sensor_samples, sensor_granules, sensor_interval
 
 #: wall-time target of one compiled chunk [s], and the step budget of the first one.
@@ -109,6 +110,7 @@ class RunRecord(NamedTuple):
     contacts: ContactChanges
     body: object = None  # the run's elastic body in space (model.inputs.BodyArrays, its last contact state) or None
     snapshot: dict | None = None  # the loop's state at the end (solver.snapshot.capture), for a restart
+    earlier: tuple = ()  # its states at the earlier restart times (time.restart_interval), in time order
 
 
 def output_times(t_end: float, dt_out: float) -> np.ndarray:
@@ -517,15 +519,35 @@ def stalled(st: S.State) -> int:
     return S.ERR_NOCONV
 
 
-def _loop_chunks(times, model, arr: LoopArrays, should_stop, on_progress, lists) -> int:
+def restart_indices(n_times: int, first: int, every: int) -> np.ndarray:
+    """The output rows (of n_times, the first being output time number `first` of the whole
+    run) at which the loop's state is stored for a restart, every `every` output times
+    (time.restart_interval; 0: none), the last row left out (its state is the run's end)."""
+    if every <= 0:
+        return np.zeros(0, np.int64)
+    o = np.arange(1, n_times - 1, dtype=np.int64)
+    return o[(first + o) % every == 0]
+
+
+def chunk_stops(n_times: int, also: np.ndarray) -> np.ndarray:
+    """The output rows the compiled chunks stop at: up to 200 spread over the run, and
+    every row of `also` (where the loop's state is captured)."""
+    n_chunks = min(200, n_times - 1)
+    spread = np.linspace(1, n_times - 1, n_chunks).round().astype(np.int64) if n_chunks else np.zeros(0, np.int64)
+    return np.union1d(spread, also).astype(np.int64)
+
+
+def _loop_chunks(times, model, arr: LoopArrays, should_stop, on_progress, lists, captures=None, first=0) -> int:
     """Call the compiled loop chunk by chunk until the end, an error or a stop request;
     between chunks the contact lists are rebuilt when the loop asks (REBUILD), patch
     contacts added (NEW_PLATE) and, with fixed contacts, the lists checked after every
-    chunk."""
+    chunk. captures: a list to which the loop's state (solver.snapshot.capture) is
+    appended at every output time of `restart_indices` (times[0] being the run's output
+    time number `first`)."""
     cfg = model.config
     fixed = model.scenario.contact.detection == "fixed"
-    n_chunks = min(200, len(times) - 1)
-    stops = np.unique(np.linspace(1, len(times) - 1, n_chunks).round().astype(int)) if n_chunks else []
+    keep = restart_indices(len(times), first, restart_steps(model.scenario.time)) if captures is not None else []
+    stops = chunk_stops(len(times), np.asarray(keep, np.int64))
     budget = FIRST_BUDGET
     warned = False
     idle = 0  # step attempts since the clock last moved
@@ -565,6 +587,8 @@ def _loop_chunks(times, model, arr: LoopArrays, should_stop, on_progress, lists)
                 status = S.PAUSED
         if status != S.OK:
             return status
+        if o_stop in keep:
+            captures.append(snapshot.capture(arr, lists))
     return _refresh(lists, arr.st, arr.w)
 
 
@@ -717,17 +741,20 @@ def _run_from(model: Model, start: dict, progress: bool, should_stop, interrupti
     loop.record(0, st, lists.g, arr.p, arr.w, arr.out)
     first_sensor_sample(model, arr.sw, st, lists.g, arr.out)
     st.count[S.C_OUT] = 1
-    return _finish(model, times, arr, lists, c1, progress, should_stop, interruptible)
+    return _finish(model, times, arr, lists, c1, progress, should_stop, interruptible, first=o1)
 
 
-def _finish(model: Model, times, arr: LoopArrays, lists: ContactLists, t1: float, progress, should_stop, interruptible):
-    """The loop from the first output on (its first call timed from t1 [perf_counter s]),
-    and the run's record."""
+def _finish(
+    model: Model, times, arr: LoopArrays, lists: ContactLists, t1: float, progress, should_stop, interruptible, first=0
+):
+    """The loop from the first output on (its first call timed from t1 [perf_counter s];
+    times[0] is the run's output time number `first`), and the run's record."""
     t_first = time.perf_counter() - t1  # includes compiling / loading the loop
     bar = None
     if progress:
         bar = progress_bar(len(times) - 1, model.scenario.name)
     polls = [should_stop] if should_stop is not None else []
+    earlier: list[dict] = []
     t2 = time.perf_counter()
     c2, c3 = time.process_time(), time.thread_time()
     try:
@@ -739,6 +766,8 @@ def _finish(model: Model, times, arr: LoopArrays, lists: ContactLists, t1: float
                 lambda: signalled() or any(f() for f in polls),
                 bar.update if bar is not None else (lambda n: None),
                 lists,
+                earlier,
+                first,
             )
     finally:
         if bar is not None:
@@ -773,6 +802,7 @@ def _finish(model: Model, times, arr: LoopArrays, lists: ContactLists, t1: float
         contacts=lists.changes(body),
         body=body,
         snapshot=snapshot.capture(arr, lists) if status == S.OK else None,
+        earlier=tuple(earlier),
     )
 
 

@@ -25,6 +25,7 @@ FIELD_UNITS: dict[str, str] = {
     "output_interval": "s",
     "field_interval": "s",
     "sensor_interval": "s",
+    "restart_interval": "s",
     "R1": "m",
     "R2_ratio": "1",
     "E": "Pa",

@@ -1,0 +1,90 @@
+"""Restart from an earlier output time (time.restart_interval): a run restarted at a stored
+time t1 before its end and continued to t2 equals the straight run to t2 bitwise at every
+output time from t1 on (implicit scheme, plate in the plane, Thornton's yielding contacts and
+friction; the first row's statistics over the interval before t1 excepted: they cover no step
+of the restarted run); a time at which no state is stored is refused, listing the stored ones."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from granplate.errors import ScenarioError
+from granplate.results.dataset import read, write
+from granplate.results.restart import restart_state, restart_times
+from granplate.results.run import simulate
+from tests.test_restart import T2, yielding
+
+T1 = 3e-5  # the first of the stored times 30, 60, 90 us (restart_interval 30 us) and the end, 100 us
+
+
+def with_interval(s, interval: float):
+    return dataclasses.replace(s, time=dataclasses.replace(s.time, restart_interval=interval))
+
+
+@pytest.fixture(scope="module")
+def straight(tmp_path_factory):
+    """The straight run to t2 with a state stored every 30 us, written and read back."""
+    s = with_interval(yielding("chain.toml", "implicit"), 3e-5)
+    path = write(simulate(s), tmp_path_factory.mktemp("earlier") / "straight.nc")
+    return s, read(path)
+
+
+def test_restart_at_an_earlier_time_equals_the_straight_run(straight):
+    s, ds = straight
+    assert restart_times(ds) == pytest.approx([3e-5, 6e-5, 9e-5, 1e-4], rel=1e-12)
+    assert float(ds.D_plastic[-1]) > 0.0 and float(ds.D_friction[-1]) > 0.0  # yield, friction
+    rest = simulate(s, start_from=ds, start_time=T1)
+    assert rest.attrs["restarted_at"] == pytest.approx(T1, rel=1e-12) and float(rest.time[-1]) == T2
+    on = ds.time.values >= rest.time.values[0]
+    assert np.array_equal(ds.time.values[on], rest.time.values)
+    first_row_differs = []
+    for name, v in ds.data_vars.items():
+        if v.dims and v.dims[0] == "time" and name in rest:
+            np.testing.assert_array_equal(rest[name].values[1:], v.values[on][1:], err_msg=str(name))
+            if not np.array_equal(rest[name].values[0], v.values[on][0]):
+                first_row_differs.append(name)
+    # the state at t1 is the same; the first row's statistics over the interval before it
+    # cover no step of the restarted run
+    assert first_row_differs == ["energy_residual_max", "iterations", "dt_min", "dt_max"]
+    s0, s1 = restart_state(ds), restart_state(rest)
+    for key in ("st.y", "st.q", "st.qd", "st.acc", "g.pair_hist", "g.wall_hist", "g.pc_hist"):
+        np.testing.assert_array_equal(s0[key], s1[key], err_msg=key)
+    # the restarted run stores its own states at the same times of the whole run
+    assert restart_times(rest) == pytest.approx([6e-5, 9e-5, 1e-4], rel=1e-12)
+    np.testing.assert_array_equal(restart_state(rest, 6e-5)["st.y"], restart_state(ds, 6e-5)["st.y"])
+
+
+def test_a_time_not_stored_is_refused_listing_the_stored_ones(straight):
+    s, ds = straight
+    with pytest.raises(
+        ScenarioError, match=r"'from_time' = 5e-05.*available: t = 3\.0+\d*e-05, 6\.0+\d*e-05, 9e-05, 0\.0001"
+    ):
+        simulate(s, start_from=ds, start_time=5e-5)
+
+
+@pytest.mark.parametrize(
+    "interval, why",
+    [(2.5e-5, "whole multiple of time.output_interval"), (1e-5 / 2, "whole multiple"), (-1.0, "must be > 0")],
+)
+def test_bad_restart_interval_refused(interval, why):
+    from granplate.setup.validate import validate
+
+    with pytest.raises(ScenarioError, match=rf"time\.restart_interval.*{why}"):
+        validate(with_interval(yielding("chain.toml", "implicit"), interval))
+
+
+def test_restart_states_are_bounded():
+    """At most MAX_RESTART_STATES states before t_end (the Dataset's size stays bounded)."""
+    from granplate.setup.run_checks import MAX_RESTART_STATES
+    from granplate.setup.validate import validate
+
+    s = yielding("chain.toml", "implicit")
+    validate(with_interval(s, 1e-5))  # 9 states before the end
+    s = dataclasses.replace(s, time=dataclasses.replace(s.time, output_interval=1e-6, field_interval=1e-6))
+    with pytest.raises(
+        ScenarioError, match=rf"time\.restart_interval.*would store 99 loop states.*at most {MAX_RESTART_STATES}"
+    ):
+        validate(with_interval(s, 1e-6))
