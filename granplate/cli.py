@@ -191,9 +191,9 @@ def _cmd_run(args) -> int:
     out = Path(args.output) if args.output else Path(f"{scenario.name}.nc")
     start = None
     if args.start_from:
-        from granplate.results.dataset import read
+        from granplate.results.restart import read_result
 
-        start = read(args.start_from)
+        start = read_result(args.start_from, "from")
     try:
         ds = simulate(
             scenario,
@@ -300,7 +300,8 @@ def build_parser() -> argparse.ArgumentParser:
         dest="start_from",
         metavar="RESULT",
         default=None,
-        help="restart from this result's last output time, or --from-time (a result netCDF file of the same granules)",
+        help="restart from this result's last output time, or --from-time (a result netCDF file of the same "
+        "granules; overrides the scenario's [restart])",
     )
     r.add_argument(
         "--from-time",

@@ -88,3 +88,46 @@ def test_restart_states_are_bounded():
         ScenarioError, match=rf"time\.restart_interval.*would store 99 loop states.*at most {MAX_RESTART_STATES}"
     ):
         validate(with_interval(s, 1e-6))
+
+
+def test_scenario_restart_key_equals_the_option(straight, tmp_path):
+    """[restart] result (relative to the scenario file) and time give the run the option
+    gives; the command line's options override them; bad input is refused naming the field."""
+    import granplate as gp
+    from granplate.setup.io import dumps
+    from granplate.setup.validate import validate
+
+    s, ds = straight
+    write(ds, tmp_path / "straight.nc")
+    text = dumps(s) + '\n[restart]\nresult = "straight.nc"\ntime = 3e-5\n'
+    (tmp_path / "go-on.toml").write_text(text)
+    keyed = gp.load_scenario(tmp_path / "go-on.toml")
+    assert keyed.restart.result == str(tmp_path / "straight.nc")
+    by_key = simulate(keyed)
+    by_option = simulate(s, start_from=ds, start_time=T1)
+    for name in ("x", "y", "vx", "E_granular", "E_plate", "D_plastic", "D_friction", "energy_residual"):
+        np.testing.assert_array_equal(by_key[name].values, by_option[name].values, err_msg=name)
+    assert by_key.attrs["restarted_at"] == by_option.attrs["restarted_at"]
+    from granplate.cli import main
+
+    out = tmp_path / "late.nc"  # the command line: its --from-time overrides restart.time
+    assert main(["run", str(tmp_path / "go-on.toml"), "--from-time", "9e-5", "-o", str(out), "-q"]) == 0
+    late = read(out)
+    assert float(late.time[0]) == pytest.approx(9e-5, rel=1e-12)
+    np.testing.assert_array_equal(late.x.values, ds.x.values[-2:])
+    assert main(["run", str(tmp_path / "go-on.toml"), "--from", str(tmp_path / "none.nc"), "-q"]) == 2
+    with pytest.raises(ScenarioError, match=r"'restart\.time' = 4e-05.*available: t = 3"):
+        simulate(gp.with_changes(keyed, {"restart.time": 4e-5}))
+    with pytest.raises(ScenarioError, match=r"'restart\.result' = .*missing\.nc.*no such file"):
+        simulate(gp.with_changes(keyed, {"restart.result": str(tmp_path / "missing.nc")}))
+    (tmp_path / "not-a-result.nc").write_text("text")
+    with pytest.raises(ScenarioError, match=r"'restart\.result' = .*not-a-result\.nc.*cannot be read"):
+        simulate(gp.with_changes(keyed, {"restart.result": str(tmp_path / "not-a-result.nc")}))
+    with pytest.raises(ScenarioError, match=r"'restart\.time' = -1\.0: must be >= 0"):
+        validate(gp.with_changes(keyed, {"restart.time": -1.0}))
+    with pytest.raises(ScenarioError, match=r"'restart\.result' = '': must name a result"):
+        validate(gp.with_changes(keyed, {"restart.result": ""}))
+    with pytest.raises(ScenarioError, match=r"'granules' = \d+: granules; the result has \d+"):
+        simulate(gp.with_changes(keyed, {"layout.count": 7}))
+    with pytest.raises(ScenarioError, match=r"'from_time' = 3e-05.*needs a result"):
+        simulate(s, start_time=3e-5)

@@ -6,7 +6,8 @@ on from one of them.
 `with_restart(ds, snap, earlier)`: ds with the captured states (solver.snapshot) added,
 each array a variable `restart_<path>` (the last) or `restart_t<k>_<path>` (the k-th of
 the attribute `restart_times`; dots of the path as "__") on dimensions of its own.
-`restart_times(ds)`: the times [s] a state is stored at. `restart_state(ds, time)`: one
+`restart_times(ds)`: the times [s] a state is stored at. `restart_source(scenario, ...)`:
+the result and time a run restarts from (the command line's, or the scenario's [restart]). `restart_state(ds, time)`: one
 state's arrays back, keyed by path. `check_restart(ds, scenario, time)`: refuses
 (ScenarioError naming the field) a result whose granules differ from the scenario's
 (count, radii, materials, dimension) or a chosen time at which no state is stored.
@@ -96,6 +97,38 @@ def restart_state(ds: xr.Dataset, time: float | None = None) -> dict[str, np.nda
         for name in ds.data_vars
         if str(name).startswith(prefix) and (earlier or not EARLIER.match(str(name)))
     }
+
+
+def read_result(path: str, field: str = "restart.result") -> xr.Dataset:
+    """The result netCDF file at `path`, or a ScenarioError naming `field`."""
+    from granplate.results.dataset import read
+
+    try:
+        return read(path)
+    except FileNotFoundError:
+        raise ScenarioError(field, path, "no such file (a result netCDF file, relative to the scenario file)") from None
+    except (OSError, ValueError) as e:
+        raise ScenarioError(field, path, f"cannot be read as a result netCDF file: {e}") from None
+
+
+def restart_source(scenario, start_from=None, start_time: float | None = None):
+    """(result, time [s] or None, its field, the time's field) a run restarts from: the
+    given result (the command line's --from, `simulate`'s start_from), else the scenario's
+    [restart] (its file read; start_time, --from-time, overrides its time); result None:
+    a run from t = 0."""
+    r = scenario.restart
+    if start_from is not None:
+        return start_from, start_time, "from", "from_time"
+    if r is None:
+        if start_time is not None:
+            raise ScenarioError(
+                "from_time", start_time, "a restart time needs a result to restart from (--from, or [restart] result)"
+            )
+        return None, None, "from", "from_time"
+    ds = read_result(r.result)
+    if start_time is not None:
+        return ds, start_time, "restart.result", "from_time"
+    return ds, r.time, "restart.result", "restart.time"
 
 
 def check_restart(

@@ -14,7 +14,7 @@ from dataclasses import replace
 
 from granplate.errors import SimulationError, YieldWarning
 from granplate.model.arrays import Model, build_model
-from granplate.results.restart import check_restart, restart_state, with_restart
+from granplate.results.restart import check_restart, restart_source, restart_state, with_restart
 from granplate.results.dataset import to_dataset
 from granplate.setup.scenario import Scenario
 from granplate.solver.compiling import CompileClock, compile_clock
@@ -80,14 +80,15 @@ def simulate(
     its `status` attribute saying why) when the run goes numerically wrong or is stopped
     by SIGINT/SIGTERM (Ctrl-C). start_from: a result (Dataset) to restart from at its last
     output time, or at start_time [s], one of its stored restart times (time.restart_interval;
-    docs/how-to/restart.md): checked against the scenario (results.restart.check_restart)
-    before anything runs.
+    docs/how-to/restart.md; absent: the scenario's [restart], if any): checked against the
+    scenario (results.restart.check_restart) before anything runs.
     """
     if t_end is not None:
         scenario = with_t_end(scenario, t_end)
     start = None
+    start_from, start_time, from_field, time_field = restart_source(scenario, start_from, start_time)
     if start_from is not None:
-        t1 = check_restart(start_from, scenario, start_time)
+        t1 = check_restart(start_from, scenario, start_time, from_field, time_field)
         start = restart_state(start_from, t1)
     with compile_clock() as clock:
         if compile_all:

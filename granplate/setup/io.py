@@ -46,6 +46,7 @@ from granplate.setup.scenario import (
     PairCoefficients,
     Plate,
     Precompression,
+    Restart,
     Scenario,
     Sensor,
     Solid,
@@ -64,6 +65,7 @@ REQUIRED: dict[type, tuple[str, ...]] = {
     Drive: ("target", "kind", "direction", "profile"),
     Precompression: ("target", "force"),
     Sensor: ("granule",),
+    Restart: ("result",),
 }
 #: Keys of a [materials.NAME] table: E, nu, rho required; Y optional (absent: unknown);
 #: the law "johnson"'s C, rate_ref, hardness_ratio, unloading_factor optional.
@@ -266,6 +268,7 @@ _TOP_TABLES: dict[str, type] = {
     "box": Box,
     "gravity": Gravity,
     "precompression": Precompression,
+    "restart": Restart,
 }
 
 
@@ -356,9 +359,9 @@ def from_dict(d: dict, base: str | os.PathLike | None = None) -> Scenario:
     Top-level keys: name, description, dimension, materials, layout, granules (or
     granules_file: a CSV, NPZ or netCDF file of them, setup.granules_file, relative to
     `base`, by default the working directory), walls, box, plate, load, contact, time,
-    solver, gravity, drives, sensors. Missing tables take the defaults (no layout, no plate, no box,
+    solver, gravity, drives, sensors, restart. Missing tables take the defaults (no layout, no plate, no box,
     no gravity, no drives; dimension 2; in 3D no load, `load.kind = "none"`). `base` is
-    also the folder a drive's CSV `file` is relative to.
+    also the folder a drive's CSV `file` and a [restart]'s `result` are relative to.
     """
     names = [f.name for f in dataclasses.fields(Scenario)]
     _check_keys("", d, names)
@@ -382,6 +385,10 @@ def from_dict(d: dict, base: str | os.PathLike | None = None) -> Scenario:
             kw[key] = _table(key, d[key], cls)
     if "time" in kw:
         kw["time"] = _initial_step_within_max(kw["time"], d["time"])
+    if "restart" in kw and base is not None and not os.path.isabs(kw["restart"].result):
+        kw["restart"] = dataclasses.replace(
+            kw["restart"], result=os.path.normpath(os.path.join(base, kw["restart"].result))
+        )
     if d.get("granules_file") is not None:
         kw.update(_granules_file(d, kw.get("dimension", 2), base))
     elif d.get("granules") is not None:
@@ -513,6 +520,8 @@ def to_dict(s: Scenario, all_materials: bool = False) -> dict:
         d["precompression"] = _plain(s.precompression)
     if s.sensors:  # (none: not written, so that every scenario without them is written as before)
         d["sensors"] = [_without_defaults(x, {"name": ""}) for x in _plain(s.sensors)]
+    if s.restart is not None:
+        d["restart"] = _plain(s.restart)
     return d
 
 

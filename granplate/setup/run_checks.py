@@ -8,7 +8,7 @@ import math
 
 from granplate.errors import ScenarioError
 from granplate.setup.threads import check_threads
-from granplate.setup.fields import finite, int_at_least, positive, string_in
+from granplate.setup.fields import finite, int_at_least, nonneg, positive, string_in
 from granplate.setup.plate_cost import MEMORY_SHARE, physical_memory
 from granplate.setup.scenario import Solid, Plate, Scenario
 
@@ -47,6 +47,21 @@ def _check_time(s: Scenario) -> None:
             f"{t.output_interval!r}, 1 <= n <= 2^53 (beyond, every double is whole)",
         )
     _check_restart_interval(t)
+    _check_restart_table(s)
+
+
+def _check_restart_table(s: Scenario) -> None:
+    """[restart]: result a non-empty file name, time (when given) >= 0 [s]; whether the
+    file holds a state at that time is checked when the run starts (results.restart)."""
+    r = s.restart
+    if r is None:
+        return
+    if not isinstance(r.result, str) or not r.result.strip():
+        raise ScenarioError(
+            "restart.result", r.result, "must name a result netCDF file (relative to the scenario file)"
+        )
+    if r.time is not None:
+        nonneg("restart.time", r.time)
 
 
 #: The most loop states a result stores before its end time (time.restart_interval).

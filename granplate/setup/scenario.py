@@ -706,6 +706,17 @@ class Sensor:
 
 
 @dataclass(frozen=True)
+class Restart:
+    """A run that goes on from a result's stored state (docs/how-to/restart.md): `result`,
+    the result netCDF file (a path relative to the scenario file's folder; the scenario as
+    read holds it joined to that folder), and `time` [s], one of its stored restart times
+    (absent: the last). The command line's `--from` and `--from-time` override them."""
+
+    result: str = ""
+    time: float | None = None
+
+
+@dataclass(frozen=True)
 class Scenario:
     """A complete run definition. Either `layout` or explicit `granules`/`walls`.
 
@@ -718,7 +729,8 @@ class Scenario:
     gravity: a body force on every granule (None: none); drives: prescribed motions of
     walls and granules and prescribed forces on granules (docs/model.md section 3.11);
     precompression: the static state the run starts from (None: as given; section 3.12);
-    sensors: force sensors in granules, sampled every time.sensor_interval (section 3.15).
+    sensors: force sensors in granules, sampled every time.sensor_interval (section 3.15);
+    restart: the result the run goes on from (None: a run from t = 0; docs/how-to/restart.md).
     """
 
     name: str = "custom"
@@ -739,6 +751,7 @@ class Scenario:
     drives: tuple[Drive, ...] = ()
     precompression: Precompression | None = None
     sensors: tuple[Sensor, ...] = ()
+    restart: Restart | None = None
 
     def material(self, name: str) -> Material:
         """The material called `name` (file-defined ones override the library)."""
