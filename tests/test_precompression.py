@@ -220,13 +220,3 @@ def test_granules_that_would_fall_are_refused():
     with pytest.raises(ScenarioError, match="fall through") as e:
         build_model(s)
     assert e.value.field == "gravity.g"
-
-
-def test_a_precompressed_run_is_not_restarted(tmp_path):
-    """Restarting a precompressed run is refused before anything runs, naming precompression
-    (its energy reference is not carried across a restart yet)."""
-    s = chain()
-    first = gp.simulate(s, t_end=1e-5, progress=False)
-    with pytest.raises(ScenarioError) as e:
-        gp.simulate(s, start_from=first, progress=False)
-    assert e.value.field == "precompression"

@@ -102,6 +102,7 @@ class Model:
     solid: object | None = None  # an elastic body in space: the built solid (solid.build.SolidModel)
     body: object | None = None  # and its arrays in the loop (model.inputs.BodyArrays)
     body_rigid: np.ndarray | None = None  # (ng,) bool: the granules on one of the body's rigid patches at t = 0
+    walls: tuple = ()  # the walls as the loop has them (`model_walls`); empty: the scenario's
 
     @property
     def n_granules(self) -> int:
@@ -111,6 +112,13 @@ class Model:
     def contact_labels(self) -> tuple[str, ...]:
         """Labels of the plate contacts (the granule touching the plate)."""
         return tuple(self.labels[i] for i in self.plate_contacts)
+
+
+def model_walls(model: "Model") -> tuple:
+    """The walls of the model's loop: the scenario's, a [precompression] target wall at
+    its static offset (model.static.precompressed), so that every contact-list rebuild
+    keeps it where the static state left it."""
+    return model.walls or tuple(model.scenario.walls)
 
 
 def coefficient_row(a: float, c: float, mu: float, k_s: float, law=math.inf) -> np.ndarray:
@@ -338,10 +346,12 @@ def wall_coefficient_row(s: Scenario, a, wall_material: str, ri: float, mi: floa
     )
 
 
-def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarray):
+def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarray, walls=None):
     """(nw, d + 1) [nx, ny, (nz,) offset] with the unit outward normal (d = the scenario's
     dimension), and (nw, N_COEF) coefficients against a rigid body (R* = R, m* = m): the
-    rows of `wall_coefficient_row`, bit for bit (as `pair_coefficients`)."""
+    rows of `wall_coefficient_row`, bit for bit (as `pair_coefficients`). walls: the
+    Walls of the rows of wc (None: the scenario's; `model_walls`)."""
+    walls = s.walls if walls is None else walls
     wc = np.asarray(wc, np.int64).reshape(-1, 2)
     wall_geo = np.zeros((len(wc), s.dimension + 1))
     wall_coef = np.zeros((len(wc), N_COEF))
@@ -353,7 +363,7 @@ def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarr
     e_star, alpha = np.empty(len(wc)), np.empty(len(wc))
     plastic = np.zeros(len(wc), bool)
     for k in np.unique(w).tolist():
-        wall = s.walls[k]
+        wall = walls[k]
         nrm = np.asarray(wall.normal, float)
         at = w == k
         wall_geo[at] = (*(nrm / np.linalg.norm(nrm)), wall.offset)
@@ -649,7 +659,7 @@ def granular_with_contacts(
     stores = ({}, {}) if stores is None else stores
     pairs = np.ascontiguousarray(pairs, np.int64).reshape(-1, 2)
     pair_coef = cached_pair_coefficients(s, mats, g, pairs, known)
-    wall_geo, wall_coef = wall_arrays(s, mats, g.radius, g.mass, wc)
+    wall_geo, wall_coef = wall_arrays(s, mats, g.radius, g.mass, wc, model_walls(model))
     wc = np.asarray(wc, np.int64).reshape(-1, 2)
     return g._replace(
         pair_ij=pairs,

@@ -246,7 +246,8 @@ def static_state(
 def precompressed(model):
     """The model whose run starts from its scenario's [precompression] static state: the
     granules' centres moved to it, the target wall's offset with them (frozen there during
-    the run); the model itself when the scenario has none."""
+    the run: its contact rows and the model's `walls`, which every contact-list rebuild
+    takes); the model itself when the scenario has none."""
     from granplate.setup.precompression_checks import precompression_wall
 
     p = model.scenario.precompression
@@ -263,4 +264,6 @@ def precompressed(model):
     y0[:, :d] = st.positions
     geo = g.wall_geo.copy()
     geo[rows, d] = st.offset
-    return dataclasses.replace(model, initial_state=y0, granular=g._replace(wall_geo=geo))
+    walls = list(model.scenario.walls)
+    walls[wall] = dataclasses.replace(walls[wall], offset=float(st.offset))
+    return dataclasses.replace(model, initial_state=y0, granular=g._replace(wall_geo=geo), walls=tuple(walls))

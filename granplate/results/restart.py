@@ -162,13 +162,6 @@ def check_restart(
     t1 = times[k]
     if not t1 < scenario.time.t_end:
         raise ScenarioError("time.t_end", scenario.time.t_end, f"must exceed the restart time {t1!r} s")
-    if scenario.precompression is not None:
-        raise ScenarioError(
-            "precompression",
-            scenario.precompression.target,
-            "a precompressed run cannot be restarted yet (its energy reference is not carried across the "
-            "restart); run it straight to the end time",
-        )
     old, new = resolve(scenario_of(ds)), resolve(scenario)
     if old.dimension != new.dimension:
         raise ScenarioError("dimension", new.dimension, f"must be the result's, {old.dimension}")
