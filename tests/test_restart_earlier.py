@@ -131,3 +131,21 @@ def test_scenario_restart_key_equals_the_option(straight, tmp_path):
         simulate(gp.with_changes(keyed, {"layout.count": 7}))
     with pytest.raises(ScenarioError, match=r"'from_time' = 3e-05.*needs a result"):
         simulate(s, start_time=3e-5)
+
+
+def test_a_run_that_stopped_keeps_its_earlier_states(straight):
+    """A result without its end state (a run stopped before its end) holds the states stored
+    before; a restart goes on from the last of them and ends where the straight run does."""
+    from granplate.results.restart import with_restart
+
+    s, ds = straight
+    states = [restart_state(ds, t) for t in (3e-5, 6e-5)]
+    bare = ds.drop_vars([k for k in ds.data_vars if str(k).startswith("restart_")])
+    bare.attrs = {k: v for k, v in ds.attrs.items() if not k.startswith("restart_")}
+    stopped = with_restart(bare, None, states)
+    assert "restart_time" not in stopped.attrs and restart_times(stopped) == pytest.approx([3e-5, 6e-5], rel=1e-12)
+    rest = simulate(s, start_from=stopped)
+    assert float(rest.time[0]) == pytest.approx(6e-5, rel=1e-12)
+    np.testing.assert_array_equal(restart_state(rest)["st.y"], restart_state(ds)["st.y"])
+    with pytest.raises(ScenarioError, match=r"the run stopped before its end"):
+        simulate(s, start_from=stopped, start_time=1e-4)

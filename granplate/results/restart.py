@@ -1,20 +1,23 @@
 """Restart from a result (docs/how-to/restart.md): the loop's state at a result's last
 output time, stored in its Dataset as `restart_*` variables, and at earlier output times
-(time.restart_interval) as `restart_t<k>_*` variables, and a run of a scenario that goes
-on from one of them.
+(time.restart_interval) as `restart_t<k>_float` and `restart_t<k>_int`, and a run of a
+scenario that goes on from one of them.
 
-`with_restart(ds, snap, earlier)`: ds with the captured states (solver.snapshot) added,
-each array a variable `restart_<path>` (the last) or `restart_t<k>_<path>` (the k-th of
-the attribute `restart_times`; dots of the path as "__") on dimensions of its own.
-`restart_times(ds)`: the times [s] a state is stored at. `restart_source(scenario, ...)`:
-the result and time a run restarts from (the command line's, or the scenario's [restart]). `restart_state(ds, time)`: one
-state's arrays back, keyed by path. `check_restart(ds, scenario, time)`: refuses
+`with_restart(ds, snap, earlier)`: ds with the captured states (solver.snapshot) added:
+the last, each array a variable `restart_<path>` (dots of the path as "__") on dimensions
+of its own; the k-th earlier one (of the attribute `restart_times`) packed flat into two
+variables `restart_t<k>_float`, `restart_t<k>_int`, whose attribute `layout` lists its
+arrays' paths and shapes. `restart_times(ds)`: the times [s] a state is stored at.
+`restart_state(ds, time)`: one state's arrays back, keyed by path.
+`restart_source(scenario, ...)`: the result and time a run restarts from (the command
+line's, or the scenario's [restart]). `check_restart(ds, scenario, time)`: refuses
 (ScenarioError naming the field) a result whose granules differ from the scenario's
 (count, radii, materials, dimension) or a chosen time at which no state is stored.
 """
 
 from __future__ import annotations
 
+import json
 import re
 
 import numpy as np
@@ -23,21 +26,56 @@ import xarray as xr
 from granplate.errors import ScenarioError
 
 PREFIX = "restart_"
-#: the names of the states stored before the last: restart_t<k>_<path>
-EARLIER = re.compile(r"^restart_t(\d+)_")
+#: the names of the states stored before the last: restart_t<k>_float, restart_t<k>_int
+EARLIER = re.compile(r"^restart_t(\d+)_(float|int)$")
 
 
-def _name(path: str, prefix: str = PREFIX) -> str:
-    return prefix + path.replace(".", "__")
+def _name(path: str) -> str:
+    return PREFIX + path.replace(".", "__")
 
 
-def _variables(snap: dict[str, np.ndarray], prefix: str, what: str) -> dict[str, xr.DataArray]:
+def _variables(snap: dict[str, np.ndarray]) -> dict[str, xr.DataArray]:
+    """The last state: one variable per array, on dimensions of its own."""
     data = {}
     for path, a in snap.items():
-        name = _name(path, prefix)
+        name = _name(path)
         dims = tuple(f"{name}_{k}" for k in range(a.ndim))
-        data[name] = xr.DataArray(a, dims=dims, attrs={"long_name": f"restart state{what}: {path}"})
+        data[name] = xr.DataArray(a, dims=dims, attrs={"long_name": f"restart state: {path}"})
     return data
+
+
+def _packed(snap: dict[str, np.ndarray], k: int, t: float) -> dict[str, xr.DataArray]:
+    """An earlier state in two flat variables, restart_t<k>_float (float64) and
+    restart_t<k>_int (int64; the integer and boolean arrays), their arrays in the order
+    of the attribute `layout` (JSON: [path, shape] pairs): a few variables per state keep
+    the file's writing and reading fast."""
+    out = {}
+    for kind, dtype, keep in (("float", np.float64, "f"), ("int", np.int64, "iub")):
+        paths = [p for p, a in snap.items() if a.dtype.kind in keep]
+        flat = [np.asarray(snap[p], dtype).ravel() for p in paths]
+        name = f"{PREFIX}t{k}_{kind}"
+        out[name] = xr.DataArray(
+            np.concatenate(flat) if flat else np.zeros(0, dtype),
+            dims=(f"{name}_n",),
+            attrs={
+                "long_name": f"restart state at t = {t!r} s: its {kind} arrays, flat",
+                "layout": json.dumps([[p, list(snap[p].shape)] for p in paths]),
+            },
+        )
+    return out
+
+
+def _unpacked(ds: xr.Dataset, k: int) -> dict[str, np.ndarray]:
+    """The arrays of the earlier state k (`_packed`), keyed by path."""
+    out = {}
+    for kind in ("float", "int"):
+        v = ds[f"{PREFIX}t{k}_{kind}"]
+        flat, at = np.asarray(v.values), 0
+        for path, shape in json.loads(v.attrs["layout"]):
+            n = int(np.prod(shape, dtype=np.int64))
+            out[path] = flat[at : at + n].reshape(shape).copy()
+            at += n
+    return out
 
 
 def with_restart(ds: xr.Dataset, snap: dict[str, np.ndarray] | None, earlier=()) -> xr.Dataset:
@@ -46,11 +84,10 @@ def with_restart(ds: xr.Dataset, snap: dict[str, np.ndarray] | None, earlier=())
     data: dict[str, xr.DataArray] = {}
     times = []
     for k, state in enumerate(earlier):
-        t = float(state["st.clock"][0])
-        times.append(t)
-        data.update(_variables(state, f"{PREFIX}t{k}_", f" at t = {t!r} s"))
+        times.append(float(state["st.clock"][0]))
+        data.update(_packed(state, k, times[-1]))
     if snap is not None:
-        data.update(_variables(snap, PREFIX, ""))
+        data.update(_variables(snap))
         times.append(float(snap["st.clock"][0]))
     if not times:
         return ds
@@ -69,12 +106,6 @@ def restart_times(ds: xr.Dataset) -> list[float]:
     return [float(ds.attrs["restart_time"])] if "restart_time" in ds.attrs else []
 
 
-def _prefix_at(ds: xr.Dataset, index: int) -> str:
-    """The variables' prefix of the state at restart_times(ds)[index]."""
-    last = "restart_time" in ds.attrs and index == len(restart_times(ds)) - 1
-    return PREFIX if last else f"{PREFIX}t{index}_"
-
-
 def stored_time(ds: xr.Dataset, time: float | None) -> int:
     """The index in restart_times(ds) of `time` [s] (to 1e-12 relative; None: the last),
     or -1 when no state is stored there."""
@@ -90,12 +121,12 @@ def restart_state(ds: xr.Dataset, time: float | None = None) -> dict[str, np.nda
     k = stored_time(ds, time)
     if k < 0:
         raise KeyError(f"no restart state at t = {time!r} s")
-    prefix = _prefix_at(ds, k)
-    earlier = prefix != PREFIX
+    if not ("restart_time" in ds.attrs and k == len(restart_times(ds)) - 1):
+        return _unpacked(ds, k)
     return {
-        str(name)[len(prefix) :].replace("__", "."): np.array(ds[name].values)
+        str(name)[len(PREFIX) :].replace("__", "."): np.array(ds[name].values)
         for name in ds.data_vars
-        if str(name).startswith(prefix) and (earlier or not EARLIER.match(str(name)))
+        if str(name).startswith(PREFIX) and not EARLIER.match(str(name))
     }
 
 
