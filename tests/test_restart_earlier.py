@@ -1,8 +1,10 @@
 """Restart from an earlier output time (time.restart_interval): a run restarted at a stored
 time t1 before its end and continued to t2 equals the straight run to t2 bitwise at every
 output time from t1 on (implicit scheme, plate in the plane, Thornton's yielding contacts and
-friction; the first row's statistics over the interval before t1 excepted: they cover no step
-of the restarted run); a time at which no state is stored is refused, listing the stored ones."""
+friction; velocity Verlet of a chain in space struck obliquely; the first row's statistics
+over the interval before t1 excepted: they cover no step of the restarted run); the
+scenario's [restart] gives what --from/--from-time give; a time at which no state is
+stored and other bad input are refused, naming the field."""
 
 from __future__ import annotations
 
@@ -55,6 +57,24 @@ def test_restart_at_an_earlier_time_equals_the_straight_run(straight):
     # the restarted run stores its own states at the same times of the whole run
     assert restart_times(rest) == pytest.approx([6e-5, 9e-5, 1e-4], rel=1e-12)
     np.testing.assert_array_equal(restart_state(rest, 6e-5)["st.y"], restart_state(ds, 6e-5)["st.y"])
+
+
+@pytest.mark.filterwarnings("ignore:.*overlap_warn")
+def test_verlet_3d_oblique_restart_at_an_earlier_time_equals_the_straight_run():
+    """Velocity Verlet of a chain in space struck obliquely: yielding and sliding contacts
+    (D_plastic, D_friction each a share of E_shock); every output row from t1 on bitwise."""
+    s = yielding("3d-chain.toml", "verlet")
+    s = dataclasses.replace(s, load=dataclasses.replace(s.load, force=2000.0, direction=(1.0, 0.6, 0.3)))
+    s = with_interval(s, 3e-5)
+    ds = simulate(s)
+    e_shock = float(ds.E_shock[-1])
+    assert float(ds.D_plastic[-1]) > 1e-2 * e_shock and float(ds.D_friction[-1]) > 1e-3 * e_shock
+    rest = simulate(s, start_from=ds, start_time=6e-5)
+    n = rest.sizes["time"]
+    for name in ("x", "y", "z", "vx", "vy", "vz", "E_granular", "D_plastic", "D_friction", "energy_residual"):
+        np.testing.assert_array_equal(rest[name].values[1:], ds[name].values[-n + 1 :], err_msg=name)
+    for key in ("st.y", "st.acc", "g.pair_hist", "g.wall_hist"):
+        np.testing.assert_array_equal(restart_state(rest)[key], restart_state(ds)[key], err_msg=key)
 
 
 def test_a_time_not_stored_is_refused_listing_the_stored_ones(straight):
