@@ -4,6 +4,7 @@ and the plate's modal model, built once per run (the plate part is cached on dis
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -102,6 +103,13 @@ class Model:
     solid: object | None = None  # an elastic body in space: the built solid (solid.build.SolidModel)
     body: object | None = None  # and its arrays in the loop (model.inputs.BodyArrays)
     body_rigid: np.ndarray | None = None  # (ng,) bool: the granules on one of the body's rigid patches at t = 0
+    run_walls: tuple = ()  # the walls where the run starts, when not the scenario's (a precompressed wall's static offset)
+
+    @property
+    def walls(self) -> tuple:
+        """The walls where the run starts: `run_walls`, or the scenario's (the contact lists
+        are rebuilt against them, a driven wall moved from there)."""
+        return self.run_walls or self.scenario.walls
 
     @property
     def n_granules(self) -> int:
@@ -649,7 +657,8 @@ def granular_with_contacts(
     stores = ({}, {}) if stores is None else stores
     pairs = np.ascontiguousarray(pairs, np.int64).reshape(-1, 2)
     pair_coef = cached_pair_coefficients(s, mats, g, pairs, known)
-    wall_geo, wall_coef = wall_arrays(s, mats, g.radius, g.mass, wc)
+    walls_at = dataclasses.replace(s, walls=model.run_walls) if model.run_walls else s
+    wall_geo, wall_coef = wall_arrays(walls_at, mats, g.radius, g.mass, wc)
     wc = np.asarray(wc, np.int64).reshape(-1, 2)
     return g._replace(
         pair_ij=pairs,

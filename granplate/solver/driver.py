@@ -297,7 +297,7 @@ class ContactLists:
         )
         self.known: dict = {}
         self.stores: tuple[dict, dict] = ({}, {})  # histories of the pairs and wall contacts off the lists
-        self.planes = wall_planes(model.scenario.walls, model.config.dimension)
+        self.planes = wall_planes(model.walls, model.config.dimension)
         self.n_rebuilds = 0  # rebuilds the loop asked for (REBUILD, dynamic detection)
         self.formed: list[tuple[int, float, float]] = []  # patch contacts: (granule, t [s], y [m])
 
@@ -322,7 +322,7 @@ class ContactLists:
         c = m.scenario.contact
         fixed = c.detection == "fixed"
         normals, offsets = self.planes
-        walls = m.scenario.walls
+        walls = m.walls
         if len(g.wall_drive):  # driven walls where they are now (docs/model.md section 3.11)
             offsets = wall_offsets_now(g, normals, offsets)
             walls = tuple(dataclasses.replace(wall, offset=float(o)) for wall, o in zip(walls, offsets))
