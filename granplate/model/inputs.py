@@ -80,7 +80,8 @@ class Granular(NamedTuple):
     Gravity and drives (docs/model.md section 3.11; empty: none): gravity (d,) [m/s^2];
     per drive: drive_target (nD,) int, the granule i >= 0 or the wall -1 - w it drives;
     drive_kind, drive_prof (nD,) int (physics.drives KIND_*, PROFILE_*); drive_dir (nD,
-    d) its unit direction; drive_par (nD, N_PAR) its profile's parameters; drive_tab (nD,
+    d) its unit direction; drive_par (nD, N_PAR) its profile's parameters (and a
+    force-driven wall's mass, physics.drives PAR_*); drive_tab (nD,
     L, 3) and drive_tlen (nD,) int its table (physics.drives TAB_*); drive_x0 (nD, d) its
     granule's centre at t = 0 [m]; drive_now (nD, N_DRIVE) its state at the last force
     pass (columns DR_*, this run's own). wall_drive (n_walls,) int: the drive of each
