@@ -82,8 +82,8 @@ def test_piston_on_a_held_sphere_rings_as_a_mass_on_a_hertz_spring(dimension):
     d_max = (2.5 * P / a) ** (2.0 / 3.0)
     period = 2.0 * math.sqrt(M * d_max / (2.0 * P)) * (2.0 / 3.0) * beta(1.0 / 3.0, 0.5)
     t_peak, s_peak = _peak(t, s)
-    assert s_peak == pytest.approx(d_max, rel=1e-4)
-    assert 2.0 * t_peak == pytest.approx(period, rel=1e-3)
+    assert s_peak == pytest.approx(d_max, rel=1e-5)
+    assert 2.0 * t_peak == pytest.approx(period, rel=1e-5)
     assert t[-1] > period and s[np.argmin(np.abs(t - period))] < 1e-2 * d_max  # back at first touch
     wf = ds.wall_force.sel(wall="top").values
     np.testing.assert_allclose(wf, a * np.maximum(s, 0.0) ** 1.5, rtol=1e-9, atol=1e-9 * P)
@@ -91,6 +91,17 @@ def test_piston_on_a_held_sphere_rings_as_a_mass_on_a_hertz_spring(dimension):
     np.testing.assert_allclose(ds.drive_force.sel(drive="wall top").values, P)
     np.testing.assert_allclose(ds.E_drive.values, P * s, rtol=1e-4, atol=1e-4 * P * d_max)
     assert float(np.abs(ds.energy_residual_max).max()) < 1e-4
+
+
+def test_the_pistons_energy_error_is_second_order():
+    """Eq. (11)'s residual of the undamped piston is Verlet's own error at its contact: it
+    falls 4x when the step halves (measured 1.29e-5, 3.22e-6, 8.0e-7 at 200, 100, 50 ns)."""
+    res = []
+    for dt in (2e-7, 1e-7):
+        d = piston(3, t_end=1.5e-4)
+        d["time"].update(dt_max=dt, dt_initial=dt)
+        res.append(float(np.abs(gp.simulate(from_dict(d), progress=False).energy_residual_max).max()))
+    assert 3.5 < res[0] / res[1] < 4.5
 
 
 def test_damped_piston_settles_at_hertz_static_overlap_and_balances_energy():
