@@ -108,3 +108,11 @@ def test_rebuilt_contact_lists_keep_the_wall_at_its_static_offset():
         assert before[model.granular.wall_w == 1][0] < 0.05  # pressed in from the scenario's 0.05 m
         lists.refresh(model.initial_state)
         np.testing.assert_array_equal(lists.g.wall_geo[:, -1], before)
+
+
+def test_held_mode_round_trips_and_frozen_is_written_as_before():
+    """`mode = "held"` and its `mass` survive TOML writing and reading; a frozen
+    precompression is written without a mass key (its text as before the held mode)."""
+    held = gp.with_changes(chain("held"), {"precompression.mass": 0.5})
+    assert gp.loads(gp.dumps(held)) == held and "mass = 0.5" in gp.dumps(held)
+    assert "mass" not in gp.dumps(chain("frozen"))
