@@ -361,7 +361,7 @@ BAD = [
     ),
     (
         {"drives": [{"target": "wall floor", "kind": "force", "direction": [0.0, -1.0], "profile": "constant"}]},
-        "drives[0].kind",
+        "drives[0].mass",
     ),
     (
         {"drives": [{"target": "wall floor", "kind": "velocity", "direction": [1.0, 0.0], "profile": "constant"}]},

@@ -102,7 +102,13 @@ class Model:
     solid: object | None = None  # an elastic body in space: the built solid (solid.build.SolidModel)
     body: object | None = None  # and its arrays in the loop (model.inputs.BodyArrays)
     body_rigid: np.ndarray | None = None  # (ng,) bool: the granules on one of the body's rigid patches at t = 0
-    walls: tuple = ()  # the walls as the loop has them (`model_walls`); empty: the scenario's
+    run_walls: tuple = ()  # the walls where the run starts, when not the scenario's (a precompressed wall's static offset)
+
+    @property
+    def walls(self) -> tuple:
+        """The walls where the run starts: `run_walls`, or the scenario's (the contact lists
+        are rebuilt against them, a driven wall moved from there)."""
+        return self.run_walls or self.scenario.walls
 
     @property
     def n_granules(self) -> int:
@@ -112,13 +118,6 @@ class Model:
     def contact_labels(self) -> tuple[str, ...]:
         """Labels of the plate contacts (the granule touching the plate)."""
         return tuple(self.labels[i] for i in self.plate_contacts)
-
-
-def model_walls(model: "Model") -> tuple:
-    """The walls of the model's loop: the scenario's, a [precompression] target wall at
-    its static offset (model.static.precompressed), so that every contact-list rebuild
-    keeps it where the static state left it."""
-    return model.walls or tuple(model.scenario.walls)
 
 
 def coefficient_row(a: float, c: float, mu: float, k_s: float, law=math.inf) -> np.ndarray:
@@ -350,7 +349,7 @@ def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarr
     """(nw, d + 1) [nx, ny, (nz,) offset] with the unit outward normal (d = the scenario's
     dimension), and (nw, N_COEF) coefficients against a rigid body (R* = R, m* = m): the
     rows of `wall_coefficient_row`, bit for bit (as `pair_coefficients`). walls: the
-    Walls of the rows of wc (None: the scenario's; `model_walls`)."""
+    Walls of the rows of wc (None: the scenario's; `Model.walls`)."""
     walls = s.walls if walls is None else walls
     wc = np.asarray(wc, np.int64).reshape(-1, 2)
     wall_geo = np.zeros((len(wc), s.dimension + 1))
@@ -659,7 +658,7 @@ def granular_with_contacts(
     stores = ({}, {}) if stores is None else stores
     pairs = np.ascontiguousarray(pairs, np.int64).reshape(-1, 2)
     pair_coef = cached_pair_coefficients(s, mats, g, pairs, known)
-    wall_geo, wall_coef = wall_arrays(s, mats, g.radius, g.mass, wc, model_walls(model))
+    wall_geo, wall_coef = wall_arrays(s, mats, g.radius, g.mass, wc, model.walls)
     wc = np.asarray(wc, np.int64).reshape(-1, 2)
     return g._replace(
         pair_ij=pairs,

@@ -15,7 +15,9 @@ from granplate.physics.drives import (
     PAR_DURATION,
     PAR_FREQUENCY,
     PAR_FREQUENCY_END,
+    PAR_MASS,
     PAR_VALUE,
+    PROFILE_CONSTANT,
     TAB_I,
     TAB_T,
     TAB_V,
@@ -63,12 +65,13 @@ def drive_fields(s: Scenario, centres: np.ndarray) -> dict:
     direction = np.zeros((nd, d))
     x0 = np.zeros((nd, d))
     for k, dr in enumerate(s.drives):
-        par[k, [PAR_VALUE, PAR_AMPLITUDE, PAR_FREQUENCY, PAR_DURATION, PAR_FREQUENCY_END]] = (
+        par[k, [PAR_VALUE, PAR_AMPLITUDE, PAR_FREQUENCY, PAR_DURATION, PAR_FREQUENCY_END, PAR_MASS]] = (
             dr.value,
             dr.amplitude,
             dr.frequency,
             dr.duration,
             dr.frequency_end,
+            dr.mass,
         )
         rows = drive_table(dr.times, dr.values)
         tab[k, : len(rows)] = rows
@@ -93,6 +96,44 @@ def drive_fields(s: Scenario, centres: np.ndarray) -> dict:
         wall_drive=wall_drive if (target < 0).any() else np.zeros(0, np.int64),
         wall_load=np.zeros(n_walls),
     )
+
+
+def with_piston(g, wall: int, direction: np.ndarray, force: float, mass: float):
+    """The granular arrays g (model.inputs.Granular or Granular3) with one more drive: wall
+    `wall` (its index in the scenario) made a piston of `mass` [kg] pushed along the unit
+    `direction` by the constant `force` [N], at rest where g's wall rows put it (the held
+    wall of a precompression, docs/model.md section 3.12)."""
+    nd, d = g.drive_dir.shape[0], len(direction)
+    par = np.zeros((1, N_PAR))
+    par[0, PAR_VALUE], par[0, PAR_MASS] = force, mass
+    tab = np.zeros((nd + 1, g.drive_tab.shape[1], 3))
+    tab[:nd] = g.drive_tab
+    n_walls = len(g.wall_load)
+    wall_drive = g.wall_drive.copy() if len(g.wall_drive) else np.full(n_walls, -1, np.int64)
+    wall_drive[wall] = nd
+    return g._replace(
+        drive_target=np.append(g.drive_target, -1 - wall).astype(np.int64),
+        drive_kind=np.append(g.drive_kind, KIND_FORCE).astype(np.int64),
+        drive_prof=np.append(g.drive_prof, PROFILE_CONSTANT).astype(np.int64),
+        drive_dir=np.vstack([g.drive_dir.reshape(nd, d), np.asarray(direction, float)[None, :]]),
+        drive_par=np.vstack([g.drive_par, par]),
+        drive_tab=tab,
+        drive_tlen=np.append(g.drive_tlen, 1).astype(np.int64),
+        drive_x0=np.vstack([g.drive_x0.reshape(nd, d), np.zeros((1, d))]),
+        drive_now=np.vstack([g.drive_now, np.zeros((1, N_DRIVE))]),
+        wall_drive=wall_drive,
+    )
+
+
+def drive_names(s: Scenario) -> list[str]:
+    """The names of the drives of the resolved scenario s in the loop's order (the Dataset's
+    `drive` axis): each [[drives]] entry's, then a held precompression's wall (its target,
+    "wall LABEL")."""
+    names = [d.name for d in s.drives]
+    p = s.precompression
+    if p is not None and p.mode == "held":
+        names.append(p.target)
+    return names
 
 
 def driven_initial_state(y0: np.ndarray, fields: dict) -> np.ndarray:

@@ -45,12 +45,15 @@ N_HIST = 4
 
 #: columns of Granular.drive_now, each drive's state at the last force pass: its
 #: displacement s [m], velocity v [m/s] and acceleration a [m/s^2] along its direction (a
-#: force drive: its force in DR_A), the force F [N] the drive applies on its body along
-#: the direction, its power F v [W], the power of the contact damping forces on the
-#: granules at the wall's velocity [W] (a wall's), and a wall's displacement when the
-#: contact list was last built [m].
-DR_S, DR_V, DR_A, DR_F, DR_P, DR_PD, DR_REF = range(7)
-N_DRIVE = 7
+#: force drive on a granule: its force in DR_A), the force F [N] the drive applies on its
+#: body along the direction, its power F v [W], the power of the contact damping forces on
+#: the granules at the wall's velocity [W] (a wall's), and a wall's displacement when the
+#: contact list was last built [m]; a wall's: the damping part of the contacts' force
+#: counted as F is [N]; a piston's (a force-driven wall, solver.drives): the contacts' force
+#: against its drive R [N] (its acceleration DR_A = (F - R) / M) and its velocity after the
+#: step's first half kick [m/s]. A piston's s and v are its state (the scheme integrates them).
+DR_S, DR_V, DR_A, DR_F, DR_P, DR_PD, DR_REF, DR_FD, DR_R, DR_VH = range(10)
+N_DRIVE = 10
 
 
 def no_history(n: int) -> np.ndarray:
@@ -77,7 +80,8 @@ class Granular(NamedTuple):
     Gravity and drives (docs/model.md section 3.11; empty: none): gravity (d,) [m/s^2];
     per drive: drive_target (nD,) int, the granule i >= 0 or the wall -1 - w it drives;
     drive_kind, drive_prof (nD,) int (physics.drives KIND_*, PROFILE_*); drive_dir (nD,
-    d) its unit direction; drive_par (nD, N_PAR) its profile's parameters; drive_tab (nD,
+    d) its unit direction; drive_par (nD, N_PAR) its profile's parameters (and a
+    force-driven wall's mass, physics.drives PAR_*); drive_tab (nD,
     L, 3) and drive_tlen (nD,) int its table (physics.drives TAB_*); drive_x0 (nD, d) its
     granule's centre at t = 0 [m]; drive_now (nD, N_DRIVE) its state at the last force
     pass (columns DR_*, this run's own). wall_drive (n_walls,) int: the drive of each

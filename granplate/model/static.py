@@ -245,9 +245,10 @@ def static_state(
 
 def precompressed(model):
     """The model whose run starts from its scenario's [precompression] static state: the
-    granules' centres moved to it, the target wall's offset with them (frozen there during
-    the run: its contact rows and the model's `walls`, which every contact-list rebuild
-    takes); the model itself when the scenario has none."""
+    granules' centres moved to it, the target wall's offset with them (`run_walls`: where
+    the walls are when the contact lists are rebuilt); frozen there during the run, or, with
+    mode = "held", a piston that keeps pushing with the force (`held_wall`); the model
+    itself when the scenario has none."""
     from granplate.setup.precompression_checks import precompression_wall
 
     p = model.scenario.precompression
@@ -265,5 +266,18 @@ def precompressed(model):
     geo = g.wall_geo.copy()
     geo[rows, d] = st.offset
     walls = list(model.scenario.walls)
-    walls[wall] = dataclasses.replace(walls[wall], offset=float(st.offset))
-    return dataclasses.replace(model, initial_state=y0, granular=g._replace(wall_geo=geo), walls=tuple(walls))
+    walls[wall] = dataclasses.replace(walls[wall], offset=st.offset)
+    g = g._replace(wall_geo=geo)
+    if p.mode == "held":
+        g = held_wall(g, model.scenario, wall, float(p.force), float(p.mass))
+    return dataclasses.replace(model, initial_state=y0, granular=g, run_walls=tuple(walls))
+
+
+def held_wall(g, s, wall: int, force: float, mass: float):
+    """The granular arrays g with the precompression's wall `wall` made a piston (model.drives
+    `with_piston`) pushed into the assembly (along minus its unit outward normal) by `force`
+    [N], of `mass` [kg] (0: the granules' total mass, docs/model.md section 3.12)."""
+    from granplate.model.drives import with_piston
+
+    n = np.asarray(s.walls[wall].normal, float)
+    return with_piston(g, wall, -n / np.linalg.norm(n), force, mass if mass > 0.0 else float(np.sum(g.mass)))

@@ -12,7 +12,8 @@ The profile P(t) [m, m/s or N] is one of
                displacement or a force drive only)
 and `profile_terms` gives its integral from 0, its value, slope and curvature at t. A
 displacement drive moves its body by s = P(t) - P(0) (velocity P', acceleration P''); a
-velocity drive by s = int_0^t P (velocity P, acceleration P'); a force drive pushes with P.
+velocity drive by s = int_0^t P (velocity P, acceleration P'); a force drive pushes with P
+(a granule, or a wall that it makes a piston of mass PAR_MASS, solver.drives).
 """
 
 from __future__ import annotations
@@ -26,9 +27,9 @@ PROFILE_CONSTANT, PROFILE_RAMP, PROFILE_HALF_SINE, PROFILE_HARMONIC, PROFILE_TAB
 #: drive kinds (the order of setup.scenario.DRIVE_KINDS)
 KIND_DISPLACEMENT, KIND_VELOCITY, KIND_FORCE = range(3)
 #: columns of a drive's parameters: value, amplitude, frequency [Hz], duration [s], the
-#: chirp's end frequency [Hz]
-PAR_VALUE, PAR_AMPLITUDE, PAR_FREQUENCY, PAR_DURATION, PAR_FREQUENCY_END = range(5)
-N_PAR = 5
+#: chirp's end frequency [Hz], and a force-driven wall's mass [kg] (a piston's; 0 otherwise)
+PAR_VALUE, PAR_AMPLITUDE, PAR_FREQUENCY, PAR_DURATION, PAR_FREQUENCY_END, PAR_MASS = range(6)
+N_PAR = 6
 #: columns of a drive's table: the times [s], the values, the integral of the values from 0
 TAB_T, TAB_V, TAB_I = range(3)
 

@@ -617,8 +617,10 @@ SUMMARY_UNITS: dict[str, object] = {
 
 def wall_and_drive_outputs(model, out: K.Output, n: int, coords: dict) -> dict[str, xr.DataArray]:
     """wall_force (time, wall) and drive_force, drive_displacement (time, drive), with the
-    coordinates `wall` (the walls' labels, or "wall K") and `drive` (the drives' names)
-    added to coords; none for a run without walls or drives."""
+    coordinates `wall` (the walls' labels, or "wall K") and `drive` (the drives' names,
+    model.drives.drive_names) added to coords; none for a run without walls or drives."""
+    from granplate.model.drives import drive_names
+
     s = model.scenario
     data: dict[str, xr.DataArray] = {}
     if s.walls:
@@ -628,11 +630,12 @@ def wall_and_drive_outputs(model, out: K.Output, n: int, coords: dict) -> dict[s
             {"long_name": "wall label"},
         )
         data["wall_force"] = _var("wall_force", ("time", "wall"), out.wall_force[:n].copy())
-    if s.drives:
+    names = drive_names(s)
+    if names:
         coords["drive"] = (
             "drive",
-            np.array([d.name for d in s.drives], dtype=str),
-            {"long_name": "drive (its label, or its target)"},
+            np.array(names, dtype=str),
+            {"long_name": "drive (its label, or its target; a held precompression's wall by its target)"},
         )
         data["drive_force"] = _var("drive_force", ("time", "drive"), out.drive[:n, :, 0].copy())
         data["drive_displacement"] = _var("drive_displacement", ("time", "drive"), out.drive[:n, :, 1].copy())

@@ -25,6 +25,10 @@ GRAVITY_MAX = 1e6
 UNIT_TOL = 1e-9
 #: a harmonic drive's period must hold at least this many of the scheme's largest steps
 STEPS_PER_PERIOD = 20
+#: the largest mass [kg] of a force-driven wall (a piston; a thousand tonnes)
+PISTON_MASS_MAX = 1e6
+#: the schemes that integrate a force-driven wall (a piston) with the granules
+PISTON_SCHEMES: tuple[str, ...] = ("verlet",)
 #: the fields each profile reads (every other field of the drive must keep its default)
 PROFILE_FIELDS: dict[str, tuple[str, ...]] = {
     "constant": ("value",),
@@ -97,6 +101,13 @@ def check_drives(s: Scenario, step_max: float, wave_speed: float) -> None:
         direction = _unit(f"{p}.direction", d.direction, s.dimension)
         if kind == "wall":
             _wall_drive(p, d, s.walls[index], direction)
+        if kind == "wall" and d.kind == "force":
+            piston_mass(f"{p}.mass", d.mass)
+            piston_scheme(s, f'{p} (a force drive on "{d.target}")')
+        elif d.mass != 0.0:
+            raise ScenarioError(
+                f"{p}.mass", d.mass, "read by a force drive on a wall only (its piston's mass [kg]); leave it out"
+            )
         string_in(f"{p}.profile", d.profile, DRIVE_PROFILES)
         _profile_fields(p, d)
         _profile_values(p, d, step_max, wave_speed)
@@ -142,16 +153,31 @@ def _unit(path: str, v: Any, dimension: int) -> tuple[float, ...]:
     return v
 
 
-def _wall_drive(p: str, d: Drive, wall, direction: tuple[float, ...]) -> None:
-    """A wall is moved, never pushed (it has no mass), along its own normal (sliding a
-    plane along itself would change only friction, which a moving wall does not carry)."""
-    if d.kind == "force":
+def piston_mass(path: str, mass: Any) -> float:
+    """A force-driven wall's mass [kg]: required, 0 < mass <= PISTON_MASS_MAX."""
+    what = f"a force-driven wall's mass [kg] is required: allowed 0 < mass <= {PISTON_MASS_MAX:g}"
+    m = finite(path, mass, what)
+    if not 0.0 < m <= PISTON_MASS_MAX:
+        raise ScenarioError(path, mass, what)
+    return m
+
+
+def piston_scheme(s: Scenario, what: str) -> None:
+    """A force-driven wall (a piston) is integrated by the schemes of PISTON_SCHEMES only."""
+    if s.solver.scheme not in PISTON_SCHEMES:
         raise ScenarioError(
-            f"{p}.kind",
-            d.kind,
-            'a wall has no mass: it takes a "displacement" or "velocity" '
-            "drive; to push with a force, drive a granule (a piston)",
+            "solver.scheme",
+            s.solver.scheme,
+            f"{what} makes the wall a piston, which only "
+            + ", ".join(repr(x) for x in PISTON_SCHEMES)
+            + " integrates: allowed "
+            + ", ".join(repr(x) for x in PISTON_SCHEMES),
         )
+
+
+def _wall_drive(p: str, d: Drive, wall, direction: tuple[float, ...]) -> None:
+    """A wall moves along its own normal (sliding a plane along itself would change only
+    friction, which a moving wall does not carry), moved or pushed (a piston)."""
     n = [float(c) for c in wall.normal]
     norm = math.hypot(*n)
     cos = sum(a * b for a, b in zip(n, direction)) / norm

@@ -100,7 +100,11 @@ DRIVE_DEFAULTS: dict[str, Any] = {
     "times": [],
     "values": [],
     "label": "",
+    "mass": 0.0,
 }
+#: [precompression]'s fields left out of its written table when they hold their default
+#: (so that every precompressed scenario is written as before the held mode).
+PRECOMPRESSION_DEFAULTS: dict[str, Any] = {"mass": 0.0}
 #: The order of a 3D granule's keys as written (its centre, then its velocities).
 GRANULE_KEYS_3D: tuple[str, ...] = ("x", "y", "z", "radius", "material", "label", "vx", "vy", "vz", "omega")
 
@@ -517,7 +521,7 @@ def to_dict(s: Scenario, all_materials: bool = False) -> dict:
     if s.drives:
         d["drives"] = [_without_defaults(x, DRIVE_DEFAULTS) for x in _plain(s.drives)]
     if s.precompression is not None:
-        d["precompression"] = _plain(s.precompression)
+        d["precompression"] = _without_defaults(_plain(s.precompression), PRECOMPRESSION_DEFAULTS)
     if s.sensors:  # (none: not written, so that every scenario without them is written as before)
         d["sensors"] = [_without_defaults(x, {"name": ""}) for x in _plain(s.sensors)]
     if s.restart is not None:

@@ -1,5 +1,5 @@
-"""The rules of [precompression] (docs/model.md section 3.12): its target wall, force, mode,
-tolerance and iterations, and what the static state can be computed for (no plate yet, the
+"""The rules of [precompression] (docs/model.md section 3.12): its target wall, force, mode
+(a held wall's mass and scheme), tolerance and iterations, and what the static state can be computed for (no plate yet, the
 target wall not driven, a granule near it)."""
 
 from __future__ import annotations
@@ -7,7 +7,8 @@ from __future__ import annotations
 import math
 
 from granplate.errors import ScenarioError
-from granplate.setup.fields import finite, int_at_least, positive, string_in
+from granplate.setup.drive_checks import piston_mass, piston_scheme
+from granplate.setup.fields import finite, int_at_least, is_number, positive, string_in
 from granplate.setup.geometry import plane_offset, unit
 from granplate.setup.scenario import PRECOMPRESSION_MODES, Scenario
 
@@ -49,6 +50,7 @@ def check_precompression(s: Scenario) -> None:
             "precompression.tolerance", p.tolerance, f"allowed {lo:g} <= tolerance <= {hi:g} (relative)"
         )
     int_at_least("precompression.max_iterations", p.max_iterations, 1)
+    _check_mode_mass(s)
     w = precompression_wall(s)
     laws = {s.contact.normal_law} | {pc.normal_law for pc in s.contact.pairs if getattr(pc, "normal_law", None)}
     if laws - {"hertz"}:
@@ -76,6 +78,23 @@ def check_precompression(s: Scenario) -> None:
             "precompression.target",
             p.target,
             "no granule within a radius of the wall: its force has nowhere to go (move the wall onto the packing)",
+        )
+
+
+def _check_mode_mass(s: Scenario) -> None:
+    """mode = "held": its mass 0 (the granules' total) or in range, and a scheme that
+    integrates a piston; "frozen" reads no mass."""
+    p = s.precompression
+    assert p is not None
+    if p.mode == "held":
+        if not (is_number(p.mass) and p.mass == 0.0):
+            piston_mass("precompression.mass", p.mass)
+        piston_scheme(s, 'precompression.mode = "held"')
+    elif not (is_number(p.mass) and p.mass == 0.0):
+        raise ScenarioError(
+            "precompression.mass",
+            p.mass,
+            'read with mode = "held" only (the held wall\'s mass [kg]); a frozen wall does not move: leave it out',
         )
 
 

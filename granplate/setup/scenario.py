@@ -617,7 +617,7 @@ DRIVE_KINDS: tuple[str, ...] = ("displacement", "velocity", "force")
 #: A drive's time profiles (`Drive.profile`; docs/scenario.md, section "Drives").
 DRIVE_PROFILES: tuple[str, ...] = ("constant", "ramp", "half-sine", "harmonic", "table", "chirp")
 #: How a precompressing wall behaves during the run (Precompression.mode).
-PRECOMPRESSION_MODES: tuple[str, ...] = ("frozen",)
+PRECOMPRESSION_MODES: tuple[str, ...] = ("frozen", "held")
 #: The two kinds of body a drive moves (`Drive.target` = "wall LABEL" or "granule LABEL").
 DRIVE_TARGETS: tuple[str, ...] = ("wall", "granule")
 
@@ -637,18 +637,23 @@ class Precompression:
     normal and the granules (with gravity, if given, and the other walls fixed) are brought
     to static equilibrium, to a residual force of `tolerance` x force on every granule and
     on the wall, in at most `max_iterations` steps of the minimiser. mode: "frozen" (the wall
-    then stays where equilibrium left it: displacement-controlled during the run)."""
+    then stays where equilibrium left it: displacement-controlled during the run) or "held"
+    (the wall becomes a piston of mass `mass` [kg] pushed by the constant force `force`: a
+    servo that keeps holding it, force-controlled; solver.scheme = "verlet"). mass: the held
+    wall's mass [kg], read with mode = "held" only; 0 (the default): the granules' total
+    mass."""
 
     target: str = ""
     force: float = 0.0
     mode: str = "frozen"
     tolerance: float = 1e-8
     max_iterations: int = 20000
+    mass: float = 0.0
 
 
 @dataclass(frozen=True)
 class Drive:
-    """Prescribed motion of a wall or a granule, or a prescribed force on a granule, along
+    """Prescribed motion of a wall or a granule, or a prescribed force on either, along
     a unit `direction` (docs/model.md section 3.11).
 
     target: "wall LABEL" or "granule LABEL" (the `label` of a [[walls]] or [[granules]]
@@ -663,7 +668,9 @@ class Drive:
     from `frequency` to `frequency_end` [Hz], held at its last value after; a displacement or
     a force). A displacement drive moves its body by P(t) - P(0) from where the scenario
     puts it; a velocity drive sets the body's velocity along the direction to P(t) from
-    t = 0 on. label: the drive's name in the Dataset (default: the target).
+    t = 0 on. A force drive on a wall makes it a rigid piston of mass `mass` [kg] (required
+    there, read nowhere else) moving along its normal, pushed by P(t) and by its contacts
+    (solver.scheme = "verlet"). label: the drive's name in the Dataset (default: the target).
     """
 
     target: str
@@ -679,6 +686,7 @@ class Drive:
     values: tuple[float, ...] = ()
     file: str | None = None
     label: str = ""
+    mass: float = 0.0
 
     @property
     def name(self) -> str:

@@ -18,7 +18,7 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
-from granplate.model.arrays import Model, granular_with_contacts, granular_with_patch_contacts, model_walls
+from granplate.model.arrays import Model, granular_with_contacts, granular_with_patch_contacts
 from granplate.model.inputs import DR_REF, DR_S, HIST_MAX, HIST_TIME, no_history
 from granplate.model.contacts import Missed, centre_coordinates, contact_lists, missed_contacts, wall_planes
 from granplate.model.neighbours import verlet_pairs, verlet_walls
@@ -299,7 +299,7 @@ class ContactLists:
         )
         self.known: dict = {}
         self.stores: tuple[dict, dict] = ({}, {})  # histories of the pairs and wall contacts off the lists
-        self.planes = wall_planes(model_walls(model), model.config.dimension)
+        self.planes = wall_planes(model.walls, model.config.dimension)
         self.n_rebuilds = 0  # rebuilds the loop asked for (REBUILD, dynamic detection)
         self.formed: list[tuple[int, float, float]] = []  # patch contacts: (granule, t [s], y [m])
 
@@ -324,7 +324,7 @@ class ContactLists:
         c = m.scenario.contact
         fixed = c.detection == "fixed"
         normals, offsets = self.planes
-        walls = model_walls(m)
+        walls = m.walls
         if len(g.wall_drive):  # driven walls where they are now (docs/model.md section 3.11)
             offsets = wall_offsets_now(g, normals, offsets)
             walls = tuple(dataclasses.replace(wall, offset=float(o)) for wall, o in zip(walls, offsets))

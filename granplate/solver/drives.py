@@ -10,14 +10,36 @@ the force the drive applies, recorded with its power. After a step, `hold_drives
 driven granule's velocity along its direction to the prescribed one (the drive's
 impulse, its work booked); the schemes book the drives' work and gravity's (RK4's
 quadrature of their powers; Verlet's kicks, `drive_kick_work`, `gravity_kick_work`).
+
+A force drive on a wall makes it a piston of mass M (`is_piston`): its displacement s and
+velocity v along the drive's direction e are state (drive_now DR_S, DR_V), which
+`begin_pass` leaves as they are; the contacts on it push back with R (their normal forces
+against e, summed by `book_wall`), and `finish_pass` gives it M s'' = P(t) - R. The
+velocity-Verlet scheme kicks and drifts it like a granule's one degree of freedom
+(`piston_kick_drift`, `piston_kick`), booking P's share of each kick as the drive's work
+and the damping's as dissipation; its kinetic energy 1/2 M v^2 (`piston_energy`) is part
+of E_g.
 """
 
 from __future__ import annotations
 
 from numba import njit
 
-from granplate.model.inputs import DR_A, DR_F, DR_P, DR_PD, DR_REF, DR_S, DR_V, HIST_MAX, HIST_RATE
-from granplate.physics.drives import KIND_FORCE, drive_motion
+from granplate.model.inputs import (
+    DR_A,
+    DR_F,
+    DR_FD,
+    DR_P,
+    DR_PD,
+    DR_R,
+    DR_REF,
+    DR_S,
+    DR_V,
+    DR_VH,
+    HIST_MAX,
+    HIST_RATE,
+)
+from granplate.physics.drives import KIND_FORCE, PAR_MASS, drive_motion
 from granplate.physics.laws import normal_law_response
 
 #: the first velocity column of a granule's state (both dimensions)
@@ -25,20 +47,29 @@ V0 = 3
 
 
 @njit(cache=True)
+def is_piston(g, k):
+    """Whether drive k pushes a wall with a force (the wall a piston)."""
+    return g.drive_target[k] < 0 and g.drive_kind[k] == KIND_FORCE
+
+
+@njit(cache=True)
 def begin_pass(t, g):
     """The drives' motion at t [s] into drive_now (DR_S, DR_V, DR_A; a force drive's
-    force in DR_A), their forces and powers zeroed, and the walls' loads zeroed."""
+    force in DR_A; a piston's s and v, its state, kept), their forces and powers zeroed,
+    and the walls' loads zeroed."""
     for w in range(g.wall_load.shape[0]):
         g.wall_load[w] = 0.0
     for k in range(g.drive_target.shape[0]):
         s, v, a = drive_motion(t, g.drive_kind[k], g.drive_prof[k], g.drive_par[k], g.drive_tab[k], g.drive_tlen[k])
         now = g.drive_now[k]
-        now[DR_S] = s
-        now[DR_V] = v
+        if not is_piston(g, k):
+            now[DR_S] = s
+            now[DR_V] = v
         now[DR_A] = a
         now[DR_F] = 0.0
         now[DR_P] = 0.0
         now[DR_PD] = 0.0
+        now[DR_FD] = 0.0
 
 
 @njit(cache=True)
@@ -67,13 +98,14 @@ def wall_motion(g, w):
 def book_wall(g, w, k, n, damp):
     """Wall contact w's normal force n [N] (its damping part damp [N]) on its wall's load
     and, for a driven wall (drive k >= 0), on the force the drive applies along its
-    direction (the contact forces on the granules, -n n . e) and on the damping forces'
-    power at the wall's velocity [W]."""
+    direction (the contact forces on the granules, -n n . e; a piston's R), its damping
+    part, and the damping forces' power at the wall's velocity [W]."""
     if g.wall_load.shape[0] > 0:
         g.wall_load[g.wall_w[w]] += n
     if k >= 0:
         ne = wall_normal_dot(g, w, k)
         g.drive_now[k, DR_F] -= n * ne
+        g.drive_now[k, DR_FD] -= damp * ne
         g.drive_now[k, DR_PD] -= damp * g.drive_now[k, DR_V] * ne
 
 
@@ -92,8 +124,9 @@ def finish_pass(y, acc, g):
     """End a force pass at state y with the accelerations acc (every other force in):
     gravity on every granule; each driven granule's acceleration along its direction
     made the prescribed one (or the prescribed force added), the force that takes
-    (mass x the acceleration it changes) and its power recorded; a driven wall's power.
-    Returns (the power of the granules' drives and of the contact damping forces at the
+    (mass x the acceleration it changes) and its power recorded; a driven wall's power; a
+    piston's acceleration (P - R) / M, its force P recorded. Returns (the power of the
+    granules' drives, of the pistons' forces and of the contact damping forces at the
     driven walls' velocities, gravity's power) [W]."""
     ng = y.shape[0]
     p_grav = 0.0
@@ -116,6 +149,12 @@ def finish_pass(y, acc, g):
                 acc[i, V0 + c] += da * g.drive_dir[k, c]
             now[DR_F] = m * da
             now[DR_P] = now[DR_F] * along(y, i, g, k)
+            power += now[DR_P]
+        elif g.drive_kind[k] == KIND_FORCE:  # a piston: pushed by P (in DR_A) and by its contacts (R)
+            now[DR_R] = now[DR_F]
+            now[DR_F] = now[DR_A]
+            now[DR_A] = (now[DR_F] - now[DR_R]) / g.drive_par[k, PAR_MASS]
+            now[DR_P] = now[DR_F] * now[DR_V]
             power += now[DR_P]
         else:  # a wall: its elastic work is booked exactly (`wall_shift_energy`), its damping's here
             now[DR_P] = now[DR_F] * now[DR_V]
@@ -173,11 +212,12 @@ def drive_kick_work(y, acc, g, hk):
 @njit(cache=True)
 def wall_powers(g):
     """(the driven walls' power F v [W], the contact damping forces' power at their
-    velocity [W]) at the last force pass."""
+    velocity [W]) at the last force pass; the pistons' are not counted (their kicks book
+    them)."""
     p = 0.0
     pd = 0.0
     for k in range(g.drive_target.shape[0]):
-        if g.drive_target[k] < 0:
+        if g.drive_target[k] < 0 and not is_piston(g, k):
             p += g.drive_now[k, DR_P]
             pd += g.drive_now[k, DR_PD]
     return p, pd
@@ -232,13 +272,14 @@ def wall_shift_energy(y0, y1, g, clip, t0, t1):
     granules move from state y0 to y1: the change of their contacts' stored energy as each
     wall moves from where it is at t0 to where it is at t1, the granules held at y0 and at
     y1 in turn, averaged (the symmetric split of the stored energy's change between the
-    walls' moves and the granules', second order in the step)."""
+    walls' moves and the granules', second order in the step). A piston's move is none of
+    it: its contacts' energy is the assembly's own (E_g)."""
     if g.wall_drive.shape[0] == 0:
         return 0.0
     work = 0.0
     for w in range(g.wall_i.shape[0]):
         k = g.wall_drive[g.wall_w[w]]
-        if k < 0:
+        if k < 0 or is_piston(g, k):
             continue
         work += 0.5 * (
             wall_contact_energy(y1, g, w, k, clip, t1)
@@ -247,3 +288,57 @@ def wall_shift_energy(y0, y1, g, clip, t0, t1):
             - wall_contact_energy(y0, g, w, k, clip, t0)
         )
     return work
+
+
+@njit(cache=True)
+def piston_kick_drift(g, h):
+    """Every piston (`is_piston`): the first half kick v += h/2 a, the drift s += h v, and
+    the velocity the force pass at the step's end reads, v + h/2 a (as solver.kicks
+    does a granule's). Returns (the work of P's share of the kick, the kinetic energy it adds
+    [J]; the damping force's share, the energy it takes, dissipated [J])."""
+    hk = 0.5 * h
+    work = 0.0
+    dissipated = 0.0
+    for k in range(g.drive_target.shape[0]):
+        if not is_piston(g, k):
+            continue
+        now = g.drive_now[k]
+        v0 = now[DR_V]
+        dv = hk * now[DR_A]
+        vm = hk * (v0 + 0.5 * dv)
+        work += now[DR_F] * vm
+        dissipated += now[DR_FD] * vm
+        now[DR_VH] = v0 + dv
+        now[DR_S] += h * now[DR_VH]
+        now[DR_V] = now[DR_VH] + dv
+    return work, dissipated
+
+
+@njit(cache=True)
+def piston_kick(g, hk):
+    """Every piston: the closing half kick v += hk a from its velocity after the first
+    (hk = h/2 [s]). Returns (P's work, the damping's dissipation) [J] as `piston_kick_drift`."""
+    work = 0.0
+    dissipated = 0.0
+    for k in range(g.drive_target.shape[0]):
+        if not is_piston(g, k):
+            continue
+        now = g.drive_now[k]
+        v0 = now[DR_VH]
+        dv = hk * now[DR_A]
+        vm = hk * (v0 + 0.5 * dv)
+        work += now[DR_F] * vm
+        dissipated += now[DR_FD] * vm
+        now[DR_V] = v0 + dv
+    return work, dissipated
+
+
+@njit(cache=True)
+def piston_energy(g):
+    """The pistons' kinetic energy sum 1/2 M v^2 [J] (part of E_g; 0 without pistons)."""
+    e = 0.0
+    for k in range(g.drive_target.shape[0]):
+        if is_piston(g, k):
+            v = g.drive_now[k, DR_V]
+            e += 0.5 * g.drive_par[k, PAR_MASS] * v * v
+    return e

@@ -23,7 +23,7 @@ from granplate.solver.interface import accept_contacts, contact_modulus, first_g
 from granplate.solver.ladder import level_step
 from granplate.solver.plate_modal import driving_dofs, modal_acceleration, plate_energy, step_matrices
 from granplate.model.inputs import DR_F
-from granplate.solver.drives import drive_displacement, walls_moved
+from granplate.solver.drives import drive_displacement, piston_energy, walls_moved
 from granplate.solver.state import (
     A_DRIVE,
     A_GRAVITY,
@@ -121,7 +121,7 @@ def initialise(st, g, p, cfg, w):
         st.force_prev[d] = st.force[d]
         st.pforce[d] = st.force[d]
     kx, ky, kz, kr = kinetic_energies(st.y, g)
-    e0 = kx + ky + kz + kr + pr.e_pot + plate_energy(st.q, st.qd, st.force, p.omega2, p.resid)
+    e0 = kx + ky + kz + kr + pr.e_pot + piston_energy(g) + plate_energy(st.q, st.qd, st.force, p.omega2, p.resid)
     st.clock[E_ZERO] = e0
     st.clock[E_IN_MAX] = e0
     reset_interval(w)
@@ -152,12 +152,13 @@ def reset_interval(w):
 
 @njit(cache=True)
 def energy_terms(y, q, qd, force, clock, acc, g, omega2, resid):
-    """The terms of eq. (11) at t_n: (E_shock, E_g, E_p, KE_x, KE_y, KE_z, KE_rot) [J]
+    """The terms of eq. (11) at t_n: (E_shock, E_g (with the pistons' kinetic energy,
+    solver.drives), E_p, KE_x, KE_y, KE_z, KE_rot) [J]
     (E_in: `energy_in`)
     (KE_z = 0 in the plane). (Arrays, not the state tuples, but for the granular arrays g
     that tell the dimension: this runs every step.)"""
     kx, ky, kz, kr = kinetic_energies(y, g)
-    eg = kx + ky + kz + kr + clock[E_POT]
+    eg = kx + ky + kz + kr + clock[E_POT] + piston_energy(g)
     ep = plate_energy(q, qd, force, omega2, resid) + clock[E_STATIC]
     eshock = acc[A_SHOCK_G] + acc[A_SHOCK_P]
     return eshock, eg, ep, kx, ky, kz, kr

@@ -60,12 +60,30 @@ def capture(arr, lists) -> dict[str, np.ndarray]:
     return out
 
 
+def _padded(stored: np.ndarray, fresh) -> np.ndarray:
+    """A stored table with fewer columns than this version's (a result written before a
+    column was added: the drives' state and parameters) completed by the fresh run's columns."""
+    if (
+        isinstance(fresh, np.ndarray)
+        and stored.ndim == 2
+        and fresh.ndim == 2
+        and stored.shape[0] == fresh.shape[0]
+        and stored.shape[1] < fresh.shape[1]
+    ):
+        out = fresh.copy()
+        out[:, : stored.shape[1]] = stored
+        return out
+    return stored
+
+
 def _rebuilt(prefix: str, tup, snap: dict[str, np.ndarray]):
     values = {}
     for name, value in zip(tup._fields, tup):
         key = f"{prefix}.{name}"
         if key in snap:
-            values[name] = np.array(snap[key], dtype=value.dtype if isinstance(value, np.ndarray) else None)
+            values[name] = _padded(
+                np.array(snap[key], dtype=value.dtype if isinstance(value, np.ndarray) else None), value
+            )
         elif isinstance(value, tuple) and hasattr(value, "_fields"):
             values[name] = _rebuilt(key, value, snap)
     return tup._replace(**values)

@@ -108,6 +108,7 @@ FIELD_UNITS: dict[str, str] = {
     "error_tol": "1",
     "implicit_dt_max": "s",
     "threads": "1",
+    "mass": "kg",
     # the measured yielding law (docs/model.md section 3.10)
     "C": "1",
     "rate_ref": "1/s",

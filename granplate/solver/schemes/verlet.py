@@ -21,7 +21,9 @@ drives (solver.drives) join each force pass; the drive forces' kicks are booked 
 way (gravity's too), a driven wall's elastic work exactly (the change of its contacts'
 energy as it moves), the damping at its velocity by the trapezoidal rule over the step
 (in the drive's work and in D_visc alike), and the impulse that gives a driven granule
-its prescribed velocity at t + h as the kinetic energy it adds.
+its prescribed velocity at t + h as the kinetic energy it adds. A force-driven wall (a
+piston, solver.drives) is kicked and drifted with the granules, its force P's share of
+each kick booked as the drive's work and its contacts' damping's as dissipation.
 """
 
 from __future__ import annotations
@@ -42,6 +44,8 @@ from granplate.solver.drives import (
     finish_pass,
     gravity_kick_work,
     hold_drives,
+    piston_kick,
+    piston_kick_drift,
     wall_powers,
     wall_shift_energy,
 )
@@ -195,6 +199,7 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
             )
     w_drive = drive_kick_work(y, st.k1, g, hk)
     w_grav = gravity_kick_work(y, st.k1, g, hk)
+    w_piston, d_piston = piston_kick_drift(g, h)  # a force-driven wall: kicked and drifted as a granule
     if sw.spar.shape[0] > 0:
         wl, wd = kick_drift_blocks(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, sw.spar)
     else:
@@ -229,6 +234,9 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
         wl2, wd2 = kick_blocks(y, w.kend, sw.fdamp[nxt], sw.fload[nxt], hk, w.kend, N_DRIFT, sw.spar)
     else:
         wl2, wd2 = kick(y, w.kend, sw.fdamp[nxt], sw.fload[nxt], hk, w.kend, N_DRIFT, 0, y.shape[0])
+    wp2, dp2 = piston_kick(g, hk)
+    w_piston += wp2
+    d_piston += dp2
     if body:
         wd2 += B.kick(b.qd, b.fmodal[nxt], b.fdamp[nxt], hk)
         if cfg.load_on_plate:
@@ -239,8 +247,9 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
             fric += B.friction_flow(y, b.qd, hk, b, nxt, g.radius, g.mass, g.inertia, cfg.arm_shrink, not forward)
     # the granules' drives' impulses; the walls' elastic work (exact) and their damping's (booked in D too)
     w_drive += hold_drives(t + h, y, g) + wall_shift_energy(st.y, y, g, cfg.clip, t, t + h) + hk * (pd0 + pd1)
+    w_drive += w_piston  # a piston's force P: its kicks' work (its kinetic energy is E_g's)
     w.dacc[0] = wl + wl2
-    w.dacc[1] = -(wd + wd2) + hk * (pd0 + pd1)  # (a driven wall: the damping at the relative velocity)
+    w.dacc[1] = -(wd + wd2) + hk * (pd0 + pd1) + d_piston  # (a driven wall: the damping at the relative velocity)
     w.dacc[2] = fric
     w.dacc[3] = w_plastic
     w.dacc[4] = w_grav
