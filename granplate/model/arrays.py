@@ -102,6 +102,10 @@ class Model:
     solid: object | None = None  # an elastic body in space: the built solid (solid.build.SolidModel)
     body: object | None = None  # and its arrays in the loop (model.inputs.BodyArrays)
     body_rigid: np.ndarray | None = None  # (ng,) bool: the granules on one of the body's rigid patches at t = 0
+    # a precompressed plate at t = 0 (docs/model.md section 3.12): its modal displacements (nm,) and its
+    # driving dofs' displacements (2 nk,) [m]; None: the plate starts undeformed
+    plate_q0: np.ndarray | None = None
+    plate_u0: np.ndarray | None = None
 
     @property
     def n_granules(self) -> int:
