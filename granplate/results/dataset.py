@@ -595,6 +595,7 @@ SUMMARY_UNITS: dict[str, object] = {
     "e_in_max": "J",
     "ep_max_fraction": "1",
     "ep_final_fraction": "1",
+    "ep_gain_max_fraction": "1",
     "eg_max_fraction": "1",
     "eg_final_fraction": "1",
     "dissipated_fraction": "1",
@@ -706,6 +707,7 @@ def summary(ds: xr.Dataset) -> dict:
         "e_in_max": float(np.max(energy_put_in(ds))) if ds.sizes["time"] else e_in,
         "ep_max_fraction": fraction(ds.E_plate.max(), plate=True),
         "ep_final_fraction": fraction(ds.E_plate[-1], plate=True),
+        "ep_gain_max_fraction": _gain_fraction(ds, e_in - e0) if has_plate else None,
         "eg_max_fraction": fraction(ds.E_granular.max()),
         "eg_final_fraction": fraction(ds.E_granular[-1]),
         "dissipated_fraction": fraction(ds.D_viscous[-1] + ds.D_friction[-1] + plastic),
@@ -728,6 +730,17 @@ def summary(ds: xr.Dataset) -> dict:
     }
     out["units"] = {k: u for k, u in SUMMARY_UNITS.items() if k in out}  # every number's unit
     return out
+
+
+def _gain_fraction(ds: xr.Dataset, work: float) -> float | None:
+    """The plate's largest energy above its energy at t = 0, max (E_p - E_p(0)), over the work
+    put in after t = 0 (e_in - e_initial) [-]: the plate's peak share of the shock with a
+    precompressed plate, whose static strain energy E_p(0) is no share of it
+    (ep_max_fraction where the run starts unloaded); None when nothing was put in."""
+    if work <= 0.0 or not ds.sizes["time"]:
+        return None
+    ep = np.asarray(ds.E_plate.values, float)
+    return float(np.max(ep - ep[0])) / work
 
 
 def _finite(value) -> float | None:
