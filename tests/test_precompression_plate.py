@@ -8,6 +8,9 @@ with a shock eq. (11) holds at every step from the stored energy (contacts + pla
 
 from __future__ import annotations
 
+import csv
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -160,3 +163,32 @@ def test_a_granule_between_the_faces_nodes_is_refused_by_name():
     with pytest.raises(ScenarioError, match="between nodes") as e:
         validate(s)
     assert e.value.field == "precompression.target"
+
+
+STUDY = Path(__file__).resolve().parents[1] / "docs" / "studies" / "precompressed-protector.toml"
+
+
+def test_the_precompressed_protector_study_runs_on_a_small_grid(tmp_path):
+    """docs/studies/precompressed-protector.toml, cut to a 2 x 2 grid (the extreme forces and
+    shocks) over 40 us, runs through `sweep`: every design completes with eq. (11) held, and
+    the plate's share of the shock is a fraction in [0, 1]."""
+    import tomllib
+
+    from distributed import Client
+
+    from granplate.study.spec import parse_study
+    from granplate.study.sweep import sweep
+
+    doc = tomllib.loads(STUDY.read_text())
+    assert len(parse_study(doc, STUDY.parent).designs) == 15
+    doc["parameters"] = {"precompression.force": [10.0, 1000.0], "load.q0": [2e3, 5e4]}
+    doc["set"] = {"time.t_end": 4e-5}
+    study = parse_study(doc, STUDY.parent)
+    with Client(processes=False, n_workers=1, threads_per_worker=1, dashboard_address=None) as client:
+        sweep(study, tmp_path, client=client, progress=False)
+    with open(tmp_path / "results.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 4
+    for row in rows:
+        assert row["status"] == "ok" and abs(float(row["energy_residual_max"])) < 1e-4
+        assert 0.0 <= float(row["ep_gain_max_fraction"]) <= 1.0
