@@ -197,3 +197,33 @@ def test_the_precompressed_protector_study_runs_on_a_small_grid(tmp_path):
     for row in rows:
         assert row["status"] == "ok" and abs(float(row["energy_residual_max"])) < 1e-4
         assert 0.0 <= float(row["ep_dynamic_max_fraction"]) <= 1.0
+
+
+def test_the_committed_study_table_is_of_its_study_file_and_on_the_page():
+    """docs/studies/precompressed-protector/results.csv holds the study file's 15 designs, all
+    completed with eq. (11) held and a share in [0, 1], and the table of
+    docs/how-to/precompressed-protector.md is that table's ep_dynamic_max_fraction. Nothing is
+    run: the table is read."""
+    from granplate.study.spec import load_study
+
+    study = load_study(STUDY)
+    with open(STUDY.parent / "precompressed-protector" / "results.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == len(study.designs) == 15
+    for row, design in zip(rows, study.designs):
+        assert tuple(float(row[n]) for n in study.names) == pytest.approx(design, rel=1e-12)
+        assert row["status"] == "ok" and abs(float(row["energy_residual_max"])) < 1e-4
+        assert 0.0 <= float(row["ep_dynamic_max_fraction"]) <= 1.0
+    assert (STUDY.parent / "precompressed-protector" / "study.toml").read_text() == STUDY.read_text()
+    page = (STUDY.parents[1] / "how-to" / "precompressed-protector.md").read_text()
+    block = page.split("<!-- precompressed-protector: begin -->\n")[1].split("\n<!-- precompressed-protector: end -->")[
+        0
+    ]
+    cells = {}
+    for line in block.splitlines()[3:]:
+        first, *shares = [c.strip() for c in line.strip("|").split("|")]
+        cells[float(first)] = shares
+    for row in rows:
+        column = [2e3, 1e4, 5e4].index(float(row["load.q0"]))
+        shown = cells[float(f"{float(row['precompression.force']):.3g}")][column]
+        assert shown == f"{100 * float(row['ep_dynamic_max_fraction']):.2f}%"
