@@ -18,6 +18,7 @@ SUMMARY_KEYS = {
     "e_in_max",
     "ep_max_fraction",
     "ep_final_fraction",
+    "ep_dynamic_max_fraction",
     "eg_max_fraction",
     "eg_final_fraction",
     "dissipated_fraction",

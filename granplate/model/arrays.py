@@ -110,6 +110,11 @@ class Model:
         are rebuilt against them, a driven wall moved from there)."""
         return self.run_walls or self.scenario.walls
 
+    # a precompressed plate at t = 0 (docs/model.md section 3.12): its modal displacements (nm,) and its
+    # driving dofs' displacements (2 nk,) [m]; None: the plate starts undeformed
+    plate_q0: np.ndarray | None = None
+    plate_u0: np.ndarray | None = None
+
     @property
     def n_granules(self) -> int:
         return len(self.labels)

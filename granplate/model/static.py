@@ -3,16 +3,18 @@ force, the state a precompressed run starts from.
 
 The granules' centres X and the target wall's offset o minimise the potential energy
 
-    Pi(X, o) = sum over contacts (2/5) A delta^(5/2) - sum_i m_i g . x_i + F o     (S1)
+    Pi(X, o, u) = sum over contacts (2/5) A delta^(5/2) - sum_i m_i g . x_i + F o + 1/2 u^T K_c u   (S1)
 
-(Hertz's energy of eq. 9 at every granule-granule and granule-wall contact in the model's
-lists, gravity's potential, and the servo's: the wall, whose unit normal n points out of the
-assembly, is pushed inwards with the force F, so its offset o along n falls while the
-contacts on it carry less than F). At the minimum every granule's net force vanishes and
-the wall's contacts carry F:
+(Hertz's energy of eq. 9 at every granule-granule, granule-wall and granule-plate contact in
+the model's lists, gravity's potential, the servo's: the wall, whose unit normal n points out
+of the assembly, is pushed inwards with the force F, so its offset o along n falls while the
+contacts on it carry less than F; and the plate's strain energy, the plate condensed to the
+normal displacements u of its contacts, K_c the inverse of its static compliance there, the
+modes' and the residual's, `plate_compliance`). At the minimum every granule's net force
+vanishes, the wall's contacts carry F and the plate's contacts carry K_c u:
 
     sum_j A delta_ij^(3/2) n_ij + sum_walls A delta^(3/2) (-n) + m_i g = 0,
-    sum over the wall's contacts A delta^(3/2) = F                                  (S2)
+    sum over the wall's contacts A delta^(3/2) = F,  A delta_k^(3/2) = (K_c u)_k        (S2)
 
 Its gradient is the residual of (S2). It is minimised by L-BFGS (scipy) from the given
 positions, then polished by Newton steps on the contacts' normal stiffness 3/2 A
@@ -41,8 +43,10 @@ class StaticState(NamedTuple):
 
     positions: (ng, d) the granules' centres [m]; offset: the target wall's offset along its
     unit normal [m] (shifted from `offset0` by the precompression); residual: the largest
-    net force on a granule or the wall over F [-]; iterations: the minimiser's and Newton's
-    steps; wall_force: the force the wall's contacts carry [N] (F to the residual)."""
+    net force on a granule, the wall or the plate over F [-]; iterations: the minimiser's and
+    Newton's steps; wall_force: the force the wall's contacts carry [N] (F to the residual);
+    plate_u: (nk,) the plate's normal displacement at each plate contact [m] and plate_force:
+    (nk,) the normal force each contact puts on the plate [N] (empty without a plate)."""
 
     positions: np.ndarray
     offset: float
@@ -50,6 +54,39 @@ class StaticState(NamedTuple):
     residual: float
     iterations: int
     wall_force: float
+    plate_u: np.ndarray = np.zeros(0)
+    plate_force: np.ndarray = np.zeros(0)
+
+
+class PlateStatics(NamedTuple):
+    """The plate condensed to the normal dofs of its nk contacts (docs/model.md section 3.12).
+
+    compliance: (2 nk, 2 nk) the static compliance at the contacts' driving dofs [m/N] (x, y
+    of each), Phi_d diag(1/omega^2) Phi_d^T + R: the loop's own modal model at rest;
+    stiffness: (nk, nk) the inverse of its normal block [N/m], K_c of (S1)."""
+
+    compliance: np.ndarray
+    stiffness: np.ndarray
+
+
+def plate_statics(p) -> PlateStatics:
+    """The static compliance and condensed stiffness of the plate arrays p (model.inputs.
+    PlateArrays): the modes' share Phi_d diag(1/omega^2) Phi_d^T plus a truncated basis'
+    residual compliance R (docs/model.md section 4.5). ScenarioError naming plate.n_modes
+    when the kept modes leave a contact without stiffness (a dense basis cut too short)."""
+    phi = np.asarray(p.phi_d, float)
+    c = (phi / np.asarray(p.omega2, float)[None, :]) @ phi.T
+    if p.resid.shape[0]:
+        c = c + np.asarray(p.resid, float)
+    cn = c[0::2, 0::2]
+    if cn.shape[0] and np.linalg.cond(cn) > 1e12:
+        raise ScenarioError(
+            "plate.n_modes",
+            cn.shape[0],
+            "the kept modes give the plate's contacts no independent static stiffness, which "
+            "[precompression] needs: keep every mode (plate.n_modes = 0) or the truncated basis",
+        )
+    return PlateStatics(compliance=c, stiffness=np.linalg.inv(cn) if cn.shape[0] else np.zeros((0, 0)))
 
 
 def contact_terms(x: np.ndarray, o: float, g, wall: int):
@@ -74,33 +111,58 @@ def contact_terms(x: np.ndarray, o: float, g, wall: int):
     return (i, j, delta, f, k, n, a), (wi, wdelta, wf, wk, wn, g.wall_w == wall, wa)
 
 
-def energy_and_forces(x: np.ndarray, o: float, g, wall: int, force: float):
+def plate_terms(x: np.ndarray, u: np.ndarray, g):
+    """Overlaps, forces and slopes of the plate contacts (rigid layers, n = (1, 0); docs/model.md
+    section 3.4) at centres x and the plate's normal displacements u at them: (i, delta, f, k, a)."""
+    pi = np.asarray(getattr(g, "pc_i", np.zeros(0, np.int64)), np.int64)
+    if not len(pi):
+        z = np.zeros(0)
+        return pi, z, z, z, z
+    pa = g.pc_coef[:, COEF_A]
+    pdelta = np.maximum(x[pi, 0] + g.radius[pi] - (g.pc_x + u), 0.0)
+    return pi, pdelta, pa * pdelta**1.5, 1.5 * pa * np.sqrt(pdelta), pa
+
+
+def energy_and_forces(x: np.ndarray, o: float, g, wall: int, force: float, u=None, kc=None):
     """(Pi [J] of (S1), the net force on every granule (ng, d) [N], the net force on the wall
-    along its inward normal [N]) at centres x and offset o: minus the gradient of Pi."""
+    along its inward normal [N], the net force on each plate contact's normal dof (nk,) [N])
+    at centres x, offset o and plate displacements u (kc: the plate's condensed stiffness
+    K_c): minus the gradient of Pi."""
     (i, j, delta, f, _, n, a), (wi, wdelta, wf, _, wn, on, wa) = contact_terms(x, o, g, wall)
+    pi, pdelta, pf, _, pa = plate_terms(x, np.zeros(0) if u is None else u, g)
     mass = g.mass
     grav = np.asarray(g.gravity, float) if len(g.gravity) else np.zeros(x.shape[1])
     e = 0.4 * (np.sum(a * delta**2.5) + np.sum(wa * wdelta**2.5)) - float(np.sum(mass[:, None] * x * grav)) + force * o
+    on_plate = np.zeros(0)
+    if len(pi):
+        ku = kc @ u
+        e += 0.4 * float(np.sum(pa * pdelta**2.5)) + 0.5 * float(u @ ku)
+        on_plate = pf - ku  # the contacts push the plate in, its stiffness back
     net = np.zeros_like(x)
     np.add.at(net, i, f[:, None] * n)
     np.add.at(net, j, -f[:, None] * n)
     np.add.at(net, wi, -wf[:, None] * wn)
+    np.add.at(net[:, 0], pi, -pf)
     net += mass[:, None] * grav
     on_wall = float(np.sum(wf[on])) - force  # the contacts push the wall out, the servo in
-    return e, net, on_wall
+    return e, net, on_wall, on_plate
 
 
-def _normal_stiffness(x: np.ndarray, o: float, g, wall: int, free: np.ndarray):
-    """The contacts' normal stiffness over the free granules' coordinates and the wall's
-    offset (the last unknown), as a sparse matrix: 3/2 A delta^(1/2) n n^T blocks (S1's
-    Hessian without the transverse geometric terms)."""
+def _normal_stiffness(x: np.ndarray, o: float, g, wall: int, free: np.ndarray, u=None, kc=None):
+    """The contacts' normal stiffness over the free granules' coordinates, the plate contacts'
+    normal displacements and the wall's offset (the last unknown), as a sparse matrix: 3/2 A
+    delta^(1/2) n n^T blocks and the plate's K_c (S1's Hessian without the transverse
+    geometric terms)."""
     from scipy.sparse import coo_matrix
 
     (i, j, _, _, k, n, _), (wi, _, _, wk, wn, on, _) = contact_terms(x, o, g, wall)
+    pi, _, _, pk, _ = plate_terms(x, np.zeros(0) if u is None else u, g)
     d = x.shape[1]
+    nk = len(pi)
     index = -np.ones(len(g.mass), np.int64)
     index[free] = np.arange(int(free.sum()))
-    size = int(free.sum()) * d + 1
+    first_u = int(free.sum()) * d  # the plate's unknowns follow the granules'
+    size = first_u + nk + 1
     rows, cols, vals = [], [], []
 
     def block(a, b, kk, nn, sign):
@@ -127,14 +189,21 @@ def _normal_stiffness(x: np.ndarray, o: float, g, wall: int, free: np.ndarray):
     rows.append(np.array([last]))
     cols.append(np.array([last]))
     vals.append(np.array([float(np.sum(wk[on]))]))
+    if nk:  # d delta / d x_i = e_x, d delta / d u_k = -1; the plate's K_c
+        ku = first_u + np.arange(nk)
+        pii = index[pi]
+        sel = pii >= 0
+        rows += [pii[sel] * d, pii[sel] * d, ku[sel], ku, np.repeat(ku, nk)]
+        cols += [pii[sel] * d, ku[sel], pii[sel] * d, ku, np.tile(ku, nk)]
+        vals += [pk[sel], -pk[sel], -pk[sel], pk, np.asarray(kc, float).ravel()]
     return coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(size, size)).tocsc()
 
 
 def unsupported_granules(g, wall: int, gravity: bool) -> tuple[np.ndarray, np.ndarray]:
-    """The granules the static state cannot hold, by the contact lists' graph (pairs and
-    wall contacts within the lists' reach): (those in a group of granules touching the target
-    wall but no other wall or held granule: the force has no path to a support; under
-    gravity, those in a group touching no wall and no held granule: they would fall)."""
+    """The granules the static state cannot hold, by the contact lists' graph (pairs, wall and
+    plate contacts within the lists' reach): (those in a group of granules touching the target
+    wall but no other wall, the plate or a held granule: the force has no path to a support;
+    under gravity, those in a group touching no wall, plate or held granule: they would fall)."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
@@ -145,6 +214,7 @@ def unsupported_granules(g, wall: int, gravity: bool) -> tuple[np.ndarray, np.nd
     support = np.zeros(n, bool)
     support[g.wall_i[g.wall_w != wall]] = True
     support[g.drive_target[g.drive_target >= 0]] = True
+    support[np.asarray(getattr(g, "pc_i", np.zeros(0, np.int64)), np.int64)] = True  # the plate is clamped
     pushed = np.zeros(n, bool)
     pushed[g.wall_i[g.wall_w == wall]] = True
     held_groups = np.unique(label[support])
@@ -152,6 +222,27 @@ def unsupported_granules(g, wall: int, gravity: bool) -> tuple[np.ndarray, np.nd
     no_path = free_group & np.isin(label, np.unique(label[pushed]))
     falling = free_group & ~pushed if gravity else np.zeros(n, bool)
     return np.flatnonzero(no_path), np.flatnonzero(falling)
+
+
+def _refuse_unsupported(g, wall: int, target: str) -> None:
+    """ScenarioError naming precompression.target or gravity.g for the granules
+    `unsupported_granules` finds."""
+    no_path, falling = unsupported_granules(g, wall, bool(len(g.gravity)) and bool(np.any(g.gravity != 0.0)))
+    if len(no_path):
+        raise ScenarioError(
+            "precompression.target",
+            target or f"wall {wall}",
+            f"its force has no path to a support: granules {', '.join(str(k + 1) for k in no_path[:5])} "
+            "touch it but, through their contacts, no other wall, the plate or a held granule (close the "
+            "packing against a wall opposite it)",
+        )
+    if len(falling):
+        raise ScenarioError(
+            "gravity.g",
+            list(g.gravity),
+            f"granules {', '.join(str(k + 1) for k in falling[:5])} rest on no wall, directly or through "
+            "their contacts: under gravity they would fall through (give them a floor)",
+        )
 
 
 def static_state(
@@ -163,76 +254,71 @@ def static_state(
     tolerance: float = 1e-8,
     max_iterations: int = 20000,
     target: str = "",
+    plate: PlateStatics | None = None,
 ) -> StaticState:
     """The static equilibrium (S2) of the granular arrays g (model.inputs.Granular or
     Granular3) from centres x0 (ng, d) [m], the wall `wall` (index in the scenario's walls,
-    offset0 [m] along its unit normal) pushed in with `force` [N]; converged when the largest
-    net force on a granule or on the wall is at most tolerance x force. ScenarioError naming
-    the field (`target`, the precompression's, or gravity.g) before minimising when the
-    contacts give the force no path to a support or granules would fall (`unsupported_granules`);
-    SimulationError with the residual reached (its `result` the StaticState) when it does not
-    converge."""
+    offset0 [m] along its unit normal) pushed in with `force` [N], the plate (when g has plate
+    contacts) condensed to its contacts by `plate` (`plate_statics`); converged when the
+    largest net force on a granule, the wall or a plate contact is at most tolerance x force.
+    ScenarioError naming the field (`target`, the precompression's, or gravity.g) before
+    minimising when the contacts give the force no path to a support or granules would fall
+    (`unsupported_granules`); SimulationError with the residual reached (its `result` the
+    StaticState) when it does not converge."""
     from scipy.optimize import minimize
     from scipy.sparse import identity
     from scipy.sparse.linalg import spsolve
 
     d = x0.shape[1]
-    no_path, falling = unsupported_granules(g, wall, bool(len(g.gravity)) and bool(np.any(g.gravity != 0.0)))
-    if len(no_path):
-        raise ScenarioError(
-            "precompression.target",
-            target or f"wall {wall}",
-            f"its force has no path to a support: granules {', '.join(str(k + 1) for k in no_path[:5])} "
-            "touch it but, through their contacts, no other wall or held granule (close the packing "
-            "against a wall opposite it)",
-        )
-    if len(falling):
-        raise ScenarioError(
-            "gravity.g",
-            list(g.gravity),
-            f"granules {', '.join(str(k + 1) for k in falling[:5])} rest on no wall, directly or through "
-            "their contacts: under gravity they would fall through (give them a floor)",
-        )
+    _refuse_unsupported(g, wall, target)
+    nk = len(getattr(g, "pc_i", ()))
+    kc = plate.stiffness if plate is not None and nk else np.zeros((nk, nk))
     held = np.zeros(len(g.mass), bool)
     held[g.drive_target[g.drive_target >= 0]] = True
     free = ~held
+    nf = int(free.sum()) * d
     a_min = float(np.min(g.wall_coef[g.wall_w == wall, COEF_A])) if np.any(g.wall_w == wall) else 1.0
     scale = (force / a_min) ** (2.0 / 3.0)  # the overlap F makes at the wall [m]: the unknowns' unit
 
     def unpack(z):
         x = x0.copy()
-        x[free] += z[:-1].reshape(-1, d) * scale
-        return x, offset0 + z[-1] * scale
+        x[free] += z[:nf].reshape(-1, d) * scale
+        return x, offset0 + z[-1] * scale, z[nf : nf + nk] * scale
+
+    def forces(z):
+        x, o, u = unpack(z)
+        return energy_and_forces(x, o, g, wall, force, u, kc)
 
     def fun(z):
-        x, o = unpack(z)
-        e, net, on_wall = energy_and_forces(x, o, g, wall, force)
-        grad = np.concatenate([-net[free].ravel(), [-on_wall]]) * scale
+        e, net, on_wall, on_plate = forces(z)
+        grad = np.concatenate([-net[free].ravel(), -on_plate, [-on_wall]]) * scale
         return e / (force * scale), grad / (force * scale)
 
     def residual(z):
-        _, net, on_wall = energy_and_forces(*unpack(z), g, wall, force)
-        return max(float(np.max(np.abs(net[free]), initial=0.0)), abs(on_wall)) / force
+        _, net, on_wall, on_plate = forces(z)
+        worst = max(float(np.max(np.abs(net[free]), initial=0.0)), float(np.max(np.abs(on_plate), initial=0.0)))
+        return max(worst, abs(on_wall)) / force
 
-    z = np.zeros(int(free.sum()) * d + 1)
+    z = np.zeros(nf + nk + 1)
     res = minimize(fun, z, jac=True, method="L-BFGS-B", options={"maxiter": max_iterations, "gtol": 1e-14, "ftol": 0.0})
     z, steps = res.x, int(res.nit)
     for _ in range(50):  # Newton on the normal stiffness, with a halving line search
         if residual(z) <= tolerance or steps >= max_iterations:
             break
-        x, o = unpack(z)
-        _, net, on_wall = energy_and_forces(x, o, g, wall, force)
-        h = _normal_stiffness(x, o, g, wall, free) * scale
-        rhs = np.concatenate([net[free].ravel(), [on_wall]])
+        x, o, u = unpack(z)
+        _, net, on_wall, on_plate = forces(z)
+        h = _normal_stiffness(x, o, g, wall, free, u, kc) * scale
+        rhs = np.concatenate([net[free].ravel(), on_plate, [on_wall]])
         dz = spsolve(h + identity(h.shape[0], format="csc") * (1e-12 * float(abs(h).max())), rhs)
         r0, t = residual(z), 1.0
         while t > 1e-6 and residual(z + t * dz) >= r0:
             t *= 0.5
         z = z + t * dz
         steps += 1
-    x, o = unpack(z)
-    _, net, on_wall = energy_and_forces(x, o, g, wall, force)
-    state = StaticState(x, float(o), float(offset0), residual(z), steps, float(on_wall + force))
+    x, o, u = unpack(z)
+    _, net, on_wall, _ = forces(z)
+    pf = plate_terms(x, u, g)[2]
+    state = StaticState(x, float(o), float(offset0), residual(z), steps, float(on_wall + force), u, pf)
     if state.residual > tolerance:
         raise SimulationError(
             f"precompression: no static equilibrium to a residual of {tolerance:g} x force after {steps} steps "
@@ -243,10 +329,25 @@ def static_state(
     return state
 
 
+def plate_at_rest(plate: PlateStatics, p, normal_force: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The plate at rest under the normal forces (nk,) [N] its contacts put on it: (q, u), the
+    modal displacements q = diag(1/omega^2) Phi_d^T F (nm,) [m kg^(1/2)] and the driving dofs'
+    displacements u = Phi_d q + R F (2 nk,) [m] (docs/model.md section 4.5), F the forces at
+    the driving dofs (x: normal, y: none, the static state being frictionless)."""
+    f = np.zeros(2 * len(normal_force))
+    f[0::2] = normal_force
+    q = (np.asarray(p.phi_d, float).T @ f) / np.asarray(p.omega2, float)
+    u = np.asarray(p.phi_d, float) @ q
+    if p.resid.shape[0]:
+        u = u + np.asarray(p.resid, float) @ f
+    return np.ascontiguousarray(q), np.ascontiguousarray(u)
+
+
 def precompressed(model):
     """The model whose run starts from its scenario's [precompression] static state: the
     granules' centres moved to it, the target wall's offset with them (`run_walls`: where
-    the walls are when the contact lists are rebuilt); frozen there during the run, or, with
+    the walls are when the contact lists are rebuilt), the plate deflected under its contacts'
+    static forces (`plate_q0`, `plate_u0`); the wall frozen there during the run, or, with
     mode = "held", a piston that keeps pushing with the force (`held_wall`); the model
     itself when the scenario has none."""
     from granplate.setup.precompression_checks import precompression_wall
@@ -260,7 +361,10 @@ def precompressed(model):
     rows = g.wall_w == wall
     offset0 = float(g.wall_geo[rows, d][0]) if np.any(rows) else 0.0
     x0 = np.ascontiguousarray(model.initial_state[:, :d])
-    st = static_state(g, x0, wall, offset0, float(p.force), float(p.tolerance), int(p.max_iterations), str(p.target))
+    plate = plate_statics(model.plate_arrays) if model.plate is not None else None
+    st = static_state(
+        g, x0, wall, offset0, float(p.force), float(p.tolerance), int(p.max_iterations), str(p.target), plate
+    )
     y0 = model.initial_state.copy()
     y0[:, :d] = st.positions
     geo = g.wall_geo.copy()
@@ -270,7 +374,11 @@ def precompressed(model):
     g = g._replace(wall_geo=geo)
     if p.mode == "held":
         g = held_wall(g, model.scenario, wall, float(p.force), float(p.mass))
-    return dataclasses.replace(model, initial_state=y0, granular=g, run_walls=tuple(walls))
+    out = dataclasses.replace(model, initial_state=y0, granular=g, run_walls=tuple(walls))
+    if plate is None:
+        return out
+    q0, u0 = plate_at_rest(plate, model.plate_arrays, st.plate_force)
+    return dataclasses.replace(out, plate_q0=q0, plate_u0=u0)
 
 
 def held_wall(g, s, wall: int, force: float, mass: float):

@@ -1,6 +1,7 @@
 """The rules of [precompression] (docs/model.md section 3.12): its target wall, force, mode
-(a held wall's mass and scheme), tolerance and iterations, and what the static state can be computed for (no plate yet, the
-target wall not driven, a granule near it)."""
+(a held wall's mass and scheme), tolerance and iterations, and what the static state can be
+computed for (the plane's plate through rigid layers, the target wall not driven, a granule
+near it)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ from granplate.errors import ScenarioError
 from granplate.setup.drive_checks import piston_mass, piston_scheme
 from granplate.setup.fields import finite, int_at_least, is_number, positive, string_in
 from granplate.setup.geometry import plane_offset, unit
-from granplate.setup.scenario import PRECOMPRESSION_MODES, Scenario
+from granplate.setup.scenario import PRECOMPRESSION_MODES, Plate, Scenario
 
 #: The largest precompression force [N] (a kilo-tonne's weight: far past any granular crystal's).
 FORCE_MAX = 1e7
@@ -33,8 +34,8 @@ def precompression_wall(s: Scenario) -> int:
 
 def check_precompression(s: Scenario) -> None:
     """[precompression] on the resolved scenario: its fields in range, its wall a labelled and
-    undriven one, no plate (its static compliance is not part of the static state yet), and
-    some granule within reach of the wall (else the force has nowhere to go)."""
+    undriven one, the plate (if any) the plane's and met through rigid layers (`_check_plate`),
+    and some granule within reach of the wall (else the force has nowhere to go)."""
     p = s.precompression
     if p is None:
         return
@@ -60,13 +61,7 @@ def check_precompression(s: Scenario) -> None:
             "the static state is Hertz's (eq. 9's energy): a scenario with contact.normal_law = "
             f'{sorted(laws - {"hertz"})[0]!r} cannot be precompressed yet; leave out [precompression] or use "hertz"',
         )
-    if s.plate is not None:
-        raise ScenarioError(
-            "precompression.target",
-            p.target,
-            "a scenario with a [plate] cannot be precompressed yet (the plate's static compliance is not part "
-            "of the static state); leave out [precompression] or the [plate]",
-        )
+    _check_plate(s)
     if any(d.target == p.target for d in s.drives):
         raise ScenarioError("precompression.target", p.target, "is driven by a [[drives]] entry: a wall is either")
     wall = s.walls[w]
@@ -95,6 +90,34 @@ def _check_mode_mass(s: Scenario) -> None:
             "precompression.mass",
             p.mass,
             'read with mode = "held" only (the held wall\'s mass [kg]); a frozen wall does not move: leave it out',
+        )
+
+
+def _check_plate(s: Scenario) -> None:
+    """What the static state holds of a [plate]: the plane's plate, its compliance at the rigid
+    layers of the granules on its face nodes at t = 0 (docs/model.md section 3.12). A 3D [plate]
+    (an elastic solid) and granules touching the face between nodes at t = 0 (patch contacts
+    from the start) are refused, naming the field."""
+    from granplate.setup.plate_checks import split_initial_contacts
+
+    if s.plate is None:
+        return
+    if not isinstance(s.plate, Plate):
+        raise ScenarioError(
+            "precompression.target",
+            s.precompression.target if s.precompression is not None else None,
+            "a 3D [plate] (an elastic solid) cannot be precompressed yet (its static compliance is not part "
+            "of the static state); leave out [precompression] or the [plate]",
+        )
+    between = split_initial_contacts(s)[1]
+    if between:
+        name = s.granules[between[0]].label or str(between[0] + 1)
+        raise ScenarioError(
+            "precompression.target",
+            s.precompression.target if s.precompression is not None else None,
+            f"granule {name} touches the plate's face between nodes at t = 0 (a patch contact): a precompressed "
+            "plate is met through rigid layers only, on the face's nodes (plate.ny sets them); move the "
+            "granule onto a node or leave out [precompression]",
         )
 
 

@@ -676,6 +676,9 @@ def run(
     arr = LoopArrays(model, times, len(model.plate_contacts))
     st, w = arr.st, arr.w
     st.y[:] = model.initial_state
+    if model.plate_q0 is not None:  # a precompressed plate starts deflected, at rest
+        st.q[:] = model.plate_q0
+        st.u[:] = model.plate_u0
     set_reference(w, st, cfg.dimension)
     w.plate_free[:] = 1
     w.plate_free[model.plate_contacts] = 0
