@@ -32,12 +32,9 @@ os.environ.setdefault("GOMP_SPINCOUNT", "30000")
 
 from numba import njit, prange  # noqa: E402
 
-from granplate.model.inputs import HIST_END, HIST_MAX, HIST_RATE
-from granplate.physics.laws import normal_law_response
-from granplate.physics.space import normal_rate_3d, pair_contact_3d
 from granplate.solver.drives import begin_pass
 from granplate.solver.granular import ForceSums, commit_history, commit_history_row
-from granplate.solver.granular3d import shock_loads, wall_forces
+from granplate.solver.granular3d import pair_normal_3d, push_pair, shock_loads, wall_forces
 from granplate.solver.kicks import kick, kick_drift
 
 #: columns of a block's buffer row fpar[k, i]: the normal force on granule i (x, y, z) [N]
@@ -79,40 +76,22 @@ def pair_forces_blocks(y, g, cfg, fpar, spar):
         ovl_j = -1
         lo, hi = block_range(k, nb, n_p)
         for p in range(lo, hi):
-            i = g.pair_ij[p, 0]
-            j = g.pair_ij[p, 1]
-            ri = g.radius[i]
-            rj = g.radius[j]
-            g.pair_hist[p, HIST_END] = 0.0
-            delta, nx, ny, nz = pair_contact_3d(y[i, 0], y[i, 1], y[i, 2], ri, y[j, 0], y[j, 1], y[j, 2], rj)
+            delta, nx, ny, nz, n, pv, ep, wp, d = pair_normal_3d(p, y, g, cfg.clip)
             if delta <= 0.0:
                 continue
-            g.pair_hist[p, HIST_END] = delta
-            if delta > ovl * min(ri, rj):
-                ovl = delta / min(ri, rj)
+            i = g.pair_ij[p, 0]
+            j = g.pair_ij[p, 1]
+            r_min = min(g.radius[i], g.radius[j])
+            if delta > ovl * r_min:
+                ovl = delta / r_min
                 ovl_i = i
                 ovl_j = j
-            ddot = normal_rate_3d(y[i, 3] - y[j, 3], y[i, 4] - y[j, 4], y[i, 5] - y[j, 5], nx, ny, nz)
-            n, pv, ep, wp = normal_law_response(
-                delta, ddot, g.pair_coef[p], g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip
-            )
             w_plastic += wp
             p_visc += pv
             e_pot += ep
-            f[i, F_X] -= n * nx
-            f[i, F_X + 1] -= n * ny
-            f[i, F_X + 2] -= n * nz
-            f[j, F_X] += n * nx
-            f[j, F_X + 1] += n * ny
-            f[j, F_X + 2] += n * nz
-            if pv != 0.0:  # the damping part of |N|, pv / ddot
-                d = pv / ddot
-                f[i, F_DX] -= d * nx
-                f[i, F_DX + 1] -= d * ny
-                f[i, F_DX + 2] -= d * nz
-                f[j, F_DX] += d * nx
-                f[j, F_DX + 1] += d * ny
-                f[j, F_DX + 2] += d * nz
+            push_pair(f, i, j, F_X, n, nx, ny, nz)
+            if pv != 0.0:
+                push_pair(f, i, j, F_DX, d, nx, ny, nz)
         spar[k, S_VISC] = p_visc
         spar[k, S_EPOT] = e_pot
         spar[k, S_PLASTIC] = w_plastic

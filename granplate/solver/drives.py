@@ -291,6 +291,15 @@ def wall_shift_energy(y0, y1, g, clip, t0, t1):
 
 
 @njit(cache=True)
+def piston_half_kick(now, v0: float, hk: float):
+    """A piston's half kick from velocity v0 [m/s] over hk [s] with its row `now` of drive_now:
+    (v0 + hk a, the work of P over it, the energy its damping force takes [J])."""
+    dv = hk * now[DR_A]
+    vm = hk * (v0 + 0.5 * dv)
+    return v0 + dv, now[DR_F] * vm, now[DR_FD] * vm
+
+
+@njit(cache=True)
 def piston_kick_drift(g, h):
     """Every piston (`is_piston`): the first half kick v += h/2 a, the drift s += h v, and
     the velocity the force pass at the step's end reads, v + h/2 a (as solver.kicks
@@ -303,14 +312,11 @@ def piston_kick_drift(g, h):
         if not is_piston(g, k):
             continue
         now = g.drive_now[k]
-        v0 = now[DR_V]
-        dv = hk * now[DR_A]
-        vm = hk * (v0 + 0.5 * dv)
-        work += now[DR_F] * vm
-        dissipated += now[DR_FD] * vm
-        now[DR_VH] = v0 + dv
+        now[DR_VH], w, d = piston_half_kick(now, now[DR_V], hk)
+        work += w
+        dissipated += d
         now[DR_S] += h * now[DR_VH]
-        now[DR_V] = now[DR_VH] + dv
+        now[DR_V] = now[DR_VH] + hk * now[DR_A]
     return work, dissipated
 
 
@@ -324,12 +330,9 @@ def piston_kick(g, hk):
         if not is_piston(g, k):
             continue
         now = g.drive_now[k]
-        v0 = now[DR_VH]
-        dv = hk * now[DR_A]
-        vm = hk * (v0 + 0.5 * dv)
-        work += now[DR_F] * vm
-        dissipated += now[DR_FD] * vm
-        now[DR_V] = v0 + dv
+        now[DR_V], w, d = piston_half_kick(now, now[DR_VH], hk)
+        work += w
+        dissipated += d
     return work, dissipated
 
 

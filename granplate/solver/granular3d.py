@@ -340,6 +340,38 @@ def force_error(k1, k0, kend, ratio, mass, inertia, radius, sc, err):
 
 
 @njit(cache=True)
+def pair_normal_3d(p, y, g, clip: bool):
+    """The normal contact of listed pair p at state y (space): (overlap delta [m], the unit
+    normal from i to j, |N| [N], viscous power [W], stored energy [J], plastic work [J], the
+    damping part of |N| pv / delta_dot [N]); its overlap into HIST_END. delta <= 0: apart,
+    the rest zero."""
+    i = g.pair_ij[p, 0]
+    j = g.pair_ij[p, 1]
+    g.pair_hist[p, HIST_END] = 0.0
+    delta, nx, ny, nz = pair_contact_3d(y[i, X], y[i, Y], y[i, Z], g.radius[i], y[j, X], y[j, Y], y[j, Z], g.radius[j])
+    if delta <= 0.0:
+        return delta, nx, ny, nz, 0.0, 0.0, 0.0, 0.0, 0.0
+    g.pair_hist[p, HIST_END] = delta
+    ddot = normal_rate_3d(y[i, VX] - y[j, VX], y[i, VY] - y[j, VY], y[i, VZ] - y[j, VZ], nx, ny, nz)
+    n, pv, ep, wp = normal_law_response(
+        delta, ddot, g.pair_coef[p], g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], clip
+    )
+    return delta, nx, ny, nz, n, pv, ep, wp, pv / ddot if pv != 0.0 else 0.0
+
+
+@njit(cache=True)
+def push_pair(out, i, j, col, s, nx, ny, nz):
+    """A pair's force s n [N] (n from i to j) on its granules into out[:, col:col + 3]:
+    minus on i, plus on j."""
+    out[i, col] -= s * nx
+    out[i, col + 1] -= s * ny
+    out[i, col + 2] -= s * nz
+    out[j, col] += s * nx
+    out[j, col + 1] += s * ny
+    out[j, col + 2] += s * nz
+
+
+@njit(cache=True)
 def normal_forces(t, y, g, cfg, acc, fdamp, fload):
     """The velocity-Verlet force pass in space (as solver.granular.normal_forces): shock
     and normal forces of every listed pair and wall contact at state y (no friction), the
@@ -363,40 +395,22 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
     if not cfg.load_on_plate:
         p_shock = shock_loads(t, y, g, cfg, acc, fload)
     for p in range(g.pair_ij.shape[0]):
-        i = g.pair_ij[p, 0]
-        j = g.pair_ij[p, 1]
-        ri = g.radius[i]
-        rj = g.radius[j]
-        g.pair_hist[p, HIST_END] = 0.0
-        delta, nx, ny, nz = pair_contact_3d(y[i, X], y[i, Y], y[i, Z], ri, y[j, X], y[j, Y], y[j, Z], rj)
+        delta, nx, ny, nz, n, pv, ep, wp, d = pair_normal_3d(p, y, g, cfg.clip)
         if delta <= 0.0:
             continue
-        g.pair_hist[p, HIST_END] = delta
-        if delta > ovl * min(ri, rj):
-            ovl = delta / min(ri, rj)
+        i = g.pair_ij[p, 0]
+        j = g.pair_ij[p, 1]
+        r_min = min(g.radius[i], g.radius[j])
+        if delta > ovl * r_min:
+            ovl = delta / r_min
             ovl_i = i
             ovl_j = j
-        ddot = normal_rate_3d(y[i, VX] - y[j, VX], y[i, VY] - y[j, VY], y[i, VZ] - y[j, VZ], nx, ny, nz)
-        n, pv, ep, wp = normal_law_response(
-            delta, ddot, g.pair_coef[p], g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip
-        )
         w_plastic += wp
         p_visc += pv
         e_pot += ep
-        acc[i, VX] -= n * nx
-        acc[i, VY] -= n * ny
-        acc[i, VZ] -= n * nz
-        acc[j, VX] += n * nx
-        acc[j, VY] += n * ny
-        acc[j, VZ] += n * nz
-        if pv != 0.0:  # the damping part of |N|, pv / ddot
-            d = pv / ddot
-            fdamp[i, VX] -= d * nx
-            fdamp[i, VY] -= d * ny
-            fdamp[i, VZ] -= d * nz
-            fdamp[j, VX] += d * nx
-            fdamp[j, VY] += d * ny
-            fdamp[j, VZ] += d * nz
+        push_pair(acc, i, j, VX, n, nx, ny, nz)
+        if pv != 0.0:
+            push_pair(fdamp, i, j, VX, d, nx, ny, nz)
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
         y, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
     )
