@@ -42,6 +42,21 @@ def test_transmission_of_a_scaled_copy_is_its_scale():
     assert table["amplitude"].attrs["window"] == "hann"
 
 
+def test_transmission_carries_the_ratio_of_the_units(tmp_path):
+    """A wall force over a drive's displacement: 2 N per 1e-6 m at the drive's frequency = 2e6 N/m, so labelled."""
+    table = spectra.spectrum_table(
+        _result(), ["wall_force:bottom", "wall_force:top"], reference="drive_displacement:piston"
+    )
+    assert list(table["transmission_units"].values) == ["N/m", "N/m"]
+    k = int(np.argmax(table["amplitude"].values[0]))
+    assert table["transmission"].values[0, k] == pytest.approx(2e6, rel=1e-6)
+    path = tmp_path / "t.csv"
+    spectra.write_csv(table, str(path))
+    assert "transmission wall_force:bottom [N/m]" in path.read_text().splitlines()[0]
+    same = spectra.spectrum_table(_result(), ["wall_force:top"], reference="wall_force:bottom")
+    assert list(same["transmission_units"].values) == ["1"]
+
+
 def test_table_lists_every_signal_and_writes_csv(tmp_path):
     """Without names, every recorded signal is in the table; the CSV has one column per signal plus frequency."""
     table = spectra.spectrum_table(_result(), [])

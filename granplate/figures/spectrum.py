@@ -1,6 +1,7 @@
 """The spectrum figure of a result (`granplate plot RESULT --figure spectrum`): the
 amplitude spectrum of each chosen signal (a) in its units against frequency [kHz], and
-with a reference signal the transmission abs(X_out / X_ref) (b) [1] on a log scale; the
+with a reference signal the transmission abs(X_out / X_ref) (b) on a log scale, in the
+signal's unit over the reference's ([1] where they agree); the
 numbers are written beside it as CSV (`granplate.results.spectra`, docs/output.md)."""
 
 from __future__ import annotations
@@ -25,13 +26,18 @@ def fig_spectrum(table: xr.Dataset, title: str = "") -> Figure:
         unit = table["signal_units"].values[i]
         axes[0].semilogy(f_khz[1:], table["amplitude"].values[i, 1:], lw=1.0, label=f"{name} [{unit}]")
         if has_tr:
-            axes[1].semilogy(f_khz[1:], table["transmission"].values[i, 1:], lw=1.0, label=str(name))
+            t_unit = table["transmission_units"].values[i]
+            axes[1].semilogy(f_khz[1:], table["transmission"].values[i, 1:], lw=1.0, label=f"{name} [{t_unit}]")
     axes[0].set_ylabel("amplitude [signal's unit]")
     axes[0].set_title("(a) one-sided amplitude spectrum, Hann window", loc="left", fontsize=10)
     axes[0].legend(fontsize=8, frameon=False)
     if has_tr:
         ref = table["transmission"].attrs["reference"]
-        axes[1].set_ylabel("transmission [1]")
+        t_units = sorted(set(table["transmission_units"].values.tolist()))
+        axes[1].set_ylabel(
+            f"transmission [{t_units[0]}]" if len(t_units) == 1 else "transmission [signal's unit / reference's]"
+        )
+        axes[1].legend(fontsize=8, frameon=False)
         axes[1].set_title(f"(b) |X / X_ref|, reference {ref}", loc="left", fontsize=10)
     axes[-1].set_xlabel("frequency [kHz]")
     if title:

@@ -91,11 +91,18 @@ def transmission(x_out: np.ndarray, x_in: np.ndarray, dt: float, floor: float = 
     return f, ratio
 
 
+def ratio_unit(unit: str, ref_unit: str) -> str:
+    """The unit of a signal in `unit` over a reference in `ref_unit`: "1" where they agree."""
+    return "1" if unit == ref_unit else f"{unit}/{ref_unit}"
+
+
 def spectrum_table(ds: xr.Dataset, names: list[str], reference: str | None = None) -> xr.Dataset:
     """The spectra of the named signals (none: every signal on the first one's time axis;
     all on the same sample times) (and, with a reference, each one's transmission
     relative to it) as a Dataset on a `frequency` [Hz] coordinate: `amplitude` (signal,
-    frequency) in each signal's units and `transmission` (signal, frequency) [1]."""
+    frequency) in each signal's units and `transmission` (signal, frequency) in the signal's
+    unit over the reference's (`transmission_units`: "1" where they agree, "N/m" for a
+    force over a displacement)."""
     if not names:  # every signal on the first one's time axis
         names = signal_names(ds)
         axis = ds[names[0].partition(":")[0]].dims[0] if names else None
@@ -105,8 +112,9 @@ def spectrum_table(ds: xr.Dataset, names: list[str], reference: str | None = Non
     rows, units, trans = [], [], []
     f = np.zeros(0)
     t0 = None
+    ref_unit = ""
     if reference:
-        t0, ref, _ = signal(ds, reference)
+        t0, ref, ref_unit = signal(ds, reference)
     else:
         ref = None
     for name in names:
@@ -132,14 +140,17 @@ def spectrum_table(ds: xr.Dataset, names: list[str], reference: str | None = Non
     out["amplitude"].attrs = {"units": ",".join(units), "window": WINDOW, "long_name": "one-sided amplitude spectrum"}
     out["signal_units"] = ("signal", units)
     if ref is not None:
+        t_units = [ratio_unit(u, ref_unit) for u in units]
         out["transmission"] = (("signal", "frequency"), np.array(trans))
-        out["transmission"].attrs = {"units": "1", "window": WINDOW, "reference": str(reference)}
+        out["transmission"].attrs = {"units": ",".join(t_units), "window": WINDOW, "reference": str(reference)}
+        out["transmission_units"] = ("signal", t_units)
     return out
 
 
 def write_csv(table: xr.Dataset, path: str) -> None:
     """The spectra as CSV: a frequency column [Hz], then each signal's amplitude (and
-    transmission) column, headed "amplitude NAME [UNIT]" / "transmission NAME [1]"."""
+    transmission) column, headed "amplitude NAME [UNIT]" / "transmission NAME [UNIT/REF]"
+    ("1" where the two units agree)."""
     cols = [table["frequency"].values]
     head = ["frequency [Hz]"]
     for i, name in enumerate(table["signal"].values):
@@ -147,5 +158,5 @@ def write_csv(table: xr.Dataset, path: str) -> None:
         head.append(f"amplitude {name} [{table['signal_units'].values[i]}]")
         if "transmission" in table:
             cols.append(table["transmission"].values[i])
-            head.append(f"transmission {name} [1]")
+            head.append(f"transmission {name} [{table['transmission_units'].values[i]}]")
     np.savetxt(path, np.column_stack(cols), delimiter=",", header=",".join(head), comments="")
