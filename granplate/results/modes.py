@@ -53,7 +53,7 @@ class Modes(NamedTuple):
     """frequencies: (n,) [Hz], ascending, zero modes included (as 0); shapes: (n, ng, d) the
     M-orthonormal mode shapes [kg^-1/2]; zero_modes: how many have no stiffness;
     contacts: the contacts in touch that give K (the plate's included); plate: (n, nm) the
-    plate's modal coordinates q of each M-orthonormal mode [-] ((n, 0) without a plate)."""
+    plate's modal coordinates q of each M-orthonormal mode [-] ((0, 0) without a plate)."""
 
     frequencies: np.ndarray
     shapes: np.ndarray
