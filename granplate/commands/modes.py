@@ -10,14 +10,29 @@ import json
 from granplate.figures.cli import add_set_option
 
 
+def granule_fraction(modes):
+    """Each mode's share of its kinetic energy in the granules [-] (the rest in the plate):
+    sum m u^2 of its M-orthonormal shape, 1 - |q|^2."""
+    import numpy as np
+
+    return 1.0 - np.sum(modes.plate**2, axis=1)
+
+
 def modes_record(modes) -> dict:
-    """The JSON of a Modes: frequencies [Hz], zero_modes, contacts."""
-    return {
+    """The JSON of a Modes: frequencies [Hz], zero_modes, contacts; coupled to the plane's
+    plate also plate_modes (the plate's modal coordinates) and granule_fraction (each mode's
+    share of kinetic energy in the granules)."""
+    record = {
         "frequencies": [float(f) for f in modes.frequencies],
         "zero_modes": modes.zero_modes,
         "contacts": modes.contacts,
         "units": {"frequencies": "Hz"},
     }
+    if modes.plate.shape[1]:
+        record["plate_modes"] = int(modes.plate.shape[1])
+        record["granule_fraction"] = [float(v) for v in granule_fraction(modes)]
+        record["units"]["granule_fraction"] = "-"
+    return record
 
 
 def _cmd_modes(args) -> int:
@@ -32,8 +47,16 @@ def _cmd_modes(args) -> int:
         f"{s.name}: {len(modes.frequencies)} modes, {modes.zero_modes} without stiffness (free directions), "
         f"{modes.contacts} contacts in touch"
     )
-    for k, f in enumerate(nonzero):
-        print(f"{k + 1:6d} {f:14.6g} Hz")
+    if modes.plate.shape[1]:
+        share = granule_fraction(modes)[modes.frequencies > 0.0]
+        print(
+            f"coupled to the plate's {modes.plate.shape[1]} modes; the granules' share of each mode's kinetic energy:"
+        )
+        for k, (f, e) in enumerate(zip(nonzero, share)):
+            print(f"{k + 1:6d} {f:14.6g} Hz {e:10.3g}")
+    else:
+        for k, f in enumerate(nonzero):
+            print(f"{k + 1:6d} {f:14.6g} Hz")
     if args.json:
         with open(args.json, "w", encoding="utf-8") as fh:
             json.dump(modes_record(modes), fh, indent=1)

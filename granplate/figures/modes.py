@@ -29,7 +29,8 @@ def draw_modes(modes, name: str, shown: int = 4):
         b.plot(np.arange(1, len(u) + 1), u / scale, "-o", ms=3, label=f"{f[k] / 1e3:.3g} kHz")
     b.set_xlabel("granule")
     b.set_ylabel("displacement along the main axis [-]")
-    b.set_title("(b) the lowest modes' shapes", loc="left", fontsize=9)
+    part = " (the granules' part)" if modes.plate.shape[1] else ""
+    b.set_title(f"(b) the lowest modes' shapes{part}", loc="left", fontsize=9)
     if len(live):
         b.legend(fontsize=7)
     fig.tight_layout()

@@ -21,6 +21,18 @@ For a monatomic chain of masses m and contact stiffness k the modes fill the aco
 up to the cut-off f_c = (1/pi) sqrt(k/m); a diatomic chain (masses m1 > m2) has an acoustic
 band up to sqrt(2k/m1)/(2 pi), a gap, and an optical band from sqrt(2k/m2)/(2 pi) to
 sqrt(2k (1/m1 + 1/m2))/(2 pi) (`chain_band_edges`).
+
+With the plane's plate (a 2D [plate]) the plate's mass-normalised modal coordinates q join the
+unknowns (its block of M the identity, of K diag(omega^2)), and each plate contact (a rigid
+layer, n = (1, 0)) couples the granule's x-displacement s to the plate's normal displacement
+there, Phi_n q + R_n F (the kept modes' shapes at the contact's driving dof and a truncated
+basis' residual compliance, massless): its spring k_c in series with R_n, condensed statically,
+
+    K += B^T K_e B,   K_e = (I + K_s R_n)^-1 K_s,   B (s, q) = s - Phi_n q                    (M2)
+
+(K_s = diag(k_c) at the static overlaps, the plate deflected at rest; with every mode kept
+R_n = 0 and the plate is its finite-element model exactly). Solved densely (`eigh`; beyond
+DENSE_MAX unknowns the lowest `count`, 50 by default, by `subset_by_index`).
 """
 
 from __future__ import annotations
@@ -40,12 +52,14 @@ ZERO_RTOL = 1e-10
 class Modes(NamedTuple):
     """frequencies: (n,) [Hz], ascending, zero modes included (as 0); shapes: (n, ng, d) the
     M-orthonormal mode shapes [kg^-1/2]; zero_modes: how many have no stiffness;
-    contacts: the contacts in touch that give K."""
+    contacts: the contacts in touch that give K (the plate's included); plate: (n, nm) the
+    plate's modal coordinates q of each M-orthonormal mode [-] ((0, 0) without a plate)."""
 
     frequencies: np.ndarray
     shapes: np.ndarray
     zero_modes: int
     contacts: int
+    plate: np.ndarray = np.zeros((0, 0))
 
 
 def stiffness_matrix(g, x: np.ndarray):
@@ -84,6 +98,8 @@ def linear_modes(model, count: int | None = None) -> Modes:
     d = g.wall_geo.shape[1] - 1
     x = np.ascontiguousarray(model.initial_state[:, :d])
     K, touching = stiffness_matrix(g, x)
+    if getattr(model, "plate", None) is not None and len(model.plate_arrays.omega2):
+        return coupled_modes(model, K, touching, count)
     m = np.repeat(g.mass, d)
     size = len(m)
     w = 1.0 / np.sqrt(m)
@@ -107,6 +123,69 @@ def linear_modes(model, count: int | None = None) -> Modes:
     if count is not None:
         freq, shapes = freq[:count], shapes[:count]
     return Modes(freq, shapes, int(np.count_nonzero(zero)), touching)
+
+
+def plate_contact_stiffness(g, p, x: np.ndarray, u0: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+    """The plate contacts' granules (nk,) and their springs in series with the plate's residual
+    compliance, K_e = (I + K_s R_n)^-1 K_s of (M2) (nk, nk) [N/m], K_s = diag((3/2) A
+    delta^(1/2)) at the overlaps of centres x (ng, d) [m] against the plate displaced by u0
+    (nk,) [m] at its contacts (p: model.inputs.PlateArrays); and how many are in touch."""
+    from granplate.model.static import plate_terms
+
+    pi, pdelta, _, pk, _ = plate_terms(x, u0, g)
+    ks = np.diag(pk)
+    if p.resid.shape[0] and len(pi):
+        rn = np.asarray(p.resid, float)[0::2, 0::2]
+        ke = np.linalg.solve(np.eye(len(pi)) + ks @ rn, ks)
+        ks = 0.5 * (ke + ke.T)  # symmetric in exact arithmetic: (I + K R)^-1 K = K (I + R K)^-1
+    return pi, ks, int(np.count_nonzero(pdelta > 0.0))
+
+
+def coupled_stiffness(model, k_granules, x: np.ndarray) -> tuple[np.ndarray, int]:
+    """The dense stiffness (ng d + nm, ng d + nm) [N/m, and 1/s^2 in the plate's block] of the
+    granules (k_granules, (M1)) and the plane's plate in modal coordinates, coupled by its
+    contacts (M2); and the plate contacts in touch."""
+    g, p = model.granular, model.plate_arrays
+    d = x.shape[1]
+    nd, nm = len(g.mass) * d, len(p.omega2)
+    u0 = np.zeros(len(g.pc_i)) if model.plate_u0 is None else np.asarray(model.plate_u0, float)[0::2]
+    pi, ke, touching = plate_contact_stiffness(g, p, x, u0)
+    k = np.zeros((nd + nm, nd + nm))
+    k[:nd, :nd] = k_granules.toarray()
+    k[nd:, nd:] = np.diag(np.asarray(p.omega2, float))
+    b = np.zeros((len(pi), nd + nm))
+    b[np.arange(len(pi)), pi * d] = 1.0  # the granule's x-displacement
+    b[:, nd:] = -np.asarray(p.phi_d, float)[0::2]  # minus the plate's at the contact
+    k += b.T @ ke @ b
+    return k, touching
+
+
+def coupled_modes(model, k_granules, touching: int, count: int | None) -> Modes:
+    """The modes (M1)-(M2) of the granules and the plane's plate together (dense `eigh`;
+    beyond DENSE_MAX unknowns the lowest `count`, 50 by default)."""
+    from scipy.linalg import eigh
+
+    g = model.granular
+    d = g.wall_geo.shape[1] - 1
+    x = np.ascontiguousarray(model.initial_state[:, :d])
+    k, on_plate = coupled_stiffness(model, k_granules, x)
+    nd = len(g.mass) * d
+    w = np.concatenate([1.0 / np.sqrt(np.repeat(g.mass, d)), np.ones(k.shape[0] - nd)])
+    sym = (k * w[:, None]) * w[None, :]
+    if len(w) <= DENSE_MAX:
+        lam, v = eigh(sym)
+    else:
+        want = min(count or 50, len(w))
+        lam, v = eigh(sym, subset_by_index=[0, want - 1])
+    top = float(np.max(np.abs(lam))) if len(lam) else 0.0
+    zero = np.abs(lam) <= ZERO_RTOL * max(top, 1e-300)
+    lam = np.where(zero, 0.0, lam)
+    freq = np.sqrt(np.maximum(lam, 0.0)) / (2.0 * math.pi)
+    z = v * w[:, None]
+    shapes, plate = z[:nd].T.reshape(len(lam), len(g.mass), d), np.ascontiguousarray(z[nd:].T)
+    if count is not None:
+        freq, shapes, plate = freq[:count], shapes[:count], plate[:count]
+    return Modes(freq, shapes, int(np.count_nonzero(zero)), touching + on_plate, plate)
 
 
 def chain_band_edges(k: float, m1: float, m2: float | None = None) -> dict[str, float]:
