@@ -159,7 +159,8 @@ def test_a_settling_that_does_not_converge_says_so_and_keeps_its_state(store_dir
 @pytest.mark.slow
 def test_poured_protector_example_runs(store_dir):
     """docs/examples/poured-protector.toml settles, then its striker hits the packing and the
-    plate takes energy while the balance (eq. 11) holds."""
+    plate takes energy while the balance (eq. 11) holds; the settled overlaps' stored energy
+    is part of E_initial, so the granules' energy never exceeds what was put in."""
     from pathlib import Path
 
     from granplate.results.run import simulate
@@ -171,3 +172,6 @@ def test_poured_protector_example_runs(store_dir):
     striker = list(ds.granule.values).index("striker")
     assert ds.vx.values[-1, striker] < 0.9 * 8.0
     assert float(ds.E_plate.max()) > 0.0
+    e0 = float(ds.E_granular.values[0] + ds.E_plate.values[0])
+    assert ds.attrs["E_initial"] == pytest.approx(e0, rel=1e-12)
+    assert float(ds.E_granular.max()) <= ds.attrs["E_initial"] * (1.0 + 1e-9)

@@ -544,14 +544,22 @@ def body_outputs(
     return data, coords, n_done
 
 
+def starts_loaded(s) -> bool:
+    """Whether scenario s (resolved) starts with stored elastic energy that is energy put in:
+    a precompressed run, or one whose contacts may start overlapped (`contact.overlap_start`,
+    a poured packing's settled overlaps)."""
+    return s.precompression is not None or s.contact.overlap_start is not None
+
+
 def initial_energy(energy0: np.ndarray, stored: bool = False) -> float:
     """E_initial [J]: the kinetic energy of the initial velocities, 1/2 m v^2 + 1/2 I omega^2
     summed over the granules (the first output row's KE_x + KE_y + KE_rot, + KE_z in space), exactly 0 for a
     run from rest. The plate starts undeformed and at rest; contacts that touch at t = 0
     (overlaps within validation's 1e-9 R) hold only the round-off energy of their overlaps
     (~1e-33 J), which is not energy put in (it stays in the loop's eq. (11) reference).
-    stored: a precompressed run (docs/model.md section 3.12), whose contacts start with the
-    static state's elastic energy: E_initial is then the whole E_g + E_p at t = 0."""
+    stored: a run whose contacts start with elastic energy (`starts_loaded`: a precompressed
+    run, docs/model.md section 3.12, or overlaps allowed by contact.overlap_start): E_initial
+    is then the whole E_g + E_p at t = 0."""
     if stored:
         return float(energy0[K.E_GRAN] + energy0[K.E_PLATE])
     return float(energy0[K.KE_X] + energy0[K.KE_Y] + energy0[K.KE_ROT] + energy0[K.KE_Z])
@@ -570,7 +578,7 @@ def _attrs(model, out: K.Output, n: int, info: dict) -> dict:
         "scheme": s.solver.scheme,
         "conventions": "SI units; see docs/output.md",
         "run_info": json.dumps(info),
-        "E_initial": initial_energy(out.energy[0], s.precompression is not None) if n else 0.0,
+        "E_initial": initial_energy(out.energy[0], starts_loaded(s)) if n else 0.0,
     }
     attrs.update(info)
     return attrs
