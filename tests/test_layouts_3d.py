@@ -326,15 +326,21 @@ def test_resolve_command_writes_granules_and_walls(tmp_path, capsys):
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.name)
 def test_examples_validate_and_are_3d(path):
-    """Every docs/examples/3d-*.toml validates as a 3D layout with a force load."""
+    """Every docs/examples/3d-*.toml validates as a 3D layout with a force load (a poured
+    packing: struck by a granule with an initial velocity instead)."""
     s = scenario_io.load_scenario(str(path))
-    assert s.dimension == 3 and s.layout is not None and s.load.kind == "force"
+    assert s.dimension == 3 and s.layout is not None
+    if s.layout.kind == "poured":
+        assert s.load.kind == "none" and any(g.vx > 0.0 for g in s.granules)
+    else:
+        assert s.load.kind == "force"
 
 
 def test_one_example_per_kind():
-    """docs/examples has a 3D example of every space lattice kind and of the chain."""
+    """docs/examples has a 3D example of every space lattice kind, of the chain and of a
+    poured packing."""
     kinds = {scenario_io.load(p).layout.kind for p in EXAMPLES}
-    assert kinds == set(KINDS) | {"chain"}
+    assert kinds == set(KINDS) | {"chain", "poured"}
 
 
 def test_short_run_of_the_stack_balances_energy():

@@ -260,14 +260,16 @@ def solid_drawing(s: Scenario, written: Scenario | None = None) -> dict:
     if not isinstance(sd, Solid):
         return {}
     from granplate.setup.geometry import granule_named
-    from granplate.setup.validate import OVERLAP_RTOL
+    from granplate.setup.granule_checks import start_overlap
     from granplate.solid.build import solid_mesh
     from granplate.solid.clearance import check_clearance
     from granplate.solid.mesh import boundary_polygons, outline_edges
 
     mesh = solid_mesh(sd)
     if sd.mesh is not None:
-        check_clearance(s, mesh, {i: granule_named(written or s, s, i) for i in range(len(s.granules))}, OVERLAP_RTOL)
+        check_clearance(
+            s, mesh, {i: granule_named(written or s, s, i) for i in range(len(s.granules))}, start_overlap(s)
+        )
     clamped = [outline_edges(mesh, mesh.boundaries[name]) for name in sd.clamped]
     held = f", clamped: {', '.join(sd.clamped)}" if sd.clamped else ", free"
     held += f", rollers: {', '.join(sd.rollers)}" if sd.rollers else ""

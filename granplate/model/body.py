@@ -186,10 +186,10 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
     mesh, surface, sn = geo.mesh, geo.surface, geo.nodes
     if sd.mesh is not None:  # a mesh file's surface against the granules (a box's: setup.validate)
         from granplate.setup.geometry import granule_named
-        from granplate.setup.validate import OVERLAP_RTOL
+        from granplate.setup.granule_checks import start_overlap
         from granplate.solid.clearance import check_clearance
 
-        check_clearance(s, mesh, {i: granule_named(s, s, i) for i in range(len(s.granules))}, OVERLAP_RTOL)
+        check_clearance(s, mesh, {i: granule_named(s, s, i) for i in range(len(s.granules))}, start_overlap(s))
     face, components = residual_face(s, surface, mesh) if sd.residual else (None, "")
     solid = build_solid(sd, material, surface=face, components=components or "z")
     rows = reduced_index(solid.dofs, (3 * sn.full[:, None] + np.arange(3)).ravel()).reshape(-1, 3)

@@ -83,6 +83,7 @@ from granplate.setup.granule_checks import (
     _check_plate_penetration,
     _check_wall_penetration,
     _planar_granules,
+    start_overlap,
 )
 from granplate.setup.load_checks import LOAD_KINDS, LOAD_KINDS_BY_DIMENSION, LOAD_TARGETS, _check_load
 from granplate.setup.contact_checks import DETECTIONS, TORQUE_ARMS, YIELDING_LAWS, _check_contact, possible_contacts
@@ -320,11 +321,11 @@ def _check_plate(s: Scenario) -> None:
 
 def _check_solid_penetration(s: Scenario, named: dict[int, str]) -> None:
     """No granule crosses the 3D solid's surface at t = 0, none has its centre inside it
-    (setup.solid_checks.check_solid_clearance, tolerance OVERLAP_RTOL x the radius, as
-    the plate's edge and the walls). A box in closed form; a mesh file's surface is
+    (setup.solid_checks.check_solid_clearance, tolerance `start_overlap` x the radius, as
+    the plate's edge and the walls: contact.overlap_start where given). A box in closed form; a mesh file's surface is
     checked where the file is read (solid.clearance), not here."""
     if isinstance(s.plate, Solid) and is_box(s.plate):
-        check_solid_clearance(s, box_distances(s), named, OVERLAP_RTOL)
+        check_solid_clearance(s, box_distances(s), named, start_overlap(s))
 
 
 def _check_walls_off_solid(s: Scenario, r: Scenario) -> None:
