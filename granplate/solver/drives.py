@@ -41,6 +41,7 @@ from granplate.model.inputs import (
 )
 from granplate.physics.drives import KIND_FORCE, PAR_MASS, drive_motion
 from granplate.physics.laws import normal_law_response
+from granplate.solver.kicks import half_kick
 
 #: the first velocity column of a granule's state (both dimensions)
 V0 = 3
@@ -294,9 +295,8 @@ def wall_shift_energy(y0, y1, g, clip, t0, t1):
 def piston_half_kick(now, v0: float, hk: float):
     """A piston's half kick from velocity v0 [m/s] over hk [s] with its row `now` of drive_now:
     (v0 + hk a, the work of P over it, the energy its damping force takes [J])."""
-    dv = hk * now[DR_A]
-    vm = hk * (v0 + 0.5 * dv)
-    return v0 + dv, now[DR_F] * vm, now[DR_FD] * vm
+    v1, _, vm = half_kick(v0, now[DR_A], hk)
+    return v1, now[DR_F] * vm, now[DR_FD] * vm
 
 
 @njit(cache=True)

@@ -8,6 +8,15 @@ from numba import njit
 
 
 @njit(cache=True)
+def half_kick(v0: float, a: float, hk: float):
+    """A half kick over hk [s] from velocity v0 with acceleration a: (v0 + hk a, the change
+    hk a, hk (v0 + hk a / 2): the mean velocity times hk, by which a force's work over the
+    kick is that force times it [m])."""
+    dv = hk * a
+    return v0 + dv, dv, hk * (v0 + 0.5 * dv)
+
+
+@njit(cache=True)
 def kick_drift(y, acc, fdamp, fload, h, ypred, n_drift, lo, hi):
     """Granules lo..hi-1: the first half kick v += h/2 a (every column from n_drift on),
     the drift x += h v (the columns before), and the state the force pass reads into ypred:
@@ -18,10 +27,7 @@ def kick_drift(y, acc, fdamp, fload, h, ypred, n_drift, lo, hi):
     w_damp = 0.0
     for i in range(lo, hi):
         for c in range(n_drift, y.shape[1]):
-            v0 = y[i, c]
-            dv = hk * acc[i, c]
-            v1 = v0 + dv
-            vm = hk * (v0 + 0.5 * dv)
+            v1, dv, vm = half_kick(y[i, c], acc[i, c], hk)
             w_load += fload[i, c] * vm
             w_damp += fdamp[i, c] * vm
             y[i, c] = v1
@@ -41,12 +47,10 @@ def kick(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi):
     w_damp = 0.0
     for i in range(lo, hi):
         for c in range(n_drift, y.shape[1]):
-            v0 = y[i, c]
-            dv = hk * acc[i, c]
-            vm = hk * (v0 + 0.5 * dv)
+            v1, _, vm = half_kick(y[i, c], acc[i, c], hk)
             w_load += fload[i, c] * vm
             w_damp += fdamp[i, c] * vm
-            y[i, c] = v0 + dv
+            y[i, c] = v1
         for c in range(n_drift):
             dy[i, c] = y[i, c + n_drift]
     return w_load, w_damp
