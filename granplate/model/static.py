@@ -20,8 +20,13 @@ Its gradient is the residual of (S2). It is minimised by L-BFGS (scipy) from the
 positions, then polished by Newton steps on the contacts' normal stiffness 3/2 A
 delta^(1/2) n n^T (a positive semi-definite matrix, the transverse geometric terms left
 out, so that every step descends) until the largest residual force is below tolerance x F.
-Granules a drive holds stay where they are. The laws of friction do not enter: the static
-state is frictionless (friction needs a history that precompression does not have).
+A granule under a displacement or velocity drive is held along the drive's direction only
+(its prescribed motion starts there) and free across it; a granule under a force drive is
+free, the drive's value at t = 0, P(0) e, a load in (S1) (-P(0) e . x_i: the rest state the
+run starts from, nothing when the profile starts at 0). Walls stay at their offsets (a
+driven wall starts where the scenario puts it), the target's servo apart. The laws of
+friction do not enter: the static state is frictionless (friction needs a history that
+precompression does not have).
 
 Pure functions of the model's arrays (no I/O): `static_state` returns the equilibrium and
 `precompressed` the model that starts from it.
@@ -123,11 +128,12 @@ def plate_terms(x: np.ndarray, u: np.ndarray, g):
     return pi, pdelta, pa * pdelta**1.5, 1.5 * pa * np.sqrt(pdelta), pa
 
 
-def energy_and_forces(x: np.ndarray, o: float, g, wall: int, force: float, u=None, kc=None):
+def energy_and_forces(x: np.ndarray, o: float, g, wall: int, force: float, u=None, kc=None, load=None):
     """(Pi [J] of (S1), the net force on every granule (ng, d) [N], the net force on the wall
     along its inward normal [N], the net force on each plate contact's normal dof (nk,) [N])
     at centres x, offset o and plate displacements u (kc: the plate's condensed stiffness
-    K_c): minus the gradient of Pi."""
+    K_c; load: (ng, d) constant forces on the granules [N], the force drives' `drive_loads`):
+    minus the gradient of Pi."""
     (i, j, delta, f, _, n, a), (wi, wdelta, wf, _, wn, on, wa) = contact_terms(x, o, g, wall)
     pi, pdelta, pf, _, pa = plate_terms(x, np.zeros(0) if u is None else u, g)
     mass = g.mass
@@ -144,12 +150,15 @@ def energy_and_forces(x: np.ndarray, o: float, g, wall: int, force: float, u=Non
     np.add.at(net, wi, -wf[:, None] * wn)
     np.add.at(net[:, 0], pi, -pf)
     net += mass[:, None] * grav
+    if load is not None:
+        e -= float(np.sum(load * x))
+        net += load
     on_wall = float(np.sum(wf[on])) - force  # the contacts push the wall out, the servo in
     return e, net, on_wall, on_plate
 
 
-def _normal_stiffness(x: np.ndarray, o: float, g, wall: int, free: np.ndarray, u=None, kc=None):
-    """The contacts' normal stiffness over the free granules' coordinates, the plate contacts'
+def _normal_stiffness(x: np.ndarray, o: float, g, wall: int, u=None, kc=None):
+    """The contacts' normal stiffness over every granule's coordinates, the plate contacts'
     normal displacements and the wall's offset (the last unknown), as a sparse matrix: 3/2 A
     delta^(1/2) n n^T blocks and the plate's K_c (S1's Hessian without the transverse
     geometric terms)."""
@@ -159,9 +168,8 @@ def _normal_stiffness(x: np.ndarray, o: float, g, wall: int, free: np.ndarray, u
     pi, _, _, pk, _ = plate_terms(x, np.zeros(0) if u is None else u, g)
     d = x.shape[1]
     nk = len(pi)
-    index = -np.ones(len(g.mass), np.int64)
-    index[free] = np.arange(int(free.sum()))
-    first_u = int(free.sum()) * d  # the plate's unknowns follow the granules'
+    index = np.arange(len(g.mass))
+    first_u = len(g.mass) * d  # the plate's unknowns follow the granules'
     size = first_u + nk + 1
     rows, cols, vals = [], [], []
 
@@ -199,11 +207,64 @@ def _normal_stiffness(x: np.ndarray, o: float, g, wall: int, free: np.ndarray, u
     return coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(size, size)).tocsc()
 
 
+def prescribed_granules(g) -> np.ndarray:
+    """(ng,) bool: the granules a displacement or velocity drive moves (held along its
+    direction in the static state)."""
+    from granplate.physics.drives import KIND_FORCE
+
+    out = np.zeros(len(g.mass), bool)
+    on = (g.drive_target >= 0) & (g.drive_kind != KIND_FORCE)
+    out[g.drive_target[on]] = True
+    return out
+
+
+def granule_freedom(g, d: int):
+    """The static state's free coordinates: a sparse (ng d, nf) matrix T with orthonormal
+    columns, the granules' displacements T z. A granule under a displacement or velocity
+    drive along e spans the plane (the line in 2D) across e; every other granule, a
+    force-driven one included, all d directions."""
+    from scipy.linalg import null_space
+    from scipy.sparse import coo_matrix
+
+    from granplate.physics.drives import KIND_FORCE
+
+    across = {}
+    for k, i in enumerate(g.drive_target):
+        if i >= 0 and g.drive_kind[k] != KIND_FORCE:
+            e = np.asarray(g.drive_dir[k], float)
+            across[int(i)] = null_space(e[None, :] / np.linalg.norm(e))  # (d, d - 1), orthonormal
+    rows, cols, vals, col = [], [], [], 0
+    for i in range(len(g.mass)):
+        basis = across.get(i, np.eye(d))
+        for c in range(basis.shape[1]):
+            rows += [i * d + p for p in range(d)]
+            cols += [col] * d
+            vals += list(basis[:, c])
+            col += 1
+    return coo_matrix((vals, (rows, cols)), shape=(len(g.mass) * d, col)).tocsr()
+
+
+def drive_loads(g, d: int) -> np.ndarray:
+    """(ng, d) the force drives' pushes on their granules at t = 0 [N], P(0) e: the static
+    state's loads (zero where a profile starts at 0: a half-sine, a chirp, a harmonic without
+    a mean)."""
+    from granplate.physics.drives import KIND_FORCE, profile_terms
+
+    load = np.zeros((len(g.mass), d))
+    for k, i in enumerate(g.drive_target):
+        if i >= 0 and g.drive_kind[k] == KIND_FORCE:
+            p0 = profile_terms(0.0, g.drive_prof[k], g.drive_par[k], g.drive_tab[k], g.drive_tlen[k])[1]
+            load[i] += float(p0) * np.asarray(g.drive_dir[k], float)
+    return load
+
+
 def unsupported_granules(g, wall: int, gravity: bool) -> tuple[np.ndarray, np.ndarray]:
     """The granules the static state cannot hold, by the contact lists' graph (pairs, wall and
     plate contacts within the lists' reach): (those in a group of granules touching the target
-    wall but no other wall, the plate or a held granule: the force has no path to a support;
-    under gravity, those in a group touching no wall, plate or held granule: they would fall)."""
+    wall but no other wall, the plate or a held granule (a displacement or velocity drive's):
+    the force has no path to a support; under gravity, those in a group touching no wall,
+    plate or held granule: they would fall). A granule held along one direction counts as a
+    support (the graph does not see directions: a load it cannot carry stops the minimiser)."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
@@ -213,7 +274,7 @@ def unsupported_granules(g, wall: int, gravity: bool) -> tuple[np.ndarray, np.nd
     _, label = connected_components(adj, directed=False)
     support = np.zeros(n, bool)
     support[g.wall_i[g.wall_w != wall]] = True
-    support[g.drive_target[g.drive_target >= 0]] = True
+    support[prescribed_granules(g)] = True
     support[np.asarray(getattr(g, "pc_i", np.zeros(0, np.int64)), np.int64)] = True  # the plate is clamped
     pushed = np.zeros(n, bool)
     pushed[g.wall_i[g.wall_w == wall]] = True
@@ -266,39 +327,39 @@ def static_state(
     (`unsupported_granules`); SimulationError with the residual reached (its `result` the
     StaticState) when it does not converge."""
     from scipy.optimize import minimize
-    from scipy.sparse import identity
+    from scipy.sparse import block_diag, identity
     from scipy.sparse.linalg import spsolve
 
     d = x0.shape[1]
     _refuse_unsupported(g, wall, target)
     nk = len(getattr(g, "pc_i", ()))
     kc = plate.stiffness if plate is not None and nk else np.zeros((nk, nk))
-    held = np.zeros(len(g.mass), bool)
-    held[g.drive_target[g.drive_target >= 0]] = True
-    free = ~held
-    nf = int(free.sum()) * d
+    basis = granule_freedom(g, d)  # the granules' free coordinates
+    nf = basis.shape[1]
+    load = drive_loads(g, d)
     a_min = float(np.min(g.wall_coef[g.wall_w == wall, COEF_A])) if np.any(g.wall_w == wall) else 1.0
     scale = (force / a_min) ** (2.0 / 3.0)  # the overlap F makes at the wall [m]: the unknowns' unit
 
     def unpack(z):
-        x = x0.copy()
-        x[free] += z[:nf].reshape(-1, d) * scale
+        x = x0 + (basis @ z[:nf]).reshape(-1, d) * scale
         return x, offset0 + z[-1] * scale, z[nf : nf + nk] * scale
 
     def forces(z):
         x, o, u = unpack(z)
-        return energy_and_forces(x, o, g, wall, force, u, kc)
+        e, net, on_wall, on_plate = energy_and_forces(x, o, g, wall, force, u, kc, load)
+        return e, basis.T @ net.ravel(), on_wall, on_plate  # the net force along the free coordinates
 
     def fun(z):
         e, net, on_wall, on_plate = forces(z)
-        grad = np.concatenate([-net[free].ravel(), -on_plate, [-on_wall]]) * scale
+        grad = np.concatenate([-net, -on_plate, [-on_wall]]) * scale
         return e / (force * scale), grad / (force * scale)
 
     def residual(z):
         _, net, on_wall, on_plate = forces(z)
-        worst = max(float(np.max(np.abs(net[free]), initial=0.0)), float(np.max(np.abs(on_plate), initial=0.0)))
+        worst = max(float(np.max(np.abs(net), initial=0.0)), float(np.max(np.abs(on_plate), initial=0.0)))
         return max(worst, abs(on_wall)) / force
 
+    project = block_diag([basis.T, identity(nk + 1)], format="csr")  # onto the free unknowns
     z = np.zeros(nf + nk + 1)
     res = minimize(fun, z, jac=True, method="L-BFGS-B", options={"maxiter": max_iterations, "gtol": 1e-14, "ftol": 0.0})
     z, steps = res.x, int(res.nit)
@@ -307,8 +368,8 @@ def static_state(
             break
         x, o, u = unpack(z)
         _, net, on_wall, on_plate = forces(z)
-        h = _normal_stiffness(x, o, g, wall, free, u, kc) * scale
-        rhs = np.concatenate([net[free].ravel(), on_plate, [on_wall]])
+        h = project @ _normal_stiffness(x, o, g, wall, u, kc) @ project.T * scale
+        rhs = np.concatenate([net, on_plate, [on_wall]])
         dz = spsolve(h + identity(h.shape[0], format="csc") * (1e-12 * float(abs(h).max())), rhs)
         r0, t = residual(z), 1.0
         while t > 1e-6 and residual(z + t * dz) >= r0:
