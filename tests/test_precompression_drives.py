@@ -53,14 +53,16 @@ scheme = "verlet"
 
 def column(count: int, drives: str, mode: str = "held", g: float = -G, floor: bool = True) -> gp.Scenario:
     """`count` steel beads b0, b1, ... standing on the floor along z, pressed by F0 from the top
-    wall, with the [[drives]] text `drives`."""
+    wall, with the [[drives]] text `drives`; g = 0: without gravity; floor False: without
+    the floor."""
     beads = "".join(
         f'[[granules]]\nlabel = "b{k}"\nx = 0.0\ny = 0.0\nz = {R + 2 * R * k!r}\nradius = {R}\nmaterial = "steel"\n'
         for k in range(count)
     )
     text = HEAD.format(g=g, top=2 * R * count, force=F0, mode=mode) + beads + drives
-    if not floor:  # no floor, no gravity
+    if not floor:
         text = text.replace('[[walls]]\nlabel = "floor"\nnormal = [0.0, 0.0, -1.0]\noffset = 0.0\n', "")
+    if not floor or g == 0.0:
         text = text.replace(f"[gravity]\ng = [0.0, 0.0, {g!r}]\n", "")
     return gp.loads(text)
 
@@ -158,4 +160,53 @@ def test_a_force_driven_bead_is_no_support():
     s = column(2, drive("granule b0", "force", (0, 0, 1), "constant", value=1.0), floor=False)
     with pytest.raises(ScenarioError) as e:
         build_model(s)
+    assert e.value.field == "precompression.target"
+
+
+SIDE = """
+[[walls]]
+label = "left"
+normal = [0.0, -1.0, 0.0]
+offset = {r!r}
+[[walls]]
+label = "right"
+normal = [0.0, 1.0, 0.0]
+offset = {r!r}
+[[drives]]
+target = "wall left"
+kind = "force"
+direction = [0.0, 1.0, 0.0]
+profile = "constant"
+value = {push!r}
+mass = 0.01
+"""
+
+
+def test_a_force_driven_wall_rests_where_its_force_at_t0_is_carried():
+    """One bead on the floor under the top wall's F0, squeezed sideways by a piston (a
+    force-driven wall pushing with 2 N) against a fixed wall: at rest the fixed side wall
+    carries the piston's 2 N, the bead sits (2 N / A_w)^(2/3) towards it, the piston 2 (2 N /
+    A_w)^(2/3) in from where it started (both overlaps), the floor carries F0; the run starts
+    there and nothing moves (the piston's displacement stays below 1e-12 m)."""
+    push = 2.0
+    s = column(1, SIDE.format(r=R, push=push), g=0.0)
+    model = build_model(s)
+    g = model.granular
+    _, (floor, top, left, right) = static_forces(model)
+    a_w = float(g.wall_coef[0, COEF_A])
+    side = (push / a_w) ** (2 / 3)
+    assert (floor, top) == (pytest.approx(F0, rel=1e-8), pytest.approx(F0, rel=1e-8))
+    assert (left, right) == (pytest.approx(push, rel=1e-8), pytest.approx(push, rel=1e-8))
+    assert model.initial_state[0, 1] == pytest.approx(side, rel=1e-8)
+    assert float(g.wall_geo[g.wall_w == 2, 3][0]) == pytest.approx(R - 2 * side, rel=1e-8)
+    ds = gp.simulate(s, progress=False)
+    assert np.max(np.abs(ds.drive_displacement.sel(drive="wall left").values)) <= 1e-12
+
+
+def test_a_column_between_the_target_and_a_piston_has_no_support():
+    """The floor made a piston (a force drive pushing up with F0): the column has no fixed
+    support, refused naming precompression.target."""
+    floor = drive("wall floor", "force", (0, 0, 1), "constant", value=F0, mass=0.01)
+    with pytest.raises(ScenarioError) as e:
+        build_model(column(2, floor, g=0.0))
     assert e.value.field == "precompression.target"

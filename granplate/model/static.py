@@ -51,7 +51,9 @@ class StaticState(NamedTuple):
     net force on a granule, the wall or the plate over F [-]; iterations: the minimiser's and
     Newton's steps; wall_force: the force the wall's contacts carry [N] (F to the residual);
     plate_u: (nk,) the plate's normal displacement at each plate contact [m] and plate_force:
-    (nk,) the normal force each contact puts on the plate [N] (empty without a plate)."""
+    (nk,) the normal force each contact puts on the plate [N] (empty without a plate);
+    pistons: the force-driven walls held as servos (`static_pistons`) and piston_offsets (np,)
+    their offsets at rest [m]."""
 
     positions: np.ndarray
     offset: float
@@ -61,6 +63,8 @@ class StaticState(NamedTuple):
     wall_force: float
     plate_u: np.ndarray = np.zeros(0)
     plate_force: np.ndarray = np.zeros(0)
+    pistons: Pistons | None = None
+    piston_offsets: np.ndarray = np.zeros(0)
 
 
 class PlateStatics(NamedTuple):
@@ -94,9 +98,10 @@ def plate_statics(p) -> PlateStatics:
     return PlateStatics(compliance=c, stiffness=np.linalg.inv(cn) if cn.shape[0] else np.zeros((0, 0)))
 
 
-def contact_terms(x: np.ndarray, o: float, g, wall: int):
+def contact_terms(x: np.ndarray, o, g, wall):
     """Overlaps, forces, slopes and normals of every listed pair and wall contact at centres x
-    and target-wall offset o: (pairs: i, j, delta, f, k, n) and (walls: i, delta, f, k, n,
+    and the servo walls' offsets o (a wall index `wall` and its offset, or arrays of them, the
+    target's first; -1: none): (pairs: i, j, delta, f, k, n) and (walls: i, delta, f, k, n,
     on_target)."""
     r = g.radius
     i, j = g.pair_ij[:, 0], g.pair_ij[:, 1]
@@ -109,11 +114,14 @@ def contact_terms(x: np.ndarray, o: float, g, wall: int):
     d_ = x.shape[1]
     wi = g.wall_i
     wn = g.wall_geo[:, :d_]
-    off = np.where(g.wall_w == wall, o, g.wall_geo[:, d_])
+    walls = np.atleast_1d(np.asarray(wall, np.int64))
+    off = g.wall_geo[:, d_].copy()
+    for w, v in zip(walls, np.broadcast_to(np.asarray(o, float), walls.shape)):
+        off[g.wall_w == w] = v
     wdelta = np.maximum(r[wi] + np.einsum("kd,kd->k", x[wi], wn) - off, 0.0)
     wa = g.wall_coef[:, COEF_A]
     wf, wk = wa * wdelta**1.5, 1.5 * wa * np.sqrt(wdelta)
-    return (i, j, delta, f, k, n, a), (wi, wdelta, wf, wk, wn, g.wall_w == wall, wa)
+    return (i, j, delta, f, k, n, a), (wi, wdelta, wf, wk, wn, g.wall_w == walls[0], wa)
 
 
 def plate_terms(x: np.ndarray, u: np.ndarray, g):
@@ -128,17 +136,21 @@ def plate_terms(x: np.ndarray, u: np.ndarray, g):
     return pi, pdelta, pa * pdelta**1.5, 1.5 * pa * np.sqrt(pdelta), pa
 
 
-def energy_and_forces(x: np.ndarray, o: float, g, wall: int, force: float, u=None, kc=None, load=None):
-    """(Pi [J] of (S1), the net force on every granule (ng, d) [N], the net force on the wall
-    along its inward normal [N], the net force on each plate contact's normal dof (nk,) [N])
-    at centres x, offset o and plate displacements u (kc: the plate's condensed stiffness
-    K_c; load: (ng, d) constant forces on the granules [N], the force drives' `drive_loads`):
-    minus the gradient of Pi."""
+def energy_and_forces(x: np.ndarray, o, g, wall, force, u=None, kc=None, load=None):
+    """(Pi [J] of (S1), the net force on every granule (ng, d) [N], the net force on each servo
+    wall along its inward normal (nw,) [N], the net force on each plate contact's normal dof
+    (nk,) [N]) at centres x, the servo walls' (`wall`, an index or (nw,) indices, the target's
+    first) offsets o pushed in by `force` (scalars or (nw,) [m], [N]), plate displacements u
+    (kc: the plate's condensed stiffness K_c) and load: (ng, d) constant forces on the granules
+    [N] (the force drives' `drive_loads`): minus the gradient of Pi."""
     (i, j, delta, f, _, n, a), (wi, wdelta, wf, _, wn, on, wa) = contact_terms(x, o, g, wall)
     pi, pdelta, pf, _, pa = plate_terms(x, np.zeros(0) if u is None else u, g)
     mass = g.mass
     grav = np.asarray(g.gravity, float) if len(g.gravity) else np.zeros(x.shape[1])
-    e = 0.4 * (np.sum(a * delta**2.5) + np.sum(wa * wdelta**2.5)) - float(np.sum(mass[:, None] * x * grav)) + force * o
+    walls = np.atleast_1d(np.asarray(wall, np.int64))
+    push = np.broadcast_to(np.asarray(force, float), walls.shape)
+    e = 0.4 * (np.sum(a * delta**2.5) + np.sum(wa * wdelta**2.5)) - float(np.sum(mass[:, None] * x * grav))
+    e += float(np.sum(push * np.broadcast_to(np.asarray(o, float), walls.shape)))  # the servos' work
     on_plate = np.zeros(0)
     if len(pi):
         ku = kc @ u
@@ -153,24 +165,25 @@ def energy_and_forces(x: np.ndarray, o: float, g, wall: int, force: float, u=Non
     if load is not None:
         e -= float(np.sum(load * x))
         net += load
-    on_wall = float(np.sum(wf[on])) - force  # the contacts push the wall out, the servo in
+    on_wall = np.array([np.sum(wf[g.wall_w == w]) for w in walls]) - push  # the contacts push out, the servo in
     return e, net, on_wall, on_plate
 
 
-def _normal_stiffness(x: np.ndarray, o: float, g, wall: int, u=None, kc=None):
+def _normal_stiffness(x: np.ndarray, o, g, wall, u=None, kc=None):
     """The contacts' normal stiffness over every granule's coordinates, the plate contacts'
-    normal displacements and the wall's offset (the last unknown), as a sparse matrix: 3/2 A
-    delta^(1/2) n n^T blocks and the plate's K_c (S1's Hessian without the transverse
-    geometric terms)."""
+    normal displacements and the servo walls' offsets (the last unknowns, in `wall`'s order),
+    as a sparse matrix: 3/2 A delta^(1/2) n n^T blocks and the plate's K_c (S1's Hessian
+    without the transverse geometric terms)."""
     from scipy.sparse import coo_matrix
 
-    (i, j, _, _, k, n, _), (wi, _, _, wk, wn, on, _) = contact_terms(x, o, g, wall)
+    (i, j, _, _, k, n, _), (wi, _, _, wk, wn, _, _) = contact_terms(x, o, g, wall)
     pi, _, _, pk, _ = plate_terms(x, np.zeros(0) if u is None else u, g)
+    walls = np.atleast_1d(np.asarray(wall, np.int64))
     d = x.shape[1]
     nk = len(pi)
     index = np.arange(len(g.mass))
-    first_u = len(g.mass) * d  # the plate's unknowns follow the granules'
-    size = first_u + nk + 1
+    first_u = len(g.mass) * d  # the plate's unknowns follow the granules', the walls' theirs
+    size = first_u + nk + len(walls)
     rows, cols, vals = [], [], []
 
     def block(a, b, kk, nn, sign):
@@ -188,15 +201,17 @@ def _normal_stiffness(x: np.ndarray, o: float, g, wall: int, u=None, kc=None):
     block(jj, ii, k, n, -1.0)
     wii = index[wi]
     block(wii, wii, wk, wn, 1.0)
-    last = size - 1
-    sel = on & (wii >= 0) & (wk > 0.0)
-    for p in range(d):  # d delta / d x = n, d delta / d o = -1
-        rows += [wii[sel] * d + p, np.full(sel.sum(), last)]
-        cols += [np.full(sel.sum(), last), wii[sel] * d + p]
-        vals += [-wk[sel] * wn[sel, p], -wk[sel] * wn[sel, p]]
-    rows.append(np.array([last]))
-    cols.append(np.array([last]))
-    vals.append(np.array([float(np.sum(wk[on]))]))
+    for c, w in enumerate(walls):
+        last = first_u + nk + c
+        on = g.wall_w == w
+        sel = on & (wii >= 0) & (wk > 0.0)
+        for p in range(d):  # d delta / d x = n, d delta / d o = -1
+            rows += [wii[sel] * d + p, np.full(sel.sum(), last)]
+            cols += [np.full(sel.sum(), last), wii[sel] * d + p]
+            vals += [-wk[sel] * wn[sel, p], -wk[sel] * wn[sel, p]]
+        rows.append(np.array([last]))
+        cols.append(np.array([last]))
+        vals.append(np.array([float(np.sum(wk[on]))]))
     if nk:  # d delta / d x_i = e_x, d delta / d u_k = -1; the plate's K_c
         ku = first_u + np.arange(nk)
         pii = index[pi]
@@ -258,13 +273,45 @@ def drive_loads(g, d: int) -> np.ndarray:
     return load
 
 
-def unsupported_granules(g, wall: int, gravity: bool) -> tuple[np.ndarray, np.ndarray]:
+class Pistons(NamedTuple):
+    """The force-driven walls in the static state (docs/model.md section 3.12): walls (np,)
+    their indices in the scenario; force (np,) their drives' push into the assembly at t = 0,
+    -P(0) e . n [N]; offset0 (np,) their offsets along their unit normals n [m]."""
+
+    walls: np.ndarray
+    force: np.ndarray
+    offset0: np.ndarray
+
+
+def static_pistons(g, wall: int) -> Pistons:
+    """The force-driven walls of the granular arrays g other than the target `wall`, with
+    contact rows (a piston out of the lists' reach touches nothing at rest): each a servo in the
+    static state pushing with its drive's value at t = 0."""
+    from granplate.physics.drives import KIND_FORCE, profile_terms
+
+    d = g.wall_geo.shape[1] - 1
+    walls, force, offset0 = [], [], []
+    for k, t in enumerate(g.drive_target):
+        w = -1 - int(t)
+        rows = np.flatnonzero(g.wall_w == w)
+        if t >= 0 or g.drive_kind[k] != KIND_FORCE or w == wall or not len(rows):
+            continue
+        p0 = float(profile_terms(0.0, g.drive_prof[k], g.drive_par[k], g.drive_tab[k], g.drive_tlen[k])[1])
+        n = g.wall_geo[rows[0], :d]
+        walls.append(w)
+        force.append(-p0 * float(np.asarray(g.drive_dir[k], float) @ n))
+        offset0.append(float(g.wall_geo[rows[0], d]))
+    return Pistons(np.array(walls, np.int64), np.array(force, float), np.array(offset0, float))
+
+
+def unsupported_granules(g, wall: int, gravity: bool, pistons: Pistons | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The granules the static state cannot hold, by the contact lists' graph (pairs, wall and
     plate contacts within the lists' reach): (those in a group of granules touching the target
-    wall but no other wall, the plate or a held granule (a displacement or velocity drive's):
-    the force has no path to a support; under gravity, those in a group touching no wall,
-    plate or held granule: they would fall). A granule held along one direction counts as a
-    support (the graph does not see directions: a load it cannot carry stops the minimiser)."""
+    wall or a piston pushing at t = 0 but no support (another wall, the plate or a held
+    granule, a displacement or velocity drive's): the force has no path to a support; under
+    gravity, those in a group touching no support or pushing wall: they would fall). Pistons
+    (`static_pistons`) are no supports. A granule held along one direction counts as a support
+    (the graph does not see directions: a load it cannot carry stops the minimiser)."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
@@ -272,12 +319,14 @@ def unsupported_granules(g, wall: int, gravity: bool) -> tuple[np.ndarray, np.nd
     i, j = g.pair_ij[:, 0], g.pair_ij[:, 1]
     adj = coo_matrix((np.ones(len(i)), (i, j)), shape=(n, n))
     _, label = connected_components(adj, directed=False)
+    servo = np.append(np.asarray([] if pistons is None else pistons.walls, np.int64), wall)
+    pushing = np.append(np.asarray([] if pistons is None else pistons.walls[pistons.force != 0.0], np.int64), wall)
     support = np.zeros(n, bool)
-    support[g.wall_i[g.wall_w != wall]] = True
+    support[g.wall_i[~np.isin(g.wall_w, servo)]] = True
     support[prescribed_granules(g)] = True
     support[np.asarray(getattr(g, "pc_i", np.zeros(0, np.int64)), np.int64)] = True  # the plate is clamped
     pushed = np.zeros(n, bool)
-    pushed[g.wall_i[g.wall_w == wall]] = True
+    pushed[g.wall_i[np.isin(g.wall_w, pushing)]] = True
     held_groups = np.unique(label[support])
     free_group = ~np.isin(label, held_groups)
     no_path = free_group & np.isin(label, np.unique(label[pushed]))
@@ -285,17 +334,19 @@ def unsupported_granules(g, wall: int, gravity: bool) -> tuple[np.ndarray, np.nd
     return np.flatnonzero(no_path), np.flatnonzero(falling)
 
 
-def _refuse_unsupported(g, wall: int, target: str) -> None:
+def _refuse_unsupported(g, wall: int, target: str, pistons: Pistons) -> None:
     """ScenarioError naming precompression.target or gravity.g for the granules
     `unsupported_granules` finds."""
-    no_path, falling = unsupported_granules(g, wall, bool(len(g.gravity)) and bool(np.any(g.gravity != 0.0)))
+    heavy = bool(len(g.gravity)) and bool(np.any(g.gravity != 0.0))
+    no_path, falling = unsupported_granules(g, wall, heavy, pistons)
     if len(no_path):
+        also = " (or a force-driven wall's, pushing at t = 0)" if len(pistons.walls) else ""
         raise ScenarioError(
             "precompression.target",
             target or f"wall {wall}",
-            f"its force has no path to a support: granules {', '.join(str(k + 1) for k in no_path[:5])} "
-            "touch it but, through their contacts, no other wall, the plate or a held granule (close the "
-            "packing against a wall opposite it)",
+            f"its force{also} has no path to a support: granules {', '.join(str(k + 1) for k in no_path[:5])} "
+            "touch it but, through their contacts, no fixed or displacement-driven wall, the plate or a held "
+            "granule (close the packing against a wall opposite it)",
         )
     if len(falling):
         raise ScenarioError(
@@ -322,7 +373,8 @@ def static_state(
     offset0 [m] along its unit normal) pushed in with `force` [N], the plate (when g has plate
     contacts) condensed to its contacts by `plate` (`plate_statics`); converged when the
     largest net force on a granule, the wall or a plate contact is at most tolerance x force.
-    ScenarioError naming the field (`target`, the precompression's, or gravity.g) before
+    The force-driven walls (`static_pistons`) are servos too, pushing with their drives' values
+    at t = 0 (`StaticState.pistons`, `piston_offsets`). ScenarioError naming the field (`target`, the precompression's, or gravity.g) before
     minimising when the contacts give the force no path to a support or granules would fall
     (`unsupported_granules`); SimulationError with the residual reached (its `result` the
     StaticState) when it does not converge."""
@@ -331,7 +383,12 @@ def static_state(
     from scipy.sparse.linalg import spsolve
 
     d = x0.shape[1]
-    _refuse_unsupported(g, wall, target)
+    pistons = static_pistons(g, wall)
+    _refuse_unsupported(g, wall, target, pistons)
+    walls = np.append(wall, pistons.walls)  # the servo walls, the target's first
+    push = np.append(force, pistons.force)
+    offsets0 = np.append(offset0, pistons.offset0)
+    nw = len(walls)
     nk = len(getattr(g, "pc_i", ()))
     kc = plate.stiffness if plate is not None and nk else np.zeros((nk, nk))
     basis = granule_freedom(g, d)  # the granules' free coordinates
@@ -342,25 +399,25 @@ def static_state(
 
     def unpack(z):
         x = x0 + (basis @ z[:nf]).reshape(-1, d) * scale
-        return x, offset0 + z[-1] * scale, z[nf : nf + nk] * scale
+        return x, offsets0 + z[nf + nk :] * scale, z[nf : nf + nk] * scale
 
     def forces(z):
         x, o, u = unpack(z)
-        e, net, on_wall, on_plate = energy_and_forces(x, o, g, wall, force, u, kc, load)
+        e, net, on_wall, on_plate = energy_and_forces(x, o, g, walls, push, u, kc, load)
         return e, basis.T @ net.ravel(), on_wall, on_plate  # the net force along the free coordinates
 
     def fun(z):
         e, net, on_wall, on_plate = forces(z)
-        grad = np.concatenate([-net, -on_plate, [-on_wall]]) * scale
+        grad = np.concatenate([-net, -on_plate, -on_wall]) * scale
         return e / (force * scale), grad / (force * scale)
 
     def residual(z):
         _, net, on_wall, on_plate = forces(z)
         worst = max(float(np.max(np.abs(net), initial=0.0)), float(np.max(np.abs(on_plate), initial=0.0)))
-        return max(worst, abs(on_wall)) / force
+        return max(worst, float(np.max(np.abs(on_wall)))) / force
 
-    project = block_diag([basis.T, identity(nk + 1)], format="csr")  # onto the free unknowns
-    z = np.zeros(nf + nk + 1)
+    project = block_diag([basis.T, identity(nk + nw)], format="csr")  # onto the free unknowns
+    z = np.zeros(nf + nk + nw)
     res = minimize(fun, z, jac=True, method="L-BFGS-B", options={"maxiter": max_iterations, "gtol": 1e-14, "ftol": 0.0})
     z, steps = res.x, int(res.nit)
     for _ in range(50):  # Newton on the normal stiffness, with a halving line search
@@ -368,8 +425,8 @@ def static_state(
             break
         x, o, u = unpack(z)
         _, net, on_wall, on_plate = forces(z)
-        h = project @ _normal_stiffness(x, o, g, wall, u, kc) @ project.T * scale
-        rhs = np.concatenate([net, on_plate, [on_wall]])
+        h = project @ _normal_stiffness(x, o, g, walls, u, kc) @ project.T * scale
+        rhs = np.concatenate([net, on_plate, on_wall])
         dz = spsolve(h + identity(h.shape[0], format="csc") * (1e-12 * float(abs(h).max())), rhs)
         r0, t = residual(z), 1.0
         while t > 1e-6 and residual(z + t * dz) >= r0:
@@ -379,7 +436,9 @@ def static_state(
     x, o, u = unpack(z)
     _, net, on_wall, _ = forces(z)
     pf = plate_terms(x, u, g)[2]
-    state = StaticState(x, float(o), float(offset0), residual(z), steps, float(on_wall + force), u, pf)
+    state = StaticState(
+        x, float(o[0]), float(offset0), residual(z), steps, float(on_wall[0] + force), u, pf, pistons, o[1:]
+    )
     if state.residual > tolerance:
         raise SimulationError(
             f"precompression: no static equilibrium to a residual of {tolerance:g} x force after {steps} steps "
@@ -432,6 +491,9 @@ def precompressed(model):
     geo[rows, d] = st.offset
     walls = list(model.scenario.walls)
     walls[wall] = dataclasses.replace(walls[wall], offset=st.offset)
+    for w, o in zip(st.pistons.walls if st.pistons is not None else (), st.piston_offsets):
+        geo[g.wall_w == w, d] = o  # a force-driven wall starts at rest where its drive's P(0) holds it
+        walls[w] = dataclasses.replace(walls[w], offset=float(o))
     g = g._replace(wall_geo=geo)
     if p.mode == "held":
         g = held_wall(g, model.scenario, wall, float(p.force), float(p.mass))
