@@ -10,18 +10,32 @@ import json
 from granplate.figures.cli import add_set_option
 
 
-def granule_fraction(modes):
-    """Each mode's share of its kinetic energy in the granules [-] (the rest in the plate):
-    sum m u^2 of its M-orthonormal shape, 1 - |q|^2."""
+def piston_fraction(modes):
+    """Each mode's share of its kinetic energy in the pistons [-]: sum M s^2 of its
+    M-orthonormal shape (zeros without a piston)."""
     import numpy as np
 
-    return 1.0 - np.sum(modes.plate**2, axis=1)
+    if not modes.pistons.shape[1]:
+        return np.zeros(len(modes.frequencies))
+    return np.sum(modes.piston_mass[None, :] * modes.pistons**2, axis=1)
 
 
-def modes_record(modes) -> dict:
+def granule_fraction(modes):
+    """Each mode's share of its kinetic energy in the granules [-] (the rest in the plate and
+    the pistons): sum m u^2 of its M-orthonormal shape, 1 - |q|^2 - sum M s^2."""
+    import numpy as np
+
+    plate = np.sum(modes.plate**2, axis=1) if modes.plate.shape[1] else 0.0
+    return 1.0 - plate - piston_fraction(modes)
+
+
+def modes_record(modes, wall_labels=()) -> dict:
     """The JSON of a Modes: frequencies [Hz], zero_modes, contacts; coupled to the plane's
     plate also plate_modes (the plate's modal coordinates) and granule_fraction (each mode's
-    share of kinetic energy in the granules)."""
+    share of kinetic energy in the granules); with pistons (force-driven or held walls, each a
+    degree of freedom) `pistons` (each one's wall, by its label in `wall_labels` where given,
+    and mass [kg]), piston_fraction (each mode's share of kinetic energy in them) and
+    granule_fraction."""
     record = {
         "frequencies": [float(f) for f in modes.frequencies],
         "zero_modes": modes.zero_modes,
@@ -30,6 +44,16 @@ def modes_record(modes) -> dict:
     }
     if modes.plate.shape[1]:
         record["plate_modes"] = int(modes.plate.shape[1])
+    if modes.pistons.shape[1]:
+        labels = list(wall_labels)
+        record["pistons"] = [
+            {"wall": labels[w] if w < len(labels) else int(w), "mass": float(m)}
+            for w, m in zip(modes.piston_walls, modes.piston_mass)
+        ]
+        record["piston_fraction"] = [float(v) for v in piston_fraction(modes)]
+        record["units"]["piston_fraction"] = "-"
+        record["units"]["pistons.mass"] = "kg"
+    if modes.plate.shape[1] or modes.pistons.shape[1]:
         record["granule_fraction"] = [float(v) for v in granule_fraction(modes)]
         record["units"]["granule_fraction"] = "-"
     return record
@@ -41,17 +65,21 @@ def _cmd_modes(args) -> int:
     from granplate.setup.io import load_scenario, parse_settings
 
     s = load_scenario(args.scenario, parse_settings(args.settings))
-    modes = linear_modes(build_model(s), args.count)
+    model = build_model(s)
+    modes = linear_modes(model, args.count)
     nonzero = modes.frequencies[modes.frequencies > 0.0]
     print(
         f"{s.name}: {len(modes.frequencies)} modes, {modes.zero_modes} without stiffness (free directions), "
         f"{modes.contacts} contacts in touch"
     )
-    if modes.plate.shape[1]:
+    labels = [w.label or str(k + 1) for k, w in enumerate(model.scenario.walls)]  # the resolved walls
+    if modes.pistons.shape[1]:
+        named = ", ".join(f"wall {labels[w]} ({m:.4g} kg)" for w, m in zip(modes.piston_walls, modes.piston_mass))
+        print(f"pistons moving with the granules: {named}")
+    if modes.plate.shape[1] or modes.pistons.shape[1]:
         share = granule_fraction(modes)[modes.frequencies > 0.0]
-        print(
-            f"coupled to the plate's {modes.plate.shape[1]} modes; the granules' share of each mode's kinetic energy:"
-        )
+        where = f"coupled to the plate's {modes.plate.shape[1]} modes; " if modes.plate.shape[1] else ""
+        print(f"{where}the granules' share of each mode's kinetic energy:")
         for k, (f, e) in enumerate(zip(nonzero, share)):
             print(f"{k + 1:6d} {f:14.6g} Hz {e:10.3g}")
     else:
@@ -59,7 +87,7 @@ def _cmd_modes(args) -> int:
             print(f"{k + 1:6d} {f:14.6g} Hz")
     if args.json:
         with open(args.json, "w", encoding="utf-8") as fh:
-            json.dump(modes_record(modes), fh, indent=1)
+            json.dump(modes_record(modes, labels), fh, indent=1)
         print(f"written {args.json}")
     if args.figure:
         from granplate.figures.modes import draw_modes

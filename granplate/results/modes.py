@@ -33,6 +33,15 @@ basis' residual compliance, massless): its spring k_c in series with R_n, conden
 (K_s = diag(k_c) at the static overlaps, the plate deflected at rest; with every mode kept
 R_n = 0 and the plate is its finite-element model exactly). Solved densely (`eigh`; beyond
 DENSE_MAX unknowns the lowest `count`, 50 by default, by `subset_by_index`).
+
+A piston (a force-driven wall, or the held precompression wall; `pistons_of`) is one more
+unknown, its displacement s along its drive's direction e, of mass M: a contact of granule i on
+its wall (normal n, stiffness k_c) changes its overlap by n . u_i + c s, c = -n . e,
+
+    K[i, i] += k_c n n^T,   K[i, s] = K[s, i]^T += k_c c n,   K[s, s] += k_c c^2          (M3)
+
+(`with_pistons`); its share of a mode is `Modes.pistons`. Walls under displacement or velocity
+drives, and frozen ones, are fixed.
 """
 
 from __future__ import annotations
@@ -53,13 +62,75 @@ class Modes(NamedTuple):
     """frequencies: (n,) [Hz], ascending, zero modes included (as 0); shapes: (n, ng, d) the
     M-orthonormal mode shapes [kg^-1/2]; zero_modes: how many have no stiffness;
     contacts: the contacts in touch that give K (the plate's included); plate: (n, nm) the
-    plate's modal coordinates q of each M-orthonormal mode [-] ((0, 0) without a plate)."""
+    plate's modal coordinates q of each M-orthonormal mode [-] ((0, 0) without a plate);
+    pistons: (n, np) each piston's displacement along its drive's direction in each
+    M-orthonormal mode [kg^-1/2] ((0, 0) without one); piston_walls: (np,) their walls'
+    indices in the scenario; piston_mass: (np,) their masses [kg]."""
 
     frequencies: np.ndarray
     shapes: np.ndarray
     zero_modes: int
     contacts: int
     plate: np.ndarray = np.zeros((0, 0))
+    pistons: np.ndarray = np.zeros((0, 0))
+    piston_walls: np.ndarray = np.zeros(0, np.int64)
+    piston_mass: np.ndarray = np.zeros(0)
+
+
+class Pistons(NamedTuple):
+    """The pistons of the granular arrays (force-driven walls, the held precompression wall's
+    included, model.drives `with_piston`): walls (np,) their indices in the scenario; mass (np,)
+    [kg]; direction (np, d) the unit direction e their drive pushes along."""
+
+    walls: np.ndarray
+    mass: np.ndarray
+    direction: np.ndarray
+
+
+def pistons_of(g) -> Pistons:
+    """The pistons of the granular arrays g: every force drive on a wall (its mass PAR_MASS)."""
+    from granplate.physics.drives import KIND_FORCE, PAR_MASS
+
+    k = np.flatnonzero((g.drive_target < 0) & (g.drive_kind == KIND_FORCE))
+    d = g.wall_geo.shape[1] - 1
+    return Pistons(
+        (-1 - g.drive_target[k]).astype(np.int64),
+        np.asarray(g.drive_par[k, PAR_MASS], float),
+        np.asarray(g.drive_dir, float).reshape(-1, d)[k],
+    )
+
+
+def with_pistons(g, x: np.ndarray, k_granules, pistons: Pistons):
+    """K of (M1) over the granules' centres x (ng, d) [m] with each piston's displacement s
+    along its direction e as one more unknown (M3): a contact of granule i on the piston's
+    wall, of normal n and stiffness k_c, has the overlap's change n . u_i + c s, c = -n . e, and
+    adds k_c c n to the (i, s) block and k_c c^2 to (s, s). A sparse (ng d + np, ng d + np)
+    matrix [N/m]."""
+    from scipy.sparse import bmat, coo_matrix
+
+    from granplate.model.static import contact_terms
+
+    d = x.shape[1]
+    size, npist = len(g.mass) * d, len(pistons.walls)
+    _, (wi, _, _, wk, wn, _, _) = contact_terms(x, 0.0, g, -1)
+    rows, cols, vals = [], [], []
+    diag = np.zeros(npist)
+    for p, (w, e) in enumerate(zip(pistons.walls, pistons.direction)):
+        on = g.wall_w == w
+        c = -wn[on] @ e
+        for q in range(d):
+            rows.append(wi[on] * d + q)
+            cols.append(np.full(int(on.sum()), p))
+            vals.append(wk[on] * c * wn[on, q])
+        diag[p] = float(np.sum(wk[on] * c * c))
+    coupling = coo_matrix(
+        (
+            np.concatenate(vals or [np.zeros(0)]),
+            (np.concatenate(rows or [np.zeros(0, int)]), np.concatenate(cols or [np.zeros(0, int)])),
+        ),
+        shape=(size, npist),
+    )
+    return bmat([[k_granules, coupling], [coupling.T, coo_matrix(np.diag(diag))]]).tocsr()
 
 
 def stiffness_matrix(g, x: np.ndarray):
@@ -98,9 +169,11 @@ def linear_modes(model, count: int | None = None) -> Modes:
     d = g.wall_geo.shape[1] - 1
     x = np.ascontiguousarray(model.initial_state[:, :d])
     K, touching = stiffness_matrix(g, x)
+    pistons = pistons_of(g)
+    K = with_pistons(g, x, K, pistons)
+    m = np.concatenate([np.repeat(g.mass, d), pistons.mass])
     if getattr(model, "plate", None) is not None and len(model.plate_arrays.omega2):
-        return coupled_modes(model, K, touching, count)
-    m = np.repeat(g.mass, d)
+        return coupled_modes(model, K, m, touching, count, pistons)
     size = len(m)
     w = 1.0 / np.sqrt(m)
     if size <= DENSE_MAX:
@@ -119,10 +192,21 @@ def linear_modes(model, count: int | None = None) -> Modes:
     zero = np.abs(lam) <= ZERO_RTOL * max(top, 1e-300)
     lam = np.where(zero, 0.0, lam)
     freq = np.sqrt(np.maximum(lam, 0.0)) / (2.0 * math.pi)
-    shapes = (v * w[:, None]).T.reshape(len(lam), len(g.mass), d)
+    z = (v * w[:, None]).T
+    ng = len(g.mass) * d
+    shapes, on_pistons = z[:, :ng].reshape(len(lam), len(g.mass), d), np.ascontiguousarray(z[:, ng:])
     if count is not None:
-        freq, shapes = freq[:count], shapes[:count]
-    return Modes(freq, shapes, int(np.count_nonzero(zero)), touching)
+        freq, shapes, on_pistons = freq[:count], shapes[:count], on_pistons[:count]
+    return Modes(
+        freq, shapes, int(np.count_nonzero(zero)), touching, np.zeros((0, 0)), *_piston_fields(on_pistons, pistons)
+    )
+
+
+def _piston_fields(on_pistons: np.ndarray, pistons: Pistons) -> tuple:
+    """Modes' pistons, piston_walls and piston_mass ((0, 0) shapes without a piston)."""
+    if not len(pistons.walls):
+        return np.zeros((0, 0)), pistons.walls, pistons.mass
+    return on_pistons, pistons.walls, pistons.mass
 
 
 def plate_contact_stiffness(g, p, x: np.ndarray, u0: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
@@ -142,12 +226,13 @@ def plate_contact_stiffness(g, p, x: np.ndarray, u0: np.ndarray) -> tuple[np.nda
 
 
 def coupled_stiffness(model, k_granules, x: np.ndarray) -> tuple[np.ndarray, int]:
-    """The dense stiffness (ng d + nm, ng d + nm) [N/m, and 1/s^2 in the plate's block] of the
-    granules (k_granules, (M1)) and the plane's plate in modal coordinates, coupled by its
-    contacts (M2); and the plate contacts in touch."""
+    """The dense stiffness (nd + nm, nd + nm) [N/m, and 1/s^2 in the plate's block] of the
+    granules (k_granules, (M1), nd unknowns: the granules' ng d, the pistons' after them, (M3))
+    and the plane's plate in modal coordinates, coupled by its contacts (M2); and the plate
+    contacts in touch."""
     g, p = model.granular, model.plate_arrays
     d = x.shape[1]
-    nd, nm = len(g.mass) * d, len(p.omega2)
+    nd, nm = k_granules.shape[0], len(p.omega2)
     u0 = np.zeros(len(g.pc_i)) if model.plate_u0 is None else np.asarray(model.plate_u0, float)[0::2]
     pi, ke, touching = plate_contact_stiffness(g, p, x, u0)
     k = np.zeros((nd + nm, nd + nm))
@@ -160,17 +245,18 @@ def coupled_stiffness(model, k_granules, x: np.ndarray) -> tuple[np.ndarray, int
     return k, touching
 
 
-def coupled_modes(model, k_granules, touching: int, count: int | None) -> Modes:
-    """The modes (M1)-(M2) of the granules and the plane's plate together (dense `eigh`;
-    beyond DENSE_MAX unknowns the lowest `count`, 50 by default)."""
+def coupled_modes(model, k_granules, mass: np.ndarray, touching: int, count: int | None, pistons: Pistons) -> Modes:
+    """The modes (M1)-(M3) of the granules (and pistons: k_granules and mass over both) and
+    the plane's plate together (dense `eigh`; beyond DENSE_MAX unknowns the lowest `count`,
+    50 by default)."""
     from scipy.linalg import eigh
 
     g = model.granular
     d = g.wall_geo.shape[1] - 1
     x = np.ascontiguousarray(model.initial_state[:, :d])
     k, on_plate = coupled_stiffness(model, k_granules, x)
-    nd = len(g.mass) * d
-    w = np.concatenate([1.0 / np.sqrt(np.repeat(g.mass, d)), np.ones(k.shape[0] - nd)])
+    nd = len(mass)
+    w = np.concatenate([1.0 / np.sqrt(mass), np.ones(k.shape[0] - nd)])
     sym = (k * w[:, None]) * w[None, :]
     if len(w) <= DENSE_MAX:
         lam, v = eigh(sym)
@@ -182,10 +268,14 @@ def coupled_modes(model, k_granules, touching: int, count: int | None) -> Modes:
     lam = np.where(zero, 0.0, lam)
     freq = np.sqrt(np.maximum(lam, 0.0)) / (2.0 * math.pi)
     z = v * w[:, None]
-    shapes, plate = z[:nd].T.reshape(len(lam), len(g.mass), d), np.ascontiguousarray(z[nd:].T)
+    ng = len(g.mass) * d
+    shapes, plate = z[:ng].T.reshape(len(lam), len(g.mass), d), np.ascontiguousarray(z[nd:].T)
+    on_pistons = np.ascontiguousarray(z[ng:nd].T)
     if count is not None:
-        freq, shapes, plate = freq[:count], shapes[:count], plate[:count]
-    return Modes(freq, shapes, int(np.count_nonzero(zero)), touching + on_plate, plate)
+        freq, shapes, plate, on_pistons = freq[:count], shapes[:count], plate[:count], on_pistons[:count]
+    return Modes(
+        freq, shapes, int(np.count_nonzero(zero)), touching + on_plate, plate, *_piston_fields(on_pistons, pistons)
+    )
 
 
 def chain_band_edges(k: float, m1: float, m2: float | None = None) -> dict[str, float]:
