@@ -1,7 +1,8 @@
 """Pistons in the linear modes (docs/model.md section 3.13, (M3)): a held precompression wall
 or a force-driven wall is one degree of freedom along its normal with its mass. Truths: the
-closed-form frequencies and shapes of a sphere between a fixed floor and a piston (two
-masses, two springs k = (3/2) F / delta at the static overlap), and the limit of an infinitely
+closed-form frequencies and shapes of a sphere between a fixed wall and a piston (two
+masses, two springs k = (3/2) F / delta at the static overlap; the held top wall, or a
+force-driven side wall), and the limit of an infinitely
 heavy piston, the fixed wall's modes plus the piston's slow ring on the chain's springs in
 series."""
 
@@ -64,12 +65,6 @@ def held(count: int, mass: float) -> gp.Scenario:
     return chain(count, f'mode = "held"\nmass = {mass!r}')
 
 
-FLOOR_PISTON = (
-    '[[drives]]\ntarget = "wall floor"\nkind = "force"\ndirection = [1.0, 0.0, 0.0]\nprofile = "constant"\n'
-    "value = {force!r}\nmass = {mass!r}\n"
-)
-
-
 def two_mass_modes(k: float, m: float, M: float) -> tuple[np.ndarray, np.ndarray]:
     """The sphere (m) on a fixed spring k and a piston (M) on it by another spring k:
     det([[2k, -k], [-k, k]] - w^2 diag(m, M)) = 0, so m M w^4 - k (2 M + m) w^2 + k^2 = 0;
@@ -80,35 +75,70 @@ def two_mass_modes(k: float, m: float, M: float) -> tuple[np.ndarray, np.ndarray
     return np.sqrt(w2) / (2 * math.pi), (2 * k - w2 * m) / k
 
 
-@pytest.mark.parametrize("how", ["held", "force drive"])
-def test_a_sphere_under_a_piston_rings_as_two_masses_on_two_springs(how):
-    """One sphere between the fixed floor and a piston of mass M = 3 m (the held top wall, or
-    the floor made a piston by a force drive of F0 under a frozen top): the two modes along
-    the column and their shapes (the piston's displacement over the sphere's, sign-invariant)
-    as the closed form to 1e-9; nothing else has stiffness (2 zero modes across)."""
-    model0 = build_model(chain(1))
-    m = float(model0.granular.mass[0])
+def test_a_sphere_under_a_held_wall_rings_as_two_masses_on_two_springs():
+    """One sphere between the fixed floor and the held top wall of mass M = 3 m: the two
+    modes along the column and their shapes (the wall's displacement over the sphere's,
+    sign-invariant) as the closed form to 1e-9; nothing else has stiffness (2 zero modes)."""
+    m = float(build_model(chain(1)).granular.mass[0])
     M = 3.0 * m
-    s = held(1, M) if how == "held" else chain(1, drives=FLOOR_PISTON.format(force=F0, mass=M))
-    model = build_model(s)
+    model = build_model(held(1, M))
     delta = R - float(model.initial_state[0, 0])  # the floor's overlap (the floor at x = 0)
     k = 1.5 * F0 / delta  # the Hertz tangent stiffness at the static overlap, both contacts carrying F0
     modes = linear_modes(model)
     assert modes.pistons.shape == (4, 1) and modes.piston_mass[0] == pytest.approx(M)
     assert modes.zero_modes == 2
-    f = modes.frequencies[modes.frequencies > 0.0]
-    want, ratio = two_mass_modes(k, m, M)
-    np.testing.assert_allclose(f, want, rtol=1e-9)
     live = np.flatnonzero(modes.frequencies > 0.0)
-    u = modes.shapes[live, 0, 0]
-    s_ = modes.pistons[live, 0]
-    e_x = -1.0 if how == "held" else 1.0  # s is along the drive's direction, into the assembly
-    np.testing.assert_allclose(e_x * s_ / u, ratio, rtol=1e-9)  # the piston's x over the sphere's
+    want, ratio = two_mass_modes(k, m, M)
+    np.testing.assert_allclose(modes.frequencies[live], want, rtol=1e-9)
+    u, s_ = modes.shapes[live, 0, 0], modes.pistons[live, 0]
+    np.testing.assert_allclose(-s_ / u, ratio, rtol=1e-9)  # the wall's x (s is along e = -x) over the sphere's
     np.testing.assert_allclose(m * u**2 + M * s_**2, 1.0, rtol=1e-12)  # M-orthonormal
     np.testing.assert_allclose(granule_fraction(modes)[live] + piston_fraction(modes)[live], 1.0, rtol=1e-12)
     record = modes_record(modes, ["floor", "top"])
-    assert record["pistons"] == [{"wall": "top" if how == "held" else "floor", "mass": pytest.approx(M)}]
+    assert record["pistons"] == [{"wall": "top", "mass": pytest.approx(M)}]
     assert len(record["piston_fraction"]) == len(record["frequencies"]) == 4
+
+
+SIDE = """
+[[walls]]
+label = "left"
+normal = [0.0, -1.0, 0.0]
+offset = {r!r}
+[[walls]]
+label = "right"
+normal = [0.0, 1.0, 0.0]
+offset = {r!r}
+[[drives]]
+target = "wall left"
+kind = "force"
+direction = [0.0, 1.0, 0.0]
+profile = "constant"
+value = {push!r}
+mass = {mass!r}
+"""
+
+
+def test_a_sphere_against_a_force_driven_wall_rings_as_two_masses_on_two_springs():
+    """The sphere between the floor and the frozen top wall (F0 along x) and, across, between a
+    fixed wall and a piston of mass M = 3 m pushing with P = 4 N (a force-driven wall): along
+    y the closed form of the two masses on springs k_y = (3/2) P / delta_y, along x the sphere
+    between fixed walls, sqrt(2 k_x / m) / (2 pi), k_x = (3/2) F0 / delta_x, to 1e-9; the
+    piston's amplitude over the sphere's as the closed form."""
+    m = float(build_model(chain(1)).granular.mass[0])
+    M, push = 3.0 * m, 4.0
+    model = build_model(chain(1, drives=SIDE.format(r=R, push=push, mass=M)))
+    x = model.initial_state[0, :3]
+    k_x, k_y = 1.5 * F0 / (R - x[0]), 1.5 * push / x[1]  # the overlaps on the floor and on the fixed side wall
+    modes = linear_modes(model)
+    assert list(modes.piston_walls) == [2] and modes.zero_modes == 1
+    live = np.flatnonzero(modes.frequencies > 0.0)
+    want, ratio = two_mass_modes(k_y, m, M)
+    along_x = math.sqrt(2.0 * k_x / m) / (2.0 * math.pi)
+    np.testing.assert_allclose(modes.frequencies[live], np.sort(np.append(want, along_x)), rtol=1e-9)
+    sideways = live[np.abs(modes.shapes[live, 0, 1]) > 1e-3 * np.abs(modes.shapes[live, 0]).max()]
+    u, s_ = modes.shapes[sideways, 0, 1], modes.pistons[sideways, 0]
+    np.testing.assert_allclose(s_ / u, ratio, rtol=1e-9)  # s along e = +y
+    assert modes_record(modes, ["floor", "top", "left", "right"])["pistons"][0]["wall"] == "left"
 
 
 def test_a_heavy_held_wall_gives_the_fixed_walls_modes_and_its_own_slow_ring():
