@@ -23,8 +23,10 @@ out, so that every step descends) until the largest residual force is below tole
 A granule under a displacement or velocity drive is held along the drive's direction only
 (its prescribed motion starts there) and free across it; a granule under a force drive is
 free, the drive's value at t = 0, P(0) e, a load in (S1) (-P(0) e . x_i: the rest state the
-run starts from, nothing when the profile starts at 0). Walls stay at their offsets (a
-driven wall starts where the scenario puts it), the target's servo apart. The laws of
+run starts from, nothing when the profile starts at 0). A force-driven wall (a piston) is a
+servo as the target is, pushing with its drive's value at t = 0 (`static_pistons`); the
+other walls stay at their offsets (a displacement- or velocity-driven wall starts where the
+scenario puts it) and are supports, as are the held granules and the plate. The laws of
 friction do not enter: the static state is frictionless (friction needs a history that
 precompression does not have).
 
