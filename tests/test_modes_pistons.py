@@ -1,10 +1,11 @@
-"""Pistons in the linear modes (docs/model.md section 3.13, (M3)): a held precompression wall
-or a force-driven wall is one degree of freedom along its normal with its mass. Truths: the
+"""Pistons and driven granules in the linear modes (docs/model.md section 3.13, (M3)): a held
+precompression wall or a force-driven wall is one degree of freedom along its normal with its
+mass, a granule under a velocity drive none along the drive's direction. Truths: the
 closed-form frequencies and shapes of a sphere between a fixed wall and a piston (two
 masses, two springs k = (3/2) F / delta at the static overlap; the held top wall, or a
-force-driven side wall), and the limit of an infinitely
-heavy piston, the fixed wall's modes plus the piston's slow ring on the chain's springs in
-series."""
+force-driven side wall), the limit of an infinitely heavy piston (the fixed wall's modes
+plus the piston's slow ring on the chain's springs in series), and a sphere between a wall
+and a held one, sqrt((k_w + k_p) / m) / (2 pi)."""
 
 from __future__ import annotations
 
@@ -163,3 +164,32 @@ def test_a_heavy_held_wall_gives_the_fixed_walls_modes_and_its_own_slow_ring():
     delta_p = 2 * R - np.diff(x)
     k_s = 1.0 / (2.0 * delta_w / (1.5 * F0) + float(np.sum(delta_p)) / (1.5 * F0))
     assert f[0] == pytest.approx(math.sqrt(k_s / 1e6) / (2 * math.pi), rel=1e-6)
+
+
+def held_bead(direction) -> str:
+    """A velocity drive holding the first bead (on the floor) still along `direction`."""
+    return (
+        f'[[drives]]\ntarget = "granule g0"\nkind = "velocity"\ndirection = {list(map(float, direction))!r}\n'
+        'profile = "constant"\nvalue = 0.0\n'
+    )
+
+
+def test_a_bead_held_by_a_drive_moves_only_across_its_direction():
+    """Two beads between the floor and the frozen top wall, the lower one held along the column
+    by a velocity drive: it is no unknown along x, and the upper one rings between it and the
+    top wall, sqrt((k_w + k_p) / m) / (2 pi) (k = (3/2) F0 / delta at each static overlap), to
+    1e-9; held across the column instead, the modes along it are the undriven chain's."""
+    model = build_model(chain(2, drives=held_bead((1, 0, 0))))
+    g = model.granular
+    x = model.initial_state[:, 0]
+    m = float(g.mass[1])
+    top = float(g.wall_geo[g.wall_w == 1, 3][0])
+    k_w, k_p = 1.5 * F0 / (x[1] + R - top), 1.5 * F0 / (2 * R - (x[1] - x[0]))
+    modes = linear_modes(model)
+    assert len(modes.frequencies) == 5 and modes.zero_modes == 4
+    assert modes.frequencies[-1] == pytest.approx(math.sqrt((k_w + k_p) / m) / (2 * math.pi), rel=1e-9)
+    assert np.all(modes.shapes[:, 0, 0] == 0.0)
+    free = linear_modes(build_model(chain(2))).frequencies
+    across = linear_modes(build_model(chain(2, drives=held_bead((0, 1, 0))))).frequencies
+    assert len(across) == 5
+    np.testing.assert_allclose(across[across > 0.0], free[free > 0.0], rtol=1e-12)

@@ -41,7 +41,8 @@ its wall (normal n, stiffness k_c) changes its overlap by n . u_i + c s, c = -n 
     K[i, i] += k_c n n^T,   K[i, s] = K[s, i]^T += k_c c n,   K[s, s] += k_c c^2          (M3)
 
 (`with_pistons`); its share of a mode is `Modes.pistons`. Walls under displacement or velocity
-drives, and frozen ones, are fixed.
+drives, and frozen ones, are fixed; a granule under a displacement or velocity drive moves
+only across the drive's direction (`held_directions`, the static state's basis).
 """
 
 from __future__ import annotations
@@ -171,9 +172,11 @@ def linear_modes(model, count: int | None = None) -> Modes:
     K, touching = stiffness_matrix(g, x)
     pistons = pistons_of(g)
     K = with_pistons(g, x, K, pistons)
-    m = np.concatenate([np.repeat(g.mass, d), pistons.mass])
     if getattr(model, "plate", None) is not None and len(model.plate_arrays.omega2):
+        m = np.concatenate([np.repeat(g.mass, d), pistons.mass])
         return coupled_modes(model, K, m, touching, count, pistons)
+    free, m = held_directions(g, d, pistons.mass)
+    K = (free.T @ K @ free).tocsr()  # a driven granule's prescribed direction is no unknown
     size = len(m)
     w = 1.0 / np.sqrt(m)
     if size <= DENSE_MAX:
@@ -192,7 +195,7 @@ def linear_modes(model, count: int | None = None) -> Modes:
     zero = np.abs(lam) <= ZERO_RTOL * max(top, 1e-300)
     lam = np.where(zero, 0.0, lam)
     freq = np.sqrt(np.maximum(lam, 0.0)) / (2.0 * math.pi)
-    z = (v * w[:, None]).T
+    z = (free @ (v * w[:, None])).T
     ng = len(g.mass) * d
     shapes, on_pistons = z[:, :ng].reshape(len(lam), len(g.mass), d), np.ascontiguousarray(z[:, ng:])
     if count is not None:
@@ -200,6 +203,23 @@ def linear_modes(model, count: int | None = None) -> Modes:
     return Modes(
         freq, shapes, int(np.count_nonzero(zero)), touching, np.zeros((0, 0)), *_piston_fields(on_pistons, pistons)
     )
+
+
+def held_directions(g, d: int, extra_mass: np.ndarray):
+    """(P, m): the unknowns' basis P, a sparse (ng d + ne, nf + ne) matrix with orthonormal
+    columns (`model.static.granule_freedom`: a granule under a displacement or velocity drive
+    moves only across its drive's direction, its motion along it being prescribed; the ne
+    unknowns after the granules', the pistons', as they are), and each column's mass m
+    (nf + ne,) [kg]: its granule's, then extra_mass (ne,)."""
+    from scipy.sparse import block_diag, identity
+
+    from granplate.model.static import granule_freedom
+
+    t = granule_freedom(g, d)
+    mass = np.asarray(t.multiply(t).T @ np.repeat(np.asarray(g.mass, float), d)).ravel()
+    ne = len(extra_mass)
+    basis = block_diag([t, identity(ne)], format="csr") if ne else t.tocsr()
+    return basis, np.append(mass, np.asarray(extra_mass, float))
 
 
 def _piston_fields(on_pistons: np.ndarray, pistons: Pistons) -> tuple:
@@ -255,8 +275,13 @@ def coupled_modes(model, k_granules, mass: np.ndarray, touching: int, count: int
     d = g.wall_geo.shape[1] - 1
     x = np.ascontiguousarray(model.initial_state[:, :d])
     k, on_plate = coupled_stiffness(model, k_granules, x)
-    nd = len(mass)
-    w = np.concatenate([1.0 / np.sqrt(mass), np.ones(k.shape[0] - nd)])
+    ng, nd = len(g.mass) * d, len(mass)
+    free, m = held_directions(g, d, mass[ng:])  # a driven granule's prescribed direction is no unknown
+    basis = np.zeros((k.shape[0], len(m) + k.shape[0] - nd))
+    basis[:nd, : len(m)] = free.toarray()
+    basis[nd:, len(m) :] = np.eye(k.shape[0] - nd)
+    k = basis.T @ k @ basis
+    w = np.concatenate([1.0 / np.sqrt(m), np.ones(k.shape[0] - len(m))])
     sym = (k * w[:, None]) * w[None, :]
     if len(w) <= DENSE_MAX:
         lam, v = eigh(sym)
@@ -267,8 +292,7 @@ def coupled_modes(model, k_granules, mass: np.ndarray, touching: int, count: int
     zero = np.abs(lam) <= ZERO_RTOL * max(top, 1e-300)
     lam = np.where(zero, 0.0, lam)
     freq = np.sqrt(np.maximum(lam, 0.0)) / (2.0 * math.pi)
-    z = v * w[:, None]
-    ng = len(g.mass) * d
+    z = basis @ (v * w[:, None])
     shapes, plate = z[:ng].T.reshape(len(lam), len(g.mass), d), np.ascontiguousarray(z[nd:].T)
     on_pistons = np.ascontiguousarray(z[ng:nd].T)
     if count is not None:
