@@ -469,7 +469,8 @@ def precompressed(model):
     """The model whose run starts from its scenario's [precompression] static state: the
     granules' centres moved to it, the target wall's offset with them (`run_walls`: where
     the walls are when the contact lists are rebuilt), the plate deflected under its contacts'
-    static forces (`plate_q0`, `plate_u0`); the wall frozen there during the run, or, with
+    static forces (`plate_q0`, `plate_u0`), the driven granules' `drive_x0` (their drives'
+    displacements count from there); the wall frozen there during the run, or, with
     mode = "held", a piston that keeps pushing with the force (`held_wall`); the model
     itself when the scenario has none."""
     from granplate.setup.precompression_checks import precompression_wall
@@ -496,7 +497,12 @@ def precompressed(model):
     for w, o in zip(st.pistons.walls if st.pistons is not None else (), st.piston_offsets):
         geo[g.wall_w == w, d] = o  # a force-driven wall starts at rest where its drive's P(0) holds it
         walls[w] = dataclasses.replace(walls[w], offset=float(o))
-    g = g._replace(wall_geo=geo)
+    on_granule = g.drive_target >= 0
+    x_drive = g.drive_x0.copy()
+    x_drive[on_granule] = st.positions[
+        g.drive_target[on_granule]
+    ]  # a drive's displacement counts from the static state
+    g = g._replace(wall_geo=geo, drive_x0=x_drive)
     if p.mode == "held":
         g = held_wall(g, model.scenario, wall, float(p.force), float(p.mass))
     out = dataclasses.replace(model, initial_state=y0, granular=g, run_walls=tuple(walls))
