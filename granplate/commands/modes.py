@@ -21,8 +21,8 @@ def piston_fraction(modes):
 
 
 def granule_fraction(modes):
-    """Each mode's share of its kinetic energy in the granules [-] (the rest in the plate and
-    the pistons): sum m u^2 of its M-orthonormal shape, 1 - |q|^2 - sum M s^2."""
+    """Each mode's share of its kinetic energy in the granules [-] (the rest in the plate, or
+    a 3D scenario's elastic solid, and the pistons): sum m u^2 of its M-orthonormal shape, 1 - |q|^2 - sum M s^2."""
     import numpy as np
 
     plate = np.sum(modes.plate**2, axis=1) if modes.plate.shape[1] else 0.0
@@ -31,8 +31,9 @@ def granule_fraction(modes):
 
 def modes_record(modes, wall_labels=()) -> dict:
     """The JSON of a Modes: frequencies [Hz], zero_modes, contacts; coupled to the plane's
-    plate also plate_modes (the plate's modal coordinates) and granule_fraction (each mode's
-    share of kinetic energy in the granules); with pistons (force-driven or held walls, each a
+    plate or a 3D scenario's elastic solid (its [plate]) also plate_modes (how many of its
+    modal coordinates) and granule_fraction (each mode's share of kinetic energy in the
+    granules, the rest in the plate or solid and the pistons); with pistons (force-driven or held walls, each a
     degree of freedom) `pistons` (each one's wall, by its label in `wall_labels` where given,
     and mass [kg]), piston_fraction (each mode's share of kinetic energy in them) and
     granule_fraction."""
@@ -78,7 +79,8 @@ def _cmd_modes(args) -> int:
         print(f"pistons moving with the granules: {named}")
     if modes.plate.shape[1] or modes.pistons.shape[1]:
         share = granule_fraction(modes)[modes.frequencies > 0.0]
-        where = f"coupled to the plate's {modes.plate.shape[1]} modes; " if modes.plate.shape[1] else ""
+        body = "solid" if modes.shapes.shape[2] == 3 else "plate"  # a 3D scenario's [plate] is an elastic solid
+        where = f"coupled to the {body}'s {modes.plate.shape[1]} modes; " if modes.plate.shape[1] else ""
         print(f"{where}the granules' share of each mode's kinetic energy:")
         for k, (f, e) in enumerate(zip(nonzero, share)):
             print(f"{k + 1:6d} {f:14.6g} Hz {e:10.3g}")

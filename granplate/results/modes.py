@@ -34,6 +34,21 @@ basis' residual compliance, massless): its spring k_c in series with R_n, conden
 R_n = 0 and the plate is its finite-element model exactly). Solved densely (`eigh`; beyond
 DENSE_MAX unknowns the lowest `count`, 50 by default, by `subset_by_index`).
 
+An elastic solid in space (the [plate] of a 3D scenario, `model.body`) joins the same way
+(`body_contacts`, `body_coupled_stiffness`): its kept M-orthonormal modes q (M the identity,
+K diag(omega^2); a free body's rigid modes at 0), and each granule-solid contact, found by the
+loop's own contact pass (solver.body: the closest point of the surface, its outward normal n,
+its patch's weights w_a over the surface nodes, the overlap with the residual in series),
+couples the granule's displacement along n to the surface's normal displacement there:
+
+    K += B^T K_e B,   K_e = (I + K_s R_n)^-1 K_s,   B (u, q) = n . u_i - phi_n q,
+    phi_n = n . sum_a w_a Phi_a,   (R_n)_kj = r_k^T R_S r_j                               (M4)
+
+(K_s = diag((3/2) A delta^(1/2)) at the overlaps at t = 0, the body at its modal state then: a
+scenario with a solid has no [precompression]; R_S the residual compliance over the face's
+normal dofs, r_k contact k's normal times its weights there; the tangential stiffness of the
+deformed surface's tilt left out, as the transverse terms are).
+
 A piston (a force-driven wall, or the held precompression wall; `pistons_of`) is one more
 unknown, its displacement s along its drive's direction e, of mass M: a contact of granule i on
 its wall (normal n, stiffness k_c) changes its overlap by n . u_i + c s, c = -n . e,
@@ -63,7 +78,8 @@ class Modes(NamedTuple):
     """frequencies: (n,) [Hz], ascending, zero modes included (as 0); shapes: (n, ng, d) the
     M-orthonormal mode shapes [kg^-1/2]; zero_modes: how many have no stiffness;
     contacts: the contacts in touch that give K (the plate's included); plate: (n, nm) the
-    plate's modal coordinates q of each M-orthonormal mode [-] ((0, 0) without a plate);
+    plate's modal coordinates q of each M-orthonormal mode [-] (in space the elastic solid's,
+    the [plate] of a 3D scenario; (0, 0) without a plate);
     pistons: (n, np) each piston's displacement along its drive's direction in each
     M-orthonormal mode [kg^-1/2] ((0, 0) without one); piston_walls: (np,) their walls'
     indices in the scenario; piston_mass: (np,) their masses [kg]."""
@@ -172,7 +188,8 @@ def linear_modes(model, count: int | None = None) -> Modes:
     K, touching = stiffness_matrix(g, x)
     pistons = pistons_of(g)
     K = with_pistons(g, x, K, pistons)
-    if getattr(model, "plate", None) is not None and len(model.plate_arrays.omega2):
+    body = getattr(model, "body", None)
+    if (getattr(model, "plate", None) is not None and len(model.plate_arrays.omega2)) or body is not None:
         m = np.concatenate([np.repeat(g.mass, d), pistons.mass])
         return coupled_modes(model, K, m, touching, count, pistons)
     free, m = held_directions(g, d, pistons.mass)
@@ -245,11 +262,84 @@ def plate_contact_stiffness(g, p, x: np.ndarray, u0: np.ndarray) -> tuple[np.nda
     return pi, ks, int(np.count_nonzero(pdelta > 0.0))
 
 
+class BodyContacts(NamedTuple):
+    """The granules' contacts in touch on an elastic body in space (docs/model.md section
+    3.13, eq. M4): granule (nk,) their granules; normal (nk, 3) the body's outward normal at
+    each contact point; phi_n (nk, nm) the kept modes' normal displacement there, n . sum_a w_a
+    Phi_a [kg^-1/2]; overlap (nk,) [m] each one's overlap (the residual's share taken off,
+    as the loop's contact pass finds it); k_s (nk,) the Hertz tangents (3/2) A delta^(1/2)
+    [N/m]; r_n (nk, nk) the residual compliance between the contact points' normal
+    displacements [m/N] ((0, 0) without one); k_e (nk, nk) the springs in series with it,
+    (I + K_s R_n)^-1 K_s [N/m]."""
+
+    granule: np.ndarray
+    normal: np.ndarray
+    phi_n: np.ndarray
+    overlap: np.ndarray
+    k_s: np.ndarray
+    r_n: np.ndarray
+    k_e: np.ndarray
+
+
+def body_contacts(model, x: np.ndarray) -> BodyContacts:
+    """The contacts of the granules at centres x (ng, 3) [m] on the model's elastic body at
+    its modal state at t = 0 (solver.body's own contact pass: each granule's closest point,
+    its patch's weights, the overlap with the residual compliance in series; the body not
+    statically deflected by them: a scenario with a body has no [precompression])."""
+    from granplate.model.inputs import GEO_DELTA, GEO_NX, GEO_NZ, GEO_TOUCH, new_body_state
+    from granplate.physics.contact import COEF_A
+    from granplate.solver import body as sb
+
+    g = model.granular
+    b = new_body_state(model.body)
+    y = np.zeros((len(g.mass), 9))
+    y[:, :3] = x
+    acc, fdamp = np.zeros_like(y), np.zeros_like(y)
+    sb.contact_forces(y, b.q.copy(), np.zeros_like(b.q), b, 0, g.radius, g.mass, False, acc, fdamp, False)
+    geo = b.geo[0]
+    granule = np.flatnonzero((geo[:, GEO_TOUCH] != 0.0) & (geo[:, GEO_DELTA] > 0.0))
+    nk, nm = len(granule), len(b.omega)
+    normal = np.ascontiguousarray(geo[granule, GEO_NX : GEO_NZ + 1])
+    phi_n = np.zeros((nk, nm))
+    for k, i in enumerate(granule):
+        sb.spread(b, 0, i, normal[k, 0], normal[k, 1], normal[k, 2], phi_n[k], 1.0)
+    overlap = geo[granule, GEO_DELTA].copy()
+    k_s = 1.5 * b.coef[granule, COEF_A] * np.sqrt(overlap)
+    r_n = body_residual(b, granule)
+    k_e = np.diag(k_s)
+    if r_n.shape[0]:
+        ke = np.linalg.solve(np.eye(nk) + k_s[:, None] * r_n, k_e)
+        k_e = 0.5 * (ke + ke.T)
+    return BodyContacts(granule, normal, phi_n, overlap, k_s, r_n, k_e)
+
+
+def body_residual(b, granule: np.ndarray) -> np.ndarray:
+    """R_n (nk, nk) [m/N]: r_k^T R_S r_j between the contacts of `granule`, located in buffer
+    0 of the body arrays b (solver.body's residual rows, each contact's normal times its
+    weights on the residual dofs S); (0, 0) without a residual compliance."""
+    from granplate.solver import body as sb
+
+    nk, n_s = len(granule), b.resid.shape[0]
+    if not n_s or not nk:
+        return np.zeros((0, 0))
+    counts = np.zeros(nk, np.int64)
+    for k, i in enumerate(granule):
+        b.active[k] = i
+        counts[k] = sb.residual_rows(b, 0, i, k)
+    upos, ulist = np.full(n_s, -1, np.int64), np.empty(n_s, np.int64)
+    n_u = sb.touched_dofs(b, nk, counts, upos, ulist)
+    rmat = np.zeros((nk, nk))
+    sb.residual_matrix(b, nk, counts, upos, ulist, n_u, np.empty((nk, n_u)), rmat)
+    return rmat
+
+
 def coupled_stiffness(model, k_granules, x: np.ndarray) -> tuple[np.ndarray, int]:
     """The dense stiffness (nd + nm, nd + nm) [N/m, and 1/s^2 in the plate's block] of the
     granules (k_granules, (M1), nd unknowns: the granules' ng d, the pistons' after them, (M3))
-    and the plane's plate in modal coordinates, coupled by its contacts (M2); and the plate
-    contacts in touch."""
+    and the plate in modal coordinates (the plane's, or a 3D scenario's elastic body),
+    coupled by its contacts (M2, M4); and the plate contacts in touch."""
+    if getattr(model, "body", None) is not None:
+        return body_coupled_stiffness(model, k_granules, x)
     g, p = model.granular, model.plate_arrays
     d = x.shape[1]
     nd, nm = k_granules.shape[0], len(p.omega2)
@@ -263,6 +353,23 @@ def coupled_stiffness(model, k_granules, x: np.ndarray) -> tuple[np.ndarray, int
     b[:, nd:] = -np.asarray(p.phi_d, float)[0::2]  # minus the plate's at the contact
     k += b.T @ ke @ b
     return k, touching
+
+
+def body_coupled_stiffness(model, k_granules, x: np.ndarray) -> tuple[np.ndarray, int]:
+    """`coupled_stiffness` with an elastic body in space (M4): its modal block diag(omega^2),
+    and each contact's spring in series with the residual, B^T K_e B, B (u, q) = n . u_i -
+    phi_n q; and the body's contacts in touch."""
+    c = body_contacts(model, x)
+    nd, nm = k_granules.shape[0], len(model.body.omega)
+    k = np.zeros((nd + nm, nd + nm))
+    k[:nd, :nd] = k_granules.toarray()
+    k[nd:, nd:] = np.diag(np.asarray(model.body.omega, float) ** 2)
+    b = np.zeros((len(c.granule), nd + nm))
+    for q in range(3):
+        b[np.arange(len(c.granule)), c.granule * 3 + q] = c.normal[:, q]  # the granule's normal displacement
+    b[:, nd:] = -c.phi_n  # minus the surface's there
+    k += b.T @ c.k_e @ b
+    return k, len(c.granule)
 
 
 def coupled_modes(model, k_granules, mass: np.ndarray, touching: int, count: int | None, pistons: Pistons) -> Modes:
