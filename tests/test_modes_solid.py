@@ -12,7 +12,6 @@ import json
 
 import numpy as np
 from scipy.linalg import eigh
-from scipy.optimize import brentq
 
 from granplate.model import build_model
 from granplate.physics.contact import COEF_A
@@ -24,23 +23,22 @@ from granplate.solid.surface import boundary_surface, closest_point, patch_weigh
 
 TOP = 0.01  # the block's top face [m]
 RADIUS = 0.004
-#: the sphere's centre: off the face's nodes, so that its weights spread over a face
-CENTRE = (0.0073, 0.0121)
+#: the spheres' centres (x, y) [m]: off the face's nodes, so that their weights spread over
+#: a face, and apart (9.3 mm between them)
+CENTRES = ((0.0073, 0.0121), (0.0142, 0.0058))
 
 
-def scenario(z: float, max_frequency: float = 1.5e5, extra: str = "") -> str:
-    """A steel sphere at height z [m] over a steel block 20 x 20 x 10 mm (hex20, 2 x 2 x 1
-    elements, clamped at the bottom), a point patch."""
+def scenario(heights, max_frequency: float = 1.5e5) -> str:
+    """Steel spheres at the heights [m] (the first at CENTRES[0], ...) over a steel block
+    20 x 20 x 10 mm (hex20, 2 x 2 x 1 elements, clamped at the bottom), a point patch."""
+    granules = "".join(
+        f'[[granules]]\nx = {x}\ny = {y}\nz = {z}\nradius = {RADIUS}\nmaterial = "steel"\n'
+        for (x, y), z in zip(CENTRES, heights)
+    )
     return f"""
 name = "sphere-on-solid"
 dimension = 3
-[[granules]]
-x = {CENTRE[0]}
-y = {CENTRE[1]}
-z = {z}
-radius = {RADIUS}
-material = "steel"
-{extra}
+{granules}
 [plate]
 size = [0.02, 0.02, {TOP}]
 elements = [2, 2, 1]
@@ -58,51 +56,65 @@ t_end = 1e-5
 """
 
 
-def resting(max_frequency: float = 1.5e5):
-    """The model of the sphere pressed 2 um into the top face."""
-    return build_model(scenario_io.loads(scenario(TOP + RADIUS - 2e-6, max_frequency)))
+def resting(max_frequency: float = 1.5e5, pressed=(2e-6,)):
+    """The model of spheres pressed into the top face by `pressed` [m] each."""
+    return build_model(scenario_io.loads(scenario([TOP + RADIUS - p for p in pressed], max_frequency)))
 
 
 def fe_system(model):
-    """The solid's dense K, M [N/m, kg] on its free dofs, and c (n_red,): the normal (z)
-    displacement at the sphere's contact point, the face's shape functions there."""
+    """The solid's dense K, M [N/m, kg] on its free dofs, and C (n_red, ng): the normal (z)
+    displacement at each sphere's contact point, the face's shape functions there."""
     solid = model.solid
     mat = solid.material
     k = stiffness_matrix(solid.basis, mat.E, mat.nu)[solid.dofs][:, solid.dofs].toarray()
     m = mass_matrix(solid.basis, mat.rho)[solid.dofs][:, solid.dofs].toarray()
     surface = boundary_surface(vector_basis(solid.mesh, solid.element))
-    cp = closest_point(surface, (*CENTRE, model.initial_state[0, 2]))
-    assert np.allclose(cp.normal, (0.0, 0.0, 1.0))
-    dofs, w = patch_weights(surface, cp.face, cp.xi)
-    c = np.zeros(len(solid.dofs))
-    np.add.at(c, reduced_index(solid.dofs, dofs[:, 2]), w)
+    c = np.zeros((len(solid.dofs), len(model.granular.mass)))
+    for i, centre in enumerate(model.initial_state[:, :3]):
+        cp = closest_point(surface, centre)
+        assert np.allclose(cp.normal, (0.0, 0.0, 1.0))
+        dofs, w = patch_weights(surface, cp.face, cp.xi)
+        np.add.at(c[:, i], reduced_index(solid.dofs, dofs[:, 2]), w)
     return k, m, c
 
 
-def contact_stiffness(model, k, c) -> float:
-    """The Hertz tangent (3/2) A delta^(1/2) at the overlap delta + r A delta^(3/2) = delta0,
-    r = c^T (K^-1 - Phi diag(1/omega^2) Phi^T) c the truncated modes' static compliance at
-    the point (a dense solve)."""
-    solid = model.solid
-    phi_c = solid.Phi.T @ c
-    r = c @ np.linalg.solve(k, c) - np.sum(phi_c**2 / solid.omega**2)
-    a = float(model.body.coef[0, COEF_A])
-    delta0 = RADIUS - (float(model.initial_state[0, 2]) - TOP)
-    delta = brentq(lambda x: x + r * a * x**1.5 - delta0, 0.0, delta0, xtol=1e-18, rtol=1e-15)
+def residual_at(model, k, c) -> np.ndarray:
+    """C^T (K^-1 - Phi diag(1/omega^2) Phi^T) C [m/N]: the truncated modes' static compliance
+    between the contact points (a dense solve)."""
+    phi_c = model.solid.Phi.T @ c
+    return c.T @ np.linalg.solve(k, c) - (phi_c / model.solid.omega[:, None] ** 2).T @ phi_c
+
+
+def contact_stiffness(model, k, c) -> np.ndarray:
+    """(ng,) the Hertz tangents (3/2) A delta^(1/2) [N/m] at the overlaps delta + R A
+    delta^(3/2) = delta0 (R: `residual_at`), by Newton from delta0."""
+    r = residual_at(model, k, c)
+    a = model.body.coef[:, COEF_A]
+    delta0 = RADIUS - (model.initial_state[:, 2] - TOP)
+    delta = delta0.copy()
+    for _ in range(50):
+        step = np.linalg.solve(
+            np.eye(len(a)) + r * (1.5 * a * np.sqrt(delta))[None, :], delta + r @ (a * delta**1.5) - delta0
+        )
+        delta -= step
+    assert np.max(np.abs(step)) < 1e-15
     return 1.5 * a * np.sqrt(delta)
 
 
-def spring_frequencies(k, m, c, ks: float, mass: float) -> np.ndarray:
-    """[Hz] of the solid with a point mass on a spring ks at c (its normal motion only)."""
-    n = len(c)
-    kk = np.zeros((n + 1, n + 1))
-    kk[:n, :n] = k + ks * np.outer(c, c)
-    kk[:n, n] = kk[n, :n] = -ks * c
-    kk[n, n] = ks
-    mm = np.zeros((n + 1, n + 1))
+def spring_modes(k, m, c, ks, masses):
+    """(frequencies [Hz], M-orthonormal vectors) of the solid with point masses on springs ks
+    at the columns of c (their normal motion only; the masses' unknowns last)."""
+    n, ng = c.shape
+    kk = np.zeros((n + ng, n + ng))
+    kk[:n, :n] = k + (c * ks) @ c.T
+    kk[:n, n:] = -c * ks
+    kk[n:, :n] = kk[:n, n:].T
+    kk[n:, n:] = np.diag(ks)
+    mm = np.zeros((n + ng, n + ng))
     mm[:n, :n] = m
-    mm[n, n] = mass
-    return np.sqrt(eigh(kk, mm, eigvals_only=True)) / (2.0 * np.pi)
+    mm[n:, n:] = np.diag(masses)
+    lam, v = eigh(kk, mm)
+    return np.sqrt(lam) / (2.0 * np.pi), v
 
 
 def attached_frequencies(k, m, c, mass: float) -> np.ndarray:
@@ -111,14 +123,14 @@ def attached_frequencies(k, m, c, mass: float) -> np.ndarray:
 
 
 def test_without_contact_the_solid_keeps_its_frequencies():
-    """A sphere 1 mm above the solid: the solid's own frequencies (to 1e-8) and the sphere's
-    three rigid modes; no contact in touch."""
-    model = build_model(scenario_io.loads(scenario(TOP + RADIUS + 1e-3)))
+    """Two spheres 1 mm above the solid: the solid's own frequencies (to 1e-8) and the
+    spheres' six rigid modes; no contact in touch."""
+    model = build_model(scenario_io.loads(scenario([TOP + RADIUS + 1e-3] * 2)))
     modes = linear_modes(model)
     own = np.sort(model.solid.omega / (2.0 * np.pi))
-    assert modes.zero_modes == 3 and modes.contacts == 0
-    np.testing.assert_allclose(modes.frequencies[3:], own, rtol=1e-8)
-    assert modes.plate.shape == (len(own) + 3, len(own))
+    assert modes.zero_modes == 6 and modes.contacts == 0
+    np.testing.assert_allclose(modes.frequencies[6:], own, rtol=1e-8)
+    assert modes.plate.shape == (len(own) + 6, len(own))
 
 
 def test_sphere_on_the_solid_against_the_whole_finite_element_model():
@@ -131,8 +143,8 @@ def test_sphere_on_the_solid_against_the_whole_finite_element_model():
         k, m, c = fe_system(model)
         ks = contact_stiffness(model, k, c)
         contacts = body_contacts(model, model.initial_state[:, :3])
-        np.testing.assert_allclose(contacts.k_s, [ks], rtol=1e-9)  # the same overlap as the loop's
-        reference = spring_frequencies(k, m, c, ks, float(model.granular.mass[0]))
+        np.testing.assert_allclose(contacts.k_s, ks, rtol=1e-9)  # the same overlap as the loop's
+        reference, _ = spring_modes(k, m, c, ks, model.granular.mass)
         modes = linear_modes(model)
         assert modes.zero_modes == 2 and modes.contacts == 1  # the sphere slides freely on the face
         got = modes.frequencies[2:6]
@@ -142,13 +154,35 @@ def test_sphere_on_the_solid_against_the_whole_finite_element_model():
     assert errors[2] < 1e-9
 
 
+def test_two_spheres_coupled_through_the_residual_compliance():
+    """Two spheres pressed 2 and 1 um into the solid (the modes below 150 kHz kept): the
+    residual compliance between their points against a dense solve (1e-6 of the diagonal),
+    and the lowest frequencies and the spheres' share of the lowest modes (sign-invariant)
+    against the full FE model with both springs, to 1e-4."""
+    model = resting(1.5e5, (2e-6, 1e-6))
+    k, m, c = fe_system(model)
+    contacts = body_contacts(model, model.initial_state[:, :3])
+    r = residual_at(model, k, c)
+    np.testing.assert_allclose(contacts.r_n, r, atol=1e-6 * float(np.max(np.diag(r))))
+    assert abs(r[0, 1]) > 1e-3 * r[0, 0]  # the two contacts do feel each other through it
+    ks = contact_stiffness(model, k, c)
+    np.testing.assert_allclose(contacts.k_s, ks, rtol=1e-9)
+    reference, v = spring_modes(k, m, c, ks, model.granular.mass)
+    modes = linear_modes(model)
+    assert modes.zero_modes == 4 and modes.contacts == 2
+    np.testing.assert_allclose(modes.frequencies[4:10], reference[:6], rtol=1e-4)
+    for j in range(2):  # the two spheres' bounces: their normal amplitudes [kg^-1/2]
+        ours, theirs = modes.shapes[4 + j, :, 2], v[-2:, j]
+        np.testing.assert_allclose(ours * np.sign(ours @ theirs), theirs, atol=1e-4 * np.max(np.abs(theirs)))
+
+
 def test_a_stiff_contact_tends_to_the_mass_attached_rigidly():
     """A contact made 10^2, 10^4, 10^6 times stiffer (Hertz's A): the lowest coupled frequency
     rises towards the solid's with the sphere's mass attached at the point, monotonically, to
     1e-7 (all modes kept)."""
     model = resting(1e8)
     k, m, c = fe_system(model)
-    rigid = attached_frequencies(k, m, c, float(model.granular.mass[0]))[0]
+    rigid = attached_frequencies(k, m, c[:, 0], float(model.granular.mass[0]))[0]
     gaps = []
     for scale in (1e2, 1e4, 1e6):
         coef = model.body.coef.copy()
@@ -168,7 +202,7 @@ def test_cli_json_gives_the_solids_share(tmp_path, capsys):
     from granplate.cli import main
 
     path = tmp_path / "s.toml"
-    path.write_text(scenario(TOP + RADIUS - 2e-6))
+    path.write_text(scenario([TOP + RADIUS - 2e-6]))
     out = tmp_path / "m.json"
     assert main(["modes", str(path), "--json", str(out)]) == 0
     record = json.loads(out.read_text())
