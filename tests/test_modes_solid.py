@@ -114,7 +114,7 @@ def spring_modes(k, m, c, ks, masses):
     mm[:n, :n] = m
     mm[n:, n:] = np.diag(masses)
     lam, v = eigh(kk, mm)
-    return np.sqrt(lam) / (2.0 * np.pi), v
+    return np.sqrt(np.maximum(lam, 0.0)) / (2.0 * np.pi), v
 
 
 def attached_frequencies(k, m, c, mass: float) -> np.ndarray:
@@ -174,6 +174,21 @@ def test_two_spheres_coupled_through_the_residual_compliance():
     for j in range(2):  # the two spheres' bounces: their normal amplitudes [kg^-1/2]
         ours, theirs = modes.shapes[4 + j, :, 2], v[-2:, j]
         np.testing.assert_allclose(ours * np.sign(ours @ theirs), theirs, atol=1e-4 * np.max(np.abs(theirs)))
+
+
+def test_sphere_on_a_free_solid():
+    """A sphere pressed 2 um into the block held nowhere (every mode kept, the residual's
+    inertia relief negligible): eight zero modes (the block's six rigid modes and the
+    sphere's two slides; the bounce of the two bodies on the spring is elastic), and the
+    elastic frequencies of the full FE model with the sphere on the Hertz spring to 1e-6."""
+    model = build_model(scenario_io.loads(scenario([TOP + RADIUS - 2e-6], 1e8).replace('clamped = ["zmin"]\n', "")))
+    k, m, c = fe_system(model)
+    ks = 1.5 * model.body.coef[:, COEF_A] * np.sqrt(2e-6)
+    np.testing.assert_allclose(body_contacts(model, model.initial_state[:, :3]).k_s, ks, rtol=1e-6)
+    reference, _ = spring_modes(k, m, c, ks, model.granular.mass)  # six rigid modes first, at round-off
+    modes = linear_modes(model)
+    assert modes.zero_modes == 8 and modes.contacts == 1
+    np.testing.assert_allclose(modes.frequencies[8:14], reference[6:12], rtol=1e-6)
 
 
 def test_a_stiff_contact_tends_to_the_mass_attached_rigidly():
