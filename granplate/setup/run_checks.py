@@ -47,7 +47,34 @@ def _check_time(s: Scenario) -> None:
             f"{t.output_interval!r}, 1 <= n <= 2^53 (beyond, every double is whole)",
         )
     _check_restart_interval(t)
+    _check_contact_interval(t)
     _check_restart_table(s)
+
+
+def contact_steps(t) -> int:
+    """The contact table's interval in output intervals (TimeSettings t): time.contact_interval,
+    or time.field_interval when absent; 0: no table."""
+    dt = t.field_interval if t.contact_interval is None else t.contact_interval
+    return round(dt / t.output_interval)
+
+
+def _check_contact_interval(t) -> None:
+    """time.contact_interval: 0 (no contact table) or a whole multiple of output_interval."""
+    if t.contact_interval is None:
+        return
+    nonneg("time.contact_interval", t.contact_interval)
+    dt = float(t.contact_interval)
+    if dt == 0.0:
+        return
+    r = dt / t.output_interval
+    n = round(r)
+    if n < 1 or abs(r - n) > INTERVAL_RTOL * r or n > 2**53:
+        raise ScenarioError(
+            "time.contact_interval",
+            dt,
+            f"must be 0 (no contact table) or a whole multiple n of time.output_interval = "
+            f"{t.output_interval!r} s, 1 <= n <= 2^53 (absent: time.field_interval)",
+        )
 
 
 def _check_restart_table(s: Scenario) -> None:
