@@ -14,7 +14,7 @@ import granplate as gp
 from granplate.cli import main
 from granplate.figures import assembly, run, show
 from granplate.figures.common import plot_curves, new_figure
-from granplate.results.dataset import scenario_of, write
+from granplate.results.dataset import write
 from granplate.setup.materials import LIBRARY, effective_modulus, sphere_mass
 
 from conftest import two_spheres
