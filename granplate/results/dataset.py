@@ -590,10 +590,14 @@ def _attrs(model, out: K.Output, n: int, info: dict) -> dict:
 
 
 def write(ds: xr.Dataset, path: str | Path) -> Path:
-    """Write a result to netCDF (compressed) and return the path."""
+    """Write a result to netCDF (its floats and the contact table compressed) and return the path."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    enc = {v: {"zlib": True, "complevel": 4} for v in ds.data_vars if ds[v].dtype.kind == "f"}
+    enc = {
+        v: {"zlib": True, "complevel": 4}
+        for v in ds.data_vars
+        if ds[v].dtype.kind == "f" or (ds[v].dtype.kind == "i" and ds[v].dims == ("link",))
+    }
     ds.to_netcdf(path, encoding=enc)
     return path
 
