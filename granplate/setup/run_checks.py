@@ -132,19 +132,24 @@ def _check_restart_interval(t) -> None:
 OUTPUT_BYTES_PER_GRANULE = 3 * 8 * 12
 OUTPUT_BYTES_PER_DOF = 3 * 8 * 2
 FIELD_BYTES_PER_DOF = 3 * 8 * 4
+#: Bytes of the contact table per granule and table time (time.contact_interval): about 3
+#: rows of 40 bytes per granule, 2 copies (the rows built, the Dataset).
+LINK_BYTES_PER_GRANULE = 2 * 3 * 40
 
 
 def output_bytes_per_second(s: Scenario) -> float:
     """About the memory [bytes] a run's outputs take per second of simulated time: a row
     of the granules' states and the plate's modal coordinates per output_interval, a plate
-    snapshot per field_interval (s resolved)."""
+    snapshot per field_interval, the contact table per contact_interval (s resolved)."""
     t = s.time
     n_dof = 0  # a 3D solid writes no fields yet (its coupling comes with its outputs)
     if isinstance(s.plate, Plate):
         p = s.plate
         n_dof = 2 * ((p.nx + 1) * (p.ny + 1) + p.nx * (p.ny + 1) + p.ny * (p.nx + 1))
     row = OUTPUT_BYTES_PER_GRANULE * len(s.granules) + OUTPUT_BYTES_PER_DOF * n_dof + 400.0
-    return row / t.output_interval + FIELD_BYTES_PER_DOF * n_dof / t.field_interval
+    steps = contact_steps(t)
+    table = LINK_BYTES_PER_GRANULE * len(s.granules) / (steps * t.output_interval) if steps > 0 else 0.0
+    return row / t.output_interval + FIELD_BYTES_PER_DOF * n_dof / t.field_interval + table
 
 
 def _check_output_size(s: Scenario) -> None:
