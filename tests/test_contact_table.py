@@ -190,3 +190,14 @@ def test_no_figure_builds_a_model_or_calls_a_contact_law():
                 bad += [f"{path.name}:{node.lineno} import {a.name}" for a in node.names if "physics" in a.name]
     assert not bad, bad
     assert len(list(root.glob("*.py"))) > 5
+
+
+def test_table_rows_follow_the_whole_runs_times():
+    """Every 5th output time of the whole run and t_end: from t = 0, and in a run restarted
+    at the 3rd output time (its rows 2 and 7 are the run's 5th and 10th, its last t_end)."""
+    from granplate.results.contact_table import table_rows
+
+    dt = 1e-6
+    np.testing.assert_array_equal(table_rows(11, 5, dt * np.arange(11), 10 * dt, dt), [0, 5, 10])
+    np.testing.assert_array_equal(table_rows(10, 5, dt * np.arange(3, 13), 12 * dt, dt), [2, 7, 9])
+    np.testing.assert_array_equal(table_rows(10, 0, dt * np.arange(10), 9 * dt, dt), [])

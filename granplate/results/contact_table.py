@@ -144,13 +144,15 @@ def wall_links(y, radius, granule, geo, vn, coef, dmax, rate, arm_shrink, clip, 
         out[k, TANGENTIAL] = abs(friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS]))
 
 
-def table_rows(n: int, steps: int, times: np.ndarray, t_end: float) -> np.ndarray:
-    """The output rows (of n) the table covers: every `steps`-th from the first, and the
-    last when the run reached t_end (as the plate snapshots); none for steps 0."""
+def table_rows(n: int, steps: int, times: np.ndarray, t_end: float, dt_out: float) -> np.ndarray:
+    """The output rows (of n, at `times` [s]) the table covers: the output times k steps
+    dt_out of the whole run (a restarted run's first row being a later one), and the last
+    when the run reached t_end (as the plate snapshots); none for steps 0."""
     if steps <= 0 or n == 0:
         return np.zeros(0, np.int64)
-    idx = np.arange(0, n, steps, dtype=np.int64)
-    if idx[-1] != n - 1 and np.isclose(times[n - 1], t_end):
+    first = int(round(float(times[0]) / dt_out))
+    idx = np.arange((-first) % steps, n, steps, dtype=np.int64)
+    if (not len(idx) or idx[-1] != n - 1) and np.isclose(times[n - 1], t_end):
         idx = np.append(idx, n - 1)
     return idx
 
@@ -333,7 +335,7 @@ def contact_table(model, out, n: int, peaks, steps: int) -> tuple[dict[str, xr.D
     output rows of `out` (solver.state.Output), every `steps` rows (run_checks.contact_steps;
     0: none, an empty dict each); peaks: the run's ContactPeaks (None: none known)."""
     t = np.asarray(out.t[:n], float)
-    rows = table_rows(n, steps, t, model.scenario.time.t_end)
+    rows = table_rows(n, steps, t, model.scenario.time.t_end, model.scenario.time.output_interval)
     if not len(rows):
         return {}, {}
     walls = wall_motion(model, out, n)
