@@ -201,3 +201,16 @@ def test_table_rows_follow_the_whole_runs_times():
     np.testing.assert_array_equal(table_rows(11, 5, dt * np.arange(11), 10 * dt, dt), [0, 5, 10])
     np.testing.assert_array_equal(table_rows(10, 5, dt * np.arange(3, 13), 12 * dt, dt), [2, 7, 9])
     np.testing.assert_array_equal(table_rows(10, 0, dt * np.arange(10), 9 * dt, dt), [])
+
+
+def test_johnson_wall_contact_is_the_force_the_loop_booked():
+    """Under the law "johnson" on a rate-dependent steel (its yield strength fixed by the
+    approach speed when the contact first yields: the history's rate factor) the table's force on the wall is, at every output
+    in touch, the force the loop booked on the wall (wall_force), and the contact yielded."""
+    text = THORNTON.replace('normal_law = "thornton"', 'normal_law = "johnson"').replace('"steel"', '"steel_302"')
+    text = text.replace("dt_initial = 2e-7\ndt_max = 2e-7", "dt_initial = 5e-8\ndt_max = 5e-8")  # 4 steps an output
+    ds = gp.simulate(gp.loads(text), progress=False)
+    mine = ds.link_partner.values == -1
+    t, force = ds.link_time.values[mine], ds.link_normal_force.values[mine]
+    assert len(t) > 50 and float(ds.D_plastic[-1]) > 0.0
+    np.testing.assert_allclose(force, ds.wall_force.sel(time=t).values[:, 0], rtol=1e-9)
