@@ -268,14 +268,15 @@ class History:
         return dmax, np.where(yielded, rate, 0.0)
 
 
-def links_at(model, y: np.ndarray, o: int, walls: WallMotion, history: History, t: float) -> Links:
-    """The contacts in touch at state y, output o (time t [s]), with their forces."""
-    from granplate.model.arrays import pair_coefficients, wall_arrays
+def links_at(model, y: np.ndarray, o: int, walls: WallMotion, history: History, t: float, known: dict) -> Links:
+    """The contacts in touch at state y, output o (time t [s]), with their forces; known:
+    the pairs' coefficient rows met so far (model.arrays.cached_pair_coefficients)."""
+    from granplate.model.arrays import cached_pair_coefficients, wall_arrays
 
     s, mats, g, cfg = model.scenario, list(model.materials), model.granular, model.config
     r = np.asarray(g.radius, float)
     pairs = touching_pairs(y, r)
-    coef = pair_coefficients(s, mats, r, g.mass, pairs)
+    coef = cached_pair_coefficients(s, mats, g, pairs, known)
     dmax, rate = history.at(history.keys(pairs[:, 0], pairs[:, 1]), t, coef)
     pv = np.zeros((len(pairs), 3))
     pair_links(y, r, pairs, coef, dmax, rate, cfg.arm_shrink, cfg.clip, pv)
@@ -343,10 +344,11 @@ def contact_table(model, out, n: int, peaks, steps: int) -> tuple[dict[str, xr.D
     plastic = yields(model)
     wanted = set(rows.tolist())
     tables: list[Links] = []
+    known: dict = {}
     for o in range(int(rows[-1]) + 1):
         y = np.ascontiguousarray(out.y[o], dtype=float)
         if o in wanted:
-            links = links_at(model, y, o, walls, history, float(t[o]))
+            links = links_at(model, y, o, walls, history, float(t[o]), known)
             tables.append(links)
             keys = history.keys(links.granule, links.partner)
             history.see(keys, links.values[:, OVERLAP])
