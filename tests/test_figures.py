@@ -14,7 +14,7 @@ import granplate as gp
 from granplate.cli import main
 from granplate.figures import assembly, run, show
 from granplate.figures.common import plot_curves, new_figure
-from granplate.results.dataset import scenario_of, write
+from granplate.results.dataset import write
 from granplate.setup.materials import LIBRARY, effective_modulus, sphere_mass
 
 from conftest import two_spheres
@@ -231,15 +231,17 @@ def test_show_result_forces_are_hertz_at_the_largest_overlap(spheres):
 
 
 def test_show_result_network_widths_and_plate(steel):
-    """A result: the model's contact count, plate contact forces as stored, line widths
-    proportional to the force, the default time a plate snapshot of largest E_plate with
-    the plate deformed and the magnification in the title."""
+    """A result: the contacts of its contact table at that time and its plate contacts,
+    their forces as stored, line widths proportional to the force, the default time a plate
+    snapshot of largest E_plate with the plate deformed and the magnification in the title."""
     a = assembly.of_result(steel)
-    scenario = scenario_of(steel)
-    assert len(a.segments) == _model_contacts(scenario)
+    on = steel.link_time.values == a.time
+    assert on.sum() > 0 and len(a.segments) == on.sum() + steel.sizes["contact"]
     ti = int(np.argmin(np.abs(steel.time.values - a.time)))
     plate = [k for k, kind in enumerate(a.kinds) if kind == "plate"]
     np.testing.assert_allclose(a.forces[plate], np.maximum(steel.contact_normal_force.values[ti], 0.0))
+    table = [k for k, kind in enumerate(a.kinds) if kind != "plate"]
+    np.testing.assert_array_equal(np.sort(a.forces[table]), np.sort(steel.link_normal_force.values[on]))
     snaps = steel.field_time.values
     assert np.min(np.abs(snaps - a.time)) < 1e-12
     ep_snap = [float(steel.E_plate.sel(time=t, method="nearest")) for t in snaps]

@@ -1,21 +1,17 @@
 """What `granplate show` draws, as plain arrays [m, N]: an `Assembly`.
 
-`of_scenario(scenario)` is the assembly before the run (the model's contact network,
-no forces); `of_result(ds, time)` is the assembly of a result at one output time: the
+`of_scenario(scenario)` is the assembly before the run (the contact network at t = 0, no
+forces); `of_result(ds, time)` is the assembly of a result at one output time: the
 granules where they are, the plate deformed (displacements magnified) when a plate-field
 snapshot exists at that time, and the normal force of every contact.
 
-Contact forces at a time of a result:
+Contact forces at a time of a result are read, never recomputed:
 
-- granule-granule: the elastic part of the normal force, A delta^(3/2) with
-  A = 4/3 E* sqrt(R*) (paper eqs. 2-4, docs/model.md section 3.2) and the overlap
-  delta = R_i + R_j - |s_j - s_i| from the stored centres;
-- granule-wall: the same law with E* = E_i/(1 - nu_i^2), R* = R_i and the overlap
-  (s_i - s_i(0)) . n measured from the initial position (docs/model.md section 3.3);
-- granule-plate: the stored `contact_normal_force` (exact, docs/output.md).
-
-The damping part gamma d(delta)/dt is left out of the first two: they are the elastic,
-reversible part of the force (the whole force at the instant of largest overlap).
+- granule-granule and granule-wall: the result's contact table (`link_*`, docs/output.md:
+  the normal force of each contact's own law, with its history and damping, at the
+  output times every time.contact_interval); a time without a table is drawn at the
+  nearest time with one (a result without any table: no such contacts drawn);
+- granule-plate: the stored `contact_normal_force` (docs/output.md).
 """
 
 from __future__ import annotations
@@ -27,12 +23,11 @@ import numpy as np
 import xarray as xr
 
 from granplate.errors import ScenarioError
-from granplate.model.arrays import loaded_granules
-from granplate.physics.contact import hertz_coefficient
+from granplate.model.arrays import find_pairs_and_walls, find_plate_contacts, loaded_granules
 from granplate.results import analysis as an
+from granplate.results.contact_table import links_of
 from granplate.results.dataset import scenario_of
 from granplate.setup.geometry import resolve
-from granplate.setup.materials import effective_modulus
 from granplate.setup.scenario import Load, Scenario, Wall
 
 #: Contact kinds, in the order of `Assembly.segments`.
@@ -98,40 +93,53 @@ class Assembly:
 # --------------------------------------------------------------------------------------
 # Contacts
 # --------------------------------------------------------------------------------------
-def hertz_elastic_force(e_star: float, r_star: float, delta: float) -> float:
-    """Elastic part of the Hertz normal force [N]: A delta^(3/2) with A of paper eq. (3)
-    (a negative overlap gives 0)."""
-    return hertz_coefficient(e_star, r_star) * max(delta, 0.0) ** 1.5
+def contact_lists(scenario: Scenario) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The contact network at t = 0 of a scenario (validated): (pairs (np, 2), wall
+    contacts (nw, 2) [granule, wall], plate contacts (nk,) granule indices), the model's
+    rules (model.arrays: gaps at most contact.neighbour_gap R; the plate's rigid layers,
+    then the patch contacts of granules between its face nodes)."""
+    from granplate.setup.validate import validate
+
+    validate(scenario)
+    s = resolve(scenario)
+    x, y, r = (np.array([getattr(g, k) for g in s.granules], float) for k in ("x", "y", "radius"))
+    pairs, walls = find_pairs_and_walls(s, x, y, r)
+    on, between = find_plate_contacts(s)
+    plate = np.concatenate([np.asarray(on, int).reshape(-1), np.asarray(between, int).reshape(-1)])
+    return np.asarray(pairs, int).reshape(-1, 2), np.asarray(walls, int).reshape(-1, 2), plate
 
 
-def contact_lists(
-    scenario: Scenario,
-    x: np.ndarray | None = None,
-    y: np.ndarray | None = None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The contact network: (pairs (np, 2), wall contacts (nw, 2) [granule, wall], plate
-    contacts (nk,) granule indices). Without positions: the model's lists at t = 0; with
-    positions x, y [m] (a result at some time): the pairs and wall contacts touching there
-    (gap at most contact.neighbour_gap R, the model's rule), since contacts form and open
-    during a run; plate contacts are the model's."""
-    from granplate.model.arrays import build_model
-    from granplate.model.contacts import fixed_wall_contacts
-    from granplate.model.neighbours import contact_pairs
+def table_time(ds: xr.Dataset, ti: int, note: str) -> tuple[int, str]:
+    """(output index, note) of the time drawn for output ti: ti itself when the result's
+    contact table covers it (or the result has none), else the nearest time it covers."""
+    if "link_table_time" not in ds.coords or not ds.sizes.get("link_table_time", 0):
+        return ti, note
+    t = ds["time"].values
+    tt = np.asarray(ds["link_table_time"].values, float)
+    k = int(np.argmin(np.abs(tt - t[ti])))
+    if tt[k] == t[ti]:
+        return ti, note
+    return int(np.argmin(np.abs(t - tt[k]))), f"{note}; drawn at the nearest time of the contact table"
 
-    model = build_model(scenario)
-    plate = np.concatenate(
-        [np.asarray(model.plate_contacts, int).reshape(-1), np.asarray(model.initial_patches, int).reshape(-1)]
-    )
-    if x is None:
-        return (np.asarray(model.pairs, int).reshape(-1, 2), np.asarray(model.wall_contacts, int).reshape(-1, 2), plate)
-    s = model.scenario
-    r = np.asarray(model.granular.radius, float)
-    gap = s.contact.neighbour_gap
-    return (
-        np.asarray(contact_pairs(x, y, r, gap), int).reshape(-1, 2),
-        np.asarray(fixed_wall_contacts(s.walls, x, y, r, gap), int).reshape(-1, 2),
-        plate,
-    )
+
+def result_links(ds: xr.Dataset, ti: int, labels) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(pairs (np, 2), wall contacts (nw, 2) [granule, wall], plate contacts (nk,) granule
+    indices, their normal forces [N] in that order) of a result at output ti: the contact
+    table's rows at that time (none without a table there) and the plate contacts with
+    their stored `contact_normal_force`."""
+    links = links_of(ds, float(ds["time"].values[ti]))
+    pairs, walls, forces = np.zeros((0, 2), int), np.zeros((0, 2), int), []
+    if links is not None:
+        to_pair = links.partner >= 0
+        pairs = np.column_stack([links.granule[to_pair], links.partner[to_pair]]).astype(int)
+        walls = np.column_stack([links.granule[~to_pair], -1 - links.partner[~to_pair]]).astype(int)
+        forces = [links.values[to_pair, 1], links.values[~to_pair, 1]]
+    plate = np.zeros(0, int)
+    if "contact" in ds.coords and "contact_normal_force" in ds:
+        index = {str(v): k for k, v in enumerate(labels)}
+        plate = np.array([index[str(c)] for c in ds["contact"].values], int)
+        forces.append(np.maximum(np.asarray(ds["contact_normal_force"].values[ti], float), 0.0))
+    return pairs, walls, plate, np.concatenate(forces) if forces else np.zeros(0)
 
 
 def wall_foot(x: float, y: float, wall: Wall) -> tuple[float, float]:
@@ -156,29 +164,6 @@ def contact_segments(x, y, r, walls, pairs, wall_contacts, plate_contacts) -> tu
         segs.append(((x[i], y[i]), (x[i] + r[i], y[i])))
         kinds.append("plate")
     return np.asarray(segs, float).reshape(-1, 2, 2), tuple(kinds)
-
-
-def contact_forces(s: Scenario, ds: xr.Dataset, ti: int, pairs, wall_contacts, plate_contacts) -> np.ndarray:
-    """Normal force [N] of every contact at output index ti, in `contact_segments` order
-    (module docstring: Hertz from the overlaps, the stored force at the plate)."""
-    x, y = ds["x"].values[ti], ds["y"].values[ti]
-    x0, y0 = ds["x"].values[0], ds["y"].values[0]
-    r = ds["radius"].values
-    mats = [s.material(g.material) for g in s.granules]
-    out = []
-    for i, j in pairs:
-        delta = r[i] + r[j] - math.hypot(x[j] - x[i], y[j] - y[i])
-        out.append(hertz_elastic_force(effective_modulus(mats[i], mats[j]), r[i] * r[j] / (r[i] + r[j]), delta))
-    for i, w in wall_contacts:
-        n = np.asarray(s.walls[w].normal, float)
-        n = n / np.linalg.norm(n)
-        delta = (x[i] - x0[i]) * n[0] + (y[i] - y0[i]) * n[1]
-        out.append(hertz_elastic_force(effective_modulus(mats[i], None), r[i], delta))
-    if len(plate_contacts):
-        stored = dict(zip((str(c) for c in ds["contact"].values), ds["contact_normal_force"].values[ti]))
-        labels = [g.label for g in s.granules]
-        out += [max(float(stored[labels[i]]), 0.0) for i in plate_contacts]
-    return np.asarray(out, float)
 
 
 # --------------------------------------------------------------------------------------
@@ -338,13 +323,15 @@ def of_scenario(scenario: Scenario) -> Assembly:
 
 def of_result(ds: xr.Dataset, time: float | None = None) -> Assembly:
     """The assembly of a result at `time` [s] (None: see `choose_time`): positions and
-    contact forces at the nearest output, the plate deformed when a snapshot exists."""
+    contact forces at the nearest output (of the contact table's, `table_time`), the plate
+    deformed when a snapshot exists."""
     scenario = scenario_of(ds)
     s = resolve(scenario)
-    ti, note = choose_time(ds, time)
+    ti, note = table_time(ds, *choose_time(ds, time))
     t = float(ds["time"].values[ti])
     x, y = np.asarray(ds["x"].values[ti], float), np.asarray(ds["y"].values[ti], float)
-    pairs, walls, plate = contact_lists(scenario, x, y)
+    labels = tuple(str(v) for v in ds["granule"].values)
+    pairs, walls, plate, forces = result_links(ds, ti, labels)
     r = np.asarray(ds["radius"].values, float)
     segs, kinds = contact_segments(x, y, r, s.walls, pairs, walls, plate)
     return Assembly(
@@ -352,7 +339,7 @@ def of_result(ds: xr.Dataset, time: float | None = None) -> Assembly:
         x=x,
         y=y,
         radius=r,
-        labels=tuple(str(v) for v in ds["granule"].values),
+        labels=labels,
         materials=tuple(str(v) for v in ds["material"].values),
         walls=s.walls,
         plate=result_plate(s, ds, t),
@@ -360,7 +347,7 @@ def of_result(ds: xr.Dataset, time: float | None = None) -> Assembly:
         loaded=loaded_granules(s, np.asarray(ds["x"].values[0], float), r),
         segments=segs,
         kinds=kinds,
-        forces=contact_forces(s, ds, ti, pairs, walls, plate),
+        forces=forces,
         time=t,
         time_note=note,
     )

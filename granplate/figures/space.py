@@ -30,13 +30,12 @@ of the body and one colour scale each for its stress and the contact forces;
 `animation(frames)` the figure laid out once over the region holding every frame, and
 the function that redraws it with frame f.
 
-Contact forces of a result at one output time come from the stored centres and the run's
-own contact coefficients (`model.arrays.pair_coefficients`, `wall_arrays`: the run's
-materials and [[contact.pairs]]), through the run's normal law (`physics.laws`: Hertz, or
-the elastic-plastic law with the largest overlap over the stored outputs up to that
-time as its history), at zero overlap rate: the elastic part of the force, as the
-plane's drawing (`figures.assembly`). Overlaps: R_i + R_j - |s_j - s_i| for a pair,
-s_i . n + R_i - offset for a wall (docs/model.md, the laws in space).
+Contact forces of a result at one output time are read from the result: the granule-
+granule and granule-wall contacts from its contact table (`link_*`, docs/output.md: the
+normal force of each contact's own law with its history and damping, every
+time.contact_interval; a time without a table is drawn at the nearest time with one, an
+animation's frame without one draws no such contacts), the contacts on an elastic body
+from its `body_contact_*`.
 """
 
 from __future__ import annotations
@@ -186,52 +185,18 @@ def body_contacts_at(ds: xr.Dataset, ti: int, pos: np.ndarray, r: np.ndarray) ->
     return np.stack([pos[on], ends], axis=1).reshape(-1, 2, 3), fn[on]
 
 
-def pair_overlaps(pos: np.ndarray, r: np.ndarray, pairs: np.ndarray) -> np.ndarray:
-    """R_i + R_j - |s_j - s_i| [m] of each pair, for pos of shape (..., n, 3)."""
-    i, j = pairs[:, 0], pairs[:, 1]
-    return r[i] + r[j] - np.linalg.norm(pos[..., j, :] - pos[..., i, :], axis=-1)
+def result_links(ds: xr.Dataset, ti: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(pairs (np, 2), wall contacts (nw, 2) [granule, wall], their normal forces [N] in that
+    order) of a result at output ti: its contact table's rows at that time (none without)."""
+    from granplate.results.contact_table import links_of
 
-
-def wall_overlaps(pos: np.ndarray, r: np.ndarray, walls, wall_contacts: np.ndarray) -> np.ndarray:
-    """s_i . n + R_i - offset [m] of each (granule, wall) contact, for pos (..., n, 3)."""
-    i, w = wall_contacts[:, 0], wall_contacts[:, 1]
-    n = np.array([unit_normal(walls[k]) for k in w]).reshape(-1, 3)
-    off = np.array([float(walls[k].offset) for k in w])
-    return np.sum(pos[..., i, :] * n, axis=-1) + r[i] - off
-
-
-def elastic_forces(coef: np.ndarray, delta: np.ndarray, delta_max: np.ndarray) -> np.ndarray:
-    """|N| [N] of each contact at overlap delta [m] (0 where apart) under the run's normal
-    law (`physics.laws.normal_law_force`, coefficient rows coef, largest overlap so far
-    delta_max), at zero overlap rate: the elastic part of the force (under the law "johnson"
-    at the rate-free yield strength: the drawing does not know each contact's rate)."""
-    from granplate.physics.laws import normal_law_force
-
-    return np.array(
-        [
-            normal_law_force(float(d), 0.0, c, float(max(m, d)), 1.0, False) if d > 0.0 else 0.0
-            for d, c, m in zip(delta, coef, delta_max)
-        ],
-        float,
-    )
-
-
-def contact_forces(s: Scenario, positions: np.ndarray, r: np.ndarray, pairs, wall_contacts) -> np.ndarray:
-    """Normal force [N] of every contact (pairs, then walls) at the last of positions
-    (times, n, 3) [m], the earlier rows giving the plastic law's largest overlap."""
-    from granplate.model.arrays import pair_coefficients, wall_arrays
-    from granplate.setup.materials import sphere_mass
-
-    mats = [s.material(g.material) for g in s.granules]
-    mass = np.array([sphere_mass(ri, m.rho) for ri, m in zip(r, mats)])
-    out = []
-    if len(pairs):
-        d = pair_overlaps(positions, r, pairs)
-        out.append(elastic_forces(pair_coefficients(s, mats, r, mass, pairs), d[-1], d.max(axis=0)))
-    if len(wall_contacts):
-        d = wall_overlaps(positions, r, s.walls, wall_contacts)
-        out.append(elastic_forces(wall_arrays(s, mats, r, mass, wall_contacts)[1], d[-1], d.max(axis=0)))
-    return np.concatenate(out) if out else np.zeros(0)
+    links = links_of(ds, float(ds["time"].values[ti]))
+    if links is None:
+        return np.zeros((0, 2), int), np.zeros((0, 2), int), np.zeros(0)
+    to_pair = links.partner >= 0
+    pairs = np.column_stack([links.granule[to_pair], links.partner[to_pair]]).astype(int)
+    walls = np.column_stack([links.granule[~to_pair], -1 - links.partner[~to_pair]]).astype(int)
+    return pairs, walls, np.concatenate([links.values[to_pair, 1], links.values[~to_pair, 1]])
 
 
 # --------------------------------------------------------------------------------------
@@ -341,7 +306,7 @@ def of_scenario(scenario: Scenario) -> Assembly3D:
 def of_result(ds: xr.Dataset, time: float | None = None) -> Assembly3D:
     """The 3D assembly of a result at `time` [s] (None: the last output): centres and
     contact forces at the nearest output (module docstring)."""
-    from granplate.figures.assembly import choose_time
+    from granplate.figures.assembly import choose_time, table_time
     from granplate.results.export import has_body
 
     s, solid = _result_scenario(ds)
@@ -349,7 +314,7 @@ def of_result(ds: xr.Dataset, time: float | None = None) -> Assembly3D:
         k, body_note = body_snapshot(ds, time)
         ti, _ = choose_time(ds, float(ds["field_time"].values[k]))
         return _assembly_at(ds, s, ti, "the output nearest the body's snapshot", solid, body_drawing(ds, k, body_note))
-    ti, note = choose_time(ds, time)
+    ti, note = table_time(ds, *choose_time(ds, time))
     return _assembly_at(ds, s, ti, note)
 
 
@@ -368,18 +333,16 @@ def _result_scenario(ds: xr.Dataset) -> tuple[Scenario, dict]:
 def _assembly_at(
     ds: xr.Dataset, s: Scenario, ti: int, note: str, solid: dict | None = None, body: dict | None = None, **scales
 ) -> Assembly3D:
-    """The result's assembly at output index ti: centres, the contacts touching there and
-    their forces; solid and body: the fields of `solid_drawing` and `body_drawing`;
-    scales: stress_top, force_top."""
+    """The result's assembly at output index ti: centres, the contacts of its contact table
+    there with their forces (`result_links`); solid and body: the fields of `solid_drawing`
+    and `body_drawing`; scales: stress_top, force_top."""
     from granplate.model.space import loaded_granules_3d
 
-    path = positions(ds, ti)
-    pos = path[-1]
+    pos, p0 = (np.stack([ds[k].values[o] for k in ("x", "y", "z")], axis=-1).astype(float) for o in (ti, 0))
     r = np.asarray(ds["radius"].values, float)
-    pairs, wc = touching(s, pos, r)
+    pairs, wc, forces = result_links(ds, ti)
     segs, kinds = contact_segments(pos, s.walls, pairs, wc)
     body_segs, body_forces = body_contacts_at(ds, ti, pos, r)
-    p0 = path[0]
     return Assembly3D(
         name=s.name,
         pos=pos,
@@ -391,7 +354,7 @@ def _assembly_at(
         loaded=loaded_granules_3d(s, p0[:, 0], p0[:, 1], p0[:, 2], r),
         segments=np.concatenate([segs, body_segs]),
         kinds=kinds + ("body",) * len(body_segs),
-        forces=np.concatenate([contact_forces(s, path, r, pairs, wc), body_forces]),
+        forces=np.concatenate([forces, body_forces]),
         time=float(ds["time"].values[ti]),
         time_note=note,
         **(solid or {}),

@@ -18,6 +18,7 @@ import xarray as xr
 from granplate.version import __version__
 from granplate.plate.peaks import BLOCK, block_starts, peak_maxima, split_coordinates, time_maxima
 from granplate.solver import state as K
+from granplate.results.contact_table import LINK_VARIABLES
 from granplate.results.yielding import largest, pair_yield
 from granplate.solver.driver import INTERRUPTED_STATUS
 
@@ -107,6 +108,9 @@ VARIABLES: dict[str, tuple[str, str]] = {
         "time each plate contact formed: 0 for those at t = 0, a patch contact's when its granule came within contact.skin R of the face",
     ),
 }
+
+
+VARIABLES.update(LINK_VARIABLES)  # the contact table's (results.contact_table)
 
 
 #: the Dataset's names of the granules' state columns, by the number of columns (the
@@ -432,6 +436,7 @@ def to_dataset(
     data["contact_time_formed"] = _var("contact_time_formed", ("contact",), axis.time_formed)
     data.update(wall_and_drive_outputs(model, out, n, coords))
     data.update(sensor_outputs(model, out, float(t[-1]) if n else -math.inf, coords))
+    data.update(link_outputs(model, out, n, contacts, coords))
     if model.plate is not None:
         ft = plate_data.pop("_field_time")
         data.update(plate_data)
@@ -585,10 +590,14 @@ def _attrs(model, out: K.Output, n: int, info: dict) -> dict:
 
 
 def write(ds: xr.Dataset, path: str | Path) -> Path:
-    """Write a result to netCDF (compressed) and return the path."""
+    """Write a result to netCDF (its floats and the contact table compressed) and return the path."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    enc = {v: {"zlib": True, "complevel": 4} for v in ds.data_vars if ds[v].dtype.kind == "f"}
+    enc = {
+        v: {"zlib": True, "complevel": 4}
+        for v in ds.data_vars
+        if ds[v].dtype.kind == "f" or (ds[v].dtype.kind == "i" and ds[v].dims == ("link",))
+    }
     ds.to_netcdf(path, encoding=enc)
     return path
 
@@ -657,6 +666,19 @@ def wall_and_drive_outputs(model, out: K.Output, n: int, coords: dict) -> dict[s
         )
         data["drive_force"] = _var("drive_force", ("time", "drive"), out.drive[:n, :, 0].copy())
         data["drive_displacement"] = _var("drive_displacement", ("time", "drive"), out.drive[:n, :, 1].copy())
+    return data
+
+
+def link_outputs(model, out: K.Output, n: int, contacts, coords: dict) -> dict[str, xr.DataArray]:
+    """The contact table (results.contact_table: every granule-granule and granule-wall
+    contact in touch every time.contact_interval), with its coordinate `link_table_time`
+    added to coords; none for time.contact_interval = 0."""
+    from granplate.results.contact_table import contact_table
+    from granplate.setup.run_checks import contact_steps
+
+    peaks = contacts.peaks if contacts is not None else None
+    data, more = contact_table(model, out, n, peaks, contact_steps(model.scenario.time))
+    coords.update(more)
     return data
 
 

@@ -124,9 +124,10 @@ def loose_scenario(s: Scenario, lay: PouredLayout, alpha_n: float | None) -> Sce
 
 def _end_state(ds) -> np.ndarray:
     """The state (ng, columns) at the chunk's last output time."""
-    from granplate.results.dataset import STATE_VARIABLES
+    from granplate.results.dataset import STATE_VARIABLES, dimension_of
+    from granplate.solver.state import STATE_COLUMNS
 
-    cols = 9 if "z" in ds else 6
+    cols = STATE_COLUMNS[dimension_of(ds)]
     return np.column_stack([np.asarray(ds[name].values[-1], float) for name in STATE_VARIABLES[cols]])
 
 

@@ -47,7 +47,34 @@ def _check_time(s: Scenario) -> None:
             f"{t.output_interval!r}, 1 <= n <= 2^53 (beyond, every double is whole)",
         )
     _check_restart_interval(t)
+    _check_contact_interval(t)
     _check_restart_table(s)
+
+
+def contact_steps(t) -> int:
+    """The contact table's interval in output intervals (TimeSettings t): time.contact_interval,
+    or time.field_interval when absent; 0: no table."""
+    dt = t.field_interval if t.contact_interval is None else t.contact_interval
+    return round(dt / t.output_interval)
+
+
+def _check_contact_interval(t) -> None:
+    """time.contact_interval: 0 (no contact table) or a whole multiple of output_interval."""
+    if t.contact_interval is None:
+        return
+    nonneg("time.contact_interval", t.contact_interval)
+    dt = float(t.contact_interval)
+    if dt == 0.0:
+        return
+    r = dt / t.output_interval
+    n = round(r)
+    if n < 1 or abs(r - n) > INTERVAL_RTOL * r or n > 2**53:
+        raise ScenarioError(
+            "time.contact_interval",
+            dt,
+            f"must be 0 (no contact table) or a whole multiple n of time.output_interval = "
+            f"{t.output_interval!r} s, 1 <= n <= 2^53 (absent: time.field_interval)",
+        )
 
 
 def _check_restart_table(s: Scenario) -> None:
@@ -105,19 +132,24 @@ def _check_restart_interval(t) -> None:
 OUTPUT_BYTES_PER_GRANULE = 3 * 8 * 12
 OUTPUT_BYTES_PER_DOF = 3 * 8 * 2
 FIELD_BYTES_PER_DOF = 3 * 8 * 4
+#: Bytes of the contact table per granule and table time (time.contact_interval): about 3
+#: rows of 40 bytes per granule, 2 copies (the rows built, the Dataset).
+LINK_BYTES_PER_GRANULE = 2 * 3 * 40
 
 
 def output_bytes_per_second(s: Scenario) -> float:
     """About the memory [bytes] a run's outputs take per second of simulated time: a row
     of the granules' states and the plate's modal coordinates per output_interval, a plate
-    snapshot per field_interval (s resolved)."""
+    snapshot per field_interval, the contact table per contact_interval (s resolved)."""
     t = s.time
     n_dof = 0  # a 3D solid writes no fields yet (its coupling comes with its outputs)
     if isinstance(s.plate, Plate):
         p = s.plate
         n_dof = 2 * ((p.nx + 1) * (p.ny + 1) + p.nx * (p.ny + 1) + p.ny * (p.nx + 1))
     row = OUTPUT_BYTES_PER_GRANULE * len(s.granules) + OUTPUT_BYTES_PER_DOF * n_dof + 400.0
-    return row / t.output_interval + FIELD_BYTES_PER_DOF * n_dof / t.field_interval
+    steps = contact_steps(t)
+    table = LINK_BYTES_PER_GRANULE * len(s.granules) / (steps * t.output_interval) if steps > 0 else 0.0
+    return row / t.output_interval + FIELD_BYTES_PER_DOF * n_dof / t.field_interval + table
 
 
 def _check_output_size(s: Scenario) -> None:

@@ -560,7 +560,9 @@ class TimeSettings:
     [[sensors]]' samples (None: output_interval), landed on by the steps like the
     output times; restart_interval: the loop's whole state is also stored at the output
     times k restart_interval before t_end (a multiple of output_interval; None: at t_end
-    only; docs/how-to/restart.md).
+    only; docs/how-to/restart.md); contact_interval: the contact table's times, the forces
+    of every granule-granule and granule-wall contact in touch (a multiple of
+    output_interval; None: every field_interval; 0: no table; docs/output.md).
     """
 
     t_end: float = 2e-3
@@ -571,6 +573,7 @@ class TimeSettings:
     field_interval: float = 2e-5
     sensor_interval: float | None = None
     restart_interval: float | None = None
+    contact_interval: float | None = None
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from granplate.model.arrays import Model, granular_with_contacts, granular_with_patch_contacts
-from granplate.model.inputs import DR_REF, DR_S, HIST_MAX, HIST_TIME, no_history
+from granplate.model.inputs import DR_REF, DR_S, HIST_MAX, HIST_RATE, HIST_TIME, no_history
 from granplate.model.contacts import Missed, centre_coordinates, contact_lists, missed_contacts, wall_planes
 from granplate.model.neighbours import verlet_pairs, verlet_walls
 from granplate.physics.contact import plate_overlap
@@ -54,6 +54,7 @@ class ContactPeaks(NamedTuple):
     partner: np.ndarray  # (n,) int64: granule j, wall -1 - w, or state.PARTNER_PLATE
     delta_max: np.ndarray  # (n,) [m]: the largest overlap
     time: np.ndarray  # (n,) [s]: when it was reached
+    rate: np.ndarray | None = None  # (n,) [-]: the rate factor that fixed its yield strength (law "johnson"; 0: unset)
 
 
 def contact_peaks(g, stores: tuple[dict, dict], body=None) -> ContactPeaks:
@@ -73,8 +74,9 @@ def contact_peaks(g, stores: tuple[dict, dict], body=None) -> ContactPeaks:
     partner = np.concatenate([np.asarray(b, np.int64) for _, b, _ in parts])
     peak = np.concatenate([_column(h, len(a), HIST_MAX) for a, _, h in parts])
     when = np.concatenate([_column(h, len(a), HIST_TIME) for a, _, h in parts])
+    rate = np.concatenate([_column(h, len(a), HIST_RATE) for a, _, h in parts])
     on = peak > 0.0
-    return ContactPeaks(granule=granule[on], partner=partner[on], delta_max=peak[on], time=when[on])
+    return ContactPeaks(granule=granule[on], partner=partner[on], delta_max=peak[on], time=when[on], rate=rate[on])
 
 
 def _column(h, n: int, c: int) -> np.ndarray:

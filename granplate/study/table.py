@@ -26,6 +26,7 @@ FIELD_UNITS: dict[str, str] = {
     "field_interval": "s",
     "sensor_interval": "s",
     "restart_interval": "s",
+    "contact_interval": "s",
     "time": "s",  # restart.time
     "R1": "m",
     "R2_ratio": "1",

@@ -1,0 +1,401 @@
+"""The result's contact table: every granule-granule and granule-wall contact in touch at
+the table's output times (time.contact_interval), with its overlap, normal force and
+friction force, computed from the recorded states by the loop's own contact laws.
+
+Each row of the table (dimension `link`) is one contact at one time: `link_time` [s], the
+granule `link_granule` and its partner `link_partner` (a granule index, or -1 - w for
+wall w of the `wall` axis), `link_overlap` delta [m], `link_normal_force` |N| [N] and
+`link_tangential_force` |F_t| [N]; the coordinate `link_table_time` lists the times the
+table covers (a time with no contact in touch has no rows). docs/output.md.
+
+How each force is found, at the recorded state (positions and velocities) of that time:
+
+- the overlap and its rate with the loop's kinematics (physics.contact in the plane,
+  physics.space and solver.granular3d in space), a driven wall where its drive put it
+  (its recorded displacement) moving at its drive's speed (the prescribed motion's, or a
+  piston's from its recorded displacements by central differences);
+- the normal force by the contact's normal law (physics.laws.normal_law_force: Hertz,
+  Thornton's or "johnson"), with the coefficient rows the loop builds
+  (model.arrays.pair_coefficients, wall_arrays) and the contact's history: its largest
+  overlap so far is the largest of its overlap now, its overlaps at the earlier output
+  times (every output time, for a run with a yielding law), and the run's final largest
+  overlap once the time it was reached has passed (solver.driver.ContactPeaks); its rate
+  factor the run's final one once it has yielded. The largest overlap is exact after the
+  contact's last loading and while it loads monotonically; between two loadings it is
+  the largest sampled at the output times (a lower bound);
+- the friction force |mu N tanh(k_s v_t)| (eq. 5) at the recorded slip rate, the law the
+  loop integrates (under solver.granular_friction = "split" it applies it in exact half
+  steps, so the force over a step is this law's along the slip's relaxation).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+import xarray as xr
+from numba import njit
+
+from granplate.physics.contact import (
+    COEF_DY,
+    COEF_KS,
+    COEF_MU,
+    contact_arm,
+    friction_magnitude,
+    pair_overlap,
+    pair_rates,
+    wall_overlap,
+    wall_rates,
+)
+from granplate.physics.laws import normal_law_force
+from granplate.physics.space import pair_contact_3d, wall_overlap_3d
+from granplate.solver.granular3d import pair_slip, wall_slip
+
+#: name -> (units, description) of the table's variables (docs/output.md)
+LINK_VARIABLES: dict[str, tuple[str, str]] = {
+    "link_time": ("s", "output time of each row of the contact table (one contact in touch at one time)"),
+    "link_granule": ("1", "the contact's granule (index on the granule axis)"),
+    "link_partner": (
+        "1",
+        "its partner: a granule index j > link_granule, or -1 - w for wall w (index on the wall axis)",
+    ),
+    "link_overlap": ("m", "the contact's overlap delta > 0"),
+    "link_normal_force": ("N", "the normal force |N| of the contact's normal law, damping included (eqs. 2-4)"),
+    "link_tangential_force": ("N", "the magnitude of the friction force mu |N| |tanh(k_s v_t)| (eq. 5)"),
+}
+
+#: the table's columns in the kernels' output rows
+OVERLAP, NORMAL, TANGENTIAL = 0, 1, 2
+
+
+class Links(NamedTuple):
+    """The contacts in touch at one time: granule (n,), partner (n,) (granule j or -1 - w),
+    values (n, 3): overlap [m], normal force [N], friction force [N]."""
+
+    granule: np.ndarray
+    partner: np.ndarray
+    values: np.ndarray
+
+
+@njit(cache=True)
+def pair_links(y, radius, pairs, coef, dmax, rate, arm_shrink, clip, out):
+    """Overlap, normal and friction force of each pair (i, j) of `pairs` at state y (the
+    plane's 6 columns or space's 9) into out (np, 3); out[p, OVERLAP] <= 0 where apart.
+    dmax, rate: each contact's largest overlap so far [m] and rate factor [-]."""
+    space = y.shape[1] == 9
+    for p in range(pairs.shape[0]):
+        i = pairs[p, 0]
+        j = pairs[p, 1]
+        ri = radius[i]
+        rj = radius[j]
+        if space:
+            delta, nx, ny, nz = pair_contact_3d(y[i, 0], y[i, 1], y[i, 2], ri, y[j, 0], y[j, 1], y[j, 2], rj)
+        else:
+            delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
+            ny = 0.0
+        out[p, OVERLAP] = delta
+        out[p, NORMAL] = 0.0
+        out[p, TANGENTIAL] = 0.0
+        if delta <= 0.0:
+            continue
+        c = coef[p]
+        ai = contact_arm(ri, delta, 0.5 * arm_shrink)
+        aj = contact_arm(rj, delta, 0.5 * arm_shrink)
+        if space:
+            ddot, sx, sy, sz = pair_slip(y, i, j, nx, ny, nz, ai, aj)
+            vt = math.sqrt(sx * sx + sy * sy + sz * sz)
+        else:
+            ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
+        n = normal_law_force(delta, ddot, c, max(dmax[p], delta), rate[p], clip)
+        out[p, NORMAL] = n
+        out[p, TANGENTIAL] = abs(friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS]))
+
+
+@njit(cache=True)
+def wall_links(y, radius, granule, geo, vn, coef, dmax, rate, arm_shrink, clip, out):
+    """Overlap, normal and friction force of each granule `granule[k]` against the wall of
+    row geo[k] ([n..., offset where the wall is], unit outward normal) moving at vn[k] [m/s]
+    along it, into out (nw, 3), as `pair_links`."""
+    space = y.shape[1] == 9
+    for k in range(granule.shape[0]):
+        i = granule[k]
+        ri = radius[i]
+        if space:
+            nx, ny, nz = geo[k, 0], geo[k, 1], geo[k, 2]
+            delta = wall_overlap_3d(y[i, 0], y[i, 1], y[i, 2], ri, nx, ny, nz, geo[k, 3])
+        else:
+            nx, nz = geo[k, 0], geo[k, 1]
+            delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, geo[k, 2])
+        out[k, OVERLAP] = delta
+        out[k, NORMAL] = 0.0
+        out[k, TANGENTIAL] = 0.0
+        if delta <= 0.0:
+            continue
+        c = coef[k]
+        a = contact_arm(ri, delta, arm_shrink)
+        if space:
+            ddot, sx, sy, sz = wall_slip(y, i, nx, ny, nz, a)
+            vt = math.sqrt(sx * sx + sy * sy + sz * sz)
+        else:
+            ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, a)
+        n = normal_law_force(delta, ddot - vn[k], c, max(dmax[k], delta), rate[k], clip)
+        out[k, NORMAL] = n
+        out[k, TANGENTIAL] = abs(friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS]))
+
+
+def table_rows(n: int, steps: int, times: np.ndarray, t_end: float, dt_out: float) -> np.ndarray:
+    """The output rows (of n, at `times` [s]) the table covers: the output times k steps
+    dt_out of the whole run (a restarted run's first row being a later one), and the last
+    when the run reached t_end (as the plate snapshots); none for steps 0."""
+    if steps <= 0 or n == 0:
+        return np.zeros(0, np.int64)
+    first = int(round(float(times[0]) / dt_out))
+    idx = np.arange((-first) % steps, n, steps, dtype=np.int64)
+    if (not len(idx) or idx[-1] != n - 1) and np.isclose(times[n - 1], t_end):
+        idx = np.append(idx, n - 1)
+    return idx
+
+
+class WallMotion(NamedTuple):
+    """The walls at every output time: unit outward normals (n_walls, d), offsets (no,
+    n_walls) [m] and speeds along the normal (no, n_walls) [m/s]."""
+
+    normal: np.ndarray
+    offset: np.ndarray
+    speed: np.ndarray
+
+
+def wall_motion(model, out, n: int) -> WallMotion:
+    """Where the walls of `model` (Model.walls, where the run starts) are at the n output
+    times of `out`: a driven wall shifted by its drive's recorded displacement along its
+    direction, moving at its prescribed speed (a piston: the central differences of its
+    displacements)."""
+    from granplate.physics.drives import drive_motion
+    from granplate.solver.drives import is_piston
+
+    walls, g = model.walls, model.granular
+    d = model.config.dimension
+    normal = np.array([np.asarray(w.normal, float) / np.linalg.norm(w.normal) for w in walls]).reshape(-1, d)
+    offset = np.tile(np.array([float(w.offset) for w in walls]), (n, 1))
+    speed = np.zeros_like(offset)
+    t = np.asarray(out.t[:n], float)
+    for w, k in enumerate(np.asarray(g.wall_drive, np.int64).tolist()):
+        if k < 0:
+            continue
+        ne = float(normal[w] @ np.asarray(g.drive_dir[k], float))
+        s = np.asarray(out.drive[:n, k, 1], float)
+        offset[:, w] += s * ne
+        if is_piston(g, k):
+            v = np.gradient(s, t) if n > 1 else np.zeros(n)
+        else:
+            args = (g.drive_kind[k], g.drive_prof[k], g.drive_par[k], g.drive_tab[k], g.drive_tlen[k])
+            v = np.array([drive_motion(float(tk), *args)[1] for tk in t])
+        speed[:, w] = v * ne
+    return WallMotion(normal, offset, speed)
+
+
+def touching_pairs(y: np.ndarray, radius: np.ndarray) -> np.ndarray:
+    """(np, 2) sorted pairs i < j whose surfaces touch or overlap at state y (a k-d tree,
+    model.neighbours.contact_pairs with no gap)."""
+    from granplate.model.neighbours import contact_pairs
+
+    z = y[:, 2] if y.shape[1] == 9 else None
+    return np.asarray(contact_pairs(y[:, 0], y[:, 1], radius, 0.0, z), np.int64).reshape(-1, 2)
+
+
+def touching_walls(y: np.ndarray, radius: np.ndarray, walls: WallMotion, o: int) -> np.ndarray:
+    """(nw, 2) [granule, wall] of the granules reaching each wall at output o (overlap >= 0)."""
+    d = walls.normal.shape[1]
+    if not len(walls.normal):
+        return np.zeros((0, 2), np.int64)
+    reach = y[:, :d] @ walls.normal.T + radius[:, None] - walls.offset[o][None, :]
+    i, w = np.nonzero(reach >= 0.0)
+    return np.column_stack([i, w]).astype(np.int64).reshape(-1, 2)
+
+
+class History:
+    """Each contact's largest overlap so far and rate factor at an output time (module
+    docstring), from the run's final histories (peaks) and the overlaps seen at the output
+    times passed so far (`see`). Contacts are keyed granule * width + (partner + n_walls + 1)."""
+
+    def __init__(self, peaks, n_granules: int, n_walls: int):
+        self.width = n_granules + n_walls + 2
+        self.n_walls = n_walls
+        self.seen_key = np.zeros(0, np.int64)
+        self.seen_max = np.zeros(0)
+        if peaks is None or not len(peaks.granule):
+            self.key, self.peak, self.when, self.rate = (np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros(0))
+            return
+        key = self.keys(peaks.granule, peaks.partner)
+        order = np.argsort(key, kind="stable")
+        self.key, self.peak, self.when = key[order], np.asarray(peaks.delta_max)[order], np.asarray(peaks.time)[order]
+        rate = np.zeros(len(key)) if peaks.rate is None else np.asarray(peaks.rate, float)
+        self.rate = rate[order]
+
+    def keys(self, granule: np.ndarray, partner: np.ndarray) -> np.ndarray:
+        return np.asarray(granule, np.int64) * self.width + (np.asarray(partner, np.int64) + self.n_walls + 1)
+
+    def see(self, key: np.ndarray, delta: np.ndarray) -> None:
+        """Take the overlaps delta [m] of the contacts `key` at one output time into the
+        largest seen so far."""
+        on = delta > 0.0
+        if not on.any():
+            return
+        keys = np.concatenate([self.seen_key, key[on]])
+        values = np.concatenate([self.seen_max, delta[on]])
+        self.seen_key, inverse = np.unique(keys, return_inverse=True)
+        self.seen_max = np.full(len(self.seen_key), -np.inf)
+        np.maximum.at(self.seen_max, inverse, values)
+
+    def at(self, key: np.ndarray, t: float, coef: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(largest overlap so far [m], rate factor [-]) of the contacts `key` at time t [s]
+        (coef: their coefficient rows: the rate factor is the loop's, 0, until the largest
+        overlap passes the rate-free yield overlap)."""
+        dmax = np.zeros(len(key))
+        if len(self.seen_key):
+            k = np.clip(np.searchsorted(self.seen_key, key), 0, len(self.seen_key) - 1)
+            hit = self.seen_key[k] == key
+            dmax[hit] = self.seen_max[k[hit]]
+        rate = np.zeros(len(key))
+        if len(self.key):
+            k = np.clip(np.searchsorted(self.key, key), 0, len(self.key) - 1)
+            hit = self.key[k] == key
+            done = hit & (self.when[k] <= t * (1.0 + 1e-12))
+            dmax[done] = np.maximum(dmax[done], self.peak[k[done]])
+            rate[hit] = self.rate[k[hit]]
+        yielded = dmax > np.asarray(coef, float).reshape(len(key), -1)[:, COEF_DY] if len(key) else np.zeros(0, bool)
+        return dmax, np.where(yielded, rate, 0.0)
+
+
+def links_at(model, y: np.ndarray, o: int, walls: WallMotion, history: History, t: float, known: dict) -> Links:
+    """The contacts in touch at state y, output o (time t [s]), with their forces; known:
+    the pairs' coefficient rows met so far (model.arrays.cached_pair_coefficients)."""
+    from granplate.model.arrays import cached_pair_coefficients, wall_arrays
+
+    s, mats, g, cfg = model.scenario, list(model.materials), model.granular, model.config
+    r = np.asarray(g.radius, float)
+    pairs = touching_pairs(y, r)
+    coef = cached_pair_coefficients(s, mats, g, pairs, known)
+    dmax, rate = history.at(history.keys(pairs[:, 0], pairs[:, 1]), t, coef)
+    pv = np.zeros((len(pairs), 3))
+    pair_links(y, r, pairs, coef, dmax, rate, cfg.arm_shrink, cfg.clip, pv)
+    wc = touching_walls(y, r, walls, o)
+    _, wcoef = wall_arrays(s, mats, r, g.mass, wc, model.walls)
+    w = wc[:, 1]
+    geo = (
+        np.column_stack([walls.normal[w], walls.offset[o, w]]) if len(wc) else np.zeros((0, walls.normal.shape[1] + 1))
+    )
+    dmax, rate = history.at(history.keys(wc[:, 0], -1 - w), t, wcoef)
+    wv = np.zeros((len(wc), 3))
+    wall_links(
+        y,
+        r,
+        np.ascontiguousarray(wc[:, 0]),
+        geo,
+        walls.speed[o, w].copy(),
+        wcoef,
+        dmax,
+        rate,
+        cfg.arm_shrink,
+        cfg.clip,
+        wv,
+    )
+    on_p, on_w = pv[:, OVERLAP] > 0.0, wv[:, OVERLAP] > 0.0
+    return Links(
+        granule=np.concatenate([pairs[on_p, 0], wc[on_w, 0]]),
+        partner=np.concatenate([pairs[on_p, 1], -1 - wc[on_w, 1]]),
+        values=np.concatenate([pv[on_p], wv[on_w]]),
+    )
+
+
+def overlaps_at(model, y: np.ndarray, o: int, walls: WallMotion, history: History) -> None:
+    """The overlaps of the contacts touching at output o taken into `history` (no forces)."""
+    r = np.asarray(model.granular.radius, float)
+    d = walls.normal.shape[1]
+    pairs = touching_pairs(y, r)
+    dist = np.linalg.norm(y[pairs[:, 1], :d] - y[pairs[:, 0], :d], axis=1)
+    history.see(history.keys(pairs[:, 0], pairs[:, 1]), r[pairs[:, 0]] + r[pairs[:, 1]] - dist)
+    wc = touching_walls(y, r, walls, o)
+    i, w = wc[:, 0], wc[:, 1]
+    delta = np.sum(y[i, :d] * walls.normal[w], axis=1) + r[i] - walls.offset[o, w]
+    history.see(history.keys(i, -1 - w), delta)
+
+
+def yields(model) -> bool:
+    """Whether any contact of the run may follow a yielding law (its history matters): a
+    law other than Hertz's between two of its granules' materials or a granule's and a wall's."""
+    s = model.scenario
+    names = sorted({m.name for m in model.materials})
+    others = names + sorted({w.material for w in model.walls})
+    return any(s.contact.law_for_pair(a, b) != "hertz" for a in names for b in others)
+
+
+def contact_table(model, out, n: int, peaks, steps: int) -> tuple[dict[str, xr.DataArray], dict]:
+    """The contact table's variables and its coordinate `link_table_time` over the first n
+    output rows of `out` (solver.state.Output), every `steps` rows (run_checks.contact_steps;
+    0: none, an empty dict each); peaks: the run's ContactPeaks (None: none known)."""
+    t = np.asarray(out.t[:n], float)
+    rows = table_rows(n, steps, t, model.scenario.time.t_end, model.scenario.time.output_interval)
+    if not len(rows):
+        return {}, {}
+    walls = wall_motion(model, out, n)
+    history = History(peaks, model.n_granules, len(model.walls))
+    plastic = yields(model)
+    wanted = set(rows.tolist())
+    tables: list[Links] = []
+    known: dict = {}
+    for o in range(int(rows[-1]) + 1):
+        y = np.ascontiguousarray(out.y[o], dtype=float)
+        if o in wanted:
+            links = links_at(model, y, o, walls, history, float(t[o]), known)
+            tables.append(links)
+            keys = history.keys(links.granule, links.partner)
+            history.see(keys, links.values[:, OVERLAP])
+        elif plastic:
+            overlaps_at(model, y, o, walls, history)
+    return table_variables(tables, t[rows])
+
+
+def table_variables(tables: list[Links], times: np.ndarray) -> tuple[dict[str, xr.DataArray], dict]:
+    """The Dataset variables of the tables at `times` [s] (module docstring)."""
+    counts = np.array([len(x.granule) for x in tables], np.int64)
+    values = np.concatenate([x.values for x in tables]) if tables else np.zeros((0, 3))
+
+    def var(name: str, data) -> xr.DataArray:
+        units, desc = LINK_VARIABLES[name]
+        return xr.DataArray(data, dims=("link",), attrs={"units": units, "long_name": desc})
+
+    data = {
+        "link_time": var("link_time", np.repeat(times, counts)),
+        "link_granule": var("link_granule", np.concatenate([x.granule for x in tables]).astype(np.int32)),
+        "link_partner": var("link_partner", np.concatenate([x.partner for x in tables]).astype(np.int32)),
+        "link_overlap": var("link_overlap", values[:, OVERLAP].copy()),
+        "link_normal_force": var("link_normal_force", values[:, NORMAL].copy()),
+        "link_tangential_force": var("link_tangential_force", values[:, TANGENTIAL].copy()),
+    }
+    coords = {
+        "link_table_time": (
+            "link_table_time",
+            np.asarray(times, float).copy(),
+            {"units": "s", "long_name": "the output times the contact table covers (time.contact_interval)"},
+        )
+    }
+    return data, coords
+
+
+def links_of(ds: xr.Dataset, t: float) -> Links | None:
+    """The contact table's rows at time t [s] of a result (None: the result has no table at
+    that time, or none at all)."""
+    if "link_table_time" not in ds.coords or "link_time" not in ds:
+        return None
+    tt = np.asarray(ds["link_table_time"].values, float)
+    if not len(tt) or not np.isclose(tt, t, rtol=1e-12, atol=0.0).any():
+        return None
+    on = np.asarray(ds["link_time"].values, float) == tt[np.argmin(np.abs(tt - t))]
+    values = np.column_stack([ds[f"link_{k}"].values[on] for k in ("overlap", "normal_force", "tangential_force")])
+    return Links(
+        granule=np.asarray(ds["link_granule"].values[on], np.int64),
+        partner=np.asarray(ds["link_partner"].values[on], np.int64),
+        values=np.asarray(values, float).reshape(-1, 3),
+    )
