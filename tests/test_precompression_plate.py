@@ -4,7 +4,7 @@ and the plate's deflection under it is the compliance of an independent static f
 solve (scikit-fem's own plane-stress elasticity form, K u = f) times F; the paper's packing,
 precompressed, stays at rest without a shock, its plate's contacts carrying the force;
 with a shock eq. (11) holds at every step from the stored energy (contacts + plate).
-(Gravity with a plate is refused: the plate's own weight is not modelled.)"""
+(Gravity with the plate: the static state about its sag, tests/test_gravity_plate.py.)"""
 
 from __future__ import annotations
 

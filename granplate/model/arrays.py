@@ -534,6 +534,7 @@ def initial_state(s: Scenario, x: np.ndarray, y: np.ndarray) -> np.ndarray:
 def build_model(scenario: Scenario) -> Model:
     """Validate, resolve and turn a scenario into the loop's arrays (in space, dimension =
     3: `model.space.build_space_model`)."""
+    from granplate.model.plate_weight import weighed
     from granplate.model.static import precompressed
 
     validate(scenario)
@@ -593,7 +594,7 @@ def build_model(scenario: Scenario) -> Model:
         materials=tuple(mats),
         initial_patches=patches,
     )
-    return precompressed(model)
+    return precompressed(weighed(model))  # the plate in its sag under its own weight, then the static state
 
 
 def carried_history(old_keys: np.ndarray, old_hist: np.ndarray, new_keys: np.ndarray, store: dict) -> np.ndarray:
