@@ -149,8 +149,9 @@ def centre_index(model) -> int:
 
 
 def plate_frequencies_checks(lim_thin, p_thin, lim_thick, p_thick, mesh_why, mind_thin, mind_thick, nf, thin):
-    """The checks of `plate_frequencies`: the thin plate's frequency parameters against Leissa's Kirchhoff values
-    and their convergence, the thick plate's against Mindlin's (Ritz)."""
+    """The checks of `plate_frequencies`: the frequency parameters lambda^2 of the thin (a/h = 50) and thick
+    (a/h = 10) plates and their mesh limits (Richardson) against Kirchhoff (Leissa) and Mindlin (Ritz), and
+    the observed orders of convergence."""
     from .plate_theory import LEISSA_CCCC_SQUARE
 
     checks = [
@@ -807,7 +808,8 @@ def zener_reference(radius: float) -> dict:
 
 def zener_plate_checks(refs, runs, model_why, cutoff, finer):
     """The checks of `zener_plate`: each sphere's restitution, contact time and peak force against Zener's,
-    and the worst case's sensitivity to the modes' cut-off and to the mesh."""
+    the flexural return time against the contact time, and the restitution at a higher cut-off and on a
+    finer mesh."""
     checks = []
     for R, ref, run in zip(ZENER_RADII, refs, runs):
         tag = f"lambda = {ref['lambda']:.3f} (R = {R * 1e3:g} mm)"
@@ -1032,8 +1034,8 @@ def history_error(ours: list, reference: list) -> float:
 
 
 def truncated_modes_checks(e_force, e_energy, ratios_f, ratios_e, runs, top, full):
-    """The checks of `truncated_modes`: the contact force's and E_p's errors against the all-modes run at each
-    cut-off, and their convergence as the cut-off rises."""
+    """The checks of `truncated_modes`: the contact force's and E_p's errors against the all-modes run at the
+    highest cut-off, their ratios between doubled cut-offs, and the residual compliance alone."""
     checks = [
         Check(
             f"max |F - F_all| / max F_all, cutoff {top:g} MHz",
