@@ -10,8 +10,6 @@ friction is split off every step (Strang): half a step of friction alone, solved
 contact by contact (`friction_flow`), RK4 of every other force, the other half of
 friction in the reverse contact order; stable for any step. Without it, RK4 integrates
 every force and the step control keeps h times that rate within rk4.RK4_FRICTION_LIMIT.
-
-The contact loops, one per contact kind, are `solver.plane_contacts`' (compiled inline).
 """
 
 from __future__ import annotations
@@ -29,28 +27,24 @@ from granplate.physics.contact import (
     COEF_RL,
     COEF_SY,
     contact_arm,
+    friction_magnitude,
+    friction_power,
+    friction_slope,
     pair_apart,
     pair_normal_rate,
     pair_overlap,
     pair_rates,
+    plate_overlap,
+    plate_rates,
     slip_after_friction,
     wall_overlap,
     wall_rates,
 )
 from granplate.physics.cavity import rate_factor
-from granplate.physics.laws import normal_law_force
-from granplate.solver.drives import begin_pass, finish_pass, wall_motion
-from granplate.solver.plane_contacts import (
-    pair_forces,
-    pair_normal_forces,
-    plate_contact_forces,
-    positions_rates,
-    shock_on_granules,
-    to_accelerations,
-    wall_forces,
-    wall_normal_forces,
-)
-from granplate.solver.plane_contacts import slip_relaxation_rate as slip_relaxation_rate
+from granplate.physics.laws import normal_law_force, normal_law_response
+from granplate.physics.shock import shock_amplitude
+from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_motion
+from granplate.solver.state import PARTNER_PLATE
 
 
 class ForceSums(NamedTuple):
@@ -73,6 +67,15 @@ class ForceSums(NamedTuple):
 
 
 @njit(cache=True)
+def slip_relaxation_rate(n, vt, mu, k_s, inv_mass_t):
+    """How fast the slip of a sticking contact relaxes [1/s]: the friction slope
+    (eq. 8's d f/d v_t) times the contact's tangential inverse mass; zero out of touch."""
+    if n <= 0.0:
+        return 0.0
+    return friction_slope(n, vt, mu, k_s) * inv_mass_t
+
+
+@njit(cache=True)
 def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, split=False, record=False):
     """Time derivative of the granular state and the plate-contact forces.
 
@@ -90,9 +93,16 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
     (not one per contact kind): calls that pass the model tuples cost more per step
     than the loops themselves when the medium is small.
     """
-    positions_rates(y, dy)
+    ng = y.shape[0]
+    for i in range(ng):
+        dy[i, 0] = y[i, 3]
+        dy[i, 1] = y[i, 4]
+        dy[i, 2] = y[i, 5]
+        dy[i, 3] = 0.0
+        dy[i, 4] = 0.0
+        dy[i, 5] = 0.0
     begin_pass(t, g)
-    p_shock = shock_on_granules(t, y, g, cfg, dy, dy[:0])
+    p_shock = 0.0
     p_visc = 0.0
     p_fric = 0.0
     e_pot = 0.0
@@ -102,35 +112,173 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
     ovl_i = -1
     ovl_j = -1
     w_plastic = 0.0
-    p_visc, p_fric, e_pot, w_plastic, rate, ovl, ovl_i, ovl_j = pair_forces(
-        y, g, cfg, dy, split, record, p_visc, p_fric, e_pot, w_plastic, rate, ovl, ovl_i, ovl_j
-    )
-    p_visc, p_fric, e_pot, w_plastic, rate, ovl, ovl_i, ovl_j = wall_forces(
-        y, g, cfg, dy, split, record, p_visc, p_fric, e_pot, w_plastic, rate, ovl, ovl_i, ovl_j
-    )
-    p_visc, p_fric, e_pot, w_plastic, rate_plate, ovl, ovl_i, ovl_j = plate_contact_forces(
-        y,
-        up,
-        vp,
-        g,
-        cfg,
-        dy,
-        fplate,
-        normal,
-        slip,
-        hold,
-        fbar,
-        record,
-        p_visc,
-        p_fric,
-        e_pot,
-        w_plastic,
-        rate_plate,
-        ovl,
-        ovl_i,
-        ovl_j,
-    )
-    to_accelerations(dy, g)
+    if not cfg.load_on_plate:  # the shock on the loaded granules
+        amp = shock_amplitude(t, cfg)
+        if amp != 0.0:
+            for i in range(ng):
+                fx = amp * g.shock_force[i]
+                tq = amp * g.shock_torque[i]
+                dy[i, 3] += fx
+                dy[i, 5] += tq
+                p_shock += fx * y[i, 3] + tq * y[i, 5]
+    for p in range(g.pair_ij.shape[0]):  # granule-granule contacts
+        i = g.pair_ij[p, 0]
+        j = g.pair_ij[p, 1]
+        ri = g.radius[i]
+        rj = g.radius[j]
+        if record:
+            g.pair_hist[p, HIST_END] = 0.0
+        if pair_apart(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj):
+            continue
+        delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
+        if delta <= 0.0:
+            continue
+        if record:
+            g.pair_hist[p, HIST_END] = delta
+        if delta > ovl * min(ri, rj):
+            ovl = delta / min(ri, rj)
+            ovl_i = i
+            ovl_j = j
+        c = g.pair_coef[p]
+        if split:  # the normal force alone: friction_flow applies the friction
+            n, pv, ep, wp = normal_law_response(
+                delta,
+                pair_normal_rate(y[i, 3], y[i, 4], y[j, 3], y[j, 4], nx, nz),
+                c,
+                g.pair_hist[p, HIST_MAX],
+                g.pair_hist[p, HIST_RATE],
+                cfg.clip,
+            )
+            w_plastic += wp
+            fx = -n * nx
+            fz = -n * nz
+            dy[i, 3] += fx
+            dy[i, 4] += fz
+            dy[j, 3] -= fx
+            dy[j, 4] -= fz
+            p_visc += pv
+            e_pot += ep
+            continue
+        ai = contact_arm(ri, delta, 0.5 * cfg.arm_shrink)
+        aj = contact_arm(rj, delta, 0.5 * cfg.arm_shrink)
+        ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
+        n, pv, ep, wp = normal_law_response(
+            delta, ddot, c, g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip
+        )
+        f = friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS])
+        pf = friction_power(f, vt)
+        w_plastic += wp
+        rate = max(
+            rate,
+            slip_relaxation_rate(
+                n,
+                vt,
+                c[COEF_MU],
+                c[COEF_KS],
+                1.0 / g.mass[i] + 1.0 / g.mass[j] + ai * ai / g.inertia[i] + aj * aj / g.inertia[j],
+            ),
+        )
+        fx = -n * nx + f * nz  # on i: -n nvec - f tvec, tvec = (-nz, nx); on j the opposite
+        fz = -n * nz - f * nx
+        dy[i, 3] += fx
+        dy[i, 4] += fz
+        dy[j, 3] -= fx
+        dy[j, 4] -= fz
+        dy[i, 5] -= f * ai
+        dy[j, 5] -= f * aj
+        p_visc += pv
+        p_fric += pf
+        e_pot += ep
+    for w in range(g.wall_i.shape[0]):  # rigid walls (a driven one moving along its normal at vn)
+        i = g.wall_i[w]
+        ri = g.radius[i]
+        nx = g.wall_geo[w, 0]
+        nz = g.wall_geo[w, 1]
+        shift, vn, kd = wall_motion(g, w)
+        delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, g.wall_geo[w, 2] + shift)
+        if record:
+            g.wall_hist[w, HIST_END] = max(delta, 0.0)
+        if delta <= 0.0:
+            continue
+        if delta > ovl * ri:
+            ovl = delta / ri
+            ovl_i = i
+            ovl_j = -1 - g.wall_w[w]
+        c = g.wall_coef[w]
+        if split:  # the normal force alone: friction_flow applies the friction
+            rate_n = y[i, 3] * nx + y[i, 4] * nz - vn
+            n, pv, ep, wp = normal_law_response(
+                delta, rate_n, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip
+            )
+            w_plastic += wp
+            book_wall(g, w, kd, n, pv / rate_n if pv != 0.0 else 0.0)
+            dy[i, 3] += -n * nx
+            dy[i, 4] += -n * nz
+            p_visc += pv
+            e_pot += ep
+            continue
+        ai = contact_arm(ri, delta, cfg.arm_shrink)
+        ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, ai)
+        n, pv, ep, wp = normal_law_response(
+            delta, ddot - vn, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip
+        )
+        book_wall(g, w, kd, n, pv / (ddot - vn) if pv != 0.0 else 0.0)
+        f = friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS])
+        pf = friction_power(f, vt)
+        w_plastic += wp
+        rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i]))
+        dy[i, 3] += -n * nx + f * nz
+        dy[i, 4] += -n * nz - f * nx
+        dy[i, 5] -= f * ai
+        p_visc += pv
+        p_fric += pf
+        e_pot += ep
+    for k in range(g.pc_i.shape[0]):  # plate contacts through the rigid layers, n = (1, 0)
+        i = g.pc_i[k]
+        ri = g.radius[i]
+        delta = plate_overlap(y[i, 0], ri, g.pc_x[k] + up[2 * k])
+        ai = contact_arm(ri, max(delta, 0.0), cfg.arm_shrink)
+        ddot, vt = plate_rates(y[i, 3], y[i, 4], y[i, 5], ai, vp[2 * k], vp[2 * k + 1])
+        if record:
+            g.pc_hist[k, HIST_END] = max(delta, 0.0)
+        n = 0.0
+        f = 0.0
+        pf = 0.0
+        if delta > 0.0:
+            if delta > ovl * ri:
+                ovl = delta / ri
+                ovl_i = i
+                ovl_j = PARTNER_PLATE
+            c = g.pc_coef[k]
+            n, pv, ep, wp = normal_law_response(
+                delta, ddot, c, g.pc_hist[k, HIST_MAX], g.pc_hist[k, HIST_RATE], cfg.clip
+            )
+            f = friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS])
+            pf = friction_power(f, vt)
+            w_plastic += wp
+            if not hold:  # the granule side only: the plate side of this map is criterion (8)
+                rate_plate = max(
+                    rate_plate,
+                    slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i]),
+                )
+            dy[i, 3] -= n
+            p_visc += pv
+            e_pot += ep
+        if hold:
+            f = fbar[k]
+            pf = 0.0
+        if f != 0.0:
+            dy[i, 4] -= f
+            dy[i, 5] -= f * ai
+            p_fric += pf
+        fplate[2 * k] = n
+        fplate[2 * k + 1] = f
+        normal[k] = n
+        slip[k] = vt
+    for i in range(ng):
+        dy[i, 3] /= g.mass[i]
+        dy[i, 4] /= g.mass[i]
+        dy[i, 5] /= g.inertia[i]
     p_drive, p_grav = finish_pass(y, dy, g)
     return ForceSums(p_shock, p_visc, p_fric, e_pot, rate, ovl, ovl_i, ovl_j, rate_plate, w_plastic, p_drive, p_grav)
 
@@ -301,20 +449,92 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
             fdamp[i, c] = 0.0
             fload[i, c] = 0.0
     begin_pass(t, g)
-    p_shock = shock_on_granules(t, y, g, cfg, acc, fload)
+    p_shock = 0.0
     p_visc = 0.0
     e_pot = 0.0
     ovl = 0.0
     ovl_i = -1
     ovl_j = -1
     w_plastic = 0.0
-    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = pair_normal_forces(
-        y, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
-    )
-    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_normal_forces(
-        y, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
-    )
-    to_accelerations(acc, g)
+    if not cfg.load_on_plate:
+        amp = shock_amplitude(t, cfg)
+        if amp != 0.0:
+            for i in range(ng):
+                fx = amp * g.shock_force[i]
+                tq = amp * g.shock_torque[i]
+                fload[i, 3] = fx
+                fload[i, 5] = tq
+                acc[i, 3] += fx
+                acc[i, 5] += tq
+                p_shock += fx * y[i, 3] + tq * y[i, 5]
+    for p in range(g.pair_ij.shape[0]):
+        i = g.pair_ij[p, 0]
+        j = g.pair_ij[p, 1]
+        ri = g.radius[i]
+        rj = g.radius[j]
+        g.pair_hist[p, HIST_END] = 0.0
+        if pair_apart(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj):
+            continue
+        delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
+        if delta <= 0.0:
+            continue
+        g.pair_hist[p, HIST_END] = delta
+        if delta > ovl * min(ri, rj):
+            ovl = delta / min(ri, rj)
+            ovl_i = i
+            ovl_j = j
+        ddot = pair_normal_rate(y[i, 3], y[i, 4], y[j, 3], y[j, 4], nx, nz)
+        n, pv, ep, wp = normal_law_response(
+            delta, ddot, g.pair_coef[p], g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip
+        )
+        w_plastic += wp
+        p_visc += pv
+        e_pot += ep
+        fx = -n * nx
+        fz = -n * nz
+        acc[i, 3] += fx
+        acc[i, 4] += fz
+        acc[j, 3] -= fx
+        acc[j, 4] -= fz
+        if pv != 0.0:  # the damping part of |N|, pv / ddot (eq. 3; with clip, what is left of it)
+            d = pv / ddot
+            fdamp[i, 3] -= d * nx
+            fdamp[i, 4] -= d * nz
+            fdamp[j, 3] += d * nx
+            fdamp[j, 4] += d * nz
+    for w in range(g.wall_i.shape[0]):
+        i = g.wall_i[w]
+        ri = g.radius[i]
+        nx = g.wall_geo[w, 0]
+        nz = g.wall_geo[w, 1]
+        shift, vn, kd = wall_motion(g, w)
+        delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, g.wall_geo[w, 2] + shift)
+        g.wall_hist[w, HIST_END] = max(delta, 0.0)
+        if delta <= 0.0:
+            continue
+        if delta > ovl * ri:
+            ovl = delta / ri
+            ovl_i = i
+            ovl_j = -1 - g.wall_w[w]
+        ddot = y[i, 3] * nx + y[i, 4] * nz - vn
+        n, pv, ep, wp = normal_law_response(
+            delta, ddot, g.wall_coef[w], g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip
+        )
+        w_plastic += wp
+        p_visc += pv
+        e_pot += ep
+        acc[i, 3] -= n * nx
+        acc[i, 4] -= n * nz
+        d = 0.0
+        if pv != 0.0:
+            d = pv / ddot
+            fdamp[i, 3] -= d * nx
+            fdamp[i, 4] -= d * nz
+        book_wall(g, w, kd, n, d)
+    for i in range(ng):
+        acc[i, 3] /= g.mass[i]
+        acc[i, 4] /= g.mass[i]
+        acc[i, 5] /= g.inertia[i]
     return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
 
 
