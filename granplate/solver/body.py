@@ -96,7 +96,7 @@ def sensor_loads(b, buf, load):
             load[i] += 0.5 * b.geo[buf, i, GEO_N]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def touching_contacts(y, q, b, buf, radius, delta0) -> int:
     """Each granule of state y (ng, 9) within REACH R of the body's bounding box located on
     its surface (buffer buf; every granule's row of geo and its HIST_END cleared first), and
@@ -133,7 +133,7 @@ def touching_contacts(y, q, b, buf, radius, delta0) -> int:
     return n_act
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def static_in_series(b, buf, n_act, delta0, clip, counts, upos):
     """The static forces of the n_act contacts in touch with the residual compliance in
     series (`solve_static`; without a residual, N_k = F(delta0_k)): counts[k] the terms of
@@ -161,7 +161,7 @@ def static_in_series(b, buf, n_act, delta0, clip, counts, upos):
     return e_static, rmat, z
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def contact_response(k, y, qd, b, buf, mass, clip, acc, fdamp, scale_acc, rmat, counts, upos, z, tilt):
     """Contact k in touch (granule i = b.active[k], overlap delta > 0 in geo): the law's force
     N at (delta, its rate against the surface's velocity, the residual's share taken off),
