@@ -71,7 +71,18 @@ def _cmd_bench(args) -> int:
 
 
 def register(subparsers) -> None:
+    """The `granplate bench` subcommand: the presets' table, and each other table's options."""
     b = subparsers.add_parser("bench", help="benchmark speed and accuracy of every scheme")
+    preset_options(b)
+    plate_and_solid_options(b)
+    scaling_options(b)
+    more_tables_options(b)
+    study_options(b)
+    b.set_defaults(func=_cmd_bench)
+
+
+def preset_options(b) -> None:
+    """The presets' table: quick mode, JSON, cases, repeats, simulated time."""
     b.add_argument("--quick", action="store_true", help="a subset of presets, shortened, 1 repeat (under a minute)")
     b.add_argument("--json", metavar="FILE", help="write the report as JSON to FILE")
     b.add_argument("--cases", help="comma-separated preset names (default: all six; quick: a subset)")
@@ -85,6 +96,11 @@ def register(subparsers) -> None:
         default=None,
         help="simulated time [s] for every case (overrides the mode's)",
     )
+
+
+def plate_and_solid_options(b) -> None:
+    """--plates (the plate-scaling table) and --solid (the 3D solid's set-up, coupled runs
+    and their profile), with their meshes and modes."""
     b.add_argument(
         "--plates",
         action="store_true",
@@ -124,6 +140,10 @@ def register(subparsers) -> None:
         default=None,
         help="with --plates: plate.modes of every mesh (default auto)",
     )
+
+
+def scaling_options(b) -> None:
+    """--scaling (the granule-scaling table): dimension, sizes, scheme, threads, LAMMPS."""
     b.add_argument(
         "--scaling",
         action="store_true",
@@ -160,6 +180,11 @@ def register(subparsers) -> None:
         action="store_true",
         help="with --scaling or --friction: leave LAMMPS out even where it is installed",
     )
+
+
+def more_tables_options(b) -> None:
+    """--startup, --friction, --plastic and --twins: a run's start, split friction, the
+    elastic-plastic law's cost and the 3D twins."""
     b.add_argument(
         "--startup",
         action="store_true",
@@ -190,6 +215,10 @@ def register(subparsers) -> None:
         "both (set-up and loop) and of the whole simulate call, medians of --repeats, timed "
         "alternately in one process (--cases, --t-end as for the presets)",
     )
+
+
+def study_options(b) -> None:
+    """--study: a design study's throughput on Dask."""
     b.add_argument(
         "--study",
         action="store_true",
@@ -203,4 +232,3 @@ def register(subparsers) -> None:
     b.add_argument(
         "--scheduler", metavar="ADDRESS", default=None, help="with --study: an existing Dask cluster instead"
     )
-    b.set_defaults(func=_cmd_bench)

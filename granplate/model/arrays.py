@@ -1,5 +1,7 @@
 """Scenario -> model arrays: contact topology, coefficients (eqs. 3-4), load resultants
 and the plate's modal model, built once per run (the plate part is cached on disk).
+The coefficient rows are `model.coefficients`' and the lists replaced during a run
+`model.relists`'; their names are importable from here too.
 """
 
 from __future__ import annotations
@@ -11,37 +13,25 @@ import numpy as np
 
 from granplate.model.contacts import contact_lists, fixed_wall_contacts
 from granplate.model.drives import drive_fields, driven_initial_state
-from granplate.model.inputs import HIST_MAX, Config, Granular, PlateArrays, no_history, scheme_number
-from granplate.physics.contact import (
-    COEF_A,
-    COEF_C,
-    COEF_DY,
-    COEF_H,
-    COEF_KAPPA,
-    COEF_KS,
-    COEF_MU,
-    COEF_RC,
-    COEF_RL,
-    COEF_SY,
-    COEF_XH,
-    N_COEF,
-    damping_coefficient,
-    hertz_coefficient,
-)
-from granplate.physics.cavity import hardness_overlap
-from granplate.physics.plastic import contact_yield_overlap
+from granplate.model.inputs import Config, Granular, PlateArrays, no_history, scheme_number
 from granplate.errors import ScenarioError
+from granplate.model.coefficients import pair_coefficients, plate_contact_coefficients, wall_arrays
+
+# the coefficients and the lists replaced during a run have modules of their own; their
+# names are importable from here as before
+from granplate.model.coefficients import coefficient_row as coefficient_row, johnson_columns as johnson_columns
+from granplate.model.coefficients import law_coefficients as law_coefficients
+from granplate.model.coefficients import law_yield_overlap as law_yield_overlap
+from granplate.model.coefficients import material_indices as material_indices, normal_law_of as normal_law_of
+from granplate.model.coefficients import pair_coefficient_row as pair_coefficient_row
+from granplate.model.coefficients import wall_coefficient_row as wall_coefficient_row
+from granplate.model.relists import cached_pair_coefficients as cached_pair_coefficients
+from granplate.model.relists import carried_history as carried_history
+from granplate.model.relists import granular_with_contacts as granular_with_contacts
+from granplate.model.relists import granular_with_patch_contacts as granular_with_patch_contacts
 from granplate.setup.geometry import resolve
 from granplate.physics.shock import shock_resultants
-from granplate.setup.materials import (
-    DEFAULT_HARDNESS_RATIO,
-    DEFAULT_UNLOADING_FACTOR,
-    effective_modulus,
-    softer_material,
-    softer_yield_strength,
-    sphere_inertia,
-    sphere_mass,
-)
+from granplate.setup.materials import sphere_inertia, sphere_mass
 from granplate.setup.scenario import Plate, Scenario
 from granplate.setup.threads import loop_threads
 from granplate.setup.plate_checks import split_initial_contacts
@@ -125,63 +115,6 @@ class Model:
         return tuple(self.labels[i] for i in self.plate_contacts)
 
 
-def coefficient_row(a: float, c: float, mu: float, k_s: float, law=math.inf) -> np.ndarray:
-    """One row of pair_coef / wall_coef / pc_coef in the columns of physics.contact:
-    Hertz A [N/m^1.5], damping c, mu [-], k_s [s/m] (eqs. 3, 5) and the normal law's
-    columns from COEF_DY on (`law_coefficients`), or the yield overlap delta_y [m] alone
-    (docs/model.md eq. P3; inf: Hertz's law)."""
-    row = np.zeros(N_COEF)
-    row[COEF_A], row[COEF_C], row[COEF_MU], row[COEF_KS] = a, c, mu, k_s
-    law = np.atleast_1d(np.asarray(law, float))
-    row[COEF_DY : COEF_DY + len(law)] = law
-    return row
-
-
-def normal_law_of(s: Scenario, a: str, b: str) -> str:
-    """The normal law (contact.normal_law, or its [[contact.pairs]] override) between
-    materials a and b."""
-    return s.contact.law_for_pair(a, b)
-
-
-def law_yield_overlap(s: Scenario, a, b, b_name: str, e_star: float, r_star: float) -> float:
-    """COEF_DY of a contact of material a (a granule's Material) with b (a granule's
-    Material, or None for a rigid wall or the plate's face, whose material is b_name):
-    the yield overlap delta_y [m] (docs/model.md eqs. P1, P3) of the softer body under the
-    elastic-plastic law "thornton", inf under Hertz's law. (Validation refuses "thornton"
-    where the Y it needs is unknown.)"""
-    if normal_law_of(s, a.name, b_name) not in ("thornton", "johnson"):
-        return math.inf
-    return contact_yield_overlap(e_star, r_star, softer_yield_strength(a, b))
-
-
-def law_coefficients(s: Scenario, a, b, b_name: str, e_star: float, r_star: float, length: float) -> np.ndarray:
-    """The normal law's columns COEF_DY..COEF_XH of a contact of material a with b (as
-    `law_yield_overlap`), `length` [m] the length that makes the approach speed a strain
-    rate (the sum of the radii; a diameter against a rigid body). Hertz: [inf, 0...];
-    "thornton": [delta_y, 0...]; "johnson": delta_y, R* Y, C, 1 / (length rate_ref), h,
-    kappa and x_h of the softer body (docs/model.md section 3.10; absent rate fields: rate-free)."""
-    if normal_law_of(s, a.name, b_name) == "johnson":
-        return johnson_columns(softer_material(a, b), e_star, r_star, length)
-    out = np.zeros(COEF_XH - COEF_DY + 1)
-    out[0] = law_yield_overlap(s, a, b, b_name, e_star, r_star)
-    return out
-
-
-def johnson_columns(m, e_star: float, r_star: float, length: float) -> np.ndarray:
-    """The law "johnson"'s columns COEF_DY..COEF_XH of a contact whose softer body is
-    of Material m (its Y known), E* [Pa], R* [m], `length` [m] (`law_coefficients`)."""
-    out = np.zeros(COEF_XH - COEF_DY + 1)
-    out[0] = contact_yield_overlap(e_star, r_star, m.Y)
-    out[COEF_SY - COEF_DY] = r_star * m.Y
-    if m.C is not None and m.rate_ref is not None:
-        out[COEF_RC - COEF_DY] = m.C
-        out[COEF_RL - COEF_DY] = 1.0 / (length * m.rate_ref)
-    out[COEF_H - COEF_DY] = DEFAULT_HARDNESS_RATIO if m.hardness_ratio is None else m.hardness_ratio
-    out[COEF_KAPPA - COEF_DY] = DEFAULT_UNLOADING_FACTOR if m.unloading_factor is None else m.unloading_factor
-    out[COEF_XH - COEF_DY] = hardness_overlap(out[COEF_H - COEF_DY])
-    return out
-
-
 def _granule_arrays(s: Scenario):
     x = np.array([g.x for g in s.granules], float)
     y = np.array([g.y for g in s.granules], float)
@@ -250,160 +183,6 @@ def loaded_granules(s: Scenario, x, r) -> np.ndarray:
         return np.array([lab in s.load.granules for lab in labels])
     left = x - r
     return np.abs(left - left.min()) <= 1e-9 * r.max()
-
-
-def pair_coefficient_row(s: Scenario, a, b, ri: float, rj: float, mi: float, mj: float) -> np.ndarray:
-    """The coefficient row of one pair of granules of Materials a and b, radii ri, rj [m] and
-    masses mi, mj [kg]: E*, R*, m* of the two (eqs. 3-4), the pair's alpha_n, mu, k_s and
-    normal law (`pair_coefficients` gives the same numbers for many pairs at once)."""
-    e_star = effective_modulus(a, b)
-    r_star = ri * rj / (ri + rj)
-    m_star = mi * mj / (mi + mj)
-    alpha, mu, ks = s.contact.for_pair(a.name, b.name)
-    coef_a = hertz_coefficient(e_star, r_star)
-    return coefficient_row(
-        coef_a,
-        damping_coefficient(alpha, m_star, coef_a),
-        mu,
-        ks,
-        law_coefficients(s, a, b, b.name, e_star, r_star, ri + rj),
-    )
-
-
-def material_indices(mats) -> tuple[list, np.ndarray]:
-    """The distinct Materials of `mats` (one per granule, by name) and each granule's index
-    among them."""
-    index: dict[str, int] = {}
-    kinds = []
-    for m in mats:
-        if m.name not in index:
-            index[m.name] = len(kinds)
-            kinds.append(m)
-    return kinds, np.array([index[m.name] for m in mats], np.int64).reshape(-1)
-
-
-def pair_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, pairs: np.ndarray) -> np.ndarray:
-    """(np, N_COEF) coefficients of the granule pairs: E*, R*, m* of the two (eqs. 3-4).
-
-    The rows of `pair_coefficient_row`, bit for bit: numpy does its operations on the same
-    doubles in the same order (products, quotients, square roots, correctly rounded), E*
-    and the pair's settings are computed once per pair of materials, and the yield overlap
-    of an elastic-plastic pair pair by pair."""
-    pairs = np.asarray(pairs, np.int64).reshape(-1, 2)
-    if not len(pairs):
-        return np.zeros((0, N_COEF))
-    r, mass = np.asarray(r, float), np.asarray(mass, float)
-    kinds, kind = material_indices(mats)
-    i, j = pairs[:, 0], pairs[:, 1]
-    ri, rj, mi, mj = r[i], r[j], mass[i], mass[j]
-    r_star = ri * rj / (ri + rj)
-    m_star = mi * mj / (mi + mj)
-    del ri, rj, mi, mj
-    combos = (
-        [(0, kinds[0], kinds[0])]
-        if len(kinds) == 1
-        else [
-            (c, kinds[c // len(kinds)], kinds[c % len(kinds)])
-            for c in np.unique(kind[i] * len(kinds) + kind[j]).tolist()
-        ]
-    )
-    combo = None if len(combos) == 1 else kind[i] * len(kinds) + kind[j]
-    # per pair of materials: E*, alpha_n, mu, k_s, whether the law is elastic-plastic (one value each when one pair)
-    e_star, alpha, mu, ks = (np.empty(len(pairs)) if combo is not None else 0.0 for _ in range(4))
-    plastic = np.zeros(len(pairs), bool)
-    for c, ka, kb in combos:
-        values = (effective_modulus(ka, kb), *s.contact.for_pair(ka.name, kb.name))
-        if combo is None:
-            e_star, alpha, mu, ks = values
-            plastic[:] = normal_law_of(s, ka.name, kb.name) != "hertz"
-            continue
-        on = combo == c
-        for column, v in zip((e_star, alpha, mu, ks), values):
-            column[on] = v
-        plastic |= on & (normal_law_of(s, ka.name, kb.name) != "hertz")
-    coef_a = 4.0 / 3.0 * e_star * np.sqrt(r_star)  # hertz_coefficient
-    pair_coef = np.zeros((len(pairs), N_COEF))
-    pair_coef[:, COEF_A] = coef_a
-    pair_coef[:, COEF_C] = alpha * np.sqrt(m_star * coef_a)  # damping_coefficient
-    pair_coef[:, COEF_MU], pair_coef[:, COEF_KS], pair_coef[:, COEF_DY] = mu, ks, math.inf
-    for p in np.flatnonzero(plastic).tolist():
-        a, b = mats[i[p]], mats[j[p]]
-        e_p = e_star if combo is None else float(e_star[p])
-        pair_coef[p, COEF_DY : COEF_XH + 1] = law_coefficients(
-            s, a, b, b.name, e_p, float(r_star[p]), float(r[i[p]] + r[j[p]])
-        )
-    return pair_coef
-
-
-def wall_coefficient_row(s: Scenario, a, wall_material: str, ri: float, mi: float) -> np.ndarray:
-    """The coefficient row of a granule of Material a, radius ri [m], mass mi [kg] against a
-    rigid wall of `wall_material` (R* = R, m* = m)."""
-    alpha, mu, ks = s.contact.for_pair(a.name, wall_material)
-    e_star = effective_modulus(a, None)
-    coef_a = hertz_coefficient(e_star, ri)
-    return coefficient_row(
-        coef_a,
-        damping_coefficient(alpha, mi, coef_a),
-        mu,
-        ks,
-        law_coefficients(s, a, None, wall_material, e_star, ri, 2.0 * ri),
-    )
-
-
-def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarray, walls=None):
-    """(nw, d + 1) [nx, ny, (nz,) offset] with the unit outward normal (d = the scenario's
-    dimension), and (nw, N_COEF) coefficients against a rigid body (R* = R, m* = m): the
-    rows of `wall_coefficient_row`, bit for bit (as `pair_coefficients`). walls: the
-    Walls of the rows of wc (None: the scenario's; `Model.walls`)."""
-    walls = s.walls if walls is None else walls
-    wc = np.asarray(wc, np.int64).reshape(-1, 2)
-    wall_geo = np.zeros((len(wc), s.dimension + 1))
-    wall_coef = np.zeros((len(wc), N_COEF))
-    if not len(wc):
-        return wall_geo, wall_coef
-    r, mass = np.asarray(r, float), np.asarray(mass, float)
-    kinds, kind = material_indices(mats)
-    i, w = wc[:, 0], wc[:, 1]
-    e_star, alpha = np.empty(len(wc)), np.empty(len(wc))
-    plastic = np.zeros(len(wc), bool)
-    for k in np.unique(w).tolist():
-        wall = walls[k]
-        nrm = np.asarray(wall.normal, float)
-        at = w == k
-        wall_geo[at] = (*(nrm / np.linalg.norm(nrm)), wall.offset)
-        for c in np.unique(kind[i[at]]).tolist():
-            on = at & (kind[i] == c)
-            e_star[on] = effective_modulus(kinds[c], None)
-            alpha[on], wall_coef[on, COEF_MU], wall_coef[on, COEF_KS] = s.contact.for_pair(kinds[c].name, wall.material)
-            plastic |= on & (normal_law_of(s, kinds[c].name, wall.material) != "hertz")
-    ri = r[i]
-    coef_a = 4.0 / 3.0 * e_star * np.sqrt(ri)  # hertz_coefficient with R* = R
-    wall_coef[:, COEF_A] = coef_a
-    wall_coef[:, COEF_C] = alpha * np.sqrt(mass[i] * coef_a)  # damping_coefficient with m* = m
-    wall_coef[:, COEF_DY] = math.inf
-    for p in np.flatnonzero(plastic).tolist():
-        wall_coef[p, COEF_DY : COEF_XH + 1] = law_coefficients(
-            s, mats[i[p]], None, s.walls[w[p]].material, float(e_star[p]), float(ri[p]), 2.0 * float(ri[p])
-        )
-    return wall_geo, wall_coef
-
-
-def plate_contact_coefficients(s: Scenario, mats, r: np.ndarray, pc: np.ndarray) -> np.ndarray:
-    """(nk, N_COEF) coefficients against the plate's rigid layers: E_k, R_k -> infinity
-    and m_k -> 0, so m* = 0 (no viscous damping)."""
-    pc_coef = np.zeros((len(pc), N_COEF))
-    for k, i in enumerate(pc):
-        alpha, mu, ks = s.contact.for_pair(mats[i].name, s.plate.material)
-        e_star = effective_modulus(mats[i], None)
-        a = hertz_coefficient(e_star, r[i])
-        pc_coef[k] = coefficient_row(
-            a,
-            damping_coefficient(alpha, 0.0, a),
-            mu,
-            ks,
-            law_coefficients(s, mats[i], None, s.plate.material, e_star, r[i], 2.0 * r[i]),
-        )
-    return pc_coef
 
 
 def face_contacts_possible(s: Scenario, plate_model) -> bool:
@@ -595,102 +374,3 @@ def build_model(scenario: Scenario) -> Model:
         initial_patches=patches,
     )
     return precompressed(weighed(model))  # the plate in its sag under its own weight, then the static state
-
-
-def carried_history(old_keys: np.ndarray, old_hist: np.ndarray, new_keys: np.ndarray, store: dict) -> np.ndarray:
-    """The histories (columns HIST_*) of the contacts new_keys (n, 2) of a rebuilt list:
-    each one's row from the old list (old_keys, old_hist) or from `store`, which holds the
-    contacts that left the list with a history, keyed (i, j), and takes those leaving now.
-    A contact keeps its largest overlap (and so its plastic flattening, docs/model.md
-    section 3.6) for the whole run, whether or not the list holds it. Keys are matched by
-    sorting (no per-contact Python): a rebuild of 10^6 contacts takes a fraction of a second."""
-    new_keys = np.asarray(new_keys, np.int64).reshape(-1, 2)
-    has = old_hist[:, HIST_MAX] > 0.0
-    keys = np.asarray(old_keys, np.int64).reshape(-1, 2)[has]
-    rows = old_hist[has]
-    if store:
-        keys = np.vstack([np.array(list(store), np.int64).reshape(-1, 2), keys])
-        rows = np.vstack([np.array(list(store.values()), float).reshape(-1, old_hist.shape[1]), rows])
-    out = no_history(len(new_keys))
-    store.clear()
-    if not len(keys):
-        return out
-    span = int(max(keys[:, 1].max(), new_keys[:, 1].max() if len(new_keys) else 0)) + 1
-    code = keys[:, 0] * span + keys[:, 1]
-    new_code = new_keys[:, 0] * span + new_keys[:, 1]
-    order = np.argsort(new_code, kind="stable")
-    pos = np.minimum(np.searchsorted(new_code[order], code), max(len(order) - 1, 0))
-    found = (new_code[order[pos]] == code) if len(order) else np.zeros(len(code), bool)
-    out[order[pos[found]]] = rows[found]  # the old list's row after the store's (it is the newer)
-    store.update(zip(map(tuple, keys[~found].tolist()), rows[~found]))
-    return out
-
-
-def cached_pair_coefficients(s: Scenario, mats, g: Granular, pairs: np.ndarray, known: dict) -> np.ndarray:
-    """`pair_coefficients` of the pairs (n, 2), each pair's row computed once per run:
-    known["codes"] (sorted i * ng + j) and known["rows"] hold those met so far and take the
-    new ones (the same numbers, bit for bit, as computing them again)."""
-    ng = len(g.radius)
-    code = pairs[:, 0] * ng + pairs[:, 1]
-    kc = known.get("codes", np.zeros(0, np.int64))
-    kr = known.get("rows", np.zeros((0, N_COEF)))
-    pos = np.minimum(np.searchsorted(kc, code), max(len(kc) - 1, 0))
-    hit = (kc[pos] == code) if len(kc) else np.zeros(len(code), bool)
-    out = np.empty((len(pairs), N_COEF))
-    out[hit] = kr[pos[hit]]
-    if not hit.all():
-        rows = pair_coefficients(s, mats, g.radius, g.mass, pairs[~hit])
-        out[~hit] = rows
-        codes = np.concatenate([kc, code[~hit]])
-        order = np.argsort(codes, kind="stable")
-        known["codes"], known["rows"] = codes[order], np.vstack([kr, rows])[order]
-    return out
-
-
-def granular_with_contacts(
-    model: Model,
-    g: Granular,
-    pairs: np.ndarray,
-    wc: np.ndarray,
-    known: dict | None = None,
-    stores: tuple[dict, dict] | None = None,
-) -> Granular:
-    """`g` with the contact lists pairs (np, 2) and wc (nw, 2) [granule, wall], their
-    coefficients and their histories carried over (`carried_history`; stores: the pairs'
-    and the walls' histories off the list, keyed (i, j) and (i, wall), updated); known:
-    the pairs' coefficient rows met so far (`cached_pair_coefficients`), reused and extended."""
-    s, mats = model.scenario, list(model.materials)
-    known = {} if known is None else known
-    stores = ({}, {}) if stores is None else stores
-    pairs = np.ascontiguousarray(pairs, np.int64).reshape(-1, 2)
-    pair_coef = cached_pair_coefficients(s, mats, g, pairs, known)
-    wall_geo, wall_coef = wall_arrays(s, mats, g.radius, g.mass, wc, model.walls)
-    wc = np.asarray(wc, np.int64).reshape(-1, 2)
-    return g._replace(
-        pair_ij=pairs,
-        pair_coef=pair_coef,
-        wall_i=np.ascontiguousarray(wc[:, 0]),
-        wall_geo=wall_geo,
-        wall_coef=wall_coef,
-        wall_w=np.ascontiguousarray(wc[:, 1]),
-        pair_hist=carried_history(g.pair_ij, g.pair_hist, pairs, stores[0]),
-        wall_hist=carried_history(np.column_stack([g.wall_i, g.wall_w]), g.wall_hist, wc, stores[1]),
-    )
-
-
-def granular_with_patch_contacts(model: Model, g: Granular, new: np.ndarray) -> Granular:
-    """`g` with a patch contact appended for each granule of `new` (docs/model.md section
-    3.5): the coefficients of a rigid layer (m* = 0), the overlap measured from the
-    undeformed face, pc_patch = 1, and a fresh history."""
-    new = np.asarray(new, np.int64).ravel()
-    s, mats = model.scenario, list(model.materials)
-    patch = g.pc_patch if len(g.pc_patch) == len(g.pc_i) else np.zeros(len(g.pc_i), np.int64)
-    return g._replace(
-        pc_i=np.concatenate([g.pc_i, new]).astype(np.int64),
-        pc_x=np.concatenate([g.pc_x, np.full(len(new), float(s.plate.x0))]),
-        pc_coef=np.ascontiguousarray(
-            np.vstack([g.pc_coef.reshape(-1, N_COEF), plate_contact_coefficients(s, mats, g.radius, new)])
-        ),
-        pc_patch=np.concatenate([patch, np.ones(len(new), np.int64)]),
-        pc_hist=np.vstack([g.pc_hist.reshape(-1, g.pc_hist.shape[1]), no_history(len(new))]),
-    )

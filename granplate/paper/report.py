@@ -180,16 +180,30 @@ def build_report(
     yielding contacts (twins: preset name -> the Thornton twin's Dataset; none: no section;
     measured: the twins under the law that matches measurement, plastic.MEASURED_LAW), the
     cases in 3D (space: preset name -> its 3D twin's Dataset; none: no section), figures."""
-    from granplate.version import __version__
-    from granplate.paper.plots import FIGURES, figure_stem
-
     rows = statements(results)
-    judged = [r for r in rows if r.holds is not None]
-    n_ok = sum(r.holds for r in judged)
     blocks = [
         Block("h1", "granplate: reproduction of the paper's section 3 and appendices"),
         verdict_summary(rows, results, checks, twins, space),
+        _introduction(rows, results, checks, twins, space, measured, seconds),
     ]
+    blocks += _statements(rows)
+    blocks += _runs(results, checks, records, twins)
+    blocks += _differences(results, checks)
+    blocks += plastic.section(
+        results, twins or {}, measured=measured, records=records, figure=(figures or {}).get(plastic.FIGURE_KEY)
+    )
+    blocks += sp.section(results, space or {}, records=records, figure=(figures or {}).get(sp.FIGURE_KEY))
+    blocks += _figures_and_animations(figures, animations)
+    return blocks
+
+
+def _introduction(rows, results: Results, checks: Results, twins, space, measured, seconds) -> Block:
+    """What the report was made from (runs, checks, twins), how many judged statements hold,
+    and a warning when the runs were shortened."""
+    from granplate.version import __version__
+
+    judged = [r for r in rows if r.holds is not None]
+    n_ok = sum(r.holds for r in judged)
     t_ends = sorted({float(d["time"].values[-1]) for d in results.values()})
     intro = (
         f"Made by granplate {__version__} from {len(results)} runs"
@@ -211,7 +225,13 @@ def build_report(
             f" **The runs were shortened (t_end = {max(t_ends) * 1e3:.3g} ms instead of 2 ms): the "
             f"comparison with the paper is not meaningful.**"
         )
-    blocks.append(Block("p", intro))
+    return Block("p", intro)
+
+
+def _statements(rows) -> list[Block]:
+    """The paper's conclusions in our runs, the statements that do not hold, and the table
+    of the paper's statements beside ours."""
+    blocks: list[Block] = []
     blocks.append(Block("h2", "The paper's conclusions in our runs"))
     blocks.append(Block("p", "\n".join(f"- {line}" for line in conclusions(rows))))
     failing = [f"{i + 1} ({r.quantity})" for i, r in enumerate(rows) if r.holds is False]
@@ -241,6 +261,12 @@ def build_report(
             ),
         )
     )
+    return blocks
+
+
+def _runs(results: Results, checks: Results, records, twins) -> list[Block]:
+    """The run table, the contact pressures per material pair, the check runs (collapsed)."""
+    blocks: list[Block] = []
     blocks.append(Block("h2", "Runs"))
     blocks.append(
         Block(
@@ -276,6 +302,12 @@ def build_report(
                 [Block("table", header=tuple(RUN_HEADER), rows=tuple(tuple(r) for r in run_rows(checks, records)))],
             )
         )
+    return blocks
+
+
+def _differences(results: Results, checks: Results) -> list[Block]:
+    """Where we differ from the paper, and why: stress, PTFE, intensity, vertical motion."""
+    blocks: list[Block] = []
     blocks.append(Block("h2", "Where we differ from the paper, and why"))
     for para in (
         stress_discussion(results, checks)
@@ -284,10 +316,14 @@ def build_report(
         + vertical_discussion(results)
     ):
         blocks.append(Block("p", para))
-    blocks += plastic.section(
-        results, twins or {}, measured=measured, records=records, figure=(figures or {}).get(plastic.FIGURE_KEY)
-    )
-    blocks += sp.section(results, space or {}, records=records, figure=(figures or {}).get(sp.FIGURE_KEY))
+    return blocks
+
+
+def _figures_and_animations(figures, animations) -> list[Block]:
+    """Each paper figure drawn (its PNG), and the animations."""
+    from granplate.paper.plots import FIGURES, figure_stem
+
+    blocks: list[Block] = []
     if figures:
         blocks.append(Block("h2", "Figures"))
         for key in FIGURES:

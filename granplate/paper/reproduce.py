@@ -556,6 +556,14 @@ def _positive_int(text: str) -> int:
 
 def register(subparsers) -> None:
     """Add the `reproduce`, `plot`, `animate` and `export` commands."""
+    register_reproduce(subparsers)
+    register_plot(subparsers)
+    register_animate(subparsers)
+    register_export(subparsers)
+
+
+def register_reproduce(subparsers) -> None:
+    """`granplate reproduce`: the paper's cases, figures, animations and report."""
     r = subparsers.add_parser(
         "reproduce",
         help="run the paper's six cases (and again with yielding "
@@ -607,6 +615,9 @@ def register(subparsers) -> None:
     r.add_argument("-q", "--quiet", action="store_true", help="no progress output")
     r.set_defaults(func=_cmd_reproduce)
 
+
+def register_plot(subparsers) -> None:
+    """`granplate plot`: the figures of any run, or one of the paper's."""
     p = subparsers.add_parser("plot", help="draw the figures of any run, or one paper figure (--figure)")
     p.add_argument("results", nargs="+", help="result .nc file(s), or a directory holding PRESET.nc files")
     p.add_argument(
@@ -635,6 +646,9 @@ def register(subparsers) -> None:
     p.add_argument("--out", default=".", help="directory for the PNG and PDF (default .)")
     p.set_defaults(func=_cmd_plot)
 
+
+def register_animate(subparsers) -> None:
+    """`granplate animate`: a result's animation."""
     a = subparsers.add_parser(
         "animate",
         help="animate a result: in the plane the granules and the deformed "
@@ -655,6 +669,9 @@ def register(subparsers) -> None:
     a.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     a.set_defaults(func=_cmd_animate)
 
+
+def register_export(subparsers) -> None:
+    """`granplate export`: a result as a ParaView time series."""
     e = subparsers.add_parser("export", help="write a ParaView time series (VTK, .pvd) of a result")
     e.add_argument("result", help="a result .nc file")
     e.add_argument("--vtk", required=True, help="output directory for the .vtu and .pvd files")

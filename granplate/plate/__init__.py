@@ -4,8 +4,8 @@ One module per concept: `fe` (mesh, Q8 basis, K and M, nodes, VTK element order)
 `constraints` (edges, clamps, symmetry line, rigid layers, the reduction T), `modes`
 (the eigenproblem and the mode sign rule), `load` (the half-sine edge load), `stress`
 (plane-stress D, strain operator, stress recovery, the disc-averaged stress), `peaks` (the
-plate maxima over the output times) and `build` (PlateModel, build_plate and its entry in
-the run store).
+plate maxima over the output times), `plate_model` (PlateModel: a built plate and its
+fields) and `build` (build_plate and its entry in the run store).
 
 Its members load on first use (module `__getattr__`): `from granplate.plate.peaks import
 ...` does not import scikit-fem, and `from granplate.plate import build_plate` imports

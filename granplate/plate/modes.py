@@ -10,7 +10,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 if TYPE_CHECKING:  # pragma: no cover
-    from granplate.plate.build import PlateModel
+    from granplate.plate.plate_model import PlateModel
 
 
 def modal_basis(K_r: sp.spmatrix, M_r: sp.spmatrix, n_modes: int = 0) -> tuple[np.ndarray, np.ndarray]:

@@ -285,6 +285,77 @@ def bounded_maxima(n_t: int, block: int, exact: Callable, c: np.ndarray, peaks: 
     return out
 
 
+def fields_in_blocks(n_t: int, B: int, evaluate, maxima, fields: np.ndarray, sizes: tuple, should_stop):
+    """The body's fields over the output times, B at a time: each time's maxima (von Mises,
+    ball-averaged von Mises [Pa], displacement [m]) and, at the snapshot times `fields`, the
+    nodal displacements (n_fields, n_nodes, 3) and each element's largest von Mises
+    (n_fields, n_elem); evaluate, maxima: `body_data`'s; sizes: (n_nodes, n_elem, n_qp);
+    should_stop polled after each block. Returns ((three maxima (n_t,)), (the two
+    snapshot arrays), how many output times were computed)."""
+    n_nodes, n_elem, n_qp = sizes
+    vm_max, ball_max, u_max = np.zeros(n_t), np.zeros(n_t), np.zeros(n_t)
+    u_field = np.zeros((len(fields), n_nodes, 3))
+    vm_field = np.zeros((len(fields), n_elem))
+    done = 0
+    for start in range(0, n_t, B):
+        rows = slice(start, min(start + B, n_t))
+        nodal, vm = evaluate(rows)
+        vm_max[rows], ball_max[rows], u_max[rows] = maxima(nodal, vm).T
+        snaps = np.flatnonzero((fields >= rows.start) & (fields < rows.stop))
+        if len(snaps):
+            k = fields[snaps] - rows.start
+            u_field[snaps] = np.moveaxis(nodal[:, :, k], -1, 0)
+            vm_field[snaps] = vm[:, k].reshape(n_elem, n_qp, len(k)).max(axis=1).T
+        done = rows.stop
+        if should_stop is not None and done < n_t and should_stop():
+            break
+    return (vm_max, ball_max, u_max), (u_field, vm_field), done
+
+
+def body_coordinates(solid, field_times: np.ndarray) -> dict:
+    """The body's coordinates for the Dataset: the snapshots' times [s], the nodes'
+    positions [m] and the elements' nodes in VTK order (name -> (dims, values, attrs))."""
+    coords = {
+        "field_time": (
+            "field_time",
+            field_times,
+            {"units": "s", "long_name": "time of the body field snapshots"},
+        )
+    }
+    for c, axis in enumerate("xyz"):
+        coords[f"body_node_{axis}"] = (
+            "body_node",
+            solid.nodes[:, c].copy(),
+            {"units": "m", "long_name": f"body node {axis}"},
+        )
+    coords["body_element_nodes"] = (
+        ("body_element", "body_element_node"),
+        vtk_connectivity(solid.basis, solid.element),
+        {
+            "long_name": f"body element nodes in VTK order (meshio cell type {MESHIO_CELLS[solid.element]})",
+            "cell_type": MESHIO_CELLS[solid.element],
+        },
+    )
+    return coords
+
+
+def checked_inputs(solid, q, field_stride: int, contact_face, contact_xi, contact_force):
+    """`body_data`'s modal coordinates and contacts as arrays of their shapes (q (n_t,
+    n_modes), face (n_t, n_g), xi (n_t, n_g, 2), force (n_t, n_g, 3)); a ValueError for a
+    q of another shape or a field_stride below 1."""
+    q = np.asarray(q, float)
+    n_t = len(q)
+    if q.shape != (n_t, solid.n_modes):
+        raise ValueError(f"q must be (n_t, {solid.n_modes}), not {q.shape}")
+    if int(field_stride) < 1:
+        raise ValueError(f"field_stride must be a positive integer, not {field_stride}")
+    face = np.asarray(contact_face, np.int64).reshape(n_t, -1)
+    n_g = face.shape[1]
+    xi = np.asarray(contact_xi, float).reshape(n_t, n_g, 2)
+    force = np.asarray(contact_force, float).reshape(n_t, n_g, 3)
+    return q, face, xi, force
+
+
 def body_data(
     solid,
     q: np.ndarray,
@@ -318,16 +389,8 @@ def body_data(
     them over their nodes, results.body_contacts.patch_forces).
 
     Returns (data variables, coordinates as name -> (dims, values, attrs))."""
-    q = np.asarray(q, float)
+    q, face, xi, force = checked_inputs(solid, q, field_stride, contact_face, contact_xi, contact_force)
     n_t = len(q)
-    if q.shape != (n_t, solid.n_modes):
-        raise ValueError(f"q must be (n_t, {solid.n_modes}), not {q.shape}")
-    if int(field_stride) < 1:
-        raise ValueError(f"field_stride must be a positive integer, not {field_stride}")
-    face = np.asarray(contact_face, np.int64).reshape(n_t, -1)
-    n_g = face.shape[1]
-    xi = np.asarray(contact_xi, float).reshape(n_t, n_g, 2)
-    force = np.asarray(contact_force, float).reshape(n_t, n_g, 3)
     ops = body_operators(solid, ball_radius) if operators is None else operators
     if ops.radius != float(ball_radius):
         raise ValueError(f"the operators' ball radius {ops.radius} m is not ball_radius = {ball_radius} m")
@@ -375,22 +438,9 @@ def body_data(
         vm_max, ball_max, u_max = every[:, 0], every[:, 1], every[:, 2]
         done = n_t
     else:
-        vm_max, ball_max, u_max = np.zeros(n_t), np.zeros(n_t), np.zeros(n_t)
-        u_field = np.zeros((len(fields), n_nodes, 3))
-        vm_field = np.zeros((len(fields), n_elem))
-        done = 0
-        for start in range(0, n_t, B):
-            rows = slice(start, min(start + B, n_t))
-            nodal, vm = evaluate(rows)
-            vm_max[rows], ball_max[rows], u_max[rows] = maxima(nodal, vm).T
-            snaps = np.flatnonzero((fields >= rows.start) & (fields < rows.stop))
-            if len(snaps):
-                k = fields[snaps] - rows.start
-                u_field[snaps] = np.moveaxis(nodal[:, :, k], -1, 0)
-                vm_field[snaps] = vm[:, k].reshape(n_elem, ops.n_qp, len(k)).max(axis=1).T
-            done = rows.stop
-            if should_stop is not None and done < n_t and should_stop():
-                break
+        (vm_max, ball_max, u_max), (u_field, vm_field), done = fields_in_blocks(
+            n_t, B, evaluate, maxima, fields, (n_nodes, n_elem, ops.n_qp), should_stop
+        )
     kept = int(np.sum(fields < done))
     data = {
         "max_von_mises": _var("max_von_mises", ("time",), vm_max[:done]),
@@ -403,25 +453,5 @@ def body_data(
     for c, axis in enumerate("xyz"):
         data[f"body_u{axis}"] = _var(f"body_u{axis}", ("field_time", "body_node"), u_field[:kept, :, c].copy())
     data["body_von_mises"] = _var("body_von_mises", ("field_time", "body_element"), vm_field[:kept])
-    coords = {
-        "field_time": (
-            "field_time",
-            np.asarray(times, float)[fields[:kept]],
-            {"units": "s", "long_name": "time of the body field snapshots"},
-        )
-    }
-    for c, axis in enumerate("xyz"):
-        coords[f"body_node_{axis}"] = (
-            "body_node",
-            solid.nodes[:, c].copy(),
-            {"units": "m", "long_name": f"body node {axis}"},
-        )
-    coords["body_element_nodes"] = (
-        ("body_element", "body_element_node"),
-        vtk_connectivity(solid.basis, solid.element),
-        {
-            "long_name": f"body element nodes in VTK order (meshio cell type {MESHIO_CELLS[solid.element]})",
-            "cell_type": MESHIO_CELLS[solid.element],
-        },
-    )
+    coords = body_coordinates(solid, np.asarray(times, float)[fields[:kept]])
     return data, coords

@@ -1,14 +1,14 @@
 """Run the compiled loop on a model: allocate the state once, call `loop.advance` in
 chunks (each bounded by output times and by a step budget calibrated to a wall-time
 target, so progress shows and a stop request is honoured within about a second, even
-when the steps have collapsed), and return a plain record of the output buffers.
+when the steps have collapsed), and return a plain record of the output buffers. Its
+pieces have modules of their own (schedule, run_contacts, loop_arrays, stop_messages),
+whose public names are importable from here too.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import logging
-import math
 import signal
 import threading
 import time
@@ -18,19 +18,21 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
-from granplate.model.arrays import Model, granular_with_contacts, granular_with_patch_contacts
-from granplate.model.inputs import DR_REF, DR_S, HIST_MAX, HIST_RATE, HIST_TIME, no_history
-from granplate.model.contacts import Missed, centre_coordinates, contact_lists, missed_contacts, wall_planes
-from granplate.model.neighbours import verlet_pairs, verlet_walls
-from granplate.physics.contact import plate_overlap
+from granplate.model.arrays import Model
 from granplate.solver import loop, snapshot, state as S
 from granplate.solver.compiling import compile_calls, compile_seconds, describe_seconds, machine_slowdown
-from granplate.plate.face import patch_weights
-from granplate.solver.interface import set_face_weights
 from granplate.solver.ladder import level_for
-from granplate.solver.schemes import scheme
+from granplate.solver.loop_arrays import LoopArrays, add_patch_contacts, attach_patches, near_face as near_face
+from granplate.solver.run_contacts import ContactChanges, ContactLists
+from granplate.solver.run_contacts import ContactPeaks as ContactPeaks, contact_peaks as contact_peaks
+from granplate.solver.run_contacts import wall_offsets_now as wall_offsets_now
+from granplate.solver.schedule import SNAP_RTOL, output_times
+from granplate.solver.schedule import sensor_setup as sensor_setup, sensor_times as sensor_times
+from granplate.solver.stop_messages import INTERRUPTED, overlap_warnings, status_message
+from granplate.solver.stop_messages import INTERRUPTED_STATUS as INTERRUPTED_STATUS
+from granplate.solver.stop_messages import contact_message as contact_message, partner_name as partner_name
 from granplate.setup.run_checks import restart_steps
-from granplate.setup.sensor_checks import n_sensor_samples, sensor_granules, sensor_interval
+from granplate.setup.sensor_checks import sensor_interval
 
 #: wall-time target of one compiled chunk [s], and the step budget of the first one.
 CHUNK_SECONDS = 0.15
@@ -40,61 +42,6 @@ log = logging.getLogger(__name__)
 #: step attempts without the clock moving after which a run is stopped (every retry
 #: goes one ladder level deeper, so a run that still advances never needs more)
 STALL_ATTEMPTS = 2 * S.N_LEVELS
-#: status of a run stopped by a signal (SIGINT, SIGTERM) or a stop request.
-INTERRUPTED = -1
-INTERRUPTED_STATUS = "interrupted by the user"
-
-
-class ContactPeaks(NamedTuple):
-    """Every contact that touched during a run, with its largest overlap (the elastic-
-    plastic law's history, docs/model.md section 3.6; the largest Hertz peak pressure
-    follows from it): those in the loop's lists at the end and those that left them."""
-
-    granule: np.ndarray  # (n,) int64: the contact's granule
-    partner: np.ndarray  # (n,) int64: granule j, wall -1 - w, or state.PARTNER_PLATE
-    delta_max: np.ndarray  # (n,) [m]: the largest overlap
-    time: np.ndarray  # (n,) [s]: when it was reached
-    rate: np.ndarray | None = None  # (n,) [-]: the rate factor that fixed its yield strength (law "johnson"; 0: unset)
-
-
-def contact_peaks(g, stores: tuple[dict, dict], body=None) -> ContactPeaks:
-    """The ContactPeaks of the lists of g (pairs, walls, plate contacts), of the histories
-    off the lists (stores: pairs by (i, j), walls by (i, wall)) and of each granule's
-    contact on an elastic body in space (body: BodyArrays, partner PARTNER_PLATE)."""
-    parts = [(g.pair_ij[:, 0], g.pair_ij[:, 1], g.pair_hist)]
-    if body is not None:
-        parts.append((np.arange(len(body.hist)), np.full(len(body.hist), S.PARTNER_PLATE), body.hist))
-    parts.append((g.wall_i, -1 - g.wall_w, g.wall_hist))
-    parts.append((g.pc_i, np.full(len(g.pc_i), S.PARTNER_PLATE), g.pc_hist))
-    for store, sign in ((stores[0], 1), (stores[1], -1)):
-        if store:
-            k = np.array(list(store), np.int64).reshape(-1, 2)
-            parts.append((k[:, 0], k[:, 1] if sign > 0 else -1 - k[:, 1], np.array(list(store.values()))))
-    granule = np.concatenate([np.asarray(a, np.int64) for a, _, _ in parts])
-    partner = np.concatenate([np.asarray(b, np.int64) for _, b, _ in parts])
-    peak = np.concatenate([_column(h, len(a), HIST_MAX) for a, _, h in parts])
-    when = np.concatenate([_column(h, len(a), HIST_TIME) for a, _, h in parts])
-    rate = np.concatenate([_column(h, len(a), HIST_RATE) for a, _, h in parts])
-    on = peak > 0.0
-    return ContactPeaks(granule=granule[on], partner=partner[on], delta_max=peak[on], time=when[on], rate=rate[on])
-
-
-def _column(h, n: int, c: int) -> np.ndarray:
-    """Column c of n history rows h (none: an empty column)."""
-    return np.asarray(h, float).reshape(n, -1)[:, c] if n else np.zeros(0)
-
-
-class ContactChanges(NamedTuple):
-    """How a run's contacts changed: the patch contacts on the plate's face (docs/model.md
-    section 3.5), those of the granules touching the face between nodes at t = 0 (time 0)
-    then those formed during the run, in the order they follow the model's rigid layers on
-    the output's contact axis, and the contact lists' rebuilds."""
-
-    granule: np.ndarray  # (n_formed,) int64: the granule of each patch contact formed
-    time: np.ndarray  # (n_formed,) [s]: when it formed (its granule within contact.skin R of the face)
-    y: np.ndarray  # (n_formed,) [m]: the height on the face where it formed (its granule's y then)
-    n_rebuilds: int  # contact-list rebuilds (detection = "dynamic": a granule moved skin R_min / 2)
-    peaks: ContactPeaks | None = None  # every contact's largest overlap
 
 
 class RunRecord(NamedTuple):
@@ -113,335 +60,6 @@ class RunRecord(NamedTuple):
     body: object = None  # the run's elastic body in space (model.inputs.BodyArrays, its last contact state) or None
     snapshot: dict | None = None  # the loop's state at the end (solver.snapshot.capture), for a restart
     earlier: tuple = ()  # its states at the earlier restart times (time.restart_interval), in time order
-
-
-def output_times(t_end: float, dt_out: float) -> np.ndarray:
-    """Output times 0, dt_out, 2 dt_out, ..., ending exactly at t_end [s]."""
-    n = int(math.ceil(t_end / dt_out - 1e-9))
-    t = np.arange(n + 1) * dt_out
-    t[-1] = t_end
-    return t
-
-
-#: a sensor's sample time within this fraction of the sensor interval of an output time
-#: is that output time (one step lands on both).
-SNAP_RTOL = 1e-9
-
-
-def sensor_times(t_first: float, t_end: float, interval: float, times: np.ndarray) -> np.ndarray:
-    """The sensors' sample times k * interval in [t_first, t_end] [s] (docs/model.md
-    section 3.15), each within SNAP_RTOL intervals of an output time (`times`) taken as
-    that output time, so that the steps land on both at once."""
-    k = np.arange(n_sensor_samples(t_end, interval))
-    ts = k * interval
-    j = np.clip(np.searchsorted(times, ts), 1, len(times) - 1) if len(times) > 1 else np.zeros(len(ts), int)
-    for cand in (j - 1, j):
-        near = np.abs(times[cand] - ts) <= SNAP_RTOL * interval
-        ts = np.where(near, times[cand], ts)
-    ts = np.unique(np.minimum(ts, t_end))  # (one step lands on each: none twice)
-    return ts[ts >= t_first - SNAP_RTOL * interval]
-
-
-def sensor_setup(model: Model, times: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
-    """(the sample times from the run's first output time on, each sensor's granule) of
-    the model's [[sensors]], or (None, None) without sensors."""
-    s = model.scenario
-    if not s.sensors:
-        return None, None
-    ts = sensor_times(float(times[0]), float(model.config.t_end), sensor_interval(s), times)
-    return ts, np.asarray(sensor_granules(s), np.int64)
-
-
-def status_message(status: int, model: Model, st: S.State) -> str:
-    """Why the run stopped, naming the quantities, the limits and what to change."""
-    e = st.err
-    cfg = model.config
-    t = e[S.ERR_T]
-    if status == INTERRUPTED:
-        return f"{INTERRUPTED_STATUS} at t = {st.clock[S.T_NOW]:.6e} s."
-    if status == S.ERR_NOCONV and int(e[S.ERR_ITER]) == 0:
-        return (
-            f"the time step cannot move the clock on at t = {t:.6e} s (step {e[S.ERR_H]:.3e} s, "
-            f"time.dt_min = {cfg.dt_min:.3e} s): the step control has collapsed. Raise time.dt_min "
-            f"or solver.error_tol."
-        )
-    if status == S.ERR_NOCONV:
-        k = int(e[S.ERR_CONTACT])
-        where = f"plate contact '{model.contact_labels[k]}'" if 0 <= k < len(model.contact_labels) else "the interface"
-        return (
-            f"the interface-force iteration cannot go on at t = {t:.6e} s: {where} has "
-            f"|N| = {e[S.ERR_N]:.4g} N, slip rate {e[S.ERR_VT]:.4g} m/s, local-map modulus "
-            f"|lambda| = {e[S.ERR_LAM]:.3g} (eq. 8) with step {e[S.ERR_H]:.3e} s after "
-            f"{int(e[S.ERR_ITER])} iterations, and the step may not go below time.dt_min = "
-            f"{cfg.dt_min:.3e} s. Lower solver.lambda_target, raise solver.max_iterations or "
-            f"lower time.dt_min."
-        )
-    if status == S.ERR_ENERGY:
-        return (
-            f"energy balance broken at t = {t:.6e} s: residual (E_p + E_g + D - E_in)/E_in = "
-            f"{e[S.ERR_RESID]:.3e} exceeds solver.energy_tol = {cfg.energy_tol:.1e} "
-            f"(step {e[S.ERR_H]:.3e} s). Lower time.dt_max or solver.lambda_target."
-        )
-    if status in (S.ERR_OVERLAP, S.ERR_MISSED, S.ERR_PLATE_REACH, S.ERR_JUMP):
-        return contact_message(status, model, st)
-    if status == S.ERR_NAN:
-        return f"the state became non-finite (NaN/inf) at t = {t:.6e} s (step {e[S.ERR_H]:.3e} s)."
-    return f"output buffer exhausted at t = {t:.6e} s (internal error, status {status})."
-
-
-def partner_name(model: Model, partner: int) -> str:
-    """'granule X', 'wall w (x, y)' or 'the plate' from a partner code (state.PARTNER_PLATE)."""
-    if partner == S.PARTNER_PLATE:
-        return "the plate"
-    if partner < 0:
-        w = -1 - partner
-        return f"wall {w} (normal {tuple(model.scenario.walls[w].normal)}, offset {model.scenario.walls[w].offset:g} m)"
-    return f"granule '{model.labels[partner]}'"
-
-
-def contact_message(status: int, model: Model, st: S.State) -> str:
-    """Why the contact watch stopped the run (solver/contacts.py, model/contacts.py)."""
-    e = st.err
-    c = model.scenario.contact
-    cfg = model.config
-    t = e[S.ERR_T]
-    i = int(e[S.ERR_CONTACT])
-    who = f"granule '{model.labels[i]}'"
-    other = partner_name(model, int(e[S.ERR_ITER]))
-    where = "(at " + ", ".join(f"{name} = {v:.6g} m" for name, v in zip("xyz", st.y[i, : cfg.dimension])) + ")"
-    if status == S.ERR_OVERLAP:
-        return (
-            f"{who} {where} and {other} overlap by {e[S.ERR_N]:.4g} m at t = {t:.6e} s, "
-            f"{e[S.ERR_RESID]:.3g} of the smaller radius, beyond contact.overlap_stop = "
-            f"{c.overlap_stop:g}: Hertz's law assumes small overlaps. Lower the load or "
-            f"time.dt_max, or stiffen the contact."
-        )
-    if status == S.ERR_MISSED:
-        how = (
-            'it is not one of the fixed contacts (contact.detection = "fixed"); use detection = "dynamic"'
-            if c.detection == "fixed"
-            else "the contact formed unseen within one step: lower time.dt_max or raise contact.skin"
-        )
-        return (
-            f"{who} {where} and {other} interpenetrate by {e[S.ERR_N]:.4g} m at t = {t:.6e} s "
-            f"and no contact accounts for it: {how}."
-        )
-    if status == S.ERR_PLATE_REACH:
-        if cfg.face_skin > 0.0:
-            why = (
-                "it came from farther than contact.skin R within one step, so its patch contact "
-                "formed unseen: lower time.dt_max or raise contact.skin"
-            )
-        elif c.detection == "fixed":
-            why = (
-                f'with contact.detection = "fixed" plate contacts are those at t = 0 (within '
-                f'contact.neighbour_gap = {c.neighbour_gap:g} R of the plate); use detection = "dynamic"'
-            )
-        else:
-            why = (
-                "contacts forming on the plate's face need every mode or the truncated basis' "
-                'static correction; use plate.n_modes = 0 (with plate.modes = "all"), or '
-                'plate.modes = "truncated" (a dense basis cut to plate.n_modes keeps plate '
-                "contacts to those at t = 0)"
-            )
-        return (
-            f"{who} {where} reached the plate's face at t = {t:.6e} s (overlap "
-            f"{e[S.ERR_N]:.4g} m) but has no plate contact: {why}."
-        )
-    return (
-        f"{who} {where} moved {e[S.ERR_N]:.4g} m ({e[S.ERR_RESID]:.3g} radii) in one step at "
-        f"t = {t:.6e} s: contacts may have been passed through. Lower time.dt_max."
-    )
-
-
-def overlap_warnings(model: Model, w: S.Work) -> list[str]:
-    """One line per granule whose largest contact overlap exceeded contact.overlap_warn
-    (of the smaller radius), with that contact's partner: Hertz's law assumes small overlaps."""
-    lim = model.scenario.contact.overlap_warn
-    out = []
-    seen = set()
-    for i in np.flatnonzero(w.ovl > lim):
-        j = int(w.ovl_with[i])
-        key = (min(i, j), max(i, j)) if j >= 0 else (int(i), j)
-        if key in seen:
-            continue
-        seen.add(key)
-        out.append(
-            f"granule '{model.labels[i]}' and {partner_name(model, j)}: overlap "
-            f"{w.ovl[i]:.3g} of the smaller radius (contact.overlap_warn = {lim:g})"
-        )
-    return out
-
-
-def wall_offsets_now(g, normals: np.ndarray, offsets: np.ndarray) -> np.ndarray:
-    """The walls' offsets [m] with each driven wall moved as far as the last force pass
-    put it (its displacement along its direction, projected on its normal)."""
-    out = offsets.copy()
-    for w, k in enumerate(g.wall_drive):
-        if k >= 0:
-            out[w] += g.drive_now[k, DR_S] * float(normals[w] @ g.drive_dir[k])
-    return out
-
-
-class ContactLists:
-    """The loop's contact lists during a run: rebuilt (detection = "dynamic") or checked
-    (fixed) from the granules' positions, between compiled chunks (model/contacts.py),
-    and how they changed (`changes`)."""
-
-    def __init__(self, model: Model):
-        self.model = model
-        g = model.granular
-        # this run's own histories (the loop updates them in place)
-        self.g = g._replace(
-            pair_hist=no_history(len(g.pair_ij)),
-            wall_hist=no_history(len(g.wall_i)),
-            pc_hist=no_history(len(g.pc_i)),
-            drive_now=g.drive_now.copy(),
-            wall_load=g.wall_load.copy(),
-        )
-        self.known: dict = {}
-        self.stores: tuple[dict, dict] = ({}, {})  # histories of the pairs and wall contacts off the lists
-        self.planes = wall_planes(model.walls, model.config.dimension)
-        self.n_rebuilds = 0  # rebuilds the loop asked for (REBUILD, dynamic detection)
-        self.formed: list[tuple[int, float, float]] = []  # patch contacts: (granule, t [s], y [m])
-
-    def changes(self, body=None) -> ContactChanges:
-        """The patch contacts formed so far and the rebuilds, as a ContactChanges (with the
-        contacts on an elastic body in space, model.inputs.BodyArrays, among the peaks)."""
-        i, t, y = zip(*self.formed) if self.formed else ((), (), ())
-        return ContactChanges(
-            granule=np.array(i, np.int64),
-            time=np.array(t, float),
-            y=np.array(y, float),
-            n_rebuilds=self.n_rebuilds,
-            peaks=contact_peaks(self.g, self.stores, body),
-        )
-
-    def refresh(self, y: np.ndarray) -> Missed | None:
-        """Rebuild (dynamic) or check (fixed) the lists at positions y[:, :2]; returns the
-        worst overlap no contact of the current list accounts for, or None."""
-        m, g = self.model, self.g
-        x, yy, z = centre_coordinates(y, m.config.dimension)
-        r = g.radius
-        c = m.scenario.contact
-        fixed = c.detection == "fixed"
-        normals, offsets = self.planes
-        walls = m.walls
-        if len(g.wall_drive):  # driven walls where they are now (docs/model.md section 3.11)
-            offsets = wall_offsets_now(g, normals, offsets)
-            walls = tuple(dataclasses.replace(wall, offset=float(o)) for wall, o in zip(walls, offsets))
-            g.drive_now[:, DR_REF] = g.drive_now[:, DR_S]
-        if fixed:
-            cand_p, cand_w = verlet_pairs(x, yy, r, 0.0, z), verlet_walls(x, yy, r, normals, offsets, 0.0, z)
-        else:
-            cand_p, cand_w = contact_lists(c, walls, x, yy, r, z)
-        cur_w = np.column_stack([g.wall_i, g.wall_w]).astype(np.int64)
-        missed = missed_contacts(g.pair_ij, cur_w, cand_p, cand_w, normals, offsets, x, yy, r, z)
-        if not fixed:
-            self.g = granular_with_contacts(m, g, cand_p, cand_w, self.known, self.stores)
-        return missed[0] if missed else None
-
-
-class LoopArrays:
-    """The arrays one run advances, replaced as a whole when a patch contact is added
-    (their contact dimension grows): the plate's modal arrays (p: its contact rows are
-    this run's own), the state, the shared and the scheme's scratch and the outputs."""
-
-    def __init__(self, model: Model, times: np.ndarray, nk: int):
-        g, p, cfg = model.granular, model.plate_arrays, model.config
-        ng, nm = model.n_granules, len(p.omega2)
-        nc = S.STATE_COLUMNS[cfg.dimension]
-        self.p = p._replace(phi_d=p.phi_d.copy(), resid=p.resid.copy()) if cfg.face_skin > 0.0 else p
-        self.st = S.new_state(ng, nm, nk, nc)
-        self.w = S.new_work(ng, nm, nk, len(p.face_y), nc)
-        if cfg.face_skin > 0.0 and p.resid_face.shape[0] > 0:  # the rigid layers' face weights: their node
-            for k, y_k in enumerate(model.plate.contact_y[:nk]):
-                first, last = patch_weights(p.face_y, float(y_k), 0.0, self.w.wface)
-                set_face_weights(k, first, last, self.w)
-        self.sw = scheme(cfg.scheme).new_scratch(ng, nm, nk, body=model.body, threads=cfg.threads)
-        ts, gs = sensor_setup(model, times)
-        self.out = S.new_output(times, ng, nm, nk, nc, len(g.wall_load), len(g.drive_target), ts, gs)
-        self.scheme = cfg.scheme
-        self.sw_threads = cfg.threads
-
-    def grow(self, nk_new: int) -> None:
-        """Room for nk_new plate contacts: every array reallocated with the old values
-        kept (contacts keep their indices; the new ones start at zero) and the per-level
-        matrices marked stale."""
-        st, w = self.st, self.w
-        ng, nm = st.y.shape[0], st.q.shape[0]
-        nc = st.y.shape[1]
-        self.st = _copied(st, S.new_state(ng, nm, nk_new, nc))
-        self.w = _copied(w, S.new_work(ng, nm, nk_new, len(w.wface), nc))
-        self.sw = _copied(self.sw, scheme(self.scheme).new_scratch(ng, nm, nk_new, threads=self.sw_threads))
-        self.out = _copied(
-            self.out,
-            S.new_output(
-                self.out.target,
-                ng,
-                nm,
-                nk_new,
-                nc,
-                self.out.wall_force.shape[1],
-                self.out.drive.shape[1],
-                self.out.sensor_target,
-                self.out.sensor_granule,
-            ),
-        )
-        phi_d = np.zeros((2 * nk_new, nm))
-        phi_d[: self.p.phi_d.shape[0]] = self.p.phi_d
-        self.p = self.p._replace(phi_d=phi_d)
-        if self.p.resid_face.shape[0] > 0:  # a truncated basis: the new contacts' static rows start at zero
-            resid = np.zeros((2 * nk_new, 2 * nk_new))
-            n = self.p.resid.shape[0]
-            resid[:n, :n] = self.p.resid
-            self.p = self.p._replace(resid=resid)
-        self.w.g_ok[:] = 0
-        self.st.clock[S.CUSTOM_H] = -1.0
-
-
-def _copied(old: tuple, new: tuple) -> tuple:
-    """`new` (a named tuple of arrays) with each array's leading block taken from `old`'s."""
-    for a, b in zip(old, new):
-        b[tuple(slice(0, min(m, n)) for m, n in zip(a.shape, b.shape))] = a[
-            tuple(slice(0, min(m, n)) for m, n in zip(a.shape, b.shape))
-        ]
-    return new
-
-
-def near_face(model: Model, y: np.ndarray, free: np.ndarray) -> np.ndarray:
-    """Granules without a plate contact (free != 0) whose centre lies within the plate's
-    height and whose surface is within contact.skin R of its undeformed face (docs/model.md
-    section 3.5), ascending."""
-    cfg, r = model.config, model.granular.radius
-    inside = (cfg.plate_ylo < y[:, 1]) & (y[:, 1] < cfg.plate_yhi) & (free != 0)
-    near = plate_overlap(y[:, 0], r * (1.0 + cfg.face_skin), cfg.plate_x0) > 0.0
-    return np.flatnonzero(inside & near).astype(np.int64)
-
-
-def add_patch_contacts(model: Model, lists: "ContactLists", arr: LoopArrays) -> int:
-    """Give every granule near the face without a plate contact a patch contact
-    centred at its height (docs/model.md section 3.5); returns how many were added."""
-    return attach_patches(model, lists, arr, near_face(model, arr.st.y, arr.w.plate_free))
-
-
-def attach_patches(model: Model, lists: "ContactLists", arr: LoopArrays, new: np.ndarray) -> int:
-    """Give each granule of `new` (ascending) a patch contact centred at its height: the
-    one path of every patch contact, those formed during the run (NEW_PLATE) and those of
-    the granules touching the face between nodes at t = 0 (before the first step); returns
-    how many were added."""
-    new = np.asarray(new, np.int64)
-    if len(new) == 0:
-        return 0
-    nk = len(lists.g.pc_i)
-    lists.g = granular_with_patch_contacts(model, lists.g, new)
-    arr.grow(nk + len(new))
-    for k, i in enumerate(new, start=nk):
-        loop.place_contact(arr.sw, k, float(arr.st.y[i, 1]), arr.st, arr.p, model.config, arr.w)
-        lists.formed.append((int(i), float(arr.st.clock[S.T_NOW]), float(arr.st.y[i, 1])))
-        arr.st.slip[k] = arr.st.y[i, 4] + model.granular.radius[i] * arr.st.y[i, 5] - arr.st.v[2 * k + 1]
-    arr.w.plate_free[new] = 0
-    return len(new)
 
 
 @contextmanager

@@ -90,8 +90,8 @@ def _rebuilt(prefix: str, tup, snap: dict[str, np.ndarray]):
 
 
 def restore(snap: dict[str, np.ndarray], arr, lists) -> None:
-    """Put the captured arrays in place of `arr`'s (a driver.LoopArrays) and `lists`'s
-    (a driver.ContactLists); the per-level caches start empty."""
+    """Put the captured arrays in place of `arr`'s (a loop_arrays.LoopArrays) and `lists`'s
+    (a run_contacts.ContactLists); the per-level caches start empty."""
     arr.st = _rebuilt("st", arr.st, snap)
     arr.w = _rebuilt("w", arr.w, snap)
     arr.sw = _rebuilt("sw", arr.sw, snap)

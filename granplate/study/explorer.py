@@ -681,34 +681,24 @@ def explorer_html(
     targets' verdicts), then the views to explore, the table, failures, the study file
     (collapsed) and the figures for papers; `live`: it reloads itself every REFRESH_S seconds while
     designs are left."""
-    from granplate.study import report as R
-
     c = data["counts"]
     what = "optimisation" if out.kind == "optimization" else "sweep"
     title = f"Study {out.folder.name}: {what} of {out.base or 'a scenario'}"
     refresh = f"<meta http-equiv='refresh' content='{REFRESH_S}'>" if live and c["left"] else ""
-    conclusion = "".join(f"<p>{_inline(p.strip())}</p>" for p in out.report.conclusion.split("\n\n") if p.strip())
-    running = " <span class='live'>(running: this page reloads as designs arrive)</span>" if refresh else ""
-    main = figures.get("main")
-    main_title = {
-        "pareto": "Pareto front of the objectives",
-        "heat": "Heat map",
-        "metric": "Metrics against the parameters",
-    }.get(main or "", "")
-    targets = R._targets(out)
-    targets = [
-        b
-        for b in targets
-        if b.kind != "h2"
-        and not (b.kind == "h3" and b.text == "Conclusion")
-        and not (b.kind == "p" and out.report.conclusion and b.text.strip() in out.report.conclusion)
-    ]
-    failures = R._failures(out)
-    definition = R._definition(out)
-    paper = "".join(
-        f"<li><a href='{html.escape(_relative(out.folder, p))}'>{html.escape(p.name)}</a></li>" for p in paper_figures
-    )
     parts = [
+        *_page_header(out, c, title, refresh),
+        *_answer_sections(out, figures),
+        *_explore_section(figures),
+        *_closing_sections(out, data, figures, paper_figures),
+    ]
+    return "\n".join(p for p in parts if p) + "\n"
+
+
+def _page_header(out: StudyOutcome, c: dict, title: str, refresh: str) -> list[str]:
+    """The page's head and header: the title, the counts (and whether it reloads), how
+    to read and explore it."""
+    running = " <span class='live'>(running: this page reloads as designs arrive)</span>" if refresh else ""
+    return [
         "<!DOCTYPE html>",
         "<html lang='en'><head><meta charset='utf-8'>",
         refresh,
@@ -725,6 +715,30 @@ def explorer_html(
         "Pa are shown in MPa, dimensionless quantities as [-]. Hover a point for its design, "
         "click it for its panel, drag a box (or a range on an axis of the parallel coordinates) to filter.</p>",
         "</header>",
+    ]
+
+
+def _answer_sections(out: StudyOutcome, figures: dict[str, Any]) -> list[str]:
+    """The answer first: the conclusion, the best designs, the main figure, then the
+    targets' verdicts."""
+    from granplate.study import report as R
+
+    conclusion = "".join(f"<p>{_inline(p.strip())}</p>" for p in out.report.conclusion.split("\n\n") if p.strip())
+    main = figures.get("main")
+    main_title = {
+        "pareto": "Pareto front of the objectives",
+        "heat": "Heat map",
+        "metric": "Metrics against the parameters",
+    }.get(main or "", "")
+    targets = R._targets(out)
+    targets = [
+        b
+        for b in targets
+        if b.kind != "h2"
+        and not (b.kind == "h3" and b.text == "Conclusion")
+        and not (b.kind == "p" and out.report.conclusion and b.text.strip() in out.report.conclusion)
+    ]
+    return [
         "<section id='answer'>",
         "<div class='answer-text'>",
         (f"<div id='conclusion' class='conclusion'><h2>Conclusion</h2>{conclusion}</div>" if conclusion else ""),
@@ -740,6 +754,13 @@ def explorer_html(
         "<div id='fig-main' class='plot main-plot'></div></div>",
         "</section>",
         (f"<section id='targets'><h2>Targets</h2>{_blocks_html(targets)}</section>" if targets else ""),
+    ]
+
+
+def _explore_section(figures: dict[str, Any]) -> list[str]:
+    """The views to explore: filters, parallel coordinates, metrics, heat maps, the table."""
+    main = figures.get("main")
+    return [
         "<section id='explore'><h2>Explore</h2>",
         "<div class='filterbar'><span id='shown'></span> <label><input type='checkbox' id='only-feasible'> "
         "feasible only</label> <label><input type='checkbox' id='only-front'> on the front only</label> "
@@ -765,6 +786,20 @@ def explorer_html(
         "<h3>Designs</h3><p class='hint'>Click a column to sort, a row for the design's panel.</p>",
         "<div class='table-wrap' id='table-wrap'><table id='designs'></table></div>",
         "</section>",
+    ]
+
+
+def _closing_sections(out: StudyOutcome, data: dict[str, Any], figures: dict[str, Any], paper_figures) -> list[str]:
+    """Failures, the study file (collapsed), the figures for papers, the design panel and
+    the page's data and scripts."""
+    from granplate.study import report as R
+
+    failures = R._failures(out)
+    definition = R._definition(out)
+    paper = "".join(
+        f"<li><a href='{html.escape(_relative(out.folder, p))}'>{html.escape(p.name)}</a></li>" for p in paper_figures
+    )
+    return [
         f"<section id='failures'>{_blocks_html(failures)}</section>",
         f"<details id='study'><summary>The study: its definition and the study file as run</summary>"
         f"{_blocks_html(definition)}</details>",
@@ -780,7 +815,6 @@ def explorer_html(
         f"<script src='{ASSETS}/explorer.js'></script>",
         "</body></html>",
     ]
-    return "\n".join(p for p in parts if p) + "\n"
 
 
 def write_explorer(

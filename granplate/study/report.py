@@ -444,14 +444,37 @@ def build_report(out: StudyOutcome, progress: bool = False, fresh: bool = False)
     the way (fresh: the figures there were drawn from these same inputs and are kept)."""
     fig_dir = out.folder / FIGURES
     if not fresh:
-        (fig_dir / INPUTS_FILE).unlink(missing_ok=True)
-        for stale in (
-            *fig_dir.glob("metric-*.p[nd][gf]"),
-            *fig_dir.glob("heatmap-*.p[nd][gf]"),
-            fig_dir / "pareto-front.png",
-            fig_dir / "pareto-front.pdf",
-        ):
-            stale.unlink(missing_ok=True)  # drawn again below, or no longer part of the study
+        _clear_figures(fig_dir)
+    blocks = _summary(out)
+    blocks += _definition(out)
+    drawn, left = shown_metrics(out)
+    chosen = best_designs(out)
+    front = pareto_front(out)
+    blocks += _targets(out)
+    blocks += _designs(out, drawn, chosen, front)
+    if out.objectives:
+        blocks += _pareto(out, front, chosen, fig_dir, fresh)
+    blocks += _metrics_against_parameters(out, drawn, left, fig_dir, fresh)
+    blocks += _heat_maps(out, drawn, fig_dir, fresh)
+    blocks += _chosen(out, chosen, fig_dir, progress)
+    blocks += _failures(out)
+    return blocks
+
+
+def _clear_figures(fig_dir: Path) -> None:
+    """Remove the figures a report draws again (or that are no longer part of the study)."""
+    (fig_dir / INPUTS_FILE).unlink(missing_ok=True)
+    for stale in (
+        *fig_dir.glob("metric-*.p[nd][gf]"),
+        *fig_dir.glob("heatmap-*.p[nd][gf]"),
+        fig_dir / "pareto-front.png",
+        fig_dir / "pareto-front.pdf",
+    ):
+        stale.unlink(missing_ok=True)  # drawn again below, or no longer part of the study
+
+
+def _summary(out: StudyOutcome) -> list[Block]:
+    """The title and the counts: designs run, failed, not run, infeasible; how to read it."""
     n_ok = sum(r.ok for r in out.rows)
     n_failed = sum(not r.ok and r.status != "not run" for r in out.rows)
     n_bad = sum(r.feasible is False for r in out.rows)
@@ -470,11 +493,12 @@ def build_report(out: StudyOutcome, progress: bool = False, fresh: bool = False)
             "are shown in MPa, dimensionless quantities as [-].",
         )
     )
-    blocks += _definition(out)
-    drawn, left = shown_metrics(out)
-    chosen = best_designs(out)
-    front = pareto_front(out)
-    blocks += _targets(out)
+    return blocks
+
+
+def _designs(out: StudyOutcome, drawn, chosen, front) -> list[Block]:
+    """The designs' table with its introduction."""
+    blocks: list[Block] = []
     blocks.append(Block("h2", "Designs"))
     blocks.append(
         Block(
@@ -490,40 +514,51 @@ def build_report(out: StudyOutcome, progress: bool = False, fresh: bool = False)
         )
     )
     blocks.append(_designs_table(out, drawn, chosen, front))
-    if out.objectives:
-        blocks.append(Block("h2", "Pareto front"))
-        path = _figure(fig_dir / "pareto-front.png", lambda: P.fig_pareto(out, front, chosen), fresh)
-        if path is not None:
-            blocks.append(
-                Block(
-                    "figure",
-                    "The trials and the Pareto front of the feasible ones"
-                    + (" (crosses: infeasible)" if out.constraints else "")
-                    + "; axes in the objectives' units",
-                    path=path,
-                )
-            )
-        first = same_design(out)
-        on_front = list(dict.fromkeys(first[i] for i in front))
+    return blocks
+
+
+def _pareto(out: StudyOutcome, front, chosen, fig_dir: Path, fresh: bool) -> list[Block]:
+    """The Pareto front: its figure and the designs on it."""
+    blocks: list[Block] = []
+    blocks.append(Block("h2", "Pareto front"))
+    path = _figure(fig_dir / "pareto-front.png", lambda: P.fig_pareto(out, front, chosen), fresh)
+    if path is not None:
         blocks.append(
             Block(
-                "p",
-                "On the front: "
-                + (
-                    ", ".join(
-                        f"{'trial' if out.kind == 'optimization' else 'design'} {out.rows[i].number}"
-                        + (
-                            f" (and {n - 1} more trials of the same design)"
-                            if (n := sum(first[j] == i for j in front)) > 1
-                            else ""
-                        )
-                        for i in on_front
-                    )
-                    or "no feasible design"
-                )
-                + ".",
+                "figure",
+                "The trials and the Pareto front of the feasible ones"
+                + (" (crosses: infeasible)" if out.constraints else "")
+                + "; axes in the objectives' units",
+                path=path,
             )
         )
+    first = same_design(out)
+    on_front = list(dict.fromkeys(first[i] for i in front))
+    blocks.append(
+        Block(
+            "p",
+            "On the front: "
+            + (
+                ", ".join(
+                    f"{'trial' if out.kind == 'optimization' else 'design'} {out.rows[i].number}"
+                    + (
+                        f" (and {n - 1} more trials of the same design)"
+                        if (n := sum(first[j] == i for j in front)) > 1
+                        else ""
+                    )
+                    for i in on_front
+                )
+                or "no feasible design"
+            )
+            + ".",
+        )
+    )
+    return blocks
+
+
+def _metrics_against_parameters(out: StudyOutcome, drawn, left, fig_dir: Path, fresh: bool) -> list[Block]:
+    """Each drawn metric against every parameter, and the metrics not drawn."""
+    blocks: list[Block] = []
     blocks.append(Block("h2", "Metrics against the parameters"))
     if left:
         blocks.append(
@@ -542,6 +577,13 @@ def build_report(out: StudyOutcome, progress: bool = False, fresh: bool = False)
                 path=_figure(fig_dir / f"metric-{m}.png", lambda: P.fig_metric(out, m), fresh),
             )
         )
+    return blocks
+
+
+def _heat_maps(out: StudyOutcome, drawn, fig_dir: Path, fresh: bool) -> list[Block]:
+    """Heat maps of the objectives, headline and target metrics over two parameters (none
+    when the study has no two to draw them over)."""
+    blocks: list[Block] = []
     heat = P.heat_axes(out)
     if heat is not None:
         blocks.append(Block("h2", "Heat maps"))
@@ -561,6 +603,13 @@ def build_report(out: StudyOutcome, progress: bool = False, fresh: bool = False)
                     blocks.append(
                         Block("figure", f"{m} [{P.shown(out.unit(m))[1]}] over {heat[0]} and {heat[1]}", path=path)
                     )
+    return blocks
+
+
+def _chosen(out: StudyOutcome, chosen, fig_dir: Path, progress: bool) -> list[Block]:
+    """The chosen designs (best per objective or headline metric, the first meeting every
+    target) with their metrics and figures; the figures of designs no longer chosen removed."""
+    blocks: list[Block] = []
     picks = chosen_designs(out, chosen)
     if picks:
         blocks.append(Block("h2", "Chosen designs"))
@@ -606,7 +655,6 @@ def build_report(out: StudyOutcome, progress: bool = False, fresh: bool = False)
     for old in fig_dir.glob("design-*.png"):  # designs no longer chosen
         if old.name.split("-")[1] not in drawn_keys:
             old.unlink()
-    blocks += _failures(out)
     return blocks
 
 

@@ -59,15 +59,12 @@ def _residual(ds) -> float:
     return float(np.max(np.abs(ds.energy_residual_max.values)))
 
 
-def energy_residual(ctx: Context) -> CaseResult:
-    """Energy residual of every preset: its size with both schemes, and its decrease under
-    step halving with the paper scheme."""
-    from granplate.setup.presets import preset, preset_names
-
-    checks = []
-    series = {}
-    full_rows = []
+def short_run_checks(series, checks):
+    """Each preset's 50 us runs, appended to `checks` (and the paper scheme's run to `series`): the largest
+    residual under the implicit scheme and under the paper scheme, and the paper scheme's observed order
+    under step halving (the bare plate: Newmark's exact balance to round-off)."""
     from granplate.setup.io import with_changes
+    from granplate.setup.presets import preset, preset_names
 
     for name in preset_names():
         # the default (implicit) scheme: its step control holds the residual's growth
@@ -133,6 +130,11 @@ def energy_residual(ctx: Context) -> CaseResult:
                 kind="min",
             )
         )
+
+
+def full_run_checks(ctx, full_rows, checks):
+    """With ctx.full, the full 2 ms runs' largest residual appended to `checks`, each run's summary to
+    `full_rows`."""
     if ctx.full:
         from .coupled import study_run
 
@@ -151,6 +153,17 @@ def energy_residual(ctx: Context) -> CaseResult:
                     kind="max",
                 )
             )
+
+
+def energy_residual(ctx: Context) -> CaseResult:
+    """Energy residual of every preset: its size with both schemes, and its decrease under
+    step halving with the paper scheme."""
+    checks = []
+    series = {}
+    full_rows = []
+
+    short_run_checks(series, checks)
+    full_run_checks(ctx, full_rows, checks)
     desc = (
         "Every preset (`granplate presets`) is run for 50 µs (the shock and the first "
         "arrivals at the plate) with the default (implicit) scheme, and with the paper "
@@ -249,26 +262,10 @@ def friction_couple(model, y: np.ndarray) -> tuple[float, float, float]:
     return dL, couple, float(np.abs(terms).sum())
 
 
-def free_assembly(ctx: Context) -> CaseResult:
-    """Linear and angular momentum of a free assembly (no walls, no plate, no load)."""
-    from granplate.model.arrays import build_model
-
-    s_fric = load_case_scenario("free-assembly")
-    s_free = load_case_scenario("free-assembly", {"contact.mu": 0.0})
-    s_arm = load_case_scenario("free-assembly", {"contact.torque_arm": "contact_point"})
-    runs = {
-        "friction": simulate(s_fric),
-        "frictionless": simulate(s_free),
-        "friction, contact-point arm": simulate(s_arm),
-    }
-    n_steps = int(runs["friction"].n_steps.values[-1])
-    tol = n_steps * EPS
-    roundoff_why = (
-        f"pairwise forces cancel exactly, so only round-off accumulates: {n_steps} "
-        f"steps x eps = {tol:.1e} (worst case, linear growth)."
-    )
-    checks = []
-    mom = {k: _momenta(ds) for k, ds in runs.items()}
+def momentum_checks(mom, checks, tol, roundoff_why):
+    """Linear momentum conserved to round-off in each run (with friction, frictionless, with the
+    contact-point arm); angular momentum too without friction and with the contact-point arm, appended
+    to `checks`."""
     for k in ("friction", "frictionless", "friction, contact-point arm"):
         px, py, L, ps, Ls = mom[k]
         drift = float(max(np.abs(px - px[0]).max(), np.abs(py - py[0]).max()) / ps)
@@ -311,6 +308,14 @@ def free_assembly(ctx: Context) -> CaseResult:
             kind="max",
         )
     )
+
+
+def friction_couple_check(s_fric, runs, checks):
+    """The angular momentum's balance with friction under the centre arm (eq. 1, docs/model.md section
+    3.1): dL/dt against the couple -f delta the pairs leave, at every output time, appended to `checks`.
+    Returns (the run, the couple at each output time)."""
+    from granplate.model.arrays import build_model
+
     model = build_model(s_fric)
     ds = runs["friction"]
     state = np.stack([ds[k].values for k in ("x", "y", "theta", "vx", "vy", "omega")], axis=-1)
@@ -333,6 +338,30 @@ def free_assembly(ctx: Context) -> CaseResult:
             kind="max",
         )
     )
+    return ds, defect
+
+
+def free_assembly(ctx: Context) -> CaseResult:
+    """Linear and angular momentum of a free assembly (no walls, no plate, no load)."""
+
+    s_fric = load_case_scenario("free-assembly")
+    s_free = load_case_scenario("free-assembly", {"contact.mu": 0.0})
+    s_arm = load_case_scenario("free-assembly", {"contact.torque_arm": "contact_point"})
+    runs = {
+        "friction": simulate(s_fric),
+        "frictionless": simulate(s_free),
+        "friction, contact-point arm": simulate(s_arm),
+    }
+    n_steps = int(runs["friction"].n_steps.values[-1])
+    tol = n_steps * EPS
+    roundoff_why = (
+        f"pairwise forces cancel exactly, so only round-off accumulates: {n_steps} "
+        f"steps x eps = {tol:.1e} (worst case, linear growth)."
+    )
+    checks = []
+    mom = {k: _momenta(ds) for k, ds in runs.items()}
+    momentum_checks(mom, checks, tol, roundoff_why)
+    ds, defect = friction_couple_check(s_fric, runs, checks)
     L_fric = mom["friction"][2]
     L_change = float(L_fric[-1] - L_fric[0])
     impulse = (

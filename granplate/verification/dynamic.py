@@ -443,37 +443,9 @@ def _bounces(t: np.ndarray, x: np.ndarray, vx: np.ndarray, centre: float) -> np.
     return np.array([tc for tc in crossings(t, x - centre) if np.interp(tc, t, vx) > 0])
 
 
-def wall_bounce(ctx: Context) -> CaseResult:
-    """A sphere bouncing between two walls: period, energy, and the damped speed decay."""
-    s = load_case_scenario("wall-bounce")
-    g = s.granules[0]
-    mat = s.materials[g.material]
-    left, right = s.walls
-    width = right.offset - (-left.offset)
-    free = width - 2 * g.radius
-    centre = 0.5 * (right.offset - left.offset)
-    ds = simulate(s)
-    t = ds.time.values
-    ups = _bounces(t, ds.x.values[:, 0], ds.vx.values[:, 0], centre)
-    periods = np.diff(ups)
-    m = sphere_mass(g.radius, mat.rho)
-    tc = hertz_reference(m, plane_modulus(mat.E, mat.nu), g.radius, g.vx)["t_c"]
-    period_ref = 2 * free / g.vx + 2 * tc
-    e0 = 0.5 * m * g.vx**2
-    ek = 0.5 * m * ds.vx.values[:, 0] ** 2
-    free_flight = np.abs(ds.x.values[:, 0] - centre) < 0.5 * free - 1e-6
-    energy_drift = float(np.abs(ek[free_flight] / e0 - 1.0).max())
-    # damped: each wall impact multiplies the speed by e(alpha_n), whatever the speed
-    alpha = 0.02
-    sd = load_case_scenario("wall-bounce", {"contact.alpha_n": alpha})
-    dd = simulate(sd)
-    e_ref = impact_ode(alpha)[0]
-    xd, vd = dd.x.values[:, 0], dd.vx.values[:, 0]
-    passes = crossings(dd.time.values, xd - centre)
-    speeds = np.abs(np.interp(passes, dd.time.values, vd))
-    ratio = speeds / g.vx
-    k_imp = np.arange(len(ratio))  # impacts before each pass of the middle
-    decay_err = float(np.abs(ratio / e_ref**k_imp - 1.0).max())
+def wall_bounce_checks(period_ref, energy_drift, decay_err, alpha, periods, ups, ratio):
+    """The checks of `wall_bounce`: the mean period against the free flight plus Hertz's contact time and
+    its spread, the kinetic energy in free flight, and the damped speeds' decay as e^k."""
     checks = [
         Check(
             f"period, mean of {len(periods)} (elastic)",
@@ -518,6 +490,41 @@ def wall_bounce(ctx: Context) -> CaseResult:
             kind="max",
         ),
     ]
+    return checks
+
+
+def wall_bounce(ctx: Context) -> CaseResult:
+    """A sphere bouncing between two walls: period, energy, and the damped speed decay."""
+    s = load_case_scenario("wall-bounce")
+    g = s.granules[0]
+    mat = s.materials[g.material]
+    left, right = s.walls
+    width = right.offset - (-left.offset)
+    free = width - 2 * g.radius
+    centre = 0.5 * (right.offset - left.offset)
+    ds = simulate(s)
+    t = ds.time.values
+    ups = _bounces(t, ds.x.values[:, 0], ds.vx.values[:, 0], centre)
+    periods = np.diff(ups)
+    m = sphere_mass(g.radius, mat.rho)
+    tc = hertz_reference(m, plane_modulus(mat.E, mat.nu), g.radius, g.vx)["t_c"]
+    period_ref = 2 * free / g.vx + 2 * tc
+    e0 = 0.5 * m * g.vx**2
+    ek = 0.5 * m * ds.vx.values[:, 0] ** 2
+    free_flight = np.abs(ds.x.values[:, 0] - centre) < 0.5 * free - 1e-6
+    energy_drift = float(np.abs(ek[free_flight] / e0 - 1.0).max())
+    # damped: each wall impact multiplies the speed by e(alpha_n), whatever the speed
+    alpha = 0.02
+    sd = load_case_scenario("wall-bounce", {"contact.alpha_n": alpha})
+    dd = simulate(sd)
+    e_ref = impact_ode(alpha)[0]
+    xd, vd = dd.x.values[:, 0], dd.vx.values[:, 0]
+    passes = crossings(dd.time.values, xd - centre)
+    speeds = np.abs(np.interp(passes, dd.time.values, vd))
+    ratio = speeds / g.vx
+    k_imp = np.arange(len(ratio))  # impacts before each pass of the middle
+    decay_err = float(np.abs(ratio / e_ref**k_imp - 1.0).max())
+    checks = wall_bounce_checks(period_ref, energy_drift, decay_err, alpha, periods, ups, ratio)
     desc = (
         "A steel sphere (R = 10 mm) at 10 m/s between two walls whose distance exceeds its "
         "diameter by 0.5 mm (`wall-bounce.toml`, dynamic detection, h = 20 ns): every wall "

@@ -332,12 +332,9 @@ ODE_WHY = (
 )
 
 
-def chung_ooi_3(ctx: Context) -> CaseResult:
-    """Test 3: restitution of the damped impact against the closed form and the ODE."""
-    alphas = (0.001, 0.006313, 0.06313, 0.2, 0.4, 1.0)
-    runs = {a: _restitution_run("chung-ooi-3-alumina", a, 3.9) for a in alphas}
-    checks: list[Check] = []
-    e_ref = {a: impact_ode(a)[0] for a in alphas}
+def damped_restitution_checks(alphas, runs, checks, e_ref):
+    """The alumina impacts' restitution at each damping alpha_n against the ODE's, and the small-alpha limit
+    against the first-order closed form (its second-order term c2), appended to `checks`."""
     for a in alphas:
         r = runs[a]
         checks.append(
@@ -366,8 +363,12 @@ def chung_ooi_3(ctx: Context) -> CaseResult:
                 kind="abs",
             )
         )
-    # speed independence (cast iron): with h = t_c/2000 at every speed, the three runs are
-    # exact rescalings of one another if and only if the law is scale-free.
+    return c2
+
+
+def cast_iron_checks(checks, e_ref):
+    """The cast-iron impacts at 0.39, 3.9 and 39 m/s: the restitution independent of the speed, as the
+    damping law makes it, and the fastest against the ODE, appended to `checks`. Returns (the speeds, their runs)."""
     speeds = (0.39, 3.9, 39.0)
     iron = {v: _restitution_run("chung-ooi-3-cast-iron", 0.06313, v) for v in speeds}
     spread = max(abs(iron[v]["e"] / iron[3.9]["e"] - 1.0) for v in speeds)
@@ -397,6 +398,12 @@ def chung_ooi_3(ctx: Context) -> CaseResult:
             ODE_WHY,
         )
     )
+    return speeds, iron
+
+
+def tension_and_step_checks(checks, e_ref, runs):
+    """The restitution without the tension clip against the ODE's, and the error's fall as the step is
+    refined, appended to `checks`."""
     noclip = _restitution_run("chung-ooi-3-alumina", 0.2, 3.9, clip=False)
     e_nc = impact_ode(0.2, clip=False)[0]
     checks.append(
@@ -425,6 +432,20 @@ def chung_ooi_3(ctx: Context) -> CaseResult:
             kind="abs",
         )
     )
+    return e_nc
+
+
+def chung_ooi_3(ctx: Context) -> CaseResult:
+    """Test 3: restitution of the damped impact against the closed form and the ODE."""
+    alphas = (0.001, 0.006313, 0.06313, 0.2, 0.4, 1.0)
+    runs = {a: _restitution_run("chung-ooi-3-alumina", a, 3.9) for a in alphas}
+    checks: list[Check] = []
+    e_ref = {a: impact_ode(a)[0] for a in alphas}
+    c2 = damped_restitution_checks(alphas, runs, checks, e_ref)
+    # speed independence (cast iron): with h = t_c/2000 at every speed, the three runs are
+    # exact rescalings of one another if and only if the law is scale-free.
+    speeds, iron = cast_iron_checks(checks, e_ref)
+    e_nc = tension_and_step_checks(checks, e_ref, runs)
 
     # figure: e against alpha, and the force-overlap loops
     desc = (

@@ -128,38 +128,10 @@ def _chain_runs() -> dict:
     }
 
 
-def chain_in_space(ctx: Context) -> CaseResult:
-    """The striker chain in space equals the plane's chain to round-off."""
-    r = _chain_runs()
-    d2, d3 = r["d2"], r["d3"]
-    g = r["plane"].granules[0]
-    v0, radius = g.vx, g.radius
-    flat_v = max(
-        float(np.abs(d3.vx.values - d2.vx.values).max()),
-        float(np.abs(d3.vy.values - d2.vy.values).max()),
-        float(np.abs(d3.vz.values).max()),
-    )
-    flat_x = max(float(np.abs(d3.x.values - d2.x.values).max()), float(np.abs(d3.z.values).max()))
-    tilt_v = float(np.abs(r["vel_along_r"] - d2.vx.values).max())
-    tilt_x = float(np.abs(r["along_r"] - d2.x.values).max())
-    across = float(r["vel_across_r"].max())
-    e_flat = max(float(np.abs(d3[k].values - d2[k].values).max()) for k in ("E_granular", "E_contact"))
-    m, _, _ = masses(r["plane"])
-    e_in = 0.5 * float(m[0]) * r["plane"].granules[0].vx ** 2
-    moved = float(np.abs(d2.vx.values[-1, 1:]).max())
-    why_flat = (
-        "in the plane z = 0 the 3D laws reduce to the plane's term by term (z, vz and "
-        "the in-plane spins stay exactly 0, docs/model.md 3.7): at most the order of a few "
-        "floating-point sums could differ, a few ulps per step (measured: an ulp, 2e-16 of v0: "
-        "space scales the normal and the accelerations by reciprocals where the plane divides)."
-    )
-    why_tilt = (
-        "along (2, 3, 6)/7 every coordinate of a centre carries a rounding of eps |s| "
-        "= 2e-16 x 0.5 m, which the overlap R_i + R_j - |s_j - s_i| (about 1e-5 m) "
-        "amplifies by |s| / delta ~ 1e3 into the force, so the two runs differ by ~1e-12 "
-        "relative per contact; 1e-9 bounds it over the ~3e4 steps of the wave (measured "
-        "7.6e-11 for velocities, 6e-12 for positions)."
-    )
+def chain_in_space_checks(why_flat, why_tilt, moved, v0, flat_v, flat_x, radius, e_flat, e_in, tilt_v, tilt_x, across):
+    """The checks of `chain_in_space`: the wave has run; in the plane z = 0 and along the tilted axis
+    (2,3,6)/7 the velocities, positions (and in the plane the energies) equal the plane's chain's to
+    round-off, and nothing moves across the tilted chain."""
     checks = [
         Check(
             "the wave has run (largest bead speed at the end / v0)",
@@ -232,6 +204,44 @@ def chain_in_space(ctx: Context) -> CaseResult:
             kind="max",
         ),
     ]
+    return checks
+
+
+def chain_in_space(ctx: Context) -> CaseResult:
+    """The striker chain in space equals the plane's chain to round-off."""
+    r = _chain_runs()
+    d2, d3 = r["d2"], r["d3"]
+    g = r["plane"].granules[0]
+    v0, radius = g.vx, g.radius
+    flat_v = max(
+        float(np.abs(d3.vx.values - d2.vx.values).max()),
+        float(np.abs(d3.vy.values - d2.vy.values).max()),
+        float(np.abs(d3.vz.values).max()),
+    )
+    flat_x = max(float(np.abs(d3.x.values - d2.x.values).max()), float(np.abs(d3.z.values).max()))
+    tilt_v = float(np.abs(r["vel_along_r"] - d2.vx.values).max())
+    tilt_x = float(np.abs(r["along_r"] - d2.x.values).max())
+    across = float(r["vel_across_r"].max())
+    e_flat = max(float(np.abs(d3[k].values - d2[k].values).max()) for k in ("E_granular", "E_contact"))
+    m, _, _ = masses(r["plane"])
+    e_in = 0.5 * float(m[0]) * r["plane"].granules[0].vx ** 2
+    moved = float(np.abs(d2.vx.values[-1, 1:]).max())
+    why_flat = (
+        "in the plane z = 0 the 3D laws reduce to the plane's term by term (z, vz and "
+        "the in-plane spins stay exactly 0, docs/model.md 3.7): at most the order of a few "
+        "floating-point sums could differ, a few ulps per step (measured: an ulp, 2e-16 of v0: "
+        "space scales the normal and the accelerations by reciprocals where the plane divides)."
+    )
+    why_tilt = (
+        "along (2, 3, 6)/7 every coordinate of a centre carries a rounding of eps |s| "
+        "= 2e-16 x 0.5 m, which the overlap R_i + R_j - |s_j - s_i| (about 1e-5 m) "
+        "amplifies by |s| / delta ~ 1e3 into the force, so the two runs differ by ~1e-12 "
+        "relative per contact; 1e-9 bounds it over the ~3e4 steps of the wave (measured "
+        "7.6e-11 for velocities, 6e-12 for positions)."
+    )
+    checks = chain_in_space_checks(
+        why_flat, why_tilt, moved, v0, flat_v, flat_x, radius, e_flat, e_in, tilt_v, tilt_x, across
+    )
     n = len(r["plane"].granules)
     desc = (
         f"The striker chain of `striker-chain.toml` ({n} touching steel spheres, R = 10 mm, striker "
@@ -307,20 +317,10 @@ def _head_on_run(alpha: float) -> dict:
     }
 
 
-def head_on_in_space(ctx: Context) -> CaseResult:
-    """Two spheres meet along a diagonal from a gap: Hertz's closed forms in space."""
-    el = _head_on_run(0.0)
-    alpha = 0.05
-    dm = _head_on_run(alpha)
-    tc_ref = hertz_contact_time(el["m_star"], el["r_star"], el["e_star"], el["v"])
-    e_ref, s_end, sol = impact_ode(alpha)
-    a_coef = hertz_reference(dm["m_star"], dm["e_star"], dm["r_star"], dm["v"])["A"]
-    length = (dm["m_star"] * dm["v"] ** 2 / a_coef) ** 0.4
-    tc_damped = (s_end + sol.y[0, -1] / e_ref) * length / dm["v"]
-    gap_why = (
-        "as gap-head-on in the plane (h = 10 ns = t_c/5300, the contact starting inside a "
-        "step: RK4's error O((h/t_c)^(5/2)) = 5e-10): the same laws on vectors."
-    )
+def head_on_in_space_checks(tc_ref, gap_why, e_ref, tc_damped, el, dm, alpha):
+    """The checks of `head_on_in_space`: the first touch, the elastic and the damped impact's contact time
+    and restitution against Hertz's closed forms, nothing across the line of centres, the spins about it
+    unchanged, the energy residual."""
     checks = [
         Check(
             "first touch t = gap / v",
@@ -394,6 +394,24 @@ def head_on_in_space(ctx: Context) -> CaseResult:
             kind="max",
         ),
     ]
+    return checks
+
+
+def head_on_in_space(ctx: Context) -> CaseResult:
+    """Two spheres meet along a diagonal from a gap: Hertz's closed forms in space."""
+    el = _head_on_run(0.0)
+    alpha = 0.05
+    dm = _head_on_run(alpha)
+    tc_ref = hertz_contact_time(el["m_star"], el["r_star"], el["e_star"], el["v"])
+    e_ref, s_end, sol = impact_ode(alpha)
+    a_coef = hertz_reference(dm["m_star"], dm["e_star"], dm["r_star"], dm["v"])["A"]
+    length = (dm["m_star"] * dm["v"] ** 2 / a_coef) ** 0.4
+    tc_damped = (s_end + sol.y[0, -1] / e_ref) * length / dm["v"]
+    gap_why = (
+        "as gap-head-on in the plane (h = 10 ns = t_c/5300, the contact starting inside a "
+        "step: RK4's error O((h/t_c)^(5/2)) = 5e-10): the same laws on vectors."
+    )
+    checks = head_on_in_space_checks(tc_ref, gap_why, e_ref, tc_damped, el, dm, alpha)
     desc = (
         "Two steel spheres (R = 10 mm) 1.23 mm apart along the diagonal n = (1, 2, 2)/3 fly at each "
         "other at 1 m/s each, spinning about n (30 and -15 rad/s) with mu = 0.3 (`3d-head-on.toml`, "
@@ -538,32 +556,10 @@ def draw_oblique_in_space(p: dict):
 # --------------------------------------------------------------------------- rolling on a wall
 
 
-def rolling_in_space(ctx: Context) -> CaseResult:
-    """A sphere pressed onto a wall and launched sliding ends rolling at v = R w = 5/7 v0."""
-    s = load_case_scenario("3d-rolling")
-    ds = simulate(s)
-    g = s.granules[0]
-    m, _, _ = masses(s)
-    v0, radius, mu = g.vx, g.radius, s.contact.mu
-    t = ds.time.values
-    _, vel, spin = state_3d(ds)
-    vx, wy = vel[:, 0, 0], spin[:, 0, 1]
-    slip = vx - radius * wy
-    t_roll = float(crossings(t, slip - 1e-6 * v0)[0])
-    # while sliding, the slip falls by (7/2) mu J_N / m, J_N the normal impulse so far, which
-    # Newton along z gives from the load's impulse and the sphere's normal momentum
-    load = s.load
-    impulse_load = load.force * load.duration / math.pi * (1.0 - np.cos(np.pi * t / load.duration))
-    impulse_normal = impulse_load + m[0] * vel[:, 0, 2]
-    sliding = slip > 2e-2 * v0  # tanh(k_s slip) = 1 to 1e-17
-    slip_ref = v0 - 3.5 * mu * impulse_normal / m[0]
-    slip_err = float(np.abs(slip - slip_ref)[sliding].max() / v0)
-    dissipated = float(ds.D_friction.values[-1])
-    others = max(
-        float(np.abs(vel[:, 0, 1]).max()),
-        float(np.abs(spin[:, 0, 0]).max()) * radius,
-        float(np.abs(spin[:, 0, 2]).max()) * radius,
-    )
+def rolling_in_space_checks(dissipated, slip_err, v0, others, vx, radius, wy, m, sliding, ds):
+    """The checks of `rolling_in_space`: rolling at v = R w = 5/7 v0, the energy friction dissipates, the
+    slip while sliding against Coulomb's closed form, no motion off the sliding plane, the energy
+    residual."""
     checks = [
         Check(
             "velocity once rolling",
@@ -631,6 +627,36 @@ def rolling_in_space(ctx: Context) -> CaseResult:
             kind="max",
         ),
     ]
+    return checks
+
+
+def rolling_in_space(ctx: Context) -> CaseResult:
+    """A sphere pressed onto a wall and launched sliding ends rolling at v = R w = 5/7 v0."""
+    s = load_case_scenario("3d-rolling")
+    ds = simulate(s)
+    g = s.granules[0]
+    m, _, _ = masses(s)
+    v0, radius, mu = g.vx, g.radius, s.contact.mu
+    t = ds.time.values
+    _, vel, spin = state_3d(ds)
+    vx, wy = vel[:, 0, 0], spin[:, 0, 1]
+    slip = vx - radius * wy
+    t_roll = float(crossings(t, slip - 1e-6 * v0)[0])
+    # while sliding, the slip falls by (7/2) mu J_N / m, J_N the normal impulse so far, which
+    # Newton along z gives from the load's impulse and the sphere's normal momentum
+    load = s.load
+    impulse_load = load.force * load.duration / math.pi * (1.0 - np.cos(np.pi * t / load.duration))
+    impulse_normal = impulse_load + m[0] * vel[:, 0, 2]
+    sliding = slip > 2e-2 * v0  # tanh(k_s slip) = 1 to 1e-17
+    slip_ref = v0 - 3.5 * mu * impulse_normal / m[0]
+    slip_err = float(np.abs(slip - slip_ref)[sliding].max() / v0)
+    dissipated = float(ds.D_friction.values[-1])
+    others = max(
+        float(np.abs(vel[:, 0, 1]).max()),
+        float(np.abs(spin[:, 0, 0]).max()) * radius,
+        float(np.abs(spin[:, 0, 2]).max()) * radius,
+    )
+    checks = rolling_in_space_checks(dissipated, slip_err, v0, others, vx, radius, wy, m, sliding, ds)
     desc = (
         "Without gravity a sphere stays on a wall only if something presses it there: a steel "
         "sphere (R = 10 mm) resting on the wall z = 0 is launched along it at 1 m/s without spin "
@@ -673,32 +699,9 @@ def draw_rolling_in_space(p: dict):
 # --------------------------------------------------------------------------- free assembly in space
 
 
-def free_assembly_in_space(ctx: Context) -> CaseResult:
-    """Spheres colliding in free space: momentum and angular momentum conserved."""
-    s = load_case_scenario("3d-free-assembly")
-    ds = simulate(s)
-    m, inertia, r = masses(s)
-    pos, vel, spin = state_3d(ds)
-    p_tot, l_tot = momenta(m, inertia, pos, vel, spin)
-    speed = float(np.linalg.norm(vel[0], axis=-1).max())
-    p_scale = float(m.sum()) * speed
-    l_scale = float((m * np.linalg.norm(pos[0], axis=-1)).sum()) * speed + float(
-        (inertia * np.linalg.norm(spin[0], axis=-1)).sum()
-    )
-    p_err = float(np.abs(p_tot - p_tot[0]).max() / p_scale)
-    l_err = float(np.abs(l_tot - l_tot[0]).max() / l_scale)
-    n = len(r)
-    d = np.linalg.norm(pos[:, :, None] - pos[:, None, :], axis=-1)
-    touch = d < r[:, None] + r[None, :]
-    met = int(np.triu(touch.any(axis=0), 1).sum())
-    spin_change = float(np.abs(spin[-1] - spin[0]).max() / np.abs(spin[0]).max())
-    why = (
-        "each contact applies equal and opposite forces, and with the arm R - delta/2 the "
-        "friction forces act at one point, so their moments cancel in the sum: the totals "
-        "change by round-off only: the positions' rounding, eps |s| per step, enters m s x v "
-        "and adds up over 1e5 steps as a random walk, sqrt(1e5) eps ~ 7e-14 (measured: P 3e-15, "
-        "L 2.6e-13 of its scale); 2e-12 leaves a factor of 8."
-    )
+def free_assembly_in_space_checks(spin_change, p_err, why, l_err, met, n, ds):
+    """The checks of `free_assembly_in_space`: the spheres met and friction changed their spins; linear and
+    angular momentum (orbital + spin) conserved; the energy residual."""
     checks = [
         Check(
             f"pairs that touched (of {n * (n - 1) // 2})",
@@ -751,6 +754,36 @@ def free_assembly_in_space(ctx: Context) -> CaseResult:
             kind="max",
         ),
     ]
+    return checks
+
+
+def free_assembly_in_space(ctx: Context) -> CaseResult:
+    """Spheres colliding in free space: momentum and angular momentum conserved."""
+    s = load_case_scenario("3d-free-assembly")
+    ds = simulate(s)
+    m, inertia, r = masses(s)
+    pos, vel, spin = state_3d(ds)
+    p_tot, l_tot = momenta(m, inertia, pos, vel, spin)
+    speed = float(np.linalg.norm(vel[0], axis=-1).max())
+    p_scale = float(m.sum()) * speed
+    l_scale = float((m * np.linalg.norm(pos[0], axis=-1)).sum()) * speed + float(
+        (inertia * np.linalg.norm(spin[0], axis=-1)).sum()
+    )
+    p_err = float(np.abs(p_tot - p_tot[0]).max() / p_scale)
+    l_err = float(np.abs(l_tot - l_tot[0]).max() / l_scale)
+    n = len(r)
+    d = np.linalg.norm(pos[:, :, None] - pos[:, None, :], axis=-1)
+    touch = d < r[:, None] + r[None, :]
+    met = int(np.triu(touch.any(axis=0), 1).sum())
+    spin_change = float(np.abs(spin[-1] - spin[0]).max() / np.abs(spin[0]).max())
+    why = (
+        "each contact applies equal and opposite forces, and with the arm R - delta/2 the "
+        "friction forces act at one point, so their moments cancel in the sum: the totals "
+        "change by round-off only: the positions' rounding, eps |s| per step, enters m s x v "
+        "and adds up over 1e5 steps as a random walk, sqrt(1e5) eps ~ 7e-14 (measured: P 3e-15, "
+        "L 2.6e-13 of its scale); 2e-12 leaves a factor of 8."
+    )
+    checks = free_assembly_in_space_checks(spin_change, p_err, why, l_err, met, n, ds)
     desc = (
         f"{n} steel spheres (R = 8-10 mm) on a jittered octahedron fly at about 4 m/s towards its "
         "centre with random spins about all three axes (`3d-free-assembly.toml`, no walls, no load, "

@@ -1,0 +1,250 @@
+"""The contacts' coefficient rows (docs/model.md eqs. 3-5 and the normal laws' columns,
+sections 3.6 and 3.10): Hertz's A, the damping c, friction mu and k_s, and the yield
+overlap and the law "johnson"'s constants, for granule pairs (E*, R*, m* of the two),
+granules against rigid walls and against the plate's rigid layers (R* = R, m* = m or 0),
+with the walls' planes. The columns are physics.contact's COEF_*.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from granplate.physics.cavity import hardness_overlap
+from granplate.physics.contact import (
+    COEF_A,
+    COEF_C,
+    COEF_DY,
+    COEF_H,
+    COEF_KAPPA,
+    COEF_KS,
+    COEF_MU,
+    COEF_RC,
+    COEF_RL,
+    COEF_SY,
+    COEF_XH,
+    N_COEF,
+    damping_coefficient,
+    hertz_coefficient,
+)
+from granplate.physics.plastic import contact_yield_overlap
+from granplate.setup.materials import (
+    DEFAULT_HARDNESS_RATIO,
+    DEFAULT_UNLOADING_FACTOR,
+    effective_modulus,
+    softer_material,
+    softer_yield_strength,
+)
+from granplate.setup.scenario import Scenario
+
+
+def coefficient_row(a: float, c: float, mu: float, k_s: float, law=math.inf) -> np.ndarray:
+    """One row of pair_coef / wall_coef / pc_coef in the columns of physics.contact:
+    Hertz A [N/m^1.5], damping c, mu [-], k_s [s/m] (eqs. 3, 5) and the normal law's
+    columns from COEF_DY on (`law_coefficients`), or the yield overlap delta_y [m] alone
+    (docs/model.md eq. P3; inf: Hertz's law)."""
+    row = np.zeros(N_COEF)
+    row[COEF_A], row[COEF_C], row[COEF_MU], row[COEF_KS] = a, c, mu, k_s
+    law = np.atleast_1d(np.asarray(law, float))
+    row[COEF_DY : COEF_DY + len(law)] = law
+    return row
+
+
+def normal_law_of(s: Scenario, a: str, b: str) -> str:
+    """The normal law (contact.normal_law, or its [[contact.pairs]] override) between
+    materials a and b."""
+    return s.contact.law_for_pair(a, b)
+
+
+def law_yield_overlap(s: Scenario, a, b, b_name: str, e_star: float, r_star: float) -> float:
+    """COEF_DY of a contact of material a (a granule's Material) with b (a granule's
+    Material, or None for a rigid wall or the plate's face, whose material is b_name):
+    the yield overlap delta_y [m] (docs/model.md eqs. P1, P3) of the softer body under the
+    elastic-plastic law "thornton", inf under Hertz's law. (Validation refuses "thornton"
+    where the Y it needs is unknown.)"""
+    if normal_law_of(s, a.name, b_name) not in ("thornton", "johnson"):
+        return math.inf
+    return contact_yield_overlap(e_star, r_star, softer_yield_strength(a, b))
+
+
+def law_coefficients(s: Scenario, a, b, b_name: str, e_star: float, r_star: float, length: float) -> np.ndarray:
+    """The normal law's columns COEF_DY..COEF_XH of a contact of material a with b (as
+    `law_yield_overlap`), `length` [m] the length that makes the approach speed a strain
+    rate (the sum of the radii; a diameter against a rigid body). Hertz: [inf, 0...];
+    "thornton": [delta_y, 0...]; "johnson": delta_y, R* Y, C, 1 / (length rate_ref), h,
+    kappa and x_h of the softer body (docs/model.md section 3.10; absent rate fields: rate-free)."""
+    if normal_law_of(s, a.name, b_name) == "johnson":
+        return johnson_columns(softer_material(a, b), e_star, r_star, length)
+    out = np.zeros(COEF_XH - COEF_DY + 1)
+    out[0] = law_yield_overlap(s, a, b, b_name, e_star, r_star)
+    return out
+
+
+def johnson_columns(m, e_star: float, r_star: float, length: float) -> np.ndarray:
+    """The law "johnson"'s columns COEF_DY..COEF_XH of a contact whose softer body is
+    of Material m (its Y known), E* [Pa], R* [m], `length` [m] (`law_coefficients`)."""
+    out = np.zeros(COEF_XH - COEF_DY + 1)
+    out[0] = contact_yield_overlap(e_star, r_star, m.Y)
+    out[COEF_SY - COEF_DY] = r_star * m.Y
+    if m.C is not None and m.rate_ref is not None:
+        out[COEF_RC - COEF_DY] = m.C
+        out[COEF_RL - COEF_DY] = 1.0 / (length * m.rate_ref)
+    out[COEF_H - COEF_DY] = DEFAULT_HARDNESS_RATIO if m.hardness_ratio is None else m.hardness_ratio
+    out[COEF_KAPPA - COEF_DY] = DEFAULT_UNLOADING_FACTOR if m.unloading_factor is None else m.unloading_factor
+    out[COEF_XH - COEF_DY] = hardness_overlap(out[COEF_H - COEF_DY])
+    return out
+
+
+def pair_coefficient_row(s: Scenario, a, b, ri: float, rj: float, mi: float, mj: float) -> np.ndarray:
+    """The coefficient row of one pair of granules of Materials a and b, radii ri, rj [m] and
+    masses mi, mj [kg]: E*, R*, m* of the two (eqs. 3-4), the pair's alpha_n, mu, k_s and
+    normal law (`pair_coefficients` gives the same numbers for many pairs at once)."""
+    e_star = effective_modulus(a, b)
+    r_star = ri * rj / (ri + rj)
+    m_star = mi * mj / (mi + mj)
+    alpha, mu, ks = s.contact.for_pair(a.name, b.name)
+    coef_a = hertz_coefficient(e_star, r_star)
+    return coefficient_row(
+        coef_a,
+        damping_coefficient(alpha, m_star, coef_a),
+        mu,
+        ks,
+        law_coefficients(s, a, b, b.name, e_star, r_star, ri + rj),
+    )
+
+
+def material_indices(mats) -> tuple[list, np.ndarray]:
+    """The distinct Materials of `mats` (one per granule, by name) and each granule's index
+    among them."""
+    index: dict[str, int] = {}
+    kinds = []
+    for m in mats:
+        if m.name not in index:
+            index[m.name] = len(kinds)
+            kinds.append(m)
+    return kinds, np.array([index[m.name] for m in mats], np.int64).reshape(-1)
+
+
+def pair_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """(np, N_COEF) coefficients of the granule pairs: E*, R*, m* of the two (eqs. 3-4).
+
+    The rows of `pair_coefficient_row`, bit for bit: numpy does its operations on the same
+    doubles in the same order (products, quotients, square roots, correctly rounded), E*
+    and the pair's settings are computed once per pair of materials, and the yield overlap
+    of an elastic-plastic pair pair by pair."""
+    pairs = np.asarray(pairs, np.int64).reshape(-1, 2)
+    if not len(pairs):
+        return np.zeros((0, N_COEF))
+    r, mass = np.asarray(r, float), np.asarray(mass, float)
+    kinds, kind = material_indices(mats)
+    i, j = pairs[:, 0], pairs[:, 1]
+    ri, rj, mi, mj = r[i], r[j], mass[i], mass[j]
+    r_star = ri * rj / (ri + rj)
+    m_star = mi * mj / (mi + mj)
+    del ri, rj, mi, mj
+    combos = (
+        [(0, kinds[0], kinds[0])]
+        if len(kinds) == 1
+        else [
+            (c, kinds[c // len(kinds)], kinds[c % len(kinds)])
+            for c in np.unique(kind[i] * len(kinds) + kind[j]).tolist()
+        ]
+    )
+    combo = None if len(combos) == 1 else kind[i] * len(kinds) + kind[j]
+    # per pair of materials: E*, alpha_n, mu, k_s, whether the law is elastic-plastic (one value each when one pair)
+    e_star, alpha, mu, ks = (np.empty(len(pairs)) if combo is not None else 0.0 for _ in range(4))
+    plastic = np.zeros(len(pairs), bool)
+    for c, ka, kb in combos:
+        values = (effective_modulus(ka, kb), *s.contact.for_pair(ka.name, kb.name))
+        if combo is None:
+            e_star, alpha, mu, ks = values
+            plastic[:] = normal_law_of(s, ka.name, kb.name) != "hertz"
+            continue
+        on = combo == c
+        for column, v in zip((e_star, alpha, mu, ks), values):
+            column[on] = v
+        plastic |= on & (normal_law_of(s, ka.name, kb.name) != "hertz")
+    coef_a = 4.0 / 3.0 * e_star * np.sqrt(r_star)  # hertz_coefficient
+    pair_coef = np.zeros((len(pairs), N_COEF))
+    pair_coef[:, COEF_A] = coef_a
+    pair_coef[:, COEF_C] = alpha * np.sqrt(m_star * coef_a)  # damping_coefficient
+    pair_coef[:, COEF_MU], pair_coef[:, COEF_KS], pair_coef[:, COEF_DY] = mu, ks, math.inf
+    for p in np.flatnonzero(plastic).tolist():
+        a, b = mats[i[p]], mats[j[p]]
+        e_p = e_star if combo is None else float(e_star[p])
+        pair_coef[p, COEF_DY : COEF_XH + 1] = law_coefficients(
+            s, a, b, b.name, e_p, float(r_star[p]), float(r[i[p]] + r[j[p]])
+        )
+    return pair_coef
+
+
+def wall_coefficient_row(s: Scenario, a, wall_material: str, ri: float, mi: float) -> np.ndarray:
+    """The coefficient row of a granule of Material a, radius ri [m], mass mi [kg] against a
+    rigid wall of `wall_material` (R* = R, m* = m)."""
+    alpha, mu, ks = s.contact.for_pair(a.name, wall_material)
+    e_star = effective_modulus(a, None)
+    coef_a = hertz_coefficient(e_star, ri)
+    return coefficient_row(
+        coef_a,
+        damping_coefficient(alpha, mi, coef_a),
+        mu,
+        ks,
+        law_coefficients(s, a, None, wall_material, e_star, ri, 2.0 * ri),
+    )
+
+
+def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarray, walls=None):
+    """(nw, d + 1) [nx, ny, (nz,) offset] with the unit outward normal (d = the scenario's
+    dimension), and (nw, N_COEF) coefficients against a rigid body (R* = R, m* = m): the
+    rows of `wall_coefficient_row`, bit for bit (as `pair_coefficients`). walls: the
+    Walls of the rows of wc (None: the scenario's; `Model.walls`)."""
+    walls = s.walls if walls is None else walls
+    wc = np.asarray(wc, np.int64).reshape(-1, 2)
+    wall_geo = np.zeros((len(wc), s.dimension + 1))
+    wall_coef = np.zeros((len(wc), N_COEF))
+    if not len(wc):
+        return wall_geo, wall_coef
+    r, mass = np.asarray(r, float), np.asarray(mass, float)
+    kinds, kind = material_indices(mats)
+    i, w = wc[:, 0], wc[:, 1]
+    e_star, alpha = np.empty(len(wc)), np.empty(len(wc))
+    plastic = np.zeros(len(wc), bool)
+    for k in np.unique(w).tolist():
+        wall = walls[k]
+        nrm = np.asarray(wall.normal, float)
+        at = w == k
+        wall_geo[at] = (*(nrm / np.linalg.norm(nrm)), wall.offset)
+        for c in np.unique(kind[i[at]]).tolist():
+            on = at & (kind[i] == c)
+            e_star[on] = effective_modulus(kinds[c], None)
+            alpha[on], wall_coef[on, COEF_MU], wall_coef[on, COEF_KS] = s.contact.for_pair(kinds[c].name, wall.material)
+            plastic |= on & (normal_law_of(s, kinds[c].name, wall.material) != "hertz")
+    ri = r[i]
+    coef_a = 4.0 / 3.0 * e_star * np.sqrt(ri)  # hertz_coefficient with R* = R
+    wall_coef[:, COEF_A] = coef_a
+    wall_coef[:, COEF_C] = alpha * np.sqrt(mass[i] * coef_a)  # damping_coefficient with m* = m
+    wall_coef[:, COEF_DY] = math.inf
+    for p in np.flatnonzero(plastic).tolist():
+        wall_coef[p, COEF_DY : COEF_XH + 1] = law_coefficients(
+            s, mats[i[p]], None, s.walls[w[p]].material, float(e_star[p]), float(ri[p]), 2.0 * float(ri[p])
+        )
+    return wall_geo, wall_coef
+
+
+def plate_contact_coefficients(s: Scenario, mats, r: np.ndarray, pc: np.ndarray) -> np.ndarray:
+    """(nk, N_COEF) coefficients against the plate's rigid layers: E_k, R_k -> infinity
+    and m_k -> 0, so m* = 0 (no viscous damping)."""
+    pc_coef = np.zeros((len(pc), N_COEF))
+    for k, i in enumerate(pc):
+        alpha, mu, ks = s.contact.for_pair(mats[i].name, s.plate.material)
+        e_star = effective_modulus(mats[i], None)
+        a = hertz_coefficient(e_star, r[i])
+        pc_coef[k] = coefficient_row(
+            a,
+            damping_coefficient(alpha, 0.0, a),
+            mu,
+            ks,
+            law_coefficients(s, mats[i], None, s.plate.material, e_star, r[i], 2.0 * r[i]),
+        )
+    return pc_coef
