@@ -11,7 +11,7 @@ import numpy as np
 
 from granplate.model.contacts import contact_lists, fixed_wall_contacts
 from granplate.model.drives import drive_fields, driven_initial_state
-from granplate.model.inputs import HIST_MAX, Config, Granular, PlateArrays, no_history, scheme_number
+from granplate.model.inputs import HIST_MAX, HIST_XI, Config, Granular, PlateArrays, no_history, scheme_number
 from granplate.physics.contact import (
     COEF_A,
     COEF_C,
@@ -19,7 +19,9 @@ from granplate.physics.contact import (
     COEF_H,
     COEF_KAPPA,
     COEF_KS,
+    COEF_KT,
     COEF_MU,
+    COEF_MUT,
     COEF_RC,
     COEF_RL,
     COEF_SY,
@@ -29,6 +31,7 @@ from granplate.physics.contact import (
     hertz_coefficient,
 )
 from granplate.physics.cavity import hardness_overlap
+from granplate.physics.mindlin import mindlin_coefficient, tangential_compliance
 from granplate.physics.plastic import contact_yield_overlap
 from granplate.errors import ScenarioError
 from granplate.setup.geometry import resolve
@@ -332,7 +335,19 @@ def pair_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, pairs:
         pair_coef[p, COEF_DY : COEF_XH + 1] = law_coefficients(
             s, a, b, b.name, e_p, float(r_star[p]), float(r[i[p]] + r[j[p]])
         )
+    if s.contact.tangential_law == "mindlin":
+        compliance = np.array([tangential_compliance(m.E, m.nu) for m in kinds])
+        mindlin_columns(pair_coef, compliance[kind[i]] + compliance[kind[j]])
     return pair_coef
+
+
+def mindlin_columns(coef: np.ndarray, compliance: np.ndarray) -> None:
+    """Rows of `coef` made Mindlin's (docs/model.md section 3.16) in place: 8 G* from
+    1 / G* = `compliance` [1/Pa] (per row, eq. M1) into COEF_KT, the Coulomb coefficient moved
+    from COEF_MU (which the tanh law reads) to COEF_MUT."""
+    coef[:, COEF_KT] = mindlin_coefficient(1.0) / compliance
+    coef[:, COEF_MUT] = coef[:, COEF_MU]
+    coef[:, COEF_MU] = 0.0
 
 
 def wall_coefficient_row(s: Scenario, a, wall_material: str, ri: float, mi: float) -> np.ndarray:
@@ -341,13 +356,17 @@ def wall_coefficient_row(s: Scenario, a, wall_material: str, ri: float, mi: floa
     alpha, mu, ks = s.contact.for_pair(a.name, wall_material)
     e_star = effective_modulus(a, None)
     coef_a = hertz_coefficient(e_star, ri)
-    return coefficient_row(
+    row = coefficient_row(
         coef_a,
         damping_coefficient(alpha, mi, coef_a),
         mu,
         ks,
         law_coefficients(s, a, None, wall_material, e_star, ri, 2.0 * ri),
     )
+    if s.contact.tangential_law == "mindlin":
+        rows = row.reshape(1, -1)
+        mindlin_columns(rows, np.array([tangential_compliance(a.E, a.nu)]))
+    return row
 
 
 def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarray, walls=None):
@@ -385,6 +404,8 @@ def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarr
         wall_coef[p, COEF_DY : COEF_XH + 1] = law_coefficients(
             s, mats[i[p]], None, s.walls[w[p]].material, float(e_star[p]), float(ri[p]), 2.0 * float(ri[p])
         )
+    if s.contact.tangential_law == "mindlin":  # a rigid wall: the granule's compliance alone
+        mindlin_columns(wall_coef, np.array([tangential_compliance(kinds[c].E, kinds[c].nu) for c in kind[i]]))
     return wall_geo, wall_coef
 
 
@@ -604,7 +625,7 @@ def carried_history(old_keys: np.ndarray, old_hist: np.ndarray, new_keys: np.nda
     section 3.6) for the whole run, whether or not the list holds it. Keys are matched by
     sorting (no per-contact Python): a rebuild of 10^6 contacts takes a fraction of a second."""
     new_keys = np.asarray(new_keys, np.int64).reshape(-1, 2)
-    has = old_hist[:, HIST_MAX] > 0.0
+    has = (old_hist[:, HIST_MAX] > 0.0) | np.any(old_hist[:, HIST_XI : HIST_XI + 3] != 0.0, axis=1)
     keys = np.asarray(old_keys, np.int64).reshape(-1, 2)[has]
     rows = old_hist[has]
     if store:

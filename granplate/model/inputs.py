@@ -39,8 +39,12 @@ STATE_COLUMNS = {2: 6, 3: 9}
 #: the overlap at the end of the last trial step [m] (taken into delta_max when the step is
 #: accepted), and the rate factor Y(rate) / Y [-] that fixed the yield strength of a contact
 #: under the law "johnson" (docs/model.md section 3.10: 0 while unset, 1 rate-free).
+#: Then Mindlin's tangential law (docs/model.md section 3.16): the elastic tangential
+#: displacement xi (3 components) [m] and the contact radius a [m] of the last accepted step,
+#: and the same two at the end of the last trial step (taken in when the step is accepted).
 HIST_MAX, HIST_TIME, HIST_END, HIST_RATE = 0, 1, 2, 3
-N_HIST = 4
+HIST_XI, HIST_A, HIST_XI_END, HIST_A_END = 4, 7, 8, 11
+N_HIST = 12
 
 
 #: columns of Granular.drive_now, each drive's state at the last force pass: its

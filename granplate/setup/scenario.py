@@ -456,6 +456,11 @@ class Load:
 #: hardness, with a rate-dependent yield strength (docs/model.md section 3.10), which needs
 #: Y likewise.
 NORMAL_LAWS: tuple[str, ...] = ("hertz", "thornton", "johnson")
+#: Tangential laws (Contact.tangential_law): "tanh", eq. (5)'s regularised Coulomb law
+#: without history (the paper's), and "mindlin", Mindlin's tangential spring 8 G* a with a
+#: Coulomb limit mu |N| and each contact's elastic tangential displacement as history
+#: (docs/model.md section 3.16; in space, under the scheme "verlet").
+TANGENTIAL_LAWS: tuple[str, ...] = ("tanh", "mindlin")
 
 
 @dataclass(frozen=True)
@@ -506,6 +511,10 @@ class Contact:
     pair, R_i - delta at a wall or plate: the true contact point, which conserves the
     angular momentum of a free assembly; with "radius" each sliding pair adds a couple
     -f delta). The slip rate uses the same arms, so the friction power stays f v_t.
+    tangential_law: the friction law of every granule-granule and granule-wall contact (one
+    of TANGENTIAL_LAWS): "tanh", eq. (5), or "mindlin", Mindlin's tangential spring with a
+    Coulomb limit mu |N| and history (docs/model.md section 3.16; its mu is `mu` and the
+    pairs' mu, k_s unused; 3D scenarios under solver.scheme "verlet" only).
     """
 
     mu: float = 0.099
@@ -521,6 +530,7 @@ class Contact:
     overlap_stop: float = 0.2
     overlap_start: float | None = None
     normal_law: str = "hertz"
+    tangential_law: str = "tanh"
 
     def for_pair(self, a: str, b: str) -> tuple[float, float, float]:
         """(alpha_n, mu, k_s) for materials a and b."""

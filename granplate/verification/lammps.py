@@ -421,9 +421,38 @@ def space_arrays(s) -> dict:
         style, lower = SPACE_WALL_PLANES[key]
         plane = repr(float(w.offset) * sum(key) + 0.0)  # + 0.0: no "-0.0"
         walls.append((style, plane, "NULL") if lower else (style, "NULL", plane))
-    p = packing_arrays(dataclasses.replace(s, walls=()))
+    mindlin = s.contact.tangential_law == "mindlin"
+    if mindlin and (s.contact.alpha_n != 0.0 or s.contact.pairs):
+        raise ValueError(
+            "contact.alpha_n, contact.pairs: must be 0 and empty for the LAMMPS adapter of "
+            "contact.tangential_law = 'mindlin' (undamped Hertz, one mu)"
+        )
+    names = {w.material for w in s.walls} - {g.material for g in s.granules}
+    if names:
+        raise ValueError(f"walls[].material: {sorted(names)}; the LAMMPS adapter takes the granules' material")
+    free = dataclasses.replace(s.contact, mu=0.0) if mindlin else s.contact
+    p = packing_arrays(dataclasses.replace(s, walls=(), contact=free, gravity=None))
     g = s.granules
-    return {**p, "z": np.array([q.z for q in g]), "vz": np.array([q.vz for q in g]), "walls": walls}
+    grav = np.zeros(3) if s.gravity is None else np.asarray(s.gravity.g, float)
+    return {
+        **p,
+        "z": np.array([q.z for q in g]),
+        "vz": np.array([q.vz for q in g]),
+        "omega": np.array([q.spin() for q in g], float).reshape(-1, 3),
+        "walls": walls,
+        "mu": float(s.contact.mu) if mindlin else None,
+        "gravity": grav,
+    }
+
+
+def tangential_model(p: dict) -> str:
+    """The tangential part of the LAMMPS model of `p` (space_arrays): none (mu 0) or, where
+    the scenario takes contact.tangential_law = "mindlin", `mindlin_rescale NULL 0.0 mu`:
+    Mindlin's stiffness 8 G* a from E and nu, no tangential damping, the Coulomb bound mu
+    |N| and the history rescaled as the contact radius shrinks (docs/model.md section 3.16)."""
+    if p.get("mu") is None:
+        return "tangential linear_nohistory 0.0 0.0"
+    return f"tangential mindlin_rescale NULL 0.0 {float(p['mu'])!r}"
 
 
 def space_commands(p: dict, dt: float, skin: float = 0.1) -> list[str]:
@@ -445,7 +474,7 @@ def space_commands(p: dict, dt: float, skin: float = 0.1) -> list[str]:
         f"region box block {box}",
         "create_box 1 box",
         "pair_style granular",
-        f"pair_coeff * * hertz/material {float(p['E'])!r} 0.0 {float(p['nu'])!r} tangential linear_nohistory 0.0 0.0 "
+        f"pair_coeff * * hertz/material {float(p['E'])!r} 0.0 {float(p['nu'])!r} {tangential_model(p)} "
         "damping velocity",
         f"neighbor {2.0 * skin * rmax!r} bin",
         "neigh_modify delay 0 every 1 check yes",
@@ -456,10 +485,7 @@ def space_wall_model(p: dict) -> str:
     """fix wall/gran's model for our rigid walls: its coefficients stand for both bodies
     (E_eff = E_w / (2 (1 - nu^2)), checked by tests/test_lammps.py), so E_w = 2 E gives our
     rigid wall's E / (1 - nu^2) (eq. 4 with the wall's compliance zero)."""
-    return (
-        f"hertz/material {2.0 * float(p['E'])!r} 0.0 {float(p['nu'])!r} tangential linear_nohistory 0.0 0.0 "
-        "damping velocity"
-    )
+    return f"hertz/material {2.0 * float(p['E'])!r} 0.0 {float(p['nu'])!r} {tangential_model(p)} damping velocity"
 
 
 def run_hertz_3d(s, dt: float, t_end: float, every: int | None = None) -> dict:
@@ -467,7 +493,7 @@ def run_hertz_3d(s, dt: float, t_end: float, every: int | None = None) -> dict:
     (velocity Verlet, fix nve/sphere, walls by fix wall/gran).
 
     every: record every `every` steps (None: only the start and the end). Returns t (n_out,)
-    [s], x, y, z, vx, vy, vz (n_out, n_granules) ordered as s.granules, setup_time_s,
+    [s], x, y, z, vx, vy, vz, wx, wy, wz (n_out, n_granules) ordered as s.granules, setup_time_s,
     loop_time_s, n_steps. RuntimeError when LAMMPS is not available."""
     cls, why = _load()
     if cls is None:
@@ -487,18 +513,25 @@ def run_hertz_3d(s, dt: float, t_end: float, every: int | None = None) -> dict:
         lmp.commands_list(
             ["fix integrate all nve/sphere", f"timestep {float(dt)!r}", "thermo_style custom step", "thermo 0"]
         )
+        if np.any(p["omega"]):
+            lmp.scatter_atoms("omega", 1, 3, (ctypes.c_double * (3 * n))(*p["omega"].ravel().tolist()))
         for w, (style, lo, hi) in enumerate(p["walls"]):
             lmp.command(f"fix wall{w} all wall/gran granular {space_wall_model(p)} {style} {lo} {hi}")
+        g_abs = float(np.linalg.norm(p["gravity"]))
+        if g_abs > 0.0:
+            gx, gy, gz = (float(c) for c in p["gravity"] / g_abs)
+            lmp.command(f"fix gravity all gravity {g_abs!r} vector {gx!r} {gy!r} {gz!r}")
         lmp.command("run 0 post no")
         setup = time.perf_counter() - t0
-        keys = ("x", "y", "z", "vx", "vy", "vz")
+        keys = ("x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz")
         out: dict = {"t": [0.0], **{k: [] for k in keys}}
 
         def record() -> None:
-            xx, vv = _gather(lmp, "x", 3), _gather(lmp, "v", 3)
+            xx, vv, ww = _gather(lmp, "x", 3), _gather(lmp, "v", 3), _gather(lmp, "omega", 3)
             for c in range(3):
                 out[keys[c]].append(xx[:, c])
                 out[keys[3 + c]].append(vv[:, c])
+                out[keys[6 + c]].append(ww[:, c])
 
         chunk = n_steps if every is None else every
         loop = run_recorded(lmp, n_steps, chunk, dt, out, record)
