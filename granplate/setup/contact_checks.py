@@ -14,7 +14,9 @@ from granplate.setup.scenario import NORMAL_LAWS, TANGENTIAL_LAWS, Scenario
 
 
 #: Lever arms of the friction torque (Contact.torque_arm).
-TORQUE_ARMS: tuple[str, ...] = ("radius", "contact_point")
+#: "lammps": Mindlin's law only (LAMMPS's pair granular: the slip rate at the arm R, the torque
+#: at R - delta/2 between spheres and R at a wall).
+TORQUE_ARMS: tuple[str, ...] = ("radius", "contact_point", "lammps")
 DETECTIONS: tuple[str, ...] = ("dynamic", "fixed")
 #: Normal laws (of NORMAL_LAWS) that need the yield strength Y of every body that can
 #: yield at a contact (both granules; the granule alone against a wall or the plate).
@@ -122,6 +124,13 @@ def _check_tangential_law(s: Scenario) -> None:
     c = s.contact
     string_in("contact.tangential_law", c.tangential_law, TANGENTIAL_LAWS)
     if c.tangential_law != "mindlin":
+        if c.torque_arm == "lammps":
+            raise ScenarioError(
+                "contact.torque_arm",
+                c.torque_arm,
+                "'lammps' is an arm of contact.tangential_law = 'mindlin' only: "
+                "with the tanh law take 'radius' or 'contact_point'",
+            )
         return
     if s.dimension != 3:
         raise ScenarioError(

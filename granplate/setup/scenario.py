@@ -510,7 +510,11 @@ class Contact:
     "radius" (R_i, paper eq. 1, docs/model.md section 3.2) or "contact_point" (R_i - delta/2 for a
     pair, R_i - delta at a wall or plate: the true contact point, which conserves the
     angular momentum of a free assembly; with "radius" each sliding pair adds a couple
-    -f delta). The slip rate uses the same arms, so the friction power stays f v_t.
+    -f delta). The slip rate uses the same arms, so the friction power stays f v_t. "lammps"
+    (contact.tangential_law = "mindlin" only): LAMMPS's pair granular, the slip rate at the
+    arm R_i and the torque at R_i - delta/2 between spheres (R_i at a wall), for a side by
+    side run with LAMMPS; the arms differ, so the couples' extra work is booked in
+    D_friction (docs/model.md section 3.16).
     tangential_law: the friction law of every granule-granule and granule-wall contact (one
     of TANGENTIAL_LAWS): "tanh", eq. (5), or "mindlin", Mindlin's tangential spring with a
     Coulomb limit mu |N| and history (docs/model.md section 3.16; its mu is `mu` and the

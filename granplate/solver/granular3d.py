@@ -547,6 +547,21 @@ def mindlin_contact(hist, k, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, n_abs):
 
 
 @njit(cache=True)
+def mindlin_old_force(hist, k, c):
+    """The tangential force on the first body at contact k's last step, -k_t xi [N] (3)."""
+    k_old = -c[COEF_KT] * hist[k, HIST_A]
+    return k_old * hist[k, HIST_XI], k_old * hist[k, HIST_XI + 1], k_old * hist[k, HIST_XI + 2]
+
+
+@njit(cache=True)
+def couple_work(y, i, da, nx, ny, nz, fx, fy, fz, dt):
+    """The work [J] over dt [s] of the couple da n x f (da [m], f [N]) on granule i's spin
+    at state y."""
+    tx, ty, tz = arm_torque_3d(da, nx, ny, nz, fx, fy, fz)
+    return dt * (tx * y[i, WX] + ty * y[i, WY] + tz * y[i, WZ])
+
+
+@njit(cache=True)
 def mindlin_parted(hist, k, c):
     """Contact k has parted: its trial history zero (a new touch starts unloaded, as
     LAMMPS's); returns the spring energy it held [J] (lost)."""
@@ -603,11 +618,19 @@ def mindlin_forces(yv, yn, h, g, cfg, acc):
         ddot = normal_rate_3d(yn[i, VX] - yn[j, VX], yn[i, VY] - yn[j, VY], yn[i, VZ] - yn[j, VZ], nx, ny, nz)
         n_abs = normal_law_force(delta, ddot, c, g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip)
         a = contact_radius(ri * rj / (ri + rj), delta)
+        f0x, f0y, f0z = mindlin_old_force(g.pair_hist, p, c)
         fx, fy, fz, e, d = mindlin_contact(g.pair_hist, p, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, n_abs)
         e_t += e
         lost += d
-        push_tangential(acc, g, i, ai, nx, ny, nz, fx, fy, fz, 1.0)
-        push_tangential(acc, g, j, aj, nx, ny, nz, fx, fy, fz, -1.0)
+        ti = ai
+        tj = aj
+        if cfg.lammps_arms:  # LAMMPS's torque arms: their couples' extra work over h is lost from D
+            ti = ri - 0.5 * delta
+            tj = rj - 0.5 * delta
+            lost -= couple_work(yv, i, ti - ai, nx, ny, nz, f0x + fx, f0y + fy, f0z + fz, 0.5 * h)
+            lost -= couple_work(yv, j, tj - aj, nx, ny, nz, f0x + fx, f0y + fy, f0z + fz, 0.5 * h)
+        push_tangential(acc, g, i, ti, nx, ny, nz, fx, fy, fz, 1.0)
+        push_tangential(acc, g, j, tj, nx, ny, nz, fx, fy, fz, -1.0)
     for w in range(g.wall_i.shape[0]):
         c = g.wall_coef[w]
         if c[COEF_KT] == 0.0:
