@@ -22,7 +22,6 @@ from granplate.setup.materials import LIBRARY
 from granplate.setup.scenario import (
     Contact,
     Granule,
-    Gravity,
     Load,
     Scenario,
     Solver,
@@ -47,56 +46,8 @@ def _time(dt: float, t_end: float, n_out: int = 20) -> TimeSettings:
     )
 
 
-def oblique_pair(dt: float = 2e-9, t_end: float = 2e-5, arm: str = "lammps") -> Scenario:
-    """Two free steel spheres meeting obliquely (no spin at first): they stick, then slide."""
-    v = 0.2
-    gs = (
-        Granule(x=0.0, y=0.0, z=0.0, radius=R, material="steel", label="a", vx=v, vy=0.6 * v, omega=(0.0, 0.0, 0.0)),
-        Granule(
-            x=2 * R + 1e-7,
-            y=0.0,
-            z=0.0,
-            radius=R,
-            material="steel",
-            label="b",
-            vx=-v,
-            vy=-0.2 * v,
-            vz=0.1 * v,
-            omega=(0.0, 0.0, 0.0),
-        ),
-    )
-    return Scenario(
-        name="oblique-pair",
-        dimension=3,
-        granules=gs,
-        load=Load(kind="none"),
-        contact=Contact(mu=0.3, alpha_n=0.0, pairs=(), tangential_law="mindlin", torque_arm=arm),
-        time=_time(dt, t_end),
-        solver=Solver(scheme="verlet"),
-    )
-
-
-def resting_sphere(
-    g: float = 1000.0, vx: float = 0.1, vy: float = 0.03, dt: float = 5e-8, t_end: float = 2e-4, n_out: int = 20
-):
-    """A steel sphere at rest on a steel floor z = 0 at its static overlap under gravity g
-    [m/s^2], launched along the floor at (vx, vy) [m/s] without spin; its static overlap [m]."""
-    a_hertz = 4.0 / 3.0 * STEEL.E / (1.0 - STEEL.nu**2) * math.sqrt(R)
-    d0 = (MASS * g / a_hertz) ** (2.0 / 3.0)
-    s = Scenario(
-        name="resting-sphere",
-        dimension=3,
-        granules=(
-            Granule(x=0.0, y=0.0, z=R - d0, radius=R, material="steel", label="a", vx=vx, vy=vy, omega=(0.0, 0.0, 0.0)),
-        ),
-        walls=(Wall(normal=(0.0, 0.0, -1.0), offset=0.0, material="steel"),),
-        load=Load(kind="none"),
-        gravity=Gravity(g=(0.0, 0.0, -g)),
-        contact=Contact(mu=0.3, alpha_n=0.0, pairs=(), tangential_law="mindlin", overlap_start=1e-3),
-        time=_time(dt, t_end, n_out),
-        solver=Solver(scheme="verlet"),
-    )
-    return s, d0
+oblique_pair = L.mindlin_pair  # two free spheres meeting obliquely: they stick, then slide
+resting_sphere = L.mindlin_floor  # a sphere on a floor under gravity, launched along it
 
 
 def run(s: Scenario):
