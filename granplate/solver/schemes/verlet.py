@@ -13,6 +13,12 @@ One step t -> t + h (fixed h = time.dt_max, cut to land on the output times):
 4. kick: v += h/2 a_n+1; on a step that lands on an output time, the closing friction
    half step (in the reverse order) so that the recorded state is the whole step's.
 
+Under Mindlin's tangential law (contact.tangential_law = "mindlin", docs/model.md section
+3.16) there is no split friction at those contacts: after the force pass of step 3,
+`mindlin_forces` adds each contact's tangential spring force, its history moved on by the
+slip at the half-step velocities (the drift's), as LAMMPS's; its stored energy joins the
+contacts' and its losses (eq. M6) D_friction.
+
 The work of each kick is booked exactly as the kinetic energy it adds: h/2 F v_mean for
 the damping part of the force (D_visc) and the load (E_shock; a line load on the elastic
 body kicks its modes the same way, at t_n and t_n + h), so eq. (11)'s residual is
