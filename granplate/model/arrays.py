@@ -26,6 +26,7 @@ from granplate.physics.contact import (
     COEF_RL,
     COEF_SY,
     COEF_XH,
+    COEF_XT,
     N_COEF,
     damping_coefficient,
     hertz_coefficient,
@@ -337,17 +338,19 @@ def pair_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, pairs:
         )
     if s.contact.tangential_law == "mindlin":
         compliance = np.array([tangential_compliance(m.E, m.nu) for m in kinds])
-        mindlin_columns(pair_coef, compliance[kind[i]] + compliance[kind[j]])
+        mindlin_columns(pair_coef, compliance[kind[i]] + compliance[kind[j]], s.contact.tangential_damping)
     return pair_coef
 
 
-def mindlin_columns(coef: np.ndarray, compliance: np.ndarray) -> None:
+def mindlin_columns(coef: np.ndarray, compliance: np.ndarray, damping: float) -> None:
     """Rows of `coef` made Mindlin's (docs/model.md section 3.16) in place: 8 G* from
     1 / G* = `compliance` [1/Pa] (per row, eq. M1) into COEF_KT, the Coulomb coefficient moved
-    from COEF_MU (which the tanh law reads) to COEF_MUT."""
+    from COEF_MU (which the tanh law reads) to COEF_MUT, the tangential damping factor x_t
+    (contact.tangential_damping) into COEF_XT."""
     coef[:, COEF_KT] = mindlin_coefficient(1.0) / compliance
     coef[:, COEF_MUT] = coef[:, COEF_MU]
     coef[:, COEF_MU] = 0.0
+    coef[:, COEF_XT] = damping
 
 
 def wall_coefficient_row(s: Scenario, a, wall_material: str, ri: float, mi: float) -> np.ndarray:
@@ -365,7 +368,7 @@ def wall_coefficient_row(s: Scenario, a, wall_material: str, ri: float, mi: floa
     )
     if s.contact.tangential_law == "mindlin":
         rows = row.reshape(1, -1)
-        mindlin_columns(rows, np.array([tangential_compliance(a.E, a.nu)]))
+        mindlin_columns(rows, np.array([tangential_compliance(a.E, a.nu)]), s.contact.tangential_damping)
     return row
 
 
@@ -405,7 +408,8 @@ def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarr
             s, mats[i[p]], None, s.walls[w[p]].material, float(e_star[p]), float(ri[p]), 2.0 * float(ri[p])
         )
     if s.contact.tangential_law == "mindlin":  # a rigid wall: the granule's compliance alone
-        mindlin_columns(wall_coef, np.array([tangential_compliance(kinds[c].E, kinds[c].nu) for c in kind[i]]))
+        compliance = np.array([tangential_compliance(kinds[c].E, kinds[c].nu) for c in kind[i]])
+        mindlin_columns(wall_coef, compliance, s.contact.tangential_damping)
     return wall_geo, wall_coef
 
 

@@ -40,11 +40,14 @@ STATE_COLUMNS = {2: 6, 3: 9}
 #: accepted), and the rate factor Y(rate) / Y [-] that fixed the yield strength of a contact
 #: under the law "johnson" (docs/model.md section 3.10: 0 while unset, 1 rate-free).
 #: Then Mindlin's tangential law (docs/model.md section 3.16): the elastic tangential
-#: displacement xi (3 components) [m] and the contact radius a [m] of the last accepted step,
-#: and the same two at the end of the last trial step (taken in when the step is accepted).
+#: displacement xi (3 components) [m], the contact radius a [m] and the tangential force on
+#: the first body (3) [N] of the last accepted step, and the same at the end of the last
+#: trial step (taken in when the step is accepted; N_MINDLIN columns each).
 HIST_MAX, HIST_TIME, HIST_END, HIST_RATE = 0, 1, 2, 3
-HIST_XI, HIST_A, HIST_XI_END, HIST_A_END = 4, 7, 8, 11
-N_HIST = 12
+HIST_XI, HIST_A, HIST_F = 4, 7, 8
+N_MINDLIN = 7
+HIST_XI_END, HIST_A_END, HIST_F_END = 11, 14, 15
+N_HIST = 18
 
 
 #: columns of Granular.drive_now, each drive's state at the last force pass: its

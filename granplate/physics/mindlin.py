@@ -9,11 +9,13 @@ the half step, eqs. M1-M5):
     a = sqrt(R* delta),  k_t = 8 G* a,   1/G* = (2 - nu_1)/G_1 + (2 - nu_2)/G_2     (M1)
     xi <- xi a / a_old  where the contact radius shrank (a < a_old)                 (M2)
     xi <- (xi - (xi.n) n) |xi| / |xi - (xi.n) n|   (into the tangent plane)         (M3)
-    xi <- xi + v_s dt,  F_t = -k_t xi                                               (M4)
-    |F_t| > mu |N|:  F_t <- mu |N| F_t / |F_t|,  xi <- -F_t / k_t                   (M5)
+    xi <- xi + v_s dt,  F_t = -k_t xi - eta_t v_s                                   (M4)
+    |F_t| > mu |N|:  F_t <- mu |N| F_t / |F_t|,  xi <- -(F_t + eta_t v_s) / k_t     (M5)
 
-with G = E / (2 (1 + nu)) and a rigid body's 1/G = 0. The spring stores 1/2 k_t |xi|^2;
-(M5) dissipates the slip work 1/2 k_t (|xi_trial|^2 - |xi|^2). One small pure function
+with G = E / (2 (1 + nu)), a rigid body's 1/G = 0, and the optional tangential damping
+eta_t = x_t c delta^(1/4) (x_t times eq. 3's normal damping coefficient, LAMMPS's `mindlin
+NULL x_t mu`). The spring stores 1/2 k_t |xi|^2; a step loses eq. (M6) (`step_loss`): the
+slip's and the damping's work, and what the stiffness's change moves. One small pure function
 each, compiled by numba; vectors are passed and returned as their three components.
 """
 
@@ -92,27 +94,24 @@ def spring_energy(k: float, xx: float, xy: float, xz: float) -> float:
 
 
 @njit(cache=True)
-def mindlin_force(xx: float, xy: float, xz: float, k: float, f_crit: float):
-    """Eqs. (M4)-(M5) after the increment: the tangential force F_t = -k_t xi on the first
-    body, capped at f_crit = mu |N| [N] with xi reset to -F_t / k_t (LAMMPS's rule; a zero
-    xi gives no force). Returns (F_t (3) [N], the new xi (3) [m], the slip work [J])."""
-    fx = -k * xx
-    fy = -k * xy
-    fz = -k * xz
+def mindlin_force(xx: float, xy: float, xz: float, k: float, f_crit: float, dx: float, dy: float, dz: float):
+    """Eqs. (M4)-(M5) after the increment: the tangential force F_t = -k_t xi + F_d on the
+    first body (F_d (3): the damping force -eta_t v_s [N]), capped at f_crit = mu |N| [N]
+    with xi reset to -(F_t - F_d) / k_t (LAMMPS's rule; a zero xi gives no force). Returns
+    (F_t (3) [N], the new xi (3) [m])."""
+    fx = -k * xx + dx
+    fy = -k * xy + dy
+    fz = -k * xz + dz
     mag = math.sqrt(fx * fx + fy * fy + fz * fz)
     if mag <= f_crit:
-        return fx, fy, fz, xx, xy, xz, 0.0
+        return fx, fy, fz, xx, xy, xz
     if xx == 0.0 and xy == 0.0 and xz == 0.0:
-        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     s = f_crit / mag
     fx *= s
     fy *= s
     fz *= s
-    nx = -fx / k
-    ny = -fy / k
-    nz = -fz / k
-    work = spring_energy(k, xx, xy, xz) - spring_energy(k, nx, ny, nz)
-    return fx, fy, fz, nx, ny, nz, work
+    return fx, fy, fz, -(fx - dx) / k, -(fy - dy) / k, -(fz - dz) / k
 
 
 @njit(cache=True)
@@ -131,22 +130,25 @@ def mindlin_step(
     vz: float,
     dt: float,
     f_crit: float,
+    damp: float,
+    f0x: float,
+    f0y: float,
+    f0z: float,
 ):
     """One contact's step of eqs. (M2)-(M5): its history xi (3) [m] and contact radius
     a_old [m] at the last step, its contact radius a [m] now, 8 G* [Pa], the unit normal
     n, the slip velocity v_s (3) [m/s] over the step dt [s] (0: the force at the last
-    step's history, turned into the plane of n) and the Coulomb limit f_crit = mu |N| [N].
+    step's history, turned into the plane of n), the Coulomb limit f_crit = mu |N| [N], the
+    tangential damping coefficient eta_t [N s/m] and the last step's force F_old (3) [N].
     Returns (F_t (3) on the first body [N], the new xi (3) [m], the spring's energy 1/2 k_t
     |xi|^2 [J], the energy lost over the step [J], eq. M6)."""
-    k_old = tangential_stiffness(k_per_radius, a_old)
-    e_old = spring_energy(k_old, xx, xy, xz)
-    f0x = -k_old * xx
-    f0y = -k_old * xy
-    f0z = -k_old * xz
+    e_old = spring_energy(tangential_stiffness(k_per_radius, a_old), xx, xy, xz)
     k = tangential_stiffness(k_per_radius, a)
     xx, xy, xz = rescale_history(xx, xy, xz, a, a_old)
     xx, xy, xz = rotate_history(xx, xy, xz, nx, ny, nz, k, f_crit)
-    fx, fy, fz, xx, xy, xz, _ = mindlin_force(xx + dt * vx, xy + dt * vy, xz + dt * vz, k, f_crit)
+    fx, fy, fz, xx, xy, xz = mindlin_force(
+        xx + dt * vx, xy + dt * vy, xz + dt * vz, k, f_crit, -damp * vx, -damp * vy, -damp * vz
+    )
     e_new = spring_energy(k, xx, xy, xz)
     return fx, fy, fz, xx, xy, xz, e_new, step_loss(f0x, f0y, f0z, fx, fy, fz, vx * dt, vy * dt, vz * dt, e_old, e_new)
 

@@ -123,6 +123,19 @@ def _check_tangential_law(s: Scenario) -> None:
     (MINDLIN_SUPPORT) and with every granule material's Poisson ratio (its G*, eq. M1)."""
     c = s.contact
     string_in("contact.tangential_law", c.tangential_law, TANGENTIAL_LAWS)
+    nonneg("contact.tangential_damping", c.tangential_damping)
+    if c.tangential_damping > ALPHA_N_MAX:
+        raise ScenarioError(
+            "contact.tangential_damping",
+            c.tangential_damping,
+            f"must be in [0, {ALPHA_N_MAX:g}] (a factor on eq. 3's normal damping coefficient)",
+        )
+    if c.tangential_law != "mindlin" and c.tangential_damping != 0.0:
+        raise ScenarioError(
+            "contact.tangential_damping",
+            c.tangential_damping,
+            "is Mindlin's (contact.tangential_law = 'mindlin'): the tanh law has no tangential damping; set 0",
+        )
     if c.tangential_law != "mindlin":
         if c.torque_arm == "lammps":
             raise ScenarioError(

@@ -518,7 +518,9 @@ class Contact:
     tangential_law: the friction law of every granule-granule and granule-wall contact (one
     of TANGENTIAL_LAWS): "tanh", eq. (5), or "mindlin", Mindlin's tangential spring with a
     Coulomb limit mu |N| and history (docs/model.md section 3.16; its mu is `mu` and the
-    pairs' mu, k_s unused; 3D scenarios under solver.scheme "verlet" only).
+    pairs' mu, k_s unused; 3D scenarios under solver.scheme "verlet" only);
+    tangential_damping: Mindlin's tangential damping x_t [-] (LAMMPS's `mindlin NULL x_t mu`):
+    eta_t = x_t c delta^(1/4), x_t times eq. (3)'s normal damping coefficient (0: none).
     """
 
     mu: float = 0.099
@@ -535,6 +537,7 @@ class Contact:
     overlap_start: float | None = None
     normal_law: str = "hertz"
     tangential_law: str = "tanh"
+    tangential_damping: float = 0.0
 
     def for_pair(self, a: str, b: str) -> tuple[float, float, float]:
         """(alpha_n, mu, k_s) for materials a and b."""

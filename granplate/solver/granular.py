@@ -18,7 +18,7 @@ from typing import NamedTuple
 
 from numba import njit
 
-from granplate.model.inputs import HIST_END, HIST_MAX, HIST_RATE, HIST_TIME, HIST_XI, HIST_XI_END
+from granplate.model.inputs import HIST_END, HIST_MAX, HIST_RATE, HIST_TIME, HIST_XI, HIST_XI_END, N_MINDLIN
 from granplate.physics.contact import (
     COEF_DY,
     COEF_KS,
@@ -375,7 +375,7 @@ def commit_history(t, hist, coef):
 def commit_history_row(t, hist, coef, k):
     """`commit_history` of contact k alone."""
     if coef[k, COEF_KT] != 0.0:  # Mindlin's tangential history (docs/model.md section 3.16)
-        for col in range(4):
+        for col in range(N_MINDLIN):
             hist[k, HIST_XI + col] = hist[k, HIST_XI_END + col]
     d = hist[k, HIST_END]
     if d > hist[k, HIST_MAX]:
