@@ -23,6 +23,7 @@ from granplate.model.coefficients import coefficient_row as coefficient_row, joh
 from granplate.model.coefficients import law_coefficients as law_coefficients
 from granplate.model.coefficients import law_yield_overlap as law_yield_overlap
 from granplate.model.coefficients import material_indices as material_indices, normal_law_of as normal_law_of
+from granplate.model.coefficients import mindlin_columns as mindlin_columns
 from granplate.model.coefficients import pair_coefficient_row as pair_coefficient_row
 from granplate.model.coefficients import wall_coefficient_row as wall_coefficient_row
 from granplate.model.relists import cached_pair_coefficients as cached_pair_coefficients
@@ -278,6 +279,7 @@ def loop_config(
         t_end=float(t.t_end),
         load_on_plate=bool(s.load.kind == "line" and s.load.target == "plate"),
         arm_shrink=1.0 if s.contact.torque_arm == "contact_point" else 0.0,
+        lammps_arms=s.contact.torque_arm == "lammps",
         scheme=scheme_number(sol.scheme),
         error_tol=float(sol.error_tol),
         force_floor=force_floor(q0, fres, tres, r, mass, s, t.output_interval) if floor is None else float(floor),

@@ -19,15 +19,19 @@ from granplate.physics.contact import (
     COEF_H,
     COEF_KAPPA,
     COEF_KS,
+    COEF_KT,
     COEF_MU,
+    COEF_MUT,
     COEF_RC,
     COEF_RL,
     COEF_SY,
     COEF_XH,
+    COEF_XT,
     N_COEF,
     damping_coefficient,
     hertz_coefficient,
 )
+from granplate.physics.mindlin import mindlin_coefficient, tangential_compliance
 from granplate.physics.plastic import contact_yield_overlap
 from granplate.setup.materials import (
     DEFAULT_HARDNESS_RATIO,
@@ -176,7 +180,21 @@ def pair_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, pairs:
         pair_coef[p, COEF_DY : COEF_XH + 1] = law_coefficients(
             s, a, b, b.name, e_p, float(r_star[p]), float(r[i[p]] + r[j[p]])
         )
+    if s.contact.tangential_law == "mindlin":
+        compliance = np.array([tangential_compliance(m.E, m.nu) for m in kinds])
+        mindlin_columns(pair_coef, compliance[kind[i]] + compliance[kind[j]], s.contact.tangential_damping)
     return pair_coef
+
+
+def mindlin_columns(coef: np.ndarray, compliance: np.ndarray, damping: float) -> None:
+    """Rows of `coef` made Mindlin's (docs/model.md section 3.16) in place: 8 G* from
+    1 / G* = `compliance` [1/Pa] (per row, eq. M1) into COEF_KT, the Coulomb coefficient moved
+    from COEF_MU (which the tanh law reads) to COEF_MUT, the tangential damping factor x_t
+    (contact.tangential_damping) into COEF_XT."""
+    coef[:, COEF_KT] = mindlin_coefficient(1.0) / compliance
+    coef[:, COEF_MUT] = coef[:, COEF_MU]
+    coef[:, COEF_MU] = 0.0
+    coef[:, COEF_XT] = damping
 
 
 def wall_coefficient_row(s: Scenario, a, wall_material: str, ri: float, mi: float) -> np.ndarray:
@@ -185,13 +203,17 @@ def wall_coefficient_row(s: Scenario, a, wall_material: str, ri: float, mi: floa
     alpha, mu, ks = s.contact.for_pair(a.name, wall_material)
     e_star = effective_modulus(a, None)
     coef_a = hertz_coefficient(e_star, ri)
-    return coefficient_row(
+    row = coefficient_row(
         coef_a,
         damping_coefficient(alpha, mi, coef_a),
         mu,
         ks,
         law_coefficients(s, a, None, wall_material, e_star, ri, 2.0 * ri),
     )
+    if s.contact.tangential_law == "mindlin":
+        rows = row.reshape(1, -1)
+        mindlin_columns(rows, np.array([tangential_compliance(a.E, a.nu)]), s.contact.tangential_damping)
+    return row
 
 
 def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarray, walls=None):
@@ -229,6 +251,9 @@ def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarr
         wall_coef[p, COEF_DY : COEF_XH + 1] = law_coefficients(
             s, mats[i[p]], None, s.walls[w[p]].material, float(e_star[p]), float(ri[p]), 2.0 * float(ri[p])
         )
+    if s.contact.tangential_law == "mindlin":  # a rigid wall: the granule's compliance alone
+        compliance = np.array([tangential_compliance(kinds[c].E, kinds[c].nu) for c in kind[i]])
+        mindlin_columns(wall_coef, compliance, s.contact.tangential_damping)
     return wall_geo, wall_coef
 
 

@@ -39,8 +39,15 @@ STATE_COLUMNS = {2: 6, 3: 9}
 #: the overlap at the end of the last trial step [m] (taken into delta_max when the step is
 #: accepted), and the rate factor Y(rate) / Y [-] that fixed the yield strength of a contact
 #: under the law "johnson" (docs/model.md section 3.10: 0 while unset, 1 rate-free).
+#: Then Mindlin's tangential law (docs/model.md section 3.16): the elastic tangential
+#: displacement xi (3 components) [m], the contact radius a [m] and the tangential force on
+#: the first body (3) [N] of the last accepted step, and the same at the end of the last
+#: trial step (taken in when the step is accepted; N_MINDLIN columns each).
 HIST_MAX, HIST_TIME, HIST_END, HIST_RATE = 0, 1, 2, 3
-N_HIST = 4
+HIST_XI, HIST_A, HIST_F = 4, 7, 8
+N_MINDLIN = 7
+HIST_XI_END, HIST_A_END, HIST_F_END = 11, 14, 15
+N_HIST = 18
 
 
 #: columns of Granular.drive_now, each drive's state at the last force pass: its
@@ -185,6 +192,7 @@ class Config(NamedTuple):
     patch_width: float = 0.0  # width of a patch contact [m] (plate.rigid_layer_width)
     dimension: int = 2  # 2: the plane (state x, y, theta, vx, vy, omega); 3: space (x, y, z, vx, vy, vz, wx, wy, wz)
     threads: int = 1  # blocks of the velocity-Verlet passes, one per thread (solver.blocks; 1: serial)
+    lammps_arms: bool = False  # contact.torque_arm = "lammps": Mindlin's torque at R - delta/2 (pairs), R (walls)
 
 
 #: columns of BodyArrays.geo, one row per granule and buffer (docs/model.md section 3.9):

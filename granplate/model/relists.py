@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from granplate.model.coefficients import pair_coefficients, plate_contact_coefficients, wall_arrays
-from granplate.model.inputs import HIST_MAX, Granular, no_history
+from granplate.model.inputs import HIST_MAX, HIST_XI, Granular, no_history
 from granplate.physics.contact import N_COEF
 from granplate.setup.scenario import Scenario
 
@@ -27,7 +27,7 @@ def carried_history(old_keys: np.ndarray, old_hist: np.ndarray, new_keys: np.nda
     section 3.6) for the whole run, whether or not the list holds it. Keys are matched by
     sorting (no per-contact Python): a rebuild of 10^6 contacts takes a fraction of a second."""
     new_keys = np.asarray(new_keys, np.int64).reshape(-1, 2)
-    has = old_hist[:, HIST_MAX] > 0.0
+    has = (old_hist[:, HIST_MAX] > 0.0) | np.any(old_hist[:, HIST_XI : HIST_XI + 3] != 0.0, axis=1)
     keys = np.asarray(old_keys, np.int64).reshape(-1, 2)[has]
     rows = old_hist[has]
     if store:

@@ -45,10 +45,15 @@ def damping_coefficient(alpha_n: float, m_star: float, a: float) -> float:
 #: section 3.10; 0 in COEF_SY: Thornton's law where COEF_DY is finite): R* Y [N/m], the rate
 #: coefficient C [-], 1 / (L rate_ref) [s/m] with L the length that makes the approach speed a
 #: strain rate, the hardness ratio h [-], the unloading factor kappa [-] and x_h, the
-#: overlap over delta_y where the pressure reaches h Y (eqs. J1-J8).
+#: overlap over delta_y where the pressure reaches h Y (eqs. J1-J8); then Mindlin's
+#: tangential law (docs/model.md section 3.16, physics.mindlin): 8 G* [Pa], the tangential
+#: stiffness per unit contact radius (0: the contact takes eq. 5's tanh law, COEF_MU), and
+#: its Coulomb coefficient mu [-] (a Mindlin contact's COEF_MU is 0, so that the tanh law's
+#: passes skip it) and its tangential damping factor x_t [-] (eta_t = x_t c delta^(1/4)).
 COEF_A, COEF_C, COEF_MU, COEF_KS, COEF_DY = 0, 1, 2, 3, 4
 COEF_SY, COEF_RC, COEF_RL, COEF_H, COEF_KAPPA, COEF_XH = 5, 6, 7, 8, 9, 10
-N_COEF = 11
+COEF_KT, COEF_MUT, COEF_XT = 11, 12, 13
+N_COEF = 14
 
 
 @njit(cache=True)

@@ -25,7 +25,9 @@ How each force is found, at the recorded state (positions and velocities) of tha
   the largest sampled at the output times (a lower bound);
 - the friction force |mu N tanh(k_s v_t)| (eq. 5) at the recorded slip rate, the law the
   loop integrates (under solver.granular_friction = "split" it applies it in exact half
-  steps, so the force over a step is this law's along the slip's relaxation).
+  steps, so the force over a step is this law's along the slip's relaxation); under
+  Mindlin's law (contact.tangential_law = "mindlin") the friction force depends on the
+  contact's tangential history, which the recorded state does not hold: NaN.
 """
 
 from __future__ import annotations
@@ -40,6 +42,7 @@ from numba import njit
 from granplate.physics.contact import (
     COEF_DY,
     COEF_KS,
+    COEF_KT,
     COEF_MU,
     contact_arm,
     friction_magnitude,
@@ -62,7 +65,10 @@ LINK_VARIABLES: dict[str, tuple[str, str]] = {
     ),
     "link_overlap": ("m", "the contact's overlap delta > 0"),
     "link_normal_force": ("N", "the normal force |N| of the contact's normal law, damping included (eqs. 2-4)"),
-    "link_tangential_force": ("N", "the magnitude of the friction force mu |N| |tanh(k_s v_t)| (eq. 5)"),
+    "link_tangential_force": (
+        "N",
+        "the magnitude of the friction force mu |N| |tanh(k_s v_t)| (eq. 5); NaN under Mindlin's law",
+    ),
 }
 
 #: the table's columns in the kernels' output rows
@@ -109,7 +115,17 @@ def pair_links(y, radius, pairs, coef, dmax, rate, arm_shrink, clip, out):
             ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
         n = normal_law_force(delta, ddot, c, max(dmax[p], delta), rate[p], clip)
         out[p, NORMAL] = n
-        out[p, TANGENTIAL] = abs(friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS]))
+        out[p, TANGENTIAL] = tangential_magnitude(n, vt, c)
+
+
+@njit(cache=True)
+def tangential_magnitude(n: float, vt: float, c) -> float:
+    """|F_t| [N] of a contact of coefficient row c at normal force n [N] and slip rate vt
+    [m/s]: the tanh law's (eq. 5); NaN for a Mindlin contact (COEF_KT set), whose force
+    follows from its tangential history, not from the state."""
+    if c[COEF_KT] > 0.0:
+        return math.nan
+    return abs(friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS]))
 
 
 @njit(cache=True)
@@ -141,7 +157,7 @@ def wall_links(y, radius, granule, geo, vn, coef, dmax, rate, arm_shrink, clip, 
             ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, a)
         n = normal_law_force(delta, ddot - vn[k], c, max(dmax[k], delta), rate[k], clip)
         out[k, NORMAL] = n
-        out[k, TANGENTIAL] = abs(friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS]))
+        out[k, TANGENTIAL] = tangential_magnitude(n, vt, c)
 
 
 def table_rows(n: int, steps: int, times: np.ndarray, t_end: float, dt_out: float) -> np.ndarray:

@@ -10,11 +10,13 @@ from typing import Any
 
 from granplate.errors import ScenarioError
 from granplate.setup.fields import material_exists, nonneg, positive, string_in
-from granplate.setup.scenario import NORMAL_LAWS, Scenario
+from granplate.setup.scenario import NORMAL_LAWS, TANGENTIAL_LAWS, Scenario
 
 
 #: Lever arms of the friction torque (Contact.torque_arm).
-TORQUE_ARMS: tuple[str, ...] = ("radius", "contact_point")
+#: "lammps": Mindlin's law only (LAMMPS's pair granular: the slip rate at the arm R, the torque
+#: at R - delta/2 between spheres and R at a wall).
+TORQUE_ARMS: tuple[str, ...] = ("radius", "contact_point", "lammps")
 DETECTIONS: tuple[str, ...] = ("dynamic", "fixed")
 #: Normal laws (of NORMAL_LAWS) that need the yield strength Y of every body that can
 #: yield at a contact (both granules; the granule alone against a wall or the plate).
@@ -106,6 +108,62 @@ def _check_contact(s: Scenario) -> None:
         if pc.normal_law is not None:
             string_in(f"{p}.normal_law", pc.normal_law, NORMAL_LAWS)
     _check_yield_strengths(s)
+    _check_tangential_law(s)
+
+
+#: Where Mindlin's tangential law runs (Contact.tangential_law = "mindlin").
+MINDLIN_SUPPORT = (
+    "Mindlin's law runs in space (dimension = 3) under solver.scheme = 'verlet', at "
+    "granule-granule and granule-wall contacts, without a [plate] (elastic body)"
+)
+
+
+def _check_tangential_law(s: Scenario) -> None:
+    """contact.tangential_law is one of TANGENTIAL_LAWS; "mindlin" only where it runs
+    (MINDLIN_SUPPORT) and with every granule material's Poisson ratio (its G*, eq. M1)."""
+    c = s.contact
+    string_in("contact.tangential_law", c.tangential_law, TANGENTIAL_LAWS)
+    nonneg("contact.tangential_damping", c.tangential_damping)
+    if c.tangential_damping > ALPHA_N_MAX:
+        raise ScenarioError(
+            "contact.tangential_damping",
+            c.tangential_damping,
+            f"must be in [0, {ALPHA_N_MAX:g}] (a factor on eq. 3's normal damping coefficient)",
+        )
+    if c.tangential_law != "mindlin" and c.tangential_damping != 0.0:
+        raise ScenarioError(
+            "contact.tangential_damping",
+            c.tangential_damping,
+            "is Mindlin's (contact.tangential_law = 'mindlin'): the tanh law has no tangential damping; set 0",
+        )
+    if c.tangential_law != "mindlin":
+        if c.torque_arm == "lammps":
+            raise ScenarioError(
+                "contact.torque_arm",
+                c.torque_arm,
+                "'lammps' is an arm of contact.tangential_law = 'mindlin' only: "
+                "with the tanh law take 'radius' or 'contact_point'",
+            )
+        return
+    if s.dimension != 3:
+        raise ScenarioError(
+            "contact.tangential_law", c.tangential_law, f"{MINDLIN_SUPPORT}; not dimension = {s.dimension}"
+        )
+    if s.solver.scheme != "verlet":
+        raise ScenarioError(
+            "contact.tangential_law", c.tangential_law, f"{MINDLIN_SUPPORT}; not solver.scheme = {s.solver.scheme!r}"
+        )
+    if s.plate is not None:
+        raise ScenarioError("contact.tangential_law", c.tangential_law, f"{MINDLIN_SUPPORT}; not with a [plate]")
+    for m in dict.fromkeys(g.material for g in s.granules):
+        nu = s.material(m).nu
+        if not isinstance(nu, (int, float)) or isinstance(nu, bool) or not -1.0 < nu <= 0.5:
+            raise ScenarioError(
+                f"materials.{m}.nu",
+                nu,
+                "must be a Poisson ratio in (-1, 0.5]: contact.tangential_law = 'mindlin' takes "
+                "the shear modulus E / (2 (1 + nu)) from it",
+            )
 
 
 def possible_contacts(s: Scenario) -> list[tuple[str, str, str]]:

@@ -456,6 +456,11 @@ class Load:
 #: hardness, with a rate-dependent yield strength (docs/model.md section 3.10), which needs
 #: Y likewise.
 NORMAL_LAWS: tuple[str, ...] = ("hertz", "thornton", "johnson")
+#: Tangential laws (Contact.tangential_law): "tanh", eq. (5)'s regularised Coulomb law
+#: without history (the paper's), and "mindlin", Mindlin's tangential spring 8 G* a with a
+#: Coulomb limit mu |N| and each contact's elastic tangential displacement as history
+#: (docs/model.md section 3.16; in space, under the scheme "verlet").
+TANGENTIAL_LAWS: tuple[str, ...] = ("tanh", "mindlin")
 
 
 @dataclass(frozen=True)
@@ -505,7 +510,17 @@ class Contact:
     "radius" (R_i, paper eq. 1, docs/model.md section 3.2) or "contact_point" (R_i - delta/2 for a
     pair, R_i - delta at a wall or plate: the true contact point, which conserves the
     angular momentum of a free assembly; with "radius" each sliding pair adds a couple
-    -f delta). The slip rate uses the same arms, so the friction power stays f v_t.
+    -f delta). The slip rate uses the same arms, so the friction power stays f v_t. "lammps"
+    (contact.tangential_law = "mindlin" only): LAMMPS's pair granular, the slip rate at the
+    arm R_i and the torque at R_i - delta/2 between spheres (R_i at a wall), for a side by
+    side run with LAMMPS; the arms differ, so the couples' extra work is booked in
+    D_friction (docs/model.md section 3.16).
+    tangential_law: the friction law of every granule-granule and granule-wall contact (one
+    of TANGENTIAL_LAWS): "tanh", eq. (5), or "mindlin", Mindlin's tangential spring with a
+    Coulomb limit mu |N| and history (docs/model.md section 3.16; its mu is `mu` and the
+    pairs' mu, k_s unused; 3D scenarios under solver.scheme "verlet" only);
+    tangential_damping: Mindlin's tangential damping x_t [-] (LAMMPS's `mindlin NULL x_t mu`):
+    eta_t = x_t c delta^(1/4), x_t times eq. (3)'s normal damping coefficient (0: none).
     """
 
     mu: float = 0.099
@@ -521,6 +536,8 @@ class Contact:
     overlap_stop: float = 0.2
     overlap_start: float | None = None
     normal_law: str = "hertz"
+    tangential_law: str = "tanh"
+    tangential_damping: float = 0.0
 
     def for_pair(self, a: str, b: str) -> tuple[float, float, float]:
         """(alpha_n, mu, k_s) for materials a and b."""

@@ -49,6 +49,13 @@ def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
     raise NotImplementedError("compiled use only")
 
 
+def mindlin_forces(yv, yn, h, g, cfg, acc):
+    """Mindlin's tangential forces after the velocity-Verlet force pass
+    (solver.granular3d.mindlin_forces): (stored energy, energy lost) [J]; none in the plane
+    (setup refuses the law there)."""
+    raise NotImplementedError("compiled use only")
+
+
 def sensor_loads(y, g, cfg, load):
     """Every granule's sensor reading [N]: half the sum of its pair and wall contacts'
     normal forces (solver.granular.sensor_loads)."""
@@ -106,6 +113,15 @@ def _normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
     if _module_of(g) is space:
         fb = blocks.normal_forces_blocks
         return lambda t, y, g, cfg, acc, fdamp, fload, fpar, spar: fb(t, y, g, cfg, acc, fdamp, fload, fpar, spar)
+
+
+@overload(mindlin_forces, inline="always")
+def _mindlin_forces(yv, yn, h, g, cfg, acc):
+    if _module_of(g) is plane:
+        return lambda yv, yn, h, g, cfg, acc: (0.0, 0.0)
+    if _module_of(g) is space:
+        fn = space.mindlin_forces
+        return lambda yv, yn, h, g, cfg, acc: fn(yv, yn, h, g, cfg, acc)
 
 
 @overload(sensor_loads, inline="always")

@@ -18,10 +18,11 @@ from typing import NamedTuple
 
 from numba import njit
 
-from granplate.model.inputs import HIST_END, HIST_MAX, HIST_RATE, HIST_TIME
+from granplate.model.inputs import HIST_END, HIST_MAX, HIST_RATE, HIST_TIME, HIST_XI, HIST_XI_END, N_MINDLIN
 from granplate.physics.contact import (
     COEF_DY,
     COEF_KS,
+    COEF_KT,
     COEF_MU,
     COEF_RC,
     COEF_RL,
@@ -373,6 +374,9 @@ def commit_history(t, hist, coef):
 @njit(cache=True)
 def commit_history_row(t, hist, coef, k):
     """`commit_history` of contact k alone."""
+    if coef[k, COEF_KT] != 0.0:  # Mindlin's tangential history (docs/model.md section 3.16)
+        for col in range(N_MINDLIN):
+            hist[k, HIST_XI + col] = hist[k, HIST_XI_END + col]
     d = hist[k, HIST_END]
     if d > hist[k, HIST_MAX]:
         if hist[k, HIST_RATE] == 0.0 and coef[k, COEF_SY] > 0.0 and d > coef[k, COEF_DY]:

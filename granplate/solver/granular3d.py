@@ -10,9 +10,32 @@ from __future__ import annotations
 
 from numba import njit
 
-from granplate.model.inputs import HIST_END, HIST_MAX, HIST_RATE
-from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm, friction_magnitude
+import math
+
+from granplate.model.inputs import (
+    HIST_A,
+    HIST_A_END,
+    HIST_END,
+    HIST_F,
+    HIST_F_END,
+    HIST_MAX,
+    HIST_RATE,
+    HIST_XI,
+    HIST_XI_END,
+    N_MINDLIN,
+)
+from granplate.physics.contact import (
+    COEF_C,
+    COEF_KS,
+    COEF_KT,
+    COEF_MU,
+    COEF_MUT,
+    COEF_XT,
+    contact_arm,
+    friction_magnitude,
+)
 from granplate.physics.laws import normal_law_force, normal_law_response
+from granplate.physics.mindlin import contact_radius, mindlin_step, spring_energy
 from granplate.physics.shock import shock_amplitude
 from granplate.physics.space import (
     arm_torque_3d,
@@ -514,3 +537,159 @@ def wall_forces(y, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl
             fdamp[i, VZ] -= d * nz
         book_wall(g, w, kd, n, d)
     return p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
+
+
+@njit(cache=True)
+def mindlin_contact(hist, k, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, n_abs):
+    """Contact k (history row hist[k], coefficient row c) under Mindlin's law over the step
+    h [s] (physics.mindlin.mindlin_step) at overlap delta and contact radius a [m] and |N| =
+    n_abs [N], damped by eta_t = x_t c delta^(1/4); its trial history into HIST_XI_END,
+    HIST_A_END, HIST_F_END. h = 0 (the force pass at t_n of a run's first step): a contact
+    with a committed history (a restart) takes its committed force back, as the run that
+    stored it had it; a new one its force from the state, which becomes its committed force
+    (what the first kick applies). Returns (F_t (3) [N], stored energy [J], energy lost [J])."""
+    if h == 0.0 and hist[k, HIST_A] > 0.0:
+        for col in range(N_MINDLIN):
+            hist[k, HIST_XI_END + col] = hist[k, HIST_XI + col]
+        e_t = spring_energy(c[COEF_KT] * hist[k, HIST_A], hist[k, HIST_XI], hist[k, HIST_XI + 1], hist[k, HIST_XI + 2])
+        return hist[k, HIST_F], hist[k, HIST_F + 1], hist[k, HIST_F + 2], e_t, 0.0
+    fx, fy, fz, xx, xy, xz, e_t, lost = mindlin_step(
+        hist[k, HIST_XI],
+        hist[k, HIST_XI + 1],
+        hist[k, HIST_XI + 2],
+        a,
+        hist[k, HIST_A],
+        c[COEF_KT],
+        nx,
+        ny,
+        nz,
+        vsx,
+        vsy,
+        vsz,
+        h,
+        c[COEF_MUT] * abs(n_abs),
+        c[COEF_XT] * c[COEF_C] * math.sqrt(math.sqrt(delta)),
+        hist[k, HIST_F],
+        hist[k, HIST_F + 1],
+        hist[k, HIST_F + 2],
+    )
+    hist[k, HIST_XI_END] = xx
+    hist[k, HIST_XI_END + 1] = xy
+    hist[k, HIST_XI_END + 2] = xz
+    hist[k, HIST_A_END] = a
+    hist[k, HIST_F_END] = fx
+    hist[k, HIST_F_END + 1] = fy
+    hist[k, HIST_F_END + 2] = fz
+    if h == 0.0:
+        for col in range(3):
+            hist[k, HIST_F + col] = hist[k, HIST_F_END + col]
+    return fx, fy, fz, e_t, lost
+
+
+@njit(cache=True)
+def mindlin_old_force(hist, k, c):
+    """The tangential force on the first body at contact k's last step [N] (3)."""
+    return hist[k, HIST_F], hist[k, HIST_F + 1], hist[k, HIST_F + 2]
+
+
+@njit(cache=True)
+def couple_work(y, i, da, nx, ny, nz, fx, fy, fz, dt):
+    """The work [J] over dt [s] of the couple da n x f (da [m], f [N]) on granule i's spin
+    at state y."""
+    tx, ty, tz = arm_torque_3d(da, nx, ny, nz, fx, fy, fz)
+    return dt * (tx * y[i, WX] + ty * y[i, WY] + tz * y[i, WZ])
+
+
+@njit(cache=True)
+def mindlin_parted(hist, k, c):
+    """Contact k has parted: its trial history zero (a new touch starts unloaded, as
+    LAMMPS's); returns the spring energy it held [J] (lost)."""
+    a_old = hist[k, HIST_A]
+    e_old = spring_energy(c[COEF_KT] * a_old, hist[k, HIST_XI], hist[k, HIST_XI + 1], hist[k, HIST_XI + 2])
+    for col in range(N_MINDLIN):
+        hist[k, HIST_XI_END + col] = 0.0
+    return e_old
+
+
+@njit(cache=True)
+def push_tangential(acc, g, i, a, nx, ny, nz, fx, fy, fz, sign):
+    """The tangential force sign * F (F on the first body [N]) and its torque a n x F on
+    granule i as accelerations into acc (as `add_friction`, divided by m and I)."""
+    inv_m = 1.0 / g.mass[i]
+    inv_i = 1.0 / g.inertia[i]
+    acc[i, VX] += sign * fx * inv_m
+    acc[i, VY] += sign * fy * inv_m
+    acc[i, VZ] += sign * fz * inv_m
+    tx, ty, tz = arm_torque_3d(a, nx, ny, nz, fx, fy, fz)
+    acc[i, WX] += tx * inv_i
+    acc[i, WY] += ty * inv_i
+    acc[i, WZ] += tz * inv_i
+
+
+@njit(cache=True)
+def mindlin_forces(yv, yn, h, g, cfg, acc):
+    """Mindlin's tangential law (docs/model.md section 3.16) at every listed pair and wall
+    contact whose coefficient row has COEF_KT > 0, after the velocity-Verlet force pass:
+    positions from yv (the pass's), the slip velocity from yv's velocities (the half step's,
+    which move the granules over h [s]; h = 0: the force of the committed history), |N|
+    from yn's (the state the normal pass read). Adds the forces and torques to the
+    accelerations acc, the trial histories into HIST_XI_END, HIST_A_END. Returns (the
+    springs' stored energy [J], the energy they lost over the step [J])."""
+    e_t = 0.0
+    lost = 0.0
+    half_shrink = 0.5 * cfg.arm_shrink
+    for p in range(g.pair_ij.shape[0]):
+        c = g.pair_coef[p]
+        if c[COEF_KT] == 0.0:
+            continue
+        i = g.pair_ij[p, 0]
+        j = g.pair_ij[p, 1]
+        ri = g.radius[i]
+        rj = g.radius[j]
+        delta, nx, ny, nz = pair_contact_3d(yv[i, X], yv[i, Y], yv[i, Z], ri, yv[j, X], yv[j, Y], yv[j, Z], rj)
+        if delta <= 0.0:
+            lost += mindlin_parted(g.pair_hist, p, c)
+            continue
+        ai = contact_arm(ri, delta, half_shrink)
+        aj = contact_arm(rj, delta, half_shrink)
+        _, vsx, vsy, vsz = pair_slip(yv, i, j, nx, ny, nz, ai, aj)
+        ddot = normal_rate_3d(yn[i, VX] - yn[j, VX], yn[i, VY] - yn[j, VY], yn[i, VZ] - yn[j, VZ], nx, ny, nz)
+        n_abs = normal_law_force(delta, ddot, c, g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip)
+        a = contact_radius(ri * rj / (ri + rj), delta)
+        f0x, f0y, f0z = mindlin_old_force(g.pair_hist, p, c)
+        fx, fy, fz, e, d = mindlin_contact(g.pair_hist, p, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, n_abs)
+        e_t += e
+        lost += d
+        ti = ai
+        tj = aj
+        if cfg.lammps_arms:  # LAMMPS's torque arms: their couples' extra work over h is lost from D
+            ti = ri - 0.5 * delta
+            tj = rj - 0.5 * delta
+            lost -= couple_work(yv, i, ti - ai, nx, ny, nz, f0x + fx, f0y + fy, f0z + fz, 0.5 * h)
+            lost -= couple_work(yv, j, tj - aj, nx, ny, nz, f0x + fx, f0y + fy, f0z + fz, 0.5 * h)
+        push_tangential(acc, g, i, ti, nx, ny, nz, fx, fy, fz, 1.0)
+        push_tangential(acc, g, j, tj, nx, ny, nz, fx, fy, fz, -1.0)
+    for w in range(g.wall_i.shape[0]):
+        c = g.wall_coef[w]
+        if c[COEF_KT] == 0.0:
+            continue
+        i = g.wall_i[w]
+        ri = g.radius[i]
+        nx = g.wall_geo[w, 0]
+        ny = g.wall_geo[w, 1]
+        nz = g.wall_geo[w, 2]
+        shift, vn, _ = wall_motion(g, w)
+        delta = wall_overlap_3d(yv[i, X], yv[i, Y], yv[i, Z], ri, nx, ny, nz, g.wall_geo[w, 3] + shift)
+        if delta <= 0.0:
+            lost += mindlin_parted(g.wall_hist, w, c)
+            continue
+        arm = contact_arm(ri, delta, cfg.arm_shrink)
+        _, vsx, vsy, vsz = wall_slip(yv, i, nx, ny, nz, arm)
+        ddot = normal_rate_3d(yn[i, VX], yn[i, VY], yn[i, VZ], nx, ny, nz) - vn
+        n_abs = normal_law_force(delta, ddot, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
+        a = contact_radius(ri, delta)
+        fx, fy, fz, e, d = mindlin_contact(g.wall_hist, w, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, n_abs)
+        e_t += e
+        lost += d
+        push_tangential(acc, g, i, arm, nx, ny, nz, fx, fy, fz, 1.0)
+    return e_t, lost

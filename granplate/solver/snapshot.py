@@ -76,6 +76,14 @@ def _padded(stored: np.ndarray, fresh) -> np.ndarray:
     return stored
 
 
+def _history_row(h, n_hist: int) -> np.ndarray:
+    """A stored contact's history row, completed with zeros to this version's n_hist
+    columns (a result written before a column was added: Mindlin's tangential history)."""
+    out = np.zeros(max(n_hist, len(h)))
+    out[: len(h)] = h
+    return out
+
+
 def _rebuilt(prefix: str, tup, snap: dict[str, np.ndarray]):
     values = {}
     for name, value in zip(tup._fields, tup):
@@ -100,6 +108,9 @@ def restore(snap: dict[str, np.ndarray], arr, lists) -> None:
     arr.st.clock[CUSTOM_H] = -1.0  # the odd step's matrices too
     lists.g = _rebuilt("g", lists.g, snap)
     lists.stores = tuple(
-        {(int(i), int(j)): np.array(h) for (i, j), h in zip(snap[f"stores.{n}_key"], snap[f"stores.{n}_hist"])}
+        {
+            (int(i), int(j)): _history_row(h, lists.g.pair_hist.shape[1])
+            for (i, j), h in zip(snap[f"stores.{n}_key"], snap[f"stores.{n}_hist"])
+        }
         for n in ("pair", "wall")
     )

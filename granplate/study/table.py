@@ -48,6 +48,7 @@ FIELD_UNITS: dict[str, str] = {
     "rigid_layer_width": "m",
     "column_radii": "m",
     "alpha_n": "1",
+    "tangential_damping": "1",
     # in space, and the layouts' counts
     "z": "m",
     "vz": "m/s",

