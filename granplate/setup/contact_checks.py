@@ -113,7 +113,7 @@ def _check_contact(s: Scenario) -> None:
 
 #: Where Mindlin's tangential law runs (Contact.tangential_law = "mindlin").
 MINDLIN_SUPPORT = (
-    "Mindlin's law runs in space (dimension = 3) under solver.scheme = 'verlet', at "
+    "Mindlin's law runs in the plane and in space (dimension = 2 or 3) under solver.scheme = 'verlet', at "
     "granule-granule and granule-wall contacts, without a [plate] (elastic body)"
 )
 
@@ -145,10 +145,6 @@ def _check_tangential_law(s: Scenario) -> None:
                 "with the tanh law take 'radius' or 'contact_point'",
             )
         return
-    if s.dimension != 3:
-        raise ScenarioError(
-            "contact.tangential_law", c.tangential_law, f"{MINDLIN_SUPPORT}; not dimension = {s.dimension}"
-        )
     if s.solver.scheme != "verlet":
         raise ScenarioError(
             "contact.tangential_law", c.tangential_law, f"{MINDLIN_SUPPORT}; not solver.scheme = {s.solver.scheme!r}"

@@ -17,7 +17,7 @@ from __future__ import annotations
 from numba.extending import overload
 
 from granplate.model.inputs import Granular, Granular3
-from granplate.solver import blocks, granular as plane, granular3d as space
+from granplate.solver import blocks, granular as plane, granular3d as space, mindlin_plane
 
 _MODULES = {Granular: plane, Granular3: space}
 
@@ -51,8 +51,8 @@ def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
 
 def mindlin_forces(yv, yn, h, g, cfg, acc):
     """Mindlin's tangential forces after the velocity-Verlet force pass
-    (solver.granular3d.mindlin_forces): (stored energy, energy lost) [J]; none in the plane
-    (setup refuses the law there)."""
+    (solver.granular3d.mindlin_forces in space, solver.mindlin_plane.mindlin_forces in the
+    plane): (stored energy, energy lost) [J]."""
     raise NotImplementedError("compiled use only")
 
 
@@ -118,7 +118,8 @@ def _normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
 @overload(mindlin_forces, inline="always")
 def _mindlin_forces(yv, yn, h, g, cfg, acc):
     if _module_of(g) is plane:
-        return lambda yv, yn, h, g, cfg, acc: (0.0, 0.0)
+        fp = mindlin_plane.mindlin_forces
+        return lambda yv, yn, h, g, cfg, acc: fp(yv, yn, h, g, cfg, acc)
     if _module_of(g) is space:
         fn = space.mindlin_forces
         return lambda yv, yn, h, g, cfg, acc: fn(yv, yn, h, g, cfg, acc)
