@@ -108,7 +108,7 @@ def launched_hexagon(
 
 
 def packing_arrays(s) -> dict:
-    """x, y, radius [m], mass [kg], vx, vy [m/s], E [Pa], nu of scenario `s`'s granules,
+    """x, y, radius [m], mass [kg], vx, vy [m/s], omega [rad/s], E [Pa], nu of scenario `s`'s granules,
     which must be free (no walls, plate or load), frictionless and undamped, of one
     material (ValueError naming the field otherwise)."""
     if s.walls:
@@ -134,6 +134,7 @@ def packing_arrays(s) -> dict:
         "mass": 4.0 / 3.0 * math.pi * r**3 * mat.rho,
         "vx": np.array([g.vx for g in s.granules]),
         "vy": np.array([g.vy for g in s.granules]),
+        "omega": np.array([g.spin()[2] for g in s.granules], float),
         "E": mat.E,
         "nu": mat.nu,
     }
@@ -181,6 +182,9 @@ def create_granules(lmp, p: dict) -> None:
     lmp.create_atoms(n, ids, [1] * n, xyz, vel)
     lmp.scatter_atoms("radius", 1, 1, (ctypes.c_double * n)(*p["radius"].tolist()))
     lmp.scatter_atoms("rmass", 1, 1, (ctypes.c_double * n)(*p["mass"].tolist()))
+    if np.any(p["omega"]):
+        spin = np.column_stack([np.zeros(n), np.zeros(n), p["omega"]]).ravel().tolist()
+        lmp.scatter_atoms("omega", 1, 3, (ctypes.c_double * (3 * n))(*spin))
 
 
 def _gather(lmp, name: str, count: int) -> np.ndarray:
@@ -304,27 +308,39 @@ def granular_arrays(s) -> dict:
     p = packing_arrays(
         dataclasses.replace(s, walls=(), contact=dataclasses.replace(s.contact, mu=0.0, alpha_n=0.0, pairs=()))
     )
-    return {**p, "walls": walls, "mu": float(s.contact.mu), "alpha_n": float(s.contact.alpha_n)}
+    return {
+        **p,
+        "walls": walls,
+        "mu": float(s.contact.mu),
+        "alpha_n": float(s.contact.alpha_n),
+        "tangential": "mindlin_rescale" if s.contact.tangential_law == "mindlin" else "mindlin",
+    }
 
 
-def granular_model(p: dict) -> str:
+def granular_model(p: dict, wall: bool = False) -> str:
     """The LAMMPS granular model of `p` (granular_arrays): hertz/material with the damping
     of eq. (3) (`damping tsuji`, never attractive: limit_damping, like contact.clip_tensile)
-    and Mindlin's tangential law (stiffness from E and nu, no tangential damping, Coulomb
-    bound mu |N|): LAMMPS's friction, not eq. (5)'s tanh law."""
+    (`damping velocity` with eta_n0 = 0 where alpha_n = 0) and Mindlin's tangential law
+    (stiffness from E and nu, no tangential damping, Coulomb bound mu |N|): `mindlin_rescale`, ours, where the scenario takes contact.tangential_law =
+    "mindlin" (docs/model.md section 3.16), else `mindlin`, LAMMPS's friction against eq.
+    (5)'s tanh law. wall: fix wall/gran's model, E_w = 2E (its coefficients stand for both
+    bodies: our rigid wall's E / (1 - nu^2), as `space_wall_model`)."""
+    young = (2.0 if wall else 1.0) * float(p["E"])
+    law = p.get("tangential", "mindlin")
+    tangential = f"tangential {law} NULL 0.0 {p['mu']!r}"
+    if p["alpha_n"] == 0.0:  # undamped: `damping velocity` with eta_n0 = 0
+        return f"hertz/material {young!r} 0.0 {float(p['nu'])!r} {tangential} damping velocity"
     e = tsuji_restitution(p["alpha_n"])
-    return (
-        f"hertz/material {float(p['E'])!r} {e!r} {float(p['nu'])!r} tangential mindlin NULL 0.0 {p['mu']!r} "
-        "damping tsuji limit_damping"
-    )
+    return f"hertz/material {young!r} {e!r} {float(p['nu'])!r} {tangential} damping tsuji limit_damping"
 
 
-def run_granular(s, dt: float, t_end: float) -> dict:
+def run_granular(s, dt: float, t_end: float, every: int | None = None) -> dict:
     """Run scenario `s` (granular_arrays: friction, damping, walls) in LAMMPS to t_end [s]
     with step dt [s] (velocity Verlet, fix nve/sphere: spheres of inertia 2/5 m R^2).
     Returns x, y, vx, vy, omega (n_granules,) at t_end ordered as s.granules, setup_time_s,
-    loop_time_s and loop_cpu_s (the `run` command's wall and CPU time [s]), n_steps.
-    RuntimeError when LAMMPS is not available."""
+    loop_time_s and loop_cpu_s (the `run` commands' wall and CPU time [s]), n_steps; with
+    `every`, each (n_out, n_granules) recorded every `every` steps from t = 0, with their
+    times t (n_out,) [s]. RuntimeError when LAMMPS is not available."""
     cls, why = _load()
     if cls is None:
         raise RuntimeError(why)
@@ -333,6 +349,14 @@ def run_granular(s, dt: float, t_end: float) -> dict:
     n_steps = int(round(t_end / dt))
     t0 = time.perf_counter()
     lmp = cls(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
+    keys = ("x", "y", "vx", "vy", "omega")
+    out: dict = {"t": [0.0], **{k: [] for k in keys}}
+
+    def record() -> None:
+        xx, vv, om = _gather(lmp, "x", 3), _gather(lmp, "v", 3), _gather(lmp, "omega", 3)
+        for k, v in zip(keys, (xx[:, 0], xx[:, 1], vv[:, 0], vv[:, 1], om[:, 2])):
+            out[k].append(v)
+
     try:
         cmds = [f"pair_coeff * * {model}" if c.startswith("pair_coeff") else c for c in setup_commands(p, dt)]
         k = cmds.index("fix integrate all nve/sphere")
@@ -340,26 +364,25 @@ def run_granular(s, dt: float, t_end: float) -> dict:
         create_granules(lmp, p)
         lmp.commands_list(cmds[k:])
         for w, (style, lo, hi) in enumerate(p["walls"]):
-            lmp.command(f"fix wall{w} all wall/gran granular {model} {style} {lo} {hi}")
+            lmp.command(f"fix wall{w} all wall/gran granular {granular_model(p, wall=True)} {style} {lo} {hi}")
         lmp.command("run 0 post no")
         setup = time.perf_counter() - t0
-        t1, c1 = time.perf_counter(), time.process_time()
-        lmp.command(f"run {n_steps} pre no post no")
-        loop, cpu = time.perf_counter() - t1, time.process_time() - c1
-        xx, vv, om = _gather(lmp, "x", 3), _gather(lmp, "v", 3), _gather(lmp, "omega", 3)
+        c1 = time.process_time()
+        if every is None:
+            t1 = time.perf_counter()
+            lmp.command(f"run {n_steps} pre no post no")
+            loop = time.perf_counter() - t1
+            record()
+        else:
+            loop = run_recorded(lmp, n_steps, every, dt, out, record)
+        cpu = time.process_time() - c1
     finally:
         lmp.close()
-    return {
-        "x": xx[:, 0],
-        "y": xx[:, 1],
-        "vx": vv[:, 0],
-        "vy": vv[:, 1],
-        "omega": om[:, 2],
-        "setup_time_s": setup,
-        "loop_time_s": loop,
-        "loop_cpu_s": cpu,
-        "n_steps": n_steps,
-    }
+    res = {k: np.array(v) if every is not None else v[-1] for k, v in out.items() if k != "t"}
+    if every is not None:
+        res["t"] = np.array(out["t"])
+    res.update(setup_time_s=setup, loop_time_s=loop, loop_cpu_s=cpu, n_steps=n_steps)
+    return res
 
 
 def static_pair_force(s, overlap: float) -> float:
@@ -1051,6 +1074,31 @@ def mindlin_pair(dt: float = MINDLIN_PAIR_STEP, t_end: float = 2e-5, arm: str = 
     return Scenario(
         name="mindlin-pair",
         dimension=3,
+        granules=gs,
+        load=Load(kind="none"),
+        contact=Contact(mu=0.3, alpha_n=0.0, pairs=(), tangential_law="mindlin", torque_arm=arm),
+        time=TimeSettings(
+            t_end=t_end, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt), output_interval=out, field_interval=out
+        ),
+        solver=Solver(scheme="verlet"),
+    )
+
+
+def mindlin_pair_plane(dt: float = MINDLIN_PAIR_STEP, t_end: float = 2e-5, arm: str = "lammps"):
+    """`mindlin_pair` in the plane (dimension = 2): two free steel spheres (R = 1 mm)
+    meeting obliquely, one spinning, mu = 0.3, undamped, Mindlin's law, the scheme "verlet"
+    at the fixed step dt [s]: the contact sticks, then slides."""
+    from granplate.setup.scenario import Contact, Granule, Load, Scenario, Solver, TimeSettings
+
+    r, v = 1e-3, 0.2
+    gs = (
+        Granule(x=0.0, y=0.0, radius=r, material="steel", label="a", vx=v, vy=0.6 * v, omega=0.0),
+        Granule(x=2 * r + 1e-7, y=0.0, radius=r, material="steel", label="b", vx=-v, vy=-0.2 * v, omega=50.0),
+    )
+    out = t_end / 20.0
+    return Scenario(
+        name="mindlin-pair-plane",
+        dimension=2,
         granules=gs,
         load=Load(kind="none"),
         contact=Contact(mu=0.3, alpha_n=0.0, pairs=(), tangential_law="mindlin", torque_arm=arm),
