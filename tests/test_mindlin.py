@@ -202,7 +202,6 @@ def test_a_mindlin_history_is_carried_across_list_rebuilds():
 @pytest.mark.parametrize(
     "change, field, match",
     [
-        ({"dimension": 2}, "contact.tangential_law", "dimension = 3"),
         ({"scheme": "paper"}, "contact.tangential_law", "solver.scheme = 'verlet'"),
         ({"law": "coulomb"}, "contact.tangential_law", "mindlin"),
         ({"arm": True}, "contact.torque_arm", "tangential_law = 'mindlin'"),
@@ -212,13 +211,10 @@ def test_a_mindlin_history_is_carried_across_list_rebuilds():
     ],
 )
 def test_unsupported_combinations_are_refused_naming_the_field(change, field, match):
-    """Mindlin's law where it does not run (the plane, another scheme), an unknown law, the
+    """Mindlin's law where it does not run (another scheme), an unknown law, the
     LAMMPS arms with the tanh law, and a material without a usable Poisson ratio are refused
     before the run, naming the field and what is allowed."""
     s = oblique_pair()
-    if "dimension" in change:
-        s = L.launched_hexagon(2, 2)
-        s = dataclasses.replace(s, contact=dataclasses.replace(s.contact, tangential_law="mindlin"))
     if "scheme" in change:
         s = dataclasses.replace(s, solver=Solver(scheme="paper"))
     if "law" in change:

@@ -99,6 +99,27 @@ def verlet_scenario(t_end: float | None = None):
     )
 
 
+#: The Mindlin run's energy tolerance: at LAMMPS_DT the packing's residual of eq. (11) is
+#: Verlet's own, 3.2e-4 of the energy in (undamped), above the default 1e-4.
+MINDLIN_ENERGY_TOL = 1e-3
+
+
+def mindlin_scenario(t_end: float | None = None, dt: float = LAMMPS_DT, alpha_n: float | None = None):
+    """The packing with mu = 0.099 under Mindlin's law (contact.tangential_law = "mindlin",
+    LAMMPS's torque arms), solver.scheme = "verlet" at the fixed step dt [s] (LAMMPS's);
+    alpha_n: eq. (3)'s damping (None: the packing's)."""
+    s = packing_scenario(0.099, "split", t_end)
+    contact = dataclasses.replace(s.contact, tangential_law="mindlin", torque_arm="lammps")
+    if alpha_n is not None:
+        contact = dataclasses.replace(contact, alpha_n=alpha_n)
+    return dataclasses.replace(
+        s,
+        contact=contact,
+        solver=dataclasses.replace(s.solver, scheme="verlet", energy_tol=MINDLIN_ENERGY_TOL),
+        time=dataclasses.replace(s.time, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt)),
+    )
+
+
 def cases(t_end: float | None = None) -> list[tuple[str, str, object]]:
     """(case, treatment, scenario) of the table; t_end overrides every run's [s]."""
     free = packing_scenario(0.0, "split", t_end)
