@@ -17,7 +17,11 @@ REPEATS times each, their median loop
 times (wall, and CPU time of this process: on a shared machine what each code used), steps, cost per contact and step (the listed contacts at t = 0, the same count for
 both), and each one's error against its own converged run (granplate: the "rk4" row, whose
 own error is ~3e-5 m/s; LAMMPS: its step / LAMMPS_REF_DIVISOR): the largest |v - v_ref|
-over the granules' velocity components at t_end [m/s].
+over the granules' velocity components at t_end [m/s]. Last, the same law in both codes
+(`mindlin_comparison`): the packing undamped under Mindlin's law (contact.tangential_law =
+"mindlin") in granplate's Verlet scheme and LAMMPS's `tangential mindlin_rescale`, both at
+LAMMPS_DT: loop times, each one's error against its own run at LAMMPS_DT /
+LAMMPS_REF_DIVISOR, and how far the two runs' velocities differ.
 """
 
 from __future__ import annotations
@@ -269,6 +273,79 @@ def lammps_comparison(t_end: float | None, reference: dict, log=print) -> dict:
     return {"contacts": contacts, "t_end_s": t, **rows, **ratio}
 
 
+def mindlin_comparison(t_end: float | None, log=print) -> dict:
+    """The packing with mu = 0.099, undamped, under Mindlin's law in granplate
+    (`mindlin_scenario`) and in LAMMPS (`tangential mindlin_rescale`), both at LAMMPS_DT:
+    the same law, integrator and step (eq. 3's damping left out: granplate's Verlet damping
+    reads the velocity predicted at the step's end, LAMMPS's the half step's). Alternately
+    REPEATS times each: median loop times, and each code's error against its own run at
+    LAMMPS_DT / LAMMPS_REF_DIVISOR; `agreement`: the largest |v_granplate - v_LAMMPS| at t_end
+    over the largest |v| [-]. Returns {"skipped": why} where LAMMPS is not installed."""
+    from granplate.verification import lammps as L
+
+    if L.unavailable():
+        return {"skipped": L.unavailable()}
+    s = mindlin_scenario(t_end, alpha_n=0.0)
+    t = float(s.time.t_end)
+    contacts = listed_contacts(s)
+    fine = LAMMPS_DT / LAMMPS_REF_DIVISOR
+    log(f"Mindlin references, dt {fine:g} s ...")
+    ours_ref = final_velocities(timed_run(mindlin_scenario(t_end, dt=fine, alpha_n=0.0))[0])
+    lammps_ref = L.run_granular(s, fine, t)
+    ours, theirs = [], []
+    for k in range(REPEATS):
+        log(f"granplate and LAMMPS under Mindlin's law, side by side ({k + 1} of {REPEATS}) ...")
+        ds, _ = timed_run(s)
+        ours.append((float(ds.attrs["loop_time_s"]), float(ds.attrs["loop_cpu_s"])))
+        lm = L.run_granular(s, LAMMPS_DT, t)
+        theirs.append((lm["loop_time_s"], lm["loop_cpu_s"]))
+    v = final_velocities(ds)
+    scale = max(float(abs(lm["vx"]).max()), float(abs(lm["vy"]).max()))
+    rows = {
+        "granplate": code_row(
+            "granplate", "Mindlin, verlet", ours, int(ds.attrs["n_steps"]), t, velocity_error(v, ours_ref), contacts
+        ),
+        "lammps": code_row(
+            "LAMMPS", "mindlin_rescale", theirs, int(lm["n_steps"]), t, velocity_error(lm, lammps_ref), contacts
+        ),
+    }
+    return {
+        "contacts": contacts,
+        "t_end_s": t,
+        **rows,
+        "agreement": velocity_error(v, lm) / scale,
+        "loop_ratio": rows["granplate"]["loop_s"] / rows["lammps"]["loop_s"],
+        "cpu_ratio": rows["granplate"]["loop_cpu_s"] / rows["lammps"]["loop_cpu_s"],
+    }
+
+
+def format_mindlin_table(cmp: dict) -> str:
+    """The Mindlin side-by-side comparison as a plain-text table (or why it was left out)."""
+    if "skipped" in cmp:
+        return f"Mindlin comparison skipped: {cmp['skipped']}"
+    head = (
+        f"{'code':<10} {'friction law':<20} {'dt [s]':>9} {'steps':>7} {'loop [s]':>9} "
+        f"{'us/(contact step)':>17} {'CPU [s]':>8} {'CPU us/(c. step)':>16} {'error [m/s]':>11}"
+    )
+    lines = [
+        f"packing with mu 0.099, undamped, Mindlin's law in both codes ({cmp['contacts']} listed contacts, "
+        f"t_end {cmp['t_end_s']:g} s, median of {len(cmp['granplate']['loop_s_all'])} alternate runs each)",
+        head,
+        "-" * len(head),
+    ]
+    for r in (cmp["granplate"], cmp["lammps"]):
+        lines.append(
+            f"{r['code']:<10} {r['law']:<20} {r['dt_s']:>9.3g} {r['n_steps']:>7d} {r['loop_s']:>9.3f} "
+            f"{r['us_per_contact_step']:>17.3f} {r['loop_cpu_s']:>8.3f} {r['cpu_us_per_contact_step']:>16.3f} "
+            f"{r['error_m_s']:>11.2e}"
+        )
+    lines.append(
+        f"loop time granplate / LAMMPS: {cmp['loop_ratio']:.2f} (wall), {cmp['cpu_ratio']:.2f} (CPU); "
+        f"velocities at t_end, granplate against LAMMPS: {cmp['agreement']:.1e} of the largest"
+    )
+    return "\n".join(lines)
+
+
 def format_friction_table(rows: list[dict]) -> str:
     """The rows as a plain-text table."""
     head = f"{'case':<24} {'friction':<8} {'t_end [s]':>9} {'steps':>9} {'steps/ms':>10} {'wall [s]':>9} {'D_fric [J]':>11}"
@@ -323,7 +400,13 @@ def main(args) -> int:
         cmp = lammps_comparison(t_end, reference, log=lambda m: print(m, file=sys.stderr, flush=True))
     print()
     print(format_lammps_table(cmp))
+    if getattr(args, "no_lammps", False):
+        mindlin = {"skipped": "--no-lammps"}
+    else:
+        mindlin = mindlin_comparison(t_end, log=lambda m: print(m, file=sys.stderr, flush=True))
+    print()
+    print(format_mindlin_table(mindlin))
     for r in rows:
         r.pop("final")
-    write_report(args, {"rows": rows, "lammps": cmp})
+    write_report(args, {"rows": rows, "lammps": cmp, "mindlin": mindlin})
     return 0
