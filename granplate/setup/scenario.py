@@ -518,7 +518,7 @@ class Contact:
     tangential_law: the friction law of every granule-granule and granule-wall contact (one
     of TANGENTIAL_LAWS): "tanh", eq. (5), or "mindlin", Mindlin's tangential spring with a
     Coulomb limit mu |N| and history (docs/model.md section 3.16; its mu is `mu` and the
-    pairs' mu, k_s unused; 3D scenarios under solver.scheme "verlet" only);
+    pairs' mu, k_s unused; solver.scheme "verlet" only, in the plane and in space);
     tangential_damping: Mindlin's tangential damping x_t [-] (LAMMPS's `mindlin NULL x_t mu`):
     eta_t = x_t c delta^(1/4), x_t times eq. (3)'s normal damping coefficient (0: none).
     """
