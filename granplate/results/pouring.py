@@ -41,6 +41,9 @@ CHUNK_STEPS = (2000, 40000)
 QUENCH_BELOW = 1e-4
 #: Output rows per chunk (the end state is the last).
 CHUNK_OUTPUTS = 4
+#: Mindlin's tangential damping x_t of a settling with layout.settle_friction (docs/model.md
+#: section 3.16: eta_t = x_t c delta^(1/4), the normal damping's coefficient at x_t = 1).
+SETTLE_TANGENTIAL_DAMPING = 1.0
 
 
 def hertz_contact_time(r: float, rho: float, E: float, nu: float, v: float) -> float:
@@ -73,10 +76,12 @@ def chunk_steps(count: int) -> int:
     return int(min(max(CHUNK_GRANULE_STEPS // max(count, 1), CHUNK_STEPS[0]), CHUNK_STEPS[1]))
 
 
-def loose_scenario(s: Scenario, lay: PouredLayout, alpha_n: float | None) -> Scenario:
+def loose_scenario(s: Scenario, lay: PouredLayout, alpha_n: float | None, friction: float = 0.0) -> Scenario:
     """The generated scenario of the settling: the loose column, the container, the pouring
     gravity, the Verlet scheme at `settling_step`, no plate and no load; alpha_n: the
-    contact damping of every pair, without friction (None: the scenario's own coefficients).
+    contact damping of every pair, without friction (None: the scenario's own coefficients);
+    friction > 0 (with alpha_n): Mindlin's friction of that coefficient instead, with the
+    tangential damping SETTLE_TANGENTIAL_DAMPING.
     The regularised friction (mu tanh(k_s v), docs/model.md section 3.2) holds no static
     load without creeping, so the damped phase settles a frictionless packing, a true
     equilibrium, which friction at rest (v = 0) leaves one."""
@@ -99,6 +104,10 @@ def loose_scenario(s: Scenario, lay: PouredLayout, alpha_n: float | None) -> Sce
     contact = dataclasses.replace(s.contact, overlap_start=None, detection="dynamic")
     if alpha_n is not None:
         contact = dataclasses.replace(contact, alpha_n=alpha_n, mu=0.0, pairs=())
+    if alpha_n is not None and friction > 0.0:
+        contact = dataclasses.replace(
+            contact, mu=friction, tangential_law="mindlin", tangential_damping=SETTLE_TANGENTIAL_DAMPING
+        )
     dt = settling_step(s, lay, g)
     t = dt * chunk_steps(lay.count)
     return Scenario(
@@ -154,21 +163,51 @@ def energies(model, state: np.ndarray, start: np.ndarray, g: tuple[float, ...]) 
     return ke, work
 
 
+class _Chunks:
+    """The settling's chunks of free motion. Without Mindlin's friction each chunk starts
+    afresh from the last one's end state (`_restarted`: its contact lists found anew);
+    with it, each chunk is a restart of the last one's result (`simulate`'s start_from),
+    so that every contact's tangential history goes on. `quench()`: the next chunk starts
+    with the velocities and spins zero."""
+
+    def __init__(self, model, state: np.ndarray):
+        self.model, self.state, self.ds, self.t = model, state, None, 0.0
+        self.chained = model.scenario.contact.tangential_law == "mindlin"
+
+    def run(self) -> np.ndarray:
+        """One more chunk; its end state."""
+        from granplate.results.run import simulate
+
+        s, self.t = self.model.scenario, self.t + self.model.config.t_end
+        with warnings.catch_warnings():  # the settling's impacts may pass yield: the packing is what counts
+            warnings.simplefilter("ignore")
+            if self.chained and self.ds is not None:
+                s = dataclasses.replace(s, time=dataclasses.replace(s.time, t_end=self.t))
+                self.ds = simulate(s, progress=False, start_from=self.ds)
+            else:
+                self.ds = simulate(s, model=_restarted(self.model, self.state), progress=False)
+        self.state = _end_state(self.ds)
+        return self.state.copy()
+
+    def quench(self) -> None:
+        self.state[:, 3:] = 0.0  # velocities and spins (the 2D rotation angle, column 2, stays)
+        if self.chained and self.ds is not None:
+            y = np.array(self.ds["restart_st__y"].values)
+            y[:, 3:] = 0.0
+            self.ds["restart_st__y"].values = y
+
+
 def _phase(model, state, start, g, lay, t_done: float, phase: str, progress: bool, quench: bool = False):
     """Chunks of `model` from `state` until KE <= settle_tolerance x the work of gravity,
     or settle_time is spent: (state, t_done, KE / work, settled). quench: a chunk that ends
     with KE <= QUENCH_BELOW x the work but above the tolerance hands the next one its
     state at rest (velocities and spins zero: granules rolling on a flat floor, which
     nothing in the contact laws stops, stop)."""
-    from granplate.results.run import simulate
-
     chunk = model.config.t_end
+    chunks = _Chunks(model, state)
     ratio = math.inf
     while t_done < lay.settle_time:
-        with warnings.catch_warnings():  # the settling's impacts may pass yield: the packing is what counts
-            warnings.simplefilter("ignore")
-            ds = simulate(model.scenario, model=_restarted(model, state), progress=False)
-        state, t_done = _end_state(ds), t_done + chunk
+        state, t_done = chunks.run(), t_done + chunk
         ke, work = energies(model, state, start, g)
         ratio = ke / work if work > 0.0 else math.inf
         line = f"pouring ({phase}): t = {t_done:.4g} s, kinetic / gravity's work = {ratio:.3g} (to {lay.settle_tolerance:g})"
@@ -178,7 +217,7 @@ def _phase(model, state, start, g, lay, t_done: float, phase: str, progress: boo
         if ratio <= lay.settle_tolerance:
             return state, t_done, ratio, True
         if quench and ratio <= QUENCH_BELOW:
-            state[:, 3:] = 0.0  # velocities and spins (the 2D rotation angle, column 2, stays)
+            chunks.quench()
     return state, t_done, ratio, False
 
 
@@ -187,6 +226,14 @@ def _phase(model, state, start, g, lay, t_done: float, phase: str, progress: boo
 #: longer) was tried: the switch to the real stiffness released its larger overlaps'
 #: energy (kinetic / gravity's work 0.18) and the real phase took longer than it saved.
 PHASES: tuple[tuple[str, str | None], ...] = (("damped", "settle"), ("real contacts", None))
+#: The one phase of a settling with Mindlin's friction (layout.settle_friction > 0): the
+#: packing rests held by its tangential springs, which a fresh phase would start without.
+FRICTIONAL_PHASES: tuple[tuple[str, str | None], ...] = (("damped, Mindlin friction", "settle"),)
+
+
+def phases(lay: PouredLayout) -> tuple[tuple[str, str | None], ...]:
+    """The settling's phases of `lay`: PHASES, or FRICTIONAL_PHASES with settle_friction."""
+    return FRICTIONAL_PHASES if lay.settle_friction > 0.0 else PHASES
 
 
 def settle(s: Scenario, lay: PouredLayout, progress: bool = False) -> dict[str, np.ndarray]:
@@ -202,11 +249,11 @@ def settle(s: Scenario, lay: PouredLayout, progress: bool = False) -> dict[str, 
             return found
         state = start = None
         t, ratio, ok = 0.0, math.inf, True
-        for phase, alpha_n in PHASES:
+        for phase, alpha_n in phases(lay):
             if not ok:
                 break
             damping = lay.settle_damping if alpha_n == "settle" else None
-            model = build_model(loose_scenario(s, lay, damping))
+            model = build_model(loose_scenario(s, lay, damping, lay.settle_friction))
             if state is None:
                 state = start = model.initial_state.copy()
             state, t, ratio, ok = _phase(model, state, start, g, lay, t, phase, progress, quench=damping is not None)

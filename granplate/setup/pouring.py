@@ -36,6 +36,8 @@ RADIUS_RANGE = (1e-9, 1e3)
 CONTAINER_MAX = 1e4
 #: The most granules a poured packing may hold.
 COUNT_MAX = 1_000_000
+#: The largest settling friction coefficient (Mindlin's mu, layout.settle_friction).
+SETTLE_FRICTION_MAX = 2.0
 #: A truncated normal or lognormal draw gives up after this many rounds of redraws.
 REDRAW_ROUNDS = 1000
 
@@ -88,6 +90,15 @@ def check_poured(s: Scenario, lay: PouredLayout) -> None:
     if not lay.settle_damping <= 2.0:
         raise ScenarioError("layout.settle_damping", lay.settle_damping, "must be in (0, 2] (alpha_n of eq. 3)")
     positive("layout.settle_time", lay.settle_time)
+    f = lay.settle_friction
+    if not (is_number(f) and 0.0 <= f <= SETTLE_FRICTION_MAX):
+        raise ScenarioError(
+            "layout.settle_friction", f, f"must be in [0, {SETTLE_FRICTION_MAX:g}] (Mindlin's mu; 0: off)"
+        )
+    if f > 0.0 and s.dimension != 3:
+        raise ScenarioError(
+            "layout.settle_friction", f, "Mindlin's friction runs in space: dimension = 3 (0 in the plane)"
+        )
 
 
 def _check_distribution(lay: PouredLayout) -> None:
@@ -221,9 +232,13 @@ def loose_column(lay: PouredLayout, dimension: int, g: tuple[float, ...], radii:
 
 def store_payload(s: Scenario, lay: PouredLayout) -> dict[str, Any]:
     """What a settled packing depends on: the layout, the dimension, gravity, the
-    materials of granules and walls, and the scenario's contact coefficients."""
+    materials of granules and walls, and the scenario's contact coefficients (a layout
+    without settle_friction keys as before that field existed)."""
+    layout = dataclasses.asdict(lay)
+    if not lay.settle_friction:
+        del layout["settle_friction"]
     return {
-        "layout": dataclasses.asdict(lay),
+        "layout": layout,
         "dimension": s.dimension,
         "g": list(pour_gravity(s, lay)),
         "materials": {m: dataclasses.asdict(s.material(m)) for m in {lay.material, lay.wall_material}},

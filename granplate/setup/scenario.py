@@ -257,7 +257,10 @@ class PouredLayout:
     scenario's [gravity]; one of them is needed, along a coordinate axis) until the
     kinetic energy is at most settle_tolerance x the work gravity did, first with the
     contact damping settle_damping and no friction, then with the scenario's own. settle_time [s]: the
-    longest settling simulated. The settled packing is kept in the run store.
+    longest settling simulated. settle_friction [-] (3D; 0: off): the packing settles instead in one
+    phase of Mindlin's friction of that coefficient (docs/model.md sections 3.14 and 3.16) with the
+    damping settle_damping, and rests as a frictional packing. The settled packing is kept in the
+    run store.
     """
 
     kind: str = "poured"
@@ -276,6 +279,7 @@ class PouredLayout:
     settle_tolerance: float = 1e-9
     settle_damping: float = 1.0
     settle_time: float = 2.0
+    settle_friction: float = 0.0
 
 
 #: `[layout] kind` -> the dataclass that holds that kind's fields.

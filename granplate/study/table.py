@@ -100,6 +100,7 @@ FIELD_UNITS: dict[str, str] = {
     "container": "m",
     "settle_tolerance": "1",
     "settle_damping": "1",
+    "settle_friction": "1",
     "settle_time": "s",
     "dt_min": "s",
     "lambda_target": "1",
