@@ -81,16 +81,21 @@ def contact_yield(model, peaks) -> list[tuple[str, float, float, float, float, s
     return rows
 
 
+def _rows(peaks, index):
+    """The rows `index` (a mask or indices) of ContactPeaks `peaks`; a column it lacks
+    (None) stays None."""
+    return type(peaks)(*(None if a is None else np.asarray(a)[index] for a in peaks))
+
+
 def pair_yield(model, peaks) -> PairYield:
     """The largest p0 of each material pair of the run (`contact_yield`), sorted by pair.
     The granule pairs, most of a large assembly's contacts, are taken by numpy: each pair
     of materials' largest p0 (its first contact in `peaks`' order), whose row
     `contact_yield` then makes, the same numbers as taking every contact's row."""
     on = peaks.partner >= 0
-    rest = type(peaks)(*(np.asarray(a)[~on] for a in peaks))
-    first = type(peaks)(*(np.asarray(a)[on] for a in peaks))
+    rest, first = _rows(peaks, ~on), _rows(peaks, on)
     chosen = pair_maxima(model, first)
-    picked = type(peaks)(*(np.asarray(a)[chosen] for a in first))
+    picked = _rows(first, chosen)
     best: dict[str, tuple] = {}
     for row in contact_yield(model, picked) + contact_yield(model, rest):
         if row[0] not in best or row[1] > best[row[0]][1]:

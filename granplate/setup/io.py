@@ -82,7 +82,9 @@ CHOICES: dict[tuple[type, str], tuple[str, ...]] = {
 }
 #: Fields left out of a written table when they hold this default (written, they would
 #: change the text, and so the stored results' keys, of every scenario written before).
-UNWRITTEN_DEFAULTS: dict[str, dict[str, Any]] = {"contact": {"normal_law": "hertz"}}
+UNWRITTEN_DEFAULTS: dict[str, dict[str, Any]] = {
+    "contact": {"normal_law": "hertz", "tangential_law": "tanh", "tangential_damping": 0.0}
+}
 #: Fields of the three-dimensional mode left out of a two-dimensional scenario's tables
 #: when they hold their default, so that every 2D scenario is written as before
 #: (`dimension = 2` itself is not written either).
