@@ -614,16 +614,9 @@ def mindlin_parted(hist, k, c):
 @njit(cache=True)
 def push_tangential(acc, g, i, a, nx, ny, nz, fx, fy, fz, sign):
     """The tangential force sign * F (F on the first body [N]) and its torque a n x F on
-    granule i as accelerations into acc (as `add_friction`, divided by m and I)."""
-    inv_m = 1.0 / g.mass[i]
-    inv_i = 1.0 / g.inertia[i]
-    acc[i, VX] += sign * fx * inv_m
-    acc[i, VY] += sign * fy * inv_m
-    acc[i, VZ] += sign * fz * inv_m
-    tx, ty, tz = arm_torque_3d(a, nx, ny, nz, fx, fy, fz)
-    acc[i, WX] += tx * inv_i
-    acc[i, WY] += ty * inv_i
-    acc[i, WZ] += tz * inv_i
+    granule i as accelerations into acc (as `add_friction`, divided by m and I): an impulse's
+    update (`apply_friction_impulse`) with the force in place of the impulse."""
+    apply_friction_impulse(acc, i, a, 1.0 / g.mass[i], 1.0 / g.inertia[i], nx, ny, nz, fx, fy, fz, sign)
 
 
 @njit(cache=True)
