@@ -18,6 +18,7 @@ import granplate as gp
 from granplate.commands.modes import granule_fraction, modes_record, piston_fraction
 from granplate.model.arrays import build_model
 from granplate.results.modes import linear_modes
+from tests.test_precompression_drives import SIDE  # a bead between a fixed side wall and a piston
 
 F0 = 10.0
 R = 0.005
@@ -98,25 +99,6 @@ def test_a_sphere_under_a_held_wall_rings_as_two_masses_on_two_springs():
     record = modes_record(modes, ["floor", "top"])
     assert record["pistons"] == [{"wall": "top", "mass": pytest.approx(M)}]
     assert len(record["piston_fraction"]) == len(record["frequencies"]) == 4
-
-
-SIDE = """
-[[walls]]
-label = "left"
-normal = [0.0, -1.0, 0.0]
-offset = {r!r}
-[[walls]]
-label = "right"
-normal = [0.0, 1.0, 0.0]
-offset = {r!r}
-[[drives]]
-target = "wall left"
-kind = "force"
-direction = [0.0, 1.0, 0.0]
-profile = "constant"
-value = {push!r}
-mass = {mass!r}
-"""
 
 
 def test_a_sphere_against_a_force_driven_wall_rings_as_two_masses_on_two_springs():

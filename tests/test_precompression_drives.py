@@ -181,7 +181,7 @@ kind = "force"
 direction = [0.0, 1.0, 0.0]
 profile = "constant"
 value = {push!r}
-mass = 0.01
+mass = {mass!r}
 """
 
 
@@ -192,7 +192,7 @@ def test_a_force_driven_wall_rests_where_its_force_at_t0_is_carried():
     A_w)^(2/3) in from where it started (both overlaps), the floor carries F0; the run starts
     there and nothing moves (the piston's displacement stays below 1e-12 m)."""
     push = 2.0
-    s = column(1, SIDE.format(r=R, push=push), g=0.0)
+    s = column(1, SIDE.format(r=R, push=push, mass=0.01), g=0.0)
     model = build_model(s)
     g = model.granular
     _, (floor, top, left, right) = static_forces(model)
