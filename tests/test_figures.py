@@ -257,6 +257,16 @@ def test_show_result_network_widths_and_plate(steel):
     assert any("contact normal force [N]" in ax.get_xlabel() for ax in fig.axes)
 
 
+def test_default_time_when_the_plate_never_moved(steel):
+    """A plate that never moved (E_plate 0 throughout) gives no plate peak to show: the
+    default time is the output of largest granular energy, named so in the title."""
+    still = steel.copy()
+    still["E_plate"] = still["E_plate"] * 0.0
+    i, note = assembly.choose_time(still, None)
+    assert i == int(np.argmax(steel["E_granular"].values)) and i > 0
+    assert note == "time of the largest granular energy (the plate never moved)"
+
+
 def test_time_outside_the_run_is_refused(steel):
     with pytest.raises(gp.ScenarioError, match="--time"):
         assembly.of_result(steel, 1.0)

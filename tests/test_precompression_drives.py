@@ -213,3 +213,13 @@ def test_a_column_between_the_target_and_a_piston_has_no_support():
     with pytest.raises(ScenarioError) as e:
         build_model(column(2, floor, g=0.0))
     assert e.value.field == "precompression.target"
+
+
+def test_a_sideways_push_at_t0_on_a_column_is_refused_naming_the_drive():
+    """A constant sideways force on a bead of a straight column has no frictionless static
+    equilibrium (no support reacts sideways): refused naming that drive's entry, not a minimiser's
+    'no equilibrium' after its iterations."""
+    drives = FLOOR + drive("granule b2", "force", (1, 0, 0), "constant", value=0.5)
+    with pytest.raises(ScenarioError) as e:
+        build_model(column(4, drives))
+    assert e.value.field == "drives[1]" and "0.5 N no support can react" in str(e.value)

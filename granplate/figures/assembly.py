@@ -262,8 +262,8 @@ def choose_time(ds: xr.Dataset, time: float | None) -> tuple[int, str]:
     """(output index, note for the title) of the time to show.
 
     time None: with a plate, the plate-field snapshot of largest plate energy (so that
-    the deformed plate can be drawn; the true peak time is named too), else the last
-    output. A given time [s] must lie within the run; the nearest output is shown.
+    the deformed plate can be drawn; the true peak time is named too); with a plate that
+    never moved, the output of largest granular energy; else the last output. A given time [s] must lie within the run; the nearest output is shown.
     """
     t = ds["time"].values
     if len(t) == 0:
@@ -274,7 +274,7 @@ def choose_time(ds: xr.Dataset, time: float | None) -> tuple[int, str]:
             raise ScenarioError("--time", time, f"allowed: {t[0]:g} to {t[-1]:g} s (the run's output times)")
         i = int(np.argmin(np.abs(t - time)))
         return i, "the output nearest the requested time"
-    if an.has_plate(ds):
+    if an.has_plate(ds) and float(np.max(ds["E_plate"].values)) > 0.0:
         ep = ds["E_plate"].values
         peak = int(np.argmax(ep))
         if ds.sizes.get("field_time", 0):
@@ -286,6 +286,8 @@ def choose_time(ds: xr.Dataset, time: float | None) -> tuple[int, str]:
                 f"the plate snapshot of largest plate energy; the peak, between snapshots, is at {t[peak] * 1e3:.4g} ms"
             )
         return peak, "time of the largest plate energy"
+    if an.has_plate(ds):
+        return int(np.argmax(ds["E_granular"].values)), "time of the largest granular energy (the plate never moved)"
     return len(t) - 1, "last output time (no plate)"
 
 

@@ -165,7 +165,8 @@ def register(subparsers) -> None:
         "--time",
         type=_time,
         default=None,
-        help="result only: the time shown [s] (default: the largest plate energy; a 3D body: its "
+        help="result only: the time shown [s] (default: the largest plate energy, or the largest granular "
+        "energy where the plate never moved; a 3D body: its "
         "snapshot of the largest von Mises stress; else the last output)",
     )
     s.add_argument(

@@ -359,6 +359,43 @@ def _refuse_unsupported(g, wall: int, target: str, pistons: Pistons) -> None:
         )
 
 
+def _refuse_unbalanced_loads(g, load: np.ndarray, d: int) -> None:
+    """ScenarioError naming the force drive (or gravity.g) whose push no support can react:
+    the assembly's whole load, the drives' pushes at t = 0 `load` (ng, d) [N] and the weight,
+    must lie in the span of the directions the supports push along (the walls' normals, the
+    held granules' drive directions, the plane's plate along x), or the frictionless static
+    state has no equilibrium (a sideways push on a straight column between two walls)."""
+    from scipy.linalg import orth
+
+    from granplate.physics.drives import KIND_FORCE
+
+    grav = np.asarray(g.gravity, float) if len(g.gravity) else np.zeros(d)
+    total = load.sum(axis=0) + float(np.sum(g.mass)) * grav
+    held = [g.drive_dir[k] for k, i in enumerate(g.drive_target) if i >= 0 and g.drive_kind[k] != KIND_FORCE]
+    plate = [np.eye(d)[0]] if len(getattr(g, "pc_i", ())) else []
+    spans = np.array([*g.wall_geo[:, :d], *held, *plate], float).reshape(-1, d)
+    q = orth(spans.T) if len(spans) else np.zeros((d, 0))
+    free = total - q @ (q.T @ total)  # what no support can push back
+    scale = float(np.sum(np.abs(load))) + float(np.sum(g.mass)) * float(np.linalg.norm(grav))
+    if float(np.linalg.norm(free)) <= 1e-9 * max(scale, 1e-300):
+        return
+    for k, i in enumerate(g.drive_target):
+        if i >= 0 and g.drive_kind[k] == KIND_FORCE and abs(float(np.dot(load[i], free))) > 0.0:
+            raise ScenarioError(
+                f"drives[{k}]",
+                f"granule {i + 1}, {np.linalg.norm(load[i]):.4g} N at t = 0",
+                f"its push at t = 0 has {np.linalg.norm(free):.4g} N no support can react: the static state "
+                "is frictionless and its walls and held granules push along other directions (start its "
+                "profile at 0, e.g. a half-sine or a harmonic without a mean, or push along a wall's normal)",
+            )
+    raise ScenarioError(
+        "gravity.g",
+        list(grav),
+        f"the weight has {np.linalg.norm(free):.4g} N along no wall's normal: the frictionless static state "
+        "has no equilibrium (give a wall across gravity)",
+    )
+
+
 def static_state(
     g,
     x0: np.ndarray,
@@ -396,6 +433,7 @@ def static_state(
     basis = granule_freedom(g, d)  # the granules' free coordinates
     nf = basis.shape[1]
     load = drive_loads(g, d)
+    _refuse_unbalanced_loads(g, load, d)
     a_min = float(np.min(g.wall_coef[g.wall_w == wall, COEF_A])) if np.any(g.wall_w == wall) else 1.0
     scale = (force / a_min) ** (2.0 / 3.0)  # the overlap F makes at the wall [m]: the unknowns' unit
 
@@ -441,7 +479,7 @@ def static_state(
     state = StaticState(
         x, float(o[0]), float(offset0), residual(z), steps, float(on_wall[0] + force), u, pf, pistons, o[1:]
     )
-    if state.residual > tolerance:
+    if not state.residual <= tolerance:  # NaN too
         raise SimulationError(
             f"precompression: no static equilibrium to a residual of {tolerance:g} x force after {steps} steps "
             f"(reached {state.residual:.3g}); give more precompression.max_iterations, a looser "
