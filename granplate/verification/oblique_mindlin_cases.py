@@ -273,7 +273,10 @@ def _description(nu: float) -> str:
         "independent integration of the same continuous law (`oblique_mindlin.reference_impact`); the "
         f"gross-sliding line Psi2 = Psi1 - 7 kappa (kappa = 2 (1 - nu)/(2 - nu) = {kappa:.4f}) from Psi1 >= "
         f"7 kappa - 1/3 = {sliding_threshold(nu):.4f}, derived for this law in docs/model.md section 3.16; "
-        "and LAMMPS's `fix wall/gran granular hertz/material ... tangential mindlin_rescale` at the same step."
+        "and LAMMPS's `fix wall/gran granular hertz/material ... tangential mindlin_rescale` at the same step. "
+        "Sources: N. Maw, J. R. Barber, J. N. Fawcett, Wear 38 (1976) 101-114 and J. Lubr. Technol. 103 (1981) "
+        "74-80; A. Di Renzo, F. P. Di Maio, Chem. Eng. Sci. 59 (2004) 525-541 and 60 (2005) 1303-1312; "
+        "C. Thornton, S. J. Cummins, P. W. Cleary, Powder Technol. 210 (2011) 189-197."
     )
 
 
@@ -286,7 +289,8 @@ def _notes(nu: float, conv: dict, with_lammps: bool, curve: dict) -> list[str]:
         f"(e_t = -v_c2 / v_c1 -> {-curve['stick_limit']:.4f}: the contact point does not reverse), Psi2 < 0 from "
         f"Psi1 = {curve['zero']:.3f}, a minimum Psi2 = {curve['min_psi2']:.3f} at Psi1 = {curve['min_psi1']:.2f}, "
         f"the sliding line from Psi1 = {sliding_threshold(nu):.4f} (where Psi2 = -1/3).",
-        "Against Maw, Barber & Fawcett (Mindlin-Deresiewicz partial slip): they find Psi2 < 0 at low Psi1 and "
+        "Against Maw, Barber & Fawcett (Mindlin-Deresiewicz partial slip): they find Psi2 < 0 at low Psi1 (1981, "
+        "a thin diametral slice) and "
         "gross slip over a wider range than rigid-body theory's; this law reproduces the reversal and the "
         "widened sliding range but not the small-Psi1 end, where its spring (no micro-slip, stiffness 8 G* a "
         "up to the cap, the displacement rescaled with a while unloading) returns the contact point forward. "
