@@ -71,3 +71,22 @@ def test_rebound_agrees_with_lammps_at_the_same_step(psi1):
     """LAMMPS's fix wall/gran with hertz/material and tangential mindlin_rescale, velocity
     Verlet at the same step: the rebound speeds agree to 1e-6 of v_n (measured 5e-14)."""
     assert C.speed_difference(C.granplate_impact(psi1), C.lammps_impact(psi1)) < 1e-6
+
+
+def test_the_normalised_curve_depends_on_nothing_but_poissons_ratio():
+    """Hertz's and Mindlin's laws are self-similar: the integration's Psi2 at a given Psi1 is
+    the same at ten times the normal speed and twice the density (to 1e-8), so the curve is
+    one per nu, as Maw, Barber & Fawcett's."""
+    mat = LIBRARY[C.MATERIAL]
+    base = C.reference_of(2.5).psi2
+    for v_n, rho in ((2.0, mat.rho), (C.V_N, 2.0 * mat.rho)):
+        v_c1 = C.tangential_speed(2.5, NU, v_n=v_n)
+        other = C.reference_impact(v_n, v_c1, C.RADIUS, mat.E, NU, rho, C.MU)
+        assert abs(other.psi2 - base) < 1e-8
+
+
+@pytest.mark.skipif(bool(L.unavailable()), reason=L.unavailable() or "lammps available")
+def test_equal_spheres_agree_with_lammps_at_the_same_step():
+    """Two equal spheres in stick-slip (Psi1 = 2.5) with LAMMPS's arms against pair granular
+    hertz/material + mindlin_rescale: both spheres' speeds and R omega to 1e-6 of v_n."""
+    assert C.pair_difference(C.pair_impact(2.5, "lammps"), C.lammps_pair(2.5)) < 1e-6

@@ -135,6 +135,105 @@ def speed_difference(a: Rebound, b: Rebound) -> float:
     return max(abs(a.v_n2 - b.v_n2), abs(a.v_t2 - b.v_t2), RADIUS * abs(a.omega2 - b.omega2)) / V_N
 
 
+#: Psi1 of the equal-sphere impacts: against the flat's curve (torque_arm "radius") and,
+#: with LAMMPS's arms, against LAMMPS.
+PAIR_PSI1 = (1.0, 2.5, 4.0, 7.0)
+PAIR_LAMMPS_PSI1 = (2.5,)
+
+
+def pair_scenario(psi1: float, dt: float = STEP, arm: str = "radius"):
+    """Two equal spheres meeting along z at the relative normal speed V_N and the relative
+    tangential speed v_c1(psi1) along x (each half of it, opposite; no spin), GAP apart; as
+    `impact_scenario` otherwise. Relative to each other they are a sphere of mass sqrt(2) m
+    on a rigid flat (E* and R* halved, k_t scaled alike) but for their line of centres,
+    which turns as they slide past each other."""
+    import dataclasses
+
+    from granplate.setup.scenario import Granule
+
+    s = impact_scenario(psi1, dt, arm)
+    g = s.granules[0]
+    top = dataclasses.replace(g, z=RADIUS + GAP / 2, vx=g.vx / 2, vz=-V_N / 2, label="a")
+    low = Granule(
+        x=0.0,
+        y=0.0,
+        z=-(RADIUS + GAP / 2),
+        radius=RADIUS,
+        material=MATERIAL,
+        label="b",
+        vx=-g.vx / 2,
+        vz=V_N / 2,
+        omega=(0.0, 0.0, 0.0),
+    )
+    t_end = s.time.t_end * 1.25  # the contact lasts 2^(1/5) times the flat's
+    n = int(math.ceil(t_end / dt / 4.0)) * 4
+    t_end = n * dt
+    time = dataclasses.replace(s.time, t_end=t_end, output_interval=t_end / 4, field_interval=t_end)
+    return dataclasses.replace(s, name=f"mindlin-pair-{psi1:g}", granules=(top, low), walls=(), time=time)
+
+
+def pair_relative(vx, vz, wy) -> tuple[float, float]:
+    """(relative normal speed apart [m/s], Psi2) of the pair's final velocities (a, b)."""
+    v_c2 = (vx[0] - vx[1]) - RADIUS * (wy[0] + wy[1])
+    return float(vz[0] - vz[1]), normalised_angle(float(v_c2), V_N, MU, LIBRARY[MATERIAL].nu)
+
+
+def pair_impact(psi1: float, arm: str = "radius", dt: float = STEP) -> dict:
+    """granplate's pair at Psi1: the final vx, vz, omega_y (a, b), the relative v_n2, Psi2."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        last = simulate(pair_scenario(psi1, dt, arm)).isel(time=-1)
+    out = {k: last[k].values.astype(float) for k in ("vx", "vz", "omega_y")}
+    out["v_n2"], out["psi2"] = pair_relative(out["vx"], out["vz"], out["omega_y"])
+    return out
+
+
+def lammps_pair(psi1: float, dt: float = STEP) -> dict:
+    """LAMMPS's pair (`pair granular` hertz/material + mindlin_rescale) at Psi1, as `pair_impact`."""
+    from .lammps import run_hertz_3d
+
+    s = pair_scenario(psi1, dt, "lammps")
+    lm = run_hertz_3d(s, dt, s.time.t_end)
+    out = {"vx": lm["vx"][-1], "vz": lm["vz"][-1], "omega_y": lm["wy"][-1]}
+    out["v_n2"], out["psi2"] = pair_relative(out["vx"], out["vz"], out["omega_y"])
+    return out
+
+
+def pair_difference(a: dict, b: dict) -> float:
+    """The largest difference of the two spheres' vx, vz and R omega_y, over V_N [-]."""
+    worst = max(float(np.abs(a[k] - b[k]).max()) for k in ("vx", "vz"))
+    return max(worst, RADIUS * float(np.abs(a["omega_y"] - b["omega_y"]).max())) / V_N
+
+
+def _pair_checks(ref_of, with_lammps: bool) -> tuple[list, dict, str]:
+    """The equal spheres: LAMMPS's pair at the same step (a check), and their Psi2 beside
+    the flat's curve (a note: the line of centres turns by about v_c t_c / (2 R) while they
+    slide past each other, which the flat's fixed normal does not)."""
+    runs = {p: pair_impact(p) for p in PAIR_PSI1}
+    checks = []
+    for p in PAIR_LAMMPS_PSI1 if with_lammps else ():
+        diff = pair_difference(pair_impact(p, "lammps"), lammps_pair(p))
+        checks.append(
+            Check(
+                f"equal spheres vs LAMMPS, Psi1 = {p:g}, speeds and R omega, max diff / v_n",
+                "-",
+                0.0,
+                "LAMMPS pair granular hertz/material + tangential mindlin_rescale, velocity Verlet (same step)",
+                diff,
+                LAMMPS_TOL,
+                'the same law, step and arms (contact.torque_arm = "lammps"): round-off',
+                "max",
+            )
+        )
+    gaps = ", ".join(f"Psi1 = {p:g}: {r['psi2'] - ref_of(p).psi2:+.1e}" for p, r in runs.items())
+    note = (
+        "Two equal spheres (relative speeds as the flat's, each sphere half of them; contact.torque_arm = "
+        '"radius"): in the normalised angles their problem is the flat\'s but for the line of centres, which '
+        f"turns as they slide past each other; Psi2 - the flat's curve: {gaps}, growing with the slide."
+    )
+    return checks, {"pair_psi1": list(runs), "pair": [r["psi2"] for r in runs.values()]}, note
+
+
 def regime(psi1: float) -> str:
     """The name of Psi1's range on the curve (steel, nu = 0.3)."""
     if psi1 >= sliding_threshold(LIBRARY[MATERIAL].nu):
@@ -183,8 +282,10 @@ def mindlin_curve(ctx: Context) -> CaseResult:
                 kind="max",
             )
         )
+    pair_checks, pair_plot, pair_note = _pair_checks(reference_of, bool(side))
+    checks += pair_checks
     curve = reference_curve()
-    notes = _notes(nu, conv, bool(side), curve)
+    notes = _notes(nu, conv, bool(side), curve) + [pair_note]
     plot = {
         "psi1": list(PSI1),
         "ours": [r.psi2 for r in ours],
@@ -193,6 +294,7 @@ def mindlin_curve(ctx: Context) -> CaseResult:
         "lammps": [r.psi2 for _, r in side],
         "nu": nu,
         "curve": curve,
+        **pair_plot,
     }
     return CaseResult.of(_description(nu), checks, notes=notes, tables=[_table(ours, ref)], plot=plot)
 
@@ -322,6 +424,7 @@ def draw_mindlin_curve(p: dict):
     nu = p["nu"]
     ax.plot(curve["psi1"], curve["psi2"], "k-", lw=2.5, alpha=0.3, label="independent integration")
     ax.plot(p["psi1"], p["ours"], "C0o", ms=5, mfc="none", label="granplate (verlet, 2 ns)")
+    ax.plot(p["pair_psi1"], p["pair"], "C1s", ms=5, mfc="none", label="granplate, two equal spheres (normal turns)")
     if p["lammps_psi1"]:
         ax.plot(p["lammps_psi1"], p["lammps"], "C3x", ms=8, label="LAMMPS mindlin_rescale (2 ns)")
     x = np.array([sliding_threshold(nu) - 2.0, 10.0])
@@ -330,7 +433,7 @@ def draw_mindlin_curve(p: dict):
     ax.axhline(0.0, color="0.5", lw=0.5)
     ax.set_xlabel("Psi1 = 2(1-nu)/(mu(2-nu)) v_c1 / v_n  [-]")
     ax.set_ylabel("Psi2 = 2(1-nu)/(mu(2-nu)) v_c2 / v_n  [-]")
-    ax.set_title("Sphere on a rigid floor, Mindlin friction: recoil against incidence", fontsize=9)
+    ax.set_title("Oblique impacts under Mindlin friction (steel, nu = 0.3, mu = 0.3)", fontsize=9)
     ax.legend(fontsize=8)
     return fig
 
