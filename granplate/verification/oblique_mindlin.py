@@ -33,6 +33,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from .impact_theory import HERTZ_TIME_CONSTANT
+
 #: Source line of the independent integration.
 REFERENCE_SOURCE = (
     "scipy DOP853 of the continuous law (Hertz, Mindlin's spring 8 G* a rescaled with a, Coulomb's cap; "
@@ -73,7 +75,7 @@ def sliding_threshold(nu: float) -> float:
     return 7.0 * stiffness_ratio(nu) - 1.0 / 3.0
 
 
-def slip_onset(nu: float) -> float:
+def slip_onset() -> float:
     """Psi1 below which the contact sticks at first touch [-]: 2/3 (xi = v_c1 t with k_t
     ~ t^(1/2) against mu N ~ t^(3/2): k_t xi / (mu N) -> 3/2 Psi1 as t -> 0)."""
     return 2.0 / 3.0
@@ -159,9 +161,9 @@ def reference_impact(
     rho [kg/m^3]."""
     k = impact_constants(radius, young, nu, rho, mu)
     m = k["m"]
-    t_c = 2.9432 * (15.0 * m * v_n**2 / (16.0 * k["A"])) ** 0.4 / v_n
+    t_c = HERTZ_TIME_CONSTANT * (15.0 * m * v_n**2 / (16.0 * k["A"])) ** 0.4 / v_n
     y = np.array([0.0, v_n, 0.0])
-    stick = normalised_angle(abs(v_c1), v_n, mu, nu) < slip_onset(nu)
+    stick = normalised_angle(abs(v_c1), v_n, mu, nu) < slip_onset()
     s = math.copysign(1.0, v_c1)
     xi = 0.0
     t = 0.0
