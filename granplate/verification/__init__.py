@@ -19,6 +19,9 @@ the page this writes, regenerated with --full):
 - space_cases.py: spheres in space (`dimension = 3`): the chain equal to the plane's, head-on
   and oblique impacts with spins about every axis (closed forms, the independent 3D
   integrator of space.py), rolling on a wall, momenta of a free assembly, Thornton's law;
+- oblique_mindlin_cases.py: Mindlin friction on the whole oblique-impact curve (Psi2
+  against Psi1) against an independent integration of the law (oblique_mindlin.py), the
+  gross-sliding line and LAMMPS;
 - plastic_cases.py: yielding impacts (Thornton's elastic-plastic law) on a wall and on a
   sphere against Thornton's restitution, the yield velocity and overlap, the force-overlap
   loop measured from the trajectory, and Y -> infinity as Hertz (plastic.py: the closed
@@ -82,6 +85,7 @@ def all_cases() -> tuple:
         gravity_cases,
         lammps,
         measured_cases,
+        oblique_mindlin_cases,
         plastic_cases,
         plate_cases,
         plate_mesh,
@@ -105,6 +109,7 @@ def all_cases() -> tuple:
         + measured_cases.CASES
         + space_cases.CASES
         + space_lammps
+        + oblique_mindlin_cases.CASES
         + plate_cases.CASES
         + plate_mesh.CASES
         + solid_cases.CASES
