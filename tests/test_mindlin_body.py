@@ -42,12 +42,15 @@ def scenario(
     t_end: float = 3e-5,
     n_out: int = 6,
     mu: float = 0.3,
+    alpha_n: float = 0.0,
+    x_t: float = 0.0,
 ) -> gp.Scenario:
     """A steel sphere (R = 2 mm) above the top face of a clamped 20 x 20 x 10 mm block of
     Young's modulus block_e [Pa] (steel's nu and density; 3 x 3 x 2 hex20, a point patch,
     modes to 150 kHz), or of a rigid steel floor there (block_e None), off the face's
     nodes; launched at (vx, 0, vz) [m/s] with spin (0, wy, 0) [rad/s], optionally pressed
-    by a constant force [N] along -z; undamped, Mindlin's law, velocity Verlet at dt [s]."""
+    by a constant force [N] along -z; Mindlin's law (damping alpha_n, tangential x_t: none by
+    default), velocity Verlet at dt [s]."""
     out = t_end / n_out
     body = (
         '[[walls]]\nnormal = [0.0, 0.0, -1.0]\noffset = -0.01\nmaterial = "steel"\n'
@@ -80,9 +83,10 @@ omega = [0.0, {wy!r}, 0.0]
 kind = "none"
 [contact]
 mu = {mu!r}
-alpha_n = 0.0
+alpha_n = {alpha_n!r}
 pairs = []
 tangential_law = "mindlin"
+tangential_damping = {x_t!r}
 overlap_start = 1e-3
 [time]
 t_end = {t_end!r}
@@ -195,15 +199,17 @@ def test_a_stiffening_block_approaches_the_rigid_floors_run():
     assert 6.0 < gaps[0] / gaps[1] < 14.0  # as 1 / E (10)
 
 
-def test_energy_balance_holds_to_second_order_in_the_step():
+@pytest.mark.parametrize("alpha_n, x_t", [(0.0, 0.0), (0.2, 1.0)])
+def test_energy_balance_holds_to_second_order_in_the_step(alpha_n, x_t):
     """Eq. (11), E_p + E_g + D = E_in at every output, with the springs' energy in E_g and
-    the slip's work in D_friction, for a sphere sliding across a steel block: the largest
+    the slip's work in D_friction, for a sphere sliding across a steel block, undamped and
+    with normal and tangential damping (the latter's work in D_friction too): the largest
     residual (relative to the energy in) falls 4x as the step halves (Verlet's own error; 1.2e-7
-    without friction), under 3e-7 at 10 ns (measured 1.7e-7, while D_friction takes 0.18 of
-    the energy in); D_friction converged to 1e-4."""
+    without friction), under 3e-7 at 10 ns (measured 1.7e-7 undamped, 1.3e-7 damped, while
+    D_friction takes 0.18-0.19 of the energy in); D_friction converged to 1e-4."""
     worst, lost = [], []
     for dt in (1e-8, 5e-9):
-        ds = run(scenario(vx=0.3, vz=-0.2, dt=dt, n_out=30))
+        ds = run(scenario(vx=0.3, vz=-0.2, dt=dt, n_out=30, alpha_n=alpha_n, x_t=x_t))
         worst.append(float(np.abs(ds["energy_residual"].values).max()))
         lost.append(float(ds["D_friction"].values[-1]))
         e_in = float(ds.attrs["E_initial"])
