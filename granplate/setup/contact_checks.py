@@ -114,13 +114,15 @@ def _check_contact(s: Scenario) -> None:
 #: Where Mindlin's tangential law runs (Contact.tangential_law = "mindlin").
 MINDLIN_SUPPORT = (
     "Mindlin's law runs in the plane and in space (dimension = 2 or 3) under solver.scheme = 'verlet', at "
-    "granule-granule and granule-wall contacts, without a [plate] (elastic body)"
+    "granule-granule and granule-wall contacts, and in space at the granules' contacts on the elastic "
+    "solid ([plate] of dimension = 3); not with the plane's [plate]"
 )
 
 
 def _check_tangential_law(s: Scenario) -> None:
     """contact.tangential_law is one of TANGENTIAL_LAWS; "mindlin" only where it runs
-    (MINDLIN_SUPPORT) and with every granule material's Poisson ratio (its G*, eq. M1)."""
+    (MINDLIN_SUPPORT) and with the Poisson ratio of every granule material and of the
+    elastic solid's (their G*, eq. M1)."""
     c = s.contact
     string_in("contact.tangential_law", c.tangential_law, TANGENTIAL_LAWS)
     nonneg("contact.tangential_damping", c.tangential_damping)
@@ -149,9 +151,12 @@ def _check_tangential_law(s: Scenario) -> None:
         raise ScenarioError(
             "contact.tangential_law", c.tangential_law, f"{MINDLIN_SUPPORT}; not solver.scheme = {s.solver.scheme!r}"
         )
-    if s.plate is not None:
-        raise ScenarioError("contact.tangential_law", c.tangential_law, f"{MINDLIN_SUPPORT}; not with a [plate]")
-    for m in dict.fromkeys(g.material for g in s.granules):
+    if s.plate is not None and s.dimension != 3:
+        raise ScenarioError(
+            "contact.tangential_law", c.tangential_law, f"{MINDLIN_SUPPORT} (here: the plane's [plate], dimension = 2)"
+        )
+    solid = [s.plate.material] if s.plate is not None else []
+    for m in dict.fromkeys([*(g.material for g in s.granules), *solid]):
         nu = s.material(m).nu
         if not isinstance(nu, (int, float)) or isinstance(nu, bool) or not -1.0 < nu <= 0.5:
             raise ScenarioError(

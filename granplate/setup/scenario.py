@@ -463,7 +463,8 @@ NORMAL_LAWS: tuple[str, ...] = ("hertz", "thornton", "johnson")
 #: Tangential laws (Contact.tangential_law): "tanh", eq. (5)'s regularised Coulomb law
 #: without history (the paper's), and "mindlin", Mindlin's tangential spring 8 G* a with a
 #: Coulomb limit mu |N| and each contact's elastic tangential displacement as history
-#: (docs/model.md section 3.16; in space, under the scheme "verlet").
+#: (docs/model.md section 3.16; under the scheme "verlet", in the plane and in space, and
+#: on the elastic solid in space).
 TANGENTIAL_LAWS: tuple[str, ...] = ("tanh", "mindlin")
 
 
@@ -519,10 +520,11 @@ class Contact:
     arm R_i and the torque at R_i - delta/2 between spheres (R_i at a wall), for a side by
     side run with LAMMPS; the arms differ, so the couples' extra work is booked in
     D_friction (docs/model.md section 3.16).
-    tangential_law: the friction law of every granule-granule and granule-wall contact (one
-    of TANGENTIAL_LAWS): "tanh", eq. (5), or "mindlin", Mindlin's tangential spring with a
-    Coulomb limit mu |N| and history (docs/model.md section 3.16; its mu is `mu` and the
-    pairs' mu, k_s unused; solver.scheme "verlet" only, in the plane and in space);
+    tangential_law: the friction law of every granule-granule and granule-wall contact and
+    of the granules' contacts on the elastic solid in space (one of TANGENTIAL_LAWS):
+    "tanh", eq. (5), or "mindlin", Mindlin's tangential spring with a Coulomb limit mu |N|
+    and history (docs/model.md section 3.16; its mu is `mu` and the pairs' mu, k_s unused;
+    solver.scheme "verlet" only, in the plane and in space; not with the plane's plate);
     tangential_damping: Mindlin's tangential damping x_t [-] (LAMMPS's `mindlin NULL x_t mu`):
     eta_t = x_t c delta^(1/4), x_t times eq. (3)'s normal damping coefficient (0: none).
     """

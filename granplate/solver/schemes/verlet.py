@@ -17,7 +17,9 @@ Under Mindlin's tangential law (contact.tangential_law = "mindlin", docs/model.m
 3.16) there is no split friction at those contacts: after the force pass of step 3,
 `mindlin_forces` adds each contact's tangential spring force, its history moved on by the
 slip at the half-step velocities (the drift's), as LAMMPS's; its stored energy joins the
-contacts' and its losses (eq. M6) D_friction.
+contacts' and its losses (eq. M6) D_friction. At an elastic body's contacts the same law runs
+after the body's force pass (solver.body_mindlin), its slip against the surface's motion
+over the step.
 
 The work of each kick is booked exactly as the kinetic energy it adds: h/2 F v_mean for
 the damping part of the force (D_visc) and the load (E_shock; a line load on the elastic
@@ -43,6 +45,7 @@ from granplate.model.inputs import STATE_COLUMNS, BodyArrays, new_body_state, no
 from granplate.physics.contact import COEF_MU
 from granplate.physics.shock import shock_amplitude
 from granplate.solver import body as B
+from granplate.solver.body_mindlin import mindlin_forces as body_mindlin, step_forces as body_step_mindlin
 from granplate.solver.blocks import N_FPAR, N_SPAR, copy_rows, kick_blocks, kick_drift_blocks
 from granplate.solver.dimension import friction_flow, mindlin_forces, normal_forces, normal_forces_blocks
 from granplate.solver.drives import (
@@ -191,6 +194,7 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
         force_pass(t, st.y, g, cfg, st.k1, sw.fdamp[cur], sw.fload[cur], sw)
         if body:
             body_pass(st.y, sw, cur, st.q, st.qd, g, cfg, st.k1, sw.fdamp)
+            body_mindlin(st.y, st.qd, b, cur, cur, 0.0, g.radius, g.mass, g.inertia, cfg.arm_shrink, st.k1)
         mindlin_forces(st.y, st.y, 0.0, g, cfg, st.k1)  # the committed tangential histories' forces
         finish_pass(st.y, st.k1, g)
     _, pd0 = wall_powers(g)  # the damping power at the driven walls' velocities at t_n
@@ -228,7 +232,11 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
     ovl_j = pr.ovl_j
     if body:
         ep_b, pv_b, wp_b, _, ovl_b, i_b = body_pass(w.ytmp, sw, nxt, b.q, b.qdp, g, cfg, w.kend, sw.fdamp)
-        e_pot += ep_b
+        e_bt, lost_bt = body_step_mindlin(
+            y, st.q, b.q, b, cur, nxt, h, g.radius, g.mass, g.inertia, cfg.arm_shrink, w.kend
+        )  # Mindlin's law on the body: the slip over h against the surface's motion
+        fric += lost_bt
+        e_pot += ep_b + e_bt
         p_visc += pv_b
         w_plastic += wp_b
         if ovl_b > ovl:
