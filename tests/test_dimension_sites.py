@@ -1,11 +1,12 @@
-"""The dimension lives in one place (docs/architecture.md, "Where the dimension lives"):
+r"""The dimension lives in one place (docs/architecture.md, "Where the dimension lives"):
 the explicit tests of the dimension outside `setup`, counted line by line with PATTERN over
 the package's source, stay at most LIMIT; and what each dimension names agrees with the
 loop's state columns and the Dataset's variables.
 
-The count, as a shell command from the repository's root:
+The count, as a shell command from the repository's root (GNU grep; the same lines):
 
-    grep -rnE '<PATTERN>' granplate --include=*.py | grep -v '^granplate/setup/'
+    grep -rnE '\bdim(ension)?"?(, ?[23]\))? ?[!=]= ?"?[23]\b|dimension_of\([^)]*\) ?[!=]=|\bis_space\b|\.ndim ?== ?3|"(z|vz|omega_[xyz]|KE_depth)" (not )?in\b|shape\[[0-9]\] ?[!=]= ?[69]\b|_module_of\([^)]*\) is\b|== ?"Granular3?"|dimension not in \(' \
+        granplate --include=*.py | grep -v '^granplate/setup/'
 """
 
 from __future__ import annotations
