@@ -57,17 +57,29 @@ def _cmd_bench(args) -> int:
         from granplate.bench import solid_coupled
 
         return int(solid_coupled.main(args))
-    if getattr(args, "solid", False) or (getattr(args, "plates", False) and args.dimension == 3):
+    if getattr(args, "solid", False):
         from granplate.bench import solid
 
         return int(solid.main(args))
     if getattr(args, "plates", False):
-        from granplate.bench import plates
-
-        return int(plates.main(args))
+        return _cmd_plates(args)
     from granplate.bench import harness
 
     return int(harness.main(args))
+
+
+#: `--plates`' benchmark module by the dimension's name (model.dimension): the plane's
+#: plate meshes, or with --dimension 3 the 3D solid's rows (as --solid)
+PLATE_BENCHES = {"plane": "plates", "space": "solid"}
+
+
+def _cmd_plates(args) -> int:
+    import importlib
+
+    from granplate.model.dimension import DIMENSIONS, PLANE
+
+    dim = DIMENSIONS.get(getattr(args, "dimension", None), PLANE)
+    return int(importlib.import_module(f"granplate.bench.{PLATE_BENCHES[dim.name]}").main(args))
 
 
 def register(subparsers) -> None:

@@ -307,14 +307,19 @@ def main(args) -> int:
     if check_scheme(scheme):
         print(f"granplate: error: {check_scheme(scheme)}", file=sys.stderr)
         return 2
+    from granplate.model.dimension import of_number
+
     dimension = getattr(args, "dimension", None) or 2
-    if dimension not in (2, 3):
+    try:
+        dim = of_number(dimension)
+    except ValueError:
         print(f"granplate: error: --dimension {dimension}: allowed 2 (the plane) or 3 (space)", file=sys.stderr)
         return 2
-    if dimension == 3:
-        from granplate.bench import scaling_space
+    return int(SCALINGS[dim.name](args, t_end, scheme))
 
-        return scaling_space.main(args, t_end, scheme)
+
+def plane_main(args, t_end: float, scheme: str) -> int:
+    """The plane's scaling table (`main`, --dimension 2): a launched hexagonal packing per size."""
     try:
         sizes = parse_sizes(args.sizes) if getattr(args, "sizes", None) else SIZES
     except ValueError as err:
@@ -325,3 +330,14 @@ def main(args) -> int:
     print(format_scaling_table(rows))
     write_report(args, rows)
     return 1 if any("failed" in r or "failed" in (r.get("lammps") or {}) for r in rows) else 0
+
+
+def _space_main(args, t_end: float, scheme: str) -> int:
+    from granplate.bench import scaling_space
+
+    return int(scaling_space.main(args, t_end, scheme))
+
+
+#: the scaling table by the dimension's name (model.dimension): the plane's, or space's
+#: (bench.scaling_space)
+SCALINGS = {"plane": plane_main, "space": _space_main}

@@ -7,6 +7,7 @@
 - `space`: the same for an assembly in space (dimension = 3): three orthogonal
   projections, spheres depth-sorted and depth-shaded, walls as their traces, contact
   lines with width by force, an elastic body deformed; the frames of `granplate animate`;
+- `drawing`: either dimension's assembly drawn (`DRAWINGS`, by the dimension's name);
 - `run`: the generic figures of any result (energies, plate contact forces, plate
   stress and strain, a 3D body's stress and contact forces, granule speeds), each
   skipped when the run lacks its quantities;

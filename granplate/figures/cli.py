@@ -49,26 +49,16 @@ def add_set_option(parser, what: str = "the scenario") -> None:
 def show_figure(target: str, time: float | None = None, changes: dict | None = None):
     """The figure of a scenario (TOML file or preset name, with `changes` by dotted path) or
     of a result file at `time` [s]; (figure, default output name)."""
-    from granplate.figures import assembly, show, space
+    from granplate.figures.drawing import result_figure, scenario_figure
     from granplate.setup.io import load_scenario
 
     if Path(target).suffix.lower() in RESULT_SUFFIXES:
         if changes:
             raise ScenarioError("--set", ", ".join(changes), "allowed only with a scenario, not a result file (.nc)")
-        ds = _read_result(target)
-        if space.is_space(ds):
-            a = space.of_result(ds, time)
-            return space.draw(a), f"{a.name}.png"
-        a = assembly.of_result(ds, time)
-    else:
-        if time is not None:
-            raise ScenarioError("--time", time, "allowed only with a result file (.nc), not a scenario")
-        scenario = load_scenario(target, changes)
-        if scenario.dimension == 3:
-            a = space.of_scenario(scenario)
-            return space.draw(a), f"{a.name}.png"
-        a = assembly.of_scenario(scenario)
-    return show.draw(a), f"{a.name}.png"
+        return result_figure(_read_result(target), time)
+    if time is not None:
+        raise ScenarioError("--time", time, "allowed only with a result file (.nc), not a scenario")
+    return scenario_figure(load_scenario(target, changes))
 
 
 def _cmd_show(args) -> int:

@@ -22,13 +22,15 @@ granules), None when it can; `figures(ds)` builds those it can. Time in ms throu
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
 
 from granplate.figures.common import new_figure, plot_curves, scenario_name, time_axis
 from granplate.results import analysis as an
-from granplate.results.dataset import dimension_of, has_solid
+from granplate.results.dataset import dimension_spec, has_solid
 
 #: Beyond this many granules the speeds are drawn as an envelope.
 MAX_LABELLED = 8
@@ -134,8 +136,9 @@ def energy_curves(ds: xr.Dataset) -> dict[str, tuple[str, np.ndarray]]:
         body = "" if an.has_plate(ds) else ", the elastic body"
         out["plate"] = ("$E_{plate}$" + body, ds["E_plate"].values)
         parts.append(("E_{plate}", ds["E_plate"].values))
-    if dimension_of(ds) == 3 and "KE_depth" in ds:  # in space: the kinetic energy along z, a part of E_granular
-        out["depth"] = ("$KE_{depth}$, translation along z (part of $E_{granular}$)", ds["KE_depth"].values)
+    for name in dimension_spec(ds).depth_energies:  # in space: the kinetic energy along z, a part of E_granular
+        if name in ds:
+            out["depth"] = ("$KE_{depth}$, translation along z (part of $E_{granular}$)", ds[name].values)
     dissipated = ds["D_viscous"].values + ds["D_friction"].values
     if plastic_work(ds) is not None:
         dissipated = dissipated + ds["D_plastic"].values
@@ -255,8 +258,7 @@ def fig_stress_strain(ds: xr.Dataset) -> Figure:
 
 def granule_speeds(ds: xr.Dataset) -> np.ndarray:
     """|v| = sqrt(vx^2 + vy^2 (+ vz^2 in space)) [m/s], shape (time, granule)."""
-    v = np.hypot(ds["vx"].values, ds["vy"].values)
-    return np.hypot(v, ds["vz"].values) if dimension_of(ds) == 3 else v
+    return functools.reduce(np.hypot, (ds[k].values for k in dimension_spec(ds).velocities))
 
 
 def fig_granule_speeds(ds: xr.Dataset) -> Figure:

@@ -54,7 +54,7 @@ from matplotlib.patches import Circle, Patch
 
 from granplate.figures.common import material_colours, new_figure, readable_duration
 from granplate.setup.scenario import Load, Scenario, Wall
-from granplate.results.dataset import dimension_of
+from granplate.model.dimension import SPACE
 
 MM = 1e3  # m -> mm
 
@@ -202,15 +202,10 @@ def result_links(ds: xr.Dataset, ti: int) -> tuple[np.ndarray, np.ndarray, np.nd
 # --------------------------------------------------------------------------------------
 # Builders
 # --------------------------------------------------------------------------------------
-def is_space(ds: xr.Dataset) -> bool:
-    """Whether a result is of a 3D run (`results.dataset.dimension_of`)."""
-    return dimension_of(ds) == 3
-
-
 def positions(ds: xr.Dataset, upto: int | None = None) -> np.ndarray:
     """Centres (time, granule, 3) [m] of a 3D result (up to output index `upto`, inclusive)."""
     sl = slice(None) if upto is None else slice(0, upto + 1)
-    return np.stack([ds[k].values[sl] for k in ("x", "y", "z")], axis=-1).astype(float)
+    return np.stack([ds[k].values[sl] for k in SPACE.positions], axis=-1).astype(float)
 
 
 def solid_drawing(s: Scenario, written: Scenario | None = None) -> dict:
@@ -338,7 +333,7 @@ def _assembly_at(
     and `body_drawing`; scales: stress_top, force_top."""
     from granplate.model.space import loaded_granules_3d
 
-    pos, p0 = (np.stack([ds[k].values[o] for k in ("x", "y", "z")], axis=-1).astype(float) for o in (ti, 0))
+    pos, p0 = (np.stack([ds[k].values[o] for k in SPACE.positions], axis=-1).astype(float) for o in (ti, 0))
     r = np.asarray(ds["radius"].values, float)
     pairs, wc, forces = result_links(ds, ti)
     segs, kinds = contact_segments(pos, s.walls, pairs, wc)

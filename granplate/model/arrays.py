@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from granplate.model.contacts import contact_lists, fixed_wall_contacts
+from granplate.model.dimension import of_number
 from granplate.model.drives import drive_fields, driven_initial_state
 from granplate.model.inputs import Config, Granular, PlateArrays, no_history, scheme_number
 from granplate.errors import ScenarioError
@@ -313,17 +314,28 @@ def initial_state(s: Scenario, x: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 
 def build_model(scenario: Scenario) -> Model:
-    """Validate, resolve and turn a scenario into the loop's arrays (in space, dimension =
-    3: `model.space.build_space_model`)."""
-    from granplate.model.plate_weight import weighed
+    """Validate, resolve and turn a scenario into the loop's arrays, by its dimension's
+    builder (`MODEL_BUILDERS`: `plane_model`, or in space `model.space.build_space_model`),
+    from its static state where it has one (`model.static.precompressed`)."""
     from granplate.model.static import precompressed
 
     validate(scenario)
     s = resolve(scenario)
-    if s.dimension == 3:
-        from granplate.model.space import build_space_model
+    return precompressed(MODEL_BUILDERS[of_number(s.dimension).name](s))
 
-        return precompressed(build_space_model(s))
+
+def space_model(s: Scenario) -> Model:
+    """The loop's arrays of resolved scenario `s` in space (`model.space.build_space_model`)."""
+    from granplate.model.space import build_space_model
+
+    return build_space_model(s)
+
+
+def plane_model(s: Scenario) -> Model:
+    """The loop's arrays of resolved scenario `s` in the plane, its plate in its sag under
+    its own weight (`model.plate_weight.weighed`)."""
+    from granplate.model.plate_weight import weighed
+
     x, y, r, rho = _granule_arrays(s)
     mats = [s.material(g.material) for g in s.granules]
     mass, inertia = masses_and_inertias(r, rho)
@@ -375,4 +387,8 @@ def build_model(scenario: Scenario) -> Model:
         materials=tuple(mats),
         initial_patches=patches,
     )
-    return precompressed(weighed(model))  # the plate in its sag under its own weight, then the static state
+    return weighed(model)
+
+
+#: the model's builder of a resolved scenario by its dimension's name (model.dimension)
+MODEL_BUILDERS = {"plane": plane_model, "space": space_model}

@@ -39,7 +39,8 @@ class Missed(NamedTuple):
 def centre_coordinates(state: np.ndarray, dimension: int):
     """(x, y, z) columns of the granules' state [m] (its first `dimension` columns; z None
     in the plane), as the neighbour searches take them."""
-    return state[:, 0], state[:, 1], (state[:, 2] if dimension == 3 else None)
+    x, y, *z = (state[:, k] for k in range(dimension))
+    return x, y, (z or [None])[0]
 
 
 def wall_planes(walls, dimension: int = 2) -> tuple[np.ndarray, np.ndarray]:

@@ -21,6 +21,7 @@ one set of scales (the body's magnification, its stress, the contact forces).
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Callable, NamedTuple
 
 import numpy as np
 import xarray as xr
@@ -33,7 +34,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
 from granplate.results import analysis as an
-from granplate.results.dataset import dimension_of
+from granplate.results.dataset import dimension_spec
 
 #: The paper's magnification of displacements in its animations.
 MAGNIFY = 125.0
@@ -190,9 +191,24 @@ def animate(
     second; magnify: displacement magnification [-] (unused in space); dpi: resolution;
     progress: a bar of the frames rendered on stderr.
     An .mp4 path falls back to .gif (Pillow) when ffmpeg is not available or fails.
+    The animation is the result's dimension's (`ANIMATIONS`: `animate_plane`, `animate_space`).
     """
-    if dimension_of(ds) == 3:
-        return animate_space(ds, path, frames=frames, fps=fps, dpi=dpi, progress=progress)
+    return animation_of(ds).write(ds, path, frames=frames, fps=fps, magnify=magnify, dpi=dpi, progress=progress)
+
+
+def animate_plane(
+    ds: xr.Dataset,
+    path: str | Path,
+    *,
+    frames: int | None = 120,
+    fps: int = 15,
+    magnify: float = MAGNIFY,
+    dpi: int = 90,
+    progress: bool = False,
+) -> Path:
+    """Write an animation of plane run `ds` to `path` (.mp4, or .gif) and return the path
+    written: per frame the granules and the plate magnified by `magnify` at its field
+    snapshots (`animate`)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     snaps = frame_indices(ds.sizes.get("field_time", 0), frames)
@@ -253,3 +269,24 @@ def animate_space(
         raise ValueError("the result has no output times to animate")
     fig, draw = space.animation(space.frames_of_result(ds, indices))
     return _save(fig, draw, len(indices), path, fps, dpi, progress)
+
+
+class Animation(NamedTuple):
+    """One dimension's animation: `write(ds, path, frames=, fps=, magnify=, dpi=,
+    progress=)` -> the path written; `ready(ds)`: whether the command line may start it (the
+    plane needs plate-field snapshots; space checks its frames as it starts)."""
+
+    write: Callable[..., Path]
+    ready: Callable[[xr.Dataset], bool]
+
+
+#: the animations by the dimension's name (model.dimension); space has no magnification
+ANIMATIONS: dict[str, Animation] = {
+    "plane": Animation(animate_plane, lambda ds: ds.sizes.get("field_time", 0) > 0),
+    "space": Animation(lambda ds, path, magnify, **kw: animate_space(ds, path, **kw), lambda ds: True),
+}
+
+
+def animation_of(ds: xr.Dataset) -> Animation:
+    """The animation of result `ds`'s dimension (`ANIMATIONS`)."""
+    return ANIMATIONS[dimension_spec(ds).name]

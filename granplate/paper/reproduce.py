@@ -29,6 +29,7 @@ import time
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any, Callable, NamedTuple
 
 from granplate.errors import ScenarioError
 
@@ -361,15 +362,39 @@ def _earlier_animations(anim_dir: Path, available: dict[str, Path]) -> list[Path
     return found
 
 
+class JobCost(NamedTuple):
+    """How a dimension's jobs are ordered and warmed up for: `factor`, its cost per element
+    against the plane's; `elements(plate)`, the elements of its [plate]; `granules_apart`:
+    whether a body with granules and one without warm up apart (their kernels and bodies
+    differ)."""
+
+    factor: float
+    elements: Callable[[Any], int]
+    granules_apart: bool
+
+
+#: the jobs' costs by the dimension's name (model.dimension): the plane's plate of nx x ny
+#: elements; space's solid of its box's elements (1 for a mesh file), each at SPACE_COST
+JOB_COSTS: dict[str, JobCost] = {
+    "plane": JobCost(1.0, lambda plate: plate.nx * plate.ny, False),
+    "space": JobCost(SPACE_COST, lambda plate: math.prod(plate.elements) if plate.elements else 1, True),
+}
+
+
+def job_cost(s) -> JobCost:
+    """The `JobCost` of scenario `s`'s dimension."""
+    from granplate.model.dimension import of_number
+
+    return JOB_COSTS[of_number(getattr(s, "dimension", 2)).name]
+
+
 def expected_cost(job: Job) -> float:
     """A rough cost of a job for ordering: elements x simulated time, steel > PTFE; a 3D
-    twin (velocity Verlet at a fixed step) by SPACE_COST per element."""
+    twin (velocity Verlet at a fixed step) by SPACE_COST per element (`JOB_COSTS`)."""
     s = job.scenario
     plate = getattr(s, "plate", None)
-    if getattr(s, "dimension", 2) == 3:
-        elements = SPACE_COST * (math.prod(plate.elements) if plate is not None and plate.elements else 1)
-    else:
-        elements = (plate.nx * plate.ny) if plate is not None else 1
+    cost = job_cost(s)
+    elements = cost.factor * (cost.elements(plate) if plate is not None else 1)
     stiff = 2.0 if (getattr(s, "layout", None) is not None and s.layout.intruder_material == "steel") else 1.0
     return elements * s.time.t_end * stiff
 
@@ -384,9 +409,8 @@ def warm_up_scenarios(jobs: list[Job]) -> list[str]:
     first: dict[tuple, Job] = {}
     for job in sorted(jobs, key=expected_cost):
         s = job.scenario
-        key: tuple = (s.solver.scheme,)
-        if getattr(s, "dimension", 2) == 3:
-            key += (3, s.layout is not None or bool(s.granules))
+        apart = job_cost(s).granules_apart
+        key: tuple = (s.solver.scheme,) + ((s.dimension, s.layout is not None or bool(s.granules)) if apart else ())
         first.setdefault(key, job)
     return [dumps(j.scenario) for j in first.values()]
 
@@ -506,14 +530,13 @@ def _cmd_plot(args) -> int:
 
 
 def _cmd_animate(args) -> int:
-    from granplate.paper.animate import animate
-    from granplate.results.dataset import dimension_of
+    from granplate.paper.animate import animate, animation_of
 
     ds = _read(_existing(args.result))
     target = Path(args.output) if args.output else Path(f"{ds.attrs.get('scenario_name', 'result')}.mp4")
     if target.suffix.lower() not in (".mp4", ".gif"):
         raise ScenarioError("-o", str(target), "allowed: a .mp4 or .gif file name")
-    if dimension_of(ds) == 2 and ds.sizes.get("field_time", 0) == 0:  # (in space: every output time)
+    if not animation_of(ds).ready(ds):  # (in space: every output time)
         raise ScenarioError("result", args.result, "has no plate-field snapshots to animate")
     written = animate(ds, target, frames=args.frames, fps=args.fps, magnify=args.magnify, progress=not args.quiet)
     print(f"written {written}")
@@ -521,29 +544,13 @@ def _cmd_animate(args) -> int:
 
 
 def _cmd_export(args) -> int:
-    from granplate.results.analysis import has_plate
-    from granplate.results.export import export_vtk, has_body, is_space
+    from granplate.results.export import export_vtk, vtk_kind
 
     ds = _read(_existing(args.result))
-    if is_space(ds) and has_body(ds):
-        pvd = export_vtk(ds, args.vtk)
-        print(
-            f"written {ds.sizes.get('field_time', 0)} snapshots of the body and {ds.sizes.get('granule', 0)} "
-            f"spheres; open {pvd} in ParaView (Warp By Vector: displacement; Glyph: sphere, scale array radius, "
-            f"factor 2)"
-        )
-        return 0
-    if is_space(ds):
-        pvd = export_vtk(ds, args.vtk)
-        print(
-            f"written {ds.sizes.get('time', 0)} output times of {ds.sizes.get('granule', 0)} spheres; open {pvd} "
-            f"in ParaView (Glyph: sphere, scale array radius, factor 2)"
-        )
-        return 0
-    if not has_plate(ds):
+    kind = vtk_kind(ds)
+    if not kind.ready(ds):
         raise ScenarioError("result", args.result, "has no plate to export")
-    pvd = export_vtk(ds, args.vtk)
-    print(f"written {ds.sizes.get('field_time', 0)} snapshots; open {pvd} in ParaView")
+    print(kind.written(ds, export_vtk(ds, args.vtk)))
     return 0
 
 

@@ -51,6 +51,7 @@ from granplate.physics.contact import (
     wall_overlap,
     wall_rates,
 )
+from granplate.model.dimension import of_state
 from granplate.physics.laws import normal_law_force
 from granplate.physics.space import pair_contact_3d, wall_overlap_3d
 from granplate.solver.granular3d import pair_slip, wall_slip
@@ -84,38 +85,134 @@ class Links(NamedTuple):
     values: np.ndarray
 
 
+#: columns of the kinematics rows: the overlap delta [m], its rate [m/s] (less a wall's
+#: speed along its normal) and the slip speed |v_t| [m/s] (0 where apart)
+DELTA, RATE, SLIP = 0, 1, 2
+
+
 @njit(cache=True)
-def pair_links(y, radius, pairs, coef, dmax, rate, arm_shrink, clip, out):
-    """Overlap, normal and friction force of each pair (i, j) of `pairs` at state y (the
-    plane's 6 columns or space's 9) into out (np, 3); out[p, OVERLAP] <= 0 where apart.
-    dmax, rate: each contact's largest overlap so far [m] and rate factor [-]."""
-    space = y.shape[1] == 9
+def pair_kinematics_plane(y, radius, pairs, arm_shrink, kin):
+    """Overlap, its rate and the slip speed of each pair (i, j) of `pairs` at the plane's
+    state y (6 columns) into kin (np, 3), with the loop's kinematics (physics.contact)."""
     for p in range(pairs.shape[0]):
         i = pairs[p, 0]
         j = pairs[p, 1]
         ri = radius[i]
         rj = radius[j]
-        if space:
-            delta, nx, ny, nz = pair_contact_3d(y[i, 0], y[i, 1], y[i, 2], ri, y[j, 0], y[j, 1], y[j, 2], rj)
-        else:
-            delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
-            ny = 0.0
-        out[p, OVERLAP] = delta
-        out[p, NORMAL] = 0.0
-        out[p, TANGENTIAL] = 0.0
+        delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
+        kin[p, DELTA] = delta
+        kin[p, RATE] = 0.0
+        kin[p, SLIP] = 0.0
+        if delta > 0.0:
+            ai = contact_arm(ri, delta, 0.5 * arm_shrink)
+            aj = contact_arm(rj, delta, 0.5 * arm_shrink)
+            ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
+            kin[p, RATE] = ddot
+            kin[p, SLIP] = vt
+
+
+@njit(cache=True)
+def pair_kinematics_space(y, radius, pairs, arm_shrink, kin):
+    """`pair_kinematics_plane` at space's state y (9 columns), with the loop's kinematics
+    in space (physics.space, solver.granular3d)."""
+    for p in range(pairs.shape[0]):
+        i = pairs[p, 0]
+        j = pairs[p, 1]
+        ri = radius[i]
+        rj = radius[j]
+        delta, nx, ny, nz = pair_contact_3d(y[i, 0], y[i, 1], y[i, 2], ri, y[j, 0], y[j, 1], y[j, 2], rj)
+        kin[p, DELTA] = delta
+        kin[p, RATE] = 0.0
+        kin[p, SLIP] = 0.0
+        if delta > 0.0:
+            ai = contact_arm(ri, delta, 0.5 * arm_shrink)
+            aj = contact_arm(rj, delta, 0.5 * arm_shrink)
+            ddot, sx, sy, sz = pair_slip(y, i, j, nx, ny, nz, ai, aj)
+            kin[p, RATE] = ddot
+            kin[p, SLIP] = math.sqrt(sx * sx + sy * sy + sz * sz)
+
+
+@njit(cache=True)
+def wall_kinematics_plane(y, radius, granule, geo, vn, arm_shrink, kin):
+    """Overlap, its rate less the wall's speed vn[k] [m/s] along its normal, and the slip
+    speed of each granule `granule[k]` against the wall of row geo[k] ([n..., offset where
+    the wall is], unit outward normal) at the plane's state y into kin (nw, 3)."""
+    for k in range(granule.shape[0]):
+        i = granule[k]
+        ri = radius[i]
+        nx, nz = geo[k, 0], geo[k, 1]
+        delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, geo[k, 2])
+        kin[k, DELTA] = delta
+        kin[k, RATE] = 0.0
+        kin[k, SLIP] = 0.0
+        if delta > 0.0:
+            a = contact_arm(ri, delta, arm_shrink)
+            ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, a)
+            kin[k, RATE] = ddot - vn[k]
+            kin[k, SLIP] = vt
+
+
+@njit(cache=True)
+def wall_kinematics_space(y, radius, granule, geo, vn, arm_shrink, kin):
+    """`wall_kinematics_plane` at space's state y (9 columns)."""
+    for k in range(granule.shape[0]):
+        i = granule[k]
+        ri = radius[i]
+        nx, ny, nz = geo[k, 0], geo[k, 1], geo[k, 2]
+        delta = wall_overlap_3d(y[i, 0], y[i, 1], y[i, 2], ri, nx, ny, nz, geo[k, 3])
+        kin[k, DELTA] = delta
+        kin[k, RATE] = 0.0
+        kin[k, SLIP] = 0.0
+        if delta > 0.0:
+            a = contact_arm(ri, delta, arm_shrink)
+            ddot, sx, sy, sz = wall_slip(y, i, nx, ny, nz, a)
+            kin[k, RATE] = ddot - vn[k]
+            kin[k, SLIP] = math.sqrt(sx * sx + sy * sy + sz * sz)
+
+
+#: the contacts' kinematics by the dimension's name (model.dimension): (pairs, walls)
+KINEMATICS = {
+    "plane": (pair_kinematics_plane, wall_kinematics_plane),
+    "space": (pair_kinematics_space, wall_kinematics_space),
+}
+
+
+@njit(cache=True)
+def link_forces(kin, coef, dmax, rate, clip, out):
+    """Overlap, normal and friction force of each contact of kinematics row kin[k] (`DELTA`,
+    `RATE`, `SLIP`) and coefficient row coef[k] into out (n, 3), by its normal law
+    (physics.laws) and `tangential_magnitude`; out[k, OVERLAP] <= 0 where apart.
+    dmax, rate: each contact's largest overlap so far [m] and rate factor [-]."""
+    for k in range(kin.shape[0]):
+        delta = kin[k, DELTA]
+        out[k, OVERLAP] = delta
+        out[k, NORMAL] = 0.0
+        out[k, TANGENTIAL] = 0.0
         if delta <= 0.0:
             continue
-        c = coef[p]
-        ai = contact_arm(ri, delta, 0.5 * arm_shrink)
-        aj = contact_arm(rj, delta, 0.5 * arm_shrink)
-        if space:
-            ddot, sx, sy, sz = pair_slip(y, i, j, nx, ny, nz, ai, aj)
-            vt = math.sqrt(sx * sx + sy * sy + sz * sz)
-        else:
-            ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
-        n = normal_law_force(delta, ddot, c, max(dmax[p], delta), rate[p], clip)
-        out[p, NORMAL] = n
-        out[p, TANGENTIAL] = tangential_magnitude(n, vt, c)
+        c = coef[k]
+        n = normal_law_force(delta, kin[k, RATE], c, max(dmax[k], delta), rate[k], clip)
+        out[k, NORMAL] = n
+        out[k, TANGENTIAL] = tangential_magnitude(n, kin[k, SLIP], c)
+
+
+def pair_links(y, radius, pairs, coef, dmax, rate, arm_shrink, clip, out) -> None:
+    """Overlap, normal and friction force of each pair (i, j) of `pairs` at state y (the
+    plane's 6 columns or space's 9: its dimension's `KINEMATICS`) into out (np, 3);
+    out[p, OVERLAP] <= 0 where apart. dmax, rate: each contact's largest overlap so far [m]
+    and rate factor [-]."""
+    kin = np.zeros((len(pairs), 3))
+    KINEMATICS[of_state(y.shape[1]).name][0](y, radius, pairs, arm_shrink, kin)
+    link_forces(kin, coef, dmax, rate, clip, out)
+
+
+def wall_links(y, radius, granule, geo, vn, coef, dmax, rate, arm_shrink, clip, out) -> None:
+    """Overlap, normal and friction force of each granule `granule[k]` against the wall of
+    row geo[k] ([n..., offset where the wall is], unit outward normal) moving at vn[k] [m/s]
+    along it, into out (nw, 3), as `pair_links`."""
+    kin = np.zeros((len(granule), 3))
+    KINEMATICS[of_state(y.shape[1]).name][1](y, radius, granule, geo, vn, arm_shrink, kin)
+    link_forces(kin, coef, dmax, rate, clip, out)
 
 
 @njit(cache=True)
@@ -126,38 +223,6 @@ def tangential_magnitude(n: float, vt: float, c) -> float:
     if c[COEF_KT] > 0.0:
         return math.nan
     return abs(friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS]))
-
-
-@njit(cache=True)
-def wall_links(y, radius, granule, geo, vn, coef, dmax, rate, arm_shrink, clip, out):
-    """Overlap, normal and friction force of each granule `granule[k]` against the wall of
-    row geo[k] ([n..., offset where the wall is], unit outward normal) moving at vn[k] [m/s]
-    along it, into out (nw, 3), as `pair_links`."""
-    space = y.shape[1] == 9
-    for k in range(granule.shape[0]):
-        i = granule[k]
-        ri = radius[i]
-        if space:
-            nx, ny, nz = geo[k, 0], geo[k, 1], geo[k, 2]
-            delta = wall_overlap_3d(y[i, 0], y[i, 1], y[i, 2], ri, nx, ny, nz, geo[k, 3])
-        else:
-            nx, nz = geo[k, 0], geo[k, 1]
-            delta = wall_overlap(y[i, 0], y[i, 1], ri, nx, nz, geo[k, 2])
-        out[k, OVERLAP] = delta
-        out[k, NORMAL] = 0.0
-        out[k, TANGENTIAL] = 0.0
-        if delta <= 0.0:
-            continue
-        c = coef[k]
-        a = contact_arm(ri, delta, arm_shrink)
-        if space:
-            ddot, sx, sy, sz = wall_slip(y, i, nx, ny, nz, a)
-            vt = math.sqrt(sx * sx + sy * sy + sz * sz)
-        else:
-            ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, a)
-        n = normal_law_force(delta, ddot - vn[k], c, max(dmax[k], delta), rate[k], clip)
-        out[k, NORMAL] = n
-        out[k, TANGENTIAL] = tangential_magnitude(n, vt, c)
 
 
 def table_rows(n: int, steps: int, times: np.ndarray, t_end: float, dt_out: float) -> np.ndarray:
@@ -214,10 +279,11 @@ def wall_motion(model, out, n: int) -> WallMotion:
 def touching_pairs(y: np.ndarray, radius: np.ndarray) -> np.ndarray:
     """(np, 2) sorted pairs i < j whose surfaces touch or overlap at state y (a k-d tree,
     model.neighbours.contact_pairs with no gap)."""
+    from granplate.model.contacts import centre_coordinates
     from granplate.model.neighbours import contact_pairs
 
-    z = y[:, 2] if y.shape[1] == 9 else None
-    return np.asarray(contact_pairs(y[:, 0], y[:, 1], radius, 0.0, z), np.int64).reshape(-1, 2)
+    x, yy, z = centre_coordinates(y, of_state(y.shape[1]).n)
+    return np.asarray(contact_pairs(x, yy, radius, 0.0, z), np.int64).reshape(-1, 2)
 
 
 def touching_walls(y: np.ndarray, radius: np.ndarray, walls: WallMotion, o: int) -> np.ndarray:

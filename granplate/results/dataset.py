@@ -16,6 +16,7 @@ import numpy as np
 import xarray as xr
 
 from granplate.version import __version__
+from granplate.model.dimension import DIMENSIONS, Dimension, of_number, of_state
 from granplate.plate.peaks import BLOCK, block_starts, peak_maxima, split_coordinates, time_maxima
 from granplate.solver import state as K
 from granplate.results.contact_table import LINK_VARIABLES
@@ -114,11 +115,8 @@ VARIABLES.update(LINK_VARIABLES)  # the contact table's (results.contact_table)
 
 
 #: the Dataset's names of the granules' state columns, by the number of columns (the
-#: plane's 6, space's 9; solver.state.STATE_COLUMNS)
-STATE_VARIABLES: dict[int, tuple[str, ...]] = {
-    6: ("x", "y", "theta", "vx", "vy", "omega"),
-    9: ("x", "y", "z", "vx", "vy", "vz", "omega_x", "omega_y", "omega_z"),
-}
+#: plane's 6, space's 9; model.dimension)
+STATE_VARIABLES: dict[int, tuple[str, ...]] = {d.state_columns: d.state_variables for d in DIMENSIONS.values()}
 
 
 def _var(name: str, dims, data) -> xr.DataArray:
@@ -348,8 +346,9 @@ def to_dataset(
     y = out.y[:n]
     e = out.energy[:n]
     data: dict[str, xr.DataArray] = dict(body_data)
+    dim = of_state(y.shape[2])
     if not summary_only:
-        for c, name in enumerate(STATE_VARIABLES[y.shape[2]]):
+        for c, name in enumerate(dim.state_variables):
             data[name] = _var(name, ("time", "granule"), y[:, :, c].copy())
     for col, name in (
         (K.E_SHOCK, "E_shock"),
@@ -366,7 +365,7 @@ def to_dataset(
         (K.RESID_MAX, "energy_residual_max"),
         (K.KE_Z, "KE_depth"),
     ):
-        if name == "KE_depth" and y.shape[2] != 9:  # (in space only)
+        if dim.foreign(name):  # (KE_depth: in space only)
             continue
         if not summary_only or name in SUMMARY_VARIABLES:
             data[name] = _var(name, ("time",), e[:, col].copy())
@@ -839,6 +838,11 @@ def dimension_of(ds: xr.Dataset) -> int:
     0.2.1, without it: 3 where it has the depth z)."""
     d = ds.attrs.get("dimension")
     return int(d) if d is not None else 3 if "z" in ds.variables else 2
+
+
+def dimension_spec(ds: xr.Dataset) -> Dimension:
+    """A result's dimension as `model.dimension.Dimension` (its names; `dimension_of`)."""
+    return of_number(dimension_of(ds))
 
 
 def elastic_body_of(ds: xr.Dataset) -> str:

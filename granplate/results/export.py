@@ -40,6 +40,7 @@ time (part 0 = body, part 1 = spheres), ``NAME-body.pvd`` and ``NAME-spheres.pvd
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Callable, NamedTuple
 from xml.sax.saxutils import quoteattr
 
 import meshio
@@ -47,7 +48,8 @@ import numpy as np
 import xarray as xr
 
 from granplate.results import analysis as an
-from granplate.results.dataset import dimension_of, has_solid
+from granplate.model.dimension import SPACE
+from granplate.results.dataset import dimension_spec, has_solid
 
 
 def _points3(x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -86,11 +88,6 @@ def granule_cloud(ds: xr.Dataset, i: int) -> meshio.Mesh:
     )
 
 
-def is_space(ds: xr.Dataset) -> bool:
-    """Whether a result is of a run in space (`results.dataset.dimension_of`)."""
-    return dimension_of(ds) == 3
-
-
 def material_names(ds: xr.Dataset) -> list[str]:
     """The result's material names, sorted: material_id i is the i-th."""
     return sorted({str(m) for m in ds["material"].values})
@@ -99,9 +96,9 @@ def material_names(ds: xr.Dataset) -> list[str]:
 def sphere_cloud(ds: xr.Dataset, i: int) -> meshio.Mesh:
     """The spheres of a 3D result at output index i as a meshio Mesh (one vertex each)."""
     n = ds.sizes["granule"]
-    pos = np.column_stack([ds[k].values[i] for k in ("x", "y", "z")]).astype(float)
-    vel = np.column_stack([ds[k].values[i] for k in ("vx", "vy", "vz")]).astype(float)
-    spin = np.column_stack([ds[k].values[i] for k in ("omega_x", "omega_y", "omega_z")]).astype(float)
+    pos = np.column_stack([ds[k].values[i] for k in SPACE.positions]).astype(float)
+    vel = np.column_stack([ds[k].values[i] for k in SPACE.velocities]).astype(float)
+    spin = np.column_stack([ds[k].values[i] for k in SPACE.spins]).astype(float)
     names = material_names(ds)
     return meshio.Mesh(
         pos,
@@ -199,17 +196,22 @@ def pvd_text(entries: list[tuple[float, int, str]]) -> str:
 def export_vtk(ds: xr.Dataset, out_dir: str | Path, name: str | None = None) -> Path:
     """Write the VTK time series of run `ds` into out_dir; returns the combined .pvd path.
 
-    name: stem of the .pvd files (default: the scenario name). Snapshots are the
-    result's field_time; granule states are taken at the output nearest to each. A run in
-    space is written by `export_spheres` (every output time), or with an elastic body by
+    name: stem of the .pvd files (default: the scenario name). The writer is the result's
+    `vtk_kind`: a run in the plane is written by `export_plate` (its plate snapshots), a
+    run in space by `export_spheres` (every output time), or with an elastic body by
     `export_body` (every body snapshot).
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    if is_space(ds) and has_body(ds):
-        return export_body(ds, out, name)
-    if is_space(ds):
-        return export_spheres(ds, out, name)
+    return vtk_kind(ds).write(ds, out, name)
+
+
+def export_plate(ds: xr.Dataset, out_dir: str | Path, name: str | None = None) -> Path:
+    """Write the plate and the granules of plane run `ds` at each plate snapshot
+    (field_time, the granules at the output nearest to each) into out_dir (module
+    docstring); returns the combined .pvd path."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
     name = name or str(ds.attrs.get("scenario_name", "result"))
     if not an.has_plate(ds):
         raise ValueError("the result has no plate to export")
@@ -231,3 +233,49 @@ def export_vtk(ds: xr.Dataset, out_dir: str | Path, name: str | None = None) -> 
     combined = out / f"{name}.pvd"
     combined.write_text(pvd_text(sorted(plate_entries + granule_entries)))
     return combined
+
+
+class VtkKind(NamedTuple):
+    """How a kind of result is written to VTK: `write(ds, out_dir, name)` -> the .pvd path;
+    `ready(ds)`: whether the result holds what it writes; `written(ds, pvd)`: what was
+    written, in words, for the command line."""
+
+    write: Callable[[xr.Dataset, Path, str | None], Path]
+    ready: Callable[[xr.Dataset], bool]
+    written: Callable[[xr.Dataset, Path], str]
+
+
+def _sizes(ds: xr.Dataset, dim: str) -> int:
+    return int(ds.sizes.get(dim, 0))
+
+
+#: the VTK writers: a result with an elastic body's fields ("body"), else by its
+#: dimension's name (model.dimension)
+VTK_KINDS: dict[str, VtkKind] = {
+    "body": VtkKind(
+        export_body,
+        lambda ds: True,
+        lambda ds, pvd: (
+            f"written {_sizes(ds, 'field_time')} snapshots of the body and {_sizes(ds, 'granule')} spheres; "
+            f"open {pvd} in ParaView (Warp By Vector: displacement; Glyph: sphere, scale array radius, factor 2)"
+        ),
+    ),
+    "space": VtkKind(
+        export_spheres,
+        lambda ds: True,
+        lambda ds, pvd: (
+            f"written {_sizes(ds, 'time')} output times of {_sizes(ds, 'granule')} spheres; open {pvd} "
+            f"in ParaView (Glyph: sphere, scale array radius, factor 2)"
+        ),
+    ),
+    "plane": VtkKind(
+        export_plate,
+        an.has_plate,
+        lambda ds, pvd: f"written {_sizes(ds, 'field_time')} snapshots; open {pvd} in ParaView",
+    ),
+}
+
+
+def vtk_kind(ds: xr.Dataset) -> VtkKind:
+    """How result `ds` is written to VTK (`VTK_KINDS`)."""
+    return VTK_KINDS["body" if has_body(ds) else dimension_spec(ds).name]

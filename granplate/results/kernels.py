@@ -118,7 +118,9 @@ class KernelSet:
 
     @property
     def what(self) -> str:
-        return f"the {self.scheme} scheme {'in space' if self.dimension == 3 else 'in the plane'}"
+        from granplate.model.dimension import of_number
+
+        return f"the {self.scheme} scheme {of_number(self.dimension).where}"
 
 
 #: Every kernel set, in the order measured (later sets reuse the callees of earlier ones).

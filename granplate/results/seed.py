@@ -30,6 +30,7 @@ def _row(ds, name: str, time: int) -> list[float]:
 def granules_at(ds, time: int = -1) -> tuple[Granule, ...]:
     """The result's granules at output time index `time` (default: the last): centres,
     velocities and spins from the Dataset, radius, material and label from its scenario."""
+    from granplate.model.dimension import of_number
     from granplate.results.dataset import scenario_of
     from granplate.setup.geometry import resolve
 
@@ -37,14 +38,14 @@ def granules_at(ds, time: int = -1) -> tuple[Granule, ...]:
     n = ds.sizes["time"]
     if not -n <= time < n:
         raise IndexError(f"output time index {time} out of range: the result has {n} output times")
-    x, y, vx, vy = (_row(ds, k, time) for k in ("x", "y", "vx", "vy"))
-    if s.dimension == 3:
-        z, vz = _row(ds, "z", time), _row(ds, "vz", time)
-        spins = list(zip(*(_row(ds, k, time) for k in ("omega_x", "omega_y", "omega_z"))))
-    else:
-        z, vz, spins = [0.0] * len(x), [0.0] * len(x), _row(ds, "omega", time)
+    dim = of_number(s.dimension)
+    rows = [_row(ds, k, time) for k in dim.positions]
+    zero = [0.0] * len(rows[0])  # z and vz beyond the plane's
+    centre = dict(zip(("x", "y", "z"), rows + [zero]))
+    velocity = dict(zip(("vx", "vy", "vz"), [_row(ds, k, time) for k in dim.velocities] + [zero]))
+    spins = [dim.spin(c) for c in zip(*(_row(ds, k, time) for k in dim.spins))]
     return tuple(
-        dataclasses.replace(g, x=x[i], y=y[i], z=z[i], vx=vx[i], vy=vy[i], vz=vz[i], omega=spins[i])
+        dataclasses.replace(g, **{k: v[i] for k, v in (centre | velocity).items()}, omega=spins[i])
         for i, g in enumerate(s.granules)
     )
 

@@ -82,8 +82,10 @@ def loop_key(sig: tuple) -> tuple[str, int] | None:
     try:
         g, sw = sig[2], sig[7]
         scheme = getattr(__import__(sw.instance_class.__module__, fromlist=["NAME"]), "NAME")
-        dimension = 3 if g.instance_class.__name__ == "Granular3" else 2
-    except (AttributeError, IndexError, ImportError, TypeError):
+        from granplate.model.dimension import of_arrays
+
+        dimension = of_arrays(g.instance_class).n
+    except (AttributeError, IndexError, ImportError, TypeError, ValueError):
         return None
     return str(scheme), dimension
 

@@ -8,23 +8,35 @@ schemes and the loop call only these (and `plate_friction_held`: whether a held
 plate-contact friction changes a step's first stage), so the same compiled code serves
 both dimensions and nothing else asks which one it is.
 
-Adding a dimension-specific granular function: write it in both modules with the same
-signature and add a stub and its overload here.
+The dimension is the granular arrays' (model.dimension: `Dimension.arrays`); a hook whose
+two implementations are more than the two modules' function of the same name has a
+factory per dimension in `_OWN`. Adding a dimension-specific granular function: write it
+in both modules with the same signature and add a stub and its overload here.
 """
 
 from __future__ import annotations
 
 from numba.extending import overload
 
-from granplate.model.inputs import Granular, Granular3
+from granplate.model import inputs
+from granplate.model.dimension import DIMENSIONS
 from granplate.solver import blocks, granular as plane, granular3d as space, mindlin_plane
 
-_MODULES = {Granular: plane, Granular3: space}
+#: the dimension's name (model.dimension) by the class of its granular arrays
+_ARRAYS = {getattr(inputs, d.arrays): d.name for d in DIMENSIONS.values()}
+
+#: each dimension's module of granular kernels, by the dimension's name
+_MODULES = {"plane": plane, "space": space}
+
+
+def _dimension_of(g) -> str | None:
+    """The dimension's name for the numba type of the granular arrays g (None: not theirs)."""
+    return _ARRAYS.get(getattr(g, "instance_class", None))
 
 
 def _module_of(g):
     """solver.granular or solver.granular3d for the numba type of the granular arrays g."""
-    return _MODULES.get(getattr(g, "instance_class", None))
+    return _MODULES.get(_dimension_of(g))
 
 
 def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, split, record):
@@ -107,22 +119,12 @@ def _normal_forces(t, y, g, cfg, acc, fdamp, fload):
 
 @overload(normal_forces_blocks, inline="always")
 def _normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
-    if _module_of(g) is plane:
-        fn = plane.normal_forces
-        return lambda t, y, g, cfg, acc, fdamp, fload, fpar, spar: fn(t, y, g, cfg, acc, fdamp, fload)
-    if _module_of(g) is space:
-        fb = blocks.normal_forces_blocks
-        return lambda t, y, g, cfg, acc, fdamp, fload, fpar, spar: fb(t, y, g, cfg, acc, fdamp, fload, fpar, spar)
+    return _own(g, "normal_forces_blocks")
 
 
 @overload(mindlin_forces, inline="always")
 def _mindlin_forces(yv, yn, h, g, cfg, acc):
-    if _module_of(g) is plane:
-        fp = mindlin_plane.mindlin_forces
-        return lambda yv, yn, h, g, cfg, acc: fp(yv, yn, h, g, cfg, acc)
-    if _module_of(g) is space:
-        fn = space.mindlin_forces
-        return lambda yv, yn, h, g, cfg, acc: fn(yv, yn, h, g, cfg, acc)
+    return _own(g, "mindlin_forces")
 
 
 @overload(sensor_loads, inline="always")
@@ -135,25 +137,12 @@ def _sensor_loads(y, g, cfg, load):
 
 @overload(plate_friction_held, inline="always")
 def _plate_friction_held(hold, g):
-    if _module_of(g) is plane:
-        return lambda hold, g: hold
-    if _module_of(g) is space:
-        return lambda hold, g: False
+    return _own(g, "plate_friction_held")
 
 
 @overload(kinetic_energies, inline="always")
 def _kinetic_energies(y, g):
-    if _module_of(g) is plane:
-        fn = plane.kinetic_energies
-
-        def plane_energies(y, g):
-            kx, ky, kr = fn(y, g.mass, g.inertia)
-            return kx, ky, 0.0, kr
-
-        return plane_energies
-    if _module_of(g) is space:
-        fn3 = space.kinetic_energies
-        return lambda y, g: fn3(y, g.mass, g.inertia)
+    return _own(g, "kinetic_energies")
 
 
 @overload(force_error, inline="always")
@@ -162,3 +151,72 @@ def _force_error(k1, k0, kend, ratio, g, sc, err):
     if m is not None:
         fn = m.force_error
         return lambda k1, k0, kend, ratio, g, sc, err: fn(k1, k0, kend, ratio, g.mass, g.inertia, g.radius, sc, err)
+
+
+# What differs between the dimensions beyond each module's function of the same name: one
+# factory per hook and dimension, each giving the implementation numba compiles.
+def _plane_normal_forces_blocks():
+    fn = plane.normal_forces  # the plane's pairs are not cut into blocks: its serial pass
+    return lambda t, y, g, cfg, acc, fdamp, fload, fpar, spar: fn(t, y, g, cfg, acc, fdamp, fload)
+
+
+def _space_normal_forces_blocks():
+    fb = blocks.normal_forces_blocks
+    return lambda t, y, g, cfg, acc, fdamp, fload, fpar, spar: fb(t, y, g, cfg, acc, fdamp, fload, fpar, spar)
+
+
+def _plane_mindlin_forces():
+    fp = mindlin_plane.mindlin_forces
+    return lambda yv, yn, h, g, cfg, acc: fp(yv, yn, h, g, cfg, acc)
+
+
+def _space_mindlin_forces():
+    fn = space.mindlin_forces
+    return lambda yv, yn, h, g, cfg, acc: fn(yv, yn, h, g, cfg, acc)
+
+
+def _plane_friction_held():
+    return lambda hold, g: hold
+
+
+def _space_friction_held():
+    return lambda hold, g: False  # no plate contacts in space yet
+
+
+def _plane_kinetic_energies():
+    fn = plane.kinetic_energies
+
+    def plane_energies(y, g):
+        kx, ky, kr = fn(y, g.mass, g.inertia)
+        return kx, ky, 0.0, kr
+
+    return plane_energies
+
+
+def _space_kinetic_energies():
+    fn3 = space.kinetic_energies
+    return lambda y, g: fn3(y, g.mass, g.inertia)
+
+
+#: the factories of the hooks that differ, by the dimension's name and the hook's name
+_OWN = {
+    "plane": {
+        "normal_forces_blocks": _plane_normal_forces_blocks,
+        "mindlin_forces": _plane_mindlin_forces,
+        "plate_friction_held": _plane_friction_held,
+        "kinetic_energies": _plane_kinetic_energies,
+    },
+    "space": {
+        "normal_forces_blocks": _space_normal_forces_blocks,
+        "mindlin_forces": _space_mindlin_forces,
+        "plate_friction_held": _space_friction_held,
+        "kinetic_energies": _space_kinetic_energies,
+    },
+}
+
+
+def _own(g, hook: str):
+    """The implementation of `hook` for the numba type of the granular arrays g (None: not
+    theirs, so that numba looks further)."""
+    make = _OWN.get(_dimension_of(g) or "", {}).get(hook)
+    return make() if make is not None else None

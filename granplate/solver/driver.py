@@ -19,6 +19,7 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from granplate.model.arrays import Model
+from granplate.model.dimension import of_number
 from granplate.solver import loop, snapshot, state as S
 from granplate.solver.compiling import compile_calls, compile_seconds, describe_seconds, machine_slowdown
 from granplate.solver.ladder import level_for
@@ -255,7 +256,7 @@ def note_compile(model: Model, calls: list[tuple]) -> bool:
     if all(is_compiled(f, args) for f, args in calls):
         return False
     name, dim = model.scenario.solver.scheme, model.config.dimension
-    where = "in space" if dim == 3 else "in the plane"
+    where = of_number(dim).where
     seconds, slow = compile_seconds(name, dim), machine_slowdown()
     busy = f"; this machine is busy, {slow:.1f}x" if slow > 1.2 else ""
     log.info(

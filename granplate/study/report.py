@@ -252,14 +252,10 @@ def design_figures(folder: Path, key: str, progress: bool = False) -> list[tuple
     ds = design_result(folder, key, progress)
     if ds is None:
         return []
-    from granplate.figures import assembly, run, show, space
+    from granplate.figures import run
+    from granplate.figures.drawing import scenario_figure
 
-    scenario = scenario_of(ds)
-    drawing = (
-        space.draw(space.of_scenario(scenario))
-        if scenario.dimension == 3
-        else show.draw(assembly.of_scenario(scenario), width=5.0)
-    )
+    drawing, _ = scenario_figure(scenario_of(ds), column=True)
     made = [("assembly", _save(drawing, fig_dir / f"{stem}-assembly.png"))]
     for name, fig in run.figures(ds).items():
         if name in DESIGN_FIGURES:
