@@ -9,7 +9,7 @@ from __future__ import annotations
 from numba import njit
 
 from granplate.solver.dimension import friction_flow, granular_rhs, plate_friction_held
-from granplate.solver.drives import hold_drives, wall_shift_energy
+from granplate.solver.drives import hold_drives, piston_rk4_end, piston_stage, pistons_at_start, wall_shift_energy
 
 #: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps h
 #: times the friction relaxation rate of every contact that RK4 integrates below this bound.
@@ -63,6 +63,7 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
         return no_granules_step(h, st.p1, w.dacc, w.pend, w.ovl_new, w.ovl_who)
     k1 = st.k1
     p1 = st.p1
+    pistons_at_start(g)  # a piston (a force-driven wall) is one more degree of freedom of the step
     split = cfg.split_friction
     fric_split = 0.0
     if split:  # friction over [t, t + h/2]; RK4 then starts from w.ynew, updated in place
@@ -83,18 +84,21 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
         k1 = w.k1h
         p1 = w.p1h
     hh = 0.5 * h
+    piston_stage(g, 1.0, hh)
     for i in range(ng):
         for c in range(nc):
             w.ytmp[i, c] = y0[i, c] + hh * k1[i, c]
     p2 = granular_rhs(
         t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k2, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
     )
+    piston_stage(g, 2.0, hh)
     for i in range(ng):
         for c in range(nc):
             w.ytmp[i, c] = y0[i, c] + hh * w.k2[i, c]
     p3 = granular_rhs(
         t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k3, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
     )
+    piston_stage(g, 2.0, h)
     for i in range(ng):
         for c in range(nc):
             w.ytmp[i, c] = y0[i, c] + h * w.k3[i, c]
@@ -102,6 +106,7 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
         t + h, w.ytmp, stage[2], stage[3], g, cfg, w.k4, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
     )
     h6 = h / 6.0
+    piston_rk4_end(g, h)
     for i in range(ng):
         for c in range(nc):  # (y0 may be w.ynew itself: each entry is read before it is written)
             w.ynew[i, c] = y0[i, c] + h6 * (k1[i, c] + 2.0 * w.k2[i, c] + 2.0 * w.k3[i, c] + w.k4[i, c])
