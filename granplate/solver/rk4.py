@@ -36,6 +36,24 @@ def no_granules_step(h, p1, dacc, pend, ovl_new, ovl_who):
 
 
 @njit(cache=True)
+def first_stage(t, y0, hold, split, st, g, cfg, w):
+    """RK4's first stage (derivative, powers) at state y0 and time t [s]: st.k1/st.p1 (the
+    last step's end, first same as last), or recomputed into w.k1h/w.p1h where the held
+    plate-contact friction (hold) or the split friction's half step changes it."""
+    if plate_friction_held(hold, g) or split:
+        pr = granular_rhs(
+            t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
+        )
+        w.p1h[0] = pr.p_shock
+        w.p1h[1] = pr.p_visc
+        w.p1h[2] = pr.p_fric
+        w.p1h[3] = pr.p_drive
+        w.p1h[4] = pr.p_grav
+        return w.k1h, w.p1h
+    return st.k1, st.p1
+
+
+@njit(cache=True)
 def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     """One step of the granules from st.y with the plate's contact points at stage[0],
     stage[1] (u, v at t + h/2) and stage[2], stage[3] (u, v at t + h): RK4 of every force,
@@ -61,8 +79,6 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     nc = y0.shape[1]
     if ng == 0:
         return no_granules_step(h, st.p1, w.dacc, w.pend, w.ovl_new, w.ovl_who)
-    k1 = st.k1
-    p1 = st.p1
     pistons_at_start(g)  # a piston (a force-driven wall) is one more degree of freedom of the step
     split = cfg.split_friction
     fric_split = 0.0
@@ -72,17 +88,7 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
                 w.ynew[i, c] = y0[i, c]
         fric_split = friction_flow(w.ynew, 0.5 * h, g, cfg, True)
         y0 = w.ynew
-    if plate_friction_held(hold, g) or split:
-        pr = granular_rhs(
-            t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
-        )
-        w.p1h[0] = pr.p_shock
-        w.p1h[1] = pr.p_visc
-        w.p1h[2] = pr.p_fric
-        w.p1h[3] = pr.p_drive
-        w.p1h[4] = pr.p_grav
-        k1 = w.k1h
-        p1 = w.p1h
+    k1, p1 = first_stage(t, y0, hold, split, st, g, cfg, w)
     hh = 0.5 * h
     piston_stage(g, 1.0, hh)
     for i in range(ng):
