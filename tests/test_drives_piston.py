@@ -141,16 +141,13 @@ BAD = [
     ({"mass": math.nan}, {}, "drives[1].mass"),
     ({"direction": [1.0, 0.0]}, {}, "drives[1].direction"),
     ({"direction": [0.6, -0.8]}, {}, "drives[1].direction"),
-    ({}, {"scheme": "implicit"}, "solver.scheme"),
-    ({}, {"scheme": "paper"}, "solver.scheme"),
 ]
 
 
 @pytest.mark.parametrize("drive, solver, field", BAD, ids=[f"{f}-{k}" for k, (_, _, f) in enumerate(BAD)])
 def test_bad_force_driven_wall_refused_naming_the_field(drive, solver, field):
-    """A force drive on a wall without a mass in range, along anything but the wall's
-    normal, or under a scheme that does not integrate a piston, is refused before anything
-    runs, naming the field."""
+    """A force drive on a wall without a mass in range, or along anything but the wall's
+    normal, is refused before anything runs, naming the field."""
     d = piston(2, **drive)
     d["solver"].update(solver)
     with pytest.raises(ScenarioError) as e:

@@ -115,7 +115,6 @@ def test_the_pressed_chain_stays_at_rest_and_balances_its_energy():
         ({"precompression.mode": "servo"}, "precompression.mode"),
         ({"precompression.mode": "held", "precompression.mass": -1.0}, "precompression.mass"),
         ({"precompression.mode": "held", "precompression.mass": float("inf")}, "precompression.mass"),
-        ({"precompression.mode": "held", "solver.scheme": "implicit"}, "solver.scheme"),
         ({"precompression.mass": 1.0}, "precompression.mass"),
         ({"precompression.tolerance": 1.0}, "precompression.tolerance"),
         ({"precompression.max_iterations": 0}, "precompression.max_iterations"),

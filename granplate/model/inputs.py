@@ -59,8 +59,12 @@ N_HIST = 18
 #: counted as F is [N]; a piston's (a force-driven wall, solver.drives): the contacts' force
 #: against its drive R [N] (its acceleration DR_A = (F - R) / M) and its velocity after the
 #: step's first half kick [m/s]. A piston's s and v are its state (the scheme integrates them).
+#: Under the RK4 schemes (paper, implicit) a piston's s, v and a at the last accepted step
+#: (DR_SC, DR_VC, DR_AC; DR_S, DR_V, DR_A are then the trial step's) and the sums of its
+#: RK4 stages' velocities and accelerations (DR_KS, DR_KV).
 DR_S, DR_V, DR_A, DR_F, DR_P, DR_PD, DR_REF, DR_FD, DR_R, DR_VH = range(10)
-N_DRIVE = 10
+DR_SC, DR_VC, DR_AC, DR_KS, DR_KV = range(10, 15)
+N_DRIVE = 15
 
 
 def no_history(n: int) -> np.ndarray:

@@ -27,8 +27,6 @@ UNIT_TOL = 1e-9
 STEPS_PER_PERIOD = 20
 #: the largest mass [kg] of a force-driven wall (a piston; a thousand tonnes)
 PISTON_MASS_MAX = 1e6
-#: the schemes that integrate a force-driven wall (a piston) with the granules
-PISTON_SCHEMES: tuple[str, ...] = ("verlet",)
 #: the fields each profile reads (every other field of the drive must keep its default)
 PROFILE_FIELDS: dict[str, tuple[str, ...]] = {
     "constant": ("value",),
@@ -104,7 +102,6 @@ def check_drives(s: Scenario, step_max: float, wave_speed: float) -> None:
             _wall_drive(p, d, s.walls[index], direction)
         if kind == "wall" and d.kind == "force":
             piston_mass(f"{p}.mass", d.mass)
-            piston_scheme(s, f'{p} (a force drive on "{d.target}")')
         elif d.mass != 0.0:
             raise ScenarioError(
                 f"{p}.mass", d.mass, "read by a force drive on a wall only (its piston's mass [kg]); leave it out"
@@ -161,19 +158,6 @@ def piston_mass(path: str, mass: Any) -> float:
     if not 0.0 < m <= PISTON_MASS_MAX:
         raise ScenarioError(path, mass, what)
     return m
-
-
-def piston_scheme(s: Scenario, what: str) -> None:
-    """A force-driven wall (a piston) is integrated by the schemes of PISTON_SCHEMES only."""
-    if s.solver.scheme not in PISTON_SCHEMES:
-        raise ScenarioError(
-            "solver.scheme",
-            s.solver.scheme,
-            f"{what} makes the wall a piston, which only "
-            + ", ".join(repr(x) for x in PISTON_SCHEMES)
-            + " integrates: allowed "
-            + ", ".join(repr(x) for x in PISTON_SCHEMES),
-        )
 
 
 def _wall_drive(p: str, d: Drive, wall, direction: tuple[float, ...]) -> None:

@@ -1,5 +1,5 @@
 """The rules of [precompression] (docs/model.md section 3.12): its target wall, force, mode
-(a held wall's mass and scheme), tolerance and iterations, and what the static state can be
+(a held wall's mass), tolerance and iterations, and what the static state can be
 computed for (the plane's plate through rigid layers, the target wall not driven, a granule
 near it)."""
 
@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 
 from granplate.errors import ScenarioError
-from granplate.setup.drive_checks import piston_mass, piston_scheme
+from granplate.setup.drive_checks import piston_mass
 from granplate.setup.fields import finite, int_at_least, is_number, positive, string_in
 from granplate.setup.geometry import plane_offset, unit
 from granplate.setup.scenario import PRECOMPRESSION_MODES, Plate, Scenario
@@ -77,14 +77,13 @@ def check_precompression(s: Scenario) -> None:
 
 
 def _check_mode_mass(s: Scenario) -> None:
-    """mode = "held": its mass 0 (the granules' total) or in range, and a scheme that
-    integrates a piston; "frozen" reads no mass."""
+    """mode = "held": its mass 0 (the granules' total) or in range (every scheme integrates
+    the piston it makes); "frozen" reads no mass."""
     p = s.precompression
     assert p is not None
     if p.mode == "held":
         if not (is_number(p.mass) and p.mass == 0.0):
             piston_mass("precompression.mass", p.mass)
-        piston_scheme(s, 'precompression.mode = "held"')
     elif not (is_number(p.mass) and p.mass == 0.0):
         raise ScenarioError(
             "precompression.mass",

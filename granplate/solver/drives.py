@@ -19,6 +19,15 @@ velocity-Verlet scheme kicks and drifts it like a granule's one degree of freedo
 (`piston_kick_drift`, `piston_kick`), booking P's share of each kick as the drive's work
 and the damping's as dissipation; its kinetic energy 1/2 M v^2 (`piston_energy`) is part
 of E_g.
+
+Under the RK4 schemes (paper, implicit) a piston is one more degree of freedom of the
+granular RK4 step (solver.rk4): `pistons_at_start` puts it at its state at the last
+accepted step (DR_SC, DR_VC, DR_AC), `piston_stage` books a stage's (v, a) into the RK4
+sums and moves it to the next stage, `piston_rk4_end` to the step's end, and
+`accept_pistons` takes the trial step's state once the step is accepted (`restore_pistons`
+puts a rejected one back). Its contacts' work on the granules is internal to E_g, P's work
+is RK4's quadrature of P v (its share of the drives' power), the damping's is in the
+contacts' viscous power at their relative rate.
 """
 
 from __future__ import annotations
@@ -27,14 +36,19 @@ from numba import njit
 
 from granplate.model.inputs import (
     DR_A,
+    DR_AC,
     DR_F,
     DR_FD,
+    DR_KS,
+    DR_KV,
     DR_P,
     DR_PD,
     DR_R,
     DR_REF,
     DR_S,
+    DR_SC,
     DR_V,
+    DR_VC,
     DR_VH,
     HIST_MAX,
     HIST_RATE,
@@ -345,3 +359,71 @@ def piston_energy(g):
             v = g.drive_now[k, DR_V]
             e += 0.5 * g.drive_par[k, PAR_MASS] * v * v
     return e
+
+
+@njit(cache=True)
+def pistons_at_start(g):
+    """Every piston at its state at the last accepted step (DR_SC, DR_VC, DR_AC) with its
+    RK4 sums zeroed: an RK4 step's first stage."""
+    for k in range(g.drive_target.shape[0]):
+        if is_piston(g, k):
+            now = g.drive_now[k]
+            now[DR_S] = now[DR_SC]
+            now[DR_V] = now[DR_VC]
+            now[DR_A] = now[DR_AC]
+            now[DR_KS] = 0.0
+            now[DR_KV] = 0.0
+
+
+@njit(cache=True)
+def piston_stage(g, weight, hs):
+    """Every piston: the last stage's velocity and acceleration (DR_V, DR_A) added to the
+    RK4 sums with `weight` (1, 2, 2, 1), then the piston moved to the next stage, its state
+    at the step's start plus hs [s] times them (RK4's s + hs v_i, v + hs a_i)."""
+    for k in range(g.drive_target.shape[0]):
+        if is_piston(g, k):
+            now = g.drive_now[k]
+            v = now[DR_V]
+            a = now[DR_A]
+            now[DR_KS] += weight * v
+            now[DR_KV] += weight * a
+            now[DR_S] = now[DR_SC] + hs * v
+            now[DR_V] = now[DR_VC] + hs * a
+
+
+@njit(cache=True)
+def piston_rk4_end(g, h):
+    """Every piston at the RK4 step's end: the fourth stage's (v, a) added to the sums, then
+    s = s_n + h/6 (v1 + 2 v2 + 2 v3 + v4), v = v_n + h/6 (a1 + 2 a2 + 2 a3 + a4)."""
+    h6 = h / 6.0
+    for k in range(g.drive_target.shape[0]):
+        if is_piston(g, k):
+            now = g.drive_now[k]
+            now[DR_KS] += now[DR_V]
+            now[DR_KV] += now[DR_A]
+            now[DR_S] = now[DR_SC] + h6 * now[DR_KS]
+            now[DR_V] = now[DR_VC] + h6 * now[DR_KV]
+
+
+@njit(cache=True)
+def accept_pistons(g):
+    """Every piston's state at the last force pass (DR_S, DR_V, DR_A: the accepted trial
+    step's end, or t = 0) taken as the state the next RK4 step starts from."""
+    for k in range(g.drive_target.shape[0]):
+        if is_piston(g, k):
+            now = g.drive_now[k]
+            now[DR_SC] = now[DR_S]
+            now[DR_VC] = now[DR_V]
+            now[DR_AC] = now[DR_A]
+
+
+@njit(cache=True)
+def restore_pistons(g):
+    """Every piston back at its state at the last accepted step (after a rejected trial
+    step, so that what reads DR_S and DR_V between steps sees the accepted state)."""
+    for k in range(g.drive_target.shape[0]):
+        if is_piston(g, k):
+            now = g.drive_now[k]
+            now[DR_S] = now[DR_SC]
+            now[DR_V] = now[DR_VC]
+            now[DR_A] = now[DR_AC]

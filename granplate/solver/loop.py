@@ -23,7 +23,7 @@ from granplate.solver.interface import accept_contacts, contact_modulus, first_g
 from granplate.solver.ladder import level_step
 from granplate.solver.plate_modal import driving_dofs, modal_acceleration, plate_energy, step_matrices
 from granplate.model.inputs import DR_F
-from granplate.solver.drives import drive_displacement, piston_energy, walls_moved
+from granplate.solver.drives import accept_pistons, drive_displacement, piston_energy, restore_pistons, walls_moved
 from granplate.solver.state import (
     A_DRIVE,
     A_GRAVITY,
@@ -109,6 +109,7 @@ def initialise(st, g, p, cfg, w):
         True,
     )
     commit_histories(st.clock[T_NOW], g)
+    accept_pistons(g)
     st.p1[0] = pr.p_shock
     st.p1[1] = pr.p_visc
     st.p1[2] = pr.p_fric
@@ -373,6 +374,7 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
         converged, it, worst, e_pot, rate = S.attempt(sw, t, h, slot, st, g, p, cfg, w)
         st.count[C_ITERS] += it
         if not converged:
+            restore_pistons(g)
             st.count[C_RETRIES] += 1
             if level_step(level + 4, cfg) < cfg.dt_min or level + 4 >= N_LEVELS:
                 lam = contact_modulus(worst, h, w.gmat[slot], g, w.normal_new, w.slip_new) if worst >= 0 else 0.0
@@ -381,10 +383,12 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
             continue
         err, retry, plate_work, fric_work = S.judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w)
         if retry >= 0:
+            restore_pistons(g)
             st.count[C_RETRIES] += 1
             st.count[C_LEVEL] = retry
             continue
         plate_work = S.commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w)
+        accept_pistons(g)
         if cfg.threads > 1:  # the copies and the pairs' histories on every core (solver.blocks)
             accept_rows(st.y, st.k0, st.k1, w.ynew, w.kend)
             accept_granular(t, h, land, t_land, plate_work, e_pot, st, w, False)

@@ -9,7 +9,7 @@ from __future__ import annotations
 from numba import njit
 
 from granplate.solver.dimension import friction_flow, granular_rhs, plate_friction_held
-from granplate.solver.drives import hold_drives, wall_shift_energy
+from granplate.solver.drives import hold_drives, piston_rk4_end, piston_stage, pistons_at_start, wall_shift_energy
 
 #: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps h
 #: times the friction relaxation rate of every contact that RK4 integrates below this bound.
@@ -33,6 +33,24 @@ def no_granules_step(h, p1, dacc, pend, ovl_new, ovl_who):
     ovl_who[0] = -1
     ovl_who[1] = -1
     return 0.0, 0.0
+
+
+@njit(cache=True)
+def first_stage(t, y0, hold, split, st, g, cfg, w):
+    """RK4's first stage (derivative, powers) at state y0 and time t [s]: st.k1/st.p1 (the
+    last step's end, first same as last), or recomputed into w.k1h/w.p1h where the held
+    plate-contact friction (hold) or the split friction's half step changes it."""
+    if plate_friction_held(hold, g) or split:
+        pr = granular_rhs(
+            t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
+        )
+        w.p1h[0] = pr.p_shock
+        w.p1h[1] = pr.p_visc
+        w.p1h[2] = pr.p_fric
+        w.p1h[3] = pr.p_drive
+        w.p1h[4] = pr.p_grav
+        return w.k1h, w.p1h
+    return st.k1, st.p1
 
 
 @njit(cache=True)
@@ -61,8 +79,7 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     nc = y0.shape[1]
     if ng == 0:
         return no_granules_step(h, st.p1, w.dacc, w.pend, w.ovl_new, w.ovl_who)
-    k1 = st.k1
-    p1 = st.p1
+    pistons_at_start(g)  # a piston (a force-driven wall) is one more degree of freedom of the step
     split = cfg.split_friction
     fric_split = 0.0
     if split:  # friction over [t, t + h/2]; RK4 then starts from w.ynew, updated in place
@@ -71,30 +88,23 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
                 w.ynew[i, c] = y0[i, c]
         fric_split = friction_flow(w.ynew, 0.5 * h, g, cfg, True)
         y0 = w.ynew
-    if plate_friction_held(hold, g) or split:
-        pr = granular_rhs(
-            t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
-        )
-        w.p1h[0] = pr.p_shock
-        w.p1h[1] = pr.p_visc
-        w.p1h[2] = pr.p_fric
-        w.p1h[3] = pr.p_drive
-        w.p1h[4] = pr.p_grav
-        k1 = w.k1h
-        p1 = w.p1h
+    k1, p1 = first_stage(t, y0, hold, split, st, g, cfg, w)
     hh = 0.5 * h
+    piston_stage(g, 1.0, hh)
     for i in range(ng):
         for c in range(nc):
             w.ytmp[i, c] = y0[i, c] + hh * k1[i, c]
     p2 = granular_rhs(
         t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k2, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
     )
+    piston_stage(g, 2.0, hh)
     for i in range(ng):
         for c in range(nc):
             w.ytmp[i, c] = y0[i, c] + hh * w.k2[i, c]
     p3 = granular_rhs(
         t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k3, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
     )
+    piston_stage(g, 2.0, h)
     for i in range(ng):
         for c in range(nc):
             w.ytmp[i, c] = y0[i, c] + h * w.k3[i, c]
@@ -102,6 +112,7 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
         t + h, w.ytmp, stage[2], stage[3], g, cfg, w.k4, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
     )
     h6 = h / 6.0
+    piston_rk4_end(g, h)
     for i in range(ng):
         for c in range(nc):  # (y0 may be w.ynew itself: each entry is read before it is written)
             w.ynew[i, c] = y0[i, c] + h6 * (k1[i, c] + 2.0 * w.k2[i, c] + 2.0 * w.k3[i, c] + w.k4[i, c])

@@ -25,6 +25,7 @@ from numba import njit
 from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm, friction_magnitude, plate_overlap
 from granplate.physics.energy import energy_residual
 from granplate.solver.dimension import force_error, kinetic_energies
+from granplate.solver.drives import piston_energy
 from granplate.solver.rk4 import rk4_granular_step, rk4_limit
 from granplate.solver.interface import forces_converged
 from granplate.solver.ladder import (
@@ -232,6 +233,7 @@ def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
         + ky
         + kz
         + kr
+        + piston_energy(g)  # (the trial step's: 0 without pistons)
         + e_pot
         + ep_new
         + st.acc[A_VISC]
