@@ -314,12 +314,14 @@ def initial_state(s: Scenario, x: np.ndarray, y: np.ndarray) -> np.ndarray:
 
 def build_model(scenario: Scenario) -> Model:
     """Validate, resolve and turn a scenario into the loop's arrays (in space, dimension =
-    3: `model.space.build_space_model`)."""
+    3: `model.space.build_space_model`); the model's scenario has the output stride of a
+    run of many granules (setup.output_stride)."""
     from granplate.model.plate_weight import weighed
     from granplate.model.static import precompressed
+    from granplate.setup.output_stride import with_output_stride
 
     validate(scenario)
-    s = resolve(scenario)
+    s = with_output_stride(resolve(scenario))  # a run of many granules outputs at a stride
     if s.dimension == 3:
         from granplate.model.space import build_space_model
 
