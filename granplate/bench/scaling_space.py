@@ -131,18 +131,19 @@ def _ours_worker(spec: dict) -> dict:
     s = dataclasses.replace(s, solver=dataclasses.replace(s.solver, threads=spec.get("threads")))
     load = os.getloadavg()[0]
     before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # [KiB]: the imports and compiled kernels
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     model = build_model(s)
-    setup = time.perf_counter() - t0
-    lists_s = [0.0]
+    setup, setup_cpu = time.perf_counter() - t0, time.process_time() - c0
+    lists_s = [0.0, 0.0]  # wall, CPU [s]
     refresh = run_contacts.ContactLists.refresh
 
     def timed_refresh(self, y):
-        t = time.perf_counter()
+        t, c = time.perf_counter(), time.process_time()
         try:
             return refresh(self, y)
         finally:
             lists_s[0] += time.perf_counter() - t
+            lists_s[1] += time.process_time() - c
 
     run_contacts.ContactLists.refresh = timed_refresh  # type: ignore[method-assign]
     t1, c1 = time.perf_counter(), time.process_time()
@@ -154,11 +155,14 @@ def _ours_worker(spec: dict) -> dict:
         "granules": len(s.granules),
         "contacts": int(len(model.pairs)),
         "setup_s": setup,
+        "setup_cpu_s": setup_cpu,
         "n_steps": int(ds.attrs["n_steps"]),
         "loop_s": loop_s,
         "loop_cpu_s": float(ds.attrs["loop_cpu_s"]),
         "lists_s": lists_s[0],
+        "lists_cpu_s": lists_s[1],
         "steps_s": loop_s - lists_s[0],
+        "steps_cpu_s": float(ds.attrs["loop_cpu_s"]) - lists_s[1],
         "end_s": run_s - loop_s - float(ds.attrs["first_call_time_s"]),
         "run_s": run_s,
         "run_cpu_s": run_cpu_s,
@@ -274,6 +278,7 @@ def _space_row(cells, mu: float, t_end: float, scheme: str, n: int, reference, l
         row["us_per_contact_step"] = per_contact_step_us(row["loop_s"], row["n_steps"], row["contacts"])
         row["cpu_us_per_contact_step"] = per_contact_step_us(row["loop_cpu_s"], row["n_steps"], row["contacts"])
         row["steps_us_per_contact_step"] = per_contact_step_us(row["steps_s"], row["n_steps"], row["contacts"])
+        row["steps_cpu_us_per_contact_step"] = per_contact_step_us(row["steps_cpu_s"], row["n_steps"], row["contacts"])
     if lammps and mu == 0.0 and "error" in row:
         log(f"scaling in space: {row['granules']} spheres, LAMMPS on {n} process(es) ...")
         lm = run_in_subprocess(
@@ -293,15 +298,15 @@ def format_space_table(rows: list[dict]) -> str:
         "| spheres | cells | contacts | mu | threads | set-up [s] | steps | loop [s] | speed-up | us/step "
         "| us/(contact step) | CPU us/(contact step) | peak [MiB] | error | LAMMPS dt [s] | LAMMPS steps "
         "| LAMMPS loop [s] | LAMMPS us/(contact step) | LAMMPS CPU us/(contact step) | LAMMPS error "
-        "| lists [s] | steps' us/(contact step) | result [s] | bytes/sphere | load |",
-        "|" + " ---: |" * 25,
+        "| lists [s] | steps' us/(contact step) | steps' CPU us/(contact step) | result [s] | bytes/sphere | load |",
+        "|" + " ---: |" * 26,
     ]
     for r in rows:
         cells = "x".join(str(c) for c in r["cells"])
         if "failed" in r:
             lines.append(
                 f"| {sphere_count(r['cells']):,} | {cells} | | {r['mu']:g} | {r.get('threads', 1)} | {r['failed']} |"
-                + " |" * 19
+                + " |" * 20
             )
             continue
         lm = r.get("lammps") or {}
@@ -339,6 +344,7 @@ def _more_columns(r: dict) -> list[str]:
     return [
         format_or_dash(r.get("lists_s"), ".3g"),
         format_or_dash(r.get("steps_us_per_contact_step"), ".3f"),
+        format_or_dash(r.get("steps_cpu_us_per_contact_step"), ".3f"),
         format_or_dash(r.get("end_s"), ".3g"),
         format_or_dash(r.get("bytes_per_sphere"), ".0f"),
         format_or_dash(r.get("load_average"), ".1f"),
