@@ -92,10 +92,25 @@ SHARES = (
 )
 
 
+def stride_notes(summary: dict) -> list[str]:
+    """The note of a run of many granules whose outputs were strided (setup.output_stride)."""
+    k = summary.get("output_stride")
+    if not k:
+        return []
+    from granplate.setup.output_stride import GRANULE_VALUES_MAX
+
+    given = summary["output_interval_given"]
+    return [
+        f"note: {summary['n_granules']:,} granules: the outputs are kept at one output time in {k}, "
+        f"time.output_interval {given:.4g} s raised to {k * given:.4g} s, so that each granule variable "
+        f"holds at most {GRANULE_VALUES_MAX:,} values (docs/output.md); time.field_interval sets it."
+    ]
+
+
 def summary_notes(summary: dict) -> list[str]:
     """What a reader needs to trust the energies: why the load's work taken back lowers
     the energies' sum, and any share above 1 (only by round-off: the energy residual)."""
-    notes = []
+    notes = stride_notes(summary)
     taken = summary.get("e_load_taken") or 0.0
     if not _negligible(summary, "e_load_taken") and taken > 0:
         notes.append(

@@ -178,6 +178,12 @@ def test_scaling_in_space_options_are_checked(capsys):
     assert all(scaling.check_scheme(name) is None for name in SCHEME_NAMES)
     assert main(["bench", "--scaling", "--dimension", "3", "--scheme", "no-such"]) == 2
     assert f"--scheme 'no-such': allowed {', '.join(SCHEME_NAMES)}" in capsys.readouterr().err
+    assert main(["bench", "--scaling", "--dimension", "3", "--mu", "0,-1"]) == 2
+    assert "--mu item '-1': allowed numbers from 0 to 1000" in capsys.readouterr().err
+    assert (
+        scaling_space.parse_frictions("0, 0.5") == (0.0, 0.5)
+        and scaling_space.parse_frictions(None) == scaling.FRICTIONS
+    )
 
 
 def test_launched_fcc_is_a_touching_fcc_packing():

@@ -298,3 +298,39 @@ def test_a_result_of_many_granules_keeps_them_beside_its_toml(tmp_path, monkeypa
     other = gp.simulate(moved, t_end=1e-6, progress=False)
     assert other.attrs["scenario_toml"] != ds.attrs["scenario_toml"]
     assert D.scenario_of(other).granules == resolve(moved).granules
+
+
+@pytest.mark.filterwarnings("ignore::granplate.errors.YieldWarning")  # the PTFE sphere yields: Hertz is timed
+def test_a_result_of_many_granules_from_a_file_restarts_and_seeds(tmp_path, monkeypatch):
+    """A granules_file scenario of more granules than GRANULES_IN_TOML_MAX, run from the
+    command line: its result keeps the granules as variables, and from that file
+    `run --from --from-time` continues the run bit for bit as one straight run, and
+    `resolve RESULT.nc` writes the granules at the result's last output time."""
+    from granplate.results import dataset as D
+
+    monkeypatch.setattr(D, "GRANULES_IN_TOML_MAX", 1)
+    # flying apart with spins (the seed at t_end is then a valid start), a restart state at 10 us
+    text = TABLES_3D.replace("vx = 1.5", "vx = -1.5").replace('material = "ptfe"', 'material = "ptfe"\nvz = 0.5')
+    text = text.replace("field_interval = 1e-6", "field_interval = 1e-6\nrestart_interval = 1e-5")
+    (tmp_path / "s.toml").write_text(_with_file(tmp_path, text, "npz", 3))
+    straight = tmp_path / "straight.nc"
+    assert main(["run", str(tmp_path / "s.toml"), "-o", str(straight), "-q"]) == 0
+    ds = D.read(straight)
+    assert ds.attrs["scenario_granules"] == "variables" and "[[granules]]" not in ds.attrs["scenario_toml"]
+    assert D.scenario_of(ds).granules == resolve(load_scenario(tmp_path / "s.toml")).granules
+    late = tmp_path / "late.nc"
+    assert (
+        main(["run", str(tmp_path / "s.toml"), "--from", str(straight), "--from-time", "1e-5", "-o", str(late), "-q"])
+        == 0
+    )
+    after = D.read(late)
+    assert float(after.time[0]) == pytest.approx(1e-5, rel=1e-12) and after.sizes["time"] == 11
+    for k in ("x", "y", "z", "vx", "vy", "vz", "omega_x", "omega_y", "omega_z"):
+        np.testing.assert_array_equal(after[k].values, ds[k].values[10:], err_msg=k)
+    assert (
+        main(["resolve", str(straight), "--granules-file", str(tmp_path / "g.csv"), "-o", str(tmp_path / "seed.toml")])
+        == 0
+    )
+    seed = load_scenario(tmp_path / "seed.toml")
+    for i, g in enumerate(seed.granules):
+        assert (g.x, g.y, g.z, g.vx) == tuple(float(ds[k].values[-1, i]) for k in ("x", "y", "z", "vx"))

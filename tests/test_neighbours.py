@@ -80,3 +80,25 @@ def test_close_pairs_equal_the_k_d_trees(n, dim):
     np.testing.assert_array_equal(all_pairs(points, distance), want)
     np.testing.assert_array_equal(close_pairs(points, distance), want)
     assert close_pairs(points, distance).dtype == np.int64
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_python_hypot_is_math_hypot_bit_for_bit(dim):
+    """python_hypot, which decides a touching lattice's pairs in contact_pairs, equals
+    math.hypot on every element: spread magnitudes, zeros, lattice steps off by round-off,
+    and a subnormal largest component."""
+    import math
+
+    from granplate.model.neighbours import python_hypot
+
+    rng = np.random.default_rng(dim)
+    n = 20_000
+    spread = rng.normal(size=(dim, n)) * 10.0 ** rng.integers(-300, 300, size=(1, n))
+    lattice = rng.integers(-3, 4, size=(dim, n)) * np.sqrt(2.0) * 1e-3 + rng.normal(size=(dim, n)) * 1e-19
+    c = np.concatenate([spread, lattice, rng.normal(size=(dim, 4))], axis=1)
+    c[0, -4:] = 0.0
+    c[:, -1] = 0.0
+    c[:, -2] = 3e-310
+    got = python_hypot(*c)
+    want = np.array([math.hypot(*c[:, k]) for k in range(c.shape[1])])
+    np.testing.assert_array_equal(got, want)

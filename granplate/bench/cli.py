@@ -187,6 +187,11 @@ def scaling_options(b) -> None:
         "LAMMPS on as many MPI processes); default 1 and every core for --scheme verlet, else 1",
     )
     b.add_argument(
+        "--mu",
+        help="with --scaling --dimension 3: comma-separated friction coefficients, rows each "
+        "(default 0,0.099); a size above 100,000 spheres runs without the reference and LAMMPS",
+    )
+    b.add_argument(
         "--no-lammps",
         dest="no_lammps",
         action="store_true",

@@ -21,6 +21,7 @@ its error against the same v_ref is at most ours.
 from __future__ import annotations
 
 import dataclasses
+import math
 import sys
 
 from granplate.bench.scaling import (
@@ -42,6 +43,10 @@ from granplate.bench import write_report
 SIZES: tuple[tuple[int, int, int], ...] = ((3, 1, 1), (3, 3, 3), (6, 6, 7), (9, 9, 9), (14, 14, 13))
 #: Sites per conventional FCC cell.
 FCC_SITES = 4
+#: Rows of more spheres than this run without the reference (RK4 at REFERENCE_DT), so
+#: without an error and LAMMPS's columns, and keep the outputs at t = 0 and t_end alone:
+#: what they time is the loop's cost per contact-step and the memory a million spheres take.
+REFERENCE_MAX_SPHERES = 100_000
 
 
 def sphere_count(cells: tuple[int, int, int]) -> int:
@@ -57,18 +62,19 @@ def launched_fcc(
     t_end: float = T_END,
     scheme: str = "implicit",
     dt: float | None = None,
+    outputs: int = 20,
 ):
     """A free FCC packing of touching steel spheres (radius [m], `cells` conventional cells,
     no walls, no plate, no load) whose first lattice plane (x smallest) moves at `speed`
     [m/s] in +x. Undamped, friction mu, dynamic detection; `scheme` with its own step, or
-    with dt [s] the fixed step dt (dt_initial = dt_max = dt)."""
+    with dt [s] the fixed step dt (dt_initial = dt_max = dt); `outputs` output intervals."""
     from granplate.setup.geometry import layout_packing
     from granplate.setup.scenario import Contact, Load, Scenario, Solver, SpaceLattice, TimeSettings
 
     packing = layout_packing(SpaceLattice(kind="fcc", cells=tuple(cells), radius=radius, walls=()))
     first = set(packing.column1)
     granules = tuple(dataclasses.replace(g, vx=speed) if g.label in first else g for g in packing.granules)
-    out = t_end / 20.0
+    out = t_end / outputs
     time_settings = TimeSettings(t_end=t_end, output_interval=out, field_interval=out)
     if dt is not None:
         time_settings = dataclasses.replace(time_settings, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt))
@@ -101,7 +107,11 @@ def max_error_3d(v: tuple, ref: dict) -> float:
 
 
 def _ours_worker(spec: dict) -> dict:
-    """Runs in a fresh subprocess: one (size, mu) of granplate; the reference when mu = 0."""
+    """Runs in a fresh subprocess: one (size, mu) of granplate; the reference when mu = 0
+    (unless spec["reference"] is "skip"). The time the loop spends on its contact lists
+    (`ContactLists.refresh`: the rebuilds and the list made at the run's end, Python on one
+    thread) is measured apart, so that the steps' own cost per contact-step can be read."""
+    import os
     import resource
     import time
     import warnings
@@ -111,28 +121,58 @@ def _ours_worker(spec: dict) -> dict:
     from granplate.errors import YieldWarning
     from granplate.model.arrays import build_model
     from granplate.results.run import simulate
+    from granplate.solver import run_contacts
 
     warnings.simplefilter("ignore", YieldWarning)  # Hertz's law is timed, elastic whatever the pressure
+    skip = spec.get("reference") == "skip"
     _warm_up(spec["scheme"])
     cells = tuple(spec["cells"])
-    s = launched_fcc(cells, mu=spec["mu"], t_end=spec["t_end"], scheme=spec["scheme"])
+    s = launched_fcc(cells, mu=spec["mu"], t_end=spec["t_end"], scheme=spec["scheme"], outputs=spec.get("outputs", 20))
     s = dataclasses.replace(s, solver=dataclasses.replace(s.solver, threads=spec.get("threads")))
-    t0 = time.perf_counter()
+    load = os.getloadavg()[0]
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # [KiB]: the imports and compiled kernels
+    t0, c0 = time.perf_counter(), time.process_time()
     model = build_model(s)
-    setup = time.perf_counter() - t0
+    setup, setup_cpu = time.perf_counter() - t0, time.process_time() - c0
+    lists_s = [0.0, 0.0]  # wall, CPU [s]
+    refresh = run_contacts.ContactLists.refresh
+
+    def timed_refresh(self, y):
+        t, c = time.perf_counter(), time.process_time()
+        try:
+            return refresh(self, y)
+        finally:
+            lists_s[0] += time.perf_counter() - t
+            lists_s[1] += time.process_time() - c
+
+    run_contacts.ContactLists.refresh = timed_refresh  # type: ignore[method-assign]
+    t1, c1 = time.perf_counter(), time.process_time()
     ds = simulate(s, model=model, progress=False)
+    run_s, run_cpu_s = time.perf_counter() - t1, time.process_time() - c1
+    run_contacts.ContactLists.refresh = refresh  # type: ignore[method-assign]
+    loop_s = float(ds.attrs["loop_time_s"])
     out = {
         "granules": len(s.granules),
         "contacts": int(len(model.pairs)),
         "setup_s": setup,
+        "setup_cpu_s": setup_cpu,
         "n_steps": int(ds.attrs["n_steps"]),
-        "loop_s": float(ds.attrs["loop_time_s"]),
+        "loop_s": loop_s,
         "loop_cpu_s": float(ds.attrs["loop_cpu_s"]),
+        "lists_s": lists_s[0],
+        "lists_cpu_s": lists_s[1],
+        "steps_s": loop_s - lists_s[0],
+        "steps_cpu_s": float(ds.attrs["loop_cpu_s"]) - lists_s[1],
+        "end_s": run_s - loop_s - float(ds.attrs["first_call_time_s"]),
+        "run_s": run_s,
+        "run_cpu_s": run_cpu_s,
         "rss_peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+        "bytes_per_sphere": (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before) * 1024.0 / len(s.granules),
+        "load_average": load,
         "energy_residual": float(np.abs(ds.energy_residual.values).max()),
         "threads": int(ds.attrs.get("threads", 1)),
     }
-    if spec["mu"] == 0.0:
+    if spec["mu"] == 0.0 and not skip:
         if spec.get("reference") is None:
             ref = simulate(launched_fcc(cells, t_end=spec["t_end"], scheme="paper", dt=REFERENCE_DT), progress=False)
             out["reference"] = {k: ref[k].values[-1].tolist() for k in ("vx", "vy", "vz")}
@@ -214,7 +254,16 @@ def run_scaling_space(
 def _space_row(cells, mu: float, t_end: float, scheme: str, n: int, reference, lammps: bool, log) -> dict:
     """One row of the 3D table: granplate on n threads and (frictionless, `lammps`) LAMMPS
     on n MPI processes to the same accuracy."""
-    spec = {"cells": list(cells), "mu": mu, "t_end": t_end, "scheme": scheme, "threads": n, "reference": reference}
+    big = sphere_count(cells) > REFERENCE_MAX_SPHERES
+    spec = {
+        "cells": list(cells),
+        "mu": mu,
+        "t_end": t_end,
+        "scheme": scheme,
+        "threads": n,
+        "reference": "skip" if big else reference,
+        "outputs": 1 if big else 20,
+    }
     row = {
         "dimension": 3,
         "cells": list(cells),
@@ -228,6 +277,8 @@ def _space_row(cells, mu: float, t_end: float, scheme: str, n: int, reference, l
         row["us_per_step"] = 1e6 * row["loop_s"] / row["n_steps"]
         row["us_per_contact_step"] = per_contact_step_us(row["loop_s"], row["n_steps"], row["contacts"])
         row["cpu_us_per_contact_step"] = per_contact_step_us(row["loop_cpu_s"], row["n_steps"], row["contacts"])
+        row["steps_us_per_contact_step"] = per_contact_step_us(row["steps_s"], row["n_steps"], row["contacts"])
+        row["steps_cpu_us_per_contact_step"] = per_contact_step_us(row["steps_cpu_s"], row["n_steps"], row["contacts"])
     if lammps and mu == 0.0 and "error" in row:
         log(f"scaling in space: {row['granules']} spheres, LAMMPS on {n} process(es) ...")
         lm = run_in_subprocess(
@@ -246,15 +297,16 @@ def format_space_table(rows: list[dict]) -> str:
     lines = [
         "| spheres | cells | contacts | mu | threads | set-up [s] | steps | loop [s] | speed-up | us/step "
         "| us/(contact step) | CPU us/(contact step) | peak [MiB] | error | LAMMPS dt [s] | LAMMPS steps "
-        "| LAMMPS loop [s] | LAMMPS us/(contact step) | LAMMPS CPU us/(contact step) | LAMMPS error |",
-        "|" + " ---: |" * 20,
+        "| LAMMPS loop [s] | LAMMPS us/(contact step) | LAMMPS CPU us/(contact step) | LAMMPS error "
+        "| lists [s] | steps' us/(contact step) | steps' CPU us/(contact step) | result [s] | bytes/sphere | load |",
+        "|" + " ---: |" * 26,
     ]
     for r in rows:
         cells = "x".join(str(c) for c in r["cells"])
         if "failed" in r:
             lines.append(
                 f"| {sphere_count(r['cells']):,} | {cells} | | {r['mu']:g} | {r.get('threads', 1)} | {r['failed']} |"
-                + " |" * 14
+                + " |" * 20
             )
             continue
         lm = r.get("lammps") or {}
@@ -276,9 +328,27 @@ def format_space_table(rows: list[dict]) -> str:
             f"| {r['setup_s']:.3f} | {r['n_steps']:,} | {r['loop_s']:.3g} | {format_or_dash(r.get('speedup'), '.2f')} "
             f"| {r['us_per_step']:.1f} "
             f"| {r['us_per_contact_step']:.3f} | {r['cpu_us_per_contact_step']:.3f} "
-            f"| {r['rss_peak_mib']:.0f} | {format_or_dash(r.get('error'), '.1e')} | " + " | ".join(lcols) + " |"
+            f"| {r['rss_peak_mib']:.0f} | {format_or_dash(r.get('error'), '.1e')} | "
+            + " | ".join(lcols)
+            + " | "
+            + " | ".join(_more_columns(r))
+            + " |"
         )
     return "\n".join(lines)
+
+
+def _more_columns(r: dict) -> list[str]:
+    """A row's last columns: its contact lists' time [s], its steps' own cost per
+    contact-step [us], the result's making after the loop [s], bytes per sphere at the
+    peak, the load average at its start ("-" where a row has none)."""
+    return [
+        format_or_dash(r.get("lists_s"), ".3g"),
+        format_or_dash(r.get("steps_us_per_contact_step"), ".3f"),
+        format_or_dash(r.get("steps_cpu_us_per_contact_step"), ".3f"),
+        format_or_dash(r.get("end_s"), ".3g"),
+        format_or_dash(r.get("bytes_per_sphere"), ".0f"),
+        format_or_dash(r.get("load_average"), ".1f"),
+    ]
 
 
 def parse_cells(text: str) -> list[tuple[int, int, int]]:
@@ -313,6 +383,22 @@ def parse_threads(text: str | None, scheme: str) -> tuple[int, ...]:
     return tuple(out)
 
 
+def parse_frictions(text: str | None) -> tuple[float, ...]:
+    """'0,0.5' -> (0.0, 0.5) (ValueError naming the bad item and the range); None: FRICTIONS."""
+    if text is None:
+        return FRICTIONS
+    out = []
+    for item in text.split(","):
+        try:
+            mu = float(item)
+        except ValueError:
+            mu = math.nan
+        if not 0.0 <= mu <= 1e3:
+            raise ValueError(f"--mu item {item!r}: allowed numbers from 0 to 1000 (friction coefficients), e.g. 0,0.5")
+        out.append(mu)
+    return tuple(out)
+
+
 def main(args, t_end: float, scheme: str) -> int:
     """`granplate bench --scaling --dimension 3 [--sizes 3x3x3,6x6x7] ...` (t_end and scheme
     checked by bench.scaling.main)."""
@@ -326,8 +412,18 @@ def main(args, t_end: float, scheme: str) -> int:
     except ValueError as err:
         print(f"granplate: error: {err}", file=sys.stderr)
         return 2
+    try:
+        frictions = parse_frictions(getattr(args, "mu", None))
+    except ValueError as err:
+        print(f"granplate: error: {err}", file=sys.stderr)
+        return 2
     rows = run_scaling_space(
-        sizes, t_end=t_end, scheme=scheme, lammps=not getattr(args, "no_lammps", False), threads=threads
+        sizes,
+        frictions=frictions,
+        t_end=t_end,
+        scheme=scheme,
+        lammps=not getattr(args, "no_lammps", False),
+        threads=threads,
     )
     print()
     print(format_space_table(rows))

@@ -316,11 +316,13 @@ def initial_state(s: Scenario, x: np.ndarray, y: np.ndarray) -> np.ndarray:
 def build_model(scenario: Scenario) -> Model:
     """Validate, resolve and turn a scenario into the loop's arrays, by its dimension's
     builder (`MODEL_BUILDERS`: `plane_model`, or in space `model.space.build_space_model`),
-    from its static state where it has one (`model.static.precompressed`)."""
+    from its static state where it has one (`model.static.precompressed`); the model's
+    scenario has the output stride of a run of many granules (`setup.output_stride`)."""
     from granplate.model.static import precompressed
+    from granplate.setup.output_stride import with_output_stride
 
     validate(scenario)
-    s = resolve(scenario)
+    s = with_output_stride(resolve(scenario))  # a run of many granules outputs at a stride
     return precompressed(MODEL_BUILDERS[of_number(s.dimension).name](s))
 
 

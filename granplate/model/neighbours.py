@@ -81,18 +81,65 @@ def candidate_pairs(x: np.ndarray, y: np.ndarray, distance: float, z: np.ndarray
 DECIDE_MARGIN = 1e-12
 
 
+def _exact_product(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(p, e) with p = fl(a b) and p + e = a b exactly (Dekker's product by Veltkamp's split)."""
+    ta, tb = a * 134217729.0, b * 134217729.0
+    ah, bh = ta - (ta - a), tb - (tb - b)
+    al, bl = a - ah, b - bh
+    p = ah * bh
+    q = ah * bl + al * bh
+    s = p + q
+    return s, p - s + q + al * bl
+
+
+def _fast_sum(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(s, e) with s = fl(a + b), s + e = a + b exactly for |a| >= |b| (Dekker's fast two-sum)."""
+    s = a + b
+    return s, b - (s - a)
+
+
+def python_hypot(*components: np.ndarray) -> np.ndarray:
+    """math.hypot(*components) of every element, bit for bit, by numpy: CPython's
+    vector_norm (its lossless scaling by a power of two, the squares' exact products summed
+    beside their round-off, the square root and its one differential correction), for
+    finite components (a subnormal largest magnitude: math.hypot itself)."""
+    mags = [np.abs(np.asarray(c, float)) for c in components]
+    top = np.maximum.reduce(mags) if len(mags) > 1 else mags[0]
+    scale = np.ldexp(1.0, -np.frexp(top)[1])
+    csum, frac1, frac2 = np.ones_like(top), np.zeros_like(top), np.zeros_like(top)
+    for m in mags:
+        v = m * scale
+        hi, lo = _exact_product(v, v)
+        csum, carry = _fast_sum(csum, hi)
+        frac1, frac2 = frac1 + lo, frac2 + carry
+    h = np.sqrt(csum - 1.0 + (frac1 + frac2))
+    hi, lo = _exact_product(-h, h)
+    csum, carry = _fast_sum(csum, hi)
+    frac1, frac2 = frac1 + lo, frac2 + carry
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        h = h + (csum - 1.0 + (frac1 + frac2)) / (2.0 * h)
+        out = np.where(top == 0.0, 0.0, h / scale)
+    for k in np.flatnonzero((top > 0.0) & (top < np.finfo(float).tiny)).tolist():  # subnormal: CPython's own
+        out[k] = math.hypot(*(float(c[k]) for c in components))
+    return out
+
+
 def contacts_among(cand: np.ndarray, x, y, r, gap_ratio: float, z=None) -> np.ndarray:
     """The mask of the candidate pairs (n, 2) that `is_contact` keeps, decided by numpy
-    for every pair but those within DECIDE_MARGIN of the limit (those by `is_contact`)."""
+    for every pair but those within DECIDE_MARGIN of the limit (those by `is_contact`'s
+    own expression with math.hypot's distance, `python_hypot`: a touching lattice puts
+    every pair there)."""
     i, j = cand[:, 0], cand[:, 1]
     dist = centre_distances(x, y, z, i, j)
     ri, rj = r[i], r[j]
     gap, limit = dist - ri - rj, gap_ratio * np.minimum(ri, rj)
     band = DECIDE_MARGIN * (dist + ri + rj)
     keep = gap <= limit - band
-    for p in np.flatnonzero(~keep & ~(gap > limit + band)).tolist():
-        a, b = int(i[p]), int(j[p])
-        keep[p] = is_contact(x[b] - x[a], y[b] - y[a], r[a], r[b], gap_ratio, None if z is None else z[b] - z[a])
+    near = np.flatnonzero(~keep & ~(gap > limit + band))
+    if len(near):
+        a, b = i[near], j[near]
+        d = (x[b] - x[a], y[b] - y[a]) + (() if z is None else (z[b] - z[a],))
+        keep[near] = python_hypot(*d) - r[a] - r[b] <= gap_ratio * np.minimum(r[a], r[b])
     return keep
 
 

@@ -636,6 +636,9 @@ SUMMARY_UNITS: dict[str, object] = {
     "threads": "1",
     "wall_time_s": "s",
     "compile_time_s": "s",
+    "output_stride": "1",
+    "output_interval_given": "s",
+    "n_granules": "1",
     "max_von_mises_ball": "Pa",
     "max_displacement": "m",
 }
@@ -769,6 +772,10 @@ def summary(ds: xr.Dataset) -> dict:
         # an elastic solid in space: its largest ball-averaged stress and displacement
         **{name: float(ds[name].max()) for name in ("max_von_mises_ball", "max_displacement") if name in ds},
     }
+    if "output_stride" in ds.attrs:  # a run of many granules output at a stride (setup.output_stride)
+        out["output_stride"] = int(ds.attrs["output_stride"])
+        out["output_interval_given"] = float(ds.attrs["output_interval_given"])
+        out["n_granules"] = int(ds.sizes.get("granule", 0))
     out["units"] = {k: u for k, u in SUMMARY_UNITS.items() if k in out}  # every number's unit
     return out
 

@@ -171,6 +171,7 @@ def check_restart(
     [restart]); returns the restart time [s]."""
     from granplate.results.dataset import scenario_of
     from granplate.setup.geometry import resolve
+    from granplate.setup.output_stride import with_output_stride
 
     times = restart_times(ds)
     if not times:
@@ -193,7 +194,7 @@ def check_restart(
     t1 = times[k]
     if not t1 < scenario.time.t_end:
         raise ScenarioError("time.t_end", scenario.time.t_end, f"must exceed the restart time {t1!r} s")
-    old, new = resolve(scenario_of(ds)), resolve(scenario)
+    old, new = resolve(scenario_of(ds)), with_output_stride(resolve(scenario))  # as the run's model has it
     if old.dimension != new.dimension:
         raise ScenarioError("dimension", new.dimension, f"must be the result's, {old.dimension}")
     if len(old.granules) != len(new.granules):

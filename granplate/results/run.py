@@ -152,6 +152,7 @@ def _simulate(
             clock,
         )
         ds = with_restart(ds, rec.snapshot, rec.earlier)
+    with_stride_note(ds, scenario, model)
     yield_note(ds)
     if rec.status != OK or interrupted(ds):
         n = ds.sizes["time"]
@@ -162,6 +163,16 @@ def _simulate(
             result=ds,
         )
     return ds
+
+
+def with_stride_note(ds, scenario: Scenario, model: Model) -> None:
+    """The attributes `output_stride` (k) and `output_interval_given` [s] of a run whose
+    model outputs every k-th output time of `scenario` (setup.output_stride); none for k = 1."""
+    given, run = scenario.time.output_interval, model.scenario.time.output_interval
+    k = round(run / given)
+    if k > 1:
+        ds.attrs["output_stride"] = int(k)
+        ds.attrs["output_interval_given"] = float(given)
 
 
 def _with_compile_time(ds, clock: CompileClock):

@@ -153,7 +153,11 @@ def output_bytes_per_second(s: Scenario) -> float:
 
 
 def _check_output_size(s: Scenario) -> None:
-    """The outputs of t_end fit in MEMORY_SHARE of the machine's memory."""
+    """The outputs of t_end fit in MEMORY_SHARE of the machine's memory (at the output
+    stride of a run of many granules, setup.output_stride)."""
+    from granplate.setup.output_stride import with_output_stride
+
+    s = with_output_stride(s)
     memory = MEMORY_SHARE * physical_memory()
     t_max = memory / output_bytes_per_second(s)
     t = s.time
