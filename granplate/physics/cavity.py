@@ -227,7 +227,7 @@ def johnson_plastic_work(delta_max: float, coef, rate: float) -> float:
     return johnson_state(delta_max, delta_max, coef, rate, 0.0)[3]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def johnson_normal_response(delta: float, delta_dot: float, coef, delta_max: float, rate: float, clip: bool):
     """The law of one contact in touch (delta > 0) with damping on its elastic part, as
     Thornton's (P13): |N| = F + c (delta - delta_p)^(1/4) d(delta)/dt while delta >
@@ -256,7 +256,7 @@ def johnson_normal_response(delta: float, delta_dot: float, coef, delta_max: flo
     return n, (n - f) * delta_dot, ep, w_p
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def johnson_normal_force(delta: float, delta_dot: float, coef, delta_max: float, rate: float, clip: bool) -> float:
     """|N| [N] of `johnson_normal_response` alone (no energies)."""
     c = coef[COEF_C]

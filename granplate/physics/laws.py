@@ -10,6 +10,14 @@ The time loop calls these for every contact kind (granule-granule, granule-wall,
 granule-plate, granule-body), so that a new normal law is one branch here and coefficient
 columns. An infinite COEF_DY takes the Hertz branch unchanged: elastic runs stay bitwise
 what they were before the plastic laws existed.
+
+Cost (docs/benchmarks.md, "Contacts that yield"): a contact whose overlap and largest
+overlap are both at or below COEF_DY takes Hertz's code here, before any plastic law is
+entered: the same result as the laws' own elastic branches (Thornton's yields at COEF_DY;
+the yield overlap of "johnson", COEF_DY (Y(rate) / Y)^2, is never below COEF_DY since
+C >= 0), without their history arithmetic or the rate factor's logarithm. The plastic laws'
+responses are compiled inline into these functions (`inline="always"`), so a contact past
+yield costs one call from the loop, as a Hertz contact does.
 """
 
 from __future__ import annotations
@@ -38,7 +46,7 @@ def normal_law_response(delta: float, delta_dot: float, coef, delta_max: float, 
     columns), largest overlap so far delta_max [m] and rate factor `rate` (Y(rate) / Y, 0 while
     unset; both read only by the plastic laws)."""
     delta_y = coef[COEF_DY]
-    if delta_y == math.inf:
+    if delta <= delta_y and delta_max <= delta_y:  # Hertz (delta_y inf) or an elastic history
         n, pv, ep = normal_response(delta, delta_dot, coef[COEF_A], coef[COEF_C], clip)
         return n, pv, ep, 0.0
     if coef[COEF_SY] > 0.0:
@@ -50,7 +58,7 @@ def normal_law_response(delta: float, delta_dot: float, coef, delta_max: float, 
 def normal_law_force(delta: float, delta_dot: float, coef, delta_max: float, rate: float, clip: bool) -> float:
     """|N| [N] of `normal_law_response` alone."""
     delta_y = coef[COEF_DY]
-    if delta_y == math.inf:
+    if delta <= delta_y and delta_max <= delta_y:  # Hertz (delta_y inf) or an elastic history
         return normal_force(delta, delta_dot, coef[COEF_A], coef[COEF_C], clip)[0]
     if coef[COEF_SY] > 0.0:
         return johnson_normal_force(delta, delta_dot, coef, delta_max, rate, clip)

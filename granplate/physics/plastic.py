@@ -227,7 +227,7 @@ def plastic_work(a: float, delta_y: float, delta_max: float) -> float:
     return loading_work - 0.4 * loading_force(a, delta_y, m) * unloading_span(delta_y, m)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def yielding_normal_response(
     delta: float, delta_dot: float, a: float, c: float, delta_y: float, delta_max: float, clip: bool
 ):
@@ -261,7 +261,7 @@ def yielding_normal_response(
     return n, (n - f) * delta_dot, 0.4 * f * d_el, w_p
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def yielding_normal_force(
     delta: float, delta_dot: float, a: float, c: float, delta_y: float, delta_max: float, clip: bool
 ) -> float:
