@@ -17,7 +17,7 @@ from __future__ import annotations
 from numba.extending import overload
 
 from granplate.model.inputs import Granular, Granular3
-from granplate.solver import blocks, granular as plane, granular3d as space, mindlin_plane
+from granplate.solver import blocks, granular as plane, granular3d as space, mindlin_plane, mindlin_space
 
 _MODULES = {Granular: plane, Granular3: space}
 
@@ -49,10 +49,11 @@ def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
     raise NotImplementedError("compiled use only")
 
 
-def mindlin_forces(yv, yn, h, g, cfg, acc):
-    """Mindlin's tangential forces after the velocity-Verlet force pass
-    (solver.granular3d.mindlin_forces in space, solver.mindlin_plane.mindlin_forces in the
-    plane): (stored energy, energy lost) [J]."""
+def mindlin_force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar):
+    """The velocity-Verlet force pass with Mindlin's tangential law in it: (ForceSums,
+    the springs' stored energy [J], their losses [J]) (solver.mindlin_plane.normal_mindlin_forces
+    in the plane; in space solver.mindlin_space.normal_mindlin_forces, or
+    solver.blocks.mindlin_forces_blocks on every core when spar has blocks)."""
     raise NotImplementedError("compiled use only")
 
 
@@ -115,14 +116,21 @@ def _normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
         return lambda t, y, g, cfg, acc, fdamp, fload, fpar, spar: fb(t, y, g, cfg, acc, fdamp, fload, fpar, spar)
 
 
-@overload(mindlin_forces, inline="always")
-def _mindlin_forces(yv, yn, h, g, cfg, acc):
+@overload(mindlin_force_pass, inline="always")
+def _mindlin_force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar):
     if _module_of(g) is plane:
-        fp = mindlin_plane.mindlin_forces
-        return lambda yv, yn, h, g, cfg, acc: fp(yv, yn, h, g, cfg, acc)
+        fp = mindlin_plane.normal_mindlin_forces
+        return lambda t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar: fp(t, yv, yn, h, g, cfg, acc, fdamp, fload)
     if _module_of(g) is space:
-        fn = space.mindlin_forces
-        return lambda yv, yn, h, g, cfg, acc: fn(yv, yn, h, g, cfg, acc)
+        fs = mindlin_space.normal_mindlin_forces
+        fb = blocks.mindlin_forces_blocks
+
+        def space_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar):
+            if spar.shape[0] > 0:
+                return fb(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar)
+            return fs(t, yv, yn, h, g, cfg, acc, fdamp, fload)
+
+        return space_pass
 
 
 @overload(sensor_loads, inline="always")
