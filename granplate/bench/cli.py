@@ -175,6 +175,14 @@ def scaling_options(b) -> None:
         "LAMMPS on as many MPI processes); default 1 and every core for --scheme verlet, else 1",
     )
     b.add_argument(
+        "--friction-law",
+        dest="friction_law",
+        choices=("tanh", "mindlin"),
+        default=None,
+        help="with --scaling --dimension 3: contact.tangential_law of the rows with friction "
+        "(default tanh, the paper's; mindlin runs under --scheme verlet)",
+    )
+    b.add_argument(
         "--no-lammps",
         dest="no_lammps",
         action="store_true",
