@@ -165,7 +165,8 @@ def test_scaling_in_space_rows_are_measured_and_documented(tmp_path):
 
 def test_scaling_in_space_options_are_checked(capsys):
     """In space --sizes takes FCC cells NXxNYxNZ; --dimension is 2 or 3; --scheme is any
-    registered scheme (model.inputs.SCHEME_NAMES), another a user error naming them all."""
+    registered scheme (model.inputs.SCHEME_NAMES), another a user error naming them all;
+    --friction-law mindlin only under --scheme verlet (where Mindlin's law runs)."""
     from granplate.bench import scaling, scaling_space
     from granplate.model.inputs import SCHEME_NAMES
 
@@ -184,6 +185,10 @@ def test_scaling_in_space_options_are_checked(capsys):
         scaling_space.parse_frictions("0, 0.5") == (0.0, 0.5)
         and scaling_space.parse_frictions(None) == scaling.FRICTIONS
     )
+    assert main(["bench", "--scaling", "--dimension", "3", "--friction-law", "mindlin", "--scheme", "implicit"]) == 2
+    assert "--friction-law mindlin: runs under --scheme verlet only" in capsys.readouterr().err
+    assert scaling_space.mu_law({"mu": 0.099, "law": "mindlin"}) == "0.099 (mindlin)"
+    assert scaling_space.mu_law({"mu": 0.0, "law": "-"}) == "0"
 
 
 def test_launched_fcc_is_a_touching_fcc_packing():

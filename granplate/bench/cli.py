@@ -192,6 +192,14 @@ def scaling_options(b) -> None:
         "(default 0,0.099); a size above 100,000 spheres runs without the reference and LAMMPS",
     )
     b.add_argument(
+        "--friction-law",
+        dest="friction_law",
+        choices=("tanh", "mindlin"),
+        default=None,
+        help="with --scaling --dimension 3: contact.tangential_law of the rows with friction "
+        "(default tanh, the paper's; mindlin runs under --scheme verlet)",
+    )
+    b.add_argument(
         "--no-lammps",
         dest="no_lammps",
         action="store_true",

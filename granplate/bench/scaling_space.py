@@ -63,11 +63,13 @@ def launched_fcc(
     scheme: str = "implicit",
     dt: float | None = None,
     outputs: int = 20,
+    law: str = "tanh",
 ):
     """A free FCC packing of touching steel spheres (radius [m], `cells` conventional cells,
     no walls, no plate, no load) whose first lattice plane (x smallest) moves at `speed`
-    [m/s] in +x. Undamped, friction mu, dynamic detection; `scheme` with its own step, or
-    with dt [s] the fixed step dt (dt_initial = dt_max = dt); `outputs` output intervals."""
+    [m/s] in +x. Undamped, friction mu under the tangential law `law` (contact.tangential_law),
+    dynamic detection; `scheme` with its own step, or with dt [s] the fixed step dt
+    (dt_initial = dt_max = dt); `outputs` output intervals."""
     from granplate.setup.geometry import layout_packing
     from granplate.setup.scenario import Contact, Load, Scenario, Solver, SpaceLattice, TimeSettings
 
@@ -85,7 +87,7 @@ def launched_fcc(
         granules=granules,
         plate=None,
         load=Load(kind="none"),
-        contact=Contact(mu=mu, alpha_n=0.0, pairs=(), detection="dynamic"),
+        contact=Contact(mu=mu, alpha_n=0.0, pairs=(), detection="dynamic", tangential_law=law),
         time=time_settings,
         solver=Solver(scheme=scheme),
     )
@@ -127,7 +129,10 @@ def _ours_worker(spec: dict) -> dict:
     skip = spec.get("reference") == "skip"
     _warm_up(spec["scheme"])
     cells = tuple(spec["cells"])
-    s = launched_fcc(cells, mu=spec["mu"], t_end=spec["t_end"], scheme=spec["scheme"], outputs=spec.get("outputs", 20))
+    law = spec.get("law", "tanh") if spec["mu"] > 0.0 else "tanh"
+    s = launched_fcc(
+        cells, mu=spec["mu"], t_end=spec["t_end"], scheme=spec["scheme"], outputs=spec.get("outputs", 20), law=law
+    )
     s = dataclasses.replace(s, solver=dataclasses.replace(s.solver, threads=spec.get("threads")))
     load = os.getloadavg()[0]
     before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # [KiB]: the imports and compiled kernels
@@ -230,9 +235,11 @@ def run_scaling_space(
     lammps: bool = True,
     log=print,
     threads: tuple[int, ...] = (1,),
+    law: str = "tanh",
 ) -> list[dict]:
     """The 3D table's rows: one per (size, mu, thread count), each measured in fresh
-    subprocesses; `speedup` is the loop's time on one thread over this row's. LAMMPS runs
+    subprocesses, the rows with friction under the tangential law `law`
+    (contact.tangential_law); `speedup` is the loop's time on one thread over this row's. LAMMPS runs
     the frictionless rows on as many MPI processes as the row has threads (`mpirun -np N`,
     its shrink-wrapped box cut into N domains)."""
     rows = []
@@ -241,7 +248,7 @@ def run_scaling_space(
             reference, one_thread = None, None
             for n in threads:
                 log(f"scaling in space: {sphere_count(cells)} spheres, mu = {mu:g}, {n} thread(s) ...")
-                row = _space_row(cells, mu, t_end, scheme, n, reference, lammps, log)
+                row = _space_row(cells, mu, t_end, scheme, n, reference, lammps, log, law)
                 reference = row.pop("reference", reference)
                 if n == 1 and "loop_s" in row:
                     one_thread = row["loop_s"]
@@ -251,9 +258,11 @@ def run_scaling_space(
     return rows
 
 
-def _space_row(cells, mu: float, t_end: float, scheme: str, n: int, reference, lammps: bool, log) -> dict:
-    """One row of the 3D table: granplate on n threads and (frictionless, `lammps`) LAMMPS
-    on n MPI processes to the same accuracy."""
+def _space_row(
+    cells, mu: float, t_end: float, scheme: str, n: int, reference, lammps: bool, log, law: str = "tanh"
+) -> dict:
+    """One row of the 3D table: granplate on n threads (friction under `law`) and
+    (frictionless, `lammps`) LAMMPS on n MPI processes to the same accuracy."""
     big = sphere_count(cells) > REFERENCE_MAX_SPHERES
     spec = {
         "cells": list(cells),
@@ -263,11 +272,13 @@ def _space_row(cells, mu: float, t_end: float, scheme: str, n: int, reference, l
         "threads": n,
         "reference": "skip" if big else reference,
         "outputs": 1 if big else 20,
+        "law": law,
     }
     row = {
         "dimension": 3,
         "cells": list(cells),
         "mu": mu,
+        "law": law if mu > 0.0 else "-",
         "scheme": scheme,
         "t_end_s": t_end,
         **run_in_subprocess("scaling_space", "_ours_worker", spec),
@@ -305,7 +316,7 @@ def format_space_table(rows: list[dict]) -> str:
         cells = "x".join(str(c) for c in r["cells"])
         if "failed" in r:
             lines.append(
-                f"| {sphere_count(r['cells']):,} | {cells} | | {r['mu']:g} | {r.get('threads', 1)} | {r['failed']} |"
+                f"| {sphere_count(r['cells']):,} | {cells} | | {mu_law(r)} | {r.get('threads', 1)} | {r['failed']} |"
                 + " |" * 20
             )
             continue
@@ -324,7 +335,7 @@ def format_space_table(rows: list[dict]) -> str:
                 format_or_dash(lm["error"], ".1e"),
             ]
         lines.append(
-            f"| {r['granules']:,} | {cells} | {r['contacts']:,} | {r['mu']:g} | {r.get('threads', 1)} "
+            f"| {r['granules']:,} | {cells} | {r['contacts']:,} | {mu_law(r)} | {r.get('threads', 1)} "
             f"| {r['setup_s']:.3f} | {r['n_steps']:,} | {r['loop_s']:.3g} | {format_or_dash(r.get('speedup'), '.2f')} "
             f"| {r['us_per_step']:.1f} "
             f"| {r['us_per_contact_step']:.3f} | {r['cpu_us_per_contact_step']:.3f} "
@@ -349,6 +360,12 @@ def _more_columns(r: dict) -> list[str]:
         format_or_dash(r.get("bytes_per_sphere"), ".0f"),
         format_or_dash(r.get("load_average"), ".1f"),
     ]
+
+
+def mu_law(row: dict) -> str:
+    """The mu column: mu, and its tangential law where it is not the default tanh."""
+    law = row.get("law", "-")
+    return f"{row['mu']:g}" + (f" ({law})" if law not in ("-", "tanh") else "")
 
 
 def parse_cells(text: str) -> list[tuple[int, int, int]]:
@@ -417,6 +434,10 @@ def main(args, t_end: float, scheme: str) -> int:
     except ValueError as err:
         print(f"granplate: error: {err}", file=sys.stderr)
         return 2
+    law = getattr(args, "friction_law", None) or "tanh"
+    if law != "tanh" and scheme != "verlet":
+        print(f"granplate: error: --friction-law {law}: runs under --scheme verlet only", file=sys.stderr)
+        return 2
     rows = run_scaling_space(
         sizes,
         frictions=frictions,
@@ -424,6 +445,7 @@ def main(args, t_end: float, scheme: str) -> int:
         scheme=scheme,
         lammps=not getattr(args, "no_lammps", False),
         threads=threads,
+        law=law,
     )
     print()
     print(format_space_table(rows))

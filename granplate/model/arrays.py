@@ -281,6 +281,7 @@ def loop_config(
         load_on_plate=bool(s.load.kind == "line" and s.load.target == "plate"),
         arm_shrink=1.0 if s.contact.torque_arm == "contact_point" else 0.0,
         lammps_arms=s.contact.torque_arm == "lammps",
+        mindlin=s.contact.tangential_law == "mindlin",
         scheme=scheme_number(sol.scheme),
         error_tol=float(sol.error_tol),
         force_floor=force_floor(q0, fres, tres, r, mass, s, t.output_interval) if floor is None else float(floor),

@@ -36,16 +36,18 @@ from granplate.solver.drives import begin_pass
 from granplate.solver.granular import ForceSums, commit_history, commit_history_row
 from granplate.solver.granular3d import pair_normal_3d, push_pair, shock_loads, wall_forces
 from granplate.solver.kicks import kick, kick_drift
+from granplate.solver.mindlin_space import pair_forces_mindlin, wall_mindlin
 
-#: columns of a block's buffer row fpar[k, i]: the normal force on granule i (x, y, z) [N]
-#: and its damping part (x, y, z) [N].
-F_X, F_DX = 0, 3
-N_FPAR = 6
+#: columns of a block's buffer row fpar[k, i]: the normal force on granule i (x, y, z) [N],
+#: its damping part (x, y, z) [N] and, under Mindlin's law, the tangential forces' torque
+#: (x, y, z) [N m] (their forces are in F_X's columns).
+F_X, F_DX, F_T = 0, 3, 6
+N_FPAR = 9
 #: columns of a block's sums spar[k]: viscous power [W], stored energy [J], plastic work
 #: [J], the largest overlap / smaller radius [-], its granule and its partner (as floats),
-#: and the kicks' load and damping work [J].
-S_VISC, S_EPOT, S_PLASTIC, S_OVL, S_OVL_I, S_OVL_J, S_WLOAD, S_WDAMP = range(8)
-N_SPAR = 8
+#: the kicks' load and damping work [J], and Mindlin's springs' energy and losses [J].
+S_VISC, S_EPOT, S_PLASTIC, S_OVL, S_OVL_I, S_OVL_J, S_WLOAD, S_WDAMP, S_ET, S_LOST = range(10)
+N_SPAR = 10
 
 
 @njit(cache=True)
@@ -66,7 +68,7 @@ def pair_forces_blocks(y, g, cfg, fpar, spar):
     for k in prange(nb):
         f = fpar[k]
         for i in range(ng):
-            for c in range(N_FPAR):
+            for c in range(F_T):  # (the torque columns are Mindlin's pass's)
                 f[i, c] = 0.0
         p_visc = 0.0
         e_pot = 0.0
@@ -167,6 +169,95 @@ def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
     )
     divide_by_inertia(acc, g.mass, g.inertia)
     return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
+
+
+@njit(parallel=True)
+def pair_mindlin_blocks(yv, yn, h, g, cfg, fpar, spar):
+    """`pair_forces_blocks` with Mindlin's law in it (solver.mindlin_space.pair_forces_mindlin
+    on block k's pairs, its buffer fpar[k]: forces, damping parts, torques; its sums into
+    spar[k], the springs' energy and losses into S_ET, S_LOST). Each contact's tangential
+    step reads and writes its own history row alone."""
+    nb = fpar.shape[0]
+    n_p = g.pair_ij.shape[0]
+    for k in prange(nb):
+        f = fpar[k]
+        for i in range(f.shape[0]):
+            for c in range(N_FPAR):
+                f[i, c] = 0.0
+        lo, hi = block_range(k, nb, n_p)
+        pv, ep, wp, ovl, ovl_i, ovl_j, e_t, lost = pair_forces_mindlin(yv, yn, h, g, cfg, lo, hi, f, f, F_X, F_DX, F_T)
+        spar[k, S_VISC] = pv
+        spar[k, S_EPOT] = ep
+        spar[k, S_PLASTIC] = wp
+        spar[k, S_OVL] = ovl
+        spar[k, S_OVL_I] = ovl_i
+        spar[k, S_OVL_J] = ovl_j
+        spar[k, S_ET] = e_t
+        spar[k, S_LOST] = lost
+
+
+@njit(parallel=True)
+def gather_torques(fpar, acc, w0):
+    """Each granule's torques from the blocks (F_T), added in block order, into acc's
+    columns w0, w0 + 1, w0 + 2 (the spin columns)."""
+    nb = fpar.shape[0]
+    for i in prange(fpar.shape[1]):
+        for c in range(3):
+            s = 0.0
+            for k in range(nb):
+                s += fpar[k, i, F_T + c]
+            acc[i, w0 + c] += s
+
+
+@njit(cache=True)
+def block_sums(spar):
+    """The blocks' sums in block order: (viscous power [W], stored energy [J], plastic work
+    [J], the largest overlap and its pair (its first occurrence in block order))."""
+    p_visc = 0.0
+    e_pot = 0.0
+    w_plastic = 0.0
+    ovl = 0.0
+    ovl_i = -1
+    ovl_j = -1
+    for k in range(spar.shape[0]):
+        p_visc += spar[k, S_VISC]
+        e_pot += spar[k, S_EPOT]
+        w_plastic += spar[k, S_PLASTIC]
+        if spar[k, S_OVL] > ovl:
+            ovl = spar[k, S_OVL]
+            ovl_i = int(spar[k, S_OVL_I])
+            ovl_j = int(spar[k, S_OVL_J])
+    return p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
+
+
+@njit(cache=True)
+def mindlin_forces_blocks(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar):
+    """solver.mindlin_space.normal_mindlin_forces on every core: the shock (serial), the
+    pairs with their Mindlin forces in blocks (`pair_mindlin_blocks`), their forces and
+    torques gathered in block order, then the walls (normal forces, then Mindlin's) in the
+    serial order. Returns (the ForceSums, the springs' energy [J], their losses [J]), each
+    sum over the blocks in block order."""
+    clear_rows(acc, fdamp, fload, 3)
+    begin_pass(t, g)
+    p_shock = 0.0
+    if not cfg.load_on_plate:
+        p_shock = shock_loads(t, yn, g, cfg, acc, fload)
+    pair_mindlin_blocks(yv, yn, h, g, cfg, fpar, spar)
+    gather_blocks(fpar, acc, fdamp, 3)
+    gather_torques(fpar, acc, 6)
+    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = block_sums(spar)
+    e_t = 0.0
+    lost = 0.0
+    for k in range(spar.shape[0]):
+        e_t += spar[k, S_ET]
+        lost += spar[k, S_LOST]
+    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
+        yn, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
+    )
+    divide_by_inertia(acc, g.mass, g.inertia)
+    e_w, lost_w = wall_mindlin(yv, yn, h, g, cfg, acc)
+    sums = ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
+    return sums, e_t + e_w, lost + lost_w
 
 
 @njit(parallel=True)

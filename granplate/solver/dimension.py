@@ -20,7 +20,7 @@ from numba.extending import overload
 
 from granplate.model import inputs
 from granplate.model.dimension import DIMENSIONS
-from granplate.solver import blocks, granular as plane, granular3d as space, mindlin_plane
+from granplate.solver import blocks, granular as plane, granular3d as space, mindlin_plane, mindlin_space
 
 #: the dimension's name (model.dimension) by the class of its granular arrays
 _ARRAYS = {getattr(inputs, d.arrays): d.name for d in DIMENSIONS.values()}
@@ -61,10 +61,11 @@ def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
     raise NotImplementedError("compiled use only")
 
 
-def mindlin_forces(yv, yn, h, g, cfg, acc):
-    """Mindlin's tangential forces after the velocity-Verlet force pass
-    (solver.granular3d.mindlin_forces in space, solver.mindlin_plane.mindlin_forces in the
-    plane): (stored energy, energy lost) [J]."""
+def mindlin_force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar):
+    """The velocity-Verlet force pass with Mindlin's tangential law in it: (ForceSums,
+    the springs' stored energy [J], their losses [J]) (solver.mindlin_plane.normal_mindlin_forces
+    in the plane; in space solver.mindlin_space.normal_mindlin_forces, or
+    solver.blocks.mindlin_forces_blocks on every core when spar has blocks)."""
     raise NotImplementedError("compiled use only")
 
 
@@ -122,9 +123,9 @@ def _normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
     return _own(g, "normal_forces_blocks")
 
 
-@overload(mindlin_forces, inline="always")
-def _mindlin_forces(yv, yn, h, g, cfg, acc):
-    return _own(g, "mindlin_forces")
+@overload(mindlin_force_pass, inline="always")
+def _mindlin_force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar):
+    return _own(g, "mindlin_force_pass")
 
 
 @overload(sensor_loads, inline="always")
@@ -165,14 +166,21 @@ def _space_normal_forces_blocks():
     return lambda t, y, g, cfg, acc, fdamp, fload, fpar, spar: fb(t, y, g, cfg, acc, fdamp, fload, fpar, spar)
 
 
-def _plane_mindlin_forces():
-    fp = mindlin_plane.mindlin_forces
-    return lambda yv, yn, h, g, cfg, acc: fp(yv, yn, h, g, cfg, acc)
+def _plane_mindlin_force_pass():
+    fp = mindlin_plane.normal_mindlin_forces  # the plane's pairs are not cut into blocks
+    return lambda t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar: fp(t, yv, yn, h, g, cfg, acc, fdamp, fload)
 
 
-def _space_mindlin_forces():
-    fn = space.mindlin_forces
-    return lambda yv, yn, h, g, cfg, acc: fn(yv, yn, h, g, cfg, acc)
+def _space_mindlin_force_pass():
+    fs = mindlin_space.normal_mindlin_forces
+    fb = blocks.mindlin_forces_blocks
+
+    def space_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar):
+        if spar.shape[0] > 0:
+            return fb(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar)
+        return fs(t, yv, yn, h, g, cfg, acc, fdamp, fload)
+
+    return space_pass
 
 
 def _plane_friction_held():
@@ -202,13 +210,13 @@ def _space_kinetic_energies():
 _OWN = {
     "plane": {
         "normal_forces_blocks": _plane_normal_forces_blocks,
-        "mindlin_forces": _plane_mindlin_forces,
+        "mindlin_force_pass": _plane_mindlin_force_pass,
         "plate_friction_held": _plane_friction_held,
         "kinetic_energies": _plane_kinetic_energies,
     },
     "space": {
         "normal_forces_blocks": _space_normal_forces_blocks,
-        "mindlin_forces": _space_mindlin_forces,
+        "mindlin_force_pass": _space_mindlin_force_pass,
         "plate_friction_held": _space_friction_held,
         "kinetic_energies": _space_kinetic_energies,
     },

@@ -18,7 +18,17 @@ from typing import NamedTuple
 
 from numba import njit
 
-from granplate.model.inputs import HIST_END, HIST_MAX, HIST_RATE, HIST_TIME, HIST_XI, HIST_XI_END, N_MINDLIN
+from granplate.model.inputs import (
+    HIST_A,
+    HIST_A_END,
+    HIST_END,
+    HIST_MAX,
+    HIST_RATE,
+    HIST_TIME,
+    HIST_XI,
+    HIST_XI_END,
+    N_MINDLIN,
+)
 from granplate.physics.contact import (
     COEF_DY,
     COEF_KS,
@@ -374,7 +384,9 @@ def commit_history(t, hist, coef):
 @njit(cache=True)
 def commit_history_row(t, hist, coef, k):
     """`commit_history` of contact k alone."""
-    if coef[k, COEF_KT] != 0.0:  # Mindlin's tangential history (docs/model.md section 3.16)
+    # Mindlin's tangential history (docs/model.md section 3.16); a contact out of touch with
+    # none, before and after (HIST_A and HIST_A_END zero: its rows are zeros), keeps its zeros
+    if coef[k, COEF_KT] != 0.0 and (hist[k, HIST_A_END] != 0.0 or hist[k, HIST_A] != 0.0):
         for col in range(N_MINDLIN):
             hist[k, HIST_XI + col] = hist[k, HIST_XI_END + col]
     d = hist[k, HIST_END]

@@ -35,7 +35,7 @@ from granplate.physics.contact import (
     friction_magnitude,
 )
 from granplate.physics.laws import normal_law_force, normal_law_response
-from granplate.physics.mindlin import contact_radius, mindlin_step, spring_energy
+from granplate.physics.mindlin import mindlin_step, spring_energy
 from granplate.physics.shock import shock_amplitude
 from granplate.physics.space import (
     arm_torque_3d,
@@ -553,6 +553,9 @@ def mindlin_contact(hist, k, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, n_abs):
             hist[k, HIST_XI_END + col] = hist[k, HIST_XI + col]
         e_t = spring_energy(c[COEF_KT] * hist[k, HIST_A], hist[k, HIST_XI], hist[k, HIST_XI + 1], hist[k, HIST_XI + 2])
         return hist[k, HIST_F], hist[k, HIST_F + 1], hist[k, HIST_F + 2], e_t, 0.0
+    damp = 0.0
+    if c[COEF_XT] != 0.0:  # eta_t = x_t c delta^(1/4)
+        damp = c[COEF_XT] * c[COEF_C] * math.sqrt(math.sqrt(delta))
     fx, fy, fz, xx, xy, xz, e_t, lost = mindlin_step(
         hist[k, HIST_XI],
         hist[k, HIST_XI + 1],
@@ -568,7 +571,7 @@ def mindlin_contact(hist, k, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, n_abs):
         vsz,
         h,
         c[COEF_MUT] * abs(n_abs),
-        c[COEF_XT] * c[COEF_C] * math.sqrt(math.sqrt(delta)),
+        damp,
         hist[k, HIST_F],
         hist[k, HIST_F + 1],
         hist[k, HIST_F + 2],
@@ -617,72 +620,3 @@ def push_tangential(acc, g, i, a, nx, ny, nz, fx, fy, fz, sign):
     granule i as accelerations into acc (as `add_friction`, divided by m and I): an impulse's
     update (`apply_friction_impulse`) with the force in place of the impulse."""
     apply_friction_impulse(acc, i, a, 1.0 / g.mass[i], 1.0 / g.inertia[i], nx, ny, nz, fx, fy, fz, sign)
-
-
-@njit(cache=True)
-def mindlin_forces(yv, yn, h, g, cfg, acc):
-    """Mindlin's tangential law (docs/model.md section 3.16) at every listed pair and wall
-    contact whose coefficient row has COEF_KT > 0, after the velocity-Verlet force pass:
-    positions from yv (the pass's), the slip velocity from yv's velocities (the half step's,
-    which move the granules over h [s]; h = 0: the force of the committed history), |N|
-    from yn's (the state the normal pass read). Adds the forces and torques to the
-    accelerations acc, the trial histories into HIST_XI_END, HIST_A_END. Returns (the
-    springs' stored energy [J], the energy they lost over the step [J])."""
-    e_t = 0.0
-    lost = 0.0
-    half_shrink = 0.5 * cfg.arm_shrink
-    for p in range(g.pair_ij.shape[0]):
-        c = g.pair_coef[p]
-        if c[COEF_KT] == 0.0:
-            continue
-        i = g.pair_ij[p, 0]
-        j = g.pair_ij[p, 1]
-        ri = g.radius[i]
-        rj = g.radius[j]
-        delta, nx, ny, nz = pair_contact_3d(yv[i, X], yv[i, Y], yv[i, Z], ri, yv[j, X], yv[j, Y], yv[j, Z], rj)
-        if delta <= 0.0:
-            lost += mindlin_parted(g.pair_hist, p, c)
-            continue
-        ai = contact_arm(ri, delta, half_shrink)
-        aj = contact_arm(rj, delta, half_shrink)
-        _, vsx, vsy, vsz = pair_slip(yv, i, j, nx, ny, nz, ai, aj)
-        ddot = normal_rate_3d(yn[i, VX] - yn[j, VX], yn[i, VY] - yn[j, VY], yn[i, VZ] - yn[j, VZ], nx, ny, nz)
-        n_abs = normal_law_force(delta, ddot, c, g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip)
-        a = contact_radius(ri * rj / (ri + rj), delta)
-        f0x, f0y, f0z = mindlin_old_force(g.pair_hist, p, c)
-        fx, fy, fz, e, d = mindlin_contact(g.pair_hist, p, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, n_abs)
-        e_t += e
-        lost += d
-        ti = ai
-        tj = aj
-        if cfg.lammps_arms:  # LAMMPS's torque arms: their couples' extra work over h is lost from D
-            ti = ri - 0.5 * delta
-            tj = rj - 0.5 * delta
-            lost -= couple_work(yv, i, ti - ai, nx, ny, nz, f0x + fx, f0y + fy, f0z + fz, 0.5 * h)
-            lost -= couple_work(yv, j, tj - aj, nx, ny, nz, f0x + fx, f0y + fy, f0z + fz, 0.5 * h)
-        push_tangential(acc, g, i, ti, nx, ny, nz, fx, fy, fz, 1.0)
-        push_tangential(acc, g, j, tj, nx, ny, nz, fx, fy, fz, -1.0)
-    for w in range(g.wall_i.shape[0]):
-        c = g.wall_coef[w]
-        if c[COEF_KT] == 0.0:
-            continue
-        i = g.wall_i[w]
-        ri = g.radius[i]
-        nx = g.wall_geo[w, 0]
-        ny = g.wall_geo[w, 1]
-        nz = g.wall_geo[w, 2]
-        shift, vn, _ = wall_motion(g, w)
-        delta = wall_overlap_3d(yv[i, X], yv[i, Y], yv[i, Z], ri, nx, ny, nz, g.wall_geo[w, 3] + shift)
-        if delta <= 0.0:
-            lost += mindlin_parted(g.wall_hist, w, c)
-            continue
-        arm = contact_arm(ri, delta, cfg.arm_shrink)
-        _, vsx, vsy, vsz = wall_slip(yv, i, nx, ny, nz, arm)
-        ddot = normal_rate_3d(yn[i, VX], yn[i, VY], yn[i, VZ], nx, ny, nz) - vn
-        n_abs = normal_law_force(delta, ddot, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
-        a = contact_radius(ri, delta)
-        fx, fy, fz, e, d = mindlin_contact(g.wall_hist, w, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, n_abs)
-        e_t += e
-        lost += d
-        push_tangential(acc, g, i, arm, nx, ny, nz, fx, fy, fz, 1.0)
-    return e_t, lost

@@ -5,13 +5,16 @@ slip velocity v_t t (eq. 6, physics.contact.pair_rates and wall_rates) enters as
 of space with no z component, so the history xi, the force and the frame update of eqs.
 (M2)-(M5) are the same code with z = 0 (xi stays along t: its third component stays
 zero); the torque of a force F at the arm a is a (n x F)_z = a F.t, on both granules.
+
+The law runs inside the velocity-Verlet force pass (`normal_mindlin_forces`): each contact's
+geometry and normal force, computed once, serve its normal force and its tangential step.
 """
 
 from __future__ import annotations
 
 from numba import njit
 
-from granplate.model.inputs import HIST_A, HIST_A_END, HIST_MAX, HIST_RATE
+from granplate.model.inputs import HIST_A, HIST_A_END, HIST_END, HIST_MAX, HIST_RATE
 from granplate.physics.contact import (
     COEF_KT,
     contact_arm,
@@ -22,20 +25,12 @@ from granplate.physics.contact import (
     wall_overlap,
     wall_rates,
 )
-from granplate.physics.laws import normal_law_force
+from granplate.physics.laws import normal_law_response
 from granplate.physics.mindlin import contact_radius
-from granplate.solver.drives import wall_motion
+from granplate.physics.shock import shock_amplitude
+from granplate.solver.drives import begin_pass, book_wall, wall_motion
+from granplate.solver.granular import ForceSums
 from granplate.solver.granular3d import mindlin_contact, mindlin_old_force, mindlin_parted
-
-
-@njit(cache=True)
-def push_tangential_plane(acc, mass, inertia, i, arm, nx, nz, fx, fy, sign):
-    """The tangential force sign * F (F = (fx, fy) on the first body [N]) and its torque
-    arm (n x F)_z (arm [m], the same sign on both bodies) on granule i of the plane (mass
-    [kg], moment of inertia [kg m^2] per granule) as accelerations into acc[:, 3:6]."""
-    acc[i, 3] += sign * fx / mass[i]
-    acc[i, 4] += sign * fy / mass[i]
-    acc[i, 5] += arm * (nx * fy - nz * fx) / inertia[i]
 
 
 @njit(cache=True)
@@ -46,23 +41,16 @@ def couple_work_plane(y, i, da, nx, nz, fx, fy, dt):
 
 
 @njit(cache=True)
-def pair_mindlin(p, i, j, ri, rj, yv, yn, h, hist, c, half_shrink, lammps_arms, clip):
-    """Mindlin's law at listed pair p (granules i, j of radii ri, rj [m]; history rows
-    hist, its coefficient row c) of the plane, as solver.granular3d.mindlin_forces: returns
-    (in touch, its force (fx, fy) on i [N], the arms of its torques on i and j [m], stored
-    energy [J], energy lost [J], the unit normal (nx, nz)). The arrays alone, not the
-    model's tuple: this runs per contact and step."""
-    if hist[p, HIST_A] == 0.0 and hist[p, HIST_A_END] == 0.0:  # no history, none begun: out of touch is nothing
-        if pair_apart(yv[i, 0], yv[i, 1], ri, yv[j, 0], yv[j, 1], rj):
-            return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    delta, nx, nz = pair_overlap(yv[i, 0], yv[i, 1], ri, yv[j, 0], yv[j, 1], rj)
-    if delta <= 0.0:
-        return False, 0.0, 0.0, 0.0, 0.0, 0.0, mindlin_parted(hist, p, c), nx, nz
+def pair_mindlin(p, i, j, ri, rj, delta, nx, nz, n_abs, yv, h, hist, c, half_shrink, lammps_arms):
+    """Mindlin's law at listed pair p in touch (granules i, j of radii ri, rj [m]; its
+    overlap delta [m], unit normal (nx, nz) and |N| = n_abs [N] from the force pass; history
+    rows hist, its coefficient row c) of the plane, the slip from yv's velocities over h [s]:
+    returns (its force (fx, fy) on i [N], the arms of its torques on i and j [m], stored
+    energy [J], energy lost [J]). The arrays alone, not the model's tuple: this runs per
+    contact and step."""
     ai = contact_arm(ri, delta, half_shrink)
     aj = contact_arm(rj, delta, half_shrink)
     _, vt = pair_rates(yv[i, 3], yv[i, 4], yv[i, 5], yv[j, 3], yv[j, 4], yv[j, 5], nx, nz, ai, aj)
-    ddot = pair_normal_rate(yn[i, 3], yn[i, 4], yn[j, 3], yn[j, 4], nx, nz)
-    n_abs = normal_law_force(delta, ddot, c, hist[p, HIST_MAX], hist[p, HIST_RATE], clip)
     a = contact_radius(ri * rj / (ri + rj), delta)
     f0x, f0y, _ = mindlin_old_force(hist, p, c)
     fx, fy, _, e, d = mindlin_contact(hist, p, c, a, delta, nx, nz, 0.0, -vt * nz, vt * nx, 0.0, h, n_abs)
@@ -73,75 +61,181 @@ def pair_mindlin(p, i, j, ri, rj, yv, yn, h, hist, c, half_shrink, lammps_arms, 
         tj = rj - 0.5 * delta
         d -= couple_work_plane(yv, i, ti - ai, nx, nz, f0x + fx, f0y + fy, 0.5 * h)
         d -= couple_work_plane(yv, j, tj - aj, nx, nz, f0x + fx, f0y + fy, 0.5 * h)
-    return True, fx, fy, ti, tj, e, d, nx, nz
+    return fx, fy, ti, tj, e, d
 
 
 @njit(cache=True)
-def mindlin_forces(yv, yn, h, g, cfg, acc):
-    """Mindlin's tangential law (docs/model.md section 3.16) at every listed pair and wall
-    contact of the plane whose coefficient row has COEF_KT > 0, after the velocity-Verlet
-    force pass, with solver.granular3d.mindlin_forces's signature and meaning: positions
-    and the slip rate from yv (the half step's velocities, over h [s]; h = 0: the committed
-    history's force), |N| from yn's velocities. Adds the forces and torques to acc[:, 3:6],
-    the trial histories into HIST_XI_END, HIST_A_END, HIST_F_END. Returns (the springs'
-    stored energy [J], the energy they lost over the step [J])."""
-    e_t = 0.0
-    lost = 0.0
-    mass = g.mass
-    inertia = g.inertia
+def pair_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
+    """The pairs' share of `normal_mindlin_forces`: every listed pair's normal force
+    (physics.laws, as solver.granular.normal_forces) at state yn and, where its coefficient
+    row has COEF_KT > 0, Mindlin's force (`pair_mindlin`) from the same overlap and |N|,
+    added to acc[:, 3:6] as forces and torques; the damping parts into fdamp, each
+    overlap into HIST_END, a parted contact's history ended (`mindlin_parted`). Returns
+    (viscous power [W], stored energy [J], plastic work [J], the largest overlap / radius,
+    its pair (i, j), the springs' energy [J], their losses [J])."""
     radius = g.radius
     pair_ij = g.pair_ij
     pair_coef = g.pair_coef
-    pair_hist = g.pair_hist
+    hist = g.pair_hist
     half_shrink = 0.5 * cfg.arm_shrink
     lammps_arms = cfg.lammps_arms
     clip = cfg.clip
+    p_visc = 0.0
+    e_pot = 0.0
+    w_plastic = 0.0
+    e_t = 0.0
+    lost = 0.0
+    ovl = 0.0
+    ovl_i = -1
+    ovl_j = -1
     for p in range(pair_ij.shape[0]):
-        c = pair_coef[p]
-        if c[COEF_KT] == 0.0:
-            continue
         i = pair_ij[p, 0]
         j = pair_ij[p, 1]
-        touch, fx, fy, ti, tj, e, d, nx, nz = pair_mindlin(
-            p, i, j, radius[i], radius[j], yv, yn, h, pair_hist, c, half_shrink, lammps_arms, clip
-        )
-        lost += d
-        if not touch:
+        ri = radius[i]
+        rj = radius[j]
+        c = pair_coef[p]
+        hist[p, HIST_END] = 0.0
+        delta = -1.0
+        if not pair_apart(yn[i, 0], yn[i, 1], ri, yn[j, 0], yn[j, 1], rj):
+            delta, nx, nz = pair_overlap(yn[i, 0], yn[i, 1], ri, yn[j, 0], yn[j, 1], rj)
+        if delta <= 0.0:
+            if c[COEF_KT] != 0.0 and (hist[p, HIST_A] != 0.0 or hist[p, HIST_A_END] != 0.0):
+                lost += mindlin_parted(hist, p, c)
             continue
-        e_t += e
-        push_tangential_plane(acc, mass, inertia, i, ti, nx, nz, fx, fy, 1.0)
-        push_tangential_plane(acc, mass, inertia, j, tj, nx, nz, fx, fy, -1.0)
-    e_w, lost_w = wall_mindlin(yv, yn, h, g, cfg, acc)
-    return e_t + e_w, lost + lost_w
+        hist[p, HIST_END] = delta
+        if delta > ovl * min(ri, rj):
+            ovl = delta / min(ri, rj)
+            ovl_i = i
+            ovl_j = j
+        ddot = pair_normal_rate(yn[i, 3], yn[i, 4], yn[j, 3], yn[j, 4], nx, nz)
+        n, pv, ep, wp = normal_law_response(delta, ddot, c, hist[p, HIST_MAX], hist[p, HIST_RATE], clip)
+        w_plastic += wp
+        p_visc += pv
+        e_pot += ep
+        fx = -n * nx
+        fy = -n * nz
+        if pv != 0.0:  # the damping part of |N|, pv / ddot (eq. 3)
+            d = pv / ddot
+            fdamp[i, 3] -= d * nx
+            fdamp[i, 4] -= d * nz
+            fdamp[j, 3] += d * nx
+            fdamp[j, 4] += d * nz
+        if c[COEF_KT] != 0.0:
+            tx, ty, ti, tj, e, d = pair_mindlin(
+                p, i, j, ri, rj, delta, nx, nz, n, yv, h, hist, c, half_shrink, lammps_arms
+            )
+            e_t += e
+            lost += d
+            fx += tx
+            fy += ty
+            tq = nx * ty - nz * tx
+            acc[i, 5] += ti * tq
+            acc[j, 5] += tj * tq
+        acc[i, 3] += fx
+        acc[i, 4] += fy
+        acc[j, 3] -= fx
+        acc[j, 4] -= fy
+    return p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, e_t, lost
 
 
 @njit(cache=True)
-def wall_mindlin(yv, yn, h, g, cfg, acc):
-    """`mindlin_forces` at the wall contacts: (stored energy [J], energy lost [J])."""
+def wall_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
+    """The walls' share of `normal_mindlin_forces`, one contact after another (a wall's
+    load and a driven wall's force are shared sums): each wall contact's normal force at
+    state yn (as solver.granular.normal_forces, booked on its wall and drive) and, where
+    COEF_KT > 0, Mindlin's force from the same overlap and |N|, into acc[:, 3:6] as forces
+    and torques. Returns (viscous power [W], stored energy [J], plastic work [J], the
+    largest overlap / radius, its granule, its partner code, springs' energy [J], losses [J])."""
+    p_visc = 0.0
+    e_pot = 0.0
+    w_plastic = 0.0
     e_t = 0.0
     lost = 0.0
-    mass = g.mass
-    inertia = g.inertia
+    ovl = 0.0
+    ovl_i = -1
+    ovl_j = -1
+    hist = g.wall_hist
     for w in range(g.wall_i.shape[0]):
-        c = g.wall_coef[w]
-        if c[COEF_KT] == 0.0:
-            continue
         i = g.wall_i[w]
         ri = g.radius[i]
+        c = g.wall_coef[w]
         nx = g.wall_geo[w, 0]
         nz = g.wall_geo[w, 1]
-        shift, vn, _ = wall_motion(g, w)
-        delta = wall_overlap(yv[i, 0], yv[i, 1], ri, nx, nz, g.wall_geo[w, 2] + shift)
+        shift, vn, kd = wall_motion(g, w)
+        delta = wall_overlap(yn[i, 0], yn[i, 1], ri, nx, nz, g.wall_geo[w, 2] + shift)
+        hist[w, HIST_END] = max(delta, 0.0)
         if delta <= 0.0:
-            lost += mindlin_parted(g.wall_hist, w, c)
+            if c[COEF_KT] != 0.0:
+                lost += mindlin_parted(hist, w, c)
+            continue
+        if delta > ovl * ri:
+            ovl = delta / ri
+            ovl_i = i
+            ovl_j = -1 - g.wall_w[w]
+        ddot = yn[i, 3] * nx + yn[i, 4] * nz - vn
+        n, pv, ep, wp = normal_law_response(delta, ddot, c, hist[w, HIST_MAX], hist[w, HIST_RATE], cfg.clip)
+        w_plastic += wp
+        p_visc += pv
+        e_pot += ep
+        acc[i, 3] -= n * nx
+        acc[i, 4] -= n * nz
+        d = 0.0
+        if pv != 0.0:
+            d = pv / ddot
+            fdamp[i, 3] -= d * nx
+            fdamp[i, 4] -= d * nz
+        book_wall(g, w, kd, n, d)
+        if c[COEF_KT] == 0.0:
             continue
         arm = contact_arm(ri, delta, cfg.arm_shrink)
         _, vt = wall_rates(yv[i, 3], yv[i, 4], yv[i, 5], nx, nz, arm)
-        ddot = yn[i, 3] * nx + yn[i, 4] * nz - vn
-        n_abs = normal_law_force(delta, ddot, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
         a = contact_radius(ri, delta)
-        fx, fy, _, e, d = mindlin_contact(g.wall_hist, w, c, a, delta, nx, nz, 0.0, -vt * nz, vt * nx, 0.0, h, n_abs)
+        fx, fy, _, e, dl = mindlin_contact(hist, w, c, a, delta, nx, nz, 0.0, -vt * nz, vt * nx, 0.0, h, n)
         e_t += e
-        lost += d
-        push_tangential_plane(acc, mass, inertia, i, arm, nx, nz, fx, fy, 1.0)
-    return e_t, lost
+        lost += dl
+        acc[i, 3] += fx
+        acc[i, 4] += fy
+        acc[i, 5] += arm * (nx * fy - nz * fx)
+    return p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, e_t, lost
+
+
+@njit(cache=True)
+def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload):
+    """The velocity-Verlet force pass of the plane (solver.granular.normal_forces) with
+    Mindlin's tangential law (docs/model.md section 3.16) in it: the shock, every listed
+    pair and wall contact's normal force at state yn (its velocities the damping's) and, at
+    the contacts whose coefficient row has COEF_KT > 0, the tangential spring's force from
+    the same overlap and |N|, its history moved on by the slip at yv's velocities over h
+    [s] (the half step's; yv's positions are yn's; h = 0: the force of the committed
+    history), trial histories into HIST_XI_END, HIST_A_END, HIST_F_END. Accelerations into
+    acc[:, 3:6], damping forces and loads apart (fdamp, fload). Returns (the ForceSums, the
+    springs' stored energy [J], the energy they lost over the step [J])."""
+    ng = yn.shape[0]
+    for i in range(ng):
+        for c in range(3, 6):
+            acc[i, c] = 0.0
+            fdamp[i, c] = 0.0
+            fload[i, c] = 0.0
+    begin_pass(t, g)
+    p_shock = 0.0
+    if not cfg.load_on_plate:
+        amp = shock_amplitude(t, cfg)
+        if amp != 0.0:
+            for i in range(ng):
+                fx = amp * g.shock_force[i]
+                tq = amp * g.shock_torque[i]
+                fload[i, 3] = fx
+                fload[i, 5] = tq
+                acc[i, 3] += fx
+                acc[i, 5] += tq
+                p_shock += fx * yn[i, 3] + tq * yn[i, 5]
+    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, e_t, lost = pair_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp)
+    pv_w, ep_w, wp_w, ovl_w, i_w, j_w, et_w, lost_w = wall_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp)
+    if ovl_w > ovl:
+        ovl, ovl_i, ovl_j = ovl_w, i_w, j_w
+    for i in range(ng):
+        acc[i, 3] /= g.mass[i]
+        acc[i, 4] /= g.mass[i]
+        acc[i, 5] /= g.inertia[i]
+    sums = ForceSums(p_shock, p_visc + pv_w, 0.0, e_pot + ep_w, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic + wp_w, 0.0, 0.0)
+    return sums, e_t + et_w, lost + lost_w

@@ -14,12 +14,12 @@ One step t -> t + h (fixed h = time.dt_max, cut to land on the output times):
    half step (in the reverse order) so that the recorded state is the whole step's.
 
 Under Mindlin's tangential law (contact.tangential_law = "mindlin", docs/model.md section
-3.16) there is no split friction at those contacts: after the force pass of step 3,
-`mindlin_forces` adds each contact's tangential spring force, its history moved on by the
-slip at the half-step velocities (the drift's), as LAMMPS's; its stored energy joins the
-contacts' and its losses (eq. M6) D_friction. At an elastic body's contacts the same law runs
-after the body's force pass (solver.body_mindlin), its slip against the surface's motion
-over the step.
+3.16) there is no split friction at those contacts: the force pass of step 3 adds each
+contact's tangential spring force from the same overlap and normal force
+(`mindlin_force_pass`), its history moved on by the slip at the half-step velocities (the
+drift's), as LAMMPS's; its stored energy joins the contacts' and its losses (eq. M6)
+D_friction. At an elastic body's contacts the same law runs after the body's force pass
+(solver.body_mindlin), its slip against the surface's motion over the step.
 
 The work of each kick is booked exactly as the kinetic energy it adds: h/2 F v_mean for
 the damping part of the force (D_visc) and the load (E_shock; a line load on the elastic
@@ -47,7 +47,7 @@ from granplate.physics.shock import shock_amplitude
 from granplate.solver import body as B
 from granplate.solver.body_mindlin import mindlin_forces as body_mindlin, step_forces as body_step_mindlin
 from granplate.solver.blocks import N_FPAR, N_SPAR, copy_rows, kick_blocks, kick_drift_blocks
-from granplate.solver.dimension import friction_flow, mindlin_forces, normal_forces, normal_forces_blocks
+from granplate.solver.dimension import friction_flow, mindlin_force_pass, normal_forces, normal_forces_blocks
 from granplate.solver.drives import (
     drive_kick_work,
     finish_pass,
@@ -138,12 +138,17 @@ def has_friction(g) -> bool:
 
 
 @njit(cache=True)
-def force_pass(t, y, g, cfg, acc, fdamp, fload, sw):
-    """The force pass at (t, y): in blocks on every core when the scratch has blocks
-    (solver.blocks), else serially. Returns the ForceSums."""
+def force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, sw):
+    """The force pass at (t, yn): in blocks on every core when the scratch has blocks
+    (solver.blocks), else serially; under Mindlin's law (cfg.mindlin) with the tangential
+    springs in it, their histories moved on by the slip at yv's velocities over h [s] (0:
+    the committed histories' forces). Returns (the ForceSums, the springs' stored energy
+    [J], their losses [J]; 0 and 0 without Mindlin's law)."""
+    if cfg.mindlin:
+        return mindlin_force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar)
     if sw.spar.shape[0] > 0:
-        return normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar)
-    return normal_forces(t, y, g, cfg, acc, fdamp, fload)
+        return normal_forces_blocks(t, yn, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar), 0.0, 0.0
+    return normal_forces(t, yn, g, cfg, acc, fdamp, fload), 0.0, 0.0
 
 
 @njit(cache=True)
@@ -191,11 +196,12 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
     cur = int(sw.split[CURRENT])
     nxt = 1 - cur
     if sw.split[STARTED] == 0.0:  # the first step: t_n's forces, loads and damping (st.k1 as `initialise` has it)
-        force_pass(t, st.y, g, cfg, st.k1, sw.fdamp[cur], sw.fload[cur], sw)
+        force_pass(
+            t, st.y, st.y, 0.0, g, cfg, st.k1, sw.fdamp[cur], sw.fload[cur], sw
+        )  # (Mindlin: the committed forces)
         if body:
             body_pass(st.y, sw, cur, st.q, st.qd, g, cfg, st.k1, sw.fdamp)
             body_mindlin(st.y, st.qd, b, cur, cur, 0.0, g.radius, g.mass, g.inertia, cfg.arm_shrink, st.k1)
-        mindlin_forces(st.y, st.y, 0.0, g, cfg, st.k1)  # the committed tangential histories' forces
         finish_pass(st.y, st.k1, g)
     _, pd0 = wall_powers(g)  # the damping power at the driven walls' velocities at t_n
     hk = 0.5 * h
@@ -221,8 +227,8 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
         wd += B.kick(b.qd, b.fmodal[cur], b.fdamp[cur], hk)
         B.turn(b.q, b.qd, b.omega, h)
         B.predicted_velocity(b, hk, cur)
-    pr = force_pass(t + h, w.ytmp, g, cfg, w.kend, sw.fdamp[nxt], sw.fload[nxt], sw)
-    e_t, lost_t = mindlin_forces(y, w.ytmp, h, g, cfg, w.kend)  # slip over h at the half step's velocities
+    # (Mindlin: the slip over h at the half step's velocities, y's)
+    pr, e_t, lost_t = force_pass(t + h, y, w.ytmp, h, g, cfg, w.kend, sw.fdamp[nxt], sw.fload[nxt], sw)
     fric += lost_t
     e_pot = pr.e_pot + e_t
     p_visc = pr.p_visc
