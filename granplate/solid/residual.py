@@ -62,9 +62,16 @@ def schur_flexibility(K: sp.spmatrix, xyz: np.ndarray, dofs: np.ndarray) -> tupl
     if not (np.array_equal(lu.perm_r, np.arange(n)) and np.array_equal(lu.perm_c, np.arange(n))):
         raise RuntimeError("the factorisation reordered the dofs; the Schur complement is not its last block")
     m = len(dofs)
-    L = lu.L[n - m :, n - m :].toarray()
-    U = lu.U[n - m :, n - m :].toarray()
-    G = la.solve_triangular(U, la.solve_triangular(L, np.eye(m), lower=True, unit_diagonal=True))
+    L = lu.L  # a full copy of the factor: sliced, then dropped before U's copy
+    L_ss = L[n - m :, n - m :].toarray()
+    del L
+    U = lu.U
+    U_ss = U[n - m :, n - m :].toarray()
+    del U
+    G = la.solve_triangular(L_ss, np.eye(m), lower=True, unit_diagonal=True, overwrite_b=True)
+    del L_ss
+    G = la.solve_triangular(U_ss, G, overwrite_b=True)
+    del U_ss
 
     def solve(b: np.ndarray) -> np.ndarray:
         b = np.asarray(b, dtype=float)
@@ -117,6 +124,43 @@ def flexibility_block(
     return out
 
 
+def static_flexibility(
+    K: sp.spmatrix,
+    dofs: np.ndarray,
+    xyz: np.ndarray,
+    M: sp.spmatrix | None = None,
+    rigid: np.ndarray | None = None,
+) -> np.ndarray:
+    """G[S, S] (|S|, |S|) [m/N] over the dofs S: K^-1's block for a held body (rigid
+    None), the inertia-relief flexibility's for a free one with mass M and M-orthonormal
+    rigid modes rigid (n, 6) (module docstring); xyz (n, 3): each dof's position [m].
+    Needs no elastic mode, so it can run beside the eigensolver."""
+    dofs = np.asarray(dofs, dtype=np.int64)
+    if rigid is None:
+        G, _ = schur_flexibility(K, xyz, dofs)
+        return G
+    # inertia relief (module docstring), on the body supported at six dofs off S
+    n = K.shape[0]
+    keep = np.setdiff1d(np.arange(n), support_dofs(rigid, avoid=dofs))
+    at = np.searchsorted(keep, dofs)
+    G_s, solve = schur_flexibility(sp.csr_matrix(K)[keep][:, keep], xyz[keep], at)
+    MR = M @ rigid
+    W = np.zeros((n, rigid.shape[1]))
+    W[keep] = solve(MR[keep])  # K_s^-1 M Phi_r
+    W_s, R_s = W[dofs], rigid[dofs]
+    return G_s - W_s @ R_s.T - R_s @ W_s.T + R_s @ (MR.T @ W) @ R_s.T
+
+
+def truncation_residual(G: np.ndarray, phi_s: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """R = G - phi_s diag(1/omega^2) phi_s^T [m/N], symmetrised: the static flexibility
+    G over S less the kept elastic modes' share (phi_s: the modes' rows at S; a free
+    body's zero modes are left out of the sum)."""
+    elastic = omega > 0.0
+    phi = phi_s[:, elastic]
+    R = G - (phi / omega[elastic] ** 2) @ phi.T
+    return 0.5 * (R + R.T)
+
+
 def residual_compliance(
     K: sp.spmatrix,
     dofs: np.ndarray,
@@ -132,19 +176,4 @@ def residual_compliance(
     Phi, omega: the kept modes (a free body's zero modes are left out of the sum);
     M, rigid: a free body's mass and M-orthonormal rigid modes (None: a held body)."""
     dofs = np.asarray(dofs, dtype=np.int64)
-    if rigid is None:
-        G, _ = schur_flexibility(K, xyz, dofs)
-    else:  # inertia relief (module docstring), on the body supported at six dofs off S
-        n = K.shape[0]
-        keep = np.setdiff1d(np.arange(n), support_dofs(rigid, avoid=dofs))
-        at = np.searchsorted(keep, dofs)
-        G_s, solve = schur_flexibility(sp.csr_matrix(K)[keep][:, keep], xyz[keep], at)
-        MR = M @ rigid
-        W = np.zeros((n, rigid.shape[1]))
-        W[keep] = solve(MR[keep])  # K_s^-1 M Phi_r
-        W_s, R_s = W[dofs], rigid[dofs]
-        G = G_s - W_s @ R_s.T - R_s @ W_s.T + R_s @ (MR.T @ W) @ R_s.T
-    elastic = omega > 0.0
-    phi_s = Phi[dofs][:, elastic]
-    R = G - (phi_s / omega[elastic] ** 2) @ phi_s.T
-    return 0.5 * (R + R.T)
+    return truncation_residual(static_flexibility(K, dofs, xyz, M, rigid), Phi[dofs], omega)
