@@ -41,7 +41,13 @@ from granplate.solid.fe import is_hexahedral, mass_matrix, node_coordinates, sca
 from granplate.solid.mesh import box_mesh, face_names, read_mesh
 from granplate.solid.factor import one_blas_thread
 from granplate.solid.modes import modes_below, rigid_body_modes, rigid_modes
-from granplate.solid.residual import flexibility, flexibility_block, static_flexibility, truncation_residual
+from granplate.solid.residual import (
+    flexibility,
+    flexibility_block,
+    static_factor,
+    static_flexibility,
+    truncation_residual,
+)
 
 log = logging.getLogger(__name__)
 
@@ -210,20 +216,26 @@ def modes_and_residual(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(omega, Phi, R over surface_dofs) of the reduced K, M (solid.modes, solid.residual).
 
-    The static flexibility over the surface (the residual's factorisation and dense
-    solves) needs no elastic mode: it runs in a second thread beside the eigensolver
-    (SuperLU, ARPACK's solves and LAPACK release the GIL), each on one BLAS thread (two
-    cores busy; the pin also keeps the two threads' BLAS limits from racing)."""
+    The residual's factorisation (solid.residual.static_factor) needs no elastic mode: it
+    runs in a second thread beside the eigensolver (SuperLU and ARPACK's solves release
+    the GIL), both on one BLAS thread; its dense part (the factor's trailing block and its
+    inverse, the largest arrays) waits for the eigensolver's end, which frees the shifted
+    factorisation, and has every BLAS thread. The outer pin spans the second thread's
+    whole life, so the two threads' BLAS limits cannot race."""
     rigid = m_rigid = None
     if free:
         rigid, m_rigid = rigid_body_modes(nodes), rigid_modes(nodes, M)
     if not surface_dofs.size:
         omega, Phi = modes_below(K, M, max_omega, xyz, rigid=rigid, k=k)
         return omega, Phi, np.zeros((0, 0))
-    with one_blas_thread(), ThreadPoolExecutor(max_workers=1, thread_name_prefix="flexibility") as pool:
-        G = pool.submit(static_flexibility, K, surface_dofs, xyz, M, m_rigid)
-        omega, Phi = modes_below(K, M, max_omega, xyz, rigid=rigid, k=k)
-        return omega, Phi, truncation_residual(G.result(), Phi[surface_dofs], omega)
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="flexibility") as pool:
+        with one_blas_thread():
+            factor = pool.submit(static_factor, K, surface_dofs, xyz, m_rigid)
+            omega, Phi = modes_below(K, M, max_omega, xyz, rigid=rigid, k=k)
+            schur = factor.result()
+    G = static_flexibility(K, surface_dofs, xyz, M, m_rigid, factor=schur)
+    del schur, factor  # the LU, before the residual's dense arrays
+    return omega, Phi, truncation_residual(G, Phi[surface_dofs], omega)
 
 
 def _stored_or_computed(payload: dict | None, compute: Callable[[], dict]) -> dict:
