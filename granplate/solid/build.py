@@ -9,6 +9,9 @@ Data flows one way::
                     -> omega, Phi (rigid-body modes of a free body)  solid.modes
                     -> R over the surface dofs                       solid.residual
 
+The residual's factorisation runs in a second thread beside the eigensolver
+(`modes_and_residual`): a cold build takes about the eigensolver's time, not the sum.
+
 The residual compliance is kept over the normal dofs of one face (default: zmax, the
 z dofs): a granule pressing on the face loads mainly those, and |S| is a third of all the
 face's dofs, a ninth of the dense matrix and a third of the solves. `components="xyz"`
