@@ -157,6 +157,24 @@ def test_free_body_build_keeps_rigid_modes_and_a_residual():
     )
 
 
+def test_residual_beside_the_eigensolver_leaves_blas_threads_and_rigid_modes_as_they_were():
+    """The residual's flexibility runs in a second thread beside the eigensolver: after the
+    build every BLAS library has its former thread count, and the rigid modes it used
+    (rigid_modes, known before the eigensolver) are the modes' first six, M-orthonormal."""
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+    from granplate.solid.boundary import reduced
+    from granplate.solid.fe import mass_matrix
+    from granplate.solid.modes import rigid_modes
+
+    counts = lambda: [p["num_threads"] for p in threadpoolctl.threadpool_info() if p["user_api"] == "blas"]
+    before = counts()
+    m = build_solid(Solid(size=(0.02, 0.01, 0.005), elements=(2, 2, 1), max_frequency=4e5), cache=False)
+    assert counts() == before
+    M = reduced(mass_matrix(m.basis, m.material.rho), m.dofs)
+    R = rigid_modes(m.nodes, M)
+    assert np.array_equal(R, m.Phi[:, :6]) and np.allclose(R.T @ (M @ R), np.eye(6), atol=1e-12)
+
+
 def test_box_signed_distance_is_the_euclidean_distance_to_the_box():
     """Outside: the distance to the nearest face, edge or corner (Pythagoras); inside: minus
     the distance to the nearest face; zero on the surface."""

@@ -9,6 +9,9 @@ Data flows one way::
                     -> omega, Phi (rigid-body modes of a free body)  solid.modes
                     -> R over the surface dofs                       solid.residual
 
+The residual's factorisation runs in a second thread beside the eigensolver
+(`modes_and_residual`): a cold build takes about the eigensolver's time, not the sum.
+
 The residual compliance is kept over the normal dofs of one face (default: zmax, the
 z dofs): a granule pressing on the face loads mainly those, and |S| is a third of all the
 face's dofs, a ninth of the dense matrix and a third of the solves. `components="xyz"`
@@ -21,6 +24,7 @@ import dataclasses
 import functools
 import hashlib
 import logging
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -38,8 +42,15 @@ from granplate.solid.boundary import face_node_dofs, face_nodes, fixed_dofs, fre
 from granplate.solid.cost import SolidCost, box_dofs, check_fits, estimate, mode_count
 from granplate.solid.fe import is_hexahedral, mass_matrix, node_coordinates, scalar_basis, stiffness_matrix
 from granplate.solid.mesh import box_mesh, face_names, read_mesh
-from granplate.solid.modes import modes_below, rigid_body_modes
-from granplate.solid.residual import flexibility, flexibility_block, residual_compliance
+from granplate.solid.factor import one_blas_thread
+from granplate.solid.modes import modes_below, rigid_body_modes, rigid_modes
+from granplate.solid.residual import (
+    flexibility,
+    flexibility_block,
+    static_factor,
+    static_flexibility,
+    truncation_residual,
+)
 
 log = logging.getLogger(__name__)
 
@@ -196,6 +207,40 @@ def window_size(n_modes: int, n_dofs: int, clamped: bool = False) -> int:
     return int(np.clip(int(margin * n_modes) + 10, 20, MAX_WINDOW))
 
 
+def modes_and_residual(
+    K: sp.spmatrix,
+    M: sp.spmatrix,
+    max_omega: float,
+    xyz: np.ndarray,
+    nodes: np.ndarray,
+    free: bool,
+    surface_dofs: np.ndarray,
+    k: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(omega, Phi, R over surface_dofs) of the reduced K, M (solid.modes, solid.residual).
+
+    The residual's factorisation (solid.residual.static_factor) needs no elastic mode: it
+    runs in a second thread beside the eigensolver (SuperLU and ARPACK's solves release
+    the GIL), both on one BLAS thread; its dense part (the factor's trailing block and its
+    inverse, the largest arrays) waits for the eigensolver's end, which frees the shifted
+    factorisation, and has every BLAS thread. The outer pin spans the second thread's
+    whole life, so the two threads' BLAS limits cannot race."""
+    rigid = m_rigid = None
+    if free:
+        rigid, m_rigid = rigid_body_modes(nodes), rigid_modes(nodes, M)
+    if not surface_dofs.size:
+        omega, Phi = modes_below(K, M, max_omega, xyz, rigid=rigid, k=k)
+        return omega, Phi, np.zeros((0, 0))
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="flexibility") as pool:
+        with one_blas_thread():
+            factor = pool.submit(static_factor, K, surface_dofs, xyz, m_rigid)
+            omega, Phi = modes_below(K, M, max_omega, xyz, rigid=rigid, k=k)
+            schur = factor.result()
+    G = static_flexibility(K, surface_dofs, xyz, M, m_rigid, factor=schur)
+    del schur, factor  # the LU, before the residual's dense arrays
+    return omega, Phi, truncation_residual(G, Phi[surface_dofs], omega)
+
+
 def _stored_or_computed(payload: dict | None, compute: Callable[[], dict]) -> dict:
     """The run store's arrays for payload, else compute() (then stored)."""
     if payload is None:
@@ -300,18 +345,8 @@ def _build_solid(
     def compute() -> dict:
         K = reduced(solid_stiffness(sbasis, mesh, sd.element, material, sd.rigid_patches), dofs)
         M = reduced(mass_matrix(sbasis, material.rho), dofs)
-        rigid = rigid_body_modes(nodes) if free else None
-        omega, Phi = modes_below(
-            K,
-            M,
-            2.0 * np.pi * sd.max_frequency,
-            xyz,
-            rigid=rigid,
-            k=window_size(cost.n_modes, len(dofs), bool(sd.clamped)),
-        )
-        resid = np.zeros((0, 0))
-        if surface_dofs.size:
-            resid = residual_compliance(K, surface_dofs, Phi, omega, xyz, M=M, rigid=Phi[:, :6] if free else None)
+        k = window_size(cost.n_modes, len(dofs), bool(sd.clamped))
+        omega, Phi, resid = modes_and_residual(K, M, 2.0 * np.pi * sd.max_frequency, xyz, nodes, free, surface_dofs, k)
         return {"omega": omega, "Phi": Phi, "dofs": dofs, "surface_dofs": surface_dofs, "resid": resid}
 
     payload = cache_payload(sd, material, surface, components) if cache else None

@@ -62,6 +62,12 @@ def m_orthonormal(V: np.ndarray, M: sp.spmatrix) -> np.ndarray:
     return la.solve_triangular(L, V.T, lower=True).T
 
 
+def rigid_modes(nodes: np.ndarray, M: sp.spmatrix) -> np.ndarray:
+    """A free body's rigid-body modes as modes_below gives them (n, 6): M-orthonormal,
+    signs fixed; nodes (n_nodes, 3) [m]. Known before the eigensolver runs."""
+    return fix_mode_signs(m_orthonormal(rigid_body_modes(nodes), M))
+
+
 def shift_inverse(K: sp.spmatrix, M: sp.spmatrix, sigma: float, xyz: np.ndarray) -> spla.LinearOperator:
     """(K - sigma M)^-1 as a LinearOperator (one sparse LU, solid.factor)."""
     return spla.LinearOperator(K.shape, matvec=factorised(K - sigma * M, xyz), dtype=float)

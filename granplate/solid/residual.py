@@ -22,6 +22,7 @@ kept for a few dofs on demand: `SolidModel.residual_block`).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -43,16 +44,27 @@ def support_dofs(rigid: np.ndarray, avoid: np.ndarray | None = None) -> np.ndarr
     return np.sort(allowed[piv[: rigid.shape[1]]])
 
 
-def schur_flexibility(K: sp.spmatrix, xyz: np.ndarray, dofs: np.ndarray) -> tuple[np.ndarray, Callable]:
-    """(K^-1[dofs, dofs] [m/N], x = K^-1 b) from one LU with `dofs` ordered last (module
-    docstring); K symmetric positive definite."""
+@dataclass(frozen=True)
+class SchurFactor:
+    """One SuperLU factorisation of a symmetric positive definite K with the dofs S
+    ordered last (module docstring): lu, the order of K's dofs in it, m = |S|."""
+
+    lu: spla.SuperLU
+    order: np.ndarray
+    m: int
+
+
+def schur_factor(K: sp.spmatrix, xyz: np.ndarray, dofs: np.ndarray) -> SchurFactor:
+    """K's LU with `dofs` ordered last, the rest under a nested-dissection order
+    (solid.factor); xyz (n, 3): each dof's position [m]. BLAS on one thread (SuperLU's
+    small blocks)."""
     from granplate.solid.factor import nested_dissection
 
     n = K.shape[0]
     K = sp.csr_matrix(K)
     interior = np.setdiff1d(np.arange(n), dofs)
     order = np.concatenate([interior[nested_dissection(K[interior][:, interior], xyz[interior])], dofs])
-    with one_blas_thread():  # SuperLU's small blocks (solid.factor); the dense solves below threaded
+    with one_blas_thread():
         lu = spla.splu(
             sp.csc_matrix(K[order][:, order]),
             permc_spec="NATURAL",
@@ -61,10 +73,24 @@ def schur_flexibility(K: sp.spmatrix, xyz: np.ndarray, dofs: np.ndarray) -> tupl
         )
     if not (np.array_equal(lu.perm_r, np.arange(n)) and np.array_equal(lu.perm_c, np.arange(n))):
         raise RuntimeError("the factorisation reordered the dofs; the Schur complement is not its last block")
-    m = len(dofs)
-    L = lu.L[n - m :, n - m :].toarray()
-    U = lu.U[n - m :, n - m :].toarray()
-    G = la.solve_triangular(U, la.solve_triangular(L, np.eye(m), lower=True, unit_diagonal=True))
+    return SchurFactor(lu, order, len(dofs))
+
+
+def schur_flexibility(factor: SchurFactor) -> tuple[np.ndarray, Callable]:
+    """(K^-1[S, S] [m/N], x = K^-1 b) from K's LU with S ordered last: the inverse of its
+    trailing block L_SS U_SS (two dense triangular solves, BLAS threads as set)."""
+    lu, order, m = factor.lu, factor.order, factor.m
+    n = len(order)
+    L = lu.L  # a full copy of the factor: sliced, then dropped before U's copy
+    L_ss = L[n - m :, n - m :].toarray()
+    del L
+    U = lu.U
+    U_ss = U[n - m :, n - m :].toarray()
+    del U
+    G = la.solve_triangular(L_ss, np.eye(m), lower=True, unit_diagonal=True, overwrite_b=True)
+    del L_ss
+    G = la.solve_triangular(U_ss, G, overwrite_b=True)
+    del U_ss
 
     def solve(b: np.ndarray) -> np.ndarray:
         b = np.asarray(b, dtype=float)
@@ -117,6 +143,54 @@ def flexibility_block(
     return out
 
 
+def static_factor(K: sp.spmatrix, dofs: np.ndarray, xyz: np.ndarray, rigid: np.ndarray | None = None) -> SchurFactor:
+    """The factorisation behind static_flexibility (its slow part; it needs no elastic
+    mode): K's (held body, rigid None) or, for a free body with M-orthonormal rigid modes
+    rigid (n, 6), that of K supported at six dofs off S, S ordered last."""
+    dofs = np.asarray(dofs, dtype=np.int64)
+    if rigid is None:
+        return schur_factor(K, xyz, dofs)
+    keep = np.setdiff1d(np.arange(K.shape[0]), support_dofs(rigid, avoid=dofs))
+    return schur_factor(sp.csr_matrix(K)[keep][:, keep], xyz[keep], np.searchsorted(keep, dofs))
+
+
+def static_flexibility(
+    K: sp.spmatrix,
+    dofs: np.ndarray,
+    xyz: np.ndarray,
+    M: sp.spmatrix | None = None,
+    rigid: np.ndarray | None = None,
+    factor: SchurFactor | None = None,
+) -> np.ndarray:
+    """G[S, S] (|S|, |S|) [m/N] over the dofs S: K^-1's block for a held body (rigid
+    None), the inertia-relief flexibility's for a free one with mass M and M-orthonormal
+    rigid modes rigid (n, 6) (module docstring); xyz (n, 3): each dof's position [m];
+    factor: static_factor(K, dofs, xyz, rigid) when already computed."""
+    dofs = np.asarray(dofs, dtype=np.int64)
+    factor = static_factor(K, dofs, xyz, rigid) if factor is None else factor
+    G_s, solve = schur_flexibility(factor)
+    if rigid is None:
+        return G_s
+    # inertia relief (module docstring), on the body supported at six dofs off S
+    n = K.shape[0]
+    keep = np.setdiff1d(np.arange(n), support_dofs(rigid, avoid=dofs))
+    MR = M @ rigid
+    W = np.zeros((n, rigid.shape[1]))
+    W[keep] = solve(MR[keep])  # K_s^-1 M Phi_r
+    W_s, R_s = W[dofs], rigid[dofs]
+    return G_s - W_s @ R_s.T - R_s @ W_s.T + R_s @ (MR.T @ W) @ R_s.T
+
+
+def truncation_residual(G: np.ndarray, phi_s: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """R = G - phi_s diag(1/omega^2) phi_s^T [m/N], symmetrised: the static flexibility
+    G over S less the kept elastic modes' share (phi_s: the modes' rows at S; a free
+    body's zero modes are left out of the sum)."""
+    elastic = omega > 0.0
+    phi = phi_s[:, elastic]
+    R = G - (phi / omega[elastic] ** 2) @ phi.T
+    return 0.5 * (R + R.T)
+
+
 def residual_compliance(
     K: sp.spmatrix,
     dofs: np.ndarray,
@@ -132,19 +206,4 @@ def residual_compliance(
     Phi, omega: the kept modes (a free body's zero modes are left out of the sum);
     M, rigid: a free body's mass and M-orthonormal rigid modes (None: a held body)."""
     dofs = np.asarray(dofs, dtype=np.int64)
-    if rigid is None:
-        G, _ = schur_flexibility(K, xyz, dofs)
-    else:  # inertia relief (module docstring), on the body supported at six dofs off S
-        n = K.shape[0]
-        keep = np.setdiff1d(np.arange(n), support_dofs(rigid, avoid=dofs))
-        at = np.searchsorted(keep, dofs)
-        G_s, solve = schur_flexibility(sp.csr_matrix(K)[keep][:, keep], xyz[keep], at)
-        MR = M @ rigid
-        W = np.zeros((n, rigid.shape[1]))
-        W[keep] = solve(MR[keep])  # K_s^-1 M Phi_r
-        W_s, R_s = W[dofs], rigid[dofs]
-        G = G_s - W_s @ R_s.T - R_s @ W_s.T + R_s @ (MR.T @ W) @ R_s.T
-    elastic = omega > 0.0
-    phi_s = Phi[dofs][:, elastic]
-    R = G - (phi_s / omega[elastic] ** 2) @ phi_s.T
-    return 0.5 * (R + R.T)
+    return truncation_residual(static_flexibility(K, dofs, xyz, M, rigid), Phi[dofs], omega)
