@@ -280,6 +280,8 @@ class PouredLayout:
     settle_damping: float = 1.0
     settle_time: float = 2.0
     settle_friction: float = 0.0
+    settle_softening: float = 1.0
+    settle_residual: float = 1e-2
 
 
 #: `[layout] kind` -> the dataclass that holds that kind's fields.
