@@ -24,7 +24,6 @@ import time
 
 import numpy as np
 
-from granplate.errors import ScenarioError
 from granplate.model.arrays import masses_and_inertias, pair_coefficients, wall_arrays
 from granplate.physics.contact import N_COEF
 from granplate.setup import pouring
@@ -277,7 +276,13 @@ def settle_ramped(s: Scenario, lay: PouredLayout, progress: bool = False) -> tup
     return p, out
 
 
-def check_ramped(s: Scenario, lay: PouredLayout) -> None:
-    """A ramped settling runs in space (dimension = 3)."""
-    if s.dimension != 3:
-        raise ScenarioError("layout.settle_softening", lay.settle_softening, "the ramped settling runs in space: dimension = 3 (1 in the plane)")
+def stored_arrays(p: Packing, out: Outcome) -> dict[str, np.ndarray]:
+    """The run store's arrays of a ramped settling: `results.pouring.packing_arrays` (centres,
+    radii, largest overlap) and what it reached: "kinetic" (kinetic energy over gravity's
+    work) and "residual" (the largest residual force over a weight)."""
+    from granplate.results.pouring import packing_arrays
+
+    arrays = packing_arrays(p.x, p.radius, p.scenario.walls)
+    arrays["kinetic"] = np.array(out.kinetic)
+    arrays["residual"] = np.array(out.residual)
+    return arrays
