@@ -38,6 +38,13 @@ log = logging.getLogger("granplate")
 SKIN = 0.4
 #: Cundall's local damping lambda [-] of the granules in contact (YADE's default is 0.2).
 LOCAL_DAMPING = 0.5
+#: The background damping of the spins [1/s]: every spin decays as exp(-SPIN_DAMPING t)
+#: besides its torques (a settling device: the law at rest has none).
+SPIN_DAMPING = 1e3
+#: The background damping of the velocities [1/s] once the fall is over (the kinetic
+#: energy first at most RAMP_BELOW of gravity's work): v decays as exp(-DRAG t) besides its
+#: forces (a settling device, as LAMMPS's fix viscous).
+DRAG = 200.0
 #: Steps of one chunk (the criteria are judged at its end).
 CHUNK_STEPS = 1000
 #: The stiffness is raised once the kinetic energy is at most this fraction of gravity's work,
@@ -136,6 +143,7 @@ def relist(p: Packing) -> None:
         i, j = cand[:, 0], cand[:, 1]
         cand = cand[np.linalg.norm(p.x[i] - p.x[j], axis=1) < r[i] + r[j] + p.skin]
     n = len(r)
+    cand = cand[np.argsort(cand[:, 0] * n + cand[:, 1], kind="stable")]  # keyed i n + j, ascending
     old = p.pairs[:, 0] * n + p.pairs[:, 1]
     new = cand[:, 0] * n + cand[:, 1]
     hist = np.zeros((len(cand), kernel.N_HIST))
@@ -153,9 +161,10 @@ def _force_args(p: Packing) -> tuple:
     return (p.x, p.v, p.w, p.radius, p.mass, p.g, p.pairs, p.pcoef, p.phist, p.walls, p.wcoef, p.whist)
 
 
-def run_chunk(p: Packing, s_end: float, dt: float, steps: int) -> None:
+def run_chunk(p: Packing, s_end: float, dt: float, steps: int, drag: float, lam: float) -> None:
     """`steps` steps of dt [s], the stiffness factor from p.s to s_end geometrically, the
-    lists rebuilt whenever a granule moved half the skin."""
+    lists rebuilt whenever a granule moved half the skin; drag [1/s]: the velocities'
+    background damping, lam [-]: Cundall's local damping."""
     done = 0
     ratio = (s_end / p.s) ** (1.0 / steps)
     while done < steps:
@@ -163,7 +172,7 @@ def run_chunk(p: Packing, s_end: float, dt: float, steps: int) -> None:
         s1 = p.s * ratio**k
         did = kernel.settle_steps(
             p.x, p.v, p.w, p.radius, p.mass, p.inertia, p.g, p.pairs, p.pcoef, p.phist, p.walls, p.wcoef,
-            p.whist, p.s, s1, LOCAL_DAMPING, dt, k, p.x_ref, 0.5 * p.skin, p.f, p.tq, p.touch,
+            p.whist, p.s, s1, lam, math.exp(-drag * dt), math.exp(-SPIN_DAMPING * dt), dt, k, p.x_ref, 0.5 * p.skin, p.f, p.tq, p.touch,
         )  # fmt: skip
         p.s *= ratio**did
         done += did
@@ -256,22 +265,19 @@ def settle_ramped(s: Scenario, lay: PouredLayout, progress: bool = False) -> tup
         s_end = min(1.0, p.s * RAMP_FACTOR) if ramp else p.s
         fall = fall_step(s, lay, s_end)
         dt = fall if falling else rest_step(p, s_end, fall)
-        run_chunk(p, s_end, dt, CHUNK_STEPS)
+        run_chunk(p, s_end, dt, CHUNK_STEPS, 0.0 if falling else DRAG, 0.0 if falling else LOCAL_DAMPING)
         out.t += dt * CHUNK_STEPS
         out.steps += CHUNK_STEPS
         out.kinetic = kinetic_fraction(p)
         out.residual = float(residual_forces(p).max())
         _report(out, p, "fall" if falling else ("ramp" if p.s < 1.0 else "rest"), progress)
-        if out.residual > lay.settle_residual:
+        falling = falling and out.kinetic > RAMP_BELOW
+        if p.s < 1.0 or out.residual > lay.settle_residual:
             continue
-        at_rest = lay.settle_tolerance if p.s >= 1.0 else RAMP_BELOW
-        if out.kinetic <= at_rest:
-            falling = False
-            if p.s >= 1.0:
-                out.settled = True
-                break
-        else:
-            _quench(p, out)  # in balance: what still moves is free motion
+        if out.kinetic <= lay.settle_tolerance:
+            out.settled = True
+            break
+        _quench(p, out)  # in balance: what still moves is free motion
     out.wall_s, out.cpu_s = time.perf_counter() - clock, time.process_time() - cpu
     return p, out
 

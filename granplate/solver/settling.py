@@ -161,10 +161,13 @@ def _local_damping(f, v, touch, lam):
 
 @njit(cache=True)
 def settle_steps(
-    x, v, w, radius, mass, inertia, g, pairs, pcoef, phist, walls, wcoef, whist, s0, s1, lam, dt, steps, x_ref, reach, f, tq, touch
+    x, v, w, radius, mass, inertia, g, pairs, pcoef, phist, walls, wcoef, whist, s0, s1, lam, keep, spin_keep, dt, steps, x_ref, reach, f, tq, touch
 ):
     """Up to `steps` velocity-Verlet steps of dt [s], the stiffness factor going
-    geometrically from s0 to s1 over them, Cundall's damping lam [-]; stops early where a
+    geometrically from s0 to s1 over them, Cundall's damping lam [-], every spin multiplied
+    by spin_keep [-] and every velocity by keep [-] once a step (a background damping: a
+    granule held at two points or spinning about a contact's normal turns freely under both
+    laws, a rattler bounces in its cage); stops early where a
     granule moved `reach` [m] or more from x_ref (its list is stale). f, tq, touch: the last
     pass's forces (kept across calls). Returns the steps done."""
     n = x.shape[0]
@@ -189,8 +192,8 @@ def settle_steps(
             hi = 0.5 * dt / inertia[i]
             d2 = 0.0
             for k in range(3):
-                v[i, k] += hm * f[i, k]
-                w[i, k] += hi * tq[i, k]
+                v[i, k] = keep * (v[i, k] + hm * f[i, k])
+                w[i, k] = spin_keep * (w[i, k] + hi * tq[i, k])
                 d2 += (x[i, k] - x_ref[i, k]) ** 2
             if d2 >= reach2:
                 far = True
