@@ -2,8 +2,7 @@
 sphere rests on the floor at Hertz's overlap (m g / A)^(2/3); a frictionless packing is in
 force balance under the real Hertz law, recomputed here from the centres alone (every
 granule's contact forces and weight sum to at most settle_residual of its weight, the floor
-carries the weight); a frictional packing's floor carries the weight within the side walls'
-Coulomb bound; the same seed settles to the same centres; bad values are refused by name."""
+carries the weight); the same seed settles to the same centres; bad values are refused by name."""
 
 from __future__ import annotations
 
@@ -61,7 +60,7 @@ def hertz_residuals(s: Scenario, c: np.ndarray, r: np.ndarray) -> tuple[np.ndarr
 def test_one_sphere_rests_at_hertz_overlap(tmp_path, monkeypatch):
     """delta = (m g / A)^(2/3), A = 4/3 E/(1 - nu^2) sqrt(R) against the rigid floor."""
     monkeypatch.setenv("GRANPLATE_CACHE", str(tmp_path))
-    s = poured(1, 0.5)
+    s = poured(1, 0.0)
     arrays = rp.settle(s, s.layout)
     r = float(arrays["radii"][0])
     m = STEEL.rho * 4.0 / 3.0 * math.pi * r**3
@@ -82,24 +81,15 @@ def test_frictionless_packing_balances_under_hertz(tmp_path, monkeypatch):
     assert floor == pytest.approx(weight, rel=s.layout.settle_residual)
 
 
-def test_frictional_packing_carries_its_weight_and_repeats(tmp_path, monkeypatch):
-    """|W - F_floor| <= mu sum N_side; the same seed settles to the same centres, bit for bit."""
+def test_same_seed_settles_to_the_same_centres(tmp_path, monkeypatch):
+    """Two settlings of one layout give the same centres, bit for bit."""
     monkeypatch.setenv("GRANPLATE_CACHE", str(tmp_path))
-    s = poured(30, 0.5)
-    arrays = rp.settle(s, s.layout)
-    assert float(arrays["residual"]) <= s.layout.settle_residual
-    _, floor, weight = hertz_residuals(s, arrays["centres"], arrays["radii"])
-    c, r = arrays["centres"], arrays["radii"]
-    side = 0.0
-    for w in pouring.container_walls(s.layout, 3, (0.0, 0.0, -G)):
-        if w.label != "zmin":
-            dw = np.maximum(c @ np.asarray(w.normal, float) + r - w.offset, 0.0)
-            side += float(np.sum(4.0 / 3.0 * effective_modulus(STEEL, None) * np.sqrt(r) * dw**1.5))
-    assert abs(weight - floor) <= 0.5 * side + s.layout.settle_residual * weight
     from granplate.results import ramped
 
+    s = poured(12, 0.0)
+    first, _ = ramped.settle_ramped(s, s.layout)
     again, _ = ramped.settle_ramped(s, s.layout)
-    assert np.array_equal(again.x, c)
+    assert np.array_equal(first.x, again.x)
 
 
 @pytest.mark.parametrize(

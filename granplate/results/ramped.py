@@ -41,8 +41,10 @@ LOCAL_DAMPING = 0.5
 #: The background damping of the spins [1/s]: every spin decays as exp(-SPIN_DAMPING t)
 #: besides its torques (a settling device: the law at rest has none).
 SPIN_DAMPING = 1e3
-#: The background damping of the velocities [1/s] once the fall is over (the kinetic
-#: energy first at most RAMP_BELOW of gravity's work): v decays as exp(-DRAG t) besides its
+#: The fall is over once the kinetic energy is at most this fraction of gravity's work: the
+#: settling devices below start and the step is the rest's.
+DAMP_BELOW = 1e-4
+#: The background damping of the velocities [1/s] once the fall is over: v decays as exp(-DRAG t) besides its
 #: forces (a settling device, as LAMMPS's fix viscous).
 DRAG = 200.0
 #: Steps of one chunk (the criteria are judged at its end).
@@ -243,10 +245,12 @@ def _quench(p: Packing, out: Outcome) -> None:
     out.quenches += 1
 
 
-def _report(out: Outcome, p: Packing, phase: str, progress: bool) -> None:
+def _report(out: Outcome, p: Packing, phase: str, progress: bool, clock: float, cpu: float) -> None:
+    """A progress line: the phase, simulated time, stiffness factor, criteria, wall and CPU seconds."""
     line = (
         f"pouring ({phase}): t = {out.t:.4g} s, stiffness x {p.s:.3g}, kinetic / gravity's work = "
-        f"{out.kinetic:.3g}, residual force / weight = {out.residual:.3g}"
+        f"{out.kinetic:.3g}, residual force / weight = {out.residual:.3g} "
+        f"({time.perf_counter() - clock:.0f} s wall, {time.process_time() - cpu:.0f} s CPU)"
     )
     log.info(line)
     if progress:
@@ -259,7 +263,7 @@ def settle_ramped(s: Scenario, lay: PouredLayout, progress: bool = False) -> tup
     clock, cpu = time.perf_counter(), time.process_time()
     p = packing(s, lay)
     out = Outcome()
-    falling = True  # until the soft packing first rests in balance: the fall's step
+    falling = True  # until the fall is over: the fall's step, no damping but the contacts'
     while out.t < lay.settle_time:
         ramp = not falling and p.s < 1.0 and out.kinetic <= RAMP_BELOW
         s_end = min(1.0, p.s * RAMP_FACTOR) if ramp else p.s
@@ -270,8 +274,8 @@ def settle_ramped(s: Scenario, lay: PouredLayout, progress: bool = False) -> tup
         out.steps += CHUNK_STEPS
         out.kinetic = kinetic_fraction(p)
         out.residual = float(residual_forces(p).max())
-        _report(out, p, "fall" if falling else ("ramp" if p.s < 1.0 else "rest"), progress)
-        falling = falling and out.kinetic > RAMP_BELOW
+        _report(out, p, "fall" if falling else ("ramp" if p.s < 1.0 else "rest"), progress, clock, cpu)
+        falling = falling and out.kinetic > DAMP_BELOW
         if p.s < 1.0 or out.residual > lay.settle_residual:
             continue
         if out.kinetic <= lay.settle_tolerance:

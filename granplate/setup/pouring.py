@@ -114,10 +114,14 @@ def _check_ramp(s: Scenario, lay: PouredLayout) -> None:
             "layout.settle_softening", k, f"must be in [1, {SETTLE_SOFTENING_MAX:g}] (1: the time loop's settling)"
         )
     if k > 1.0 and s.dimension != 3:
-        raise ScenarioError("layout.settle_softening", k, "the ramped settling runs in space: dimension = 3 (1 in the plane)")
+        raise ScenarioError(
+            "layout.settle_softening", k, "the ramped settling runs in space: dimension = 3 (1 in the plane)"
+        )
     r = lay.settle_residual
     if not (is_number(r) and 0.0 < r <= 1.0):
-        raise ScenarioError("layout.settle_residual", r, "must be in (0, 1] (a granule's residual force over its weight)")
+        raise ScenarioError(
+            "layout.settle_residual", r, "must be in (0, 1] (a granule's residual force over its weight)"
+        )
 
 
 def _check_distribution(lay: PouredLayout) -> None:

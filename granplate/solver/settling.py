@@ -131,7 +131,9 @@ def contact_forces(x, v, w, radius, mass, g, pairs, pcoef, phist, walls, wcoef, 
                     whist[row, q] = 0.0
                 continue
             c = wcoef[row]
-            n_abs, n_el = normal_force(delta, normal_rate_3d(v[i, 0], v[i, 1], v[i, 2], nx, ny, nz), s * c[COEF_A], sq * c[COEF_C], True)
+            n_abs, n_el = normal_force(
+                delta, normal_rate_3d(v[i, 0], v[i, 1], v[i, 2], nx, ny, nz), s * c[COEF_A], sq * c[COEF_C], True
+            )
             if elastic:
                 n_abs = n_el
             arm = ri - 0.5 * delta
@@ -161,7 +163,31 @@ def _local_damping(f, v, touch, lam):
 
 @njit(cache=True)
 def settle_steps(
-    x, v, w, radius, mass, inertia, g, pairs, pcoef, phist, walls, wcoef, whist, s0, s1, lam, keep, spin_keep, dt, steps, x_ref, reach, f, tq, touch
+    x,
+    v,
+    w,
+    radius,
+    mass,
+    inertia,
+    g,
+    pairs,
+    pcoef,
+    phist,
+    walls,
+    wcoef,
+    whist,
+    s0,
+    s1,
+    lam,
+    keep,
+    spin_keep,
+    dt,
+    steps,
+    x_ref,
+    reach,
+    f,
+    tq,
+    touch,
 ):
     """Up to `steps` velocity-Verlet steps of dt [s], the stiffness factor going
     geometrically from s0 to s1 over them, Cundall's damping lam [-], every spin multiplied
@@ -225,7 +251,9 @@ def stiffness_sums(x, radius, pairs, pcoef, walls, wcoef, s):
             delta = x[i, 0] * walls[q, 0] + x[i, 1] * walls[q, 1] + x[i, 2] * walls[q, 2] + radius[i] - walls[q, 3]
             if delta > 0.0:
                 c = wcoef[i * nw + q]
-                out[i] += s * (1.5 * c[COEF_A] * math.sqrt(delta) + ROLL_MOBILITY * c[COEF_KT] * contact_radius(radius[i], delta))
+                out[i] += s * (
+                    1.5 * c[COEF_A] * math.sqrt(delta) + ROLL_MOBILITY * c[COEF_KT] * contact_radius(radius[i], delta)
+                )
     return out
 
 
@@ -246,7 +274,9 @@ def wall_loads(x, radius, walls, wcoef, whist, s):
             c = wcoef[row]
             n_abs = s * c[COEF_A] * delta * math.sqrt(delta)
             scratch = whist[row : row + 1].copy()
-            fx, fy, fz = _tangential(scratch, 0, c, s, sq, contact_radius(radius[i], delta), delta, nx, ny, nz, 0.0, 0.0, 0.0, 0.0, n_abs)
+            fx, fy, fz = _tangential(
+                scratch, 0, c, s, sq, contact_radius(radius[i], delta), delta, nx, ny, nz, 0.0, 0.0, 0.0, 0.0, n_abs
+            )
             out[k, 0] += n_abs
             out[k, 1] += fx
             out[k, 2] += fy
