@@ -39,14 +39,15 @@ SKIN = 0.4
 #: Cundall's local damping lambda [-] of the granules in contact (YADE's default is 0.2).
 LOCAL_DAMPING = 0.5
 #: The background damping of the spins [1/s]: every spin decays as exp(-SPIN_DAMPING t)
-#: besides its torques (a settling device: the law at rest has none).
-SPIN_DAMPING = 1e3
-#: The fall is over once the kinetic energy is at most this fraction of gravity's work: the
-#: settling devices below start and the step is the rest's.
-DAMP_BELOW = 1e-4
-#: The background damping of the velocities [1/s] once the fall is over: v decays as exp(-DRAG t) besides its
-#: forces (a settling device, as LAMMPS's fix viscous).
-DRAG = 200.0
+#: besides its torques (a settling device; 0: off, the quenches stop free spins instead).
+SPIN_DAMPING = 0.0
+#: A chunk of the fall that ends with the kinetic energy at most this fraction of gravity's
+#: work (but above RAMP_BELOW) hands the next its state at rest (a quench).
+QUENCH_BELOW = 1e-4
+#: The background damping of the velocities [1/s] after the fall: v decays as exp(-DRAG t)
+#: besides its forces (a settling device, as LAMMPS's fix viscous). 0: off (200 1/s was
+#: tried: it slowed the rest phase's rearrangements, which did not end).
+DRAG = 0.0
 #: Steps of one chunk (the criteria are judged at its end).
 CHUNK_STEPS = 1000
 #: The stiffness is raised once the kinetic energy is at most this fraction of gravity's work,
@@ -263,19 +264,21 @@ def settle_ramped(s: Scenario, lay: PouredLayout, progress: bool = False) -> tup
     clock, cpu = time.perf_counter(), time.process_time()
     p = packing(s, lay)
     out = Outcome()
-    falling = True  # until the fall is over: the fall's step, no damping but the contacts'
+    falling = True  # until the kinetic energy first falls to RAMP_BELOW: the fall's step
     while out.t < lay.settle_time:
         ramp = not falling and p.s < 1.0 and out.kinetic <= RAMP_BELOW
         s_end = min(1.0, p.s * RAMP_FACTOR) if ramp else p.s
         fall = fall_step(s, lay, s_end)
         dt = fall if falling else rest_step(p, s_end, fall)
-        run_chunk(p, s_end, dt, CHUNK_STEPS, 0.0 if falling else DRAG, 0.0 if falling else LOCAL_DAMPING)
+        run_chunk(p, s_end, dt, CHUNK_STEPS, 0.0 if falling else DRAG, LOCAL_DAMPING)
         out.t += dt * CHUNK_STEPS
         out.steps += CHUNK_STEPS
         out.kinetic = kinetic_fraction(p)
         out.residual = float(residual_forces(p).max())
         _report(out, p, "fall" if falling else ("ramp" if p.s < 1.0 else "rest"), progress, clock, cpu)
-        falling = falling and out.kinetic > DAMP_BELOW
+        falling = falling and out.kinetic > RAMP_BELOW
+        if falling and out.kinetic <= QUENCH_BELOW:
+            _quench(p, out)  # the fall is over: what still moves is rolling and spinning
         if p.s < 1.0 or out.residual > lay.settle_residual:
             continue
         if out.kinetic <= lay.settle_tolerance:
