@@ -2,7 +2,8 @@
 sphere rests on the floor at Hertz's overlap (m g / A)^(2/3); a frictionless packing is in
 force balance under the real Hertz law, recomputed here from the centres alone (every
 granule's contact forces and weight sum to at most settle_residual of its weight, the floor
-carries the weight); the same seed settles to the same centres; bad values are refused by name."""
+carries the weight); a frictional packing's floor carries the weight within the side walls'
+Coulomb bound; the same seed settles to the same centres; bad values are refused by name."""
 
 from __future__ import annotations
 
@@ -79,6 +80,23 @@ def test_frictionless_packing_balances_under_hertz(tmp_path, monkeypatch):
     assert res.max() <= 1.01 * s.layout.settle_residual
     assert res.max() == pytest.approx(float(arrays["residual"]), rel=0.01)
     assert floor == pytest.approx(weight, rel=s.layout.settle_residual)
+
+
+def test_frictional_packing_carries_its_weight(tmp_path, monkeypatch):
+    """|W - F_floor| <= mu sum N_side + settle_residual W (Coulomb at the side walls), the
+    Hertz forces recomputed from the centres."""
+    monkeypatch.setenv("GRANPLATE_CACHE", str(tmp_path))
+    s = poured(30, 0.5)
+    arrays = rp.settle(s, s.layout)
+    assert float(arrays["residual"]) <= s.layout.settle_residual
+    _, floor, weight = hertz_residuals(s, arrays["centres"], arrays["radii"])
+    c, r = arrays["centres"], arrays["radii"]
+    side = 0.0
+    for w in pouring.container_walls(s.layout, 3, (0.0, 0.0, -G)):
+        if w.label != "zmin":
+            dw = np.maximum(c @ np.asarray(w.normal, float) + r - w.offset, 0.0)
+            side += float(np.sum(4.0 / 3.0 * effective_modulus(STEEL, None) * np.sqrt(r) * dw**1.5))
+    assert abs(weight - floor) <= 0.5 * side + s.layout.settle_residual * weight
 
 
 def test_same_seed_settles_to_the_same_centres(tmp_path, monkeypatch):
