@@ -11,7 +11,8 @@ radii go to the run store (`setup.pouring.STORE_KIND`); a settling that does not
 within settle_time keeps what it reached in the store under the kind "poured-partial"
 and stops with the residual kinetic energy and what to change. Importing this module
 registers `settle` with `setup.pouring` (`granplate/__init__.py` does, so every import of
-granplate has it).
+granplate has it). With layout.settle_softening > 1 (3D) the settling is `results.ramped`'s
+instead, stored the same way.
 """
 
 from __future__ import annotations
