@@ -11,7 +11,8 @@ radii go to the run store (`setup.pouring.STORE_KIND`); a settling that does not
 within settle_time keeps what it reached in the store under the kind "poured-partial"
 and stops with the residual kinetic energy and what to change. Importing this module
 registers `settle` with `setup.pouring` (`granplate/__init__.py` does, so every import of
-granplate has it).
+granplate has it). With layout.settle_softening > 1 (3D) the settling is `results.ramped`'s
+instead, stored the same way.
 """
 
 from __future__ import annotations
@@ -247,6 +248,8 @@ def settle(s: Scenario, lay: PouredLayout, progress: bool = False) -> dict[str, 
         found = store.load_arrays(pouring.STORE_KIND, payload, pouring.STORE_FORMAT)
         if found is not None:
             return found
+        if lay.settle_softening > 1.0:
+            return _settle_ramped(s, lay, payload, progress)
         state = start = None
         t, ratio, ok = 0.0, math.inf, True
         for phase, alpha_n in phases(lay):
@@ -271,20 +274,45 @@ def settle(s: Scenario, lay: PouredLayout, progress: bool = False) -> dict[str, 
         return arrays
 
 
+def _settle_ramped(s: Scenario, lay: PouredLayout, payload: dict, progress: bool) -> dict[str, np.ndarray]:
+    """`results.ramped`'s settling (layout.settle_softening > 1), stored as `settle`'s."""
+    from granplate.results import ramped
+
+    p, out = ramped.settle_ramped(s, lay, progress)
+    arrays = ramped.stored_arrays(p, out)
+    if not out.settled:
+        path = store.save_arrays("poured-partial", payload, pouring.STORE_FORMAT, arrays)
+        raise ScenarioError(
+            "layout.settle_time",
+            lay.settle_time,
+            f"the packing has not settled: kinetic energy / gravity's work = {out.kinetic:.3g}, residual force / "
+            f"weight = {out.residual:.3g} after {out.t:.4g} s (to {lay.settle_tolerance:g} and "
+            f"{lay.settle_residual:g}); raise layout.settle_time, layout.settle_tolerance or layout.settle_residual "
+            f"(the state reached is kept: {path})",
+        )
+    store.save_arrays(pouring.STORE_KIND, payload, pouring.STORE_FORMAT, arrays)
+    return arrays
+
+
 def settled_arrays(model, state: np.ndarray) -> dict[str, np.ndarray]:
-    """The store's arrays of a state: centres, radii and the largest overlap at rest of a
-    pair or a granule against a wall, over the smaller radius [-]."""
+    """The store's arrays of a state: `packing_arrays` of its centres."""
+    d = model.config.dimension
+    return packing_arrays(state[:, :d], np.asarray(model.granular.radius, float), model.scenario.walls)
+
+
+def packing_arrays(centres: np.ndarray, radii: np.ndarray, walls) -> dict[str, np.ndarray]:
+    """The store's arrays of a packing: centres (n, d) [m], radii [m] and the largest
+    overlap at rest of a pair or a granule against one of the Walls, over the smaller radius [-]."""
     from granplate.setup.pairs import close_pairs
 
-    d = model.config.dimension
-    c, r = state[:, :d].copy(), np.asarray(model.granular.radius, float)
+    c, r = np.array(centres, float), np.asarray(radii, float)
     worst = 0.0
     pairs = close_pairs(c, 2.0 * float(r.max())) if len(r) else np.zeros((0, 2), np.int64)
     if len(pairs):
         i, j = pairs[:, 0], pairs[:, 1]
         ov = (r[i] + r[j] - np.linalg.norm(c[i] - c[j], axis=1)) / np.minimum(r[i], r[j])
         worst = max(worst, float(ov.max()))
-    for w in model.scenario.walls:
+    for w in walls:
         n = np.asarray(w.normal, float) / np.linalg.norm(w.normal)
         worst = max(worst, float(((c @ n + r - w.offset) / r).max()))
     return {"centres": c, "radii": r, "overlap": np.array(max(worst, 0.0))}

@@ -83,7 +83,8 @@ CHOICES: dict[tuple[type, str], tuple[str, ...]] = {
 #: Fields left out of a written table when they hold this default (written, they would
 #: change the text, and so the stored results' keys, of every scenario written before).
 UNWRITTEN_DEFAULTS: dict[str, dict[str, Any]] = {
-    "contact": {"normal_law": "hertz", "tangential_law": "tanh", "tangential_damping": 0.0}
+    "contact": {"normal_law": "hertz", "tangential_law": "tanh", "tangential_damping": 0.0},
+    "layout": {"settle_softening": 1.0, "settle_residual": 1e-2},
 }
 #: Fields of the three-dimensional mode left out of a two-dimensional scenario's tables
 #: when they hold their default, so that every 2D scenario is written as before
@@ -467,7 +468,7 @@ def _layout_materials(layout: Any) -> set[str]:
 
 def _layout_dict(layout: Any) -> dict:
     """[layout] as a dict; `kind` left out for the paper's packing (its default)."""
-    d = _plain(layout)
+    d = _without_defaults(_plain(layout), UNWRITTEN_DEFAULTS["layout"])
     if d.get("kind") == "paper":
         del d["kind"]
     return d

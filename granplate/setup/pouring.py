@@ -38,6 +38,9 @@ CONTAINER_MAX = 1e4
 COUNT_MAX = 1_000_000
 #: The largest settling friction coefficient (Mindlin's mu, layout.settle_friction).
 SETTLE_FRICTION_MAX = 2.0
+#: The largest softening of a ramped settling (layout.settle_softening: the first phase's
+#: stiffness is the real law's over it).
+SETTLE_SOFTENING_MAX = 1e6
 #: A truncated normal or lognormal draw gives up after this many rounds of redraws.
 REDRAW_ROUNDS = 1000
 
@@ -98,6 +101,26 @@ def check_poured(s: Scenario, lay: PouredLayout) -> None:
     if f > 0.0 and s.dimension != 3:
         raise ScenarioError(
             "layout.settle_friction", f, "Mindlin's friction runs in space: dimension = 3 (0 in the plane)"
+        )
+    _check_ramp(s, lay)
+
+
+def _check_ramp(s: Scenario, lay: PouredLayout) -> None:
+    """settle_softening in [1, SETTLE_SOFTENING_MAX] (above 1: the ramped settling, in
+    space) and settle_residual in (0, 1]."""
+    k = lay.settle_softening
+    if not (is_number(k) and 1.0 <= k <= SETTLE_SOFTENING_MAX):
+        raise ScenarioError(
+            "layout.settle_softening", k, f"must be in [1, {SETTLE_SOFTENING_MAX:g}] (1: the time loop's settling)"
+        )
+    if k > 1.0 and s.dimension != 3:
+        raise ScenarioError(
+            "layout.settle_softening", k, "the ramped settling runs in space: dimension = 3 (1 in the plane)"
+        )
+    r = lay.settle_residual
+    if not (is_number(r) and 0.0 < r <= 1.0):
+        raise ScenarioError(
+            "layout.settle_residual", r, "must be in (0, 1] (a granule's residual force over its weight)"
         )
 
 
@@ -233,10 +256,12 @@ def loose_column(lay: PouredLayout, dimension: int, g: tuple[float, ...], radii:
 def store_payload(s: Scenario, lay: PouredLayout) -> dict[str, Any]:
     """What a settled packing depends on: the layout, the dimension, gravity, the
     materials of granules and walls, and the scenario's contact coefficients (a layout
-    without settle_friction keys as before that field existed)."""
+    without settle_friction, or without settle_softening, keys as before those fields existed)."""
     layout = dataclasses.asdict(lay)
     if not lay.settle_friction:
         del layout["settle_friction"]
+    if lay.settle_softening == 1.0:  # the time loop's settling: keyed as before the ramped one
+        del layout["settle_softening"], layout["settle_residual"]
     return {
         "layout": layout,
         "dimension": s.dimension,

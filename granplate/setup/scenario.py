@@ -259,7 +259,10 @@ class PouredLayout:
     contact damping settle_damping and no friction, then with the scenario's own. settle_time [s]: the
     longest settling simulated. settle_friction [-] (3D; 0: off): the packing settles instead in one
     phase of Mindlin's friction of that coefficient (docs/model.md sections 3.14 and 3.16) with the
-    damping settle_damping, and rests as a frictional packing. The settled packing is kept in the
+    damping settle_damping, and rests as a frictional packing. settle_softening [-] (3D; 1: off):
+    above 1, the ramped settling (docs/model.md section 3.14): the fall at every contact's stiffness
+    over settle_softening, the stiffness ramped to the real law's, settled when also every granule's
+    residual force is at most settle_residual [-] of its weight. The settled packing is kept in the
     run store.
     """
 
@@ -280,6 +283,8 @@ class PouredLayout:
     settle_damping: float = 1.0
     settle_time: float = 2.0
     settle_friction: float = 0.0
+    settle_softening: float = 1.0
+    settle_residual: float = 1e-2
 
 
 #: `[layout] kind` -> the dataclass that holds that kind's fields.

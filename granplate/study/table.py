@@ -101,6 +101,8 @@ FIELD_UNITS: dict[str, str] = {
     "settle_tolerance": "1",
     "settle_damping": "1",
     "settle_friction": "1",
+    "settle_softening": "1",
+    "settle_residual": "1",
     "settle_time": "s",
     "dt_min": "s",
     "lambda_target": "1",

@@ -1,0 +1,284 @@
+"""The compiled loop of a ramped settling of spheres (docs/model.md section 3.14, "Ramped
+settling"): velocity Verlet of spheres in a box of plane walls under gravity, Hertz's
+normal law with eq. (3)'s damping and Mindlin's tangential law (physics.mindlin), every
+contact's stiffness scaled by a factor s (the Hertz coefficient A and Mindlin's 8 G* by s,
+the damping coefficient c = alpha_n sqrt(m* A) by sqrt(s)) that the driver ramps from a
+soft start to the real law's s = 1, and Cundall's local damping of the granules in contact
+(YADE's NewtonIntegrator damping): each component of a granule's unbalanced force and
+torque F reduced by lambda |F| where it does work (F v > 0) and raised by it where it
+brakes, which leaves a state at rest, F = 0, unchanged.
+
+Histories: per listed pair and per (granule, wall) the tangential spring's force per unit
+stiffness factor, s xi [m] (so that a change of s leaves the tangential force where it was,
+as a modulus raised at a fixed stress), and the contact radius of the last step. Arrays in,
+arrays out; nothing allocated per step.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from granplate.physics.contact import COEF_A, COEF_C, COEF_KT, COEF_MUT, COEF_XT, normal_force
+from granplate.physics.mindlin import contact_radius, mindlin_force, rescale_history, rotate_history
+from granplate.physics.space import arm_torque_3d, normal_rate_3d, pair_contact_3d, slip_velocity_3d
+
+#: Columns of a history row: s xi (3) [m], the contact radius a of the last step [m].
+H_XI, H_A = 0, 3
+N_HIST = 4
+#: A granule's share of the rotational mobility in Verlet's stability bound: 1/m + r^2/I =
+#: 3.5/m for a solid sphere (I = 2/5 m r^2).
+ROLL_MOBILITY = 3.5
+
+
+@njit(cache=True)
+def _tangential(hist, p, c, s, sq, a, delta, nx, ny, nz, vsx, vsy, vsz, dt, n_abs):
+    """Mindlin's force on the first body (eqs. M2-M5) at stiffness factor s (sq = sqrt(s)),
+    the history row p of `hist` advanced over dt [s] by the slip v_s (dt = 0: the history's
+    force, unchanged)."""
+    k = s * c[COEF_KT] * a
+    if k <= 0.0:
+        return 0.0, 0.0, 0.0
+    xx = hist[p, H_XI] / s
+    xy = hist[p, H_XI + 1] / s
+    xz = hist[p, H_XI + 2] / s
+    xx, xy, xz = rescale_history(xx, xy, xz, a, hist[p, H_A])
+    f_crit = c[COEF_MUT] * n_abs
+    xx, xy, xz = rotate_history(xx, xy, xz, nx, ny, nz, k, f_crit)
+    eta = c[COEF_XT] * sq * c[COEF_C] * math.sqrt(math.sqrt(delta)) if dt > 0.0 else 0.0
+    fx, fy, fz, xx, xy, xz = mindlin_force(
+        xx + dt * vsx, xy + dt * vsy, xz + dt * vsz, k, f_crit, -eta * vsx, -eta * vsy, -eta * vsz
+    )
+    hist[p, H_XI] = xx * s
+    hist[p, H_XI + 1] = xy * s
+    hist[p, H_XI + 2] = xz * s
+    hist[p, H_A] = a
+    return fx, fy, fz
+
+
+@njit(cache=True)
+def _push(f, tq, i, sign, n_abs, nx, ny, nz, arm, fx, fy, fz):
+    """Granule i's share of a contact: the normal force -sign |N| n and sign F_t, and the
+    torque arm n x F_t."""
+    f[i, 0] += sign * (fx - n_abs * nx)
+    f[i, 1] += sign * (fy - n_abs * ny)
+    f[i, 2] += sign * (fz - n_abs * nz)
+    tx, ty, tz = arm_torque_3d(arm, nx, ny, nz, fx, fy, fz)
+    tq[i, 0] += tx
+    tq[i, 1] += ty
+    tq[i, 2] += tz
+
+
+@njit(cache=True)
+def contact_forces(x, v, w, radius, mass, g, pairs, pcoef, phist, walls, wcoef, whist, s, dt, elastic, f, tq, touch):
+    """Forces f (n, 3) [N] and torques tq (n, 3) [N m] on the granules at positions x, with
+    gravity m g, the velocities v, spins w (the half step's) over the step dt [s] (the
+    histories advance; dt = 0: the elastic state alone, histories kept), and touch (n,) the
+    count of each granule's contacts. elastic: the normal force without eq. (3)'s damping
+    (the static residual). walls (nw, 4): outward unit normal and offset of each plane."""
+    n = x.shape[0]
+    sq = math.sqrt(s)
+    for i in range(n):
+        for k in range(3):
+            f[i, k] = mass[i] * g[k]
+            tq[i, k] = 0.0
+        touch[i] = 0
+    for p in range(pairs.shape[0]):
+        i = pairs[p, 0]
+        j = pairs[p, 1]
+        ri = radius[i]
+        rj = radius[j]
+        delta, nx, ny, nz = pair_contact_3d(x[i, 0], x[i, 1], x[i, 2], ri, x[j, 0], x[j, 1], x[j, 2], rj)
+        if delta <= 0.0:
+            for k in range(N_HIST):
+                phist[p, k] = 0.0
+            continue
+        c = pcoef[p]
+        rate = normal_rate_3d(v[i, 0] - v[j, 0], v[i, 1] - v[j, 1], v[i, 2] - v[j, 2], nx, ny, nz)
+        n_abs, n_el = normal_force(delta, rate, s * c[COEF_A], sq * c[COEF_C], True)
+        if elastic:
+            n_abs = n_el
+        ai = ri - 0.5 * delta
+        aj = rj - 0.5 * delta
+        vsx, vsy, vsz = slip_velocity_3d(
+            v[i, 0] - v[j, 0],
+            v[i, 1] - v[j, 1],
+            v[i, 2] - v[j, 2],
+            ai * w[i, 0] + aj * w[j, 0],
+            ai * w[i, 1] + aj * w[j, 1],
+            ai * w[i, 2] + aj * w[j, 2],
+            nx,
+            ny,
+            nz,
+        )
+        a = contact_radius(ri * rj / (ri + rj), delta)
+        fx, fy, fz = _tangential(phist, p, c, s, sq, a, delta, nx, ny, nz, vsx, vsy, vsz, dt, n_abs)
+        _push(f, tq, i, 1.0, n_abs, nx, ny, nz, ai, fx, fy, fz)
+        _push(f, tq, j, -1.0, n_abs, nx, ny, nz, aj, fx, fy, fz)
+        touch[i] += 1
+        touch[j] += 1
+    nw = walls.shape[0]
+    for i in range(n):
+        ri = radius[i]
+        for k in range(nw):
+            nx, ny, nz = walls[k, 0], walls[k, 1], walls[k, 2]
+            delta = x[i, 0] * nx + x[i, 1] * ny + x[i, 2] * nz + ri - walls[k, 3]
+            row = i * nw + k
+            if delta <= 0.0:
+                for q in range(N_HIST):
+                    whist[row, q] = 0.0
+                continue
+            c = wcoef[row]
+            n_abs, n_el = normal_force(
+                delta, normal_rate_3d(v[i, 0], v[i, 1], v[i, 2], nx, ny, nz), s * c[COEF_A], sq * c[COEF_C], True
+            )
+            if elastic:
+                n_abs = n_el
+            arm = ri - 0.5 * delta
+            vsx, vsy, vsz = slip_velocity_3d(
+                v[i, 0], v[i, 1], v[i, 2], arm * w[i, 0], arm * w[i, 1], arm * w[i, 2], nx, ny, nz
+            )
+            a = contact_radius(ri, delta)
+            fx, fy, fz = _tangential(whist, row, c, s, sq, a, delta, nx, ny, nz, vsx, vsy, vsz, dt, n_abs)
+            _push(f, tq, i, 1.0, n_abs, nx, ny, nz, arm, fx, fy, fz)
+            touch[i] += 1
+
+
+@njit(cache=True)
+def _local_damping(f, v, touch, lam):
+    """Cundall's local damping in place: each component of a touching granule's f reduced
+    by lam |f| where f v > 0, raised by it where f v < 0."""
+    for i in range(f.shape[0]):
+        if touch[i] == 0:
+            continue
+        for k in range(3):
+            fv = f[i, k] * v[i, k]
+            if fv > 0.0:
+                f[i, k] *= 1.0 - lam
+            elif fv < 0.0:
+                f[i, k] *= 1.0 + lam
+
+
+@njit(cache=True)
+def settle_steps(
+    x,
+    v,
+    w,
+    radius,
+    mass,
+    inertia,
+    g,
+    pairs,
+    pcoef,
+    phist,
+    walls,
+    wcoef,
+    whist,
+    s0,
+    s1,
+    lam,
+    keep,
+    spin_keep,
+    dt,
+    steps,
+    x_ref,
+    reach,
+    f,
+    tq,
+    touch,
+):
+    """Up to `steps` velocity-Verlet steps of dt [s], the stiffness factor going
+    geometrically from s0 to s1 over them, Cundall's damping lam [-], every spin multiplied
+    by spin_keep [-] and every velocity by keep [-] once a step (a background damping: a
+    granule held at two points or spinning about a contact's normal turns freely under both
+    laws, a rattler bounces in its cage); stops early where a
+    granule moved `reach` [m] or more from x_ref (its list is stale). f, tq, touch: the last
+    pass's forces (kept across calls). Returns the steps done."""
+    n = x.shape[0]
+    reach2 = reach * reach
+    ratio = (s1 / s0) ** (1.0 / steps) if steps > 0 else 1.0
+    s = s0
+    for step in range(steps):
+        s *= ratio
+        for i in range(n):
+            hm = 0.5 * dt / mass[i]
+            hi = 0.5 * dt / inertia[i]
+            for k in range(3):
+                v[i, k] += hm * f[i, k]
+                w[i, k] += hi * tq[i, k]
+                x[i, k] += dt * v[i, k]
+        contact_forces(x, v, w, radius, mass, g, pairs, pcoef, phist, walls, wcoef, whist, s, dt, False, f, tq, touch)
+        _local_damping(f, v, touch, lam)
+        _local_damping(tq, w, touch, lam)
+        far = False
+        for i in range(n):
+            hm = 0.5 * dt / mass[i]
+            hi = 0.5 * dt / inertia[i]
+            d2 = 0.0
+            for k in range(3):
+                v[i, k] = keep * (v[i, k] + hm * f[i, k])
+                w[i, k] = spin_keep * (w[i, k] + hi * tq[i, k])
+                d2 += (x[i, k] - x_ref[i, k]) ** 2
+            if d2 >= reach2:
+                far = True
+        if far:
+            return step + 1
+    return steps
+
+
+@njit(cache=True)
+def stiffness_sums(x, radius, pairs, pcoef, walls, wcoef, s):
+    """Each granule's sum of its contacts' normal stiffness dN/d delta = 3/2 s A delta^(1/2)
+    and ROLL_MOBILITY x their tangential stiffness s 8 G* a [N/m] (Verlet's bound on the
+    step: dt < sqrt(2 m / that sum))."""
+    n = x.shape[0]
+    out = np.zeros(n)
+    for p in range(pairs.shape[0]):
+        i = pairs[p, 0]
+        j = pairs[p, 1]
+        delta, _, _, _ = pair_contact_3d(x[i, 0], x[i, 1], x[i, 2], radius[i], x[j, 0], x[j, 1], x[j, 2], radius[j])
+        if delta <= 0.0:
+            continue
+        a = contact_radius(radius[i] * radius[j] / (radius[i] + radius[j]), delta)
+        k = s * (1.5 * pcoef[p, COEF_A] * math.sqrt(delta) + ROLL_MOBILITY * pcoef[p, COEF_KT] * a)
+        out[i] += k
+        out[j] += k
+    nw = walls.shape[0]
+    for i in range(n):
+        for q in range(nw):
+            delta = x[i, 0] * walls[q, 0] + x[i, 1] * walls[q, 1] + x[i, 2] * walls[q, 2] + radius[i] - walls[q, 3]
+            if delta > 0.0:
+                c = wcoef[i * nw + q]
+                out[i] += s * (
+                    1.5 * c[COEF_A] * math.sqrt(delta) + ROLL_MOBILITY * c[COEF_KT] * contact_radius(radius[i], delta)
+                )
+    return out
+
+
+@njit(cache=True)
+def wall_loads(x, radius, walls, wcoef, whist, s):
+    """(nw, 4): each wall's elastic normal force [N] (positive in compression) and the
+    tangential forces (3) [N] its contacts' histories exert on the granules, at rest."""
+    nw = walls.shape[0]
+    out = np.zeros((nw, 4))
+    sq = math.sqrt(s)
+    for i in range(x.shape[0]):
+        for k in range(nw):
+            nx, ny, nz = walls[k, 0], walls[k, 1], walls[k, 2]
+            delta = x[i, 0] * nx + x[i, 1] * ny + x[i, 2] * nz + radius[i] - walls[k, 3]
+            if delta <= 0.0:
+                continue
+            row = i * nw + k
+            c = wcoef[row]
+            n_abs = s * c[COEF_A] * delta * math.sqrt(delta)
+            scratch = whist[row : row + 1].copy()
+            fx, fy, fz = _tangential(
+                scratch, 0, c, s, sq, contact_radius(radius[i], delta), delta, nx, ny, nz, 0.0, 0.0, 0.0, 0.0, n_abs
+            )
+            out[k, 0] += n_abs
+            out[k, 1] += fx
+            out[k, 2] += fy
+            out[k, 3] += fz
+    return out
