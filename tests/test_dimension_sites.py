@@ -35,9 +35,9 @@ PATTERN = re.compile(
 )
 
 #: the most sites allowed: the Dataset's dimension of a file written before its attribute
-#: (results/dataset.py), the LAMMPS adapter's refusal of a 2D scenario in its 3D map
-#: (verification/lammps.py), and results/pouring.py's two (a poured layout's granules)
-LIMIT = 4
+#: (results/dataset.py) and the LAMMPS adapter's refusal of a 2D scenario in its 3D map
+#: (verification/lammps.py)
+LIMIT = 2
 
 
 def sites(root: Path = PACKAGE) -> list[str]:

@@ -26,6 +26,7 @@ import numpy as np
 
 from granplate import store
 from granplate.errors import ScenarioError
+from granplate.model.dimension import of_number
 from granplate.setup import pouring
 from granplate.setup.scenario import Granule, Gravity, Load, PouredLayout, Scenario, Solver, TimeSettings
 
@@ -89,7 +90,8 @@ def loose_scenario(s: Scenario, lay: PouredLayout, alpha_n: float | None, fricti
     g = pouring.pour_gravity(s, lay)
     radii = pouring.poured_radii(lay)
     c = pouring.loose_column(lay, s.dimension, g, radii)
-    z = c[:, 2] if s.dimension == 3 else np.zeros(len(radii))
+    z = np.pad(c, ((0, 0), (0, 3 - c.shape[1])))[:, 2]  # 0 in the plane
+    spin = of_number(s.dimension).spin((0.0, 0.0, 0.0))
     granules = tuple(
         Granule(
             float(c[i, 0]),
@@ -98,7 +100,7 @@ def loose_scenario(s: Scenario, lay: PouredLayout, alpha_n: float | None, fricti
             lay.material,
             label=f"p{i + 1}",
             z=float(z[i]),
-            omega=(0.0, 0.0, 0.0) if s.dimension == 3 else 0.0,
+            omega=spin,
         )
         for i in range(len(radii))
     )
