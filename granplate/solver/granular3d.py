@@ -362,7 +362,7 @@ def force_error(k1, k0, kend, ratio, mass, inertia, radius, sc, err):
     return sc, err
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")  # per contact: inlined, g not passed by value
 def pair_normal_3d(p, y, g, clip: bool):
     """The normal contact of listed pair p at state y (space): (overlap delta [m], the unit
     normal from i to j, |N| [N], viscous power [W], stored energy [J], plastic work [J], the
@@ -382,7 +382,7 @@ def pair_normal_3d(p, y, g, clip: bool):
     return delta, nx, ny, nz, n, pv, ep, wp, pv / ddot if pv != 0.0 else 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")  # per contact: inlined, g not passed by value
 def push_pair(out, i, j, col, s, nx, ny, nz):
     """A pair's force s n [N] (n from i to j) on its granules into out[:, col:col + 3]:
     minus on i, plus on j."""
@@ -614,7 +614,7 @@ def mindlin_parted(hist, k, c):
     return e_old
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")  # per contact: inlined, g not passed by value
 def push_tangential(acc, g, i, a, nx, ny, nz, fx, fy, fz, sign):
     """The tangential force sign * F (F on the first body [N]) and its torque a n x F on
     granule i as accelerations into acc (as `add_friction`, divided by m and I): an impulse's

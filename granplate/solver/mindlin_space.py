@@ -38,7 +38,7 @@ from granplate.solver.granular3d import (
 )
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")  # per contact: inlined, g not passed by value
 def pair_mindlin_3d(p, i, j, delta, nx, ny, nz, n_abs, yv, h, g, cfg):
     """Mindlin's law at listed pair p in touch (granules i, j; its overlap delta [m], unit
     normal n from i to j and |N| = n_abs [N] from the force pass), the slip from yv's
@@ -65,7 +65,7 @@ def pair_mindlin_3d(p, i, j, delta, nx, ny, nz, n_abs, yv, h, g, cfg):
     return fx, fy, fz, ti, tj, e, d
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")  # per contact: inlined, g not passed by value
 def push_couple(out, i, col, arm, nx, ny, nz, fx, fy, fz):
     """The torque arm n x F [N m] (F on the first body [N]) into out[i, col:col + 3]."""
     tx, ty, tz = arm_torque_3d(arm, nx, ny, nz, fx, fy, fz)
@@ -161,7 +161,7 @@ def wall_mindlin(yv, yn, h, g, cfg, acc):
     return e_t, lost
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")  # per contact: inlined, g not passed by value
 def wall_normal_force(yn, i, w, delta, nx, ny, nz, vn, g, cfg) -> float:
     """|N| [N] of wall contact w (granule i, overlap delta [m], outward normal n, the wall's
     normal velocity vn [m/s]) at state yn, as the normal pass has it."""
