@@ -30,13 +30,13 @@ import os
 # GOMP_SPINCOUNT or OMP_WAIT_POLICY is kept. Measured in docs/benchmarks.md.
 os.environ.setdefault("GOMP_SPINCOUNT", "30000")
 
-from numba import njit, prange  # noqa: E402
+from numba import get_num_threads, njit, prange  # noqa: E402
 
 from granplate.solver.drives import begin_pass
-from granplate.solver.granular import ForceSums, commit_history, commit_history_row
-from granplate.solver.granular3d import pair_normal_3d, push_pair, shock_loads, wall_forces
+from granplate.solver.granular import ForceSums, commit_history, commit_rows
+from granplate.solver.granular3d import pair_forces, shock_loads, wall_forces
 from granplate.solver.kicks import kick, kick_drift
-from granplate.solver.mindlin_space import pair_forces_mindlin, wall_mindlin
+from granplate.solver.mindlin_space import wall_mindlin
 
 #: columns of a block's buffer row fpar[k, i]: the normal force on granule i (x, y, z) [N],
 #: its damping part (x, y, z) [N] and, under Mindlin's law, the tangential forces' torque
@@ -70,30 +70,10 @@ def pair_forces_blocks(y, g, cfg, fpar, spar):
         for i in range(ng):
             for c in range(F_T):  # (the torque columns are Mindlin's pass's)
                 f[i, c] = 0.0
-        p_visc = 0.0
-        e_pot = 0.0
-        w_plastic = 0.0
-        ovl = 0.0
-        ovl_i = -1
-        ovl_j = -1
         lo, hi = block_range(k, nb, n_p)
-        for p in range(lo, hi):
-            delta, nx, ny, nz, n, pv, ep, wp, d = pair_normal_3d(p, y, g, cfg.clip)
-            if delta <= 0.0:
-                continue
-            i = g.pair_ij[p, 0]
-            j = g.pair_ij[p, 1]
-            r_min = min(g.radius[i], g.radius[j])
-            if delta > ovl * r_min:
-                ovl = delta / r_min
-                ovl_i = i
-                ovl_j = j
-            w_plastic += wp
-            p_visc += pv
-            e_pot += ep
-            push_pair(f, i, j, F_X, n, nx, ny, nz)
-            if pv != 0.0:
-                push_pair(f, i, j, F_DX, d, nx, ny, nz)
+        p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, _, _ = pair_forces(
+            y, y, 0.0, g, cfg, lo, hi, f, f, F_X, F_DX, F_T, False
+        )
         spar[k, S_VISC] = p_visc
         spar[k, S_EPOT] = e_pot
         spar[k, S_PLASTIC] = w_plastic
@@ -173,8 +153,8 @@ def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
 
 @njit(parallel=True)
 def pair_mindlin_blocks(yv, yn, h, g, cfg, fpar, spar):
-    """`pair_forces_blocks` with Mindlin's law in it (solver.mindlin_space.pair_forces_mindlin
-    on block k's pairs, its buffer fpar[k]: forces, damping parts, torques; its sums into
+    """`pair_forces_blocks` with Mindlin's law in it (solver.granular3d.pair_forces
+    with its tangential step, on block k's pairs, its buffer fpar[k]: forces, damping parts, torques; its sums into
     spar[k], the springs' energy and losses into S_ET, S_LOST). Each contact's tangential
     step reads and writes its own history row alone."""
     nb = fpar.shape[0]
@@ -185,7 +165,7 @@ def pair_mindlin_blocks(yv, yn, h, g, cfg, fpar, spar):
             for c in range(N_FPAR):
                 f[i, c] = 0.0
         lo, hi = block_range(k, nb, n_p)
-        pv, ep, wp, ovl, ovl_i, ovl_j, e_t, lost = pair_forces_mindlin(yv, yn, h, g, cfg, lo, hi, f, f, F_X, F_DX, F_T)
+        pv, ep, wp, ovl, ovl_i, ovl_j, e_t, lost = pair_forces(yv, yn, h, g, cfg, lo, hi, f, f, F_X, F_DX, F_T, True)
         spar[k, S_VISC] = pv
         spar[k, S_EPOT] = ep
         spar[k, S_PLASTIC] = wp
@@ -314,10 +294,12 @@ def accept_rows(y, k0, k1, ynew, kend):
 
 @njit(parallel=True)
 def commit_pair_histories(t, hist, coef):
-    """solver.granular.commit_history of the pairs, contact by contact on every core (each
-    row on its own: the same numbers)."""
-    for k in prange(hist.shape[0]):
-        commit_history_row(t, hist, coef, k)
+    """solver.granular.commit_history of the pairs on every core, a block of rows per
+    thread (each row on its own: the same numbers)."""
+    nb = get_num_threads()
+    for k in prange(nb):
+        lo, hi = block_range(k, nb, hist.shape[0])
+        commit_rows(t, hist, coef, lo, hi)
 
 
 @njit(cache=True)
