@@ -1,5 +1,5 @@
 """An elastic body's modes in the velocity-Verlet step (docs/model.md section 3.9): the half
-kicks by the contact forces and by a load on the body, each with its work, the exact free
+kicks by the contact forces and by a load on the body (its own weight too), each with its work, the exact free
 vibration of every mode between kicks, and the modal velocity the force pass reads.
 """
 
@@ -56,6 +56,7 @@ def turn(q, qd, omega, h) -> None:
 @njit(cache=True)
 def predicted_velocity(b, hk, buf) -> None:
     """The modal velocity the force pass reads, qdp = qd + hk Phi^T F_n (the velocity at
-    the step's end as the granules' is predicted, v + h/2 a_n)."""
+    the step's end as the granules' is predicted, v + h/2 a_n; the body's weight b.weight
+    with the contact forces)."""
     for m in range(b.qd.shape[0]):
-        b.qdp[m] = b.qd[m] + hk * b.fmodal[buf, m]
+        b.qdp[m] = b.qd[m] + hk * (b.fmodal[buf, m] + b.weight[m])

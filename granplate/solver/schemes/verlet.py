@@ -26,7 +26,7 @@ the damping part of the force (D_visc) and the load (E_shock; a line load on the
 body kicks its modes the same way, at t_n and t_n + h), so eq. (11)'s residual is
 Verlet's own energy error, O(h^2), which the loop checks at every step. Gravity and the
 drives (solver.drives) join each force pass; the drive forces' kicks are booked the same
-way (gravity's too), a driven wall's elastic work exactly (the change of its contacts'
+way (gravity's too, and its weight's on an elastic body's modes, model.body_weight), a driven wall's elastic work exactly (the change of its contacts'
 energy as it moves), the damping at its velocity by the trapezoidal rule over the step
 (in the drive's work and in D_visc alike), and the impulse that gives a driven granule
 its prescribed velocity at t + h as the kinetic energy it adds. A force-driven wall (a
@@ -224,6 +224,7 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
     if body:
         if cfg.load_on_plate:
             wl += B.load_kick(b.qd, b.load, shock_amplitude(t, cfg), hk)
+        w_grav += B.load_kick(b.qd, b.weight, 1.0, hk)  # the body's own weight (model.body_weight)
         wd += B.kick(b.qd, b.fmodal[cur], b.fdamp[cur], hk)
         B.turn(b.q, b.qd, b.omega, h)
         B.predicted_velocity(b, hk, cur)
@@ -264,6 +265,7 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
         wd2 += B.kick(b.qd, b.fmodal[nxt], b.fdamp[nxt], hk)
         if cfg.load_on_plate:
             wl2 += B.load_kick(b.qd, b.load, shock_amplitude(t + h, cfg), hk)
+        w_grav += B.load_kick(b.qd, b.weight, 1.0, hk)
     if friction and sw.split[LAND] != 0.0:  # an output time: the closing half step
         fric += friction_flow(y, hk, g, cfg, not forward)
         if body:
