@@ -30,8 +30,6 @@ from typing import NamedTuple
 
 import numpy as np
 
-from granplate.model.inputs import GEO_DIST, GEO_NX, new_body_state
-
 
 class BodyContacts(NamedTuple):
     """The granules' contacts on the solid in the static state: granule (nk,) int, direction
@@ -45,36 +43,68 @@ class BodyContacts(NamedTuple):
     compliance: np.ndarray
 
 
-def located(model, x: np.ndarray):
-    """A run's copy of the model's body with every granule near it (solver.body.REACH) located
-    on its surface at centres x (ng, 3) [m] (buffer 0: face, point, normal, patch weights), and
-    (ng,) bool: which were located."""
-    from granplate.solver import body as B
+class Located(NamedTuple):
+    """Where each granule touches the solid's surface (solver.body's `locate`, here from the
+    solid layer's own kernels): near (ng,) bool, whether the granule is within a radius of
+    the body's bounding box; distance (ng,) [m] from the surface to its centre; normal
+    (ng, 3) the outward normal there; nodes, weights: per granule, its patch's surface nodes
+    and their weights (summing to one)."""
 
-    b = new_body_state(model.body)
-    y = np.zeros((len(x), 9))
-    y[:, :3] = x
-    zeros = np.zeros(len(b.q))
-    acc = np.zeros_like(y)
-    B.contact_forces(y, zeros, zeros, b, 0, model.granular.radius, model.granular.mass, False, acc, acc.copy(), True)
-    return b, b.count[0] > 0
+    near: np.ndarray
+    distance: np.ndarray
+    normal: np.ndarray
+    nodes: list
+    weights: list
+
+
+def located(body, x: np.ndarray, radius: np.ndarray) -> Located:
+    """Each granule at centres x (ng, 3) [m] (radii (ng,) [m]) within a radius of the body's
+    bounding box located on the surface of the BodyArrays `body` as the loop locates it
+    (solver/body.py): the closest point by `follow_closest` from the granule's seed face,
+    its patch the face's shape functions there (patch radius 0) or the disc of surface nodes
+    within the patch radius a, weighted by their surface share times (1 - r^2/a^2)^2 and
+    normalised."""
+    from granplate.solid.closest import follow_closest
+    from granplate.solid.surface import face_shape_functions
+
+    ng = len(x)
+    near = np.all((x >= body.box[0] - radius[:, None]) & (x <= body.box[1] + radius[:, None]), axis=1)
+    distance, normal = np.full(ng, np.inf), np.zeros((ng, 3))
+    nodes: list = [np.zeros(0, np.int64)] * ng
+    weights: list = [np.zeros(0)] * ng
+    kind, a = int(body.kind[0]), float(body.patch[0])
+    out = np.empty(9)
+    shape, d_shape = np.empty(body.face_nodes.shape[1]), np.empty((body.face_nodes.shape[1], 2))
+    for i in np.flatnonzero(near):
+        seed = int(body.face[0, i]) if body.face[0, i] >= 0 else 0
+        f = follow_closest(body.face_nodes, kind, body.neighbours, seed, np.ascontiguousarray(x[i], float), out)
+        distance[i], normal[i] = out[8], out[5:8]
+        if a > 0.0:
+            rho2 = np.sum((body.node_xyz - out[2:5]) ** 2, axis=1) / (a * a)
+            inside = np.flatnonzero(rho2 < 1.0)
+            k = body.node_area[inside] * (1.0 - rho2[inside]) ** 2
+            nodes[i], weights[i] = inside, k / np.sum(k)
+        else:
+            face_shape_functions(kind, out[0], out[1], shape, d_shape)
+            nodes[i], weights[i] = np.asarray(body.face_snode[f], np.int64), shape.copy()
+    return Located(near, distance, normal, nodes, weights)
 
 
 def body_contacts(model, x: np.ndarray, q_weight: np.ndarray) -> BodyContacts:
     """The contacts (B1)-(B2) of the granules within a radius of the solid's surface at
     centres x (ng, 3) [m], the modes sagged by q_weight (nm,) under the body's weight."""
-    b, near = located(model, x)
+    b = model.body
     r = model.granular.radius
-    dist = b.geo[0, :, GEO_DIST]
-    who = np.flatnonzero(near & (dist - r <= r))
+    loc = located(b, x, r)
+    dist = loc.distance
+    who = np.flatnonzero(loc.near & (dist - r <= r))
     nm = len(b.omega)
     n_s = b.resid.shape[0]
-    e = -b.geo[0, who, GEO_NX : GEO_NX + 3]
+    e = -loc.normal[who]
     a = np.zeros((nm, len(who)))
     rv = np.zeros((n_s, len(who)))
     for k, i in enumerate(who):
-        for slot in range(b.count[0, i]):
-            node, w = b.entry[0, i, slot], b.weights[0, i, slot]
+        for node, w in zip(loc.nodes[i], loc.weights[i]):
             for c in range(3):
                 row = b.node_rows[node, c]
                 if row >= 0:

@@ -8,8 +8,9 @@ clamped dofs' rows dropped). On the modes it is the constant modal force
 
     f_k = phi_k^T f_g   [N kg^-1/2],                                               (G1)
 
-which the velocity-Verlet scheme adds to each half kick of the modes as a load, its work
-booked as gravity's in eq. (11) (as the granules' weight is). The solid starts at rest in
+which the velocity-Verlet scheme integrates exactly: each mode turns about its static
+deflection (solver.body_modes.turn_weighed), the weight's work f . (q(t + h) - q(t)) booked as
+gravity's in eq. (11) (as the granules' weight is). The solid starts at rest in
 its static sag under its weight (as the plane's plate does), the modal static deflection
 
     q_k = f_k / omega_k^2,                                                          (G2)
