@@ -163,18 +163,20 @@ def test_the_solid_rests_in_its_sag_and_eq_11_holds_with_a_sphere_dropped_on_it(
     assert np.max(np.abs(ds["energy_residual"].values)) < 1e-5
 
 
-@pytest.mark.parametrize("residual", [True, False])
-def test_a_sphere_pressed_on_the_heavy_solid_rests_with_the_static_force(residual):
+@pytest.mark.parametrize("residual, patch", [(True, 0.0), (False, 0.006)])
+def test_a_sphere_pressed_on_the_heavy_solid_rests_with_the_static_force(residual, patch):
     """A sphere pressed on the solid's top face by a wall with F under gravity
     ([precompression]): at t = 0 the solid pushes back with F + m g, and the run from that
-    state stays at rest (the sphere's speed a round-off's)."""
+    state stays at rest (the sphere's speed a round-off's); with the residual compliance and a
+    point patch, and with the modes alone and a disc patch."""
     force = 0.1
     wall = (
         f"residual = {'true' if residual else 'false'}\n"
         '[[walls]]\nlabel = "top"\nnormal = [0.0, 0.0, 1.0]\noffset = 0.014\n'
         f'[precompression]\ntarget = "wall top"\nforce = {force}\ntolerance = 1e-10\n'
     )
-    s = gp.loads(SOLID.format(vz=0.0, z=0.012, fmax=1.5e5, more=wall, g=-G, t_end=2e-6))
+    text = SOLID.format(vz=0.0, z=0.012, fmax=1.5e5, more=wall, g=-G, t_end=2e-6)
+    s = gp.loads(text.replace("patch_radius = 0.0", f"patch_radius = {patch}"))
     m = build_model(s)
     mass = float(m.granular.mass[0])
     y = np.ascontiguousarray(m.initial_state.copy())
