@@ -227,12 +227,17 @@ def _normal_stiffness(x: np.ndarray, o, g, wall, u=None, kc=None, direction=None
         ku = first_u + np.arange(nk)
         pii = index[pi]
         sel = pii >= 0
-        e = np.tile(np.eye(d)[0], (nk, 1)) if direction is None else np.asarray(direction, float)
-        block(pii, pii, pk, e, 1.0)
-        for p in range(d):
-            rows += [pii[sel] * d + p, ku[sel]]
-            cols += [ku[sel], pii[sel] * d + p]
-            vals += [-pk[sel] * e[sel, p], -pk[sel] * e[sel, p]]
+        if direction is None:  # the plane's plate: along x alone
+            rows += [pii[sel] * d, pii[sel] * d, ku[sel]]
+            cols += [pii[sel] * d, ku[sel], pii[sel] * d]
+            vals += [pk[sel], -pk[sel], -pk[sel]]
+        else:
+            e = np.asarray(direction, float)
+            block(pii, pii, pk, e, 1.0)
+            for p in range(d):
+                rows += [pii[sel] * d + p, ku[sel]]
+                cols += [ku[sel], pii[sel] * d + p]
+                vals += [-pk[sel] * e[sel, p], -pk[sel] * e[sel, p]]
         rows += [ku, np.repeat(ku, nk)]
         cols += [ku, np.tile(ku, nk)]
         vals += [pk, np.asarray(kc, float).ravel()]
