@@ -208,15 +208,12 @@ def test_a_sphere_pressed_onto_the_sagged_plate_sits_where_statics_puts_it():
     assert np.max(np.abs(ds["energy_residual"].values)) < 1e-9
 
 
-def test_gravity_with_a_3d_plate_is_refused_by_name():
-    """Space's elastic solid does not carry its weight: gravity with a 3D [plate] is refused
-    before anything runs, naming gravity.g."""
+def test_gravity_with_a_3d_plate_is_valid():
+    """Space's elastic solid carries its weight (model.body_weight; tests/test_body_gravity.py):
+    gravity with a 3D [plate] passes validation."""
     from pathlib import Path
 
-    from granplate.errors import ScenarioError
     from granplate.setup.validate import validate
 
     text = (Path(__file__).resolve().parents[1] / "docs" / "examples" / "3d-fcc-on-plate.toml").read_text()
-    with pytest.raises(ScenarioError, match="solid") as e:
-        validate(gp.loads(text + "\n[gravity]\ng = [-9.81, 0.0, 0.0]\n"))
-    assert e.value.field == "gravity.g"
+    validate(gp.loads(text + "\n[gravity]\ng = [-9.81, 0.0, 0.0]\n"))

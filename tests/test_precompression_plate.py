@@ -170,18 +170,15 @@ def test_a_granule_between_the_faces_nodes_is_refused_by_name():
     assert e.value.field == "precompression.target"
 
 
-def test_a_3d_plate_is_refused_by_name():
-    """A 3D [plate] (an elastic solid) is not part of the static state yet: a precompression
-    of docs/examples/3d-fcc-on-plate.toml (its layout's wall xmin) is refused before anything
-    runs, naming precompression.target."""
-    from granplate.errors import ScenarioError
+def test_a_3d_plate_is_valid():
+    """A 3D [plate] (an elastic solid) is part of the static state (model.body_static;
+    tests/test_body_gravity.py): a precompression of docs/examples/3d-fcc-on-plate.toml (its
+    layout's wall xmin) passes validation."""
     from granplate.setup.validate import validate
 
     text = (Path(__file__).resolve().parents[1] / "docs" / "examples" / "3d-fcc-on-plate.toml").read_text()
     text = text.replace("walls = []", 'walls = ["xmin"]') + '\n[precompression]\ntarget = "wall xmin"\nforce = 1.0\n'
-    with pytest.raises(ScenarioError, match="3D") as e:
-        validate(gp.loads(text))
-    assert e.value.field == "precompression.target"
+    validate(gp.loads(text))
 
 
 STUDY = Path(__file__).resolve().parents[1] / "docs" / "studies" / "precompressed-protector.toml"

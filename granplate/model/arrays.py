@@ -328,10 +328,12 @@ def build_model(scenario: Scenario) -> Model:
 
 
 def space_model(s: Scenario) -> Model:
-    """The loop's arrays of resolved scenario `s` in space (`model.space.build_space_model`)."""
+    """The loop's arrays of resolved scenario `s` in space (`model.space.build_space_model`),
+    its elastic solid in its sag under its own weight (`model.body_weight.weighed_body`)."""
+    from granplate.model.body_weight import weighed_body
     from granplate.model.space import build_space_model
 
-    return build_space_model(s)
+    return weighed_body(build_space_model(s))
 
 
 def plane_model(s: Scenario) -> Model:

@@ -241,6 +241,7 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
         box=box,
         coef=body_coefficients(s, mats, r, mass, material, rigid),
         load=modal_line_load(s, surface, solid),
+        weight=z(nm),
         patch=np.array([radius]),
         face=np.vstack([seeds, seeds]),
         geo=z((2, ng, N_GEO)),

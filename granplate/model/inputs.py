@@ -231,7 +231,9 @@ class BodyArrays(NamedTuple):
     n_s) [m/N] the residual compliance over S ((0, 0): none); box: (2, 3) [m] the lowest
     and highest corner of the body's bounding box; coef: (ng, N_COEF) each granule's
     contact coefficients with the body; load: (nm,) the modal projection Phi^T f of a
-    line load on the body's face xmin per unit q0 [N kg^-1/2 per N/m] (zeros: none).
+    line load on the body's face xmin per unit q0 [N kg^-1/2 per N/m] (zeros: none);
+    weight: (nm,) the modal force of the body's own weight Phi^T f_g [N kg^-1/2] (zeros:
+    none; model.body_weight).
 
     The state of one run (new_body_state copies it): face: (2, ng) int each granule's
     closest face in the two buffers (t_n and the trial step's end; the seed of the next
@@ -266,6 +268,7 @@ class BodyArrays(NamedTuple):
     box: np.ndarray
     coef: np.ndarray
     load: np.ndarray
+    weight: np.ndarray
     patch: np.ndarray
     face: np.ndarray
     geo: np.ndarray
@@ -310,6 +313,7 @@ def no_body(ng: int, nm: int) -> BodyArrays:
         box=z((2, 3)),
         coef=z((0, 5)),
         load=z(nm),
+        weight=z(nm),
         patch=z(1),
         face=np.zeros((2, 0), i),
         geo=z((2, 0, N_GEO)),

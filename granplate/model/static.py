@@ -74,10 +74,13 @@ class PlateStatics(NamedTuple):
 
     compliance: (2 nk, 2 nk) the static compliance at the contacts' driving dofs [m/N] (x, y
     of each), Phi_d diag(1/omega^2) Phi_d^T + R: the loop's own modal model at rest;
-    stiffness: (nk, nk) the inverse of its normal block [N/m], K_c of (S1)."""
+    stiffness: (nk, nk) the inverse of its normal block [N/m], K_c of (S1); direction: (nk, d)
+    each contact's unit normal into the plate (None: the plane's plate, e_x; an elastic solid
+    in space, model.body_static: minus the surface's outward normal)."""
 
     compliance: np.ndarray
     stiffness: np.ndarray
+    direction: np.ndarray | None = None
 
 
 def plate_statics(p) -> PlateStatics:
@@ -126,27 +129,30 @@ def contact_terms(x: np.ndarray, o, g, wall):
     return (i, j, delta, f, k, n, a), (wi, wdelta, wf, wk, wn, g.wall_w == walls[0], wa)
 
 
-def plate_terms(x: np.ndarray, u: np.ndarray, g):
+def plate_terms(x: np.ndarray, u: np.ndarray, g, direction=None):
     """Overlaps, forces and slopes of the plate contacts (rigid layers, n = (1, 0); docs/model.md
-    section 3.4) at centres x and the plate's normal displacements u at them: (i, delta, f, k, a)."""
+    section 3.4; or along `direction` (nk, d), each contact's unit normal into the plate) at
+    centres x and the plate's normal displacements u at them: (i, delta, f, k, a)."""
     pi = np.asarray(getattr(g, "pc_i", np.zeros(0, np.int64)), np.int64)
     if not len(pi):
         z = np.zeros(0)
         return pi, z, z, z, z
     pa = g.pc_coef[:, COEF_A]
-    pdelta = np.maximum(x[pi, 0] + g.radius[pi] - (g.pc_x + u), 0.0)
+    along = x[pi, 0] if direction is None else np.einsum("kd,kd->k", x[pi], direction)
+    pdelta = np.maximum(along + g.radius[pi] - (g.pc_x + u), 0.0)
     return pi, pdelta, pa * pdelta**1.5, 1.5 * pa * np.sqrt(pdelta), pa
 
 
-def energy_and_forces(x: np.ndarray, o, g, wall, force, u=None, kc=None, load=None):
+def energy_and_forces(x: np.ndarray, o, g, wall, force, u=None, kc=None, load=None, direction=None):
     """(Pi [J] of (S1), the net force on every granule (ng, d) [N], the net force on each servo
     wall along its inward normal (nw,) [N], the net force on each plate contact's normal dof
     (nk,) [N]) at centres x, the servo walls' (`wall`, an index or (nw,) indices, the target's
     first) offsets o pushed in by `force` (scalars or (nw,) [m], [N]), plate displacements u
     (kc: the plate's condensed stiffness K_c) and load: (ng, d) constant forces on the granules
-    [N] (the force drives' `drive_loads`): minus the gradient of Pi."""
+    [N] (the force drives' `drive_loads`), direction: the plate contacts' (`plate_terms`): minus
+    the gradient of Pi."""
     (i, j, delta, f, _, n, a), (wi, wdelta, wf, _, wn, on, wa) = contact_terms(x, o, g, wall)
-    pi, pdelta, pf, _, pa = plate_terms(x, np.zeros(0) if u is None else u, g)
+    pi, pdelta, pf, _, pa = plate_terms(x, np.zeros(0) if u is None else u, g, direction)
     mass = g.mass
     grav = np.asarray(g.gravity, float) if len(g.gravity) else np.zeros(x.shape[1])
     walls = np.atleast_1d(np.asarray(wall, np.int64))
@@ -162,7 +168,10 @@ def energy_and_forces(x: np.ndarray, o, g, wall, force, u=None, kc=None, load=No
     np.add.at(net, i, f[:, None] * n)
     np.add.at(net, j, -f[:, None] * n)
     np.add.at(net, wi, -wf[:, None] * wn)
-    np.add.at(net[:, 0], pi, -pf)
+    if direction is None:
+        np.add.at(net[:, 0], pi, -pf)
+    else:
+        np.add.at(net, pi, -pf[:, None] * direction)
     net += mass[:, None] * grav
     if load is not None:
         e -= float(np.sum(load * x))
@@ -171,7 +180,7 @@ def energy_and_forces(x: np.ndarray, o, g, wall, force, u=None, kc=None, load=No
     return e, net, on_wall, on_plate
 
 
-def _normal_stiffness(x: np.ndarray, o, g, wall, u=None, kc=None):
+def _normal_stiffness(x: np.ndarray, o, g, wall, u=None, kc=None, direction=None):
     """The contacts' normal stiffness over every granule's coordinates, the plate contacts'
     normal displacements and the servo walls' offsets (the last unknowns, in `wall`'s order),
     as a sparse matrix: 3/2 A delta^(1/2) n n^T blocks and the plate's K_c (S1's Hessian
@@ -179,7 +188,7 @@ def _normal_stiffness(x: np.ndarray, o, g, wall, u=None, kc=None):
     from scipy.sparse import coo_matrix
 
     (i, j, _, _, k, n, _), (wi, _, _, wk, wn, _, _) = contact_terms(x, o, g, wall)
-    pi, _, _, pk, _ = plate_terms(x, np.zeros(0) if u is None else u, g)
+    pi, _, _, pk, _ = plate_terms(x, np.zeros(0) if u is None else u, g, direction)
     walls = np.atleast_1d(np.asarray(wall, np.int64))
     d = x.shape[1]
     nk = len(pi)
@@ -214,13 +223,24 @@ def _normal_stiffness(x: np.ndarray, o, g, wall, u=None, kc=None):
         rows.append(np.array([last]))
         cols.append(np.array([last]))
         vals.append(np.array([float(np.sum(wk[on]))]))
-    if nk:  # d delta / d x_i = e_x, d delta / d u_k = -1; the plate's K_c
+    if nk:  # d delta / d x_i = e (e_x: the plane's plate), d delta / d u_k = -1; the plate's K_c
         ku = first_u + np.arange(nk)
         pii = index[pi]
         sel = pii >= 0
-        rows += [pii[sel] * d, pii[sel] * d, ku[sel], ku, np.repeat(ku, nk)]
-        cols += [pii[sel] * d, ku[sel], pii[sel] * d, ku, np.tile(ku, nk)]
-        vals += [pk[sel], -pk[sel], -pk[sel], pk, np.asarray(kc, float).ravel()]
+        if direction is None:  # the plane's plate: along x alone
+            rows += [pii[sel] * d, pii[sel] * d, ku[sel]]
+            cols += [pii[sel] * d, ku[sel], pii[sel] * d]
+            vals += [pk[sel], -pk[sel], -pk[sel]]
+        else:
+            e = np.asarray(direction, float)
+            block(pii, pii, pk, e, 1.0)
+            for p in range(d):
+                rows += [pii[sel] * d + p, ku[sel]]
+                cols += [ku[sel], pii[sel] * d + p]
+                vals += [-pk[sel] * e[sel, p], -pk[sel] * e[sel, p]]
+        rows += [ku, np.repeat(ku, nk)]
+        cols += [ku, np.tile(ku, nk)]
+        vals += [pk, np.asarray(kc, float).ravel()]
     return coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(size, size)).tocsc()
 
 
@@ -359,11 +379,11 @@ def _refuse_unsupported(g, wall: int, target: str, pistons: Pistons) -> None:
         )
 
 
-def _refuse_unbalanced_loads(g, load: np.ndarray, d: int) -> None:
+def _refuse_unbalanced_loads(g, load: np.ndarray, d: int, direction=None) -> None:
     """ScenarioError naming the force drive (or gravity.g) whose push no support can react:
     the assembly's whole load, the drives' pushes at t = 0 `load` (ng, d) [N] and the weight,
     must lie in the span of the directions the supports push along (the walls' normals, the
-    held granules' drive directions, the plane's plate along x), or the frictionless static
+    held granules' drive directions, the plate along x or its contacts' `direction`), or the frictionless static
     state has no equilibrium (a sideways push on a straight column between two walls)."""
     from scipy.linalg import orth
 
@@ -373,6 +393,8 @@ def _refuse_unbalanced_loads(g, load: np.ndarray, d: int) -> None:
     total = load.sum(axis=0) + float(np.sum(g.mass)) * grav
     held = [g.drive_dir[k] for k, i in enumerate(g.drive_target) if i >= 0 and g.drive_kind[k] != KIND_FORCE]
     plate = [np.eye(d)[0]] if len(getattr(g, "pc_i", ())) else []
+    if direction is not None:
+        plate = list(np.asarray(direction, float))
     spans = np.array([*g.wall_geo[:, :d], *held, *plate], float).reshape(-1, d)
     q = orth(spans.T) if len(spans) else np.zeros((d, 0))
     free = total - q @ (q.T @ total)  # what no support can push back
@@ -433,7 +455,8 @@ def static_state(
     basis = granule_freedom(g, d)  # the granules' free coordinates
     nf = basis.shape[1]
     load = drive_loads(g, d)
-    _refuse_unbalanced_loads(g, load, d)
+    direction = plate.direction if plate is not None else None
+    _refuse_unbalanced_loads(g, load, d, direction)
     a_min = float(np.min(g.wall_coef[g.wall_w == wall, COEF_A])) if np.any(g.wall_w == wall) else 1.0
     scale = (force / a_min) ** (2.0 / 3.0)  # the overlap F makes at the wall [m]: the unknowns' unit
 
@@ -443,7 +466,7 @@ def static_state(
 
     def forces(z):
         x, o, u = unpack(z)
-        e, net, on_wall, on_plate = energy_and_forces(x, o, g, walls, push, u, kc, load)
+        e, net, on_wall, on_plate = energy_and_forces(x, o, g, walls, push, u, kc, load, direction)
         return e, basis.T @ net.ravel(), on_wall, on_plate  # the net force along the free coordinates
 
     def fun(z):
@@ -465,7 +488,7 @@ def static_state(
             break
         x, o, u = unpack(z)
         _, net, on_wall, on_plate = forces(z)
-        h = project @ _normal_stiffness(x, o, g, walls, u, kc) @ project.T * scale
+        h = project @ _normal_stiffness(x, o, g, walls, u, kc, direction) @ project.T * scale
         rhs = np.concatenate([net, on_plate, on_wall])
         dz = spsolve(h + identity(h.shape[0], format="csc") * (1e-12 * float(abs(h).max())), rhs)
         r0, t = residual(z), 1.0
@@ -475,7 +498,7 @@ def static_state(
         steps += 1
     x, o, u = unpack(z)
     _, net, on_wall, _ = forces(z)
-    pf = plate_terms(x, u, g)[2]
+    pf = plate_terms(x, u, g, direction)[2]
     state = StaticState(
         x, float(o[0]), float(offset0), residual(z), steps, float(on_wall[0] + force), u, pf, pistons, o[1:]
     )
@@ -507,7 +530,8 @@ def precompressed(model):
     """The model whose run starts from its scenario's [precompression] static state: the
     granules' centres moved to it, the target wall's offset with them (`run_walls`: where
     the walls are when the contact lists are rebuilt), the plate deflected under its contacts'
-    static forces (`plate_q0`, `plate_u0`), the driven granules' `drive_x0` (their drives'
+    static forces (`plate_q0`, `plate_u0`; space's elastic solid: its modes `plate_q0` under its
+    weight and its contacts' forces, model.body_static), the driven granules' `drive_x0` (their drives'
     displacements count from there); the wall frozen there during the run, or, with
     mode = "held", a piston that keeps pushing with the force (`held_wall`); the model
     itself when the scenario has none."""
@@ -523,8 +547,14 @@ def precompressed(model):
     offset0 = float(g.wall_geo[rows, d][0]) if np.any(rows) else 0.0
     x0 = np.ascontiguousarray(model.initial_state[:, :d])
     plate = plate_statics(model.plate_arrays) if model.plate is not None else None
+    g_static, body, q_weight = g, None, np.zeros(0)
+    if model.body is not None:  # the elastic solid in space: its contacts' compliance (model.body_static)
+        from granplate.model.body_static import body_statics
+
+        q_weight = model.plate_q0 if model.plate_q0 is not None else np.zeros(len(model.body.omega))
+        g_static, plate, body = body_statics(model, x0, q_weight)
     st = static_state(
-        g, x0, wall, offset0, float(p.force), float(p.tolerance), int(p.max_iterations), str(p.target), plate
+        g_static, x0, wall, offset0, float(p.force), float(p.tolerance), int(p.max_iterations), str(p.target), plate
     )
     y0 = model.initial_state.copy()
     y0[:, :d] = st.positions
@@ -544,6 +574,11 @@ def precompressed(model):
     if p.mode == "held":
         g = held_wall(g, model.scenario, wall, float(p.force), float(p.mass))
     out = dataclasses.replace(model, initial_state=y0, granular=g, run_walls=tuple(walls))
+    if body is not None:  # the solid's modes at rest under its weight and the contacts' static forces
+        from granplate.model.body_static import body_at_rest
+
+        q0 = body_at_rest(body, model.body.omega, q_weight, st.plate_force)
+        return dataclasses.replace(out, plate_q0=q0, plate_u0=np.zeros(0))
     if plate is None:
         return out
     q0, u0 = plate_at_rest(plate, model.plate_arrays, st.plate_force)

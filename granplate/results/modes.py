@@ -284,8 +284,9 @@ class BodyContacts(NamedTuple):
 def body_contacts(model, x: np.ndarray) -> BodyContacts:
     """The contacts of the granules at centres x (ng, 3) [m] on the model's elastic body at
     its modal state at t = 0 (solver.body's own contact pass: each granule's closest point,
-    its patch's weights, the overlap with the residual compliance in series; the body not
-    statically deflected by them: a scenario with a body has no [precompression])."""
+    its patch's weights, the overlap with the residual compliance in series; the body's modes
+    at their static state, `plate_q0`, under its weight and a [precompression]'s contact
+    forces, model.body_static, else undeformed)."""
     from granplate.model.inputs import GEO_DELTA, GEO_NX, GEO_NZ, GEO_TOUCH, new_body_state
     from granplate.physics.contact import COEF_A
     from granplate.solver import body as sb
@@ -295,7 +296,8 @@ def body_contacts(model, x: np.ndarray) -> BodyContacts:
     y = np.zeros((len(g.mass), 9))
     y[:, :3] = x
     acc, fdamp = np.zeros_like(y), np.zeros_like(y)
-    sb.contact_forces(y, b.q.copy(), np.zeros_like(b.q), b, 0, g.radius, g.mass, False, acc, fdamp, False)
+    q0 = b.q.copy() if model.plate_q0 is None else np.ascontiguousarray(model.plate_q0, float)
+    sb.contact_forces(y, q0, np.zeros_like(b.q), b, 0, g.radius, g.mass, False, acc, fdamp, False)
     geo = b.geo[0]
     granule = np.flatnonzero((geo[:, GEO_TOUCH] != 0.0) & (geo[:, GEO_DELTA] > 0.0))
     nk, nm = len(granule), len(b.omega)

@@ -53,9 +53,9 @@ def granule_labels(s: Scenario) -> list[str]:
 
 
 def check_gravity(s: Scenario) -> None:
-    """[gravity] g: one finite component per dimension, |g| <= GRAVITY_MAX; in space no
-    [plate] (the elastic solid's own weight is not modelled; the plane's plate carries it,
-    docs/model.md section 3.11)."""
+    """[gravity] g: one finite component per dimension, |g| <= GRAVITY_MAX (the plate, the
+    plane's or space's elastic solid, carries its own weight too, docs/model.md section 3.11;
+    a solid no support holds against it is refused when it is built, model.body_weight)."""
     if s.gravity is None:
         return
     g = s.gravity.g
@@ -68,15 +68,6 @@ def check_gravity(s: Scenario) -> None:
         )
     if not math.hypot(*g) <= GRAVITY_MAX:
         raise ScenarioError("gravity.g", list(g), f"allowed |g| <= {GRAVITY_MAX:g} m/s^2")
-    if s.plate is not None and s.dimension == 3:
-        raise ScenarioError(
-            "gravity.g",
-            list(g),
-            "gravity acts on the granules alone in space: a scenario of dimension = 3 with a "
-            "[plate] (an elastic solid) cannot have it yet (the solid's own weight, and the static "
-            "sag it would start from, are not modelled); leave out [gravity] or the [plate], or "
-            "use the plane's plate (dimension = 2), which carries its weight",
-        )
 
 
 def check_drives(s: Scenario, step_max: float, wave_speed: float) -> None:

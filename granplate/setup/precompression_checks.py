@@ -1,7 +1,7 @@
 """The rules of [precompression] (docs/model.md section 3.12): its target wall, force, mode
 (a held wall's mass), tolerance and iterations, and what the static state can be
-computed for (the plane's plate through rigid layers, the target wall not driven, a granule
-near it)."""
+computed for (the plane's plate through rigid layers, space's elastic solid, the target wall
+not driven, a granule near it)."""
 
 from __future__ import annotations
 
@@ -94,20 +94,15 @@ def _check_mode_mass(s: Scenario) -> None:
 
 def _check_plate(s: Scenario) -> None:
     """What the static state holds of a [plate]: the plane's plate, its compliance at the rigid
-    layers of the granules on its face nodes at t = 0 (docs/model.md section 3.12). A 3D [plate]
-    (an elastic solid) and granules touching the face between nodes at t = 0 (patch contacts
-    from the start) are refused, naming the field."""
+    layers of the granules on its face nodes at t = 0 (docs/model.md section 3.12); granules
+    touching the face between nodes at t = 0 (patch contacts from the start) are refused,
+    naming the field. Space's elastic solid holds its contacts wherever they are."""
     from granplate.setup.plate_checks import split_initial_contacts
 
     if s.plate is None:
         return
     if not isinstance(s.plate, Plate):
-        raise ScenarioError(
-            "precompression.target",
-            s.precompression.target if s.precompression is not None else None,
-            "a 3D [plate] (an elastic solid) cannot be precompressed yet (its static compliance is not part "
-            "of the static state); leave out [precompression] or the [plate]",
-        )
+        return  # space's elastic solid: its contacts' static compliance (model.body_static)
     between = split_initial_contacts(s)[1]
     if between:
         name = s.granules[between[0]].label or str(between[0] + 1)

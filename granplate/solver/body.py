@@ -64,6 +64,7 @@ from granplate.solver.granular3d import VX, X
 from granplate.solver.body_friction import friction_flow as friction_flow, slip_row as slip_row
 from granplate.solver.body_modes import kick as kick, load_kick as load_kick
 from granplate.solver.body_modes import predicted_velocity as predicted_velocity, turn as turn
+from granplate.solver.body_modes import turn_weighed as turn_weighed
 from granplate.solver.body_residual import NEWTON_RTOL as NEWTON_RTOL, NEWTON_STEPS as NEWTON_STEPS
 from granplate.solver.body_residual import RESID_RTOL as RESID_RTOL, RESID_SWEEPS as RESID_SWEEPS
 from granplate.solver.body_residual import residual_load, residual_matrix, residual_rows, residual_tilt

@@ -26,7 +26,8 @@ the damping part of the force (D_visc) and the load (E_shock; a line load on the
 body kicks its modes the same way, at t_n and t_n + h), so eq. (11)'s residual is
 Verlet's own energy error, O(h^2), which the loop checks at every step. Gravity and the
 drives (solver.drives) join each force pass; the drive forces' kicks are booked the same
-way (gravity's too), a driven wall's elastic work exactly (the change of its contacts'
+way (gravity's too; an elastic body's own weight, a constant modal force, turns its modes
+exactly about their static deflection, its work booked as gravity's), a driven wall's elastic work exactly (the change of its contacts'
 energy as it moves), the damping at its velocity by the trapezoidal rule over the step
 (in the drive's work and in D_visc alike), and the impulse that gives a driven granule
 its prescribed velocity at t + h as the kinetic energy it adds. A force-driven wall (a
@@ -225,7 +226,7 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
         if cfg.load_on_plate:
             wl += B.load_kick(b.qd, b.load, shock_amplitude(t, cfg), hk)
         wd += B.kick(b.qd, b.fmodal[cur], b.fdamp[cur], hk)
-        B.turn(b.q, b.qd, b.omega, h)
+        w_grav += B.turn_weighed(b.q, b.qd, b.omega, b.weight, h)  # its own weight too (model.body_weight)
         B.predicted_velocity(b, hk, cur)
     # (Mindlin: the slip over h at the half step's velocities, y's)
     pr, e_t, lost_t = force_pass(t + h, y, w.ytmp, h, g, cfg, w.kend, sw.fdamp[nxt], sw.fload[nxt], sw)
