@@ -111,8 +111,7 @@ def max_error_3d(v: tuple, ref: dict) -> float:
 def _ours_worker(spec: dict) -> dict:
     """Runs in a fresh subprocess: one (size, mu) of granplate; the reference when mu = 0
     (unless spec["reference"] is "skip"). The time the loop spends on its contact lists
-    (`ContactLists.refresh`: the rebuilds and the list made at the run's end, Python on one
-    thread) is measured apart, so that the steps' own cost per contact-step can be read."""
+    (`ContactLists.refresh`: the rebuilds the loop asks for, Python on one thread) is measured apart, so that the steps' own cost per contact-step can be read."""
     import os
     import resource
     import time

@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 
 from granplate.setup.pairs import close_pairs
 
@@ -208,3 +209,101 @@ def verlet_walls(
         i = np.flatnonzero(gap <= skin * r)
         out.append(np.column_stack([i, np.full(len(i), w)]).astype(np.int64))
     return np.concatenate(out).reshape(-1, 2)
+
+
+#: Most cells per centre of `reaching_pairs`' dense cell grid (a sparser assembly, its
+#: bounding box mostly empty, is searched by the k-d tree instead).
+CELLS_PER_CENTRE = 8
+
+
+@njit(cache=True)
+def _grid_pairs(p, r, reach, lo, h, nc):  # pragma: no cover - compiled
+    """Sorted pairs (i < j) of the centres p (n, d <= 3) [m] with |p_j - p_i|^2 <= ((R_i +
+    R_j) reach)^2, from a cell grid of side h >= 2 R_max reach [m] from corner lo with
+    nc (3,) cells per axis: each centre against the centres of its cell and the 26 (8 in
+    the plane) around it, its partners sorted by insertion."""
+    n, d = p.shape
+    key = np.empty(n, np.int64)
+    cell = np.zeros((n, 3), np.int64)
+    for i in range(n):
+        for k in range(d):
+            cell[i, k] = min(int((p[i, k] - lo[k]) / h), nc[k] - 1)
+        key[i] = (cell[i, 0] * nc[1] + cell[i, 1]) * nc[2] + cell[i, 2]
+    start = np.zeros(nc[0] * nc[1] * nc[2] + 1, np.int64)
+    for i in range(n):
+        start[key[i] + 1] += 1
+    for c in range(1, len(start)):
+        start[c] += start[c - 1]
+    member = np.empty(n, np.int64)
+    fill = start[:-1].copy()
+    for i in range(n):
+        member[fill[key[i]]] = i
+        fill[key[i]] += 1
+    out = np.empty((max(16, 8 * n), 2), np.int64)
+    m = 0
+    buf = np.empty(64, np.int64)
+    span = np.ones(3, np.int64)
+    for k in range(d, 3):
+        span[k] = 0
+    for i in range(n):
+        nb = 0
+        for a in range(max(cell[i, 0] - span[0], 0), min(cell[i, 0] + span[0], nc[0] - 1) + 1):
+            for b in range(max(cell[i, 1] - span[1], 0), min(cell[i, 1] + span[1], nc[1] - 1) + 1):
+                for c in range(max(cell[i, 2] - span[2], 0), min(cell[i, 2] + span[2], nc[2] - 1) + 1):
+                    q = (a * nc[1] + b) * nc[2] + c
+                    for s in range(start[q], start[q + 1]):
+                        j = member[s]
+                        if j <= i:
+                            continue
+                        d2 = 0.0
+                        for k in range(d):
+                            e = p[j, k] - p[i, k]
+                            d2 += e * e
+                        lim = (r[i] + r[j]) * reach
+                        if d2 <= lim * lim:
+                            if nb == len(buf):
+                                buf = np.concatenate((buf, np.empty(nb, np.int64)))
+                            buf[nb] = j
+                            nb += 1
+        for u in range(1, nb):  # insertion sort: a few partners each
+            v = buf[u]
+            w = u - 1
+            while w >= 0 and buf[w] > v:
+                buf[w + 1] = buf[w]
+                w -= 1
+            buf[w + 1] = v
+        if m + nb > out.shape[0]:
+            grown = np.empty((2 * out.shape[0] + nb, 2), np.int64)
+            grown[:m] = out[:m]
+            out = grown
+        for u in range(nb):
+            out[m, 0] = i
+            out[m, 1] = buf[u]
+            m += 1
+    return out[:m].copy()
+
+
+def reaching_pairs(points: np.ndarray, r: np.ndarray, reach: float = 1.0 + SEARCH_MARGIN) -> np.ndarray:
+    """(n, 2) sorted pairs (i < j) of the centres points (n, 2 or 3) [m] whose squared
+    distance is at most ((R_i + R_j) reach)^2: with the default reach, a superset of the
+    pairs that touch or overlap by any rounding of their distance (`is_contact` with no
+    gap, the loop's overlap). A compiled cell grid of side 2 R_max reach, one pass, no sort
+    beyond each centre's few partners; a sparse assembly (more than CELLS_PER_CENTRE cells
+    per centre) or non-finite centres: the k-d tree (`candidate_pairs`), the same test after it."""
+    p = np.ascontiguousarray(points, dtype=float)
+    r = np.ascontiguousarray(r, dtype=float)
+    n = len(p)
+    if n < 2:
+        return np.zeros((0, 2), np.int64)
+    h = 2.0 * float(r.max()) * reach * (1.0 + SEARCH_MARGIN)
+    lo, hi = p.min(axis=0), p.max(axis=0)
+    nc = np.ones(3, np.int64)
+    if np.isfinite(p).all() and h > 0.0:
+        span = np.floor((hi - lo) / h) + 1.0
+        if float(np.prod(span)) <= CELLS_PER_CENTRE * n + 64:
+            nc[: p.shape[1]] = span.astype(np.int64)
+            return _grid_pairs(p, r, float(reach), lo, h, nc)
+    cand = close_pairs(p, h)
+    i, j = cand[:, 0], cand[:, 1]
+    d2 = np.sum((p[j] - p[i]) ** 2, axis=1)
+    return np.ascontiguousarray(cand[d2 <= ((r[i] + r[j]) * reach) ** 2]).reshape(-1, 2)

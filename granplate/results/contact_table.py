@@ -196,20 +196,11 @@ def link_forces(kin, coef, dmax, rate, clip, out):
         out[k, TANGENTIAL] = tangential_magnitude(n, kin[k, SLIP], c)
 
 
-def pair_links(y, radius, pairs, coef, dmax, rate, arm_shrink, clip, out) -> None:
-    """Overlap, normal and friction force of each pair (i, j) of `pairs` at state y (the
-    plane's 6 columns or space's 9: its dimension's `KINEMATICS`) into out (np, 3);
-    out[p, OVERLAP] <= 0 where apart. dmax, rate: each contact's largest overlap so far [m]
-    and rate factor [-]."""
-    kin = np.zeros((len(pairs), 3))
-    KINEMATICS[of_state(y.shape[1]).name][0](y, radius, pairs, arm_shrink, kin)
-    link_forces(kin, coef, dmax, rate, clip, out)
-
-
 def wall_links(y, radius, granule, geo, vn, coef, dmax, rate, arm_shrink, clip, out) -> None:
     """Overlap, normal and friction force of each granule `granule[k]` against the wall of
     row geo[k] ([n..., offset where the wall is], unit outward normal) moving at vn[k] [m/s]
-    along it, into out (nw, 3), as `pair_links`."""
+    along it, into out (nw, 3); out[k, OVERLAP] <= 0 where apart. dmax, rate: each
+    contact's largest overlap so far [m] and rate factor [-]."""
     kin = np.zeros((len(granule), 3))
     KINEMATICS[of_state(y.shape[1]).name][1](y, radius, granule, geo, vn, arm_shrink, kin)
     link_forces(kin, coef, dmax, rate, clip, out)
@@ -278,12 +269,30 @@ def wall_motion(model, out, n: int) -> WallMotion:
 
 def touching_pairs(y: np.ndarray, radius: np.ndarray) -> np.ndarray:
     """(np, 2) sorted pairs i < j whose surfaces touch or overlap at state y (a k-d tree,
-    model.neighbours.contact_pairs with no gap)."""
+    model.neighbours.contact_pairs with no gap): the reference `in_touch` keeps to."""
     from granplate.model.contacts import centre_coordinates
     from granplate.model.neighbours import contact_pairs
 
     x, yy, z = centre_coordinates(y, of_state(y.shape[1]).n)
     return np.asarray(contact_pairs(x, yy, radius, 0.0, z), np.int64).reshape(-1, 2)
+
+
+def reaching(y: np.ndarray, radius: np.ndarray) -> np.ndarray:
+    """(nc, 2) sorted pairs i < j at state y that may touch by any rounding of their
+    distance (model.neighbours.reaching_pairs: one compiled cell-grid pass)."""
+    from granplate.model.neighbours import reaching_pairs
+
+    return reaching_pairs(y[:, : of_state(y.shape[1]).n], radius)
+
+
+def in_touch(y: np.ndarray, radius: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """The mask of `pairs` (sorted, i < j) that `touching_pairs` returns at state y: the
+    same test (model.neighbours.contacts_among with no gap), on these pairs alone."""
+    from granplate.model.contacts import centre_coordinates
+    from granplate.model.neighbours import contacts_among
+
+    x, yy, z = centre_coordinates(y, of_state(y.shape[1]).n)
+    return contacts_among(pairs, x, yy, radius, 0.0, z)
 
 
 def touching_walls(y: np.ndarray, radius: np.ndarray, walls: WallMotion, o: int) -> np.ndarray:
@@ -357,11 +366,16 @@ def links_at(model, y: np.ndarray, o: int, walls: WallMotion, history: History, 
 
     s, mats, g, cfg = model.scenario, list(model.materials), model.granular, model.config
     r = np.asarray(g.radius, float)
-    pairs = touching_pairs(y, r)
+    cand = reaching(y, r)  # kept: those of `touching_pairs` that overlap, in its order
+    kin = np.zeros((len(cand), 3))
+    KINEMATICS[of_state(y.shape[1]).name][0](y, r, cand, cfg.arm_shrink, kin)
+    on = np.flatnonzero(kin[:, DELTA] > 0.0)
+    on = on[in_touch(y, r, cand[on])]
+    pairs, kin = cand[on], kin[on]
     coef = cached_pair_coefficients(s, mats, g, pairs, known)
     dmax, rate = history.at(history.keys(pairs[:, 0], pairs[:, 1]), t, coef)
     pv = np.zeros((len(pairs), 3))
-    pair_links(y, r, pairs, coef, dmax, rate, cfg.arm_shrink, cfg.clip, pv)
+    link_forces(kin, coef, dmax, rate, cfg.clip, pv)
     wc = touching_walls(y, r, walls, o)
     _, wcoef = wall_arrays(s, mats, r, g.mass, wc, model.walls)
     w = wc[:, 1]
@@ -395,9 +409,11 @@ def overlaps_at(model, y: np.ndarray, o: int, walls: WallMotion, history: Histor
     """The overlaps of the contacts touching at output o taken into `history` (no forces)."""
     r = np.asarray(model.granular.radius, float)
     d = walls.normal.shape[1]
-    pairs = touching_pairs(y, r)
-    dist = np.linalg.norm(y[pairs[:, 1], :d] - y[pairs[:, 0], :d], axis=1)
-    history.see(history.keys(pairs[:, 0], pairs[:, 1]), r[pairs[:, 0]] + r[pairs[:, 1]] - dist)
+    cand = reaching(y, r)
+    delta = r[cand[:, 0]] + r[cand[:, 1]] - np.linalg.norm(y[cand[:, 1], :d] - y[cand[:, 0], :d], axis=1)
+    on = np.flatnonzero(delta > 0.0)
+    on = on[in_touch(y, r, cand[on])]
+    history.see(history.keys(cand[on, 0], cand[on, 1]), delta[on])
     wc = touching_walls(y, r, walls, o)
     i, w = wc[:, 0], wc[:, 1]
     delta = np.sum(y[i, :d] * walls.normal[w], axis=1) + r[i] - walls.offset[o, w]
