@@ -25,7 +25,6 @@ ALLOWED = {
     "solver/schemes/verlet.py": "being rewritten for the Mindlin friction law (attempt: 106 lines); split it after",
     "model/space.py": "being rewritten for the Mindlin friction law (the 3D model's arrays)",
     "model/static.py": "being rewritten for the static precompression's new cases",
-    "results/dataset.py": "being rewritten for the contact table (to_dataset: 172 lines); split it after",
 }
 
 #: functions kept whole for speed ("file:function"), with the measured cost of splitting them

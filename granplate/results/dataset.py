@@ -313,58 +313,101 @@ def to_dataset(
     axis = run_contacts(model, contacts)
     plate_data: dict[str, xr.DataArray] = {}
     if model.plate is not None:
-        force = out.force[:n].reshape(n, out.force.shape[1] * out.force.shape[2])
-        if summary_only:
-            every = peak_maxima(axis.plate, plate_coordinates(axis.plate, out.q[:n], force))
-            for col, name in enumerate(("max_von_mises", "max_von_mises_disc", "max_eps_yy")):
-                plate_data[name] = _var(name, ("time",), every[:, col].copy())
-        else:
-            plate_data, n_done = plate_fields(
-                model,
-                out.q[:n],
-                out.qd[:n],
-                out.t[:n],
-                force,
-                should_stop=should_stop,
-                progress=progress,
-                plate=axis.plate,
-            )
-            if n_done < n:
-                n = n_done
-                info = {
-                    **info,
-                    "status": f"{INTERRUPTED_STATUS} at t = {out.t[n - 1]:.6e} s, while building the result.",
-                }
+        plate_data, n_done = _plate_outputs(model, out, n, axis, summary_only, should_stop, progress)
+        n, info = _interrupted_at(out, n, n_done, info)
     body_data: dict[str, xr.DataArray] = {}
     body_coords: dict = {}
     if model.solid is not None:
         body_data, body_coords, n_done = body_outputs(model, out, n, summary_only, should_stop)
-        if n_done < n:
-            n = n_done
-            info = {**info, "status": f"{INTERRUPTED_STATUS} at t = {out.t[n - 1]:.6e} s, while building the result."}
+        n, info = _interrupted_at(out, n, n_done, info)
     t = out.t[:n].copy()
+    data: dict[str, xr.DataArray] = dict(body_data)
+    data.update(_state_and_energies(model, out, n, summary_only))
+    coords = _coordinates(model, t, axis, summary_only)
+    info = _yield_outputs(model, contacts, data, coords, info)
+    coords.update(body_coords)
+    if summary_only:
+        data.update(plate_data)
+        ds = xr.Dataset(data, coords=coords)
+        return _with_scenario(ds, _attrs(model, out, n, info), s)
+    data.update(_step_outputs(out, n, axis))
+    data.update(wall_and_drive_outputs(model, out, n, coords))
+    data.update(sensor_outputs(model, out, float(t[-1]) if n else -math.inf, coords))
+    data.update(link_outputs(model, out, n, contacts, coords))
+    if model.plate is not None:
+        _add_plate_mesh(data, coords, plate_data, axis.plate)
+    ds = xr.Dataset(data, coords=coords)
+    if len(axis.granule) == 0:
+        ds = ds.drop_dims("contact", errors="ignore")
+    return _with_scenario(ds, _attrs(model, out, n, info), s)
+
+
+def _interrupted_at(out: K.Output, n: int, n_done: int, info: dict) -> tuple[int, dict]:
+    """(the output rows kept, the run's info): n and info as they are when every row was
+    built (n_done == n); else the n_done rows built and the status of a run interrupted
+    while its result was built."""
+    if n_done >= n:
+        return n, info
+    status = f"{INTERRUPTED_STATUS} at t = {out.t[n_done - 1]:.6e} s, while building the result."
+    return n_done, {**info, "status": status}
+
+
+def _plate_outputs(model, out: K.Output, n: int, axis, summary_only: bool, should_stop, progress: bool):
+    """(the plate's variables, the output rows built): its maxima alone over the output
+    times that can hold the run's largest value (summary_only, granplate.plate.peaks), or
+    its fields (`plate_fields`, polling should_stop), from the modal coordinates and the
+    contact forces of the first n rows."""
+    force = out.force[:n].reshape(n, out.force.shape[1] * out.force.shape[2])
+    if not summary_only:
+        return plate_fields(
+            model,
+            out.q[:n],
+            out.qd[:n],
+            out.t[:n],
+            force,
+            should_stop=should_stop,
+            progress=progress,
+            plate=axis.plate,
+        )
+    plate_data: dict[str, xr.DataArray] = {}
+    every = peak_maxima(axis.plate, plate_coordinates(axis.plate, out.q[:n], force))
+    for col, name in enumerate(("max_von_mises", "max_von_mises_disc", "max_eps_yy")):
+        plate_data[name] = _var(name, ("time",), every[:, col].copy())
+    return plate_data, n
+
+
+#: the energy columns of the output (solver.state) and their variables' names
+ENERGY_VARIABLES = (
+    (K.E_SHOCK, "E_shock"),
+    (K.E_GRAN, "E_granular"),
+    (K.E_PLATE, "E_plate"),
+    (K.D_VISC, "D_viscous"),
+    (K.D_FRIC, "D_friction"),
+    (K.D_PLASTIC, "D_plastic"),
+    (K.E_POTG, "E_contact"),
+    (K.KE_X, "KE_horizontal"),
+    (K.KE_Y, "KE_vertical"),
+    (K.KE_ROT, "KE_rotational"),
+    (K.RESID, "energy_residual"),
+    (K.RESID_MAX, "energy_residual_max"),
+    (K.KE_Z, "KE_depth"),
+)
+
+
+def _state_and_energies(model, out: K.Output, n: int, summary_only: bool) -> dict[str, xr.DataArray]:
+    """The granules' states (not with summary_only) and the energies of the first n output
+    rows, as the Dataset's variables: the state variables of the state's dimension, the
+    energy balance's terms (those `summary` reads with summary_only), the plate's energy
+    about its static state, gravity's and the drives' work where the run has them."""
+    s = model.scenario
     y = out.y[:n]
     e = out.energy[:n]
-    data: dict[str, xr.DataArray] = dict(body_data)
+    data: dict[str, xr.DataArray] = {}
     dim = of_state(y.shape[2])
     if not summary_only:
         for c, name in enumerate(dim.state_variables):
             data[name] = _var(name, ("time", "granule"), y[:, :, c].copy())
-    for col, name in (
-        (K.E_SHOCK, "E_shock"),
-        (K.E_GRAN, "E_granular"),
-        (K.E_PLATE, "E_plate"),
-        (K.D_VISC, "D_viscous"),
-        (K.D_FRIC, "D_friction"),
-        (K.D_PLASTIC, "D_plastic"),
-        (K.E_POTG, "E_contact"),
-        (K.KE_X, "KE_horizontal"),
-        (K.KE_Y, "KE_vertical"),
-        (K.KE_ROT, "KE_rotational"),
-        (K.RESID, "energy_residual"),
-        (K.RESID_MAX, "energy_residual_max"),
-        (K.KE_Z, "KE_depth"),
-    ):
+    for col, name in ENERGY_VARIABLES:
         if dim.foreign(name):  # (KE_depth: in space only)
             continue
         if not summary_only or name in SUMMARY_VARIABLES:
@@ -377,7 +420,13 @@ def to_dataset(
         data["E_gravity"] = _var("E_gravity", ("time",), e[:, K.E_GRAVITY].copy())
     if s.drives:
         data["E_drive"] = _var("E_drive", ("time",), e[:, K.E_DRIVE].copy())
-    nk = len(axis.granule)
+    return data
+
+
+def _coordinates(model, t: np.ndarray, axis, summary_only: bool) -> dict:
+    """The Dataset's coordinates: time [s], the granules (label, radius, mass, material)
+    and, but with summary_only, the plate contacts' granules."""
+    s = model.scenario
     coords = {
         "time": ("time", t, {"units": "s", "long_name": "time"}),
         "granule": ("granule", np.array(model.labels, dtype=str), {"long_name": "granule label (paper numbering)"}),
@@ -400,68 +449,76 @@ def to_dataset(
             {"long_name": "granule material"},
         ),
     }
+    return coords
+
+
+def _yield_outputs(model, contacts, data: dict, coords: dict, info: dict) -> dict:
+    """The contacts' largest pressures by material pair (results.yielding, where the run
+    recorded its contacts' peaks) into data and coords (material_pair); returns the run's
+    info with the largest contact pressure and its yield-onset ratio added."""
     py = pair_yield(model, contacts.peaks) if contacts is not None and contacts.peaks is not None else None
-    if py is not None:
-        coords["material_pair"] = (
-            "material_pair",
-            np.array(py.pair, dtype=str),
-            {"long_name": "material pair of contacts (docs/model.md section 3.6)"},
-        )
-        for name, values in (
-            ("pair_max_contact_pressure", py.pressure),
-            ("pair_yield_onset_ratio", py.ratio),
-            ("pair_yield_strength", py.yield_strength),
-            ("pair_max_pressure_time", py.time),
-            ("pair_max_pressure_contact", np.array(py.contact, dtype=str)),
-            ("pair_normal_law", np.array(py.law, dtype=str)),
-        ):
-            data[name] = _var(name, ("material_pair",), values)
-        p_max, ratio = largest(py)
-        info = {**info, "max_contact_pressure": p_max, "yield_onset_ratio": ratio}
-    coords.update(body_coords)
-    if summary_only:
-        data.update(plate_data)
-        ds = xr.Dataset(data, coords=coords)
-        return _with_scenario(ds, _attrs(model, out, n, info), s)
-    data["contact_normal_force"] = _var("contact_normal_force", ("time", "contact"), out.force[:n, :, 0].copy())
-    data["contact_tangential_force"] = _var("contact_tangential_force", ("time", "contact"), out.force[:n, :, 1].copy())
-    data["contact_slip_rate"] = _var("contact_slip_rate", ("time", "contact"), out.slip[:n].copy())
-    data["local_map_modulus"] = _var("local_map_modulus", ("time", "contact"), out.lam[:n].copy())
-    data["iterations"] = _var("iterations", ("time", "contact"), out.iters[:n].copy())
-    data["dt_min"] = _var("dt_min", ("time",), out.stats[:n, K.S_DT_MIN].copy())
-    data["dt_max"] = _var("dt_max", ("time",), out.stats[:n, K.S_DT_MAX].copy())
-    data["n_steps"] = _var("n_steps", ("time",), out.stats[:n, K.S_STEPS].astype(np.int64))
-    data["n_iterations"] = _var("n_iterations", ("time",), out.stats[:n, K.S_ITERS].astype(np.int64))
-    data["contact_time_formed"] = _var("contact_time_formed", ("contact",), axis.time_formed)
-    data.update(wall_and_drive_outputs(model, out, n, coords))
-    data.update(sensor_outputs(model, out, float(t[-1]) if n else -math.inf, coords))
-    data.update(link_outputs(model, out, n, contacts, coords))
-    if model.plate is not None:
-        ft = plate_data.pop("_field_time")
-        data.update(plate_data)
-        plate = axis.plate
-        coords["field_time"] = ("field_time", ft, {"units": "s", "long_name": "time of the plate field snapshots"})
-        coords["node_x"] = ("node", plate.node_xy[:, 0].copy(), {"units": "m", "long_name": "plate node x"})
-        coords["node_y"] = ("node", plate.node_xy[:, 1].copy(), {"units": "m", "long_name": "plate node y"})
-        coords["x_symmetry"] = (
-            "x_symmetry",
-            plate.node_xy[np.asarray(plate.symmetry_nodes), 0].copy(),
-            {"units": "m", "long_name": "x along the plate's symmetry line"},
-        )
-        data["element_nodes"] = xr.DataArray(
-            np.asarray(plate.elements, np.int64),
-            dims=("element", "element_node"),
-            attrs={"long_name": "plate element connectivity (VTK quadratic quad order)"},
-        )
-        data["contact_y"] = xr.DataArray(
-            np.asarray(plate.contact_y, float),
-            dims=("contact",),
-            attrs={"units": "m", "long_name": "y of each plate contact"},
-        )
-    ds = xr.Dataset(data, coords=coords)
-    if nk == 0:
-        ds = ds.drop_dims("contact", errors="ignore")
-    return _with_scenario(ds, _attrs(model, out, n, info), s)
+    if py is None:
+        return info
+    coords["material_pair"] = (
+        "material_pair",
+        np.array(py.pair, dtype=str),
+        {"long_name": "material pair of contacts (docs/model.md section 3.6)"},
+    )
+    for name, values in (
+        ("pair_max_contact_pressure", py.pressure),
+        ("pair_yield_onset_ratio", py.ratio),
+        ("pair_yield_strength", py.yield_strength),
+        ("pair_max_pressure_time", py.time),
+        ("pair_max_pressure_contact", np.array(py.contact, dtype=str)),
+        ("pair_normal_law", np.array(py.law, dtype=str)),
+    ):
+        data[name] = _var(name, ("material_pair",), values)
+    p_max, ratio = largest(py)
+    return {**info, "max_contact_pressure": p_max, "yield_onset_ratio": ratio}
+
+
+def _step_outputs(out: K.Output, n: int, axis) -> dict[str, xr.DataArray]:
+    """The plate contacts' forces, slip rates, local map moduli and iterations, and the
+    steps' statistics (smallest and largest step, steps and iterations per output
+    interval) of the first n output rows; each plate contact's time of forming."""
+    return {
+        "contact_normal_force": _var("contact_normal_force", ("time", "contact"), out.force[:n, :, 0].copy()),
+        "contact_tangential_force": _var("contact_tangential_force", ("time", "contact"), out.force[:n, :, 1].copy()),
+        "contact_slip_rate": _var("contact_slip_rate", ("time", "contact"), out.slip[:n].copy()),
+        "local_map_modulus": _var("local_map_modulus", ("time", "contact"), out.lam[:n].copy()),
+        "iterations": _var("iterations", ("time", "contact"), out.iters[:n].copy()),
+        "dt_min": _var("dt_min", ("time",), out.stats[:n, K.S_DT_MIN].copy()),
+        "dt_max": _var("dt_max", ("time",), out.stats[:n, K.S_DT_MAX].copy()),
+        "n_steps": _var("n_steps", ("time",), out.stats[:n, K.S_STEPS].astype(np.int64)),
+        "n_iterations": _var("n_iterations", ("time",), out.stats[:n, K.S_ITERS].astype(np.int64)),
+        "contact_time_formed": _var("contact_time_formed", ("contact",), axis.time_formed),
+    }
+
+
+def _add_plate_mesh(data: dict, coords: dict, plate_data: dict, plate) -> None:
+    """The plate's fields (plate_data, its snapshot times as the coordinate field_time),
+    its nodes [m], the x of its symmetry line [m], its elements and its contacts' y [m]
+    into data and coords."""
+    ft = plate_data.pop("_field_time")
+    data.update(plate_data)
+    coords["field_time"] = ("field_time", ft, {"units": "s", "long_name": "time of the plate field snapshots"})
+    coords["node_x"] = ("node", plate.node_xy[:, 0].copy(), {"units": "m", "long_name": "plate node x"})
+    coords["node_y"] = ("node", plate.node_xy[:, 1].copy(), {"units": "m", "long_name": "plate node y"})
+    coords["x_symmetry"] = (
+        "x_symmetry",
+        plate.node_xy[np.asarray(plate.symmetry_nodes), 0].copy(),
+        {"units": "m", "long_name": "x along the plate's symmetry line"},
+    )
+    data["element_nodes"] = xr.DataArray(
+        np.asarray(plate.elements, np.int64),
+        dims=("element", "element_node"),
+        attrs={"long_name": "plate element connectivity (VTK quadratic quad order)"},
+    )
+    data["contact_y"] = xr.DataArray(
+        np.asarray(plate.contact_y, float),
+        dims=("contact",),
+        attrs={"units": "m", "long_name": "y of each plate contact"},
+    )
 
 
 #: Scenarios with more granules than this keep them out of the result's scenario_toml, as the
