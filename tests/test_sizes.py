@@ -21,9 +21,7 @@ CORE = ("physics", "model", "solver", "plate", "solid")
 #: files exempt from both limits, relative to the package, with why
 ALLOWED = {
     "solver/granular3d.py": "being rewritten for the Mindlin friction law (granular_rhs: 148 lines); split it after",
-    "solver/blocks.py": "being rewritten for the Mindlin friction law (the threaded Verlet passes)",
     "solver/schemes/verlet.py": "being rewritten for the Mindlin friction law (attempt: 106 lines); split it after",
-    "model/space.py": "being rewritten for the Mindlin friction law (the 3D model's arrays)",
     "model/static.py": "being rewritten for the static precompression's new cases",
 }
 
