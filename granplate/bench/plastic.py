@@ -142,7 +142,8 @@ def kernel_case(t_end: float | None = None) -> dict:
     from granplate.model.arrays import build_model, granular_with_contacts
     from granplate.model.contacts import contact_lists
     from granplate.model.inputs import HIST_MAX, HIST_RATE
-    from granplate.physics.contact import COEF_DY, pair_overlap
+    from granplate.physics.contact import COEF_DY, COEF_NLAW, pair_overlap
+    from granplate.setup.law_registry import HERTZ
     from granplate.solver.granular import friction_flow, granular_rhs
 
     s = gp.with_changes(packing_scenario(0.099, "split", t_end), {"contact.normal_law": "thornton"})
@@ -162,8 +163,8 @@ def kernel_case(t_end: float | None = None) -> dict:
         g.pair_hist[p, HIST_MAX] = 1.05 * max(d, 0.0)
         touch += d > 0.0
     elastic = g._replace(pair_coef=g.pair_coef.copy(), wall_coef=g.wall_coef.copy())
-    elastic.pair_coef[:, COEF_DY] = np.inf
-    elastic.wall_coef[:, COEF_DY] = np.inf
+    for coef in (elastic.pair_coef, elastic.wall_coef):  # Hertz's law: its id, a yield overlap never reached
+        coef[:, COEF_NLAW], coef[:, COEF_DY] = HERTZ, np.inf
     jm = build_model(with_law(s, "johnson"))
     johnson = granular_with_contacts(jm, jm.granular, pairs, wc)
     johnson = johnson._replace(pair_hist=g.pair_hist.copy(), wall_hist=g.wall_hist.copy())

@@ -48,12 +48,13 @@ def body_coefficients(
 ) -> np.ndarray:
     """(ng, N_COEF) each granule's contact coefficients with the body: Hertz A with E* of
     both materials and the granule's radius (the body flat there), damping with m* = m_i
-    (the body's mass much larger), the pair's friction and yield overlap; a granule on a
+    (the body's mass much larger), the pair's friction, yield overlap and law ids; a granule on a
     rigid patch (on_rigid) meets a rigid body, the 2D rigid layer's law (E* of the granule
     alone, m* = 0: no damping, docs/model.md section 3.4). Under Mindlin's tangential law
     (docs/model.md section 3.16) the rows are Mindlin's: 1/G* of both, or of the granule
     alone on a rigid patch."""
     from granplate.model.arrays import coefficient_row, law_coefficients, mindlin_columns
+    from granplate.model.coefficients import normal_law_id
     from granplate.physics.mindlin import tangential_compliance
 
     coef = np.zeros((len(r), N_COEF))
@@ -71,6 +72,7 @@ def body_coefficients(
             mu,
             ks,
             law_coefficients(s, m, other, body_material.name, e_star, float(r[i]), 2.0 * float(r[i])),
+            normal_law_id(s, m.name, body_material.name),
         )
         if mindlin:
             compliance[i] = tangential_compliance(m.E, m.nu)

@@ -1,6 +1,7 @@
 """The contacts' coefficient rows (docs/model.md eqs. 3-5 and the normal laws' columns,
-sections 3.6 and 3.10): Hertz's A, the damping c, friction mu and k_s, and the yield
-overlap and the law "johnson"'s constants, for granule pairs (E*, R*, m* of the two),
+sections 3.6 and 3.10): Hertz's A, the damping c, friction mu and k_s, the yield
+overlap and the law "johnson"'s constants, Mindlin's columns and the contact's normal and
+tangential law ids (setup.law_registry), for granule pairs (E*, R*, m* of the two),
 granules against rigid walls and against the plate's rigid layers (R* = R, m* = m or 0),
 with the walls' planes. The columns are physics.contact's COEF_*.
 """
@@ -22,9 +23,11 @@ from granplate.physics.contact import (
     COEF_KT,
     COEF_MU,
     COEF_MUT,
+    COEF_NLAW,
     COEF_RC,
     COEF_RL,
     COEF_SY,
+    COEF_TLAW,
     COEF_XH,
     COEF_XT,
     N_COEF,
@@ -40,18 +43,22 @@ from granplate.setup.materials import (
     softer_material,
     softer_yield_strength,
 )
+from granplate.setup.law_registry import HERTZ, MINDLIN, NORMAL_LAW_IDS, TANH, YIELDING_LAWS
 from granplate.setup.scenario import Scenario
 
 
-def coefficient_row(a: float, c: float, mu: float, k_s: float, law=math.inf) -> np.ndarray:
+def coefficient_row(a: float, c: float, mu: float, k_s: float, law=math.inf, normal_law: int = HERTZ) -> np.ndarray:
     """One row of pair_coef / wall_coef / pc_coef in the columns of physics.contact:
-    Hertz A [N/m^1.5], damping c, mu [-], k_s [s/m] (eqs. 3, 5) and the normal law's
+    Hertz A [N/m^1.5], damping c, mu [-], k_s [s/m] (eqs. 3, 5), the normal law's
     columns from COEF_DY on (`law_coefficients`), or the yield overlap delta_y [m] alone
-    (docs/model.md eq. P3; inf: Hertz's law)."""
+    (docs/model.md eq. P3; inf: never reached), the normal law's id `normal_law`
+    (setup.law_registry's NORMAL_LAW_IDS, `normal_law_id`) and the tanh law's tangential id
+    (`mindlin_columns` makes a row Mindlin's)."""
     row = np.zeros(N_COEF)
     row[COEF_A], row[COEF_C], row[COEF_MU], row[COEF_KS] = a, c, mu, k_s
     law = np.atleast_1d(np.asarray(law, float))
     row[COEF_DY : COEF_DY + len(law)] = law
+    row[COEF_NLAW], row[COEF_TLAW] = normal_law, TANH
     return row
 
 
@@ -61,13 +68,19 @@ def normal_law_of(s: Scenario, a: str, b: str) -> str:
     return s.contact.law_for_pair(a, b)
 
 
+def normal_law_id(s: Scenario, a: str, b: str) -> int:
+    """The id (COEF_NLAW, setup.law_registry) of the normal law between materials a and b
+    (`normal_law_of`)."""
+    return NORMAL_LAW_IDS[normal_law_of(s, a, b)]
+
+
 def law_yield_overlap(s: Scenario, a, b, b_name: str, e_star: float, r_star: float) -> float:
     """COEF_DY of a contact of material a (a granule's Material) with b (a granule's
     Material, or None for a rigid wall or the plate's face, whose material is b_name):
     the yield overlap delta_y [m] (docs/model.md eqs. P1, P3) of the softer body under the
     elastic-plastic law "thornton", inf under Hertz's law. (Validation refuses "thornton"
     where the Y it needs is unknown.)"""
-    if normal_law_of(s, a.name, b_name) not in ("thornton", "johnson"):
+    if normal_law_of(s, a.name, b_name) not in YIELDING_LAWS:
         return math.inf
     return contact_yield_overlap(e_star, r_star, softer_yield_strength(a, b))
 
@@ -115,6 +128,7 @@ def pair_coefficient_row(s: Scenario, a, b, ri: float, rj: float, mi: float, mj:
         mu,
         ks,
         law_coefficients(s, a, b, b.name, e_star, r_star, ri + rj),
+        normal_law_id(s, a.name, b.name),
     )
 
 
@@ -156,24 +170,26 @@ def pair_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, pairs:
         ]
     )
     combo = None if len(combos) == 1 else kind[i] * len(kinds) + kind[j]
-    # per pair of materials: E*, alpha_n, mu, k_s, whether the law is elastic-plastic (one value each when one pair)
+    # per pair of materials: E*, alpha_n, mu, k_s, the normal law's id (one value each when one pair)
     e_star, alpha, mu, ks = (np.empty(len(pairs)) if combo is not None else 0.0 for _ in range(4))
-    plastic = np.zeros(len(pairs), bool)
+    nlaw = np.full(len(pairs), HERTZ, np.int64)
     for c, ka, kb in combos:
         values = (effective_modulus(ka, kb), *s.contact.for_pair(ka.name, kb.name))
         if combo is None:
             e_star, alpha, mu, ks = values
-            plastic[:] = normal_law_of(s, ka.name, kb.name) != "hertz"
+            nlaw[:] = normal_law_id(s, ka.name, kb.name)
             continue
         on = combo == c
         for column, v in zip((e_star, alpha, mu, ks), values):
             column[on] = v
-        plastic |= on & (normal_law_of(s, ka.name, kb.name) != "hertz")
+        nlaw[on] = normal_law_id(s, ka.name, kb.name)
+    plastic = nlaw != HERTZ
     coef_a = 4.0 / 3.0 * e_star * np.sqrt(r_star)  # hertz_coefficient
     pair_coef = np.zeros((len(pairs), N_COEF))
     pair_coef[:, COEF_A] = coef_a
     pair_coef[:, COEF_C] = alpha * np.sqrt(m_star * coef_a)  # damping_coefficient
     pair_coef[:, COEF_MU], pair_coef[:, COEF_KS], pair_coef[:, COEF_DY] = mu, ks, math.inf
+    pair_coef[:, COEF_NLAW], pair_coef[:, COEF_TLAW] = nlaw, TANH
     for p in np.flatnonzero(plastic).tolist():
         a, b = mats[i[p]], mats[j[p]]
         e_p = e_star if combo is None else float(e_star[p])
@@ -190,11 +206,12 @@ def mindlin_columns(coef: np.ndarray, compliance: np.ndarray, damping: float) ->
     """Rows of `coef` made Mindlin's (docs/model.md section 3.16) in place: 8 G* from
     1 / G* = `compliance` [1/Pa] (per row, eq. M1) into COEF_KT, the Coulomb coefficient moved
     from COEF_MU (which the tanh law reads) to COEF_MUT, the tangential damping factor x_t
-    (contact.tangential_damping) into COEF_XT."""
+    (contact.tangential_damping) into COEF_XT, Mindlin's id into COEF_TLAW."""
     coef[:, COEF_KT] = mindlin_coefficient(1.0) / compliance
     coef[:, COEF_MUT] = coef[:, COEF_MU]
     coef[:, COEF_MU] = 0.0
     coef[:, COEF_XT] = damping
+    coef[:, COEF_TLAW] = MINDLIN
 
 
 def wall_coefficient_row(s: Scenario, a, wall_material: str, ri: float, mi: float) -> np.ndarray:
@@ -209,6 +226,7 @@ def wall_coefficient_row(s: Scenario, a, wall_material: str, ri: float, mi: floa
         mu,
         ks,
         law_coefficients(s, a, None, wall_material, e_star, ri, 2.0 * ri),
+        normal_law_id(s, a.name, wall_material),
     )
     if s.contact.tangential_law == "mindlin":
         rows = row.reshape(1, -1)
@@ -231,7 +249,7 @@ def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarr
     kinds, kind = material_indices(mats)
     i, w = wc[:, 0], wc[:, 1]
     e_star, alpha = np.empty(len(wc)), np.empty(len(wc))
-    plastic = np.zeros(len(wc), bool)
+    nlaw = np.full(len(wc), HERTZ, np.int64)
     for k in np.unique(w).tolist():
         wall = walls[k]
         nrm = np.asarray(wall.normal, float)
@@ -241,13 +259,14 @@ def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarr
             on = at & (kind[i] == c)
             e_star[on] = effective_modulus(kinds[c], None)
             alpha[on], wall_coef[on, COEF_MU], wall_coef[on, COEF_KS] = s.contact.for_pair(kinds[c].name, wall.material)
-            plastic |= on & (normal_law_of(s, kinds[c].name, wall.material) != "hertz")
+            nlaw[on] = normal_law_id(s, kinds[c].name, wall.material)
     ri = r[i]
     coef_a = 4.0 / 3.0 * e_star * np.sqrt(ri)  # hertz_coefficient with R* = R
     wall_coef[:, COEF_A] = coef_a
     wall_coef[:, COEF_C] = alpha * np.sqrt(mass[i] * coef_a)  # damping_coefficient with m* = m
     wall_coef[:, COEF_DY] = math.inf
-    for p in np.flatnonzero(plastic).tolist():
+    wall_coef[:, COEF_NLAW], wall_coef[:, COEF_TLAW] = nlaw, TANH
+    for p in np.flatnonzero(nlaw != HERTZ).tolist():
         wall_coef[p, COEF_DY : COEF_XH + 1] = law_coefficients(
             s, mats[i[p]], None, s.walls[w[p]].material, float(e_star[p]), float(ri[p]), 2.0 * float(ri[p])
         )
@@ -271,5 +290,6 @@ def plate_contact_coefficients(s: Scenario, mats, r: np.ndarray, pc: np.ndarray)
             mu,
             ks,
             law_coefficients(s, mats[i], None, s.plate.material, e_star, r[i], 2.0 * r[i]),
+            normal_law_id(s, mats[i].name, s.plate.material),
         )
     return pc_coef

@@ -40,20 +40,25 @@ def damping_coefficient(alpha_n: float, m_star: float, a: float) -> float:
 #: columns of the coefficient arrays pair_coef, wall_coef, pc_coef (model arrays):
 #: Hertz coefficient A [N/m^1.5] (eq. 3), damping coefficient c with gamma = c delta^(1/4)
 #: (eq. 3), friction coefficient mu [-], regularisation k_s [s/m] (eq. 5), and the yield
-#: overlap delta_y [m] of the elastic-plastic law (docs/model.md section 3.6, eq. P3;
-#: inf: the contact follows Hertz's law, eq. 2); then the law "johnson" (docs/model.md
-#: section 3.10; 0 in COEF_SY: Thornton's law where COEF_DY is finite): R* Y [N/m], the rate
+#: overlap delta_y [m] of the yielding laws (docs/model.md section 3.6, eq. P3; inf under
+#: Hertz's law, eq. 2); then the law "johnson"'s (docs/model.md section 3.10; 0 under the
+#: other laws): R* Y [N/m], the rate
 #: coefficient C [-], 1 / (L rate_ref) [s/m] with L the length that makes the approach speed a
 #: strain rate, the hardness ratio h [-], the unloading factor kappa [-] and x_h, the
 #: overlap over delta_y where the pressure reaches h Y (eqs. J1-J8); then Mindlin's
 #: tangential law (docs/model.md section 3.16, physics.mindlin): 8 G* [Pa], the tangential
-#: stiffness per unit contact radius (0: the contact takes eq. 5's tanh law, COEF_MU), and
+#: stiffness per unit contact radius (0 under eq. 5's tanh law, which reads COEF_MU), and
 #: its Coulomb coefficient mu [-] (a Mindlin contact's COEF_MU is 0, so that the tanh law's
-#: passes skip it) and its tangential damping factor x_t [-] (eta_t = x_t c delta^(1/4)).
+#: passes skip it) and its tangential damping factor x_t [-] (eta_t = x_t c delta^(1/4));
+#: then the contact's law ids (setup.law_registry), integer values on which the laws
+#: dispatch: its normal law (COEF_NLAW: NORMAL_LAW_IDS, physics.laws) and its tangential
+#: law (COEF_TLAW: TANGENTIAL_LAW_IDS). No other column selects a law: a Hertz row's
+#: COEF_DY is inf (a yield overlap never reached), a tanh row's COEF_KT 0.
 COEF_A, COEF_C, COEF_MU, COEF_KS, COEF_DY = 0, 1, 2, 3, 4
 COEF_SY, COEF_RC, COEF_RL, COEF_H, COEF_KAPPA, COEF_XH = 5, 6, 7, 8, 9, 10
 COEF_KT, COEF_MUT, COEF_XT = 11, 12, 13
-N_COEF = 14
+COEF_NLAW, COEF_TLAW = 14, 15
+N_COEF = 16
 
 
 @njit(cache=True)

@@ -42,8 +42,8 @@ from numba import njit
 from granplate.physics.contact import (
     COEF_DY,
     COEF_KS,
-    COEF_KT,
     COEF_MU,
+    COEF_TLAW,
     contact_arm,
     friction_magnitude,
     pair_overlap,
@@ -54,6 +54,7 @@ from granplate.physics.contact import (
 from granplate.model.dimension import of_state
 from granplate.physics.laws import normal_law_force
 from granplate.physics.space import pair_contact_3d, wall_overlap_3d
+from granplate.setup.law_registry import MINDLIN
 from granplate.solver.granular3d import pair_slip, wall_slip
 
 #: name -> (units, description) of the table's variables (docs/output.md)
@@ -209,9 +210,9 @@ def wall_links(y, radius, granule, geo, vn, coef, dmax, rate, arm_shrink, clip, 
 @njit(cache=True)
 def tangential_magnitude(n: float, vt: float, c) -> float:
     """|F_t| [N] of a contact of coefficient row c at normal force n [N] and slip rate vt
-    [m/s]: the tanh law's (eq. 5); NaN for a Mindlin contact (COEF_KT set), whose force
+    [m/s]: the tanh law's (eq. 5); NaN for a Mindlin contact (COEF_TLAW), whose force
     follows from its tangential history, not from the state."""
-    if c[COEF_KT] > 0.0:
+    if c[COEF_TLAW] == MINDLIN:
         return math.nan
     return abs(friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS]))
 

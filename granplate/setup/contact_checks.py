@@ -10,6 +10,10 @@ from typing import Any
 
 from granplate.errors import ScenarioError
 from granplate.setup.fields import material_exists, nonneg, positive, string_in
+
+# YIELDING_LAWS: the normal laws that need the yield strength Y of every body that can yield
+# at a contact (both granules; the granule alone against a wall or the plate)
+from granplate.setup.law_registry import YIELDING_LAWS as YIELDING_LAWS
 from granplate.setup.scenario import NORMAL_LAWS, TANGENTIAL_LAWS, Scenario
 
 
@@ -18,9 +22,6 @@ from granplate.setup.scenario import NORMAL_LAWS, TANGENTIAL_LAWS, Scenario
 #: at R - delta/2 between spheres and R at a wall).
 TORQUE_ARMS: tuple[str, ...] = ("radius", "contact_point", "lammps")
 DETECTIONS: tuple[str, ...] = ("dynamic", "fixed")
-#: Normal laws (of NORMAL_LAWS) that need the yield strength Y of every body that can
-#: yield at a contact (both granules; the granule alone against a wall or the plate).
-YIELDING_LAWS: tuple[str, ...] = ("thornton", "johnson")
 #: Largest Coulomb coefficient (real dry pairs stay below about 2, rubber on glass).
 MU_MAX = 10.0
 #: Largest tanh smoothing k_s [s/m]: a smoothing slip rate 1/k_s of at least 1 um/s (the

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from granplate.setup.law_registry import NORMAL_LAW_IDS, TANGENTIAL_LAW_IDS
 from granplate.setup.materials import LIBRARY, Material
 
 
@@ -463,14 +464,14 @@ class Load:
 #: strength Y of every body that can yield at the contact; "johnson", Hertz to yield,
 #: then Johnson's expanding-cavity mean pressure over the plastic contact disc up to the
 #: hardness, with a rate-dependent yield strength (docs/model.md section 3.10), which needs
-#: Y likewise.
-NORMAL_LAWS: tuple[str, ...] = ("hertz", "thornton", "johnson")
+#: Y likewise. The names of the laws' registry (setup.law_registry), in its order.
+NORMAL_LAWS: tuple[str, ...] = tuple(NORMAL_LAW_IDS)
 #: Tangential laws (Contact.tangential_law): "tanh", eq. (5)'s regularised Coulomb law
 #: without history (the paper's), and "mindlin", Mindlin's tangential spring 8 G* a with a
 #: Coulomb limit mu |N| and each contact's elastic tangential displacement as history
 #: (docs/model.md section 3.16; under the scheme "verlet", in the plane and in space, and
-#: on the elastic solid in space).
-TANGENTIAL_LAWS: tuple[str, ...] = ("tanh", "mindlin")
+#: on the elastic solid in space). The names of the laws' registry (setup.law_registry).
+TANGENTIAL_LAWS: tuple[str, ...] = tuple(TANGENTIAL_LAW_IDS)
 
 
 @dataclass(frozen=True)

@@ -20,18 +20,19 @@ import numpy as np
 from numba import njit
 
 from granplate.model.inputs import GEO_DELTA, GEO_N, GEO_NX, GEO_NY, GEO_NZ, GEO_TOUCH
-from granplate.physics.contact import COEF_KT, contact_arm
+from granplate.physics.contact import COEF_TLAW, contact_arm
 from granplate.physics.mindlin import contact_radius
 from granplate.physics.space import slip_velocity_3d
+from granplate.setup.law_registry import MINDLIN
 from granplate.solver.body_surface import spread, surface_velocity
 from granplate.solver.granular3d import VX, WX, apply_friction_impulse, mindlin_contact, mindlin_parted
 
 
 @njit(cache=True)
 def has_mindlin(b) -> bool:
-    """Whether any granule's contact with the body is under Mindlin's law (COEF_KT > 0)."""
+    """Whether any granule's contact with the body is under Mindlin's law (COEF_TLAW)."""
     for i in range(b.coef.shape[0]):
-        if b.coef[i, COEF_KT] != 0.0:
+        if b.coef[i, COEF_TLAW] == MINDLIN:
             return True
     return False
 
@@ -51,7 +52,7 @@ def surface_motion(b, buf_old, buf, i, vq):
 @njit(cache=True)
 def mindlin_forces(y, vq, b, buf_old, buf, h, radius, mass, inertia, arm_shrink, acc):
     """Mindlin's law at every granule's contact on the body whose coefficient row has
-    COEF_KT > 0, after the body's force pass into buffer buf (its overlaps, normals, |N|
+    COEF_TLAW = MINDLIN, after the body's force pass into buffer buf (its overlaps, normals, |N|
     and patches): the slip from y's velocities and spins (the half step's) against the
     surface's motion at the modal rates vq (nm,) [(q_n+1 - q_n) / h; h = 0: the force of the
     committed history, vq the modal velocity], over h [s]. Adds F_t / m and the torque's
@@ -63,7 +64,7 @@ def mindlin_forces(y, vq, b, buf_old, buf, h, radius, mass, inertia, arm_shrink,
     g = b.geo[buf]
     for i in range(b.coef.shape[0]):
         c = b.coef[i]
-        if c[COEF_KT] == 0.0:
+        if c[COEF_TLAW] != MINDLIN:
             continue
         delta = g[i, GEO_DELTA]
         if g[i, GEO_TOUCH] == 0.0 or delta <= 0.0:

@@ -32,11 +32,11 @@ from granplate.model.inputs import (
 from granplate.physics.contact import (
     COEF_DY,
     COEF_KS,
-    COEF_KT,
     COEF_MU,
+    COEF_NLAW,
     COEF_RC,
     COEF_RL,
-    COEF_SY,
+    COEF_TLAW,
     contact_arm,
     friction_magnitude,
     friction_power,
@@ -54,6 +54,7 @@ from granplate.physics.contact import (
 from granplate.physics.cavity import rate_factor
 from granplate.physics.laws import normal_law_force, normal_law_response
 from granplate.physics.shock import shock_amplitude
+from granplate.setup.law_registry import JOHNSON, MINDLIN
 from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_motion
 from granplate.solver.state import PARTNER_PLATE
 
@@ -387,12 +388,12 @@ def commit_rows(t, hist, coef, lo, hi):
     for k in range(lo, hi):
         # Mindlin's tangential history (docs/model.md section 3.16); a contact out of touch
         # with none, before and after (HIST_A and HIST_A_END zero: its rows are zeros), keeps its zeros
-        if coef[k, COEF_KT] != 0.0 and (hist[k, HIST_A_END] != 0.0 or hist[k, HIST_A] != 0.0):
+        if coef[k, COEF_TLAW] == MINDLIN and (hist[k, HIST_A_END] != 0.0 or hist[k, HIST_A] != 0.0):
             for col in range(N_MINDLIN):
                 hist[k, HIST_XI + col] = hist[k, HIST_XI_END + col]
         d = hist[k, HIST_END]
         if d > hist[k, HIST_MAX]:
-            if hist[k, HIST_RATE] == 0.0 and coef[k, COEF_SY] > 0.0 and d > coef[k, COEF_DY]:
+            if hist[k, HIST_RATE] == 0.0 and coef[k, COEF_NLAW] == JOHNSON and d > coef[k, COEF_DY]:
                 v = fixing_speed(d, hist[k, HIST_MAX], t, hist[k, HIST_TIME])
                 hist[k, HIST_RATE] = rate_factor(v, coef[k, COEF_RC], coef[k, COEF_RL])
             hist[k, HIST_MAX] = d

@@ -28,6 +28,7 @@ from granplate.physics.contact import (
     COEF_C,
     COEF_KS,
     COEF_KT,
+    COEF_TLAW,
     COEF_MU,
     COEF_MUT,
     COEF_XT,
@@ -37,6 +38,7 @@ from granplate.physics.contact import (
 from granplate.physics.laws import normal_law_force, normal_law_response
 from granplate.physics.mindlin import contact_radius, mindlin_step, spring_energy
 from granplate.physics.shock import shock_amplitude
+from granplate.setup.law_registry import MINDLIN
 from granplate.physics.space import (
     arm_torque_3d,
     friction_along_slip,
@@ -588,7 +590,7 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, out, out_d, c_f, c_d, c_t, tangential
     """Listed pairs lo..hi-1 of the velocity-Verlet force pass in space: each pair's normal
     force at state yn (its overlap into HIST_END) into out[:, c_f:c_f + 3] (minus on i,
     plus on j), its damping part into out_d[:, c_d:c_d + 3]; with `tangential`, at the
-    pairs whose coefficient row has COEF_KT > 0, Mindlin's force from the same overlap and
+    pairs whose coefficient row names Mindlin's law (COEF_TLAW), Mindlin's force from the same overlap and
     |N| (docs/model.md section 3.16; the slip from yv's velocities over h [s]) added to the
     forces and its torques into out[:, c_t:c_t + 3], a parted pair's history ended
     (`mindlin_parted`). The serial pass (`normal_forces`, solver.mindlin_space) and each
@@ -617,7 +619,7 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, out, out_d, c_f, c_d, c_t, tangential
         rj = g.radius[j]
         hist[p, HIST_END] = 0.0
         delta, nx, ny, nz = pair_contact_3d(yn[i, X], yn[i, Y], yn[i, Z], ri, yn[j, X], yn[j, Y], yn[j, Z], rj)
-        kt = tangential and g.pair_coef[p, COEF_KT] != 0.0
+        kt = tangential and g.pair_coef[p, COEF_TLAW] == MINDLIN
         if delta <= 0.0:
             if kt and (hist[p, HIST_A] != 0.0 or hist[p, HIST_A_END] != 0.0):
                 lost += mindlin_parted(hist, p, g.pair_coef[p])

@@ -16,7 +16,7 @@ from numba import njit
 
 from granplate.model.inputs import HIST_A, HIST_A_END, HIST_END, HIST_MAX, HIST_RATE
 from granplate.physics.contact import (
-    COEF_KT,
+    COEF_TLAW,
     contact_arm,
     pair_apart,
     pair_normal_rate,
@@ -28,6 +28,7 @@ from granplate.physics.contact import (
 from granplate.physics.laws import normal_law_response
 from granplate.physics.mindlin import contact_radius
 from granplate.physics.shock import shock_amplitude
+from granplate.setup.law_registry import MINDLIN
 from granplate.solver.drives import begin_pass, book_wall, wall_motion
 from granplate.solver.granular import ForceSums
 from granplate.solver.granular3d import mindlin_contact, mindlin_old_force, mindlin_parted
@@ -68,7 +69,7 @@ def pair_mindlin(p, i, j, ri, rj, delta, nx, nz, n_abs, yv, h, hist, c, half_shr
 def pair_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
     """The pairs' share of `normal_mindlin_forces`: every listed pair's normal force
     (physics.laws, as solver.granular.normal_forces) at state yn and, where its coefficient
-    row has COEF_KT > 0, Mindlin's force (`pair_mindlin`) from the same overlap and |N|,
+    row names Mindlin's law (COEF_TLAW), Mindlin's force (`pair_mindlin`) from the same overlap and |N|,
     added to acc[:, 3:6] as forces and torques; the damping parts into fdamp, each
     overlap into HIST_END, a parted contact's history ended (`mindlin_parted`). Returns
     (viscous power [W], stored energy [J], plastic work [J], the largest overlap / radius,
@@ -99,7 +100,7 @@ def pair_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
         if not pair_apart(yn[i, 0], yn[i, 1], ri, yn[j, 0], yn[j, 1], rj):
             delta, nx, nz = pair_overlap(yn[i, 0], yn[i, 1], ri, yn[j, 0], yn[j, 1], rj)
         if delta <= 0.0:
-            if c[COEF_KT] != 0.0 and (hist[p, HIST_A] != 0.0 or hist[p, HIST_A_END] != 0.0):
+            if c[COEF_TLAW] == MINDLIN and (hist[p, HIST_A] != 0.0 or hist[p, HIST_A_END] != 0.0):
                 lost += mindlin_parted(hist, p, c)
             continue
         hist[p, HIST_END] = delta
@@ -120,7 +121,7 @@ def pair_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
             fdamp[i, 4] -= d * nz
             fdamp[j, 3] += d * nx
             fdamp[j, 4] += d * nz
-        if c[COEF_KT] != 0.0:
+        if c[COEF_TLAW] == MINDLIN:
             tx, ty, ti, tj, e, d = pair_mindlin(
                 p, i, j, ri, rj, delta, nx, nz, n, yv, h, hist, c, half_shrink, lammps_arms
             )
@@ -143,7 +144,7 @@ def wall_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
     """The walls' share of `normal_mindlin_forces`, one contact after another (a wall's
     load and a driven wall's force are shared sums): each wall contact's normal force at
     state yn (as solver.granular.normal_forces, booked on its wall and drive) and, where
-    COEF_KT > 0, Mindlin's force from the same overlap and |N|, into acc[:, 3:6] as forces
+    COEF_TLAW = MINDLIN, Mindlin's force from the same overlap and |N|, into acc[:, 3:6] as forces
     and torques. Returns (viscous power [W], stored energy [J], plastic work [J], the
     largest overlap / radius, its granule, its partner code, springs' energy [J], losses [J])."""
     p_visc = 0.0
@@ -165,7 +166,7 @@ def wall_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
         delta = wall_overlap(yn[i, 0], yn[i, 1], ri, nx, nz, g.wall_geo[w, 2] + shift)
         hist[w, HIST_END] = max(delta, 0.0)
         if delta <= 0.0:
-            if c[COEF_KT] != 0.0:
+            if c[COEF_TLAW] == MINDLIN:
                 lost += mindlin_parted(hist, w, c)
             continue
         if delta > ovl * ri:
@@ -185,7 +186,7 @@ def wall_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
             fdamp[i, 3] -= d * nx
             fdamp[i, 4] -= d * nz
         book_wall(g, w, kd, n, d)
-        if c[COEF_KT] == 0.0:
+        if c[COEF_TLAW] != MINDLIN:
             continue
         arm = contact_arm(ri, delta, cfg.arm_shrink)
         _, vt = wall_rates(yv[i, 3], yv[i, 4], yv[i, 5], nx, nz, arm)
@@ -204,7 +205,7 @@ def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload):
     """The velocity-Verlet force pass of the plane (solver.granular.normal_forces) with
     Mindlin's tangential law (docs/model.md section 3.16) in it: the shock, every listed
     pair and wall contact's normal force at state yn (its velocities the damping's) and, at
-    the contacts whose coefficient row has COEF_KT > 0, the tangential spring's force from
+    the contacts whose coefficient row names Mindlin's law (COEF_TLAW), the tangential spring's force from
     the same overlap and |N|, its history moved on by the slip at yv's velocities over h
     [s] (the half step's; yv's positions are yn's; h = 0: the force of the committed
     history), trial histories into HIST_XI_END, HIST_A_END, HIST_F_END. Accelerations into

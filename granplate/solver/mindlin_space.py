@@ -12,10 +12,11 @@ from __future__ import annotations
 from numba import njit
 
 from granplate.model.inputs import HIST_MAX, HIST_RATE
-from granplate.physics.contact import COEF_KT, contact_arm
+from granplate.physics.contact import COEF_TLAW, contact_arm
 from granplate.physics.laws import normal_law_force
 from granplate.physics.mindlin import contact_radius
 from granplate.physics.space import normal_rate_3d, wall_overlap_3d
+from granplate.setup.law_registry import MINDLIN
 from granplate.solver.drives import begin_pass, wall_motion
 from granplate.solver.granular import ForceSums
 from granplate.solver.granular3d import (
@@ -36,7 +37,7 @@ from granplate.solver.granular3d import (
 
 @njit(cache=True)
 def wall_mindlin(yv, yn, h, g, cfg, acc):
-    """Mindlin's law at the wall contacts whose coefficient row has COEF_KT > 0, after the
+    """Mindlin's law at the wall contacts whose coefficient row names Mindlin's law (COEF_TLAW), after the
     normal pass (a wall's few contacts: their geometry and |N| again): the slip from yv's
     velocities over h [s], |N| from yn's; the forces and torques added to the
     accelerations acc. Returns (the springs' energy [J], their losses [J])."""
@@ -44,7 +45,7 @@ def wall_mindlin(yv, yn, h, g, cfg, acc):
     lost = 0.0
     for w in range(g.wall_i.shape[0]):
         c = g.wall_coef[w]
-        if c[COEF_KT] == 0.0:
+        if c[COEF_TLAW] != MINDLIN:
             continue
         i = g.wall_i[w]
         ri = g.radius[i]
@@ -72,8 +73,8 @@ def wall_mindlin(yv, yn, h, g, cfg, acc):
 def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload):
     """solver.granular3d.normal_forces with Mindlin's tangential law in it (docs/model.md
     section 3.16): the shock, every listed pair and wall contact's normal force at state yn
-    (its velocities the damping's) and, at the contacts whose coefficient row has COEF_KT >
-    0, the tangential spring's force from the same overlap and |N|, its history moved on by
+    (its velocities the damping's) and, at the contacts whose coefficient row names Mindlin's
+    law (COEF_TLAW), the tangential spring's force from the same overlap and |N|, its history moved on by
     the slip at yv's velocities over h [s] (the half step's; yv's positions are yn's; h = 0:
     the force of the committed history), the trial histories into HIST_XI_END, HIST_A_END,
     HIST_F_END. Returns (the ForceSums, the springs' stored energy [J], the energy they

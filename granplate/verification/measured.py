@@ -144,10 +144,11 @@ def johnson_row(material: str, **changes) -> np.ndarray:
     import dataclasses
 
     from granplate.model.arrays import coefficient_row, johnson_columns
+    from granplate.setup.law_registry import JOHNSON
 
     e_star, r_star, a, m = contact_of(material)
     m = dataclasses.replace(m, **changes)
-    return coefficient_row(a, 0.0, 0.0, 0.0, johnson_columns(m, e_star, r_star, 2.0 * SPHERE_RADIUS))
+    return coefficient_row(a, 0.0, 0.0, 0.0, johnson_columns(m, e_star, r_star, 2.0 * SPHERE_RADIUS), JOHNSON)
 
 
 def replay_johnson(c: Curve, speed: float | None = None, **changes) -> np.ndarray:
