@@ -17,9 +17,14 @@ arrays out; nothing allocated per step.
 from __future__ import annotations
 
 import math
+import os
 
-import numpy as np
-from numba import njit, prange
+# OpenMP's idle threads spin briefly before they sleep (as solver.blocks sets it, read when
+# the threading layer loads; a user's own setting is kept).
+os.environ.setdefault("GOMP_SPINCOUNT", "30000")
+
+import numpy as np  # noqa: E402
+from numba import njit, prange  # noqa: E402
 
 from granplate.physics.contact import COEF_A, COEF_C, COEF_KT, COEF_MUT, COEF_XT, normal_force
 from granplate.physics.mindlin import contact_radius, mindlin_force, rescale_history, rotate_history
