@@ -1,5 +1,5 @@
 """The ramped settling of a poured packing (layout.settle_softening) against statics: one
-sphere rests on the floor at Hertz's overlap (m g / A)^(2/3); a frictionless packing is in
+sphere rests on the floor at Hertz's overlap (m g / A)^(2/3); one or two threads settle to the same state; a frictionless packing is in
 force balance under the real Hertz law, recomputed here from the centres alone (every
 granule's contact forces and weight sum to at most settle_residual of its weight, the floor
 carries the weight); a frictional packing's floor carries the weight within the side walls'
@@ -7,6 +7,7 @@ Coulomb bound; the same seed settles to the same centres; bad values are refused
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -17,7 +18,7 @@ from granplate.results import pouring as rp
 from granplate.setup import pouring
 from granplate.setup.materials import LIBRARY, effective_modulus
 from granplate.setup.pairs import close_pairs
-from granplate.setup.scenario import Contact, Gravity, PouredLayout, Scenario
+from granplate.setup.scenario import Contact, Gravity, PouredLayout, Scenario, Solver
 
 G = 9.81
 STEEL = LIBRARY["steel"]
@@ -108,6 +109,20 @@ def test_same_seed_settles_to_the_same_centres(tmp_path, monkeypatch):
     first, _ = ramped.settle_ramped(s, s.layout)
     again, _ = ramped.settle_ramped(s, s.layout)
     assert np.array_equal(first.x, again.x)
+
+
+def test_threads_settle_to_the_same_centres(tmp_path, monkeypatch):
+    """One and two threads give the same centres, bit for bit (sums gathered in pair order)."""
+    monkeypatch.setenv("GRANPLATE_CACHE", str(tmp_path))
+    from granplate.results import ramped
+    from granplate.setup.threads import available_threads
+
+    if available_threads() < 2:
+        pytest.skip("one thread only")
+    s = poured(12, 0.5, settle_time=0.05)
+    one, _ = ramped.settle_ramped(dataclasses.replace(s, solver=Solver(threads=1)), s.layout)
+    two, _ = ramped.settle_ramped(dataclasses.replace(s, solver=Solver(threads=2)), s.layout)
+    assert np.array_equal(one.x, two.x) and np.array_equal(one.w, two.w)
 
 
 @pytest.mark.parametrize(

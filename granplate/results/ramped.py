@@ -261,6 +261,20 @@ def _report(out: Outcome, p: Packing, phase: str, progress: bool, clock: float, 
 def settle_ramped(s: Scenario, lay: PouredLayout, progress: bool = False) -> tuple[Packing, Outcome]:
     """The ramped settling of `lay` in `s` (module docstring): the packing reached and what
     it reached. Stops at settle_time of simulated time."""
+    import numba
+
+    from granplate.setup.threads import loop_threads
+
+    before = numba.get_num_threads()
+    numba.set_num_threads(loop_threads(s.solver.threads, lay.count, "verlet"))
+    try:
+        return _settle_ramped(s, lay, progress)
+    finally:
+        numba.set_num_threads(before)
+
+
+def _settle_ramped(s: Scenario, lay: PouredLayout, progress: bool) -> tuple[Packing, Outcome]:
+    """`settle_ramped` on the threads set."""
     clock, cpu = time.perf_counter(), time.process_time()
     p = packing(s, lay)
     out = Outcome()

@@ -17,9 +17,14 @@ arrays out; nothing allocated per step.
 from __future__ import annotations
 
 import math
+import os
 
-import numpy as np
-from numba import njit
+# OpenMP's idle threads spin briefly before they sleep (as solver.blocks sets it, read when
+# the threading layer loads; a user's own setting is kept).
+os.environ.setdefault("GOMP_SPINCOUNT", "30000")
+
+import numpy as np  # noqa: E402
+from numba import njit, prange  # noqa: E402
 
 from granplate.physics.contact import COEF_A, COEF_C, COEF_KT, COEF_MUT, COEF_XT, normal_force
 from granplate.physics.mindlin import contact_radius, mindlin_force, rescale_history, rotate_history
@@ -71,26 +76,44 @@ def _push(f, tq, i, sign, n_abs, nx, ny, nz, arm, fx, fy, fz):
     tq[i, 2] += tz
 
 
+#: Columns of a pair's row of the pass's buffer: |N| [N], the unit normal n (3) [-], the
+#: tangential force on the first granule (3) [N], the overlap delta [m] (<= 0: apart).
+P_N, P_NX, P_FT, P_DELTA = 0, 1, 4, 7
+N_PAIR = 8
+
+
 @njit(cache=True)
-def contact_forces(x, v, w, radius, mass, g, pairs, pcoef, phist, walls, wcoef, whist, s, dt, elastic, f, tq, touch):
-    """Forces f (n, 3) [N] and torques tq (n, 3) [N m] on the granules at positions x, with
-    gravity m g, the velocities v, spins w (the half step's) over the step dt [s] (the
-    histories advance; dt = 0: the elastic state alone, histories kept), and touch (n,) the
-    count of each granule's contacts. elastic: the normal force without eq. (3)'s damping
-    (the static residual). walls (nw, 4): outward unit normal and offset of each plane."""
-    n = x.shape[0]
-    sq = math.sqrt(s)
-    for i in range(n):
-        for k in range(3):
-            f[i, k] = mass[i] * g[k]
-            tq[i, k] = 0.0
-        touch[i] = 0
+def adjacency(pairs, n):
+    """Each granule's listed pairs, ascending: the pair indices items[start[i]:start[i + 1]]
+    of granule i (a counting sort of the pair list)."""
+    start = np.zeros(n + 1, np.int64)
     for p in range(pairs.shape[0]):
+        start[pairs[p, 0] + 1] += 1
+        start[pairs[p, 1] + 1] += 1
+    for i in range(n):
+        start[i + 1] += start[i]
+    fill = start[:-1].copy()
+    items = np.empty(2 * pairs.shape[0], np.int64)
+    for p in range(pairs.shape[0]):
+        for q in range(2):
+            i = pairs[p, q]
+            items[fill[i]] = p
+            fill[i] += 1
+    return start, items
+
+
+@njit(parallel=True)
+def _pair_pass(x, v, w, radius, pairs, pcoef, phist, s, dt, elastic, buf):
+    """Every listed pair's contact (a thread per block of pairs; each writes its own rows of
+    buf and of the histories): |N|, n, Mindlin's force on the first granule, the overlap."""
+    sq = math.sqrt(s)
+    for p in prange(pairs.shape[0]):
         i = pairs[p, 0]
         j = pairs[p, 1]
         ri = radius[i]
         rj = radius[j]
         delta, nx, ny, nz = pair_contact_3d(x[i, 0], x[i, 1], x[i, 2], ri, x[j, 0], x[j, 1], x[j, 2], rj)
+        buf[p, P_DELTA] = delta
         if delta <= 0.0:
             for k in range(N_HIST):
                 phist[p, k] = 0.0
@@ -115,13 +138,52 @@ def contact_forces(x, v, w, radius, mass, g, pairs, pcoef, phist, walls, wcoef, 
         )
         a = contact_radius(ri * rj / (ri + rj), delta)
         fx, fy, fz = _tangential(phist, p, c, s, sq, a, delta, nx, ny, nz, vsx, vsy, vsz, dt, n_abs)
-        _push(f, tq, i, 1.0, n_abs, nx, ny, nz, ai, fx, fy, fz)
-        _push(f, tq, j, -1.0, n_abs, nx, ny, nz, aj, fx, fy, fz)
-        touch[i] += 1
-        touch[j] += 1
+        buf[p, P_N] = n_abs
+        buf[p, P_NX] = nx
+        buf[p, P_NX + 1] = ny
+        buf[p, P_NX + 2] = nz
+        buf[p, P_FT] = fx
+        buf[p, P_FT + 1] = fy
+        buf[p, P_FT + 2] = fz
+
+
+@njit(parallel=True)
+def _granule_pass(
+    x, v, w, radius, mass, g, pairs, buf, start, items, walls, wcoef, whist, s, dt, elastic, f, tq, touch
+):
+    """Each granule's forces and torques (a thread per block of granules): its weight, its
+    pairs' shares in ascending pair order (as a serial pass over the pair list adds them:
+    the same sums, bit for bit, on any number of threads), then its wall contacts."""
+    sq = math.sqrt(s)
     nw = walls.shape[0]
-    for i in range(n):
+    for i in prange(x.shape[0]):
+        for k in range(3):
+            f[i, k] = mass[i] * g[k]
+            tq[i, k] = 0.0
+        touch[i] = 0
         ri = radius[i]
+        for q in range(start[i], start[i + 1]):
+            p = items[q]
+            delta = buf[p, P_DELTA]
+            if delta <= 0.0:
+                continue
+            sign = 1.0 if pairs[p, 0] == i else -1.0
+            nx, ny, nz = buf[p, P_NX], buf[p, P_NX + 1], buf[p, P_NX + 2]
+            _push(
+                f,
+                tq,
+                i,
+                sign,
+                buf[p, P_N],
+                nx,
+                ny,
+                nz,
+                ri - 0.5 * delta,
+                buf[p, P_FT],
+                buf[p, P_FT + 1],
+                buf[p, P_FT + 2],
+            )
+            touch[i] += 1
         for k in range(nw):
             nx, ny, nz = walls[k, 0], walls[k, 1], walls[k, 2]
             delta = x[i, 0] * nx + x[i, 1] * ny + x[i, 2] * nz + ri - walls[k, 3]
@@ -147,18 +209,61 @@ def contact_forces(x, v, w, radius, mass, g, pairs, pcoef, phist, walls, wcoef, 
 
 
 @njit(cache=True)
-def _local_damping(f, v, touch, lam):
-    """Cundall's local damping in place: each component of a touching granule's f reduced
-    by lam |f| where f v > 0, raised by it where f v < 0."""
-    for i in range(f.shape[0]):
-        if touch[i] == 0:
-            continue
+def contact_forces(x, v, w, radius, mass, g, pairs, pcoef, phist, walls, wcoef, whist, s, dt, elastic, f, tq, touch):
+    """Forces f (n, 3) [N] and torques tq (n, 3) [N m] on the granules at positions x, with
+    gravity m g, the velocities v, spins w (the half step's) over the step dt [s] (the
+    histories advance; dt = 0: the elastic state alone, histories kept), and touch (n,) the
+    count of each granule's contacts. elastic: the normal force without eq. (3)'s damping
+    (the static residual). walls (nw, 4): outward unit normal and offset of each plane."""
+    start, items = adjacency(pairs, x.shape[0])
+    buf = np.empty((pairs.shape[0], N_PAIR))
+    _pair_pass(x, v, w, radius, pairs, pcoef, phist, s, dt, elastic, buf)
+    _granule_pass(x, v, w, radius, mass, g, pairs, buf, start, items, walls, wcoef, whist, s, dt, elastic, f, tq, touch)
+
+
+@njit(inline="always")
+def _damped(fk, vk, lam):
+    """Cundall's local damping of one component: fk reduced by lam |fk| where fk vk > 0,
+    raised by it where fk vk < 0."""
+    fv = fk * vk
+    if fv > 0.0:
+        return fk * (1.0 - lam)
+    if fv < 0.0:
+        return fk * (1.0 + lam)
+    return fk
+
+
+@njit(parallel=True)
+def _drift(x, v, w, f, tq, mass, inertia, dt):
+    """The first half kick and the drift of every granule."""
+    for i in prange(x.shape[0]):
+        hm = 0.5 * dt / mass[i]
+        hi = 0.5 * dt / inertia[i]
         for k in range(3):
-            fv = f[i, k] * v[i, k]
-            if fv > 0.0:
-                f[i, k] *= 1.0 - lam
-            elif fv < 0.0:
-                f[i, k] *= 1.0 + lam
+            v[i, k] += hm * f[i, k]
+            w[i, k] += hi * tq[i, k]
+            x[i, k] += dt * v[i, k]
+
+
+@njit(parallel=True)
+def _kick(x, v, w, f, tq, touch, mass, inertia, dt, lam, keep, spin_keep, x_ref, reach2):
+    """Cundall's damping of the touching granules' forces and torques (in f, tq), the second
+    half kick, the background damping; returns how many granules moved reach [m] or more."""
+    far = 0
+    for i in prange(x.shape[0]):
+        hm = 0.5 * dt / mass[i]
+        hi = 0.5 * dt / inertia[i]
+        d2 = 0.0
+        for k in range(3):
+            if touch[i] != 0:
+                f[i, k] = _damped(f[i, k], v[i, k], lam)
+                tq[i, k] = _damped(tq[i, k], w[i, k], lam)
+            v[i, k] = keep * (v[i, k] + hm * f[i, k])
+            w[i, k] = spin_keep * (w[i, k] + hi * tq[i, k])
+            d2 += (x[i, k] - x_ref[i, k]) ** 2
+        if d2 >= reach2:
+            far += 1
+    return far
 
 
 @njit(cache=True)
@@ -195,35 +300,22 @@ def settle_steps(
     granule held at two points or spinning about a contact's normal turns freely under both
     laws, a rattler bounces in its cage); stops early where a
     granule moved `reach` [m] or more from x_ref (its list is stale). f, tq, touch: the last
-    pass's forces (kept across calls). Returns the steps done."""
-    n = x.shape[0]
+    pass's forces (kept across calls). Each pass runs on numba's threads (granules and pairs
+    in blocks, every sum in a fixed order: the same state on any number of threads).
+    Returns the steps done."""
+    start, items = adjacency(pairs, x.shape[0])
+    buf = np.empty((pairs.shape[0], N_PAIR))
     reach2 = reach * reach
     ratio = (s1 / s0) ** (1.0 / steps) if steps > 0 else 1.0
     s = s0
     for step in range(steps):
         s *= ratio
-        for i in range(n):
-            hm = 0.5 * dt / mass[i]
-            hi = 0.5 * dt / inertia[i]
-            for k in range(3):
-                v[i, k] += hm * f[i, k]
-                w[i, k] += hi * tq[i, k]
-                x[i, k] += dt * v[i, k]
-        contact_forces(x, v, w, radius, mass, g, pairs, pcoef, phist, walls, wcoef, whist, s, dt, False, f, tq, touch)
-        _local_damping(f, v, touch, lam)
-        _local_damping(tq, w, touch, lam)
-        far = False
-        for i in range(n):
-            hm = 0.5 * dt / mass[i]
-            hi = 0.5 * dt / inertia[i]
-            d2 = 0.0
-            for k in range(3):
-                v[i, k] = keep * (v[i, k] + hm * f[i, k])
-                w[i, k] = spin_keep * (w[i, k] + hi * tq[i, k])
-                d2 += (x[i, k] - x_ref[i, k]) ** 2
-            if d2 >= reach2:
-                far = True
-        if far:
+        _drift(x, v, w, f, tq, mass, inertia, dt)
+        _pair_pass(x, v, w, radius, pairs, pcoef, phist, s, dt, False, buf)
+        _granule_pass(
+            x, v, w, radius, mass, g, pairs, buf, start, items, walls, wcoef, whist, s, dt, False, f, tq, touch
+        )
+        if _kick(x, v, w, f, tq, touch, mass, inertia, dt, lam, keep, spin_keep, x_ref, reach2) > 0:
             return step + 1
     return steps
 
