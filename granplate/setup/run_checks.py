@@ -210,6 +210,13 @@ def _check_solid_scheme(s: Scenario) -> None:
             "or by the implicit scheme (section 6.7), not by the paper's scheme (written for the plane's plate "
             'contacts): set solver.scheme = "implicit" or "verlet"',
         )
+    if s.load.kind == "line" and s.load.target == "plate":
+        raise ScenarioError(
+            "load.target",
+            s.load.target,
+            'a line load on the elastic solid itself is driven by velocity Verlet only (under "implicit" its '
+            'modes do not yet take it): set solver.scheme = "verlet", or load the granules',
+        )
     if sv.granular_friction != "split":
         raise ScenarioError(
             "solver.granular_friction",
