@@ -211,7 +211,7 @@ def test_3d_refusals_name_the_field(change, field, words):
 
 
 def test_solid_needs_the_verlet_scheme_and_then_builds():
-    """A box solid with the implicit scheme is refused naming solver.scheme; with "verlet"
+    """A box solid with the paper scheme is refused naming solver.scheme; with "verlet"
     (what a file that names no scheme gets) it validates and build_model gives the body's
     modes and contact arrays."""
     from granplate.model import build_model
@@ -223,10 +223,10 @@ def test_solid_needs_the_verlet_scheme_and_then_builds():
             "max_frequency": 5e4,
             "origin": [0.2, 0.2, 0.2],
         },  # clear of the box's and the tilted wall's planes
-        solver={"scheme": "implicit"},
+        solver={"scheme": "paper"},
     )
     e = refused(d)
-    assert e.field == "solver.scheme" and "verlet" in str(e)
+    assert e.field == "solver.scheme" and "verlet" in str(e) and "implicit" in str(e)
     d["solver"] = {"scheme": "verlet", "granular_friction": "split"}
     s = scenario_io.from_dict(d)
     validate(s)

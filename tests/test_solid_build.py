@@ -90,7 +90,7 @@ def test_3d_plate_is_a_solid_with_defaults():
 def test_valid_solid_validates_and_builds_its_model_with_the_verlet_scheme():
     """A scenario file with a solid and no [solver] scheme reads with scheme "verlet" (the
     scheme that couples a solid), validates and builds its model with the body's arrays; the
-    same scenario told to use "implicit" is refused naming solver.scheme."""
+    same scenario told to use "paper" is refused naming solver.scheme."""
     import dataclasses
 
     from granplate.model import build_model
@@ -100,7 +100,7 @@ def test_valid_solid_validates_and_builds_its_model_with_the_verlet_scheme():
     validate(s)
     m = build_model(s)
     assert m.body is not None and m.body.phi.shape == (len(m.solid.dofs), m.solid.n_modes)
-    bad = dataclasses.replace(s, solver=dataclasses.replace(s.solver, scheme="implicit"))
+    bad = dataclasses.replace(s, solver=dataclasses.replace(s.solver, scheme="paper"))
     with pytest.raises(ScenarioError, match="verlet") as e:
         validate(bad)
     assert e.value.field == "solver.scheme"

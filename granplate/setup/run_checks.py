@@ -180,13 +180,7 @@ def _check_solver(s: Scenario) -> None:
     if sv.scheme in GRANULAR_SCHEMES:
         _check_granular_scheme(s)
     elif isinstance(s.plate, Solid):
-        raise ScenarioError(
-            "solver.scheme",
-            sv.scheme,
-            "an elastic solid in 3D is coupled to the granules by "
-            "velocity Verlet with its modes turned exactly (docs/model.md section 3.9): set "
-            'solver.scheme = "verlet" and solver.granular_friction = "split"',
-        )
+        _check_solid_scheme(s)
     lam = finite("solver.lambda_target", sv.lambda_target, "must be in (0, 1)")
     if not 0.0 < lam < 1.0:
         raise ScenarioError("solver.lambda_target", sv.lambda_target, "must be in (0, 1)")
@@ -197,6 +191,39 @@ def _check_solver(s: Scenario) -> None:
     positive("solver.error_tol", sv.error_tol)
     positive("solver.implicit_dt_max", sv.implicit_dt_max)
     check_threads(sv.threads)
+
+
+#: Schemes that drive an elastic solid in 3D besides the granular ones (docs/model.md
+#: section 6.7): its modes advanced exactly for contact forces linear over the step.
+SOLID_SCHEMES: tuple[str, ...] = ("implicit",)
+
+
+def _check_solid_scheme(s: Scenario) -> None:
+    """An elastic solid in 3D under a plate scheme: "implicit" (not "paper", whose
+    predictor-corrector is written for the plane's plate contacts), friction split off."""
+    sv = s.solver
+    if sv.scheme not in SOLID_SCHEMES:
+        raise ScenarioError(
+            "solver.scheme",
+            sv.scheme,
+            "an elastic solid in 3D is coupled to the granules by velocity Verlet (docs/model.md section 3.9) "
+            "or by the implicit scheme (section 6.7), not by the paper's scheme (written for the plane's plate "
+            'contacts): set solver.scheme = "implicit" or "verlet"',
+        )
+    if s.load.kind == "line" and s.load.target == "plate":
+        raise ScenarioError(
+            "load.target",
+            s.load.target,
+            'a line load on the elastic solid itself is driven by velocity Verlet only (under "implicit" its '
+            'modes do not yet take it): set solver.scheme = "verlet", or load the granules',
+        )
+    if sv.granular_friction != "split":
+        raise ScenarioError(
+            "solver.granular_friction",
+            sv.granular_friction,
+            f'must be "split" with an elastic solid in 3D and solver.scheme = {sv.scheme!r} (the friction at '
+            "the solid's contacts is split off exactly, as velocity Verlet's, docs/model.md section 6.7)",
+        )
 
 
 def _check_granular_scheme(s: Scenario) -> None:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from numba import njit
 
+from granplate.solver import body_implicit as BI
 from granplate.solver.dimension import friction_flow, granular_rhs, plate_friction_held
 from granplate.solver.drives import hold_drives, piston_rk4_end, piston_stage, pistons_at_start, wall_shift_energy
 
@@ -54,41 +55,66 @@ def first_stage(t, y0, hold, split, st, g, cfg, w):
 
 
 @njit(cache=True)
-def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
+def opening_friction(y0, h, g, cfg, w):
+    """The split friction's first half step: y0 copied into w.ynew and the friction alone
+    over h/2 there (`friction_flow`). Returns its dissipation [J]."""
+    for i in range(y0.shape[0]):
+        for c in range(y0.shape[1]):
+            w.ynew[i, c] = y0[i, c]
+    return friction_flow(w.ynew, 0.5 * h, g, cfg, True)
+
+
+@njit(cache=True)
+def drive_work(t, h, p1, p2, p3, p4, st, g, cfg, w):
+    """The drives' work over the step into w.dacc[5] (RK4's quadrature of their power at
+    the stages' sums p1..p4, the impulse that gives the driven granules their prescribed
+    velocity at t + h, the driven walls' elastic work exactly) and gravity's into w.dacc[4]."""
+    h6 = h / 6.0
+    w.dacc[5] = (
+        h6 * (p1[3] + 2.0 * p2.p_drive + 2.0 * p3.p_drive + p4.p_drive)
+        + hold_drives(t + h, w.ynew, g)
+        + wall_shift_energy(st.y, w.ynew, g, cfg.clip, t, t + h)
+    )
+    w.dacc[4] = h6 * (p1[4] + 2.0 * p2.p_grav + 2.0 * p3.p_grav + p4.p_grav)
+
+
+@njit(cache=True)
+def rk4_granular_step(t, h, stage, hold, st, g, cfg, w, b=None, bs=None):
     """One step of the granules from st.y with the plate's contact points at stage[0],
     stage[1] (u, v at t + h/2) and stage[2], stage[3] (u, v at t + h): RK4 of every force,
     or with cfg.split_friction, half a step of the granule-granule and granule-wall
     friction alone (`friction_flow`), RK4 of the other forces, and the other half of that
-    friction in reverse order (Strang).
+    friction in reverse order (Strang). With an elastic body in space (b: BodyArrays, bs:
+    solver.body_implicit.BodyStep; None: none) its forces join every stage at the modes'
+    motion in bs, its friction the split's half steps.
 
-    Stage 1 reuses st.k1/st.p1 (first same as last), unless hold (the plate-contact
-    friction held at w.fbar over the step; in the plane only, solver.dimension) or the
-    split (the friction half step moves the velocities) changes it. Writes w.ynew,
-    w.kend (without the split friction; with gravity and the drives, solver.drives), w.fnew
-    (forces on the plate at t + h), w.normal_new, w.slip_new, w.pend (powers at t + h) and
-    w.dacc (shock, viscous, friction work over the step, and the plastic work past the
-    contacts' largest overlaps, whose end overlaps go into their histories' HIST_END; the work of
-    gravity and of the drives), w.ovl_new and w.ovl_who (the
-    largest relative overlap at t + h and its contact). Returns (stored contact energy at
-    t + h [J], largest slip relaxation rate at t + h of a contact whose friction RK4
-    integrates [1/s]: with cfg.split_friction the plate contacts unless hold, 0 with hold;
-    without it every contact, as the presets' results were computed).
+    Stage 1 reuses st.k1/st.p1 (first same as last), unless hold (in the plane only) or the
+    split (the friction half step moves the velocities) changes it. Writes w.ynew, w.kend
+    (without the split friction; with gravity and the drives, solver.drives), w.fnew
+    (forces on the plate at t + h), w.normal_new, w.slip_new, w.pend (powers at t + h),
+    w.dacc (shock, viscous, friction work over the step, the plastic work past the
+    contacts' largest overlaps, whose end overlaps go into their histories' HIST_END, the
+    work of gravity and of the drives), w.ovl_new and w.ovl_who (the largest relative
+    overlap at t + h and its contact). Returns (stored contact energy at t + h [J], largest
+    slip relaxation rate at t + h of a contact whose friction RK4 integrates [1/s]: with
+    cfg.split_friction the plate contacts unless hold, 0 with hold; else every contact).
     """
     y0 = st.y
     ng = y0.shape[0]
     nc = y0.shape[1]
     if ng == 0:
+        if b is not None:  # the body's modes over the step (no contact forces)
+            BI.open_step(t, h, y0, False, st, b, bs, g, cfg, st.k1, st.p1, False)
         return no_granules_step(h, st.p1, w.dacc, w.pend, w.ovl_new, w.ovl_who)
     pistons_at_start(g)  # a piston (a force-driven wall) is one more degree of freedom of the step
     split = cfg.split_friction
     fric_split = 0.0
     if split:  # friction over [t, t + h/2]; RK4 then starts from w.ynew, updated in place
-        for i in range(ng):
-            for c in range(nc):
-                w.ynew[i, c] = y0[i, c]
-        fric_split = friction_flow(w.ynew, 0.5 * h, g, cfg, True)
+        fric_split = opening_friction(y0, h, g, cfg, w)
         y0 = w.ynew
     k1, p1 = first_stage(t, y0, hold, split, st, g, cfg, w)
+    if b is not None:  # the body's friction half step, its forces at t_n, its modes over h
+        fric_split += BI.open_step(t, h, y0, split, st, b, bs, g, cfg, k1, p1, split)
     hh = 0.5 * h
     piston_stage(g, 1.0, hh)
     for i in range(ng):
@@ -97,6 +123,8 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     p2 = granular_rhs(
         t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k2, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
     )
+    if b is not None:
+        BI.stage_pass(w.ytmp, 1, b, bs, g, cfg, w.k2, 1)
     piston_stage(g, 2.0, hh)
     for i in range(ng):
         for c in range(nc):
@@ -104,6 +132,8 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     p3 = granular_rhs(
         t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k3, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
     )
+    if b is not None:
+        BI.stage_pass(w.ytmp, 1, b, bs, g, cfg, w.k3, 2)
     piston_stage(g, 2.0, h)
     for i in range(ng):
         for c in range(nc):
@@ -111,6 +141,8 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     p4 = granular_rhs(
         t + h, w.ytmp, stage[2], stage[3], g, cfg, w.k4, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
     )
+    if b is not None:
+        BI.stage_pass(w.ytmp, 2, b, bs, g, cfg, w.k4, 3)
     h6 = h / 6.0
     piston_rk4_end(g, h)
     for i in range(ng):
@@ -119,17 +151,15 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     w.dacc[0] = h6 * (p1[0] + 2.0 * p2.p_shock + 2.0 * p3.p_shock + p4.p_shock)
     w.dacc[1] = h6 * (p1[1] + 2.0 * p2.p_visc + 2.0 * p3.p_visc + p4.p_visc)
     w.dacc[2] = h6 * (p1[2] + 2.0 * p2.p_fric + 2.0 * p3.p_fric + p4.p_fric)
+    if b is not None:  # the body's viscous work at the inner stages; its forces at the end
+        w.dacc[1] += h6 * (2.0 * bs.pv[1] + 2.0 * bs.pv[2] + bs.pv[3])
+        BI.end_pass(w.ynew, b, bs, g, cfg)
     if split:  # friction over [t + h/2, t + h]
         fric_split += friction_flow(w.ynew, hh, g, cfg, False)
+        if b is not None:
+            fric_split += BI.close_friction(w.ynew, h, b, bs, g, cfg)
         w.dacc[2] += fric_split
-    # the drives' work (RK4's quadrature of their power, the impulse that gives the driven granules
-    # their prescribed velocity at t + h, the driven walls' elastic work exactly) and gravity's
-    w.dacc[5] = (
-        h6 * (p1[3] + 2.0 * p2.p_drive + 2.0 * p3.p_drive + p4.p_drive)
-        + hold_drives(t + h, w.ynew, g)
-        + wall_shift_energy(st.y, w.ynew, g, cfg.clip, t, t + h)
-    )
-    w.dacc[4] = h6 * (p1[4] + 2.0 * p2.p_grav + 2.0 * p3.p_grav + p4.p_grav)
+    drive_work(t, h, p1, p2, p3, p4, st, g, cfg, w)
     pe = granular_rhs(
         t + h, w.ynew, stage[2], stage[3], g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar, split, True
     )
@@ -142,9 +172,12 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     w.ovl_new[0] = pe.ovl
     w.ovl_who[0] = pe.ovl_i
     w.ovl_who[1] = pe.ovl_j
+    e_body = 0.0
+    if b is not None:  # the end pass's body forces, energy, damping, plastic work and overlap
+        e_body = BI.end_sums(bs, w)
     if not cfg.split_friction:
-        return pe.e_pot, max(pe.rate, pe.rate_plate)
-    return pe.e_pot, 0.0 if hold else pe.rate_plate  # a held plate-contact friction is not RK4's
+        return pe.e_pot + e_body, max(pe.rate, pe.rate_plate)
+    return pe.e_pot + e_body, 0.0 if hold else pe.rate_plate  # a held plate-contact friction is not RK4's
 
 
 @njit(cache=True)

@@ -12,6 +12,11 @@ One step t -> t + h:
 3. the step is accepted, or redone smaller, on a local error estimate (the distance of
    the interface and granule forces from their extrapolation) and the growth of the
    energy residual (eq. 11); steps are output_interval / 2^k and tile every interval.
+
+With an elastic body in space (solver.body, no plate contacts) steps 1-2 are the body's:
+its modes advanced exactly for contact forces linear over the step, the granules' RK4
+stages against its motion, the end force by a fixed point iterated to convergence
+(solver.body_implicit, docs/model.md section 6.7); step 3 is the same.
 """
 
 from __future__ import annotations
@@ -22,8 +27,11 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from granplate.model.inputs import STATE_COLUMNS, BodyArrays, new_body_state, no_body
 from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm, friction_magnitude, plate_overlap
 from granplate.physics.energy import energy_residual
+from granplate.solver import body as B
+from granplate.solver import body_implicit as BI
 from granplate.solver.dimension import force_error, kinetic_energies
 from granplate.solver.drives import piston_energy
 from granplate.solver.rk4 import rk4_granular_step, rk4_limit
@@ -45,6 +53,7 @@ from granplate.solver.plate_modal import (
     modal_coefficients,
     static_matrices,
 )
+from granplate.solver.granular import commit_history
 from granplate.solver.schemes.newton import held_friction, newton_update
 from granplate.solver.state import (
     A_DRIVE,
@@ -56,6 +65,7 @@ from granplate.solver.state import (
     A_VISC,
     C_LEVEL,
     E_IN_MAX,
+    E_STATIC,
     E_ZERO,
     F_SCALE,
     H_LAST,
@@ -83,12 +93,16 @@ class Scratch(NamedTuple):
     mmat: np.ndarray  # (N_LEVELS + 1, 4, nd, nd) driving-DOF response to the unknowns
     qn: np.ndarray  # (nm,) modes at the end of the step being tried
     qdn: np.ndarray
+    body: BodyArrays  # the elastic body in space and this run's contacts on it (no faces: none)
+    bstep: BI.BodyStep  # the body's modes over the step and its fixed point (solver.body_implicit)
 
 
 def new_scratch(ng: int, nm: int, nk: int, body=None, threads: int = 1) -> Scratch:
-    """Scratch for ng granules, nm modes, nk plate contacts."""
+    """Scratch for ng granules, nm modes, nk plate contacts, with this run's own copy of
+    the elastic body's contact state (body None: no body)."""
     nd = 2 * nk
     z = np.zeros
+    b = no_body(ng, nm) if body is None else new_body_state(body)
     return Scratch(
         ustar=z((4, nd)),
         jac=z((nd, nd)),
@@ -98,6 +112,8 @@ def new_scratch(ng: int, nm: int, nk: int, body=None, threads: int = 1) -> Scrat
         mmat=z((N_LEVELS + 1, 4, nd, nd)),
         qn=z(nm),
         qdn=z(nm),
+        body=b,
+        bstep=BI.body_step_for(b, ng, max(STATE_COLUMNS.values())),
     )
 
 
@@ -152,7 +168,10 @@ def held_friction_target(normal, normal_new, slip_new, g, fnew):
 def attempt(sw, t, h, slot, st, g, p, cfg, w):
     """Known plate motion, then Newton on the interface unknowns from the guess in
     w.fguess. Returns (converged, iterations, worst contact, stored energy at t + h,
-    largest slip relaxation rate of a contact whose friction RK4 integrates)."""
+    largest slip relaxation rate of a contact whose friction RK4 integrates). With an
+    elastic body: `body_attempt`."""
+    if B.has_body(sw.body):
+        return body_attempt(sw, t, h, slot, st, g, cfg, w)
     exact_predict(t, h, st, p, cfg, sw.mcoef[slot], sw.ustar)
     for k in range(sw.vguess.shape[0]):
         sw.vguess[k] = st.slip[k]
@@ -172,6 +191,32 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
             break
         newton_update(h, sw.mmat[slot], w.stage[2], g, st, w, sw.jac, sw.rhs, sw.vguess)
     return converged, it, worst, e_pot, rate
+
+
+@njit(cache=True)
+def body_attempt(sw, t, h, slot, st, g, cfg, w):
+    """The step with an elastic body (solver.body_implicit): the modes' end force F1
+    guessed, then RK4 of the granules against the modes' motion under it and F1 relaxed
+    towards the end pass's, until they agree to cfg.rtol. Returns as `attempt` (the
+    worst contact -1)."""
+    b = sw.body
+    bs = sw.bstep
+    mc = sw.mcoef[slot]
+    for m in range(mc.shape[0]):
+        for c in range(mc.shape[1]):
+            bs.mc[m, c] = mc[m, c]
+    BI.first_guess(h, st.clock[H_LAST], b, bs)
+    converged = False
+    e_pot = 0.0
+    rate = 0.0
+    it = 0
+    while it < cfg.max_iter:
+        it += 1
+        e_pot, rate = rk4_granular_step(t, h, w.stage, True, st, g, cfg, w, b, bs)
+        if BI.relax(it, cfg.rtol, b, bs):
+            converged = True
+            break
+    return converged, it, -1, e_pot, rate
 
 
 @njit(cache=True)
@@ -218,7 +263,10 @@ def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
     relative to error_tol, level to retry at or -1, edge-load work [J], held-friction
     work [J])."""
     fric_work = held_friction_work(st, g, cfg, w)
-    work, ep_new = exact_correct(t, h, st, p, cfg, sw.mcoef[slot], w.fguess, sw.qn, sw.qdn)
+    if B.has_body(sw.body):  # the body's modes (and its line load's work)
+        work, ep_new = BI.end_energy(t, h, sw.body, sw.bstep, cfg, sw.qn, sw.qdn)
+    else:
+        work, ep_new = exact_correct(t, h, st, p, cfg, sw.mcoef[slot], w.fguess, sw.qn, sw.qdn)
     kx, ky, kz, kr = kinetic_energies(w.ynew, g)
     e_in = (
         st.clock[E_ZERO]
@@ -264,8 +312,11 @@ def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
 @njit(cache=True)
 def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
     """Take the trial step's modes and driving-DOF motion; book the held friction's
-    work. Returns the edge load's work over the step [J]."""
+    work; with an elastic body, its contacts' histories and the residual's energy at t + h.
+    Returns the edge load's work over the step [J]."""
     w.dacc[2] += fric_work
+    if B.has_body(sw.body):
+        st.clock[E_STATIC] = BI.accept(t, h, sw.body, sw.bstep)
     for m in range(st.q.shape[0]):
         st.q[m] = sw.qn[m]
         st.qd[m] = sw.qdn[m]
@@ -312,5 +363,28 @@ def contacts_moved(sw, t, st, p, cfg):
 
 @njit(cache=True)
 def start(sw, t, st, g, cfg):
-    """Nothing at t = 0 beyond the loop's own energies (no elastic body in space)."""
-    return 0.0, 0.0
+    """An elastic body's contacts at t = 0 (state y, modes as set): their forces join the
+    granules' derivative and viscous power (st.k1, st.p1: every step's first stage), the
+    contacts start loaded at their overlaps. Returns (the contacts' stored energy, the
+    residual compliance's) [J]; (0, 0) without a body."""
+    b = sw.body
+    if not B.has_body(b):
+        return 0.0, 0.0
+    bs = sw.bstep
+    cur = int(bs.flags[BI.CUR])
+    for m in range(st.q.shape[0]):
+        bs.qs[0, m] = st.q[m]
+        bs.qds[0, m] = st.qd[m]
+    e_pot, pv, _, _, _ = BI.pass_at(st.y, 0, cur, b, bs, g, cfg, st.k1)
+    st.p1[1] += pv
+    for m in range(st.q.shape[0]):
+        bs.fprev[m] = b.fmodal[cur, m]
+    commit_history(t, b.hist, b.coef)
+    return e_pot, b.static[cur]
+
+
+@njit(cache=True)
+def body_sensor_loads(sw, load):
+    """The elastic body's share of the sensors' readings at t_n (load (ng,) [N]): half the
+    normal force of each granule's contact with it, from t_n's buffer."""
+    B.sensor_loads(sw.body, int(sw.bstep.flags[BI.CUR]), load)
