@@ -10,6 +10,7 @@ from numba import njit
 
 from granplate.solver.dimension import friction_flow, granular_rhs, plate_friction_held
 from granplate.solver.drives import hold_drives, piston_rk4_end, piston_stage, pistons_at_start, wall_shift_energy
+from granplate.solver.mindlin_rk4 import begin_stages, next_stage, stage_energy
 
 #: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps h
 #: times the friction relaxation rate of every contact that RK4 integrates below this bound.
@@ -39,8 +40,9 @@ def no_granules_step(h, p1, dacc, pend, ovl_new, ovl_who):
 def first_stage(t, y0, hold, split, st, g, cfg, w):
     """RK4's first stage (derivative, powers) at state y0 and time t [s]: st.k1/st.p1 (the
     last step's end, first same as last), or recomputed into w.k1h/w.p1h where the held
-    plate-contact friction (hold) or the split friction's half step changes it."""
-    if plate_friction_held(hold, g) or split:
+    plate-contact friction (hold) or the split friction's half step changes it, or
+    Mindlin's law needs the stage's slip (solver.mindlin_rk4)."""
+    if plate_friction_held(hold, g) or split or cfg.mindlin_stages:
         pr = granular_rhs(
             t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
         )
@@ -72,7 +74,10 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     largest relative overlap at t + h and its contact). Returns (stored contact energy at
     t + h [J], largest slip relaxation rate at t + h of a contact whose friction RK4
     integrates [1/s]: with cfg.split_friction the plate contacts unless hold, 0 with hold;
-    without it every contact, as the presets' results were computed).
+    without it every contact, as the presets' results were computed). Under Mindlin's law
+    (cfg.mindlin_stages) each contact's elastic displacement is integrated with the stages
+    (solver.mindlin_rk4), the rise of the springs' energy taken out of the friction work,
+    and the rate is at least every touching Mindlin contact's sticking frequency.
     """
     y0 = st.y
     ng = y0.shape[0]
@@ -88,9 +93,13 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
                 w.ynew[i, c] = y0[i, c]
         fric_split = friction_flow(w.ynew, 0.5 * h, g, cfg, True)
         y0 = w.ynew
+    mindlin = cfg.mindlin_stages
+    e_spring = begin_stages(g) if mindlin else 0.0
     k1, p1 = first_stage(t, y0, hold, split, st, g, cfg, w)
     hh = 0.5 * h
     piston_stage(g, 1.0, hh)
+    if mindlin:
+        next_stage(g, 1.0, hh, False)
     for i in range(ng):
         for c in range(nc):
             w.ytmp[i, c] = y0[i, c] + hh * k1[i, c]
@@ -98,6 +107,8 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
         t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k2, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
     )
     piston_stage(g, 2.0, hh)
+    if mindlin:
+        next_stage(g, 2.0, hh, False)
     for i in range(ng):
         for c in range(nc):
             w.ytmp[i, c] = y0[i, c] + hh * w.k2[i, c]
@@ -105,6 +116,8 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
         t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k3, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
     )
     piston_stage(g, 2.0, h)
+    if mindlin:
+        next_stage(g, 2.0, h, False)
     for i in range(ng):
         for c in range(nc):
             w.ytmp[i, c] = y0[i, c] + h * w.k3[i, c]
@@ -113,6 +126,8 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     )
     h6 = h / 6.0
     piston_rk4_end(g, h)
+    if mindlin:
+        next_stage(g, 1.0, h6, True)
     for i in range(ng):
         for c in range(nc):  # (y0 may be w.ynew itself: each entry is read before it is written)
             w.ynew[i, c] = y0[i, c] + h6 * (k1[i, c] + 2.0 * w.k2[i, c] + 2.0 * w.k3[i, c] + w.k4[i, c])
@@ -134,6 +149,8 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
         t + h, w.ynew, stage[2], stage[3], g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar, split, True
     )
     w.dacc[3] = pe.w_plastic
+    if mindlin:  # the springs' energy is E_g's: its rise over the step is not lost
+        w.dacc[2] -= stage_energy(g) - e_spring
     w.pend[0] = pe.p_shock
     w.pend[1] = pe.p_visc
     w.pend[2] = pe.p_fric
@@ -144,7 +161,8 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     w.ovl_who[1] = pe.ovl_j
     if not cfg.split_friction:
         return pe.e_pot, max(pe.rate, pe.rate_plate)
-    return pe.e_pot, 0.0 if hold else pe.rate_plate  # a held plate-contact friction is not RK4's
+    # a held plate-contact friction is not RK4's; pe.rate: Mindlin's sticking contacts (else 0 here)
+    return pe.e_pot, max(0.0 if hold else pe.rate_plate, pe.rate)
 
 
 @njit(cache=True)
