@@ -23,7 +23,7 @@ a patch contact's move) takes the force of the committed history at its state.
 
 Energy (eq. 11): each stage's dissipated power -F_t . v_s goes with the friction power into
 RK4's quadrature; the step's end takes the rise of the springs' energy out of it
-(`stage_energy` less what `begin_stages` returns), as the springs' energy is in E_g.
+(`spring_rise`), as the springs' energy is in E_g.
 """
 
 from __future__ import annotations
@@ -293,9 +293,12 @@ def _begin_rows(hist, coef) -> float:
 
 
 @njit(cache=True)
-def begin_stages(g) -> float:
-    """Before an RK4 step's first stage: every Mindlin contact's stage sums and increment
-    zero, HIST_A_END = -1 (inside a step). Returns the springs' committed energy [J]."""
+def begin_stages(g, cfg) -> float:
+    """Before an RK4 step's first stage (with cfg.mindlin_stages, else nothing): every
+    Mindlin contact's stage sums and increment zero, HIST_A_END = -1 (inside a step).
+    Returns the springs' committed energy [J] (0 without Mindlin's law)."""
+    if not cfg.mindlin_stages:
+        return 0.0
     return _begin_rows(g.pair_hist, g.pair_coef) + _begin_rows(g.wall_hist, g.wall_coef)
 
 
@@ -313,10 +316,12 @@ def _next_rows(hist, coef, weight, tau, final):
 
 
 @njit(cache=True)
-def next_stage(g, weight, tau, final):
-    """After an RK4 stage: its slip velocity (HIST_F_END) added with `weight` (1, 2, 2, 1)
+def next_stage(g, cfg, weight, tau, final):
+    """After an RK4 stage (with cfg.mindlin_stages, else nothing): its slip velocity (HIST_F_END) added with `weight` (1, 2, 2, 1)
     to each Mindlin contact's sum (HIST_XI_END), and the next stage's increment tau times
     it [m] (tau = h/2, h/2, h [s]), or at the last (final) tau = h/6 times the sum."""
+    if not cfg.mindlin_stages:
+        return
     _next_rows(g.pair_hist, g.pair_coef, weight, tau, final)
     _next_rows(g.wall_hist, g.wall_coef, weight, tau, final)
 
@@ -335,6 +340,9 @@ def _energy_rows(hist, coef) -> float:
 
 
 @njit(cache=True)
-def stage_energy(g) -> float:
-    """The springs' energy of the trial histories at the step's end [J]."""
-    return _energy_rows(g.pair_hist, g.pair_coef) + _energy_rows(g.wall_hist, g.wall_coef)
+def spring_rise(g, cfg, e_start) -> float:
+    """The rise of the springs' energy over the step [J]: that of the trial histories at its
+    end less e_start [J], what `begin_stages` returned (0 without Mindlin's law)."""
+    if not cfg.mindlin_stages:
+        return 0.0
+    return _energy_rows(g.pair_hist, g.pair_coef) + _energy_rows(g.wall_hist, g.wall_coef) - e_start

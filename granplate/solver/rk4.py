@@ -10,7 +10,7 @@ from numba import njit
 
 from granplate.solver.dimension import friction_flow, granular_rhs, plate_friction_held
 from granplate.solver.drives import hold_drives, piston_rk4_end, piston_stage, pistons_at_start, wall_shift_energy
-from granplate.solver.mindlin_rk4 import begin_stages, next_stage, stage_energy
+from granplate.solver.mindlin_rk4 import begin_stages, next_stage, spring_rise
 
 #: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps h
 #: times the friction relaxation rate of every contact that RK4 integrates below this bound.
@@ -74,10 +74,8 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     largest relative overlap at t + h and its contact). Returns (stored contact energy at
     t + h [J], largest slip relaxation rate at t + h of a contact whose friction RK4
     integrates [1/s]: with cfg.split_friction the plate contacts unless hold, 0 with hold;
-    without it every contact, as the presets' results were computed). Under Mindlin's law
-    (cfg.mindlin_stages) each contact's elastic displacement is integrated with the stages
-    (solver.mindlin_rk4), the rise of the springs' energy taken out of the friction work,
-    and the rate is at least every touching Mindlin contact's sticking frequency.
+    without it every contact, as the presets' results were computed; at least each touching
+    Mindlin contact's sticking frequency, whose history the stages integrate: solver.mindlin_rk4).
     """
     y0 = st.y
     ng = y0.shape[0]
@@ -93,13 +91,11 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
                 w.ynew[i, c] = y0[i, c]
         fric_split = friction_flow(w.ynew, 0.5 * h, g, cfg, True)
         y0 = w.ynew
-    mindlin = cfg.mindlin_stages
-    e_spring = begin_stages(g) if mindlin else 0.0
+    e_spring = begin_stages(g, cfg)
     k1, p1 = first_stage(t, y0, hold, split, st, g, cfg, w)
     hh = 0.5 * h
     piston_stage(g, 1.0, hh)
-    if mindlin:
-        next_stage(g, 1.0, hh, False)
+    next_stage(g, cfg, 1.0, hh, False)
     for i in range(ng):
         for c in range(nc):
             w.ytmp[i, c] = y0[i, c] + hh * k1[i, c]
@@ -107,8 +103,7 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
         t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k2, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
     )
     piston_stage(g, 2.0, hh)
-    if mindlin:
-        next_stage(g, 2.0, hh, False)
+    next_stage(g, cfg, 2.0, hh, False)
     for i in range(ng):
         for c in range(nc):
             w.ytmp[i, c] = y0[i, c] + hh * w.k2[i, c]
@@ -116,8 +111,7 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
         t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k3, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
     )
     piston_stage(g, 2.0, h)
-    if mindlin:
-        next_stage(g, 2.0, h, False)
+    next_stage(g, cfg, 2.0, h, False)
     for i in range(ng):
         for c in range(nc):
             w.ytmp[i, c] = y0[i, c] + h * w.k3[i, c]
@@ -126,8 +120,7 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
     )
     h6 = h / 6.0
     piston_rk4_end(g, h)
-    if mindlin:
-        next_stage(g, 1.0, h6, True)
+    next_stage(g, cfg, 1.0, h6, True)
     for i in range(ng):
         for c in range(nc):  # (y0 may be w.ynew itself: each entry is read before it is written)
             w.ynew[i, c] = y0[i, c] + h6 * (k1[i, c] + 2.0 * w.k2[i, c] + 2.0 * w.k3[i, c] + w.k4[i, c])
@@ -149,8 +142,7 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w):
         t + h, w.ynew, stage[2], stage[3], g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar, split, True
     )
     w.dacc[3] = pe.w_plastic
-    if mindlin:  # the springs' energy is E_g's: its rise over the step is not lost
-        w.dacc[2] -= stage_energy(g) - e_spring
+    w.dacc[2] -= spring_rise(g, cfg, e_spring)  # Mindlin's springs' energy is E_g's, not lost
     w.pend[0] = pe.p_shock
     w.pend[1] = pe.p_visc
     w.pend[2] = pe.p_fric
