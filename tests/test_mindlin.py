@@ -202,7 +202,7 @@ def test_a_mindlin_history_is_carried_across_list_rebuilds():
 @pytest.mark.parametrize(
     "change, field, match",
     [
-        ({"scheme": "paper"}, "contact.tangential_law", "solver.scheme = 'verlet'"),
+        ({"scheme": "paper"}, "contact.torque_arm", "solver.scheme = 'verlet' only"),
         ({"law": "coulomb"}, "contact.tangential_law", "mindlin"),
         ({"arm": True}, "contact.torque_arm", "tangential_law = 'mindlin'"),
         ({"nu": 0.7}, "materials.steel.nu", r"\(-1, 0.5"),
@@ -211,7 +211,7 @@ def test_a_mindlin_history_is_carried_across_list_rebuilds():
     ],
 )
 def test_unsupported_combinations_are_refused_naming_the_field(change, field, match):
-    """Mindlin's law where it does not run (another scheme), an unknown law, the
+    """LAMMPS's torque arms under another scheme than Verlet, an unknown law, the
     LAMMPS arms with the tanh law, and a material without a usable Poisson ratio are refused
     before the run, naming the field and what is allowed."""
     s = oblique_pair()

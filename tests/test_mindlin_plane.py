@@ -141,11 +141,13 @@ def test_frictional_packing_agrees_with_lammps_at_its_step():
     assert np.abs(ds.omega.values[-1]).max() > 1.0  # friction turned the granules
 
 
-def test_the_plane_runs_mindlin_but_a_plate_and_other_schemes_are_refused():
-    """The plane under Verlet validates; with the paper's scheme it is refused naming
-    contact.tangential_law and the scheme."""
+def test_the_plane_runs_mindlin_under_every_scheme_but_lammps_arms_under_verlet_alone():
+    """The plane validates under Verlet and under the paper's scheme with the radius as
+    the arm; LAMMPS's arms under the paper's scheme are refused naming contact.torque_arm
+    and the scheme they run under."""
     s = L.mindlin_pair_plane()
     validate(s)
-    with pytest.raises(ScenarioError, match="solver.scheme = 'verlet'") as err:
+    validate(dataclasses.replace(L.mindlin_pair_plane(arm="radius"), solver=Solver(scheme="paper")))
+    with pytest.raises(ScenarioError, match="solver.scheme = 'verlet' only") as err:
         validate(dataclasses.replace(s, solver=Solver(scheme="paper")))
-    assert "contact.tangential_law" in str(err.value)
+    assert "contact.torque_arm" in str(err.value)

@@ -282,6 +282,7 @@ def loop_config(
         arm_shrink=1.0 if s.contact.torque_arm == "contact_point" else 0.0,
         lammps_arms=s.contact.torque_arm == "lammps",
         mindlin=s.contact.tangential_law == "mindlin",
+        mindlin_stages=s.contact.tangential_law == "mindlin" and sol.scheme != "verlet",
         scheme=scheme_number(sol.scheme),
         error_tol=float(sol.error_tol),
         force_floor=force_floor(q0, fres, tres, r, mass, s, t.output_interval) if floor is None else float(floor),

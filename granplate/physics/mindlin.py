@@ -163,3 +163,47 @@ def step_loss(f0x, f0y, f0z, fx, fy, fz, sx, sy, sz, e_old: float, e_new: float)
     put in) at fixed xi."""
     work = -0.5 * ((f0x + fx) * sx + (f0y + fy) * sy + (f0z + fz) * sz)
     return work - (e_new - e_old)
+
+
+@njit(cache=True)
+def stage_force(
+    xx: float,
+    xy: float,
+    xz: float,
+    a: float,
+    a_old: float,
+    k_per_radius: float,
+    nx: float,
+    ny: float,
+    nz: float,
+    ix: float,
+    iy: float,
+    iz: float,
+    vx: float,
+    vy: float,
+    vz: float,
+    f_crit: float,
+    damp: float,
+):
+    """Eqs. (M2)-(M5) at one stage of a multi-stage step (RK4, docs/model.md section 3.16):
+    the committed history xi (3) [m] of contact radius a_old [m], rescaled to the stage's
+    contact radius a [m] and turned into the plane of its normal n, moved on by the
+    increment (ix, iy, iz) [m] the slip has made since the step's start (its normal part
+    removed), damped by eta_t = damp [N s/m] on the stage's slip velocity v (3) [m/s] and
+    capped at f_crit = mu |N| [N]. Returns (F_t (3) on the first body [N], xi (3) [m], the
+    spring's energy 1/2 k_t |xi|^2 [J])."""
+    k = tangential_stiffness(k_per_radius, a)
+    xx, xy, xz = rescale_history(xx, xy, xz, a, a_old)
+    xx, xy, xz = rotate_history(xx, xy, xz, nx, ny, nz, k, f_crit)
+    i_n = ix * nx + iy * ny + iz * nz
+    fx, fy, fz, xx, xy, xz = mindlin_force(
+        xx + ix - i_n * nx,
+        xy + iy - i_n * ny,
+        xz + iz - i_n * nz,
+        k,
+        f_crit,
+        -damp * vx,
+        -damp * vy,
+        -damp * vz,
+    )
+    return fx, fy, fz, xx, xy, xz, spring_energy(k, xx, xy, xz)

@@ -114,9 +114,10 @@ def _check_contact(s: Scenario) -> None:
 
 #: Where Mindlin's tangential law runs (Contact.tangential_law = "mindlin").
 MINDLIN_SUPPORT = (
-    "Mindlin's law runs in the plane and in space (dimension = 2 or 3) under solver.scheme = 'verlet', at "
-    "granule-granule and granule-wall contacts, and in space at the granules' contacts on the elastic "
-    "solid ([plate] of dimension = 3); not with the plane's [plate]"
+    "Mindlin's law runs in the plane and in space (dimension = 2 or 3) under every solver.scheme "
+    "('verlet', 'paper', 'implicit'), at granule-granule and granule-wall contacts, and in space at the "
+    "granules' contacts on the elastic solid ([plate] of dimension = 3, scheme 'verlet'); not with the "
+    "plane's [plate] (its plate contacts keep the tanh law's held friction)"
 )
 
 
@@ -148,9 +149,12 @@ def _check_tangential_law(s: Scenario) -> None:
                 "with the tanh law take 'radius' or 'contact_point'",
             )
         return
-    if s.solver.scheme != "verlet":
+    if s.solver.scheme != "verlet" and c.torque_arm == "lammps":
         raise ScenarioError(
-            "contact.tangential_law", c.tangential_law, f"{MINDLIN_SUPPORT}; not solver.scheme = {s.solver.scheme!r}"
+            "contact.torque_arm",
+            c.torque_arm,
+            f"'lammps' (LAMMPS's torque arms) runs under solver.scheme = 'verlet' only, not {s.solver.scheme!r}: "
+            "take 'radius' or 'contact_point'",
         )
     if s.plate is not None and s.dimension != 3:
         raise ScenarioError(

@@ -11,6 +11,7 @@ from numba import njit
 from granplate.solver import body_implicit as BI
 from granplate.solver.dimension import friction_flow, granular_rhs, plate_friction_held
 from granplate.solver.drives import hold_drives, piston_rk4_end, piston_stage, pistons_at_start, wall_shift_energy
+from granplate.solver.mindlin_rk4 import begin_stages, next_stage, spring_rise
 
 #: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps h
 #: times the friction relaxation rate of every contact that RK4 integrates below this bound.
@@ -40,8 +41,9 @@ def no_granules_step(h, p1, dacc, pend, ovl_new, ovl_who):
 def first_stage(t, y0, hold, split, st, g, cfg, w):
     """RK4's first stage (derivative, powers) at state y0 and time t [s]: st.k1/st.p1 (the
     last step's end, first same as last), or recomputed into w.k1h/w.p1h where the held
-    plate-contact friction (hold) or the split friction's half step changes it."""
-    if plate_friction_held(hold, g) or split:
+    plate-contact friction (hold) or the split friction's half step changes it, or
+    Mindlin's law needs the stage's slip (solver.mindlin_rk4)."""
+    if plate_friction_held(hold, g) or split or cfg.mindlin_stages:
         pr = granular_rhs(
             t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
         )
@@ -79,6 +81,30 @@ def drive_work(t, h, p1, p2, p3, p4, st, g, cfg, w):
 
 
 @njit(cache=True)
+def stage_quadrature(h6, p1, p2, p3, p4, dacc):
+    """Simpson's rule of RK4 over the step (h6 = h / 6 [s]) of the shock's, the damping's
+    and friction's powers at the four stages (p1: stage 1's (3,) array; p2-p4: ForceSums)
+    into dacc[0:3] [J]."""
+    dacc[0] = h6 * (p1[0] + 2.0 * p2.p_shock + 2.0 * p3.p_shock + p4.p_shock)
+    dacc[1] = h6 * (p1[1] + 2.0 * p2.p_visc + 2.0 * p3.p_visc + p4.p_visc)
+    dacc[2] = h6 * (p1[2] + 2.0 * p2.p_fric + 2.0 * p3.p_fric + p4.p_fric)
+
+
+@njit(cache=True)
+def record_end(pe, pend, ovl_new, ovl_who):
+    """The end pass's powers at t + h (ForceSums pe) into pend, its largest overlap and
+    its contact into ovl_new, ovl_who."""
+    pend[0] = pe.p_shock
+    pend[1] = pe.p_visc
+    pend[2] = pe.p_fric
+    pend[3] = pe.p_drive
+    pend[4] = pe.p_grav
+    ovl_new[0] = pe.ovl
+    ovl_who[0] = pe.ovl_i
+    ovl_who[1] = pe.ovl_j
+
+
+@njit(cache=True)
 def rk4_granular_step(t, h, stage, hold, st, g, cfg, w, b=None, bs=None):
     """One step of the granules from st.y with the plate's contact points at stage[0],
     stage[1] (u, v at t + h/2) and stage[2], stage[3] (u, v at t + h): RK4 of every force,
@@ -88,16 +114,19 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w, b=None, bs=None):
     solver.body_implicit.BodyStep; None: none) its forces join every stage at the modes'
     motion in bs, its friction the split's half steps.
 
-    Stage 1 reuses st.k1/st.p1 (first same as last), unless hold (in the plane only) or the
-    split (the friction half step moves the velocities) changes it. Writes w.ynew, w.kend
-    (without the split friction; with gravity and the drives, solver.drives), w.fnew
-    (forces on the plate at t + h), w.normal_new, w.slip_new, w.pend (powers at t + h),
-    w.dacc (shock, viscous, friction work over the step, the plastic work past the
-    contacts' largest overlaps, whose end overlaps go into their histories' HIST_END, the
-    work of gravity and of the drives), w.ovl_new and w.ovl_who (the largest relative
-    overlap at t + h and its contact). Returns (stored contact energy at t + h [J], largest
-    slip relaxation rate at t + h of a contact whose friction RK4 integrates [1/s]: with
-    cfg.split_friction the plate contacts unless hold, 0 with hold; else every contact).
+    Stage 1 reuses st.k1/st.p1 (first same as last), unless hold (the plate-contact
+    friction held at w.fbar over the step; in the plane only, solver.dimension) or the
+    split (the friction half step moves the velocities) changes it. Writes w.ynew,
+    w.kend (without the split friction; with gravity and the drives, solver.drives), w.fnew
+    (forces on the plate at t + h), w.normal_new, w.slip_new, w.pend (powers at t + h) and
+    w.dacc (shock, viscous, friction work over the step, and the plastic work past the
+    contacts' largest overlaps, whose end overlaps go into their histories' HIST_END; the work of
+    gravity and of the drives), w.ovl_new and w.ovl_who (the
+    largest relative overlap at t + h and its contact). Returns (stored contact energy at
+    t + h [J], largest slip relaxation rate at t + h of a contact whose friction RK4
+    integrates [1/s]: with cfg.split_friction the plate contacts unless hold, 0 with hold;
+    without it every contact, as the presets' results were computed; at least each touching
+    Mindlin contact's sticking frequency, whose history the stages integrate: solver.mindlin_rk4).
     """
     y0 = st.y
     ng = y0.shape[0]
@@ -112,11 +141,13 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w, b=None, bs=None):
     if split:  # friction over [t, t + h/2]; RK4 then starts from w.ynew, updated in place
         fric_split = opening_friction(y0, h, g, cfg, w)
         y0 = w.ynew
+    e_spring = begin_stages(g, cfg)
     k1, p1 = first_stage(t, y0, hold, split, st, g, cfg, w)
     if b is not None:  # the body's friction half step, its forces at t_n, its modes over h
         fric_split += BI.open_step(t, h, y0, split, st, b, bs, g, cfg, k1, p1, split)
     hh = 0.5 * h
     piston_stage(g, 1.0, hh)
+    next_stage(g, cfg, 1.0, hh, False)
     for i in range(ng):
         for c in range(nc):
             w.ytmp[i, c] = y0[i, c] + hh * k1[i, c]
@@ -126,6 +157,7 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w, b=None, bs=None):
     if b is not None:
         BI.stage_pass(w.ytmp, 1, b, bs, g, cfg, w.k2, 1)
     piston_stage(g, 2.0, hh)
+    next_stage(g, cfg, 2.0, hh, False)
     for i in range(ng):
         for c in range(nc):
             w.ytmp[i, c] = y0[i, c] + hh * w.k2[i, c]
@@ -135,6 +167,7 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w, b=None, bs=None):
     if b is not None:
         BI.stage_pass(w.ytmp, 1, b, bs, g, cfg, w.k3, 2)
     piston_stage(g, 2.0, h)
+    next_stage(g, cfg, 2.0, h, False)
     for i in range(ng):
         for c in range(nc):
             w.ytmp[i, c] = y0[i, c] + h * w.k3[i, c]
@@ -145,12 +178,11 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w, b=None, bs=None):
         BI.stage_pass(w.ytmp, 2, b, bs, g, cfg, w.k4, 3)
     h6 = h / 6.0
     piston_rk4_end(g, h)
+    next_stage(g, cfg, 1.0, h6, True)
     for i in range(ng):
         for c in range(nc):  # (y0 may be w.ynew itself: each entry is read before it is written)
             w.ynew[i, c] = y0[i, c] + h6 * (k1[i, c] + 2.0 * w.k2[i, c] + 2.0 * w.k3[i, c] + w.k4[i, c])
-    w.dacc[0] = h6 * (p1[0] + 2.0 * p2.p_shock + 2.0 * p3.p_shock + p4.p_shock)
-    w.dacc[1] = h6 * (p1[1] + 2.0 * p2.p_visc + 2.0 * p3.p_visc + p4.p_visc)
-    w.dacc[2] = h6 * (p1[2] + 2.0 * p2.p_fric + 2.0 * p3.p_fric + p4.p_fric)
+    stage_quadrature(h6, p1, p2, p3, p4, w.dacc)
     if b is not None:  # the body's viscous work at the inner stages; its forces at the end
         w.dacc[1] += h6 * (2.0 * bs.pv[1] + 2.0 * bs.pv[2] + bs.pv[3])
         BI.end_pass(w.ynew, b, bs, g, cfg)
@@ -164,20 +196,15 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w, b=None, bs=None):
         t + h, w.ynew, stage[2], stage[3], g, cfg, w.kend, w.fnew, w.normal_new, w.slip_new, False, w.fbar, split, True
     )
     w.dacc[3] = pe.w_plastic
-    w.pend[0] = pe.p_shock
-    w.pend[1] = pe.p_visc
-    w.pend[2] = pe.p_fric
-    w.pend[3] = pe.p_drive
-    w.pend[4] = pe.p_grav
-    w.ovl_new[0] = pe.ovl
-    w.ovl_who[0] = pe.ovl_i
-    w.ovl_who[1] = pe.ovl_j
+    w.dacc[2] -= spring_rise(g, cfg, e_spring)  # Mindlin's springs' energy is E_g's, not lost
+    record_end(pe, w.pend, w.ovl_new, w.ovl_who)
     e_body = 0.0
     if b is not None:  # the end pass's body forces, energy, damping, plastic work and overlap
         e_body = BI.end_sums(bs, w)
     if not cfg.split_friction:
         return pe.e_pot + e_body, max(pe.rate, pe.rate_plate)
-    return pe.e_pot + e_body, 0.0 if hold else pe.rate_plate  # a held plate-contact friction is not RK4's
+    # a held plate-contact friction is not RK4's; pe.rate: Mindlin's sticking contacts (else 0 here)
+    return pe.e_pot + e_body, max(0.0 if hold else pe.rate_plate, pe.rate)
 
 
 @njit(cache=True)
