@@ -107,3 +107,12 @@ def test_restart_continues_the_run(implicit_run):
     n = rest.sizes["time"]
     for name in ("x", "z", "vx", "vz", "E_granular", "E_plate", "D_friction", "energy_residual"):
         np.testing.assert_array_equal(rest[name].values, implicit_run[name].values[-n:], err_msg=name)
+
+
+def test_implicit_refuses_what_it_does_not_carry_to_the_solid():
+    """The implicit scheme refuses, by field, the solid's weight, a static state with the
+    solid and Mindlin's law at its contacts (velocity Verlet carries them)."""
+    with pytest.raises(ScenarioError, match=r"gravity\.g.*verlet"):
+        validate(scenario(IMPLICIT + "\n[gravity]\ng = [0.0, 0.0, -9.81]\n"))
+    with pytest.raises(ScenarioError, match=r"contact\.tangential_law.*verlet"):
+        validate(scenario(**{"contact.tangential_law": "mindlin"}))
