@@ -75,8 +75,12 @@ class LoopArrays:
 
 
 def _copied(old: tuple, new: tuple) -> tuple:
-    """`new` (a named tuple of arrays) with each array's leading block taken from `old`'s."""
+    """`new` (a named tuple of arrays, or of such tuples: a scheme's scratch holding an
+    elastic body's arrays) with each array's leading block taken from `old`'s."""
     for a, b in zip(old, new):
+        if isinstance(a, tuple):
+            _copied(a, b)
+            continue
         b[tuple(slice(0, min(m, n)) for m, n in zip(a.shape, b.shape))] = a[
             tuple(slice(0, min(m, n)) for m, n in zip(a.shape, b.shape))
         ]
