@@ -290,11 +290,20 @@ class BodyArrays(NamedTuple):
     rgrad: np.ndarray
 
 
+class NoBodyArrays(BodyArrays):
+    """The BodyArrays of a run without an elastic body: the same fields, empty, and a type of
+    its own, so that the compiled loop picks the code without a body when it compiles
+    (`solver.body.by_body`) and never compiles the body's for such a run."""
+
+    __slots__ = ()
+
+
 def no_body(ng: int, nm: int) -> BodyArrays:
-    """The BodyArrays of a run without an elastic body (no faces: the loop skips it)."""
+    """The BodyArrays of a run without an elastic body (no faces: the loop skips it), of the
+    type NoBodyArrays."""
     z = np.zeros
     i = np.int64
-    return BodyArrays(
+    return NoBodyArrays(
         face_nodes=z((0, 1, 3)),
         face_snode=np.zeros((0, 1), i),
         node_xyz=z((0, 3)),

@@ -35,6 +35,7 @@ import math
 
 import numpy as np
 from numba import njit
+from numba.extending import overload
 
 from granplate.model.inputs import (
     GEO_DAMP,
@@ -54,6 +55,7 @@ from granplate.model.inputs import (
     HIST_END,
     HIST_MAX,
     HIST_RATE,
+    NoBodyArrays,
 )
 from granplate.physics.laws import normal_law_response, normal_law_slopes
 from granplate.physics.space import normal_rate_3d, surface_overlap
@@ -77,6 +79,21 @@ from granplate.solver.body_surface import surface_velocity, tangent_map as tange
 #: body's bounding box (a surface that moves out of the box by more than REACH - 1 radii
 #: towards a granule would be missed).
 REACH = 2.0
+
+
+def by_body(b, with_body, body_args, without, plain_args):
+    """with_body(*body_args) in a run with an elastic body, without(*plain_args) in one
+    without (b of type model.inputs.NoBodyArrays): chosen when the loop compiles, so that
+    a run without a body never compiles the body's code (it doubled the loop's compile
+    time)."""
+    raise NotImplementedError("compiled use only")
+
+
+@overload(by_body, inline="always")
+def _by_body(b, with_body, body_args, without, plain_args):
+    if getattr(b, "instance_class", None) is NoBodyArrays:
+        return lambda b, with_body, body_args, without, plain_args: without(*plain_args)
+    return lambda b, with_body, body_args, without, plain_args: with_body(*body_args)
 
 
 @njit(cache=True)

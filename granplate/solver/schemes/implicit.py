@@ -169,9 +169,16 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
     """Known plate motion, then Newton on the interface unknowns from the guess in
     w.fguess. Returns (converged, iterations, worst contact, stored energy at t + h,
     largest slip relaxation rate of a contact whose friction RK4 integrates). With an
-    elastic body: `body_attempt`."""
-    if B.has_body(sw.body):
-        return body_attempt(sw, t, h, slot, st, g, cfg, w)
+    elastic body: `body_attempt`, else `plate_attempt`."""
+    return B.by_body(
+        sw.body, body_attempt, (sw, t, h, slot, st, g, cfg, w), plate_attempt, (sw, t, h, slot, st, g, p, cfg, w)
+    )
+
+
+@njit(cache=True)
+def plate_attempt(sw, t, h, slot, st, g, p, cfg, w):
+    """`attempt` without an elastic body in space (the plane's plate, if any, held by
+    Newton on its contacts' forces)."""
     exact_predict(t, h, st, p, cfg, sw.mcoef[slot], sw.ustar)
     for k in range(sw.vguess.shape[0]):
         sw.vguess[k] = st.slip[k]
@@ -263,10 +270,13 @@ def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
     relative to error_tol, level to retry at or -1, edge-load work [J], held-friction
     work [J])."""
     fric_work = held_friction_work(st, g, cfg, w)
-    if B.has_body(sw.body):  # the body's modes (and its line load's work)
-        work, ep_new = BI.end_energy(t, h, sw.body, sw.bstep, cfg, sw.qn, sw.qdn)
-    else:
-        work, ep_new = exact_correct(t, h, st, p, cfg, sw.mcoef[slot], w.fguess, sw.qn, sw.qdn)
+    work, ep_new = B.by_body(  # the body's modes (and its line load's work), or the plate's
+        sw.body,
+        BI.end_energy,
+        (t, h, sw.body, sw.bstep, cfg, sw.qn, sw.qdn),
+        exact_correct,
+        (t, h, st, p, cfg, sw.mcoef[slot], w.fguess, sw.qn, sw.qdn),
+    )
     kx, ky, kz, kr = kinetic_energies(w.ynew, g)
     e_in = (
         st.clock[E_ZERO]
@@ -315,8 +325,7 @@ def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
     work; with an elastic body, its contacts' histories and the residual's energy at t + h.
     Returns the edge load's work over the step [J]."""
     w.dacc[2] += fric_work
-    if B.has_body(sw.body):
-        st.clock[E_STATIC] = BI.accept(t, h, sw.body, sw.bstep)
+    st.clock[E_STATIC] = B.by_body(sw.body, BI.accept, (t, h, sw.body, sw.bstep), no_static, (st,))
     for m in range(st.q.shape[0]):
         st.q[m] = sw.qn[m]
         st.qd[m] = sw.qdn[m]
@@ -367,9 +376,25 @@ def start(sw, t, st, g, cfg):
     granules' derivative and viscous power (st.k1, st.p1: every step's first stage), the
     contacts start loaded at their overlaps. Returns (the contacts' stored energy, the
     residual compliance's) [J]; (0, 0) without a body."""
+    return B.by_body(sw.body, body_start, (sw, t, st, g, cfg), no_body_start, (sw,))
+
+
+@njit(cache=True)
+def no_body_start(sw):
+    """`start` without an elastic body: nothing stored (0, 0) [J]."""
+    return 0.0, 0.0
+
+
+@njit(cache=True)
+def no_static(st):
+    """The residual compliance's energy without an elastic body: st's, unchanged [J]."""
+    return st.clock[E_STATIC]
+
+
+@njit(cache=True)
+def body_start(sw, t, st, g, cfg):
+    """`start` with an elastic body (its docstring)."""
     b = sw.body
-    if not B.has_body(b):
-        return 0.0, 0.0
     bs = sw.bstep
     cur = int(bs.flags[BI.CUR])
     for m in range(st.q.shape[0]):
