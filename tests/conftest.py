@@ -21,7 +21,44 @@ def _plate_cache(tmp_path_factory):
     # the suite's workers share the cores: large verlet runs leave solver.threads at one
     # thread (tests/test_blocks.py sets it where threads are what it checks)
     os.environ.setdefault("GRANPLATE_THREADS", "1")
+    _compile_kernel_sets_once()
     yield
+
+
+def _compile_kernel_sets_once() -> None:
+    """Under pytest-xdist, each worker compiles the kernel sets (results.kernels) that no
+    worker has compiled yet, one set at a time under a lock the workers share, before its
+    first test: the even workers from the first set on, the odd ones from the last, so that
+    no set is compiled twice (numba's disk cache serves it to the others) and both cores
+    compile. Without xdist, or where a set cannot compile, the tests compile what they use."""
+    import hashlib
+    import os
+    import tempfile
+
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "")
+    if not worker or int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1")) < 2:
+        return
+    try:
+        import fcntl
+    except ImportError:  # not on this platform: each worker compiles what it uses
+        return
+    import granplate
+    from granplate.results import kernels
+
+    sets = list(kernels.KERNEL_SETS)
+    if int(worker.removeprefix("gw") or 0) % 2:
+        sets.reverse()
+    package = str(Path(granplate.__file__).resolve().parent)
+    locks = Path(tempfile.gettempdir()) / f"granplate-compile-{hashlib.sha1(package.encode()).hexdigest()[:12]}"
+    locks.mkdir(exist_ok=True)
+    for k in sets:
+        with open(locks / f"{k.name}.lock", "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            try:
+                if kernels.missing((k,)):
+                    kernels.compile_set(k)
+            except Exception:  # noqa: BLE001 - the tests then compile what they use, and say what fails
+                pass
 
 
 def two_spheres(
