@@ -105,6 +105,18 @@ def test_the_compile_clock_counts_numbas_compiling_once():
     assert first > 0.0 and clock.seconds == first
 
 
+def test_the_loop_can_be_kept_in_the_disk_cache():
+    """Every compiled time loop (solver.loop.advance) of this process can be written to
+    numba's disk cache: none uses dynamic globals (numba's get_num_threads in the loop did,
+    and then every new process compiled the loop again)."""
+    from granplate.results.run import simulate
+    from granplate.solver.loop import advance
+
+    simulate(_tiny())
+    libraries = [cres.library for cres in advance.overloads.values()]
+    assert libraries and not any(lib.has_dynamic_globals for lib in libraries)
+
+
 def test_summary_states_compile_seconds_apart_from_the_wall_time(monkeypatch):
     """A compile inside the run (a fresh function compiled while the model is built) is in
     compile_time_s, and wall_time_s leaves it out."""

@@ -30,7 +30,7 @@ import os
 # GOMP_SPINCOUNT or OMP_WAIT_POLICY is kept. Measured in docs/benchmarks.md.
 os.environ.setdefault("GOMP_SPINCOUNT", "30000")
 
-from numba import get_num_threads, njit, prange  # noqa: E402
+from numba import njit, prange  # noqa: E402
 
 from granplate.solver.drives import begin_pass
 from granplate.solver.granular import ForceSums, commit_history, commit_rows
@@ -293,18 +293,18 @@ def accept_rows(y, k0, k1, ynew, kend):
 
 
 @njit(parallel=True)
-def commit_pair_histories(t, hist, coef):
-    """solver.granular.commit_history of the pairs on every core, a block of rows per
-    thread (each row on its own: the same numbers)."""
-    nb = get_num_threads()
+def commit_pair_histories(t, hist, coef, nb):
+    """solver.granular.commit_history of the pairs on every core, in nb blocks of rows (one
+    per thread, Config.threads: numba's get_num_threads here would keep the loop from its
+    disk cache; each row on its own: the same numbers)."""
     for k in prange(nb):
         lo, hi = block_range(k, nb, hist.shape[0])
         commit_rows(t, hist, coef, lo, hi)
 
 
 @njit(cache=True)
-def commit_histories_blocks(t, g):
-    """solver.granular.commit_histories with the pairs on every core."""
-    commit_pair_histories(t, g.pair_hist, g.pair_coef)
+def commit_histories_blocks(t, g, nb):
+    """solver.granular.commit_histories with the pairs on every core, in nb blocks."""
+    commit_pair_histories(t, g.pair_hist, g.pair_coef, nb)
     commit_history(t, g.wall_hist, g.wall_coef)
     commit_history(t, g.pc_hist, g.pc_coef)

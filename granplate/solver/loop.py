@@ -392,7 +392,7 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
         if cfg.threads > 1:  # the copies and the pairs' histories on every core (solver.blocks)
             accept_rows(st.y, st.k0, st.k1, w.ynew, w.kend)
             accept_granular(t, h, land, t_land, plate_work, e_pot, st, w, False)
-            commit_histories_blocks(st.clock[T_NOW], g)
+            commit_histories_blocks(st.clock[T_NOW], g, cfg.threads)
         else:
             accept_granular(t, h, land, t_land, plate_work, e_pot, st, w, True)
             commit_histories(st.clock[T_NOW], g)
