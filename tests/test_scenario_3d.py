@@ -17,7 +17,8 @@ import pytest
 
 from granplate.errors import ScenarioError
 from granplate.setup import io as scenario_io
-from granplate.setup.geometry import box_walls, force_loaded_granules, resolve
+from granplate.model.loads import loaded_labels
+from granplate.setup.geometry import box_walls, resolve
 from granplate.setup.presets import preset, preset_names
 from granplate.setup.scenario import BOX_WALLS, Box, Granule, Load, Scenario, Wall
 from granplate.setup.validate import validate
@@ -165,11 +166,11 @@ def test_force_loaded_granules_are_those_furthest_against_the_direction():
         Granule(x=0.05, y=0.0, z=0.2, radius=0.01, material="steel", label="r"),
     )
     s = Scenario(dimension=3, granules=gs, load=Load(kind="force", force=1.0))
-    assert force_loaded_granules(s) == ("p", "q")  # both reach x = 0.01
+    assert loaded_labels(s) == ("p", "q")  # both reach x = 0.01
     up = dataclasses.replace(s, load=Load(kind="force", force=1.0, direction=(0.0, 0.0, -3.0)))
-    assert force_loaded_granules(up) == ("r",)  # furthest against -z: largest z + R
+    assert loaded_labels(up) == ("r",)  # furthest against -z: largest z + R
     given = dataclasses.replace(s, load=Load(kind="force", force=1.0, granules=("r",)))
-    assert force_loaded_granules(given) == ("r",)
+    assert loaded_labels(given) == ("r",)
 
 
 @pytest.mark.parametrize(
@@ -382,7 +383,7 @@ def test_docs_3d_example_validates():
     validate(s)
     r = resolve(s)
     assert r.dimension == 3 and len(r.granules) == 2 and [w.label for w in r.walls] == list(BOX_WALLS)
-    assert r.load.kind == "force" and force_loaded_granules(r) == (r.granules[0].label,)
+    assert r.load.kind == "force" and loaded_labels(r) == (r.granules[0].label,)
 
 
 # --------------------------------------------------------------------------- fuzz

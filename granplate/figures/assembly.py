@@ -23,7 +23,8 @@ import numpy as np
 import xarray as xr
 
 from granplate.errors import ScenarioError
-from granplate.model.arrays import find_pairs_and_walls, find_plate_contacts, loaded_granules
+from granplate.model.arrays import find_pairs_and_walls, find_plate_contacts
+from granplate.model.loads import loaded_granules
 from granplate.results import analysis as an
 from granplate.results.contact_table import links_of
 from granplate.results.dataset import scenario_of
@@ -317,7 +318,7 @@ def of_scenario(scenario: Scenario) -> Assembly:
         walls=s.walls,
         plate=scenario_plate(s, plate, y),
         load=s.load,
-        loaded=loaded_granules(s, x, r),
+        loaded=loaded_granules(s, np.column_stack([x, y]), r),
         segments=segs,
         kinds=kinds,
     )
@@ -346,7 +347,7 @@ def of_result(ds: xr.Dataset, time: float | None = None) -> Assembly:
         walls=s.walls,
         plate=result_plate(s, ds, t),
         load=s.load,
-        loaded=loaded_granules(s, np.asarray(ds["x"].values[0], float), r),
+        loaded=loaded_granules(s, np.column_stack([ds["x"].values[0], ds["y"].values[0]]), r),
         segments=segs,
         kinds=kinds,
         forces=forces,

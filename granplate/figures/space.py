@@ -274,7 +274,7 @@ def of_scenario(scenario: Scenario) -> Assembly3D:
     """The 3D assembly of a scenario before its run: initial centres, the contacts
     touching at t = 0 (no forces: granule pairs, walls and the elastic solid,
     `body_touching`), its elastic solid (`solid_drawing`)."""
-    from granplate.model.space import loaded_granules_3d
+    from granplate.model.loads import loaded_granules
     from granplate.setup.geometry import resolve
 
     s = resolve(scenario)
@@ -291,7 +291,7 @@ def of_scenario(scenario: Scenario) -> Assembly3D:
         materials=tuple(g.material for g in s.granules),
         walls=s.walls,
         load=s.load,
-        loaded=loaded_granules_3d(s, pos[:, 0], pos[:, 1], pos[:, 2], r),
+        loaded=loaded_granules(s, pos, r),
         segments=np.concatenate([segs, body]),
         kinds=kinds + ("body",) * len(body),
         **solid_drawing(s, scenario),
@@ -331,7 +331,7 @@ def _assembly_at(
     """The result's assembly at output index ti: centres, the contacts of its contact table
     there with their forces (`result_links`); solid and body: the fields of `solid_drawing`
     and `body_drawing`; scales: stress_top, force_top."""
-    from granplate.model.space import loaded_granules_3d
+    from granplate.model.loads import loaded_granules
 
     pos, p0 = (np.stack([ds[k].values[o] for k in SPACE.positions], axis=-1).astype(float) for o in (ti, 0))
     r = np.asarray(ds["radius"].values, float)
@@ -346,7 +346,7 @@ def _assembly_at(
         materials=tuple(str(v) for v in ds["material"].values),
         walls=s.walls,
         load=s.load,
-        loaded=loaded_granules_3d(s, p0[:, 0], p0[:, 1], p0[:, 2], r),
+        loaded=loaded_granules(s, p0, r),
         segments=np.concatenate([segs, body_segs]),
         kinds=kinds + ("body",) * len(body_segs),
         forces=np.concatenate([forces, body_forces]),

@@ -14,6 +14,7 @@ import numpy as np
 from granplate.model.contacts import contact_lists, fixed_wall_contacts
 from granplate.model.dimension import of_number
 from granplate.model.drives import drive_fields, driven_initial_state
+from granplate.model import loads
 from granplate.model.inputs import Config, Granular, PlateArrays, StagesConfig, no_history, scheme_number
 from granplate.errors import ScenarioError
 from granplate.model.coefficients import pair_coefficients, plate_contact_coefficients, wall_arrays
@@ -32,7 +33,6 @@ from granplate.model.relists import carried_history as carried_history
 from granplate.model.relists import granular_with_contacts as granular_with_contacts
 from granplate.model.relists import granular_with_patch_contacts as granular_with_patch_contacts
 from granplate.setup.geometry import resolve
-from granplate.physics.shock import shock_resultants
 from granplate.setup.materials import sphere_inertia, sphere_mass
 from granplate.setup.scenario import Plate, Scenario
 from granplate.setup.threads import loop_threads
@@ -174,19 +174,6 @@ def find_plate_contacts(s: Scenario) -> tuple[np.ndarray, np.ndarray]:
     return np.array(on, np.int64), np.array(between, np.int64)
 
 
-def loaded_granules(s: Scenario, x, r) -> np.ndarray:
-    """Mask of the granules the line load pushes: load.granules, or column 1 (the
-    granules whose left surface is leftmost)."""
-    n = len(x)
-    if s.load.kind == "none" or s.load.target != "granules" or n == 0:
-        return np.zeros(n, bool)
-    if s.load.granules:
-        labels = [g.label for g in s.granules]
-        return np.array([lab in s.load.granules for lab in labels])
-    left = x - r
-    return np.abs(left - left.min()) <= 1e-9 * r.max()
-
-
 def face_contacts_possible(s: Scenario, plate_model) -> bool:
     """Whether granules may get patch contacts during the run (docs/model.md section 3.5):
     dynamic detection, granules, and a plate integrated in all its modes or in the
@@ -210,9 +197,7 @@ def plate_modal_arrays(s: Scenario, y: np.ndarray, pc: np.ndarray):
     if s.plate is not None:
         from granplate.plate import build_plate
 
-        edge = None
-        if s.load.kind == "line" and s.load.target == "plate":
-            edge = (s.load.y0, s.load.length)
+        edge = loads.plate_edge(s)
         plate_model = build_plate(
             s.plate,
             s.plate.x0,
@@ -261,7 +246,7 @@ def loop_config(
     scheme's force floor [N] when given (else `force_floor` of the plane's load)."""
     t = s.time
     sol = s.solver
-    q0 = s.load.q0 if s.load.kind == "line" else 0.0
+    q0 = loads.amplitude(s)
     plate = s.plate if isinstance(s.plate, Plate) else None  # the plane's plate (an elastic solid: model.body)
     stages = s.contact.tangential_law == "mindlin" and sol.scheme != "verlet"
     return (StagesConfig if stages else Config)(
@@ -279,7 +264,7 @@ def loop_config(
         dt_min=float(t.dt_min),
         out_dt=float(t.output_interval),
         t_end=float(t.t_end),
-        load_on_plate=bool(s.load.kind == "line" and s.load.target == "plate"),
+        load_on_plate=loads.plate_edge(s) is not None,
         arm_shrink=1.0 if s.contact.torque_arm == "contact_point" else 0.0,
         lammps_arms=s.contact.torque_arm == "lammps",
         mindlin=s.contact.tangential_law == "mindlin",
@@ -350,7 +335,8 @@ def plane_model(s: Scenario) -> Model:
     loop_pairs, loop_wc = contact_lists(s.contact, s.walls, x, y, r)
     wall_geo, wall_coef = wall_arrays(s, mats, r, mass, loop_wc)
     pc, patches = find_plate_contacts(s)
-    fres, tres = shock_resultants(y, r, loaded_granules(s, x, r), s.load.y0, s.load.length)
+    forces, torques = loads.resultants(s, np.column_stack([x, y]), r)
+    fres, tres = np.ascontiguousarray(forces[:, 0]), np.ascontiguousarray(torques[:, 2])  # the plane's x and z
     plate_model, plate_arrays = plate_modal_arrays(s, y, pc)
     if len(patches) and len(plate_arrays.face_y) == 0:  # pragma: no cover - guarded by validation
         raise ScenarioError(

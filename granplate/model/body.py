@@ -16,6 +16,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from granplate.model import loads
 from granplate.model.inputs import N_GEO, BodyArrays, no_history
 from granplate.physics.contact import N_COEF, damping_coefficient, hertz_coefficient
 from granplate.setup.materials import effective_modulus
@@ -112,9 +113,10 @@ def patch_radius(s: Scenario, extent: np.ndarray, reach: float) -> float:
 
 def modal_line_load(s: Scenario, surface, solid) -> np.ndarray:
     """(nm,) Phi^T f: the modal forces per unit q0 of a line load on the body (load.kind
-    "line", target "plate": the bare plate's shock on the box's face xmin,
+    "line", target "plate" (model.loads.plate_edge): the bare plate's shock on the box's face xmin,
     solid.traction); zeros for any other load."""
-    if not (s.load.kind == "line" and s.load.target == "plate"):
+    edge = loads.plate_edge(s)
+    if edge is None:
         return np.zeros(solid.n_modes)
     from granplate.solid.traction import face_xmin_line_load
 
@@ -124,8 +126,8 @@ def modal_line_load(s: Scenario, surface, solid) -> np.ndarray:
         3 * len(solid.nodes),
         float(sd.origin[0]),
         float(sd.size[2]),
-        s.load.y0,
-        s.load.length,
+        edge[0],
+        edge[1],
         1e-9 * max(sd.size),
     )
     return np.ascontiguousarray(solid.Phi.T @ f[solid.dofs])

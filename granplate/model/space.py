@@ -1,8 +1,8 @@
 """Scenario -> model arrays in space (`dimension = 3`, docs/model.md section 3.7): the
 granules' centres, velocities and spin vectors, their pair and wall contact lists and
-coefficients (the same laws and coefficients as the plane, `model.arrays`), the 3D shock
-(load.kind = "force": a half-sine total force shared by the loaded granules along a
-direction, docs/model.md section 5.4; kind = "line": the plane's line load on a planar
+coefficients (the same laws and coefficients as the plane, `model.arrays`), the shock's
+shares (model.loads: "force", a half-sine total force shared by the loaded granules along
+a direction, docs/model.md section 5.4; "line", the plane's line load on a planar
 packing, section 5.1), the elastic body of its [plate] (model.body) and
 the loop's settings. `model.arrays.build_model` calls `build_space_model` for a scenario
 of dimension 3: the one place the model's dimension is decided.
@@ -15,6 +15,7 @@ import operator
 
 import numpy as np
 
+from granplate.model import loads
 from granplate.model.contacts import contact_lists
 from granplate.model.inputs import STATE_COLUMNS, Granular3, PlateArrays, no_history
 from granplate.setup.pairs import contact_search_distance, superset_pairs
@@ -37,63 +38,6 @@ def spin_vector(omega) -> tuple[float, float, float]:
     """A granule's spin (wx, wy, wz) [rad/s] from its `omega` field (a 3-vector in space)."""
     w = tuple(float(v) for v in omega)
     return (w[0], w[1], w[2])
-
-
-def load_direction(s: Scenario) -> np.ndarray:
-    """The unit direction of the 3D shock (load.direction, normalised)."""
-    d = np.asarray(s.load.direction, float)
-    return d / np.linalg.norm(d)
-
-
-def loaded_granules_3d(s: Scenario, x, y, z, r) -> np.ndarray:
-    """Mask of the granules the 3D shock pushes: load.granules, or the granules whose
-    surface lies furthest against the load's direction (min of s.d - R within 1e-9 R_max);
-    a line load's as in the plane (`model.arrays.loaded_granules`)."""
-    n = len(x)
-    if s.load.kind == "line":
-        from granplate.model.arrays import loaded_granules
-
-        return loaded_granules(s, x, r)
-    if s.load.kind != "force" or n == 0:
-        return np.zeros(n, bool)
-    if s.load.granules:
-        return np.array([g.label in s.load.granules for g in s.granules])
-    d = load_direction(s)
-    back = x * d[0] + y * d[1] + z * d[2] - r
-    return np.abs(back - back.min()) <= 1e-9 * r.max()
-
-
-def shock_shares(s: Scenario, loaded: np.ndarray) -> np.ndarray:
-    """(ng, 3) each granule's share of the total force along the load's direction [-]:
-    direction / n_loaded on the loaded granules, zero elsewhere (the force amplitude,
-    load.force [N], is the loop's q0)."""
-    out = np.zeros((len(loaded), 3))
-    if loaded.any():
-        out[loaded] = load_direction(s) / int(loaded.sum())
-    return out
-
-
-def shock_resultants_3d(s: Scenario, x, y, z, r) -> tuple[np.ndarray, np.ndarray]:
-    """(ng, 3) forces and (ng, 3) torques per unit amplitude on each granule [-, m]: a
-    "force" load's shares (`shock_shares`, no torque), or the planar line load of
-    docs/model.md section 5.1 on the granules it pushes (`model.arrays.loaded_granules`):
-    F_i / q0 along +x and tau_i / q0 about z, as in the plane (physics.shock)."""
-    ng = len(x)
-    if s.load.kind == "line":
-        from granplate.model.arrays import loaded_granules
-        from granplate.physics.shock import shock_resultants
-
-        f, tau = shock_resultants(y, r, loaded_granules(s, x, r), s.load.y0, s.load.length)
-        forces, torques = np.zeros((ng, 3)), np.zeros((ng, 3))
-        forces[:, 0], torques[:, 2] = f, tau
-        return forces, torques
-    return shock_shares(s, loaded_granules_3d(s, x, y, z, r)), np.zeros((ng, 3))
-
-
-def shock_amplitude(s: Scenario) -> float:
-    """The loop's shock amplitude: load.force [N] (kind "force"), load.q0 [N/m] (kind
-    "line"), else 0."""
-    return {"force": float(s.load.force), "line": float(s.load.q0)}.get(s.load.kind, 0.0)
 
 
 def initial_state_3d(s: Scenario) -> np.ndarray:
@@ -122,7 +66,7 @@ def force_floor_3d(
 
     if len(r) == 0:
         return 0.0
-    shock = abs(shock_amplitude(s)) * float(np.abs(shares).sum())
+    shock = abs(loads.amplitude(s)) * float(np.abs(shares).sum())
     moving = range(len(r)) if state is None else np.flatnonzero((state[:, 3:] != 0.0).any(axis=1)).tolist()
     momentum = sum(granule_momentum(mass[i], r[i], s.granules[i]) for i in moving)
     return FORCE_FLOOR_FRACTION * (shock + float(momentum) / out_dt)
@@ -172,7 +116,7 @@ def build_space_model(s: Scenario):
     loop_pairs, loop_wc = contact_lists(s.contact, s.walls, x, y, r, z, cand)
     state = initial_state_3d(s)
     wall_geo, wall_coef = wall_arrays(s, mats, r, mass, loop_wc)
-    shares, torques = shock_resultants_3d(s, x, y, z, r)
+    shares, torques = loads.resultants(s, np.column_stack([x, y, z]), r)
     granular = Granular3(
         mass=mass,
         inertia=inertia,
@@ -202,7 +146,7 @@ def build_space_model(s: Scenario):
         mass,
         floor=force_floor_3d(s, mass, r, shares, s.time.output_interval, state),
     )._replace(
-        q0=shock_amplitude(s), dimension=3, split_friction=s.solver.granular_friction == "split" and not frictionless(s)
+        q0=loads.amplitude(s), dimension=3, split_friction=s.solver.granular_friction == "split" and not frictionless(s)
     )
     solid, body, rigid = None, None, np.zeros(len(r), bool)
     if s.plate is not None:

@@ -161,25 +161,6 @@ def box_walls(box: Box) -> tuple[Wall, ...]:
     return tuple(walls)
 
 
-#: Tolerance, times the largest radius, of "furthest against the direction" (`force_loaded_granules`).
-FORCE_TIE_RTOL = 1e-9
-
-
-def force_loaded_granules(scenario: Scenario) -> tuple[str, ...]:
-    """Labels of the granules a 3D `kind = "force"` load acts on: `load.granules` when
-    given, else those whose surface is furthest against the load's direction d (the
-    smallest s . d - R [m] over the granules, within FORCE_TIE_RTOL x the largest radius).
-    `scenario`: resolved (labels filled)."""
-    gs = scenario.granules
-    if scenario.load.granules or not gs:
-        return tuple(scenario.load.granules)
-    d = unit(scenario.load.direction)
-    lead = [g.x * d[0] + g.y * d[1] + g.z * d[2] - g.radius for g in gs]
-    tol = FORCE_TIE_RTOL * max(g.radius for g in gs)
-    first = min(lead)
-    return tuple(g.label for g, s in zip(gs, lead) if s <= first + tol)
-
-
 def solid_against(sd: Solid, granules: tuple[Granule, ...], xp: float) -> tuple[float, float, float]:
     """The origin [m] of a box solid placed against a packing: its face xmin at the
     packing's far side xp [m], centred on the packing's extent in y and z."""

@@ -444,7 +444,7 @@ class Load:
     kind = "force" (3D): a total force F(t) = force sin(pi t / T) [N] along direction
     (any length > 0, normalised by the solver), shared equally by the loaded granules
     (empty `granules`: those whose surface is furthest against the direction,
-    `geometry.force_loaded_granules`).
+    `model.loads.force`).
     """
 
     kind: str = "line"
