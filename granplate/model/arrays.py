@@ -15,7 +15,7 @@ from granplate.model.contacts import contact_lists, fixed_wall_contacts
 from granplate.model.dimension import of_number
 from granplate.model.drives import drive_fields, driven_initial_state
 from granplate.model import loads
-from granplate.model.inputs import Config, Granular, PlateArrays, StagesConfig, no_history, scheme_number
+from granplate.model.inputs import Config, Granular, PlateArrays, no_history, scheme_number
 from granplate.errors import ScenarioError
 from granplate.model.coefficients import pair_coefficients, plate_contact_coefficients, wall_arrays
 
@@ -248,8 +248,7 @@ def loop_config(
     sol = s.solver
     q0 = loads.amplitude(s)
     plate = s.plate if isinstance(s.plate, Plate) else None  # the plane's plate (an elastic solid: model.body)
-    stages = s.contact.tangential_law == "mindlin" and sol.scheme != "verlet"
-    return (StagesConfig if stages else Config)(
+    return Config(
         q0=float(q0),
         duration=float(s.load.duration),
         clip=bool(s.contact.clip_tensile),
@@ -268,6 +267,7 @@ def loop_config(
         arm_shrink=1.0 if s.contact.torque_arm == "contact_point" else 0.0,
         lammps_arms=s.contact.torque_arm == "lammps",
         mindlin=s.contact.tangential_law == "mindlin",
+        mindlin_stages=s.contact.tangential_law == "mindlin" and sol.scheme != "verlet",
         scheme=scheme_number(sol.scheme),
         error_tol=float(sol.error_tol),
         force_floor=force_floor(q0, fres, tres, r, mass, s, t.output_interval) if floor is None else float(floor),

@@ -198,14 +198,7 @@ class Config(NamedTuple):
     threads: int = 1  # blocks of the velocity-Verlet passes, one per thread (solver.blocks; 1: serial)
     lammps_arms: bool = False  # contact.torque_arm = "lammps": Mindlin's torque at R - delta/2 (pairs), R (walls)
     mindlin: bool = False  # contact.tangential_law = "mindlin": the Verlet force pass runs Mindlin's law in it
-
-
-class StagesConfig(Config):
-    """The Config of a run whose RK4 stages carry Mindlin's law (solver.mindlin_rk4): the
-    same fields, a type of its own, so that the loop compiles the stages' code only for
-    such runs (solver.mindlin_rk4.by_stages)."""
-
-    __slots__ = ()
+    mindlin_stages: bool = False  # Mindlin's law under the RK4 schemes: in their stages (solver.mindlin_rk4)
 
 
 #: columns of BodyArrays.geo, one row per granule and buffer (docs/model.md section 3.9):

@@ -56,7 +56,7 @@ from granplate.physics.laws import normal_law_force, normal_law_response
 from granplate.physics.shock import shock_amplitude
 from granplate.setup.law_registry import JOHNSON, MINDLIN
 from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_motion
-from granplate.solver.mindlin_rk4 import by_stages, plane_stages, unchanged_sums
+from granplate.solver.mindlin_rk4 import plane_stages
 from granplate.solver.state import PARTNER_PLATE
 
 
@@ -288,9 +288,8 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         fplate[2 * k + 1] = f
         normal[k] = n
         slip[k] = vt
-    p_fric, e_pot, rate = by_stages(  # Mindlin's law in RK4's stages (solver.mindlin_rk4)
-        cfg, plane_stages, (y, dy, g, cfg, record, p_fric, e_pot, rate), unchanged_sums, (p_fric, e_pot, rate)
-    )
+    if cfg.mindlin_stages:  # Mindlin's law in RK4's stages (solver.mindlin_rk4)
+        p_fric, e_pot, rate = plane_stages(y, dy, g, cfg, record, p_fric, e_pot, rate)
     for i in range(ng):
         dy[i, 3] /= g.mass[i]
         dy[i, 4] /= g.mass[i]

@@ -49,7 +49,7 @@ from granplate.physics.space import (
 )
 from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_motion
 from granplate.solver.granular import ForceSums, friction_impulse, slip_relaxation_rate
-from granplate.solver.mindlin_rk4 import by_stages, space_stages, unchanged_sums
+from granplate.solver.mindlin_rk4 import space_stages
 
 #: state columns of a granule in space
 X, Y, Z, VX, VY, VZ, WX, WY, WZ = range(9)
@@ -244,9 +244,8 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         add_friction(dy, i, a, nx, ny, nz, fx, fy, fz, 1.0)
         p_fric += f_mag * speed
         rate = max(rate, slip_relaxation_rate(n, speed, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + a * a / g.inertia[i]))
-    p_fric, e_pot, rate = by_stages(  # Mindlin's law in RK4's stages (solver.mindlin_rk4)
-        cfg, space_stages, (y, dy, g, cfg, record, p_fric, e_pot, rate), unchanged_sums, (p_fric, e_pot, rate)
-    )
+    if cfg.mindlin_stages:  # Mindlin's law in RK4's stages (solver.mindlin_rk4)
+        p_fric, e_pot, rate = space_stages(y, dy, g, cfg, record, p_fric, e_pot, rate)
     for i in range(ng):
         inv_m = 1.0 / g.mass[i]
         inv_i = 1.0 / g.inertia[i]

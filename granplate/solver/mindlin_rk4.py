@@ -31,9 +31,7 @@ from __future__ import annotations
 import math
 
 from numba import njit
-from numba.extending import overload
 
-from granplate.model.inputs import StagesConfig
 from granplate.model.inputs import HIST_A, HIST_A_END, HIST_F_END, HIST_MAX, HIST_RATE, HIST_XI, HIST_XI_END, N_MINDLIN
 from granplate.physics.contact import (
     COEF_C,
@@ -51,48 +49,6 @@ from granplate.physics.laws import normal_law_force
 from granplate.physics.mindlin import contact_radius, spring_energy, stage_force
 from granplate.physics.space import arm_torque_3d, normal_rate_3d, pair_contact_3d, slip_velocity_3d, wall_overlap_3d
 from granplate.solver.drives import wall_motion
-
-
-def by_stages(cfg, with_stages, stage_args, without, plain_args):
-    """with_stages(*stage_args) in a run whose RK4 stages carry Mindlin's law (cfg of type
-    model.inputs.StagesConfig), without(*plain_args) in any other: chosen when the loop
-    compiles, so that the other runs never compile the stages' code."""
-    raise NotImplementedError("compiled use only")
-
-
-@overload(by_stages, inline="always")
-def _by_stages(cfg, with_stages, stage_args, without, plain_args):
-    if getattr(cfg, "instance_class", None) is StagesConfig:
-        return lambda cfg, with_stages, stage_args, without, plain_args: with_stages(*stage_args)
-    return lambda cfg, with_stages, stage_args, without, plain_args: without(*plain_args)
-
-
-@njit(cache=True, inline="always")
-def _true() -> bool:
-    return True
-
-
-@njit(cache=True, inline="always")
-def _false() -> bool:
-    return False
-
-
-@njit(cache=True, inline="always")
-def _nothing(e_start) -> float:
-    return 0.0
-
-
-@njit(cache=True, inline="always")
-def in_stages(cfg) -> bool:
-    """Whether Mindlin's law runs in the RK4 stages (cfg a model.inputs.StagesConfig)."""
-    return by_stages(cfg, _true, (), _false, ())
-
-
-@njit(cache=True, inline="always")
-def unchanged_sums(p_fric, e_pot, rate):
-    """A force pass's friction power [W], potential energy [J] and relaxation rate [1/s]
-    as they are: what `plane_stages`/`space_stages` leave of them without Mindlin's law."""
-    return p_fric, e_pot, rate
 
 
 @njit(cache=True)
@@ -338,14 +294,11 @@ def _begin_rows(hist, coef) -> float:
 
 @njit(cache=True)
 def begin_stages(g, cfg) -> float:
-    """Before an RK4 step's first stage (with Mindlin's law in the stages, else nothing): every
+    """Before an RK4 step's first stage (with cfg.mindlin_stages, else nothing): every
     Mindlin contact's stage sums and increment zero, HIST_A_END = -1 (inside a step).
     Returns the springs' committed energy [J] (0 without Mindlin's law)."""
-    return by_stages(cfg, _begin_both, (g,), _nothing, (0.0,))
-
-
-@njit(cache=True)
-def _begin_both(g) -> float:
+    if not cfg.mindlin_stages:
+        return 0.0
     return _begin_rows(g.pair_hist, g.pair_coef) + _begin_rows(g.wall_hist, g.wall_coef)
 
 
@@ -364,12 +317,13 @@ def _next_rows(hist, coef, weight, tau, final):
 
 @njit(cache=True)
 def next_stage(g, cfg, weight, tau, final):
-    """After an RK4 stage (with Mindlin's law in the stages, else nothing): its slip velocity (HIST_F_END) added with `weight` (1, 2, 2, 1)
+    """After an RK4 stage (with cfg.mindlin_stages, else nothing): its slip velocity (HIST_F_END) added with `weight` (1, 2, 2, 1)
     to each Mindlin contact's sum (HIST_XI_END), and the next stage's increment tau times
     it [m] (tau = h/2, h/2, h [s]), or at the last (final) tau = h/6 times the sum."""
-    if in_stages(cfg):
-        _next_rows(g.pair_hist, g.pair_coef, weight, tau, final)
-        _next_rows(g.wall_hist, g.wall_coef, weight, tau, final)
+    if not cfg.mindlin_stages:
+        return
+    _next_rows(g.pair_hist, g.pair_coef, weight, tau, final)
+    _next_rows(g.wall_hist, g.wall_coef, weight, tau, final)
 
 
 @njit(cache=True)
@@ -389,9 +343,6 @@ def _energy_rows(hist, coef) -> float:
 def spring_rise(g, cfg, e_start) -> float:
     """The rise of the springs' energy over the step [J]: that of the trial histories at its
     end less e_start [J], what `begin_stages` returned (0 without Mindlin's law)."""
-    return by_stages(cfg, _rise_both, (g, e_start), _nothing, (e_start,))
-
-
-@njit(cache=True)
-def _rise_both(g, e_start) -> float:
+    if not cfg.mindlin_stages:
+        return 0.0
     return _energy_rows(g.pair_hist, g.pair_coef) + _energy_rows(g.wall_hist, g.wall_coef) - e_start

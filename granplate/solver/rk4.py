@@ -11,7 +11,7 @@ from numba import njit
 from granplate.solver import body_implicit as BI
 from granplate.solver.dimension import friction_flow, granular_rhs, plate_friction_held
 from granplate.solver.drives import hold_drives, piston_rk4_end, piston_stage, pistons_at_start, wall_shift_energy
-from granplate.solver.mindlin_rk4 import begin_stages, in_stages, next_stage, spring_rise
+from granplate.solver.mindlin_rk4 import begin_stages, next_stage, spring_rise
 
 #: RK4 stays stable for h * rate < 2.785 on a decaying mode; the step control keeps h
 #: times the friction relaxation rate of every contact that RK4 integrates below this bound.
@@ -43,7 +43,7 @@ def first_stage(t, y0, hold, split, st, g, cfg, w):
     last step's end, first same as last), or recomputed into w.k1h/w.p1h where the held
     plate-contact friction (hold) or the split friction's half step changes it, or
     Mindlin's law needs the stage's slip (solver.mindlin_rk4)."""
-    if plate_friction_held(hold, g) or split or in_stages(cfg):
+    if plate_friction_held(hold, g) or split or cfg.mindlin_stages:
         pr = granular_rhs(
             t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
         )
