@@ -21,8 +21,6 @@ CORE = ("physics", "model", "solver", "plate", "solid")
 #: files exempt from both limits, relative to the package, with why
 ALLOWED = {
     "solver/granular3d.py": "being rewritten for the Mindlin friction law (granular_rhs: 148 lines); split it after",
-    "solver/schemes/verlet.py": "being rewritten for the Mindlin friction law (attempt: 106 lines); split it after",
-    "model/static.py": "being rewritten for the static precompression's new cases",
 }
 
 #: functions kept whole for speed ("file:function"), with the measured cost of splitting them

@@ -10,33 +10,23 @@ from __future__ import annotations
 
 from numba import njit
 
-import math
 
 from granplate.model.inputs import (
     HIST_A,
     HIST_A_END,
     HIST_END,
-    HIST_F,
-    HIST_F_END,
     HIST_MAX,
     HIST_RATE,
-    HIST_XI,
-    HIST_XI_END,
-    N_MINDLIN,
 )
 from granplate.physics.contact import (
-    COEF_C,
     COEF_KS,
-    COEF_KT,
     COEF_TLAW,
     COEF_MU,
-    COEF_MUT,
-    COEF_XT,
     contact_arm,
     friction_magnitude,
 )
 from granplate.physics.laws import normal_law_force, normal_law_response
-from granplate.physics.mindlin import contact_radius, mindlin_step, spring_energy
+from granplate.physics.mindlin import contact_radius
 from granplate.physics.shock import shock_amplitude
 from granplate.setup.law_registry import MINDLIN
 from granplate.physics.space import (
@@ -49,6 +39,7 @@ from granplate.physics.space import (
 )
 from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_motion
 from granplate.solver.granular import ForceSums, friction_impulse, slip_relaxation_rate
+from granplate.solver.mindlin_history import mindlin_contact, mindlin_old_force, mindlin_parted
 from granplate.solver.mindlin_rk4 import space_stages
 
 #: state columns of a granule in space
@@ -505,78 +496,11 @@ def wall_forces(y, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl
 
 
 @njit(cache=True)
-def mindlin_contact(hist, k, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, n_abs):
-    """Contact k (history row hist[k], coefficient row c) under Mindlin's law over the step
-    h [s] (physics.mindlin.mindlin_step) at overlap delta and contact radius a [m] and |N| =
-    n_abs [N], damped by eta_t = x_t c delta^(1/4); its trial history into HIST_XI_END,
-    HIST_A_END, HIST_F_END. h = 0 (the force pass at t_n of a run's first step): a contact
-    with a committed history (a restart) takes its committed force back, as the run that
-    stored it had it; a new one its force from the state, which becomes its committed force
-    (what the first kick applies). Returns (F_t (3) [N], stored energy [J], energy lost [J])."""
-    if h == 0.0 and hist[k, HIST_A] > 0.0:
-        for col in range(N_MINDLIN):
-            hist[k, HIST_XI_END + col] = hist[k, HIST_XI + col]
-        e_t = spring_energy(c[COEF_KT] * hist[k, HIST_A], hist[k, HIST_XI], hist[k, HIST_XI + 1], hist[k, HIST_XI + 2])
-        return hist[k, HIST_F], hist[k, HIST_F + 1], hist[k, HIST_F + 2], e_t, 0.0
-    damp = 0.0
-    if c[COEF_XT] != 0.0:  # eta_t = x_t c delta^(1/4)
-        damp = c[COEF_XT] * c[COEF_C] * math.sqrt(math.sqrt(delta))
-    fx, fy, fz, xx, xy, xz, e_t, lost = mindlin_step(
-        hist[k, HIST_XI],
-        hist[k, HIST_XI + 1],
-        hist[k, HIST_XI + 2],
-        a,
-        hist[k, HIST_A],
-        c[COEF_KT],
-        nx,
-        ny,
-        nz,
-        vsx,
-        vsy,
-        vsz,
-        h,
-        c[COEF_MUT] * abs(n_abs),
-        damp,
-        hist[k, HIST_F],
-        hist[k, HIST_F + 1],
-        hist[k, HIST_F + 2],
-    )
-    hist[k, HIST_XI_END] = xx
-    hist[k, HIST_XI_END + 1] = xy
-    hist[k, HIST_XI_END + 2] = xz
-    hist[k, HIST_A_END] = a
-    hist[k, HIST_F_END] = fx
-    hist[k, HIST_F_END + 1] = fy
-    hist[k, HIST_F_END + 2] = fz
-    if h == 0.0:
-        for col in range(3):
-            hist[k, HIST_F + col] = hist[k, HIST_F_END + col]
-    return fx, fy, fz, e_t, lost
-
-
-@njit(cache=True)
-def mindlin_old_force(hist, k, c):
-    """The tangential force on the first body at contact k's last step [N] (3)."""
-    return hist[k, HIST_F], hist[k, HIST_F + 1], hist[k, HIST_F + 2]
-
-
-@njit(cache=True)
 def couple_work(y, i, da, nx, ny, nz, fx, fy, fz, dt):
     """The work [J] over dt [s] of the couple da n x f (da [m], f [N]) on granule i's spin
     at state y."""
     tx, ty, tz = arm_torque_3d(da, nx, ny, nz, fx, fy, fz)
     return dt * (tx * y[i, WX] + ty * y[i, WY] + tz * y[i, WZ])
-
-
-@njit(cache=True)
-def mindlin_parted(hist, k, c):
-    """Contact k has parted: its trial history zero (a new touch starts unloaded, as
-    LAMMPS's); returns the spring energy it held [J] (lost)."""
-    a_old = hist[k, HIST_A]
-    e_old = spring_energy(c[COEF_KT] * a_old, hist[k, HIST_XI], hist[k, HIST_XI + 1], hist[k, HIST_XI + 2])
-    for col in range(N_MINDLIN):
-        hist[k, HIST_XI_END + col] = 0.0
-    return e_old
 
 
 @njit(cache=True, inline="always")  # per contact: arrays and scalars only

@@ -1,5 +1,5 @@
 """Mindlin's tangential law in the plane (docs/model.md section 3.16): the law of space
-(physics.mindlin through solver.granular3d's per-contact step, `mindlin_contact`) on the
+(physics.mindlin through solver.mindlin_history's per-contact step, `mindlin_contact`) on the
 plane's contacts, whose tangent is the normal turned by 90 degrees, t = (-n_y, n_x). The
 slip velocity v_t t (eq. 6, physics.contact.pair_rates and wall_rates) enters as a vector
 of space with no z component, so the history xi, the force and the frame update of eqs.
@@ -31,7 +31,7 @@ from granplate.physics.shock import shock_amplitude
 from granplate.setup.law_registry import MINDLIN
 from granplate.solver.drives import begin_pass, book_wall, wall_motion
 from granplate.solver.granular import ForceSums
-from granplate.solver.granular3d import mindlin_contact, mindlin_old_force, mindlin_parted
+from granplate.solver.mindlin_history import mindlin_contact, mindlin_old_force, mindlin_parted
 
 
 @njit(cache=True)

@@ -1,7 +1,7 @@
 """Mindlin's tangential law in the velocity-Verlet force pass in space (docs/model.md
 section 3.16): each pair's geometry and normal force, computed once by the pass's pair
 loop (solver.granular3d.pair_forces with its tangential step on), serve its tangential
-step too (physics.mindlin through solver.granular3d's per-contact step,
+step too (physics.mindlin through solver.mindlin_history's per-contact step,
 `mindlin_contact`); the walls' springs follow the normal pass (`wall_mindlin`). The serial
 pass (`normal_mindlin_forces`) and the threaded one (solver.blocks, one block's buffer
 each) run the same pair loop.
@@ -19,6 +19,7 @@ from granplate.physics.space import normal_rate_3d, wall_overlap_3d
 from granplate.setup.law_registry import MINDLIN
 from granplate.solver.drives import begin_pass, wall_motion
 from granplate.solver.granular import ForceSums
+from granplate.solver.mindlin_history import mindlin_contact, mindlin_parted
 from granplate.solver.granular3d import (
     VX,
     WX,
@@ -26,8 +27,6 @@ from granplate.solver.granular3d import (
     Y,
     Z,
     apply_friction_impulse,
-    mindlin_contact,
-    mindlin_parted,
     pair_forces,
     shock_loads,
     wall_forces,

@@ -44,9 +44,8 @@ from numba import njit
 
 from granplate.model.inputs import STATE_COLUMNS, BodyArrays, new_body_state, no_body
 from granplate.physics.contact import COEF_MU
-from granplate.physics.shock import shock_amplitude
 from granplate.solver import body as B
-from granplate.solver.body_mindlin import mindlin_forces as body_mindlin, step_forces as body_step_mindlin
+from granplate.solver.schemes import verlet_body as VB
 from granplate.solver.blocks import N_FPAR, N_SPAR, copy_rows, kick_blocks, kick_drift_blocks
 from granplate.solver.dimension import friction_flow, mindlin_force_pass, normal_forces, normal_forces_blocks
 from granplate.solver.drives import (
@@ -59,13 +58,10 @@ from granplate.solver.drives import (
     wall_powers,
     wall_shift_energy,
 )
-from granplate.solver.granular import commit_history
 from granplate.solver.kicks import kick, kick_drift
 from granplate.solver.ladder import step_to_output
-from granplate.solver.state import E_STATIC, PARTNER_PLATE
 
-#: the partner code of a granule's contact with the elastic body (the plate's).
-PARTNER_BODY = PARTNER_PLATE
+from granplate.solver.schemes.verlet_body import PARTNER_BODY as PARTNER_BODY
 
 NAME = "verlet"
 #: the state's leading columns that drift (x, y, theta in the plane; x, y, z in space),
@@ -153,24 +149,52 @@ def force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, sw):
 
 
 @njit(cache=True)
-def body_pass(y, sw, buf, q, qd, g, cfg, acc, fdamp):
-    """The elastic body's contact forces at (y, q, qd) into buffer buf (solver.body),
-    added to the granules' accelerations acc and damping forces fdamp; returns (their
-    stored energy, viscous power, plastic work, residual energy [J, W, J, J], largest
-    overlap / radius, its granule)."""
-    return B.contact_forces(y, q, qd, sw.body, buf, g.radius, g.mass, cfg.clip, acc, fdamp[buf], True)
-
-
-@njit(cache=True)
 def start(sw, t, st, g, cfg):
     """The body's contact energies at t = 0 (state y, modes at rest or as set): (the
     contacts' stored energy, the residual compliance's) [J]; (0, 0) without a body."""
-    if not B.has_body(sw.body):
-        return 0.0, 0.0
-    cur = int(sw.split[CURRENT])
-    e_pot, _, _, e_static, _, _ = body_pass(st.y, sw, cur, st.q, st.qd, g, cfg, st.k1, sw.fdamp)
-    commit_history(t, sw.body.hist, sw.body.coef)  # contacts start loaded at their overlaps at t = 0
-    return e_pot, e_static
+    return VB.start_energies(sw.body, st.y, int(sw.split[CURRENT]), st, g, cfg, st.k1, sw.fdamp, t)
+
+
+@njit(cache=True)
+def copy_state(y, st, sw):
+    """y = st.y (in blocks when the scratch has them), and the trial's modes from t_n's."""
+    if sw.spar.shape[0] > 0:
+        copy_rows(y, st.y)
+    else:
+        for i in range(y.shape[0]):
+            for c in range(y.shape[1]):
+                y[i, c] = st.y[i, c]
+    VB.modes_from(sw.body, st)
+
+
+@njit(cache=True)
+def first_forces(t, st, g, cfg, sw, cur):
+    """t_n's forces, loads and damping on the run's first step (st.k1 as `initialise` has
+    it; Mindlin's law with the committed histories), the body's too."""
+    force_pass(t, st.y, st.y, 0.0, g, cfg, st.k1, sw.fdamp[cur], sw.fload[cur], sw)
+    VB.first_forces(st.y, sw.body, cur, st, g, cfg, st.k1, sw.fdamp)
+    finish_pass(st.y, st.k1, g)
+
+
+@njit(cache=True)
+def book(w, wl, d_visc, fric, w_plastic, w_grav, w_drive, p_shock, p_visc, ovl, ovl_i, ovl_j):
+    """The step's works into w.dacc (load, damping, friction, plastic, gravity, drives
+    [J]), the end powers into w.pend (load, viscous [W]), the largest overlap into
+    w.ovl_new / w.ovl_who."""
+    w.dacc[0] = wl
+    w.dacc[1] = d_visc
+    w.dacc[2] = fric
+    w.dacc[3] = w_plastic
+    w.dacc[4] = w_grav
+    w.dacc[5] = w_drive
+    w.pend[0] = p_shock
+    w.pend[1] = p_visc
+    w.pend[2] = 0.0
+    w.pend[3] = 0.0
+    w.pend[4] = 0.0
+    w.ovl_new[0] = ovl
+    w.ovl_who[0] = ovl_i
+    w.ovl_who[1] = ovl_j
 
 
 @njit(cache=True)
@@ -182,39 +206,20 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
     over h between them (into sw.body.q, qd, committed by `commit`). Always converged, one
     force pass. Returns (True, 1, -1, stored energy at t + h [J], 0)."""
     y = w.ynew
-    if sw.spar.shape[0] > 0:
-        copy_rows(y, st.y)
-    else:
-        for i in range(y.shape[0]):
-            for c in range(y.shape[1]):
-                y[i, c] = st.y[i, c]
     b = sw.body
-    body = B.has_body(b)
-    if body:
-        for m in range(b.q.shape[0]):
-            b.q[m] = st.q[m]
-            b.qd[m] = st.qd[m]
+    copy_state(y, st, sw)
     cur = int(sw.split[CURRENT])
     nxt = 1 - cur
-    if sw.split[STARTED] == 0.0:  # the first step: t_n's forces, loads and damping (st.k1 as `initialise` has it)
-        force_pass(
-            t, st.y, st.y, 0.0, g, cfg, st.k1, sw.fdamp[cur], sw.fload[cur], sw
-        )  # (Mindlin: the committed forces)
-        if body:
-            body_pass(st.y, sw, cur, st.q, st.qd, g, cfg, st.k1, sw.fdamp)
-            body_mindlin(st.y, st.qd, b, cur, cur, 0.0, g.radius, g.mass, g.inertia, cfg.arm_shrink, st.k1)
-        finish_pass(st.y, st.k1, g)
+    if sw.split[STARTED] == 0.0:
+        first_forces(t, st, g, cfg, sw, cur)
     _, pd0 = wall_powers(g)  # the damping power at the driven walls' velocities at t_n
     hk = 0.5 * h
-    friction = has_friction(g) or (body and body_friction(b))
+    friction = has_friction(g) or VB.body_friction(b)
     forward = sw.split[FORWARD] != 0.0
     fric = 0.0
     if friction:
         fric = friction_flow(y, sw.split[OWED] + hk, g, cfg, forward)
-        if body:
-            fric += B.friction_flow(
-                y, b.qd, sw.split[OWED] + hk, b, cur, g.radius, g.mass, g.inertia, cfg.arm_shrink, forward
-            )
+        fric += VB.friction(y, b, cur, sw.split[OWED] + hk, g, cfg, forward)
     w_drive = drive_kick_work(y, st.k1, g, hk)
     w_grav = gravity_kick_work(y, st.k1, g, hk)
     w_piston, d_piston = piston_kick_drift(g, h)  # a force-driven wall: kicked and drifted as a granule
@@ -222,34 +227,13 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
         wl, wd = kick_drift_blocks(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, sw.spar)
     else:
         wl, wd = kick_drift(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, 0, y.shape[0])
-    if body:
-        if cfg.load_on_plate:
-            wl += B.load_kick(b.qd, b.load, shock_amplitude(t, cfg), hk)
-        wd += B.kick(b.qd, b.fmodal[cur], b.fdamp[cur], hk)
-        w_grav += B.turn_weighed(b.q, b.qd, b.omega, b.weight, h)  # its own weight too (model.body_weight)
-        B.predicted_velocity(b, hk, cur)
+    wl, wd, w_grav = VB.first_kick(b, t, h, cur, cfg, wl, wd, w_grav)
     # (Mindlin: the slip over h at the half step's velocities, y's)
     pr, e_t, lost_t = force_pass(t + h, y, w.ytmp, h, g, cfg, w.kend, sw.fdamp[nxt], sw.fload[nxt], sw)
-    fric += lost_t
-    e_pot = pr.e_pot + e_t
-    p_visc = pr.p_visc
-    w_plastic = pr.w_plastic
-    ovl = pr.ovl
-    ovl_i = pr.ovl_i
-    ovl_j = pr.ovl_j
-    if body:
-        ep_b, pv_b, wp_b, _, ovl_b, i_b = body_pass(w.ytmp, sw, nxt, b.q, b.qdp, g, cfg, w.kend, sw.fdamp)
-        e_bt, lost_bt = body_step_mindlin(
-            y, st.q, b.q, b, cur, nxt, h, g.radius, g.mass, g.inertia, cfg.arm_shrink, w.kend
-        )  # Mindlin's law on the body: the slip over h against the surface's motion
-        fric += lost_bt
-        e_pot += ep_b + e_bt
-        p_visc += pv_b
-        w_plastic += wp_b
-        if ovl_b > ovl:
-            ovl = ovl_b
-            ovl_i = i_b
-            ovl_j = PARTNER_BODY
+    e_pot, p_visc, w_plastic, fric, ovl, ovl_i, ovl_j = VB.end_pass(
+        y, w.ytmp, st, b, cur, nxt, h, g, cfg, w.kend, sw.fdamp,
+        pr.e_pot + e_t, pr.p_visc, pr.w_plastic, fric + lost_t, pr.ovl, pr.ovl_i, pr.ovl_j,
+    )  # fmt: skip
     finish_pass(w.ytmp, w.kend, g)  # gravity and the drives
     _, pd1 = wall_powers(g)
     w_drive += drive_kick_work(y, w.kend, g, hk)
@@ -261,33 +245,16 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
     wp2, dp2 = piston_kick(g, hk)
     w_piston += wp2
     d_piston += dp2
-    if body:
-        wd2 += B.kick(b.qd, b.fmodal[nxt], b.fdamp[nxt], hk)
-        if cfg.load_on_plate:
-            wl2 += B.load_kick(b.qd, b.load, shock_amplitude(t + h, cfg), hk)
+    wl2, wd2 = VB.second_kick(b, t, h, nxt, cfg, wl2, wd2)
     if friction and sw.split[LAND] != 0.0:  # an output time: the closing half step
         fric += friction_flow(y, hk, g, cfg, not forward)
-        if body:
-            fric += B.friction_flow(y, b.qd, hk, b, nxt, g.radius, g.mass, g.inertia, cfg.arm_shrink, not forward)
+        fric += VB.friction(y, b, nxt, hk, g, cfg, not forward)
     # the granules' drives' impulses; the walls' elastic work (exact) and their damping's (booked in D too)
     w_drive += hold_drives(t + h, y, g) + wall_shift_energy(st.y, y, g, cfg.clip, t, t + h) + hk * (pd0 + pd1)
     w_drive += w_piston  # a piston's force P: its kicks' work (its kinetic energy is E_g's)
-    w.dacc[0] = wl + wl2
-    w.dacc[1] = -(wd + wd2) + hk * (pd0 + pd1) + d_piston  # (a driven wall: the damping at the relative velocity)
-    w.dacc[2] = fric
-    w.dacc[3] = w_plastic
-    w.dacc[4] = w_grav
-    w.dacc[5] = w_drive
-    w.pend[3] = 0.0
-    w.pend[4] = 0.0
-    w.pend[0] = pr.p_shock
-    if body and cfg.load_on_plate:  # the body's load's power at t + h [W]
-        w.pend[0] += shock_amplitude(t + h, cfg) * np.dot(b.load, b.qd)
-    w.pend[1] = p_visc
-    w.pend[2] = 0.0
-    w.ovl_new[0] = ovl
-    w.ovl_who[0] = ovl_i
-    w.ovl_who[1] = ovl_j
+    d_visc = -(wd + wd2) + hk * (pd0 + pd1) + d_piston  # (a driven wall: the damping at the relative velocity)
+    p_shock = pr.p_shock + VB.load_power(b, t + h, cfg)  # the body's load's power at t + h [W]
+    book(w, wl + wl2, d_visc, fric, w_plastic, w_grav, w_drive, p_shock, p_visc, ovl, ovl_i, ovl_j)
     return True, 1, -1, e_pot, 0.0
 
 
@@ -296,15 +263,6 @@ def body_sensor_loads(sw, load):
     """The elastic body's share of the sensors' readings at t_n (load (ng,) [N]): half the
     normal force of each granule's contact with it, from the force pass of t_n's buffer."""
     B.sensor_loads(sw.body, int(sw.split[CURRENT]), load)
-
-
-@njit(cache=True)
-def body_friction(b) -> bool:
-    """Whether any granule's contact with the body has a friction coefficient."""
-    for i in range(b.coef.shape[0]):
-        if b.coef[i, COEF_MU] != 0.0:
-            return True
-    return False
 
 
 @njit(cache=True)
@@ -318,13 +276,7 @@ def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
     """The trial's end forces become t_n's (the buffers swap); the friction owed is half
     this step, or nothing when it landed on an output time; each friction pass made
     reverses the order of the next. Returns the plate work: 0 (no plate)."""
-    b = sw.body
-    if B.has_body(b):  # the modes and the residual's energy at t + h
-        for m in range(b.q.shape[0]):
-            st.q[m] = b.q[m]
-            st.qd[m] = b.qd[m]
-        st.clock[E_STATIC] = b.static[1 - int(sw.split[CURRENT])]
-        commit_history(t + h, b.hist, b.coef)
+    VB.commit_modes(sw.body, st, 1 - int(sw.split[CURRENT]), t + h)  # the modes and the residual's energy at t + h
     sw.split[CURRENT] = 1.0 - sw.split[CURRENT]
     sw.split[STARTED] = 1.0
     land = sw.split[LAND] != 0.0
