@@ -16,7 +16,7 @@ from granplate.cli import main
 from granplate.errors import YieldWarning
 from granplate.figures import run
 from granplate.figures.cli import skipped_notes
-from granplate.results.dataset import write
+from granplate.results.dataset import has_solid, write
 from granplate.setup import io as scenario_io
 
 from conftest import two_spheres
@@ -71,7 +71,7 @@ def _units_everywhere(fig):
 def test_the_drop_is_a_body_run(drop):
     """The run touched the body (a peak normal force of the order of 100 N), stressed and
     moved it, and kept its modes: what the figures below draw is not zero."""
-    assert run.has_body(drop) and drop.sizes["mode"] > 0
+    assert has_solid(drop) and drop.sizes["mode"] > 0
     force = drop.body_contact_normal_force.values
     assert 50.0 < force[:, 0].max() < 200.0 and np.all(force[:, 1] == 0.0)
     assert drop.max_von_mises.values.max() > 1e6 and drop.max_displacement.values.max() > 1e-7

@@ -289,12 +289,6 @@ def fig_granule_speeds(ds: xr.Dataset) -> Figure:
     return _finish(fig, ds, (ax,), "granule speeds")
 
 
-def has_body(ds: xr.Dataset) -> bool:
-    """Whether the result carries a 3D elastic body's stress and displacement history
-    (`results.dataset.has_solid`)."""
-    return has_solid(ds)
-
-
 def fig_body_stress(ds: xr.Dataset) -> Figure:
     """The 3D body's largest von Mises stress and its ball average [MPa] (a) and its
     largest displacement [um] (b), against time [ms]; a summary-only run's skipped blocks
@@ -438,16 +432,16 @@ def missing(name: str, ds: xr.Dataset) -> str | None:
     """Why the result cannot have figure `name` ("no plate", ...), None when it can."""
     if ds.sizes.get("time", 0) == 0:
         return "the run has no output times"
-    if name == "contact-forces" and has_body(ds):
+    if name == "contact-forces" and has_solid(ds):
         see = ": see body-contact-forces" if missing("body-contact-forces", ds) is None else ""
         return "the run's elastic body is a 3D solid" + see
     if name == "contact-forces" and (ds.sizes.get("contact", 0) == 0 or "contact_normal_force" not in ds):
         return "the run has no plate contacts"
-    if name == "stress-strain" and has_body(ds):
+    if name == "stress-strain" and has_solid(ds):
         return "eps_yy is a 2D plate strain; a 3D body has body-stress"
     if name == "stress-strain" and not ("max_von_mises" in ds and an.has_plate(ds)):
         return "the run has no plate"
-    if name in ("body-stress", "body-contact-forces") and not has_body(ds):
+    if name in ("body-stress", "body-contact-forces") and not has_solid(ds):
         return "the run has no 3D elastic body"
     if name == "body-contact-forces" and not an.has_granules(ds):
         return "the run has no granules"

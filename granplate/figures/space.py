@@ -302,10 +302,10 @@ def of_result(ds: xr.Dataset, time: float | None = None) -> Assembly3D:
     """The 3D assembly of a result at `time` [s] (None: the last output): centres and
     contact forces at the nearest output (module docstring)."""
     from granplate.figures.assembly import choose_time, table_time
-    from granplate.results.export import has_body
+    from granplate.results.dataset import has_solid
 
     s, solid = _result_scenario(ds)
-    if has_body(ds):
+    if has_solid(ds):
         k, body_note = body_snapshot(ds, time)
         ti, _ = choose_time(ds, float(ds["field_time"].values[k]))
         return _assembly_at(ds, s, ti, "the output nearest the body's snapshot", solid, body_drawing(ds, k, body_note))
@@ -317,11 +317,11 @@ def _result_scenario(ds: xr.Dataset) -> tuple[Scenario, dict]:
     """(the result's resolved scenario, its solid's drawing without the undeformed facets,
     {} without a body's fields)."""
     from granplate.results.dataset import scenario_of
-    from granplate.results.export import has_body
+    from granplate.results.dataset import has_solid
     from granplate.setup.geometry import resolve
 
     s = resolve(scenario_of(ds))
-    solid = {k: v for k, v in solid_drawing(s).items() if k != "solid_faces"} if has_body(ds) else {}
+    solid = {k: v for k, v in solid_drawing(s).items() if k != "solid_faces"} if has_solid(ds) else {}
     return s, solid
 
 
@@ -361,9 +361,9 @@ def _assembly_at(
 def frame_times(ds: xr.Dataset) -> np.ndarray:
     """The times [s] an animation of a 3D result can draw: the body's field snapshots
     (`field_time`) for a result with an elastic body's fields, else every output time."""
-    from granplate.results.export import has_body
+    from granplate.results.dataset import has_solid
 
-    return np.asarray(ds["field_time" if has_body(ds) else "time"].values, float)
+    return np.asarray(ds["field_time" if has_solid(ds) else "time"].values, float)
 
 
 def frames_of_result(ds: xr.Dataset, indices) -> list[Assembly3D]:

@@ -118,12 +118,6 @@ def sphere_cloud(ds: xr.Dataset, i: int) -> meshio.Mesh:
 BODY_CELLS = {20: "hexahedron20", 27: "hexahedron27", 10: "tetra10"}
 
 
-def has_body(ds: xr.Dataset) -> bool:
-    """Whether a result holds the fields of an elastic body (a 3D run's solid;
-    `results.dataset.has_solid`)."""
-    return has_solid(ds)
-
-
 def body_mesh(ds: xr.Dataset, k: int) -> meshio.Mesh:
     """The body at field snapshot k as a meshio Mesh (quadratic cells, displacement, von Mises)."""
     pts = np.column_stack([ds[f"body_node_{c}"].values for c in "xyz"]).astype(float)
@@ -278,4 +272,4 @@ VTK_KINDS: dict[str, VtkKind] = {
 
 def vtk_kind(ds: xr.Dataset) -> VtkKind:
     """How result `ds` is written to VTK (`VTK_KINDS`)."""
-    return VTK_KINDS["body" if has_body(ds) else dimension_spec(ds).name]
+    return VTK_KINDS["body" if has_solid(ds) else dimension_spec(ds).name]
