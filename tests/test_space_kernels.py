@@ -21,7 +21,7 @@ from granplate.physics.space import (
     pair_overlap_3d,
     slip_velocity_3d,
 )
-from granplate.solver import granular as plane, granular3d as space
+from granplate.solver import friction_space, granular as plane, granular3d as space
 
 
 def planar_state():
@@ -97,7 +97,7 @@ def test_friction_flow_in_space_relaxes_as_in_the_plane():
     m, g, y = planar_state()
     g3, y3 = lifted(g, y)
     w2 = plane.friction_flow(y, 2e-7, g, m.config, True)
-    w3 = space.friction_flow(y3, 2e-7, g3, m.config._replace(dimension=3), True)
+    w3 = friction_space.friction_flow(y3, 2e-7, g3, m.config._replace(dimension=3), True)
     assert w2 > 0.0 and w3 == pytest.approx(w2, rel=1e-10)
     np.testing.assert_allclose(y3[:, 3:5], y[:, 3:5], rtol=0, atol=1e-12)
     np.testing.assert_allclose(y3[:, 8], y[:, 5], rtol=0, atol=1e-9)

@@ -33,7 +33,10 @@ class Dimension:
     columns: positions, angles, velocities, spins); depth_energies: the Dataset's kinetic
     energies of the translation out of the plane [J] (part of E_granular); arrays: the class
     name of the loop's granular arrays (model.inputs); spin: a granule's scenario `omega`
-    [rad/s] from its spin components (a number in the plane, a vector in space).
+    [rad/s] from its spin components (a number in the plane, a vector in space); solids:
+    whether a run may hold an elastic solid in the loop's arrays (model.inputs.BodyArrays;
+    the plane's plate has its own), so that a run without one shares their compiled loop
+    (one compile serves both) rather than a loop of its own without the body's code.
     """
 
     n: int
@@ -46,6 +49,7 @@ class Dimension:
     depth_energies: tuple[str, ...]
     arrays: str
     spin: Callable[[Sequence[float]], float | tuple[float, ...]]
+    solids: bool
 
     @property
     def state_variables(self) -> tuple[str, ...]:
@@ -78,6 +82,7 @@ PLANE = Dimension(
     depth_energies=(),
     arrays="Granular",
     spin=operator.itemgetter(0),
+    solids=False,
 )
 
 SPACE = Dimension(
@@ -91,6 +96,7 @@ SPACE = Dimension(
     depth_energies=("KE_depth",),
     arrays="Granular3",
     spin=tuple,
+    solids=True,
 )
 
 #: the dimensions by their number

@@ -55,6 +55,15 @@ def contact_radius(r_star: float, delta: float) -> float:
 
 
 @njit(cache=True)
+def tangential_damping(x_t: float, c: float, delta: float) -> float:
+    """The tangential damping coefficient eta_t = x_t c delta^(1/4) [N s/m]: x_t times eq.
+    (3)'s normal damping coefficient c [N s/m^(5/4)] at overlap delta [m] (0 where x_t = 0)."""
+    if x_t == 0.0:
+        return 0.0
+    return x_t * c * math.sqrt(math.sqrt(delta))
+
+
+@njit(cache=True)
 def tangential_stiffness(k_per_radius: float, a: float) -> float:
     """k_t = 8 G* a [N/m] from the coefficient 8 G* [Pa] and the contact radius a [m]."""
     return k_per_radius * a

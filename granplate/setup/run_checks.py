@@ -260,7 +260,11 @@ def _check_granular_scheme(s: Scenario) -> None:
         raise ScenarioError(
             "solver.scheme",
             sv.scheme,
-            'integrates the granules alone (velocity Verlet): a scenario with a [plate] needs "implicit" or "paper"',
+            "velocity Verlet does not drive the plane's plate: the plate's contacts (rigid layers and face "
+            "patches, docs/model.md sections 3.4-3.5) move its modes inside the paper's and the implicit "
+            "scheme's steps only (sections 6.1-6.2), while velocity Verlet's kicks take the granules alone "
+            "(section 6.5; in space it drives the elastic solid, section 3.9): "
+            'set solver.scheme = "implicit" or "paper"',
         )
     if sv.granular_friction != "split":
         raise ScenarioError(

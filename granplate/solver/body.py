@@ -20,7 +20,7 @@ is N n with N the law's whole force at (delta, its rate) (damping included), plu
 static force's pull along the deformed surface's tilt and the residual's moving weights
 (the exact gradient of the contact's potential); the body gets -N n over the patch, on the
 modes Phi^T (w (x) -N n). Friction is split off as for
-granule pairs (solver.granular3d.friction_flow): an exact impulse along the slip, against
+granule pairs (solver.friction_space.friction_flow): an exact impulse along the slip, against
 the granule's and the body's mobility along it, booked as the kinetic energy it removes.
 
 The pieces have modules of their own, their names importable from here too: where a
@@ -83,9 +83,9 @@ REACH = 2.0
 
 def by_body(b, with_body, body_args, without, plain_args):
     """with_body(*body_args) in a run with an elastic body, without(*plain_args) in one
-    without (b of type model.inputs.NoBodyArrays): chosen when the loop compiles, so that
-    a run without a body never compiles the body's code (it doubled the loop's compile
-    time)."""
+    without: chosen when the loop compiles where b is of type model.inputs.NoBodyArrays (a
+    run that never compiles the body's code), else when it runs (`has_body`: a run without a
+    body that shares the loop compiled for the runs with one, model.inputs.no_body)."""
     raise NotImplementedError("compiled use only")
 
 
@@ -93,7 +93,13 @@ def by_body(b, with_body, body_args, without, plain_args):
 def _by_body(b, with_body, body_args, without, plain_args):
     if getattr(b, "instance_class", None) is NoBodyArrays:
         return lambda b, with_body, body_args, without, plain_args: without(*plain_args)
-    return lambda b, with_body, body_args, without, plain_args: with_body(*body_args)
+
+    def either(b, with_body, body_args, without, plain_args):
+        if has_body(b):
+            return with_body(*body_args)
+        return without(*plain_args)
+
+    return either
 
 
 @njit(cache=True)

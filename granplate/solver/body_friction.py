@@ -1,5 +1,5 @@
 """Friction at an elastic body's contacts, split off as for granule pairs
-(solver.granular3d.friction_flow; docs/model.md section 3.9): an exact impulse along the
+(solver.friction_space.friction_flow; docs/model.md section 3.9): an exact impulse along the
 slip, against the granule's and the body's mobility along it, booked as the kinetic energy
 it removes.
 """
@@ -16,7 +16,8 @@ from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm
 from granplate.physics.space import friction_along_slip, slip_velocity_3d
 from granplate.solver.body_surface import spread, surface_velocity
 from granplate.solver.granular import friction_impulse
-from granplate.solver.granular3d import VX, WX, apply_friction_impulse
+from granplate.solver.friction_space import apply_friction_impulse
+from granplate.solver.granular3d import VX, WX
 
 
 @njit(cache=True)

@@ -35,7 +35,7 @@ from granplate.solver import body as B
 from granplate.solver.body_surface import surface_velocity
 from granplate.solver.granular import commit_history
 from granplate.solver.granular3d import VX
-from granplate.solver.state import PARTNER_PLATE
+from granplate.solver.state import PARTNER_BODY
 from granplate.solver.plate_modal import (
     MC_IF0,
     MC_IF1,
@@ -63,8 +63,6 @@ RELAX_MIN, RELAX_MAX = 0.02, 2.0
 #: columns of BodyStep.sums: the end pass's stored energy [J], viscous power [W], plastic
 #: work [J], largest overlap / radius, its granule
 S_EPOT, S_PVISC, S_PLASTIC, S_OVL, S_OVL_I = range(5)
-#: the partner code of a granule's contact with the elastic body (the plate's)
-PARTNER_BODY = PARTNER_PLATE
 
 
 class BodyStep(NamedTuple):

@@ -25,7 +25,8 @@ from granplate.physics.mindlin import contact_radius
 from granplate.physics.space import slip_velocity_3d
 from granplate.setup.law_registry import MINDLIN
 from granplate.solver.body_surface import spread, surface_velocity
-from granplate.solver.granular3d import VX, WX, apply_friction_impulse
+from granplate.solver.friction_space import apply_friction_impulse
+from granplate.solver.granular3d import VX, WX
 from granplate.solver.mindlin_history import mindlin_contact, mindlin_parted
 
 

@@ -20,13 +20,22 @@ from numba.extending import overload
 
 from granplate.model import inputs
 from granplate.model.dimension import DIMENSIONS
-from granplate.solver import blocks, granular as plane, granular3d as space, mindlin_plane, mindlin_space
+from granplate.solver import (
+    blocks,
+    friction_space,
+    granular as plane,
+    granular3d as space,
+    mindlin_plane,
+    mindlin_space,
+)
 
 #: the dimension's name (model.dimension) by the class of its granular arrays
 _ARRAYS = {getattr(inputs, d.arrays): d.name for d in DIMENSIONS.values()}
 
 #: each dimension's module of granular kernels, by the dimension's name
 _MODULES = {"plane": plane, "space": space}
+#: each dimension's split friction (`friction_flow`), by the dimension's name
+_FRICTION = {"plane": plane, "space": friction_space}
 
 
 def _dimension_of(g) -> str | None:
@@ -104,7 +113,7 @@ def _granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, sp
 
 @overload(friction_flow, inline="always")
 def _friction_flow(y, dt, g, cfg, forward):
-    m = _module_of(g)
+    m = _FRICTION.get(_dimension_of(g))
     if m is not None:
         fn = m.friction_flow
         return lambda y, dt, g, cfg, forward: fn(y, dt, g, cfg, forward)

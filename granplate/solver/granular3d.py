@@ -38,7 +38,7 @@ from granplate.physics.space import (
     wall_overlap_3d,
 )
 from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_motion
-from granplate.solver.granular import ForceSums, friction_impulse, slip_relaxation_rate
+from granplate.solver.granular import ForceSums, slip_relaxation_rate
 from granplate.solver.mindlin_history import mindlin_contact, mindlin_old_force, mindlin_parted
 from granplate.solver.mindlin_rk4 import space_stages
 
@@ -100,14 +100,9 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
     listed pair and wall contact (physics.laws, with each contact's history) and, unless
     split, their friction on the slip vector (physics.space). As solver.granular.granular_rhs
     (record: the contacts' end overlaps into HIST_END); returns its ForceSums."""
-    ng = y.shape[0]
-    for i in range(ng):
-        for c in range(3):
-            dy[i, c] = y[i, 3 + c]
-        for c in range(3, 9):
-            dy[i, c] = 0.0
+    begin_derivative(y, dy)
     begin_pass(t, g)
-    p_shock = 0.0
+    p_shock = 0.0 if cfg.load_on_plate else shock_derivative(t, y, g, cfg, dy)
     p_visc = 0.0
     p_fric = 0.0
     e_pot = 0.0
@@ -116,16 +111,6 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
     ovl_i = -1
     ovl_j = -1
     w_plastic = 0.0
-    if not cfg.load_on_plate:
-        amp = shock_amplitude(t, cfg)
-        if amp != 0.0:
-            for i in range(ng):
-                for c in range(3):
-                    f = amp * g.shock_force[i, c]
-                    tq = amp * g.shock_torque[i, c]
-                    dy[i, VX + c] += f
-                    dy[i, WX + c] += tq
-                    p_shock += f * y[i, VX + c] + tq * y[i, WX + c]
     half_shrink = 0.5 * cfg.arm_shrink
     for p in range(g.pair_ij.shape[0]):
         i = g.pair_ij[p, 0]
@@ -197,6 +182,59 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
                 1.0 / g.mass[i] + 1.0 / g.mass[j] + ai * ai / g.inertia[i] + aj * aj / g.inertia[j],
             ),
         )
+    p_visc, e_pot, w_plastic, p_fric, rate, ovl, ovl_i, ovl_j = wall_derivative(
+        y, g, cfg, dy, split, record, p_visc, e_pot, w_plastic, p_fric, rate, ovl, ovl_i, ovl_j
+    )
+    if cfg.mindlin_stages:  # Mindlin's law in RK4's stages (solver.mindlin_rk4)
+        p_fric, e_pot, rate = space_stages(y, dy, g, cfg, record, p_fric, e_pot, rate)
+    accelerations(dy, g)
+    p_drive, p_grav = finish_pass(y, dy, g)
+    return ForceSums(p_shock, p_visc, p_fric, e_pot, rate, ovl, ovl_i, ovl_j, 0.0, w_plastic, p_drive, p_grav)
+
+
+@njit(cache=True, inline="always")  # granular_rhs in steps, inlined: no call, no compile of its own
+def begin_derivative(y, dy):
+    """dy's position columns the velocities of y (ng, 9), its force and torque columns zero."""
+    for i in range(y.shape[0]):
+        for c in range(3):
+            dy[i, c] = y[i, 3 + c]
+        for c in range(3, 9):
+            dy[i, c] = 0.0
+
+
+@njit(cache=True, inline="always")  # granular_rhs in steps, inlined: no call, no compile of its own
+def shock_derivative(t, y, g, cfg, dy) -> float:
+    """The shock's forces and torques on the loaded granules at t [s] added to dy's force
+    and torque columns; returns its power [W]."""
+    p_shock = 0.0
+    amp = shock_amplitude(t, cfg)
+    if amp != 0.0:
+        for i in range(y.shape[0]):
+            for c in range(3):
+                f = amp * g.shock_force[i, c]
+                tq = amp * g.shock_torque[i, c]
+                dy[i, VX + c] += f
+                dy[i, WX + c] += tq
+                p_shock += f * y[i, VX + c] + tq * y[i, WX + c]
+    return p_shock
+
+
+@njit(cache=True, inline="always")  # granular_rhs in steps, inlined: no call, no compile of its own
+def accelerations(dy, g):
+    """dy's force and torque columns [N, N m] divided by the masses and inertias."""
+    for i in range(dy.shape[0]):
+        inv_m = 1.0 / g.mass[i]
+        inv_i = 1.0 / g.inertia[i]
+        for c in range(3):
+            dy[i, VX + c] *= inv_m
+            dy[i, WX + c] *= inv_i
+
+
+@njit(cache=True, inline="always")  # granular_rhs in steps, inlined: no call, no compile of its own
+def wall_derivative(y, g, cfg, dy, split, record, p_visc, e_pot, w_plastic, p_fric, rate, ovl, ovl_i, ovl_j):
+    """`granular_rhs`'s wall contacts: their normal forces and, unless split, their
+    friction into dy, their sums added to those given and the largest overlap kept;
+    returns (p_visc, e_pot, w_plastic, p_fric, rate, ovl, ovl_i, ovl_j)."""
     for w in range(g.wall_i.shape[0]):
         i = g.wall_i[w]
         ri = g.radius[i]
@@ -235,98 +273,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         add_friction(dy, i, a, nx, ny, nz, fx, fy, fz, 1.0)
         p_fric += f_mag * speed
         rate = max(rate, slip_relaxation_rate(n, speed, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + a * a / g.inertia[i]))
-    if cfg.mindlin_stages:  # Mindlin's law in RK4's stages (solver.mindlin_rk4)
-        p_fric, e_pot, rate = space_stages(y, dy, g, cfg, record, p_fric, e_pot, rate)
-    for i in range(ng):
-        inv_m = 1.0 / g.mass[i]
-        inv_i = 1.0 / g.inertia[i]
-        for c in range(3):
-            dy[i, VX + c] *= inv_m
-            dy[i, WX + c] *= inv_i
-    p_drive, p_grav = finish_pass(y, dy, g)
-    return ForceSums(p_shock, p_visc, p_fric, e_pot, rate, ovl, ovl_i, ovl_j, 0.0, w_plastic, p_drive, p_grav)
-
-
-@njit(cache=True)
-def apply_friction_impulse(y, i, a, inv_m, inv_i, nx, ny, nz, px, py, pz, sign):
-    """The impulse sign * P (px, py, pz the friction impulse on the first body [N s]) on
-    granule i: its velocity by sign P / m, its spin by a n x P / I."""
-    y[i, VX] += sign * px * inv_m
-    y[i, VY] += sign * py * inv_m
-    y[i, VZ] += sign * pz * inv_m
-    tx, ty, tz = arm_torque_3d(a, nx, ny, nz, px, py, pz)
-    y[i, WX] += tx * inv_i
-    y[i, WY] += ty * inv_i
-    y[i, WZ] += tz * inv_i
-
-
-@njit(cache=True)
-def friction_flow(y, dt, g, cfg, forward):
-    """Friction alone at every pair and wall contact over dt [s], one contact after the
-    other (as solver.granular.friction_flow): the slip speed |v_s| relaxes exactly along
-    its own direction (a sphere's tangential mobility is isotropic, so an impulse along
-    -v_s changes v_s along v_s only, at the rate m_t^-1 = 1/m_i + 1/m_j + a_i^2/I_i +
-    a_j^2/I_j). Returns the energy dissipated [J]."""
-    n_p = g.pair_ij.shape[0]
-    n_w = g.wall_i.shape[0]
-    half_shrink = 0.5 * cfg.arm_shrink
-    work = 0.0
-    for k in range(n_p + n_w):
-        q = k if forward else n_p + n_w - 1 - k
-        if q < n_p:
-            c = g.pair_coef[q]
-            if c[COEF_MU] == 0.0:
-                continue
-            i = g.pair_ij[q, 0]
-            j = g.pair_ij[q, 1]
-            ri = g.radius[i]
-            rj = g.radius[j]
-            delta, nx, ny, nz = pair_contact_3d(y[i, X], y[i, Y], y[i, Z], ri, y[j, X], y[j, Y], y[j, Z], rj)
-            if delta <= 0.0:
-                continue
-            ai = contact_arm(ri, delta, half_shrink)
-            aj = contact_arm(rj, delta, half_shrink)
-            ddot, vsx, vsy, vsz = pair_slip(y, i, j, nx, ny, nz, ai, aj)
-            speed = _speed(vsx, vsy, vsz)
-            if speed == 0.0:
-                continue
-            n = normal_law_force(delta, ddot, c, g.pair_hist[q, HIST_MAX], g.pair_hist[q, HIST_RATE], cfg.clip)
-            inv_mi = 1.0 / g.mass[i]
-            inv_mj = 1.0 / g.mass[j]
-            inv_ii = 1.0 / g.inertia[i]
-            inv_ij = 1.0 / g.inertia[j]
-            imp, dw = friction_impulse(
-                speed, n, c[COEF_MU], c[COEF_KS], inv_mi + inv_mj + ai * ai * inv_ii + aj * aj * inv_ij, dt
-            )
-            px, py, pz = friction_along_slip(imp, speed, vsx, vsy, vsz)
-            apply_friction_impulse(y, i, ai, inv_mi, inv_ii, nx, ny, nz, px, py, pz, 1.0)
-            apply_friction_impulse(y, j, aj, inv_mj, inv_ij, nx, ny, nz, px, py, pz, -1.0)
-            work += dw
-        else:
-            w = q - n_p
-            i = g.wall_i[w]
-            ri = g.radius[i]
-            nx = g.wall_geo[w, 0]
-            ny = g.wall_geo[w, 1]
-            nz = g.wall_geo[w, 2]
-            shift, vn, _ = wall_motion(g, w)  # (a driven wall where the last force pass put it)
-            delta = wall_overlap_3d(y[i, X], y[i, Y], y[i, Z], ri, nx, ny, nz, g.wall_geo[w, 3] + shift)
-            c = g.wall_coef[w]
-            if delta <= 0.0 or c[COEF_MU] == 0.0:
-                continue
-            a = contact_arm(ri, delta, cfg.arm_shrink)
-            ddot, vsx, vsy, vsz = wall_slip(y, i, nx, ny, nz, a)
-            speed = _speed(vsx, vsy, vsz)
-            if speed == 0.0:
-                continue
-            n = normal_law_force(delta, ddot - vn, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
-            inv_m = 1.0 / g.mass[i]
-            inv_i = 1.0 / g.inertia[i]
-            imp, dw = friction_impulse(speed, n, c[COEF_MU], c[COEF_KS], inv_m + a * a * inv_i, dt)
-            px, py, pz = friction_along_slip(imp, speed, vsx, vsy, vsz)
-            apply_friction_impulse(y, i, a, inv_m, inv_i, nx, ny, nz, px, py, pz, 1.0)
-            work += dw
-    return work
+    return p_visc, e_pot, w_plastic, p_fric, rate, ovl, ovl_i, ovl_j
 
 
 @njit(cache=True)

@@ -8,13 +8,25 @@ solver.mindlin_space) and of the elastic body (solver.body_mindlin) call these.
 
 from __future__ import annotations
 
-import math
 
 from numba import njit
 
 from granplate.model.inputs import HIST_A, HIST_A_END, HIST_F, HIST_F_END, HIST_XI, HIST_XI_END, N_MINDLIN
 from granplate.physics.contact import COEF_C, COEF_KT, COEF_MUT, COEF_XT
-from granplate.physics.mindlin import mindlin_step, spring_energy
+from granplate.physics.mindlin import mindlin_step, spring_energy, tangential_damping
+
+
+@njit(cache=True)
+def record_trial(hist, k, xx, xy, xz, a, fx, fy, fz) -> None:
+    """Contact k's trial history: its tangential displacement xi (3) [m] into HIST_XI_END,
+    its contact radius a [m] into HIST_A_END and its force F_t (3) [N] into HIST_F_END."""
+    hist[k, HIST_XI_END] = xx
+    hist[k, HIST_XI_END + 1] = xy
+    hist[k, HIST_XI_END + 2] = xz
+    hist[k, HIST_A_END] = a
+    hist[k, HIST_F_END] = fx
+    hist[k, HIST_F_END + 1] = fy
+    hist[k, HIST_F_END + 2] = fz
 
 
 @njit(cache=True)
@@ -31,9 +43,7 @@ def mindlin_contact(hist, k, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, n_abs):
             hist[k, HIST_XI_END + col] = hist[k, HIST_XI + col]
         e_t = spring_energy(c[COEF_KT] * hist[k, HIST_A], hist[k, HIST_XI], hist[k, HIST_XI + 1], hist[k, HIST_XI + 2])
         return hist[k, HIST_F], hist[k, HIST_F + 1], hist[k, HIST_F + 2], e_t, 0.0
-    damp = 0.0
-    if c[COEF_XT] != 0.0:  # eta_t = x_t c delta^(1/4)
-        damp = c[COEF_XT] * c[COEF_C] * math.sqrt(math.sqrt(delta))
+    damp = tangential_damping(c[COEF_XT], c[COEF_C], delta)
     fx, fy, fz, xx, xy, xz, e_t, lost = mindlin_step(
         hist[k, HIST_XI],
         hist[k, HIST_XI + 1],
@@ -54,13 +64,7 @@ def mindlin_contact(hist, k, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, n_abs):
         hist[k, HIST_F + 1],
         hist[k, HIST_F + 2],
     )
-    hist[k, HIST_XI_END] = xx
-    hist[k, HIST_XI_END + 1] = xy
-    hist[k, HIST_XI_END + 2] = xz
-    hist[k, HIST_A_END] = a
-    hist[k, HIST_F_END] = fx
-    hist[k, HIST_F_END + 1] = fy
-    hist[k, HIST_F_END + 2] = fz
+    record_trial(hist, k, xx, xy, xz, a, fx, fy, fz)
     if h == 0.0:
         for col in range(3):
             hist[k, HIST_F + col] = hist[k, HIST_F_END + col]

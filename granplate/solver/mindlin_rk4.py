@@ -46,7 +46,8 @@ from granplate.physics.contact import (
     wall_rates,
 )
 from granplate.physics.laws import normal_law_force
-from granplate.physics.mindlin import contact_radius, spring_energy, stage_force
+from granplate.physics.mindlin import contact_radius, spring_energy, stage_force, tangential_damping
+from granplate.solver.mindlin_history import record_trial
 from granplate.physics.space import arm_torque_3d, normal_rate_3d, pair_contact_3d, slip_velocity_3d, wall_overlap_3d
 from granplate.solver.drives import wall_motion
 
@@ -67,9 +68,7 @@ def stage_contact(hist, k, c, a, delta, nx, ny, nz, vx, vy, vz, n_abs, record):
         ix = hist[k, HIST_F_END]
         iy = hist[k, HIST_F_END + 1]
         iz = hist[k, HIST_F_END + 2]
-    damp = 0.0
-    if c[COEF_XT] != 0.0:  # eta_t = x_t c delta^(1/4)
-        damp = c[COEF_XT] * c[COEF_C] * math.sqrt(math.sqrt(delta))
+    damp = tangential_damping(c[COEF_XT], c[COEF_C], delta)
     fx, fy, fz, xx, xy, xz, e = stage_force(
         hist[k, HIST_XI],
         hist[k, HIST_XI + 1],
@@ -90,13 +89,7 @@ def stage_contact(hist, k, c, a, delta, nx, ny, nz, vx, vy, vz, n_abs, record):
         damp,
     )
     if record:
-        hist[k, HIST_XI_END] = xx
-        hist[k, HIST_XI_END + 1] = xy
-        hist[k, HIST_XI_END + 2] = xz
-        hist[k, HIST_A_END] = a
-        hist[k, HIST_F_END] = fx
-        hist[k, HIST_F_END + 1] = fy
-        hist[k, HIST_F_END + 2] = fz
+        record_trial(hist, k, xx, xy, xz, a, fx, fy, fz)
     elif staged:
         hist[k, HIST_F_END] = vx
         hist[k, HIST_F_END + 1] = vy

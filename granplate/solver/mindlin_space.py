@@ -20,13 +20,13 @@ from granplate.setup.law_registry import MINDLIN
 from granplate.solver.drives import begin_pass, wall_motion
 from granplate.solver.granular import ForceSums
 from granplate.solver.mindlin_history import mindlin_contact, mindlin_parted
+from granplate.solver.friction_space import apply_friction_impulse
 from granplate.solver.granular3d import (
     VX,
     WX,
     X,
     Y,
     Z,
-    apply_friction_impulse,
     pair_forces,
     shock_loads,
     wall_forces,

@@ -27,7 +27,7 @@ import numpy as np  # noqa: E402
 from numba import njit, prange  # noqa: E402
 
 from granplate.physics.contact import COEF_A, COEF_C, COEF_KT, COEF_MUT, COEF_XT, normal_force
-from granplate.physics.mindlin import contact_radius, mindlin_force, rescale_history, rotate_history
+from granplate.physics.mindlin import contact_radius, mindlin_force, rescale_history, rotate_history, tangential_damping
 from granplate.physics.space import arm_torque_3d, normal_rate_3d, pair_contact_3d, slip_velocity_3d
 
 #: Columns of a history row: s xi (3) [m], the contact radius a of the last step [m].
@@ -52,7 +52,7 @@ def _tangential(hist, p, c, s, sq, a, delta, nx, ny, nz, vsx, vsy, vsz, dt, n_ab
     xx, xy, xz = rescale_history(xx, xy, xz, a, hist[p, H_A])
     f_crit = c[COEF_MUT] * n_abs
     xx, xy, xz = rotate_history(xx, xy, xz, nx, ny, nz, k, f_crit)
-    eta = c[COEF_XT] * sq * c[COEF_C] * math.sqrt(math.sqrt(delta)) if dt > 0.0 else 0.0
+    eta = sq * tangential_damping(c[COEF_XT], c[COEF_C], delta) if dt > 0.0 else 0.0
     fx, fy, fz, xx, xy, xz = mindlin_force(
         xx + dt * vsx, xy + dt * vsy, xz + dt * vsz, k, f_crit, -eta * vsx, -eta * vsy, -eta * vsz
     )

@@ -63,6 +63,8 @@ OK, ERR_NAN, ERR_ENERGY, ERR_NOCONV, ERR_BUFFER, PAUSED = 0, 1, 2, 3, 4, 5
 REBUILD, ERR_OVERLAP, ERR_PLATE_REACH, ERR_JUMP, ERR_MISSED, NEW_PLATE = 6, 7, 8, 9, 10, 11
 #: partner code of a plate contact in Work.ovl_with (a granule j >= 0, wall w: -1 - w)
 PARTNER_PLATE = -(1 << 40)
+#: the partner code of a granule's contact with the elastic body in space (the plate's)
+PARTNER_BODY = PARTNER_PLATE
 
 #: time steps live on a ladder h_l = dt_max 2^(-l/4), l < N_LEVELS; slot N_LEVELS of the
 #: per-level arrays holds an odd step (one that lands on an output time).

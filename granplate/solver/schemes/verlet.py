@@ -61,7 +61,7 @@ from granplate.solver.drives import (
 from granplate.solver.kicks import kick, kick_drift
 from granplate.solver.ladder import step_to_output
 
-from granplate.solver.schemes.verlet_body import PARTNER_BODY as PARTNER_BODY
+from granplate.solver.state import PARTNER_BODY as PARTNER_BODY
 
 NAME = "verlet"
 #: the state's leading columns that drift (x, y, theta in the plane; x, y, z in space),
