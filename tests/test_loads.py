@@ -35,6 +35,24 @@ def test_every_kind_has_its_module_and_its_rules():
     assert all(kind.name == name for name, kind in loads.KINDS.items())
 
 
+def test_a_new_kind_is_its_module_and_one_rules_entry(monkeypatch):
+    """A kind registered once (an entry of LOAD_RULES) is read from the module of its name,
+    and a module whose KIND bears another name is refused, naming both."""
+    import sys
+    import types
+
+    from granplate.setup.load_checks import LoadRules
+
+    module = types.ModuleType("granplate.model.loads.pulse")
+    module.KIND = loads.KINDS["none"]._replace(name="pulse")
+    monkeypatch.setitem(sys.modules, "granplate.model.loads.pulse", module)
+    monkeypatch.setitem(LOAD_RULES, "pulse", LoadRules((2, 3), lambda s: None))
+    assert loads._kinds()["pulse"] is module.KIND
+    module.KIND = loads.KINDS["none"]
+    with pytest.raises(ImportError, match="pulse.KIND is named 'none'"):
+        loads._kinds()
+
+
 def test_line_load_pushes_column_one_with_the_closed_form_resultants():
     """A line load pushes the leftmost granules, each with int q dy and its moment over its
     diameter (paper eq. 12): a granule centred on the load's middle takes 2 L/pi sin(pi R/L) and no torque."""

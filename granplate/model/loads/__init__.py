@@ -6,17 +6,20 @@ load on the plate), and which granules it pushes with what share of the amplitud
 (forces per unit amplitude along x, y, z and torques about them). The time amplitude is
 physics.shock.shock_amplitude, the one call every kernel makes.
 
-Adding a kind: a module here with a `KIND = LoadKind(...)`, one entry in `KINDS`, and its
-field rules and dimensions in setup/load_checks.py.
+Adding a kind: a module here named as the kind, with a `KIND = LoadKind(...)`, and one
+entry in setup.load_checks.LOAD_RULES (its dimensions and its field rules), the one
+registry: `KINDS` is read from it.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from importlib import import_module
 from typing import NamedTuple
 
 import numpy as np
 
+from granplate.setup.load_checks import LOAD_RULES
 from granplate.setup.scenario import Load, Scenario
 
 
@@ -78,9 +81,15 @@ def labelled(s: Scenario) -> np.ndarray | None:
 
 
 def _kinds() -> dict[str, LoadKind]:
-    from granplate.model.loads import force, line, none
-
-    return {k.name: k for k in (line.KIND, force.KIND, none.KIND)}
+    """Every kind that setup.load_checks.LOAD_RULES registers, from the module of its name
+    here (model.loads.NAME's KIND): the one registry of load kinds."""
+    kinds = {}
+    for name in LOAD_RULES:
+        kind = import_module(f"{__name__}.{name}").KIND
+        if kind.name != name:
+            raise ImportError(f"{__name__}.{name}.KIND is named {kind.name!r}: a load kind's module bears its name")
+        kinds[name] = kind
+    return kinds
 
 
 KINDS: dict[str, LoadKind] = _kinds()
