@@ -53,6 +53,35 @@ def sigint_ignored() -> Iterator[None]:
         signal.signal(signal.SIGINT, previous)
 
 
+def numba_threads_from_environment() -> None:
+    """numba's configuration read again from the environment (its thread count,
+    NUMBA_NUM_THREADS), where its threads have not started. A Dask worker's environment
+    (LocalCluster's `env`) is set after the worker process imported numba, whose thread
+    count then stays the machine's until its next compile reads the environment again, and
+    that compile fails ("Cannot set NUMBA_NUM_THREADS to a different value once the
+    threads have been launched") where anything started the threads with the old count."""
+    import numba
+
+    try:
+        numba.config.reload_config()
+    except RuntimeError:  # the threads run already: the next compile reports it, naming the variable
+        pass
+
+
+def _numba_threads_plugin():
+    """A Dask worker plugin that runs `numba_threads_from_environment` on every worker as
+    it starts (and on each worker a nanny restarts)."""
+    from distributed import WorkerPlugin
+
+    class NumbaThreads(WorkerPlugin):
+        name = "granplate-numba-threads"
+
+        def setup(self, worker) -> None:
+            numba_threads_from_environment()
+
+    return NumbaThreads()
+
+
 @contextmanager
 def dask_client(workers: int | None = None, scheduler: str | None = None) -> Iterator:
     """A Dask Client: of the cluster at scheduler's address, else of a new LocalCluster of
@@ -85,6 +114,7 @@ def dask_client(workers: int | None = None, scheduler: str | None = None) -> Ite
         )
     try:
         with Client(cluster) as client:
+            client.register_plugin(_numba_threads_plugin())
             yield client
     finally:
         cluster.close()
