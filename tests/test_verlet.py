@@ -222,11 +222,12 @@ def test_guards_hold_under_verlet():
 
 
 def test_refusals_name_the_field():
-    """A scenario with a [plate], or with the friction inside the step, is refused under
-    verlet in one line naming the field, before anything runs."""
+    """A scenario with the plane's plate, or with the friction inside the step, is refused
+    under verlet in one line naming the field (and, for the plate, why), before anything runs."""
     import granplate as gp
 
-    with pytest.raises(ScenarioError, match=r"'solver\.scheme' = 'verlet': .*\[plate\]") as err:
+    why = r"'solver\.scheme' = 'verlet': velocity Verlet does not drive the plane's plate: .*its modes"
+    with pytest.raises(ScenarioError, match=why + r'.*"implicit" or "paper"') as err:
         validate(gp.with_changes(gp.preset("steel-r1"), {"solver.scheme": "verlet"}))
     assert "\n" not in str(err.value)
     s = dataclasses.replace(oblique_pair(), solver=Solver(scheme="verlet", granular_friction="rk4"))

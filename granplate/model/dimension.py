@@ -33,10 +33,7 @@ class Dimension:
     columns: positions, angles, velocities, spins); depth_energies: the Dataset's kinetic
     energies of the translation out of the plane [J] (part of E_granular); arrays: the class
     name of the loop's granular arrays (model.inputs); spin: a granule's scenario `omega`
-    [rad/s] from its spin components (a number in the plane, a vector in space); solids:
-    whether a run may hold an elastic solid in the loop's arrays (model.inputs.BodyArrays;
-    the plane's plate has its own), so that a run without one shares their compiled loop
-    (one compile serves both) rather than a loop of its own without the body's code.
+    [rad/s] from its spin components (a number in the plane, a vector in space).
     """
 
     n: int
@@ -49,7 +46,6 @@ class Dimension:
     depth_energies: tuple[str, ...]
     arrays: str
     spin: Callable[[Sequence[float]], float | tuple[float, ...]]
-    solids: bool
 
     @property
     def state_variables(self) -> tuple[str, ...]:
@@ -82,7 +78,6 @@ PLANE = Dimension(
     depth_energies=(),
     arrays="Granular",
     spin=operator.itemgetter(0),
-    solids=False,
 )
 
 SPACE = Dimension(
@@ -96,7 +91,6 @@ SPACE = Dimension(
     depth_energies=("KE_depth",),
     arrays="Granular3",
     spin=tuple,
-    solids=True,
 )
 
 #: the dimensions by their number

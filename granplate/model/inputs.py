@@ -298,13 +298,12 @@ class NoBodyArrays(BodyArrays):
     __slots__ = ()
 
 
-def no_body(ng: int, nm: int, shared: bool = False) -> BodyArrays:
+def no_body(ng: int, nm: int) -> BodyArrays:
     """The BodyArrays of a run without an elastic body (no faces: the loop skips it), of the
-    type NoBodyArrays (a loop compiled without the body's code), or with shared, of the type
-    BodyArrays (the loop compiled for the runs with a body, which this run then shares)."""
+    type NoBodyArrays."""
     z = np.zeros
     i = np.int64
-    return (BodyArrays if shared else NoBodyArrays)(
+    return NoBodyArrays(
         face_nodes=z((0, 1, 3)),
         face_snode=np.zeros((0, 1), i),
         node_xyz=z((0, 3)),

@@ -83,9 +83,9 @@ REACH = 2.0
 
 def by_body(b, with_body, body_args, without, plain_args):
     """with_body(*body_args) in a run with an elastic body, without(*plain_args) in one
-    without: chosen when the loop compiles where b is of type model.inputs.NoBodyArrays (a
-    run that never compiles the body's code), else when it runs (`has_body`: a run without a
-    body that shares the loop compiled for the runs with one, model.inputs.no_body)."""
+    without (b of type model.inputs.NoBodyArrays): chosen when the loop compiles, so that
+    a run without a body never compiles the body's code (it doubled the loop's compile
+    time)."""
     raise NotImplementedError("compiled use only")
 
 
@@ -93,13 +93,7 @@ def by_body(b, with_body, body_args, without, plain_args):
 def _by_body(b, with_body, body_args, without, plain_args):
     if getattr(b, "instance_class", None) is NoBodyArrays:
         return lambda b, with_body, body_args, without, plain_args: without(*plain_args)
-
-    def either(b, with_body, body_args, without, plain_args):
-        if has_body(b):
-            return with_body(*body_args)
-        return without(*plain_args)
-
-    return either
+    return lambda b, with_body, body_args, without, plain_args: with_body(*body_args)
 
 
 @njit(cache=True)

@@ -7,8 +7,6 @@ from __future__ import annotations
 import numpy as np
 
 from granplate.model.arrays import Model, granular_with_patch_contacts
-from granplate.model.dimension import of_number
-from granplate.model.inputs import no_body
 from granplate.physics.contact import plate_overlap
 from granplate.plate.face import patch_weights
 from granplate.solver import loop, state as S
@@ -34,8 +32,7 @@ class LoopArrays:
             for k, y_k in enumerate(model.plate.contact_y[:nk]):
                 first, last = patch_weights(p.face_y, float(y_k), 0.0, self.w.wface)
                 set_face_weights(k, first, last, self.w)
-        body = model.body if model.body is not None else no_body(ng, nm, of_number(cfg.dimension).solids)
-        self.sw = scheme(cfg.scheme).new_scratch(ng, nm, nk, body=body, threads=cfg.threads)
+        self.sw = scheme(cfg.scheme).new_scratch(ng, nm, nk, body=model.body, threads=cfg.threads)
         ts, gs = sensor_setup(model, times)
         self.out = S.new_output(times, ng, nm, nk, nc, len(g.wall_load), len(g.drive_target), ts, gs)
         self.scheme = cfg.scheme

@@ -3,10 +3,9 @@ its contact forces in each force pass (solver.body) and Mindlin's law there
 (solver.body_mindlin), its modes kicked by them and by a line load, turned exactly over
 the step under its own weight, the friction at its contacts split off as the granules'.
 
-Each piece goes through `solver.body.by_body`: a run without a body gets the neutral value
-(nothing, zero, its sums unchanged), chosen when the loop compiles in the plane (the type
-model.inputs.NoBodyArrays: none of the body's code is compiled) and when it runs in space
-(an empty body: the loop is the one compiled for the runs with a solid).
+Each piece is chosen by the arrays' type when the loop compiles (`solver.body.by_body`):
+a run without a body (model.inputs.NoBodyArrays) compiles none of the body's code and
+gets the neutral value (nothing, zero, its sums unchanged).
 """
 
 from __future__ import annotations
