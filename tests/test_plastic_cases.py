@@ -1,5 +1,5 @@
 """The verification case `plastic-impact` (yielding impacts simulated by the time loop):
-it passes with figures off, and its checks fail when the truth or the loop is wrong."""
+it passes and draws its figure, and its checks fail when the truth or the loop is wrong."""
 
 from __future__ import annotations
 
@@ -15,8 +15,13 @@ from granplate.verification.plastic import thornton_restitution
 
 
 @pytest.fixture(scope="module")
-def result(tmp_path_factory):
-    return run_case(V.get_case("plastic-impact"), Context(out=tmp_path_factory.mktemp("plastic"), figures=False))
+def context(tmp_path_factory) -> Context:
+    return Context(out=tmp_path_factory.mktemp("plastic"))
+
+
+@pytest.fixture(scope="module")
+def result(context):
+    return run_case(V.get_case("plastic-impact"), context)
 
 
 @pytest.fixture(scope="module")
@@ -33,13 +38,16 @@ def by_quantity(checks, start: str):
     return [c for c in checks if c.quantity.startswith(start)]
 
 
-def test_case_passes_without_figures(result):
+def test_case_passes_and_draws_its_figure(result, context):
     """plastic-impact runs every impact through the loop and passes: restitution against
     P12 at 1.5-100 v_y on a wall and on a sphere far inside its 1% (within 1e-6), the
-    Y -> infinity run bitwise Hertz's, and no figure is drawn with figures off."""
+    Y -> infinity run bitwise Hertz's; each check says why and where its truth comes from,
+    and the figure is drawn (the suite's only run of this case: tests/test_verification.py
+    leaves it to this file)."""
     assert result.crashed is None, result.crashed
     assert result.passed, [(c.quantity, c.ours, c.reference) for c in result.checks if not c.passed]
-    assert result.figure is None
+    assert all(c.why and c.source for c in result.checks)
+    assert result.figure and (context.figure_dir / result.figure).is_file()
     rest = by_quantity(result.checks, "restitution, ")
     assert len(rest) == 2 * len(P.RATIOS)
     assert max(c.error for c in rest) < 1e-6

@@ -28,8 +28,12 @@ def ctx(tmp_path_factory) -> Context:
 #: tests/test_verification_space.py, so that the suite's two workers share the cases.
 SPACE_CASES = tuple(n for n in V.case_names(full=False) if n.startswith(("3d-", "lammps-3d", "solid-")))
 
+#: Fast cases that a test file of their own runs whole (every check and the figure), so
+#: that the suite runs each once.
+OWN_FILE = {"plastic-impact": "tests/test_plastic_cases.py"}
 
-@pytest.mark.parametrize("name", [n for n in V.case_names(full=False) if n not in SPACE_CASES])
+
+@pytest.mark.parametrize("name", [n for n in V.case_names(full=False) if n not in SPACE_CASES + tuple(OWN_FILE)])
 def test_fast_case(name, ctx):
     """Each fast case in the plane runs, draws its figure and passes every check (except
     the known, explained model-form failures, which must still fail exactly as documented)."""

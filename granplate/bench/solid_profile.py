@@ -16,7 +16,7 @@ import sys
 import time
 
 import numpy as np
-from numba import njit
+from granplate.jit import njit
 
 from granplate.solver import body as B
 from granplate.bench import write_report

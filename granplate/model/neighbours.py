@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from granplate.jit import njit
 
 from granplate.setup.pairs import close_pairs
 
@@ -216,7 +216,7 @@ def verlet_walls(
 CELLS_PER_CENTRE = 8
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def _grid_pairs(p, r, reach, lo, h, nc):  # pragma: no cover - compiled
     """Sorted pairs (i < j) of the centres p (n, d <= 3) [m] with |p_j - p_i|^2 <= ((R_i +
     R_j) reach)^2, from a cell grid of side h >= 2 R_max reach [m] from corner lo with

@@ -33,7 +33,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from granplate.jit import njit
 
 from granplate.physics.contact import (
     COEF_A,
@@ -68,7 +68,7 @@ def cavity_pressure(x: float) -> float:
     return 2.0 / 3.0 * (1.0 + CAVITY_LOG0 + 0.5 * math.log(x))
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def hardness_overlap(h: float) -> float:
     """x_h: where the cavity pressure reaches the hardness h Y (J4)."""
     return math.exp(2.0 * (1.5 * h - 1.0 - CAVITY_LOG0))
@@ -283,7 +283,7 @@ def johnson_normal_slopes(delta: float, coef, delta_max: float, rate: float):
     return k, coef[COEF_C] * math.sqrt(math.sqrt(d_el))
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def johnson_replay(delta: np.ndarray, coef, speed: float) -> np.ndarray:
     """The law's force [N] along an overlap history delta (n,) [m] from a virgin contact,
     its yield strength fixed by the approach speed `speed` [m/s] (<= 0: rate-free; no

@@ -19,16 +19,16 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from granplate.jit import njit
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def hertz_coefficient(e_star: float, r_star: float) -> float:
     """A = 4/3 E* sqrt(R*) [N/m^(3/2)], paper eq. (3)."""
     return 4.0 / 3.0 * e_star * math.sqrt(r_star)
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def damping_coefficient(alpha_n: float, m_star: float, a: float) -> float:
     """c such that gamma = c delta^(1/4): c = alpha_n sqrt(m* A), paper eq. (3).
 
@@ -68,7 +68,7 @@ def contact_arm(radius: float, delta: float, shrink: float) -> float:
     return radius - shrink * delta
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def pair_overlap(xi: float, yi: float, ri: float, xj: float, yj: float, rj: float):
     """Overlap of spheres i, j, delta = R_i + R_j - |s_j - s_i| [m] (negative: a gap),
     and the unit normal (nx, nz) from i to j. Returns (delta, nx, nz)."""
@@ -100,7 +100,7 @@ def pair_normal_rate(vxi: float, vyi: float, vxj: float, vyj: float, nx: float, 
     return -((vxj - vxi) * nx + (vyj - vyi) * nz)
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def pair_rates(
     vxi: float, vyi: float, wi: float, vxj: float, vyj: float, wj: float, nx: float, nz: float, ai: float, aj: float
 ):
@@ -125,7 +125,7 @@ def wall_rates(vx: float, vy: float, w: float, nx: float, nz: float, a: float):
     return vx * nx + vy * nz, -vx * nz + vy * nx + a * w
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def plate_overlap(x: float, r: float, edge_x: float) -> float:
     """Overlap of a sphere with the plate's rigid layer at x = edge_x (n = (1, 0)) [m]."""
     return x + r - edge_x
@@ -146,7 +146,7 @@ def hertz_elastic(delta: float, a: float) -> float:
     return a * delta * math.sqrt(delta)
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def normal_force(delta: float, delta_dot: float, a: float, c: float, clip: bool):
     """Magnitude of the normal force |N| of eq. (2) and its elastic part [N].
 
@@ -163,7 +163,7 @@ def normal_force(delta: float, delta_dot: float, a: float, c: float, clip: bool)
     return n, elastic
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def friction_magnitude(n_abs: float, v_t: float, mu: float, k_s: float) -> float:
     """Signed friction mu |N| tanh(k_s v_t) [N], eq. (5); the force on i is minus this along t."""
     return mu * n_abs * math.tanh(k_s * v_t)

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from granplate.jit import njit
 
 #: profile ids (the order of setup.scenario.DRIVE_PROFILES)
 PROFILE_CONSTANT, PROFILE_RAMP, PROFILE_HALF_SINE, PROFILE_HARMONIC, PROFILE_TABLE, PROFILE_CHIRP = range(6)
@@ -59,7 +59,7 @@ def table_terms(t, tab, n):
     return tab[lo, TAB_I] + 0.5 * (tab[lo, TAB_V] + value) * dt, value, slope
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def profile_terms(t, pid, par, tab, n):
     """(int_0^t P, P(t), P'(t), P''(t)) of profile pid with parameters par (PAR_*) and
     table tab[:n] (profile "table" only), t >= 0 [s]."""
@@ -108,7 +108,7 @@ def chirp_terms(t, a, f0, f1, T):
     return 0.0, a * s, a * w * c, a * (dw * c - w * w * s)
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def drive_motion(t, kind, pid, par, tab, n):
     """What a drive prescribes at t [s]: (s, v, a) the displacement [m] from t = 0,
     velocity [m/s] and acceleration [m/s^2] of a displacement or velocity drive along its

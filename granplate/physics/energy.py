@@ -9,7 +9,7 @@ the plastic work of yielding contacts (docs/model.md section 3.6, eq. P10), zero
 
 from __future__ import annotations
 
-from numba import njit
+from granplate.jit import njit
 
 
 @njit(cache=True)

@@ -25,7 +25,7 @@ contact does.
 
 from __future__ import annotations
 
-from numba import njit
+from granplate.jit import njit
 
 from granplate.physics.cavity import johnson_normal_force, johnson_normal_response, johnson_normal_slopes
 from granplate.physics.contact import (

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from granplate.jit import njit
 
 #: LAMMPS's threshold of a frame update (its EPSILON): the history is turned into the new
 #: tangent plane only where its normal part carries a force above EPSILON mu |N|.
@@ -36,13 +36,13 @@ def shear_modulus(young: float, poisson: float) -> float:
     return young / (2.0 * (1.0 + poisson))
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def tangential_compliance(young: float, poisson: float) -> float:
     """One body's share (2 - nu) / G [1/Pa] of 1 / G* (eq. M1)."""
     return (2.0 - poisson) / shear_modulus(young, poisson)
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def mindlin_coefficient(g_star: float) -> float:
     """8 G* [Pa]: the tangential stiffness per unit contact radius, k_t = 8 G* a (eq. M1)."""
     return 8.0 * g_star

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from granplate.jit import njit
 
 from granplate.physics.contact import contact_energy, hertz_elastic, normal_force, normal_response
 
@@ -40,13 +40,13 @@ from granplate.physics.contact import contact_energy, hertz_elastic, normal_forc
 YIELD_ONSET_FACTOR = 1.6
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def limiting_pressure(y_strength: float) -> float:
     """p_y = 1.6 Y [Pa] (P1), Y: the yield strength of the softer body [Pa]."""
     return YIELD_ONSET_FACTOR * y_strength
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def hertz_peak_pressure(e_star: float, r_star: float, delta: float) -> float:
     """Hertz's peak contact pressure p0 = (2/pi) E* sqrt(delta / R*) [Pa] (P2); 0 out of touch."""
     if delta <= 0.0:
@@ -60,7 +60,7 @@ def yield_onset_ratio(e_star: float, r_star: float, delta: float, y_strength: fl
     return hertz_peak_pressure(e_star, r_star, delta) / limiting_pressure(y_strength)
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def yield_overlap(e_star: float, r_star: float, p_y: float) -> float:
     """delta_y = (pi p_y / (2 E*))^2 R* [m] (P3): the overlap at which p0 reaches p_y."""
     q = math.pi * p_y / (2.0 * e_star)
@@ -89,7 +89,7 @@ def plastic_stiffness(a: float, delta_y: float) -> float:
     return 1.5 * a * math.sqrt(delta_y)
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def loading_force(a: float, delta_y: float, delta: float) -> float:
     """The virgin loading curve [N] (P5): A delta^(3/2) up to delta_y, then
     F_y + k_p (delta - delta_y)."""
@@ -107,7 +107,7 @@ def unloading_span(delta_y: float, delta_max: float) -> float:
     return (1.5 * delta_max - 0.5 * delta_y) * math.sqrt(delta_y / delta_max)
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def residual_overlap(delta_y: float, delta_max: float) -> float:
     """delta_p [m] (P7): the overlap at which the unloading curve from delta_max reaches
     zero force (the permanent flattening); 0 while delta_max <= delta_y."""
@@ -134,7 +134,7 @@ def updated_max_overlap(delta: float, delta_max: float) -> float:
     return delta if delta > delta_max else delta_max
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def plastic_force(a: float, delta_y: float, delta: float, delta_max: float) -> float:
     """Normal force of the elastic-plastic law [N] (P8) at overlap delta with history
     delta_max (the largest overlap before; delta > delta_max is loading).
@@ -212,7 +212,7 @@ def plastic_elastic_energy(a: float, delta_y: float, delta: float, delta_max: fl
     return 0.4 * loading_force(a, delta_y, m) * d * d * math.sqrt(d) / (w * math.sqrt(w))
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def plastic_work(a: float, delta_y: float, delta_max: float) -> float:
     """Plastic work W_p(delta_max) [J] (P10): the work of the loading curve up to
     delta_max less the elastic energy it stores there,

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-from numba import njit
+from granplate.jit import njit
 
 #: Gauss-Legendre 2-point rule on [-1, 1]: exact for the quadratic shape functions.
 _GAUSS_X = 0.5773502691896257
@@ -62,7 +62,7 @@ def edge_shape_functions(xi):
     return 0.5 * xi * (xi - 1.0), 1.0 - xi * xi, 0.5 * xi * (xi + 1.0)
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def patch_weights(face_y, y_c, width, weights):
     """Consistent nodal weights of a patch of `width` [m] centred at y_c [m] on the face
     whose nodes lie at face_y (sorted; corners at even indices, mid-sides at odd ones):

@@ -33,7 +33,7 @@ from __future__ import annotations
 from typing import Callable
 
 import numpy as np
-from numba import njit
+from granplate.jit import njit
 
 from granplate.plate.stress import plane_stresses, von_mises_plane_stress
 
@@ -136,7 +136,7 @@ def _unit_rows(plate, first: int, stop: int, n_cols: int) -> np.ndarray:
     return out
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def distance_peaks(c: np.ndarray, m: np.ndarray, rows: np.ndarray, refs: np.ndarray) -> np.ndarray:
     """(len(rows), 3): sum_i |c[rows[k], i] - c[refs[k], i]| m[i] (m: (n, 3)) for each k (refs[k] < 0:
     from rest, sum_i |c[rows[k], i]| m[i]): how far each maximum can move between the two

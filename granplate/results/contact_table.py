@@ -37,7 +37,7 @@ from typing import NamedTuple
 
 import numpy as np
 import xarray as xr
-from numba import njit
+from granplate.jit import njit
 
 from granplate.physics.contact import (
     COEF_DY,
@@ -91,7 +91,7 @@ class Links(NamedTuple):
 DELTA, RATE, SLIP = 0, 1, 2
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def pair_kinematics_plane(y, radius, pairs, arm_shrink, kin):
     """Overlap, its rate and the slip speed of each pair (i, j) of `pairs` at the plane's
     state y (6 columns) into kin (np, 3), with the loop's kinematics (physics.contact)."""
@@ -112,7 +112,7 @@ def pair_kinematics_plane(y, radius, pairs, arm_shrink, kin):
             kin[p, SLIP] = vt
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def pair_kinematics_space(y, radius, pairs, arm_shrink, kin):
     """`pair_kinematics_plane` at space's state y (9 columns), with the loop's kinematics
     in space (physics.space, solver.granular3d)."""
@@ -133,7 +133,7 @@ def pair_kinematics_space(y, radius, pairs, arm_shrink, kin):
             kin[p, SLIP] = math.sqrt(sx * sx + sy * sy + sz * sz)
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def wall_kinematics_plane(y, radius, granule, geo, vn, arm_shrink, kin):
     """Overlap, its rate less the wall's speed vn[k] [m/s] along its normal, and the slip
     speed of each granule `granule[k]` against the wall of row geo[k] ([n..., offset where
@@ -153,7 +153,7 @@ def wall_kinematics_plane(y, radius, granule, geo, vn, arm_shrink, kin):
             kin[k, SLIP] = vt
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def wall_kinematics_space(y, radius, granule, geo, vn, arm_shrink, kin):
     """`wall_kinematics_plane` at space's state y (9 columns)."""
     for k in range(granule.shape[0]):
@@ -178,7 +178,7 @@ KINEMATICS = {
 }
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def link_forces(kin, coef, dmax, rate, clip, out):
     """Overlap, normal and friction force of each contact of kinematics row kin[k] (`DELTA`,
     `RATE`, `SLIP`) and coefficient row coef[k] into out (n, 3), by its normal law

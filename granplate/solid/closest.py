@@ -8,7 +8,7 @@ touched and those sharing a corner with it), without Python per step.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from granplate.jit import njit
 
 from granplate.solid.face_shapes import _QUAD_NODES, _TRI_NODES, TRI6, face_shape_functions, face_shape_hessians
 
@@ -77,7 +77,7 @@ def _edge_ends(kind, e):
     return _QUAD_NODES[i, 0], _QUAD_NODES[i, 1], _QUAD_NODES[j, 0], _QUAD_NODES[j, 1]
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def face_closest(X, kind, p, out):
     """The closest point to p (3,) [m] on one face with nodes X (n, 3) [m].
 
@@ -182,7 +182,7 @@ def _face_closest(X, kind, p, out, N, dN, d2N, x, J, K):
     return best
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def face_normal(X, kind, xi, eta, normal):
     """The face's outward unit normal (x_xi x x_eta normalised) at (xi, eta), in place."""
     n = X.shape[0]
@@ -198,7 +198,7 @@ def face_normal(X, kind, xi, eta, normal):
     normal /= norm
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def contact_frame(X, kind, p, out):
     """From out[0:5] (face coordinates and closest point, `face_closest`) and the centre p:
     out[5:8] the outward unit normal, out[8] the signed distance [m] (positive outside).
@@ -285,7 +285,7 @@ def slide_closest(nodes, kind, neighbours, face, p, out):
     return face
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def follow_closest(nodes, kind, neighbours, face, p, out):
     """`slide_closest`, with a shortcut for a centre outside the body whose foot stays
     inside its face (reference coordinates within INTERIOR of the face's edges), or lies on

@@ -7,7 +7,7 @@ with their first and second derivatives, compiled.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from granplate.jit import njit
 
 #: Face kinds: the code the compiled functions take, and the nodes per face.
 QUAD8, QUAD9, TRI6 = 0, 1, 2
@@ -19,7 +19,7 @@ _QUAD_NODES = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [0, -1], [1, 0], [0,
 _TRI_NODES = np.array([[0, 0], [1, 0], [0, 1], [0.5, 0], [0.5, 0.5], [0, 0.5]], float)
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def face_shape_functions(kind, xi, eta, N, dN):
     """The face's shape functions N (n_nodes,) and their derivatives dN (n_nodes, 2) with
     respect to (xi, eta) at a reference point, written in place (node order of the module)."""

@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-from numba import njit
+from granplate.jit import njit
 
 from granplate.solid.surface import NODES_PER_FACE, Surface, face_shape_functions
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def _weights(kind, xi, n_nodes):
     """(n_c, n_nodes) the face's shape functions at each contact's point xi (n_c, 2)."""
     w = np.empty((xi.shape[0], n_nodes))

@@ -30,7 +30,8 @@ import os
 # GOMP_SPINCOUNT or OMP_WAIT_POLICY is kept. Measured in docs/benchmarks.md.
 os.environ.setdefault("GOMP_SPINCOUNT", "30000")
 
-from numba import njit, prange  # noqa: E402
+from numba import prange  # noqa: E402
+from granplate.jit import njit  # noqa: E402
 
 from granplate.solver.drives import begin_pass
 from granplate.solver.granular import ForceSums, commit_history, commit_rows

@@ -34,7 +34,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from granplate.jit import njit
 from numba.extending import overload
 
 from granplate.model.inputs import (
@@ -273,7 +273,7 @@ def contact_forces(y, q, qd, b, buf, radius, mass, clip, acc, fdamp, scale_acc):
     return e_pot, p_visc, w_plastic, e_static, ovl, ovl_i
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def replay(ys, qs, qds, b, radius, mass, clip, face_out, xi_out, force_out, normal_out) -> None:
     """The body's contacts at recorded states (ys (nt, ng, 9), qs, qds (nt, nm)), one time
     after the other (each search seeded by the last): face_out (nt, ng) the face touched
@@ -302,7 +302,7 @@ def replay(ys, qs, qds, b, radius, mass, clip, face_out, xi_out, force_out, norm
             force_out[o, i, 2] = -n * g[GEO_NZ]
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def patch_loads(b, face, xi, force, out_t, out_col, out_val) -> int:
     """The nodal forces of recorded contact forces spread over their disc patches (b.patch
     > 0): face (nt, ng) the face each granule touches (-1: none), xi (nt, ng, 2) its point

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from granplate.jit import njit
 
 from granplate.model.inputs import GEO_DELTA, GEO_N, GEO_NX, GEO_NY, GEO_NZ, GEO_TOUCH
 from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm

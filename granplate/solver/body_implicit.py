@@ -27,7 +27,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from granplate.jit import njit
 
 from granplate.model.inputs import GEO_DAMP, GEO_DELTA, GEO_NX, GEO_NY, GEO_NZ, GEO_TOUCH, BodyArrays
 from granplate.physics.shock import shock_amplitude

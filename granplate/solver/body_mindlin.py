@@ -17,7 +17,7 @@ slip's work in D_friction (eq. M6), not in D_visc.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from granplate.jit import njit
 
 from granplate.model.inputs import GEO_DELTA, GEO_N, GEO_NX, GEO_NY, GEO_NZ, GEO_TOUCH
 from granplate.physics.contact import COEF_TLAW, contact_arm

@@ -8,7 +8,7 @@ r_k N_k and the residual's pull along the surface as the patch weights move.
 
 from __future__ import annotations
 
-from numba import njit
+from granplate.jit import njit
 
 from granplate.model.inputs import GEO_DELTA, GEO_NSTAT, GEO_NX, HIST_MAX, HIST_RATE
 from granplate.physics.laws import normal_law_force, normal_law_slopes
@@ -66,7 +66,7 @@ def static_overlap(target, r, c, delta_max, speed, clip) -> float:
     return x
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def residual_rows(b, buf, i, k) -> int:
     """Contact k (granule i) as a combination of the residual dofs: its normal n times its
     patch's weights on the dofs of S (rcol, rcoef row k), and each term's gradient in the
@@ -89,7 +89,7 @@ def residual_rows(b, buf, i, k) -> int:
     return nt
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def touched_dofs(b, n_act, counts, upos, ulist) -> int:
     """The residual dofs U the contacts in touch load: ulist[:n] (n returned), upos[s] their
     position in it (upos all -1 on entry)."""
@@ -104,7 +104,7 @@ def touched_dofs(b, n_act, counts, upos, ulist) -> int:
     return n
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def residual_matrix(b, n_act, counts, upos, ulist, n_u, rows, rmat) -> None:
     """rmat[k, j] = r_k^T R_S r_j [m/N] between the contacts in touch: for each k its row
     r_k^T R_S over the touched dofs U (kept in rows[k], for `residual_load`), then its

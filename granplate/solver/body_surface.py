@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from granplate.jit import njit
 
 from granplate.model.inputs import GEO_DIST, GEO_ETA, GEO_GX, GEO_GY, GEO_GZ, GEO_NX, GEO_NY, GEO_NZ, GEO_XI
 from granplate.solid.surface import face_shape_functions, follow_closest

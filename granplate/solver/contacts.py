@@ -9,7 +9,7 @@ cfg.face_skin R of it the chunk ends and the driver gives them a patch contact
 
 from __future__ import annotations
 
-from numba import njit
+from granplate.jit import njit
 
 from granplate.physics.contact import plate_overlap
 from granplate.solver.state import (

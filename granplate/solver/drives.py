@@ -32,7 +32,7 @@ contacts' viscous power at their relative rate.
 
 from __future__ import annotations
 
-from numba import njit
+from granplate.jit import njit
 
 from granplate.model.inputs import (
     DR_A,
@@ -61,7 +61,7 @@ from granplate.solver.kicks import half_kick
 V0 = 3
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def is_piston(g, k):
     """Whether drive k pushes a wall with a force (the wall a piston)."""
     return g.drive_target[k] < 0 and g.drive_kind[k] == KIND_FORCE

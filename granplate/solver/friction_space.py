@@ -7,7 +7,7 @@ contacts too.
 
 from __future__ import annotations
 
-from numba import njit
+from granplate.jit import njit
 
 from granplate.model.inputs import HIST_MAX, HIST_RATE
 from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
-from numba import njit
+from granplate.jit import njit
 
 from granplate.model.inputs import (
     HIST_A,
@@ -414,7 +414,7 @@ def fixing_speed(d: float, d_old: float, t: float, t_old: float) -> float:
     return -1.0
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def commit_histories(t, g):
     """`commit_history` of every contact kind of g (pairs, walls, plate contacts)."""
     commit_history(t, g.pair_hist, g.pair_coef)

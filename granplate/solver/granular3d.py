@@ -8,7 +8,7 @@ granular arrays' type). No plate contacts in space yet: the plate arguments are 
 
 from __future__ import annotations
 
-from numba import njit
+from granplate.jit import njit
 
 
 from granplate.model.inputs import (

@@ -9,7 +9,7 @@ called by the loop and the driver after these functions change the rows.
 
 from __future__ import annotations
 
-from numba import njit
+from granplate.jit import njit
 
 from granplate.physics.contact import COEF_KS, COEF_MU, local_map_modulus, plate_overlap
 from granplate.plate.face import patch_weights
@@ -98,7 +98,7 @@ def face_compliance(k, j, c, cj, p, w):
     return s
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def set_face_weights(k, first, last, w):
     """Keep w.wface[first:last + 1] as contact k's face weights (w.pweight, w.prange)."""
     for n in range(w.pweight.shape[1]):

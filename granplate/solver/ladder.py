@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from granplate.jit import njit
 
 from granplate.solver.state import LEVEL_RATIO, N_LEVELS
 
@@ -17,7 +17,7 @@ def level_step(level, cfg):
     return cfg.dt_max * LEVEL_RATIO**level
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def level_for(h, cfg):
     """Smallest ladder level whose step does not exceed h."""
     if h >= cfg.dt_max:

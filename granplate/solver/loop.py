@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from granplate.jit import njit
 
 from granplate.physics.energy import energy_residual, energy_total
 from granplate.solver import schemes as S
@@ -86,7 +86,7 @@ from granplate.solver.state import (
 )
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def initialise(st, g, p, cfg, w):
     """Forces, accelerations and energies at t = 0 (state y, q, qd already set); the
     granules' derivative as every step's end one (without the split-off friction); the
@@ -128,7 +128,7 @@ def initialise(st, g, p, cfg, w):
     reset_interval(w)
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def start_scheme(sw, st, g, cfg):
     """What the scheme adds at t = 0 after `initialise` (its hook `start`): an elastic
     body's contact energies (solver.body) join E_pot, E_p and E_0."""
@@ -172,7 +172,7 @@ def energy_in(clock, eshock, acc):
     return clock[E_ZERO] + eshock + (acc[A_GRAVITY] + acc[A_DRIVE])
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def record(o, st, g, p, w, out):
     """Write the state at t_n into output row o and restart the interval maxima."""
     eshock, eg, ep, kx, ky, kz, kr = energy_terms(st.y, st.q, st.qd, st.force, st.clock, st.acc, g, p.omega2, p.resid)
@@ -224,7 +224,7 @@ def record(o, st, g, p, w, out):
     reset_interval(w)
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def record_sensors(sw, st, g, cfg, out):
     """Write every sensor's reading at t_n into the next sensor row (docs/model.md section
     3.15): half the sum of the normal forces on its granule, of its pair and wall contacts
@@ -346,7 +346,7 @@ def accept_granular(t, h, land, t_out, plate_work, e_pot, st, w, rows):
     w.dt_int[1] = max(w.dt_int[1], h)
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
     """Advance from st.clock[T_NOW] to t_stop (an output time) with the scheme whose
     scratch is sw, trying at most max_attempts steps. Returns a status: OK, PAUSED
@@ -445,7 +445,7 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
     return OK if st.clock[T_NOW] >= t_stop - 1e-9 * cfg.dt_min else PAUSED
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def place_contact(sw, k, y_c, st, p, cfg, w):
     """Centre patch contact k at height y_c [m] on the face (interface.place_patch) and
     give the scheme whose scratch is sw its state at the contact's rows (its hook

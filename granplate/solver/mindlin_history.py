@@ -9,7 +9,7 @@ solver.mindlin_space) and of the elastic body (solver.body_mindlin) call these.
 from __future__ import annotations
 
 
-from numba import njit
+from granplate.jit import njit
 
 from granplate.model.inputs import HIST_A, HIST_A_END, HIST_F, HIST_F_END, HIST_XI, HIST_XI_END, N_MINDLIN
 from granplate.physics.contact import COEF_C, COEF_KT, COEF_MUT, COEF_XT

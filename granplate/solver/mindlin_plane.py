@@ -12,7 +12,7 @@ geometry and normal force, computed once, serve its normal force and its tangent
 
 from __future__ import annotations
 
-from numba import njit
+from granplate.jit import njit
 
 from granplate.model.inputs import HIST_A, HIST_A_END, HIST_END, HIST_MAX, HIST_RATE
 from granplate.physics.contact import (

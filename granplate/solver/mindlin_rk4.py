@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from granplate.jit import njit
 
 from granplate.model.inputs import HIST_A, HIST_A_END, HIST_F_END, HIST_MAX, HIST_RATE, HIST_XI, HIST_XI_END, N_MINDLIN
 from granplate.physics.contact import (

@@ -9,7 +9,7 @@ each) run the same pair loop.
 
 from __future__ import annotations
 
-from numba import njit
+from granplate.jit import njit
 
 from granplate.model.inputs import HIST_MAX, HIST_RATE
 from granplate.physics.contact import COEF_TLAW, contact_arm

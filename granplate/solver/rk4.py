@@ -6,7 +6,7 @@ or space's solver.granular3d).
 
 from __future__ import annotations
 
-from numba import njit
+from granplate.jit import njit
 
 from granplate.solver import body_implicit as BI
 from granplate.solver.dimension import friction_flow, granular_rhs, plate_friction_held

@@ -24,7 +24,8 @@ import os
 os.environ.setdefault("GOMP_SPINCOUNT", "30000")
 
 import numpy as np  # noqa: E402
-from numba import njit, prange  # noqa: E402
+from numba import prange  # noqa: E402
+from granplate.jit import njit  # noqa: E402
 
 from granplate.physics.contact import COEF_A, COEF_C, COEF_KT, COEF_MUT, COEF_XT, normal_force
 from granplate.physics.mindlin import contact_radius, mindlin_force, rescale_history, rotate_history, tangential_damping
@@ -208,7 +209,7 @@ def _granule_pass(
             touch[i] += 1
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def contact_forces(x, v, w, radius, mass, g, pairs, pcoef, phist, walls, wcoef, whist, s, dt, elastic, f, tq, touch):
     """Forces f (n, 3) [N] and torques tq (n, 3) [N m] on the granules at positions x, with
     gravity m g, the velocities v, spins w (the half step's) over the step dt [s] (the
@@ -266,7 +267,7 @@ def _kick(x, v, w, f, tq, touch, mass, inertia, dt, lam, keep, spin_keep, x_ref,
     return far
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def settle_steps(
     x,
     v,
@@ -320,7 +321,7 @@ def settle_steps(
     return steps
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def stiffness_sums(x, radius, pairs, pcoef, walls, wcoef, s):
     """Each granule's sum of its contacts' normal stiffness dN/d delta = 3/2 s A delta^(1/2)
     and ROLL_MOBILITY x their tangential stiffness s 8 G* a [N/m] (Verlet's bound on the

@@ -25,7 +25,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from granplate.jit import njit
 
 from granplate.model.inputs import STATE_COLUMNS, BodyArrays, new_body_state, no_body
 from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm, friction_magnitude, plate_overlap

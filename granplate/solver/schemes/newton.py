@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from granplate.jit import njit
 
 from granplate.model.inputs import HIST_MAX, HIST_RATE
 from granplate.physics.contact import COEF_KS, COEF_MU, friction_magnitude, plate_overlap

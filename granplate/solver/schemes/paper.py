@@ -17,7 +17,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from granplate.jit import njit
 
 from granplate.solver.rk4 import rk4_granular_step, rk4_limit
 from granplate.solver.interface import forces_converged

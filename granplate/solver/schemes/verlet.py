@@ -40,7 +40,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from granplate.jit import njit
 
 from granplate.model.inputs import STATE_COLUMNS, BodyArrays, new_body_state, no_body
 from granplate.physics.contact import COEF_MU

@@ -11,7 +11,7 @@ gets the neutral value (nothing, zero, its sums unchanged).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from granplate.jit import njit
 
 from granplate.physics.contact import COEF_MU
 from granplate.physics.shock import shock_amplitude
