@@ -23,7 +23,7 @@ from numba.core.registry import CPUDispatcher
 
 #: Appended to a kernel's qualified name for its Python entry, so that numba's on-disk
 #: cache keeps the two apart (it names cache files by module and qualified name).
-ENTRY_SUFFIX = "<python entry>"
+ENTRY_SUFFIX = "__python_entry"
 
 #: The kernels Python has called (each compiled its entry), in the order of their first call.
 PYTHON_CALLED: list[str] = []
@@ -64,6 +64,8 @@ def njit(function: Callable | None = None, *, entry: bool = False, **options: An
         if entry:
             return numba_njit(**options)(f)
         disp = numba_njit(**options, **WITHOUT_WRAPPERS)(f)
+        if not isinstance(disp, CPUDispatcher):  # NUMBA_DISABLE_JIT: the plain function
+            return disp
         disp.__class__ = Kernel  # numba's own dispatcher, its Python call sent to the entry
         disp._entry_options = options
         return disp
