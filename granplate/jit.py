@@ -16,6 +16,7 @@ start, the model build's kernels): compiled as numba compiles them, wrappers and
 from __future__ import annotations
 
 import types
+from collections import Counter
 from typing import Any, Callable
 
 from numba import njit as numba_njit
@@ -25,8 +26,9 @@ from numba.core.registry import CPUDispatcher
 #: cache keeps the two apart (it names cache files by module and qualified name).
 ENTRY_SUFFIX = "__python_entry"
 
-#: The kernels Python has called (each compiled its entry), in the order of their first call.
-PYTHON_CALLED: list[str] = []
+#: How many times Python has called each kernel (by module and name): each one compiled its
+#: entry at its first call.
+PYTHON_CALLS: Counter[str] = Counter()
 
 #: Compile options of a kernel: the wrappers only a call from Python or C needs left out.
 WITHOUT_WRAPPERS = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True}
@@ -40,6 +42,7 @@ class Kernel(CPUDispatcher):
     _entry_options: dict = {}
 
     def __call__(self, *args, **kwargs):
+        PYTHON_CALLS[f"{self.py_func.__module__}.{self.py_func.__qualname__}"] += 1
         return self.python_entry()(*args, **kwargs)
 
     def python_entry(self) -> CPUDispatcher:
@@ -51,7 +54,6 @@ class Kernel(CPUDispatcher):
             copy.__qualname__ = f"{f.__qualname__}{ENTRY_SUFFIX}"
             copy.__doc__ = f.__doc__
             self._entry = numba_njit(**self._entry_options)(copy)
-            PYTHON_CALLED.append(f"{f.__module__}.{f.__qualname__}")
         return self._entry
 
 
