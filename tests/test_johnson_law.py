@@ -17,6 +17,7 @@ from granplate.errors import ScenarioError
 from granplate.setup.validate import validate
 from granplate.physics.cavity import (
     X_BRIDGE,
+    fixing_speed,
     hardness_overlap,
     johnson_normal_response,
     johnson_state,
@@ -26,7 +27,6 @@ from granplate.physics.cavity import (
 )
 from granplate.physics.contact import COEF_C, COEF_DY, hertz_elastic, normal_response
 from granplate.physics.laws import normal_law_response
-from granplate.solver.granular import fixing_speed
 from granplate.verification.measured import johnson_row
 
 ROW = johnson_row("steel_302")  # two spheres R = 3.175 mm of AISI 302

@@ -147,3 +147,90 @@ def test_unknown_law_is_refused_at_setup(contact, field):
     assert info.value.field == field
     names = TANGENTIAL_LAW_IDS if "tangential" in field else NORMAL_LAW_IDS
     assert all(f"'{name}'" in str(info.value) for name in names)
+
+
+#: a normal law written as a user would add one (docs/architecture.md, "Adding a normal law"):
+#: a linear spring k delta, k = R* Y / delta_y of the row (any constant of the row would do)
+LINEAR_LAW = """
+import numpy as np
+from granplate.jit import njit
+from granplate.physics.contact import COEF_DY, COEF_SY, N_LAW_COLUMNS
+
+
+@njit(cache=True, inline="always")
+def law_response(delta, delta_dot, coef, delta_max, rate, clip):
+    k = coef[COEF_SY] / coef[COEF_DY]
+    return k * delta, 0.0, 0.5 * k * delta * delta, 0.0
+
+
+@njit(cache=True, inline="always")
+def law_force(delta, delta_dot, coef, delta_max, rate, clip):
+    return coef[COEF_SY] / coef[COEF_DY] * delta
+
+
+@njit(cache=True, inline="always")
+def law_slopes(delta, coef, delta_max, rate):
+    return coef[COEF_SY] / coef[COEF_DY], 0.0
+
+
+@njit(cache=True, inline="always")
+def law_rate(d, d_old, t, t_old, rate, coef):
+    return rate + 1.0
+
+
+def law_columns(softer, e_star, r_star, length):
+    out = np.zeros(N_LAW_COLUMNS)
+    out[0], out[1] = 1e-6, 2.0 * r_star * e_star * 1e-6
+    return out
+"""
+
+
+def test_a_new_normal_law_is_one_module_and_one_registry_entry(tmp_path, monkeypatch):
+    """A law given as one module and one registry line is found by name (its columns) and
+    dispatched by its id, the next after the registered ones: its closed form k delta, slope
+    k, energy k delta^2 / 2, its own history update; the registered laws keep their ids."""
+    from numba import njit
+
+    from granplate.physics import laws
+    from granplate.setup import law_registry
+
+    (tmp_path / "granplate_linear_law.py").write_text(LINEAR_LAW)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setitem(law_registry.NORMAL_LAW_REGISTRY, "linear", law_registry.NormalLaw("granplate_linear_law"))
+    names = list(law_registry.NORMAL_LAW_REGISTRY)
+    modules = [laws.law_module(n) for n in names]
+    response = laws.pick_of_six(tuple(m.law_response for m in modules))
+    slopes = laws.pick_of_four(tuple(m.law_slopes for m in modules))
+    rate = laws.pick_of_six(tuple(m.law_rate for m in modules))
+
+    @njit
+    def call(law, d, c):
+        return (
+            response(law, d, 0.0, c, 0.0, 1.0, True),
+            slopes(law, d, c, 0.0, 1.0),
+            rate(law, d, 0.0, 1.0, 0.0, 5.0, c),
+        )
+
+    c = row("hertz")
+    c[COEF_DY : COEF_XH + 1] = laws.law_columns("linear", STEEL, E_STAR, R_STAR, 2 * R)
+    k = 2.0 * R_STAR * E_STAR
+    (n, pv, ep, wp), (kd, kv), r = call(names.index("linear"), 2e-6, c)
+    assert (n, ep, kd, r) == pytest.approx((k * 2e-6, 0.5 * k * 4e-12, k, 6.0), rel=1e-14)
+    (n, pv, ep, wp), (kd, kv), r = call(HERTZ, 2e-6, c)
+    assert n == pytest.approx(A * 2e-6**1.5, rel=1e-12) and r == 5.0
+
+
+def test_every_registered_law_module_gives_the_interface():
+    """Each registry entry's module gives every function the dispatch builds on (law_module's check), and a
+    module lacking one is refused naming it."""
+    from granplate.physics import laws
+    from granplate.setup import law_registry
+
+    for name in NORMAL_LAW_IDS:
+        module = laws.law_module(name)
+        assert all(callable(getattr(module, f)) for f in laws.LAW_FUNCTIONS)
+    bad = law_registry.NormalLaw("granplate.physics.mindlin")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(law_registry.NORMAL_LAW_REGISTRY, "broken", bad)
+        with pytest.raises(ImportError, match="lacks law_response"):
+            laws.law_module("broken")

@@ -21,9 +21,8 @@ from granplate.model.coefficients import pair_coefficients, plate_contact_coeffi
 
 # the coefficients and the lists replaced during a run have modules of their own; their
 # names are importable from here as before
-from granplate.model.coefficients import coefficient_row as coefficient_row, johnson_columns as johnson_columns
+from granplate.model.coefficients import coefficient_row as coefficient_row
 from granplate.model.coefficients import law_coefficients as law_coefficients
-from granplate.model.coefficients import law_yield_overlap as law_yield_overlap
 from granplate.model.coefficients import material_indices as material_indices, normal_law_of as normal_law_of
 from granplate.model.coefficients import mindlin_columns as mindlin_columns
 from granplate.model.coefficients import pair_coefficient_row as pair_coefficient_row

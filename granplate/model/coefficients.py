@@ -12,21 +12,15 @@ import math
 
 import numpy as np
 
-from granplate.physics.cavity import hardness_overlap
 from granplate.physics.contact import (
     COEF_A,
     COEF_C,
     COEF_DY,
-    COEF_H,
-    COEF_KAPPA,
     COEF_KS,
     COEF_KT,
     COEF_MU,
     COEF_MUT,
     COEF_NLAW,
-    COEF_RC,
-    COEF_RL,
-    COEF_SY,
     COEF_TLAW,
     COEF_XH,
     COEF_XT,
@@ -35,23 +29,20 @@ from granplate.physics.contact import (
     hertz_coefficient,
 )
 from granplate.physics.mindlin import mindlin_coefficient, tangential_compliance
-from granplate.physics.plastic import contact_yield_overlap
+from granplate.physics.laws import law_columns
 from granplate.setup.materials import (
-    DEFAULT_HARDNESS_RATIO,
-    DEFAULT_UNLOADING_FACTOR,
     effective_modulus,
     softer_material,
-    softer_yield_strength,
 )
-from granplate.setup.law_registry import HERTZ, MINDLIN, NORMAL_LAW_IDS, TANH, YIELDING_LAWS
+from granplate.setup.law_registry import HERTZ, MINDLIN, NORMAL_LAW_IDS, TANH
 from granplate.setup.scenario import Scenario
 
 
 def coefficient_row(a: float, c: float, mu: float, k_s: float, law=math.inf, normal_law: int = HERTZ) -> np.ndarray:
     """One row of pair_coef / wall_coef / pc_coef in the columns of physics.contact:
     Hertz A [N/m^1.5], damping c, mu [-], k_s [s/m] (eqs. 3, 5), the normal law's
-    columns from COEF_DY on (`law_coefficients`), or the yield overlap delta_y [m] alone
-    (docs/model.md eq. P3; inf: never reached), the normal law's id `normal_law`
+    columns from COEF_DY on (`law_coefficients`; inf alone: a yield overlap never
+    reached), the normal law's id `normal_law`
     (setup.law_registry's NORMAL_LAW_IDS, `normal_law_id`) and the tanh law's tangential id
     (`mindlin_columns` makes a row Mindlin's)."""
     row = np.zeros(N_COEF)
@@ -74,43 +65,15 @@ def normal_law_id(s: Scenario, a: str, b: str) -> int:
     return NORMAL_LAW_IDS[normal_law_of(s, a, b)]
 
 
-def law_yield_overlap(s: Scenario, a, b, b_name: str, e_star: float, r_star: float) -> float:
-    """COEF_DY of a contact of material a (a granule's Material) with b (a granule's
-    Material, or None for a rigid wall or the plate's face, whose material is b_name):
-    the yield overlap delta_y [m] (docs/model.md eqs. P1, P3) of the softer body under the
-    elastic-plastic law "thornton", inf under Hertz's law. (Validation refuses "thornton"
-    where the Y it needs is unknown.)"""
-    if normal_law_of(s, a.name, b_name) not in YIELDING_LAWS:
-        return math.inf
-    return contact_yield_overlap(e_star, r_star, softer_yield_strength(a, b))
-
-
 def law_coefficients(s: Scenario, a, b, b_name: str, e_star: float, r_star: float, length: float) -> np.ndarray:
-    """The normal law's columns COEF_DY..COEF_XH of a contact of material a with b (as
-    `law_yield_overlap`), `length` [m] the length that makes the approach speed a strain
-    rate (the sum of the radii; a diameter against a rigid body). Hertz: [inf, 0...];
-    "thornton": [delta_y, 0...]; "johnson": delta_y, R* Y, C, 1 / (length rate_ref), h,
-    kappa and x_h of the softer body (docs/model.md section 3.10; absent rate fields: rate-free)."""
-    if normal_law_of(s, a.name, b_name) == "johnson":
-        return johnson_columns(softer_material(a, b), e_star, r_star, length)
-    out = np.zeros(COEF_XH - COEF_DY + 1)
-    out[0] = law_yield_overlap(s, a, b, b_name, e_star, r_star)
-    return out
-
-
-def johnson_columns(m, e_star: float, r_star: float, length: float) -> np.ndarray:
-    """The law "johnson"'s columns COEF_DY..COEF_XH of a contact whose softer body is
-    of Material m (its Y known), E* [Pa], R* [m], `length` [m] (`law_coefficients`)."""
-    out = np.zeros(COEF_XH - COEF_DY + 1)
-    out[0] = contact_yield_overlap(e_star, r_star, m.Y)
-    out[COEF_SY - COEF_DY] = r_star * m.Y
-    if m.C is not None and m.rate_ref is not None:
-        out[COEF_RC - COEF_DY] = m.C
-        out[COEF_RL - COEF_DY] = 1.0 / (length * m.rate_ref)
-    out[COEF_H - COEF_DY] = DEFAULT_HARDNESS_RATIO if m.hardness_ratio is None else m.hardness_ratio
-    out[COEF_KAPPA - COEF_DY] = DEFAULT_UNLOADING_FACTOR if m.unloading_factor is None else m.unloading_factor
-    out[COEF_XH - COEF_DY] = hardness_overlap(out[COEF_H - COEF_DY])
-    return out
+    """The normal law's columns COEF_DY..COEF_XH (physics.laws' `law_columns`: its module's)
+    of a contact of material a (a granule's Material) with b (a granule's Material, or None
+    for a rigid wall or the plate's face, whose material is b_name), E* [Pa], R* [m],
+    `length` [m] the length that makes the approach speed a strain rate (the sum of the
+    radii; a diameter against a rigid body). Hertz's: [inf, 0...]; a yielding law's yield
+    overlap is its softer body's (validation refuses a yielding law where the Y it needs is
+    unknown)."""
+    return law_columns(normal_law_of(s, a.name, b_name), softer_material(a, b), e_star, r_star, length)
 
 
 def pair_coefficient_row(s: Scenario, a, b, ri: float, rj: float, mi: float, mj: float) -> np.ndarray:

@@ -45,9 +45,12 @@ from granplate.physics.contact import (
     COEF_RL,
     COEF_SY,
     COEF_XH,
+    N_LAW_COLUMNS,
     normal_force,
     normal_response,
 )
+from granplate.physics.plastic import contact_yield_overlap
+from granplate.setup.materials import DEFAULT_HARDNESS_RATIO, DEFAULT_UNLOADING_FACTOR
 
 #: the Hertz force and slope at yield in units of R* Y delta_y and R* Y (J2): F_y = 2/3 pi p_y
 #: R* delta_y and k_y = pi p_y R* with p_y = 1.6 Y
@@ -297,4 +300,77 @@ def johnson_replay(delta: np.ndarray, coef, speed: float) -> np.ndarray:
             out[i] = johnson_state(d, m, coef, rate, 0.0)[0]
         if d > m:
             m = d
+    return out
+
+
+# The law as a registered normal law ("johnson"; docs/architecture.md, "Adding a normal
+# law"): the common arguments of physics.laws. A contact whose overlap and largest overlap
+# are both at or below the rate-free yield overlap COEF_DY takes Hertz's code at once,
+# without the rate factor's logarithm (the same result: the law's yield overlap at its rate
+# factor is never below COEF_DY, since C >= 0).
+
+
+@njit(cache=True, inline="always")
+def law_response(delta: float, delta_dot: float, coef, delta_max: float, rate: float, clip: bool):
+    """`johnson_normal_response`, with Hertz's code for an elastic history."""
+    delta_y = coef[COEF_DY]
+    if delta <= delta_y and delta_max <= delta_y:
+        n, pv, ep = normal_response(delta, delta_dot, coef[COEF_A], coef[COEF_C], clip)
+        return n, pv, ep, 0.0
+    return johnson_normal_response(delta, delta_dot, coef, delta_max, rate, clip)
+
+
+@njit(cache=True, inline="always")
+def law_force(delta: float, delta_dot: float, coef, delta_max: float, rate: float, clip: bool) -> float:
+    """`johnson_normal_force`, with Hertz's code for an elastic history."""
+    delta_y = coef[COEF_DY]
+    if delta <= delta_y and delta_max <= delta_y:
+        return normal_force(delta, delta_dot, coef[COEF_A], coef[COEF_C], clip)[0]
+    return johnson_normal_force(delta, delta_dot, coef, delta_max, rate, clip)
+
+
+@njit(cache=True, inline="always")
+def law_slopes(delta: float, coef, delta_max: float, rate: float):
+    """`johnson_normal_slopes`."""
+    return johnson_normal_slopes(delta, coef, delta_max, rate)
+
+
+@njit(cache=True, inline="always")
+def law_rate(d: float, d_old: float, t: float, t_old: float, rate: float, coef) -> float:
+    """The rate factor once the largest overlap grows from d_old (reached at t_old [s]) to
+    d [m] (at t [s]): fixed in the accepted step where the largest overlap first passes the
+    rate-free yield overlap, from the approach speed (d - d_old) / (t - t_old) over that
+    step (`rate_factor`; -1, rate-free, when the contact passed yield in its first step in
+    touch); else unchanged."""
+    if rate == 0.0 and d > coef[COEF_DY]:
+        return rate_factor(fixing_speed(d, d_old, t, t_old), coef[COEF_RC], coef[COEF_RL])
+    return rate
+
+
+@njit(cache=True)
+def fixing_speed(d: float, d_old: float, t: float, t_old: float) -> float:
+    """The approach speed [m/s] that fixes a contact's yield strength (docs/model.md
+    section 3.10): the growth of its largest overlap over the accepted step, (d - d_old) /
+    (t - t_old), from its previous largest overlap d_old reached at t_old; -1 (rate-free)
+    when there is none (the contact passed yield in its first step in touch)."""
+    if d_old > 0.0 and t > t_old:
+        return (d - d_old) / (t - t_old)
+    return -1.0
+
+
+def law_columns(softer, e_star: float, r_star: float, length: float) -> np.ndarray:
+    """The law's columns COEF_DY..COEF_XH of a contact whose softer body is `softer` (a
+    Material, its Y known), E* [Pa], R* [m], `length` [m] the length that makes the approach
+    speed a strain rate: delta_y, R* Y, C, 1 / (length rate_ref), h, kappa and x_h
+    (docs/model.md section 3.10; absent rate fields: rate-free)."""
+    m = softer
+    out = np.zeros(N_LAW_COLUMNS)
+    out[0] = contact_yield_overlap(e_star, r_star, m.Y)
+    out[COEF_SY - COEF_DY] = r_star * m.Y
+    if m.C is not None and m.rate_ref is not None:
+        out[COEF_RC - COEF_DY] = m.C
+        out[COEF_RL - COEF_DY] = 1.0 / (length * m.rate_ref)
+    out[COEF_H - COEF_DY] = DEFAULT_HARDNESS_RATIO if m.hardness_ratio is None else m.hardness_ratio
+    out[COEF_KAPPA - COEF_DY] = DEFAULT_UNLOADING_FACTOR if m.unloading_factor is None else m.unloading_factor
+    out[COEF_XH - COEF_DY] = hardness_overlap(out[COEF_H - COEF_DY])
     return out

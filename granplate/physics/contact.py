@@ -59,6 +59,9 @@ COEF_SY, COEF_RC, COEF_RL, COEF_H, COEF_KAPPA, COEF_XH = 5, 6, 7, 8, 9, 10
 COEF_KT, COEF_MUT, COEF_XT = 11, 12, 13
 COEF_NLAW, COEF_TLAW = 14, 15
 N_COEF = 16
+#: the normal law's own columns, COEF_DY..COEF_XH: the yield overlap (inf for a law that
+#: never yields) and six parameters a law reads as it defines them (its `law_columns`)
+N_LAW_COLUMNS = COEF_XH - COEF_DY + 1
 
 
 @njit(cache=True)

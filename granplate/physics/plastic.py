@@ -30,9 +30,20 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from granplate.jit import njit
 
-from granplate.physics.contact import contact_energy, hertz_elastic, normal_force, normal_response
+from granplate.physics.contact import (
+    COEF_A,
+    COEF_C,
+    COEF_DY,
+    N_LAW_COLUMNS,
+    contact_energy,
+    hertz_elastic,
+    normal_force,
+    normal_response,
+)
 
 #: p_y / Y: the Hertz peak pressure at which yield starts under a sphere, p0 = 1.6 Y
 #: (von Mises, nu = 0.3; Johnson, Contact Mechanics, 1985, section 6.2), taken by Thornton
@@ -287,3 +298,48 @@ def yielding_normal_slopes(delta: float, a: float, c: float, delta_y: float, del
     if d_el <= 0.0:
         return 0.0, 0.0
     return plastic_force_slope(a, delta_y, delta, delta_max), c * math.sqrt(math.sqrt(d_el))
+
+
+# The law as a registered normal law ("thornton"; docs/architecture.md, "Adding a normal
+# law"): the common arguments of physics.laws, the coefficient row holding A, c and
+# delta_y. A contact whose overlap and largest overlap are both at or below delta_y takes
+# Hertz's code at once, before any plastic arithmetic.
+
+
+@njit(cache=True, inline="always")
+def law_response(delta: float, delta_dot: float, coef, delta_max: float, rate: float, clip: bool):
+    """`yielding_normal_response` of the row `coef` (rate unused)."""
+    delta_y = coef[COEF_DY]
+    if delta <= delta_y and delta_max <= delta_y:  # an elastic history: Hertz, eqs. (2) and (9)
+        n, pv, ep = normal_response(delta, delta_dot, coef[COEF_A], coef[COEF_C], clip)
+        return n, pv, ep, 0.0
+    return yielding_normal_response(delta, delta_dot, coef[COEF_A], coef[COEF_C], delta_y, delta_max, clip)
+
+
+@njit(cache=True, inline="always")
+def law_force(delta: float, delta_dot: float, coef, delta_max: float, rate: float, clip: bool) -> float:
+    """`yielding_normal_force` of the row `coef` (rate unused)."""
+    delta_y = coef[COEF_DY]
+    if delta <= delta_y and delta_max <= delta_y:
+        return normal_force(delta, delta_dot, coef[COEF_A], coef[COEF_C], clip)[0]
+    return yielding_normal_force(delta, delta_dot, coef[COEF_A], coef[COEF_C], delta_y, delta_max, clip)
+
+
+@njit(cache=True, inline="always")
+def law_slopes(delta: float, coef, delta_max: float, rate: float):
+    """`yielding_normal_slopes` of the row `coef` (rate unused)."""
+    return yielding_normal_slopes(delta, coef[COEF_A], coef[COEF_C], coef[COEF_DY], delta_max)
+
+
+@njit(cache=True, inline="always")
+def law_rate(d: float, d_old: float, t: float, t_old: float, rate: float, coef) -> float:
+    """The rate factor as the largest overlap grows: unchanged (Y is rate-free here)."""
+    return rate
+
+
+def law_columns(softer, e_star: float, r_star: float, length: float) -> np.ndarray:
+    """The law's columns COEF_DY..COEF_XH: the yield overlap delta_y [m] (P3) of the softer
+    body (`softer`, a Material with its Y; E* [Pa], R* [m]), no other parameter."""
+    out = np.zeros(N_LAW_COLUMNS)
+    out[0] = contact_yield_overlap(e_star, r_star, softer.Y)
+    return out

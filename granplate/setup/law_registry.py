@@ -3,25 +3,47 @@ writes in contact.normal_law, [[contact.pairs]].normal_law and contact.tangentia
 and its law id, the integer value a contact's coefficient row holds in its law column
 (physics.contact's COEF_NLAW, COEF_TLAW), on which physics.laws and the tangential
 passes dispatch. Setup lists the allowed names from here (setup.scenario's NORMAL_LAWS,
-TANGENTIAL_LAWS), model.coefficients writes the ids into the rows: a new law is its
-module, one line here and its branch in the dispatch (docs/architecture.md, "Adding a
-normal law").
+TANGENTIAL_LAWS), model.coefficients writes the ids into the rows.
+
+A normal law is one module and one line of NORMAL_LAW_REGISTRY: the module gives the
+law's compiled functions (`law_response`, `law_force`, `law_slopes`, `law_rate`) and its
+coefficient columns (`law_columns`), and physics.laws builds the dispatch on the law id
+from this table (docs/architecture.md, "Adding a normal law").
 
 Pure data (no numba): the ids are read as compile-time constants by the kernels.
 """
 
 from __future__ import annotations
 
-#: Normal laws, name -> law id (COEF_NLAW): "hertz", eq. (2) with eq. (3)'s damping
-#: (physics.contact); "thornton", Thornton's elastic-perfectly plastic law (docs/model.md
-#: section 3.6, physics.plastic); "johnson", Hertz to yield, then Johnson's expanding cavity
-#: up to the hardness with a rate-dependent yield strength (section 3.10, physics.cavity).
-NORMAL_LAW_IDS: dict[str, int] = {"hertz": 0, "thornton": 1, "johnson": 2}
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class NormalLaw:
+    """One normal law: `module`, the module that implements it (its `law_*` functions);
+    `yields`, whether it yields at the overlap COEF_DY (then it needs the yield strength Y
+    of every body that can yield at the contact, and setup refuses it where Y is unknown)."""
+
+    module: str
+    yields: bool = False
+
+
+#: Normal laws, name -> implementation, in the order of their law ids (COEF_NLAW):
+#: "hertz", eq. (2) with eq. (3)'s damping (physics.hertz); "thornton", Thornton's
+#: elastic-perfectly plastic law (docs/model.md section 3.6, physics.plastic); "johnson",
+#: Hertz to yield, then Johnson's expanding cavity up to the hardness with a rate-dependent
+#: yield strength (section 3.10, physics.cavity).
+NORMAL_LAW_REGISTRY: dict[str, NormalLaw] = {
+    "hertz": NormalLaw("granplate.physics.hertz"),
+    "thornton": NormalLaw("granplate.physics.plastic", yields=True),
+    "johnson": NormalLaw("granplate.physics.cavity", yields=True),
+}
+#: name -> law id, the position in NORMAL_LAW_REGISTRY (Hertz's id 0: an elastic contact
+#: takes its branch after one compare)
+NORMAL_LAW_IDS: dict[str, int] = {name: k for k, name in enumerate(NORMAL_LAW_REGISTRY)}
 HERTZ, THORNTON, JOHNSON = NORMAL_LAW_IDS["hertz"], NORMAL_LAW_IDS["thornton"], NORMAL_LAW_IDS["johnson"]
-#: Normal laws that yield at the overlap COEF_DY: they need the yield strength Y of every
-#: body that can yield at the contact, and take Hertz's code while the contact's overlap and
-#: largest overlap stay at or below COEF_DY.
-YIELDING_LAWS: tuple[str, ...] = ("thornton", "johnson")
+#: Normal laws that yield at the overlap COEF_DY (NormalLaw.yields).
+YIELDING_LAWS: tuple[str, ...] = tuple(name for name, law in NORMAL_LAW_REGISTRY.items() if law.yields)
 
 #: Tangential laws, name -> law id (COEF_TLAW): "tanh", eq. (5)'s regularised Coulomb law
 #: without history (physics.contact); "mindlin", Mindlin's tangential spring with a Coulomb

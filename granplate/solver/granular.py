@@ -30,12 +30,8 @@ from granplate.model.inputs import (
     N_MINDLIN,
 )
 from granplate.physics.contact import (
-    COEF_DY,
     COEF_KS,
     COEF_MU,
-    COEF_NLAW,
-    COEF_RC,
-    COEF_RL,
     COEF_TLAW,
     contact_arm,
     friction_magnitude,
@@ -51,10 +47,9 @@ from granplate.physics.contact import (
     wall_overlap,
     wall_rates,
 )
-from granplate.physics.cavity import rate_factor
-from granplate.physics.laws import normal_law_force, normal_law_response
+from granplate.physics.laws import normal_law_force, normal_law_rate, normal_law_response
 from granplate.physics.shock import shock_amplitude
-from granplate.setup.law_registry import JOHNSON, MINDLIN
+from granplate.setup.law_registry import MINDLIN
 from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_motion
 from granplate.solver.mindlin_rk4 import plane_stages
 from granplate.solver.state import PARTNER_PLATE
@@ -377,10 +372,10 @@ def friction_flow(y, dt, g, cfg, forward):
 @njit(cache=True)
 def commit_history(t, hist, coef):
     """Take the accepted step's end overlaps (column HIST_END) into the contacts' largest
-    overlaps (HIST_MAX, reached at time t [s]: HIST_TIME) of one history array, and fix the
-    yield strength of a contact under the law "johnson" (coefficient rows `coef`) in the step
-    where its largest overlap first passes the rate-free yield overlap: its rate factor
-    Y(rate) / Y (`cavity.rate_factor`) at `fixing_speed`."""
+    overlaps (HIST_MAX, reached at time t [s]: HIST_TIME) of one history array, and update
+    the rate factor (HIST_RATE) of a contact whose largest overlap grows as its normal law
+    says (coefficient rows `coef`; `laws.normal_law_rate`: the law "johnson" fixes its
+    yield strength in the step where its largest overlap first passes yield)."""
     commit_rows(t, hist, coef, 0, hist.shape[0])
 
 
@@ -396,22 +391,11 @@ def commit_rows(t, hist, coef, lo, hi):
                 hist[k, HIST_XI + col] = hist[k, HIST_XI_END + col]
         d = hist[k, HIST_END]
         if d > hist[k, HIST_MAX]:
-            if hist[k, HIST_RATE] == 0.0 and coef[k, COEF_NLAW] == JOHNSON and d > coef[k, COEF_DY]:
-                v = fixing_speed(d, hist[k, HIST_MAX], t, hist[k, HIST_TIME])
-                hist[k, HIST_RATE] = rate_factor(v, coef[k, COEF_RC], coef[k, COEF_RL])
+            hist[k, HIST_RATE] = normal_law_rate(
+                d, hist[k, HIST_MAX], t, hist[k, HIST_TIME], hist[k, HIST_RATE], coef[k]
+            )
             hist[k, HIST_MAX] = d
             hist[k, HIST_TIME] = t
-
-
-@njit(cache=True)
-def fixing_speed(d: float, d_old: float, t: float, t_old: float) -> float:
-    """The approach speed [m/s] that fixes a contact's yield strength (docs/model.md
-    section 3.10): the growth of its largest overlap over the accepted step, (d - d_old) /
-    (t - t_old), from its previous largest overlap d_old reached at t_old; -1 (rate-free)
-    when there is none (the contact passed yield in its first step in touch)."""
-    if d_old > 0.0 and t > t_old:
-        return (d - d_old) / (t - t_old)
-    return -1.0
 
 
 @njit(entry=True, cache=True)

@@ -143,12 +143,13 @@ def johnson_row(material: str, **changes) -> np.ndarray:
     (its fields changed by `changes`, e.g. unloading_factor), as the loop builds it."""
     import dataclasses
 
-    from granplate.model.arrays import coefficient_row, johnson_columns
+    from granplate.model.arrays import coefficient_row
+    from granplate.physics.laws import law_columns
     from granplate.setup.law_registry import JOHNSON
 
     e_star, r_star, a, m = contact_of(material)
     m = dataclasses.replace(m, **changes)
-    return coefficient_row(a, 0.0, 0.0, 0.0, johnson_columns(m, e_star, r_star, 2.0 * SPHERE_RADIUS), JOHNSON)
+    return coefficient_row(a, 0.0, 0.0, 0.0, law_columns("johnson", m, e_star, r_star, 2.0 * SPHERE_RADIUS), JOHNSON)
 
 
 def replay_johnson(c: Curve, speed: float | None = None, **changes) -> np.ndarray:
