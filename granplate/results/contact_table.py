@@ -433,14 +433,19 @@ def yields(model) -> bool:
 def contact_table(model, out, n: int, peaks, steps: int) -> tuple[dict[str, xr.DataArray], dict]:
     """The contact table's variables and its coordinate `link_table_time` over the first n
     output rows of `out` (solver.state.Output), every `steps` rows (run_checks.contact_steps;
-    0: none, an empty dict each); peaks: the run's ContactPeaks (None: none known)."""
+    0: none, an empty dict each); peaks: the run's ContactPeaks (None: none known).
+
+    A run whose contacts all follow Hertz's law (no history) is tabled in blocks of output
+    times at once (`elastic_links`); a run with a yielding law time by time, each contact's
+    largest overlap carried from the times before (`links_at`)."""
     t = np.asarray(out.t[:n], float)
     rows = table_rows(n, steps, t, model.scenario.time.t_end, model.scenario.time.output_interval)
     if not len(rows):
         return {}, {}
     walls = wall_motion(model, out, n)
+    if not yields(model):
+        return table_variables(*elastic_links(model, out, rows, walls), t[rows])
     history = History(peaks, model.n_granules, len(model.walls))
-    plastic = yields(model)
     wanted = set(rows.tolist())
     tables: list[Links] = []
     known: dict = {}
@@ -451,15 +456,130 @@ def contact_table(model, out, n: int, peaks, steps: int) -> tuple[dict[str, xr.D
             tables.append(links)
             keys = history.keys(links.granule, links.partner)
             history.see(keys, links.values[:, OVERLAP])
-        elif plastic:
+        else:
             overlaps_at(model, y, o, walls, history)
-    return table_variables(tables, t[rows])
-
-
-def table_variables(tables: list[Links], times: np.ndarray) -> tuple[dict[str, xr.DataArray], dict]:
-    """The Dataset variables of the tables at `times` [s] (module docstring)."""
     counts = np.array([len(x.granule) for x in tables], np.int64)
-    values = np.concatenate([x.values for x in tables]) if tables else np.zeros((0, 3))
+    joined = Links(*(np.concatenate([getattr(x, f) for x in tables]) for f in Links._fields))
+    return table_variables(counts, joined, t[rows])
+
+
+#: the most (output time, candidate contact) rows `elastic_links` treats at once
+BLOCK_ROWS = 1_000_000
+
+
+def block_candidates(ys: np.ndarray, r: np.ndarray) -> np.ndarray | None:
+    """(nc, 2) sorted pairs i < j that may touch at any of the states ys (nb, ng, columns)
+    (model.neighbours.reaching_pairs at the first state, its reach widened by twice the
+    largest displacement D from it); None where D exceeds half the smallest radius (a block
+    of fewer times is cheaper) or is not finite."""
+    from granplate.model.neighbours import SEARCH_MARGIN, reaching_pairs
+
+    d = of_state(ys.shape[2]).n
+    p0 = ys[0, :, :d]
+    disp = float(np.sqrt(np.max(np.sum((ys[:, :, :d] - p0) ** 2, axis=2)))) if len(ys) > 1 else 0.0
+    r_min = float(r.min()) if len(r) else 0.0
+    if not math.isfinite(disp) or (disp > 0.5 * r_min and len(ys) > 1):
+        return None
+    return reaching_pairs(p0, r, 1.0 + SEARCH_MARGIN + disp / r_min if disp > 0.0 else 1.0 + SEARCH_MARGIN)
+
+
+def elastic_links(model, out, rows: np.ndarray, walls: WallMotion) -> tuple[np.ndarray, Links]:
+    """The contacts in touch at the output rows `rows` of a run without contact history
+    (every law Hertz's), with their forces, as `links_at` gives them time by time: the
+    number of contacts at each row and the rows' contacts in time order (at each time the
+    pairs, sorted, then the wall contacts). Output times are taken in blocks of at most
+    BLOCK_ROWS candidate rows, over which no granule moves more than half the smallest
+    radius: one candidate search per block, the kinematics and laws of all its rows in one
+    compiled call each."""
+    r = np.asarray(model.granular.radius, float)
+    ng = len(r)
+    parts: list[tuple[np.ndarray, Links, int]] = []
+    known: dict = {}
+    start = 0
+    while start < len(rows):
+        nb = min(len(rows) - start, max(1, BLOCK_ROWS // max(ng, 1)))
+        while True:
+            ys = np.ascontiguousarray(out.y[rows[start : start + nb]], dtype=float)
+            cand = block_candidates(ys, r)
+            if nb == 1 or (cand is not None and len(cand) * nb <= BLOCK_ROWS):
+                break
+            nb = max(1, nb // 2)
+        if cand is None:
+            cand = reaching(ys[0], r)
+        parts.append(block_links(model, ys, rows[start : start + nb], cand, walls, known))
+        start += nb
+    counts = np.concatenate([np.bincount(p[0], minlength=p[2]) for p in parts]).astype(np.int64)
+    joined = Links(*(np.concatenate([getattr(p[1], f) for p in parts]) for f in Links._fields))
+    return counts, joined
+
+
+def block_links(model, ys: np.ndarray, rows: np.ndarray, cand: np.ndarray, walls: WallMotion, known: dict):
+    """(row of each contact in touch (index into rows), their Links, len(rows)) at the states
+    ys (nb, ng, columns) of the output rows `rows`, from the candidate pairs `cand`: the
+    states are laid end to end as nb * ng granules, so that the kinematics, the touch test
+    and the laws run once over every (time, pair) and (time, wall) row."""
+    from granplate.model.arrays import wall_arrays
+    from granplate.model.contacts import centre_coordinates
+    from granplate.model.neighbours import contacts_among
+
+    s, mats, g, cfg = model.scenario, list(model.materials), model.granular, model.config
+    nb, ng, c = ys.shape
+    d = of_state(c).n
+    r = np.asarray(g.radius, float)
+    flat = ys.reshape(nb * ng, c)
+    r_flat = np.tile(r, nb)
+    base = (np.arange(nb, dtype=np.int64) * ng)[:, None]
+    pairs = np.column_stack([(base + cand[:, 0]).ravel(), (base + cand[:, 1]).ravel()]).reshape(-1, 2)
+    pair_kin, wall_kin = KINEMATICS[of_state(c).name]
+    kin = np.zeros((len(pairs), 3))
+    pair_kin(flat, r_flat, pairs, cfg.arm_shrink, kin)
+    on = np.flatnonzero(kin[:, DELTA] > 0.0)
+    x, yy, z = centre_coordinates(flat, d)
+    on = on[contacts_among(pairs[on], x, yy, r_flat, 0.0, z)]
+    pt, pi, pj = pairs[on, 0] // ng, pairs[on, 0] % ng, pairs[on, 1] % ng
+    code, inverse = np.unique(pi * ng + pj, return_inverse=True)
+    coef = cached_rows(s, mats, g, np.column_stack([code // ng, code % ng]), known)[inverse.ravel()]
+    pv = np.zeros((len(on), 3))
+    link_forces(np.ascontiguousarray(kin[on]), coef, np.zeros(len(on)), np.zeros(len(on)), cfg.clip, pv)
+    # granules reaching each wall (overlap >= 0), as `touching_walls` at each time
+    if len(walls.normal):
+        reach = (flat[:, :d] @ walls.normal.T).reshape(nb, ng, -1) + r[None, :, None] - walls.offset[rows][:, None, :]
+        wt, wi, ww = np.nonzero(reach >= 0.0)
+    else:
+        wt = wi = ww = np.zeros(0, np.int64)
+    wkey, winv = np.unique(wi * len(walls.normal) + ww, return_inverse=True) if len(wi) else (np.zeros(0, np.int64), wi)
+    nw = max(len(walls.normal), 1)
+    _, wcoef = wall_arrays(s, mats, r, g.mass, np.column_stack([wkey // nw, wkey % nw]), model.walls)
+    wcoef = wcoef[np.asarray(winv, np.int64).ravel()] if len(wi) else wcoef
+    geo = np.column_stack([walls.normal[ww], walls.offset[rows[wt], ww]]) if len(wi) else np.zeros((0, d + 1))
+    wkin = np.zeros((len(wi), 3))
+    wall_kin(
+        flat, r_flat, np.ascontiguousarray(wt * ng + wi), geo, walls.speed[rows[wt], ww].copy(), cfg.arm_shrink, wkin
+    )
+    wv = np.zeros((len(wi), 3))
+    link_forces(wkin, wcoef, np.zeros(len(wi)), np.zeros(len(wi)), cfg.clip, wv)
+    keep_p, keep_w = pv[:, OVERLAP] > 0.0, wv[:, OVERLAP] > 0.0
+    t_all = np.concatenate([pt[keep_p], wt[keep_w]])
+    kind = np.concatenate([np.zeros(int(keep_p.sum()), np.int64), np.ones(int(keep_w.sum()), np.int64)])
+    gran = np.concatenate([pi[keep_p], wi[keep_w]])
+    other = np.concatenate([pj[keep_p], ww[keep_w]])  # the partner granule, or the wall's index
+    order = np.lexsort((other, gran, kind, t_all))
+    partner = np.concatenate([pj[keep_p], -1 - ww[keep_w]])
+    values = np.concatenate([pv[keep_p], wv[keep_w]])[order]
+    return t_all[order], Links(granule=gran[order], partner=partner[order], values=values), nb
+
+
+def cached_rows(s, mats, g, pairs: np.ndarray, known: dict) -> np.ndarray:
+    """model.relists.cached_pair_coefficients of the distinct sorted pairs (n, 2)."""
+    from granplate.model.arrays import cached_pair_coefficients
+
+    return cached_pair_coefficients(s, mats, g, np.asarray(pairs, np.int64).reshape(-1, 2), known)
+
+
+def table_variables(counts: np.ndarray, links: Links, times: np.ndarray) -> tuple[dict[str, xr.DataArray], dict]:
+    """The Dataset variables of the table at `times` [s], counts[k] contacts at times[k], the
+    rows `links` in time order (module docstring)."""
+    values = np.asarray(links.values, float).reshape(-1, 3)
 
     def var(name: str, data) -> xr.DataArray:
         units, desc = LINK_VARIABLES[name]
@@ -467,8 +587,8 @@ def table_variables(tables: list[Links], times: np.ndarray) -> tuple[dict[str, x
 
     data = {
         "link_time": var("link_time", np.repeat(times, counts)),
-        "link_granule": var("link_granule", np.concatenate([x.granule for x in tables]).astype(np.int32)),
-        "link_partner": var("link_partner", np.concatenate([x.partner for x in tables]).astype(np.int32)),
+        "link_granule": var("link_granule", np.asarray(links.granule).astype(np.int32)),
+        "link_partner": var("link_partner", np.asarray(links.partner).astype(np.int32)),
         "link_overlap": var("link_overlap", values[:, OVERLAP].copy()),
         "link_normal_force": var("link_normal_force", values[:, NORMAL].copy()),
         "link_tangential_force": var("link_tangential_force", values[:, TANGENTIAL].copy()),
