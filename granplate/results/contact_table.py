@@ -41,6 +41,7 @@ from granplate.jit import njit
 
 from granplate.physics.contact import (
     COEF_DY,
+    N_COEF,
     COEF_KS,
     COEF_MU,
     COEF_TLAW,
@@ -197,16 +198,6 @@ def link_forces(kin, coef, dmax, rate, clip, out):
         out[k, TANGENTIAL] = tangential_magnitude(n, kin[k, SLIP], c)
 
 
-def wall_links(y, radius, granule, geo, vn, coef, dmax, rate, arm_shrink, clip, out) -> None:
-    """Overlap, normal and friction force of each granule `granule[k]` against the wall of
-    row geo[k] ([n..., offset where the wall is], unit outward normal) moving at vn[k] [m/s]
-    along it, into out (nw, 3); out[k, OVERLAP] <= 0 where apart. dmax, rate: each
-    contact's largest overlap so far [m] and rate factor [-]."""
-    kin = np.zeros((len(granule), 3))
-    KINEMATICS[of_state(y.shape[1]).name][1](y, radius, granule, geo, vn, arm_shrink, kin)
-    link_forces(kin, coef, dmax, rate, clip, out)
-
-
 @njit(cache=True)
 def tangential_magnitude(n: float, vt: float, c) -> float:
     """|F_t| [N] of a contact of coefficient row c at normal force n [N] and slip rate vt
@@ -270,7 +261,7 @@ def wall_motion(model, out, n: int) -> WallMotion:
 
 def touching_pairs(y: np.ndarray, radius: np.ndarray) -> np.ndarray:
     """(np, 2) sorted pairs i < j whose surfaces touch or overlap at state y (a k-d tree,
-    model.neighbours.contact_pairs with no gap): the reference `in_touch` keeps to."""
+    model.neighbours.contact_pairs with no gap): the reference of the table's touch test."""
     from granplate.model.contacts import centre_coordinates
     from granplate.model.neighbours import contact_pairs
 
@@ -286,141 +277,6 @@ def reaching(y: np.ndarray, radius: np.ndarray) -> np.ndarray:
     return reaching_pairs(y[:, : of_state(y.shape[1]).n], radius)
 
 
-def in_touch(y: np.ndarray, radius: np.ndarray, pairs: np.ndarray) -> np.ndarray:
-    """The mask of `pairs` (sorted, i < j) that `touching_pairs` returns at state y: the
-    same test (model.neighbours.contacts_among with no gap), on these pairs alone."""
-    from granplate.model.contacts import centre_coordinates
-    from granplate.model.neighbours import contacts_among
-
-    x, yy, z = centre_coordinates(y, of_state(y.shape[1]).n)
-    return contacts_among(pairs, x, yy, radius, 0.0, z)
-
-
-def touching_walls(y: np.ndarray, radius: np.ndarray, walls: WallMotion, o: int) -> np.ndarray:
-    """(nw, 2) [granule, wall] of the granules reaching each wall at output o (overlap >= 0)."""
-    d = walls.normal.shape[1]
-    if not len(walls.normal):
-        return np.zeros((0, 2), np.int64)
-    reach = y[:, :d] @ walls.normal.T + radius[:, None] - walls.offset[o][None, :]
-    i, w = np.nonzero(reach >= 0.0)
-    return np.column_stack([i, w]).astype(np.int64).reshape(-1, 2)
-
-
-class History:
-    """Each contact's largest overlap so far and rate factor at an output time (module
-    docstring), from the run's final histories (peaks) and the overlaps seen at the output
-    times passed so far (`see`). Contacts are keyed granule * width + (partner + n_walls + 1)."""
-
-    def __init__(self, peaks, n_granules: int, n_walls: int):
-        self.width = n_granules + n_walls + 2
-        self.n_walls = n_walls
-        self.seen_key = np.zeros(0, np.int64)
-        self.seen_max = np.zeros(0)
-        if peaks is None or not len(peaks.granule):
-            self.key, self.peak, self.when, self.rate = (np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros(0))
-            return
-        key = self.keys(peaks.granule, peaks.partner)
-        order = np.argsort(key, kind="stable")
-        self.key, self.peak, self.when = key[order], np.asarray(peaks.delta_max)[order], np.asarray(peaks.time)[order]
-        rate = np.zeros(len(key)) if peaks.rate is None else np.asarray(peaks.rate, float)
-        self.rate = rate[order]
-
-    def keys(self, granule: np.ndarray, partner: np.ndarray) -> np.ndarray:
-        return np.asarray(granule, np.int64) * self.width + (np.asarray(partner, np.int64) + self.n_walls + 1)
-
-    def see(self, key: np.ndarray, delta: np.ndarray) -> None:
-        """Take the overlaps delta [m] of the contacts `key` at one output time into the
-        largest seen so far."""
-        on = delta > 0.0
-        if not on.any():
-            return
-        keys = np.concatenate([self.seen_key, key[on]])
-        values = np.concatenate([self.seen_max, delta[on]])
-        self.seen_key, inverse = np.unique(keys, return_inverse=True)
-        self.seen_max = np.full(len(self.seen_key), -np.inf)
-        np.maximum.at(self.seen_max, inverse, values)
-
-    def at(self, key: np.ndarray, t: float, coef: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(largest overlap so far [m], rate factor [-]) of the contacts `key` at time t [s]
-        (coef: their coefficient rows: the rate factor is the loop's, 0, until the largest
-        overlap passes the rate-free yield overlap)."""
-        dmax = np.zeros(len(key))
-        if len(self.seen_key):
-            k = np.clip(np.searchsorted(self.seen_key, key), 0, len(self.seen_key) - 1)
-            hit = self.seen_key[k] == key
-            dmax[hit] = self.seen_max[k[hit]]
-        rate = np.zeros(len(key))
-        if len(self.key):
-            k = np.clip(np.searchsorted(self.key, key), 0, len(self.key) - 1)
-            hit = self.key[k] == key
-            done = hit & (self.when[k] <= t * (1.0 + 1e-12))
-            dmax[done] = np.maximum(dmax[done], self.peak[k[done]])
-            rate[hit] = self.rate[k[hit]]
-        yielded = dmax > np.asarray(coef, float).reshape(len(key), -1)[:, COEF_DY] if len(key) else np.zeros(0, bool)
-        return dmax, np.where(yielded, rate, 0.0)
-
-
-def links_at(model, y: np.ndarray, o: int, walls: WallMotion, history: History, t: float, known: dict) -> Links:
-    """The contacts in touch at state y, output o (time t [s]), with their forces; known:
-    the pairs' coefficient rows met so far (model.arrays.cached_pair_coefficients)."""
-    from granplate.model.arrays import cached_pair_coefficients, wall_arrays
-
-    s, mats, g, cfg = model.scenario, list(model.materials), model.granular, model.config
-    r = np.asarray(g.radius, float)
-    cand = reaching(y, r)  # kept: those of `touching_pairs` that overlap, in its order
-    kin = np.zeros((len(cand), 3))
-    KINEMATICS[of_state(y.shape[1]).name][0](y, r, cand, cfg.arm_shrink, kin)
-    on = np.flatnonzero(kin[:, DELTA] > 0.0)
-    on = on[in_touch(y, r, cand[on])]
-    pairs, kin = cand[on], kin[on]
-    coef = cached_pair_coefficients(s, mats, g, pairs, known)
-    dmax, rate = history.at(history.keys(pairs[:, 0], pairs[:, 1]), t, coef)
-    pv = np.zeros((len(pairs), 3))
-    link_forces(kin, coef, dmax, rate, cfg.clip, pv)
-    wc = touching_walls(y, r, walls, o)
-    _, wcoef = wall_arrays(s, mats, r, g.mass, wc, model.walls)
-    w = wc[:, 1]
-    geo = (
-        np.column_stack([walls.normal[w], walls.offset[o, w]]) if len(wc) else np.zeros((0, walls.normal.shape[1] + 1))
-    )
-    dmax, rate = history.at(history.keys(wc[:, 0], -1 - w), t, wcoef)
-    wv = np.zeros((len(wc), 3))
-    wall_links(
-        y,
-        r,
-        np.ascontiguousarray(wc[:, 0]),
-        geo,
-        walls.speed[o, w].copy(),
-        wcoef,
-        dmax,
-        rate,
-        cfg.arm_shrink,
-        cfg.clip,
-        wv,
-    )
-    on_p, on_w = pv[:, OVERLAP] > 0.0, wv[:, OVERLAP] > 0.0
-    return Links(
-        granule=np.concatenate([pairs[on_p, 0], wc[on_w, 0]]),
-        partner=np.concatenate([pairs[on_p, 1], -1 - wc[on_w, 1]]),
-        values=np.concatenate([pv[on_p], wv[on_w]]),
-    )
-
-
-def overlaps_at(model, y: np.ndarray, o: int, walls: WallMotion, history: History) -> None:
-    """The overlaps of the contacts touching at output o taken into `history` (no forces)."""
-    r = np.asarray(model.granular.radius, float)
-    d = walls.normal.shape[1]
-    cand = reaching(y, r)
-    delta = r[cand[:, 0]] + r[cand[:, 1]] - np.linalg.norm(y[cand[:, 1], :d] - y[cand[:, 0], :d], axis=1)
-    on = np.flatnonzero(delta > 0.0)
-    on = on[in_touch(y, r, cand[on])]
-    history.see(history.keys(cand[on, 0], cand[on, 1]), delta[on])
-    wc = touching_walls(y, r, walls, o)
-    i, w = wc[:, 0], wc[:, 1]
-    delta = np.sum(y[i, :d] * walls.normal[w], axis=1) + r[i] - walls.offset[o, w]
-    history.see(history.keys(i, -1 - w), delta)
-
-
 def yields(model) -> bool:
     """Whether any contact of the run may follow a yielding law (its history matters): a
     law other than Hertz's between two of its granules' materials or a granule's and a wall's."""
@@ -430,40 +286,106 @@ def yields(model) -> bool:
     return any(s.contact.law_for_pair(a, b) != "hertz" for a in names for b in others)
 
 
+class Seen(NamedTuple):
+    """The contacts in touch at some output rows, one row each, sorted by output row, then
+    pairs (granule, partner) before walls (granule, wall): `time` the output row, `granule`,
+    `partner` (granule j, or -1 - w), `delta` the overlap [m], `table` whether the row is a
+    table time, and at table times `kin` (n, 3) the kinematics (DELTA, RATE, SLIP) and `coef`
+    (n, N_COEF) the coefficient row (zeros elsewhere)."""
+
+    time: np.ndarray
+    granule: np.ndarray
+    partner: np.ndarray
+    delta: np.ndarray
+    table: np.ndarray
+    kin: np.ndarray
+    coef: np.ndarray
+
+
 def contact_table(model, out, n: int, peaks, steps: int) -> tuple[dict[str, xr.DataArray], dict]:
     """The contact table's variables and its coordinate `link_table_time` over the first n
     output rows of `out` (solver.state.Output), every `steps` rows (run_checks.contact_steps;
     0: none, an empty dict each); peaks: the run's ContactPeaks (None: none known).
 
-    A run whose contacts all follow Hertz's law (no history) is tabled in blocks of output
-    times at once (`elastic_links`); a run with a yielding law time by time, each contact's
-    largest overlap carried from the times before (`links_at`)."""
+    The output rows are taken in blocks (`seen_in_blocks`): a run whose contacts all follow
+    Hertz's law needs its table times alone; a run with a yielding law every output time up
+    to the last table time, whose overlaps give each contact's largest overlap at the table
+    times (`largest_overlaps`)."""
     t = np.asarray(out.t[:n], float)
     rows = table_rows(n, steps, t, model.scenario.time.t_end, model.scenario.time.output_interval)
     if not len(rows):
         return {}, {}
     walls = wall_motion(model, out, n)
-    if not yields(model):
-        return table_variables(*elastic_links(model, out, rows, walls), t[rows])
-    history = History(peaks, model.n_granules, len(model.walls))
-    wanted = set(rows.tolist())
-    tables: list[Links] = []
-    known: dict = {}
-    for o in range(int(rows[-1]) + 1):
-        y = np.ascontiguousarray(out.y[o], dtype=float)
-        if o in wanted:
-            links = links_at(model, y, o, walls, history, float(t[o]), known)
-            tables.append(links)
-            keys = history.keys(links.granule, links.partner)
-            history.see(keys, links.values[:, OVERLAP])
-        else:
-            overlaps_at(model, y, o, walls, history)
-    counts = np.array([len(x.granule) for x in tables], np.int64)
-    joined = Links(*(np.concatenate([getattr(x, f) for x in tables]) for f in Links._fields))
-    return table_variables(counts, joined, t[rows])
+    plastic = yields(model)
+    seen_rows = np.arange(int(rows[-1]) + 1, dtype=np.int64) if plastic else rows
+    table = np.zeros(len(seen_rows), bool)
+    table[np.searchsorted(seen_rows, rows)] = True
+    seen = seen_in_blocks(model, out, seen_rows, table, walls)
+    on = np.flatnonzero(seen.table)
+    if plastic:
+        dmax, rate = largest_overlaps(seen, t, peaks, model.n_granules, len(model.walls))
+        dmax, rate = dmax[on], rate[on]
+    else:
+        dmax = rate = np.zeros(len(on))
+    values = np.zeros((len(on), 3))
+    link_forces(
+        np.ascontiguousarray(seen.kin[on]), np.ascontiguousarray(seen.coef[on]), dmax, rate, model.config.clip, values
+    )
+    links = Links(granule=seen.granule[on], partner=seen.partner[on], values=values)
+    counts = np.bincount(np.searchsorted(rows, seen.time[on]), minlength=len(rows)).astype(np.int64)
+    return table_variables(counts, links, t[rows])
 
 
-#: the most (output time, candidate contact) rows `elastic_links` treats at once
+def contact_keys(granule: np.ndarray, partner: np.ndarray, n_granules: int, n_walls: int) -> np.ndarray:
+    """One integer per contact: granule * (n_granules + n_walls + 2) + (partner + n_walls + 1)."""
+    width = n_granules + n_walls + 2
+    return np.asarray(granule, np.int64) * width + (np.asarray(partner, np.int64) + n_walls + 1)
+
+
+@njit(entry=True, cache=True)
+def earlier_maxima(first: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """out[k] = the largest of values[g..k-1] over the run of rows g..k-1 that row k's group
+    began with (first[g] True), 0 where none: each contact's largest overlap at the output
+    times before, its rows in time order."""
+    out = np.zeros(values.shape[0])
+    top = 0.0
+    for k in range(values.shape[0]):
+        if first[k]:
+            top = 0.0
+        out[k] = top
+        if values[k] > top:
+            top = values[k]
+    return out
+
+
+def largest_overlaps(seen: Seen, t: np.ndarray, peaks, n_granules: int, n_walls: int) -> tuple[np.ndarray, np.ndarray]:
+    """Each seen row's contact's largest overlap so far [m] and rate factor [-] (module
+    docstring): the largest of its overlaps at the output times before, and the run's final
+    largest overlap (peaks: solver.driver.ContactPeaks) once the time it was reached has
+    passed; the run's final rate factor once that largest overlap passes the rate-free yield
+    overlap COEF_DY, else 0 (the loop's value while unset)."""
+    key = contact_keys(seen.granule, seen.partner, n_granules, n_walls)
+    order = np.lexsort((seen.time, key))
+    first = np.ones(len(key), bool)
+    first[1:] = key[order][1:] != key[order][:-1]
+    dmax = np.empty(len(key))
+    dmax[order] = earlier_maxima(first, np.ascontiguousarray(seen.delta[order]))
+    rate = np.zeros(len(key))
+    if peaks is not None and len(peaks.granule) and len(key):
+        pk = contact_keys(peaks.granule, peaks.partner, n_granules, n_walls)
+        by = np.argsort(pk, kind="stable")
+        pk, peak, when = pk[by], np.asarray(peaks.delta_max, float)[by], np.asarray(peaks.time, float)[by]
+        prate = (np.zeros(len(pk)) if peaks.rate is None else np.asarray(peaks.rate, float))[by]
+        k = np.clip(np.searchsorted(pk, key), 0, len(pk) - 1)
+        hit = pk[k] == key
+        done = hit & (when[k] <= t[seen.time] * (1.0 + 1e-12))
+        dmax[done] = np.maximum(dmax[done], peak[k[done]])
+        rate[hit] = prate[k[hit]]
+    yielded = dmax > seen.coef[:, COEF_DY]
+    return dmax, np.where(yielded & seen.table, rate, 0.0)
+
+
+#: the most (output time, candidate contact) rows `seen_in_blocks` treats at once
 BLOCK_ROWS = 1_000_000
 
 
@@ -483,17 +405,14 @@ def block_candidates(ys: np.ndarray, r: np.ndarray) -> np.ndarray | None:
     return reaching_pairs(p0, r, 1.0 + SEARCH_MARGIN + disp / r_min if disp > 0.0 else 1.0 + SEARCH_MARGIN)
 
 
-def elastic_links(model, out, rows: np.ndarray, walls: WallMotion) -> tuple[np.ndarray, Links]:
-    """The contacts in touch at the output rows `rows` of a run without contact history
-    (every law Hertz's), with their forces, as `links_at` gives them time by time: the
-    number of contacts at each row and the rows' contacts in time order (at each time the
-    pairs, sorted, then the wall contacts). Output times are taken in blocks of at most
-    BLOCK_ROWS candidate rows, over which no granule moves more than half the smallest
-    radius: one candidate search per block, the kinematics and laws of all its rows in one
-    compiled call each."""
+def seen_in_blocks(model, out, rows: np.ndarray, table: np.ndarray, walls: WallMotion) -> Seen:
+    """The contacts in touch at the output rows `rows` of `out` (`Seen`; table[k]: whether
+    rows[k] is a table time), in blocks of output rows of at most BLOCK_ROWS candidate rows
+    over which no granule moves more than half the smallest radius: one candidate search per
+    block, the kinematics of all its rows in one compiled call (`block_seen`)."""
     r = np.asarray(model.granular.radius, float)
     ng = len(r)
-    parts: list[tuple[np.ndarray, Links, int]] = []
+    parts: list[Seen] = []
     known: dict = {}
     start = 0
     while start < len(rows):
@@ -506,74 +425,124 @@ def elastic_links(model, out, rows: np.ndarray, walls: WallMotion) -> tuple[np.n
             nb = max(1, nb // 2)
         if cand is None:
             cand = reaching(ys[0], r)
-        parts.append(block_links(model, ys, rows[start : start + nb], cand, walls, known))
+        parts.append(block_seen(model, ys, rows[start : start + nb], table[start : start + nb], cand, walls, known))
         start += nb
-    counts = np.concatenate([np.bincount(p[0], minlength=p[2]) for p in parts]).astype(np.int64)
-    joined = Links(*(np.concatenate([getattr(p[1], f) for p in parts]) for f in Links._fields))
-    return counts, joined
+    return Seen(*(np.concatenate([getattr(p, f) for p in parts]) for f in Seen._fields))
 
 
-def block_links(model, ys: np.ndarray, rows: np.ndarray, cand: np.ndarray, walls: WallMotion, known: dict):
-    """(row of each contact in touch (index into rows), their Links, len(rows)) at the states
-    ys (nb, ng, columns) of the output rows `rows`, from the candidate pairs `cand`: the
-    states are laid end to end as nb * ng granules, so that the kinematics, the touch test
-    and the laws run once over every (time, pair) and (time, wall) row."""
-    from granplate.model.arrays import wall_arrays
+def block_seen(
+    model, ys, rows: np.ndarray, table: np.ndarray, cand: np.ndarray, walls: WallMotion, known: dict
+) -> Seen:
+    """`Seen` of the states ys (nb, ng, columns) at the output rows `rows` from the candidate
+    pairs `cand`: the states laid end to end as nb * ng granules, so that the kinematics and
+    the touch test run once over every (time, pair) and (time, wall) row. At a table time
+    the overlap is the kinematics' (physics.contact, physics.space); between, the distance's
+    (pairs: R_i + R_j - |x_j - x_i|; walls: x . n + R - offset), as the loop's own histories
+    see it."""
     from granplate.model.contacts import centre_coordinates
     from granplate.model.neighbours import contacts_among
 
-    s, mats, g, cfg = model.scenario, list(model.materials), model.granular, model.config
+    cfg = model.config
     nb, ng, c = ys.shape
     d = of_state(c).n
-    r = np.asarray(g.radius, float)
+    r = np.asarray(model.granular.radius, float)
     flat = ys.reshape(nb * ng, c)
     r_flat = np.tile(r, nb)
     base = (np.arange(nb, dtype=np.int64) * ng)[:, None]
     pairs = np.column_stack([(base + cand[:, 0]).ravel(), (base + cand[:, 1]).ravel()]).reshape(-1, 2)
     pair_kin, wall_kin = KINEMATICS[of_state(c).name]
     kin = np.zeros((len(pairs), 3))
-    pair_kin(flat, r_flat, pairs, cfg.arm_shrink, kin)
+    at_table = table[pairs[:, 0] // ng]
+    sub = np.zeros((int(at_table.sum()), 3))
+    pair_kin(flat, r_flat, np.ascontiguousarray(pairs[at_table]), cfg.arm_shrink, sub)
+    kin[at_table] = sub
+    between = ~at_table
+    if between.any():
+        i, j = pairs[between, 0], pairs[between, 1]
+        kin[between, DELTA] = r_flat[i] + r_flat[j] - np.linalg.norm(flat[j, :d] - flat[i, :d], axis=1)
     on = np.flatnonzero(kin[:, DELTA] > 0.0)
     x, yy, z = centre_coordinates(flat, d)
     on = on[contacts_among(pairs[on], x, yy, r_flat, 0.0, z)]
     pt, pi, pj = pairs[on, 0] // ng, pairs[on, 0] % ng, pairs[on, 1] % ng
-    code, inverse = np.unique(pi * ng + pj, return_inverse=True)
-    coef = cached_rows(s, mats, g, np.column_stack([code // ng, code % ng]), known)[inverse.ravel()]
-    pv = np.zeros((len(on), 3))
-    link_forces(np.ascontiguousarray(kin[on]), coef, np.zeros(len(on)), np.zeros(len(on)), cfg.clip, pv)
-    # granules reaching each wall (overlap >= 0), as `touching_walls` at each time
-    if len(walls.normal):
-        reach = (flat[:, :d] @ walls.normal.T).reshape(nb, ng, -1) + r[None, :, None] - walls.offset[rows][:, None, :]
-        wt, wi, ww = np.nonzero(reach >= 0.0)
-    else:
-        wt = wi = ww = np.zeros(0, np.int64)
-    wkey, winv = np.unique(wi * len(walls.normal) + ww, return_inverse=True) if len(wi) else (np.zeros(0, np.int64), wi)
-    nw = max(len(walls.normal), 1)
-    _, wcoef = wall_arrays(s, mats, r, g.mass, np.column_stack([wkey // nw, wkey % nw]), model.walls)
-    wcoef = wcoef[np.asarray(winv, np.int64).ravel()] if len(wi) else wcoef
-    geo = np.column_stack([walls.normal[ww], walls.offset[rows[wt], ww]]) if len(wi) else np.zeros((0, d + 1))
-    wkin = np.zeros((len(wi), 3))
-    wall_kin(
-        flat, r_flat, np.ascontiguousarray(wt * ng + wi), geo, walls.speed[rows[wt], ww].copy(), cfg.arm_shrink, wkin
+    pair_coef = np.zeros((len(on), N_COEF))
+    tab = table[pt]
+    if tab.any():
+        code, inverse = np.unique(pi[tab] * ng + pj[tab], return_inverse=True)
+        rows_ = cached_rows(model, np.column_stack([code // ng, code % ng]), known)
+        pair_coef[tab] = rows_[np.asarray(inverse, np.int64).ravel()]
+    wt, wi, ww, wkin, wall_coef = block_walls(model, flat, rows, table, walls, r_flat, ng, wall_kin)
+    keep = wkin[:, DELTA] > 0.0
+    wt, wi, ww, wkin, wall_coef = wt[keep], wi[keep], ww[keep], wkin[keep], wall_coef[keep]
+    time = np.concatenate([pt, wt])
+    kind = np.concatenate([np.zeros(len(pt), np.int64), np.ones(len(wt), np.int64)])
+    gran = np.concatenate([pi, wi])
+    other = np.concatenate([pj, ww])  # the partner granule, or the wall's index
+    order = np.lexsort((other, gran, kind, time))
+    all_kin = np.concatenate([kin[on], wkin])[order]
+    return Seen(
+        time=rows[time[order]],
+        granule=gran[order],
+        partner=np.concatenate([pj, -1 - ww])[order],
+        delta=all_kin[:, DELTA].copy(),
+        table=table[time[order]],
+        kin=all_kin,
+        coef=np.concatenate([pair_coef, wall_coef])[order],
     )
-    wv = np.zeros((len(wi), 3))
-    link_forces(wkin, wcoef, np.zeros(len(wi)), np.zeros(len(wi)), cfg.clip, wv)
-    keep_p, keep_w = pv[:, OVERLAP] > 0.0, wv[:, OVERLAP] > 0.0
-    t_all = np.concatenate([pt[keep_p], wt[keep_w]])
-    kind = np.concatenate([np.zeros(int(keep_p.sum()), np.int64), np.ones(int(keep_w.sum()), np.int64)])
-    gran = np.concatenate([pi[keep_p], wi[keep_w]])
-    other = np.concatenate([pj[keep_p], ww[keep_w]])  # the partner granule, or the wall's index
-    order = np.lexsort((other, gran, kind, t_all))
-    partner = np.concatenate([pj[keep_p], -1 - ww[keep_w]])
-    values = np.concatenate([pv[keep_p], wv[keep_w]])[order]
-    return t_all[order], Links(granule=gran[order], partner=partner[order], values=values), nb
 
 
-def cached_rows(s, mats, g, pairs: np.ndarray, known: dict) -> np.ndarray:
+def block_walls(model, flat, rows, table, walls: WallMotion, r_flat, ng: int, wall_kin):
+    """(time in the block, granule, wall, kinematics (n, 3), coefficient rows) of the granules
+    reaching each wall (x . n + R - offset >= 0) at the block's states `flat` (nb * ng rows);
+    the kinematics' at table times (the wall where its drive put it, moving at its speed),
+    the overlap x . n + R - offset between; coefficient rows at table times (zeros between)."""
+    from granplate.model.arrays import wall_arrays
+
+    nb = len(rows)
+    nw = len(walls.normal)
+    d = walls.normal.shape[1]
+    if not nw:
+        e = np.zeros(0, np.int64)
+        return e, e, e, np.zeros((0, 3)), np.zeros((0, N_COEF))
+    r = r_flat[:ng]
+    reach = (flat[:, :d] @ walls.normal.T).reshape(nb, ng, nw) + r[None, :, None] - walls.offset[rows][:, None, :]
+    wt, wi, ww = np.nonzero(reach >= 0.0)
+    o = rows[wt]
+    tab = table[wt]
+    kin = np.zeros((len(wt), 3))
+    geo = np.column_stack([walls.normal[ww[tab]], walls.offset[o[tab], ww[tab]]]).reshape(-1, d + 1)
+    sub = np.zeros((int(tab.sum()), 3))
+    wall_kin(
+        flat,
+        r_flat,
+        np.ascontiguousarray(wt[tab] * ng + wi[tab]),
+        geo,
+        walls.speed[o[tab], ww[tab]].copy(),
+        model.config.arm_shrink,
+        sub,
+    )
+    kin[tab] = sub
+    if (~tab).any():
+        i, w, gi = wi[~tab], ww[~tab], wt[~tab] * ng + wi[~tab]
+        kin[~tab, DELTA] = np.sum(flat[gi, :d] * walls.normal[w], axis=1) + r[i] - walls.offset[o[~tab], w]
+    coef = np.zeros((len(wt), N_COEF))
+    if tab.any():
+        key, inverse = np.unique(wi[tab] * nw + ww[tab], return_inverse=True)
+        g = model.granular
+        _, rows_ = wall_arrays(
+            model.scenario, list(model.materials), r, g.mass, np.column_stack([key // nw, key % nw]), model.walls
+        )
+        coef[tab] = rows_[np.asarray(inverse, np.int64).ravel()]
+    return wt, wi, ww, kin, coef
+
+
+def cached_rows(model, pairs: np.ndarray, known: dict) -> np.ndarray:
     """model.relists.cached_pair_coefficients of the distinct sorted pairs (n, 2)."""
     from granplate.model.arrays import cached_pair_coefficients
 
-    return cached_pair_coefficients(s, mats, g, np.asarray(pairs, np.int64).reshape(-1, 2), known)
+    g = model.granular
+    return cached_pair_coefficients(
+        model.scenario, list(model.materials), g, np.asarray(pairs, np.int64).reshape(-1, 2), known
+    )
 
 
 def table_variables(counts: np.ndarray, links: Links, times: np.ndarray) -> tuple[dict[str, xr.DataArray], dict]:
