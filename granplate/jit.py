@@ -11,6 +11,15 @@ compiles its own entry once, the same function with both wrappers, cached apart.
 
 `njit(entry=True)` marks the functions the driver calls from Python (the time loop, its
 start, the model build's kernels): compiled as numba compiles them, wrappers and all.
+
+The time loop (`solver.loop.advance`) is compiled with `NO_REFCOUNT`: without numba's
+reference counting, which every kernel it calls inherits (numba passes that option down to
+the kernels a function calls when they do not set it). The loop hands the run's named
+tuples of arrays (some 200 arrays) to every hook of its step, and numba counted a
+reference to each array at the entry and exit of every call: for a small assembly that
+counting was nine tenths of a step (docs/benchmarks.md, "Reference counting"). Nothing the
+step calls may allocate an array then (numba refuses to compile one that does, naming it):
+the step works in the run's scratch arrays, made before the loop starts.
 """
 
 from __future__ import annotations
@@ -32,6 +41,10 @@ PYTHON_CALLS: Counter[str] = Counter()
 
 #: Compile options of a kernel: the wrappers only a call from Python or C needs left out.
 WITHOUT_WRAPPERS = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True}
+
+#: Compile options of the time loop: no reference counting (numba's NRT) in it or in any
+#: kernel it calls (they inherit the option); none of them may allocate.
+NO_REFCOUNT = {"_nrt": False}
 
 
 class Kernel(CPUDispatcher):

@@ -3,6 +3,8 @@ numbers called from Python as from compiled code, and a run calls none from Pyth
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba.core.registry import CPUDispatcher
 
@@ -71,3 +73,88 @@ def test_a_run_calls_no_kernel_from_python():
         for s in k.scenarios():
             simulate(s, t_end=kernels.SHORT_T_END, progress=False)
     assert jit.PYTHON_CALLS - before == {}
+
+
+class _Springs(NamedTuple):
+    """A named tuple of arrays, as the loop's: positions and stiffnesses."""
+
+    x: np.ndarray
+    k: np.ndarray
+
+
+def _springs(name: str):
+    """A kernel (its name) summing 1/2 k x^2 over the springs of positive k, each term by a
+    kernel of its own: the shape of the loop's passes, whose reference counts numba keeps."""
+
+    def term(t: _Springs, i: int) -> float:
+        return 0.5 * t.k[i] * t.x[i] * t.x[i]
+
+    compiled_term = njit(term)
+
+    def energy(t: _Springs) -> float:
+        e = 0.0
+        for i in range(t.x.shape[0]):
+            if t.k[i] > 0.0:
+                e += compiled_term(t, i)
+        return e
+
+    energy.__qualname__ = energy.__name__ = name
+    return njit(energy)
+
+
+#: the same kernel twice: one called from a loop compiled with NO_REFCOUNT, one from a plain one
+_energy_uncounted = _springs("_energy_uncounted")
+_energy_counted = _springs("_energy_counted")
+
+
+@njit(entry=True, **jit.NO_REFCOUNT)
+def _loop_uncounted(t: _Springs, n: int) -> float:
+    s = 0.0
+    for _ in range(n):
+        s += _energy_uncounted(t)
+    return s
+
+
+@njit(entry=True)
+def _loop_counted(t: _Springs, n: int) -> float:
+    s = 0.0
+    for _ in range(n):
+        s += _energy_counted(t)
+    return s
+
+
+def _counts_references(dispatcher) -> bool:
+    """Whether the machine code numba built for the dispatcher calls its reference counting."""
+    code = next(iter(dispatcher.overloads.values())).library.get_llvm_str()
+    return "@NRT_incref" in code or "@NRT_decref" in code
+
+
+def test_a_kernel_the_loop_calls_counts_no_references():
+    """A kernel called from a function compiled with NO_REFCOUNT inherits it: neither counts
+    the references of the named tuple's arrays, while the same kernel called from a plain
+    function does (so the check sees counting where there is some); both give 1/2 k x^2 n."""
+    t = _Springs(np.array([1.0, 2.0]), np.array([2.0, 0.5]))
+    assert _loop_uncounted(t, 3) == _loop_counted(t, 3) == 3 * (0.5 * 2.0 * 1.0 + 0.5 * 0.5 * 4.0)
+    assert not _counts_references(_loop_uncounted) and not _counts_references(_energy_uncounted)
+    assert _counts_references(_energy_counted)
+
+
+def test_the_time_loop_counts_no_references_and_a_run_leaves_none_behind():
+    """solver.loop.advance is compiled with NO_REFCOUNT, and a run (velocity Verlet, the
+    plane) leaves the model's arrays with the references they had before it."""
+    import gc
+    import sys
+
+    from granplate.model.arrays import build_model
+    from granplate.results import kernels
+    from granplate.solver import loop
+    from granplate.solver.driver import run
+
+    assert loop.advance.targetoptions.get("_nrt") is False
+    s = next(k for k in kernels.KERNEL_SETS if k.name == "verlet-2d").scenarios()[0]
+    m = build_model(s)
+    arrays = [a for a in m.granular if isinstance(a, np.ndarray)]
+    before = [sys.getrefcount(a) for a in arrays]
+    run(m)
+    gc.collect()
+    assert [sys.getrefcount(a) for a in arrays] == before

@@ -264,5 +264,6 @@ def build_body(s: Scenario, mats, r: np.ndarray, mass: np.ndarray):
         rcol=np.zeros((ng, 3 * n_p), np.int64),
         rcoef=z((ng, 3 * n_p)),
         rgrad=z((ng, 3 * n_p, 3)),
+        mrow=z(nm),
     )
     return solid, arrays, rigid

@@ -247,7 +247,9 @@ class BodyArrays(NamedTuple):
     q, qd, qdp: (nm,) the trial step's modal displacement and velocity and the velocity
     predicted for the force pass; static: (2,) the residual compliance's energy [J];
     active: (ng,) int, and rcol, rcoef: (ng, 3 P), rgrad: (ng, 3 P, 3)
-    scratch of the residual solve (each term's dof in S, its weight, its gradient).
+    scratch of the residual solve (each term's dof in S, its weight, its gradient); mrow:
+    (nm,) modal scratch of a step (the split friction's unit impulse share,
+    solver.body_friction; the modes' rates of Mindlin's pass, solver.body_mindlin).
     """
 
     face_nodes: np.ndarray
@@ -288,6 +290,7 @@ class BodyArrays(NamedTuple):
     rcol: np.ndarray
     rcoef: np.ndarray
     rgrad: np.ndarray
+    mrow: np.ndarray
 
 
 class NoBodyArrays(BodyArrays):
@@ -342,6 +345,7 @@ def no_body(ng: int, nm: int) -> BodyArrays:
         rcol=np.zeros((0, 3), i),
         rcoef=z((0, 3)),
         rgrad=z((0, 3, 3)),
+        mrow=z(nm),
     )
 
 
@@ -366,4 +370,5 @@ def new_body_state(b: BodyArrays) -> BodyArrays:
         rcol=b.rcol.copy(),
         rcoef=b.rcoef.copy(),
         rgrad=b.rgrad.copy(),
+        mrow=b.mrow.copy(),
     )

@@ -396,6 +396,8 @@ def block_candidates(ys: np.ndarray, r: np.ndarray) -> np.ndarray | None:
     of fewer times is cheaper) or is not finite."""
     from granplate.model.neighbours import SEARCH_MARGIN, reaching_pairs
 
+    if ys.shape[1] < 2:
+        return np.zeros((0, 2), np.int64)
     d = of_state(ys.shape[2]).n
     p0 = ys[0, :, :d]
     disp = float(np.sqrt(np.max(np.sum((ys[:, :, :d] - p0) ** 2, axis=2)))) if len(ys) > 1 else 0.0

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from granplate.jit import njit
 
 from granplate.model.inputs import GEO_DELTA, GEO_N, GEO_NX, GEO_NY, GEO_NZ, GEO_TOUCH
@@ -42,7 +41,7 @@ def friction_flow(y, qd, dt, b, buf, radius, mass, inertia, arm_shrink, forward)
     Returns the energy dissipated [J]: the kinetic energy the impulses removed."""
     ng = y.shape[0]
     nm = qd.shape[0]
-    row = np.empty(nm)
+    row = b.mrow  # (nm,) scratch
     work = 0.0
     g = b.geo[buf]
     for kk in range(ng):

@@ -16,7 +16,6 @@ slip's work in D_friction (eq. M6), not in D_visc.
 
 from __future__ import annotations
 
-import numpy as np
 from granplate.jit import njit
 
 from granplate.model.inputs import GEO_DELTA, GEO_N, GEO_NX, GEO_NY, GEO_NZ, GEO_TOUCH
@@ -104,7 +103,7 @@ def step_forces(y, q0, q1, b, buf_old, buf, h, radius, mass, inertia, arm_shrink
     (0, 0) at once where no contact is Mindlin's."""
     if not has_mindlin(b):
         return 0.0, 0.0
-    vq = np.empty(q0.shape[0])
+    vq = b.mrow  # (nm,) scratch: the modes' rates
     for m in range(vq.shape[0]):
         vq[m] = (q1[m] - q0[m]) / h
     return mindlin_forces(y, vq, b, buf_old, buf, h, radius, mass, inertia, arm_shrink, acc)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-from granplate.jit import njit
+from granplate.jit import NO_REFCOUNT, njit
 
 from granplate.physics.energy import energy_residual, energy_total
 from granplate.solver import schemes as S
@@ -346,7 +346,7 @@ def accept_granular(t, h, land, t_out, plate_work, e_pot, st, w, rows):
     w.dt_int[1] = max(w.dt_int[1], h)
 
 
-@njit(entry=True, cache=True)
+@njit(entry=True, cache=True, **NO_REFCOUNT)
 def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
     """Advance from st.clock[T_NOW] to t_stop (an output time) with the scheme whose
     scratch is sw, trying at most max_attempts steps. Returns a status: OK, PAUSED

@@ -28,7 +28,9 @@ BODY_MODEL = (
 #: the threaded passes' block buffers (solver.blocks: rewritten by every force pass, and
 #: sized by the thread count, which a restart may change)
 BLOCKS = frozenset({"sw.fpar", "sw.spar"})
-LEFT_OUT = CACHES | BLOCKS | {f"sw.body.{name}" for name in BODY_MODEL}
+#: scratch rewritten before every use
+SCRATCH = frozenset({"sw.body.mrow"})
+LEFT_OUT = CACHES | BLOCKS | SCRATCH | {f"sw.body.{name}" for name in BODY_MODEL}
 
 
 def _flat(prefix: str, tup, out: dict[str, np.ndarray]) -> None:
