@@ -19,7 +19,9 @@ tuples of arrays (some 200 arrays) to every hook of its step, and numba counted 
 reference to each array at the entry and exit of every call: for a small assembly that
 counting was nine tenths of a step (docs/benchmarks.md, "Reference counting"). Nothing the
 step calls may allocate an array then (numba refuses to compile one that does, naming it):
-the step works in the run's scratch arrays, made before the loop starts.
+the step works in the run's scratch arrays, made before the loop starts. Nor does a
+kernel of the step return an array (it returns numbers and flags): a kernel compiled
+elsewhere with reference counting would hand the loop a reference it never gives back.
 """
 
 from __future__ import annotations

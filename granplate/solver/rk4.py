@@ -42,7 +42,8 @@ def first_stage(t, y0, hold, split, st, g, cfg, w):
     """RK4's first stage (derivative, powers) at state y0 and time t [s]: st.k1/st.p1 (the
     last step's end, first same as last), or recomputed into w.k1h/w.p1h where the held
     plate-contact friction (hold) or the split friction's half step changes it, or
-    Mindlin's law needs the stage's slip (solver.mindlin_rk4)."""
+    Mindlin's law needs the stage's slip (solver.mindlin_rk4). Returns whether it was
+    recomputed (a flag, not the arrays: the time loop counts no references, jit.NO_REFCOUNT)."""
     if plate_friction_held(hold, g) or split or cfg.mindlin_stages:
         pr = granular_rhs(
             t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
@@ -52,8 +53,8 @@ def first_stage(t, y0, hold, split, st, g, cfg, w):
         w.p1h[2] = pr.p_fric
         w.p1h[3] = pr.p_drive
         w.p1h[4] = pr.p_grav
-        return w.k1h, w.p1h
-    return st.k1, st.p1
+        return True
+    return False
 
 
 @njit(cache=True)
@@ -142,7 +143,9 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w, b=None, bs=None):
         fric_split = opening_friction(y0, h, g, cfg, w)
         y0 = w.ynew
     e_spring = begin_stages(g, cfg)
-    k1, p1 = first_stage(t, y0, hold, split, st, g, cfg, w)
+    recomputed = first_stage(t, y0, hold, split, st, g, cfg, w)
+    k1 = w.k1h if recomputed else st.k1
+    p1 = w.p1h if recomputed else st.p1
     if b is not None:  # the body's friction half step, its forces at t_n, its modes over h
         fric_split += BI.open_step(t, h, y0, split, st, b, bs, g, cfg, k1, p1, split)
     hh = 0.5 * h
