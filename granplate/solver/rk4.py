@@ -143,9 +143,7 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w, b=None, bs=None):
         fric_split = opening_friction(y0, h, g, cfg, w)
         y0 = w.ynew
     e_spring = begin_stages(g, cfg)
-    recomputed = first_stage(t, y0, hold, split, st, g, cfg, w)
-    k1 = w.k1h if recomputed else st.k1
-    p1 = w.p1h if recomputed else st.p1
+    k1, p1 = (w.k1h, w.p1h) if first_stage(t, y0, hold, split, st, g, cfg, w) else (st.k1, st.p1)
     if b is not None:  # the body's friction half step, its forces at t_n, its modes over h
         fric_split += BI.open_step(t, h, y0, split, st, b, bs, g, cfg, k1, p1, split)
     hh = 0.5 * h
