@@ -134,9 +134,9 @@ def test_restitution_closed_form_first_order():
 
 def test_local_map_modulus_eq8():
     """|lambda| = 1/2 mu k_s |N| dt c cosh^-2(k_s v_t) (paper eq. 8)."""
-    lam = C.local_map_modulus(0.099, 1000.0, 50.0, 4e-9, 1e5, 0.0)
+    lam = C.local_map_modulus(C.friction_slope(50.0, 0.0, 0.099, 1000.0), 4e-9, 1e5)
     assert lam == pytest.approx(0.5 * 0.099 * 1000 * 50 * 4e-9 * 1e5)
-    assert C.local_map_modulus(0.099, 1000.0, 50.0, 4e-9, 1e5, 1e-2) < lam
+    assert C.local_map_modulus(C.friction_slope(50.0, 1e-2, 0.099, 1000.0), 4e-9, 1e5) < lam
 
 
 @pytest.mark.parametrize("v0, decay", [(2e-4, 0.3), (2e-3, 5.0), (-0.05, 40.0), (0.5, 1e3), (36.0, 2e4), (-36.0, 4e4)])

@@ -26,7 +26,7 @@ from granplate.setup.scenario import (
     TimeSettings,
     Wall,
 )
-from granplate.physics.contact import COEF_A, COEF_KS, hertz_elastic
+from granplate.physics.contact import COEF_A, hertz_elastic
 from granplate.solver.granular import friction_flow, kinetic_energies, slip_relaxation_rate
 
 R = 0.01
@@ -139,8 +139,7 @@ def test_squeezed_sphere_loses_its_kinetic_energy_to_friction_exactly():
     rate = slip_relaxation_rate(
         hertz_elastic(5e-5, g.wall_coef[0, COEF_A]),
         0.0,
-        0.2,
-        g.wall_coef[0, COEF_KS],
+        g.wall_coef[0],
         1.0 / m + g.radius[0] ** 2 / inertia,
     )
     assert 50 * ds.attrs["n_steps"] < 2e-4 * rate

@@ -199,9 +199,9 @@ def test_a_new_normal_law_is_one_module_and_one_registry_entry(tmp_path, monkeyp
     monkeypatch.setitem(law_registry.NORMAL_LAW_REGISTRY, "linear", law_registry.NormalLaw("granplate_linear_law"))
     names = list(law_registry.NORMAL_LAW_REGISTRY)
     modules = [laws.law_module(n) for n in names]
-    response = laws.pick_of_six(tuple(m.law_response for m in modules))
-    slopes = laws.pick_of_four(tuple(m.law_slopes for m in modules))
-    rate = laws.pick_of_six(tuple(m.law_rate for m in modules))
+    response = laws.pick_of(tuple(m.law_response for m in modules), 6)
+    slopes = laws.pick_of(tuple(m.law_slopes for m in modules), 4)
+    rate = laws.pick_of(tuple(m.law_rate for m in modules), 6)
 
     @njit
     def call(law, d, c):

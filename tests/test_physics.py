@@ -53,7 +53,9 @@ def test_friction_and_its_slope_eqs_5_8():
         slope = (f(v + h) - f(v - h)) / (2 * h)
         assert C.friction_slope(n, v, mu, ks) == pytest.approx(slope, rel=1e-8)
         dt, ct = 1e-7, 3.0
-        assert C.local_map_modulus(mu, ks, n, dt, ct, v) == pytest.approx(0.5 * slope * dt * ct, rel=1e-8)
+        assert C.local_map_modulus(C.friction_slope(n, v, mu, ks), dt, ct) == pytest.approx(
+            0.5 * slope * dt * ct, rel=1e-8
+        )
 
 
 def test_pair_kinematics_eq_6():

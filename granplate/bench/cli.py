@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from granplate.bench import write_report
+from granplate.setup.law_registry import TANGENTIAL_LAW_REGISTRY
 
 
 def _cmd_study(args) -> int:
@@ -194,7 +195,7 @@ def scaling_options(b) -> None:
     b.add_argument(
         "--friction-law",
         dest="friction_law",
-        choices=("tanh", "mindlin"),
+        choices=tuple(TANGENTIAL_LAW_REGISTRY),
         default=None,
         help="with --scaling --dimension 3: contact.tangential_law of the rows with friction "
         "(default tanh, the paper's; mindlin runs under --scheme verlet)",

@@ -24,7 +24,6 @@ from granplate.model.coefficients import pair_coefficients, plate_contact_coeffi
 from granplate.model.coefficients import coefficient_row as coefficient_row
 from granplate.model.coefficients import law_coefficients as law_coefficients
 from granplate.model.coefficients import material_indices as material_indices, normal_law_of as normal_law_of
-from granplate.model.coefficients import mindlin_columns as mindlin_columns
 from granplate.model.coefficients import pair_coefficient_row as pair_coefficient_row
 from granplate.model.coefficients import wall_coefficient_row as wall_coefficient_row
 from granplate.model.relists import cached_pair_coefficients as cached_pair_coefficients
@@ -32,6 +31,7 @@ from granplate.model.relists import carried_history as carried_history
 from granplate.model.relists import granular_with_contacts as granular_with_contacts
 from granplate.model.relists import granular_with_patch_contacts as granular_with_patch_contacts
 from granplate.setup.geometry import resolve
+from granplate.setup.law_registry import TANGENTIAL_LAW_REGISTRY
 from granplate.setup.materials import sphere_inertia, sphere_mass
 from granplate.setup.scenario import Plate, Scenario
 from granplate.setup.threads import loop_threads
@@ -265,8 +265,8 @@ def loop_config(
         load_on_plate=loads.plate_edge(s) is not None,
         arm_shrink=1.0 if s.contact.torque_arm == "contact_point" else 0.0,
         lammps_arms=s.contact.torque_arm == "lammps",
-        mindlin=s.contact.tangential_law == "mindlin",
-        mindlin_stages=s.contact.tangential_law == "mindlin" and sol.scheme != "verlet",
+        history_friction=TANGENTIAL_LAW_REGISTRY[s.contact.tangential_law].history,
+        history_stages=TANGENTIAL_LAW_REGISTRY[s.contact.tangential_law].history and sol.scheme != "verlet",
         scheme=scheme_number(sol.scheme),
         error_tol=float(sol.error_tol),
         force_floor=force_floor(q0, fres, tres, r, mass, s, t.output_interval) if floor is None else float(floor),

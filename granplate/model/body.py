@@ -51,16 +51,15 @@ def body_coefficients(
     both materials and the granule's radius (the body flat there), damping with m* = m_i
     (the body's mass much larger), the pair's friction, yield overlap and law ids; a granule on a
     rigid patch (on_rigid) meets a rigid body, the 2D rigid layer's law (E* of the granule
-    alone, m* = 0: no damping, docs/model.md section 3.4). Under Mindlin's tangential law
-    (docs/model.md section 3.16) the rows are Mindlin's: 1/G* of both, or of the granule
-    alone on a rigid patch."""
-    from granplate.model.arrays import coefficient_row, law_coefficients, mindlin_columns
-    from granplate.model.coefficients import normal_law_id
+    alone, m* = 0: no damping, docs/model.md section 3.4). The tangential law's columns
+    (Mindlin's, docs/model.md section 3.16) from 1/G* of both, or of the granule alone on a
+    rigid patch."""
+    from granplate.model.arrays import coefficient_row, law_coefficients
+    from granplate.model.coefficients import normal_law_id, tangential_law_columns
     from granplate.physics.mindlin import tangential_compliance
 
     coef = np.zeros((len(r), N_COEF))
     compliance = np.zeros(len(r))
-    mindlin = s.contact.tangential_law == "mindlin"
     for i, m in enumerate(mats):
         alpha, mu, ks = s.contact.for_pair(m.name, body_material.name)
         rigid = on_rigid is not None and bool(on_rigid[i])
@@ -75,12 +74,10 @@ def body_coefficients(
             law_coefficients(s, m, other, body_material.name, e_star, float(r[i]), 2.0 * float(r[i])),
             normal_law_id(s, m.name, body_material.name),
         )
-        if mindlin:
-            compliance[i] = tangential_compliance(m.E, m.nu)
-            if not rigid:
-                compliance[i] += tangential_compliance(body_material.E, body_material.nu)
-    if mindlin and len(r):
-        mindlin_columns(coef, compliance, s.contact.tangential_damping)
+        compliance[i] = tangential_compliance(m.E, m.nu)
+        if not rigid:
+            compliance[i] += tangential_compliance(body_material.E, body_material.nu)
+    tangential_law_columns(s, coef, compliance)
     return coef
 
 

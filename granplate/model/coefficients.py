@@ -17,24 +17,22 @@ from granplate.physics.contact import (
     COEF_C,
     COEF_DY,
     COEF_KS,
-    COEF_KT,
     COEF_MU,
-    COEF_MUT,
     COEF_NLAW,
     COEF_TLAW,
     COEF_XH,
-    COEF_XT,
     N_COEF,
     damping_coefficient,
     hertz_coefficient,
 )
-from granplate.physics.mindlin import mindlin_coefficient, tangential_compliance
+from granplate.physics.laws import tangential_columns
+from granplate.physics.mindlin import tangential_compliance
 from granplate.physics.laws import law_columns
 from granplate.setup.materials import (
     effective_modulus,
     softer_material,
 )
-from granplate.setup.law_registry import HERTZ, MINDLIN, NORMAL_LAW_IDS, TANH
+from granplate.setup.law_registry import HERTZ, NORMAL_LAW_IDS, TANH
 from granplate.setup.scenario import Scenario
 
 
@@ -44,7 +42,7 @@ def coefficient_row(a: float, c: float, mu: float, k_s: float, law=math.inf, nor
     columns from COEF_DY on (`law_coefficients`; inf alone: a yield overlap never
     reached), the normal law's id `normal_law`
     (setup.law_registry's NORMAL_LAW_IDS, `normal_law_id`) and the tanh law's tangential id
-    (`mindlin_columns` makes a row Mindlin's)."""
+    (`tangential_columns` makes a row another tangential law's)."""
     row = np.zeros(N_COEF)
     row[COEF_A], row[COEF_C], row[COEF_MU], row[COEF_KS] = a, c, mu, k_s
     law = np.atleast_1d(np.asarray(law, float))
@@ -152,29 +150,29 @@ def pair_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, pairs:
     pair_coef[:, COEF_A] = coef_a
     pair_coef[:, COEF_C] = alpha * np.sqrt(m_star * coef_a)  # damping_coefficient
     pair_coef[:, COEF_MU], pair_coef[:, COEF_KS], pair_coef[:, COEF_DY] = mu, ks, math.inf
-    pair_coef[:, COEF_NLAW], pair_coef[:, COEF_TLAW] = nlaw, TANH
+    pair_coef[:, COEF_NLAW] = nlaw
     for p in np.flatnonzero(plastic).tolist():
         a, b = mats[i[p]], mats[j[p]]
         e_p = e_star if combo is None else float(e_star[p])
         pair_coef[p, COEF_DY : COEF_XH + 1] = law_coefficients(
             s, a, b, b.name, e_p, float(r_star[p]), float(r[i[p]] + r[j[p]])
         )
-    if s.contact.tangential_law == "mindlin":
-        compliance = np.array([tangential_compliance(m.E, m.nu) for m in kinds])
-        mindlin_columns(pair_coef, compliance[kind[i]] + compliance[kind[j]], s.contact.tangential_damping)
+    compliance = kind_compliances(kinds)
+    tangential_law_columns(s, pair_coef, compliance[kind[i]] + compliance[kind[j]])
     return pair_coef
 
 
-def mindlin_columns(coef: np.ndarray, compliance: np.ndarray, damping: float) -> None:
-    """Rows of `coef` made Mindlin's (docs/model.md section 3.16) in place: 8 G* from
-    1 / G* = `compliance` [1/Pa] (per row, eq. M1) into COEF_KT, the Coulomb coefficient moved
-    from COEF_MU (which the tanh law reads) to COEF_MUT, the tangential damping factor x_t
-    (contact.tangential_damping) into COEF_XT, Mindlin's id into COEF_TLAW."""
-    coef[:, COEF_KT] = mindlin_coefficient(1.0) / compliance
-    coef[:, COEF_MUT] = coef[:, COEF_MU]
-    coef[:, COEF_MU] = 0.0
-    coef[:, COEF_XT] = damping
-    coef[:, COEF_TLAW] = MINDLIN
+def kind_compliances(kinds) -> np.ndarray:
+    """Each Material's share (2 - nu) / G [1/Pa] of a contact's tangential compliance 1/G*."""
+    return np.array([tangential_compliance(m.E, m.nu) for m in kinds], float)
+
+
+def tangential_law_columns(s: Scenario, coef: np.ndarray, compliance: np.ndarray) -> None:
+    """The scenario's tangential law (contact.tangential_law) into the rows `coef` in place:
+    its columns and id (physics.laws.tangential_columns), from each row's 1/G* = `compliance`
+    [1/Pa] (the two bodies' shares summed, a rigid body's 0)."""
+    if len(coef):
+        tangential_columns(s.contact.tangential_law, coef, compliance, s.contact)
 
 
 def wall_coefficient_row(s: Scenario, a, wall_material: str, ri: float, mi: float) -> np.ndarray:
@@ -191,9 +189,7 @@ def wall_coefficient_row(s: Scenario, a, wall_material: str, ri: float, mi: floa
         law_coefficients(s, a, None, wall_material, e_star, ri, 2.0 * ri),
         normal_law_id(s, a.name, wall_material),
     )
-    if s.contact.tangential_law == "mindlin":
-        rows = row.reshape(1, -1)
-        mindlin_columns(rows, np.array([tangential_compliance(a.E, a.nu)]), s.contact.tangential_damping)
+    tangential_law_columns(s, row.reshape(1, -1), kind_compliances([a]))
     return row
 
 
@@ -228,14 +224,12 @@ def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarr
     wall_coef[:, COEF_A] = coef_a
     wall_coef[:, COEF_C] = alpha * np.sqrt(mass[i] * coef_a)  # damping_coefficient with m* = m
     wall_coef[:, COEF_DY] = math.inf
-    wall_coef[:, COEF_NLAW], wall_coef[:, COEF_TLAW] = nlaw, TANH
+    wall_coef[:, COEF_NLAW] = nlaw
     for p in np.flatnonzero(nlaw != HERTZ).tolist():
         wall_coef[p, COEF_DY : COEF_XH + 1] = law_coefficients(
             s, mats[i[p]], None, s.walls[w[p]].material, float(e_star[p]), float(ri[p]), 2.0 * float(ri[p])
         )
-    if s.contact.tangential_law == "mindlin":  # a rigid wall: the granule's compliance alone
-        compliance = np.array([tangential_compliance(kinds[c].E, kinds[c].nu) for c in kind[i]])
-        mindlin_columns(wall_coef, compliance, s.contact.tangential_damping)
+    tangential_law_columns(s, wall_coef, kind_compliances(kinds)[kind[i]])  # a rigid wall: the granule's alone
     return wall_geo, wall_coef
 
 

@@ -197,8 +197,8 @@ class Config(NamedTuple):
     dimension: int = 2  # 2: the plane (state x, y, theta, vx, vy, omega); 3: space (x, y, z, vx, vy, vz, wx, wy, wz)
     threads: int = 1  # blocks of the velocity-Verlet passes, one per thread (solver.blocks; 1: serial)
     lammps_arms: bool = False  # contact.torque_arm = "lammps": Mindlin's torque at R - delta/2 (pairs), R (walls)
-    mindlin: bool = False  # contact.tangential_law = "mindlin": the Verlet force pass runs Mindlin's law in it
-    mindlin_stages: bool = False  # Mindlin's law under the RK4 schemes: in their stages (solver.mindlin_rk4)
+    history_friction: bool = False  # a tangential law with history (Mindlin's): the Verlet force pass runs it
+    history_stages: bool = False  # that law under the RK4 schemes: in their stages (solver.mindlin_rk4)
 
 
 #: columns of BodyArrays.geo, one row per granule and buffer (docs/model.md section 3.9):

@@ -209,7 +209,7 @@ def friction_slope(n_abs: float, v_t: float, mu: float, k_s: float) -> float:
     """d f / d v_t = mu k_s |N| / cosh^2(k_s v_t) [N s/m], the slope of eq. (5) that
     criterion (8) multiplies by the step and the compliance."""
     ch = math.cosh(k_s * v_t)
-    return mu * k_s * n_abs / (ch * ch)
+    return mu * n_abs * k_s / (ch * ch)
 
 
 #: beyond this |k_s v_t| sinh(k_s v_t) is handled through its logarithm (no overflow).
@@ -240,13 +240,14 @@ def slip_after_friction(v_t: float, n_abs: float, mu: float, k_s: float, inv_mas
 
 
 @njit(cache=True)
-def local_map_modulus(mu: float, k_s: float, n_abs: float, dt: float, c_t: float, v_t: float) -> float:
+def local_map_modulus(slope: float, dt: float, c_t: float) -> float:
     """|lambda| of the frictional local map at a plate contact, paper eq. (8):
-    1/2 (d f / d v_t) dt c_t.
+    1/2 (d f / d v_t) dt c_t, with the friction law's slope d f / d v_t [N s/m] (eq. 5's:
+    `friction_slope`; physics.laws.tangential_slopes) and step dt [s].
 
     c_t: the tangential driving DOF's diagonal entry of (M + dt^2 K / 4)^-1 [1/kg].
     """
-    return 0.5 * friction_slope(n_abs, v_t, mu, k_s) * dt * c_t
+    return 0.5 * slope * dt * c_t
 
 
 @njit(cache=True)

@@ -27,12 +27,13 @@ from __future__ import annotations
 
 import importlib
 from types import ModuleType
+from typing import NamedTuple
 
 import numpy as np
 
 from granplate.jit import njit
-from granplate.physics.contact import COEF_NLAW
-from granplate.setup.law_registry import NORMAL_LAW_REGISTRY
+from granplate.physics.contact import COEF_NLAW, COEF_TLAW
+from granplate.setup.law_registry import NORMAL_LAW_REGISTRY, TANGENTIAL_LAW_REGISTRY, TangentialLaw
 
 #: the functions every normal law module gives (physics.hertz shows the signatures)
 LAW_FUNCTIONS = ("law_response", "law_force", "law_slopes", "law_rate", "law_columns")
@@ -40,61 +41,52 @@ LAW_FUNCTIONS = ("law_response", "law_force", "law_slopes", "law_rate", "law_col
 
 def law_module(name: str) -> ModuleType:
     """The module of the registered normal law `name`, checked to give every LAW_FUNCTIONS."""
-    module = importlib.import_module(NORMAL_LAW_REGISTRY[name].module)
-    missing = [f for f in LAW_FUNCTIONS if not hasattr(module, f)]
+    return checked_module(f"normal law {name!r}", NORMAL_LAW_REGISTRY[name].module, LAW_FUNCTIONS)
+
+
+def checked_module(what: str, path: str, functions: tuple[str, ...]) -> ModuleType:
+    """The module at `path`, checked to give every one of `functions` (else an ImportError
+    naming `what` and the missing ones)."""
+    module = importlib.import_module(path)
+    missing = [f for f in functions if not hasattr(module, f)]
     if missing:
-        raise ImportError(f"normal law {name!r}: module {module.__name__} lacks {', '.join(missing)}")
+        raise ImportError(f"{what}: module {module.__name__} lacks {', '.join(missing)}")
     return module
 
 
-def pick_of_six(functions: tuple, first: int = 0):
-    """A compiled function (law, a, b, c, d, e, f) -> functions[law - first](a, ..., f): one
-    compare per function before the law's (the last is taken without a compare)."""
-    head = functions[0]
-    if len(functions) == 1:
-
-        @njit(cache=True, inline="always")
-        def last(law, a, b, c, d, e, f):
-            return head(a, b, c, d, e, f)
-
-        return last
-    tail = pick_of_six(functions[1:], first + 1)
-
-    @njit(cache=True, inline="always")
-    def pick(law, a, b, c, d, e, f):
-        if law == first:
-            return head(a, b, c, d, e, f)
-        return tail(law, a, b, c, d, e, f)
-
-    return pick
+def pick_of(functions: tuple, arity: int, ids: tuple[int, ...] | None = None, default=None):
+    """A compiled function (law, a0, ..., a[arity-1]) -> functions[k](a0, ...) for the k
+    whose id is `law` (ids[k]; None: k itself): one compare per function before the law's.
+    default: the function for an id not in ids (None: the last function is taken without a
+    compare). Compiled inline (`inline="always"`), like the laws' functions: the chain costs
+    the caller its compares only. The source of each link is written for its arity (numba
+    compiles no call with *args to an inlined function)."""
+    ids = tuple(range(len(functions))) if ids is None else tuple(ids)
+    names = ", ".join(f"a{k}" for k in range(arity))
+    chain = default
+    if chain is None:
+        functions, ids, chain = functions[:-1], ids[:-1], _link(f"return HEAD({names})", names, HEAD=functions[-1])
+    else:
+        chain = _link(f"return HEAD({names})", names, HEAD=default)
+    for function, law in zip(reversed(functions), reversed(ids)):
+        body = f"if law == {int(law)}:\n        return HEAD({names})\n    return TAIL(law, {names})"
+        chain = _link(body, names, HEAD=function, TAIL=chain)
+    return chain
 
 
-def pick_of_four(functions: tuple, first: int = 0):
-    """`pick_of_six` for functions of four arguments."""
-    head = functions[0]
-    if len(functions) == 1:
-
-        @njit(cache=True, inline="always")
-        def last(law, a, b, c, d):
-            return head(a, b, c, d)
-
-        return last
-    tail = pick_of_four(functions[1:], first + 1)
-
-    @njit(cache=True, inline="always")
-    def pick(law, a, b, c, d):
-        if law == first:
-            return head(a, b, c, d)
-        return tail(law, a, b, c, d)
-
-    return pick
+def _link(body: str, names: str, **space):
+    """One compiled link of a `pick_of` chain: def pick(law, names): body, with `space`
+    (the functions it calls) as its globals."""
+    source = f"def pick(law, {names}):\n    {body}\n"
+    exec(compile(source, "<granplate.physics.laws dispatch>", "exec"), space)
+    return njit(inline="always")(space["pick"])
 
 
 _MODULES = tuple(law_module(name) for name in NORMAL_LAW_REGISTRY)
-_RESPONSE = pick_of_six(tuple(m.law_response for m in _MODULES))
-_FORCE = pick_of_six(tuple(m.law_force for m in _MODULES))
-_SLOPES = pick_of_four(tuple(m.law_slopes for m in _MODULES))
-_RATE = pick_of_six(tuple(m.law_rate for m in _MODULES))
+_RESPONSE = pick_of(tuple(m.law_response for m in _MODULES), 6)
+_FORCE = pick_of(tuple(m.law_force for m in _MODULES), 6)
+_SLOPES = pick_of(tuple(m.law_slopes for m in _MODULES), 4)
+_RATE = pick_of(tuple(m.law_rate for m in _MODULES), 6)
 
 
 @njit(cache=True)
@@ -132,3 +124,185 @@ def law_columns(name: str, softer, e_star: float, r_star: float, length: float) 
     that makes its approach speed a strain rate (the sum of the radii, a diameter against a
     rigid body)."""
     return law_module(name).law_columns(softer, e_star, r_star, length)
+
+
+# -- Tangential laws (setup.law_registry's TANGENTIAL_LAW_REGISTRY, ids in its order, the
+# coefficient row's column COEF_TLAW). A rate law's force follows from |N| and the slip
+# rate: the rate passes (every force pass of a scheme, the split friction, Newton's
+# Jacobian, criterion 8) reach it through `tangential_friction`, `tangential_slopes` and
+# `tangential_relaxed_slip`, which give a contact under a history law no rate friction. A
+# history law (Mindlin's) keeps a tangential displacement per contact (the history columns
+# HIST_XI.., model.inputs): the history passes (solver.mindlin_history, the RK4 stages of
+# solver.mindlin_rk4) reach it through `keeps_history` and the `tangential_*` functions of
+# its history. physics.tanh_friction and physics.mindlin show the signatures.
+
+#: the functions a rate law's module gives
+RATE_FUNCTIONS = ("law_friction", "law_slopes", "law_relaxed_slip", "law_columns")
+#: the functions a history law's module gives
+HISTORY_FUNCTIONS = ("law_scale", "law_stiffness", "law_energy", "law_step", "law_stage", "law_columns")
+
+
+def tangential_module(name: str, law: TangentialLaw | None = None) -> ModuleType:
+    """The module of the registered tangential law `name` (or of `law`), checked to give
+    every function of its kind (HISTORY_FUNCTIONS or RATE_FUNCTIONS)."""
+    law = TANGENTIAL_LAW_REGISTRY[name] if law is None else law
+    return checked_module(f"tangential law {name!r}", law.module, HISTORY_FUNCTIONS if law.history else RATE_FUNCTIONS)
+
+
+@njit(cache=True, inline="always")
+def _yes() -> bool:
+    return True
+
+
+@njit(cache=True, inline="always")
+def _no() -> bool:
+    return False
+
+
+@njit(cache=True, inline="always")
+def _no_friction(n_abs, v_t, coef) -> float:
+    return 0.0
+
+
+@njit(cache=True, inline="always")
+def _no_slopes(n_abs, v_t, coef):
+    return 0.0, 0.0
+
+
+@njit(cache=True, inline="always")
+def _slip_kept(v_t, n_abs, coef, inv_mass_t, dt) -> float:
+    return v_t
+
+
+@njit(cache=True, inline="always")
+def _no_history_scale(coef, r_star, delta) -> float:
+    return 0.0
+
+
+@njit(cache=True, inline="always")
+def _no_history_stiffness(coef, a) -> float:
+    return 0.0
+
+
+@njit(cache=True, inline="always")
+def _no_history_energy(coef, a, xx, xy, xz) -> float:
+    return 0.0
+
+
+@njit(cache=True, inline="always")
+def _no_history_step(xx, xy, xz, a, a_old, coef, delta, nx, ny, nz, vx, vy, vz, dt, n_abs, f0x, f0y, f0z):
+    return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+
+
+@njit(cache=True, inline="always")
+def _no_history_stage(xx, xy, xz, a, a_old, coef, delta, nx, ny, nz, ix, iy, iz, vx, vy, vz, n_abs):
+    return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+
+
+class TangentialDispatch(NamedTuple):
+    """The compiled dispatch functions on a tangential law id, built from a registry
+    (`tangential_dispatch`): each (law, arguments of the law modules' function) -> its
+    value; an id of the other kind gets the default (no friction, no history)."""
+
+    keeps_history: object
+    friction: object
+    slopes: object
+    relaxed_slip: object
+    scale: object
+    stiffness: object
+    energy: object
+    step: object
+    stage: object
+
+
+def tangential_dispatch(registry: dict[str, TangentialLaw]) -> TangentialDispatch:
+    """The dispatch functions of the tangential laws of `registry` (ids in its order)."""
+    laws = [(k, law, tangential_module(name, law)) for k, (name, law) in enumerate(registry.items())]
+    rate = [(k, m) for k, law, m in laws if not law.history]
+    held = [(k, m) for k, law, m in laws if law.history]
+
+    def chain(kind: list, function: str, arity: int, default):
+        return pick_of(tuple(getattr(m, function) for _, m in kind), arity, tuple(k for k, _ in kind), default)
+
+    return TangentialDispatch(
+        pick_of(tuple(_yes for _ in held), 0, tuple(k for k, _ in held), _no),
+        chain(rate, "law_friction", 3, _no_friction),
+        chain(rate, "law_slopes", 3, _no_slopes),
+        chain(rate, "law_relaxed_slip", 5, _slip_kept),
+        chain(held, "law_scale", 3, _no_history_scale),
+        chain(held, "law_stiffness", 2, _no_history_stiffness),
+        chain(held, "law_energy", 5, _no_history_energy),
+        chain(held, "law_step", 18, _no_history_step),
+        chain(held, "law_stage", 17, _no_history_stage),
+    )
+
+
+_T = tangential_dispatch(TANGENTIAL_LAW_REGISTRY)
+_KEEPS, _FRICTION, _TSLOPES, _RELAXED = _T.keeps_history, _T.friction, _T.slopes, _T.relaxed_slip
+_TSCALE, _TSTIFF, _TENERGY, _TSTEP, _TSTAGE = _T.scale, _T.stiffness, _T.energy, _T.step, _T.stage
+
+
+@njit(cache=True, inline="always")
+def keeps_history(coef) -> bool:
+    """Whether the tangential law of coefficient row `coef` keeps a history per contact."""
+    return _KEEPS(coef[COEF_TLAW])
+
+
+@njit(cache=True)
+def tangential_friction(n_abs: float, v_t: float, coef) -> float:
+    """A rate law's signed friction f [N] at |N| = n_abs [N] and slip rate v_t [m/s]; on the
+    first body it acts along -t (0 under a history law)."""
+    return _FRICTION(coef[COEF_TLAW], n_abs, v_t, coef)
+
+
+@njit(cache=True)
+def tangential_slopes(n_abs: float, v_t: float, coef):
+    """A rate law's (d f / d|N| [-], d f / d v_t [N s/m]) (0, 0 under a history law)."""
+    return _TSLOPES(coef[COEF_TLAW], n_abs, v_t, coef)
+
+
+@njit(cache=True)
+def tangential_relaxed_slip(v_t: float, n_abs: float, coef, inv_mass_t: float, dt: float) -> float:
+    """The slip rate [m/s] after a rate law alone acted for dt [s] at a contact of
+    tangential inverse mass inv_mass_t [1/kg], |N| held: the law's exact flow (unchanged
+    under a history law)."""
+    return _RELAXED(coef[COEF_TLAW], v_t, n_abs, coef, inv_mass_t, dt)
+
+
+@njit(cache=True, inline="always")
+def tangential_scale(coef, r_star: float, delta: float) -> float:
+    """A history law's scale of its history at overlap delta [m] of a contact of R* [m]
+    (Mindlin's: the contact radius [m])."""
+    return _TSCALE(coef[COEF_TLAW], coef, r_star, delta)
+
+
+@njit(cache=True, inline="always")
+def tangential_stiffness(coef, a: float) -> float:
+    """A history law's sticking stiffness k_t [N/m] at scale a."""
+    return _TSTIFF(coef[COEF_TLAW], coef, a)
+
+
+@njit(cache=True, inline="always")
+def tangential_energy(coef, a: float, xx: float, xy: float, xz: float) -> float:
+    """The energy [J] a history law stores in the history xi (3) [m] at scale a."""
+    return _TENERGY(coef[COEF_TLAW], coef, a, xx, xy, xz)
+
+
+@njit(cache=True)
+def tangential_step(xx, xy, xz, a, a_old, coef, delta, nx, ny, nz, vx, vy, vz, dt, n_abs, f0x, f0y, f0z):
+    """A history law's step of dt [s] (physics.mindlin.law_step's arguments and values)."""
+    return _TSTEP(coef[COEF_TLAW], xx, xy, xz, a, a_old, coef, delta, nx, ny, nz, vx, vy, vz, dt, n_abs, f0x, f0y, f0z)
+
+
+@njit(cache=True)
+def tangential_stage(xx, xy, xz, a, a_old, coef, delta, nx, ny, nz, ix, iy, iz, vx, vy, vz, n_abs):
+    """A history law's force at one stage of a multi-stage step (physics.mindlin.law_stage)."""
+    return _TSTAGE(coef[COEF_TLAW], xx, xy, xz, a, a_old, coef, delta, nx, ny, nz, ix, iy, iz, vx, vy, vz, n_abs)
+
+
+def tangential_columns(name: str, coef: np.ndarray, compliance: np.ndarray, contact) -> None:
+    """The tangential law `name`'s columns of the rows `coef` in place, its id into COEF_TLAW
+    (compliance: each row's 1/G* [1/Pa], the two bodies' (2 - nu)/G summed, a rigid body's
+    0; contact: the scenario's Contact)."""
+    tangential_module(name).law_columns(coef, compliance, contact)
+    coef[:, COEF_TLAW] = list(TANGENTIAL_LAW_REGISTRY).index(name)

@@ -23,7 +23,10 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from granplate.jit import njit
+from granplate.physics.contact import COEF_C, COEF_KT, COEF_MU, COEF_MUT, COEF_XT
 
 #: LAMMPS's threshold of a frame update (its EPSILON): the history is turned into the new
 #: tangent plane only where its normal part carries a force above EPSILON mu |N|.
@@ -216,3 +219,64 @@ def stage_force(
         -damp * vz,
     )
     return fx, fy, fz, xx, xy, xz, spring_energy(k, xx, xy, xz)
+
+
+# -- Mindlin's law as a registered tangential law with history (physics.laws dispatches on
+# its id; docs/architecture.md, "Adding a tangential law"). The common arguments: the
+# contact's coefficient row `coef` (physics.contact's columns: 8 G* in COEF_KT, mu in
+# COEF_MUT, x_t in COEF_XT), its overlap delta [m] and |N| = n_abs [N], its history xi (3)
+# [m] with the scale `a_old` [m] it was stored at (Mindlin's: the contact radius), the scale
+# `a` now (`law_scale`), the unit normal n (3) and the slip velocity v (3) [m/s].
+
+
+@njit(cache=True, inline="always")
+def law_scale(coef, r_star: float, delta: float) -> float:
+    """The scale the history is stored at, at overlap delta [m] of a contact of R* [m]: the
+    contact radius a = sqrt(R* delta) [m] (eq. M1)."""
+    return contact_radius(r_star, delta)
+
+
+@njit(cache=True, inline="always")
+def law_stiffness(coef, a: float) -> float:
+    """The sticking contact's tangential stiffness k_t = 8 G* a [N/m] (eq. M1)."""
+    return tangential_stiffness(coef[COEF_KT], a)
+
+
+@njit(cache=True, inline="always")
+def law_energy(coef, a: float, xx: float, xy: float, xz: float) -> float:
+    """The energy the history xi (3) [m] stores at scale a [m]: 1/2 k_t |xi|^2 [J]."""
+    return spring_energy(tangential_stiffness(coef[COEF_KT], a), xx, xy, xz)
+
+
+@njit(cache=True, inline="always")
+def law_step(xx, xy, xz, a, a_old, coef, delta, nx, ny, nz, vx, vy, vz, dt, n_abs, f0x, f0y, f0z):
+    """One step of dt [s] (`mindlin_step`, eqs. M2-M6) with the tangential damping
+    eta_t = x_t c delta^(1/4) and the Coulomb limit mu |N|; f0 (3): the last step's force [N].
+    Returns (F_t (3) on the first body [N], the new xi (3) [m], stored energy [J], energy
+    lost over the step [J])."""
+    damp = tangential_damping(coef[COEF_XT], coef[COEF_C], delta)
+    return mindlin_step(
+        xx, xy, xz, a, a_old, coef[COEF_KT], nx, ny, nz, vx, vy, vz, dt, coef[COEF_MUT] * n_abs, damp, f0x, f0y, f0z
+    )
+
+
+@njit(cache=True, inline="always")
+def law_stage(xx, xy, xz, a, a_old, coef, delta, nx, ny, nz, ix, iy, iz, vx, vy, vz, n_abs):
+    """The force at one stage of a multi-stage step (`stage_force`): the committed history
+    moved on by the increment i (3) [m] the slip made since the step's start, damped on the
+    stage's slip velocity v (3). Returns (F_t (3) [N], xi (3) [m], stored energy [J])."""
+    damp = tangential_damping(coef[COEF_XT], coef[COEF_C], delta)
+    return stage_force(
+        xx, xy, xz, a, a_old, coef[COEF_KT], nx, ny, nz, ix, iy, iz, vx, vy, vz, coef[COEF_MUT] * n_abs, damp
+    )
+
+
+def law_columns(coef: np.ndarray, compliance: np.ndarray, contact) -> None:
+    """Rows of `coef` made Mindlin's in place: 8 G* from 1 / G* = `compliance` [1/Pa] (per
+    row, eq. M1) into COEF_KT, the Coulomb coefficient moved from COEF_MU (which the rate
+    laws read: the rate passes then pass these rows by) to COEF_MUT, the tangential damping
+    factor x_t (contact.tangential_damping) into COEF_XT."""
+    coef[:, COEF_KT] = mindlin_coefficient(1.0) / compliance
+    coef[:, COEF_MUT] = coef[:, COEF_MU]
+    coef[:, COEF_MU] = 0.0
+    coef[:, COEF_XT] = contact.tangential_damping

@@ -42,20 +42,15 @@ from granplate.jit import njit
 from granplate.physics.contact import (
     COEF_DY,
     N_COEF,
-    COEF_KS,
-    COEF_MU,
-    COEF_TLAW,
     contact_arm,
-    friction_magnitude,
     pair_overlap,
     pair_rates,
     wall_overlap,
     wall_rates,
 )
 from granplate.model.dimension import of_state
-from granplate.physics.laws import normal_law_force
+from granplate.physics.laws import keeps_history, normal_law_force, tangential_friction
 from granplate.physics.space import pair_contact_3d, wall_overlap_3d
-from granplate.setup.law_registry import MINDLIN
 from granplate.solver.granular3d import pair_slip, wall_slip
 
 #: name -> (units, description) of the table's variables (docs/output.md)
@@ -201,11 +196,11 @@ def link_forces(kin, coef, dmax, rate, clip, out):
 @njit(cache=True)
 def tangential_magnitude(n: float, vt: float, c) -> float:
     """|F_t| [N] of a contact of coefficient row c at normal force n [N] and slip rate vt
-    [m/s]: the tanh law's (eq. 5); NaN for a Mindlin contact (COEF_TLAW), whose force
-    follows from its tangential history, not from the state."""
-    if c[COEF_TLAW] == MINDLIN:
+    [m/s]: its rate law's (eq. 5 for the tanh law); NaN under a law with history (Mindlin's),
+    whose force follows from its tangential history, not from the state."""
+    if keeps_history(c):
         return math.nan
-    return abs(friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS]))
+    return abs(tangential_friction(n, vt, c))
 
 
 def table_rows(n: int, steps: int, times: np.ndarray, t_end: float, dt_out: float) -> np.ndarray:

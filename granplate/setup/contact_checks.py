@@ -13,6 +13,7 @@ from granplate.setup.fields import material_exists, nonneg, positive, string_in
 
 # YIELDING_LAWS: the normal laws that need the yield strength Y of every body that can yield
 # at a contact (both granules; the granule alone against a wall or the plate)
+from granplate.setup.law_registry import TANGENTIAL_LAW_REGISTRY
 from granplate.setup.law_registry import YIELDING_LAWS as YIELDING_LAWS
 from granplate.setup.scenario import NORMAL_LAWS, TANGENTIAL_LAWS, Scenario
 
@@ -122,9 +123,9 @@ MINDLIN_SUPPORT = (
 
 
 def _check_tangential_law(s: Scenario) -> None:
-    """contact.tangential_law is one of TANGENTIAL_LAWS; "mindlin" only where it runs
-    (MINDLIN_SUPPORT) and with the Poisson ratio of every granule material and of the
-    elastic solid's (their G*, eq. M1)."""
+    """contact.tangential_law is one of TANGENTIAL_LAWS; a law with history ("mindlin") only
+    where the history passes run (MINDLIN_SUPPORT) and with the Poisson ratio of every
+    granule material and of the elastic solid's (their G*, eq. M1)."""
     c = s.contact
     string_in("contact.tangential_law", c.tangential_law, TANGENTIAL_LAWS)
     nonneg("contact.tangential_damping", c.tangential_damping)
@@ -134,13 +135,14 @@ def _check_tangential_law(s: Scenario) -> None:
             c.tangential_damping,
             f"must be in [0, {ALPHA_N_MAX:g}] (a factor on eq. 3's normal damping coefficient)",
         )
-    if c.tangential_law != "mindlin" and c.tangential_damping != 0.0:
+    history = TANGENTIAL_LAW_REGISTRY[c.tangential_law].history  # the rules of a law with history (Mindlin's)
+    if not history and c.tangential_damping != 0.0:
         raise ScenarioError(
             "contact.tangential_damping",
             c.tangential_damping,
             "is Mindlin's (contact.tangential_law = 'mindlin'): the tanh law has no tangential damping; set 0",
         )
-    if c.tangential_law != "mindlin":
+    if not history:
         if c.torque_arm == "lammps":
             raise ScenarioError(
                 "contact.torque_arm",

@@ -8,7 +8,8 @@ TANGENTIAL_LAWS), model.coefficients writes the ids into the rows.
 A normal law is one module and one line of NORMAL_LAW_REGISTRY: the module gives the
 law's compiled functions (`law_response`, `law_force`, `law_slopes`, `law_rate`) and its
 coefficient columns (`law_columns`), and physics.laws builds the dispatch on the law id
-from this table (docs/architecture.md, "Adding a normal law").
+from this table (docs/architecture.md, "Adding a normal law"). A tangential law likewise is
+one module and one line of TANGENTIAL_LAW_REGISTRY ("Adding a tangential law").
 
 Pure data (no numba): the ids are read as compile-time constants by the kernels.
 """
@@ -45,9 +46,30 @@ HERTZ, THORNTON, JOHNSON = NORMAL_LAW_IDS["hertz"], NORMAL_LAW_IDS["thornton"], 
 #: Normal laws that yield at the overlap COEF_DY (NormalLaw.yields).
 YIELDING_LAWS: tuple[str, ...] = tuple(name for name, law in NORMAL_LAW_REGISTRY.items() if law.yields)
 
-#: Tangential laws, name -> law id (COEF_TLAW): "tanh", eq. (5)'s regularised Coulomb law
-#: without history (physics.contact); "mindlin", Mindlin's tangential spring with a Coulomb
-#: limit and the contact's tangential displacement as history (docs/model.md section 3.16,
-#: physics.mindlin).
-TANGENTIAL_LAW_IDS: dict[str, int] = {"tanh": 0, "mindlin": 1}
+
+@dataclass(frozen=True)
+class TangentialLaw:
+    """One tangential law: `module`, the module that implements it; `history`, whether it
+    keeps a history per contact (a tangential displacement, as Mindlin's spring: its module
+    gives `law_scale`, `law_stiffness`, `law_energy`, `law_step`, `law_stage`, and the
+    history passes run it) or is a rate law (its force follows from |N| and the slip rate:
+    `law_friction`, `law_slopes`, `law_relaxed_slip`, run by the rate passes and the split
+    friction). Either gives `law_columns`."""
+
+    module: str
+    history: bool = False
+
+
+#: Tangential laws, name -> implementation, in the order of their law ids (COEF_TLAW):
+#: "tanh", eq. (5)'s regularised Coulomb law without history (physics.tanh_friction);
+#: "mindlin", Mindlin's tangential spring with a Coulomb limit and the contact's tangential
+#: displacement as history (docs/model.md section 3.16, physics.mindlin).
+TANGENTIAL_LAW_REGISTRY: dict[str, TangentialLaw] = {
+    "tanh": TangentialLaw("granplate.physics.tanh_friction"),
+    "mindlin": TangentialLaw("granplate.physics.mindlin", history=True),
+}
+#: name -> law id, the position in TANGENTIAL_LAW_REGISTRY
+TANGENTIAL_LAW_IDS: dict[str, int] = {name: k for k, name in enumerate(TANGENTIAL_LAW_REGISTRY)}
 TANH, MINDLIN = TANGENTIAL_LAW_IDS["tanh"], TANGENTIAL_LAW_IDS["mindlin"]
+#: Tangential laws that keep a history per contact (TangentialLaw.history).
+HISTORY_LAWS: tuple[str, ...] = tuple(name for name, law in TANGENTIAL_LAW_REGISTRY.items() if law.history)

@@ -11,7 +11,7 @@ import math
 from granplate.jit import njit
 
 from granplate.model.inputs import GEO_DELTA, GEO_N, GEO_NX, GEO_NY, GEO_NZ, GEO_TOUCH
-from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm
+from granplate.physics.contact import COEF_MU, contact_arm
 from granplate.physics.space import friction_along_slip, slip_velocity_3d
 from granplate.solver.body_surface import spread, surface_velocity
 from granplate.solver.granular import friction_impulse
@@ -76,7 +76,7 @@ def friction_flow(y, qd, dt, b, buf, radius, mass, inertia, arm_shrink, forward)
         mob = slip_row(b, buf, i, sx, sy, sz, row)
         inv_m = 1.0 / mass[i]
         inv_i = 1.0 / inertia[i]
-        imp, _ = friction_impulse(speed, g[i, GEO_N], c[COEF_MU], c[COEF_KS], inv_m + a * a * inv_i + mob, dt)
+        imp, _ = friction_impulse(speed, g[i, GEO_N], c, inv_m + a * a * inv_i + mob, dt)
         if imp == 0.0:
             continue
         ke0 = 0.0

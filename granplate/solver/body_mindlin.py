@@ -19,10 +19,9 @@ from __future__ import annotations
 from granplate.jit import njit
 
 from granplate.model.inputs import GEO_DELTA, GEO_N, GEO_NX, GEO_NY, GEO_NZ, GEO_TOUCH
-from granplate.physics.contact import COEF_TLAW, contact_arm
-from granplate.physics.mindlin import contact_radius
+from granplate.physics.contact import contact_arm
+from granplate.physics.laws import keeps_history, tangential_scale
 from granplate.physics.space import slip_velocity_3d
-from granplate.setup.law_registry import MINDLIN
 from granplate.solver.body_surface import spread, surface_velocity
 from granplate.solver.friction_space import apply_friction_impulse
 from granplate.solver.granular3d import VX, WX
@@ -33,7 +32,7 @@ from granplate.solver.mindlin_history import mindlin_contact, mindlin_parted
 def has_mindlin(b) -> bool:
     """Whether any granule's contact with the body is under Mindlin's law (COEF_TLAW)."""
     for i in range(b.coef.shape[0]):
-        if b.coef[i, COEF_TLAW] == MINDLIN:
+        if keeps_history(b.coef[i]):
             return True
     return False
 
@@ -65,7 +64,7 @@ def mindlin_forces(y, vq, b, buf_old, buf, h, radius, mass, inertia, arm_shrink,
     g = b.geo[buf]
     for i in range(b.coef.shape[0]):
         c = b.coef[i]
-        if c[COEF_TLAW] != MINDLIN:
+        if not keeps_history(c):
             continue
         delta = g[i, GEO_DELTA]
         if g[i, GEO_TOUCH] == 0.0 or delta <= 0.0:
@@ -87,7 +86,7 @@ def mindlin_forces(y, vq, b, buf_old, buf, h, radius, mass, inertia, arm_shrink,
             ny,
             nz,
         )
-        a = contact_radius(radius[i], delta)  # R* = R: the body flat there
+        a = tangential_scale(c, radius[i], delta)  # R* = R: the body flat there
         fx, fy, fz, e, d = mindlin_contact(b.hist, i, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, abs(g[i, GEO_N]))
         e_t += e
         lost += d

@@ -10,7 +10,7 @@ from __future__ import annotations
 from granplate.jit import njit
 
 from granplate.model.inputs import HIST_MAX, HIST_RATE
-from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm
+from granplate.physics.contact import COEF_MU, contact_arm
 from granplate.physics.laws import normal_law_force
 from granplate.physics.space import arm_torque_3d, friction_along_slip, pair_contact_3d, wall_overlap_3d
 from granplate.solver.drives import wall_motion
@@ -66,9 +66,7 @@ def friction_flow(y, dt, g, cfg, forward):
             inv_mj = 1.0 / g.mass[j]
             inv_ii = 1.0 / g.inertia[i]
             inv_ij = 1.0 / g.inertia[j]
-            imp, dw = friction_impulse(
-                speed, n, c[COEF_MU], c[COEF_KS], inv_mi + inv_mj + ai * ai * inv_ii + aj * aj * inv_ij, dt
-            )
+            imp, dw = friction_impulse(speed, n, c, inv_mi + inv_mj + ai * ai * inv_ii + aj * aj * inv_ij, dt)
             px, py, pz = friction_along_slip(imp, speed, vsx, vsy, vsz)
             apply_friction_impulse(y, i, ai, inv_mi, inv_ii, nx, ny, nz, px, py, pz, 1.0)
             apply_friction_impulse(y, j, aj, inv_mj, inv_ij, nx, ny, nz, px, py, pz, -1.0)
@@ -93,7 +91,7 @@ def friction_flow(y, dt, g, cfg, forward):
             n = normal_law_force(delta, ddot - vn, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
             inv_m = 1.0 / g.mass[i]
             inv_i = 1.0 / g.inertia[i]
-            imp, dw = friction_impulse(speed, n, c[COEF_MU], c[COEF_KS], inv_m + a * a * inv_i, dt)
+            imp, dw = friction_impulse(speed, n, c, inv_m + a * a * inv_i, dt)
             px, py, pz = friction_along_slip(imp, speed, vsx, vsy, vsz)
             apply_friction_impulse(y, i, a, inv_m, inv_i, nx, ny, nz, px, py, pz, 1.0)
             work += dw

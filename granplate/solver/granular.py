@@ -30,26 +30,28 @@ from granplate.model.inputs import (
     N_MINDLIN,
 )
 from granplate.physics.contact import (
-    COEF_KS,
     COEF_MU,
-    COEF_TLAW,
     contact_arm,
-    friction_magnitude,
     friction_power,
-    friction_slope,
     pair_apart,
     pair_normal_rate,
     pair_overlap,
     pair_rates,
     plate_overlap,
     plate_rates,
-    slip_after_friction,
     wall_overlap,
     wall_rates,
 )
-from granplate.physics.laws import normal_law_force, normal_law_rate, normal_law_response
+from granplate.physics.laws import (
+    keeps_history,
+    normal_law_force,
+    normal_law_rate,
+    normal_law_response,
+    tangential_friction,
+    tangential_relaxed_slip,
+    tangential_slopes,
+)
 from granplate.physics.shock import shock_amplitude
-from granplate.setup.law_registry import MINDLIN
 from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_motion
 from granplate.solver.mindlin_rk4 import plane_stages
 from granplate.solver.state import PARTNER_PLATE
@@ -75,12 +77,12 @@ class ForceSums(NamedTuple):
 
 
 @njit(cache=True)
-def slip_relaxation_rate(n, vt, mu, k_s, inv_mass_t):
-    """How fast the slip of a sticking contact relaxes [1/s]: the friction slope
-    (eq. 8's d f/d v_t) times the contact's tangential inverse mass; zero out of touch."""
+def slip_relaxation_rate(n, vt, c, inv_mass_t):
+    """How fast the slip of a sticking contact relaxes [1/s]: its rate law's slope (eq. 8's
+    d f/d v_t; coefficient row c) times the contact's tangential inverse mass; zero out of touch."""
     if n <= 0.0:
         return 0.0
-    return friction_slope(n, vt, mu, k_s) * inv_mass_t
+    return tangential_slopes(n, vt, c)[1] * inv_mass_t
 
 
 @njit(cache=True)
@@ -173,7 +175,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         n, pv, ep, wp = normal_law_response(
             delta, ddot, c, g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip
         )
-        f = friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS])
+        f = tangential_friction(n, vt, c)
         pf = friction_power(f, vt)
         w_plastic += wp
         rate = max(
@@ -181,8 +183,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             slip_relaxation_rate(
                 n,
                 vt,
-                c[COEF_MU],
-                c[COEF_KS],
+                c,
                 1.0 / g.mass[i] + 1.0 / g.mass[j] + ai * ai / g.inertia[i] + aj * aj / g.inertia[j],
             ),
         )
@@ -231,10 +232,10 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             delta, ddot - vn, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip
         )
         book_wall(g, w, kd, n, pv / (ddot - vn) if pv != 0.0 else 0.0)
-        f = friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS])
+        f = tangential_friction(n, vt, c)
         pf = friction_power(f, vt)
         w_plastic += wp
-        rate = max(rate, slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i]))
+        rate = max(rate, slip_relaxation_rate(n, vt, c, 1.0 / g.mass[i] + ai * ai / g.inertia[i]))
         dy[i, 3] += -n * nx + f * nz
         dy[i, 4] += -n * nz - f * nx
         dy[i, 5] -= f * ai
@@ -261,13 +262,13 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             n, pv, ep, wp = normal_law_response(
                 delta, ddot, c, g.pc_hist[k, HIST_MAX], g.pc_hist[k, HIST_RATE], cfg.clip
             )
-            f = friction_magnitude(n, vt, c[COEF_MU], c[COEF_KS])
+            f = tangential_friction(n, vt, c)
             pf = friction_power(f, vt)
             w_plastic += wp
             if not hold:  # the granule side only: the plate side of this map is criterion (8)
                 rate_plate = max(
                     rate_plate,
-                    slip_relaxation_rate(n, vt, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + ai * ai / g.inertia[i]),
+                    slip_relaxation_rate(n, vt, c, 1.0 / g.mass[i] + ai * ai / g.inertia[i]),
                 )
             dy[i, 3] -= n
             p_visc += pv
@@ -283,7 +284,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         fplate[2 * k + 1] = f
         normal[k] = n
         slip[k] = vt
-    if cfg.mindlin_stages:  # Mindlin's law in RK4's stages (solver.mindlin_rk4)
+    if cfg.history_stages:  # Mindlin's law in RK4's stages (solver.mindlin_rk4)
         p_fric, e_pot, rate = plane_stages(y, dy, g, cfg, record, p_fric, e_pot, rate)
     for i in range(ng):
         dy[i, 3] /= g.mass[i]
@@ -294,12 +295,13 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
 
 
 @njit(cache=True)
-def friction_impulse(vt, n, mu, k_s, inv_mass_t, dt):
-    """Friction alone at one contact over dt [s] (eq. 5, |N| = n held): the slip rate vt
-    [m/s] relaxes exactly (`slip_after_friction`) to v1. Returns (the impulse
-    P = (vt - v1) / m_t^-1 [N s], along -t on the first body, and the energy it dissipates,
-    the kinetic energy it removes, P (vt + v1) / 2 >= 0 [J])."""
-    v1 = slip_after_friction(vt, n, mu, k_s, inv_mass_t, dt)
+def friction_impulse(vt, n, c, inv_mass_t, dt):
+    """Friction alone at one contact of coefficient row c over dt [s] (|N| = n held): the
+    slip rate vt [m/s] relaxes exactly by its rate law's flow (eq. 5's for the tanh law,
+    `laws.tangential_relaxed_slip`) to v1. Returns (the impulse P = (vt - v1) / m_t^-1
+    [N s], along -t on the first body, and the energy it dissipates, the kinetic energy it
+    removes, P (vt + v1) / 2 >= 0 [J])."""
+    v1 = tangential_relaxed_slip(vt, n, c, inv_mass_t, dt)
     imp = (vt - v1) / inv_mass_t
     return imp, 0.5 * imp * (vt + v1)
 
@@ -337,7 +339,7 @@ def friction_flow(y, dt, g, cfg, forward):
             inv_mj = 1.0 / g.mass[j]
             inv_ii = ai / g.inertia[i]  # the spin change per unit impulse
             inv_ij = aj / g.inertia[j]
-            imp, dw = friction_impulse(vt, n, c[COEF_MU], c[COEF_KS], inv_mi + inv_mj + ai * inv_ii + aj * inv_ij, dt)
+            imp, dw = friction_impulse(vt, n, c, inv_mi + inv_mj + ai * inv_ii + aj * inv_ij, dt)
             y[i, 3] += imp * nz * inv_mi
             y[i, 4] -= imp * nx * inv_mi
             y[i, 5] -= imp * inv_ii
@@ -361,7 +363,7 @@ def friction_flow(y, dt, g, cfg, forward):
             n = normal_law_force(delta, ddot - vn, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
             inv_m = 1.0 / g.mass[i]
             inv_i = ai / g.inertia[i]
-            imp, dw = friction_impulse(vt, n, c[COEF_MU], c[COEF_KS], inv_m + ai * inv_i, dt)
+            imp, dw = friction_impulse(vt, n, c, inv_m + ai * inv_i, dt)
             y[i, 3] += imp * nz * inv_m
             y[i, 4] -= imp * nx * inv_m
             y[i, 5] -= imp * inv_i
@@ -384,9 +386,9 @@ def commit_rows(t, hist, coef, lo, hi):
     """`commit_history` of contacts lo..hi-1 (written out per row: a compiled call per row
     costs 4.6x this loop, measured on 56,754 rows)."""
     for k in range(lo, hi):
-        # Mindlin's tangential history (docs/model.md section 3.16); a contact out of touch
-        # with none, before and after (HIST_A and HIST_A_END zero: its rows are zeros), keeps its zeros
-        if coef[k, COEF_TLAW] == MINDLIN and (hist[k, HIST_A_END] != 0.0 or hist[k, HIST_A] != 0.0):
+        # a tangential law's history (Mindlin's, docs/model.md section 3.16); a contact out of
+        # touch with none, before and after (HIST_A and HIST_A_END zero: its rows are zeros), keeps its zeros
+        if keeps_history(coef[k]) and (hist[k, HIST_A_END] != 0.0 or hist[k, HIST_A] != 0.0):
             for col in range(N_MINDLIN):
                 hist[k, HIST_XI + col] = hist[k, HIST_XI_END + col]
         d = hist[k, HIST_END]

@@ -18,17 +18,15 @@ from granplate.model.inputs import (
     HIST_MAX,
     HIST_RATE,
 )
-from granplate.physics.contact import (
-    COEF_KS,
-    COEF_TLAW,
-    COEF_MU,
-    contact_arm,
-    friction_magnitude,
+from granplate.physics.contact import COEF_MU, contact_arm
+from granplate.physics.laws import (
+    keeps_history,
+    normal_law_force,
+    normal_law_response,
+    tangential_friction,
+    tangential_scale,
 )
-from granplate.physics.laws import normal_law_force, normal_law_response
-from granplate.physics.mindlin import contact_radius
 from granplate.physics.shock import shock_amplitude
-from granplate.setup.law_registry import MINDLIN
 from granplate.physics.space import (
     arm_torque_3d,
     friction_along_slip,
@@ -167,7 +165,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             nz,
         )
         speed = _speed(vsx, vsy, vsz)
-        f_mag = friction_magnitude(n, speed, c[COEF_MU], c[COEF_KS])
+        f_mag = tangential_friction(n, speed, c)
         fx, fy, fz = friction_along_slip(f_mag, speed, vsx, vsy, vsz)
         add_friction(dy, i, ai, nx, ny, nz, fx, fy, fz, 1.0)
         add_friction(dy, j, aj, nx, ny, nz, fx, fy, fz, -1.0)
@@ -177,15 +175,14 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
             slip_relaxation_rate(
                 n,
                 speed,
-                c[COEF_MU],
-                c[COEF_KS],
+                c,
                 1.0 / g.mass[i] + 1.0 / g.mass[j] + ai * ai / g.inertia[i] + aj * aj / g.inertia[j],
             ),
         )
     p_visc, e_pot, w_plastic, p_fric, rate, ovl, ovl_i, ovl_j = wall_derivative(
         y, g, cfg, dy, split, record, p_visc, e_pot, w_plastic, p_fric, rate, ovl, ovl_i, ovl_j
     )
-    if cfg.mindlin_stages:  # Mindlin's law in RK4's stages (solver.mindlin_rk4)
+    if cfg.history_stages:  # Mindlin's law in RK4's stages (solver.mindlin_rk4)
         p_fric, e_pot, rate = space_stages(y, dy, g, cfg, record, p_fric, e_pot, rate)
     accelerations(dy, g)
     p_drive, p_grav = finish_pass(y, dy, g)
@@ -268,11 +265,11 @@ def wall_derivative(y, g, cfg, dy, split, record, p_visc, e_pot, w_plastic, p_fr
         a = contact_arm(ri, delta, cfg.arm_shrink)
         _, vsx, vsy, vsz = wall_slip(y, i, nx, ny, nz, a)
         speed = _speed(vsx, vsy, vsz)
-        f_mag = friction_magnitude(n, speed, c[COEF_MU], c[COEF_KS])
+        f_mag = tangential_friction(n, speed, c)
         fx, fy, fz = friction_along_slip(f_mag, speed, vsx, vsy, vsz)
         add_friction(dy, i, a, nx, ny, nz, fx, fy, fz, 1.0)
         p_fric += f_mag * speed
-        rate = max(rate, slip_relaxation_rate(n, speed, c[COEF_MU], c[COEF_KS], 1.0 / g.mass[i] + a * a / g.inertia[i]))
+        rate = max(rate, slip_relaxation_rate(n, speed, c, 1.0 / g.mass[i] + a * a / g.inertia[i]))
     return p_visc, e_pot, w_plastic, p_fric, rate, ovl, ovl_i, ovl_j
 
 
@@ -464,7 +461,7 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, out, out_d, c_f, c_d, c_t, tangential
     """Listed pairs lo..hi-1 of the velocity-Verlet force pass in space: each pair's normal
     force at state yn (its overlap into HIST_END) into out[:, c_f:c_f + 3] (minus on i,
     plus on j), its damping part into out_d[:, c_d:c_d + 3]; with `tangential`, at the
-    pairs whose coefficient row names Mindlin's law (COEF_TLAW), Mindlin's force from the same overlap and
+    pairs whose tangential law keeps a history (Mindlin's: laws.keeps_history), its force from the same overlap and
     |N| (docs/model.md section 3.16; the slip from yv's velocities over h [s]) added to the
     forces and its torques into out[:, c_t:c_t + 3], a parted pair's history ended
     (`mindlin_parted`). The serial pass (`normal_forces`, solver.mindlin_space) and each
@@ -493,7 +490,7 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, out, out_d, c_f, c_d, c_t, tangential
         rj = g.radius[j]
         hist[p, HIST_END] = 0.0
         delta, nx, ny, nz = pair_contact_3d(yn[i, X], yn[i, Y], yn[i, Z], ri, yn[j, X], yn[j, Y], yn[j, Z], rj)
-        kt = tangential and g.pair_coef[p, COEF_TLAW] == MINDLIN
+        kt = tangential and keeps_history(g.pair_coef[p])
         if delta <= 0.0:
             if kt and (hist[p, HIST_A] != 0.0 or hist[p, HIST_A_END] != 0.0):
                 lost += mindlin_parted(hist, p, g.pair_coef[p])
@@ -514,12 +511,12 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, out, out_d, c_f, c_d, c_t, tangential
         push_pair(out, i, j, c_f, n, nx, ny, nz)
         if pv != 0.0:  # the damping part of |N|, pv / ddot
             push_pair(out_d, i, j, c_d, pv / ddot, nx, ny, nz)
-        if kt:  # Mindlin's spring from the same overlap and |N|
+        if kt:  # the history law's force (Mindlin's spring) from the same overlap and |N|
             c = g.pair_coef[p]
             ai = contact_arm(ri, delta, half_shrink)
             aj = contact_arm(rj, delta, half_shrink)
             _, vsx, vsy, vsz = pair_slip(yv, i, j, nx, ny, nz, ai, aj)
-            a = contact_radius(ri * rj / (ri + rj), delta)
+            a = tangential_scale(c, ri * rj / (ri + rj), delta)
             f0x, f0y, f0z = mindlin_old_force(hist, p, c)
             fx, fy, fz, e, dl = mindlin_contact(hist, p, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, n)
             ti = ai

@@ -11,7 +11,8 @@ from __future__ import annotations
 
 from granplate.jit import njit
 
-from granplate.physics.contact import COEF_KS, COEF_MU, local_map_modulus, plate_overlap
+from granplate.physics.contact import local_map_modulus, plate_overlap
+from granplate.physics.laws import tangential_slopes
 from granplate.plate.face import patch_weights
 from granplate.solver.dimension import granular_rhs
 from granplate.solver.plate_modal import static_energy
@@ -53,9 +54,7 @@ def forces_converged(it, rtol, atol, fnew, fguess, conv_iter):
 @njit(cache=True)
 def contact_modulus(k, h, gm, g, normal, slip):
     """|lambda| of eq. (8) at plate contact k for step h (gm: G(h))."""
-    return local_map_modulus(
-        g.pc_coef[k, COEF_MU], g.pc_coef[k, COEF_KS], normal[k], h, gm[2 * k + 1, 2 * k + 1], slip[k]
-    )
+    return local_map_modulus(tangential_slopes(normal[k], slip[k], g.pc_coef[k])[1], h, gm[2 * k + 1, 2 * k + 1])
 
 
 @njit(cache=True)
@@ -68,9 +67,7 @@ def accept_contacts(h, gm, pc_coef, normal_new, slip_new, conv_iter, normal, sli
     for k in range(normal.shape[0]):
         normal[k] = normal_new[k]
         slip[k] = slip_new[k]
-        lam = local_map_modulus(
-            pc_coef[k, COEF_MU], pc_coef[k, COEF_KS], normal[k], h, gm[2 * k + 1, 2 * k + 1], slip[k]
-        )
+        lam = local_map_modulus(tangential_slopes(normal[k], slip[k], pc_coef[k])[1], h, gm[2 * k + 1, 2 * k + 1])
         lam_int[k] = max(lam_int[k], lam)
         it_int[k] = max(it_int[k], conv_iter[k] if conv_iter[k] > 0 else 1)
         lam_max = max(lam_max, lam)

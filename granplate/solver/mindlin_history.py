@@ -12,8 +12,7 @@ from __future__ import annotations
 from granplate.jit import njit
 
 from granplate.model.inputs import HIST_A, HIST_A_END, HIST_F, HIST_F_END, HIST_XI, HIST_XI_END, N_MINDLIN
-from granplate.physics.contact import COEF_C, COEF_KT, COEF_MUT, COEF_XT
-from granplate.physics.mindlin import mindlin_step, spring_energy, tangential_damping
+from granplate.physics.laws import tangential_energy, tangential_step
 
 
 @njit(cache=True)
@@ -41,16 +40,16 @@ def mindlin_contact(hist, k, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, n_abs):
     if h == 0.0 and hist[k, HIST_A] > 0.0:
         for col in range(N_MINDLIN):
             hist[k, HIST_XI_END + col] = hist[k, HIST_XI + col]
-        e_t = spring_energy(c[COEF_KT] * hist[k, HIST_A], hist[k, HIST_XI], hist[k, HIST_XI + 1], hist[k, HIST_XI + 2])
+        e_t = tangential_energy(c, hist[k, HIST_A], hist[k, HIST_XI], hist[k, HIST_XI + 1], hist[k, HIST_XI + 2])
         return hist[k, HIST_F], hist[k, HIST_F + 1], hist[k, HIST_F + 2], e_t, 0.0
-    damp = tangential_damping(c[COEF_XT], c[COEF_C], delta)
-    fx, fy, fz, xx, xy, xz, e_t, lost = mindlin_step(
+    fx, fy, fz, xx, xy, xz, e_t, lost = tangential_step(
         hist[k, HIST_XI],
         hist[k, HIST_XI + 1],
         hist[k, HIST_XI + 2],
         a,
         hist[k, HIST_A],
-        c[COEF_KT],
+        c,
+        delta,
         nx,
         ny,
         nz,
@@ -58,8 +57,7 @@ def mindlin_contact(hist, k, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, n_abs):
         vsy,
         vsz,
         h,
-        c[COEF_MUT] * abs(n_abs),
-        damp,
+        abs(n_abs),
         hist[k, HIST_F],
         hist[k, HIST_F + 1],
         hist[k, HIST_F + 2],
@@ -82,7 +80,7 @@ def mindlin_parted(hist, k, c):
     """Contact k has parted: its trial history zero (a new touch starts unloaded, as
     LAMMPS's); returns the spring energy it held [J] (lost)."""
     a_old = hist[k, HIST_A]
-    e_old = spring_energy(c[COEF_KT] * a_old, hist[k, HIST_XI], hist[k, HIST_XI + 1], hist[k, HIST_XI + 2])
+    e_old = tangential_energy(c, a_old, hist[k, HIST_XI], hist[k, HIST_XI + 1], hist[k, HIST_XI + 2])
     for col in range(N_MINDLIN):
         hist[k, HIST_XI_END + col] = 0.0
     return e_old

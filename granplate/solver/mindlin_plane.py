@@ -16,7 +16,6 @@ from granplate.jit import njit
 
 from granplate.model.inputs import HIST_A, HIST_A_END, HIST_END, HIST_MAX, HIST_RATE
 from granplate.physics.contact import (
-    COEF_TLAW,
     contact_arm,
     pair_apart,
     pair_normal_rate,
@@ -25,10 +24,8 @@ from granplate.physics.contact import (
     wall_overlap,
     wall_rates,
 )
-from granplate.physics.laws import normal_law_response
-from granplate.physics.mindlin import contact_radius
+from granplate.physics.laws import keeps_history, normal_law_response, tangential_scale
 from granplate.physics.shock import shock_amplitude
-from granplate.setup.law_registry import MINDLIN
 from granplate.solver.drives import begin_pass, book_wall, wall_motion
 from granplate.solver.granular import ForceSums
 from granplate.solver.mindlin_history import mindlin_contact, mindlin_old_force, mindlin_parted
@@ -52,7 +49,7 @@ def pair_mindlin(p, i, j, ri, rj, delta, nx, nz, n_abs, yv, h, hist, c, half_shr
     ai = contact_arm(ri, delta, half_shrink)
     aj = contact_arm(rj, delta, half_shrink)
     _, vt = pair_rates(yv[i, 3], yv[i, 4], yv[i, 5], yv[j, 3], yv[j, 4], yv[j, 5], nx, nz, ai, aj)
-    a = contact_radius(ri * rj / (ri + rj), delta)
+    a = tangential_scale(c, ri * rj / (ri + rj), delta)
     f0x, f0y, _ = mindlin_old_force(hist, p, c)
     fx, fy, _, e, d = mindlin_contact(hist, p, c, a, delta, nx, nz, 0.0, -vt * nz, vt * nx, 0.0, h, n_abs)
     ti = ai
@@ -100,7 +97,7 @@ def pair_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
         if not pair_apart(yn[i, 0], yn[i, 1], ri, yn[j, 0], yn[j, 1], rj):
             delta, nx, nz = pair_overlap(yn[i, 0], yn[i, 1], ri, yn[j, 0], yn[j, 1], rj)
         if delta <= 0.0:
-            if c[COEF_TLAW] == MINDLIN and (hist[p, HIST_A] != 0.0 or hist[p, HIST_A_END] != 0.0):
+            if keeps_history(c) and (hist[p, HIST_A] != 0.0 or hist[p, HIST_A_END] != 0.0):
                 lost += mindlin_parted(hist, p, c)
             continue
         hist[p, HIST_END] = delta
@@ -121,7 +118,7 @@ def pair_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
             fdamp[i, 4] -= d * nz
             fdamp[j, 3] += d * nx
             fdamp[j, 4] += d * nz
-        if c[COEF_TLAW] == MINDLIN:
+        if keeps_history(c):
             tx, ty, ti, tj, e, d = pair_mindlin(
                 p, i, j, ri, rj, delta, nx, nz, n, yv, h, hist, c, half_shrink, lammps_arms
             )
@@ -166,7 +163,7 @@ def wall_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
         delta = wall_overlap(yn[i, 0], yn[i, 1], ri, nx, nz, g.wall_geo[w, 2] + shift)
         hist[w, HIST_END] = max(delta, 0.0)
         if delta <= 0.0:
-            if c[COEF_TLAW] == MINDLIN:
+            if keeps_history(c):
                 lost += mindlin_parted(hist, w, c)
             continue
         if delta > ovl * ri:
@@ -186,11 +183,11 @@ def wall_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
             fdamp[i, 3] -= d * nx
             fdamp[i, 4] -= d * nz
         book_wall(g, w, kd, n, d)
-        if c[COEF_TLAW] != MINDLIN:
+        if not keeps_history(c):
             continue
         arm = contact_arm(ri, delta, cfg.arm_shrink)
         _, vt = wall_rates(yv[i, 3], yv[i, 4], yv[i, 5], nx, nz, arm)
-        a = contact_radius(ri, delta)
+        a = tangential_scale(c, ri, delta)
         fx, fy, _, e, dl = mindlin_contact(hist, w, c, a, delta, nx, nz, 0.0, -vt * nz, vt * nx, 0.0, h, n)
         e_t += e
         lost += dl

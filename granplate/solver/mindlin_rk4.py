@@ -34,10 +34,6 @@ from granplate.jit import njit
 
 from granplate.model.inputs import HIST_A, HIST_A_END, HIST_F_END, HIST_MAX, HIST_RATE, HIST_XI, HIST_XI_END, N_MINDLIN
 from granplate.physics.contact import (
-    COEF_C,
-    COEF_KT,
-    COEF_MUT,
-    COEF_XT,
     contact_arm,
     pair_apart,
     pair_overlap,
@@ -45,8 +41,14 @@ from granplate.physics.contact import (
     wall_overlap,
     wall_rates,
 )
-from granplate.physics.laws import normal_law_force
-from granplate.physics.mindlin import contact_radius, spring_energy, stage_force, tangential_damping
+from granplate.physics.laws import (
+    keeps_history,
+    normal_law_force,
+    tangential_energy,
+    tangential_scale,
+    tangential_stage,
+    tangential_stiffness,
+)
 from granplate.solver.mindlin_history import record_trial
 from granplate.physics.space import arm_torque_3d, normal_rate_3d, pair_contact_3d, slip_velocity_3d, wall_overlap_3d
 from granplate.solver.drives import wall_motion
@@ -68,14 +70,14 @@ def stage_contact(hist, k, c, a, delta, nx, ny, nz, vx, vy, vz, n_abs, record):
         ix = hist[k, HIST_F_END]
         iy = hist[k, HIST_F_END + 1]
         iz = hist[k, HIST_F_END + 2]
-    damp = tangential_damping(c[COEF_XT], c[COEF_C], delta)
-    fx, fy, fz, xx, xy, xz, e = stage_force(
+    fx, fy, fz, xx, xy, xz, e = tangential_stage(
         hist[k, HIST_XI],
         hist[k, HIST_XI + 1],
         hist[k, HIST_XI + 2],
         a,
         hist[k, HIST_A],
-        c[COEF_KT],
+        c,
+        delta,
         nx,
         ny,
         nz,
@@ -85,8 +87,7 @@ def stage_contact(hist, k, c, a, delta, nx, ny, nz, vx, vy, vz, n_abs, record):
         vx,
         vy,
         vz,
-        c[COEF_MUT] * abs(n_abs),
-        damp,
+        abs(n_abs),
     )
     if record:
         record_trial(hist, k, xx, xy, xz, a, fx, fy, fz)
@@ -128,7 +129,7 @@ def plane_stages(y, dy, g, cfg, record, p_fric, e_pot, rate):
     hist = g.pair_hist
     for p in range(g.pair_ij.shape[0]):
         c = g.pair_coef[p]
-        if c[COEF_KT] == 0.0:
+        if not keeps_history(c):
             continue
         i = g.pair_ij[p, 0]
         j = g.pair_ij[p, 1]
@@ -146,7 +147,7 @@ def plane_stages(y, dy, g, cfg, record, p_fric, e_pot, rate):
         aj = contact_arm(rj, delta, half_shrink)
         ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, ai, aj)
         n = normal_law_force(delta, ddot, c, hist[p, HIST_MAX], hist[p, HIST_RATE], cfg.clip)
-        a = contact_radius(ri * rj / (ri + rj), delta)
+        a = tangential_scale(c, ri * rj / (ri + rj), delta)
         fx, fy, _, e = stage_contact(hist, p, c, a, delta, nx, nz, 0.0, -vt * nz, vt * nx, 0.0, n, record)
         tq = nx * fy - nz * fx  # F_t . t, t = (-n_z, n_x)
         dy[i, 3] += fx
@@ -158,11 +159,11 @@ def plane_stages(y, dy, g, cfg, record, p_fric, e_pot, rate):
         p_fric -= tq * vt
         e_pot += e
         inv_m = 1.0 / g.mass[i] + 1.0 / g.mass[j] + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]
-        rate = max(rate, sticking_rate(c[COEF_KT] * a, inv_m))
+        rate = max(rate, sticking_rate(tangential_stiffness(c, a), inv_m))
     hist = g.wall_hist
     for w in range(g.wall_i.shape[0]):
         c = g.wall_coef[w]
-        if c[COEF_KT] == 0.0:
+        if not keeps_history(c):
             continue
         i = g.wall_i[w]
         ri = g.radius[i]
@@ -176,7 +177,7 @@ def plane_stages(y, dy, g, cfg, record, p_fric, e_pot, rate):
         arm = contact_arm(ri, delta, cfg.arm_shrink)
         ddot, vt = wall_rates(y[i, 3], y[i, 4], y[i, 5], nx, nz, arm)
         n = normal_law_force(delta, ddot - vn, c, hist[w, HIST_MAX], hist[w, HIST_RATE], cfg.clip)
-        a = contact_radius(ri, delta)
+        a = tangential_scale(c, ri, delta)
         fx, fy, _, e = stage_contact(hist, w, c, a, delta, nx, nz, 0.0, -vt * nz, vt * nx, 0.0, n, record)
         tq = nx * fy - nz * fx
         dy[i, 3] += fx
@@ -184,7 +185,7 @@ def plane_stages(y, dy, g, cfg, record, p_fric, e_pot, rate):
         dy[i, 5] += arm * tq
         p_fric -= tq * vt
         e_pot += e
-        rate = max(rate, sticking_rate(c[COEF_KT] * a, 1.0 / g.mass[i] + arm * arm / g.inertia[i]))
+        rate = max(rate, sticking_rate(tangential_stiffness(c, a), 1.0 / g.mass[i] + arm * arm / g.inertia[i]))
     return p_fric, e_pot, rate
 
 
@@ -208,7 +209,7 @@ def space_stages(y, dy, g, cfg, record, p_fric, e_pot, rate):
     hist = g.pair_hist
     for p in range(g.pair_ij.shape[0]):
         c = g.pair_coef[p]
-        if c[COEF_KT] == 0.0:
+        if not keeps_history(c):
             continue
         i = g.pair_ij[p, 0]
         j = g.pair_ij[p, 1]
@@ -229,18 +230,18 @@ def space_stages(y, dy, g, cfg, record, p_fric, e_pot, rate):
         vx, vy, vz = slip_velocity_3d(rvx, rvy, rvz, sx, sy, sz, nx, ny, nz)
         ddot = normal_rate_3d(rvx, rvy, rvz, nx, ny, nz)
         n = normal_law_force(delta, ddot, c, hist[p, HIST_MAX], hist[p, HIST_RATE], cfg.clip)
-        a = contact_radius(ri * rj / (ri + rj), delta)
+        a = tangential_scale(c, ri * rj / (ri + rj), delta)
         fx, fy, fz, e = stage_contact(hist, p, c, a, delta, nx, ny, nz, vx, vy, vz, n, record)
         push_space(dy, i, ai, nx, ny, nz, fx, fy, fz, 1.0)
         push_space(dy, j, aj, nx, ny, nz, fx, fy, fz, -1.0)
         p_fric -= fx * vx + fy * vy + fz * vz
         e_pot += e
         inv_m = 1.0 / g.mass[i] + 1.0 / g.mass[j] + ai * ai / g.inertia[i] + aj * aj / g.inertia[j]
-        rate = max(rate, sticking_rate(c[COEF_KT] * a, inv_m))
+        rate = max(rate, sticking_rate(tangential_stiffness(c, a), inv_m))
     hist = g.wall_hist
     for w in range(g.wall_i.shape[0]):
         c = g.wall_coef[w]
-        if c[COEF_KT] == 0.0:
+        if not keeps_history(c):
             continue
         i = g.wall_i[w]
         ri = g.radius[i]
@@ -259,12 +260,12 @@ def space_stages(y, dy, g, cfg, record, p_fric, e_pot, rate):
         vx, vy, vz = slip_velocity_3d(y[i, 3], y[i, 4], y[i, 5], sx, sy, sz, nx, ny, nz)
         ddot = normal_rate_3d(y[i, 3], y[i, 4], y[i, 5], nx, ny, nz) - vn
         n = normal_law_force(delta, ddot, c, hist[w, HIST_MAX], hist[w, HIST_RATE], cfg.clip)
-        a = contact_radius(ri, delta)
+        a = tangential_scale(c, ri, delta)
         fx, fy, fz, e = stage_contact(hist, w, c, a, delta, nx, ny, nz, vx, vy, vz, n, record)
         push_space(dy, i, arm, nx, ny, nz, fx, fy, fz, 1.0)
         p_fric -= fx * vx + fy * vy + fz * vz
         e_pot += e
-        rate = max(rate, sticking_rate(c[COEF_KT] * a, 1.0 / g.mass[i] + arm * arm / g.inertia[i]))
+        rate = max(rate, sticking_rate(tangential_stiffness(c, a), 1.0 / g.mass[i] + arm * arm / g.inertia[i]))
     return p_fric, e_pot, rate
 
 
@@ -273,11 +274,9 @@ def _begin_rows(hist, coef) -> float:
     """`begin_stages` of one history array; returns its springs' committed energy [J]."""
     e = 0.0
     for k in range(hist.shape[0]):
-        if coef[k, COEF_KT] == 0.0:
+        if not keeps_history(coef[k]):
             continue
-        e += spring_energy(
-            coef[k, COEF_KT] * hist[k, HIST_A], hist[k, HIST_XI], hist[k, HIST_XI + 1], hist[k, HIST_XI + 2]
-        )
+        e += tangential_energy(coef[k], hist[k, HIST_A], hist[k, HIST_XI], hist[k, HIST_XI + 1], hist[k, HIST_XI + 2])
         for col in range(3):
             hist[k, HIST_XI_END + col] = 0.0
             hist[k, HIST_F_END + col] = 0.0
@@ -287,10 +286,10 @@ def _begin_rows(hist, coef) -> float:
 
 @njit(cache=True)
 def begin_stages(g, cfg) -> float:
-    """Before an RK4 step's first stage (with cfg.mindlin_stages, else nothing): every
+    """Before an RK4 step's first stage (with cfg.history_stages, else nothing): every
     Mindlin contact's stage sums and increment zero, HIST_A_END = -1 (inside a step).
     Returns the springs' committed energy [J] (0 without Mindlin's law)."""
-    if not cfg.mindlin_stages:
+    if not cfg.history_stages:
         return 0.0
     return _begin_rows(g.pair_hist, g.pair_coef) + _begin_rows(g.wall_hist, g.wall_coef)
 
@@ -299,7 +298,7 @@ def begin_stages(g, cfg) -> float:
 def _next_rows(hist, coef, weight, tau, final):
     """`next_stage` of one history array."""
     for k in range(hist.shape[0]):
-        if coef[k, COEF_KT] == 0.0:
+        if not keeps_history(coef[k]):
             continue
         for col in range(3):
             v = hist[k, HIST_F_END + col]
@@ -310,10 +309,10 @@ def _next_rows(hist, coef, weight, tau, final):
 
 @njit(cache=True)
 def next_stage(g, cfg, weight, tau, final):
-    """After an RK4 stage (with cfg.mindlin_stages, else nothing): its slip velocity (HIST_F_END) added with `weight` (1, 2, 2, 1)
+    """After an RK4 stage (with cfg.history_stages, else nothing): its slip velocity (HIST_F_END) added with `weight` (1, 2, 2, 1)
     to each Mindlin contact's sum (HIST_XI_END), and the next stage's increment tau times
     it [m] (tau = h/2, h/2, h [s]), or at the last (final) tau = h/6 times the sum."""
-    if not cfg.mindlin_stages:
+    if not cfg.history_stages:
         return
     _next_rows(g.pair_hist, g.pair_coef, weight, tau, final)
     _next_rows(g.wall_hist, g.wall_coef, weight, tau, final)
@@ -324,11 +323,11 @@ def _energy_rows(hist, coef) -> float:
     """`stage_energy` of one history array."""
     e = 0.0
     for k in range(hist.shape[0]):
-        if coef[k, COEF_KT] != 0.0:
+        if keeps_history(coef[k]):
             x = hist[k, HIST_XI_END]
             y = hist[k, HIST_XI_END + 1]
             z = hist[k, HIST_XI_END + 2]
-            e += spring_energy(coef[k, COEF_KT] * hist[k, HIST_A_END], x, y, z)
+            e += tangential_energy(coef[k], hist[k, HIST_A_END], x, y, z)
     return e
 
 
@@ -336,6 +335,6 @@ def _energy_rows(hist, coef) -> float:
 def spring_rise(g, cfg, e_start) -> float:
     """The rise of the springs' energy over the step [J]: that of the trial histories at its
     end less e_start [J], what `begin_stages` returned (0 without Mindlin's law)."""
-    if not cfg.mindlin_stages:
+    if not cfg.history_stages:
         return 0.0
     return _energy_rows(g.pair_hist, g.pair_coef) + _energy_rows(g.wall_hist, g.wall_coef) - e_start

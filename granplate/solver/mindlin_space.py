@@ -12,11 +12,9 @@ from __future__ import annotations
 from granplate.jit import njit
 
 from granplate.model.inputs import HIST_MAX, HIST_RATE
-from granplate.physics.contact import COEF_TLAW, contact_arm
-from granplate.physics.laws import normal_law_force
-from granplate.physics.mindlin import contact_radius
+from granplate.physics.contact import contact_arm
+from granplate.physics.laws import keeps_history, normal_law_force, tangential_scale
 from granplate.physics.space import normal_rate_3d, wall_overlap_3d
-from granplate.setup.law_registry import MINDLIN
 from granplate.solver.drives import begin_pass, wall_motion
 from granplate.solver.granular import ForceSums
 from granplate.solver.mindlin_history import mindlin_contact, mindlin_parted
@@ -44,7 +42,7 @@ def wall_mindlin(yv, yn, h, g, cfg, acc):
     lost = 0.0
     for w in range(g.wall_i.shape[0]):
         c = g.wall_coef[w]
-        if c[COEF_TLAW] != MINDLIN:
+        if not keeps_history(c):
             continue
         i = g.wall_i[w]
         ri = g.radius[i]
@@ -60,7 +58,7 @@ def wall_mindlin(yv, yn, h, g, cfg, acc):
         _, vsx, vsy, vsz = wall_slip(yv, i, nx, ny, nz, arm)
         ddot = normal_rate_3d(yn[i, VX], yn[i, VX + 1], yn[i, VX + 2], nx, ny, nz) - vn
         n_abs = normal_law_force(delta, ddot, c, g.wall_hist[w, HIST_MAX], g.wall_hist[w, HIST_RATE], cfg.clip)
-        a = contact_radius(ri, delta)
+        a = tangential_scale(c, ri, delta)
         fx, fy, fz, e, d = mindlin_contact(g.wall_hist, w, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, n_abs)
         e_t += e
         lost += d

@@ -44,7 +44,7 @@ def first_stage(t, y0, hold, split, st, g, cfg, w):
     plate-contact friction (hold) or the split friction's half step changes it, or
     Mindlin's law needs the stage's slip (solver.mindlin_rk4). Returns whether it was
     recomputed (a flag, not the arrays: the time loop counts no references, jit.NO_REFCOUNT)."""
-    if plate_friction_held(hold, g) or split or cfg.mindlin_stages:
+    if plate_friction_held(hold, g) or split or cfg.history_stages:
         pr = granular_rhs(
             t, y0, st.u, st.v, g, cfg, w.k1h, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
         )

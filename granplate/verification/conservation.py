@@ -240,7 +240,8 @@ def friction_couple(model, y: np.ndarray) -> tuple[float, float, float]:
     default torques of docs/model.md section 3.2 (arm R on each granule) a frictional pair leaves the couple
     f (d - R_i - R_j) = -f delta, so dL/dt = -sum_pairs f delta.
     """
-    from granplate.physics.contact import friction_magnitude, normal_force, pair_overlap, pair_rates
+    from granplate.physics.contact import normal_force, pair_overlap, pair_rates
+    from granplate.physics.laws import tangential_friction
     from granplate.solver import granular as K
 
     g, cfg = model.granular, model.config
@@ -258,7 +259,7 @@ def friction_couple(model, y: np.ndarray) -> tuple[float, float, float]:
             continue
         ddot, vt = pair_rates(y[i, 3], y[i, 4], y[i, 5], y[j, 3], y[j, 4], y[j, 5], nx, nz, g.radius[i], g.radius[j])
         n, _ = normal_force(delta, ddot, g.pair_coef[p, 0], g.pair_coef[p, 1], cfg.clip)
-        couple -= friction_magnitude(n, vt, g.pair_coef[p, 2], g.pair_coef[p, 3]) * delta
+        couple -= tangential_friction(n, vt, g.pair_coef[p]) * delta
     return dL, couple, float(np.abs(terms).sum())
 
 

@@ -28,7 +28,8 @@ import numpy as np
 from granplate.jit import njit
 
 from granplate.model.inputs import STATE_COLUMNS, BodyArrays, new_body_state, no_body
-from granplate.physics.contact import COEF_KS, COEF_MU, contact_arm, friction_magnitude, plate_overlap
+from granplate.physics.contact import contact_arm, plate_overlap
+from granplate.physics.laws import tangential_friction
 from granplate.physics.energy import energy_residual
 from granplate.solver import body as B
 from granplate.solver import body_implicit as BI
@@ -161,7 +162,7 @@ def held_friction_target(normal, normal_new, slip_new, g, fnew):
     slip the friction impulse is second-order accurate like the normal one."""
     for k in range(g.pc_i.shape[0]):
         nbar = 0.5 * (normal[k] + normal_new[k])
-        fnew[2 * k + 1] = friction_magnitude(nbar, slip_new[k], g.pc_coef[k, COEF_MU], g.pc_coef[k, COEF_KS])
+        fnew[2 * k + 1] = tangential_friction(nbar, slip_new[k], g.pc_coef[k])
 
 
 @njit(cache=True)

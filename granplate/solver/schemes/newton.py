@@ -1,8 +1,9 @@
 """Newton's method for the implicit scheme's interface unknowns.
 
 The variables are, at every plate contact, the normal force's end value N and the end
-slip rate v; the held friction follows as mu (|N_n| + N)/2 tanh(k_s v) (held_friction),
-so it never leaves the friction cone and the stiff stick regime is solved in the slip
+slip rate v; the held friction follows as the contact's friction law at the mean normal
+force (|N_n| + N)/2 and v, mu (|N_n| + N)/2 tanh(k_s v) for eq. (5) (held_friction,
+physics.laws.tangential_friction), so it never leaves the friction cone and the stiff stick regime is solved in the slip
 rate, where the equation is mild. Residuals: N - N(delta, rate) (eq. 2) and v - v_t
 (eq. 6) after the step. The Jacobian is assembled from the contact laws' derivatives
 and the plate's exact response (mmat: u, v of the driving DOFs at t + h per unit force),
@@ -13,22 +14,22 @@ h^2/(6 m), h/(2 m); held friction: h (1/m + R^2/I)).
 
 from __future__ import annotations
 
-import math
 
 from granplate.jit import njit
 
 from granplate.model.inputs import HIST_MAX, HIST_RATE
-from granplate.physics.contact import COEF_KS, COEF_MU, friction_magnitude, plate_overlap
-from granplate.physics.laws import normal_law_slopes
+from granplate.physics.contact import plate_overlap
+from granplate.physics.laws import normal_law_slopes, tangential_friction, tangential_slopes
 
 
 @njit(cache=True)
 def held_friction(normal, fguess, vguess, g, fbar):
     """Held friction of each plate contact from the Newton variables, into the odd
-    entries of fguess and into fbar: mu (|N_n| + N_guess)/2 tanh(k_s v_guess) (eq. 5)."""
+    entries of fguess and into fbar: the contact's friction law at Nbar = (|N_n| + N_guess)/2
+    and v_guess (eq. 5: mu Nbar tanh(k_s v_guess))."""
     for k in range(g.pc_i.shape[0]):
         nbar = 0.5 * (normal[k] + max(fguess[2 * k], 0.0))
-        fguess[2 * k + 1] = friction_magnitude(nbar, vguess[k], g.pc_coef[k, COEF_MU], g.pc_coef[k, COEF_KS])
+        fguess[2 * k + 1] = tangential_friction(nbar, vguess[k], g.pc_coef[k])
         fbar[k] = fguess[2 * k + 1]
 
 
@@ -69,18 +70,14 @@ def law_jacobian(h, mmat, u_end, g, w, jac, rhs, vguess):
 
 @njit(cache=True)
 def chain_to_variables(normal, fguess, vguess, g, jac):
-    """Chain rule from U to the variables z = (N, v): dU_y/dN = mu tanh(k_s v)/2 and
-    dU_y/dv = mu Nbar k_s / cosh^2(k_s v) (eq. 5); turns jac into d(residual)/dz."""
+    """Chain rule from U to the variables z = (N, v): dU_y/dN = (df/d|N|)/2 and dU_y/dv =
+    df/dv at Nbar, the friction law's slopes (physics.laws.tangential_slopes; eq. 5: mu
+    tanh(k_s v)/2 and mu Nbar k_s / cosh^2(k_s v)); turns jac into d(residual)/dz."""
     nd = jac.shape[0]
     for j in range(g.pc_i.shape[0]):
-        mu = g.pc_coef[j, COEF_MU]
-        k_s = g.pc_coef[j, COEF_KS]
-        ch = math.cosh(k_s * vguess[j])
         nbar = 0.5 * (normal[j] + max(fguess[2 * j], 0.0))
-        # = friction_slope(nbar, v, mu, k_s) in another rounding order; kept, since the
-        # shared function moves the implicit results by round-off (golden not bitwise)
-        phi_v = mu * nbar * k_s / (ch * ch)
-        phi_n = 0.5 * mu * math.tanh(k_s * vguess[j])
+        f_n, phi_v = tangential_slopes(nbar, vguess[j], g.pc_coef[j])
+        phi_n = 0.5 * f_n
         for a in range(nd):
             dy_ = jac[a, 2 * j + 1]
             jac[a, 2 * j] = (1.0 if a == 2 * j else 0.0) - (jac[a, 2 * j] + dy_ * phi_n)

@@ -137,11 +137,11 @@ def has_friction(g) -> bool:
 @njit(cache=True)
 def force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, sw):
     """The force pass at (t, yn): in blocks on every core when the scratch has blocks
-    (solver.blocks), else serially; under Mindlin's law (cfg.mindlin) with the tangential
+    (solver.blocks), else serially; under Mindlin's law (cfg.history_friction) with the tangential
     springs in it, their histories moved on by the slip at yv's velocities over h [s] (0:
     the committed histories' forces). Returns (the ForceSums, the springs' stored energy
     [J], their losses [J]; 0 and 0 without Mindlin's law)."""
-    if cfg.mindlin:
+    if cfg.history_friction:
         return mindlin_force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar)
     if sw.spar.shape[0] > 0:
         return normal_forces_blocks(t, yn, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar), 0.0, 0.0
