@@ -8,22 +8,10 @@ from __future__ import annotations
 import numpy as np
 
 from granplate.model.inputs import N_DRIVE
-from granplate.physics.drives import (
-    KIND_FORCE,
-    N_PAR,
-    PAR_AMPLITUDE,
-    PAR_DURATION,
-    PAR_FREQUENCY,
-    PAR_FREQUENCY_END,
-    PAR_MASS,
-    PAR_VALUE,
-    PROFILE_CONSTANT,
-    TAB_I,
-    TAB_T,
-    TAB_V,
-    drive_motion,
-)
-from granplate.setup.scenario import DRIVE_KINDS, DRIVE_PROFILES, Scenario
+from granplate.physics.drives import KIND_FORCE, PROFILE_CONSTANT, drive_motion
+from granplate.physics.profiles import N_PAR, PAR_MASS, PAR_VALUE, TAB_I, TAB_T, TAB_V
+from granplate.setup.drive_profiles import DRIVE_PROFILES, PAR_FIELDS
+from granplate.setup.scenario import DRIVE_KINDS, Scenario
 
 
 def drive_targets(s: Scenario) -> np.ndarray:
@@ -65,14 +53,8 @@ def drive_fields(s: Scenario, centres: np.ndarray) -> dict:
     direction = np.zeros((nd, d))
     x0 = np.zeros((nd, d))
     for k, dr in enumerate(s.drives):
-        par[k, [PAR_VALUE, PAR_AMPLITUDE, PAR_FREQUENCY, PAR_DURATION, PAR_FREQUENCY_END, PAR_MASS]] = (
-            dr.value,
-            dr.amplitude,
-            dr.frequency,
-            dr.duration,
-            dr.frequency_end,
-            dr.mass,
-        )
+        par[k, : len(PAR_FIELDS)] = [getattr(dr, name) for name in PAR_FIELDS]
+        par[k, PAR_MASS] = dr.mass
         rows = drive_table(dr.times, dr.values)
         tab[k, : len(rows)] = rows
         tlen[k] = len(rows)

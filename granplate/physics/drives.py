@@ -1,7 +1,8 @@
 """A drive's time profile and the motion it prescribes (docs/model.md section 3.11), as
 compiled functions of arrays: a profile id, its parameters (PAR_* columns) and a table.
 
-The profile P(t) [m, m/s or N] is one of
+The profile P(t) [m, m/s or N] is one of the registered profiles (one module each in
+physics/profiles/, setup.drive_profiles.DRIVE_PROFILE_REGISTRY), today
     constant   P = value
     ramp       P = value min(t / T, 1)
     half-sine  P = amplitude sin(pi t / T) for t <= T, 0 after
@@ -10,7 +11,8 @@ The profile P(t) [m, m/s or N] is one of
     chirp      P = amplitude sin(phi(t)) for t <= T, P(T) after, phi = 2 pi (f0 t + (f1 - f0) t^2 / (2 T)):
                the frequency phi' / (2 pi) swept linearly from f0 to f1 (no integral: a
                displacement or a force drive only)
-and `profile_terms` gives its integral from 0, its value, slope and curvature at t. A
+and `profile_terms` gives its integral from 0, its value, slope and curvature at t (the
+profile's module's own, dispatched on the profile id). A
 displacement drive moves its body by s = P(t) - P(0) (velocity P', acceleration P''); a
 velocity drive by s = int_0^t P (velocity P, acceleration P'); a force drive pushes with P
 (a granule, or a wall that it makes a piston of mass PAR_MASS, solver.drives).
@@ -18,94 +20,35 @@ velocity drive by s = int_0^t P (velocity P, acceleration P'); a force drive pus
 
 from __future__ import annotations
 
-import math
+from types import ModuleType
 
 from granplate.jit import njit
+from granplate.physics.dispatch import checked_module, pick_of
+from granplate.physics.profiles import N_PAR as N_PAR
+from granplate.physics.profiles import PAR_MASS as PAR_MASS
+from granplate.physics.profiles import PAR_VALUE as PAR_VALUE
+from granplate.setup.drive_profiles import DRIVE_PROFILE_REGISTRY
 
-#: profile ids (the order of setup.scenario.DRIVE_PROFILES)
-PROFILE_CONSTANT, PROFILE_RAMP, PROFILE_HALF_SINE, PROFILE_HARMONIC, PROFILE_TABLE, PROFILE_CHIRP = range(6)
 #: drive kinds (the order of setup.scenario.DRIVE_KINDS)
 KIND_DISPLACEMENT, KIND_VELOCITY, KIND_FORCE = range(3)
-#: columns of a drive's parameters: value, amplitude, frequency [Hz], duration [s], the
-#: chirp's end frequency [Hz], and a force-driven wall's mass [kg] (a piston's; 0 otherwise)
-PAR_VALUE, PAR_AMPLITUDE, PAR_FREQUENCY, PAR_DURATION, PAR_FREQUENCY_END, PAR_MASS = range(6)
-N_PAR = 6
-#: columns of a drive's table: the times [s], the values, the integral of the values from 0
-TAB_T, TAB_V, TAB_I = range(3)
+#: the profile "constant"'s id (a held precompression's piston pushes with one)
+PROFILE_CONSTANT = list(DRIVE_PROFILE_REGISTRY).index("constant")
 
 
-@njit(cache=True)
-def table_terms(t, tab, n):
-    """(integral from 0, value, slope) at t of the piecewise-linear table tab[:n] (columns
-    TAB_T, TAB_V, TAB_I: its times, values and their integral from 0 at each time); at a
-    point, the slope of the segment after it."""
-    if t < tab[0, TAB_T]:
-        v0 = tab[0, TAB_V]
-        return v0 * t, v0, 0.0
-    last = n - 1
-    if t >= tab[last, TAB_T]:
-        return tab[last, TAB_I] + tab[last, TAB_V] * (t - tab[last, TAB_T]), tab[last, TAB_V], 0.0
-    lo = 0
-    hi = last
-    while hi - lo > 1:  # tab[lo, T] <= t < tab[hi, T]
-        mid = (lo + hi) // 2
-        if tab[mid, TAB_T] <= t:
-            lo = mid
-        else:
-            hi = mid
-    dt = t - tab[lo, TAB_T]
-    slope = (tab[hi, TAB_V] - tab[lo, TAB_V]) / (tab[hi, TAB_T] - tab[lo, TAB_T])
-    value = tab[lo, TAB_V] + slope * dt
-    return tab[lo, TAB_I] + 0.5 * (tab[lo, TAB_V] + value) * dt, value, slope
+def profile_module(name: str) -> ModuleType:
+    """The module of the registered drive profile `name`, checked to give `profile_terms`."""
+    return checked_module(f"drive profile {name!r}", DRIVE_PROFILE_REGISTRY[name].module, ("profile_terms",))
+
+
+_TERMS = pick_of(tuple(profile_module(name).profile_terms for name in DRIVE_PROFILE_REGISTRY), 4)
 
 
 @njit(entry=True, cache=True)
 def profile_terms(t, pid, par, tab, n):
-    """(int_0^t P, P(t), P'(t), P''(t)) of profile pid with parameters par (PAR_*) and
-    table tab[:n] (profile "table" only), t >= 0 [s]."""
-    value = par[PAR_VALUE]
-    if pid == PROFILE_CONSTANT:
-        return value * t, value, 0.0, 0.0
-    if pid == PROFILE_RAMP:
-        T = par[PAR_DURATION]
-        if t < T:
-            return 0.5 * value * t * t / T, value * t / T, value / T, 0.0
-        return value * (t - 0.5 * T), value, 0.0, 0.0
-    a = par[PAR_AMPLITUDE]
-    if pid == PROFILE_HALF_SINE:
-        T = par[PAR_DURATION]
-        k = math.pi / T
-        if t <= T:
-            return (
-                a / k * (1.0 - math.cos(k * t)),
-                a * math.sin(k * t),
-                a * k * math.cos(k * t),
-                -a * k * k * math.sin(k * t),
-            )
-        return 2.0 * a / k, 0.0, 0.0, 0.0
-    if pid == PROFILE_HARMONIC:
-        w = 2.0 * math.pi * par[PAR_FREQUENCY]
-        s = math.sin(w * t)
-        c = math.cos(w * t)
-        return value * t + a / w * (1.0 - c), value + a * s, a * w * c, -a * w * w * s
-    if pid == PROFILE_CHIRP:
-        return chirp_terms(t, a, par[PAR_FREQUENCY], par[PAR_FREQUENCY_END], par[PAR_DURATION])
-    integral, v, slope = table_terms(t, tab, n)
-    return integral, v, slope, 0.0
-
-
-@njit(cache=True)
-def chirp_terms(t, a, f0, f1, T):
-    """(0, P, P', P'') of the chirp P = a sin(phi), phi = 2 pi (f0 t + (f1 - f0) t^2 / (2 T)),
-    for t <= T; held at P(T) after, so that a displacement stays continuous (its integral is
-    not computed: 0)."""
-    if t > T:
-        return 0.0, a * math.sin(2.0 * math.pi * (f0 * T + 0.5 * (f1 - f0) * T)), 0.0, 0.0
-    phi = 2.0 * math.pi * (f0 * t + 0.5 * (f1 - f0) * t * t / T)
-    w = 2.0 * math.pi * (f0 + (f1 - f0) * t / T)
-    dw = 2.0 * math.pi * (f1 - f0) / T
-    s, c = math.sin(phi), math.cos(phi)
-    return 0.0, a * s, a * w * c, a * (dw * c - w * w * s)
+    """(int_0^t P, P(t), P'(t), P''(t)) of the profile of id pid (its position in
+    setup.drive_profiles.DRIVE_PROFILE_REGISTRY) with parameters par (PAR_*) and table
+    tab[:n] (profile "table" only), t >= 0 [s]."""
+    return _TERMS(pid, t, par, tab, n)
 
 
 @njit(entry=True, cache=True)

@@ -25,13 +25,13 @@ code at the top of its law's function, before any plastic arithmetic.
 
 from __future__ import annotations
 
-import importlib
 from types import ModuleType
 from typing import NamedTuple
 
 import numpy as np
 
 from granplate.jit import njit
+from granplate.physics.dispatch import checked_module, pick_of
 from granplate.physics.contact import COEF_NLAW, COEF_TLAW
 from granplate.setup.law_registry import NORMAL_LAW_REGISTRY, TANGENTIAL_LAW_REGISTRY, TangentialLaw
 
@@ -42,44 +42,6 @@ LAW_FUNCTIONS = ("law_response", "law_force", "law_slopes", "law_rate", "law_col
 def law_module(name: str) -> ModuleType:
     """The module of the registered normal law `name`, checked to give every LAW_FUNCTIONS."""
     return checked_module(f"normal law {name!r}", NORMAL_LAW_REGISTRY[name].module, LAW_FUNCTIONS)
-
-
-def checked_module(what: str, path: str, functions: tuple[str, ...]) -> ModuleType:
-    """The module at `path`, checked to give every one of `functions` (else an ImportError
-    naming `what` and the missing ones)."""
-    module = importlib.import_module(path)
-    missing = [f for f in functions if not hasattr(module, f)]
-    if missing:
-        raise ImportError(f"{what}: module {module.__name__} lacks {', '.join(missing)}")
-    return module
-
-
-def pick_of(functions: tuple, arity: int, ids: tuple[int, ...] | None = None, default=None):
-    """A compiled function (law, a0, ..., a[arity-1]) -> functions[k](a0, ...) for the k
-    whose id is `law` (ids[k]; None: k itself): one compare per function before the law's.
-    default: the function for an id not in ids (None: the last function is taken without a
-    compare). Compiled inline (`inline="always"`), like the laws' functions: the chain costs
-    the caller its compares only. The source of each link is written for its arity (numba
-    compiles no call with *args to an inlined function)."""
-    ids = tuple(range(len(functions))) if ids is None else tuple(ids)
-    names = ", ".join(f"a{k}" for k in range(arity))
-    chain = default
-    if chain is None:
-        functions, ids, chain = functions[:-1], ids[:-1], _link(f"return HEAD({names})", names, HEAD=functions[-1])
-    else:
-        chain = _link(f"return HEAD({names})", names, HEAD=default)
-    for function, law in zip(reversed(functions), reversed(ids)):
-        body = f"if law == {int(law)}:\n        return HEAD({names})\n    return TAIL(law, {names})"
-        chain = _link(body, names, HEAD=function, TAIL=chain)
-    return chain
-
-
-def _link(body: str, names: str, **space):
-    """One compiled link of a `pick_of` chain: def pick(law, names): body, with `space`
-    (the functions it calls) as its globals."""
-    source = f"def pick(law, {names}):\n    {body}\n"
-    exec(compile(source, "<granplate.physics.laws dispatch>", "exec"), space)
-    return njit(inline="always")(space["pick"])
 
 
 _MODULES = tuple(law_module(name) for name in NORMAL_LAW_REGISTRY)

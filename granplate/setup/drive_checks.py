@@ -11,40 +11,17 @@ from typing import Any
 
 from granplate.errors import ScenarioError
 from granplate.setup.fields import closest_name, finite, is_number, string_in
-from granplate.setup.scenario import (
-    DRIVE_KINDS,
-    DRIVE_PROFILES,
-    DRIVE_TARGETS,
-    Drive,
-    Scenario,
-)
+from granplate.setup.drive_profiles import DRIVE_PROFILE_REGISTRY, DRIVE_PROFILES, PAR_FIELDS
+from granplate.setup.scenario import DRIVE_KINDS, DRIVE_TARGETS, Drive, Scenario
 
 #: the largest |g| [m/s^2] a scenario may ask for (a centrifuge's 10^5 g)
 GRAVITY_MAX = 1e6
 #: a drive's direction must have unit length within this
 UNIT_TOL = 1e-9
-#: a harmonic drive's period must hold at least this many of the scheme's largest steps
-STEPS_PER_PERIOD = 20
 #: the largest mass [kg] of a force-driven wall (a piston; a thousand tonnes)
 PISTON_MASS_MAX = 1e6
-#: the fields each profile reads (every other field of the drive must keep its default)
-PROFILE_FIELDS: dict[str, tuple[str, ...]] = {
-    "constant": ("value",),
-    "ramp": ("value", "duration"),
-    "half-sine": ("amplitude", "duration"),
-    "harmonic": ("value", "amplitude", "frequency"),
-    "table": ("times", "values"),
-    "chirp": ("amplitude", "frequency", "frequency_end", "duration"),
-}
-_DEFAULTS = {
-    "value": 0.0,
-    "amplitude": 0.0,
-    "frequency": 0.0,
-    "duration": 0.0,
-    "frequency_end": 0.0,
-    "times": (),
-    "values": (),
-}
+#: the defaults of the fields a profile may read (a field it does not read must keep its own)
+_DEFAULTS: dict[str, Any] = {**PAR_FIELDS, "times": (), "values": ()}
 
 
 def granule_labels(s: Scenario) -> list[str]:
@@ -75,7 +52,7 @@ def check_drives(s: Scenario, step_max: float, wave_speed: float) -> None:
     granule, driven once), kind, direction (a unit vector; a wall's along its normal),
     profile and the fields that profile reads (and no other), the peak speed it asks for
     below `wave_speed` [m/s] (Hertz's law is quasi-static), a harmonic's period at least
-    STEPS_PER_PERIOD steps of `step_max` [s]."""
+    setup.drive_profiles.STEPS_PER_PERIOD steps of `step_max` [s]."""
     seen: dict[str, int] = {}
     for k, d in enumerate(s.drives):
         p = f"drives[{k}]"
@@ -168,7 +145,7 @@ def _wall_drive(p: str, d: Drive, wall, direction: tuple[float, ...]) -> None:
 def _profile_fields(p: str, d: Drive) -> None:
     """The fields the profile reads are numbers of the right kind; the others keep their
     defaults (a field the profile would ignore is refused, not silently dropped)."""
-    used = PROFILE_FIELDS[d.profile]
+    used = DRIVE_PROFILE_REGISTRY[d.profile].fields
     if d.file is not None:
         raise ScenarioError(
             f"{p}.file",
@@ -189,47 +166,13 @@ def _profile_fields(p: str, d: Drive) -> None:
 
 
 def _profile_values(p: str, d: Drive, step_max: float, wave_speed: float) -> None:
-    """Durations and frequencies in range, the table's times increasing, and the peak
-    speed the drive asks for below the wave speed."""
-    speed = 0.0  # the largest speed [m/s] a motion drive asks for
-    if d.profile in ("ramp", "half-sine", "chirp"):
-        if not d.duration > 0.0:
-            raise ScenarioError(f"{p}.duration", d.duration, "must be > 0 [s]")
-    if d.profile == "constant":
-        speed = abs(d.value) if d.kind == "velocity" else 0.0
-    elif d.profile == "ramp":
-        speed = abs(d.value) if d.kind == "velocity" else abs(d.value) / d.duration
-    elif d.profile == "half-sine":
-        speed = abs(d.amplitude) * (1.0 if d.kind == "velocity" else math.pi / d.duration)
-    elif d.profile == "chirp":
-        if d.kind == "velocity":
-            raise ScenarioError(
-                f"{p}.kind",
-                d.kind,
-                "a chirp prescribes a displacement or a force (its velocity's integral, a Fresnel "
-                'integral, is not computed): use kind = "displacement"',
-            )
-        for name in ("frequency", "frequency_end"):
-            _frequency_in_range(f"{p}.{name}", getattr(d, name), step_max)
-        f_top = max(d.frequency, d.frequency_end)
-        speed = 2.0 * math.pi * abs(d.amplitude) * (f_top + abs(d.frequency_end - d.frequency) / 2.0)
-    elif d.profile == "harmonic":
-        _frequency_in_range(f"{p}.frequency", d.frequency, step_max)
-        if d.kind == "velocity":
-            speed = abs(d.value) + abs(d.amplitude)
-        else:
-            speed = 2.0 * math.pi * d.frequency * abs(d.amplitude)
-    else:
-        speed = _table_speed(p, d)
+    """The profile's own rules (its registry entry's `speed`: durations and frequencies in
+    range, a table's times increasing) and the peak speed the drive asks for below the wave
+    speed."""
+    profile = DRIVE_PROFILE_REGISTRY[d.profile]
+    speed = profile.speed(p, d, step_max)  # the largest speed [m/s] a motion drive asks for
     if d.kind != "force" and not speed < wave_speed:
-        field = {
-            "constant": "value",
-            "ramp": "value",
-            "half-sine": "amplitude",
-            "harmonic": "amplitude",
-            "table": "values",
-            "chirp": "amplitude",
-        }[d.profile]
+        field = profile.speed_field
         raise ScenarioError(
             f"{p}.{field}",
             getattr(d, field),
@@ -237,39 +180,3 @@ def _profile_values(p: str, d: Drive, step_max: float, wave_speed: float) -> Non
             f"below {wave_speed:.6g} m/s, the slowest elastic wave speed sqrt(E / rho) of the "
             "materials (Hertz's law is quasi-static)",
         )
-
-
-def _frequency_in_range(path: str, f: float, step_max: float) -> None:
-    """0 < f <= the frequency whose period holds STEPS_PER_PERIOD of the scheme's largest steps."""
-    f_max = 1.0 / (STEPS_PER_PERIOD * step_max)
-    if not 0.0 < f <= f_max:
-        raise ScenarioError(
-            path,
-            f,
-            f"allowed 0 < frequency <= {f_max:.6g} Hz (a period of at least {STEPS_PER_PERIOD} steps of {step_max:g} s)",
-        )
-
-
-def _table_speed(p: str, d: Drive) -> float:
-    """A table's checks (two or more points, finite, times >= 0 and increasing) and the
-    largest speed it asks for [m/s]."""
-    t, v = d.times, d.values
-    for name, xs in (("times", t), ("values", v)):
-        if not isinstance(xs, tuple) or not all(is_number(x) and math.isfinite(x) for x in xs):
-            raise ScenarioError(f"{p}.{name}", xs, "must be a list of finite numbers")
-    if len(t) < 2 or len(t) != len(v):
-        raise ScenarioError(
-            f"{p}.times", list(t), f"must hold two or more times, as many as values ({len(t)} times, {len(v)} values)"
-        )
-    if t[0] < 0.0:
-        raise ScenarioError(f"{p}.times", list(t), "must start at t >= 0 [s]")
-    for a, (t0, t1) in enumerate(zip(t[:-1], t[1:])):
-        if not t1 > t0:
-            raise ScenarioError(
-                f"{p}.times", list(t), f"must increase: times[{a + 1}] = {t1!r} is not after times[{a}] = {t0!r}"
-            )
-    if d.kind == "velocity":
-        return max(abs(x) for x in v)
-    if d.kind == "displacement":
-        return max(abs(v1 - v0) / (t1 - t0) for t0, t1, v0, v1 in zip(t[:-1], t[1:], v[:-1], v[1:]))
-    return 0.0

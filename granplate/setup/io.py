@@ -30,10 +30,10 @@ import tomli_w
 
 from granplate.errors import ScenarioError
 from granplate.setup.fields import check_dimension, closest_name, string_in
+from granplate.setup.drive_profiles import DRIVE_PROFILES
 from granplate.setup.materials import LIBRARY, Material
 from granplate.setup.scenario import (
     DRIVE_KINDS,
-    DRIVE_PROFILES,
     PRECOMPRESSION_MODES,
     LAYOUT_KINDS,
     NORMAL_LAWS,

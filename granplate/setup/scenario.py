@@ -646,8 +646,6 @@ class Solver:
 
 #: What a drive prescribes along its direction (`Drive.kind`).
 DRIVE_KINDS: tuple[str, ...] = ("displacement", "velocity", "force")
-#: A drive's time profiles (`Drive.profile`; docs/scenario.md, section "Drives").
-DRIVE_PROFILES: tuple[str, ...] = ("constant", "ramp", "half-sine", "harmonic", "table", "chirp")
 #: How a precompressing wall behaves during the run (Precompression.mode).
 PRECOMPRESSION_MODES: tuple[str, ...] = ("frozen", "held")
 #: The two kinds of body a drive moves (`Drive.target` = "wall LABEL" or "granule LABEL").

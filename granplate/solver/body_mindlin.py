@@ -30,7 +30,7 @@ from granplate.solver.mindlin_history import mindlin_contact, mindlin_parted
 
 @njit(cache=True)
 def has_mindlin(b) -> bool:
-    """Whether any granule's contact with the body is under Mindlin's law (COEF_TLAW)."""
+    """Whether any granule's contact with the body is under a tangential law with history (Mindlin's; laws.keeps_history)."""
     for i in range(b.coef.shape[0]):
         if keeps_history(b.coef[i]):
             return True
@@ -52,7 +52,7 @@ def surface_motion(b, buf_old, buf, i, vq):
 @njit(cache=True)
 def mindlin_forces(y, vq, b, buf_old, buf, h, radius, mass, inertia, arm_shrink, acc):
     """Mindlin's law at every granule's contact on the body whose coefficient row has
-    COEF_TLAW = MINDLIN, after the body's force pass into buffer buf (its overlaps, normals, |N|
+    a tangential law with history (Mindlin's), after the body's force pass into buffer buf (its overlaps, normals, |N|
     and patches): the slip from y's velocities and spins (the half step's) against the
     surface's motion at the modal rates vq (nm,) [(q_n+1 - q_n) / h; h = 0: the force of the
     committed history, vq the modal velocity], over h [s]. Adds F_t / m and the torque's

@@ -66,7 +66,7 @@ def pair_mindlin(p, i, j, ri, rj, delta, nx, nz, n_abs, yv, h, hist, c, half_shr
 def pair_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
     """The pairs' share of `normal_mindlin_forces`: every listed pair's normal force
     (physics.laws, as solver.granular.normal_forces) at state yn and, where its coefficient
-    row names Mindlin's law (COEF_TLAW), Mindlin's force (`pair_mindlin`) from the same overlap and |N|,
+    row's tangential law keeps a history (Mindlin's; laws.keeps_history), Mindlin's force (`pair_mindlin`) from the same overlap and |N|,
     added to acc[:, 3:6] as forces and torques; the damping parts into fdamp, each
     overlap into HIST_END, a parted contact's history ended (`mindlin_parted`). Returns
     (viscous power [W], stored energy [J], plastic work [J], the largest overlap / radius,
@@ -141,7 +141,7 @@ def wall_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
     """The walls' share of `normal_mindlin_forces`, one contact after another (a wall's
     load and a driven wall's force are shared sums): each wall contact's normal force at
     state yn (as solver.granular.normal_forces, booked on its wall and drive) and, where
-    COEF_TLAW = MINDLIN, Mindlin's force from the same overlap and |N|, into acc[:, 3:6] as forces
+    a tangential law with history (Mindlin's), Mindlin's force from the same overlap and |N|, into acc[:, 3:6] as forces
     and torques. Returns (viscous power [W], stored energy [J], plastic work [J], the
     largest overlap / radius, its granule, its partner code, springs' energy [J], losses [J])."""
     p_visc = 0.0
@@ -202,7 +202,7 @@ def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload):
     """The velocity-Verlet force pass of the plane (solver.granular.normal_forces) with
     Mindlin's tangential law (docs/model.md section 3.16) in it: the shock, every listed
     pair and wall contact's normal force at state yn (its velocities the damping's) and, at
-    the contacts whose coefficient row names Mindlin's law (COEF_TLAW), the tangential spring's force from
+    the contacts whose tangential law keeps a history (Mindlin's; laws.keeps_history), the tangential spring's force from
     the same overlap and |N|, its history moved on by the slip at yv's velocities over h
     [s] (the half step's; yv's positions are yn's; h = 0: the force of the committed
     history), trial histories into HIST_XI_END, HIST_A_END, HIST_F_END. Accelerations into

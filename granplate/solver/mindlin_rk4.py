@@ -120,9 +120,9 @@ def sticking_rate(kt, inv_mass) -> float:
 
 @njit(cache=True)
 def plane_stages(y, dy, g, cfg, record, p_fric, e_pot, rate):
-    """Mindlin's law at the plane's pair and wall contacts whose coefficient row has
-    COEF_KT > 0, at state y: the forces and torques added to dy (forces, not yet divided
-    by the masses), the dissipated power -F_t . v_s to p_fric [W], the springs' energy to
+    """The history law (Mindlin's) at the plane's pair and wall contacts whose tangential
+    law keeps a history (laws.keeps_history), at state y: the forces and torques added to
+    dy (forces, not yet divided by the masses), the dissipated power -F_t . v_s to p_fric [W], the springs' energy to
     e_pot [J], the sticking rate to rate [1/s]; record: the trial histories. Returns
     (p_fric, e_pot, rate)."""
     half_shrink = 0.5 * cfg.arm_shrink

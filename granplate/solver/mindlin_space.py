@@ -34,7 +34,7 @@ from granplate.solver.granular3d import (
 
 @njit(cache=True)
 def wall_mindlin(yv, yn, h, g, cfg, acc):
-    """Mindlin's law at the wall contacts whose coefficient row names Mindlin's law (COEF_TLAW), after the
+    """Mindlin's law at the wall contacts whose tangential law keeps a history (Mindlin's; laws.keeps_history), after the
     normal pass (a wall's few contacts: their geometry and |N| again): the slip from yv's
     velocities over h [s], |N| from yn's; the forces and torques added to the
     accelerations acc. Returns (the springs' energy [J], their losses [J])."""
@@ -70,8 +70,8 @@ def wall_mindlin(yv, yn, h, g, cfg, acc):
 def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload):
     """solver.granular3d.normal_forces with Mindlin's tangential law in it (docs/model.md
     section 3.16): the shock, every listed pair and wall contact's normal force at state yn
-    (its velocities the damping's) and, at the contacts whose coefficient row names Mindlin's
-    law (COEF_TLAW), the tangential spring's force from the same overlap and |N|, its history moved on by
+    (its velocities the damping's) and, at the contacts whose tangential law keeps a
+    history (Mindlin's; laws.keeps_history), the tangential spring's force from the same overlap and |N|, its history moved on by
     the slip at yv's velocities over h [s] (the half step's; yv's positions are yn's; h = 0:
     the force of the committed history), the trial histories into HIST_XI_END, HIST_A_END,
     HIST_F_END. Returns (the ForceSums, the springs' stored energy [J], the energy they
