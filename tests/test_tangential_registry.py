@@ -209,7 +209,13 @@ LAW_NAMES = re.compile(
     r"\b(friction_magnitude|friction_slope|slip_after_friction|mindlin_step|stage_force|mindlin_force)\("
     r"|COEF_TLAW\]\s*[!=]=|\b(MINDLIN|TANH)\b\s*[!=]=|[!=]=\s*\b(MINDLIN|TANH)\b"
 )
-LAW_HOMES = {"physics/contact.py", "physics/tanh_friction.py", "physics/mindlin.py", "physics/laws.py"}
+LAW_HOMES = {
+    "physics/contact.py",
+    "physics/tanh_friction.py",
+    "physics/mindlin.py",
+    "physics/mindlin_force.py",
+    "physics/laws.py",
+}
 
 
 def test_every_pass_reaches_the_tangential_laws_through_the_dispatch():

@@ -167,15 +167,15 @@ def energies(model, state: np.ndarray, start: np.ndarray, g: tuple[float, ...]) 
 
 
 class _Chunks:
-    """The settling's chunks of free motion. Without Mindlin's friction each chunk starts
-    afresh from the last one's end state (`_restarted`: its contact lists found anew);
-    with it, each chunk is a restart of the last one's result (`simulate`'s start_from),
+    """The settling's chunks of free motion. Without a tangential law with history (Mindlin's)
+    each chunk starts afresh from the last one's end state (`_restarted`: its contact lists
+    found anew); with one, each chunk is a restart of the last one's result (`simulate`'s start_from),
     so that every contact's tangential history goes on. `quench()`: the next chunk starts
     with the velocities and spins zero."""
 
     def __init__(self, model, state: np.ndarray):
         self.model, self.state, self.ds, self.t = model, state, None, 0.0
-        self.chained = model.scenario.contact.tangential_law == "mindlin"
+        self.chained = model.config.history_friction
 
     def run(self) -> np.ndarray:
         """One more chunk; its end state."""

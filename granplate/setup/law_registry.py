@@ -63,10 +63,13 @@ class TangentialLaw:
 #: Tangential laws, name -> implementation, in the order of their law ids (COEF_TLAW):
 #: "tanh", eq. (5)'s regularised Coulomb law without history (physics.tanh_friction);
 #: "mindlin", Mindlin's tangential spring with a Coulomb limit and the contact's tangential
-#: displacement as history (docs/model.md section 3.16, physics.mindlin).
+#: displacement as history (docs/model.md section 3.16, physics.mindlin); "mindlin_force",
+#: the same law in its incremental form, the elastic tangential force as history (LAMMPS's
+#: `mindlin_rescale/force`, physics.mindlin_force).
 TANGENTIAL_LAW_REGISTRY: dict[str, TangentialLaw] = {
     "tanh": TangentialLaw("granplate.physics.tanh_friction"),
     "mindlin": TangentialLaw("granplate.physics.mindlin", history=True),
+    "mindlin_force": TangentialLaw("granplate.physics.mindlin_force", history=True),
 }
 #: name -> law id, the position in TANGENTIAL_LAW_REGISTRY
 TANGENTIAL_LAW_IDS: dict[str, int] = {name: k for k, name in enumerate(TANGENTIAL_LAW_REGISTRY)}

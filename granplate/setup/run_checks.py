@@ -9,6 +9,7 @@ import math
 from granplate.errors import ScenarioError
 from granplate.setup.threads import check_threads
 from granplate.setup.fields import finite, int_at_least, nonneg, positive, string_in
+from granplate.setup.law_registry import TANGENTIAL_LAW_REGISTRY
 from granplate.setup.plate_cost import MEMORY_SHARE, physical_memory
 from granplate.setup.scenario import Solid, Plate, Scenario
 
@@ -215,7 +216,7 @@ def _check_solid_implicit_inputs(s: Scenario) -> None:
             "given",
             f"a static state with the elastic solid is computed for velocity Verlet only (section 3.12): {verlet}",
         )
-    if s.contact.tangential_law != "tanh":
+    if TANGENTIAL_LAW_REGISTRY[s.contact.tangential_law].history:
         raise ScenarioError(
             "contact.tangential_law",
             s.contact.tangential_law,

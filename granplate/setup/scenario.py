@@ -470,7 +470,9 @@ NORMAL_LAWS: tuple[str, ...] = tuple(NORMAL_LAW_IDS)
 #: without history (the paper's), and "mindlin", Mindlin's tangential spring 8 G* a with a
 #: Coulomb limit mu |N| and each contact's elastic tangential displacement as history
 #: (docs/model.md section 3.16; under the scheme "verlet", in the plane and in space, and
-#: on the elastic solid in space). The names of the laws' registry (setup.law_registry).
+#: on the elastic solid in space), and "mindlin_force", the same law in its incremental
+#: form with the elastic tangential force as history (LAMMPS's `mindlin_rescale/force`).
+#: The names of the laws' registry (setup.law_registry).
 TANGENTIAL_LAWS: tuple[str, ...] = tuple(TANGENTIAL_LAW_IDS)
 
 
@@ -530,7 +532,8 @@ class Contact:
     of the granules' contacts on the elastic solid in space (one of TANGENTIAL_LAWS):
     "tanh", eq. (5), or "mindlin", Mindlin's tangential spring with a Coulomb limit mu |N|
     and history (docs/model.md section 3.16; its mu is `mu` and the pairs' mu, k_s unused;
-    solver.scheme "verlet" only, in the plane and in space; not with the plane's plate);
+    in the plane and in space; not with the plane's plate), or "mindlin_force", the same
+    law in its incremental form (the elastic force as history; where "mindlin" runs);
     tangential_damping: Mindlin's tangential damping x_t [-] (LAMMPS's `mindlin NULL x_t mu`):
     eta_t = x_t c delta^(1/4), x_t times eq. (3)'s normal damping coefficient (0: none).
     """

@@ -313,8 +313,13 @@ def granular_arrays(s) -> dict:
         "walls": walls,
         "mu": float(s.contact.mu),
         "alpha_n": float(s.contact.alpha_n),
-        "tangential": "mindlin_rescale" if s.contact.tangential_law == "mindlin" else "mindlin",
+        "tangential": LAMMPS_TANGENTIAL.get(s.contact.tangential_law, "mindlin"),
     }
+
+
+#: LAMMPS's tangential model of each of our tangential laws with history (pair granular's
+#: `tangential` keyword): the displacement form with the rescale rule, and its force form.
+LAMMPS_TANGENTIAL = {"mindlin": "mindlin_rescale", "mindlin_force": "mindlin_rescale/force"}
 
 
 def granular_model(p: dict, wall: bool = False) -> str:
@@ -444,7 +449,7 @@ def space_arrays(s) -> dict:
         style, lower = SPACE_WALL_PLANES[key]
         plane = repr(float(w.offset) * sum(key) + 0.0)  # + 0.0: no "-0.0"
         walls.append((style, plane, "NULL") if lower else (style, "NULL", plane))
-    mindlin = s.contact.tangential_law == "mindlin"
+    mindlin = s.contact.tangential_law in LAMMPS_TANGENTIAL
     if mindlin and (s.contact.alpha_n != 0.0 or s.contact.pairs):
         raise ValueError(
             "contact.alpha_n, contact.pairs: must be 0 and empty for the LAMMPS adapter of "
@@ -464,18 +469,20 @@ def space_arrays(s) -> dict:
         "omega": np.array([q.spin() for q in g], float).reshape(-1, 3),
         "walls": walls,
         "mu": float(s.contact.mu) if mindlin else None,
+        "tangential": LAMMPS_TANGENTIAL.get(s.contact.tangential_law, ""),
         "gravity": grav,
     }
 
 
 def tangential_model(p: dict) -> str:
     """The tangential part of the LAMMPS model of `p` (space_arrays): none (mu 0) or, where
-    the scenario takes contact.tangential_law = "mindlin", `mindlin_rescale NULL 0.0 mu`:
+    the scenario takes a law with history, `mindlin_rescale NULL 0.0 mu` for "mindlin" (or
+    `mindlin_rescale/force` for "mindlin_force", LAMMPS_TANGENTIAL):
     Mindlin's stiffness 8 G* a from E and nu, no tangential damping, the Coulomb bound mu
     |N| and the history rescaled as the contact radius shrinks (docs/model.md section 3.16)."""
     if p.get("mu") is None:
         return "tangential linear_nohistory 0.0 0.0"
-    return f"tangential mindlin_rescale NULL 0.0 {float(p['mu'])!r}"
+    return f"tangential {p.get('tangential') or 'mindlin_rescale'} NULL 0.0 {float(p['mu'])!r}"
 
 
 def space_commands(p: dict, dt: float, skin: float = 0.1) -> list[str]:
