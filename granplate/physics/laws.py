@@ -1,4 +1,5 @@
-"""The normal law of one contact, chosen by its law id, the coefficient row's column
+"""The contact laws of one contact, chosen by their law ids: the tangential law's by the
+coefficient row's column COEF_TLAW (the second half of this module), the normal law's by
 COEF_NLAW: the laws of setup.law_registry's NORMAL_LAW_REGISTRY, in its order (Hertz's,
 eq. 2, physics.hertz; Thornton's, docs/model.md section 3.6, physics.plastic; "johnson",
 section 3.10, physics.cavity), each with the contact's history: its largest overlap
