@@ -141,7 +141,7 @@ def test_a_kernel_the_loop_calls_counts_no_references():
 
 def test_the_time_loop_counts_no_references_and_a_run_leaves_none_behind():
     """solver.loop.advance is compiled with NO_REFCOUNT, and a run (velocity Verlet, the
-    plane) leaves the model's arrays with the references they had before it."""
+    plane) leaves the model's arrays with no more references than they had before it."""
     import gc
     import sys
 
@@ -154,7 +154,10 @@ def test_the_time_loop_counts_no_references_and_a_run_leaves_none_behind():
     s = next(k for k in kernels.KERNEL_SETS if k.name == "verlet-2d").scenarios()[0]
     m = build_model(s)
     arrays = [a for a in m.granular if isinstance(a, np.ndarray)]
+    gc.collect()  # garbage left by earlier tests may still hold a cached array: free it first
     before = [sys.getrefcount(a) for a in arrays]
     run(m)
     gc.collect()
-    assert [sys.getrefcount(a) for a in arrays] == before
+    after = [sys.getrefcount(a) for a in arrays]
+    # none gains a reference (a set-up cache the run trims may drop one it held)
+    assert all(a <= b for a, b in zip(after, before, strict=True)), (before, after)
