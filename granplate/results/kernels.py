@@ -96,9 +96,11 @@ def _space_granules(scheme: str) -> list[Scenario]:
     from granplate.setup.presets import preset
 
     alone = _with_sensor(loads(_FCC.format(scheme=scheme)))  # the granules alone, in a box, a sensor in one
-    if scheme != "verlet":
+    if scheme == "paper":  # (no elastic solid under the paper's scheme)
         return [alone]
     on_plate = with_changes(preset("3d-steel-r1"), {"plate.elements": [2, 8, 1]})
+    if scheme == "implicit":  # an elastic solid makes the implicit scheme's loop one of its own
+        return [alone, with_changes(on_plate, {"solver.scheme": "implicit"})]
     bare = with_changes(preset("3d-bare-plate"), {"plate.elements": [2, 8, 1]})
     return [on_plate, bare, alone]  # the granules alone in space run the same loop, its body empty
 
