@@ -91,3 +91,48 @@ def test_one_blas_thread_limits_and_restores():
         inside = [p["num_threads"] for p in threadpoolctl.threadpool_info() if p["user_api"] == "blas"]
     after = [p["num_threads"] for p in threadpoolctl.threadpool_info() if p["user_api"] == "blas"]
     assert inside and all(n == 1 for n in inside) and after == before
+
+
+def test_windows_side_by_side_find_the_dense_spectrum_as_one_by_one():
+    """Two planned windows solved at once on a pool give the dense LAPACK spectrum below
+    the cut-off (no mode lost or repeated), the same pairs bitwise as one by one; a plan
+    whose second shift lies too high to reach the first window's cut is dropped, and the
+    windows one by one still find every mode."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    K, M, nodes, dofs = system([0.03, 0.02, 0.004], [3, 2, 1], clamped=("xmin",))
+    lam, _ = la.eigh(K.toarray(), M.toarray())
+    cut = np.sqrt(lam[25] * lam[26])
+    xyz = nodes[dofs // 3]
+    plan = ((None, 14), (lam[19], 14))
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        side = modes_below(K, M, np.sqrt(cut), xyz, k=8, plan=plan, pool=pool)
+    alone = modes_below(K, M, np.sqrt(cut), xyz, k=8, plan=plan)
+    assert len(side[0]) == 26 and np.allclose(side[0] ** 2, lam[:26], rtol=1e-9)
+    assert np.array_equal(side[0], alone[0]) and np.array_equal(side[1], alone[1])
+    too_high = modes_below(K, M, np.sqrt(cut), xyz, k=8, plan=((None, 6), (lam[60], 6)))
+    assert len(too_high[0]) == 26 and np.allclose(too_high[0] ** 2, lam[:26], rtol=1e-9)
+
+
+def test_split_plan_shifts_the_second_window_between_the_estimate_and_the_cut_off():
+    """Below SPLIT_VALUES one window; from it on two, the first asking its share, the
+    second shifted halfway (in omega^2) between the estimated top of the first and the
+    cut-off, asking the rest and the overlap."""
+    from granplate.solid.modes import SPLIT_LOW_SHARE, SPLIT_OVERLAP, SPLIT_VALUES, split_plan
+
+    assert split_plan(SPLIT_VALUES - 1, 4.0, lambda c: 1.0) == ((None, SPLIT_VALUES - 1),)
+    (s0, k0), (s1, k1) = split_plan(200, 4.0, lambda c: c / 100.0)
+    low = int(SPLIT_LOW_SHARE * 200)
+    assert s0 is None and k0 == low and s1 == 0.5 * (low / 100.0 + 4.0)
+    assert k1 == 200 - low + int(SPLIT_OVERLAP * 200)
+
+
+@pytest.mark.parametrize("rollers", [(), ("zmin",)])
+def test_mass_operator_is_the_mass_matrix_product(rollers):
+    """M x by the scalar mass on each node's dofs equals M's own product (whole nodes kept)
+    and falls back to it where rollers fix single dofs."""
+    from granplate.solid.modes import mass_operator
+
+    K, M, nodes, dofs = system([0.03, 0.02, 0.004], [3, 2, 1], clamped=("xmin",), rollers=rollers)
+    x = np.random.default_rng(3).standard_normal(M.shape[0])
+    assert np.allclose(mass_operator(M) @ x, M @ x, rtol=1e-13, atol=0.0)

@@ -24,6 +24,7 @@ import dataclasses
 import functools
 import hashlib
 import logging
+import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -39,11 +40,11 @@ from granplate.setup.materials import LIBRARY, Material
 from granplate.setup.scenario import Solid
 from granplate.setup.solid_checks import check_faces, check_solid_fields
 from granplate.solid.boundary import face_node_dofs, face_nodes, fixed_dofs, free_dofs, reduced, reduced_index
-from granplate.solid.cost import SolidCost, box_dofs, check_fits, estimate, mode_count
+from granplate.solid.cost import SolidCost, box_dofs, check_fits, estimate, mode_count, omega_below
 from granplate.solid.fe import is_hexahedral, mass_matrix, node_coordinates, scalar_basis, stiffness_matrix
 from granplate.solid.mesh import box_mesh, face_names, read_mesh
 from granplate.solid.factor import one_blas_thread
-from granplate.solid.modes import modes_below, rigid_body_modes, rigid_modes
+from granplate.solid.modes import modes_below, rigid_body_modes, rigid_modes, split_plan
 from granplate.solid.residual import (
     flexibility,
     flexibility_block,
@@ -207,6 +208,25 @@ def window_size(n_modes: int, n_dofs: int, clamped: bool = False) -> int:
     return int(np.clip(int(margin * n_modes) + 10, 20, MAX_WINDOW))
 
 
+def window_plan(extent: np.ndarray, material: Material, max_omega: float, k: int) -> tuple:
+    """The eigensolver's first windows (solid.modes.split_plan), the second one shifted by
+    the Weyl estimate (solid.cost.mode_count) of a body of these sides [m]."""
+    size = tuple(float(e) for e in extent)
+    return split_plan(
+        k,
+        max_omega**2,
+        lambda c: omega_below(c, size, material.E, material.nu, material.rho) ** 2,  # type: ignore[arg-type]
+    )
+
+
+def machine_cores() -> int:
+    """The cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - not Linux
+        return os.cpu_count() or 1
+
+
 def modes_and_residual(
     K: sp.spmatrix,
     M: sp.spmatrix,
@@ -216,28 +236,36 @@ def modes_and_residual(
     free: bool,
     surface_dofs: np.ndarray,
     k: int,
+    plan: tuple = (),
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(omega, Phi, R over surface_dofs) of the reduced K, M (solid.modes, solid.residual).
 
     The residual's factorisation (solid.residual.static_factor) needs no elastic mode: it
-    runs in a second thread beside the eigensolver (SuperLU and ARPACK's solves release
-    the GIL), both on one BLAS thread; its dense part (the factor's trailing block and its
-    inverse, the largest arrays) waits for the eigensolver's end, which frees the shifted
-    factorisation, and has every BLAS thread. The outer pin spans the second thread's
-    whole life, so the two threads' BLAS limits cannot race."""
+    and the eigensolver's planned windows (solid.modes: plan) share a pool of threads, one
+    per core (SuperLU and ARPACK release the GIL), the windows first (the first, the
+    smaller, then leaves its core to the factorisation), each on one BLAS thread; the dense
+    part of the residual (the factor's trailing block and its inverse, the largest arrays)
+    waits for the eigensolver's end, which frees the shifted factorisations, and has every
+    BLAS thread. The outer pin spans the threads' whole life, so their BLAS limits cannot
+    race."""
     rigid = m_rigid = None
     if free:
         rigid, m_rigid = rigid_body_modes(nodes), rigid_modes(nodes, M)
-    if not surface_dofs.size:
-        omega, Phi = modes_below(K, M, max_omega, xyz, rigid=rigid, k=k)
-        return omega, Phi, np.zeros((0, 0))
-    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="flexibility") as pool:
+    tasks = max(1, len(plan)) + bool(surface_dofs.size)
+    factor: list = []
+    with ThreadPoolExecutor(max_workers=max(1, min(tasks, machine_cores())), thread_name_prefix="solid") as pool:
         with one_blas_thread():
-            factor = pool.submit(static_factor, K, surface_dofs, xyz, m_rigid)
-            omega, Phi = modes_below(K, M, max_omega, xyz, rigid=rigid, k=k)
-            schur = factor.result()
+
+            def residual_factor() -> None:
+                factor.append(pool.submit(static_factor, K, surface_dofs, xyz, m_rigid))
+
+            then = residual_factor if surface_dofs.size else None
+            omega, Phi = modes_below(K, M, max_omega, xyz, rigid=rigid, k=k, plan=plan, pool=pool, then=then)
+            schur = factor.pop().result() if factor else None
+    if schur is None:
+        return omega, Phi, np.zeros((0, 0))
     G = static_flexibility(K, surface_dofs, xyz, M, m_rigid, factor=schur)
-    del schur, factor  # the LU, before the residual's dense arrays
+    del schur  # the LU, before the residual's dense arrays
     return omega, Phi, truncation_residual(G, Phi[surface_dofs], omega)
 
 
@@ -346,7 +374,9 @@ def _build_solid(
         K = reduced(solid_stiffness(sbasis, mesh, sd.element, material, sd.rigid_patches), dofs)
         M = reduced(mass_matrix(sbasis, material.rho), dofs)
         k = window_size(cost.n_modes, len(dofs), bool(sd.clamped))
-        omega, Phi, resid = modes_and_residual(K, M, 2.0 * np.pi * sd.max_frequency, xyz, nodes, free, surface_dofs, k)
+        max_omega = 2.0 * np.pi * sd.max_frequency
+        plan = window_plan(xyz.max(axis=0) - xyz.min(axis=0), material, max_omega, k)
+        omega, Phi, resid = modes_and_residual(K, M, max_omega, xyz, nodes, free, surface_dofs, k, plan)
         return {"omega": omega, "Phi": Phi, "dofs": dofs, "surface_dofs": surface_dofs, "resid": resid}
 
     payload = cache_payload(sd, material, surface, components) if cache else None

@@ -82,6 +82,17 @@ def mode_count(size: tuple[float, float, float], E: float, nu: float, rho: float
     return int(math.ceil(flexural + in_plane + volume_modes)) + 6
 
 
+def omega_below(count: float, size: tuple[float, float, float], E: float, nu: float, rho: float) -> float:
+    """The angular frequency [rad/s] below which mode_count puts `count` modes (bisection)."""
+    lo, hi = 0.0, 1.0
+    while mode_count(size, E, nu, rho, hi) < count and hi < 1e15:
+        hi *= 2.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if mode_count(size, E, nu, rho, mid) < count else (lo, mid)
+    return hi
+
+
 def estimate(n_dofs: int, separator: int, n_modes: int, n_surface: int, window: int) -> SolidCost:
     """The cost of modes (windows of `window` values) and a residual compliance over
     n_surface dofs of a body of n_dofs dofs (module docstring)."""
