@@ -24,7 +24,6 @@ import dataclasses
 import functools
 import hashlib
 import logging
-import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,6 +37,7 @@ from granplate import store
 from granplate.errors import ScenarioError
 from granplate.setup.materials import LIBRARY, Material
 from granplate.setup.scenario import Solid
+from granplate.setup.threads import available_threads
 from granplate.setup.solid_checks import check_faces, check_solid_fields
 from granplate.solid.boundary import face_node_dofs, face_nodes, fixed_dofs, free_dofs, reduced, reduced_index
 from granplate.solid.cost import SolidCost, box_dofs, check_fits, estimate, mode_count, omega_below
@@ -219,14 +219,6 @@ def window_plan(extent: np.ndarray, material: Material, max_omega: float, k: int
     )
 
 
-def machine_cores() -> int:
-    """The cores this process may run on."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # pragma: no cover - not Linux
-        return os.cpu_count() or 1
-
-
 def modes_and_residual(
     K: sp.spmatrix,
     M: sp.spmatrix,
@@ -242,7 +234,8 @@ def modes_and_residual(
 
     The residual's factorisation (solid.residual.static_factor) needs no elastic mode: it
     and the eigensolver's planned windows (solid.modes: plan) share a pool of threads, one
-    per core (SuperLU and ARPACK release the GIL), the windows first (the first, the
+    per core numba may use (NUMBA_NUM_THREADS: a design study's worker has one; SuperLU
+    and ARPACK release the GIL), the windows first (the first, the
     smaller, then leaves its core to the factorisation), each on one BLAS thread; the dense
     part of the residual (the factor's trailing block and its inverse, the largest arrays)
     waits for the eigensolver's end, which frees the shifted factorisations, and has every
@@ -253,7 +246,7 @@ def modes_and_residual(
         rigid, m_rigid = rigid_body_modes(nodes), rigid_modes(nodes, M)
     tasks = max(1, len(plan)) + bool(surface_dofs.size)
     factor: list = []
-    with ThreadPoolExecutor(max_workers=max(1, min(tasks, machine_cores())), thread_name_prefix="solid") as pool:
+    with ThreadPoolExecutor(max_workers=max(1, min(tasks, available_threads())), thread_name_prefix="solid") as pool:
         with one_blas_thread():
 
             def residual_factor() -> None:
