@@ -71,23 +71,44 @@ def test_loop_signatures_name_their_scheme_and_dimension():
             None,
         )
 
-    assert loop_key(sig(Granular3, verlet.Scratch)) == ("verlet", 3)
-    assert loop_key(sig(Granular, implicit.Scratch)) == ("implicit", 2)
+    assert loop_key(sig(Granular3, verlet.Scratch)) == ("verlet", 3, False)
+    assert loop_key(sig(Granular, implicit.Scratch)) == ("implicit", 2, False)
     assert loop_key(("too", "short")) is None
 
 
+def test_loop_signatures_name_whether_they_carry_a_solid():
+    """A scratch whose body arrays are model.inputs.BodyArrays is the loop with an elastic
+    solid; NoBodyArrays (a run without) is not."""
+    from granplate.model.inputs import BodyArrays, NoBodyArrays
+    from granplate.solver.compiling import carries_solid
+    from granplate.solver.schemes import implicit
+
+    def scratch(body):
+        fields = implicit.Scratch._fields
+        member = [types.SimpleNamespace(instance_class=None)] * len(fields)
+        member[fields.index("body")] = types.SimpleNamespace(instance_class=body)
+        return types.SimpleNamespace(instance_class=implicit.Scratch, types=tuple(member))
+
+    assert carries_solid(scratch(BodyArrays)) and not carries_solid(scratch(NoBodyArrays))
+    assert not carries_solid(types.SimpleNamespace(instance_class=implicit.Scratch))
+
+
 def test_missing_sets_are_those_whose_loop_is_not_compiled():
-    """Every scheme in both dimensions is a kernel set; those whose (scheme, dimension) the
-    cache holds are not compiled again, and a run needs compiling only when its own is
-    missing."""
+    """Every scheme in both dimensions is a kernel set; those whose loops the cache holds
+    (with a solid too, for the sets that drive one) are not compiled again, and a run needs
+    compiling only when its own is missing."""
     from granplate.results.kernels import KERNEL_SETS, missing, needs_compiling
     from granplate.setup.validate import SCHEMES
 
     assert {(k.scheme, k.dimension) for k in KERNEL_SETS} == {(s, d) for s in SCHEMES for d in (2, 3)}
-    have = {("implicit", 2), ("verlet", 3)}
+    have = {("implicit", 2, False), ("verlet", 3, False), ("verlet", 3, True)}
     assert [k.name for k in missing(compiled=have)] == ["paper-2d", "verlet-2d", "implicit-3d", "paper-3d"]
     assert not needs_compiling(_tiny(), compiled=have)
-    assert needs_compiling(_tiny(), compiled={("implicit", 3)})
+    assert needs_compiling(_tiny(), compiled={("implicit", 3, False)})
+    every = set().union(*(k.loops for k in KERNEL_SETS))
+    alone = every - {("implicit", 3, True)}  # an older cache: the implicit loop in space without a solid
+    assert [k.name for k in missing(compiled=alone)] == ["implicit-3d"]
+    assert missing(compiled=every) == []
 
 
 def test_the_compile_clock_counts_numbas_compiling_once():

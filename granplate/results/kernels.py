@@ -113,6 +113,12 @@ class KernelSet:
     scheme: str
     dimension: int
     scenarios: Callable[[], list[Scenario]]
+    solid: bool = False  # its runs compile the loop with an elastic solid too
+
+    @property
+    def loops(self) -> set[tuple[str, int, bool]]:
+        """The (scheme, dimension, solid) keys of the loops its runs compile."""
+        return {(self.scheme, self.dimension, False)} | ({(self.scheme, self.dimension, True)} if self.solid else set())
 
     @property
     def name(self) -> str:
@@ -130,23 +136,27 @@ KERNEL_SETS: tuple[KernelSet, ...] = (
     KernelSet("implicit", 2, lambda: _plane_granules("implicit")),
     KernelSet("paper", 2, lambda: _plane_granules("paper")),
     KernelSet("verlet", 2, lambda: _plane_granules("verlet")),
-    KernelSet("implicit", 3, lambda: _space_granules("implicit")),
+    KernelSet("implicit", 3, lambda: _space_granules("implicit"), solid=True),
     KernelSet("paper", 3, lambda: _space_granules("paper")),
-    KernelSet("verlet", 3, lambda: _space_granules("verlet")),
+    KernelSet("verlet", 3, lambda: _space_granules("verlet"), solid=True),
 )
 
 
 def missing(sets: tuple[KernelSet, ...] = KERNEL_SETS, compiled: set | None = None) -> list[KernelSet]:
-    """The kernel sets whose time loop numba's cache does not hold (compiled: the
-    (scheme, dimension) pairs it holds, default `compiled_loops()`)."""
+    """The kernel sets some of whose time loops numba's cache does not hold (compiled: the
+    (scheme, dimension, solid) keys it holds, default `compiled_loops()`): a cache that
+    holds a scheme's loop for granules alone but not with a solid misses the set."""
     have = compiled_loops() if compiled is None else compiled
-    return [k for k in sets if (k.scheme, k.dimension) not in have]
+    return [k for k in sets if not k.loops <= set(have)]
 
 
 def needs_compiling(scenario: Scenario, compiled: set | None = None) -> bool:
     """Whether a run of `scenario` would compile its time loop first."""
+    from granplate.setup.scenario import Solid
+
     have = compiled_loops() if compiled is None else compiled
-    return (scenario.solver.scheme, getattr(scenario, "dimension", 2)) not in have
+    key = (scenario.solver.scheme, getattr(scenario, "dimension", 2), isinstance(scenario.plate, Solid))
+    return key not in have
 
 
 def estimate(sets: list[KernelSet]) -> float:

@@ -5,9 +5,10 @@ the seconds spent compiling.
   (its "numba:compile" events, the outermost only: a callee compiled inside its caller
   counts once; loading from numba's on-disk cache is no compile and is not counted), so
   that a run's wall time leaves them out and states them apart (`compile_time_s`).
-- `compiled_loops()`: the (scheme, dimension) pairs whose time loop (`loop.advance`) numba
-  holds compiled, in this process or in its on-disk cache, read from the cache's index
-  without compiling or loading anything.
+- `compiled_loops()`: the (scheme, dimension, solid) keys whose time loop (`loop.advance`)
+  numba holds compiled, in this process or in its on-disk cache, read from the cache's
+  index without compiling or loading anything (solid: the loop with an elastic body's
+  arrays, a type of its own, model.inputs.BodyArrays against NoBodyArrays).
 - `compile_seconds(scheme, dimension)`: how long compiling a kernel set takes on a cold
   cache, measured (`compile_seconds.json`, written by `granplate compile --measure`).
 - `compile_calls`: compile (or load) dispatchers for given arguments before a clock starts.
@@ -75,10 +76,11 @@ def compile_clock() -> Iterator[CompileClock]:
         yield clock
 
 
-def loop_key(sig: tuple) -> tuple[str, int] | None:
-    """(scheme, dimension) of a signature of `loop.advance` (its arguments t_stop,
+def loop_key(sig: tuple) -> tuple[str, int, bool] | None:
+    """(scheme, dimension, solid) of a signature of `loop.advance` (its arguments t_stop,
     max_attempts, g, p, cfg, st, w, sw, out): the dimension from g's class (Granular or
-    Granular3), the scheme from the module of sw's class (its Scratch); None when unknown."""
+    Granular3), the scheme from the module of sw's class (its Scratch), solid from the type
+    of the scratch's body arrays (carries_solid); None when unknown."""
     try:
         g, sw = sig[2], sig[7]
         scheme = getattr(__import__(sw.instance_class.__module__, fromlist=["NAME"]), "NAME")
@@ -87,11 +89,23 @@ def loop_key(sig: tuple) -> tuple[str, int] | None:
         dimension = of_arrays(g.instance_class).n
     except (AttributeError, IndexError, ImportError, TypeError, ValueError):
         return None
-    return str(scheme), dimension
+    return str(scheme), dimension, carries_solid(sw)
 
 
-def compiled_loops() -> set[tuple[str, int]]:
-    """The (scheme, dimension) pairs whose time loop numba holds compiled: in this process
+def carries_solid(scratch_type) -> bool:
+    """Whether a scheme's Scratch type carries an elastic body's arrays (its field `body`
+    of type model.inputs.BodyArrays; NoBodyArrays, or no such field, is a run without)."""
+    from granplate.model.inputs import BodyArrays
+
+    try:
+        body = scratch_type.types[scratch_type.instance_class._fields.index("body")]
+    except (AttributeError, IndexError, ValueError):
+        return False
+    return getattr(body, "instance_class", None) is BodyArrays
+
+
+def compiled_loops() -> set[tuple[str, int, bool]]:
+    """The (scheme, dimension, solid) keys whose time loop numba holds compiled: in this process
     or in its on-disk cache's index for this source and this machine's code generator
     (read, not loaded: nothing is compiled). Empty when the cache cannot be read."""
     from granplate.solver import loop
