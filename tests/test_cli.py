@@ -29,6 +29,7 @@ SUMMARY_KEYS = {
     "n_steps",
     "threads",
     "wall_time_s",
+    "loop_time_s",
     "t_end",
     "plastic_fraction",
     "max_contact_pressure",

@@ -235,12 +235,11 @@ def modes_and_residual(
     The residual's factorisation (solid.residual.static_factor) needs no elastic mode: it
     and the eigensolver's planned windows (solid.modes: plan) share a pool of threads, one
     per core numba may use (NUMBA_NUM_THREADS: a design study's worker has one; SuperLU
-    and ARPACK release the GIL), the windows first (the first, the
-    smaller, then leaves its core to the factorisation), each on one BLAS thread; the dense
-    part of the residual (the factor's trailing block and its inverse, the largest arrays)
-    waits for the eigensolver's end, which frees the shifted factorisations, and has every
-    BLAS thread. The outer pin spans the threads' whole life, so their BLAS limits cannot
-    race."""
+    and ARPACK release the GIL), the windows first (the first, the smaller, then leaves
+    its core to the factorisation), each on one BLAS thread; the dense part of the
+    residual (the factor's trailing block and its inverse, the largest arrays) waits for
+    the eigensolver's end, which frees the shifted factorisations, and has every BLAS
+    thread. The outer pin spans the threads' whole life, so their BLAS limits cannot race."""
     rigid = m_rigid = None
     if free:
         rigid, m_rigid = rigid_body_modes(nodes), rigid_modes(nodes, M)

@@ -59,9 +59,15 @@ def keeps_every_field(scenario) -> bool:
     return scenario.plate is not None and abs(t.field_interval - t.output_interval) <= 1e-9 * t.output_interval
 
 
+#: Summary keys a design keeps among its timings, not its metrics (loop_time_s: timings' loop_s).
+TIMING_KEYS: tuple[str, ...] = ("loop_time_s",)
+
+
 def metrics(ds) -> dict[str, Any]:
-    """gp.summary of a result, with the study's extra metrics (and their units) added."""
-    summary = gp.summary(ds)
+    """gp.summary of a result, less TIMING_KEYS, with the study's extra metrics (and their
+    units) added."""
+    summary = {k: v for k, v in gp.summary(ds).items() if k not in TIMING_KEYS}
+    summary["units"] = {k: u for k, u in summary.get("units", {}).items() if k not in TIMING_KEYS}
     summary["granular_mass"] = float(ds["mass"].sum()) if "mass" in ds else None
     summary["max_von_mises_nodes"] = nodal_von_mises(ds)
     summary["units"] = {**summary.get("units", {}), **{k: u for k, (u, _) in EXTRA_METRICS.items()}}
@@ -72,7 +78,8 @@ def metric_units() -> dict[str, str]:
     """Every metric a design has (gp.summary's and the extra ones) and its unit."""
     from granplate.results.dataset import SUMMARY_UNITS
 
-    return {**SUMMARY_UNITS, **{k: u for k, (u, _) in EXTRA_METRICS.items()}}
+    units = {k: u for k, u in SUMMARY_UNITS.items() if k not in TIMING_KEYS}
+    return {**units, **{k: u for k, (u, _) in EXTRA_METRICS.items()}}
 
 
 def design_key(scenario_toml: str) -> str:
