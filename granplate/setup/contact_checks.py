@@ -117,7 +117,7 @@ def _check_contact(s: Scenario) -> None:
 MINDLIN_SUPPORT = (
     "Mindlin's law runs in the plane and in space (dimension = 2 or 3) under every solver.scheme "
     "('verlet', 'paper', 'implicit'), at granule-granule and granule-wall contacts, and in space at the "
-    "granules' contacts on the elastic solid ([plate] of dimension = 3, scheme 'verlet'); not with the "
+    "granules' contacts on the elastic solid ([plate] of dimension = 3, schemes 'verlet' and 'implicit'); not with the "
     "plane's [plate] (its plate contacts keep the tanh law's held friction)"
 )
 

@@ -9,7 +9,6 @@ import math
 from granplate.errors import ScenarioError
 from granplate.setup.threads import check_threads
 from granplate.setup.fields import finite, int_at_least, nonneg, positive, string_in
-from granplate.setup.law_registry import TANGENTIAL_LAW_REGISTRY
 from granplate.setup.plate_cost import MEMORY_SHARE, physical_memory
 from granplate.setup.scenario import Solid, Plate, Scenario
 
@@ -201,8 +200,8 @@ SOLID_SCHEMES: tuple[str, ...] = ("implicit",)
 
 def _check_solid_implicit_inputs(s: Scenario) -> None:
     """What the implicit scheme does not yet carry to an elastic solid in 3D, refused by
-    name: the solid's weight, a static state with it, Mindlin's law (velocity Verlet has all
-    three, docs/model.md sections 3.11, 3.12, 3.16)."""
+    name: the solid's weight and a static state with it (velocity Verlet has both,
+    docs/model.md sections 3.11, 3.12)."""
     verlet = 'set solver.scheme = "verlet"'
     if s.gravity is not None:
         raise ScenarioError(
@@ -215,12 +214,6 @@ def _check_solid_implicit_inputs(s: Scenario) -> None:
             "precompression",
             "given",
             f"a static state with the elastic solid is computed for velocity Verlet only (section 3.12): {verlet}",
-        )
-    if TANGENTIAL_LAW_REGISTRY[s.contact.tangential_law].history:
-        raise ScenarioError(
-            "contact.tangential_law",
-            s.contact.tangential_law,
-            f"Mindlin's law at the elastic solid's contacts runs under velocity Verlet only (section 3.16): {verlet}",
         )
 
 

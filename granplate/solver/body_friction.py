@@ -10,9 +10,10 @@ import math
 
 from granplate.jit import njit
 
-from granplate.model.inputs import GEO_DELTA, GEO_N, GEO_NX, GEO_NY, GEO_NZ, GEO_TOUCH
+from granplate.model.inputs import GEO_DELTA, GEO_N, GEO_TOUCH
 from granplate.physics.contact import COEF_MU, contact_arm
-from granplate.physics.space import friction_along_slip, slip_velocity_3d
+from granplate.physics.space import friction_along_slip
+from granplate.solver.body_mindlin import contact_slip
 from granplate.solver.body_surface import spread, surface_velocity
 from granplate.solver.granular import friction_impulse
 from granplate.solver.friction_space import apply_friction_impulse
@@ -51,22 +52,9 @@ def friction_flow(y, qd, dt, b, buf, radius, mass, inertia, arm_shrink, forward)
         c = b.coef[i]
         if c[COEF_MU] == 0.0 or g[i, GEO_N] <= 0.0:
             continue
-        nx = -g[i, GEO_NX]  # from the granule into the body
-        ny = -g[i, GEO_NY]
-        nz = -g[i, GEO_NZ]
         a = contact_arm(radius[i], g[i, GEO_DELTA], arm_shrink)
         v0, v1, v2 = surface_velocity(b, buf, i, qd)
-        vsx, vsy, vsz = slip_velocity_3d(
-            y[i, VX] - v0,
-            y[i, VX + 1] - v1,
-            y[i, VX + 2] - v2,
-            a * y[i, WX],
-            a * y[i, WX + 1],
-            a * y[i, WX + 2],
-            nx,
-            ny,
-            nz,
-        )
+        vsx, vsy, vsz, nx, ny, nz = contact_slip(y, g, i, a, v0, v1, v2)  # n from the granule into the body
         speed = math.sqrt(vsx * vsx + vsy * vsy + vsz * vsz)
         if speed == 0.0:
             continue

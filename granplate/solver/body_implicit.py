@@ -32,8 +32,10 @@ from granplate.jit import njit
 from granplate.model.inputs import GEO_DAMP, GEO_DELTA, GEO_NX, GEO_NY, GEO_NZ, GEO_TOUCH, BodyArrays
 from granplate.physics.shock import shock_amplitude
 from granplate.solver import body as B
+from granplate.solver import body_mindlin as BM
 from granplate.solver.body_surface import surface_velocity
 from granplate.solver.granular import commit_history
+from granplate.solver import mindlin_rk4 as MR
 from granplate.solver.granular3d import VX
 from granplate.solver.state import PARTNER_BODY
 from granplate.solver.plate_modal import (
@@ -61,8 +63,9 @@ RELAX_FIRST = 1.0
 #: bounds of |omega| (Aitken's factor), so that one noisy difference cannot stall or blow it up
 RELAX_MIN, RELAX_MAX = 0.02, 2.0
 #: columns of BodyStep.sums: the end pass's stored energy [J], viscous power [W], plastic
-#: work [J], largest overlap / radius, its granule
-S_EPOT, S_PVISC, S_PLASTIC, S_OVL, S_OVL_I = range(5)
+#: work [J], largest overlap / radius, its granule, Mindlin's power -F_t . v_s [W] and
+#: largest sticking rate [1/s]; the springs' committed energy at the step's start [J]
+S_EPOT, S_PVISC, S_PLASTIC, S_OVL, S_OVL_I, S_PFRIC, S_RATE, S_SPRING0 = range(8)
 
 
 class BodyStep(NamedTuple):
@@ -79,7 +82,8 @@ class BodyStep(NamedTuple):
     acc: np.ndarray  # (ng, nc) the end pass's accelerations [m/s^2]
     fdamp: np.ndarray  # (ng, nc) the passes' damping forces (not used by this scheme) [N]
     pv: np.ndarray  # (4,) the body contacts' viscous power at the RK4 stages [W]
-    sums: np.ndarray  # (5,) the end pass's S_* values
+    pf: np.ndarray  # (4,) their Mindlin springs' power -F_t . v_s at the RK4 stages [W]
+    sums: np.ndarray  # (8,) the end pass's S_* values, the springs' start energy
     flags: np.ndarray  # (2,) CUR, RELAX
     mc: np.ndarray  # (nm, N_MCOEF) the step's modal coefficients (solver.plate_modal)
 
@@ -98,7 +102,8 @@ def new_body_step(ng: int, nm: int, nc: int) -> BodyStep:
         acc=z((ng, nc)),
         fdamp=z((ng, nc)),
         pv=z(4),
-        sums=z(5),
+        pf=z(4),
+        sums=z(8),
         flags=flags,
         mc=z((nm, N_MCOEF)),
     )
@@ -137,15 +142,25 @@ def modal_stages(t, h, b, bs, cfg):
 
 
 @njit(cache=True)
-def pass_at(y, row, buf, b, bs, g, cfg, acc):
+def pass_at(y, row, buf, b, bs, g, cfg, acc, record):
     """The body's contact forces at granule state y and the modes of row `row` of bs.qs,
-    bs.qds into buffer buf (solver.body.contact_forces), their accelerations added to acc.
-    Returns (stored energy [J], viscous power [W], plastic work [J], largest overlap /
-    radius, its granule)."""
+    bs.qds into buffer buf (solver.body.contact_forces), their accelerations added to acc;
+    with cfg.history_stages Mindlin's law there too, in the RK4 stage the contacts'
+    histories stand at (solver.body_mindlin.stage_forces; record: the step's end, its
+    trial histories written). Returns (stored energy, the springs' included [J], viscous
+    power [W], plastic work [J], largest overlap / radius, its granule, the springs' power
+    -F_t . v_s [W], their largest sticking rate [1/s])."""
     ep, _, wp, _, ovl, ovl_i = B.contact_forces(
         y, bs.qs[row], bs.qds[row], b, buf, g.radius, g.mass, cfg.clip, acc, bs.fdamp, True
     )
-    return ep, damping_power(y, bs.qds[row], b, buf), wp, ovl, ovl_i
+    e_t = 0.0
+    pf = 0.0
+    rate = 0.0
+    if cfg.history_stages:
+        e_t, pf, rate = BM.stage_forces(
+            y, bs.qds[row], b, buf, g.radius, g.mass, g.inertia, cfg.arm_shrink, acc, record
+        )
+    return ep + e_t, damping_power(y, bs.qds[row], b, buf), wp, ovl, ovl_i, pf, rate
 
 
 @njit(cache=True)
@@ -174,9 +189,11 @@ def open_step(t, h, y0, split, st, b, bs, g, cfg, k1, p1, fresh) -> float:
     step on y0 and on them (split: the opening half of the split-off friction), the force
     pass at t_n again where the velocities moved (fresh: k1, p1 are the granules' own,
     just recomputed, and gain the body's share; else they are t_n's, the body's in them),
-    then the modes' motion over the step (`modal_stages`). Returns the friction's
+    then the modes' motion over the step (`modal_stages`); Mindlin's springs' stage sums
+    begun around that pass (`begin_stages`, `next_stage`). Returns the friction's
     dissipation [J]."""
     cur = int(bs.flags[CUR])
+    bs.sums[S_SPRING0] = begin_stages(b, cfg)
     for m in range(bs.qs.shape[1]):
         bs.qs[0, m] = st.q[m]
         bs.qds[0, m] = st.qd[m]
@@ -184,19 +201,24 @@ def open_step(t, h, y0, split, st, b, bs, g, cfg, k1, p1, fresh) -> float:
     if split:
         fric = B.friction_flow(y0, bs.qds[0], 0.5 * h, b, cur, g.radius, g.mass, g.inertia, cfg.arm_shrink, True)
     if fresh:
-        _, pv, _, _, _ = pass_at(y0, 0, cur, b, bs, g, cfg, k1)
+        _, pv, _, _, _, pf, _ = pass_at(y0, 0, cur, b, bs, g, cfg, k1, False)
         p1[1] += pv
+        p1[2] += pf
     modal_stages(t, h, b, bs, cfg)
+    next_stage(b, cfg, 1.0, 0.5 * h, False)
     return fric
 
 
 @njit(cache=True)
-def stage_pass(y, row, b, bs, g, cfg, acc, stage) -> None:
+def stage_pass(y, row, b, bs, g, cfg, acc, stage, weight, tau, final) -> None:
     """An inner RK4 stage's body forces (granule state y, the modes of row `row`) into the
     trial step's buffer, added to the stage's derivative acc; its viscous power into
-    bs.pv[stage]."""
-    _, pv, _, _, _ = pass_at(y, row, 1 - int(bs.flags[CUR]), b, bs, g, cfg, acc)
+    bs.pv[stage], its Mindlin springs' into bs.pf[stage], their stage sums moved on
+    (`next_stage` with weight, tau, final)."""
+    _, pv, _, _, _, pf, _ = pass_at(y, row, 1 - int(bs.flags[CUR]), b, bs, g, cfg, acc, False)
     bs.pv[stage] = pv
+    bs.pf[stage] = pf
+    next_stage(b, cfg, weight, tau, final)
 
 
 @njit(cache=True)
@@ -207,8 +229,10 @@ def end_pass(y, b, bs, g, cfg) -> None:
     for i in range(bs.acc.shape[0]):
         for c in range(bs.acc.shape[1]):
             bs.acc[i, c] = 0.0
-    ep, pv, wp, ovl, ovl_i = pass_at(y, 2, 1 - int(bs.flags[CUR]), b, bs, g, cfg, bs.acc)
+    ep, pv, wp, ovl, ovl_i, pf, rate = pass_at(y, 2, 1 - int(bs.flags[CUR]), b, bs, g, cfg, bs.acc, True)
     bs.sums[S_EPOT] = ep
+    bs.sums[S_PFRIC] = pf
+    bs.sums[S_RATE] = rate
     bs.sums[S_PVISC] = pv
     bs.sums[S_PLASTIC] = wp
     bs.sums[S_OVL] = ovl
@@ -224,21 +248,23 @@ def close_friction(y, h, b, bs, g, cfg) -> float:
 
 
 @njit(cache=True)
-def end_sums(bs, w) -> float:
+def end_sums(b, bs, cfg, w) -> tuple:
     """The end pass's share of the trial step's end values (solver.rk4): its accelerations
-    added to w.kend, its viscous power to w.pend[1], its plastic work to w.dacc[3], its
-    overlap to the largest (w.ovl_new, w.ovl_who) where larger. Returns its stored
-    energy [J]."""
+    added to w.kend, its viscous power to w.pend[1], its Mindlin springs' to w.pend[2], its
+    plastic work to w.dacc[3], its overlap to the largest (w.ovl_new, w.ovl_who) where
+    larger. Returns (its stored energy [J], the springs' largest sticking rate [1/s], the
+    rise of their energy over the step [J])."""
     for i in range(w.kend.shape[0]):
         for c in range(w.kend.shape[1]):
             w.kend[i, c] += bs.acc[i, c]
     w.pend[1] += bs.sums[S_PVISC]
+    w.pend[2] += bs.sums[S_PFRIC]
     w.dacc[3] += bs.sums[S_PLASTIC]
     if bs.sums[S_OVL] > w.ovl_new[0]:
         w.ovl_new[0] = bs.sums[S_OVL]
         w.ovl_who[0] = int(bs.sums[S_OVL_I])
         w.ovl_who[1] = PARTNER_BODY
-    return bs.sums[S_EPOT]
+    return bs.sums[S_EPOT], bs.sums[S_RATE], spring_rise(b, cfg, bs.sums[S_SPRING0])
 
 
 @njit(cache=True)
@@ -327,3 +353,38 @@ def accept(t, h, b, bs) -> float:
 def body_step_for(body: BodyArrays, ng: int, nc: int) -> BodyStep:
     """The BodyStep of a run with this body (nm its modes; none: an empty one)."""
     return new_body_step(ng if body.face_nodes.shape[0] > 0 else 0, body.omega.shape[0], nc)
+
+
+@njit(cache=True)
+def stage_work(h6, bs) -> tuple:
+    """The body contacts' viscous and Mindlin work at the RK4 step's inner stages 2-4
+    (Simpson's weights 2, 2, 1 times h6 = h / 6 [s]; stage 1's powers are in the step's
+    first stage sums) [J]."""
+    visc = h6 * (2.0 * bs.pv[1] + 2.0 * bs.pv[2] + bs.pv[3])
+    fric = h6 * (2.0 * bs.pf[1] + 2.0 * bs.pf[2] + bs.pf[3])
+    return visc, fric
+
+
+@njit(cache=True)
+def begin_stages(b, cfg) -> float:
+    """`solver.mindlin_rk4.begin_stages` for the body's contacts (with cfg.history_stages):
+    their stage sums zero, inside a step. Returns their springs' committed energy [J]."""
+    if not cfg.history_stages:
+        return 0.0
+    return MR.begin_rows(b.hist, b.coef)
+
+
+@njit(cache=True)
+def next_stage(b, cfg, weight, tau, final) -> None:
+    """`solver.mindlin_rk4.next_stage` for the body's contacts (with cfg.history_stages)."""
+    if cfg.history_stages:
+        MR.next_rows(b.hist, b.coef, weight, tau, final)
+
+
+@njit(cache=True)
+def spring_rise(b, cfg, e_start) -> float:
+    """The rise of the body contacts' springs' energy over the step [J] (e_start what
+    `begin_stages` returned; 0 without Mindlin's law)."""
+    if not cfg.history_stages:
+        return 0.0
+    return MR.energy_rows(b.hist, b.coef) - e_start

@@ -12,6 +12,10 @@ weights at both ends of the step when the granule touched at t_n too. The tangen
 force F_t acts on the granule (with its torque a n x F_t) and -F_t on the body, spread
 over the same patch weights as the normal force; its damping part is booked with the
 slip's work in D_friction (eq. M6), not in D_visc.
+
+Under the RK4 schemes (the implicit scheme's body, solver.body_implicit) the same contacts
+take the law in the stages instead (`stage_forces`, solver.mindlin_rk4's staged history):
+each stage's slip against the surface's velocity at the stage's modal velocities.
 """
 
 from __future__ import annotations
@@ -20,12 +24,13 @@ from granplate.jit import njit
 
 from granplate.model.inputs import GEO_DELTA, GEO_N, GEO_NX, GEO_NY, GEO_NZ, GEO_TOUCH
 from granplate.physics.contact import contact_arm
-from granplate.physics.laws import keeps_history, tangential_scale
+from granplate.physics.laws import keeps_history, tangential_scale, tangential_stiffness
 from granplate.physics.space import slip_velocity_3d
 from granplate.solver.body_surface import spread, surface_velocity
 from granplate.solver.friction_space import apply_friction_impulse
 from granplate.solver.granular3d import VX, WX
 from granplate.solver.mindlin_history import mindlin_contact, mindlin_parted
+from granplate.solver.mindlin_rk4 import stage_apart, stage_contact, sticking_rate
 
 
 @njit(cache=True)
@@ -70,22 +75,9 @@ def mindlin_forces(y, vq, b, buf_old, buf, h, radius, mass, inertia, arm_shrink,
         if g[i, GEO_TOUCH] == 0.0 or delta <= 0.0:
             lost += mindlin_parted(b.hist, i, c)
             continue
-        nx = -g[i, GEO_NX]  # from the granule into the body
-        ny = -g[i, GEO_NY]
-        nz = -g[i, GEO_NZ]
         arm = contact_arm(radius[i], delta, arm_shrink)
         v0, v1, v2 = surface_motion(b, buf_old, buf, i, vq)
-        vsx, vsy, vsz = slip_velocity_3d(
-            y[i, VX] - v0,
-            y[i, VX + 1] - v1,
-            y[i, VX + 2] - v2,
-            arm * y[i, WX],
-            arm * y[i, WX + 1],
-            arm * y[i, WX + 2],
-            nx,
-            ny,
-            nz,
-        )
+        vsx, vsy, vsz, nx, ny, nz = contact_slip(y, g, i, arm, v0, v1, v2)
         a = tangential_scale(c, radius[i], delta)  # R* = R: the body flat there
         fx, fy, fz, e, d = mindlin_contact(b.hist, i, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, abs(g[i, GEO_N]))
         e_t += e
@@ -106,3 +98,60 @@ def step_forces(y, q0, q1, b, buf_old, buf, h, radius, mass, inertia, arm_shrink
     for m in range(vq.shape[0]):
         vq[m] = (q1[m] - q0[m]) / h
     return mindlin_forces(y, vq, b, buf_old, buf, h, radius, mass, inertia, arm_shrink, acc)
+
+
+@njit(cache=True)
+def contact_slip(y, g, i, arm, v0, v1, v2):
+    """Granule i's slip velocity [m/s] at its contact on the body (its geometry row g[i] of
+    one buffer) against the surface's velocity (v0, v1, v2) [m/s] there, and the unit normal
+    from the granule into the body."""
+    nx = -g[i, GEO_NX]
+    ny = -g[i, GEO_NY]
+    nz = -g[i, GEO_NZ]
+    vsx, vsy, vsz = slip_velocity_3d(
+        y[i, VX] - v0,
+        y[i, VX + 1] - v1,
+        y[i, VX + 2] - v2,
+        arm * y[i, WX],
+        arm * y[i, WX + 1],
+        arm * y[i, WX + 2],
+        nx,
+        ny,
+        nz,
+    )
+    return vsx, vsy, vsz, nx, ny, nz
+
+
+@njit(cache=True)
+def stage_forces(y, qd, b, buf, radius, mass, inertia, arm_shrink, acc, record):
+    """Mindlin's law at an RK4 stage (solver.mindlin_rk4.stage_contact) at every granule's
+    contact on the body under a law with history, after the body's force pass into buffer
+    buf at granule state y and modal velocities qd (nm,): F_t / m and a n x F_t / I added
+    to acc, -F_t to the modal forces b.fmodal[buf]; record: the trial histories (the step's
+    end pass). Returns (the springs' energy [J], the power -F_t . v_s [W], the largest
+    sticking rate sqrt(k_t / m_t) [1/s])."""
+    e_t = 0.0
+    p_fric = 0.0
+    rate = 0.0
+    g = b.geo[buf]
+    for i in range(b.coef.shape[0]):
+        c = b.coef[i]
+        if not keeps_history(c):
+            continue
+        delta = g[i, GEO_DELTA]
+        if g[i, GEO_TOUCH] == 0.0 or delta <= 0.0:
+            stage_apart(b.hist, i, record)
+            continue
+        arm = contact_arm(radius[i], delta, arm_shrink)
+        v0, v1, v2 = surface_velocity(b, buf, i, qd)
+        vsx, vsy, vsz, nx, ny, nz = contact_slip(y, g, i, arm, v0, v1, v2)
+        a = tangential_scale(c, radius[i], delta)  # R* = R: the body flat there
+        fx, fy, fz, e = stage_contact(b.hist, i, c, a, delta, nx, ny, nz, vsx, vsy, vsz, g[i, GEO_N], record)
+        inv_m = 1.0 / mass[i]
+        inv_i = 1.0 / inertia[i]
+        apply_friction_impulse(acc, i, arm, inv_m, inv_i, nx, ny, nz, fx, fy, fz, 1.0)
+        spread(b, buf, i, -fx, -fy, -fz, b.fmodal[buf], 1.0)
+        e_t += e
+        p_fric -= fx * vsx + fy * vsy + fz * vsz
+        rate = max(rate, sticking_rate(tangential_stiffness(c, a), inv_m + arm * arm * inv_i))
+    return e_t, p_fric, rate

@@ -270,7 +270,7 @@ def space_stages(y, dy, g, cfg, record, p_fric, e_pot, rate):
 
 
 @njit(cache=True)
-def _begin_rows(hist, coef) -> float:
+def begin_rows(hist, coef) -> float:
     """`begin_stages` of one history array; returns its springs' committed energy [J]."""
     e = 0.0
     for k in range(hist.shape[0]):
@@ -291,11 +291,11 @@ def begin_stages(g, cfg) -> float:
     Returns the springs' committed energy [J] (0 without Mindlin's law)."""
     if not cfg.history_stages:
         return 0.0
-    return _begin_rows(g.pair_hist, g.pair_coef) + _begin_rows(g.wall_hist, g.wall_coef)
+    return begin_rows(g.pair_hist, g.pair_coef) + begin_rows(g.wall_hist, g.wall_coef)
 
 
 @njit(cache=True)
-def _next_rows(hist, coef, weight, tau, final):
+def next_rows(hist, coef, weight, tau, final):
     """`next_stage` of one history array."""
     for k in range(hist.shape[0]):
         if not keeps_history(coef[k]):
@@ -314,12 +314,12 @@ def next_stage(g, cfg, weight, tau, final):
     it [m] (tau = h/2, h/2, h [s]), or at the last (final) tau = h/6 times the sum."""
     if not cfg.history_stages:
         return
-    _next_rows(g.pair_hist, g.pair_coef, weight, tau, final)
-    _next_rows(g.wall_hist, g.wall_coef, weight, tau, final)
+    next_rows(g.pair_hist, g.pair_coef, weight, tau, final)
+    next_rows(g.wall_hist, g.wall_coef, weight, tau, final)
 
 
 @njit(cache=True)
-def _energy_rows(hist, coef) -> float:
+def energy_rows(hist, coef) -> float:
     """`stage_energy` of one history array."""
     e = 0.0
     for k in range(hist.shape[0]):
@@ -337,4 +337,4 @@ def spring_rise(g, cfg, e_start) -> float:
     end less e_start [J], what `begin_stages` returned (0 without Mindlin's law)."""
     if not cfg.history_stages:
         return 0.0
-    return _energy_rows(g.pair_hist, g.pair_coef) + _energy_rows(g.wall_hist, g.wall_coef) - e_start
+    return energy_rows(g.pair_hist, g.pair_coef) + energy_rows(g.wall_hist, g.wall_coef) - e_start

@@ -121,14 +121,11 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w, b=None, bs=None):
     w.kend (without the split friction; with gravity and the drives, solver.drives), w.fnew
     (forces on the plate at t + h), w.normal_new, w.slip_new, w.pend (powers at t + h) and
     w.dacc (shock, viscous, friction work over the step, and the plastic work past the
-    contacts' largest overlaps, whose end overlaps go into their histories' HIST_END; the work of
-    gravity and of the drives), w.ovl_new and w.ovl_who (the
-    largest relative overlap at t + h and its contact). Returns (stored contact energy at
-    t + h [J], largest slip relaxation rate at t + h of a contact whose friction RK4
-    integrates [1/s]: with cfg.split_friction the plate contacts unless hold, 0 with hold;
-    without it every contact, as the presets' results were computed; at least each touching
-    Mindlin contact's sticking frequency, whose history the stages integrate: solver.mindlin_rk4).
-    """
+    contacts' largest overlaps, whose end overlaps go into their histories' HIST_END; the
+    work of gravity and of the drives), w.ovl_new and w.ovl_who (the largest relative
+    overlap at t + h and its contact). Returns (stored contact energy at t + h [J], the
+    largest slip relaxation rate at t + h of a contact whose friction RK4 integrates
+    [1/s]: `end_rate`, and the body's Mindlin contacts' sticking rates)."""
     y0 = st.y
     ng = y0.shape[0]
     nc = y0.shape[1]
@@ -143,9 +140,10 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w, b=None, bs=None):
         fric_split = opening_friction(y0, h, g, cfg, w)
         y0 = w.ynew
     e_spring = begin_stages(g, cfg)
-    k1, p1 = (w.k1h, w.p1h) if first_stage(t, y0, hold, split, st, g, cfg, w) else (st.k1, st.p1)
+    fresh = first_stage(t, y0, hold, split, st, g, cfg, w)
+    k1, p1 = (w.k1h, w.p1h) if fresh else (st.k1, st.p1)
     if b is not None:  # the body's friction half step, its forces at t_n, its modes over h
-        fric_split += BI.open_step(t, h, y0, split, st, b, bs, g, cfg, k1, p1, split)
+        fric_split += BI.open_step(t, h, y0, split, st, b, bs, g, cfg, k1, p1, fresh)
     hh = 0.5 * h
     piston_stage(g, 1.0, hh)
     next_stage(g, cfg, 1.0, hh, False)
@@ -156,7 +154,7 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w, b=None, bs=None):
         t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k2, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
     )
     if b is not None:
-        BI.stage_pass(w.ytmp, 1, b, bs, g, cfg, w.k2, 1)
+        BI.stage_pass(w.ytmp, 1, b, bs, g, cfg, w.k2, 1, 2.0, hh, False)
     piston_stage(g, 2.0, hh)
     next_stage(g, cfg, 2.0, hh, False)
     for i in range(ng):
@@ -166,7 +164,7 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w, b=None, bs=None):
         t + hh, w.ytmp, stage[0], stage[1], g, cfg, w.k3, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
     )
     if b is not None:
-        BI.stage_pass(w.ytmp, 1, b, bs, g, cfg, w.k3, 2)
+        BI.stage_pass(w.ytmp, 1, b, bs, g, cfg, w.k3, 2, 2.0, h, False)
     piston_stage(g, 2.0, h)
     next_stage(g, cfg, 2.0, h, False)
     for i in range(ng):
@@ -176,7 +174,7 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w, b=None, bs=None):
         t + h, w.ytmp, stage[2], stage[3], g, cfg, w.k4, w.fscratch, w.nscratch, w.sscratch, hold, w.fbar, split, False
     )
     if b is not None:
-        BI.stage_pass(w.ytmp, 2, b, bs, g, cfg, w.k4, 3)
+        BI.stage_pass(w.ytmp, 2, b, bs, g, cfg, w.k4, 3, 1.0, h / 6.0, True)
     h6 = h / 6.0
     piston_rk4_end(g, h)
     next_stage(g, cfg, 1.0, h6, True)
@@ -184,8 +182,10 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w, b=None, bs=None):
         for c in range(nc):  # (y0 may be w.ynew itself: each entry is read before it is written)
             w.ynew[i, c] = y0[i, c] + h6 * (k1[i, c] + 2.0 * w.k2[i, c] + 2.0 * w.k3[i, c] + w.k4[i, c])
     stage_quadrature(h6, p1, p2, p3, p4, w.dacc)
-    if b is not None:  # the body's viscous work at the inner stages; its forces at the end
-        w.dacc[1] += h6 * (2.0 * bs.pv[1] + 2.0 * bs.pv[2] + bs.pv[3])
+    if b is not None:  # the body's viscous and Mindlin work at the inner stages; its forces at the end
+        visc, fric = BI.stage_work(h6, bs)
+        w.dacc[1] += visc
+        w.dacc[2] += fric
         BI.end_pass(w.ynew, b, bs, g, cfg)
     if split:  # friction over [t + h/2, t + h]
         fric_split += friction_flow(w.ynew, hh, g, cfg, False)
@@ -200,12 +200,23 @@ def rk4_granular_step(t, h, stage, hold, st, g, cfg, w, b=None, bs=None):
     w.dacc[2] -= spring_rise(g, cfg, e_spring)  # Mindlin's springs' energy is E_g's, not lost
     record_end(pe, w.pend, w.ovl_new, w.ovl_who)
     e_body = 0.0
+    rate = end_rate(pe, hold, cfg)
     if b is not None:  # the end pass's body forces, energy, damping, plastic work and overlap
-        e_body = BI.end_sums(bs, w)
+        e_body, rate_body, rise = BI.end_sums(b, bs, cfg, w)
+        w.dacc[2] -= rise
+        rate = max(rate, rate_body)
+    return pe.e_pot + e_body, rate
+
+
+@njit(cache=True)
+def end_rate(pe, hold, cfg) -> float:
+    """The largest slip relaxation rate at t + h of a contact whose friction RK4 integrates
+    (ForceSums pe of the end pass) [1/s]: every contact's without the split friction, as the
+    presets' results were computed; with it the plate contacts' unless held (a held
+    plate-contact friction is not RK4's) and Mindlin's sticking contacts' (pe.rate)."""
     if not cfg.split_friction:
-        return pe.e_pot + e_body, max(pe.rate, pe.rate_plate)
-    # a held plate-contact friction is not RK4's; pe.rate: Mindlin's sticking contacts (else 0 here)
-    return pe.e_pot + e_body, max(0.0 if hold else pe.rate_plate, pe.rate)
+        return max(pe.rate, pe.rate_plate)
+    return max(0.0 if hold else pe.rate_plate, pe.rate)
 
 
 @njit(cache=True)

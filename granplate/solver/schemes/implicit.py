@@ -401,8 +401,9 @@ def body_start(sw, t, st, g, cfg):
     for m in range(st.q.shape[0]):
         bs.qs[0, m] = st.q[m]
         bs.qds[0, m] = st.qd[m]
-    e_pot, pv, _, _, _ = BI.pass_at(st.y, 0, cur, b, bs, g, cfg, st.k1)
+    e_pot, pv, _, _, _, pf, _ = BI.pass_at(st.y, 0, cur, b, bs, g, cfg, st.k1, True)
     st.p1[1] += pv
+    st.p1[2] += pf
     for m in range(st.q.shape[0]):
         bs.fprev[m] = b.fmodal[cur, m]
     commit_history(t, b.hist, b.coef)
