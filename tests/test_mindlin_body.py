@@ -16,13 +16,11 @@ import numpy as np
 import pytest
 
 import granplate as gp
-from granplate.errors import ScenarioError
 from granplate.model.inputs import GEO_DELTA, GEO_N, HIST_XI
 from granplate.physics.mindlin import tangential_compliance
 from granplate.results.restart import restart_state
 from granplate.results.run import simulate
 from granplate.setup.materials import LIBRARY
-from granplate.setup.validate import validate
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "docs" / "examples"
 R = 0.002  # the sphere's radius [m]
@@ -234,17 +232,3 @@ def test_restart_mid_contact_equals_the_straight_run_bitwise():
     for key in ("st.q", "st.qd", "sw.body.hist"):
         np.testing.assert_array_equal(s1[key], s0[key], err_msg=key)
     assert float(straight["D_friction"].values[-1]) > 0.0
-
-
-def test_the_planes_plate_is_still_refused_naming_the_field():
-    """Mindlin's law with the plane's plate (dimension = 2) is refused before the run,
-    naming contact.tangential_law and saying where the law runs (the solid in space)."""
-    s = gp.loads((EXAMPLES / "chain.toml").read_text())
-    s = dataclasses.replace(
-        s,
-        contact=dataclasses.replace(s.contact, tangential_law="mindlin"),
-        solver=dataclasses.replace(s.solver, scheme="verlet"),
-    )
-    with pytest.raises(ScenarioError, match="elastic solid") as err:
-        validate(s)
-    assert "contact.tangential_law" in str(err.value) and "dimension = 2" in str(err.value)

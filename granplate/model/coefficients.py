@@ -235,7 +235,8 @@ def wall_arrays(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, wc: np.ndarr
 
 def plate_contact_coefficients(s: Scenario, mats, r: np.ndarray, pc: np.ndarray) -> np.ndarray:
     """(nk, N_COEF) coefficients against the plate's rigid layers: E_k, R_k -> infinity
-    and m_k -> 0, so m* = 0 (no viscous damping)."""
+    and m_k -> 0, so m* = 0 (no viscous damping); the tangential law's columns with the
+    granule's 1/G* alone (as E* is the granule's)."""
     pc_coef = np.zeros((len(pc), N_COEF))
     for k, i in enumerate(pc):
         alpha, mu, ks = s.contact.for_pair(mats[i].name, s.plate.material)
@@ -249,4 +250,5 @@ def plate_contact_coefficients(s: Scenario, mats, r: np.ndarray, pc: np.ndarray)
             law_coefficients(s, mats[i], None, s.plate.material, e_star, r[i], 2.0 * r[i]),
             normal_law_id(s, mats[i].name, s.plate.material),
         )
+    tangential_law_columns(s, pc_coef, kind_compliances([mats[i] for i in pc]))  # a rigid layer: the granule's alone
     return pc_coef

@@ -113,19 +113,10 @@ def _check_contact(s: Scenario) -> None:
     _check_tangential_law(s)
 
 
-#: Where Mindlin's tangential law runs (Contact.tangential_law = "mindlin").
-MINDLIN_SUPPORT = (
-    "Mindlin's law runs in the plane and in space (dimension = 2 or 3) under every solver.scheme "
-    "('verlet', 'paper', 'implicit'), at granule-granule and granule-wall contacts, and in space at the "
-    "granules' contacts on the elastic solid ([plate] of dimension = 3, schemes 'verlet' and 'implicit'); not with the "
-    "plane's [plate] (its plate contacts keep the tanh law's held friction)"
-)
-
-
 def _check_tangential_law(s: Scenario) -> None:
-    """contact.tangential_law is one of TANGENTIAL_LAWS; a law with history ("mindlin") only
-    where the history passes run (MINDLIN_SUPPORT) and with the Poisson ratio of every
-    granule material and of the elastic solid's (their G*, eq. M1)."""
+    """contact.tangential_law is one of TANGENTIAL_LAWS; a law with history ("mindlin") with
+    the Poisson ratio of every granule material and of the elastic solid's (their G*, eq.
+    M1). It runs at every contact kind under every scheme (docs/model.md section 3.16)."""
     c = s.contact
     string_in("contact.tangential_law", c.tangential_law, TANGENTIAL_LAWS)
     nonneg("contact.tangential_damping", c.tangential_damping)
@@ -157,10 +148,6 @@ def _check_tangential_law(s: Scenario) -> None:
             c.torque_arm,
             f"'lammps' (LAMMPS's torque arms) runs under solver.scheme = 'verlet' only, not {s.solver.scheme!r}: "
             "take 'radius' or 'contact_point'",
-        )
-    if s.plate is not None and s.dimension != 3:
-        raise ScenarioError(
-            "contact.tangential_law", c.tangential_law, f"{MINDLIN_SUPPORT} (here: the plane's [plate], dimension = 2)"
         )
     solid = [s.plate.material] if s.plate is not None else []
     for m in dict.fromkeys([*(g.material for g in s.granules), *solid]):

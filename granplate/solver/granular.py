@@ -53,7 +53,7 @@ from granplate.physics.laws import (
 )
 from granplate.physics.shock import shock_amplitude
 from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_motion
-from granplate.solver.mindlin_rk4 import plane_stages
+from granplate.solver.mindlin_rk4 import plane_stages, plate_stages
 from granplate.solver.state import PARTNER_PLATE
 
 
@@ -286,6 +286,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         slip[k] = vt
     if cfg.history_stages:  # Mindlin's law in RK4's stages (solver.mindlin_rk4)
         p_fric, e_pot, rate = plane_stages(y, dy, g, cfg, record, p_fric, e_pot, rate)
+        p_fric, e_pot, rate = plate_stages(y, up, g, cfg, record, dy, fplate, normal, slip, p_fric, e_pot, rate)
     for i in range(ng):
         dy[i, 3] /= g.mass[i]
         dy[i, 4] /= g.mass[i]

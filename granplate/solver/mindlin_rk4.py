@@ -38,6 +38,7 @@ from granplate.physics.contact import (
     pair_apart,
     pair_overlap,
     pair_rates,
+    plate_overlap,
     wall_overlap,
     wall_rates,
 )
@@ -190,6 +191,39 @@ def plane_stages(y, dy, g, cfg, record, p_fric, e_pot, rate):
 
 
 @njit(cache=True)
+def plate_stages(y, up, g, cfg, record, dy, fplate, normal, slip, p_fric, e_pot, rate):
+    """The history law (Mindlin's) at the plane's plate contacts whose tangential law keeps
+    a history, after the plate-contact pass of `solver.granular.granular_rhs` (its |N| in
+    normal, its slip rates v_t = v_y - v_edge,y + a omega in slip; up the driving DOFs'
+    displacement): n = (1, 0) into the plate, t = (0, 1); F_t on the granule into dy (forces,
+    not yet divided by the masses) with its torque a F_t, -F_t on the plate into fplate's
+    odd entries; -F_t v_t to p_fric [W], the springs' energy to e_pot [J], the sticking rate
+    to rate [1/s]; record: the trial histories. Returns (p_fric, e_pot, rate)."""
+    hist = g.pc_hist
+    for k in range(g.pc_i.shape[0]):
+        c = g.pc_coef[k]
+        if not keeps_history(c):
+            continue
+        i = g.pc_i[k]
+        ri = g.radius[i]
+        delta = plate_overlap(y[i, 0], ri, g.pc_x[k] + up[2 * k])
+        if delta <= 0.0:
+            stage_apart(hist, k, record)
+            continue
+        arm = contact_arm(ri, delta, cfg.arm_shrink)
+        vt = slip[k]
+        a = tangential_scale(c, ri, delta)
+        _, fy, _, e = stage_contact(hist, k, c, a, delta, 1.0, 0.0, 0.0, 0.0, vt, 0.0, normal[k], record)
+        dy[i, 4] += fy
+        dy[i, 5] += arm * fy
+        fplate[2 * k + 1] -= fy
+        p_fric -= fy * vt
+        e_pot += e
+        rate = max(rate, sticking_rate(tangential_stiffness(c, a), 1.0 / g.mass[i] + arm * arm / g.inertia[i]))
+    return p_fric, e_pot, rate
+
+
+@njit(cache=True)
 def push_space(dy, i, a, nx, ny, nz, fx, fy, fz, sign):
     """sign * F [N] on granule i's velocity columns of dy and its torque a n x F [N m] on
     the spin columns (the torque's sign the same on both bodies of a pair)."""
@@ -291,7 +325,9 @@ def begin_stages(g, cfg) -> float:
     Returns the springs' committed energy [J] (0 without Mindlin's law)."""
     if not cfg.history_stages:
         return 0.0
-    return begin_rows(g.pair_hist, g.pair_coef) + begin_rows(g.wall_hist, g.wall_coef)
+    return (
+        begin_rows(g.pair_hist, g.pair_coef) + begin_rows(g.wall_hist, g.wall_coef) + begin_rows(g.pc_hist, g.pc_coef)
+    )
 
 
 @njit(cache=True)
@@ -316,6 +352,7 @@ def next_stage(g, cfg, weight, tau, final):
         return
     next_rows(g.pair_hist, g.pair_coef, weight, tau, final)
     next_rows(g.wall_hist, g.wall_coef, weight, tau, final)
+    next_rows(g.pc_hist, g.pc_coef, weight, tau, final)
 
 
 @njit(cache=True)
@@ -337,4 +374,5 @@ def spring_rise(g, cfg, e_start) -> float:
     end less e_start [J], what `begin_stages` returned (0 without Mindlin's law)."""
     if not cfg.history_stages:
         return 0.0
-    return energy_rows(g.pair_hist, g.pair_coef) + energy_rows(g.wall_hist, g.wall_coef) - e_start
+    e_end = energy_rows(g.pair_hist, g.pair_coef) + energy_rows(g.wall_hist, g.wall_coef)
+    return e_end + energy_rows(g.pc_hist, g.pc_coef) - e_start

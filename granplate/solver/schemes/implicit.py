@@ -29,7 +29,7 @@ from granplate.jit import njit
 
 from granplate.model.inputs import STATE_COLUMNS, BodyArrays, new_body_state, no_body
 from granplate.physics.contact import contact_arm, plate_overlap
-from granplate.physics.laws import tangential_friction
+from granplate.physics.laws import keeps_history, tangential_friction
 from granplate.physics.energy import energy_residual
 from granplate.solver import body as B
 from granplate.solver import body_implicit as BI
@@ -161,6 +161,8 @@ def held_friction_target(normal, normal_new, slip_new, g, fnew):
     rate (backward Euler) but the normal force averaged over the step, so that in gross
     slip the friction impulse is second-order accurate like the normal one."""
     for k in range(g.pc_i.shape[0]):
+        if keeps_history(g.pc_coef[k]):  # a history law's end force is RK4's (not held)
+            continue
         nbar = 0.5 * (normal[k] + normal_new[k])
         fnew[2 * k + 1] = tangential_friction(nbar, slip_new[k], g.pc_coef[k])
 
