@@ -262,6 +262,7 @@ def loop_config(
         dt_min=float(t.dt_min),
         out_dt=float(t.output_interval),
         t_end=float(t.t_end),
+        energy_span=float(t.t_end if sol.energy_span is None else sol.energy_span),
         load_on_plate=loads.plate_edge(s) is not None,
         arm_shrink=1.0 if s.contact.torque_arm == "contact_point" else 0.0,
         lammps_arms=s.contact.torque_arm == "lammps",

@@ -199,6 +199,9 @@ class Config(NamedTuple):
     lammps_arms: bool = False  # contact.torque_arm = "lammps": Mindlin's torque at R - delta/2 (pairs), R (walls)
     history_friction: bool = False  # a tangential law with history (Mindlin's): the Verlet force pass runs it
     history_stages: bool = False  # that law under the RK4 schemes: in their stages (solver.mindlin_rk4)
+    energy_span: float = (
+        0.0  # implicit scheme: the time [s] its step control spreads energy_tol / 2 over (solver.energy_span)
+    )
 
 
 #: columns of BodyArrays.geo, one row per granule and buffer (docs/model.md section 3.9):

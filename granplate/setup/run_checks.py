@@ -190,6 +190,8 @@ def _check_solver(s: Scenario) -> None:
     positive("solver.energy_tol", sv.energy_tol)
     positive("solver.error_tol", sv.error_tol)
     positive("solver.implicit_dt_max", sv.implicit_dt_max)
+    if sv.energy_span is not None:
+        positive("solver.energy_span", sv.energy_span)
     check_threads(sv.threads)
 
 

@@ -625,6 +625,9 @@ class Solver:
     error_tol: "implicit" scheme, the local error (relative distance of the interface
     forces and the granules' net forces from their extrapolation) the step control aims
     at; the step is also held to an energy-residual growth of energy_tol / 2 over the run;
+    energy_span: "implicit" scheme, the simulated time [s] over which that growth is spread
+    (None: time.t_end); a run continued from a result (--from) takes the straight run's
+    steps when both legs give it the straight run's t_end;
     implicit_dt_max: "implicit" scheme, the largest step [s] (rounded down to
     time.output_interval / 2^k; time.dt_max bounds the "paper" scheme);
     granular_friction: friction at granule-granule and granule-wall contacts, "split"
@@ -645,6 +648,7 @@ class Solver:
     implicit_dt_max: float = 1e-6
     granular_friction: str = "split"
     threads: int | None = None
+    energy_span: float | None = None
 
 
 #: What a drive prescribes along its direction (`Drive.kind`).

@@ -312,8 +312,8 @@ def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
     err = step_error(ratio, st, g, cfg, w) / cfg.error_tol
     if not (cfg.q0 != 0.0 and t < cfg.duration):  # (E_in ~ 0 while the shock starts)
         # each step may add its share of energy_tol * ENERGY_STEP_FRACTION, the run
-        # counted in steps of dt_max
-        err = max(err, abs(d_res) * cfg.t_end / (cfg.energy_tol * ENERGY_STEP_FRACTION * cfg.dt_max))
+        # (solver.energy_span: its t_end unless given) counted in steps of dt_max
+        err = max(err, abs(d_res) * cfg.energy_span / (cfg.energy_tol * ENERGY_STEP_FRACTION * cfg.dt_max))
     retry = -1
     if err > REJECT_FACTOR and st.clock[H_LAST] > 0.0:
         new_level = max(level_for(h * max(0.2, 0.9 / math.sqrt(err)), cfg), level + 1)
