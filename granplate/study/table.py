@@ -112,6 +112,7 @@ FIELD_UNITS: dict[str, str] = {
     "energy_tol": "1",
     "error_tol": "1",
     "implicit_dt_max": "s",
+    "energy_span": "s",
     "threads": "1",
     "mass": "kg",
     # the measured yielding law (docs/model.md section 3.10)
