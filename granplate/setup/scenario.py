@@ -528,11 +528,11 @@ class Contact:
     arm R_i and the torque at R_i - delta/2 between spheres (R_i at a wall), for a side by
     side run with LAMMPS; the arms differ, so the couples' extra work is booked in
     D_friction (docs/model.md section 3.16).
-    tangential_law: the friction law of every granule-granule and granule-wall contact and
-    of the granules' contacts on the elastic solid in space (one of TANGENTIAL_LAWS):
-    "tanh", eq. (5), or "mindlin", Mindlin's tangential spring with a Coulomb limit mu |N|
-    and history (docs/model.md section 3.16; its mu is `mu` and the pairs' mu, k_s unused;
-    in the plane and in space; not with the plane's plate), or "mindlin_force", the same
+    tangential_law: the friction law of every granule-granule, granule-wall and
+    granule-plate contact and of the granules' contacts on the elastic solid in space (one
+    of TANGENTIAL_LAWS): "tanh", eq. (5), or "mindlin", Mindlin's tangential spring with a
+    Coulomb limit mu |N| and history (docs/model.md section 3.16; its mu is `mu` and the
+    pairs' mu, k_s unused; in the plane and in space, every scheme), or "mindlin_force", the same
     law in its incremental form (the elastic force as history; where "mindlin" runs);
     tangential_damping: Mindlin's tangential damping x_t [-] (LAMMPS's `mindlin NULL x_t mu`):
     eta_t = x_t c delta^(1/4), x_t times eq. (3)'s normal damping coefficient (0: none).
