@@ -25,8 +25,7 @@ from __future__ import annotations
 from granplate.jit import njit
 
 from granplate.model.inputs import HIST_MAX, HIST_RATE
-from granplate.physics.contact import plate_overlap
-from granplate.physics.contact import COEF_MU
+from granplate.physics.contact import COEF_MU, plate_overlap
 from granplate.physics.laws import (
     keeps_history,
     normal_law_slopes,
@@ -75,7 +74,7 @@ def law_jacobian(h, mmat, u_end, g, w, jac, rhs, vguess):
     """Residuals (rhs) and their derivatives with respect to the interface forces U
     (jac), row by row from the contact laws: dN_k/dU_e = dN/d(delta) d(delta)/dU_e +
     dN/d(rate) d(rate)/dU_e (eq. 2, or the elastic-plastic law's slope, physics.laws) and
-    dv_k/dU_e (eq. 6). u_end: driving-DOF
+    dv_k/dU_e (eq. 6), or under a history law dF_t/dU_e (`history_slopes`). u_end: driving-DOF
     displacement at t + h; w: the trial step's end values (ynew, fnew, slip_new)."""
     nd = jac.shape[0]
     for k in range(g.pc_i.shape[0]):
