@@ -51,13 +51,13 @@ def mindlin_coefficient(g_star: float) -> float:
     return 8.0 * g_star
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def contact_radius(r_star: float, delta: float) -> float:
     """Hertz's contact radius a = sqrt(R* delta) [m] (eq. M1)."""
     return math.sqrt(r_star * delta)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def tangential_damping(x_t: float, c: float, delta: float) -> float:
     """The tangential damping coefficient eta_t = x_t c delta^(1/4) [N s/m]: x_t times eq.
     (3)'s normal damping coefficient c [N s/m^(5/4)] at overlap delta [m] (0 where x_t = 0)."""
@@ -66,13 +66,13 @@ def tangential_damping(x_t: float, c: float, delta: float) -> float:
     return x_t * c * math.sqrt(math.sqrt(delta))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def tangential_stiffness(k_per_radius: float, a: float) -> float:
     """k_t = 8 G* a [N/m] from the coefficient 8 G* [Pa] and the contact radius a [m]."""
     return k_per_radius * a
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def rescale_history(xx: float, xy: float, xz: float, a: float, a_old: float):
     """Eq. (M2), LAMMPS's `mindlin_rescale`: xi scaled by a / a_old where the contact
     radius a [m] is below its value a_old at the last step (unloading), else unchanged."""
@@ -82,7 +82,7 @@ def rescale_history(xx: float, xy: float, xz: float, a: float, a_old: float):
     return xx, xy, xz
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def rotate_history(xx: float, xy: float, xz: float, nx: float, ny: float, nz: float, k: float, f_crit: float):
     """Eq. (M3): xi's normal part removed and its length kept, where that part's force k
     |xi.n| exceeds FRAME_EPSILON f_crit (k: k_t [N/m], f_crit = mu |N| [N]; as LAMMPS's
@@ -99,13 +99,13 @@ def rotate_history(xx: float, xy: float, xz: float, nx: float, ny: float, nz: fl
     return px * s, py * s, pz * s
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def spring_energy(k: float, xx: float, xy: float, xz: float) -> float:
     """The tangential spring's stored energy 1/2 k_t |xi|^2 [J]."""
     return 0.5 * k * (xx * xx + xy * xy + xz * xz)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def mindlin_force(xx: float, xy: float, xz: float, k: float, f_crit: float, dx: float, dy: float, dz: float):
     """Eqs. (M4)-(M5) after the increment: the tangential force F_t = -k_t xi + F_d on the
     first body (F_d (3): the damping force -eta_t v_s [N]), capped at f_crit = mu |N| [N]
@@ -126,7 +126,7 @@ def mindlin_force(xx: float, xy: float, xz: float, k: float, f_crit: float, dx: 
     return fx, fy, fz, -(fx - dx) / k, -(fy - dy) / k, -(fz - dz) / k
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def mindlin_step(
     xx: float,
     xy: float,
@@ -165,7 +165,7 @@ def mindlin_step(
     return fx, fy, fz, xx, xy, xz, e_new, step_loss(f0x, f0y, f0z, fx, fy, fz, vx * dt, vy * dt, vz * dt, e_old, e_new)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def step_loss(f0x, f0y, f0z, fx, fy, fz, sx, sy, sz, e_old: float, e_new: float) -> float:
     """Eq. (M6): the energy a contact lost over a step [J], the work its slip s (3) [m] did
     against the tangential force by the trapezoidal rule (F_old, F_new on the first body
@@ -177,7 +177,7 @@ def step_loss(f0x, f0y, f0z, fx, fy, fz, sx, sy, sz, e_old: float, e_new: float)
     return work - (e_new - e_old)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def stage_force(
     xx: float,
     xy: float,

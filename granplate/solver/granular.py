@@ -389,7 +389,7 @@ def commit_rows(t, hist, coef, lo, hi):
     for k in range(lo, hi):
         # a tangential law's history (Mindlin's, docs/model.md section 3.16); a contact out of
         # touch with none, before and after (HIST_A and HIST_A_END zero: its rows are zeros), keeps its zeros
-        if keeps_history(coef[k]) and (hist[k, HIST_A_END] != 0.0 or hist[k, HIST_A] != 0.0):
+        if (hist[k, HIST_A_END] != 0.0 or hist[k, HIST_A] != 0.0) and keeps_history(coef[k]):
             for col in range(N_MINDLIN):
                 hist[k, HIST_XI + col] = hist[k, HIST_XI_END + col]
         d = hist[k, HIST_END]

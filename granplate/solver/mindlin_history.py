@@ -15,7 +15,7 @@ from granplate.model.inputs import HIST_A, HIST_A_END, HIST_F, HIST_F_END, HIST_
 from granplate.physics.laws import tangential_energy, tangential_step
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def record_trial(hist, k, xx, xy, xz, a, fx, fy, fz) -> None:
     """Contact k's trial history: its tangential displacement xi (3) [m] into HIST_XI_END,
     its contact radius a [m] into HIST_A_END and its force F_t (3) [N] into HIST_F_END."""
@@ -28,7 +28,7 @@ def record_trial(hist, k, xx, xy, xz, a, fx, fy, fz) -> None:
     hist[k, HIST_F_END + 2] = fz
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def mindlin_contact(hist, k, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, n_abs):
     """Contact k (history row hist[k], coefficient row c) under Mindlin's law over the step
     h [s] (physics.mindlin.mindlin_step) at overlap delta and contact radius a [m] and |N| =
@@ -69,13 +69,13 @@ def mindlin_contact(hist, k, c, a, delta, nx, ny, nz, vsx, vsy, vsz, h, n_abs):
     return fx, fy, fz, e_t, lost
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def mindlin_old_force(hist, k, c):
     """The tangential force on the first body at contact k's last step [N] (3)."""
     return hist[k, HIST_F], hist[k, HIST_F + 1], hist[k, HIST_F + 2]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def mindlin_parted(hist, k, c):
     """Contact k has parted: its trial history zero (a new touch starts unloaded, as
     LAMMPS's); returns the spring energy it held [J] (lost)."""

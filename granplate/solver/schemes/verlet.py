@@ -123,8 +123,12 @@ def prepare_level(sw, h, p, slot):
 
 
 @njit(cache=True)
-def has_friction(g) -> bool:
-    """Whether any listed pair or wall contact has a friction coefficient."""
+def has_friction(g, cfg) -> bool:
+    """Whether any listed pair or wall contact has a rate law's friction coefficient (none
+    under a history law, cfg.history_friction: contact.tangential_law is one for every
+    contact, and the scan of every row each step is then skipped)."""
+    if cfg.history_friction:
+        return False
     for p in range(g.pair_coef.shape[0]):
         if g.pair_coef[p, COEF_MU] != 0.0:
             return True
@@ -214,7 +218,7 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
         first_forces(t, st, g, cfg, sw, cur)
     _, pd0 = wall_powers(g)  # the damping power at the driven walls' velocities at t_n
     hk = 0.5 * h
-    friction = has_friction(g) or VB.body_friction(b)
+    friction = has_friction(g, cfg) or VB.body_friction(b)
     forward = sw.split[FORWARD] != 0.0
     fric = 0.0
     if friction:
