@@ -14,7 +14,16 @@ import pytest
 
 from granplate.errors import ScenarioError
 from granplate.model.coefficients import pair_coefficient_row, pair_coefficients, wall_coefficient_row
-from granplate.physics.contact import COEF_A, COEF_DY, COEF_NLAW, COEF_TLAW, COEF_XH, friction_magnitude
+from granplate.physics.contact import (
+    COEF_A,
+    COEF_DY,
+    COEF_KS,
+    COEF_MU,
+    COEF_NLAW,
+    COEF_TLAW,
+    COEF_XH,
+    friction_magnitude,
+)
 from granplate.physics.laws import normal_law_force, normal_law_response, normal_law_slopes
 from granplate.results.contact_table import tangential_magnitude
 from granplate.setup.law_registry import (
@@ -127,8 +136,10 @@ def test_each_tangential_law_id_selects_its_law():
     """A tanh row's friction is mu |N| tanh(k_s v_t) (eq. 5); a Mindlin row's depends on its
     history (the contact table says NaN)."""
     c = row("hertz")
-    assert tangential_magnitude(2.0, 1e-3, c) == abs(friction_magnitude(2.0, 1e-3, c[2], c[3]))
-    assert tangential_magnitude(2.0, 1e-3, c) == pytest.approx(2.0 * c[2] * math.tanh(c[3] * 1e-3), rel=1e-14)
+    assert tangential_magnitude(2.0, 1e-3, c) == abs(friction_magnitude(2.0, 1e-3, c[COEF_MU], c[COEF_KS]))
+    assert tangential_magnitude(2.0, 1e-3, c) == pytest.approx(
+        2.0 * c[COEF_MU] * math.tanh(c[COEF_KS] * 1e-3), rel=1e-14
+    )
     assert math.isnan(tangential_magnitude(2.0, 1e-3, row("hertz", "mindlin")))
 
 

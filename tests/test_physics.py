@@ -104,11 +104,14 @@ def test_energy_residual_eq_11():
 
 
 def test_coefficient_columns():
-    """The named columns index A, c, mu, k_s, delta_y, then the law "johnson"'s R* Y, C, 1 / (L rate_ref),
-    h, kappa, x_h, then Mindlin's 8 G*, mu and x_t, then the normal and tangential law ids, in that
-    order (the model arrays' layout)."""
-    assert (C.COEF_A, C.COEF_C, C.COEF_MU, C.COEF_KS, C.COEF_DY, C.N_COEF) == (0, 1, 2, 3, 4, 16)
-    assert (C.COEF_SY, C.COEF_RC, C.COEF_RL, C.COEF_H, C.COEF_KAPPA, C.COEF_XH) == (5, 6, 7, 8, 9, 10)
-    assert (C.COEF_KT, C.COEF_MUT, C.COEF_XT) == (11, 12, 13)
-    assert (C.COEF_NLAW, C.COEF_TLAW) == (14, 15)
+    """The named columns index A, c, the normal and tangential law ids, mu, k_s, delta_y, then
+    the law "johnson"'s R* Y, C, 1 / (L rate_ref), h, kappa, x_h, then Mindlin's 8 G*, mu and
+    x_t, in that order (the model arrays' layout): what every force pass reads of every
+    listed contact (A, c, the ids, mu) lies in a row's first 64 bytes, the normal law's own
+    columns are one slice."""
+    assert (C.COEF_A, C.COEF_C, C.COEF_NLAW, C.COEF_TLAW, C.COEF_MU, C.N_COEF) == (0, 1, 2, 3, 4, 16)
+    assert max(C.COEF_A, C.COEF_C, C.COEF_NLAW, C.COEF_TLAW, C.COEF_MU) * 8 < 64
+    assert (C.COEF_KS, C.COEF_DY) == (5, 6)
+    assert (C.COEF_SY, C.COEF_RC, C.COEF_RL, C.COEF_H, C.COEF_KAPPA, C.COEF_XH) == (7, 8, 9, 10, 11, 12)
+    assert (C.COEF_KT, C.COEF_MUT, C.COEF_XT) == (13, 14, 15)
     assert C.hertz_coefficient(1e11, 0.004) == pytest.approx(4 / 3 * 1e11 * math.sqrt(0.004))

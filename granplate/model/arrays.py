@@ -231,6 +231,15 @@ def plate_modal_arrays(s: Scenario, y: np.ndarray, pc: np.ndarray):
     )
 
 
+def rate_friction(c) -> bool:
+    """Whether any pair or wall contact of the Contact settings `c` can carry a rate law's
+    friction (the tangential law without history, mu > 0 by default or for some material
+    pair): False lets velocity Verlet skip its per-step look for friction."""
+    if TANGENTIAL_LAW_REGISTRY[c.tangential_law].history:
+        return False
+    return c.mu != 0.0 or any(p.mu is not None and p.mu != 0.0 for p in c.pairs)
+
+
 def loop_config(
     s: Scenario,
     fres: np.ndarray,
@@ -268,6 +277,7 @@ def loop_config(
         lammps_arms=s.contact.torque_arm == "lammps",
         history_friction=TANGENTIAL_LAW_REGISTRY[s.contact.tangential_law].history,
         history_stages=TANGENTIAL_LAW_REGISTRY[s.contact.tangential_law].history and sol.scheme != "verlet",
+        rate_friction=rate_friction(s.contact),
         scheme=scheme_number(sol.scheme),
         error_tol=float(sol.error_tol),
         force_floor=force_floor(q0, fres, tres, r, mass, s, t.output_interval) if floor is None else float(floor),

@@ -39,7 +39,8 @@ def damping_coefficient(alpha_n: float, m_star: float, a: float) -> float:
 
 #: columns of the coefficient arrays pair_coef, wall_coef, pc_coef (model arrays):
 #: Hertz coefficient A [N/m^1.5] (eq. 3), damping coefficient c with gamma = c delta^(1/4)
-#: (eq. 3), friction coefficient mu [-], regularisation k_s [s/m] (eq. 5), and the yield
+#: (eq. 3), the contact's law ids (below), friction coefficient mu [-], regularisation k_s
+#: [s/m] (eq. 5), and the yield
 #: overlap delta_y [m] of the yielding laws (docs/model.md section 3.6, eq. P3; inf under
 #: Hertz's law, eq. 2); then the law "johnson"'s (docs/model.md section 3.10; 0 under the
 #: other laws): R* Y [N/m], the rate
@@ -49,15 +50,17 @@ def damping_coefficient(alpha_n: float, m_star: float, a: float) -> float:
 #: tangential law (docs/model.md section 3.16, physics.mindlin): 8 G* [Pa], the tangential
 #: stiffness per unit contact radius (0 under eq. 5's tanh law, which reads COEF_MU), and
 #: its Coulomb coefficient mu [-] (a Mindlin contact's COEF_MU is 0, so that the tanh law's
-#: passes skip it) and its tangential damping factor x_t [-] (eta_t = x_t c delta^(1/4));
-#: then the contact's law ids (setup.law_registry), integer values on which the laws
-#: dispatch: its normal law (COEF_NLAW: NORMAL_LAW_IDS, physics.laws) and its tangential
-#: law (COEF_TLAW: TANGENTIAL_LAW_IDS). No other column selects a law: a Hertz row's
-#: COEF_DY is inf (a yield overlap never reached), a tanh row's COEF_KT 0.
-COEF_A, COEF_C, COEF_MU, COEF_KS, COEF_DY = 0, 1, 2, 3, 4
-COEF_SY, COEF_RC, COEF_RL, COEF_H, COEF_KAPPA, COEF_XH = 5, 6, 7, 8, 9, 10
-COEF_KT, COEF_MUT, COEF_XT = 11, 12, 13
-COEF_NLAW, COEF_TLAW = 14, 15
+#: passes skip it) and its tangential damping factor x_t [-] (eta_t = x_t c delta^(1/4)).
+#: The law ids (setup.law_registry) are integer values on which the laws dispatch: the
+#: normal law (COEF_NLAW: NORMAL_LAW_IDS, physics.laws) and the tangential law (COEF_TLAW:
+#: TANGENTIAL_LAW_IDS). No other column selects a law: a Hertz row's COEF_DY is inf (a
+#: yield overlap never reached), a tanh row's COEF_KT 0. The columns every force pass reads
+#: of every listed contact (A, c, the ids, mu) are the row's first eight numbers, one
+#: cache line of 64 bytes: a contact out of touch or under Hertz's law costs the pass one
+#: line of its row, not both (docs/benchmarks.md, "Strong scaling").
+COEF_A, COEF_C, COEF_NLAW, COEF_TLAW, COEF_MU, COEF_KS, COEF_DY = 0, 1, 2, 3, 4, 5, 6
+COEF_SY, COEF_RC, COEF_RL, COEF_H, COEF_KAPPA, COEF_XH = 7, 8, 9, 10, 11, 12
+COEF_KT, COEF_MUT, COEF_XT = 13, 14, 15
 N_COEF = 16
 #: the normal law's own columns, COEF_DY..COEF_XH: the yield overlap (inf for a law that
 #: never yields) and six parameters a law reads as it defines them (its `law_columns`)

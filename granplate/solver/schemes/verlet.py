@@ -124,10 +124,11 @@ def prepare_level(sw, h, p, slot):
 
 @njit(cache=True)
 def has_friction(g, cfg) -> bool:
-    """Whether any listed pair or wall contact has a rate law's friction coefficient (none
-    under a history law, cfg.history_friction: contact.tangential_law is one for every
-    contact, and the scan of every row each step is then skipped)."""
-    if cfg.history_friction:
+    """Whether any listed pair or wall contact has a rate law's friction coefficient: none
+    where the scenario gives none (cfg.rate_friction False: no mu > 0, or a history law,
+    contact.tangential_law being one for every contact), and the scan of every row each
+    step is then skipped."""
+    if not cfg.rate_friction:
         return False
     for p in range(g.pair_coef.shape[0]):
         if g.pair_coef[p, COEF_MU] != 0.0:
