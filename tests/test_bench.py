@@ -163,6 +163,30 @@ def test_scaling_in_space_rows_are_measured_and_documented(tmp_path):
         assert lm["cpu_us_per_contact_step"] == pytest.approx(1e6 * lm["cpu_s"] / (lm["n_steps"] * 6))
 
 
+def test_scaling_in_space_mindlin_rows_run_lammps_at_our_step(tmp_path):
+    """`bench --scaling --dimension 3 --scheme verlet --friction-law mindlin` on one FCC cell:
+    the frictional row runs LAMMPS under the same law and torque arms at granplate's step,
+    one algorithm, so the two codes' velocities at t_end agree to round-off (where LAMMPS is
+    installed); the keys are documented."""
+    from granplate.verification import lammps as L
+
+    out = tmp_path / "mindlin3.json"
+    args = ["--sizes", "1x1x1", "--t-end", "4e-6", "--mu", "0.099", "--friction-law", "mindlin", "--threads", "1"]
+    args += ["--json", str(out)]
+    assert main(["bench", "--scaling", "--dimension", "3", "--scheme", "verlet", *args]) == 0
+    (row,) = json.loads(out.read_text())
+    text = (ROOT / "docs" / "benchmarks.md").read_text().split("### Scaling in space JSON")[1].split("\n## ")[0]
+    line = next(line for line in text.splitlines() if line.startswith("| `lammps`"))
+    assert row["law"] == "mindlin" and "final" not in row and row["dt_s"] > 0.0
+    lm = row["lammps"]
+    if L.unavailable():
+        assert "skipped" in lm
+        return
+    assert set(lm) <= set(re.findall(r"`([a-z_0-9]+)`", line)), lm
+    assert lm["dt_s"] == row["dt_s"] and lm["n_steps"] == row["n_steps"] and lm["error"] is None
+    assert lm["agreement"] < 1e-12
+
+
 def test_scaling_in_space_options_are_checked(capsys):
     """In space --sizes takes FCC cells NXxNYxNZ; --dimension is 2 or 3; --scheme is any
     registered scheme (model.inputs.SCHEME_NAMES), another a user error naming them all;

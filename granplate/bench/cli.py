@@ -198,7 +198,7 @@ def scaling_options(b) -> None:
         choices=tuple(TANGENTIAL_LAW_REGISTRY),
         default=None,
         help="with --scaling --dimension 3: contact.tangential_law of the rows with friction "
-        "(default tanh, the paper's; mindlin runs under --scheme verlet)",
+        "(default tanh, the paper's; mindlin runs under --scheme verlet, beside LAMMPS's same law at our step)",
     )
     b.add_argument(
         "--no-lammps",

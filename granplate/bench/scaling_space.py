@@ -15,7 +15,9 @@ warm-up run, `build_model` (set-up), `simulate` (loop, steps), the peak resident
 then (frictionless rows) the reference, RK4 (the paper scheme) at REFERENCE_DT, and the
 error max |v - v_ref| / SPEED over the spheres' three velocity components at t_end. LAMMPS
 (another fresh subprocess) runs the same packing at steps from LAMMPS_DT_START, halved until
-its error against the same v_ref is at most ours.
+its error against the same v_ref is at most ours. The rows with friction under a law LAMMPS
+has, under velocity Verlet (Mindlin's, `same_law`), are one algorithm in both codes: LAMMPS
+runs them at our step and law, and the row says how far apart the two codes' velocities end.
 """
 
 from __future__ import annotations
@@ -67,7 +69,8 @@ def launched_fcc(
 ):
     """A free FCC packing of touching steel spheres (radius [m], `cells` conventional cells,
     no walls, no plate, no load) whose first lattice plane (x smallest) moves at `speed`
-    [m/s] in +x. Undamped, friction mu under the tangential law `law` (contact.tangential_law),
+    [m/s] in +x. Undamped, friction mu under the tangential law `law` (contact.tangential_law;
+    under velocity Verlet a law LAMMPS has, with its torque arms: `torque_arm`),
     dynamic detection; `scheme` with its own step, or with dt [s] the fixed step dt
     (dt_initial = dt_max = dt); `outputs` output intervals."""
     from granplate.setup.geometry import layout_packing
@@ -87,10 +90,27 @@ def launched_fcc(
         granules=granules,
         plate=None,
         load=Load(kind="none"),
-        contact=Contact(mu=mu, alpha_n=0.0, pairs=(), detection="dynamic", tangential_law=law),
+        contact=Contact(
+            mu=mu, alpha_n=0.0, pairs=(), detection="dynamic", tangential_law=law, torque_arm=torque_arm(law, scheme)
+        ),
         time=time_settings,
         solver=Solver(scheme=scheme),
     )
+
+
+def torque_arm(law: str, scheme: str) -> str:
+    """contact.torque_arm of the packing: "lammps" (LAMMPS's arms, R - delta / 2) where
+    LAMMPS runs the same tangential law under the same integrator (`same_law`), so that the
+    two codes' runs are one algorithm; else the default."""
+    return "lammps" if same_law(law, scheme) else "radius"
+
+
+def same_law(law: str, scheme: str) -> bool:
+    """Whether LAMMPS runs the frictional rows' law (a law with history it has: Mindlin's)
+    under granplate's integrator (velocity Verlet, `scheme`)."""
+    from granplate.verification.lammps import LAMMPS_TANGENTIAL
+
+    return scheme == "verlet" and law in LAMMPS_TANGENTIAL
 
 
 def _warm_up(scheme: str) -> None:
@@ -176,6 +196,9 @@ def _ours_worker(spec: dict) -> dict:
         "energy_residual": float(np.abs(ds.energy_residual.values).max()),
         "threads": int(ds.attrs.get("threads", 1)),
     }
+    if spec["mu"] > 0.0 and same_law(law, spec["scheme"]) and not skip:  # LAMMPS runs this step and law
+        out["final"] = {k: ds[k].values[-1].tolist() for k in ("vx", "vy", "vz")}
+        out["dt_s"] = float(s.time.dt_max)
     if spec["mu"] == 0.0 and not skip:
         if spec.get("reference") is None:
             ref = simulate(launched_fcc(cells, t_end=spec["t_end"], scheme="paper", dt=REFERENCE_DT), progress=False)
@@ -226,6 +249,36 @@ def _lammps_worker(spec: dict) -> dict:
     }
 
 
+def _lammps_same_law_worker(spec: dict) -> dict:
+    """Runs in a fresh subprocess (on the row's MPI processes): LAMMPS (run_hertz_3d) on the
+    frictional packing under the same tangential law and torque arms at granplate's own
+    step (spec["dt_s"]): the same algorithm, so the same accuracy; `agreement`: the largest
+    |v - v_granplate| at t_end over the launch speed (spec["final"]: granplate's velocities)."""
+    import resource
+    import time
+
+    from granplate.verification import lammps as L
+
+    if L.unavailable():
+        return {"skipped": L.unavailable()}
+    s = launched_fcc(tuple(spec["cells"]), mu=spec["mu"], t_end=spec["t_end"], scheme=spec["scheme"], law=spec["law"])
+    L.run_hertz_3d(launched_fcc((1, 1, 1), t_end=1e-7), 1e-8, 1e-7)  # load the library once
+    c0 = time.process_time()
+    res = L.run_hertz_3d(s, spec["dt_s"], spec["t_end"])
+    cpu = time.process_time() - c0
+    return {
+        "dt_s": spec["dt_s"],
+        "n_steps": res["n_steps"],
+        "setup_s": res["setup_time_s"],
+        "loop_s": res["loop_time_s"],
+        "cpu_s": cpu,
+        "error": None,
+        "agreement": max_error_3d(tuple(res[k][-1] for k in ("vx", "vy", "vz")), spec["final"]),
+        "reached": True,
+        "rss_peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+    }
+
+
 def run_scaling_space(
     sizes=SIZES,
     frictions=FRICTIONS,
@@ -239,8 +292,9 @@ def run_scaling_space(
     """The 3D table's rows: one per (size, mu, thread count), each measured in fresh
     subprocesses, the rows with friction under the tangential law `law`
     (contact.tangential_law); `speedup` is the loop's time on one thread over this row's. LAMMPS runs
-    the frictionless rows on as many MPI processes as the row has threads (`mpirun -np N`,
-    its shrink-wrapped box cut into N domains)."""
+    the frictionless rows, and those of a law it has under velocity Verlet (`same_law`), on
+    as many MPI processes as the row has threads (`mpirun -np N`, its shrink-wrapped box cut
+    into N domains)."""
     rows = []
     for cells in sizes:
         for mu in frictions:
@@ -289,11 +343,18 @@ def _space_row(
         row["cpu_us_per_contact_step"] = per_contact_step_us(row["loop_cpu_s"], row["n_steps"], row["contacts"])
         row["steps_us_per_contact_step"] = per_contact_step_us(row["steps_s"], row["n_steps"], row["contacts"])
         row["steps_cpu_us_per_contact_step"] = per_contact_step_us(row["steps_cpu_s"], row["n_steps"], row["contacts"])
+    lm = None
     if lammps and mu == 0.0 and "error" in row:
         log(f"scaling in space: {row['granules']} spheres, LAMMPS on {n} process(es) ...")
         lm = run_in_subprocess(
             "scaling_space", "_lammps_worker", {**spec, "error": row["error"], "reference": row["reference"]}, n
         )
+    elif lammps and "final" in row:
+        log(f"scaling in space: {row['granules']} spheres, LAMMPS under the same law on {n} process(es) ...")
+        same = {**spec, "dt_s": row["dt_s"], "final": row.pop("final")}
+        lm = run_in_subprocess("scaling_space", "_lammps_same_law_worker", same, n)
+    row.pop("final", None)
+    if lm is not None:
         if "loop_s" in lm:
             lm["us_per_contact_step"] = per_contact_step_us(lm["loop_s"], lm["n_steps"], row["contacts"])
             lm["cpu_us_per_contact_step"] = per_contact_step_us(lm["cpu_s"], lm["n_steps"], row["contacts"])
@@ -303,7 +364,8 @@ def _space_row(
 
 
 def format_space_table(rows: list[dict]) -> str:
-    """The 3D scaling table as Markdown (LAMMPS columns on the frictionless rows)."""
+    """The 3D scaling table as Markdown (LAMMPS columns on the frictionless rows, and on the
+    frictional rows whose law LAMMPS runs at our step: `same_law`)."""
     lines = [
         "| spheres | cells | contacts | mu | threads | set-up [s] | steps | loop [s] | speed-up | us/step "
         "| us/(contact step) | CPU us/(contact step) | peak [MiB] | error | LAMMPS dt [s] | LAMMPS steps "
@@ -331,7 +393,7 @@ def format_space_table(rows: list[dict]) -> str:
                 format_or_dash(lm["loop_s"], ".3g"),
                 format_or_dash(lm["us_per_contact_step"], ".3f"),
                 format_or_dash(lm["cpu_us_per_contact_step"], ".3f"),
-                format_or_dash(lm["error"], ".1e"),
+                lammps_error(lm),
             ]
         lines.append(
             f"| {r['granules']:,} | {cells} | {r['contacts']:,} | {mu_law(r)} | {r.get('threads', 1)} "
@@ -345,6 +407,15 @@ def format_space_table(rows: list[dict]) -> str:
             + " |"
         )
     return "\n".join(lines)
+
+
+def lammps_error(lm: dict) -> str:
+    """The LAMMPS error column: its error against the reference, or, run at granplate's
+    step under the same law, how far its velocities are from granplate's (over the launch
+    speed)."""
+    if lm.get("agreement") is not None:
+        return f"same step and law: {lm['agreement']:.1e} from ours"
+    return format_or_dash(lm["error"], ".1e")
 
 
 def _more_columns(r: dict) -> list[str]:

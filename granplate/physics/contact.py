@@ -57,7 +57,7 @@ def damping_coefficient(alpha_n: float, m_star: float, a: float) -> float:
 #: yield overlap never reached), a tanh row's COEF_KT 0. The columns every force pass reads
 #: of every listed contact (A, c, the ids, mu) are the row's first eight numbers, one
 #: cache line of 64 bytes: a contact out of touch or under Hertz's law costs the pass one
-#: line of its row, not both (docs/benchmarks.md, "Strong scaling").
+#: line of its row, not both (docs/benchmarks.md, "Every core in one run").
 COEF_A, COEF_C, COEF_NLAW, COEF_TLAW, COEF_MU, COEF_KS, COEF_DY = 0, 1, 2, 3, 4, 5, 6
 COEF_SY, COEF_RC, COEF_RL, COEF_H, COEF_KAPPA, COEF_XH = 7, 8, 9, 10, 11, 12
 COEF_KT, COEF_MUT, COEF_XT = 13, 14, 15
