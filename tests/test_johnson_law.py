@@ -25,7 +25,7 @@ from granplate.physics.cavity import (
     rate_factor,
     unloading_span,
 )
-from granplate.physics.contact import COEF_C, COEF_DY, hertz_elastic, normal_response
+from granplate.physics.contact import COEF_A, COEF_C, COEF_DY, COEF_RL, hertz_elastic, normal_response
 from granplate.physics.laws import normal_law_response
 from granplate.verification.measured import johnson_row
 
@@ -60,7 +60,7 @@ def test_force_and_slope_continuous_at_yield_and_bridge(x0):
     assert hi[0] == pytest.approx(lo[0], rel=1e-7)
     assert hi[1] == pytest.approx(lo[1], rel=1e-7)
     if x0 == 1.0:
-        assert lo[1] == pytest.approx(1.5 * ROW[0] * math.sqrt(d0), rel=1e-7)
+        assert lo[1] == pytest.approx(1.5 * ROW[COEF_A] * math.sqrt(d0), rel=1e-7)
 
 
 def test_fully_plastic_line_and_cavity_pressure():
@@ -124,8 +124,8 @@ def test_response_books_the_plastic_work_past_the_largest_overlap():
 def test_rate_dependence():
     """Y(rate) = Y [1 + C ln(rate / rate_ref)], rate = v / (2 R): the fully plastic force scales with it;
     1 at or below the reference rate; an unset rate factor takes the current approach speed's."""
-    assert rate_factor(V, 0.025, ROW[7]) == pytest.approx(PHI, rel=1e-14)
-    assert rate_factor(1e-9, 0.025, ROW[7]) == 1.0 and rate_factor(-1.0, 0.025, ROW[7]) == 1.0
+    assert rate_factor(V, 0.025, ROW[COEF_RL]) == pytest.approx(PHI, rel=1e-14)
+    assert rate_factor(1e-9, 0.025, ROW[COEF_RL]) == 1.0 and rate_factor(-1.0, 0.025, ROW[COEF_RL]) == 1.0
     d = 5e-4
     slow = johnson_state(d, 0.0, ROW, 1.0, 0.0)[0]
     assert johnson_state(d, 0.0, ROW, PHI, 0.0)[0] == pytest.approx(PHI * slow, rel=1e-12)

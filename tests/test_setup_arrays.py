@@ -21,6 +21,7 @@ from granplate.model.arrays import (
     wall_coefficient_row,
 )
 from granplate.model.neighbours import candidate_pairs, contact_pairs, is_contact
+from granplate.physics.contact import COEF_DY
 from granplate.setup.materials import LIBRARY, sphere_inertia, sphere_mass
 from granplate.setup.scenario import Contact, Granule, PairCoefficients, Scenario, Wall
 from granplate.setup.validate import validate
@@ -69,7 +70,7 @@ def test_contact_coefficients_equal_the_pair_by_pair_equations_bit_for_bit():
     assert len(pairs) > 500
     got = pair_coefficients(s, mats, r, mass, pairs)
     want = np.array([pair_coefficient_row(s, mats[i], mats[j], r[i], r[j], mass[i], mass[j]) for i, j in pairs])
-    assert np.isfinite(want[:, 4]).any() and np.isinf(want[:, 4]).any()  # both laws present
+    assert np.isfinite(want[:, COEF_DY]).any() and np.isinf(want[:, COEF_DY]).any()  # both laws present
     np.testing.assert_array_equal(got, want)
     wc = np.array([(i, w) for w in range(2) for i in range(0, len(r), 7)])
     geo, coef = wall_arrays(s, mats, r, mass, wc)

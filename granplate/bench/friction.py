@@ -108,10 +108,13 @@ def verlet_scenario(t_end: float | None = None):
 MINDLIN_ENERGY_TOL = 1e-3
 
 
-def mindlin_scenario(t_end: float | None = None, dt: float = LAMMPS_DT, alpha_n: float | None = None):
+def mindlin_scenario(
+    t_end: float | None = None, dt: float = LAMMPS_DT, alpha_n: float | None = None, damping: str | None = None
+):
     """The packing with mu = 0.099 under Mindlin's law (contact.tangential_law = "mindlin",
     LAMMPS's torque arms), solver.scheme = "verlet" at the fixed step dt [s] (LAMMPS's);
-    alpha_n: eq. (3)'s damping (None: the packing's)."""
+    alpha_n: eq. (3)'s damping (None: the packing's); damping: solver.verlet_damping (None:
+    the default, the predicted velocities)."""
     s = packing_scenario(0.099, "split", t_end)
     contact = dataclasses.replace(s.contact, tangential_law="mindlin", torque_arm="lammps")
     if alpha_n is not None:
@@ -119,7 +122,7 @@ def mindlin_scenario(t_end: float | None = None, dt: float = LAMMPS_DT, alpha_n:
     return dataclasses.replace(
         s,
         contact=contact,
-        solver=dataclasses.replace(s.solver, scheme="verlet", energy_tol=MINDLIN_ENERGY_TOL),
+        solver=dataclasses.replace(s.solver, scheme="verlet", energy_tol=MINDLIN_ENERGY_TOL, verlet_damping=damping),
         time=dataclasses.replace(s.time, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt)),
     )
 
@@ -276,11 +279,14 @@ def lammps_comparison(t_end: float | None, reference: dict, log=print) -> dict:
 def mindlin_comparison(t_end: float | None, log=print) -> dict:
     """The packing with mu = 0.099, undamped, under Mindlin's law in granplate
     (`mindlin_scenario`) and in LAMMPS (`tangential mindlin_rescale`), both at LAMMPS_DT:
-    the same law, integrator and step (eq. 3's damping left out: granplate's Verlet damping
-    reads the velocity predicted at the step's end, LAMMPS's the half step's). Alternately
-    REPEATS times each: median loop times, and each code's error against its own run at
-    LAMMPS_DT / LAMMPS_REF_DIVISOR; `agreement`: the largest |v_granplate - v_LAMMPS| at t_end
-    over the largest |v| [-]. Returns {"skipped": why} where LAMMPS is not installed."""
+    the same law, integrator and step (eq. 3's damping left out of the timed runs: granplate's
+    Verlet damping reads the velocity predicted at the step's end by default, LAMMPS's the
+    half step's). Alternately REPEATS times each: median loop times, and each code's error
+    against its own run at LAMMPS_DT / LAMMPS_REF_DIVISOR; `agreement`: the largest
+    |v_granplate - v_LAMMPS| at t_end over the largest |v| [-]; `damped_agreement`: the same
+    of the packing with its damping (LAMMPS's `damping tsuji`) and granplate's force pass at
+    the half step's velocities (solver.verlet_damping = "half_step"). Returns {"skipped":
+    why} where LAMMPS is not installed."""
     from granplate.verification import lammps as L
 
     if L.unavailable():
@@ -301,6 +307,11 @@ def mindlin_comparison(t_end: float | None, log=print) -> dict:
         theirs.append((lm["loop_time_s"], lm["loop_cpu_s"]))
     v = final_velocities(ds)
     scale = max(float(abs(lm["vx"]).max()), float(abs(lm["vy"]).max()))
+    log("the same, damped (eq. 3 against damping tsuji, the half step's velocities in both) ...")
+    damped = mindlin_scenario(t_end, damping="half_step")
+    lm_d = L.run_granular(damped, LAMMPS_DT, t)
+    scale_d = max(float(abs(lm_d["vx"]).max()), float(abs(lm_d["vy"]).max()))
+    damped_agreement = velocity_error(final_velocities(timed_run(damped)[0]), lm_d) / scale_d
     rows = {
         "granplate": code_row(
             "granplate", "Mindlin, verlet", ours, int(ds.attrs["n_steps"]), t, velocity_error(v, ours_ref), contacts
@@ -314,6 +325,7 @@ def mindlin_comparison(t_end: float | None, log=print) -> dict:
         "t_end_s": t,
         **rows,
         "agreement": velocity_error(v, lm) / scale,
+        "damped_agreement": damped_agreement,
         "loop_ratio": rows["granplate"]["loop_s"] / rows["lammps"]["loop_s"],
         "cpu_ratio": rows["granplate"]["loop_cpu_s"] / rows["lammps"]["loop_cpu_s"],
     }
@@ -341,7 +353,8 @@ def format_mindlin_table(cmp: dict) -> str:
         )
     lines.append(
         f"loop time granplate / LAMMPS: {cmp['loop_ratio']:.2f} (wall), {cmp['cpu_ratio']:.2f} (CPU); "
-        f"velocities at t_end, granplate against LAMMPS: {cmp['agreement']:.1e} of the largest"
+        f"velocities at t_end, granplate against LAMMPS: {cmp['agreement']:.1e} of the largest; damped "
+        f'(alpha_n of the packing, damping tsuji, solver.verlet_damping = "half_step"): {cmp["damped_agreement"]:.1e}'
     )
     return "\n".join(lines)
 

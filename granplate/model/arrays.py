@@ -278,6 +278,7 @@ def loop_config(
         history_friction=TANGENTIAL_LAW_REGISTRY[s.contact.tangential_law].history,
         history_stages=TANGENTIAL_LAW_REGISTRY[s.contact.tangential_law].history and sol.scheme != "verlet",
         rate_friction=rate_friction(s.contact),
+        half_step_damping=sol.verlet_damping == "half_step",
         scheme=scheme_number(sol.scheme),
         error_tol=float(sol.error_tol),
         force_floor=force_floor(q0, fres, tres, r, mass, s, t.output_interval) if floor is None else float(floor),

@@ -199,6 +199,7 @@ class Config(NamedTuple):
     lammps_arms: bool = False  # contact.torque_arm = "lammps": Mindlin's torque at R - delta/2 (pairs), R (walls)
     history_friction: bool = False  # a tangential law with history (Mindlin's): the Verlet force pass runs it
     history_stages: bool = False  # that law under the RK4 schemes: in their stages (solver.mindlin_rk4)
+    half_step_damping: bool = False  # solver.verlet_damping = "half_step": Verlet's force pass reads v at t + h/2
     rate_friction: bool = (
         True  # a pair or wall contact may carry a rate law's mu (False: Verlet skips the friction passes' scan)
     )

@@ -19,6 +19,8 @@ SCHEMES: tuple[str, ...] = ("paper", "implicit", "verlet")
 GRANULAR_SCHEMES: tuple[str, ...] = ("verlet",)
 #: Treatments of the granule-granule and granule-wall friction (Solver.granular_friction).
 GRANULAR_FRICTIONS: tuple[str, ...] = ("split", "rk4")
+#: The velocities velocity Verlet's force pass reads at t + h (Solver.verlet_damping).
+VERLET_DAMPINGS: tuple[str, ...] = ("predicted", "half_step")
 #: Relative tolerance for field_interval being a multiple of output_interval.
 INTERVAL_RTOL = 1e-9
 
@@ -177,6 +179,21 @@ def _check_solver(s: Scenario) -> None:
     sv = s.solver
     string_in("solver.scheme", sv.scheme, SCHEMES)
     string_in("solver.granular_friction", sv.granular_friction, GRANULAR_FRICTIONS)
+    if sv.verlet_damping is not None:
+        string_in("solver.verlet_damping", sv.verlet_damping, VERLET_DAMPINGS)
+    if sv.verlet_damping == "half_step" and sv.scheme != "verlet":
+        raise ScenarioError(
+            "solver.verlet_damping",
+            sv.verlet_damping,
+            f'sets the velocities velocity Verlet\'s force pass reads: solver.scheme = "verlet" only, not {sv.scheme!r}',
+        )
+    if sv.verlet_damping == "half_step" and isinstance(s.plate, Solid):
+        raise ScenarioError(
+            "solver.verlet_damping",
+            sv.verlet_damping,
+            "an elastic solid's contacts read its modes' predicted velocities (docs/model.md section 3.9): "
+            "\"predicted\" only with a [plate] in space (the half step's is LAMMPS's convention for granules alone)",
+        )
     if sv.scheme in GRANULAR_SCHEMES:
         _check_granular_scheme(s)
     elif isinstance(s.plate, Solid):

@@ -635,7 +635,11 @@ class Solver:
     of the other forces) or "rk4" (always in RK4, the step cut to keep RK4 stable on it);
     threads: how many cores the "verlet" scheme's loop uses (an integer from 1 to the
     machine's cores; absent: every core for an assembly of at least PARALLEL_MIN_GRANULES
-    granules, else 1; 1: the serial loop; docs/model.md section 6.6).
+    granules, else 1; 1: the serial loop; docs/model.md section 6.6);
+    verlet_damping: the velocities the "verlet" scheme's force pass reads at t + h, so its
+    contact damping: "predicted" (absent: the default; v + h/2 a_n, second order) or "half_step"
+    (v at t + h/2, LAMMPS's `fix nve/sphere`: the same algorithm as LAMMPS's, step for
+    step; docs/model.md section 6.5).
     """
 
     scheme: str = "implicit"
@@ -649,6 +653,7 @@ class Solver:
     granular_friction: str = "split"
     threads: int | None = None
     energy_span: float | None = None
+    verlet_damping: str | None = None
 
 
 #: What a drive prescribes along its direction (`Drive.kind`).

@@ -242,14 +242,14 @@ def mindlin_forces_blocks(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar):
 
 
 @njit(parallel=True)
-def kick_drift_blocks(y, acc, fdamp, fload, h, ypred, n_drift, spar):
+def kick_drift_blocks(y, acc, fdamp, fload, h, ypred, n_drift, spar, predict):
     """solver.kicks.kick_drift over blocks of granules (each granule's update is the serial
     one's, bit for bit; the work sums per block into spar[k], S_WLOAD and S_WDAMP). Returns
     (the load's work, the damping force's work) [J], summed in block order."""
     nb = spar.shape[0]
     for k in prange(nb):
         lo, hi = block_range(k, nb, y.shape[0])
-        spar[k, S_WLOAD], spar[k, S_WDAMP] = kick_drift(y, acc, fdamp, fload, h, ypred, n_drift, lo, hi)
+        spar[k, S_WLOAD], spar[k, S_WDAMP] = kick_drift(y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict)
     return work_sums(spar)
 
 

@@ -17,11 +17,12 @@ def half_kick(v0: float, a: float, hk: float):
 
 
 @njit(cache=True)
-def kick_drift(y, acc, fdamp, fload, h, ypred, n_drift, lo, hi):
+def kick_drift(y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict=True):
     """Granules lo..hi-1: the first half kick v += h/2 a (every column from n_drift on),
     the drift x += h v (the columns before), and the state the force pass reads into ypred:
-    the new positions, and the velocities predicted at the end, v + h/2 a. Returns (the
-    load's work, the damping force's work) of the kick [J]: h/2 F (v_before + v_after)/2."""
+    the new positions, and the velocities predicted at the end, v + h/2 a (predict False:
+    the half step's v, as LAMMPS's force pass reads them; solver.verlet_damping). Returns
+    (the load's work, the damping force's work) of the kick [J]: h/2 F (v_before + v_after)/2."""
     hk = 0.5 * h
     w_load = 0.0
     w_damp = 0.0
@@ -31,7 +32,7 @@ def kick_drift(y, acc, fdamp, fload, h, ypred, n_drift, lo, hi):
             w_load += fload[i, c] * vm
             w_damp += fdamp[i, c] * vm
             y[i, c] = v1
-            ypred[i, c] = v1 + dv
+            ypred[i, c] = v1 + dv if predict else v1
         for c in range(n_drift):
             y[i, c] += h * y[i, c + n_drift]
             ypred[i, c] = y[i, c]

