@@ -163,28 +163,29 @@ def test_scaling_in_space_rows_are_measured_and_documented(tmp_path):
         assert lm["cpu_us_per_contact_step"] == pytest.approx(1e6 * lm["cpu_s"] / (lm["n_steps"] * 6))
 
 
-def test_scaling_in_space_mindlin_rows_run_lammps_at_our_step(tmp_path):
-    """`bench --scaling --dimension 3 --scheme verlet --friction-law mindlin` on one FCC cell:
-    the frictional row runs LAMMPS under the same law and torque arms at granplate's step,
-    one algorithm, so the two codes' velocities at t_end agree to round-off (where LAMMPS is
-    installed); the keys are documented."""
+def test_scaling_in_space_mindlin_rows_run_lammps_at_our_step():
+    """The 3D table's rows under Mindlin's law (`--scheme verlet --friction-law mindlin`): the
+    packing takes LAMMPS's torque arms, and LAMMPS under the same law at granplate's step
+    (`_lammps_same_law_worker`, in process here) is one algorithm with ours: the velocities at
+    t_end agree to round-off (where LAMMPS is installed); its keys are documented."""
+    from granplate.bench import scaling_space as S
+    from granplate.results.run import simulate
     from granplate.verification import lammps as L
 
-    out = tmp_path / "mindlin3.json"
-    args = ["--sizes", "1x1x1", "--t-end", "4e-6", "--mu", "0.099", "--friction-law", "mindlin", "--threads", "1"]
-    args += ["--json", str(out)]
-    assert main(["bench", "--scaling", "--dimension", "3", "--scheme", "verlet", *args]) == 0
-    (row,) = json.loads(out.read_text())
-    text = (ROOT / "docs" / "benchmarks.md").read_text().split("### Scaling in space JSON")[1].split("\n## ")[0]
-    line = next(line for line in text.splitlines() if line.startswith("| `lammps`"))
-    assert row["law"] == "mindlin" and "final" not in row and row["dt_s"] > 0.0
-    lm = row["lammps"]
+    s = S.launched_fcc((1, 1, 1), mu=0.099, t_end=4e-6, scheme="verlet", law="mindlin")
+    assert s.contact.torque_arm == "lammps" and S.same_law("mindlin", "verlet") and not S.same_law("tanh", "verlet")
+    ds = simulate(s, progress=False)
+    final = {k: ds[k].values[-1].tolist() for k in ("vx", "vy", "vz")}
+    spec = {"cells": [1, 1, 1], "mu": 0.099, "t_end": 4e-6, "scheme": "verlet", "law": "mindlin"}
+    lm = S._lammps_same_law_worker({**spec, "dt_s": float(s.time.dt_max), "final": final})
     if L.unavailable():
         assert "skipped" in lm
         return
+    text = (ROOT / "docs" / "benchmarks.md").read_text().split("### Scaling in space JSON")[1].split("\n## ")[0]
+    line = next(line for line in text.splitlines() if line.startswith("| `lammps`"))
     assert set(lm) <= set(re.findall(r"`([a-z_0-9]+)`", line)), lm
-    assert lm["dt_s"] == row["dt_s"] and lm["n_steps"] == row["n_steps"] and lm["error"] is None
-    assert lm["agreement"] < 1e-12
+    assert lm["n_steps"] == int(ds.attrs["n_steps"]) and lm["error"] is None
+    assert lm["agreement"] < 1e-12 and S.lammps_error(lm).startswith("same step and law")
 
 
 def test_scaling_in_space_options_are_checked(capsys):
