@@ -12,6 +12,7 @@ import argparse
 import importlib
 import json
 import logging
+import os
 import sys
 import warnings
 from pathlib import Path
@@ -196,6 +197,21 @@ def keep_dask_out() -> None:
             sys.modules.setdefault(name, None)
 
 
+def result_path(output: str | None, name: str) -> Path:
+    """The result file of `granplate run`: -o's path (an existing folder: NAME.nc in it),
+    else NAME.nc here. Its folder must exist and be writable, checked before the run so that
+    no run's result is lost at the end (ValueError with the reason otherwise)."""
+    out = Path(output) if output else Path(f"{name}.nc")
+    if out.is_dir():
+        out = out / f"{name}.nc"
+    folder = out.parent
+    if not folder.is_dir():
+        raise ValueError(f"-o {output}: the folder {folder} does not exist (create it first)")
+    if not os.access(folder, os.W_OK) or (out.exists() and not os.access(out, os.W_OK)):
+        raise ValueError(f"-o {output or out}: {out} cannot be written (permissions)")
+    return out
+
+
 def _cmd_run(args) -> int:
     from granplate.results.dataset import summary
     from granplate.results.kernels import compile_all_wanted
@@ -203,7 +219,11 @@ def _cmd_run(args) -> int:
     from granplate.results.run import interrupted, simulate
 
     scenario = load_scenario(args.scenario, parse_settings(args.settings))
-    out = Path(args.output) if args.output else Path(f"{scenario.name}.nc")
+    try:
+        out = result_path(args.output, scenario.name)
+    except ValueError as err:
+        print(f"granplate: error: {err}", file=sys.stderr)
+        return 2
     start = None
     if args.start_from:
         from granplate.results.restart import read_result

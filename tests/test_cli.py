@@ -182,6 +182,20 @@ def test_bad_file_is_refused_with_field_name(tmp_path, capsys, old, new, field):
     assert not (tmp_path / "x.nc").exists()
 
 
+def test_run_output_folder_is_checked_before_the_run(tmp_path, capsys, monkeypatch):
+    """`-o` naming an existing folder writes NAME.nc in it; a folder that does not exist is
+    refused before the run (exit 2, one line naming -o), so no result is lost at its end."""
+    assert main(["run", "steel-r1", "--t-end", "2e-6", "-o", str(tmp_path), "-q"]) == 0
+    assert (tmp_path / "steel-r1.nc").exists()
+    capsys.readouterr()
+    ran = []
+    monkeypatch.setattr("granplate.results.run.simulate", lambda *a, **k: ran.append(1))
+    assert main(["run", "steel-r1", "-o", str(tmp_path / "no" / "r.nc"), "-q"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("granplate: error: -o ") and "does not exist" in err and err.count("\n") == 1
+    assert not ran
+
+
 def test_unknown_preset_and_bad_t_end(capsys):
     """Unknown preset or a non-positive --t-end: exit 2 with the allowed values named."""
     assert main(["run", "no-such-case"]) == 2
