@@ -839,7 +839,7 @@ def draw_lammps_hertz(p: dict):
     fig, axes = new_figure()
     ax = axes[0, 0]
     t = fine["t"] * 1e6
-    for k in (0, len(s.granules) // 2, len(s.granules) - 1):
+    for k in sorted({0, len(s.granules) // 2, len(s.granules) - 1}):  # (each granule once)
         (line,) = ax.plot(t, fine["ours"]["vx"][:, k], "-", label=f"granplate, {s.granules[k].label}")
         ax.plot(
             fine["lammps"]["t"] * 1e6,
