@@ -357,3 +357,27 @@ def test_startup_rows_are_measured_and_documented(tmp_path, capsys):
     assert rows[1]["beyond_two_s"] == pytest.approx(rows[1]["first_step_s"] - rows[0]["first_step_s"])
     assert main(["bench", "--startup", "--formats", "xls"]) == 2
     assert "--formats item 'xls': allowed toml, csv, npz, nc" in capsys.readouterr().err
+
+
+def test_pour_rows_are_measured_and_documented(tmp_path, capsys, monkeypatch):
+    """`bench --pour` on 30 spheres, one thread: settled (kinetic and residual within the
+    layout's criteria), every key documented; bad sizes are a user error."""
+    from granplate.bench import pour
+
+    monkeypatch.setattr(pour, "WARM_UP", 2)
+    out = tmp_path / "pour.json"
+    assert main(["bench", "--pour", "--sizes", "30", "--threads", "1", "--json", str(out)]) == 0
+    report = json.loads(out.read_text())
+    (r,) = report["rows"]
+    assert r["spheres"] == 30 and r["threads"] == 1 and r["settled"] and r["steps"] > 0
+    assert r["kinetic"] <= 1e-9 and r["residual"] <= 1e-2
+    text = (ROOT / "docs" / "benchmarks.md").read_text().split("### Pour JSON")[1]
+    documented = {
+        k
+        for line in text.splitlines()
+        if line.startswith("| `")
+        for k in re.findall(r"`([a-z_0-9]+)`", line.split("|")[1])
+    }
+    assert set(r) <= documented and "`target_s`" in text and report["target_s"] == pour.TARGET_S
+    assert main(["bench", "--pour", "--sizes", "ten"]) == 2
+    assert "--sizes 'ten'" in capsys.readouterr().err

@@ -42,6 +42,10 @@ def _cmd_bench(args) -> int:
         return int(friction.main(args))
     if getattr(args, "study", False):
         return _cmd_study(args)
+    if getattr(args, "pour", False):
+        from granplate.bench import pour
+
+        return int(pour.main(args))
     if getattr(args, "twins", False):
         from granplate.bench import twins
 
@@ -175,7 +179,8 @@ def scaling_options(b) -> None:
     b.add_argument(
         "--sizes",
         help="with --scaling: comma-separated COLUMNSxROWS (default 4x3,8x13,32x32,56x54,100x100); "
-        "with --dimension 3 FCC cells NXxNYxNZ (default 3x1x1,3x3x3,6x6x7,9x9x9,14x14x13)",
+        "with --dimension 3 FCC cells NXxNYxNZ (default 3x1x1,3x3x3,6x6x7,9x9x9,14x14x13); "
+        "with --pour: comma-separated sphere counts (default 1000,10000)",
     )
     b.add_argument(
         "--scheme",
@@ -185,7 +190,8 @@ def scaling_options(b) -> None:
     b.add_argument(
         "--threads",
         help="with --scaling --dimension 3: comma-separated thread counts, a row each (solver.threads; "
-        "LAMMPS on as many MPI processes); default 1 and every core for --scheme verlet, else 1",
+        "LAMMPS on as many MPI processes); default 1 and every core for --scheme verlet, else 1; "
+        "with --pour: the settling's threads (default every core)",
     )
     b.add_argument(
         "--mu",
@@ -220,6 +226,12 @@ def more_tables_options(b) -> None:
         "format (--formats toml,csv,npz,nc); medians of --repeats fresh processes (default 3)",
     )
     b.add_argument("--formats", help="with --startup: comma-separated toml,csv,npz,nc (default all)")
+    b.add_argument(
+        "--pour",
+        action="store_true",
+        help="instead: poured packings in space dropped one by one and settled at the real "
+        "stiffness (1,000 and 10,000 spheres): deposition, wall and CPU time, steps, what it reached",
+    )
     b.add_argument(
         "--friction",
         action="store_true",

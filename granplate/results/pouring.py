@@ -89,7 +89,7 @@ def loose_scenario(s: Scenario, lay: PouredLayout, alpha_n: float | None, fricti
     equilibrium, which friction at rest (v = 0) leaves one."""
     g = pouring.pour_gravity(s, lay)
     radii = pouring.poured_radii(lay)
-    c = pouring.loose_column(lay, s.dimension, g, radii)
+    c, _ = pouring.dropped(lay, s.dimension, g)
     z = np.pad(c, ((0, 0), (0, 3 - c.shape[1])))[:, 2]  # 0 in the plane
     spin = of_number(s.dimension).spin((0.0, 0.0, 0.0))
     granules = tuple(
@@ -132,6 +132,13 @@ def loose_scenario(s: Scenario, lay: PouredLayout, alpha_n: float | None, fricti
         ),
         solver=dataclasses.replace(Solver(), scheme="verlet", energy_tol=1e-2),
     )
+
+
+def release_centres(s: Scenario, lay: PouredLayout) -> np.ndarray:
+    """(count, dimension) the centres [m] the granules were released from (gravity's work
+    is counted from there): `setup.pouring.dropped`'s."""
+    g = pouring.pour_gravity(s, lay)
+    return pouring.dropped(lay, s.dimension, g)[1]
 
 
 def _end_state(ds) -> np.ndarray:
@@ -250,7 +257,7 @@ def settle(s: Scenario, lay: PouredLayout, progress: bool = False) -> dict[str, 
         found = store.load_arrays(pouring.STORE_KIND, payload, pouring.STORE_FORMAT)
         if found is not None:
             return found
-        if lay.settle_softening > 1.0:
+        if pouring.settles_ramped(s, lay):
             return _settle_ramped(s, lay, payload, progress)
         state = start = None
         t, ratio, ok = 0.0, math.inf, True
@@ -260,7 +267,8 @@ def settle(s: Scenario, lay: PouredLayout, progress: bool = False) -> dict[str, 
             damping = lay.settle_damping if alpha_n == "settle" else None
             model = build_model(loose_scenario(s, lay, damping, lay.settle_friction))
             if state is None:
-                state = start = model.initial_state.copy()
+                state, start = model.initial_state.copy(), model.initial_state.copy()
+                start[:, : s.dimension] = release_centres(s, lay)
             state, t, ratio, ok = _phase(model, state, start, g, lay, t, phase, progress, quench=damping is not None)
         arrays = settled_arrays(model, state)
         if not ok:

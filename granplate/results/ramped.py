@@ -10,6 +10,8 @@ geometrically, at most RAMP_FACTOR a chunk, to the real law's (s = 1), the tange
 forces carried over; at s = 1 the settling goes on until the kinetic energy is at most
 settle_tolerance x gravity's work and every granule's residual force (its contacts'
 elastic forces and its weight: a static balance) is at most settle_residual x its weight.
+A packing dropped one by one (layout.drop = "sequential", `setup.deposition`) skips the
+fall: it starts at rest, touching, at the stiffness 1 / settle_softening (1 by default).
 The compiled steps are `solver.settling`'s; this module lists the contacts (a Verlet list
 with a skin, rebuilt when a granule moved half of it), picks the steps and judges the
 phases.
@@ -93,10 +95,11 @@ class Packing:
 
 
 def packing(s: Scenario, lay: PouredLayout) -> Packing:
-    """The loose column of `lay` at rest, its walls and their coefficients, at the settling's
-    soft stiffness (`results.pouring.loose_scenario` gives the contacts: damping
+    """The dropped granules of `lay` at rest (the loose column, or the deposited packing of
+    drop = "sequential"; gravity's work counted from where they were released), its walls
+    and their coefficients, at the settling's soft stiffness (`results.pouring.loose_scenario` gives the contacts: damping
     settle_damping, Mindlin's friction settle_friction)."""
-    from granplate.results.pouring import loose_scenario
+    from granplate.results.pouring import loose_scenario, release_centres
 
     loose = loose_scenario(s, lay, lay.settle_damping, lay.settle_friction)
     n = len(loose.granules)
@@ -129,7 +132,7 @@ def packing(s: Scenario, lay: PouredLayout) -> Packing:
         np.zeros((n, 3)),
         np.zeros((n, 3)),
         np.zeros(n, np.int64),
-        x.copy(),
+        release_centres(s, lay),
         1.0 / lay.settle_softening,
     )
     relist(p)
@@ -278,7 +281,7 @@ def _settle_ramped(s: Scenario, lay: PouredLayout, progress: bool) -> tuple[Pack
     clock, cpu = time.perf_counter(), time.process_time()
     p = packing(s, lay)
     out = Outcome()
-    falling = True  # until the kinetic energy first falls to RAMP_BELOW: the fall's step
+    falling = lay.drop != "sequential"  # until the kinetic energy first falls to RAMP_BELOW: the fall's step
     while out.t < lay.settle_time:
         ramp = not falling and p.s < 1.0 and out.kinetic <= RAMP_BELOW
         s_end = min(1.0, p.s * RAMP_FACTOR) if ramp else p.s

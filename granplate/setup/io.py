@@ -84,7 +84,7 @@ CHOICES: dict[tuple[type, str], tuple[str, ...]] = {
 #: change the text, and so the stored results' keys, of every scenario written before).
 UNWRITTEN_DEFAULTS: dict[str, dict[str, Any]] = {
     "contact": {"normal_law": "hertz", "tangential_law": "tanh", "tangential_damping": 0.0},
-    "layout": {"settle_softening": 1.0, "settle_residual": 1e-2},
+    "layout": {"settle_softening": 1.0, "settle_residual": 1e-2, "drop": "column"},
 }
 #: Fields of the three-dimensional mode left out of a two-dimensional scenario's tables
 #: when they hold their default, so that every 2D scenario is written as before

@@ -12,6 +12,7 @@ does not hold.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from typing import Any, Callable
 
@@ -20,7 +21,8 @@ import numpy as np
 from granplate import store
 from granplate.errors import ScenarioError
 from granplate.setup.fields import is_number, positive, string_in
-from granplate.setup.scenario import BOX_WALLS, POURED_DISTRIBUTIONS, PouredLayout, Scenario, Wall
+from granplate.setup import deposition
+from granplate.setup.scenario import BOX_WALLS, POURED_DISTRIBUTIONS, POURED_DROPS, PouredLayout, Scenario, Wall
 
 #: The run store's kind and format of a settled packing.
 STORE_KIND = "poured"
@@ -70,6 +72,7 @@ def check_poured(s: Scenario, lay: PouredLayout) -> None:
     if not rr[0] <= rr[1]:
         raise ScenarioError("layout.radius_range", list(rr), "must be [min, max] with min <= max")
     string_in("layout.distribution", lay.distribution, POURED_DISTRIBUTIONS)
+    string_in("layout.drop", lay.drop, POURED_DROPS)
     _check_distribution(lay)
     if not (isinstance(lay.seed, int) and not isinstance(lay.seed, bool) and lay.seed >= 0):
         raise ScenarioError("layout.seed", lay.seed, "must be an integer >= 0")
@@ -253,6 +256,37 @@ def loose_column(lay: PouredLayout, dimension: int, g: tuple[float, ...], radii:
     return centres
 
 
+def dropped(lay: PouredLayout, dimension: int, g: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """(centres where the settling starts, centres the granules were released from) (count,
+    dimension) [m] of `poured_radii(lay)`: the loose column (both the same), or for drop =
+    "sequential" the granules deposited one by one (`setup.deposition.deposit`: at rest on
+    the pile, each released just above it). Copies of the last few computed."""
+    centres, release = _dropped(lay, dimension, tuple(g))
+    return centres.copy(), release.copy()
+
+
+def clear_dropped() -> None:
+    """Forget the packings `dropped` keeps (a benchmark times them afresh)."""
+    _dropped.cache_clear()
+
+
+@functools.lru_cache(maxsize=4)
+def _dropped(lay: PouredLayout, dimension: int, g: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray]:
+    radii = poured_radii(lay)
+    if lay.drop == "sequential":
+        axis, sign = floor_axis(g)
+        centres, release, _ = deposition.deposit(radii, container_size(lay, dimension), axis, sign, lay.seed)
+        return centres, release
+    c = loose_column(lay, dimension, g, radii)
+    return c, c
+
+
+def settles_ramped(s: Scenario, lay: PouredLayout) -> bool:
+    """Whether the ramped settling's kernel settles `lay` (`results.ramped`, in space): with
+    settle_softening > 1, or a sequential drop in space (its fall skipped)."""
+    return lay.settle_softening > 1.0 or (lay.drop == "sequential" and s.dimension == 3)
+
+
 def store_payload(s: Scenario, lay: PouredLayout) -> dict[str, Any]:
     """What a settled packing depends on: the layout, the dimension, gravity, the
     materials of granules and walls, and the scenario's contact coefficients (a layout
@@ -260,8 +294,10 @@ def store_payload(s: Scenario, lay: PouredLayout) -> dict[str, Any]:
     layout = dataclasses.asdict(lay)
     if not lay.settle_friction:
         del layout["settle_friction"]
-    if lay.settle_softening == 1.0:  # the time loop's settling: keyed as before the ramped one
+    if lay.settle_softening == 1.0 and not settles_ramped(s, lay):  # keyed as before the ramped settling
         del layout["settle_softening"], layout["settle_residual"]
+    if lay.drop == "column":  # keyed as before the sequential drop
+        del layout["drop"]
     return {
         "layout": layout,
         "dimension": s.dimension,

@@ -240,6 +240,8 @@ class SpaceLattice:
 
 #: Size distributions of a poured packing (`PouredLayout.distribution`).
 POURED_DISTRIBUTIONS: tuple[str, ...] = ("uniform", "discrete", "normal", "lognormal")
+#: How a poured packing's granules are dropped (`PouredLayout.drop`).
+POURED_DROPS: tuple[str, ...] = ("column", "sequential")
 
 
 @dataclass(frozen=True)
@@ -263,8 +265,10 @@ class PouredLayout:
     damping settle_damping, and rests as a frictional packing. settle_softening [-] (3D; 1: off):
     above 1, the ramped settling (docs/model.md section 3.14): the fall at every contact's stiffness
     over settle_softening, the stiffness ramped to the real law's, settled when also every granule's
-    residual force is at most settle_residual [-] of its weight. The settled packing is kept in the
-    run store.
+    residual force is at most settle_residual [-] of its weight. drop: "column" (the loose column
+    above, all granules falling at once) or "sequential": one at a time, each rolled to rest on
+    the pile before the next (`setup.deposition`), then settled at the real stiffness (in space by
+    the ramped settling's kernel, its fall skipped). The settled packing is kept in the run store.
     """
 
     kind: str = "poured"
@@ -286,6 +290,7 @@ class PouredLayout:
     settle_friction: float = 0.0
     settle_softening: float = 1.0
     settle_residual: float = 1e-2
+    drop: str = "column"
 
 
 #: `[layout] kind` -> the dataclass that holds that kind's fields.
