@@ -13,7 +13,7 @@ from granplate.model.inputs import SCHEME_NAMES, Config, Granular, PlateArrays, 
 from granplate.physics.contact import N_COEF
 from granplate.solver import loop, schemes, state as S
 from granplate.solver.plate_modal import step_matrices
-from granplate.solver.schemes.newton import solve_dense
+from granplate.dense import solve_dense
 
 
 def test_compliance_is_the_driving_block_of_the_newmark_matrix():
@@ -45,8 +45,10 @@ def test_dense_solve_matches_numpy():
         rhs = rng.normal(size=n)
         want = np.linalg.solve(m, rhs)
         x = rhs.copy()
-        solve_dense(m.copy(), x)
+        assert solve_dense(m.copy(), x) > 0.0
         np.testing.assert_allclose(x, want, rtol=1e-10)
+    singular = np.array([[1.0, 2.0], [2.0, 4.0]])  # rank 1: its second pivot vanishes
+    assert solve_dense(singular, np.array([1.0, 2.0])) == 0.0
 
 
 def one_mode_run(scheme: str, omega_h: float, n_steps: int = 1, budget: int = 100):

@@ -12,7 +12,7 @@ PACKAGE = Path(granplate.__file__).parent
 
 #: bottom to top; a module may import its own layer and the layers below it.
 LAYERS = (
-    ("version", "errors", "store", "jit"),
+    ("version", "errors", "store", "jit", "dense"),
     ("setup",),
     ("physics",),
     ("plate", "solid"),

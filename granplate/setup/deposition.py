@@ -23,6 +23,7 @@ import math
 
 import numpy as np
 
+from granplate.dense import solve_dense
 from granplate.jit import njit
 
 #: A contact is active (it constrains the motion) when its surface gap is at most this
@@ -61,33 +62,6 @@ PROJECTION_TOL = 1e-13
 
 
 @njit(cache=True)
-def _solve_small(a: np.ndarray, b: np.ndarray, k: int, x: np.ndarray) -> bool:
-    """x[:k] = a[:k, :k]^-1 b[:k] by Gaussian elimination with partial pivoting (a and b
-    overwritten); False where a is singular to SINGULAR."""
-    for c in range(k):
-        piv = c
-        for i in range(c + 1, k):
-            if abs(a[i, c]) > abs(a[piv, c]):
-                piv = i
-        if abs(a[piv, c]) <= SINGULAR:
-            return False
-        for j in range(k):
-            a[c, j], a[piv, j] = a[piv, j], a[c, j]
-        b[c], b[piv] = b[piv], b[c]
-        for i in range(c + 1, k):
-            f = a[i, c] / a[c, c]
-            for j in range(c, k):
-                a[i, j] -= f * a[c, j]
-            b[i] -= f * b[c]
-    for c in range(k - 1, -1, -1):
-        s = b[c]
-        for j in range(c + 1, k):
-            s -= a[c, j] * x[j]
-        x[c] = s / a[c, c]
-    return True
-
-
-@njit(cache=True)
 def cone_projection(normals: np.ndarray, m: int, g: np.ndarray, weights: np.ndarray) -> np.ndarray:
     """The projection of the direction g on the cone {u : n_k . u >= 0, k < m} of the
     first m unit normals: g + sum_k lambda_k n_k with lambda >= 0 (the least squares'),
@@ -120,8 +94,9 @@ def cone_projection(normals: np.ndarray, m: int, g: np.ndarray, weights: np.ndar
                         for c in range(d):
                             s += normals[pick[i], c] * normals[pick[j], c]
                         a[i, j] = s
-                ok = _solve_small(a, b, k, lam)
+                ok = solve_dense(a[:k, :k], b[:k]) > SINGULAR
                 for i in range(k):
+                    lam[i] = b[i]
                     ok = ok and lam[i] >= 0.0
             if ok:
                 for c in range(d):

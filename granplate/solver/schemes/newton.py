@@ -22,6 +22,7 @@ sticks, mu sign(F_t) times the normal force's while it slides.
 from __future__ import annotations
 
 
+from granplate.dense import solve_dense
 from granplate.jit import njit
 
 from granplate.model.inputs import HIST_MAX, HIST_RATE
@@ -125,41 +126,6 @@ def chain_to_variables(normal, fguess, vguess, g, jac):
             dy_ = jac[a, 2 * j + 1]
             jac[a, 2 * j] = (1.0 if a == 2 * j else 0.0) - (jac[a, 2 * j] + dy_ * phi_n)
             jac[a, 2 * j + 1] = (1.0 if a == 2 * j + 1 else 0.0) - dy_ * phi_v
-
-
-@njit(cache=True)
-def solve_dense(jac, rhs):
-    """Solve jac x = rhs in place (x into rhs) by Gaussian elimination with partial
-    pivoting; a zero pivot column gives x = 0 there. jac is overwritten."""
-    nd = rhs.shape[0]
-    for col in range(nd):
-        piv = col
-        big = abs(jac[col, col])
-        for r in range(col + 1, nd):
-            if abs(jac[r, col]) > big:
-                big = abs(jac[r, col])
-                piv = r
-        if big == 0.0:
-            continue
-        if piv != col:
-            for b in range(nd):
-                tmp = jac[col, b]
-                jac[col, b] = jac[piv, b]
-                jac[piv, b] = tmp
-            tmp = rhs[col]
-            rhs[col] = rhs[piv]
-            rhs[piv] = tmp
-        for r in range(col + 1, nd):
-            fac = jac[r, col] / jac[col, col]
-            if fac != 0.0:
-                for b in range(col, nd):
-                    jac[r, b] -= fac * jac[col, b]
-                rhs[r] -= fac * rhs[col]
-    for col in range(nd - 1, -1, -1):
-        acc = rhs[col]
-        for b in range(col + 1, nd):
-            acc -= jac[col, b] * rhs[b]
-        rhs[col] = acc / jac[col, col] if jac[col, col] != 0.0 else 0.0
 
 
 @njit(cache=True)
