@@ -141,3 +141,17 @@ def test_step_recovers_after_collapsing_to_dt_min(gap):
     assert dt.min() <= 2 * s.time.dt_min  # it did go down to dt_min
     assert dt.min() >= 0.5 * s.time.dt_min
     assert float(np.abs(ds.energy_residual).max()) < 1e-5
+
+
+@pytest.mark.parametrize(("scheme", "field"), [("implicit", "solver.implicit_dt_max"), ("paper", "time.dt_max")])
+def test_energy_stop_names_the_step_ceiling_of_the_scheme(scheme, field):
+    """A run stopped by the energy balance says which field caps its step: under "implicit"
+    solver.implicit_dt_max (time.dt_max does not cap its steps)."""
+    import dataclasses
+
+    from granplate.errors import SimulationError
+
+    s = pressed_and_sheared(scheme)
+    s = dataclasses.replace(s, solver=dataclasses.replace(s.solver, energy_tol=1e-15))
+    with pytest.raises(SimulationError, match=f"Lower {field} or solver.lambda_target"):
+        gp.simulate(s, progress=False)

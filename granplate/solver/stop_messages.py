@@ -42,13 +42,19 @@ def status_message(status: int, model: Model, st: S.State) -> str:
         return (
             f"energy balance broken at t = {t:.6e} s: residual (E_p + E_g + D - E_in)/E_in = "
             f"{e[S.ERR_RESID]:.3e} exceeds solver.energy_tol = {cfg.energy_tol:.1e} "
-            f"(step {e[S.ERR_H]:.3e} s). Lower time.dt_max or solver.lambda_target."
+            f"(step {e[S.ERR_H]:.3e} s). Lower {step_ceiling(model)} or solver.lambda_target."
         )
     if status in (S.ERR_OVERLAP, S.ERR_MISSED, S.ERR_PLATE_REACH, S.ERR_JUMP):
         return contact_message(status, model, st)
     if status == S.ERR_NAN:
         return f"the state became non-finite (NaN/inf) at t = {t:.6e} s (step {e[S.ERR_H]:.3e} s)."
     return f"output buffer exhausted at t = {t:.6e} s (internal error, status {status})."
+
+
+def step_ceiling(model: Model) -> str:
+    """The field that caps the run's step: solver.implicit_dt_max under the implicit
+    scheme (model.arrays caps its steps by it, not by time.dt_max), else time.dt_max."""
+    return "solver.implicit_dt_max" if model.scenario.solver.scheme == "implicit" else "time.dt_max"
 
 
 def partner_name(model: Model, partner: int) -> str:
