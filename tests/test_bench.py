@@ -72,11 +72,11 @@ def test_bench_unknown_case_is_a_user_error(capsys):
 
 def test_bench_of_a_3d_twin_says_why_not_and_where_instead(capsys):
     """A 3D twin (a preset `granplate run` knows) is refused by the scheme benchmark with
-    one line that says why and names the coupled 3D bench, before anything runs."""
+    one line that says why and names the twins' bench, before anything runs."""
     assert main(["bench", "--quick", "--cases", "steel-r1,3d-steel-r1"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("granplate: error: case(s) 3d-steel-r1: 3D twins") and err.count("\n") == 1
-    assert "bench --solid --coupled" in err and "unknown" not in err
+    assert "bench --twins" in err and "unknown" not in err
 
 
 def test_scaling_rows_are_measured_and_documented(tmp_path):
@@ -301,7 +301,8 @@ def test_lammps_accuracy_counts_round_off_as_equal():
 def test_twins_rows_are_measured_and_documented(tmp_path):
     """`bench --twins` on ptfe-r05-weak shortened: one row whose keys are the documented
     ones, its differences and ratios the quotients of its own figures, and the verdicts
-    the targets' (bench.twins.THIN_LIMIT, SPEED_TARGET) applied to them."""
+    the targets' (bench.twins.THIN_LIMIT, SPEED_TARGET) applied to them; the twin on the
+    implicit scheme too, with eq. (11) held."""
     from granplate.bench import twins
 
     out = tmp_path / "twins.json"
@@ -321,6 +322,11 @@ def test_twins_rows_are_measured_and_documented(tmp_path):
         abs(row["e_shock_rel_diff"]) <= twins.THIN_LIMIT["e_shock"]
         and abs(row["ep_max_fraction_rel_diff"]) <= twins.THIN_LIMIT["ep_max_fraction"]
     )
+    # the same twin on the implicit scheme: its own steps, its figures' quotients
+    assert row["n_steps_3d_implicit"] > 0 and row["n_steps_3d_implicit"] != row["n_steps_3d"]
+    assert row["e_shock_implicit_rel_diff"] == pytest.approx(row["e_shock_3d_implicit_j"] / row["e_shock_2d_j"] - 1.0)
+    assert row["wall_ratio_implicit"] == pytest.approx(row["wall_3d_implicit_s"] / row["wall_2d_s"])
+    assert row["energy_residual_3d_implicit"] < 1e-4
 
 
 def test_twins_options_are_checked(capsys):

@@ -44,7 +44,7 @@ dt_max = 2e-8
 output_interval = 2e-7
 field_interval = 2e-6
 [solver]
-scheme = "verlet"
+scheme = "{scheme}"
 """
 
 BEAM = """
@@ -141,41 +141,48 @@ def test_a_free_solid_under_gravity_is_refused_by_name():
     naming gravity.g."""
     from granplate.errors import ScenarioError
 
-    text = SOLID.format(vz=0.0, z=0.02, fmax=1.5e5, more="", g=-G, t_end=2e-6).replace('clamped = ["zmin"]\n', "")
+    text = SOLID.format(vz=0.0, z=0.02, fmax=1.5e5, more="", g=-G, t_end=2e-6, scheme="verlet").replace(
+        'clamped = ["zmin"]\n', ""
+    )
     with pytest.raises(ScenarioError, match="weight") as e:
         build_model(gp.loads(text))
     assert e.value.field == "gravity.g"
 
 
-def test_the_solid_rests_in_its_sag_and_eq_11_holds_with_a_sphere_dropped_on_it():
+@pytest.mark.parametrize("scheme", ["verlet", "implicit"])
+def test_the_solid_rests_in_its_sag_and_eq_11_holds_with_a_sphere_dropped_on_it(scheme):
     """Without a contact the solid starts at rest in its sag and stays there to round-off (its
     modes turn exactly about it); a sphere striking it under gravity: eq. (11) holds at every
-    step with the weight's work on the solid and the sphere booked as gravity's."""
-    s = gp.loads(SOLID.format(vz=0.0, z=0.02, fmax=1.5e5, more="", g=-G, t_end=4e-6))
+    step with the weight's work on the solid and the sphere booked as gravity's. Both schemes
+    that drive the solid."""
+    s = gp.loads(SOLID.format(vz=0.0, z=0.02, fmax=1.5e5, more="", g=-G, t_end=4e-6, scheme=scheme))
     m = build_model(s)
     ds = gp.simulate(s, progress=False)
     q = ds["body_q"].values
     assert np.max(np.abs(ds["energy_residual"].values)) < 1e-10
     assert np.max(np.abs(q - m.plate_q0[None, :])) < 1e-9 * np.max(np.abs(m.plate_q0))
-    s = gp.loads(SOLID.format(vz=-0.2, z=0.0120005, fmax=1.5e5, more="", g=-G, t_end=1.5e-5))
+    s = gp.loads(SOLID.format(vz=-0.2, z=0.0120005, fmax=1.5e5, more="", g=-G, t_end=1.5e-5, scheme=scheme))
     ds = gp.simulate(s, progress=False)
     assert float(np.max(ds["E_contact"].values)) > 0.0
     assert np.max(np.abs(ds["energy_residual"].values)) < 1e-5
 
 
-@pytest.mark.parametrize("residual, patch", [(True, 0.0), (False, 0.006)])
-def test_a_sphere_pressed_on_the_heavy_solid_rests_with_the_static_force(residual, patch):
+@pytest.mark.parametrize(
+    "residual, patch, scheme", [(True, 0.0, "verlet"), (False, 0.006, "verlet"), (True, 0.0, "implicit")]
+)
+def test_a_sphere_pressed_on_the_heavy_solid_rests_with_the_static_force(residual, patch, scheme):
     """A sphere pressed on the solid's top face by a wall with F under gravity
     ([precompression]): at t = 0 the solid pushes back with F + m g, and the run from that
     state stays at rest (the sphere's speed a round-off's); with the residual compliance and a
-    point patch, and with the modes alone and a disc patch."""
+    point patch, and with the modes alone and a disc patch; under either scheme that drives
+    the solid."""
     force = 0.1
     wall = (
         f"residual = {'true' if residual else 'false'}\n"
         '[[walls]]\nlabel = "top"\nnormal = [0.0, 0.0, 1.0]\noffset = 0.014\n'
         f'[precompression]\ntarget = "wall top"\nforce = {force}\ntolerance = 1e-10\n'
     )
-    text = SOLID.format(vz=0.0, z=0.012, fmax=1.5e5, more=wall, g=-G, t_end=2e-6)
+    text = SOLID.format(vz=0.0, z=0.012, fmax=1.5e5, more=wall, g=-G, t_end=2e-6, scheme=scheme)
     s = gp.loads(text.replace("patch_radius = 0.0", f"patch_radius = {patch}"))
     m = build_model(s)
     mass = float(m.granular.mass[0])

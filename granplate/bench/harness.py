@@ -269,9 +269,9 @@ def run(quick: bool = False, cases=None, repeats: int | None = None, t_end: floa
     twins = [c for c in cases if c in gp.preset_names(include_3d=True) and c not in gp.preset_names()]
     if twins:
         raise ValueError(
-            f"case(s) {', '.join(twins)}: 3D twins, which run under velocity Verlet alone, not the "
-            f"plate schemes this benchmark compares ({', '.join(schemes())}); `granplate bench "
-            f"--solid --coupled` times a coupled 3D run"
+            f"case(s) {', '.join(twins)}: 3D twins, which this benchmark of the plane's plate schemes "
+            f"({', '.join(schemes())}) does not run; `granplate bench --twins` times each twin under "
+            f"velocity Verlet and the implicit scheme beside its 2D case"
         )
     unknown = [c for c in cases if c not in gp.preset_names()]
     if unknown:

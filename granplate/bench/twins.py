@@ -1,5 +1,6 @@
 """`granplate bench --twins`: each paper case beside its 3D twin (docs/model.md section
-8.1), in one process, timed alternately 2D / 3D.
+8.1) under velocity Verlet (the presets' scheme) and under the implicit scheme, in one
+process, timed alternately 2D / 3D / 3D implicit.
 
 Per case: the thin-limit agreement (E_shock and the plate's peak share, 3D against 2D,
 unrounded, against THIN_LIMIT's targets), the twin's energy residual and step, and the
@@ -8,7 +9,7 @@ time loop), the loop's CPU time, and the whole `simulate` call (the run and the 
 Dataset: for a 3D body its stresses at every output time), each the median of `repeats`
 runs after a 1 us warm-up run of each (the compiled loops loaded, the plate and the slab
 read from the run store). The speed target is a twin's wall time at most SPEED_TARGET
-times its 2D preset's.
+times its 2D preset's (velocity Verlet's; the implicit twin's ratio is reported beside it).
 """
 
 from __future__ import annotations
@@ -51,46 +52,56 @@ def timed_run(s) -> dict:
     }
 
 
+#: The schemes that drive the 3D twin's elastic solid: the presets' own ("verlet") and
+#: "implicit" (docs/model.md section 6.7), each row's "3d" and "3d_implicit" columns.
+TWIN_SCHEMES = {"3d": "verlet", "3d_implicit": "implicit"}
+
+
 def bench_case(name: str, t_end: float | None = None, repeats: int = REPEATS) -> dict:
-    """The row of preset `name` and its twin "3d-NAME" (module docstring)."""
+    """The row of preset `name` and its twin "3d-NAME" under each of TWIN_SCHEMES (module
+    docstring)."""
     import granplate as gp
 
-    plane, space = gp.preset(name), gp.preset("3d-" + name)
+    plane = gp.preset(name)
     if t_end is not None:
-        plane, space = (gp.with_changes(s, {"time.t_end": float(t_end)}) for s in (plane, space))
-    for s in (plane, space):  # warm-up: kernels loaded, plate and slab from the run store
+        plane = gp.with_changes(plane, {"time.t_end": float(t_end)})
+    runs_of = {"2d": plane}
+    for col, scheme in TWIN_SCHEMES.items():
+        changes = {"solver.scheme": scheme} | ({} if t_end is None else {"time.t_end": float(t_end)})
+        runs_of[col] = gp.with_changes(gp.preset("3d-" + name), changes)
+    for s in runs_of.values():  # warm-up: kernels loaded, plate and slab from the run store
         timed_run(gp.with_changes(s, {"time.t_end": 1e-6}))
-    runs = {"2d": [], "3d": []}
+    runs = {d: [] for d in runs_of}
     for _ in range(max(int(repeats), 1)):
-        runs["2d"].append(timed_run(plane))
-        runs["3d"].append(timed_run(space))
+        for d, s in runs_of.items():
+            runs[d].append(timed_run(s))
     med = {
         d: {k: statistics.median(r[k] for r in rs) for k in ("wall_s", "loop_cpu_s", "simulate_s")}
         for d, rs in runs.items()
     }
-    a, b = runs["2d"][-1]["summary"], runs["3d"][-1]["summary"]
-    diff = {m: (b[m] / a[m] - 1.0 if a[m] else float("nan")) for m in THIN_LIMIT}
-    row = {
-        "case": name,
-        "t_end_s": float(space.time.t_end),
-        "e_shock_2d_j": a["e_shock"],
-        "e_shock_3d_j": b["e_shock"],
-        "e_shock_rel_diff": diff["e_shock"],
-        "ep_max_fraction_2d": a["ep_max_fraction"],
-        "ep_max_fraction_3d": b["ep_max_fraction"],
-        "ep_max_fraction_rel_diff": diff["ep_max_fraction"],
-        "energy_residual_3d": b["energy_residual_max"],
-        "dt_3d_s": runs["3d"][-1]["dt_s"],
-        "n_steps_3d": runs["3d"][-1]["n_steps"],
-        "repeats": len(runs["2d"]),
-    }
-    for d in ("2d", "3d"):
+    a = runs["2d"][-1]["summary"]
+    row = {"case": name, "t_end_s": float(runs_of["3d"].time.t_end), "e_shock_2d_j": a["e_shock"]}
+    row["ep_max_fraction_2d"] = a["ep_max_fraction"]
+    for d in TWIN_SCHEMES:
+        b = runs[d][-1]["summary"]
+        tail = "" if d == "3d" else "_implicit"
+        diff = {m: (b[m] / a[m] - 1.0 if a[m] else float("nan")) for m in THIN_LIMIT}
+        row[f"e_shock_{d}_j"] = b["e_shock"]
+        row[f"e_shock{tail}_rel_diff"] = diff["e_shock"]
+        row[f"ep_max_fraction_{d}"] = b["ep_max_fraction"]
+        row[f"ep_max_fraction{tail}_rel_diff"] = diff["ep_max_fraction"]
+        row[f"energy_residual_{d}"] = b["energy_residual_max"]
+        row[f"n_steps_{d}"] = runs[d][-1]["n_steps"]
+        row[f"within_thin_limit{tail}"] = all(abs(diff[m]) <= tol for m, tol in THIN_LIMIT.items())
+    row["dt_3d_s"] = runs["3d"][-1]["dt_s"]
+    row["repeats"] = len(runs["2d"])
+    for d in runs:
         row[f"wall_{d}_s"] = med[d]["wall_s"]
         row[f"loop_cpu_{d}_s"] = med[d]["loop_cpu_s"]
         row[f"simulate_{d}_s"] = med[d]["simulate_s"]
     row["wall_ratio"] = med["3d"]["wall_s"] / med["2d"]["wall_s"]
+    row["wall_ratio_implicit"] = med["3d_implicit"]["wall_s"] / med["2d"]["wall_s"]
     row["simulate_ratio"] = med["3d"]["simulate_s"] / med["2d"]["simulate_s"]
-    row["within_thin_limit"] = all(abs(diff[m]) <= tol for m, tol in THIN_LIMIT.items())
     row["within_speed_target"] = row["wall_ratio"] <= SPEED_TARGET
     return row
 
@@ -110,13 +121,29 @@ def format_table(rows: list[dict]) -> str:
             f"{r['wall_2d_s']:.2f} / {r['wall_3d_s']:.2f} | {r['wall_ratio']:.2f} | "
             f"{r['simulate_2d_s']:.2f} / {r['simulate_3d_s']:.2f} | {r['simulate_ratio']:.2f} |"
         )
+    lines += ["", "The same twins on the implicit scheme (3D against 2D; wall time beside velocity Verlet's):", ""]
+    head = (
+        "| case | E_shock 3D implicit [J] | diff | peak share 3D implicit | diff | residual | steps | "
+        "wall 3D implicit / verlet [s] | loop CPU implicit / verlet [s] | ratio to 2D |"
+    )
+    lines += [head, "|" + "---|" * (head.count("|") - 1)]
+    for r in rows:
+        lines.append(
+            f"| {r['case']} | {r['e_shock_3d_implicit_j']:.4e} | {100 * r['e_shock_implicit_rel_diff']:+.3f}% | "
+            f"{r['ep_max_fraction_3d_implicit']:.4g} | {100 * r['ep_max_fraction_implicit_rel_diff']:+.2f}% | "
+            f"{r['energy_residual_3d_implicit']:.1e} | {r['n_steps_3d_implicit']} | "
+            f"{r['wall_3d_implicit_s']:.2f} / {r['wall_3d_s']:.2f} | "
+            f"{r['loop_cpu_3d_implicit_s']:.2f} / {r['loop_cpu_3d_s']:.2f} | {r['wall_ratio_implicit']:.2f} |"
+        )
     ok = sum(r["within_thin_limit"] for r in rows)
+    ok_i = sum(r["within_thin_limit_implicit"] for r in rows)
     fast = sum(r["within_speed_target"] for r in rows)
     lines.append("")
     lines.append(
         f"thin limit (E_shock within {100 * THIN_LIMIT['e_shock']:g}%, peak share within "
         f"{100 * THIN_LIMIT['ep_max_fraction']:g}%): {ok} of {len(rows)} cases; wall time at most "
-        f"{SPEED_TARGET:g}x the 2D preset's: {fast} of {len(rows)}"
+        f"{SPEED_TARGET:g}x the 2D preset's: {fast} of {len(rows)}; the implicit twins within the thin limit: "
+        f"{ok_i} of {len(rows)}"
     )
     return "\n".join(lines)
 

@@ -217,25 +217,6 @@ def _check_solver(s: Scenario) -> None:
 SOLID_SCHEMES: tuple[str, ...] = ("implicit",)
 
 
-def _check_solid_implicit_inputs(s: Scenario) -> None:
-    """What the implicit scheme does not yet carry to an elastic solid in 3D, refused by
-    name: the solid's weight and a static state with it (velocity Verlet has both,
-    docs/model.md sections 3.11, 3.12)."""
-    verlet = 'set solver.scheme = "verlet"'
-    if s.gravity is not None:
-        raise ScenarioError(
-            "gravity.g",
-            s.gravity.g,
-            f"the elastic solid's weight is carried by velocity Verlet only (docs/model.md section 3.11): {verlet}",
-        )
-    if s.precompression is not None:
-        raise ScenarioError(
-            "precompression",
-            "given",
-            f"a static state with the elastic solid is computed for velocity Verlet only (section 3.12): {verlet}",
-        )
-
-
 def _check_solid_scheme(s: Scenario) -> None:
     """An elastic solid in 3D under a plate scheme: "implicit" (not "paper", whose
     predictor-corrector is written for the plane's plate contacts), friction split off."""
@@ -248,14 +229,6 @@ def _check_solid_scheme(s: Scenario) -> None:
             "or by the implicit scheme (section 6.7), not by the paper's scheme (written for the plane's plate "
             'contacts): set solver.scheme = "implicit" or "verlet"',
         )
-    if s.load.kind == "line" and s.load.target == "plate":
-        raise ScenarioError(
-            "load.target",
-            s.load.target,
-            'a line load on the elastic solid itself is driven by velocity Verlet only (under "implicit" its '
-            'modes do not yet take it): set solver.scheme = "verlet", or load the granules',
-        )
-    _check_solid_implicit_inputs(s)
     if sv.granular_friction != "split":
         raise ScenarioError(
             "solver.granular_friction",

@@ -122,12 +122,13 @@ def load_amplitudes(t, h, cfg):
 def modal_stages(t, h, b, bs, cfg):
     """The modes at t + h/2 and t + h (rows 1, 2 of bs.qs, bs.qds) from row 0 under the
     force F0 + (F1 - F0) s/h + L(s): F0 = b.fmodal[CUR], F1 = bs.f1, L the line load's
-    projection linear between its amplitudes (docs/model.md section 6.7)."""
+    projection linear between its amplitudes, plus the body's own weight, constant
+    (b.weight: zeros without gravity; docs/model.md sections 3.11 and 6.7)."""
     cur = int(bs.flags[CUR])
     amp0, amp1 = load_amplitudes(t, h, cfg)
     for m in range(bs.qs.shape[1]):
-        f0 = b.fmodal[cur, m] + amp0 * b.load[m]
-        f1 = bs.f1[m] + amp1 * b.load[m]
+        f0 = b.fmodal[cur, m] + amp0 * b.load[m] + b.weight[m]
+        f1 = bs.f1[m] + amp1 * b.load[m] + b.weight[m]
         q0 = bs.qs[0, m]
         v0 = bs.qds[0, m]
         c = bs.mc[m]
@@ -325,8 +326,8 @@ def end_energy(t, h, b, bs, cfg, qn, qdn):
         q1 = bs.qs[2, m]
         v1 = bs.qds[2, m]
         if cfg.load_on_plate:
-            f0 = b.fmodal[cur, m] + amp0 * b.load[m]
-            f1 = bs.f1[m] + amp1 * b.load[m]
+            f0 = b.fmodal[cur, m] + amp0 * b.load[m] + b.weight[m]
+            f1 = bs.f1[m] + amp1 * b.load[m] + b.weight[m]
             c = bs.mc[m]
             qint = c[MC_IQ] * bs.qs[0, m] + c[MC_IV] * bs.qds[0, m] + c[MC_IF0] * f0 + c[MC_IF1] * f1
             work += b.load[m] * (amp1 * q1 - amp0 * bs.qs[0, m] - (amp1 - amp0) * qint / h)
@@ -334,6 +335,16 @@ def end_energy(t, h, b, bs, cfg, qn, qdn):
         qdn[m] = v1
         energy += 0.5 * (v1 * v1 + b.omega[m] * b.omega[m] * q1 * q1)
     return work, energy + b.static[1 - cur]
+
+
+@njit(cache=True)
+def weight_work(b, bs) -> float:
+    """The work of the body's own weight over the step [J]: the constant modal force
+    b.weight times the modes' displacement, exactly (0 without gravity)."""
+    work = 0.0
+    for m in range(bs.qs.shape[1]):
+        work += b.weight[m] * (bs.qs[2, m] - bs.qs[0, m])
+    return work
 
 
 @njit(cache=True)

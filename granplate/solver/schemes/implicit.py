@@ -81,6 +81,12 @@ REJECT_FACTOR = 2.0
 SHOCK_STEPS = 100
 #: share of solver.energy_tol the step control lets the residual drift over a run.
 ENERGY_STEP_FRACTION = 0.5
+#: a jump of the residual that a smaller step does not shrink (a retry at JUMP_STEP or less
+#: of the first rejected step still changing it by JUMP_KEPT or more of that step's change)
+#: is the contact geometry's, not the integration's (a contact's foot crossing an element's
+#: edge on an elastic solid's surface, docs/model.md section 6.7), and is accepted.
+JUMP_STEP = 0.6
+JUMP_KEPT = 0.8
 
 
 class Scratch(NamedTuple):
@@ -96,6 +102,7 @@ class Scratch(NamedTuple):
     qdn: np.ndarray
     body: BodyArrays  # the elastic body in space and this run's contacts on it (no faces: none)
     bstep: BI.BodyStep  # the body's modes over the step and its fixed point (solver.body_implicit)
+    chase: np.ndarray  # (3,) the first step at this t rejected by the energy term: t, |its residual change|, h
 
 
 def new_scratch(ng: int, nm: int, nk: int, body=None, threads: int = 1) -> Scratch:
@@ -115,6 +122,7 @@ def new_scratch(ng: int, nm: int, nk: int, body=None, threads: int = 1) -> Scrat
         qdn=z(nm),
         body=b,
         bstep=BI.body_step_for(b, ng, max(STATE_COLUMNS.values())),
+        chase=np.array([np.nan, 0.0, 0.0]),
     )
 
 
@@ -280,6 +288,7 @@ def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
         exact_correct,
         (t, h, st, p, cfg, sw.mcoef[slot], w.fguess, sw.qn, sw.qdn),
     )
+    w.dacc[4] += B.by_body(sw.body, BI.weight_work, (sw.body, sw.bstep), no_weight, ())  # the body's own weight
     kx, ky, kz, kr = kinetic_energies(w.ynew, g)
     e_in = (
         st.clock[E_ZERO]
@@ -310,16 +319,32 @@ def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
     if denom > 0.0 and math.isfinite(total):
         d_res = energy_residual(total, e_in, denom) - st.clock[RES_LAST]
     err = step_error(ratio, st, g, cfg, w) / cfg.error_tol
+    by_energy = False
     if not (cfg.q0 != 0.0 and t < cfg.duration):  # (E_in ~ 0 while the shock starts)
         # each step may add its share of energy_tol * ENERGY_STEP_FRACTION, the run
         # (solver.energy_span: its t_end unless given) counted in steps of dt_max
-        err = max(err, abs(d_res) * cfg.energy_span / (cfg.energy_tol * ENERGY_STEP_FRACTION * cfg.dt_max))
+        e_err = abs(d_res) * cfg.energy_span / (cfg.energy_tol * ENERGY_STEP_FRACTION * cfg.dt_max)
+        if e_err > err and not jump_kept(sw.chase, t, h, d_res):
+            err = e_err
+            by_energy = True
     retry = -1
     if err > REJECT_FACTOR and st.clock[H_LAST] > 0.0:
         new_level = max(level_for(h * max(0.2, 0.9 / math.sqrt(err)), cfg), level + 1)
         if new_level < N_LEVELS and level_step(dyadic_round(new_level, cfg), cfg) < level_step(level, cfg):
             retry = new_level
+    if retry >= 0 and by_energy and sw.chase[0] != t:
+        sw.chase[0] = t
+        sw.chase[1] = abs(d_res)
+        sw.chase[2] = h
     return err, retry, work, fric_work
+
+
+@njit(cache=True)
+def jump_kept(chase, t, h, d_res) -> bool:
+    """Whether the residual's change d_res over this retried step from t is a jump that the
+    smaller step did not shrink (JUMP_STEP, JUMP_KEPT against the first step at t that the
+    energy term rejected, `chase`), to be accepted rather than chased down to dt_min."""
+    return chase[0] == t and h <= JUMP_STEP * chase[2] and abs(d_res) >= JUMP_KEPT * chase[1]
 
 
 @njit(cache=True)
@@ -386,6 +411,12 @@ def start(sw, t, st, g, cfg):
 def no_body_start(sw):
     """`start` without an elastic body: nothing stored (0, 0) [J]."""
     return 0.0, 0.0
+
+
+@njit(cache=True)
+def no_weight():
+    """The weight's work on an elastic body without one: 0 [J]."""
+    return 0.0
 
 
 @njit(cache=True)
