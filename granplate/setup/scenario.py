@@ -619,10 +619,11 @@ class Solver:
 
     scheme: "implicit" (default: Newton on the interface forces with the plate-contact
     friction held over the step, plate modes integrated exactly, step from an error
-    estimate), "paper" (the paper's fixed-point interpolation-iteration with the
-    criterion (8) step control) or "verlet" (velocity Verlet of the granules alone, no
-    plate: one normal-force pass per fixed step time.dt_max, friction split off exactly;
-    docs/model.md section 6.5);
+    estimate; an elastic solid in 3D by a fixed point within each step, section 6.7),
+    "paper" (the paper's fixed-point interpolation-iteration with the criterion (8) step
+    control; the plane's plate only) or "verlet" (velocity Verlet of the granules and of
+    an elastic solid in 3D, not of the plane's plate: one normal-force pass per fixed
+    step time.dt_max, friction split off exactly; docs/model.md section 6.5);
     lambda_target: the local-map modulus the step control aims for (< 1);
     iteration_rtol, iteration_atol [N]: convergence of the interface forces;
     max_iterations: per step before the step is retried at half size;
