@@ -27,7 +27,7 @@ import time
 import numpy as np
 
 from granplate.model.arrays import masses_and_inertias, pair_coefficients, wall_arrays
-from granplate.physics.contact import N_COEF
+from granplate.physics.contact import COEF_XT, N_COEF
 from granplate.setup import pouring
 from granplate.setup.pairs import close_pairs
 from granplate.setup.scenario import PouredLayout, Scenario
@@ -63,6 +63,48 @@ STATIC_STEP = 0.5
 STEP_GROWTH = 4.0
 
 
+def settling_rows(coef: np.ndarray, x_t: np.ndarray | None, damped: bool) -> np.ndarray:
+    """Contact rows `coef` as the settling runs them (docs/model.md section 3.14): Mindlin's
+    tangential damping ratio (COEF_XT) the contacts' own, x_t (None: coef's), where
+    `damped`, else 0. The settling runs without it at first (`tangential_damping_on`): under
+    their own weight millimetre granules touch with overlaps of nanometres, where that
+    damping, x_t c delta^(1/4), holds a granule that rolls or slides off its rest to a
+    viscous creep at the slip rate F / eta for tenths of a second; without it the granule
+    reaches its new rest in milliseconds and Cundall's damping takes the energy. Where a
+    packing in balance still moves after a quench, it is on again and takes what rolls and
+    spins freely. A static state is the same with or without a damping: only the path to
+    it changes."""
+    out = np.ascontiguousarray(coef, float).copy()
+    out[:, COEF_XT] = (coef[:, COEF_XT] if x_t is None else x_t) if damped else 0.0
+    return out
+
+
+#: Mindlin's tangential damping is turned on (for the rest of the settling) at the
+#: BALANCED_CHUNKS-th chunk that ends in balance: a packing in balance is quenched, and one
+#: that a quench did not bring to rest still moves freely (rolling, spinning), which that
+#: damping takes (`settling_rows`).
+BALANCED_CHUNKS = 2
+
+
+def tangential_damping_on(p: "Packing", out: "Outcome", lay: PouredLayout) -> bool:
+    """Whether the next chunk runs with Mindlin's tangential damping (`settling_rows`): off
+    until BALANCED_CHUNKS chunks at the real stiffness have ended in balance (every
+    residual force at most settle_residual of a weight), on from then."""
+    if p.s >= 1.0 and out.residual <= lay.settle_residual:
+        p.balanced += 1
+    return p.damped or p.balanced >= BALANCED_CHUNKS
+
+
+def set_tangential_damping(p: "Packing", damped: bool) -> None:
+    """The settling's pair and wall rows with Mindlin's tangential damping on or off
+    (`settling_rows`)."""
+    if damped == p.damped:
+        return
+    p.damped = damped
+    p.pcoef = settling_rows(p.pcoef, p.xt_pairs, damped)
+    p.wcoef = settling_rows(p.wcoef, p.xt_walls, damped)
+
+
 @dataclasses.dataclass
 class Packing:
     """The granules' state and contact lists of a ramped settling (3D arrays, SI units)."""
@@ -88,6 +130,10 @@ class Packing:
     touch: np.ndarray
     start: np.ndarray
     s: float
+    xt_walls: np.ndarray | None = None  # the wall rows' own tangential damping ratio
+    xt_pairs: np.ndarray | None = None  # the listed pairs' own
+    damped: bool = False  # Mindlin's tangential damping on (`settling_rows`)
+    balanced: int = 0  # chunks at the real stiffness that ended in balance
 
     @property
     def skin(self) -> float:
@@ -123,7 +169,7 @@ def packing(s: Scenario, lay: PouredLayout) -> Packing:
         inertia,
         np.asarray(pouring.pour_gravity(s, lay), float),
         walls,
-        np.ascontiguousarray(wcoef),
+        settling_rows(wcoef, None, False),
         np.zeros((n * nw, kernel.N_HIST)),
         empty,
         np.zeros((0, N_COEF)),
@@ -134,6 +180,7 @@ def packing(s: Scenario, lay: PouredLayout) -> Packing:
         np.zeros(n, np.int64),
         release_centres(s, lay),
         1.0 / lay.settle_softening,
+        xt_walls=np.ascontiguousarray(wcoef[:, COEF_XT], float),
     )
     relist(p)
     kernel.contact_forces(*_force_args(p), p.s, 0.0, False, p.f, p.tq, p.touch)
@@ -158,7 +205,9 @@ def relist(p: Packing) -> None:
         hit = old[at] == new
         hist[hit] = p.phist[at[hit]]
     p.pairs = np.ascontiguousarray(cand, np.int64)
-    p.pcoef = np.ascontiguousarray(pair_coefficients(p.scenario, p.mats, r, p.mass, p.pairs))
+    rows = pair_coefficients(p.scenario, p.mats, r, p.mass, p.pairs)
+    p.xt_pairs = np.ascontiguousarray(rows[:, COEF_XT], float)
+    p.pcoef = settling_rows(rows, None, p.damped)
     p.phist = hist
     p.x_ref = p.x.copy()
 
@@ -296,6 +345,7 @@ def _settle_ramped(s: Scenario, lay: PouredLayout, progress: bool) -> tuple[Pack
         falling = falling and out.kinetic > RAMP_BELOW
         if falling and out.kinetic <= QUENCH_BELOW:
             _quench(p, out)  # the fall is over: what still moves is rolling and spinning
+        set_tangential_damping(p, tangential_damping_on(p, out, lay))
         if p.s < 1.0 or out.residual > lay.settle_residual:
             continue
         if out.kinetic <= lay.settle_tolerance:
