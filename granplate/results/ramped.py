@@ -62,12 +62,18 @@ RAMP_FACTOR = 2.0
 STATIC_STEP = 0.5
 STEP_GROWTH = 4.0
 
+#: Mindlin's tangential damping is turned on (for the rest of the settling) at the
+#: BALANCED_CHUNKS-th chunk that ends in balance: a packing in balance is quenched, and one
+#: that a quench did not bring to rest still moves freely (rolling, spinning), which that
+#: damping takes (`settling_rows`).
+BALANCED_CHUNKS = 2
 
-def settling_rows(coef: np.ndarray, x_t: np.ndarray | None, damped: bool) -> np.ndarray:
+
+def settling_rows(coef: np.ndarray, x_t: np.ndarray, damped: bool) -> np.ndarray:
     """Contact rows `coef` as the settling runs them (docs/model.md section 3.14): Mindlin's
-    tangential damping ratio (COEF_XT) the contacts' own, x_t (None: coef's), where
-    `damped`, else 0. The settling runs without it at first (`tangential_damping_on`): under
-    their own weight millimetre granules touch with overlaps of nanometres, where that
+    tangential damping ratio (COEF_XT) the contacts' own, x_t, where `damped`, else 0. The
+    settling runs without it at first (`tangential_damping_on`): under their own weight
+    millimetre granules touch with overlaps of nanometres, where that
     damping, x_t c delta^(1/4), holds a granule that rolls or slides off its rest to a
     viscous creep at the slip rate F / eta for tenths of a second; without it the granule
     reaches its new rest in milliseconds and Cundall's damping takes the energy. Where a
@@ -75,15 +81,8 @@ def settling_rows(coef: np.ndarray, x_t: np.ndarray | None, damped: bool) -> np.
     spins freely. A static state is the same with or without a damping: only the path to
     it changes."""
     out = np.ascontiguousarray(coef, float).copy()
-    out[:, COEF_XT] = (coef[:, COEF_XT] if x_t is None else x_t) if damped else 0.0
+    out[:, COEF_XT] = x_t if damped else 0.0
     return out
-
-
-#: Mindlin's tangential damping is turned on (for the rest of the settling) at the
-#: BALANCED_CHUNKS-th chunk that ends in balance: a packing in balance is quenched, and one
-#: that a quench did not bring to rest still moves freely (rolling, spinning), which that
-#: damping takes (`settling_rows`).
-BALANCED_CHUNKS = 2
 
 
 def tangential_damping_on(p: "Packing", out: "Outcome", lay: PouredLayout) -> bool:
@@ -169,7 +168,7 @@ def packing(s: Scenario, lay: PouredLayout) -> Packing:
         inertia,
         np.asarray(pouring.pour_gravity(s, lay), float),
         walls,
-        settling_rows(wcoef, None, False),
+        settling_rows(wcoef, wcoef[:, COEF_XT], False),
         np.zeros((n * nw, kernel.N_HIST)),
         empty,
         np.zeros((0, N_COEF)),
@@ -207,7 +206,7 @@ def relist(p: Packing) -> None:
     p.pairs = np.ascontiguousarray(cand, np.int64)
     rows = pair_coefficients(p.scenario, p.mats, r, p.mass, p.pairs)
     p.xt_pairs = np.ascontiguousarray(rows[:, COEF_XT], float)
-    p.pcoef = settling_rows(rows, None, p.damped)
+    p.pcoef = settling_rows(rows, p.xt_pairs, p.damped)
     p.phist = hist
     p.x_ref = p.x.copy()
 
