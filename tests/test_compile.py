@@ -51,46 +51,25 @@ def _fresh_function():
     return f
 
 
-def test_loop_signatures_name_their_scheme_and_dimension():
-    """(scheme, dimension) of loop.advance's signature: the scratch's module names the scheme,
-    the granular arrays' class the dimension."""
-    from granplate.model.inputs import Granular, Granular3
+def test_loop_signatures_name_their_scheme_dimension_and_solid():
+    """(scheme, dimension, solid) of loop.advance's signature: the scratch's module names the
+    scheme, the granular arrays' class the dimension, the body arrays' class whether the run
+    has an elastic solid (model.inputs.BodyArrays; NoBodyArrays is a run without)."""
+    from granplate.model.inputs import BodyArrays, Granular, Granular3, NoBodyArrays
     from granplate.solver.compiling import loop_key
     from granplate.solver.schemes import implicit, verlet
 
-    def sig(g, sw):
-        return (
-            None,
-            None,
-            types.SimpleNamespace(instance_class=g),
-            None,
-            None,
-            None,
-            None,
-            types.SimpleNamespace(instance_class=sw),
-            None,
-        )
+    def sig(g, sw, body=NoBodyArrays):
+        def of(cls):
+            return types.SimpleNamespace(instance_class=cls)
+
+        return (None, None, of(g), None, of(body), None, None, None, of(sw), None)
 
     assert loop_key(sig(Granular3, verlet.Scratch)) == ("verlet", 3, False)
+    assert loop_key(sig(Granular3, verlet.Scratch, BodyArrays)) == ("verlet", 3, True)
+    assert loop_key(sig(Granular3, implicit.Scratch, BodyArrays)) == ("implicit", 3, True)
     assert loop_key(sig(Granular, implicit.Scratch)) == ("implicit", 2, False)
     assert loop_key(("too", "short")) is None
-
-
-def test_loop_signatures_name_whether_they_carry_a_solid():
-    """A scratch whose body arrays are model.inputs.BodyArrays is the loop with an elastic
-    solid; NoBodyArrays (a run without) is not."""
-    from granplate.model.inputs import BodyArrays, NoBodyArrays
-    from granplate.solver.compiling import carries_solid
-    from granplate.solver.schemes import implicit
-
-    def scratch(body):
-        fields = implicit.Scratch._fields
-        member = [types.SimpleNamespace(instance_class=None)] * len(fields)
-        member[fields.index("body")] = types.SimpleNamespace(instance_class=body)
-        return types.SimpleNamespace(instance_class=implicit.Scratch, types=tuple(member))
-
-    assert carries_solid(scratch(BodyArrays)) and not carries_solid(scratch(NoBodyArrays))
-    assert not carries_solid(types.SimpleNamespace(instance_class=implicit.Scratch))
 
 
 def test_missing_sets_are_those_whose_loop_is_not_compiled():

@@ -112,7 +112,7 @@ def test_run_whose_clock_stops_ends_with_a_message(monkeypatch):
     model = gp.build_model(gp.with_changes(gp.preset("steel-r1"), {"time.t_end": 1e-5}))
     calls = []
 
-    def frozen(t_stop, budget, g, p, cfg, st, w, sw, out):
+    def frozen(t_stop, budget, g, p, b, cfg, st, w, sw, out):
         calls.append(budget)
         st.count[driver.S.C_RETRIES] += 1
         return driver.S.PAUSED

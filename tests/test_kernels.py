@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from granplate.model.inputs import SCHEME_NAMES, Config, Granular, PlateArrays, scheme_number
+from granplate.model.inputs import SCHEME_NAMES, Config, Granular, PlateArrays, no_body, scheme_number
 from granplate.physics.contact import N_COEF
 from granplate.solver import loop, schemes, state as S
 from granplate.solver.plate_modal import step_matrices
@@ -95,6 +95,7 @@ def one_mode_run(scheme: str, omega_h: float, n_steps: int = 1, budget: int = 10
     )
     st, w_, out = S.new_state(0, 1, 0), S.new_work(0, 1, 0), S.new_output(np.array([0.0, n_steps * h]), 0, 1, 0)
     sw = schemes.scheme(scheme).new_scratch(0, 1, 0)
+    b = no_body(0, 1)
     st.q[0] = 1.0
     loop.initialise(st, g, p, cfg, w_)
     loop.record(0, st, g, p, w_, out)
@@ -102,7 +103,7 @@ def one_mode_run(scheme: str, omega_h: float, n_steps: int = 1, budget: int = 10
     calls = 0
     status = S.PAUSED
     while status == S.PAUSED:
-        status = loop.advance(n_steps * h, budget, g, p, cfg, st, w_, sw, out)
+        status = loop.advance(n_steps * h, budget, g, p, b, cfg, st, w_, sw, out)
         calls += 1
     return status, st, out, calls
 
@@ -163,4 +164,4 @@ def test_registry_names_and_refusals():
     with pytest.raises(ValueError, match="scheme number 7"):
         schemes.scheme(7)
     with pytest.raises(NotImplementedError):
-        schemes.attempt(None, 0, 0, 0, None, None, None, None, None)
+        schemes.attempt(None, 0, 0, 0, None, None, None, None, None, None)

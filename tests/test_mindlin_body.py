@@ -223,12 +223,12 @@ def test_restart_mid_contact_equals_the_straight_run_bitwise():
     s = scenario(vx=0.05, vz=-0.2, wy=100.0, t_end=3e-5, n_out=30)
     straight = run(s)
     first = run(s, t_end=1.3e-5)
-    assert np.abs(restart_state(first)["sw.body.hist"][0, HIST_XI : HIST_XI + 3]).max() > 0.0  # in touch, loaded
+    assert np.abs(restart_state(first)["b.hist"][0, HIST_XI : HIST_XI + 3]).max() > 0.0  # in touch, loaded
     rest = run(s, start_from=first)
     n = rest.sizes["time"]
     for name in ("x", "z", "vx", "vz", "omega_y", "E_granular", "E_plate", "D_friction", "energy_residual"):
         np.testing.assert_array_equal(rest[name].values, straight[name].values[-n:], err_msg=name)
     s0, s1 = restart_state(straight), restart_state(rest)
-    for key in ("st.q", "st.qd", "sw.body.hist"):
+    for key in ("st.q", "st.qd", "b.hist"):
         np.testing.assert_array_equal(s1[key], s0[key], err_msg=key)
     assert float(straight["D_friction"].values[-1]) > 0.0

@@ -78,30 +78,26 @@ def compile_clock() -> Iterator[CompileClock]:
 
 def loop_key(sig: tuple) -> tuple[str, int, bool] | None:
     """(scheme, dimension, solid) of a signature of `loop.advance` (its arguments t_stop,
-    max_attempts, g, p, cfg, st, w, sw, out): the dimension from g's class (Granular or
+    max_attempts, g, p, b, cfg, st, w, sw, out): the dimension from g's class (Granular or
     Granular3), the scheme from the module of sw's class (its Scratch), solid from the type
-    of the scratch's body arrays (carries_solid); None when unknown."""
+    of the body arrays b (carries_solid); None when unknown."""
     try:
-        g, sw = sig[2], sig[7]
+        g, b, sw = sig[2], sig[4], sig[8]
         scheme = getattr(__import__(sw.instance_class.__module__, fromlist=["NAME"]), "NAME")
         from granplate.model.dimension import of_arrays
 
         dimension = of_arrays(g.instance_class).n
     except (AttributeError, IndexError, ImportError, TypeError, ValueError):
         return None
-    return str(scheme), dimension, carries_solid(sw)
+    return str(scheme), dimension, carries_solid(b)
 
 
-def carries_solid(scratch_type) -> bool:
-    """Whether a scheme's Scratch type carries an elastic body's arrays (its field `body`
-    of type model.inputs.BodyArrays; NoBodyArrays, or no such field, is a run without)."""
+def carries_solid(body_type) -> bool:
+    """Whether the loop's body arrays (their numba type) are an elastic body's
+    (model.inputs.BodyArrays; NoBodyArrays is a run without)."""
     from granplate.model.inputs import BodyArrays
 
-    try:
-        body = scratch_type.types[scratch_type.instance_class._fields.index("body")]
-    except (AttributeError, IndexError, ValueError):
-        return False
-    return getattr(body, "instance_class", None) is BodyArrays
+    return getattr(body_type, "instance_class", None) is BodyArrays
 
 
 def compiled_loops() -> set[tuple[str, int, bool]]:

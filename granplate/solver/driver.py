@@ -185,7 +185,7 @@ def _loop_chunks(times, model, arr: LoopArrays, should_stop, on_progress, lists,
             n0 = st.count[S.C_STEPS] + st.count[S.C_RETRIES]
             t_before = st.clock[S.T_NOW]
             t0 = time.perf_counter()
-            status = loop.advance(float(times[o_stop]), budget, lists.g, arr.p, cfg, st, arr.w, arr.sw, arr.out)
+            status = loop.advance(float(times[o_stop]), budget, lists.g, arr.p, arr.b, cfg, st, arr.w, arr.sw, arr.out)
             attempts = int(st.count[S.C_STEPS] + st.count[S.C_RETRIES] - n0)
             budget = next_budget(budget, attempts, time.perf_counter() - t0)
             idle = idle + max(attempts, 1) if st.clock[S.T_NOW] <= t_before else 0
@@ -314,35 +314,35 @@ def run(
     st.count[S.C_LEVEL] = level_for(model.scenario.time.dt_initial, cfg)
     calls = [
         (loop.initialise, (st, lists.g, arr.p, cfg, w)),
-        (loop.start_scheme, (arr.sw, st, lists.g, cfg)),
+        (loop.start_scheme, (arr.sw, st, lists.g, arr.b, cfg)),
         (loop.record, (0, st, lists.g, arr.p, w, arr.out)),
-        *sensor_calls(arr.sw, st, lists.g, cfg, arr.out),
-        (loop.advance, (float(times[-1]), FIRST_BUDGET, lists.g, arr.p, cfg, st, arr.w, arr.sw, arr.out)),
+        *sensor_calls(arr, st, lists.g, cfg),
+        (loop.advance, (float(times[-1]), FIRST_BUDGET, lists.g, arr.p, arr.b, cfg, st, arr.w, arr.sw, arr.out)),
     ]
     t1 = time.perf_counter()
     note_compile(model, calls)
     compile_calls(calls)  # before the bar and the loop's clock: neither counts the compile
     loop.initialise(st, lists.g, arr.p, cfg, w)
-    loop.start_scheme(arr.sw, st, lists.g, cfg)
+    loop.start_scheme(arr.sw, st, lists.g, arr.b, cfg)
     loop.record(0, st, lists.g, arr.p, w, arr.out)
-    first_sensor_sample(model, arr.sw, st, lists.g, arr.out)
+    first_sensor_sample(model, arr, st, lists.g)
     st.count[S.C_OUT] = 1
     return _finish(model, times, arr, lists, t1, progress, should_stop, interruptible)
 
 
-def sensor_calls(sw, st: S.State, g, cfg, out: S.Output) -> list[tuple]:
+def sensor_calls(arr: LoopArrays, st: S.State, g, cfg) -> list[tuple]:
     """The compiled call a run with sensors makes from Python (its first sample), to
     compile before the loop's clock starts; none without sensors."""
-    return [(loop.record_sensors, (sw, st, g, cfg, out))] if len(out.sensor_granule) else []
+    return [(loop.record_sensors, (arr.sw, st, g, arr.b, cfg, arr.out))] if len(arr.out.sensor_granule) else []
 
 
-def first_sensor_sample(model: Model, sw, st: S.State, g, out: S.Output) -> None:
+def first_sensor_sample(model: Model, arr: LoopArrays, st: S.State, g) -> None:
     """The sensors' sample at the run's first output time, when it is a sample time (to
     SNAP_RTOL intervals: a restart's clock is the first run's end, to its rounding)."""
-    if not len(out.sensor_target):
+    if not len(arr.out.sensor_target):
         return
-    if out.sensor_target[0] <= st.clock[S.T_NOW] + SNAP_RTOL * sensor_interval(model.scenario):
-        loop.record_sensors(sw, st, g, model.config, out)
+    if arr.out.sensor_target[0] <= st.clock[S.T_NOW] + SNAP_RTOL * sensor_interval(model.scenario):
+        loop.record_sensors(arr.sw, st, g, arr.b, model.config, arr.out)
 
 
 def _run_from(model: Model, start: dict, progress: bool, should_stop, interruptible: bool) -> RunRecord:
@@ -359,14 +359,14 @@ def _run_from(model: Model, start: dict, progress: bool, should_stop, interrupti
     st = arr.st
     calls = [
         (loop.record, (0, st, lists.g, arr.p, arr.w, arr.out)),
-        *sensor_calls(arr.sw, st, lists.g, cfg, arr.out),
-        (loop.advance, (float(times[-1]), FIRST_BUDGET, lists.g, arr.p, cfg, st, arr.w, arr.sw, arr.out)),
+        *sensor_calls(arr, st, lists.g, cfg),
+        (loop.advance, (float(times[-1]), FIRST_BUDGET, lists.g, arr.p, arr.b, cfg, st, arr.w, arr.sw, arr.out)),
     ]
     c1 = time.perf_counter()
     note_compile(model, calls)
     compile_calls(calls)
     loop.record(0, st, lists.g, arr.p, arr.w, arr.out)
-    first_sensor_sample(model, arr.sw, st, lists.g, arr.out)
+    first_sensor_sample(model, arr, st, lists.g)
     st.count[S.C_OUT] = 1
     return _finish(model, times, arr, lists, c1, progress, should_stop, interruptible, first=o1)
 
@@ -413,7 +413,7 @@ def _finish(
         "overlap_warnings": overlap_warnings(model, w),
     }
     message = "ok" if status == S.OK else status_message(status, model, st)
-    body = getattr(arr.sw, "body", None) if model.body is not None else None
+    body = arr.b if model.body is not None else None
     for line in info["overlap_warnings"]:
         warnings.warn(
             f"{model.scenario.name}: {line}: Hertz's law assumes overlaps small against the radii.",

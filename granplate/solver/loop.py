@@ -129,10 +129,10 @@ def initialise(st, g, p, cfg, w):
 
 
 @njit(entry=True, cache=True)
-def start_scheme(sw, st, g, cfg):
-    """What the scheme adds at t = 0 after `initialise` (its hook `start`): an elastic
-    body's contact energies (solver.body) join E_pot, E_p and E_0."""
-    e_pot, e_static = S.start(sw, st.clock[T_NOW], st, g, cfg)
+def start_scheme(sw, st, g, b, cfg):
+    """What the scheme adds at t = 0 after `initialise` (its hook `start`): the contact
+    energies of the elastic body in space b (solver.body) join E_pot, E_p and E_0."""
+    e_pot, e_static = S.start(sw, st.clock[T_NOW], st, g, b, cfg)
     if e_pot != 0.0 or e_static != 0.0:
         st.clock[E_POT] += e_pot
         st.clock[E_STATIC] = e_static
@@ -225,14 +225,14 @@ def record(o, st, g, p, w, out):
 
 
 @njit(entry=True, cache=True)
-def record_sensors(sw, st, g, cfg, out):
+def record_sensors(sw, st, g, b, cfg, out):
     """Write every sensor's reading at t_n into the next sensor row (docs/model.md section
     3.15): half the sum of the normal forces on its granule, of its pair and wall contacts
     (`sensor_loads`), of its plate contacts (their |N| at t_n) and of its contact with the
-    scheme's own body (the hook body_sensor_loads of the scheme whose scratch is sw)."""
+    elastic body in space b (the hook body_sensor_loads of the scheme whose scratch is sw)."""
     s = out.sensor_n[0]
     sensor_loads(st.y, g, cfg, out.sensor_load)
-    S.body_sensor_loads(sw, out.sensor_load)
+    S.body_sensor_loads(sw, b, out.sensor_load)
     for k in range(g.pc_i.shape[0]):
         out.sensor_load[g.pc_i[k]] += 0.5 * st.normal[k]
     out.sensor_t[s] = st.clock[T_NOW]
@@ -347,9 +347,10 @@ def accept_granular(t, h, land, t_out, plate_work, e_pot, st, w, rows):
 
 
 @njit(entry=True, cache=True, **NO_REFCOUNT)
-def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
+def advance(t_stop, max_attempts, g, p, b, cfg, st, w, sw, out):
     """Advance from st.clock[T_NOW] to t_stop (an output time) with the scheme whose
-    scratch is sw, trying at most max_attempts steps. Returns a status: OK, PAUSED
+    scratch is sw, trying at most max_attempts steps; the elastic bodies are p (the modal
+    plate) and b (the elastic body in space, or NoBodyArrays). Returns a status: OK, PAUSED
     (budget spent; call again) or an error, with st.err filled and the state the last
     accepted one. Steps land on the output times and on the sensors' sample times
     (out.sensor_target; `record_sensors` at each). After every accepted step the patch
@@ -371,7 +372,7 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
             prepare_slot(sw, h, slot, st, p, w)
         ratio = h / st.clock[H_LAST] if st.clock[H_LAST] > 0.0 else 0.0
         first_guess(ratio, st, w)
-        converged, it, worst, e_pot, rate = S.attempt(sw, t, h, slot, st, g, p, cfg, w)
+        converged, it, worst, e_pot, rate = S.attempt(sw, t, h, slot, st, g, p, b, cfg, w)
         st.count[C_ITERS] += it
         if not converged:
             restore_pistons(g)
@@ -381,13 +382,13 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
                 return step_too_small(t, h, it, worst, lam, w.normal_new, w.slip_new, st)
             st.count[C_LEVEL] = level + 4
             continue
-        err, retry, plate_work, fric_work = S.judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w)
+        err, retry, plate_work, fric_work = S.judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, b, cfg, w)
         if retry >= 0:
             restore_pistons(g)
             st.count[C_RETRIES] += 1
             st.count[C_LEVEL] = retry
             continue
-        plate_work = S.commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w)
+        plate_work = S.commit(sw, t, h, slot, plate_work, fric_work, st, g, p, b, cfg, w)
         accept_pistons(g)
         if cfg.threads > 1:  # the copies and the pairs' histories on every core (solver.blocks)
             accept_rows(st.y, st.k0, st.k1, w.ynew, w.kend)
@@ -412,7 +413,7 @@ def advance(t_stop, max_attempts, g, p, cfg, st, w, sw, out):
             return status
         if land:
             if out.sensor_n[0] < out.sensor_target.shape[0] and out.sensor_target[out.sensor_n[0]] <= t_land:
-                record_sensors(sw, st, g, cfg, out)
+                record_sensors(sw, st, g, b, cfg, out)
             if on_output:
                 record(o, st, g, p, w, out)
                 st.count[C_OUT] = o + 1

@@ -1,4 +1,4 @@
-"""The arrays one run advances (the plate's modal arrays, the state, the scratch and the
+"""The arrays one run advances (the elastic bodies' arrays, the state, the scratch and the
 outputs), grown as a whole when patch contacts form on the plate's face (docs/model.md
 section 3.5), and the one path by which every patch contact is placed."""
 
@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from granplate.model.arrays import Model, granular_with_patch_contacts
+from granplate.model.inputs import new_body_state, no_body
 from granplate.physics.contact import plate_overlap
 from granplate.plate.face import patch_weights
 from granplate.solver import loop, state as S
@@ -18,8 +19,10 @@ from granplate.solver.schemes import scheme
 
 class LoopArrays:
     """The arrays one run advances, replaced as a whole when a patch contact is added
-    (their contact dimension grows): the plate's modal arrays (p: its contact rows are
-    this run's own), the state, the shared and the scheme's scratch and the outputs."""
+    (their contact dimension grows): the elastic bodies, p (the modal plate: its contact
+    rows are this run's own) and b (the elastic body in space with this run's own contact
+    state, or NoBodyArrays: none), the state, the shared and the scheme's scratch and the
+    outputs."""
 
     def __init__(self, model: Model, times: np.ndarray, nk: int):
         g, p, cfg = model.granular, model.plate_arrays, model.config
@@ -32,6 +35,7 @@ class LoopArrays:
             for k, y_k in enumerate(model.plate.contact_y[:nk]):
                 first, last = patch_weights(p.face_y, float(y_k), 0.0, self.w.wface)
                 set_face_weights(k, first, last, self.w)
+        self.b = no_body(ng, nm) if model.body is None else new_body_state(model.body)
         self.sw = scheme(cfg.scheme).new_scratch(ng, nm, nk, body=model.body, threads=cfg.threads)
         ts, gs = sensor_setup(model, times)
         self.out = S.new_output(times, ng, nm, nk, nc, len(g.wall_load), len(g.drive_target), ts, gs)
@@ -75,8 +79,8 @@ class LoopArrays:
 
 
 def _copied(old: tuple, new: tuple) -> tuple:
-    """`new` (a named tuple of arrays, or of such tuples: a scheme's scratch holding an
-    elastic body's arrays) with each array's leading block taken from `old`'s."""
+    """`new` (a named tuple of arrays, or of such tuples: the implicit scheme's scratch
+    holding its body step) with each array's leading block taken from `old`'s."""
     for a, b in zip(old, new):
         if isinstance(a, tuple):
             _copied(a, b)

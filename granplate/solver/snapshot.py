@@ -2,8 +2,8 @@
 (a restart, docs/how-to/restart.md).
 
 `capture(arr, lists)`: every array a continued run needs, keyed by a path such as
-"st.y" (the State), "w.ovl" (the shared scratch), "sw.split" or "sw.body.x" (the scheme's
-scratch and the elastic body's state), "p.phi_d" (the plate's contact rows of this run;
+"st.y" (the State), "w.ovl" (the shared scratch), "sw.split" (the scheme's scratch), "b.x"
+(the elastic body in space's contact state; nothing in a run without one), "p.phi_d" (the plate's contact rows of this run;
 its other modal arrays are the model's), "g.pair_hist" (the contact lists and each contact's history: largest overlap, rate
 factor, friction state), "stores.pair_key" / "stores.pair_hist" (the histories of the
 contacts off the lists). The elastic body's model arrays (faces, modes, residual
@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from granplate.model.inputs import NoBodyArrays
 from granplate.solver.state import CUSTOM_H
 
 #: per-level caches, recomputed on first use (their `ok` flags are cleared on restore)
@@ -29,8 +30,11 @@ BODY_MODEL = (
 #: sized by the thread count, which a restart may change)
 BLOCKS = frozenset({"sw.fpar", "sw.spar"})
 #: scratch rewritten before every use
-SCRATCH = frozenset({"sw.body.mrow"})
-LEFT_OUT = CACHES | BLOCKS | SCRATCH | {f"sw.body.{name}" for name in BODY_MODEL}
+SCRATCH = frozenset({"b.mrow"})
+LEFT_OUT = CACHES | BLOCKS | SCRATCH | {f"b.{name}" for name in BODY_MODEL}
+#: the prefix the elastic body's state had in snapshots written when the scheme's scratch
+#: held it (read as "b.")
+FORMER_BODY = "sw.body."
 
 
 def _flat(prefix: str, tup, out: dict[str, np.ndarray]) -> None:
@@ -53,7 +57,8 @@ def _store_arrays(store: dict, n_hist: int) -> tuple[np.ndarray, np.ndarray]:
 def capture(arr, lists) -> dict[str, np.ndarray]:
     """The run's state now (module docstring), as arrays keyed by path."""
     out: dict[str, np.ndarray] = {}
-    for prefix, tup in (("st", arr.st), ("w", arr.w), ("sw", arr.sw), ("g", lists.g)):
+    body = () if isinstance(arr.b, NoBodyArrays) else (("b", arr.b),)  # none: nothing of it to keep
+    for prefix, tup in (("st", arr.st), ("w", arr.w), ("sw", arr.sw), *body, ("g", lists.g)):
         _flat(prefix, tup, out)
     out["p.phi_d"], out["p.resid"] = arr.p.phi_d.copy(), arr.p.resid.copy()  # the rest of p: the model's
     n_hist = lists.g.pair_hist.shape[1]
@@ -101,10 +106,13 @@ def _rebuilt(prefix: str, tup, snap: dict[str, np.ndarray]):
 
 def restore(snap: dict[str, np.ndarray], arr, lists) -> None:
     """Put the captured arrays in place of `arr`'s (a loop_arrays.LoopArrays) and `lists`'s
-    (a run_contacts.ContactLists); the per-level caches start empty."""
+    (a run_contacts.ContactLists); the per-level caches start empty. A snapshot written
+    when the scheme's scratch held the elastic body ("sw.body.x") is read the same."""
+    snap = {"b." + k[len(FORMER_BODY) :] if k.startswith(FORMER_BODY) else k: v for k, v in snap.items()}
     arr.st = _rebuilt("st", arr.st, snap)
     arr.w = _rebuilt("w", arr.w, snap)
     arr.sw = _rebuilt("sw", arr.sw, snap)
+    arr.b = _rebuilt("b", arr.b, snap)
     arr.p = _rebuilt("p", arr.p, snap)
     arr.w.g_ok[:] = 0
     arr.st.clock[CUSTOM_H] = -1.0  # the odd step's matrices too

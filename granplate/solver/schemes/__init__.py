@@ -1,27 +1,34 @@
 """The coupling schemes, one module each, behind one interface, and their registry.
 
 A scheme module defines NAME, a `Scratch` named tuple (its own scratch arrays),
-`new_scratch(ng, nm, nk, body=None, threads=1)`, and nine compiled hooks, each taking its Scratch first:
+`new_scratch(ng, nm, nk, body=None, threads=1)` (sized for the model's elastic body in
+space, `body`, whose arrays it does not hold), and nine compiled hooks, each taking its
+Scratch first. The elastic bodies are the loop's own arrays, beside the granules' g: p,
+the modal plate (model.inputs.PlateArrays: the plane's plate, its contacts in g's `pc_*`
+rows; no modes in space) and b, the elastic body in space (model.inputs.BodyArrays with
+this run's contact state, or NoBodyArrays: none). A scheme that drives no body in space
+takes b and leaves it; one that does chooses its code by b's type when the loop compiles
+(solver.body.by_body):
 
     plan(sw, count, cfg, pos, rem) -> (level, h, slot, land)
     prepare_level(sw, h, p, slot)
-    attempt(sw, t, h, slot, st, g, p, cfg, w) -> (converged, iterations, worst, e_pot, rate)
-    judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w) -> (err, retry, work, fric_work)
-    commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w) -> plate work [J]
+    attempt(sw, t, h, slot, st, g, p, b, cfg, w) -> (converged, iterations, worst, e_pot, rate)
+    judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, b, cfg, w) -> (err, retry, work, fric_work)
+    commit(sw, t, h, slot, plate_work, fric_work, st, g, p, b, cfg, w) -> plate work [J]
     next_level(sw, h, slot, level, err, lam_max, rate, t_now, cfg) -> (level, h_new)
     contact_placed(sw, k, st, p)
     contacts_moved(sw, t, st, p, cfg)
-    start(sw, t, st, g, cfg) -> (contact energy, residual energy) [J] at t = 0
+    start(sw, t, st, g, b, cfg) -> (contact energy, residual energy) [J] at t = 0
 
 and one optional hook, absent from a scheme whose bodies are the granules and the plate
 alone (then it adds nothing):
 
-    body_sensor_loads(sw, load)   half the normal force of each granule's contact with the
-                                  scheme's own body (an elastic solid in space) added to
-                                  its sensor reading load[i] [N] (docs/model.md section 3.15)
+    body_sensor_loads(sw, b, load)   half the normal force of each granule's contact with the
+                                     elastic body in space b added to its sensor reading
+                                     load[i] [N] (docs/model.md section 3.15)
 
-`start` gives what the scheme's own bodies hold at t = 0 (an elastic body in space's
-contacts, solver.body; (0, 0) for the others). The two before it keep the scheme's own driving-DOF state true when the plate contacts' rows
+`start` gives what the bodies hold at t = 0 beyond the loop's own energies (the contacts
+of the elastic body in space b, solver.body; (0, 0) without one). The two before it keep the scheme's own driving-DOF state true when the plate contacts' rows
 of Phi_d change between steps (solver/interface.py, docs/model.md section 3.5):
 `contact_placed` after plate contact k's rows were set with the modes held (a patch
 contact added), `contacts_moved` after loaded patch contacts moved (what depends on
@@ -77,17 +84,17 @@ def prepare_level(sw, h, p, slot):
     raise NotImplementedError("compiled use only")
 
 
-def attempt(sw, t, h, slot, st, g, p, cfg, w):
+def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
     """The scheme's trial step."""
     raise NotImplementedError("compiled use only")
 
 
-def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
+def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, b, cfg, w):
     """The scheme's acceptance test of a converged trial step."""
     raise NotImplementedError("compiled use only")
 
 
-def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
+def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, b, cfg, w):
     """The scheme's plate update of an accepted step."""
     raise NotImplementedError("compiled use only")
 
@@ -122,27 +129,27 @@ def _prepare_level(sw, h, p, slot):
 
 
 @overload(attempt, inline="always")
-def _attempt(sw, t, h, slot, st, g, p, cfg, w):
+def _attempt(sw, t, h, slot, st, g, p, b, cfg, w):
     fn = _hook_of(sw, "attempt")
     if fn is not None:
-        return lambda sw, t, h, slot, st, g, p, cfg, w: fn(sw, t, h, slot, st, g, p, cfg, w)
+        return lambda sw, t, h, slot, st, g, p, b, cfg, w: fn(sw, t, h, slot, st, g, p, b, cfg, w)
 
 
 @overload(judge, inline="always")
-def _judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
+def _judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, b, cfg, w):
     fn = _hook_of(sw, "judge")
     if fn is not None:
-        return lambda sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w: fn(
-            sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w
+        return lambda sw, t, h, slot, level, ratio, e_pot, st, g, p, b, cfg, w: fn(
+            sw, t, h, slot, level, ratio, e_pot, st, g, p, b, cfg, w
         )
 
 
 @overload(commit, inline="always")
-def _commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
+def _commit(sw, t, h, slot, plate_work, fric_work, st, g, p, b, cfg, w):
     fn = _hook_of(sw, "commit")
     if fn is not None:
-        return lambda sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w: fn(
-            sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w
+        return lambda sw, t, h, slot, plate_work, fric_work, st, g, p, b, cfg, w: fn(
+            sw, t, h, slot, plate_work, fric_work, st, g, p, b, cfg, w
         )
 
 
@@ -169,29 +176,29 @@ def _contacts_moved(sw, t, st, p, cfg):
         return lambda sw, t, st, p, cfg: fn(sw, t, st, p, cfg)
 
 
-def start(sw, t, st, g, cfg):
+def start(sw, t, st, g, b, cfg):
     """The scheme's own energies at t = 0."""
     raise NotImplementedError("compiled use only")
 
 
 @overload(start, inline="always")
-def _start(sw, t, st, g, cfg):
+def _start(sw, t, st, g, b, cfg):
     fn = _hook_of(sw, "start")
     if fn is not None:
-        return lambda sw, t, st, g, cfg: fn(sw, t, st, g, cfg)
+        return lambda sw, t, st, g, b, cfg: fn(sw, t, st, g, b, cfg)
 
 
-def body_sensor_loads(sw, load):
+def body_sensor_loads(sw, b, load):
     """The scheme's own body's share of the sensors' readings (none where it has no hook)."""
     raise NotImplementedError("compiled use only")
 
 
 @overload(body_sensor_loads, inline="always")
-def _body_sensor_loads(sw, load):
+def _body_sensor_loads(sw, b, load):
     module = _BY_SCRATCH.get(getattr(sw, "instance_class", None))
     if module is None:
         return None
     fn = getattr(module, "body_sensor_loads", None)
     if fn is None:
-        return lambda sw, load: None
-    return lambda sw, load: fn(sw, load)
+        return lambda sw, b, load: None
+    return lambda sw, b, load: fn(sw, b, load)

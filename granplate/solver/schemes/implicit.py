@@ -27,7 +27,7 @@ from typing import NamedTuple
 import numpy as np
 from granplate.jit import njit
 
-from granplate.model.inputs import STATE_COLUMNS, BodyArrays, new_body_state, no_body
+from granplate.model.inputs import STATE_COLUMNS, no_body
 from granplate.physics.contact import contact_arm, plate_overlap
 from granplate.physics.laws import keeps_history, tangential_friction
 from granplate.physics.energy import energy_residual
@@ -100,17 +100,16 @@ class Scratch(NamedTuple):
     mmat: np.ndarray  # (N_LEVELS + 1, 4, nd, nd) driving-DOF response to the unknowns
     qn: np.ndarray  # (nm,) modes at the end of the step being tried
     qdn: np.ndarray
-    body: BodyArrays  # the elastic body in space and this run's contacts on it (no faces: none)
     bstep: BI.BodyStep  # the body's modes over the step and its fixed point (solver.body_implicit)
     chase: np.ndarray  # (3,) the first step at this t rejected by the energy term: t, |its residual change|, h
 
 
 def new_scratch(ng: int, nm: int, nk: int, body=None, threads: int = 1) -> Scratch:
-    """Scratch for ng granules, nm modes, nk plate contacts, with this run's own copy of
-    the elastic body's contact state (body None: no body)."""
+    """Scratch for ng granules, nm modes, nk plate contacts, and the step state of the
+    model's elastic body in space `body` (None: no body; its arrays are the loop's b)."""
     nd = 2 * nk
     z = np.zeros
-    b = no_body(ng, nm) if body is None else new_body_state(body)
+    b = no_body(ng, nm) if body is None else body
     return Scratch(
         ustar=z((4, nd)),
         jac=z((nd, nd)),
@@ -120,7 +119,6 @@ def new_scratch(ng: int, nm: int, nk: int, body=None, threads: int = 1) -> Scrat
         mmat=z((N_LEVELS + 1, 4, nd, nd)),
         qn=z(nm),
         qdn=z(nm),
-        body=b,
         bstep=BI.body_step_for(b, ng, max(STATE_COLUMNS.values())),
         chase=np.array([np.nan, 0.0, 0.0]),
     )
@@ -176,13 +174,13 @@ def held_friction_target(normal, normal_new, slip_new, g, fnew):
 
 
 @njit(cache=True)
-def attempt(sw, t, h, slot, st, g, p, cfg, w):
+def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
     """Known plate motion, then Newton on the interface unknowns from the guess in
     w.fguess. Returns (converged, iterations, worst contact, stored energy at t + h,
     largest slip relaxation rate of a contact whose friction RK4 integrates). With an
-    elastic body: `body_attempt`, else `plate_attempt`."""
+    elastic body in space b: `body_attempt`, else `plate_attempt`."""
     return B.by_body(
-        sw.body, body_attempt, (sw, t, h, slot, st, g, cfg, w), plate_attempt, (sw, t, h, slot, st, g, p, cfg, w)
+        b, body_attempt, (sw, t, h, slot, st, g, b, cfg, w), plate_attempt, (sw, t, h, slot, st, g, p, cfg, w)
     )
 
 
@@ -212,12 +210,11 @@ def plate_attempt(sw, t, h, slot, st, g, p, cfg, w):
 
 
 @njit(cache=True)
-def body_attempt(sw, t, h, slot, st, g, cfg, w):
+def body_attempt(sw, t, h, slot, st, g, b, cfg, w):
     """The step with an elastic body (solver.body_implicit): the modes' end force F1
     guessed, then RK4 of the granules against the modes' motion under it and F1 relaxed
     towards the end pass's, until they agree to cfg.rtol. Returns as `attempt` (the
     worst contact -1)."""
-    b = sw.body
     bs = sw.bstep
     mc = sw.mcoef[slot]
     for m in range(mc.shape[0]):
@@ -275,20 +272,20 @@ def step_error(ratio, st, g, cfg, w):
 
 
 @njit(cache=True)
-def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
+def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, b, cfg, w):
     """Error of the converged trial step (nothing committed yet): the local error
     estimate and the energy residual's growth (eq. 11) over its share. Returns (error
     relative to error_tol, level to retry at or -1, edge-load work [J], held-friction
     work [J])."""
     fric_work = held_friction_work(st, g, cfg, w)
     work, ep_new = B.by_body(  # the body's modes (and its line load's work), or the plate's
-        sw.body,
+        b,
         BI.end_energy,
-        (t, h, sw.body, sw.bstep, cfg, sw.qn, sw.qdn),
+        (t, h, b, sw.bstep, cfg, sw.qn, sw.qdn),
         exact_correct,
         (t, h, st, p, cfg, sw.mcoef[slot], w.fguess, sw.qn, sw.qdn),
     )
-    w.dacc[4] += B.by_body(sw.body, BI.weight_work, (sw.body, sw.bstep), no_weight, ())  # the body's own weight
+    w.dacc[4] += B.by_body(b, BI.weight_work, (b, sw.bstep), no_weight, ())  # the body's own weight
     kx, ky, kz, kr = kinetic_energies(w.ynew, g)
     e_in = (
         st.clock[E_ZERO]
@@ -348,12 +345,12 @@ def jump_kept(chase, t, h, d_res) -> bool:
 
 
 @njit(cache=True)
-def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
+def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, b, cfg, w):
     """Take the trial step's modes and driving-DOF motion; book the held friction's
     work; with an elastic body, its contacts' histories and the residual's energy at t + h.
     Returns the edge load's work over the step [J]."""
     w.dacc[2] += fric_work
-    st.clock[E_STATIC] = B.by_body(sw.body, BI.accept, (t, h, sw.body, sw.bstep), no_static, (st,))
+    st.clock[E_STATIC] = B.by_body(b, BI.accept, (t, h, b, sw.bstep), no_static, (st,))
     for m in range(st.q.shape[0]):
         st.q[m] = sw.qn[m]
         st.qd[m] = sw.qdn[m]
@@ -399,12 +396,12 @@ def contacts_moved(sw, t, st, p, cfg):
 
 
 @njit(cache=True)
-def start(sw, t, st, g, cfg):
-    """An elastic body's contacts at t = 0 (state y, modes as set): their forces join the
+def start(sw, t, st, g, b, cfg):
+    """The contacts of the elastic body in space b at t = 0 (state y, modes as set): their forces join the
     granules' derivative and viscous power (st.k1, st.p1: every step's first stage), the
     contacts start loaded at their overlaps. Returns (the contacts' stored energy, the
     residual compliance's) [J]; (0, 0) without a body."""
-    return B.by_body(sw.body, body_start, (sw, t, st, g, cfg), no_body_start, (sw,))
+    return B.by_body(b, body_start, (sw, t, st, g, b, cfg), no_body_start, (sw,))
 
 
 @njit(cache=True)
@@ -426,9 +423,8 @@ def no_static(st):
 
 
 @njit(cache=True)
-def body_start(sw, t, st, g, cfg):
+def body_start(sw, t, st, g, b, cfg):
     """`start` with an elastic body (its docstring)."""
-    b = sw.body
     bs = sw.bstep
     cur = int(bs.flags[BI.CUR])
     for m in range(st.q.shape[0]):
@@ -444,7 +440,7 @@ def body_start(sw, t, st, g, cfg):
 
 
 @njit(cache=True)
-def body_sensor_loads(sw, load):
-    """The elastic body's share of the sensors' readings at t_n (load (ng,) [N]): half the
+def body_sensor_loads(sw, b, load):
+    """The elastic body b's share of the sensors' readings at t_n (load (ng,) [N]): half the
     normal force of each granule's contact with it, from t_n's buffer."""
-    B.sensor_loads(sw.body, int(sw.bstep.flags[BI.CUR]), load)
+    B.sensor_loads(b, int(sw.bstep.flags[BI.CUR]), load)

@@ -83,7 +83,7 @@ def stage_motion(h, u, v, aavg, stage):
 
 
 @njit(cache=True)
-def attempt(sw, t, h, slot, st, g, p, cfg, w):
+def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
     """Predictor, then the interpolation-iteration from the guess in w.fguess.
     Returns (converged, iterations, worst contact, stored energy at t + h, largest
     slip relaxation rate of a contact whose friction RK4 integrates)."""
@@ -110,14 +110,14 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
 
 
 @njit(cache=True)
-def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
+def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, b, cfg, w):
     """A converged step is always accepted. Returns (error, retry level = -1, plate
     work = 0, friction work = 0)."""
     return 0.0, -1, 0.0, 0.0
 
 
 @njit(cache=True)
-def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
+def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, b, cfg, w):
     """Advance every mode with the converged forces and the driving DOFs by Newmark
     (a_n+1 of the last iteration); returns the edge load's work over the step [J]."""
     work = newmark_correct(t, h, st, p, cfg, w.dmode[slot], sw.qdd_star, w.fguess)
@@ -172,6 +172,6 @@ def contacts_moved(sw, t, st, p, cfg):
 
 
 @njit(cache=True)
-def start(sw, t, st, g, cfg):
+def start(sw, t, st, g, b, cfg):
     """Nothing at t = 0 beyond the loop's own energies (no elastic body in space)."""
     return 0.0, 0.0

@@ -43,7 +43,7 @@ from typing import NamedTuple
 import numpy as np
 from granplate.jit import njit
 
-from granplate.model.inputs import STATE_COLUMNS, BodyArrays, new_body_state, no_body
+from granplate.model.inputs import STATE_COLUMNS, BodyArrays
 from granplate.physics.contact import COEF_MU
 from granplate.solver import body as B
 from granplate.solver.schemes import verlet_body as VB
@@ -84,24 +84,21 @@ class Scratch(NamedTuple):
     fdamp: np.ndarray  # (2, ng, N_COLUMNS) damping force on each granule [N] (velocity columns)
     fload: np.ndarray  # (2, ng, N_COLUMNS) shock load on each granule [N, N m]
     split: np.ndarray  # (5,) OWED, FORWARD, LAND, STARTED, CURRENT
-    body: BodyArrays  # the elastic body in space and this run's contacts on it (no faces: none)
     fpar: np.ndarray  # (nb, ng, N_FPAR) each block's forces on the granules [N] (solver.blocks; (0, 0, 0): serial)
     spar: np.ndarray  # (nb, N_SPAR) each block's sums (solver.blocks)
 
 
 def new_scratch(ng: int, nm: int, nk: int, body: BodyArrays | None = None, threads: int = 1) -> Scratch:
-    """Scratch for ng granules and nm modes (nk plate contacts: none are used), with this
-    run's own copy of the elastic body's contact state (body None: no body), and the
-    buffers of `threads` blocks (solver.blocks) when it is over 1."""
+    """Scratch for ng granules and nm modes (nk plate contacts: none are used; the elastic
+    body in space is the loop's b, and `body` needs nothing here), and the buffers of
+    `threads` blocks (solver.blocks) when it is over 1."""
     split = np.zeros(5)
     split[FORWARD] = 1.0
-    b = no_body(ng, nm) if body is None else new_body_state(body)
     nb = threads if threads > 1 else 0
     return Scratch(
         fdamp=np.zeros((2, ng, N_COLUMNS)),
         fload=np.zeros((2, ng, N_COLUMNS)),
         split=split,
-        body=b,
         fpar=np.zeros((nb, ng if nb else 0, N_FPAR)),
         spar=np.zeros((nb, N_SPAR)),
     )
@@ -155,30 +152,32 @@ def force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, sw):
 
 
 @njit(cache=True)
-def start(sw, t, st, g, cfg):
-    """The body's contact energies at t = 0 (state y, modes at rest or as set): (the
-    contacts' stored energy, the residual compliance's) [J]; (0, 0) without a body."""
-    return VB.start_energies(sw.body, st.y, int(sw.split[CURRENT]), st, g, cfg, st.k1, sw.fdamp, t)
+def start(sw, t, st, g, b, cfg):
+    """The contact energies of the elastic body in space b at t = 0 (state y, modes at rest
+    or as set): (the contacts' stored energy, the residual compliance's) [J]; (0, 0)
+    without a body."""
+    return VB.start_energies(b, st.y, int(sw.split[CURRENT]), st, g, cfg, st.k1, sw.fdamp, t)
 
 
 @njit(cache=True)
-def copy_state(y, st, sw):
-    """y = st.y (in blocks when the scratch has them), and the trial's modes from t_n's."""
+def copy_state(y, st, b, sw):
+    """y = st.y (in blocks when the scratch has them), and the trial's modes of the body b
+    from t_n's."""
     if sw.spar.shape[0] > 0:
         copy_rows(y, st.y)
     else:
         for i in range(y.shape[0]):
             for c in range(y.shape[1]):
                 y[i, c] = st.y[i, c]
-    VB.modes_from(sw.body, st)
+    VB.modes_from(b, st)
 
 
 @njit(cache=True)
-def first_forces(t, st, g, cfg, sw, cur):
+def first_forces(t, st, g, b, cfg, sw, cur):
     """t_n's forces, loads and damping on the run's first step (st.k1 as `initialise` has
     it; Mindlin's law with the committed histories), the body's too."""
     force_pass(t, st.y, st.y, 0.0, g, cfg, st.k1, sw.fdamp[cur], sw.fload[cur], sw)
-    VB.first_forces(st.y, sw.body, cur, st, g, cfg, st.k1, sw.fdamp)
+    VB.first_forces(st.y, b, cur, st, g, cfg, st.k1, sw.fdamp)
     finish_pass(st.y, st.k1, g)
 
 
@@ -204,20 +203,19 @@ def book(w, wl, d_visc, fric, w_plastic, w_grav, w_drive, p_shock, p_visc, ovl, 
 
 
 @njit(cache=True)
-def attempt(sw, t, h, slot, st, g, p, cfg, w):
+def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
     """One Verlet step from st.y into w.ynew (see the module docstring): the trial's
     accelerations at t + h into w.kend, the load's, damping's, friction's and plastic work
-    into w.dacc, the largest overlap into w.ovl_new / w.ovl_who. With an elastic body
-    (solver.body) its modes take the same kicks from the contact forces and turn exactly
-    over h between them (into sw.body.q, qd, committed by `commit`). Always converged, one
+    into w.dacc, the largest overlap into w.ovl_new / w.ovl_who. With an elastic body in
+    space b (solver.body) its modes take the same kicks from the contact forces and turn
+    exactly over h between them (into b.q, qd, committed by `commit`). Always converged, one
     force pass. Returns (True, 1, -1, stored energy at t + h [J], 0)."""
     y = w.ynew
-    b = sw.body
-    copy_state(y, st, sw)
+    copy_state(y, st, b, sw)
     cur = int(sw.split[CURRENT])
     nxt = 1 - cur
     if sw.split[STARTED] == 0.0:
-        first_forces(t, st, g, cfg, sw, cur)
+        first_forces(t, st, g, b, cfg, sw, cur)
     _, pd0 = wall_powers(g)  # the damping power at the driven walls' velocities at t_n
     hk = 0.5 * h
     friction = has_friction(g, cfg) or VB.body_friction(b)
@@ -266,24 +264,24 @@ def attempt(sw, t, h, slot, st, g, p, cfg, w):
 
 
 @njit(cache=True)
-def body_sensor_loads(sw, load):
-    """The elastic body's share of the sensors' readings at t_n (load (ng,) [N]): half the
+def body_sensor_loads(sw, b, load):
+    """The elastic body b's share of the sensors' readings at t_n (load (ng,) [N]): half the
     normal force of each granule's contact with it, from the force pass of t_n's buffer."""
-    B.sensor_loads(sw.body, int(sw.split[CURRENT]), load)
+    B.sensor_loads(b, int(sw.split[CURRENT]), load)
 
 
 @njit(cache=True)
-def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, cfg, w):
+def judge(sw, t, h, slot, level, ratio, e_pot, st, g, p, b, cfg, w):
     """Every step is accepted (a fixed step). Returns (0, -1, 0, 0)."""
     return 0.0, -1, 0.0, 0.0
 
 
 @njit(cache=True)
-def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, cfg, w):
+def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, b, cfg, w):
     """The trial's end forces become t_n's (the buffers swap); the friction owed is half
     this step, or nothing when it landed on an output time; each friction pass made
     reverses the order of the next. Returns the plate work: 0 (no plate)."""
-    VB.commit_modes(sw.body, st, 1 - int(sw.split[CURRENT]), t + h)  # the modes and the residual's energy at t + h
+    VB.commit_modes(b, st, 1 - int(sw.split[CURRENT]), t + h)  # the modes and the residual's energy at t + h
     sw.split[CURRENT] = 1.0 - sw.split[CURRENT]
     sw.split[STARTED] = 1.0
     land = sw.split[LAND] != 0.0
