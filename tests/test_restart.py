@@ -13,6 +13,7 @@ import pytest
 
 import granplate as gp
 from granplate.errors import ScenarioError
+from granplate.model.inputs import N_HIST, N_HIST_NORMAL
 from granplate.results.dataset import read, write
 from granplate.results.restart import restart_state
 from granplate.results.run import simulate
@@ -56,6 +57,29 @@ def test_implicit_2d_plate_restart_equals_straight_run(plate_runs):
     assert float(straight.D_plastic[-1]) > 0.0 and float(straight.D_friction[-1]) > 0.0  # yield, friction
     assert not any(k.startswith("b.") for k in restart_state(first))  # no body in space: nothing of it kept
     same_end(straight, simulate(s, start_from=from_file))
+
+
+def widened(ds):
+    """ds with its restart state's history rows of four columns widened to N_HIST (as a result
+    written when every run kept 18), the new columns zero."""
+    for name in [str(v) for v in ds.data_vars if str(v).startswith(("restart_g__", "restart_stores__"))]:
+        v = ds[name].values
+        if name.endswith("_hist") and v.ndim == 2 and v.shape[1] == N_HIST_NORMAL:
+            w = np.zeros((v.shape[0], N_HIST))
+            w[:, :N_HIST_NORMAL] = v
+            ds = ds.drop_vars(name).assign({name: ((f"{name}_rows", f"{name}_columns"), w)})
+    return ds
+
+
+def test_history_rows_of_a_run_without_a_history_law_are_the_normal_laws(plate_runs):
+    """Friction without history (tanh): each contact's history is the normal law's four
+    numbers; a result written when the rows were 18 numbers restarts to the same end, bitwise."""
+    s, straight, first, _ = plate_runs
+    state = restart_state(first)
+    assert state["g.pair_hist"].shape[1] == state["g.pc_hist"].shape[1] == N_HIST_NORMAL
+    old = widened(first)
+    assert restart_state(old)["g.pair_hist"].shape[1] == N_HIST
+    same_end(straight, simulate(s, start_from=old))
 
 
 @pytest.mark.filterwarnings("ignore:.*overlap_warn")

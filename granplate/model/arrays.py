@@ -17,7 +17,8 @@ from granplate.model.drives import drive_fields, driven_initial_state
 from granplate.model import loads
 from granplate.model.inputs import Config, Granular, PlateArrays, no_history, scheme_number
 from granplate.errors import ScenarioError
-from granplate.model.coefficients import pair_coefficients, plate_contact_coefficients, wall_arrays
+from granplate.model.coefficients import pair_coefficients, plate_contact_coefficients, scenario_history_columns
+from granplate.model.coefficients import wall_arrays
 
 # the coefficients and the lists replaced during a run have modules of their own; their
 # names are importable from here as before
@@ -370,9 +371,9 @@ def plane_model(s: Scenario) -> Model:
         pc_coef=plate_contact_coefficients(s, mats, r, pc),
         shock_force=fres,
         shock_torque=tres,
-        pair_hist=no_history(len(loop_pairs)),
-        wall_hist=no_history(len(loop_wc)),
-        pc_hist=no_history(len(pc)),
+        pair_hist=no_history(len(loop_pairs), scenario_history_columns(s)),
+        wall_hist=no_history(len(loop_wc), scenario_history_columns(s)),
+        pc_hist=no_history(len(pc), scenario_history_columns(s)),
     )
     drives = drive_fields(s, np.column_stack([x, y]))
     granular = granular._replace(**drives)

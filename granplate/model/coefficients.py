@@ -32,8 +32,15 @@ from granplate.setup.materials import (
     effective_modulus,
     softer_material,
 )
-from granplate.setup.law_registry import HERTZ, NORMAL_LAW_IDS, TANH
+from granplate.model.inputs import history_columns
+from granplate.setup.law_registry import HERTZ, NORMAL_LAW_IDS, TANGENTIAL_LAW_REGISTRY, TANH
 from granplate.setup.scenario import Scenario
+
+
+def scenario_history_columns(s: Scenario) -> int:
+    """The columns of the contacts' history rows of a run of s (model.inputs.history_columns):
+    Mindlin's need them all, the other tangential laws the normal law's four."""
+    return history_columns(TANGENTIAL_LAW_REGISTRY[s.contact.tangential_law].history)
 
 
 def coefficient_row(a: float, c: float, mu: float, k_s: float, law=math.inf, normal_law: int = HERTZ) -> np.ndarray:

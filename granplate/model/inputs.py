@@ -48,6 +48,11 @@ HIST_XI, HIST_A, HIST_F = 4, 7, 8
 N_MINDLIN = 7
 HIST_XI_END, HIST_A_END, HIST_F_END = 11, 14, 15
 N_HIST = 18
+#: the columns a contact's history row has in a run whose tangential law keeps no history
+#: (the normal law's, HIST_MAX to HIST_RATE): a row of 4 numbers, not 18, streamed by every
+#: force pass and history commit (docs/benchmarks.md, "Every core in one run"). Mindlin's
+#: columns are read only where the contact's law keeps a history (laws.keeps_history).
+N_HIST_NORMAL = 4
 
 
 #: columns of Granular.drive_now, each drive's state at the last force pass: its
@@ -67,9 +72,16 @@ DR_SC, DR_VC, DR_AC, DR_KS, DR_KV = range(10, 15)
 N_DRIVE = 15
 
 
-def no_history(n: int) -> np.ndarray:
-    """A zero history for n contacts ((n, N_HIST), columns HIST_*)."""
-    return np.zeros((n, N_HIST))
+def no_history(n: int, columns: int = N_HIST) -> np.ndarray:
+    """A zero history for n contacts ((n, columns), columns HIST_*: N_HIST, or
+    N_HIST_NORMAL in a run without a tangential law with history, `history_columns`)."""
+    return np.zeros((n, columns))
+
+
+def history_columns(history: bool) -> int:
+    """The columns of a run's contact histories: N_HIST where its tangential law keeps a
+    history (Mindlin's), else N_HIST_NORMAL."""
+    return N_HIST if history else N_HIST_NORMAL
 
 
 class Granular(NamedTuple):
@@ -85,8 +97,9 @@ class Granular(NamedTuple):
     unit q0 [m, m^2]; pc_patch: (nk,) int, 1 for a patch contact (its plate rows move
     with the granule, docs/model.md section 3.5), 0 for a rigid layer; empty while
     there is no patch contact (the loop then skips them at no cost); pair_hist,
-    wall_hist, pc_hist: (np, N_HIST), (nw, N_HIST), (nk, N_HIST) each contact's history
-    (columns HIST_*), this run's own (the loop updates them in place).
+    wall_hist, pc_hist: (np, H), (nw, H), (nk, H) each contact's history (columns HIST_*;
+    H = N_HIST, or N_HIST_NORMAL without a tangential law with history: `history_columns`),
+    this run's own (the loop updates them in place).
 
     Gravity and drives (docs/model.md section 3.11; empty: none): gravity (d,) [m/s^2];
     per drive: drive_target (nD,) int, the granule i >= 0 or the wall -1 - w it drives;

@@ -33,7 +33,7 @@ def carried_history(old_keys: np.ndarray, old_hist: np.ndarray, new_keys: np.nda
     if store:
         keys = np.vstack([np.array(list(store), np.int64).reshape(-1, 2), keys])
         rows = np.vstack([np.array(list(store.values()), float).reshape(-1, old_hist.shape[1]), rows])
-    out = no_history(len(new_keys))
+    out = no_history(len(new_keys), old_hist.shape[1])
     store.clear()
     if not len(keys):
         return out
@@ -114,5 +114,5 @@ def granular_with_patch_contacts(model: Model, g: Granular, new: np.ndarray) -> 
             np.vstack([g.pc_coef.reshape(-1, N_COEF), plate_contact_coefficients(s, mats, g.radius, new)])
         ),
         pc_patch=np.concatenate([patch, np.ones(len(new), np.int64)]),
-        pc_hist=np.vstack([g.pc_hist.reshape(-1, g.pc_hist.shape[1]), no_history(len(new))]),
+        pc_hist=np.vstack([g.pc_hist.reshape(-1, g.pc_hist.shape[1]), no_history(len(new), g.pc_hist.shape[1])]),
     )

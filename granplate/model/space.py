@@ -17,6 +17,7 @@ import numpy as np
 
 from granplate.model import loads
 from granplate.model.contacts import contact_lists
+from granplate.model.coefficients import scenario_history_columns
 from granplate.model.inputs import STATE_COLUMNS, Granular3, PlateArrays, no_history
 from granplate.setup.pairs import contact_search_distance, superset_pairs
 from granplate.physics.contact import N_COEF
@@ -132,9 +133,9 @@ def build_space_model(s: Scenario):
         pc_coef=np.zeros((0, N_COEF)),
         shock_force=shares,
         shock_torque=torques,
-        pair_hist=no_history(len(loop_pairs)),
-        wall_hist=no_history(len(loop_wc)),
-        pc_hist=no_history(0),
+        pair_hist=no_history(len(loop_pairs), scenario_history_columns(s)),
+        wall_hist=no_history(len(loop_wc), scenario_history_columns(s)),
+        pc_hist=no_history(0, scenario_history_columns(s)),
     )
     drives = drive_fields(s, np.column_stack([x, y, z]))
     granular = granular._replace(**drives)

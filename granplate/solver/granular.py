@@ -386,10 +386,11 @@ def commit_history(t, hist, coef):
 def commit_rows(t, hist, coef, lo, hi):
     """`commit_history` of contacts lo..hi-1 (written out per row: a compiled call per row
     costs 4.6x this loop, measured on 56,754 rows)."""
+    tangential = hist.shape[1] > HIST_A_END  # rows with a tangential history's columns (model.inputs.history_columns)
     for k in range(lo, hi):
         # a tangential law's history (Mindlin's, docs/model.md section 3.16); a contact out of
         # touch with none, before and after (HIST_A and HIST_A_END zero: its rows are zeros), keeps its zeros
-        if (hist[k, HIST_A_END] != 0.0 or hist[k, HIST_A] != 0.0) and keeps_history(coef[k]):
+        if tangential and (hist[k, HIST_A_END] != 0.0 or hist[k, HIST_A] != 0.0) and keeps_history(coef[k]):
             for col in range(N_MINDLIN):
                 hist[k, HIST_XI + col] = hist[k, HIST_XI_END + col]
         d = hist[k, HIST_END]

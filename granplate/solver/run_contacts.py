@@ -89,9 +89,9 @@ class ContactLists:
         g = model.granular
         # this run's own histories (the loop updates them in place)
         self.g = g._replace(
-            pair_hist=no_history(len(g.pair_ij)),
-            wall_hist=no_history(len(g.wall_i)),
-            pc_hist=no_history(len(g.pc_i)),
+            pair_hist=no_history(len(g.pair_ij), g.pair_hist.shape[1]),
+            wall_hist=no_history(len(g.wall_i), g.wall_hist.shape[1]),
+            pc_hist=no_history(len(g.pc_i), g.pc_hist.shape[1]),
             drive_now=g.drive_now.copy(),
             wall_load=g.wall_load.copy(),
         )

@@ -68,24 +68,30 @@ def capture(arr, lists) -> dict[str, np.ndarray]:
 
 
 def _padded(stored: np.ndarray, fresh) -> np.ndarray:
-    """A stored table with fewer columns than this version's (a result written before a
-    column was added: the drives' state and parameters) completed by the fresh run's columns."""
-    if (
-        isinstance(fresh, np.ndarray)
-        and stored.ndim == 2
-        and fresh.ndim == 2
-        and stored.shape[0] == fresh.shape[0]
-        and stored.shape[1] < fresh.shape[1]
+    """A stored table with fewer columns than this run's (a result written before a column
+    was added: the drives' state and parameters) completed by the fresh run's columns; one
+    with more, the extra ones all zero (history rows written when every run kept Mindlin's
+    columns, model.inputs.history_columns), cut to this run's."""
+    if not (
+        isinstance(fresh, np.ndarray) and stored.ndim == 2 and fresh.ndim == 2 and stored.shape[0] == fresh.shape[0]
     ):
+        return stored
+    if stored.shape[1] < fresh.shape[1]:
         out = fresh.copy()
         out[:, : stored.shape[1]] = stored
         return out
+    if stored.shape[1] > fresh.shape[1] and not np.any(stored[:, fresh.shape[1] :]):
+        return np.ascontiguousarray(stored[:, : fresh.shape[1]])
     return stored
 
 
 def _history_row(h, n_hist: int) -> np.ndarray:
-    """A stored contact's history row, completed with zeros to this version's n_hist
-    columns (a result written before a column was added: Mindlin's tangential history)."""
+    """A stored contact's history row as this run's n_hist columns: completed with zeros (a
+    result written before a column was added: Mindlin's tangential history), or cut where
+    the extra columns are zero (written when every run kept Mindlin's columns)."""
+    h = np.asarray(h, float)
+    if len(h) > n_hist and not np.any(h[n_hist:]):
+        return h[:n_hist].copy()
     out = np.zeros(max(n_hist, len(h)))
     out[: len(h)] = h
     return out
