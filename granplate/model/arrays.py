@@ -356,6 +356,7 @@ def plane_model(s: Scenario) -> Model:
             s.contact.detection,
             "granules touching the face between nodes at t = 0 need patch contacts",
         )
+    columns = scenario_history_columns(s)  # the history rows: 4 numbers, or 18 under a history law
     granular = Granular(
         mass=mass,
         inertia=inertia,
@@ -371,9 +372,9 @@ def plane_model(s: Scenario) -> Model:
         pc_coef=plate_contact_coefficients(s, mats, r, pc),
         shock_force=fres,
         shock_torque=tres,
-        pair_hist=no_history(len(loop_pairs), scenario_history_columns(s)),
-        wall_hist=no_history(len(loop_wc), scenario_history_columns(s)),
-        pc_hist=no_history(len(pc), scenario_history_columns(s)),
+        pair_hist=no_history(len(loop_pairs), columns),
+        wall_hist=no_history(len(loop_wc), columns),
+        pc_hist=no_history(len(pc), columns),
     )
     drives = drive_fields(s, np.column_stack([x, y]))
     granular = granular._replace(**drives)

@@ -118,6 +118,7 @@ def build_space_model(s: Scenario):
     state = initial_state_3d(s)
     wall_geo, wall_coef = wall_arrays(s, mats, r, mass, loop_wc)
     shares, torques = loads.resultants(s, np.column_stack([x, y, z]), r)
+    columns = scenario_history_columns(s)  # the history rows: 4 numbers, or 18 under a history law
     granular = Granular3(
         mass=mass,
         inertia=inertia,
@@ -133,9 +134,9 @@ def build_space_model(s: Scenario):
         pc_coef=np.zeros((0, N_COEF)),
         shock_force=shares,
         shock_torque=torques,
-        pair_hist=no_history(len(loop_pairs), scenario_history_columns(s)),
-        wall_hist=no_history(len(loop_wc), scenario_history_columns(s)),
-        pc_hist=no_history(0, scenario_history_columns(s)),
+        pair_hist=no_history(len(loop_pairs), columns),
+        wall_hist=no_history(len(loop_wc), columns),
+        pc_hist=no_history(0, columns),
     )
     drives = drive_fields(s, np.column_stack([x, y, z]))
     granular = granular._replace(**drives)
