@@ -46,9 +46,10 @@ F_X, F_DX, F_T = 0, 3, 6
 N_FPAR = 9
 #: columns of a block's sums spar[k]: viscous power [W], stored energy [J], plastic work
 #: [J], the largest overlap / smaller radius [-], its granule and its partner (as floats),
-#: the kicks' load and damping work [J], and Mindlin's springs' energy and losses [J].
-S_VISC, S_EPOT, S_PLASTIC, S_OVL, S_OVL_I, S_OVL_J, S_WLOAD, S_WDAMP, S_ET, S_LOST = range(10)
-N_SPAR = 10
+#: the kicks' load and damping work [J], Mindlin's springs' energy and losses [J], and (row
+#: 0: in all) how many granules the last force pass gave a damping force (`gather_forces`).
+S_VISC, S_EPOT, S_PLASTIC, S_OVL, S_OVL_I, S_OVL_J, S_WLOAD, S_WDAMP, S_ET, S_LOST, S_DAMPED = range(11)
+N_SPAR = 11
 
 
 @njit(cache=True)
@@ -57,20 +58,34 @@ def block_range(k, nb, n):
     return (k * n) // nb, ((k + 1) * n) // nb
 
 
+@njit(cache=True)
+def clear_block(k, nb, acc, fdamp, fload, f, n_cols):
+    """Block k's share of a pass's clearing: its buffer's first n_cols columns fpar[k] (f)
+    for every granule, and its own granules' rows (`block_range` over the granules) of acc,
+    fdamp and fload from the velocity columns on."""
+    for i in range(f.shape[0]):
+        for c in range(n_cols):
+            f[i, c] = 0.0
+    lo, hi = block_range(k, nb, acc.shape[0])
+    for i in range(lo, hi):
+        for c in range(3, acc.shape[1]):
+            acc[i, c] = 0.0
+            fdamp[i, c] = 0.0
+            fload[i, c] = 0.0
+
+
 @njit(parallel=True)
-def pair_forces_blocks(y, g, cfg, fpar, spar):
+def pair_forces_blocks(y, g, cfg, fpar, spar, acc, fdamp, fload):
     """The normal forces of every listed granule pair at state y (space), block by block:
-    block k's pairs' forces on their granules into fpar[k] (zeroed first), its viscous
-    power, stored energy, plastic work and largest overlap into spar[k]; each pair's
-    overlap into HIST_END (as solver.granular3d.normal_forces)."""
+    block k clears its buffer fpar[k] and its granules' rows of acc, fdamp and fload
+    (`clear_block`), then puts its pairs' forces on their granules into fpar[k], its
+    viscous power, stored energy, plastic work and largest overlap into spar[k]; each
+    pair's overlap into HIST_END (as solver.granular3d.normal_forces)."""
     nb = fpar.shape[0]
     n_p = g.pair_ij.shape[0]
-    ng = y.shape[0]
     for k in prange(nb):
         f = fpar[k]
-        for i in range(ng):
-            for c in range(F_T):  # (the torque columns are Mindlin's pass's)
-                f[i, c] = 0.0
+        clear_block(k, nb, acc, fdamp, fload, f, F_T)  # (the torque columns are Mindlin's pass's)
         lo, hi = block_range(k, nb, n_p)
         p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, _, _ = pair_forces(
             y, y, 0.0, g, cfg, lo, hi, f, f, F_X, F_DX, F_T, False
@@ -83,77 +98,71 @@ def pair_forces_blocks(y, g, cfg, fpar, spar):
         spar[k, S_OVL_J] = ovl_j
 
 
-@njit(parallel=True)
-def gather_blocks(fpar, acc, fdamp, v0):
-    """Each granule's forces from the blocks, added in block order, into acc and fdamp's
-    columns v0, v0 + 1, v0 + 2 (the velocity columns)."""
+@njit(cache=True)
+def gather_rows(fpar, acc, fdamp, mass, inertia, torques, lo, hi):
+    """`gather_forces` for granules lo..hi-1; returns how many have a damping force."""
     nb = fpar.shape[0]
-    for i in prange(fpar.shape[1]):
+    n_damped = 0
+    for i in range(lo, hi):
+        damped = False
         for c in range(3):
-            s = 0.0
-            d = 0.0
+            s = acc[i, 3 + c]
+            d = fdamp[i, 3 + c]
+            w = acc[i, 6 + c]
             for k in range(nb):
                 s += fpar[k, i, F_X + c]
                 d += fpar[k, i, F_DX + c]
-            acc[i, v0 + c] += s
-            fdamp[i, v0 + c] += d
+                if torques:
+                    w += fpar[k, i, F_T + c]
+            acc[i, 3 + c] = s / mass[i]
+            fdamp[i, 3 + c] = d
+            acc[i, 6 + c] = w / inertia[i]
+            damped = damped or d != 0.0 or fdamp[i, 6 + c] != 0.0
+        if damped:
+            n_damped += 1
+    return n_damped
 
 
 @njit(parallel=True)
-def clear_rows(acc, fdamp, fload, c0):
-    """Zero the columns from c0 on of acc, fdamp and fload, granule by granule."""
-    for i in prange(acc.shape[0]):
-        for c in range(c0, acc.shape[1]):
-            acc[i, c] = 0.0
-            fdamp[i, c] = 0.0
-            fload[i, c] = 0.0
-
-
-@njit(parallel=True)
-def divide_by_inertia(acc, mass, inertia):
-    """Forces and torques into accelerations (space: columns 3-5 and 6-8)."""
-    for i in prange(acc.shape[0]):
-        for c in range(3):
-            acc[i, 3 + c] /= mass[i]
-            acc[i, 6 + c] /= inertia[i]
+def gather_forces(fpar, acc, fdamp, mass, inertia, torques, spar):
+    """Each granule's forces from the blocks, added in block order to what acc and fdamp
+    hold already (the shock's and the walls'), then acc's forces and torques made
+    accelerations: acc[:, 3:6] /= mass, acc[:, 6:9] /= inertia (space's velocity and spin
+    columns); the blocks' torques (F_T) too when `torques` (Mindlin's pass). The granules
+    in blocks; how many of them have a damping force (fdamp not zero) into spar[0,
+    S_DAMPED]."""
+    nb = spar.shape[0]
+    for k in prange(nb):
+        lo, hi = block_range(k, nb, acc.shape[0])
+        spar[k, S_DAMPED] = gather_rows(fpar, acc, fdamp, mass, inertia, torques, lo, hi)
+    n = 0.0
+    for k in range(nb):
+        n += spar[k, S_DAMPED]
+    spar[0, S_DAMPED] = n
 
 
 @njit(cache=True)
 def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
-    """solver.granular3d.normal_forces on every core: the shock (serial), the pairs in
-    blocks (`pair_forces_blocks`), their forces gathered in block order, then the walls in
-    the serial order. Returns the ForceSums (sums over the blocks in block order; the
-    largest overlap's first occurrence in the serial order)."""
-    clear_rows(acc, fdamp, fload, 3)
+    """solver.granular3d.normal_forces on every core: the pairs in blocks
+    (`pair_forces_blocks`, which clear the rows too), the shock (serial), the walls in the
+    serial order, then the blocks' forces gathered in block order with the division by the
+    inertias (`gather_forces`). Returns the ForceSums (sums over the blocks in block order;
+    the largest overlap's first occurrence in the serial order)."""
     begin_pass(t, g)
+    pair_forces_blocks(y, g, cfg, fpar, spar, acc, fdamp, fload)
     p_shock = 0.0
     if not cfg.load_on_plate:
         p_shock = shock_loads(t, y, g, cfg, acc, fload)
-    pair_forces_blocks(y, g, cfg, fpar, spar)
-    gather_blocks(fpar, acc, fdamp, 3)
-    p_visc = 0.0
-    e_pot = 0.0
-    w_plastic = 0.0
-    ovl = 0.0
-    ovl_i = -1
-    ovl_j = -1
-    for k in range(fpar.shape[0]):
-        p_visc += spar[k, S_VISC]
-        e_pot += spar[k, S_EPOT]
-        w_plastic += spar[k, S_PLASTIC]
-        if spar[k, S_OVL] > ovl:
-            ovl = spar[k, S_OVL]
-            ovl_i = int(spar[k, S_OVL_I])
-            ovl_j = int(spar[k, S_OVL_J])
+    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = block_sums(spar)
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
         y, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
     )
-    divide_by_inertia(acc, g.mass, g.inertia)
+    gather_forces(fpar, acc, fdamp, g.mass, g.inertia, False, spar)
     return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
 
 
 @njit(parallel=True)
-def pair_mindlin_blocks(yv, yn, h, g, cfg, fpar, spar):
+def pair_mindlin_blocks(yv, yn, h, g, cfg, fpar, spar, acc, fdamp, fload):
     """`pair_forces_blocks` with Mindlin's law in it (solver.granular3d.pair_forces
     with its tangential step, on block k's pairs, its buffer fpar[k]: forces, damping parts, torques; its sums into
     spar[k], the springs' energy and losses into S_ET, S_LOST). Each contact's tangential
@@ -162,9 +171,7 @@ def pair_mindlin_blocks(yv, yn, h, g, cfg, fpar, spar):
     n_p = g.pair_ij.shape[0]
     for k in prange(nb):
         f = fpar[k]
-        for i in range(f.shape[0]):
-            for c in range(N_FPAR):
-                f[i, c] = 0.0
+        clear_block(k, nb, acc, fdamp, fload, f, N_FPAR)
         lo, hi = block_range(k, nb, n_p)
         pv, ep, wp, ovl, ovl_i, ovl_j, e_t, lost = pair_forces(yv, yn, h, g, cfg, lo, hi, f, f, F_X, F_DX, F_T, True)
         spar[k, S_VISC] = pv
@@ -175,19 +182,6 @@ def pair_mindlin_blocks(yv, yn, h, g, cfg, fpar, spar):
         spar[k, S_OVL_J] = ovl_j
         spar[k, S_ET] = e_t
         spar[k, S_LOST] = lost
-
-
-@njit(parallel=True)
-def gather_torques(fpar, acc, w0):
-    """Each granule's torques from the blocks (F_T), added in block order, into acc's
-    columns w0, w0 + 1, w0 + 2 (the spin columns)."""
-    nb = fpar.shape[0]
-    for i in prange(fpar.shape[1]):
-        for c in range(3):
-            s = 0.0
-            for k in range(nb):
-                s += fpar[k, i, F_T + c]
-            acc[i, w0 + c] += s
 
 
 @njit(cache=True)
@@ -213,19 +207,17 @@ def block_sums(spar):
 
 @njit(cache=True)
 def mindlin_forces_blocks(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar):
-    """solver.mindlin_space.normal_mindlin_forces on every core: the shock (serial), the
-    pairs with their Mindlin forces in blocks (`pair_mindlin_blocks`), their forces and
-    torques gathered in block order, then the walls (normal forces, then Mindlin's) in the
-    serial order. Returns (the ForceSums, the springs' energy [J], their losses [J]), each
+    """solver.mindlin_space.normal_mindlin_forces on every core: the pairs with their
+    Mindlin forces in blocks (`pair_mindlin_blocks`, which clear the rows too), the shock
+    (serial), the walls' normal forces in the serial order, the blocks' forces and torques
+    gathered in block order with the division by the inertias (`gather_forces`), then the
+    walls' Mindlin forces. Returns (the ForceSums, the springs' energy [J], their losses [J]), each
     sum over the blocks in block order."""
-    clear_rows(acc, fdamp, fload, 3)
     begin_pass(t, g)
+    pair_mindlin_blocks(yv, yn, h, g, cfg, fpar, spar, acc, fdamp, fload)
     p_shock = 0.0
     if not cfg.load_on_plate:
         p_shock = shock_loads(t, yn, g, cfg, acc, fload)
-    pair_mindlin_blocks(yv, yn, h, g, cfg, fpar, spar)
-    gather_blocks(fpar, acc, fdamp, 3)
-    gather_torques(fpar, acc, 6)
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = block_sums(spar)
     e_t = 0.0
     lost = 0.0
@@ -235,31 +227,34 @@ def mindlin_forces_blocks(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar):
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
         yn, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
     )
-    divide_by_inertia(acc, g.mass, g.inertia)
+    gather_forces(fpar, acc, fdamp, g.mass, g.inertia, True, spar)
     e_w, lost_w = wall_mindlin(yv, yn, h, g, cfg, acc)
     sums = ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
     return sums, e_t + e_w, lost + lost_w
 
 
 @njit(parallel=True)
-def kick_drift_blocks(y, acc, fdamp, fload, h, ypred, n_drift, spar, predict):
+def kick_drift_blocks(y, acc, fdamp, fload, h, ypred, n_drift, spar, predict, loads, damped):
     """solver.kicks.kick_drift over blocks of granules (each granule's update is the serial
-    one's, bit for bit; the work sums per block into spar[k], S_WLOAD and S_WDAMP). Returns
-    (the load's work, the damping force's work) [J], summed in block order."""
+    one's, bit for bit; the work sums per block into spar[k], S_WLOAD and S_WDAMP; fload
+    and fdamp read only where `loads` and `damped`). Returns (the load's work, the damping
+    force's work) [J], summed in block order."""
     nb = spar.shape[0]
     for k in prange(nb):
         lo, hi = block_range(k, nb, y.shape[0])
-        spar[k, S_WLOAD], spar[k, S_WDAMP] = kick_drift(y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict)
+        spar[k, S_WLOAD], spar[k, S_WDAMP] = kick_drift(
+            y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict, loads, damped
+        )
     return work_sums(spar)
 
 
 @njit(parallel=True)
-def kick_blocks(y, acc, fdamp, fload, hk, dy, n_drift, spar):
+def kick_blocks(y, acc, fdamp, fload, hk, dy, n_drift, spar, loads, damped):
     """solver.kicks.kick over blocks of granules, as `kick_drift_blocks`."""
     nb = spar.shape[0]
     for k in prange(nb):
         lo, hi = block_range(k, nb, y.shape[0])
-        spar[k, S_WLOAD], spar[k, S_WDAMP] = kick(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi)
+        spar[k, S_WLOAD], spar[k, S_WDAMP] = kick(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi, loads, damped)
     return work_sums(spar)
 
 

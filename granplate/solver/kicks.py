@@ -17,20 +17,24 @@ def half_kick(v0: float, a: float, hk: float):
 
 
 @njit(cache=True)
-def kick_drift(y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict=True):
+def kick_drift(y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict=True, loads=True, damped=True):
     """Granules lo..hi-1: the first half kick v += h/2 a (every column from n_drift on),
     the drift x += h v (the columns before), and the state the force pass reads into ypred:
     the new positions, and the velocities predicted at the end, v + h/2 a (predict False:
     the half step's v, as LAMMPS's force pass reads them; solver.verlet_damping). Returns
-    (the load's work, the damping force's work) of the kick [J]: h/2 F (v_before + v_after)/2."""
+    (the load's work, the damping force's work) of the kick [J]: h/2 F (v_before + v_after)/2.
+    fload (fdamp) is not read where `loads` (`damped`) is False: the caller knows it is all
+    zero, and its work is then 0 exactly as the sum would give."""
     hk = 0.5 * h
     w_load = 0.0
     w_damp = 0.0
     for i in range(lo, hi):
         for c in range(n_drift, y.shape[1]):
             v1, dv, vm = half_kick(y[i, c], acc[i, c], hk)
-            w_load += fload[i, c] * vm
-            w_damp += fdamp[i, c] * vm
+            if loads:
+                w_load += fload[i, c] * vm
+            if damped:
+                w_damp += fdamp[i, c] * vm
             y[i, c] = v1
             ypred[i, c] = v1 + dv if predict else v1
         for c in range(n_drift):
@@ -40,17 +44,20 @@ def kick_drift(y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict=True):
 
 
 @njit(cache=True)
-def kick(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi):
+def kick(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi, loads=True, damped=True):
     """Granules lo..hi-1: the closing half kick v += hk a (hk = h/2); dy (the loop's
     derivative at the end of the step) gets the end velocities as the rates of the
-    drifting columns. Returns the load's and the damping force's work [J] as `kick_drift`."""
+    drifting columns. Returns the load's and the damping force's work [J] as `kick_drift`
+    (`loads`, `damped` as there)."""
     w_load = 0.0
     w_damp = 0.0
     for i in range(lo, hi):
         for c in range(n_drift, y.shape[1]):
             v1, _, vm = half_kick(y[i, c], acc[i, c], hk)
-            w_load += fload[i, c] * vm
-            w_damp += fdamp[i, c] * vm
+            if loads:
+                w_load += fload[i, c] * vm
+            if damped:
+                w_damp += fdamp[i, c] * vm
             y[i, c] = v1
         for c in range(n_drift):
             dy[i, c] = y[i, c + n_drift]

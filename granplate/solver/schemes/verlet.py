@@ -47,7 +47,8 @@ from granplate.model.inputs import STATE_COLUMNS, BodyArrays
 from granplate.physics.contact import COEF_MU
 from granplate.solver import body as B
 from granplate.solver.schemes import verlet_body as VB
-from granplate.solver.blocks import N_FPAR, N_SPAR, copy_rows, kick_blocks, kick_drift_blocks
+from granplate.physics.shock import shock_amplitude
+from granplate.solver.blocks import N_FPAR, N_SPAR, S_DAMPED, copy_rows, kick_blocks, kick_drift_blocks
 from granplate.solver.dimension import friction_flow, mindlin_force_pass, normal_forces, normal_forces_blocks
 from granplate.solver.drives import (
     drive_kick_work,
@@ -86,6 +87,7 @@ class Scratch(NamedTuple):
     split: np.ndarray  # (5,) OWED, FORWARD, LAND, STARTED, CURRENT
     fpar: np.ndarray  # (nb, ng, N_FPAR) each block's forces on the granules [N] (solver.blocks; (0, 0, 0): serial)
     spar: np.ndarray  # (nb, N_SPAR) each block's sums (solver.blocks)
+    quiet: np.ndarray  # (2, 2) per buffer: 1 where its loads (column 0), its damping forces (1) are all zero
 
 
 def new_scratch(ng: int, nm: int, nk: int, body: BodyArrays | None = None, threads: int = 1) -> Scratch:
@@ -101,6 +103,7 @@ def new_scratch(ng: int, nm: int, nk: int, body: BodyArrays | None = None, threa
         split=split,
         fpar=np.zeros((nb, ng if nb else 0, N_FPAR)),
         spar=np.zeros((nb, N_SPAR)),
+        quiet=np.zeros((2, 2)),
     )
 
 
@@ -144,11 +147,26 @@ def force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, sw):
     springs in it, their histories moved on by the slip at yv's velocities over h [s] (0:
     the committed histories' forces). Returns (the ForceSums, the springs' stored energy
     [J], their losses [J]; 0 and 0 without Mindlin's law)."""
+    if sw.spar.shape[0] > 0:
+        sw.spar[0, S_DAMPED] = 1.0  # (damped until a threaded pass in space counts its granules)
     if cfg.history_friction:
         return mindlin_force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar)
     if sw.spar.shape[0] > 0:
         return normal_forces_blocks(t, yn, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar), 0.0, 0.0
     return normal_forces(t, yn, g, cfg, acc, fdamp, fload), 0.0, 0.0
+
+
+@njit(cache=True)
+def note_quiet(sw, buf, t, b, cfg):
+    """After the force pass at t [s] into buffer buf (the elastic body's too): whether its
+    loads are all zero (none on the granules: the shock on the plate, or its amplitude 0
+    at t) and its damping forces (no granule given one by the threaded pass in space, no
+    elastic body), in sw.quiet[buf]; the threaded kicks then skip reading them
+    (solver.blocks). Without blocks nothing is noted: the serial kicks read every row."""
+    if sw.spar.shape[0] == 0:
+        return
+    sw.quiet[buf, 0] = 1.0 if cfg.load_on_plate or shock_amplitude(t, cfg) == 0.0 else 0.0
+    sw.quiet[buf, 1] = 1.0 if sw.spar[0, S_DAMPED] == 0.0 and not B.has_body(b) else 0.0
 
 
 @njit(cache=True)
@@ -178,6 +196,7 @@ def first_forces(t, st, g, b, cfg, sw, cur):
     it; Mindlin's law with the committed histories), the body's too."""
     force_pass(t, st.y, st.y, 0.0, g, cfg, st.k1, sw.fdamp[cur], sw.fload[cur], sw)
     VB.first_forces(st.y, b, cur, st, g, cfg, st.k1, sw.fdamp)
+    note_quiet(sw, cur, t, b, cfg)
     finish_pass(st.y, st.k1, g)
 
 
@@ -229,7 +248,10 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
     w_piston, d_piston = piston_kick_drift(g, h)  # a force-driven wall: kicked and drifted as a granule
     predict = not cfg.half_step_damping  # the force pass at the predicted end velocities, or the half step's
     if sw.spar.shape[0] > 0:
-        wl, wd = kick_drift_blocks(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, sw.spar, predict)
+        loads, damped = sw.quiet[cur, 0] == 0.0, sw.quiet[cur, 1] == 0.0
+        wl, wd = kick_drift_blocks(
+            y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, sw.spar, predict, loads, damped
+        )
     else:
         wl, wd = kick_drift(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, 0, y.shape[0], predict)
     wl, wd, w_grav = VB.first_kick(b, t, h, cur, cfg, wl, wd, w_grav)
@@ -239,12 +261,14 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
         y, w.ytmp, st, b, cur, nxt, h, g, cfg, w.kend, sw.fdamp,
         pr.e_pot + e_t, pr.p_visc, pr.w_plastic, fric + lost_t, pr.ovl, pr.ovl_i, pr.ovl_j,
     )  # fmt: skip
+    note_quiet(sw, nxt, t + h, b, cfg)
     finish_pass(w.ytmp, w.kend, g)  # gravity and the drives
     _, pd1 = wall_powers(g)
     w_drive += drive_kick_work(y, w.kend, g, hk)
     w_grav += gravity_kick_work(y, w.kend, g, hk)
     if sw.spar.shape[0] > 0:
-        wl2, wd2 = kick_blocks(y, w.kend, sw.fdamp[nxt], sw.fload[nxt], hk, w.kend, N_DRIFT, sw.spar)
+        loads, damped = sw.quiet[nxt, 0] == 0.0, sw.quiet[nxt, 1] == 0.0
+        wl2, wd2 = kick_blocks(y, w.kend, sw.fdamp[nxt], sw.fload[nxt], hk, w.kend, N_DRIFT, sw.spar, loads, damped)
     else:
         wl2, wd2 = kick(y, w.kend, sw.fdamp[nxt], sw.fload[nxt], hk, w.kend, N_DRIFT, 0, y.shape[0])
     wp2, dp2 = piston_kick(g, hk)
