@@ -177,10 +177,11 @@ def test_scaling_in_space_mindlin_rows_run_lammps_at_our_step():
     ds = simulate(s, progress=False)
     final = {k: ds[k].values[-1].tolist() for k in ("vx", "vy", "vz")}
     spec = {"cells": [1, 1, 1], "mu": 0.099, "t_end": 4e-6, "scheme": "verlet", "law": "mindlin"}
-    lm = S._lammps_same_law_worker({**spec, "dt_s": float(s.time.dt_max), "final": final})
+    lm = S._lammps_same_law_worker({**spec, "dt_s": float(s.time.dt_max), "final": final, "repeats": 2})
     if L.unavailable():
         assert "skipped" in lm
         return
+    assert len(lm["loop_s_runs"]) == 2 and lm["loop_s"] == min(lm["loop_s_runs"])  # the faster of the middle two
     text = (ROOT / "docs" / "benchmarks.md").read_text().split("### Scaling in space JSON")[1].split("\n## ")[0]
     line = next(line for line in text.splitlines() if line.startswith("| `lammps`"))
     assert set(lm) <= set(re.findall(r"`([a-z_0-9]+)`", line)), lm
@@ -212,6 +213,10 @@ def test_scaling_in_space_options_are_checked(capsys):
     )
     assert main(["bench", "--scaling", "--dimension", "3", "--friction-law", "mindlin", "--scheme", "implicit"]) == 2
     assert "--friction-law mindlin: runs under --scheme verlet only" in capsys.readouterr().err
+    assert main(["bench", "--scaling", "--dimension", "3", "--repeats", "0"]) == 2
+    assert "--repeats 0: allowed integers from 1" in capsys.readouterr().err
+    runs = [(0.9, "a"), (0.5, "b"), (1.7, "c"), (0.7, "d"), (0.8, "e")]
+    assert scaling_space.median_run(runs) == (0.8, "e") and scaling_space.median_run(runs[:4]) == (0.7, "d")
     assert scaling_space.mu_law({"mu": 0.099, "law": "mindlin"}) == "0.099 (mindlin)"
     assert scaling_space.mu_law({"mu": 0.0, "law": "-"}) == "0"
 

@@ -104,7 +104,11 @@ def preset_options(b) -> None:
     b.add_argument("--json", metavar="FILE", help="write the report as JSON to FILE")
     b.add_argument("--cases", help="comma-separated preset names (default: all six; quick: a subset)")
     b.add_argument(
-        "--repeats", type=int, default=None, help="timed repeats per case; the median is reported (default 3, quick 1)"
+        "--repeats",
+        type=int,
+        default=None,
+        help="timed repeats per case; the median is reported (default 3, quick 1; with --scaling --dimension 3: "
+        "each row's run timed that many times in its process, granplate's and LAMMPS's, default 1)",
     )
     b.add_argument(
         "--t-end",

@@ -128,6 +128,12 @@ def max_error_3d(v: tuple, ref: dict) -> float:
     return float(max(np.abs(np.asarray(vc) - np.asarray(ref[k])).max() for vc, k in zip(v, ("vx", "vy", "vz"))) / SPEED)
 
 
+def median_run(runs: list) -> tuple:
+    """The run of median loop time among `runs` (tuples whose first item is the loop time
+    [s]; of an even count the faster of the middle two)."""
+    return sorted(runs, key=lambda r: r[0])[(len(runs) - 1) // 2]
+
+
 def _ours_worker(spec: dict) -> dict:
     """Runs in a fresh subprocess: one (size, mu) of granplate; the reference when mu = 0
     (unless spec["reference"] is "skip"). The time the loop spends on its contact lists
@@ -170,11 +176,15 @@ def _ours_worker(spec: dict) -> dict:
             lists_s[1] += time.process_time() - c
 
     run_contacts.ContactLists.refresh = timed_refresh  # type: ignore[method-assign]
-    t1, c1 = time.perf_counter(), time.process_time()
-    ds = simulate(s, model=model, progress=False)
-    run_s, run_cpu_s = time.perf_counter() - t1, time.process_time() - c1
+    runs = []
+    for _ in range(spec.get("repeats", 1)):  # the same run again: its median is reported
+        lists_s[:] = [0.0, 0.0]
+        t1, c1 = time.perf_counter(), time.process_time()
+        ds = simulate(s, model=model, progress=False)
+        run_s, run_cpu_s = time.perf_counter() - t1, time.process_time() - c1
+        runs.append((float(ds.attrs["loop_time_s"]), ds, run_s, run_cpu_s, list(lists_s)))
     run_contacts.ContactLists.refresh = refresh  # type: ignore[method-assign]
-    loop_s = float(ds.attrs["loop_time_s"])
+    loop_s, ds, run_s, run_cpu_s, lists_s = median_run(runs)
     out = {
         "granules": len(s.granules),
         "contacts": int(len(model.pairs)),
@@ -195,6 +205,7 @@ def _ours_worker(spec: dict) -> dict:
         "load_average": load,
         "energy_residual": float(np.abs(ds.energy_residual.values).max()),
         "threads": int(ds.attrs.get("threads", 1)),
+        "loop_s_runs": [r[0] for r in runs],
     }
     if spec["mu"] > 0.0 and same_law(law, spec["scheme"]) and not skip:  # LAMMPS runs this step and law
         out["final"] = {k: ds[k].values[-1].tolist() for k in ("vx", "vy", "vz")}
@@ -241,8 +252,16 @@ def _lammps_worker(spec: dict) -> dict:
         if as_accurate(err, spec["error"]):
             break
         dt /= 2.0
+    last = tried[-1]
+    runs = [(last["loop_s"], last)]
+    for _ in range(spec.get("repeats", 1) - 1):  # the accurate step again: its median is reported
+        c0 = time.process_time()
+        res = L.run_hertz_3d(s, last["dt_s"], spec["t_end"])
+        runs.append((res["loop_time_s"], {**last, "loop_s": res["loop_time_s"], "cpu_s": time.process_time() - c0}))
+    tried[-1] = median_run(runs)[1]
     return {
         **tried[-1],
+        "loop_s_runs": [r[0] for r in runs],
         "reached": as_accurate(tried[-1]["error"], spec["error"]),
         "tried": tried,
         "rss_peak_mib": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
@@ -263,10 +282,14 @@ def _lammps_same_law_worker(spec: dict) -> dict:
         return {"skipped": L.unavailable()}
     s = launched_fcc(tuple(spec["cells"]), mu=spec["mu"], t_end=spec["t_end"], scheme=spec["scheme"], law=spec["law"])
     L.run_hertz_3d(launched_fcc((1, 1, 1), t_end=1e-7), 1e-8, 1e-7)  # load the library once
-    c0 = time.process_time()
-    res = L.run_hertz_3d(s, spec["dt_s"], spec["t_end"])
-    cpu = time.process_time() - c0
+    runs = []
+    for _ in range(spec.get("repeats", 1)):  # its median is reported
+        c0 = time.process_time()
+        res = L.run_hertz_3d(s, spec["dt_s"], spec["t_end"])
+        runs.append((res["loop_time_s"], res, time.process_time() - c0))
+    _, res, cpu = median_run(runs)
     return {
+        "loop_s_runs": [r[0] for r in runs],
         "dt_s": spec["dt_s"],
         "n_steps": res["n_steps"],
         "setup_s": res["setup_time_s"],
@@ -288,20 +311,22 @@ def run_scaling_space(
     log=print,
     threads: tuple[int, ...] = (1,),
     law: str = "tanh",
+    repeats: int = 1,
 ) -> list[dict]:
     """The 3D table's rows: one per (size, mu, thread count), each measured in fresh
     subprocesses, the rows with friction under the tangential law `law`
     (contact.tangential_law); `speedup` is the loop's time on one thread over this row's. LAMMPS runs
     the frictionless rows, and those of a law it has under velocity Verlet (`same_law`), on
     as many MPI processes as the row has threads (`mpirun -np N`, its shrink-wrapped box cut
-    into N domains)."""
+    into N domains). Each run is timed `repeats` times in its process (granplate's after
+    its first run, LAMMPS's at the step it keeps), the median reported."""
     rows = []
     for cells in sizes:
         for mu in frictions:
             reference, one_thread = None, None
             for n in threads:
                 log(f"scaling in space: {sphere_count(cells)} spheres, mu = {mu:g}, {n} thread(s) ...")
-                row = _space_row(cells, mu, t_end, scheme, n, reference, lammps, log, law)
+                row = _space_row(cells, mu, t_end, scheme, n, reference, lammps, log, law, repeats)
                 reference = row.pop("reference", reference)
                 if n == 1 and "loop_s" in row:
                     one_thread = row["loop_s"]
@@ -312,7 +337,7 @@ def run_scaling_space(
 
 
 def _space_row(
-    cells, mu: float, t_end: float, scheme: str, n: int, reference, lammps: bool, log, law: str = "tanh"
+    cells, mu: float, t_end: float, scheme: str, n: int, reference, lammps: bool, log, law: str = "tanh", repeats=1
 ) -> dict:
     """One row of the 3D table: granplate on n threads (friction under `law`) and
     (frictionless, `lammps`) LAMMPS on n MPI processes to the same accuracy."""
@@ -326,6 +351,7 @@ def _space_row(
         "reference": "skip" if big else reference,
         "outputs": 1 if big else 20,
         "law": law,
+        "repeats": repeats,
     }
     row = {
         "dimension": 3,
@@ -334,6 +360,7 @@ def _space_row(
         "law": law if mu > 0.0 else "-",
         "scheme": scheme,
         "t_end_s": t_end,
+        "repeats": repeats,
         **run_in_subprocess("scaling_space", "_ours_worker", spec),
     }
     row["threads"] = n
@@ -505,6 +532,11 @@ def main(args, t_end: float, scheme: str) -> int:
         print(f"granplate: error: {err}", file=sys.stderr)
         return 2
     law = getattr(args, "friction_law", None) or "tanh"
+    repeats = getattr(args, "repeats", None)
+    repeats = 1 if repeats is None else repeats
+    if repeats < 1:
+        print(f"granplate: error: --repeats {repeats}: allowed integers from 1", file=sys.stderr)
+        return 2
     if law != "tanh" and scheme != "verlet":
         print(f"granplate: error: --friction-law {law}: runs under --scheme verlet only", file=sys.stderr)
         return 2
@@ -516,6 +548,7 @@ def main(args, t_end: float, scheme: str) -> int:
         lammps=not getattr(args, "no_lammps", False),
         threads=threads,
         law=law,
+        repeats=repeats,
     )
     print()
     print(format_space_table(rows))
