@@ -13,7 +13,7 @@ import pytest
 
 import granplate as gp
 from granplate.errors import ScenarioError
-from granplate.model.inputs import N_HIST, N_HIST_NORMAL
+from granplate.model.inputs import HIST_XI, HIST_XI_END, N_HIST, N_HIST_NORMAL, N_HIST_STEP, N_MINDLIN
 from granplate.results.dataset import read, write
 from granplate.results.restart import restart_state
 from granplate.results.run import simulate
@@ -80,6 +80,46 @@ def test_history_rows_of_a_run_without_a_history_law_are_the_normal_laws(plate_r
     old = widened(first)
     assert restart_state(old)["g.pair_hist"].shape[1] == N_HIST
     same_end(straight, simulate(s, start_from=old))
+
+
+def with_trial_columns(ds):
+    """ds with its restart state's Mindlin rows of N_HIST_STEP columns widened to N_HIST as a
+    result written when every run kept the trial apart: the trial columns a copy of the
+    committed ones (what the commit leaves)."""
+    for name in [str(v) for v in ds.data_vars if str(v).startswith(("restart_g__", "restart_stores__"))]:
+        v = ds[name].values
+        if name.endswith("_hist") and v.ndim == 2 and v.shape[1] == N_HIST_STEP:
+            w = np.zeros((v.shape[0], N_HIST))
+            w[:, :N_HIST_STEP] = v
+            w[:, HIST_XI_END : HIST_XI_END + N_MINDLIN] = v[:, HIST_XI : HIST_XI + N_MINDLIN]
+            ds = ds.drop_vars(name).assign({name: ((f"{name}_rows", f"{name}_columns"), w)})
+    return ds
+
+
+def test_verlet_mindlin_histories_move_on_in_place_and_earlier_rows_restart_the_same():
+    """Mindlin's law under velocity Verlet (an fcc stack in its box, so pairs and walls): each
+    contact's history is N_HIST_STEP numbers moved on in place; the run restarts to the same
+    end bitwise from its own result and from one whose rows keep the trial apart (N_HIST, as
+    results were written before), which then runs the trial-and-commit path."""
+    changes = {"contact.tangential_law": "mindlin", "contact.mu": 0.3, "solver.scheme": "verlet"}
+    s = gp.load_scenario(EXAMPLES / "3d-fcc.toml", {**changes, "time.output_interval": 1e-5})
+    straight = simulate(s)
+    first = simulate(s, t_end=T1)
+    state = restart_state(first)
+    assert state["g.pair_hist"].shape[1] == state["g.wall_hist"].shape[1] == N_HIST_STEP
+    assert np.count_nonzero(state["g.pair_hist"][:, HIST_XI : HIST_XI + 3]) > 0  # springs loaded
+    assert np.count_nonzero(state["g.wall_hist"][:, HIST_XI : HIST_XI + 3]) > 0
+    same_end(straight, simulate(s, start_from=first))
+    old = with_trial_columns(first)
+    assert restart_state(old)["g.pair_hist"].shape[1] == N_HIST
+    rest = simulate(s, start_from=old)
+    assert restart_state(rest)["g.pair_hist"].shape[1] == N_HIST  # the rows it read, kept
+    for name, v in straight.data_vars.items():
+        if "time" in v.dims and v.dims[0] == "time" and name in rest and not name.startswith("restart_"):
+            np.testing.assert_array_equal(v.isel(time=-1).values, rest[name].isel(time=-1).values, err_msg=str(name))
+    s0, s1 = restart_state(straight), restart_state(rest)
+    for key in ("g.pair_hist", "g.wall_hist"):
+        np.testing.assert_array_equal(s0[key], s1[key][:, :N_HIST_STEP], err_msg=key)
 
 
 @pytest.mark.filterwarnings("ignore:.*overlap_warn")

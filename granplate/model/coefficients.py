@@ -39,8 +39,9 @@ from granplate.setup.scenario import Scenario
 
 def scenario_history_columns(s: Scenario) -> int:
     """The columns of the contacts' history rows of a run of s (model.inputs.history_columns):
-    Mindlin's need them all, the other tangential laws the normal law's four."""
-    return history_columns(TANGENTIAL_LAW_REGISTRY[s.contact.tangential_law].history)
+    Mindlin's need them all (under velocity Verlet, which moves them on in place, all but the
+    trial's), the other tangential laws the normal law's four."""
+    return history_columns(TANGENTIAL_LAW_REGISTRY[s.contact.tangential_law].history, s.solver.scheme == "verlet")
 
 
 def coefficient_row(a: float, c: float, mu: float, k_s: float, law=math.inf, normal_law: int = HERTZ) -> np.ndarray:

@@ -48,6 +48,11 @@ HIST_XI, HIST_A, HIST_F = 4, 7, 8
 N_MINDLIN = 7
 HIST_XI_END, HIST_A_END, HIST_F_END = 11, 14, 15
 N_HIST = 18
+#: the columns of a Mindlin contact's row under velocity Verlet (HIST_MAX to HIST_F): every
+#: step is accepted, so the force pass moves the history on in place and the trial columns
+#: (HIST_XI_END to HIST_F_END) are not kept (solver.mindlin_history.trial_column; a row of
+#: N_HIST columns, a scheme that may retry a step, keeps the trial apart until it commits).
+N_HIST_STEP = HIST_XI_END
 #: the columns a contact's history row has in a run whose tangential law keeps no history
 #: (the normal law's, HIST_MAX to HIST_RATE): a row of 4 numbers, not 18, streamed by every
 #: force pass and history commit (docs/benchmarks.md, "Every core in one run"). Mindlin's
@@ -78,10 +83,13 @@ def no_history(n: int, columns: int = N_HIST) -> np.ndarray:
     return np.zeros((n, columns))
 
 
-def history_columns(history: bool) -> int:
-    """The columns of a run's contact histories: N_HIST where its tangential law keeps a
-    history (Mindlin's), else N_HIST_NORMAL."""
-    return N_HIST if history else N_HIST_NORMAL
+def history_columns(history: bool, in_place: bool = False) -> int:
+    """The columns of a run's contact histories: where its tangential law keeps a history
+    (Mindlin's) N_HIST, or N_HIST_STEP where the scheme moves it on in place (`in_place`:
+    velocity Verlet); else N_HIST_NORMAL."""
+    if not history:
+        return N_HIST_NORMAL
+    return N_HIST_STEP if in_place else N_HIST
 
 
 class Granular(NamedTuple):

@@ -386,7 +386,9 @@ def commit_history(t, hist, coef):
 def commit_rows(t, hist, coef, lo, hi):
     """`commit_history` of contacts lo..hi-1 (written out per row: a compiled call per row
     costs 4.6x this loop, measured on 56,754 rows)."""
-    tangential = hist.shape[1] > HIST_A_END  # rows with a tangential history's columns (model.inputs.history_columns)
+    # rows that keep a trial tangential history apart (model.inputs.history_columns: N_HIST; a
+    # row of N_HIST_STEP, velocity Verlet's, was moved on in place by the force pass)
+    tangential = hist.shape[1] > HIST_A_END
     for k in range(lo, hi):
         # a tangential law's history (Mindlin's, docs/model.md section 3.16); a contact out of
         # touch with none, before and after (HIST_A and HIST_A_END zero: its rows are zeros), keeps its zeros

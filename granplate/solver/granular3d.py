@@ -11,13 +11,7 @@ from __future__ import annotations
 from granplate.jit import njit
 
 
-from granplate.model.inputs import (
-    HIST_A,
-    HIST_A_END,
-    HIST_END,
-    HIST_MAX,
-    HIST_RATE,
-)
+from granplate.model.inputs import HIST_END, HIST_MAX, HIST_RATE
 from granplate.physics.contact import COEF_MU, contact_arm
 from granplate.physics.laws import (
     keeps_history,
@@ -37,7 +31,7 @@ from granplate.physics.space import (
 )
 from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_motion
 from granplate.solver.granular import ForceSums, slip_relaxation_rate
-from granplate.solver.mindlin_history import mindlin_contact, mindlin_old_force, mindlin_parted
+from granplate.solver.mindlin_history import mindlin_contact, mindlin_old_force, mindlin_parted, mindlin_touched
 from granplate.solver.mindlin_rk4 import space_stages
 
 #: state columns of a granule in space
@@ -492,7 +486,7 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, out, out_d, c_f, c_d, c_t, tangential
         delta, nx, ny, nz = pair_contact_3d(yn[i, X], yn[i, Y], yn[i, Z], ri, yn[j, X], yn[j, Y], yn[j, Z], rj)
         kt = tangential and keeps_history(g.pair_coef[p])
         if delta <= 0.0:
-            if kt and (hist[p, HIST_A] != 0.0 or hist[p, HIST_A_END] != 0.0):
+            if kt and mindlin_touched(hist, p):
                 lost += mindlin_parted(hist, p, g.pair_coef[p])
             continue
         hist[p, HIST_END] = delta

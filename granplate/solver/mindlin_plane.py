@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from granplate.jit import njit
 
-from granplate.model.inputs import HIST_A, HIST_A_END, HIST_END, HIST_MAX, HIST_RATE
+from granplate.model.inputs import HIST_END, HIST_MAX, HIST_RATE
 from granplate.physics.contact import (
     contact_arm,
     pair_apart,
@@ -28,7 +28,7 @@ from granplate.physics.laws import keeps_history, normal_law_response, tangentia
 from granplate.physics.shock import shock_amplitude
 from granplate.solver.drives import begin_pass, book_wall, wall_motion
 from granplate.solver.granular import ForceSums
-from granplate.solver.mindlin_history import mindlin_contact, mindlin_old_force, mindlin_parted
+from granplate.solver.mindlin_history import mindlin_contact, mindlin_old_force, mindlin_parted, mindlin_touched
 
 
 @njit(cache=True)
@@ -97,7 +97,7 @@ def pair_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
         if not pair_apart(yn[i, 0], yn[i, 1], ri, yn[j, 0], yn[j, 1], rj):
             delta, nx, nz = pair_overlap(yn[i, 0], yn[i, 1], ri, yn[j, 0], yn[j, 1], rj)
         if delta <= 0.0:
-            if keeps_history(c) and (hist[p, HIST_A] != 0.0 or hist[p, HIST_A_END] != 0.0):
+            if keeps_history(c) and mindlin_touched(hist, p):
                 lost += mindlin_parted(hist, p, c)
             continue
         hist[p, HIST_END] = delta
@@ -205,7 +205,7 @@ def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload):
     the contacts whose tangential law keeps a history (Mindlin's; laws.keeps_history), the tangential spring's force from
     the same overlap and |N|, its history moved on by the slip at yv's velocities over h
     [s] (the half step's; yv's positions are yn's; h = 0: the force of the committed
-    history), trial histories into HIST_XI_END, HIST_A_END, HIST_F_END. Accelerations into
+    history), the trial histories as solver.mindlin_history.trial_column says. Accelerations into
     acc[:, 3:6], damping forces and loads apart (fdamp, fload). Returns (the ForceSums, the
     springs' stored energy [J], the energy they lost over the step [J])."""
     ng = yn.shape[0]

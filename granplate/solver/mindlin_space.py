@@ -73,8 +73,8 @@ def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload):
     (its velocities the damping's) and, at the contacts whose tangential law keeps a
     history (Mindlin's; laws.keeps_history), the tangential spring's force from the same overlap and |N|, its history moved on by
     the slip at yv's velocities over h [s] (the half step's; yv's positions are yn's; h = 0:
-    the force of the committed history), the trial histories into HIST_XI_END, HIST_A_END,
-    HIST_F_END. Returns (the ForceSums, the springs' stored energy [J], the energy they
+    the force of the committed history), the trial histories as
+    solver.mindlin_history.trial_column says. Returns (the ForceSums, the springs' stored energy [J], the energy they
     lost over the step [J])."""
     for i in range(yn.shape[0]):
         for c in range(3, 9):
