@@ -19,7 +19,7 @@ from granplate.setup.validate import validate
 from granplate.solver import granular3d
 from granplate.solver.blocks import N_FPAR, N_SPAR, normal_forces_blocks
 from granplate.solver.driver import ContactLists
-from granplate.model.inputs import HIST_END, HIST_XI, HIST_XI_END, N_MINDLIN
+from granplate.model.inputs import HIST_END, HIST_XI, N_HIST_STEP
 
 THREADS = min(2, available_threads())
 
@@ -140,7 +140,7 @@ def test_study_workers_run_one_thread_each():
 @pytest.mark.parametrize("nb", [1, 3])
 def test_block_mindlin_pass_equals_the_serial_pass(nb):
     """Mindlin's force pass in nb blocks (solver.blocks.mindlin_forces_blocks) gives the serial
-    pass's accelerations and spins to round-off, each contact's trial history bit for bit
+    pass's accelerations and spins to round-off, each contact's history bit for bit
     (its own step alone), and the springs' energy and losses to round-off."""
     from granplate.solver.blocks import mindlin_forces_blocks
     from granplate.solver.mindlin_space import normal_mindlin_forces
@@ -156,25 +156,26 @@ def test_block_mindlin_pass_equals_the_serial_pass(nb):
     y[:, :3] += rng.normal(0.0, 2e-6, (len(y), 3))
     y[:, 3:9] += rng.normal(0.0, 0.1, (len(y), 6))
     ng = len(y)
-    start = g.pair_hist.copy()
+    start = g.pair_hist.copy(), g.wall_hist.copy()
     out = []
     for blocks in (False, True):
-        hist = start.copy()  # both from the same committed histories
+        hist, wall = (h.copy() for h in start)  # both from the same committed histories
         acc, fd, fl = (np.zeros((ng, 9)) for _ in range(3))
         for _ in range(3):  # three steps, the histories moving on between them
             g.pair_hist[:] = hist
+            g.wall_hist[:] = wall
             if blocks:
                 sums, e_t, lost = mindlin_forces_blocks(
                     0.0, y, y, 1e-8, g, cfg, acc, fd, fl, np.zeros((nb, ng, N_FPAR)), np.zeros((nb, N_SPAR))
                 )
             else:
                 sums, e_t, lost = normal_mindlin_forces(0.0, y, y, 1e-8, g, cfg, acc, fd, fl)
-            hist = g.pair_hist.copy()
-            hist[:, HIST_XI : HIST_XI + N_MINDLIN] = hist[:, HIST_XI_END : HIST_XI_END + N_MINDLIN]  # taken in
+            hist, wall = g.pair_hist.copy(), g.wall_hist.copy()  # (velocity Verlet's rows: moved on in place)
         out.append((acc.copy(), g.pair_hist.copy(), e_t, lost))
     (a0, h0, e0, l0), (a1, h1, e1, l1) = out
+    assert g.pair_hist.shape[1] == N_HIST_STEP
     assert np.array_equal(h0, h1)
-    assert e0 > 0.0 and np.abs(h0[:, HIST_XI_END : HIST_XI_END + 3]).max() > 0.0
+    assert e0 > 0.0 and np.abs(h0[:, HIST_XI : HIST_XI + 3]).max() > 0.0
     assert np.abs(a1 - a0).max() <= 1e-13 * np.abs(a0).max()
     assert np.abs(a0[:, 6:9]).max() > 0.0  # the tangential forces' torques
     assert e1 == pytest.approx(e0, rel=1e-13) and l1 == pytest.approx(l0, rel=1e-12, abs=1e-25)

@@ -35,21 +35,23 @@ from granplate.jit import njit  # noqa: E402
 
 from granplate.solver.drives import begin_pass
 from granplate.solver.granular import ForceSums, commit_history, commit_rows
-from granplate.solver.granular3d import pair_forces, shock_loads, wall_forces
+from granplate.solver.granular3d import BUF_DAMP, N_BUF, VX, WX, pair_forces, shock_loads, wall_forces
 from granplate.solver.kicks import kick, kick_drift
 from granplate.solver.mindlin_space import wall_mindlin
 
-#: columns of a block's buffer row fpar[k, i]: the normal force on granule i (x, y, z) [N],
-#: its damping part (x, y, z) [N] and, under Mindlin's law, the tangential forces' torque
-#: (x, y, z) [N m] (their forces are in F_X's columns).
-F_X, F_DX, F_T = 0, 3, 6
-N_FPAR = 9
+#: columns of a block's buffer row fpar[k, i], for a granule i outside the block's own rows
+#: (`owned_rows`): the damping part of the forces on it (x, y, z) [N], the normal forces
+#: (x, y, z) [N] and, under Mindlin's law, the tangential forces' torques (x, y, z) [N m]
+#: (their forces are in F_X's columns): solver.granular3d's buffer columns.
+F_DX, F_X, F_T = BUF_DAMP, VX, WX
+N_FPAR = N_BUF
 #: columns of a block's sums spar[k]: viscous power [W], stored energy [J], plastic work
 #: [J], the largest overlap / smaller radius [-], its granule and its partner (as floats),
-#: the kicks' load and damping work [J], Mindlin's springs' energy and losses [J], and (row
-#: 0: in all) how many granules the last force pass gave a damping force (`gather_forces`).
-S_VISC, S_EPOT, S_PLASTIC, S_OVL, S_OVL_I, S_OVL_J, S_WLOAD, S_WDAMP, S_ET, S_LOST, S_DAMPED = range(11)
-N_SPAR = 11
+#: the kicks' load and damping work [J], Mindlin's springs' energy and losses [J], (row
+#: 0: in all) how many granules the last force pass gave a damping force (`gather_forces`),
+#: and the range [S_TLO, S_THI) of the buffer rows the block's pairs wrote (as floats).
+S_VISC, S_EPOT, S_PLASTIC, S_OVL, S_OVL_I, S_OVL_J, S_WLOAD, S_WDAMP, S_ET, S_LOST, S_DAMPED, S_TLO, S_THI = range(13)
+N_SPAR = 13
 
 
 @njit(cache=True)
@@ -59,14 +61,36 @@ def block_range(k, nb, n):
 
 
 @njit(cache=True)
-def clear_block(k, nb, acc, fdamp, fload, f, n_cols):
-    """Block k's share of a pass's clearing: its buffer's first n_cols columns fpar[k] (f)
-    for every granule, and its own granules' rows (`block_range` over the granules) of acc,
-    fdamp and fload from the velocity columns on."""
-    for i in range(f.shape[0]):
-        for c in range(n_cols):
-            f[i, c] = 0.0
-    lo, hi = block_range(k, nb, acc.shape[0])
+def owner_start(k, nb, pair_ij, ng):
+    """The first granule block k of nb owns (`owned_rows`): 0 for the first block, ng past
+    the last; else the first granule of its pairs, at least any earlier block's (so the
+    blocks' rows follow one another whatever the pair order; sorted pairs make them the
+    granules each block's pairs start from)."""
+    if k <= 0:
+        return 0
+    if k >= nb:
+        return ng
+    n_p = pair_ij.shape[0]
+    a = 0
+    for q in range(1, k + 1):
+        lo, _ = block_range(q, nb, n_p)
+        a = max(a, pair_ij[lo, 0] if lo < n_p else ng)
+    return min(a, ng)
+
+
+@njit(cache=True)
+def owned_rows(k, nb, pair_ij, ng):
+    """The granules [lo, hi) whose rows block k writes straight into the accelerations: no
+    other block writes them there (their forces from other blocks' pairs wait in those
+    blocks' buffers, `gather_forces`)."""
+    return owner_start(k, nb, pair_ij, ng), owner_start(k + 1, nb, pair_ij, ng)
+
+
+@njit(cache=True)
+def clear_block(acc, fdamp, fload, lo, hi):
+    """Block k's share of a pass's clearing: its own granules' rows lo..hi-1 of acc, fdamp
+    and fload from the velocity columns on (its buffer is zero already: `gather_rows`
+    zeroes what it reads)."""
     for i in range(lo, hi):
         for c in range(3, acc.shape[1]):
             acc[i, c] = 0.0
@@ -74,67 +98,79 @@ def clear_block(k, nb, acc, fdamp, fload, f, n_cols):
             fload[i, c] = 0.0
 
 
+@njit(cache=True, inline="always")
+def block_pairs(yv, yn, h, g, cfg, k, fpar, spar, acc, fdamp, fload, tangential):
+    """Block k's pairs (`block_range` of the pair list; solver.granular3d.pair_forces): its
+    own granules' rows cleared and their forces put straight into acc and fdamp, the other
+    granules' into its buffer fpar[k]; its sums and buffered rows' range into spar[k].
+    Returns (the springs' energy [J], their losses [J])."""
+    nb = fpar.shape[0]
+    ng = acc.shape[0]
+    own_lo, own_hi = owned_rows(k, nb, g.pair_ij, ng)
+    clear_block(acc, fdamp, fload, own_lo, own_hi)
+    lo, hi = block_range(k, nb, g.pair_ij.shape[0])
+    pv, ep, wp, ovl, ovl_i, ovl_j, e_t, lost, t_lo, t_hi = pair_forces(
+        yv, yn, h, g, cfg, lo, hi, acc, fdamp, fpar[k], own_lo, own_hi, tangential
+    )
+    spar[k, S_VISC] = pv
+    spar[k, S_EPOT] = ep
+    spar[k, S_PLASTIC] = wp
+    spar[k, S_OVL] = ovl
+    spar[k, S_OVL_I] = ovl_i
+    spar[k, S_OVL_J] = ovl_j
+    spar[k, S_TLO] = t_lo
+    spar[k, S_THI] = t_hi
+    return e_t, lost
+
+
 @njit(parallel=True)
 def pair_forces_blocks(y, g, cfg, fpar, spar, acc, fdamp, fload):
-    """The normal forces of every listed granule pair at state y (space), block by block:
-    block k clears its buffer fpar[k] and its granules' rows of acc, fdamp and fload
-    (`clear_block`), then puts its pairs' forces on their granules into fpar[k], its
-    viscous power, stored energy, plastic work and largest overlap into spar[k]; each
-    pair's overlap into HIST_END (as solver.granular3d.normal_forces)."""
-    nb = fpar.shape[0]
-    n_p = g.pair_ij.shape[0]
-    for k in prange(nb):
-        f = fpar[k]
-        clear_block(k, nb, acc, fdamp, fload, f, F_T)  # (the torque columns are Mindlin's pass's)
-        lo, hi = block_range(k, nb, n_p)
-        p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, _, _ = pair_forces(
-            y, y, 0.0, g, cfg, lo, hi, f, f, F_X, F_DX, F_T, False
-        )
-        spar[k, S_VISC] = p_visc
-        spar[k, S_EPOT] = e_pot
-        spar[k, S_PLASTIC] = w_plastic
-        spar[k, S_OVL] = ovl
-        spar[k, S_OVL_I] = ovl_i
-        spar[k, S_OVL_J] = ovl_j
+    """The normal forces of every listed granule pair at state y (space), block by block
+    (`block_pairs`): block k clears its own granules' rows of acc, fdamp and fload and puts
+    its pairs' forces on them there, on other granules into its buffer fpar[k]; its viscous
+    power, stored energy, plastic work, largest overlap and buffered rows into spar[k];
+    each pair's overlap into HIST_END (as solver.granular3d.normal_forces)."""
+    for k in prange(fpar.shape[0]):
+        block_pairs(y, y, 0.0, g, cfg, k, fpar, spar, acc, fdamp, fload, False)
 
 
 @njit(cache=True)
-def gather_rows(fpar, acc, fdamp, mass, inertia, torques, lo, hi):
-    """`gather_forces` for granules lo..hi-1; returns how many have a damping force."""
-    nb = fpar.shape[0]
+def gather_rows(fpar, spar, acc, fdamp, mass, inertia, lo, hi):
+    """`gather_forces` for granules lo..hi-1: the buffered forces of each block whose
+    buffered rows [S_TLO, S_THI) meet them added in block order (and zeroed, ready for the
+    next pass), then the division; returns how many have a damping force."""
+    for k in range(fpar.shape[0]):
+        for i in range(max(lo, int(spar[k, S_TLO])), min(hi, int(spar[k, S_THI]))):
+            for c in range(3):
+                acc[i, VX + c] += fpar[k, i, F_X + c]
+                fdamp[i, VX + c] += fpar[k, i, F_DX + c]
+                acc[i, WX + c] += fpar[k, i, F_T + c]
+                fpar[k, i, F_X + c] = 0.0
+                fpar[k, i, F_DX + c] = 0.0
+                fpar[k, i, F_T + c] = 0.0
     n_damped = 0
     for i in range(lo, hi):
         damped = False
         for c in range(3):
-            s = acc[i, 3 + c]
-            d = fdamp[i, 3 + c]
-            w = acc[i, 6 + c]
-            for k in range(nb):
-                s += fpar[k, i, F_X + c]
-                d += fpar[k, i, F_DX + c]
-                if torques:
-                    w += fpar[k, i, F_T + c]
-            acc[i, 3 + c] = s / mass[i]
-            fdamp[i, 3 + c] = d
-            acc[i, 6 + c] = w / inertia[i]
-            damped = damped or d != 0.0 or fdamp[i, 6 + c] != 0.0
+            acc[i, VX + c] /= mass[i]
+            acc[i, WX + c] /= inertia[i]
+            damped = damped or fdamp[i, VX + c] != 0.0 or fdamp[i, WX + c] != 0.0
         if damped:
             n_damped += 1
     return n_damped
 
 
 @njit(parallel=True)
-def gather_forces(fpar, acc, fdamp, mass, inertia, torques, spar):
-    """Each granule's forces from the blocks, added in block order to what acc and fdamp
-    hold already (the shock's and the walls'), then acc's forces and torques made
-    accelerations: acc[:, 3:6] /= mass, acc[:, 6:9] /= inertia (space's velocity and spin
-    columns); the blocks' torques (F_T) too when `torques` (Mindlin's pass). The granules
-    in blocks; how many of them have a damping force (fdamp not zero) into spar[0,
-    S_DAMPED]."""
+def gather_forces(fpar, acc, fdamp, mass, inertia, spar):
+    """Each granule's forces from the blocks' buffers, added in block order to what acc and
+    fdamp hold (its own block's pairs', the shock's and the walls'), then acc's forces and
+    torques made accelerations: acc[:, 3:6] /= mass, acc[:, 6:9] /= inertia (space's
+    velocity and spin columns). The granules in blocks; how many of them have a damping
+    force (fdamp not zero) into spar[0, S_DAMPED]."""
     nb = spar.shape[0]
     for k in prange(nb):
         lo, hi = block_range(k, nb, acc.shape[0])
-        spar[k, S_DAMPED] = gather_rows(fpar, acc, fdamp, mass, inertia, torques, lo, hi)
+        spar[k, S_DAMPED] = gather_rows(fpar, spar, acc, fdamp, mass, inertia, lo, hi)
     n = 0.0
     for k in range(nb):
         n += spar[k, S_DAMPED]
@@ -157,31 +193,19 @@ def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
         y, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
     )
-    gather_forces(fpar, acc, fdamp, g.mass, g.inertia, False, spar)
+    gather_forces(fpar, acc, fdamp, g.mass, g.inertia, spar)
     return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
 
 
 @njit(parallel=True)
 def pair_mindlin_blocks(yv, yn, h, g, cfg, fpar, spar, acc, fdamp, fload):
-    """`pair_forces_blocks` with Mindlin's law in it (solver.granular3d.pair_forces
-    with its tangential step, on block k's pairs, its buffer fpar[k]: forces, damping parts, torques; its sums into
-    spar[k], the springs' energy and losses into S_ET, S_LOST). Each contact's tangential
-    step reads and writes its own history row alone."""
-    nb = fpar.shape[0]
-    n_p = g.pair_ij.shape[0]
-    for k in prange(nb):
-        f = fpar[k]
-        clear_block(k, nb, acc, fdamp, fload, f, N_FPAR)
-        lo, hi = block_range(k, nb, n_p)
-        pv, ep, wp, ovl, ovl_i, ovl_j, e_t, lost = pair_forces(yv, yn, h, g, cfg, lo, hi, f, f, F_X, F_DX, F_T, True)
-        spar[k, S_VISC] = pv
-        spar[k, S_EPOT] = ep
-        spar[k, S_PLASTIC] = wp
-        spar[k, S_OVL] = ovl
-        spar[k, S_OVL_I] = ovl_i
-        spar[k, S_OVL_J] = ovl_j
-        spar[k, S_ET] = e_t
-        spar[k, S_LOST] = lost
+    """`pair_forces_blocks` with Mindlin's law in it (solver.granular3d.pair_forces with its
+    tangential step, on block k's pairs: forces, damping parts and torques, its own
+    granules' straight into acc and fdamp, the others' into fpar[k]; its sums into spar[k],
+    the springs' energy and losses into S_ET, S_LOST). Each contact's tangential step reads
+    and writes its own history row alone."""
+    for k in prange(fpar.shape[0]):
+        spar[k, S_ET], spar[k, S_LOST] = block_pairs(yv, yn, h, g, cfg, k, fpar, spar, acc, fdamp, fload, True)
 
 
 @njit(cache=True)
@@ -227,7 +251,7 @@ def mindlin_forces_blocks(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar):
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
         yn, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
     )
-    gather_forces(fpar, acc, fdamp, g.mass, g.inertia, True, spar)
+    gather_forces(fpar, acc, fdamp, g.mass, g.inertia, spar)
     e_w, lost_w = wall_mindlin(yv, yn, h, g, cfg, acc)
     sums = ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
     return sums, e_t + e_w, lost + lost_w

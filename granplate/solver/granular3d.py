@@ -297,15 +297,33 @@ def force_error(k1, k0, kend, ratio, mass, inertia, radius, sc, err):
 
 
 @njit(cache=True, inline="always")  # per contact: arrays and scalars only
-def push_pair(out, i, j, col, s, nx, ny, nz):
-    """A pair's force s n [N] (n from i to j) on its granules into out[:, col:col + 3]:
-    minus on i, plus on j."""
-    out[i, col] -= s * nx
-    out[i, col + 1] -= s * ny
-    out[i, col + 2] -= s * nz
-    out[j, col] += s * nx
-    out[j, col + 1] += s * ny
-    out[j, col + 2] += s * nz
+def push_pair(out_i, out_j, i, j, col_i, col_j, s, nx, ny, nz):
+    """A pair's force s n [N] (n from i to j) on its granules: minus on i into
+    out_i[i, col_i:col_i + 3], plus on j into out_j[j, col_j:col_j + 3]."""
+    out_i[i, col_i] -= s * nx
+    out_i[i, col_i + 1] -= s * ny
+    out_i[i, col_i + 2] -= s * nz
+    out_j[j, col_j] += s * nx
+    out_j[j, col_j + 1] += s * ny
+    out_j[j, col_j + 2] += s * nz
+
+
+#: columns of a block's buffer row (solver.blocks' fpar[k, i]) of a granule outside the
+#: block's own rows: the damping part of its forces (x, y, z) [N] in BUF_DAMP's; its forces
+#: [N] and torques [N m] in the columns they have in the accelerations (VX, WX).
+BUF_DAMP = 0
+N_BUF = 9
+
+
+@njit(cache=True, inline="always")
+def row_target(acc, fdamp, buf, i, own_lo, own_hi, t_lo, t_hi):
+    """Where a pass puts granule i's forces: its own rows [own_lo, own_hi) straight into
+    acc and fdamp (damping in column VX), any other into the buffer buf (damping in
+    BUF_DAMP), the buffered rows' range [t_lo, t_hi) widened. Returns (the forces' array, the
+    damping's, the damping's column, t_lo, t_hi)."""
+    if own_lo <= i < own_hi:
+        return acc, fdamp, VX, t_lo, t_hi
+    return buf, buf, BUF_DAMP, min(t_lo, i), max(t_hi, i + 1)
 
 
 @njit(cache=True)
@@ -325,9 +343,9 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
     p_shock = 0.0
     if not cfg.load_on_plate:
         p_shock = shock_loads(t, y, g, cfg, acc, fload)
-    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, _, _ = pair_forces(
-        y, y, 0.0, g, cfg, 0, g.pair_ij.shape[0], acc, fdamp, VX, VX, WX, False
-    )
+    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, _, _, _, _ = pair_forces(
+        y, y, 0.0, g, cfg, 0, g.pair_ij.shape[0], acc, fdamp, acc, 0, ng, False
+    )  # (every granule its own: no buffer)
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
         y, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
     )
@@ -451,17 +469,19 @@ def push_couple(out, i, col, arm, nx, ny, nz, fx, fy, fz):
 
 
 @njit(cache=True)
-def pair_forces(yv, yn, h, g, cfg, lo, hi, out, out_d, c_f, c_d, c_t, tangential):
+def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tangential):
     """Listed pairs lo..hi-1 of the velocity-Verlet force pass in space: each pair's normal
-    force at state yn (its overlap into HIST_END) into out[:, c_f:c_f + 3] (minus on i,
-    plus on j), its damping part into out_d[:, c_d:c_d + 3]; with `tangential`, at the
-    pairs whose tangential law keeps a history (Mindlin's: laws.keeps_history), its force from the same overlap and
-    |N| (docs/model.md section 3.16; the slip from yv's velocities over h [s]) added to the
-    forces and its torques into out[:, c_t:c_t + 3], a parted pair's history ended
-    (`mindlin_parted`). The serial pass (`normal_forces`, solver.mindlin_space) and each
-    block of the threaded ones (solver.blocks) run this over their range. Returns (viscous
-    power [W], stored energy [J], plastic work [J], the largest overlap / smaller radius,
-    its pair (i, j), the springs' energy [J], their losses [J]).
+    force at state yn (its overlap into HIST_END) on its granules (minus on i, plus on j)
+    into acc[:, VX:VX + 3], its damping part into fdamp[:, VX:VX + 3]; with `tangential`,
+    at the pairs whose tangential law keeps a history (Mindlin's: laws.keeps_history), its
+    force from the same overlap and |N| (docs/model.md section 3.16; the slip from yv's
+    velocities over h [s]) added to the forces and its torques into acc[:, WX:WX + 3], a
+    parted pair's history ended (`mindlin_parted`). Granules outside [own_lo, own_hi) take
+    theirs in the buffer buf instead (`row_target`; a block of the threaded passes,
+    solver.blocks); the serial pass (`normal_forces`, solver.mindlin_space) owns every
+    granule. Returns (viscous power [W], stored energy [J], plastic work [J], the largest
+    overlap / smaller radius, its pair (i, j), the springs' energy [J], their losses [J],
+    and the range [t_lo, t_hi) of the buffer's rows written; empty: t_lo >= t_hi).
 
     Written out per contact for speed: a compiled function called per contact with the
     granular arrays (or even a few of them) costs 3-30x this loop (measured on 56,754
@@ -475,6 +495,8 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, out, out_d, c_f, c_d, c_t, tangential
     ovl = 0.0
     ovl_i = -1
     ovl_j = -1
+    t_lo = acc.shape[0]
+    t_hi = 0
     hist = g.pair_hist
     half_shrink = 0.5 * cfg.arm_shrink
     for p in range(lo, hi):
@@ -502,9 +524,11 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, out, out_d, c_f, c_d, c_t, tangential
         w_plastic += wp
         p_visc += pv
         e_pot += ep
-        push_pair(out, i, j, c_f, n, nx, ny, nz)
+        fi, di, ci, t_lo, t_hi = row_target(acc, fdamp, buf, i, own_lo, own_hi, t_lo, t_hi)
+        fj, dj, cj, t_lo, t_hi = row_target(acc, fdamp, buf, j, own_lo, own_hi, t_lo, t_hi)
+        push_pair(fi, fj, i, j, VX, VX, n, nx, ny, nz)
         if pv != 0.0:  # the damping part of |N|, pv / ddot
-            push_pair(out_d, i, j, c_d, pv / ddot, nx, ny, nz)
+            push_pair(di, dj, i, j, ci, cj, pv / ddot, nx, ny, nz)
         if kt:  # the history law's force (Mindlin's spring) from the same overlap and |N|
             c = g.pair_coef[p]
             ai = contact_arm(ri, delta, half_shrink)
@@ -522,12 +546,12 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, out, out_d, c_f, c_d, c_t, tangential
                 dl -= couple_work(yv, j, tj - aj, nx, ny, nz, f0x + fx, f0y + fy, f0z + fz, 0.5 * h)
             e_t += e
             lost += dl
-            out[i, c_f] += fx  # (F on i, -F on j)
-            out[i, c_f + 1] += fy
-            out[i, c_f + 2] += fz
-            out[j, c_f] -= fx
-            out[j, c_f + 1] -= fy
-            out[j, c_f + 2] -= fz
-            push_couple(out, i, c_t, ti, nx, ny, nz, fx, fy, fz)
-            push_couple(out, j, c_t, tj, nx, ny, nz, fx, fy, fz)
-    return p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, e_t, lost
+            fi[i, VX] += fx  # (F on i, -F on j)
+            fi[i, VX + 1] += fy
+            fi[i, VX + 2] += fz
+            fj[j, VX] -= fx
+            fj[j, VX + 1] -= fy
+            fj[j, VX + 2] -= fz
+            push_couple(fi, i, WX, ti, nx, ny, nz, fx, fy, fz)
+            push_couple(fj, j, WX, tj, nx, ny, nz, fx, fy, fz)
+    return p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, e_t, lost, t_lo, t_hi
