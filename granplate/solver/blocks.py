@@ -49,9 +49,12 @@ N_FPAR = N_BUF
 #: [J], the largest overlap / smaller radius [-], its granule and its partner (as floats),
 #: the kicks' load and damping work [J], Mindlin's springs' energy and losses [J], (row
 #: 0: in all) how many granules the last force pass gave a damping force (`gather_forces`),
-#: and the range [S_TLO, S_THI) of the buffer rows the block's pairs wrote (as floats).
-S_VISC, S_EPOT, S_PLASTIC, S_OVL, S_OVL_I, S_OVL_J, S_WLOAD, S_WDAMP, S_ET, S_LOST, S_DAMPED, S_TLO, S_THI = range(13)
-N_SPAR = 13
+#: the range [S_TLO, S_THI) of the buffer rows the block's pairs wrote (as floats), and
+#: (row 0, set by the scheme before a pass) 1 where the pass's load rows (S_ZERO_LOADS), its
+#: damping rows (S_ZERO_DAMP) are all zero already, so the blocks leave them uncleared.
+S_VISC, S_EPOT, S_PLASTIC, S_OVL, S_OVL_I, S_OVL_J, S_WLOAD, S_WDAMP, S_ET, S_LOST, S_DAMPED = range(11)
+S_TLO, S_THI, S_ZERO_LOADS, S_ZERO_DAMP = range(11, 15)
+N_SPAR = 15
 
 
 @njit(cache=True)
@@ -87,15 +90,21 @@ def owned_rows(k, nb, pair_ij, ng):
 
 
 @njit(cache=True)
-def clear_block(acc, fdamp, fload, lo, hi):
-    """Block k's share of a pass's clearing: its own granules' rows lo..hi-1 of acc, fdamp
-    and fload from the velocity columns on (its buffer is zero already: `gather_rows`
-    zeroes what it reads)."""
+def clear_block(acc, fdamp, fload, lo, hi, damp, loads):
+    """Block k's share of a pass's clearing: its own granules' rows lo..hi-1 of acc, and of
+    fdamp and fload where `damp` and `loads` (else they are all zero already), from the
+    velocity columns on (its buffer is zero already: `gather_rows` zeroes what it reads)."""
     for i in range(lo, hi):
         for c in range(3, acc.shape[1]):
             acc[i, c] = 0.0
-            fdamp[i, c] = 0.0
-            fload[i, c] = 0.0
+    if damp:
+        for i in range(lo, hi):
+            for c in range(3, acc.shape[1]):
+                fdamp[i, c] = 0.0
+    if loads:
+        for i in range(lo, hi):
+            for c in range(3, acc.shape[1]):
+                fload[i, c] = 0.0
 
 
 @njit(cache=True, inline="always")
@@ -107,7 +116,7 @@ def block_pairs(yv, yn, h, g, cfg, k, fpar, spar, acc, fdamp, fload, tangential)
     nb = fpar.shape[0]
     ng = acc.shape[0]
     own_lo, own_hi = owned_rows(k, nb, g.pair_ij, ng)
-    clear_block(acc, fdamp, fload, own_lo, own_hi)
+    clear_block(acc, fdamp, fload, own_lo, own_hi, spar[0, S_ZERO_DAMP] == 0.0, spar[0, S_ZERO_LOADS] == 0.0)
     lo, hi = block_range(k, nb, g.pair_ij.shape[0])
     pv, ep, wp, ovl, ovl_i, ovl_j, e_t, lost, t_lo, t_hi = pair_forces(
         yv, yn, h, g, cfg, lo, hi, acc, fdamp, fpar[k], own_lo, own_hi, tangential
@@ -302,13 +311,13 @@ def copy_rows(dst, src):
 
 
 @njit(parallel=True)
-def accept_rows(y, k0, k1, ynew, kend):
+def accept_rows(y, k1, ynew, kend):
     """The accepted step's state and derivatives (solver.loop.accept_granular's copies:
-    y = ynew, k0 = k1, k1 = kend), granule by granule on every core."""
+    y = ynew, k1 = kend), granule by granule on every core. (The derivatives of the step
+    before, k0, serve the implicit scheme's error alone, which runs on one thread.)"""
     for i in prange(y.shape[0]):
         for c in range(y.shape[1]):
             y[i, c] = ynew[i, c]
-            k0[i, c] = k1[i, c]
             k1[i, c] = kend[i, c]
 
 

@@ -391,7 +391,7 @@ def advance(t_stop, max_attempts, g, p, b, cfg, st, w, sw, out):
         plate_work = S.commit(sw, t, h, slot, plate_work, fric_work, st, g, p, b, cfg, w)
         accept_pistons(g)
         if cfg.threads > 1:  # the copies and the pairs' histories on every core (solver.blocks)
-            accept_rows(st.y, st.k0, st.k1, w.ynew, w.kend)
+            accept_rows(st.y, st.k1, w.ynew, w.kend)
             accept_granular(t, h, land, t_land, plate_work, e_pot, st, w, False)
             commit_histories_blocks(st.clock[T_NOW], g, cfg.threads)
         else:

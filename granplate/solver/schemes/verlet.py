@@ -48,7 +48,16 @@ from granplate.physics.contact import COEF_MU
 from granplate.solver import body as B
 from granplate.solver.schemes import verlet_body as VB
 from granplate.physics.shock import shock_amplitude
-from granplate.solver.blocks import N_FPAR, N_SPAR, S_DAMPED, copy_rows, kick_blocks, kick_drift_blocks
+from granplate.solver.blocks import (
+    N_FPAR,
+    N_SPAR,
+    S_DAMPED,
+    S_ZERO_DAMP,
+    S_ZERO_LOADS,
+    copy_rows,
+    kick_blocks,
+    kick_drift_blocks,
+)
 from granplate.solver.dimension import friction_flow, mindlin_force_pass, normal_forces, normal_forces_blocks
 from granplate.solver.drives import (
     drive_kick_work,
@@ -141,14 +150,20 @@ def has_friction(g, cfg) -> bool:
 
 
 @njit(cache=True)
-def force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, sw):
-    """The force pass at (t, yn): in blocks on every core when the scratch has blocks
-    (solver.blocks), else serially; under Mindlin's law (cfg.history_friction) with the tangential
+def force_pass(t, yv, yn, h, g, cfg, sw, buf, acc):
+    """The force pass at (t, yn) into buffer buf (sw.fdamp[buf], sw.fload[buf]; the
+    accelerations into acc): in blocks on every core when the scratch has blocks
+    (solver.blocks: they leave uncleared the buffer's rows its last pass left all zero,
+    sw.quiet), else serially; under Mindlin's law (cfg.history_friction) with the tangential
     springs in it, their histories moved on by the slip at yv's velocities over h [s] (0:
     the committed histories' forces). Returns (the ForceSums, the springs' stored energy
     [J], their losses [J]; 0 and 0 without Mindlin's law)."""
+    fdamp = sw.fdamp[buf]
+    fload = sw.fload[buf]
     if sw.spar.shape[0] > 0:
         sw.spar[0, S_DAMPED] = 1.0  # (damped until a threaded pass in space counts its granules)
+        sw.spar[0, S_ZERO_LOADS] = sw.quiet[buf, 0]
+        sw.spar[0, S_ZERO_DAMP] = sw.quiet[buf, 1]
     if cfg.history_friction:
         return mindlin_force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar)
     if sw.spar.shape[0] > 0:
@@ -194,7 +209,7 @@ def copy_state(y, st, b, sw):
 def first_forces(t, st, g, b, cfg, sw, cur):
     """t_n's forces, loads and damping on the run's first step (st.k1 as `initialise` has
     it; Mindlin's law with the committed histories), the body's too."""
-    force_pass(t, st.y, st.y, 0.0, g, cfg, st.k1, sw.fdamp[cur], sw.fload[cur], sw)
+    force_pass(t, st.y, st.y, 0.0, g, cfg, sw, cur, st.k1)
     VB.first_forces(st.y, b, cur, st, g, cfg, st.k1, sw.fdamp)
     note_quiet(sw, cur, t, b, cfg)
     finish_pass(st.y, st.k1, g)
@@ -256,7 +271,7 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
         wl, wd = kick_drift(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, 0, y.shape[0], predict)
     wl, wd, w_grav = VB.first_kick(b, t, h, cur, cfg, wl, wd, w_grav)
     # (Mindlin: the slip over h at the half step's velocities, y's)
-    pr, e_t, lost_t = force_pass(t + h, y, w.ytmp, h, g, cfg, w.kend, sw.fdamp[nxt], sw.fload[nxt], sw)
+    pr, e_t, lost_t = force_pass(t + h, y, w.ytmp, h, g, cfg, sw, nxt, w.kend)
     e_pot, p_visc, w_plastic, fric, ovl, ovl_i, ovl_j = VB.end_pass(
         y, w.ytmp, st, b, cur, nxt, h, g, cfg, w.kend, sw.fdamp,
         pr.e_pot + e_t, pr.p_visc, pr.w_plastic, fric + lost_t, pr.ovl, pr.ovl_i, pr.ovl_j,
