@@ -137,9 +137,10 @@ def test_study_workers_run_one_thread_each():
         assert client.submit(_numba_threads, pure=False).result() == 1
 
 
-@pytest.mark.parametrize("nb", [1, 3])
-def test_block_mindlin_pass_equals_the_serial_pass(nb):
-    """Mindlin's force pass in nb blocks (solver.blocks.mindlin_forces_blocks) gives the serial
+@pytest.mark.parametrize("nt, nb", [(1, 1), (3, 3), (2, 8)])
+def test_block_mindlin_pass_equals_the_serial_pass(nt, nb):
+    """Mindlin's force pass in nb blocks dealt out to nt buffers (solver.blocks.
+    mindlin_forces_blocks: a thread's blocks in turn, into its buffer) gives the serial
     pass's accelerations and spins to round-off, each contact's history bit for bit
     (its own step alone), and the springs' energy and losses to round-off."""
     from granplate.solver.blocks import mindlin_forces_blocks
@@ -166,7 +167,7 @@ def test_block_mindlin_pass_equals_the_serial_pass(nb):
             g.wall_hist[:] = wall
             if blocks:
                 sums, e_t, lost = mindlin_forces_blocks(
-                    0.0, y, y, 1e-8, g, cfg, acc, fd, fl, np.zeros((nb, ng, N_FPAR)), np.zeros((nb, N_SPAR))
+                    0.0, y, y, 1e-8, g, cfg, acc, fd, fl, np.zeros((nt, ng, N_FPAR)), np.zeros((nb, N_SPAR))
                 )
             else:
                 sums, e_t, lost = normal_mindlin_forces(0.0, y, y, 1e-8, g, cfg, acc, fd, fl)

@@ -57,6 +57,21 @@ S_TLO, S_THI, S_ZERO_LOADS, S_ZERO_DAMP = range(11, 15)
 N_SPAR = 15
 
 
+#: blocks of pairs per thread under a law whose contacts in touch cost much more than those
+#: apart (Mindlin's), dealt out in turn (thread t of T runs blocks t, t + T, ...): the
+#: contacts in touch gather where a wave has reached, and granules are often numbered along
+#: the direction it travels, so each thread then takes slabs across the packing rather than
+#: one half of it (docs/benchmarks.md). The normal pass runs one block per thread.
+BLOCKS_PER_THREAD = 4
+
+
+def block_count(threads: int) -> int:
+    """The blocks (rows of the sums spar) of a run on `threads` threads: none for one thread
+    (the serial passes), else BLOCKS_PER_THREAD per thread; the buffers fpar are one per
+    thread."""
+    return BLOCKS_PER_THREAD * threads if threads > 1 else 0
+
+
 @njit(cache=True)
 def block_range(k, nb, n):
     """The items [lo, hi) of block k of nb over n items (contiguous, sizes within one)."""
@@ -108,18 +123,17 @@ def clear_block(acc, fdamp, fload, lo, hi, damp, loads):
 
 
 @njit(cache=True, inline="always")
-def block_pairs(yv, yn, h, g, cfg, k, fpar, spar, acc, fdamp, fload, tangential):
-    """Block k's pairs (`block_range` of the pair list; solver.granular3d.pair_forces): its
-    own granules' rows cleared and their forces put straight into acc and fdamp, the other
-    granules' into its buffer fpar[k]; its sums and buffered rows' range into spar[k].
-    Returns (the springs' energy [J], their losses [J])."""
-    nb = fpar.shape[0]
+def block_pairs(yv, yn, h, g, cfg, k, nb, buf, spar, acc, fdamp, fload, tangential):
+    """Block k of nb's pairs (`block_range` of the pair list; solver.granular3d.pair_forces):
+    its own granules' rows cleared and their forces put straight into acc and fdamp, the
+    other granules' into the buffer buf; its sums into spar[k]. Returns (the springs' energy
+    [J], their losses [J], and the buffer rows [lo, hi) it wrote)."""
     ng = acc.shape[0]
     own_lo, own_hi = owned_rows(k, nb, g.pair_ij, ng)
     clear_block(acc, fdamp, fload, own_lo, own_hi, spar[0, S_ZERO_DAMP] == 0.0, spar[0, S_ZERO_LOADS] == 0.0)
     lo, hi = block_range(k, nb, g.pair_ij.shape[0])
     pv, ep, wp, ovl, ovl_i, ovl_j, e_t, lost, t_lo, t_hi = pair_forces(
-        yv, yn, h, g, cfg, lo, hi, acc, fdamp, fpar[k], own_lo, own_hi, tangential
+        yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tangential
     )
     spar[k, S_VISC] = pv
     spar[k, S_EPOT] = ep
@@ -127,36 +141,55 @@ def block_pairs(yv, yn, h, g, cfg, k, fpar, spar, acc, fdamp, fload, tangential)
     spar[k, S_OVL] = ovl
     spar[k, S_OVL_I] = ovl_i
     spar[k, S_OVL_J] = ovl_j
-    spar[k, S_TLO] = t_lo
-    spar[k, S_THI] = t_hi
-    return e_t, lost
+    return e_t, lost, t_lo, t_hi
+
+
+@njit(cache=True, inline="always")
+def thread_pairs(yv, yn, h, g, cfg, t, nb, fpar, spar, acc, fdamp, fload, tangential):
+    """The share of thread t of T (T = the buffers fpar): blocks t, t + T, ... of nb in
+    turn (`block_pairs`), their buffered forces in fpar[t] and its rows' range in spar[t,
+    S_TLO:S_THI + 1]; under Mindlin's law (`tangential`) each block's springs' energy and
+    losses into spar[k, S_ET], spar[k, S_LOST]."""
+    t_lo = acc.shape[0]
+    t_hi = 0
+    for k in range(t, nb, fpar.shape[0]):
+        e_t, lost, b_lo, b_hi = block_pairs(yv, yn, h, g, cfg, k, nb, fpar[t], spar, acc, fdamp, fload, tangential)
+        if tangential:
+            spar[k, S_ET] = e_t
+            spar[k, S_LOST] = lost
+        t_lo = min(t_lo, b_lo)
+        t_hi = max(t_hi, b_hi)
+    spar[t, S_TLO] = t_lo
+    spar[t, S_THI] = t_hi
 
 
 @njit(parallel=True)
 def pair_forces_blocks(y, g, cfg, fpar, spar, acc, fdamp, fload):
-    """The normal forces of every listed granule pair at state y (space), block by block
-    (`block_pairs`): block k clears its own granules' rows of acc, fdamp and fload and puts
-    its pairs' forces on them there, on other granules into its buffer fpar[k]; its viscous
-    power, stored energy, plastic work, largest overlap and buffered rows into spar[k];
+    """The normal forces of every listed granule pair at state y (space), one block per
+    thread (`thread_pairs`): block k clears its own granules' rows of acc, fdamp and fload
+    and puts its pairs' forces on them there, on other granules into its thread's buffer
+    fpar[k]; its viscous power, stored energy, plastic work, largest overlap into spar[k];
     each pair's overlap into HIST_END (as solver.granular3d.normal_forces)."""
-    for k in prange(fpar.shape[0]):
-        block_pairs(y, y, 0.0, g, cfg, k, fpar, spar, acc, fdamp, fload, False)
+    nt = fpar.shape[0]
+    for t in prange(nt):
+        thread_pairs(y, y, 0.0, g, cfg, t, nt, fpar, spar, acc, fdamp, fload, False)
 
 
 @njit(cache=True)
 def gather_rows(fpar, spar, acc, fdamp, mass, inertia, lo, hi):
-    """`gather_forces` for granules lo..hi-1: the buffered forces of each block whose
-    buffered rows [S_TLO, S_THI) meet them added in block order (and zeroed, ready for the
-    next pass), then the division; returns how many have a damping force."""
-    for k in range(fpar.shape[0]):
-        for i in range(max(lo, int(spar[k, S_TLO])), min(hi, int(spar[k, S_THI]))):
+    """`gather_forces` for granules lo..hi-1: the buffered forces of each thread's buffer
+    fpar[t] whose written rows [spar[t, S_TLO], spar[t, S_THI]) meet them, added in
+    buffer order (and zeroed, ready for the next pass), then the division; returns how many
+    have a damping force."""
+    for t in range(fpar.shape[0]):
+        for i in range(max(lo, int(spar[t, S_TLO])), min(hi, int(spar[t, S_THI]))):
             for c in range(3):
-                acc[i, VX + c] += fpar[k, i, F_X + c]
-                fdamp[i, VX + c] += fpar[k, i, F_DX + c]
-                acc[i, WX + c] += fpar[k, i, F_T + c]
-                fpar[k, i, F_X + c] = 0.0
-                fpar[k, i, F_DX + c] = 0.0
-                fpar[k, i, F_T + c] = 0.0
+                acc[i, VX + c] += fpar[t, i, F_X + c]
+                fdamp[i, VX + c] += fpar[t, i, F_DX + c]
+                acc[i, WX + c] += fpar[t, i, F_T + c]
+                fpar[t, i, F_X + c] = 0.0
+                fpar[t, i, F_DX + c] = 0.0
+                fpar[t, i, F_T + c] = 0.0
     n_damped = 0
     for i in range(lo, hi):
         damped = False
@@ -198,7 +231,7 @@ def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
     p_shock = 0.0
     if not cfg.load_on_plate:
         p_shock = shock_loads(t, y, g, cfg, acc, fload)
-    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = block_sums(spar)
+    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = block_sums(spar, fpar.shape[0])
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
         y, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
     )
@@ -209,25 +242,26 @@ def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
 @njit(parallel=True)
 def pair_mindlin_blocks(yv, yn, h, g, cfg, fpar, spar, acc, fdamp, fload):
     """`pair_forces_blocks` with Mindlin's law in it (solver.granular3d.pair_forces with its
-    tangential step, on block k's pairs: forces, damping parts and torques, its own
-    granules' straight into acc and fdamp, the others' into fpar[k]; its sums into spar[k],
-    the springs' energy and losses into S_ET, S_LOST). Each contact's tangential step reads
-    and writes its own history row alone."""
-    for k in prange(fpar.shape[0]):
-        spar[k, S_ET], spar[k, S_LOST] = block_pairs(yv, yn, h, g, cfg, k, fpar, spar, acc, fdamp, fload, True)
+    tangential step: forces, damping parts and torques), in BLOCKS_PER_THREAD blocks per
+    thread dealt out in turn (every row of spar a block: `thread_pairs`); the springs'
+    energy and losses into S_ET, S_LOST. Each contact's tangential step reads and writes its
+    own history row alone."""
+    for t in prange(fpar.shape[0]):
+        thread_pairs(yv, yn, h, g, cfg, t, spar.shape[0], fpar, spar, acc, fdamp, fload, True)
 
 
 @njit(cache=True)
-def block_sums(spar):
-    """The blocks' sums in block order: (viscous power [W], stored energy [J], plastic work
-    [J], the largest overlap and its pair (its first occurrence in block order))."""
+def block_sums(spar, nb):
+    """The sums of the pass's nb blocks (spar's first rows) in block order: (viscous power
+    [W], stored energy [J], plastic work [J], the largest overlap and its pair (its first
+    occurrence in block order))."""
     p_visc = 0.0
     e_pot = 0.0
     w_plastic = 0.0
     ovl = 0.0
     ovl_i = -1
     ovl_j = -1
-    for k in range(spar.shape[0]):
+    for k in range(nb):
         p_visc += spar[k, S_VISC]
         e_pot += spar[k, S_EPOT]
         w_plastic += spar[k, S_PLASTIC]
@@ -251,7 +285,7 @@ def mindlin_forces_blocks(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar):
     p_shock = 0.0
     if not cfg.load_on_plate:
         p_shock = shock_loads(t, yn, g, cfg, acc, fload)
-    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = block_sums(spar)
+    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = block_sums(spar, spar.shape[0])
     e_t = 0.0
     lost = 0.0
     for k in range(spar.shape[0]):

@@ -54,6 +54,7 @@ from granplate.solver.blocks import (
     S_DAMPED,
     S_ZERO_DAMP,
     S_ZERO_LOADS,
+    block_count,
     copy_rows,
     kick_blocks,
     kick_drift_blocks,
@@ -94,23 +95,23 @@ class Scratch(NamedTuple):
     fdamp: np.ndarray  # (2, ng, N_COLUMNS) damping force on each granule [N] (velocity columns)
     fload: np.ndarray  # (2, ng, N_COLUMNS) shock load on each granule [N, N m]
     split: np.ndarray  # (5,) OWED, FORWARD, LAND, STARTED, CURRENT
-    fpar: np.ndarray  # (nb, ng, N_FPAR) each block's forces on the granules [N] (solver.blocks; (0, 0, 0): serial)
-    spar: np.ndarray  # (nb, N_SPAR) each block's sums (solver.blocks)
+    fpar: np.ndarray  # (threads, ng, N_FPAR) each thread's buffered forces on granules other blocks own [N] (solver.blocks; (0, 0, 0): serial)
+    spar: np.ndarray  # (nb, N_SPAR) each block's sums (solver.blocks.block_count)
     quiet: np.ndarray  # (2, 2) per buffer: 1 where its loads (column 0), its damping forces (1) are all zero
 
 
 def new_scratch(ng: int, nm: int, nk: int, body: BodyArrays | None = None, threads: int = 1) -> Scratch:
     """Scratch for ng granules and nm modes (nk plate contacts: none are used; the elastic
     body in space is the loop's b, and `body` needs nothing here), and the buffers of
-    `threads` blocks (solver.blocks) when it is over 1."""
+    blocks for `threads` threads (solver.blocks.block_count) when it is over 1."""
     split = np.zeros(5)
     split[FORWARD] = 1.0
-    nb = threads if threads > 1 else 0
+    nb = block_count(threads)
     return Scratch(
         fdamp=np.zeros((2, ng, N_COLUMNS)),
         fload=np.zeros((2, ng, N_COLUMNS)),
         split=split,
-        fpar=np.zeros((nb, ng if nb else 0, N_FPAR)),
+        fpar=np.zeros((threads if nb else 0, ng if nb else 0, N_FPAR)),
         spar=np.zeros((nb, N_SPAR)),
         quiet=np.zeros((2, 2)),
     )
