@@ -1,11 +1,15 @@
 """The velocity-Verlet passes on every core (`solver.threads`, docs/model.md section 6.6):
-the contacts and the granules cut into `nb` fixed blocks, one per thread, each block's
-forces and sums kept apart and then added in block order.
+the contacts and the granules cut into `nb` fixed blocks, each block's sums kept apart
+and then added in block order.
 
 Each block k takes the contiguous range `block_range(k, nb, n)` of the pair list (or of
-the granules), whatever thread runs it, and writes only its own slice of the buffers
-(`fpar[k]`, `spar[k]`), so a run is bitwise the same for a given number of blocks however
-the threads are scheduled, and it differs from the serial loop (`solver.threads = 1`,
+the granules), whatever thread runs it. A block of pairs owns a range of granules
+(`owned_rows`): it writes their forces straight into the pass's arrays, and the forces on
+the few granules past its own (its pairs' partners) into the buffer of the thread that
+runs it, `fpar[t]` (thread t of T runs blocks t, t + T, ...: `thread_pairs`); each
+granule then takes the buffers' rows in a fixed order (`gather_forces`). No two blocks
+write the same number, so a run is bitwise the same for a given thread count however the
+threads are scheduled, and it differs from the serial loop (`solver.threads = 1`,
 solver.granular3d.normal_forces) only by the order in which each granule's contact forces
 and the energy sums are added: round-off. The contact laws, the overlaps and the largest
 overlap (its first occurrence in pair order, as the serial pass finds it) are the same
@@ -39,8 +43,8 @@ from granplate.solver.granular3d import BUF_DAMP, N_BUF, VX, WX, pair_forces, sh
 from granplate.solver.kicks import kick, kick_drift
 from granplate.solver.mindlin_space import wall_mindlin
 
-#: columns of a block's buffer row fpar[k, i], for a granule i outside the block's own rows
-#: (`owned_rows`): the damping part of the forces on it (x, y, z) [N], the normal forces
+#: columns of a thread's buffer row fpar[t, i], for a granule i outside the own rows
+#: (`owned_rows`) of the block that wrote it: the damping part of the forces on it (x, y, z) [N], the normal forces
 #: (x, y, z) [N] and, under Mindlin's law, the tangential forces' torques (x, y, z) [N m]
 #: (their forces are in F_X's columns): solver.granular3d's buffer columns.
 F_DX, F_X, F_T = BUF_DAMP, VX, WX
@@ -49,7 +53,7 @@ N_FPAR = N_BUF
 #: [J], the largest overlap / smaller radius [-], its granule and its partner (as floats),
 #: the kicks' load and damping work [J], Mindlin's springs' energy and losses [J], (row
 #: 0: in all) how many granules the last force pass gave a damping force (`gather_forces`),
-#: the range [S_TLO, S_THI) of the buffer rows the block's pairs wrote (as floats), and
+#: (row t: thread t's) the range [S_TLO, S_THI) of its buffer's rows written (as floats), and
 #: (row 0, set by the scheme before a pass) 1 where the pass's load rows (S_ZERO_LOADS), its
 #: damping rows (S_ZERO_DAMP) are all zero already, so the blocks leave them uncleared.
 S_VISC, S_EPOT, S_PLASTIC, S_OVL, S_OVL_I, S_OVL_J, S_WLOAD, S_WDAMP, S_ET, S_LOST, S_DAMPED = range(11)
@@ -98,9 +102,9 @@ def owner_start(k, nb, pair_ij, ng):
 
 @njit(cache=True)
 def owned_rows(k, nb, pair_ij, ng):
-    """The granules [lo, hi) whose rows block k writes straight into the accelerations: no
-    other block writes them there (their forces from other blocks' pairs wait in those
-    blocks' buffers, `gather_forces`)."""
+    """The granules [lo, hi) whose rows block k of nb writes straight into the
+    accelerations: no other block writes them there (their forces from other blocks' pairs
+    wait in the buffers of the threads that run those blocks, `gather_forces`)."""
     return owner_start(k, nb, pair_ij, ng), owner_start(k + 1, nb, pair_ij, ng)
 
 
@@ -168,7 +172,7 @@ def pair_forces_blocks(y, g, cfg, fpar, spar, acc, fdamp, fload):
     """The normal forces of every listed granule pair at state y (space), one block per
     thread (`thread_pairs`): block k clears its own granules' rows of acc, fdamp and fload
     and puts its pairs' forces on them there, on other granules into its thread's buffer
-    fpar[k]; its viscous power, stored energy, plastic work, largest overlap into spar[k];
+    fpar[k] (one block per thread: k = t); its viscous power, stored energy, plastic work, largest overlap into spar[k];
     each pair's overlap into HIST_END (as solver.granular3d.normal_forces)."""
     nt = fpar.shape[0]
     for t in prange(nt):
@@ -204,8 +208,8 @@ def gather_rows(fpar, spar, acc, fdamp, mass, inertia, lo, hi):
 
 @njit(parallel=True)
 def gather_forces(fpar, acc, fdamp, mass, inertia, spar):
-    """Each granule's forces from the blocks' buffers, added in block order to what acc and
-    fdamp hold (its own block's pairs', the shock's and the walls'), then acc's forces and
+    """Each granule's forces from the threads' buffers, added in buffer order to what acc
+    and fdamp hold (its own block's pairs', the shock's and the walls'), then acc's forces and
     torques made accelerations: acc[:, 3:6] /= mass, acc[:, 6:9] /= inertia (space's
     velocity and spin columns). The granules in blocks; how many of them have a damping
     force (fdamp not zero) into spar[0, S_DAMPED]."""
