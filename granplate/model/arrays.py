@@ -356,7 +356,7 @@ def plane_model(s: Scenario) -> Model:
             s.contact.detection,
             "granules touching the face between nodes at t = 0 need patch contacts",
         )
-    columns = scenario_history_columns(s)  # the history rows: 4 numbers, or 18 (11 under verlet) under a history law
+    columns = scenario_history_columns(s)  # history rows: 4 numbers; 18 under a history law (11 under verlet)
     granular = Granular(
         mass=mass,
         inertia=inertia,

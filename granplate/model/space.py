@@ -118,7 +118,7 @@ def build_space_model(s: Scenario):
     state = initial_state_3d(s)
     wall_geo, wall_coef = wall_arrays(s, mats, r, mass, loop_wc)
     shares, torques = loads.resultants(s, np.column_stack([x, y, z]), r)
-    columns = scenario_history_columns(s)  # the history rows: 4 numbers, or 18 (11 under verlet) under a history law
+    columns = scenario_history_columns(s)  # history rows: 4 numbers; 18 under a history law (11 under verlet)
     granular = Granular3(
         mass=mass,
         inertia=inertia,

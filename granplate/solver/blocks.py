@@ -44,9 +44,10 @@ from granplate.solver.kicks import kick, kick_drift
 from granplate.solver.mindlin_space import wall_mindlin
 
 #: columns of a thread's buffer row fpar[t, i], for a granule i outside the own rows
-#: (`owned_rows`) of the block that wrote it: the damping part of the forces on it (x, y, z) [N], the normal forces
-#: (x, y, z) [N] and, under Mindlin's law, the tangential forces' torques (x, y, z) [N m]
-#: (their forces are in F_X's columns): solver.granular3d's buffer columns.
+#: (`owned_rows`) of the block that wrote it: the damping part of the forces on it
+#: (x, y, z) [N], the normal forces (x, y, z) [N] and, under Mindlin's law, the tangential
+#: forces' torques (x, y, z) [N m] (their forces are in F_X's columns): solver.granular3d's
+#: buffer columns.
 F_DX, F_X, F_T = BUF_DAMP, VX, WX
 N_FPAR = N_BUF
 #: columns of a block's sums spar[k]: viscous power [W], stored energy [J], plastic work
@@ -172,8 +173,9 @@ def pair_forces_blocks(y, g, cfg, fpar, spar, acc, fdamp, fload):
     """The normal forces of every listed granule pair at state y (space), one block per
     thread (`thread_pairs`): block k clears its own granules' rows of acc, fdamp and fload
     and puts its pairs' forces on them there, on other granules into its thread's buffer
-    fpar[k] (one block per thread: k = t); its viscous power, stored energy, plastic work, largest overlap into spar[k];
-    each pair's overlap into HIST_END (as solver.granular3d.normal_forces)."""
+    fpar[k] (one block per thread: k = t); its viscous power, stored energy, plastic work
+    and largest overlap into spar[k]; each pair's overlap into HIST_END (as
+    solver.granular3d.normal_forces)."""
     nt = fpar.shape[0]
     for t in prange(nt):
         thread_pairs(y, y, 0.0, g, cfg, t, nt, fpar, spar, acc, fdamp, fload, False)

@@ -308,8 +308,8 @@ def push_pair(out_i, out_j, i, j, col_i, col_j, s, nx, ny, nz):
     out_j[j, col_j + 2] += s * nz
 
 
-#: columns of a block's buffer row (solver.blocks' fpar[k, i]) of a granule outside the
-#: block's own rows: the damping part of its forces (x, y, z) [N] in BUF_DAMP's; its forces
+#: columns of a thread's buffer row (solver.blocks' fpar[t, i]) of a granule outside the
+#: own rows of the block that wrote it: the damping part of its forces (x, y, z) [N] in BUF_DAMP's; its forces
 #: [N] and torques [N m] in the columns they have in the accelerations (VX, WX).
 BUF_DAMP = 0
 N_BUF = 9
