@@ -87,10 +87,12 @@ def test_block_force_pass_equals_the_serial_pass(nb):
     y[:, 3:6] += rng.normal(0.0, 0.1, (len(y), 3))
     ng = len(y)
     acc0, fd0, fl0 = (np.zeros((ng, 9)) for _ in range(3))
-    serial = granular3d.normal_forces(0.0, y, g, cfg, acc0, fd0, fl0)
+    serial = granular3d.normal_forces(0.0, y, g, cfg, acc0, fd0, fl0, -1.0)
     end0 = g.pair_hist[:, HIST_END].copy()
     acc1, fd1, fl1 = (np.zeros((ng, 9)) for _ in range(3))
-    blocks = normal_forces_blocks(0.0, y, g, cfg, acc1, fd1, fl1, np.zeros((nb, ng, N_FPAR)), np.zeros((nb, N_SPAR)))
+    blocks = normal_forces_blocks(
+        0.0, y, g, cfg, acc1, fd1, fl1, np.zeros((nb, ng, N_FPAR)), np.zeros((nb, N_SPAR)), -1.0
+    )
     assert np.array_equal(g.pair_hist[:, HIST_END], end0)
     assert (blocks.ovl, blocks.ovl_i, blocks.ovl_j) == (serial.ovl, serial.ovl_i, serial.ovl_j)
     assert serial.ovl > 0.0
@@ -167,10 +169,10 @@ def test_block_mindlin_pass_equals_the_serial_pass(nt, nb):
             g.wall_hist[:] = wall
             if blocks:
                 sums, e_t, lost = mindlin_forces_blocks(
-                    0.0, y, y, 1e-8, g, cfg, acc, fd, fl, np.zeros((nt, ng, N_FPAR)), np.zeros((nb, N_SPAR))
+                    0.0, y, y, 1e-8, g, cfg, acc, fd, fl, np.zeros((nt, ng, N_FPAR)), np.zeros((nb, N_SPAR)), 1e-8
                 )
             else:
-                sums, e_t, lost = normal_mindlin_forces(0.0, y, y, 1e-8, g, cfg, acc, fd, fl)
+                sums, e_t, lost = normal_mindlin_forces(0.0, y, y, 1e-8, g, cfg, acc, fd, fl, 1e-8)
             hist, wall = g.pair_hist.copy(), g.wall_hist.copy()  # (velocity Verlet's rows: moved on in place)
         out.append((acc.copy(), g.pair_hist.copy(), e_t, lost))
     (a0, h0, e0, l0), (a1, h1, e1, l1) = out
@@ -221,10 +223,10 @@ def test_block_pass_counts_the_granules_it_damps(alpha_n):
     y[:, 3:6] += 0.1
     ng = len(y)
     acc0, fd0, fl0 = (np.zeros((ng, 9)) for _ in range(3))
-    granular3d.normal_forces(0.0, y, g, cfg, acc0, fd0, fl0)
+    granular3d.normal_forces(0.0, y, g, cfg, acc0, fd0, fl0, -1.0)
     acc1, fd1, fl1 = (np.full((ng, 9), 7.0) for _ in range(3))  # the pass clears what it writes
     spar = np.zeros((2, N_SPAR))
-    normal_forces_blocks(0.0, y, g, cfg, acc1, fd1, fl1, np.zeros((2, ng, N_FPAR)), spar)
+    normal_forces_blocks(0.0, y, g, cfg, acc1, fd1, fl1, np.zeros((2, ng, N_FPAR)), spar, -1.0)
     assert spar[0, S_DAMPED] == np.count_nonzero(np.abs(fd0).sum(axis=1))
     assert (spar[0, S_DAMPED] > 0) == (alpha_n > 0.0)
     assert np.abs(fd1[:, 3:] - fd0[:, 3:]).max() <= 1e-13 * max(np.abs(fd0).max(), 1e-30)

@@ -128,7 +128,7 @@ def clear_block(acc, fdamp, fload, lo, hi, damp, loads):
 
 
 @njit(cache=True, inline="always")
-def block_pairs(yv, yn, h, g, cfg, k, nb, buf, spar, acc, fdamp, fload, tangential):
+def block_pairs(yv, yn, h, g, cfg, k, nb, buf, spar, acc, fdamp, fload, tangential, commit_t):
     """Block k of nb's pairs (`block_range` of the pair list; solver.granular3d.pair_forces):
     its own granules' rows cleared and their forces put straight into acc and fdamp, the
     other granules' into the buffer buf; its sums into spar[k]. Returns (the springs' energy
@@ -138,7 +138,7 @@ def block_pairs(yv, yn, h, g, cfg, k, nb, buf, spar, acc, fdamp, fload, tangenti
     clear_block(acc, fdamp, fload, own_lo, own_hi, spar[0, S_ZERO_DAMP] == 0.0, spar[0, S_ZERO_LOADS] == 0.0)
     lo, hi = block_range(k, nb, g.pair_ij.shape[0])
     pv, ep, wp, ovl, ovl_i, ovl_j, e_t, lost, t_lo, t_hi = pair_forces(
-        yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tangential
+        yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tangential, commit_t
     )
     spar[k, S_VISC] = pv
     spar[k, S_EPOT] = ep
@@ -150,7 +150,7 @@ def block_pairs(yv, yn, h, g, cfg, k, nb, buf, spar, acc, fdamp, fload, tangenti
 
 
 @njit(cache=True, inline="always")
-def thread_pairs(yv, yn, h, g, cfg, t, nb, fpar, spar, acc, fdamp, fload, tangential):
+def thread_pairs(yv, yn, h, g, cfg, t, nb, fpar, spar, acc, fdamp, fload, tangential, commit_t):
     """The share of thread t of T (T = the buffers fpar): blocks t, t + T, ... of nb in
     turn (`block_pairs`), their buffered forces in fpar[t] and its rows' range in spar[t,
     S_TLO:S_THI + 1]; under Mindlin's law (`tangential`) each block's springs' energy and
@@ -158,7 +158,9 @@ def thread_pairs(yv, yn, h, g, cfg, t, nb, fpar, spar, acc, fdamp, fload, tangen
     t_lo = acc.shape[0]
     t_hi = 0
     for k in range(t, nb, fpar.shape[0]):
-        e_t, lost, b_lo, b_hi = block_pairs(yv, yn, h, g, cfg, k, nb, fpar[t], spar, acc, fdamp, fload, tangential)
+        e_t, lost, b_lo, b_hi = block_pairs(
+            yv, yn, h, g, cfg, k, nb, fpar[t], spar, acc, fdamp, fload, tangential, commit_t
+        )
         if tangential:
             spar[k, S_ET] = e_t
             spar[k, S_LOST] = lost
@@ -169,16 +171,16 @@ def thread_pairs(yv, yn, h, g, cfg, t, nb, fpar, spar, acc, fdamp, fload, tangen
 
 
 @njit(parallel=True)
-def pair_forces_blocks(y, g, cfg, fpar, spar, acc, fdamp, fload):
+def pair_forces_blocks(y, g, cfg, fpar, spar, acc, fdamp, fload, commit_t):
     """The normal forces of every listed granule pair at state y (space), one block per
     thread (`thread_pairs`): block k clears its own granules' rows of acc, fdamp and fload
     and puts its pairs' forces on them there, on other granules into its thread's buffer
     fpar[k] (one block per thread: k = t); its viscous power, stored energy, plastic work
-    and largest overlap into spar[k]; each pair's overlap into HIST_END (as
-    solver.granular3d.normal_forces)."""
+    and largest overlap into spar[k]; each pair's overlap into HIST_END, committed at
+    commit_t [s] (as solver.granular3d.normal_forces)."""
     nt = fpar.shape[0]
     for t in prange(nt):
-        thread_pairs(y, y, 0.0, g, cfg, t, nt, fpar, spar, acc, fdamp, fload, False)
+        thread_pairs(y, y, 0.0, g, cfg, t, nt, fpar, spar, acc, fdamp, fload, False, commit_t)
 
 
 @njit(cache=True)
@@ -226,14 +228,14 @@ def gather_forces(fpar, acc, fdamp, mass, inertia, spar):
 
 
 @njit(cache=True)
-def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
+def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar, commit_t):
     """solver.granular3d.normal_forces on every core: the pairs in blocks
     (`pair_forces_blocks`, which clear the rows too), the shock (serial), the walls in the
     serial order, then the blocks' forces gathered in block order with the division by the
     inertias (`gather_forces`). Returns the ForceSums (sums over the blocks in block order;
     the largest overlap's first occurrence in the serial order)."""
     begin_pass(t, g)
-    pair_forces_blocks(y, g, cfg, fpar, spar, acc, fdamp, fload)
+    pair_forces_blocks(y, g, cfg, fpar, spar, acc, fdamp, fload, commit_t)
     p_shock = 0.0
     if not cfg.load_on_plate:
         p_shock = shock_loads(t, y, g, cfg, acc, fload)
@@ -246,14 +248,14 @@ def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
 
 
 @njit(parallel=True)
-def pair_mindlin_blocks(yv, yn, h, g, cfg, fpar, spar, acc, fdamp, fload):
+def pair_mindlin_blocks(yv, yn, h, g, cfg, fpar, spar, acc, fdamp, fload, commit_t):
     """`pair_forces_blocks` with Mindlin's law in it (solver.granular3d.pair_forces with its
     tangential step: forces, damping parts and torques), in BLOCKS_PER_THREAD blocks per
     thread dealt out in turn (every row of spar a block: `thread_pairs`); the springs'
     energy and losses into S_ET, S_LOST. Each contact's tangential step reads and writes its
     own history row alone."""
     for t in prange(fpar.shape[0]):
-        thread_pairs(yv, yn, h, g, cfg, t, spar.shape[0], fpar, spar, acc, fdamp, fload, True)
+        thread_pairs(yv, yn, h, g, cfg, t, spar.shape[0], fpar, spar, acc, fdamp, fload, True, commit_t)
 
 
 @njit(cache=True)
@@ -279,7 +281,7 @@ def block_sums(spar, nb):
 
 
 @njit(cache=True)
-def mindlin_forces_blocks(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar):
+def mindlin_forces_blocks(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, commit_t):
     """solver.mindlin_space.normal_mindlin_forces on every core: the pairs with their
     Mindlin forces in blocks (`pair_mindlin_blocks`, which clear the rows too), the shock
     (serial), the walls' normal forces in the serial order, the blocks' forces and torques
@@ -287,7 +289,7 @@ def mindlin_forces_blocks(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar):
     walls' Mindlin forces. Returns (the ForceSums, the springs' energy [J], their losses [J]), each
     sum over the blocks in block order."""
     begin_pass(t, g)
-    pair_mindlin_blocks(yv, yn, h, g, cfg, fpar, spar, acc, fdamp, fload)
+    pair_mindlin_blocks(yv, yn, h, g, cfg, fpar, spar, acc, fdamp, fload, commit_t)
     p_shock = 0.0
     if not cfg.load_on_plate:
         p_shock = shock_loads(t, yn, g, cfg, acc, fload)

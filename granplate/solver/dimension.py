@@ -58,19 +58,20 @@ def friction_flow(y, dt, g, cfg, forward):
     raise NotImplementedError("compiled use only")
 
 
-def normal_forces(t, y, g, cfg, acc, fdamp, fload):
+def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t):
     """The velocity-Verlet force pass: shock and normal forces alone, the damping force and
-    load of each granule apart (solver.granular.normal_forces)."""
+    load of each granule apart, the pairs' overlaps committed at commit_t [s] (< 0: not;
+    solver.granular.normal_forces)."""
     raise NotImplementedError("compiled use only")
 
 
-def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
+def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar, commit_t):
     """The velocity-Verlet force pass with the granule pairs in blocks on every core
     (solver.blocks) in space; the plane's serial pass (its pairs are not cut into blocks)."""
     raise NotImplementedError("compiled use only")
 
 
-def mindlin_force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar):
+def mindlin_force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, commit_t):
     """The velocity-Verlet force pass with Mindlin's tangential law in it: (ForceSums,
     the springs' stored energy [J], their losses [J]) (solver.mindlin_plane.normal_mindlin_forces
     in the plane; in space solver.mindlin_space.normal_mindlin_forces, or
@@ -120,20 +121,20 @@ def _friction_flow(y, dt, g, cfg, forward):
 
 
 @overload(normal_forces, inline="always")
-def _normal_forces(t, y, g, cfg, acc, fdamp, fload):
+def _normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t):
     m = _module_of(g)
     if m is not None:
         fn = m.normal_forces
-        return lambda t, y, g, cfg, acc, fdamp, fload: fn(t, y, g, cfg, acc, fdamp, fload)
+        return lambda t, y, g, cfg, acc, fdamp, fload, commit_t: fn(t, y, g, cfg, acc, fdamp, fload, commit_t)
 
 
 @overload(normal_forces_blocks, inline="always")
-def _normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar):
+def _normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar, commit_t):
     return _own(g, "normal_forces_blocks")
 
 
 @overload(mindlin_force_pass, inline="always")
-def _mindlin_force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar):
+def _mindlin_force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, commit_t):
     return _own(g, "mindlin_force_pass")
 
 
@@ -167,27 +168,31 @@ def _force_error(k1, k0, kend, ratio, g, sc, err):
 # factory per hook and dimension, each giving the implementation numba compiles.
 def _plane_normal_forces_blocks():
     fn = plane.normal_forces  # the plane's pairs are not cut into blocks: its serial pass
-    return lambda t, y, g, cfg, acc, fdamp, fload, fpar, spar: fn(t, y, g, cfg, acc, fdamp, fload)
+    return lambda t, y, g, cfg, acc, fdamp, fload, fpar, spar, commit_t: fn(t, y, g, cfg, acc, fdamp, fload, commit_t)
 
 
 def _space_normal_forces_blocks():
     fb = blocks.normal_forces_blocks
-    return lambda t, y, g, cfg, acc, fdamp, fload, fpar, spar: fb(t, y, g, cfg, acc, fdamp, fload, fpar, spar)
+    return lambda t, y, g, cfg, acc, fdamp, fload, fpar, spar, commit_t: fb(
+        t, y, g, cfg, acc, fdamp, fload, fpar, spar, commit_t
+    )
 
 
 def _plane_mindlin_force_pass():
     fp = mindlin_plane.normal_mindlin_forces  # the plane's pairs are not cut into blocks
-    return lambda t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar: fp(t, yv, yn, h, g, cfg, acc, fdamp, fload)
+    return lambda t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, commit_t: fp(
+        t, yv, yn, h, g, cfg, acc, fdamp, fload, commit_t
+    )
 
 
 def _space_mindlin_force_pass():
     fs = mindlin_space.normal_mindlin_forces
     fb = blocks.mindlin_forces_blocks
 
-    def space_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar):
+    def space_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, commit_t):
         if spar.shape[0] > 0:
-            return fb(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar)
-        return fs(t, yv, yn, h, g, cfg, acc, fdamp, fload)
+            return fb(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, commit_t)
+        return fs(t, yv, yn, h, g, cfg, acc, fdamp, fload, commit_t)
 
     return space_pass
 

@@ -382,6 +382,17 @@ def commit_history(t, hist, coef):
     commit_rows(t, hist, coef, 0, hist.shape[0])
 
 
+@njit(cache=True, inline="always")
+def commit_overlap(t, hist, k, d, c):
+    """Contact k's overlap d [m] at the accepted step's end t [s] into its largest
+    overlap (HIST_MAX, reached at HIST_TIME) where it exceeds it, its rate factor
+    (HIST_RATE) updated as its law says (coefficient row c; `laws.normal_law_rate`)."""
+    if d > hist[k, HIST_MAX]:
+        hist[k, HIST_RATE] = normal_law_rate(d, hist[k, HIST_MAX], t, hist[k, HIST_TIME], hist[k, HIST_RATE], c)
+        hist[k, HIST_MAX] = d
+        hist[k, HIST_TIME] = t
+
+
 @njit(cache=True)
 def commit_rows(t, hist, coef, lo, hi):
     """`commit_history` of contacts lo..hi-1 (written out per row: a compiled call per row
@@ -395,13 +406,7 @@ def commit_rows(t, hist, coef, lo, hi):
         if tangential and (hist[k, HIST_A_END] != 0.0 or hist[k, HIST_A] != 0.0) and keeps_history(coef[k]):
             for col in range(N_MINDLIN):
                 hist[k, HIST_XI + col] = hist[k, HIST_XI_END + col]
-        d = hist[k, HIST_END]
-        if d > hist[k, HIST_MAX]:
-            hist[k, HIST_RATE] = normal_law_rate(
-                d, hist[k, HIST_MAX], t, hist[k, HIST_TIME], hist[k, HIST_RATE], coef[k]
-            )
-            hist[k, HIST_MAX] = d
-            hist[k, HIST_TIME] = t
+        commit_overlap(t, hist, k, hist[k, HIST_END], coef[k])
 
 
 @njit(entry=True, cache=True)
@@ -442,14 +447,16 @@ def kinetic_energies(y, mass, inertia):
 
 
 @njit(cache=True)
-def normal_forces(t, y, g, cfg, acc, fdamp, fload):
+def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t):
     """The velocity-Verlet force pass (solver.schemes.verlet) in the plane: the shock on
     the loaded granules and the normal force (eqs. 2-4, physics.laws with each contact's
     history) of every listed pair and wall contact at state y, whose velocities are the
     ones the damping reads; no friction (the scheme applies it by `friction_flow`). Writes
     the accelerations into acc[:, 3:6] and, apart, each granule's damping force and shock
     load (fdamp, fload [:, 3:6]: N, N, N m), from which the scheme books the work of each
-    kick; each contact's overlap into its history's HIST_END (0 out of touch). No plate
+    kick; each contact's overlap into its history's HIST_END (0 out of touch), a pair's
+    committed at commit_t [s] (`commit_overlap`; the trial of a scheme whose every step is
+    accepted; commit_t < 0: none, a pass at t_n). No plate
     contacts (the scheme runs without a plate). Returns the ForceSums: shock and viscous
     power at y [W], stored energy [J], the largest overlap, the plastic work past the
     largest overlaps [J]; no friction rates."""
@@ -498,6 +505,8 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
         n, pv, ep, wp = normal_law_response(
             delta, ddot, g.pair_coef[p], g.pair_hist[p, HIST_MAX], g.pair_hist[p, HIST_RATE], cfg.clip
         )
+        if commit_t >= 0.0:
+            commit_overlap(commit_t, g.pair_hist, p, delta, g.pair_coef[p])
         w_plastic += wp
         p_visc += pv
         e_pot += ep

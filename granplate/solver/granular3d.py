@@ -30,7 +30,7 @@ from granplate.physics.space import (
     wall_overlap_3d,
 )
 from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_motion
-from granplate.solver.granular import ForceSums, slip_relaxation_rate
+from granplate.solver.granular import ForceSums, commit_overlap, slip_relaxation_rate
 from granplate.solver.mindlin_history import mindlin_contact, mindlin_old_force, mindlin_parted, mindlin_touched
 from granplate.solver.mindlin_rk4 import space_stages
 
@@ -327,12 +327,13 @@ def row_target(acc, fdamp, buf, i, own_lo, own_hi, t_lo, t_hi):
 
 
 @njit(cache=True)
-def normal_forces(t, y, g, cfg, acc, fdamp, fload):
+def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t):
     """The velocity-Verlet force pass in space (as solver.granular.normal_forces): shock
     and normal forces of every listed pair and wall contact at state y (no friction), the
     accelerations into acc[:, 3:9], each granule's damping force and shock load apart
     (fdamp, fload [:, 3:9] [N, N m]; the normal forces act through the centres, a line
-    load's torques on the spins), the contacts' overlaps into HIST_END. Returns the ForceSums."""
+    load's torques on the spins), the contacts' overlaps into HIST_END (the pairs'
+    committed at commit_t [s]; < 0: not). Returns the ForceSums."""
     ng = y.shape[0]
     for i in range(ng):
         for c in range(3, 9):
@@ -344,7 +345,7 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload):
     if not cfg.load_on_plate:
         p_shock = shock_loads(t, y, g, cfg, acc, fload)
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, _, _, _, _ = pair_forces(
-        y, y, 0.0, g, cfg, 0, g.pair_ij.shape[0], acc, fdamp, acc, 0, ng, False
+        y, y, 0.0, g, cfg, 0, g.pair_ij.shape[0], acc, fdamp, acc, 0, ng, False, commit_t
     )  # (every granule its own: no buffer)
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
         y, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
@@ -469,9 +470,10 @@ def push_couple(out, i, col, arm, nx, ny, nz, fx, fy, fz):
 
 
 @njit(cache=True)
-def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tangential):
+def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tangential, commit_t):
     """Listed pairs lo..hi-1 of the velocity-Verlet force pass in space: each pair's normal
-    force at state yn (its overlap into HIST_END) on its granules (minus on i, plus on j)
+    force at state yn (its overlap into HIST_END, committed at commit_t [s] as
+    solver.granular.normal_forces says; < 0: not) on its granules (minus on i, plus on j)
     into acc[:, VX:VX + 3], its damping part into fdamp[:, VX:VX + 3]; with `tangential`,
     at the pairs whose tangential law keeps a history (Mindlin's: laws.keeps_history), its
     force from the same overlap and |N| (docs/model.md section 3.16; the slip from yv's
@@ -521,6 +523,8 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tang
         n, pv, ep, wp = normal_law_response(
             delta, ddot, g.pair_coef[p], hist[p, HIST_MAX], hist[p, HIST_RATE], cfg.clip
         )
+        if commit_t >= 0.0:
+            commit_overlap(commit_t, hist, p, delta, g.pair_coef[p])
         w_plastic += wp
         p_visc += pv
         e_pot += ep

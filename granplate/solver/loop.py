@@ -14,7 +14,7 @@ from granplate.jit import NO_REFCOUNT, njit
 
 from granplate.physics.energy import energy_residual, energy_total
 from granplate.solver import schemes as S
-from granplate.solver.blocks import accept_rows, commit_histories_blocks
+from granplate.solver.blocks import accept_rows
 from granplate.solver.contacts import watch_contacts
 from granplate.solver.dimension import granular_rhs, kinetic_energies, sensor_loads
 from granplate.solver.granular import commit_histories
@@ -83,6 +83,7 @@ from granplate.solver.state import (
     S_RETRIES,
     S_STEPS,
     T_NOW,
+    T_TRIAL,
 )
 
 
@@ -372,6 +373,7 @@ def advance(t_stop, max_attempts, g, p, b, cfg, st, w, sw, out):
             prepare_slot(sw, h, slot, st, p, w)
         ratio = h / st.clock[H_LAST] if st.clock[H_LAST] > 0.0 else 0.0
         first_guess(ratio, st, w)
+        st.clock[T_TRIAL] = t_land if land else t + h  # (as accept_granular moves the clock)
         converged, it, worst, e_pot, rate = S.attempt(sw, t, h, slot, st, g, p, b, cfg, w)
         st.count[C_ITERS] += it
         if not converged:
@@ -390,13 +392,12 @@ def advance(t_stop, max_attempts, g, p, b, cfg, st, w, sw, out):
             continue
         plate_work = S.commit(sw, t, h, slot, plate_work, fric_work, st, g, p, b, cfg, w)
         accept_pistons(g)
-        if cfg.threads > 1:  # the copies and the pairs' histories on every core (solver.blocks)
+        if cfg.threads > 1:  # the copies on every core (solver.blocks)
             accept_rows(st.y, st.k1, w.ynew, w.kend)
             accept_granular(t, h, land, t_land, plate_work, e_pot, st, w, False)
-            commit_histories_blocks(st.clock[T_NOW], g, cfg.threads)
         else:
             accept_granular(t, h, land, t_land, plate_work, e_pot, st, w, True)
-            commit_histories(st.clock[T_NOW], g)
+        S.commit_histories(sw, st.clock[T_NOW], g, cfg)
         lam_max = accept_contacts(
             h, w.gmat[slot], g.pc_coef, w.normal_new, w.slip_new, w.conv_iter, st.normal, st.slip, w.lam_int, w.it_int
         )

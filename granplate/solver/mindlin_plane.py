@@ -27,7 +27,7 @@ from granplate.physics.contact import (
 from granplate.physics.laws import keeps_history, normal_law_response, tangential_scale
 from granplate.physics.shock import shock_amplitude
 from granplate.solver.drives import begin_pass, book_wall, wall_motion
-from granplate.solver.granular import ForceSums
+from granplate.solver.granular import ForceSums, commit_overlap
 from granplate.solver.mindlin_history import mindlin_contact, mindlin_old_force, mindlin_parted, mindlin_touched
 
 
@@ -63,12 +63,13 @@ def pair_mindlin(p, i, j, ri, rj, delta, nx, nz, n_abs, yv, h, hist, c, half_shr
 
 
 @njit(cache=True)
-def pair_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
+def pair_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp, commit_t):
     """The pairs' share of `normal_mindlin_forces`: every listed pair's normal force
     (physics.laws, as solver.granular.normal_forces) at state yn and, where its coefficient
     row's tangential law keeps a history (Mindlin's; laws.keeps_history), Mindlin's force (`pair_mindlin`) from the same overlap and |N|,
     added to acc[:, 3:6] as forces and torques; the damping parts into fdamp, each
-    overlap into HIST_END, a parted contact's history ended (`mindlin_parted`). Returns
+    overlap into HIST_END (committed at commit_t [s] as solver.granular.normal_forces
+    says), a parted contact's history ended (`mindlin_parted`). Returns
     (viscous power [W], stored energy [J], plastic work [J], the largest overlap / radius,
     its pair (i, j), the springs' energy [J], their losses [J])."""
     radius = g.radius
@@ -107,6 +108,8 @@ def pair_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
             ovl_j = j
         ddot = pair_normal_rate(yn[i, 3], yn[i, 4], yn[j, 3], yn[j, 4], nx, nz)
         n, pv, ep, wp = normal_law_response(delta, ddot, c, hist[p, HIST_MAX], hist[p, HIST_RATE], clip)
+        if commit_t >= 0.0:
+            commit_overlap(commit_t, hist, p, delta, c)
         w_plastic += wp
         p_visc += pv
         e_pot += ep
@@ -198,14 +201,15 @@ def wall_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
 
 
 @njit(cache=True)
-def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload):
+def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload, commit_t):
     """The velocity-Verlet force pass of the plane (solver.granular.normal_forces) with
     Mindlin's tangential law (docs/model.md section 3.16) in it: the shock, every listed
     pair and wall contact's normal force at state yn (its velocities the damping's) and, at
     the contacts whose tangential law keeps a history (Mindlin's; laws.keeps_history), the tangential spring's force from
     the same overlap and |N|, its history moved on by the slip at yv's velocities over h
     [s] (the half step's; yv's positions are yn's; h = 0: the force of the committed
-    history), the trial histories as solver.mindlin_history.trial_column says. Accelerations into
+    history), the trial histories as solver.mindlin_history.trial_column says, the pairs'
+    overlaps committed at commit_t [s] (< 0: none; solver.granular.normal_forces). Accelerations into
     acc[:, 3:6], damping forces and loads apart (fdamp, fload). Returns (the ForceSums, the
     springs' stored energy [J], the energy they lost over the step [J])."""
     ng = yn.shape[0]
@@ -227,7 +231,9 @@ def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload):
                 acc[i, 3] += fx
                 acc[i, 5] += tq
                 p_shock += fx * yn[i, 3] + tq * yn[i, 5]
-    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, e_t, lost = pair_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp)
+    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, e_t, lost = pair_forces_mindlin(
+        yv, yn, h, g, cfg, acc, fdamp, commit_t
+    )
     pv_w, ep_w, wp_w, ovl_w, i_w, j_w, et_w, lost_w = wall_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp)
     if ovl_w > ovl:
         ovl, ovl_i, ovl_j = ovl_w, i_w, j_w

@@ -67,14 +67,15 @@ def wall_mindlin(yv, yn, h, g, cfg, acc):
 
 
 @njit(cache=True)
-def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload):
+def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload, commit_t):
     """solver.granular3d.normal_forces with Mindlin's tangential law in it (docs/model.md
     section 3.16): the shock, every listed pair and wall contact's normal force at state yn
     (its velocities the damping's) and, at the contacts whose tangential law keeps a
     history (Mindlin's; laws.keeps_history), the tangential spring's force from the same overlap and |N|, its history moved on by
     the slip at yv's velocities over h [s] (the half step's; yv's positions are yn's; h = 0:
     the force of the committed history), the trial histories as
-    solver.mindlin_history.trial_column says. Returns (the ForceSums, the springs' stored energy [J], the energy they
+    solver.mindlin_history.trial_column says, the pairs' overlaps committed at commit_t [s]
+    (< 0: not; solver.granular.normal_forces). Returns (the ForceSums, the springs' stored energy [J], the energy they
     lost over the step [J])."""
     for i in range(yn.shape[0]):
         for c in range(3, 9):
@@ -86,7 +87,7 @@ def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload):
     if not cfg.load_on_plate:
         p_shock = shock_loads(t, yn, g, cfg, acc, fload)
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, e_t, lost, _, _ = pair_forces(
-        yv, yn, h, g, cfg, 0, g.pair_ij.shape[0], acc, fdamp, acc, 0, yn.shape[0], True
+        yv, yn, h, g, cfg, 0, g.pair_ij.shape[0], acc, fdamp, acc, 0, yn.shape[0], True, commit_t
     )  # (every granule its own: no buffer)
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
         yn, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j

@@ -14,6 +14,10 @@ from granplate.model.inputs import STATE_COLUMNS  # noqa: F401 - the state's col
 T_NOW, H_LAST, E_IN_MAX, E_ZERO, E_POT, CUSTOM_H, F_SCALE, RES_LAST = 0, 1, 2, 3, 4, 5, 6, 7
 # the energy of an elastic body's residual compliance at its contacts [J] (solver.body; part of E_p)
 E_STATIC = 8
+# the time the trial step ends at, as the clock will read once it is accepted [s] (set
+# before each attempt: a scheme whose every step is accepted commits the contacts' largest
+# overlaps in its force pass then)
+T_TRIAL = 9
 N_CLOCK = 10
 # count (int64)
 C_STEPS, C_LEVEL, C_OUT, C_ITERS, C_RETRIES = 0, 1, 2, 3, 4

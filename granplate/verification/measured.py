@@ -268,7 +268,7 @@ def replay_contact_pass(c: Curve) -> np.ndarray:
     for k in range(len(t)):
         y[0, 3] = rate[k]
         y[1, 0] = 2.0 * SPHERE_RADIUS - delta[k]
-        normal_forces(float(t[k]), y, g, cfg, acc, fdamp, fload)
+        normal_forces(float(t[k]), y, g, cfg, acc, fdamp, fload, -1.0)  # (committed below)
         out[k] = abs(acc[1, 3]) * g.mass[1]
         commit_histories(float(t[k]), g)
     return out[len(t) - len(c.t) :]

@@ -20,12 +20,17 @@ takes b and leaves it; one that does chooses its code by b's type when the loop 
     contacts_moved(sw, t, st, p, cfg)
     start(sw, t, st, g, b, cfg) -> (contact energy, residual energy) [J] at t = 0
 
-and one optional hook, absent from a scheme whose bodies are the granules and the plate
-alone (then it adds nothing):
+and two optional hooks:
 
     body_sensor_loads(sw, b, load)   half the normal force of each granule's contact with the
                                      elastic body in space b added to its sensor reading
-                                     load[i] [N] (docs/model.md section 3.15)
+                                     load[i] [N] (docs/model.md section 3.15); absent from a
+                                     scheme whose bodies are the granules and the plate alone
+                                     (then it adds nothing)
+    commit_histories(sw, t, g, cfg)  the contacts' histories of an accepted step ending at
+                                     t [s]; absent: every contact's end overlap committed
+                                     after the step (solver.granular.commit_histories, the
+                                     pairs in blocks on every core with cfg.threads > 1)
 
 `start` gives what the bodies hold at t = 0 beyond the loop's own energies (the contacts
 of the elastic body in space b, solver.body; (0, 0) without one). The two before it keep the scheme's own driving-DOF state true when the plate contacts' rows
@@ -48,6 +53,8 @@ from types import ModuleType
 from numba.extending import overload
 
 from granplate.model.inputs import SCHEME_NAMES
+from granplate.solver.blocks import commit_histories_blocks
+from granplate.solver.granular import commit_histories as commit_every_history
 from granplate.solver.schemes import implicit, paper, verlet
 
 #: the registered schemes by name, in the order of model.inputs.SCHEME_NAMES.
@@ -202,3 +209,27 @@ def _body_sensor_loads(sw, b, load):
     if fn is None:
         return lambda sw, b, load: None
     return lambda sw, b, load: fn(sw, b, load)
+
+
+def commit_histories(sw, t, g, cfg):
+    """The contacts' histories of the accepted step ending at t [s] (the scheme's hook, or
+    every contact's end overlap committed after the step)."""
+    raise NotImplementedError("compiled use only")
+
+
+@overload(commit_histories, inline="always")
+def _commit_histories(sw, t, g, cfg):
+    module = _BY_SCRATCH.get(getattr(sw, "instance_class", None))
+    if module is None:
+        return None
+    fn = getattr(module, "commit_histories", None)
+    if fn is not None:
+        return lambda sw, t, g, cfg: fn(sw, t, g, cfg)
+
+    def commit_after_step(sw, t, g, cfg):
+        if cfg.threads > 1:
+            commit_histories_blocks(t, g, cfg.threads)
+        else:
+            commit_every_history(t, g)
+
+    return commit_after_step

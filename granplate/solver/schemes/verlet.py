@@ -43,7 +43,7 @@ from typing import NamedTuple
 import numpy as np
 from granplate.jit import njit
 
-from granplate.model.inputs import STATE_COLUMNS, BodyArrays
+from granplate.model.inputs import N_HIST_STEP, STATE_COLUMNS, BodyArrays
 from granplate.physics.contact import COEF_MU
 from granplate.solver import body as B
 from granplate.solver.schemes import verlet_body as VB
@@ -70,9 +70,11 @@ from granplate.solver.drives import (
     wall_powers,
     wall_shift_energy,
 )
+from granplate.solver.granular import commit_history
 from granplate.solver.kicks import kick, kick_drift
 from granplate.solver.ladder import step_to_output
 
+from granplate.solver.state import T_TRIAL
 from granplate.solver.state import PARTNER_BODY as PARTNER_BODY
 
 NAME = "verlet"
@@ -151,14 +153,16 @@ def has_friction(g, cfg) -> bool:
 
 
 @njit(cache=True)
-def force_pass(t, yv, yn, h, g, cfg, sw, buf, acc):
+def force_pass(t, yv, yn, h, g, cfg, sw, buf, acc, commit_t):
     """The force pass at (t, yn) into buffer buf (sw.fdamp[buf], sw.fload[buf]; the
     accelerations into acc): in blocks on every core when the scratch has blocks
     (solver.blocks: they leave uncleared the buffer's rows its last pass left all zero,
     sw.quiet), else serially; under Mindlin's law (cfg.history_friction) with the tangential
     springs in it, their histories moved on by the slip at yv's velocities over h [s] (0:
-    the committed histories' forces). Returns (the ForceSums, the springs' stored energy
-    [J], their losses [J]; 0 and 0 without Mindlin's law)."""
+    the committed histories' forces); the pairs' overlaps committed at commit_t [s] (the
+    trial's end as the clock will read it, st.clock[T_TRIAL]: every step is accepted; < 0:
+    not, the pass at t_n). Returns (the ForceSums, the springs' stored energy [J], their
+    losses [J]; 0 and 0 without Mindlin's law)."""
     fdamp = sw.fdamp[buf]
     fload = sw.fload[buf]
     if sw.spar.shape[0] > 0:
@@ -166,10 +170,10 @@ def force_pass(t, yv, yn, h, g, cfg, sw, buf, acc):
         sw.spar[0, S_ZERO_LOADS] = sw.quiet[buf, 0]
         sw.spar[0, S_ZERO_DAMP] = sw.quiet[buf, 1]
     if cfg.history_friction:
-        return mindlin_force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar)
+        return mindlin_force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar, commit_t)
     if sw.spar.shape[0] > 0:
-        return normal_forces_blocks(t, yn, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar), 0.0, 0.0
-    return normal_forces(t, yn, g, cfg, acc, fdamp, fload), 0.0, 0.0
+        return normal_forces_blocks(t, yn, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar, commit_t), 0.0, 0.0
+    return normal_forces(t, yn, g, cfg, acc, fdamp, fload, commit_t), 0.0, 0.0
 
 
 @njit(cache=True)
@@ -210,7 +214,7 @@ def copy_state(y, st, b, sw):
 def first_forces(t, st, g, b, cfg, sw, cur):
     """t_n's forces, loads and damping on the run's first step (st.k1 as `initialise` has
     it; Mindlin's law with the committed histories), the body's too."""
-    force_pass(t, st.y, st.y, 0.0, g, cfg, sw, cur, st.k1)
+    force_pass(t, st.y, st.y, 0.0, g, cfg, sw, cur, st.k1, -1.0)
     VB.first_forces(st.y, b, cur, st, g, cfg, st.k1, sw.fdamp)
     note_quiet(sw, cur, t, b, cfg)
     finish_pass(st.y, st.k1, g)
@@ -272,7 +276,7 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
         wl, wd = kick_drift(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, 0, y.shape[0], predict)
     wl, wd, w_grav = VB.first_kick(b, t, h, cur, cfg, wl, wd, w_grav)
     # (Mindlin: the slip over h at the half step's velocities, y's)
-    pr, e_t, lost_t = force_pass(t + h, y, w.ytmp, h, g, cfg, sw, nxt, w.kend)
+    pr, e_t, lost_t = force_pass(t + h, y, w.ytmp, h, g, cfg, sw, nxt, w.kend, st.clock[T_TRIAL])
     e_pot, p_visc, w_plastic, fric, ovl, ovl_i, ovl_j = VB.end_pass(
         y, w.ytmp, st, b, cur, nxt, h, g, cfg, w.kend, sw.fdamp,
         pr.e_pot + e_t, pr.p_visc, pr.w_plastic, fric + lost_t, pr.ovl, pr.ovl_i, pr.ovl_j,
@@ -329,6 +333,19 @@ def commit(sw, t, h, slot, plate_work, fric_work, st, g, p, b, cfg, w):
         sw.split[FORWARD] = 1.0 - sw.split[FORWARD]
     sw.split[OWED] = 0.0 if land else 0.5 * h
     return 0.0
+
+
+@njit(cache=True)
+def commit_histories(sw, t, g, cfg):
+    """The contacts' histories of the accepted step ending at t [s]: the trial's force pass
+    committed the pairs' largest overlaps already (every step is accepted; `force_pass`'s
+    commit_t), the walls' are committed here (solver.granular.commit_history). Pair rows
+    that keep a Mindlin trial apart (N_HIST columns, as a run restarted from a result
+    stored so has them) take it in here too; their overlaps, committed, stay as they are."""
+    if g.pair_hist.shape[1] > N_HIST_STEP:
+        commit_history(t, g.pair_hist, g.pair_coef)
+    commit_history(t, g.wall_hist, g.wall_coef)
+    commit_history(t, g.pc_hist, g.pc_coef)
 
 
 @njit(cache=True)
