@@ -54,7 +54,7 @@ N_FPAR = N_BUF
 #: [J], the largest overlap / smaller radius [-], its granule and its partner (as floats),
 #: the kicks' load and damping work [J], Mindlin's springs' energy and losses [J], (row
 #: 0: in all) how many granules the last force pass gave a damping force (`gather_forces`),
-#: (row t: thread t's) the range [S_TLO, S_THI) of its buffer's rows written (as floats), and
+#: (row k: block k's) the range [S_TLO, S_THI) of the buffer rows it wrote (as floats), and
 #: (row 0, set by the scheme before a pass) 1 where the pass's load rows (S_ZERO_LOADS), its
 #: damping rows (S_ZERO_DAMP) are all zero already, so the blocks leave them uncleared.
 S_VISC, S_EPOT, S_PLASTIC, S_OVL, S_OVL_I, S_OVL_J, S_WLOAD, S_WDAMP, S_ET, S_LOST, S_DAMPED = range(11)
@@ -152,11 +152,10 @@ def block_pairs(yv, yn, h, g, cfg, k, nb, buf, spar, acc, fdamp, fload, tangenti
 @njit(cache=True, inline="always")
 def thread_pairs(yv, yn, h, g, cfg, t, nb, fpar, spar, acc, fdamp, fload, tangential, commit_t):
     """The share of thread t of T (T = the buffers fpar): blocks t, t + T, ... of nb in
-    turn (`block_pairs`), their buffered forces in fpar[t] and its rows' range in spar[t,
-    S_TLO:S_THI + 1]; under Mindlin's law (`tangential`) each block's springs' energy and
+    turn (`block_pairs`), their buffered forces in fpar[t] and each block k's rows' range
+    in spar[k, S_TLO:S_THI + 1] (a thread's blocks lie apart: the rows between them are
+    not its to gather); under Mindlin's law (`tangential`) each block's springs' energy and
     losses into spar[k, S_ET], spar[k, S_LOST]."""
-    t_lo = acc.shape[0]
-    t_hi = 0
     for k in range(t, nb, fpar.shape[0]):
         e_t, lost, b_lo, b_hi = block_pairs(
             yv, yn, h, g, cfg, k, nb, fpar[t], spar, acc, fdamp, fload, tangential, commit_t
@@ -164,10 +163,8 @@ def thread_pairs(yv, yn, h, g, cfg, t, nb, fpar, spar, acc, fdamp, fload, tangen
         if tangential:
             spar[k, S_ET] = e_t
             spar[k, S_LOST] = lost
-        t_lo = min(t_lo, b_lo)
-        t_hi = max(t_hi, b_hi)
-    spar[t, S_TLO] = t_lo
-    spar[t, S_THI] = t_hi
+        spar[k, S_TLO] = b_lo
+        spar[k, S_THI] = b_hi
 
 
 @njit(parallel=True)
@@ -184,20 +181,23 @@ def pair_forces_blocks(y, g, cfg, fpar, spar, acc, fdamp, fload, commit_t):
 
 
 @njit(cache=True)
-def gather_rows(fpar, spar, acc, fdamp, mass, inertia, lo, hi):
+def gather_rows(fpar, spar, n_pair_blocks, acc, fdamp, mass, inertia, lo, hi):
     """`gather_forces` for granules lo..hi-1: the buffered forces of each thread's buffer
-    fpar[t] whose written rows [spar[t, S_TLO], spar[t, S_THI]) meet them, added in
-    buffer order (and zeroed, ready for the next pass), then the division; returns how many
-    have a damping force."""
-    for t in range(fpar.shape[0]):
-        for i in range(max(lo, int(spar[t, S_TLO])), min(hi, int(spar[t, S_THI]))):
-            for c in range(3):
-                acc[i, VX + c] += fpar[t, i, F_X + c]
-                fdamp[i, VX + c] += fpar[t, i, F_DX + c]
-                acc[i, WX + c] += fpar[t, i, F_T + c]
-                fpar[t, i, F_X + c] = 0.0
-                fpar[t, i, F_DX + c] = 0.0
-                fpar[t, i, F_T + c] = 0.0
+    fpar[t], in the rows [spar[k, S_TLO], spar[k, S_THI]) its blocks k (of n_pair_blocks,
+    dealt out as `thread_pairs` does) wrote that meet them, added in buffer order (and
+    zeroed, ready for the next pass: a row two of its blocks wrote is added once), then the
+    division; returns how many have a damping force."""
+    nt = fpar.shape[0]
+    for t in range(nt):
+        for k in range(t, n_pair_blocks, nt):
+            for i in range(max(lo, int(spar[k, S_TLO])), min(hi, int(spar[k, S_THI]))):
+                for c in range(3):
+                    acc[i, VX + c] += fpar[t, i, F_X + c]
+                    fdamp[i, VX + c] += fpar[t, i, F_DX + c]
+                    acc[i, WX + c] += fpar[t, i, F_T + c]
+                    fpar[t, i, F_X + c] = 0.0
+                    fpar[t, i, F_DX + c] = 0.0
+                    fpar[t, i, F_T + c] = 0.0
     n_damped = 0
     for i in range(lo, hi):
         damped = False
@@ -211,8 +211,9 @@ def gather_rows(fpar, spar, acc, fdamp, mass, inertia, lo, hi):
 
 
 @njit(parallel=True)
-def gather_forces(fpar, acc, fdamp, mass, inertia, spar):
-    """Each granule's forces from the threads' buffers, added in buffer order to what acc
+def gather_forces(fpar, acc, fdamp, mass, inertia, spar, n_pair_blocks):
+    """Each granule's forces from the threads' buffers (the pass's n_pair_blocks blocks of
+    pairs wrote them: `gather_rows`), added in buffer order to what acc
     and fdamp hold (its own block's pairs', the shock's and the walls'), then acc's forces and
     torques made accelerations: acc[:, 3:6] /= mass, acc[:, 6:9] /= inertia (space's
     velocity and spin columns). The granules in blocks; how many of them have a damping
@@ -220,7 +221,7 @@ def gather_forces(fpar, acc, fdamp, mass, inertia, spar):
     nb = spar.shape[0]
     for k in prange(nb):
         lo, hi = block_range(k, nb, acc.shape[0])
-        spar[k, S_DAMPED] = gather_rows(fpar, spar, acc, fdamp, mass, inertia, lo, hi)
+        spar[k, S_DAMPED] = gather_rows(fpar, spar, n_pair_blocks, acc, fdamp, mass, inertia, lo, hi)
     n = 0.0
     for k in range(nb):
         n += spar[k, S_DAMPED]
@@ -243,7 +244,7 @@ def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar, commit_t):
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
         y, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
     )
-    gather_forces(fpar, acc, fdamp, g.mass, g.inertia, spar)
+    gather_forces(fpar, acc, fdamp, g.mass, g.inertia, spar, fpar.shape[0])
     return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
 
 
@@ -302,7 +303,7 @@ def mindlin_forces_blocks(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, c
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
         yn, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
     )
-    gather_forces(fpar, acc, fdamp, g.mass, g.inertia, spar)
+    gather_forces(fpar, acc, fdamp, g.mass, g.inertia, spar, spar.shape[0])
     e_w, lost_w = wall_mindlin(yv, yn, h, g, cfg, acc)
     sums = ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
     return sums, e_t + e_w, lost + lost_w
