@@ -56,10 +56,12 @@ N_FPAR = N_BUF
 #: 0: in all) how many granules the last force pass gave a damping force (`gather_forces`),
 #: (row k: block k's) the range [S_TLO, S_THI) of the buffer rows it wrote (as floats), and
 #: (row 0, set by the scheme before a pass) 1 where the pass's load rows (S_ZERO_LOADS), its
-#: damping rows (S_ZERO_DAMP) are all zero already, so the blocks leave them uncleared.
+#: damping rows (S_ZERO_DAMP) are all zero already, so the blocks leave them uncleared; a
+#: block of granules' kinetic energies KE_x, KE_y, KE_z, KE_rot [J] (S_KX to S_KR).
 S_VISC, S_EPOT, S_PLASTIC, S_OVL, S_OVL_I, S_OVL_J, S_WLOAD, S_WDAMP, S_ET, S_LOST, S_DAMPED = range(11)
 S_TLO, S_THI, S_ZERO_LOADS, S_ZERO_DAMP = range(11, 15)
-N_SPAR = 15
+S_KX, S_KY, S_KZ, S_KR = range(15, 19)
+N_SPAR = 19
 
 
 #: blocks of pairs per thread under a law whose contacts in touch cost much more than those

@@ -97,6 +97,11 @@ def kinetic_energies(y, g):
     raise NotImplementedError("compiled use only")
 
 
+def kinetic_energies_part(y, g, lo, hi):
+    """(KE_x, KE_y, KE_z, KE_rot) [J] of granules lo..hi-1 (`kinetic_energies` of a range)."""
+    raise NotImplementedError("compiled use only")
+
+
 def force_error(k1, k0, kend, ratio, g, sc, err):
     """The implicit scheme's granule error terms: (scale, error) [N]."""
     raise NotImplementedError("compiled use only")
@@ -154,6 +159,11 @@ def _plate_friction_held(hold, g):
 @overload(kinetic_energies, inline="always")
 def _kinetic_energies(y, g):
     return _own(g, "kinetic_energies")
+
+
+@overload(kinetic_energies_part, inline="always")
+def _kinetic_energies_part(y, g, lo, hi):
+    return _own(g, "kinetic_energies_part")
 
 
 @overload(force_error, inline="always")
@@ -220,6 +230,21 @@ def _space_kinetic_energies():
     return lambda y, g: fn3(y, g.mass, g.inertia)
 
 
+def _plane_kinetic_energies_part():
+    fn = plane.kinetic_energies
+
+    def plane_part(y, g, lo, hi):
+        kx, ky, kr = fn(y[lo:hi], g.mass[lo:hi], g.inertia[lo:hi])
+        return kx, ky, 0.0, kr
+
+    return plane_part
+
+
+def _space_kinetic_energies_part():
+    fn3 = space.kinetic_energies
+    return lambda y, g, lo, hi: fn3(y[lo:hi], g.mass[lo:hi], g.inertia[lo:hi])
+
+
 #: the factories of the hooks that differ, by the dimension's name and the hook's name
 _OWN = {
     "plane": {
@@ -227,12 +252,14 @@ _OWN = {
         "mindlin_force_pass": _plane_mindlin_force_pass,
         "plate_friction_held": _plane_friction_held,
         "kinetic_energies": _plane_kinetic_energies,
+        "kinetic_energies_part": _plane_kinetic_energies_part,
     },
     "space": {
         "normal_forces_blocks": _space_normal_forces_blocks,
         "mindlin_force_pass": _space_mindlin_force_pass,
         "plate_friction_held": _space_friction_held,
         "kinetic_energies": _space_kinetic_energies,
+        "kinetic_energies_part": _space_kinetic_energies_part,
     },
 }
 

@@ -160,6 +160,12 @@ def energy_terms(y, q, qd, force, clock, acc, g, omega2, resid):
     (KE_z = 0 in the plane). (Arrays, not the state tuples, but for the granular arrays g
     that tell the dimension: this runs every step.)"""
     kx, ky, kz, kr = kinetic_energies(y, g)
+    return energy_terms_of(kx, ky, kz, kr, q, qd, force, clock, acc, g, omega2, resid)
+
+
+@njit(cache=True)
+def energy_terms_of(kx, ky, kz, kr, q, qd, force, clock, acc, g, omega2, resid):
+    """`energy_terms` from the granules' kinetic energies KE_x, KE_y, KE_z, KE_rot [J]."""
     eg = kx + ky + kz + kr + clock[E_POT] + piston_energy(g)
     ep = plate_energy(q, qd, force, omega2, resid) + clock[E_STATIC]
     eshock = acc[A_SHOCK_G] + acc[A_SHOCK_P]
@@ -276,11 +282,14 @@ def step_too_small(t, h, it, worst, lam, normal, slip, st):
 
 
 @njit(cache=True)
-def check_energy(h, y, q, qd, force, clock, acc, g, omega2, resid, energy_tol, res_int, err):
-    """Eq. (11) after an accepted step: keep the residual's running values (clock,
-    res_int); returns OK, ERR_NAN or ERR_ENERGY (above energy_tol) with err filled.
-    (Arrays, not the state tuples: this runs every step.)"""
-    eshock, eg, ep, kx, ky, kz, kr = energy_terms(y, q, qd, force, clock, acc, g, omega2, resid)
+def check_energy(h, ke, q, qd, force, clock, acc, g, omega2, resid, energy_tol, res_int, err):
+    """Eq. (11) after an accepted step, the granules' kinetic energies ke = (KE_x, KE_y,
+    KE_z, KE_rot) [J] given (the scheme's hook step_kinetic_energies): keep the residual's
+    running values (clock, res_int); returns OK, ERR_NAN or ERR_ENERGY (above energy_tol)
+    with err filled. (Arrays, not the state tuples: this runs every step.)"""
+    eshock, eg, ep, kx, ky, kz, kr = energy_terms_of(
+        ke[0], ke[1], ke[2], ke[3], q, qd, force, clock, acc, g, omega2, resid
+    )
     e_in = energy_in(clock, eshock, acc)
     if e_in > clock[E_IN_MAX]:
         clock[E_IN_MAX] = e_in
@@ -407,8 +416,9 @@ def advance(t_stop, max_attempts, g, p, b, cfg, st, w, sw, out):
         if level_step(new_level, cfg) < cfg.dt_min:
             return step_too_small(st.clock[T_NOW], h_new, it, worst_contact(w), lam_max, st.normal, st.slip, st)
         st.count[C_LEVEL] = new_level
+        ke = S.step_kinetic_energies(sw, st.y, g)
         status = check_energy(
-            h, st.y, st.q, st.qd, st.force, st.clock, st.acc, g, p.omega2, p.resid, cfg.energy_tol, w.res_int, st.err
+            h, ke, st.q, st.qd, st.force, st.clock, st.acc, g, p.omega2, p.resid, cfg.energy_tol, w.res_int, st.err
         )
         if status != OK:
             return status

@@ -31,6 +31,9 @@ and two optional hooks:
                                      t [s]; absent: every contact's end overlap committed
                                      after the step (solver.granular.commit_histories, the
                                      pairs in blocks on every core with cfg.threads > 1)
+    step_kinetic_energies(sw, y, g)  the granules' (KE_x, KE_y, KE_z, KE_rot) [J] at state
+                                     y for the energy check after each step; absent: summed
+                                     serially (solver.dimension.kinetic_energies)
 
 `start` gives what the bodies hold at t = 0 beyond the loop's own energies (the contacts
 of the elastic body in space b, solver.body; (0, 0) without one). The two before it keep the scheme's own driving-DOF state true when the plate contacts' rows
@@ -53,6 +56,7 @@ from types import ModuleType
 from numba.extending import overload
 
 from granplate.model.inputs import SCHEME_NAMES
+from granplate.solver.dimension import kinetic_energies as kinetic_energies_serial
 from granplate.solver.blocks import commit_histories_blocks
 from granplate.solver.granular import commit_histories as commit_every_history
 from granplate.solver.schemes import implicit, paper, verlet
@@ -233,3 +237,20 @@ def _commit_histories(sw, t, g, cfg):
             commit_every_history(t, g)
 
     return commit_after_step
+
+
+def step_kinetic_energies(sw, y, g):
+    """The granules' kinetic energies at state y for the step's energy check (the scheme's
+    hook, or their serial sums)."""
+    raise NotImplementedError("compiled use only")
+
+
+@overload(step_kinetic_energies, inline="always")
+def _step_kinetic_energies(sw, y, g):
+    module = _BY_SCRATCH.get(getattr(sw, "instance_class", None))
+    if module is None:
+        return None
+    fn = getattr(module, "step_kinetic_energies", None)
+    if fn is not None:
+        return lambda sw, y, g: fn(sw, y, g)
+    return lambda sw, y, g: kinetic_energies_serial(y, g)

@@ -41,6 +41,8 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+from numba import prange
+
 from granplate.jit import njit
 
 from granplate.model.inputs import N_HIST_STEP, STATE_COLUMNS, BodyArrays
@@ -51,15 +53,24 @@ from granplate.physics.shock import shock_amplitude
 from granplate.solver.blocks import (
     N_FPAR,
     N_SPAR,
+    S_KR,
+    S_KX,
     S_DAMPED,
     S_ZERO_DAMP,
     S_ZERO_LOADS,
     block_count,
+    block_range,
     copy_rows,
     kick_blocks,
     kick_drift_blocks,
 )
-from granplate.solver.dimension import friction_flow, mindlin_force_pass, normal_forces, normal_forces_blocks
+from granplate.solver.dimension import (
+    friction_flow,
+    kinetic_energies_part,
+    mindlin_force_pass,
+    normal_forces,
+    normal_forces_blocks,
+)
 from granplate.solver.drives import (
     drive_kick_work,
     finish_pass,
@@ -346,6 +357,41 @@ def commit_histories(sw, t, g, cfg):
         commit_history(t, g.pair_hist, g.pair_coef)
     commit_history(t, g.wall_hist, g.wall_coef)
     commit_history(t, g.pc_hist, g.pc_coef)
+
+
+@njit(cache=True)
+def step_kinetic_energies(sw, y, g):
+    """The granules' (KE_x, KE_y, KE_z, KE_rot) [J] at state y for the step's energy check:
+    in blocks on every core when the scratch has blocks (`kinetic_energy_blocks`), else
+    serially (solver.dimension.kinetic_energies)."""
+    if sw.spar.shape[0] > 0:
+        return kinetic_energy_blocks(y, g, sw.spar)
+    return kinetic_energies_part(y, g, 0, y.shape[0])
+
+
+@njit(parallel=True)
+def kinetic_energy_blocks(y, g, spar):
+    """The kinetic energies of the granules in the blocks of spar's rows
+    (solver.blocks.block_range), each block's into spar[k, S_KX:S_KR + 1], summed in block
+    order: deterministic for a given thread count, the serial sums' to round-off."""
+    nb = spar.shape[0]
+    for k in prange(nb):
+        lo, hi = block_range(k, nb, y.shape[0])
+        kx, ky, kz, kr = kinetic_energies_part(y, g, lo, hi)
+        spar[k, S_KX] = kx
+        spar[k, S_KX + 1] = ky
+        spar[k, S_KX + 2] = kz
+        spar[k, S_KR] = kr
+    kx = 0.0
+    ky = 0.0
+    kz = 0.0
+    kr = 0.0
+    for k in range(nb):
+        kx += spar[k, S_KX]
+        ky += spar[k, S_KX + 1]
+        kz += spar[k, S_KX + 2]
+        kr += spar[k, S_KR]
+    return kx, ky, kz, kr
 
 
 @njit(cache=True)
