@@ -19,7 +19,7 @@ from granplate.setup.validate import validate
 from granplate.solver import granular3d
 from granplate.solver.blocks import N_FPAR, N_SPAR, normal_forces_blocks
 from granplate.solver.driver import ContactLists
-from granplate.model.inputs import HIST_END, HIST_XI, N_HIST_STEP
+from granplate.model.inputs import HIST_END, HIST_MAX, HIST_TIME, HIST_XI, N_HIST_STEP
 
 THREADS = min(2, available_threads())
 
@@ -258,3 +258,117 @@ def test_shocked_undamped_packing_on_threads_equals_the_serial_loop():
         a, b = one[name].values, many[name].values
         assert np.abs(a - b).max() <= 1e-12 * np.abs(a).max(), name  # (measured: at most 1e-14)
     assert np.abs(one.energy_residual.values - many.energy_residual.values).max() < 1e-12
+
+
+def _pass_commits(s, force_pass, seed):
+    """The pair histories after `force_pass(y, g, cfg, commit_t)` at a perturbed state of
+    scenario s: committed by the pass at t (commit_t = t) and by the loop's commit after a
+    pass that commits nothing (commit_t = -1, then solver.granular.commit_history), each
+    from the same histories; returns both and the histories before."""
+    from granplate.solver.granular import commit_history
+
+    m = build_model(s)
+    lists = ContactLists(m)
+    lists.refresh(m.initial_state)
+    g, cfg = lists.g, m.config
+    rng = np.random.default_rng(seed)
+    y = m.initial_state.copy()
+    dim = 3 if y.shape[1] == 9 else 2
+    y[:, :dim] += rng.normal(0.0, 2e-6, (len(y), dim))
+    y[:, dim : 2 * dim] += rng.normal(0.0, 0.1, (len(y), dim))
+    t = 3.7e-6
+    before = g.pair_hist.copy()
+    force_pass(y, g, cfg, -1.0)
+    commit_history(t, g.pair_hist, g.pair_coef)
+    after_step = g.pair_hist.copy()
+    g.pair_hist[:] = before
+    force_pass(y, g, cfg, t)
+    return g.pair_hist.copy(), after_step, before, t
+
+
+def _space_passes():
+    from granplate.solver.blocks import mindlin_forces_blocks
+    from granplate.solver.mindlin_space import normal_mindlin_forces
+
+    def arrays(y):
+        return (np.zeros((len(y), 9)) for _ in range(3))
+
+    def serial(y, g, cfg, commit_t):
+        granular3d.normal_forces(0.0, y, g, cfg, *arrays(y), commit_t)
+
+    def blocks(y, g, cfg, commit_t):
+        normal_forces_blocks(0.0, y, g, cfg, *arrays(y), np.zeros((3, len(y), N_FPAR)), np.zeros((3, N_SPAR)), commit_t)
+
+    def mindlin(y, g, cfg, commit_t):
+        normal_mindlin_forces(0.0, y, y, 1e-8, g, cfg, *arrays(y), commit_t)
+
+    def mindlin_blocks(y, g, cfg, commit_t):
+        acc, fd, fl = arrays(y)
+        mindlin_forces_blocks(
+            0.0, y, y, 1e-8, g, cfg, acc, fd, fl, np.zeros((2, len(y), N_FPAR)), np.zeros((8, N_SPAR)), commit_t
+        )
+
+    return {"serial": serial, "blocks": blocks, "mindlin": mindlin, "mindlin_blocks": mindlin_blocks}
+
+
+@pytest.mark.parametrize("kind", ["serial", "blocks", "mindlin", "mindlin_blocks"])
+def test_force_pass_commits_the_largest_overlaps_as_the_step_commit_does(kind):
+    """Velocity Verlet's force pass in space, told the step's end time, commits each pair's
+    largest overlap, its time and its yielding law's rate factor to the bits the commit
+    after the step gives (every Verlet step is accepted, so the loop then skips it)."""
+    law = "mindlin" if kind.startswith("mindlin") else "tanh"
+    s = packing(1, mu=0.3 if law == "mindlin" else 0.0)
+    s = dataclasses.replace(s, contact=dataclasses.replace(s.contact, normal_law="johnson", tangential_law=law))
+    in_pass, after_step, before, t = _pass_commits(s, _space_passes()[kind], 13)
+    assert np.array_equal(in_pass, after_step)
+    grew = after_step[:, HIST_MAX] > before[:, HIST_MAX]
+    assert grew.any() and np.all(after_step[grew, HIST_TIME] == t)
+
+
+def test_plane_force_passes_commit_the_largest_overlaps_as_the_step_commit_does():
+    """The same in the plane: solver.granular.normal_forces and Mindlin's pass
+    (solver.mindlin_plane) committing in the pass give the commit after the step's bits."""
+    from pathlib import Path
+
+    from granplate.setup.io import load
+    from granplate.solver import granular
+    from granplate.solver.mindlin_plane import normal_mindlin_forces
+
+    base = load(Path(__file__).resolve().parents[1] / "docs" / "examples" / "square.toml")
+    for law, mu in (("tanh", 0.0), ("mindlin", 0.3)):
+        s = dataclasses.replace(
+            base,
+            plate=None,
+            contact=dataclasses.replace(base.contact, normal_law="johnson", tangential_law=law, mu=mu),
+            solver=dataclasses.replace(base.solver, scheme="verlet"),
+        )
+
+        def plane_pass(y, g, cfg, commit_t, law=law):
+            acc, fd, fl = (np.zeros((len(y), 6)) for _ in range(3))
+            if law == "mindlin":
+                normal_mindlin_forces(0.0, y, y, 1e-8, g, cfg, acc, fd, fl, commit_t)
+            else:
+                granular.normal_forces(0.0, y, g, cfg, acc, fd, fl, commit_t)
+
+        in_pass, after_step, before, t = _pass_commits(s, plane_pass, 17)
+        assert np.array_equal(in_pass, after_step), law
+        grew = after_step[:, HIST_MAX] > before[:, HIST_MAX]
+        assert grew.any() and np.all(after_step[grew, HIST_TIME] == t), law
+
+
+def test_threaded_energy_check_sums_the_kinetic_energies_in_blocks():
+    """The threaded Verlet step's kinetic energies (solver.schemes.verlet
+    step_kinetic_energies: blocks on every core) are the serial sums to round-off, the
+    same bits each call."""
+    from granplate.solver.schemes.verlet import kinetic_energy_blocks
+
+    m = build_model(packing(1, mu=0.0))
+    g = m.granular
+    y = m.initial_state.copy()
+    y[:, 3:9] = np.random.default_rng(19).normal(0.0, 1.0, (len(y), 6))
+    serial = np.array(granular3d.kinetic_energies(y, g.mass, g.inertia))
+    spar = np.zeros((8, N_SPAR))
+    blocks = np.array(kinetic_energy_blocks(y, g, spar))
+    assert np.all(serial > 0.0)
+    np.testing.assert_allclose(blocks, serial, rtol=1e-14)
+    assert np.array_equal(blocks, np.array(kinetic_energy_blocks(y, g, spar)))
