@@ -55,6 +55,8 @@ from types import ModuleType
 
 from numba.extending import overload
 
+from granplate.jit import njit
+
 from granplate.model.inputs import SCHEME_NAMES
 from granplate.solver.dimension import kinetic_energies as kinetic_energies_serial
 from granplate.solver.blocks import commit_histories_blocks
@@ -199,6 +201,36 @@ def _start(sw, t, st, g, b, cfg):
         return lambda sw, t, st, g, b, cfg: fn(sw, t, st, g, b, cfg)
 
 
+def _optional_hook(sw, name: str, default):
+    """The optional hook `name` of the scheme whose Scratch type is `sw` (numba type), or
+    `default` (a compiled function of the same signature) where the scheme has none; None
+    where sw is no scheme's scratch (numba looks further)."""
+    module = _BY_SCRATCH.get(getattr(sw, "instance_class", None))
+    return None if module is None else getattr(module, name, default)
+
+
+@njit(cache=True)
+def _no_body_loads(sw, b, load):
+    """A scheme without an elastic body in space adds nothing to the sensors."""
+    return
+
+
+@njit(cache=True)
+def _commit_after_step(sw, t, g, cfg):
+    """Every contact's end overlap committed after the step (the pairs in blocks on every
+    core with cfg.threads > 1)."""
+    if cfg.threads > 1:
+        commit_histories_blocks(t, g, cfg.threads)
+    else:
+        commit_every_history(t, g)
+
+
+@njit(cache=True)
+def _serial_kinetic_energies(sw, y, g):
+    """The granules' kinetic energies summed serially (solver.dimension)."""
+    return kinetic_energies_serial(y, g)
+
+
 def body_sensor_loads(sw, b, load):
     """The scheme's own body's share of the sensors' readings (none where it has no hook)."""
     raise NotImplementedError("compiled use only")
@@ -206,13 +238,9 @@ def body_sensor_loads(sw, b, load):
 
 @overload(body_sensor_loads, inline="always")
 def _body_sensor_loads(sw, b, load):
-    module = _BY_SCRATCH.get(getattr(sw, "instance_class", None))
-    if module is None:
-        return None
-    fn = getattr(module, "body_sensor_loads", None)
-    if fn is None:
-        return lambda sw, b, load: None
-    return lambda sw, b, load: fn(sw, b, load)
+    fn = _optional_hook(sw, "body_sensor_loads", _no_body_loads)
+    if fn is not None:
+        return lambda sw, b, load: fn(sw, b, load)
 
 
 def commit_histories(sw, t, g, cfg):
@@ -223,20 +251,9 @@ def commit_histories(sw, t, g, cfg):
 
 @overload(commit_histories, inline="always")
 def _commit_histories(sw, t, g, cfg):
-    module = _BY_SCRATCH.get(getattr(sw, "instance_class", None))
-    if module is None:
-        return None
-    fn = getattr(module, "commit_histories", None)
+    fn = _optional_hook(sw, "commit_histories", _commit_after_step)
     if fn is not None:
         return lambda sw, t, g, cfg: fn(sw, t, g, cfg)
-
-    def commit_after_step(sw, t, g, cfg):
-        if cfg.threads > 1:
-            commit_histories_blocks(t, g, cfg.threads)
-        else:
-            commit_every_history(t, g)
-
-    return commit_after_step
 
 
 def step_kinetic_energies(sw, y, g):
@@ -247,10 +264,6 @@ def step_kinetic_energies(sw, y, g):
 
 @overload(step_kinetic_energies, inline="always")
 def _step_kinetic_energies(sw, y, g):
-    module = _BY_SCRATCH.get(getattr(sw, "instance_class", None))
-    if module is None:
-        return None
-    fn = getattr(module, "step_kinetic_energies", None)
+    fn = _optional_hook(sw, "step_kinetic_energies", _serial_kinetic_energies)
     if fn is not None:
         return lambda sw, y, g: fn(sw, y, g)
-    return lambda sw, y, g: kinetic_energies_serial(y, g)
