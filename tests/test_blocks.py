@@ -195,7 +195,7 @@ def test_kicks_that_skip_zero_rows_change_no_bit():
     out = []
     for flag in (True, False):
         y, ypred = y0.copy(), np.zeros((50, 9))
-        w1 = kick_drift(y, acc, zeros, zeros, 1e-3, ypred, 3, 0, 50, True, flag, flag)
+        w1 = kick_drift(y, y, acc, zeros, zeros, 1e-3, ypred, 3, 0, 50, True, flag, flag)
         dy = np.zeros((50, 9))
         w2 = kick(y, acc, zeros, zeros, 5e-4, dy, 3, 0, 50, flag, flag)
         out.append((y, ypred, dy, w1, w2))
@@ -372,3 +372,47 @@ def test_threaded_energy_check_sums_the_kinetic_energies_in_blocks():
     assert np.all(serial > 0.0)
     np.testing.assert_allclose(blocks, serial, rtol=1e-14)
     assert np.array_equal(blocks, np.array(kinetic_energy_blocks(y, g, spar)))
+
+
+@pytest.mark.parametrize("case", ["quiet", "rebuild", "jump", "reach", "new_plate", "two"])
+def test_screened_contact_watch_reports_what_the_serial_walk_does(case):
+    """solver.contacts.watch_contacts screened in blocks on every core (Work.wflag longer
+    than 1) returns the serial walk's status and failure record, wherever in the granule
+    order the granule with something to report lies."""
+    from granplate.solver.contacts import watch_contacts
+    from granplate.solver.state import ERR_CONTACT, ERR_JUMP, ERR_PLATE_REACH, NEW_PLATE, OK, REBUILD
+
+    rng = np.random.default_rng(11)
+    ng, r, move = 203, 1e-3, 1e-3
+    y = np.zeros((ng, 9))
+    y[:, :3] = rng.uniform(0.0, 0.05, (ng, 3))
+    yref = y[:, :3].copy()
+    y[:, :3] += rng.uniform(-0.5, 0.5, (ng, 3)) * move / 2.0  # each moved less than `move`
+    radius = np.full(ng, r)
+    plate_free = np.zeros(ng, np.int64)
+    x0 = 0.2  # the plate's face, beyond every granule
+    k = 151
+    if case == "rebuild":
+        y[k, 1] = yref[k, 1] + 1.5 * move
+    elif case == "jump":
+        y[k, 2] = yref[k, 2] + 3.0 * move  # past rebuild_move + R
+    elif case == "reach":
+        plate_free[k], y[k, 0], yref[k, 0] = 1, x0, x0
+    elif case == "new_plate":
+        plate_free[k], y[k, 0], yref[k, 0] = 1, x0 - 1.2 * r, x0 - 1.2 * r
+    elif case == "two":  # a rebuild early in the order, a patch contact later: the later status stands
+        y[7, 0] = yref[7, 0] + 1.5 * move
+        plate_free[k], y[k, 0], yref[k, 0] = 1, x0 - 1.2 * r, x0 - 1.2 * r
+    want = {"quiet": OK, "rebuild": REBUILD, "jump": ERR_JUMP, "reach": ERR_PLATE_REACH}.get(case, NEW_PLATE)
+    found = []
+    for n_flags in (1, 2, 5):
+        err = np.zeros(8)
+        status = watch_contacts(
+            0.0, y, np.zeros(0), radius, plate_free, yref, np.zeros(ng), np.zeros(ng, np.int64), np.zeros(1),
+            np.full(2, -1, np.int64), 0.1, x0, -1.0, 1.0, move, 0.5, 3, np.zeros(n_flags, np.int64), err,
+        )  # fmt: skip
+        found.append((status, err.tolist()))
+    assert found[0][0] == want
+    if want not in (OK, REBUILD):  # (a rebuild names no granule)
+        assert found[0][1][ERR_CONTACT] == k
+    assert found[1] == found[0] and found[2] == found[0]

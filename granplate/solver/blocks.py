@@ -312,16 +312,16 @@ def mindlin_forces_blocks(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, c
 
 
 @njit(parallel=True)
-def kick_drift_blocks(y, acc, fdamp, fload, h, ypred, n_drift, spar, predict, loads, damped):
-    """solver.kicks.kick_drift over blocks of granules (each granule's update is the serial
-    one's, bit for bit; the work sums per block into spar[k], S_WLOAD and S_WDAMP; fload
-    and fdamp read only where `loads` and `damped`). Returns (the load's work, the damping
-    force's work) [J], summed in block order."""
+def kick_drift_blocks(y0, y, acc, fdamp, fload, h, ypred, n_drift, spar, predict, loads, damped):
+    """solver.kicks.kick_drift from y0 into y over blocks of granules (each granule's update
+    is the serial one's, bit for bit; the work sums per block into spar[k], S_WLOAD and
+    S_WDAMP; fload and fdamp read only where `loads` and `damped`). Returns (the load's
+    work, the damping force's work) [J], summed in block order."""
     nb = spar.shape[0]
     for k in prange(nb):
         lo, hi = block_range(k, nb, y.shape[0])
         spar[k, S_WLOAD], spar[k, S_WDAMP] = kick_drift(
-            y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict, loads, damped
+            y0, y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict, loads, damped
         )
     return work_sums(spar)
 

@@ -9,9 +9,12 @@ cfg.face_skin R of it the chunk ends and the driver gives them a patch contact
 
 from __future__ import annotations
 
+from numba import prange
+
 from granplate.jit import njit
 
 from granplate.physics.contact import plate_overlap
+from granplate.solver.blocks import block_range
 from granplate.solver.state import (
     ERR_CONTACT,
     ERR_ITER,
@@ -61,6 +64,63 @@ def plate_face(u):
     return dmax
 
 
+@njit(cache=True, inline="always")
+def near_plate(i, y, plate_free, plate_ylo, plate_yhi) -> bool:
+    """Whether granule i, without a plate contact, lies within the plate's span
+    plate_ylo < y < plate_yhi [m]."""
+    return plate_free[i] != 0 and plate_ylo < y[i, 1] < plate_yhi
+
+
+@njit(cache=True, inline="always")
+def moved_squared(i, y, yref, ndim) -> float:
+    """The square of how far granule i has moved since the contact list was built (its
+    position in yref, the first ndim columns) [m^2]."""
+    d2 = 0.0
+    for c in range(ndim):
+        dc = y[i, c] - yref[i, c]
+        d2 += dc * dc
+    return d2
+
+
+@njit(cache=True)
+def granules_quiet(
+    lo, hi, y, radius, plate_free, yref, face, plate_x0, plate_ylo, plate_yhi, rebuild_move, face_skin, ndim
+):
+    """Whether granules lo..hi-1 give the watch's walk (`watch_contacts`) nothing to
+    report: none without a plate contact reaches the face (at x = face [m]) or comes
+    within face_skin R of the undeformed one, none has moved rebuild_move [m] or more."""
+    move2 = rebuild_move * rebuild_move
+    for i in range(lo, hi):
+        if near_plate(i, y, plate_free, plate_ylo, plate_yhi):
+            if plate_overlap(y[i, 0], radius[i], face) > 0.0:
+                return False
+            if face_skin > 0.0 and plate_overlap(y[i, 0], radius[i] * (1.0 + face_skin), plate_x0) > 0.0:
+                return False
+        if rebuild_move > 0.0 and moved_squared(i, y, yref, ndim) > move2:
+            return False
+    return True
+
+
+@njit(parallel=True)
+def quiet_blocks(
+    flags, y, radius, plate_free, yref, face, plate_x0, plate_ylo, plate_yhi, rebuild_move, face_skin, ndim
+):
+    """`granules_quiet` over every granule in blocks on every core, one per entry of flags
+    (solver.blocks's ranges; each block's answer into its flag): whether the serial walk
+    would find nothing."""
+    nb = flags.shape[0]
+    for k in prange(nb):
+        lo, hi = block_range(k, nb, y.shape[0])
+        quiet = granules_quiet(
+            lo, hi, y, radius, plate_free, yref, face, plate_x0, plate_ylo, plate_yhi, rebuild_move, face_skin, ndim
+        )
+        flags[k] = 1 if quiet else 0
+    for k in range(nb):
+        if flags[k] == 0:
+            return False
+    return True
+
+
 @njit(cache=True)
 def watch_contacts(
     t,
@@ -80,6 +140,7 @@ def watch_contacts(
     rebuild_move,
     face_skin,
     ndim,
+    flags,
     err,
 ):
     """Check the state after an accepted step; returns OK, REBUILD (the list must be
@@ -88,8 +149,10 @@ def watch_contacts(
     a patch contact; err[ERR_CONTACT] names it), ERR_OVERLAP, ERR_PLATE_REACH or ERR_JUMP
     with err filled. The step's largest overlap comes from the last evaluation of the
     forces (ovl_new, ovl_who: granular.granular_rhs); ovl, ovl_with keep each granule's
-    largest; ndim: the positions' dimension (2 or 3: the first ndim state columns). (Arrays
-    and the Config's scalars, not the tuples: this runs every step.)"""
+    largest; ndim: the positions' dimension (2 or 3: the first ndim state columns). With
+    more than one flag (a threaded run: Work.wflag) the granules are first screened in as
+    many blocks on every core (`quiet_blocks`), and walked in order only when one has
+    something to report: the same answer. (Arrays and the Config's scalars, not the tuples: this runs every step.)"""
     i = ovl_who[0]
     if i >= 0:
         partner = ovl_who[1]
@@ -101,10 +164,14 @@ def watch_contacts(
             r = radius[i] if partner < 0 else min(radius[i], radius[partner])
             return stop(ERR_OVERLAP, t, err, i, partner, rel * r, rel)
     face = plate_x0 + plate_face(u)
+    if flags.shape[0] > 1 and quiet_blocks(
+        flags, y, radius, plate_free, yref, face, plate_x0, plate_ylo, plate_yhi, rebuild_move, face_skin, ndim
+    ):
+        return OK
     status = OK
     move2 = rebuild_move * rebuild_move
     for i in range(y.shape[0]):
-        if plate_free[i] != 0 and plate_ylo < y[i, 1] < plate_yhi:
+        if near_plate(i, y, plate_free, plate_ylo, plate_yhi):
             reach = plate_overlap(y[i, 0], radius[i], face)
             if reach > 0.0:
                 return stop(ERR_PLATE_REACH, t, err, i, PARTNER_PLATE, reach, reach / radius[i])
@@ -112,10 +179,7 @@ def watch_contacts(
                 status = NEW_PLATE
                 err[ERR_CONTACT] = i
         if rebuild_move > 0.0:
-            d2 = 0.0
-            for c in range(ndim):
-                dc = y[i, c] - yref[i, c]
-                d2 += dc * dc
+            d2 = moved_squared(i, y, yref, ndim)
             if d2 > move2:
                 status = REBUILD
                 jump = rebuild_move + radius[i]

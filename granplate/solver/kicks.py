@@ -17,9 +17,11 @@ def half_kick(v0: float, a: float, hk: float):
 
 
 @njit(cache=True)
-def kick_drift(y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict=True, loads=True, damped=True):
-    """Granules lo..hi-1: the first half kick v += h/2 a (every column from n_drift on),
-    the drift x += h v (the columns before), and the state the force pass reads into ypred:
+def kick_drift(y0, y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict=True, loads=True, damped=True):
+    """Granules lo..hi-1 from state y0 into y (y0 may be y itself: each entry is read before
+    it is written; another array spares the step a copy of the state): the first half kick
+    v = v0 + h/2 a (every column from n_drift on), the drift x = x0 + h v (the columns
+    before), and the state the force pass reads into ypred:
     the new positions, and the velocities predicted at the end, v + h/2 a (predict False:
     the half step's v, as LAMMPS's force pass reads them; solver.verlet_damping). Returns
     (the load's work, the damping force's work) of the kick [J]: h/2 F (v_before + v_after)/2.
@@ -30,7 +32,7 @@ def kick_drift(y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict=True, lo
     w_damp = 0.0
     for i in range(lo, hi):
         for c in range(n_drift, y.shape[1]):
-            v1, dv, vm = half_kick(y[i, c], acc[i, c], hk)
+            v1, dv, vm = half_kick(y0[i, c], acc[i, c], hk)
             if loads:
                 w_load += fload[i, c] * vm
             if damped:
@@ -38,7 +40,7 @@ def kick_drift(y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict=True, lo
             y[i, c] = v1
             ypred[i, c] = v1 + dv if predict else v1
         for c in range(n_drift):
-            y[i, c] += h * y[i, c + n_drift]
+            y[i, c] = y0[i, c] + h * y[i, c + n_drift]
             ypred[i, c] = y[i, c]
     return w_load, w_damp
 

@@ -448,6 +448,7 @@ def advance(t_stop, max_attempts, g, p, b, cfg, st, w, sw, out):
             cfg.rebuild_move,
             cfg.face_skin,
             cfg.dimension,
+            w.wflag,
             st.err,
         )
         if status != OK:

@@ -30,7 +30,7 @@ class LoopArrays:
         nc = S.STATE_COLUMNS[cfg.dimension]
         self.p = p._replace(phi_d=p.phi_d.copy(), resid=p.resid.copy()) if cfg.face_skin > 0.0 else p
         self.st = S.new_state(ng, nm, nk, nc)
-        self.w = S.new_work(ng, nm, nk, len(p.face_y), nc)
+        self.w = S.new_work(ng, nm, nk, len(p.face_y), nc, cfg.threads)
         if cfg.face_skin > 0.0 and p.resid_face.shape[0] > 0:  # the rigid layers' face weights: their node
             for k, y_k in enumerate(model.plate.contact_y[:nk]):
                 first, last = patch_weights(p.face_y, float(y_k), 0.0, self.w.wface)
@@ -50,7 +50,7 @@ class LoopArrays:
         ng, nm = st.y.shape[0], st.q.shape[0]
         nc = st.y.shape[1]
         self.st = _copied(st, S.new_state(ng, nm, nk_new, nc))
-        self.w = _copied(w, S.new_work(ng, nm, nk_new, len(w.wface), nc))
+        self.w = _copied(w, S.new_work(ng, nm, nk_new, len(w.wface), nc, len(w.wflag)))
         self.sw = _copied(self.sw, scheme(self.scheme).new_scratch(ng, nm, nk_new, threads=self.sw_threads))
         self.out = _copied(
             self.out,

@@ -144,6 +144,7 @@ class Work(NamedTuple):
     patch_y: np.ndarray  # (nk,) the height [m] each patch contact's weights were computed at
     pweight: np.ndarray  # (nk, n_face) each plate contact's nodal weights on the face (truncated basis)
     prange: np.ndarray  # (nk, 2) int: the first and last face node of each row of pweight
+    wflag: np.ndarray  # (threads,) int scratch: each block's flag in the threaded contact watch (solver.contacts)
 
 
 class Output(NamedTuple):
@@ -197,9 +198,9 @@ def new_state(ng: int, nm: int, nk: int, nc: int = 6) -> State:
     )
 
 
-def new_work(ng: int, nm: int, nk: int, n_face: int = 0, nc: int = 6) -> Work:
+def new_work(ng: int, nm: int, nk: int, n_face: int = 0, nc: int = 6, threads: int = 1) -> Work:
     """Shared scratch for ng granules of nc state columns, nm modes, nk plate contacts and
-    n_face face nodes."""
+    n_face face nodes, on `threads` threads."""
     nd = 2 * nk
     z = np.zeros
     return Work(
@@ -242,6 +243,7 @@ def new_work(ng: int, nm: int, nk: int, n_face: int = 0, nc: int = 6) -> Work:
         patch_y=z(nk),
         pweight=z((nk, n_face)),
         prange=np.zeros((nk, 2), np.int64),
+        wflag=np.zeros(max(threads, 1), np.int64),
     )
 
 

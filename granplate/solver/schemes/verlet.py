@@ -209,16 +209,19 @@ def start(sw, t, st, g, b, cfg):
 
 
 @njit(cache=True)
-def copy_state(y, st, b, sw):
-    """y = st.y (in blocks when the scratch has them), and the trial's modes of the body b
-    from t_n's."""
+def start_state(y, st, b, sw, copy):
+    """The trial's modes of the body b from t_n's and, where `copy` (the rate friction moves
+    the velocities before the first kick, which then starts from y), y = st.y (in blocks
+    when the scratch has them); else the kick starts from st.y itself, sparing the copy."""
+    VB.modes_from(b, st)
+    if not copy:
+        return
     if sw.spar.shape[0] > 0:
         copy_rows(y, st.y)
     else:
         for i in range(y.shape[0]):
             for c in range(y.shape[1]):
                 y[i, c] = st.y[i, c]
-    VB.modes_from(b, st)
 
 
 @njit(cache=True)
@@ -261,30 +264,31 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
     exactly over h between them (into b.q, qd, committed by `commit`). Always converged, one
     force pass. Returns (True, 1, -1, stored energy at t + h [J], 0)."""
     y = w.ynew
-    copy_state(y, st, b, sw)
+    friction = has_friction(g, cfg) or VB.body_friction(b)
+    start_state(y, st, b, sw, friction)
+    y0 = y if friction else st.y  # the state the first kick starts from (it writes y)
     cur = int(sw.split[CURRENT])
     nxt = 1 - cur
     if sw.split[STARTED] == 0.0:
         first_forces(t, st, g, b, cfg, sw, cur)
     _, pd0 = wall_powers(g)  # the damping power at the driven walls' velocities at t_n
     hk = 0.5 * h
-    friction = has_friction(g, cfg) or VB.body_friction(b)
     forward = sw.split[FORWARD] != 0.0
     fric = 0.0
     if friction:
         fric = friction_flow(y, sw.split[OWED] + hk, g, cfg, forward)
         fric += VB.friction(y, b, cur, sw.split[OWED] + hk, g, cfg, forward)
-    w_drive = drive_kick_work(y, st.k1, g, hk)
-    w_grav = gravity_kick_work(y, st.k1, g, hk)
+    w_drive = drive_kick_work(y0, st.k1, g, hk)
+    w_grav = gravity_kick_work(y0, st.k1, g, hk)
     w_piston, d_piston = piston_kick_drift(g, h)  # a force-driven wall: kicked and drifted as a granule
     predict = not cfg.half_step_damping  # the force pass at the predicted end velocities, or the half step's
     if sw.spar.shape[0] > 0:
         loads, damped = sw.quiet[cur, 0] == 0.0, sw.quiet[cur, 1] == 0.0
         wl, wd = kick_drift_blocks(
-            y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, sw.spar, predict, loads, damped
+            y0, y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, sw.spar, predict, loads, damped
         )
     else:
-        wl, wd = kick_drift(y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, 0, y.shape[0], predict)
+        wl, wd = kick_drift(y0, y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, 0, y.shape[0], predict)
     wl, wd, w_grav = VB.first_kick(b, t, h, cur, cfg, wl, wd, w_grav)
     # (Mindlin: the slip over h at the half step's velocities, y's)
     pr, e_t, lost_t = force_pass(t + h, y, w.ytmp, h, g, cfg, sw, nxt, w.kend, st.clock[T_TRIAL])
