@@ -61,6 +61,14 @@ def normal_law_response(delta: float, delta_dot: float, coef, delta_max: float, 
     return _RESPONSE(coef[COEF_NLAW], delta, delta_dot, coef, delta_max, rate, clip)
 
 
+@njit(cache=True, inline="always")
+def normal_law_response_inline(delta: float, delta_dot: float, coef, delta_max: float, rate: float, clip: bool):
+    """`normal_law_response` compiled into its caller, for the one loop where a call per
+    contact shows: the velocity-Verlet pair loop in space (solver.granular3d.pair_forces;
+    docs/benchmarks.md). Elsewhere the call keeps the callers' compilation short."""
+    return _RESPONSE(coef[COEF_NLAW], delta, delta_dot, coef, delta_max, rate, clip)
+
+
 @njit(cache=True)
 def normal_law_force(delta: float, delta_dot: float, coef, delta_max: float, rate: float, clip: bool) -> float:
     """|N| [N] of `normal_law_response` alone."""
@@ -251,9 +259,11 @@ def tangential_energy(coef, a: float, xx: float, xy: float, xz: float) -> float:
     return _TENERGY(coef[COEF_TLAW], coef, a, xx, xy, xz)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def tangential_step(xx, xy, xz, a, a_old, coef, delta, nx, ny, nz, vx, vy, vz, dt, n_abs, f0x, f0y, f0z):
-    """A history law's step of dt [s] (physics.mindlin.law_step's arguments and values)."""
+    """A history law's step of dt [s] (physics.mindlin.law_step's arguments and values),
+    compiled into its caller (solver.mindlin_history.mindlin_contact: the pair loops'
+    tangential step, a call per contact in touch)."""
     return _TSTEP(coef[COEF_TLAW], xx, xy, xz, a, a_old, coef, delta, nx, ny, nz, vx, vy, vz, dt, n_abs, f0x, f0y, f0z)
 
 

@@ -17,6 +17,7 @@ from granplate.physics.laws import (
     keeps_history,
     normal_law_force,
     normal_law_response,
+    normal_law_response_inline,
     tangential_friction,
     tangential_scale,
 )
@@ -520,7 +521,7 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tang
             ovl_i = i
             ovl_j = j
         ddot = normal_rate_3d(yn[i, VX] - yn[j, VX], yn[i, VY] - yn[j, VY], yn[i, VZ] - yn[j, VZ], nx, ny, nz)
-        n, pv, ep, wp = normal_law_response(
+        n, pv, ep, wp = normal_law_response_inline(
             delta, ddot, g.pair_coef[p], hist[p, HIST_MAX], hist[p, HIST_RATE], cfg.clip
         )
         if commit_t >= 0.0:
