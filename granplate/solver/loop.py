@@ -401,7 +401,9 @@ def advance(t_stop, max_attempts, g, p, b, cfg, st, w, sw, out):
             continue
         plate_work = S.commit(sw, t, h, slot, plate_work, fric_work, st, g, p, b, cfg, w)
         accept_pistons(g)
-        if cfg.threads > 1:  # the copies on every core (solver.blocks)
+        if S.steps_in_place(sw, g):  # the state holds the step's end already
+            accept_granular(t, h, land, t_land, plate_work, e_pot, st, w, False)
+        elif cfg.threads > 1:  # the copies on every core (solver.blocks)
             accept_rows(st.y, st.k1, w.ynew, w.kend)
             accept_granular(t, h, land, t_land, plate_work, e_pot, st, w, False)
         else:

@@ -20,7 +20,7 @@ takes b and leaves it; one that does chooses its code by b's type when the loop 
     contacts_moved(sw, t, st, p, cfg)
     start(sw, t, st, g, b, cfg) -> (contact energy, residual energy) [J] at t = 0
 
-and two optional hooks:
+and four optional hooks:
 
     body_sensor_loads(sw, b, load)   half the normal force of each granule's contact with the
                                      elastic body in space b added to its sensor reading
@@ -34,6 +34,10 @@ and two optional hooks:
     step_kinetic_energies(sw, y, g)  the granules' (KE_x, KE_y, KE_z, KE_rot) [J] at state
                                      y for the energy check after each step; absent: summed
                                      serially (solver.dimension.kinetic_energies)
+    steps_in_place(sw, g) -> bool    whether `attempt` wrote the step's end state and
+                                     derivatives into st.y and st.k1 themselves (a scheme
+                                     whose every step is accepted); absent: False, they
+                                     wait in w.ynew and w.kend and the loop copies them in
 
 `start` gives what the bodies hold at t = 0 beyond the loop's own energies (the contacts
 of the elastic body in space b, solver.body; (0, 0) without one). The two before it keep the scheme's own driving-DOF state true when the plate contacts' rows
@@ -231,6 +235,12 @@ def _serial_kinetic_energies(sw, y, g):
     return kinetic_energies_serial(y, g)
 
 
+@njit(cache=True)
+def _trial_apart(sw, g):
+    """A scheme without the hook writes its trial into the Work arrays (w.ynew, w.kend)."""
+    return False
+
+
 def body_sensor_loads(sw, b, load):
     """The scheme's own body's share of the sensors' readings (none where it has no hook)."""
     raise NotImplementedError("compiled use only")
@@ -267,3 +277,17 @@ def _step_kinetic_energies(sw, y, g):
     fn = _optional_hook(sw, "step_kinetic_energies", _serial_kinetic_energies)
     if fn is not None:
         return lambda sw, y, g: fn(sw, y, g)
+
+
+def steps_in_place(sw, g):
+    """Whether the scheme's step wrote its end state and derivatives into the state itself
+    (st.y, st.k1; the scheme's hook), so that the loop's acceptance copies nothing; else
+    (no hook) they wait in w.ynew, w.kend for it."""
+    raise NotImplementedError("compiled use only")
+
+
+@overload(steps_in_place, inline="always")
+def _steps_in_place(sw, g):
+    fn = _optional_hook(sw, "steps_in_place", _trial_apart)
+    if fn is not None:
+        return lambda sw, g: fn(sw, g)

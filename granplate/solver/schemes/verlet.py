@@ -209,6 +209,15 @@ def start(sw, t, st, g, b, cfg):
 
 
 @njit(cache=True)
+def steps_in_place(sw, g) -> bool:
+    """Whether the step writes its end state and derivatives into st.y and st.k1 themselves
+    (every step is accepted; the loop then copies nothing): where no wall is driven, whose
+    elastic work over the step reads the state at t_n beside the new one
+    (solver.drives.wall_shift_energy); else into w.ynew and w.kend."""
+    return g.wall_drive.shape[0] == 0
+
+
+@njit(cache=True)
 def start_state(y, st, b, sw, copy):
     """The trial's modes of the body b from t_n's and, where `copy` (the rate friction moves
     the velocities before the first kick, which then starts from y), y = st.y (in blocks
@@ -258,14 +267,17 @@ def book(w, wl, d_visc, fric, w_plastic, w_grav, w_drive, p_shock, p_visc, ovl, 
 @njit(cache=True)
 def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
     """One Verlet step from st.y into w.ynew (see the module docstring): the trial's
-    accelerations at t + h into w.kend, the load's, damping's, friction's and plastic work
+    accelerations at t + h into w.kend (both into st.y and st.k1 themselves where the step
+    runs in place, `steps_in_place`), the load's, damping's, friction's and plastic work
     into w.dacc, the largest overlap into w.ovl_new / w.ovl_who. With an elastic body in
     space b (solver.body) its modes take the same kicks from the contact forces and turn
     exactly over h between them (into b.q, qd, committed by `commit`). Always converged, one
     force pass. Returns (True, 1, -1, stored energy at t + h [J], 0)."""
-    y = w.ynew
+    in_place = steps_in_place(sw, g)
+    y = st.y if in_place else w.ynew
+    kend = st.k1 if in_place else w.kend  # (st.k1, t_n's, is read before the force pass)
     friction = has_friction(g, cfg) or VB.body_friction(b)
-    start_state(y, st, b, sw, friction)
+    start_state(y, st, b, sw, friction and not in_place)
     y0 = y if friction else st.y  # the state the first kick starts from (it writes y)
     cur = int(sw.split[CURRENT])
     nxt = 1 - cur
@@ -291,21 +303,21 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
         wl, wd = kick_drift(y0, y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, 0, y.shape[0], predict)
     wl, wd, w_grav = VB.first_kick(b, t, h, cur, cfg, wl, wd, w_grav)
     # (Mindlin: the slip over h at the half step's velocities, y's)
-    pr, e_t, lost_t = force_pass(t + h, y, w.ytmp, h, g, cfg, sw, nxt, w.kend, st.clock[T_TRIAL])
+    pr, e_t, lost_t = force_pass(t + h, y, w.ytmp, h, g, cfg, sw, nxt, kend, st.clock[T_TRIAL])
     e_pot, p_visc, w_plastic, fric, ovl, ovl_i, ovl_j = VB.end_pass(
-        y, w.ytmp, st, b, cur, nxt, h, g, cfg, w.kend, sw.fdamp,
+        y, w.ytmp, st, b, cur, nxt, h, g, cfg, kend, sw.fdamp,
         pr.e_pot + e_t, pr.p_visc, pr.w_plastic, fric + lost_t, pr.ovl, pr.ovl_i, pr.ovl_j,
     )  # fmt: skip
     note_quiet(sw, nxt, t + h, b, cfg)
-    finish_pass(w.ytmp, w.kend, g)  # gravity and the drives
+    finish_pass(w.ytmp, kend, g)  # gravity and the drives
     _, pd1 = wall_powers(g)
-    w_drive += drive_kick_work(y, w.kend, g, hk)
-    w_grav += gravity_kick_work(y, w.kend, g, hk)
+    w_drive += drive_kick_work(y, kend, g, hk)
+    w_grav += gravity_kick_work(y, kend, g, hk)
     if sw.spar.shape[0] > 0:
         loads, damped = sw.quiet[nxt, 0] == 0.0, sw.quiet[nxt, 1] == 0.0
-        wl2, wd2 = kick_blocks(y, w.kend, sw.fdamp[nxt], sw.fload[nxt], hk, w.kend, N_DRIFT, sw.spar, loads, damped)
+        wl2, wd2 = kick_blocks(y, kend, sw.fdamp[nxt], sw.fload[nxt], hk, kend, N_DRIFT, sw.spar, loads, damped)
     else:
-        wl2, wd2 = kick(y, w.kend, sw.fdamp[nxt], sw.fload[nxt], hk, w.kend, N_DRIFT, 0, y.shape[0])
+        wl2, wd2 = kick(y, kend, sw.fdamp[nxt], sw.fload[nxt], hk, kend, N_DRIFT, 0, y.shape[0])
     wp2, dp2 = piston_kick(g, hk)
     w_piston += wp2
     d_piston += dp2
