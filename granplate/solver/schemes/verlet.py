@@ -52,7 +52,9 @@ from granplate.solver.schemes import verlet_body as VB
 from granplate.physics.shock import shock_amplitude
 from granplate.solver.blocks import (
     N_FPAR,
+    BLOCKS_PER_THREAD,
     N_SPAR,
+    S_DEALT,
     S_KR,
     S_KX,
     S_DAMPED,
@@ -61,6 +63,7 @@ from granplate.solver.blocks import (
     block_count,
     block_range,
     copy_rows,
+    thread_block,
     kick_blocks,
     kick_drift_blocks,
 )
@@ -177,6 +180,7 @@ def force_pass(t, yv, yn, h, g, cfg, sw, buf, acc, commit_t):
     fdamp = sw.fdamp[buf]
     fload = sw.fload[buf]
     if sw.spar.shape[0] > 0:
+        sw.spar[0, S_DEALT] = 1.0 if cfg.history_friction else 0.0  # (the pairs' blocks dealt out in turn)
         sw.spar[0, S_DAMPED] = 1.0  # (damped until a threaded pass in space counts its granules)
         sw.spar[0, S_ZERO_LOADS] = sw.quiet[buf, 0]
         sw.spar[0, S_ZERO_DAMP] = sw.quiet[buf, 1]
@@ -388,16 +392,21 @@ def step_kinetic_energies(sw, y, g):
 @njit(parallel=True)
 def kinetic_energy_blocks(y, g, spar):
     """The kinetic energies of the granules in the blocks of spar's rows
-    (solver.blocks.block_range), each block's into spar[k, S_KX:S_KR + 1], summed in block
-    order: deterministic for a given thread count, the serial sums' to round-off."""
+    (solver.blocks.block_range; each thread's blocks as solver.blocks.thread_block deals
+    them), each block's into spar[k, S_KX:S_KR + 1], summed in block order: deterministic
+    for a given thread count, the serial sums' to round-off."""
     nb = spar.shape[0]
-    for k in prange(nb):
-        lo, hi = block_range(k, nb, y.shape[0])
-        kx, ky, kz, kr = kinetic_energies_part(y, g, lo, hi)
-        spar[k, S_KX] = kx
-        spar[k, S_KX + 1] = ky
-        spar[k, S_KX + 2] = kz
-        spar[k, S_KR] = kr
+    nt = nb // BLOCKS_PER_THREAD
+    dealt = spar[0, S_DEALT] != 0.0
+    for t in prange(nt):
+        for s in range(BLOCKS_PER_THREAD):
+            k = thread_block(t, s, nt, nb, dealt)
+            lo, hi = block_range(k, nb, y.shape[0])
+            kx, ky, kz, kr = kinetic_energies_part(y, g, lo, hi)
+            spar[k, S_KX] = kx
+            spar[k, S_KX + 1] = ky
+            spar[k, S_KX + 2] = kz
+            spar[k, S_KR] = kr
     kx = 0.0
     ky = 0.0
     kz = 0.0
