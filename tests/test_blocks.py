@@ -416,3 +416,31 @@ def test_screened_contact_watch_reports_what_the_serial_walk_does(case):
     if want not in (OK, REBUILD):  # (a rebuild names no granule)
         assert found[0][1][ERR_CONTACT] == k
     assert found[1] == found[0] and found[2] == found[0]
+
+
+def test_pair_blocks_balance_the_last_pass_cost_and_cover_the_list():
+    """solver.blocks.pair_blocks: equal shares of the list without a last pass over as many
+    pairs; after one, contiguous ranges covering every pair once whose cost (a pair apart
+    1, in touch 1 + TOUCH_WEIGHT) is equal to within one block's spread-out estimate."""
+    from granplate.solver.blocks import S_PHI, S_PLO, S_TOUCH, TOUCH_WEIGHT, pair_blocks
+
+    nb, n_p = 8, 10_000
+    spar = np.zeros((nb, N_SPAR))
+    pair_blocks(spar, nb, n_p, True)  # no last pass: equal shares
+    assert spar[:, S_PLO].tolist() == [k * n_p // nb for k in range(nb)]
+    rng = np.random.default_rng(2)
+    touching = rng.random(n_p) < np.linspace(0.9, 0.05, n_p)  # a wave's front: most contacts in touch early in the list
+    cost = 1.0 + TOUCH_WEIGHT * touching
+    for _ in range(4):  # each pass counts its blocks' contacts in touch, the next takes its ranges from them
+        for k in range(nb):
+            lo, hi = int(spar[k, S_PLO]), int(spar[k, S_PHI])
+            spar[k, S_TOUCH] = touching[lo:hi].sum()
+        pair_blocks(spar, nb, n_p, True)
+    lo, hi = spar[:, S_PLO].astype(int), spar[:, S_PHI].astype(int)
+    assert lo[0] == 0 and hi[-1] == n_p and np.array_equal(lo[1:], hi[:-1]) and np.all(hi >= lo)
+    shares = np.array([cost[a:b].sum() for a, b in zip(lo, hi)])
+    assert shares.max() / shares.mean() < 1.03
+    static = np.array([cost[k * n_p // nb : (k + 1) * n_p // nb].sum() for k in range(nb)])
+    assert static.max() / static.mean() > 1.3  # (the equal shares were far from it)
+    pair_blocks(spar, nb, n_p + 1, True)  # another list: equal shares again
+    assert spar[:, S_PLO].tolist() == [k * (n_p + 1) // nb for k in range(nb)]

@@ -345,7 +345,7 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t):
     p_shock = 0.0
     if not cfg.load_on_plate:
         p_shock = shock_loads(t, y, g, cfg, acc, fload)
-    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, _, _, _, _ = pair_forces(
+    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, _, _, _, _, _ = pair_forces(
         y, y, 0.0, g, cfg, 0, g.pair_ij.shape[0], acc, fdamp, acc, 0, ng, False, commit_t
     )  # (every granule its own: no buffer)
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
@@ -484,7 +484,8 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tang
     solver.blocks); the serial pass (`normal_forces`, solver.mindlin_space) owns every
     granule. Returns (viscous power [W], stored energy [J], plastic work [J], the largest
     overlap / smaller radius, its pair (i, j), the springs' energy [J], their losses [J],
-    and the range [t_lo, t_hi) of the buffer's rows written; empty: t_lo >= t_hi).
+    the range [t_lo, t_hi) of the buffer's rows written (empty: t_lo >= t_hi), and how many
+    of the pairs touch).
 
     Written out per contact for speed: a compiled function called per contact with the
     granular arrays (or even a few of them) costs 3-30x this loop (measured on 56,754
@@ -500,6 +501,7 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tang
     ovl_j = -1
     t_lo = acc.shape[0]
     t_hi = 0
+    n_touch = 0
     hist = g.pair_hist
     half_shrink = 0.5 * cfg.arm_shrink
     for p in range(lo, hi):
@@ -515,6 +517,7 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tang
                 lost += mindlin_parted(hist, p, g.pair_coef[p])
             continue
         hist[p, HIST_END] = delta
+        n_touch += 1
         r_min = min(ri, rj)
         if delta > ovl * r_min:
             ovl = delta / r_min
@@ -559,4 +562,4 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tang
             fj[j, VX + 2] -= fz
             push_couple(fi, i, WX, ti, nx, ny, nz, fx, fy, fz)
             push_couple(fj, j, WX, tj, nx, ny, nz, fx, fy, fz)
-    return p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, e_t, lost, t_lo, t_hi
+    return p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, e_t, lost, t_lo, t_hi, n_touch

@@ -29,9 +29,10 @@ BODY_MODEL = (
 #: the threaded passes' block buffers (solver.blocks: rewritten by every force pass, and
 #: sized by the thread count, which a restart may change)
 BLOCKS = frozenset({"sw.fpar", "sw.spar"})
-#: scratch rewritten before every use, and the Verlet kicks' hints which rows are zero (a
-#: restart starts without them: its kicks read every row, to the same sums)
-SCRATCH = frozenset({"b.mrow", "sw.quiet"})
+#: scratch rewritten before every use (the threaded contact watch's flags, sized by the
+#: thread count), and the Verlet kicks' hints which rows are zero (a restart starts without
+#: them: its kicks read every row, to the same sums)
+SCRATCH = frozenset({"b.mrow", "sw.quiet", "w.wflag"})
 LEFT_OUT = CACHES | BLOCKS | SCRATCH | {f"b.{name}" for name in BODY_MODEL}
 #: the prefix the elastic body's state had in snapshots written when the scheme's scratch
 #: held it (read as "b.")
