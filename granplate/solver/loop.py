@@ -401,13 +401,10 @@ def advance(t_stop, max_attempts, g, p, b, cfg, st, w, sw, out):
             continue
         plate_work = S.commit(sw, t, h, slot, plate_work, fric_work, st, g, p, b, cfg, w)
         accept_pistons(g)
-        if S.steps_in_place(sw, g):  # the state holds the step's end already
-            accept_granular(t, h, land, t_land, plate_work, e_pot, st, w, False)
-        elif cfg.threads > 1:  # the copies on every core (solver.blocks)
+        apart = not S.steps_in_place(sw, g)  # (else the state holds the step's end already)
+        if apart and cfg.threads > 1:  # the copies on every core (solver.blocks)
             accept_rows(st.y, st.k1, w.ynew, w.kend)
-            accept_granular(t, h, land, t_land, plate_work, e_pot, st, w, False)
-        else:
-            accept_granular(t, h, land, t_land, plate_work, e_pot, st, w, True)
+        accept_granular(t, h, land, t_land, plate_work, e_pot, st, w, apart and cfg.threads == 1)
         S.commit_histories(sw, st.clock[T_NOW], g, cfg)
         lam_max = accept_contacts(
             h, w.gmat[slot], g.pc_coef, w.normal_new, w.slip_new, w.conv_iter, st.normal, st.slip, w.lam_int, w.it_int
