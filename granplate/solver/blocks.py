@@ -59,7 +59,7 @@ N_FPAR = N_BUF
 #: damping rows (S_ZERO_DAMP) are all zero already, so the blocks leave them uncleared; a
 #: block of granules' kinetic energies KE_x, KE_y, KE_z, KE_rot [J] (S_KX to S_KR); (row 0,
 #: set by the scheme) 1 where the passes over granules deal their blocks out to the threads
-#: in turn as the pairs' are (S_DEALT: `thread_block`).
+#: in turn as the pairs' are (S_DEALT: `granule_block`).
 S_VISC, S_EPOT, S_PLASTIC, S_OVL, S_OVL_I, S_OVL_J, S_WLOAD, S_WDAMP, S_ET, S_LOST, S_DAMPED = range(11)
 S_TLO, S_THI, S_ZERO_LOADS, S_ZERO_DAMP = range(11, 15)
 S_KX, S_KY, S_KZ, S_KR = range(15, 19)
@@ -98,13 +98,18 @@ def block_range(k, nb, n):
 
 
 @njit(cache=True, inline="always")
-def thread_block(t, s, nt, nb, dealt):
-    """Block number s of thread t's share of nb blocks over nt threads: dealt out in turn
-    (t + s nt, as the pairs' blocks under Mindlin's law: `thread_pairs`) or in one run
-    (t nb / nt + s, as the pairs' one block per thread). A pass over the granules that
-    takes its blocks so finds each granule's rows where the pair pass that wrote them ran:
-    in the same core's cache."""
-    return t + s * nt if dealt else t * (nb // nt) + s
+def granule_block(spar, nt, t, s, n):
+    """Block number s (of nb / nt) of thread t's share of spar's nb blocks of n granules
+    over nt threads (nt dividing nb): (k, lo, hi), block k and its granules [lo, hi)
+    (`block_range`), the blocks dealt out in turn (k = t + s nt) where spar[0, S_DEALT]
+    says the pairs' are (Mindlin's law: `thread_pairs`), else in one run (k = t nb / nt +
+    s, as the pairs' one block per thread). A pass over the granules that takes its blocks
+    so finds each granule's rows where the pair pass that wrote them ran: in the same
+    core's cache."""
+    nb = spar.shape[0]
+    k = t + s * nt if spar[0, S_DEALT] != 0.0 else t * (nb // nt) + s
+    lo, hi = block_range(k, nb, n)
+    return k, lo, hi
 
 
 @njit(cache=True)
@@ -283,15 +288,13 @@ def gather_forces(fpar, acc, fdamp, mass, inertia, spar, n_pair_blocks):
     and fdamp hold (its own block's pairs', the shock's and the walls'), then acc's forces and
     torques made accelerations: acc[:, 3:6] /= mass, acc[:, 6:9] /= inertia (space's
     velocity and spin columns). The granules in blocks, each thread's those of its pair
-    blocks (`thread_block`, spar[0, S_DEALT]); how many of them have a damping force (fdamp
+    blocks (`granule_block`); how many of them have a damping force (fdamp
     not zero) into spar[0, S_DAMPED]."""
     nb = spar.shape[0]
     nt = fpar.shape[0]
-    dealt = spar[0, S_DEALT] != 0.0
     for t in prange(nt):
         for s in range(nb // nt):
-            k = thread_block(t, s, nt, nb, dealt)
-            lo, hi = block_range(k, nb, acc.shape[0])
+            k, lo, hi = granule_block(spar, nt, t, s, acc.shape[0])
             spar[k, S_DAMPED] = gather_rows(fpar, spar, n_pair_blocks, acc, fdamp, mass, inertia, lo, hi)
     n = 0.0
     for k in range(nb):
@@ -386,15 +389,12 @@ def kick_drift_blocks(y0, y, acc, fdamp, fload, h, ypred, n_drift, spar, predict
     """solver.kicks.kick_drift from y0 into y over blocks of granules (each granule's update
     is the serial one's, bit for bit; the work sums per block into spar[k], S_WLOAD and
     S_WDAMP; fload and fdamp read only where `loads` and `damped`), each thread's blocks
-    those of the pair pass's blocks (`thread_block`, spar[0, S_DEALT]). Returns (the load's
+    those of the pair pass's blocks (`granule_block`). Returns (the load's
     work, the damping force's work) [J], summed in block order."""
-    nb = spar.shape[0]
-    nt = nb // BLOCKS_PER_THREAD
-    dealt = spar[0, S_DEALT] != 0.0
+    nt = spar.shape[0] // BLOCKS_PER_THREAD
     for t in prange(nt):
         for s in range(BLOCKS_PER_THREAD):
-            k = thread_block(t, s, nt, nb, dealt)
-            lo, hi = block_range(k, nb, y.shape[0])
+            k, lo, hi = granule_block(spar, nt, t, s, y.shape[0])
             spar[k, S_WLOAD], spar[k, S_WDAMP] = kick_drift(
                 y0, y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict, loads, damped
             )
@@ -404,13 +404,10 @@ def kick_drift_blocks(y0, y, acc, fdamp, fload, h, ypred, n_drift, spar, predict
 @njit(parallel=True)
 def kick_blocks(y, acc, fdamp, fload, hk, dy, n_drift, spar, loads, damped):
     """solver.kicks.kick over blocks of granules, as `kick_drift_blocks`."""
-    nb = spar.shape[0]
-    nt = nb // BLOCKS_PER_THREAD
-    dealt = spar[0, S_DEALT] != 0.0
+    nt = spar.shape[0] // BLOCKS_PER_THREAD
     for t in prange(nt):
         for s in range(BLOCKS_PER_THREAD):
-            k = thread_block(t, s, nt, nb, dealt)
-            lo, hi = block_range(k, nb, y.shape[0])
+            k, lo, hi = granule_block(spar, nt, t, s, y.shape[0])
             spar[k, S_WLOAD], spar[k, S_WDAMP] = kick(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi, loads, damped)
     return work_sums(spar)
 

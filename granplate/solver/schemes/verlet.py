@@ -61,9 +61,8 @@ from granplate.solver.blocks import (
     S_ZERO_DAMP,
     S_ZERO_LOADS,
     block_count,
-    block_range,
     copy_rows,
-    thread_block,
+    granule_block,
     kick_blocks,
     kick_drift_blocks,
 )
@@ -392,16 +391,13 @@ def step_kinetic_energies(sw, y, g):
 @njit(parallel=True)
 def kinetic_energy_blocks(y, g, spar):
     """The kinetic energies of the granules in the blocks of spar's rows
-    (solver.blocks.block_range; each thread's blocks as solver.blocks.thread_block deals
-    them), each block's into spar[k, S_KX:S_KR + 1], summed in block order: deterministic
+    (solver.blocks.granule_block: each thread's blocks dealt as its pair blocks), each block's into spar[k, S_KX:S_KR + 1], summed in block order: deterministic
     for a given thread count, the serial sums' to round-off."""
     nb = spar.shape[0]
     nt = nb // BLOCKS_PER_THREAD
-    dealt = spar[0, S_DEALT] != 0.0
     for t in prange(nt):
         for s in range(BLOCKS_PER_THREAD):
-            k = thread_block(t, s, nt, nb, dealt)
-            lo, hi = block_range(k, nb, y.shape[0])
+            k, lo, hi = granule_block(spar, nt, t, s, y.shape[0])
             kx, ky, kz, kr = kinetic_energies_part(y, g, lo, hi)
             spar[k, S_KX] = kx
             spar[k, S_KX + 1] = ky
