@@ -13,7 +13,7 @@ from granplate.bench.scaling_space import launched_fcc
 from granplate.errors import ScenarioError, YieldWarning
 from granplate.model.arrays import build_model
 from granplate.results.run import simulate
-from granplate.setup.scenario import Wall
+from granplate.setup.scenario import Drive, Wall
 from granplate.setup.threads import PARALLEL_MIN_GRANULES, available_threads, check_threads, loop_threads
 from granplate.setup.validate import validate
 from granplate.solver import granular3d
@@ -444,3 +444,88 @@ def test_pair_blocks_balance_the_last_pass_cost_and_cover_the_list():
     assert static.max() / static.mean() > 1.3  # (the equal shares were far from it)
     pair_blocks(spar, nb, n_p + 1, True)  # another list: equal shares again
     assert spar[:, S_PLO].tolist() == [k * (n_p + 1) // nb for k in range(nb)]
+
+
+def test_first_kick_that_clears_the_accelerations_changes_no_bit():
+    """solver.kicks.kick_drift with `clear` (the threaded step in place: its force pass then
+    writes over acc uncleared) gives the bits of the kick without it, and leaves zeros in
+    exactly the columns it kicked."""
+    from granplate.solver.kicks import kick_drift
+
+    rng = np.random.default_rng(7)
+    y0, acc0 = rng.normal(size=(40, 9)), rng.normal(size=(40, 9))
+    fdamp, fload = rng.normal(size=(40, 9)), rng.normal(size=(40, 9))
+    out = []
+    for clear in (False, True):
+        y, ypred, acc = y0.copy(), np.zeros((40, 9)), acc0.copy()
+        works = kick_drift(y0, y, acc, fdamp, fload, 1e-3, ypred, 3, 5, 33, True, True, True, clear)
+        out.append((y, ypred, works, acc))
+    (y1, p1, w1, a1), (y2, p2, w2, a2) = out
+    assert np.array_equal(y1, y2) and np.array_equal(p1, p2) and w1 == w2
+    assert np.array_equal(a1, acc0)
+    assert np.all(a2[5:33, 3:] == 0.0)
+    assert np.array_equal(a2[5:33, :3], acc0[5:33, :3])
+    assert np.array_equal(a2[:5], acc0[:5]) and np.array_equal(a2[33:], acc0[33:])
+
+
+def test_closing_kick_gives_the_kinetic_energies_of_the_kicked_state():
+    """solver.schemes.verlet.closing_kick_blocks: the serial kick's state and works to the
+    bit (works to round-off: summed per block), and with `energies` the blocks' kinetic
+    energies, summed in block order, those `kinetic_energy_blocks` finds at the kicked state,
+    bit for bit; without, the energy columns are left as they were."""
+    from granplate.solver.blocks import S_KR, S_KX
+    from granplate.solver.kicks import kick
+    from granplate.solver.schemes.verlet import closing_kick_blocks, kinetic_energy_blocks, kinetic_sums
+
+    m = build_model(packing(1, mu=0.0))
+    g = m.granular
+    rng = np.random.default_rng(23)
+    y0 = m.initial_state.copy()
+    y0[:, 3:9] = rng.normal(0.0, 1.0, (len(y0), 6))
+    acc, fdamp = rng.normal(size=y0.shape), rng.normal(size=y0.shape)
+    fload = np.zeros_like(y0)
+    y_serial, dy_serial = y0.copy(), np.zeros_like(y0)
+    w_serial = kick(y_serial, acc, fdamp, fload, 5e-4, dy_serial, 3, 0, len(y0), False, True)
+    for energies in (True, False):
+        y, dy, spar = y0.copy(), np.zeros_like(y0), np.zeros((8, N_SPAR))
+        spar[:, S_KX : S_KR + 1] = -1.0
+        works = closing_kick_blocks(y, acc, fdamp, fload, 5e-4, dy, 3, spar, False, True, g, energies)
+        assert np.array_equal(y, y_serial) and np.array_equal(dy, dy_serial)
+        np.testing.assert_allclose(works, w_serial, rtol=1e-12)
+        if energies:
+            sums = np.array(kinetic_sums(spar))
+            assert np.all(sums > 0.0)
+            assert np.array_equal(sums, np.array(kinetic_energy_blocks(y, g, np.zeros((8, N_SPAR)))))
+        else:
+            assert np.all(spar[:, S_KX : S_KR + 1] == -1.0)
+
+
+@pytest.mark.parametrize("target", ["granule", "wall"])
+def test_driven_packing_on_threads_equals_the_serial_loop(target):
+    """A driven granule (its velocity set after the closing kick: the kinetic energies are
+    then summed apart) or a driven wall (the step kept apart from t_n's state: no clearing
+    first kick) on THREADS threads: the serial loop's motion to round-off, the energy
+    balance held."""
+    s = packing(None)
+    if target == "granule":
+        first = dataclasses.replace(s.granules[0], label="pushed")
+        s = dataclasses.replace(s, granules=(first, *s.granules[1:]))
+        drive = Drive(target="granule pushed", kind="velocity", direction=(1.0, 0.0, 0.0), value=0.5)
+    else:
+        drive = Drive(
+            target="wall floor",
+            kind="displacement",
+            direction=(-1.0, 0.0, 0.0),
+            profile="ramp",
+            value=2e-6,
+            duration=1e-5,
+        )
+    s = dataclasses.replace(s, drives=(drive,))
+    one = run(dataclasses.replace(s, solver=dataclasses.replace(s.solver, threads=1)))
+    many = run(dataclasses.replace(s, solver=dataclasses.replace(s.solver, threads=THREADS)))
+    np.testing.assert_allclose(many["x"].values, one["x"].values, rtol=0.0, atol=1e-12)
+    v_scale = float(np.abs(one["vx"].values).max())
+    np.testing.assert_allclose(many["vx"].values, one["vx"].values, rtol=0.0, atol=1e-9 * v_scale)
+    a, b = one.energy_residual.values, many.energy_residual.values
+    assert np.abs(b).max() < 1e-4
+    assert np.abs(a - b).max() < 1e-9

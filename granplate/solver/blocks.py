@@ -40,7 +40,7 @@ from granplate.jit import njit  # noqa: E402
 from granplate.solver.drives import begin_pass
 from granplate.solver.granular import ForceSums, commit_history, commit_rows
 from granplate.solver.granular3d import BUF_DAMP, N_BUF, VX, WX, pair_forces, shock_loads, wall_forces
-from granplate.solver.kicks import kick, kick_drift
+from granplate.solver.kicks import kick_drift
 from granplate.solver.mindlin_space import wall_mindlin
 
 #: columns of a thread's buffer row fpar[t, i], for a granule i outside the own rows
@@ -68,7 +68,13 @@ S_DEALT = 19
 #: how many of them touched (S_TOUCH), and the end of its next range (S_EDGE, worked out
 #: before the old ranges are let go)
 S_PLO, S_PHI, S_TOUCH, S_EDGE = 20, 21, 22, 23
-N_SPAR = 24
+#: (row 0, set by the scheme) 1 where the accelerations' rows are zero from the velocity
+#: columns on already (the step's first kick cleared them as it read them:
+#: solver.kicks.kick_drift's `clear`), so the pair blocks leave them uncleared (S_ZERO_ACC);
+#: 1 where the blocks' kinetic energies S_KX..S_KR are those of the state the loop checks
+#: next (the closing kick computed them: S_KE_READY)
+S_ZERO_ACC, S_KE_READY = 24, 25
+N_SPAR = 26
 
 #: what a pair in touch costs the Mindlin pass beside one apart, less one (the weight the
 #: blocks are balanced by: `pair_blocks`; measured on the 10,192-sphere packing: a block's
@@ -179,13 +185,14 @@ def owned_rows(k, nb, pair_ij, ng, spar):
 
 
 @njit(cache=True)
-def clear_block(acc, fdamp, fload, lo, hi, damp, loads):
-    """Block k's share of a pass's clearing: its own granules' rows lo..hi-1 of acc, and of
-    fdamp and fload where `damp` and `loads` (else they are all zero already), from the
+def clear_block(acc, fdamp, fload, lo, hi, forces, damp, loads):
+    """Block k's share of a pass's clearing: its own granules' rows lo..hi-1 of acc, fdamp
+    and fload where `forces`, `damp` and `loads` (else they are all zero already), from the
     velocity columns on (its buffer is zero already: `gather_rows` zeroes what it reads)."""
-    for i in range(lo, hi):
-        for c in range(3, acc.shape[1]):
-            acc[i, c] = 0.0
+    if forces:
+        for i in range(lo, hi):
+            for c in range(3, acc.shape[1]):
+                acc[i, c] = 0.0
     if damp:
         for i in range(lo, hi):
             for c in range(3, acc.shape[1]):
@@ -204,7 +211,16 @@ def block_pairs(yv, yn, h, g, cfg, k, nb, buf, spar, acc, fdamp, fload, tangenti
     [J], their losses [J], and the buffer rows [lo, hi) it wrote)."""
     ng = acc.shape[0]
     own_lo, own_hi = owned_rows(k, nb, g.pair_ij, ng, spar)
-    clear_block(acc, fdamp, fload, own_lo, own_hi, spar[0, S_ZERO_DAMP] == 0.0, spar[0, S_ZERO_LOADS] == 0.0)
+    clear_block(
+        acc,
+        fdamp,
+        fload,
+        own_lo,
+        own_hi,
+        spar[0, S_ZERO_ACC] == 0.0,
+        spar[0, S_ZERO_DAMP] == 0.0,
+        spar[0, S_ZERO_LOADS] == 0.0,
+    )
     lo, hi = int(spar[k, S_PLO]), int(spar[k, S_PHI])
     pv, ep, wp, ovl, ovl_i, ovl_j, e_t, lost, t_lo, t_hi, n_touch = pair_forces(
         yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tangential, commit_t
@@ -385,30 +401,20 @@ def mindlin_forces_blocks(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, c
 
 
 @njit(parallel=True)
-def kick_drift_blocks(y0, y, acc, fdamp, fload, h, ypred, n_drift, spar, predict, loads, damped):
+def kick_drift_blocks(y0, y, acc, fdamp, fload, h, ypred, n_drift, spar, predict, loads, damped, clear):
     """solver.kicks.kick_drift from y0 into y over blocks of granules (each granule's update
     is the serial one's, bit for bit; the work sums per block into spar[k], S_WLOAD and
-    S_WDAMP; fload and fdamp read only where `loads` and `damped`), each thread's blocks
-    those of the pair pass's blocks (`granule_block`). Returns (the load's
-    work, the damping force's work) [J], summed in block order."""
+    S_WDAMP; fload and fdamp read only where `loads` and `damped`; acc's kicked columns
+    zeroed as they are read where `clear`), each thread's blocks those of the pair pass's
+    blocks (`granule_block`). Returns (the load's work, the damping force's work) [J],
+    summed in block order."""
     nt = spar.shape[0] // BLOCKS_PER_THREAD
     for t in prange(nt):
         for s in range(BLOCKS_PER_THREAD):
             k, lo, hi = granule_block(spar, nt, t, s, y.shape[0])
             spar[k, S_WLOAD], spar[k, S_WDAMP] = kick_drift(
-                y0, y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict, loads, damped
+                y0, y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict, loads, damped, clear
             )
-    return work_sums(spar)
-
-
-@njit(parallel=True)
-def kick_blocks(y, acc, fdamp, fload, hk, dy, n_drift, spar, loads, damped):
-    """solver.kicks.kick over blocks of granules, as `kick_drift_blocks`."""
-    nt = spar.shape[0] // BLOCKS_PER_THREAD
-    for t in prange(nt):
-        for s in range(BLOCKS_PER_THREAD):
-            k, lo, hi = granule_block(spar, nt, t, s, y.shape[0])
-            spar[k, S_WLOAD], spar[k, S_WDAMP] = kick(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi, loads, damped)
     return work_sums(spar)
 
 

@@ -17,7 +17,7 @@ def half_kick(v0: float, a: float, hk: float):
 
 
 @njit(cache=True)
-def kick_drift(y0, y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict=True, loads=True, damped=True):
+def kick_drift(y0, y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict=True, loads=True, damped=True, clear=False):
     """Granules lo..hi-1 from state y0 into y (y0 may be y itself: each entry is read before
     it is written; another array spares the step a copy of the state): the first half kick
     v = v0 + h/2 a (every column from n_drift on), the drift x = x0 + h v (the columns
@@ -26,13 +26,17 @@ def kick_drift(y0, y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict=True
     the half step's v, as LAMMPS's force pass reads them; solver.verlet_damping). Returns
     (the load's work, the damping force's work) of the kick [J]: h/2 F (v_before + v_after)/2.
     fload (fdamp) is not read where `loads` (`damped`) is False: the caller knows it is all
-    zero, and its work is then 0 exactly as the sum would give."""
+    zero, and its work is then 0 exactly as the sum would give. `clear`: each acceleration
+    of the kicked columns is set to zero once read (the step's force pass then writes the
+    new ones into acc without clearing it first: solver.blocks.clear_block)."""
     hk = 0.5 * h
     w_load = 0.0
     w_damp = 0.0
     for i in range(lo, hi):
         for c in range(n_drift, y.shape[1]):
             v1, dv, vm = half_kick(y0[i, c], acc[i, c], hk)
+            if clear:
+                acc[i, c] = 0.0
             if loads:
                 w_load += fload[i, c] * vm
             if damped:

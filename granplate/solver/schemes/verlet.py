@@ -58,13 +58,17 @@ from granplate.solver.blocks import (
     S_KR,
     S_KX,
     S_DAMPED,
+    S_KE_READY,
+    S_WDAMP,
+    S_WLOAD,
+    S_ZERO_ACC,
     S_ZERO_DAMP,
     S_ZERO_LOADS,
     block_count,
     copy_rows,
     granule_block,
-    kick_blocks,
     kick_drift_blocks,
+    work_sums,
 )
 from granplate.solver.dimension import (
     friction_flow,
@@ -166,7 +170,7 @@ def has_friction(g, cfg) -> bool:
 
 
 @njit(cache=True)
-def force_pass(t, yv, yn, h, g, cfg, sw, buf, acc, commit_t):
+def force_pass(t, yv, yn, h, g, cfg, sw, buf, acc, commit_t, cleared=False):
     """The force pass at (t, yn) into buffer buf (sw.fdamp[buf], sw.fload[buf]; the
     accelerations into acc): in blocks on every core when the scratch has blocks
     (solver.blocks: they leave uncleared the buffer's rows its last pass left all zero,
@@ -174,8 +178,9 @@ def force_pass(t, yv, yn, h, g, cfg, sw, buf, acc, commit_t):
     springs in it, their histories moved on by the slip at yv's velocities over h [s] (0:
     the committed histories' forces); the pairs' overlaps committed at commit_t [s] (the
     trial's end as the clock will read it, st.clock[T_TRIAL]: every step is accepted; < 0:
-    not, the pass at t_n). Returns (the ForceSums, the springs' stored energy [J], their
-    losses [J]; 0 and 0 without Mindlin's law)."""
+    not, the pass at t_n); `cleared`: the first kick left acc's rows zero from the velocity
+    columns on (solver.blocks.S_ZERO_ACC). Returns (the ForceSums, the springs' stored
+    energy [J], their losses [J]; 0 and 0 without Mindlin's law)."""
     fdamp = sw.fdamp[buf]
     fload = sw.fload[buf]
     if sw.spar.shape[0] > 0:
@@ -183,6 +188,7 @@ def force_pass(t, yv, yn, h, g, cfg, sw, buf, acc, commit_t):
         sw.spar[0, S_DAMPED] = 1.0  # (damped until a threaded pass in space counts its granules)
         sw.spar[0, S_ZERO_LOADS] = sw.quiet[buf, 0]
         sw.spar[0, S_ZERO_DAMP] = sw.quiet[buf, 1]
+        sw.spar[0, S_ZERO_ACC] = 1.0 if cleared else 0.0
     if cfg.history_friction:
         return mindlin_force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar, commit_t)
     if sw.spar.shape[0] > 0:
@@ -277,6 +283,9 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
     exactly over h between them (into b.q, qd, committed by `commit`). Always converged, one
     force pass. Returns (True, 1, -1, stored energy at t + h [J], 0)."""
     in_place = steps_in_place(sw, g)
+    threaded = sw.spar.shape[0] > 0
+    if threaded:
+        sw.spar[0, S_KE_READY] = 0.0
     y = st.y if in_place else w.ynew
     kend = st.k1 if in_place else w.kend  # (st.k1, t_n's, is read before the force pass)
     friction = has_friction(g, cfg) or VB.body_friction(b)
@@ -297,16 +306,16 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
     w_grav = gravity_kick_work(y0, st.k1, g, hk)
     w_piston, d_piston = piston_kick_drift(g, h)  # a force-driven wall: kicked and drifted as a granule
     predict = not cfg.half_step_damping  # the force pass at the predicted end velocities, or the half step's
-    if sw.spar.shape[0] > 0:
+    if threaded:  # (stepping in place, the kick clears the accelerations it reads: the pass writes over them)
         loads, damped = sw.quiet[cur, 0] == 0.0, sw.quiet[cur, 1] == 0.0
         wl, wd = kick_drift_blocks(
-            y0, y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, sw.spar, predict, loads, damped
+            y0, y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, sw.spar, predict, loads, damped, in_place
         )
     else:
         wl, wd = kick_drift(y0, y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, 0, y.shape[0], predict)
     wl, wd, w_grav = VB.first_kick(b, t, h, cur, cfg, wl, wd, w_grav)
     # (Mindlin: the slip over h at the half step's velocities, y's)
-    pr, e_t, lost_t = force_pass(t + h, y, w.ytmp, h, g, cfg, sw, nxt, kend, st.clock[T_TRIAL])
+    pr, e_t, lost_t = force_pass(t + h, y, w.ytmp, h, g, cfg, sw, nxt, kend, st.clock[T_TRIAL], threaded and in_place)
     e_pot, p_visc, w_plastic, fric, ovl, ovl_i, ovl_j = VB.end_pass(
         y, w.ytmp, st, b, cur, nxt, h, g, cfg, kend, sw.fdamp,
         pr.e_pot + e_t, pr.p_visc, pr.w_plastic, fric + lost_t, pr.ovl, pr.ovl_i, pr.ovl_j,
@@ -316,9 +325,13 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
     _, pd1 = wall_powers(g)
     w_drive += drive_kick_work(y, kend, g, hk)
     w_grav += gravity_kick_work(y, kend, g, hk)
-    if sw.spar.shape[0] > 0:
+    if threaded:  # (with the kinetic energies, where nothing moves the velocities after the kick)
         loads, damped = sw.quiet[nxt, 0] == 0.0, sw.quiet[nxt, 1] == 0.0
-        wl2, wd2 = kick_blocks(y, kend, sw.fdamp[nxt], sw.fload[nxt], hk, kend, N_DRIFT, sw.spar, loads, damped)
+        energies = g.drive_target.shape[0] == 0 and not (friction and sw.split[LAND] != 0.0)
+        wl2, wd2 = closing_kick_blocks(
+            y, kend, sw.fdamp[nxt], sw.fload[nxt], hk, kend, N_DRIFT, sw.spar, loads, damped, g, energies
+        )
+        sw.spar[0, S_KE_READY] = 1.0 if energies else 0.0
     else:
         wl2, wd2 = kick(y, kend, sw.fdamp[nxt], sw.fload[nxt], hk, kend, N_DRIFT, 0, y.shape[0])
     wp2, dp2 = piston_kick(g, hk)
@@ -381,9 +394,13 @@ def commit_histories(sw, t, g, cfg):
 @njit(cache=True)
 def step_kinetic_energies(sw, y, g):
     """The granules' (KE_x, KE_y, KE_z, KE_rot) [J] at state y for the step's energy check:
-    in blocks on every core when the scratch has blocks (`kinetic_energy_blocks`), else
-    serially (solver.dimension.kinetic_energies)."""
+    in blocks on every core when the scratch has blocks (`kinetic_energy_blocks`; the
+    blocks' sums the step's closing kick left, where it says they are y's:
+    `closing_kick_blocks`), else serially (solver.dimension.kinetic_energies)."""
     if sw.spar.shape[0] > 0:
+        if sw.spar[0, S_KE_READY] != 0.0:
+            sw.spar[0, S_KE_READY] = 0.0
+            return kinetic_sums(sw.spar)
         return kinetic_energy_blocks(y, g, sw.spar)
     return kinetic_energies_part(y, g, 0, y.shape[0])
 
@@ -393,16 +410,28 @@ def kinetic_energy_blocks(y, g, spar):
     """The kinetic energies of the granules in the blocks of spar's rows
     (solver.blocks.granule_block: each thread's blocks dealt as its pair blocks), each block's into spar[k, S_KX:S_KR + 1], summed in block order: deterministic
     for a given thread count, the serial sums' to round-off."""
-    nb = spar.shape[0]
-    nt = nb // BLOCKS_PER_THREAD
+    nt = spar.shape[0] // BLOCKS_PER_THREAD
     for t in prange(nt):
         for s in range(BLOCKS_PER_THREAD):
             k, lo, hi = granule_block(spar, nt, t, s, y.shape[0])
-            kx, ky, kz, kr = kinetic_energies_part(y, g, lo, hi)
-            spar[k, S_KX] = kx
-            spar[k, S_KX + 1] = ky
-            spar[k, S_KX + 2] = kz
-            spar[k, S_KR] = kr
+            block_kinetic_energies(y, g, spar, k, lo, hi)
+    return kinetic_sums(spar)
+
+
+@njit(cache=True, inline="always")
+def block_kinetic_energies(y, g, spar, k, lo, hi):
+    """The kinetic energies of granules lo..hi-1 (block k) into spar[k, S_KX:S_KR + 1]."""
+    kx, ky, kz, kr = kinetic_energies_part(y, g, lo, hi)
+    spar[k, S_KX] = kx
+    spar[k, S_KX + 1] = ky
+    spar[k, S_KX + 2] = kz
+    spar[k, S_KR] = kr
+
+
+@njit(cache=True)
+def kinetic_sums(spar):
+    """(KE_x, KE_y, KE_z, KE_rot) [J]: the blocks' (spar[k, S_KX:S_KR + 1]) in block order."""
+    nb = spar.shape[0]
     kx = 0.0
     ky = 0.0
     kz = 0.0
@@ -413,6 +442,22 @@ def kinetic_energy_blocks(y, g, spar):
         kz += spar[k, S_KX + 2]
         kr += spar[k, S_KR]
     return kx, ky, kz, kr
+
+
+@njit(parallel=True)
+def closing_kick_blocks(y, acc, fdamp, fload, hk, dy, n_drift, spar, loads, damped, g, energies):
+    """solver.kicks.kick over blocks of granules (as solver.blocks.kick_drift_blocks), and
+    where `energies` each block's kinetic energies at the kicked state while its rows are
+    at hand (`block_kinetic_energies`: a pass over the granules fewer). Returns (the load's
+    work, the damping force's work) [J], summed in block order."""
+    nt = spar.shape[0] // BLOCKS_PER_THREAD
+    for t in prange(nt):
+        for s in range(BLOCKS_PER_THREAD):
+            k, lo, hi = granule_block(spar, nt, t, s, y.shape[0])
+            spar[k, S_WLOAD], spar[k, S_WDAMP] = kick(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi, loads, damped)
+            if energies:
+                block_kinetic_energies(y, g, spar, k, lo, hi)
+    return work_sums(spar)
 
 
 @njit(cache=True)
