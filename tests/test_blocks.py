@@ -409,13 +409,64 @@ def test_screened_contact_watch_reports_what_the_serial_walk_does(case):
         err = np.zeros(8)
         status = watch_contacts(
             0.0, y, np.zeros(0), radius, plate_free, yref, np.zeros(ng), np.zeros(ng, np.int64), np.zeros(1),
-            np.full(2, -1, np.int64), 0.1, x0, -1.0, 1.0, move, 0.5, 3, np.zeros(n_flags, np.int64), err,
+            np.full(2, -1, np.int64), 0.1, x0, -1.0, 1.0, move, 0.5, 3, -1.0, np.zeros(n_flags, np.int64), err,
         )  # fmt: skip
         found.append((status, err.tolist()))
     assert found[0][0] == want
     if want not in (OK, REBUILD):  # (a rebuild names no granule)
         assert found[0][1][ERR_CONTACT] == k
     assert found[1] == found[0] and found[2] == found[0]
+
+
+@pytest.mark.parametrize("case", ["quiet", "rebuild", "jump", "edge"])
+def test_watch_screened_by_the_measured_moves_reports_what_the_walk_does(case):
+    """solver.contacts.watch_contacts given the step's largest squared move (moved2, the
+    threaded first kick's: solver.schemes.verlet.first_kick_blocks) with no plate span to
+    reach returns the walk's status and failure record; the first kick's per-block moves
+    are solver.contacts.largest_move's of its blocks, which cover every granule."""
+    from granplate.solver.blocks import S_MOVED
+    from granplate.solver.contacts import largest_move, watch_contacts
+    from granplate.solver.schemes.verlet import first_kick_blocks
+    from granplate.solver.state import ERR_CONTACT, ERR_JUMP, OK, REBUILD
+
+    rng = np.random.default_rng(13)
+    ng, r, move = 157, 1e-3, 1e-3
+    y = np.zeros((ng, 9))
+    y[:, :3] = rng.uniform(0.0, 0.05, (ng, 3))
+    yref = y[:, :3].copy()
+    y[:, :3] += rng.uniform(-0.5, 0.5, (ng, 3)) * move / 2.0
+    k = 97
+    if case == "rebuild":
+        y[k, 1] = yref[k, 1] + 1.5 * move
+    elif case == "jump":
+        y[k, 2] = yref[k, 2] + 3.0 * move
+    elif case == "edge":  # rebuild_move to round-off: the screen and the walk decide alike
+        y[k, :3] = yref[k]
+        y[k, 0] += move
+    y[:, 3:] = rng.normal(0.0, 1.0, (ng, 6))
+    acc, zeros = rng.normal(0.0, 1.0, (ng, 9)), np.zeros((ng, 9))
+    if case == "edge":  # (held where it is)
+        y[k, 3:], acc[k] = 0.0, 0.0
+    spar = np.zeros((8, N_SPAR))  # (8 blocks: 2 threads' share, each thread's in one run)
+    y1, ypred = y.copy(), np.zeros((ng, 9))
+    first_kick_blocks(y, y1, acc, zeros, zeros, 1e-9, ypred, spar, True, False, False, False, yref, 3)
+    y = y1
+    bounds = [(i * ng) // 8 for i in range(9)]
+    for b in range(8):
+        assert spar[b, S_MOVED] == largest_move(y, yref, bounds[b], bounds[b + 1], 3)
+    moved2 = max(spar[:, S_MOVED])
+    found = []
+    for m2 in (-1.0, moved2):
+        err = np.zeros(8)
+        status = watch_contacts(
+            0.0, y, np.zeros(0), np.full(ng, r), np.ones(ng, np.int64), yref, np.zeros(ng), np.zeros(ng, np.int64),
+            np.zeros(1), np.full(2, -1, np.int64), 0.1, 0.2, 0.0, 0.0, move, 0.5, 3, m2, np.zeros(1, np.int64), err,
+        )  # fmt: skip
+        found.append((status, err.tolist()))
+    want = {"rebuild": REBUILD, "jump": ERR_JUMP, "quiet": OK}.get(case, found[0][0])
+    assert found[0][0] == want and want in (OK, REBUILD, ERR_JUMP) and found[1] == found[0]
+    if case == "jump":
+        assert found[0][1][ERR_CONTACT] == k
 
 
 def test_pair_blocks_balance_the_last_pass_cost_and_cover_the_list():

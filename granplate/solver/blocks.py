@@ -40,7 +40,6 @@ from granplate.jit import njit  # noqa: E402
 from granplate.solver.drives import begin_pass
 from granplate.solver.granular import ForceSums, commit_history, commit_rows
 from granplate.solver.granular3d import BUF_DAMP, N_BUF, VX, WX, pair_forces, shock_loads, wall_forces
-from granplate.solver.kicks import kick_drift
 from granplate.solver.mindlin_space import wall_mindlin
 
 #: columns of a thread's buffer row fpar[t, i], for a granule i outside the own rows
@@ -74,7 +73,11 @@ S_PLO, S_PHI, S_TOUCH, S_EDGE = 20, 21, 22, 23
 #: 1 where the blocks' kinetic energies S_KX..S_KR are those of the state the loop checks
 #: next (the closing kick computed them: S_KE_READY)
 S_ZERO_ACC, S_KE_READY = 24, 25
-N_SPAR = 26
+#: (row k, the first kick) the largest squared move of block k's granules since the contact
+#: list's reference [m^2] (S_MOVED); (row 0) 1 where those are the state's the loop watches
+#: next (S_MOVES_READY)
+S_MOVED, S_MOVES_READY = 26, 27
+N_SPAR = 28
 
 #: what a pair in touch costs the Mindlin pass beside one apart, less one (the weight the
 #: blocks are balanced by: `pair_blocks`; measured on the 10,192-sphere packing: a block's
@@ -398,24 +401,6 @@ def mindlin_forces_blocks(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, c
     e_w, lost_w = wall_mindlin(yv, yn, h, g, cfg, acc)
     sums = ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
     return sums, e_t + e_w, lost + lost_w
-
-
-@njit(parallel=True)
-def kick_drift_blocks(y0, y, acc, fdamp, fload, h, ypred, n_drift, spar, predict, loads, damped, clear):
-    """solver.kicks.kick_drift from y0 into y over blocks of granules (each granule's update
-    is the serial one's, bit for bit; the work sums per block into spar[k], S_WLOAD and
-    S_WDAMP; fload and fdamp read only where `loads` and `damped`; acc's kicked columns
-    zeroed as they are read where `clear`), each thread's blocks those of the pair pass's
-    blocks (`granule_block`). Returns (the load's work, the damping force's work) [J],
-    summed in block order."""
-    nt = spar.shape[0] // BLOCKS_PER_THREAD
-    for t in prange(nt):
-        for s in range(BLOCKS_PER_THREAD):
-            k, lo, hi = granule_block(spar, nt, t, s, y.shape[0])
-            spar[k, S_WLOAD], spar[k, S_WDAMP] = kick_drift(
-                y0, y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict, loads, damped, clear
-            )
-    return work_sums(spar)
 
 
 @njit(cache=True)

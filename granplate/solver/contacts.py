@@ -82,6 +82,15 @@ def moved_squared(i, y, yref, ndim) -> float:
     return d2
 
 
+@njit(cache=True, inline="always")
+def largest_move(y, yref, lo, hi, ndim) -> float:
+    """The largest `moved_squared` of granules lo..hi-1 [m^2] (0 for none)."""
+    d2 = 0.0
+    for i in range(lo, hi):
+        d2 = max(d2, moved_squared(i, y, yref, ndim))
+    return d2
+
+
 @njit(cache=True)
 def granules_quiet(
     lo, hi, y, radius, plate_free, yref, face, plate_x0, plate_ylo, plate_yhi, rebuild_move, face_skin, ndim
@@ -140,6 +149,7 @@ def watch_contacts(
     rebuild_move,
     face_skin,
     ndim,
+    moved2,
     flags,
     err,
 ):
@@ -152,7 +162,11 @@ def watch_contacts(
     largest; ndim: the positions' dimension (2 or 3: the first ndim state columns). With
     more than one flag (a threaded run: Work.wflag) the granules are first screened in as
     many blocks on every core (`quiet_blocks`), and walked in order only when one has
-    something to report: the same answer. (Arrays and the Config's scalars, not the tuples: this runs every step.)"""
+    something to report: the same answer. moved2 >= 0: the largest squared move since yref
+    of any granule [m^2], which the step measured as it moved them (the scheme's hook
+    largest_move; -1: not measured); with no plate span to reach (plate_ylo >= plate_yhi,
+    the granules in space) it is the screen, and the walk runs only when it finds a move
+    of rebuild_move or more. (Arrays and the Config's scalars, not the tuples: this runs every step.)"""
     i = ovl_who[0]
     if i >= 0:
         partner = ovl_who[1]
@@ -164,7 +178,10 @@ def watch_contacts(
             r = radius[i] if partner < 0 else min(radius[i], radius[partner])
             return stop(ERR_OVERLAP, t, err, i, partner, rel * r, rel)
     face = plate_x0 + plate_face(u)
-    if flags.shape[0] > 1 and quiet_blocks(
+    if moved2 >= 0.0 and plate_yhi <= plate_ylo:  # only the moves to screen, measured already
+        if rebuild_move <= 0.0 or moved2 <= rebuild_move * rebuild_move:
+            return OK
+    elif flags.shape[0] > 1 and quiet_blocks(
         flags, y, radius, plate_free, yref, face, plate_x0, plate_ylo, plate_yhi, rebuild_move, face_skin, ndim
     ):
         return OK

@@ -447,6 +447,7 @@ def advance(t_stop, max_attempts, g, p, b, cfg, st, w, sw, out):
             cfg.rebuild_move,
             cfg.face_skin,
             cfg.dimension,
+            S.largest_move(sw),
             w.wflag,
             st.err,
         )

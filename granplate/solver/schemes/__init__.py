@@ -20,7 +20,7 @@ takes b and leaves it; one that does chooses its code by b's type when the loop 
     contacts_moved(sw, t, st, p, cfg)
     start(sw, t, st, g, b, cfg) -> (contact energy, residual energy) [J] at t = 0
 
-and four optional hooks:
+and five optional hooks:
 
     body_sensor_loads(sw, b, load)   half the normal force of each granule's contact with the
                                      elastic body in space b added to its sensor reading
@@ -31,6 +31,11 @@ and four optional hooks:
                                      t [s]; absent: every contact's end overlap committed
                                      after the step (solver.granular.commit_histories, the
                                      pairs in blocks on every core with cfg.threads > 1)
+    largest_move(sw) -> float        the largest squared distance [m^2] a granule has moved
+                                     since the contact list's reference (Work.yref), where
+                                     the step measured it as it moved them (the contact
+                                     watch then screens nothing itself); absent: -1, not
+                                     measured (solver.contacts.watch_contacts)
     step_kinetic_energies(sw, y, g)  the granules' (KE_x, KE_y, KE_z, KE_rot) [J] at state
                                      y for the energy check after each step; absent: summed
                                      serially (solver.dimension.kinetic_energies)
@@ -236,6 +241,12 @@ def _serial_kinetic_energies(sw, y, g):
 
 
 @njit(cache=True)
+def _moves_unmeasured(sw):
+    """A scheme without the hook leaves the contact watch to measure the moves."""
+    return -1.0
+
+
+@njit(cache=True)
 def _trial_apart(sw, g):
     """A scheme without the hook writes its trial into the Work arrays (w.ynew, w.kend)."""
     return False
@@ -277,6 +288,19 @@ def _step_kinetic_energies(sw, y, g):
     fn = _optional_hook(sw, "step_kinetic_energies", _serial_kinetic_energies)
     if fn is not None:
         return lambda sw, y, g: fn(sw, y, g)
+
+
+def largest_move(sw):
+    """The largest squared move of a granule since the contact list's reference [m^2] where
+    the scheme's step measured it (the scheme's hook), else -1."""
+    raise NotImplementedError("compiled use only")
+
+
+@overload(largest_move, inline="always")
+def _largest_move(sw):
+    fn = _optional_hook(sw, "largest_move", _moves_unmeasured)
+    if fn is not None:
+        return lambda sw: fn(sw)
 
 
 def steps_in_place(sw, g):

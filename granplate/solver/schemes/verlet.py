@@ -59,6 +59,8 @@ from granplate.solver.blocks import (
     S_KX,
     S_DAMPED,
     S_KE_READY,
+    S_MOVED,
+    S_MOVES_READY,
     S_WDAMP,
     S_WLOAD,
     S_ZERO_ACC,
@@ -67,9 +69,9 @@ from granplate.solver.blocks import (
     block_count,
     copy_rows,
     granule_block,
-    kick_drift_blocks,
     work_sums,
 )
+from granplate.solver.contacts import largest_move as block_largest_move
 from granplate.solver.dimension import (
     friction_flow,
     kinetic_energies_part,
@@ -286,6 +288,7 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
     threaded = sw.spar.shape[0] > 0
     if threaded:
         sw.spar[0, S_KE_READY] = 0.0
+        sw.spar[0, S_MOVES_READY] = 0.0
     y = st.y if in_place else w.ynew
     kend = st.k1 if in_place else w.kend  # (st.k1, t_n's, is read before the force pass)
     friction = has_friction(g, cfg) or VB.body_friction(b)
@@ -308,9 +311,11 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
     predict = not cfg.half_step_damping  # the force pass at the predicted end velocities, or the half step's
     if threaded:  # (stepping in place, the kick clears the accelerations it reads: the pass writes over them)
         loads, damped = sw.quiet[cur, 0] == 0.0, sw.quiet[cur, 1] == 0.0
-        wl, wd = kick_drift_blocks(
-            y0, y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, sw.spar, predict, loads, damped, in_place
-        )
+        wl, wd = first_kick_blocks(
+            y0, y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, sw.spar, predict, loads, damped, in_place,
+            w.yref, cfg.dimension,
+        )  # fmt: skip
+        sw.spar[0, S_MOVES_READY] = 1.0  # (the positions move in this kick alone)
     else:
         wl, wd = kick_drift(y0, y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, 0, y.shape[0], predict)
     wl, wd, w_grav = VB.first_kick(b, t, h, cur, cfg, wl, wd, w_grav)
@@ -445,8 +450,43 @@ def kinetic_sums(spar):
 
 
 @njit(parallel=True)
+def first_kick_blocks(y0, y, acc, fdamp, fload, h, ypred, spar, predict, loads, damped, clear, yref, ndim):
+    """solver.kicks.kick_drift from y0 into y over blocks of granules (each granule's update
+    is the serial one's, bit for bit; the work sums per block into spar[k], S_WLOAD and
+    S_WDAMP; fload and fdamp read only where `loads` and `damped`; acc's kicked columns
+    zeroed as they are read where `clear`), each thread's blocks those of the pair pass's
+    blocks (solver.blocks.granule_block); each block's largest squared move since the
+    contact list's reference yref (its first ndim columns) [m^2] into spar[k, S_MOVED] while
+    its rows are at hand (`largest_move`: the contact watch's screen). Returns (the load's work, the damping
+    force's work) [J], summed in block order."""
+    nt = spar.shape[0] // BLOCKS_PER_THREAD
+    for t in prange(nt):
+        for s in range(BLOCKS_PER_THREAD):
+            k, lo, hi = granule_block(spar, nt, t, s, y.shape[0])
+            spar[k, S_WLOAD], spar[k, S_WDAMP] = kick_drift(
+                y0, y, acc, fdamp, fload, h, ypred, N_DRIFT, lo, hi, predict, loads, damped, clear
+            )
+            spar[k, S_MOVED] = block_largest_move(y, yref, lo, hi, ndim)
+    return work_sums(spar)
+
+
+@njit(cache=True)
+def largest_move(sw) -> float:
+    """The largest squared move of a granule since the contact list's reference [m^2], which
+    the threaded step's first kick measured (`first_kick_blocks`), the blocks' largest;
+    -1 where it did not (the serial step, or read already): the contact watch measures."""
+    if sw.spar.shape[0] == 0 or sw.spar[0, S_MOVES_READY] == 0.0:
+        return -1.0
+    sw.spar[0, S_MOVES_READY] = 0.0
+    d2 = 0.0
+    for k in range(sw.spar.shape[0]):
+        d2 = max(d2, sw.spar[k, S_MOVED])
+    return d2
+
+
+@njit(parallel=True)
 def closing_kick_blocks(y, acc, fdamp, fload, hk, dy, n_drift, spar, loads, damped, g, energies):
-    """solver.kicks.kick over blocks of granules (as solver.blocks.kick_drift_blocks), and
+    """solver.kicks.kick over blocks of granules (as `first_kick_blocks`), and
     where `energies` each block's kinetic energies at the kicked state while its rows are
     at hand (`block_kinetic_energies`: a pass over the granules fewer). Returns (the load's
     work, the damping force's work) [J], summed in block order."""
