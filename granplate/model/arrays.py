@@ -30,6 +30,7 @@ from granplate.model.coefficients import wall_coefficient_row as wall_coefficien
 from granplate.model.relists import cached_pair_coefficients as cached_pair_coefficients
 from granplate.model.relists import carried_history as carried_history
 from granplate.model.relists import granular_with_contacts as granular_with_contacts
+from granplate.model.relists import with_pair_kinds
 from granplate.model.relists import granular_with_patch_contacts as granular_with_patch_contacts
 from granplate.setup.geometry import resolve
 from granplate.setup.law_registry import TANGENTIAL_LAW_REGISTRY
@@ -377,7 +378,7 @@ def plane_model(s: Scenario) -> Model:
         pc_hist=no_history(len(pc), columns),
     )
     drives = drive_fields(s, np.column_stack([x, y]))
-    granular = granular._replace(**drives)
+    granular = with_pair_kinds(granular._replace(**drives))
     model = Model(
         scenario=s,
         labels=tuple(g.label or str(i + 1) for i, g in enumerate(s.granules)),

@@ -170,6 +170,34 @@ def pair_coefficients(s: Scenario, mats, r: np.ndarray, mass: np.ndarray, pairs:
     return pair_coef
 
 
+#: An odd 64-bit multiplier (FNV-1a's prime) that mixes a row's bits into one key.
+_KEY_PRIME = np.uint64(0x100000001B3)
+
+
+def coefficient_kinds(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct rows of the coefficient rows `rows` (n, N_COEF), by their bits: (kind
+    (n,) int32, table (k, N_COEF)) with table[kind] equal to rows bit for bit, the kinds in
+    the order of the rows' keys. A packing of one size and material has one kind, found by
+    one comparison; else each row's bits are mixed into a key, the keys sorted, and the
+    table checked against every row (rows of one key but other bits: sorted by their bits
+    instead). About a second for the 6 million pairs of a million spheres."""
+    rows = np.ascontiguousarray(rows, float).reshape(-1, N_COEF)
+    if not len(rows):
+        return np.zeros(0, np.int32), np.zeros((0, N_COEF))
+    bits = rows.view(np.uint64)
+    if np.array_equal(bits, np.broadcast_to(bits[0], bits.shape)):
+        return np.zeros(len(rows), np.int32), rows[:1].copy()
+    key = np.zeros(len(rows), np.uint64)
+    with np.errstate(over="ignore"):
+        for c in range(N_COEF):
+            key = (key ^ bits[:, c]) * _KEY_PRIME
+    _, first, kind = np.unique(key, return_index=True, return_inverse=True)
+    kind = kind.reshape(-1)
+    if not all(np.array_equal(bits[first, c][kind], bits[:, c]) for c in range(N_COEF)):  # two rows of one key
+        _, first, kind = np.unique(bits.view(np.dtype((np.void, 8 * N_COEF))).ravel(), True, True)
+    return kind.reshape(-1).astype(np.int32), rows[first]
+
+
 def kind_compliances(kinds) -> np.ndarray:
     """Each Material's share (2 - nu) / G [1/Pa] of a contact's tangential compliance 1/G*."""
     return np.array([tangential_compliance(m.E, m.nu) for m in kinds], float)

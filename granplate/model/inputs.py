@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 
+from granplate.physics.contact import N_COEF
 from granplate.physics.drives import N_PAR
 from granplate.setup.validate import SCHEMES
 
@@ -119,6 +120,12 @@ class Granular(NamedTuple):
     pass (columns DR_*, this run's own). wall_drive (n_walls,) int: the drive of each
     scenario wall or -1 (empty: no wall is driven); wall_load (n_walls,): the normal force
     each wall received at the last force pass [N] (this run's own).
+
+    The pairs' coefficient kinds (model.relists.with_pair_kinds; empty: not made yet):
+    pair_kind (np,) int32, the row of kind_coef (nk, N_COEF) that holds pair p's row
+    pair_coef[p], bit for bit (model.coefficients.coefficient_kinds). The pair loop of
+    velocity Verlet in space reads them: a few rows that stay in the cache, where a row per
+    pair would come from memory at every pass. Made with pair_coef, never changed apart.
     """
 
     mass: np.ndarray
@@ -151,6 +158,8 @@ class Granular(NamedTuple):
     drive_now: np.ndarray = np.zeros((0, N_DRIVE))
     wall_drive: np.ndarray = np.zeros(0, np.int64)
     wall_load: np.ndarray = np.zeros(0)
+    pair_kind: np.ndarray = np.zeros(0, np.int32)
+    kind_coef: np.ndarray = np.zeros((0, N_COEF))
 
 
 #: Flat arrays of a granular medium in space (docs/model.md section 3.7), with the fields of

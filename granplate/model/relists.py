@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from granplate.model.coefficients import pair_coefficients, plate_contact_coefficients, wall_arrays
+from granplate.model.coefficients import coefficient_kinds, pair_coefficients, plate_contact_coefficients, wall_arrays
 from granplate.model.inputs import HIST_MAX, HIST_XI, Granular, no_history
 from granplate.physics.contact import N_COEF
 from granplate.setup.scenario import Scenario
@@ -69,6 +69,19 @@ def cached_pair_coefficients(s: Scenario, mats, g: Granular, pairs: np.ndarray, 
     return out
 
 
+def with_pair_kinds(g: Granular) -> Granular:
+    """`g` with its pairs' coefficient kinds (pair_kind, kind_coef: model.inputs.Granular)
+    made from pair_coef (`coefficient_kinds`)."""
+    kind, table = coefficient_kinds(g.pair_coef)
+    return g._replace(pair_kind=kind, kind_coef=table)
+
+
+def pair_kinds_stale(g: Granular) -> bool:
+    """Whether g's pair kinds are not its pairs' (another count: a Granular made without
+    them, or from a stored run's arrays)."""
+    return g.pair_kind.shape[0] != g.pair_ij.shape[0] or (len(g.pair_ij) > 0 and not len(g.kind_coef))
+
+
 def granular_with_contacts(
     model: Model,
     g: Granular,
@@ -80,7 +93,8 @@ def granular_with_contacts(
     """`g` with the contact lists pairs (np, 2) and wc (nw, 2) [granule, wall], their
     coefficients and their histories carried over (`carried_history`; stores: the pairs'
     and the walls' histories off the list, keyed (i, j) and (i, wall), updated); known:
-    the pairs' coefficient rows met so far (`cached_pair_coefficients`), reused and extended."""
+    the pairs' coefficient rows met so far (`cached_pair_coefficients`), reused and extended;
+    their kinds made anew (`with_pair_kinds`)."""
     s, mats = model.scenario, list(model.materials)
     known = {} if known is None else known
     stores = ({}, {}) if stores is None else stores
@@ -88,9 +102,12 @@ def granular_with_contacts(
     pair_coef = cached_pair_coefficients(s, mats, g, pairs, known)
     wall_geo, wall_coef = wall_arrays(s, mats, g.radius, g.mass, wc, model.walls)
     wc = np.asarray(wc, np.int64).reshape(-1, 2)
+    kind, table = coefficient_kinds(pair_coef)
     return g._replace(
         pair_ij=pairs,
         pair_coef=pair_coef,
+        pair_kind=kind,
+        kind_coef=table,
         wall_i=np.ascontiguousarray(wc[:, 0]),
         wall_geo=wall_geo,
         wall_coef=wall_coef,

@@ -19,6 +19,7 @@ from granplate.model import loads
 from granplate.model.contacts import contact_lists
 from granplate.model.coefficients import scenario_history_columns
 from granplate.model.inputs import STATE_COLUMNS, Granular3, PlateArrays, no_history
+from granplate.model.relists import with_pair_kinds
 from granplate.setup.pairs import contact_search_distance, superset_pairs
 from granplate.physics.contact import N_COEF
 from granplate.setup.scenario import Scenario
@@ -139,7 +140,7 @@ def build_space_model(s: Scenario):
         pc_hist=no_history(0, columns),
     )
     drives = drive_fields(s, np.column_stack([x, y, z]))
-    granular = granular._replace(**drives)
+    granular = with_pair_kinds(granular._replace(**drives))
     cfg = loop_config(
         s,
         np.zeros(len(r)),

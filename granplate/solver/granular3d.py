@@ -485,7 +485,8 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tang
     granule. Returns (viscous power [W], stored energy [J], plastic work [J], the largest
     overlap / smaller radius, its pair (i, j), the springs' energy [J], their losses [J],
     the range [t_lo, t_hi) of the buffer's rows written (empty: t_lo >= t_hi), and how many
-    of the pairs touch).
+    of the pairs touch). Each pair's coefficients are its kind's row (g.kind_coef[g.pair_kind[p]],
+    pair_coef[p]'s bits: model.inputs.Granular), a few rows that stay in the cache.
 
     Written out per contact for speed: a compiled function called per contact with the
     granular arrays (or even a few of them) costs 3-30x this loop (measured on 56,754
@@ -510,11 +511,12 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tang
         ri = g.radius[i]
         rj = g.radius[j]
         hist[p, HIST_END] = 0.0
+        c = g.kind_coef[g.pair_kind[p]]
         delta, nx, ny, nz = pair_contact_3d(yn[i, X], yn[i, Y], yn[i, Z], ri, yn[j, X], yn[j, Y], yn[j, Z], rj)
-        kt = tangential and keeps_history(g.pair_coef[p])
+        kt = tangential and keeps_history(c)
         if delta <= 0.0:
             if kt and mindlin_touched(hist, p):
-                lost += mindlin_parted(hist, p, g.pair_coef[p])
+                lost += mindlin_parted(hist, p, c)
             continue
         hist[p, HIST_END] = delta
         n_touch += 1
@@ -524,11 +526,9 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tang
             ovl_i = i
             ovl_j = j
         ddot = normal_rate_3d(yn[i, VX] - yn[j, VX], yn[i, VY] - yn[j, VY], yn[i, VZ] - yn[j, VZ], nx, ny, nz)
-        n, pv, ep, wp = normal_law_response_inline(
-            delta, ddot, g.pair_coef[p], hist[p, HIST_MAX], hist[p, HIST_RATE], cfg.clip
-        )
+        n, pv, ep, wp = normal_law_response_inline(delta, ddot, c, hist[p, HIST_MAX], hist[p, HIST_RATE], cfg.clip)
         if commit_t >= 0.0:
-            commit_overlap(commit_t, hist, p, delta, g.pair_coef[p])
+            commit_overlap(commit_t, hist, p, delta, c)
         w_plastic += wp
         p_visc += pv
         e_pot += ep
@@ -538,7 +538,6 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tang
         if pv != 0.0:  # the damping part of |N|, pv / ddot
             push_pair(di, dj, i, j, ci, cj, pv / ddot, nx, ny, nz)
         if kt:  # the history law's force (Mindlin's spring) from the same overlap and |N|
-            c = g.pair_coef[p]
             ai = contact_arm(ri, delta, half_shrink)
             aj = contact_arm(rj, delta, half_shrink)
             _, vsx, vsy, vsz = pair_slip(yv, i, j, nx, ny, nz, ai, aj)

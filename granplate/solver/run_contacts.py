@@ -14,6 +14,7 @@ from granplate.model.arrays import Model, granular_with_contacts
 from granplate.model.contacts import Missed, centre_coordinates, contact_lists, missed_contacts, wall_planes
 from granplate.model.inputs import DR_REF, DR_S, HIST_MAX, HIST_RATE, HIST_TIME, no_history
 from granplate.model.neighbours import verlet_pairs, verlet_walls
+from granplate.model.relists import pair_kinds_stale, with_pair_kinds
 from granplate.solver import state as S
 
 
@@ -87,6 +88,8 @@ class ContactLists:
     def __init__(self, model: Model):
         self.model = model
         g = model.granular
+        if pair_kinds_stale(g):  # (a Granular made without its pairs' kinds)
+            g = with_pair_kinds(g)
         # this run's own histories (the loop updates them in place)
         self.g = g._replace(
             pair_hist=no_history(len(g.pair_ij), g.pair_hist.shape[1]),

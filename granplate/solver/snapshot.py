@@ -17,10 +17,12 @@ from __future__ import annotations
 import numpy as np
 
 from granplate.model.inputs import NoBodyArrays
+from granplate.model.relists import with_pair_kinds
 from granplate.solver.state import CUSTOM_H
 
-#: per-level caches, recomputed on first use (their `ok` flags are cleared on restore)
-CACHES = frozenset({"w.dmode", "w.gmat", "sw.mcoef", "sw.mmat"})
+#: per-level caches, recomputed on first use (their `ok` flags are cleared on restore), and
+#: the pairs' coefficient kinds, made again from the stored pair_coef on restore
+CACHES = frozenset({"w.dmode", "w.gmat", "sw.mcoef", "sw.mmat", "g.pair_kind", "g.kind_coef"})
 #: the elastic body's model arrays (the same in every run of the model: not stored)
 BODY_MODEL = (
     "face_nodes face_snode node_xyz node_area node_rows node_resid grid grid_origin grid_shape "
@@ -124,7 +126,7 @@ def restore(snap: dict[str, np.ndarray], arr, lists) -> None:
     arr.p = _rebuilt("p", arr.p, snap)
     arr.w.g_ok[:] = 0
     arr.st.clock[CUSTOM_H] = -1.0  # the odd step's matrices too
-    lists.g = _rebuilt("g", lists.g, snap)
+    lists.g = with_pair_kinds(_rebuilt("g", lists.g, snap))  # (the kinds of the stored pairs)
     lists.stores = tuple(
         {
             (int(i), int(j)): _history_row(h, lists.g.pair_hist.shape[1])
