@@ -134,9 +134,15 @@ def _check_restart_interval(t) -> None:
 OUTPUT_BYTES_PER_GRANULE = 3 * 8 * 12
 OUTPUT_BYTES_PER_DOF = 3 * 8 * 2
 FIELD_BYTES_PER_DOF = 3 * 8 * 4
-#: Bytes of the contact table per granule and table time (time.contact_interval): about 3
-#: rows of 40 bytes per granule, 2 copies (the rows built, the Dataset).
+#: Bytes of the contact table per granule and table time (time.contact_interval): rows of
+#: 40 bytes, 2 copies (the rows built, the Dataset), about 3 rows per granule in the plane
+#: and 6 in space (a close packing's 12 neighbours).
 LINK_BYTES_PER_GRANULE = 2 * 3 * 40
+LINK_ROWS_PER_GRANULE = {2: 3, 3: 6}
+#: Bytes the model and the loop hold per granule beside the outputs: its contact list and
+#: coefficients, histories, state and scratch (8,300 measured at a million spheres in
+#: space, docs/benchmarks.md).
+MODEL_BYTES_PER_GRANULE = 8_500
 
 
 def output_bytes_per_second(s: Scenario) -> float:
@@ -150,28 +156,35 @@ def output_bytes_per_second(s: Scenario) -> float:
         n_dof = 2 * ((p.nx + 1) * (p.ny + 1) + p.nx * (p.ny + 1) + p.ny * (p.nx + 1))
     row = OUTPUT_BYTES_PER_GRANULE * len(s.granules) + OUTPUT_BYTES_PER_DOF * n_dof + 400.0
     steps = contact_steps(t)
-    table = LINK_BYTES_PER_GRANULE * len(s.granules) / (steps * t.output_interval) if steps > 0 else 0.0
+    link = LINK_BYTES_PER_GRANULE * LINK_ROWS_PER_GRANULE.get(s.dimension, 3) // 3
+    table = link * len(s.granules) / (steps * t.output_interval) if steps > 0 else 0.0
     return row / t.output_interval + FIELD_BYTES_PER_DOF * n_dof / t.field_interval + table
 
 
 def _check_output_size(s: Scenario) -> None:
-    """The outputs of t_end fit in MEMORY_SHARE of the machine's memory (at the output
-    stride of a run of many granules, setup.output_stride)."""
+    """The outputs of t_end fit in MEMORY_SHARE of the machine's memory beside the model and
+    the loop (MODEL_BYTES_PER_GRANULE a granule), at the output stride of a run of many
+    granules (setup.output_stride)."""
     from granplate.setup.output_stride import with_output_stride
 
     s = with_output_stride(s)
-    memory = MEMORY_SHARE * physical_memory()
-    t_max = memory / output_bytes_per_second(s)
+    total = MEMORY_SHARE * physical_memory()
+    model = MODEL_BYTES_PER_GRANULE * len(s.granules)
+    memory = total - model
+    t_max = max(memory, 0.0) / output_bytes_per_second(s)
     t = s.time
-    if memory > 0.0 and not t.t_end <= t_max:
+    if total > 0.0 and not t.t_end <= t_max:
+        need = t.t_end * output_bytes_per_second(s)
         raise ScenarioError(
             "time.t_end",
             t.t_end,
             f"allowed: t_end <= {t_max:.3g} s with these output intervals: the outputs would need "
-            f"about {t.t_end / t_max * (memory / 1e9):.3g} GB ({t.t_end / t.output_interval:.3g} "
+            f"about {need / 1e9:.3g} GB ({t.t_end / t.output_interval:.3g} "
             f"output times, time.output_interval = {t.output_interval!r} s; "
             f"{t.t_end / t.field_interval:.3g} plate snapshots, time.field_interval = "
-            f"{t.field_interval!r} s), this machine allows {memory / 1e9:.3g} GB",
+            f"{t.field_interval!r} s) beside about {model / 1e9:.3g} GB for the model of "
+            f"{len(s.granules)} granules, this machine allows {total / 1e9:.3g} GB in all: raise "
+            "the intervals or shorten t_end",
         )
 
 

@@ -23,7 +23,8 @@ from granplate.model.dimension import of_number
 from granplate.solver import loop, snapshot, state as S
 from granplate.solver.compiling import compile_calls, compile_seconds, describe_seconds, machine_slowdown
 from granplate.solver.ladder import level_for
-from granplate.solver.loop_arrays import LoopArrays, add_patch_contacts, attach_patches, near_face as near_face
+from granplate.solver.loop_arrays import LoopArrays, add_patch_contacts, attach_patches, map_pages
+from granplate.solver.loop_arrays import near_face as near_face
 from granplate.solver.run_contacts import ContactChanges, ContactLists
 from granplate.solver.run_contacts import ContactPeaks as ContactPeaks, contact_peaks as contact_peaks
 from granplate.solver.run_contacts import wall_offsets_now as wall_offsets_now
@@ -312,6 +313,7 @@ def run(
         attach_patches(model, lists, arr, model.initial_patches)  # touching between nodes at t = 0
         st, w = arr.st, arr.w  # grown
     st.count[S.C_LEVEL] = level_for(model.scenario.time.dt_initial, cfg)
+    map_pages(st, w, arr.sw, arr.b, arr.out, lists.g)  # (the pages the loop writes, mapped before its clock)
     calls = [
         (loop.initialise, (st, lists.g, arr.p, cfg, w)),
         (loop.start_scheme, (arr.sw, st, lists.g, arr.b, cfg)),
@@ -357,6 +359,7 @@ def _run_from(model: Model, start: dict, progress: bool, should_stop, interrupti
     lists = ContactLists(model)
     snapshot.restore(start, arr, lists)
     st = arr.st
+    map_pages(st, arr.w, arr.sw, arr.b, arr.out, lists.g)
     calls = [
         (loop.record, (0, st, lists.g, arr.p, arr.w, arr.out)),
         *sensor_calls(arr, st, lists.g, cfg),

@@ -1,0 +1,40 @@
+"""The run's arrays (solver.loop_arrays): their pages mapped at set-up leave every number
+as it was, nested named tuples included, and arrays that cannot be written alone."""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from granplate.solver.loop_arrays import MAP_BYTES, map_pages
+
+
+class Inner(NamedTuple):
+    big: np.ndarray
+    small: np.ndarray
+
+
+class Outer(NamedTuple):
+    inner: Inner
+    data: np.ndarray
+    frozen: np.ndarray
+    strided: np.ndarray
+    count: int
+
+
+def test_mapping_pages_changes_no_number():
+    """Arrays over MAP_BYTES (C-contiguous, writeable), in nested tuples too, keep every
+    bit; a read-only array and a strided view are passed by; small arrays are untouched."""
+    rng = np.random.default_rng(2)
+    data = rng.normal(size=(3 * MAP_BYTES // 8 + 17,))
+    data[5] = -0.0
+    frozen = rng.normal(size=(MAP_BYTES // 8 + 1,))
+    frozen.flags.writeable = False
+    base = rng.normal(size=(2 * MAP_BYTES // 8, 2))
+    inner = Inner(big=np.zeros((MAP_BYTES // 8, 3)), small=np.arange(5.0))
+    tup = Outer(inner=inner, data=data, frozen=frozen, strided=base[:, 0], count=3)
+    before = [a.copy() for a in (inner.big, inner.small, data, frozen, base)]
+    map_pages(tup)
+    for a, b in zip((inner.big, inner.small, data, frozen, base), before):
+        assert np.array_equal(a.view(np.uint8), b.view(np.uint8))
