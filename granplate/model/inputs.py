@@ -97,7 +97,7 @@ class Granular(NamedTuple):
     """Flat arrays of the granular medium and its contacts (SI units).
 
     mass, inertia, radius: (ng,); pair_ij: (np, 2) granule indices (the pairs that may
-    touch, sorted); pair_coef: (np, 4) [A, c, mu, k_s] with gamma = c delta^(1/4); wall_i:
+    touch, sorted); pair_coef: (np, N_COEF) each pair's coefficient row (physics.contact COEF_*); wall_i:
     (nw,); wall_geo: (nw, 3) [nx, ny, offset]; wall_coef: (nw, 4); wall_w: (nw,) index of
     the wall in the scenario; pc_i: (nk,) granule of each plate contact;
     pc_x: (nk,) x of the plate edge the contact's overlap is measured from (the
