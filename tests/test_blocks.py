@@ -580,3 +580,27 @@ def test_driven_packing_on_threads_equals_the_serial_loop(target):
     a, b = one.energy_residual.values, many.energy_residual.values
     assert np.abs(b).max() < 1e-4
     assert np.abs(a - b).max() < 1e-9
+
+
+def test_serial_pass_notes_its_zero_rows_for_the_kicks():
+    """solver.schemes.verlet.note_quiet without blocks (one thread): an all-zero damping
+    buffer is noted quiet (the serial kicks then skip it and the loads' rows, to the same
+    bits: test_kicks_that_skip_zero_rows_change_no_bit), one nonzero damping number anywhere
+    in the velocity columns is not; the loads are quiet once the shock is over."""
+    from granplate.model.inputs import no_body
+    from granplate.solver.schemes.verlet import new_scratch, note_quiet
+
+    m = build_model(packing(1, mu=0.0))
+    ng = m.n_granules
+    sw = new_scratch(ng, 0, 0)
+    b = no_body(ng, 0)
+    late = 10.0 * m.config.duration
+    note_quiet(sw, 1, late, b, m.config)
+    assert sw.quiet[1, 0] == 1.0 and sw.quiet[1, 1] == 1.0
+    sw.fdamp[1, ng - 1, 8] = 1e-30
+    note_quiet(sw, 1, late, b, m.config)
+    assert sw.quiet[1, 1] == 0.0
+    sw.fdamp[1, ng - 1, 8] = 0.0
+    sw.fdamp[1, 0, 2] = 1.0  # a position column: not a kick's
+    note_quiet(sw, 1, late, b, m.config)
+    assert sw.quiet[1, 1] == 1.0

@@ -203,12 +203,23 @@ def note_quiet(sw, buf, t, b, cfg):
     """After the force pass at t [s] into buffer buf (the elastic body's too): whether its
     loads are all zero (none on the granules: the shock on the plate, or its amplitude 0
     at t) and its damping forces (no granule given one by the threaded pass in space, no
-    elastic body), in sw.quiet[buf]; the threaded kicks then skip reading them
-    (solver.blocks). Without blocks nothing is noted: the serial kicks read every row."""
-    if sw.spar.shape[0] == 0:
-        return
+    elastic body), in sw.quiet[buf]; the kicks then skip reading them (the threaded passes
+    leave them uncleared too: solver.blocks). The threaded pass counted the granules it
+    damped; the serial one's damping rows are read once here (`rows_zero`), where the two
+    kicks would read them and the loads' rows."""
     sw.quiet[buf, 0] = 1.0 if cfg.load_on_plate or shock_amplitude(t, cfg) == 0.0 else 0.0
-    sw.quiet[buf, 1] = 1.0 if sw.spar[0, S_DAMPED] == 0.0 and not B.has_body(b) else 0.0
+    undamped = sw.spar[0, S_DAMPED] == 0.0 if sw.spar.shape[0] > 0 else rows_zero(sw.fdamp[buf])
+    sw.quiet[buf, 1] = 1.0 if undamped and not B.has_body(b) else 0.0
+
+
+@njit(cache=True)
+def rows_zero(a) -> bool:
+    """Whether every number of a (n, columns) from the velocity columns on (N_DRIFT) is 0."""
+    for i in range(a.shape[0]):
+        for c in range(N_DRIFT, a.shape[1]):
+            if a[i, c] != 0.0:
+                return False
+    return True
 
 
 @njit(cache=True)
@@ -317,7 +328,10 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
         )  # fmt: skip
         sw.spar[0, S_MOVES_READY] = 1.0  # (the positions move in this kick alone)
     else:
-        wl, wd = kick_drift(y0, y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, 0, y.shape[0], predict)
+        loads, damped = sw.quiet[cur, 0] == 0.0, sw.quiet[cur, 1] == 0.0
+        wl, wd = kick_drift(
+            y0, y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, 0, y.shape[0], predict, loads, damped
+        )
     wl, wd, w_grav = VB.first_kick(b, t, h, cur, cfg, wl, wd, w_grav)
     # (Mindlin: the slip over h at the half step's velocities, y's)
     pr, e_t, lost_t = force_pass(t + h, y, w.ytmp, h, g, cfg, sw, nxt, kend, st.clock[T_TRIAL], threaded and in_place)
@@ -338,7 +352,8 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
         )
         sw.spar[0, S_KE_READY] = 1.0 if energies else 0.0
     else:
-        wl2, wd2 = kick(y, kend, sw.fdamp[nxt], sw.fload[nxt], hk, kend, N_DRIFT, 0, y.shape[0])
+        loads, damped = sw.quiet[nxt, 0] == 0.0, sw.quiet[nxt, 1] == 0.0
+        wl2, wd2 = kick(y, kend, sw.fdamp[nxt], sw.fload[nxt], hk, kend, N_DRIFT, 0, y.shape[0], loads, damped)
     wp2, dp2 = piston_kick(g, hk)
     w_piston += wp2
     d_piston += dp2
