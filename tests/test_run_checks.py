@@ -42,4 +42,4 @@ def test_a_packing_in_space_counts_its_contact_rows():
     plane's about 3: the table's share of the outputs is counted so."""
     s = fcc(20)
     per_output = output_bytes_per_second(s) * s.time.output_interval / len(s.granules)
-    assert per_output > run_checks.OUTPUT_BYTES_PER_GRANULE + 2 * run_checks.LINK_BYTES_PER_GRANULE - 1.0
+    assert per_output > run_checks.OUTPUT_BYTES_PER_GRANULE + 6 * run_checks.LINK_BYTES_PER_ROW - 1.0

@@ -180,7 +180,8 @@ def coefficient_kinds(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     the order of the rows' keys. A packing of one size and material has one kind, found by
     one comparison; else each row's bits are mixed into a key, the keys sorted, and the
     table checked against every row (rows of one key but other bits: sorted by their bits
-    instead). About a second for the 6 million pairs of a million spheres."""
+    instead). For the 6 million pairs of a million spheres: 0.1 s for one kind, about 3 s
+    for several (the sort)."""
     rows = np.ascontiguousarray(rows, float).reshape(-1, N_COEF)
     if not len(rows):
         return np.zeros(0, np.int32), np.zeros((0, N_COEF))

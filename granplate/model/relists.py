@@ -102,18 +102,17 @@ def granular_with_contacts(
     pair_coef = cached_pair_coefficients(s, mats, g, pairs, known)
     wall_geo, wall_coef = wall_arrays(s, mats, g.radius, g.mass, wc, model.walls)
     wc = np.asarray(wc, np.int64).reshape(-1, 2)
-    kind, table = coefficient_kinds(pair_coef)
-    return g._replace(
-        pair_ij=pairs,
-        pair_coef=pair_coef,
-        pair_kind=kind,
-        kind_coef=table,
-        wall_i=np.ascontiguousarray(wc[:, 0]),
-        wall_geo=wall_geo,
-        wall_coef=wall_coef,
-        wall_w=np.ascontiguousarray(wc[:, 1]),
-        pair_hist=carried_history(g.pair_ij, g.pair_hist, pairs, stores[0]),
-        wall_hist=carried_history(np.column_stack([g.wall_i, g.wall_w]), g.wall_hist, wc, stores[1]),
+    return with_pair_kinds(
+        g._replace(
+            pair_ij=pairs,
+            pair_coef=pair_coef,
+            wall_i=np.ascontiguousarray(wc[:, 0]),
+            wall_geo=wall_geo,
+            wall_coef=wall_coef,
+            wall_w=np.ascontiguousarray(wc[:, 1]),
+            pair_hist=carried_history(g.pair_ij, g.pair_hist, pairs, stores[0]),
+            wall_hist=carried_history(np.column_stack([g.wall_i, g.wall_w]), g.wall_hist, wc, stores[1]),
+        )
     )
 
 

@@ -134,10 +134,10 @@ def _check_restart_interval(t) -> None:
 OUTPUT_BYTES_PER_GRANULE = 3 * 8 * 12
 OUTPUT_BYTES_PER_DOF = 3 * 8 * 2
 FIELD_BYTES_PER_DOF = 3 * 8 * 4
-#: Bytes of the contact table per granule and table time (time.contact_interval): rows of
-#: 40 bytes, 2 copies (the rows built, the Dataset), about 3 rows per granule in the plane
-#: and 6 in space (a close packing's 12 neighbours).
-LINK_BYTES_PER_GRANULE = 2 * 3 * 40
+#: Bytes of a contact table's row (time.contact_interval): 40 bytes, 2 copies (the rows
+#: built, the Dataset); about 3 rows per granule and table time in the plane, 6 in space
+#: (a close packing's 12 neighbours).
+LINK_BYTES_PER_ROW = 2 * 40
 LINK_ROWS_PER_GRANULE = {2: 3, 3: 6}
 #: Bytes the model and the loop hold per granule beside the outputs: its contact list and
 #: coefficients, histories, state and scratch (8,300 measured at a million spheres in
@@ -156,7 +156,7 @@ def output_bytes_per_second(s: Scenario) -> float:
         n_dof = 2 * ((p.nx + 1) * (p.ny + 1) + p.nx * (p.ny + 1) + p.ny * (p.nx + 1))
     row = OUTPUT_BYTES_PER_GRANULE * len(s.granules) + OUTPUT_BYTES_PER_DOF * n_dof + 400.0
     steps = contact_steps(t)
-    link = LINK_BYTES_PER_GRANULE * LINK_ROWS_PER_GRANULE.get(s.dimension, 3) // 3
+    link = LINK_BYTES_PER_ROW * LINK_ROWS_PER_GRANULE[s.dimension]
     table = link * len(s.granules) / (steps * t.output_interval) if steps > 0 else 0.0
     return row / t.output_interval + FIELD_BYTES_PER_DOF * n_dof / t.field_interval + table
 

@@ -320,15 +320,14 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
     w_grav = gravity_kick_work(y0, st.k1, g, hk)
     w_piston, d_piston = piston_kick_drift(g, h)  # a force-driven wall: kicked and drifted as a granule
     predict = not cfg.half_step_damping  # the force pass at the predicted end velocities, or the half step's
+    loads, damped = sw.quiet[cur, 0] == 0.0, sw.quiet[cur, 1] == 0.0  # (else all zero: not read)
     if threaded:  # (stepping in place, the kick clears the accelerations it reads: the pass writes over them)
-        loads, damped = sw.quiet[cur, 0] == 0.0, sw.quiet[cur, 1] == 0.0
         wl, wd = first_kick_blocks(
             y0, y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, sw.spar, predict, loads, damped, in_place,
             w.yref, cfg.dimension,
         )  # fmt: skip
         sw.spar[0, S_MOVES_READY] = 1.0  # (the positions move in this kick alone)
     else:
-        loads, damped = sw.quiet[cur, 0] == 0.0, sw.quiet[cur, 1] == 0.0
         wl, wd = kick_drift(
             y0, y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, 0, y.shape[0], predict, loads, damped
         )
@@ -344,15 +343,14 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
     _, pd1 = wall_powers(g)
     w_drive += drive_kick_work(y, kend, g, hk)
     w_grav += gravity_kick_work(y, kend, g, hk)
+    loads, damped = sw.quiet[nxt, 0] == 0.0, sw.quiet[nxt, 1] == 0.0
     if threaded:  # (with the kinetic energies, where nothing moves the velocities after the kick)
-        loads, damped = sw.quiet[nxt, 0] == 0.0, sw.quiet[nxt, 1] == 0.0
         energies = g.drive_target.shape[0] == 0 and not (friction and sw.split[LAND] != 0.0)
         wl2, wd2 = closing_kick_blocks(
             y, kend, sw.fdamp[nxt], sw.fload[nxt], hk, kend, N_DRIFT, sw.spar, loads, damped, g, energies
         )
         sw.spar[0, S_KE_READY] = 1.0 if energies else 0.0
     else:
-        loads, damped = sw.quiet[nxt, 0] == 0.0, sw.quiet[nxt, 1] == 0.0
         wl2, wd2 = kick(y, kend, sw.fdamp[nxt], sw.fload[nxt], hk, kend, N_DRIFT, 0, y.shape[0], loads, damped)
     wp2, dp2 = piston_kick(g, hk)
     w_piston += wp2
