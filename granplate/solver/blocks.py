@@ -38,7 +38,7 @@ from numba import prange  # noqa: E402
 from granplate.jit import njit  # noqa: E402
 
 from granplate.solver.drives import begin_pass
-from granplate.solver.granular import ForceSums, commit_history, commit_rows
+from granplate.solver.granular import ForceSums, clear_rows, commit_history, commit_rows
 from granplate.solver.granular3d import BUF_DAMP, N_BUF, VX, WX, pair_forces, shock_loads, wall_forces
 from granplate.solver.mindlin_space import wall_mindlin
 
@@ -187,25 +187,6 @@ def owned_rows(k, nb, pair_ij, ng, spar):
     return owner_start(k, nb, pair_ij, ng, spar), owner_start(k + 1, nb, pair_ij, ng, spar)
 
 
-@njit(cache=True)
-def clear_block(acc, fdamp, fload, lo, hi, forces, damp, loads):
-    """Block k's share of a pass's clearing: its own granules' rows lo..hi-1 of acc, fdamp
-    and fload where `forces`, `damp` and `loads` (else they are all zero already), from the
-    velocity columns on (its buffer is zero already: `gather_rows` zeroes what it reads)."""
-    if forces:
-        for i in range(lo, hi):
-            for c in range(3, acc.shape[1]):
-                acc[i, c] = 0.0
-    if damp:
-        for i in range(lo, hi):
-            for c in range(3, acc.shape[1]):
-                fdamp[i, c] = 0.0
-    if loads:
-        for i in range(lo, hi):
-            for c in range(3, acc.shape[1]):
-                fload[i, c] = 0.0
-
-
 @njit(cache=True, inline="always")
 def block_pairs(yv, yn, h, g, cfg, k, nb, buf, spar, acc, fdamp, fload, tangential, commit_t):
     """Block k of nb's pairs (`block_range` of the pair list; solver.granular3d.pair_forces):
@@ -214,7 +195,7 @@ def block_pairs(yv, yn, h, g, cfg, k, nb, buf, spar, acc, fdamp, fload, tangenti
     [J], their losses [J], and the buffer rows [lo, hi) it wrote)."""
     ng = acc.shape[0]
     own_lo, own_hi = owned_rows(k, nb, g.pair_ij, ng, spar)
-    clear_block(
+    clear_rows(  # (its buffer is zero already: `gather_rows` zeroes what it reads)
         acc,
         fdamp,
         fload,

@@ -58,10 +58,11 @@ def friction_flow(y, dt, g, cfg, forward):
     raise NotImplementedError("compiled use only")
 
 
-def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t):
+def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=True, loads=True):
     """The velocity-Verlet force pass: shock and normal forces alone, the damping force and
     load of each granule apart, the pairs' overlaps committed at commit_t [s] (< 0: not;
-    solver.granular.normal_forces)."""
+    solver.granular.normal_forces), the rows of acc, fdamp, fload cleared first where
+    `forces`, `damp`, `loads` (solver.granular.clear_rows)."""
     raise NotImplementedError("compiled use only")
 
 
@@ -71,11 +72,14 @@ def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar, commit_t):
     raise NotImplementedError("compiled use only")
 
 
-def mindlin_force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, commit_t):
+def mindlin_force_pass(
+    t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, commit_t, forces=True, damp=True, loads=True
+):
     """The velocity-Verlet force pass with Mindlin's tangential law in it: (ForceSums,
     the springs' stored energy [J], their losses [J]) (solver.mindlin_plane.normal_mindlin_forces
     in the plane; in space solver.mindlin_space.normal_mindlin_forces, or
-    solver.blocks.mindlin_forces_blocks on every core when spar has blocks)."""
+    solver.blocks.mindlin_forces_blocks on every core when spar has blocks, which read
+    what to clear from spar); the serial passes clear as `normal_forces`."""
     raise NotImplementedError("compiled use only")
 
 
@@ -126,11 +130,13 @@ def _friction_flow(y, dt, g, cfg, forward):
 
 
 @overload(normal_forces, inline="always")
-def _normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t):
+def _normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=True, loads=True):
     m = _module_of(g)
     if m is not None:
         fn = m.normal_forces
-        return lambda t, y, g, cfg, acc, fdamp, fload, commit_t: fn(t, y, g, cfg, acc, fdamp, fload, commit_t)
+        return lambda t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=True, loads=True: fn(
+            t, y, g, cfg, acc, fdamp, fload, commit_t, forces, damp, loads
+        )
 
 
 @overload(normal_forces_blocks, inline="always")
@@ -139,7 +145,9 @@ def _normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar, commit_t)
 
 
 @overload(mindlin_force_pass, inline="always")
-def _mindlin_force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, commit_t):
+def _mindlin_force_pass(
+    t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, commit_t, forces=True, damp=True, loads=True
+):
     return _own(g, "mindlin_force_pass")
 
 
@@ -190,19 +198,21 @@ def _space_normal_forces_blocks():
 
 def _plane_mindlin_force_pass():
     fp = mindlin_plane.normal_mindlin_forces  # the plane's pairs are not cut into blocks
-    return lambda t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, commit_t: fp(
-        t, yv, yn, h, g, cfg, acc, fdamp, fload, commit_t
-    )
+
+    def plane_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, commit_t, forces=True, damp=True, loads=True):
+        return fp(t, yv, yn, h, g, cfg, acc, fdamp, fload, commit_t, forces, damp, loads)
+
+    return plane_pass
 
 
 def _space_mindlin_force_pass():
     fs = mindlin_space.normal_mindlin_forces
     fb = blocks.mindlin_forces_blocks
 
-    def space_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, commit_t):
+    def space_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, commit_t, forces=True, damp=True, loads=True):
         if spar.shape[0] > 0:
             return fb(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, commit_t)
-        return fs(t, yv, yn, h, g, cfg, acc, fdamp, fload, commit_t)
+        return fs(t, yv, yn, h, g, cfg, acc, fdamp, fload, commit_t, forces, damp, loads)
 
     return space_pass
 

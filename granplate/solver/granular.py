@@ -137,7 +137,7 @@ def granular_rhs(t, y, up, vp, g, cfg, dy, fplate, normal, slip, hold, fbar, spl
         ri = g.radius[i]
         rj = g.radius[j]
         if record:
-            g.pair_hist[p, HIST_END] = 0.0
+            clear_overlap(g.pair_hist, p)
         if pair_apart(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj):
             continue
         delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)
@@ -382,6 +382,37 @@ def commit_history(t, hist, coef):
     commit_rows(t, hist, coef, 0, hist.shape[0])
 
 
+@njit(cache=True)
+def clear_rows(acc, fdamp, fload, lo, hi, forces=True, damp=True, loads=True):
+    """A force pass's clearing of granules lo..hi-1: their rows of acc, fdamp and fload from
+    the velocity columns on (N_DRIFT, 3 in both dimensions) made zero where `forces`,
+    `damp` and `loads` (else the caller knows them all zero already: the first kick
+    cleared acc, solver.kicks.kick_drift; the last pass into fdamp or fload left it so,
+    solver.schemes.verlet.note_quiet)."""
+    if forces:
+        for i in range(lo, hi):
+            for c in range(3, acc.shape[1]):
+                acc[i, c] = 0.0
+    if damp:
+        for i in range(lo, hi):
+            for c in range(3, fdamp.shape[1]):
+                fdamp[i, c] = 0.0
+    if loads:
+        for i in range(lo, hi):
+            for c in range(3, fload.shape[1]):
+                fload[i, c] = 0.0
+
+
+@njit(cache=True, inline="always")
+def clear_overlap(hist, k):
+    """Contact k's overlap of this pass (HIST_END) made 0 before the pass finds it, written
+    only where it is not 0 already: a contact out of touch leaves its history row unwritten,
+    sparing its cache line the write back to memory (a million-granule packing's pairs are
+    mostly out of touch)."""
+    if hist[k, HIST_END] != 0.0:
+        hist[k, HIST_END] = 0.0
+
+
 @njit(cache=True, inline="always")
 def commit_overlap(t, hist, k, d, c):
     """Contact k's overlap d [m] at the accepted step's end t [s] into its largest
@@ -447,7 +478,7 @@ def kinetic_energies(y, mass, inertia):
 
 
 @njit(cache=True)
-def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t):
+def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=True, loads=True):
     """The velocity-Verlet force pass (solver.schemes.verlet) in the plane: the shock on
     the loaded granules and the normal force (eqs. 2-4, physics.laws with each contact's
     history) of every listed pair and wall contact at state y, whose velocities are the
@@ -456,16 +487,13 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t):
     load (fdamp, fload [:, 3:6]: N, N, N m), from which the scheme books the work of each
     kick; each contact's overlap into its history's HIST_END (0 out of touch), a pair's
     committed at commit_t [s] (`commit_overlap`; the trial of a scheme whose every step is
-    accepted; commit_t < 0: none, a pass at t_n). No plate
+    accepted; commit_t < 0: none, a pass at t_n). The rows of acc, fdamp and fload are
+    cleared first where `forces`, `damp`, `loads` (`clear_rows`). No plate
     contacts (the scheme runs without a plate). Returns the ForceSums: shock and viscous
     power at y [W], stored energy [J], the largest overlap, the plastic work past the
     largest overlaps [J]; no friction rates."""
     ng = y.shape[0]
-    for i in range(ng):
-        for c in range(3, 6):
-            acc[i, c] = 0.0
-            fdamp[i, c] = 0.0
-            fload[i, c] = 0.0
+    clear_rows(acc, fdamp, fload, 0, ng, forces, damp, loads)
     begin_pass(t, g)
     p_shock = 0.0
     p_visc = 0.0
@@ -490,7 +518,7 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t):
         j = g.pair_ij[p, 1]
         ri = g.radius[i]
         rj = g.radius[j]
-        g.pair_hist[p, HIST_END] = 0.0
+        clear_overlap(g.pair_hist, p)
         if pair_apart(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj):
             continue
         delta, nx, nz = pair_overlap(y[i, 0], y[i, 1], ri, y[j, 0], y[j, 1], rj)

@@ -31,7 +31,7 @@ from granplate.physics.space import (
     wall_overlap_3d,
 )
 from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_motion
-from granplate.solver.granular import ForceSums, commit_overlap, slip_relaxation_rate
+from granplate.solver.granular import ForceSums, clear_overlap, clear_rows, commit_overlap, slip_relaxation_rate
 from granplate.solver.mindlin_history import mindlin_contact, mindlin_old_force, mindlin_parted, mindlin_touched
 from granplate.solver.mindlin_rk4 import space_stages
 
@@ -328,19 +328,16 @@ def row_target(acc, fdamp, buf, i, own_lo, own_hi, t_lo, t_hi):
 
 
 @njit(cache=True)
-def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t):
+def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=True, loads=True):
     """The velocity-Verlet force pass in space (as solver.granular.normal_forces): shock
     and normal forces of every listed pair and wall contact at state y (no friction), the
     accelerations into acc[:, 3:9], each granule's damping force and shock load apart
     (fdamp, fload [:, 3:9] [N, N m]; the normal forces act through the centres, a line
     load's torques on the spins), the contacts' overlaps into HIST_END (the pairs'
-    committed at commit_t [s]; < 0: not). Returns the ForceSums."""
+    committed at commit_t [s]; < 0: not). Their rows are cleared first where `forces`,
+    `damp`, `loads` (solver.granular.clear_rows). Returns the ForceSums."""
     ng = y.shape[0]
-    for i in range(ng):
-        for c in range(3, 9):
-            acc[i, c] = 0.0
-            fdamp[i, c] = 0.0
-            fload[i, c] = 0.0
+    clear_rows(acc, fdamp, fload, 0, ng, forces, damp, loads)
     begin_pass(t, g)
     p_shock = 0.0
     if not cfg.load_on_plate:
@@ -510,7 +507,7 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tang
         j = g.pair_ij[p, 1]
         ri = g.radius[i]
         rj = g.radius[j]
-        hist[p, HIST_END] = 0.0
+        clear_overlap(hist, p)
         c = g.kind_coef[g.pair_kind[p]]
         delta, nx, ny, nz = pair_contact_3d(yn[i, X], yn[i, Y], yn[i, Z], ri, yn[j, X], yn[j, Y], yn[j, Z], rj)
         kt = tangential and keeps_history(c)

@@ -27,7 +27,7 @@ from granplate.physics.contact import (
 from granplate.physics.laws import keeps_history, normal_law_response, tangential_scale
 from granplate.physics.shock import shock_amplitude
 from granplate.solver.drives import begin_pass, book_wall, wall_motion
-from granplate.solver.granular import ForceSums, commit_overlap
+from granplate.solver.granular import ForceSums, clear_overlap, clear_rows, commit_overlap
 from granplate.solver.mindlin_history import mindlin_contact, mindlin_old_force, mindlin_parted, mindlin_touched
 
 
@@ -93,7 +93,7 @@ def pair_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp, commit_t):
         ri = radius[i]
         rj = radius[j]
         c = pair_coef[p]
-        hist[p, HIST_END] = 0.0
+        clear_overlap(hist, p)
         delta = -1.0
         if not pair_apart(yn[i, 0], yn[i, 1], ri, yn[j, 0], yn[j, 1], rj):
             delta, nx, nz = pair_overlap(yn[i, 0], yn[i, 1], ri, yn[j, 0], yn[j, 1], rj)
@@ -201,7 +201,7 @@ def wall_forces_mindlin(yv, yn, h, g, cfg, acc, fdamp):
 
 
 @njit(cache=True)
-def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload, commit_t):
+def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=True, loads=True):
     """The velocity-Verlet force pass of the plane (solver.granular.normal_forces) with
     Mindlin's tangential law (docs/model.md section 3.16) in it: the shock, every listed
     pair and wall contact's normal force at state yn (its velocities the damping's) and, at
@@ -210,14 +210,11 @@ def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload, commit_t):
     [s] (the half step's; yv's positions are yn's; h = 0: the force of the committed
     history), the trial histories as solver.mindlin_history.trial_column says, the pairs'
     overlaps committed at commit_t [s] (< 0: none; solver.granular.normal_forces). Accelerations into
-    acc[:, 3:6], damping forces and loads apart (fdamp, fload). Returns (the ForceSums, the
+    acc[:, 3:6], damping forces and loads apart (fdamp, fload), their rows cleared first
+    as there. Returns (the ForceSums, the
     springs' stored energy [J], the energy they lost over the step [J])."""
     ng = yn.shape[0]
-    for i in range(ng):
-        for c in range(3, 6):
-            acc[i, c] = 0.0
-            fdamp[i, c] = 0.0
-            fload[i, c] = 0.0
+    clear_rows(acc, fdamp, fload, 0, ng, forces, damp, loads)
     begin_pass(t, g)
     p_shock = 0.0
     if not cfg.load_on_plate:

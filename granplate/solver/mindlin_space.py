@@ -16,7 +16,7 @@ from granplate.physics.contact import contact_arm
 from granplate.physics.laws import keeps_history, normal_law_force, tangential_scale
 from granplate.physics.space import normal_rate_3d, wall_overlap_3d
 from granplate.solver.drives import begin_pass, wall_motion
-from granplate.solver.granular import ForceSums
+from granplate.solver.granular import ForceSums, clear_rows
 from granplate.solver.mindlin_history import mindlin_contact, mindlin_parted
 from granplate.solver.friction_space import apply_friction_impulse
 from granplate.solver.granular3d import (
@@ -67,7 +67,7 @@ def wall_mindlin(yv, yn, h, g, cfg, acc):
 
 
 @njit(cache=True)
-def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload, commit_t):
+def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=True, loads=True):
     """solver.granular3d.normal_forces with Mindlin's tangential law in it (docs/model.md
     section 3.16): the shock, every listed pair and wall contact's normal force at state yn
     (its velocities the damping's) and, at the contacts whose tangential law keeps a
@@ -75,13 +75,9 @@ def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload, commit_t):
     the slip at yv's velocities over h [s] (the half step's; yv's positions are yn's; h = 0:
     the force of the committed history), the trial histories as
     solver.mindlin_history.trial_column says, the pairs' overlaps committed at commit_t [s]
-    (< 0: not; solver.granular.normal_forces). Returns (the ForceSums, the springs' stored energy [J], the energy they
-    lost over the step [J])."""
-    for i in range(yn.shape[0]):
-        for c in range(3, 9):
-            acc[i, c] = 0.0
-            fdamp[i, c] = 0.0
-            fload[i, c] = 0.0
+    (< 0: not; solver.granular.normal_forces), the rows cleared first as there. Returns (the
+    ForceSums, the springs' stored energy [J], the energy they lost over the step [J])."""
+    clear_rows(acc, fdamp, fload, 0, yn.shape[0], forces, damp, loads)
     begin_pass(t, g)
     p_shock = 0.0
     if not cfg.load_on_plate:

@@ -181,21 +181,26 @@ def force_pass(t, yv, yn, h, g, cfg, sw, buf, acc, commit_t, cleared=False):
     the committed histories' forces); the pairs' overlaps committed at commit_t [s] (the
     trial's end as the clock will read it, st.clock[T_TRIAL]: every step is accepted; < 0:
     not, the pass at t_n); `cleared`: the first kick left acc's rows zero from the velocity
-    columns on (solver.blocks.S_ZERO_ACC). Returns (the ForceSums, the springs' stored
-    energy [J], their losses [J]; 0 and 0 without Mindlin's law)."""
+    columns on (solver.blocks.S_ZERO_ACC). The pass leaves uncleared the rows it knows zero
+    (acc's where `cleared`, the buffer's where its last pass left them so: sw.quiet), in
+    blocks and serially alike. Returns (the ForceSums, the springs' stored energy [J], their
+    losses [J]; 0 and 0 without Mindlin's law)."""
     fdamp = sw.fdamp[buf]
     fload = sw.fload[buf]
+    forces, damp, loads = not cleared, sw.quiet[buf, 1] == 0.0, sw.quiet[buf, 0] == 0.0  # (which rows to clear)
     if sw.spar.shape[0] > 0:
         sw.spar[0, S_DEALT] = 1.0 if cfg.history_friction else 0.0  # (the pairs' blocks dealt out in turn)
         sw.spar[0, S_DAMPED] = 1.0  # (damped until a threaded pass in space counts its granules)
-        sw.spar[0, S_ZERO_LOADS] = sw.quiet[buf, 0]
-        sw.spar[0, S_ZERO_DAMP] = sw.quiet[buf, 1]
-        sw.spar[0, S_ZERO_ACC] = 1.0 if cleared else 0.0
+        sw.spar[0, S_ZERO_LOADS] = 0.0 if loads else 1.0
+        sw.spar[0, S_ZERO_DAMP] = 0.0 if damp else 1.0
+        sw.spar[0, S_ZERO_ACC] = 0.0 if forces else 1.0
     if cfg.history_friction:
-        return mindlin_force_pass(t, yv, yn, h, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar, commit_t)
+        return mindlin_force_pass(
+            t, yv, yn, h, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar, commit_t, forces, damp, loads
+        )
     if sw.spar.shape[0] > 0:
         return normal_forces_blocks(t, yn, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar, commit_t), 0.0, 0.0
-    return normal_forces(t, yn, g, cfg, acc, fdamp, fload, commit_t), 0.0, 0.0
+    return normal_forces(t, yn, g, cfg, acc, fdamp, fload, commit_t, forces, damp, loads), 0.0, 0.0
 
 
 @njit(cache=True)
@@ -321,7 +326,8 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
     w_piston, d_piston = piston_kick_drift(g, h)  # a force-driven wall: kicked and drifted as a granule
     predict = not cfg.half_step_damping  # the force pass at the predicted end velocities, or the half step's
     loads, damped = sw.quiet[cur, 0] == 0.0, sw.quiet[cur, 1] == 0.0  # (else all zero: not read)
-    if threaded:  # (stepping in place, the kick clears the accelerations it reads: the pass writes over them)
+    # (stepping in place, the kick clears the accelerations it reads: the pass writes over them)
+    if threaded:
         wl, wd = first_kick_blocks(
             y0, y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, sw.spar, predict, loads, damped, in_place,
             w.yref, cfg.dimension,
@@ -329,11 +335,12 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
         sw.spar[0, S_MOVES_READY] = 1.0  # (the positions move in this kick alone)
     else:
         wl, wd = kick_drift(
-            y0, y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, 0, y.shape[0], predict, loads, damped
-        )
+            y0, y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, 0, y.shape[0], predict, loads, damped,
+            in_place,
+        )  # fmt: skip
     wl, wd, w_grav = VB.first_kick(b, t, h, cur, cfg, wl, wd, w_grav)
     # (Mindlin: the slip over h at the half step's velocities, y's)
-    pr, e_t, lost_t = force_pass(t + h, y, w.ytmp, h, g, cfg, sw, nxt, kend, st.clock[T_TRIAL], threaded and in_place)
+    pr, e_t, lost_t = force_pass(t + h, y, w.ytmp, h, g, cfg, sw, nxt, kend, st.clock[T_TRIAL], in_place)
     e_pot, p_visc, w_plastic, fric, ovl, ovl_i, ovl_j = VB.end_pass(
         y, w.ytmp, st, b, cur, nxt, h, g, cfg, kend, sw.fdamp,
         pr.e_pot + e_t, pr.p_visc, pr.w_plastic, fric + lost_t, pr.ovl, pr.ovl_i, pr.ovl_j,
