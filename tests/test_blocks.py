@@ -540,7 +540,7 @@ def test_closing_kick_gives_the_kinetic_energies_of_the_kicked_state():
     for energies in (True, False):
         y, dy, spar = y0.copy(), np.zeros_like(y0), np.zeros((8, N_SPAR))
         spar[:, S_KX : S_KR + 1] = -1.0
-        works = closing_kick_blocks(y, acc, fdamp, fload, 5e-4, dy, 3, spar, False, True, g, energies)
+        works = closing_kick_blocks(y, acc, fdamp, fload, 5e-4, dy, 3, spar, False, True, g, energies, False, 3)
         assert np.array_equal(y, y_serial) and np.array_equal(dy, dy_serial)
         np.testing.assert_allclose(works, w_serial, rtol=1e-12)
         if energies:
@@ -549,6 +549,41 @@ def test_closing_kick_gives_the_kinetic_energies_of_the_kicked_state():
             assert np.array_equal(sums, np.array(kinetic_energy_blocks(y, g, np.zeros((8, N_SPAR)))))
         else:
             assert np.all(spar[:, S_KX : S_KR + 1] == -1.0)
+
+
+@pytest.mark.parametrize("n_move, nc", [(3, 9), (2, 6)])
+def test_dividing_kick_is_the_division_then_the_kick(n_move, nc):
+    """solver.kicks.divide_kick from forces and torques: the accelerations the pass's
+    division gives (the first n_move velocity columns by the mass, the rest by the inertia,
+    as the plane's and space's passes divide) and the state, rates and works of `kick`
+    after it, bit for bit; in space over blocks on threads too (closing_kick_blocks with
+    `divide`)."""
+    from granplate.solver.kicks import divide_kick, kick
+    from granplate.solver.schemes.verlet import closing_kick_blocks
+
+    rng = np.random.default_rng(31)
+    n = 40
+    y0, force = rng.normal(size=(n, nc)), rng.normal(size=(n, nc))
+    fdamp, fload = rng.normal(size=(n, nc)), rng.normal(size=(n, nc))
+    mass, inertia = rng.uniform(0.5, 2.0, n), rng.uniform(1e-3, 1e-2, n)
+    acc = force.copy()
+    acc[:, 3 : 3 + n_move] /= mass[:, None]
+    acc[:, 3 + n_move :] /= inertia[:, None]
+    y_ref, dy_ref = y0.copy(), np.zeros((n, nc))
+    w_ref = kick(y_ref, acc, fdamp, fload, 5e-4, dy_ref, 3, 0, n, True, True)
+    y, a, dy = y0.copy(), force.copy(), np.zeros((n, nc))
+    w = divide_kick(y, a, fdamp, fload, 5e-4, dy, 3, n_move, mass, inertia, 0, n, True, True)
+    assert np.array_equal(a[:, 3:], acc[:, 3:]) and np.array_equal(a[:, :3], force[:, :3])
+    assert np.array_equal(y, y_ref) and np.array_equal(dy, dy_ref) and w == w_ref
+    if nc == 6:
+        return
+    g = build_model(packing(1, mu=0.0)).granular._replace(mass=mass, inertia=inertia)
+    y, a, dy = y0.copy(), force.copy(), np.zeros((n, nc))
+    works = closing_kick_blocks(
+        y, a, fdamp, fload, 5e-4, dy, 3, np.zeros((4, N_SPAR)), True, True, g, False, True, n_move
+    )
+    assert np.array_equal(a[:, 3:], acc[:, 3:]) and np.array_equal(y, y_ref) and np.array_equal(dy, dy_ref)
+    np.testing.assert_allclose(works, w_ref, rtol=1e-12)
 
 
 @pytest.mark.parametrize("target", ["granule", "wall"])

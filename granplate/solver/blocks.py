@@ -77,7 +77,10 @@ S_ZERO_ACC, S_KE_READY = 24, 25
 #: list's reference [m^2] (S_MOVED); (row 0) 1 where those are the state's the loop watches
 #: next (S_MOVES_READY)
 S_MOVED, S_MOVES_READY = 26, 27
-N_SPAR = 28
+#: (row 0, set by the scheme) 1 where the pass leaves acc's forces and torques [N, N m]
+#: undivided: the closing kick makes them accelerations (solver.kicks.divide_kick)
+S_UNDIVIDED = 28
+N_SPAR = 29
 
 #: what a pair in touch costs the Mindlin pass beside one apart, less one (the weight the
 #: blocks are balanced by: `pair_blocks`; measured on the 10,192-sphere packing: a block's
@@ -257,7 +260,8 @@ def gather_rows(fpar, spar, n_pair_blocks, acc, fdamp, mass, inertia, lo, hi):
     fpar[t], in the rows [spar[k, S_TLO], spar[k, S_THI]) its blocks k (of n_pair_blocks,
     dealt out as `thread_pairs` does) wrote that meet them, added in buffer order (and
     zeroed, ready for the next pass: a row two of its blocks wrote is added once), then the
-    division; returns how many have a damping force."""
+    division (none where spar[0, S_UNDIVIDED]: the closing kick divides); returns how many
+    have a damping force."""
     nt = fpar.shape[0]
     for t in range(nt):
         for k in range(t, n_pair_blocks, nt):
@@ -269,12 +273,14 @@ def gather_rows(fpar, spar, n_pair_blocks, acc, fdamp, mass, inertia, lo, hi):
                     fpar[t, i, F_X + c] = 0.0
                     fpar[t, i, F_DX + c] = 0.0
                     fpar[t, i, F_T + c] = 0.0
+    divide = spar[0, S_UNDIVIDED] == 0.0
     n_damped = 0
     for i in range(lo, hi):
         damped = False
         for c in range(3):
-            acc[i, VX + c] /= mass[i]
-            acc[i, WX + c] /= inertia[i]
+            if divide:
+                acc[i, VX + c] /= mass[i]
+                acc[i, WX + c] /= inertia[i]
             damped = damped or fdamp[i, VX + c] != 0.0 or fdamp[i, WX + c] != 0.0
         if damped:
             n_damped += 1
@@ -287,7 +293,7 @@ def gather_forces(fpar, acc, fdamp, mass, inertia, spar, n_pair_blocks):
     pairs wrote them: `gather_rows`), added in buffer order to what acc
     and fdamp hold (its own block's pairs', the shock's and the walls'), then acc's forces and
     torques made accelerations: acc[:, 3:6] /= mass, acc[:, 6:9] /= inertia (space's
-    velocity and spin columns). The granules in blocks, each thread's those of its pair
+    velocity and spin columns; left to the closing kick where spar[0, S_UNDIVIDED]). The granules in blocks, each thread's those of its pair
     blocks (`granule_block`); how many of them have a damping force (fdamp
     not zero) into spar[0, S_DAMPED]."""
     nb = spar.shape[0]

@@ -58,11 +58,12 @@ def friction_flow(y, dt, g, cfg, forward):
     raise NotImplementedError("compiled use only")
 
 
-def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=True, loads=True):
+def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=True, loads=True, divide=True):
     """The velocity-Verlet force pass: shock and normal forces alone, the damping force and
     load of each granule apart, the pairs' overlaps committed at commit_t [s] (< 0: not;
     solver.granular.normal_forces), the rows of acc, fdamp, fload cleared first where
-    `forces`, `damp`, `loads` (solver.granular.clear_rows)."""
+    `forces`, `damp`, `loads` (solver.granular.clear_rows), the forces made accelerations
+    where `divide` (else the closing kick does: solver.kicks.divide_kick)."""
     raise NotImplementedError("compiled use only")
 
 
@@ -130,13 +131,15 @@ def _friction_flow(y, dt, g, cfg, forward):
 
 
 @overload(normal_forces, inline="always")
-def _normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=True, loads=True):
+def _normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=True, loads=True, divide=True):
     m = _module_of(g)
     if m is not None:
         fn = m.normal_forces
-        return lambda t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=True, loads=True: fn(
-            t, y, g, cfg, acc, fdamp, fload, commit_t, forces, damp, loads
-        )
+
+        def dimension_pass(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=True, loads=True, divide=True):
+            return fn(t, y, g, cfg, acc, fdamp, fload, commit_t, forces, damp, loads, divide)
+
+        return dimension_pass
 
 
 @overload(normal_forces_blocks, inline="always")
@@ -186,7 +189,16 @@ def _force_error(k1, k0, kend, ratio, g, sc, err):
 # factory per hook and dimension, each giving the implementation numba compiles.
 def _plane_normal_forces_blocks():
     fn = plane.normal_forces  # the plane's pairs are not cut into blocks: its serial pass
-    return lambda t, y, g, cfg, acc, fdamp, fload, fpar, spar, commit_t: fn(t, y, g, cfg, acc, fdamp, fload, commit_t)
+
+    def plane_pass(t, y, g, cfg, acc, fdamp, fload, fpar, spar, commit_t):  # (what to clear and divide: spar's row 0)
+        forces, damp, loads = (
+            spar[0, blocks.S_ZERO_ACC] == 0.0,
+            spar[0, blocks.S_ZERO_DAMP] == 0.0,
+            spar[0, blocks.S_ZERO_LOADS] == 0.0,
+        )
+        return fn(t, y, g, cfg, acc, fdamp, fload, commit_t, forces, damp, loads, spar[0, blocks.S_UNDIVIDED] == 0.0)
+
+    return plane_pass
 
 
 def _space_normal_forces_blocks():

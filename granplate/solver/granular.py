@@ -478,7 +478,7 @@ def kinetic_energies(y, mass, inertia):
 
 
 @njit(cache=True)
-def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=True, loads=True):
+def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=True, loads=True, divide=True):
     """The velocity-Verlet force pass (solver.schemes.verlet) in the plane: the shock on
     the loaded granules and the normal force (eqs. 2-4, physics.laws with each contact's
     history) of every listed pair and wall contact at state y, whose velocities are the
@@ -488,7 +488,8 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=T
     kick; each contact's overlap into its history's HIST_END (0 out of touch), a pair's
     committed at commit_t [s] (`commit_overlap`; the trial of a scheme whose every step is
     accepted; commit_t < 0: none, a pass at t_n). The rows of acc, fdamp and fload are
-    cleared first where `forces`, `damp`, `loads` (`clear_rows`). No plate
+    cleared first where `forces`, `damp`, `loads` (`clear_rows`); without `divide`, acc
+    keeps the forces and torque (solver.kicks.divide_kick makes them accelerations). No plate
     contacts (the scheme runs without a plate). Returns the ForceSums: shock and viscous
     power at y [W], stored energy [J], the largest overlap, the plastic work past the
     largest overlaps [J]; no friction rates."""
@@ -579,10 +580,11 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=T
             fdamp[i, 3] -= d * nx
             fdamp[i, 4] -= d * nz
         book_wall(g, w, kd, n, d)
-    for i in range(ng):
-        acc[i, 3] /= g.mass[i]
-        acc[i, 4] /= g.mass[i]
-        acc[i, 5] /= g.inertia[i]
+    if divide:
+        for i in range(ng):
+            acc[i, 3] /= g.mass[i]
+            acc[i, 4] /= g.mass[i]
+            acc[i, 5] /= g.inertia[i]
     return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
 
 

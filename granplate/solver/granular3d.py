@@ -328,14 +328,16 @@ def row_target(acc, fdamp, buf, i, own_lo, own_hi, t_lo, t_hi):
 
 
 @njit(cache=True)
-def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=True, loads=True):
+def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=True, loads=True, divide=True):
     """The velocity-Verlet force pass in space (as solver.granular.normal_forces): shock
     and normal forces of every listed pair and wall contact at state y (no friction), the
     accelerations into acc[:, 3:9], each granule's damping force and shock load apart
     (fdamp, fload [:, 3:9] [N, N m]; the normal forces act through the centres, a line
     load's torques on the spins), the contacts' overlaps into HIST_END (the pairs'
     committed at commit_t [s]; < 0: not). Their rows are cleared first where `forces`,
-    `damp`, `loads` (solver.granular.clear_rows). Returns the ForceSums."""
+    `damp`, `loads` (solver.granular.clear_rows); without `divide`, acc keeps the forces
+    and torques [N, N m] (the closing kick divides them: solver.kicks.divide_kick). Returns
+    the ForceSums."""
     ng = y.shape[0]
     clear_rows(acc, fdamp, fload, 0, ng, forces, damp, loads)
     begin_pass(t, g)
@@ -348,10 +350,11 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=T
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
         y, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
     )
-    for i in range(ng):
-        for c in range(3):
-            acc[i, VX + c] /= g.mass[i]
-            acc[i, WX + c] /= g.inertia[i]
+    if divide:
+        for i in range(ng):
+            for c in range(3):
+                acc[i, VX + c] /= g.mass[i]
+                acc[i, WX + c] /= g.inertia[i]
     return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
 
 

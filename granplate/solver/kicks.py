@@ -68,3 +68,27 @@ def kick(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi, loads=True, damped=True)
         for c in range(n_drift):
             dy[i, c] = y[i, c + n_drift]
     return w_load, w_damp
+
+
+@njit(cache=True)
+def divide_kick(y, acc, fdamp, fload, hk, dy, n_drift, n_move, mass, inertia, lo, hi, loads=True, damped=True):
+    """`kick` from the force pass's forces and torques in acc [N, N m] (a pass that left
+    its division to the kick): each made an acceleration in acc as the pass would have made
+    it (the first n_move velocity columns divided by the mass [kg], the others by the
+    moment of inertia [kg m^2]) and the kick taken with it, bit for bit `kick` after the
+    pass's division, in one pass over the rows instead of two."""
+    w_load = 0.0
+    w_damp = 0.0
+    for i in range(lo, hi):
+        for c in range(n_drift, y.shape[1]):
+            a = acc[i, c] / (mass[i] if c < n_drift + n_move else inertia[i])
+            acc[i, c] = a
+            v1, _, vm = half_kick(y[i, c], a, hk)
+            if loads:
+                w_load += fload[i, c] * vm
+            if damped:
+                w_damp += fdamp[i, c] * vm
+            y[i, c] = v1
+        for c in range(n_drift):
+            dy[i, c] = y[i, c + n_drift]
+    return w_load, w_damp

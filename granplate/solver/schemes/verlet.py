@@ -61,6 +61,7 @@ from granplate.solver.blocks import (
     S_KE_READY,
     S_MOVED,
     S_MOVES_READY,
+    S_UNDIVIDED,
     S_WDAMP,
     S_WLOAD,
     S_ZERO_ACC,
@@ -90,7 +91,7 @@ from granplate.solver.drives import (
     wall_shift_energy,
 )
 from granplate.solver.granular import commit_history
-from granplate.solver.kicks import kick, kick_drift
+from granplate.solver.kicks import divide_kick, kick, kick_drift
 from granplate.solver.ladder import step_to_output
 
 from granplate.solver.state import T_TRIAL
@@ -172,7 +173,7 @@ def has_friction(g, cfg) -> bool:
 
 
 @njit(cache=True)
-def force_pass(t, yv, yn, h, g, cfg, sw, buf, acc, commit_t, cleared=False):
+def force_pass(t, yv, yn, h, g, cfg, sw, buf, acc, commit_t, cleared=False, divide=True):
     """The force pass at (t, yn) into buffer buf (sw.fdamp[buf], sw.fload[buf]; the
     accelerations into acc): in blocks on every core when the scratch has blocks
     (solver.blocks: they leave uncleared the buffer's rows its last pass left all zero,
@@ -183,8 +184,9 @@ def force_pass(t, yv, yn, h, g, cfg, sw, buf, acc, commit_t, cleared=False):
     not, the pass at t_n); `cleared`: the first kick left acc's rows zero from the velocity
     columns on (solver.blocks.S_ZERO_ACC). The pass leaves uncleared the rows it knows zero
     (acc's where `cleared`, the buffer's where its last pass left them so: sw.quiet), in
-    blocks and serially alike. Returns (the ForceSums, the springs' stored energy [J], their
-    losses [J]; 0 and 0 without Mindlin's law)."""
+    blocks and serially alike. Without `divide` (the normal pass alone) acc keeps the forces
+    and torques, for the closing kick to divide (`closing_divides`). Returns (the ForceSums,
+    the springs' stored energy [J], their losses [J]; 0 and 0 without Mindlin's law)."""
     fdamp = sw.fdamp[buf]
     fload = sw.fload[buf]
     forces, damp, loads = not cleared, sw.quiet[buf, 1] == 0.0, sw.quiet[buf, 0] == 0.0  # (which rows to clear)
@@ -194,13 +196,14 @@ def force_pass(t, yv, yn, h, g, cfg, sw, buf, acc, commit_t, cleared=False):
         sw.spar[0, S_ZERO_LOADS] = 0.0 if loads else 1.0
         sw.spar[0, S_ZERO_DAMP] = 0.0 if damp else 1.0
         sw.spar[0, S_ZERO_ACC] = 0.0 if forces else 1.0
+        sw.spar[0, S_UNDIVIDED] = 0.0 if divide else 1.0
     if cfg.history_friction:
         return mindlin_force_pass(
             t, yv, yn, h, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar, commit_t, forces, damp, loads
         )
     if sw.spar.shape[0] > 0:
         return normal_forces_blocks(t, yn, g, cfg, acc, fdamp, fload, sw.fpar, sw.spar, commit_t), 0.0, 0.0
-    return normal_forces(t, yn, g, cfg, acc, fdamp, fload, commit_t, forces, damp, loads), 0.0, 0.0
+    return normal_forces(t, yn, g, cfg, acc, fdamp, fload, commit_t, forces, damp, loads, divide), 0.0, 0.0
 
 
 @njit(cache=True)
@@ -225,6 +228,15 @@ def rows_zero(a) -> bool:
             if a[i, c] != 0.0:
                 return False
     return True
+
+
+@njit(cache=True)
+def closing_divides(g, b, cfg) -> bool:
+    """Whether the step's force pass leaves its forces undivided for the closing kick
+    (solver.kicks.divide_kick: a pass over the granules fewer): where nothing reads the
+    accelerations between the two (no gravity, no granule drives, no elastic body) and the
+    pass applies no impulses after its division (no Mindlin's law at the walls)."""
+    return not cfg.history_friction and g.gravity.shape[0] == 0 and g.drive_target.shape[0] == 0 and not B.has_body(b)
 
 
 @njit(cache=True)
@@ -340,7 +352,8 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
         )  # fmt: skip
     wl, wd, w_grav = VB.first_kick(b, t, h, cur, cfg, wl, wd, w_grav)
     # (Mindlin: the slip over h at the half step's velocities, y's)
-    pr, e_t, lost_t = force_pass(t + h, y, w.ytmp, h, g, cfg, sw, nxt, kend, st.clock[T_TRIAL], in_place)
+    divides = closing_divides(g, b, cfg)
+    pr, e_t, lost_t = force_pass(t + h, y, w.ytmp, h, g, cfg, sw, nxt, kend, st.clock[T_TRIAL], in_place, not divides)
     e_pot, p_visc, w_plastic, fric, ovl, ovl_i, ovl_j = VB.end_pass(
         y, w.ytmp, st, b, cur, nxt, h, g, cfg, kend, sw.fdamp,
         pr.e_pot + e_t, pr.p_visc, pr.w_plastic, fric + lost_t, pr.ovl, pr.ovl_i, pr.ovl_j,
@@ -354,9 +367,15 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
     if threaded:  # (with the kinetic energies, where nothing moves the velocities after the kick)
         energies = g.drive_target.shape[0] == 0 and not (friction and sw.split[LAND] != 0.0)
         wl2, wd2 = closing_kick_blocks(
-            y, kend, sw.fdamp[nxt], sw.fload[nxt], hk, kend, N_DRIFT, sw.spar, loads, damped, g, energies
-        )
+            y, kend, sw.fdamp[nxt], sw.fload[nxt], hk, kend, N_DRIFT, sw.spar, loads, damped, g, energies, divides,
+            cfg.dimension,
+        )  # fmt: skip
         sw.spar[0, S_KE_READY] = 1.0 if energies else 0.0
+    elif divides:
+        wl2, wd2 = divide_kick(
+            y, kend, sw.fdamp[nxt], sw.fload[nxt], hk, kend, N_DRIFT, cfg.dimension, g.mass, g.inertia, 0, y.shape[0],
+            loads, damped,
+        )  # fmt: skip
     else:
         wl2, wd2 = kick(y, kend, sw.fdamp[nxt], sw.fload[nxt], hk, kend, N_DRIFT, 0, y.shape[0], loads, damped)
     wp2, dp2 = piston_kick(g, hk)
@@ -505,16 +524,22 @@ def largest_move(sw) -> float:
 
 
 @njit(parallel=True)
-def closing_kick_blocks(y, acc, fdamp, fload, hk, dy, n_drift, spar, loads, damped, g, energies):
-    """solver.kicks.kick over blocks of granules (as `first_kick_blocks`), and
-    where `energies` each block's kinetic energies at the kicked state while its rows are
-    at hand (`block_kinetic_energies`: a pass over the granules fewer). Returns (the load's
-    work, the damping force's work) [J], summed in block order."""
+def closing_kick_blocks(y, acc, fdamp, fload, hk, dy, n_drift, spar, loads, damped, g, energies, divide, n_move):
+    """solver.kicks.kick over blocks of granules (as `first_kick_blocks`; where `divide`,
+    solver.kicks.divide_kick from the pass's forces, n_move velocity columns by the mass),
+    and where `energies` each block's kinetic energies at the kicked state while its rows
+    are at hand (`block_kinetic_energies`: a pass over the granules fewer). Returns (the
+    load's work, the damping force's work) [J], summed in block order."""
     nt = spar.shape[0] // BLOCKS_PER_THREAD
     for t in prange(nt):
         for s in range(BLOCKS_PER_THREAD):
             k, lo, hi = granule_block(spar, nt, t, s, y.shape[0])
-            spar[k, S_WLOAD], spar[k, S_WDAMP] = kick(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi, loads, damped)
+            if divide:
+                spar[k, S_WLOAD], spar[k, S_WDAMP] = divide_kick(
+                    y, acc, fdamp, fload, hk, dy, n_drift, n_move, g.mass, g.inertia, lo, hi, loads, damped
+                )
+            else:
+                spar[k, S_WLOAD], spar[k, S_WDAMP] = kick(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi, loads, damped)
             if energies:
                 block_kinetic_energies(y, g, spar, k, lo, hi)
     return work_sums(spar)
