@@ -78,9 +78,10 @@ S_ZERO_ACC, S_KE_READY = 24, 25
 #: next (S_MOVES_READY)
 S_MOVED, S_MOVES_READY = 26, 27
 #: (row 0, set by the scheme) 1 where the pass leaves acc's forces and torques [N, N m]
-#: undivided: the closing kick makes them accelerations (solver.kicks.divide_kick)
-S_UNDIVIDED = 28
-N_SPAR = 29
+#: undivided: the closing kick makes them accelerations (solver.kicks.divide_kick); (row k)
+#: how many of block k's pairs gave their granules a damping force (S_PUSHED)
+S_UNDIVIDED, S_PUSHED = 28, 29
+N_SPAR = 30
 
 #: what a pair in touch costs the Mindlin pass beside one apart, less one (the weight the
 #: blocks are balanced by: `pair_blocks`; measured on the 10,192-sphere packing: a block's
@@ -209,10 +210,11 @@ def block_pairs(yv, yn, h, g, cfg, k, nb, buf, spar, acc, fdamp, fload, tangenti
         spar[0, S_ZERO_LOADS] == 0.0,
     )
     lo, hi = int(spar[k, S_PLO]), int(spar[k, S_PHI])
-    pv, ep, wp, ovl, ovl_i, ovl_j, e_t, lost, t_lo, t_hi, n_touch = pair_forces(
+    pv, ep, wp, ovl, ovl_i, ovl_j, e_t, lost, t_lo, t_hi, n_touch, n_damp = pair_forces(
         yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tangential, commit_t
     )
     spar[k, S_TOUCH] = n_touch
+    spar[k, S_PUSHED] = n_damp
     spar[k, S_VISC] = pv
     spar[k, S_EPOT] = ep
     spar[k, S_PLASTIC] = wp
@@ -255,13 +257,13 @@ def pair_forces_blocks(y, g, cfg, fpar, spar, acc, fdamp, fload, commit_t):
 
 
 @njit(cache=True)
-def gather_rows(fpar, spar, n_pair_blocks, acc, fdamp, mass, inertia, lo, hi):
+def gather_rows(fpar, spar, n_pair_blocks, acc, fdamp, mass, inertia, lo, hi, count=True):
     """`gather_forces` for granules lo..hi-1: the buffered forces of each thread's buffer
     fpar[t], in the rows [spar[k, S_TLO], spar[k, S_THI]) its blocks k (of n_pair_blocks,
     dealt out as `thread_pairs` does) wrote that meet them, added in buffer order (and
     zeroed, ready for the next pass: a row two of its blocks wrote is added once), then the
     division (none where spar[0, S_UNDIVIDED]: the closing kick divides); returns how many
-    have a damping force."""
+    have a damping force (0 without `count`: the pass gave none, `may_have_damped`)."""
     nt = fpar.shape[0]
     for t in range(nt):
         for k in range(t, n_pair_blocks, nt):
@@ -273,35 +275,53 @@ def gather_rows(fpar, spar, n_pair_blocks, acc, fdamp, mass, inertia, lo, hi):
                     fpar[t, i, F_X + c] = 0.0
                     fpar[t, i, F_DX + c] = 0.0
                     fpar[t, i, F_T + c] = 0.0
-    divide = spar[0, S_UNDIVIDED] == 0.0
-    n_damped = 0
-    for i in range(lo, hi):
-        damped = False
-        for c in range(3):
-            if divide:
+    if spar[0, S_UNDIVIDED] == 0.0:
+        for i in range(lo, hi):
+            for c in range(3):
                 acc[i, VX + c] /= mass[i]
                 acc[i, WX + c] /= inertia[i]
-            damped = damped or fdamp[i, VX + c] != 0.0 or fdamp[i, WX + c] != 0.0
-        if damped:
-            n_damped += 1
+    n_damped = 0
+    if count:
+        for i in range(lo, hi):
+            for c in range(3):
+                if fdamp[i, VX + c] != 0.0 or fdamp[i, WX + c] != 0.0:
+                    n_damped += 1
+                    break
     return n_damped
 
 
+@njit(cache=True)
+def may_have_damped(g, fdamp, spar, n_pair_blocks) -> bool:
+    """Whether the pass may have given a granule a damping force: one of its pair blocks
+    did (spar[k, S_PUSHED]), or a wall contact's granule has one (the walls add theirs
+    serially); else every row of fdamp is zero (cleared, or known zero: S_ZERO_DAMP) and
+    the gather need not read them."""
+    for k in range(n_pair_blocks):
+        if spar[k, S_PUSHED] != 0.0:
+            return True
+    for w in range(g.wall_i.shape[0]):
+        i = g.wall_i[w]
+        for c in range(3, fdamp.shape[1]):
+            if fdamp[i, c] != 0.0:
+                return True
+    return False
+
+
 @njit(parallel=True)
-def gather_forces(fpar, acc, fdamp, mass, inertia, spar, n_pair_blocks):
+def gather_forces(fpar, acc, fdamp, mass, inertia, spar, n_pair_blocks, count=True):
     """Each granule's forces from the threads' buffers (the pass's n_pair_blocks blocks of
     pairs wrote them: `gather_rows`), added in buffer order to what acc
     and fdamp hold (its own block's pairs', the shock's and the walls'), then acc's forces and
     torques made accelerations: acc[:, 3:6] /= mass, acc[:, 6:9] /= inertia (space's
     velocity and spin columns; left to the closing kick where spar[0, S_UNDIVIDED]). The granules in blocks, each thread's those of its pair
     blocks (`granule_block`); how many of them have a damping force (fdamp
-    not zero) into spar[0, S_DAMPED]."""
+    not zero; where `count`, else none) into spar[0, S_DAMPED]."""
     nb = spar.shape[0]
     nt = fpar.shape[0]
     for t in prange(nt):
         for s in range(nb // nt):
             k, lo, hi = granule_block(spar, nt, t, s, acc.shape[0])
-            spar[k, S_DAMPED] = gather_rows(fpar, spar, n_pair_blocks, acc, fdamp, mass, inertia, lo, hi)
+            spar[k, S_DAMPED] = gather_rows(fpar, spar, n_pair_blocks, acc, fdamp, mass, inertia, lo, hi, count)
     n = 0.0
     for k in range(nb):
         n += spar[k, S_DAMPED]
@@ -324,7 +344,8 @@ def normal_forces_blocks(t, y, g, cfg, acc, fdamp, fload, fpar, spar, commit_t):
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
         y, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
     )
-    gather_forces(fpar, acc, fdamp, g.mass, g.inertia, spar, fpar.shape[0])
+    n_pb = fpar.shape[0]
+    gather_forces(fpar, acc, fdamp, g.mass, g.inertia, spar, n_pb, may_have_damped(g, fdamp, spar, n_pb))
     return ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
 
 
@@ -384,7 +405,8 @@ def mindlin_forces_blocks(t, yv, yn, h, g, cfg, acc, fdamp, fload, fpar, spar, c
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
         yn, g, cfg, acc, fdamp, p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j
     )
-    gather_forces(fpar, acc, fdamp, g.mass, g.inertia, spar, spar.shape[0])
+    n_pb = spar.shape[0]
+    gather_forces(fpar, acc, fdamp, g.mass, g.inertia, spar, n_pb, may_have_damped(g, fdamp, spar, n_pb))
     e_w, lost_w = wall_mindlin(yv, yn, h, g, cfg, acc)
     sums = ForceSums(p_shock, p_visc, 0.0, e_pot, 0.0, ovl, ovl_i, ovl_j, 0.0, w_plastic, 0.0, 0.0)
     return sums, e_t + e_w, lost + lost_w

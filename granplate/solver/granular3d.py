@@ -344,7 +344,7 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=T
     p_shock = 0.0
     if not cfg.load_on_plate:
         p_shock = shock_loads(t, y, g, cfg, acc, fload)
-    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, _, _, _, _, _ = pair_forces(
+    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, _, _, _, _, _, _ = pair_forces(
         y, y, 0.0, g, cfg, 0, g.pair_ij.shape[0], acc, fdamp, acc, 0, ng, False, commit_t
     )  # (every granule its own: no buffer)
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
@@ -484,8 +484,8 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tang
     solver.blocks); the serial pass (`normal_forces`, solver.mindlin_space) owns every
     granule. Returns (viscous power [W], stored energy [J], plastic work [J], the largest
     overlap / smaller radius, its pair (i, j), the springs' energy [J], their losses [J],
-    the range [t_lo, t_hi) of the buffer's rows written (empty: t_lo >= t_hi), and how many
-    of the pairs touch). Each pair's coefficients are its kind's row (g.kind_coef[g.pair_kind[p]],
+    the range [t_lo, t_hi) of the buffer's rows written (empty: t_lo >= t_hi), how many
+    of the pairs touch, and how many gave their granules a damping force). Each pair's coefficients are its kind's row (g.kind_coef[g.pair_kind[p]],
     pair_coef[p]'s bits: model.inputs.Granular), a few rows that stay in the cache.
 
     Written out per contact for speed: a compiled function called per contact with the
@@ -503,6 +503,7 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tang
     t_lo = acc.shape[0]
     t_hi = 0
     n_touch = 0
+    n_damp = 0
     hist = g.pair_hist
     half_shrink = 0.5 * cfg.arm_shrink
     for p in range(lo, hi):
@@ -537,6 +538,7 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tang
         push_pair(fi, fj, i, j, VX, VX, n, nx, ny, nz)
         if pv != 0.0:  # the damping part of |N|, pv / ddot
             push_pair(di, dj, i, j, ci, cj, pv / ddot, nx, ny, nz)
+            n_damp += 1
         if kt:  # the history law's force (Mindlin's spring) from the same overlap and |N|
             ai = contact_arm(ri, delta, half_shrink)
             aj = contact_arm(rj, delta, half_shrink)
@@ -561,4 +563,4 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tang
             fj[j, VX + 2] -= fz
             push_couple(fi, i, WX, ti, nx, ny, nz, fx, fy, fz)
             push_couple(fj, j, WX, tj, nx, ny, nz, fx, fy, fz)
-    return p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, e_t, lost, t_lo, t_hi, n_touch
+    return p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, e_t, lost, t_lo, t_hi, n_touch, n_damp

@@ -82,7 +82,7 @@ def normal_mindlin_forces(t, yv, yn, h, g, cfg, acc, fdamp, fload, commit_t, for
     p_shock = 0.0
     if not cfg.load_on_plate:
         p_shock = shock_loads(t, yn, g, cfg, acc, fload)
-    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, e_t, lost, _, _, _ = pair_forces(
+    p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j, e_t, lost, _, _, _, _ = pair_forces(
         yv, yn, h, g, cfg, 0, g.pair_ij.shape[0], acc, fdamp, acc, 0, yn.shape[0], True, commit_t
     )  # (every granule its own: no buffer)
     p_visc, e_pot, w_plastic, ovl, ovl_i, ovl_j = wall_forces(
