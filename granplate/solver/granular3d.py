@@ -34,6 +34,7 @@ from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_mot
 from granplate.solver.granular import ForceSums, clear_overlap, clear_rows, commit_overlap, slip_relaxation_rate
 from granplate.solver.mindlin_history import mindlin_contact, mindlin_old_force, mindlin_parted, mindlin_touched
 from granplate.solver.mindlin_rk4 import space_stages
+from granplate.solver.prefetch import PAIRS_AHEAD, prefetch_row
 
 #: state columns of a granule in space
 X, Y, Z, VX, VY, VZ, WX, WY, WZ = range(9)
@@ -491,7 +492,8 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tang
     Written out per contact for speed: a compiled function called per contact with the
     granular arrays (or even a few of them) costs 3-30x this loop (measured on 56,754
     pairs: 0.74 ms per pass written out, 4.4 ms through an inlined per-contact function
-    taking four arrays, 28 ms taking the arrays' named tuple)."""
+    taking four arrays, 28 ms taking the arrays' named tuple). The rows of the second granule
+    of the pair PAIRS_AHEAD places on are asked for ahead (solver.prefetch)."""
     p_visc = 0.0
     e_pot = 0.0
     w_plastic = 0.0
@@ -507,6 +509,10 @@ def pair_forces(yv, yn, h, g, cfg, lo, hi, acc, fdamp, buf, own_lo, own_hi, tang
     hist = g.pair_hist
     half_shrink = 0.5 * cfg.arm_shrink
     for p in range(lo, hi):
+        if p + PAIRS_AHEAD < hi:  # (the second granule's rows of a pair ahead: solver.prefetch)
+            ahead = g.pair_ij[p + PAIRS_AHEAD, 1]
+            prefetch_row(yn, ahead)
+            prefetch_row(acc, ahead)
         i = g.pair_ij[p, 0]
         j = g.pair_ij[p, 1]
         ri = g.radius[i]
