@@ -38,7 +38,8 @@ from numba import prange  # noqa: E402
 from granplate.jit import njit  # noqa: E402
 
 from granplate.solver.drives import begin_pass
-from granplate.solver.granular import ForceSums, clear_rows, commit_history, commit_rows
+from granplate.solver.clearing import clear_rows
+from granplate.solver.granular import ForceSums, commit_history, commit_rows
 from granplate.solver.granular3d import BUF_DAMP, N_BUF, VX, WX, pair_forces, shock_loads, wall_forces
 from granplate.solver.mindlin_space import wall_mindlin
 

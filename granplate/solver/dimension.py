@@ -62,7 +62,7 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=T
     """The velocity-Verlet force pass: shock and normal forces alone, the damping force and
     load of each granule apart, the pairs' overlaps committed at commit_t [s] (< 0: not;
     solver.granular.normal_forces), the rows of acc, fdamp, fload cleared first where
-    `forces`, `damp`, `loads` (solver.granular.clear_rows), the forces made accelerations
+    `forces`, `damp`, `loads` (solver.clearing.clear_rows), the forces made accelerations
     where `divide` (else the closing kick does: solver.kicks.divide_kick)."""
     raise NotImplementedError("compiled use only")
 

@@ -52,6 +52,7 @@ from granplate.physics.laws import (
     tangential_slopes,
 )
 from granplate.physics.shock import shock_amplitude
+from granplate.solver.clearing import clear_overlap, clear_rows
 from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_motion
 from granplate.solver.mindlin_rk4 import plane_stages, plate_stages
 from granplate.solver.state import PARTNER_PLATE
@@ -382,37 +383,6 @@ def commit_history(t, hist, coef):
     commit_rows(t, hist, coef, 0, hist.shape[0])
 
 
-@njit(cache=True)
-def clear_rows(acc, fdamp, fload, lo, hi, forces=True, damp=True, loads=True):
-    """A force pass's clearing of granules lo..hi-1: their rows of acc, fdamp and fload from
-    the velocity columns on (N_DRIFT, 3 in both dimensions) made zero where `forces`,
-    `damp` and `loads` (else the caller knows them all zero already: the first kick
-    cleared acc, solver.kicks.kick_drift; the last pass into fdamp or fload left it so,
-    solver.schemes.verlet.note_quiet)."""
-    if forces:
-        for i in range(lo, hi):
-            for c in range(3, acc.shape[1]):
-                acc[i, c] = 0.0
-    if damp:
-        for i in range(lo, hi):
-            for c in range(3, fdamp.shape[1]):
-                fdamp[i, c] = 0.0
-    if loads:
-        for i in range(lo, hi):
-            for c in range(3, fload.shape[1]):
-                fload[i, c] = 0.0
-
-
-@njit(cache=True, inline="always")
-def clear_overlap(hist, k):
-    """Contact k's overlap of this pass (HIST_END) made 0 before the pass finds it, written
-    only where it is not 0 already: a contact out of touch leaves its history row unwritten,
-    sparing its cache line the write back to memory (a million-granule packing's pairs are
-    mostly out of touch)."""
-    if hist[k, HIST_END] != 0.0:
-        hist[k, HIST_END] = 0.0
-
-
 @njit(cache=True, inline="always")
 def commit_overlap(t, hist, k, d, c):
     """Contact k's overlap d [m] at the accepted step's end t [s] into its largest
@@ -488,7 +458,7 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=T
     kick; each contact's overlap into its history's HIST_END (0 out of touch), a pair's
     committed at commit_t [s] (`commit_overlap`; the trial of a scheme whose every step is
     accepted; commit_t < 0: none, a pass at t_n). The rows of acc, fdamp and fload are
-    cleared first where `forces`, `damp`, `loads` (`clear_rows`); without `divide`, acc
+    cleared first where `forces`, `damp`, `loads` (solver.clearing.clear_rows); without `divide`, acc
     keeps the forces and torque (solver.kicks.divide_kick makes them accelerations). No plate
     contacts (the scheme runs without a plate). Returns the ForceSums: shock and viscous
     power at y [W], stored energy [J], the largest overlap, the plastic work past the

@@ -31,7 +31,8 @@ from granplate.physics.space import (
     wall_overlap_3d,
 )
 from granplate.solver.drives import begin_pass, book_wall, finish_pass, wall_motion
-from granplate.solver.granular import ForceSums, clear_overlap, clear_rows, commit_overlap, slip_relaxation_rate
+from granplate.solver.clearing import clear_overlap, clear_rows
+from granplate.solver.granular import ForceSums, commit_overlap, slip_relaxation_rate
 from granplate.solver.mindlin_history import mindlin_contact, mindlin_old_force, mindlin_parted, mindlin_touched
 from granplate.solver.mindlin_rk4 import space_stages
 from granplate.solver.prefetch import PAIRS_AHEAD, prefetch_row
@@ -336,7 +337,7 @@ def normal_forces(t, y, g, cfg, acc, fdamp, fload, commit_t, forces=True, damp=T
     (fdamp, fload [:, 3:9] [N, N m]; the normal forces act through the centres, a line
     load's torques on the spins), the contacts' overlaps into HIST_END (the pairs'
     committed at commit_t [s]; < 0: not). Their rows are cleared first where `forces`,
-    `damp`, `loads` (solver.granular.clear_rows); without `divide`, acc keeps the forces
+    `damp`, `loads` (solver.clearing.clear_rows); without `divide`, acc keeps the forces
     and torques [N, N m] (the closing kick divides them: solver.kicks.divide_kick). Returns
     the ForceSums."""
     ng = y.shape[0]

@@ -28,7 +28,7 @@ def kick_drift(y0, y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict=True
     fload (fdamp) is not read where `loads` (`damped`) is False: the caller knows it is all
     zero, and its work is then 0 exactly as the sum would give. `clear`: each acceleration
     of the kicked columns is set to zero once read (the step's force pass then writes the
-    new ones into acc without clearing it first: solver.granular.clear_rows)."""
+    new ones into acc without clearing it first: solver.clearing.clear_rows)."""
     hk = 0.5 * h
     w_load = 0.0
     w_damp = 0.0

@@ -27,7 +27,8 @@ from granplate.physics.contact import (
 from granplate.physics.laws import keeps_history, normal_law_response, tangential_scale
 from granplate.physics.shock import shock_amplitude
 from granplate.solver.drives import begin_pass, book_wall, wall_motion
-from granplate.solver.granular import ForceSums, clear_overlap, clear_rows, commit_overlap
+from granplate.solver.clearing import clear_overlap, clear_rows
+from granplate.solver.granular import ForceSums, commit_overlap
 from granplate.solver.mindlin_history import mindlin_contact, mindlin_old_force, mindlin_parted, mindlin_touched
 
 

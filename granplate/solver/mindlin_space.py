@@ -16,7 +16,8 @@ from granplate.physics.contact import contact_arm
 from granplate.physics.laws import keeps_history, normal_law_force, tangential_scale
 from granplate.physics.space import normal_rate_3d, wall_overlap_3d
 from granplate.solver.drives import begin_pass, wall_motion
-from granplate.solver.granular import ForceSums, clear_rows
+from granplate.solver.clearing import clear_rows
+from granplate.solver.granular import ForceSums
 from granplate.solver.mindlin_history import mindlin_contact, mindlin_parted
 from granplate.solver.friction_space import apply_friction_impulse
 from granplate.solver.granular3d import (
