@@ -49,40 +49,19 @@ def kick_drift(y0, y, acc, fdamp, fload, h, ypred, n_drift, lo, hi, predict=True
     return w_load, w_damp
 
 
-@njit(cache=True)
-def kick(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi, loads=True, damped=True):
-    """Granules lo..hi-1: the closing half kick v += hk a (hk = h/2); dy (the loop's
-    derivative at the end of the step) gets the end velocities as the rates of the
-    drifting columns. Returns the load's and the damping force's work [J] as `kick_drift`
-    (`loads`, `damped` as there)."""
+@njit(cache=True, inline="always")
+def closing_rows(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi, loads, damped, divide, n_move, mass, inertia):
+    """The closing half kick of granules lo..hi-1 (`kick`), where `divide` from forces and
+    torques in acc made accelerations first (`divide_kick`: the first n_move velocity
+    columns by mass, the others by inertia; else mass and inertia are not read)."""
     w_load = 0.0
     w_damp = 0.0
     for i in range(lo, hi):
         for c in range(n_drift, y.shape[1]):
-            v1, _, vm = half_kick(y[i, c], acc[i, c], hk)
-            if loads:
-                w_load += fload[i, c] * vm
-            if damped:
-                w_damp += fdamp[i, c] * vm
-            y[i, c] = v1
-        for c in range(n_drift):
-            dy[i, c] = y[i, c + n_drift]
-    return w_load, w_damp
-
-
-@njit(cache=True)
-def divide_kick(y, acc, fdamp, fload, hk, dy, n_drift, n_move, mass, inertia, lo, hi, loads=True, damped=True):
-    """`kick` from the force pass's forces and torques in acc [N, N m] (a pass that left
-    its division to the kick): each made an acceleration in acc as the pass would have made
-    it (the first n_move velocity columns divided by the mass [kg], the others by the
-    moment of inertia [kg m^2]) and the kick taken with it, bit for bit `kick` after the
-    pass's division, in one pass over the rows instead of two."""
-    w_load = 0.0
-    w_damp = 0.0
-    for i in range(lo, hi):
-        for c in range(n_drift, y.shape[1]):
-            a = acc[i, c] / (mass[i] if c < n_drift + n_move else inertia[i])
-            acc[i, c] = a
+            a = acc[i, c]
+            if divide:
+                a = a / (mass[i] if c < n_drift + n_move else inertia[i])
+                acc[i, c] = a
             v1, _, vm = half_kick(y[i, c], a, hk)
             if loads:
                 w_load += fload[i, c] * vm
@@ -92,3 +71,23 @@ def divide_kick(y, acc, fdamp, fload, hk, dy, n_drift, n_move, mass, inertia, lo
         for c in range(n_drift):
             dy[i, c] = y[i, c + n_drift]
     return w_load, w_damp
+
+
+@njit(cache=True)
+def kick(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi, loads=True, damped=True):
+    """Granules lo..hi-1: the closing half kick v += hk a (hk = h/2); dy (the loop's
+    derivative at the end of the step) gets the end velocities as the rates of the
+    drifting columns. Returns the load's and the damping force's work [J] as `kick_drift`
+    (`loads`, `damped` as there)."""
+    none = y[:0, 0]  # (no masses: not read)
+    return closing_rows(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi, loads, damped, False, 0, none, none)
+
+
+@njit(cache=True)
+def divide_kick(y, acc, fdamp, fload, hk, dy, n_drift, n_move, mass, inertia, lo, hi, loads=True, damped=True):
+    """`kick` from the force pass's forces and torques in acc [N, N m] (a pass that left
+    its division to the kick): each made an acceleration in acc as the pass would have made
+    it (the first n_move velocity columns divided by the mass [kg], the others by the
+    moment of inertia [kg m^2]) and the kick taken with it, bit for bit `kick` after the
+    pass's division, in one pass over the rows instead of two."""
+    return closing_rows(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi, loads, damped, True, n_move, mass, inertia)
