@@ -99,7 +99,9 @@ def map_pages(*tuples) -> None:
                 and value.flags.writeable
             ):
                 flat = value.reshape(-1).view(np.uint8)
-                flat[:: 8 * PAGE_DOUBLES] = flat[:: 8 * PAGE_DOUBLES]
+                flat[:: 8 * PAGE_DOUBLES] = flat[
+                    :: 8 * PAGE_DOUBLES
+                ].copy()  # (a view onto itself: numpy writes nothing)
             elif isinstance(value, tuple) and hasattr(value, "_fields"):
                 map_pages(value)
 
