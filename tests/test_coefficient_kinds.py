@@ -16,7 +16,7 @@ from granplate.errors import YieldWarning
 from granplate.model import coefficients
 from granplate.model.arrays import build_model, granular_with_contacts
 from granplate.model.coefficients import coefficient_kinds
-from granplate.model.relists import pair_kinds_stale, with_pair_kinds
+from granplate.model.relists import cached_pair_coefficients, pair_kinds_stale, with_pair_kinds
 from granplate.physics.contact import N_COEF
 from granplate.results.run import simulate
 from granplate.setup.threads import available_threads
@@ -86,6 +86,23 @@ def test_model_and_rebuilt_lists_carry_their_pairs_kinds():
     assert pair_kinds_stale(bare) and not pair_kinds_stale(with_pair_kinds(bare))
     lists = ContactLists(dataclasses.replace(m, granular=bare))
     assert same_bits(lists.g.kind_coef[lists.g.pair_kind], lists.g.pair_coef)
+
+
+def test_cached_rows_are_the_rows_computed_again():
+    """model.relists.cached_pair_coefficients over calls whose pairs overlap, come in any
+    order, all met or none: each row is pair_coefficients' own to the bit, and the cache
+    stays sorted by code with each pair once."""
+    m = build_model(polydisperse())
+    s, mats, g = m.scenario, list(m.materials), m.granular
+    rng = np.random.default_rng(11)
+    pairs = g.pair_ij
+    known: dict = {}
+    for take in (pairs[::3], pairs[rng.permutation(len(pairs))[: len(pairs) // 2]], pairs, pairs[::-5], pairs[:0]):
+        got = cached_pair_coefficients(s, mats, g, np.ascontiguousarray(take), known)
+        assert same_bits(got, coefficients.pair_coefficients(s, mats, g.radius, g.mass, take))
+        codes = known["codes"]
+        assert np.all(codes[1:] > codes[:-1]) and len(codes) == len(known["rows"])
+    assert len(known["codes"]) == len(pairs)
 
 
 @pytest.mark.parametrize("threads", sorted({1, min(2, available_threads())}))

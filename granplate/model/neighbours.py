@@ -82,7 +82,8 @@ def candidate_pairs(x: np.ndarray, y: np.ndarray, distance: float, z: np.ndarray
 DECIDE_MARGIN = 1e-12
 
 
-def _exact_product(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+@njit(cache=True, inline="always")
+def _exact_product(a: float, b: float) -> tuple[float, float]:
     """(p, e) with p = fl(a b) and p + e = a b exactly (Dekker's product by Veltkamp's split)."""
     ta, tb = a * 134217729.0, b * 134217729.0
     ah, bh = ta - (ta - a), tb - (tb - b)
@@ -93,35 +94,51 @@ def _exact_product(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return s, p - s + q + al * bl
 
 
-def _fast_sum(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+@njit(cache=True, inline="always")
+def _fast_sum(a: float, b: float) -> tuple[float, float]:
     """(s, e) with s = fl(a + b), s + e = a + b exactly for |a| >= |b| (Dekker's fast two-sum)."""
     s = a + b
     return s, b - (s - a)
 
 
+@njit(cache=True)
+def _hypot_columns(c: np.ndarray) -> np.ndarray:
+    """CPython's vector_norm of each column of c (k, n) (`python_hypot`), for finite
+    components whose largest magnitude is 0 or normal."""
+    k, n = c.shape
+    out = np.zeros(n)
+    for e in range(n):
+        top = 0.0
+        for d in range(k):
+            top = max(top, abs(c[d, e]))
+        if top == 0.0:
+            continue
+        scale = math.ldexp(1.0, -math.frexp(top)[1])
+        csum, frac1, frac2 = 1.0, 0.0, 0.0
+        for d in range(k):
+            v = abs(c[d, e]) * scale
+            hi, lo = _exact_product(v, v)
+            csum, carry = _fast_sum(csum, hi)
+            frac1, frac2 = frac1 + lo, frac2 + carry
+        h = math.sqrt(csum - 1.0 + (frac1 + frac2))
+        hi, lo = _exact_product(-h, h)
+        csum, carry = _fast_sum(csum, hi)
+        frac1, frac2 = frac1 + lo, frac2 + carry
+        h = h + (csum - 1.0 + (frac1 + frac2)) / (2.0 * h)
+        out[e] = h / scale
+    return out
+
+
 def python_hypot(*components: np.ndarray) -> np.ndarray:
-    """math.hypot(*components) of every element, bit for bit, by numpy: CPython's
+    """math.hypot(*components) of every element, bit for bit, compiled: CPython's
     vector_norm (its lossless scaling by a power of two, the squares' exact products summed
     beside their round-off, the square root and its one differential correction), for
     finite components (a subnormal largest magnitude: math.hypot itself)."""
-    mags = [np.abs(np.asarray(c, float)) for c in components]
-    top = np.maximum.reduce(mags) if len(mags) > 1 else mags[0]
-    scale = np.ldexp(1.0, -np.frexp(top)[1])
-    csum, frac1, frac2 = np.ones_like(top), np.zeros_like(top), np.zeros_like(top)
-    for m in mags:
-        v = m * scale
-        hi, lo = _exact_product(v, v)
-        csum, carry = _fast_sum(csum, hi)
-        frac1, frac2 = frac1 + lo, frac2 + carry
-    h = np.sqrt(csum - 1.0 + (frac1 + frac2))
-    hi, lo = _exact_product(-h, h)
-    csum, carry = _fast_sum(csum, hi)
-    frac1, frac2 = frac1 + lo, frac2 + carry
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        h = h + (csum - 1.0 + (frac1 + frac2)) / (2.0 * h)
-        out = np.where(top == 0.0, 0.0, h / scale)
+    c = np.ascontiguousarray(np.vstack([np.ravel(np.asarray(x, float)) for x in components]))
+    out = _hypot_columns(c)
+    top = np.max(np.abs(c), axis=0) if c.shape[1] else np.zeros(0)
     for k in np.flatnonzero((top > 0.0) & (top < np.finfo(float).tiny)).tolist():  # subnormal: CPython's own
-        out[k] = math.hypot(*(float(c[k]) for c in components))
+        out[k] = math.hypot(*(float(x) for x in c[:, k]))
     return out
 
 

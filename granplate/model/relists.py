@@ -58,14 +58,22 @@ def cached_pair_coefficients(s: Scenario, mats, g: Granular, pairs: np.ndarray, 
     kr = known.get("rows", np.zeros((0, N_COEF)))
     pos = np.minimum(np.searchsorted(kc, code), max(len(kc) - 1, 0))
     hit = (kc[pos] == code) if len(kc) else np.zeros(len(code), bool)
-    out = np.empty((len(pairs), N_COEF))
-    out[hit] = kr[pos[hit]]
-    if not hit.all():
-        rows = pair_coefficients(s, mats, g.radius, g.mass, pairs[~hit])
-        out[~hit] = rows
-        codes = np.concatenate([kc, code[~hit]])
-        order = np.argsort(codes, kind="stable")
-        known["codes"], known["rows"] = codes[order], np.vstack([kr, rows])[order]
+    if hit.all():
+        return np.take(kr, pos, axis=0)
+    new = np.flatnonzero(~hit)
+    rows = pair_coefficients(s, mats, g.radius, g.mass, pairs[new])
+    if hit.any():
+        out = np.empty((len(pairs), N_COEF))
+        out[new] = rows
+        out[hit] = np.take(kr, pos[hit], axis=0)
+    else:
+        out = rows
+    new_code = code[new]
+    if len(new_code) > 1 and not np.all(new_code[1:] >= new_code[:-1]):
+        order = np.argsort(new_code, kind="stable")
+        new_code, rows = new_code[order], rows[order]
+    at = np.searchsorted(kc, new_code, side="right")  # (the rows merged in code order: copies of both)
+    known["codes"], known["rows"] = np.insert(kc, at, new_code), np.insert(kr, at, rows, axis=0)
     return out
 
 

@@ -461,12 +461,20 @@ def block_seen(
     x, yy, z = centre_coordinates(flat, d)
     on = on[contacts_among(pairs[on], x, yy, r_flat, 0.0, z)]
     pt, pi, pj = pairs[on, 0] // ng, pairs[on, 0] % ng, pairs[on, 1] % ng
-    pair_coef = np.zeros((len(on), N_COEF))
     tab = table[pt]
+    pair_coef = None if len(tab) and tab.all() else np.zeros((len(on), N_COEF))
     if tab.any():
-        code, inverse = np.unique(pi[tab] * ng + pj[tab], return_inverse=True)
+        codes = pi[tab] * ng + pj[tab]
+        if np.all(codes[1:] > codes[:-1]):  # (one table time, its pairs in order: each its own row)
+            code, inverse = codes, None
+        else:
+            code, inverse = np.unique(codes, return_inverse=True)
         rows_ = cached_rows(model, np.column_stack([code // ng, code % ng]), known)
-        pair_coef[tab] = rows_[np.asarray(inverse, np.int64).ravel()]
+        rows_ = rows_ if inverse is None else np.take(rows_, np.asarray(inverse, np.int64).ravel(), axis=0)
+        if pair_coef is None:
+            pair_coef = rows_
+        else:
+            pair_coef[tab] = rows_
     wt, wi, ww, wkin, wall_coef = block_walls(model, flat, rows, table, walls, r_flat, ng, wall_kin)
     keep = wkin[:, DELTA] > 0.0
     wt, wi, ww, wkin, wall_coef = wt[keep], wi[keep], ww[keep], wkin[keep], wall_coef[keep]
@@ -475,6 +483,9 @@ def block_seen(
     gran = np.concatenate([pi, wi])
     other = np.concatenate([pj, ww])  # the partner granule, or the wall's index
     order = np.lexsort((other, gran, kind, time))
+    met_in_order = len(wt) == 0 and bool(np.all(order[1:] > order[:-1]))  # (pairs alone, as met: no copies)
+    if met_in_order:
+        order = slice(None)
     all_kin = np.concatenate([kin[on], wkin])[order]
     return Seen(
         time=rows[time[order]],
@@ -483,7 +494,7 @@ def block_seen(
         delta=all_kin[:, DELTA].copy(),
         table=table[time[order]],
         kin=all_kin,
-        coef=np.concatenate([pair_coef, wall_coef])[order],
+        coef=pair_coef if met_in_order else np.concatenate([pair_coef, wall_coef])[order],
     )
 
 
