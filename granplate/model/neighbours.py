@@ -101,7 +101,7 @@ def _fast_sum(a: float, b: float) -> tuple[float, float]:
     return s, b - (s - a)
 
 
-@njit(cache=True)
+@njit(entry=True, cache=True)
 def _hypot_columns(c: np.ndarray) -> np.ndarray:
     """CPython's vector_norm of each column of c (k, n) (`python_hypot`), for finite
     components whose largest magnitude is 0 or normal."""
