@@ -98,10 +98,8 @@ def map_pages(*tuples) -> None:
                 and value.flags.c_contiguous
                 and value.flags.writeable
             ):
-                flat = value.reshape(-1).view(np.uint8)
-                flat[:: 8 * PAGE_DOUBLES] = flat[
-                    :: 8 * PAGE_DOUBLES
-                ].copy()  # (a view onto itself: numpy writes nothing)
+                flat, step = value.reshape(-1).view(np.uint8), 8 * PAGE_DOUBLES
+                flat[::step] = flat[::step].copy()  # (not a view onto itself: numpy would write nothing)
             elif isinstance(value, tuple) and hasattr(value, "_fields"):
                 map_pages(value)
 
