@@ -13,15 +13,23 @@ compiles its own entry once, the same function with both wrappers, cached apart.
 start, the model build's kernels): compiled as numba compiles them, wrappers and all.
 
 The time loop (`solver.loop.advance`) is compiled with `NO_REFCOUNT`: without numba's
-reference counting, which every kernel it calls inherits (numba passes that option down to
-the kernels a function calls when they do not set it). The loop hands the run's named
-tuples of arrays (some 200 arrays) to every hook of its step, and numba counted a
-reference to each array at the entry and exit of every call: for a small assembly that
-counting was nine tenths of a step (docs/benchmarks.md, "Reference counting"). Nothing the
-step calls may allocate an array then (numba refuses to compile one that does, naming it):
-the step works in the run's scratch arrays, made before the loop starts. Nor does a
-kernel of the step return an array (it returns numbers and flags): a kernel compiled
-elsewhere with reference counting would hand the loop a reference it never gives back.
+reference counting. The loop hands the run's named tuples of arrays (some 200 arrays) to
+every hook of its step, and numba counted a reference to each array at the entry and exit
+of every call: for a small assembly that counting was nine tenths of a step
+(docs/benchmarks.md, "Reference counting"). Nothing the step calls may allocate an array
+then (numba refuses to compile one that does, naming it): the step works in the run's
+scratch arrays, made before the loop starts. Nor does a kernel of the step return an
+array (it returns numbers and flags).
+
+Every kernel sets `NO_REFCOUNT` itself. numba would otherwise compile a kernel that does
+not set it as its first caller is compiled, keep that one machine code for every caller,
+and keep it in its on-disk cache: a loop kernel first called from Python (a test, a
+session) or from a set-up function counted references in every later run's loop, which
+then took 1.8x as long (docs/benchmarks.md, "A kernel's code whoever calls it first").
+A kernel that makes arrays (its scratch, its result) says so, `njit(refcount=True)`: it
+is compiled with the counting, whoever calls it, and so frees the arrays it makes itself
+(an elastic body's contact pass, which the loop calls). It returns arrays only to a
+kernel that counts too.
 """
 
 from __future__ import annotations
@@ -31,6 +39,7 @@ from collections import Counter
 from typing import Any, Callable
 
 from numba import njit as numba_njit
+from numba.core.errors import ForceLiteralArg, NumbaError
 from numba.core.registry import CPUDispatcher
 
 #: Appended to a kernel's qualified name for its Python entry, so that numba's on-disk
@@ -44,17 +53,40 @@ PYTHON_CALLS: Counter[str] = Counter()
 #: Compile options of a kernel: the wrappers only a call from Python or C needs left out.
 WITHOUT_WRAPPERS = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True}
 
-#: Compile options of the time loop: no reference counting (numba's NRT) in it or in any
-#: kernel it calls (they inherit the option); none of them may allocate.
+#: Compile options of the time loop and of every kernel (but those made with refcount=True):
+#: no reference counting (numba's NRT); none of them may allocate.
 NO_REFCOUNT = {"_nrt": False}
+
+#: Compile options of a kernel that makes arrays (njit(refcount=True)): reference counting
+#: (numba's default), whoever calls it.
+COUNTED = {"_nrt": True}
 
 
 class Kernel(CPUDispatcher):
     """A function numba compiles without its Python and C wrappers (callable from compiled
-    code); called from Python, it runs its entry, compiled once with the wrappers."""
+    code); called from Python, it runs its entry, compiled once with the wrappers.
+
+    Compiled without reference counting (NO_REFCOUNT) whoever calls it first, or with it
+    where made with refcount=True (COUNTED, `njit`)."""
 
     _entry: CPUDispatcher | None = None
     _entry_options: dict = {}
+
+    def compile(self, sig):
+        """numba's compile; a kernel compiled without reference counting that fails to
+        (it makes arrays, or calls a kernel that does) gets a note saying so."""
+        try:
+            return super().compile(sig)
+        except ForceLiteralArg:  # (numba asking for literal arguments: not a failure)
+            raise
+        except NumbaError as e:
+            if self.targetoptions.get("_nrt") is False:
+                e.add_note(
+                    f"granplate: {self.py_func.__module__}.{self.py_func.__qualname__} is compiled without "
+                    "reference counting (granplate.jit.NO_REFCOUNT); if it makes arrays, mark it "
+                    "njit(refcount=True)."
+                )
+            raise
 
     def __call__(self, *args, **kwargs):
         PYTHON_CALLS[f"{self.py_func.__module__}.{self.py_func.__qualname__}"] += 1
@@ -72,15 +104,18 @@ class Kernel(CPUDispatcher):
         return self._entry
 
 
-def njit(function: Callable | None = None, *, entry: bool = False, **options: Any):
+def njit(function: Callable | None = None, *, entry: bool = False, refcount: bool = False, **options: Any):
     """numba.njit for granplate's kernels (`@njit`, `@njit(cache=True, ...)`), compiled
-    without the Python and C wrappers; entry=True: a function the driver calls from
-    Python, compiled with them (numba's own njit)."""
+    without the Python and C wrappers and without reference counting (NO_REFCOUNT), whoever
+    calls it first; refcount=True: a kernel that makes arrays, compiled with the counting
+    (COUNTED), whoever calls it; entry=True: a function the driver calls from Python,
+    compiled with the wrappers (numba's own njit)."""
 
     def decorate(f: Callable):
         if entry:
             return numba_njit(**options)(f)
-        disp = numba_njit(**options, **WITHOUT_WRAPPERS)(f)
+        pinned = COUNTED if refcount else NO_REFCOUNT
+        disp = numba_njit(**{**pinned, **options}, **WITHOUT_WRAPPERS)(f)
         if not isinstance(disp, CPUDispatcher):  # NUMBA_DISABLE_JIT: the plain function
             return disp
         disp.__class__ = Kernel  # numba's own dispatcher, its Python call sent to the entry

@@ -82,14 +82,15 @@ class _Springs(NamedTuple):
     k: np.ndarray
 
 
-def _springs(name: str):
+def _springs(name: str, refcount: bool = False):
     """A kernel (its name) summing 1/2 k x^2 over the springs of positive k, each term by a
-    kernel of its own: the shape of the loop's passes, whose reference counts numba keeps."""
+    kernel of its own: the shape of the loop's passes, whose reference counts numba keeps
+    where a kernel counts them (`refcount`)."""
 
     def term(t: _Springs, i: int) -> float:
         return 0.5 * t.k[i] * t.x[i] * t.x[i]
 
-    compiled_term = njit(term)
+    compiled_term = njit(term, refcount=refcount)
 
     def energy(t: _Springs) -> float:
         e = 0.0
@@ -99,12 +100,14 @@ def _springs(name: str):
         return e
 
     energy.__qualname__ = energy.__name__ = name
-    return njit(energy)
+    return njit(energy, refcount=refcount)
 
 
-#: the same kernel twice: one called from a loop compiled with NO_REFCOUNT, one from a plain one
+#: the same kernel three times: one first called from a loop compiled with NO_REFCOUNT, one
+#: from a plain function (numba's default: counting), and one that asks to count (refcount=True)
 _energy_uncounted = _springs("_energy_uncounted")
-_energy_counted = _springs("_energy_counted")
+_energy_plain_first = _springs("_energy_plain_first")
+_energy_counted = _springs("_energy_counted", refcount=True)
 
 
 @njit(entry=True, **jit.NO_REFCOUNT)
@@ -116,11 +119,29 @@ def _loop_uncounted(t: _Springs, n: int) -> float:
 
 
 @njit(entry=True)
+def _loop_plain(t: _Springs, n: int) -> float:
+    s = 0.0
+    for _ in range(n):
+        s += _energy_plain_first(t)
+    return s
+
+
+@njit(entry=True)
 def _loop_counted(t: _Springs, n: int) -> float:
     s = 0.0
     for _ in range(n):
         s += _energy_counted(t)
     return s
+
+
+@njit(refcount=True)
+def _ones(n: int) -> np.ndarray:
+    return np.ones(n)
+
+
+@njit(entry=True)
+def _sum_of_ones(n: int) -> float:
+    return _ones(n).sum()
 
 
 def _counts_references(dispatcher) -> bool:
@@ -129,14 +150,56 @@ def _counts_references(dispatcher) -> bool:
     return "@NRT_incref" in code or "@NRT_decref" in code
 
 
-def test_a_kernel_the_loop_calls_counts_no_references():
-    """A kernel called from a function compiled with NO_REFCOUNT inherits it: neither counts
-    the references of the named tuple's arrays, while the same kernel called from a plain
-    function does (so the check sees counting where there is some); both give 1/2 k x^2 n."""
+def test_a_kernel_counts_no_references_whoever_calls_it_first():
+    """A kernel is compiled as the time loop needs it (NO_REFCOUNT) whoever compiles it
+    first: called first from a plain function (numba would have it inherit that function's
+    counting, and keep it in its cache for the loop), it counts no references of the named
+    tuple's arrays, like the same kernel the loop calls; one made with refcount=True counts
+    them whoever calls it (so the check sees counting where there is some). All give
+    1/2 k x^2 n."""
     t = _Springs(np.array([1.0, 2.0]), np.array([2.0, 0.5]))
-    assert _loop_uncounted(t, 3) == _loop_counted(t, 3) == 3 * (0.5 * 2.0 * 1.0 + 0.5 * 0.5 * 4.0)
+    expected = 3 * (0.5 * 2.0 * 1.0 + 0.5 * 0.5 * 4.0)
+    assert _loop_plain(t, 3) == _loop_uncounted(t, 3) == _loop_counted(t, 3) == expected
+    assert _counts_references(_loop_plain)  # (the plain caller itself counts)
+    assert not _counts_references(_energy_plain_first)
     assert not _counts_references(_loop_uncounted) and not _counts_references(_energy_uncounted)
     assert _counts_references(_energy_counted)
+    assert _energy_plain_first.targetoptions["_nrt"] is False
+    assert _energy_counted.targetoptions["_nrt"] is True
+
+
+@njit(entry=True, **jit.NO_REFCOUNT)
+def _loop_sum_of_ones(n: int, repeats: int) -> float:
+    s = 0.0
+    for _ in range(repeats):
+        s += _ones_sum(n)
+    return s
+
+
+@njit(refcount=True)
+def _ones_sum(n: int) -> float:
+    return _ones(n).sum()
+
+
+def test_a_kernel_that_makes_arrays_says_so_and_the_loop_may_call_it():
+    """A kernel that allocates (np.ones) compiles with refcount=True, gives its arrays to a
+    caller that counts, and frees them when a loop without counting calls it: the sum of n
+    ones is n, and 1,000 calls leave numba's allocations balanced."""
+    from numba.core.runtime import _nrt_python as nrt, rtsys
+
+    assert _sum_of_ones(4) == 4.0
+    _loop_sum_of_ones(3, 1)
+    was_on = nrt.memsys_stats_enabled()
+    nrt.memsys_enable_stats()
+    try:
+        before = rtsys.get_allocation_stats()
+        assert _loop_sum_of_ones(3, 1000) == 3000.0
+        after = rtsys.get_allocation_stats()
+    finally:
+        if not was_on:
+            nrt.memsys_disable_stats()
+    assert after.alloc - before.alloc == 1000
+    assert after.alloc - before.alloc == after.free - before.free
 
 
 def test_the_time_loop_counts_no_references_and_a_run_leaves_none_behind():

@@ -38,7 +38,7 @@ def _near(b, y, radius, n):
     return c
 
 
-@njit
+@njit(refcount=True)
 def _locate(b, y, radius, n):
     nfn = b.face_nodes.shape[1]
     out = np.empty(9)
@@ -63,7 +63,7 @@ def _motion(b, act, q, qd, n):
     return s
 
 
-@njit
+@njit(refcount=True)
 def _spread(b, act, nm, n):
     out = np.zeros(nm)
     for _ in range(n):
@@ -72,7 +72,7 @@ def _spread(b, act, nm, n):
     return out[0]
 
 
-@njit
+@njit(refcount=True)
 def _residual(b, act, n):
     n_act = act.shape[0]
     counts = np.zeros(max(n_act, 1), np.int64)

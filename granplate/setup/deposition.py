@@ -61,7 +61,7 @@ PROJECTION_SWEEPS = 100
 PROJECTION_TOL = 1e-13
 
 
-@njit(cache=True)
+@njit(refcount=True, cache=True)
 def cone_projection(normals: np.ndarray, m: int, g: np.ndarray, weights: np.ndarray) -> np.ndarray:
     """The projection of the direction g on the cone {u : n_k . u >= 0, k < m} of the
     first m unit normals: g + sum_k lambda_k n_k with lambda >= 0 (the least squares'),
@@ -239,7 +239,7 @@ def _margin(weights, touching, m: int) -> float:
     return low / total if total > 0.0 else 1.0
 
 
-@njit(cache=True)
+@njit(refcount=True, cache=True)
 def _settle_one(p, r, centres, radii, hax, axis, size, cell, ncell, head, nxt, cand, normals, kept, nudges) -> int:
     """Move the granule of radius r from p down its path of steepest descent until it
     rests (module docstring); p is updated in place. A rest whose weakest support carries
@@ -323,7 +323,7 @@ def _settle_one(p, r, centres, radii, hax, axis, size, cell, ncell, head, nxt, c
     return MAX_STEPS
 
 
-@njit(cache=True)
+@njit(refcount=True, cache=True)
 def deposit_frame(radii: np.ndarray, start: np.ndarray, size: np.ndarray, axis: int, cell: float, nudges: np.ndarray):
     """The granules of `radii` dropped in turn from `start` (n, d): its footprint coordinates
     (the height is set at release) in the box [0, size] whose floor is height 0 along `axis`;

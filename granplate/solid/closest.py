@@ -149,7 +149,8 @@ def _face_closest(X, kind, p, out, N, dN, d2N, x, J, K):
         best = _distance2(X, kind, p, xi, eta, N, dN, x, J)
         out[0] = xi
         out[1] = eta
-        out[2:5] = x
+        for c in range(3):
+            out[2 + c] = x[c]
         return best
     # the edges
     n_edges = 3 if kind == TRI6 else 4
@@ -178,7 +179,8 @@ def _face_closest(X, kind, p, out, N, dN, d2N, x, J, K):
             best = d2
             out[0] = ax + u * tx
             out[1] = ay + u * ty
-            out[2:5] = x
+            for c in range(3):
+                out[2 + c] = x[c]
     return best
 
 
@@ -245,7 +247,7 @@ def _lower_bound2(X, p):
     return gap * gap if gap > 0.0 else 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, refcount=True)  # (its scratch arrays)
 def slide_closest(nodes, kind, neighbours, face, p, out):
     """The closest point to p (3,) [m] on the surface near `face`: project onto the face and
     its neighbours (`face_neighbours`), move to the nearest, repeat until the face stays.
@@ -303,7 +305,7 @@ def follow_closest(nodes, kind, neighbours, face, p, out):
     return slide_closest(nodes, kind, neighbours, face, p, out)
 
 
-@njit(cache=True)
+@njit(refcount=True, cache=True)
 def _along_normal(X, kind, out) -> bool:
     """Whether the unit direction out[5:8] from the foot (out[0:2]) to the centre is the
     face's own outward normal there, to ALONG (`contact_frame`'s output)."""

@@ -114,7 +114,7 @@ def sensor_loads(b, buf, load):
             load[i] += 0.5 * b.geo[buf, i, GEO_N]
 
 
-@njit(cache=True, inline="always")
+@njit(refcount=True, cache=True, inline="always")
 def touching_contacts(y, q, b, buf, radius, delta0) -> int:
     """Each granule of state y (ng, 9) within REACH R of the body's bounding box located on
     its surface (buffer buf; every granule's row of geo and its HIST_END cleared first), and
@@ -151,7 +151,7 @@ def touching_contacts(y, q, b, buf, radius, delta0) -> int:
     return n_act
 
 
-@njit(cache=True, inline="always")
+@njit(refcount=True, cache=True, inline="always")
 def static_in_series(b, buf, n_act, delta0, clip, counts, upos):
     """The static forces of the n_act contacts in touch with the residual compliance in
     series (`solve_static`; without a residual, N_k = F(delta0_k)): counts[k] the terms of
@@ -226,7 +226,7 @@ def contact_response(k, y, qd, b, buf, mass, clip, acc, fdamp, scale_acc, rmat, 
     return ep, pv, wp
 
 
-@njit(cache=True)
+@njit(refcount=True, cache=True)
 def contact_forces(y, q, qd, b, buf, radius, mass, clip, acc, fdamp, scale_acc):
     """The body's contact forces at granule state y (ng, 9), modal displacement q and
     velocity qd (nm,) into buffer buf: each granule within REACH R of the body's bounding

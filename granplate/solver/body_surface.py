@@ -74,7 +74,7 @@ def patch_frame(nx, ny, nz):
     return t1x, t1y, t1z, ny * t1z - nz * t1y, nz * t1x - nx * t1z, nx * t1y - ny * t1x
 
 
-@njit(cache=True)
+@njit(refcount=True, cache=True)
 def locate(b, buf, i, p, out, N, dN) -> None:
     """Granule i's contact on the undeformed surface (docs/model.md section 3.9), centre p
     (3,) [m], into buffer buf: the closest point (face, face coordinates, signed distance,
@@ -163,7 +163,7 @@ def disc_patch(b, buf, i, x0, x1, x2, nx, ny, nz) -> None:
         b.grad[i, e, 2] = g2 - gn * nz
 
 
-@njit(cache=True)
+@njit(refcount=True, cache=True)
 def surface_velocity(b, buf, i, qd):
     """The surface's velocity at granule i's contact (buffer buf), its patch's weighted mean
     sum_e w_e Phi_e qd [m/s] (x, y, z)."""

@@ -83,7 +83,7 @@ P_N, P_NX, P_FT, P_DELTA = 0, 1, 4, 7
 N_PAIR = 8
 
 
-@njit(cache=True)
+@njit(refcount=True, cache=True)
 def adjacency(pairs, n):
     """Each granule's listed pairs, ascending: the pair indices items[start[i]:start[i + 1]]
     of granule i (a counting sort of the pair list)."""
@@ -246,7 +246,7 @@ def _drift(x, v, w, f, tq, mass, inertia, dt):
             x[i, k] += dt * v[i, k]
 
 
-@njit(parallel=True)
+@njit(refcount=True, parallel=True)
 def _kick(x, v, w, f, tq, touch, mass, inertia, dt, lam, keep, spin_keep, x_ref, reach2):
     """Cundall's damping of the touching granules' forces and torques (in f, tq), the second
     half kick, the background damping; returns how many granules moved reach [m] or more."""
@@ -350,7 +350,7 @@ def stiffness_sums(x, radius, pairs, pcoef, walls, wcoef, s):
     return out
 
 
-@njit(cache=True)
+@njit(refcount=True, cache=True)
 def wall_loads(x, radius, walls, wcoef, whist, s):
     """(nw, 4): each wall's elastic normal force [N] (positive in compression) and the
     tangential forces (3) [N] its contacts' histories exert on the granules, at rest."""
