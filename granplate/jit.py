@@ -73,8 +73,8 @@ class Kernel(CPUDispatcher):
     _entry_options: dict = {}
 
     def compile(self, sig):
-        """numba's compile; a kernel compiled without reference counting that fails to
-        (it makes arrays, or calls a kernel that does) gets a note saying so."""
+        """numba's compile; a kernel compiled without reference counting that fails to (it
+        makes arrays) gets a note saying so."""
         try:
             return super().compile(sig)
         except ForceLiteralArg:  # (numba asking for literal arguments: not a failure)
