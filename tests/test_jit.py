@@ -110,28 +110,22 @@ _energy_plain_first = _springs("_energy_plain_first")
 _energy_counted = _springs("_energy_counted", refcount=True)
 
 
-@njit(entry=True, **jit.NO_REFCOUNT)
-def _loop_uncounted(t: _Springs, n: int) -> float:
-    s = 0.0
-    for _ in range(n):
-        s += _energy_uncounted(t)
-    return s
+def _repeated(kernel, **options):
+    """An entry (compiled with `options`) summing kernel(t) over n calls: the shape of the
+    time loop calling a kernel at every step."""
+
+    def loop(t, n: int) -> float:
+        s = 0.0
+        for _ in range(n):
+            s += kernel(t)
+        return s
+
+    return njit(loop, entry=True, **options)
 
 
-@njit(entry=True)
-def _loop_plain(t: _Springs, n: int) -> float:
-    s = 0.0
-    for _ in range(n):
-        s += _energy_plain_first(t)
-    return s
-
-
-@njit(entry=True)
-def _loop_counted(t: _Springs, n: int) -> float:
-    s = 0.0
-    for _ in range(n):
-        s += _energy_counted(t)
-    return s
+_loop_uncounted = _repeated(_energy_uncounted, **jit.NO_REFCOUNT)
+_loop_plain = _repeated(_energy_plain_first)
+_loop_counted = _repeated(_energy_counted)
 
 
 @njit(refcount=True)
@@ -168,17 +162,12 @@ def test_a_kernel_counts_no_references_whoever_calls_it_first():
     assert _energy_counted.targetoptions["_nrt"] is True
 
 
-@njit(entry=True, **jit.NO_REFCOUNT)
-def _loop_sum_of_ones(n: int, repeats: int) -> float:
-    s = 0.0
-    for _ in range(repeats):
-        s += _ones_sum(n)
-    return s
-
-
 @njit(refcount=True)
 def _ones_sum(n: int) -> float:
     return _ones(n).sum()
+
+
+_loop_sum_of_ones = _repeated(_ones_sum, **jit.NO_REFCOUNT)
 
 
 def test_a_kernel_that_makes_arrays_says_so_and_the_loop_may_call_it():
