@@ -360,7 +360,7 @@ def test_threaded_energy_check_sums_the_kinetic_energies_in_blocks():
     """The threaded Verlet step's kinetic energies (solver.schemes.verlet
     step_kinetic_energies: blocks on every core) are the serial sums to round-off, the
     same bits each call."""
-    from granplate.solver.schemes.verlet import kinetic_energy_blocks
+    from granplate.solver.schemes.verlet_kicks import kinetic_energy_blocks
 
     m = build_model(packing(1, mu=0.0))
     g = m.granular
@@ -426,7 +426,7 @@ def test_watch_screened_by_the_measured_moves_reports_what_the_walk_does(case):
     are solver.contacts.largest_move's of its blocks, which cover every granule."""
     from granplate.solver.blocks import S_MOVED
     from granplate.solver.contacts import largest_move, watch_contacts
-    from granplate.solver.schemes.verlet import first_kick_blocks
+    from granplate.solver.schemes.verlet_kicks import first_kick_blocks
     from granplate.solver.state import ERR_CONTACT, ERR_JUMP, OK, REBUILD
 
     rng = np.random.default_rng(13)
@@ -526,7 +526,7 @@ def test_closing_kick_gives_the_kinetic_energies_of_the_kicked_state():
     bit for bit; without, the energy columns are left as they were."""
     from granplate.solver.blocks import S_KR, S_KX
     from granplate.solver.kicks import kick
-    from granplate.solver.schemes.verlet import closing_kick_blocks, kinetic_energy_blocks, kinetic_sums
+    from granplate.solver.schemes.verlet_kicks import closing_kick_blocks, kinetic_energy_blocks, kinetic_sums
 
     m = build_model(packing(1, mu=0.0))
     g = m.granular
@@ -559,7 +559,7 @@ def test_dividing_kick_is_the_division_then_the_kick(n_move, nc):
     after it, bit for bit; in space over blocks on threads too (closing_kick_blocks with
     `divide`)."""
     from granplate.solver.kicks import divide_kick, kick
-    from granplate.solver.schemes.verlet import closing_kick_blocks
+    from granplate.solver.schemes.verlet_kicks import closing_kick_blocks
 
     rng = np.random.default_rng(31)
     n = 40
@@ -618,10 +618,12 @@ def test_driven_packing_on_threads_equals_the_serial_loop(target):
 
 
 def test_serial_pass_notes_its_zero_rows_for_the_kicks():
-    """solver.schemes.verlet.note_quiet without blocks (one thread): an all-zero damping
-    buffer is noted quiet (the serial kicks then skip it and the loads' rows, to the same
-    bits: test_kicks_that_skip_zero_rows_change_no_bit), one nonzero damping number anywhere
-    in the velocity columns is not; the loads are quiet once the shock is over."""
+    """solver.schemes.verlet.note_quiet without blocks (one thread): after a pass without
+    viscous power an all-zero damping buffer is noted quiet (the serial kicks then skip it
+    and the loads' rows, to the same bits: test_kicks_that_skip_zero_rows_change_no_bit), one
+    nonzero damping number anywhere in the velocity columns is not; a pass with viscous
+    power damped a granule, so its buffer is not read; the loads are quiet once the shock
+    is over."""
     from granplate.model.inputs import no_body
     from granplate.solver.schemes.verlet import new_scratch, note_quiet
 
@@ -630,12 +632,14 @@ def test_serial_pass_notes_its_zero_rows_for_the_kicks():
     sw = new_scratch(ng, 0, 0)
     b = no_body(ng, 0)
     late = 10.0 * m.config.duration
-    note_quiet(sw, 1, late, b, m.config)
+    note_quiet(sw, 1, late, b, m.config, 0.0)
     assert sw.quiet[1, 0] == 1.0 and sw.quiet[1, 1] == 1.0
+    note_quiet(sw, 1, late, b, m.config, 1e-9)
+    assert sw.quiet[1, 0] == 1.0 and sw.quiet[1, 1] == 0.0
     sw.fdamp[1, ng - 1, 8] = 1e-30
-    note_quiet(sw, 1, late, b, m.config)
+    note_quiet(sw, 1, late, b, m.config, 0.0)
     assert sw.quiet[1, 1] == 0.0
     sw.fdamp[1, ng - 1, 8] = 0.0
     sw.fdamp[1, 0, 2] = 1.0  # a position column: not a kick's
-    note_quiet(sw, 1, late, b, m.config)
+    note_quiet(sw, 1, late, b, m.config, 0.0)
     assert sw.quiet[1, 1] == 1.0

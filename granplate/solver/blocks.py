@@ -84,9 +84,10 @@ S_MOVED, S_MOVES_READY = 26, 27
 S_UNDIVIDED, S_PUSHED = 28, 29
 N_SPAR = 30
 
-#: what a pair in touch costs the Mindlin pass beside one apart, less one (the weight the
-#: blocks are balanced by: `pair_blocks`; measured on the 10,192-sphere packing: a block's
-#: time grows by about four pairs apart per pair in touch)
+#: what a pair in touch costs a pass beside one apart, less one (the weight the blocks are
+#: balanced by: `pair_blocks`; measured on the 10,192-sphere packing: under Mindlin's law a
+#: block's time grows by about four pairs apart per pair in touch; the normal pass gave
+#: the same times with 1, 2, 4 or 8, all about 7% faster than blocks of equal pair counts)
 TOUCH_WEIGHT = 4.0
 
 
@@ -94,7 +95,8 @@ TOUCH_WEIGHT = 4.0
 #: apart (Mindlin's), dealt out in turn (thread t of T runs blocks t, t + T, ...): the
 #: contacts in touch gather where a wave has reached, and granules are often numbered along
 #: the direction it travels, so each thread then takes slabs across the packing rather than
-#: one half of it (docs/benchmarks.md). The normal pass runs one block per thread.
+#: one half of it (docs/benchmarks.md). The normal pass runs one block per thread (balanced
+#: too: `pair_forces_blocks`).
 BLOCKS_PER_THREAD = 4
 
 
@@ -127,7 +129,7 @@ def granule_block(spar, nt, t, s, n):
 
 
 @njit(cache=True)
-def pair_blocks(spar, nb, n_p, balanced):
+def pair_blocks(spar, nb, n_p, balanced, weight=TOUCH_WEIGHT):
     """The pairs [spar[k, S_PLO], spar[k, S_PHI]) of each block k of nb over the n_p listed
     pairs, before a pass: `block_range`'s equal shares, or (`balanced`, and the last pass
     ran over as many pairs) shares of equal cost by the last pass's counts of pairs in
@@ -143,17 +145,17 @@ def pair_blocks(spar, nb, n_p, balanced):
         return
     total = 0.0
     for k in range(nb):
-        total += (spar[k, S_PHI] - spar[k, S_PLO]) + TOUCH_WEIGHT * spar[k, S_TOUCH]
+        total += (spar[k, S_PHI] - spar[k, S_PLO]) + weight * spar[k, S_TOUCH]
     k = 0
     below = 0.0  # the cost of the old blocks before block k
     start = 0
     for j in range(1, nb):
         target = total * j / nb
-        while k < nb - 1 and below + (spar[k, S_PHI] - spar[k, S_PLO]) + TOUCH_WEIGHT * spar[k, S_TOUCH] <= target:
-            below += (spar[k, S_PHI] - spar[k, S_PLO]) + TOUCH_WEIGHT * spar[k, S_TOUCH]
+        while k < nb - 1 and below + (spar[k, S_PHI] - spar[k, S_PLO]) + weight * spar[k, S_TOUCH] <= target:
+            below += (spar[k, S_PHI] - spar[k, S_PLO]) + weight * spar[k, S_TOUCH]
             k += 1
         lo, hi = spar[k, S_PLO], spar[k, S_PHI]
-        cost = (hi - lo) + TOUCH_WEIGHT * spar[k, S_TOUCH]
+        cost = (hi - lo) + weight * spar[k, S_TOUCH]
         cut = lo + (hi - lo) * min(max((target - below) / cost, 0.0), 1.0) if cost > 0.0 else lo
         edge = min(max(int(cut), start), n_p)
         spar[j - 1, S_EDGE] = edge
@@ -246,13 +248,14 @@ def thread_pairs(yv, yn, h, g, cfg, t, nb, fpar, spar, acc, fdamp, fload, tangen
 @njit(parallel=True)
 def pair_forces_blocks(y, g, cfg, fpar, spar, acc, fdamp, fload, commit_t):
     """The normal forces of every listed granule pair at state y (space), one block per
-    thread (`thread_pairs`): block k clears its own granules' rows of acc, fdamp and fload
+    thread (`thread_pairs`), the blocks of equal cost by the last pass's counts of pairs in
+    touch (`pair_blocks`: a wave puts them in one part of the packing): block k clears its own granules' rows of acc, fdamp and fload
     and puts its pairs' forces on them there, on other granules into its thread's buffer
     fpar[k] (one block per thread: k = t); its viscous power, stored energy, plastic work
     and largest overlap into spar[k]; each pair's overlap into HIST_END, committed at
     commit_t [s] (as solver.granular3d.normal_forces)."""
     nt = fpar.shape[0]
-    pair_blocks(spar, nt, g.pair_ij.shape[0], False)
+    pair_blocks(spar, nt, g.pair_ij.shape[0], True)
     for t in prange(nt):
         thread_pairs(y, y, 0.0, g, cfg, t, nt, fpar, spar, acc, fdamp, fload, False, commit_t)
 

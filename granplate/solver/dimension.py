@@ -102,8 +102,10 @@ def kinetic_energies(y, g):
     raise NotImplementedError("compiled use only")
 
 
-def kinetic_energies_part(y, g, lo, hi):
-    """(KE_x, KE_y, KE_z, KE_rot) [J] of granules lo..hi-1 (`kinetic_energies` of a range)."""
+def kinetic_energies_part(y, g, lo, hi, sums):
+    """(KE_x, KE_y, KE_z, KE_rot) [J] of granules lo..hi-1 added in granule order to sums
+    (those four of the granules before: (0.0, 0.0, 0.0, 0.0) to start; `kinetic_energies`
+    of a range, carried over consecutive ranges bit for bit the whole range's)."""
     raise NotImplementedError("compiled use only")
 
 
@@ -173,7 +175,7 @@ def _kinetic_energies(y, g):
 
 
 @overload(kinetic_energies_part, inline="always")
-def _kinetic_energies_part(y, g, lo, hi):
+def _kinetic_energies_part(y, g, lo, hi, sums):
     return _own(g, "kinetic_energies_part")
 
 
@@ -255,8 +257,8 @@ def _space_kinetic_energies():
 def _plane_kinetic_energies_part():
     fn = plane.kinetic_energies
 
-    def plane_part(y, g, lo, hi):
-        kx, ky, kr = fn(y[lo:hi], g.mass[lo:hi], g.inertia[lo:hi])
+    def plane_part(y, g, lo, hi, sums):
+        kx, ky, kr = fn(y[lo:hi], g.mass[lo:hi], g.inertia[lo:hi], sums[0], sums[1], sums[3])
         return kx, ky, 0.0, kr
 
     return plane_part
@@ -264,7 +266,7 @@ def _plane_kinetic_energies_part():
 
 def _space_kinetic_energies_part():
     fn3 = space.kinetic_energies
-    return lambda y, g, lo, hi: fn3(y[lo:hi], g.mass[lo:hi], g.inertia[lo:hi])
+    return lambda y, g, lo, hi, sums: fn3(y[lo:hi], g.mass[lo:hi], g.inertia[lo:hi], sums[0], sums[1], sums[2], sums[3])
 
 
 #: the factories of the hooks that differ, by the dimension's name and the hook's name

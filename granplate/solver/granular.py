@@ -434,12 +434,10 @@ def force_error(k1, k0, kend, ratio, mass, inertia, radius, sc, err):
 
 
 @njit(cache=True)
-def kinetic_energies(y, mass, inertia):
-    """Horizontal, vertical and rotational kinetic energy of the granules [J] (eq. 10).
-    (Arrays, not the model tuple: this runs every step.)"""
-    kx = 0.0
-    ky = 0.0
-    kr = 0.0
+def kinetic_energies(y, mass, inertia, kx=0.0, ky=0.0, kr=0.0):
+    """Horizontal, vertical and rotational kinetic energy of the granules [J] (eq. 10),
+    added in granule order to kx, ky, kr (those of granules before these: a range's sums
+    carried on). (Arrays, not the model tuple: this runs every step.)"""
     for i in range(y.shape[0]):
         kx += 0.5 * mass[i] * y[i, 3] * y[i, 3]
         ky += 0.5 * mass[i] * y[i, 4] * y[i, 4]

@@ -271,13 +271,10 @@ def wall_derivative(y, g, cfg, dy, split, record, p_visc, e_pot, w_plastic, p_fr
 
 
 @njit(cache=True)
-def kinetic_energies(y, mass, inertia):
+def kinetic_energies(y, mass, inertia, kx=0.0, ky=0.0, kz=0.0, kr=0.0):
     """Kinetic energy of the granules along x, y, z and of their spins [J]: (KE_x, KE_y,
-    KE_z, KE_rot)."""
-    kx = 0.0
-    ky = 0.0
-    kz = 0.0
-    kr = 0.0
+    KE_z, KE_rot), added in granule order to kx, ky, kz, kr (those of granules before these:
+    a range's sums carried on)."""
     for i in range(y.shape[0]):
         kx += 0.5 * mass[i] * y[i, VX] * y[i, VX]
         ky += 0.5 * mass[i] * y[i, VY] * y[i, VY]

@@ -32,9 +32,10 @@ BODY_MODEL = (
 #: sized by the thread count, which a restart may change)
 BLOCKS = frozenset({"sw.fpar", "sw.spar"})
 #: scratch rewritten before every use (the threaded contact watch's flags, sized by the
-#: thread count), and the Verlet kicks' hints which rows are zero (a restart starts without
-#: them: its kicks read every row, to the same sums)
-SCRATCH = frozenset({"b.mrow", "sw.quiet", "w.wflag"})
+#: thread count), and the Verlet kicks' hints which rows are zero and measures for the
+#: checks after a step (a restart starts without them: its kicks read every row, to the
+#: same sums, and the checks measure for themselves)
+SCRATCH = frozenset({"b.mrow", "sw.quiet", "sw.notes", "w.wflag"})
 LEFT_OUT = CACHES | BLOCKS | SCRATCH | {f"b.{name}" for name in BODY_MODEL}
 #: the prefix the elastic body's state had in snapshots written when the scheme's scratch
 #: held it (read as "b.")

@@ -41,7 +41,6 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import prange
 
 from granplate.jit import njit
 
@@ -52,27 +51,19 @@ from granplate.solver.schemes import verlet_body as VB
 from granplate.physics.shock import shock_amplitude
 from granplate.solver.blocks import (
     N_FPAR,
-    BLOCKS_PER_THREAD,
     N_SPAR,
     S_DEALT,
-    S_KR,
-    S_KX,
     S_DAMPED,
     S_KE_READY,
     S_MOVED,
     S_MOVES_READY,
     S_UNDIVIDED,
-    S_WDAMP,
-    S_WLOAD,
     S_ZERO_ACC,
     S_ZERO_DAMP,
     S_ZERO_LOADS,
     block_count,
     copy_rows,
-    granule_block,
-    work_sums,
 )
-from granplate.solver.contacts import largest_move as block_largest_move
 from granplate.solver.dimension import (
     friction_flow,
     kinetic_energies_part,
@@ -91,17 +82,29 @@ from granplate.solver.drives import (
     wall_shift_energy,
 )
 from granplate.solver.granular import commit_history
-from granplate.solver.kicks import divide_kick, kick, kick_drift
 from granplate.solver.ladder import step_to_output
+from granplate.solver.schemes.verlet_kicks import (
+    N_DRIFT,
+    N_NOTES,
+    NOTE_KE_READY,
+    NOTE_KR,
+    NOTE_KX,
+    NOTE_KY,
+    NOTE_KZ,
+    NOTE_MOVED,
+    NOTE_MOVES_READY,
+    closing_kick_blocks,
+    closing_kick_serial,
+    first_kick_blocks,
+    first_kick_serial,
+    kinetic_energy_blocks,
+    kinetic_sums,
+)
 
 from granplate.solver.state import T_TRIAL
 from granplate.solver.state import PARTNER_BODY as PARTNER_BODY
 
 NAME = "verlet"
-#: the state's leading columns that drift (x, y, theta in the plane; x, y, z in space),
-#: each at the rate held N_DRIFT columns to its right; the columns from N_DRIFT on are
-#: velocities and spins, which the kicks change.
-N_DRIFT = 3
 #: the scratch's per-granule arrays have room for the widest state (space's).
 N_COLUMNS = max(STATE_COLUMNS.values())
 #: columns of Scratch.split: friction time owed [s], order of the next friction pass
@@ -120,6 +123,7 @@ class Scratch(NamedTuple):
     fpar: np.ndarray  # (threads, ng, N_FPAR) each thread's buffered forces on granules other blocks own [N] (solver.blocks; (0, 0, 0): serial)
     spar: np.ndarray  # (nb, N_SPAR) each block's sums (solver.blocks.block_count)
     quiet: np.ndarray  # (2, 2) per buffer: 1 where its loads (column 0), its damping forces (1) are all zero
+    notes: np.ndarray  # (N_NOTES,) the serial kicks' measures (NOTE_*)
 
 
 def new_scratch(ng: int, nm: int, nk: int, body: BodyArrays | None = None, threads: int = 1) -> Scratch:
@@ -136,6 +140,7 @@ def new_scratch(ng: int, nm: int, nk: int, body: BodyArrays | None = None, threa
         fpar=np.zeros((threads if nb else 0, ng if nb else 0, N_FPAR)),
         spar=np.zeros((nb, N_SPAR)),
         quiet=np.zeros((2, 2)),
+        notes=np.zeros(N_NOTES),
     )
 
 
@@ -207,16 +212,20 @@ def force_pass(t, yv, yn, h, g, cfg, sw, buf, acc, commit_t, cleared=False, divi
 
 
 @njit(cache=True)
-def note_quiet(sw, buf, t, b, cfg):
-    """After the force pass at t [s] into buffer buf (the elastic body's too): whether its
-    loads are all zero (none on the granules: the shock on the plate, or its amplitude 0
-    at t) and its damping forces (no granule given one by the threaded pass in space, no
-    elastic body), in sw.quiet[buf]; the kicks then skip reading them (the threaded passes
-    leave them uncleared too: solver.blocks). The threaded pass counted the granules it
-    damped; the serial one's damping rows are read once here (`rows_zero`), where the two
-    kicks would read them and the loads' rows."""
+def note_quiet(sw, buf, t, b, cfg, p_visc):
+    """After the force pass at t [s] into buffer buf (the elastic body's too), whose viscous
+    power was p_visc [W]: whether its loads are all zero (none on the granules: the shock on
+    the plate, or its amplitude 0 at t) and its damping forces (no granule given one by the
+    threaded pass in space, no elastic body), in sw.quiet[buf]; the kicks then skip reading
+    them (the threaded passes leave them uncleared too: solver.blocks). The threaded pass
+    counted the granules it damped. The serial one damped some where its viscous power is
+    not zero (each contact's damping adds its power); else its damping rows are read once
+    here (`rows_zero`), where the two kicks would read them and the loads' rows."""
     sw.quiet[buf, 0] = 1.0 if cfg.load_on_plate or shock_amplitude(t, cfg) == 0.0 else 0.0
-    undamped = sw.spar[0, S_DAMPED] == 0.0 if sw.spar.shape[0] > 0 else rows_zero(sw.fdamp[buf])
+    if sw.spar.shape[0] > 0:
+        undamped = sw.spar[0, S_DAMPED] == 0.0
+    else:
+        undamped = p_visc == 0.0 and rows_zero(sw.fdamp[buf])
     sw.quiet[buf, 1] = 1.0 if undamped and not B.has_body(b) else 0.0
 
 
@@ -276,9 +285,9 @@ def start_state(y, st, b, sw, copy):
 def first_forces(t, st, g, b, cfg, sw, cur):
     """t_n's forces, loads and damping on the run's first step (st.k1 as `initialise` has
     it; Mindlin's law with the committed histories), the body's too."""
-    force_pass(t, st.y, st.y, 0.0, g, cfg, sw, cur, st.k1, -1.0)
+    pr, _, _ = force_pass(t, st.y, st.y, 0.0, g, cfg, sw, cur, st.k1, -1.0)
     VB.first_forces(st.y, b, cur, st, g, cfg, st.k1, sw.fdamp)
-    note_quiet(sw, cur, t, b, cfg)
+    note_quiet(sw, cur, t, b, cfg, pr.p_visc)
     finish_pass(st.y, st.k1, g)
 
 
@@ -317,6 +326,8 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
     if threaded:
         sw.spar[0, S_KE_READY] = 0.0
         sw.spar[0, S_MOVES_READY] = 0.0
+    sw.notes[NOTE_KE_READY] = 0.0
+    sw.notes[NOTE_MOVES_READY] = 0.0
     y = st.y if in_place else w.ynew
     kend = st.k1 if in_place else w.kend  # (st.k1, t_n's, is read before the force pass)
     friction = has_friction(g, cfg) or VB.body_friction(b)
@@ -346,9 +357,9 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
         )  # fmt: skip
         sw.spar[0, S_MOVES_READY] = 1.0  # (the positions move in this kick alone)
     else:
-        wl, wd = kick_drift(
-            y0, y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, N_DRIFT, 0, y.shape[0], predict, loads, damped,
-            in_place,
+        wl, wd = first_kick_serial(
+            y0, y, st.k1, sw.fdamp[cur], sw.fload[cur], h, w.ytmp, predict, loads, damped, in_place, w.yref,
+            cfg.dimension, sw.notes,
         )  # fmt: skip
     wl, wd, w_grav = VB.first_kick(b, t, h, cur, cfg, wl, wd, w_grav)
     # (Mindlin: the slip over h at the half step's velocities, y's)
@@ -358,26 +369,25 @@ def attempt(sw, t, h, slot, st, g, p, b, cfg, w):
         y, w.ytmp, st, b, cur, nxt, h, g, cfg, kend, sw.fdamp,
         pr.e_pot + e_t, pr.p_visc, pr.w_plastic, fric + lost_t, pr.ovl, pr.ovl_i, pr.ovl_j,
     )  # fmt: skip
-    note_quiet(sw, nxt, t + h, b, cfg)
+    note_quiet(sw, nxt, t + h, b, cfg, p_visc)
     finish_pass(w.ytmp, kend, g)  # gravity and the drives
     _, pd1 = wall_powers(g)
     w_drive += drive_kick_work(y, kend, g, hk)
     w_grav += gravity_kick_work(y, kend, g, hk)
     loads, damped = sw.quiet[nxt, 0] == 0.0, sw.quiet[nxt, 1] == 0.0
-    if threaded:  # (with the kinetic energies, where nothing moves the velocities after the kick)
-        energies = g.drive_target.shape[0] == 0 and not (friction and sw.split[LAND] != 0.0)
+    # (with the kinetic energies, where nothing moves the velocities after the kick)
+    energies = g.drive_target.shape[0] == 0 and not (friction and sw.split[LAND] != 0.0)
+    if threaded:
         wl2, wd2 = closing_kick_blocks(
             y, kend, sw.fdamp[nxt], sw.fload[nxt], hk, kend, N_DRIFT, sw.spar, loads, damped, g, energies, divides,
             cfg.dimension,
         )  # fmt: skip
         sw.spar[0, S_KE_READY] = 1.0 if energies else 0.0
-    elif divides:
-        wl2, wd2 = divide_kick(
-            y, kend, sw.fdamp[nxt], sw.fload[nxt], hk, kend, N_DRIFT, cfg.dimension, g.mass, g.inertia, 0, y.shape[0],
-            loads, damped,
-        )  # fmt: skip
     else:
-        wl2, wd2 = kick(y, kend, sw.fdamp[nxt], sw.fload[nxt], hk, kend, N_DRIFT, 0, y.shape[0], loads, damped)
+        wl2, wd2 = closing_kick_serial(
+            y, kend, sw.fdamp[nxt], sw.fload[nxt], hk, kend, loads, damped, g, energies, divides, cfg.dimension,
+            sw.notes,
+        )  # fmt: skip
     wp2, dp2 = piston_kick(g, hk)
     w_piston += wp2
     d_piston += dp2
@@ -446,103 +456,30 @@ def step_kinetic_energies(sw, y, g):
             sw.spar[0, S_KE_READY] = 0.0
             return kinetic_sums(sw.spar)
         return kinetic_energy_blocks(y, g, sw.spar)
-    return kinetic_energies_part(y, g, 0, y.shape[0])
-
-
-@njit(parallel=True)
-def kinetic_energy_blocks(y, g, spar):
-    """The kinetic energies of the granules in the blocks of spar's rows
-    (solver.blocks.granule_block: each thread's blocks dealt as its pair blocks), each block's into spar[k, S_KX:S_KR + 1], summed in block order: deterministic
-    for a given thread count, the serial sums' to round-off."""
-    nt = spar.shape[0] // BLOCKS_PER_THREAD
-    for t in prange(nt):
-        for s in range(BLOCKS_PER_THREAD):
-            k, lo, hi = granule_block(spar, nt, t, s, y.shape[0])
-            block_kinetic_energies(y, g, spar, k, lo, hi)
-    return kinetic_sums(spar)
-
-
-@njit(cache=True, inline="always")
-def block_kinetic_energies(y, g, spar, k, lo, hi):
-    """The kinetic energies of granules lo..hi-1 (block k) into spar[k, S_KX:S_KR + 1]."""
-    kx, ky, kz, kr = kinetic_energies_part(y, g, lo, hi)
-    spar[k, S_KX] = kx
-    spar[k, S_KX + 1] = ky
-    spar[k, S_KX + 2] = kz
-    spar[k, S_KR] = kr
-
-
-@njit(cache=True)
-def kinetic_sums(spar):
-    """(KE_x, KE_y, KE_z, KE_rot) [J]: the blocks' (spar[k, S_KX:S_KR + 1]) in block order."""
-    nb = spar.shape[0]
-    kx = 0.0
-    ky = 0.0
-    kz = 0.0
-    kr = 0.0
-    for k in range(nb):
-        kx += spar[k, S_KX]
-        ky += spar[k, S_KX + 1]
-        kz += spar[k, S_KX + 2]
-        kr += spar[k, S_KR]
-    return kx, ky, kz, kr
-
-
-@njit(parallel=True)
-def first_kick_blocks(y0, y, acc, fdamp, fload, h, ypred, spar, predict, loads, damped, clear, yref, ndim):
-    """solver.kicks.kick_drift from y0 into y over blocks of granules (each granule's update
-    is the serial one's, bit for bit; the work sums per block into spar[k], S_WLOAD and
-    S_WDAMP; fload and fdamp read only where `loads` and `damped`; acc's kicked columns
-    zeroed as they are read where `clear`), each thread's blocks those of the pair pass's
-    blocks (solver.blocks.granule_block); each block's largest squared move since the
-    contact list's reference yref (its first ndim columns) [m^2] into spar[k, S_MOVED] while
-    its rows are at hand (`largest_move`: the contact watch's screen). Returns (the load's work, the damping
-    force's work) [J], summed in block order."""
-    nt = spar.shape[0] // BLOCKS_PER_THREAD
-    for t in prange(nt):
-        for s in range(BLOCKS_PER_THREAD):
-            k, lo, hi = granule_block(spar, nt, t, s, y.shape[0])
-            spar[k, S_WLOAD], spar[k, S_WDAMP] = kick_drift(
-                y0, y, acc, fdamp, fload, h, ypred, N_DRIFT, lo, hi, predict, loads, damped, clear
-            )
-            spar[k, S_MOVED] = block_largest_move(y, yref, lo, hi, ndim)
-    return work_sums(spar)
+    if sw.notes[NOTE_KE_READY] != 0.0:
+        sw.notes[NOTE_KE_READY] = 0.0
+        n = sw.notes
+        return n[NOTE_KX], n[NOTE_KY], n[NOTE_KZ], n[NOTE_KR]
+    return kinetic_energies_part(y, g, 0, y.shape[0], (0.0, 0.0, 0.0, 0.0))
 
 
 @njit(cache=True)
 def largest_move(sw) -> float:
     """The largest squared move of a granule since the contact list's reference [m^2], which
-    the threaded step's first kick measured (`first_kick_blocks`), the blocks' largest;
-    -1 where it did not (the serial step, or read already): the contact watch measures."""
-    if sw.spar.shape[0] == 0 or sw.spar[0, S_MOVES_READY] == 0.0:
+    the step's first kick measured (`first_kick_blocks` in blocks, the blocks' largest;
+    `first_kick_serial`); -1 where it did not (read already): the contact watch measures."""
+    if sw.spar.shape[0] == 0:
+        if sw.notes[NOTE_MOVES_READY] == 0.0:
+            return -1.0
+        sw.notes[NOTE_MOVES_READY] = 0.0
+        return sw.notes[NOTE_MOVED]
+    if sw.spar[0, S_MOVES_READY] == 0.0:
         return -1.0
     sw.spar[0, S_MOVES_READY] = 0.0
     d2 = 0.0
     for k in range(sw.spar.shape[0]):
         d2 = max(d2, sw.spar[k, S_MOVED])
     return d2
-
-
-@njit(parallel=True)
-def closing_kick_blocks(y, acc, fdamp, fload, hk, dy, n_drift, spar, loads, damped, g, energies, divide, n_move):
-    """solver.kicks.kick over blocks of granules (as `first_kick_blocks`; where `divide`,
-    solver.kicks.divide_kick from the pass's forces, n_move velocity columns by the mass),
-    and where `energies` each block's kinetic energies at the kicked state while its rows
-    are at hand (`block_kinetic_energies`: a pass over the granules fewer). Returns (the
-    load's work, the damping force's work) [J], summed in block order."""
-    nt = spar.shape[0] // BLOCKS_PER_THREAD
-    for t in prange(nt):
-        for s in range(BLOCKS_PER_THREAD):
-            k, lo, hi = granule_block(spar, nt, t, s, y.shape[0])
-            if divide:
-                spar[k, S_WLOAD], spar[k, S_WDAMP] = divide_kick(
-                    y, acc, fdamp, fload, hk, dy, n_drift, n_move, g.mass, g.inertia, lo, hi, loads, damped
-                )
-            else:
-                spar[k, S_WLOAD], spar[k, S_WDAMP] = kick(y, acc, fdamp, fload, hk, dy, n_drift, lo, hi, loads, damped)
-            if energies:
-                block_kinetic_energies(y, g, spar, k, lo, hi)
-    return work_sums(spar)
 
 
 @njit(cache=True)
