@@ -129,7 +129,7 @@ def granule_block(spar, nt, t, s, n):
 
 
 @njit(cache=True)
-def pair_blocks(spar, nb, n_p, balanced, weight=TOUCH_WEIGHT):
+def pair_blocks(spar, nb, n_p, balanced):
     """The pairs [spar[k, S_PLO], spar[k, S_PHI]) of each block k of nb over the n_p listed
     pairs, before a pass: `block_range`'s equal shares, or (`balanced`, and the last pass
     ran over as many pairs) shares of equal cost by the last pass's counts of pairs in
@@ -145,17 +145,17 @@ def pair_blocks(spar, nb, n_p, balanced, weight=TOUCH_WEIGHT):
         return
     total = 0.0
     for k in range(nb):
-        total += (spar[k, S_PHI] - spar[k, S_PLO]) + weight * spar[k, S_TOUCH]
+        total += (spar[k, S_PHI] - spar[k, S_PLO]) + TOUCH_WEIGHT * spar[k, S_TOUCH]
     k = 0
     below = 0.0  # the cost of the old blocks before block k
     start = 0
     for j in range(1, nb):
         target = total * j / nb
-        while k < nb - 1 and below + (spar[k, S_PHI] - spar[k, S_PLO]) + weight * spar[k, S_TOUCH] <= target:
-            below += (spar[k, S_PHI] - spar[k, S_PLO]) + weight * spar[k, S_TOUCH]
+        while k < nb - 1 and below + (spar[k, S_PHI] - spar[k, S_PLO]) + TOUCH_WEIGHT * spar[k, S_TOUCH] <= target:
+            below += (spar[k, S_PHI] - spar[k, S_PLO]) + TOUCH_WEIGHT * spar[k, S_TOUCH]
             k += 1
         lo, hi = spar[k, S_PLO], spar[k, S_PHI]
-        cost = (hi - lo) + weight * spar[k, S_TOUCH]
+        cost = (hi - lo) + TOUCH_WEIGHT * spar[k, S_TOUCH]
         cut = lo + (hi - lo) * min(max((target - below) / cost, 0.0), 1.0) if cost > 0.0 else lo
         edge = min(max(int(cut), start), n_p)
         spar[j - 1, S_EDGE] = edge
