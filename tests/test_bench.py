@@ -189,6 +189,33 @@ def test_scaling_in_space_mindlin_rows_run_lammps_at_our_step():
     assert lm["agreement"] < 1e-12 and S.lammps_error(lm).startswith("same step and law")
 
 
+def test_scaling_in_space_rows_past_the_reference_run_lammps_at_our_step():
+    """A frictionless row too big for the RK4 reference (as 10^6 spheres are; here one cell
+    marked so) keeps its velocities at t_end under velocity Verlet, and LAMMPS at granplate's
+    step is one algorithm with ours: the velocities agree to round-off (where LAMMPS is
+    installed). Its output times fall on its steps, which LAMMPS does not cut (2 us of 40 ns
+    steps in 10 intervals, not 20). Under the implicit scheme no such row runs LAMMPS."""
+    from granplate.bench import scaling_space as S
+    from granplate.verification import lammps as L
+
+    assert S.lammps_at_our_step(0.0, "tanh", "verlet", big=True)
+    assert not S.lammps_at_our_step(0.0, "tanh", "verlet", big=False)  # (halved to the reference's error)
+    assert not S.lammps_at_our_step(0.0, "tanh", "implicit", big=True)
+    assert not S.lammps_at_our_step(0.1, "tanh", "verlet", big=True)
+    assert S.lammps_at_our_step(0.1, "mindlin", "verlet", big=True)
+    assert S.outputs_on_steps(2e-6, 4e-8, 20) == 10 and S.outputs_on_steps(2e-5, 4e-8, 20) == 20
+    spec = {"cells": [1, 1, 1], "mu": 0.0, "t_end": 2e-6, "scheme": "verlet", "law": "tanh", "reference": "skip"}
+    row = S._ours_worker({**spec, "outputs": 20})
+    assert row["n_steps"] == round(2e-6 / row["dt_s"]) == 50  # (20 output times would cut 10 steps)
+    assert "error" not in row and "reference" not in row and len(row["final"]["vx"]) == 4
+    assert max(abs(v) for v in row["final"]["vy"]) > 0.05  # (the launched plane has pushed the others aside)
+    lm = S._lammps_same_law_worker({**spec, "dt_s": row["dt_s"], "final": row["final"]})
+    if L.unavailable():
+        assert "skipped" in lm
+        return
+    assert lm["n_steps"] == row["n_steps"] and lm["agreement"] < 1e-12
+
+
 def test_scaling_in_space_options_are_checked(capsys):
     """In space --sizes takes FCC cells NXxNYxNZ; --dimension is 2 or 3; --scheme is any
     registered scheme (model.inputs.SCHEME_NAMES), another a user error naming them all;

@@ -200,7 +200,8 @@ def scaling_options(b) -> None:
     b.add_argument(
         "--mu",
         help="with --scaling --dimension 3: comma-separated friction coefficients, rows each "
-        "(default 0,0.099); a size above 100,000 spheres runs without the reference and LAMMPS",
+        "(default 0,0.099); a size above 100,000 spheres runs without the reference, and "
+        "LAMMPS runs it at our step under --scheme verlet (frictionless, or --friction-law mindlin)",
     )
     b.add_argument(
         "--friction-law",

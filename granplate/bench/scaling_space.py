@@ -18,6 +18,8 @@ error max |v - v_ref| / SPEED over the spheres' three velocity components at t_e
 its error against the same v_ref is at most ours. The rows with friction under a law LAMMPS
 has, under velocity Verlet (Mindlin's, `same_law`), are one algorithm in both codes: LAMMPS
 runs them at our step and law, and the row says how far apart the two codes' velocities end.
+So do the frictionless rows of more than REFERENCE_MAX_SPHERES spheres under velocity
+Verlet, which have no reference to halve LAMMPS's step against (`lammps_at_our_step`).
 """
 
 from __future__ import annotations
@@ -46,8 +48,9 @@ SIZES: tuple[tuple[int, int, int], ...] = ((3, 1, 1), (3, 3, 3), (6, 6, 7), (9, 
 #: Sites per conventional FCC cell.
 FCC_SITES = 4
 #: Rows of more spheres than this run without the reference (RK4 at REFERENCE_DT), so
-#: without an error and LAMMPS's columns, and keep the outputs at t = 0 and t_end alone:
-#: what they time is the loop's cost per contact-step and the memory a million spheres take.
+#: without an error, and keep the outputs at t = 0 and t_end alone: what they time is the
+#: loop's cost per contact-step and the memory a million spheres take. Under velocity
+#: Verlet LAMMPS runs them at our step (`lammps_at_our_step`): one algorithm, so one accuracy.
 REFERENCE_MAX_SPHERES = 100_000
 
 
@@ -113,6 +116,25 @@ def same_law(law: str, scheme: str) -> bool:
     return scheme == "verlet" and law in LAMMPS_TANGENTIAL
 
 
+def lammps_at_our_step(mu: float, law: str, scheme: str, big: bool) -> bool:
+    """Whether LAMMPS runs a row at granplate's own step (and the row keeps its velocities
+    at t_end to compare): the rows with friction under a law LAMMPS has under our
+    integrator (`same_law`), and, under velocity Verlet, the frictionless rows too big for
+    the reference (`big`: above REFERENCE_MAX_SPHERES), where no step-halving to a
+    reference's error can be done: velocity Verlet at one step is one algorithm in both codes."""
+    if mu > 0.0:
+        return same_law(law, scheme)
+    return big and scheme == "verlet"
+
+
+def outputs_on_steps(t_end: float, dt: float, outputs: int) -> int:
+    """The most output intervals, at most `outputs`, that each hold a whole number of steps
+    dt [s] to t_end [s]: granplate cuts a step to land on an output time, which LAMMPS run
+    at one fixed step does not, so a row that LAMMPS runs at our step takes these."""
+    n = max(1, round(t_end / dt))
+    return max(k for k in range(1, max(1, outputs) + 1) if n % k == 0)
+
+
 def _warm_up(scheme: str) -> None:
     """Load the compiled 3D kernels of `scheme` and of the reference's paper scheme (1 us runs)."""
     from granplate.results.run import simulate
@@ -155,9 +177,12 @@ def _ours_worker(spec: dict) -> dict:
     _warm_up(spec["scheme"])
     cells = tuple(spec["cells"])
     law = spec.get("law", "tanh") if spec["mu"] > 0.0 else "tanh"
-    s = launched_fcc(
-        cells, mu=spec["mu"], t_end=spec["t_end"], scheme=spec["scheme"], outputs=spec.get("outputs", 20), law=law
-    )
+    outputs = spec.get("outputs", 20)
+    s = launched_fcc(cells, mu=spec["mu"], t_end=spec["t_end"], scheme=spec["scheme"], outputs=outputs, law=law)
+    at_our_step = lammps_at_our_step(spec["mu"], law, spec["scheme"], skip)
+    if at_our_step and outputs_on_steps(spec["t_end"], s.time.dt_max, outputs) != outputs:  # (LAMMPS: no cut step)
+        outputs = outputs_on_steps(spec["t_end"], s.time.dt_max, outputs)
+        s = launched_fcc(cells, mu=spec["mu"], t_end=spec["t_end"], scheme=spec["scheme"], outputs=outputs, law=law)
     s = dataclasses.replace(s, solver=dataclasses.replace(s.solver, threads=spec.get("threads")))
     load = os.getloadavg()[0]
     before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # [KiB]: the imports and compiled kernels
@@ -207,7 +232,7 @@ def _ours_worker(spec: dict) -> dict:
         "threads": int(ds.attrs.get("threads", 1)),
         "loop_s_runs": [r[0] for r in runs],
     }
-    if spec["mu"] > 0.0 and same_law(law, spec["scheme"]) and not skip:  # LAMMPS runs this step and law
+    if at_our_step:  # LAMMPS runs this step and law
         out["final"] = {k: ds[k].values[-1].tolist() for k in ("vx", "vy", "vz")}
         out["dt_s"] = float(s.time.dt_max)
     if spec["mu"] == 0.0 and not skip:
@@ -377,7 +402,7 @@ def _space_row(
             "scaling_space", "_lammps_worker", {**spec, "error": row["error"], "reference": row["reference"]}, n
         )
     elif lammps and "final" in row:
-        log(f"scaling in space: {row['granules']} spheres, LAMMPS under the same law on {n} process(es) ...")
+        log(f"scaling in space: {row['granules']} spheres, LAMMPS at our step and law on {n} process(es) ...")
         same = {**spec, "dt_s": row["dt_s"], "final": row.pop("final")}
         lm = run_in_subprocess("scaling_space", "_lammps_same_law_worker", same, n)
     row.pop("final", None)
